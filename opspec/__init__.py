@@ -1,0 +1,8 @@
+"""opspec: execute operational specifications (XPDL / SISARL-XPDL) of assistive devices and
+their users, for usability evaluation, walkthroughs, specification tests and hardware in the loop.
+
+Importing ``opspec`` stays light: no lxml, Textual or pyserial is imported here.
+"""
+
+__version__ = "0.1.0"
+__all__ = ["__version__"]

@@ -1,0 +1,252 @@
+"""Activities of every kind, with their events, triggers, deadlines, loops and restrictions.
+
+XPDL 1.0 and 2.x spellings of the same thing arrive here as the same values: ``Tool`` and
+``TaskApplication`` become :class:`TaskApplication`, ``BlockId`` and ``ActivitySetId`` become
+:class:`BlockActivity`, ``AND``/``XOR`` and ``Parallel``/``Exclusive`` become
+:class:`GatewayType` members.
+"""
+
+from __future__ import annotations
+
+import enum
+from dataclasses import dataclass
+
+from opspec.errors import SourceLocation
+from opspec.model.common import Element
+from opspec.model.data import ActualParameter
+from opspec.model.expressions import Expression
+from opspec.model.sisarl import ActivityDirectives, CoordinationBuiltIn
+
+__all__ = [
+    "Activity",
+    "ActivityBody",
+    "BlockActivity",
+    "Deadline",
+    "Event",
+    "EventPosition",
+    "Execution",
+    "GatewayType",
+    "Join",
+    "Loop",
+    "LoopKind",
+    "Mode",
+    "NoImplementation",
+    "Reference",
+    "Route",
+    "Split",
+    "SubFlow",
+    "Task",
+    "TaskApplication",
+    "TaskKind",
+    "Trigger",
+    "TriggerKind",
+]
+
+
+class GatewayType(enum.Enum):
+    XOR = "XOR"              # exclusive, data-based (XPDL 1.0 XOR, 2.x Exclusive)
+    EVENT = "EVENT"          # exclusive, event-based (deferred choice)
+    AND = "AND"              # parallel
+    OR = "OR"                # inclusive
+    COMPLEX = "COMPLEX"
+
+
+class Mode(enum.Enum):
+    """StartMode / FinishMode."""
+
+    AUTOMATIC = "Automatic"
+    MANUAL = "Manual"
+
+
+class Execution(enum.Enum):
+    SYNCHR = "SYNCHR"
+    ASYNCHR = "ASYNCHR"
+
+
+class TaskKind(enum.Enum):
+    APPLICATION = "application"   # XPDL 1.0 Tool / 2.x TaskApplication
+    MANUAL = "manual"
+    USER = "user"
+    SCRIPT = "script"
+    SERVICE = "service"
+    SEND = "send"
+    RECEIVE = "receive"
+    REFERENCE = "reference"
+    BUSINESS_RULE = "business-rule"
+
+
+class TriggerKind(enum.Enum):
+    NONE = "none"
+    MESSAGE = "message"
+    TIMER = "timer"
+    RULE = "rule"                 # 2.0 Rule, 2.1+ Conditional
+    SIGNAL = "signal"
+    LINK = "link"
+    ERROR = "error"
+    ESCALATION = "escalation"
+    COMPENSATION = "compensation"
+    CANCEL = "cancel"
+    TERMINATE = "terminate"
+    MULTIPLE = "multiple"
+    PARALLEL_MULTIPLE = "parallel-multiple"
+
+
+class EventPosition(enum.Enum):
+    START = "start"
+    INTERMEDIATE = "intermediate"
+    END = "end"
+
+
+class LoopKind(enum.Enum):
+    STANDARD = "standard"
+    MULTI_INSTANCE = "multi-instance"
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class Trigger:
+    """What an event waits for or throws.
+
+    ``name`` is the message, signal, link or error name (or code); timers carry
+    ``time_date``/``time_cycle`` as written plus ``duration``, a parsed expression giving seconds
+    when the front end understood it; rules carry ``condition``. ``attached_to`` is the activity
+    a boundary (intermediate) event is attached to; ``interrupting`` tells whether it cancels it.
+    """
+
+    kind: TriggerKind = TriggerKind.NONE
+    name: str | None = None
+    time_date: str | None = None
+    time_cycle: str | None = None
+    duration: Expression | None = None
+    condition: Expression | None = None
+    attached_to: str | None = None
+    interrupting: bool = True
+    catching: bool = True
+
+
+@dataclass(frozen=True, slots=True)
+class ActivityBody:
+    """Base of what an activity *is* (its XPDL implementation or kind)."""
+
+
+@dataclass(frozen=True, slots=True)
+class NoImplementation(ActivityBody):
+    """``Implementation/No``: performed outside the engine (manual work, a device)."""
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class TaskApplication:
+    application: str
+    actual_parameters: tuple[ActualParameter, ...] = ()
+    package_ref: str | None = None
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class Task(ActivityBody):
+    kind: TaskKind
+    applications: tuple[TaskApplication, ...] = ()
+    message: str | None = None
+    script: str | None = None
+    implementation: str | None = None       # WebService / Unspecified / Other, as written
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class SubFlow(ActivityBody):
+    process: str
+    execution: Execution = Execution.SYNCHR
+    actual_parameters: tuple[ActualParameter, ...] = ()
+    package_ref: str | None = None
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class Reference(ActivityBody):
+    """XPDL 2.x ``Reference``: this activity is another activity of the process."""
+
+    activity: str
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class Route(ActivityBody):
+    """A gateway: it only routes; its join/split behaviour is in the activity's restrictions."""
+
+    gateway: GatewayType = GatewayType.XOR
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class BlockActivity(ActivityBody):
+    activity_set: str
+    start_activity: str | None = None
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class Event(ActivityBody):
+    position: EventPosition
+    trigger: Trigger = Trigger()
+    result: str | None = None      # end events: None, Message, Error, Terminate…
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class Deadline:
+    """``Deadline``: when ``duration`` (seconds) elapses, raise ``exception_name``.
+
+    Synchronous deadlines interrupt the activity; asynchronous ones let it run on and start the
+    exception path beside it.
+    """
+
+    duration_text: str
+    duration: Expression | None = None
+    execution: Execution = Execution.SYNCHR
+    exception_name: str | None = None
+    location: SourceLocation | None = None
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class Loop:
+    kind: LoopKind = LoopKind.STANDARD
+    condition: Expression | None = None
+    condition_text: str | None = None
+    maximum: int | None = None
+    test_before: bool = False
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class Join:
+    type: GatewayType = GatewayType.XOR
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class Split:
+    """A split; ``transition_refs`` keeps the declared order (XOR evaluates in this order)."""
+
+    type: GatewayType = GatewayType.XOR
+    transition_refs: tuple[str, ...] = ()
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class Activity(Element):
+    """One node of a process graph. Ids are scoped per process (and per activity set)."""
+
+    body: ActivityBody = NoImplementation()
+    performers: tuple[str, ...] = ()
+    start_mode: Mode = Mode.AUTOMATIC
+    finish_mode: Mode = Mode.AUTOMATIC
+    priority: int | None = None
+    deadlines: tuple[Deadline, ...] = ()
+    loop: Loop | None = None
+    join: Join | None = None
+    split: Split | None = None
+    lane: str | None = None
+    directives: ActivityDirectives = ActivityDirectives()
+    coordination: CoordinationBuiltIn | None = None
+
+    @property
+    def is_route(self) -> bool:
+        return isinstance(self.body, Route)
+
+    @property
+    def is_manual(self) -> bool:
+        """True when the activity waits for its performer instead of running by itself."""
+        if self.directives.auto_run is not None:
+            return not self.directives.auto_run
+        if self.start_mode is Mode.MANUAL:
+            return True
+        return isinstance(self.body, Task) and self.body.kind in (TaskKind.MANUAL, TaskKind.USER)

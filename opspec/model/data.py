@@ -1,0 +1,156 @@
+"""Workflow data: types, type declarations, data fields and parameters (XPDL class A/B)."""
+
+from __future__ import annotations
+
+import enum
+from dataclasses import dataclass
+
+from opspec.errors import SourceLocation
+from opspec.model.common import Element
+from opspec.model.expressions import Expression
+
+__all__ = [
+    "ActualParameter",
+    "ArrayType",
+    "BasicKind",
+    "BasicType",
+    "DataField",
+    "DataType",
+    "DeclaredType",
+    "EnumerationType",
+    "ExternalReferenceType",
+    "FormalParameter",
+    "ListType",
+    "ParameterMode",
+    "RecordMember",
+    "RecordType",
+    "SchemaType",
+    "TypeDeclaration",
+    "UnionType",
+]
+
+
+class BasicKind(enum.Enum):
+    STRING = "STRING"
+    FLOAT = "FLOAT"
+    INTEGER = "INTEGER"
+    REFERENCE = "REFERENCE"
+    DATETIME = "DATETIME"
+    DATE = "DATE"
+    TIME = "TIME"
+    BOOLEAN = "BOOLEAN"
+    PERFORMER = "PERFORMER"
+
+
+@dataclass(frozen=True, slots=True)
+class DataType:
+    """Base of every data type."""
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class BasicType(DataType):
+    kind: BasicKind
+    length: int | None = None
+    precision: int | None = None
+    scale: int | None = None
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class DeclaredType(DataType):
+    """Reference to a package :class:`TypeDeclaration` by id."""
+
+    ref: str
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class SchemaType(DataType):
+    """An inline XML schema, kept as raw XML text."""
+
+    raw_xml: str = ""
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class ExternalReferenceType(DataType):
+    location: str
+    xref: str | None = None
+    namespace: str | None = None
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class RecordMember:
+    name: str
+    type: DataType
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class RecordType(DataType):
+    members: tuple[RecordMember, ...] = ()
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class UnionType(DataType):
+    members: tuple[RecordMember, ...] = ()
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class EnumerationType(DataType):
+    values: tuple[str, ...] = ()
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class ArrayType(DataType):
+    element: DataType
+    lower: int | None = None
+    upper: int | None = None
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class ListType(DataType):
+    element: DataType
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class TypeDeclaration(Element):
+    type: DataType
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class DataField(Element):
+    """A package-wide or workflow-wide variable.
+
+    ``initial_value`` is the text as written; ``initial`` is its typed value (parsed by the front
+    end according to ``type``) or ``None`` when there is none or it could not be typed.
+    """
+
+    type: DataType
+    initial_value: str | None = None
+    initial: str | int | float | bool | None = None
+    is_array: bool = False
+    correlation: bool = False
+    read_only: bool = False
+
+
+class ParameterMode(enum.Enum):
+    IN = "IN"
+    OUT = "OUT"
+    INOUT = "INOUT"
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class FormalParameter(Element):
+    type: DataType
+    mode: ParameterMode = ParameterMode.IN
+    is_array: bool = False
+    required: bool = False
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class ActualParameter:
+    """An actual parameter: the text as written and, when it parses, its expression.
+
+    In XPDL 1.0 this is usually a bare data field id; in 2.x an expression.
+    """
+
+    text: str
+    expression: Expression | None = None
+    location: SourceLocation | None = None

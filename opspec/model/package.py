@@ -1,0 +1,83 @@
+"""The package: the root of a specification, and the XPDL versions opspec reads."""
+
+from __future__ import annotations
+
+import enum
+from dataclasses import dataclass
+
+from opspec.model.common import Element
+from opspec.model.data import DataField, TypeDeclaration
+from opspec.model.process import WorkflowProcess
+from opspec.model.resources import Application, Participant, Pool
+from opspec.model.sisarl import MetricDefinition, Mode
+
+__all__ = ["ExternalPackage", "Package", "PackageHeader", "XpdlVersion"]
+
+
+class XpdlVersion(enum.Enum):
+    """The XPDL version, taken from the root element's namespace (never from XPDLVersion)."""
+
+    V1_0 = "1.0"
+    V2_0 = "2.0"
+    V2_1 = "2.1"
+    V2_2 = "2.2"
+    NONE = "none"      # no namespace: read with 2.x element names
+
+    @property
+    def is_1_0(self) -> bool:
+        return self is XpdlVersion.V1_0
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class PackageHeader:
+    xpdl_version: str | None = None
+    vendor: str | None = None
+    created: str | None = None
+    modified: str | None = None
+    description: str | None = None
+    documentation: str | None = None
+    cost_unit: str | None = None
+    priority_unit: str | None = None
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class ExternalPackage(Element):
+    """``ExternalPackage``: ``href`` as written; resolution happens in the front end."""
+
+    href: str = ""
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class Package(Element):
+    version: XpdlVersion = XpdlVersion.V2_1
+    source: str | None = None
+    header: PackageHeader = PackageHeader()
+    conformance_class: str | None = None       # NON_BLOCKED / LOOP_BLOCKED / FULL_BLOCKED
+    script_language: str | None = None
+    type_declarations: tuple[TypeDeclaration, ...] = ()
+    participants: tuple[Participant, ...] = ()
+    applications: tuple[Application, ...] = ()
+    data_fields: tuple[DataField, ...] = ()
+    pools: tuple[Pool, ...] = ()
+    processes: tuple[WorkflowProcess, ...] = ()
+    external_packages: tuple[ExternalPackage, ...] = ()
+    metrics: tuple[MetricDefinition, ...] = ()
+    modes: tuple[Mode, ...] = ()
+
+    def process(self, process_id: str) -> WorkflowProcess | None:
+        for process in self.processes:
+            if process.id == process_id:
+                return process
+        return None
+
+    def participant(self, participant_id: str) -> Participant | None:
+        for participant in self.participants:
+            if participant.id == participant_id:
+                return participant
+        return None
+
+    def application(self, application_id: str) -> Application | None:
+        for application in self.applications:
+            if application.id == application_id:
+                return application
+        return None

@@ -1,0 +1,113 @@
+"""Workflow processes, activity sets and transitions."""
+
+from __future__ import annotations
+
+import enum
+from dataclasses import dataclass
+
+from opspec.model.activities import Activity
+from opspec.model.common import Element
+from opspec.model.data import DataField, FormalParameter
+
+from opspec.model.resources import Application, Participant
+from opspec.model.sisarl import ProcessDirectives
+
+__all__ = [
+    "ActivitySet",
+    "Condition",
+    "ConditionKind",
+    "ProcessHeader",
+    "Transition",
+    "WorkflowProcess",
+]
+
+
+class ConditionKind(enum.Enum):
+    NONE = "NONE"                       # unconditional
+    CONDITION = "CONDITION"
+    OTHERWISE = "OTHERWISE"
+    EXCEPTION = "EXCEPTION"
+    DEFAULTEXCEPTION = "DEFAULTEXCEPTION"
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class Condition:
+    """A transition condition. ``text`` is what the file said; ``expression`` its parse (for
+    CONDITION). For EXCEPTION, ``exception_name`` names the exception it catches (from the
+    condition text), ``None`` meaning any."""
+
+    kind: ConditionKind = ConditionKind.NONE
+    text: str | None = None
+    expression: Expression | None = None
+    exception_name: str | None = None
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class Transition(Element):
+    source: str
+    target: str
+    condition: Condition = Condition()
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class ActivitySet(Element):
+    activities: tuple[Activity, ...] = ()
+    transitions: tuple[Transition, ...] = ()
+    ad_hoc: bool = False
+
+    def activity(self, activity_id: str) -> Activity | None:
+        for activity in self.activities:
+            if activity.id == activity_id:
+                return activity
+        return None
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class ProcessHeader:
+    created: str | None = None
+    description: str | None = None
+    priority: str | None = None
+    limit: str | None = None
+    valid_from: str | None = None
+    valid_to: str | None = None
+    duration: str | None = None
+    duration_unit: str | None = None
+    waiting_time: str | None = None
+    working_time: str | None = None
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class WorkflowProcess(Element):
+    header: ProcessHeader = ProcessHeader()
+    access_level: str | None = None
+    data_fields: tuple[DataField, ...] = ()
+    formal_parameters: tuple[FormalParameter, ...] = ()
+    participants: tuple[Participant, ...] = ()
+    applications: tuple[Application, ...] = ()
+    activities: tuple[Activity, ...] = ()
+    transitions: tuple[Transition, ...] = ()
+    activity_sets: tuple[ActivitySet, ...] = ()
+    directives: ProcessDirectives = ProcessDirectives()
+    priority: int | None = None
+
+    def activity(self, activity_id: str) -> Activity | None:
+        """The top-level activity with this id (activity-set members are not searched)."""
+        for activity in self.activities:
+            if activity.id == activity_id:
+                return activity
+        return None
+
+    def activity_set(self, set_id: str) -> ActivitySet | None:
+        for activity_set in self.activity_sets:
+            if activity_set.id == set_id:
+                return activity_set
+        return None
+
+    def all_activities(self) -> tuple[Activity, ...]:
+        """Top-level activities followed by those of every activity set."""
+        out = list(self.activities)
+        for activity_set in self.activity_sets:
+            out.extend(activity_set.activities)
+        return tuple(out)
+
+
