@@ -32,6 +32,7 @@ from opspec.model.common import Element, ExtendedAttribute, find_extended
 from opspec.model.data import (
     ActualParameter,
     ArrayType,
+    Assignment,
     BasicKind,
     BasicType,
     DataField,
@@ -74,7 +75,7 @@ from opspec.model.sisarl import Mode as WorkflowMode
 
 __all__ = [
     "Activity", "ActivityBody", "ActivityDirectives", "ActivitySet", "ActualParameter",
-    "Application", "ArrayType", "BasicKind", "BasicType", "Binary", "BlockActivity", "Call",
+    "Application", "ArrayType", "Assignment", "BasicKind", "BasicType", "Binary", "BlockActivity", "Call",
     "Condition", "ConditionKind", "CoordinationBuiltIn", "CoordinationKind", "DataField",
     "DataType", "Deadline", "DeclaredType", "Distribution", "Element", "EnumerationType",
     "Event", "EventPosition", "EventSelector", "Execution", "Expression", "ExtendedAttribute",

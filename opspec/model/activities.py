@@ -13,7 +13,7 @@ from dataclasses import dataclass
 
 from opspec.errors import SourceLocation
 from opspec.model.common import Element
-from opspec.model.data import ActualParameter
+from opspec.model.data import ActualParameter, Assignment
 from opspec.model.expressions import Expression
 from opspec.model.sisarl import ActivityDirectives, CoordinationBuiltIn
 
@@ -237,6 +237,7 @@ class Activity(Element):
     lane: str | None = None
     directives: ActivityDirectives = ActivityDirectives()
     coordination: CoordinationBuiltIn | None = None
+    assignments: tuple[Assignment, ...] = ()
 
     @property
     def is_route(self) -> bool:

@@ -12,6 +12,7 @@ from opspec.model.expressions import Expression
 __all__ = [
     "ActualParameter",
     "ArrayType",
+    "Assignment",
     "BasicKind",
     "BasicType",
     "DataField",
@@ -153,4 +154,16 @@ class ActualParameter:
 
     text: str
     expression: Expression | None = None
+    location: SourceLocation | None = None
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class Assignment:
+    """XPDL 2.1 ``Assignment``: set data field ``target`` to ``expression`` at the activity's
+    ``Start`` or ``End`` (``assign_time``), or when a transition is taken."""
+
+    target: str
+    text: str
+    expression: Expression | None = None
+    assign_time: str = "End"
     location: SourceLocation | None = None

@@ -7,7 +7,7 @@ from dataclasses import dataclass
 
 from opspec.model.activities import Activity
 from opspec.model.common import Element
-from opspec.model.data import DataField, FormalParameter
+from opspec.model.data import Assignment, DataField, FormalParameter
 
 from opspec.model.resources import Application, Participant
 from opspec.model.sisarl import ProcessDirectives
@@ -47,6 +47,7 @@ class Transition(Element):
     source: str
     target: str
     condition: Condition = Condition()
+    assignments: tuple[Assignment, ...] = ()
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
@@ -89,6 +90,7 @@ class WorkflowProcess(Element):
     activity_sets: tuple[ActivitySet, ...] = ()
     directives: ProcessDirectives = ProcessDirectives()
     priority: int | None = None
+    assignments: tuple[Assignment, ...] = ()
 
     def activity(self, activity_id: str) -> Activity | None:
         """The top-level activity with this id (activity-set members are not searched)."""
