@@ -1,0 +1,1 @@
+"""One module per ``opspec`` subcommand; each exposes ``register(subparsers)``."""

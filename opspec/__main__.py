@@ -1,0 +1,5 @@
+import sys
+
+from opspec.cli import main
+
+sys.exit(main())
