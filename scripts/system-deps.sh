@@ -1,0 +1,18 @@
+#!/usr/bin/env bash
+# System packages some tests drive for real (tmux for the terminal walkthrough test). Installed
+# only when missing and only when we may (root or passwordless sudo); tests that need a missing
+# tool skip with a message naming this script.
+set -uo pipefail
+need=()
+command -v tmux >/dev/null 2>&1 || need+=(tmux)
+[ ${#need[@]} -eq 0 ] && exit 0
+if [ "$(id -u)" -eq 0 ]; then sudo=""; elif sudo -n true 2>/dev/null; then sudo="sudo -n"; else
+  echo "system-deps: missing ${need[*]} and no root: the tests that need them will be skipped" >&2
+  exit 0
+fi
+if command -v apt-get >/dev/null 2>&1; then
+  $sudo apt-get update -qq >/dev/null 2>&1 || true
+  DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y -qq "${need[@]}" >/dev/null 2>&1 \
+    || echo "system-deps: could not install ${need[*]}: the tests that need them will be skipped" >&2
+fi
+exit 0
