@@ -8,7 +8,7 @@ from dataclasses import dataclass
 from opspec.model.activities import Activity
 from opspec.model.common import Element
 from opspec.model.data import Assignment, DataField, FormalParameter
-
+from opspec.model.expressions import Expression
 from opspec.model.resources import Application, Participant
 from opspec.model.sisarl import ProcessDirectives
 
