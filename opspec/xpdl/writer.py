@@ -1,0 +1,908 @@
+"""Model -> standard XPDL 2.1 XML.
+
+:func:`write_xpdl` writes every model element back as XPDL 2.1
+(``http://www.wfmc.org/2008/XPDL2.1``), children in the order the official schema
+(``bpmnxpdl_31.xsd``) requires, so that the output of a schema-valid input validates again.
+
+- Extended attributes are written verbatim (``Value``, text and raw child XML).
+- SISARL-XPDL directives (:mod:`opspec.model.sisarl`) are written as ``ExtendedAttribute``
+  elements named ``opspec:…`` (``docs/sisarl-xpdl.md``), except where a verbatim extended
+  attribute of the same name is already there (the reader may keep those), so nothing is
+  written twice.
+- Conditions, assignments and parameters are written from their original text when the model
+  has it, else printed from the expression tree (:func:`expression_text`).
+
+Known losses (the model does not keep them, or XPDL 2.1 has no place for them): graphics,
+application types other than Script/Xslt/Form, ``business-rule`` tasks (written as
+``TaskService``), the ``interrupting`` flag of boundary events, source lines.
+"""
+
+from __future__ import annotations
+
+import math
+import re
+from collections.abc import Iterable
+from decimal import Decimal
+from xml.sax.saxutils import quoteattr
+
+from lxml import etree
+
+from opspec.model import (
+    Activity,
+    ActivityDirectives,
+    ActivitySet,
+    ActualParameter,
+    Application,
+    ArrayType,
+    Assignment,
+    BasicType,
+    Binary,
+    BlockActivity,
+    Call,
+    Condition,
+    ConditionKind,
+    CoordinationBuiltIn,
+    CoordinationKind,
+    DataField,
+    DataType,
+    DeclaredType,
+    Distribution,
+    EnumerationType,
+    Event,
+    EventPosition,
+    EventSelector,
+    Expression,
+    ExtendedAttribute,
+    ExternalReferenceType,
+    FormalParameter,
+    GatewayType,
+    Lane,
+    ListType,
+    Literal,
+    MetricDefinition,
+    MetricKind,
+    Name,
+    NoImplementation,
+    Package,
+    Participant,
+    Pool,
+    ProcessDirectives,
+    RecordType,
+    Reference,
+    Route,
+    SchemaType,
+    SubFlow,
+    Task,
+    TaskKind,
+    Transition,
+    Trigger,
+    TriggerKind,
+    TriggerRef,
+    TypeDeclaration,
+    Unary,
+    UnionType,
+    WorkflowMode,
+    WorkflowProcess,
+)
+
+__all__ = [
+    "XPDL21",
+    "distribution_text",
+    "duration_text",
+    "expression_text",
+    "trigger_text",
+    "write_xpdl",
+]
+
+XPDL21 = "http://www.wfmc.org/2008/XPDL2.1"
+XPDL10 = "http://www.wfmc.org/2002/XPDL1.0"
+OPSPEC = "urn:opspec:sisarl:1"
+_NSMAP = {None: XPDL21, "opspec": OPSPEC}
+
+_Element = etree._Element
+
+
+def _q(local: str) -> str:
+    return f"{{{XPDL21}}}{local}"
+
+
+def _sub(parent: _Element, local: str, text: str | None = None, **attrs: str | None) -> _Element:
+    element = etree.SubElement(parent, _q(local))
+    for key, value in attrs.items():
+        if value is not None:
+            element.set(key, value)
+    if text is not None:
+        element.text = text
+    return element
+
+
+def _bool(value: bool) -> str:
+    return "true" if value else "false"
+
+
+# --------------------------------------------------------------------------- text forms
+
+
+_PRECEDENCE = {"or": 1, "and": 2, "==": 3, "!=": 3, "<": 4, "<=": 4, ">": 4, ">=": 4,
+               "+": 5, "-": 5, "*": 6, "/": 6, "%": 6}
+_SPELLING = {"and": "&&", "or": "||"}
+
+
+def _literal_text(value: str | int | float | bool | None) -> str:
+    if value is None:
+        return "null"
+    if isinstance(value, bool):
+        return "true" if value else "false"
+    if isinstance(value, str):
+        escaped = value.replace("\\", "\\\\").replace('"', '\\"').replace("\n", "\\n")
+        return f'"{escaped}"'
+    return repr(value)
+
+
+def expression_text(expression: Expression, parent: int = 0) -> str:
+    """JavaScript-style text of an expression tree (``n < 3 && !done``), parenthesised only
+    where precedence requires; the condition parser reads it back to the same tree."""
+    if isinstance(expression, Literal):
+        return _literal_text(expression.value)
+    if isinstance(expression, Name):
+        return ".".join(expression.path)
+    if isinstance(expression, Call):
+        return f"{expression.function}({', '.join(expression_text(a) for a in expression.args)})"
+    if isinstance(expression, Unary):
+        symbol = "!" if expression.op == "not" else "-"
+        return f"{symbol}{expression_text(expression.operand, 7)}"
+    if isinstance(expression, Binary):
+        mine = _PRECEDENCE.get(expression.op, 0)
+        # Left-associative: the right operand needs parentheses at equal precedence.
+        text = (
+            f"{expression_text(expression.left, mine)} "
+            f"{_SPELLING.get(expression.op, expression.op)} "
+            f"{expression_text(expression.right, mine + 1)}"
+        )
+        return f"({text})" if mine < parent else text
+    raise TypeError(f"cannot write expression node {expression!r}")
+
+
+def duration_text(seconds: float) -> str:
+    """ISO 8601 duration in seconds (``PT0.1S``, ``PT300S``) that parses back to ``seconds``."""
+    if math.isinf(seconds) or math.isnan(seconds):
+        raise ValueError(f"cannot write a duration of {seconds} seconds")
+    if float(seconds).is_integer():
+        return f"PT{int(seconds)}S"
+    return f"PT{Decimal(repr(float(seconds))):f}S"
+
+
+def _number_text(value: float) -> str:
+    if float(value).is_integer() and abs(value) < 2**53:
+        return str(int(value))
+    return f"{Decimal(repr(float(value))):f}"
+
+
+def _time_of_day(seconds: float) -> str:
+    whole = int(seconds)
+    hours, rest = divmod(whole, 3600)
+    minutes, secs = divmod(rest, 60)
+    text = f"{hours:02d}:{minutes:02d}"
+    if secs or seconds != whole:
+        text += f":{secs:02d}" if seconds == whole else f":{secs + seconds - whole:06.3f}"
+    return text
+
+
+def trigger_text(trigger: TriggerRef) -> str:
+    """The SISARL trigger syntax of ``trigger`` (``message:trg_1``, ``timer:08:00 every P1D``,
+    ``period:PT0.1S offset PT1S``, ``rule:n > 3``)."""
+    kind = trigger.kind
+    if kind == "none":
+        return "none"
+    if kind in ("message", "signal"):
+        return f"{kind}:{trigger.name or ''}"
+    if kind == "rule":
+        condition = expression_text(trigger.condition) if trigger.condition else "true"
+        return f"rule:{condition}"
+    if kind == "period":
+        text = f"period:{duration_text(trigger.every or 0.0)}"
+        if trigger.offset:
+            text += f" offset {duration_text(trigger.offset)}"
+        return text
+    if kind == "timer":
+        if trigger.at:
+            text = "timer:" + ",".join(_time_of_day(t) for t in trigger.at)
+            if trigger.every is not None:
+                text += f" every {duration_text(trigger.every)}"
+            return text
+        return f"timer:after {duration_text(trigger.offset)}"
+    return f"{kind}:{trigger.name or ''}"
+
+
+def distribution_text(distribution: Distribution) -> str:
+    """``Name(key=value, …)`` (BPSim names where BPSim has them)."""
+    parameters = ", ".join(f"{k}={_number_text(v)}" for k, v in distribution.parameters)
+    return f"{distribution.kind}({parameters})"
+
+
+# --------------------------------------------------------------------------- extended attributes
+
+
+_FRAGMENT_PARSER = etree.XMLParser(resolve_entities=False, no_network=True, load_dtd=False)
+
+
+def _append_raw_xml(element: _Element, raw_xml: str) -> None:
+    """Put the verbatim child XML of an extended attribute back under ``element``."""
+    wrapper = f'<w xmlns:opspec="{OPSPEC}">{raw_xml}</w>'
+    try:
+        parsed = etree.fromstring(wrapper.encode("utf-8"), _FRAGMENT_PARSER)
+    except etree.XMLSyntaxError:
+        # Not well-formed on its own (it always was in the source): keep it as text.
+        element.text = (element.text or "") + raw_xml
+        return
+    if parsed.text and parsed.text.strip():
+        element.text = (element.text or "") + parsed.text
+    for child in list(parsed):
+        element.append(child)
+
+
+def _write_extended(parent: _Element, attributes: Iterable[ExtendedAttribute]) -> None:
+    attributes = list(attributes)
+    if not attributes:
+        return
+    container = _sub(parent, "ExtendedAttributes")
+    for attribute in attributes:
+        element = _sub(container, "ExtendedAttribute", Name=attribute.name, Value=attribute.value)
+        if attribute.text is not None:
+            element.text = attribute.text
+        if attribute.raw_xml:
+            _append_raw_xml(element, attribute.raw_xml)
+
+
+def _merged(
+    verbatim: tuple[ExtendedAttribute, ...], generated: list[ExtendedAttribute]
+) -> list[ExtendedAttribute]:
+    present = {attribute.name for attribute in verbatim}
+    return list(verbatim) + [a for a in generated if a.name not in present]
+
+
+def _ea(name: str, value: str | None = None, raw_xml: str | None = None) -> ExtendedAttribute:
+    return ExtendedAttribute(name=f"opspec:{name}", value=value, raw_xml=raw_xml)
+
+
+def _attr_xml(local: str, attributes: dict[str, str | None], children: str = "") -> str:
+    """``<opspec:local a="…">children</opspec:local>`` (the prefix is declared by the caller)."""
+    attrs = "".join(f" {k}={quoteattr(v)}" for k, v in attributes.items() if v is not None)
+    if not children:
+        return f"<opspec:{local}{attrs}/>"
+    return f"<opspec:{local}{attrs}>{children}</opspec:{local}>"
+
+
+def process_directive_attributes(directives: ProcessDirectives) -> list[ExtendedAttribute]:
+    """The ``opspec:`` extended attributes that state ``directives`` (defaults left out)."""
+    out: list[ExtendedAttribute] = []
+    if directives.period is not None:
+        out.append(_ea("Period", duration_text(directives.period)))
+    if directives.priority is not None:
+        out.append(_ea("Priority", str(directives.priority)))
+    if directives.deadline is not None:
+        out.append(_ea("Deadline", duration_text(directives.deadline)))
+    if directives.start_trigger is not None:
+        out.append(_ea("StartTrigger", trigger_text(directives.start_trigger)))
+    if directives.end_trigger is not None:
+        out.append(_ea("EndTrigger", trigger_text(directives.end_trigger)))
+    if directives.auto_start is not None:
+        out.append(_ea("AutoStart", _bool(directives.auto_start)))
+    if directives.lane is not None:
+        out.append(_ea("Lane", directives.lane))
+    if directives.mode is not None:
+        out.append(_ea("Mode", directives.mode))
+    return out
+
+
+def activity_directive_attributes(directives: ActivityDirectives) -> list[ExtendedAttribute]:
+    """The ``opspec:`` extended attributes that state activity ``directives``."""
+    out: list[ExtendedAttribute] = []
+    if directives.auto_run is not None:
+        out.append(_ea("AutoRun", _bool(directives.auto_run)))
+    if directives.priority_increment:
+        out.append(_ea("PriorityIncrement", str(directives.priority_increment)))
+    if directives.start_trigger is not None:
+        out.append(_ea("StartTrigger", trigger_text(directives.start_trigger)))
+    if directives.end_trigger is not None:
+        out.append(_ea("EndTrigger", trigger_text(directives.end_trigger)))
+    if directives.raises is not None:
+        out.append(_ea("Raises", trigger_text(directives.raises)))
+    if directives.cpu_demand is not None:
+        out.append(_ea("CpuDemand", duration_text(directives.cpu_demand)))
+    if directives.duration is not None:
+        out.append(_ea("Duration", distribution_text(directives.duration)))
+    return out
+
+
+def builtin_attribute(builtin: CoordinationBuiltIn) -> ExtendedAttribute:
+    """``opspec:BuiltIn`` with the built-in's element, as ``docs/sisarl-xpdl.md`` writes it."""
+    kind = builtin.kind
+    if kind is CoordinationKind.PUSH_DATA or kind is CoordinationKind.PULL_DATA:
+        local = "PushData" if kind is CoordinationKind.PUSH_DATA else "PullData"
+        ref = builtin.inputs[0] if kind is CoordinationKind.PUSH_DATA and builtin.inputs \
+            else builtin.output
+        return _ea("BuiltIn", raw_xml=_attr_xml(local, {"Channel": builtin.channel, "Ref": ref}))
+    if kind is CoordinationKind.MODE_CHANGE:
+        return _ea("BuiltIn", raw_xml=_attr_xml("ModeChange", {"To": builtin.target_mode}))
+    local = {CoordinationKind.ARBITER: "Arbiter", CoordinationKind.VOTER: "Voter",
+             CoordinationKind.SUPERPOSITION: "Superposition"}[kind]
+    attributes: dict[str, str | None] = {"Output": builtin.output}
+    if builtin.options:
+        attributes["Options"] = " ".join(builtin.options)
+    inputs = []
+    for index, ref in enumerate(builtin.inputs):
+        weight = builtin.weights[index] if index < len(builtin.weights) else None
+        inputs.append(_attr_xml("Input", {
+            "Ref": ref, "Weight": None if weight is None else _number_text(weight)}))
+    return _ea("BuiltIn", raw_xml=_attr_xml(local, attributes, "".join(inputs)))
+
+
+def _selector_xml(local: str, selector: EventSelector, name: str | None = None) -> str:
+    return _attr_xml(local, {
+        "Name": name, "Event": selector.event, "Process": selector.process,
+        "Activity": selector.activity,
+        "Which": selector.which if selector.which != "first" or local == "From" else None,
+    })
+
+
+def _metric_xml(metric: MetricDefinition) -> str:
+    if metric.kind is MetricKind.COUNT and metric.select is not None:
+        base = {"Name": metric.name, "Event": metric.select.event,
+                "Process": metric.select.process, "Activity": metric.select.activity}
+        return _attr_xml("Count", {**base, "Unit": metric.unit,
+                                   "Description": metric.description})
+    if metric.kind is MetricKind.DURATION:
+        children = ""
+        if metric.start is not None:
+            children += _selector_xml("From", metric.start)
+        if metric.end is not None:
+            children += _selector_xml("To", metric.end)
+        return _attr_xml("Duration", {"Name": metric.name, "Unit": metric.unit,
+                                      "Description": metric.description}, children)
+    return _attr_xml("Ratio", {"Name": metric.name, "Numerator": metric.numerator,
+                               "Denominator": metric.denominator, "Unit": metric.unit,
+                               "Description": metric.description})
+
+
+def _mode_xml(mode: WorkflowMode) -> str:
+    return _attr_xml("Mode", {
+        "Id": mode.id, "Initial": "true" if mode.initial else None,
+        "Workflows": " ".join(mode.workflows), "Source": mode.source})
+
+
+def package_directive_attributes(package: Package) -> list[ExtendedAttribute]:
+    out: list[ExtendedAttribute] = []
+    if package.metrics:
+        out.append(_ea("Metrics", raw_xml="".join(_metric_xml(m) for m in package.metrics)))
+    if package.modes:
+        out.append(_ea("Modes", raw_xml="".join(_mode_xml(m) for m in package.modes)))
+    return out
+
+
+# --------------------------------------------------------------------------- data
+
+
+def _write_data_type(parent: _Element, data_type: DataType) -> None:
+    if isinstance(data_type, BasicType):
+        basic = _sub(parent, "BasicType", Type=data_type.kind.value)
+        for local, value in (("Length", data_type.length), ("Precision", data_type.precision),
+                             ("Scale", data_type.scale)):
+            if value is not None:
+                _sub(basic, local, str(value))
+    elif isinstance(data_type, DeclaredType):
+        _sub(parent, "DeclaredType", Id=data_type.ref)
+    elif isinstance(data_type, SchemaType):
+        schema = _sub(parent, "SchemaType")
+        if data_type.raw_xml:
+            _append_raw_xml(schema, data_type.raw_xml)
+    elif isinstance(data_type, ExternalReferenceType):
+        _sub(parent, "ExternalReference", location=data_type.location, xref=data_type.xref,
+             namespace=data_type.namespace)
+    elif isinstance(data_type, (RecordType, UnionType)):
+        record = _sub(parent, "RecordType" if isinstance(data_type, RecordType) else "UnionType")
+        for index, member in enumerate(data_type.members, start=1):
+            # XPDL 2.1 Members have no Name (the reader numbers them member1, member2…);
+            # a real name is kept as the Name attribute some editors write.
+            element = _sub(record, "Member")
+            if member.name != f"member{index}":
+                element.set("Name", member.name)
+            _write_data_type(element, member.type)
+    elif isinstance(data_type, EnumerationType):
+        enumeration = _sub(parent, "EnumerationType")
+        for value in data_type.values:
+            _sub(enumeration, "EnumerationValue", Name=value)
+    elif isinstance(data_type, ArrayType):
+        array = _sub(parent, "ArrayType", LowerIndex=str(data_type.lower or 0),
+                     UpperIndex=str(data_type.upper if data_type.upper is not None else 0))
+        _write_data_type(array, data_type.element)
+    elif isinstance(data_type, ListType):
+        _write_data_type(_sub(parent, "ListType"), data_type.element)
+    else:
+        raise TypeError(f"cannot write data type {data_type!r}")
+
+
+def _write_data_fields(parent: _Element, fields: tuple[DataField, ...]) -> None:
+    if not fields:
+        return
+    container = _sub(parent, "DataFields")
+    for field in fields:
+        element = _sub(container, "DataField", Id=field.id, Name=field.name,
+                       ReadOnly=_bool(True) if field.read_only else None,
+                       IsArray=_bool(True) if field.is_array else None,
+                       Correlation=_bool(True) if field.correlation else None)
+        _write_data_type(_sub(element, "DataType"), field.type)
+        if field.initial_value is not None:
+            _sub(element, "InitialValue", field.initial_value)
+        elif field.initial is not None:
+            _sub(element, "InitialValue", _literal_text(field.initial))
+        if field.description is not None:
+            _sub(element, "Description", field.description)
+        _write_extended(element, field.extended_attributes)
+
+
+def _write_formal_parameters(parent: _Element, parameters: tuple[FormalParameter, ...]) -> None:
+    if not parameters:
+        return
+    container = _sub(parent, "FormalParameters")
+    for parameter in parameters:
+        element = _sub(container, "FormalParameter", Id=parameter.id, Mode=parameter.mode.value,
+                       Name=parameter.name,
+                       Required=_bool(True) if parameter.required else None,
+                       IsArray=_bool(True) if parameter.is_array else None)
+        _write_data_type(_sub(element, "DataType"), parameter.type)
+        if parameter.description is not None:
+            _sub(element, "Description", parameter.description)
+
+
+def _write_actual_parameters(parent: _Element, parameters: tuple[ActualParameter, ...]) -> None:
+    if not parameters:
+        return
+    container = _sub(parent, "ActualParameters")
+    for parameter in parameters:
+        text = parameter.text
+        if not text and parameter.expression is not None:
+            text = expression_text(parameter.expression)
+        _sub(container, "ActualParameter", text)
+
+
+def _write_assignments(parent: _Element, assignments: tuple[Assignment, ...]) -> None:
+    if not assignments:
+        return
+    container = _sub(parent, "Assignments")
+    for assignment in assignments:
+        element = _sub(container, "Assignment", AssignTime=assignment.assign_time)
+        _sub(element, "Target", assignment.target)
+        text = assignment.text
+        if not text and assignment.expression is not None:
+            text = expression_text(assignment.expression)
+        _sub(element, "Expression", text)
+
+
+# --------------------------------------------------------------------------- resources
+
+
+def _write_participants(parent: _Element, participants: tuple[Participant, ...]) -> None:
+    if not participants:
+        return
+    container = _sub(parent, "Participants")
+    for participant in participants:
+        element = _sub(container, "Participant", Id=participant.id, Name=participant.name)
+        _sub(element, "ParticipantType", Type=participant.type.value)
+        if participant.description is not None:
+            _sub(element, "Description", participant.description)
+        _write_extended(element, participant.extended_attributes)
+
+
+_APPLICATION_TYPES = {"Script", "Xslt", "Form"}  # the XPDL 2.1 types with no required content
+
+
+def _write_applications(parent: _Element, applications: tuple[Application, ...]) -> None:
+    if not applications:
+        return
+    container = _sub(parent, "Applications")
+    for application in applications:
+        element = _sub(container, "Application", Id=application.id, Name=application.name)
+        if application.description is not None:
+            _sub(element, "Description", application.description)
+        if application.kind in _APPLICATION_TYPES:
+            _sub(_sub(element, "Type"), application.kind)
+        _write_formal_parameters(element, application.formal_parameters)
+        if not application.formal_parameters:
+            _sub(element, "FormalParameters")
+        _write_extended(element, application.extended_attributes)
+
+
+def _flatten_lanes(lanes: tuple[Lane, ...]) -> list[Lane]:
+    out: list[Lane] = []
+    for lane in lanes:
+        out.append(lane)
+        out.extend(_flatten_lanes(lane.lanes))
+    return out
+
+
+def _write_pools(parent: _Element, pools: tuple[Pool, ...]) -> None:
+    if not pools:
+        return
+    container = _sub(parent, "Pools")
+    for pool in pools:
+        element = _sub(container, "Pool", Id=pool.id, Name=pool.name, Process=pool.process,
+                       Participant=pool.participant, BoundaryVisible=_bool(pool.boundary_visible))
+        if pool.lanes:
+            lanes = _sub(element, "Lanes")
+            # XPDL 2.1 lanes are flat; nesting is stated by NestedLane references.
+            for lane in _flatten_lanes(pool.lanes):
+                lane_element = _sub(lanes, "Lane", Id=lane.id, Name=lane.name,
+                                    ParentPool=lane.parent_pool)
+                if lane.performers:
+                    performers = _sub(lane_element, "Performers")
+                    for performer in lane.performers:
+                        _sub(performers, "Performer", performer)
+                for nested in lane.lanes:
+                    _sub(lane_element, "NestedLane", LaneId=nested.id)
+
+
+# --------------------------------------------------------------------------- activities
+
+
+_GATEWAY = {GatewayType.XOR: "Exclusive", GatewayType.EVENT: "Exclusive",
+            GatewayType.AND: "Parallel", GatewayType.OR: "Inclusive",
+            GatewayType.COMPLEX: "Complex"}
+
+_TRIGGER_NAMES = {
+    TriggerKind.NONE: "None", TriggerKind.MESSAGE: "Message", TriggerKind.TIMER: "Timer",
+    TriggerKind.RULE: "Conditional", TriggerKind.SIGNAL: "Signal", TriggerKind.LINK: "Link",
+    TriggerKind.ERROR: "Error", TriggerKind.COMPENSATION: "Compensation",
+    TriggerKind.CANCEL: "Cancel", TriggerKind.TERMINATE: "Terminate",
+    TriggerKind.MULTIPLE: "Multiple", TriggerKind.PARALLEL_MULTIPLE: "Multiple",
+    TriggerKind.ESCALATION: "None",   # XPDL 2.1 has no escalation events
+}
+_START_TRIGGERS = {"None", "Message", "Timer", "Conditional", "Signal", "Multiple"}
+_INTERMEDIATE_TRIGGERS = {"None", "Message", "Timer", "Error", "Cancel", "Conditional", "Link",
+                          "Signal", "Compensation", "Multiple"}
+_END_RESULTS = {"None", "Message", "Error", "Cancel", "Compensation", "Signal", "Terminate",
+                "Multiple"}
+_NMTOKEN_BAD = re.compile(r"[^\w.:-]")
+
+
+def _nmtoken(text: str) -> str:
+    return _NMTOKEN_BAD.sub("_", text) or "_"
+
+
+def _write_trigger_detail(parent: _Element, trigger: Trigger, name: str) -> None:
+    """The trigger's child element (message, timer, condition…), when it has one."""
+    kind = trigger.kind
+    catch_throw = "CATCH" if trigger.catching else "THROW"
+    if kind is TriggerKind.MESSAGE:
+        element = _sub(parent, "TriggerResultMessage", CatchThrow=catch_throw)
+        if trigger.name is not None:
+            _sub(element, "Message", Id=_nmtoken(trigger.name), Name=trigger.name)
+    elif kind is TriggerKind.TIMER and name == "Timer":
+        element = _sub(parent, "TriggerTimer")
+        if trigger.time_date is not None:
+            _sub(element, "TimeDate", trigger.time_date)
+        else:
+            cycle = trigger.time_cycle
+            if cycle is None and isinstance(trigger.duration, Literal) and isinstance(
+                trigger.duration.value, (int, float)) and not isinstance(
+                    trigger.duration.value, bool):
+                cycle = duration_text(float(trigger.duration.value))
+            _sub(element, "TimeCycle", cycle or "")
+    elif kind is TriggerKind.RULE and name == "Conditional":
+        element = _sub(parent, "TriggerConditional", ConditionName=trigger.name)
+        if trigger.condition is not None:
+            _sub(element, "Expression", expression_text(trigger.condition))
+    elif kind is TriggerKind.SIGNAL and name == "Signal":
+        element = _sub(parent, "TriggerResultSignal", Name=trigger.name, CatchThrow=catch_throw)
+        _sub(element, "Properties")
+    elif kind is TriggerKind.LINK and name == "Link":
+        _sub(parent, "TriggerResultLink", Name=_nmtoken(trigger.name) if trigger.name else None,
+             CatchThrow=catch_throw)
+    elif kind is TriggerKind.ERROR and name == "Error":
+        _sub(parent, "ResultError", ErrorCode=trigger.name)
+    elif kind is TriggerKind.COMPENSATION and name == "Compensation":
+        _sub(parent, "TriggerResultCompensation")
+    elif kind is TriggerKind.CANCEL and name == "Cancel" and parent.tag == _q("IntermediateEvent"):
+        _sub(parent, "TriggerResultCancel")
+
+
+def _write_event(parent: _Element, event: Event) -> None:
+    container = _sub(parent, "Event")
+    trigger = event.trigger
+    name = _TRIGGER_NAMES[trigger.kind]
+    if event.position is EventPosition.START:
+        name = name if name in _START_TRIGGERS else "None"
+        element = _sub(container, "StartEvent", Trigger=name)
+    elif event.position is EventPosition.INTERMEDIATE:
+        name = name if name in _INTERMEDIATE_TRIGGERS else "None"
+        element = _sub(container, "IntermediateEvent", Trigger=name,
+                       Target=trigger.attached_to)
+    else:
+        result = event.result if event.result in _END_RESULTS else None
+        name = result or (name if name in _END_RESULTS else "None")
+        element = _sub(container, "EndEvent", Result=name)
+    _write_trigger_detail(element, trigger, name)
+
+
+_TASK_ELEMENTS = {
+    TaskKind.MANUAL: "TaskManual", TaskKind.USER: "TaskUser", TaskKind.SCRIPT: "TaskScript",
+    TaskKind.SERVICE: "TaskService", TaskKind.SEND: "TaskSend",
+    TaskKind.RECEIVE: "TaskReceive", TaskKind.REFERENCE: "TaskReference",
+    TaskKind.BUSINESS_RULE: "TaskService",   # XPDL 2.2 only; closest 2.1 form
+}
+_IMPLEMENTATIONS = {"WebService", "Other", "Unspecified"}
+
+
+def _write_task(parent: _Element, task: Task, script_language: str | None) -> None:
+    implementation = _sub(parent, "Implementation")
+    if task.kind is TaskKind.APPLICATION:
+        if len(task.applications) > 1:
+            # XPDL 2.1 tasks call one application; several are only expressible as the
+            # (deprecated, still schema-valid) XPDL 1.0 Tool list.
+            for application in task.applications:
+                tool = etree.SubElement(implementation, f"{{{XPDL10}}}Tool",
+                                        Id=application.application, Type="APPLICATION")
+                if application.actual_parameters:
+                    params = etree.SubElement(tool, f"{{{XPDL10}}}ActualParameters")
+                    for parameter in application.actual_parameters:
+                        etree.SubElement(params, f"{{{XPDL10}}}ActualParameter").text = (
+                            parameter.text)
+            return
+        element = _sub(_sub(implementation, "Task"), "TaskApplication")
+        if task.applications:
+            application = task.applications[0]
+            element.set("Id", application.application)
+            if application.package_ref is not None:
+                element.set("PackageRef", application.package_ref)
+            _write_actual_parameters(element, application.actual_parameters)
+        else:
+            element.set("Id", task.implementation or "_")
+        return
+    local = _TASK_ELEMENTS[task.kind]
+    attrs: dict[str, str | None] = {}
+    if local in ("TaskUser", "TaskService", "TaskSend", "TaskReceive") and (
+        task.implementation in _IMPLEMENTATIONS
+    ):
+        attrs["Implementation"] = task.implementation
+    if local == "TaskReceive":
+        attrs["Instantiate"] = "false"
+    if local == "TaskReference":
+        attrs["TaskRef"] = task.implementation or task.message or "_"
+    element = _sub(_sub(implementation, "Task"), local, **attrs)
+    if local == "TaskScript":
+        _sub(element, "Script", task.script or "", Type=script_language or "text/javascript")
+    elif local in ("TaskSend", "TaskReceive") and task.message is not None:
+        _sub(element, "Message", Id=_nmtoken(task.message), Name=task.message)
+
+
+def _write_body(parent: _Element, activity: Activity, script_language: str | None) -> None:
+    body = activity.body
+    if isinstance(body, Route):
+        attrs = {"GatewayType": _GATEWAY[body.gateway]}
+        if body.gateway is GatewayType.EVENT:
+            attrs["ExclusiveType"] = "Event"
+        _sub(parent, "Route", **attrs)
+    elif isinstance(body, NoImplementation):
+        _sub(_sub(parent, "Implementation"), "No")
+    elif isinstance(body, Task):
+        _write_task(parent, body, script_language)
+    elif isinstance(body, SubFlow):
+        element = _sub(_sub(parent, "Implementation"), "SubFlow", Id=body.process,
+                       Execution=body.execution.value, PackageRef=body.package_ref)
+        _write_actual_parameters(element, body.actual_parameters)
+    elif isinstance(body, Reference):
+        _sub(_sub(parent, "Implementation"), "Reference", ActivityId=body.activity)
+    elif isinstance(body, BlockActivity):
+        _sub(parent, "BlockActivity", ActivitySetId=body.activity_set,
+             StartActivityId=body.start_activity)
+    elif isinstance(body, Event):
+        _write_event(parent, body)
+    else:
+        raise TypeError(f"cannot write activity body {body!r}")
+
+
+def _write_activity(parent: _Element, activity: Activity, script_language: str | None) -> None:
+    element = _sub(parent, "Activity", Id=activity.id, Name=activity.name)
+    if activity.start_mode.value != "Automatic":
+        element.set("StartMode", activity.start_mode.value)
+    if activity.finish_mode.value != "Automatic":
+        element.set("FinishMode", activity.finish_mode.value)
+    if activity.description is not None:
+        _sub(element, "Description", activity.description)
+    _write_body(element, activity, script_language)
+    if activity.performers:
+        performers = _sub(element, "Performers")
+        for performer in activity.performers:
+            _sub(performers, "Performer", performer)
+    if activity.priority is not None:
+        _sub(element, "Priority", str(activity.priority))
+    for deadline in activity.deadlines:
+        deadline_element = _sub(element, "Deadline", Execution=deadline.execution.value)
+        _sub(deadline_element, "DeadlineDuration", deadline.duration_text)
+        if deadline.exception_name is not None:
+            _sub(deadline_element, "ExceptionName", deadline.exception_name)
+    if activity.join is not None or activity.split is not None:
+        restriction = _sub(_sub(element, "TransitionRestrictions"), "TransitionRestriction")
+        if activity.join is not None:
+            join = _sub(restriction, "Join", Type=_GATEWAY[activity.join.type])
+            if activity.join.type is GatewayType.EVENT:
+                join.set("ExclusiveType", "Event")
+        if activity.split is not None:
+            split = _sub(restriction, "Split", Type=_GATEWAY[activity.split.type])
+            if activity.split.type is GatewayType.EVENT:
+                split.set("ExclusiveType", "Event")
+            if activity.split.transition_refs:
+                refs = _sub(split, "TransitionRefs")
+                for ref in activity.split.transition_refs:
+                    _sub(refs, "TransitionRef", Id=ref)
+    generated = activity_directive_attributes(activity.directives)
+    if activity.coordination is not None:
+        generated.append(builtin_attribute(activity.coordination))
+    _write_extended(element, _merged(activity.extended_attributes, generated))
+    if activity.loop is not None:
+        loop = activity.loop
+        condition = loop.condition_text
+        if condition is None and loop.condition is not None:
+            condition = expression_text(loop.condition)
+        if loop.kind.value == "standard":
+            loop_element = _sub(element, "Loop", LoopType="Standard")
+            _sub(loop_element, "LoopStandard", LoopCondition=condition,
+                 LoopMaximum=None if loop.maximum is None else str(loop.maximum),
+                 TestTime="Before" if loop.test_before else "After")
+        else:
+            loop_element = _sub(element, "Loop", LoopType="MultiInstance")
+            _sub(loop_element, "LoopMultiInstance", MI_Condition=condition,
+                 MI_Ordering="Sequential")
+    _write_assignments(element, activity.assignments)
+    if activity.lane is not None:
+        _sub(_sub(element, "NodeGraphicsInfos"), "NodeGraphicsInfo", LaneId=activity.lane)
+
+
+def _condition_text(condition: Condition) -> str | None:
+    if condition.text is not None:
+        return condition.text
+    if condition.expression is not None:
+        return expression_text(condition.expression)
+    return condition.exception_name
+
+
+def _write_transitions(parent: _Element, transitions: tuple[Transition, ...]) -> None:
+    if not transitions:
+        return
+    container = _sub(parent, "Transitions")
+    for transition in transitions:
+        element = _sub(container, "Transition", Id=transition.id, From=transition.source,
+                       To=transition.target, Name=transition.name)
+        condition = transition.condition
+        if condition.kind is not ConditionKind.NONE or condition.text:
+            condition_element = _sub(element, "Condition")
+            if condition.kind is not ConditionKind.NONE:
+                condition_element.set("Type", condition.kind.value)
+            text = _condition_text(condition)
+            if condition.kind in (ConditionKind.CONDITION, ConditionKind.NONE):
+                if text is not None:
+                    _sub(condition_element, "Expression", text)
+            elif text is not None:
+                condition_element.text = text
+        if transition.description is not None:
+            _sub(element, "Description", transition.description)
+        _write_extended(element, transition.extended_attributes)
+        _write_assignments(element, transition.assignments)
+
+
+def _write_activities(parent: _Element, activities: tuple[Activity, ...],
+                      script_language: str | None) -> None:
+    if not activities:
+        return
+    container = _sub(parent, "Activities")
+    for activity in activities:
+        _write_activity(container, activity, script_language)
+
+
+def _write_activity_sets(parent: _Element, sets: tuple[ActivitySet, ...],
+                         script_language: str | None) -> None:
+    if not sets:
+        return
+    container = _sub(parent, "ActivitySets")
+    for activity_set in sets:
+        element = _sub(container, "ActivitySet", Id=activity_set.id, Name=activity_set.name,
+                       AdHoc=_bool(True) if activity_set.ad_hoc else None)
+        _write_activities(element, activity_set.activities, script_language)
+        _write_transitions(element, activity_set.transitions)
+
+
+def _write_process(parent: _Element, process: WorkflowProcess, package: Package) -> None:
+    element = _sub(parent, "WorkflowProcess", Id=process.id, Name=process.name,
+                   AccessLevel=process.access_level)
+    header = process.header
+    header_element = _sub(element, "ProcessHeader", DurationUnit=header.duration_unit)
+    priority = header.priority if header.priority is not None else (
+        None if process.priority is None else str(process.priority))
+    description = header.description if header.description is not None else process.description
+    for local, value in (("Created", header.created), ("Description", description),
+                         ("Priority", priority), ("Limit", header.limit),
+                         ("ValidFrom", header.valid_from), ("ValidTo", header.valid_to)):
+        if value is not None:
+            _sub(header_element, local, value)
+    if header.waiting_time or header.working_time or header.duration:
+        estimation = _sub(header_element, "TimeEstimation")
+        for local, value in (("WaitingTime", header.waiting_time),
+                             ("WorkingTime", header.working_time),
+                             ("Duration", header.duration)):
+            if value is not None:
+                _sub(estimation, local, value)
+    _write_formal_parameters(element, process.formal_parameters)
+    _write_participants(element, process.participants)
+    _write_applications(element, process.applications)
+    _write_data_fields(element, process.data_fields)
+    _write_activity_sets(element, process.activity_sets, package.script_language)
+    _write_activities(element, process.activities, package.script_language)
+    _write_transitions(element, process.transitions)
+    _write_extended(element, _merged(process.extended_attributes,
+                                     process_directive_attributes(process.directives)))
+    _write_assignments(element, process.assignments)
+
+
+# --------------------------------------------------------------------------- package
+
+
+def build_tree(package: Package) -> _Element:
+    """The ``Package`` element of ``package`` (for callers that post-process the tree)."""
+    root = etree.Element(_q("Package"), nsmap=_NSMAP)  # type: ignore[arg-type]
+    root.set("Id", package.id)
+    if package.name is not None:
+        root.set("Name", package.name)
+    header = package.header
+    header_element = _sub(root, "PackageHeader")
+    _sub(header_element, "XPDLVersion", "2.1")
+    _sub(header_element, "Vendor", header.vendor or "opspec")
+    _sub(header_element, "Created", header.created or "")
+    description = header.description if header.description is not None else package.description
+    for local, value in (("ModificationDate", header.modified), ("Description", description),
+                         ("Documentation", header.documentation),
+                         ("PriorityUnit", header.priority_unit),
+                         ("CostUnit", header.cost_unit)):
+        if value is not None:
+            _sub(header_element, local, value)
+    if package.conformance_class is not None:
+        _sub(root, "ConformanceClass", GraphConformance=package.conformance_class)
+    if package.script_language is not None:
+        _sub(root, "Script", Type=package.script_language)
+    if package.external_packages:
+        container = _sub(root, "ExternalPackages")
+        for external in package.external_packages:
+            element = _sub(container, "ExternalPackage", href=external.href, Id=external.id,
+                           Name=external.name)
+            _write_extended(element, external.extended_attributes)
+    if package.type_declarations:
+        container = _sub(root, "TypeDeclarations")
+        for declaration in package.type_declarations:
+            _write_type_declaration(container, declaration)
+    _write_participants(root, package.participants)
+    _write_applications(root, package.applications)
+    _write_data_fields(root, package.data_fields)
+    _write_pools(root, package.pools)
+    if package.processes:
+        container = _sub(root, "WorkflowProcesses")
+        for process in package.processes:
+            _write_process(container, process, package)
+    _write_extended(root, _merged(package.extended_attributes,
+                                  package_directive_attributes(package)))
+    return root
+
+
+def _write_type_declaration(parent: _Element, declaration: TypeDeclaration) -> None:
+    element = _sub(parent, "TypeDeclaration", Id=declaration.id, Name=declaration.name)
+    _write_data_type(element, declaration.type)
+    if declaration.description is not None:
+        _sub(element, "Description", declaration.description)
+    _write_extended(element, declaration.extended_attributes)
+
+
+def write_xpdl(package: Package) -> bytes:
+    """``package`` as a standard XPDL 2.1 document (UTF-8, with an XML declaration)."""
+    root = build_tree(package)
+    etree.cleanup_namespaces(root, keep_ns_prefixes=["opspec"])
+    data: bytes = etree.tostring(root, xml_declaration=True, encoding="UTF-8",
+                                 pretty_print=True)
+    return data
