@@ -243,7 +243,8 @@ class LogNormal(Distribution):
         return LogNormal(self.mu + math.log(_positive("factor", factor)), self.sigma)
 
     def to_params(self) -> dict[str, Any]:
-        return {"kind": "lognormal", "median": self.median, "sigma": self.sigma}
+        # 15 significant digits: exp(log(60)) prints as 60.0, not 59.999999999999986.
+        return {"kind": "lognormal", "median": float(f"{self.median:.15g}"), "sigma": self.sigma}
 
 
 @dataclass(frozen=True, slots=True)

@@ -1,0 +1,222 @@
+"""The user model: per manual activity a duration and error parameters, plus a routine.
+
+A :class:`UserModel` is immutable data (usually loaded from TOML by
+:func:`opspec.usermodels.loader.load_user_model`); :meth:`UserModel.performer` turns it into a
+:class:`~opspec.usermodels.performer.StochasticUser` bound to one user's random stream.
+A :class:`Modifier` (age slowing, a heavier slow tail, lower adherence) transforms a model.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Iterable, Mapping
+from dataclasses import dataclass, field, replace
+from types import MappingProxyType
+from typing import TYPE_CHECKING
+
+from opspec.errors import Diagnostic, Severity, SourceLocation, UserModelError
+from opspec.usermodels.distributions import (
+    Constant,
+    Distribution,
+    ParameterError,
+    WithExponentialTail,
+)
+from opspec.usermodels.errors import Busy, Commission, ExtraDelay, Omission, Repetition
+from opspec.usermodels.routine import Routine
+
+if TYPE_CHECKING:
+    import numpy as np
+
+    from opspec.usermodels.performer import StochasticUser
+
+__all__ = ["ActivityModel", "Modifier", "UserModel"]
+
+
+@dataclass(frozen=True, slots=True)
+class ActivityModel:
+    """How the person performs one manual activity (or answers one choice).
+
+    ``prompt`` marks activities whose noticing depends on the routine and adherence drift
+    (hearing an alarm); it defaults to true when ``omission`` is given. For choices, either
+    ``intended`` (with an optional ``commission``) or ``probabilities`` (a fixed chance per
+    alternative, renormalised over the offered alternatives) says what is picked.
+    """
+
+    duration: Distribution = field(default_factory=lambda: Constant(0.0))
+    omission: Omission | None = None
+    prompt: bool = False
+    commission: Commission | None = None
+    repetition: Repetition | None = None
+    delay: ExtraDelay | None = None
+    intended: str | None = None
+    probabilities: tuple[tuple[str, float], ...] = ()
+    source: str | None = None
+
+    def __post_init__(self) -> None:
+        if self.probabilities:
+            total = sum(p for _, p in self.probabilities)
+            if not math.isclose(total, 1.0, abs_tol=1e-6):
+                raise ParameterError("probabilities", f"must add up to 1, got {total:g}")
+            if self.intended is not None:
+                raise ParameterError("probabilities", "cannot be combined with intended",
+                                     hint="use intended + commission, or probabilities")
+
+    @property
+    def is_choice_model(self) -> bool:
+        return self.intended is not None or bool(self.probabilities)
+
+    def choice_ids(self) -> set[str]:
+        """Alternative ids this model names (for validation against the spec)."""
+        ids = {name for name, _ in self.probabilities}
+        if self.intended:
+            ids.add(self.intended)
+        if self.commission:
+            ids.update(self.commission.alternatives)
+        return ids
+
+
+@dataclass(frozen=True, slots=True)
+class Modifier:
+    """A transformation of a model, applied to every activity:
+
+    * ``duration_factor`` multiplies durations (general slowing);
+    * ``tail_fraction`` adds an exponential slow tail whose mean is that fraction of each
+      activity's mean duration (activities with mean 0 are left alone);
+    * ``notice_factor`` multiplies the chance of noticing each prompt (``1 - omission``).
+    """
+
+    name: str = "modifier"
+    duration_factor: float = 1.0
+    tail_fraction: float = 0.0
+    notice_factor: float = 1.0
+    source: str | None = None
+
+    def __post_init__(self) -> None:
+        for param in ("duration_factor", "tail_fraction", "notice_factor"):
+            value = getattr(self, param)
+            if isinstance(value, bool) or not isinstance(value, (int, float)) or not (
+                    math.isfinite(value) and value >= 0):
+                raise ParameterError(param, f"must be a number >= 0, got {value!r}")
+        if self.duration_factor == 0:
+            raise ParameterError("duration_factor", "must be > 0, got 0")
+        if self.notice_factor > 1:
+            raise ParameterError("notice_factor", f"must be in [0, 1], got {self.notice_factor:g}")
+
+    @property
+    def is_identity(self) -> bool:
+        return (self.duration_factor == 1.0 and self.tail_fraction == 0.0
+                and self.notice_factor == 1.0)
+
+    def apply_to(self, activity: ActivityModel) -> ActivityModel:
+        duration = activity.duration
+        if self.duration_factor != 1.0:
+            duration = duration.scaled(self.duration_factor)
+        if self.tail_fraction > 0.0 and duration.mean > 0.0:
+            duration = WithExponentialTail(duration, self.tail_fraction * duration.mean)
+        omission = activity.omission
+        if omission is not None and self.notice_factor != 1.0:
+            omission = replace(omission,
+                               probability=1.0 - (1.0 - omission.probability) * self.notice_factor)
+        return replace(activity, duration=duration, omission=omission)
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class UserModel:
+    """A complete user model. ``activities`` maps activity ids (manual activities and
+    choices) to their models; ``default`` covers activities not listed (``None``: every
+    manual activity must be listed). ``path`` says where it was loaded from, for messages."""
+
+    name: str
+    activities: Mapping[str, ActivityModel]
+    default: ActivityModel | None = None
+    busy: Busy | None = None
+    routine: Routine = field(default_factory=Routine)
+    modifiers: tuple[Modifier, ...] = ()
+    description: str = ""
+    source: str = ""
+    path: str = "<python>"
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "activities", MappingProxyType(dict(self.activities)))
+
+    def activity(self, activity_id: str) -> ActivityModel:
+        """The model of ``activity_id`` (falling back to ``default``)."""
+        found = self.activities.get(activity_id, self.default)
+        if found is None:
+            raise UserModelError(
+                f"activity {activity_id!r} is not covered by user model {self.name!r}",
+                location=SourceLocation(self.path, key="activities"),
+                hint=f"add [activities.{activity_id}] with a duration, or a [defaults] table")
+        return found
+
+    def covers(self, activity_id: str) -> bool:
+        return self.default is not None or activity_id in self.activities
+
+    def validate_against(
+        self,
+        manual_activity_ids: Iterable[str],
+        *,
+        choices: Mapping[str, Iterable[str]] | None = None,
+    ) -> list[Diagnostic]:
+        """Check the model against a spec's user lane before any simulation starts.
+
+        ``manual_activity_ids`` are the manual activities the model performs; ``choices`` maps
+        each deferred-choice id to its alternative ids. Raises :class:`UserModelError` when an
+        activity or choice is not covered (naming the file, the missing ids and the fix) or a
+        choice model names an alternative the spec does not offer. Returns warnings for
+        activities in the model that the spec does not have (usually typos).
+        """
+        manual = list(dict.fromkeys(manual_activity_ids))
+        choice_map = {k: list(v) for k, v in (choices or {}).items()}
+        missing = [a for a in [*manual, *choice_map] if not self.covers(a)]
+        if missing:
+            ids = ", ".join(missing)
+            raise UserModelError(
+                f"user model {self.name!r} does not cover manual "
+                f"activit{'y' if len(missing) == 1 else 'ies'} of the spec: {ids}",
+                location=SourceLocation(self.path, key="activities"),
+                hint="add " + " ".join(f"[activities.{a}]" for a in missing)
+                + " with at least a duration, or a [defaults] table")
+        for choice_id, alternatives in choice_map.items():
+            model = self.activity(choice_id)
+            unknown = sorted(model.choice_ids() - set(alternatives))
+            if unknown:
+                raise UserModelError(
+                    f"choice {choice_id!r} has no alternative {', '.join(map(repr, unknown))}",
+                    location=SourceLocation(self.path, key=f"activities.{choice_id}"),
+                    hint="the spec offers: " + ", ".join(alternatives))
+        known = set(manual) | set(choice_map)
+        warnings = []
+        for activity_id in self.activities:
+            if activity_id not in known:
+                warnings.append(Diagnostic(
+                    SourceLocation(self.path, key=f"activities.{activity_id}"),
+                    Severity.WARNING, "unused-user-activity",
+                    f"activity {activity_id!r} is not a manual activity or choice of the spec",
+                    hint="check the spelling against the spec's activity ids"))
+        if self.busy is not None:
+            for activity_id in sorted(self.busy.engaged - known):
+                warnings.append(Diagnostic(
+                    SourceLocation(self.path, key="busy.engaged"), Severity.WARNING,
+                    "unused-user-activity",
+                    f"busy.engaged names {activity_id!r}, which the spec's user lane lacks"))
+        return warnings
+
+    def with_modifier(self, modifier: Modifier) -> UserModel:
+        """This model with ``modifier`` applied to every activity (and the default)."""
+        if modifier.is_identity:
+            return replace(self, modifiers=(*self.modifiers, modifier))
+        return replace(
+            self,
+            activities={k: modifier.apply_to(v) for k, v in self.activities.items()},
+            default=modifier.apply_to(self.default) if self.default else None,
+            modifiers=(*self.modifiers, modifier),
+            name=self.name if self.name == modifier.name else f"{self.name}+{modifier.name}",
+        )
+
+    def performer(self, rng: np.random.Generator, *, trace_decisions: bool = True
+                  ) -> StochasticUser:
+        """A performer of this model drawing from ``rng`` (one stream per simulated user)."""
+        from opspec.usermodels.performer import StochasticUser
+
+        return StochasticUser(self, rng, trace_decisions=trace_decisions)

@@ -1,0 +1,216 @@
+"""``StochasticUser``: a :class:`~opspec.engine.performers.Performer` driven by a user model.
+
+Every random number comes from the one numpy ``Generator`` given to the constructor (the
+evaluation derives it per user from the run seed:
+``numpy.random.default_rng(numpy.random.SeedSequence(seed, spawn_key=(user_index,)))``), in
+this fixed order for each offered work item:
+
+0. routine: when the offer falls on a day not drawn yet, one uniform per *probabilistic*
+   routine window per day (windows in file order);
+1. busy: no draw - an offer from another instance while an instance is engaged is omitted;
+2. omission: one uniform, if the activity has an ``omission`` or is a ``prompt``
+   (noticed iff ``u < (1 - p_omission) * routine notice factor``); stops here if omitted;
+3. choice (work items with ``choices``): with ``probabilities``, one uniform; with
+   ``intended`` + ``commission`` under its cap, one uniform, and when wrong, one integer if
+   there are several wrong alternatives, then one ``recovery`` sample; with neither, one
+   integer (a uniform pick);
+4. extra delay: one uniform if configured, plus one ``delay.duration`` sample when it occurs;
+5. duration: one sample of the activity's distribution (its own documented draws);
+6. repetition: one uniform if configured, plus one more duration sample when it occurs;
+7. commission on a plain activity: one uniform if configured, plus one ``recovery`` sample
+   when it occurs.
+
+The same model, seed and sequence of offers therefore give the same decisions. Decisions are
+recorded through ``session.trace`` with kinds ``user.omitted`` (``reason``: ``busy``, the
+omission's reason, a routine window's name, or ``adherence``), ``user.wrong_choice``,
+``user.slip``, ``user.repeated``, ``user.delayed`` and ``user.deferred``.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from typing import Any
+
+import numpy as np
+
+from opspec.engine.performers import PerformerSession, WorkItem
+from opspec.errors import UserModelError
+from opspec.usermodels.model import ActivityModel, UserModel
+from opspec.usermodels.routine import RoutineTracker
+
+__all__ = ["StochasticUser"]
+
+
+class StochasticUser:
+    """Performs the work items of a user lane according to a :class:`UserModel`.
+
+    Implements the Performer protocol (``attach``, ``offer``, ``withdraw``). One instance
+    per simulated user; not thread-safe (the engine calls it from its one thread).
+    """
+
+    def __init__(self, model: UserModel, rng: np.random.Generator, *,
+                 trace_decisions: bool = True) -> None:
+        self.model = model
+        self.rng = rng
+        self.trace_decisions = trace_decisions
+        self._session: PerformerSession | None = None
+        self._routine = RoutineTracker(model.routine, rng)
+        self._pending: dict[int, WorkItem] = {}
+        self._engaged: set[int] = set()          # lane instances the person is engaged in
+        self._wrong: dict[tuple[int, str], int] = {}
+        self._recovery: dict[tuple[int, str], float] = {}
+        self._models: dict[str, ActivityModel] = {}
+
+    # ------------------------------------------------------------------ Performer protocol
+
+    def attach(self, session: PerformerSession) -> None:
+        self._session = session
+
+    def offer(self, item: WorkItem) -> None:
+        session = self._require_session()
+        model = self._model_of(item.activity)
+        lane = item.root_instance if item.root_instance is not None else item.instance
+        now = session.now
+        state = self._routine.state(now)
+        busy = self.model.busy
+
+        if busy is not None and busy.ignores(item.activity) and (
+                len(self._engaged) > 1 or (self._engaged and lane not in self._engaged)):
+            self._omit(item, lane, "busy")
+            return
+
+        omission = model.omission
+        if omission is not None or model.prompt:
+            p_miss = omission.probability if omission is not None else 0.0
+            u = float(self.rng.random())
+            if u >= (1.0 - p_miss) * state.notice_factor:
+                if u >= 1.0 - p_miss:
+                    reason = omission.reason if omission is not None else "not noticed"
+                elif state.window is not None:
+                    reason = state.window
+                else:
+                    reason = "adherence"
+                self._omit(item, lane, reason)
+                return
+
+        delay = 0.0
+        choice: str | None = None
+        if item.choices:
+            choice, delay = self._choose(item, model, lane)
+
+        if model.delay is not None and float(self.rng.random()) < model.delay.probability:
+            extra = model.delay.duration.sample(self.rng)
+            delay += extra
+            self._trace("user.delayed", item, seconds=extra)
+
+        factor = state.duration_factor
+        duration = model.duration.sample(self.rng) * factor
+        if model.repetition is not None and float(
+                self.rng.random()) < model.repetition.probability:
+            duration += model.duration.sample(self.rng) * factor
+            self._trace("user.repeated", item)
+        if (model.commission is not None and not item.choices
+                and float(self.rng.random()) < model.commission.probability):
+            recovery = model.commission.recovery.sample(self.rng)
+            duration += recovery
+            self._trace("user.slip", item, recovery=recovery)
+
+        start = now
+        if state.start_at is not None:
+            start = state.start_at
+            self._trace("user.deferred", item, until=start)
+
+        if busy is not None:
+            if item.activity in busy.engaged:
+                self._engaged.add(lane)
+            else:
+                self._engaged.discard(lane)
+
+        self._pending[item.key] = item
+        total = max(0.0, start - now + max(0.0, delay) + max(0.0, duration))
+        session.call_later(total, lambda: self._finish(item, lane, choice))
+
+    def withdraw(self, item: WorkItem, reason: str) -> None:
+        if self._pending.pop(item.key, None) is not None:
+            lane = item.root_instance if item.root_instance is not None else item.instance
+            self._release(lane)
+
+    # ------------------------------------------------------------------ internals
+
+    def _require_session(self) -> PerformerSession:
+        if self._session is None:
+            raise UserModelError("StochasticUser.offer() called before attach(session)")
+        return self._session
+
+    def _model_of(self, activity: str) -> ActivityModel:
+        found = self._models.get(activity)
+        if found is None:
+            found = self._models[activity] = self.model.activity(activity)
+        return found
+
+    def _choose(self, item: WorkItem, model: ActivityModel, lane: int) -> tuple[str, float]:
+        """Pick an alternative (draw order: see the module docstring); returns the choice and
+        the recovery time owed from an earlier wrong pick of this choice."""
+        choices = item.choices
+        key = (lane, item.activity)
+        owed = self._recovery.pop(key, 0.0)
+        if model.probabilities:
+            weights = dict(model.probabilities)
+            offered = [(c, weights.get(c, 0.0)) for c in choices]
+            total = sum(w for _, w in offered)
+            u = float(self.rng.random()) * total
+            for choice, weight in offered:
+                if u < weight:
+                    return choice, owed
+                u -= weight
+            return offered[-1][0], owed
+        intended = model.intended
+        if intended is None or intended not in choices:
+            if intended is not None:
+                raise UserModelError(
+                    f"choice {item.activity!r}: intended alternative {intended!r} is not "
+                    f"offered (offered: {', '.join(choices)})")
+            return choices[int(self.rng.integers(len(choices)))], owed
+        commission = model.commission
+        count = self._wrong.get(key, 0)
+        if commission is not None and count < commission.max_per_instance:
+            if float(self.rng.random()) < commission.probability:
+                wrong = [c for c in (commission.alternatives or choices)
+                         if c != intended and c in choices]
+                if wrong:
+                    pick = wrong[0] if len(wrong) == 1 else wrong[
+                        int(self.rng.integers(len(wrong)))]
+                    self._wrong[key] = count + 1
+                    self._recovery[key] = commission.recovery.sample(self.rng)
+                    self._trace("user.wrong_choice", item, choice=pick, intended=intended)
+                    return pick, owed
+        self._wrong.pop(key, None)
+        return intended, owed
+
+    def _finish(self, item: WorkItem, lane: int, choice: str | None) -> None:
+        if self._pending.pop(item.key, None) is None:
+            return  # withdrawn meanwhile
+        busy = self.model.busy
+        if busy is not None and (item.activity in busy.release_after
+                                 or item.activity not in busy.engaged):
+            self._engaged.discard(lane)
+        self._require_session().complete(item, choice=choice)
+
+    def _omit(self, item: WorkItem, lane: int, reason: str) -> None:
+        if reason != "busy":
+            self._release(lane)
+        self._trace("user.omitted", item, reason=reason)
+        self._require_session().omit(item, reason)
+
+    def _release(self, lane: int) -> None:
+        self._engaged.discard(lane)
+        for key in [k for k in self._wrong if k[0] == lane]:
+            del self._wrong[key]
+        for key in [k for k in self._recovery if k[0] == lane]:
+            del self._recovery[key]
+
+    def _trace(self, kind: str, item: WorkItem, **data: Any) -> None:
+        if self.trace_decisions and self._session is not None:
+            payload: Mapping[str, Any] = {"instance": item.instance, "activity": item.activity,
+                                          "process": item.process, **data}
+            self._session.trace(kind, payload)
