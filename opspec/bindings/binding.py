@@ -1,0 +1,504 @@
+"""DeviceBinding: a Performer whose work is done by a serial device speaking a profile's
+line protocol, with the profile's fallback when the device misbehaves.
+
+Threads. pySerial's reader thread and the reply timers never touch the engine: they post
+callbacks into the binding's :class:`~opspec.bindings.inbox.Inbox`, which the engine drains
+on its own thread. Every method below runs on that engine thread, except where a docstring
+says otherwise, so the binding's state needs no locks.
+
+Faults are trace events of kind :data:`~opspec.engine.trace.EventKind.FAULT` whose ``data``
+names the fault (``fault``: ``timeout``, ``garbage``, ``unexpected-line``, ``late-reply``,
+``disconnected``, ``reconnect-failed``, ``unavailable``, ``unknown-operation``,
+``missing-data``) and the ``action`` taken (``retry``, ``reconnect``, ``simulate``, ``abort``,
+``none``). Each exchange is a ``device.exchange`` event carrying its round-trip ``latency``
+in seconds; notes (bound, switched to simulated, reconnected) are ``device.note`` events.
+"""
+
+from __future__ import annotations
+
+import threading
+import time
+from collections import deque
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
+from functools import partial
+from typing import Any, Final, Literal
+
+import serial
+
+from opspec.bindings.inbox import Inbox
+from opspec.bindings.latency import LatencySummary, summarise
+from opspec.bindings.profiles import DeviceProfile, Operation
+from opspec.bindings.simulated import SimulatedDevice
+from opspec.bindings.templates import TemplateError
+from opspec.bindings.transport import LineFramer, LineReaderThread, open_port
+from opspec.engine.performers import PerformerSession, WorkItem
+from opspec.engine.trace import EventKind
+from opspec.errors import BindingError
+
+__all__ = ["DeviceBinding", "DEVICE_EXCHANGE", "DEVICE_NOTE", "DEVICE_EVENT"]
+
+DEVICE_EXCHANGE: Final = "device.exchange"   # a command and its reply, with latency
+DEVICE_NOTE: Final = "device.note"           # bound / simulated / reconnected / switched
+DEVICE_EVENT: Final = "device.event"         # an unsolicited line the profile knows
+
+Mode = Literal["device", "simulated", "aborted"]
+Connection = Literal["open", "reconnecting", "gone", "closed", "none"]
+
+
+@dataclass(eq=False, slots=True)
+class _Job:
+    """One command for one work item, possibly sent several times."""
+
+    item: WorkItem
+    op: Operation
+    line: str
+    attempts: int = 0
+    seq: int = 0
+    sent_at: float = 0.0
+    timer: threading.Timer | None = None
+    withdrawn: bool = False
+    last_fault: str = ""
+
+
+class DeviceBinding:
+    """Performs the work items of ``participants`` on a device (or on its simulation).
+
+    Build it with :func:`opspec.bindings.bind`; ``port`` is an already open pySerial port
+    (``None``: simulated from the start, with ``notes`` saying why). Call :meth:`close` when
+    the run ends. ``inbox`` must be drained by the engine's loop (shared by all bindings of a
+    run is fine).
+    """
+
+    def __init__(self, profile: DeviceProfile, participants: Sequence[str], url: str | None,
+                 port: serial.SerialBase | None, *, inbox: Inbox | None = None,
+                 notes: Sequence[str] = ()) -> None:
+        self.profile = profile
+        self.participants: tuple[str, ...] = tuple(participants)
+        self.url = url
+        self.inbox = inbox if inbox is not None else Inbox()
+        self.notes: list[str] = list(notes)
+        #: Round-trip time of every answered command, in seconds (wall clock).
+        self.latencies: list[float] = []
+        #: The data of every fault reported, in order (also in the trace).
+        self.faults: list[dict[str, Any]] = []
+        self._session: PerformerSession | None = None
+        self._sim = SimulatedDevice(profile)
+        start: Mode = "device" if port is not None else "simulated"
+        self._modes: dict[str, Mode] = {p: start for p in self.participants}
+        self._port = port
+        self._reader: LineReaderThread | None = None
+        self._connection: Connection = "open" if port is not None else "none"
+        self._generation = 0
+        self._queue: deque[_Job] = deque()
+        self._inflight: _Job | None = None
+        self._waiting: list[WorkItem] = []          # passive operations awaiting an event
+        self._timed_out: deque[_Job] = deque()       # replies we gave up waiting for
+        self._seq = 0
+        self._closed = threading.Event()
+        self._newline = profile.serial.newline.encode()
+
+    # ------------------------------------------------------------------ public
+    @property
+    def simulated(self) -> bool:
+        """Whether every participant is served by the simulated device now."""
+        return all(mode == "simulated" for mode in self._modes.values())
+
+    @property
+    def requires_wall_clock(self) -> bool:
+        """Whether a real transport is (still) in use, so the run must follow wall time."""
+        return self._connection in ("open", "reconnecting")
+
+    def mode(self, participant: str | None) -> Mode:
+        """``device``, ``simulated`` or ``aborted`` for ``participant``."""
+        return self._modes.get(participant or "", "device" if self._port else "simulated")
+
+    def latency_summary(self) -> LatencySummary:
+        return summarise(self.latencies)
+
+    def attach(self, session: PerformerSession) -> None:
+        """Remember the session, report the notes and start reading the port."""
+        self._session = session
+        self._sim.attach(session)
+        for note in self.notes:
+            self._note(note)
+        if self._port is not None and self._reader is None:
+            self._start_reader(self._port)
+
+    def offer(self, item: WorkItem) -> None:
+        participant = item.participant or ""
+        if self.mode(participant) == "simulated":
+            self._sim.offer(item)
+            return
+        fallback = self.profile.fallback_for(participant)
+        op = self.profile.operation_for(item.application, item.activity)
+        if op is None:
+            message = (f"{self._who(item)}: profile {self.profile.name!r} has no operation for "
+                       f"application {item.application!r} / activity {item.activity!r}")
+            self._fault("unknown-operation", message, item=item, action="abort")
+            self._session_().fail(item, fallback.exception, message)
+            return
+        if self.mode(participant) == "aborted":
+            message = f"{self._who(item)}: the device on {self.url} is unavailable"
+            self._fault("unavailable", message, item=item, action="abort")
+            self._session_().fail(item, fallback.exception, message)
+            return
+        if op.command is None:
+            self._waiting.append(item)
+            return
+        try:
+            line = op.command.fill({**op.defaults, **item.data})
+        except TemplateError as error:
+            message = f"{self._who(item)}: cannot build the command for {op.name!r}: {error}"
+            self._fault("missing-data", message, item=item, action="abort")
+            self._session_().fail(item, fallback.exception, message)
+            return
+        self._queue.append(_Job(item, op, line))
+        self._pump()
+
+    def withdraw(self, item: WorkItem, reason: str) -> None:
+        self._sim.withdraw(item, reason)
+        self._waiting = [w for w in self._waiting if w.key != item.key]
+        for job in (*self._queue, self._inflight):
+            if job is not None and job.item.key == item.key:
+                job.withdrawn = True  # a command already sent cannot be unsent
+
+    def close(self) -> None:
+        """Stop the reader, cancel timers, close the port. Idempotent; any thread."""
+        self._closed.set()
+        self._connection = "closed"
+        for job in (*self._queue, self._inflight):
+            if job is not None and job.timer is not None:
+                job.timer.cancel()
+        reader, self._reader = self._reader, None
+        if reader is not None:
+            reader.shutdown()
+        elif self._port is not None:
+            try:
+                self._port.close()
+            except (serial.SerialException, OSError):
+                pass
+
+    def __enter__(self) -> DeviceBinding:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()
+
+    # ------------------------------------------------------------------ reader side
+    def _start_reader(self, port: serial.SerialBase) -> None:
+        self._generation += 1
+        gen = self._generation
+        post = self.inbox.post
+
+        def factory() -> LineFramer:
+            # these three run on the reader thread: post only, never touch state
+            return LineFramer(
+                self.profile.serial,
+                on_line=lambda text, at: post(partial(self._on_line, gen, text, at)),
+                on_garbage=lambda raw, at, why: post(partial(self._on_garbage, gen, raw, why)),
+                on_lost=lambda exc: post(partial(self._on_lost, gen, exc)),
+            )
+
+        self._port = port
+        self._reader = LineReaderThread(port, factory)
+        self._reader.name = f"serial-{self.profile.name}"
+        self._reader.start()
+        self._connection = "open"
+
+    # ------------------------------------------------------------------ sending
+    def _pump(self) -> None:
+        """Send the next queued command if the line is free (one command at a time)."""
+        while self._inflight is None and self._queue and self._connection == "open":
+            job = self._queue.popleft()
+            if job.withdrawn:
+                continue
+            participant = job.item.participant
+            if self.mode(participant) != "device":
+                self._reroute(job)
+                continue
+            fallback = self.profile.fallback_for(participant)
+            if job.attempts > fallback.retries:
+                self._give_up(job, f"{job.last_fault or 'failed'} after {job.attempts} "
+                              "attempt(s)")
+                continue
+            self._send(job)
+
+    def _send(self, job: _Job) -> None:
+        assert self._reader is not None
+        self._seq += 1
+        job.seq, job.attempts = self._seq, job.attempts + 1
+        self._inflight = job
+        data = job.line.encode(self.profile.serial.encoding, "replace") + self._newline
+        job.sent_at = time.perf_counter()
+        try:
+            self._reader.write(data)
+        except (serial.SerialException, OSError) as error:
+            self._disconnected(error, "writing")
+            return
+        timer = threading.Timer(job.op.timeout_s, self.inbox.post,
+                                (partial(self._on_timeout, job.seq),))
+        timer.daemon = True
+        job.timer = timer
+        timer.start()
+
+    def _finish(self, job: _Job) -> None:
+        if job.timer is not None:
+            job.timer.cancel()
+        if self._inflight is job:
+            self._inflight = None
+
+    # ------------------------------------------------------------------ receiving
+    def _on_line(self, gen: int, text: str, at: float) -> None:
+        if gen != self._generation or self._connection == "closed":
+            return
+        job = self._inflight
+        if job is not None:
+            for template in job.op.ok:
+                values = template.match(text)
+                if values is not None:
+                    self._answered(job, text, at, values, None)
+                    return
+            for template, exception in job.op.errors:
+                if template.match(text) is not None:
+                    self._answered(job, text, at, None, exception)
+                    return
+        for rule in self.profile.events.values():
+            values = rule.line.match(text)
+            if values is not None:
+                self._on_event(rule.name, rule.trigger, rule.complete, values, text)
+                return
+        if any(t.match(text) is not None for t in self.profile.ignore):
+            return
+        if job is not None:
+            self._attempt_failed(job, "garbage", f"unexpected reply {text!r} to {job.line!r}")
+        elif self._timed_out and self._is_reply(text):
+            late = self._timed_out.popleft()
+            self._fault("late-reply", f"{self._who(late.item)}: reply {text!r} to {late.line!r} "
+                        f"came after its {late.op.timeout_s * 1000:g} ms timeout", item=late.item,
+                        line=late.line, reply=text, latency=at - late.sent_at)
+        else:
+            self._fault("unexpected-line", f"{self._label()}: unexpected line {text!r} from "
+                        f"{self.url}", reply=text)
+
+    def _on_garbage(self, gen: int, raw: bytes, why: str) -> None:
+        if gen != self._generation or self._connection == "closed":
+            return
+        message = f"garbled data from {self.url} ({why}): {raw[:40]!r}"
+        if self._inflight is not None:
+            self._attempt_failed(self._inflight, "garbage", f"{self._who(self._inflight.item)}: "
+                                 f"{message}")
+        else:
+            self._fault("garbage", f"{self._label()}: {message}")
+
+    def _is_reply(self, text: str) -> bool:
+        return any(t.match(text) is not None
+                   for op in self.profile.operations.values()
+                   for t in (*op.ok, *(e[0] for e in op.errors)))
+
+    def _answered(self, job: _Job, text: str, at: float, values: Mapping[str, Any] | None,
+                  exception: str | None) -> None:
+        self._finish(job)
+        latency = at - job.sent_at
+        self.latencies.append(latency)
+        details: dict[str, Any] = {"device": self.profile.name, "participant": job.item.participant,
+                                   "activity": job.item.activity, "command": job.line,
+                                   "reply": text, "latency": latency, "attempt": job.attempts}
+        if exception is not None:
+            details["exception"] = exception
+        self._session_().trace(DEVICE_EXCHANGE, details)
+        if not job.withdrawn:
+            if exception is None:
+                self._session_().complete(job.item, dict(values) if values else None)
+            else:
+                self._session_().fail(job.item, exception,
+                                      f"{self._who(job.item)}: the device answered {text!r} "
+                                      f"to {job.line!r}")
+        self._pump()
+
+    def _on_event(self, name: str, trigger: str | None, complete: str | None,
+                  values: Mapping[str, Any], text: str) -> None:
+        session = self._session_()
+        session.trace(DEVICE_EVENT, {"device": self.profile.name, "event": name, "line": text,
+                                     "data": dict(values)})
+        done = False
+        if complete is not None:
+            for item in self._waiting:
+                if complete in (item.application, item.activity):
+                    self._waiting.remove(item)
+                    session.complete(item, dict(values) or None)
+                    done = True
+                    break
+        if trigger is not None:
+            session.raise_trigger(trigger, dict(values) or None)
+        elif not done:
+            self._note(f"{self._label()}: event {name!r} ignored: no activity {complete!r} "
+                       "was waiting for it")
+
+    # ------------------------------------------------------------------ faults
+    def _on_timeout(self, seq: int) -> None:
+        job = self._inflight
+        if job is None or job.seq != seq or self._connection == "closed":
+            return  # answered (or superseded) meanwhile
+        self._timed_out.append(job)
+        self._attempt_failed(job, "timeout", f"{self._who(job.item)}: no reply to {job.line!r} "
+                             f"within {job.op.timeout_s * 1000:g} ms")
+
+    def _attempt_failed(self, job: _Job, fault: str, message: str) -> None:
+        """A timeout or garbage: report, then retry or apply the participant's fallback."""
+        self._finish(job)
+        fallback = self.profile.fallback_for(job.item.participant)
+        action = "retry" if job.attempts <= fallback.retries else fallback.then
+        job.last_fault = fault
+        self._fault(fault, message, item=job.item, action=action, line=job.line,
+                    attempt=job.attempts)
+        self._queue.appendleft(job)
+        self._pump()
+
+    def _give_up(self, job: _Job, reason: str) -> None:
+        participant = job.item.participant or ""
+        fallback = self.profile.fallback_for(participant)
+        if fallback.then == "simulate":
+            self._switch_to_simulated(participant, reason)
+            if not job.withdrawn:
+                self._sim.offer(job.item)
+        elif not job.withdrawn:
+            self._session_().fail(job.item, fallback.exception,
+                                  f"{self._who(job.item)}: {job.line!r} failed: {reason}")
+
+    def _switch_to_simulated(self, participant: str, reason: str) -> None:
+        if self._modes.get(participant) == "simulated":
+            return
+        self._modes[participant] = "simulated"
+        self._note(f"{participant or self.profile.name}: {reason}; using the simulated "
+                   f"{participant or self.profile.name} from now on")
+        for item in [w for w in self._waiting if (w.participant or "") == participant]:
+            self._waiting.remove(item)
+            self._sim.offer(item)
+
+    def _reroute(self, job: _Job) -> None:
+        """A queued job whose participant left the device: simulate it or fail it."""
+        if job.withdrawn:
+            return
+        if self.mode(job.item.participant) == "simulated":
+            self._sim.offer(job.item)
+        else:
+            fallback = self.profile.fallback_for(job.item.participant)
+            message = f"{self._who(job.item)}: the device on {self.url} is unavailable"
+            self._session_().fail(job.item, fallback.exception, message)
+
+    def _on_lost(self, gen: int, exc: BaseException | None) -> None:
+        if gen != self._generation or self._connection != "open" or self._closed.is_set():
+            return
+        self._disconnected(exc, "reading")
+
+    def _disconnected(self, exc: BaseException | None, doing: str) -> None:
+        """The port failed: close it, report, and reconnect (on a helper thread) or fall back."""
+        reason = str(exc) if exc is not None else "the port was closed"
+        self._generation += 1  # lines still queued from the dead reader are ignored
+        reader, self._reader = self._reader, None
+        if reader is not None:
+            reader.shutdown()
+        job, self._inflight = self._inflight, None
+        if job is not None:
+            if job.timer is not None:
+                job.timer.cancel()
+            job.last_fault = "disconnected"
+            self._queue.appendleft(job)
+        attempts = self.profile.fallback.reconnect_attempts
+        self._connection = "reconnecting"
+        self._fault("disconnected", f"{self._label()}: {self.url} failed while {doing}: {reason}",
+                    item=job.item if job else None, line=job.line if job else None,
+                    action="reconnect" if attempts else "fallback")
+        if attempts == 0:
+            self._reconnect_failed(self._generation, "no reconnection attempts declared")
+            return
+        gen = self._generation
+        threading.Thread(target=self._reconnect_worker, args=(gen, attempts),
+                         name=f"reconnect-{self.profile.name}", daemon=True).start()
+
+    def _reconnect_worker(self, gen: int, attempts: int) -> None:
+        """Helper thread: try to reopen the port; post the outcome to the engine."""
+        assert self.url is not None
+        last = ""
+        for _ in range(attempts):
+            if self._closed.wait(self.profile.fallback.reconnect_delay_s):
+                return
+            try:
+                port = open_port(self.url, self.profile.serial)
+            except BindingError as error:
+                last = error.message
+                continue
+            if self.profile.serial.settle_s and "://" not in self.url:
+                self._closed.wait(self.profile.serial.settle_s)
+            self.inbox.post(partial(self._reconnected, gen, port))
+            return
+        self.inbox.post(partial(self._reconnect_failed, gen,
+                                f"{attempts} reconnection attempt(s) failed: {last}"))
+
+    def _reconnected(self, gen: int, port: serial.SerialBase) -> None:
+        if gen != self._generation or self._closed.is_set():
+            port.close()
+            return
+        self._start_reader(port)
+        self._note(f"{self._label()}: reconnected to {self.url}")
+        self._pump()
+
+    def _reconnect_failed(self, gen: int, reason: str) -> None:
+        if gen != self._generation or self._closed.is_set():
+            return
+        self._connection = "gone"
+        actions = sorted({self.profile.fallback_for(p).then for p in self.participants})
+        self._fault("reconnect-failed", f"{self._label()}: cannot reopen {self.url}: {reason}",
+                    action="/".join(actions))
+        for participant in self.participants:
+            if self.profile.fallback_for(participant).then == "simulate":
+                self._switch_to_simulated(participant, f"{self.url} is gone")
+            else:
+                self._modes[participant] = "aborted"
+                for item in [w for w in self._waiting if (w.participant or "") == participant]:
+                    self._waiting.remove(item)
+                    self._session_().fail(item, self.profile.fallback_for(participant).exception,
+                                          f"{participant}: the device on {self.url} is gone")
+        jobs, self._queue = list(self._queue), deque()
+        for job in jobs:
+            if self.mode(job.item.participant) == "device":
+                self._modes[job.item.participant or ""] = "aborted"  # an unlisted participant
+            self._reroute(job)
+
+    # ------------------------------------------------------------------ reporting
+    def _fault(self, fault: str, message: str, *, item: WorkItem | None = None,
+               action: str = "none", line: str | None = None, **extra: Any) -> None:
+        data: dict[str, Any] = {"fault": fault, "device": self.profile.name, "port": self.url,
+                                "message": message, "action": action}
+        if item is not None:
+            data.update(participant=item.participant, activity=item.activity,
+                        instance=item.instance, item=item.key)
+        if line is not None:
+            data["command"] = line
+        data.update(extra)
+        self.faults.append(data)
+        if self._session is not None:
+            self._session.trace(EventKind.FAULT, data)
+
+    def _note(self, message: str) -> None:
+        if message not in self.notes:
+            self.notes.append(message)
+        if self._session is not None:
+            self._session.trace(DEVICE_NOTE, {"device": self.profile.name, "port": self.url,
+                                              "message": message})
+
+    def _session_(self) -> PerformerSession:
+        if self._session is None:
+            raise RuntimeError(f"DeviceBinding for {self._label()} used before attach()")
+        return self._session
+
+    def _who(self, item: WorkItem) -> str:
+        return item.participant or self._label()
+
+    def _label(self) -> str:
+        return ", ".join(self.participants) or self.profile.name
+
+    def __repr__(self) -> str:
+        return (f"DeviceBinding({self.profile.name!r}, participants={self.participants!r}, "
+                f"url={self.url!r}, connection={self._connection!r})")

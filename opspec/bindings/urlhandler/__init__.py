@@ -1,0 +1,1 @@
+"""pySerial URL handlers provided by opspec (found through ``serial.protocol_handler_packages``)."""
