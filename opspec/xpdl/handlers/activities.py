@@ -1,0 +1,217 @@
+"""The Activity handler: body, performers, modes, priority, deadlines, loop, restrictions,
+lane, assignments and SISARL directives of one activity."""
+
+from __future__ import annotations
+
+import dataclasses
+
+from lxml import etree
+
+from opspec.errors import SpecError
+from opspec.model.activities import (
+    Activity,
+    ActivityBody,
+    Deadline,
+    Execution,
+    GatewayType,
+    Join,
+    Loop,
+    LoopKind,
+    Mode,
+    NoImplementation,
+    Route,
+    Split,
+)
+from opspec.model.data import Assignment
+from opspec.xpdl.handlers.bodies import BODIES, gateway_type
+from opspec.xpdl.handlers.common import (
+    BuildContext,
+    attr,
+    base_fields,
+    child,
+    children,
+    grandchildren,
+    parse_int,
+    text_of,
+)
+from opspec.xpdl.handlers.events import parse_condition_element
+from opspec.xpdl.handlers.resources import performers_of
+from opspec.xpdl.sisarl import activity_directives
+
+__all__ = ["build_activity", "build_assignments"]
+
+
+def _mode(element: etree._Element, name: str, ctx: BuildContext) -> Mode:
+    raw = attr(element, name)
+    if raw is None:
+        return Mode.AUTOMATIC
+    for mode in Mode:
+        if raw.lower() == mode.value.lower():
+            return mode
+    ctx.warning(element, "bad-mode", f"unknown {name} {raw!r}; Automatic assumed",
+                "use Automatic or Manual")
+    return Mode.AUTOMATIC
+
+
+def _expression_text(element: etree._Element | None) -> str | None:
+    if element is None:
+        return None
+    expression = child(element, "Expression")
+    source = expression if expression is not None else element
+    return "".join(source.itertext()).strip() or None
+
+
+def _deadlines(element: etree._Element, ctx: BuildContext) -> tuple[Deadline, ...]:
+    from opspec.xpdl.durations import parse_duration_expression
+
+    out: list[Deadline] = []
+    for deadline in children(element, "Deadline"):
+        duration_element = child(deadline, "DeadlineDuration")
+        text = _expression_text(duration_element) or ""
+        duration = None
+        if text:
+            try:
+                duration = parse_duration_expression(text)
+            except (SpecError, ValueError, RecursionError):
+                ctx.warning(duration_element, "bad-deadline",
+                            f"deadline {text!r} is not a duration opspec understands; it never "
+                            "expires in a simulation",
+                            "write an ISO 8601 duration (PT5M), seconds (300) or an expression "
+                            "over data fields")
+        else:
+            ctx.warning(deadline, "bad-deadline", "Deadline has no duration; it never expires",
+                        "add <DeadlineDuration>PT5M</DeadlineDuration>")
+        raw = (attr(deadline, "Execution") or "ASYNCHR").upper()
+        execution = Execution.SYNCHR if raw == "SYNCHR" else Execution.ASYNCHR
+        out.append(Deadline(duration_text=text, duration=duration, execution=execution,
+                            exception_name=text_of(child(deadline, "ExceptionName")),
+                            location=ctx.loc(deadline)))
+    return tuple(out)
+
+
+def _loop(element: etree._Element, ctx: BuildContext) -> Loop | None:
+    loop = child(element, "Loop")
+    if loop is None:
+        return None
+    kind_text = (attr(loop, "LoopType") or "").lower()
+    if kind_text == "standard" or (not kind_text and child(loop, "LoopStandard") is not None):
+        detail = child(loop, "LoopStandard")
+        if detail is None:
+            return Loop(kind=LoopKind.STANDARD)
+        text = attr(detail, "LoopCondition") or _expression_text(child(detail, "LoopCondition"))
+        return Loop(kind=LoopKind.STANDARD, condition_text=text,
+                    condition=parse_condition_element(detail, text, ctx, "loop condition"),
+                    maximum=parse_int(attr(detail, "LoopMaximum")),
+                    test_before=(attr(detail, "TestTime") or "After").lower() == "before")
+    if kind_text == "multiinstance" or (not kind_text and child(loop, "LoopMultiInstance") is not None):
+        detail = child(loop, "LoopMultiInstance")
+        text = None
+        if detail is not None:
+            text = attr(detail, "MI_Condition") or _expression_text(child(detail, "MI_Condition"))
+        return Loop(kind=LoopKind.MULTI_INSTANCE, condition_text=text,
+                    condition=_expression(detail, text, ctx, "multi-instance count"))
+    return None  # LoopType="None"
+
+
+def _expression(element: etree._Element | None, text: str | None, ctx: BuildContext, what: str
+                ) -> object | None:
+    from opspec.xpdl.conditions import parse_expression
+
+    if text is None:
+        return None
+    try:
+        return parse_expression(text, location=ctx.loc(element))
+    except (SpecError, ValueError, RecursionError) as error:
+        ctx.warning(element, "bad-expression", f"{what} {text!r} cannot be understood: "
+                    f"{getattr(error, 'message', error)}", "write an expression over data fields")
+        return None
+
+
+def build_assignments(element: etree._Element, ctx: BuildContext) -> tuple[Assignment, ...]:
+    """``element/Assignments/Assignment`` (XPDL 2.1): Target := Expression at AssignTime."""
+    from opspec.xpdl.conditions import parse_expression
+
+    out: list[Assignment] = []
+    for assignment in grandchildren(element, "Assignments", "Assignment"):
+        target = _expression_text(child(assignment, "Target"))
+        text = _expression_text(child(assignment, "Expression")) or ""
+        if target is None:
+            ctx.warning(assignment, "bad-assignment", "Assignment has no Target; it is ignored",
+                        "add <Target>data_field</Target>")
+            continue
+        expression = None
+        if text:
+            try:
+                expression = parse_expression(text, location=ctx.loc(assignment))
+            except (SpecError, ValueError, RecursionError) as error:
+                ctx.warning(assignment, "bad-assignment", f"assignment to {target!r} of {text!r} "
+                            f"cannot be understood: {getattr(error, 'message', error)}",
+                            "write an expression over data fields")
+        out.append(Assignment(target=target, text=text, expression=expression,
+                              assign_time=attr(assignment, "AssignTime") or "End",
+                              location=ctx.loc(assignment)))
+    return tuple(out)
+
+
+def _restrictions(element: etree._Element, ctx: BuildContext) -> tuple[Join | None, Split | None]:
+    join: Join | None = None
+    split: Split | None = None
+    for restriction in grandchildren(element, "TransitionRestrictions", "TransitionRestriction"):
+        join_element = child(restriction, "Join")
+        if join_element is not None and join is None:
+            join = Join(type=gateway_type(join_element, "Type", ctx) or GatewayType.XOR)
+        split_element = child(restriction, "Split")
+        if split_element is not None and split is None:
+            refs = tuple(ref_id for ref in grandchildren(split_element, "TransitionRefs", "TransitionRef")
+                         if (ref_id := attr(ref, "Id")) is not None)
+            split = Split(type=gateway_type(split_element, "Type", ctx) or GatewayType.XOR,
+                          transition_refs=refs)
+    return join, split
+
+
+def _lane(element: etree._Element) -> str | None:
+    for info in grandchildren(element, "NodeGraphicsInfos", "NodeGraphicsInfo"):
+        lane = attr(info, "LaneId")
+        if lane is not None:
+            return lane
+    return None
+
+
+def _body(element: etree._Element, ctx: BuildContext) -> tuple[ActivityBody, etree._Element | None]:
+    for sub in BODIES.matching(element):
+        return BODIES.build(sub, ctx), sub
+    return NoImplementation(), None
+
+
+def build_activity(element: etree._Element, ctx: BuildContext) -> Activity:
+    fields = base_fields(element, ctx, kind="Activity")
+    body, body_element = _body(element, ctx)
+    join, split = _restrictions(element, ctx)
+    if isinstance(body, Route) and body_element is not None and attr(body_element, "GatewayType") is None:
+        # XPDL 1.0 and Bizagi routes say what they do only through their restrictions.
+        derived = (split.type if split else None) or (join.type if join else None) or GatewayType.XOR
+        body = dataclasses.replace(body, gateway=derived)
+    priority_text = text_of(child(element, "Priority"))
+    priority = parse_int(priority_text)
+    if priority_text is not None and priority is None:
+        ctx.warning(child(element, "Priority"), "bad-priority",
+                    f"Priority {priority_text!r} of activity {fields['id']!r} is not an integer; ignored",
+                    "write an integer")
+    directives, coordination = activity_directives(element, ctx)
+    return Activity(
+        body=body,
+        performers=performers_of(element),
+        start_mode=_mode(element, "StartMode", ctx),
+        finish_mode=_mode(element, "FinishMode", ctx),
+        priority=priority,
+        deadlines=_deadlines(element, ctx),
+        loop=_loop(element, ctx),
+        join=join,
+        split=split,
+        lane=_lane(element),
+        directives=directives,
+        coordination=coordination,
+        assignments=build_assignments(element, ctx),
+        **fields,
+    )
+

@@ -1,0 +1,194 @@
+"""What every handler shares: the build context (file, diagnostics) and tree helpers.
+
+Handlers run on a *normalised* tree (:mod:`opspec.xpdl.normalize`): every XPDL element is in
+:data:`~opspec.xpdl.namespaces.CANONICAL` and uses its XPDL 2.1 spelling.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from typing import Any, TypeVar
+
+from lxml import etree
+
+from opspec.errors import Diagnostic, Severity, SourceLocation
+from opspec.model.common import ExtendedAttribute
+from opspec.model.package import XpdlVersion
+from opspec.xpdl.namespaces import CANONICAL, qname
+from opspec.xpdl.reader import line_of
+
+__all__ = [
+    "BuildContext",
+    "attr",
+    "base_fields",
+    "child",
+    "child_text",
+    "children",
+    "extended_attributes",
+    "grandchildren",
+    "local_name",
+    "parse_bool",
+    "parse_int",
+    "text_of",
+]
+
+T = TypeVar("T")
+Node = etree._Element
+
+
+@dataclass(slots=True)
+class BuildContext:
+    """One file being built: where it is, its version, and the diagnostics found so far."""
+
+    path: str
+    version: XpdlVersion
+    diagnostics: list[Diagnostic] = field(default_factory=list)
+
+    def loc(self, element: Node | None) -> SourceLocation:
+        return SourceLocation(self.path, line_of(element) if element is not None else None)
+
+    def report(
+        self, element: Node | None, severity: Severity, code: str, message: str, hint: str = ""
+    ) -> None:
+        self.diagnostics.append(Diagnostic(self.loc(element), severity, code, message, hint))
+
+    def error(self, element: Node | None, code: str, message: str, hint: str = "") -> None:
+        self.report(element, Severity.ERROR, code, message, hint)
+
+    def warning(self, element: Node | None, code: str, message: str, hint: str = "") -> None:
+        self.report(element, Severity.WARNING, code, message, hint)
+
+    def each(self, elements: list[Node], build: Callable[[Node, BuildContext], T | None]) -> tuple[T, ...]:
+        """Build every element, dropping those whose handler gave ``None``."""
+        out: list[T] = []
+        for element in elements:
+            value = build(element, self)
+            if value is not None:
+                out.append(value)
+        return tuple(out)
+
+
+def local_name(element: Node) -> str:
+    tag = element.tag
+    if not isinstance(tag, str):
+        return ""
+    return tag.rsplit("}", 1)[-1]
+
+
+def child(element: Node, local: str) -> Node | None:
+    return element.find(qname(local, CANONICAL))
+
+
+def children(element: Node | None, local: str) -> list[Node]:
+    if element is None:
+        return []
+    return element.findall(qname(local, CANONICAL))
+
+
+def grandchildren(element: Node, wrapper: str, local: str) -> list[Node]:
+    """``element/wrapper/local`` over every ``wrapper`` (files sometimes repeat wrappers)."""
+    out: list[Node] = []
+    for group in children(element, wrapper):
+        out.extend(children(group, local))
+    return out
+
+
+def text_of(element: Node | None) -> str | None:
+    """The element's stripped text, or ``None`` when absent or blank."""
+    if element is None or element.text is None:
+        return None
+    text = element.text.strip()
+    return text or None
+
+
+def child_text(element: Node, local: str) -> str | None:
+    return text_of(child(element, local))
+
+
+def attr(element: Node, name: str) -> str | None:
+    """An attribute's stripped value, ``None`` when absent or blank."""
+    value = element.get(name)
+    if value is None:
+        return None
+    value = value.strip()
+    return value or None
+
+
+def parse_bool(text: str | None) -> bool | None:
+    if text is None:
+        return None
+    lowered = text.strip().lower()
+    if lowered in ("true", "1", "yes"):
+        return True
+    if lowered in ("false", "0", "no"):
+        return False
+    return None
+
+
+def parse_int(text: str | None) -> int | None:
+    if text is None:
+        return None
+    try:
+        return int(text.strip())
+    except ValueError:
+        try:
+            number = float(text.strip())
+        except ValueError:
+            return None
+        return int(number) if number.is_integer() else None
+
+
+def _raw_children(element: Node) -> str | None:
+    parts = [
+        etree.tostring(sub, encoding="unicode", with_tail=False)
+        for sub in element
+        if isinstance(sub.tag, str)
+    ]
+    return "".join(parts) or None
+
+
+def extended_attributes(element: Node, ctx: BuildContext) -> tuple[ExtendedAttribute, ...]:
+    """Every ``ExtendedAttributes/ExtendedAttribute`` of ``element``, kept verbatim."""
+    out: list[ExtendedAttribute] = []
+    for ext in grandchildren(element, "ExtendedAttributes", "ExtendedAttribute"):
+        name = ext.get("Name")
+        if name is None:
+            ctx.warning(ext, "extended-attribute-without-name",
+                        "ExtendedAttribute has no Name; it is kept with an empty name",
+                        "give every ExtendedAttribute a Name")
+            name = ""
+        out.append(
+            ExtendedAttribute(
+                name=name,
+                value=ext.get("Value"),
+                text=ext.text if ext.text is not None and ext.text.strip() else None,
+                raw_xml=_raw_children(ext),
+                location=ctx.loc(ext),
+            )
+        )
+    return tuple(out)
+
+
+def base_fields(
+    element: Node, ctx: BuildContext, *, kind: str, id_default: str | None = None
+) -> dict[str, Any]:
+    """The :class:`~opspec.model.common.Element` fields (id, name, description, extended
+    attributes, location). A missing Id is an error (the element gets a placeholder id) unless
+    ``id_default`` is given (elements whose Id is optional)."""
+    element_id = attr(element, "Id") or id_default
+    if element_id is None:
+        line = line_of(element)
+        element_id = f"<{kind} without Id at line {line}>" if line else f"<{kind} without Id>"
+        ctx.error(element, "missing-id", f"{kind} has no Id",
+                  f"add an Id attribute to the {kind}")
+    description = child_text(element, "Description")
+    if description is None:
+        description = attr(element, "Description")
+    return {
+        "id": element_id,
+        "name": attr(element, "Name"),
+        "description": description,
+        "extended_attributes": extended_attributes(element, ctx),
+        "location": ctx.loc(element),
+    }

@@ -1,0 +1,178 @@
+"""The normalising pass: one XPDL dialect for the handlers.
+
+It runs on the lxml tree after reading and before building, and does two things:
+
+1. every element in any XPDL namespace (1.0, 2.0, 2.1, 2.2 or none) is renamed into
+   :data:`~opspec.xpdl.namespaces.CANONICAL`, so handlers are keyed by one namespace (files mix
+   them: XPDL 2.0 exports carry ``deprecated:SubFlow`` elements in the 1.0 namespace);
+2. XPDL 1.0 (and 2.0) spellings are rewritten into their XPDL 2.1 forms:
+
+   ============================================  ==============================================
+   1.0 / 2.0                                     2.1
+   ============================================  ==============================================
+   ``Implementation/Tool`` (one or more)         ``Implementation/Task/TaskApplication``
+   ``BlockActivity@BlockId``                     ``BlockActivity@ActivitySetId``
+   ``Activity/Performer``, ``Lane/Performer``    ``…/Performers/Performer``
+   ``<StartMode><Automatic/></StartMode>``       ``Activity@StartMode="Automatic"`` (Finish too)
+   ``Join/Split@Type`` AND / XOR / OR            Parallel / Exclusive / Inclusive
+   ``Route@GatewayType`` AND / XOR / OR          Parallel / Exclusive / Inclusive
+   ``Condition`` text                            ``Condition/Expression`` text
+   ``Deadline/DeadlineCondition``                ``Deadline/DeadlineDuration``
+   ``Trigger="Rule"`` + ``TriggerRule``          ``Trigger="Conditional"`` + ``TriggerConditional``
+   ============================================  ==============================================
+
+The contents of ``ExtendedAttribute`` and ``SchemaType`` elements are never touched, so vendor
+data is kept exactly as written. Each rewrite fires only on its old shape, so the pass is
+idempotent and safe on files that mix versions. Line numbers of moved elements are kept.
+"""
+
+from __future__ import annotations
+
+from lxml import etree
+
+from opspec.xpdl.namespaces import CANONICAL, is_xpdl_namespace, qname
+
+__all__ = ["normalize"]
+
+_OPAQUE = frozenset({"ExtendedAttribute", "SchemaType"})
+_GATE_SYNONYMS = {"AND": "Parallel", "XOR": "Exclusive", "OR": "Inclusive"}
+
+
+def _q(local: str) -> str:
+    return qname(local, CANONICAL)
+
+
+_Index = dict[str, list[etree._Element]]
+
+
+def _index(root: etree._Element) -> _Index:
+    """Canonical elements by local name, in document order, outside opaque contents."""
+    found: _Index = {}
+    prefix = _q("")
+    stack: list[etree._Element] = [root]
+    while stack:
+        element = stack.pop()
+        tag = element.tag
+        if not isinstance(tag, str) or not tag.startswith(prefix):
+            continue  # comments, PIs and foreign (vendor) elements
+        local = tag[len(prefix):]
+        found.setdefault(local, []).append(element)
+        if local not in _OPAQUE:
+            stack.extend(reversed(element))
+    return found
+
+
+def _canonical_namespaces(root: etree._Element) -> None:
+    # Foreign (vendor) elements and opaque contents are not entered: they are kept verbatim.
+    stack: list[etree._Element] = [root]
+    while stack:
+        element = stack.pop()
+        if not isinstance(element.tag, str):
+            continue  # comments, processing instructions
+        name = etree.QName(element)
+        if not is_xpdl_namespace(name.namespace):
+            continue
+        if name.namespace != CANONICAL:
+            element.tag = _q(name.localname)
+        if name.localname not in _OPAQUE:
+            stack.extend(element)
+
+
+def _tools_to_tasks(index: _Index) -> None:
+    for implementation in index.get("Implementation", []):
+        tools = implementation.findall(_q("Tool"))
+        if not tools:
+            continue
+        task = etree.Element(_q("Task"))
+        task.sourceline = tools[0].sourceline
+        tools[0].addprevious(task)
+        for tool in tools:
+            tool.tag = _q("TaskApplication")
+            task.append(tool)
+
+
+def _performers(index: _Index) -> None:
+    for tag in ("Activity", "Lane"):
+        for owner in index.get(tag, []):
+            loose = owner.findall(_q("Performer"))
+            if not loose:
+                continue
+            performers = owner.find(_q("Performers"))
+            if performers is None:
+                performers = etree.Element(_q("Performers"))
+                performers.sourceline = loose[0].sourceline
+                loose[0].addprevious(performers)
+            for performer in loose:
+                performers.append(performer)
+
+
+def _modes(index: _Index) -> None:
+    for activity in index.get("Activity", []):
+        for tag in ("StartMode", "FinishMode"):
+            element = activity.find(_q(tag))
+            if element is None:
+                continue
+            chosen = next((etree.QName(c).localname for c in element if isinstance(c.tag, str)), None)
+            if chosen and activity.get(tag) is None:
+                activity.set(tag, chosen)
+            activity.remove(element)
+
+
+def _gateways(index: _Index) -> None:
+    for tag, attribute in (("Join", "Type"), ("Split", "Type"), ("Route", "GatewayType")):
+        for element in index.get(tag, []):
+            value = element.get(attribute)
+            if value is not None and value.strip().upper() in _GATE_SYNONYMS:
+                element.set(attribute, _GATE_SYNONYMS[value.strip().upper()])
+
+
+def _conditions(index: _Index) -> None:
+    for condition in index.get("Condition", []):
+        parent = condition.getparent()
+        if parent is None or etree.QName(parent).localname != "Transition":
+            continue
+        if condition.find(_q("Expression")) is not None:
+            continue
+        text = condition.text
+        if text is not None and text.strip():
+            expression = etree.SubElement(condition, _q("Expression"))
+            expression.text = text
+            expression.sourceline = condition.sourceline
+            condition.text = None
+
+
+def _deadlines(index: _Index) -> None:
+    for deadline in index.get("Deadline", []):
+        old = deadline.find(_q("DeadlineCondition"))
+        if old is not None and deadline.find(_q("DeadlineDuration")) is None:
+            old.tag = _q("DeadlineDuration")
+
+
+def _block_ids(index: _Index) -> None:
+    for block in index.get("BlockActivity", []):
+        old = block.get("BlockId")
+        if old is not None and block.get("ActivitySetId") is None:
+            block.set("ActivitySetId", old)
+            del block.attrib["BlockId"]
+
+
+def _rules(index: _Index) -> None:
+    for tag in ("StartEvent", "IntermediateEvent"):
+        for event in index.get(tag, []):
+            if (event.get("Trigger") or "").strip() == "Rule":
+                event.set("Trigger", "Conditional")
+            rule = event.find(_q("TriggerRule"))
+            if rule is not None and event.find(_q("TriggerConditional")) is None:
+                rule.tag = _q("TriggerConditional")
+                if rule.get("RuleName") is not None and rule.get("ConditionName") is None:
+                    rule.set("ConditionName", rule.get("RuleName") or "")
+
+
+def normalize(root: etree._Element) -> etree._Element:
+    """Rewrite ``root`` in place into the canonical namespace and XPDL 2.1 forms; return it."""
+    _canonical_namespaces(root)
+    index = _index(root)
+    for rewrite in (_tools_to_tasks, _performers, _modes, _gateways, _conditions, _deadlines,
+                    _block_ids, _rules):
+        rewrite(index)
+    return root

@@ -1,0 +1,260 @@
+"""The hardened XML reader: bytes in, an lxml tree and its XPDL version out.
+
+Contract:
+
+- no network, no DTD loading, no entity expansion (``XMLParser(resolve_entities=False,
+  no_network=True, load_dtd=False, huge_tree=False)``), and any ``DOCTYPE`` is rejected outright
+  (XPDL never needs one; DTDs are how XXE and entity bombs get in);
+- a size limit (:data:`DEFAULT_MAX_BYTES`, configurable) checked before parsing, and while
+  reading a stream, so a 1 GB file is never read into memory;
+- byte-order marks (UTF-8/UTF-16), missing XML declarations and ``ASCII``/``us-ascii``
+  declarations on files that really hold UTF-8 are handled; a file that is not valid UTF-8 and
+  declares nothing else is read as Latin-1 with a warning;
+- the version comes from the root element's namespace only (:mod:`opspec.xpdl.namespaces`);
+- every fatal problem is an :class:`XmlReadError` (a :class:`~opspec.errors.SpecError`) with a
+  stable ``code`` and the file:line where it was found.
+"""
+
+from __future__ import annotations
+
+import re
+from dataclasses import dataclass
+from pathlib import Path
+from typing import BinaryIO, Final
+
+from lxml import etree
+
+from opspec.errors import Diagnostic, Severity, SourceLocation, SpecError
+from opspec.model.package import XpdlVersion
+from opspec.xpdl.namespaces import XPDL_NAMESPACES, version_of_namespace
+
+__all__ = [
+    "DEFAULT_MAX_BYTES",
+    "ReadOutcome",
+    "XmlReadError",
+    "line_of",
+    "read_file",
+    "read_limited",
+    "read_tree",
+    "read_xml",
+]
+
+#: Default size limit of one specification file (64 MiB).
+DEFAULT_MAX_BYTES: Final = 64 * 1024 * 1024
+
+# libxml2 stores line numbers in 16 bits for some nodes: from 65,535 on they are not trustworthy.
+_LAST_TRUSTED_LINE: Final = 65534
+_CHUNK: Final = 1024 * 1024
+
+_DECLARED_ENCODING = re.compile(rb"""^\s*<\?xml[^>]*?encoding\s*=\s*["']([A-Za-z0-9._-]+)["']""")
+_ASCII_NAMES: Final = frozenset({"ascii", "us-ascii", "ansi_x3.4-1968", "iso646-us", "us"})
+_DOCTYPE_MARKERS: Final = (
+    b"<!DOCTYPE",
+    "<!DOCTYPE".encode("utf-16-le"),
+    "<!DOCTYPE".encode("utf-16-be"),
+)
+
+
+class XmlReadError(SpecError):
+    """A file cannot be read as XPDL at all. ``code`` is one of ``io-error``, ``too-big``,
+    ``empty-file``, ``not-well-formed``, ``doctype``, ``unknown-root``, ``unknown-version``."""
+
+    def __init__(self, code: str, message: str, *, location: SourceLocation, hint: str = "") -> None:
+        self.code = code
+        super().__init__(message, location=location, hint=hint)
+
+    def diagnostic(self) -> Diagnostic:
+        location = self.location or SourceLocation("<unknown>")
+        return Diagnostic(location, Severity.ERROR, self.code, self.message, self.hint)
+
+
+@dataclass(frozen=True, slots=True)
+class ReadOutcome:
+    """A parsed file: its root element, its version and non-fatal reading warnings."""
+
+    root: etree._Element
+    version: XpdlVersion
+    warnings: tuple[Diagnostic, ...] = ()
+
+
+def line_of(element: object) -> int | None:
+    """The 1-based line of an lxml element, or ``None`` when unknown or untrustworthy."""
+    line = getattr(element, "sourceline", None)
+    if isinstance(line, int) and 0 < line <= _LAST_TRUSTED_LINE:
+        return line
+    return None
+
+
+def _parser(encoding: str | None = None) -> etree.XMLParser:
+    return etree.XMLParser(
+        resolve_entities=False,
+        no_network=True,
+        load_dtd=False,
+        huge_tree=False,
+        remove_comments=False,
+        encoding=encoding,
+    )
+
+
+def read_limited(stream: BinaryIO, *, path: str, max_bytes: int = DEFAULT_MAX_BYTES) -> bytes:
+    """Read a binary stream to its end, refusing it as soon as it exceeds ``max_bytes``.
+
+    At most ``max_bytes`` plus one chunk is ever held in memory.
+    """
+    chunks: list[bytes] = []
+    total = 0
+    while True:
+        chunk = stream.read(min(_CHUNK, max_bytes + 1 - total) or 1)
+        if not chunk:
+            return b"".join(chunks)
+        total += len(chunk)
+        if total > max_bytes:
+            raise _too_big(path, max_bytes)
+        chunks.append(chunk)
+
+
+def read_file(path: str | Path, *, max_bytes: int = DEFAULT_MAX_BYTES) -> bytes:
+    """The bytes of a file, checking its size before reading it."""
+    shown = str(path)
+    try:
+        size = Path(path).stat().st_size
+        if size > max_bytes:
+            raise _too_big(shown, max_bytes)
+        with open(path, "rb") as stream:
+            return read_limited(stream, path=shown, max_bytes=max_bytes)
+    except XmlReadError:
+        raise
+    except OSError as error:
+        reason = error.strerror or type(error).__name__
+        raise XmlReadError(
+            "io-error",
+            f"cannot read the file: {reason}",
+            location=SourceLocation(shown),
+            hint="check the path and its permissions",
+        ) from None
+
+
+def _too_big(path: str, max_bytes: int) -> XmlReadError:
+    return XmlReadError(
+        "too-big",
+        f"file is larger than the limit of {max_bytes:,} bytes",
+        location=SourceLocation(path),
+        hint="split the package into several files referenced as ExternalPackages, or raise "
+        "the size limit",
+    )
+
+
+def _has_doctype(data: bytes) -> bool:
+    head = data[: 64 * 1024]
+    return any(marker in head for marker in _DOCTYPE_MARKERS)
+
+
+def _doctype_error(path: str, line: int | None) -> XmlReadError:
+    return XmlReadError(
+        "doctype",
+        "DOCTYPE declarations are not allowed in specifications",
+        location=SourceLocation(path, line),
+        hint="remove the <!DOCTYPE ...> line; XPDL needs no DTD, and DTDs can read local files "
+        "or expand entities without bound",
+    )
+
+
+def _declared_encoding(data: bytes) -> str | None:
+    match = _DECLARED_ENCODING.match(data.removeprefix(b"\xef\xbb\xbf")[:512])
+    return match.group(1).decode("ascii").lower() if match else None
+
+
+def _is_encoding_error(error: etree.XMLSyntaxError) -> bool:
+    text = str(error).lower()
+    return "encoding" in text or "utf-8" in text or "char 0x" in text
+
+
+def _parse(data: bytes, path: str) -> tuple[etree._Element, list[Diagnostic]]:
+    warnings: list[Diagnostic] = []
+    declared = _declared_encoding(data)
+    utf16 = data.startswith((b"\xff\xfe", b"\xfe\xff"))
+    # Files that declare ASCII but hold UTF-8 (common in exported fragments): UTF-8 is a superset
+    # of ASCII, so reading them as UTF-8 loses nothing and accepts the real content.
+    first = "utf-8" if declared in _ASCII_NAMES else None
+    try:
+        return etree.fromstring(data, _parser(first)), warnings
+    except etree.XMLSyntaxError as error:
+        if _has_doctype(data):
+            raise _doctype_error(path, error.lineno) from None
+        retry = not utf16 and _is_encoding_error(error) and declared in (None, "utf-8", *_ASCII_NAMES)
+        if not retry:
+            raise _not_well_formed(path, error) from None
+        original = error
+    try:
+        root = etree.fromstring(data, _parser("iso-8859-1"))
+    except etree.XMLSyntaxError:
+        raise _not_well_formed(path, original) from None
+    warnings.append(
+        Diagnostic(
+            SourceLocation(path, original.lineno or None),
+            Severity.WARNING,
+            "encoding-guessed",
+            "the file is not valid UTF-8 and declares no other encoding; read it as Latin-1",
+            "add an XML declaration naming the real encoding, or save the file as UTF-8",
+        )
+    )
+    return root, warnings
+
+
+def _not_well_formed(path: str, error: etree.XMLSyntaxError) -> XmlReadError:
+    message = error.msg or str(error)
+    message = re.sub(r"\s*\(<string>, line \d+\)$", "", message)
+    return XmlReadError(
+        "not-well-formed",
+        f"not well-formed XML: {message}",
+        location=SourceLocation(path, error.lineno or None),
+        hint="fix the XML syntax at that line (an editor with XML checking shows it)",
+    )
+
+
+def read_tree(data: bytes, *, path: str, max_bytes: int = DEFAULT_MAX_BYTES) -> ReadOutcome:
+    """Parse ``data`` safely and check that it is an XPDL package. Raises :class:`XmlReadError`."""
+    if len(data) > max_bytes:
+        raise _too_big(path, max_bytes)
+    if not data.strip(b" \t\r\n\x00\xef\xbb\xbf\xff\xfe"):
+        raise XmlReadError(
+            "empty-file",
+            "the file is empty",
+            location=SourceLocation(path),
+            hint="an XPDL file starts with a <Package> element",
+        )
+    root, warnings = _parse(data, path)
+    tree = root.getroottree()
+    if tree.docinfo.doctype or tree.docinfo.internalDTD is not None:
+        raise _doctype_error(path, 1)
+    qname = etree.QName(root)
+    line = line_of(root)
+    if qname.localname != "Package":
+        raise XmlReadError(
+            "unknown-root",
+            f"root element is <{qname.localname}>, not an XPDL <Package>",
+            location=SourceLocation(path, line),
+            hint="give opspec an XPDL package file (its root element is Package)",
+        )
+    version = version_of_namespace(qname.namespace)
+    if version is None:
+        known = ", ".join(ns for ns in XPDL_NAMESPACES if ns)
+        raise XmlReadError(
+            "unknown-version",
+            f"unknown XPDL namespace {qname.namespace!r} on <Package>",
+            location=SourceLocation(path, line),
+            hint=f"use one of {known}, or no namespace",
+        )
+    return ReadOutcome(root, version, tuple(warnings))
+
+
+def read_xml(
+    data: bytes, *, path: str, max_bytes: int = DEFAULT_MAX_BYTES
+) -> tuple[etree._Element, XpdlVersion]:
+    """Parse ``data`` safely; return the root ``Package`` element and the XPDL version.
+
+    Raises :class:`XmlReadError` (with ``path:line``) for anything that is not a readable XPDL
+    package: too big, empty, not well-formed, a DOCTYPE, another root element or namespace.
+    """
+    outcome = read_tree(data, path=path, max_bytes=max_bytes)
+    return outcome.root, outcome.version

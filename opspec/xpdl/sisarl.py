@@ -1,0 +1,203 @@
+"""SISARL-XPDL extensions: engine directives, coordination built-ins, metrics and modes.
+
+Directives are ``ExtendedAttribute``s named ``opspec:NAME`` (value in ``Value`` or the text),
+or, as a shorthand, attributes ``opspec:NAME`` in the ``urn:opspec:sisarl:1`` namespace on the
+element; both give the same model. Unknown ``opspec:`` names are ``unknown-directive``
+warnings; bad values are ``bad-directive`` errors naming file:line and what is allowed.
+The syntax is documented in ``docs/sisarl-xpdl.md``.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass
+from typing import Any
+
+from lxml import etree
+
+from opspec.errors import Diagnostic, Severity, SourceLocation
+from opspec.model.sisarl import (
+    ActivityDirectives,
+    CoordinationBuiltIn,
+    Mode,
+    ProcessDirectives,
+)
+from opspec.xpdl.handlers.common import BuildContext, grandchildren
+from opspec.xpdl.namespaces import OPSPEC, OPSPEC_PREFIX
+from opspec.xpdl.sisarl_values import (
+    SisarlValueError,
+    parse_boolean,
+    parse_distribution,
+    parse_integer,
+    parse_period,
+    parse_seconds,
+    parse_trigger,
+)
+
+__all__ = [
+    "ACTIVITY_DIRECTIVES",
+    "PACKAGE_DIRECTIVES",
+    "PROCESS_DIRECTIVES",
+    "Directive",
+    "activity_directives",
+    "package_extensions",
+    "process_directives",
+]
+
+
+@dataclass(frozen=True, slots=True)
+class Directive:
+    """One ``opspec:`` directive as written: its name (without prefix), its value text, the
+    ``ExtendedAttribute`` element when written in that form, and where it is."""
+
+    name: str
+    value: str
+    element: etree._Element | None
+    location: SourceLocation
+
+
+PROCESS_DIRECTIVES = ("Period", "Rate", "Priority", "Deadline", "Latency", "StartTrigger",
+                      "EndTrigger", "AutoStart", "Lane", "Mode")
+ACTIVITY_DIRECTIVES = ("AutoRun", "PriorityIncrement", "StartTrigger", "EndTrigger", "Raises",
+                       "CpuDemand", "Duration", "BuiltIn")
+PACKAGE_DIRECTIVES = ("Metrics", "Modes")
+
+
+def collect(element: etree._Element, ctx: BuildContext, known: tuple[str, ...],
+            what: str) -> dict[str, Directive]:
+    """Every ``opspec:`` directive on ``element`` (both forms), warning about unknown names."""
+    found: dict[str, Directive] = {}
+
+    def add(directive: Directive) -> None:
+        if directive.name not in known:
+            ctx.diagnostics.append(_diag(directive.location, "warning", "unknown-directive",
+                                   f"unknown directive opspec:{directive.name} on {what}",
+                                   f"known on {what}: {', '.join('opspec:' + k for k in known)}"))
+            return
+        if directive.name in found:
+            ctx.diagnostics.append(_diag(directive.location, "warning", "duplicate-directive",
+                                   f"opspec:{directive.name} is given twice on {what}; the "
+                                   "last one counts", "remove one of them"))
+        found[directive.name] = directive
+
+    for name, value in element.attrib.items():
+        if name.startswith(f"{{{OPSPEC}}}"):
+            add(Directive(name.split("}", 1)[1], value, None, ctx.loc(element)))
+    for ext in grandchildren(element, "ExtendedAttributes", "ExtendedAttribute"):
+        name = ext.get("Name") or ""
+        if name.startswith(OPSPEC_PREFIX):
+            value = ext.get("Value")
+            if value is None:
+                value = (ext.text or "").strip()
+            add(Directive(name[len(OPSPEC_PREFIX):], value, ext, ctx.loc(ext)))
+    return found
+
+
+def _diag(location: SourceLocation, severity: str, code: str, message: str, hint: str) -> Diagnostic:
+    return Diagnostic(location, Severity(severity), code, message, hint)
+
+
+def _apply(directives: dict[str, Directive], ctx: BuildContext,
+           parsers: dict[str, tuple[str, Callable[[Directive], Any]]]) -> dict[str, Any]:
+    """Parse each directive with its parser into a model field; bad values are errors."""
+    values: dict[str, Any] = {}
+    for name, directive in directives.items():
+        if name not in parsers:
+            continue
+        field_name, parse = parsers[name]
+        try:
+            values[field_name] = parse(directive)
+        except SisarlValueError as error:
+            ctx.diagnostics.append(_diag(directive.location, "error", "bad-directive",
+                                         f"opspec:{name}: {error.message}", error.hint))
+    return values
+
+
+def _lane(directive: Directive) -> str:
+    value = directive.value.strip()
+    if value not in ("user", "device"):
+        raise SisarlValueError(f"lane must be 'user' or 'device', not {value!r}",
+                               location=directive.location, hint="write user or device")
+    return value
+
+
+def _mode_id(directive: Directive) -> str:
+    value = directive.value.strip()
+    if not value:
+        raise SisarlValueError("mode id is empty", location=directive.location,
+                               hint="name a mode declared in opspec:Modes")
+    return value
+
+
+def process_directives(element: etree._Element, ctx: BuildContext) -> ProcessDirectives:
+    """The :class:`ProcessDirectives` of a ``WorkflowProcess`` element."""
+    found = collect(element, ctx, PROCESS_DIRECTIVES, "a WorkflowProcess")
+    if "Deadline" in found and "Latency" in found:
+        ctx.diagnostics.append(_diag(found["Latency"].location, "warning", "duplicate-directive",
+                               "opspec:Latency is an alias of opspec:Deadline; Deadline counts",
+                               "keep one of them"))
+        del found["Latency"]
+    if "Period" in found and "Rate" in found:
+        ctx.diagnostics.append(_diag(found["Rate"].location, "warning", "duplicate-directive",
+                               "opspec:Rate and opspec:Period both given; Period counts",
+                               "keep one of them"))
+        del found["Rate"]
+    values = _apply(found, ctx, {
+        "Period": ("period", lambda d: parse_period(d.value, d.location, rate=False)),
+        "Rate": ("period", lambda d: parse_period(d.value, d.location, rate=True)),
+        "Priority": ("priority", lambda d: parse_integer(d.value, d.location, "priority")),
+        "Deadline": ("deadline", lambda d: parse_seconds(d.value, d.location, "deadline")),
+        "Latency": ("deadline", lambda d: parse_seconds(d.value, d.location, "latency")),
+        "StartTrigger": ("start_trigger", lambda d: parse_trigger(d.value, d.location)),
+        "EndTrigger": ("end_trigger", lambda d: parse_trigger(d.value, d.location)),
+        "AutoStart": ("auto_start", lambda d: parse_boolean(d.value, d.location, "AutoStart")),
+        "Lane": ("lane", _lane),
+        "Mode": ("mode", _mode_id),
+    })
+    return ProcessDirectives(**values)
+
+
+def activity_directives(
+    element: etree._Element, ctx: BuildContext
+) -> tuple[ActivityDirectives, CoordinationBuiltIn | None]:
+    """The :class:`ActivityDirectives` and coordination built-in of an ``Activity`` element."""
+    from opspec.xpdl.sisarl_builtins import build_builtin
+
+    found = collect(element, ctx, ACTIVITY_DIRECTIVES, "an Activity")
+    values = _apply(found, ctx, {
+        "AutoRun": ("auto_run", lambda d: parse_boolean(d.value, d.location, "AutoRun")),
+        "PriorityIncrement": ("priority_increment",
+                              lambda d: parse_integer(d.value, d.location, "PriorityIncrement")),
+        "StartTrigger": ("start_trigger", lambda d: parse_trigger(d.value, d.location)),
+        "EndTrigger": ("end_trigger", lambda d: parse_trigger(d.value, d.location)),
+        "Raises": ("raises", _raises),
+        "CpuDemand": ("cpu_demand", lambda d: parse_seconds(d.value, d.location, "CpuDemand")),
+        "Duration": ("duration", lambda d: parse_distribution(d.value, d.location)),
+    })
+    builtin = None
+    if "BuiltIn" in found:
+        builtin = build_builtin(found["BuiltIn"], ctx)
+    return ActivityDirectives(**values), builtin
+
+
+def _raises(directive: Directive) -> Any:
+    trigger = parse_trigger(directive.value, directive.location)
+    if trigger.kind not in ("message", "signal"):
+        raise SisarlValueError(f"an activity can only raise a message or a signal, not "
+                               f"{trigger.kind!r}", location=directive.location,
+                               hint="write message:NAME or signal:NAME")
+    return trigger
+
+
+def package_extensions(element: etree._Element, ctx: BuildContext) -> dict[str, Any]:
+    """``metrics`` and ``modes`` of a ``Package`` element, as Package keyword arguments."""
+    from opspec.xpdl.sisarl_builtins import build_metrics, build_modes
+
+    found = collect(element, ctx, PACKAGE_DIRECTIVES, "a Package")
+    out: dict[str, Any] = {}
+    if "Metrics" in found:
+        out["metrics"] = build_metrics(found["Metrics"], ctx)
+    if "Modes" in found:
+        modes: tuple[Mode, ...] = build_modes(found["Modes"], ctx)
+        out["modes"] = modes
+    return out

@@ -1,0 +1,210 @@
+"""The structured SISARL-XPDL directives: ``opspec:BuiltIn`` (coordination built-ins),
+``opspec:Metrics`` and ``opspec:Modes``. Their content is child elements in the
+``urn:opspec:sisarl:1`` namespace inside the ``ExtendedAttribute``."""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING
+
+from lxml import etree
+
+from opspec.errors import Diagnostic, Severity, SourceLocation
+from opspec.model.sisarl import (
+    CoordinationBuiltIn,
+    CoordinationKind,
+    EventSelector,
+    MetricDefinition,
+    MetricKind,
+    Mode,
+)
+from opspec.xpdl.handlers.common import BuildContext
+from opspec.xpdl.namespaces import OPSPEC
+
+if TYPE_CHECKING:
+    from opspec.xpdl.sisarl import Directive
+
+__all__ = ["BUILT_INS", "build_builtin", "build_metrics", "build_modes"]
+
+BUILT_INS = ("Arbiter", "Voter", "Superposition", "PushData", "PullData", "ModeChange")
+_METRICS = ("Count", "Duration", "Ratio")
+_WHICH = ("first", "last")
+
+
+class _Bad(Exception):
+    """Internal: a structured directive is malformed at ``element``."""
+
+    def __init__(self, element: etree._Element, message: str, hint: str) -> None:
+        super().__init__(message)
+        self.element = element
+        self.message = message
+        self.hint = hint
+
+
+def _ours(element: etree._Element) -> list[etree._Element]:
+    return [sub for sub in element if isinstance(sub.tag, str) and sub.tag.startswith(f"{{{OPSPEC}}}")]
+
+
+def _local(element: etree._Element) -> str:
+    return str(element.tag).split("}", 1)[-1]
+
+
+def _need(element: etree._Element, name: str) -> str:
+    value = (element.get(name) or "").strip()
+    if not value:
+        raise _Bad(element, f"opspec:{_local(element)} needs attribute {name}",
+                   f"add {name}=\"...\" to <opspec:{_local(element)}>")
+    return value
+
+
+def _report(ctx: BuildContext, error: _Bad, code: str) -> None:
+    ctx.diagnostics.append(Diagnostic(ctx.loc(error.element), Severity.ERROR, code, error.message,
+                                      error.hint))
+
+
+def _container(directive: Directive, ctx: BuildContext) -> etree._Element | None:
+    if directive.element is None:
+        ctx.diagnostics.append(Diagnostic(
+            directive.location, Severity.ERROR, "bad-directive",
+            f"opspec:{directive.name} cannot be written as an attribute",
+            f"write <ExtendedAttribute Name=\"opspec:{directive.name}\"> with child elements"))
+        return None
+    return directive.element
+
+
+def _inputs(element: etree._Element) -> list[etree._Element]:
+    return [sub for sub in _ours(element) if _local(sub) == "Input"]
+
+
+def _builtin(element: etree._Element) -> CoordinationBuiltIn:
+    kind = _local(element)
+    if kind in ("Arbiter", "Voter", "Superposition"):
+        output = _need(element, "Output")
+        inputs = _inputs(element)
+        if not inputs:
+            raise _Bad(element, f"opspec:{kind} has no inputs",
+                       f"add <opspec:Input Ref=\"data_field\"/> children to <opspec:{kind}>")
+        refs = tuple(_need(sub, "Ref") for sub in inputs)
+        if kind == "Arbiter":
+            return CoordinationBuiltIn(kind=CoordinationKind.ARBITER, inputs=refs, output=output)
+        if kind == "Voter":
+            options = tuple(_need(element, "Options").split())
+            return CoordinationBuiltIn(kind=CoordinationKind.VOTER, inputs=refs, output=output,
+                                       options=options)
+        weights: list[float] = []
+        for sub in inputs:
+            text = (sub.get("Weight") or "1").strip()
+            try:
+                weights.append(float(text))
+            except ValueError:
+                raise _Bad(sub, f"Weight {text!r} of opspec:Input is not a number",
+                           "write a number, e.g. Weight=\"0.7\"") from None
+        return CoordinationBuiltIn(kind=CoordinationKind.SUPERPOSITION, inputs=refs,
+                                   output=output, weights=tuple(weights))
+    if kind == "PushData":
+        return CoordinationBuiltIn(kind=CoordinationKind.PUSH_DATA, channel=_need(element, "Channel"),
+                                   inputs=(_need(element, "Ref"),))
+    if kind == "PullData":
+        return CoordinationBuiltIn(kind=CoordinationKind.PULL_DATA, channel=_need(element, "Channel"),
+                                   output=_need(element, "Ref"))
+    if kind == "ModeChange":
+        return CoordinationBuiltIn(kind=CoordinationKind.MODE_CHANGE,
+                                   target_mode=_need(element, "To"))
+    raise _Bad(element, f"unknown built-in opspec:{kind}",
+               f"use one of {', '.join('opspec:' + b for b in BUILT_INS)}")
+
+
+def build_builtin(directive: Directive, ctx: BuildContext) -> CoordinationBuiltIn | None:
+    container = _container(directive, ctx)
+    if container is None:
+        return None
+    elements = _ours(container)
+    if len(elements) != 1:
+        ctx.diagnostics.append(Diagnostic(
+            directive.location, Severity.ERROR, "bad-built-in",
+            f"opspec:BuiltIn must hold exactly one built-in element, found {len(elements)}",
+            f"put one of {', '.join('opspec:' + b for b in BUILT_INS)} inside it"))
+        return None
+    try:
+        return _builtin(elements[0])
+    except _Bad as error:
+        _report(ctx, error, "bad-built-in")
+        return None
+
+
+def _selector(element: etree._Element) -> EventSelector:
+    which = (element.get("Which") or "first").strip()
+    if which not in _WHICH:
+        raise _Bad(element, f"Which must be first or last, not {which!r}", "write Which=\"first\"")
+    return EventSelector(event=_need(element, "Event"), process=element.get("Process"),
+                         activity=element.get("Activity"), which=which)
+
+
+def _metric(element: etree._Element, location: SourceLocation) -> MetricDefinition:
+    kind = _local(element)
+    name = _need(element, "Name")
+    common = {"name": name, "description": element.get("Description"),
+              "unit": element.get("Unit"), "location": location}
+    if kind == "Count":
+        return MetricDefinition(kind=MetricKind.COUNT, select=_selector(element), **common)
+    if kind == "Duration":
+        ends = {_local(sub): sub for sub in _ours(element)}
+        if "From" not in ends or "To" not in ends:
+            raise _Bad(element, f"opspec:Duration {name!r} needs opspec:From and opspec:To",
+                       "add <opspec:From Event=.../> and <opspec:To Event=.../>")
+        return MetricDefinition(kind=MetricKind.DURATION, start=_selector(ends["From"]),
+                                end=_selector(ends["To"]), **common)
+    if kind == "Ratio":
+        return MetricDefinition(kind=MetricKind.RATIO, numerator=_need(element, "Numerator"),
+                                denominator=_need(element, "Denominator"), **common)
+    raise _Bad(element, f"unknown metric opspec:{kind}",
+               f"use one of {', '.join('opspec:' + m for m in _METRICS)}")
+
+
+def build_metrics(directive: Directive, ctx: BuildContext) -> tuple[MetricDefinition, ...]:
+    container = _container(directive, ctx)
+    if container is None:
+        return ()
+    metrics: list[MetricDefinition] = []
+    for element in _ours(container):
+        try:
+            metric = _metric(element, ctx.loc(element))
+        except _Bad as error:
+            _report(ctx, error, "bad-metric")
+            continue
+        if any(m.name == metric.name for m in metrics):
+            _report(ctx, _Bad(element, f"metric {metric.name!r} is declared twice",
+                              "give every metric its own Name"), "bad-metric")
+            continue
+        metrics.append(metric)
+    return tuple(metrics)
+
+
+def build_modes(directive: Directive, ctx: BuildContext) -> tuple[Mode, ...]:
+    container = _container(directive, ctx)
+    if container is None:
+        return ()
+    modes: list[Mode] = []
+    for element in _ours(container):
+        try:
+            if _local(element) != "Mode":
+                raise _Bad(element, f"opspec:Modes may only hold opspec:Mode, not opspec:{_local(element)}",
+                           "write <opspec:Mode Id=... Workflows=.../>")
+            initial = (element.get("Initial") or "false").strip().lower()
+            if initial not in ("true", "false"):
+                raise _Bad(element, f"Initial must be true or false, not {initial!r}",
+                           "write Initial=\"true\"")
+            mode = Mode(id=_need(element, "Id"), workflows=tuple((element.get("Workflows") or "").split()),
+                        initial=initial == "true", source=element.get("Source"))
+        except _Bad as error:
+            _report(ctx, error, "bad-mode")
+            continue
+        if any(m.id == mode.id for m in modes):
+            _report(ctx, _Bad(element, f"mode {mode.id!r} is declared twice", "give every mode its own Id"),
+                    "bad-mode")
+            continue
+        modes.append(mode)
+    if modes and sum(m.initial for m in modes) > 1:
+        ctx.diagnostics.append(Diagnostic(directive.location, Severity.ERROR, "bad-mode",
+                                          "more than one mode is Initial=\"true\"",
+                                          "mark exactly one mode as initial"))
+    return tuple(modes)
