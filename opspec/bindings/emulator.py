@@ -19,7 +19,7 @@ import socket
 import threading
 import time
 import tty
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from typing import Any, Final, Literal
 
@@ -174,6 +174,8 @@ class _Server(threading.Thread):
         self._outbox: list[tuple[float, int, bytes]] = []   # (due, seq, data), a heap
         self._injected: list[tuple[float, int, bytes]] = []  # posted by other threads
         self._seq = itertools.count()
+        #: Called on the emulator's thread with ``"<- line"`` / ``"-> line"`` / notes.
+        self.log: Callable[[str], None] | None = None
 
     # -- called from any thread
     def send_event(self, name: str, after_s: float = 0.0,
@@ -233,15 +235,23 @@ class _Server(threading.Thread):
             if not line:
                 continue
             self.received.append(line)
+            self._log(f"<- {line}")
             for action in self.device.handle_line(line):
                 if isinstance(action, Reply):
+                    late = f" (in {action.delay_s * 1000:g} ms)" if action.delay_s else ""
+                    self._log(f"-> {action.data.decode('ascii', 'backslashreplace').rstrip()}{late}")
                     heapq.heappush(self._outbox, (_now() + action.delay_s, next(self._seq),
                                                   action.data))
                 else:
+                    self._log("-- dropping the line (disconnect)")
                     self._outbox.clear()
                     self.dropped.set()
                     self._drop()
                     return
+
+    def _log(self, text: str) -> None:
+        if self.log is not None:
+            self.log(text)
 
     def run(self) -> None:
         try:

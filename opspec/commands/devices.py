@@ -1,0 +1,139 @@
+"""``opspec devices``: list serial ports and the profiles matching them, and emulate a
+profile's device on a pseudo-terminal or a socket."""
+
+from __future__ import annotations
+
+import argparse
+import sys
+import threading
+from typing import Any
+
+__all__ = ["register"]
+
+
+def register(subparsers: Any) -> None:
+    parser = subparsers.add_parser(
+        "devices", help="list serial ports and device profiles; emulate a device",
+        description="Device profiles live in devices/ (see devices/README.md).")
+    parser.set_defaults(handler=lambda args: (parser.print_help(), 2)[1])
+    sub = parser.add_subparsers(dest="devices_command", metavar="ACTION")
+
+    listing = sub.add_parser("list", help="show serial ports and which profiles match them")
+    listing.add_argument("--profiles", metavar="DIR", help="profile folder (default: devices/)")
+    listing.set_defaults(handler=_list)
+
+    emulate = sub.add_parser(
+        "emulate", help="play a profile's device on a pseudo-terminal or a socket",
+        description="Play PROFILE's device until Ctrl+C. Type an event name (e.g. report) "
+        "and Enter to send that unsolicited event.")
+    emulate.add_argument("profile", metavar="PROFILE", help="profile name or .toml path")
+    emulate.add_argument("--port", default="pty", metavar="pty|socket://HOST:PORT",
+                         help="where to listen (default: a new pseudo-terminal; "
+                         "socket://127.0.0.1:0 picks a free port)")
+    emulate.add_argument("--fault", default="none", metavar="SPEC",
+                         help="none, silent[:N], garbage[:N], late:MS, disconnect:N, error:LINE")
+    emulate.add_argument("--event", action="append", default=[], metavar="NAME@SECONDS",
+                         help="send event NAME after SECONDS (repeatable), e.g. report@5")
+    emulate.add_argument("--duration", type=float, metavar="SECONDS",
+                         help="stop after SECONDS instead of waiting for Ctrl+C")
+    emulate.add_argument("--quiet", action="store_true", help="do not print the traffic")
+    emulate.add_argument("--profiles", metavar="DIR", help="profile folder (default: devices/)")
+    emulate.set_defaults(handler=_emulate)
+
+
+def _list(args: argparse.Namespace) -> int:
+    from opspec.bindings.profiles import default_profiles_dir, load_profiles
+    from opspec.bindings.transport import list_ports
+
+    folder = args.profiles or default_profiles_dir()
+    profiles = load_profiles(folder)
+    ports = list_ports()
+    print("Serial ports:")
+    if not ports:
+        print("  (none found)")
+    for port in ports:
+        ids = f"{port.vid:04x}:{port.pid:04x}" if port.vid is not None and port.pid else "-"
+        serial_number = f" serial {port.serial_number}" if port.serial_number else ""
+        matching = [p.name for p in profiles if port.matches(p.port)]
+        fits = f"  -> {', '.join(matching)}" if matching else ""
+        print(f"  {port.device}  [{ids}{serial_number}] {port.description}{fits}")
+    print("  (virtual ports - pseudo-terminals, socket://, loop://, emulator:// - are never "
+          "listed; bind them by path or URL)")
+    print(f"\nProfiles in {folder}:")
+    for profile in profiles:
+        rules = profile.port.describe()
+        print(f"  {profile.name:<22} participants: {', '.join(profile.participants):<20} "
+              f"port: {rules}")
+    return 0
+
+
+def _emulate(args: argparse.Namespace) -> int:
+    from opspec.bindings.emulator import (
+        Behaviour,
+        EmulatedDevice,
+        PtyEmulator,
+        SocketEmulator,
+    )
+    from opspec.bindings.profiles import resolve_profile
+    from opspec.errors import BindingError
+
+    profile = resolve_profile(args.profile, args.profiles)
+    device = EmulatedDevice(profile, Behaviour.parse(args.fault))
+    events: list[tuple[str, float]] = []
+    for spec in args.event:
+        name, _, after = spec.partition("@")
+        try:
+            events.append((name, float(after or 0)))
+        except ValueError:
+            raise BindingError(f"--event {spec!r}: expected NAME@SECONDS, e.g. report@5") from None
+    if args.port == "pty":
+        server: PtyEmulator | SocketEmulator = PtyEmulator(device)
+    elif args.port.startswith("socket://"):
+        host, _, port_text = args.port[len("socket://"):].rpartition(":")
+        try:
+            server = SocketEmulator(device, host or "127.0.0.1", int(port_text))
+        except ValueError:
+            raise BindingError(f"--port {args.port!r}: expected socket://HOST:PORT") from None
+    else:
+        raise BindingError(f"--port {args.port!r}: expected pty or socket://HOST:PORT",
+                           hint="the emulator creates the port; bind opspec to what it prints")
+    if not args.quiet:
+        server.log = lambda text: print(f"  {text}", flush=True)
+    try:  # Ctrl+C at any point from here is the normal way to stop: exit 0
+        for name, after in events:
+            server.send_event(name, after)
+        server.start()
+        participants = ", ".join(profile.participants)
+        print(f"Emulating {profile.name} ({participants}), fault "
+              f"{device.behaviour.describe()}, on {server.url}", flush=True)
+        print(f"  bind it with: --bind {profile.participants[0]}={server.url}", flush=True)
+        if profile.events:
+            print(f"  events: {', '.join(profile.events)} (type a name and Enter to send it)",
+                  flush=True)
+        _read_stdin_events(server, profile.events)
+        server.join(args.duration)
+    except KeyboardInterrupt:
+        pass
+    finally:
+        server.stop()
+    print("Emulator stopped.", flush=True)
+    return 0
+
+
+def _read_stdin_events(server: Any, events: Any) -> None:
+    """Send the event named on each stdin line; a daemon thread, so Ctrl+C is never blocked."""
+    if sys.stdin is None or sys.stdin.closed:
+        return
+
+    def loop() -> None:
+        for raw in sys.stdin:
+            name = raw.strip()
+            if not name:
+                continue
+            if name in events:
+                server.send_event(name)
+            else:
+                print(f"  unknown event {name!r}; events: {', '.join(events) or 'none'}",
+                      flush=True)
+
+    threading.Thread(target=loop, name="emulator-stdin", daemon=True).start()
