@@ -1,0 +1,168 @@
+"""The hardened reader: hostile and malformed input gives one clean error naming file:line."""
+
+from __future__ import annotations
+
+import io
+from pathlib import Path
+
+import pytest
+
+from opspec.errors import Severity
+from opspec.model import XpdlVersion
+from opspec.xpdl import XmlReadError, load_package, parse_bytes, read_xml
+from opspec.xpdl.reader import line_of, read_limited
+
+DATA = Path(__file__).parent / "data"
+
+MINIMAL = b'<Package xmlns="http://www.wfmc.org/2008/XPDL2.1" Id="p"/>'
+
+
+@pytest.mark.parametrize(
+    ("name", "code", "line"),
+    [
+        ("xxe.xpdl", "doctype", 1),
+        ("billion_laughs.xpdl", "doctype", 1),
+        ("external_dtd.xpdl", "doctype", 1),
+        ("garbage.xpdl", "not-well-formed", 1),
+        ("truncated.xpdl", "not-well-formed", 6),
+        ("empty.xpdl", "empty-file", None),
+        ("wrong_root.xpdl", "unknown-root", 2),
+        ("unknown_namespace.xpdl", "unknown-version", 2),
+    ],
+    ids=lambda value: str(value),
+)
+def test_hostile_or_broken_file_is_rejected_with_one_located_error(
+    name: str, code: str, line: int | None
+) -> None:
+    result = load_package(DATA / name)
+    assert result.package is None
+    assert not result.ok
+    assert [d.code for d in result.diagnostics] == [code]
+    diagnostic = result.diagnostics[0]
+    assert diagnostic.severity is Severity.ERROR
+    assert diagnostic.location.path.endswith(name)
+    if line is not None:
+        assert diagnostic.location.line is not None and diagnostic.location.line >= line
+    assert "\n" not in str(diagnostic)
+
+
+def test_xxe_never_leaks_local_files() -> None:
+    result = load_package(DATA / "xxe.xpdl")
+    assert "root:" not in "".join(str(d) for d in result.diagnostics)
+    assert "DOCTYPE" in result.diagnostics[0].message
+
+
+def test_doctype_message_says_how_to_fix() -> None:
+    with pytest.raises(XmlReadError, match="DOCTYPE declarations are not allowed") as info:
+        read_xml((DATA / "external_dtd.xpdl").read_bytes(), path="x.xpdl")
+    assert info.value.code == "doctype"
+    assert "remove the <!DOCTYPE" in str(info.value)
+
+
+def test_file_over_the_size_limit_is_refused_before_parsing(tmp_path: Path) -> None:
+    big = tmp_path / "big.xpdl"
+    big.write_bytes(MINIMAL + b" " * 5000)
+    result = load_package(big, max_bytes=1000)
+    assert result.package is None
+    assert result.diagnostics[0].code == "too-big"
+    assert "1,000 bytes" in result.diagnostics[0].message
+
+
+class EndlessStream(io.RawIOBase):
+    """A stream that never ends (like /dev/zero); counts what was read."""
+
+    def __init__(self) -> None:
+        self.delivered = 0
+
+    def readable(self) -> bool:
+        return True
+
+    def read(self, size: int = -1) -> bytes:
+        size = 65536 if size is None or size < 0 else size
+        self.delivered += size
+        return b"<" * size
+
+
+def test_endless_stream_is_cut_off_just_past_the_limit() -> None:
+    stream = EndlessStream()
+    with pytest.raises(XmlReadError, match="larger than the limit") as info:
+        read_limited(stream, path="endless", max_bytes=100_000)  # type: ignore[arg-type]
+    assert info.value.code == "too-big"
+    assert stream.delivered <= 100_001 + 1024 * 1024
+
+
+def test_bytes_over_the_limit_are_refused() -> None:
+    result = parse_bytes(MINIMAL + b" " * 100, path="mem.xpdl", max_bytes=50)
+    assert [d.code for d in result.diagnostics] == ["too-big"]
+
+
+def test_missing_file_is_an_io_error_not_a_traceback(tmp_path: Path) -> None:
+    result = load_package(tmp_path / "nope.xpdl")
+    assert result.package is None
+    assert result.diagnostics[0].code == "io-error"
+
+
+@pytest.mark.parametrize(
+    ("namespace", "version"),
+    [
+        ("http://www.wfmc.org/2002/XPDL1.0", XpdlVersion.V1_0),
+        ("http://www.wfmc.org/2004/XPDL2.0alpha", XpdlVersion.V2_0),
+        ("http://www.wfmc.org/2008/XPDL2.1", XpdlVersion.V2_1),
+        ("http://www.wfmc.org/2009/XPDL2.2", XpdlVersion.V2_2),
+        ("", XpdlVersion.NONE),
+    ],
+    ids=["1.0", "2.0", "2.1", "2.2", "none"],
+)
+def test_version_comes_from_root_namespace_not_xpdlversion(
+    namespace: str, version: XpdlVersion
+) -> None:
+    xmlns = f' xmlns="{namespace}"' if namespace else ""
+    data = (f'<Package{xmlns} Id="p"><PackageHeader><XPDLVersion>2.2</XPDLVersion>'
+            "</PackageHeader></Package>").encode()
+    _, got = read_xml(data, path="v.xpdl")
+    assert got is version
+
+
+@pytest.mark.parametrize(
+    "data",
+    [
+        b"\xef\xbb\xbf" + MINIMAL,
+        '<?xml version="1.0" encoding="UTF-16"?>'.encode("utf-16") + MINIMAL.decode().encode("utf-16")[2:],
+        MINIMAL,
+        b'<?xml version="1.0" encoding="ASCII"?>' + MINIMAL.replace(b'Id="p"', 'Id="p" Name="caf\u00e9"'.encode()),
+        b'<?xml version="1.0" encoding="us-ascii"?>' + MINIMAL,
+    ],
+    ids=["utf8-bom", "utf16-bom", "no-declaration", "ascii-declared-utf8-content", "us-ascii"],
+)
+def test_encodings_found_in_real_files_are_read(data: bytes) -> None:
+    result = parse_bytes(data, path="enc.xpdl")
+    assert result.package is not None, result.diagnostics
+    assert result.package.id == "p"
+
+
+def test_ascii_declared_file_keeps_utf8_text() -> None:
+    data = b'<?xml version="1.0" encoding="ASCII"?>' + MINIMAL.replace(
+        b'Id="p"', 'Id="p" Name="caf\u00e9"'.encode())
+    result = parse_bytes(data, path="enc.xpdl")
+    assert result.package is not None and result.package.name == "caf\u00e9"
+
+
+def test_latin1_file_without_declaration_is_read_with_a_warning() -> None:
+    data = MINIMAL.replace(b'Id="p"', 'Id="p" Name="caf\u00e9"'.encode("latin-1"))
+    result = parse_bytes(data, path="latin.xpdl")
+    assert result.package is not None and result.package.name == "caf\u00e9"
+    assert [d.code for d in result.diagnostics] == ["encoding-guessed"]
+
+
+def test_line_numbers_past_65535_are_unknown() -> None:
+    data = b'<Package xmlns="http://www.wfmc.org/2008/XPDL2.1" Id="p">' + b"\n" * 70000 + b"<X/></Package>"
+    root, _ = read_xml(data, path="long.xpdl")
+    assert line_of(root) == 1
+    assert line_of(root[0]) is None
+
+
+def test_deeply_nested_input_is_refused_not_a_crash() -> None:
+    data = b'<Package xmlns="http://www.wfmc.org/2008/XPDL2.1" Id="p">' + b"<a>" * 100_000
+    result = parse_bytes(data, path="deep.xpdl")
+    assert result.package is None
+    assert result.diagnostics[0].code == "not-well-formed"
