@@ -1,0 +1,120 @@
+"""Loading device profiles: the shipped ones load, and every malformed one is refused with
+the file and the dotted key at fault."""
+
+from __future__ import annotations
+
+import re
+from pathlib import Path
+
+import pytest
+
+from opspec.bindings.profiles import (
+    load_profile,
+    load_profiles,
+    profiles_serving,
+    resolve_profile,
+)
+from opspec.errors import BindingError
+
+DEVICES = Path(__file__).resolve().parents[2] / "devices"
+INVALID = Path(__file__).parent / "data" / "invalid"
+
+
+def test_every_shipped_profile_loads() -> None:
+    names = [p.name for p in load_profiles(DEVICES)]
+    assert names == ["barcode_scanner", "cart_motors", "medication_dispenser",
+                     "range_finder", "rfid_reader"]
+
+
+def test_dispenser_profile_serves_alarm_and_dispenser_with_button_raising_trg_1() -> None:
+    profile = load_profile(DEVICES / "medication_dispenser.toml")
+    assert profile.participants == ("alarm", "dispenser")
+    assert set(profile.operations) == {"alarm_on", "alarm_off", "dispense"}
+    dispense = profile.operations["dispense"]
+    assert dispense.command is not None
+    assert dispense.command.fill({"slot": 2}) == "DISPENSE 2"
+    assert dispense.timeout_s == pytest.approx(3.0)
+    assert profile.operations["alarm_on"].timeout_s == pytest.approx(0.5)
+    assert profile.events["report"].trigger == "trg_1"
+    assert (profile.port.vid, profile.port.pid) == (0x2341, 0x0043)
+    assert profile.fallback_for("alarm").then == "simulate"
+    assert profile.fallback_for("dispenser").then == "abort"
+    assert profile.fallback_for("dispenser").exception == "DispenserFault"
+    # per-participant fallback inherits what it does not override
+    assert profile.fallback_for("dispenser").retries == profile.fallback.retries
+
+
+def test_operation_is_found_by_application_then_activity() -> None:
+    profile = load_profile(DEVICES / "medication_dispenser.toml")
+    assert profile.operation_for("alarm_on", "A3").name == "alarm_on"  # type: ignore[union-attr]
+    assert profile.operation_for(None, "dispense").name == "dispense"  # type: ignore[union-attr]
+    assert profile.operation_for("sing", "A9") is None
+
+
+def test_range_finder_reply_gives_typed_data() -> None:
+    profile = load_profile(DEVICES / "range_finder.toml")
+    (ok,) = profile.operations["measure_range"].ok
+    assert ok.match("RANGE 123") == {"distance": 123}
+
+
+def test_profiles_serving_and_resolve_by_name() -> None:
+    profiles = load_profiles(DEVICES)
+    assert [p.name for p in profiles_serving("alarm", profiles)] == ["medication_dispenser"]
+    assert resolve_profile("cart_motors", DEVICES).participants == ("motors",)
+
+
+# (file stem, dotted key named in the message, words of the message)
+INVALID_CASES = [
+    ("syntax_error", None, "invalid TOML"),
+    ("missing_format", "format", "required key is missing"),
+    ("unsupported_format", "format", "unsupported profile format 7"),
+    ("missing_participants", "participants", "required key is missing"),
+    ("participants_not_a_list", "participants", "expected a non-empty list"),
+    ("unknown_top_level_key", "operation", "unknown key"),
+    ("baudrate_not_an_integer", "serial.baudrate", "expected an integer"),
+    ("unknown_parity", "serial.parity", "expected one of none, even, odd"),
+    ("negative_timeout", "serial.reply_timeout_ms", "expected a duration >= 0"),
+    ("bad_newline", "serial.newline", "expected"),
+    ("bad_vid_pid", "port.vid_pid", "four hex digits"),
+    ("no_operations", "operations", "at least one operation"),
+    ("unbalanced_brace", "operations.dispense.command", "unbalanced"),
+    ("unknown_placeholder_type", "operations.dispense.command", "unknown type 'hex'"),
+    ("misspelt_operation_key", "operations.alarm_on.comand", "unknown key"),
+    ("exception_not_an_identifier", "errors.ERR {reason}", "must be an identifier"),
+    ("event_without_action", "events.report", "needs `trigger`"),
+    ("fallback_unknown_action", "fallback.then", "\"simulate\" or \"abort\""),
+    ("fallback_unknown_participant", "fallback.pump", "names no participant"),
+]
+
+
+def test_every_invalid_case_has_a_data_file_and_vice_versa() -> None:
+    assert sorted(p.stem for p in INVALID.glob("*.toml")) == sorted(c[0] for c in INVALID_CASES)
+
+
+@pytest.mark.parametrize(("stem", "key", "words"), INVALID_CASES,
+                         ids=[case[0] for case in INVALID_CASES])
+def test_malformed_profile_is_refused_naming_file_and_key(stem: str, key: str | None,
+                                                          words: str) -> None:
+    path = INVALID / f"{stem}.toml"
+    where = f"{path}: {key}" if key else str(path)
+    with pytest.raises(BindingError, match=re.escape(where)) as caught:
+        load_profile(path)
+    assert words in str(caught.value)
+
+
+def test_missing_profile_file_says_so() -> None:
+    with pytest.raises(BindingError, match="nowhere.toml does not exist"):
+        load_profile(INVALID / "nowhere.toml")
+
+
+def test_unknown_profile_name_lists_the_available_ones() -> None:
+    with pytest.raises(BindingError, match="available: barcode_scanner, cart_motors"):
+        resolve_profile("teapot", DEVICES)
+
+
+def test_two_profiles_with_one_name_are_refused(tmp_path: Path) -> None:
+    text = (DEVICES / "range_finder.toml").read_text()
+    (tmp_path / "a.toml").write_text(text)
+    (tmp_path / "b.toml").write_text(text)
+    with pytest.raises(BindingError, match="two profiles are named 'range_finder'"):
+        load_profiles(tmp_path)
