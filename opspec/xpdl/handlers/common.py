@@ -6,6 +6,7 @@ Handlers run on a *normalised* tree (:mod:`opspec.xpdl.normalize`): every XPDL e
 
 from __future__ import annotations
 
+import copy
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Any, TypeVar
@@ -30,6 +31,7 @@ __all__ = [
     "local_name",
     "parse_bool",
     "parse_int",
+    "raw_xml",
     "text_of",
 ]
 
@@ -139,13 +141,16 @@ def parse_int(text: str | None) -> int | None:
         return int(number) if number.is_integer() else None
 
 
+def raw_xml(element: Node) -> str:
+    """``element`` serialised on its own, declaring only the namespaces it uses."""
+    alone = copy.deepcopy(element)
+    alone.tail = None
+    etree.cleanup_namespaces(alone)
+    return etree.tostring(alone, encoding="unicode")
+
+
 def _raw_children(element: Node) -> str | None:
-    parts = [
-        etree.tostring(sub, encoding="unicode", with_tail=False)
-        for sub in element
-        if isinstance(sub.tag, str)
-    ]
-    return "".join(parts) or None
+    return "".join(raw_xml(sub) for sub in element if isinstance(sub.tag, str)) or None
 
 
 def extended_attributes(element: Node, ctx: BuildContext) -> tuple[ExtendedAttribute, ...]:

@@ -35,6 +35,7 @@ from opspec.xpdl.handlers.common import (
     grandchildren,
     parse_bool,
     parse_int,
+    raw_xml,
     text_of,
 )
 from opspec.xpdl.handlers.registry import Registry
@@ -93,8 +94,7 @@ def _declared(element: etree._Element, ctx: BuildContext) -> DataType:
 
 @DATA_TYPES.register("SchemaType")
 def _schema(element: etree._Element, ctx: BuildContext) -> DataType:
-    raw = "".join(etree.tostring(sub, encoding="unicode", with_tail=False)
-                  for sub in element if isinstance(sub.tag, str))
+    raw = "".join(raw_xml(sub) for sub in element if isinstance(sub.tag, str))
     return SchemaType(raw_xml=raw)
 
 
