@@ -22,6 +22,7 @@ Build one from a TOML table or a spec's BPSim parameter with :func:`make_distrib
 
 from __future__ import annotations
 
+import difflib
 import math
 from abc import ABC, abstractmethod
 from collections.abc import Callable, Mapping, Sequence
@@ -367,7 +368,7 @@ class TruncatedNormal(Distribution):
         a, b = self._ab()
         if a > 0:  # reflect: sample -Z on [-b, -a], whose lower tail is accurate
             lo, hi = _ncdf(-b), _ncdf(-a)
-            z = -_STD_NORMAL.inv_cdf(min(max(lo + u * (hi - lo), 1e-300), 1 - 1e-16))
+            z = -_STD_NORMAL.inv_cdf(min(max(hi - u * (hi - lo), 1e-300), 1 - 1e-16))
         else:
             lo, hi = _ncdf(a), _ncdf(b)
             z = _STD_NORMAL.inv_cdf(min(max(lo + u * (hi - lo), 1e-300), 1 - 1e-16))
@@ -381,7 +382,7 @@ class TruncatedNormal(Distribution):
         u = rng.random(n)
         if a > 0:
             lo, hi = special.ndtr(-b), special.ndtr(-a)
-            z = -special.ndtri(lo + u * (hi - lo))
+            z = -special.ndtri(hi - u * (hi - lo))
         else:
             lo, hi = special.ndtr(a), special.ndtr(b)
             z = special.ndtri(lo + u * (hi - lo))
@@ -740,6 +741,13 @@ class _Params:
             if name in self.left:
                 return self.left.pop(name)
         if required and default is None:
+            if self.left:  # a misspelt name is likelier than a forgotten one
+                typo = sorted(self.left)[0]
+                close = difflib.get_close_matches(typo, names, n=1)
+                raise ParameterError(
+                    typo, f"is not a parameter of a {self.kind} distribution",
+                    hint=f"did you mean {close[0]}?" if close else
+                    f"{names[0]} is required")
             raise ParameterError(
                 names[0], f"is required for a {self.kind} distribution",
                 hint=f"add {names[0]} = <number>")

@@ -118,7 +118,8 @@ class Busy:
 
     An instance becomes engaged when one of ``engaged`` is offered to the person, and is
     released when the instance is offered (or completes) an activity outside ``engaged``,
-    completes one of ``release_after``, or has its work item omitted or withdrawn. While any
+    completes one of ``release_after``, has its work item omitted or withdrawn, or ends
+    (completes an engaged activity and offers nothing next at the same moment). While any
     instance is engaged, offers from *other* instances are omitted with reason ``"busy"`` -
     all of them, or only those whose activity is in ``ignore`` when it is given.
     """

@@ -60,6 +60,7 @@ class StochasticUser:
         self._wrong: dict[tuple[int, str], int] = {}
         self._recovery: dict[tuple[int, str], float] = {}
         self._models: dict[str, ActivityModel] = {}
+        self._handover: dict[int, int] = {}      # lane -> key of its last completed item
 
     # ------------------------------------------------------------------ Performer protocol
 
@@ -73,6 +74,7 @@ class StochasticUser:
         now = session.now
         state = self._routine.state(now)
         busy = self.model.busy
+        self._handover.pop(lane, None)
 
         if busy is not None and busy.ignores(item.activity) and (
                 len(self._engaged) > 1 or (self._engaged and lane not in self._engaged)):
@@ -132,8 +134,7 @@ class StochasticUser:
 
     def withdraw(self, item: WorkItem, reason: str) -> None:
         if self._pending.pop(item.key, None) is not None:
-            lane = item.root_instance if item.root_instance is not None else item.instance
-            self._release(lane)
+            self._release(self._lane_of(item))
 
     # ------------------------------------------------------------------ internals
 
@@ -191,10 +192,31 @@ class StochasticUser:
         if self._pending.pop(item.key, None) is None:
             return  # withdrawn meanwhile
         busy = self.model.busy
-        if busy is not None and (item.activity in busy.release_after
-                                 or item.activity not in busy.engaged):
-            self._engaged.discard(lane)
-        self._require_session().complete(item, choice=choice)
+        session = self._require_session()
+        handover = False
+        if busy is not None and lane in self._engaged:
+            if item.activity in busy.release_after or item.activity not in busy.engaged:
+                self._engaged.discard(lane)
+            else:
+                handover = True
+                self._handover[lane] = item.key
+        session.complete(item, choice=choice)
+        if handover and self._handover.get(lane) == item.key:
+            # Stay engaged if the instance offers its next activity at this same moment;
+            # release if it ended (nothing offered when this zero-delay check runs). An
+            # engine that routes in several zero-delay steps may release and re-engage at
+            # the same instant, which no prompt can fall into except at that exact time.
+            session.call_later(0.0, lambda: self._end_handover(lane, item.key))
+
+    def _end_handover(self, lane: int, key: int) -> None:
+        if self._handover.get(lane) == key:
+            del self._handover[lane]
+            if not any(self._lane_of(i) == lane for i in self._pending.values()):
+                self._engaged.discard(lane)
+
+    @staticmethod
+    def _lane_of(item: WorkItem) -> int:
+        return item.root_instance if item.root_instance is not None else item.instance
 
     def _omit(self, item: WorkItem, lane: int, reason: str) -> None:
         if reason != "busy":
