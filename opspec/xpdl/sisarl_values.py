@@ -65,6 +65,10 @@ _POSITIVE: Final = frozenset({"standardDeviation", "sd", "sigma", "shape", "scal
 _CALL = re.compile(r"^\s*([A-Za-z_][A-Za-z0-9_]*)\s*\((.*)\)\s*$", re.DOTALL)
 
 
+def _detail(error: Exception) -> str:
+    return str(getattr(error, "message", error))
+
+
 def _fail(message: str, location: SourceLocation | None, hint: str) -> SisarlValueError:
     return SisarlValueError(message, location=location, hint=hint)
 
@@ -75,8 +79,8 @@ def parse_seconds(text: str, location: SourceLocation | None, what: str) -> floa
 
     try:
         seconds = float(parse_duration(text, location=location))
-    except SpecError as error:
-        raise _fail(f"{what} {text!r} is not a duration: {error.message}", location,
+    except (SpecError, ValueError) as error:
+        raise _fail(f"{what} {text!r} is not a duration: {_detail(error)}", location,
                     "write an ISO 8601 duration (PT0.1S), a number of seconds (0.1) or 100ms") from None
     if not math.isfinite(seconds) or seconds < 0:
         raise _fail(f"{what} {text!r} must be a finite, non-negative duration", location,
@@ -95,8 +99,8 @@ def parse_period(text: str, location: SourceLocation | None, *, rate: bool) -> f
 
     try:
         hertz = float(parse_rate(text, location=location))
-    except SpecError as error:
-        raise _fail(f"rate {text!r} is not a rate: {error.message}", location,
+    except (SpecError, ValueError) as error:
+        raise _fail(f"rate {text!r} is not a rate: {_detail(error)}", location,
                     "write 10Hz, 10/s or 10 (per second)") from None
     if not math.isfinite(hertz) or hertz <= 0:
         raise _fail(f"rate {text!r} must be a positive number per second", location, "write e.g. 10Hz")
@@ -140,8 +144,8 @@ def _timer(rest: str, location: SourceLocation | None) -> TriggerRef:
     for item in times_text.split(","):
         try:
             times.append(float(parse_time_of_day(item.strip(), location=location)))
-        except SpecError as error:
-            raise _fail(f"timer time {item.strip()!r} is not a time of day: {error.message}",
+        except (SpecError, ValueError) as error:
+            raise _fail(f"timer time {item.strip()!r} is not a time of day: {_detail(error)}",
                         location, "write times as HH:MM, e.g. timer:08:00,20:00") from None
     every = parse_seconds(every_text, location, "timer repetition") if every_text.strip() else 86400.0
     if every <= 0:
@@ -165,8 +169,8 @@ def _rule(rest: str, location: SourceLocation | None) -> TriggerRef:
         raise _fail("rule trigger needs a condition: rule:CONDITION", location, _TRIGGER_SYNTAX)
     try:
         condition = parse_condition(rest, location=location)
-    except SpecError as error:
-        raise _fail(f"rule condition {rest.strip()!r} cannot be understood: {error.message}",
+    except (SpecError, ValueError) as error:
+        raise _fail(f"rule condition {rest.strip()!r} cannot be understood: {_detail(error)}",
                     location, "write an expression over data fields, e.g. rule:level < 10") from None
     return TriggerRef(kind="rule", condition=condition, location=location)
 
