@@ -1,0 +1,83 @@
+"""Property-based robustness: mutated corpus files never make the loader raise or hang; they
+give a package or diagnostics (issue 2, "Bad input")."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
+from lxml import etree
+
+from opspec.xpdl import LoadResult, parse_bytes
+
+CORPUS = Path("/work/shared/corpus/xpdl")
+SAMPLES = sorted(CORPUS.glob("*.xpdl"))[::4] if CORPUS.is_dir() else []
+SPEC = Path(__file__).resolve().parents[2] / "specs" / "medication_dispenser.xpdl"
+SOURCES = [SPEC, *SAMPLES]
+DATA = {path.name: path.read_bytes() for path in SOURCES}
+
+FUZZ = settings(max_examples=25, deadline=2000, derandomize=True,
+                suppress_health_check=[HealthCheck.too_slow, HealthCheck.data_too_large])
+
+
+def check(result: LoadResult) -> None:
+    assert result.package is not None or result.diagnostics
+    assert "internal-error" not in [d.code for d in result.diagnostics], result.diagnostics
+    for diagnostic in result.diagnostics:
+        assert diagnostic.location.path
+        str(diagnostic)
+
+
+names = st.sampled_from(sorted(DATA))
+
+
+@pytest.mark.skipif(not SAMPLES, reason="shared corpus not present")
+@FUZZ
+@given(name=names, flips=st.lists(st.tuples(st.floats(0, 1, exclude_max=True), st.integers(0, 255)),
+                                  min_size=1, max_size=8))
+def test_byte_flips_never_crash(name: str, flips: list[tuple[float, int]]) -> None:
+    data = bytearray(DATA[name])
+    for where, value in flips:
+        data[int(where * len(data))] = value
+    check(parse_bytes(bytes(data), path=name))
+
+
+@pytest.mark.skipif(not SAMPLES, reason="shared corpus not present")
+@FUZZ
+@given(name=names, cut=st.floats(0, 1))
+def test_truncation_never_crashes(name: str, cut: float) -> None:
+    data = DATA[name]
+    check(parse_bytes(data[: int(cut * len(data))], path=name))
+
+
+def _elements(root: etree._Element) -> list[etree._Element]:
+    return [e for e in root.iter() if isinstance(e.tag, str) and e is not root]
+
+
+@pytest.mark.skipif(not SAMPLES, reason="shared corpus not present")
+@FUZZ
+@given(name=names, edits=st.lists(st.tuples(st.sampled_from(["delete", "duplicate", "strip", "text"]),
+                                            st.floats(0, 1, exclude_max=True)),
+                                  min_size=1, max_size=6))
+def test_structural_mutations_never_crash(name: str, edits: list[tuple[str, float]]) -> None:
+    root = etree.fromstring(DATA[name], etree.XMLParser(resolve_entities=False, no_network=True))
+    for action, where in edits:
+        elements = _elements(root)
+        if not elements:
+            break
+        element = elements[int(where * len(elements))]
+        parent = element.getparent()
+        if action == "delete" and parent is not None:
+            parent.remove(element)
+        elif action == "duplicate" and parent is not None:
+            import copy
+
+            element.addnext(copy.deepcopy(element))
+        elif action == "strip":
+            for key in list(element.attrib):
+                del element.attrib[key]
+        else:
+            element.text = "@@ not & valid ( ] {"
+    check(parse_bytes(etree.tostring(root), path=name))
