@@ -126,13 +126,17 @@ def _read_stdin_events(server: Any, events: Any) -> None:
         return
 
     def loop() -> None:
-        for raw in sys.stdin:
+        while True:
+            try:
+                raw = sys.stdin.readline()
+            except (OSError, ValueError):  # no usable stdin (detached, captured): use --event
+                return
+            if not raw:  # end of input: keep emulating, stop listening
+                return
             name = raw.strip()
-            if not name:
-                continue
-            if name in events:
+            if name and name in events:
                 server.send_event(name)
-            else:
+            elif name:
                 print(f"  unknown event {name!r}; events: {', '.join(events) or 'none'}",
                       flush=True)
 

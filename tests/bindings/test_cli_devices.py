@@ -1,0 +1,71 @@
+"""``opspec devices list`` and ``opspec devices emulate``."""
+
+from __future__ import annotations
+
+import os
+import signal
+import subprocess
+import sys
+
+import pytest
+import serial
+
+from opspec.cli import main
+
+from .conftest import DEVICES, needs_pty
+
+
+def test_list_shows_ports_profiles_and_says_virtual_ports_are_never_listed(
+        capsys: pytest.CaptureFixture[str]) -> None:
+    assert main(["devices", "list", "--profiles", str(DEVICES)]) == 0
+    out = capsys.readouterr().out
+    assert "Serial ports:" in out
+    assert "virtual ports" in out and "never listed" in out
+    assert "medication_dispenser" in out and "VID:PID 2341:0043" in out
+
+
+def test_emulate_bad_fault_is_a_one_line_error(capsys: pytest.CaptureFixture[str]) -> None:
+    status = main(["devices", "emulate", "medication_dispenser", "--fault", "loud",
+                   "--profiles", str(DEVICES)])
+    assert status == 2
+    assert "unknown emulator fault 'loud'" in capsys.readouterr().err
+
+
+def test_emulate_unknown_port_kind_is_explained(capsys: pytest.CaptureFixture[str]) -> None:
+    assert main(["devices", "emulate", "range_finder", "--port", "tcp:1",
+                 "--profiles", str(DEVICES)]) == 2
+    assert "expected pty or socket://HOST:PORT" in capsys.readouterr().err
+
+
+@needs_pty
+def test_emulate_prints_the_pty_answers_and_stops_cleanly_on_ctrl_c() -> None:
+    process = subprocess.Popen(
+        [sys.executable, "-m", "opspec", "devices", "emulate", "medication_dispenser",
+         "--port", "pty", "--profiles", str(DEVICES)],
+        stdin=subprocess.PIPE, stdout=subprocess.PIPE, text=True)
+    try:
+        assert process.stdout is not None and process.stdin is not None
+        first = process.stdout.readline()
+        path = first.rsplit(" on ", 1)[1].strip()
+        assert path.startswith("/dev/")
+        with serial.serial_for_url(path, timeout=10) as port:
+            port.write(b"DISPENSE 2\n")
+            assert port.readline() == b"OK DISPENSED 2\n"
+            process.stdin.write("report\n")  # an event typed on stdin
+            process.stdin.flush()
+            assert port.readline() == b"BUTTON REPORT\n"
+        process.send_signal(signal.SIGINT)
+        assert process.wait(10) == 0
+        assert "Emulator stopped." in process.stdout.read()
+    finally:
+        if process.poll() is None:
+            process.kill()
+            process.wait()
+
+
+def test_emulate_on_a_socket_for_a_fixed_duration(capsys: pytest.CaptureFixture[str]) -> None:
+    assert main(["devices", "emulate", "range_finder", "--port", "socket://127.0.0.1:0",
+                 "--duration", "0.2", "--profiles", str(DEVICES)]) == 0
+    out = capsys.readouterr().out
+    assert "Emulating range_finder" in out and "socket://127.0.0.1:" in out
+    assert "Emulator stopped." in out
