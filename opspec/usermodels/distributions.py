@@ -244,8 +244,11 @@ class LogNormal(Distribution):
         return LogNormal(self.mu + math.log(_positive("factor", factor)), self.sigma)
 
     def to_params(self) -> dict[str, Any]:
-        # 15 significant digits: exp(log(60)) prints as 60.0, not 59.999999999999986.
-        return {"kind": "lognormal", "median": float(f"{self.median:.15g}"), "sigma": self.sigma}
+        # Prefer the readable median (60.0, not 59.999999999999986) when it reads back exactly.
+        median = float(f"{self.median:.15g}")
+        if math.log(median) == self.mu:
+            return {"kind": "lognormal", "median": median, "sigma": self.sigma}
+        return {"kind": "lognormal", "mu": self.mu, "sigma": self.sigma}
 
 
 @dataclass(frozen=True, slots=True)
