@@ -306,3 +306,23 @@ def test_bad_metrics_and_modes_are_errors(xml: str, code: str) -> None:
     result = package_with(xml)
     assert [d.code for d in result.errors] == [code]
     assert result.errors[0].location.line == 2
+
+
+DOC = Path(__file__).resolve().parents[2] / "docs" / "sisarl-xpdl.md"
+
+
+def test_complete_example_in_the_documentation_loads_cleanly() -> None:
+    text = DOC.read_text(encoding="utf-8")
+    start = text.index("## A complete example")
+    block = text[text.index("```xml\n", start) + len("```xml\n"):]
+    block = block[: block.index("```")]
+    result = parse_bytes(block.encode(), path="docs/sisarl-xpdl.md")
+    assert result.ok and not result.diagnostics, [str(d) for d in result.diagnostics]
+    assert result.package is not None
+    guide = result.package.process("guide")
+    assert guide is not None and guide.directives.period == pytest.approx(0.1)
+    propel = result.package.process("propel")
+    assert propel is not None and propel.directives.period == pytest.approx(0.05)
+    arbiter = guide.activity("arbitrate")
+    assert arbiter is not None and arbiter.coordination is not None
+    assert [m.id for m in result.package.modes] == ["clean", "dock"]
