@@ -62,7 +62,8 @@ def _package_id_of(path: Path) -> str | None:
             return None
         for _, element in etree.iterparse(str(path), events=("start",), resolve_entities=False,
                                           no_network=True, load_dtd=False, huge_tree=False):
-            return element.get("Id")
+            value = element.get("Id")
+            return str(value) if value is not None else None
     except (OSError, etree.LxmlError):
         return None
     return None

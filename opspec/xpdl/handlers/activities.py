@@ -23,6 +23,7 @@ from opspec.model.activities import (
     Split,
 )
 from opspec.model.data import Assignment
+from opspec.model.expressions import Expression
 from opspec.xpdl.handlers.bodies import BODIES, gateway_type
 from opspec.xpdl.handlers.common import (
     BuildContext,
@@ -114,7 +115,7 @@ def _loop(element: etree._Element, ctx: BuildContext) -> Loop | None:
 
 
 def _expression(element: etree._Element | None, text: str | None, ctx: BuildContext, what: str
-                ) -> object | None:
+                ) -> Expression | None:
     from opspec.xpdl.conditions import parse_expression
 
     if text is None:

@@ -9,7 +9,7 @@ from __future__ import annotations
 import copy
 from collections.abc import Callable
 from dataclasses import dataclass, field
-from typing import Any, TypeVar
+from typing import Any, TypeAlias, TypeVar
 
 from lxml import etree
 
@@ -36,7 +36,7 @@ __all__ = [
 ]
 
 T = TypeVar("T")
-Node = etree._Element
+Node: TypeAlias = etree._Element
 
 
 @dataclass(slots=True)
@@ -85,7 +85,7 @@ def child(element: Node, local: str) -> Node | None:
 def children(element: Node | None, local: str) -> list[Node]:
     if element is None:
         return []
-    return element.findall(qname(local, CANONICAL))
+    return list(element.findall(qname(local, CANONICAL)))
 
 
 def grandchildren(element: Node, wrapper: str, local: str) -> list[Node]:
@@ -146,7 +146,7 @@ def raw_xml(element: Node) -> str:
     alone = copy.deepcopy(element)
     alone.tail = None
     etree.cleanup_namespaces(alone)
-    return etree.tostring(alone, encoding="unicode")
+    return str(etree.tostring(alone, encoding="unicode"))
 
 
 def _raw_children(element: Node) -> str | None:

@@ -3,6 +3,8 @@ with their triggers and results (XPDL 2.0 ``Rule`` arrives normalised as ``Condi
 
 from __future__ import annotations
 
+from typing import Any
+
 from lxml import etree
 
 from opspec.errors import SpecError
@@ -86,7 +88,7 @@ def _kind(raw: str | None, element: etree._Element, ctx: BuildContext, what: str
     return kind
 
 
-def _timer(element: etree._Element, ctx: BuildContext) -> dict[str, object]:
+def _timer(element: etree._Element, ctx: BuildContext) -> dict[str, Any]:
     from opspec.xpdl.durations import parse_duration_expression
 
     timer = child(element, "TriggerTimer")
@@ -106,7 +108,7 @@ def _timer(element: etree._Element, ctx: BuildContext) -> dict[str, object]:
     return {"time_date": date, "time_cycle": cycle, "duration": duration}
 
 
-def _details(element: etree._Element, kind: TriggerKind, ctx: BuildContext) -> dict[str, object]:
+def _details(element: etree._Element, kind: TriggerKind, ctx: BuildContext) -> dict[str, Any]:
     """Name / timer / condition / direction of a trigger from its detail child."""
     if kind is TriggerKind.MESSAGE:
         detail = child(element, "TriggerResultMessage")
@@ -158,7 +160,7 @@ def _start(element: etree._Element, ctx: BuildContext) -> ActivityBody:
     kind = _kind(attr(element, "Trigger"), element, ctx, "start trigger")
     details = _details(element, kind, ctx)
     details["catching"] = True
-    trigger = Trigger(kind=kind, interrupting=_interrupting(element), **details)  # type: ignore[arg-type]
+    trigger = Trigger(kind=kind, interrupting=_interrupting(element), **details)
     return Event(position=EventPosition.START, trigger=trigger)
 
 
@@ -166,7 +168,7 @@ def _start(element: etree._Element, ctx: BuildContext) -> ActivityBody:
 def _intermediate(element: etree._Element, ctx: BuildContext) -> ActivityBody:
     kind = _kind(attr(element, "Trigger"), element, ctx, "intermediate trigger")
     details = _details(element, kind, ctx)
-    trigger = Trigger(kind=kind, attached_to=attr(element, "Target"),  # type: ignore[arg-type]
+    trigger = Trigger(kind=kind, attached_to=attr(element, "Target"),
                       interrupting=_interrupting(element), **details)
     return Event(position=EventPosition.INTERMEDIATE, trigger=trigger)
 
@@ -177,6 +179,6 @@ def _end(element: etree._Element, ctx: BuildContext) -> ActivityBody:
     kind = _kind(result, element, ctx, "end result")
     details = _details(element, kind, ctx)
     details["catching"] = False
-    trigger = Trigger(kind=kind, **details)  # type: ignore[arg-type]
+    trigger = Trigger(kind=kind, **details)
     return Event(position=EventPosition.END, trigger=trigger, result=result or "None")
 
