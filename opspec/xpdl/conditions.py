@@ -64,6 +64,12 @@ MAX_DEPTH = 100
 """Deepest tree accepted; keeps evaluation and printing far from Python's recursion limit."""
 
 _HINT = 'conditions are JavaScript-like expressions over data fields, e.g. status == "ok" && n < 3'
+_HINTS = {
+    "condition": _HINT,
+    "expression": 'expressions are JavaScript-like, over data fields, e.g. total * 2 + 1',
+    "duration": "write a duration (PT5M, 300, 5 min) or an expression over data fields giving"
+    " seconds (timeout * 60)",
+}
 
 
 class ConditionSyntaxError(SpecError):
@@ -397,7 +403,12 @@ class _Parser:
 
     def fail(self, offset: int, problem: str) -> ConditionSyntaxError:
         return ConditionSyntaxError(
-            self.original, offset, problem, kind=self.kind, location=self.location
+            self.original,
+            offset,
+            problem,
+            kind=self.kind,
+            location=self.location,
+            hint=_HINTS.get(self.kind, _HINT),
         )
 
     def parse(self) -> Expression:
