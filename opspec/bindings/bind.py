@@ -68,7 +68,7 @@ def bind(participants: str | Sequence[str], url: str, profile: DeviceProfile, *,
 class BindSpec:
     """One parsed ``PARTICIPANT[:PROFILE]=URL|auto``."""
 
-    __slots__ = ("participant", "profile", "url", "text")
+    __slots__ = ("participant", "profile", "text", "url")
 
     def __init__(self, participant: str, profile: str | None, url: str, text: str) -> None:
         self.participant, self.profile, self.url, self.text = participant, profile, url, text

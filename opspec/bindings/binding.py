@@ -22,7 +22,7 @@ from collections import deque
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from functools import partial
-from typing import Any, Final, Literal
+from typing import Any, Final, Literal, Self
 
 import serial
 
@@ -36,7 +36,7 @@ from opspec.engine.performers import PerformerSession, WorkItem
 from opspec.engine.trace import EventKind
 from opspec.errors import BindingError
 
-__all__ = ["DeviceBinding", "DEVICE_EXCHANGE", "DEVICE_NOTE", "DEVICE_EVENT"]
+__all__ = ["DEVICE_EVENT", "DEVICE_EXCHANGE", "DEVICE_NOTE", "DeviceBinding"]
 
 DEVICE_EXCHANGE: Final = "device.exchange"   # a command and its reply, with latency
 DEVICE_NOTE: Final = "device.note"           # bound / simulated / reconnected / switched
@@ -71,7 +71,7 @@ class DeviceBinding:
     """
 
     def __init__(self, profile: DeviceProfile, participants: Sequence[str], url: str | None,
-                 port: serial.SerialBase | None, *, inbox: Inbox | None = None,
+                 port: serial.Serial | None, *, inbox: Inbox | None = None,
                  notes: Sequence[str] = ()) -> None:
         self.profile = profile
         self.participants: tuple[str, ...] = tuple(participants)
@@ -179,14 +179,14 @@ class DeviceBinding:
             except (serial.SerialException, OSError):
                 pass
 
-    def __enter__(self) -> DeviceBinding:
+    def __enter__(self) -> Self:
         return self
 
     def __exit__(self, *exc: object) -> None:
         self.close()
 
     # ------------------------------------------------------------------ reader side
-    def _start_reader(self, port: serial.SerialBase) -> None:
+    def _start_reader(self, port: serial.Serial) -> None:
         self._generation += 1
         gen = self._generation
         post = self.inbox.post
@@ -436,7 +436,7 @@ class DeviceBinding:
         self.inbox.post(partial(self._reconnect_failed, gen,
                                 f"{attempts} reconnection attempt(s) failed: {last}"))
 
-    def _reconnected(self, gen: int, port: serial.SerialBase) -> None:
+    def _reconnected(self, gen: int, port: serial.Serial) -> None:
         if gen != self._generation or self._closed.is_set():
             port.close()
             return

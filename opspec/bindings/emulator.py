@@ -21,14 +21,21 @@ import time
 import tty
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass
-from typing import Any, Final, Literal
+from typing import Any, Final, Literal, Self
 
 from opspec.bindings.profiles import DeviceProfile
 from opspec.bindings.templates import TemplateError
 from opspec.errors import BindingError
 
-__all__ = ["Behaviour", "EmulatedDevice", "PtyEmulator", "SocketEmulator", "Reply",
-           "DISCONNECT", "GARBAGE"]
+__all__ = [
+    "DISCONNECT",
+    "GARBAGE",
+    "Behaviour",
+    "EmulatedDevice",
+    "PtyEmulator",
+    "Reply",
+    "SocketEmulator",
+]
 
 BehaviourKind = Literal["none", "silent", "garbage", "late", "disconnect", "error"]
 #: What the ``garbage`` behaviour sends: undecodable bytes and no known reply.
@@ -196,7 +203,7 @@ class _Server(threading.Thread):
         if self.is_alive() and threading.current_thread() is not self:
             self.join(5)
 
-    def __enter__(self) -> _Server:
+    def __enter__(self) -> Self:
         self.start()
         return self
 

@@ -86,11 +86,8 @@ class PortMatch:
             return False
         if self.serial_number is not None and serial_number != self.serial_number:
             return False
-        if self.description is not None and (
-            self.description.lower() not in (description or "").lower()
-        ):
-            return False
-        return True
+        return self.description is None or (
+            self.description.lower() in (description or "").lower())
 
 
 @dataclass(frozen=True, slots=True)

@@ -21,7 +21,7 @@ from collections.abc import Mapping
 from dataclasses import dataclass, field
 from typing import Any
 
-__all__ = ["LineTemplate", "TemplateError", "PLACEHOLDER_TYPES"]
+__all__ = ["PLACEHOLDER_TYPES", "LineTemplate", "TemplateError"]
 
 # type name -> (regex for matching, converter)
 PLACEHOLDER_TYPES: dict[str, tuple[str, type]] = {

@@ -45,12 +45,13 @@ def register_url_handlers() -> None:
 register_url_handlers()
 
 
-def open_port(url: str, settings: SerialSettings, who: str = "") -> serial.SerialBase:
+def open_port(url: str, settings: SerialSettings, who: str = "") -> serial.Serial:
     """Open ``url`` with the profile's settings, or raise BindingError naming the port and
     the reason (the operating system's words, e.g. ``[Errno 2] No such file or directory``)."""
     prefix = f"{who}: " if who else ""
     try:
-        port = serial.serial_for_url(
+        # every URL handler's class offers the serial.Serial API; the stubs say SerialBase
+        port: serial.Serial = serial.serial_for_url(
             url, baudrate=settings.baudrate, bytesize=settings.bytesize,
             parity=settings.parity, stopbits=settings.stopbits, timeout=_POLL_S,
             write_timeout=max(1.0, settings.reply_timeout_s),
@@ -121,7 +122,7 @@ def find_port(profile: DeviceProfile, ports: Sequence[PortInfo] | None = None
     return found[0].device, note
 
 
-class LineFramer(serial.threaded.Packetizer):  # type: ignore[misc]
+class LineFramer(serial.threaded.Packetizer):
     """Split received bytes into lines (``\\n``, ``\\r\\n`` or ``\\r`` per the profile).
 
     Calls ``on_line(text, received_at)`` with trailing whitespace stripped, or
@@ -167,7 +168,7 @@ class LineFramer(serial.threaded.Packetizer):  # type: ignore[misc]
         self.on_lost(exc)  # never re-raise on the reader thread: the binding reports it
 
 
-class LineReaderThread(serial.threaded.ReaderThread):  # type: ignore[misc]
+class LineReaderThread(serial.threaded.ReaderThread):
     """ReaderThread that stops within ``_POLL_S`` on transports without ``cancel_read``
     (``socket://``, ``loop://``), instead of the base class's one second."""
 
@@ -176,7 +177,7 @@ class LineReaderThread(serial.threaded.ReaderThread):  # type: ignore[misc]
             self.serial.timeout = _POLL_S
         self.protocol = self.protocol_factory()
         self.protocol.connection_made(self)
-        self._connection_made.set()
+        self._connection_made.set()  # type: ignore[attr-defined]  # the base class's
         error: BaseException | None = None
         while self.alive and self.serial.is_open:
             try:
@@ -190,7 +191,7 @@ class LineReaderThread(serial.threaded.ReaderThread):  # type: ignore[misc]
                 self.protocol.data_received(data)
         self.alive = False
         self.protocol.connection_lost(error)
-        self.protocol = None
+        self.protocol = None  # type: ignore[assignment]  # as the base class does
 
     def shutdown(self) -> None:
         """Stop reading and close the port; never raises, never blocks for long."""

@@ -67,7 +67,7 @@ def test_auto_binds_the_port_whose_usb_ids_match(
              PortInfo(emulator.url, "Arduino Uno", "USB VID:PID=2341:0043", 0x2341, 0x0043)]
     binding = binder(["alarm"], "auto", dispenser_profile, ports=ports)
     assert binding.url == emulator.url and not binding.simulated
-    assert f"matched VID:PID 2341:0043" in binding.notes[0]
+    assert "matched VID:PID 2341:0043" in binding.notes[0]
     binding.offer(item("alarm_on"))
     run_until(binding.inbox, session, lambda: bool(session.answered))
     assert session.faults() == []

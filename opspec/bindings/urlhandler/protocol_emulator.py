@@ -25,7 +25,7 @@ from opspec.errors import OpspecError
 __all__ = ["Serial"]
 
 
-class Serial(protocol_loop.Serial):  # type: ignore[misc]
+class Serial(protocol_loop.Serial):
     """A loop:// port whose other end is an emulated device."""
 
     def __init__(self, *args: Any, **kwargs: Any) -> None:
@@ -41,7 +41,7 @@ class Serial(protocol_loop.Serial):  # type: ignore[misc]
         options = urllib.parse.parse_qs(query, keep_blank_values=True)
         unknown = set(options) - {"fault", "event"}
         if unknown:
-            raise ValueError(f"unknown option {sorted(unknown)[0]!r} in {url} "
+            raise ValueError(f"unknown option {min(unknown)!r} in {url} "
                              "(emulator:// takes fault= and event=NAME@SECONDS)")
         try:
             profile = resolve_profile(urllib.parse.unquote(where))
@@ -73,7 +73,7 @@ class Serial(protocol_loop.Serial):  # type: ignore[misc]
             for byte in data:
                 self.queue.put(bytes((byte,)))
 
-    def write(self, data: bytes) -> int:
+    def write(self, data: bytes) -> int:  # type: ignore[override]  # Buffer in 3.12
         if not self.is_open:
             raise PortNotOpenError()
         if self._vanished:
