@@ -36,9 +36,7 @@ from opspec.model import (
     ArrayType,
     Assignment,
     BasicType,
-    Binary,
     BlockActivity,
-    Call,
     Condition,
     ConditionKind,
     CoordinationBuiltIn,
@@ -61,7 +59,6 @@ from opspec.model import (
     Literal,
     MetricDefinition,
     MetricKind,
-    Name,
     NoImplementation,
     Package,
     Participant,
@@ -79,11 +76,11 @@ from opspec.model import (
     TriggerKind,
     TriggerRef,
     TypeDeclaration,
-    Unary,
     UnionType,
     WorkflowMode,
     WorkflowProcess,
 )
+from opspec.model.expression_text import to_text
 
 __all__ = [
     "XPDL21",
@@ -123,44 +120,14 @@ def _bool(value: bool) -> str:
 # --------------------------------------------------------------------------- text forms
 
 
-_PRECEDENCE = {"or": 1, "and": 2, "==": 3, "!=": 3, "<": 4, "<=": 4, ">": 4, ">=": 4,
-               "+": 5, "-": 5, "*": 6, "/": 6, "%": 6}
-_SPELLING = {"and": "&&", "or": "||"}
+def expression_text(expression: Expression) -> str:
+    """JavaScript-style text of an expression tree (``n < 3 && !done``) that the condition
+    parser reads back to the same tree (the model's shared printer)."""
+    return to_text(expression)
 
 
 def _literal_text(value: str | int | float | bool | None) -> str:
-    if value is None:
-        return "null"
-    if isinstance(value, bool):
-        return "true" if value else "false"
-    if isinstance(value, str):
-        escaped = value.replace("\\", "\\\\").replace('"', '\\"').replace("\n", "\\n")
-        return f'"{escaped}"'
-    return repr(value)
-
-
-def expression_text(expression: Expression, parent: int = 0) -> str:
-    """JavaScript-style text of an expression tree (``n < 3 && !done``), parenthesised only
-    where precedence requires; the condition parser reads it back to the same tree."""
-    if isinstance(expression, Literal):
-        return _literal_text(expression.value)
-    if isinstance(expression, Name):
-        return ".".join(expression.path)
-    if isinstance(expression, Call):
-        return f"{expression.function}({', '.join(expression_text(a) for a in expression.args)})"
-    if isinstance(expression, Unary):
-        symbol = "!" if expression.op == "not" else "-"
-        return f"{symbol}{expression_text(expression.operand, 7)}"
-    if isinstance(expression, Binary):
-        mine = _PRECEDENCE.get(expression.op, 0)
-        # Left-associative: the right operand needs parentheses at equal precedence.
-        text = (
-            f"{expression_text(expression.left, mine)} "
-            f"{_SPELLING.get(expression.op, expression.op)} "
-            f"{expression_text(expression.right, mine + 1)}"
-        )
-        return f"({text})" if mine < parent else text
-    raise TypeError(f"cannot write expression node {expression!r}")
+    return to_text(Literal(value))
 
 
 def duration_text(seconds: float) -> str:
@@ -670,9 +637,13 @@ def _write_task(parent: _Element, task: Task, script_language: str | None) -> No
         attrs["TaskRef"] = task.implementation or task.message or "_"
     element = _sub(_sub(implementation, "Task"), local, **attrs)
     if local == "TaskScript":
-        _sub(element, "Script", task.script or "", Type=script_language or "text/javascript")
+        # Inside a task, Script is an ExpressionType: its language is ScriptType (the
+        # package-level Script element is the one with a Type attribute).
+        _sub(element, "Script", task.script or "", ScriptType=script_language)
     elif local in ("TaskSend", "TaskReceive") and task.message is not None:
         _sub(element, "Message", Id=_nmtoken(task.message), Name=task.message)
+    elif local in ("TaskUser", "TaskService") and task.message is not None:
+        _sub(element, "MessageIn", Id=_nmtoken(task.message), Name=task.message)
 
 
 def _write_body(parent: _Element, activity: Activity, script_language: str | None) -> None:

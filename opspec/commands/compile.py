@@ -1,0 +1,57 @@
+"""``opspec compile IN [-o OUT.wfs]``: write the workflow script (``.wfs``) of an XPDL spec.
+
+Exit status: 0 written (warnings are printed), 1 the spec has errors (each printed as
+``path:line: severity: message``; nothing is written), 2 the input cannot be read or the output
+cannot be written.
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from pathlib import Path
+from typing import Any
+
+__all__ = ["register"]
+
+
+def register(subparsers: Any) -> None:
+    parser = subparsers.add_parser(
+        "compile", help="compile an XPDL spec into a workflow script (.wfs) the engine loads",
+        description="Load IN (XPDL or SISARL-XPDL), refuse it if it has errors, and write its "
+        "compiled workflow script (versioned JSON, docs/wfs-format.md).")
+    parser.add_argument("input", metavar="IN", help="the XPDL specification")
+    parser.add_argument("-o", "--output", metavar="OUT.wfs",
+                        help="where to write the script (default: IN with the suffix .wfs)")
+    parser.add_argument("--strict", action="store_true",
+                        help="treat warnings as errors")
+    parser.set_defaults(handler=run)
+
+
+def run(args: argparse.Namespace) -> int:
+    from opspec.errors import SpecError
+    from opspec.xpdl.compile import compile_spec, default_output
+
+    source = Path(args.input)
+    if not source.is_file():
+        what = "is a folder" if source.is_dir() else "does not exist"
+        print(f"opspec compile: cannot read {source}: it {what}", file=sys.stderr)
+        return 2
+    target = Path(args.output) if args.output else default_output(source)
+    try:
+        result = compile_spec(source, target, strict=args.strict)
+    except SpecError as error:
+        for diagnostic in error.diagnostics or ():
+            print(diagnostic, file=sys.stderr)
+        if not error.diagnostics:
+            print(f"opspec compile: {error}", file=sys.stderr)
+        print(f"opspec compile: {source} has errors; nothing written", file=sys.stderr)
+        return 1
+    except OSError as error:
+        print(f"opspec compile: cannot write {target}: {error.strerror or error}",
+              file=sys.stderr)
+        return 2
+    for diagnostic in result.diagnostics:
+        print(diagnostic, file=sys.stderr)
+    print(f"{result.output}: compiled from {source}")
+    return 0

@@ -1,0 +1,15 @@
+"""Fixtures of the writer and preprocessor tests."""
+
+from __future__ import annotations
+
+import pytest
+from lxml import etree
+
+from builtin_models import SCHEMA_PATH
+
+
+@pytest.fixture(scope="session")
+def xpdl_schema() -> etree.XMLSchema:
+    """The official XPDL 2.1 schema, loaded from local files only (it imports the 1.0 schema
+    from the same folder; no network)."""
+    return etree.XMLSchema(etree.parse(str(SCHEMA_PATH), etree.XMLParser(no_network=True)))
