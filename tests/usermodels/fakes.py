@@ -5,13 +5,16 @@ engine."""
 from __future__ import annotations
 
 import heapq
+import json
 import itertools
 import math
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
+from pathlib import Path
 from typing import Any
 
 from opspec.engine.performers import WorkItem
+from opspec.engine.trace import EventKind, TraceEvent
 
 
 class FakeSession:
@@ -27,15 +30,24 @@ class FakeSession:
         self.triggers: list[tuple[float, str]] = []
         self.on_complete: Callable[[WorkItem, str | None], None] | None = None
         self.on_omit: Callable[[WorkItem, str], None] | None = None
+        self.events: list[TraceEvent] = []   # what an engine would trace, in order
+
+    def log(self, kind: str, item: WorkItem, **data: Any) -> None:
+        self.events.append(TraceEvent(time=self.now, kind=kind, process=item.process,
+                                      instance=item.instance, activity=item.activity,
+                                      lane="user", participant="user", data=data,
+                                      seq=len(self.events)))
 
     def complete(self, item: WorkItem, data: Mapping[str, Any] | None = None,
                  choice: str | None = None) -> None:
         self.completed.append((self.now, item, choice))
+        self.log(EventKind.ACTIVITY_COMPLETED, item, **({"choice": choice} if choice else {}))
         if self.on_complete:
             self.on_complete(item, choice)
 
     def omit(self, item: WorkItem, reason: str = "") -> None:
         self.omitted.append((self.now, item, reason))
+        self.log(EventKind.ACTIVITY_OMITTED, item, reason=reason)
         if self.on_omit:
             self.on_omit(item, reason)
 
@@ -96,6 +108,8 @@ class DispenserLane:
     def offer(self, activity: str, instance: int, choices: tuple[str, ...] = ()) -> None:
         item = make_item(activity, instance, choices=choices, at=self.session.now)
         self.offers.append(item)
+        self.session.log(EventKind.ACTIVITY_OFFERED, item,
+                         **({"choices": list(choices)} if choices else {}))
         self.performer.offer(item)
 
     def dose(self, at: float) -> None:
@@ -131,3 +145,11 @@ class DispenserLane:
             return
         choices = ("press_report", "press_wrong_button") if nxt == "choose_button" else ()
         self.session.call_later(0.0, lambda: self.offer(nxt, item.instance, choices))
+
+
+def write_trace(path: Path, events: list[TraceEvent]) -> Path:
+    """A JSON Lines trace file: the versioned header, then one event per line."""
+    lines = [json.dumps({"format": "opspec-trace", "version": 1})]
+    lines += [json.dumps(e.to_json()) for e in events]
+    path.write_text("\n".join(lines) + "\n", encoding="utf-8")
+    return path
