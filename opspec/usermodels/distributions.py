@@ -32,7 +32,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 import numpy.typing as npt
-from scipy import special, stats
+from scipy import special, stats  # type: ignore[import-untyped]
 
 from opspec.errors import UserModelError
 
@@ -40,13 +40,13 @@ if TYPE_CHECKING:
     from opspec.model import Distribution as ModelDistribution
 
 __all__ = [
+    "KINDS",
     "Constant",
     "Distribution",
     "Empirical",
     "ExGaussian",
     "Exponential",
     "Gamma",
-    "KINDS",
     "LogNormal",
     "ParameterError",
     "Triangular",
@@ -745,7 +745,7 @@ class _Params:
                 return self.left.pop(name)
         if required and default is None:
             if self.left:  # a misspelt name is likelier than a forgotten one
-                typo = sorted(self.left)[0]
+                typo = min(self.left)
                 close = difflib.get_close_matches(typo, names, n=1)
                 raise ParameterError(
                     typo, f"is not a parameter of a {self.kind} distribution",
@@ -758,7 +758,7 @@ class _Params:
 
     def finish(self) -> None:
         if self.left:
-            name = sorted(self.left)[0]
+            name = min(self.left)
             raise ParameterError(
                 name, f"is not a parameter of a {self.kind} distribution",
                 hint="expected one of: " + ", ".join(self.expected))
@@ -850,7 +850,7 @@ _ALIASES: dict[str, str] = {
 KINDS: tuple[str, ...] = tuple(sorted(_BUILDERS))
 
 
-def make_distribution(params: Mapping[str, Any] | float | int) -> Distribution:
+def make_distribution(params: Mapping[str, Any] | float) -> Distribution:
     """Build a distribution from its TOML table (``{"kind": "lognormal", "median": 60,
     "sigma": 0.6}``) or a bare number (a constant). Accepted kinds: :data:`KINDS` plus the BPSim
     names (``LogNormalDistribution``…). Raises :class:`ParameterError` naming the offending

@@ -32,7 +32,7 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
-from scipy import stats
+from scipy import stats  # type: ignore[import-untyped]
 
 from opspec.engine.trace import TRACE_FORMAT, TRACE_FORMAT_VERSION, EventKind, TraceEvent
 from opspec.errors import SourceLocation, UserModelError
@@ -134,7 +134,7 @@ def collect(paths: Sequence[str | Path], lane: str = "user") -> Observations:
     for path in paths:
         obs.files += 1
         run = 0
-        outstanding: dict[tuple[int, Any], deque[tuple[float, str]]] = {}
+        outstanding: dict[tuple[int, Any, str], deque[tuple[float, str]]] = {}
         in_progress: dict[tuple[int, Any, str], int] = Counter()
         pending_choice: dict[tuple[int, Any], tuple[str, tuple[str, ...]]] = {}
         picks_of: dict[tuple[int, Any], dict[str, list[str]]] = {}

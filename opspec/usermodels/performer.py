@@ -174,17 +174,16 @@ class StochasticUser:
             return choices[int(self.rng.integers(len(choices)))], owed
         commission = model.commission
         count = self._wrong.get(key, 0)
-        if commission is not None and count < commission.max_per_instance:
-            if float(self.rng.random()) < commission.probability:
-                wrong = [c for c in (commission.alternatives or choices)
-                         if c != intended and c in choices]
-                if wrong:
-                    pick = wrong[0] if len(wrong) == 1 else wrong[
-                        int(self.rng.integers(len(wrong)))]
-                    self._wrong[key] = count + 1
-                    self._recovery[key] = commission.recovery.sample(self.rng)
-                    self._trace("user.wrong_choice", item, choice=pick, intended=intended)
-                    return pick, owed
+        if (commission is not None and count < commission.max_per_instance
+                and float(self.rng.random()) < commission.probability):
+            wrong = [c for c in (commission.alternatives or choices)
+                     if c != intended and c in choices]
+            if wrong:
+                pick = wrong[0] if len(wrong) == 1 else wrong[int(self.rng.integers(len(wrong)))]
+                self._wrong[key] = count + 1
+                self._recovery[key] = commission.recovery.sample(self.rng)
+                self._trace("user.wrong_choice", item, choice=pick, intended=intended)
+                return pick, owed
         self._wrong.pop(key, None)
         return intended, owed
 

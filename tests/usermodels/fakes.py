@@ -5,8 +5,8 @@ engine."""
 from __future__ import annotations
 
 import heapq
-import json
 import itertools
+import json
 import math
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field

@@ -53,7 +53,7 @@ def test_fit_recovers_the_walk_lognormal(fitted) -> None:
 
 def test_fit_recovers_the_not_heard_rate_with_its_interval(fitted) -> None:
     fit = next(f for f in fitted.fits if f.activity == "hear_alarm")
-    omitted, answered, (low, high) = fit.omission
+    _omitted, answered, (low, high) = fit.omission
     p = fitted.model.activities["hear_alarm"].omission.probability
     assert p == pytest.approx(0.15, abs=5 * math.sqrt(0.15 * 0.85 / answered))
     assert low < p < high
@@ -146,10 +146,10 @@ BAD_TRACES = {
                  r":2: not valid JSON"),
     "future-version": ('{"format": "opspec-trace", "version": 9}\n',
                        r":1: unsupported trace version 9"),
-    "no-user-lane": ('{"format": "opspec-trace", "version": 1}\n'
+    "no-user-lane": (('{"format": "opspec-trace", "version": 1}\n'
                      '{"time": 0, "kind": "activity.offered", "activity": "x", "lane": '
-                     '"device", "instance": 1}\n', r"no activity of lane 'user'.*lanes seen: "
-                     r"device"),
+                     '"device", "instance": 1}\n'), (r"no activity of lane 'user'.*lanes seen: "
+                     r"device")),
     "event-without-time": ('{"format": "opspec-trace", "version": 1}\n{"kind": "x"}\n',
                            r":2: not a trace event"),
 }

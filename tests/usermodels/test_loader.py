@@ -60,22 +60,22 @@ def test_the_dispenser_preset_equals_the_spec_user_model(dispenser_users_path) -
 
 
 BAD = {
-    "negative-sigma": ('[activities.walk_to_dispenser]\n'
-                       'duration = { kind = "lognormal", median = 60, sigma = -1 }',
-                       r"users.toml: activities.walk_to_dispenser.duration.sigma: "
-                       r"must be > 0, got -1"),
+    "negative-sigma": (('[activities.walk_to_dispenser]\n'
+                       'duration = { kind = "lognormal", median = 60, sigma = -1 }'),
+                       (r"users.toml: activities.walk_to_dispenser.duration.sigma: "
+                       r"must be > 0, got -1")),
     "unknown-distribution": ('[activities.walk]\nduration = { kind = "gauss", mean = 1 }',
-                             r"users.toml: activities.walk.duration.kind: unknown "
-                             r"distribution 'gauss' \(use one of: constant"),
+                             (r"users.toml: activities.walk.duration.kind: unknown "
+                             r"distribution 'gauss' \(use one of: constant")),
     "probability-above-1": ('[activities.hear]\nomission = 1.5',
-                            r"users.toml: activities.hear.omission.probability: must be a "
-                            r"probability in \[0, 1\], got 1.5"),
-    "negative-probability": ('[activities.c]\nintended = "a"\n'
-                             'commission = { probability = -0.1 }',
+                            (r"users.toml: activities.hear.omission.probability: must be a "
+                            r"probability in \[0, 1\], got 1.5")),
+    "negative-probability": (('[activities.c]\nintended = "a"\n'
+                             'commission = { probability = -0.1 }'),
                              r"activities.c.commission.probability: must be a probability"),
     "unknown-activity-key": ('[activities.walk]\nduraton = 3',
-                             r"users.toml: activities.walk.duraton: unknown key \(expected "
-                             r"one of: duration"),
+                             (r"users.toml: activities.walk.duraton: unknown key \(expected "
+                             r"one of: duration")),
     "unknown-top-key": ('[activites.walk]\nduration = 3', r"users.toml: activites: unknown key"),
     "bad-window": ('[[routine.windows]]\nname = "asleep"\nstart = "23:00"\nend = "31:00"',
                    r"routine.windows\[0\].end: is not a time of day"),
@@ -83,8 +83,8 @@ BAD = {
     "probabilities-sum": ('[activities.c]\nprobabilities = { a = 0.5, b = 0.6 }',
                           r"activities.c.probabilities: must add up to 1, got 1.1"),
     "bad-version": ('version = 7', r"users.toml: version: unsupported version 7"),
-    "nested-typo": ('[activities.w]\nduration = { kind = "with_tail", tau = 1, '
-                    'base = { kind = "gamma", shape = -1, scale = 1 } }',
+    "nested-typo": (('[activities.w]\nduration = { kind = "with_tail", tau = 1, '
+                    'base = { kind = "gamma", shape = -1, scale = 1 } }'),
                     r"activities.w.duration.base.shape: must be > 0"),
     "not-toml": ('[activities.walk\n', r"users.toml: not valid TOML"),
 }
