@@ -421,18 +421,21 @@ class DeviceBinding:
         """Helper thread: try to reopen the port; post the outcome to the engine."""
         assert self.url is not None
         last = ""
-        for _ in range(attempts):
-            if self._closed.wait(self.profile.fallback.reconnect_delay_s):
+        try:
+            for _ in range(attempts):
+                if self._closed.wait(self.profile.fallback.reconnect_delay_s):
+                    return
+                try:
+                    port = open_port(self.url, self.profile.serial)
+                except BindingError as error:
+                    last = error.message
+                    continue
+                if self.profile.serial.settle_s and "://" not in self.url:
+                    self._closed.wait(self.profile.serial.settle_s)
+                self.inbox.post(partial(self._reconnected, gen, port))
                 return
-            try:
-                port = open_port(self.url, self.profile.serial)
-            except BindingError as error:
-                last = error.message
-                continue
-            if self.profile.serial.settle_s and "://" not in self.url:
-                self._closed.wait(self.profile.serial.settle_s)
-            self.inbox.post(partial(self._reconnected, gen, port))
-            return
+        except Exception as error:  # noqa: BLE001 - the engine must hear back, whatever happens
+            last = f"{type(error).__name__}: {error}"
         self.inbox.post(partial(self._reconnect_failed, gen,
                                 f"{attempts} reconnection attempt(s) failed: {last}"))
 

@@ -294,8 +294,10 @@ def _now() -> float:
 class PtyEmulator(_Server):
     """The device on a pseudo-terminal pair. :attr:`path` is the slave to open (``/dev/pts/N``).
 
-    A ``disconnect`` closes the pair: the slave path disappears, like an unplugged USB
-    adapter, so reopening it fails.
+    A ``disconnect`` closes the master: the slave path disappears, like an unplugged USB
+    adapter, so reopening it fails. The emulator keeps its slave descriptor until
+    :meth:`stop`, so the kernel cannot hand the same ``/dev/pts/N`` to another process
+    meanwhile (which would let a reconnect reach a stranger's terminal).
     """
 
     def __init__(self, device: EmulatedDevice) -> None:
@@ -330,13 +332,15 @@ class PtyEmulator(_Server):
             os.write(self._master, data)
 
     def _drop(self) -> None:
-        self._close()
-
-    def _close(self) -> None:
         if self._open:
             self._open = False
             os.close(self._master)
+
+    def _close(self) -> None:
+        self._drop()
+        if self._slave >= 0:
             os.close(self._slave)
+            self._slave = -1
 
 
 class SocketEmulator(_Server):

@@ -65,6 +65,9 @@ def open_port(url: str, settings: SerialSettings, who: str = "") -> serial.Seria
                            hint="check the cable and the path (`opspec devices list`), and "
                            "that you may use the port (e.g. membership of the dialout group)"
                            ) from None
+    except Exception as error:  # noqa: BLE001 - e.g. termios.error from a dying pty
+        raise BindingError(f"{prefix}cannot open {url}: {type(error).__name__}: {error}",
+                           hint="the port vanished or is not a serial device") from None
     return port
 
 
