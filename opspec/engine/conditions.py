@@ -167,17 +167,9 @@ def _equal(a: Any, b: Any) -> bool:
     return bool(a == b)
 
 
-def _order(a: Any, b: Any, op: str) -> int:
+def _order(a: Any, b: Any) -> int:
     """-1, 0 or 1; raises for pairs that have no order."""
-    if isinstance(a, str) and isinstance(b, str):
-        return (a > b) - (a < b)
-    x, y = _ordered_number(a), _ordered_number(b)
-    if x is None or y is None:
-        culprit = a if x is None else b
-        raise _Problem(
-            f"cannot compare {_show(a)} {op} {_show(b)}: {_text(culprit)} is not a number"
-        )
-    return (x > y) - (x < y)
+    return -1 if _ordered(a, b, "<") else (1 if _ordered(a, b, ">") else 0)
 
 
 def _ordered_number(value: Any) -> int | float | None:
@@ -189,12 +181,26 @@ def _ordered_number(value: Any) -> int | float | None:
 
 
 def _less(a: Any, b: Any) -> bool:
-    return _order(a, b, "<") < 0
+    return _ordered(a, b, "<")
 
 
-_ORDERING: dict[str, Callable[[int], bool]] = {
-    "<": lambda c: c < 0, "<=": lambda c: c <= 0, ">": lambda c: c > 0, ">=": lambda c: c >= 0,
+_FAST_ORDERING: dict[str, Callable[[Any, Any], bool]] = {
+    "<": operator.lt, "<=": operator.le, ">": operator.gt, ">=": operator.ge,
 }
+
+
+def _ordered(a: Any, b: Any, op: str) -> bool:
+    """``a op b`` for an ordering operator, by the ordering rules (NaN compares false)."""
+    test = _FAST_ORDERING[op]
+    if isinstance(a, str) and isinstance(b, str):
+        return test(a, b)
+    x, y = _ordered_number(a), _ordered_number(b)
+    if x is None or y is None:
+        culprit = a if x is None else b
+        raise _Problem(
+            f"cannot compare {_show(a)} {op} {_show(b)}: {_text(culprit)} is not a number"
+        )
+    return test(x, y)
 
 
 def _add(a: Any, b: Any) -> Any:
@@ -290,7 +296,7 @@ def _extreme(pick_less: bool) -> Callable[..., Any]:
 
 
 def _compare(a: Any, b: Any) -> int:
-    return 0 if _equal(a, b) else _order(a, b, "compared with")
+    return 0 if _equal(a, b) else _order(a, b)
 
 
 _IMPLEMENTATIONS: dict[str, Callable[..., Any]] = {
@@ -436,8 +442,8 @@ def _walk(expr: Expression, data: Mapping[str, Any], clock: Callable[[], float] 
             return _equal(left, right)
         if op == "!=":
             return not _equal(left, right)
-        if op in _ORDERING:
-            return _ORDERING[op](_order(left, right, op))
+        if op in _FAST_ORDERING:
+            return _ordered(left, right, op)
         if op in _ARITHMETIC:
             return _ARITHMETIC[op](left, right)
         raise _Problem(f"unknown operator {op!r}")
@@ -560,7 +566,7 @@ def _compile_binary(expr: Binary) -> _Fn:
         return either
     if op in ("==", "!="):
         return _compile_equality(expr, left, right, negate=op == "!=")
-    if op in _ORDERING:
+    if op in _FAST_ORDERING:
         return _compile_ordering(expr, left, right)
     if op in _ARITHMETIC:
         arithmetic = _ARITHMETIC[op]
@@ -610,10 +616,7 @@ def _compile_equality(expr: Binary, left: _Fn, right: _Fn, *, negate: bool) -> _
 
 def _compile_ordering(expr: Binary, left: _Fn, right: _Fn) -> _Fn:
     op = expr.op
-    test = _ORDERING[op]
-    fast: Callable[[Any, Any], bool] = {
-        "<": operator.lt, "<=": operator.le, ">": operator.gt, ">=": operator.ge,
-    }[op]
+    fast = _FAST_ORDERING[op]
     constant = expr.right.value if isinstance(expr.right, Literal) else None
     if (
         isinstance(expr.left, Name) and len(expr.left.path) == 1
@@ -630,7 +633,7 @@ def _compile_ordering(expr: Binary, left: _Fn, right: _Fn) -> _Fn:
             kind = type(value)
             if kind is int or kind is float:
                 return fast(value, constant)
-            return test(_order(value, constant, op))
+            return _ordered(value, constant, op)
 
         return field_ordering
     if type(constant) in (int, float):
@@ -640,7 +643,7 @@ def _compile_ordering(expr: Binary, left: _Fn, right: _Fn) -> _Fn:
             kind = type(value)
             if kind is int or kind is float:
                 return fast(value, constant)
-            return test(_order(value, constant, op))
+            return _ordered(value, constant, op)
 
         return ordering_constant
 
@@ -651,7 +654,7 @@ def _compile_ordering(expr: Binary, left: _Fn, right: _Fn) -> _Fn:
             return fast(a, b)
         if ta is str and tb is str:
             return fast(a, b)
-        return test(_order(a, b, op))
+        return _ordered(a, b, op)
 
     return ordering
 
