@@ -27,10 +27,10 @@ import serial
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
-from opspec.bindings import bind, load_profile, summarise  # noqa: E402
-from opspec.bindings.emulator import EmulatedDevice, PtyEmulator  # noqa: E402
-from opspec.bindings.latency import LatencySummary  # noqa: E402
-from opspec.engine.performers import WorkItem  # noqa: E402
+from opspec.bindings import bind, load_profile, summarise
+from opspec.bindings.emulator import EmulatedDevice, PtyEmulator
+from opspec.bindings.latency import LatencySummary
+from opspec.engine.performers import WorkItem
 
 PROFILE = ROOT / "devices" / "medication_dispenser.toml"
 
