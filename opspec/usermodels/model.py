@@ -169,6 +169,12 @@ class UserModel:
         manual = list(dict.fromkeys(manual_activity_ids))
         choice_map = {k: list(v) for k, v in (choices or {}).items()}
         missing = [a for a in [*manual, *choice_map] if not self.covers(a)]
+        if missing and not self.activities and self.default is None and self.modifiers:
+            raise UserModelError(
+                f"{self.name!r} is a modifier (it changes a model) and covers no activity",
+                location=SourceLocation(self.path),
+                hint=f"combine it with a base model, e.g. --user-model "
+                f"SPEC.users.toml,{self.name}")
         if missing:
             ids = ", ".join(missing)
             raise UserModelError(

@@ -140,7 +140,9 @@ def test_defaults_cover_every_activity(tmp_path: Path) -> None:
 
 
 def test_a_modifier_preset_alone_covers_nothing() -> None:
-    with pytest.raises(UserModelError, match="does not cover"):
+    with pytest.raises(UserModelError, match=r"older-adults.toml: 'older-adults' is a modifier "
+                       r".*combine it with a base model, e.g. --user-model "
+                       r"SPEC.users.toml,older-adults"):
         load_user_model("older-adults").validate_against(["walk"])
 
 
