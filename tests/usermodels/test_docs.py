@@ -11,7 +11,7 @@ import pytest
 from opspec.usermodels import parse_user_model
 
 DOC = Path(__file__).resolve().parents[2] / "docs" / "user-models.md"
-BLOCKS = re.findall(r"```toml\n(.*?)```", DOC.read_text(encoding="utf-8"), re.S)
+BLOCKS = re.findall(r"```toml\n(.*?)```", DOC.read_text(encoding="utf-8"), re.DOTALL)
 
 
 def test_the_docs_have_toml_examples() -> None:
