@@ -216,7 +216,7 @@ def _arbiter(builtin: CoordinationBuiltIn, s: _Set, output: str) -> None:
         branches.append(s.link(decide, pick, _condition(_holds_command(ref))))
         s.link(pick, done)
     idle = s.add("idle", "Arbiter: no input has a command",
-                 assignments=(_assign(output, Literal("")),))
+                 assignments=(_assign(output, Literal(None)),))
     branches.append(s.link(decide, idle, _OTHERWISE))
     s.link(idle, done)
     s.set_split(decide, branches)
@@ -258,6 +258,14 @@ def _voter(builtin: CoordinationBuiltIn, s: _Set, output: str,
     s.link(previous, decide)
     done = s.route("done", "Voter: done", join=True)
     branches = []
+    # Nobody voted for a listed option: the output is null (as the engine's voter gives).
+    nobody: Expression = Binary("==", Name((tallies[0],)), Literal(0))
+    for tally in tallies[1:]:
+        nobody = Binary("and", nobody, Binary("==", Name((tally,)), Literal(0)))
+    abstain = s.add("none", "Voter: no vote for any option",
+                    assignments=(_assign(output, Literal(None)),))
+    branches.append(s.link(decide, abstain, _condition(nobody)))
+    s.link(abstain, done)
     for index, option in enumerate(options):
         pick = s.add(f"pick{index + 1}", f"Voter: {option} wins",
                      assignments=(_assign(output, Literal(option)),))
@@ -324,21 +332,21 @@ def _translate(builtin: CoordinationBuiltIn, s: _Set, new_fields: list[DataField
             report.error(s.owner, "the push-data built-in needs a Channel and a Ref",
                          "write <opspec:PushData Channel=\"…\" Ref=\"data_field\"/>")
             return False
-        _application_task(s, "push", f"Push {builtin.inputs[0]} to {builtin.channel}",
+        _application_task(s, "call", f"Push {builtin.inputs[0]} to {builtin.channel}",
                           PUSH_APPLICATION, (Literal(builtin.channel), builtin.inputs[0]))
     elif kind is CoordinationKind.PULL_DATA:
         if builtin.channel is None:
             report.error(s.owner, "the pull-data built-in needs a Channel",
                          "write <opspec:PullData Channel=\"…\" Ref=\"data_field\"/>")
             return False
-        _application_task(s, "pull", f"Pull {output} from {builtin.channel}",
+        _application_task(s, "call", f"Pull {output} from {builtin.channel}",
                           PULL_APPLICATION, (Literal(builtin.channel), output))
     elif kind is CoordinationKind.MODE_CHANGE:
         if not builtin.target_mode:
             report.error(s.owner, "the mode-change built-in names no mode",
                          "write <opspec:ModeChange To=\"mode_id\"/>")
             return False
-        _application_task(s, "change", f"Change to mode {builtin.target_mode}",
+        _application_task(s, "call", f"Change to mode {builtin.target_mode}",
                           MODE_CHANGE_APPLICATION, (Literal(builtin.target_mode),))
     return True
 

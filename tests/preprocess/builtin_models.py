@@ -25,6 +25,7 @@ from opspec.model import (
     ProcessDirectives,
     Route,
     Transition,
+    Trigger,
     TriggerRef,
     WorkflowMode,
     WorkflowProcess,
@@ -66,7 +67,9 @@ def builtin_process(key: str) -> WorkflowProcess:
             Activity(id=f"{pid}_coordinate", name=f"{key} built-in", body=Route(),
                      performers=("robot",), lane="device_lane", coordination=BUILTINS[key],
                      directives=ActivityDirectives(priority_increment=1)),
-            Activity(id=f"{pid}_end", body=Event(position=EventPosition.END),
+            Activity(id=f"{pid}_end", body=Event(position=EventPosition.END,
+                                                 trigger=Trigger(catching=False),
+                                                 result="None"),
                      lane="device_lane"),
         ),
         transitions=(
