@@ -316,12 +316,10 @@ _FIELD_DECODERS: dict[type, dict[str, Decoder]] = {}
 
 
 def _build_decoders() -> None:
-    namespace: dict[str, Any] = {}
-    for module in (expressions, common, data, sisarl, activities, resources, process, package):
-        namespace.update(vars(module))
-    namespace["SourceLocation"] = SourceLocation
+    # Resolve each class's annotations in its own module (no shared namespace: two modules
+    # both define a ``Mode``, and a merged namespace would take precedence over the right one).
     for cls in TAGS.values():
-        hints = typing.get_type_hints(cls, localns=namespace)
+        hints = typing.get_type_hints(cls)
         _FIELD_DECODERS[cls] = {
             f.name: _decoder_for(hints[f.name]) for f in dataclasses.fields(cls)
         }

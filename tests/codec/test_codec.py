@@ -61,13 +61,12 @@ from opspec.model import (
     WorkflowMode,
     WorkflowProcess,
 )
+from opspec.model import Mode as ActivityMode
 from opspec.model import codec
 
 
 def _reachable_dataclasses() -> set[type]:
     """Every dataclass a Package can contain, found by walking the type hints."""
-    namespace = dict(vars(__import__("opspec.model", fromlist=["*"])))
-    namespace["SourceLocation"] = SourceLocation
     seen: set[type] = set()
     stack: list[Any] = [Package]
     while stack:
@@ -84,7 +83,7 @@ def _reachable_dataclasses() -> set[type]:
             sub for sub in hint.__subclasses__()
             if getattr(sys.modules[sub.__module__], sub.__name__, None) is sub
         )
-        hints = typing.get_type_hints(hint, localns=namespace)
+        hints = typing.get_type_hints(hint)
         stack.extend(hints[f.name] for f in dataclasses.fields(hint))
     return seen
 
@@ -99,12 +98,6 @@ def test_every_model_class_a_package_can_hold_has_a_type_tag() -> None:
 
 
 # --------------------------------------------------------------------------- random models
-
-_NAMESPACE: dict[str, Any] = {}
-for _module in ("expressions", "common", "data", "sisarl", "activities", "resources",
-                "process", "package"):
-    _NAMESPACE.update(vars(__import__(f"opspec.model.{_module}", fromlist=["*"])))
-_NAMESPACE["SourceLocation"] = SourceLocation
 
 # Text as XML can carry it (no lone surrogates), short to keep examples small.
 _text = st.text(st.characters(blacklist_categories=("Cs",)), max_size=8)
@@ -148,7 +141,7 @@ def _strategy(hint: Any, depth: int) -> st.SearchStrategy[Any]:
 
 
 def _build(cls: type, depth: int) -> st.SearchStrategy[Any]:
-    hints = typing.get_type_hints(cls, localns=_NAMESPACE)
+    hints = typing.get_type_hints(cls)
     kwargs = {}
     for f in dataclasses.fields(cls):
         strategy = _strategy(hints[f.name], depth)
@@ -212,7 +205,8 @@ def _rich_package() -> Package:
                 ActualParameter(text="n", expression=Name(("n",))),))),
             Activity(id="app", body=Task(kind=TaskKind.APPLICATION, applications=(
                 TaskApplication(application="beep"),))),
-            Activity(id="block", body=BlockActivity(activity_set="S")),
+            Activity(id="block", body=BlockActivity(activity_set="S"),
+                     start_mode=ActivityMode.MANUAL),
         ),
         transitions=(
             Transition(id="t1", source="start", target="arbitrate",
