@@ -85,7 +85,7 @@ def truthy(value: Any) -> bool:
     if value is True:
         return True
     if isinstance(value, (int, float)):
-        return value == value and value != 0  # NaN is false
+        return value != 0 and not (isinstance(value, float) and math.isnan(value))
     if isinstance(value, str):
         return value.strip().lower() not in _FALSE_TEXTS
     if isinstance(value, Sized):
@@ -633,6 +633,10 @@ def _compile_ordering(expr: Binary, left: _Fn, right: _Fn) -> _Fn:
             kind = type(value)
             if kind is int or kind is float:
                 return fast(value, constant)
+            if kind is str:  # XPDL data often holds numbers as text ("3")
+                number = _numeric_text(value)
+                if number is not None:
+                    return fast(number, constant)
             return _ordered(value, constant, op)
 
         return field_ordering

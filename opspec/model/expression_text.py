@@ -85,17 +85,17 @@ def _text(expr: Expression) -> tuple[str, int]:
         )
         return f"{symbol}({operand})" if wrap else f"{symbol}{operand}", _PREFIX
     if isinstance(expr, Binary):
-        power = PRECEDENCE.get(expr.op)
-        if power is None:
+        op_power = PRECEDENCE.get(expr.op)
+        if op_power is None:
             raise ValueError(f"unknown binary operator {expr.op!r}")
         left, left_power = _text(expr.left)
         right, right_power = _text(expr.right)
         # Comparisons never chain in printed text: the parser reads "a < b < c" as a range.
-        if left_power < power or (left_power == power and expr.op in _COMPARISONS):
+        if left_power < op_power or (left_power == op_power and expr.op in _COMPARISONS):
             left = f"({left})"
-        if right_power <= power:
+        if right_power <= op_power:
             right = f"({right})"
-        return f"{left} {_SPELLING.get(expr.op, expr.op)} {right}", power
+        return f"{left} {_SPELLING.get(expr.op, expr.op)} {right}", op_power
     raise ValueError(f"not an expression node: {expr!r}")
 
 

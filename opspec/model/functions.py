@@ -15,7 +15,7 @@ from collections.abc import Mapping
 from dataclasses import dataclass
 from types import MappingProxyType
 
-__all__ = ["FUNCTIONS", "FunctionSignature", "TIME_FUNCTIONS"]
+__all__ = ["FUNCTIONS", "TIME_FUNCTIONS", "FunctionSignature"]
 
 
 @dataclass(frozen=True, slots=True)

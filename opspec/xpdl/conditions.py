@@ -47,11 +47,11 @@ from opspec.model.expressions import Binary, Call, Expression, Literal, Name, Un
 from opspec.model.functions import FUNCTIONS, TIME_FUNCTIONS, FunctionSignature
 
 __all__ = [
-    "ConditionSyntaxError",
     "FUNCTIONS",
-    "FunctionSignature",
     "MAX_DEPTH",
     "MAX_LENGTH",
+    "ConditionSyntaxError",
+    "FunctionSignature",
     "names_used",
     "parse_condition",
     "parse_expression",
@@ -209,7 +209,8 @@ class _Tokenizer:
         self.fail = fail
 
     def tokens(self) -> list[_Token]:
-        text, i, out = self.text, 0, []
+        text, i = self.text, 0
+        out: list[_Token] = []
         while i < len(text):
             ch = text[i]
             if ch.isspace():
@@ -278,7 +279,7 @@ class _Tokenizer:
             return self._finish_number(start, j, float(digits), "fFdD")
         return self._finish_number(start, j, int(digits), "LlfFdD")
 
-    def _finish_number(self, start: int, end: int, value: int | float, suffixes: str) -> _Token:
+    def _finish_number(self, start: int, end: int, value: float, suffixes: str) -> _Token:
         text = self.text
         following = text[end + 1 : end + 2]
         if end < len(text) and text[end] in suffixes and not (
@@ -296,7 +297,8 @@ class _Tokenizer:
         return _Token("num", text[start:end], start, value)
 
     def _string(self, start: int) -> tuple[_Token, int]:
-        text, quote, i, out = self.text, self.text[start], start + 1, []
+        text, quote, i = self.text, self.text[start], start + 1
+        out: list[str] = []
         while i < len(text):
             ch = text[i]
             if ch == quote:

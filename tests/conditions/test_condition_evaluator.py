@@ -138,15 +138,15 @@ def test_truthiness_rules(value: Any, expected: bool) -> None:
 ERRORS = [
     # (id, text, message fragment)
     ("missing-field", "missing == 1",
-     "data field 'missing' does not exist (fields: count_text, done, empty, flag_text, n, "
-     "nothing, order, price, status, tags)"),
-    ("missing-record-member", "order.nope", "record 'order' has no member 'nope' (members: "
-     "customer, lines, total)"),
+     ("data field 'missing' does not exist (fields: count_text, done, empty, flag_text, n, "
+      "nothing, order, price, status, tags)")),
+    ("missing-record-member", "order.nope",
+     "record 'order' has no member 'nope' (members: customer, lines, total)"),
     ("member-of-text", "status.nope", "'status' is text, so it has no member 'nope'"),
     ("division-by-zero", "n / 0", "division by zero"),
     ("remainder-by-zero", "n % 0", "remainder of a division by zero"),
-    ("order-number-and-word", 'n < "abc"', "cannot compare 2 (number) < 'abc' (text): abc is not "
-     "a number"),
+    ("order-number-and-word", 'n < "abc"',
+     "cannot compare 2 (number) < 'abc' (text): abc is not a number"),
     ("order-with-null", "nothing > 1", "cannot compare null > 1 (number)"),
     ("arithmetic-on-word", 'status * 2', "'*' needs a number, got 'approved' (text)"),
     ("len-of-number", "len(n)", "len() needs a text, list or record"),

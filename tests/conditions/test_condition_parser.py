@@ -20,7 +20,7 @@ def n(*path: str) -> Name:
     return Name(path)
 
 
-def lit(value: str | int | float | bool | None) -> Literal:
+def lit(value: str | float | bool | None) -> Literal:
     return Literal(value)
 
 
