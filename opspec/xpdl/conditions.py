@@ -39,12 +39,12 @@ Everything else is a :class:`ConditionSyntaxError` naming the column of the prob
 from __future__ import annotations
 
 from collections.abc import Callable
-from dataclasses import dataclass
 
 from opspec.errors import Diagnostic, Severity, SourceLocation, SpecError
 from opspec.model.expression_text import PRECEDENCE, SCRIPT_WORDS, to_text
 from opspec.model.expressions import Binary, Call, Expression, Literal, Name, Unary
 from opspec.model.functions import FUNCTIONS, TIME_FUNCTIONS, FunctionSignature
+from opspec.xpdl.condition_tokens import Token, Tokenizer, unwrap
 
 __all__ = [
     "FUNCTIONS",
@@ -139,7 +139,7 @@ def parse_condition(
     """The tree for a transition/loop/trigger condition, or ``None`` when ``text`` is ``None``,
     empty or only white space (and CDATA padding): "no condition". Raises
     :class:`ConditionSyntaxError`."""
-    if text is None or not _unwrap(text).strip().rstrip(";").strip():
+    if text is None or not unwrap(text).strip().rstrip(";").strip():
         return None
     return parse_expression(text, location=location, kind="condition")
 
@@ -159,180 +159,6 @@ def names_used(expr: Expression) -> frozenset[str]:
         elif isinstance(node, Call):
             stack.extend(node.args)
     return frozenset(found)
-
-
-# --------------------------------------------------------------------------- tokenizer
-
-
-@dataclass(frozen=True, slots=True)
-class _Token:
-    kind: str  # "num", "str", "word", "op", "end"
-    text: str  # as written (for messages)
-    start: int
-    value: str | int | float | None = None
-
-
-_OPERATORS = (
-    "===", "!==", "==", "!=", "<>", "<=", ">=", "&&", "||",
-    "=", "<", ">", "!", "+", "-", "*", "/", "%", "(", ")", ",", ".", ";", "≤", "≥", "≠",
-)
-_NOT_SUPPORTED = {
-    "&": "'&' is not an operator here; write '&&' (and)",
-    "|": "'|' is not an operator here; write '||' (or)",
-    "?": "the ?: operator is not supported; use two transitions with opposite conditions",
-    "[": "indexing with [...] is not supported; name record members with dots (order.total)",
-    "{": "blocks {...} are scripts, not conditions",
-    "^": "'^' is not supported",
-}
-_SIMPLE_ESCAPES = {
-    "n": "\n", "t": "\t", "r": "\r", "b": "\b", "f": "\f", "v": "\v", "0": "\0",
-}
-_CDATA_OPEN, _CDATA_CLOSE = "<![CDATA[", "]]>"
-
-
-def _unwrap(text: str) -> str:
-    """Replace a CDATA wrapper by spaces (keeping columns)."""
-    stripped = text.strip()
-    if stripped.startswith(_CDATA_OPEN) and stripped.endswith(_CDATA_CLOSE):
-        start = text.index(_CDATA_OPEN)
-        end = text.rindex(_CDATA_CLOSE)
-        return (
-            text[:start] + " " * len(_CDATA_OPEN) + text[start + len(_CDATA_OPEN) : end]
-            + " " * len(_CDATA_CLOSE) + text[end + len(_CDATA_CLOSE) :]
-        )
-    return text
-
-
-class _Tokenizer:
-    def __init__(self, text: str, fail: Callable[[int, str], ConditionSyntaxError]) -> None:
-        self.text = text
-        self.fail = fail
-
-    def tokens(self) -> list[_Token]:
-        text, i = self.text, 0
-        out: list[_Token] = []
-        while i < len(text):
-            ch = text[i]
-            if ch.isspace():
-                i += 1
-            elif _digit(ch) or (
-                ch == "." and _digit(text[i + 1 : i + 2])
-                and not (out and out[-1].kind in ("word", "num", "str") or _closes(out))
-            ):
-                token = self._number(i)
-                out.append(token)
-                i = token.start + len(token.text)
-            elif ch in "'\"":
-                token, i = self._string(i)
-                out.append(token)
-            elif ch.isalpha() or ch in "_$":
-                j = i + 1
-                while j < len(text) and (text[j].isalnum() or text[j] in "_$"):
-                    j += 1
-                out.append(_Token("word", text[i:j], i))
-                i = j
-            else:
-                for op in _OPERATORS:
-                    if text.startswith(op, i):
-                        out.append(_Token("op", op, i))
-                        i += len(op)
-                        break
-                else:
-                    problem = _NOT_SUPPORTED.get(ch, f"unexpected character {ch!r}")
-                    raise self.fail(i, problem)
-        out.append(_Token("end", "", len(text)))
-        return out
-
-    def _number(self, start: int) -> _Token:
-        text, i = self.text, start
-        if text.startswith(("0x", "0X"), i):
-            j = i + 2
-            while j < len(text) and text[j] in "0123456789abcdefABCDEF":
-                j += 1
-            if j == i + 2:
-                raise self.fail(i, "a hexadecimal number needs digits after '0x'")
-            return self._finish_number(start, j, int(text[i + 2 : j], 16), "Ll")
-        j = i
-        while j < len(text) and _digit(text[j]):
-            j += 1
-        is_float = False
-        if j < len(text) and text[j] == "." and _digit(text[j + 1 : j + 2]):
-            is_float = True
-            j += 1
-            while j < len(text) and _digit(text[j]):
-                j += 1
-        if j < len(text) and text[j] in "eE":
-            k = j + 1
-            if k < len(text) and text[k] in "+-":
-                k += 1
-            if k < len(text) and _digit(text[k]):
-                is_float = True
-                j = k
-                while j < len(text) and _digit(text[j]):
-                    j += 1
-        digits = text[i:j]
-        if len(digits) > 400:
-            raise self.fail(i, "number has too many digits")
-        if not all("0" <= c <= "9" or c in ".eE+-" for c in digits):
-            raise self.fail(i, f"cannot read number {digits!r}")
-        if is_float:
-            return self._finish_number(start, j, float(digits), "fFdD")
-        return self._finish_number(start, j, int(digits), "LlfFdD")
-
-    def _finish_number(self, start: int, end: int, value: float, suffixes: str) -> _Token:
-        text = self.text
-        following = text[end + 1 : end + 2]
-        if end < len(text) and text[end] in suffixes and not (
-            following.isalnum() or following in ("_", "$")
-        ):
-            if text[end] in "fFdD":
-                value = float(value)
-            end += 1
-        if end < len(text) and (text[end].isalnum() or text[end] in "_$"):
-            raise self.fail(
-                end,
-                f"unexpected {text[end]!r} right after the number {text[start:end]} "
-                "(names cannot start with a digit; durations belong in Deadline elements)",
-            )
-        return _Token("num", text[start:end], start, value)
-
-    def _string(self, start: int) -> tuple[_Token, int]:
-        text, quote, i = self.text, self.text[start], start + 1
-        out: list[str] = []
-        while i < len(text):
-            ch = text[i]
-            if ch == quote:
-                return _Token("str", text[start : i + 1], start, "".join(out)), i + 1
-            if ch == "\\" and i + 1 < len(text):
-                code = text[i + 1]
-                if code in "uUxX":
-                    out.append(self._code_point(i))
-                    i += 6 if code in "uU" else 4
-                    continue
-                out.append(_SIMPLE_ESCAPES.get(code, code))
-                i += 2
-                continue
-            out.append(ch)
-            i += 1
-        raise self.fail(start, f"the text starting with {quote} is never closed")
-
-    def _code_point(self, i: int) -> str:
-        width = 4 if self.text[i + 1] in "uU" else 2
-        digits = self.text[i + 2 : i + 2 + width]
-        if len(digits) != width or any(c not in "0123456789abcdefABCDEF" for c in digits):
-            raise self.fail(i, f"escape {self.text[i : i + 2]} needs {width} hex digits")
-        value = int(digits, 16)
-        if 0xD800 <= value <= 0xDFFF:
-            raise self.fail(i, "escape names a lone surrogate, which is not a character")
-        return chr(value)
-
-
-def _digit(ch: str) -> bool:
-    return len(ch) == 1 and "0" <= ch <= "9"
-
-
-def _closes(tokens: list[_Token]) -> bool:
-    return bool(tokens) and tokens[-1].kind == "op" and tokens[-1].text == ")"
 
 
 # --------------------------------------------------------------------------- parser
@@ -401,7 +227,7 @@ class _Parser:
         self.location = location
         self.pos = 0
         self.nesting = 0
-        self.tokens: list[_Token] = []
+        self.tokens: list[Token] = []
 
     def fail(self, offset: int, problem: str) -> ConditionSyntaxError:
         return ConditionSyntaxError(
@@ -417,7 +243,7 @@ class _Parser:
         text = self.original
         if len(text) > MAX_LENGTH:
             raise self.fail(0, f"text is longer than {MAX_LENGTH} characters")
-        self.tokens = _Tokenizer(_unwrap(text), self.fail).tokens()
+        self.tokens = Tokenizer(unwrap(text), self.fail).tokens()
         if self.peek().kind == "end" or self.peek().text == ";":
             raise self.fail(self.peek().start, f"the {self.kind} is empty")
         expr = self.expression(0)
@@ -435,7 +261,7 @@ class _Parser:
             raise self.fail(0, f"nested more than {MAX_DEPTH} levels deep; split it up")
         return expr
 
-    def leftover(self, token: _Token) -> str:
+    def leftover(self, token: Token) -> str:
         previous = self.tokens[self.pos - 1].text
         if token.kind == "op" and token.text == ";":
             return "only one expression is allowed (';' separates script statements)"
@@ -448,16 +274,16 @@ class _Parser:
             )
         return f"unexpected {token.text!r} after {previous!r}: expected an operator or the end"
 
-    def peek(self) -> _Token:
+    def peek(self) -> Token:
         return self.tokens[self.pos]
 
-    def advance(self) -> _Token:
+    def advance(self) -> Token:
         token = self.tokens[self.pos]
         if token.kind != "end":
             self.pos += 1
         return token
 
-    def expect(self, op: str, problem: str) -> _Token:
+    def expect(self, op: str, problem: str) -> Token:
         token = self.peek()
         if token.kind == "op" and token.text == op:
             return self.advance()
@@ -480,7 +306,7 @@ class _Parser:
         self.nesting -= 1
         return left
 
-    def infix_power(self, token: _Token) -> int:
+    def infix_power(self, token: Token) -> int:
         if token.kind == "word":
             return {"or": 1, "and": 2}.get(token.text.lower(), 0)
         if token.kind != "op":
@@ -498,7 +324,7 @@ class _Parser:
             return _POSTFIX
         return 0
 
-    def prefix(self, token: _Token) -> Expression:
+    def prefix(self, token: Token) -> Expression:
         if token.kind in ("num", "str"):
             return Literal(token.value)
         if token.kind == "word":
@@ -522,7 +348,7 @@ class _Parser:
             return self.expression(_PREFIX)
         return self.missing_value(token)
 
-    def missing_value(self, token: _Token) -> Expression:
+    def missing_value(self, token: Token) -> Expression:
         index = self.pos if token.kind == "end" else self.pos - 1
         previous = self.tokens[index - 1].text if index > 0 else ""
         if token.kind == "end":
@@ -533,7 +359,7 @@ class _Parser:
             )
         raise self.fail(token.start, f"expected a value but found {token.text!r}")
 
-    def word(self, token: _Token) -> Expression:
+    def word(self, token: Token) -> Expression:
         lowered = token.text.lower()
         if lowered in _LITERAL_WORDS:
             return Literal(_LITERAL_WORDS[lowered])
@@ -617,7 +443,7 @@ class _Parser:
             return self.checked_call(signature, (receiver, *args), start, name)
         raise self.fail(start, f"unsupported method .{name}()")
 
-    def infix(self, left: Expression, token: _Token, power: int) -> Expression:
+    def infix(self, left: Expression, token: Token, power: int) -> Expression:
         text = token.text if token.kind == "op" else token.text.lower()
         if text in ("||", "or"):
             return Binary("or", left, self.operand(token, 1))
@@ -640,13 +466,13 @@ class _Parser:
             )
         return self.method(left, part.text, self.arguments(), token.start)
 
-    def operand(self, operator: _Token, power: int) -> Expression:
+    def operand(self, operator: Token, power: int) -> Expression:
         following = self.peek()
         if following.kind == "end":
             raise self.fail(following.start, f"expected a value after {operator.text!r}")
         return self.expression(power)
 
-    def ordering(self, left: Expression, token: _Token) -> Expression:
+    def ordering(self, left: Expression, token: Token) -> Expression:
         """``a < b <= c`` reads as ``a < b && b <= c`` (what people mean by a range)."""
         right = self.operand(token, 5)
         result: Expression = Binary(_ORDERING[token.text], left, right)
