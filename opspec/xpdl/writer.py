@@ -225,7 +225,12 @@ def _merged(
     verbatim: tuple[ExtendedAttribute, ...], generated: list[ExtendedAttribute]
 ) -> list[ExtendedAttribute]:
     present = {attribute.name for attribute in verbatim}
+    # A kept alias states the same directive (Rate = 1/Period, Latency = Deadline).
+    present |= {_ALIASES[name] for name in present if name in _ALIASES}
     return list(verbatim) + [a for a in generated if a.name not in present]
+
+
+_ALIASES = {"opspec:Rate": "opspec:Period", "opspec:Latency": "opspec:Deadline"}
 
 
 def _ea(name: str, value: str | None = None, raw_xml: str | None = None) -> ExtendedAttribute:

@@ -323,3 +323,26 @@ def test_preprocess_io_problems_are_one_line_and_exit_2(tmp_path: Path, which: s
     assert completed.returncode == 2
     assert len(completed.stderr.strip().splitlines()) == 1
     assert "Traceback" not in completed.stderr
+
+
+def test_the_documented_example_preprocesses_to_valid_xpdl_that_loads_cleanly(
+    tmp_path: Path, xpdl_schema: etree.XMLSchema
+) -> None:
+    import re
+
+    docs = Path(__file__).resolve().parents[2] / "docs" / "sisarl-xpdl.md"
+    (example,) = [b for b in re.findall(r"```xml\n(.*?)```", docs.read_text(), re.S)
+                  if "<Package" in b]
+    source = tmp_path / "example.xpdl"
+    source.write_text(example)
+    loaded = load_package(source)
+    assert loaded.ok and loaded.package is not None
+    data, diagnostics = preprocess_to_xpdl(loaded.package)
+    assert diagnostics == ()
+    assert schema_errors(xpdl_schema, data) == []
+    again = parse_bytes(data, path="example.std.xpdl")
+    # No warnings either: a kept opspec:Rate is not doubled by a generated opspec:Period.
+    assert again.diagnostics == (), [str(d) for d in again.diagnostics]
+    assert again.package is not None
+    assert [p.directives for p in again.package.processes] == [
+        p.directives for p in loaded.package.processes]
