@@ -3,7 +3,9 @@ official XPDL 2.1 schema check."""
 
 from __future__ import annotations
 
+import dataclasses
 from pathlib import Path
+from typing import Any
 
 from lxml import etree
 
@@ -112,3 +114,18 @@ def schema_errors(schema: etree.XMLSchema, data: bytes) -> list[str]:
     if schema.validate(document):
         return []
     return [f"{e.line}: {e.message}" for e in schema.error_log]
+
+
+def without_locations(value: Any) -> Any:
+    """``value`` with every source location removed (a rewrite moves every line)."""
+    if dataclasses.is_dataclass(value) and not isinstance(value, type):
+        changes = {}
+        for f in dataclasses.fields(value):
+            item = getattr(value, f.name)
+            new = None if f.name == "location" else without_locations(item)
+            if new is not item:
+                changes[f.name] = new
+        return dataclasses.replace(value, **changes) if changes else value
+    if isinstance(value, tuple):
+        return tuple(without_locations(item) for item in value)
+    return value

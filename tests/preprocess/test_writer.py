@@ -5,12 +5,11 @@ from __future__ import annotations
 
 import dataclasses
 from pathlib import Path
-from typing import Any
 
 import pytest
 from lxml import etree
 
-from builtin_models import builtin_package, schema_errors
+from builtin_models import builtin_package, schema_errors, without_locations
 from opspec.model import (
     Distribution,
     ExtendedAttribute,
@@ -44,25 +43,10 @@ NOT_VALID_AS_2_1 = {
 }
 
 
-def _strip(value: Any) -> Any:
-    """``value`` with every source location removed (a rewrite moves every line)."""
-    if dataclasses.is_dataclass(value) and not isinstance(value, type):
-        changes = {}
-        for f in dataclasses.fields(value):
-            item = getattr(value, f.name)
-            new = None if f.name == "location" else _strip(item)
-            if new is not item:
-                changes[f.name] = new
-        return dataclasses.replace(value, **changes) if changes else value
-    if isinstance(value, tuple):
-        return tuple(_strip(item) for item in value)
-    return value
-
-
 def _comparable(package: Package) -> Package:
     """What a rewrite must keep: everything but locations, the source path, the version the
     file was read as, and the header fields the writer must fill in for XPDL 2.1."""
-    package = _strip(package)
+    package = without_locations(package)
     header = dataclasses.replace(package.header, xpdl_version=None, vendor=None, created=None)
     # Known loss: XPDL 2.1 application types with required content (Ejb, Pojo, WebService,
     # BusinessRule) are not in the model, so they cannot be written back.
