@@ -1,0 +1,41 @@
+"""The engine: compiled packages executed on a SimPy clock (see ``simulation``).
+
+Import what you need from the submodules; the names below are loaded lazily so that
+``import opspec.engine`` stays light.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+__all__ = [
+    "CallablePerformer", "CompiledPackage", "EngineConfig", "JsonlSink", "MemorySink",
+    "MetricsListener", "PerformerRegistry", "RunResult", "ScriptedUser", "Simulation",
+    "SimulatedDevice", "compile_package", "read_trace", "simulate",
+]
+
+_WHERE = {
+    "CallablePerformer": "opspec.engine.builtin_performers",
+    "ScriptedUser": "opspec.engine.builtin_performers",
+    "SimulatedDevice": "opspec.engine.builtin_performers",
+    "CompiledPackage": "opspec.engine.compiled",
+    "compile_package": "opspec.engine.compiled",
+    "EngineConfig": "opspec.engine.config",
+    "JsonlSink": "opspec.engine.trace_sinks",
+    "MemorySink": "opspec.engine.trace_sinks",
+    "read_trace": "opspec.engine.trace_sinks",
+    "MetricsListener": "opspec.engine.metrics",
+    "PerformerRegistry": "opspec.engine.registry",
+    "RunResult": "opspec.engine.simulation",
+    "Simulation": "opspec.engine.simulation",
+    "simulate": "opspec.engine.simulation",
+}
+
+
+def __getattr__(name: str) -> Any:
+    module = _WHERE.get(name)
+    if module is None:
+        raise AttributeError(f"module 'opspec.engine' has no attribute {name!r}")
+    import importlib
+
+    return getattr(importlib.import_module(module), name)

@@ -21,7 +21,9 @@ class WorkItem:
 
     ``key`` is unique per run and identifies the offer in every call back to the session.
     ``choices`` lists alternative activity ids when the person may pick one of several
-    (a deferred choice / event-based gateway); it is empty otherwise.
+    (a deferred choice / event-based gateway); it is empty otherwise. ``duration`` is a draw
+    from the activity's declared duration distribution (``None`` when it declares none), for
+    performers that simulate the work (``SimulatedDevice``).
     """
 
     key: int
@@ -36,6 +38,7 @@ class WorkItem:
     data: Mapping[str, Any] = field(default_factory=dict)
     choices: tuple[str, ...] = ()
     root_instance: int | None = None
+    duration: float | None = None      # drawn from the activity's declared duration, if any
 
 
 class PerformerSession(Protocol):

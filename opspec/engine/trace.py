@@ -32,6 +32,8 @@ class EventKind:
     PROCESS_COMPLETED = "process.completed"
     PROCESS_TERMINATED = "process.terminated"
     PROCESS_ABORTED = "process.aborted"
+    PROCESS_SUSPENDED = "process.suspended"
+    PROCESS_RESUMED = "process.resumed"
     ACTIVITY_STARTED = "activity.started"
     ACTIVITY_OFFERED = "activity.offered"        # manual/external: waiting for its performer
     ACTIVITY_COMPLETED = "activity.completed"

@@ -1,0 +1,633 @@
+"""Compile a model :class:`~opspec.model.Package` into runtime tables, once per package.
+
+A :class:`CompiledPackage` is immutable after :func:`compile_package` returns and is shared by
+every :class:`~opspec.engine.simulation.Simulation` built from it (an evaluation builds
+thousands), so everything that does not depend on one run is decided here: activities are
+indexed by small ints, outgoing transitions are kept in the declared split order and split by
+condition kind, joins know their incoming transitions, conditions/assignments/deadlines are
+compiled closures, subflow targets and parameter mappings are resolved, distributions are
+samplers, lanes and participants are looked up.
+
+What an activity *is* at run time is one of the ``K_*`` kinds below; the interpreter
+(:mod:`opspec.engine.interpreter`) dispatches on it.
+"""
+
+from __future__ import annotations
+
+import re
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass, field
+from typing import Any
+
+from opspec.engine.conditions import compile_condition, compile_expression
+from opspec.engine.sampling import Sampler, make_sampler, parse_duration_text
+from opspec.errors import OpspecError, SourceLocation, SpecError
+from opspec.model import (
+    Activity,
+    BlockActivity,
+    ConditionKind,
+    CoordinationBuiltIn,
+    Event,
+    EventPosition,
+    Execution,
+    Expression,
+    GatewayType,
+    Literal,
+    LoopKind,
+    Name,
+    NoImplementation,
+    Package,
+    ParameterMode,
+    Reference,
+    Route,
+    SubFlow,
+    Task,
+    Transition,
+    TriggerKind,
+    TriggerRef,
+    WorkflowProcess,
+)
+
+__all__ = [
+    "CompiledActivity", "CompiledGraph", "CompiledPackage", "CompiledProcess", "CTransition",
+    "CTrigger", "Evaluator", "compile_package",
+    "K_ASYNC", "K_BLOCK", "K_CATCH", "K_COORD", "K_GATEWAY", "K_MANUAL", "K_NOOP", "K_SUBFLOW",
+    "K_TASK", "K_THROW", "J_AND", "J_OR", "J_XOR", "S_AND", "S_OR", "S_XOR",
+]
+
+Evaluator = Callable[[Mapping[str, Any], float], Any]
+"""A compiled expression: ``fn(data, now) -> value``."""
+
+# activity kinds
+K_NOOP, K_TASK, K_MANUAL, K_SUBFLOW, K_ASYNC, K_CATCH, K_THROW, K_BLOCK, K_COORD, K_GATEWAY = (
+    range(10))
+KIND_NAMES = ("noop", "task", "manual", "subflow", "async-subflow", "catch", "throw", "block",
+              "coordination", "event-gateway")
+# joins and splits
+J_XOR, J_AND, J_OR = range(3)
+S_XOR, S_AND, S_OR = range(3)
+# transition kinds
+T_NONE, T_COND, T_OTHERWISE, T_EXCEPTION, T_DEFAULT = range(5)
+
+_IDENT = re.compile(r"^[A-Za-z_][A-Za-z0-9_.]*$")
+_USER_LANES = frozenset({"user", "user_lane", "user lane", "users"})
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class CTrigger:
+    """A start/end/catch/throw trigger ready to arm: ``kind`` is message, signal, timer,
+    period, rule or none."""
+
+    kind: str
+    name: str | None = None
+    at: tuple[float, ...] = ()
+    every: float | None = None
+    offset: float = 0.0
+    seconds: Evaluator | None = None       # timer catch events: delay from data
+    condition: Evaluator | None = None     # rules
+    location: SourceLocation | None = None
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class CTransition:
+    index: int
+    id: str
+    target: int
+    kind: int
+    condition: Evaluator | None
+    exception: str | None
+    assignments: tuple[tuple[str, Evaluator], ...]
+
+
+@dataclass(slots=True, eq=False)
+class CompiledActivity:
+    """One activity of a graph, ready to run. Not mutated after compilation."""
+
+    index: int
+    id: str
+    label: str
+    process: str
+    location: SourceLocation | None
+    kind: int = K_NOOP
+    general: bool = False            # a general activity (queued by the pooled processor)
+    participant: str | None = None
+    lane: str | None = None          # lane shown in the trace
+    lanes: tuple[str, ...] = ()      # names a performer may be bound to, most specific first
+    user_lane: bool = False
+    join: int = J_XOR
+    in_slots: dict[int, int] = field(default_factory=dict)   # transition index -> join slot
+    split: int = S_XOR
+    out: tuple[CTransition, ...] = ()
+    otherwise: tuple[CTransition, ...] = ()
+    exceptions: tuple[CTransition, ...] = ()
+    default_exception: CTransition | None = None
+    choice: tuple[CTransition, ...] = ()      # deferred choice offered after completion
+    start_assign: tuple[tuple[str, Evaluator], ...] = ()
+    end_assign: tuple[tuple[str, Evaluator], ...] = ()
+    raises: CTrigger | None = None
+    trigger: CTrigger | None = None          # catch/throw events; activity start trigger
+    start_trigger: CTrigger | None = None
+    end_trigger: CTrigger | None = None
+    terminate: bool = False                  # end event with Terminate result
+    deadlines: tuple[tuple[Evaluator, bool, str], ...] = ()   # (seconds, synchronous, exception)
+    sampler: Sampler | None = None
+    cpu: float = 0.0
+    priority_increment: int = 0
+    subflow: str | None = None
+    params: tuple[tuple[ParameterMode, str, Evaluator | None, str | None], ...] = ()
+    application: str | None = None
+    loop: tuple[Evaluator | None, int | None, bool] | None = None
+    block: CompiledGraph | None = None
+    coordination: CoordinationBuiltIn | None = None
+    boundary: tuple[int, ...] = ()
+    attached_to: int = -1
+    interrupting: bool = True
+    upstream: frozenset[int] = frozenset()  # OR joins: activities that can reach this one
+    fast: bool = False                       # instantaneous without any wait (no ActInst)
+
+    def where(self) -> str:
+        return str(self.location) if self.location is not None else "<built in Python>"
+
+
+@dataclass(slots=True, eq=False)
+class CompiledGraph:
+    """The activities and transitions of a process or activity set."""
+
+    name: str
+    process: str
+    activities: tuple[CompiledActivity, ...] = ()
+    starts: tuple[int, ...] = ()
+    by_id: dict[str, int] = field(default_factory=dict)
+    has_or_join: bool = False
+
+
+@dataclass(slots=True, eq=False)
+class CompiledProcess:
+    id: str
+    label: str
+    graph: CompiledGraph
+    data: dict[str, Any]
+    formals: tuple[tuple[str, ParameterMode], ...]
+    priority: int
+    lane: str | None
+    start_trigger: CTrigger | None
+    end_trigger: CTrigger | None
+    auto_start: bool
+    deadline: float | None
+    mode: str | None
+    location: SourceLocation | None
+
+
+@dataclass(slots=True, eq=False)
+class CompiledPackage:
+    """Everything a run needs from a package, computed once."""
+
+    id: str
+    source: str | None
+    package: Package
+    processes: dict[str, CompiledProcess]
+    data: dict[str, Any]
+    throwable: frozenset[str]
+    modes: dict[str, frozenset[str]]
+    initial_mode: str | None
+    mode_sources: dict[str, str]
+    _want_cache: dict[Any, frozenset[tuple[str, str | None, str | None]]] = field(
+        default_factory=dict)
+
+    def expand_selectors(
+        self, selectors: frozenset[tuple[str, str | None, str | None]]
+    ) -> frozenset[tuple[str, str | None, str | None]]:
+        """(kind, process, activity) keys matched by ``selectors`` (``None`` = any), cached."""
+        cached = self._want_cache.get(selectors)
+        if cached is not None:
+            return cached
+        keys: set[tuple[str, str | None, str | None]] = set()
+        pairs: list[tuple[str | None, str | None]] = [(None, None)]
+        for proc in self.processes.values():
+            pairs.append((proc.id, None))
+            stack = [proc.graph]
+            while stack:
+                graph = stack.pop()
+                for act in graph.activities:
+                    pairs.append((proc.id, act.id))
+                    if act.block is not None:
+                        stack.append(act.block)
+        for kind, process, activity in selectors:
+            for pid, aid in pairs:
+                if (process is None or process == pid) and (activity is None or activity == aid):
+                    keys.add((kind, pid, aid))
+        result = frozenset(keys)
+        self._want_cache[selectors] = result
+        return result
+
+
+def _spec_error(message: str, location: SourceLocation | None, hint: str = "") -> SpecError:
+    return SpecError(message, location=location, hint=hint)
+
+
+class _Compiler:
+    def __init__(self, package: Package) -> None:
+        self.package = package
+        self.throwable: set[str] = set()
+        self.participants = {p.id: p for p in package.participants}
+        self.participant_lane: dict[str, tuple[str, ...]] = {}
+        for pool in package.pools:
+            for lane in pool.all_lanes():
+                for performer in lane.performers:
+                    names = tuple(n for n in (lane.id, lane.name) if n)
+                    self.participant_lane.setdefault(performer, names)
+        self.subflow_targets = {
+            a.body.process for p in package.processes for a in p.all_activities()
+            if isinstance(a.body, SubFlow)}
+
+    # -- expressions -------------------------------------------------------------------
+    def expr(self, expression: Expression | None, text: str | None,
+             location: SourceLocation | None, what: str, condition: bool = False) -> Evaluator:
+        if expression is None:
+            if text is None or not text.strip():
+                raise _spec_error(f"{what} has no expression", location)
+            stripped = text.strip()
+            if _IDENT.match(stripped) and stripped not in ("true", "false", "null"):
+                expression = Name(tuple(stripped.split(".")))
+            else:
+                seconds = parse_duration_text(stripped)
+                if seconds is None:
+                    raise _spec_error(f"{what} {stripped!r} was not understood", location,
+                                      "write an expression over data fields")
+                expression = Literal(seconds)
+        try:
+            if condition:
+                return compile_condition(expression, location=location)
+            return compile_expression(expression, location=location)
+        except OpspecError as error:  # the evaluator rejects an expression it cannot run
+            raise _spec_error(f"{what} cannot be evaluated: {error.message}", location) from None
+
+    def cond(self, expression: Expression | None, text: str | None,
+             location: SourceLocation | None, what: str) -> Evaluator:
+        """Like :meth:`expr`, but the value is a boolean under the truthiness rules."""
+        return self.expr(expression, text, location, what, condition=True)
+
+    def seconds(self, expression: Expression | None, text: str | None,
+                location: SourceLocation | None, what: str) -> Evaluator:
+        if expression is None and text is not None:
+            value = parse_duration_text(text)
+            if value is not None:
+                return lambda data, now, _v=value: _v
+        return self.expr(expression, text, location, what)
+
+    def trigger_ref(self, ref: TriggerRef | None) -> CTrigger | None:
+        if ref is None or ref.kind == "none":
+            return None
+        condition = None
+        if ref.condition is not None:
+            condition = self.cond(ref.condition, None, ref.location, "rule trigger")
+        return CTrigger(kind=ref.kind, name=ref.name, at=tuple(sorted(ref.at)), every=ref.every,
+                        offset=ref.offset, condition=condition, location=ref.location)
+
+    def event_trigger(self, event: Event, act: Activity) -> CTrigger | None:
+        trig = event.trigger
+        kind = trig.kind
+        if kind in (TriggerKind.MESSAGE, TriggerKind.SIGNAL, TriggerKind.LINK,
+                    TriggerKind.ERROR, TriggerKind.ESCALATION):
+            name = trig.name or act.id
+            mapped = "signal" if kind is TriggerKind.SIGNAL else "message"
+            return CTrigger(kind=mapped, name=name, location=act.location)
+        if kind is TriggerKind.TIMER:
+            seconds = None
+            if trig.duration is not None or trig.time_cycle or trig.time_date:
+                seconds = self.seconds(trig.duration, trig.time_cycle or trig.time_date,
+                                       act.location, f"timer of activity {act.id!r}")
+            return CTrigger(kind="timer", seconds=seconds, location=act.location)
+        if kind is TriggerKind.RULE:
+            cond = self.cond(trig.condition, None, act.location, f"rule of activity {act.id!r}")
+            return CTrigger(kind="rule", condition=cond, location=act.location)
+        return None
+
+    # -- graphs --------------------------------------------------------------------------
+    def graph(self, proc: WorkflowProcess, name: str, activities: tuple[Activity, ...],
+              transitions: tuple[Transition, ...], proc_lane: str | None,
+              start: str | None = None) -> CompiledGraph:
+        graph = CompiledGraph(name=name, process=proc.id)
+        by_id = {a.id: i for i, a in enumerate(activities)}
+        graph.by_id = by_id
+        acts: list[CompiledActivity] = []
+        for i, act in enumerate(activities):
+            acts.append(CompiledActivity(index=i, id=act.id, label=act.label, process=proc.id,
+                                         location=act.location))
+        outgoing: dict[int, list[CTransition]] = {i: [] for i in range(len(activities))}
+        incoming: dict[int, list[int]] = {i: [] for i in range(len(activities))}
+        trans_by_id: dict[str, CTransition] = {}
+        for ti, tr in enumerate(transitions):
+            if tr.source not in by_id or tr.target not in by_id:
+                missing = tr.source if tr.source not in by_id else tr.target
+                raise _spec_error(
+                    f"transition {tr.id!r} of {name!r} points to activity {missing!r}, which "
+                    f"is not in it", tr.location, "activity ids are scoped per process")
+            ck = tr.condition.kind
+            kind = {ConditionKind.NONE: T_NONE, ConditionKind.CONDITION: T_COND,
+                    ConditionKind.OTHERWISE: T_OTHERWISE, ConditionKind.EXCEPTION: T_EXCEPTION,
+                    ConditionKind.DEFAULTEXCEPTION: T_DEFAULT}[ck]
+            cond = None
+            if kind == T_COND:
+                if tr.condition.expression is None and not (tr.condition.text or "").strip():
+                    kind = T_NONE
+                else:
+                    cond = self.cond(tr.condition.expression, tr.condition.text, tr.location,
+                                     f"condition of transition {tr.id!r}")
+            exc = tr.condition.exception_name
+            if kind == T_EXCEPTION and exc is None and tr.condition.text:
+                exc = tr.condition.text.strip() or None
+            assigns = tuple((a.target, self.expr(a.expression, a.text, a.location,
+                                                 f"assignment to {a.target!r}"))
+                            for a in tr.assignments)
+            ct = CTransition(index=ti, id=tr.id, target=by_id[tr.target], kind=kind,
+                             condition=cond, exception=exc, assignments=assigns)
+            trans_by_id[tr.id] = ct
+            outgoing[by_id[tr.source]].append(ct)
+            incoming[by_id[tr.target]].append(ti)
+        for i, act in enumerate(activities):
+            self.activity(proc, act, acts[i], acts, by_id, outgoing[i], incoming[i],
+                          trans_by_id, proc_lane)
+        # boundary events attach to their activity
+        for i, act in enumerate(activities):
+            body = act.body
+            if isinstance(body, Event) and body.trigger.attached_to:
+                host = by_id.get(body.trigger.attached_to)
+                if host is None:
+                    raise _spec_error(f"event {act.id!r} is attached to unknown activity "
+                                      f"{body.trigger.attached_to!r}", act.location)
+                acts[i].attached_to = host
+                acts[i].interrupting = body.trigger.interrupting
+                acts[host].boundary = (*acts[host].boundary, i)
+                acts[host].fast = False
+        if start is not None:
+            if start not in by_id:
+                raise _spec_error(f"start activity {start!r} is not in {name!r}", None)
+            graph.starts = (by_id[start],)
+        else:
+            graph.starts = tuple(i for i in range(len(activities))
+                                 if not incoming[i] and acts[i].attached_to < 0)
+        graph.activities = tuple(acts)
+        # OR joins need to know what can still reach them
+        predecessors: dict[int, set[int]] = {i: set() for i in range(len(acts))}
+        for i, outs in outgoing.items():
+            for ct in outs:
+                predecessors[ct.target].add(i)
+        for ca in acts:
+            if ca.join == J_OR:
+                graph.has_or_join = True
+                seen: set[int] = set()
+                stack = list(predecessors[ca.index])
+                while stack:
+                    node = stack.pop()
+                    if node in seen:
+                        continue
+                    seen.add(node)
+                    stack.extend(predecessors[node])
+                seen.discard(ca.index)
+                ca.upstream = frozenset(seen)
+        return graph
+
+    def activity(self, proc: WorkflowProcess, act: Activity, ca: CompiledActivity,
+                 acts: list[CompiledActivity], by_id: dict[str, int],
+                 outgoing: list[CTransition], incoming: list[int],
+                 trans_by_id: dict[str, CTransition], proc_lane: str | None) -> None:
+        body = act.body
+        if isinstance(body, Reference):
+            target = proc.activity(body.activity)
+            if target is None:
+                raise _spec_error(f"activity {act.id!r} references unknown activity "
+                                  f"{body.activity!r}", act.location)
+            body = target.body
+        directives = act.directives
+        ca.participant = act.performers[0] if act.performers else None
+        lanes: list[str] = []
+        if act.lane:
+            lanes.append(act.lane)
+        if ca.participant and ca.participant in self.participant_lane:
+            lanes.extend(self.participant_lane[ca.participant])
+        if proc_lane:
+            lanes.append(proc_lane)
+        ca.lanes = tuple(dict.fromkeys(lanes))
+        ca.lane = proc_lane or (lanes[0] if lanes else None)
+        participant = self.participants.get(ca.participant or "") or next(
+            (p for p in proc.participants if p.id == ca.participant), None)
+        ca.user_lane = any(n.lower() in _USER_LANES for n in ca.lanes) or bool(
+            participant is not None and participant.is_human)
+        # kind
+        if isinstance(body, Route):
+            ca.kind = K_GATEWAY if body.gateway is GatewayType.EVENT else K_NOOP
+        elif isinstance(body, SubFlow):
+            ca.kind = K_SUBFLOW if body.execution is Execution.SYNCHR else K_ASYNC
+            target = self.package.process(body.process)
+            if target is None:
+                raise _spec_error(f"subflow {act.id!r} calls unknown process {body.process!r}",
+                                  act.location, "name a WorkflowProcess of this package")
+            ca.subflow = target.id
+            ca.params = self.params(body.actual_parameters, target.formal_parameters, act,
+                                    f"process {target.id!r}")
+        elif isinstance(body, BlockActivity):
+            ca.kind = K_BLOCK
+            aset = proc.activity_set(body.activity_set)
+            if aset is None:
+                raise _spec_error(f"block activity {act.id!r} names unknown activity set "
+                                  f"{body.activity_set!r}", act.location)
+            ca.block = self.graph(proc, aset.id, aset.activities, aset.transitions, proc_lane,
+                                  body.start_activity)
+        elif isinstance(body, Event):
+            trig = self.event_trigger(body, act)
+            if body.position is EventPosition.INTERMEDIATE:
+                if trig is not None and not body.trigger.catching and trig.kind in (
+                        "message", "signal"):
+                    ca.kind = K_THROW
+                    self.throwable.add(trig.name or "")
+                elif trig is not None:
+                    ca.kind = K_CATCH
+                ca.trigger = trig
+            elif body.position is EventPosition.END:
+                result = (body.result or "").lower()
+                if result == "terminate" or body.trigger.kind is TriggerKind.TERMINATE:
+                    ca.terminate = True
+                elif result in ("message", "signal") and trig is not None:
+                    ca.kind = K_THROW
+                    ca.trigger = trig
+                    self.throwable.add(trig.name or "")
+            else:
+                ca.trigger = trig      # start events: the process start trigger (see below)
+        elif isinstance(body, Task):
+            if body.applications:
+                ca.application = body.applications[0].application
+                app = self.package.application(ca.application) or next(
+                    (a for a in proc.applications if a.id == ca.application), None)
+                formals = app.formal_parameters if app is not None else ()
+                ca.params = self.params(body.applications[0].actual_parameters, formals, act,
+                                        f"application {ca.application!r}")
+            ca.kind = K_TASK
+            ca.general = True
+        elif isinstance(body, NoImplementation):
+            ca.general = True
+        if act.coordination is not None:
+            ca.kind = K_COORD
+            ca.coordination = act.coordination
+            ca.general = False
+        manual_body = isinstance(body, NoImplementation | Task)
+        if manual_body and act.coordination is None and (act.is_manual or ca.user_lane):
+            ca.kind = K_MANUAL
+            ca.general = False
+        # joins and splits
+        if act.join is not None and len(incoming) > 1:
+            ca.join = {GatewayType.AND: J_AND, GatewayType.OR: J_OR,
+                       GatewayType.COMPLEX: J_AND}.get(act.join.type, J_XOR)
+        ca.in_slots = {ti: slot for slot, ti in enumerate(incoming)}
+        ordered = list(outgoing)
+        if act.split is not None and act.split.transition_refs:
+            rank = {ref: n for n, ref in enumerate(act.split.transition_refs)}
+            ordered.sort(key=lambda t: rank.get(t.id, len(rank) + t.index))
+        normal = tuple(t for t in ordered if t.kind in (T_NONE, T_COND))
+        ca.out = normal
+        ca.otherwise = tuple(t for t in ordered if t.kind == T_OTHERWISE)
+        ca.exceptions = tuple(t for t in ordered if t.kind == T_EXCEPTION)
+        ca.default_exception = next((t for t in ordered if t.kind == T_DEFAULT), None)
+        if act.split is not None:
+            ca.split = {GatewayType.AND: S_AND, GatewayType.OR: S_OR}.get(act.split.type, S_XOR)
+        elif len(normal) > 1 and all(t.kind == T_NONE for t in normal) and not ca.otherwise:
+            ca.split = S_AND      # no split declared, several unconditional: run them all
+        # directives
+        ca.start_assign = tuple(
+            (a.target, self.expr(a.expression, a.text, a.location, f"assignment to {a.target!r}"))
+            for a in act.assignments if a.assign_time.lower() == "start")
+        ca.end_assign = tuple(
+            (a.target, self.expr(a.expression, a.text, a.location, f"assignment to {a.target!r}"))
+            for a in act.assignments if a.assign_time.lower() != "start")
+        ca.raises = self.trigger_ref(directives.raises)
+        if ca.raises is not None and ca.raises.name:
+            self.throwable.add(ca.raises.name)
+        ca.start_trigger = self.trigger_ref(directives.start_trigger)
+        ca.end_trigger = self.trigger_ref(directives.end_trigger)
+        ca.priority_increment = directives.priority_increment
+        ca.cpu = float(directives.cpu_demand or 0.0)
+        if directives.duration is not None:
+            try:
+                ca.sampler = make_sampler(directives.duration)
+            except ValueError as error:
+                raise _spec_error(f"duration of activity {act.id!r}: {error}", act.location,
+                                  "see docs/sisarl-xpdl.md for the distributions") from None
+        ca.deadlines = tuple(
+            (self.seconds(d.duration, d.duration_text, d.location or act.location,
+                          f"deadline of activity {act.id!r}"),
+             d.execution is Execution.SYNCHR, d.exception_name or "deadline")
+            for d in act.deadlines)
+        if act.loop is not None and act.loop.kind is LoopKind.STANDARD:
+            cond = None
+            if act.loop.condition is not None or act.loop.condition_text:
+                cond = self.cond(act.loop.condition, act.loop.condition_text, act.location,
+                                 f"loop condition of activity {act.id!r}")
+            ca.loop = (cond, act.loop.maximum, act.loop.test_before)
+        # instantaneous under the dedicated model (tasks: unless a callable is bound to the
+        # application at run time; general activities: unless the pooled model queues them)
+        ca.fast = (ca.kind in (K_NOOP, K_THROW, K_TASK) and not ca.deadlines
+                   and ca.loop is None and ca.sampler is None and ca.cpu == 0.0
+                   and ca.start_trigger is None and ca.end_trigger is None and not ca.boundary)
+
+    def finish_choices(self, graph: CompiledGraph) -> None:
+        """Deferred choice on an XOR split: all unconditional branches go to manual
+        activities of the same performer (checked after every activity is compiled)."""
+        acts = graph.activities
+        for ca in acts:
+            if ca.block is not None:
+                self.finish_choices(ca.block)
+            if ca.kind == K_GATEWAY or ca.split != S_XOR or ca.kind == K_MANUAL:
+                continue
+            branches = [t for t in ca.out if t.kind == T_NONE]
+            if len(branches) < 2 or len(branches) != len(ca.out):
+                continue
+            targets = [acts[t.target] for t in branches]
+            if all(t.kind == K_MANUAL for t in targets) and len(
+                    {(t.participant, t.lanes) for t in targets}) == 1:
+                ca.choice = tuple(branches)
+                ca.fast = False
+
+    def params(self, actuals: tuple[Any, ...], formals: tuple[Any, ...], act: Activity,
+               what: str) -> tuple[tuple[ParameterMode, str, Evaluator | None, str | None], ...]:
+        if formals and len(actuals) != len(formals):
+            raise _spec_error(
+                f"activity {act.id!r} passes {len(actuals)} actual parameters to {what}, which "
+                f"declares {len(formals)} formal parameters", act.location,
+                "give one actual parameter per formal parameter, in order")
+        out = []
+        for n, actual in enumerate(actuals):
+            if formals:
+                formal_id, mode = formals[n].id, formals[n].mode
+            else:
+                formal_id, mode = f"p{n}", ParameterMode.IN
+            expression = actual.expression
+            if expression is None and _IDENT.match(actual.text.strip()):
+                expression = Name(tuple(actual.text.strip().split(".")))
+            target = expression.path[0] if isinstance(expression, Name) else None
+            if mode is not ParameterMode.IN and target is None:
+                raise _spec_error(
+                    f"actual parameter {n + 1} of activity {act.id!r} ({actual.text!r}) must "
+                    f"name a data field: formal {formal_id!r} is {mode.value}",
+                    actual.location or act.location)
+            fn = None
+            if mode is not ParameterMode.OUT:
+                fn = self.expr(expression, actual.text, actual.location or act.location,
+                               f"actual parameter {n + 1} of activity {act.id!r}")
+            out.append((mode, formal_id, fn, target))
+        return tuple(out)
+
+    def process(self, proc: WorkflowProcess) -> CompiledProcess:
+        directives = proc.directives
+        lane = directives.lane
+        graph = self.graph(proc, proc.id, proc.activities, proc.transitions, lane)
+        self.finish_choices(graph)
+        data: dict[str, Any] = {f.id: None for f in proc.formal_parameters}
+        data.update({f.id: f.initial for f in proc.data_fields})
+        start = self.trigger_ref(directives.start_trigger)
+        if start is None:
+            for index in graph.starts:
+                ca = graph.activities[index]
+                if ca.trigger is not None and ca.kind == K_NOOP:
+                    trig = ca.trigger
+                    if trig.kind == "timer" and trig.seconds is not None:
+                        every = float(trig.seconds({}, 0.0))
+                        start = CTrigger(kind="period", every=every, offset=every,
+                                         location=trig.location)
+                    else:
+                        start = trig
+                    break
+        if start is None and directives.period is not None:
+            start = CTrigger(kind="period", every=directives.period, location=proc.location)
+        if start is not None and start.kind == "timer" and not start.at and start.every:
+            start = CTrigger(kind="period", every=start.every, offset=start.offset,
+                             location=start.location)
+        auto = directives.auto_start
+        if auto is None:
+            auto = start is None and proc.id not in self.subflow_targets
+        priority = directives.priority if directives.priority is not None else (
+            proc.priority or 0)
+        return CompiledProcess(
+            id=proc.id, label=proc.label, graph=graph, data=data,
+            formals=tuple((f.id, f.mode) for f in proc.formal_parameters), priority=priority,
+            lane=lane, start_trigger=start, end_trigger=self.trigger_ref(directives.end_trigger),
+            auto_start=bool(auto), deadline=directives.deadline, mode=directives.mode,
+            location=proc.location)
+
+
+def compile_package(package: Package) -> CompiledPackage:
+    """Compile ``package`` (fatal problems raise :class:`~opspec.errors.SpecError` with the
+    location of the element at fault)."""
+    compiler = _Compiler(package)
+    processes = {p.id: compiler.process(p) for p in package.processes}
+    modes = {m.id: frozenset(m.workflows) for m in package.modes}
+    for proc in processes.values():
+        if proc.mode is not None:
+            modes[proc.mode] = modes.get(proc.mode, frozenset()) | {proc.id}
+    initial = next((m.id for m in package.modes if m.initial), None)
+    if initial is None and modes:
+        initial = next(iter(modes))
+    return CompiledPackage(
+        id=package.id, source=package.source, package=package, processes=processes,
+        data={f.id: f.initial for f in package.data_fields},
+        throwable=frozenset(compiler.throwable), modes=modes, initial_mode=initial,
+        mode_sources={m.id: m.source for m in package.modes if m.source})

@@ -1,0 +1,153 @@
+"""Engine configuration: processor model, workers, priorities, timer resolution, switch cost.
+
+The configuration of the source design's *engine manager* (maximum number of workflow
+processing threads, timer resolution, number of priorities) plus what opspec needs to simulate
+both processor models and the wall-clock mode. It is an immutable value; build it with keyword
+arguments or load it from TOML::
+
+    [engine]
+    processor_model = "pooled"     # "dedicated" | "pooled"
+    workers = 2
+    priorities = 4
+    timer_resolution = 0.01        # seconds; 0 = exact
+    switch_cost = 0.0005           # seconds per transition between general activities (pooled)
+    realtime = false
+    speed = 1.0                    # wall-clock mode: simulated seconds per wall second
+
+Keys may also sit at the top level of the file. Unknown keys and bad values raise
+:class:`~opspec.errors.ConfigurationError` naming ``path: key`` and what is allowed.
+"""
+
+from __future__ import annotations
+
+import math
+import tomllib
+from collections.abc import Mapping
+from dataclasses import dataclass, fields
+from pathlib import Path
+from typing import Any, Literal
+
+from opspec.errors import ConfigurationError, SourceLocation
+
+__all__ = ["EngineConfig", "PROCESSOR_MODELS"]
+
+PROCESSOR_MODELS = ("dedicated", "pooled")
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class EngineConfig:
+    """How the engine executes a package.
+
+    - ``processor_model``: ``"dedicated"`` (each workflow instance has its own worker,
+      transitions are free, priority increments are ignored) or ``"pooled"`` (``workers``
+      workers serve one FIFO queue per priority level; every transition into a general
+      activity costs ``switch_cost`` seconds of a worker; ``cpu_demand`` occupies a worker).
+    - ``workers``: number of workers of the pooled model (>= 1).
+    - ``priorities``: number of priority levels (>= 1); effective priorities are clamped to
+      ``0 .. priorities-1`` and the highest level is served first.
+    - ``timer_resolution``: timers (start triggers, timer events, deadlines) fire on the next
+      multiple of this many seconds; ``0`` means exactly.
+    - ``switch_cost``: seconds a pooled worker spends per transition to a general activity.
+    - ``realtime`` / ``speed``: run against the wall clock, ``speed`` simulated seconds per
+      wall-clock second.
+    """
+
+    processor_model: Literal["dedicated", "pooled"] = "dedicated"
+    workers: int = 1
+    priorities: int = 8
+    timer_resolution: float = 0.0
+    switch_cost: float = 0.0
+    realtime: bool = False
+    speed: float = 1.0
+
+    def __post_init__(self) -> None:
+        _check(self, None)
+
+    @property
+    def pooled(self) -> bool:
+        return self.processor_model == "pooled"
+
+    @classmethod
+    def from_mapping(
+        cls, values: Mapping[str, Any], *, path: str = "<options>", base: EngineConfig | None = None
+    ) -> EngineConfig:
+        """A configuration from ``values`` (unknown keys rejected), on top of ``base``."""
+        allowed = {f.name for f in fields(cls)}
+        for key in values:
+            if key not in allowed:
+                raise ConfigurationError(
+                    f"unknown engine option {key!r}",
+                    location=SourceLocation(path, key=key),
+                    hint=f"allowed options: {', '.join(sorted(allowed))}",
+                )
+        merged = {f.name: getattr(base or _DEFAULT, f.name) for f in fields(cls)}
+        merged.update(values)
+        for key in ("workers", "priorities"):
+            if isinstance(merged[key], float) and merged[key].is_integer():
+                merged[key] = int(merged[key])
+        config = object.__new__(cls)
+        for key, value in merged.items():
+            object.__setattr__(config, key, value)
+        _check(config, path)
+        return config
+
+    @classmethod
+    def load(cls, path: str | Path, **overrides: Any) -> EngineConfig:
+        """Read a TOML file (``[engine]`` table or top-level keys), then apply ``overrides``."""
+        text_path = str(path)
+        try:
+            with open(path, "rb") as handle:
+                document = tomllib.load(handle)
+        except FileNotFoundError:
+            raise ConfigurationError(
+                "engine configuration file not found", location=SourceLocation(text_path),
+                hint="check the path given to --engine-config") from None
+        except tomllib.TOMLDecodeError as error:
+            raise ConfigurationError(
+                f"not valid TOML: {error}", location=SourceLocation(text_path),
+                hint="fix the syntax (see https://toml.io)") from None
+        table = document.get("engine", document)
+        if not isinstance(table, dict):
+            raise ConfigurationError("[engine] must be a table",
+                                     location=SourceLocation(text_path, key="engine"))
+        table = {k: v for k, v in table.items() if k != "engine"}
+        config = cls.from_mapping(table, path=text_path)
+        return config.with_options(**overrides) if overrides else config
+
+    def with_options(self, **overrides: Any) -> EngineConfig:
+        """A copy with keyword ``overrides`` applied (validated like the file)."""
+        return EngineConfig.from_mapping(overrides, base=self)
+
+
+def _fail(path: str | None, key: str, message: str, hint: str) -> ConfigurationError:
+    return ConfigurationError(message, location=SourceLocation(path or "<options>", key=key),
+                              hint=hint)
+
+
+def _check(config: EngineConfig, path: str | None) -> None:
+    if config.processor_model not in PROCESSOR_MODELS:
+        raise _fail(path, "processor_model",
+                    f"processor_model {config.processor_model!r} is not known",
+                    f"allowed values: {', '.join(PROCESSOR_MODELS)}")
+    for key in ("workers", "priorities"):
+        value = getattr(config, key)
+        if isinstance(value, bool) or not isinstance(value, int) or value < 1:
+            raise _fail(path, key, f"{key} must be a whole number >= 1, not {value!r}",
+                        f"write e.g. {key} = 2")
+    for key in ("timer_resolution", "switch_cost"):
+        value = getattr(config, key)
+        if (isinstance(value, bool) or not isinstance(value, int | float)
+                or not math.isfinite(value) or value < 0):
+            raise _fail(path, key, f"{key} must be a number of seconds >= 0, not {value!r}",
+                        f"write e.g. {key} = 0.001")
+    if not isinstance(config.realtime, bool):
+        raise _fail(path, "realtime", f"realtime must be true or false, not {config.realtime!r}",
+                    "allowed values: true, false")
+    speed = config.speed
+    if (isinstance(speed, bool) or not isinstance(speed, int | float)
+            or not math.isfinite(speed) or speed <= 0):
+        raise _fail(path, "speed", f"speed must be a number > 0, not {speed!r}",
+                    "write e.g. speed = 60 (one simulated minute per wall second)")
+
+
+_DEFAULT = EngineConfig()

@@ -1,0 +1,60 @@
+"""Behaviour-coordination built-ins of SISARL-XPDL, as pure functions, and the supervisor
+mailbox for push/pull data.
+
+- **arbiter** (fixed priority): ``inputs`` are command fields, highest priority first; the
+  output is the first command that is set (not ``None``, not ``""``), else ``None``.
+- **voter**: ``inputs`` are votes; the output is the option with the most votes. Ties go to
+  the option listed first in ``options`` (or, without options, the value voted first).
+  Votes that are ``None`` abstain.
+- **superposition**: ``inputs`` are numbers or equal-length vectors, ``weights`` their
+  weights (default 1 each); the output is the weighted sum (a float or a list).
+- **push**: puts the value of ``inputs[0]`` (a tuple of all inputs if several) into the
+  supervisor mailbox ``channel``; never blocks.
+- **pull**: takes the oldest value of mailbox ``channel`` into ``output``; when the mailbox
+  is empty the activity waits until something is pushed (the supervisor holds data until
+  the receiver is ready, and each value is delivered once, oldest first).
+- **mode change**: switches the active workflow set to ``target_mode`` (see
+  :meth:`opspec.engine.interpreter.Interpreter.change_mode`).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from typing import Any
+
+__all__ = ["arbiter", "superposition", "voter"]
+
+
+def arbiter(commands: Sequence[Any]) -> Any:
+    """The first command that is set, in priority order."""
+    for command in commands:
+        if command is not None and command != "":
+            return command
+    return None
+
+
+def voter(votes: Sequence[Any], options: Sequence[Any] = ()) -> Any:
+    """The most voted value; ties broken by ``options`` order, else by first vote."""
+    counts: dict[Any, int] = {}
+    for vote in votes:
+        if vote is not None:
+            counts[vote] = counts.get(vote, 0) + 1
+    if not counts:
+        return None
+    order = [o for o in options if o in counts] + [v for v in counts if v not in options]
+    best = max(counts.values())
+    return next(v for v in order if counts[v] == best)
+
+
+def superposition(values: Sequence[Any], weights: Sequence[float] = ()) -> Any:
+    """Weighted sum of numbers or of equal-length vectors."""
+    w = list(weights) or [1.0] * len(values)
+    if len(w) != len(values):
+        raise ValueError(f"superposition has {len(values)} inputs but {len(w)} weights")
+    if all(isinstance(v, int | float) for v in values):
+        return float(sum(wi * vi for wi, vi in zip(w, values, strict=True)))
+    vectors = [list(v) for v in values]
+    size = len(vectors[0]) if vectors else 0
+    if any(len(v) != size for v in vectors):
+        raise ValueError("superposition inputs are vectors of different lengths")
+    return [float(sum(wi * v[i] for wi, v in zip(w, vectors, strict=True))) for i in range(size)]

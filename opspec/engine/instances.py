@@ -1,0 +1,101 @@
+"""Run state: workflow instances, frames (a token scope over a graph) and activity instances.
+
+Plain ``__slots__`` objects keyed by small ints: the interpreter creates several per dose
+cycle, so they stay small and cheap. Life-cycle states are ints from
+:mod:`opspec.engine.lifecycle`.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, MutableMapping
+from typing import TYPE_CHECKING, Any
+
+from opspec.engine.lifecycle import NOT_STARTED
+
+if TYPE_CHECKING:
+    from opspec.engine.compiled import CompiledActivity, CompiledGraph, CompiledProcess
+    from opspec.engine.performers import WorkItem
+
+__all__ = ["ActivityInstance", "Frame", "ProcessInstance"]
+
+
+class ProcessInstance:
+    """One running (or finished) workflow instance.
+
+    ``data`` holds the workflow-wide variables; ``scope`` is what expressions see (``data``
+    itself, or a chain of ``data`` and the package-wide variables). ``parent`` is the activity
+    instance of a synchronous subflow call waiting for this one.
+    """
+
+    __slots__ = ("id", "process", "data", "scope", "state", "priority", "parent", "root",
+                 "frames", "started_at", "deferred", "trigger")
+
+    def __init__(self, id: int, process: CompiledProcess, data: dict[str, Any],
+                 scope: MutableMapping[str, Any], priority: int,
+                 parent: ActivityInstance | None, root: int, started_at: float) -> None:
+        self.id = id
+        self.process = process
+        self.data = data
+        self.scope = scope
+        self.state = NOT_STARTED
+        self.priority = priority
+        self.parent = parent
+        self.root = root
+        self.frames: list[Frame] = []
+        self.started_at = started_at
+        self.deferred: list[tuple[Any, ...]] = []
+        self.trigger: str | None = None
+
+    def __repr__(self) -> str:
+        return f"<ProcessInstance {self.process.id}#{self.id}>"
+
+
+class Frame:
+    """Tokens of one instance moving through one graph (the process or an activity set).
+
+    ``live`` counts tokens on their way (in the ready queue) plus activity instances running;
+    ``parked`` counts tokens waiting at AND/OR joins; the frame is done when both are zero.
+    """
+
+    __slots__ = ("graph", "inst", "owner", "live", "parked", "joins", "ors", "running")
+
+    def __init__(self, graph: CompiledGraph, inst: ProcessInstance,
+                 owner: ActivityInstance | None) -> None:
+        self.graph = graph
+        self.inst = inst
+        self.owner = owner                    # the block activity instance, for activity sets
+        self.live = 0
+        self.parked = 0
+        self.joins: dict[int, list[int]] = {}
+        self.ors: dict[int, int] = {}
+        self.running: dict[int, ActivityInstance] = {}
+
+
+class ActivityInstance:
+    """An activity that takes time or waits: offered, running a subflow, catching an event,
+    waiting for a worker, looping, under a deadline.
+
+    ``gen`` is bumped whenever the instance stops waiting, so stale timer callbacks that still
+    sit in SimPy's queue recognise they are obsolete (SimPy cannot cancel a scheduled event).
+    """
+
+    __slots__ = ("key", "act", "frame", "state", "started_at", "item", "child", "iteration",
+                 "gen", "waiting", "choice", "cleanup", "performer")
+
+    def __init__(self, key: int, act: CompiledActivity, frame: Frame, started_at: float) -> None:
+        self.key = key
+        self.act = act
+        self.frame = frame
+        self.state = NOT_STARTED
+        self.started_at = started_at
+        self.item: WorkItem | None = None
+        self.child: Any = None                # ProcessInstance or Frame
+        self.iteration = 0
+        self.gen = 0
+        self.waiting = ""                     # what it waits for, for deadlock reports
+        self.choice: tuple[Any, ...] = ()     # deferred choice: the transitions offered
+        self.cleanup: list[Callable[[], None]] = []
+        self.performer: Any = None
+
+    def __repr__(self) -> str:
+        return f"<ActivityInstance {self.act.process}.{self.act.id}#{self.key}>"

@@ -1,0 +1,132 @@
+"""Declared metrics computed incrementally from the trace, as a trace listener.
+
+- COUNT: the number of events matching ``select``: ``{"kind": "count", "total": N}``.
+- DURATION: per process instance (the *root* instance, so a subflow's events count for the
+  workflow that called it), seconds from the ``first`` (or ``last``) event matching
+  ``start`` to the next event matching ``end``; one sample per instance:
+  ``{"kind": "duration", "n", "mean", "p95", "min", "max"}`` (``None`` values when n = 0).
+- RATIO: numerator metric / denominator metric (their totals or means):
+  ``{"kind": "ratio", "value": x}`` (``None`` when the denominator is 0).
+
+The output shape is shared with ``opspec evaluate --json``.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Iterable
+from typing import Any
+
+from opspec.engine.trace import TraceEvent
+from opspec.model import EventSelector, MetricDefinition, MetricKind
+
+__all__ = ["MetricsListener", "percentile", "summarise_durations"]
+
+
+def _matches(selector: EventSelector, event: TraceEvent) -> bool:
+    return (selector.event == event.kind
+            and (selector.process is None or selector.process == event.process)
+            and (selector.activity is None or selector.activity == event.activity))
+
+
+def percentile(values: list[float], q: float) -> float:
+    """Linear-interpolation percentile (numpy's default), ``q`` in 0..100."""
+    ordered = sorted(values)
+    if not ordered:
+        return math.nan
+    pos = (len(ordered) - 1) * q / 100.0
+    lo = math.floor(pos)
+    hi = min(lo + 1, len(ordered) - 1)
+    return ordered[lo] + (ordered[hi] - ordered[lo]) * (pos - lo)
+
+
+def summarise_durations(samples: list[float]) -> dict[str, Any]:
+    if not samples:
+        return {"kind": "duration", "n": 0, "mean": None, "p95": None, "min": None,
+                "max": None}
+    return {"kind": "duration", "n": len(samples), "mean": sum(samples) / len(samples),
+            "p95": percentile(samples, 95.0), "min": min(samples), "max": max(samples)}
+
+
+class MetricsListener:
+    """Computes ``definitions`` from the events it receives.
+
+    ``selects`` tells the simulation which events it needs, so events nobody needs are
+    never built. Instances are identified by ``(root instance)``: the instance id of the
+    event, mapped to the root through ``process.started`` events' ``parent`` field.
+    """
+
+    def __init__(self, definitions: Iterable[MetricDefinition]) -> None:
+        self.definitions = tuple(definitions)
+        self.counts: dict[str, int] = {}
+        self.samples: dict[str, list[float]] = {}
+        self._open: dict[str, dict[int, float]] = {}
+        self._root: dict[int, int] = {}
+        self._by_kind: dict[str, list[tuple[MetricDefinition, str]]] = {}
+        selects: set[tuple[str, str | None, str | None]] = {("process.started", None, None)}
+        for metric in self.definitions:
+            if metric.kind is MetricKind.COUNT and metric.select is not None:
+                self.counts[metric.name] = 0
+                self._add(metric, metric.select, "count", selects)
+            elif metric.kind is MetricKind.DURATION and metric.start and metric.end:
+                self.samples[metric.name] = []
+                self._open[metric.name] = {}
+                self._add(metric, metric.start, "start", selects)
+                self._add(metric, metric.end, "end", selects)
+        self.selects = frozenset(selects)
+
+    def _add(self, metric: MetricDefinition, selector: EventSelector, role: str,
+             selects: set[tuple[str, str | None, str | None]]) -> None:
+        self._by_kind.setdefault(selector.event, []).append((metric, role))
+        selects.add((selector.event, selector.process, selector.activity))
+
+    def __call__(self, event: TraceEvent) -> None:
+        kind = event.kind
+        if kind == "process.started" and event.instance is not None:
+            parent = event.data.get("parent")
+            self._root[event.instance] = (self._root.get(parent, parent)
+                                          if parent is not None else event.instance)
+        interested = self._by_kind.get(kind)
+        if not interested:
+            return
+        for metric, role in interested:
+            if role == "count":
+                if _matches(metric.select, event):  # type: ignore[arg-type]
+                    self.counts[metric.name] += 1
+                continue
+            selector = metric.start if role == "start" else metric.end
+            if not _matches(selector, event):  # type: ignore[arg-type]
+                continue
+            root = self._root.get(event.instance or 0, event.instance or 0)
+            pending = self._open[metric.name]
+            if role == "start":
+                if selector.which == "last" or root not in pending:  # type: ignore[union-attr]
+                    pending[root] = event.time
+            elif root in pending:
+                self.samples[metric.name].append(event.time - pending.pop(root))
+
+    def values(self) -> dict[str, dict[str, Any]]:
+        """Every declared metric in the shared output shape."""
+        out: dict[str, dict[str, Any]] = {}
+        for metric in self.definitions:
+            if metric.kind is MetricKind.COUNT:
+                out[metric.name] = {"kind": "count", "total": self.counts.get(metric.name, 0)}
+            elif metric.kind is MetricKind.DURATION:
+                out[metric.name] = summarise_durations(self.samples.get(metric.name, []))
+        for metric in self.definitions:
+            if metric.kind is MetricKind.RATIO:
+                num = _scalar(out.get(metric.numerator or ""))
+                den = _scalar(out.get(metric.denominator or ""))
+                value = num / den if num is not None and den else None
+                out[metric.name] = {"kind": "ratio", "value": value}
+        return out
+
+
+def _scalar(value: dict[str, Any] | None) -> float | None:
+    if value is None:
+        return None
+    if value["kind"] == "count":
+        return float(value["total"])
+    if value["kind"] == "duration":
+        return value["mean"]
+    return value.get("value")

@@ -1,0 +1,443 @@
+"""The public face of the engine: build a :class:`Simulation`, run it, read its result.
+
+::
+
+    compiled = compile_package(package)              # once per package
+    sim = Simulation(compiled, EngineConfig(), performers={"user": ScriptedUser(...)}, seed=1)
+    result = sim.run(until=86_400)
+    result.metrics["doses_taken"]                    # {"kind": "count", "total": 4}
+
+Constructing a Simulation from a compiled package is cheap (no graph work; about as much as
+creating a SimPy environment), so evaluations build one per simulated household. Several
+simulations may share one SimPy environment (``env=``): each keeps its own messages, data and
+performers, so they are independent households on one clock.
+
+Start triggers (armed when the run starts, for workflows of the active mode):
+
+* none — the workflow starts at time 0 if it has no start trigger, is no subflow target and
+  its start event catches nothing (or its ``auto_start`` directive says so);
+* ``timer`` — at each time of day in ``at`` (seconds since midnight) plus ``offset``,
+  repeated every ``every`` seconds (one day by default); ``timer:after D`` fires once;
+* ``period`` — at ``offset``, ``offset + every``, …;
+* ``message``/``signal`` — each time one is raised (never buffered);
+* ``rule`` — each time the condition over package-wide data becomes true.
+
+End triggers of a workflow terminate its running instances.
+"""
+
+from __future__ import annotations
+
+import math
+import queue
+from collections.abc import Callable, Iterable, Iterator, Mapping
+from dataclasses import dataclass, field
+from typing import Any
+
+import simpy
+
+from opspec.engine.compiled import CompiledPackage, CompiledProcess, CTrigger, compile_package
+from opspec.engine.config import EngineConfig
+from opspec.engine.interpreter import Interpreter
+from opspec.engine.lifecycle import LIFECYCLE, RUNNING, SUSPENDED, TERMINATED
+from opspec.engine.metrics import MetricsListener
+from opspec.engine.performers import Performer, WorkItem
+from opspec.engine.registry import PerformerRegistry
+from opspec.engine.trace import EventKind as EK
+from opspec.engine.trace import TraceEvent, TraceListener
+from opspec.engine.trace_sinks import MemorySink
+from opspec.errors import ConfigurationError, ExecutionError
+from opspec.model import Package
+
+__all__ = ["RunResult", "Simulation", "simulate"]
+
+DAY = 86_400.0
+
+
+@dataclass(frozen=True, slots=True)
+class RunResult:
+    """What a run produced: the trace (if kept), the declared metrics and a summary.
+
+    ``summary`` keys: ``time`` (simulated end), ``seed``, ``events`` (trace events emitted),
+    ``sim_events`` (SimPy events scheduled), ``instances`` (started/completed/terminated/
+    aborted/open), ``deadlocks`` and ``faults`` (lists of dicts with a ``message``),
+    ``stale_completions``, ``drift`` (wall-clock mode) and ``pool`` (pooled model).
+    """
+
+    trace: tuple[TraceEvent, ...] | None
+    metrics: dict[str, dict[str, Any]]
+    summary: dict[str, Any] = field(default_factory=dict)
+
+    def deadlock_error(self) -> ExecutionError | None:
+        """An :class:`ExecutionError` describing the deadlocks, or ``None``."""
+        deadlocks = self.summary.get("deadlocks") or []
+        if not deadlocks:
+            return None
+        first = deadlocks[0]
+        more = f" (and {len(deadlocks) - 1} more)" if len(deadlocks) > 1 else ""
+        return ExecutionError(first["message"] + more, sim_time=first["time"],
+                              hint="check the joins, triggers and performers named")
+
+
+class _Session:
+    """The :class:`~opspec.engine.performers.PerformerSession` of one simulation."""
+
+    __slots__ = ("_sim",)
+
+    def __init__(self, sim: Simulation) -> None:
+        self._sim = sim
+
+    @property
+    def now(self) -> float:
+        return self._sim.env.now
+
+    def complete(self, item: WorkItem, data: Mapping[str, Any] | None = None,
+                 choice: str | None = None) -> None:
+        self._sim.performer_complete(item, data, choice)
+
+    def omit(self, item: WorkItem, reason: str = "") -> None:
+        self._sim.performer_omit(item, reason)
+
+    def fail(self, item: WorkItem, exception: str, message: str = "") -> None:
+        self._sim.performer_fail(item, exception, message)
+
+    def raise_trigger(self, name: str, data: Mapping[str, Any] | None = None) -> None:
+        self._sim.raise_trigger(name, data)
+
+    def call_later(self, delay: float, callback: Callable[[], None]) -> None:
+        self._sim.call_at(delay, callback)
+
+    def trace(self, kind: str, data: Mapping[str, Any] | None = None) -> None:
+        sim = self._sim
+        if sim.wants(kind, None, None):
+            sim.emit(kind, data=dict(data) if data else None)
+
+
+class Simulation(Interpreter):
+    """One run of a compiled package on a SimPy clock.
+
+    - ``performers``: a :class:`PerformerRegistry` or a mapping from participant ids / lane
+      names to performers (a ``CallablePerformer`` also binds its Application ids).
+      Activities outside the user lane with no performer complete by themselves.
+    - ``listeners``: trace listeners; a listener with a ``selects`` attribute (a set of
+      ``(kind, process, activity)`` with ``None`` wildcards) only receives those events, and
+      events nobody selects are never built.
+    - ``params``: overrides of package-wide data fields.
+    - ``keep_trace``: keep every event in memory (``RunResult.trace``).
+    - ``env``: share a SimPy environment with other simulations (independent households).
+    - ``scope``: the household index path, prefixed to every random stream.
+    - ``mode_loader``: loads the package a mode's ``source`` names, for run-time mode loads.
+    """
+
+    def __init__(self, compiled: CompiledPackage | Package, config: EngineConfig | None = None,
+                 *, performers: PerformerRegistry | Mapping[str, Performer] | None = None,
+                 seed: int = 0, listeners: Iterable[TraceListener] = (),
+                 params: Mapping[str, Any] | None = None, keep_trace: bool = False,
+                 env: simpy.Environment | None = None, scope: Iterable[int] = (),
+                 mode_loader: Callable[[str], CompiledPackage] | None = None) -> None:
+        if isinstance(compiled, Package):
+            compiled = compile_package(compiled)
+        self.seed = seed
+        self.memory = MemorySink() if keep_trace else None
+        self.metrics = MetricsListener(compiled.package.metrics) if (
+            compiled.package.metrics) else None
+        all_listeners: list[TraceListener] = list(listeners)
+        if self.metrics is not None:
+            all_listeners.append(self.metrics)
+        if self.memory is not None:
+            all_listeners.append(self.memory)
+        super().__init__(compiled, config or _DEFAULT_CONFIG,
+                         performers=PerformerRegistry.coerce(performers), seed=seed,
+                         listeners=all_listeners, params=params, env=env, scope=tuple(scope),
+                         mode_loader=mode_loader)
+        self.session = _Session(self)
+        self._booted = False
+        self._posted: queue.SimpleQueue[Callable[[], None]] = queue.SimpleQueue()
+        self.wake: Callable[[], None] | None = None
+        self.drift: dict[str, Any] | None = None
+
+    # ------------------------------------------------------------------ boot
+    def boot(self) -> None:
+        """Attach performers and arm start triggers (done by the first run/step)."""
+        if self._booted:
+            return
+        self._booted = True
+        for performer in self.registry.performers():
+            performer.attach(self.session)
+        if self.wants(EK.RUN_STARTED, None, None):
+            self.emit(EK.RUN_STARTED, data={"seed": self.seed, "package": self.compiled.id,
+                                            "processor_model": self.config.processor_model})
+        for proc in self.processes.values():
+            self.arm_process(proc)
+        self._drain()
+
+    def arm_process(self, proc: CompiledProcess) -> None:
+        """Arm the start and end triggers of ``proc`` (mode membership checked on firing)."""
+        start = proc.start_trigger
+        if start is None:
+            if proc.auto_start and self.is_active(proc.id):
+                self.start_process(proc, trigger="auto")
+        else:
+            self._arm(start, lambda trig: self._triggered_start(proc, trig))
+        if proc.end_trigger is not None:
+            self._arm(proc.end_trigger, lambda trig: self.terminate_all(
+                proc.id, f"end trigger {trig}"), ends=proc)
+
+    def _triggered_start(self, proc: CompiledProcess, trigger: str) -> None:
+        if self.is_active(proc.id):
+            self.start_process(proc, trigger=trigger)
+
+    def _arm(self, trig: CTrigger, fire: Callable[[str], None],
+             ends: CompiledProcess | None = None) -> None:
+        kind = trig.kind
+        if kind in ("message", "signal"):
+            table = self._ends if ends is not None else self._starts
+            if ends is not None:
+                table.setdefault((kind, trig.name or ""), []).append(ends)
+            else:
+                proc = next(p for p in self.processes.values() if p.start_trigger is trig)
+                table.setdefault((kind, trig.name or ""), []).append(proc)
+        elif kind in ("timer", "period"):
+            times = _occurrences(trig, self.env.now)
+            self._next_timer(times, fire, f"{kind}")
+        elif kind == "rule":
+            condition = trig.condition
+            assert condition is not None
+            state = {"last": False}
+
+            def holds() -> bool:
+                value = bool(condition(self.package_data, self.env.now))
+                rising = value and not state["last"]
+                state["last"] = value
+                return rising
+            key = next(self._rule_keys)
+            self._rules[key] = (holds, lambda: fire("rule"), None)
+
+    def _next_timer(self, times: Iterator[float], fire: Callable[[str], None],
+                    label: str) -> None:
+        at = next(times, None)
+        if at is None:
+            return
+        if self._resolution > 0.0:
+            at = math.ceil(at / self._resolution) * self._resolution
+        timeout = self.env.timeout(max(0.0, at - self.env.now))
+
+        def fired(_event: Any) -> None:
+            fire(label)
+            self._drain()
+            self._next_timer(times, fire, label)
+        timeout.callbacks.append(fired)
+
+    # ------------------------------------------------------------------ control
+    def start(self, process_id: str, data: Mapping[str, Any] | None = None) -> int:
+        """Start an instance of ``process_id`` now; returns its instance id."""
+        self.boot()
+        proc = self.processes.get(process_id)
+        if proc is None:
+            raise ExecutionError(f"no process {process_id!r} in package {self.compiled.id!r}",
+                                 hint="known: " + ", ".join(sorted(self.processes)))
+        inst = self.start_process(proc, data, trigger="api")
+        self._drain()
+        return inst.id
+
+    def raise_trigger(self, name: str, data: Mapping[str, Any] | None = None) -> None:
+        """Raise ``message:NAME``, ``signal:NAME`` or a bare NAME (a message), now."""
+        kind, sep, rest = name.partition(":")
+        if sep and kind in ("message", "signal"):
+            self.broadcast(kind, rest, data)
+        else:
+            self.broadcast("message", name, data)
+        self._drain()
+
+    def _instance(self, instance_id: int) -> Any:
+        inst = self.live.get(instance_id)
+        if inst is None:
+            raise ExecutionError(f"instance {instance_id} is not running",
+                                 hint="it may have finished; see the trace")
+        return inst
+
+    def suspend(self, instance_id: int) -> None:
+        """Suspend an instance: nothing of it moves until :meth:`resume`."""
+        inst = self._instance(instance_id)
+        inst.state = LIFECYCLE.next(inst.state, "suspend", f"instance {instance_id}")
+        if self.wants(EK.PROCESS_SUSPENDED, inst.process.id, None):
+            self.emit(EK.PROCESS_SUSPENDED, inst.process.id, inst.id, None, inst.process.lane)
+
+    def resume(self, instance_id: int) -> None:
+        inst = self._instance(instance_id)
+        inst.state = LIFECYCLE.next(inst.state, "resume", f"instance {instance_id}")
+        if self.wants(EK.PROCESS_RESUMED, inst.process.id, None):
+            self.emit(EK.PROCESS_RESUMED, inst.process.id, inst.id, None, inst.process.lane)
+        deferred, inst.deferred = inst.deferred, []
+        self._ready.extend(deferred)      # deferred tokens were still counted as live
+        self._drain()
+
+    def terminate(self, instance_id: int, reason: str = "terminated by request") -> None:
+        self.end_instance(self._instance(instance_id), TERMINATED, reason)
+        self._drain()
+
+    def instance_state(self, instance_id: int) -> str:
+        """WfMC state name of a live instance (``running``/``suspended``) or ``finished``."""
+        inst = self.live.get(instance_id)
+        return "finished" if inst is None else ("suspended" if inst.state == SUSPENDED
+                                                else "running")
+
+    # ------------------------------------------------------------------ stepping
+    def post(self, callback: Callable[[], None]) -> None:
+        """Thread-safe: run ``callback`` on the engine's thread before the next step."""
+        self._posted.put(callback)
+        wake = self.wake
+        if wake is not None:
+            wake()
+
+    def drain_posts(self) -> int:
+        count = 0
+        while True:
+            try:
+                callback = self._posted.get_nowait()
+            except queue.Empty:
+                break
+            callback()
+            count += 1
+        if count:
+            self._drain()
+        return count
+
+    def peek(self) -> float:
+        """Time of the next scheduled event (``inf`` when there is none)."""
+        self.boot()
+        return float(self.env.peek())
+
+    def step(self) -> bool:
+        """Process posted input and one SimPy event; ``False`` when nothing was left."""
+        self.boot()
+        self.drain_posts()
+        try:
+            self.env.step()
+        except simpy.core.EmptySchedule:
+            return False
+        return True
+
+    def run(self, until: float | None = None) -> RunResult:
+        """Run to simulated time ``until`` (or until nothing is scheduled) and summarise."""
+        self.boot()
+        if until is not None and until < self.env.now:
+            raise ExecutionError(f"until ({until}) must not be before the current simulated "
+                                 f"time ({self.env.now})")
+        self.drain_posts()
+        if self.config.realtime:
+            from opspec.engine.wallclock import run_realtime
+
+            self.drift = run_realtime(self, until, self.config.speed)
+        elif until is None:
+            self.env.run()
+        else:
+            self.env.run(until=until)
+        self.check_waiting(horizon=until)
+        if self.wants(EK.RUN_ENDED, None, None):
+            self.emit(EK.RUN_ENDED, data={"open": len(self.live),
+                                          "deadlocks": len(self.deadlocks)})
+        return self.result()
+
+    def check_waiting(self, horizon: float | None) -> None:
+        """Report instances that wait for what can never come (see ``deadlock`` below).
+
+        When nothing is scheduled any more, every instance still waiting is deadlocked. When
+        the run stopped at its horizon, waiting is normal unless an activity waits for a
+        performer that does not exist.
+        """
+        dry = self.env.peek() == math.inf
+        for inst in list(self.live.values()):
+            if inst.state != RUNNING:
+                continue
+            waiting = [(ai.act.id, ai.waiting) for frame in inst.frames
+                       for ai in frame.running.values()]
+            if dry:
+                why = "nothing is scheduled any more"
+            else:
+                waiting = [w for w in waiting if w[1].startswith("performer for")]
+                why = "no performer is bound"
+            if waiting:
+                self.report_deadlock(inst, [f"{a} ({w})" for a, w in waiting], why)
+
+    def result(self) -> RunResult:
+        """The result so far (metrics are computed incrementally)."""
+        counts = dict(self.counts)
+        counts["open"] = len(self.live)
+        summary: dict[str, Any] = {
+            "time": self.env.now, "seed": self.seed, "events": self._seq,
+            "sim_events": _event_count(self.env), "instances": counts,
+            "deadlocks": list(self.deadlocks), "faults": list(self.faults),
+            "stale_completions": self.stale_completions, "drift": self.drift,
+            "mode": self.mode,
+        }
+        if self._pool is not None:
+            summary["pool"] = {"workers": self.config.workers, "busy_time": self._pool.busy_time,
+                               "max_waiting": self._pool.max_waiting}
+        return RunResult(tuple(self.memory.events) if self.memory is not None else None,
+                         self.metrics.values() if self.metrics is not None else {}, summary)
+
+
+def _event_count(env: simpy.Environment) -> int:
+    counter = getattr(env, "_eid", None)
+    if counter is None:
+        return 0
+    # itertools.count's repr shows the next value without consuming it
+    text = repr(counter)
+    try:
+        return int(text[text.index("(") + 1:text.index(")")])
+    except ValueError:
+        return 0
+
+
+def _occurrences(trig: CTrigger, now: float) -> Iterator[float]:
+    """Absolute firing times (>= ``now``) of a timer or period trigger."""
+    if trig.kind == "period":
+        every = trig.every or 0.0
+        if every <= 0:
+            yield max(now, trig.offset)
+            return
+        k = max(0, math.ceil((now - trig.offset) / every))
+        while True:
+            yield trig.offset + k * every
+            k += 1
+    if not trig.at:
+        if trig.every:
+            k = 1
+            while True:
+                yield trig.offset + k * trig.every
+                k += 1
+        yield now + trig.offset
+        return
+    every = trig.every or DAY
+    cycle = max(0, math.floor((now - trig.offset) / every))
+    while True:
+        for at in trig.at:
+            t = cycle * every + at + trig.offset
+            if t >= now:
+                yield t
+        cycle += 1
+
+
+_DEFAULT_CONFIG = EngineConfig()
+
+
+def simulate(package: Package | CompiledPackage, *, days: float | None = None,
+             until: float | None = None, seed: int = 0,
+             performers: PerformerRegistry | Mapping[str, Performer] | None = None,
+             config: EngineConfig | None = None, keep_trace: bool = True,
+             listeners: Iterable[TraceListener] = (),
+             params: Mapping[str, Any] | None = None) -> RunResult:
+    """Compile (if needed), run one simulation for ``days`` or to ``until`` seconds."""
+    if days is not None and until is not None:
+        raise ConfigurationError("give days or until, not both")
+    horizon = days * DAY if days is not None else until
+    compiled = package if isinstance(package, CompiledPackage) else compile_package(package)
+    if horizon is None and any(p.start_trigger is not None and p.start_trigger.kind in (
+            "timer", "period") and (p.start_trigger.every or p.start_trigger.at)
+            for p in compiled.processes.values()):
+        raise ConfigurationError(
+            "this package has periodic start triggers, so it never runs out of events",
+            hint="give days= or until= (opspec run --days D or --until SECONDS)")
+    sim = Simulation(compiled, config, performers=performers, seed=seed, listeners=listeners,
+                     params=params, keep_trace=keep_trace)
+    return sim.run(until=horizon)
