@@ -38,8 +38,7 @@ from typing import Any
 
 from opspec import __version__
 from opspec.errors import SourceLocation, SpecError
-from opspec.model import activities, common, data, expressions, package, process, resources
-from opspec.model import sisarl
+from opspec.model import activities, common, data, expressions, package, process, resources, sisarl
 from opspec.model.package import Package
 
 __all__ = [

@@ -44,7 +44,7 @@ def compile_spec(
     Raises :class:`SpecError` carrying every diagnostic when the spec has errors (``strict``
     counts warnings as errors); nothing is written then. ``OSError`` from writing propagates.
     """
-    result = load_package(source, strict=strict)
+    result = load_package(Path(source), strict=strict)
     if not result.ok or result.package is None:
         raise SpecError.from_diagnostics(result.diagnostics)
     target = Path(output) if output is not None else default_output(source)

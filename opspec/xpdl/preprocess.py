@@ -123,6 +123,7 @@ def _condition(expression: Expression) -> Condition:
 
 
 _OTHERWISE = Condition(kind=ConditionKind.OTHERWISE)
+_ALWAYS = Condition()
 
 
 def _assign(target: str, expression: Expression) -> Assignment:
@@ -185,7 +186,7 @@ class _Set:
         return activity
 
     def link(self, source: Activity, target: Activity,
-             condition: Condition = Condition()) -> Transition:
+             condition: Condition = _ALWAYS) -> Transition:
         transition = Transition(id=self.ids.fresh(f"{self.owner.id}.t{len(self.transitions) + 1}"),
                                 source=source.id, target=target.id, condition=condition)
         self.transitions.append(transition)

@@ -19,17 +19,13 @@ application types other than Script/Xslt/Form, ``business-rule`` tasks (written 
 
 from __future__ import annotations
 
-import math
 import re
 from collections.abc import Iterable
-from decimal import Decimal
-from xml.sax.saxutils import quoteattr
 
 from lxml import etree
 
 from opspec.model import (
     Activity,
-    ActivityDirectives,
     ActivitySet,
     ActualParameter,
     Application,
@@ -39,17 +35,12 @@ from opspec.model import (
     BlockActivity,
     Condition,
     ConditionKind,
-    CoordinationBuiltIn,
-    CoordinationKind,
     DataField,
     DataType,
     DeclaredType,
-    Distribution,
     EnumerationType,
     Event,
     EventPosition,
-    EventSelector,
-    Expression,
     ExtendedAttribute,
     ExternalReferenceType,
     FormalParameter,
@@ -57,13 +48,10 @@ from opspec.model import (
     Lane,
     ListType,
     Literal,
-    MetricDefinition,
-    MetricKind,
     NoImplementation,
     Package,
     Participant,
     Pool,
-    ProcessDirectives,
     RecordType,
     Reference,
     Route,
@@ -74,13 +62,22 @@ from opspec.model import (
     Transition,
     Trigger,
     TriggerKind,
-    TriggerRef,
     TypeDeclaration,
     UnionType,
-    WorkflowMode,
     WorkflowProcess,
 )
-from opspec.model.expression_text import to_text
+from opspec.xpdl.sisarl_write import (
+    activity_directive_attributes,
+    builtin_attribute,
+    distribution_text,
+    duration_text,
+    expression_text,
+    literal_text,
+    merged_attributes,
+    package_directive_attributes,
+    process_directive_attributes,
+    trigger_text,
+)
 
 __all__ = [
     "XPDL21",
@@ -96,14 +93,12 @@ XPDL10 = "http://www.wfmc.org/2002/XPDL1.0"
 OPSPEC = "urn:opspec:sisarl:1"
 _NSMAP = {None: XPDL21, "opspec": OPSPEC}
 
-_Element = etree._Element
-
 
 def _q(local: str) -> str:
     return f"{{{XPDL21}}}{local}"
 
 
-def _sub(parent: _Element, local: str, text: str | None = None, **attrs: str | None) -> _Element:
+def _sub(parent: etree._Element, local: str, text: str | None = None, **attrs: str | None) -> etree._Element:
     element = etree.SubElement(parent, _q(local))
     for key, value in attrs.items():
         if value is not None:
@@ -117,83 +112,13 @@ def _bool(value: bool) -> str:
     return "true" if value else "false"
 
 
-# --------------------------------------------------------------------------- text forms
-
-
-def expression_text(expression: Expression) -> str:
-    """JavaScript-style text of an expression tree (``n < 3 && !done``) that the condition
-    parser reads back to the same tree (the model's shared printer)."""
-    return to_text(expression)
-
-
-def _literal_text(value: str | int | float | bool | None) -> str:
-    return to_text(Literal(value))
-
-
-def duration_text(seconds: float) -> str:
-    """ISO 8601 duration in seconds (``PT0.1S``, ``PT300S``) that parses back to ``seconds``."""
-    if math.isinf(seconds) or math.isnan(seconds):
-        raise ValueError(f"cannot write a duration of {seconds} seconds")
-    if float(seconds).is_integer():
-        return f"PT{int(seconds)}S"
-    return f"PT{Decimal(repr(float(seconds))):f}S"
-
-
-def _number_text(value: float) -> str:
-    if float(value).is_integer() and abs(value) < 2**53:
-        return str(int(value))
-    return f"{Decimal(repr(float(value))):f}"
-
-
-def _time_of_day(seconds: float) -> str:
-    whole = int(seconds)
-    hours, rest = divmod(whole, 3600)
-    minutes, secs = divmod(rest, 60)
-    text = f"{hours:02d}:{minutes:02d}"
-    if secs or seconds != whole:
-        text += f":{secs:02d}" if seconds == whole else f":{secs + seconds - whole:06.3f}"
-    return text
-
-
-def trigger_text(trigger: TriggerRef) -> str:
-    """The SISARL trigger syntax of ``trigger`` (``message:trg_1``, ``timer:08:00 every P1D``,
-    ``period:PT0.1S offset PT1S``, ``rule:n > 3``)."""
-    kind = trigger.kind
-    if kind == "none":
-        return "none"
-    if kind in ("message", "signal"):
-        return f"{kind}:{trigger.name or ''}"
-    if kind == "rule":
-        condition = expression_text(trigger.condition) if trigger.condition else "true"
-        return f"rule:{condition}"
-    if kind == "period":
-        text = f"period:{duration_text(trigger.every or 0.0)}"
-        if trigger.offset:
-            text += f" offset {duration_text(trigger.offset)}"
-        return text
-    if kind == "timer":
-        if trigger.at:
-            text = "timer:" + ",".join(_time_of_day(t) for t in trigger.at)
-            if trigger.every is not None:
-                text += f" every {duration_text(trigger.every)}"
-            return text
-        return f"timer:after {duration_text(trigger.offset)}"
-    return f"{kind}:{trigger.name or ''}"
-
-
-def distribution_text(distribution: Distribution) -> str:
-    """``Name(key=value, …)`` (BPSim names where BPSim has them)."""
-    parameters = ", ".join(f"{k}={_number_text(v)}" for k, v in distribution.parameters)
-    return f"{distribution.kind}({parameters})"
-
-
 # --------------------------------------------------------------------------- extended attributes
 
 
 _FRAGMENT_PARSER = etree.XMLParser(resolve_entities=False, no_network=True, load_dtd=False)
 
 
-def _append_raw_xml(element: _Element, raw_xml: str) -> None:
+def _append_raw_xml(element: etree._Element, raw_xml: str) -> None:
     """Put the verbatim child XML of an extended attribute back under ``element``."""
     wrapper = f'<w xmlns:opspec="{OPSPEC}">{raw_xml}</w>'
     try:
@@ -208,7 +133,7 @@ def _append_raw_xml(element: _Element, raw_xml: str) -> None:
         element.append(child)
 
 
-def _write_extended(parent: _Element, attributes: Iterable[ExtendedAttribute]) -> None:
+def _write_extended(parent: etree._Element, attributes: Iterable[ExtendedAttribute]) -> None:
     attributes = list(attributes)
     if not attributes:
         return
@@ -221,141 +146,10 @@ def _write_extended(parent: _Element, attributes: Iterable[ExtendedAttribute]) -
             _append_raw_xml(element, attribute.raw_xml)
 
 
-def _merged(
-    verbatim: tuple[ExtendedAttribute, ...], generated: list[ExtendedAttribute]
-) -> list[ExtendedAttribute]:
-    present = {attribute.name for attribute in verbatim}
-    # A kept alias states the same directive (Rate = 1/Period, Latency = Deadline).
-    present |= {_ALIASES[name] for name in present if name in _ALIASES}
-    return list(verbatim) + [a for a in generated if a.name not in present]
-
-
-_ALIASES = {"opspec:Rate": "opspec:Period", "opspec:Latency": "opspec:Deadline"}
-
-
-def _ea(name: str, value: str | None = None, raw_xml: str | None = None) -> ExtendedAttribute:
-    return ExtendedAttribute(name=f"opspec:{name}", value=value, raw_xml=raw_xml)
-
-
-def _attr_xml(local: str, attributes: dict[str, str | None], children: str = "") -> str:
-    """``<opspec:local a="…">children</opspec:local>`` (the prefix is declared by the caller)."""
-    attrs = "".join(f" {k}={quoteattr(v)}" for k, v in attributes.items() if v is not None)
-    if not children:
-        return f"<opspec:{local}{attrs}/>"
-    return f"<opspec:{local}{attrs}>{children}</opspec:{local}>"
-
-
-def process_directive_attributes(directives: ProcessDirectives) -> list[ExtendedAttribute]:
-    """The ``opspec:`` extended attributes that state ``directives`` (defaults left out)."""
-    out: list[ExtendedAttribute] = []
-    if directives.period is not None:
-        out.append(_ea("Period", duration_text(directives.period)))
-    if directives.priority is not None:
-        out.append(_ea("Priority", str(directives.priority)))
-    if directives.deadline is not None:
-        out.append(_ea("Deadline", duration_text(directives.deadline)))
-    if directives.start_trigger is not None:
-        out.append(_ea("StartTrigger", trigger_text(directives.start_trigger)))
-    if directives.end_trigger is not None:
-        out.append(_ea("EndTrigger", trigger_text(directives.end_trigger)))
-    if directives.auto_start is not None:
-        out.append(_ea("AutoStart", _bool(directives.auto_start)))
-    if directives.lane is not None:
-        out.append(_ea("Lane", directives.lane))
-    if directives.mode is not None:
-        out.append(_ea("Mode", directives.mode))
-    return out
-
-
-def activity_directive_attributes(directives: ActivityDirectives) -> list[ExtendedAttribute]:
-    """The ``opspec:`` extended attributes that state activity ``directives``."""
-    out: list[ExtendedAttribute] = []
-    if directives.auto_run is not None:
-        out.append(_ea("AutoRun", _bool(directives.auto_run)))
-    if directives.priority_increment:
-        out.append(_ea("PriorityIncrement", str(directives.priority_increment)))
-    if directives.start_trigger is not None:
-        out.append(_ea("StartTrigger", trigger_text(directives.start_trigger)))
-    if directives.end_trigger is not None:
-        out.append(_ea("EndTrigger", trigger_text(directives.end_trigger)))
-    if directives.raises is not None:
-        out.append(_ea("Raises", trigger_text(directives.raises)))
-    if directives.cpu_demand is not None:
-        out.append(_ea("CpuDemand", duration_text(directives.cpu_demand)))
-    if directives.duration is not None:
-        out.append(_ea("Duration", distribution_text(directives.duration)))
-    return out
-
-
-def builtin_attribute(builtin: CoordinationBuiltIn) -> ExtendedAttribute:
-    """``opspec:BuiltIn`` with the built-in's element, as ``docs/sisarl-xpdl.md`` writes it."""
-    kind = builtin.kind
-    if kind is CoordinationKind.PUSH_DATA or kind is CoordinationKind.PULL_DATA:
-        local = "PushData" if kind is CoordinationKind.PUSH_DATA else "PullData"
-        ref = builtin.inputs[0] if kind is CoordinationKind.PUSH_DATA and builtin.inputs \
-            else builtin.output
-        return _ea("BuiltIn", raw_xml=_attr_xml(local, {"Channel": builtin.channel, "Ref": ref}))
-    if kind is CoordinationKind.MODE_CHANGE:
-        return _ea("BuiltIn", raw_xml=_attr_xml("ModeChange", {"To": builtin.target_mode}))
-    local = {CoordinationKind.ARBITER: "Arbiter", CoordinationKind.VOTER: "Voter",
-             CoordinationKind.SUPERPOSITION: "Superposition"}[kind]
-    attributes: dict[str, str | None] = {"Output": builtin.output}
-    if builtin.options:
-        attributes["Options"] = " ".join(builtin.options)
-    inputs = []
-    for index, ref in enumerate(builtin.inputs):
-        weight = builtin.weights[index] if index < len(builtin.weights) else None
-        inputs.append(_attr_xml("Input", {
-            "Ref": ref, "Weight": None if weight is None else _number_text(weight)}))
-    return _ea("BuiltIn", raw_xml=_attr_xml(local, attributes, "".join(inputs)))
-
-
-def _selector_xml(local: str, selector: EventSelector, name: str | None = None) -> str:
-    return _attr_xml(local, {
-        "Name": name, "Event": selector.event, "Process": selector.process,
-        "Activity": selector.activity,
-        "Which": selector.which if selector.which != "first" or local == "From" else None,
-    })
-
-
-def _metric_xml(metric: MetricDefinition) -> str:
-    if metric.kind is MetricKind.COUNT and metric.select is not None:
-        base = {"Name": metric.name, "Event": metric.select.event,
-                "Process": metric.select.process, "Activity": metric.select.activity}
-        return _attr_xml("Count", {**base, "Unit": metric.unit,
-                                   "Description": metric.description})
-    if metric.kind is MetricKind.DURATION:
-        children = ""
-        if metric.start is not None:
-            children += _selector_xml("From", metric.start)
-        if metric.end is not None:
-            children += _selector_xml("To", metric.end)
-        return _attr_xml("Duration", {"Name": metric.name, "Unit": metric.unit,
-                                      "Description": metric.description}, children)
-    return _attr_xml("Ratio", {"Name": metric.name, "Numerator": metric.numerator,
-                               "Denominator": metric.denominator, "Unit": metric.unit,
-                               "Description": metric.description})
-
-
-def _mode_xml(mode: WorkflowMode) -> str:
-    return _attr_xml("Mode", {
-        "Id": mode.id, "Initial": "true" if mode.initial else None,
-        "Workflows": " ".join(mode.workflows), "Source": mode.source})
-
-
-def package_directive_attributes(package: Package) -> list[ExtendedAttribute]:
-    out: list[ExtendedAttribute] = []
-    if package.metrics:
-        out.append(_ea("Metrics", raw_xml="".join(_metric_xml(m) for m in package.metrics)))
-    if package.modes:
-        out.append(_ea("Modes", raw_xml="".join(_mode_xml(m) for m in package.modes)))
-    return out
-
-
 # --------------------------------------------------------------------------- data
 
 
-def _write_data_type(parent: _Element, data_type: DataType) -> None:
+def _write_data_type(parent: etree._Element, data_type: DataType) -> None:
     if isinstance(data_type, BasicType):
         basic = _sub(parent, "BasicType", Type=data_type.kind.value)
         for local, value in (("Length", data_type.length), ("Precision", data_type.precision),
@@ -382,8 +176,8 @@ def _write_data_type(parent: _Element, data_type: DataType) -> None:
             _write_data_type(element, member.type)
     elif isinstance(data_type, EnumerationType):
         enumeration = _sub(parent, "EnumerationType")
-        for value in data_type.values:
-            _sub(enumeration, "EnumerationValue", Name=value)
+        for enum_value in data_type.values:
+            _sub(enumeration, "EnumerationValue", Name=enum_value)
     elif isinstance(data_type, ArrayType):
         array = _sub(parent, "ArrayType", LowerIndex=str(data_type.lower or 0),
                      UpperIndex=str(data_type.upper if data_type.upper is not None else 0))
@@ -394,7 +188,7 @@ def _write_data_type(parent: _Element, data_type: DataType) -> None:
         raise TypeError(f"cannot write data type {data_type!r}")
 
 
-def _write_data_fields(parent: _Element, fields: tuple[DataField, ...]) -> None:
+def _write_data_fields(parent: etree._Element, fields: tuple[DataField, ...]) -> None:
     if not fields:
         return
     container = _sub(parent, "DataFields")
@@ -407,13 +201,13 @@ def _write_data_fields(parent: _Element, fields: tuple[DataField, ...]) -> None:
         if field.initial_value is not None:
             _sub(element, "InitialValue", field.initial_value)
         elif field.initial is not None:
-            _sub(element, "InitialValue", _literal_text(field.initial))
+            _sub(element, "InitialValue", literal_text(field.initial))
         if field.description is not None:
             _sub(element, "Description", field.description)
         _write_extended(element, field.extended_attributes)
 
 
-def _write_formal_parameters(parent: _Element, parameters: tuple[FormalParameter, ...]) -> None:
+def _write_formal_parameters(parent: etree._Element, parameters: tuple[FormalParameter, ...]) -> None:
     if not parameters:
         return
     container = _sub(parent, "FormalParameters")
@@ -427,7 +221,7 @@ def _write_formal_parameters(parent: _Element, parameters: tuple[FormalParameter
             _sub(element, "Description", parameter.description)
 
 
-def _write_actual_parameters(parent: _Element, parameters: tuple[ActualParameter, ...]) -> None:
+def _write_actual_parameters(parent: etree._Element, parameters: tuple[ActualParameter, ...]) -> None:
     if not parameters:
         return
     container = _sub(parent, "ActualParameters")
@@ -438,7 +232,7 @@ def _write_actual_parameters(parent: _Element, parameters: tuple[ActualParameter
         _sub(container, "ActualParameter", text)
 
 
-def _write_assignments(parent: _Element, assignments: tuple[Assignment, ...]) -> None:
+def _write_assignments(parent: etree._Element, assignments: tuple[Assignment, ...]) -> None:
     if not assignments:
         return
     container = _sub(parent, "Assignments")
@@ -454,7 +248,7 @@ def _write_assignments(parent: _Element, assignments: tuple[Assignment, ...]) ->
 # --------------------------------------------------------------------------- resources
 
 
-def _write_participants(parent: _Element, participants: tuple[Participant, ...]) -> None:
+def _write_participants(parent: etree._Element, participants: tuple[Participant, ...]) -> None:
     if not participants:
         return
     container = _sub(parent, "Participants")
@@ -469,7 +263,7 @@ def _write_participants(parent: _Element, participants: tuple[Participant, ...])
 _APPLICATION_TYPES = {"Script", "Xslt", "Form"}  # the XPDL 2.1 types with no required content
 
 
-def _write_applications(parent: _Element, applications: tuple[Application, ...]) -> None:
+def _write_applications(parent: etree._Element, applications: tuple[Application, ...]) -> None:
     if not applications:
         return
     container = _sub(parent, "Applications")
@@ -493,7 +287,7 @@ def _flatten_lanes(lanes: tuple[Lane, ...]) -> list[Lane]:
     return out
 
 
-def _write_pools(parent: _Element, pools: tuple[Pool, ...]) -> None:
+def _write_pools(parent: etree._Element, pools: tuple[Pool, ...]) -> None:
     if not pools:
         return
     container = _sub(parent, "Pools")
@@ -541,7 +335,7 @@ def _nmtoken(text: str) -> str:
     return _NMTOKEN_BAD.sub("_", text) or "_"
 
 
-def _write_trigger_detail(parent: _Element, trigger: Trigger, name: str) -> None:
+def _write_trigger_detail(parent: etree._Element, trigger: Trigger, name: str) -> None:
     """The trigger's child element (message, timer, condition…), when it has one."""
     kind = trigger.kind
     catch_throw = "CATCH" if trigger.catching else "THROW"
@@ -578,7 +372,7 @@ def _write_trigger_detail(parent: _Element, trigger: Trigger, name: str) -> None
         _sub(parent, "TriggerResultCancel")
 
 
-def _write_event(parent: _Element, event: Event) -> None:
+def _write_event(parent: etree._Element, event: Event) -> None:
     container = _sub(parent, "Event")
     trigger = event.trigger
     name = _TRIGGER_NAMES[trigger.kind]
@@ -605,7 +399,7 @@ _TASK_ELEMENTS = {
 _IMPLEMENTATIONS = {"WebService", "Other", "Unspecified"}
 
 
-def _write_task(parent: _Element, task: Task, script_language: str | None) -> None:
+def _write_task(parent: etree._Element, task: Task, script_language: str | None) -> None:
     implementation = _sub(parent, "Implementation")
     if task.kind is TaskKind.APPLICATION:
         if len(task.applications) > 1:
@@ -651,7 +445,7 @@ def _write_task(parent: _Element, task: Task, script_language: str | None) -> No
         _sub(element, "MessageIn", Id=_nmtoken(task.message), Name=task.message)
 
 
-def _write_body(parent: _Element, activity: Activity, script_language: str | None) -> None:
+def _write_body(parent: etree._Element, activity: Activity, script_language: str | None) -> None:
     body = activity.body
     if isinstance(body, Route):
         attrs = {"GatewayType": _GATEWAY[body.gateway]}
@@ -677,7 +471,7 @@ def _write_body(parent: _Element, activity: Activity, script_language: str | Non
         raise TypeError(f"cannot write activity body {body!r}")
 
 
-def _write_activity(parent: _Element, activity: Activity, script_language: str | None) -> None:
+def _write_activity(parent: etree._Element, activity: Activity, script_language: str | None) -> None:
     element = _sub(parent, "Activity", Id=activity.id, Name=activity.name)
     if activity.start_mode.value != "Automatic":
         element.set("StartMode", activity.start_mode.value)
@@ -714,7 +508,7 @@ def _write_activity(parent: _Element, activity: Activity, script_language: str |
     generated = activity_directive_attributes(activity.directives)
     if activity.coordination is not None:
         generated.append(builtin_attribute(activity.coordination))
-    _write_extended(element, _merged(activity.extended_attributes, generated))
+    _write_extended(element, merged_attributes(activity.extended_attributes, generated))
     if activity.loop is not None:
         loop = activity.loop
         condition = loop.condition_text
@@ -742,7 +536,7 @@ def _condition_text(condition: Condition) -> str | None:
     return condition.exception_name
 
 
-def _write_transitions(parent: _Element, transitions: tuple[Transition, ...]) -> None:
+def _write_transitions(parent: etree._Element, transitions: tuple[Transition, ...]) -> None:
     if not transitions:
         return
     container = _sub(parent, "Transitions")
@@ -766,7 +560,7 @@ def _write_transitions(parent: _Element, transitions: tuple[Transition, ...]) ->
         _write_assignments(element, transition.assignments)
 
 
-def _write_activities(parent: _Element, activities: tuple[Activity, ...],
+def _write_activities(parent: etree._Element, activities: tuple[Activity, ...],
                       script_language: str | None) -> None:
     if not activities:
         return
@@ -775,7 +569,7 @@ def _write_activities(parent: _Element, activities: tuple[Activity, ...],
         _write_activity(container, activity, script_language)
 
 
-def _write_activity_sets(parent: _Element, sets: tuple[ActivitySet, ...],
+def _write_activity_sets(parent: etree._Element, sets: tuple[ActivitySet, ...],
                          script_language: str | None) -> None:
     if not sets:
         return
@@ -787,7 +581,7 @@ def _write_activity_sets(parent: _Element, sets: tuple[ActivitySet, ...],
         _write_transitions(element, activity_set.transitions)
 
 
-def _write_process(parent: _Element, process: WorkflowProcess, package: Package) -> None:
+def _write_process(parent: etree._Element, process: WorkflowProcess, package: Package) -> None:
     element = _sub(parent, "WorkflowProcess", Id=process.id, Name=process.name,
                    AccessLevel=process.access_level)
     header = process.header
@@ -814,7 +608,7 @@ def _write_process(parent: _Element, process: WorkflowProcess, package: Package)
     _write_activity_sets(element, process.activity_sets, package.script_language)
     _write_activities(element, process.activities, package.script_language)
     _write_transitions(element, process.transitions)
-    _write_extended(element, _merged(process.extended_attributes,
+    _write_extended(element, merged_attributes(process.extended_attributes,
                                      process_directive_attributes(process.directives)))
     _write_assignments(element, process.assignments)
 
@@ -822,9 +616,9 @@ def _write_process(parent: _Element, process: WorkflowProcess, package: Package)
 # --------------------------------------------------------------------------- package
 
 
-def build_tree(package: Package) -> _Element:
+def build_tree(package: Package) -> etree._Element:
     """The ``Package`` element of ``package`` (for callers that post-process the tree)."""
-    root = etree.Element(_q("Package"), nsmap=_NSMAP)  # type: ignore[arg-type]
+    root = etree.Element(_q("Package"), nsmap=_NSMAP)
     root.set("Id", package.id)
     if package.name is not None:
         root.set("Name", package.name)
@@ -862,12 +656,12 @@ def build_tree(package: Package) -> _Element:
         container = _sub(root, "WorkflowProcesses")
         for process in package.processes:
             _write_process(container, process, package)
-    _write_extended(root, _merged(package.extended_attributes,
+    _write_extended(root, merged_attributes(package.extended_attributes,
                                   package_directive_attributes(package)))
     return root
 
 
-def _write_type_declaration(parent: _Element, declaration: TypeDeclaration) -> None:
+def _write_type_declaration(parent: etree._Element, declaration: TypeDeclaration) -> None:
     element = _sub(parent, "TypeDeclaration", Id=declaration.id, Name=declaration.name)
     _write_data_type(element, declaration.type)
     if declaration.description is not None:

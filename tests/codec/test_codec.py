@@ -60,9 +60,9 @@ from opspec.model import (
     Unary,
     WorkflowMode,
     WorkflowProcess,
+    codec,
 )
 from opspec.model import Mode as ActivityMode
-from opspec.model import codec
 
 
 def _reachable_dataclasses() -> set[type]:

@@ -3,9 +3,8 @@
 from __future__ import annotations
 
 import pytest
-from lxml import etree
-
 from builtin_models import SCHEMA_PATH
+from lxml import etree
 
 
 @pytest.fixture(scope="session")

@@ -9,9 +9,9 @@ from pathlib import Path
 from typing import Any
 
 import pytest
+from builtin_models import BUILTINS, DATA, builtin_package, schema_errors, without_locations
 from lxml import etree
 
-from builtin_models import BUILTINS, DATA, builtin_package, schema_errors, without_locations
 from opspec.engine.conditions import evaluate, evaluate_condition
 from opspec.errors import Severity
 from opspec.model import (
@@ -170,7 +170,7 @@ def test_generated_ids_never_clash_with_existing_ones() -> None:
 def test_the_arbiter_passes_the_highest_priority_input_that_has_a_command(
     avoid: str | None, wander: str, expected: str | None
 ) -> None:
-    activity, activity_set = _expanded("arbiter")
+    _, activity_set = _expanded("arbiter")
     data = {"avoid_cmd": avoid, "wander_cmd": wander, "motor_cmd": "stale"}
     _run(activity_set, activity_set.activities[0].id, data)
     assert data["motor_cmd"] == expected
@@ -189,7 +189,7 @@ def test_the_arbiter_passes_the_highest_priority_input_that_has_a_command(
 def test_the_voter_outputs_the_option_with_most_votes_ties_by_option_order(
     votes: tuple[str | None, ...], expected: str | None
 ) -> None:
-    activity, activity_set = _expanded("voter")
+    _, activity_set = _expanded("voter")
     data: dict[str, Any] = {"vote_a": votes[0], "vote_b": votes[1], "vote_c": votes[2],
                             "motor_cmd": ""}
     _run(activity_set, activity_set.activities[0].id, data)
@@ -204,7 +204,7 @@ def test_the_voter_tallies_are_new_integer_data_fields_of_the_process() -> None:
 
 
 def test_superposition_assigns_the_weighted_sum_in_one_activity() -> None:
-    activity, activity_set = _expanded("superposition")
+    _, activity_set = _expanded("superposition")
     assert len(activity_set.activities) == 1
     data = {"v_avoid": 1.0, "v_goal": 2.0, "v": 0.0}
     _run(activity_set, activity_set.activities[0].id, data)
@@ -224,7 +224,7 @@ def test_data_exchange_and_mode_change_call_the_opspec_application(
     key: str, application: str, parameters: list[str]
 ) -> None:
     result = preprocess(builtin_package((key,)))
-    activity, activity_set = _compound(_process(result.package, key))
+    _, activity_set = _compound(_process(result.package, key))
     (task_activity,) = activity_set.activities
     assert isinstance(task_activity.body, Task)
     (call,) = task_activity.body.applications
@@ -331,7 +331,7 @@ def test_the_documented_example_preprocesses_to_valid_xpdl_that_loads_cleanly(
     import re
 
     docs = Path(__file__).resolve().parents[2] / "docs" / "sisarl-xpdl.md"
-    (example,) = [b for b in re.findall(r"```xml\n(.*?)```", docs.read_text(), re.S)
+    (example,) = [b for b in re.findall(r"```xml\n(.*?)```", docs.read_text(), re.DOTALL)
                   if "<Package" in b]
     source = tmp_path / "example.xpdl"
     source.write_text(example)

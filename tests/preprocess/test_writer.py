@@ -7,9 +7,9 @@ import dataclasses
 from pathlib import Path
 
 import pytest
+from builtin_models import builtin_package, schema_errors, without_locations
 from lxml import etree
 
-from builtin_models import builtin_package, schema_errors, without_locations
 from opspec.model import (
     Distribution,
     ExtendedAttribute,
