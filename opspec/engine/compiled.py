@@ -144,6 +144,8 @@ class CompiledActivity:
     interrupting: bool = True
     upstream: frozenset[int] = frozenset()  # OR joins: activities that can reach this one
     fast: bool = False                       # instantaneous without any wait (no ActInst)
+    plain: bool = False                      # waits, but without deadline/loop/trigger/boundary
+    next: int = -1                           # the one unconditional successor, if that is all
 
     def where(self) -> str:
         return str(self.location) if self.location is not None else "<built in Python>"
@@ -359,7 +361,7 @@ class _Compiler:
                 acts[i].attached_to = host
                 acts[i].interrupting = body.trigger.interrupting
                 acts[host].boundary = (*acts[host].boundary, i)
-                acts[host].fast = False
+                acts[host].fast = acts[host].plain = False
         if start is not None:
             if start not in by_id:
                 raise _spec_error(f"start activity {start!r} is not in {name!r}", None)
@@ -367,6 +369,12 @@ class _Compiler:
         else:
             graph.starts = tuple(i for i in range(len(activities))
                                  if not incoming[i] and acts[i].attached_to < 0)
+            if activities and not graph.starts:
+                raise _spec_error(
+                    f"{name!r} has no start activity: every activity has an incoming "
+                    f"transition", proc.location,
+                    "add a start event (or an activity without incoming transitions) in "
+                    "front of the cycle")
         graph.activities = tuple(acts)
         # OR joins need to know what can still reach them
         predecessors: dict[int, set[int]] = {i: set() for i in range(len(acts))}
@@ -525,9 +533,10 @@ class _Compiler:
             ca.loop = (cond, act.loop.maximum, act.loop.test_before)
         # instantaneous under the dedicated model (tasks: unless a callable is bound to the
         # application at run time; general activities: unless the pooled model queues them)
-        ca.fast = (ca.kind in (K_NOOP, K_THROW, K_TASK) and not ca.deadlines
-                   and ca.loop is None and ca.sampler is None and ca.cpu == 0.0
-                   and ca.start_trigger is None and ca.end_trigger is None and not ca.boundary)
+        ca.plain = (not ca.deadlines and ca.loop is None and ca.sampler is None
+                    and ca.cpu == 0.0 and ca.start_trigger is None and ca.end_trigger is None
+                    and not ca.boundary)
+        ca.fast = ca.plain and ca.kind in (K_NOOP, K_THROW, K_TASK, K_ASYNC)
 
     def finish_choices(self, graph: CompiledGraph) -> None:
         """Deferred choice on an XOR split: all unconditional branches go to manual
@@ -545,7 +554,11 @@ class _Compiler:
             if all(t.kind == K_MANUAL for t in targets) and len(
                     {(t.participant, t.lanes) for t in targets}) == 1:
                 ca.choice = tuple(branches)
-                ca.fast = False
+        for ca in acts:
+            only = ca.out[0] if len(ca.out) == 1 else None
+            if (only is not None and only.kind == T_NONE and not only.assignments
+                    and not ca.otherwise and not ca.choice and not ca.terminate):
+                ca.next = only.target
 
     def params(self, actuals: tuple[Any, ...], formals: tuple[Any, ...], act: Activity,
                what: str) -> tuple[tuple[ParameterMode, str, Evaluator | None, str | None], ...]:

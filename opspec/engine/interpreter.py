@@ -116,13 +116,15 @@ class Interpreter:
                                       self._after_cpu, _alive) if config.pooled else None)
         self.raised_names: set[str] = set()
         self.mode = compiled.initial_mode
-        # trace
-        self._listeners = list(listeners)
+        # trace: listeners with a ``raw`` method get the fields without a TraceEvent object
+        self._listeners = [lst for lst in listeners if getattr(lst, "raw", None) is None]
+        self._raw = [lst.raw for lst in listeners  # type: ignore[attr-defined]
+                     if getattr(lst, "raw", None) is not None]
         self._seq = 0
         self._pkg = compiled.id
         self._all = False
         selectors: set[tuple[str, str | None, str | None]] = set()
-        for listener in self._listeners:
+        for listener in listeners:
             wanted = getattr(listener, "selects", None)
             if wanted is None:
                 self._all = True
@@ -130,6 +132,8 @@ class Interpreter:
             selectors.update(wanted)
         self._want = (frozenset() if self._all or not selectors
                       else compiled.expand_selectors(frozenset(selectors)))
+        self._aflags = _Flags(self, _ACT_KINDS)      # CompiledActivity -> wanted-kind bits
+        self._pflags = _Flags(self, _PROC_KINDS)     # process id -> wanted-kind bits
 
     # ------------------------------------------------------------------ trace
     def wants(self, kind: str, process: str | None, activity: str | None) -> bool:
@@ -140,10 +144,14 @@ class Interpreter:
              participant: str | None = None, data: Mapping[str, Any] | None = None) -> None:
         """Send one trace event to every listener (callers check :meth:`wants` first)."""
         self._seq += 1
-        event = TraceEvent(self.env.now, kind, process, instance, activity, lane, participant,
-                           self._pkg, data if data is not None else _EMPTY, self._seq)
-        for listener in self._listeners:
-            listener(event)
+        now = self.env._now
+        for raw in self._raw:
+            raw(now, kind, process, instance, activity, data)
+        if self._listeners:
+            event = TraceEvent(now, kind, process, instance, activity, lane, participant,
+                               self._pkg, data if data is not None else _EMPTY, self._seq)
+            for listener in self._listeners:
+                listener(event)
 
     def _emit_act(self, kind: str, inst: ProcessInstance, act: CompiledActivity,
                   data: Mapping[str, Any] | None = None) -> None:
@@ -197,7 +205,7 @@ class Interpreter:
 
     def _align(self, delay: float) -> float:
         res = self._resolution
-        now = self.env.now
+        now = self.env._now
         target = -(-(now + delay) // res) * res
         return max(0.0, target - now)
 
@@ -226,12 +234,12 @@ class Interpreter:
         if parent is not None:
             root = parent.frame.inst.root
             priority = max(priority, parent.frame.inst.priority)
-        inst = ProcessInstance(iid, proc, local, scope, priority, parent, root, self.env.now)
+        inst = ProcessInstance(iid, proc, local, scope, priority, parent, root, self.env._now)
         inst.state = RUNNING
         inst.trigger = trigger
         self.live[iid] = inst
         self.counts["started"] += 1
-        if self._all or (EK.PROCESS_STARTED, proc.id, None) in self._want:
+        if self._pflags[proc.id] & 1:
             self.emit(EK.PROCESS_STARTED, proc.id, iid, None, proc.lane, None,
                       {"trigger": trigger, "parent": parent.frame.inst.id if parent else None})
         frame = Frame(proc.graph, inst, None)
@@ -267,9 +275,9 @@ class Interpreter:
         self.live.pop(inst.id, None)
         self.counts["completed"] += 1
         proc = inst.process
-        if self._all or (EK.PROCESS_COMPLETED, proc.id, None) in self._want:
+        if self._pflags[proc.id] & 2:
             self.emit(EK.PROCESS_COMPLETED, proc.id, inst.id, None, proc.lane, None,
-                      {"duration": self.env.now - inst.started_at})
+                      {"duration": self.env._now - inst.started_at})
         parent = inst.parent
         if parent is not None and parent.state == RUNNING:
             parent.child = None
@@ -308,8 +316,8 @@ class Interpreter:
             str(inst.process.location) if inst.process.location else "<built in Python>")
         what = f"activity {act.id!r} of " if act is not None else ""
         text = (f"{where}: {what}process {inst.process.id!r} (instance {inst.id}) aborted at "
-                f"t={self.env.now:.3f} s: {message}")
-        self.faults.append({"time": self.env.now, "process": inst.process.id,
+                f"t={self.env._now:.3f} s: {message}")
+        self.faults.append({"time": self.env._now, "process": inst.process.id,
                             "instance": inst.id, "activity": act.id if act else None,
                             "message": text})
         self.end_instance(inst, ABORTED, text)
@@ -408,8 +416,8 @@ class Interpreter:
         """Record a deadlock of ``inst`` (trace + summary) and abort it."""
         proc = inst.process
         text = (f"deadlock in process {proc.id!r} (instance {inst.id}) at "
-                f"t={self.env.now:.3f} s: {why}; waiting: {', '.join(waiting) or '-'}")
-        self.deadlocks.append({"time": self.env.now, "process": proc.id, "instance": inst.id,
+                f"t={self.env._now:.3f} s: {why}; waiting: {', '.join(waiting) or '-'}")
+        self.deadlocks.append({"time": self.env._now, "process": proc.id, "instance": inst.id,
                                "waiting": waiting, "message": text})
         if self.wants(EK.DEADLOCK, proc.id, None):
             self.emit(EK.DEADLOCK, proc.id, inst.id, None, proc.lane, None,
@@ -417,20 +425,54 @@ class Interpreter:
         self.end_instance(inst, ABORTED, text)
 
     # ------------------------------------------------------------------ activities
-    def _start(self, frame: Frame, act: CompiledActivity) -> None:
-        if act.fast and not (act.general and self._pooled) and (
-                act.kind != K_TASK or act.application not in self._apps):
+    def _start(self, frame: Frame, act: CompiledActivity | None) -> None:
+        """Start ``act``. Instantaneous activities run here, in a loop that carries the
+        token straight on to the next activity (no queue round trip) as long as the next
+        one has no AND/OR join to synchronise at."""
+        pooled = self._pooled
+        apps = self._apps
+        while act is not None:
+            if not act.fast or (act.general and pooled) or (
+                    act.kind == K_TASK and act.application in apps):
+                self._start_slow(frame, act)
+                return
             inst = frame.inst
-            if self._all or (EK.ACTIVITY_STARTED, act.process, act.id) in self._want:
+            if self._aflags[act] & 1:
                 self.emit(EK.ACTIVITY_STARTED, act.process, inst.id, act.id, act.lane,
                           act.participant)
             if act.start_assign and not self._assign(inst, act, act.start_assign):
                 return
-            self._finish(frame, act)
-            return
-        ai = ActivityInstance(next(self._keys), act, frame, self.env.now)
+            if act.kind == K_ASYNC:
+                data = self._params_in(inst, act)
+                if data is None:
+                    return
+                self.start_process(self.processes[act.subflow],  # type: ignore[index]
+                                   data, trigger=f"subflow:{act.id}")
+            act = self._done_next(frame, act)
+
+    def _params_in(self, inst: ProcessInstance, act: CompiledActivity
+                   ) -> dict[str, Any] | None:
+        now = self.env._now
+        try:
+            return {formal: (fn(inst.scope, now) if fn is not None else None)
+                    for _mode, formal, fn, _target in act.params}
+        except OpspecError as error:
+            self.abort(inst, act, f"an actual parameter failed: {error.message}")
+            return None
+
+    def _start_slow(self, frame: Frame, act: CompiledActivity) -> None:
+        ai = ActivityInstance(next(self._keys), act, frame, self.env._now)
         ai.state = RUNNING
         frame.running[ai.key] = ai
+        if act.plain and not (act.general and self._pooled):
+            inst = frame.inst
+            if self._aflags[act] & 1:
+                self.emit(EK.ACTIVITY_STARTED, act.process, inst.id, act.id, act.lane,
+                          act.participant)
+            if act.start_assign and not self._assign(inst, act, act.start_assign):
+                return
+            self._body(ai)
+            return
         if act.start_trigger is not None:
             ai.waiting = f"start trigger {act.start_trigger.kind}:{act.start_trigger.name}"
             self._wait_trigger(ai, act.start_trigger, self._activate_cb, None)
@@ -448,7 +490,7 @@ class Interpreter:
         self._emit_act(EK.ACTIVITY_STARTED, inst, act)
         if act.start_assign and not self._assign(inst, act, act.start_assign):
             return
-        now = self.env.now
+        now = self.env._now
         for seconds, synchronous, exception in act.deadlines:
             try:
                 delay = float(seconds(inst.scope, now))
@@ -472,7 +514,7 @@ class Interpreter:
         if cond is None:
             return maximum is not None
         inst = ai.frame.inst
-        return bool(cond(inst.scope, self.env.now))
+        return bool(cond(inst.scope, self.env._now))
 
     def _run_body(self, ai: ActivityInstance, _a: Any = None, _b: Any = None) -> None:
         if ai.state != RUNNING:
@@ -567,7 +609,8 @@ class Interpreter:
         elif kind == K_GATEWAY:
             self._offer_choice(ai, act.out)
         else:                                       # noop, throw, task without a callable
-            self._body_done(ai, None)
+            # queued, not called: a chain of such activities must not grow the stack
+            self._ready.append((self._body_done, ai, None, None))
 
     def _body_done(self, ai: ActivityInstance, data: Mapping[str, Any] | None,
                    _unused: Any = None) -> None:
@@ -604,13 +647,24 @@ class Interpreter:
         self._finish(frame, ai.act)
 
     def _finish(self, frame: Frame, act: CompiledActivity) -> None:
-        """Completion of ``act``: end assignments, throw/raise, trace, then the split."""
+        """Completion of ``act``, then on to what follows it."""
+        nxt = self._done_next(frame, act)
+        if nxt is not None:
+            self._start(frame, nxt)
+
+    def _done_next(self, frame: Frame, act: CompiledActivity) -> CompiledActivity | None:
+        """Complete ``act`` (end assignments, throw/raise, trace) and take its split.
+
+        Returns the activity the token moves on to when it can be started right away (an
+        XOR split or a single transition into an activity without AND/OR join); otherwise
+        the token has been queued, parked or has ended, and ``None`` is returned.
+        """
         inst = frame.inst
         if act.end_assign and not self._assign(inst, act, act.end_assign):
-            return
+            return None
         if act.kind == K_THROW and act.trigger is not None:
             self.broadcast(act.trigger.kind, act.trigger.name or "", None, inst, act)
-        if self._all or (EK.ACTIVITY_COMPLETED, act.process, act.id) in self._want:
+        if self._aflags[act] & 2:
             self.emit(EK.ACTIVITY_COMPLETED, act.process, inst.id, act.id, act.lane,
                       act.participant)
         if act.raises is not None:
@@ -621,12 +675,49 @@ class Interpreter:
             if parent is not None and parent.state == RUNNING:
                 parent.child = None
                 self._body_done(parent, None)
-            return
-        self._leave(frame, act)
+            return None
+        if inst.state != RUNNING:
+            return None
+        acts = frame.graph.activities
+        nxt = act.next
+        if nxt >= 0:
+            target = acts[nxt]
+            if not target.join:
+                return target
+            trans = act.out[0]
+        elif act.split == S_XOR and not act.choice and (act.out or act.otherwise):
+            scope = inst.scope
+            now = self.env._now
+            try:
+                for trans in act.out:
+                    cond = trans.condition
+                    if cond is None or cond(scope, now):
+                        break
+                else:
+                    if not act.otherwise:
+                        self.abort(inst, act, "no outgoing transition can be taken (no "
+                                   "condition holds and there is no OTHERWISE transition)")
+                        return None
+                    trans = act.otherwise[0]
+            except OpspecError as error:
+                self.abort(inst, act, f"a transition condition failed: {error.message}")
+                return None
+            target = acts[trans.target]
+            if not target.join:
+                if trans.assignments:
+                    for target_name, fn in trans.assignments:
+                        self._set(inst, None, target_name, fn(scope, now))
+                return target
+        else:
+            self._leave(frame, act)
+            return None
+        self._take(frame, trans)
+        self._token_gone(frame)
+        return None
 
     def _leave(self, frame: Frame, act: CompiledActivity) -> None:
         if act.choice:
-            ai = ActivityInstance(next(self._keys), act, frame, self.env.now)
+            ai = ActivityInstance(next(self._keys), act, frame, self.env._now)
             ai.state = RUNNING
             frame.running[ai.key] = ai
             self._offer_choice(ai, act.choice)
@@ -635,7 +726,7 @@ class Interpreter:
         if outs or act.otherwise:
             inst = frame.inst
             scope = inst.scope
-            now = self.env.now
+            now = self.env._now
             taken = False
             try:
                 if act.split == S_XOR:
@@ -665,7 +756,7 @@ class Interpreter:
     def _take(self, frame: Frame, trans: CTransition, performed: bool = False) -> None:
         if trans.assignments:
             inst = frame.inst
-            now = self.env.now
+            now = self.env._now
             for target, fn in trans.assignments:
                 self._set(inst, None, target, fn(inst.scope, now))
         frame.live += 1
@@ -702,7 +793,7 @@ class Interpreter:
 
     def _assign(self, inst: ProcessInstance, act: CompiledActivity,
                 assignments: tuple[tuple[str, Any], ...]) -> bool:
-        now = self.env.now
+        now = self.env._now
         try:
             for target, fn in assignments:
                 self._set(inst, act, target, fn(inst.scope, now))
@@ -713,7 +804,7 @@ class Interpreter:
 
     def _inputs(self, ai: ActivityInstance) -> dict[str, Any] | None:
         inst = ai.frame.inst
-        now = self.env.now
+        now = self.env._now
         out: dict[str, Any] = {}
         try:
             for mode, formal, fn, _target in ai.act.params:
@@ -739,18 +830,18 @@ class Interpreter:
         elif kind in ("timer", "period"):
             inst = ai.frame.inst
             if trig.seconds is not None:
-                delay = float(trig.seconds(inst.scope, self.env.now))
+                delay = float(trig.seconds(inst.scope, self.env._now))
             else:
                 delay = trig.offset or (trig.every or 0.0)
             self._later(delay, lambda a, _x: handler(a, arg, None), ai)
         elif kind == "rule":
             assert trig.condition is not None
             inst = ai.frame.inst
-            if trig.condition(inst.scope, self.env.now):
+            if trig.condition(inst.scope, self.env._now):
                 handler(ai, arg, None)
                 return
             rkey = next(self._rule_keys)
-            self._rules[rkey] = (lambda: trig.condition(inst.scope, self.env.now),  # type: ignore[misc]
+            self._rules[rkey] = (lambda: trig.condition(inst.scope, self.env._now),  # type: ignore[misc]
                                  lambda: handler(ai, arg, None), ai)
             ai.cleanup.append(lambda: self._rules.pop(rkey, None))
 
@@ -922,14 +1013,14 @@ class Interpreter:
         act = ai.act
         inst = ai.frame.inst
         item = WorkItem(ai.key, act.process, inst.id, act.id, act.label, act.participant,
-                        act.lane, self.env.now, act.application,
+                        act.lane, self.env._now, act.application,
                         data if data is not None else MappingProxyType(inst.data), choices,
                         inst.root, duration)
         ai.item = item
         ai.performer = performer
         ai.waiting = "performer"
         self._offers[ai.key] = ai
-        if self._all or (EK.ACTIVITY_OFFERED, act.process, act.id) in self._want:
+        if self._aflags[act] & 4:
             self.emit(EK.ACTIVITY_OFFERED, act.process, inst.id, act.id, act.lane,
                       act.participant, {"choices": list(choices)} if choices else None)
         performer.offer(item)
@@ -1010,7 +1101,7 @@ class Interpreter:
                     raise ExecutionError(
                         f"work item {item.key} ({item.activity}) needs a choice among "
                         f"{', '.join(item.choices)}, got {choice!r}",
-                        hint="call complete(item, choice=ACTIVITY_ID)", sim_time=self.env.now)
+                        hint="call complete(item, choice=ACTIVITY_ID)", sim_time=self.env._now)
             self._ready.append((self._choose, ai, trans, data))
         else:
             if data and ai.act.params:
@@ -1141,6 +1232,33 @@ class Interpreter:
 
     def arm_process(self, proc: CompiledProcess) -> None:   # pragma: no cover - overridden
         raise NotImplementedError
+
+
+_ACT_KINDS = (EK.ACTIVITY_STARTED, EK.ACTIVITY_COMPLETED, EK.ACTIVITY_OFFERED)
+_PROC_KINDS = (EK.PROCESS_STARTED, EK.PROCESS_COMPLETED)
+
+
+class _Flags(dict[Any, int]):
+    """Which of ``kinds`` some listener wants, as bits, per activity or process id;
+    computed on first use (a hit is a plain dict lookup: cheaper than building a key)."""
+
+    def __init__(self, interp: Interpreter, kinds: tuple[str, ...]) -> None:
+        super().__init__()
+        self._interp = interp
+        self._kinds = kinds
+
+    def __missing__(self, key: Any) -> int:
+        interp = self._interp
+        if isinstance(key, str):
+            process, activity = key, None
+        else:
+            process, activity = key.process, key.id
+        bits = 0
+        for n, kind in enumerate(self._kinds):
+            if interp.wants(kind, process, activity):
+                bits |= 1 << n
+        self[key] = bits
+        return bits
 
 
 def _alive(ai: ActivityInstance) -> bool:

@@ -1,9 +1,8 @@
 """Declared metrics computed incrementally from the trace, as a trace listener.
 
 - COUNT: the number of events matching ``select``: ``{"kind": "count", "total": N}``.
-- DURATION: per process instance (the *root* instance, so a subflow's events count for the
-  workflow that called it), seconds from the ``first`` (or ``last``) event matching
-  ``start`` to the next event matching ``end``; one sample per instance:
+- DURATION: per process instance, seconds from the ``first`` (or ``last``) event matching
+  ``start`` to the next event matching ``end`` of the same instance; one sample per pair:
   ``{"kind": "duration", "n", "mean", "p95", "min", "max"}`` (``None`` values when n = 0).
 - RATIO: numerator metric / denominator metric (their totals or means):
   ``{"kind": "ratio", "value": x}`` (``None`` when the denominator is 0).
@@ -14,19 +13,13 @@ The output shape is shared with ``opspec evaluate --json``.
 from __future__ import annotations
 
 import math
-from collections.abc import Iterable
+from collections.abc import Iterable, Mapping
 from typing import Any
 
 from opspec.engine.trace import TraceEvent
 from opspec.model import EventSelector, MetricDefinition, MetricKind
 
 __all__ = ["MetricsListener", "percentile", "summarise_durations"]
-
-
-def _matches(selector: EventSelector, event: TraceEvent) -> bool:
-    return (selector.event == event.kind
-            and (selector.process is None or selector.process == event.process)
-            and (selector.activity is None or selector.activity == event.activity))
 
 
 def percentile(values: list[float], q: float) -> float:
@@ -52,8 +45,7 @@ class MetricsListener:
     """Computes ``definitions`` from the events it receives.
 
     ``selects`` tells the simulation which events it needs, so events nobody needs are
-    never built. Instances are identified by ``(root instance)``: the instance id of the
-    event, mapped to the root through ``process.started`` events' ``parent`` field.
+    never built.
     """
 
     def __init__(self, definitions: Iterable[MetricDefinition]) -> None:
@@ -61,9 +53,8 @@ class MetricsListener:
         self.counts: dict[str, int] = {}
         self.samples: dict[str, list[float]] = {}
         self._open: dict[str, dict[int, float]] = {}
-        self._root: dict[int, int] = {}
-        self._by_kind: dict[str, list[tuple[MetricDefinition, str]]] = {}
-        selects: set[tuple[str, str | None, str | None]] = {("process.started", None, None)}
+        self._by_kind: dict[str, list[tuple[MetricDefinition, str, EventSelector]]] = {}
+        selects: set[tuple[str, str | None, str | None]] = set()
         for metric in self.definitions:
             if metric.kind is MetricKind.COUNT and metric.select is not None:
                 self.counts[metric.name] = 0
@@ -77,33 +68,34 @@ class MetricsListener:
 
     def _add(self, metric: MetricDefinition, selector: EventSelector, role: str,
              selects: set[tuple[str, str | None, str | None]]) -> None:
-        self._by_kind.setdefault(selector.event, []).append((metric, role))
+        self._by_kind.setdefault(selector.event, []).append((metric, role, selector))
         selects.add((selector.event, selector.process, selector.activity))
 
     def __call__(self, event: TraceEvent) -> None:
-        kind = event.kind
-        if kind == "process.started" and event.instance is not None:
-            parent = event.data.get("parent")
-            self._root[event.instance] = (self._root.get(parent, parent)
-                                          if parent is not None else event.instance)
+        self.raw(event.time, event.kind, event.process, event.instance, event.activity,
+                 event.data)
+
+    def raw(self, time: float, kind: str, process: str | None, instance: int | None,
+            activity: str | None, data: Mapping[str, Any] | None = None) -> None:
+        """The same as calling with a TraceEvent, without building one (the engine uses
+        this when no other listener needs the event object)."""
         interested = self._by_kind.get(kind)
         if not interested:
             return
-        for metric, role in interested:
+        for metric, role, selector in interested:
+            if not ((selector.process is None or selector.process == process)
+                    and (selector.activity is None or selector.activity == activity)):
+                continue
             if role == "count":
-                if _matches(metric.select, event):  # type: ignore[arg-type]
-                    self.counts[metric.name] += 1
+                self.counts[metric.name] += 1
                 continue
-            selector = metric.start if role == "start" else metric.end
-            if not _matches(selector, event):  # type: ignore[arg-type]
-                continue
-            root = self._root.get(event.instance or 0, event.instance or 0)
+            key = instance or 0
             pending = self._open[metric.name]
             if role == "start":
-                if selector.which == "last" or root not in pending:  # type: ignore[union-attr]
-                    pending[root] = event.time
-            elif root in pending:
-                self.samples[metric.name].append(event.time - pending.pop(root))
+                if selector.which == "last" or key not in pending:
+                    pending[key] = time
+            elif key in pending:
+                self.samples[metric.name].append(time - pending.pop(key))
 
     def values(self) -> dict[str, dict[str, Any]]:
         """Every declared metric in the shared output shape."""

@@ -1,0 +1,63 @@
+"""Fixtures and trace predicates for the engine tests (models are built in builders.py)."""
+
+from __future__ import annotations
+
+import sys
+from collections.abc import Iterable, Mapping
+from pathlib import Path
+from typing import Any
+
+import pytest
+
+sys.path.insert(0, str(Path(__file__).parent))
+
+from opspec.engine.config import EngineConfig  # noqa: E402
+from opspec.engine.simulation import RunResult, Simulation  # noqa: E402
+from opspec.engine.trace import TraceEvent  # noqa: E402
+from opspec.model import Package  # noqa: E402
+
+MODELS = {
+    "dedicated": EngineConfig(),
+    "pooled": EngineConfig(processor_model="pooled", workers=2, switch_cost=0.001),
+}
+
+
+@pytest.fixture(params=list(MODELS), ids=list(MODELS))
+def config(request: pytest.FixtureRequest) -> EngineConfig:
+    """Each pattern test runs under both processor models."""
+    return MODELS[request.param]
+
+
+def run(package: Package, *, performers: Mapping[str, Any] | None = None,
+        config: EngineConfig | None = None, until: float | None = None, seed: int = 0,
+        **kwargs: Any) -> RunResult:
+    sim = Simulation(package, config, performers=performers, seed=seed, keep_trace=True,
+                     **kwargs)
+    return sim.run(until=until)
+
+
+def events(result: RunResult, kind: str | None = None, process: str | None = None,
+           activity: str | None = None) -> list[TraceEvent]:
+    assert result.trace is not None
+    return [e for e in result.trace
+            if (kind is None or e.kind == kind) and (process is None or e.process == process)
+            and (activity is None or e.activity == activity)]
+
+
+def completed(result: RunResult, process: str | None = None) -> list[str]:
+    """Ids of completed activities in trace order."""
+    return [e.activity for e in events(result, "activity.completed", process)
+            if e.activity is not None]
+
+
+def times(result: RunResult, kind: str, activity: str) -> list[float]:
+    return [e.time for e in events(result, kind, activity=activity)]
+
+
+def kinds(result: RunResult) -> list[str]:
+    return [e.kind for e in result.trace or ()]
+
+
+def before(order: Iterable[str], first: str, second: str) -> bool:
+    items = list(order)
+    return items.index(first) < items.index(second)
