@@ -454,8 +454,8 @@ class Interpreter:
                    ) -> dict[str, Any] | None:
         now = self.env._now
         try:
-            return {formal: (fn(inst.scope, now) if fn is not None else None)
-                    for _mode, formal, fn, _target in act.params}
+            return {formal: fn(inst.scope, now)
+                    for _mode, formal, fn, _target in act.params if fn is not None}
         except OpspecError as error:
             self.abort(inst, act, f"an actual parameter failed: {error.message}")
             return None
@@ -807,8 +807,9 @@ class Interpreter:
         now = self.env._now
         out: dict[str, Any] = {}
         try:
-            for mode, formal, fn, _target in ai.act.params:
-                out[formal] = fn(inst.scope, now) if fn is not None else None
+            for _mode, formal, fn, _target in ai.act.params:
+                if fn is not None:                  # OUT parameters carry nothing in
+                    out[formal] = fn(inst.scope, now)
         except OpspecError as error:
             self._fail(ai, "parameter", f"an actual parameter failed: {error.message}")
             return None
