@@ -132,6 +132,10 @@ class Interpreter:
             selectors.update(wanted)
         self._want = (frozenset() if self._all or not selectors
                       else compiled.expand_selectors(frozenset(selectors)))
+        # each full listener only receives what it selects (None: everything)
+        self._full = [(lst, None if getattr(lst, "selects", None) is None
+                       else compiled.expand_selectors(frozenset(lst.selects)))  # type: ignore[attr-defined]
+                      for lst in self._listeners]
         self._aflags = _Flags(self, _ACT_KINDS)      # CompiledActivity -> wanted-kind bits
         self._pflags = _Flags(self, _PROC_KINDS)     # process id -> wanted-kind bits
 
@@ -147,11 +151,12 @@ class Interpreter:
         now = self.env._now
         for raw in self._raw:
             raw(now, kind, process, instance, activity, data)
-        if self._listeners:
+        if self._full:
             event = TraceEvent(now, kind, process, instance, activity, lane, participant,
                                self._pkg, data if data is not None else _EMPTY, self._seq)
-            for listener in self._listeners:
-                listener(event)
+            for listener, selects in self._full:
+                if selects is None or (kind, process, activity) in selects:
+                    listener(event)
 
     def _emit_act(self, kind: str, inst: ProcessInstance, act: CompiledActivity,
                   data: Mapping[str, Any] | None = None) -> None:

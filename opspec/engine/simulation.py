@@ -330,7 +330,7 @@ class Simulation(Interpreter):
             self.drift = run_realtime(self, until, self.config.speed)
         elif until is None:
             self.env.run()
-        else:
+        elif until > self.env.now:
             self.env.run(until=until)
         self.check_waiting(horizon=until)
         if self.wants(EK.RUN_ENDED, None, None):

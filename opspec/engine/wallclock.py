@@ -63,7 +63,8 @@ async def drive(sim: Simulation, until: float | None, speed: float) -> dict[str,
                 except TimeoutError:
                     pass
             if until is not None and env.peek() > until:
-                env.run(until=until)
+                if env.now < until:
+                    env.run(until=until)
                 break
             lateness = time.perf_counter() - wall_due  # wall-clock
             env.step()
