@@ -18,9 +18,7 @@ import argparse
 import cProfile
 import gc
 import json
-import math
 import pstats
-import subprocess
 import sys
 import time
 from pathlib import Path
@@ -31,13 +29,13 @@ BENCH = Path("/work/shared/bench")
 sys.path.insert(0, str(ROOT / "tests" / "engine"))
 sys.path.insert(0, str(BENCH))
 
-import numpy as np  # noqa: E402
-from scenario import DEADLINE, DOSE_TIMES, WRONG_EXTRA, draw_day  # noqa: E402
+import numpy as np
+from scenario import DEADLINE, DOSE_TIMES, WRONG_EXTRA, draw_day
 
-from opspec.engine.compiled import compile_package  # noqa: E402
-from opspec.engine.performers import PerformerSession, WorkItem  # noqa: E402
-from opspec.engine.random import user_stream  # noqa: E402
-from opspec.engine.simulation import Simulation  # noqa: E402
+from opspec.engine.compiled import compile_package
+from opspec.engine.performers import PerformerSession, WorkItem
+from opspec.engine.random import user_stream
+from opspec.engine.simulation import Simulation
 
 DAY = 86_400.0
 
@@ -67,7 +65,7 @@ class BenchUser:
         for i, dose in enumerate(DOSE_TIMES):
             if tod + 1e-6 >= dose:
                 slot = i
-        k = int(round((tod - DOSE_TIMES[slot]) / DEADLINE))
+        k = round((tod - DOSE_TIMES[slot]) / DEADLINE)
         return day * 4 + slot, k, self.days[day][slot]
 
     def offer(self, item: WorkItem) -> None:

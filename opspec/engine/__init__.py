@@ -9,9 +9,20 @@ from __future__ import annotations
 from typing import Any
 
 __all__ = [
-    "CallablePerformer", "CompiledPackage", "EngineConfig", "JsonlSink", "MemorySink",
-    "MetricsListener", "PerformerRegistry", "RunResult", "ScriptedUser", "Simulation",
-    "SimulatedDevice", "compile_package", "read_trace", "simulate",
+    "CallablePerformer",
+    "CompiledPackage",
+    "EngineConfig",
+    "JsonlSink",
+    "MemorySink",
+    "MetricsListener",
+    "PerformerRegistry",
+    "RunResult",
+    "ScriptedUser",
+    "SimulatedDevice",
+    "Simulation",
+    "compile_package",
+    "read_trace",
+    "simulate",
 ]
 
 _WHERE = {

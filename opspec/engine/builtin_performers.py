@@ -7,6 +7,7 @@ All of them talk to the engine only through the
 
 from __future__ import annotations
 
+import functools
 import json
 import tomllib
 from collections.abc import Callable, Mapping, Sequence
@@ -64,7 +65,7 @@ class CallablePerformer(_Base):
             return
         try:
             result = function(item.data)
-        except Exception as error:  # the user's implementation failed: an activity fault
+        except Exception as error:  # noqa: BLE001 - the user's code failed: an activity fault
             session.fail(item, type(error).__name__, str(error) or type(error).__name__)
             return
         session.complete(item, result)
@@ -214,7 +215,7 @@ class ScriptedUser(_Base):
             if step.verb == "raise":
                 self._used.add(index)
                 session.call_later(max(0.0, step.delay - session.now),
-                                   lambda s=step: self._raise(s))
+                                   functools.partial(self._raise, step))
 
     def _raise(self, step: Step) -> None:
         session = self._session()
@@ -231,7 +232,7 @@ class ScriptedUser(_Base):
                 if not step.repeat:
                     self._used.add(index)
                 delay = (max(0.0, step.delay - session.now) if step.absolute else step.delay)
-                session.call_later(delay, lambda s=step: self._act(s, item))
+                session.call_later(delay, functools.partial(self._act, step, item))
                 return
         if self.default == "complete":
             self._act(Step("complete", item.choices[0] if item.choices else item.activity),

@@ -49,10 +49,30 @@ from opspec.model import (
 )
 
 __all__ = [
-    "CompiledActivity", "CompiledGraph", "CompiledPackage", "CompiledProcess", "CTransition",
-    "CTrigger", "Evaluator", "compile_package",
-    "K_ASYNC", "K_BLOCK", "K_CATCH", "K_COORD", "K_GATEWAY", "K_MANUAL", "K_NOOP", "K_SUBFLOW",
-    "K_TASK", "K_THROW", "J_AND", "J_OR", "J_XOR", "S_AND", "S_OR", "S_XOR",
+    "J_AND",
+    "J_OR",
+    "J_XOR",
+    "K_ASYNC",
+    "K_BLOCK",
+    "K_CATCH",
+    "K_COORD",
+    "K_GATEWAY",
+    "K_MANUAL",
+    "K_NOOP",
+    "K_SUBFLOW",
+    "K_TASK",
+    "K_THROW",
+    "S_AND",
+    "S_OR",
+    "S_XOR",
+    "CTransition",
+    "CTrigger",
+    "CompiledActivity",
+    "CompiledGraph",
+    "CompiledPackage",
+    "CompiledProcess",
+    "Evaluator",
+    "compile_package",
 ]
 
 Evaluator = Callable[[Mapping[str, Any], float], Any]
@@ -274,7 +294,7 @@ class _Compiler:
         if expression is None and text is not None:
             value = parse_duration_text(text)
             if value is not None:
-                return lambda data, now, _v=value: _v
+                return _constant(value)
         return self.expr(expression, text, location, what)
 
     def trigger_ref(self, ref: TriggerRef | None) -> CTrigger | None:
@@ -427,13 +447,13 @@ class _Compiler:
             ca.kind = K_GATEWAY if body.gateway is GatewayType.EVENT else K_NOOP
         elif isinstance(body, SubFlow):
             ca.kind = K_SUBFLOW if body.execution is Execution.SYNCHR else K_ASYNC
-            target = self.package.process(body.process)
-            if target is None:
+            called = self.package.process(body.process)
+            if called is None:
                 raise _spec_error(f"subflow {act.id!r} calls unknown process {body.process!r}",
                                   act.location, "name a WorkflowProcess of this package")
-            ca.subflow = target.id
-            ca.params = self.params(body.actual_parameters, target.formal_parameters, act,
-                                    f"process {target.id!r}")
+            ca.subflow = called.id
+            ca.params = self.params(body.actual_parameters, called.formal_parameters, act,
+                                    f"process {called.id!r}")
         elif isinstance(body, BlockActivity):
             ca.kind = K_BLOCK
             aset = proc.activity_set(body.activity_set)
@@ -625,6 +645,10 @@ class _Compiler:
             lane=lane, start_trigger=start, end_trigger=self.trigger_ref(directives.end_trigger),
             auto_start=bool(auto), deadline=directives.deadline, mode=directives.mode,
             location=proc.location)
+
+
+def _constant(value: float) -> Evaluator:
+    return lambda data, now: value
 
 
 def compile_package(package: Package) -> CompiledPackage:

@@ -29,7 +29,7 @@ from typing import Any, Literal
 
 from opspec.errors import ConfigurationError, SourceLocation
 
-__all__ = ["EngineConfig", "PROCESSOR_MODELS"]
+__all__ = ["PROCESSOR_MODELS", "EngineConfig"]
 
 PROCESSOR_MODELS = ("dedicated", "pooled")
 

@@ -27,8 +27,20 @@ class ProcessInstance:
     instance of a synchronous subflow call waiting for this one.
     """
 
-    __slots__ = ("id", "process", "data", "scope", "state", "priority", "parent", "root",
-                 "frames", "started_at", "deferred", "trigger")
+    __slots__ = (
+        "data",
+        "deferred",
+        "frames",
+        "id",
+        "parent",
+        "priority",
+        "process",
+        "root",
+        "scope",
+        "started_at",
+        "state",
+        "trigger",
+    )
 
     def __init__(self, id: int, process: CompiledProcess, data: dict[str, Any],
                  scope: MutableMapping[str, Any], priority: int,
@@ -57,7 +69,7 @@ class Frame:
     ``parked`` counts tokens waiting at AND/OR joins; the frame is done when both are zero.
     """
 
-    __slots__ = ("graph", "inst", "owner", "live", "parked", "joins", "ors", "running")
+    __slots__ = ("graph", "inst", "joins", "live", "ors", "owner", "parked", "running")
 
     def __init__(self, graph: CompiledGraph, inst: ProcessInstance,
                  owner: ActivityInstance | None) -> None:
@@ -79,8 +91,21 @@ class ActivityInstance:
     sit in SimPy's queue recognise they are obsolete (SimPy cannot cancel a scheduled event).
     """
 
-    __slots__ = ("key", "act", "frame", "state", "started_at", "item", "child", "iteration",
-                 "gen", "waiting", "choice", "cleanup", "performer")
+    __slots__ = (
+        "act",
+        "child",
+        "choice",
+        "cleanup",
+        "frame",
+        "gen",
+        "item",
+        "iteration",
+        "key",
+        "performer",
+        "started_at",
+        "state",
+        "waiting",
+    )
 
     def __init__(self, key: int, act: CompiledActivity, frame: Frame, started_at: float) -> None:
         self.key = key

@@ -119,6 +119,5 @@ def _scalar(value: dict[str, Any] | None) -> float | None:
         return None
     if value["kind"] == "count":
         return float(value["total"])
-    if value["kind"] == "duration":
-        return value["mean"]
-    return value.get("value")
+    result = value["mean"] if value["kind"] == "duration" else value.get("value")
+    return None if result is None else float(result)

@@ -33,8 +33,16 @@ class PooledProcessor:
     ``is_alive(job)`` lets the pool skip jobs cancelled while they waited.
     """
 
-    __slots__ = ("env", "free", "queues", "waiting", "on_done", "is_alive", "busy_time",
-                 "max_waiting")
+    __slots__ = (
+        "busy_time",
+        "env",
+        "free",
+        "is_alive",
+        "max_waiting",
+        "on_done",
+        "queues",
+        "waiting",
+    )
 
     def __init__(self, env: simpy.Environment, workers: int, priorities: int,
                  on_done: Callable[[Any], None], is_alive: Callable[[Any], bool]) -> None:
@@ -49,15 +57,14 @@ class PooledProcessor:
 
     def submit(self, job: Any, level: int, cost: float) -> bool:
         top = len(self.queues) - 1
-        level = 0 if level < 0 else (top if level > top else level)
+        level = 0 if level < 0 else (min(level, top))
         if self.free > 0:
             self.free -= 1
             self._run(job, cost)
             return False
         self.queues[level].append((job, cost))
         self.waiting += 1
-        if self.waiting > self.max_waiting:
-            self.max_waiting = self.waiting
+        self.max_waiting = max(self.max_waiting, self.waiting)
         return True
 
     def _run(self, job: Any, cost: float) -> None:

@@ -43,7 +43,7 @@ class Streams:
     an evaluation, ``()`` for a lone run); it is prepended to every named stream's key.
     """
 
-    __slots__ = ("seed", "scope", "_cache")
+    __slots__ = ("_cache", "scope", "seed")
 
     def __init__(self, seed: int, scope: Sequence[int] = ()) -> None:
         self.seed = int(seed)

@@ -20,7 +20,7 @@ __all__ = ["PerformerRegistry"]
 class PerformerRegistry:
     """Bindings of names to :class:`~opspec.engine.performers.Performer` objects."""
 
-    __slots__ = ("names", "applications", "default_device")
+    __slots__ = ("applications", "default_device", "names")
 
     def __init__(self, bindings: Mapping[str, Performer] | None = None, *,
                  default_device: Performer | None = None) -> None:

@@ -7,10 +7,12 @@
     result = sim.run(until=86_400)
     result.metrics["doses_taken"]                    # {"kind": "count", "total": 4}
 
-Constructing a Simulation from a compiled package is cheap (no graph work; about as much as
-creating a SimPy environment), so evaluations build one per simulated household. Several
-simulations may share one SimPy environment (``env=``): each keeps its own messages, data and
-performers, so they are independent households on one clock.
+Constructing a Simulation from a compiled package is cheap (no graph work: about 40 us), so
+evaluations build one per simulated household and run them one after another: measured on
+the dispenser (300 households x 30 days), that is about 10 % faster than all households on one
+shared environment, whose event heap grows with the number of households. Sharing is still
+possible (``env=``): each simulation keeps its own messages, data and performers, so they are
+independent households on one clock.
 
 Start triggers (armed when the run starts, for workflows of the active mode):
 

@@ -12,9 +12,9 @@ from dataclasses import dataclass, field
 from typing import Any, Protocol
 
 __all__ = [
-    "EventKind",
     "TRACE_FORMAT",
     "TRACE_FORMAT_VERSION",
+    "EventKind",
     "TraceEvent",
     "TraceListener",
 ]

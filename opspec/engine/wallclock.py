@@ -33,7 +33,10 @@ async def drive(sim: Simulation, until: float | None, speed: float) -> dict[str,
     """The asyncio stepping loop (usable inside an existing loop, e.g. the TUI's)."""
     loop = asyncio.get_running_loop()
     woken = asyncio.Event()
-    sim.wake = lambda: loop.call_soon_threadsafe(woken.set)
+    def wake() -> None:
+        loop.call_soon_threadsafe(woken.set)
+
+    sim.wake = wake
     env = sim.env
     sim_start = env.now
     wall_start = time.perf_counter()  # wall-clock

@@ -13,6 +13,7 @@ from collections.abc import Sequence
 from typing import Any
 
 from opspec.errors import SourceLocation
+from opspec.model import Activity as _Activity
 from opspec.model import (
     ActivityDirectives,
     ActivitySet,
@@ -56,7 +57,6 @@ from opspec.model import (
     TriggerRef,
     WorkflowProcess,
 )
-from opspec.model import Activity as _Activity
 from opspec.model import Literal as _Literal
 from opspec.xpdl.conditions import parse_condition, parse_expression
 

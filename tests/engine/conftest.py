@@ -11,10 +11,10 @@ import pytest
 
 sys.path.insert(0, str(Path(__file__).parent))
 
-from opspec.engine.config import EngineConfig  # noqa: E402
-from opspec.engine.simulation import RunResult, Simulation  # noqa: E402
-from opspec.engine.trace import TraceEvent  # noqa: E402
-from opspec.model import Package  # noqa: E402
+from opspec.engine.config import EngineConfig
+from opspec.engine.simulation import RunResult, Simulation
+from opspec.engine.trace import TraceEvent
+from opspec.model import Package
 
 MODELS = {
     "dedicated": EngineConfig(),

@@ -4,8 +4,23 @@
 from __future__ import annotations
 
 from builders import (
-    act, app, catch, count, deadline, duration, end_event, field, formal, manual, pkg, proc,
-    ratio, route, start_event, subflow, task,
+    act,
+    app,
+    catch,
+    count,
+    deadline,
+    duration,
+    end_event,
+    field,
+    formal,
+    manual,
+    pkg,
+    proc,
+    ratio,
+    route,
+    start_event,
+    subflow,
+    task,
 )
 
 from opspec.model import Package

@@ -125,8 +125,7 @@ def test_failed_subflow_raises_aborted_in_the_caller(config: EngineConfig) -> No
 
 @pytest.mark.parametrize("text", ["n > ", "unknown_field > 1"], ids=["syntax", "missing-field"])
 def test_condition_that_cannot_be_evaluated_aborts_the_instance(text: str) -> None:
-    from opspec.model import Condition, ConditionKind, Transition
-    from opspec.model import Name
+    from opspec.model import Condition, ConditionKind, Name, Transition
 
     bad = Transition(id="t_bad", source="a", target="b",
                      condition=Condition(kind=ConditionKind.CONDITION, text=text,

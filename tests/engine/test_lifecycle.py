@@ -7,7 +7,13 @@ from builders import catch, pkg, proc
 from conftest import completed, events
 
 from opspec.engine.lifecycle import (
-    ABORTED, COMPLETED, LIFECYCLE, NOT_STARTED, RUNNING, SUSPENDED, TERMINATED,
+    ABORTED,
+    COMPLETED,
+    LIFECYCLE,
+    NOT_STARTED,
+    RUNNING,
+    SUSPENDED,
+    TERMINATED,
 )
 from opspec.engine.simulation import Simulation
 from opspec.errors import ExecutionError
