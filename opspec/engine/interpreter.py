@@ -660,12 +660,19 @@ class Interpreter:
             act = ai.act
             for key, value in data.items():
                 self._set(inst, act, key, value)
-        if ai.act.loop is not None:
+        act = ai.act
+        if act.loop is not None:
+            # each iteration is one execution of the activity: its assignments apply each time
+            inst = ai.frame.inst
+            if act.end_assign and not self._assign(inst, act, act.end_assign):
+                return
             ai.iteration += 1
             if ai.iteration > 1_000_000:
-                self.abort(ai.frame.inst, ai.act, "loop ran 1,000,000 times; add a maximum")
+                self.abort(inst, act, "loop ran 1,000,000 times; add a maximum")
                 return
             if self._loop_again(ai):
+                if act.start_assign and not self._assign(inst, act, act.start_assign):
+                    return
                 self._ready.append((self._run_body, ai, None, None))
                 return
         self._complete(ai)
@@ -695,7 +702,7 @@ class Interpreter:
         the token has been queued, parked or has ended, and ``None`` is returned.
         """
         inst = frame.inst
-        if act.end_assign and not self._assign(inst, act, act.end_assign):
+        if act.end_assign and act.loop is None and not self._assign(inst, act, act.end_assign):
             return None
         if act.kind == K_THROW and act.trigger is not None:
             self.broadcast(act.trigger.kind, act.trigger.name or "", None, inst, act)
