@@ -166,6 +166,7 @@ class CompiledActivity:
     fast: bool = False                       # instantaneous without any wait (no ActInst)
     plain: bool = False                      # waits, but without deadline/loop/trigger/boundary
     next: int = -1                           # the one unconditional successor, if that is all
+    simple_end: bool = False                 # completes with no assignment/throw/raise/terminate
 
     def where(self) -> str:
         return str(self.location) if self.location is not None else "<built in Python>"
@@ -575,6 +576,8 @@ class _Compiler:
                     {(t.participant, t.lanes) for t in targets}) == 1:
                 ca.choice = tuple(branches)
         for ca in acts:
+            ca.simple_end = (not ca.end_assign and ca.kind != K_THROW and ca.raises is None
+                             and not ca.terminate)
             only = ca.out[0] if len(ca.out) == 1 else None
             if (only is not None and only.kind == T_NONE and not only.assignments
                     and not ca.otherwise and not ca.choice and not ca.terminate):

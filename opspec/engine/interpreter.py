@@ -702,6 +702,16 @@ class Interpreter:
         the token has been queued, parked or has ended, and ``None`` is returned.
         """
         inst = frame.inst
+        if act.simple_end:
+            if self._aflags[act] & 2:
+                self.emit(EK.ACTIVITY_COMPLETED, act.process, inst.id, act.id, act.lane,
+                          act.participant)
+            nxt = act.next
+            if nxt >= 0:
+                target = frame.graph.activities[nxt]
+                if not target.join:
+                    return target
+            return self._split(frame, act, inst)
         if act.end_assign and act.loop is None and not self._assign(inst, act, act.end_assign):
             return None
         if act.kind == K_THROW and act.trigger is not None:
@@ -720,6 +730,11 @@ class Interpreter:
             return None
         if inst.state != RUNNING:
             return None
+        return self._split(frame, act, inst)
+
+    def _split(self, frame: Frame, act: CompiledActivity, inst: ProcessInstance
+               ) -> CompiledActivity | None:
+        """The split of a completed activity (see :meth:`_done_next`)."""
         acts = frame.graph.activities
         nxt = act.next
         if nxt >= 0:
