@@ -1,0 +1,369 @@
+"""Run a spec for a test: one or many simulated users, a script or a user model, one result.
+
+::
+
+    result = simulate(spec, users=200, days=1, user_model="dispenser-reference", seed=7)
+    result.metrics["doses_taken"]          # pooled over the 200 users: {"kind": "count", ...}
+    result.samples("doses_taken")          # one value per user (replication)
+    result.value("report_latency_s.p95")   # a pooled scalar
+    result.instances("notify_workflow")    # per-instance slices of the trace
+
+Replication ``u`` (one simulated user and their device, a household) is an independent
+:class:`~opspec.engine.simulation.Simulation` with ``scope=(u,)`` and, for a user model, the
+user stream ``default_rng(SeedSequence(seed, spawn_key=(u,)))``: user ``u`` behaves the same
+whatever the number of users, so adding users never changes the first ones.
+
+Who performs the user lane: the ``user_model`` (a :class:`~opspec.usermodels.UserModel`, a
+preset name or a TOML path), else the ``script`` (see :mod:`opspec.testing.script`), else the
+cooperative user ``script=[]`` (every offer completed at once, a choice takes its first
+alternative). ``performers`` binds anything else (devices, callables) by participant or lane.
+"""
+
+from __future__ import annotations
+
+import math
+import zlib
+from collections.abc import Callable, Iterable, Mapping, Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+from opspec.engine.compiled import CompiledActivity, CompiledPackage, compile_package
+from opspec.engine.config import EngineConfig
+from opspec.engine.metrics import summarise_durations
+from opspec.engine.performers import Performer
+from opspec.engine.random import user_stream
+from opspec.engine.simulation import DAY, RunResult, Simulation
+from opspec.engine.trace import EventKind, TraceEvent
+from opspec.errors import ConfigurationError
+from opspec.model import Package
+from opspec.testing.script import Script, load_script, parse_script
+
+if TYPE_CHECKING:
+    from opspec.usermodels import UserModel
+
+__all__ = [
+    "FIELDS",
+    "InstanceRun",
+    "SimulationResult",
+    "SpecNames",
+    "derive_seed",
+    "load_spec_file",
+    "simulate",
+    "spec_names",
+]
+
+#: fields of each metric kind, the first being the one a bare metric name means
+FIELDS = {"count": ("total",), "duration": ("mean", "n", "p95", "min", "max"),
+          "ratio": ("value",)}
+
+
+def derive_seed(base: int, text: str) -> int:
+    """A seed mixing ``base`` with ``text`` (a test id): independent per test, reproducible,
+    stable across processes and Python versions (CRC-32, not ``hash``)."""
+    return (int(base) * 1_000_003 + zlib.crc32(text.encode("utf-8"))) % 2**63
+
+
+def load_spec_file(path: str | Path) -> Package:
+    """Load an XPDL spec (``SpecError`` with ``path:line`` when it is broken)."""
+    from opspec.xpdl.loader import load_spec
+
+    return load_spec(path)
+
+
+@dataclass(frozen=True, slots=True)
+class SpecNames:
+    """The names a spec defines, for checking what tests and scripts refer to."""
+
+    processes: tuple[str, ...]
+    activities: tuple[str, ...]
+    triggers: tuple[str, ...]
+    metrics: tuple[str, ...]
+    user_performers: tuple[str, ...]
+
+
+def _activities(compiled: CompiledPackage) -> Iterable[CompiledActivity]:
+    for proc in compiled.processes.values():
+        stack = [proc.graph]
+        while stack:
+            graph = stack.pop()
+            for act in graph.activities:
+                yield act
+                if act.block is not None:
+                    stack.append(act.block)
+
+
+def spec_names(compiled: CompiledPackage) -> SpecNames:
+    """Processes, activities, trigger (message/signal) names, metrics, and the names the user
+    lane's performers bind to (participants of user-lane activities, else their lane)."""
+    activities: dict[str, None] = {}
+    triggers: dict[str, None] = {}
+    user: dict[str, None] = {}
+    for act in _activities(compiled):
+        activities[act.id] = None
+        for trig in (act.raises, act.trigger, act.start_trigger, act.end_trigger):
+            if trig is not None and trig.name and trig.kind in ("message", "signal"):
+                triggers[trig.name] = None
+        if act.user_lane:
+            name = act.participant or (act.lanes[0] if act.lanes else None)
+            if name:
+                user[name] = None
+    for proc in compiled.processes.values():
+        for trig in (proc.start_trigger, proc.end_trigger):
+            if trig is not None and trig.name and trig.kind in ("message", "signal"):
+                triggers[trig.name] = None
+    return SpecNames(tuple(compiled.processes), tuple(activities), tuple(triggers),
+                     tuple(m.name for m in compiled.package.metrics), tuple(user) or ("user",))
+
+
+@dataclass(frozen=True, slots=True)
+class InstanceRun:
+    """One process instance of one replication, with its slice of the trace.
+
+    ``outcome`` is ``completed``, ``terminated``, ``aborted`` or ``open`` (still running when
+    the run ended). ``events`` are the events of this instance only, in order.
+    """
+
+    replication: int
+    process: str
+    instance: int
+    started: float
+    ended: float | None
+    outcome: str
+    events: tuple[TraceEvent, ...]
+
+    def completed(self, activity: str) -> bool:
+        return any(e.kind == EventKind.ACTIVITY_COMPLETED and e.activity == activity
+                   for e in self.events)
+
+
+_ENDS = {EventKind.PROCESS_COMPLETED: "completed", EventKind.PROCESS_TERMINATED: "terminated",
+         EventKind.PROCESS_ABORTED: "aborted"}
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class SimulationResult:
+    """What :func:`simulate` produced: one :class:`RunResult` per replication, pooled metrics.
+
+    ``metrics`` has the engine's shape (``{"doses_taken": {"kind": "count", "total": 3}}``),
+    pooled over replications: counts summed, durations summarised over every sample, ratios
+    recomputed from the pooled metrics. ``per_replication`` holds each replication's own.
+    """
+
+    spec: Package
+    names: SpecNames
+    seed: int
+    horizon: float | None
+    runs: tuple[RunResult, ...]
+    metrics: dict[str, dict[str, Any]]
+    durations: dict[str, tuple[float, ...]] = field(default_factory=dict)
+
+    @property
+    def users(self) -> int:
+        return len(self.runs)
+
+    @property
+    def replications(self) -> int:
+        return len(self.runs)
+
+    @property
+    def per_replication(self) -> list[dict[str, dict[str, Any]]]:
+        return [run.metrics for run in self.runs]
+
+    @property
+    def metric_names(self) -> tuple[str, ...]:
+        """The metrics the spec declares (what ``metric`` arguments may name)."""
+        return self.names.metrics
+
+    @property
+    def traces(self) -> tuple[tuple[TraceEvent, ...], ...]:
+        """Each replication's trace (only when traces were kept)."""
+        out = []
+        for run in self.runs:
+            if run.trace is None:
+                raise ConfigurationError(
+                    "this result kept no trace",
+                    hint="pass keep_trace=True to simulate() (traces of more than "
+                         "100 users are not kept by default)")
+            out.append(run.trace)
+        return tuple(out)
+
+    @property
+    def trace(self) -> tuple[TraceEvent, ...]:
+        """The trace of a one-user run (for many users, see :attr:`traces`)."""
+        traces = self.traces
+        if len(traces) != 1:
+            raise ConfigurationError(
+                f"this result has {len(traces)} replications, so it has no single trace",
+                hint="use result.traces, result.instances(process), or simulate(users=1)")
+        return traces[0]
+
+    def _split(self, metric: str) -> tuple[str, str | None]:
+        name, _, part = metric.partition(".")
+        if name not in self.metrics:
+            known = ", ".join(self.metric_names) or "(the spec declares no metrics)"
+            raise ConfigurationError(f"the spec has no metric {name!r}",
+                                     hint=f"its metrics are: {known}")
+        kind = self.metrics[name]["kind"]
+        if part and part not in FIELDS.get(kind, ()):
+            raise ConfigurationError(
+                f"metric {name!r} is a {kind}; it has no field {part!r}",
+                hint="its fields are: " + ", ".join(FIELDS.get(kind, ())))
+        return name, part or None
+
+    @staticmethod
+    def _scalar(values: Mapping[str, Any], part: str | None) -> float | None:
+        key = part or FIELDS[values["kind"]][0]
+        value = values.get(key)
+        return None if value is None else float(value)
+
+    def value(self, metric: str) -> float | None:
+        """A pooled scalar: ``"doses_taken"`` (a count's total), ``"report_latency_s"`` (a
+        duration's mean), ``"report_latency_s.p95"``, ``"alarms_per_dose"`` (a ratio's value).
+        ``None`` when undefined (a mean of no samples)."""
+        name, part = self._split(metric)
+        return self._scalar(self.metrics[name], part)
+
+    def samples(self, metric: str) -> list[float]:
+        """One value per replication (same spelling as :meth:`value`), skipping replications
+        where it is undefined (a duration with no sample, a ratio over zero)."""
+        name, part = self._split(metric)
+        out = []
+        for run in self.runs:
+            value = self._scalar(run.metrics[name], part)
+            if value is not None:
+                out.append(value)
+        return out
+
+    def observations(self, metric: str) -> list[float]:
+        """Every sample of a duration metric, pooled over replications (for quantiles)."""
+        name, _ = self._split(metric)
+        if self.metrics[name]["kind"] != "duration":
+            raise ConfigurationError(f"metric {name!r} is a {self.metrics[name]['kind']}, "
+                                     "not a duration", hint="use samples() for it")
+        return list(self.durations.get(name, ()))
+
+    def instances(self, process: str) -> list[InstanceRun]:
+        """The instances of ``process`` in every replication, each with its trace slice."""
+        if process not in self.names.processes:
+            raise ConfigurationError(
+                f"the spec has no process {process!r}",
+                hint="its processes are: " + ", ".join(self.names.processes))
+        out: list[InstanceRun] = []
+        for rep, trace in enumerate(self.traces):
+            by_id: dict[int, list[TraceEvent]] = {}
+            for event in trace:
+                if event.instance is not None:
+                    by_id.setdefault(event.instance, []).append(event)
+            for inst, events in by_id.items():
+                first = events[0]
+                if first.process != process or first.kind != EventKind.PROCESS_STARTED:
+                    continue
+                end = next((e for e in events if e.kind in _ENDS), None)
+                out.append(InstanceRun(rep, process, inst, first.time,
+                                       end.time if end else None,
+                                       _ENDS[end.kind] if end else "open", tuple(events)))
+        return out
+
+
+def _pool(runs: Sequence[RunResult], samples: Mapping[str, list[float]],
+          definitions: Package) -> dict[str, dict[str, Any]]:
+    if len(runs) == 1:
+        return dict(runs[0].metrics)
+    out: dict[str, dict[str, Any]] = {}
+    ratios = []
+    for metric in definitions.metrics:
+        first = runs[0].metrics.get(metric.name)
+        if first is None:
+            continue
+        if first["kind"] == "count":
+            out[metric.name] = {"kind": "count",
+                                "total": sum(r.metrics[metric.name]["total"] for r in runs)}
+        elif first["kind"] == "duration":
+            out[metric.name] = summarise_durations(list(samples.get(metric.name, [])))
+        else:
+            ratios.append(metric)
+    for metric in ratios:
+        num = _pooled_scalar(out.get(metric.numerator or ""))
+        den = _pooled_scalar(out.get(metric.denominator or ""))
+        out[metric.name] = {"kind": "ratio",
+                            "value": num / den if num is not None and den else None}
+    return out
+
+
+def _pooled_scalar(values: Mapping[str, Any] | None) -> float | None:
+    if values is None:
+        return None
+    value = values.get(FIELDS[values["kind"]][0])
+    return None if value is None else float(value)
+
+
+def _user_model(ref: Any) -> UserModel:
+    from opspec.usermodels import UserModel, load_user_model
+
+    if isinstance(ref, UserModel):
+        return ref
+    return load_user_model(ref)
+
+
+def _script(ref: Any) -> Script:
+    if isinstance(ref, (str, Path)):
+        return load_script(ref)
+    return parse_script(ref)
+
+
+def simulate(spec: Package | CompiledPackage | str | Path, *, users: int = 1,
+             days: float | None = None, until: float | None = None,
+             script: Script | Sequence[Any] | str | Path | None = None,
+             user_model: Any = None, seed: int = 0,
+             engine_config: EngineConfig | Mapping[str, Any] | None = None,
+             performers: Mapping[str, Performer] | None = None,
+             keep_trace: bool | None = None,
+             params: Mapping[str, Any] | None = None,
+             progress: Callable[[int], None] | None = None) -> SimulationResult:
+    """Run ``spec`` for ``users`` independent users, ``days`` days (default 1) or to ``until``
+    seconds; see the module docstring. ``keep_trace`` defaults to keeping traces of up to 100
+    users. Raises :class:`~opspec.errors.OpspecError` subclasses for bad arguments (naming the
+    spec's processes, activities, triggers or metrics when a name is unknown)."""
+    if isinstance(spec, (str, Path)):
+        spec = load_spec_file(spec)
+    compiled = spec if isinstance(spec, CompiledPackage) else compile_package(spec)
+    if isinstance(users, bool) or not isinstance(users, int) or users < 1:
+        raise ConfigurationError(f"users must be a whole number >= 1, not {users!r}")
+    if days is not None and until is not None:
+        raise ConfigurationError("give days or until, not both")
+    horizon = until if until is not None else (days if days is not None else 1.0) * DAY
+    if not (horizon > 0 and math.isfinite(horizon)):
+        raise ConfigurationError(f"the run length must be a positive number of seconds, "
+                                 f"not {horizon!r}")
+    config = (EngineConfig.from_mapping(engine_config) if isinstance(engine_config, Mapping)
+              else engine_config)
+    names = spec_names(compiled)
+    model = _user_model(user_model) if user_model is not None else None
+    plan = None if model is not None else _script([] if script is None else script)
+    if plan is not None:
+        plan.check_names(names.activities, names.triggers)
+    keep = users <= 100 if keep_trace is None else keep_trace
+    runs: list[RunResult] = []
+    pooled: dict[str, list[float]] = {}
+    for u in range(users):
+        listeners = []
+        if model is not None:
+            user: Performer = model.performer(user_stream(seed, u))
+        else:
+            assert plan is not None
+            user = scripted = plan.performer()
+            listeners.append(scripted)
+        bindings: dict[str, Performer] = {name: user for name in names.user_performers}
+        bindings.update(performers or {})
+        sim = Simulation(compiled, config, performers=bindings, seed=seed, scope=(u,),
+                         listeners=listeners, keep_trace=keep, params=params)
+        runs.append(sim.run(until=horizon))
+        if sim.metrics is not None:
+            for name, values in sim.metrics.samples.items():
+                pooled.setdefault(name, []).extend(values)
+        if progress is not None:
+            progress(u + 1)
+    return SimulationResult(compiled.package, names, seed, horizon, tuple(runs),
+                            _pool(runs, pooled, compiled.package),
+                            {k: tuple(v) for k, v in pooled.items()})
