@@ -1,0 +1,193 @@
+"""Deciding the statistical ``then`` lines of scenario files: pass, refuted, or too few runs.
+
+A claim "X >= b with C confidence" passes when the one-sided lower confidence bound of X at
+level C is at least ``b``; it is refuted when the one-sided upper bound is below ``b``; and
+otherwise the data cannot decide: the message then says how many replications would, if the
+estimate stayed where it is. ``in [a, b]`` uses the two-sided interval at level C.
+
+Intervals: Wilson score for rates (good coverage near 0 and 1, unlike the Wald interval),
+Student t for means of per-replication values, and the distribution-free order-statistic
+interval (binomial) for quantiles of pooled observations.
+
+Each ``decide_*`` returns ``None`` when the claim holds, else the failure message.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+
+__all__ = ["decide_mean", "decide_quantile", "decide_rate", "wilson"]
+
+_MAX_N = 10**9
+
+
+def _z(level: float) -> float:
+    from scipy.stats import norm
+
+    return float(norm.ppf(level))
+
+
+def wilson(successes: int, trials: int, z: float) -> tuple[float, float]:
+    """The Wilson score interval for ``successes``/``trials`` at normal quantile ``z``."""
+    if trials <= 0:
+        return 0.0, 1.0
+    p = successes / trials
+    denom = 1 + z * z / trials
+    centre = (p + z * z / (2 * trials)) / denom
+    half = z * math.sqrt(p * (1 - p) / trials + z * z / (4 * trials * trials)) / denom
+    return max(0.0, centre - half), min(1.0, centre + half)
+
+
+def _levels(op: str, level: float) -> float:
+    """The normal/t quantile level of the bounds used: one-sided, or two-sided for ``in``."""
+    return (1 + level) / 2 if op == "in" else level
+
+
+def _verdict(op: str, a: float, b: float | None, lo: float, hi: float) -> str | None:
+    """``None`` (holds), ``"refuted"`` or ``"undecided"``."""
+    if op in (">=", ">"):
+        return None if (lo > a if op == ">" else lo >= a) else (
+            "refuted" if hi < a else "undecided")
+    if op in ("<=", "<"):
+        return None if (hi < a if op == "<" else hi <= a) else (
+            "refuted" if lo > a else "undecided")
+    assert b is not None
+    if a <= lo and hi <= b:
+        return None
+    return "refuted" if hi < a or lo > b else "undecided"
+
+
+def _bound_text(op: str, a: float, b: float | None) -> str:
+    return f"in [{a:g}, {b:g}]" if op == "in" else f"{op} {a:g}"
+
+
+def _distance(op: str, a: float, b: float | None, estimate: float) -> float:
+    """How far ``estimate`` is from the nearest bound that decides the claim."""
+    if op == "in":
+        assert b is not None
+        return min(abs(estimate - a), abs(b - estimate))
+    return abs(estimate - a)
+
+
+def decide_rate(text: str, successes: int, trials: int, op: str, a: float, b: float | None,
+                level: float, *, units: str = "trials", replications: int = 1) -> str | None:
+    """Decide ``successes/trials OP a`` (or ``in [a, b]``) at confidence ``level``."""
+    z = _z(_levels(op, level))
+    if trials == 0:
+        return (f"expected {text}\n  but there were no {units} at all in {replications} "
+                "replication(s): simulate longer or more users")
+    lo, hi = wilson(successes, trials, z)
+    verdict = _verdict(op, a, b, lo, hi)
+    if verdict is None:
+        return None
+    estimate = successes / trials
+    side = "two-sided" if op == "in" else "one-sided"
+    lines = [f"expected {text}",
+             f"  estimate {estimate:.4g} ({successes}/{trials} {units}, {replications} "
+             f"replication(s)); {level:.0%} {side} Wilson interval [{lo:.4g}, {hi:.4g}]; "
+             f"bound {_bound_text(op, a, b)}"]
+    if verdict == "refuted":
+        lines.append("  the claim is false at this confidence")
+        return "\n".join(lines)
+    if _distance(op, a, b, estimate) == 0:
+        lines.append("  too few to decide, and the estimate sits on the bound: no number of "
+                     "replications would settle it")
+        return "\n".join(lines)
+    needed = _rate_trials(estimate, z, op, a, b, trials)
+    per = trials / max(1, replications)
+    reps = math.ceil(needed / per) if per > 0 else needed
+    lines.append(f"  too few replications to decide: about {reps} replications "
+                 f"(~{needed} {units}) would, if the estimate stays at {estimate:.4g}")
+    return "\n".join(lines)
+
+
+def _rate_trials(p: float, z: float, op: str, a: float, b: float | None, start: int) -> int:
+    """Smallest trial count (by doubling, then bisection) at which the Wilson interval around
+    the same estimate ``p`` decides the claim."""
+    def decided(n: int) -> bool:
+        lo, hi = wilson(round(p * n), n, z)
+        return _verdict(op, a, b, lo, hi) != "undecided"
+
+    hi_n = max(1, start)
+    while not decided(hi_n) and hi_n < _MAX_N:
+        hi_n *= 2
+    lo_n = max(1, hi_n // 2)
+    while lo_n + 1 < hi_n:
+        mid = (lo_n + hi_n) // 2
+        if decided(mid):
+            hi_n = mid
+        else:
+            lo_n = mid
+    return hi_n
+
+
+def decide_mean(text: str, values: Sequence[float], op: str, a: float, b: float | None,
+                level: float) -> str | None:
+    """Decide ``mean(values) OP a`` at confidence ``level`` with a Student t interval."""
+    from scipy.stats import t as student
+
+    n = len(values)
+    if n < 2:
+        return (f"expected {text}\n  but only {n} replication(s) had a value: a mean's "
+                "interval needs at least 2 (try users=30)")
+    mean = sum(values) / n
+    sd = math.sqrt(sum((v - mean) ** 2 for v in values) / (n - 1))
+    q = float(student.ppf(_levels(op, level), n - 1))
+    half = q * sd / math.sqrt(n)
+    lo, hi = mean - half, mean + half
+    verdict = _verdict(op, a, b, lo, hi)
+    if verdict is None:
+        return None
+    side = "two-sided" if op == "in" else "one-sided"
+    lines = [f"expected {text}",
+             f"  estimate {mean:.4g} (sd {sd:.3g}, {n} replications); {level:.0%} {side} t "
+             f"interval [{lo:.4g}, {hi:.4g}]; bound {_bound_text(op, a, b)}"]
+    if verdict == "refuted":
+        lines.append("  the claim is false at this confidence")
+        return "\n".join(lines)
+    gap = _distance(op, a, b, mean)
+    if gap == 0 or sd == 0:
+        lines.append("  too few to decide, and the estimate sits on the bound")
+    else:
+        needed = max(n + 1, math.ceil((q * sd / gap) ** 2))
+        lines.append(f"  too few replications to decide: about {needed} would, if the "
+                     f"estimate and spread stay where they are")
+    return "\n".join(lines)
+
+
+def decide_quantile(text: str, values: Sequence[float], q: float, op: str, a: float,
+                    b: float | None, level: float) -> str | None:
+    """Decide ``quantile_q(values) OP a`` with the distribution-free order-statistic
+    interval: the ``k``-th smallest value is an upper bound of the ``q``-quantile with
+    confidence ``P(Binomial(n, q) < k)``."""
+    from scipy.stats import binom
+
+    n = len(values)
+    ordered = sorted(values)
+    side_level = _levels(op, level)
+    if n == 0:
+        return f"expected {text}\n  but there were no observations at all"
+    k_hi = int(binom.ppf(side_level, n, q)) + 1          # 1-based rank of the upper bound
+    k_lo = int(binom.ppf(1 - side_level, n, q))          # 1-based rank of the lower bound
+    hi = ordered[k_hi - 1] if k_hi <= n else math.inf
+    lo = ordered[k_lo - 1] if k_lo >= 1 else -math.inf
+    verdict = _verdict(op, a, b, lo, hi)
+    if verdict is None:
+        return None
+    below = sum(1 for v in ordered if v <= a) / n
+    estimate = ordered[min(n - 1, max(0, math.ceil(q * n) - 1))]
+    side = "two-sided" if op == "in" else "one-sided"
+    lines = [f"expected {text}",
+             f"  estimate {estimate:.4g} ({n} observations); {level:.0%} {side} "
+             f"order-statistic interval [{lo:.4g}, {hi:.4g}]; bound {_bound_text(op, a, b)}"]
+    if verdict == "refuted":
+        lines.append("  the claim is false at this confidence")
+    elif op in ("<=", "<", ">=", ">") and not math.isclose(below, q):
+        z = _z(side_level)
+        needed = max(n + 1, math.ceil(z * z * q * (1 - q) / (below - q) ** 2))
+        lines.append(f"  too few observations to decide: about {needed} would, if the "
+                     f"distribution stays ({below:.1%} of them are now <= {a:g})")
+    else:
+        lines.append("  too few observations to decide")
+    return "\n".join(lines)

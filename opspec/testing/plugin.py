@@ -1,0 +1,297 @@
+"""The opspec pytest plugin (registered through the ``pytest11`` entry point ``opspec``).
+
+Fixtures:
+
+* ``spec`` - the :class:`~opspec.model.Package` named by ``@pytest.mark.spec("path")`` on the
+  test (or its class/module), else by a module-level ``SPEC = "path"``. Paths are tried
+  relative to the test file, then to pytest's rootdir. Loaded once per session per file.
+* ``simulate`` - :func:`opspec.testing.simulate.simulate` with the test's seed as default
+  and paths (spec, user model, script file) resolved like the marker's::
+
+      def test_reporting_user_takes_the_dose(spec, simulate):
+          result = simulate(spec, script=[("after trg_2 90s", "press_report")])
+          assert result.value("doses_taken") == 4
+
+* ``opspec_seed`` - the seed ``simulate`` uses: ``--opspec-seed`` (default 0) mixed with the
+  test id, so tests are independent of each other but each is reproducible. A failing test's
+  report shows it.
+* ``device_url`` / ``device_profile`` - ``--device-url`` and ``--device-profile`` for
+  hardware-in-the-loop tests (marked ``hardware``); ``device_url`` skips without a URL.
+* ``regen_golden`` - whether ``--opspec-regen-golden`` was given (golden traces are written
+  instead of compared).
+
+Scenario files (``*.scenario.toml``, see :mod:`opspec.testing.scenario`) are collected as
+tests, one item per ``[[scenario]]``.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterator, Sequence
+from pathlib import Path
+from typing import Any
+
+import pytest
+
+from opspec.errors import OpspecError
+
+__all__ = [
+    "ScenarioFile",
+    "ScenarioItem",
+    "Simulator",
+    "pytest_addoption",
+    "pytest_collect_file",
+    "pytest_configure",
+]
+
+_SEED_KEY = pytest.StashKey[int]()
+_SPECS_KEY = pytest.StashKey[dict[Path, Any]]()
+
+
+def pytest_addoption(parser: pytest.Parser) -> None:
+    group = parser.getgroup("opspec", "opspec executable specifications")
+    group.addoption("--opspec-seed", type=int, default=0, metavar="N",
+                    help="base seed of simulate() and scenario files; each test mixes in its "
+                         "own id, so tests stay independent but reproducible (default 0)")
+    group.addoption("--opspec-regen-golden", action="store_true", default=False,
+                    help="write golden traces instead of comparing runs with them")
+    group.addoption("--device-url", default=None, metavar="URL",
+                    help="serial port or pySerial URL of a real device for tests marked "
+                         "'hardware' (e.g. /dev/ttyUSB0, /dev/ttyACM0, rfc2217://host:port)")
+    group.addoption("--device-profile", default="medication_dispenser", metavar="NAME",
+                    help="device profile (name in devices/ or .toml path) of that device")
+
+
+def pytest_configure(config: pytest.Config) -> None:
+    config.addinivalue_line(
+        "markers", "spec(path): the XPDL spec the 'spec' fixture loads (relative to the test "
+                   "file or the rootdir)")
+    config.addinivalue_line(
+        "markers", "hardware: needs a real serial device (--device-url)")
+    config.stash[_SPECS_KEY] = {}
+
+
+# ---------------------------------------------------------------- paths and specs
+def resolve_path(ref: str | Path, config: pytest.Config, near: Path | None) -> Path:
+    """``ref`` as an existing path: absolute, else next to ``near`` (a test file), else under
+    the rootdir. Fails the test with the places tried when none exists."""
+    path = Path(ref)
+    candidates = [path] if path.is_absolute() else [
+        *([near.parent / path] if near is not None else []), config.rootpath / path]
+    for candidate in candidates:
+        if candidate.exists():
+            return candidate.resolve()
+    pytest.fail(f"{ref}: file not found (looked at {', '.join(map(str, candidates))})",
+                pytrace=False)
+
+
+def load_cached(path: Path, config: pytest.Config) -> Any:
+    """The package of ``path``, loaded once per session; a broken spec fails the test with
+    its ``path:line`` message (no traceback)."""
+    cache = config.stash[_SPECS_KEY]
+    if path not in cache:
+        from opspec.engine.compiled import compile_package
+        from opspec.xpdl.loader import load_spec
+
+        try:
+            package = load_spec(path)
+            cache[path] = (package, compile_package(package))
+        except OpspecError as error:
+            pytest.fail(f"cannot load the spec: {error}", pytrace=False)
+    return cache[path]
+
+
+def _compiled_for(package: Any, config: pytest.Config) -> Any:
+    for cached, compiled in config.stash[_SPECS_KEY].values():
+        if cached is package:
+            return compiled
+    return package
+
+
+@pytest.fixture
+def spec(request: pytest.FixtureRequest) -> Any:
+    """The spec of ``@pytest.mark.spec(path)`` or the module's ``SPEC``."""
+    marker = request.node.get_closest_marker("spec")
+    ref: Any = None
+    if marker is not None:
+        if len(marker.args) != 1:
+            pytest.fail("@pytest.mark.spec takes one path, e.g. "
+                        "@pytest.mark.spec('specs/medication_dispenser.xpdl')", pytrace=False)
+        ref = marker.args[0]
+    else:
+        ref = getattr(request.module, "SPEC", None) if request.module is not None else None
+    if ref is None:
+        pytest.fail("the 'spec' fixture needs @pytest.mark.spec('path/to/spec.xpdl') on the "
+                    "test or a module-level SPEC = 'path/to/spec.xpdl'", pytrace=False)
+    path = resolve_path(ref, request.config, request.node.path)
+    return load_cached(path, request.config)[0]
+
+
+@pytest.fixture
+def opspec_seed(request: pytest.FixtureRequest) -> int:
+    """The test's seed: ``--opspec-seed`` mixed with the test id."""
+    from opspec.testing.simulate import derive_seed
+
+    seed = derive_seed(request.config.getoption("--opspec-seed"), request.node.nodeid)
+    request.node.stash[_SEED_KEY] = seed
+    return seed
+
+
+class Simulator:
+    """The ``simulate`` fixture: :func:`opspec.testing.simulate.simulate` bound to a test.
+
+    ``seed`` defaults to the test's seed; ``spec`` may be a Package (e.g. the ``spec``
+    fixture) or a path; relative paths (spec, ``user_model`` file, ``script`` file) are
+    resolved next to the test file, then under the rootdir. Errors in the arguments (unknown
+    activity in a script, bad user model) fail the test with opspec's message, not a
+    traceback.
+    """
+
+    def __init__(self, config: pytest.Config, near: Path | None, seed: int) -> None:
+        self.config = config
+        self.near = near
+        self.seed = seed
+
+    def _path_or_name(self, ref: Any) -> Any:
+        if isinstance(ref, (str, Path)) and (str(ref).endswith((".toml", ".json"))
+                                             or isinstance(ref, Path)):
+            return resolve_path(ref, self.config, self.near)
+        return ref
+
+    def __call__(self, spec: Any = None, users: int = 1, days: float | None = None,
+                 script: Any = None, user_model: Any = None, seed: int | None = None,
+                 until: float | None = None, engine_config: Any = None,
+                 **options: Any) -> Any:
+        from opspec.testing.simulate import simulate
+
+        if spec is None:
+            pytest.fail("simulate() needs a spec: simulate(spec, ...) with the 'spec' fixture "
+                        "or a path", pytrace=False)
+        if isinstance(spec, (str, Path)):
+            spec = load_cached(resolve_path(spec, self.config, self.near), self.config)[1]
+        else:
+            spec = _compiled_for(spec, self.config)
+        if isinstance(user_model, Path) or (isinstance(user_model, str)
+                                            and user_model.endswith(".toml")):
+            user_model = resolve_path(user_model, self.config, self.near)
+        if isinstance(script, (str, Path)):
+            script = resolve_path(script, self.config, self.near)
+        try:
+            return simulate(spec, users=users, days=days, script=script,
+                            user_model=user_model, seed=self.seed if seed is None else seed,
+                            until=until, engine_config=engine_config, **options)
+        except OpspecError as error:
+            pytest.fail(f"simulate(): {error}", pytrace=False)
+
+
+@pytest.fixture
+def simulate(request: pytest.FixtureRequest, opspec_seed: int) -> Simulator:
+    """Run a spec; see :class:`Simulator`."""
+    return Simulator(request.config, request.node.path, opspec_seed)
+
+
+@pytest.fixture
+def regen_golden(request: pytest.FixtureRequest) -> bool:
+    """True when ``--opspec-regen-golden`` was given."""
+    return bool(request.config.getoption("--opspec-regen-golden"))
+
+
+@pytest.fixture
+def golden(request: pytest.FixtureRequest) -> Any:
+    """``golden(trace_or_result, path)``: compare with a stored golden trace (written instead
+    with ``--opspec-regen-golden``); ``path`` is relative to the test file."""
+    from opspec.testing import golden as golden_module
+
+    regenerate = bool(request.config.getoption("--opspec-regen-golden"))
+    near = request.node.path
+
+    def check(run: Any, path: str | Path, **options: Any) -> Any:
+        trace = getattr(run, "trace", run)
+        target = Path(path) if Path(path).is_absolute() else near.parent / path
+        return golden_module.compare_golden(trace, target, regenerate=regenerate, **options)
+
+    return check
+
+
+@pytest.fixture
+def device_url(request: pytest.FixtureRequest) -> str:
+    """``--device-url``; the test is skipped when it is not given."""
+    url = request.config.getoption("--device-url")
+    if not url:
+        pytest.skip("needs a real device: run pytest with --device-url=/dev/ttyUSB0 (or a "
+                    "pySerial URL) and -m hardware")
+    return str(url)
+
+
+@pytest.fixture
+def device_profile(request: pytest.FixtureRequest) -> str:
+    """``--device-profile`` (default ``medication_dispenser``)."""
+    return str(request.config.getoption("--device-profile"))
+
+
+@pytest.hookimpl(hookwrapper=True)
+def pytest_runtest_makereport(item: pytest.Item, call: pytest.CallInfo[None]) -> Iterator[None]:
+    outcome = yield
+    report = outcome.get_result()
+    seed = item.stash.get(_SEED_KEY, None)
+    if seed is not None and report.failed:
+        base = item.config.getoption("--opspec-seed")
+        report.sections.append(("opspec", f"seed {seed} (from --opspec-seed={base} and the "
+                                          "test id; simulate(seed=...) overrides it)"))
+
+
+# ---------------------------------------------------------------- scenario files
+def pytest_collect_file(file_path: Path, parent: pytest.Collector) -> pytest.Collector | None:
+    if file_path.name.endswith(".scenario.toml"):
+        collector: pytest.Collector = ScenarioFile.from_parent(parent, path=file_path)
+        return collector
+    return None
+
+
+class ScenarioFile(pytest.File):
+    """A ``*.scenario.toml`` file: one test item per ``[[scenario]]``."""
+
+    def collect(self) -> Sequence[pytest.Item]:
+        from opspec.testing.scenario import load_scenarios
+
+        try:
+            document = load_scenarios(self.path, rootdir=self.config.rootpath)
+        except OpspecError as error:
+            raise self.CollectError(f"bad scenario file: {error}") from None
+        return [ScenarioItem.from_parent(self, name=scenario.name, scenario=scenario)
+                for scenario in document.scenarios]
+
+
+class ScenarioFailure(Exception):
+    """A scenario whose expectations did not hold (the message says which and why)."""
+
+
+class ScenarioItem(pytest.Item):
+    """One scenario: run its ``given``, check each ``then``."""
+
+    def __init__(self, *, scenario: Any, **kwargs: Any) -> None:
+        super().__init__(**kwargs)
+        self.scenario = scenario
+
+    def runtest(self) -> None:
+        from opspec.testing.scenario import run_scenario
+        from opspec.testing.simulate import derive_seed
+
+        seed = derive_seed(self.config.getoption("--opspec-seed"), self.nodeid)
+        if self.scenario.seed is None:
+            self.stash[_SEED_KEY] = seed
+        package = load_cached(self.scenario.spec_path, self.config)[1]
+        try:
+            failures = run_scenario(self.scenario, package, seed=seed)
+        except OpspecError as error:
+            raise ScenarioFailure(f"{self.scenario.where}: {error}") from None
+        if failures:
+            raise ScenarioFailure("\n\n".join(failures))
+
+    def repr_failure(self, excinfo: pytest.ExceptionInfo[BaseException],
+                     style: Any = None) -> str:
+        if isinstance(excinfo.value, ScenarioFailure):
+            return str(excinfo.value)
+        return str(super().repr_failure(excinfo, style=style))
+
+    def reportinfo(self) -> tuple[Path, int | None, str]:
+        return self.path, None, f"scenario: {self.name}"

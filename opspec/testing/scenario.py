@@ -1,0 +1,262 @@
+"""Scenario files (``*.scenario.toml``): spec tests for people who do not write Python.
+
+::
+
+    spec = "../medication_dispenser.xpdl"        # relative to this file (or the rootdir)
+
+    [given]                                      # defaults for every scenario (optional)
+    days = 1
+
+    [[scenario]]
+    name = "a user who reports 90 s after the first alarm takes the dose"
+    given = { script = [["after trg_2 90s", "press_report"]], until = "09:00" }
+    then = ["doses_taken == 1", "report_latency_s.mean == 90"]
+
+``given`` keys: ``script`` (a list of ``[when, action]`` pairs, see
+:mod:`opspec.testing.script`, or the path of a script file), ``user_model`` (a preset name or
+a TOML path), ``users`` (independent simulated users, default 1), ``days`` (default 1) or
+``until`` (seconds or a duration such as ``"9h"`` / ``"09:00"``), ``seed`` (default: the
+test's seed), ``engine`` (engine options, as in ``[engine]`` of a config file), ``params``
+(package data overrides). ``then`` lines are :mod:`opspec.testing.expectations`.
+
+Every mistake is reported when the file is collected, as ``path: key: what (how to fix)``.
+"""
+
+from __future__ import annotations
+
+import tomllib
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+from opspec.errors import ConfigurationError, OpspecError, SourceLocation
+from opspec.testing.expectations import Expectation, parse_expectation
+from opspec.testing.script import Script, load_script, parse_script
+
+__all__ = ["Scenario", "ScenarioDocument", "load_scenarios", "run_scenario"]
+
+_TOP = ("spec", "given", "scenario", "description")
+_SCENARIO = ("name", "given", "then", "description")
+_TRACE_FORMS = frozenset({"never", "eventually", "count", "before", "within", "twice"})
+_GIVEN = ("script", "user_model", "users", "days", "until", "seed", "engine", "params")
+
+
+@dataclass(frozen=True, slots=True)
+class Scenario:
+    """One ``[[scenario]]`` ready to run (``where`` is ``path: scenario[N]``)."""
+
+    name: str
+    where: str
+    spec_path: Path
+    expectations: tuple[Expectation, ...]
+    script: Script | None = None
+    user_model: Any = None
+    users: int = 1
+    days: float | None = None
+    until: float | None = None
+    seed: int | None = None
+    engine: Mapping[str, Any] = field(default_factory=dict)
+    params: Mapping[str, Any] = field(default_factory=dict)
+    description: str = ""
+
+
+@dataclass(frozen=True, slots=True)
+class ScenarioDocument:
+    path: Path
+    spec_path: Path
+    scenarios: tuple[Scenario, ...]
+
+
+def _error(path: Path, key: str | None, message: str, hint: str = "") -> ConfigurationError:
+    return ConfigurationError(message, location=SourceLocation(str(path), key=key), hint=hint)
+
+
+def _find(path: Path, ref: str, rootdir: Path | None) -> Path | None:
+    candidate = Path(ref)
+    if candidate.is_absolute():
+        return candidate if candidate.exists() else None
+    for base in (path.parent, rootdir):
+        if base is not None and (base / candidate).exists():
+            return (base / candidate).resolve()
+    return None
+
+
+def _unknown(path: Path, key: str, table: Mapping[str, Any], allowed: Sequence[str]) -> None:
+    for name in table:
+        if name not in allowed:
+            where = f"{key}.{name}" if key else name
+            raise _error(path, where, f"unknown key {name!r}",
+                         "allowed keys: " + ", ".join(allowed))
+
+
+def _given(path: Path, key: str, table: Any, rootdir: Path | None) -> dict[str, Any]:
+    if not isinstance(table, Mapping):
+        raise _error(path, key, "'given' is a table",
+                     'write given = { script = [["after trg_2 90s", "press_report"]] }')
+    _unknown(path, key, table, _GIVEN)
+    out: dict[str, Any] = {}
+    if "script" in table:
+        value = table["script"]
+        where = f"{path}: {key}.script"
+        if isinstance(value, str):
+            found = _find(path, value, rootdir)
+            if found is None:
+                raise _error(path, f"{key}.script", f"script file {value!r} not found",
+                             "give a path relative to this file, or a list of [when, action]")
+            out["script"] = load_script(found)
+        else:
+            out["script"] = parse_script(value, where=where)
+    if "user_model" in table:
+        ref = table["user_model"]
+        if not isinstance(ref, str):
+            raise _error(path, f"{key}.user_model", "a user model is a preset name or a path")
+        from opspec.usermodels import load_user_model
+
+        found = _find(path, ref, rootdir) if ref.endswith(".toml") else None
+        try:
+            out["user_model"] = load_user_model(found or ref)
+        except OpspecError as error:
+            raise _error(path, f"{key}.user_model", str(error)) from None
+    for name in ("users", "seed"):
+        if name in table:
+            value = table[name]
+            if isinstance(value, bool) or not isinstance(value, int) or value < (
+                    1 if name == "users" else 0):
+                raise _error(path, f"{key}.{name}", f"{name} must be a whole number"
+                             + (" >= 1" if name == "users" else " >= 0") + f", not {value!r}")
+            out[name] = value
+    if "days" in table:
+        value = table["days"]
+        if isinstance(value, bool) or not isinstance(value, (int, float)) or value <= 0:
+            raise _error(path, f"{key}.days", f"days must be a positive number, not {value!r}")
+        out["days"] = float(value)
+    if "until" in table:
+        out["until"] = _until(path, f"{key}.until", table["until"])
+    for name in ("engine", "params"):
+        if name in table:
+            if not isinstance(table[name], Mapping):
+                raise _error(path, f"{key}.{name}", f"{name} is a table")
+            out[name] = dict(table[name])
+    if "engine" in out:
+        from opspec.engine.config import EngineConfig
+
+        EngineConfig.from_mapping(out["engine"], path=f"{path}: {key}.engine")
+    return out
+
+
+def _until(path: Path, key: str, value: Any) -> float:
+    if isinstance(value, bool) or not isinstance(value, (int, float, str)):
+        raise _error(path, key, f"until is seconds or a duration, not {value!r}")
+    if isinstance(value, str):
+        from opspec.xpdl.durations import parse_duration
+
+        try:
+            value = parse_duration(value)
+        except OpspecError as error:
+            raise _error(path, key, error.message, "write e.g. 3600, \"9h\" or \"09:00\"") \
+                from None
+    if value <= 0:
+        raise _error(path, key, f"until must be positive, not {value!r}")
+    return float(value)
+
+
+def load_scenarios(path: str | Path, *, rootdir: Path | None = None) -> ScenarioDocument:
+    """Read and check a scenario file, including its names against its spec.
+
+    Raises :class:`ConfigurationError` (``path: key: ...``) or the spec's own error.
+    """
+    path = Path(path)
+    try:
+        document = tomllib.loads(path.read_text(encoding="utf-8"))
+    except OSError as error:
+        raise _error(path, None, f"cannot read it: {error.strerror or error}") from None
+    except (tomllib.TOMLDecodeError, UnicodeDecodeError) as error:
+        raise _error(path, None, f"not valid TOML: {error}") from None
+    _unknown(path, "", document, _TOP)
+    ref = document.get("spec")
+    if not isinstance(ref, str):
+        raise _error(path, "spec", "the file needs spec = \"path/to/spec.xpdl\"",
+                     "a path relative to this file or the rootdir")
+    spec_path = _find(path, ref, rootdir)
+    if spec_path is None:
+        raise _error(path, "spec", f"spec {ref!r} not found",
+                     "a path relative to this file or the rootdir")
+    from opspec.engine.compiled import compile_package
+    from opspec.testing.simulate import spec_names
+    from opspec.xpdl.loader import load_spec
+
+    try:
+        names = spec_names(compile_package(load_spec(spec_path)))
+    except OpspecError as error:
+        raise _error(path, "spec", f"the spec does not load: {error}") from None
+    defaults = _given(path, "given", document.get("given", {}), rootdir)
+    entries = document.get("scenario")
+    if not isinstance(entries, list) or not entries:
+        raise _error(path, "scenario", "no [[scenario]] tables",
+                     'add [[scenario]] with name, given and then = ["doses_taken == 1"]')
+    scenarios: list[Scenario] = []
+    seen: set[str] = set()
+    for n, entry in enumerate(entries):
+        key = f"scenario[{n}]"
+        if not isinstance(entry, Mapping):
+            raise _error(path, key, "each scenario is a table")
+        _unknown(path, key, entry, _SCENARIO)
+        name = entry.get("name")
+        if not isinstance(name, str) or not name.strip():
+            raise _error(path, f"{key}.name", "each scenario needs a name")
+        if name in seen:
+            raise _error(path, f"{key}.name", f"scenario name {name!r} is used twice")
+        seen.add(name)
+        given = {**defaults, **_given(path, f"{key}.given", entry.get("given", {}), rootdir)}
+        if "days" in given and "until" in given:
+            raise _error(path, f"{key}.given", "give days or until, not both")
+        then = entry.get("then")
+        if isinstance(then, str):
+            then = [then]
+        if not isinstance(then, list) or not then:
+            raise _error(path, f"{key}.then", "'then' lists what must hold",
+                         'write then = ["doses_taken == 1"]')
+        expectations = []
+        for m, text in enumerate(then):
+            where = f"{path}: {key}.then[{m}]"
+            expectation = parse_expectation(text, where=where)
+            expectation.check_names(names, where)
+            expectations.append(expectation)
+        script = given.get("script")
+        if isinstance(script, Script):
+            try:
+                script.check_names(names.activities, names.triggers)
+            except ConfigurationError as error:
+                raise _error(path, f"{key}.given.script", error.message, error.hint) from None
+        if script is not None and "user_model" in given:
+            raise _error(path, f"{key}.given", "give a script or a user model, not both")
+        scenarios.append(Scenario(
+            name=name.strip(), where=f"{path}: {key}", spec_path=spec_path,
+            expectations=tuple(expectations), script=script,
+            user_model=given.get("user_model"), users=given.get("users", 1),
+            days=given.get("days"), until=given.get("until"), seed=given.get("seed"),
+            engine=given.get("engine", {}), params=given.get("params", {}),
+            description=str(entry.get("description", ""))))
+    return ScenarioDocument(path, spec_path, tuple(scenarios))
+
+
+def run_scenario(scenario: Scenario, spec: Any, *, seed: int = 0) -> list[str]:
+    """Run ``scenario`` on ``spec`` (a Package or CompiledPackage); return one failure
+    message per expectation that does not hold (empty when all do)."""
+    from opspec.testing.simulate import simulate
+
+    needs_trace = any(e.form in _TRACE_FORMS for e in scenario.expectations)
+    result = simulate(spec, users=scenario.users, days=scenario.days, until=scenario.until,
+                      script=scenario.script, user_model=scenario.user_model,
+                      seed=scenario.seed if scenario.seed is not None else seed,
+                      engine_config=scenario.engine or None, params=scenario.params or None,
+                      keep_trace=True if needs_trace else None)
+    failures = []
+    for number, expectation in enumerate(scenario.expectations):
+        message = expectation.check(result)
+        if message is not None:
+            failures.append(f"{scenario.where}.then[{number}]: {message}")
+    if failures:
+        failures.append(f"(seed {result.seed}; {result.replications} replication(s))")
+    return failures
