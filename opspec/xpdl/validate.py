@@ -1,0 +1,173 @@
+"""Validation of specification files: the reader's diagnostics plus the model's structural checks.
+
+:func:`validate_file` loads one file with :func:`opspec.xpdl.loader.load_package` (which never
+raises for bad input), runs :func:`opspec.model.checks.check_package` on the package it gets,
+merges both lists (a problem both report is listed once) and returns a :class:`FileReport`.
+:func:`spec_files` expands the command line's files and folders. The rest formats reports as
+``path:line: severity: message (hint)`` lines or JSON objects; ``opspec validate`` is a thin
+wrapper around this module.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from collections.abc import Iterable, Sequence
+from dataclasses import dataclass
+from pathlib import Path
+
+from opspec.errors import Diagnostic, Severity
+from opspec.model.checks import check_package
+from opspec.xpdl.loader import load_package
+from opspec.xpdl.reader import DEFAULT_MAX_BYTES
+
+__all__ = [
+    "SPEC_SUFFIXES",
+    "FileReport",
+    "merge_diagnostics",
+    "spec_files",
+    "summary",
+    "validate_file",
+]
+
+SPEC_SUFFIXES = (".xpdl", ".xml")
+
+# Codes that mean "the file could not be read at all" (exit status 2, not 1).
+IO_CODES = frozenset({"io-error"})
+
+# Reader code -> check code for the same problem at the same place: the reader's wins.
+_SAME_PROBLEM = {"unresolved-subflow": "undefined-subflow"}
+
+
+@dataclass(frozen=True, slots=True)
+class FileReport:
+    """The outcome of validating one file.
+
+    ``version`` is the XPDL version read from the root namespace (``"1.0"``, ``"2.1"``,
+    ``"none"``…) or ``None`` when no package could be built. ``diagnostics`` may include
+    problems of other files the package refers to (each carries its own path).
+    """
+
+    path: str
+    version: str | None
+    diagnostics: tuple[Diagnostic, ...]
+
+    @property
+    def ok(self) -> bool:
+        """No error (warnings allowed, unless strict mode promoted them)."""
+        return not any(d.severity is Severity.ERROR for d in self.diagnostics)
+
+    @property
+    def unreadable(self) -> bool:
+        """The file could not be read (missing, permission denied): an I/O problem."""
+        return any(d.code in IO_CODES for d in self.diagnostics)
+
+    def count(self, severity: Severity) -> int:
+        return sum(1 for d in self.diagnostics if d.severity is severity)
+
+    def to_json(self) -> dict[str, object]:
+        """The ``--json`` object: ``path``, ``version``, ``ok`` and ``diagnostics`` (each with
+        ``path``, ``line``, ``severity``, ``code``, ``message`` and ``hint``)."""
+        return {
+            "path": self.path,
+            "version": self.version,
+            "ok": self.ok,
+            "diagnostics": [d.to_json() for d in self.diagnostics],
+        }
+
+    def lines(self) -> list[str]:
+        """One ``path:line: severity: message (hint)`` line per diagnostic."""
+        return [str(d) for d in self.diagnostics]
+
+
+def merge_diagnostics(*groups: Iterable[Diagnostic]) -> tuple[Diagnostic, ...]:
+    """Concatenate ``groups`` (reader first), dropping repeats, sorted by file and line.
+
+    A repeat is a diagnostic with the same path, line, code and message as an earlier one, or
+    a check that restates a reader diagnostic at the same place under another code
+    (``undefined-subflow`` after ``unresolved-subflow``). The sort is stable, so problems on
+    one line keep their order; diagnostics without a line come first in their file.
+    """
+    seen: set[tuple[str, int | None, str, str]] = set()
+    places: set[tuple[str, int | None, str]] = set()
+    out: list[Diagnostic] = []
+    for group in groups:
+        for diagnostic in group:
+            where = (diagnostic.location.path, diagnostic.location.line)
+            key = (*where, diagnostic.code, diagnostic.message)
+            if key in seen or (*where, diagnostic.code) in places:
+                continue
+            seen.add(key)
+            restated = _SAME_PROBLEM.get(diagnostic.code)
+            if restated is not None:
+                places.add((*where, restated))
+            out.append(diagnostic)
+    order = {path: n for n, path in enumerate(dict.fromkeys(d.location.path for d in out))}
+    out.sort(key=lambda d: (order[d.location.path], d.location.line or 0))
+    return tuple(out)
+
+
+def _promote(diagnostics: Iterable[Diagnostic]) -> tuple[Diagnostic, ...]:
+    return tuple(
+        dataclasses.replace(d, severity=Severity.ERROR) if d.severity is Severity.WARNING else d
+        for d in diagnostics)
+
+
+def validate_file(path: str | Path, *, strict: bool = False,
+                  max_bytes: int = DEFAULT_MAX_BYTES) -> FileReport:
+    """Load ``path`` and check its package; never raises for bad input.
+
+    ``strict`` turns every warning (the reader's and the checks') into an error.
+    """
+    result = load_package(path, max_bytes=max_bytes)
+    checks: list[Diagnostic] = []
+    version = None
+    if result.package is not None:
+        version = result.package.version.value
+        checks = check_package(result.package, packages=result.packages)
+    diagnostics = merge_diagnostics(result.diagnostics, checks)
+    if strict:
+        diagnostics = _promote(diagnostics)
+    return FileReport(str(path), version, diagnostics)
+
+
+def spec_files(paths: Sequence[str | Path]) -> tuple[list[Path], list[str]]:
+    """The files to validate, and a problem line for every argument that cannot be used.
+
+    A file argument is taken as it is (whatever its suffix); a folder contributes every
+    ``*.xpdl`` and ``*.xml`` file below it, recursively, sorted. A missing path, or a folder
+    holding no such file, gives a problem. Files named twice are validated once.
+    """
+    files: list[Path] = []
+    problems: list[str] = []
+    for raw in paths:
+        path = Path(raw)
+        if path.is_dir():
+            found = sorted(p for p in path.rglob("*")
+                           if p.suffix.lower() in SPEC_SUFFIXES and p.is_file())
+            if not found:
+                problems.append(f"{path}: no *.xpdl or *.xml file in this folder")
+            files.extend(found)
+        elif path.exists():
+            files.append(path)
+        else:
+            problems.append(f"{path}: no such file or folder")
+    return list(dict.fromkeys(files)), problems
+
+
+def summary(reports: Sequence[FileReport]) -> str:
+    """``3 files checked: 1 with errors (4 errors, 2 warnings)`` and the like."""
+    files = len(reports)
+    errors = sum(r.count(Severity.ERROR) for r in reports)
+    warnings = sum(r.count(Severity.WARNING) for r in reports)
+    failed = sum(1 for r in reports if not r.ok)
+    noun = "file" if files == 1 else "files"
+
+    def plural(n: int, word: str) -> str:
+        return f"{n} {word}{'' if n == 1 else 's'}"
+
+    if failed:
+        verdict = f"{failed} with errors"
+    else:
+        verdict = "no errors"
+    return (f"{files} {noun} checked: {verdict} "
+            f"({plural(errors, 'error')}, {plural(warnings, 'warning')})")
