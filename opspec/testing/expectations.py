@@ -397,4 +397,5 @@ def expect(result: SimulationResult, *lines: str) -> None:
         if message is not None:
             failures.append(message)
     if failures:
+        failures.append(f"(seed {result.seed}, {result.replications} replication(s))")
         raise AssertionError("\n\n".join(failures))

@@ -41,6 +41,7 @@ __all__ = [
     "pytest_addoption",
     "pytest_collect_file",
     "pytest_configure",
+    "simulator_for",
 ]
 
 _SEED_KEY = pytest.StashKey[int]()
@@ -151,12 +152,6 @@ class Simulator:
         self.near = near
         self.seed = seed
 
-    def _path_or_name(self, ref: Any) -> Any:
-        if isinstance(ref, (str, Path)) and (str(ref).endswith((".toml", ".json"))
-                                             or isinstance(ref, Path)):
-            return resolve_path(ref, self.config, self.near)
-        return ref
-
     def __call__(self, spec: Any = None, users: int = 1, days: float | None = None,
                  script: Any = None, user_model: Any = None, seed: int | None = None,
                  until: float | None = None, engine_config: Any = None,
@@ -187,6 +182,20 @@ class Simulator:
 def simulate(request: pytest.FixtureRequest, opspec_seed: int) -> Simulator:
     """Run a spec; see :class:`Simulator`."""
     return Simulator(request.config, request.node.path, opspec_seed)
+
+
+def simulator_for(request: pytest.FixtureRequest) -> Simulator:
+    """A :class:`Simulator` for a fixture of any scope (its seed mixes ``--opspec-seed`` with
+    the requesting node's id), e.g. to share one expensive many-user run in a module::
+
+        @pytest.fixture(scope="module")
+        def reference_users(request):
+            return simulator_for(request)(SPEC, users=600, user_model="dispenser-reference")
+    """
+    from opspec.testing.simulate import derive_seed
+
+    seed = derive_seed(request.config.getoption("--opspec-seed"), request.node.nodeid)
+    return Simulator(request.config, request.node.path, seed)
 
 
 @pytest.fixture

@@ -76,7 +76,8 @@ def _find(path: Path, ref: str, rootdir: Path | None) -> Path | None:
     candidate = Path(ref)
     if candidate.is_absolute():
         return candidate if candidate.exists() else None
-    for base in (path.parent, rootdir):
+    here = path.parent if path.is_absolute() or rootdir is None else rootdir / path.parent
+    for base in (here, rootdir):
         if base is not None and (base / candidate).exists():
             return (base / candidate).resolve()
     return None
@@ -167,8 +168,11 @@ def load_scenarios(path: str | Path, *, rootdir: Path | None = None) -> Scenario
     Raises :class:`ConfigurationError` (``path: key: ...``) or the spec's own error.
     """
     path = Path(path)
+    if rootdir is not None and path.is_absolute() and path.is_relative_to(rootdir):
+        path = path.relative_to(rootdir)     # messages name the file as the user wrote it
     try:
-        document = tomllib.loads(path.read_text(encoding="utf-8"))
+        full = path if path.is_absolute() or rootdir is None else rootdir / path
+        document = tomllib.loads(full.read_text(encoding="utf-8"))
     except OSError as error:
         raise _error(path, None, f"cannot read it: {error.strerror or error}") from None
     except (tomllib.TOMLDecodeError, UnicodeDecodeError) as error:
@@ -208,7 +212,10 @@ def load_scenarios(path: str | Path, *, rootdir: Path | None = None) -> Scenario
         if name in seen:
             raise _error(path, f"{key}.name", f"scenario name {name!r} is used twice")
         seen.add(name)
-        given = {**defaults, **_given(path, f"{key}.given", entry.get("given", {}), rootdir)}
+        own = _given(path, f"{key}.given", entry.get("given", {}), rootdir)
+        inherited = {k: v for k, v in defaults.items()
+                     if not ({k, *own} >= {"days", "until"})}   # own days/until win
+        given = {**inherited, **own}
         if "days" in given and "until" in given:
             raise _error(path, f"{key}.given", "give days or until, not both")
         then = entry.get("then")
