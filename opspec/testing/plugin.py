@@ -241,11 +241,28 @@ def device_profile(request: pytest.FixtureRequest) -> str:
 def pytest_runtest_makereport(item: pytest.Item, call: pytest.CallInfo[None]) -> Iterator[None]:
     outcome = yield
     report = outcome.get_result()
+    if call.excinfo is not None and isinstance(call.excinfo.value, OpspecError) and (
+            report.failed and not isinstance(item, ScenarioItem)):
+        # an opspec error in a test is a usage problem: its message says what and how to
+        # fix it; the test line that caused it is enough context (no opspec internals)
+        report.longrepr = _opspec_error_repr(item, call.excinfo)
     seed = item.stash.get(_SEED_KEY, None)
     if seed is not None and report.failed:
         base = item.config.getoption("--opspec-seed")
         report.sections.append(("opspec", f"seed {seed} (from --opspec-seed={base} and the "
                                           "test id; simulate(seed=...) overrides it)"))
+
+
+def _opspec_error_repr(item: pytest.Item, excinfo: pytest.ExceptionInfo[BaseException]
+                       ) -> str:
+    error = excinfo.value
+    where = ""
+    for entry in reversed(excinfo.traceback):
+        if Path(str(entry.path)) == item.path:
+            line = entry.statement.lines[0].strip() if entry.statement.lines else ""
+            where = f"{item.path.name}:{entry.lineno + 1}: {line}\n"
+            break
+    return f"{where}{type(error).__name__}: {error}"
 
 
 # ---------------------------------------------------------------- scenario files

@@ -1,0 +1,136 @@
+"""The plugin's fixtures and options, seen from a user's test suite (pytester)."""
+
+from __future__ import annotations
+
+import re
+
+import pytest
+
+
+def test_spec_fixture_loads_the_marked_spec_relative_to_the_rootdir_or_the_test_file(
+        project: pytest.Pytester) -> None:
+    project.makepyfile(test_specs="""
+        import pytest
+
+        @pytest.mark.spec("specs/dispenser.xpdl")
+        def test_by_marker(spec):
+            assert spec.id == "medication_dispenser"
+
+        def test_by_module_constant(spec):
+            assert spec.id == "medication_dispenser"
+
+        SPEC = "specs/dispenser.xpdl"
+    """)
+    project.mkdir("sub")
+    (project.path / "sub" / "test_near.py").write_text(
+        "import pytest\n"
+        "@pytest.mark.spec('../specs/dispenser.xpdl')\n"
+        "def test_near_the_test_file(spec):\n"
+        "    assert spec.id == 'medication_dispenser'\n")
+    project.runpytest().assert_outcomes(passed=3)
+
+
+def test_a_test_without_a_spec_is_told_how_to_name_one(pytester: pytest.Pytester) -> None:
+    pytester.makepyfile("def test_it(spec):\n    pass\n")
+    result = pytester.runpytest()
+    result.assert_outcomes(errors=1)
+    result.stdout.fnmatch_lines(["*needs @pytest.mark.spec('path/to/spec.xpdl')*SPEC =*"])
+
+
+def test_a_missing_spec_file_names_the_places_looked_at(pytester: pytest.Pytester) -> None:
+    pytester.makepyfile("SPEC = 'specs/nope.xpdl'\ndef test_it(spec):\n    pass\n")
+    result = pytester.runpytest()
+    result.stdout.fnmatch_lines(["*specs/nope.xpdl: file not found (looked at *"])
+
+
+def test_a_broken_spec_fails_with_its_file_and_line_not_a_traceback(
+        pytester: pytest.Pytester) -> None:
+    (pytester.path / "broken.xpdl").write_text(
+        '<?xml version="1.0"?>\n<Package xmlns="http://www.wfmc.org/2008/XPDL2.1" Id="p">\n'
+        '<WorkflowProcesses><WorkflowProcess Id="w"><Activities>\n'
+        '<Activity Id="a"/></Activities><Transitions>\n'
+        '<Transition Id="t" From="a" To="missing"/>\n'
+        '</Transitions></WorkflowProcess></WorkflowProcesses></Package>\n')
+    pytester.makepyfile("SPEC = 'broken.xpdl'\ndef test_it(spec):\n    pass\n")
+    result = pytester.runpytest()
+    result.assert_outcomes(errors=1)
+    result.stdout.fnmatch_lines(["*cannot load the spec: *broken.xpdl:*"])
+    assert "Traceback" not in result.stdout.str()
+
+
+def test_simulate_runs_a_script_given_as_plain_data(project: pytest.Pytester) -> None:
+    project.makepyfile("""
+        SPEC = "specs/dispenser.xpdl"
+
+        def test_it(spec, simulate):
+            result = simulate(spec, script=[("after trg_2 90s", "press_report")], until=9 * 3600)
+            assert result.value("doses_taken") == 1
+            assert result.value("report_latency_s") == 90
+            assert [i.outcome for i in result.instances("notify_workflow")] == ["completed"]
+            assert result.metric_names[0] == "doses_due"
+    """)
+    project.runpytest().assert_outcomes(passed=1)
+
+
+SEEDED = """
+    SPEC = "specs/dispenser.xpdl"
+
+    def test_one(spec, simulate, opspec_seed):
+        result = simulate(spec, users=3, user_model="specs/dispenser.users.toml")
+        print("RESULT one", opspec_seed, result.samples("report_latency_s"))
+
+    def test_two(spec, simulate, opspec_seed):
+        result = simulate(spec, users=3, user_model="specs/dispenser.users.toml")
+        print("RESULT two", opspec_seed, result.samples("report_latency_s"))
+"""
+
+
+def _results(result: pytest.RunResult) -> dict[str, str]:
+    return dict(re.findall(r"RESULT (\w+) (\d+ \[[^\]]*\])", result.stdout.str()))
+
+
+def test_the_seed_option_makes_runs_reproducible_and_tests_independent(
+        project: pytest.Pytester) -> None:
+    project.makepyfile(SEEDED)
+    first = _results(project.runpytest("-s", "--opspec-seed=5"))
+    again = _results(project.runpytest("-s", "--opspec-seed=5"))
+    other = _results(project.runpytest("-s", "--opspec-seed=6"))
+    assert first == again and len(first) == 2
+    assert first["one"] != first["two"]          # each test mixes in its own id
+    assert first["one"] != other["one"]          # and the base seed matters
+
+
+def test_a_failing_test_reports_its_seed(project: pytest.Pytester) -> None:
+    project.makepyfile("""
+        SPEC = "specs/dispenser.xpdl"
+
+        def test_it(spec, simulate):
+            simulate(spec, until=3600)
+            assert False
+    """)
+    result = project.runpytest("--opspec-seed=11")
+    result.stdout.fnmatch_lines(["*opspec*", "seed * (from --opspec-seed=11 and the test id*"])
+
+
+def test_device_url_skips_hardware_tests_without_it_and_passes_it_on(
+        pytester: pytest.Pytester) -> None:
+    pytester.makepyfile("""
+        def test_board(device_url, device_profile):
+            print("URL", device_url, device_profile)
+    """)
+    pytester.runpytest().assert_outcomes(skipped=1)
+    result = pytester.runpytest("-s", "--device-url=loop://", "--device-profile=cart")
+    result.assert_outcomes(passed=1)
+    result.stdout.fnmatch_lines(["*URL loop:// cart*"])
+
+
+def test_the_regen_golden_flag_reaches_the_tests(pytester: pytest.Pytester) -> None:
+    pytester.makepyfile("def test_it(regen_golden):\n    print('REGEN', regen_golden)\n")
+    assert "REGEN False" in pytester.runpytest("-s").stdout.str()
+    assert "REGEN True" in pytester.runpytest("-s", "--opspec-regen-golden").stdout.str()
+
+
+def test_the_options_are_in_pytest_help(pytester: pytest.Pytester) -> None:
+    text = pytester.runpytest("--help").stdout.str()
+    for option in ("--opspec-seed", "--opspec-regen-golden", "--device-url", "--device-profile"):
+        assert re.search(rf"^\s+{option}", text, re.M), option
