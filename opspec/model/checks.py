@@ -142,11 +142,12 @@ def _dangling(process: WorkflowProcess, aset: ActivitySet | None, graph: FlowGra
             if not end or end in graph.by_id:
                 continue      # an empty end was reported by the reader (missing From/To)
             elsewhere = _find_elsewhere(report.package, end)
-            hint = f"fix {'To' if verb == 'points to' else 'From'}"
+            attribute = "To" if verb == "points to" else "From"
             if elsewhere:
-                hint += f"; {end!r} is an activity of {elsewhere}"
+                hint = (f"{end!r} is an activity of {elsewhere}: set {attribute} to an activity "
+                        f"of {container}, or move the transition there")
             else:
-                hint += " to the Id of an activity of the same level"
+                hint = f"set {attribute} to the Id of an activity of {container}"
             report.error(
                 transition, "dangling-transition",
                 f"Transition {transition.id!r} {verb} activity {end!r}, which is not in "

@@ -319,11 +319,17 @@ class RefChecks:
     def _undefined(self, process: WorkflowProcess, place: object, what: str, name: str) -> None:
         location = place if isinstance(place, SourceLocation) else getattr(place, "location",
                                                                               None)
+        named = [f.id for f in (*self.package.data_fields, *process.data_fields,
+                                *process.formal_parameters) if f.name == name]
+        if named:
+            hint = (f"{name!r} is the Name of data field {named[0]!r}; expressions use Ids: "
+                    f"write {named[0]!r} (or give the field the Id {name!r})")
+        else:
+            hint = f"declare a DataField {name!r} or fix the name"
         self.report.error(
             location or process.location, "undefined-data-field",
             f"{what} reads {name!r}, which is not a data field or formal parameter of "
-            f"{where(process, None)} nor a data field of package {self.package.id!r}",
-            f"declare a DataField {name!r} or fix the name")
+            f"{where(process, None)} nor a data field of package {self.package.id!r}", hint)
 
 
 def _is_performer(data_type: object) -> bool:
