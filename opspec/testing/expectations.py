@@ -389,6 +389,7 @@ def expect(result: SimulationResult, *lines: str) -> None:
     message), e.g. ``expect(result, "rate doses_taken/doses_due >= 0.99 with 95% confidence")``.
     A line naming something the spec lacks raises :class:`ConfigurationError` listing the
     names it has."""
+    __tracebackhide__ = True     # pytest: the failure is the test's line, not ours
     failures = []
     for line in lines:
         expectation = parse_expectation(line, where="expect()")

@@ -152,6 +152,9 @@ class Simulator:
         self.near = near
         self.seed = seed
 
+    def __repr__(self) -> str:
+        return f"<simulate fixture, seed {self.seed}>"
+
     def __call__(self, spec: Any = None, users: int = 1, days: float | None = None,
                  script: Any = None, user_model: Any = None, seed: int | None = None,
                  until: float | None = None, engine_config: Any = None,

@@ -64,6 +64,7 @@ _HINT = ("write e.g. (90, 'complete walk_to_dispenser'), ('after trg_2 90s', 'pr
          "('at 08:03', 'raise trg_1'), ('never', 'press_report') or ('otherwise', 'omit'); "
          "see docs/spec-testing.md")
 _DAY = 86_400.0
+_PLURAL = {"activity": "activities", "trigger": "triggers", "anchor": "activities and triggers"}
 
 ScriptEntry = tuple[float | str, str]
 
@@ -111,8 +112,7 @@ class Script:
                 raise ConfigurationError(
                     f"the script names {what} {name!r}, which the spec does not have",
                     location=SourceLocation(self.where),
-                    hint=f"known {'activities and triggers' if what == 'anchor' else what + 's'}"
-                         f": {listing}")
+                    hint=f"known {_PLURAL[what]}: {listing}")
 
     def performer(self) -> ScriptUser:
         """A fresh performer following this script (one per simulated user)."""

@@ -158,6 +158,10 @@ class SimulationResult:
     metrics: dict[str, dict[str, Any]]
     durations: dict[str, tuple[float, ...]] = field(default_factory=dict)
 
+    def __repr__(self) -> str:
+        return (f"<SimulationResult {self.spec.id}: {self.replications} replication(s), "
+                f"seed {self.seed}>")
+
     @property
     def users(self) -> int:
         return len(self.runs)
