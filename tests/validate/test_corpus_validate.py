@@ -1,0 +1,95 @@
+"""Every real-world corpus file validates without an internal error, and whether it has errors
+is recorded here (with the problem that makes it so), so a change in the checks shows up as a
+reviewed change of this table."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+
+from opspec.errors import Severity
+from opspec.xpdl.validate import validate_file
+
+CORPUS = Path("/work/shared/corpus/xpdl")
+if not CORPUS.is_dir():  # pragma: no cover - the corpus lives beside the repository
+    CORPUS = Path(__file__).resolve().parents[3] / "shared" / "corpus" / "xpdl"
+FILES = sorted(CORPUS.glob("*.xpdl")) if CORPUS.is_dir() else []
+
+# File -> the error codes it must have (empty: no errors). Anything not listed: no errors.
+ERRORS: dict[str, set[str]] = {
+    # condition '0 <= Entity.Cost <= 5000': the package declares a field 'Cost', no 'Entity'
+    "bonita-simprocess__Example6.xpdl": {"undefined-data-field"},
+    # three deadlines whose exceptions Bonita handles in Java hooks, not with transitions
+    "bonita__carpool.xpdl": {"deadline-without-exception-path"},
+    # subflow targets live in other Bonita files that are not declared as ExternalPackages
+    "bonita__mainSubflowJoinXor.xpdl": {"undefined-subflow"},
+    "bonita__subflowParams.xpdl": {"undefined-subflow"},
+    "bonita__testManagementAPIWithParsingError.xpdl": {"not-well-formed"},
+    # the schema-walk artefact with "Id"/"Value" placeholders everywhere
+    "bpmve__PackageBasic.xpdl": {"dangling-transition", "duplicate-id",
+                                 "missing-external-package", "undefined-participant"},
+    # an XPDL 2.0 sample: fields, an application and a performer it never declares
+    "bpmxpdl20__sample.xpdl": {"deadline-without-exception-path", "undefined-application",
+                               "undefined-data-field", "undefined-participant"},
+    # transitions between a process and an activity set of another process
+    "g360__Subprocess4_with_exception.xpdl": {"dangling-transition"},
+    "jawe10__sample_workflow_process.xpdl": {
+        "deadline-without-exception-path", "parameter-count-mismatch", "undefined-application",
+        "undefined-data-field", "undefined-participant"},
+    "tibco-af__Fallstudie_4-09_e-Car_Produktion.xpdl": {"bad-condition"},
+    # TIBCO conditions read fields by Name; ids are generated
+    "tibco-af__Test_loop_2.xpdl": {"undefined-data-field"},
+    "tibco-af__Test_multiple_pools_processes_and_lanes.xpdl": {"undefined-data-field"},
+    # SubFlow Id="-unknown-"
+    "tibcofrg___GPkNEEeyEd-eq-1NLZ2xQg.frg.xpdl": {"undefined-subflow"},
+    # a data field and a formal parameter both called 'publish'
+    "wfmc__publication-1.0.xpdl": {"duplicate-id"},
+}
+
+
+@pytest.mark.skipif(not FILES, reason="corpus not available")
+@pytest.mark.parametrize("path", FILES, ids=[p.name for p in FILES])
+def test_corpus_file_validates_without_internal_error(path: Path) -> None:
+    report = validate_file(path)
+    codes = {d.code for d in report.diagnostics}
+    assert "internal-error" not in codes
+    assert all(d.location.path for d in report.diagnostics)
+    errors = {d.code for d in report.diagnostics if d.severity is Severity.ERROR}
+    assert errors == ERRORS.get(path.name, set())
+    assert report.ok is (not errors)
+
+
+def _report(name: str) -> list[str]:
+    path = CORPUS / name
+    if not path.is_file():
+        pytest.skip("corpus not available")
+    return [str(d) for d in validate_file(path).diagnostics]
+
+
+def test_loop_blocked_example_breaks_its_declared_conformance_class() -> None:
+    lines = _report("jawe10__LoopBlocked.xpdl")
+    cycle = [line for line in lines if "declares graph conformance LOOP_BLOCKED" in line]
+    assert len(cycle) == 1
+    assert ":83: warning:" in cycle[0] and "process 'LOOP_BLOCKED_Test_Wor1'" in cycle[0]
+    assert "LOOP_BLOCKED_Test_Wor1_Act4 -> LOOP_BLOCKED_Test_Wor1_Act3" in cycle[0]
+
+
+def test_g360_transitions_crossing_processes_are_dangling() -> None:
+    lines = _report("g360__Subprocess4_with_exception.xpdl")
+    assert any(line.endswith(":165: error: Transition '436' comes from activity '364', which "
+                             "is not in process '1' (activity ids are scoped per process) ('364' "
+                             "is an activity of process '2': set From to an activity of process "
+                             "'1', or move the transition there)") for line in lines)
+    assert sum("dangling" in line or "is not in process" in line for line in lines) == 6
+
+
+def test_e_car_case_study_may_deadlock_at_its_and_joins() -> None:
+    lines = _report("tibco-af__Fallstudie_4-09_e-Car_Produktion.xpdl")
+    joins = [line for line in lines if "AND-join" in line]
+    assert len(joins) == 2 and all(": warning: " in line for line in joins)
+
+
+def test_wfmc_deadline_sample_places_activities_in_lanes_it_does_not_declare() -> None:
+    lines = _report("wfmc__deadline.xpdl")
+    assert sum("which no pool of the package declares" in line for line in lines) == 6
