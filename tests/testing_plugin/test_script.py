@@ -1,0 +1,130 @@
+"""The script language for scripted users: plain (when, action) data, files, and behaviour."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+
+from opspec.errors import ConfigurationError
+from opspec.testing.script import load_script, parse_script
+from opspec.testing.simulate import simulate
+
+from .conftest import DISPENSER
+
+EIGHT = 8 * 3600.0
+
+
+@pytest.fixture(scope="module")
+def spec() -> object:
+    from opspec.engine.compiled import compile_package
+    from opspec.xpdl.loader import load_spec
+
+    return compile_package(load_spec(DISPENSER))
+
+
+@pytest.mark.parametrize(("when", "action", "verb", "target", "delay", "absolute"), [
+    (90, "complete walk_to_dispenser", "complete", "walk_to_dispenser", 90.0, False),
+    ("90s", "walk_to_dispenser", "complete", "walk_to_dispenser", 90.0, False),
+    ("+1m30s", "walk_to_dispenser", "complete", "walk_to_dispenser", 90.0, False),
+    ("PT90S", "choose press_report", "choose", "press_report", 90.0, False),
+    ("at 08:03", "raise trg_1", "raise", "trg_1", EIGHT + 180, True),
+    ("at 08:00 on day 2", "press_report", "complete", "press_report", 86_400 + EIGHT, True),
+    ("at 3600", "omit take_pill", "omit", "take_pill", 3600.0, True),
+], ids=["seconds", "duration", "plus", "iso", "clock", "day-2", "at-seconds"])
+def test_times_and_actions_read_as_documented(when: object, action: str, verb: str,
+                                              target: str, delay: float,
+                                              absolute: bool) -> None:
+    (step,) = parse_script([(when, action)]).steps
+    assert (step.verb, step.target, step.delay, step.absolute) == (verb, target, delay,
+                                                                   absolute)
+
+
+def test_never_each_after_and_otherwise() -> None:
+    script = parse_script([("never", "press_report"), ("each after trg_2 5s", "take_pill"),
+                           ("otherwise", "omit")])
+    never, each = script.steps
+    assert (never.verb, never.repeat) == ("omit", True)
+    assert each.repeat and script.anchors == {1: "trg_2"} and script.otherwise == "omit"
+
+
+@pytest.mark.parametrize(("entries", "message"), [
+    ([("soon", "press_report")], r"steps\[0\]: cannot read the time 'soon'"),
+    ([(-5, "press_report")], r"steps\[0\]: the time -5 is negative"),
+    ([(0, "")], r"steps\[0\]: the action '' is not text"),
+    ([("after trg_2", "press_report")], r"needs a name and a time"),
+    ([("after trg_2 5s", "raise trg_1")], r"a 'raise' step takes an absolute time"),
+    ([("otherwise", "dance")], r"'otherwise' takes one of complete, omit, wait"),
+    ([("never", "omit press_report")], r"'never' takes one activity name"),
+    ([(1, "press_report"), "press"], r"steps\[1\]: a step is a \(when, action\) pair"),
+    ([("at 25:00", "raise trg_1")], r"time of day"),
+    ("press_report", r"a script is a list of \(when, action\) pairs"),
+], ids=["bad-time", "negative", "empty-action", "after-without-time", "raise-after",
+        "otherwise", "never-verb", "not-a-pair", "bad-clock", "not-a-list"])
+def test_bad_steps_are_explained(entries: object, message: str) -> None:
+    with pytest.raises(ConfigurationError, match=message):
+        parse_script(entries)  # type: ignore[arg-type]
+
+
+def test_unknown_names_are_listed_against_the_spec(spec: object) -> None:
+    with pytest.raises(ConfigurationError, match=r"trigger 'trg_3'.*known triggers: trg_1, trg_2"):
+        simulate(spec, script=[("at 1", "raise trg_3")], until=60)  # type: ignore[arg-type]
+    with pytest.raises(ConfigurationError, match=r"anchor 'alarm'.*activities and triggers"):
+        simulate(spec, script=[("after alarm 5s", "press_report")],  # type: ignore[arg-type]
+                 until=60)
+
+
+def test_a_script_file_reads_pairs_and_tables(tmp_path: Path, spec: object) -> None:
+    path = tmp_path / "late.toml"
+    path.write_text('otherwise = "complete"\nsteps = [\n  ["after trg_2 120s", "press_report"],\n'
+                    '  { when = "each 30s", do = "take_pill" },\n]\n')
+    script = load_script(path)
+    assert [s.target for s in script.steps] == ["press_report", "take_pill"]
+    result = simulate(spec, script=path, until=9 * 3600)  # type: ignore[arg-type]
+    assert result.value("report_latency_s") == 120.0
+
+
+@pytest.mark.parametrize(("text", "message"), [
+    ("steps = [[1]]", r"late.toml: steps\[0\]: a step is a \(when, action\) pair"),
+    ('steps = []\nspeed = 2', r"late.toml: speed: unknown key"),
+    ('otherwise = "later"', r"late.toml: otherwise: 'otherwise' takes one of"),
+    ("steps = [", r"late.toml: the script is not valid TOML"),
+    ('steps = [{ do = "x", after = 3 }]', r"steps\[0\]: a step table has 'do'.*unknown key"),
+], ids=["short-pair", "unknown-key", "bad-otherwise", "not-toml", "table-key"])
+def test_bad_script_files_name_the_file_and_key(tmp_path: Path, text: str,
+                                                message: str) -> None:
+    path = tmp_path / "late.toml"
+    path.write_text(text)
+    with pytest.raises(ConfigurationError, match=message):
+        load_script(path)
+
+
+def test_a_raise_at_a_time_reports_without_pressing_anything(spec: object) -> None:
+    result = simulate(spec, script=[("at 08:03", "raise trg_1"), ("never", "press_report")],  # type: ignore[arg-type]
+                      until=9 * 3600)
+    assert result.value("doses_taken") == 1 and result.value("report_latency_s") == 180.0
+
+
+def test_otherwise_omit_is_a_user_who_ignores_everything(spec: object) -> None:
+    result = simulate(spec, script=[("otherwise", "omit")], until=9 * 3600)  # type: ignore[arg-type]
+    assert result.value("doses_missed") == 1 and result.value("alarms") == 3
+
+
+def test_otherwise_wait_leaves_offers_pending(spec: object) -> None:
+    result = simulate(spec, script=[("otherwise", "wait")], until=9 * 3600)  # type: ignore[arg-type]
+    assert result.value("doses_missed") == 1
+    assert {i.outcome for i in result.instances("user_workflow")} == {"open"}
+
+
+def test_each_step_applies_to_every_dose_and_once_only_to_the_first(spec: object) -> None:
+    once = simulate(spec, script=[("after trg_2 60s", "press_report")], days=1)  # type: ignore[arg-type]
+    each = simulate(spec, script=[("each after trg_2 60s", "press_report")], days=1)  # type: ignore[arg-type]
+    assert once.samples("report_latency_s.max") == [60.0]
+    assert once.value("report_latency_s.min") == 0.0        # the later doses: reported at once
+    assert each.value("report_latency_s.min") == each.value("report_latency_s.max") == 60.0
+
+
+def test_after_an_activity_counts_from_its_completion(spec: object) -> None:
+    result = simulate(spec, script=[("after sound_alarm 45s", "press_report")],  # type: ignore[arg-type]
+                      until=9 * 3600)
+    assert result.value("report_latency_s") == 45.0
