@@ -31,9 +31,10 @@ import operator
 import re
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
+from itertools import pairwise
 
 from opspec.engine.trace import EventKind, TraceEvent
-from opspec.errors import ConfigurationError
+from opspec.errors import ConfigurationError, SourceLocation
 from opspec.testing.simulate import FIELDS, SimulationResult, SpecNames
 
 __all__ = ["Expectation", "expect", "format_events", "parse_expectation"]
@@ -49,20 +50,20 @@ _SUBJECT = r"(?P<{0}kind>activity|trigger|process)\s+(?P<{0}name>[\w.:-]+)"
 _TARGET = rf"(?:(?P<op>{_OP})\s*(?P<num>{_NUM})|in\s*\[\s*(?P<lo>{_NUM})\s*,\s*(?P<hi>{_NUM})\s*\])"
 _CONF = r"\s+with\s+(?P<conf>\d+(?:\.\d+)?)\s*%\s+confidence"
 _FORMS: list[tuple[str, re.Pattern[str]]] = [
-    ("rate", re.compile(rf"rate\s+(?P<num_m>\w+)\s*/\s*(?P<den_m>\w+)\s*{_TARGET}{_CONF}", re.I)),
-    ("mean", re.compile(rf"mean\s+(?P<metric>[\w.]+)\s*{_TARGET}{_CONF}", re.I)),
+    ("rate", re.compile(rf"rate\s+(?P<num_m>\w+)\s*/\s*(?P<den_m>\w+)\s*{_TARGET}{_CONF}", re.IGNORECASE)),
+    ("mean", re.compile(rf"mean\s+(?P<metric>[\w.]+)\s*{_TARGET}{_CONF}", re.IGNORECASE)),
     ("quantile", re.compile(rf"p(?P<q>\d+(?:\.\d+)?)\s+(?P<metric>\w+)\s*{_TARGET}{_CONF}",
-                            re.I)),
+                            re.IGNORECASE)),
     ("twice", re.compile(rf"never\s+{_SUBJECT.format('a')}\s+twice\s+within\s+(?P<gap>.+)",
-                         re.I)),
-    ("never", re.compile(rf"never\s+{_SUBJECT.format('a')}", re.I)),
-    ("eventually", re.compile(rf"eventually\s+{_SUBJECT.format('a')}", re.I)),
-    ("count", re.compile(rf"count\s+{_SUBJECT.format('a')}\s*{_TARGET}", re.I)),
+                         re.IGNORECASE)),
+    ("never", re.compile(rf"never\s+{_SUBJECT.format('a')}", re.IGNORECASE)),
+    ("eventually", re.compile(rf"eventually\s+{_SUBJECT.format('a')}", re.IGNORECASE)),
+    ("count", re.compile(rf"count\s+{_SUBJECT.format('a')}\s*{_TARGET}", re.IGNORECASE)),
     ("within", re.compile(rf"{_SUBJECT.format('b')}\s+within\s+(?P<gap>.+?)\s+after\s+"
-                          rf"{_SUBJECT.format('a')}", re.I)),
+                          rf"{_SUBJECT.format('a')}", re.IGNORECASE)),
     ("before", re.compile(rf"{_SUBJECT.format('a')}\s+before\s+{_SUBJECT.format('b')}",
-                          re.I)),
-    ("metric", re.compile(rf"(?P<metric>[\w]+(?:\.\w+)?)\s*{_TARGET}", re.I)),
+                          re.IGNORECASE)),
+    ("metric", re.compile(rf"(?P<metric>[\w]+(?:\.\w+)?)\s*{_TARGET}", re.IGNORECASE)),
 ]
 _KIND_EVENT = {"activity": EventKind.ACTIVITY_COMPLETED, "trigger": EventKind.TRIGGER_RAISED,
                "process": EventKind.PROCESS_STARTED}
@@ -210,7 +211,7 @@ class Expectation:
     def _check_twice(self, result: SimulationResult) -> str | None:
         gap = _duration(self.groups["gap"])
         for rep, events in enumerate(self._events(result, "a")):
-            for first, second in zip(events, events[1:], strict=False):
+            for first, second in pairwise(events):
                 if second.time - first.time < gap:
                     lines = [f"expected {self.text}",
                              f"  but {self._subject('a')} happened at {_time(first.time)} and "
@@ -280,9 +281,7 @@ def parse_expectation(text: str, *, where: str = "<then>") -> Expectation:
 
 
 # ---------------------------------------------------------------- formatting
-def _loc(where: str) -> object:
-    from opspec.errors import SourceLocation
-
+def _loc(where: str) -> SourceLocation:
     path, _, key = where.partition(": ")
     return SourceLocation(path, key=key or None)
 

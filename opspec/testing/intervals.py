@@ -16,16 +16,22 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
+from typing import Any
 
 __all__ = ["decide_mean", "decide_quantile", "decide_rate", "wilson"]
 
 _MAX_N = 10**9
 
 
-def _z(level: float) -> float:
-    from scipy.stats import norm
+def _stats() -> Any:
+    """scipy.stats, imported when first needed (it is slow to import)."""
+    import scipy.stats  # type: ignore[import-untyped]
 
-    return float(norm.ppf(level))
+    return scipy.stats
+
+
+def _z(level: float) -> float:
+    return float(_stats().norm.ppf(level))
 
 
 def wilson(successes: int, trials: int, z: float) -> tuple[float, float]:
@@ -84,9 +90,9 @@ def decide_rate(text: str, successes: int, trials: int, op: str, a: float, b: fl
     estimate = successes / trials
     side = "two-sided" if op == "in" else "one-sided"
     lines = [f"expected {text}",
-             f"  estimate {estimate:.4g} ({successes}/{trials} {units}, {replications} "
-             f"replication(s)); {level:.0%} {side} Wilson interval [{lo:.4g}, {hi:.4g}]; "
-             f"bound {_bound_text(op, a, b)}"]
+             (f"  estimate {estimate:.4g} ({successes}/{trials} {units}, {replications} "
+              f"replication(s)); {level:.0%} {side} Wilson interval [{lo:.4g}, {hi:.4g}]; "
+              f"bound {_bound_text(op, a, b)}")]
     if verdict == "refuted":
         lines.append("  the claim is false at this confidence")
         return "\n".join(lines)
@@ -125,8 +131,7 @@ def _rate_trials(p: float, z: float, op: str, a: float, b: float | None, start: 
 def decide_mean(text: str, values: Sequence[float], op: str, a: float, b: float | None,
                 level: float) -> str | None:
     """Decide ``mean(values) OP a`` at confidence ``level`` with a Student t interval."""
-    from scipy.stats import t as student
-
+    student = _stats().t
     n = len(values)
     if n < 2:
         return (f"expected {text}\n  but only {n} replication(s) had a value: a mean's "
@@ -141,8 +146,8 @@ def decide_mean(text: str, values: Sequence[float], op: str, a: float, b: float 
         return None
     side = "two-sided" if op == "in" else "one-sided"
     lines = [f"expected {text}",
-             f"  estimate {mean:.4g} (sd {sd:.3g}, {n} replications); {level:.0%} {side} t "
-             f"interval [{lo:.4g}, {hi:.4g}]; bound {_bound_text(op, a, b)}"]
+             (f"  estimate {mean:.4g} (sd {sd:.3g}, {n} replications); {level:.0%} {side} t "
+              f"interval [{lo:.4g}, {hi:.4g}]; bound {_bound_text(op, a, b)}")]
     if verdict == "refuted":
         lines.append("  the claim is false at this confidence")
         return "\n".join(lines)
@@ -161,8 +166,7 @@ def decide_quantile(text: str, values: Sequence[float], q: float, op: str, a: fl
     """Decide ``quantile_q(values) OP a`` with the distribution-free order-statistic
     interval: the ``k``-th smallest value is an upper bound of the ``q``-quantile with
     confidence ``P(Binomial(n, q) < k)``."""
-    from scipy.stats import binom
-
+    binom = _stats().binom
     n = len(values)
     ordered = sorted(values)
     side_level = _levels(op, level)
@@ -179,8 +183,8 @@ def decide_quantile(text: str, values: Sequence[float], q: float, op: str, a: fl
     estimate = ordered[min(n - 1, max(0, math.ceil(q * n) - 1))]
     side = "two-sided" if op == "in" else "one-sided"
     lines = [f"expected {text}",
-             f"  estimate {estimate:.4g} ({n} observations); {level:.0%} {side} "
-             f"order-statistic interval [{lo:.4g}, {hi:.4g}]; bound {_bound_text(op, a, b)}"]
+             (f"  estimate {estimate:.4g} ({n} observations); {level:.0%} {side} "
+              f"order-statistic interval [{lo:.4g}, {hi:.4g}]; bound {_bound_text(op, a, b)}")]
     if verdict == "refuted":
         lines.append("  the claim is false at this confidence")
     elif op in ("<=", "<", ">=", ">") and not math.isclose(below, q):

@@ -26,7 +26,7 @@ tests, one item per ``[[scenario]]``.
 
 from __future__ import annotations
 
-from collections.abc import Iterator, Sequence
+from collections.abc import Generator, Sequence
 from pathlib import Path
 from typing import Any
 
@@ -211,8 +211,11 @@ def regen_golden(request: pytest.FixtureRequest) -> bool:
 def golden(request: pytest.FixtureRequest) -> Any:
     """``golden(trace_or_result, path)``: compare with a stored golden trace (written instead
     with ``--opspec-regen-golden``); ``path`` is relative to the test file."""
-    from opspec.testing import golden as golden_module
-
+    try:
+        from opspec.testing import golden as golden_module
+    except ImportError:
+        pytest.fail("golden traces need opspec.testing.golden, which this installation "
+                    "lacks", pytrace=False)
     regenerate = bool(request.config.getoption("--opspec-regen-golden"))
     near = request.node.path
 
@@ -241,9 +244,10 @@ def device_profile(request: pytest.FixtureRequest) -> str:
 
 
 @pytest.hookimpl(hookwrapper=True)
-def pytest_runtest_makereport(item: pytest.Item, call: pytest.CallInfo[None]) -> Iterator[None]:
+def pytest_runtest_makereport(item: pytest.Item, call: pytest.CallInfo[None]
+                              ) -> Generator[None, Any, None]:
     outcome = yield
-    report = outcome.get_result()
+    report: pytest.TestReport = outcome.get_result()
     if call.excinfo is not None and isinstance(call.excinfo.value, OpspecError) and (
             report.failed and not isinstance(item, ScenarioItem)):
         # an opspec error in a test is a usage problem: its message says what and how to
@@ -252,8 +256,9 @@ def pytest_runtest_makereport(item: pytest.Item, call: pytest.CallInfo[None]) ->
     seed = item.stash.get(_SEED_KEY, None)
     if seed is not None and report.failed:
         base = item.config.getoption("--opspec-seed")
-        report.sections.append(("opspec", f"seed {seed} (from --opspec-seed={base} and the "
-                                          "test id; simulate(seed=...) overrides it)"))
+        text = (f"seed {seed} (from --opspec-seed={base} and the test id; "
+                "simulate(seed=...) overrides it)")
+        report.sections.append(("opspec", text))
 
 
 def _opspec_error_repr(item: pytest.Item, excinfo: pytest.ExceptionInfo[BaseException]

@@ -319,7 +319,7 @@ def load_script(path: str | Path) -> Script:
     unknown = set(document) - {"steps", "otherwise"}
     if unknown:
         raise ConfigurationError(f"unknown key(s) {', '.join(sorted(unknown))}",
-                                 location=SourceLocation(where, key=sorted(unknown)[0]),
+                                 location=SourceLocation(where, key=min(unknown)),
                                  hint="a script file has 'otherwise' and 'steps'")
     script = parse_script(list(document.get("steps", [])), where=where)
     if "otherwise" in document:

@@ -5,16 +5,10 @@ from __future__ import annotations
 from pathlib import Path
 
 import pytest
+import scipy.stats  # noqa: F401
 
 # pytester's in-process runs drop the modules an inner run imported; numpy (and so the engine)
 # cannot be imported twice in one process, so everything the inner runs use is imported here.
-import opspec.testing.expectations
-import opspec.testing.intervals
-import opspec.testing.scenario
-import opspec.testing.simulate
-import opspec.usermodels
-import opspec.xpdl.loader
-import scipy.stats  # noqa: F401
 
 pytest_plugins = ["pytester"]
 

@@ -49,8 +49,8 @@ def test_a_script_naming_an_unknown_activity_lists_the_activities(
 def test_it(spec, simulate):
     simulate(spec, script=[("after trg_2 90s", "press_reprot")])
 """)
-    result.stdout.fnmatch_lines(["*simulate(): *names activity 'press_reprot', which the spec "
-                                 "does not have (known activities: *press_report*"])
+    result.stdout.fnmatch_lines([("*simulate(): *names activity 'press_reprot', which the spec "
+                                  "does not have (known activities: *press_report*")])
 
 
 def test_a_statistical_claim_with_too_few_replications_says_how_many_it_needs(
@@ -63,8 +63,8 @@ def test_it(spec, simulate):
     result.assert_outcomes(failed=1)
     result.stdout.fnmatch_lines([
         "*expected rate doses_taken/doses_due >= 0.99 with 95% confidence",
-        "*estimate * (*/40 doses_due, 10 replication(s)); 95% one-sided Wilson interval "
-        "*; bound >= 0.99",
+        ("*estimate * (*/40 doses_due, 10 replication(s)); 95% one-sided Wilson interval "
+         "*; bound >= 0.99"),
         "*too few replications to decide: about * replications (~* doses_due) would*"])
     needed = int(re.search(r"about (\d+) replications", result.stdout.str())[1])  # type: ignore[index]
     assert needed > 10

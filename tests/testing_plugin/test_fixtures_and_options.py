@@ -133,4 +133,4 @@ def test_the_regen_golden_flag_reaches_the_tests(pytester: pytest.Pytester) -> N
 def test_the_options_are_in_pytest_help(pytester: pytest.Pytester) -> None:
     text = pytester.runpytest("--help").stdout.str()
     for option in ("--opspec-seed", "--opspec-regen-golden", "--device-url", "--device-profile"):
-        assert re.search(rf"^\s+{option}", text, re.M), option
+        assert re.search(rf"^\s+{option}", text, re.MULTILINE), option

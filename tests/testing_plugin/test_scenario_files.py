@@ -88,33 +88,33 @@ BAD = {
     "spec-not-found": ('spec = "nope.xpdl"\n[[scenario]]\nname = "x"\nthen = ["alarms == 1"]\n',
                        "spec: spec 'nope.xpdl' not found"),
     "no-scenarios": ('spec = "specs/dispenser.xpdl"\n', "scenario: no [[scenario]] tables"),
-    "unreadable-then": ('spec = "specs/dispenser.xpdl"\n[[scenario]]\nname = "x"\n'
-                        'then = ["alarms are many"]\n',
+    "unreadable-then": (('spec = "specs/dispenser.xpdl"\n[[scenario]]\nname = "x"\n'
+                        'then = ["alarms are many"]\n'),
                         "scenario[0].then[0]: cannot read the expectation 'alarms are many'"),
-    "unknown-metric": ('spec = "specs/dispenser.xpdl"\n[[scenario]]\nname = "x"\n'
-                       'then = ["doses == 1"]\n',
-                       "scenario[0].then[0]: 'doses == 1' names metric 'doses', which the spec "
-                       "does not have (the spec's metric names are: doses_due*"),
-    "unknown-given-key": ('spec = "specs/dispenser.xpdl"\n[[scenario]]\nname = "x"\n'
-                          'given = { user = 3 }\nthen = ["alarms == 1"]\n',
+    "unknown-metric": (('spec = "specs/dispenser.xpdl"\n[[scenario]]\nname = "x"\n'
+                       'then = ["doses == 1"]\n'),
+                       ("scenario[0].then[0]: 'doses == 1' names metric 'doses', which the spec "
+                       "does not have (the spec's metric names are: doses_due*")),
+    "unknown-given-key": (('spec = "specs/dispenser.xpdl"\n[[scenario]]\nname = "x"\n'
+                          'given = { user = 3 }\nthen = ["alarms == 1"]\n'),
                           "scenario[0].given.user: unknown key 'user'"),
-    "bad-script-step": ('spec = "specs/dispenser.xpdl"\n[[scenario]]\nname = "x"\n'
-                        'given = { script = [["soon", "press_report"]] }\nthen = ["alarms == 1"]\n',
+    "bad-script-step": (('spec = "specs/dispenser.xpdl"\n[[scenario]]\nname = "x"\n'
+                        'given = { script = [["soon", "press_report"]] }\nthen = ["alarms == 1"]\n'),
                         "scenario[0].given.script: steps[0]: cannot read the time 'soon'*"),
-    "script-unknown-activity": ('spec = "specs/dispenser.xpdl"\n[[scenario]]\nname = "x"\n'
+    "script-unknown-activity": (('spec = "specs/dispenser.xpdl"\n[[scenario]]\nname = "x"\n'
                                 'given = { script = [["never", "report"]] }\n'
-                                'then = ["alarms == 1"]\n',
+                                'then = ["alarms == 1"]\n'),
                                 "scenario[0].given.script: the script names activity 'report'*"),
-    "negative-users": ('spec = "specs/dispenser.xpdl"\n[[scenario]]\nname = "x"\n'
-                       'given = { users = 0 }\nthen = ["alarms == 1"]\n',
+    "negative-users": (('spec = "specs/dispenser.xpdl"\n[[scenario]]\nname = "x"\n'
+                       'given = { users = 0 }\nthen = ["alarms == 1"]\n'),
                        "scenario[0].given.users: users must be a whole number >= 1, not 0"),
     "not-toml": ('spec = \n', "not valid TOML*"),
-    "twice-the-same-name": ('spec = "specs/dispenser.xpdl"\n[[scenario]]\nname = "x"\n'
+    "twice-the-same-name": (('spec = "specs/dispenser.xpdl"\n[[scenario]]\nname = "x"\n'
                             'then = ["alarms == 1"]\n[[scenario]]\nname = "x"\n'
-                            'then = ["alarms == 1"]\n',
+                            'then = ["alarms == 1"]\n'),
                             "scenario[1].name: scenario name 'x' is used twice"),
-    "unknown-user-model": ('spec = "specs/dispenser.xpdl"\n[[scenario]]\nname = "x"\n'
-                           'given = { user_model = "nobody" }\nthen = ["alarms == 1"]\n',
+    "unknown-user-model": (('spec = "specs/dispenser.xpdl"\n[[scenario]]\nname = "x"\n'
+                           'given = { user_model = "nobody" }\nthen = ["alarms == 1"]\n'),
                            "scenario[0].given.user_model: *nobody*"),
 }
 
