@@ -239,6 +239,18 @@ class SimulationResult:
                 out.append(value)
         return out
 
+    def counts(self, numerator: str, denominator: str) -> tuple[int, int]:
+        """Pooled ``(successes, trials)`` of two count metrics, for rate assertions
+        (``counts("doses_taken", "doses_due")``)."""
+        pair = []
+        for metric in (numerator, denominator):
+            name, _ = self._split(metric)
+            if self.metrics[name]["kind"] != "count":
+                raise ConfigurationError(f"metric {name!r} is a {self.metrics[name]['kind']}, "
+                                         "not a count", hint="a rate is count / count")
+            pair.append(int(self.metrics[name]["total"]))
+        return pair[0], pair[1]
+
     def observations(self, metric: str) -> list[float]:
         """Every sample of a duration metric, pooled over replications (for quantiles)."""
         name, _ = self._split(metric)

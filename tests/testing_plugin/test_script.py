@@ -128,3 +128,17 @@ def test_after_an_activity_counts_from_its_completion(spec: object) -> None:
     result = simulate(spec, script=[("after sound_alarm 45s", "press_report")],  # type: ignore[arg-type]
                       until=9 * 3600)
     assert result.value("report_latency_s") == 45.0
+
+
+def test_many_users_pool_metrics_and_keep_per_user_samples(spec: object) -> None:
+    result = simulate(spec, users=5, user_model="dispenser-reference", seed=2)  # type: ignore[arg-type]
+    assert result.replications == 5 and len(result.samples("doses_due")) == 5
+    assert result.counts("doses_taken", "doses_due") == (result.value("doses_taken"), 20)
+    assert result.value("report_latency_s.n") == len(result.observations("report_latency_s"))
+    assert sum(result.samples("alarms")) == result.value("alarms")
+    again = simulate(spec, users=3, user_model="dispenser-reference", seed=2)  # type: ignore[arg-type]
+    assert again.samples("report_latency_s") == result.samples("report_latency_s")[:3]
+    with pytest.raises(ConfigurationError, match="has 5 replications, so it has no single trace"):
+        _ = result.trace
+    with pytest.raises(ConfigurationError, match="'alarms_per_dose' is a ratio, not a count"):
+        result.counts("alarms_per_dose", "doses_due")
