@@ -1,0 +1,75 @@
+"""The user lane of a compiled package, as the front ends need it.
+
+``opspec run``, ``opspec evaluate``, the walkthrough and the test helpers all bind one user
+performer to the names the user lane's activities are offered under, and check a user model
+against the lane's manual activities and deferred choices before anything runs. This module
+answers both questions once, from the compiled tables.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterator
+from dataclasses import dataclass
+
+from opspec.engine.compiled import K_GATEWAY, K_MANUAL, CompiledActivity, CompiledPackage
+
+__all__ = ["UserLane", "all_activities", "user_lane"]
+
+
+@dataclass(frozen=True, slots=True)
+class UserLane:
+    """What the user lane of a package asks of its performer.
+
+    - ``bind_names``: participant ids (or lane names) to bind the user performer to;
+    - ``manual``: ids of the manual activities a user performs, in spec order;
+    - ``choices``: deferred-choice activity id → the ids of its alternatives.
+    """
+
+    bind_names: tuple[str, ...]
+    manual: tuple[str, ...]
+    choices: dict[str, tuple[str, ...]]
+
+    @property
+    def empty(self) -> bool:
+        return not self.manual and not self.choices
+
+
+def all_activities(compiled: CompiledPackage) -> Iterator[CompiledActivity]:
+    """Every compiled activity of every process, activity sets included."""
+    for proc in compiled.processes.values():
+        stack = [proc.graph]
+        while stack:
+            graph = stack.pop()
+            for act in graph.activities:
+                yield act
+                if act.block is not None:
+                    stack.append(act.block)
+
+
+def user_lane(compiled: CompiledPackage) -> UserLane:
+    """The user lane of ``compiled`` (``bind_names`` is ``("user",)`` when nothing names it)."""
+    names: dict[str, None] = {}
+    manual: dict[str, None] = {}
+    choices: dict[str, tuple[str, ...]] = {}
+    for proc in compiled.processes.values():
+        stack = [proc.graph]
+        while stack:
+            graph = stack.pop()
+            for act in graph.activities:
+                if act.block is not None:
+                    stack.append(act.block)
+                if not act.user_lane:
+                    continue
+                name = act.participant or (act.lanes[0] if act.lanes else None)
+                if name:
+                    names[name] = None
+                if act.kind == K_MANUAL:
+                    manual[act.id] = None
+                # a deferred choice: an event-based gateway, or an activity whose own
+                # outgoing transitions are offered as alternatives after it completes
+                branches = act.choice or (act.out if act.kind == K_GATEWAY else ())
+                alternatives = tuple(graph.activities[t.target].id for t in branches
+                                     if graph.activities[t.target].kind == K_MANUAL)
+                if alternatives:
+                    choices[act.id] = alternatives
+    return UserLane(tuple(names) or ("user",), tuple(manual), choices)
