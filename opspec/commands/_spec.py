@@ -1,0 +1,119 @@
+"""What several commands share: loading a spec (XPDL or ``.wfs``) and choosing the user lane's
+performer (a script, a user model, or the spec's companion ``SPEC.users.toml``)."""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+from opspec.errors import ConfigurationError
+
+if TYPE_CHECKING:
+    from opspec.engine.compiled import CompiledPackage
+    from opspec.engine.performers import Performer
+    from opspec.engine.trace import TraceListener
+    from opspec.model import Package
+
+__all__ = ["UserChoice", "choose_user", "companion_user_model", "load_any_spec"]
+
+
+def load_any_spec(path: str | Path) -> Package:
+    """The package in ``path``: a compiled workflow script (``.wfs``) or an XPDL file.
+
+    Raises :class:`~opspec.errors.SpecError` (with ``path:line``) for a broken spec and
+    :class:`~opspec.errors.ConfigurationError` for a path that is not a readable file.
+    """
+    target = Path(path)
+    if not target.is_file():
+        what = "a folder" if target.is_dir() else "not found"
+        raise ConfigurationError(f"{target}: {what}; give one specification file",
+                                 hint="e.g. specs/medication_dispenser.xpdl")
+    if target.suffix == ".wfs":
+        from opspec.model.codec import read_wfs
+
+        return read_wfs(target)
+    from opspec.xpdl.loader import load_spec
+
+    return load_spec(target)
+
+
+def companion_user_model(spec_path: str | Path) -> Path | None:
+    """``SPEC.users.toml`` next to the spec, if there is one."""
+    path = Path(spec_path)
+    candidate = path.with_name(path.name.removesuffix(path.suffix) + ".users.toml")
+    return candidate if candidate.is_file() else None
+
+
+@dataclass(frozen=True)
+class UserChoice:
+    """Who performs the user lane: ``make(user_index, seed)`` builds a fresh performer and
+    the listeners it needs (a scripted user listens to the trace to anchor its steps);
+    ``describe`` says so in words for the run's header."""
+
+    describe: str
+    make: Callable[[int, int], tuple[Performer | None, list[TraceListener]]]
+
+
+def choose_user(compiled: CompiledPackage, spec_path: str | Path, *, script: str | None,
+                user_model: str | None, companion: bool = True) -> UserChoice:
+    """The user-lane performer the options ask for, checked against the spec before any run.
+
+    ``script`` wins over ``user_model``; with neither, the spec's companion user model is used
+    when ``companion`` is true and one exists; otherwise nobody performs the user lane.
+    """
+    from opspec.engine.lanes import user_lane
+
+    lane = user_lane(compiled)
+    if script is not None and user_model is not None:
+        raise ConfigurationError("give --script or --user-model, not both",
+                                 hint="a script plays exact actions; a model draws them")
+    if script is not None:
+        from opspec.testing.script import load_script
+
+        plan = load_script(script)
+        from opspec.engine.lanes import all_activities
+
+        triggers = {t.name for a in all_activities(compiled)
+                    for t in (a.raises, a.trigger, a.start_trigger, a.end_trigger)
+                    if t is not None and t.name}
+        triggers |= {t.name for p in compiled.processes.values()
+                     for t in (p.start_trigger, p.end_trigger) if t is not None and t.name}
+        plan.check_names([a.id for a in all_activities(compiled)], sorted(triggers))
+
+        def scripted(_user: int, _seed: int) -> tuple[Performer | None, list[TraceListener]]:
+            performer = plan.performer()
+            return performer, [performer]
+
+        return UserChoice(f"the script {script}", scripted)
+    ref: str | Path | None = user_model
+    if ref is None and companion:
+        ref = companion_user_model(spec_path)
+    if ref is None:
+        def nobody(_user: int, _seed: int) -> tuple[Performer | None, list[TraceListener]]:
+            return None, []
+
+        text = ("nobody (no --script or --user-model, and no companion .users.toml): "
+                "user-lane activities wait" if not lane.empty else "nobody (no user lane)")
+        return UserChoice(text, nobody)
+    from opspec.engine.random import user_stream
+    from opspec.usermodels.loader import load_user_model
+
+    model = load_user_model(ref)
+    if not lane.empty:
+        model.validate_against(lane.manual, choices=lane.choices)
+
+    def stochastic(user: int, seed: int) -> tuple[Performer | None, list[TraceListener]]:
+        return model.performer(user_stream(seed, user)), []
+
+    return UserChoice(f"the user model {ref}", stochastic)
+
+
+def bind_user(compiled: CompiledPackage, performer: Performer | None) -> dict[str, Any]:
+    """Performer bindings giving ``performer`` the whole user lane (empty for nobody)."""
+    if performer is None:
+        return {}
+    from opspec.engine.lanes import user_lane
+
+    return {name: performer for name in user_lane(compiled).bind_names}

@@ -1,0 +1,430 @@
+"""``opspec run SPEC``: one simulation of a spec, as a readable timeline or one JSON object.
+
+The user lane is performed by ``--script FILE`` (exact actions), ``--user-model FILE|PRESET``
+(a stochastic user), or by default the spec's companion ``SPEC.users.toml`` when there is one.
+``--trace FILE`` streams every event to JSON Lines as the run goes (flushed on every exit
+path, so an interrupted run keeps what happened). ``--bind PARTICIPANT=URL`` binds
+participants to serial devices (docs in ``devices/README.md``); a bound real device switches
+the run to wall-clock time.
+
+Exit status: 0 the run ended normally; 1 the run found a problem (a deadlock, an aborted
+instance, a device fault); 2 usage, configuration or I/O errors (from the CLI).
+"""
+
+from __future__ import annotations
+
+import argparse
+import contextlib
+import json
+import math
+import sys
+from collections.abc import Iterator
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+from opspec.errors import ConfigurationError
+
+if TYPE_CHECKING:
+    from opspec.engine.simulation import RunResult
+    from opspec.engine.trace import TraceEvent
+
+__all__ = ["json_metrics", "register", "run", "timeline_line"]
+
+DAY = 86_400.0
+
+# Kinds shown in the default (brief) timeline: what a reader follows; the full trace has all.
+BRIEF_KINDS = frozenset({
+    "process.started", "process.completed", "process.terminated", "process.aborted",
+    "activity.completed", "activity.omitted", "activity.failed", "activity.aborted",
+    "activity.withdrawn", "trigger.raised", "deadline.expired", "exception.raised",
+    "mode.changed", "fault", "deadlock", "device.note", "user.decision",
+})
+
+
+def register(subparsers: Any) -> None:
+    parser = subparsers.add_parser(
+        "run", help="run one simulation of a spec and show what happened",
+        description="Run SPEC (XPDL or .wfs) once on the simulated clock, device workflows "
+        "and the user lane together, and print a timeline, the spec's metrics and a summary "
+        "(or one JSON object with --json). Exit status: 0 normal end; 1 a deadlock, an "
+        "aborted instance or a device fault; 2 usage or configuration errors.")
+    parser.add_argument("spec", metavar="SPEC", help="the specification (.xpdl or .wfs)")
+    length = parser.add_mutually_exclusive_group()
+    length.add_argument("--days", type=float, metavar="D",
+                        help="simulated days to run (default: 1 for specs with periodic "
+                        "triggers, else until nothing is left to do)")
+    length.add_argument("--until", metavar="T",
+                        help="simulated end time: seconds, or an ISO 8601 duration (PT8H)")
+    parser.add_argument("--seed", type=int, default=0, help="run seed (default 0)")
+    user = parser.add_mutually_exclusive_group()
+    user.add_argument("--script", metavar="FILE",
+                      help="a scripted user (TOML/JSON steps, or a recorded walkthrough)")
+    user.add_argument("--user-model", metavar="FILE|PRESET",
+                      help="a stochastic user model (file or preset; 'A,B' chains a modifier)")
+    user.add_argument("--no-user", action="store_true",
+                      help="nobody performs the user lane (ignore SPEC.users.toml)")
+    parser.add_argument("--trace", metavar="FILE", help="write the full trace as JSON Lines")
+    parser.add_argument("--engine-config", metavar="FILE", help="engine configuration TOML")
+    parser.add_argument("--processor-model", choices=("dedicated", "pooled"),
+                        help="override the configuration's processor model")
+    parser.add_argument("--workers", type=int, help="override the pooled model's workers")
+    parser.add_argument("--realtime", action="store_true",
+                        help="run against the wall clock (see --speed)")
+    parser.add_argument("--speed", type=float, default=None,
+                        help="with --realtime: simulated seconds per wall second (default 1)")
+    parser.add_argument("--bind", action="append", default=[], metavar="PARTICIPANT=URL",
+                        help="bind a participant to a serial device URL or 'auto' "
+                        "(repeatable; see devices/README.md)")
+    parser.add_argument("--devices", metavar="DIR",
+                        help="folder of device profiles for --bind (default: devices/)")
+    parser.add_argument("--timeline", choices=("brief", "all", "none"), default="brief",
+                        help="which events the printed timeline shows (default brief)")
+    parser.add_argument("--json", action="store_true",
+                        help="print one JSON object (metrics shaped as opspec evaluate --json)")
+    parser.set_defaults(handler=run)
+
+
+def run(args: argparse.Namespace) -> int:
+    from opspec.commands._spec import bind_user, choose_user, load_any_spec
+    from opspec.engine.compiled import compile_package
+    from opspec.engine.simulation import Simulation
+    from opspec.engine.trace_sinks import JsonlSink
+
+    package = load_any_spec(args.spec)
+    compiled = compile_package(package)
+    config = _config(args)
+    horizon = _horizon(args, compiled)
+    user = choose_user(compiled, args.spec, script=args.script, user_model=args.user_model,
+                       companion=not args.no_user)
+    out = sys.stdout
+    printer = None if args.json or args.timeline == "none" else _Timeline(
+        out, brief=args.timeline == "brief", quiet=quiet_activities(compiled))
+    if not args.json:
+        length = ("until nothing is left to do" if horizon is None
+                  else f"for {_span(horizon)} simulated")
+        print(f"opspec run: {package.name or package.id} ({args.spec}), seed {args.seed}, "
+              f"{length}", file=out)
+        print(f"  user lane: {user.describe}", file=out)
+        print(f"  engine: {config.processor_model}"
+              + (f", {config.workers} worker(s)" if config.pooled else "")
+              + (f", wall clock at {config.speed:g}x" if config.realtime else ""), file=out)
+    performer, listeners = user.make(0, args.seed)
+    performers: dict[str, Any] = bind_user(compiled, performer)
+    performers.update(_world_performers(compiled, args.seed))
+    with contextlib.ExitStack() as stack:
+        devices = _devices(args, stack)
+        if devices is not None:
+            performers.update(devices.performers)
+            for note in devices.notes:
+                if not args.json:
+                    print(f"  device: {note}", file=out)
+            if devices.requires_wall_clock and not config.realtime:
+                config = config.with_options(realtime=True, speed=args.speed or 1.0)
+                if not args.json:
+                    print("  a real device is bound: running on the wall clock", file=out)
+        sink = None
+        if args.trace:
+            sink = stack.enter_context(_open_sink(JsonlSink, args.trace, {
+                "spec": str(args.spec), "seed": args.seed, "package": package.id}))
+            listeners.append(sink)
+        if printer is not None:
+            listeners.append(printer)
+            if not args.json:
+                print(file=out)
+        sim = Simulation(compiled, config, performers=performers, seed=args.seed,
+                         listeners=listeners)
+        if devices is not None:
+            devices.install(sim)
+        result = sim.run(until=horizon)
+        medians = _medians(sim)
+        device_report = devices.report() if devices is not None else None
+    if args.json:
+        print(json.dumps(_json_document(args, package, horizon, result, device_report,
+                                        medians),
+                         default=str, allow_nan=False))
+    else:
+        _print_summary(out, result, medians, args.trace, device_report,
+                       shown=printer.shown if printer else 0)
+    problems = result.summary.get("deadlocks") or result.summary.get("faults") or (
+        result.summary.get("instances", {}).get("aborted", 0))
+    return 1 if problems else 0
+
+
+# ---------------------------------------------------------------------------- options
+
+
+def _config(args: argparse.Namespace) -> Any:
+    from opspec.engine.config import EngineConfig
+
+    config = EngineConfig.load(args.engine_config) if args.engine_config else EngineConfig()
+    overrides: dict[str, Any] = {}
+    if args.processor_model:
+        overrides["processor_model"] = args.processor_model
+    if args.workers is not None:
+        overrides["workers"] = args.workers
+    if args.speed is not None and not args.realtime and not config.realtime:
+        raise ConfigurationError("--speed only applies with --realtime",
+                                 hint="add --realtime, or drop --speed")
+    if args.realtime:
+        overrides["realtime"] = True
+        overrides["speed"] = args.speed if args.speed is not None else 1.0
+    return config.with_options(**overrides) if overrides else config
+
+
+def _horizon(args: argparse.Namespace, compiled: Any) -> float | None:
+    if args.days is not None:
+        if not (args.days > 0 and math.isfinite(args.days)):
+            raise ConfigurationError(f"--days must be a positive number, not {args.days:g}")
+        return float(args.days * DAY)
+    if args.until is not None:
+        return _parse_until(args.until)
+    periodic = any(p.start_trigger is not None and p.start_trigger.kind in ("timer", "period")
+                   for p in compiled.processes.values())
+    return DAY if periodic else None
+
+
+def _parse_until(text: str) -> float:
+    try:
+        value = float(text)
+    except ValueError:
+        from opspec.xpdl.durations import parse_duration
+
+        try:
+            value = parse_duration(text)
+        except Exception:  # noqa: BLE001 - any parse failure is the same usage error
+            raise ConfigurationError(f"--until {text!r} is not a number of seconds or an "
+                                     "ISO 8601 duration", hint="e.g. --until 3600 or "
+                                     "--until PT8H") from None
+    if not (value > 0 and math.isfinite(value)):
+        raise ConfigurationError(f"--until must be a positive time, not {text!r}")
+    return value
+
+
+def _world_performers(compiled: Any, seed: int) -> dict[str, Any]:
+    try:
+        from opspec.bindings.worlds import world_performers
+    except ImportError:
+        return {}
+    return dict(world_performers(compiled, seed=seed, user=0))
+
+
+def _devices(args: argparse.Namespace, stack: contextlib.ExitStack) -> Any:
+    if not args.bind:
+        return None
+    try:
+        from opspec.bindings.attach import attach_devices
+    except ImportError:
+        raise ConfigurationError("--bind is not available in this build of opspec") from None
+    folder = args.devices or _default_devices()
+    return stack.enter_context(attach_devices(args.bind, folder))
+
+
+def _default_devices() -> Path:
+    here = Path.cwd() / "devices"
+    if here.is_dir():
+        return here
+    return Path(__file__).resolve().parents[2] / "devices"
+
+
+@contextlib.contextmanager
+def _open_sink(factory: Any, path: str, header: dict[str, Any]) -> Iterator[Any]:
+    try:
+        Path(path).parent.mkdir(parents=True, exist_ok=True)
+        sink = factory(path, header)
+    except OSError as error:
+        raise ConfigurationError(f"cannot write the trace {path}: "
+                                 f"{error.strerror or error}",
+                                 hint="choose a writable path with --trace") from None
+    try:
+        yield sink
+    finally:
+        sink.close()
+
+
+# ---------------------------------------------------------------------------- output
+
+
+def clock(seconds: float) -> str:
+    """``d1 08:00:00`` (day 1 is the first day) or ``d1 08:00:00.250`` with fractions."""
+    day, rest = divmod(seconds, DAY)
+    hours, rest = divmod(rest, 3600)
+    minutes, secs = divmod(rest, 60)
+    frac = f"{secs:06.3f}" if abs(secs - round(secs)) > 1e-6 else f"{round(secs):02d}"
+    return f"d{int(day) + 1} {int(hours):02d}:{int(minutes):02d}:{frac}"
+
+
+def _span(seconds: float) -> str:
+    if seconds >= DAY and seconds % DAY == 0:
+        days = int(seconds // DAY)
+        return f"{days} day{'s' if days != 1 else ''}"
+    if seconds >= 3600:
+        return f"{seconds / 3600:g} h"
+    return f"{seconds:g} s"
+
+
+def timeline_line(event: TraceEvent) -> str:
+    """One readable line: time, lane, process#instance, what happened, key details."""
+    data = event.data or {}
+    kind = event.kind
+    what: str
+    if kind == "trigger.raised":
+        what = f"trigger {data.get('name', '?')} raised" + (
+            f" by {event.activity}" if event.activity else "")
+    elif kind.startswith("activity."):
+        verb = kind.split(".", 1)[1]
+        what = f"{event.activity} {verb}"
+        if data.get("choice"):
+            what += f" (chose {data['choice']})"
+    elif kind.startswith("process."):
+        what = f"{event.process} {kind.split('.', 1)[1]}"
+    elif kind == "deadline.expired":
+        what = f"deadline of {event.activity} expired"
+    elif kind == "exception.raised":
+        what = f"exception {data.get('exception', '?')} at {event.activity}"
+    else:
+        what = kind + (f" {event.activity}" if event.activity else "")
+    details = ("reason", "message", "latency") + (
+        () if kind == "exception.raised" else ("exception",))
+    for key in details:
+        if key in data:
+            value = data[key]
+            if isinstance(value, float):
+                value = f"{value:g}"
+            what += f"  [{key}: {value}]"
+            break
+    where = f"{event.process or ''}#{event.instance}" if event.instance is not None else (
+        event.process or "")
+    lane = event.lane or ("" if event.process is None else "device")
+    return f"{clock(event.time):>16}  {lane:<7} {where:<24} {what}"
+
+
+def quiet_activities(compiled: Any) -> frozenset[tuple[str, str]]:
+    """(process, activity) pairs whose completion says nothing to a reader: routes, start and
+    end events, and other activities that do no work."""
+    from opspec.engine.compiled import K_GATEWAY, K_NOOP
+    from opspec.engine.lanes import all_activities
+
+    return frozenset((a.process, a.id) for a in all_activities(compiled)
+                     if a.kind in (K_NOOP, K_GATEWAY) and a.sampler is None and not a.raises)
+
+
+class _Timeline:
+    """A trace listener printing the timeline as the run goes (nothing is held back)."""
+
+    def __init__(self, out: Any, *, brief: bool, quiet: frozenset[tuple[str, str]]) -> None:
+        self.out = out
+        self.selects = None
+        self.brief = brief
+        self.quiet = quiet
+        self.shown = 0
+
+    def __call__(self, event: TraceEvent) -> None:
+        if self.brief and not self._worth_showing(event):
+            return
+        self.shown += 1
+        print(timeline_line(event), file=self.out)
+
+    def _worth_showing(self, event: TraceEvent) -> bool:
+        if event.kind not in BRIEF_KINDS:
+            return False
+        if event.kind == "activity.completed":
+            return (event.process or "", event.activity or "") not in self.quiet and (
+                "choice" in (event.data or {}) or event.activity is not None)
+        if event.kind == "exception.raised":   # the deadline line already said it
+            return "deadline" not in str((event.data or {}).get("message", ""))
+        return True
+
+
+def _medians(sim: Any) -> dict[str, float]:
+    from statistics import median
+
+    samples = sim.metrics.samples if sim.metrics is not None else {}
+    return {name: median(values) for name, values in samples.items() if values}
+
+
+def json_metrics(metrics: dict[str, dict[str, Any]],
+                 medians: dict[str, float] | None = None) -> dict[str, dict[str, Any]]:
+    """The run's metrics in the shape of ``opspec evaluate --json`` for one replication:
+    counts with ``total``; durations with ``mean``, ``median``, ``p95``, ``n``; ratios with
+    ``value``."""
+    out: dict[str, dict[str, Any]] = {}
+    for name, value in metrics.items():
+        kind = value.get("kind")
+        if kind == "count":
+            out[name] = {"kind": "count", "total": value.get("total", 0)}
+        elif kind == "duration":
+            out[name] = {"kind": "duration", "mean": value.get("mean"),
+                         "median": (medians or {}).get(name), "p95": value.get("p95"),
+                         "n": value.get("n", 0), "min": value.get("min"),
+                         "max": value.get("max")}
+        else:
+            out[name] = dict(value)
+    return out
+
+
+def _json_document(args: argparse.Namespace, package: Any, horizon: float | None,
+                   result: RunResult, devices: dict[str, Any] | None,
+                   medians: dict[str, float]) -> dict[str, Any]:
+    summary = result.summary
+    doc: dict[str, Any] = {
+        "spec": str(args.spec), "package": package.id, "seed": args.seed,
+        "days": args.days, "until": horizon, "time": summary.get("time"),
+        "metrics": json_metrics(result.metrics, medians),
+        "instances": summary.get("instances"), "events": summary.get("events"),
+        "deadlocks": [d.get("message") for d in summary.get("deadlocks") or []],
+        "faults": [f.get("message") for f in summary.get("faults") or []],
+        "trace": args.trace,
+    }
+    if summary.get("drift"):
+        doc["drift"] = summary["drift"]
+    if summary.get("pool"):
+        doc["pool"] = summary["pool"]
+    if devices is not None:
+        doc["devices"] = devices
+    return doc
+
+
+def _fmt(value: Any, unit: str = "") -> str:
+    if value is None:
+        return "-"
+    if isinstance(value, float):
+        return f"{value:.4g}{unit}"
+    return f"{value}{unit}"
+
+
+def _print_summary(out: Any, result: RunResult, medians: dict[str, float], trace: str | None,
+                   devices: dict[str, Any] | None, *, shown: int) -> None:
+    summary = result.summary
+    print(file=out)
+    metrics = json_metrics(result.metrics, medians)
+    if metrics:
+        print("metrics", file=out)
+        width = max(len(n) for n in metrics)
+        for name, value in metrics.items():
+            if value["kind"] == "count":
+                text = f"{value['total']}"
+            elif value["kind"] == "duration":
+                text = (f"n {value['n']}" if not value["n"] else
+                        f"mean {_fmt(value['mean'], ' s')}, median {_fmt(value['median'], ' s')}"
+                        f", p95 {_fmt(value['p95'], ' s')}, n {value['n']}")
+            else:
+                text = _fmt(value.get("value"))
+            print(f"  {name:<{width}}  {text}", file=out)
+    counts = summary.get("instances", {})
+    parts = ", ".join(f"{k} {v}" for k, v in counts.items() if v)
+    print(f"ended at {clock(summary.get('time', 0.0))}: {summary.get('events', 0)} events"
+          f" ({shown} shown), instances: {parts or 'none'}", file=out)
+    drift = summary.get("drift")
+    if drift:
+        print(f"wall-clock drift: mean {drift.get('mean_s', 0) * 1000:.2f} ms, "
+              f"max {drift.get('max_s', 0) * 1000:.2f} ms over {drift.get('events', 0)} "
+              "events", file=out)
+    if devices:
+        for name, info in devices.items() if isinstance(devices, dict) else []:
+            print(f"device {name}: {info}", file=out)
+    for problem in summary.get("deadlocks") or []:
+        print(f"deadlock: {problem.get('message')}", file=out)
+    for fault in summary.get("faults") or []:
+        print(f"fault: {fault.get('message')}", file=out)
+    if trace:
+        print(f"trace: {trace}", file=out)

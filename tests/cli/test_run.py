@@ -1,0 +1,181 @@
+"""`opspec run`: one simulation, a readable timeline, JSON metrics, traces that are never lost."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import pytest
+
+from opspec.cli import main
+from opspec.engine.trace_sinks import read_trace
+
+ROOT = Path(__file__).resolve().parents[2]
+SPEC = ROOT / "specs" / "medication_dispenser.xpdl"
+FIRST_DOSE = ["--until", str(9 * 3600)]       # 08:00 dose plus its alarms and deadline
+
+
+def run_json(capsys: pytest.CaptureFixture[str], *args: str) -> tuple[int, dict]:
+    status = main(["run", str(SPEC), "--json", *args])
+    out = capsys.readouterr().out
+    return status, json.loads(out)
+
+
+def script(tmp_path: Path, *steps: tuple[str, str]) -> str:
+    path = tmp_path / "user.toml"
+    body = ",\n".join(f'  ["{when}", "{action}"]' for when, action in steps)
+    path.write_text(f'otherwise = "complete"\nsteps = [\n{body}\n]\n', encoding="utf-8")
+    return str(path)
+
+
+def test_user_reporting_90s_after_the_alarm_takes_the_dose(tmp_path, capsys):
+    status, doc = run_json(capsys, *FIRST_DOSE,
+                           "--script", script(tmp_path, ("after trg_2 90s", "press_report")))
+    assert status == 0
+    metrics = doc["metrics"]
+    assert metrics["doses_taken"] == {"kind": "count", "total": 1}
+    assert metrics["doses_missed"]["total"] == 0
+    latency = metrics["report_latency_s"]
+    assert latency["n"] == 1
+    assert latency["mean"] == pytest.approx(90.0)
+    assert latency["median"] == pytest.approx(90.0)
+    assert latency["p95"] == pytest.approx(90.0)
+
+
+def test_user_who_never_reports_gets_three_alarms_a_miss_and_the_caregiver(tmp_path, capsys):
+    status, doc = run_json(capsys, *FIRST_DOSE, "--script", script(
+        tmp_path, ("never", "press_report")))
+    assert status == 0
+    metrics = doc["metrics"]
+    assert metrics["alarms"]["total"] == 3
+    assert metrics["doses_missed"]["total"] == 1
+    assert metrics["caregiver_notified"]["total"] == 1
+    assert metrics["doses_taken"]["total"] == 0
+
+
+def test_json_has_the_run_parameters_and_instance_counts(capsys):
+    status, doc = run_json(capsys, "--days", "2", "--seed", "7")
+    assert status == 0
+    assert doc["seed"] == 7 and doc["days"] == 2 and doc["until"] == 2 * 86400
+    assert doc["metrics"]["doses_due"]["total"] == 8
+    assert doc["instances"]["started"] == doc["instances"]["completed"]
+    assert doc["deadlocks"] == [] and doc["faults"] == []
+
+
+def test_same_seed_same_run_and_another_seed_differs(capsys):
+    _, first = run_json(capsys, "--days", "3", "--seed", "11")
+    _, again = run_json(capsys, "--days", "3", "--seed", "11")
+    _, other = run_json(capsys, "--days", "3", "--seed", "12")
+    assert first["metrics"] == again["metrics"]
+    assert first["metrics"] != other["metrics"]
+
+
+def test_timeline_shows_the_story_of_a_dose(tmp_path, capsys):
+    status = main(["run", str(SPEC), *FIRST_DOSE, "--script",
+                   script(tmp_path, ("after trg_2 90s", "press_report"))])
+    out = capsys.readouterr().out
+    assert status == 0
+    assert "user lane: the script" in out
+    lines = out.splitlines()
+    alarm = next(i for i, line in enumerate(lines) if "sound_alarm completed" in line)
+    report = next(i for i, line in enumerate(lines) if "press_report completed" in line)
+    dispense = next(i for i, line in enumerate(lines) if "dispense completed" in line)
+    assert alarm < report < dispense
+    assert lines[alarm].strip().startswith("d1 08:00:00")
+    assert lines[report].strip().startswith("d1 08:01:30")
+    assert "doses_taken" in out and "report_latency_s" in out
+    # routes and start/end events are left out of the brief timeline
+    assert "merge completed" not in out
+
+
+def test_trace_file_holds_every_event_and_reads_back(tmp_path, capsys):
+    trace = tmp_path / "out" / "run.jsonl"
+    status, doc = run_json(capsys, "--days", "1", "--trace", str(trace))
+    assert status == 0 and doc["trace"] == str(trace)
+    events = list(read_trace(trace))
+    assert len(events) == doc["events"]
+    assert events[0].kind == "run.started" and events[-1].kind == "run.ended"
+
+
+def test_companion_user_model_is_used_unless_told_otherwise(capsys):
+    main(["run", str(SPEC), "--days", "1"])
+    assert "medication_dispenser.users.toml" in capsys.readouterr().out
+    status = main(["run", str(SPEC), "--days", "1", "--no-user"])
+    out = capsys.readouterr().out
+    assert "user-lane activities wait" in out
+    # nobody performs the lane, so its instances wait forever: reported, not hidden
+    assert status == 1
+    assert "no performer is bound" in out
+
+
+def test_pooled_processor_model_reports_its_pool(capsys):
+    status, doc = run_json(capsys, "--days", "1", "--processor-model", "pooled",
+                           "--workers", "2")
+    assert status == 0
+    assert doc["pool"]["workers"] == 2
+
+
+def test_realtime_at_high_speed_reports_drift(tmp_path, capsys):
+    status, doc = run_json(capsys, "--until", "30000", "--realtime", "--speed", "100000",
+                           "--script", script(tmp_path, ("after trg_2 30s", "press_report")))
+    assert status == 0
+    assert doc["drift"]["events"] > 0
+    assert doc["metrics"]["doses_taken"]["total"] == 1
+
+
+@pytest.mark.parametrize("args, message", [
+    (["--speed", "10"], "--speed only applies with --realtime"),
+    (["--days", "-1"], "--days must be a positive number"),
+    (["--until", "soon"], "is not a number of seconds or an ISO 8601 duration"),
+    (["--user-model", "no-such-preset"], "no-such-preset"),
+    (["--engine-config", "/nonexistent/engine.toml"], "engine.toml"),
+], ids=["speed-without-realtime", "negative-days", "bad-until", "unknown-preset",
+        "missing-engine-config"])
+def test_bad_options_are_one_line_errors_with_status_2(args, message, capsys):
+    status = main(["run", str(SPEC), *args])
+    err = capsys.readouterr().err
+    assert status == 2
+    assert message in err
+    assert "Traceback" not in err
+
+
+def test_script_naming_an_unknown_activity_lists_the_real_ones(tmp_path, capsys):
+    status = main(["run", str(SPEC), "--script", script(tmp_path, ("10s", "press_red"))])
+    err = capsys.readouterr().err
+    assert status == 2
+    assert "press_red" in err and "press_report" in err
+
+
+def test_broken_spec_names_file_and_line(tmp_path, capsys):
+    broken = tmp_path / "broken.xpdl"
+    broken.write_text(SPEC.read_text(encoding="utf-8").replace("</Package>", ""),
+                      encoding="utf-8")
+    status = main(["run", str(broken)])
+    err = capsys.readouterr().err
+    assert status == 1
+    assert f"{broken}:" in err
+
+
+def test_spec_given_as_a_folder_is_a_usage_error(capsys):
+    assert main(["run", str(ROOT / "specs")]) == 2
+    assert "give one specification file" in capsys.readouterr().err
+
+
+def test_deadlock_is_reported_with_exit_status_1(tmp_path, capsys):
+    deadlock = ROOT / "tests" / "validate" / "data" / "and_join_deadlock.xpdl"
+    status = main(["run", str(deadlock)])
+    out = capsys.readouterr().out
+    assert status == 1
+    assert "deadlock:" in out and "join" in out
+
+
+def test_compiled_script_runs_like_the_xpdl(tmp_path, capsys):
+    wfs = tmp_path / "dispenser.wfs"
+    assert main(["compile", str(SPEC), "-o", str(wfs)]) == 0
+    capsys.readouterr()
+    main(["run", str(wfs), "--json", "--days", "1", "--no-user"])
+    from_wfs = json.loads(capsys.readouterr().out)
+    main(["run", str(SPEC), "--json", "--days", "1", "--no-user"])
+    from_xpdl = json.loads(capsys.readouterr().out)
+    assert from_wfs["metrics"] == from_xpdl["metrics"]
+    assert from_wfs["metrics"]["doses_missed"]["total"] == 4
