@@ -1,0 +1,370 @@
+"""The evaluation's figures: one PNG per function, readable by people who did not run it.
+
+Every function draws one figure, writes it as a PNG to ``path`` (parent folders are created)
+and returns ``path``. Empty input never raises: the figure then says "no observations", so a
+report of a run in which nothing happened still has all its pictures. Non-finite values
+(NaN, ±inf) are left out and counted in the figure's note.
+
+Conventions, so every figure reads the same way:
+
+- colours from the Okabe-Ito palette (distinguishable with the common colour-vision
+  deficiencies), and each series also differs by marker or line style, never by colour alone;
+- axis labels carry units (seconds, %, count); titles say what the reader sees;
+- rates whose estimates and intervals all lie in [0, 1] are shown as percentages.
+
+matplotlib is imported inside the functions, so ``import opspec.evaluation`` stays light. We
+draw on :class:`matplotlib.figure.Figure` objects with the Agg canvas instead of pyplot: no
+global figure registry (nothing leaks across thousands of calls, and the functions are safe
+in worker threads), and no GUI backend is ever chosen.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Iterator, Mapping, Sequence
+from contextlib import contextmanager
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+from opspec.errors import EvaluationError
+
+if TYPE_CHECKING:
+    from matplotlib.axes import Axes
+    from matplotlib.figure import Figure
+
+__all__ = [
+    "DPI",
+    "PALETTE",
+    "activity_rates_figure",
+    "comparison_figure",
+    "latency_figure",
+    "over_days_figure",
+    "rates_figure",
+    "time_of_day_figure",
+]
+
+DPI = 110
+
+#: Okabe & Ito (2008), "Color Universal Design": safe for deuteranopia, protanopia, tritanopia.
+PALETTE: tuple[str, ...] = (
+    "#0072B2",  # blue
+    "#E69F00",  # orange
+    "#009E73",  # bluish green
+    "#CC79A7",  # reddish purple
+    "#D55E00",  # vermillion
+    "#56B4E9",  # sky blue
+    "#F0E442",  # yellow (last: low contrast on white)
+    "#000000",  # black
+)
+_MARKERS = ("o", "s", "^", "D", "v", "P", "X", "*")
+_LINESTYLES = ("-", "--", "-.", ":")
+
+_RC: dict[str, Any] = {
+    "font.size": 11,
+    "axes.titlesize": 12,
+    "axes.labelsize": 11,
+    "xtick.labelsize": 10,
+    "ytick.labelsize": 10,
+    "legend.fontsize": 10,
+    "figure.titlesize": 13,
+    "axes.grid": True,
+    "grid.alpha": 0.3,
+    "axes.spines.top": False,
+    "axes.spines.right": False,
+}
+
+NO_OBSERVATIONS = "no observations"
+
+
+# --------------------------------------------------------------------------------- helpers
+
+@contextmanager
+def _figure(width: float, height: float) -> Iterator[Figure]:
+    """A fresh Agg-backed figure under opspec's style (fonts, grid, palette)."""
+    import matplotlib
+    from cycler import cycler
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.figure import Figure
+
+    rc = {**_RC, "axes.prop_cycle": cycler(color=PALETTE)}
+    with matplotlib.rc_context(rc):  # type: ignore[arg-type]  # keys are literal rc names
+        fig = Figure(figsize=(width, height), dpi=DPI, layout="constrained")
+        FigureCanvasAgg(fig)
+        yield fig
+
+
+def _save(fig: Figure, path: Path) -> Path:
+    path = Path(path)
+    try:
+        path.parent.mkdir(parents=True, exist_ok=True)
+        fig.savefig(path, format="png", dpi=DPI, facecolor="white")
+    except OSError as error:
+        raise EvaluationError(f"cannot write the figure {path}: {error.strerror or error}",
+                              hint="check that the output folder exists, is writable and "
+                                   "the disk is not full") from None
+    return path
+
+
+def _finite(values: Sequence[float]) -> tuple[list[float], int]:
+    """The finite values as floats, and how many others were dropped."""
+    kept = [float(v) for v in values if v is not None and math.isfinite(float(v))]
+    return kept, len(values) - len(kept)
+
+
+def _empty(path: Path, title: str, width: float = 8.0, height: float = 3.2) -> Path:
+    """A figure whose only content is its title and the words "no observations"."""
+    with _figure(width, height) as fig:
+        ax = fig.add_subplot()
+        ax.set_axis_off()
+        ax.set_title(title)
+        ax.text(0.5, 0.5, NO_OBSERVATIONS, ha="center", va="center", fontsize=16,
+                color="#444444", transform=ax.transAxes)
+        return _save(fig, path)
+
+
+def _text(label: object) -> str:
+    """A user-supplied name as literal text: a ``$`` would otherwise start mathtext."""
+    return str(label).replace("$", r"\$")
+
+
+def _is_rate(values: Sequence[float]) -> bool:
+    return bool(values) and all(0.0 <= v <= 1.0 for v in values)
+
+
+def _percent_axis(ax: Axes, axis: str = "x") -> None:
+    from matplotlib.ticker import PercentFormatter
+
+    target = ax.xaxis if axis == "x" else ax.yaxis
+    target.set_major_formatter(PercentFormatter(xmax=1.0, decimals=None))
+
+
+def _fmt(value: float, percent: bool) -> str:
+    if percent:
+        return f"{100.0 * value:.3g} %"
+    return f"{value:.4g}"
+
+
+def _note_dropped(fig: Figure, dropped: int) -> None:
+    if dropped:
+        fig.text(0.01, 0.005, f"{dropped} non-finite value(s) left out", fontsize=9,
+                 color="#444444", ha="left", va="bottom")
+
+
+def _bar_height(rows: int) -> float:
+    """Figure height (inches) for one horizontal row per item, within sane bounds."""
+    return min(2.0 + 0.45 * rows, 24.0)
+
+
+# --------------------------------------------------------------------------------- figures
+
+def latency_figure(metric: str, values: Sequence[float], path: Path) -> Path:
+    """ECDF (left) and histogram (right) of one duration metric, in seconds.
+
+    Mean, median and 95th percentile are marked on both panels with distinct line styles and
+    their values in the legend.
+    """
+    import numpy as np
+
+    metric = _text(metric)
+    title = f"{metric}: distribution of durations"
+    data, dropped = _finite(values)
+    if not data:
+        return _empty(path, title)
+    arr = np.asarray(data, dtype=float)
+    marks = (("mean", float(arr.mean()), "-", PALETTE[1]),
+             ("median", float(np.median(arr)), "--", PALETTE[2]),
+             ("p95", float(np.percentile(arr, 95)), ":", PALETTE[4]))
+    with _figure(11.0, 4.4) as fig:
+        fig.suptitle(f"{metric}: how long it took ({arr.size} observations)")
+        left, right = fig.subplots(1, 2)
+        # ECDF: a step function by hand (Axes.ecdf needs matplotlib >= 3.8)
+        xs = np.sort(arr)
+        ys = np.arange(1, xs.size + 1) / xs.size
+        left.step(np.concatenate(([xs[0]], xs)), np.concatenate(([0.0], ys)), where="post",
+                  color=PALETTE[0], linewidth=2, label="share done within x")
+        left.set_title("Cumulative share of observations")
+        left.set_xlabel(f"{metric} (seconds)")
+        left.set_ylabel("share of observations (%)")
+        left.set_ylim(0.0, 1.02)
+        _percent_axis(left, "y")
+        bins: Any = "auto" if np.ptp(arr) > 0 else 1
+        right.hist(arr, bins=bins, color=PALETTE[5], edgecolor=PALETTE[0], linewidth=0.6)
+        right.set_title("Histogram")
+        right.set_xlabel(f"{metric} (seconds)")
+        right.set_ylabel("number of observations")
+        for name, value, style, colour in marks:
+            for ax in (left, right):
+                ax.axvline(value, linestyle=style, color=colour, linewidth=1.8,
+                           label=f"{name} = {value:.4g} s" if ax is right else None)
+        right.legend(loc="best", frameon=True)
+        _note_dropped(fig, dropped)
+        return _save(fig, path)
+
+
+def rates_figure(rows: Sequence[tuple[str, float, float, float]], path: Path) -> Path:
+    """Each ``(label, estimate, ci_low, ci_high)`` as a point with its 95 % CI as error bars.
+
+    When every number lies in [0, 1] the axis shows percentages.
+    """
+    title = "Outcome rates with 95 % confidence intervals"
+    clean = [(_text(label), float(est), float(lo), float(hi)) for label, est, lo, hi in rows
+             if all(math.isfinite(float(v)) for v in (est, lo, hi))]
+    dropped = len(rows) - len(clean)
+    if not clean:
+        return _empty(path, title)
+    percent = _is_rate([v for _, est, lo, hi in clean for v in (est, lo, hi)])
+    with _figure(8.5, _bar_height(len(clean))) as fig:
+        ax = fig.add_subplot()
+        positions = list(range(len(clean)))[::-1]  # first row on top
+        for pos, (label, est, lo, hi) in zip(positions, clean, strict=True):
+            ax.errorbar([est], [pos], xerr=[[max(est - lo, 0.0)], [max(hi - est, 0.0)]],
+                        fmt="o", color=PALETTE[0], ecolor=PALETTE[0], capsize=5,
+                        markersize=7, linewidth=1.8)
+            ax.annotate(f"{_fmt(est, percent)}  [{_fmt(lo, percent)}, {_fmt(hi, percent)}]",
+                        (hi, pos), xytext=(6, 0), textcoords="offset points", va="center",
+                        fontsize=9)
+        ax.set_yticks(positions, [label for label, *_ in clean])
+        ax.set_ylim(-0.7, len(clean) - 0.3)
+        ax.set_title(f"{title} (point = estimate, bar = interval)")
+        if percent:
+            _percent_axis(ax, "x")
+            ax.set_xlabel("rate (% of opportunities)")
+            upper = max(hi for *_, hi in clean)
+            ax.set_xlim(0.0, min(1.0, upper * 1.35 + 0.01) if upper > 0 else 0.05)
+        else:
+            ax.set_xlabel("value")
+            ax.margins(x=0.25)
+        _note_dropped(fig, dropped)
+        return _save(fig, path)
+
+
+def over_days_figure(series: Mapping[str, Sequence[float]], path: Path) -> Path:
+    """One line per metric: its value on day 1, 2, …, D."""
+    title = "Outcomes over the simulated days"
+    present = {_text(name): list(vals) for name, vals in series.items() if len(vals) > 0}
+    if not present:
+        return _empty(path, title)
+    longest = max(len(v) for v in present.values())
+    with _figure(9.0, 4.6) as fig:
+        ax = fig.add_subplot()
+        for i, (name, vals) in enumerate(present.items()):
+            days = list(range(1, len(vals) + 1))
+            ys = [float(v) if v is not None and math.isfinite(float(v)) else math.nan
+                  for v in vals]
+            ax.plot(days, ys, color=PALETTE[i % len(PALETTE)],
+                    marker=_MARKERS[i % len(_MARKERS)] if longest <= 60 else None,
+                    linestyle=_LINESTYLES[i % len(_LINESTYLES)], linewidth=1.8, label=name)
+        ax.set_title(f"{title}: value of each metric per day")
+        ax.set_xlabel("simulated day")
+        ax.set_ylabel("value per day (metric's own unit)")
+        ax.set_xlim(0.5, longest + 0.5)
+        if longest <= 31:
+            ax.set_xticks(range(1, longest + 1, 1 if longest <= 15 else 2))
+        ax.legend(loc="best")
+        return _save(fig, path)
+
+
+def time_of_day_figure(series: Mapping[str, Sequence[int]], path: Path) -> Path:
+    """One line per metric: how many times it happened in each hour of the day (0 to 23)."""
+    title = "Outcomes by time of day"
+    for name, counts in series.items():
+        if len(counts) != 24:
+            raise EvaluationError(f"time_of_day_figure: metric {name!r} has {len(counts)} "
+                                  "counts, expected 24 (one per hour 0..23)")
+    present = {_text(name): list(c) for name, c in series.items() if any(c)}
+    if not present:
+        return _empty(path, title)
+    hours = list(range(24))
+    with _figure(9.0, 4.6) as fig:
+        ax = fig.add_subplot()
+        for i, (name, counts) in enumerate(present.items()):
+            ax.plot(hours, counts, color=PALETTE[i % len(PALETTE)],
+                    marker=_MARKERS[i % len(_MARKERS)],
+                    linestyle=_LINESTYLES[i % len(_LINESTYLES)], linewidth=1.8,
+                    drawstyle="steps-mid", label=name)
+        ax.set_title(f"{title}: occurrences in each hour")
+        ax.set_xlabel("hour of the simulated day (0–23)")
+        ax.set_ylabel("count (occurrences)")
+        ax.set_xticks(range(0, 24, 2))
+        ax.set_xlim(-0.5, 23.5)
+        ax.set_ylim(bottom=0)
+        ax.legend(loc="best")
+        return _save(fig, path)
+
+
+def activity_rates_figure(rows: Sequence[tuple[str, float, float]], path: Path) -> Path:
+    """Grouped horizontal bars: omission rate and error rate of each (manual) activity."""
+    title = "Omission and error rates per activity"
+    clean = [(_text(a), float(o), float(e)) for a, o, e in rows
+             if math.isfinite(float(o)) and math.isfinite(float(e))]
+    dropped = len(rows) - len(clean)
+    if not clean:
+        return _empty(path, title)
+    percent = _is_rate([v for _, o, e in clean for v in (o, e)])
+    with _figure(8.5, _bar_height(int(1.5 * len(clean)) + 1)) as fig:
+        ax = fig.add_subplot()
+        n = len(clean)
+        centres = list(range(n))[::-1]
+        height = 0.38
+        omission = ax.barh([c + height / 2 for c in centres], [o for _, o, _ in clean],
+                           height=height, color=PALETTE[1], edgecolor="black", linewidth=0.5,
+                           label="omission rate (not done)")
+        error = ax.barh([c - height / 2 for c in centres], [e for *_, e in clean],
+                        height=height, color=PALETTE[0], edgecolor="black", linewidth=0.5,
+                        hatch="//", label="error rate (done wrongly)")
+        for bars in (omission, error):
+            ax.bar_label(bars, labels=[_fmt(b.get_width(), percent) for b in bars],
+                         padding=3, fontsize=9)
+        ax.set_yticks(centres, [a for a, *_ in clean])
+        ax.set_title(f"{title} (share of the times it was asked for)")
+        if percent:
+            _percent_axis(ax, "x")
+            ax.set_xlabel("rate (% of offers)")
+            top = max(max(o, e) for _, o, e in clean)
+            ax.set_xlim(0.0, min(1.0, top * 1.3 + 0.01) if top > 0 else 0.05)
+        else:
+            ax.set_xlabel("rate")
+            ax.margins(x=0.2)
+        ax.legend(loc="lower right")
+        _note_dropped(fig, dropped)
+        return _save(fig, path)
+
+
+def comparison_figure(rows: Sequence[tuple[str, float, float, float]], path: Path) -> Path:
+    """Forest plot: each ``(metric, difference B − A, ci_low, ci_high)`` against a zero line.
+
+    Differences whose interval excludes zero are drawn filled; the others hollow.
+    """
+    title = "Design B minus design A, with 95 % confidence intervals"
+    clean = [(_text(m), float(d), float(lo), float(hi)) for m, d, lo, hi in rows
+             if all(math.isfinite(float(v)) for v in (d, lo, hi))]
+    dropped = len(rows) - len(clean)
+    if not clean:
+        return _empty(path, title)
+    with _figure(9.0, _bar_height(len(clean))) as fig:
+        ax = fig.add_subplot()
+        positions = list(range(len(clean)))[::-1]
+        ax.axvline(0.0, color="black", linewidth=1.2, linestyle="--", label="no difference")
+        shown_sig = shown_not = False
+        for pos, (name, diff, lo, hi) in zip(positions, clean, strict=True):
+            significant = lo > 0.0 or hi < 0.0
+            colour = PALETTE[4] if significant else PALETTE[0]
+            label = None
+            if significant and not shown_sig:
+                label, shown_sig = "interval excludes 0", True
+            elif not significant and not shown_not:
+                label, shown_not = "interval includes 0", True
+            ax.errorbar([diff], [pos], xerr=[[max(diff - lo, 0.0)], [max(hi - diff, 0.0)]],
+                        fmt="D" if significant else "o", color=colour, ecolor=colour,
+                        markerfacecolor=colour if significant else "white", capsize=5,
+                        markersize=7, linewidth=1.8, label=label)
+            ax.annotate(f"{diff:+.4g}  [{lo:+.4g}, {hi:+.4g}]", (hi, pos), xytext=(6, 0),
+                        textcoords="offset points", va="center", fontsize=9)
+        ax.set_yticks(positions, [m for m, *_ in clean])
+        ax.set_ylim(-0.7, len(clean) - 0.3)
+        ax.margins(x=0.3)
+        ax.set_title(title)
+        ax.set_xlabel("difference B − A (in each metric's own unit)")
+        ax.legend(loc="best")
+        _note_dropped(fig, dropped)
+        return _save(fig, path)

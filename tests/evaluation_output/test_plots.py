@@ -1,0 +1,122 @@
+"""Every figure of the evaluation report is a real PNG, for normal data and for no data."""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+from pathlib import Path
+
+import numpy as np
+import pytest
+from PIL import Image
+
+from opspec.errors import EvaluationError
+from opspec.evaluation import plots
+
+PNG_SIGNATURE = b"\x89PNG\r\n\x1a\n"
+
+RNG = np.random.default_rng(20260105)
+LATENCIES = RNG.lognormal(4.0, 0.5, 400).tolist()
+
+Draw = Callable[[Path], Path]
+
+NORMAL: dict[str, Draw] = {
+    "latency": lambda p: plots.latency_figure("report_latency_s", LATENCIES, p),
+    "latency-one-value": lambda p: plots.latency_figure("walk_s", [42.0], p),
+    "rates": lambda p: plots.rates_figure(
+        [("doses missed", 0.0034, 0.001, 0.008), ("doses taken", 0.95, 0.93, 0.97)], p),
+    "rates-not-proportions": lambda p: plots.rates_figure(
+        [("alarms per dose", 1.2, 1.1, 1.3)], p),
+    "over-days": lambda p: plots.over_days_figure(
+        {"doses_taken": [4, 3, 4, 4, 2], "$doses_missed$_": [0, 1, 0, 0, 2]}, p),
+    "time-of-day": lambda p: plots.time_of_day_figure(
+        {"alarms": [0] * 8 + [30] + [0] * 3 + [30] + [0] * 5 + [30] + [0] * 3 + [30] + [0]}, p),
+    "activity-rates": lambda p: plots.activity_rates_figure(
+        [("hear_alarm", 0.15, 0.0), ("choose_button", 0.0, 0.05)], p),
+    "comparison": lambda p: plots.comparison_figure(
+        [("doses_missed", -0.01, -0.02, -0.002), ("report_latency_s", 3.2, -1.5, 7.9)], p),
+}
+
+EMPTY: dict[str, Draw] = {
+    "latency": lambda p: plots.latency_figure("report_latency_s", [], p),
+    "latency-only-nan": lambda p: plots.latency_figure("x", [math.nan, math.inf], p),
+    "rates": lambda p: plots.rates_figure([], p),
+    "over-days": lambda p: plots.over_days_figure({}, p),
+    "over-days-empty-series": lambda p: plots.over_days_figure({"doses_taken": []}, p),
+    "time-of-day": lambda p: plots.time_of_day_figure({}, p),
+    "time-of-day-all-zero": lambda p: plots.time_of_day_figure({"alarms": [0] * 24}, p),
+    "activity-rates": lambda p: plots.activity_rates_figure([], p),
+    "comparison": lambda p: plots.comparison_figure([], p),
+}
+
+
+def assert_valid_png(path: Path) -> tuple[int, int]:
+    data = path.read_bytes()
+    assert data.startswith(PNG_SIGNATURE), f"{path} is not a PNG"
+    with Image.open(path) as image:
+        image.verify()          # checks chunk CRCs
+    with Image.open(path) as image:
+        image.load()            # decodes the pixels
+        size: tuple[int, int] = image.size
+    assert size[0] >= 300 and size[1] >= 200, f"{path} is too small to read: {size}"
+    return size
+
+
+@pytest.mark.parametrize("name", list(NORMAL), ids=list(NORMAL))
+def test_figure_is_a_readable_png_for_normal_data(name: str, tmp_path: Path) -> None:
+    path = tmp_path / f"{name}.png"
+    assert NORMAL[name](path) == path
+    assert_valid_png(path)
+
+
+@pytest.mark.parametrize("name", list(EMPTY), ids=list(EMPTY))
+def test_figure_for_no_data_is_a_png_saying_no_observations(name: str, tmp_path: Path) -> None:
+    path = tmp_path / f"{name}.png"
+    assert EMPTY[name](path) == path
+    assert_valid_png(path)
+    # the "no observations" figure is the same picture whatever function drew it, apart
+    # from its title: mostly white, so it compresses far better than any real plot
+    assert path.stat().st_size < 20_000
+
+
+def test_figure_with_data_differs_from_its_empty_figure(tmp_path: Path) -> None:
+    full = plots.latency_figure("m", LATENCIES, tmp_path / "full.png")
+    empty = plots.latency_figure("m", [], tmp_path / "empty.png")
+    assert full.stat().st_size > 2 * empty.stat().st_size
+
+
+def test_figure_folder_is_created(tmp_path: Path) -> None:
+    path = tmp_path / "plots" / "deep" / "rates.png"
+    plots.rates_figure([("x", 0.5, 0.4, 0.6)], path)
+    assert_valid_png(path)
+
+
+def test_unwritable_figure_path_is_an_evaluation_error(tmp_path: Path) -> None:
+    blocker = tmp_path / "file"
+    blocker.write_text("not a folder")
+    with pytest.raises(EvaluationError, match=r"cannot write the figure .*rates\.png"):
+        plots.rates_figure([("x", 0.5, 0.4, 0.6)], blocker / "rates.png")
+
+
+def test_time_of_day_needs_24_counts_per_metric(tmp_path: Path) -> None:
+    with pytest.raises(EvaluationError, match=r"'alarms' has 23 counts, expected 24"):
+        plots.time_of_day_figure({"alarms": [1] * 23}, tmp_path / "t.png")
+
+
+def test_hostile_labels_are_drawn_as_text(tmp_path: Path) -> None:
+    # mathtext markers and markup in names must not crash the renderer
+    labels = [("$\\frac{$", 0.1, 0.0, 0.2), ("$x$_$", 0.4, 0.3, 0.5),
+              ("<script>", 0.2, 0.1, 0.3), ("a_b^c", 0.3, 0.2, 0.4)]
+    assert_valid_png(plots.rates_figure(labels, tmp_path / "r.png"))
+    assert_valid_png(plots.latency_figure("$x_", [1.0, 2.0], tmp_path / "l.png"))
+
+
+def test_import_of_evaluation_does_not_import_matplotlib() -> None:
+    import subprocess
+    import sys
+
+    code = ("import sys, opspec.evaluation.plots, opspec.evaluation.html; "
+            "print('matplotlib' in sys.modules)")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                         check=True)
+    assert out.stdout.strip() == "False"
