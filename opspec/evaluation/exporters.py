@@ -141,12 +141,16 @@ class _StreamingWriter:
                                hint="check that the output folder is writable and the disk "
                                     "is not full")
 
-    def _write(self, text: str) -> None:
+    def _check_open(self) -> IO[str]:
         if self._handle is None:
             raise EvaluationError(f"the trace export {self.path} is already closed",
                                   hint="add every case before close()")
+        return self._handle
+
+    def _write(self, text: str) -> None:
+        handle = self._check_open()
         try:
-            self._handle.write(text)
+            handle.write(text)
         except OSError as error:
             raise self._error(error) from None
 
@@ -359,6 +363,7 @@ class JsonlTraceWriter(_StreamingWriter):
     def add_case(self, case_id: str, events: Iterable[TraceEvent],
                  attributes: Mapping[str, Any] | None = None) -> None:
         """Write every event of one case (all kinds, input order), tagged with ``case``."""
+        self._check_open()
         dumps = json.dumps
         if attributes:
             self._write(dumps({"seq": 0, "time": 0.0, "kind": "case.started",
