@@ -150,6 +150,11 @@ def _note_dropped(fig: Figure, dropped: int) -> None:
                  color="#444444", ha="left", va="bottom")
 
 
+def _outside_legend(ax: Axes) -> None:
+    """The legend to the right of the plot, where it never hides a line."""
+    ax.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), borderaxespad=0.0)
+
+
 def _bar_height(rows: int) -> float:
     """Figure height (inches) for one horizontal row per item, within sane bounds."""
     return min(2.0 + 0.45 * rows, 24.0)
@@ -260,7 +265,9 @@ def over_days_figure(series: Mapping[str, Sequence[float]], path: Path) -> Path:
         ax.set_xlim(0.5, longest + 0.5)
         if longest <= 31:
             ax.set_xticks(range(1, longest + 1, 1 if longest <= 15 else 2))
-        ax.legend(loc="best")
+        if all(v >= 0 for vals in present.values() for v in vals if v is not None):
+            ax.set_ylim(bottom=0)
+        _outside_legend(ax)
         return _save(fig, path)
 
 
@@ -288,7 +295,7 @@ def time_of_day_figure(series: Mapping[str, Sequence[int]], path: Path) -> Path:
         ax.set_xticks(range(0, 24, 2))
         ax.set_xlim(-0.5, 23.5)
         ax.set_ylim(bottom=0)
-        ax.legend(loc="best")
+        _outside_legend(ax)
         return _save(fig, path)
 
 
