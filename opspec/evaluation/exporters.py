@@ -270,7 +270,9 @@ class XesWriter(_StreamingWriter):
 
         ``data.changed`` values are held until the next exported event of the same instance
         and activity (normally its completion) and written on it as typed attributes named
-        after the data field; changes with no such later event are dropped.
+        after the data field; changes with no such later event are dropped. If ``events``
+        raises, the writer is abandoned (the ``.partial`` file stays, ``path`` is untouched)
+        and the exception propagates: a half-written trace cannot be completed.
         """
         out = ["  <trace>", f'    <string key="concept:name" value="{_attr(case_id)}"/>']
         for key, value in (attributes or {}).items():
@@ -281,17 +283,23 @@ class XesWriter(_StreamingWriter):
         self._write("\n".join(out) + "\n")
         pending: dict[tuple[int | None, str | None], dict[str, Any]] = {}
         written = 0
-        for event in events:
-            if event.kind == EventKind.DATA_CHANGED:
-                pending.setdefault((event.instance, event.activity), {}).update(event.data)
-                continue
-            if event.kind not in self.kinds:
-                continue
-            data = pending.pop((event.instance, event.activity), None)
-            if event.activity is not None:
-                data = {**pending.pop((event.instance, None), {}), **(data or {})}
-            self._write(self._event(event, data))
-            written += 1
+        try:
+            for event in events:
+                if event.kind == EventKind.DATA_CHANGED:
+                    pending.setdefault((event.instance, event.activity), {}).update(event.data)
+                    continue
+                if event.kind not in self.kinds:
+                    continue
+                data = pending.pop((event.instance, event.activity), None)
+                if event.activity is not None:
+                    data = {**pending.pop((event.instance, None), {}), **(data or {})}
+                self._write(self._event(event, data))
+                written += 1
+        except BaseException:
+            # half a <trace> cannot be finished into valid XML: stop here, keep the
+            # .partial file for inspection, and refuse further cases
+            self._abandon()
+            raise
         self._write("  </trace>\n")
         self.cases += 1
         self.events += written

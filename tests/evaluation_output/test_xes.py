@@ -276,6 +276,21 @@ def test_failure_inside_the_with_block_leaves_only_the_partial_file(tmp_path: Pa
     assert (tmp_path / "traces.xes.partial").exists()
 
 
+def test_case_that_fails_midway_stops_the_export(tmp_path: Path) -> None:
+    def broken() -> Iterator[TraceEvent]:
+        yield TraceEvent(1.0, EventKind.ACTIVITY_STARTED, process="p", instance=1,
+                         activity="a")
+        raise RuntimeError("replication crashed")
+
+    writer = XesWriter(tmp_path / "traces.xes")
+    with pytest.raises(RuntimeError, match="replication crashed"):
+        writer.add_case("u", broken())
+    with pytest.raises(EvaluationError, match="already closed"):
+        writer.add_case("next", [])
+    writer.close()
+    assert not (tmp_path / "traces.xes").exists()
+
+
 def test_unwritable_folder_is_an_evaluation_error(tmp_path: Path) -> None:
     blocker = tmp_path / "file"
     blocker.write_text("x")
