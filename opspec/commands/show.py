@@ -148,11 +148,27 @@ def _parameter(parameter: FormalParameter) -> str:
 def _trigger(trigger: TriggerRef) -> str:
     if trigger.name:
         return f"{trigger.kind}:{trigger.name}"
-    if trigger.every is not None:
-        return f"{trigger.kind} every {trigger.every:g} s"
+    text = trigger.kind
     if trigger.at:
-        return f"{trigger.kind} at {', '.join(f'{t:g}' for t in trigger.at)} s"
-    return trigger.kind
+        text += " at " + ", ".join(_clock(t) for t in trigger.at)
+    if trigger.every is not None:
+        text += f" every {_span(trigger.every)}"
+    return text
+
+
+def _clock(seconds: float) -> str:
+    """Seconds after midnight as ``08:00`` (or ``08:00:30``)."""
+    minutes, secs = divmod(seconds, 60)
+    hours, minutes = divmod(int(minutes), 60)
+    return f"{hours:02d}:{minutes:02d}" + (f":{secs:02g}" if secs else "")
+
+
+def _span(seconds: float) -> str:
+    for unit, size in (("day", 86_400), ("h", 3_600), ("min", 60)):
+        if seconds >= size and seconds % size == 0:
+            count = int(seconds // size)
+            return f"{count} {unit}" + ("s" if unit == "day" and count != 1 else "")
+    return f"{seconds:g} s"
 
 
 def _directives(directives: ProcessDirectives) -> str:

@@ -196,3 +196,11 @@ def test_dot_of_one_missing_process_raises_key_error() -> None:
     with pytest.raises(KeyError):
         package_to_dot(package(), process="nope")
 
+
+
+def test_timer_start_triggers_show_clock_times_and_period(capsys):
+    from opspec.cli import main
+
+    spec = Path(__file__).resolve().parents[2] / "specs" / "medication_dispenser.xpdl"
+    assert main(["show", str(spec)]) == 0
+    assert "starts on timer at 08:00, 12:00, 18:00, 22:00 every 1 day" in capsys.readouterr().out
