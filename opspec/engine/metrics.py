@@ -53,6 +53,12 @@ class MetricsListener:
         self.counts: dict[str, int] = {}
         self.samples: dict[str, list[float]] = {}
         self._open: dict[str, dict[int, float]] = {}
+        # When ``keep_times`` is set (evaluation runs), the simulated time of every counted
+        # event and of the end of every duration sample is kept too, for outcomes over days
+        # and time of day; plain runs don't pay for it.
+        self.keep_times = False
+        self.count_times: dict[str, list[float]] = {}
+        self.sample_times: dict[str, list[float]] = {}
         self._by_kind: dict[str, list[tuple[MetricDefinition, str, EventSelector]]] = {}
         selects: set[tuple[str, str | None, str | None]] = set()
         for metric in self.definitions:
@@ -88,6 +94,8 @@ class MetricsListener:
                 continue
             if role == "count":
                 self.counts[metric.name] += 1
+                if self.keep_times:
+                    self.count_times.setdefault(metric.name, []).append(time)
                 continue
             key = instance or 0
             pending = self._open[metric.name]
@@ -96,6 +104,8 @@ class MetricsListener:
                     pending[key] = time
             elif key in pending:
                 self.samples[metric.name].append(time - pending.pop(key))
+                if self.keep_times:
+                    self.sample_times.setdefault(metric.name, []).append(time)
 
     def values(self) -> dict[str, dict[str, Any]]:
         """Every declared metric in the shared output shape."""
