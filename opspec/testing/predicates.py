@@ -1,0 +1,687 @@
+"""Trace predicates that read like the spec, for ``assert holds(result, ...)`` and ``check``.
+
+::
+
+    from opspec.testing.predicates import check, count, happens_before, holds, never, within
+
+    assert holds(result, within("sound_alarm", "press_report", 60))
+    check(result, happens_before("sound_alarm", "press_report") & never("notify_caregiver"))
+    check(result, (count("dispense") == 1).per_instance("notify_workflow"))
+
+A predicate is judged on each trace of what it is given - a
+:class:`~opspec.testing.simulate.SimulationResult` (every replication), an engine
+:class:`~opspec.engine.simulation.RunResult`, or a plain sequence of
+:class:`~opspec.engine.trace.TraceEvent` - and holds when it holds on every one.
+
+Events are named like monitors (:mod:`opspec.engine.monitors`): a bare name is an activity's
+completion, a trigger's raise or a process's start (``activity:``, ``trigger:``, ``process:``
+make it explicit; ``a|b`` is either); :func:`activity_completed`, :func:`event` and any
+``Callable[[TraceEvent], bool]`` select events too. Names are checked against the spec (of a
+``SimulationResult``, or ``spec=``): one the spec lacks raises
+:class:`~opspec.errors.ConfigurationError` listing the names it has.
+
+:func:`check` raises ``AssertionError`` with the claim, why it failed, and the few events
+around the violation (marked ``>``), not the whole trace.
+"""
+
+from __future__ import annotations
+
+import math
+import operator
+from collections.abc import Callable, Iterable, Sequence
+from dataclasses import dataclass
+from typing import Any
+
+from opspec.engine.monitors import Subject, clock, parse_subject
+from opspec.engine.trace import EventKind, TraceEvent
+from opspec.errors import ConfigurationError
+
+__all__ = [
+    "Count",
+    "Match",
+    "Predicate",
+    "activity_completed",
+    "activity_started",
+    "check",
+    "count",
+    "event",
+    "eventually",
+    "happens_before",
+    "holds",
+    "never",
+    "per_instance",
+    "process_started",
+    "trigger_raised",
+    "within",
+]
+
+#: events shown before / after each focus event of a failure, and at most in all
+BEFORE, AFTER, MAX_LINES = 4, 2, 14
+
+
+@dataclass(frozen=True, slots=True)
+class Failure:
+    """Why a predicate failed on one trace: message lines and the events to show."""
+
+    lines: tuple[str, ...]
+    focus: tuple[TraceEvent, ...] = ()
+    trace: Sequence[TraceEvent] = ()
+
+
+@dataclass(frozen=True, slots=True)
+class _Run:
+    label: str                          # "" or " (replication 3)"
+    events: Sequence[TraceEvent]
+    end: float                          # simulated end of the run (windows after it: unjudged)
+
+
+class Predicate:
+    """A property of one trace. Combine with ``&``, ``|``, ``~``; scope with
+    :meth:`per_instance`. Subclasses implement :meth:`describe`, :meth:`fail` and
+    :meth:`subjects`."""
+
+    def describe(self) -> str:
+        raise NotImplementedError
+
+    def subjects(self) -> tuple[Subject, ...]:
+        """Named things this predicate refers to (checked against the spec)."""
+        return ()
+
+    def processes(self) -> tuple[str, ...]:
+        """Process names this predicate scopes to (checked against the spec)."""
+        return ()
+
+    def fail(self, events: Sequence[TraceEvent], end: float) -> Failure | None:
+        """``None`` when the predicate holds on ``events`` (a run ending at ``end``)."""
+        raise NotImplementedError
+
+    def witness(self, events: Sequence[TraceEvent]) -> tuple[TraceEvent, ...]:
+        """Events showing why the predicate holds (for a failing ``~p``)."""
+        return ()
+
+    def __repr__(self) -> str:
+        return self.describe()
+
+    def __and__(self, other: Predicate) -> Predicate:
+        return _All((self, _as_predicate(other)))
+
+    def __or__(self, other: Predicate) -> Predicate:
+        return _Any((self, _as_predicate(other)))
+
+    def __invert__(self) -> Predicate:
+        return _Not(self)
+
+    def per_instance(self, process: str) -> Predicate:
+        """This predicate on each instance of ``process`` (its own events only)."""
+        return per_instance(process, self)
+
+
+# ---------------------------------------------------------------- selecting events
+class Match(Predicate):
+    """A selector of events; as a predicate it means "happens at least once"."""
+
+    def __init__(self, test: Callable[[TraceEvent], bool], text: str,
+                 subject: Subject | None = None, process: str | None = None) -> None:
+        self._test = test
+        self.text = text
+        self.subject = subject
+        self.process = process
+
+    def __call__(self, event: TraceEvent) -> bool:
+        return self._test(event)
+
+    def describe(self) -> str:
+        return self.text
+
+    def subjects(self) -> tuple[Subject, ...]:
+        return (self.subject,) if self.subject is not None else ()
+
+    def processes(self) -> tuple[str, ...]:
+        return (self.process,) if self.process is not None else ()
+
+    def all(self, events: Iterable[TraceEvent]) -> list[TraceEvent]:
+        return [e for e in events if self._test(e)]
+
+    def fail(self, events: Sequence[TraceEvent], end: float) -> Failure | None:
+        if any(self._test(e) for e in events):
+            return None
+        return Failure((f"but {self.text} never happened (the run went to {clock(end)})",),
+                       tuple(events[-BEFORE:]), events)
+
+    def witness(self, events: Sequence[TraceEvent]) -> tuple[TraceEvent, ...]:
+        return tuple(self.all(events)[:1])
+
+    def __invert__(self) -> Predicate:
+        return never(self)
+
+
+def _subject_match(subject: Subject) -> Match:
+    return Match(subject.matches, str(subject), subject)
+
+
+def _as_match(what: str | Match | Callable[[TraceEvent], bool]) -> Match:
+    if isinstance(what, Match):
+        return what
+    if isinstance(what, str):
+        return _subject_match(parse_subject(what))
+    if callable(what):
+        return Match(what, getattr(what, "__name__", repr(what)))
+    raise TypeError(f"expected an event name, a Match or a callable, not {what!r}")
+
+
+def _as_predicate(what: Any) -> Predicate:
+    if isinstance(what, Predicate):
+        return what
+    return _as_match(what)
+
+
+def _selector(kind: str, what: str, name: str, process: str | None,
+              test: Callable[[TraceEvent], bool]) -> Match:
+    in_process = f" in {process}" if process else ""
+    return Match(lambda e: e.kind == kind and test(e) and (process is None or e.process == process),
+                 f"{what} {name} {kind.split('.')[1]}{in_process}", Subject(name, what), process)
+
+
+def activity_completed(name: str, *, process: str | None = None) -> Match:
+    """Completions of activity ``name`` (in ``process`` only, if given)."""
+    return _selector(EventKind.ACTIVITY_COMPLETED, "activity", name, process,
+                     lambda e: e.activity == name)
+
+
+def activity_started(name: str, *, process: str | None = None) -> Match:
+    """Starts of activity ``name``."""
+    return _selector(EventKind.ACTIVITY_STARTED, "activity", name, process,
+                     lambda e: e.activity == name)
+
+
+def trigger_raised(name: str) -> Match:
+    """Raises of the message or signal ``name``."""
+    return _selector(EventKind.TRIGGER_RAISED, "trigger", name, None,
+                     lambda e: e.data.get("name") == name)
+
+
+def process_started(name: str) -> Match:
+    """Starts of instances of process ``name``."""
+    return _selector(EventKind.PROCESS_STARTED, "process", name, None,
+                     lambda e: e.process == name)
+
+
+def event(kind: str, *, activity: str | None = None, process: str | None = None,
+          **data: Any) -> Match:
+    """Events of ``kind`` (e.g. ``"activity.omitted"``) with these fields and data values."""
+    def test(e: TraceEvent) -> bool:
+        return (e.kind == kind and (activity is None or e.activity == activity)
+                and (process is None or e.process == process)
+                and all(e.data.get(k) == v for k, v in data.items()))
+
+    parts = [kind, *(x for x in (activity, process and f"in {process}") if x),
+             *(f"{k}={v!r}" for k, v in data.items())]
+    subject = Subject(activity, "activity") if activity else None
+    return Match(test, " ".join(parts), subject, process)
+
+
+# ---------------------------------------------------------------- temporal predicates
+class _Eventually(Predicate):
+    def __init__(self, match: Match) -> None:
+        self.match = match
+
+    def describe(self) -> str:
+        return f"eventually({self.match.describe()})"
+
+    def subjects(self) -> tuple[Subject, ...]:
+        return self.match.subjects()
+
+    def processes(self) -> tuple[str, ...]:
+        return self.match.processes()
+
+    def fail(self, events: Sequence[TraceEvent], end: float) -> Failure | None:
+        return self.match.fail(events, end)
+
+    def witness(self, events: Sequence[TraceEvent]) -> tuple[TraceEvent, ...]:
+        return self.match.witness(events)
+
+
+class _Never(_Eventually):
+    def describe(self) -> str:
+        return f"never({self.match.describe()})"
+
+    def fail(self, events: Sequence[TraceEvent], end: float) -> Failure | None:
+        hits = self.match.all(events)
+        if not hits:
+            return None
+        return Failure((f"but {self.match.describe()} happened {len(hits)} time(s), first at "
+                        f"{clock(hits[0].time)}",), (hits[0],), events)
+
+    def witness(self, events: Sequence[TraceEvent]) -> tuple[TraceEvent, ...]:
+        return ()
+
+    def __invert__(self) -> Predicate:
+        return _Eventually(self.match)
+
+
+def eventually(what: str | Match | Predicate | Callable[[TraceEvent], bool]) -> Predicate:
+    """``what`` happens at least once (a predicate is returned as it is)."""
+    if isinstance(what, Predicate) and not isinstance(what, Match):
+        return what
+    return _Eventually(_as_match(what))
+
+
+def never(what: str | Match | Predicate | Callable[[TraceEvent], bool]) -> Predicate:
+    """``what`` never happens (for a predicate: it does not hold, i.e. ``~what``)."""
+    if isinstance(what, Predicate) and not isinstance(what, Match):
+        return _Not(what)
+    return _Never(_as_match(what))
+
+
+class _Before(Predicate):
+    def __init__(self, a: Match, b: Match, each: bool) -> None:
+        self.a, self.b, self.each = a, b, each
+
+    def describe(self) -> str:
+        each = ", each=True" if self.each else ""
+        return f"happens_before({self.a.describe()}, {self.b.describe()}{each})"
+
+    def subjects(self) -> tuple[Subject, ...]:
+        return self.a.subjects() + self.b.subjects()
+
+    def processes(self) -> tuple[str, ...]:
+        return self.a.processes() + self.b.processes()
+
+    def fail(self, events: Sequence[TraceEvent], end: float) -> Failure | None:
+        seen_a = seen_b = 0
+        last_a: TraceEvent | None = None
+        for e in events:
+            if self.b(e):
+                if seen_a == 0 or (self.each and seen_a <= seen_b):
+                    if seen_a == 0:
+                        why = f"and no {self.a.describe()} came before it"
+                    else:
+                        why = (f"but only {seen_a} {self.a.describe()} before it (the last at "
+                               f"{clock(last_a.time if last_a else 0.0)}) for {seen_b + 1} "
+                               f"{self.b.describe()}")
+                    focus = (e,) if last_a is None else (last_a, e)
+                    return Failure((f"but {self.b.describe()} happened at {clock(e.time)} "
+                                    f"{why}",), focus, events)
+                seen_b += 1
+            if self.a(e):   # an event matching both counts as b first: b needs an earlier a
+                seen_a += 1
+                last_a = e
+        return None
+
+
+def happens_before(a: str | Match | Callable[[TraceEvent], bool],
+                   b: str | Match | Callable[[TraceEvent], bool], *,
+                   each: bool = False) -> Predicate:
+    """No ``b`` before the first ``a`` (``b`` may not happen at all). ``each=True``: every
+    ``b`` has its own earlier ``a`` (the n-th ``b`` comes after the n-th ``a``)."""
+    return _Before(_as_match(a), _as_match(b), each)
+
+
+class _Within(Predicate):
+    def __init__(self, a: Match, b: Match, seconds: float) -> None:
+        self.a, self.b, self.seconds = a, b, seconds
+
+    def describe(self) -> str:
+        return f"within({self.a.describe()}, {self.b.describe()}, {self.seconds:g} s)"
+
+    def subjects(self) -> tuple[Subject, ...]:
+        return self.a.subjects() + self.b.subjects()
+
+    def processes(self) -> tuple[str, ...]:
+        return self.a.processes() + self.b.processes()
+
+    def fail(self, events: Sequence[TraceEvent], end: float) -> Failure | None:
+        responses = [e for e in events if self.b(e)]
+        for cause in (e for e in events if self.a(e)):
+            due = cause.time + self.seconds
+            if due > end:
+                continue          # the run ended before the window closed: not judged
+            after = [e for e in responses if e.seq > cause.seq]
+            if after and after[0].time <= due:
+                continue
+            nxt = (f"; the next came at {clock(after[0].time)}, "
+                   f"{after[0].time - cause.time:g} s after it" if after
+                   else f"; none came before the end ({clock(end)})")
+            return Failure((f"but {self.a.describe()} at {clock(cause.time)} was not followed "
+                            f"by {self.b.describe()} within {self.seconds:g} s{nxt}",),
+                           (cause, *after[:1]), events)
+        return None
+
+
+def within(a: str | Match | Callable[[TraceEvent], bool],
+           b: str | Match | Callable[[TraceEvent], bool], seconds: float) -> Predicate:
+    """Every ``a`` is followed by a ``b`` (later in the trace) at most ``seconds`` later.
+    An ``a`` whose window is cut off by the end of the run is not judged."""
+    if not (seconds >= 0 and math.isfinite(seconds)):
+        raise ConfigurationError(f"within(): seconds must be >= 0, not {seconds!r}")
+    return _Within(_as_match(a), _as_match(b), float(seconds))
+
+
+# ---------------------------------------------------------------- counting
+_CMP: dict[str, Callable[[int, float], bool]] = {
+    "==": operator.eq, "!=": operator.ne, "<": operator.lt, "<=": operator.le,
+    ">": operator.gt, ">=": operator.ge}
+
+
+class _Counted(Predicate):
+    def __init__(self, match: Match, op: str, a: float, b: float | None = None) -> None:
+        self.match, self.op, self.a, self.b = match, op, a, b
+
+    def describe(self) -> str:
+        target = (f"between {self.a:g} and {self.b:g}" if self.op == "in"
+                  else f"{self.op} {self.a:g}")
+        return f"count({self.match.describe()}) {target}"
+
+    def subjects(self) -> tuple[Subject, ...]:
+        return self.match.subjects()
+
+    def processes(self) -> tuple[str, ...]:
+        return self.match.processes()
+
+    def _ok(self, n: int) -> bool:
+        if self.op == "in":
+            assert self.b is not None
+            return self.a <= n <= self.b
+        return _CMP[self.op](n, self.a)
+
+    def fail(self, events: Sequence[TraceEvent], end: float) -> Failure | None:
+        hits = self.match.all(events)
+        if self._ok(len(hits)):
+            return None
+        shown = tuple(hits[:3]) + tuple(hits[-2:] if len(hits) > 3 else ())
+        return Failure((f"but it happened {len(hits)} time(s)",), shown, events)
+
+
+class Count:
+    """``count(x)``: compare with ``==``, ``!=``, ``<``, ``<=``, ``>``, ``>=``, or use
+    :meth:`between`, :meth:`at_least`, :meth:`at_most`; each gives a :class:`Predicate`
+    judged per trace (per replication, or per instance with ``per_instance``)."""
+
+    __hash__ = None  # type: ignore[assignment]
+
+    def __init__(self, match: Match) -> None:
+        self.match = match
+
+    def __repr__(self) -> str:
+        return f"count({self.match.describe()})"
+
+    def __eq__(self, n: object) -> Predicate:  # type: ignore[override]
+        return _Counted(self.match, "==", _number(n))
+
+    def __ne__(self, n: object) -> Predicate:  # type: ignore[override]
+        return _Counted(self.match, "!=", _number(n))
+
+    def __lt__(self, n: float) -> Predicate:
+        return _Counted(self.match, "<", _number(n))
+
+    def __le__(self, n: float) -> Predicate:
+        return _Counted(self.match, "<=", _number(n))
+
+    def __gt__(self, n: float) -> Predicate:
+        return _Counted(self.match, ">", _number(n))
+
+    def __ge__(self, n: float) -> Predicate:
+        return _Counted(self.match, ">=", _number(n))
+
+    def between(self, lo: float, hi: float) -> Predicate:
+        """``lo <= count <= hi``."""
+        if lo > hi:
+            raise ConfigurationError(f"count().between({lo}, {hi}): the range is empty")
+        return _Counted(self.match, "in", _number(lo), _number(hi))
+
+    def at_least(self, n: float) -> Predicate:
+        return self >= n
+
+    def at_most(self, n: float) -> Predicate:
+        return self <= n
+
+    def exactly(self, n: float) -> Predicate:
+        return self == n
+
+    def of(self, events: Sequence[TraceEvent]) -> int:
+        """How many events of ``events`` match."""
+        return len(self.match.all(events))
+
+
+def _number(n: object) -> float:
+    if isinstance(n, bool) or not isinstance(n, (int, float)):
+        raise TypeError(f"count() compares with a number, not {n!r}")
+    return float(n)
+
+
+def count(what: str | Match | Callable[[TraceEvent], bool]) -> Count:
+    """How many times ``what`` happens in a trace (see :class:`Count`)."""
+    return Count(_as_match(what))
+
+
+# ---------------------------------------------------------------- composition and scope
+class _All(Predicate):
+    def __init__(self, parts: tuple[Predicate, ...]) -> None:
+        flat: list[Predicate] = []
+        for p in parts:
+            flat.extend(p.parts if isinstance(p, _All) else (p,))
+        self.parts = tuple(flat)
+
+    def describe(self) -> str:
+        return " & ".join(_paren(p) for p in self.parts)
+
+    def subjects(self) -> tuple[Subject, ...]:
+        return tuple(s for p in self.parts for s in p.subjects())
+
+    def processes(self) -> tuple[str, ...]:
+        return tuple(s for p in self.parts for s in p.processes())
+
+    def fail(self, events: Sequence[TraceEvent], end: float) -> Failure | None:
+        for part in self.parts:
+            failure = part.fail(events, end)
+            if failure is not None:
+                return Failure((f"{part.describe()} does not hold:", *failure.lines),
+                               failure.focus, failure.trace)
+        return None
+
+    def witness(self, events: Sequence[TraceEvent]) -> tuple[TraceEvent, ...]:
+        return tuple(e for p in self.parts for e in p.witness(events))[:4]
+
+
+class _Any(_All):
+    def __init__(self, parts: tuple[Predicate, ...]) -> None:
+        flat: list[Predicate] = []
+        for p in parts:
+            flat.extend(p.parts if isinstance(p, _Any) else (p,))
+        self.parts = tuple(flat)
+
+    def describe(self) -> str:
+        return " | ".join(_paren(p) for p in self.parts)
+
+    def fail(self, events: Sequence[TraceEvent], end: float) -> Failure | None:
+        failures = [part.fail(events, end) for part in self.parts]
+        if any(f is None for f in failures):
+            return None
+        lines: list[str] = ["but none of the alternatives holds:"]
+        for part, failure in zip(self.parts, failures, strict=True):
+            assert failure is not None
+            lines.append(f"  {part.describe()}: " + " ".join(failure.lines))
+        first = failures[0]
+        assert first is not None
+        return Failure(tuple(lines), first.focus, first.trace)
+
+
+class _Not(Predicate):
+    def __init__(self, inner: Predicate) -> None:
+        self.inner = inner
+
+    def describe(self) -> str:
+        return f"~{_paren(self.inner)}"
+
+    def subjects(self) -> tuple[Subject, ...]:
+        return self.inner.subjects()
+
+    def processes(self) -> tuple[str, ...]:
+        return self.inner.processes()
+
+    def fail(self, events: Sequence[TraceEvent], end: float) -> Failure | None:
+        if self.inner.fail(events, end) is not None:
+            return None
+        return Failure((f"but {self.inner.describe()} holds",), self.inner.witness(events),
+                       events)
+
+    def __invert__(self) -> Predicate:
+        return self.inner
+
+
+def _paren(p: Predicate) -> str:
+    text = p.describe()
+    return f"({text})" if isinstance(p, (_All, _Not)) or " | " in text else text
+
+
+class _PerInstance(Predicate):
+    def __init__(self, process: str, inner: Predicate) -> None:
+        self.process, self.inner = process, inner
+
+    def describe(self) -> str:
+        return f"per_instance({self.process!r}, {self.inner.describe()})"
+
+    def subjects(self) -> tuple[Subject, ...]:
+        return self.inner.subjects()
+
+    def processes(self) -> tuple[str, ...]:
+        return (self.process, *self.inner.processes())
+
+    def instances(self, events: Sequence[TraceEvent]) -> list[list[TraceEvent]]:
+        by_id: dict[int, list[TraceEvent]] = {}
+        for e in events:
+            if e.instance is not None:
+                by_id.setdefault(e.instance, []).append(e)
+        return [evs for evs in by_id.values()
+                if evs[0].kind == EventKind.PROCESS_STARTED and evs[0].process == self.process]
+
+    def fail(self, events: Sequence[TraceEvent], end: float) -> Failure | None:
+        for own in self.instances(events):
+            failure = self.inner.fail(own, end)
+            if failure is not None:
+                head = (f"in {self.process} instance #{own[0].instance} (started "
+                        f"{clock(own[0].time)}):")
+                return Failure((head, *failure.lines), failure.focus, own)
+        return None
+
+
+def per_instance(process: str, predicate: Predicate | str | Match) -> Predicate:
+    """``predicate`` on each instance of ``process`` separately, seeing only that instance's
+    events (so ``count("dispense") == 1`` means once per dose, not once per run)."""
+    return _PerInstance(process, _as_predicate(predicate))
+
+
+# ---------------------------------------------------------------- judging results
+def _runs(obj: Any) -> list[_Run]:
+    from opspec.engine.simulation import RunResult
+
+    if isinstance(obj, RunResult):
+        if obj.trace is None:
+            raise ConfigurationError("this run kept no trace",
+                                     hint="run it with keep_trace=True")
+        return [_Run("", obj.trace, float(obj.summary.get("time", _end(obj.trace))))]
+    traces = getattr(obj, "traces", None)
+    if traces is not None and hasattr(obj, "runs"):      # a SimulationResult
+        horizon = getattr(obj, "horizon", None)
+        many = len(traces) > 1
+        return [_Run(f" (replication {i})" if many else "", t,
+                     float(horizon) if horizon is not None else _end(t))
+                for i, t in enumerate(traces)]
+    if isinstance(obj, Sequence) and all(isinstance(e, TraceEvent) for e in obj):
+        return [_Run("", obj, _end(obj))]
+    raise TypeError("expected a SimulationResult, a RunResult or a sequence of TraceEvent, "
+                    f"not {type(obj).__name__}")
+
+
+def _end(trace: Sequence[TraceEvent]) -> float:
+    return trace[-1].time if trace else 0.0
+
+
+def _names(obj: Any, spec: Any) -> Any:
+    if spec is None:
+        return getattr(obj, "names", None)
+    if hasattr(spec, "activities") and hasattr(spec, "triggers"):
+        return spec
+    from opspec.engine.compiled import CompiledPackage, compile_package
+    from opspec.testing.simulate import spec_names
+
+    compiled = spec if isinstance(spec, CompiledPackage) else compile_package(spec)
+    return spec_names(compiled)
+
+
+def check_names(predicate: Predicate, names: Any) -> None:
+    """:class:`ConfigurationError` when ``predicate`` names something the spec lacks."""
+    for subject in predicate.subjects():
+        subject.bind(names)
+    for process in predicate.processes():
+        if process not in names.processes:
+            raise ConfigurationError(f"the spec has no process {process!r}",
+                                     hint="its processes are: " + ", ".join(names.processes))
+
+
+def failures(obj: Any, predicate: Predicate | str | Match, *, spec: Any = None,
+             first: bool = True) -> list[str]:
+    """The failure messages of ``predicate`` on each trace of ``obj`` (the first only, by
+    default); empty when it holds."""
+    predicate = _as_predicate(predicate)
+    names = _names(obj, spec)
+    if names is not None:
+        check_names(predicate, names)
+    out = []
+    for run in _runs(obj):
+        failure = predicate.fail(run.events, run.end)
+        if failure is None:
+            continue
+        lines = [f"expected {predicate.describe()}" + run.label,
+                 *(f"  {line}" for line in failure.lines)]
+        lines.extend(trace_slice(failure.trace or run.events, failure.focus))
+        out.append("\n".join(lines))
+        if first:
+            break
+    return out
+
+
+def holds(obj: Any, predicate: Predicate | str | Match, *, spec: Any = None) -> bool:
+    """Whether ``predicate`` holds on every trace of ``obj``. Names the spec lacks raise
+    :class:`ConfigurationError` (they are a mistake in the test, not a failed claim)."""
+    return not failures(obj, predicate, spec=spec)
+
+
+def check(obj: Any, *predicates: Predicate | str | Match, spec: Any = None) -> None:
+    """Assert every predicate on ``obj``; ``AssertionError`` with each failure's claim,
+    reason and trace slice."""
+    __tracebackhide__ = True
+    messages = [m for p in predicates for m in failures(obj, p, spec=spec)]
+    if messages:
+        seed = getattr(obj, "seed", None)
+        if seed is not None and hasattr(obj, "replications"):
+            messages.append(f"(seed {seed}, {obj.replications} replication(s))")
+        raise AssertionError("\n\n".join(messages))
+
+
+def trace_slice(trace: Sequence[TraceEvent], focus: Sequence[TraceEvent]) -> list[str]:
+    """A few events around each focus event (marked ``>``), ``...`` between the pieces."""
+    from opspec.testing.expectations import format_events
+
+    if not focus or not trace:
+        return []
+    index = {id(e): i for i, e in enumerate(trace)}
+    marked = {index[id(e)] for e in focus if id(e) in index}
+    if not marked:
+        return ["  trace (relevant events):", *format_events(list(focus)[:MAX_LINES])]
+    keep: set[int] = set()
+    for i in sorted(marked):
+        keep.update(range(max(0, i - BEFORE), min(len(trace), i + AFTER + 1)))
+    rows = sorted(keep)
+    if len(rows) > MAX_LINES:      # keep the marked rows and their closest neighbours
+        rows = sorted(sorted(rows, key=lambda r: min(abs(r - m) for m in marked))[:MAX_LINES])
+    lines = [f"  trace around it ({len(marked)} marked event(s) of {len(trace)}):"]
+    previous = None
+    for r in rows:
+        if previous is not None and r != previous + 1:
+            lines.append("    ...")
+        (text,) = format_events([trace[r]])
+        lines.append((">" + text[1:]) if r in marked else text)
+        previous = r
+    return lines
+
