@@ -20,23 +20,10 @@ __all__ = ["UserChoice", "choose_user", "companion_user_model", "load_any_spec"]
 
 
 def load_any_spec(path: str | Path) -> Package:
-    """The package in ``path``: a compiled workflow script (``.wfs``) or an XPDL file.
+    """The package in ``path`` (XPDL or ``.wfs``); see :func:`opspec.xpdl.open_spec.open_spec`."""
+    from opspec.xpdl.open_spec import open_spec
 
-    Raises :class:`~opspec.errors.SpecError` (with ``path:line``) for a broken spec and
-    :class:`~opspec.errors.ConfigurationError` for a path that is not a readable file.
-    """
-    target = Path(path)
-    if not target.is_file():
-        what = "a folder" if target.is_dir() else "not found"
-        raise ConfigurationError(f"{target}: {what}; give one specification file",
-                                 hint="e.g. specs/medication_dispenser.xpdl")
-    if target.suffix == ".wfs":
-        from opspec.model.codec import read_wfs
-
-        return read_wfs(target)
-    from opspec.xpdl.loader import load_spec
-
-    return load_spec(target)
+    return open_spec(path)
 
 
 def companion_user_model(spec_path: str | Path) -> Path | None:

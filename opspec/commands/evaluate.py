@@ -1,0 +1,230 @@
+"""``opspec evaluate SPEC``: many simulated users over many days, stored, summarised, reported.
+
+See ``docs/evaluation.md``. Exit status: 0 every replication finished; 1 some failed (listed;
+``--resume`` runs them again) or the spec is broken; 2 usage, configuration or I/O errors.
+"""
+
+from __future__ import annotations
+
+import argparse
+import contextlib
+import json
+import os
+import sys
+from dataclasses import asdict
+from datetime import UTC, datetime
+from pathlib import Path
+from typing import Any
+
+from opspec.errors import EvaluationError
+
+__all__ = ["register", "run"]
+
+EXPORTS = ("xes", "jsonl")
+
+
+def register(subparsers: Any) -> None:
+    parser = subparsers.add_parser(
+        "evaluate", help="evaluate a spec with many simulated users; report with CIs and plots",
+        description="Run SPEC for N simulated users x D days (each user an independent "
+        "replication with their own random streams), store every result in OUT/results.sqlite "
+        "as it finishes, and write OUT/report.html with metrics, confidence intervals and "
+        "plots. The same seed gives the same results whatever the number of workers.")
+    parser.add_argument("spec", metavar="SPEC", nargs="?",
+                        help="the specification (.xpdl or .wfs); optional with --resume")
+    parser.add_argument("--users", type=int, default=100, help="simulated users (default 100)")
+    parser.add_argument("--days", type=float, default=30.0,
+                        help="simulated days per user (default 30)")
+    parser.add_argument("--seed", type=int, default=0, help="run seed (default 0)")
+    parser.add_argument("--user-model", metavar="FILE|PRESET",
+                        help="user model file or preset, 'A,B' to chain (default: the spec's "
+                        "companion SPEC.users.toml)")
+    parser.add_argument("--compare", metavar="SPEC2",
+                        help="a second design, run on the same simulated users")
+    parser.add_argument("--engine-config", metavar="FILE", help="engine configuration TOML")
+    parser.add_argument("--workers", type=int, default=None,
+                        help="worker processes (default: all local cores)")
+    parser.add_argument("--scheduler", metavar="ADDRESS",
+                        help="run on an existing Dask distributed cluster (tcp://host:8786)")
+    parser.add_argument("--out", metavar="DIR",
+                        help="output folder (default: runs/<spec>-<date-time>)")
+    parser.add_argument("--resume", action="store_true",
+                        help="finish the evaluation stored in --out (missing or failed users)")
+    parser.add_argument("--export", action="append", default=[], metavar="FMT",
+                        help="also write traces: xes (traces.xes), jsonl (traces.jsonl); "
+                        "repeatable or comma-separated")
+    parser.add_argument("--json", action="store_true",
+                        help="print one JSON object with the results (docs/evaluation.md)")
+    parser.add_argument("--quiet", action="store_true", help="no progress output")
+    parser.set_defaults(handler=run)
+
+
+def _exports(values: list[str]) -> tuple[str, ...]:
+    formats: list[str] = []
+    for value in values:
+        for part in value.split(","):
+            fmt = part.strip().lower()
+            if fmt not in EXPORTS:
+                raise EvaluationError(f"--export {part!r} is not a known format",
+                                      hint=f"choose from: {', '.join(EXPORTS)}")
+            if fmt not in formats:
+                formats.append(fmt)
+    return tuple(formats)
+
+
+def _default_out(spec: str) -> Path:
+    stem = Path(spec).name.split(".")[0]
+    stamp = datetime.now(UTC).strftime("%Y%m%d-%H%M%S")
+    return Path("runs") / f"{stem}-{stamp}"
+
+
+def _engine(path: str | None) -> dict[str, Any]:
+    if path is None:
+        return {}
+    from opspec.engine.config import EngineConfig
+
+    return asdict(EngineConfig.load(path))
+
+
+def _new_plan(args: argparse.Namespace) -> Any:
+    from opspec.commands._spec import companion_user_model
+    from opspec.evaluation.plan import Design, EvaluationPlan, file_digest
+
+    if args.spec is None:
+        raise EvaluationError("give the SPEC to evaluate (or --resume --out DIR)")
+    specs = [("A", args.spec)] + ([("B", args.compare)] if args.compare else [])
+    designs = []
+    for label, path in specs:
+        from opspec.xpdl.open_spec import open_spec
+
+        open_spec(path)                       # a broken spec stops here, with path:line
+        designs.append(Design(label, str(path), file_digest(path)))
+    model = args.user_model
+    if model is None:
+        companion = companion_user_model(args.spec)
+        model = str(companion) if companion is not None else None
+    return EvaluationPlan(designs=tuple(designs), users=args.users, days=args.days,
+                          seed=args.seed, user_model=model, engine=_engine(args.engine_config),
+                          export=_exports(args.export))
+
+
+def _check_plan(plan: Any) -> list[dict[str, Any]]:
+    """Load every design and the user model once, before any simulation: bad inputs stop the
+    run here. Returns the metric definitions of design A."""
+    from opspec.evaluation.replication import prepare
+
+    definitions: list[dict[str, Any]] = []
+    for design in plan.designs:
+        context = prepare(design.spec, design.sha256, plan.user_model, plan.engine)
+        from opspec.engine.lanes import user_lane
+
+        if context.model is None and not user_lane(context.compiled).empty:
+            raise EvaluationError(
+                f"{design.spec}: the spec has a user lane but no user model was given",
+                hint="give --user-model FILE|PRESET (presets: opspec fit --help, "
+                "docs/user-models.md) or put SPEC.users.toml next to the spec")
+        if design.label == "A":
+            definitions = [{"name": m.name, "kind": m.kind.value.lower(),
+                            "numerator": m.numerator, "denominator": m.denominator,
+                            "unit": m.unit, "description": m.description}
+                           for m in context.compiled.package.metrics]
+    return definitions
+
+
+def run(args: argparse.Namespace) -> int:
+    from opspec import __version__
+    from opspec.evaluation.plan import EvaluationPlan
+    from opspec.evaluation.progress import make_progress
+    from opspec.evaluation.runner import run_evaluation
+    from opspec.evaluation.store import ResultStore
+
+    workers = args.workers if args.workers is not None else (os.cpu_count() or 1)
+    if workers < 1:
+        raise EvaluationError(f"--workers must be >= 1, not {workers}")
+    if args.resume:
+        if not args.out:
+            raise EvaluationError("--resume needs --out DIR (the folder of the run to finish)")
+        store = ResultStore(args.out, create=False)
+        plan = EvaluationPlan.from_json(store.get("plan"))
+        if args.spec is not None:
+            differs = _new_plan(args).same_results_as(plan)
+            if differs:
+                store.close()
+                raise EvaluationError(
+                    f"{args.out} holds a run with other {', '.join(differs)}",
+                    hint="resume with the same options (or none: `opspec evaluate --resume "
+                    f"--out {args.out}`), or choose another --out")
+        definitions = _check_plan(plan)
+    else:
+        plan = _new_plan(args)
+        definitions = _check_plan(plan)
+        out = Path(args.out) if args.out else _default_out(args.spec)
+        if (out / "results.sqlite").exists():
+            raise EvaluationError(f"{out} already holds an evaluation",
+                                  hint="add --resume to finish it, or choose another --out")
+        store = ResultStore(out, create=True)
+        store.put("plan", plan.to_json())
+        store.put("metrics", definitions)
+        store.put("opspec_version", __version__)
+        store.put("started", datetime.now(UTC).isoformat(timespec="seconds"))
+    with store, contextlib.ExitStack() as stack:
+        on_trace = _trace_writers(stack, store.folder, plan, resumed=args.resume)
+        progress = make_progress(sys.stderr, quiet=args.quiet or args.json)
+        outcome = run_evaluation(plan, store, workers=workers, scheduler=args.scheduler,
+                                 progress=progress, on_trace=on_trace)
+        stack.close()
+        from opspec.evaluation.report import write_report
+        from opspec.evaluation.summary import compare_designs, summarise_design
+
+        report = write_report(store)
+        metrics = summarise_design(store, "A", plan.days)
+        compare = None
+        if len(plan.designs) > 1:
+            compare = {"spec": plan.design("B").spec,
+                       "metrics": summarise_design(store, "B", plan.days),
+                       "difference": compare_designs(store)}
+        failures = store.failures()
+    if args.json:
+        doc = {"spec": plan.design("A").spec, "users": plan.users, "days": plan.days,
+               "seed": plan.seed, "user_model": plan.user_model, "workers": workers,
+               "out": str(store.folder), "report": str(report), "metrics": metrics,
+               "failed": [{"design": d, "user": u, "error": e} for d, u, e in failures],
+               "wall_s": round(outcome.wall_s, 3)}
+        if compare is not None:
+            doc["compare"] = compare
+        print(json.dumps(doc, allow_nan=False, default=str))
+    else:
+        from opspec.evaluation.tables import print_summary
+
+        print_summary(sys.stdout, plan, metrics, compare, outcome, failures, workers)
+        print(f"results: {store.path}\nreport: {report}")
+    return 1 if failures else 0
+
+
+def _trace_writers(stack: contextlib.ExitStack, folder: Path, plan: Any, *, resumed: bool
+                   ) -> Any:
+    if not plan.export:
+        return None
+    from opspec.engine.trace import TraceEvent
+    from opspec.evaluation.exporters import JsonlTraceWriter, XesWriter
+
+    suffix = ""
+    if resumed:   # never overwrite traces an earlier (interrupted) run wrote
+        n = 1
+        while any((folder / f"traces.resume-{n}.{fmt}").exists() for fmt in plan.export):
+            n += 1
+        suffix = f".resume-{n}"
+    attrs = {"spec": plan.design("A").spec, "seed": str(plan.seed)}
+    writers = []
+    for fmt in plan.export:
+        path = folder / f"traces{suffix}.{fmt}"
+        factory = XesWriter if fmt == "xes" else JsonlTraceWriter
+        writers.append(stack.enter_context(factory(path, log_attributes=attrs)))
+
+    def write(record: Any) -> None:
+        events = [TraceEvent.from_json(e) for e in record.trace]
+        for writer in writers:
+            writer.add_case(f"{record.design}/{record.user}", events,
+                            {"design": record.design, "user": record.user})
+
+    return write

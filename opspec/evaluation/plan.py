@@ -1,0 +1,90 @@
+"""What an evaluation run is: designs (specs), users, days, seed, user model, engine options.
+
+The plan is stored with the results (``run`` table of the store) so that ``--resume`` finishes
+exactly the run that was started, and is sent to workers as plain JSON.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import math
+from collections.abc import Mapping
+from dataclasses import asdict, dataclass, field
+from pathlib import Path
+from typing import Any
+
+from opspec.errors import EvaluationError
+
+__all__ = ["DAY", "Design", "EvaluationPlan", "file_digest"]
+
+DAY = 86_400.0
+
+
+def file_digest(path: str | Path) -> str:
+    """SHA-256 of a file's bytes (the spec a stored run was made with)."""
+    try:
+        return hashlib.sha256(Path(path).read_bytes()).hexdigest()
+    except OSError as error:
+        raise EvaluationError(f"cannot read {path}: {error.strerror or error}") from None
+
+
+@dataclass(frozen=True, slots=True)
+class Design:
+    """One device design under evaluation: ``A`` is the spec, ``B`` the ``--compare`` spec."""
+
+    label: str
+    spec: str
+    sha256: str
+
+
+@dataclass(frozen=True, slots=True)
+class EvaluationPlan:
+    """Everything that determines an evaluation's results (and nothing that doesn't, such as
+    the number of workers: results are the same whatever it is)."""
+
+    designs: tuple[Design, ...]
+    users: int
+    days: float
+    seed: int
+    user_model: str | None = None
+    engine: Mapping[str, Any] = field(default_factory=dict)
+    export: tuple[str, ...] = ()
+
+    def __post_init__(self) -> None:
+        if isinstance(self.users, bool) or not isinstance(self.users, int) or self.users < 1:
+            raise EvaluationError(f"--users must be a whole number >= 1, not {self.users!r}")
+        if not (isinstance(self.days, (int, float)) and math.isfinite(self.days)
+                and self.days > 0):
+            raise EvaluationError(f"--days must be a positive number, not {self.days!r}")
+
+    @property
+    def horizon(self) -> float:
+        return float(self.days) * DAY
+
+    def design(self, label: str) -> Design:
+        for design in self.designs:
+            if design.label == label:
+                return design
+        raise EvaluationError(f"no design {label!r} in this run")
+
+    def to_json(self) -> dict[str, Any]:
+        doc = asdict(self)
+        doc["designs"] = [asdict(d) for d in self.designs]
+        doc["engine"] = dict(self.engine)
+        doc["export"] = list(self.export)
+        return doc
+
+    @classmethod
+    def from_json(cls, doc: Mapping[str, Any]) -> EvaluationPlan:
+        return cls(designs=tuple(Design(**d) for d in doc["designs"]), users=int(doc["users"]),
+                   days=float(doc["days"]), seed=int(doc["seed"]),
+                   user_model=doc.get("user_model"), engine=dict(doc.get("engine") or {}),
+                   export=tuple(doc.get("export") or ()))
+
+    def same_results_as(self, other: EvaluationPlan) -> list[str]:
+        """What differs between two plans in ways that change results (for ``--resume``)."""
+        mine, theirs = self.to_json(), other.to_json()
+        return [key for key in ("designs", "users", "days", "seed", "user_model", "engine")
+                if json.dumps(mine[key], sort_keys=True) != json.dumps(theirs[key],
+                                                                        sort_keys=True)]

@@ -1,0 +1,145 @@
+"""Run an evaluation's replications on ``concurrent.futures`` executors and store each result.
+
+- one worker: replications run in this process (no pool to start);
+- ``workers > 1``: a process pool of that many workers;
+- ``scheduler``: an existing Dask distributed cluster, through ``client.get_executor()`` —
+  the same code path as the pool.
+Users are sent in chunks so the per-task overhead stays negligible; every record is stored
+(and committed) in this process as soon as its chunk returns. A chunk whose worker dies is
+recorded as failed replications with the reason; ``--resume`` runs them again.
+"""
+
+from __future__ import annotations
+
+import concurrent.futures as cf
+import math
+import time
+from collections.abc import Callable, Iterator, Sequence
+from contextlib import contextmanager
+from dataclasses import dataclass
+from typing import Any
+
+from opspec.errors import EvaluationError
+from opspec.evaluation.plan import EvaluationPlan
+from opspec.evaluation.replication import ReplicationRecord, run_users
+from opspec.evaluation.store import ResultStore
+
+__all__ = ["Progress", "RunOutcome", "chunks", "run_evaluation"]
+
+
+@dataclass(frozen=True, slots=True)
+class RunOutcome:
+    """How the run went: replications done now, already stored, failed, and wall time."""
+
+    done: int
+    skipped: int
+    failed: int
+    wall_s: float
+
+
+class Progress:
+    """Receives progress; the CLI shows a bar or log lines. ``total`` is set once."""
+
+    def start(self, total: int, already: int) -> None: ...
+
+    def advance(self, n: int) -> None: ...
+
+    def finish(self) -> None: ...
+
+
+TraceSink = Callable[[ReplicationRecord], None]
+
+
+def chunks(users: Sequence[int], workers: int) -> list[list[int]]:
+    """Chunks of about 8 per worker, 1 to 50 users each, in user order."""
+    if not users:
+        return []
+    size = max(1, min(50, math.ceil(len(users) / (workers * 8))))
+    return [list(users[i:i + size]) for i in range(0, len(users), size)]
+
+
+@contextmanager
+def _executor(workers: int, scheduler: str | None) -> Iterator[cf.Executor | None]:
+    if scheduler:
+        try:
+            from distributed import Client
+        except ImportError:
+            raise EvaluationError("--scheduler needs dask.distributed",
+                                  hint="pip install 'opspec[dask]'") from None
+        try:
+            client = Client(scheduler, timeout=20)
+        except Exception as error:  # noqa: BLE001 - any connection failure, said plainly
+            raise EvaluationError(f"cannot reach the Dask scheduler at {scheduler}: {error}",
+                                  hint="check the address (tcp://host:8786) and that the "
+                                  "scheduler is running") from None
+        try:
+            yield client.get_executor()
+        finally:
+            client.close()
+        return
+    if workers <= 1:
+        yield None
+        return
+    import multiprocessing
+
+    # fork keeps start-up cheap; each worker loads the spec once (replication.prepare)
+    context = multiprocessing.get_context("fork" if hasattr(__import__("os"), "fork")
+                                          else "spawn")
+    pool = cf.ProcessPoolExecutor(max_workers=workers, mp_context=context)
+    try:
+        yield pool
+    finally:
+        pool.shutdown(wait=True, cancel_futures=True)
+
+
+def run_evaluation(plan: EvaluationPlan, store: ResultStore, *, workers: int = 1,
+                   scheduler: str | None = None, progress: Progress | None = None,
+                   on_trace: TraceSink | None = None) -> RunOutcome:
+    """Run every replication of ``plan`` not yet stored as done, storing each as it ends."""
+    started = time.perf_counter()
+    progress = progress or Progress()
+    pending: list[tuple[str, list[int]]] = []
+    skipped = 0
+    for design in plan.designs:
+        finished = store.finished(design.label)
+        skipped += len(finished)
+        todo = [u for u in range(plan.users) if u not in finished]
+        pending.extend((design.label, chunk) for chunk in chunks(todo, max(1, workers)))
+    total = plan.users * len(plan.designs)
+    progress.start(total, skipped)
+    doc = plan.to_json()
+    done = failed = 0
+
+    def keep(records: list[ReplicationRecord]) -> None:
+        nonlocal done, failed
+        for record in records:
+            if on_trace is not None and record.trace is not None:
+                on_trace(record)
+            record.trace = None
+            store.add(record)
+            if record.status == "done":
+                done += 1
+            else:
+                failed += 1
+        progress.advance(len(records))
+
+    try:
+        with _executor(workers, scheduler) as executor:
+            if executor is None:
+                for label, users in pending:
+                    keep(run_users(doc, label, users))
+            else:
+                futures = {executor.submit(run_users, doc, label, users): (label, users)
+                           for label, users in pending}
+                for future in cf.as_completed(futures):
+                    label, users = futures[future]
+                    try:
+                        records = future.result()
+                    except Exception as error:  # noqa: BLE001 - a dead worker, recorded
+                        reason = f"worker failed: {type(error).__name__}: {error}"
+                        records = [ReplicationRecord(label, u, "failed", error=reason)
+                                   for u in users]
+                    keep(records)
+    finally:
+        progress.finish()
+    return RunOutcome(done, skipped, failed, time.perf_counter() - started)

@@ -1,0 +1,164 @@
+"""The result store: one SQLite database per evaluation, in its output folder.
+
+WAL mode, one transaction per replication, committed as soon as the replication finishes:
+killing the run at any moment loses at most the replications in flight, and ``--resume``
+runs only what is missing or failed. The schema (a contract with the report code and with
+anyone who opens ``results.sqlite`` in another tool):
+
+- ``run(key, value)``: JSON values — ``plan`` (the EvaluationPlan), ``opspec_version``,
+  ``started``;
+- ``replication(design, user, status, error, metrics, wall_s)``: one row per user and design,
+  ``metrics`` the user's declared metrics as JSON (the ``opspec run --json`` shape);
+- ``sample(design, user, metric, value, time)``: every duration observation, ``time`` the
+  simulated time it ended;
+- ``outcome(design, user, metric, day, hour, n)``: count-metric events by day (0-based) and
+  hour of day;
+- ``activity(design, user, activity, offered, completed, omitted, wrong)``: the user lane's
+  manual activities.
+"""
+
+from __future__ import annotations
+
+import json
+import sqlite3
+from collections.abc import Iterator
+from pathlib import Path
+from typing import Any
+
+from opspec.errors import EvaluationError
+from opspec.evaluation.replication import ReplicationRecord
+
+__all__ = ["SCHEMA_VERSION", "ResultStore"]
+
+SCHEMA_VERSION = 1
+
+_SCHEMA = """
+CREATE TABLE IF NOT EXISTS run (key TEXT PRIMARY KEY, value TEXT NOT NULL);
+CREATE TABLE IF NOT EXISTS replication (
+    design TEXT NOT NULL, user INTEGER NOT NULL, status TEXT NOT NULL, error TEXT,
+    metrics TEXT, wall_s REAL, PRIMARY KEY (design, user));
+CREATE TABLE IF NOT EXISTS sample (
+    design TEXT NOT NULL, user INTEGER NOT NULL, metric TEXT NOT NULL, value REAL NOT NULL,
+    time REAL NOT NULL);
+CREATE INDEX IF NOT EXISTS sample_by_metric ON sample (design, metric, value);
+CREATE INDEX IF NOT EXISTS sample_by_user ON sample (design, user);
+CREATE TABLE IF NOT EXISTS outcome (
+    design TEXT NOT NULL, user INTEGER NOT NULL, metric TEXT NOT NULL, day INTEGER NOT NULL,
+    hour INTEGER NOT NULL, n INTEGER NOT NULL);
+CREATE INDEX IF NOT EXISTS outcome_by_user ON outcome (design, user);
+CREATE TABLE IF NOT EXISTS activity (
+    design TEXT NOT NULL, user INTEGER NOT NULL, activity TEXT NOT NULL, offered INTEGER,
+    completed INTEGER, omitted INTEGER, wrong INTEGER);
+CREATE INDEX IF NOT EXISTS activity_by_user ON activity (design, user);
+"""
+
+FILENAME = "results.sqlite"
+
+
+def _fail(path: Path, doing: str, error: BaseException) -> EvaluationError:
+    reason = getattr(error, "strerror", None) or str(error)
+    return EvaluationError(f"{path}: cannot {doing}: {reason}",
+                           hint="check that the output folder is writable and the disk has "
+                           "room (--out DIR chooses another folder)")
+
+
+class ResultStore:
+    """An open result store. Use as a context manager; every write commits at once."""
+
+    def __init__(self, folder: str | Path, *, create: bool) -> None:
+        self.folder = Path(folder)
+        self.path = self.folder / FILENAME
+        if create:
+            try:
+                self.folder.mkdir(parents=True, exist_ok=True)
+            except OSError as error:
+                raise _fail(self.folder, "create the output folder", error) from None
+        elif not self.path.is_file():
+            raise EvaluationError(f"{self.path}: no stored evaluation to resume",
+                                  hint="run without --resume first, or give the --out folder "
+                                  "of the run to finish")
+        try:
+            self._db = sqlite3.connect(self.path, timeout=30.0, isolation_level=None)
+            self._db.execute("PRAGMA journal_mode=WAL")
+            self._db.execute("PRAGMA synchronous=NORMAL")
+            self._db.executescript(_SCHEMA)
+        except sqlite3.Error as error:
+            raise _fail(self.path, "open the result database", error) from None
+
+    # ------------------------------------------------------------------ run parameters
+
+    def put(self, key: str, value: Any) -> None:
+        self._write(lambda db: db.execute(
+            "INSERT OR REPLACE INTO run (key, value) VALUES (?, ?)", (key, json.dumps(value))),
+            "store the run parameters")
+
+    def get(self, key: str) -> Any:
+        row = self._db.execute("SELECT value FROM run WHERE key = ?", (key,)).fetchone()
+        return None if row is None else json.loads(row[0])
+
+    # ------------------------------------------------------------------ replications
+
+    def finished(self, design: str) -> set[int]:
+        """Users of ``design`` whose replication is stored as done."""
+        rows = self._db.execute(
+            "SELECT user FROM replication WHERE design = ? AND status = 'done'", (design,))
+        return {int(r[0]) for r in rows}
+
+    def add(self, record: ReplicationRecord) -> None:
+        """Store one replication (replacing an earlier failed attempt) in one transaction."""
+        def write(db: sqlite3.Connection) -> None:
+            key = (record.design, record.user)
+            db.execute("BEGIN IMMEDIATE")
+            try:
+                for table in ("sample", "outcome", "activity"):
+                    db.execute(f"DELETE FROM {table} WHERE design = ? AND user = ?", key)
+                db.execute("INSERT OR REPLACE INTO replication VALUES (?, ?, ?, ?, ?, ?)",
+                           (*key, record.status, record.error,
+                            json.dumps(record.metrics, allow_nan=True), record.wall_s))
+                db.executemany("INSERT INTO sample VALUES (?, ?, ?, ?, ?)",
+                               [(*key, m, v, t) for m, v, t in record.samples])
+                db.executemany("INSERT INTO outcome VALUES (?, ?, ?, ?, ?, ?)",
+                               [(*key, m, d, h, n) for (m, d, h), n in record.outcomes.items()])
+                db.executemany("INSERT INTO activity VALUES (?, ?, ?, ?, ?, ?, ?)",
+                               [(*key, a, *c) for a, c in record.activities.items()])
+                db.execute("COMMIT")
+            except BaseException:
+                db.execute("ROLLBACK")
+                raise
+
+        self._write(write, f"store replication {record.design}/{record.user}")
+
+    def failures(self) -> list[tuple[str, int, str]]:
+        rows = self._db.execute("SELECT design, user, error FROM replication "
+                                "WHERE status != 'done' ORDER BY design, user")
+        return [(str(d), int(u), str(e)) for d, u, e in rows]
+
+    def user_metrics(self, design: str) -> Iterator[tuple[int, dict[str, dict[str, Any]]]]:
+        """(user, metrics) of every finished replication of ``design``, by user."""
+        rows = self._db.execute("SELECT user, metrics FROM replication WHERE design = ? AND "
+                                "status = 'done' ORDER BY user", (design,))
+        for user, metrics in rows:
+            yield int(user), json.loads(metrics)
+
+    def query(self, sql: str, params: tuple[Any, ...] = ()) -> list[tuple[Any, ...]]:
+        return list(self._db.execute(sql, params))
+
+    # ------------------------------------------------------------------ plumbing
+
+    def _write(self, action: Any, doing: str) -> None:
+        try:
+            action(self._db)
+        except sqlite3.Error as error:
+            raise _fail(self.path, doing, error) from None
+
+    def close(self) -> None:
+        try:
+            self._db.close()
+        except sqlite3.Error:
+            pass
+
+    def __enter__(self) -> ResultStore:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()

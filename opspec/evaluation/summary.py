@@ -1,0 +1,153 @@
+"""Per-metric summaries of a stored evaluation (the ``metrics`` of ``opspec evaluate --json``).
+
+- count: ``total`` over all users, and per user ``mean``, ``sd``, ``ci95``, ``median``,
+  ``p95`` of the users' totals (and ``per_day``, the mean per user-day);
+- duration: pooled ``n``, ``mean`` (with ``ci95``), ``sd``, ``median``, ``p95`` of all
+  observations, and ``per_user`` (mean and sd of the users' own means);
+- ratio: ``value`` = Σ numerator / Σ denominator over users with ``ci95``, and ``per_user``.
+Intervals are described in :mod:`opspec.evaluation.statistics`. Quantiles of pooled
+observations are computed in the database, so memory does not grow with the number of users.
+"""
+
+from __future__ import annotations
+
+import math
+import statistics as pystats
+from collections.abc import Mapping, Sequence
+from typing import Any
+
+from opspec.evaluation.statistics import paired_difference, ratio_estimate
+from opspec.evaluation.store import ResultStore
+
+__all__ = ["compare_designs", "metric_definitions", "summarise_design", "user_pairs"]
+
+
+def metric_definitions(store: ResultStore) -> list[dict[str, Any]]:
+    """The declared metrics stored with the run (name, kind, numerator, denominator, unit)."""
+    return list(store.get("metrics") or [])
+
+
+def _percentile(ordered: Sequence[float], q: float) -> float | None:
+    if not ordered:
+        return None
+    pos = (len(ordered) - 1) * q
+    lo = math.floor(pos)
+    hi = min(lo + 1, len(ordered) - 1)
+    return ordered[lo] + (ordered[hi] - ordered[lo]) * (pos - lo)
+
+
+def _scalar_pair(metric: Mapping[str, Any] | None) -> tuple[float, float]:
+    """(y, n) of one user's value of a count or duration metric."""
+    if not metric:
+        return 0.0, 0.0
+    if metric.get("kind") == "count":
+        return float(metric.get("total") or 0), 1.0
+    if metric.get("kind") == "duration":
+        n = float(metric.get("n") or 0)
+        mean = metric.get("mean")
+        return (float(mean) * n if mean is not None else 0.0), n
+    value = metric.get("value")
+    return (float(value), 1.0) if value is not None else (0.0, 0.0)
+
+
+def user_pairs(store: ResultStore, design: str, definition: Mapping[str, Any]
+               ) -> list[tuple[int, tuple[float, float]]]:
+    """Per finished user of ``design``: the (y, n) pair of ``definition``'s metric."""
+    name = definition["name"]
+    out = []
+    for user, metrics in store.user_metrics(design):
+        if definition["kind"] == "ratio":
+            num, _ = _scalar_pair(metrics.get(definition.get("numerator") or ""))
+            den, _ = _scalar_pair(metrics.get(definition.get("denominator") or ""))
+            out.append((user, (num, den)))
+        else:
+            out.append((user, _scalar_pair(metrics.get(name))))
+    return out
+
+
+def _pooled_quantile(store: ResultStore, design: str, metric: str, n: int, q: float
+                     ) -> float | None:
+    if n == 0:
+        return None
+    pos = (n - 1) * q
+    lo = math.floor(pos)
+    rows = store.query("SELECT value FROM sample WHERE design = ? AND metric = ? "
+                       "ORDER BY value LIMIT 2 OFFSET ?", (design, metric, lo))
+    values = [float(r[0]) for r in rows]
+    if len(values) == 1 or pos == lo:
+        return values[0]
+    return values[0] + (values[1] - values[0]) * (pos - lo)
+
+
+def _sd(values: Sequence[float]) -> float | None:
+    return pystats.stdev(values) if len(values) > 1 else None
+
+
+def summarise_design(store: ResultStore, design: str, days: float, level: float = 0.95
+                     ) -> dict[str, dict[str, Any]]:
+    """Every declared metric of ``design`` summarised (see the module docstring)."""
+    out: dict[str, dict[str, Any]] = {}
+    for definition in metric_definitions(store):
+        name, kind = definition["name"], definition["kind"]
+        pairs = [p for _, p in user_pairs(store, design, definition)]
+        estimate = ratio_estimate(pairs, level)
+        users = len(pairs)
+        if kind == "count":
+            totals = sorted(y for y, _ in pairs)
+            out[name] = {
+                "kind": "count", "total": int(sum(totals)), "users": users,
+                "mean": estimate.value, "sd": _sd(totals), "ci95": estimate.ci,
+                "median": _percentile(totals, 0.5), "p95": _percentile(totals, 0.95),
+                "per_day": (estimate.value / days) if estimate.value is not None else None,
+            }
+        elif kind == "duration":
+            n = int(sum(n for _, n in pairs))
+            means = [y / k for y, k in pairs if k > 0]
+            sq = store.query("SELECT SUM(value * value) FROM sample WHERE design = ? AND "
+                             "metric = ?", (design, name))
+            sd = None
+            if n > 1 and estimate.value is not None and sq and sq[0][0] is not None:
+                var = (float(sq[0][0]) - n * estimate.value ** 2) / (n - 1)
+                sd = math.sqrt(max(var, 0.0))
+            out[name] = {
+                "kind": "duration", "unit": definition.get("unit") or "s", "n": n,
+                "mean": estimate.value, "ci95": estimate.ci, "sd": sd,
+                "median": _pooled_quantile(store, design, name, n, 0.5),
+                "p95": _pooled_quantile(store, design, name, n, 0.95),
+                "per_user": {"users": len(means),
+                             "mean": pystats.fmean(means) if means else None,
+                             "sd": _sd(means)},
+            }
+        else:
+            ratios = [y / k for y, k in pairs if k > 0]
+            out[name] = {
+                "kind": "ratio", "value": estimate.value, "ci95": estimate.ci,
+                "numerator": definition.get("numerator"),
+                "denominator": definition.get("denominator"),
+                "per_user": {"users": len(ratios),
+                             "mean": pystats.fmean(ratios) if ratios else None,
+                             "sd": _sd(ratios)},
+            }
+    return out
+
+
+def compare_designs(store: ResultStore, a: str = "A", b: str = "B", level: float = 0.95
+                    ) -> dict[str, dict[str, Any]]:
+    """Per metric: B − A on the users both designs finished, paired by user."""
+    out: dict[str, dict[str, Any]] = {}
+    for definition in metric_definitions(store):
+        pairs_a = dict(user_pairs(store, a, definition))
+        pairs_b = dict(user_pairs(store, b, definition))
+        users = sorted(set(pairs_a) & set(pairs_b))
+        diff = paired_difference([pairs_a[u] for u in users], [pairs_b[u] for u in users],
+                                 level)
+        ea = ratio_estimate([pairs_a[u] for u in users], level)
+        eb = ratio_estimate([pairs_b[u] for u in users], level)
+        significant = (diff.low is not None and diff.high is not None
+                       and (diff.low > 0 or diff.high < 0))
+        out[definition["name"]] = {
+            "kind": definition["kind"], "a": ea.value, "b": eb.value,
+            "difference": diff.value, "ci95": diff.ci, "users": len(users),
+            "significant": significant,
+        }
+    return out

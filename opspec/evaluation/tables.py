@@ -1,0 +1,103 @@
+"""Plain-text tables of an evaluation's results (the terminal summary and the report's tables)."""
+
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
+from typing import IO, Any
+
+__all__ = ["comparison_rows", "fmt", "is_rate", "metric_rows", "print_summary", "table"]
+
+METRIC_HEADERS = ("metric", "kind", "estimate", "95 % CI", "median", "p95", "n")
+COMPARE_HEADERS = ("metric", "A", "B", "B − A", "95 % CI", "")
+
+
+def fmt(value: Any, unit: str = "", *, percent: bool = False) -> str:
+    """A number for people: 4 significant digits, a unit, or a percentage."""
+    if value is None:
+        return "–"
+    if percent:
+        return f"{value * 100:.2f} %"
+    if isinstance(value, float):
+        text = f"{value:.4g}" if abs(value) < 1e6 else f"{value:.3e}"
+    else:
+        text = str(value)
+    return f"{text} {unit}".rstrip()
+
+
+def is_rate(name: str, summary: Mapping[str, Any]) -> bool:
+    """A ratio read as a percentage: named ``…rate``/``…share`` and between 0 and 1."""
+    value = summary.get("value", summary.get("a"))
+    return (summary["kind"] == "ratio" and name.endswith(("rate", "share"))
+            and (value is None or 0.0 <= value <= 1.0))
+
+
+def _ci(summary: Mapping[str, Any], unit: str = "", *, percent: bool = False) -> str:
+    low, high = (summary.get("ci95") or [None, None])
+    if low is None or high is None:
+        return "–"
+    return f"[{fmt(low, unit, percent=percent)}, {fmt(high, unit, percent=percent)}]"
+
+
+def metric_rows(metrics: Mapping[str, Mapping[str, Any]]) -> list[tuple[str, ...]]:
+    rows = []
+    for name, s in metrics.items():
+        kind = s["kind"]
+        if kind == "count":
+            rows.append((name, "count", f"{fmt(s['mean'])} per user", _ci(s),
+                         fmt(s["median"]), fmt(s["p95"]), f"total {s['total']}"))
+        elif kind == "duration":
+            unit = s.get("unit") or "s"
+            rows.append((name, "duration", fmt(s["mean"], unit), _ci(s, unit),
+                         fmt(s["median"], unit), fmt(s["p95"], unit), str(s["n"])))
+        else:
+            percent = is_rate(name, s)
+            rows.append((name, "ratio", fmt(s["value"], percent=percent),
+                         _ci(s, percent=percent), "–", "–", ""))
+    return rows
+
+
+def comparison_rows(difference: Mapping[str, Mapping[str, Any]]) -> list[tuple[str, ...]]:
+    rows = []
+    for name, d in difference.items():
+        percent = is_rate(name, d)
+        rows.append((name, fmt(d["a"], percent=percent), fmt(d["b"], percent=percent),
+                     fmt(d["difference"], percent=percent), _ci(d, percent=percent),
+                     "differs" if d["significant"] else ""))
+    return rows
+
+
+def table(headers: Sequence[str], rows: Sequence[Sequence[str]]) -> list[str]:
+    widths = [max(len(h), *(len(r[i]) for r in rows)) if rows else len(h)
+              for i, h in enumerate(headers)]
+    line = "  ".join(h.ljust(w) for h, w in zip(headers, widths, strict=True)).rstrip()
+    out = [line, "  ".join("-" * w for w in widths)]
+    out += ["  ".join(c.ljust(w) for c, w in zip(r, widths, strict=True)).rstrip()
+            for r in rows]
+    return out
+
+
+def print_summary(out: IO[str], plan: Any, metrics: Mapping[str, Any],
+                  compare: Mapping[str, Any] | None, outcome: Any,
+                  failures: Sequence[tuple[str, int, str]], workers: int) -> None:
+    design = plan.design("A")
+    print(f"opspec evaluate: {design.spec}, {plan.users} users x {plan.days:g} days, seed "
+          f"{plan.seed}, user model {plan.user_model or 'none'}", file=out)
+    ran = f"{outcome.done} replications in {outcome.wall_s:.1f} s on {workers} worker(s)"
+    if outcome.skipped:
+        ran += f" ({outcome.skipped} already stored)"
+    print(ran, file=out)
+    print(file=out)
+    for line in table(METRIC_HEADERS, metric_rows(metrics)):
+        print(line, file=out)
+    if compare is not None:
+        print(f"\ncompared with B = {compare['spec']} (same users, paired):", file=out)
+        for line in table(COMPARE_HEADERS, comparison_rows(compare["difference"])):
+            print(line, file=out)
+    if failures:
+        print(f"\n{len(failures)} replication(s) failed:", file=out)
+        for design_label, user, error in failures[:10]:
+            print(f"  {design_label}/{user}: {error}", file=out)
+        if len(failures) > 10:
+            print(f"  … and {len(failures) - 10} more", file=out)
+        print("run again with --resume --out <folder> to complete them", file=out)
+    print(file=out)

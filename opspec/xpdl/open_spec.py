@@ -1,0 +1,30 @@
+"""Open a specification whatever its form: an XPDL file or a compiled workflow script (.wfs)."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from opspec.errors import ConfigurationError
+from opspec.model import Package
+
+__all__ = ["open_spec"]
+
+
+def open_spec(path: str | Path) -> Package:
+    """The package in ``path`` (``.wfs`` scripts load directly, anything else as XPDL).
+
+    Raises :class:`~opspec.errors.SpecError` (with ``path:line``) for a broken spec and
+    :class:`~opspec.errors.ConfigurationError` for a path that is not a readable file.
+    """
+    target = Path(path)
+    if not target.is_file():
+        what = "a folder" if target.is_dir() else "not found"
+        raise ConfigurationError(f"{target}: {what}; give one specification file",
+                                 hint="e.g. specs/medication_dispenser.xpdl")
+    if target.suffix == ".wfs":
+        from opspec.model.codec import read_wfs
+
+        return read_wfs(target)
+    from opspec.xpdl.loader import load_spec
+
+    return load_spec(target)
