@@ -44,6 +44,7 @@ __all__ = [
     "MaxCount",
     "MinGap",
     "Monitor",
+    "MonitorResult",
     "MonitorRun",
     "Names",
     "Never",
@@ -201,6 +202,16 @@ class Violation:
         return f"{clock(self.time)}: {self.monitor}: {self.message}"
 
 
+@dataclass(frozen=True, slots=True)
+class MonitorResult:
+    """What one monitor saw in one run: ``count`` violations, the first of them kept."""
+
+    monitor: str
+    replication: int
+    count: int
+    violations: tuple[Violation, ...] = ()
+
+
 class MonitorRun:
     """One monitor watching one run: a trace listener. Subclasses implement
     :meth:`observe` (and :meth:`finish` when a violation can be due to something that did not
@@ -224,6 +235,11 @@ class MonitorRun:
 
     def finish(self, end: float) -> None:
         """The run ended at simulated time ``end`` (judge what is still pending)."""
+
+    def result(self) -> MonitorResult:
+        """The frozen outcome (call after :meth:`finish`)."""
+        return MonitorResult(self.monitor.text, self.replication, self.count,
+                             tuple(self.violations))
 
     def violate(self, time: float, message: str,
                 events: Iterable[TraceEvent] | None = None) -> None:

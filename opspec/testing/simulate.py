@@ -157,6 +157,15 @@ class SimulationResult:
     runs: tuple[RunResult, ...]
     metrics: dict[str, dict[str, Any]]
     durations: dict[str, tuple[float, ...]] = field(default_factory=dict)
+    #: what each monitor saw in each replication (see :mod:`opspec.testing.monitors`)
+    monitor_results: tuple[Any, ...] = ()
+
+    def monitor_report(self, confidence: float = 0.95) -> Any:
+        """Monitor violations, per monitor, with a hazard (violations per user-day) and its
+        exact interval: :func:`opspec.testing.monitors.monitor_report`."""
+        from opspec.testing.monitors import monitor_report
+
+        return monitor_report(self, confidence=confidence)
 
     def __repr__(self) -> str:
         return (f"<SimulationResult {self.spec.id}: {self.replications} replication(s), "
@@ -336,11 +345,14 @@ def simulate(spec: Package | CompiledPackage | str | Path, *, users: int = 1,
              performers: Mapping[str, Performer] | None = None,
              keep_trace: bool | None = None,
              params: Mapping[str, Any] | None = None,
-             progress: Callable[[int], None] | None = None) -> SimulationResult:
+             progress: Callable[[int], None] | None = None,
+             monitors: Sequence[Any] | None = None) -> SimulationResult:
     """Run ``spec`` for ``users`` independent users, ``days`` days (default 1) or to ``until``
     seconds; see the module docstring. ``keep_trace`` defaults to keeping traces of up to 100
     users. Raises :class:`~opspec.errors.OpspecError` subclasses for bad arguments (naming the
-    spec's processes, activities, triggers or metrics when a name is unknown)."""
+    spec's processes, activities, triggers or metrics when a name is unknown).
+    ``monitors`` (monitor objects or their text form, see :mod:`opspec.testing.monitors`) are
+    checked in every replication, with those the spec declares (``opspec:Monitor``)."""
     if isinstance(spec, (str, Path)):
         spec = load_spec_file(spec)
     compiled = spec if isinstance(spec, CompiledPackage) else compile_package(spec)
@@ -360,10 +372,15 @@ def simulate(spec: Package | CompiledPackage | str | Path, *, users: int = 1,
     if plan is not None:
         plan.check_names(names.activities, names.triggers)
     keep = users <= 100 if keep_trace is None else keep_trace
+    from opspec.testing.monitors import monitors_for
+
+    watch = monitors_for(compiled, names, monitors)
+    watched: list[Any] = []
     runs: list[RunResult] = []
     pooled: dict[str, list[float]] = {}
     for u in range(users):
-        listeners = []
+        listeners: list[Any] = [m.start(u) for m in watch]
+        watches = list(listeners)
         if model is not None:
             user: Performer = model.performer(user_stream(seed, u))
         else:
@@ -375,6 +392,9 @@ def simulate(spec: Package | CompiledPackage | str | Path, *, users: int = 1,
         sim = Simulation(compiled, config, performers=bindings, seed=seed, scope=(u,),
                          listeners=listeners, keep_trace=keep, params=params)
         runs.append(sim.run(until=horizon))
+        for watcher in watches:
+            watcher.finish(horizon)
+            watched.append(watcher.result())
         if sim.metrics is not None:
             for name, values in sim.metrics.samples.items():
                 pooled.setdefault(name, []).extend(values)
@@ -382,4 +402,4 @@ def simulate(spec: Package | CompiledPackage | str | Path, *, users: int = 1,
             progress(u + 1)
     return SimulationResult(compiled.package, names, seed, horizon, tuple(runs),
                             _pool(runs, pooled, compiled.package),
-                            {k: tuple(v) for k, v in pooled.items()})
+                            {k: tuple(v) for k, v in pooled.items()}, tuple(watched))

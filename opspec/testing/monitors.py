@@ -1,0 +1,233 @@
+"""Monitors in tests: safety properties checked during every simulated run.
+
+::
+
+    from opspec.testing.monitors import assert_no_violations, min_gap
+
+    result = simulate(spec, users=200, user_model="older-adults",
+                      monitors=[min_gap("dispense", hours=3.75), "max_count dispense 4 per 24h"])
+    assert_no_violations(result)             # AssertionError with each violation's events
+    print(result.monitor_report())           # violations per user-day, exact 95 % interval
+
+A spec declares its own monitors as a package ``ExtendedAttribute``; :func:`simulate` checks
+them in every run as well::
+
+    <ExtendedAttribute Name="opspec:Monitor" Value="min_gap dispense 4h"/>
+
+The listener classes and the text form live in :mod:`opspec.engine.monitors` (usable by any
+layer); this module adds the constructors tests use and the report.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterable, Sequence
+from dataclasses import dataclass
+from typing import Any
+
+from opspec.engine.monitors import (
+    BoundedResponse,
+    MaxCount,
+    MinGap,
+    Monitor,
+    MonitorResult,
+    Names,
+    Never,
+    NeverWhile,
+    Violation,
+    clock,
+    package_monitors,
+    parse_monitor,
+    parse_subject,
+    poisson_interval,
+)
+from opspec.errors import ConfigurationError
+
+__all__ = [
+    "Monitor",
+    "MonitorReport",
+    "MonitorRow",
+    "Violation",
+    "assert_no_violations",
+    "bounded_response",
+    "max_count_per",
+    "min_gap",
+    "monitor",
+    "monitor_report",
+    "monitors_for",
+    "never_happens",
+    "never_while",
+]
+
+
+def _seconds(seconds: float, minutes: float, hours: float) -> float:
+    total = float(seconds) + 60.0 * minutes + 3600.0 * hours
+    if not total > 0:
+        raise ConfigurationError("a monitor's time must be positive",
+                                 hint="give seconds=, minutes= or hours=")
+    return total
+
+
+def _span_text(seconds: float) -> str:
+    return f"{seconds / 3600:g}h" if seconds >= 3600 else f"{seconds:g}s"
+
+
+def monitor(text: str) -> Monitor:
+    """A monitor from its text form (``"min_gap dispense 4h"``, see
+    :mod:`opspec.engine.monitors`)."""
+    return parse_monitor(text)
+
+
+def min_gap(subject: str, *, seconds: float = 0, minutes: float = 0, hours: float = 0
+            ) -> Monitor:
+    """No two ``subject`` closer than the given time: ``min_gap("dispense", hours=4)``."""
+    gap = _seconds(seconds, minutes, hours)
+    return MinGap(parse_subject(subject), gap, text=f"min_gap {subject} {_span_text(gap)}")
+
+
+def never_happens(subject: str) -> Monitor:
+    """``subject`` never happens."""
+    return Never(parse_subject(subject), text=f"never {subject}")
+
+
+def never_while(subject: str, *, after: str, until: str) -> Monitor:
+    """``subject`` never happens after an ``after`` and before the next ``until``."""
+    return NeverWhile(parse_subject(subject), parse_subject(after), parse_subject(until),
+                      text=f"never_while {subject} after {after} until {until}")
+
+
+def max_count_per(subject: str, limit: int, *, seconds: float = 0, minutes: float = 0,
+                  hours: float = 0) -> Monitor:
+    """At most ``limit`` ``subject`` in any window of the given length."""
+    if isinstance(limit, bool) or not isinstance(limit, int) or limit < 0:
+        raise ConfigurationError(f"max_count_per(): limit must be a whole number >= 0, "
+                                 f"not {limit!r}")
+    window = _seconds(seconds, minutes, hours)
+    return MaxCount(parse_subject(subject), limit, window,
+                    text=f"max_count {subject} {limit} per {_span_text(window)}")
+
+
+def bounded_response(trigger: str, response: str, seconds: float) -> Monitor:
+    """Every ``trigger`` is answered by a ``response`` within ``seconds``."""
+    gap = _seconds(seconds, 0, 0)
+    return BoundedResponse(parse_subject(trigger), parse_subject(response), gap,
+                           text=f"bounded_response {trigger} {response} {gap:g}s")
+
+
+def monitors_for(compiled: Any, names: Names, extra: Iterable[Monitor | str] | None
+                 ) -> list[Monitor]:
+    """The spec's declared monitors plus ``extra`` (objects or text), bound to its names
+    (:class:`ConfigurationError` listing the names when one is unknown)."""
+    package = getattr(compiled, "package", compiled)
+    declared = package_monitors(getattr(package, "extended_attributes", ()),
+                                path=getattr(package, "source", None))
+    out = []
+    for item in [*declared, *(extra or ())]:
+        m = parse_monitor(item) if isinstance(item, str) else item
+        if not isinstance(m, Monitor):
+            raise ConfigurationError(f"{item!r} is not a monitor",
+                                     hint="pass monitor objects (min_gap(...), ...) or their "
+                                          "text form ('min_gap dispense 4h')")
+        try:
+            out.append(m.bind(names))
+        except ConfigurationError as error:
+            raise ConfigurationError(f"monitor {m.text!r}: {error.message}",
+                                     location=error.location, hint=error.hint) from None
+    return out
+
+
+# ---------------------------------------------------------------- the report
+@dataclass(frozen=True, slots=True)
+class MonitorRow:
+    """One monitor over every replication: violations, the users affected and the hazard
+    (violations per user-day) with its exact Poisson interval."""
+
+    monitor: str
+    violations: int
+    replications_affected: int
+    replications: int
+    user_days: float
+    hazard: float
+    hazard_lo: float
+    hazard_hi: float
+    first: tuple[Violation, ...]
+
+    def __str__(self) -> str:
+        return (f"{self.monitor}: {self.violations} violation(s) in "
+                f"{self.replications_affected}/{self.replications} replication(s); "
+                f"{self.hazard:.4g} per user-day [{self.hazard_lo:.4g}, {self.hazard_hi:.4g}]")
+
+
+@dataclass(frozen=True, slots=True)
+class MonitorReport:
+    """Every monitor of a result (``result.monitor_report()``); ``ok`` when none fired."""
+
+    rows: tuple[MonitorRow, ...]
+    confidence: float
+
+    @property
+    def ok(self) -> bool:
+        return all(row.violations == 0 for row in self.rows)
+
+    def row(self, monitor: str) -> MonitorRow:
+        for r in self.rows:
+            if r.monitor == monitor:
+                return r
+        raise ConfigurationError(f"no monitor {monitor!r} in this result",
+                                 hint="its monitors are: "
+                                      + (", ".join(r.monitor for r in self.rows) or "(none)"))
+
+    def __str__(self) -> str:
+        if not self.rows:
+            return "no monitors"
+        head = f"monitors (hazard: violations per user-day, exact {self.confidence:.0%} interval)"
+        return "\n".join([head, *(f"  {row}" for row in self.rows)])
+
+    def describe(self, limit: int = 3) -> str:
+        """The report plus the first ``limit`` violations of each monitor, with events."""
+        from opspec.testing.expectations import format_events
+
+        lines = [str(self)]
+        for row in self.rows:
+            for v in row.first[:limit]:
+                where = f" (replication {v.replication})" if row.replications > 1 else ""
+                lines.append(f"  {row.monitor}: {clock(v.time)}{where}: {v.message}")
+                lines.extend(format_events(v.events))
+            if row.violations > limit:
+                lines.append(f"  ... {row.violations - min(limit, len(row.first))} more "
+                             f"violation(s) of {row.monitor}")
+        return "\n".join(lines)
+
+
+def monitor_report(result: Any, confidence: float = 0.95) -> MonitorReport:
+    """The monitor report of a :class:`~opspec.testing.simulate.SimulationResult`."""
+    outcomes: Sequence[MonitorResult] = result.monitor_results
+    replications = result.replications
+    days = (result.horizon or 0.0) / 86_400.0
+    exposure = max(replications * days, 1e-12)
+    order: dict[str, list[MonitorResult]] = {}
+    for outcome in outcomes:
+        order.setdefault(outcome.monitor, []).append(outcome)
+    rows = []
+    for name, parts in order.items():
+        total = sum(p.count for p in parts)
+        rate, lo, hi = poisson_interval(total, exposure, confidence)
+        first = tuple(v for p in parts for v in p.violations)[:20]
+        rows.append(MonitorRow(name, total, sum(1 for p in parts if p.count), replications,
+                               replications * days, rate, lo, hi, first))
+    return MonitorReport(tuple(rows), confidence)
+
+
+def assert_no_violations(result: Any, *monitors: str, limit: int = 3) -> None:
+    """``AssertionError`` when a monitor (any, or those named by their text) fired in any
+    replication, showing the report and the first violations with their events."""
+    __tracebackhide__ = True
+    report = monitor_report(result)
+    rows = report.rows if not monitors else tuple(report.row(m) for m in monitors)
+    if not rows:
+        raise ConfigurationError("this result has no monitors",
+                                 hint="pass simulate(..., monitors=[...]) or declare "
+                                      "opspec:Monitor in the spec")
+    bad = MonitorReport(tuple(r for r in rows if r.violations), report.confidence)
+    if bad.rows:
+        raise AssertionError("monitor violations:\n" + bad.describe(limit)
+                             + f"\n(seed {result.seed}, {result.replications} replication(s))")
