@@ -17,7 +17,7 @@ from typing import Any
 
 from opspec.errors import OpspecError
 
-__all__ = ["ActivityRecorder", "ReplicationRecord", "run_users", "prepare"]
+__all__ = ["ActivityRecorder", "ReplicationRecord", "prepare", "run_users"]
 
 DAY = 86_400.0
 USER_KINDS_WRONG = ("user.wrong_choice", "user.slip")

@@ -13,8 +13,13 @@ from typing import Any
 
 from opspec.evaluation.store import ResultStore
 from opspec.evaluation.summary import compare_designs, metric_definitions, summarise_design
-from opspec.evaluation.tables import (COMPARE_HEADERS, METRIC_HEADERS, comparison_rows,
-                                      is_rate, metric_rows)
+from opspec.evaluation.tables import (
+    COMPARE_HEADERS,
+    METRIC_HEADERS,
+    comparison_rows,
+    is_rate,
+    metric_rows,
+)
 
 __all__ = ["write_report"]
 
@@ -83,10 +88,10 @@ def write_report(store: ResultStore) -> Path:
                  ("opspec", str(store.get("opspec_version"))),
                  ("started", str(store.get("started")))]
     sections.append(Section("Run", paragraphs=(
-        "Each simulated user is an independent replication with their own random streams; "
+        ("Each simulated user is an independent replication with their own random streams; "
         "designs are compared on the same users (common random numbers). Intervals are 95 % "
         "confidence intervals over users (cluster-robust for pooled observations; see "
-        "docs/evaluation.md).",), tables=(Table(("parameter", "value"), tuple(run_rows)),)))
+        "docs/evaluation.md)."),), tables=(Table(("parameter", "value"), tuple(run_rows)),)))
 
     for design in designs:
         metrics = summarise_design(store, design, days)
@@ -111,7 +116,7 @@ def write_report(store: ResultStore) -> Path:
         counts = [d["name"] for d in definitions if d["kind"] == "count"]
         if counts:
             users = done.get(design, 0)
-            per_day = {c: _per_day(store, design, c, max(1, int(round(days))), users)
+            per_day = {c: _per_day(store, design, c, max(1, round(days)), users)
                        for c in counts}
             images.append(plots.over_days_figure(per_day, figures / f"{design}-days.png"))
             captions.append("Count outcomes per user, day by day")
@@ -142,8 +147,8 @@ def write_report(store: ResultStore) -> Path:
                 for n, v, lo, hi in rows]
         images = (plots.comparison_figure(rows, figures / "comparison.png"),) if rows else ()
         sections.append(Section("B compared with A", paragraphs=(
-            "Differences B − A per metric on the same simulated users (paired); 'differs' "
-            "marks intervals that exclude zero.",),
+            ("Differences B − A per metric on the same simulated users (paired); 'differs' "
+            "marks intervals that exclude zero."),),
             tables=(Table(COMPARE_HEADERS, tuple(comparison_rows(difference))),),
             images=images, captions=("Paired differences with 95 % CIs",) if images else ()))
 

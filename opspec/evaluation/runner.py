@@ -17,7 +17,6 @@ import time
 from collections.abc import Callable, Iterator, Sequence
 from contextlib import contextmanager
 from dataclasses import dataclass
-from typing import Any
 
 from opspec.errors import EvaluationError
 from opspec.evaluation.plan import EvaluationPlan

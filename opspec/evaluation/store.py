@@ -23,7 +23,7 @@ import json
 import sqlite3
 from collections.abc import Iterator
 from pathlib import Path
-from typing import Any
+from typing import Any, Self
 
 from opspec.errors import EvaluationError
 from opspec.evaluation.replication import ReplicationRecord
@@ -157,7 +157,7 @@ class ResultStore:
         except sqlite3.Error:
             pass
 
-    def __enter__(self) -> ResultStore:
+    def __enter__(self) -> Self:
         return self
 
     def __exit__(self, *exc: object) -> None:
