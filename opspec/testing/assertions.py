@@ -1,0 +1,475 @@
+"""Statistical assertions over many simulated users, and the numeric core behind them.
+
+::
+
+    from opspec.testing.assertions import assert_mean, assert_quantile, assert_rate
+
+    assert_rate(result, ("doses_taken", "doses_due"), at_least=0.95, confidence=0.95)
+    assert_mean(result, "alarms_per_dose", between=(1.1, 1.3))
+    assert_quantile(result, "report_latency_s", 0.95, at_most=600)
+
+A claim passes when the confidence bound on its side clears the bound (``at_least``: the
+one-sided lower bound at ``confidence``; ``at_most``: the upper; both or ``between``: the
+two-sided interval lies inside). It fails as *refuted* when the bound on the other side is
+on the wrong side too, and otherwise as *undecided*, saying how many replications would
+decide it if the estimate stayed where it is. Every message states the estimate, its
+interval, the bound and n.
+
+Intervals (the core functions return ``Estimate(estimate, lo, hi)``, two-sided at the given
+confidence; a one-sided bound at level C is one end of the two-sided interval at 2C-1):
+
+* rates: Wilson score (default; good coverage near 0 and 1) or Clopper-Pearson (exact,
+  conservative), over pooled successes/trials. Pooling assumes the trials are independent;
+  doses of one user are not quite, so prefer per-user claims (``assert_mean``) when users
+  differ a lot.
+* means of per-replication values: Student t (default) or a seeded BCa bootstrap
+  (``scipy.stats.bootstrap``, 9999 resamples), for skewed values and small n.
+* quantiles of pooled observations: the distribution-free order-statistic interval (the ranks
+  come from the binomial distribution; valid for any continuous distribution).
+
+Sequential mode (:func:`assert_rate_sequential`) simulates batches until the claim is decided
+or ``max_users`` is reached; with at most K looks it decides each look at confidence
+``1 - (1 - C)/K`` (Bonferroni), so the chance of a wrong pass (or a wrong refutation) over
+all looks stays at most ``1 - C``.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
+from typing import Any, NamedTuple
+
+from opspec.errors import ConfigurationError
+
+__all__ = [
+    "Decision",
+    "Estimate",
+    "SequentialOutcome",
+    "assert_mean",
+    "assert_quantile",
+    "assert_rate",
+    "assert_rate_sequential",
+    "decide",
+    "mean_interval",
+    "quantile_interval",
+    "rate_interval",
+]
+
+_MAX_N = 10**9
+RATE_METHODS = ("wilson", "clopper-pearson")
+MEAN_METHODS = ("t", "bootstrap")
+
+
+class Estimate(NamedTuple):
+    """A point estimate and its interval (a tuple, so ``est, lo, hi = ...`` works)."""
+
+    estimate: float
+    lo: float
+    hi: float
+
+
+def _stats() -> Any:
+    import scipy.stats  # type: ignore[import-untyped]
+
+    return scipy.stats
+
+
+def _check_confidence(confidence: float) -> None:
+    if not 0.5 <= confidence < 1.0:
+        raise ConfigurationError(f"confidence must be at least 0.5 and below 1, not "
+                                 f"{confidence!r}", hint="e.g. confidence=0.95")
+
+
+# ---------------------------------------------------------------- the numeric core
+def rate_interval(successes: int, trials: int, confidence: float = 0.95, *,
+                  method: str = "wilson") -> Estimate:
+    """Two-sided interval of a proportion ``successes/trials`` at ``confidence``."""
+    if method not in RATE_METHODS:
+        raise ConfigurationError(f"unknown rate method {method!r}",
+                                 hint="use " + " or ".join(RATE_METHODS))
+    if trials <= 0:
+        return Estimate(math.nan, 0.0, 1.0)
+    if not 0 <= successes <= trials:
+        raise ConfigurationError(f"a rate needs 0 <= successes <= trials, not "
+                                 f"{successes}/{trials}",
+                                 hint="this is not a proportion; use assert_mean for it")
+    p = successes / trials
+    alpha = 1.0 - confidence
+    if method == "clopper-pearson":
+        beta = _stats().beta
+        lo = 0.0 if successes == 0 else float(beta.ppf(alpha / 2, successes,
+                                                       trials - successes + 1))
+        hi = 1.0 if successes == trials else float(beta.ppf(1 - alpha / 2, successes + 1,
+                                                            trials - successes))
+        return Estimate(p, lo, hi)
+    z = float(_stats().norm.ppf(1 - alpha / 2))
+    denom = 1 + z * z / trials
+    centre = (p + z * z / (2 * trials)) / denom
+    half = z * math.sqrt(p * (1 - p) / trials + z * z / (4 * trials * trials)) / denom
+    return Estimate(p, max(0.0, centre - half), min(1.0, centre + half))
+
+
+def mean_interval(values: Sequence[float], confidence: float = 0.95, *, method: str = "t",
+                  seed: int = 0, resamples: int = 9999) -> Estimate:
+    """Two-sided interval of the mean of ``values``: Student t, or a BCa bootstrap seeded
+    with ``seed`` (same values and seed, same interval). Needs at least 2 values."""
+    if method not in MEAN_METHODS:
+        raise ConfigurationError(f"unknown mean method {method!r}",
+                                 hint="use " + " or ".join(MEAN_METHODS))
+    n = len(values)
+    if n < 2:
+        raise ConfigurationError(f"a mean's interval needs at least 2 values, not {n}")
+    mean = math.fsum(values) / n
+    sd = math.sqrt(math.fsum((v - mean) ** 2 for v in values) / (n - 1))
+    if sd == 0:
+        return Estimate(mean, mean, mean)
+    if method == "t":
+        half = float(_stats().t.ppf((1 + confidence) / 2, n - 1)) * sd / math.sqrt(n)
+        return Estimate(mean, mean - half, mean + half)
+    import numpy as np
+
+    res = _stats().bootstrap((np.asarray(values, dtype=float),), np.mean,
+                             confidence_level=confidence, n_resamples=resamples,
+                             method="BCa", random_state=np.random.default_rng(seed))
+    ci = res.confidence_interval
+    return Estimate(mean, float(ci.low), float(ci.high))
+
+
+def quantile_interval(values: Sequence[float], q: float, confidence: float = 0.95
+                      ) -> Estimate:
+    """Distribution-free two-sided interval of the ``q``-quantile: order statistics
+    ``X(l) <= x_q <= X(u)`` with binomial ranks so that each tail has probability at most
+    ``(1 - confidence)/2``; a bound the data cannot give is ``-inf``/``inf``."""
+    if not 0 < q < 1:
+        raise ConfigurationError(f"q must be between 0 and 1, not {q!r}", hint="q=0.95 is p95")
+    n = len(values)
+    if n == 0:
+        return Estimate(math.nan, -math.inf, math.inf)
+    binom = _stats().binom
+    ordered = sorted(values)
+    tail = (1 - confidence) / 2
+    k_lo = int(binom.ppf(tail, n, q))             # 1-based rank of the lower bound
+    k_hi = int(binom.ppf(1 - tail, n, q)) + 1     # 1-based rank of the upper bound
+    lo = ordered[k_lo - 1] if k_lo >= 1 else -math.inf
+    hi = ordered[k_hi - 1] if k_hi <= n else math.inf
+    estimate = ordered[min(n - 1, max(0, math.ceil(q * n) - 1))]
+    return Estimate(estimate, lo, hi)
+
+
+# ---------------------------------------------------------------- deciding
+@dataclass(frozen=True, slots=True, repr=False)
+class Decision:
+    """The outcome of a statistical claim: ``verdict`` is ``"pass"``, ``"refuted"`` or
+    ``"undecided"``; ``needed`` is the estimated number of replications that would decide an
+    undecided claim (``None`` when none would: the estimate sits on the bound)."""
+
+    claim: str
+    verdict: str
+    estimate: float
+    lo: float
+    hi: float
+    n: int
+    confidence: float
+    sides: str                  # "one-sided" or "two-sided"
+    interval: str               # "Wilson", "t", ...
+    bound: str                  # ">= 0.95", "in [1, 2]"
+    detail: str = ""            # "(40/40 doses_due, 10 replications)"
+    needed: int | None = None
+    unit: str = "replications"
+
+    def __repr__(self) -> str:
+        return f"<Decision {self.verdict}: {self.claim}; estimate {self.estimate:.4g} " \
+               f"[{self.lo:.4g}, {self.hi:.4g}], n={self.n}>"
+
+    def __str__(self) -> str:
+        return self.message()
+
+    @property
+    def passed(self) -> bool:
+        return self.verdict == "pass"
+
+    def message(self) -> str:
+        lines = [f"expected {self.claim}",
+                 f"  estimate {self.estimate:.4g} {self.detail}".rstrip() + f"; n = {self.n}",
+                 f"  {self.confidence:.0%} {self.sides} {self.interval} interval "
+                 f"[{self.lo:.4g}, {self.hi:.4g}]; bound {self.bound}"]
+        if self.verdict == "refuted":
+            lines.append(f"  refuted: the claim is false at {self.confidence:.0%} confidence")
+        elif self.verdict == "undecided":
+            if self.needed is None:
+                lines.append("  too few to decide, and the estimate sits on the bound: no "
+                             "number of replications would settle it")
+            else:
+                lines.append(f"  too few {self.unit} to decide: about {self.needed} "
+                             f"{self.unit} would, if the estimate stays at "
+                             f"{self.estimate:.4g}")
+        return "\n".join(lines)
+
+
+def _target(at_least: float | None, at_most: float | None,
+            between: tuple[float, float] | None) -> tuple[float | None, float | None]:
+    if between is not None:
+        if at_least is not None or at_most is not None:
+            raise ConfigurationError("give between=(lo, hi) or at_least/at_most, not both")
+        at_least, at_most = float(between[0]), float(between[1])
+    if at_least is None and at_most is None:
+        raise ConfigurationError("a statistical assertion needs a bound",
+                                 hint="give at_least=, at_most= or between=(lo, hi)")
+    if at_least is not None and at_most is not None and at_least > at_most:
+        raise ConfigurationError(f"the range [{at_least}, {at_most}] is empty")
+    return at_least, at_most
+
+
+def _bound_text(at_least: float | None, at_most: float | None) -> str:
+    if at_least is not None and at_most is not None:
+        return f"in [{at_least:g}, {at_most:g}]"
+    return f">= {at_least:g}" if at_least is not None else f"<= {at_most:g}"
+
+
+def _two_sided_level(confidence: float, at_least: float | None, at_most: float | None
+                     ) -> float:
+    """The two-sided level whose ends are the bounds used (one-sided at C: 2C - 1)."""
+    both = at_least is not None and at_most is not None
+    return confidence if both else 2 * confidence - 1
+
+
+def decide(lo: float, hi: float, at_least: float | None, at_most: float | None) -> str:
+    """``"pass"``, ``"refuted"`` or ``"undecided"`` for an interval and bounds."""
+    ok = (at_least is None or lo >= at_least) and (at_most is None or hi <= at_most)
+    if ok:
+        return "pass"
+    wrong = (at_least is not None and hi < at_least) or (at_most is not None and lo > at_most)
+    return "refuted" if wrong else "undecided"
+
+
+def _distance(estimate: float, at_least: float | None, at_most: float | None) -> float:
+    gaps = [abs(estimate - b) for b in (at_least, at_most) if b is not None]
+    return min(gaps)
+
+
+def _smallest(decided: Callable[[int], bool], start: int) -> int | None:
+    """Smallest n >= start with ``decided(n)`` (doubling, then bisection); None if > 1e9."""
+    hi = max(1, start)
+    while not decided(hi):
+        hi *= 2
+        if hi > _MAX_N:
+            return None
+    lo = max(1, hi // 2)
+    if lo == hi or decided(lo):
+        return lo
+    while lo + 1 < hi:
+        mid = (lo + hi) // 2
+        if decided(mid):
+            hi = mid
+        else:
+            lo = mid
+    return hi
+
+
+def _rate_decision(claim: str, successes: int, trials: int, at_least: float | None,
+                   at_most: float | None, confidence: float, method: str, replications: int,
+                   units: str) -> Decision:
+    level = _two_sided_level(confidence, at_least, at_most)
+    sides = "two-sided" if level == confidence else "one-sided"
+    name = "Wilson" if method == "wilson" else "Clopper-Pearson"
+    if trials == 0:
+        return Decision(claim, "undecided", math.nan, 0.0, 1.0, 0, confidence, sides, name,
+                        _bound_text(at_least, at_most),
+                        f"(no {units} at all in {replications} replication(s))", None)
+    est, lo, hi = rate_interval(successes, trials, level, method=method)
+    verdict = decide(lo, hi, at_least, at_most)
+    needed = None
+    if verdict == "undecided" and _distance(est, at_least, at_most) > 0:
+        def settles(n: int) -> bool:
+            _, a, b = rate_interval(round(est * n), n, level, method=method)
+            return decide(a, b, at_least, at_most) != "undecided"
+
+        trials_needed = _smallest(settles, trials)
+        if trials_needed is not None:
+            per = trials / max(1, replications)
+            needed = max(replications + 1, math.ceil(trials_needed / per))
+    return Decision(claim, verdict, est, lo, hi, trials, confidence, sides, name,
+                    _bound_text(at_least, at_most),
+                    f"({successes}/{trials} {units}, {replications} replication(s))", needed)
+
+
+def _rate_counts(result: Any, metric: Any) -> tuple[int, int, str, str]:
+    """(successes, trials, claim subject, unit name) of ``metric`` in ``result``."""
+    if isinstance(metric, tuple) and len(metric) == 2:
+        num, den = metric
+        if isinstance(num, int) and isinstance(den, int):
+            return num, den, f"{num}/{den}", "trials"
+        s, t = result.counts(str(num), str(den))
+        return s, t, f"{num}/{den}", str(den)
+    if isinstance(metric, str):
+        result.value(metric)                  # unknown names: ConfigurationError listing them
+        definition = next(m for m in result.spec.metrics if m.name == metric)
+        if definition.numerator and definition.denominator:
+            s, t = result.counts(definition.numerator, definition.denominator)
+            return s, t, metric, definition.denominator
+        raise ConfigurationError(f"metric {metric!r} is not a ratio of two counts",
+                                 hint="name a ratio metric or pass (numerator, denominator)")
+    raise ConfigurationError(f"a rate is a ratio metric's name or a (numerator, denominator) "
+                             f"pair, not {metric!r}")
+
+
+def _fail(decision: Decision, result: Any) -> None:
+    __tracebackhide__ = True
+    if decision.passed:
+        return
+    seed = getattr(result, "seed", None)
+    tail = f"\n(seed {seed}, {result.replications} replication(s))" if seed is not None else ""
+    raise AssertionError(decision.message() + tail)
+
+
+# ---------------------------------------------------------------- assertions
+def assert_rate(result: Any, metric: str | tuple[Any, Any], *, at_least: float | None = None,
+                at_most: float | None = None, confidence: float = 0.95,
+                method: str = "wilson") -> Decision:
+    """Assert a proportion pooled over replications: ``metric`` is a ratio metric of two
+    counts (``"taken_ratio"``), a pair of count metrics (``("doses_taken", "doses_due")``),
+    or a pair of ints. Returns the :class:`Decision` when it passes."""
+    __tracebackhide__ = True
+    _check_confidence(confidence)
+    at_least, at_most = _target(at_least, at_most, None)
+    if method not in RATE_METHODS:
+        raise ConfigurationError(f"unknown rate method {method!r}",
+                                 hint="use " + " or ".join(RATE_METHODS))
+    s, t, subject, units = _rate_counts(result, metric)
+    claim = f"rate {subject} {_bound_text(at_least, at_most)} with {confidence:.0%} confidence"
+    decision = _rate_decision(claim, s, t, at_least, at_most, confidence, method,
+                              getattr(result, "replications", 1), units)
+    _fail(decision, result)
+    return decision
+
+
+def assert_mean(result: Any, metric: str, *, at_least: float | None = None,
+                at_most: float | None = None, between: tuple[float, float] | None = None,
+                confidence: float = 0.95, method: str = "t", seed: int = 0) -> Decision:
+    """Assert the mean of ``metric``'s per-replication values (``result.samples``), with a
+    Student t or seeded BCa bootstrap interval."""
+    __tracebackhide__ = True
+    _check_confidence(confidence)
+    at_least, at_most = _target(at_least, at_most, between)
+    values = result.samples(metric)
+    bound = _bound_text(at_least, at_most)
+    claim = f"mean {metric} {bound} with {confidence:.0%} confidence"
+    level = _two_sided_level(confidence, at_least, at_most)
+    sides = "two-sided" if level == confidence else "one-sided"
+    name = "Student t" if method == "t" else "BCa bootstrap"
+    n = len(values)
+    if n < 2:
+        decision = Decision(claim, "undecided", values[0] if values else math.nan, -math.inf,
+                            math.inf, n, confidence, sides, name, bound,
+                            "(a mean's interval needs at least 2 replications with a value)",
+                            30)
+        _fail(decision, result)
+    est, lo, hi = mean_interval(values, level, method=method, seed=seed)
+    verdict = decide(lo, hi, at_least, at_most)
+    needed = None
+    mean = est
+    sd = math.sqrt(math.fsum((v - mean) ** 2 for v in values) / (n - 1))
+    gap = _distance(est, at_least, at_most)
+    if verdict == "undecided" and gap > 0 and sd > 0:
+        t = _stats().t
+
+        def settles(k: int) -> bool:
+            return float(t.ppf((1 + level) / 2, max(1, k - 1))) * sd / math.sqrt(k) < gap
+
+        needed = _smallest(settles, n)
+        needed = None if needed is None else max(n + 1, needed)
+    decision = Decision(claim, verdict, est, lo, hi, n, confidence, sides, name, bound,
+                        f"(sd {sd:.3g}, {n} replications)", needed)
+    _fail(decision, result)
+    return decision
+
+
+def assert_quantile(result: Any, metric: str, q: float, *, at_most: float | None = None,
+                    at_least: float | None = None, confidence: float = 0.95) -> Decision:
+    """Assert the ``q``-quantile of every observation of a duration metric
+    (``result.observations``) with the distribution-free order-statistic interval."""
+    __tracebackhide__ = True
+    _check_confidence(confidence)
+    at_least, at_most = _target(at_least, at_most, None)
+    values = result.observations(metric)
+    bound = _bound_text(at_least, at_most)
+    claim = f"p{q * 100:g} {metric} {bound} with {confidence:.0%} confidence"
+    level = _two_sided_level(confidence, at_least, at_most)
+    sides = "two-sided" if level == confidence else "one-sided"
+    est, lo, hi = quantile_interval(values, q, level)
+    verdict = decide(lo, hi, at_least, at_most)
+    n = len(values)
+    needed = None
+    if verdict == "undecided" and n and (at_least is None or at_most is None):
+        edge = at_most if at_most is not None else at_least
+        assert edge is not None
+        below = sum(1 for v in values if v <= edge) / max(1, n)
+        if n and not math.isclose(below, q):
+            z = float(_stats().norm.ppf((1 + level) / 2))
+            needed = max(n + 1, math.ceil(z * z * q * (1 - q) / (below - q) ** 2))
+    decision = Decision(claim, verdict, est, lo, hi, n, confidence, sides, "order-statistic",
+                        bound, f"({n} observations)", needed, unit="observations")
+    _fail(decision, result)
+    return decision
+
+
+# ---------------------------------------------------------------- sequential
+@dataclass(frozen=True, slots=True)
+class SequentialOutcome:
+    """How a sequential assertion ended: the last look's decision, the looks taken, the
+    users simulated, and the per-look confidence used."""
+
+    decision: Decision
+    looks: int
+    users: int
+    max_looks: int
+    look_confidence: float
+
+
+def assert_rate_sequential(simulate_batch: Callable[[int, int], Any],
+                           metric: str | tuple[Any, Any], *, at_least: float | None = None,
+                           at_most: float | None = None, confidence: float = 0.95,
+                           method: str = "wilson", batch_users: int = 100,
+                           max_users: int = 2000) -> SequentialOutcome:
+    """Simulate batches until the rate claim is decided or ``max_users`` are simulated.
+
+    ``simulate_batch(k, n)`` returns a :class:`~opspec.testing.simulate.SimulationResult` of
+    ``n`` users, independent of every other batch (e.g. ``simulate(spec, users=n,
+    seed=derive_seed(base, str(k)))``). With ``K = ceil(max_users / batch_users)`` looks, each
+    look decides at ``1 - (1 - confidence)/K`` on the counts pooled so far (Bonferroni), so
+    the error rate over all looks is at most ``1 - confidence``. Passing returns the outcome;
+    a refutation, or no decision by the cap, raises ``AssertionError`` saying so."""
+    __tracebackhide__ = True
+    _check_confidence(confidence)
+    at_least, at_most = _target(at_least, at_most, None)
+    if batch_users < 1 or max_users < batch_users:
+        raise ConfigurationError("need 1 <= batch_users <= max_users")
+    max_looks = math.ceil(max_users / batch_users)
+    look_conf = 1 - (1 - confidence) / max_looks
+    successes = trials = users = 0
+    subject = units = ""
+    decision: Decision | None = None
+    last: Any = None
+    for look in range(1, max_looks + 1):
+        size = min(batch_users, max_users - users)
+        last = simulate_batch(look - 1, size)
+        s, t, subject, units = _rate_counts(last, metric)
+        successes, trials, users = successes + s, trials + t, users + size
+        claim = (f"rate {subject} {_bound_text(at_least, at_most)} with {confidence:.0%} "
+                 f"confidence (sequential, {look_conf:.4%} per look, up to {max_looks} looks)")
+        decision = _rate_decision(claim, successes, trials, at_least, at_most, look_conf,
+                                  method, users, units)
+        if decision.verdict != "undecided":
+            break
+    assert decision is not None
+    outcome = SequentialOutcome(decision, look, users, max_looks, look_conf)
+    if decision.passed:
+        return outcome
+    text = decision.message()
+    if decision.verdict == "undecided":
+        text += (f"\n  stopped at the cap: {users} users in {look} look(s) (max_users="
+                 f"{max_users}) did not decide it; raise max_users")
+    else:
+        text += f"\n  decided after {look} of {max_looks} look(s), {users} users"
+    raise AssertionError(text)
