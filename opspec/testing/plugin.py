@@ -220,9 +220,9 @@ def golden(request: pytest.FixtureRequest) -> Any:
     near = request.node.path
 
     def check(run: Any, path: str | Path, **options: Any) -> Any:
-        trace = getattr(run, "trace", run)
+        __tracebackhide__ = True
         target = Path(path) if Path(path).is_absolute() else near.parent / path
-        return golden_module.compare_golden(trace, target, regenerate=regenerate, **options)
+        return golden_module.compare_golden(run, target, regenerate=regenerate, **options)
 
     return check
 
