@@ -6,7 +6,11 @@
 * :mod:`~opspec.testing.simulate` - :func:`simulate` for one or many users, and its result;
 * :mod:`~opspec.testing.script` - scripted users as plain data;
 * :mod:`~opspec.testing.expectations` - readable ``then`` lines and :func:`expect`;
-* :mod:`~opspec.testing.scenario` - ``*.scenario.toml`` files.
+* :mod:`~opspec.testing.scenario` - ``*.scenario.toml`` files;
+* :mod:`~opspec.testing.predicates` - trace predicates (``holds``, ``check``, ``within``, ...);
+* :mod:`~opspec.testing.golden` - golden traces with readable diffs;
+* :mod:`~opspec.testing.assertions` - statistical assertions and their numeric core;
+* :mod:`~opspec.testing.monitors` - safety monitors checked during every simulated run.
 
 Names are loaded lazily so that importing :mod:`opspec.testing` stays light (no pytest, no
 numpy until used). The guide is ``docs/spec-testing.md``.
@@ -21,13 +25,36 @@ __all__ = [
     "Script",
     "ScriptUser",
     "SimulationResult",
+    "activity_completed",
+    "assert_mean",
+    "assert_no_violations",
+    "assert_quantile",
+    "assert_rate",
+    "assert_rate_sequential",
+    "bounded_response",
+    "check",
+    "count",
+    "event",
+    "eventually",
     "expect",
+    "happens_before",
+    "holds",
     "load_scenarios",
     "load_script",
+    "max_count_per",
+    "min_gap",
+    "monitor",
+    "never",
+    "never_happens",
+    "never_while",
     "parse_expectation",
     "parse_script",
+    "per_instance",
+    "process_started",
     "simulate",
     "simulator_for",
+    "trigger_raised",
+    "within",
 ]
 
 _WHERE = {
@@ -42,6 +69,29 @@ _WHERE = {
     "parse_expectation": "opspec.testing.expectations",
     "load_scenarios": "opspec.testing.scenario",
     "simulator_for": "opspec.testing.plugin",
+    "activity_completed": "opspec.testing.predicates",
+    "check": "opspec.testing.predicates",
+    "count": "opspec.testing.predicates",
+    "event": "opspec.testing.predicates",
+    "eventually": "opspec.testing.predicates",
+    "happens_before": "opspec.testing.predicates",
+    "holds": "opspec.testing.predicates",
+    "never": "opspec.testing.predicates",
+    "per_instance": "opspec.testing.predicates",
+    "process_started": "opspec.testing.predicates",
+    "trigger_raised": "opspec.testing.predicates",
+    "within": "opspec.testing.predicates",
+    "assert_mean": "opspec.testing.assertions",
+    "assert_quantile": "opspec.testing.assertions",
+    "assert_rate": "opspec.testing.assertions",
+    "assert_rate_sequential": "opspec.testing.assertions",
+    "assert_no_violations": "opspec.testing.monitors",
+    "bounded_response": "opspec.testing.monitors",
+    "max_count_per": "opspec.testing.monitors",
+    "min_gap": "opspec.testing.monitors",
+    "monitor": "opspec.testing.monitors",
+    "never_happens": "opspec.testing.monitors",
+    "never_while": "opspec.testing.monitors",
 }
 
 

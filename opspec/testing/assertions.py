@@ -192,8 +192,8 @@ class Decision:
     def message(self) -> str:
         lines = [f"expected {self.claim}",
                  f"  estimate {self.estimate:.4g} {self.detail}".rstrip() + f"; n = {self.n}",
-                 f"  {self.confidence:.0%} {self.sides} {self.interval} interval "
-                 f"[{self.lo:.4g}, {self.hi:.4g}]; bound {self.bound}"]
+                 (f"  {self.confidence:.0%} {self.sides} {self.interval} interval "
+                 f"[{self.lo:.4g}, {self.hi:.4g}]; bound {self.bound}")]
         if self.verdict == "refuted":
             lines.append(f"  refuted: the claim is false at {self.confidence:.0%} confidence")
         elif self.verdict == "undecided":

@@ -249,8 +249,8 @@ class _Never(_Eventually):
         hits = self.match.all(events)
         if not hits:
             return None
-        return Failure((f"but {self.match.describe()} happened {len(hits)} time(s), first at "
-                        f"{clock(hits[0].time)}",), (hits[0],), events)
+        return Failure(((f"but {self.match.describe()} happened {len(hits)} time(s), first at "
+                        f"{clock(hits[0].time)}"),), (hits[0],), events)
 
     def witness(self, events: Sequence[TraceEvent]) -> tuple[TraceEvent, ...]:
         return ()
@@ -300,8 +300,8 @@ class _Before(Predicate):
                                f"{clock(last_a.time if last_a else 0.0)}) for {seen_b + 1} "
                                f"{self.b.describe()}")
                     focus = (e,) if last_a is None else (last_a, e)
-                    return Failure((f"but {self.b.describe()} happened at {clock(e.time)} "
-                                    f"{why}",), focus, events)
+                    return Failure(((f"but {self.b.describe()} happened at {clock(e.time)} "
+                                    f"{why}"),), focus, events)
                 seen_b += 1
             if self.a(e):   # an event matching both counts as b first: b needs an earlier a
                 seen_a += 1
@@ -342,8 +342,8 @@ class _Within(Predicate):
             nxt = (f"; the next came at {clock(after[0].time)}, "
                    f"{after[0].time - cause.time:g} s after it" if after
                    else f"; none came before the end ({clock(end)})")
-            return Failure((f"but {self.a.describe()} at {clock(cause.time)} was not followed "
-                            f"by {self.b.describe()} within {self.seconds:g} s{nxt}",),
+            return Failure(((f"but {self.a.describe()} at {clock(cause.time)} was not followed "
+                            f"by {self.b.describe()} within {self.seconds:g} s{nxt}"),),
                            (cause, *after[:1]), events)
         return None
 
@@ -459,8 +459,8 @@ class _All(Predicate):
     def __init__(self, parts: tuple[Predicate, ...]) -> None:
         flat: list[Predicate] = []
         for p in parts:
-            flat.extend(p.parts if isinstance(p, _All) else (p,))
-        self.parts = tuple(flat)
+            flat.extend(p.parts if type(p) is _All else (p,))   # not an _Any: no flattening
+        self.parts: tuple[Predicate, ...] = tuple(flat)
 
     def describe(self) -> str:
         return " & ".join(_paren(p) for p in self.parts)
@@ -487,7 +487,7 @@ class _Any(_All):
     def __init__(self, parts: tuple[Predicate, ...]) -> None:
         flat: list[Predicate] = []
         for p in parts:
-            flat.extend(p.parts if isinstance(p, _Any) else (p,))
+            flat.extend(p.parts if type(p) is _Any else (p,))
         self.parts = tuple(flat)
 
     def describe(self) -> str:

@@ -47,6 +47,8 @@ def test_a_user_reporting_90_s_after_the_alarm_responds_within_90_but_not_60_sec
     (per_instance("user_workflow", never("dispense")), True),
     (never("dispense") | eventually("press_report"), True),
     (never("dispense") & eventually("press_report"), False),
+    ((never("dispense") | eventually("press_report")) & never("notify_caregiver"), True),
+    (never("notify_caregiver") & (never("dispense") | never("press_report")), False),
     (~never("dispense"), True),
     (~happens_before("sound_alarm", "dispense"), False),
     (event("activity.offered", activity="take_pill"), True),
@@ -84,7 +86,7 @@ def test_a_failed_never_marks_the_first_occurrence(prompt_user: SimulationResult
     with pytest.raises(AssertionError, match=r"dispense happened 1 time\(s\), first at "
                                              r"day 1 08:01:30.0") as info:
         check(prompt_user, never("dispense"))
-    assert [line for line in str(info.value).splitlines() if line.startswith(">")][0].endswith(
+    assert next(line for line in str(info.value).splitlines() if line.startswith(">")).endswith(
         "activity.completed   dispense")
 
 
