@@ -72,7 +72,7 @@ def _line(event: TraceEvent, replication: int | None, ignore: frozenset[str]) ->
     for key in _KEYS:
         value = getattr(event, key)
         if value is not None and key not in ignore:
-            obj[key] = round(value, 6) if key == "time" else value
+            obj[key] = round(float(value), 6) if key == "time" else value
     if "seq" not in ignore:
         obj["seq"] = event.seq
     if "package" not in ignore and event.package is not None:

@@ -11,7 +11,24 @@ from typing import Any
 
 import pytest
 
-from opspec.testing import SimulationResult, expect, simulator_for
+from opspec.testing import (
+    SimulationResult,
+    assert_mean,
+    assert_no_violations,
+    assert_quantile,
+    assert_rate,
+    assert_rate_sequential,
+    check,
+    count,
+    expect,
+    happens_before,
+    min_gap,
+    never,
+    per_instance,
+    simulator_for,
+    within,
+)
+from opspec.testing.simulate import derive_seed
 
 SPEC = "../medication_dispenser.xpdl"
 USERS = "../medication_dispenser.users.toml"
@@ -99,3 +116,85 @@ def test_reference_users_never_get_a_double_dose(spec: Any, simulate: Any) -> No
     result = simulate(spec, users=40, days=3, user_model=USERS, keep_trace=True)
     expect(result, "never activity dispense twice within 3h45m", "doses_due == 480")
     assert result.value("doses_taken") + result.value("doses_missed") == 480
+
+
+# ---------------------------------------------------------------- trace predicates
+def test_a_user_reporting_within_60_s_of_every_first_alarm_takes_every_dose(
+        spec: Any, simulate: Any) -> None:
+    result = simulate(spec, script=[("each after trg_2 45s", "press_report")], days=1)
+    check(result,
+          within("sound_alarm", "press_report", 60),
+          happens_before("sound_alarm", "press_report", each=True),
+          within("press_report", "dispense", 0),
+          per_instance("notify_workflow", (count("dispense") == 1) & never("notify_caregiver")
+                       & (count("sound_alarm") == 1)))
+
+
+def test_a_user_who_never_reports_is_alarmed_three_times_then_the_caregiver_is_called(
+        spec: Any, simulate: Any) -> None:
+    result = simulate(spec, script=[("never", "press_report")], days=1)
+    check(result, never("dispense"),
+          per_instance("notify_workflow", (count("sound_alarm") == 3)
+                       & happens_before("record_missed", "notify_caregiver")
+                       & within("process:notify_workflow", "notify_caregiver", 15 * 60)))
+
+
+# ---------------------------------------------------------------- golden trace
+def test_the_morning_dose_of_a_prompt_user_matches_its_golden_trace(
+        spec: Any, simulate: Any, golden: Any) -> None:
+    # review golden/prompt_user_morning.jsonl when it changes (pytest --opspec-regen-golden)
+    result = simulate(spec, script=[("after trg_2 90s", "press_report")],
+                      until=FIRST_DOSE_HOUR, seed=1)
+    golden(result, "golden/prompt_user_morning.jsonl")
+
+
+# ---------------------------------------------------------------- older adults
+# The reference user slowed down 1.5x (the older-adults modifier, docs/user-models.md).
+OLDER_ADULTS = "dispenser-reference,older-adults"
+
+
+@pytest.fixture(scope="module")
+def older_adults(request: pytest.FixtureRequest) -> SimulationResult:
+    result: SimulationResult = simulator_for(request)(SPEC, users=200, days=1,
+                                                      user_model=OLDER_ADULTS)
+    return result
+
+
+def test_older_adults_take_at_least_98_percent_of_doses(older_adults: SimulationResult
+                                                        ) -> None:
+    assert_rate(older_adults, "taken_rate", at_least=0.98, confidence=0.95)
+
+
+def test_older_adults_report_within_10_minutes_at_the_95th_percentile(
+        older_adults: SimulationResult) -> None:
+    assert_quantile(older_adults, "report_latency_s", 0.95, at_most=600)
+    assert_mean(older_adults, "alarms_per_dose", at_most=1.35)
+
+
+def test_older_adults_take_98_percent_decided_sequentially(spec: Any, simulate: Any,
+                                                           opspec_seed: int) -> None:
+    # batches of 100 users until the claim is decided (Bonferroni over at most 10 looks)
+    outcome = assert_rate_sequential(
+        lambda k, n: simulate(spec, users=n, user_model=OLDER_ADULTS,
+                              seed=derive_seed(opspec_seed, f"batch {k}")),
+        ("doses_taken", "doses_due"), at_least=0.98, batch_users=100, max_users=1000)
+    assert outcome.users < 1000         # clear enough to stop before the cap
+
+
+# ---------------------------------------------------------------- monitors
+def test_reference_users_never_get_two_dispenses_within_3h45m(spec: Any, simulate: Any
+                                                              ) -> None:
+    result = simulate(spec, users=40, days=3, user_model=USERS,
+                      monitors=[min_gap("dispense", minutes=225), min_gap("dispense", hours=4)])
+    assert_no_violations(result, "min_gap dispense 3.75h")
+    # the 4 h rule is broken routinely (see the xfail below): a hazard, not a rare event
+    assert result.monitor_report().row("min_gap dispense 4h").hazard_lo > 0.2
+
+
+@pytest.mark.xfail(strict=True, reason=(
+    "spec finding: the monitor 'min_gap dispense 4h' fires - 08:00/12:00 and 18:00/22:00 are "
+    "exactly 4 h apart, so a late report then a prompt one dispense less than 4 h apart"))
+def test_monitor_no_dispense_within_4_hours_of_the_previous_one(spec: Any, simulate: Any
+                                                                ) -> None:
+    result = simulate(spec, users=20, days=2, user_model=USERS, monitors=["min_gap dispense 4h"])
+    assert_no_violations(result)
