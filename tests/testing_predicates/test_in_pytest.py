@@ -45,10 +45,10 @@ def test_typo(spec, simulate):
 ''')
     result.assert_outcomes(failed=1)
     result.stdout.fnmatch_lines([
-        "test_spec.py:*: check(simulate(spec, script=PROMPT, until=9 * 3600), "
-        "never(\"notify_caregivr\"))",
-        "ConfigurationError: the spec has no activity, trigger or process 'notify_caregivr' "
-        "(its activities are: *notify_caregiver*"])
+        ("test_spec.py:*: check(simulate(spec, script=PROMPT, until=9 * 3600), "
+        "never(\"notify_caregivr\"))"),
+        ("ConfigurationError: the spec has no activity, trigger or process 'notify_caregivr' "
+        "(its activities are: *notify_caregiver*")])
     assert "Traceback" not in result.stdout.str()
 
 
@@ -62,8 +62,8 @@ def test_rate(spec, simulate):
         "E * expected rate taken_rate >= 0.99 with 95% confidence",
         "E * estimate 1 (12/12 doses_due, 3 replication(s)); n = 12",
         "E * 95% one-sided Wilson interval ?0.*, 1?; bound >= 0.99",
-        "E * too few replications to decide: about * replications would, if the estimate "
-        "stays at 1"])
+        ("E * too few replications to decide: about * replications would, if the estimate "
+        "stays at 1")])
 
 
 def test_a_monitor_violation_fails_with_the_events_that_broke_it(
@@ -79,6 +79,6 @@ def test_gap(spec, simulate):
     result.stdout.fnmatch_lines([
         "E * monitor violations:",
         "E * min_gap dispense 4h: 1 violation(s) in 1/1 replication(s); 1 per user-day *",
-        "E * min_gap dispense 4h: day 1 22:00:10.0: activity dispense at day 1 18:04:50.0 and "
-        "again at day 1 22:00:10.0, 3.92222 h apart (at least 4 h required)",
+        ("E * min_gap dispense 4h: day 1 22:00:10.0: activity dispense at day 1 18:04:50.0 and "
+        "again at day 1 22:00:10.0, 3.92222 h apart (at least 4 h required)"),
         "E *day 1 18:04:50.0 * activity.completed   dispense"])
