@@ -1,0 +1,139 @@
+"""dispenser-day: the engine against the hand-coded SimPy baseline, in the same run.
+
+    python benchmarks/dispenser_day.py [--users 1000] [--days 30] [--seed 1] [--repeat 1]
+
+Runs the reference scenario (``../shared/bench/SCENARIO.md``) twice, each in its own process so
+peak memory (ru_maxrss) is measured the same way for both:
+
+- **engine**: ``specs/medication_dispenser.xpdl`` with ``specs/medication_dispenser.users.toml``
+  (the spec and user model a user runs), one Simulation per user, one user after another on one
+  core — what one evaluation worker does, without the result store and report;
+- **baseline**: ``../shared/bench/handcoded_simpy.py`` (the scenario written directly in SimPy).
+
+It prints wall time, dose cycles per second and peak RSS of both, the engine/baseline ratio, and
+the outcome statistics of both with 99 % confidence intervals and whether they agree (the two
+draw their random numbers differently, so they agree statistically, not exactly).
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import statistics
+import subprocess
+import sys
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+BENCH = ROOT.parent / "shared" / "bench"
+
+_ENGINE = r"""
+import json, resource, sys, time
+users, days, seed = int(sys.argv[1]), int(sys.argv[2]), int(sys.argv[3])
+from opspec.engine.compiled import compile_package
+from opspec.engine.lanes import user_lane
+from opspec.engine.random import user_stream
+from opspec.engine.simulation import Simulation
+from opspec.usermodels.loader import load_user_model
+from opspec.xpdl.open_spec import open_spec
+compiled = compile_package(open_spec(sys.argv[4]))
+model = load_user_model(sys.argv[5])
+names = user_lane(compiled).bind_names
+t0, c0 = time.perf_counter(), time.process_time()
+taken = missed = alarms = due = 0
+lat_sum = 0.0
+lat = []
+per_user_missed = []
+for u in range(users):
+    user = model.performer(user_stream(seed, u))
+    sim = Simulation(compiled, performers={n: user for n in names}, seed=seed, scope=(u,))
+    m = sim.run(until=days * 86400.0).metrics
+    taken += m["doses_taken"]["total"]; missed += m["doses_missed"]["total"]
+    alarms += m["alarms"]["total"]; due += m["doses_due"]["total"]
+    lat.extend(sim.metrics.samples["report_latency_s"])
+    per_user_missed.append(m["doses_missed"]["total"])
+wall, cpu = time.perf_counter() - t0, time.process_time() - c0
+lat.sort()
+print(json.dumps({"wall_s": wall, "cpu_s": cpu, "cycles": due, "taken": taken,
+    "missed": missed, "alarms": alarms, "lat_mean_s": sum(lat) / len(lat),
+    "lat_sd_s": (sum((x - sum(lat) / len(lat)) ** 2 for x in lat) / (len(lat) - 1)) ** 0.5,
+    "lat_n": len(lat), "lat_p95_s": lat[int(0.95 * (len(lat) - 1))],
+    "peak_rss_mib": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024}))
+"""
+
+_BASELINE = r"""
+import json, resource, runpy, sys, io, contextlib
+sys.path.insert(0, sys.argv[1])
+sys.argv = ["handcoded_simpy.py", "--users", sys.argv[2], "--days", sys.argv[3], "--seed", sys.argv[4]]
+out = io.StringIO()
+with contextlib.redirect_stdout(out):
+    runpy.run_path(sys.argv[0] if False else __import__("os").path.join(sys.path[0], "handcoded_simpy.py"), run_name="__main__")
+rec = json.loads(out.getvalue().strip().splitlines()[-1])
+rec["peak_rss_mib"] = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
+print(json.dumps(rec))
+"""
+
+
+def _run(code: str, *args: str) -> dict[str, float]:
+    done = subprocess.run([sys.executable, "-c", code, *args], capture_output=True, text=True,
+                          check=False, cwd=ROOT)
+    if done.returncode != 0:
+        sys.exit(f"benchmark process failed:\n{done.stderr}")
+    return json.loads(done.stdout.strip().splitlines()[-1])
+
+
+def wilson(k: float, n: float, z: float) -> tuple[float, float]:
+    p = k / n
+    centre = (p + z * z / (2 * n)) / (1 + z * z / n)
+    half = z * math.sqrt(p * (1 - p) / n + z * z / (4 * n * n)) / (1 + z * z / n)
+    return centre - half, centre + half
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--users", type=int, default=1000)
+    parser.add_argument("--days", type=int, default=30)
+    parser.add_argument("--seed", type=int, default=1)
+    parser.add_argument("--repeat", type=int, default=1, help="median of R runs of each")
+    args = parser.parse_args()
+    if not (BENCH / "handcoded_simpy.py").is_file():
+        sys.exit(f"baseline not found in {BENCH}")
+    spec = str(ROOT / "specs" / "medication_dispenser.xpdl")
+    model = str(ROOT / "specs" / "medication_dispenser.users.toml")
+    size = (str(args.users), str(args.days), str(args.seed))
+    engines = [_run(_ENGINE, *size, spec, model) for _ in range(args.repeat)]
+    bases = [_run(_BASELINE, str(BENCH), *size) for _ in range(args.repeat)]
+    engine, base = engines[0], bases[0]
+    e_wall = statistics.median(r["wall_s"] for r in engines)
+    b_wall = statistics.median(r["wall_s"] for r in bases)
+    cycles = args.users * args.days * 4
+    print(f"dispenser-day: {args.users} users x {args.days} days = {cycles} dose cycles, "
+          f"seed {args.seed}, median of {args.repeat}")
+    print(f"{'':<22}{'wall s':>9}{'cycles/s':>11}{'peak RSS MiB':>14}")
+    print(f"{'engine (spec + model)':<22}{e_wall:>9.2f}{cycles / e_wall:>11.0f}"
+          f"{max(r['peak_rss_mib'] for r in engines):>14.0f}")
+    print(f"{'hand-coded SimPy':<22}{b_wall:>9.2f}{cycles / b_wall:>11.0f}"
+          f"{max(r['peak_rss_mib'] for r in bases):>14.0f}")
+    print(f"ratio engine / baseline: {e_wall / b_wall:.2f}x wall time (target <= 2x)")
+    z = 2.5758
+    e_miss = wilson(engine["missed"], cycles, z)
+    b_miss = wilson(base["missed"], cycles, z)
+    e_lat = engine["lat_mean_s"]
+    e_half = z * engine["lat_sd_s"] / math.sqrt(engine["lat_n"])
+    b_lat = float(base["lat_mean_s"])
+    print("\noutcomes (99 % CIs)")
+    print(f"  missed %      engine {engine['missed'] / cycles * 100:.3f} "
+          f"[{e_miss[0] * 100:.3f}, {e_miss[1] * 100:.3f}]   baseline "
+          f"{base['missed'] / cycles * 100:.3f} [{b_miss[0] * 100:.3f}, {b_miss[1] * 100:.3f}]"
+          f"   agree: {e_miss[0] <= b_miss[1] and b_miss[0] <= e_miss[1]}")
+    print(f"  latency mean  engine {e_lat:.1f} s [{e_lat - e_half:.1f}, {e_lat + e_half:.1f}]"
+          f"   baseline {b_lat:.1f} s   agree: {abs(e_lat - b_lat) <= e_half * math.sqrt(2)}")
+    print(f"  alarms/dose   engine {engine['alarms'] / cycles:.4f}   baseline "
+          f"{float(base['alarms_per_dose']):.4f}")
+    print(f"  latency p95   engine {engine['lat_p95_s']:.0f} s   baseline "
+          f"{float(base['lat_p95_s']):.0f} s")
+
+
+if __name__ == "__main__":
+    main()
