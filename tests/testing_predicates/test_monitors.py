@@ -170,3 +170,19 @@ def test_the_hazard_interval_is_the_exact_garwood_interval(count: int, exposure:
     assert rate == count / exposure
     assert lo == pytest.approx(expected_lo, rel=1e-6)
     assert hi == pytest.approx(expected_hi, rel=1e-6)
+
+
+def test_monitors_see_the_same_violations_whether_or_not_traces_are_kept(
+        dispenser: CompiledPackage) -> None:
+    watch = [min_gap("dispense", hours=4), "bounded_response process:notify_workflow dispense 5min"]
+
+    def run(keep: bool) -> list[tuple[str, float, str, int]]:
+        result = simulate(dispenser, users=15, days=2, user_model="dispenser-reference",
+                          seed=2, keep_trace=keep, monitors=watch)
+        return [(v.monitor, v.time, v.message, v.replication)
+                for row in result.monitor_report().rows for v in row.first]
+
+    kept = run(True)
+    assert kept == run(False)
+    assert {m for m, *_ in kept} == {"min_gap dispense 4h",
+                                     "bounded_response process:notify_workflow dispense 5min"}
