@@ -197,7 +197,9 @@ class Decision:
         if self.verdict == "refuted":
             lines.append(f"  refuted: the claim is false at {self.confidence:.0%} confidence")
         elif self.verdict == "undecided":
-            if self.needed is None:
+            if self.n == 0:
+                lines.append("  nothing to judge: simulate longer or more users")
+            elif self.needed is None:
                 lines.append("  too few to decide, and the estimate sits on the bound: no "
                              "number of replications would settle it")
             else:

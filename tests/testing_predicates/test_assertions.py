@@ -198,3 +198,9 @@ def test_sequential_mode_reports_the_cap_when_undecided() -> None:
     with pytest.raises(AssertionError, match="stopped at the cap: 300 users in 3 look"):
         assert_rate_sequential(Batches(0.95), ("taken", "due"), at_least=0.95,
                                batch_users=100, max_users=300)
+
+
+def test_a_rate_with_no_trials_says_there_is_nothing_to_judge() -> None:
+    with pytest.raises(AssertionError, match=r"\(no due at all in 10 replication\(s\)\).*\n.*\n"
+                                             "  nothing to judge: simulate longer or more users"):
+        assert_rate(FakeResult(0, 0), ("taken", "due"), at_least=0.9)

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import pytest
 
+from opspec.engine.compiled import CompiledPackage
 from opspec.engine.trace import TraceEvent
 from opspec.errors import ConfigurationError
 from opspec.testing.predicates import (
@@ -141,3 +142,16 @@ def test_predicates_judge_every_replication(dispenser: object) -> None:
     assert holds(result, count("notify_caregiver") == 4)
     with pytest.raises(AssertionError, match=r"expected count\(dispense\) >= 1 \(replication 0\)"):
         check(result, count("dispense") >= 1)
+
+
+def test_an_engine_run_result_is_judged_and_checked_against_spec_when_given(
+        dispenser: CompiledPackage) -> None:
+    from opspec.engine.simulation import simulate as run_engine
+    from opspec.testing.script import parse_script
+
+    user = parse_script([("after trg_2 30s", "press_report")]).performer()
+    run = run_engine(dispenser, until=9 * 3600.0, performers={"user": user}, listeners=[user])
+    assert holds(run, within("sound_alarm", "dispense", 30))
+    assert holds(run, never("no_such_activity"))                 # no spec: nothing to check
+    with pytest.raises(ConfigurationError, match="no activity, trigger or process 'no_such"):
+        holds(run, never("no_such_activity"), spec=dispenser)
