@@ -100,6 +100,12 @@ class DeviceBinding:
 
     # ------------------------------------------------------------------ public
     @property
+    def applications(self) -> dict[str, None]:
+        """The profile's operations: the engine routes automatic activities whose Application
+        id names one of them to this binding (see PerformerRegistry.bind)."""
+        return dict.fromkeys(self.profile.operations)
+
+    @property
     def simulated(self) -> bool:
         """Whether every participant is served by the simulated device now."""
         return all(mode == "simulated" for mode in self._modes.values())
@@ -127,7 +133,10 @@ class DeviceBinding:
 
     def offer(self, item: WorkItem) -> None:
         participant = item.participant or ""
-        if self.mode(participant) == "simulated":
+        # routed here by Application id (see ``applications``) for a participant this run
+        # did not bind to the device: the simulated device performs it
+        if self.mode(participant) == "simulated" or (
+                participant and participant not in self._modes):
             self._sim.offer(item)
             return
         fallback = self.profile.fallback_for(participant)

@@ -99,29 +99,29 @@ def run(args: argparse.Namespace) -> int:
     out = sys.stdout
     printer = None if args.json or args.timeline == "none" else _Timeline(
         out, brief=args.timeline == "brief", quiet=quiet_activities(compiled))
-    if not args.json:
-        length = ("until nothing is left to do" if horizon is None
-                  else f"for {_span(horizon)} simulated")
-        print(f"opspec run: {package.name or package.id} ({args.spec}), seed {args.seed}, "
-              f"{length}", file=out)
-        print(f"  user lane: {user.describe}", file=out)
-        print(f"  engine: {config.processor_model}"
-              + (f", {config.workers} worker(s)" if config.pooled else "")
-              + (f", wall clock at {config.speed:g}x" if config.realtime else ""), file=out)
     performer, listeners = user.make(0, args.seed)
     performers: dict[str, Any] = bind_user(compiled, performer)
     performers.update(_world_performers(compiled, args.seed))
     with contextlib.ExitStack() as stack:
-        devices = _devices(args, stack)
+        devices = _devices(args, stack)          # a port that won't open stops us here
+        if devices is not None and devices.requires_wall_clock and not config.realtime:
+            config = config.with_options(realtime=True, speed=args.speed or 1.0)
+        if not args.json:
+            length = ("until nothing is left to do" if horizon is None
+                      else f"for {_span(horizon)} simulated")
+            print(f"opspec run: {package.name or package.id} ({args.spec}), seed {args.seed}, "
+                  f"{length}", file=out)
+            print(f"  user lane: {user.describe}", file=out)
+            print(f"  engine: {config.processor_model}"
+                  + (f", {config.workers} worker(s)" if config.pooled else "")
+                  + (f", wall clock at {config.speed:g}x" if config.realtime else ""), file=out)
         if devices is not None:
             performers.update(devices.performers)
             for note in devices.notes:
                 if not args.json:
                     print(f"  device: {note}", file=out)
-            if devices.requires_wall_clock and not config.realtime:
-                config = config.with_options(realtime=True, speed=args.speed or 1.0)
-                if not args.json:
-                    print("  a real device is bound: running on the wall clock", file=out)
+            if devices.requires_wall_clock and not args.json and not args.realtime:
+                print("  a real device is bound: running on the wall clock", file=out)
         sink = None
         if args.trace:
             sink = stack.enter_context(_open_sink(JsonlSink, args.trace, {
@@ -145,8 +145,9 @@ def run(args: argparse.Namespace) -> int:
     else:
         _print_summary(out, result, medians, args.trace, device_report,
                        shown=printer.shown if printer else 0)
+    device_faults = any(info.get("faults") for info in (device_report or {}).values())
     problems = result.summary.get("deadlocks") or result.summary.get("faults") or (
-        result.summary.get("instances", {}).get("aborted", 0))
+        result.summary.get("instances", {}).get("aborted", 0)) or device_faults
     return 1 if problems else 0
 
 
@@ -162,7 +163,7 @@ def _config(args: argparse.Namespace) -> Any:
         overrides["processor_model"] = args.processor_model
     if args.workers is not None:
         overrides["workers"] = args.workers
-    if args.speed is not None and not args.realtime and not config.realtime:
+    if args.speed is not None and not (args.realtime or config.realtime or args.bind):
         raise ConfigurationError("--speed only applies with --realtime",
                                  hint="add --realtime, or drop --speed")
     if args.realtime:
@@ -215,15 +216,7 @@ def _devices(args: argparse.Namespace, stack: contextlib.ExitStack) -> Any:
         from opspec.bindings.attach import attach_devices
     except ImportError:
         raise ConfigurationError("--bind is not available in this build of opspec") from None
-    folder = args.devices or _default_devices()
-    return stack.enter_context(attach_devices(args.bind, folder))
-
-
-def _default_devices() -> Path:
-    here = Path.cwd() / "devices"
-    if here.is_dir():
-        return here
-    return Path(__file__).resolve().parents[2] / "devices"
+    return stack.enter_context(attach_devices(args.bind, args.devices))
 
 
 @contextlib.contextmanager
@@ -419,9 +412,19 @@ def _print_summary(out: Any, result: RunResult, medians: dict[str, float], trace
         print(f"wall-clock drift: mean {drift.get('mean_s', 0) * 1000:.2f} ms, "
               f"max {drift.get('max_s', 0) * 1000:.2f} ms over {drift.get('events', 0)} "
               "events", file=out)
-    if devices:
-        for name, info in devices.items() if isinstance(devices, dict) else []:
-            print(f"device {name}: {info}", file=out)
+    for name, info in (devices or {}).items():
+        latency = info.get("latency_ms") or {}
+        modes = ", ".join(f"{p} {m}" for p, m in (info.get("mode") or {}).items())
+        where = info.get("url") or "simulated"
+        rtt = (f"round trip mean {latency.get('mean')} ms, p99 {latency.get('p99')} ms, "
+               f"max {latency.get('max')} ms over {latency.get('count')} commands"
+               if latency.get("count") else "no commands answered")
+        faults = info.get("faults") or []
+        print(f"device {name} ({info.get('profile')} on {where}): {modes}; {rtt}; "
+              f"{len(faults)} fault(s)", file=out)
+        for fault in faults[:5]:
+            print(f"  fault {fault.get('fault')}: {fault.get('message')} "
+                  f"(then {fault.get('action')})", file=out)
     for problem in summary.get("deadlocks") or []:
         print(f"deadlock: {problem.get('message')}", file=out)
     for fault in summary.get("faults") or []:

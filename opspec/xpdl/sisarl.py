@@ -60,7 +60,7 @@ PROCESS_DIRECTIVES = ("Period", "Rate", "Priority", "Deadline", "Latency", "Star
                       "EndTrigger", "AutoStart", "Lane", "Mode")
 ACTIVITY_DIRECTIVES = ("AutoRun", "PriorityIncrement", "StartTrigger", "EndTrigger", "Raises",
                        "CpuDemand", "Duration", "BuiltIn")
-PACKAGE_DIRECTIVES = ("Metrics", "Modes")
+PACKAGE_DIRECTIVES = ("Metrics", "Modes", "Monitor", "World", "WorldFile")
 
 
 def collect(element: etree._Element, ctx: BuildContext, known: tuple[str, ...],

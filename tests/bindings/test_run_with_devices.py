@@ -1,0 +1,141 @@
+"""`opspec run --bind`: the dispenser spec driving an emulated device over a real
+pseudo-terminal or a socket, in wall-clock time, with every fault named and the run going on."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+from typing import Any
+
+import pytest
+
+from opspec.bindings import load_profile
+from opspec.bindings.emulator import Behaviour, EmulatedDevice, PtyEmulator, SocketEmulator
+from opspec.cli import main
+
+from .conftest import DATA, DEVICES, needs_pty
+
+SPEC = Path(__file__).resolve().parents[2] / "specs" / "medication_dispenser.xpdl"
+# 00:00 → 10:00 at 20,000x (1.8 s): device replies take wall time, so leave slack after 08:00
+FIRST_DOSE = ["--until", "36000", "--realtime", "--speed", "20000"]
+
+
+class ButtonPressingDevice(EmulatedDevice):
+    """The dispenser board with a user who presses *report* right after each alarm."""
+
+    server: Any = None
+
+    def handle_line(self, line: str) -> list[Any]:
+        actions = super().handle_line(line)
+        if line.strip() == "ALARM ON" and self.server is not None:
+            self.server.send_event("report", after_s=0.002)
+        return actions
+
+
+@pytest.fixture
+def board():
+    servers: list[Any] = []
+
+    def start(*, fault: str = "none", on: str = "pty", presses: bool = False,
+              profile: Path = DEVICES / "medication_dispenser.toml") -> Any:
+        cls = ButtonPressingDevice if presses else EmulatedDevice
+        device = cls(load_profile(profile), Behaviour.parse(fault))
+        server = PtyEmulator(device) if on == "pty" else SocketEmulator(device)
+        device.server = server
+        servers.append(server)
+        server.start()
+        return server
+
+    yield start
+    for server in servers:
+        server.stop()
+
+
+def run(capsys: pytest.CaptureFixture[str], *args: str) -> tuple[int, dict[str, Any] | None,
+                                                                 str]:
+    status = main(["run", str(SPEC), *args])
+    captured = capsys.readouterr()
+    doc = json.loads(captured.out) if "--json" in args and captured.out.strip() else None
+    return status, doc, captured.out + captured.err
+
+
+def script(tmp_path: Path, *steps: tuple[str, str]) -> str:
+    path = tmp_path / "user.toml"
+    body = ",".join(f'["{w}", "{a}"]' for w, a in steps)
+    path.write_text(f'otherwise = "complete"\nsteps = [{body}]\n', encoding="utf-8")
+    return str(path)
+
+
+@needs_pty
+def test_dispenser_over_a_pseudo_terminal_takes_the_dose(board, capsys, tmp_path):
+    server = board(on="pty")
+    status, doc, _ = run(capsys, *FIRST_DOSE, "--json", "--bind", f"alarm={server.url}",
+                         "--bind", f"dispenser={server.url}", "--script",
+                         script(tmp_path, ("after trg_2 60s", "press_report")))
+    assert status == 0
+    assert doc["metrics"]["doses_taken"]["total"] == 1
+    device = doc["devices"]["alarm, dispenser"]
+    assert device["url"] == server.url
+    assert device["mode"] == {"alarm": "device", "dispenser": "device"}
+    assert device["latency_ms"]["count"] >= 2          # ALARM ON and DISPENSE answered
+    assert device["faults"] == []
+    assert doc["drift"]["events"] > 0
+
+
+@needs_pty
+def test_button_on_the_device_reports_for_the_user(board, capsys, tmp_path):
+    server = board(on="pty", presses=True)
+    status, doc, _ = run(capsys, *FIRST_DOSE, "--json", "--bind", f"alarm={server.url}",
+                         "--script", script(tmp_path, ("never", "press_report")))
+    assert status == 0
+    assert doc["metrics"]["doses_taken"]["total"] == 1
+    assert doc["metrics"]["doses_missed"]["total"] == 0
+
+
+def test_dispenser_over_a_socket(board, capsys, tmp_path):
+    server = board(on="socket")
+    status, doc, _ = run(capsys, *FIRST_DOSE, "--json", "--bind", f"alarm={server.url}",
+                         "--script", script(tmp_path, ("after trg_2 30s", "press_report")))
+    assert status == 0
+    assert doc["metrics"]["doses_taken"]["total"] == 1
+    assert doc["devices"]["alarm"]["latency_ms"]["count"] >= 1
+
+
+@pytest.mark.parametrize("fault, named", [
+    ("silent", "timeout"),
+    ("garbage", "garbage"),
+], ids=["no-reply", "garbage"])
+def test_misbehaving_alarm_is_a_named_fault_and_the_alarm_goes_on_simulated(
+        fault, named, board, capsys, tmp_path):
+    server = board(on="pty", fault=fault, profile=DATA / "test_dispenser.toml")
+    trace = tmp_path / "trace.jsonl"
+    # reply timeouts are wall-clock (300 ms): at 20,000x two of them span about 3.3 h
+    status, doc, _ = run(capsys, "--until", "43000", "--realtime", "--speed", "20000",
+                         "--json", "--bind", f"alarm:test_dispenser={server.url}",
+                         "--devices", str(DATA), "--trace", str(trace),
+                         "--script", script(tmp_path, ("after trg_2 30s", "press_report")))
+    faults = doc["devices"]["alarm"]["faults"]
+    assert any(f["fault"] == named for f in faults)
+    assert doc["devices"]["alarm"]["mode"]["alarm"] == "simulated"
+    # the device's fallback kept the dose going: the user still got it
+    assert doc["metrics"]["doses_taken"]["total"] == 1
+    kinds = [json.loads(line)["kind"] for line in trace.read_text().splitlines()[1:]]
+    assert "fault" in kinds and kinds[-1] == "run.ended"
+    assert status == 1           # a device fault is a problem worth an exit status
+
+
+def test_unopenable_port_stops_the_run_before_it_begins(capsys):
+    status, _, output = run(capsys, "--bind", "alarm=/dev/opspec-no-such-port")
+    assert status == 2
+    assert "/dev/opspec-no-such-port" in output and "No such file" in output
+    assert "opspec run:" not in output          # nothing ran
+    assert "Traceback" not in output
+
+
+def test_auto_without_a_device_falls_back_to_simulated_and_says_so(capsys, tmp_path):
+    status, _, output = run(capsys, "--until", "29700", "--timeline", "none",
+                            "--bind", "alarm=auto",
+                            "--script", script(tmp_path, ("after trg_2 30s", "press_report")))
+    assert status == 0
+    assert "using the simulated alarm" in output
+    assert "alarm simulated" in output
