@@ -1,0 +1,53 @@
+"""What every simulated world shares: simulated time, a random stream, trace output, and the
+device operations the specs' applications name."""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Mapping
+from typing import Any
+
+import numpy as np
+
+__all__ = ["World"]
+
+Tracer = Callable[[str, Mapping[str, Any]], None]
+
+STEP_S = 0.05          # integration step: 5 cm at 1 m/s, well under the robot's size
+
+
+class World:
+    """A world advanced lazily to the engine's time whenever a device is used.
+
+    Subclasses implement :meth:`_step` (move everything by ``dt``) and the sensor reads.
+    Facts worth counting are traced as ``world.*`` events (``tracer(kind, data)``).
+    """
+
+    def __init__(self, rng: np.random.Generator) -> None:
+        self.rng = rng
+        self.time = 0.0
+        self.tracer: Tracer | None = None
+
+    def trace(self, kind: str, **data: Any) -> None:
+        if self.tracer is not None:
+            self.tracer(kind, data)
+
+    def advance(self, now: float) -> None:
+        """Move the world forward to simulated time ``now`` in small steps."""
+        while self.time < now - 1e-12:
+            dt = min(STEP_S, now - self.time)
+            self._step(dt)
+            self.time += dt
+
+    def _step(self, dt: float) -> None:
+        raise NotImplementedError
+
+    # device operations, by Application id: each returns the data the activity completes with
+    def operation(self, application: str, data: Mapping[str, Any]) -> dict[str, Any]:
+        handler = getattr(self, f"op_{application}", None)
+        if handler is None:
+            raise KeyError(application)
+        result: dict[str, Any] = handler(data)
+        return result
+
+    def applications(self) -> list[str]:
+        return [name[3:] for name in dir(self) if name.startswith("op_")]

@@ -1,0 +1,132 @@
+"""A rectangular room with box obstacles: the vacuum cleaner's room and the cart's ward.
+
+The robot (a disc of ``radius``) moves by its motor command; it cannot enter walls or
+obstacles — a move that would is not made, and the contact latches the bumper and, at the
+start of each contact, traces ``world.collision``. A coverage grid of ``cell`` metres records
+where the robot has been (``world.covered`` per new cell). The battery drains linearly. In the
+ward, an RFID tag on the patient is readable within ``tag_range`` metres, and the wristband's
+bar code can be scanned there too.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping, Sequence
+from typing import Any
+
+import numpy as np
+
+from opspec.bindings.world.base import World
+from opspec.bindings.world.geometry import Box, ray_to_box, wrap_angle
+from opspec.bindings.world.robot import Robot
+
+__all__ = ["RoomWorld"]
+
+
+class RoomWorld(World):
+    def __init__(self, rng: np.random.Generator, *, width: float = 5.0, height: float = 4.0,
+                 obstacles: Sequence[Sequence[float]] = ((1.5, 1.5, 2.1, 2.3),
+                                                         (3.4, 0.6, 4.0, 1.2)),
+                 start: Sequence[float] = (0.5, 0.5, 0.3), radius: float = 0.15,
+                 cell: float = 0.25, range_noise: float = 0.01, drain_per_s: float = 0.02,
+                 tag: Sequence[float] | None = None, tag_range: float = 0.8,
+                 patient_id: str = "patient-17") -> None:
+        super().__init__(rng)
+        self.room = Box(0.0, 0.0, float(width), float(height))
+        self.obstacles = [Box(*map(float, o)) for o in obstacles]
+        self.radius = float(radius)
+        self.robot = Robot(float(start[0]), float(start[1]), float(start[2]))
+        self.cell = float(cell)
+        self.cells_x = max(1, int(math.ceil(width / cell)))
+        self.cells_y = max(1, int(math.ceil(height / cell)))
+        self.covered: set[tuple[int, int]] = set()
+        self.range_noise = float(range_noise)
+        self.drain_per_s = float(drain_per_s)
+        self.tag = tuple(map(float, tag)) if tag is not None else None
+        self.tag_range = float(tag_range)
+        self.patient_id = patient_id
+        self.bumped = False
+        self.in_contact = False
+        self.collisions = 0
+        self._cover()
+
+    # ------------------------------------------------------------------ motion
+    def _free(self, x: float, y: float) -> bool:
+        r = self.radius
+        if not (self.room.x0 + r <= x <= self.room.x1 - r and
+                self.room.y0 + r <= y <= self.room.y1 - r):
+            return False
+        return not any(o.contains(x, y, margin=r) for o in self.obstacles)
+
+    def _step(self, dt: float) -> None:
+        robot = self.robot
+        x, y, heading = robot.pose_after(dt)
+        robot.heading = wrap_angle(heading)
+        if (x, y) == (robot.x, robot.y):
+            self.in_contact = False if robot.command in ("stop",) else self.in_contact
+            return
+        if self._free(x, y):
+            robot.x, robot.y = x, y
+            self.in_contact = False
+            self._cover()
+        else:
+            self.bumped = True
+            if not self.in_contact:
+                self.in_contact = True
+                self.collisions += 1
+                self.trace("world.collision", x=round(robot.x, 3), y=round(robot.y, 3))
+
+    def _cover(self) -> None:
+        robot, cell, reach = self.robot, self.cell, self.radius
+        for cx in range(int((robot.x - reach) // cell), int((robot.x + reach) // cell) + 1):
+            for cy in range(int((robot.y - reach) // cell), int((robot.y + reach) // cell) + 1):
+                if not (0 <= cx < self.cells_x and 0 <= cy < self.cells_y):
+                    continue
+                centre_x, centre_y = (cx + 0.5) * cell, (cy + 0.5) * cell
+                if (centre_x - robot.x) ** 2 + (centre_y - robot.y) ** 2 <= reach ** 2 + (
+                        cell / 2) ** 2 and (cx, cy) not in self.covered:
+                    self.covered.add((cx, cy))
+                    self.trace("world.covered", cell=[cx, cy])
+
+    @property
+    def coverage(self) -> float:
+        """Share of the room's cells the robot has passed over (obstacles included)."""
+        return len(self.covered) / (self.cells_x * self.cells_y)
+
+    # ------------------------------------------------------------------ devices
+    def op_read_range(self, _data: Mapping[str, Any]) -> dict[str, Any]:
+        robot = self.robot
+        best = ray_to_box(robot.x, robot.y, robot.heading, self.room, inside=True)
+        for box in self.obstacles:
+            best = min(best, ray_to_box(robot.x, robot.y, robot.heading, box, inside=False))
+        distance = max(0.0, best - self.radius + float(self.rng.normal(0.0, self.range_noise)))
+        return {"distance": round(distance, 4)}
+
+    def op_read_bump(self, _data: Mapping[str, Any]) -> dict[str, Any]:
+        bumped, self.bumped = self.bumped, False
+        return {"bump": bumped}
+
+    def op_drive(self, data: Mapping[str, Any]) -> dict[str, Any]:
+        command = str(data.get("motor_cmd") or "stop")
+        if command == "turn_random":
+            # the random-move manoeuvre: a new heading a quarter to three quarters round
+            self.robot.heading = wrap_angle(
+                self.robot.heading + float(self.rng.uniform(math.pi / 2, 3 * math.pi / 2)))
+            command = "stop"
+        self.robot.command = command
+        return {}
+
+    def op_read_battery(self, _data: Mapping[str, Any]) -> dict[str, Any]:
+        return {"level": round(max(0.0, 100.0 - self.drain_per_s * self.time), 3)}
+
+    def _near_tag(self) -> bool:
+        if self.tag is None:
+            return False
+        return math.hypot(self.robot.x - self.tag[0], self.robot.y - self.tag[1]) <= (
+            self.tag_range)
+
+    def op_read_rfid(self, _data: Mapping[str, Any]) -> dict[str, Any]:
+        return {"tag": self.patient_id if self._near_tag() else ""}
+
+    def op_scan_barcode(self, _data: Mapping[str, Any]) -> dict[str, Any]:
+        return {"patient_id": self.patient_id if self._near_tag() else ""}

@@ -1,0 +1,123 @@
+"""The toy sumo's ring: our robot against an opponent, bout after bout.
+
+The ring is a disc of ``ring_radius`` metres. The opponent drives towards our robot at
+``opponent_speed`` with a seeded wobble. Robots in contact push each other: the one driving
+into the other harder (speed along the line of contact) moves both. A robot whose centre
+leaves the ring loses the bout (``world.bout`` plus ``world.bout_won`` / ``world.bout_lost``);
+a bout lasting ``bout_limit_s`` is a draw. After each bout both robots return to their corners.
+The bumper senses contact with the opponent or the ring's edge (a line sensor); the range
+finder sees the opponent when it is within 20 degrees of straight ahead, else the ring's edge.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping
+from typing import Any
+
+import numpy as np
+
+from opspec.bindings.world.base import World
+from opspec.bindings.world.geometry import ray_to_circle_inside, wrap_angle
+from opspec.bindings.world.robot import Robot
+
+__all__ = ["SumoWorld"]
+
+
+class SumoWorld(World):
+    def __init__(self, rng: np.random.Generator, *, ring_radius: float = 1.5,
+                 radius: float = 0.15, opponent_speed: float = 0.25, bout_limit_s: float = 60.0,
+                 range_noise: float = 0.01, drain_per_s: float = 0.02) -> None:
+        super().__init__(rng)
+        self.ring = float(ring_radius)
+        self.radius = float(radius)
+        self.opponent_speed = float(opponent_speed)
+        self.bout_limit_s = float(bout_limit_s)
+        self.range_noise = float(range_noise)
+        self.drain_per_s = float(drain_per_s)
+        self.robot = Robot(0.0, 0.0, 0.0)
+        self.opponent = Robot(0.0, 0.0, 0.0)
+        self.bumped = False
+        self.in_contact = False
+        self.bout_started = 0.0
+        self.results = {"won": 0, "lost": 0, "draw": 0}
+        self._corners()
+
+    def _corners(self) -> None:
+        offset = self.ring * 0.5
+        wobble = float(self.rng.uniform(-0.4, 0.4))
+        self.robot.x, self.robot.y, self.robot.heading = -offset, 0.0, wobble
+        self.opponent.x, self.opponent.y, self.opponent.heading = offset, 0.0, math.pi
+        self.bout_started = self.time
+
+    def _end_bout(self, result: str) -> None:
+        self.results[result] += 1
+        self.trace("world.bout", result=result, seconds=round(self.time - self.bout_started, 2))
+        if result != "draw":
+            self.trace(f"world.bout_{result}")
+        self._corners()
+
+    def _step(self, dt: float) -> None:
+        me, other = self.robot, self.opponent
+        # the opponent steers towards us, with a wobble
+        aim = math.atan2(me.y - other.y, me.x - other.x)
+        other.heading = wrap_angle(aim + float(self.rng.normal(0.0, 0.3)))
+        v_me, w_me = me.velocity()
+        me.heading = wrap_angle(me.heading + w_me * dt)
+        gap = math.hypot(me.x - other.x, me.y - other.y)
+        if gap <= 2 * self.radius:
+            if not self.in_contact:
+                self.in_contact = True
+                self.trace("world.collision", x=round(me.x, 3), y=round(me.y, 3))
+            self.bumped = True
+            # push: components of each robot's velocity along the line from us to them
+            ux, uy = (other.x - me.x) / max(gap, 1e-9), (other.y - me.y) / max(gap, 1e-9)
+            mine = v_me * (math.cos(me.heading) * ux + math.sin(me.heading) * uy)
+            theirs = self.opponent_speed * -(math.cos(other.heading) * ux
+                                             + math.sin(other.heading) * uy)
+            shove = (mine - theirs) * dt        # > 0: we push them back, < 0: they push us
+            for robot in (me, other):
+                robot.x += shove * ux
+                robot.y += shove * uy
+        else:
+            self.in_contact = False
+            me.x += v_me * dt * math.cos(me.heading)
+            me.y += v_me * dt * math.sin(me.heading)
+            step = min(self.opponent_speed * dt, gap - 2 * self.radius)
+            other.x += step * math.cos(other.heading)
+            other.y += step * math.sin(other.heading)
+        if math.hypot(other.x, other.y) > self.ring:
+            self._end_bout("won")
+        elif math.hypot(me.x, me.y) > self.ring:
+            self._end_bout("lost")
+        elif self.time - self.bout_started >= self.bout_limit_s:
+            self._end_bout("draw")
+        elif self.ring - math.hypot(me.x, me.y) < 0.1:
+            self.bumped = True                 # the line sensor sees the ring's edge
+
+    # ------------------------------------------------------------------ devices
+    def op_read_range(self, _data: Mapping[str, Any]) -> dict[str, Any]:
+        me, other = self.robot, self.opponent
+        bearing = wrap_angle(math.atan2(other.y - me.y, other.x - me.x) - me.heading)
+        if abs(bearing) <= math.radians(20):
+            distance = math.hypot(other.x - me.x, other.y - me.y) - 2 * self.radius
+        else:
+            distance = ray_to_circle_inside(me.x, me.y, me.heading, self.ring) - self.radius
+        noisy = distance + float(self.rng.normal(0.0, self.range_noise))
+        return {"distance": round(max(0.0, noisy), 4)}
+
+    def op_read_bump(self, _data: Mapping[str, Any]) -> dict[str, Any]:
+        bumped, self.bumped = self.bumped, False
+        return {"bump": bumped}
+
+    def op_drive(self, data: Mapping[str, Any]) -> dict[str, Any]:
+        command = str(data.get("motor_cmd") or "stop")
+        if command == "turn_random":
+            self.robot.heading = wrap_angle(
+                self.robot.heading + float(self.rng.uniform(math.pi / 2, 3 * math.pi / 2)))
+            command = "stop"
+        self.robot.command = command
+        return {}
+
+    def op_read_battery(self, _data: Mapping[str, Any]) -> dict[str, Any]:
+        return {"level": round(max(0.0, 100.0 - self.drain_per_s * self.time), 3)}
