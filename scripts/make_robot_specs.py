@@ -86,8 +86,11 @@ def tr(tid: str, frm: str, to: str, cond: str | None = None) -> str:
 
 def process(pid: str, name: str, activities: list[str], transitions: list[str], *,
             rate: str | None = None, period: str | None = None, priority: int,
-            mode: str | None = None, data: list[str] = (), auto_start: bool = False) -> str:
+            mode: str | None = None, data: list[str] = (), auto_start: bool = False,
+            deadline: str | None = None) -> str:
     directives = {"Lane": "device", "Priority": str(priority)}
+    if deadline:
+        directives["Deadline"] = deadline
     if rate:
         directives["Rate"] = rate
     if period:
@@ -113,7 +116,7 @@ def sense() -> str:
                 '<opspec:PushData Channel="range" Ref="distance"/>'), end()], [
         tr("s1", "start", "read_range"), tr("s2", "read_range", "read_bump"),
         tr("s3", "read_bump", "push_range"), tr("s4", "push_range", "end")],
-        rate="5Hz", priority=3, mode="run")
+        rate="5Hz", priority=3, mode="run", deadline="50ms")
 
 
 def avoid() -> str:
@@ -127,7 +130,7 @@ def avoid() -> str:
         tr("a1", "start", "pull_range"), tr("a2", "pull_range", "near"),
         tr("a3", "near", "turn_away", "seen &lt; 0.35"), tr("a4", "near", "clear", "OTHERWISE"),
         tr("a5", "turn_away", "merge"), tr("a6", "clear", "merge"), tr("a7", "merge", "end")],
-        rate="5Hz", priority=2, mode="run",
+        rate="5Hz", priority=2, mode="run", deadline="100ms",
         data=[field("seen", "FLOAT", "10.0")])
 
 
@@ -187,7 +190,8 @@ def arbitrate() -> str:
                          '</opspec:Arbiter>'),
         task("drive", "drive", "Drive the motors"), end()], [
         tr("d1", "start", "arbiter"), tr("d2", "arbiter", "drive"), tr("d3", "drive", "end")],
-        rate="5Hz", priority=5, mode="run", data=[field("motor_cmd", "STRING", '"stop"')])
+        rate="5Hz", priority=5, mode="run", deadline="50ms",
+        data=[field("motor_cmd", "STRING", '"stop"')])
 
 
 def battery() -> str:

@@ -79,6 +79,9 @@ def register(subparsers: Any) -> None:
                         help="folder of device profiles for --bind (default: devices/)")
     parser.add_argument("--timeline", choices=("brief", "all", "none"), default="brief",
                         help="which events the printed timeline shows (default brief)")
+    parser.add_argument("--timing", action="store_true",
+                        help="report per-workflow response times, jitter, deadline misses "
+                        "and the pooled model's context switches")
     parser.add_argument("--json", action="store_true",
                         help="print one JSON object (metrics shaped as opspec evaluate --json)")
     parser.set_defaults(handler=run)
@@ -127,6 +130,12 @@ def run(args: argparse.Namespace) -> int:
             sink = stack.enter_context(_open_sink(JsonlSink, args.trace, {
                 "spec": str(args.spec), "seed": args.seed, "package": package.id}))
             listeners.append(sink)
+        timing = None
+        if args.timing:
+            from opspec.engine.timing import TimingListener
+
+            timing = TimingListener()
+            listeners.append(timing)
         if printer is not None:
             listeners.append(printer)
             if not args.json:
@@ -138,11 +147,15 @@ def run(args: argparse.Namespace) -> int:
         result = sim.run(until=horizon)
         medians = _medians(sim)
         device_report = devices.report() if devices is not None else None
+    timing_summary = timing.summary() if timing is not None else None
     if args.json:
-        print(json.dumps(_json_document(args, package, horizon, result, device_report,
-                                        medians),
-                         default=str, allow_nan=False))
+        doc = _json_document(args, package, horizon, result, device_report, medians)
+        if timing_summary is not None:
+            doc["timing"] = timing_summary
+        print(json.dumps(doc, default=str, allow_nan=False))
     else:
+        if timing_summary is not None:
+            _print_timing(out, timing_summary, result.summary.get("pool"))
         _print_summary(out, result, medians, args.trace, device_report,
                        shown=printer.shown if printer else 0)
     device_faults = any(info.get("faults") for info in (device_report or {}).values())
@@ -383,6 +396,25 @@ def _fmt(value: Any, unit: str = "") -> str:
     if isinstance(value, float):
         return f"{value:.4g}{unit}"
     return f"{value}{unit}"
+
+
+def _ms(value: Any) -> str:
+    return "-" if value is None else f"{value * 1000:.2f}"
+
+
+def _print_timing(out: Any, timing: dict[str, dict[str, Any]], pool: dict[str, Any] | None
+                  ) -> None:
+    print("\ntiming (milliseconds of simulated time)", file=out)
+    print(f"  {'workflow':<20}{'started':>8}{'done':>8}{'misses':>8}{'mean resp':>11}"
+          f"{'p95 resp':>10}{'max resp':>10}{'jitter':>9}", file=out)
+    for name, t in timing.items():
+        print(f"  {name:<20}{t['started']:>8}{t['completed']:>8}{t['misses']:>8}"
+              f"{_ms(t['response_mean_s']):>11}{_ms(t['response_p95_s']):>10}"
+              f"{_ms(t['response_max_s']):>10}{_ms(t['jitter_s']):>9}", file=out)
+    if pool:
+        print(f"  pooled model: {pool.get('workers')} worker(s), {pool.get('switches')} context "
+              f"switches, busy {_fmt(pool.get('busy_time'))} s, at most "
+              f"{pool.get('max_waiting')} waiting", file=out)
 
 
 def _print_summary(out: Any, result: RunResult, medians: dict[str, float], trace: str | None,

@@ -41,6 +41,7 @@ class PooledProcessor:
         "max_waiting",
         "on_done",
         "queues",
+        "switches",
         "waiting",
     )
 
@@ -54,6 +55,7 @@ class PooledProcessor:
         self.is_alive = is_alive
         self.busy_time = 0.0
         self.max_waiting = 0
+        self.switches = 0            # activities dispatched to a worker (one switch each)
 
     def submit(self, job: Any, level: int, cost: float) -> bool:
         top = len(self.queues) - 1
@@ -68,6 +70,7 @@ class PooledProcessor:
         return True
 
     def _run(self, job: Any, cost: float) -> None:
+        self.switches += 1
         self.busy_time += cost
         if cost > 0.0:
             timeout = self.env.timeout(cost)

@@ -374,7 +374,8 @@ class Simulation(Interpreter):
         }
         if self._pool is not None:
             summary["pool"] = {"workers": self.config.workers, "busy_time": self._pool.busy_time,
-                               "max_waiting": self._pool.max_waiting}
+                               "max_waiting": self._pool.max_waiting,
+                               "switches": self._pool.switches}
         return RunResult(tuple(self.memory.events) if self.memory is not None else None,
                          self.metrics.values() if self.metrics is not None else {}, summary)
 
