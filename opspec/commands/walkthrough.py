@@ -1,0 +1,118 @@
+"""``opspec walkthrough SPEC``: a person performs the user lane in a terminal UI.
+
+See ``docs/walkthrough.md``. The recording (a script ``opspec run --script`` replays) is
+written as the session goes, with the trace beside it; quitting says where both are.
+"""
+
+from __future__ import annotations
+
+import argparse
+import contextlib
+import sys
+from datetime import UTC, datetime
+from pathlib import Path
+from typing import Any
+
+from opspec.errors import ConfigurationError
+
+__all__ = ["register", "run"]
+
+
+def register(subparsers: Any) -> None:
+    parser = subparsers.add_parser(
+        "walkthrough", help="perform a spec's user lane yourself in a terminal UI",
+        description="Run SPEC's device workflows on a simulated clock while you perform the "
+        "user lane: see what the device does, act with one key, control time, hand your lane "
+        "to a user model and back. Press ? in the app for the keys.")
+    parser.add_argument("spec", metavar="SPEC", help="the specification (.xpdl or .wfs)")
+    parser.add_argument("--speed", type=float, default=60.0,
+                        help="simulated seconds per wall second at start (default 60)")
+    parser.add_argument("--seed", type=int, default=0, help="run seed (default 0)")
+    parser.add_argument("--days", type=float, default=1.0, help="simulated days (default 1)")
+    parser.add_argument("--user-model", metavar="FILE|PRESET",
+                        help="the model that performs your lane when you hand it over "
+                        "(default: the spec's companion SPEC.users.toml)")
+    parser.add_argument("--record", metavar="FILE",
+                        help="where to write the recording (default "
+                        "walkthroughs/<spec>-<date-time>.json)")
+    parser.add_argument("--no-record", action="store_true", help="do not record")
+    parser.add_argument("--replay", metavar="FILE",
+                        help="replay a recording (or any script) instead of performing")
+    parser.add_argument("--bind", action="append", default=[], metavar="PARTICIPANT=URL",
+                        help="bind a participant to a serial device (see devices/README.md)")
+    parser.add_argument("--devices", metavar="DIR", help="device profile folder")
+    parser.set_defaults(handler=run)
+
+
+def run(args: argparse.Namespace) -> int:
+    from opspec.commands._spec import companion_user_model, load_any_spec
+    from opspec.engine.compiled import compile_package
+
+    if not (args.speed > 0):
+        raise ConfigurationError(f"--speed must be positive, not {args.speed:g}")
+    package = load_any_spec(args.spec)            # a broken spec opens nothing
+    compiled = compile_package(package)
+    model_ref = args.user_model or companion_user_model(args.spec)
+    factory = _model_factory(compiled, model_ref, args.seed) if model_ref else None
+    replay = None
+    if args.replay:
+        from opspec.testing.script import load_script
+
+        replay = load_script(args.replay).performer()
+    record = None if args.no_record or args.replay else Path(
+        args.record or Path("walkthroughs") / (
+            f"{Path(args.spec).name.split('.')[0]}-"
+            f"{datetime.now(UTC).strftime('%Y%m%d-%H%M%S')}.json"))
+    with contextlib.ExitStack() as stack:
+        performers: dict[str, Any] = {}
+        notes: list[str] = []
+        try:
+            from opspec.bindings.worlds import world_performers
+
+            performers.update(world_performers(compiled, seed=args.seed, user=0))
+        except ImportError:
+            pass
+        devices = None
+        if args.bind:
+            from opspec.bindings.attach import attach_devices
+
+            devices = stack.enter_context(attach_devices(args.bind, args.devices))
+            performers.update(devices.performers)
+            notes.extend(devices.notes)
+        from opspec.tui.app import WalkthroughApp
+        from opspec.tui.session import WalkSession
+
+        session = WalkSession(compiled, seed=args.seed, days=args.days, record=record,
+                              model_factory=factory, performers=performers, replay=replay,
+                              spec_path=str(args.spec))
+        session.speed = args.speed
+        if devices is not None:
+            devices.install(session.sim)
+        app = WalkthroughApp(session, title=package.name or package.id, notes=notes)
+        try:
+            app.run()
+        finally:
+            session.close()
+    if record is not None:
+        print(f"recording: {record}\ntrace: {record.with_suffix('.trace.jsonl')}\n"
+              f"replay it with: opspec walkthrough {args.spec} --replay {record}  or  "
+              f"opspec run {args.spec} --script {record}", file=sys.stderr)
+    return 0
+
+
+def _model_factory(compiled: Any, ref: Any, seed: int) -> Any:
+    from opspec.engine.lanes import user_lane
+    from opspec.engine.random import user_stream
+    from opspec.usermodels.loader import load_user_model
+
+    model = load_user_model(ref)
+    lane = user_lane(compiled)
+    if not lane.empty:
+        model.validate_against(lane.manual, choices=lane.choices)
+    handovers = [0]
+
+    def make() -> Any:
+        handovers[0] += 1
+        return model.performer(user_stream(seed, 1000 + handovers[0]))
+
+    return make

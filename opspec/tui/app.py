@@ -1,0 +1,298 @@
+"""The walkthrough app: a person performs the user lane of a spec while its device runs.
+
+Layout (works in 80×24, grows with the terminal): a status line (simulated clock, speed,
+running or paused, who performs the lane); the device panel (what each participant did last,
+running workflow instances and the activity each is in, pending deadlines with a countdown);
+the person's panel (what can be done now, one key each — also clickable — and a banner when
+the device calls); the timeline (newest first, filterable by lane). Every state is said in
+words and symbols, never by colour alone. The engine is stepped from this app's event loop.
+"""
+
+from __future__ import annotations
+
+import string
+from typing import Any, ClassVar
+
+from rich.text import Text
+from textual.app import App, ComposeResult
+from textual.binding import Binding
+from textual.containers import Horizontal, Vertical
+from textual.screen import ModalScreen
+from textual.widgets import Footer, Static
+
+from opspec.tui.session import WalkSession, clock
+
+__all__ = ["WalkthroughApp"]
+
+SPEEDS = {"1": 1.0, "2": 10.0, "3": 60.0, "4": 600.0}
+OFFER_KEYS = string.ascii_lowercase[:6]          # a..f act on the offers shown
+LANES = ("all", "device", "user")
+TICK_S = 0.1
+
+HELP = """\
+[b]opspec walkthrough — keys[/b]
+
+  [b]a[/b]–[b]f[/b]     do the action shown next to the letter (or click it)
+  [b]x[/b]       do not do the first action (an omission, recorded)
+  [b]space[/b]   pause / resume the clock
+  [b]1 2 3 4[/b] speed: real time, 10x, 60x, 600x
+  [b]w[/b]       let 30 simulated seconds pass
+  [b]n[/b]       skip to the next event
+  [b]u[/b]       skip until something needs you
+  [b]h[/b]       hand your lane to the user model / take it back
+  [b]l[/b]       timeline: all lanes / device / user
+  [b]?[/b]       this help        [b]q[/b]  quit (the recording is kept)
+
+Press escape or ? to close."""
+
+
+class HelpScreen(ModalScreen[None]):
+    BINDINGS: ClassVar = [Binding("escape,question_mark,q", "dismiss", "close")]
+    DEFAULT_CSS = """
+    HelpScreen { align: center middle; }
+    HelpScreen > Static { width: 70; max-width: 100%; border: heavy $accent; padding: 1 2;
+                          background: $surface; }
+    """
+
+    def compose(self) -> ComposeResult:
+        yield Static(HELP, id="help-text")
+
+
+class StatusLine(Static):
+    """The clock and controls line; it owns the app's tick timer (so the timer dies with
+    the widget and never fires into an unmounted app)."""
+
+    def on_mount(self) -> None:
+        self.set_interval(TICK_S, self._tick)
+
+    def _tick(self) -> None:
+        if self.is_mounted:
+            app = self.app
+            if isinstance(app, WalkthroughApp):
+                app.tick(TICK_S)
+
+
+class OfferLine(Static):
+    """One action the person can take; clicking it does it."""
+
+    def __init__(self, index: int, text: Text) -> None:
+        super().__init__(text, classes="offer")
+        self.index = index
+
+    def on_click(self) -> None:
+        app = self.app
+        if isinstance(app, WalkthroughApp):
+            app.do_offer(self.index)
+
+
+class WalkthroughApp(App[str | None]):
+    """See the module docstring. ``session`` is a :class:`WalkSession`; the app's return
+    value is the recording's path (or ``None`` when not recording)."""
+
+    TITLE = "opspec walkthrough"
+    CSS = """
+    Screen { layout: vertical; }
+    #status { height: 1; background: $primary; color: $text; padding: 0 1; }
+    #panels { height: 1fr; min-height: 9; }
+    #device, #person { width: 1fr; border: round $secondary; padding: 0 1; }
+    #person.calling { border: heavy $warning; }
+    #timeline { height: 8; border: round $secondary; padding: 0 1; }
+    .offer { height: auto; }
+    .offer:hover { background: $boost; }
+    """
+    BINDINGS: ClassVar = [
+        Binding("space", "pause", "pause"),
+        Binding("1", "speed('1')", "1x", show=False),
+        Binding("2", "speed('2')", "10x", show=False),
+        Binding("3", "speed('3')", "60x", show=False),
+        Binding("4", "speed('4')", "600x", show=False),
+        Binding("w", "wait", "wait 30s"),
+        Binding("n", "next_event", "next event"),
+        Binding("u", "until_user", "until me"),
+        Binding("h", "hand_over", "model/me"),
+        Binding("l", "lane", "lanes", show=False),
+        Binding("x", "ignore", "don't", show=False),
+        Binding("question_mark", "help", "help"),
+        Binding("q", "quit_walk", "quit"),
+        *[Binding(k, f"offer({i})", show=False) for i, k in enumerate(OFFER_KEYS)],
+    ]
+
+    def __init__(self, session: WalkSession, *, title: str = "", notes: list[str] = ()) -> None:
+        super().__init__()
+        self.session = session
+        self.spec_title = title
+        self.notes = list(notes)
+        self.lane_filter = 0
+        self._was_calling = False
+        session.listeners.append(self._on_event)
+
+    # ------------------------------------------------------------------ layout
+    def compose(self) -> ComposeResult:
+        yield StatusLine(id="status")
+        with Horizontal(id="panels"):
+            yield Static(id="device")
+            with Vertical(id="person"):
+                yield Static(id="call")
+                yield Vertical(id="offers")
+        yield Static(id="timeline")
+        yield Footer()
+
+    def on_mount(self) -> None:
+        self.query_one("#device", Static).border_title = "Device"
+        self.query_one("#person", Vertical).border_title = "You (the user lane)"
+        self.query_one("#timeline", Static).border_title = "Timeline (newest first)"
+        self.refresh_views()
+
+    # ------------------------------------------------------------------ time
+    def tick(self, wall_seconds: float) -> None:
+        before = len(self.session.offers)
+        self.session.advance(wall_seconds)
+        if not self.session.paused or len(self.session.offers) != before:
+            self.refresh_views()
+
+    def _on_event(self, event: Any) -> None:
+        if self.session.calling and not self._was_calling:
+            self.bell()                      # the device calls: ring where the terminal can
+        self._was_calling = self.session.calling
+
+    # ------------------------------------------------------------------ actions
+    def action_pause(self) -> None:
+        self.session.paused = not self.session.paused
+        self.refresh_views()
+
+    def action_speed(self, key: str) -> None:
+        self.session.speed = SPEEDS[key]
+        self.refresh_views()
+
+    def action_wait(self) -> None:
+        self.session._run_to(min(self.session.horizon, self.session.now + 30.0))
+        self.refresh_views()
+
+    def action_next_event(self) -> None:
+        self.session.skip_to_next_event()
+        self.refresh_views()
+
+    def action_until_user(self) -> None:
+        self.session.skip_until_user()
+        self.refresh_views()
+
+    def action_hand_over(self) -> None:
+        if self.session.handed_over:
+            self.session.take_back()
+            self.notify("You perform the user lane again.")
+        elif self.session.hand_over():
+            self.notify("The user model performs your lane; press h to take it back.")
+        else:
+            self.notify("No user model: start with --user-model FILE|PRESET.",
+                        severity="warning")
+        self.refresh_views()
+
+    def action_lane(self) -> None:
+        self.lane_filter = (self.lane_filter + 1) % len(LANES)
+        self.refresh_views()
+
+    def action_offer(self, index: int) -> None:
+        self.do_offer(index)
+
+    def do_offer(self, index: int) -> None:
+        offers = self.session.offers
+        if 0 <= index < len(offers):
+            self.session.act(offers[index])
+            self.refresh_views()
+
+    def action_ignore(self) -> None:
+        if self.session.offers:
+            self.session.ignore(self.session.offers[0])
+            self.refresh_views()
+
+    def action_help(self) -> None:
+        self.push_screen(HelpScreen())
+
+    def action_quit_walk(self) -> None:
+        self.session.close()
+        path = self.session.record_path
+        self.exit(str(path) if path is not None else None)
+
+    # ------------------------------------------------------------------ views
+    def refresh_views(self) -> None:
+        if not self.is_mounted:
+            return
+        session = self.session
+        state = "PAUSED" if session.paused else "running"
+        who = "model performs your lane" if session.handed_over else "you perform the lane"
+        end = "  [ENDED]" if session.ended else ""
+        self.query_one("#status", Static).update(Text(
+            f"{clock(session.now)}  {session.speed:g}x  {state}  |  {who}  |  "
+            f"{self.spec_title}{end}", no_wrap=True, overflow="ellipsis"))
+        self.query_one("#device", Static).update(self._device_text())
+        person = self.query_one("#person", Vertical)
+        call = self.query_one("#call", Static)
+        if session.calling:
+            person.add_class("calling")
+            call.update(Text("(!) THE DEVICE IS CALLING YOU", style="bold reverse"))
+        else:
+            person.remove_class("calling")
+            call.update("" if session.offers else "(nothing to do now: press u to skip "
+                        "until something needs you)")
+        box = self.query_one("#offers", Vertical)
+        box.remove_children()
+        if session.handed_over:
+            box.mount(Static("The user model is performing. Press h to take over."))
+        else:
+            lines = []
+            for n, offer in enumerate(session.offers[:len(OFFER_KEYS)]):
+                what = ("choose: " if offer.choice else "") + offer.label
+                line = Text()
+                line.append(f"[{OFFER_KEYS[n]}]", style="bold reverse")
+                line.append(f" {what}")
+                lines.append(OfferLine(n, line))
+            if lines:
+                box.mount(*lines)
+        self.query_one("#timeline", Static).update(self._timeline_text())
+
+    def _device_text(self) -> Text:
+        session = self.session
+        text = Text()
+        for participant, last in sorted(session.participants.items()):
+            marker = "(x) " if last.startswith("FAULT") else "*  "
+            text.append(f"{marker}{participant}: {last}\n",
+                        style="bold red" if last.startswith("FAULT") else "")
+        if session.current:
+            text.append("Running:\n", style="bold")
+            for instance, (process, activity) in sorted(session.current.items())[:6]:
+                text.append(f"  {process}#{instance} at {activity}\n")
+        for (instance, activity), due in sorted(session.deadlines.items(),
+                                                key=lambda kv: kv[1])[:3]:
+            left = max(0.0, due - session.now)
+            text.append(f"deadline {activity} (#{instance}) in {int(left // 60):02d}:"
+                        f"{int(left % 60):02d}\n", style="bold")
+        for note in self.notes:
+            text.append(f"note: {note}\n")
+        if not text.plain:
+            text.append("(idle)")
+        return text
+
+    def _timeline_text(self) -> Text:
+        lane = LANES[self.lane_filter]
+        text = Text(f"showing: {lane}\n", style="dim")
+        shown = 0
+        for event in reversed(self.session.events):
+            if event.kind not in _TIMELINE_KINDS or (lane != "all" and event.lane != lane):
+                continue
+            what = f"{event.activity or event.process or ''} {event.kind.split('.')[-1]}"
+            if event.kind == "trigger.raised":
+                what = f"trigger {(event.data or {}).get('name', '?')} raised"
+            elif event.kind == "walkthrough.action":
+                data = event.data or {}
+                what = f"{'you' if data.get('by') == 'person' else 'model'}: {data.get('action')}"
+            text.append(f"{clock(event.time)[3:]}  {event.lane or '':<6} {what}\n")
+            shown += 1
+            if shown >= 6:
+                break
+        return text
+
+
+_TIMELINE_KINDS = frozenset({
+    "activity.completed", "activity.omitted", "activity.withdrawn", "activity.offered",
+    "trigger.raised", "deadline.expired", "process.started", "process.completed", "fault",
+    "mode.changed", "walkthrough.action"})
