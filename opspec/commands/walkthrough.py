@@ -8,7 +8,6 @@ from __future__ import annotations
 
 import argparse
 import contextlib
-import sys
 from datetime import UTC, datetime
 from pathlib import Path
 from typing import Any
@@ -96,7 +95,7 @@ def run(args: argparse.Namespace) -> int:
     if record is not None:
         print(f"recording: {record}\ntrace: {record.with_suffix('.trace.jsonl')}\n"
               f"replay it with: opspec walkthrough {args.spec} --replay {record}  or  "
-              f"opspec run {args.spec} --script {record}", file=sys.stderr)
+              f"opspec run {args.spec} --script {record}")
     return 0
 
 

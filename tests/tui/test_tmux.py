@@ -1,0 +1,54 @@
+"""The real `opspec walkthrough` in a real terminal (tmux): keys in, screen out."""
+
+from __future__ import annotations
+
+import shutil
+import subprocess
+import sys
+import time
+import uuid
+from pathlib import Path
+
+import pytest
+from conftest import SPEC
+
+pytestmark = pytest.mark.skipif(shutil.which("tmux") is None,
+                                reason="tmux is not installed (scripts/system-deps.sh installs it)")
+
+
+def tmux(*args: str) -> str:
+    return subprocess.run(["tmux", *args], capture_output=True, text=True, check=True).stdout
+
+
+def wait_for(session: str, text: str, timeout: float = 30.0) -> str:
+    deadline = time.monotonic() + timeout
+    screen = ""
+    while time.monotonic() < deadline:
+        screen = tmux("capture-pane", "-p", "-t", session)
+        if text in screen:
+            return screen
+        time.sleep(0.2)
+    raise AssertionError(f"{text!r} never appeared; the screen was:\n{screen}")
+
+
+def test_walkthrough_in_tmux_shows_the_alarm_and_says_where_the_recording_is(tmp_path):
+    session = f"opspec-{uuid.uuid4().hex[:8]}"
+    record = tmp_path / "walk.json"
+    command = f"{sys.executable} -m opspec.cli walkthrough {SPEC} --record {record}"
+    tmux("new-session", "-d", "-s", session, "-x", "100", "-y", "30")
+    try:
+        tmux("set-option", "-t", session, "remain-on-exit", "on")
+        tmux("send-keys", "-t", session, command, "Enter")
+        wait_for(session, "you perform the lane")
+        tmux("send-keys", "-t", session, "space")
+        tmux("send-keys", "-t", session, "u")
+        screen = wait_for(session, "THE DEVICE IS CALLING YOU")
+        assert "Hear the alarm" in screen and "08:00:00" in screen
+        tmux("send-keys", "-t", session, "a")
+        wait_for(session, "Walk to the dispenser")
+        tmux("send-keys", "-t", session, "q")
+        said = wait_for(session, "recording:")
+        assert str(record.name) in said
+        assert "complete hear_alarm" in Path(record).read_text(encoding="utf-8")
+    finally:
+        subprocess.run(["tmux", "kill-session", "-t", session], capture_output=True)

@@ -1,0 +1,154 @@
+"""Walking the medication dispenser in the app (Textual's Pilot, headless): the alarm at
+08:00, a report and the dose taken with the right latency, three ignored alarms, hand-over to
+the model and back, recordings that replay to the same trace, help and quit."""
+
+from __future__ import annotations
+
+import json
+
+import pytest
+from conftest import SPEC
+
+from opspec.testing.script import load_script
+from opspec.tui.app import WalkthroughApp
+from opspec.tui.session import WalkSession
+
+
+def metric(session: WalkSession, name: str) -> dict:
+    return session.sim.metrics.values()[name]
+
+
+def screen_text(app: WalkthroughApp) -> str:
+    return "\n".join(str(w.render()) for w in app.query("Static"))
+
+
+async def start(app: WalkthroughApp, pilot) -> None:
+    await pilot.press("space")          # pause: the tests drive time with keys only
+    await pilot.pause()
+
+
+@pytest.mark.asyncio
+async def test_alarm_at_eight_then_a_report_after_90s_takes_the_dose(compiled, tmp_path):
+    session = WalkSession(compiled, record=tmp_path / "walk.json")
+    app = WalkthroughApp(session, title="dispenser")
+    async with app.run_test(size=(80, 24)) as pilot:
+        await start(app, pilot)
+        await pilot.press("u")                         # skip until something needs me
+        assert session.now == 8 * 3600
+        assert "THE DEVICE IS CALLING YOU" in screen_text(app)
+        assert "Hear the alarm" in screen_text(app)
+        await pilot.press("a")                          # I hear it
+        await pilot.press("w", "w", "w")                # walking takes 90 s
+        await pilot.press("a")                          # arrived
+        assert [o.choice for o in session.offers] == ["press_report", "press_wrong_button"]
+        await pilot.press("a")                          # the right button
+        await pilot.press("u")
+        assert session.offers[0].item.activity == "take_pill"
+        await pilot.press("a")
+        await pilot.pause()
+    assert metric(session, "doses_taken")["total"] == 1
+    assert metric(session, "report_latency_s")["mean"] == pytest.approx(90.0)
+    assert metric(session, "alarms")["total"] == 1
+
+
+@pytest.mark.asyncio
+async def test_three_ignored_alarms_end_in_a_miss_and_the_caregiver(compiled):
+    session = WalkSession(compiled)
+    app = WalkthroughApp(session)
+    async with app.run_test(size=(80, 24)) as pilot:
+        await start(app, pilot)
+        for _ in range(12):
+            if session.now >= 8 * 3600 + 900:
+                break
+            await pilot.press("n")                      # let the device go on without me
+        await pilot.pause()
+        assert "notify_caregiver" in screen_text(app) or metric(
+            session, "caregiver_notified")["total"] == 1
+    assert metric(session, "alarms")["total"] == 3
+    assert metric(session, "doses_missed")["total"] == 1
+    assert metric(session, "caregiver_notified")["total"] == 1
+
+
+@pytest.mark.asyncio
+async def test_hand_over_to_the_model_and_take_the_lane_back(compiled, model_factory):
+    session = WalkSession(compiled, model_factory=model_factory)
+    app = WalkthroughApp(session)
+    async with app.run_test(size=(100, 30)) as pilot:
+        await start(app, pilot)
+        await pilot.press("u")
+        assert session.offers
+        await pilot.press("h")                          # the model takes the lane
+        assert session.handed_over and not session.offers
+        assert "model performs your lane" in screen_text(app)
+        for _ in range(10):
+            await pilot.press("n")
+        await pilot.press("h")                          # and I take it back
+        assert not session.handed_over
+        await pilot.press("u")
+        await pilot.pause()
+        assert session.offers                           # the next dose asks me again
+        assert session.now >= 12 * 3600
+    assert metric(session, "doses_due")["total"] >= 2
+
+
+@pytest.mark.asyncio
+async def test_recorded_session_replays_to_the_same_trace(compiled, tmp_path):
+    record = tmp_path / "walk.json"
+    session = WalkSession(compiled, record=record)
+    app = WalkthroughApp(session)
+    async with app.run_test(size=(80, 24)) as pilot:
+        await start(app, pilot)
+        await pilot.press("u", "a", "w", "w", "a", "b")   # the wrong button first
+        await pilot.press("u", "a", "u", "a", "u", "a")
+        await pilot.press("q")
+    assert app.return_value == str(record)
+    steps = json.loads(record.read_text(encoding="utf-8"))["steps"]
+    assert any("press_wrong_button" in action for _, action in steps)
+    original = [(e.time, e.kind, e.activity) for e in session.events
+                if e.kind.startswith(("activity.", "process.", "trigger."))]
+
+    replay = load_script(record).performer()
+    again = WalkSession(compiled, replay=replay)
+    again._run_to(session.now)
+    replayed = [(e.time, e.kind, e.activity) for e in again.events
+                if e.kind.startswith(("activity.", "process.", "trigger."))]
+    assert replayed == original
+    trace = record.with_suffix(".trace.jsonl")
+    assert trace.is_file() and "walkthrough.action" in trace.read_text(encoding="utf-8")
+
+
+@pytest.mark.asyncio
+async def test_help_screen_lists_the_keys_and_closes(compiled):
+    app = WalkthroughApp(WalkSession(compiled))
+    async with app.run_test(size=(80, 24)) as pilot:
+        await pilot.press("question_mark")
+        await pilot.pause()
+        text = str(app.screen.query_one("#help-text").render())
+        assert "pause / resume" in text and "hand your lane" in text
+        await pilot.press("escape")
+        await pilot.pause()
+        assert not app.screen.query("#help-text")
+
+
+@pytest.mark.asyncio
+async def test_quitting_returns_the_recording_path_and_keeps_what_was_done(compiled, tmp_path):
+    record = tmp_path / "r.json"
+    session = WalkSession(compiled, record=record)
+    app = WalkthroughApp(session)
+    async with app.run_test(size=(80, 24)) as pilot:
+        await start(app, pilot)
+        await pilot.press("u", "a")
+        # the recording is on disk before quitting: a crash now would lose nothing
+        assert "complete hear_alarm" in record.read_text(encoding="utf-8")
+        await pilot.press("q")
+    assert app.return_value == str(record)
+
+
+def test_broken_spec_opens_nothing_and_prints_the_diagnostics(tmp_path, capsys):
+    from opspec.cli import main
+
+    broken = tmp_path / "broken.xpdl"
+    broken.write_text(SPEC.read_text(encoding="utf-8").replace("</Package>", ""),
+                      encoding="utf-8")
+    assert main(["walkthrough", str(broken)]) == 1
+    assert f"{broken}:" in capsys.readouterr().err
