@@ -156,11 +156,11 @@ def test_full_blocked_wants_every_split_closed_by_a_join_of_its_kind():
 # check reports their errors and exits 1).
 CORPUS_VERDICTS = {
     "jawe10__LoopBlocked.xpdl": (
-        ["conformance"], "declares LOOP_BLOCKED but Act4 -> Act3 -> Act5 -> Act4 is a cycle "
-        "(JaWE files it under 'Invalid')"),
+        ["conformance"], ("declares LOOP_BLOCKED but Act4 -> Act3 -> Act5 -> Act4 is a cycle "
+        "(JaWE files it under 'Invalid')")),
     "jawe21__Business_Example.xpdl": (
-        ["improper-completion"], "the AND-join Act13 waits for Act11 and Act101, which lie on "
-        "different branches of an exclusive split: only correlated data could make both come"),
+        ["improper-completion"], ("the AND-join Act13 waits for Act11 and Act101, which lie on "
+        "different branches of an exclusive split: only correlated data could make both come")),
     "bonita__testManagementAPIWithParsingError.xpdl": ("unloadable", "not well-formed XML"),
     "bpmve__PackageBasic.xpdl": ("unloadable", "its ExternalPackage file is not in the corpus"),
     "tibco-af__Fallstudie_4-09_e-Car_Produktion.xpdl": (
