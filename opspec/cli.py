@@ -21,7 +21,7 @@ from collections.abc import Sequence
 from opspec import __version__
 from opspec.errors import OpspecError, SpecError
 
-__all__ = ["main", "build_parser"]
+__all__ = ["build_parser", "main"]
 
 # The subcommands, in the order ``opspec --help`` lists them. Listed explicitly (no plugin
 # discovery) so the CLI's surface is visible in one place; modules import lazily so that

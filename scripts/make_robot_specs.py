@@ -352,10 +352,10 @@ def main() -> None:
             count("patients_found", "activity.completed", "identify", "confirm"),
             count("collisions", "world.collision"),
             count("cells_covered", "world.covered"),
-            '      <opspec:Duration Name="time_to_find_s" Unit="s">'
+            ('      <opspec:Duration Name="time_to_find_s" Unit="s">'
             '<opspec:From Event="process.started" Process="mission"/>'
             '<opspec:To Event="activity.completed" Process="mission" Activity="wait_found"/>'
-            '</opspec:Duration>']),
+            '</opspec:Duration>')]),
         [*ROBOT_APPS[:3], "read_rfid", "scan_barcode"], cart_fields, modes=False)
     cart = cart.replace('<ExtendedAttribute Name="opspec:Mode" Value="run"/>', "")
     for name, text in (("vacuum_cleaner", vacuum), ("toy_sumo", sumo),

@@ -15,12 +15,12 @@ from dataclasses import dataclass
 
 __all__ = [
     "BINARY_OPERATORS",
+    "UNARY_OPERATORS",
     "Binary",
     "Call",
     "Expression",
     "Literal",
     "Name",
-    "UNARY_OPERATORS",
     "Unary",
 ]
 

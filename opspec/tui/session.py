@@ -276,17 +276,17 @@ class WalkSession:
                         (event.process or "", event.activity), ()):
                     try:
                         due = float(seconds({}, event.time))
-                    except Exception:  # noqa: BLE001 - a data-dependent deadline: not shown
+                    except Exception:  # noqa: BLE001, S112 - a data-dependent deadline: not shown
                         continue
                     self.deadlines[(event.instance, event.activity)] = event.time + due
             elif kind in ("activity.completed", "deadline.expired", "activity.withdrawn",
                           "activity.aborted", "activity.omitted"):
                 self.deadlines.pop((event.instance, event.activity), None)
-        if kind.startswith("process.") and kind != "process.started":
-            if event.instance is not None:
-                self.current.pop(event.instance, None)
-                self.deadlines = {k: v for k, v in self.deadlines.items()
-                                  if k[0] != event.instance}
+        if kind.startswith("process.") and kind != "process.started" and (
+                event.instance is not None):
+            self.current.pop(event.instance, None)
+            self.deadlines = {k: v for k, v in self.deadlines.items()
+                              if k[0] != event.instance}
         if kind == "activity.completed" and event.participant and event.lane != "user":
             self.participants[event.participant] = (
                 f"{event.activity} at {clock(event.time)[3:]}")

@@ -16,8 +16,8 @@ from opspec.model.sisarl import Distribution, TriggerRef
 
 __all__ = [
     "DISTRIBUTIONS",
-    "SisarlValueError",
     "TRIGGER_KINDS",
+    "SisarlValueError",
     "parse_boolean",
     "parse_distribution",
     "parse_integer",

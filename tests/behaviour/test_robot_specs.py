@@ -19,9 +19,9 @@ from opspec.xpdl.open_spec import open_spec
 ROOT = Path(__file__).resolve().parents[2]
 SPECS = ROOT / "specs"
 sys.path.insert(0, str(ROOT / "tests" / "preprocess"))
-from builtin_models import without_locations  # noqa: E402
+from builtin_models import without_locations
 
-from opspec.bindings.worlds import world_performers  # noqa: E402
+from opspec.bindings.worlds import world_performers
 
 
 def run_spec(path: Path, until: float, seed: int = 0, **kw: Any) -> Any:

@@ -51,4 +51,4 @@ def test_walkthrough_in_tmux_shows_the_alarm_and_says_where_the_recording_is(tmp
         assert str(record.name) in said
         assert "complete hear_alarm" in Path(record).read_text(encoding="utf-8")
     finally:
-        subprocess.run(["tmux", "kill-session", "-t", session], capture_output=True)
+        subprocess.run(["tmux", "kill-session", "-t", session], capture_output=True, check=False)

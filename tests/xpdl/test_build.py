@@ -179,8 +179,8 @@ def test_xpdl_2_0_rule_trigger_is_a_conditional_trigger() -> None:
         ('<IntermediateEvent Trigger="Link"><TriggerResultLink Name="l"/></IntermediateEvent>',
          TriggerKind.LINK, "l"),
         ('<IntermediateEvent Trigger="Cancel" Target="x"/>', TriggerKind.CANCEL, None),
-        ('<StartEvent Trigger="Conditional"><TriggerConditional><Expression>level &lt; 3</Expression>'
-         "</TriggerConditional></StartEvent>", TriggerKind.RULE, None),
+        (('<StartEvent Trigger="Conditional"><TriggerConditional><Expression>level &lt; 3</Expression>'
+         "</TriggerConditional></StartEvent>"), TriggerKind.RULE, None),
     ],
     ids=["terminate", "error", "signal", "link", "cancel", "conditional"],
 )

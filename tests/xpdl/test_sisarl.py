@@ -230,11 +230,11 @@ def test_arbiter_inputs_keep_priority_order() -> None:
 @pytest.mark.parametrize(
     ("xml", "kind", "fields"),
     [
-        ('<opspec:Voter Output="cmd" Options="forward left right stop"><opspec:Input Ref="a"/>'
-         '<opspec:Input Ref="b"/></opspec:Voter>', CoordinationKind.VOTER,
+        (('<opspec:Voter Output="cmd" Options="forward left right stop"><opspec:Input Ref="a"/>'
+         '<opspec:Input Ref="b"/></opspec:Voter>'), CoordinationKind.VOTER,
          {"options": ("forward", "left", "right", "stop"), "inputs": ("a", "b")}),
-        ('<opspec:Superposition Output="v"><opspec:Input Ref="a" Weight="0.7"/>'
-         '<opspec:Input Ref="b"/></opspec:Superposition>', CoordinationKind.SUPERPOSITION,
+        (('<opspec:Superposition Output="v"><opspec:Input Ref="a" Weight="0.7"/>'
+         '<opspec:Input Ref="b"/></opspec:Superposition>'), CoordinationKind.SUPERPOSITION,
          {"weights": (0.7, 1.0), "output": "v"}),
         ('<opspec:PushData Channel="range" Ref="distance"/>', CoordinationKind.PUSH_DATA,
          {"channel": "range", "inputs": ("distance",)}),
@@ -294,11 +294,11 @@ def test_metrics_and_modes() -> None:
     [
         ('<ExtendedAttribute Name="opspec:Metrics"><opspec:Count Event="x"/></ExtendedAttribute>', "bad-metric"),
         ('<ExtendedAttribute Name="opspec:Metrics"><opspec:Duration Name="d"/></ExtendedAttribute>', "bad-metric"),
-        ('<ExtendedAttribute Name="opspec:Metrics"><opspec:Count Name="c" Event="e" Which="middle"/>'
-         "</ExtendedAttribute>", "bad-metric"),
+        (('<ExtendedAttribute Name="opspec:Metrics"><opspec:Count Name="c" Event="e" Which="middle"/>'
+         "</ExtendedAttribute>"), "bad-metric"),
         ('<ExtendedAttribute Name="opspec:Modes"><opspec:Mode Workflows="a"/></ExtendedAttribute>', "bad-mode"),
-        ('<ExtendedAttribute Name="opspec:Modes"><opspec:Mode Id="a" Initial="true"/>'
-         '<opspec:Mode Id="b" Initial="true"/></ExtendedAttribute>', "bad-mode"),
+        (('<ExtendedAttribute Name="opspec:Modes"><opspec:Mode Id="a" Initial="true"/>'
+         '<opspec:Mode Id="b" Initial="true"/></ExtendedAttribute>'), "bad-mode"),
     ],
     ids=["count-no-name", "duration-no-ends", "bad-which", "mode-no-id", "two-initial"],
 )
