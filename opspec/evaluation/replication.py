@@ -105,7 +105,7 @@ def prepare(spec: str, sha256: str, user_model: str | None, engine: Mapping[str,
         if not lane.empty:
             model.validate_against(lane.manual, choices=lane.choices)
     config = EngineConfig.from_mapping(engine) if engine else EngineConfig()
-    context = _Context(compiled, lane.bind_names, lane.manual, model, config)
+    context = _Context(compiled, lane.bind_names, (*lane.manual, *lane.choices), model, config)
     _CONTEXTS[key] = context
     return context
 
