@@ -161,6 +161,10 @@ CORPUS_VERDICTS = {
     "jawe21__Business_Example.xpdl": (
         ["improper-completion"], ("the AND-join Act13 waits for Act11 and Act101, which lie on "
         "different branches of an exclusive split: only correlated data could make both come")),
+    "g360__Subprocess4_with_exception.xpdl": (
+        ["dead"], ("the block's activity set starts at '232' (StartActivityId), and the "
+        "transitions 235 -> 438 -> 233 that would lead through Task E are written in the "
+        "wrong process (validate reports them), so Task E '438' has no way in")),
     "bonita__testManagementAPIWithParsingError.xpdl": ("unloadable", "not well-formed XML"),
     "bpmve__PackageBasic.xpdl": ("unloadable", "its ExternalPackage file is not in the corpus"),
     "tibco-af__Fallstudie_4-09_e-Car_Produktion.xpdl": (
