@@ -1,17 +1,38 @@
-"""``opspec check SPEC...``: soundness of each process's control flow (docs/soundness.md).
+"""``opspec check SPEC... [--json] [--max-states N] [--process ID]``: soundness of each
+process's control flow (see docs/soundness.md and :mod:`opspec.model.soundness`).
 
-Exit status: 0 every process is sound; 1 a problem was found (or a spec has errors); 2 usage,
-I/O, or a state space too large to decide within ``--max-states``.
+Each problem prints as ``path:line: error: process: message`` with its witness (the activities
+fired from the start) on the next line, then one line per process level and a summary per
+file; ``--json`` prints one JSON object per file instead (JSON Lines).
+
+Exit status: 0 every process level is sound; 1 a problem was found, or a spec has errors that
+keep it from loading; 2 usage or I/O problems (a missing path, an unreadable file, an unknown
+``--process``), or a state space larger than ``--max-states`` with no problem found (the
+verdict is then undecided, never "sound"). Over several files, the highest status wins.
 """
 
 from __future__ import annotations
 
 import argparse
 import json
+import sys
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
+
+if TYPE_CHECKING:
+    from opspec.model.soundness import SoundnessReport
 
 __all__ = ["register", "run"]
+
+
+def _positive(text: str) -> int:
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{text!r} is not a whole number") from None
+    if value < 1:
+        raise argparse.ArgumentTypeError(f"{value} must be at least 1")
+    return value
 
 
 def register(subparsers: Any) -> None:
@@ -22,37 +43,45 @@ def register(subparsers: Any) -> None:
         "conditional branch may be taken) and report deadlocks, livelocks, activities that "
         "can never run, improper completion, AND-joins that can't fire and unbounded places, "
         "each with a witness path; plus violations of the package's declared graph "
-        "conformance class. Exit status: 0 sound, 1 a problem found, 2 usage or I/O errors "
-        "or a state space larger than --max-states.")
+        "conformance class. Exit status: 0 sound, 1 a problem found (or a spec that does "
+        "not load), 2 usage or I/O errors, or a state space larger than --max-states.")
     parser.add_argument("specs", nargs="+", metavar="SPEC", help="spec files or folders")
-    parser.add_argument("--json", action="store_true", help="one JSON object per file")
-    parser.add_argument("--max-states", type=int, default=100_000, metavar="N",
-                        help="markings explored per process level (default 100000)")
-    parser.add_argument("--process", metavar="ID", help="check only this process")
+    parser.add_argument("--json", action="store_true",
+                        help="print one JSON object per file (JSON Lines)")
+    parser.add_argument("--max-states", type=_positive, default=100_000, metavar="N",
+                        help="markings explored per process level before giving up "
+                        "(default 100000)")
+    parser.add_argument("--process", metavar="ID", help="check only the process with this Id")
     parser.set_defaults(handler=run)
 
 
 def run(args: argparse.Namespace) -> int:
     from opspec.model.soundness import check_process
     from opspec.xpdl.loader import load_package
-    from opspec.xpdl.validate import spec_files
+    from opspec.xpdl.validate import IO_CODES, spec_files
 
     files, usage = spec_files(args.specs)
     for message in usage:
-        print(f"opspec check: {message}")
+        print(f"opspec check: {message}", file=sys.stderr)
     worst = 2 if usage else 0
     for path in files:
         result = load_package(path)
         if result.package is None or not result.ok:
-            for diagnostic in result.errors or result.diagnostics:
-                print(diagnostic)
-            worst = max(worst, 1)
+            errors = result.errors or result.diagnostics
+            _print_unloadable(path, errors, as_json=args.json)
+            worst = max(worst, 2 if any(d.code in IO_CODES for d in errors) else 1)
             continue
         package = result.package
-        reports = []
-        for process in package.processes:
-            if args.process and process.id != args.process:
-                continue
+        processes = [p for p in package.processes
+                     if args.process is None or p.id == args.process]
+        if args.process is not None and not processes:
+            names = ", ".join(p.id for p in package.processes) or "none"
+            print(f"opspec check: {path}: no process {args.process!r} (its processes: "
+                  f"{names})", file=sys.stderr)
+            worst = 2
+            continue
+        reports: list[SoundnessReport] = []
+        for process in processes:
             reports.extend(check_process(process, conformance=package.conformance_class,
                                          max_states=args.max_states))
         status = _print(path, reports, as_json=args.json, max_states=args.max_states)
@@ -60,26 +89,53 @@ def run(args: argparse.Namespace) -> int:
     return worst
 
 
-def _print(path: Path, reports: list[Any], *, as_json: bool, max_states: int) -> int:
+def _print_unloadable(path: Path, errors: Any, *, as_json: bool) -> None:
+    if as_json:
+        print(json.dumps({
+            "path": str(path), "sound": False, "loaded": False, "processes": [],
+            "problems": [],
+            "errors": [{"line": d.location.line, "severity": d.severity.value,
+                        "code": d.code, "message": d.message} for d in errors]},
+            ensure_ascii=False))
+        return
+    for diagnostic in errors:
+        print(diagnostic)
+    print(f"{path}: not checked: the spec does not load (fix the errors above; "
+          "`opspec validate` lists every problem)")
+
+
+def _print(path: Path, reports: list[SoundnessReport], *, as_json: bool,
+           max_states: int) -> int:
+    """Print one file's verdict; return its exit status (0, 1 or 2)."""
     problems = [p for r in reports for p in r.problems]
     undecided = [r for r in reports if not r.complete]
     if as_json:
         print(json.dumps({
-            "path": str(path), "sound": not problems and not undecided,
+            "path": str(path), "sound": not problems and not undecided, "loaded": True,
+            "max_states": max_states,
             "processes": [{"process": r.process, "states": r.states, "complete": r.complete,
-                           "sound": r.sound} for r in reports],
-            "problems": [{"kind": p.kind, "process": p.process, "activity": p.activity,
-                          "line": p.line, "message": p.message, "witness": list(p.witness)}
-                         for p in problems]}))
+                           "sound": r.sound, "problems": len(r.problems)} for r in reports],
+            "problems": [{"kind": p.kind, "severity": "error", "process": p.process,
+                          "activity": p.activity, "line": p.line, "message": p.message,
+                          "witness": list(p.witness)} for p in problems],
+            "errors": []}, ensure_ascii=False))
     else:
         for problem in problems:
             where = f"{path}:{problem.line}" if problem.line else str(path)
             print(f"{where}: error: {problem.process}: {problem.message}")
             if problem.witness:
-                print(f"    witness: {' -> '.join(problem.witness)}")
-        for report in undecided:
-            print(f"{path}: {report.process}: more than {max_states} states: soundness "
-                  "undecided (raise --max-states, or simplify the process)")
+                cyclic = problem.kind == "conformance" and len(problem.witness) > 1 and (
+                    problem.witness[0] == problem.witness[-1])
+                label = "cycle" if cyclic else "witness"
+                print(f"    {label}: {' -> '.join(problem.witness)}")
+        for report in reports:
+            if not report.complete:
+                print(f"{path}: warning: {report.process}: more than {max_states} states: "
+                      "soundness undecided (raise --max-states, or simplify the process)")
+        for report in reports:
+            verdict = ("sound" if report.sound else
+                       f"{len(report.problems)} problem(s)" if report.problems else "undecided")
+            print(f"{path}: {report.process}: {verdict} ({report.states} states)")
         sound = sum(1 for r in reports if r.sound)
         print(f"{path}: {sound} of {len(reports)} process level(s) sound, "
               f"{len(problems)} problem(s)")
