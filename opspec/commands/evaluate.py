@@ -131,6 +131,52 @@ def _check_plan(plan: Any) -> list[dict[str, Any]]:
     return definitions
 
 
+def _user_model_digest(plan: Any) -> str | None:
+    """SHA-256 of the user-model file (None for presets: they change with opspec itself)."""
+    from opspec.evaluation.plan import file_digest
+
+    if plan.user_model is None or not Path(plan.user_model).is_file():
+        return None
+    return file_digest(plan.user_model)
+
+
+def _store_parameters(store: Any, plan: Any, definitions: list[dict[str, Any]],
+                      version: str) -> None:
+    """The ``run`` table: the plan (what ``--resume`` re-runs) and, as separate keys for
+    readers of the database, the parameters it is made of."""
+    a = plan.design("A")
+    store.put("plan", plan.to_json())
+    store.put("metrics", definitions)
+    store.put("spec", a.spec)
+    store.put("spec_sha256", a.sha256)
+    store.put("designs", [{"label": d.label, "spec": d.spec, "sha256": d.sha256}
+                          for d in plan.designs])
+    store.put("users", plan.users)
+    store.put("days", plan.days)
+    store.put("seed", plan.seed)
+    store.put("user_model", plan.user_model)
+    store.put("user_model_sha256", _user_model_digest(plan))
+    store.put("opspec_version", version)
+    store.put("started", datetime.now(UTC).isoformat(timespec="seconds"))
+
+
+def _check_unchanged(store: Any, plan: Any) -> None:
+    """Refuse to resume when a spec or the user-model file changed since the run started:
+    the finished and the remaining users would then describe different designs."""
+    from opspec.evaluation.plan import file_digest
+
+    changed = [d.spec for d in plan.designs if file_digest(d.spec) != d.sha256]
+    stored_model = store.get("user_model_sha256")
+    if stored_model is not None and _user_model_digest(plan) != stored_model:
+        changed.append(str(plan.user_model))
+    if changed:
+        store.close()
+        raise EvaluationError(
+            f"{store.folder}: cannot resume, {', '.join(changed)} changed since the run "
+            "started", hint="restore the files as they were, or start a new run with "
+            "another --out")
+
+
 def run(args: argparse.Namespace) -> int:
     from opspec import __version__
     from opspec.evaluation.plan import EvaluationPlan
@@ -154,6 +200,7 @@ def run(args: argparse.Namespace) -> int:
                     f"{args.out} holds a run with other {', '.join(differs)}",
                     hint="resume with the same options (or none: `opspec evaluate --resume "
                     f"--out {args.out}`), or choose another --out")
+        _check_unchanged(store, plan)
         definitions = _check_plan(plan)
     else:
         plan = _new_plan(args)
@@ -163,10 +210,7 @@ def run(args: argparse.Namespace) -> int:
             raise EvaluationError(f"{out} already holds an evaluation",
                                   hint="add --resume to finish it, or choose another --out")
         store = ResultStore(out, create=True)
-        store.put("plan", plan.to_json())
-        store.put("metrics", definitions)
-        store.put("opspec_version", __version__)
-        store.put("started", datetime.now(UTC).isoformat(timespec="seconds"))
+        _store_parameters(store, plan, definitions, __version__)
     with store, contextlib.ExitStack() as stack:
         on_trace = _trace_writers(stack, store.folder, plan, resumed=args.resume)
         progress = make_progress(sys.stderr, quiet=args.quiet or args.json)
@@ -176,7 +220,13 @@ def run(args: argparse.Namespace) -> int:
         from opspec.evaluation.report import write_report
         from opspec.evaluation.summary import compare_designs, summarise_design
 
-        report = write_report(store)
+        try:
+            report = write_report(store)
+        except OSError as error:
+            raise EvaluationError(
+                f"{store.folder}: cannot write the report: {error.strerror or error}",
+                hint="the results are stored; free some space and run `opspec evaluate "
+                f"--resume --out {store.folder}` to write the report again") from None
         metrics = summarise_design(store, "A", plan.days)
         compare = None
         if len(plan.designs) > 1:

@@ -15,6 +15,7 @@ import concurrent.futures as cf
 import math
 import time
 from collections.abc import Callable, Iterator, Sequence
+from concurrent.futures import BrokenExecutor
 from contextlib import contextmanager
 from dataclasses import dataclass
 
@@ -58,7 +59,8 @@ def chunks(users: Sequence[int], workers: int) -> list[list[int]]:
 
 
 @contextmanager
-def _executor(workers: int, scheduler: str | None) -> Iterator[cf.Executor | None]:
+def _executor(workers: int, scheduler: str | None) -> Iterator[tuple[cf.Executor | None, int]]:
+    """The executor to use and how many chunks to keep in flight on it (None: in-process)."""
     if scheduler:
         try:
             from distributed import Client
@@ -72,12 +74,13 @@ def _executor(workers: int, scheduler: str | None) -> Iterator[cf.Executor | Non
                                   hint="check the address (tcp://host:8786) and that the "
                                   "scheduler is running") from None
         try:
-            yield client.get_executor()
+            threads = sum(client.nthreads().values())
+            yield client.get_executor(), max(2, 2 * threads)
         finally:
             client.close()
         return
     if workers <= 1:
-        yield None
+        yield None, 1
         return
     import multiprocessing
 
@@ -86,18 +89,76 @@ def _executor(workers: int, scheduler: str | None) -> Iterator[cf.Executor | Non
                                           else "spawn")
     pool = cf.ProcessPoolExecutor(max_workers=workers, mp_context=context)
     try:
-        yield pool
+        yield pool, 2 * workers
     finally:
         pool.shutdown(wait=True, cancel_futures=True)
+
+
+Chunk = tuple[str, list[int]]
+Keep = Callable[[list[ReplicationRecord]], None]
+
+
+def _drain(executor: cf.Executor, doc: dict[str, object], pending: Sequence[Chunk],
+           slots: int, keep: Keep) -> list[tuple[str, list[int], str]]:
+    """Run ``pending`` chunks on ``executor``, at most ``slots`` in flight, storing each chunk
+    as it returns. Returns the chunks lost because the process pool broke (a worker process
+    died), with the reason; a chunk whose task raised becomes failed replications.
+
+    Keeping only a few chunks in flight bounds the memory of results waiting to be stored
+    (traces, when exporting) whatever the number of users.
+    """
+    queue = iter(pending)
+    running: dict[cf.Future[list[ReplicationRecord]], Chunk] = {}
+    lost: list[tuple[str, list[int], str]] = []
+
+    def fill() -> None:
+        while len(running) < slots:
+            item = next(queue, None)
+            if item is None:
+                return
+            try:
+                running[executor.submit(run_users, doc, *item)] = item
+            except BrokenExecutor as error:
+                reason = _dead_worker(error)
+                lost.append((*item, reason))
+                lost.extend((label, users, reason) for label, users in queue)
+                return
+
+    fill()
+    while running:
+        finished, _ = cf.wait(running, return_when=cf.FIRST_COMPLETED)
+        for future in finished:
+            label, users = running.pop(future)
+            try:
+                records = future.result()
+            except BrokenExecutor as error:
+                lost.append((label, users, _dead_worker(error)))
+                continue
+            except Exception as error:  # noqa: BLE001 - a failed task, recorded
+                reason = f"worker failed: {type(error).__name__}: {error}"
+                records = [ReplicationRecord(label, u, "failed", error=reason) for u in users]
+            keep(records)
+            del records
+        fill()
+    return lost
+
+
+def _dead_worker(error: BaseException) -> str:
+    return f"worker failed: a worker process died ({type(error).__name__}: {error})"
 
 
 def run_evaluation(plan: EvaluationPlan, store: ResultStore, *, workers: int = 1,
                    scheduler: str | None = None, progress: Progress | None = None,
                    on_trace: TraceSink | None = None) -> RunOutcome:
-    """Run every replication of ``plan`` not yet stored as done, storing each as it ends."""
+    """Run every replication of ``plan`` not yet stored as done, storing each as it ends.
+
+    A worker process that dies (killed, out of memory) breaks its process pool and every chunk
+    in flight with it: those chunks run once more in a fresh pool, and what fails again is
+    stored as failed replications with the reason (``--resume`` runs them again).
+    """
     started = time.perf_counter()
     progress = progress or Progress()
-    pending: list[tuple[str, list[int]]] = []
+    pending: list[Chunk] = []
     skipped = 0
     for design in plan.designs:
         finished = store.finished(design.label)
@@ -123,22 +184,21 @@ def run_evaluation(plan: EvaluationPlan, store: ResultStore, *, workers: int = 1
         progress.advance(len(records))
 
     try:
-        with _executor(workers, scheduler) as executor:
+        lost: list[tuple[str, list[int], str]] = []
+        with _executor(workers, scheduler) as (executor, slots):
             if executor is None:
                 for label, users in pending:
                     keep(run_users(doc, label, users))
             else:
-                futures = {executor.submit(run_users, doc, label, users): (label, users)
-                           for label, users in pending}
-                for future in cf.as_completed(futures):
-                    label, users = futures[future]
-                    try:
-                        records = future.result()
-                    except Exception as error:  # noqa: BLE001 - a dead worker, recorded
-                        reason = f"worker failed: {type(error).__name__}: {error}"
-                        records = [ReplicationRecord(label, u, "failed", error=reason)
-                                   for u in users]
-                    keep(records)
+                lost = _drain(executor, doc, pending, slots, keep)
+        if lost and scheduler is None:
+            # one more try in a fresh pool (Dask reschedules lost tasks by itself)
+            with _executor(workers, None) as (executor, slots):
+                assert executor is not None
+                lost = _drain(executor, doc, [(label, users) for label, users, _ in lost],
+                              slots, keep)
+        for label, users, reason in lost:
+            keep([ReplicationRecord(label, u, "failed", error=reason) for u in users])
     finally:
         progress.finish()
     return RunOutcome(done, skipped, failed, time.perf_counter() - started)

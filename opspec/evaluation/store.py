@@ -5,8 +5,10 @@ killing the run at any moment loses at most the replications in flight, and ``--
 runs only what is missing or failed. The schema (a contract with the report code and with
 anyone who opens ``results.sqlite`` in another tool):
 
-- ``run(key, value)``: JSON values — ``plan`` (the EvaluationPlan), ``opspec_version``,
-  ``started``;
+- ``run(key, value)``: JSON values — ``plan`` (the EvaluationPlan, what ``--resume``
+  re-runs), ``metrics`` (the declared metrics), and for other readers the same parameters as
+  separate keys: ``spec``, ``spec_sha256``, ``designs``, ``users``, ``days``, ``seed``,
+  ``user_model``, ``user_model_sha256``, ``opspec_version``, ``started``;
 - ``replication(design, user, status, error, metrics, wall_s)``: one row per user and design,
   ``metrics`` the user's declared metrics as JSON (the ``opspec run --json`` shape);
 - ``sample(design, user, metric, value, time)``: every duration observation, ``time`` the
@@ -123,7 +125,9 @@ class ResultStore:
                                [(*key, a, *c) for a, c in record.activities.items()])
                 db.execute("COMMIT")
             except BaseException:
-                db.execute("ROLLBACK")
+                # SQLite may already have rolled back (disk full); keep the original error
+                if db.in_transaction:
+                    db.execute("ROLLBACK")
                 raise
 
         self._write(write, f"store replication {record.design}/{record.user}")

@@ -274,3 +274,116 @@ def test_summary_table_on_a_terminal_run(tmp_path, capsys):
     assert status == 0
     assert "95 % CI" in out and "taken_rate" in out and "%" in out
     assert f"report: {tmp_path / 't' / 'report.html'}" in out
+
+
+def _plan(users: int, days: float = 1):
+    from opspec.evaluation.plan import Design, EvaluationPlan, file_digest
+
+    return EvaluationPlan(designs=(Design("A", str(SPEC), file_digest(SPEC)),), users=users,
+                          days=days, seed=0, user_model=str(USERS_TOML))
+
+
+def _die_once_per_user(plan, design, users):
+    """A worker process that dies (as if killed) the first time it meets user 1."""
+    from opspec.evaluation.replication import run_users
+
+    marker = Path(os.environ["OPSPEC_TEST_MARKER"])
+    if 1 in users and not marker.exists():
+        marker.write_text("died", encoding="utf-8")
+        os._exit(9)
+    return run_users(plan, design, users)
+
+
+def test_chunks_lost_with_a_killed_worker_run_again_in_a_fresh_pool(tmp_path, monkeypatch):
+    from opspec.evaluation import runner
+    from opspec.evaluation.store import ResultStore
+
+    monkeypatch.setenv("OPSPEC_TEST_MARKER", str(tmp_path / "marker"))
+    monkeypatch.setattr(runner, "run_users", _die_once_per_user)
+    with ResultStore(tmp_path / "run", create=True) as store:
+        outcome = runner.run_evaluation(_plan(8), store, workers=2)
+        assert (tmp_path / "marker").exists(), "the worker should have died once"
+        assert outcome.failed == 0 and outcome.done == 8
+        assert store.finished("A") == set(range(8)) and store.failures() == []
+
+
+def test_a_full_disk_is_a_clear_error_and_leaves_a_sound_database(tmp_path):
+    from opspec.errors import EvaluationError
+    from opspec.evaluation.runner import run_evaluation
+    from opspec.evaluation.store import ResultStore
+
+    plan = _plan(30, days=3)
+    with ResultStore(tmp_path, create=True) as store:
+        store.put("plan", plan.to_json())
+        pages = store.query("PRAGMA page_count")[0][0]
+        # a disk with room for a few pages more than the empty database
+        store.query(f"PRAGMA max_page_count = {pages + 6}")
+        with pytest.raises(EvaluationError, match=r"cannot store replication A/\d+: "
+                           r"database or disk is full.*writable"):
+            run_evaluation(plan, store, workers=1)
+        kept = store.finished("A")
+        assert 0 < len(kept) < 30
+    with sqlite3.connect(tmp_path / "results.sqlite") as conn:
+        assert conn.execute("PRAGMA integrity_check").fetchone()[0] == "ok"
+        # every stored replication is whole: its samples are all there
+        for user, metrics in conn.execute("SELECT user, metrics FROM replication"):
+            n = json.loads(metrics)["report_latency_s"]["n"]
+            stored = conn.execute("SELECT COUNT(*) FROM sample WHERE user = ?",
+                                  (user,)).fetchone()[0]
+            assert stored == n
+    with ResultStore(tmp_path, create=False) as store:     # room again: resume finishes
+        outcome = run_evaluation(plan, store, workers=1)
+        assert outcome.skipped == len(kept) and store.finished("A") == set(range(30))
+
+
+@pytest.mark.parametrize("args, message", [
+    (["--users", "-3"], "--users must be a whole number >= 1"),
+    (["--users", "0"], "--users must be a whole number >= 1"),
+    (["--days", "-1"], "--days must be a positive number"),
+    (["--days", "nan"], "--days must be a positive number"),
+    (["--workers", "0"], "--workers must be >= 1"),
+], ids=["negative-users", "no-users", "negative-days", "nan-days", "no-workers"])
+def test_impossible_run_sizes_are_refused_before_anything_runs(args, message, evaluate,
+                                                              tmp_path):
+    out = tmp_path / "never"
+    status, doc, err = evaluate(str(SPEC), *args, "--out", str(out))
+    assert status == 2 and doc is None
+    assert message in err
+    assert not out.exists()
+
+
+def test_broken_spec_stops_with_its_location_before_anything_runs(evaluate, tmp_path):
+    broken = tmp_path / "broken.xpdl"
+    broken.write_text(SPEC.read_text(encoding="utf-8").replace("</Activities>", "", 1),
+                      encoding="utf-8")
+    out = tmp_path / "never"
+    status, doc, err = evaluate(str(broken), "--user-model", str(USERS_TOML), "--out",
+                                str(out))
+    assert status == 1 and doc is None
+    assert f"{broken}:" in err and "Traceback" not in err
+    assert not out.exists()
+
+
+def test_run_parameters_are_stored_for_other_readers(evaluate, tmp_path):
+    out = tmp_path / "run"
+    assert evaluate(str(SPEC), "--users", "2", "--days", "1", "--seed", "4", "--out",
+                    str(out))[0] == 0
+    with sqlite3.connect(out / "results.sqlite") as conn:
+        run = {k: json.loads(v) for k, v in conn.execute("SELECT key, value FROM run")}
+    assert run["spec"] == str(SPEC) and len(run["spec_sha256"]) == 64
+    assert (run["users"], run["days"], run["seed"]) == (2, 1.0, 4)
+    assert run["user_model"] == str(USERS_TOML)
+    assert [d["label"] for d in run["designs"]] == ["A"]
+    assert {"opspec_version", "started", "plan", "metrics"} <= set(run)
+
+
+def test_resume_refuses_a_spec_changed_since_the_run_started(evaluate, tmp_path):
+    spec = tmp_path / "dispenser.xpdl"
+    spec.write_text(SPEC.read_text(encoding="utf-8"), encoding="utf-8")
+    out = str(tmp_path / "run")
+    assert evaluate(str(spec), "--users", "2", "--days", "1", "--user-model",
+                    str(USERS_TOML), "--out", out)[0] == 0
+    spec.write_text(SPEC.read_text(encoding="utf-8").replace("PT300S", "PT600S"),
+                    encoding="utf-8")
+    status, _, err = evaluate("--resume", "--out", out)
+    assert status == 2 and f"{spec} changed since the run started" in err
