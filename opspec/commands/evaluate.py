@@ -265,11 +265,14 @@ def _trace_writers(stack: contextlib.ExitStack, folder: Path, plan: Any, *, resu
             n += 1
         suffix = f".resume-{n}"
     attrs = {"spec": plan.design("A").spec, "seed": str(plan.seed)}
-    writers = []
+    writers: list[XesWriter | JsonlTraceWriter] = []
     for fmt in plan.export:
         path = folder / f"traces{suffix}.{fmt}"
-        factory = XesWriter if fmt == "xes" else JsonlTraceWriter
-        writers.append(stack.enter_context(factory(path, log_attributes=attrs)))
+        writer: XesWriter | JsonlTraceWriter = (
+            XesWriter(path, log_attributes=attrs) if fmt == "xes"
+            else JsonlTraceWriter(path, log_attributes=attrs))
+        stack.enter_context(writer)
+        writers.append(writer)
 
     def write(record: Any) -> None:
         events = [TraceEvent.from_json(e) for e in record.trace]

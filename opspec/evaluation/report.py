@@ -124,7 +124,7 @@ def write_report(store: ResultStore) -> Path:
             images.append(plots.time_of_day_figure(hours, figures / f"{design}-hours.png"))
             captions.append("Count outcomes by hour of day (all users and days)")
         activity = _activity_rates(store, design)
-        activity_table = ()
+        activity_table: tuple[Table, ...] = ()
         if activity:
             images.append(plots.activity_rates_figure(activity,
                                                       figures / f"{design}-activities.png"))
@@ -145,12 +145,14 @@ def write_report(store: ResultStore) -> Path:
                 for name, d in difference.items() if d["difference"] is not None]
         rows = [(n, v, lo if lo is not None else v, hi if hi is not None else v)
                 for n, v, lo, hi in rows]
-        images = (plots.comparison_figure(rows, figures / "comparison.png"),) if rows else ()
+        compared = ((plots.comparison_figure(rows, figures / "comparison.png"),) if rows
+                    else ())
         sections.append(Section("B compared with A", paragraphs=(
             ("Differences B − A per metric on the same simulated users (paired); 'differs' "
             "marks intervals that exclude zero."),),
             tables=(Table(COMPARE_HEADERS, tuple(comparison_rows(difference))),),
-            images=images, captions=("Paired differences with 95 % CIs",) if images else ()))
+            images=compared,
+            captions=("Paired differences with 95 % CIs",) if compared else ()))
 
     if failures:
         sections.append(Section("Failed replications", paragraphs=(

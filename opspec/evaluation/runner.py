@@ -68,16 +68,17 @@ def _executor(workers: int, scheduler: str | None) -> Iterator[tuple[cf.Executor
             raise EvaluationError("--scheduler needs dask.distributed",
                                   hint="pip install 'opspec[dask]'") from None
         try:
-            client = Client(scheduler, timeout=20)
+            client = Client(scheduler, timeout=20)  # type: ignore[no-untyped-call]
         except Exception as error:  # noqa: BLE001 - any connection failure, said plainly
             raise EvaluationError(f"cannot reach the Dask scheduler at {scheduler}: {error}",
                                   hint="check the address (tcp://host:8786) and that the "
                                   "scheduler is running") from None
         try:
-            threads = sum(client.nthreads().values())
-            yield client.get_executor(), max(2, 2 * threads)
+            threads = sum(client.nthreads().values())  # type: ignore[no-untyped-call]
+            executor = client.get_executor()  # type: ignore[no-untyped-call]
+            yield executor, max(2, 2 * threads)
         finally:
-            client.close()
+            client.close()  # type: ignore[no-untyped-call]
         return
     if workers <= 1:
         yield None, 1

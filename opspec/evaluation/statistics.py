@@ -24,7 +24,7 @@ __all__ = ["Estimate", "paired_difference", "ratio_estimate", "t_quantile"]
 
 def t_quantile(level: float, df: int) -> float:
     """The two-sided Student-t quantile for confidence ``level`` (normal when df is huge)."""
-    from scipy import stats
+    from scipy import stats  # type: ignore[import-untyped]
 
     return float(stats.t.ppf(0.5 + level / 2.0, df)) if df > 0 else math.inf
 

@@ -39,7 +39,7 @@ def _ci(summary: Mapping[str, Any], unit: str = "", *, percent: bool = False) ->
 
 
 def metric_rows(metrics: Mapping[str, Mapping[str, Any]]) -> list[tuple[str, ...]]:
-    rows = []
+    rows: list[tuple[str, ...]] = []
     for name, s in metrics.items():
         kind = s["kind"]
         if kind == "count":
@@ -57,7 +57,7 @@ def metric_rows(metrics: Mapping[str, Mapping[str, Any]]) -> list[tuple[str, ...
 
 
 def comparison_rows(difference: Mapping[str, Mapping[str, Any]]) -> list[tuple[str, ...]]:
-    rows = []
+    rows: list[tuple[str, ...]] = []
     for name, d in difference.items():
         percent = is_rate(name, d)
         rows.append((name, fmt(d["a"], percent=percent), fmt(d["b"], percent=percent),
