@@ -5,8 +5,10 @@ Each problem prints as ``path:line: error: process: message`` with its witness (
 fired from the start) on the next line, then one line per process level and a summary per
 file; ``--json`` prints one JSON object per file instead (JSON Lines).
 
-Exit status: 0 every process level is sound; 1 a problem was found, or a spec has errors that
-keep it from loading; 2 usage or I/O problems (a missing path, an unreadable file, an unknown
+A spec whose reader reported errors is still checked when a package could be built (its
+conditions do not matter here); the errors are printed first and make the status 1.
+
+Exit status: 0 every process level is sound; 1 a problem was found, or a spec has errors; 2 usage or I/O problems (a missing path, an unreadable file, an unknown
 ``--process``), or a state space larger than ``--max-states`` with no problem found (the
 verdict is then undecided, never "sound"). Over several files, the highest status wins.
 """
@@ -20,6 +22,9 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 if TYPE_CHECKING:
+    from collections.abc import Sequence
+
+    from opspec.errors import Diagnostic
     from opspec.model.soundness import SoundnessReport
 
 __all__ = ["register", "run"]
@@ -66,11 +71,14 @@ def run(args: argparse.Namespace) -> int:
     worst = 2 if usage else 0
     for path in files:
         result = load_package(path)
-        if result.package is None or not result.ok:
-            errors = result.errors or result.diagnostics
-            _print_unloadable(path, errors, as_json=args.json)
-            worst = max(worst, 2 if any(d.code in IO_CODES for d in errors) else 1)
+        errors = result.errors
+        if result.package is None:
+            _print_unloadable(path, result.diagnostics, as_json=args.json)
+            io = any(d.code in IO_CODES for d in result.diagnostics)
+            worst = max(worst, 2 if io else 1)
             continue
+        # conditions are abstracted, so a spec whose errors leave its control flow readable
+        # (a condition opspec cannot parse, a duplicate lane id) is still checked
         package = result.package
         processes = [p for p in package.processes
                      if args.process is None or p.id == args.process]
@@ -84,42 +92,47 @@ def run(args: argparse.Namespace) -> int:
         for process in processes:
             reports.extend(check_process(process, conformance=package.conformance_class,
                                          max_states=args.max_states))
-        status = _print(path, reports, as_json=args.json, max_states=args.max_states)
+        status = _print(path, reports, errors, as_json=args.json, max_states=args.max_states)
         worst = max(worst, status)
     return worst
 
 
-def _print_unloadable(path: Path, errors: Any, *, as_json: bool) -> None:
+def _errors_json(errors: Sequence[Diagnostic]) -> list[dict[str, Any]]:
+    return [{"line": d.location.line, "severity": d.severity.value, "code": d.code,
+             "message": d.message} for d in errors]
+
+
+def _print_unloadable(path: Path, errors: Sequence[Diagnostic], *, as_json: bool) -> None:
     if as_json:
         print(json.dumps({
             "path": str(path), "sound": False, "loaded": False, "processes": [],
-            "problems": [],
-            "errors": [{"line": d.location.line, "severity": d.severity.value,
-                        "code": d.code, "message": d.message} for d in errors]},
-            ensure_ascii=False))
+            "problems": [], "errors": _errors_json(errors)}, ensure_ascii=False))
         return
     for diagnostic in errors:
         print(diagnostic)
-    print(f"{path}: not checked: the spec does not load (fix the errors above; "
-          "`opspec validate` lists every problem)")
+    print(f"{path}: not checked: the file could not be read as XPDL")
 
 
-def _print(path: Path, reports: list[SoundnessReport], *, as_json: bool,
-           max_states: int) -> int:
-    """Print one file's verdict; return its exit status (0, 1 or 2)."""
+def _print(path: Path, reports: list[SoundnessReport], errors: Sequence[Diagnostic], *,
+           as_json: bool, max_states: int) -> int:
+    """Print one file's verdict; return its exit status (0, 1 or 2). Load ``errors`` make
+    it 1 at least (and the file is never called sound)."""
     problems = [p for r in reports for p in r.problems]
     undecided = [r for r in reports if not r.complete]
     if as_json:
         print(json.dumps({
-            "path": str(path), "sound": not problems and not undecided, "loaded": True,
+            "path": str(path), "sound": not problems and not undecided and not errors,
+            "loaded": True,
             "max_states": max_states,
             "processes": [{"process": r.process, "states": r.states, "complete": r.complete,
                            "sound": r.sound, "problems": len(r.problems)} for r in reports],
             "problems": [{"kind": p.kind, "severity": "error", "process": p.process,
                           "activity": p.activity, "line": p.line, "message": p.message,
                           "witness": list(p.witness)} for p in problems],
-            "errors": []}, ensure_ascii=False))
+            "errors": _errors_json(errors)}, ensure_ascii=False))
     else:
+        for diagnostic in errors:
+            print(diagnostic)
         for problem in problems:
             where = f"{path}:{problem.line}" if problem.line else str(path)
             print(f"{where}: error: {problem.process}: {problem.message}")
@@ -138,7 +151,8 @@ def _print(path: Path, reports: list[SoundnessReport], *, as_json: bool,
             print(f"{path}: {report.process}: {verdict} ({report.states} states)")
         sound = sum(1 for r in reports if r.sound)
         print(f"{path}: {sound} of {len(reports)} process level(s) sound, "
-              f"{len(problems)} problem(s)")
-    if problems:
+              f"{len(problems)} problem(s)" + (f", {len(errors)} spec error(s) (see "
+                                                "`opspec validate`)" if errors else ""))
+    if problems or errors:
         return 1
     return 2 if undecided else 0

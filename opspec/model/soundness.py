@@ -17,8 +17,8 @@ problem comes with the shortest witness (the activities fired from the start):
   option to complete is lost: an endless loop with no way out);
 - **dead**: an activity that fires in no reachable marking; **and-join-never-fires**: the
   same for an AND join, saying which of its inputs ever get a token;
-- **unbounded**: more than :data:`TOKEN_BOUND` tokens on one place (the successors of such a
-  marking are not explored, so dead activities and livelocks are not reported then);
+- **unbounded**: more than :data:`TOKEN_BOUND` tokens on one place (the exploration stops
+  there, so dead activities and livelocks are not reported then);
 - **conformance**: a violation of the package's graph conformance class
   (:mod:`opspec.model.soundness_conformance`).
 
@@ -131,7 +131,8 @@ def check_level(process: str, graph: FlowGraph, starts: tuple[str, ...], *,
                         f"unbounded: tokens pile up on {net.places[over]!r} before {target!r} "
                         f"(more than {TOKEN_BOUND}): the flow creates tokens faster than it "
                         "consumes them", (*witness(state), activity_id), _line(graph, target)))
-                continue
+                queue.clear()        # one is enough: the rest of the space is unbounded too
+                break
             successors.append(nxt)
             if nxt not in parents:
                 if len(parents) >= max_states:

@@ -18,7 +18,8 @@ boundary event; moves are activity firings. The rules follow the engine
   (the engine takes the conditions that hold); **OR splits** any subset of their transitions;
   when the subset is empty, the OTHERWISE transition (no OTHERWISE: the engine aborts the
   instance, which is not a token move and is left to the validator);
-- no split and several unconditional transitions (no OTHERWISE): all of them (BPMN reading);
+- no split and several unconditional transitions (no OTHERWISE): all of them, as in the
+  engine, except out of an XOR or event-based Route (read as a choice);
 - **exceptions**: EXCEPTION/DEFAULTEXCEPTION transitions (deadlines, faults, raised
   exceptions) are an alternative way to end the activity; an interrupting boundary event is an
   alternative way to end its host, a non-interrupting one an extra token besides it;
@@ -176,9 +177,13 @@ class TokenNet:
         regular = [(p, k) for p, k in normal if k is not ConditionKind.OTHERWISE]
         otherwise = [p for p, k in normal if k is ConditionKind.OTHERWISE][:1]
         split = split_type(activity)
-        if (activity.split is None and not isinstance(activity.body, Route) and len(regular) > 1
+        exclusive_route = isinstance(activity.body, Route) and activity.body.gateway in (
+            GatewayType.XOR, GatewayType.EVENT)
+        if (activity.split is None and not exclusive_route and len(regular) > 1
                 and all(k is ConditionKind.NONE for _, k in regular) and not otherwise):
-            split = GatewayType.AND      # several unconditional flows out of a plain activity
+            # several unconditional flows and no split: all of them, as the engine does (an
+            # XOR gateway drawn without TransitionRestrictions is still read as a choice)
+            split = GatewayType.AND
         interrupting = [self.boundary_place[e] for e in self.graph.boundary.get(activity.id, ())
                         if self._interrupting(e)]
         extra = tuple(self.boundary_place[e] for e in self.graph.boundary.get(activity.id, ())
