@@ -14,6 +14,7 @@ after changing the shared shape so the three stay consistent.
 
 from __future__ import annotations
 
+import re
 from pathlib import Path
 
 SPECS = Path(__file__).resolve().parents[1] / "specs"
@@ -100,6 +101,11 @@ def process(pid: str, name: str, activities: list[str], transitions: list[str], 
     if auto_start:
         directives["AutoStart"] = "true"
     fields = f"\n  <DataFields>\n{chr(10).join(data)}\n  </DataFields>" if data else ""
+    # XPDL 2.1 wants activity ids unique in the whole package: prefix the generic ones
+    generic = ("start", "end", "merge", "drive")
+    pattern = re.compile(r'(Activity Id|From|To)="(' + "|".join(generic) + ')"')
+    activities = [pattern.sub(lambda m: f'{m[1]}="{pid}_{m[2]}"', a) for a in activities]
+    transitions = [pattern.sub(lambda m: f'{m[1]}="{pid}_{m[2]}"', t) for t in transitions]
     return (f'    <WorkflowProcess Id="{pid}" Name="{name}">\n      <ProcessHeader/>{fields}\n'
             f'      <Activities>\n{chr(10).join(activities)}\n      </Activities>\n'
             f'      <Transitions>\n{chr(10).join(transitions)}\n      </Transitions>\n'

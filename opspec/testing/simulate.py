@@ -337,6 +337,15 @@ def _script(ref: Any) -> Script:
     return parse_script(ref)
 
 
+def _world(compiled: CompiledPackage, seed: int, user: int) -> dict[str, Performer]:
+    """The simulated devices of the world the spec declares (``opspec:World``), if any."""
+    try:
+        from opspec.bindings.worlds import world_performers
+    except ImportError:
+        return {}
+    return dict(world_performers(compiled, seed=seed, user=user))
+
+
 def simulate(spec: Package | CompiledPackage | str | Path, *, users: int = 1,
              days: float | None = None, until: float | None = None,
              script: Script | Sequence[Any] | str | Path | None = None,
@@ -387,7 +396,8 @@ def simulate(spec: Package | CompiledPackage | str | Path, *, users: int = 1,
             assert plan is not None
             user = scripted = plan.performer()
             listeners.append(scripted)
-        bindings: dict[str, Performer] = {name: user for name in names.user_performers}
+        bindings: dict[str, Performer] = _world(compiled, seed, u)
+        bindings.update({name: user for name in names.user_performers})
         bindings.update(performers or {})
         sim = Simulation(compiled, config, performers=bindings, seed=seed, scope=(u,),
                          listeners=listeners, keep_trace=keep, params=params)

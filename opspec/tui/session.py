@@ -291,8 +291,10 @@ class WalkSession:
             self.participants[event.participant] = (
                 f"{event.activity} at {clock(event.time)[3:]}")
         if kind in ("fault", "device.note"):
-            who = str((event.data or {}).get("participant") or "device")
-            self.participants[who] = "FAULT: " + str((event.data or {}).get("message", ""))
+            data = event.data or {}
+            who = str(data.get("participant") or data.get("device") or "device")
+            prefix = "FAULT: " if kind == "fault" else "note: "
+            self.participants[who] = prefix + str(data.get("message", ""))
         if kind == "process.started" and event.lane == "user":
             self.calling = True
         if kind == "process.completed" and event.lane == "user":

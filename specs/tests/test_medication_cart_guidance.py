@@ -1,0 +1,22 @@
+"""Executable tests of specs/medication_cart_guidance.xpdl: the cart drives down the ward and
+identifies the patient by RFID tag and wristband bar code."""
+
+from __future__ import annotations
+
+from typing import Any
+
+from opspec.testing import assert_mean, check, happens_before
+
+SPEC = "../medication_cart_guidance.xpdl"
+
+
+def test_the_patient_is_confirmed_only_after_tag_and_bar_code(spec: Any,
+                                                              simulate: Any) -> None:
+    result = simulate(spec, until=900.0)
+    check(result, happens_before("activity:scan", "activity:confirm"), spec=spec)
+
+
+def test_carts_find_the_patient_within_five_minutes_on_average(spec: Any,
+                                                               simulate: Any) -> None:
+    result = simulate(spec, users=6, until=1200.0)
+    assert_mean(result, "time_to_find_s", at_most=300.0, confidence=0.95)

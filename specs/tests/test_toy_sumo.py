@@ -1,0 +1,20 @@
+"""Executable tests of specs/toy_sumo.xpdl: the move-back-and-hit manoeuvre wins bouts."""
+
+from __future__ import annotations
+
+from typing import Any
+
+from opspec.testing import assert_mean, check, count
+
+SPEC = "../toy_sumo.xpdl"
+TEN_MINUTES = 600.0
+
+
+def test_contact_is_answered_by_moving_back_then_hitting(spec: Any, simulate: Any) -> None:
+    result = simulate(spec, until=120.0)
+    check(result, count("activity:move_back") >= 1, count("activity:hit") >= 1, spec=spec)
+
+
+def test_the_sumo_wins_a_fair_share_of_its_bouts(spec: Any, simulate: Any) -> None:
+    result = simulate(spec, users=6, until=TEN_MINUTES)
+    assert_mean(result, "bouts_won", at_least=1.0, confidence=0.95)
