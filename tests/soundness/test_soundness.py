@@ -152,40 +152,160 @@ def test_full_blocked_wants_every_split_closed_by_a_join_of_its_kind():
 
 # ----------------------------------------------------------------------------- corpus
 
-# Each corpus file's verdict and why. "unloadable" files are rejected by the reader (the
-# check reports their errors and exits 1).
-CORPUS_VERDICTS = {
-    "jawe10__LoopBlocked.xpdl": (
-        ["conformance"], ("declares LOOP_BLOCKED but Act4 -> Act3 -> Act5 -> Act4 is a cycle "
-        "(JaWE files it under 'Invalid')")),
-    "jawe21__Business_Example.xpdl": (
-        ["improper-completion"], ("the AND-join Act13 waits for Act11 and Act101, which lie on "
-        "different branches of an exclusive split: only correlated data could make both come")),
-    "g360__Subprocess4_with_exception.xpdl": (
-        ["dead"], ("the block's activity set starts at '232' (StartActivityId), and the "
-        "transitions 235 -> 438 -> 233 that would lead through Task E are written in the "
-        "wrong process (validate reports them), so Task E '438' has no way in")),
-    "bonita__testManagementAPIWithParsingError.xpdl": ("unloadable", "not well-formed XML"),
-    "bpmve__PackageBasic.xpdl": ("unloadable", "its ExternalPackage file is not in the corpus"),
-    "tibco-af__Fallstudie_4-09_e-Car_Produktion.xpdl": (
-        "unloadable", "transitions reference activities that do not exist"),
+SOUND = "sound"
+UNREADABLE = "unreadable"
+
+# Every corpus file, its verdict and why. A verdict is SOUND, UNREADABLE (not XPDL at all:
+# exit 1, nothing checked) or the sorted problem kinds found; ``errors`` marks files whose
+# reader errors make the status 1 although their control flow is checked.
+CORPUS_VERDICTS: dict[str, tuple[str | list[str], bool, str]] = {
+    "bizagi21__Test_multiple_workflow_processes.xpdl": (SOUND, False,
+        "an empty pool process and two straight start -> task -> end sequences"),
+    "bizagi22__Diagram_1.xpdl": (SOUND, False,
+        ("two processes whose parallel (AND route) branches each run to their own end: "
+        "implicit termination, no join to wait at")),
+    "bizagi22__diagram1.xpdl": (SOUND, False,
+        ("a task with two unconditional flows runs both branches (no split declared), each "
+        "branch ends on its own")),
+    "bizagi22__diagram3.xpdl": (SOUND, False,
+        ("a long sequence with one exclusive gateway whose two paths each reach their own "
+        "end")),
+    "bonita-bull__splits_joins_complex.xpdl": (SOUND, False,
+        ("two AND splits closed by three AND joins: every join gets a token from each of its "
+        "branches in every run (50 markings)")),
+    "bonita-nova__suspendResume.xpdl": (SOUND, False, "a three-activity sequence"),
+    "bonita-simprocess__Example6.xpdl": (SOUND, False,
+        "a subflow call (one move) and a process whose XOR split is closed by an XOR join"),
+    "bonita__ApprovalWorkflow.xpdl": (SOUND, False,
+        ("Approval's conditions lead to Reject or Accept, both to the XOR-joined end; its AND "
+        "joins have one incoming transition each, so they never wait")),
+    "bonita__Habilitation.xpdl": (SOUND, False, "a five-activity sequence"),
+    "bonita__InputOutputConnector.xpdl": (SOUND, False, "a three-activity sequence"),
+    "bonita__activityHook-v4.xpdl": (SOUND, False, "a three-activity sequence"),
+    "bonita__arbitraryCycle.xpdl": (SOUND, False,
+        ("two interleaved loops (a1..a4 and a2..a6) left by conditions on a2 and a6; the AND "
+        "joins have one incoming transition each, so they never wait")),
+    "bonita__carpool.xpdl": (SOUND, False,
+        ("WaitRequest and WaitAnswer choose by condition between going on, cancelling and a "
+        "deadline activity that loops back; a way out always remains (no livelock)")),
+    "bonita__mainSubflowJoinXor.xpdl": (SOUND, False,
+        ("the start runs two subflows in parallel (two unconditional flows) and an XOR join "
+        "lets each token through to the end: no token is stuck")),
+    "bonita__subflowParams-sub.xpdl": (SOUND, False, "a three-activity sequence"),
+    "bonita__subflowParams.xpdl": (SOUND, False, "a subflow call between start and end"),
+    "bonita__testManagementAPIWithParsingError.xpdl": (UNREADABLE, True,
+        "not well-formed XML (a mismatched tag at line 28): nothing to check"),
+    "bpmve__PackageBasic.xpdl": (SOUND, True,
+        ("a template with placeholder ids: duplicate lane ids and a missing ExternalPackage are "
+        "reader errors (status 1), but its processes are empty and therefore sound")),
+    "bpmxpdl20__sample.xpdl": (SOUND, False,
+        ("the order process's XOR splits all end at the rejection or acceptance path, its AND "
+        "split 30 is closed by the AND join 31; Fill Order's AND split with two conditions "
+        "runs to two ends")),
+    "g360__Subprocess.xpdl": (SOUND, False,
+        ("an embedded subprocess (a BlockActivity, its activity set checked on its own) "
+        "beside a task; 'NON-BLOCKED' is no conformance class, so nothing is restricted")),
+    "g360__Subprocess4_with_exception.xpdl": (["dead"], False,
+        ("the block's activity set starts at '232' (StartActivityId), and the transitions "
+        "235 -> 438 -> 233 that would lead through Task E are written in the wrong process "
+        "(validate reports them), so Task E '438' has no way in")),
+    "g360__Three_tasks_and_event_gateway.xpdl": (SOUND, False,
+        ("an exclusive gateway before a message and a timer event: either is taken, both "
+        "branches reach the end")),
+    "g360__complex.xpdl": (SOUND, False,
+        ("an AND split whose branches meet at a4 without a join: a4 and the rest run twice "
+        "(a multi-merge), which completes properly under implicit termination")),
+    "g360__dfs.xpdl": (SOUND, False,
+        "AND splits into branches that end separately, one of them an embedded subprocess"),
+    "jawe10__LoopBlocked.xpdl": (["conformance"], False,
+        ("declares LOOP_BLOCKED but Act4 -> Act3 -> Act5 -> Act4 is a cycle (JaWE files it "
+        "under 'Invalid'); its second process has no cycle")),
+    "jawe10__document_approval.xpdl": (SOUND, False,
+        ("review loops go back to Update Document and leave by Publish Document; the review's "
+        "EXCEPTION path rejoins through an XOR join")),
+    "jawe10__leave_request.xpdl": (SOUND, False,
+        "five XOR splits and two EXCEPTION paths, all reaching an end; no AND join"),
+    "jawe10__sample_workflow_process.xpdl": (SOUND, False,
+        ("XOR splits closed by XOR joins, the AND split closed by an AND join on parallel "
+        "branches, and an EXCEPTION path to its own end")),
+    "jawe10__workflow_patterns.xpdl": (SOUND, False,
+        ("the 15 WfMC pattern processes: Multiple Choice and Multiple Merge use AND splits "
+        "with conditions (any subset of branches), Discriminator and N-out-of-M merge them "
+        "with XOR joins (tokens run on, 504 markings), Synchronization closes AND with AND")),
+    "jawe21__Application_Repository.xpdl": (SOUND, False, "a repository: no process"),
+    "jawe21__Business_Example.xpdl": (["improper-completion"], False,
+        ("the AND-join Act13 waits for Act11 and Act101, which lie on different branches of an "
+        "exclusive split: only correlated data could make both come")),
+    "jawe21__Participant_Repository.xpdl": (SOUND, False, "a repository: no process"),
+    "jawe21__Process_Repository.xpdl": (SOUND, False, "two three-activity sequences"),
+    "jawe21__leave_request.xpdl": (SOUND, False,
+        "as the XPDL 1.0 leave request: XOR splits and EXCEPTION paths, all reaching an end"),
+    "jawe21__nested_lanes.xpdl": (SOUND, False,
+        "one AND split whose branches end separately"),
+    "tibco-af__Fallstudie_4-09_e-Car_Produktion.xpdl": (["improper-completion"], True,
+        ("its conditions are German prose (reader errors, status 1), but its control flow is "
+        "checked: 'Individualteile benötigt' is decided twice by separate XOR splits, and "
+        "when they disagree the AND joins waiting for 'Individualteile erhalten' keep a "
+        "token: sound only if the data correlates")),
+    "tibco-af__Test_loop_2.xpdl": (SOUND, False,
+        "two nested loops built from XOR gateways, each with an OTHERWISE way out"),
+    "tibco-af__Test_multiple_pools_processes_and_lanes.xpdl": (SOUND, False,
+        ("two start events in one process (both run), an AND split closed by an AND join; "
+        "the second process's XOR split is closed by an XOR join")),
+    "tibco__InsuranceClaimHandling.xpdl": (SOUND, False,
+        ("XOR gateways with OTHERWISE paths meet at one XOR join; the AND split for advice "
+        "and payment is closed by an AND join")),
+    "tibcofrg___GM0bEEeyEd-eq-1NLZ2xQg.frg.xpdl": (SOUND, False,
+        ("an embedded subprocess (a transaction) whose XOR split leads to End (OTHERWISE) or "
+        "Abort")),
+    "tibcofrg___GPkNEEeyEd-eq-1NLZ2xQg.frg.xpdl": (SOUND, False,
+        ("a subflow call with three boundary events (cancel, error, timeout), each leading "
+        "to its handler task: any of them may interrupt the call, every path ends")),
+    "tibcofrg___GPn3cEeyEd-eq-1NLZ2xQg__es_AR.frg.xpdl": (SOUND, False,
+        "a plain sequence of five activities"),
+    "tibcofrg___GQAR8EeyEd-eq-1NLZ2xQg.frg.xpdl": (SOUND, False,
+        "two sequences, one around a subflow call"),
+    "wfmc__deadline.xpdl": (SOUND, False,
+        ("Step 1's deadline takes the DEFAULTEXCEPTION path instead of Step 2; both meet at "
+        "Step 3's XOR join")),
+    "wfmc__publication-1.0.xpdl": (SOUND, False,
+        "a review loop left by an XOR split, and an AND split closed by an AND join"),
+    "wfmc__subflow.xpdl": (SOUND, False, ("main flow, subflow and inner flow: sequences of "
+        "subflow calls (one move each)")),
 }
 CORPUS_FILES = sorted(p.name for p in CORPUS.glob("*.xpdl")) if CORPUS.is_dir() else []
+
+
+@pytest.mark.skipif(not CORPUS_FILES, reason="shared corpus not present")
+def test_every_corpus_file_has_a_verdict_with_a_reason():
+    assert sorted(CORPUS_VERDICTS) == CORPUS_FILES
+    assert all(len(why) > 10 for _verdict, _errors, why in CORPUS_VERDICTS.values())
 
 
 @pytest.mark.skipif(not CORPUS_FILES, reason="shared corpus not present")
 @pytest.mark.parametrize("name", CORPUS_FILES)
 def test_corpus_file_verdict(name, capsys):
     status = main(["check", "--json", "--max-states", "20000", str(CORPUS / name)])
-    out = capsys.readouterr().out
-    expected, _why = CORPUS_VERDICTS.get(name, ([], "sound: every process completes properly"))
-    if expected == "unloadable":
-        assert status == 1
+    doc = json.loads(capsys.readouterr().out.splitlines()[-1])
+    expected, errors, why = CORPUS_VERDICTS[name]
+    assert bool(doc["errors"]) is errors, why
+    if expected == UNREADABLE:
+        assert status == 1 and doc["loaded"] is False, why
         return
-    doc = json.loads(out.splitlines()[-1])
-    assert sorted({p["kind"] for p in doc["problems"]}) == expected
-    assert status == (1 if expected else 0)
-    assert doc["sound"] is (not expected)
+    kinds_found = sorted({p["kind"] for p in doc["problems"]})
+    assert kinds_found == ([] if expected == SOUND else expected), why
+    assert all(process["complete"] for process in doc["processes"]), why
+    assert status == (0 if expected == SOUND and not errors else 1), why
+    assert doc["sound"] is (expected == SOUND and not errors), why
+
+
+@pytest.mark.skipif(not CORPUS_FILES, reason="shared corpus not present")
+def test_loop_blocked_corpus_file_names_its_cycle(capsys):
+    assert main(["check", str(CORPUS / "jawe10__LoopBlocked.xpdl")]) == 1
+    out = capsys.readouterr().out
+    assert "jawe10__LoopBlocked.xpdl:" in out and "LOOP_BLOCKED" in out
+    assert ("cycle: LOOP_BLOCKED_Test_Wor1_Act4 -> LOOP_BLOCKED_Test_Wor1_Act3 -> "
+            "LOOP_BLOCKED_Test_Wor1_Act5 -> LOOP_BLOCKED_Test_Wor1_Act4") in out
 
 
 @pytest.mark.parametrize("spec", sorted((ROOT / "specs").glob("*.xpdl")),
