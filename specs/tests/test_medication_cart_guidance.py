@@ -12,11 +12,11 @@ SPEC = "../medication_cart_guidance.xpdl"
 
 def test_the_patient_is_confirmed_only_after_tag_and_bar_code(spec: Any,
                                                               simulate: Any) -> None:
-    result = simulate(spec, until=900.0)
+    result = simulate(spec, until=300.0)
     check(result, happens_before("activity:scan", "activity:confirm"), spec=spec)
 
 
 def test_carts_find_the_patient_within_five_minutes_on_average(spec: Any,
                                                                simulate: Any) -> None:
-    result = simulate(spec, users=6, until=1200.0)
+    result = simulate(spec, users=4, until=400.0, keep_trace=False)
     assert_mean(result, "time_to_find_s", at_most=300.0, confidence=0.95)
