@@ -194,12 +194,34 @@ def _livelock(process: str, graph: FlowGraph, net: TokenNet,
     state = next((s for s in parents if s not in settled), None)   # BFS order: shortest
     if state is None:
         return []
+    # every successor of a lost state is lost too: walk on until a state repeats, so the
+    # witness shows the loop the tokens are caught in
+    walk: list[str] = []
+    loop: list[str] = []
+    seen = {state: 0}
+    node = state
+    while edges.get(node):
+        nxt = edges[node][0]
+        walk.append(_fired_between(net, node, nxt))
+        if nxt in seen:
+            loop = walk[seen[nxt]:]
+            break
+        seen[nxt] = len(walk)
+        node = nxt
     active = _holders(net, state[0])
     where = active[0] if active else None
+    names = ", ".join(dict.fromkeys(loop)) or ", ".join(active)
     return [Problem(
         "livelock", process, where,
         "livelock: from here the process can never complete, it loops for ever through "
-        f"{', '.join(active)} (give the loop a way out)", witness(state), _line(graph, where))]
+        f"{names} (give the loop a way out)", (*witness(state), *walk),
+        _line(graph, where))]
+
+
+def _fired_between(net: TokenNet, before: State, after: State) -> str:
+    """The activity whose firing turns ``before`` into ``after``."""
+    return next(activity for activity, marking, _ in net.firings(before[0])
+                if marking == after[0])
 
 
 def _dead(process: str, graph: FlowGraph, net: TokenNet, fired: set[str],

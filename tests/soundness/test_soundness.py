@@ -10,9 +10,10 @@ from pathlib import Path
 import pytest
 
 from opspec.cli import main
-from opspec.model import GatewayType, Route
-from opspec.model.activities import Join, Split
-from opspec.model.soundness import check_process
+from opspec.model import ConditionKind, Event, EventPosition, GatewayType, Route
+from opspec.model.activities import BlockActivity, Join, Split, Trigger, TriggerKind
+from opspec.model.process import ActivitySet
+from opspec.model.soundness import TOKEN_BOUND, check_process
 
 ROOT = Path(__file__).resolve().parents[2]
 sys.path.insert(0, str(ROOT / "tests" / "validate"))
@@ -332,3 +333,213 @@ def test_cli_state_space_exceeded_exits_2(capsys):
 
 def test_cli_missing_file_is_a_usage_error(capsys):
     assert main(["check", "/nonexistent/spec.xpdl"]) == 2
+
+
+# ------------------------------------------------------------------ engine rules in the game
+
+COND = {"kind": ConditionKind.CONDITION, "text": "x > 1"}
+
+
+def fork_join(split: GatewayType, join: GatewayType, *, conditional: bool = False,
+              otherwise_to: str | None = None):
+    """start -> S(split) -> a, b -> J(join) -> end, optionally with conditions on S's flows
+    and an OTHERWISE transition from S."""
+    extra = (tr("tw", "S", otherwise_to, kind=ConditionKind.OTHERWISE),) if otherwise_to else ()
+    other = (end("other", 16),) if otherwise_to else ()
+    flow = COND if conditional else {}
+    return process(activities=(
+        start(), act("S", 11, split=Split(type=split)), act("a", 12), act("b", 13),
+        gateway("J", 14, join=join), end(line=15), *other), transitions=(
+        tr("t0", "start", "S"), tr("ta", "S", "a", **flow), tr("tb", "S", "b", **flow),
+        *extra, tr("ja", "a", "J"), tr("jb", "b", "J"), tr("te", "J", "end")))
+
+
+def test_and_split_with_conditions_may_take_any_subset_so_an_and_join_can_deadlock():
+    # JaWE writes a multiple choice as an AND split with conditions; the engine takes the
+    # conditions that hold, so one branch alone may run
+    found = problems(fork_join(GatewayType.AND, GatewayType.AND, conditional=True,
+                               otherwise_to="other"))
+    deadlock = next(p for p in found if p.kind == "deadlock")
+    assert deadlock.activity == "J" and deadlock.witness[:2] == ("start", "S")
+
+
+def test_and_split_takes_otherwise_only_when_no_condition_holds():
+    proc = fork_join(GatewayType.AND, GatewayType.OR, conditional=True, otherwise_to="other")
+    assert problems(proc) == []         # 'other' is reachable: no dead activity
+    proc = fork_join(GatewayType.AND, GatewayType.AND, otherwise_to="other")
+    assert [p.activity for p in problems(proc) if p.kind == "dead"] == ["other"]
+
+
+def test_or_split_closed_by_or_join_is_sound_but_by_and_join_deadlocks():
+    assert problems(fork_join(GatewayType.OR, GatewayType.OR)) == []
+    assert "deadlock" in kinds(fork_join(GatewayType.OR, GatewayType.AND))
+
+
+def test_complex_join_waits_like_an_and_join():
+    assert "deadlock" in kinds(fork_join(GatewayType.XOR, GatewayType.COMPLEX))
+    assert problems(fork_join(GatewayType.AND, GatewayType.COMPLEX)) == []
+
+
+def test_terminate_end_event_removes_the_tokens_left_behind():
+    def build(result: str | None):
+        return process(activities=(
+            start(), act("S", 11, split=Split(type=GatewayType.AND)), act("a", 12),
+            gateway("w", 13, join=GatewayType.AND), act("never", 14),
+            act("stop", 15, body=Event(position=EventPosition.END, result=result))),
+            transitions=(tr("t0", "start", "S"), tr("t1", "S", "a"), tr("t2", "S", "w"),
+                         tr("t3", "never", "w"), tr("t4", "w", "never"),
+                         tr("t5", "a", "stop")))
+    assert "improper-completion" in kinds(build(None))
+    assert "improper-completion" not in kinds(build("Terminate"))
+
+
+def test_interrupting_boundary_event_replaces_its_host_and_non_interrupting_adds_a_token():
+    def build(interrupting: bool):
+        timer = Event(position=EventPosition.INTERMEDIATE,
+                      trigger=Trigger(kind=TriggerKind.TIMER, attached_to="h",
+                                      interrupting=interrupting))
+        return process(activities=(
+            start(), act("h", 11), act("e", 12, body=timer), act("after", 13),
+            act("handler", 14), gateway("J", 15, join=GatewayType.AND), end(line=16),
+            end("end2", 17)), transitions=(
+            tr("t0", "start", "h"), tr("t1", "h", "after"), tr("t2", "e", "handler"),
+            tr("t3", "after", "J"), tr("t4", "handler", "J"), tr("t5", "J", "end")))
+    assert "and-join-never-fires" in kinds(build(True))
+    assert "and-join-never-fires" not in kinds(build(False))
+
+
+def test_activity_set_starts_where_its_block_activity_says():
+    inner = ActivitySet(id="set", activities=(act("first", 21), act("second", 22)))
+    proc = process(activities=(
+        start(), act("blk", 11, body=BlockActivity(activity_set="set", start_activity="first")),
+        end()), transitions=(tr("t0", "start", "blk"), tr("t1", "blk", "end")),
+        activity_sets=(inner,))
+    found = problems(proc)
+    assert [(p.process, p.kind, p.activity, p.line) for p in found] == [
+        ("Pump/set", "dead", "second", 22)]
+
+
+def test_livelock_witness_leads_into_the_loop():
+    proc = process(activities=(start(), act("a", 11), act("b", 12)),
+                   transitions=(tr("t0", "start", "a"), tr("t1", "a", "b"),
+                                tr("t2", "b", "a")))
+    livelock = next(p for p in problems(proc) if p.kind == "livelock")
+    # from the start on, completion is impossible: the witness runs once round the loop
+    assert livelock.witness == ("start", "a", "b", "a")
+    assert livelock.activity == "start" and "never complete" in livelock.message
+    assert "through b, a" in livelock.message
+    assert [p.kind for p in problems(proc)] == ["livelock"]
+
+
+def test_unbounded_witness_ends_where_the_bound_is_passed():
+    proc = process(activities=(start(), gateway("S", 11, split=GatewayType.AND),
+                               act("a", 12), end(line=13)),
+                   transitions=(tr("t0", "start", "S"), tr("t1", "S", "S"),
+                                tr("t2", "S", "a"), tr("t3", "a", "end")))
+    unbounded = next(p for p in problems(proc) if p.kind == "unbounded")
+    assert unbounded.witness[0] == "start" and set(unbounded.witness[1:]) <= {"S", "a", "end"}
+    assert f"more than {TOKEN_BOUND}" in unbounded.message
+
+
+# ---------------------------------------------------------------------- FULL_BLOCKED blocks
+
+def test_full_blocked_accepts_a_proper_block():
+    proc = fork_join(GatewayType.AND, GatewayType.AND)
+    assert problems(proc, conformance="FULL_BLOCKED") == []
+
+
+def test_full_blocked_reports_branches_that_never_meet():
+    proc = process(activities=(start(), gateway("S", 11, split=GatewayType.AND),
+                               end("e1", 12), end("e2", 13)),
+                   transitions=(tr("t0", "start", "S"), tr("t1", "S", "e1"),
+                                tr("t2", "S", "e2")))
+    found = problems(proc, conformance="FULL_BLOCKED")
+    assert [(p.kind, p.activity) for p in found] == [("conformance", "S")]
+    assert "never meet" in found[0].message
+    assert problems(proc, conformance="LOOP_BLOCKED") == []
+
+
+def test_full_blocked_reports_a_block_entered_from_outside():
+    proc = process(activities=(
+        start(), gateway("X", 11, split=GatewayType.XOR), gateway("S", 12,
+                                                                  split=GatewayType.AND),
+        act("a", 13), act("b", 14), gateway("J", 15, join=GatewayType.AND),
+        gateway("M", 16, join=GatewayType.XOR), end(line=17)), transitions=(
+        tr("t0", "start", "X"), tr("t1", "X", "S"), tr("t2", "X", "b"), tr("t3", "S", "a"),
+        tr("t4", "S", "b"), tr("t5", "a", "J"), tr("t6", "b", "J"), tr("t7", "J", "M"),
+        tr("t8", "M", "end")))
+    messages = [p.message for p in problems(proc, conformance="FULL_BLOCKED")
+                if p.kind == "conformance"]
+    assert any("entered from outside, by 'X' -> 'b'" in m for m in messages)
+
+
+# ------------------------------------------------------------------------------------ CLI
+
+def test_cli_json_has_one_object_per_file_with_processes_problems_and_witnesses(capsys):
+    data = ROOT / "tests" / "validate" / "data" / "and_join_deadlock.xpdl"
+    spec = ROOT / "specs" / "medication_dispenser.xpdl"
+    assert main(["check", "--json", str(data), str(spec)]) == 1
+    docs = [json.loads(line) for line in capsys.readouterr().out.splitlines()]
+    assert [d["path"] for d in docs] == [str(data), str(spec)]
+    bad, good = docs
+    assert set(bad) == {"path", "sound", "loaded", "max_states", "processes", "problems",
+                        "errors"}
+    assert bad["sound"] is False and good["sound"] is True and good["problems"] == []
+    deadlock = next(p for p in bad["problems"] if p["kind"] == "deadlock")
+    assert set(deadlock) == {"kind", "severity", "process", "activity", "line", "message",
+                             "witness"}
+    assert deadlock["witness"][:2] == ["start", "X"] and deadlock["line"] == 21
+    assert {p["process"] for p in good["processes"]} >= {"notify_workflow", "user_workflow"}
+    assert all(p["complete"] and p["sound"] for p in good["processes"])
+
+
+def test_cli_prints_a_verdict_per_process_level(capsys):
+    spec = ROOT / "specs" / "medication_dispenser.xpdl"
+    assert main(["check", "--process", "notify_workflow", str(spec)]) == 0
+    lines = capsys.readouterr().out.splitlines()
+    assert lines[0].startswith(f"{spec}: notify_workflow: sound (")
+    assert lines[-1] == f"{spec}: 1 of 1 process level(s) sound, 0 problem(s)"
+
+
+def test_cli_unknown_process_is_a_usage_error_listing_the_processes(capsys):
+    spec = ROOT / "specs" / "medication_dispenser.xpdl"
+    assert main(["check", "--process", "nope", str(spec)]) == 2
+    err = capsys.readouterr().err
+    assert "no process 'nope'" in err and "notify_workflow" in err
+
+
+def test_cli_rejects_a_max_states_below_one(capsys):
+    with pytest.raises(SystemExit) as exit_info:
+        main(["check", "--max-states", "0", str(ROOT / "specs" / "medication_dispenser.xpdl")])
+    assert exit_info.value.code == 2
+    assert "--max-states: 0 must be at least 1" in capsys.readouterr().err
+
+
+def test_cli_state_space_message_names_the_level_and_the_limit(capsys):
+    spec = ROOT / "specs" / "medication_dispenser.xpdl"
+    assert main(["check", "--json", "--max-states", "3", str(spec)]) == 2
+    doc = json.loads(capsys.readouterr().out)
+    assert doc["sound"] is False and doc["max_states"] == 3
+    assert any(not p["complete"] for p in doc["processes"])
+    assert main(["check", "--max-states", "3", str(spec)]) == 2
+    out = capsys.readouterr().out
+    assert "warning: notify_workflow: more than 3 states: soundness undecided" in out
+
+
+def test_cli_checks_the_control_flow_of_a_spec_with_reader_errors(tmp_path, capsys):
+    text = (ROOT / "tests" / "validate" / "data" / "and_join_deadlock.xpdl").read_text(
+        encoding="utf-8")
+    assert "<Transition " in text
+    spec = tmp_path / "broken.xpdl"
+    spec.write_text(text.replace("<Transition ", "<Transition Bogus=\"1\" ", 1)
+                    .replace("</Package>", "</Package>\n"), encoding="utf-8")
+    assert main(["check", str(spec)]) == 1
+    assert "deadlock" in capsys.readouterr().out
+
+
+def test_cli_unreadable_xml_is_reported_not_checked(tmp_path, capsys):
+    spec = tmp_path / "bad.xpdl"
+    spec.write_text("<Package><oops></Package>", encoding="utf-8")
+    assert main(["check", str(spec)]) == 1
+    out = capsys.readouterr().out
+    assert f"{spec}:1: error: not well-formed XML" in out and "not checked" in out
