@@ -387,3 +387,16 @@ def test_resume_refuses_a_spec_changed_since_the_run_started(evaluate, tmp_path)
                     encoding="utf-8")
     status, _, err = evaluate("--resume", "--out", out)
     assert status == 2 and f"{spec} changed since the run started" in err
+
+
+def test_specs_with_a_simulated_world_give_each_user_their_own_world(evaluate, tmp_path):
+    """The vacuum cleaner's room comes from bindings.worlds, one per user from (seed, u):
+    users differ, and the results do not depend on the number of workers."""
+    spec = SPEC.parent / "vacuum_cleaner.xpdl"
+    args = [str(spec), "--users", "3", "--days", "0.003", "--seed", "2"]
+    status, one, err = evaluate(*args, "--workers", "1", "--out", str(tmp_path / "w1"))
+    assert status == 0, err
+    _, two, _ = evaluate(*args, "--workers", "2", "--out", str(tmp_path / "w2"))
+    assert metrics_of(one) == metrics_of(two)
+    covered = one["metrics"]["cells_covered"]
+    assert covered["total"] > 0 and covered["sd"] > 0
