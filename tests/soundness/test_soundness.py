@@ -529,12 +529,14 @@ def test_cli_state_space_message_names_the_level_and_the_limit(capsys):
 def test_cli_checks_the_control_flow_of_a_spec_with_reader_errors(tmp_path, capsys):
     text = (ROOT / "tests" / "validate" / "data" / "and_join_deadlock.xpdl").read_text(
         encoding="utf-8")
-    assert "<Transition " in text
-    spec = tmp_path / "broken.xpdl"
-    spec.write_text(text.replace("<Transition ", "<Transition Bogus=\"1\" ", 1)
-                    .replace("</Package>", "</Package>\n"), encoding="utf-8")
-    assert main(["check", str(spec)]) == 1
-    assert "deadlock" in capsys.readouterr().out
+    spec = tmp_path / "prose.xpdl"
+    spec.write_text(text.replace("<Expression>n &gt; 0</Expression>",
+                                 "<Expression>parts needed</Expression>"), encoding="utf-8")
+    assert main(["check", "--json", str(spec)]) == 1
+    doc = json.loads(capsys.readouterr().out)
+    assert [e["code"] for e in doc["errors"]] == ["bad-condition"]
+    assert "deadlock" in {p["kind"] for p in doc["problems"]}
+    assert doc["loaded"] is True and doc["sound"] is False
 
 
 def test_cli_unreadable_xml_is_reported_not_checked(tmp_path, capsys):
