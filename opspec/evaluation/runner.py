@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import concurrent.futures as cf
 import math
+import os
 import time
 from collections.abc import Callable, Iterator, Sequence
 from concurrent.futures import BrokenExecutor
@@ -86,13 +87,30 @@ def _executor(workers: int, scheduler: str | None) -> Iterator[tuple[cf.Executor
     import multiprocessing
 
     # fork keeps start-up cheap; each worker loads the spec once (replication.prepare)
-    context = multiprocessing.get_context("fork" if hasattr(__import__("os"), "fork")
+    context = multiprocessing.get_context("fork" if hasattr(os, "fork")
                                           else "spawn")
-    pool = cf.ProcessPoolExecutor(max_workers=workers, mp_context=context)
+    pool = cf.ProcessPoolExecutor(max_workers=workers, mp_context=context,
+                                  initializer=_exit_with_parent, initargs=(os.getpid(),))
     try:
         yield pool, 2 * workers
     finally:
         pool.shutdown(wait=True, cancel_futures=True)
+
+
+def _exit_with_parent(parent: int) -> None:
+    """Pool worker initializer: end this worker when the evaluation process is gone.
+
+    A killed evaluation (``kill -9``, out of memory) cannot shut its pool down, and workers
+    blocked on their task queue would otherwise live on as orphans, holding CPU and memory.
+    """
+    import threading
+
+    def watch() -> None:
+        while os.getppid() == parent:
+            time.sleep(1.0)
+        os._exit(1)
+
+    threading.Thread(target=watch, name="opspec-parent-watch", daemon=True).start()
 
 
 Chunk = tuple[str, list[int]]

@@ -122,7 +122,7 @@ def test_a_longer_deadline_misses_fewer_doses_on_the_same_users(evaluate, tmp_pa
 def test_interrupted_run_resumes_to_the_same_results(tmp_path, evaluate):
     out = tmp_path / "killed"
     cmd = [sys.executable, "-m", "opspec.cli", "evaluate", str(SPEC), "--users", "40",
-           "--days", "6", "--seed", "9", "--workers", "1", "--out", str(out), "--quiet"]
+           "--days", "6", "--seed", "9", "--workers", "2", "--out", str(out), "--quiet"]
     proc = subprocess.Popen(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
                             env={**os.environ, "PYTHONPATH": str(SPEC.parents[1])})
     db = out / "results.sqlite"
@@ -138,14 +138,34 @@ def test_interrupted_run_resumes_to_the_same_results(tmp_path, evaluate):
             if stored >= 5:
                 break
         time.sleep(0.05)
+    workers = _children(proc.pid)
     proc.kill()
     proc.wait()
     assert 5 <= stored < 40, "the run should have been killed part-way"
+    # the pool's workers do not outlive the killed run
+    assert workers, "the run should have started its worker pool"
+    deadline = time.monotonic() + 30
+    while any(Path(f"/proc/{w}").exists() for w in workers) and time.monotonic() < deadline:
+        time.sleep(0.1)
+    assert not [w for w in workers if Path(f"/proc/{w}").exists()], "orphaned workers"
     status, resumed, err = evaluate("--resume", "--out", str(out), "--workers", "2")
     assert status == 0, err
     _, whole, _ = evaluate(str(SPEC), "--users", "40", "--days", "6", "--seed", "9",
                            "--workers", "2", "--out", str(tmp_path / "whole"))
     assert metrics_of(resumed) == metrics_of(whole)
+
+
+def _children(pid: int) -> list[int]:
+    """Process ids whose parent is ``pid`` (Linux /proc; empty elsewhere)."""
+    found = []
+    for stat in Path("/proc").glob("[0-9]*/stat"):
+        try:
+            fields = stat.read_text().rsplit(")", 1)[1].split()
+        except OSError:
+            continue
+        if int(fields[1]) == pid:
+            found.append(int(stat.parent.name))
+    return found
 
 
 def test_failed_replications_are_recorded_and_resume_completes_them(tmp_path, monkeypatch):
