@@ -214,8 +214,15 @@ def run(args: argparse.Namespace) -> int:
     with store, contextlib.ExitStack() as stack:
         on_trace = _trace_writers(stack, store.folder, plan, resumed=args.resume)
         progress = make_progress(sys.stderr, quiet=args.quiet or args.json)
-        outcome = run_evaluation(plan, store, workers=workers, scheduler=args.scheduler,
-                                 progress=progress, on_trace=on_trace)
+        try:
+            outcome = run_evaluation(plan, store, workers=workers, scheduler=args.scheduler,
+                                     progress=progress, on_trace=on_trace)
+        except KeyboardInterrupt:
+            stored = sum(len(store.finished(d.label)) for d in plan.designs)
+            print(f"evaluate: stopped; {stored} of {plan.users * len(plan.designs)} "
+                  f"replications are stored in {store.path}; finish with `opspec evaluate "
+                  f"--resume --out {store.folder}`", file=sys.stderr)
+            raise
         stack.close()
         from opspec.evaluation.report import write_report
         from opspec.evaluation.summary import compare_designs, summarise_design
