@@ -50,12 +50,15 @@ class Progress:
 
 TraceSink = Callable[[ReplicationRecord], None]
 
+# Users per chunk when traces are exported (each chunk's traces cross to the parent at once).
+EXPORT_CHUNK = 4
 
-def chunks(users: Sequence[int], workers: int) -> list[list[int]]:
-    """Chunks of about 8 per worker, 1 to 50 users each, in user order."""
+
+def chunks(users: Sequence[int], workers: int, most: int = 50) -> list[list[int]]:
+    """Chunks of about 8 per worker, 1 to ``most`` users each, in user order."""
     if not users:
         return []
-    size = max(1, min(50, math.ceil(len(users) / (workers * 8))))
+    size = max(1, min(most, math.ceil(len(users) / (workers * 8))))
     return [list(users[i:i + size]) for i in range(0, len(users), size)]
 
 
@@ -179,11 +182,14 @@ def run_evaluation(plan: EvaluationPlan, store: ResultStore, *, workers: int = 1
     progress = progress or Progress()
     pending: list[Chunk] = []
     skipped = 0
+    # a user-month of the dispenser is ~0.4 MB of trace: small chunks when traces travel back
+    most = EXPORT_CHUNK if plan.export else 50
     for design in plan.designs:
         finished = store.finished(design.label)
         skipped += len(finished)
         todo = [u for u in range(plan.users) if u not in finished]
-        pending.extend((design.label, chunk) for chunk in chunks(todo, max(1, workers)))
+        pending.extend((design.label, chunk)
+                       for chunk in chunks(todo, max(1, workers), most=most))
     total = plan.users * len(plan.designs)
     progress.start(total, skipped)
     doc = plan.to_json()
