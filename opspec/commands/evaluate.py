@@ -187,6 +187,10 @@ def run(args: argparse.Namespace) -> int:
     workers = args.workers if args.workers is not None else (os.cpu_count() or 1)
     if workers < 1:
         raise EvaluationError(f"--workers must be >= 1, not {workers}")
+    if args.scheduler:
+        from opspec.evaluation.runner import check_scheduler
+
+        check_scheduler(args.scheduler)
     if args.resume:
         if not args.out:
             raise EvaluationError("--resume needs --out DIR (the folder of the run to finish)")

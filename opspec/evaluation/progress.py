@@ -37,9 +37,14 @@ class LogProgress(Progress):
     def _line(self, now: float) -> None:
         ran = self.done - self.already
         rate = ran / (now - self._start) if now > self._start else 0.0
-        left = (self.total - self.done) / rate if rate > 0 else float("nan")
-        print(f"evaluate: {self.done}/{self.total} replications ({rate:.0f}/s, "
-              f"about {left:.0f} s left)", file=self.stream, flush=True)
+        if self.done >= self.total:
+            left = "done"
+        elif rate > 0:
+            left = f"about {(self.total - self.done) / rate:.0f} s left"
+        else:
+            left = "time left not known yet"
+        print(f"evaluate: {self.done}/{self.total} replications ({rate:.0f}/s, {left})",
+              file=self.stream, flush=True)
 
     def finish(self) -> None:
         self._line(time.perf_counter())

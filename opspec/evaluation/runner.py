@@ -19,13 +19,14 @@ from collections.abc import Callable, Iterator, Sequence
 from concurrent.futures import BrokenExecutor
 from contextlib import contextmanager
 from dataclasses import dataclass
+from typing import Any
 
 from opspec.errors import EvaluationError
 from opspec.evaluation.plan import EvaluationPlan
 from opspec.evaluation.replication import ReplicationRecord, run_users
 from opspec.evaluation.store import ResultStore
 
-__all__ = ["Progress", "RunOutcome", "chunks", "run_evaluation"]
+__all__ = ["Progress", "RunOutcome", "check_scheduler", "chunks", "run_evaluation"]
 
 
 @dataclass(frozen=True, slots=True)
@@ -50,6 +51,9 @@ class Progress:
 
 TraceSink = Callable[[ReplicationRecord], None]
 
+# Seconds to wait for a Dask scheduler to answer.
+SCHEDULER_TIMEOUT = 10
+
 # Users per chunk when traces are exported (each chunk's traces cross to the parent at once).
 EXPORT_CHUNK = 4
 
@@ -62,27 +66,38 @@ def chunks(users: Sequence[int], workers: int, most: int = 50) -> list[list[int]
     return [list(users[i:i + size]) for i in range(0, len(users), size)]
 
 
+def _connect(scheduler: str) -> Any:
+    """A Dask client of the cluster at ``scheduler``, or a clear EvaluationError."""
+    try:
+        from distributed import Client
+    except ImportError:
+        raise EvaluationError("--scheduler needs dask.distributed",
+                              hint="pip install 'opspec[dask]'") from None
+    try:
+        return Client(scheduler, timeout=SCHEDULER_TIMEOUT)  # type: ignore[no-untyped-call]
+    except Exception as error:  # noqa: BLE001 - any connection failure, said plainly
+        raise EvaluationError(f"cannot reach the Dask scheduler at {scheduler}: {error}",
+                              hint="check the address (tcp://host:8786) and that the "
+                              "scheduler is running") from None
+
+
+def check_scheduler(scheduler: str) -> None:
+    """Connect to the Dask scheduler once and disconnect: called before anything is created,
+    so a wrong address fails without leaving an empty output folder behind."""
+    _connect(scheduler).close()
+
+
 @contextmanager
 def _executor(workers: int, scheduler: str | None) -> Iterator[tuple[cf.Executor | None, int]]:
     """The executor to use and how many chunks to keep in flight on it (None: in-process)."""
     if scheduler:
+        client = _connect(scheduler)
         try:
-            from distributed import Client
-        except ImportError:
-            raise EvaluationError("--scheduler needs dask.distributed",
-                                  hint="pip install 'opspec[dask]'") from None
-        try:
-            client = Client(scheduler, timeout=20)  # type: ignore[no-untyped-call]
-        except Exception as error:  # noqa: BLE001 - any connection failure, said plainly
-            raise EvaluationError(f"cannot reach the Dask scheduler at {scheduler}: {error}",
-                                  hint="check the address (tcp://host:8786) and that the "
-                                  "scheduler is running") from None
-        try:
-            threads = sum(client.nthreads().values())  # type: ignore[no-untyped-call]
-            executor = client.get_executor()  # type: ignore[no-untyped-call]
+            threads = sum(client.nthreads().values())
+            executor = client.get_executor()
             yield executor, max(2, 2 * threads)
         finally:
-            client.close()  # type: ignore[no-untyped-call]
+            client.close()
         return
     if workers <= 1:
         yield None, 1

@@ -420,3 +420,22 @@ def test_specs_with_a_simulated_world_give_each_user_their_own_world(evaluate, t
     assert metrics_of(one) == metrics_of(two)
     covered = one["metrics"]["cells_covered"]
     assert covered["total"] > 0 and covered["sd"] > 0
+
+
+def test_unreachable_scheduler_is_a_clear_error_before_anything_is_written(evaluate, tmp_path,
+                                                                          monkeypatch):
+    pytest.importorskip("distributed")
+    import socket
+
+    from opspec.evaluation import runner
+
+    monkeypatch.setattr(runner, "SCHEDULER_TIMEOUT", 1)
+    with socket.socket() as sock:            # a port nobody listens on
+        sock.bind(("127.0.0.1", 0))
+        port = sock.getsockname()[1]
+    out = tmp_path / "never"
+    status, doc, err = evaluate(str(SPEC), "--users", "2", "--days", "1", "--scheduler",
+                                f"tcp://127.0.0.1:{port}", "--out", str(out))
+    assert status == 2 and doc is None
+    assert f"cannot reach the Dask scheduler at tcp://127.0.0.1:{port}" in err
+    assert not out.exists()
