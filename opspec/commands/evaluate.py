@@ -248,6 +248,7 @@ def run(args: argparse.Namespace) -> int:
     if args.json:
         doc = {"spec": plan.design("A").spec, "users": plan.users, "days": plan.days,
                "seed": plan.seed, "user_model": plan.user_model, "workers": workers,
+               "scheduler": args.scheduler,
                "out": str(store.folder), "report": str(report), "metrics": metrics,
                "failed": [{"design": d, "user": u, "error": e} for d, u, e in failures],
                "wall_s": round(outcome.wall_s, 3)}
