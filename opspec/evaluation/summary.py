@@ -3,8 +3,10 @@
 - count: ``total`` over all users, and per user ``mean``, ``sd``, ``ci95``, ``median``,
   ``p95`` of the users' totals (and ``per_day``, the mean per user-day);
 - duration: pooled ``n``, ``mean`` (with ``ci95``), ``sd``, ``median``, ``p95`` of all
-  observations, and ``per_user`` (mean and sd of the users' own means);
-- ratio: ``value`` = Σ numerator / Σ denominator over users with ``ci95``, and ``per_user``.
+  observations, and ``per_user``: ``users``, ``mean``, ``sd``, ``ci95``, ``median``, ``p95``
+  of the users' own means (users without observations left out);
+- ratio: ``value`` = Σ numerator / Σ denominator over users with ``ci95``, and ``per_user``
+  (the same fields, over the users' own ratios).
 Intervals are described in :mod:`opspec.evaluation.statistics`. Quantiles of pooled
 observations are computed in the database, so memory does not grow with the number of users.
 """
@@ -83,6 +85,16 @@ def _sd(values: Sequence[float]) -> float | None:
     return pystats.stdev(values) if len(values) > 1 else None
 
 
+def _per_user(values: Sequence[float], level: float) -> dict[str, Any]:
+    """The distribution over users of each user's own value (their mean duration, their
+    ratio): how much users differ, beside the pooled estimate."""
+    ordered = sorted(values)
+    estimate = ratio_estimate([(v, 1.0) for v in ordered], level)
+    return {"users": len(ordered), "mean": estimate.value, "sd": _sd(ordered),
+            "ci95": estimate.ci, "median": _percentile(ordered, 0.5),
+            "p95": _percentile(ordered, 0.95)}
+
+
 def summarise_design(store: ResultStore, design: str, days: float, level: float = 0.95
                      ) -> dict[str, dict[str, Any]]:
     """Every declared metric of ``design`` summarised (see the module docstring)."""
@@ -114,9 +126,7 @@ def summarise_design(store: ResultStore, design: str, days: float, level: float 
                 "mean": estimate.value, "ci95": estimate.ci, "sd": sd,
                 "median": _pooled_quantile(store, design, name, n, 0.5),
                 "p95": _pooled_quantile(store, design, name, n, 0.95),
-                "per_user": {"users": len(means),
-                             "mean": pystats.fmean(means) if means else None,
-                             "sd": _sd(means)},
+                "per_user": _per_user(means, level),
             }
         else:
             ratios = [y / k for y, k in pairs if k > 0]
@@ -124,9 +134,7 @@ def summarise_design(store: ResultStore, design: str, days: float, level: float 
                 "kind": "ratio", "value": estimate.value, "ci95": estimate.ci,
                 "numerator": definition.get("numerator"),
                 "denominator": definition.get("denominator"),
-                "per_user": {"users": len(ratios),
-                             "mean": pystats.fmean(ratios) if ratios else None,
-                             "sd": _sd(ratios)},
+                "per_user": _per_user(ratios, level),
             }
     return out
 

@@ -88,6 +88,10 @@ def test_json_document_has_the_documented_shape(evaluate, tmp_path):
     assert len(count["ci95"]) == 2
     duration = doc["metrics"]["report_latency_s"]
     assert {"mean", "median", "p95", "ci95", "n"} <= set(duration)
+    per_user = duration["per_user"]
+    assert {"users", "mean", "sd", "ci95", "median", "p95"} <= set(per_user)
+    assert per_user["users"] == 4 and per_user["ci95"][0] <= per_user["mean"]
+    assert {"value", "ci95", "per_user"} <= set(doc["metrics"]["taken_rate"])
     assert doc["failed"] == []
     report = Path(doc["report"])
     html = report.read_text(encoding="utf-8")
