@@ -16,9 +16,11 @@ from opspec.evaluation.summary import compare_designs, metric_definitions, summa
 from opspec.evaluation.tables import (
     COMPARE_HEADERS,
     METRIC_HEADERS,
+    PER_USER_HEADERS,
     comparison_rows,
     is_rate,
     metric_rows,
+    per_user_rows,
 )
 
 __all__ = ["write_report"]
@@ -133,10 +135,13 @@ def write_report(store: ResultStore) -> Path:
                                     tuple((a, f"{o * 100:.2f} %", f"{w * 100:.2f} %")
                                           for a, o, w in activity),
                                     "Per-activity rates of the user lane"),)
+        spread = per_user_rows(metrics)
+        spread_table = (Table(PER_USER_HEADERS, tuple(spread), "How users differ: each "
+                              "user's own mean duration or ratio, over users"),) if spread else ()
         sections.append(Section(title, tables=(Table(METRIC_HEADERS,
                                                      tuple(metric_rows(metrics)),
                                                      "Declared metrics of the spec"),
-                                               *activity_table),
+                                               *spread_table, *activity_table),
                                 images=tuple(images), captions=tuple(captions)))
 
     if "B" in designs:

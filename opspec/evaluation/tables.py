@@ -5,9 +5,11 @@ from __future__ import annotations
 from collections.abc import Mapping, Sequence
 from typing import IO, Any
 
-__all__ = ["comparison_rows", "fmt", "is_rate", "metric_rows", "print_summary", "table"]
+__all__ = ["comparison_rows", "fmt", "is_rate", "metric_rows", "per_user_rows", "print_summary",
+           "table"]
 
 METRIC_HEADERS = ("metric", "kind", "estimate", "95 % CI", "median", "p95", "n")
+PER_USER_HEADERS = ("metric", "users", "mean", "sd", "95 % CI", "median", "p95")
 COMPARE_HEADERS = ("metric", "A", "B", "B − A", "95 % CI", "")
 
 
@@ -53,6 +55,24 @@ def metric_rows(metrics: Mapping[str, Mapping[str, Any]]) -> list[tuple[str, ...
             percent = is_rate(name, s)
             rows.append((name, "ratio", fmt(s["value"], percent=percent),
                          _ci(s, percent=percent), "–", "–", ""))
+    return rows
+
+
+def per_user_rows(metrics: Mapping[str, Mapping[str, Any]]) -> list[tuple[str, ...]]:
+    """Durations and ratios over users: the spread of each user's own value."""
+    rows: list[tuple[str, ...]] = []
+    for name, s in metrics.items():
+        per_user = s.get("per_user")
+        if not per_user or not per_user.get("users"):
+            continue
+        unit = (s.get("unit") or "s") if s["kind"] == "duration" else ""
+        percent = is_rate(name, s)
+        rows.append((f"{name} ({'mean per user' if unit else 'per user'})",
+                     str(per_user["users"]), fmt(per_user["mean"], unit, percent=percent),
+                     fmt(per_user["sd"], unit, percent=percent),
+                     _ci(per_user, unit, percent=percent),
+                     fmt(per_user["median"], unit, percent=percent),
+                     fmt(per_user["p95"], unit, percent=percent)))
     return rows
 
 

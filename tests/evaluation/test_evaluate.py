@@ -96,7 +96,7 @@ def test_json_document_has_the_documented_shape(evaluate, tmp_path):
     report = Path(doc["report"])
     html = report.read_text(encoding="utf-8")
     assert report.name == "report.html" and "data:image/png;base64," in html
-    assert "report_latency_s" in html
+    assert "report_latency_s" in html and "How users differ" in html
     assert (report.parent / "report.md").is_file()
 
 
