@@ -5,9 +5,13 @@ mailbox for push/pull data.
   output is the first command that is set (not ``None``, not ``""``), else ``None``.
 - **voter**: ``inputs`` are votes; the output is the option with the most votes. Ties go to
   the option listed first in ``options`` (or, without options, the value voted first).
-  Votes that are ``None`` abstain.
+  Votes that are ``None`` or ``""`` abstain (``""`` is the specs' "no command", as for the
+  arbiter); no votes at all gives ``None``. A vote outside ``options`` still counts, ranked
+  after the listed options (in the order first voted).
 - **superposition**: ``inputs`` are numbers or equal-length vectors, ``weights`` their
-  weights (default 1 each); the output is the weighted sum (a float or a list).
+  weights (default 1 each); the output is the weighted sum (a float or a list). Inputs that
+  are ``None`` or ``""`` (a behaviour with nothing to say) are left out with their weights;
+  all left out gives ``None``.
 - **push**: puts the value of ``inputs[0]`` (a tuple of all inputs if several) into the
   supervisor mailbox ``channel``; never blocks.
 - **pull**: takes the oldest value of mailbox ``channel`` into ``output``; when the mailbox
@@ -34,10 +38,11 @@ def arbiter(commands: Sequence[Any]) -> Any:
 
 
 def voter(votes: Sequence[Any], options: Sequence[Any] = ()) -> Any:
-    """The most voted value; ties broken by ``options`` order, else by first vote."""
+    """The most voted value; ties broken by ``options`` order, else by first vote.
+    ``None`` and ``""`` abstain."""
     counts: dict[Any, int] = {}
     for vote in votes:
-        if vote is not None:
+        if vote is not None and vote != "":
             counts[vote] = counts.get(vote, 0) + 1
     if not counts:
         return None
@@ -47,10 +52,14 @@ def voter(votes: Sequence[Any], options: Sequence[Any] = ()) -> Any:
 
 
 def superposition(values: Sequence[Any], weights: Sequence[float] = ()) -> Any:
-    """Weighted sum of numbers or of equal-length vectors."""
+    """Weighted sum of numbers or of equal-length vectors; unset inputs are left out."""
     w = list(weights) or [1.0] * len(values)
     if len(w) != len(values):
         raise ValueError(f"superposition has {len(values)} inputs but {len(w)} weights")
+    pairs = [(wi, v) for wi, v in zip(w, values, strict=True) if v is not None and v != ""]
+    if not pairs:
+        return None
+    w, values = [wi for wi, _ in pairs], [v for _, v in pairs]
     if all(isinstance(v, int | float) for v in values):
         return float(sum(wi * vi for wi, vi in zip(w, values, strict=True)))
     vectors = [list(v) for v in values]
