@@ -36,6 +36,7 @@ Semantics (XPDL / SISARL, see ``docs/trace-format.md`` for what each step record
 
 from __future__ import annotations
 
+import dataclasses
 import itertools
 from collections import ChainMap, deque
 from collections.abc import Callable, Mapping, MutableMapping
@@ -1276,6 +1277,11 @@ class Interpreter:
             new = {pid: p for pid, p in loaded.processes.items() if pid not in self.processes}
             if new:
                 self.processes = {**self.processes, **new}
+                # the loaded workflows belong to the mode that loaded them (on a copy: the
+                # compiled package may be shared with other runs)
+                self.compiled = dataclasses.replace(self.compiled, modes={
+                    **self.compiled.modes,
+                    mode: self.compiled.modes.get(mode, frozenset()) | frozenset(new)})
                 for proc in new.values():
                     self.arm_process(proc)
         old = self.mode

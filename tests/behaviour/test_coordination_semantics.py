@@ -258,3 +258,24 @@ def test_mode_change_loads_the_workflows_of_a_mode_given_by_source(tmp_path: Pat
     assert loads == [("docking.xpdl", 2.5)]
     assert recorder.seen == [(0.8, "forward"), (1.8, "forward"), (3.0, "stop"), (4.0, "stop")]
     assert result.summary["mode"] == "dock"
+
+
+def test_workflows_loaded_for_a_mode_stop_when_the_mode_is_left(tmp_path: Path) -> None:
+    docking = compiled(tmp_path, [process("park", [assign("halt", ("motor_cmd", '"stop"')),
+                                                   task("park_drive", "drive")], Period="1s",
+                                           fields=[field("motor_cmd", "STRING", '""')])],
+                       applications=["drive"], name="docking")
+    model = compiled(tmp_path, [
+        process("clean", [assign("sweep", ("motor_cmd", '"forward"')), task("drive", "drive")],
+                Period="1s", Mode="clean", fields=[field("motor_cmd", "STRING", '""')]),
+        process("to_dock", [builtin("go_dock", '<opspec:ModeChange To="dock"/>')],
+                StartTrigger="timer:after 1.5s"),
+        process("to_clean", [builtin("go_clean", '<opspec:ModeChange To="clean"/>')],
+                StartTrigger="timer:after 3.5s")],
+        applications=["drive"],
+        package_attributes=MODES.format(source=' Source="docking.xpdl"'))
+    recorder = Recorder(["drive"], "motor_cmd")
+    Simulation(model, performers={"motors": recorder},
+               mode_loader=lambda _source: docking).run(until=6.0)
+    assert recorder.seen == [(0.0, "forward"), (1.0, "forward"), (2.0, "stop"), (3.0, "stop"),
+                             (4.0, "forward"), (5.0, "forward")]
