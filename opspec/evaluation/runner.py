@@ -172,12 +172,17 @@ def _drain(executor: cf.Executor, doc: dict[str, object], pending: Sequence[Chun
                 lost.append((label, users, _dead_worker(error)))
                 continue
             except Exception as error:  # noqa: BLE001 - a failed task, recorded
-                reason = f"worker failed: {type(error).__name__}: {error}"
-                records = [ReplicationRecord(label, u, "failed", error=reason) for u in users]
+                records = _failed(label, users, error)
             keep(records)
             del records
         fill()
     return lost
+
+
+def _failed(label: str, users: Sequence[int], error: Exception) -> list[ReplicationRecord]:
+    """A chunk whose task raised: each of its users a failed replication with the reason."""
+    reason = f"worker failed: {type(error).__name__}: {error}"
+    return [ReplicationRecord(label, u, "failed", error=reason) for u in users]
 
 
 def _dead_worker(error: BaseException) -> str:
@@ -228,7 +233,11 @@ def run_evaluation(plan: EvaluationPlan, store: ResultStore, *, workers: int = 1
         with _executor(workers, scheduler) as (executor, slots):
             if executor is None:
                 for label, users in pending:
-                    keep(run_users(doc, label, users))
+                    try:
+                        records = run_users(doc, label, users)
+                    except Exception as error:  # noqa: BLE001 - as a failed task in a pool
+                        records = _failed(label, users, error)
+                    keep(records)
             else:
                 lost = _drain(executor, doc, pending, slots, keep)
         if lost and scheduler is None:

@@ -190,14 +190,16 @@ def test_failed_replications_are_recorded_and_resume_completes_them(tmp_path, mo
     with ResultStore(tmp_path, create=True) as store:
         store.put("plan", plan.to_json())
         monkeypatch.setattr(replication, "run_user", flaky)
-        with pytest.raises(RuntimeError):
-            run_evaluation(plan, store, workers=1)
-        monkeypatch.undo()
-        # replications finished before the crash are kept
-        assert store.finished("A") == {0, 1}
         outcome = run_evaluation(plan, store, workers=1)
-        assert outcome.skipped == 2 and outcome.done == 4
-        assert store.finished("A") == set(range(6))
+        monkeypatch.undo()
+        # the crashing chunks are failed replications with the reason; the others are kept
+        assert outcome.failed == 2 and outcome.done == 4
+        assert store.finished("A") == {0, 1, 3, 5}
+        assert [(u, "simulated crash" in e) for _, u, e in store.failures()] == [(2, True),
+                                                                                 (4, True)]
+        outcome = run_evaluation(plan, store, workers=1)
+        assert outcome.skipped == 4 and outcome.done == 2
+        assert store.finished("A") == set(range(6)) and store.failures() == []
 
 
 def test_a_dead_worker_becomes_failed_replications_with_the_reason(tmp_path, monkeypatch):
@@ -443,3 +445,31 @@ def test_unreachable_scheduler_is_a_clear_error_before_anything_is_written(evalu
     assert status == 2 and doc is None
     assert f"cannot reach the Dask scheduler at tcp://127.0.0.1:{port}" in err
     assert not out.exists()
+
+
+def test_failed_replications_are_listed_exit_1_and_resume_completes_them(evaluate, tmp_path,
+                                                                         monkeypatch):
+    from opspec.errors import ExecutionError
+    from opspec.evaluation import replication
+
+    real = replication._world_performers
+
+    def broken_for_user_1(compiled, seed, user):
+        if user == 1:
+            raise ExecutionError("the simulated device fell over")
+        return real(compiled, seed, user)
+
+    out = str(tmp_path / "run")
+    monkeypatch.setattr(replication, "_world_performers", broken_for_user_1)
+    status, doc, _ = evaluate(str(SPEC), "--users", "3", "--days", "1", "--workers", "1",
+                              "--out", out)
+    assert status == 1
+    assert doc["failed"] == [{"design": "A", "user": 1,
+                              "error": "the simulated device fell over"}]
+    assert doc["metrics"]["doses_due"]["users"] == 2
+    html = Path(doc["report"]).read_text(encoding="utf-8")
+    assert "Failed replications" in html and "the simulated device fell over" in html
+    monkeypatch.undo()
+    status, doc, _ = evaluate("--resume", "--out", out)
+    assert status == 0 and doc["failed"] == []
+    assert doc["metrics"]["doses_due"]["users"] == 3
