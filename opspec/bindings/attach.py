@@ -69,8 +69,11 @@ class AttachedDevices:
             sim.post(drain)
 
     def report(self) -> dict[str, Any]:
-        """Per binding: where it is bound, whether simulated now, round-trip latencies in ms,
-        and the faults (kind, message, action), for the run's summary and JSON."""
+        """Per binding (keyed by its participants, comma-separated): ``profile``, ``url``,
+        ``mode`` per participant (``device``/``simulated``/``aborted``), ``latency_ms``
+        (``count``, ``mean``, ``p99``, ``max`` of the answered commands' round trips; None
+        without any) and ``faults`` (``at`` simulated seconds, ``fault``, ``message``,
+        ``action``), for the run's summary and JSON."""
         out: dict[str, Any] = {}
         for binding in self.bindings:
             latency = binding.latency_summary()
@@ -79,7 +82,7 @@ class AttachedDevices:
                 "mode": {p: binding.mode(p) for p in binding.participants},
                 "latency_ms": {"count": latency.count, "mean": _ms(latency.mean),
                                "p99": _ms(latency.p99), "max": _ms(latency.max)},
-                "faults": [{k: f.get(k) for k in ("fault", "message", "action")}
+                "faults": [{k: f.get(k) for k in ("at", "fault", "message", "action")}
                            for f in binding.faults],
             }
         return out

@@ -80,7 +80,8 @@ class DeviceBinding:
         self.notes: list[str] = list(notes)
         #: Round-trip time of every answered command, in seconds (wall clock).
         self.latencies: list[float] = []
-        #: The data of every fault reported, in order (also in the trace).
+        #: The data of every fault reported, in order (also in the trace), plus ``at``: the
+        #: simulated time it was reported (None before :meth:`attach`).
         self.faults: list[dict[str, Any]] = []
         self._session: PerformerSession | None = None
         self._sim = SimulatedDevice(profile)
@@ -405,9 +406,10 @@ class DeviceBinding:
         """The port failed: close it, report, and reconnect (on a helper thread) or fall back."""
         reason = str(exc) if exc is not None else "the port was closed"
         self._generation += 1  # lines still queued from the dead reader are ignored
-        reader, self._reader = self._reader, None
-        if reader is not None:
-            reader.shutdown()
+        # the dead reader is shut down on a helper thread, never here: closing a port can
+        # block (pySerial's socket:// sleeps 0.3 s in close()), which would stall a
+        # wall-clock run by thousands of simulated seconds at high speed factors
+        dead, self._reader = self._reader, None
         job, self._inflight = self._inflight, None
         if job is not None:
             if job.timer is not None:
@@ -420,15 +422,27 @@ class DeviceBinding:
                     item=job.item if job else None, line=job.line if job else None,
                     action="reconnect" if attempts else "fallback")
         if attempts == 0:
+            if dead is not None:
+                threading.Thread(target=dead.shutdown, name=f"close-{self.profile.name}",
+                                 daemon=True).start()
             self._reconnect_failed(self._generation, "no reconnection attempts declared")
             return
         gen = self._generation
-        threading.Thread(target=self._reconnect_worker, args=(gen, attempts),
+        threading.Thread(target=self._reconnect_worker, args=(gen, attempts, dead),
                          name=f"reconnect-{self.profile.name}", daemon=True).start()
 
-    def _reconnect_worker(self, gen: int, attempts: int) -> None:
-        """Helper thread: try to reopen the port; post the outcome to the engine."""
+    def _reconnect_worker(self, gen: int, attempts: int,
+                          dead: LineReaderThread | None = None) -> None:
+        """Helper thread: close the dead port, try to reopen it; post the outcome to the
+        engine."""
         assert self.url is not None
+        if dead is not None:
+            if "://" in self.url:
+                # a URL transport needs no exclusive access: reconnect while it closes
+                threading.Thread(target=dead.shutdown, name=f"close-{self.profile.name}",
+                                 daemon=True).start()
+            else:
+                dead.shutdown()   # a device path must be released before it is reopened
         last = ""
         try:
             for _ in range(attempts):
@@ -489,7 +503,8 @@ class DeviceBinding:
         if line is not None:
             data["command"] = line
         data.update(extra)
-        self.faults.append(data)
+        # the report gives each fault's simulated time (the trace event carries it already)
+        self.faults.append({**data, "at": self._session.now if self._session else None})
         if self._session is not None:
             self._session.trace(EventKind.FAULT, data)
 

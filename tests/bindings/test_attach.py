@@ -1,0 +1,300 @@
+"""`attach_devices`: the API `opspec run` and the walkthrough use to put bound devices into a
+run — performers, notes, the wall clock, device callbacks on the engine's thread, the device
+report, and every port closed whatever ends the run. The runs here drive
+``specs/medication_dispenser.xpdl`` through :class:`Simulation` exactly as ``opspec run`` does,
+in wall-clock mode at 20,000x so they take a second or two."""
+
+from __future__ import annotations
+
+import threading
+from collections.abc import Iterator
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import pytest
+
+from opspec.bindings import load_profile
+from opspec.bindings.attach import AttachedDevices, attach_devices
+from opspec.bindings.emulator import Behaviour, EmulatedDevice, PtyEmulator, Reply, SocketEmulator
+from opspec.commands._spec import bind_user, choose_user, load_any_spec
+from opspec.engine.compiled import compile_package
+from opspec.engine.config import EngineConfig
+from opspec.engine.simulation import RunResult, Simulation
+from opspec.engine.trace import TraceEvent
+from opspec.errors import BindingError
+
+from .conftest import DATA, DEVICES, needs_pty
+
+SPEC = Path(__file__).resolve().parents[2] / "specs" / "medication_dispenser.xpdl"
+SPEED = 20000.0
+FIRST_DOSE = 36000.0          # 10:00: the 08:00 dose is over, with slack for device replies
+FAST = "run_dispenser"        # tests/bindings/data: 300 ms reply timeouts, 50 ms reconnects
+
+
+def _serial_threads() -> list[threading.Thread]:
+    return [t for t in threading.enumerate() if t.name.startswith("serial-") and t.is_alive()]
+
+
+class ButtonPressingDevice(EmulatedDevice):
+    """The dispenser board with a user who presses *report* right after each alarm."""
+
+    server: Any = None
+
+    def handle_line(self, line: str) -> list[Any]:
+        actions = super().handle_line(line)
+        if line.strip() == "ALARM ON" and self.server is not None:
+            self.server.send_event("report", after_s=0.002)
+        return actions
+
+
+class ChattyDevice(EmulatedDevice):
+    """The dispenser board printing a line no profile knows after each answer."""
+
+    def handle_line(self, line: str) -> list[Any]:
+        actions = super().handle_line(line)
+        return [*actions, Reply(b"HELLO?\n", delay_s=0.005)]
+
+
+@pytest.fixture
+def board() -> Iterator[Any]:
+    """``board(cls, fault, on, profile)``: a running emulator, stopped at teardown."""
+    servers: list[PtyEmulator | SocketEmulator] = []
+
+    def start(cls: type[EmulatedDevice] = EmulatedDevice, fault: str = "none",
+              on: str = "pty", profile: str = FAST) -> PtyEmulator | SocketEmulator:
+        path = DATA / f"{profile}.toml" if profile == FAST else DEVICES / f"{profile}.toml"
+        device = cls(load_profile(path), Behaviour.parse(fault))
+        server: PtyEmulator | SocketEmulator = (
+            PtyEmulator(device) if on == "pty" else SocketEmulator(device))
+        device.server = server  # type: ignore[attr-defined]
+        servers.append(server)
+        server.start()
+        return server
+
+    yield start
+    for server in servers:
+        server.stop()
+
+
+@dataclass
+class Outcome:
+    result: RunResult
+    report: dict[str, Any]
+    notes: list[str]
+    wall_clock: bool
+    threads: set[int]                 # threads that emitted device events
+
+    def kinds(self) -> list[str]:
+        assert self.result.trace is not None
+        return [e.kind for e in self.result.trace]
+
+    def faults(self) -> list[dict[str, Any]]:
+        assert self.result.trace is not None
+        return [dict(e.data or {}) for e in self.result.trace if e.kind == "fault"]
+
+    def metric(self, name: str) -> Any:
+        return self.result.metrics[name]["total"]
+
+
+def script(tmp_path: Path, *steps: tuple[str, str]) -> str:
+    path = tmp_path / "user.toml"
+    body = ",".join(f'["{w}", "{a}"]' for w, a in steps)
+    path.write_text(f'otherwise = "complete"\nsteps = [{body}]\n', encoding="utf-8")
+    return str(path)
+
+
+def simulate(bind: list[str], user: str, *, until: float = FIRST_DOSE, spec: Path = SPEC,
+             profiles: Path = DATA) -> Outcome:
+    """What ``opspec run --bind`` does, through the public API."""
+    compiled = compile_package(load_any_spec(spec))
+    performer, listeners = choose_user(compiled, spec, script=user, user_model=None,
+                                       companion=False).make(0, 1)
+    performers: dict[str, Any] = bind_user(compiled, performer)
+    threads: set[int] = set()
+
+    def device_thread(event: TraceEvent) -> None:
+        if event.kind.startswith("device.") or event.kind == "fault":
+            threads.add(threading.get_ident())
+
+    with attach_devices(bind, profiles) as devices:
+        performers.update(devices.performers)
+        config = EngineConfig().with_options(realtime=devices.requires_wall_clock,
+                                             speed=SPEED)
+        sim = Simulation(compiled, config, performers=performers, seed=1,
+                         listeners=[*listeners, device_thread], keep_trace=True)
+        devices.install(sim)
+        result = sim.run(until=until)
+        outcome = Outcome(result, devices.report(), list(devices.notes),
+                          devices.requires_wall_clock, threads)
+    assert not _serial_threads(), "a reader thread outlived attach_devices"
+    return outcome
+
+
+# ---------------------------------------------------------------------------- the API
+
+
+def test_attached_devices_give_one_performer_per_participant_and_say_where_they_are(
+        ) -> None:
+    url = f"emulator://{DATA / f'{FAST}.toml'}"
+    with attach_devices([f"alarm:{FAST}={url}", f"dispenser:{FAST}={url}"], DATA) as devices:
+        assert isinstance(devices, AttachedDevices)
+        assert set(devices.performers) == {"alarm", "dispenser"}
+        assert devices.performers["alarm"] is devices.performers["dispenser"]  # one port
+        assert devices.notes == [f"alarm, dispenser: bound to {url} ({FAST})"]
+        assert devices.requires_wall_clock
+        report = devices.report()["alarm, dispenser"]
+        assert report["mode"] == {"alarm": "device", "dispenser": "device"}
+        assert report["latency_ms"] == {"count": 0, "mean": None, "p99": None, "max": None}
+    assert not devices.requires_wall_clock          # closed: nothing left to wait for
+
+
+def test_auto_without_a_device_is_simulated_needs_no_wall_clock_and_says_so() -> None:
+    with attach_devices(["alarm=auto"], DEVICES, ports=[]) as devices:
+        assert not devices.requires_wall_clock
+        assert any("using the simulated alarm" in note for note in devices.notes)
+        assert devices.report()["alarm"]["mode"] == {"alarm": "simulated"}
+
+
+def test_no_bind_arguments_attach_nothing() -> None:
+    with attach_devices([], DEVICES) as devices:
+        assert devices.performers == {} and devices.notes == []
+        assert not devices.requires_wall_clock and devices.report() == {}
+
+
+@needs_pty
+def test_every_port_is_closed_when_the_run_is_interrupted(board: Any) -> None:
+    server = board(on="pty")
+    with (pytest.raises(KeyboardInterrupt),
+          attach_devices([f"alarm:{FAST}={server.url}"], DATA) as devices):
+        binding = devices.performers["alarm"]
+        binding.attach(_NullSession())  # type: ignore[arg-type]
+        assert _serial_threads()            # the reader is running
+        raise KeyboardInterrupt
+    assert not _serial_threads()
+    assert not binding.requires_wall_clock
+
+
+@needs_pty
+def test_a_port_that_will_not_open_closes_the_ones_already_open(board: Any,
+                                                                 tmp_path: Path) -> None:
+    # the fast dispenser and the shipped range finder side by side
+    for source in (DATA / f"{FAST}.toml", DEVICES / "range_finder.toml"):
+        (tmp_path / source.name).write_bytes(source.read_bytes())
+    server = board(on="pty")
+    with pytest.raises(BindingError, match=r"/dev/opspec-no-such-port.*No such file"):
+        attach_devices([f"alarm:{FAST}={server.url}",
+                        "range_finder=/dev/opspec-no-such-port"], tmp_path)
+    assert not _serial_threads()
+
+
+class _NullSession:
+    now = 0.0
+
+    def trace(self, kind: str, data: Any = None) -> None:
+        pass
+
+
+# ---------------------------------------------------------------------------- runs
+
+
+@needs_pty
+def test_the_button_on_a_pseudo_terminal_reports_and_the_dose_is_taken(
+        board: Any, tmp_path: Path) -> None:
+    server = board(ButtonPressingDevice, on="pty")
+    run = simulate([f"alarm:{FAST}={server.url}", f"dispenser:{FAST}={server.url}"],
+                   script(tmp_path, ("never", "press_report")))
+    assert run.wall_clock
+    assert run.metric("doses_taken") == 1 and run.metric("doses_missed") == 0
+    exchanges = [e.data for e in run.result.trace or () if e.kind == "device.exchange"]
+    assert [x["command"] for x in exchanges] == ["ALARM ON", "DISPENSE 1"]
+    events = [e.data for e in run.result.trace or () if e.kind == "device.event"]
+    assert [x["event"] for x in events] == ["report"]
+    device = run.report["alarm, dispenser"]
+    assert device["latency_ms"]["count"] == 2 and device["latency_ms"]["max"] > 0
+    assert device["faults"] == []
+    # reader-thread lines were handled on the engine's (this) thread
+    assert run.threads == {threading.get_ident()}
+    assert run.result.summary["drift"]["events"] > 0
+    assert run.kinds()[-1] == "run.ended"
+
+
+def test_the_dose_over_a_loop_url_emulator(tmp_path: Path) -> None:
+    url = f"emulator://{DATA / f'{FAST}.toml'}"
+    run = simulate([f"alarm:{FAST}={url}", f"dispenser:{FAST}={url}"],
+                   script(tmp_path, ("after trg_2 30s", "press_report")))
+    assert run.metric("doses_taken") == 1
+    assert run.report["alarm, dispenser"]["latency_ms"]["count"] == 2
+    assert run.faults() == []
+
+
+def test_a_socket_that_drops_mid_run_is_reconnected_and_the_dose_is_taken(
+        board: Any, tmp_path: Path) -> None:
+    server = board(fault="disconnect:1", on="socket")
+    # until 11:56: reconnecting takes real time (50 ms here, about 1000 simulated seconds)
+    run = simulate([f"alarm:{FAST}={server.url}", f"dispenser:{FAST}={server.url}"],
+                   script(tmp_path, ("after trg_2 30s", "press_report")), until=43000)
+    assert [(f["fault"], f["action"]) for f in run.faults()] == [("disconnected", "reconnect")]
+    notes = [e.data["message"] for e in run.result.trace or () if e.kind == "device.note"]
+    assert any("reconnected" in note for note in notes)
+    assert run.metric("doses_taken") == 1
+    assert run.report["alarm, dispenser"]["mode"] == {"alarm": "device", "dispenser": "device"}
+    fault = run.report["alarm, dispenser"]["faults"][0]
+    assert fault["fault"] == "disconnected" and 28800 <= fault["at"] < FIRST_DOSE
+
+
+@needs_pty
+def test_a_vanished_drawer_aborts_the_dispense_along_its_exception_transition(
+        board: Any, tmp_path: Path) -> None:
+    # the shipped spec has no EXCEPTION flow out of `dispense`; give it one to record a miss
+    text = SPEC.read_text(encoding="utf-8").replace(
+        '<Transition Id="n_taken" From="dispense" To="record_taken"/>',
+        '<Transition Id="n_taken" From="dispense" To="record_taken"/>'
+        '<Transition Id="n_fault" From="dispense" To="record_missed">'
+        '<Condition Type="EXCEPTION">DispenserFault</Condition></Transition>')
+    assert "n_fault" in text
+    spec = tmp_path / "medication_dispenser.xpdl"
+    spec.write_text(text, encoding="utf-8")
+    server = board(fault="disconnect:1", on="pty")
+    run = simulate([f"alarm:{FAST}={server.url}", f"dispenser:{FAST}={server.url}"],
+                   script(tmp_path, ("after trg_2 30s", "press_report")), spec=spec)
+    assert [(f["fault"], f["action"]) for f in run.faults()] == [
+        ("disconnected", "reconnect"), ("reconnect-failed", "abort/simulate")]
+    device = run.report["alarm, dispenser"]
+    assert device["mode"] == {"alarm": "simulated", "dispenser": "aborted"}
+    assert run.metric("doses_taken") == 0 and run.metric("doses_missed") == 1
+    assert not run.wall_clock                   # the port is gone: nothing real is left
+    failed = [e for e in run.result.trace or () if e.kind == "activity.failed"]
+    assert [(e.activity, (e.data or {}).get("exception")) for e in failed] == [
+        ("dispense", "DispenserFault")]
+    assert run.result.summary["instances"]["aborted"] == 0   # handled, not aborted
+    assert run.kinds()[-1] == "run.ended"
+
+
+@needs_pty
+def test_a_line_nobody_expects_is_a_named_fault_and_the_run_goes_on(
+        board: Any, tmp_path: Path) -> None:
+    server = board(ChattyDevice, on="pty")
+    run = simulate([f"alarm:{FAST}={server.url}", f"dispenser:{FAST}={server.url}"],
+                   script(tmp_path, ("after trg_2 30s", "press_report")))
+    unexpected = [f for f in run.faults() if f["fault"] == "unexpected-line"]
+    assert unexpected and all(f["action"] == "none" for f in unexpected)
+    assert "'HELLO?'" in unexpected[0]["message"]
+    assert run.metric("doses_taken") == 1
+    assert run.report["alarm, dispenser"]["mode"] == {"alarm": "device", "dispenser": "device"}
+
+
+@needs_pty
+@pytest.mark.parametrize(("fault", "named"), [("silent", "timeout"), ("garbage", "garbage")],
+                         ids=["no-reply", "garbage"])
+def test_a_misbehaving_alarm_retries_then_goes_on_simulated(
+        fault: str, named: str, board: Any, tmp_path: Path) -> None:
+    server = board(fault=fault, on="pty")
+    # two 300 ms (wall) timeouts span about 3.3 simulated hours at 20,000x
+    run = simulate([f"alarm:{FAST}={server.url}"],
+                   script(tmp_path, ("after trg_2 30s", "press_report")), until=43000)
+    assert [(f["fault"], f["action"]) for f in run.faults()][:2] == [
+        (named, "retry"), (named, "simulate")]
+    assert run.report["alarm"]["mode"] == {"alarm": "simulated"}
+    assert run.metric("doses_taken") == 1        # the simulated alarm kept the dose going
+    assert run.kinds()[-1] == "run.ended"
