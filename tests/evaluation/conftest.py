@@ -23,3 +23,8 @@ def evaluate(capsys: pytest.CaptureFixture[str]):
         return status, doc, captured.err
 
     return run
+
+
+def metrics_of(doc: dict) -> dict:
+    """The metrics of an ``--json`` document, without each metric's ``users`` count."""
+    return {k: {f: v for f, v in m.items() if f != "users"} for k, m in doc["metrics"].items()}

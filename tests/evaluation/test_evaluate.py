@@ -1,24 +1,17 @@
-"""`opspec evaluate`: many users, results independent of workers, stored as they finish,
-summaries that match the reference scenario's closed form, reports, exports, bad inputs."""
+"""`opspec evaluate`: many users, results independent of workers and backend, summaries that
+match the reference scenario's closed form, paired comparisons, reports, exports, worlds.
+Faults are in test_faults.py, bad input in test_bad_input.py."""
 
 from __future__ import annotations
 
 import json
-import os
 import sqlite3
-import subprocess
-import sys
-import time
 from pathlib import Path
 
 import pytest
-from conftest import SPEC, USERS_TOML
+from conftest import SPEC, USERS_TOML, metrics_of
 
 from opspec.cli import main
-
-
-def metrics_of(doc: dict) -> dict:
-    return {k: {f: v for f, v in m.items() if f != "users"} for k, m in doc["metrics"].items()}
 
 
 def test_same_seed_gives_the_same_results_with_one_or_two_workers(evaluate, tmp_path):
@@ -123,103 +116,6 @@ def test_a_longer_deadline_misses_fewer_doses_on_the_same_users(evaluate, tmp_pa
     assert alarms["ci95"][1] < 0
 
 
-def test_interrupted_run_resumes_to_the_same_results(tmp_path, evaluate):
-    out = tmp_path / "killed"
-    cmd = [sys.executable, "-m", "opspec.cli", "evaluate", str(SPEC), "--users", "40",
-           "--days", "6", "--seed", "9", "--workers", "2", "--out", str(out), "--quiet"]
-    proc = subprocess.Popen(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
-                            env={**os.environ, "PYTHONPATH": str(SPEC.parents[1])})
-    db = out / "results.sqlite"
-    deadline = time.monotonic() + 120
-    stored = 0
-    while time.monotonic() < deadline and proc.poll() is None:
-        if db.exists():
-            try:
-                with sqlite3.connect(db, timeout=5) as conn:
-                    stored = conn.execute("SELECT COUNT(*) FROM replication").fetchone()[0]
-            except sqlite3.Error:
-                stored = 0
-            if stored >= 5:
-                break
-        time.sleep(0.05)
-    workers = _children(proc.pid)
-    proc.kill()
-    proc.wait()
-    assert 5 <= stored < 40, "the run should have been killed part-way"
-    # the pool's workers do not outlive the killed run
-    assert workers, "the run should have started its worker pool"
-    deadline = time.monotonic() + 30
-    while any(Path(f"/proc/{w}").exists() for w in workers) and time.monotonic() < deadline:
-        time.sleep(0.1)
-    assert not [w for w in workers if Path(f"/proc/{w}").exists()], "orphaned workers"
-    status, resumed, err = evaluate("--resume", "--out", str(out), "--workers", "2")
-    assert status == 0, err
-    _, whole, _ = evaluate(str(SPEC), "--users", "40", "--days", "6", "--seed", "9",
-                           "--workers", "2", "--out", str(tmp_path / "whole"))
-    assert metrics_of(resumed) == metrics_of(whole)
-
-
-def _children(pid: int) -> list[int]:
-    """Process ids whose parent is ``pid`` (Linux /proc; empty elsewhere)."""
-    found = []
-    for stat in Path("/proc").glob("[0-9]*/stat"):
-        try:
-            fields = stat.read_text().rsplit(")", 1)[1].split()
-        except OSError:
-            continue
-        if int(fields[1]) == pid:
-            found.append(int(stat.parent.name))
-    return found
-
-
-def test_failed_replications_are_recorded_and_resume_completes_them(tmp_path, monkeypatch):
-    from opspec.evaluation import replication
-    from opspec.evaluation.plan import Design, EvaluationPlan, file_digest
-    from opspec.evaluation.runner import run_evaluation
-    from opspec.evaluation.store import ResultStore
-
-    plan = EvaluationPlan(designs=(Design("A", str(SPEC), file_digest(SPEC)),), users=6,
-                          days=1, seed=0, user_model=str(USERS_TOML))
-    real = replication.run_user
-
-    def flaky(context, design, user, **kw):
-        if user in (2, 4):
-            raise RuntimeError("simulated crash")
-        return real(context, design, user, **kw)
-
-    with ResultStore(tmp_path, create=True) as store:
-        store.put("plan", plan.to_json())
-        monkeypatch.setattr(replication, "run_user", flaky)
-        outcome = run_evaluation(plan, store, workers=1)
-        monkeypatch.undo()
-        # the crashing chunks are failed replications with the reason; the others are kept
-        assert outcome.failed == 2 and outcome.done == 4
-        assert store.finished("A") == {0, 1, 3, 5}
-        assert [(u, "simulated crash" in e) for _, u, e in store.failures()] == [(2, True),
-                                                                                 (4, True)]
-        outcome = run_evaluation(plan, store, workers=1)
-        assert outcome.skipped == 4 and outcome.done == 2
-        assert store.finished("A") == set(range(6)) and store.failures() == []
-
-
-def test_a_dead_worker_becomes_failed_replications_with_the_reason(tmp_path, monkeypatch):
-    from opspec.evaluation import runner
-    from opspec.evaluation.plan import Design, EvaluationPlan, file_digest
-    from opspec.evaluation.store import ResultStore
-
-    plan = EvaluationPlan(designs=(Design("A", str(SPEC), file_digest(SPEC)),), users=4,
-                          days=1, seed=0, user_model=str(USERS_TOML))
-    monkeypatch.setattr(runner, "run_users", _exit_in_worker)
-    with ResultStore(tmp_path, create=True) as store:
-        outcome = runner.run_evaluation(plan, store, workers=2)
-        assert outcome.failed == 4 and outcome.done == 0
-        assert all("worker failed" in error for _, _, error in store.failures())
-
-
-def _exit_in_worker(plan, design, users):
-    os._exit(3)
-
-
 def test_exports_write_one_case_per_user(evaluate, tmp_path):
     from opspec.engine.trace_sinks import read_trace
 
@@ -236,63 +132,6 @@ def test_exports_write_one_case_per_user(evaluate, tmp_path):
     assert xes.count("<trace>") == 3
 
 
-@pytest.mark.parametrize("content, message", [
-    ('[activities.hear_alarm]\nduration = { kind = "zipf", a = 2 }\n', "zipf"),
-    ('[activities.hear_alarm]\nduration = { kind = "lognormal", median = -60, sigma = 0.6 }\n',
-     "median"),
-    ('[activities.hear_alarm]\nduration = 0\nomission = { probability = 1.5 }\n',
-     "probability"),
-], ids=["unknown-distribution", "negative-scale", "probability-above-1"])
-def test_bad_user_model_stops_before_any_simulation(content, message, evaluate, tmp_path):
-    model = tmp_path / "bad.users.toml"
-    model.write_text(content, encoding="utf-8")
-    out = tmp_path / "never"
-    status, doc, err = evaluate(str(SPEC), "--user-model", str(model), "--out", str(out))
-    assert status == 2 and doc is None
-    assert str(model) in err and message in err
-    assert not out.exists()
-
-
-def test_model_not_covering_a_manual_activity_names_it(evaluate, tmp_path):
-    text = USERS_TOML.read_text(encoding="utf-8")
-    start = text.index("[activities.take_pill]")
-    end = text.find("\n[", start + 1)
-    model = tmp_path / "partial.users.toml"
-    model.write_text(text[:start] + (text[end:] if end != -1 else ""), encoding="utf-8")
-    status, _, err = evaluate(str(SPEC), "--user-model", str(model), "--out",
-                              str(tmp_path / "x"))
-    assert status == 2
-    assert "take_pill" in err and str(model) in err
-
-
-def test_unwritable_output_folder_is_a_clear_error(evaluate, tmp_path):
-    blocker = tmp_path / "file"
-    blocker.write_text("not a folder", encoding="utf-8")
-    status, _, err = evaluate(str(SPEC), "--users", "2", "--days", "1", "--out",
-                              str(blocker / "out"))
-    assert status == 2
-    assert "cannot create the output folder" in err and "Traceback" not in err
-
-
-def test_existing_results_need_resume_and_resume_refuses_other_options(evaluate, tmp_path):
-    out = str(tmp_path / "run")
-    assert evaluate(str(SPEC), "--users", "2", "--days", "1", "--out", out)[0] == 0
-    status, _, err = evaluate(str(SPEC), "--users", "2", "--days", "1", "--out", out)
-    assert status == 2 and "already holds an evaluation" in err
-    status, _, err = evaluate(str(SPEC), "--users", "3", "--days", "1", "--out", out,
-                              "--resume")
-    assert status == 2 and "users" in err
-    status, doc, _ = evaluate("--resume", "--out", out)
-    assert status == 0 and doc["users"] == 2
-
-
-def test_unknown_export_format_and_resume_without_out(evaluate, tmp_path):
-    status, _, err = evaluate(str(SPEC), "--export", "csv", "--out", str(tmp_path / "e"))
-    assert status == 2 and "xes, jsonl" in err
-    status, _, err = evaluate("--resume")
-    assert status == 2 and "--resume needs --out" in err
-
-
 def test_summary_table_on_a_terminal_run(tmp_path, capsys):
     status = main(["evaluate", str(SPEC), "--users", "3", "--days", "1", "--workers", "1",
                    "--out", str(tmp_path / "t")])
@@ -300,94 +139,6 @@ def test_summary_table_on_a_terminal_run(tmp_path, capsys):
     assert status == 0
     assert "95 % CI" in out and "taken_rate" in out and "%" in out
     assert f"report: {tmp_path / 't' / 'report.html'}" in out
-
-
-def _plan(users: int, days: float = 1):
-    from opspec.evaluation.plan import Design, EvaluationPlan, file_digest
-
-    return EvaluationPlan(designs=(Design("A", str(SPEC), file_digest(SPEC)),), users=users,
-                          days=days, seed=0, user_model=str(USERS_TOML))
-
-
-def _die_once_per_user(plan, design, users):
-    """A worker process that dies (as if killed) the first time it meets user 1."""
-    from opspec.evaluation.replication import run_users
-
-    marker = Path(os.environ["OPSPEC_TEST_MARKER"])
-    if 1 in users and not marker.exists():
-        marker.write_text("died", encoding="utf-8")
-        os._exit(9)
-    return run_users(plan, design, users)
-
-
-def test_chunks_lost_with_a_killed_worker_run_again_in_a_fresh_pool(tmp_path, monkeypatch):
-    from opspec.evaluation import runner
-    from opspec.evaluation.store import ResultStore
-
-    monkeypatch.setenv("OPSPEC_TEST_MARKER", str(tmp_path / "marker"))
-    monkeypatch.setattr(runner, "run_users", _die_once_per_user)
-    with ResultStore(tmp_path / "run", create=True) as store:
-        outcome = runner.run_evaluation(_plan(8), store, workers=2)
-        assert (tmp_path / "marker").exists(), "the worker should have died once"
-        assert outcome.failed == 0 and outcome.done == 8
-        assert store.finished("A") == set(range(8)) and store.failures() == []
-
-
-def test_a_full_disk_is_a_clear_error_and_leaves_a_sound_database(tmp_path):
-    from opspec.errors import EvaluationError
-    from opspec.evaluation.runner import run_evaluation
-    from opspec.evaluation.store import ResultStore
-
-    plan = _plan(30, days=3)
-    with ResultStore(tmp_path, create=True) as store:
-        store.put("plan", plan.to_json())
-        pages = store.query("PRAGMA page_count")[0][0]
-        # a disk with room for a few pages more than the empty database
-        store.query(f"PRAGMA max_page_count = {pages + 6}")
-        with pytest.raises(EvaluationError, match=r"cannot store replication A/\d+: "
-                           r"database or disk is full.*writable"):
-            run_evaluation(plan, store, workers=1)
-        kept = store.finished("A")
-        assert 0 < len(kept) < 30
-    with sqlite3.connect(tmp_path / "results.sqlite") as conn:
-        assert conn.execute("PRAGMA integrity_check").fetchone()[0] == "ok"
-        # every stored replication is whole: its samples are all there
-        for user, metrics in conn.execute("SELECT user, metrics FROM replication"):
-            n = json.loads(metrics)["report_latency_s"]["n"]
-            stored = conn.execute("SELECT COUNT(*) FROM sample WHERE user = ?",
-                                  (user,)).fetchone()[0]
-            assert stored == n
-    with ResultStore(tmp_path, create=False) as store:     # room again: resume finishes
-        outcome = run_evaluation(plan, store, workers=1)
-        assert outcome.skipped == len(kept) and store.finished("A") == set(range(30))
-
-
-@pytest.mark.parametrize("args, message", [
-    (["--users", "-3"], "--users must be a whole number >= 1"),
-    (["--users", "0"], "--users must be a whole number >= 1"),
-    (["--days", "-1"], "--days must be a positive number"),
-    (["--days", "nan"], "--days must be a positive number"),
-    (["--workers", "0"], "--workers must be >= 1"),
-], ids=["negative-users", "no-users", "negative-days", "nan-days", "no-workers"])
-def test_impossible_run_sizes_are_refused_before_anything_runs(args, message, evaluate,
-                                                              tmp_path):
-    out = tmp_path / "never"
-    status, doc, err = evaluate(str(SPEC), *args, "--out", str(out))
-    assert status == 2 and doc is None
-    assert message in err
-    assert not out.exists()
-
-
-def test_broken_spec_stops_with_its_location_before_anything_runs(evaluate, tmp_path):
-    broken = tmp_path / "broken.xpdl"
-    broken.write_text(SPEC.read_text(encoding="utf-8").replace("</Activities>", "", 1),
-                      encoding="utf-8")
-    out = tmp_path / "never"
-    status, doc, err = evaluate(str(broken), "--user-model", str(USERS_TOML), "--out",
-                                str(out))
-    assert status == 1 and doc is None
-    assert f"{broken}:" in err and "Traceback" not in err
-    assert not out.exists()
 
 
 def test_run_parameters_are_stored_for_other_readers(evaluate, tmp_path):
@@ -403,18 +154,6 @@ def test_run_parameters_are_stored_for_other_readers(evaluate, tmp_path):
     assert {"opspec_version", "started", "plan", "metrics"} <= set(run)
 
 
-def test_resume_refuses_a_spec_changed_since_the_run_started(evaluate, tmp_path):
-    spec = tmp_path / "dispenser.xpdl"
-    spec.write_text(SPEC.read_text(encoding="utf-8"), encoding="utf-8")
-    out = str(tmp_path / "run")
-    assert evaluate(str(spec), "--users", "2", "--days", "1", "--user-model",
-                    str(USERS_TOML), "--out", out)[0] == 0
-    spec.write_text(SPEC.read_text(encoding="utf-8").replace("PT300S", "PT600S"),
-                    encoding="utf-8")
-    status, _, err = evaluate("--resume", "--out", out)
-    assert status == 2 and f"{spec} changed since the run started" in err
-
-
 def test_specs_with_a_simulated_world_give_each_user_their_own_world(evaluate, tmp_path):
     """The vacuum cleaner's room comes from bindings.worlds, one per user from (seed, u):
     users differ, and the results do not depend on the number of workers."""
@@ -426,50 +165,3 @@ def test_specs_with_a_simulated_world_give_each_user_their_own_world(evaluate, t
     assert metrics_of(one) == metrics_of(two)
     covered = one["metrics"]["cells_covered"]
     assert covered["total"] > 0 and covered["sd"] > 0
-
-
-def test_unreachable_scheduler_is_a_clear_error_before_anything_is_written(evaluate, tmp_path,
-                                                                          monkeypatch):
-    pytest.importorskip("distributed")
-    import socket
-
-    from opspec.evaluation import runner
-
-    monkeypatch.setattr(runner, "SCHEDULER_TIMEOUT", 1)
-    with socket.socket() as sock:            # a port nobody listens on
-        sock.bind(("127.0.0.1", 0))
-        port = sock.getsockname()[1]
-    out = tmp_path / "never"
-    status, doc, err = evaluate(str(SPEC), "--users", "2", "--days", "1", "--scheduler",
-                                f"tcp://127.0.0.1:{port}", "--out", str(out))
-    assert status == 2 and doc is None
-    assert f"cannot reach the Dask scheduler at tcp://127.0.0.1:{port}" in err
-    assert not out.exists()
-
-
-def test_failed_replications_are_listed_exit_1_and_resume_completes_them(evaluate, tmp_path,
-                                                                         monkeypatch):
-    from opspec.errors import ExecutionError
-    from opspec.evaluation import replication
-
-    real = replication._world_performers
-
-    def broken_for_user_1(compiled, seed, user):
-        if user == 1:
-            raise ExecutionError("the simulated device fell over")
-        return real(compiled, seed, user)
-
-    out = str(tmp_path / "run")
-    monkeypatch.setattr(replication, "_world_performers", broken_for_user_1)
-    status, doc, _ = evaluate(str(SPEC), "--users", "3", "--days", "1", "--workers", "1",
-                              "--out", out)
-    assert status == 1
-    assert doc["failed"] == [{"design": "A", "user": 1,
-                              "error": "the simulated device fell over"}]
-    assert doc["metrics"]["doses_due"]["users"] == 2
-    html = Path(doc["report"]).read_text(encoding="utf-8")
-    assert "Failed replications" in html and "the simulated device fell over" in html
-    monkeypatch.undo()
-    status, doc, _ = evaluate("--resume", "--out", out)
-    assert status == 0 and doc["failed"] == []
-    assert doc["metrics"]["doses_due"]["users"] == 3
