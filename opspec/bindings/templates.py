@@ -1,7 +1,8 @@
 """Line templates: the one small language device profiles use for commands, replies and events.
 
 A template is literal text with ``{name}`` placeholders, optionally typed: ``{slot:int}``,
-``{distance:float}``, ``{reason:str}`` (``str`` is the default). ``{{`` and ``}}`` stand for
+``{distance:float}``, ``{bump:bool}`` (``1``/``0``, ``true``/``false``, ``on``/``off``,
+``yes``/``no`` in any case; sent as ``1``/``0``), ``{reason:str}`` (``str`` is the default). ``{{`` and ``}}`` stand for
 literal braces. The same template works both ways:
 
 * :meth:`LineTemplate.fill` formats an outgoing line from values (``DISPENSE {slot:int}`` with
@@ -17,17 +18,30 @@ No ``str.format`` is used, so a profile can never reach attributes or indexes of
 from __future__ import annotations
 
 import re
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from typing import Any
 
 __all__ = ["PLACEHOLDER_TYPES", "LineTemplate", "TemplateError"]
 
+_TRUE, _FALSE = frozenset({"1", "true", "on", "yes"}), frozenset({"0", "false", "off", "no"})
+
+
+def _to_bool(value: Any) -> bool:
+    """A boolean from a device word or an engine value; anything else raises ValueError."""
+    if isinstance(value, bool | int) and value in (0, 1):
+        return bool(value)
+    if isinstance(value, str) and value.strip().lower() in _TRUE | _FALSE:
+        return value.strip().lower() in _TRUE
+    raise ValueError(f"not a boolean: {value!r}")
+
+
 # type name -> (regex for matching, converter)
-PLACEHOLDER_TYPES: dict[str, tuple[str, type]] = {
+PLACEHOLDER_TYPES: dict[str, tuple[str, Callable[[Any], Any]]] = {
     "str": (r".+?", str),
     "int": (r"[-+]?\d+", int),
     "float": (r"[-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?", float),
+    "bool": (r"(?i:1|0|true|false|on|off|yes|no)", _to_bool),
 }
 
 _TOKEN = re.compile(r"\{\{|\}\}|\{([^{}]*)\}|[{}]")
@@ -123,7 +137,7 @@ class LineTemplate:
                     raise TemplateError(
                         f"{self.text!r}: {{{name}:{kind}}} got {value!r}, which is not {kind}"
                     ) from None
-            text = str(value)
+            text = ("1" if value else "0") if kind == "bool" else str(value)
             if "\n" in text or "\r" in text:
                 raise TemplateError(f"{self.text!r}: {{{name}}} value contains a line break")
             out.append(text)

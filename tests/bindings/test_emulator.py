@@ -22,12 +22,13 @@ def test_replies_follow_the_profile(dispenser_profile: DeviceProfile,
     assert device.handle_line("ALARM ON") == [Reply(b"OK\n")]
     assert device.handle_line("DISPENSE 4") == [Reply(b"OK DISPENSED 4\n")]
     assert device.handle_line("MAKE COFFEE") == [Reply(b"ERR UNKNOWN\n")]
-    assert EmulatedDevice(range_finder).handle_line("RANGE?") == [Reply(b"RANGE 123\n")]
+    assert EmulatedDevice(range_finder).handle_line("RANGE?") == [Reply(b"RANGE 1.23\n")]
 
 
 def test_cart_motors_use_crlf(dispenser_profile: DeviceProfile) -> None:
     device = EmulatedDevice(load_profile(DEVICES / "cart_motors.toml"))
     assert device.handle_line("MOTOR 50 -50") == [Reply(b"OK\r\n")]
+    assert device.handle_line("DRIVE turn_left") == [Reply(b"OK\r\n")]
     assert device.event_line("bump") == b"BUMP FRONT\r\n"
 
 

@@ -22,8 +22,29 @@ INVALID = Path(__file__).parent / "data" / "invalid"
 
 def test_every_shipped_profile_loads() -> None:
     names = [p.name for p in load_profiles(DEVICES)]
-    assert names == ["barcode_scanner", "cart_motors", "medication_dispenser",
-                     "range_finder", "rfid_reader"]
+    assert names == ["barcode_scanner", "battery", "bumper", "cart_motors",
+                     "medication_dispenser", "range_finder", "rfid_reader"]
+
+
+SPECS = DEVICES.parent / "specs"
+
+
+@pytest.mark.parametrize("spec", ["medication_dispenser", "vacuum_cleaner", "toy_sumo",
+                                  "medication_cart_guidance"])
+def test_every_device_activity_of_the_shipped_specs_has_a_profile_operation(spec: str) -> None:
+    from opspec.commands._spec import load_any_spec
+    from opspec.engine.compiled import compile_package
+    from opspec.engine.lanes import all_activities
+
+    compiled = compile_package(load_any_spec(SPECS / f"{spec}.xpdl"))
+    profiles = load_profiles(DEVICES)
+    # the dispenser's notify_caregiver is a message to a person, not a serial device
+    needed = {(a.participant, a.application) for a in all_activities(compiled)
+              if a.application and a.application != "notify_caregiver"}
+    assert needed
+    for participant, application in sorted(needed, key=str):
+        (profile,) = profiles_serving(participant or "", profiles)
+        assert profile.operation_for(application, "") is not None, (participant, application)
 
 
 def test_dispenser_profile_serves_alarm_and_dispenser_with_button_raising_trg_1() -> None:
@@ -53,8 +74,9 @@ def test_operation_is_found_by_application_then_activity() -> None:
 
 def test_range_finder_reply_gives_typed_data() -> None:
     profile = load_profile(DEVICES / "range_finder.toml")
-    (ok,) = profile.operations["measure_range"].ok
-    assert ok.match("RANGE 123") == {"distance": 123}
+    (ok,) = profile.operations["read_range"].ok
+    assert ok.match("RANGE 1.23") == {"distance": 1.23}
+    assert ok.match("RANGE 2") == {"distance": 2.0}
 
 
 def test_profiles_serving_and_resolve_by_name() -> None:
@@ -108,7 +130,7 @@ def test_missing_profile_file_says_so() -> None:
 
 
 def test_unknown_profile_name_lists_the_available_ones() -> None:
-    with pytest.raises(BindingError, match="available: barcode_scanner, cart_motors"):
+    with pytest.raises(BindingError, match="available: barcode_scanner, battery, bumper"):
         resolve_profile("teapot", DEVICES)
 
 

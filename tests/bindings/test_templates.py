@@ -19,6 +19,17 @@ def test_match_returns_typed_values_or_none() -> None:
     assert template.match("XRANGE 1 cm") is None
 
 
+def test_bool_placeholders_read_device_words_and_send_1_or_0() -> None:
+    template = LineTemplate.parse("BUMP {bump:bool}")
+    assert [template.match(f"BUMP {w}") for w in ("1", "0", "TRUE", "off", "yes")] == [
+        {"bump": True}, {"bump": False}, {"bump": True}, {"bump": False}, {"bump": True}]
+    assert template.match("BUMP maybe") is None
+    assert template.fill({"bump": True}) == "BUMP 1"
+    assert template.fill({"bump": "false"}) == "BUMP 0"
+    with pytest.raises(TemplateError, match="not bool"):
+        template.fill({"bump": 7})
+
+
 def test_literal_braces_are_doubled() -> None:
     template = LineTemplate.parse("SET {{mode}} {value:int}")
     assert template.fill({"value": 3}) == "SET {mode} 3"
