@@ -2,78 +2,79 @@
 
 A package names its world with ``<ExtendedAttribute Name="opspec:World" Value="vacuum-room"/>``
 and may give parameters in a TOML file next to the spec
-(``<ExtendedAttribute Name="opspec:WorldFile" Value="vacuum_cleaner.world.toml"/>``, keys as
-the world's constructor takes them: ``width``, ``obstacles``…). :func:`world_performers` gives
-the performers ``opspec run``, ``opspec evaluate``, the walkthrough and the test helpers bind:
-one per world, serving the world's applications by Application id. Each simulated user gets a
-world of their own, drawing from a stream derived from ``(seed, user)``.
+(``<ExtendedAttribute Name="opspec:WorldFile" Value="vacuum_cleaner.world.toml"/>``) and/or
+inline, as children of the ``opspec:World`` attribute, which win over the file::
+
+    <ExtendedAttribute Name="opspec:World" Value="vacuum-room">
+      <opspec:Parameter Name="drain_per_s" Value="1.0"/>
+      <opspec:Parameter Name="obstacles" Value="[[1.5, 1.5, 2.1, 2.3]]"/>
+    </ExtendedAttribute>
+
+Keys are the world's constructor parameters (``width``, ``obstacles``…; see
+:class:`~opspec.bindings.world.room.RoomWorld` and :class:`~opspec.bindings.world.sumo.SumoWorld`);
+an inline ``Value`` is read as a TOML value (a bare word is a string). :func:`world_performers`
+gives the performers ``opspec run``, ``opspec evaluate``, the walkthrough and the test helpers
+bind: one per world, serving the world's applications by Application id. Each simulated user
+gets a world of their own, drawing from a stream derived from ``(seed, user)``.
 
 Worlds are registered here by name; spec text never names Python code.
 """
 
 from __future__ import annotations
 
+import functools
+import inspect
 import tomllib
-from collections.abc import Callable
+import xml.etree.ElementTree as ElementTree
+from collections.abc import Callable, Mapping
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
+from opspec.bindings.world.base import World
+from opspec.bindings.world.room import RoomWorld
+from opspec.bindings.world.sumo import SumoWorld
 from opspec.errors import ConfigurationError, SourceLocation
 
 if TYPE_CHECKING:
-    from opspec.bindings.world.base import World
     from opspec.engine.compiled import CompiledPackage
     from opspec.engine.performers import Performer
+    from opspec.model import ExtendedAttribute
 
-__all__ = ["WORLDS", "world_performers"]
+__all__ = ["WORLDS", "world_parameters", "world_performers"]
 
+#: the ward: a 20 x 3 m corridor with two carts in the way and the patient near its far end
+WARD: dict[str, Any] = {"width": 20.0, "height": 3.0, "start": (0.6, 1.5, 0.0),
+                        "obstacles": ((6.0, 0.0, 6.6, 1.0), (11.0, 2.0, 11.6, 3.0)),
+                        "tag": (17.0, 2.4), "drain_per_s": 0.0}
 
-def _room(rng: Any, **params: Any) -> World:
-    from opspec.bindings.world.room import RoomWorld
-
-    return RoomWorld(rng, **params)
-
-
-def _ward(rng: Any, **params: Any) -> World:
-    from opspec.bindings.world.room import RoomWorld
-
-    defaults: dict[str, Any] = {"width": 20.0, "height": 3.0, "start": (0.6, 1.5, 0.0),
-                                "obstacles": ((6.0, 0.0, 6.6, 1.0), (11.0, 2.0, 11.6, 3.0)),
-                                "tag": (17.0, 2.4), "drain_per_s": 0.0}
-    return RoomWorld(rng, **{**defaults, **params})
-
-
-def _ring(rng: Any, **params: Any) -> World:
-    from opspec.bindings.world.sumo import SumoWorld
-
-    return SumoWorld(rng, **params)
-
-
-#: world name → factory(rng, **parameters)
+#: world name -> factory(rng, **parameters); a class or a partial of one, so its parameters
+#: (and their defaults) can be listed and checked before the world is built
 WORLDS: dict[str, Callable[..., World]] = {
-    "vacuum-room": _room,
-    "ward": _ward,
-    "sumo-ring": _ring,
+    "vacuum-room": RoomWorld,
+    "ward": functools.partial(RoomWorld, **WARD),
+    "sumo-ring": SumoWorld,
 }
 
+_NS = "{urn:opspec:sisarl:1}"
 
-def _attribute(compiled: CompiledPackage, name: str) -> Any:
+
+def _attribute(compiled: CompiledPackage, name: str) -> ExtendedAttribute | None:
     for attribute in compiled.package.extended_attributes:
         if attribute.name == name:
             return attribute
     return None
 
 
-def _parameters(compiled: CompiledPackage, world_attr: Any) -> dict[str, Any]:
+def _file_parameters(compiled: CompiledPackage, world_attr: ExtendedAttribute
+                     ) -> tuple[dict[str, Any], str | None]:
     attribute = _attribute(compiled, "opspec:WorldFile")
     if attribute is None or not attribute.value:
-        return {}
-    base = Path(compiled.package.source or ".").parent
-    path = base / attribute.value
+        return {}, None
+    path = Path(compiled.package.source or ".").parent / attribute.value
     where = attribute.location or world_attr.location
     try:
         with open(path, "rb") as handle:
-            return dict(tomllib.load(handle))
+            return dict(tomllib.load(handle)), str(path)
     except OSError as error:
         raise ConfigurationError(f"cannot read the world file {path}: "
                                  f"{error.strerror or error}", location=where,
@@ -82,9 +83,62 @@ def _parameters(compiled: CompiledPackage, world_attr: Any) -> dict[str, Any]:
         raise ConfigurationError(f"{path}: not valid TOML: {error}", location=where) from None
 
 
+def _inline_parameters(attribute: ExtendedAttribute) -> dict[str, Any]:
+    """``<opspec:Parameter Name=… Value=…/>`` children of the opspec:World attribute."""
+    if not attribute.raw_xml:
+        return {}
+    # raw_xml is what the hardened reader already parsed and re-serialised: no DTDs, no
+    # entities left, so the standard library parser is safe here
+    root = ElementTree.fromstring(f'<root xmlns:opspec="urn:opspec:sisarl:1">'
+                                  f"{attribute.raw_xml}</root>")
+    params: dict[str, Any] = {}
+    for element in root:
+        if element.tag != f"{_NS}Parameter" or not element.get("Name"):
+            raise ConfigurationError(
+                f"opspec:World holds <{element.tag.replace(_NS, 'opspec:')}>; only "
+                f"<opspec:Parameter Name=\"...\" Value=\"...\"/> is allowed there",
+                location=attribute.location)
+        text = element.get("Value", "")
+        try:
+            params[element.get("Name", "")] = tomllib.loads(f"v = {text}")["v"]
+        except tomllib.TOMLDecodeError:
+            params[element.get("Name", "")] = text          # a bare word: a string
+    return params
+
+
+def world_parameters(factory: Callable[..., World]) -> dict[str, Any]:
+    """The parameters a world factory takes, with their defaults (``rng`` left out)."""
+    signature = inspect.signature(factory)
+    return {name: p.default for name, p in signature.parameters.items()
+            if name != "rng" and p.kind is inspect.Parameter.KEYWORD_ONLY}
+
+
+def _build(name: str, factory: Callable[..., World], rng: Any, params: Mapping[str, Any],
+           attribute: ExtendedAttribute, file: str | None, inline: Mapping[str, Any]) -> World:
+    known = world_parameters(factory)
+    for key in params:
+        if key not in known:
+            where = (attribute.location if key in inline or file is None
+                     else SourceLocation(file, key=key))
+            raise ConfigurationError(
+                f"world {name!r} has no parameter {key!r}", location=where,
+                hint=f"its parameters: {', '.join(sorted(known))}")
+    try:
+        return factory(rng, **params)
+    except (TypeError, ValueError) as error:
+        raise ConfigurationError(f"world {name!r}: {error}",
+                                 location=SourceLocation(file) if file and not inline
+                                 else attribute.location,
+                                 hint="check the world's parameters "
+                                      "(docs/behaviour-specs.md, 'The worlds')") from None
+
+
 def world_performers(compiled: CompiledPackage, *, seed: int, user: int
                      ) -> dict[str, Performer]:
-    """The performers of the world ``compiled`` declares ({} when it declares none)."""
+    """The performers of the world ``compiled`` declares ({} when it declares none).
+
+    Raises :class:`ConfigurationError` for an unknown world (naming the known ones), an
+    unreadable world file, an unknown parameter or an impossible value."""
     attribute = _attribute(compiled, "opspec:World")
     if attribute is None:
         return {}
@@ -98,11 +152,8 @@ def world_performers(compiled: CompiledPackage, *, seed: int, user: int
     from opspec.bindings.world.device import WorldDevices
     from opspec.engine.random import named_stream
 
-    params = _parameters(compiled, attribute)
-    try:
-        world = factory(named_stream(seed, f"world/{name}", (user,)), **params)
-    except TypeError as error:
-        raise ConfigurationError(f"world {name!r}: bad parameters: {error}",
-                                 location=attribute.location,
-                                 hint="check the keys of the opspec:WorldFile") from None
+    from_file, file = _file_parameters(compiled, attribute)
+    inline = _inline_parameters(attribute)
+    world = _build(name, factory, named_stream(seed, f"world/{name}", (user,)),
+                   {**from_file, **inline}, attribute, file, inline)
     return {"world": WorldDevices(world)}

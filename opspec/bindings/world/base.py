@@ -26,6 +26,7 @@ class World:
         self.rng = rng
         self.time = 0.0
         self.tracer: Tracer | None = None
+        self._announced = False
 
     def trace(self, kind: str, **data: Any) -> None:
         if self.tracer is not None:
@@ -33,6 +34,11 @@ class World:
 
     def advance(self, now: float) -> None:
         """Move the world forward to simulated time ``now`` in small steps."""
+        if not self._announced:
+            # facts of the initial state (cells under the robot at the start) are traced at
+            # the first use, once the tracer is attached, so counts from the trace are whole
+            self._announced = True
+            self._announce()
         while self.time < now - 1e-12:
             dt = min(STEP_S, now - self.time)
             self._step(dt)
@@ -40,6 +46,9 @@ class World:
 
     def _step(self, dt: float) -> None:
         raise NotImplementedError
+
+    def _announce(self) -> None:
+        """Trace facts of the initial state (subclass hook; nothing by default)."""
 
     # device operations, by Application id: each returns the data the activity completes with
     def operation(self, application: str, data: Mapping[str, Any]) -> dict[str, Any]:

@@ -23,7 +23,19 @@ from opspec.bindings.world.robot import Robot
 __all__ = ["RoomWorld"]
 
 
+def _box(corners: Sequence[float]) -> Box:
+    if len(corners) != 4:
+        raise ValueError(f"an obstacle is [x0, y0, x1, y1], not {list(corners)}")
+    box = Box(*map(float, corners))
+    if not (box.x0 < box.x1 and box.y0 < box.y1):
+        raise ValueError(f"obstacle {list(corners)} needs x0 < x1 and y0 < y1")
+    return box
+
+
 class RoomWorld(World):
+    """The room (``width`` x ``height`` metres, walls on its edges, ``obstacles`` as
+    ``[x0, y0, x1, y1]`` boxes) with the robot starting at ``start`` = ``[x, y, heading]``."""
+
     def __init__(self, rng: np.random.Generator, *, width: float = 5.0, height: float = 4.0,
                  obstacles: Sequence[Sequence[float]] = ((1.5, 1.5, 2.1, 2.3),
                                                          (3.4, 0.6, 4.0, 1.2)),
@@ -32,10 +44,22 @@ class RoomWorld(World):
                  tag: Sequence[float] | None = None, tag_range: float = 0.8,
                  patient_id: str = "patient-17") -> None:
         super().__init__(rng)
-        self.room = Box(0.0, 0.0, float(width), float(height))
-        self.obstacles = [Box(*map(float, o)) for o in obstacles]
         self.radius = float(radius)
+        if not (self.radius > 0 and float(cell) > 0):
+            raise ValueError(f"radius ({radius}) and cell ({cell}) must be positive")
+        if not (width > 2 * self.radius and height > 2 * self.radius):
+            raise ValueError(f"a {width} x {height} m room has no room for a robot of "
+                             f"radius {radius} m")
+        self.room = Box(0.0, 0.0, float(width), float(height))
+        self.obstacles = [_box(o) for o in obstacles]
+        if len(start) != 3:
+            raise ValueError(f"start must be [x, y, heading], not {list(start)}")
         self.robot = Robot(float(start[0]), float(start[1]), float(start[2]))
+        if not self._free(self.robot.x, self.robot.y):
+            raise ValueError(f"start ({start[0]}, {start[1]}) puts the robot in a wall or "
+                             "an obstacle")
+        if tag is not None and not (len(tag) == 2 and self.room.contains(*map(float, tag))):
+            raise ValueError(f"tag must be [x, y] inside the room, not {list(tag)}")
         self.cell = float(cell)
         self.cells_x = max(1, math.ceil(width / cell))
         self.cells_y = max(1, math.ceil(height / cell))
@@ -87,6 +111,10 @@ class RoomWorld(World):
                         cell / 2) ** 2 and (cx, cy) not in self.covered:
                     self.covered.add((cx, cy))
                     self.trace("world.covered", cell=[cx, cy])
+
+    def _announce(self) -> None:
+        for cx, cy in sorted(self.covered):
+            self.trace("world.covered", cell=[cx, cy])
 
     @property
     def coverage(self) -> float:

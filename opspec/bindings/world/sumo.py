@@ -29,6 +29,9 @@ class SumoWorld(World):
                  radius: float = 0.15, opponent_speed: float = 0.25, bout_limit_s: float = 60.0,
                  range_noise: float = 0.01, drain_per_s: float = 0.02) -> None:
         super().__init__(rng)
+        if not (radius > 0 and ring_radius > 4 * radius and bout_limit_s > 0):
+            raise ValueError(f"the ring (radius {ring_radius} m) must hold two robots of "
+                             f"radius {radius} m apart, and bout_limit_s must be positive")
         self.ring = float(ring_radius)
         self.radius = float(radius)
         self.opponent_speed = float(opponent_speed)
@@ -80,7 +83,10 @@ class SumoWorld(World):
                 robot.x += shove * ux
                 robot.y += shove * uy
         else:
-            self.in_contact = False
+            # a contact ends when the robots are clearly apart (2 cm), not when the wobbling
+            # opponent leaves a hair's gap: one shoving match is one collision
+            if gap > 2 * self.radius + 0.02:
+                self.in_contact = False
             me.x += v_me * dt * math.cos(me.heading)
             me.y += v_me * dt * math.sin(me.heading)
             step = min(self.opponent_speed * dt, gap - 2 * self.radius)
