@@ -198,3 +198,25 @@ def test_failed_replications_are_listed_exit_1_and_resume_completes_them(evaluat
     status, doc, _ = evaluate("--resume", "--out", out)
     assert status == 0 and doc["failed"] == []
     assert doc["metrics"]["doses_due"]["users"] == 3
+
+
+def test_a_report_that_cannot_be_written_keeps_the_results_and_resume_writes_it(
+        evaluate, tmp_path, monkeypatch):
+    import errno
+
+    from opspec.evaluation import report
+
+    def disk_full(store):
+        raise OSError(errno.ENOSPC, "No space left on device")
+
+    out = tmp_path / "run"
+    monkeypatch.setattr(report, "write_report", disk_full)
+    status, doc, err = evaluate(str(SPEC), "--users", "3", "--days", "1", "--workers", "1",
+                                "--out", str(out))
+    assert status == 2 and doc is None
+    assert "cannot write the report: No space left on device" in err
+    assert f"--resume --out {out}" in err and "Traceback" not in err
+    monkeypatch.undo()
+    status, doc, _ = evaluate("--resume", "--out", str(out))
+    assert status == 0 and Path(doc["report"]).is_file()
+    assert doc["metrics"]["doses_due"]["total"] == 3 * 4
