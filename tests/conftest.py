@@ -5,3 +5,18 @@
 ``@pytest.mark.hardware`` against a real device: ``pytest --device-url=/dev/ttyUSB0 -m hardware``.
 Without ``--device-url`` those tests are skipped with a message saying how to run them.
 """
+
+import os
+
+import pytest
+
+
+@pytest.fixture(autouse=True)
+def _inner_pytest_runs_leave_the_snapshot_plugin_alone(request: pytest.FixtureRequest,
+                                                       monkeypatch: pytest.MonkeyPatch) -> None:
+    """pytester runs pytest in this process; pytest-textual-snapshot keeps its temporary
+    folder's name in the environment, replaces it when a session starts and deletes it when
+    that session ends, so an inner run would leave the outer session pointing at a deleted
+    folder. Putting the outer value back after each pytester test keeps the outer one."""
+    if "pytester" in request.fixturenames and "TEXTUAL_SNAPSHOT_TEMPDIR" in os.environ:
+        monkeypatch.setenv("TEXTUAL_SNAPSHOT_TEMPDIR", os.environ["TEXTUAL_SNAPSHOT_TEMPDIR"])
