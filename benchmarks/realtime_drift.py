@@ -1,29 +1,44 @@
-"""Wall-clock drift of a 10 ms periodic workflow in real-time mode, and device round trips.
+"""Wall-clock drift of a 10 ms periodic workflow in real-time mode, with and without a device.
 
-    python benchmarks/realtime_drift.py [--seconds 5] [--period-ms 10]
+    python benchmarks/realtime_drift.py [--seconds 5] [--period-ms 10] [--no-device]
 
 Runs a one-activity workflow started every period (SISARL ``opspec:Period``) at speed 1 for a
 few wall-clock seconds through the engine's wall-clock driver, and prints how late events ran
-against their wall-clock due time (mean, p99, max, share later than 10 ms). Command round-trip
-latency over a pseudo-terminal is measured by ``benchmarks/serial_latency.py``.
+against their wall-clock due time (mean, p99, max, share later than 10 ms) and how far the
+simulated clock was behind the wall clock when the run ended. Then the same with the activity
+performed by a device: ``alarm_on`` of the medication dispenser profile sent to the emulator on
+a pseudo-terminal through ``attach_devices`` (the hybrid-time path of ``opspec run --bind``),
+with the command round trips. Command round-trip latency alone is measured by
+``benchmarks/serial_latency.py``.
 """
 
 from __future__ import annotations
 
 import argparse
+import os
+import sys
 import tempfile
+import time
 from pathlib import Path
+from typing import Any
+
+ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT))
 
 SPEC = """<?xml version="1.0" encoding="UTF-8"?>
 <Package xmlns="http://www.wfmc.org/2008/XPDL2.1" Id="tick" Name="10 ms tick">
   <PackageHeader><XPDLVersion>2.1</XPDLVersion><Vendor>opspec</Vendor>
     <Created>2026-11-23</Created></PackageHeader>
+  <Participants>
+    <Participant Id="alarm"><ParticipantType Type="SYSTEM"/></Participant>
+  </Participants>
+  <Applications><Application Id="alarm_on"/></Applications>
   <WorkflowProcesses>
     <WorkflowProcess Id="tick" Name="tick">
       <ProcessHeader/>
       <Activities>
         <Activity Id="start"><Event><StartEvent/></Event></Activity>
-        <Activity Id="sense"><Implementation><No/></Implementation></Activity>
+        <Activity Id="sense">{body}</Activity>
         <Activity Id="end"><Event><EndEvent/></Event></Activity>
       </Activities>
       <Transitions>
@@ -39,27 +54,62 @@ SPEC = """<?xml version="1.0" encoding="UTF-8"?>
 """
 
 
-def main() -> None:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--seconds", type=float, default=5.0)
-    parser.add_argument("--period-ms", type=float, default=10.0)
-    args = parser.parse_args()
+NO_WORK = "<Implementation><No/></Implementation>"
+DEVICE_WORK = ('<Implementation><Task><TaskApplication Id="alarm_on"/></Task></Implementation>'
+               "<Performers><Performer>alarm</Performer></Performers>")
+
+
+def run(period_ms: float, seconds: float, device_url: str | None) -> None:
+    from opspec.bindings.attach import attach_devices
     from opspec.engine.config import EngineConfig
     from opspec.engine.simulation import Simulation
     from opspec.xpdl.loader import load_spec
 
     with tempfile.TemporaryDirectory() as tmp:
         path = Path(tmp) / "tick.xpdl"
-        path.write_text(SPEC.format(period=f"{args.period_ms / 1000:g}"), encoding="utf-8")
+        path.write_text(SPEC.format(period=f"{period_ms / 1000:g}",
+                                    body=DEVICE_WORK if device_url else NO_WORK),
+                        encoding="utf-8")
         package = load_spec(path)
-    sim = Simulation(package, EngineConfig(realtime=True, speed=1.0))
-    result = sim.run(until=args.seconds)
+    binds = [f"alarm={device_url}"] if device_url else []
+    with attach_devices(binds, ROOT / "devices", settle_s=0) as devices:
+        sim = Simulation(package, EngineConfig(realtime=True, speed=1.0),
+                         performers=dict(devices.performers))
+        devices.install(sim)
+        started = time.perf_counter()
+        result = sim.run(until=seconds)
+        wall = time.perf_counter() - started
+        report: dict[str, Any] = devices.report()
     drift = result.summary["drift"]
-    print(f"{args.period_ms:g} ms periodic workflow, {args.seconds:g} s of wall-clock time, "
+    what = f"device alarm_on over {device_url}" if device_url else "no device"
+    print(f"{period_ms:g} ms periodic workflow, {what}: {seconds:g} s simulated in "
+          f"{wall:.3f} s wall (behind by {(wall - seconds) * 1e3:.1f} ms at the end), "
           f"{result.summary['instances'].get('completed', 0)} instances")
-    print(f"lateness of {drift['events']} events: mean {drift['mean_s'] * 1e3:.3f} ms, "
+    print(f"  lateness of {drift['events']} events: mean {drift['mean_s'] * 1e3:.3f} ms, "
           f"p99 {drift['p99_s'] * 1e3:.3f} ms, max {drift['max_s'] * 1e3:.3f} ms, "
           f"{drift['late_10ms']} later than 10 ms")
+    for name, info in report.items():
+        rtt = info["latency_ms"]
+        print(f"  device {name}: {rtt['count']} round trips, mean {rtt['mean']} ms, "
+              f"p99 {rtt['p99']} ms, max {rtt['max']} ms, {len(info['faults'])} fault(s)")
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--seconds", type=float, default=5.0)
+    parser.add_argument("--period-ms", type=float, default=10.0)
+    parser.add_argument("--no-device", action="store_true",
+                        help="skip the run with the emulated device on a pseudo-terminal")
+    args = parser.parse_args()
+    run(args.period_ms, args.seconds, None)
+    if args.no_device or not hasattr(os, "openpty"):
+        return
+    from opspec.bindings import load_profile
+    from opspec.bindings.emulator import EmulatedDevice, PtyEmulator
+
+    profile = load_profile(ROOT / "devices" / "medication_dispenser.toml")
+    with PtyEmulator(EmulatedDevice(profile)) as emulator:
+        run(args.period_ms, args.seconds, emulator.url)
 
 
 if __name__ == "__main__":
