@@ -139,3 +139,17 @@ def test_auto_without_a_device_falls_back_to_simulated_and_says_so(capsys, tmp_p
     assert status == 0
     assert "using the simulated alarm" in output
     assert "alarm simulated" in output
+
+
+@needs_pty
+def test_device_faults_are_on_the_screen_with_the_fallback_taken(board, capsys, tmp_path):
+    server = board(on="pty", fault="garbage", profile=DATA / "test_dispenser.toml")
+    status, _, output = run(capsys, "--until", "43000", "--realtime", "--speed", "20000",
+                            "--timeline", "brief", "--bind", f"alarm:test_dispenser={server.url}",
+                            "--devices", str(DATA),
+                            "--script", script(tmp_path, ("after trg_2 30s", "press_report")))
+    assert status == 1
+    assert "fault garbage:" in output and "(then retry)" in output
+    assert "(then simulate)" in output
+    assert "using the simulated alarm from now on" in output
+    assert "Traceback" not in output
