@@ -72,6 +72,14 @@ def _exports(values: list[str]) -> tuple[str, ...]:
     return tuple(formats)
 
 
+def _local_cores() -> int:
+    """The cores this process may run on (a container or taskset may allow fewer than the
+    machine has)."""
+    if hasattr(os, "sched_getaffinity"):
+        return max(1, len(os.sched_getaffinity(0)))
+    return os.cpu_count() or 1
+
+
 def _default_out(spec: str) -> Path:
     stem = Path(spec).name.split(".")[0]
     stamp = datetime.now(UTC).strftime("%Y%m%d-%H%M%S")
@@ -184,7 +192,7 @@ def run(args: argparse.Namespace) -> int:
     from opspec.evaluation.runner import run_evaluation
     from opspec.evaluation.store import ResultStore
 
-    workers = args.workers if args.workers is not None else (os.cpu_count() or 1)
+    workers = args.workers if args.workers is not None else _local_cores()
     if workers < 1:
         raise EvaluationError(f"--workers must be >= 1, not {workers}")
     if args.scheduler:
