@@ -225,7 +225,8 @@ def run(args: argparse.Namespace) -> int:
         _store_parameters(store, plan, definitions, __version__)
     with store, contextlib.ExitStack() as stack:
         on_trace = _trace_writers(stack, store.folder, plan, resumed=args.resume)
-        progress = make_progress(sys.stderr, quiet=args.quiet or args.json)
+        progress = make_progress(sys.stderr, quiet=args.quiet or args.json,
+                                 label="users" if len(plan.designs) == 1 else "replications")
         try:
             outcome = run_evaluation(plan, store, workers=workers, scheduler=args.scheduler,
                                      progress=progress, on_trace=on_trace)

@@ -14,8 +14,10 @@ __all__ = ["LogProgress", "make_progress"]
 class LogProgress(Progress):
     """One line every ``every`` seconds (and at the end): done, rate, time left."""
 
-    def __init__(self, stream: IO[str], every: float = 5.0) -> None:
+    def __init__(self, stream: IO[str], every: float = 5.0, label: str = "replications"
+                 ) -> None:
         self.stream = stream
+        self.label = label
         self.every = every
         self.total = self.done = self.already = 0
         self._start = self._last = 0.0
@@ -24,7 +26,7 @@ class LogProgress(Progress):
         self.total, self.already, self.done = total, already, already
         self._start = self._last = time.perf_counter()
         if already:
-            print(f"evaluate: resuming, {already} of {total} replications already stored",
+            print(f"evaluate: resuming, {already} of {total} {self.label} already stored",
                   file=self.stream, flush=True)
 
     def advance(self, n: int) -> None:
@@ -43,7 +45,7 @@ class LogProgress(Progress):
             left = f"about {(self.total - self.done) / rate:.0f} s left"
         else:
             left = "time left not known yet"
-        print(f"evaluate: {self.done}/{self.total} replications ({rate:.0f}/s, {left})",
+        print(f"evaluate: {self.done}/{self.total} {self.label} ({rate:.0f}/s, {left})",
               file=self.stream, flush=True)
 
     def finish(self) -> None:
@@ -51,12 +53,12 @@ class LogProgress(Progress):
 
 
 class _RichProgress(Progress):
-    def __init__(self, stream: IO[str]) -> None:
+    def __init__(self, stream: IO[str], label: str) -> None:
         from rich.console import Console
         from rich.progress import BarColumn, MofNCompleteColumn, TextColumn, TimeRemainingColumn
         from rich.progress import Progress as Bar
 
-        self._bar = Bar(TextColumn("users"), BarColumn(), MofNCompleteColumn(),
+        self._bar = Bar(TextColumn(label), BarColumn(), MofNCompleteColumn(),
                         TextColumn("{task.fields[rate]}"), TimeRemainingColumn(),
                         console=Console(file=stream), transient=False)
         self._task: Any = None
@@ -65,7 +67,7 @@ class _RichProgress(Progress):
 
     def start(self, total: int, already: int) -> None:
         self._bar.start()
-        self._task = self._bar.add_task("users", total=total, completed=already, rate="")
+        self._task = self._bar.add_task("evaluate", total=total, completed=already, rate="")
         self._start = time.perf_counter()
 
     def advance(self, n: int) -> None:
@@ -78,11 +80,13 @@ class _RichProgress(Progress):
         self._bar.stop()
 
 
-def make_progress(stream: IO[str] | None = None, *, quiet: bool = False) -> Progress:
-    """A bar when ``stream`` is a terminal, log lines when it is not, nothing when quiet."""
+def make_progress(stream: IO[str] | None = None, *, quiet: bool = False,
+                  label: str = "users") -> Progress:
+    """A bar when ``stream`` is a terminal, log lines when it is not, nothing when quiet.
+    ``label`` names what is counted (users; replications when two designs run)."""
     stream = stream or sys.stderr
     if quiet:
         return Progress()
     if stream.isatty():
-        return _RichProgress(stream)
-    return LogProgress(stream)
+        return _RichProgress(stream, label)
+    return LogProgress(stream, label=label)

@@ -170,8 +170,11 @@ def test_exports_write_one_case_per_user(evaluate, tmp_path):
 def test_summary_table_on_a_terminal_run(tmp_path, capsys):
     status = main(["evaluate", str(SPEC), "--users", "3", "--days", "1", "--workers", "1",
                    "--out", str(tmp_path / "t")])
-    out = capsys.readouterr().out
+    captured = capsys.readouterr()
+    out = captured.out
     assert status == 0
+    # not a terminal: plain progress lines on stderr, ending with the total
+    assert "evaluate: 3/3 users (" in captured.err and "done)" in captured.err
     assert "95 % CI" in out and "taken_rate" in out and "%" in out
     assert f"report: {tmp_path / 't' / 'report.html'}" in out
 
