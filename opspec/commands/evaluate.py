@@ -116,12 +116,12 @@ def _new_plan(args: argparse.Namespace) -> Any:
                           export=_exports(args.export))
 
 
-def _check_plan(plan: Any) -> list[dict[str, Any]]:
+def _check_plan(plan: Any) -> dict[str, list[dict[str, Any]]]:
     """Load every design and the user model once, before any simulation: bad inputs stop the
-    run here. Returns the metric definitions of design A."""
+    run here. Returns the metric definitions of each design, by label."""
     from opspec.evaluation.replication import prepare
 
-    definitions: list[dict[str, Any]] = []
+    definitions: dict[str, list[dict[str, Any]]] = {}
     for design in plan.designs:
         context = prepare(design.spec, design.sha256, plan.user_model, plan.engine)
         from opspec.engine.lanes import user_lane
@@ -131,11 +131,10 @@ def _check_plan(plan: Any) -> list[dict[str, Any]]:
                 f"{design.spec}: the spec has a user lane but no user model was given",
                 hint="give --user-model FILE|PRESET (presets: opspec fit --help, "
                 "docs/user-models.md) or put SPEC.users.toml next to the spec")
-        if design.label == "A":
-            definitions = [{"name": m.name, "kind": m.kind.value.lower(),
-                            "numerator": m.numerator, "denominator": m.denominator,
-                            "unit": m.unit, "description": m.description}
-                           for m in context.compiled.package.metrics]
+        definitions[design.label] = [
+            {"name": m.name, "kind": m.kind.value.lower(), "numerator": m.numerator,
+             "denominator": m.denominator, "unit": m.unit, "description": m.description}
+            for m in context.compiled.package.metrics]
     return definitions
 
 
@@ -148,13 +147,16 @@ def _user_model_digest(plan: Any) -> str | None:
     return file_digest(plan.user_model)
 
 
-def _store_parameters(store: Any, plan: Any, definitions: list[dict[str, Any]],
+def _store_parameters(store: Any, plan: Any, definitions: dict[str, list[dict[str, Any]]],
                       version: str) -> None:
     """The ``run`` table: the plan (what ``--resume`` re-runs) and, as separate keys for
     readers of the database, the parameters it is made of."""
     a = plan.design("A")
     store.put("plan", plan.to_json())
-    store.put("metrics", definitions)
+    store.put("metrics", definitions["A"])
+    for label, declared in definitions.items():
+        if label != "A":
+            store.put(f"metrics_{label}", declared)
     store.put("spec", a.spec)
     store.put("spec_sha256", a.sha256)
     store.put("designs", [{"label": d.label, "spec": d.spec, "sha256": d.sha256}
@@ -213,7 +215,7 @@ def run(args: argparse.Namespace) -> int:
                     hint="resume with the same options (or none: `opspec evaluate --resume "
                     f"--out {args.out}`), or choose another --out")
         _check_unchanged(store, plan)
-        definitions = _check_plan(plan)
+        _check_plan(plan)
     else:
         plan = _new_plan(args)
         definitions = _check_plan(plan)

@@ -74,7 +74,6 @@ def write_report(store: ResultStore) -> Path:
     days = float(plan.get("days", 1))
     designs = [d["label"] for d in plan.get("designs", [])] or ["A"]
     specs = {d["label"]: d["spec"] for d in plan.get("designs", [])}
-    definitions = metric_definitions(store)
     sections = []
 
     done = {d: _users_done(store, d) for d in designs}
@@ -109,6 +108,7 @@ def write_report(store: ResultStore) -> Path:
         if rates:
             images.append(plots.rates_figure(rates, figures / f"{design}-rates.png"))
             captions.append("Outcome rates with 95 % confidence intervals")
+        definitions = metric_definitions(store, design)
         for d in definitions:
             if d["kind"] == "duration":
                 values = _observations(store, design, d["name"])

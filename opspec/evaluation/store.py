@@ -6,7 +6,7 @@ runs only what is missing or failed. The schema (a contract with the report code
 anyone who opens ``results.sqlite`` in another tool):
 
 - ``run(key, value)``: JSON values — ``plan`` (the EvaluationPlan, what ``--resume``
-  re-runs), ``metrics`` (the declared metrics), and for other readers the same parameters as
+  re-runs), ``metrics`` (the metrics design A declares; ``metrics_B`` those of B), and for other readers the same parameters as
   separate keys: ``spec``, ``spec_sha256``, ``designs``, ``users``, ``days``, ``seed``,
   ``user_model``, ``user_model_sha256``, ``opspec_version``, ``started``;
 - ``replication(design, user, status, error, metrics, wall_s)``: one row per user and design,

@@ -24,8 +24,14 @@ from opspec.evaluation.store import ResultStore
 __all__ = ["compare_designs", "metric_definitions", "summarise_design", "user_pairs"]
 
 
-def metric_definitions(store: ResultStore) -> list[dict[str, Any]]:
-    """The declared metrics stored with the run (name, kind, numerator, denominator, unit)."""
+def metric_definitions(store: ResultStore, design: str = "A") -> list[dict[str, Any]]:
+    """The metrics ``design`` declares (name, kind, numerator, denominator, unit), as stored
+    with the run: ``metrics`` for design A, ``metrics_B`` for B (falling back to A's in stores
+    written before B's were kept)."""
+    if design != "A":
+        own = store.get(f"metrics_{design}")
+        if own is not None:
+            return list(own)
     return list(store.get("metrics") or [])
 
 
@@ -99,7 +105,7 @@ def summarise_design(store: ResultStore, design: str, days: float, level: float 
                      ) -> dict[str, dict[str, Any]]:
     """Every declared metric of ``design`` summarised (see the module docstring)."""
     out: dict[str, dict[str, Any]] = {}
-    for definition in metric_definitions(store):
+    for definition in metric_definitions(store, design):
         name, kind = definition["name"], definition["kind"]
         pairs = [p for _, p in user_pairs(store, design, definition)]
         estimate = ratio_estimate(pairs, level)
@@ -141,9 +147,15 @@ def summarise_design(store: ResultStore, design: str, days: float, level: float 
 
 def compare_designs(store: ResultStore, a: str = "A", b: str = "B", level: float = 0.95
                     ) -> dict[str, dict[str, Any]]:
-    """Per metric: B − A on the users both designs finished, paired by user."""
+    """Per metric both designs declare alike (same name, kind, numerator and denominator):
+    B − A on the users both designs finished, paired by user."""
     out: dict[str, dict[str, Any]] = {}
-    for definition in metric_definitions(store):
+    theirs = {d["name"]: d for d in metric_definitions(store, b)}
+    for definition in metric_definitions(store, a):
+        other = theirs.get(definition["name"])
+        if other is None or any(other.get(k) != definition.get(k)
+                                for k in ("kind", "numerator", "denominator")):
+            continue
         pairs_a = dict(user_pairs(store, a, definition))
         pairs_b = dict(user_pairs(store, b, definition))
         users = sorted(set(pairs_a) & set(pairs_b))

@@ -203,3 +203,20 @@ def test_specs_with_a_simulated_world_give_each_user_their_own_world(evaluate, t
     assert metrics_of(one) == metrics_of(two)
     covered = one["metrics"]["cells_covered"]
     assert covered["total"] > 0 and covered["sd"] > 0
+
+
+def test_designs_with_different_metrics_compare_only_what_both_declare(evaluate, tmp_path):
+    other = tmp_path / "dispenser_b.xpdl"
+    text = SPEC.read_text(encoding="utf-8").replace(
+        '<opspec:Count Name="caregiver_notified"', '<opspec:Count Name="caregiver_calls"')
+    other.write_text(text, encoding="utf-8")
+    status, doc, _ = evaluate(str(SPEC), "--compare", str(other), "--users", "3", "--days",
+                              "1", "--workers", "1", "--user-model", str(USERS_TOML),
+                              "--out", str(tmp_path / "cmp"))
+    assert status == 0
+    assert "caregiver_notified" in doc["metrics"]
+    assert "caregiver_calls" in doc["compare"]["metrics"]
+    assert "caregiver_notified" not in doc["compare"]["metrics"]
+    difference = doc["compare"]["difference"]
+    assert "caregiver_notified" not in difference and "caregiver_calls" not in difference
+    assert difference["doses_due"]["difference"] == 0
