@@ -24,8 +24,9 @@ def register(subparsers: Any) -> None:
         "user lane: see what the device does, act with one key, control time, hand your lane "
         "to a user model and back. Press ? in the app for the keys.")
     parser.add_argument("spec", metavar="SPEC", help="the specification (.xpdl or .wfs)")
-    parser.add_argument("--speed", type=float, default=60.0,
-                        help="simulated seconds per wall second at start (default 60)")
+    parser.add_argument("--speed", type=float, default=None,
+                        help="simulated seconds per wall second at start (default 60; 1 "
+                        "with a real device bound)")
     parser.add_argument("--seed", type=int, default=0, help="run seed (default 0)")
     parser.add_argument("--days", type=float, default=1.0, help="simulated days (default 1)")
     parser.add_argument("--user-model", metavar="FILE|PRESET",
@@ -47,7 +48,7 @@ def run(args: argparse.Namespace) -> int:
     from opspec.commands._spec import companion_user_model, load_any_spec
     from opspec.engine.compiled import compile_package
 
-    if not (args.speed > 0):
+    if args.speed is not None and not (args.speed > 0):
         raise ConfigurationError(f"--speed must be positive, not {args.speed:g}")
     package = load_any_spec(args.spec)            # a broken spec opens nothing
     compiled = compile_package(package)
@@ -81,22 +82,31 @@ def run(args: argparse.Namespace) -> int:
         from opspec.tui.app import WalkthroughApp
         from opspec.tui.session import WalkSession
 
+        served: dict[str, tuple[str, ...]] = {}
+        for binding in devices.bindings if devices is not None else ():
+            served[binding.profile.name] = served.get(binding.profile.name, ()) + tuple(
+                binding.participants)
         session = WalkSession(compiled, seed=args.seed, days=args.days, record=record,
                               model_factory=factory, performers=performers, replay=replay,
-                              spec_path=str(args.spec))
-        session.speed = args.speed
+                              spec_path=str(args.spec), device_participants=served)
+        # a real device answers in wall time: start in real time unless told otherwise
+        real = devices is not None and devices.requires_wall_clock
+        session.speed = args.speed if args.speed is not None else 1.0 if real else 60.0
         if devices is not None:
             devices.install(session.sim)
         app = WalkthroughApp(session, title=package.name or package.id, notes=notes)
+        interrupted = False
         try:
             app.run()
+        except KeyboardInterrupt:          # a SIGINT from outside the terminal's keys
+            interrupted = True
         finally:
             session.close()
     if record is not None:
         print(f"recording: {record}\ntrace: {record.with_suffix('.trace.jsonl')}\n"
               f"replay it with: opspec walkthrough {args.spec} --replay {record}  or  "
               f"opspec run {args.spec} --script {record}")
-    return 0
+    return 130 if interrupted else 0
 
 
 def _model_factory(compiled: Any, ref: Any, seed: int) -> Any:

@@ -90,11 +90,14 @@ class WalkthroughApp(App[str | None]):
     value is the recording's path (or ``None`` when not recording)."""
 
     TITLE = "opspec walkthrough"
+    ENABLE_COMMAND_PALETTE = False       # the footer's room goes to the walkthrough's keys
     CSS = """
     Screen { layout: vertical; }
     #status { height: 1; background: $primary; color: $text; padding: 0 1; }
     #panels { height: 1fr; min-height: 9; }
-    #device, #person { width: 1fr; border: round $secondary; padding: 0 1; }
+    #device, #person { width: 1fr; height: 1fr; border: round $secondary; padding: 0 1; }
+    #device { width: 3fr; text-wrap: nowrap; text-overflow: ellipsis; }
+    #person { width: 2fr; }
     #person.calling { border: heavy $warning; }
     #timeline { height: 8; border: round $secondary; padding: 0 1; }
     .offer { height: auto; }
@@ -114,6 +117,7 @@ class WalkthroughApp(App[str | None]):
         Binding("x", "ignore", "don't", show=False),
         Binding("question_mark", "help", "help"),
         Binding("q", "quit_walk", "quit"),
+        Binding("ctrl+c,ctrl+q", "quit_walk", "quit", show=False, priority=True),
         *[Binding(k, f"offer({i})", show=False) for i, k in enumerate(OFFER_KEYS)],
     ]
 
@@ -151,9 +155,10 @@ class WalkthroughApp(App[str | None]):
             self.refresh_views()
 
     def _on_event(self, event: Any) -> None:
-        if self.session.calling and not self._was_calling:
+        calling = self.session.calling or self.session.board.ringing
+        if calling and not self._was_calling:
             self.bell()                      # the device calls: ring where the terminal can
-        self._was_calling = self.session.calling
+        self._was_calling = calling
 
     # ------------------------------------------------------------------ actions
     def action_pause(self) -> None:
@@ -219,7 +224,9 @@ class WalkthroughApp(App[str | None]):
             return
         session = self.session
         state = "PAUSED" if session.paused else "running"
-        who = "model performs your lane" if session.handed_over else "you perform the lane"
+        who = ("replaying the recording" if session.replaying
+               else "model performs your lane" if session.handed_over
+               else "you perform the lane")
         end = "  [ENDED]" if session.ended else ""
         self.query_one("#status", Static).update(Text(
             f"{clock(session.now)}  {session.speed:g}x  {state}  |  {who}  |  "
@@ -229,7 +236,7 @@ class WalkthroughApp(App[str | None]):
         call = self.query_one("#call", Static)
         if session.calling:
             person.add_class("calling")
-            call.update(Text("(!) THE DEVICE IS CALLING YOU", style="bold reverse"))
+            call.update(Text("(!) THE DEVICE CALLS YOU", style="bold reverse"))
         else:
             person.remove_class("calling")
             call.update("" if session.offers else "(nothing to do now: press u to skip "
@@ -252,14 +259,19 @@ class WalkthroughApp(App[str | None]):
 
     def _device_text(self) -> Text:
         session = self.session
-        text = Text()
-        for participant, last in sorted(session.participants.items()):
-            marker = "(x) " if last.startswith("FAULT") else "*  "
-            text.append(f"{marker}{participant}: {last}\n",
-                        style="bold red" if last.startswith("FAULT") else "")
+        text = Text(no_wrap=True, overflow="ellipsis")
+        for row in session.board.rows():
+            marker = "(x)" if row.status.startswith("FAULT") else "(!)" if row.alert else " * "
+            line = Text(no_wrap=True, overflow="ellipsis")
+            line.append(f"{marker} {row.id}: ", style="bold")
+            line.append(row.status, style="bold reverse" if row.alert else "")
+            text.append_text(line)
+            text.append("\n")
+            if row.detail:
+                text.append(f"      {row.detail}\n", style="italic")
         if session.current:
             text.append("Running:\n", style="bold")
-            for instance, (process, activity) in sorted(session.current.items())[:6]:
+            for instance, (process, activity) in sorted(session.current.items())[:4]:
                 text.append(f"  {process}#{instance} at {activity}\n")
         for (instance, activity), due in sorted(session.deadlines.items(),
                                                 key=lambda kv: kv[1])[:3]:

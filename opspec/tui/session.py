@@ -22,7 +22,7 @@ import math
 import os
 import time
 from collections import deque
-from collections.abc import Callable, Mapping
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -32,6 +32,7 @@ from opspec.engine.lanes import user_lane
 from opspec.engine.performers import PerformerSession, WorkItem
 from opspec.engine.simulation import Simulation
 from opspec.engine.trace import TraceEvent
+from opspec.tui.devices import DeviceBoard
 
 __all__ = ["Offer", "WalkSession"]
 
@@ -122,7 +123,8 @@ class WalkSession:
     def __init__(self, compiled: CompiledPackage, *, seed: int = 0, days: float = 1.0,
                  record: str | Path | None = None, model_factory: Callable[[], Any] | None = None,
                  performers: Mapping[str, Any] | None = None, config: Any = None,
-                 replay: Any = None, spec_path: str = "") -> None:
+                 replay: Any = None, spec_path: str = "",
+                 device_participants: Mapping[str, Sequence[str]] | None = None) -> None:
         self.compiled = compiled
         self.seed = seed
         self.horizon = days * DAY
@@ -134,6 +136,9 @@ class WalkSession:
         self.deadlines: dict[tuple[int, str], float] = {}   # (instance, activity) -> due time
         self.current: dict[int, tuple[str, str]] = {}       # instance -> (process, activity)
         self.participants: dict[str, str] = {}              # participant -> last action
+        #: each device participant's state (ringing, busy, last done, display, fault)
+        self.board = DeviceBoard(compiled, device_participants)
+        self.replaying = replay is not None
         self.offers: list[Offer] = []
         self.calling = False                                # the device is calling the user
         self.ended = False
@@ -159,7 +164,7 @@ class WalkSession:
             user = self.lane_user
         for name in lane.bind_names:
             bound[name] = user
-        listeners: list[Any] = [self._on_event]
+        listeners: list[Any] = [self.board, self._on_event]
         if replay is not None:
             listeners.append(replay)
         if self._trace_file is not None:

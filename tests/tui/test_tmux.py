@@ -42,7 +42,7 @@ def test_walkthrough_in_tmux_shows_the_alarm_and_says_where_the_recording_is(tmp
         wait_for(session, "you perform the lane")
         tmux("send-keys", "-t", session, "space")
         tmux("send-keys", "-t", session, "u")
-        screen = wait_for(session, "THE DEVICE IS CALLING YOU")
+        screen = wait_for(session, "THE DEVICE CALLS YOU")
         assert "Hear the alarm" in screen and "08:00:00" in screen
         tmux("send-keys", "-t", session, "a")
         wait_for(session, "Walk to the dispenser")

@@ -35,7 +35,7 @@ async def test_alarm_at_eight_then_a_report_after_90s_takes_the_dose(compiled, t
         await start(app, pilot)
         await pilot.press("u")                         # skip until something needs me
         assert session.now == 8 * 3600
-        assert "THE DEVICE IS CALLING YOU" in screen_text(app)
+        assert "THE DEVICE CALLS YOU" in screen_text(app)
         assert "Hear the alarm" in screen_text(app)
         await pilot.press("a")                          # I hear it
         await pilot.press("w", "w", "w")                # walking takes 90 s
@@ -152,3 +152,32 @@ def test_broken_spec_opens_nothing_and_prints_the_diagnostics(tmp_path, capsys):
                       encoding="utf-8")
     assert main(["walkthrough", str(broken)]) == 1
     assert f"{broken}:" in capsys.readouterr().err
+
+
+@pytest.mark.asyncio
+async def test_ctrl_c_quits_cleanly_with_the_recording_path(compiled, tmp_path):
+    record = tmp_path / "c.json"
+    app = WalkthroughApp(WalkSession(compiled, record=record))
+    async with app.run_test(size=(80, 24)) as pilot:
+        await start(app, pilot)
+        await pilot.press("ctrl+c")
+    assert app.return_value == str(record)
+    assert record.is_file()
+
+
+@pytest.mark.asyncio
+async def test_a_device_fault_is_shown_on_its_participant(compiled):
+    session = WalkSession(compiled, device_participants={
+        "medication_dispenser": ("alarm", "dispenser")})
+    app = WalkthroughApp(session)
+    async with app.run_test(size=(80, 24)) as pilot:
+        await start(app, pilot)
+        await pilot.press("u")
+        assert "((( RINGING )))" in screen_text(app)
+        session.sim.session.trace("fault", {
+            "fault": "disconnected", "device": "medication_dispenser",
+            "message": "the board is gone"})
+        await pilot.press("w")
+        text = screen_text(app)
+        assert "(x) alarm: FAULT at 08:00: the board is gone" in text
+        assert "(x) dispenser: FAULT" in text
