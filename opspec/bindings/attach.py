@@ -16,6 +16,7 @@ Every port is closed when the block ends, whatever ends it.
 from __future__ import annotations
 
 import math
+import threading
 from collections.abc import Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, Self
@@ -88,9 +89,19 @@ class AttachedDevices:
         return out
 
     def close(self) -> None:
+        """Close every binding (idempotent). They close side by side: a ``socket://`` port
+        takes 0.3 s to close in pySerial, which would add up over several devices."""
         self.inbox.wake = None
-        for binding in self.bindings:
-            binding.close()
+        closers = [threading.Thread(target=b.close, name=f"close-{b.profile.name}")
+                   for b in self.bindings[1:]]
+        for closer in closers:
+            closer.start()
+        try:
+            if self.bindings:
+                self.bindings[0].close()
+        finally:
+            for closer in closers:
+                closer.join()
 
     def __enter__(self) -> Self:
         return self

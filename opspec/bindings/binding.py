@@ -464,7 +464,9 @@ class DeviceBinding:
 
     def _reconnected(self, gen: int, port: serial.Serial) -> None:
         if gen != self._generation or self._closed.is_set():
-            port.close()
+            # not on the engine's thread: a socket:// close sleeps (see _disconnected)
+            threading.Thread(target=port.close, name=f"close-{self.profile.name}",
+                             daemon=True).start()
             return
         self._start_reader(port)
         self._note(f"{self._label()}: reconnected to {self.url}")
