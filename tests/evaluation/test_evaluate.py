@@ -26,12 +26,17 @@ def test_same_seed_gives_the_same_results_with_one_or_two_workers(evaluate, tmp_
     assert metrics_of(other) != metrics_of(one)
 
 
-def test_dask_cluster_gives_the_same_results_as_local_workers(evaluate, tmp_path):
+@pytest.mark.parametrize("processes, workers", [
+    (False, 1),
+    pytest.param(True, 2, marks=pytest.mark.slow),     # ~10-20 s: starts two interpreters
+], ids=["in-process-worker", "two-worker-processes"])
+def test_dask_cluster_gives_the_same_results_as_local_workers(processes, workers, evaluate,
+                                                              tmp_path):
     distributed = pytest.importorskip("distributed")
     args = [str(SPEC), "--users", "6", "--days", "2", "--seed", "3"]
     _, local, _ = evaluate(*args, "--workers", "1", "--out", str(tmp_path / "local"))
-    with distributed.LocalCluster(n_workers=1, threads_per_worker=1, processes=False,
-                                  dashboard_address=None) as cluster:
+    with distributed.LocalCluster(n_workers=workers, threads_per_worker=1,
+                                  processes=processes, dashboard_address=None) as cluster:
         status, remote, _ = evaluate(*args, "--scheduler", cluster.scheduler_address,
                                      "--out", str(tmp_path / "dask"))
     assert status == 0
