@@ -167,13 +167,46 @@ def manoeuvre(kind: str) -> str:
                         ("escape_cmd", '"turn_random"'), when="Start", duration="0.2")]
         chain = [tr("m4", "back_up", "random_move"), tr("m5", "random_move", "done")]
         first = "back_up"
+        data = []
     else:
+        # after moving back, two sensors vote on how to hit: the range finder (charge if
+        # something is near ahead, else it abstains) and the line sensor (turn if on the
+        # ring's rim, else charge). Off the rim the sumo charges; on the rim with something
+        # near ahead (the opponent, or the edge itself: the range finder cannot tell) the
+        # votes tie and the tie goes to the option listed first, turn_random: in doubt, the
+        # sumo does not charge out of the ring
         steps = [assign("move_back", "Move back", ("escape_cmd", '"back"'), when="Start",
                         duration="0.4"),
-                 assign("hit", "Hit: charge forward", ("escape_cmd", '"charge"'), when="Start",
-                        duration="1.0")]
-        chain = [tr("m4", "move_back", "hit"), tr("m5", "hit", "done")]
+                 route("opponent_ahead", "Opponent ahead?"),
+                 assign("range_says_charge", "Range votes: charge", ("vote_range", '"charge"')),
+                 assign("range_abstains", "Range abstains", ("vote_range", '""')),
+                 route("range_voted", "Range voted", join=True),
+                 route("on_rim", "On the ring's rim?"),
+                 assign("line_says_turn", "Line sensor votes: turn",
+                        ("vote_edge", '"turn_random"')),
+                 assign("line_says_charge", "Line sensor votes: charge",
+                        ("vote_edge", '"charge"')),
+                 route("line_voted", "Line sensor voted", join=True),
+                 builtin("choose_hit", "Vote on the hit",
+                         '<opspec:Voter Output="hit_cmd" Options="turn_random charge">'
+                         '<opspec:Input Ref="vote_range"/>'
+                         '<opspec:Input Ref="vote_edge"/></opspec:Voter>'),
+                 assign("hit", "Hit: charge forward (or turn away)", ("escape_cmd", "hit_cmd"),
+                        when="Start", duration="1.0")]
+        chain = [tr("m4", "move_back", "opponent_ahead"),
+                 tr("v1", "opponent_ahead", "range_says_charge", "distance &lt; 0.6"),
+                 tr("v2", "opponent_ahead", "range_abstains", "OTHERWISE"),
+                 tr("v3", "range_says_charge", "range_voted"),
+                 tr("v4", "range_abstains", "range_voted"), tr("v5", "range_voted", "on_rim"),
+                 tr("v6", "on_rim", "line_says_turn", "edge == true"),
+                 tr("v7", "on_rim", "line_says_charge", "OTHERWISE"),
+                 tr("v8", "line_says_turn", "line_voted"),
+                 tr("v9", "line_says_charge", "line_voted"),
+                 tr("v10", "line_voted", "choose_hit"), tr("v11", "choose_hit", "hit"),
+                 tr("m5", "hit", "done")]
         first = "move_back"
+        data = [field("vote_range", "STRING", '""'), field("vote_edge", "STRING", '""'),
+                field("hit_cmd", "STRING", '"charge"')]
     return process("manoeuvre", "Manoeuvre on contact", [
         start(), route("contact", "Bumped?"),
         assign("engage", "Start the manoeuvre", ("escaping", "true")), *steps,
@@ -185,7 +218,7 @@ def manoeuvre(kind: str) -> str:
         tr("m2b", "contact", "merge", "escaping == true"),
         tr("m3", "contact", "calm", "OTHERWISE"), tr("m3b", "engage", first), *chain,
         tr("m6", "done", "merge"), tr("m7", "calm", "merge"), tr("m8", "merge", "end")],
-        rate="5Hz", priority=4, mode="run")
+        rate="5Hz", priority=4, mode="run", data=data)
 
 
 def arbitrate() -> str:
@@ -254,7 +287,7 @@ def mission() -> str:
 
 APPLICATIONS = {
     "read_range": "Range finder: distance ahead (m)",
-    "read_bump": "Bumper: contact since the last read",
+    "read_bump": "Bumper: contact since the last read; line sensor: on the ring's rim",
     "drive": "Motors: execute motor_cmd",
     "read_battery": "Battery level (%)",
     "read_rfid": "RFID reader: tag in range",
@@ -301,7 +334,8 @@ def package(pid: str, name: str, description: str, world: str, processes: list[s
 {body}
   </WorkflowProcesses>
   <ExtendedAttributes>
-    <ExtendedAttribute Name="opspec:World" Value="{world}"/>{mode_xml}
+    <ExtendedAttribute Name="opspec:World" Value="{world}"/>
+    <ExtendedAttribute Name="opspec:WorldFile" Value="{pid}.world.toml"/>{mode_xml}
     <ExtendedAttribute Name="opspec:Metrics">
 {metrics}
     </ExtendedAttribute>
@@ -311,6 +345,7 @@ def package(pid: str, name: str, description: str, world: str, processes: list[s
 
 
 ROBOT_FIELDS = [field("distance", "FLOAT", "10.0"), field("bump", "BOOLEAN", "false"),
+                field("edge", "BOOLEAN", "false"),
                 field("level", "FLOAT", "100.0"), field("escaping", "BOOLEAN", "false"),
                 field("escape_cmd", "STRING", '""'), field("avoid_cmd", "STRING", '""'),
                 field("wander_cmd", "STRING", '"forward"')]

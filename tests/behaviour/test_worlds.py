@@ -78,9 +78,9 @@ def test_driving_into_a_wall_stops_at_the_wall_and_counts_one_collision() -> Non
     world.advance(30.0)                               # 9 m of driving in a 5 m room
     assert world.robot.x == pytest.approx(5.0 - world.radius, abs=0.3 * 0.05 + 1e-9)
     assert [k for k, _ in facts if k == "world.collision"] == ["world.collision"]
-    assert world.op_read_bump({}) == {"bump": True}
+    assert world.op_read_bump({})["bump"] is True
     world.advance(30.1)
-    assert world.op_read_bump({}) == {"bump": True}   # still pressed against the wall
+    assert world.op_read_bump({})["bump"] is True   # still pressed against the wall
     assert world.collisions == 1
 
 
@@ -90,8 +90,8 @@ def test_the_bumper_latches_a_contact_until_it_is_read() -> None:
     world.advance(2.0)
     world.op_drive({"motor_cmd": "back"})
     world.advance(3.0)                                # backed away from the wall
-    assert world.op_read_bump({}) == {"bump": True}   # the contact is remembered...
-    assert world.op_read_bump({}) == {"bump": False}  # ...once
+    assert world.op_read_bump({})["bump"] is True   # the contact is remembered...
+    assert world.op_read_bump({})["bump"] is False  # ...once
     world.op_drive({"motor_cmd": "forward"})
     world.advance(10.0)
     assert world.collisions == 2                      # a new contact is a new collision

@@ -132,7 +132,7 @@ class RoomWorld(World):
 
     def op_read_bump(self, _data: Mapping[str, Any]) -> dict[str, Any]:
         bumped, self.bumped = self.bumped, False
-        return {"bump": bumped}
+        return {"bump": bumped, "edge": False}         # a room has no ring edge
 
     def op_drive(self, data: Mapping[str, Any]) -> dict[str, Any]:
         command = str(data.get("motor_cmd") or "stop")

@@ -5,8 +5,9 @@ The ring is a disc of ``ring_radius`` metres. The opponent drives towards our ro
 into the other harder (speed along the line of contact) moves both. A robot whose centre
 leaves the ring loses the bout (``world.bout`` plus ``world.bout_won`` / ``world.bout_lost``);
 a bout lasting ``bout_limit_s`` is a draw. After each bout both robots return to their corners.
-The bumper senses contact with the opponent or the ring's edge (a line sensor); the range
-finder sees the opponent when it is within 20 degrees of straight ahead, else the ring's edge.
+The bumper senses contact with the opponent or the ring's edge; a line sensor tells whether
+the robot stands on the rim band (``edge_band`` metres wide); the range finder sees the
+opponent when it is within 20 degrees of straight ahead, else the ring's edge.
 """
 
 from __future__ import annotations
@@ -27,7 +28,8 @@ __all__ = ["SumoWorld"]
 class SumoWorld(World):
     def __init__(self, rng: np.random.Generator, *, ring_radius: float = 1.5,
                  radius: float = 0.15, opponent_speed: float = 0.25, bout_limit_s: float = 60.0,
-                 range_noise: float = 0.01, drain_per_s: float = 0.02) -> None:
+                 range_noise: float = 0.01, drain_per_s: float = 0.02,
+                 edge_band: float = 0.3) -> None:
         super().__init__(rng)
         if not (radius > 0 and ring_radius > 4 * radius and bout_limit_s > 0):
             raise ValueError(f"the ring (radius {ring_radius} m) must hold two robots of "
@@ -38,6 +40,7 @@ class SumoWorld(World):
         self.bout_limit_s = float(bout_limit_s)
         self.range_noise = float(range_noise)
         self.drain_per_s = float(drain_per_s)
+        self.edge_band = float(edge_band)
         self.robot = Robot(0.0, 0.0, 0.0)
         self.opponent = Robot(0.0, 0.0, 0.0)
         self.bumped = False
@@ -113,8 +116,11 @@ class SumoWorld(World):
         return {"distance": round(max(0.0, noisy), 4)}
 
     def op_read_bump(self, _data: Mapping[str, Any]) -> dict[str, Any]:
+        """The bumper (latched until read) and the line sensor: ``edge`` is whether the
+        robot stands on the ring's rim band (within ``edge_band`` metres of the edge) now."""
         bumped, self.bumped = self.bumped, False
-        return {"bump": bumped}
+        edge = self.ring - math.hypot(self.robot.x, self.robot.y) < self.edge_band
+        return {"bump": bumped, "edge": edge}
 
     def op_drive(self, data: Mapping[str, Any]) -> dict[str, Any]:
         command = str(data.get("motor_cmd") or "stop")
