@@ -34,8 +34,9 @@ class ReplicationRecord:
     metrics: dict[str, dict[str, Any]] = field(default_factory=dict)
     samples: list[tuple[str, float, float]] = field(default_factory=list)  # metric, value, t
     outcomes: dict[tuple[str, int, int], int] = field(default_factory=dict)  # metric,day,hour
-    activities: dict[str, list[int]] = field(default_factory=dict)  # offered, completed,
-    wall_s: float = 0.0                                              # omitted, wrong
+    # activity -> [offered, completed, omitted, wrong]
+    activities: dict[str, list[int]] = field(default_factory=dict)
+    wall_s: float = 0.0
     trace: list[dict[str, Any]] | None = None
 
 
