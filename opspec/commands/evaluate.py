@@ -9,6 +9,7 @@ from __future__ import annotations
 import argparse
 import contextlib
 import json
+import math
 import os
 import sys
 from dataclasses import asdict
@@ -265,13 +266,24 @@ def run(args: argparse.Namespace) -> int:
                "wall_s": round(outcome.wall_s, 3)}
         if compare is not None:
             doc["compare"] = compare
-        print(json.dumps(doc, allow_nan=False, default=str))
+        print(json.dumps(_finite(doc), allow_nan=False, default=str))
     else:
         from opspec.evaluation.tables import print_summary
 
         print_summary(sys.stdout, plan, metrics, compare, outcome, failures, workers)
         print(f"results: {store.path}\nreport: {report}")
     return 1 if failures else 0
+
+
+def _finite(value: Any) -> Any:
+    """``value`` with NaN and infinities as ``null`` (JSON has no spelling for them)."""
+    if isinstance(value, float):
+        return value if math.isfinite(value) else None
+    if isinstance(value, dict):
+        return {k: _finite(v) for k, v in value.items()}
+    if isinstance(value, (list, tuple)):
+        return [_finite(v) for v in value]
+    return value
 
 
 def _trace_writers(stack: contextlib.ExitStack, folder: Path, plan: Any, *, resumed: bool
