@@ -25,10 +25,10 @@ from __future__ import annotations
 import functools
 import inspect
 import tomllib
-import xml.etree.ElementTree as ElementTree
 from collections.abc import Callable, Mapping
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
+from xml.etree import ElementTree
 
 from opspec.bindings.world.base import World
 from opspec.bindings.world.room import RoomWorld

@@ -3,6 +3,7 @@ in the syntax a designer writes (docs/behaviour-specs.md), read by the real read
 
 from __future__ import annotations
 
+import itertools
 from collections.abc import Mapping, Sequence
 from pathlib import Path
 from typing import Any
@@ -46,7 +47,7 @@ def process(pid: str, activities: Sequence[str], *, fields: Sequence[str] = (),
     """A straight-line workflow of ``activities`` (in order) with ``opspec:`` directives."""
     ids = [a.split('Id="', 1)[1].split('"', 1)[0] for a in activities]
     transitions = "".join(f'<Transition Id="{pid}_t{n}" From="{a}" To="{b}"/>'
-                          for n, (a, b) in enumerate(zip(ids, ids[1:], strict=False)))
+                          for n, (a, b) in enumerate(itertools.pairwise(ids)))
     attrs = "".join(f'<ExtendedAttribute Name="opspec:{k}" Value="{v}"/>'
                     for k, v in directives.items())
     data = f"<DataFields>{''.join(fields)}</DataFields>" if fields else ""

@@ -208,17 +208,17 @@ def test_world_parameters_come_from_the_world_file_and_inline_ones_win(tmp_path:
 @pytest.mark.parametrize(("attributes", "message"), [
     ('<ExtendedAttribute Name="opspec:World" Value="moon-base"/>',
      r"unknown world 'moon-base'.*known worlds: sumo-ring, vacuum-room, ward"),
-    ('<ExtendedAttribute Name="opspec:World" Value="vacuum-room">'
-     '<opspec:Parameter Name="widht" Value="6"/></ExtendedAttribute>',
+    (('<ExtendedAttribute Name="opspec:World" Value="vacuum-room">'
+     '<opspec:Parameter Name="widht" Value="6"/></ExtendedAttribute>'),
      r"situation.xpdl:\d+: world 'vacuum-room' has no parameter 'widht'.*width"),
-    ('<ExtendedAttribute Name="opspec:World" Value="vacuum-room">'
-     '<opspec:Parameter Name="start" Value="[1.8, 1.8, 0.0]"/></ExtendedAttribute>',
+    (('<ExtendedAttribute Name="opspec:World" Value="vacuum-room">'
+     '<opspec:Parameter Name="start" Value="[1.8, 1.8, 0.0]"/></ExtendedAttribute>'),
      r"start \(1.8, 1.8\) puts the robot in a wall or an obstacle"),
-    ('<ExtendedAttribute Name="opspec:World" Value="sumo-ring">'
-     '<opspec:Parameter Name="ring_radius" Value="0.2"/></ExtendedAttribute>',
+    (('<ExtendedAttribute Name="opspec:World" Value="sumo-ring">'
+     '<opspec:Parameter Name="ring_radius" Value="0.2"/></ExtendedAttribute>'),
      r"must hold two robots"),
-    ('<ExtendedAttribute Name="opspec:World" Value="ward"/>'
-     '<ExtendedAttribute Name="opspec:WorldFile" Value="missing.toml"/>',
+    (('<ExtendedAttribute Name="opspec:World" Value="ward"/>'
+     '<ExtendedAttribute Name="opspec:WorldFile" Value="missing.toml"/>'),
      r"cannot read the world file .*missing.toml"),
 ], ids=["unknown-world", "unknown-parameter", "start-in-an-obstacle", "ring-too-small",
         "missing-world-file"])
