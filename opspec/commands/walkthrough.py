@@ -86,11 +86,12 @@ def run(args: argparse.Namespace) -> int:
         for binding in devices.bindings if devices is not None else ():
             served[binding.profile.name] = served.get(binding.profile.name, ()) + tuple(
                 binding.participants)
-        session = WalkSession(compiled, seed=args.seed, days=args.days, record=record,
-                              model_factory=factory, performers=performers, replay=replay,
-                              spec_path=str(args.spec), device_participants=served)
         # a real device answers in wall time: start in real time unless told otherwise
         real = devices is not None and devices.requires_wall_clock
+        session = WalkSession(compiled, seed=args.seed, days=args.days, record=record,
+                              model_factory=factory, performers=performers, replay=replay,
+                              spec_path=str(args.spec), device_participants=served,
+                              wall_devices=real)
         session.speed = args.speed if args.speed is not None else 1.0 if real else 60.0
         if devices is not None:
             devices.install(session.sim)

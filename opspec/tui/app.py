@@ -150,8 +150,9 @@ class WalkthroughApp(App[str | None]):
     # ------------------------------------------------------------------ time
     def tick(self, wall_seconds: float) -> None:
         before = len(self.session.offers)
+        skipping = self.session.skipping
         self.session.advance(wall_seconds)
-        if not self.session.paused or len(self.session.offers) != before:
+        if not self.session.paused or skipping or len(self.session.offers) != before:
             self.refresh_views()
 
     def _on_event(self, event: Any) -> None:
@@ -227,7 +228,8 @@ class WalkthroughApp(App[str | None]):
         who = ("replaying the recording" if session.replaying
                else "model performs your lane" if session.handed_over
                else "you perform the lane")
-        end = "  [ENDED]" if session.ended else ""
+        end = ("  [ENDED]" if session.ended
+               else "  [waiting for the device]" if session.waiting_for_devices else "")
         self.query_one("#status", Static).update(Text(
             f"{clock(session.now)}  {session.speed:g}x  {state}  |  {who}  |  "
             f"{self.spec_title}{end}", no_wrap=True, overflow="ellipsis"))

@@ -37,6 +37,8 @@ from opspec.tui.devices import DeviceBoard
 __all__ = ["Offer", "WalkSession"]
 
 DAY = 86_400.0
+_ANSWERED = frozenset({"activity.completed", "activity.omitted", "activity.failed",
+                       "activity.withdrawn", "activity.aborted", "deadline.expired"})
 
 
 @dataclass(frozen=True, slots=True)
@@ -124,7 +126,8 @@ class WalkSession:
                  record: str | Path | None = None, model_factory: Callable[[], Any] | None = None,
                  performers: Mapping[str, Any] | None = None, config: Any = None,
                  replay: Any = None, spec_path: str = "",
-                 device_participants: Mapping[str, Sequence[str]] | None = None) -> None:
+                 device_participants: Mapping[str, Sequence[str]] | None = None,
+                 wall_devices: bool = False) -> None:
         self.compiled = compiled
         self.seed = seed
         self.horizon = days * DAY
@@ -139,6 +142,10 @@ class WalkSession:
         #: each device participant's state (ringing, busy, last done, display, fault)
         self.board = DeviceBoard(compiled, device_participants)
         self.replaying = replay is not None
+        #: real devices are bound: their answers come in wall time (see waiting_for_devices)
+        self.wall_devices = wall_devices
+        self.device_work: set[tuple[int, str]] = set()      # offered to a device, unanswered
+        self.skipping = False                               # a skip until the user goes on
         self.offers: list[Offer] = []
         self.calling = False                                # the device is calling the user
         self.ended = False
@@ -179,23 +186,48 @@ class WalkSession:
         return float(self.sim.env.now)
 
     def advance(self, wall_seconds: float) -> None:
-        """Let ``wall_seconds`` of real time pass at the current speed (unless paused)."""
-        if self.paused or self.ended:
+        """Let ``wall_seconds`` of real time pass at the current speed (unless paused); a
+        skip held up by a real device goes on once the device has answered."""
+        if self.skipping:
+            self.sim.drain_posts()
+            self._skip()
+            return
+        if self.ended:
+            return
+        if self.paused:
+            # the clock stands still, but a device's answer is taken at the current time
+            self._run_to(self.now)
             return
         self._run_to(min(self.horizon, self.now + wall_seconds * self.speed))
 
+    @property
+    def waiting_for_devices(self) -> bool:
+        """Whether a real device (answering in wall time) has work it has not answered yet:
+        skipping simulated time now would jump past its answer."""
+        return self.wall_devices and bool(self.device_work)
+
     def skip_to_next_event(self) -> None:
+        """Jump to the next scheduled event (not while a real device is busy)."""
+        if self.waiting_for_devices:
+            return
         due = self.sim.peek()
         self._run_to(min(self.horizon, due if math.isfinite(due) else self.horizon))
 
     def skip_until_user(self) -> None:
-        """Run until something is offered to the person (or the run ends)."""
-        while not self.offers and not self.ended:
+        """Run until something is offered to the person (or the run ends). With a real
+        device busy the skip pauses until it answers (:meth:`advance` resumes it)."""
+        self.skipping = True
+        self._skip()
+
+    def _skip(self) -> None:
+        while not self.offers and not self.ended and not self.waiting_for_devices:
             due = self.sim.peek()
             if not math.isfinite(due):
                 self._run_to(self.horizon)
                 break
             self._run_to(min(self.horizon, due))
+        if self.offers or self.ended or self.handed_over:
+            self.skipping = False
 
     def _run_to(self, target: float) -> None:
         env = self.sim.env
@@ -274,6 +306,11 @@ class WalkSession:
                 o.item.instance == event.instance and o.item.activity == event.activity)]
             self.lane_user.items = {k: i for k, i in self.lane_user.items.items() if not (
                 i.instance == event.instance and i.activity == event.activity)}
+        if event.instance is not None and event.activity and event.lane != "user":
+            if kind == "activity.offered":
+                self.device_work.add((event.instance, event.activity))
+            elif kind in _ANSWERED:
+                self.device_work.discard((event.instance, event.activity))
         if event.instance is not None and event.activity:
             if kind in ("activity.started", "activity.offered"):
                 self.current[event.instance] = (event.process or "", event.activity)
@@ -289,6 +326,7 @@ class WalkSession:
                 self.deadlines.pop((event.instance, event.activity), None)
         if kind.startswith("process.") and kind != "process.started" and (
                 event.instance is not None):
+            self.device_work = {w for w in self.device_work if w[0] != event.instance}
             self.current.pop(event.instance, None)
             self.deadlines = {k: v for k, v in self.deadlines.items()
                               if k[0] != event.instance}
@@ -318,9 +356,12 @@ class WalkSession:
     def _write_record(self) -> None:
         if self.record_path is None:
             return
-        doc = {"otherwise": "wait", "steps": self._steps}
+        # one step per line: readable, and diffable between two sessions
+        steps = ",\n  ".join(json.dumps(step) for step in self._steps)
+        text = ('{"otherwise": "wait", "steps": [' + (f"\n  {steps}\n" if steps else "")
+                + "]}\n")
         tmp = self.record_path.with_suffix(self.record_path.suffix + ".tmp")
-        tmp.write_text(json.dumps(doc, indent=1) + "\n", encoding="utf-8")
+        tmp.write_text(text, encoding="utf-8")
         os.replace(tmp, self.record_path)
 
     def close(self) -> None:

@@ -181,3 +181,62 @@ async def test_a_device_fault_is_shown_on_its_participant(compiled):
         text = screen_text(app)
         assert "(x) alarm: FAULT at 08:00: the board is gone" in text
         assert "(x) dispenser: FAULT" in text
+
+
+async def until(pilot, condition, what: str, limit: int = 300) -> None:
+    """Let the app run (a device answers in wall time) until ``condition()`` holds."""
+    for _ in range(limit):
+        if condition():
+            return
+        await pilot.pause(0.05)
+    raise AssertionError(f"never happened: {what}")
+
+
+@pytest.mark.asyncio
+async def test_a_bound_device_that_drops_the_line_shows_a_fault_and_the_walk_goes_on(compiled):
+    from opspec.bindings.attach import attach_devices
+
+    url = "emulator://medication_dispenser?fault=disconnect:1"
+    with attach_devices([f"alarm={url}", f"dispenser={url}"], SPEC.parents[1] / "devices") as d:
+        session = WalkSession(compiled, performers=d.performers, wall_devices=True,
+                              device_participants={"medication_dispenser": ("alarm",
+                                                                            "dispenser")})
+        d.install(session.sim)
+        app = WalkthroughApp(session)
+        async with app.run_test(size=(80, 24)) as pilot:
+            await start(app, pilot)
+            await pilot.press("u")             # the skip waits for the board's answer
+            await until(pilot, lambda: session.offers, "the alarm reached the person")
+            assert session.now == 8 * 3600     # not skipped past the dose
+            await pilot.press("a", "w", "a", "a")   # hear, walk, press report: dispense
+            await until(pilot, lambda: any(r.status.startswith("FAULT")
+                                           for r in session.board.rows()), "a fault")
+            await until(pilot, lambda: not session.device_work, "the fallback answered")
+            await pilot.press("w")
+            assert "(x) " in screen_text(app) and "FAULT at 08:0" in screen_text(app)
+            await pilot.press("a", "u")         # take the pill; on to the next dose
+            await until(pilot, lambda: bool(session.offers) and session.now > 9 * 3600,
+                        "the next dose after the fault")
+
+
+def test_a_walkthrough_trace_fits_a_user_model(compiled, tmp_path, capsys):
+    from opspec.cli import main
+
+    record = tmp_path / "walk.json"
+    session = WalkSession(compiled, record=record)
+    for _dose in range(3):
+        for activity in ("hear_alarm", "walk_to_dispenser", "choose_button", "take_pill"):
+            session.skip_until_user()
+            session._run_to(session.now + 45)
+            session.act(next(o for o in session.offers if o.item.activity == activity))
+    session.close()
+    assert json.loads(record.read_text(encoding="utf-8"))["steps"][0] == [
+        "at 28845.0", "complete hear_alarm"]
+    actions = [json.loads(line) for line in
+               record.with_suffix(".trace.jsonl").read_text(encoding="utf-8").splitlines()
+               if "walkthrough.action" in line]
+    assert len(actions) == 12 and all(a["data"]["wall"] > 0 for a in actions)
+    fitted = tmp_path / "fitted.toml"
+    assert main(["fit", str(record.with_suffix(".trace.jsonl")), "-o", str(fitted)]) == 0
+    text = fitted.read_text(encoding="utf-8")
+    assert "[activities.walk_to_dispenser]" in text and 'intended = "press_report"' in text
