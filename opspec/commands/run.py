@@ -140,8 +140,10 @@ def run(args: argparse.Namespace) -> int:
             listeners.append(printer)
             if not args.json:
                 print(file=out)
+        from opspec.xpdl.open_spec import mode_loader_for
+
         sim = Simulation(compiled, config, performers=performers, seed=args.seed,
-                         listeners=listeners)
+                         listeners=listeners, mode_loader=mode_loader_for(package))
         if devices is not None:
             devices.install(sim)
         result = sim.run(until=horizon)

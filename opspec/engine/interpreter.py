@@ -1274,6 +1274,10 @@ class Interpreter:
         source = self.compiled.mode_sources.get(mode)
         if source is not None and self.mode_loader is not None:
             loaded = self.mode_loader(source)
+            if not isinstance(loaded, CompiledPackage):      # a Package: compile it here
+                from opspec.engine.compiled import compile_package
+
+                loaded = compile_package(loaded)
             new = {pid: p for pid, p in loaded.processes.items() if pid not in self.processes}
             if new:
                 self.processes = {**self.processes, **new}

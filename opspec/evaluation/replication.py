@@ -124,6 +124,7 @@ def run_user(context: _Context, design: str, user: int, *, seed: int, horizon: f
     """Simulate user ``user`` of ``design``; a failure becomes a ``failed`` record."""
     from opspec.engine.random import user_stream
     from opspec.engine.simulation import Simulation
+    from opspec.xpdl.open_spec import mode_loader_for
 
     start = time.perf_counter()
     try:
@@ -134,7 +135,8 @@ def run_user(context: _Context, design: str, user: int, *, seed: int, horizon: f
                 performers[name] = performer
         recorder = ActivityRecorder(context.manual)
         sim = Simulation(context.compiled, context.config, performers=performers, seed=seed,
-                         scope=(user,), listeners=[recorder], keep_trace=keep_trace)
+                         scope=(user,), listeners=[recorder], keep_trace=keep_trace,
+                         mode_loader=mode_loader_for(context.compiled.package))
         if sim.metrics is not None:
             sim.metrics.keep_times = True
         result = sim.run(until=horizon)

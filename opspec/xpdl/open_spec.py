@@ -2,12 +2,13 @@
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from pathlib import Path
 
 from opspec.errors import ConfigurationError
 from opspec.model import Package
 
-__all__ = ["open_spec"]
+__all__ = ["mode_loader_for", "open_spec"]
 
 
 def open_spec(path: str | Path) -> Package:
@@ -28,3 +29,18 @@ def open_spec(path: str | Path) -> Package:
     from opspec.xpdl.loader import load_spec
 
     return load_spec(target)
+
+
+def mode_loader_for(package: Package) -> Callable[[str], Package]:
+    """A loader for the specs a package's modes name (``<opspec:Mode Source="dock.xpdl">``),
+    relative to the package's own file, each read once. The engine compiles what it returns
+    when the mode is first entered."""
+    base = Path(package.source).parent if package.source else Path.cwd()
+    cache: dict[str, Package] = {}
+
+    def load(source: str) -> Package:
+        if source not in cache:
+            cache[source] = open_spec(base / source)
+        return cache[source]
+
+    return load

@@ -179,3 +179,70 @@ def test_compiled_script_runs_like_the_xpdl(tmp_path, capsys):
     from_xpdl = json.loads(capsys.readouterr().out)
     assert from_wfs["metrics"] == from_xpdl["metrics"]
     assert from_wfs["metrics"]["doses_missed"]["total"] == 4
+
+
+MAIN_WITH_MODES = """<?xml version="1.0" encoding="UTF-8"?>
+<Package xmlns="http://www.wfmc.org/2008/XPDL2.1" xmlns:opspec="urn:opspec:sisarl:1"
+         Id="main" Name="main">
+  <PackageHeader><XPDLVersion>2.1</XPDLVersion><Vendor>t</Vendor><Created>2026</Created>
+  </PackageHeader>
+  <WorkflowProcesses>
+    <WorkflowProcess Id="switch" Name="switch">
+      <ProcessHeader/>
+      <Activities>
+        <Activity Id="s_start"><Event><StartEvent/></Event></Activity>
+        <Activity Id="s_work"><Implementation><No/></Implementation>
+          <ExtendedAttributes><ExtendedAttribute Name="opspec:Duration"
+            Value="ConstantParameter(5)"/></ExtendedAttributes></Activity>
+        <Activity Id="s_go"><Implementation><No/></Implementation>
+          <ExtendedAttributes><ExtendedAttribute Name="opspec:BuiltIn">
+            <opspec:ModeChange To="later"/></ExtendedAttribute></ExtendedAttributes></Activity>
+        <Activity Id="s_end"><Event><EndEvent/></Event></Activity>
+      </Activities>
+      <Transitions>
+        <Transition Id="a" From="s_start" To="s_work"/><Transition Id="b" From="s_work" To="s_go"/>
+        <Transition Id="c" From="s_go" To="s_end"/>
+      </Transitions>
+      <ExtendedAttributes><ExtendedAttribute Name="opspec:AutoStart" Value="true"/>
+      </ExtendedAttributes>
+    </WorkflowProcess>
+  </WorkflowProcesses>
+  <ExtendedAttributes>
+    <ExtendedAttribute Name="opspec:Modes"><opspec:Mode Id="first" Initial="true"
+      Workflows="switch"/><opspec:Mode Id="later" Source="later.xpdl"/></ExtendedAttribute>
+  </ExtendedAttributes>
+</Package>
+"""
+
+LATER = """<?xml version="1.0" encoding="UTF-8"?>
+<Package xmlns="http://www.wfmc.org/2008/XPDL2.1" Id="later" Name="later">
+  <PackageHeader><XPDLVersion>2.1</XPDLVersion><Vendor>t</Vendor><Created>2026</Created>
+  </PackageHeader>
+  <WorkflowProcesses>
+    <WorkflowProcess Id="hello" Name="hello">
+      <ProcessHeader/>
+      <Activities>
+        <Activity Id="h_start"><Event><StartEvent/></Event></Activity>
+        <Activity Id="h_end"><Event><EndEvent/></Event></Activity>
+      </Activities>
+      <Transitions><Transition Id="h" From="h_start" To="h_end"/></Transitions>
+      <ExtendedAttributes><ExtendedAttribute Name="opspec:AutoStart" Value="true"/>
+      </ExtendedAttributes>
+    </WorkflowProcess>
+  </WorkflowProcesses>
+</Package>
+"""
+
+
+def test_a_mode_loads_its_workflows_from_another_spec_at_run_time(tmp_path, capsys):
+    main_spec = tmp_path / "main.xpdl"
+    main_spec.write_text(MAIN_WITH_MODES, encoding="utf-8")
+    (tmp_path / "later.xpdl").write_text(LATER, encoding="utf-8")
+    trace = tmp_path / "t.jsonl"
+    assert main(["run", str(main_spec), "--until", "20", "--trace", str(trace),
+                 "--timeline", "none"]) == 0
+    capsys.readouterr()
+    events = list(read_trace(trace))
+    changed = [e for e in events if e.kind == "mode.changed"]
+    hello = [e for e in events if e.kind == "process.started" and e.process == "hello"]
+    assert [e.time for e in changed] == [5.0] and [e.time for e in hello] == [5.0]
