@@ -29,6 +29,7 @@ from .conftest import DATA, DEVICES, needs_pty
 SPEC = Path(__file__).resolve().parents[2] / "specs" / "medication_dispenser.xpdl"
 SPEED = 20000.0
 FIRST_DOSE = 36000.0          # 10:00: the 08:00 dose is over, with slack for device replies
+SHIPPED = "medication_dispenser"
 FAST = "run_dispenser"        # tests/bindings/data: 200 ms reply timeouts, 50 ms reconnects
 
 
@@ -108,7 +109,7 @@ def script(tmp_path: Path, *steps: tuple[str, str]) -> str:
 
 
 def simulate(bind: list[str], user: str, *, until: float = FIRST_DOSE, spec: Path = SPEC,
-             profiles: Path = DATA) -> Outcome:
+             profiles: Path = DATA, settle_s: float | None = None) -> Outcome:
     """What ``opspec run --bind`` does, through the public API."""
     compiled = compile_package(load_any_spec(spec))
     performer, listeners = choose_user(compiled, spec, script=user, user_model=None,
@@ -120,7 +121,7 @@ def simulate(bind: list[str], user: str, *, until: float = FIRST_DOSE, spec: Pat
         if event.kind.startswith("device.") or event.kind == "fault":
             threads.add(threading.get_ident())
 
-    with attach_devices(bind, profiles) as devices:
+    with attach_devices(bind, profiles, settle_s=settle_s) as devices:
         performers.update(devices.performers)
         config = EngineConfig().with_options(realtime=devices.requires_wall_clock,
                                              speed=SPEED)
@@ -204,15 +205,17 @@ class _NullSession:
 @needs_pty
 def test_the_button_on_a_pseudo_terminal_reports_and_the_dose_is_taken(
         board: Any, tmp_path: Path) -> None:
-    server = board(ButtonPressingDevice, on="pty")
-    run = simulate([f"alarm:{FAST}={server.url}", f"dispenser:{FAST}={server.url}"],
-                   script(tmp_path, ("never", "press_report")))
+    # the shipped profile (500 ms replies, 3 s for the drawer), without the Uno's reset wait
+    server = board(ButtonPressingDevice, on="pty", profile=SHIPPED)
+    run = simulate([f"alarm={server.url}", f"dispenser={server.url}"],
+                   script(tmp_path, ("never", "press_report")), profiles=DEVICES, settle_s=0)
     assert run.wall_clock
     assert run.metric("doses_taken") == 1 and run.metric("doses_missed") == 0
     exchanges = [e.data for e in run.result.trace or () if e.kind == "device.exchange"]
     assert [x["command"] for x in exchanges] == ["ALARM ON", "DISPENSE 1"]
     events = [e.data for e in run.result.trace or () if e.kind == "device.event"]
     assert [x["event"] for x in events] == ["report"]
+    assert run.faults() == []
     device = run.report["alarm, dispenser"]
     assert device["latency_ms"]["count"] == 2 and device["latency_ms"]["max"] > 0
     assert device["faults"] == []
@@ -223,9 +226,9 @@ def test_the_button_on_a_pseudo_terminal_reports_and_the_dose_is_taken(
 
 
 def test_the_dose_over_a_loop_url_emulator(tmp_path: Path) -> None:
-    url = f"emulator://{DATA / f'{FAST}.toml'}"
-    run = simulate([f"alarm:{FAST}={url}", f"dispenser:{FAST}={url}"],
-                   script(tmp_path, ("after trg_2 30s", "press_report")))
+    url = f"emulator://{DEVICES / f'{SHIPPED}.toml'}"
+    run = simulate([f"alarm={url}", f"dispenser={url}"],
+                   script(tmp_path, ("after trg_2 30s", "press_report")), profiles=DEVICES)
     assert run.metric("doses_taken") == 1
     assert run.report["alarm, dispenser"]["latency_ms"]["count"] == 2
     assert run.faults() == []
@@ -279,9 +282,10 @@ def test_a_vanished_drawer_aborts_the_dispense_along_its_exception_transition(
 @needs_pty
 def test_a_line_nobody_expects_is_a_named_fault_and_the_run_goes_on(
         board: Any, tmp_path: Path) -> None:
-    server = board(ChattyDevice, on="pty")
-    run = simulate([f"alarm:{FAST}={server.url}", f"dispenser:{FAST}={server.url}"],
-                   script(tmp_path, ("after trg_2 30s", "press_report")))
+    server = board(ChattyDevice, on="pty", profile=SHIPPED)
+    run = simulate([f"alarm={server.url}", f"dispenser={server.url}"],
+                   script(tmp_path, ("after trg_2 30s", "press_report")), profiles=DEVICES,
+                   settle_s=0)
     assert [(f["fault"], f["action"]) for f in run.faults()] == [("unexpected-line", "none")]
     assert "unexpected line 'HELLO?'" in run.faults()[0]["message"]
     assert run.metric("doses_taken") == 1
