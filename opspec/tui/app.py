@@ -41,7 +41,11 @@ HELP = """\
   [b]u[/b]       skip until something needs you
   [b]h[/b]       hand your lane to the user model / take it back
   [b]l[/b]       timeline: all lanes / device / user
-  [b]?[/b]       this help        [b]q[/b]  quit (the recording is kept)
+  [b]?[/b]       this help
+  [b]q[/b], [b]ctrl+c[/b] quit (the recording is kept; its path is printed)
+
+Device panel: (!) an alert (a ringing alarm), (x) a device fault,
+> what a participant is doing now.
 
 Press escape or ? to close."""
 
@@ -94,12 +98,12 @@ class WalkthroughApp(App[str | None]):
     CSS = """
     Screen { layout: vertical; }
     #status { height: 1; background: $primary; color: $text; padding: 0 1; }
-    #panels { height: 1fr; min-height: 9; }
+    #panels { height: 2fr; min-height: 12; }
     #device, #person { width: 1fr; height: 1fr; border: round $secondary; padding: 0 1; }
     #device { width: 3fr; text-wrap: nowrap; text-overflow: ellipsis; }
     #person { width: 2fr; }
     #person.calling { border: heavy $warning; }
-    #timeline { height: 8; border: round $secondary; padding: 0 1; }
+    #timeline { height: 1fr; min-height: 5; border: round $secondary; padding: 0 1; }
     .offer { height: auto; }
     .offer:hover { background: $boost; }
     """
@@ -288,10 +292,15 @@ class WalkthroughApp(App[str | None]):
 
     def _timeline_text(self) -> Text:
         lane = LANES[self.lane_filter]
-        text = Text(f"showing: {lane}\n", style="dim")
+        text = Text()
+        text.append(f"showing: {lane} (l: change)\n", style="dim")
+        # as many events as the box holds (it grows with the terminal)
+        rows = max(3, self.query_one("#timeline", Static).content_size.height - 1)
         shown = 0
         for event in reversed(self.session.events):
-            if event.kind not in _TIMELINE_KINDS or (lane != "all" and event.lane != lane):
+            # the person's (or the model's) actions belong to the user lane
+            shown_lane = "user" if event.kind == "walkthrough.action" else event.lane or ""
+            if event.kind not in _TIMELINE_KINDS or (lane != "all" and shown_lane != lane):
                 continue
             what = f"{event.activity or event.process or ''} {event.kind.split('.')[-1]}"
             if event.kind == "trigger.raised":
@@ -299,9 +308,9 @@ class WalkthroughApp(App[str | None]):
             elif event.kind == "walkthrough.action":
                 data = event.data or {}
                 what = f"{'you' if data.get('by') == 'person' else 'model'}: {data.get('action')}"
-            text.append(f"{clock(event.time)[3:]}  {event.lane or '':<6} {what}\n")
+            text.append(f"{clock(event.time)[3:]}  {shown_lane:<6} {what}\n")
             shown += 1
-            if shown >= 6:
+            if shown >= rows:
                 break
         return text
 

@@ -146,6 +146,7 @@ class WalkSession:
         self.wall_devices = wall_devices
         self.device_work: set[tuple[int, str]] = set()      # offered to a device, unanswered
         self.skipping = False                               # a skip until the user goes on
+        self.calls = 0                                      # user-lane processes started
         self.offers: list[Offer] = []
         self.calling = False                                # the device is calling the user
         self.ended = False
@@ -220,13 +221,16 @@ class WalkSession:
         self._skip()
 
     def _skip(self) -> None:
-        while not self.offers and not self.ended and not self.waiting_for_devices:
+        # with the lane handed over nothing waits for the person: stop at the next call
+        calls = self.calls
+        while not self.offers and not self.ended and not self.waiting_for_devices and not (
+                self.handed_over and self.calls > calls):
             due = self.sim.peek()
             if not math.isfinite(due):
                 self._run_to(self.horizon)
                 break
             self._run_to(min(self.horizon, due))
-        if self.offers or self.ended or self.handed_over:
+        if self.offers or self.ended or (self.handed_over and self.calls > calls):
             self.skipping = False
 
     def _run_to(self, target: float) -> None:
@@ -340,6 +344,7 @@ class WalkSession:
             self.participants[who] = prefix + str(data.get("message", ""))
         if kind == "process.started" and event.lane == "user":
             self.calling = True
+            self.calls += 1
         if kind == "process.completed" and event.lane == "user":
             self.calling = False
         for listener in self.listeners:
@@ -349,9 +354,8 @@ class WalkSession:
     def _record(self, action: str, *, by: str) -> None:
         self._steps.append([f"at {self.now!r}", action])
         self._write_record()
-        if self._trace_file is not None:
-            self.sim.session.trace("walkthrough.action", {
-                "action": action, "by": by, "wall": time.time()})  # wall-clock: the record
+        self.sim.session.trace("walkthrough.action", {
+            "action": action, "by": by, "wall": time.time()})  # wall-clock: the record
 
     def _write_record(self) -> None:
         if self.record_path is None:

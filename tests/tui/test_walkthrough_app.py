@@ -240,3 +240,59 @@ def test_a_walkthrough_trace_fits_a_user_model(compiled, tmp_path, capsys):
     assert main(["fit", str(record.with_suffix(".trace.jsonl")), "-o", str(fitted)]) == 0
     text = fitted.read_text(encoding="utf-8")
     assert "[activities.walk_to_dispenser]" in text and 'intended = "press_report"' in text
+
+
+@pytest.mark.asyncio
+async def test_replaying_a_recording_in_the_app_performs_it_by_itself(compiled, tmp_path):
+    record = tmp_path / "walk.json"
+    record.write_text('{"otherwise": "wait", "steps": [["at 28830.0", "complete hear_alarm"],'
+                      ' ["at 28890.0", "complete walk_to_dispenser"],'
+                      ' ["at 28890.0", "choose press_report"],'
+                      ' ["at 28900.0", "complete take_pill"]]}', encoding="utf-8")
+    session = WalkSession(compiled, replay=load_script(record).performer())
+    app = WalkthroughApp(session)
+    async with app.run_test(size=(80, 24)) as pilot:
+        await start(app, pilot)
+        assert "replaying the recording" in screen_text(app)
+        for _ in range(8):
+            await pilot.press("n")
+        await pilot.press("w", "w", "w")
+        assert not session.offers                       # nothing is offered to the person
+    assert metric(session, "doses_taken")["total"] == 1
+    assert metric(session, "report_latency_s")["mean"] == pytest.approx(90.0)
+
+
+@pytest.mark.asyncio
+async def test_an_offer_is_done_by_clicking_it_and_the_timeline_filters_lanes(compiled):
+    session = WalkSession(compiled)
+    app = WalkthroughApp(session)
+    async with app.run_test(size=(80, 24)) as pilot:
+        await start(app, pilot)
+        await pilot.press("u")
+        assert await pilot.click(".offer")
+        await pilot.pause()
+        assert session.offers[0].item.activity == "walk_to_dispenser"
+        timeline = app.query_one("#timeline")
+        assert "user   you: complete hear_alarm" in str(timeline.render())
+        await pilot.press("l")                          # device only
+        shown = str(timeline.render())
+        assert "showing: device" in shown and "device trigger trg_2 raised" in shown
+        assert " user " not in shown
+        await pilot.press("l")                          # user only
+        shown = str(timeline.render())
+        assert "showing: user" in shown and "you: complete hear_alarm" in shown
+        assert "hear_alarm completed" in shown and " device " not in shown
+
+
+@pytest.mark.asyncio
+async def test_while_the_model_has_the_lane_skipping_stops_at_the_next_call(compiled,
+                                                                          model_factory):
+    session = WalkSession(compiled, model_factory=model_factory)
+    app = WalkthroughApp(session)
+    async with app.run_test(size=(80, 24)) as pilot:
+        await start(app, pilot)
+        await pilot.press("h", "u")                     # the model performs; skip
+        assert session.now == 8 * 3600 and session.calls == 1
+        assert "model performs your lane" in screen_text(app)
+        await pilot.press("n", "n", "n", "u")
+        assert 8 * 3600 < session.now <= 12 * 3600
