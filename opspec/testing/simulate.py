@@ -23,13 +23,14 @@ from __future__ import annotations
 
 import math
 import zlib
-from collections.abc import Callable, Iterable, Mapping, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-from opspec.engine.compiled import CompiledActivity, CompiledPackage, compile_package
+from opspec.engine.compiled import CompiledPackage, compile_package
 from opspec.engine.config import EngineConfig
+from opspec.engine.lanes import all_activities
 from opspec.engine.metrics import summarise_durations
 from opspec.engine.performers import Performer
 from opspec.engine.random import user_stream
@@ -82,24 +83,13 @@ class SpecNames:
     user_performers: tuple[str, ...]
 
 
-def _activities(compiled: CompiledPackage) -> Iterable[CompiledActivity]:
-    for proc in compiled.processes.values():
-        stack = [proc.graph]
-        while stack:
-            graph = stack.pop()
-            for act in graph.activities:
-                yield act
-                if act.block is not None:
-                    stack.append(act.block)
-
-
 def spec_names(compiled: CompiledPackage) -> SpecNames:
     """Processes, activities, trigger (message/signal) names, metrics, and the names the user
     lane's performers bind to (participants of user-lane activities, else their lane)."""
     activities: dict[str, None] = {}
     triggers: dict[str, None] = {}
     user: dict[str, None] = {}
-    for act in _activities(compiled):
+    for act in all_activities(compiled):
         activities[act.id] = None
         for trig in (act.raises, act.trigger, act.start_trigger, act.end_trigger):
             if trig is not None and trig.name and trig.kind in ("message", "signal"):
