@@ -3,12 +3,13 @@ device operations the specs' applications name."""
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable, Mapping
 from typing import Any
 
 import numpy as np
 
-__all__ = ["World"]
+__all__ = ["RobotWorld", "World"]
 
 Tracer = Callable[[str, Mapping[str, Any]], None]
 
@@ -60,3 +61,27 @@ class World:
 
     def applications(self) -> list[str]:
         return [name[3:] for name in dir(self) if name.startswith("op_")]
+
+
+class RobotWorld(World):
+    """A world with one robot of ours (``self.robot``) and a battery draining linearly at
+    ``self.drain_per_s`` % per second: the motors and the battery gauge every such world has."""
+
+    robot: Any
+    drain_per_s: float
+
+    def op_drive(self, data: Mapping[str, Any]) -> dict[str, Any]:
+        """Execute ``motor_cmd``; ``turn_random`` (the random-move manoeuvre) turns to a new
+        heading a quarter to three quarters round at once, then stops."""
+        from opspec.bindings.world.geometry import wrap_angle
+
+        command = str(data.get("motor_cmd") or "stop")
+        if command == "turn_random":
+            self.robot.heading = wrap_angle(
+                self.robot.heading + float(self.rng.uniform(math.pi / 2, 3 * math.pi / 2)))
+            command = "stop"
+        self.robot.command = command
+        return {}
+
+    def op_read_battery(self, _data: Mapping[str, Any]) -> dict[str, Any]:
+        return {"level": round(max(0.0, 100.0 - self.drain_per_s * self.time), 3)}

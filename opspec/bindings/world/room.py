@@ -16,7 +16,7 @@ from typing import Any
 
 import numpy as np
 
-from opspec.bindings.world.base import World
+from opspec.bindings.world.base import RobotWorld
 from opspec.bindings.world.geometry import Box, ray_to_box, wrap_angle
 from opspec.bindings.world.robot import Robot
 
@@ -32,7 +32,7 @@ def _box(corners: Sequence[float]) -> Box:
     return box
 
 
-class RoomWorld(World):
+class RoomWorld(RobotWorld):
     """The room (``width`` x ``height`` metres, walls on its edges, ``obstacles`` as
     ``[x0, y0, x1, y1]`` boxes) with the robot starting at ``start`` = ``[x, y, heading]``."""
 
@@ -134,18 +134,7 @@ class RoomWorld(World):
         bumped, self.bumped = self.bumped, False
         return {"bump": bumped, "edge": False}         # a room has no ring edge
 
-    def op_drive(self, data: Mapping[str, Any]) -> dict[str, Any]:
-        command = str(data.get("motor_cmd") or "stop")
-        if command == "turn_random":
-            # the random-move manoeuvre: a new heading a quarter to three quarters round
-            self.robot.heading = wrap_angle(
-                self.robot.heading + float(self.rng.uniform(math.pi / 2, 3 * math.pi / 2)))
-            command = "stop"
-        self.robot.command = command
-        return {}
 
-    def op_read_battery(self, _data: Mapping[str, Any]) -> dict[str, Any]:
-        return {"level": round(max(0.0, 100.0 - self.drain_per_s * self.time), 3)}
 
     def _near_tag(self) -> bool:
         if self.tag is None:

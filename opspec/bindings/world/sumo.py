@@ -18,14 +18,14 @@ from typing import Any
 
 import numpy as np
 
-from opspec.bindings.world.base import World
+from opspec.bindings.world.base import RobotWorld
 from opspec.bindings.world.geometry import ray_to_circle_inside, wrap_angle
 from opspec.bindings.world.robot import Robot
 
 __all__ = ["SumoWorld"]
 
 
-class SumoWorld(World):
+class SumoWorld(RobotWorld):
     def __init__(self, rng: np.random.Generator, *, ring_radius: float = 1.5,
                  radius: float = 0.15, opponent_speed: float = 0.25, bout_limit_s: float = 60.0,
                  range_noise: float = 0.01, drain_per_s: float = 0.02,
@@ -122,14 +122,4 @@ class SumoWorld(World):
         edge = self.ring - math.hypot(self.robot.x, self.robot.y) < self.edge_band
         return {"bump": bumped, "edge": edge}
 
-    def op_drive(self, data: Mapping[str, Any]) -> dict[str, Any]:
-        command = str(data.get("motor_cmd") or "stop")
-        if command == "turn_random":
-            self.robot.heading = wrap_angle(
-                self.robot.heading + float(self.rng.uniform(math.pi / 2, 3 * math.pi / 2)))
-            command = "stop"
-        self.robot.command = command
-        return {}
 
-    def op_read_battery(self, _data: Mapping[str, Any]) -> dict[str, Any]:
-        return {"level": round(max(0.0, 100.0 - self.drain_per_s * self.time), 3)}
