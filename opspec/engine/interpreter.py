@@ -82,7 +82,7 @@ from opspec.engine.registry import PerformerRegistry
 from opspec.engine.trace import EventKind as EK
 from opspec.engine.trace import TraceEvent, TraceListener
 from opspec.errors import ExecutionError, OpspecError
-from opspec.model import CoordinationKind, ParameterMode
+from opspec.model import CoordinationKind, Package, ParameterMode
 
 __all__ = ["Interpreter"]
 
@@ -101,7 +101,7 @@ class Interpreter:
     def __init__(self, compiled: CompiledPackage, config: EngineConfig, *,
                  performers: PerformerRegistry, seed: int, listeners: list[TraceListener],
                  params: Mapping[str, Any] | None, env: simpy.Environment | None,
-                 scope: tuple[int, ...], mode_loader: Callable[[str], CompiledPackage] | None
+                 scope: tuple[int, ...], mode_loader: Callable[[str], CompiledPackage | Package] | None
                  ) -> None:
         self.compiled = compiled
         self.config = config

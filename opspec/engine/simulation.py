@@ -135,7 +135,7 @@ class Simulation(Interpreter):
                  seed: int = 0, listeners: Iterable[TraceListener] = (),
                  params: Mapping[str, Any] | None = None, keep_trace: bool = False,
                  env: simpy.Environment | None = None, scope: Iterable[int] = (),
-                 mode_loader: Callable[[str], CompiledPackage] | None = None) -> None:
+                 mode_loader: Callable[[str], CompiledPackage | Package] | None = None) -> None:
         if isinstance(compiled, Package):
             compiled = compile_package(compiled)
         self.seed = seed
