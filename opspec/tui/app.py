@@ -11,6 +11,7 @@ words and symbols, never by colour alone. The engine is stepped from this app's 
 from __future__ import annotations
 
 import string
+from collections.abc import Sequence
 from typing import Any, ClassVar
 
 from rich.text import Text
@@ -125,13 +126,15 @@ class WalkthroughApp(App[str | None]):
         *[Binding(k, f"offer({i})", show=False) for i, k in enumerate(OFFER_KEYS)],
     ]
 
-    def __init__(self, session: WalkSession, *, title: str = "", notes: list[str] = ()) -> None:
+    def __init__(self, session: WalkSession, *, title: str = "",
+                 notes: Sequence[str] = ()) -> None:
         super().__init__()
         self.session = session
         self.spec_title = title
         self.notes = list(notes)
         self.lane_filter = 0
         self._was_calling = False
+        self._views_ready = False            # set once mounted, cleared when quitting
         session.listeners.append(self._on_event)
 
     # ------------------------------------------------------------------ layout
@@ -149,6 +152,7 @@ class WalkthroughApp(App[str | None]):
         self.query_one("#device", Static).border_title = "Device"
         self.query_one("#person", Vertical).border_title = "You (the user lane)"
         self.query_one("#timeline", Static).border_title = "Timeline (newest first)"
+        self._views_ready = True
         self.refresh_views()
 
     # ------------------------------------------------------------------ time
@@ -216,16 +220,25 @@ class WalkthroughApp(App[str | None]):
             self.refresh_views()
 
     def action_help(self) -> None:
-        self.push_screen(HelpScreen())
+        # the clock stands still while the person reads (and resumes as it was)
+        was_paused = self.session.paused
+        self.session.paused = True
+
+        def resume(_result: None) -> None:
+            self.session.paused = was_paused
+            self.refresh_views()
+
+        self.push_screen(HelpScreen(), resume)
 
     def action_quit_walk(self) -> None:
+        self._views_ready = False
         self.session.close()
         path = self.session.record_path
         self.exit(str(path) if path is not None else None)
 
     # ------------------------------------------------------------------ views
     def refresh_views(self) -> None:
-        if not self.is_mounted:
+        if not self._views_ready:
             return
         session = self.session
         state = "PAUSED" if session.paused else "running"
@@ -284,8 +297,10 @@ class WalkthroughApp(App[str | None]):
             left = max(0.0, due - session.now)
             text.append(f"deadline {activity} (#{instance}) in {int(left // 60):02d}:"
                         f"{int(left % 60):02d}\n", style="bold")
+        shown = {state.note for state in session.board.states.values()}
         for note in self.notes:
-            text.append(f"note: {note}\n")
+            if note not in shown:        # notes a device also traced are on its participants
+                text.append(f"note: {note}\n")
         if not text.plain:
             text.append("(idle)")
         return text

@@ -44,6 +44,8 @@ def test_walkthrough_in_tmux_shows_the_alarm_and_says_where_the_recording_is(tmp
         tmux("send-keys", "-t", session, "u")
         screen = wait_for(session, "THE DEVICE CALLS YOU")
         assert "Hear the alarm" in screen and "08:00:00" in screen
+        assert "alarm: ((( RINGING ))) since 08:00" in screen      # the device panel
+        assert "deadline wait_report (#2) in 05:00" in screen
         tmux("send-keys", "-t", session, "a")
         wait_for(session, "Walk to the dispenser")
         tmux("send-keys", "-t", session, "q")

@@ -124,10 +124,12 @@ async def test_help_screen_lists_the_keys_and_closes(compiled):
         await pilot.press("question_mark")
         await pilot.pause()
         text = str(app.screen.query_one("#help-text").render())
-        assert "pause / resume" in text and "hand your lane" in text
+        assert "pause / resume" in text and "hand your lane" in text and "ctrl+c" in text
+        assert app.session.paused                      # the clock waits while I read
         await pilot.press("escape")
         await pilot.pause()
         assert not app.screen.query("#help-text")
+        assert not app.session.paused                  # and runs again as it did
 
 
 @pytest.mark.asyncio
