@@ -297,9 +297,8 @@ class WalkthroughApp(App[str | None]):
             left = max(0.0, due - session.now)
             text.append(f"deadline {activity} (#{instance}) in {int(left // 60):02d}:"
                         f"{int(left % 60):02d}\n", style="bold")
-        shown = {state.note for state in session.board.states.values()}
         for note in self.notes:
-            if note not in shown:        # notes a device also traced are on its participants
+            if note not in session.board.notes_seen:   # traced notes are on the participants
                 text.append(f"note: {note}\n")
         if not text.plain:
             text.append("(idle)")
@@ -320,6 +319,10 @@ class WalkthroughApp(App[str | None]):
             what = f"{event.activity or event.process or ''} {event.kind.split('.')[-1]}"
             if event.kind == "trigger.raised":
                 what = f"trigger {(event.data or {}).get('name', '?')} raised"
+            elif event.kind == "fault":
+                data = event.data or {}
+                what = f"FAULT {data.get('device') or ''} {data.get('participant') or ''}: " \
+                       f"{data.get('fault', '')}"
             elif event.kind == "walkthrough.action":
                 data = event.data or {}
                 what = f"{'you' if data.get('by') == 'person' else 'model'}: {data.get('action')}"

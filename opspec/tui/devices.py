@@ -45,7 +45,7 @@ class ParticipantState:
     busy: dict[tuple[int, str], str] = field(default_factory=dict)
     last: tuple[str, float] | None = None
     display: dict[str, str] = field(default_factory=dict)
-    fault: tuple[str, float] | None = None
+    fault: tuple[str, str, float] | None = None     # (kind, message, time)
     note: str | None = None
 
 
@@ -80,6 +80,8 @@ class DeviceBoard:
                     sounding=bool(_SOUNDING.search(pid) or _SOUNDING.search(names.get(pid, ""))))
         #: device name (profile) → the participants it serves, for faults without a participant
         self.device_participants = {k: tuple(v) for k, v in (device_participants or {}).items()}
+        #: every device note seen in the trace (the view lists other notes apart)
+        self.notes_seen: set[str] = set()
 
     # ------------------------------------------------------------------ events
     def __call__(self, event: TraceEvent) -> None:
@@ -121,6 +123,8 @@ class DeviceBoard:
     def _device_event(self, event: TraceEvent) -> None:
         data = event.data or {}
         message = str(data.get("message", "") or data.get("fault", ""))
+        if event.kind == "device.note":
+            self.notes_seen.add(message)
         who: tuple[str, ...]
         if data.get("participant"):
             who = (str(data["participant"]),)
@@ -133,7 +137,7 @@ class DeviceBoard:
             if state is None:
                 state = self.states[pid] = ParticipantState(pid, pid)
             if event.kind == "fault":
-                state.fault = (message, event.time)
+                state.fault = (str(data.get("fault") or "fault"), message, event.time)
             else:
                 state.note = message
 
@@ -145,7 +149,7 @@ class DeviceBoard:
             last = f"last: {state.last[0]} {_hhmm(state.last[1])}" if state.last else ""
             alert = True
             if state.fault is not None:
-                status = f"FAULT at {_hhmm(state.fault[1])}: {state.fault[0]}"
+                status = f"FAULT at {_hhmm(state.fault[2])}: {state.fault[0]}"
             elif state.signalling:
                 name, _activity, since = next(iter(state.signalling.values()))
                 status = (f"((( RINGING ))) since {_hhmm(since)}" if state.sounding
@@ -160,7 +164,8 @@ class DeviceBoard:
                     status, last = last, ""
                 else:
                     status = "idle"
-            parts = [last] if last else []
+            parts = [state.fault[1]] if state.fault is not None else []
+            parts.extend([last] if last else [])
             parts.extend(f"{k}={v}" for k, v in state.display.items())
             if state.note and state.fault is None:
                 parts.append(f"note: {state.note}")

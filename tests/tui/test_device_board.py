@@ -70,7 +70,8 @@ def test_a_device_fault_shows_on_the_participants_it_concerns(compiled, data, wh
     session.sim.session.trace("fault", data)
     faulty = [r.id for r in session.board.rows() if r.status.startswith("FAULT")]
     assert faulty == who
-    assert data["message"] in row(session, who[0]).status
+    assert row(session, who[0]).status == f"FAULT at 08:00: {data['fault']}"
+    assert data["message"] in row(session, who[0]).detail
 
 
 def test_a_device_note_is_shown_beside_the_participant_without_alarming(compiled):

@@ -181,7 +181,7 @@ async def test_a_device_fault_is_shown_on_its_participant(compiled):
             "message": "the board is gone"})
         await pilot.press("w")
         text = screen_text(app)
-        assert "(x) alarm: FAULT at 08:00: the board is gone" in text
+        assert "(x) alarm: FAULT at 08:00: disconnected" in text
         assert "(x) dispenser: FAULT" in text
 
 
