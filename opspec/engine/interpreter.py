@@ -849,10 +849,10 @@ class Interpreter:
             inst.data[target] = value
         else:
             self.package_data[target] = value
-        proc = inst.process.id
-        aid = act.id if act is not None else None
-        if self._all or (EK.DATA_CHANGED, proc, aid) in self._want:
-            self.emit(EK.DATA_CHANGED, proc, inst.id, aid, inst.process.lane, None,
+        if (self._aflags[act] & 8 if act is not None
+                else self._all or (EK.DATA_CHANGED, inst.process.id, None) in self._want):
+            self.emit(EK.DATA_CHANGED, inst.process.id, inst.id,
+                      act.id if act is not None else None, inst.process.lane, None,
                       {target: value})
         if self._rules:
             self._check_rules()
@@ -945,7 +945,8 @@ class Interpreter:
         self.raised_names.add(name)
         proc = inst.process.id if inst is not None else None
         aid = act.id if act is not None else None
-        if self._all or (EK.TRIGGER_RAISED, proc, aid) in self._want:
+        if (self._aflags[act] & 16 if act is not None
+                else self._all or (EK.TRIGGER_RAISED, proc, aid) in self._want):
             self.emit(EK.TRIGGER_RAISED, proc, inst.id if inst else None, aid,
                       act.lane if act else None, act.participant if act else None,
                       {"trigger": kind, "name": name, **(dict(data) if data else {})})
@@ -1314,7 +1315,8 @@ class Interpreter:
         raise NotImplementedError
 
 
-_ACT_KINDS = (EK.ACTIVITY_STARTED, EK.ACTIVITY_COMPLETED, EK.ACTIVITY_OFFERED)
+_ACT_KINDS = (EK.ACTIVITY_STARTED, EK.ACTIVITY_COMPLETED, EK.ACTIVITY_OFFERED,
+              EK.DATA_CHANGED, EK.TRIGGER_RAISED)
 _PROC_KINDS = (EK.PROCESS_STARTED, EK.PROCESS_COMPLETED)
 
 
