@@ -68,8 +68,12 @@ class StochasticUser:
         self._session = session
 
     def offer(self, item: WorkItem) -> None:
-        session = self._require_session()
-        model = self._model_of(item.activity)
+        session = self._session
+        if session is None:
+            session = self._require_session()
+        model = self._models.get(item.activity)
+        if model is None:
+            model = self._model_of(item.activity)
         lane = item.root_instance if item.root_instance is not None else item.instance
         now = session.now
         state = self._routine.state(now)

@@ -172,6 +172,7 @@ class RoutineTracker:
 
     def __init__(self, routine: Routine, rng: np.random.Generator) -> None:
         self.routine = routine
+        self._trivial = routine.is_trivial     # checked on every offer
         self._rng = rng
         self._drawn_through = -2  # last day whose occurrences were drawn
         self._happens: dict[tuple[int, int], bool] = {}
@@ -204,7 +205,7 @@ class RoutineTracker:
 
     def state(self, now: float) -> RoutineState:
         """The routine's effect on an activity offered at ``now``."""
-        if self.routine.is_trivial:
+        if self._trivial:
             return _TRIVIAL
         day = math.floor(now / DAY)
         drift = self.routine.drift
