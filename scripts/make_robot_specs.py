@@ -296,7 +296,8 @@ APPLICATIONS = {
 
 
 def package(pid: str, name: str, description: str, world: str, processes: list[str],
-            metrics: str, apps: list[str], fields: list[str], modes: bool = True) -> str:
+            metrics: str, apps: list[str], fields: list[str], run_length: str,
+            modes: bool = True) -> str:
     participants = sorted({app_owner(a) for a in apps})
     parts = "\n".join(f'    <Participant Id="{p}" Name="{p.replace("_", " ")}">'
                       f'<ParticipantType Type="SYSTEM"/></Participant>' for p in participants)
@@ -335,7 +336,8 @@ def package(pid: str, name: str, description: str, world: str, processes: list[s
   </WorkflowProcesses>
   <ExtendedAttributes>
     <ExtendedAttribute Name="opspec:World" Value="{world}"/>
-    <ExtendedAttribute Name="opspec:WorldFile" Value="{pid}.world.toml"/>{mode_xml}
+    <ExtendedAttribute Name="opspec:WorldFile" Value="{pid}.world.toml"/>
+    <ExtendedAttribute Name="opspec:RunLength" Value="{run_length}"/>{mode_xml}
     <ExtendedAttribute Name="opspec:Metrics">
 {metrics}
     </ExtendedAttribute>
@@ -368,7 +370,9 @@ def main() -> None:
         "vacuum-room", shared[:3] + [manoeuvre("vacuum")] + shared[3:], "\n".join([
             count("cells_covered", "world.covered"), count("collisions", "world.collision"),
             count("manoeuvres", "activity.completed", "manoeuvre", "back_up"),
-            count("dockings", "mode.changed")]), ROBOT_APPS, ROBOT_FIELDS)
+            count("dockings", "mode.changed")]), ROBOT_APPS, ROBOT_FIELDS,
+        # one cleaning run: the battery reaches 20 % at about 67 min, then the robot docks
+        run_length="PT75M")
     sumo = package(
         "toy_sumo", "Toy sumo robot",
         "The toy sumo (EMWF TR-IIS-08-005, section 6): the vacuum cleaner's graph with a "
@@ -380,7 +384,8 @@ def main() -> None:
             count("manoeuvres", "activity.completed", "manoeuvre", "move_back"),
             count("dockings", "mode.changed"),
             '      <opspec:Ratio Name="win_rate" Numerator="bouts_won" Denominator="bouts"/>']),
-        ROBOT_APPS, ROBOT_FIELDS)
+        # a tournament of bouts (60 s at most each), over before the battery asks to dock
+        ROBOT_APPS, ROBOT_FIELDS, run_length="PT30M")
     cart_fields = [*ROBOT_FIELDS, field("tag", "STRING", '""'),
                    field("patient_id", "STRING", '""'), field("found", "BOOLEAN", "false")]
     cart = package(
@@ -397,7 +402,9 @@ def main() -> None:
             '<opspec:From Event="process.started" Process="mission"/>'
             '<opspec:To Event="activity.completed" Process="mission" Activity="wait_found"/>'
             '</opspec:Duration>')]),
-        [*ROBOT_APPS[:3], "read_rfid", "scan_barcode"], cart_fields, modes=False)
+        [*ROBOT_APPS[:3], "read_rfid", "scan_barcode"], cart_fields,
+        # one round down the ward: the patient is usually found within two minutes
+        run_length="PT10M", modes=False)
     cart = cart.replace('<ExtendedAttribute Name="opspec:Mode" Value="run"/>', "")
     for name, text in (("vacuum_cleaner", vacuum), ("toy_sumo", sumo),
                        ("medication_cart_guidance", cart)):

@@ -34,8 +34,9 @@ def register(subparsers: Any) -> None:
     parser.add_argument("spec", metavar="SPEC", nargs="?",
                         help="the specification (.xpdl or .wfs); optional with --resume")
     parser.add_argument("--users", type=int, default=100, help="simulated users (default 100)")
-    parser.add_argument("--days", type=float, default=30.0,
-                        help="simulated days per user (default 30)")
+    parser.add_argument("--days", type=float, default=None,
+                        help="simulated days per user (default: the spec's opspec:RunLength "
+                        "if it declares one, else 30)")
     parser.add_argument("--seed", type=int, default=0, help="run seed (default 0)")
     parser.add_argument("--user-model", metavar="FILE|PRESET",
                         help="user model file or preset, 'A,B' to chain (default: the spec's "
@@ -97,22 +98,28 @@ def _engine(path: str | None) -> dict[str, Any]:
 
 def _new_plan(args: argparse.Namespace) -> Any:
     from opspec.commands._spec import companion_user_model
-    from opspec.evaluation.plan import Design, EvaluationPlan, file_digest
+    from opspec.evaluation.plan import DAY, Design, EvaluationPlan, file_digest
 
     if args.spec is None:
         raise EvaluationError("give the SPEC to evaluate (or --resume --out DIR)")
     specs = [("A", args.spec)] + ([("B", args.compare)] if args.compare else [])
     designs = []
+    run_lengths = []
     for label, path in specs:
         from opspec.xpdl.open_spec import open_spec
 
-        open_spec(path)                       # a broken spec stops here, with path:line
+        package = open_spec(path)             # a broken spec stops here, with path:line
+        run_lengths.append(package.run_length)
         designs.append(Design(label, str(path), file_digest(path)))
+    days = args.days
+    if days is None:
+        # a robot's run is minutes, a dispenser's life is days: the spec says which
+        days = run_lengths[0] / DAY if run_lengths[0] is not None else 30.0
     model = args.user_model
     if model is None:
         companion = companion_user_model(args.spec)
         model = str(companion) if companion is not None else None
-    return EvaluationPlan(designs=tuple(designs), users=args.users, days=args.days,
+    return EvaluationPlan(designs=tuple(designs), users=args.users, days=days,
                           seed=args.seed, user_model=model, engine=_engine(args.engine_config),
                           export=_exports(args.export))
 

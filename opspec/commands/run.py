@@ -51,8 +51,9 @@ def register(subparsers: Any) -> None:
     parser.add_argument("spec", metavar="SPEC", help="the specification (.xpdl or .wfs)")
     length = parser.add_mutually_exclusive_group()
     length.add_argument("--days", type=float, metavar="D",
-                        help="simulated days to run (default: 1 for specs with periodic "
-                        "triggers, else until nothing is left to do)")
+                        help="simulated days to run (default: the spec's opspec:RunLength "
+                        "if it declares one, else 1 for specs with periodic triggers, else "
+                        "until nothing is left to do)")
     length.add_argument("--until", metavar="T",
                         help="simulated end time: seconds, or an ISO 8601 duration (PT8H)")
     parser.add_argument("--seed", type=int, default=0, help="run seed (default 0)")
@@ -194,6 +195,8 @@ def _horizon(args: argparse.Namespace, compiled: Any) -> float | None:
         return float(args.days * DAY)
     if args.until is not None:
         return _parse_until(args.until)
+    if compiled.package.run_length is not None:
+        return float(compiled.package.run_length)
     periodic = any(p.start_trigger is not None and p.start_trigger.kind in ("timer", "period")
                    for p in compiled.processes.values())
     return DAY if periodic else None
@@ -267,6 +270,8 @@ def _span(seconds: float) -> str:
         return f"{days} day{'s' if days != 1 else ''}"
     if seconds >= 3600:
         return f"{seconds / 3600:g} h"
+    if seconds >= 60 and seconds % 60 == 0:
+        return f"{seconds / 60:g} min"
     return f"{seconds:g} s"
 
 

@@ -16,9 +16,21 @@ from typing import Any
 
 from opspec.errors import EvaluationError
 
-__all__ = ["DAY", "Design", "EvaluationPlan", "file_digest"]
+__all__ = ["DAY", "Design", "EvaluationPlan", "file_digest", "span"]
 
 DAY = 86_400.0
+
+
+def span(days: float) -> str:
+    """A run length for people: ``30 days``, ``1 day``, ``75 min``, ``1.5 h``."""
+    if days >= 1:
+        return f"{days:g} day{'s' if days != 1 else ''}"
+    seconds = days * DAY
+    if seconds >= 3600 and round(seconds) % 3600 == 0 or seconds >= 7200:
+        return f"{seconds / 3600:.4g} h"
+    if seconds >= 60:
+        return f"{seconds / 60:.4g} min"
+    return f"{seconds:.4g} s"
 
 
 def file_digest(path: str | Path) -> str:

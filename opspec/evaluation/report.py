@@ -11,6 +11,7 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Any
 
+from opspec.evaluation.plan import span
 from opspec.evaluation.store import ResultStore
 from opspec.evaluation.summary import compare_designs, metric_definitions, summarise_design
 from opspec.evaluation.tables import (
@@ -81,7 +82,7 @@ def write_report(store: ResultStore) -> Path:
     run_rows = [("spec (A)", specs.get("A", "?"))]
     if "B" in specs:
         run_rows.append(("compared with (B)", specs["B"]))
-    run_rows += [("users", str(plan.get("users"))), ("days per user", f"{days:g}"),
+    run_rows += [("users", str(plan.get("users"))), ("simulated time per user", span(days)),
                  ("seed", str(plan.get("seed"))),
                  ("user model", str(plan.get("user_model") or "none")),
                  ("replications done", ", ".join(f"{d}: {n}" for d, n in done.items())),

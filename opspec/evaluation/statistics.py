@@ -55,7 +55,12 @@ def ratio_estimate(pairs: Sequence[tuple[float, float]], level: float = 0.95) ->
     resid = sum((y - r * n) ** 2 for y, n in pairs)
     se = math.sqrt(resid / (users * (users - 1))) / nbar
     half = t_quantile(level, users - 1) * se
-    return Estimate(r, r - half, r + half, contributing)
+    low = r - half
+    if low < 0.0 and all(y >= 0.0 for y, _ in pairs):
+        # counts, durations and ratios of counts cannot be negative; with few users the t
+        # interval would say they might be (a count of collisions "from -1.3 to 7.8")
+        low = 0.0
+    return Estimate(r, low, r + half, contributing)
 
 
 def paired_difference(a: Sequence[tuple[float, float]], b: Sequence[tuple[float, float]],

@@ -5,6 +5,8 @@ from __future__ import annotations
 from collections.abc import Mapping, Sequence
 from typing import IO, Any
 
+from opspec.evaluation.plan import span
+
 __all__ = ["comparison_rows", "fmt", "is_rate", "metric_rows", "per_user_rows", "print_summary",
            "table"]
 
@@ -100,7 +102,7 @@ def print_summary(out: IO[str], plan: Any, metrics: Mapping[str, Any],
                   compare: Mapping[str, Any] | None, outcome: Any,
                   failures: Sequence[tuple[str, int, str]], workers: int) -> None:
     design = plan.design("A")
-    print(f"opspec evaluate: {design.spec}, {plan.users} users x {plan.days:g} days, seed "
+    print(f"opspec evaluate: {design.spec}, {plan.users} users x {span(plan.days)}, seed "
           f"{plan.seed}, user model {plan.user_model or 'none'}", file=out)
     ran = f"{outcome.done} replications in {outcome.wall_s:.1f} s on {workers} worker(s)"
     if outcome.skipped:

@@ -63,6 +63,7 @@ class Package(Element):
     external_packages: tuple[ExternalPackage, ...] = ()
     metrics: tuple[MetricDefinition, ...] = ()
     modes: tuple[Mode, ...] = ()
+    run_length: float | None = None            # opspec:RunLength: one run's natural length, s
 
     def process(self, process_id: str) -> WorkflowProcess | None:
         for process in self.processes:

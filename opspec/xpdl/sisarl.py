@@ -60,7 +60,7 @@ PROCESS_DIRECTIVES = ("Period", "Rate", "Priority", "Deadline", "Latency", "Star
                       "EndTrigger", "AutoStart", "Lane", "Mode")
 ACTIVITY_DIRECTIVES = ("AutoRun", "PriorityIncrement", "StartTrigger", "EndTrigger", "Raises",
                        "CpuDemand", "Duration", "BuiltIn")
-PACKAGE_DIRECTIVES = ("Metrics", "Modes", "Monitor", "World", "WorldFile")
+PACKAGE_DIRECTIVES = ("Metrics", "Modes", "Monitor", "World", "WorldFile", "RunLength")
 
 
 def collect(element: etree._Element, ctx: BuildContext, known: tuple[str, ...],
@@ -119,6 +119,14 @@ def _lane(directive: Directive) -> str:
         raise SisarlValueError(f"lane must be 'user' or 'device', not {value!r}",
                                location=directive.location, hint="write user or device")
     return value
+
+
+def _run_length(directive: Directive) -> float:
+    seconds = parse_seconds(directive.value, directive.location, "run length")
+    if seconds <= 0:
+        raise SisarlValueError(f"run length {directive.value!r} must be longer than zero",
+                               location=directive.location, hint="write e.g. PT1H")
+    return seconds
 
 
 def _mode_id(directive: Directive) -> str:
@@ -190,11 +198,12 @@ def _raises(directive: Directive) -> Any:
 
 
 def package_extensions(element: etree._Element, ctx: BuildContext) -> dict[str, Any]:
-    """``metrics`` and ``modes`` of a ``Package`` element, as Package keyword arguments."""
+    """``metrics``, ``modes`` and ``run_length`` of a ``Package`` element, as Package
+    keyword arguments."""
     from opspec.xpdl.sisarl_builtins import build_metrics, build_modes
 
     found = collect(element, ctx, PACKAGE_DIRECTIVES, "a Package")
-    out: dict[str, Any] = {}
+    out: dict[str, Any] = _apply(found, ctx, {"RunLength": ("run_length", _run_length)})
     if "Metrics" in found:
         out["metrics"] = build_metrics(found["Metrics"], ctx)
     if "Modes" in found:

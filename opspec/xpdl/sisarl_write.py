@@ -247,4 +247,6 @@ def package_directive_attributes(package: Package) -> list[ExtendedAttribute]:
         out.append(_ea("Metrics", raw_xml="".join(_metric_xml(m) for m in package.metrics)))
     if package.modes:
         out.append(_ea("Modes", raw_xml="".join(_mode_xml(m) for m in package.modes)))
+    if package.run_length is not None:
+        out.append(_ea("RunLength", value=f"PT{package.run_length!r}S"))
     return out

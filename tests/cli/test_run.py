@@ -62,6 +62,17 @@ def test_json_has_the_run_parameters_and_instance_counts(capsys):
     assert doc["deadlocks"] == [] and doc["faults"] == []
 
 
+def test_a_spec_with_a_run_length_runs_that_long_unless_told_otherwise(capsys):
+    cart = str(ROOT / "specs" / "medication_cart_guidance.xpdl")   # opspec:RunLength PT10M
+    assert main(["run", cart, "--json"]) == 0
+    doc = json.loads(capsys.readouterr().out)
+    assert doc["until"] == 600.0 and doc["metrics"]["patients_found"]["total"] == 1
+    assert main(["run", cart, "--until", "30", "--json"]) == 0
+    assert json.loads(capsys.readouterr().out)["until"] == 30.0
+    assert main(["run", cart, "--timeline", "none"]) == 0
+    assert "for 10 min simulated" in capsys.readouterr().out
+
+
 def test_same_seed_same_run_and_another_seed_differs(capsys):
     _, first = run_json(capsys, "--days", "3", "--seed", "11")
     _, again = run_json(capsys, "--days", "3", "--seed", "11")

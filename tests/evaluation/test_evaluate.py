@@ -210,6 +210,20 @@ def test_specs_with_a_simulated_world_give_each_user_their_own_world(evaluate, t
     assert covered["total"] > 0 and covered["sd"] > 0
 
 
+def test_a_spec_with_a_run_length_is_evaluated_over_that_length(evaluate, tmp_path, capsys):
+    """The cart declares opspec:RunLength PT10M: one run is ten minutes, not 30 days."""
+    spec = SPEC.parent / "medication_cart_guidance.xpdl"
+    status, doc, err = evaluate(str(spec), "--users", "2", "--workers", "1",
+                                "--out", str(tmp_path / "cart"))
+    assert status == 0, err
+    assert doc["days"] == pytest.approx(600 / 86400)
+    assert doc["metrics"]["patients_found"]["total"] == 2
+    status = main(["evaluate", str(spec), "--users", "2", "--workers", "1",
+                   "--out", str(tmp_path / "cart2")])
+    assert status == 0
+    assert "2 users x 10 min" in capsys.readouterr().out
+
+
 def test_designs_with_different_metrics_compare_only_what_both_declare(evaluate, tmp_path):
     other = tmp_path / "dispenser_b.xpdl"
     text = SPEC.read_text(encoding="utf-8").replace(

@@ -40,6 +40,14 @@ def test_ratio_interval_covers_the_true_ratio_about_95_percent_of_the_time():
     assert 0.92 <= covered / repetitions <= 0.975
 
 
+def test_a_count_interval_never_goes_below_zero():
+    # four robots, collisions 0, 0, 1, 12: the t interval's lower end would be about -5
+    estimate = ratio_estimate([(0.0, 1.0), (0.0, 1.0), (1.0, 1.0), (12.0, 1.0)])
+    assert estimate.low == 0.0
+    assert estimate.high == pytest.approx(
+        stats.t.interval(0.95, 3, loc=3.25, scale=stats.sem([0, 0, 1, 12]))[1])
+
+
 def test_no_observations_gives_no_estimate_and_one_user_no_interval():
     assert ratio_estimate([]).value is None
     assert ratio_estimate([(0.0, 0.0), (0.0, 0.0)]).value is None

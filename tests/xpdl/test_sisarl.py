@@ -326,3 +326,28 @@ def test_complete_example_in_the_documentation_loads_cleanly() -> None:
     arbiter = guide.activity("arbitrate")
     assert arbiter is not None and arbiter.coordination is not None
     assert [m.id for m in result.package.modes] == ["clean", "dock"]
+
+
+@pytest.mark.parametrize(("value", "seconds"), [("PT10M", 600.0), ("PT1H30M", 5400.0),
+                                                 ("90", 90.0)], ids=["minutes", "h+min", "seconds"])
+def test_run_length_is_the_length_of_one_run(value: str, seconds: float) -> None:
+    result = package_with(ea("RunLength", value))
+    assert result.ok, [str(d) for d in result.diagnostics]
+    assert result.package is not None and result.package.run_length == seconds
+
+
+@pytest.mark.parametrize("value", ["soon", "PT0S", "-5"], ids=["words", "zero", "negative"])
+def test_bad_run_length_is_an_error_naming_the_line(value: str) -> None:
+    result = package_with(ea("RunLength", value))
+    assert [d.code for d in result.errors] == ["bad-directive"]
+    error = result.errors[0]
+    assert error.location.line == 2 and "RunLength" in error.message and error.hint
+
+
+def test_run_length_survives_writing_and_reading_back() -> None:
+    from opspec.xpdl.writer import write_xpdl
+
+    result = package_with(ea("RunLength", "PT75M"))
+    assert result.package is not None
+    again = parse_bytes(write_xpdl(result.package), path="w.xpdl")
+    assert again.package is not None and again.package.run_length == 4500.0
