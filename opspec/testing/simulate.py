@@ -346,8 +346,8 @@ def simulate(spec: Package | CompiledPackage | str | Path, *, users: int = 1,
              params: Mapping[str, Any] | None = None,
              progress: Callable[[int], None] | None = None,
              monitors: Sequence[Any] | None = None) -> SimulationResult:
-    """Run ``spec`` for ``users`` independent users, ``days`` days (default 1) or to ``until``
-    seconds; see the module docstring. ``keep_trace`` defaults to keeping traces of up to 100
+    """Run ``spec`` for ``users`` independent users, ``days`` days or to ``until`` seconds
+    (default: the spec's ``opspec:RunLength``, else one day); see the module docstring. ``keep_trace`` defaults to keeping traces of up to 100
     users. Raises :class:`~opspec.errors.OpspecError` subclasses for bad arguments (naming the
     spec's processes, activities, triggers or metrics when a name is unknown).
     ``monitors`` (monitor objects or their text form, see :mod:`opspec.testing.monitors`) are
@@ -359,7 +359,12 @@ def simulate(spec: Package | CompiledPackage | str | Path, *, users: int = 1,
         raise ConfigurationError(f"users must be a whole number >= 1, not {users!r}")
     if days is not None and until is not None:
         raise ConfigurationError("give days or until, not both")
-    horizon = until if until is not None else (days if days is not None else 1.0) * DAY
+    if until is not None:
+        horizon = until
+    elif days is not None:
+        horizon = days * DAY
+    else:                                   # the spec's opspec:RunLength, else one day
+        horizon = compiled.package.run_length or DAY
     if not (horizon > 0 and math.isfinite(horizon)):
         raise ConfigurationError(f"the run length must be a positive number of seconds, "
                                  f"not {horizon!r}")

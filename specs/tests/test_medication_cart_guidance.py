@@ -20,3 +20,12 @@ def test_carts_find_the_patient_within_five_minutes_on_average(spec: Any,
                                                                simulate: Any) -> None:
     result = simulate(spec, users=4, until=400.0, keep_trace=False)
     assert_mean(result, "time_to_find_s", at_most=300.0, confidence=0.95)
+
+
+def test_one_run_is_the_specs_run_length_unless_told_otherwise(spec: Any,
+                                                               simulate: Any) -> None:
+    """The cart declares opspec:RunLength PT10M: simulate() runs ten minutes by default."""
+    result = simulate(spec)
+    assert result.horizon == 600.0
+    assert result.metrics["patients_found"]["total"] == 1
+    assert simulate(spec, days=0.001).horizon == 86.4
