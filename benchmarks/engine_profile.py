@@ -25,7 +25,7 @@ from pathlib import Path
 from typing import Any
 
 ROOT = Path(__file__).resolve().parent.parent
-BENCH = Path("/work/shared/bench")
+BENCH = ROOT.parent / "shared" / "bench"
 sys.path.insert(0, str(ROOT / "tests" / "engine"))
 sys.path.insert(0, str(BENCH))
 
