@@ -56,9 +56,11 @@ def run(args: argparse.Namespace) -> int:
     factory = _model_factory(compiled, model_ref, args.seed) if model_ref else None
     replay = None
     if args.replay:
-        from opspec.testing.script import load_script
+        from opspec.tui.replay import load_recording
 
-        replay = load_script(args.replay).performer()
+        # checked against the spec like `opspec run --script` (a misspelt name would never
+        # match an offer)
+        replay = load_recording(args.replay, compiled)
     record = None if args.no_record or args.replay else Path(
         args.record or Path("walkthroughs") / (
             f"{Path(args.spec).name.split('.')[0]}-"

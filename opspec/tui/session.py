@@ -33,6 +33,7 @@ from opspec.engine.performers import PerformerSession, WorkItem
 from opspec.engine.simulation import Simulation
 from opspec.engine.trace import TraceEvent
 from opspec.tui.devices import DeviceBoard
+from opspec.tui.replay import tagged_action
 
 __all__ = ["Offer", "WalkSession"]
 
@@ -54,7 +55,11 @@ class Offer:
 
     @property
     def action(self) -> str:
-        return f"choose {self.choice}" if self.choice else f"complete {self.item.activity}"
+        """The recorded action, naming the instance (``complete hear_alarm #6``): a replay
+        acts on the same one of several identical offers."""
+        if self.choice:
+            return tagged_action("choose", self.choice, self.item.instance)
+        return tagged_action("complete", self.item.activity, self.item.instance)
 
 
 class _LaneUser:
@@ -96,16 +101,18 @@ class _RecordingSession:
 
     def complete(self, item: WorkItem, data: Mapping[str, Any] | None = None,
                  choice: str | None = None) -> None:
-        self.walk._record(f"choose {choice}" if choice else f"complete {item.activity}",
+        self.walk._record(tagged_action("choose", choice, item.instance) if choice
+                          else tagged_action("complete", item.activity, item.instance),
                           by="model")
         self.engine.complete(item, data, choice)
 
     def omit(self, item: WorkItem, reason: str = "") -> None:
-        self.walk._record(f"omit {item.activity}", by="model")
+        self.walk._record(tagged_action("omit", item.activity, item.instance), by="model")
         self.engine.omit(item, reason)
 
     def fail(self, item: WorkItem, exception: str, message: str = "") -> None:
-        self.walk._record(f"fail {item.activity} {exception}", by="model")
+        self.walk._record(tagged_action("fail", item.activity, item.instance, exception),
+                          by="model")
         self.engine.fail(item, exception, message)
 
     def raise_trigger(self, name: str, data: Mapping[str, Any] | None = None) -> None:
@@ -264,7 +271,8 @@ class WalkSession:
         if engine is None or offer.item.key not in self.lane_user.items:
             return
         self.lane_user.items.pop(offer.item.key, None)
-        self._record(f"omit {offer.item.activity}", by="person")
+        self._record(tagged_action("omit", offer.item.activity, offer.item.instance),
+                     by="person")
         self._drop_offers(offer.item.key)
         engine.omit(offer.item, "the person chose not to")
 

@@ -9,8 +9,8 @@ import json
 import pytest
 from conftest import SPEC
 
-from opspec.testing.script import load_script
 from opspec.tui.app import WalkthroughApp
+from opspec.tui.replay import load_recording
 from opspec.tui.session import WalkSession
 
 
@@ -104,13 +104,12 @@ async def test_recorded_session_replays_to_the_same_trace(compiled, tmp_path):
     assert app.return_value == str(record)
     steps = json.loads(record.read_text(encoding="utf-8"))["steps"]
     assert any("press_wrong_button" in action for _, action in steps)
-    original = [(e.time, e.kind, e.activity) for e in session.events
+    original = [(e.time, e.kind, e.instance, e.activity) for e in session.events
                 if e.kind.startswith(("activity.", "process.", "trigger."))]
 
-    replay = load_script(record).performer()
-    again = WalkSession(compiled, replay=replay)
+    again = WalkSession(compiled, replay=load_recording(record, compiled))
     again._run_to(session.now)
-    replayed = [(e.time, e.kind, e.activity) for e in again.events
+    replayed = [(e.time, e.kind, e.instance, e.activity) for e in again.events
                 if e.kind.startswith(("activity.", "process.", "trigger."))]
     assert replayed == original
     trace = record.with_suffix(".trace.jsonl")
@@ -233,7 +232,7 @@ def test_a_walkthrough_trace_fits_a_user_model(compiled, tmp_path, capsys):
             session.act(next(o for o in session.offers if o.item.activity == activity))
     session.close()
     assert json.loads(record.read_text(encoding="utf-8"))["steps"][0] == [
-        "at 28845.0", "complete hear_alarm"]
+        "at 28845.0", "complete hear_alarm #4"]
     actions = [json.loads(line) for line in
                record.with_suffix(".trace.jsonl").read_text(encoding="utf-8").splitlines()
                if "walkthrough.action" in line]
@@ -251,7 +250,7 @@ async def test_replaying_a_recording_in_the_app_performs_it_by_itself(compiled, 
                       ' ["at 28890.0", "complete walk_to_dispenser"],'
                       ' ["at 28890.0", "choose press_report"],'
                       ' ["at 28900.0", "complete take_pill"]]}', encoding="utf-8")
-    session = WalkSession(compiled, replay=load_script(record).performer())
+    session = WalkSession(compiled, replay=load_recording(record, compiled))
     app = WalkthroughApp(session)
     async with app.run_test(size=(80, 24)) as pilot:
         await start(app, pilot)
