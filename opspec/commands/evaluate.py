@@ -248,7 +248,11 @@ def run(args: argparse.Namespace) -> int:
             raise
         stack.close()
         from opspec.evaluation.report import write_report
-        from opspec.evaluation.summary import compare_designs, summarise_design
+        from opspec.evaluation.summary import (
+            compare_designs,
+            summarise_design,
+            summarise_monitors,
+        )
 
         try:
             report = write_report(store)
@@ -258,10 +262,12 @@ def run(args: argparse.Namespace) -> int:
                 hint="the results are stored; free some space and run `opspec evaluate "
                 f"--resume --out {store.folder}` to write the report again") from None
         metrics = summarise_design(store, "A", plan.days)
+        monitors = summarise_monitors(store, "A", plan.days)
         compare = None
         if len(plan.designs) > 1:
             compare = {"spec": plan.design("B").spec,
                        "metrics": summarise_design(store, "B", plan.days),
+                       "monitors": summarise_monitors(store, "B", plan.days),
                        "difference": compare_designs(store)}
         failures = store.failures()
     if args.json:
@@ -269,6 +275,7 @@ def run(args: argparse.Namespace) -> int:
                "seed": plan.seed, "user_model": plan.user_model, "workers": workers,
                "scheduler": args.scheduler,
                "out": str(store.folder), "report": str(report), "metrics": metrics,
+               "monitors": monitors,
                "failed": [{"design": d, "user": u, "error": e} for d, u, e in failures],
                "wall_s": round(outcome.wall_s, 3)}
         if compare is not None:
@@ -277,7 +284,8 @@ def run(args: argparse.Namespace) -> int:
     else:
         from opspec.evaluation.tables import print_summary
 
-        print_summary(sys.stdout, plan, metrics, compare, outcome, failures, workers)
+        print_summary(sys.stdout, plan, metrics, compare, outcome, failures, workers,
+                      monitors=monitors)
         print(f"results: {store.path}\nreport: {report}")
     return 1 if failures else 0
 

@@ -104,6 +104,10 @@ def run(args: argparse.Namespace) -> int:
     printer = None if args.json or args.timeline == "none" else _Timeline(
         out, brief=args.timeline == "brief", quiet=quiet_activities(compiled))
     performer, listeners = user.make(0, args.seed)
+    from opspec.engine.monitors import declared_monitors
+
+    watches = [m.start(0) for m in declared_monitors(compiled)]
+    listeners.extend(watches)
     performers: dict[str, Any] = bind_user(compiled, performer)
     performers.update(_world_performers(compiled, args.seed))
     with contextlib.ExitStack() as stack:
@@ -148,11 +152,18 @@ def run(args: argparse.Namespace) -> int:
         if devices is not None:
             devices.install(sim)
         result = sim.run(until=horizon)
+        for watch in watches:
+            watch.finish(float(result.summary.get("time", horizon or 0.0)))
+        monitors = {w.monitor.text: w.result() for w in watches}
         medians = _medians(sim)
         device_report = devices.report() if devices is not None else None
     timing_summary = timing.summary() if timing is not None else None
     if args.json:
         doc = _json_document(args, package, horizon, result, device_report, medians)
+        if monitors:
+            doc["monitors"] = {text: {"violations": r.count, "first": [
+                {"time": v.time, "message": v.message} for v in r.violations[:MONITOR_SHOWN]]}
+                for text, r in monitors.items()}
         if timing_summary is not None:
             doc["timing"] = timing_summary
         print(json.dumps(doc, default=str, allow_nan=False))
@@ -161,10 +172,28 @@ def run(args: argparse.Namespace) -> int:
             _print_timing(out, timing_summary, result.summary.get("pool"))
         _print_summary(out, result, medians, args.trace, device_report,
                        shown=printer.shown if printer else 0)
+        _print_monitors(out, monitors)
     device_faults = any(info.get("faults") for info in (device_report or {}).values())
     problems = result.summary.get("deadlocks") or result.summary.get("faults") or (
         result.summary.get("instances", {}).get("aborted", 0)) or device_faults
     return 1 if problems else 0
+
+
+#: violations listed per monitor (all are counted)
+MONITOR_SHOWN = 5
+
+
+def _print_monitors(out: Any, monitors: dict[str, Any]) -> None:
+    """The spec's monitors (``opspec:Monitor``): how often each was violated, the first few."""
+    for text, result in monitors.items():
+        if not result.count:
+            print(f"monitor {text}: no violation", file=out)
+            continue
+        print(f"monitor {text}: {result.count} violation(s)", file=out)
+        for violation in result.violations[:MONITOR_SHOWN]:
+            print(f"  {clock(violation.time)}: {violation.message}", file=out)
+        if result.count > MONITOR_SHOWN:
+            print(f"  … and {result.count - MONITOR_SHOWN} more", file=out)
 
 
 # ---------------------------------------------------------------------------- options

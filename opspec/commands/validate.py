@@ -30,6 +30,25 @@ def register(subparsers: Any) -> None:
     parser.set_defaults(handler=run)
 
 
+def engine_checks(package: Any) -> list[Any]:
+    """What only the engine can judge: the monitors the spec declares (``bad-monitor``)."""
+    from opspec.engine.compiled import compile_package
+    from opspec.engine.monitors import declared_monitors
+    from opspec.errors import ConfigurationError, Diagnostic, OpspecError, Severity, SourceLocation
+
+    try:
+        compiled = compile_package(package)
+    except OpspecError:
+        return []             # the structural checks report what keeps it from compiling
+    try:
+        declared_monitors(compiled)
+    except ConfigurationError as error:
+        where = error.location or SourceLocation(str(getattr(package, "source", None) or "?"))
+        return [Diagnostic(where, Severity.ERROR, "bad-monitor", error.message,
+                           error.hint or "")]
+    return []
+
+
 def run(args: argparse.Namespace) -> int:
     from opspec.xpdl.validate import spec_files, summary, validate_file
 
@@ -38,7 +57,7 @@ def run(args: argparse.Namespace) -> int:
         print(f"opspec validate: {problem}", file=sys.stderr)
     reports = []
     for path in files:
-        report = validate_file(path, strict=args.strict)
+        report = validate_file(path, strict=args.strict, extra=engine_checks)
         reports.append(report)
         if args.json:
             print(json.dumps(report.to_json(), ensure_ascii=False))

@@ -32,7 +32,7 @@ import re
 from collections import deque
 from collections.abc import Iterable, Sequence
 from dataclasses import dataclass, field, replace
-from typing import Protocol
+from typing import Any, Protocol
 
 from opspec.engine.sampling import parse_duration_text
 from opspec.engine.trace import EventKind, TraceEvent
@@ -51,6 +51,7 @@ __all__ = [
     "NeverWhile",
     "Subject",
     "Violation",
+    "declared_monitors",
     "package_monitors",
     "parse_monitor",
     "parse_subject",
@@ -180,6 +181,7 @@ def _span(seconds: float) -> str:
 
 def clock(seconds: float) -> str:
     """``day 1 08:00:00.0`` for simulated seconds (the format of trace listings)."""
+    seconds = round(seconds, 1)         # 59.96 s is shown as the next minute, not "60.0"
     day, rest = divmod(seconds, 86_400.0)
     hours, rest = divmod(rest, 3600.0)
     minutes, secs = divmod(rest, 60.0)
@@ -520,6 +522,29 @@ def package_monitors(attributes: Iterable[object], *, path: str | None = None
             line = line.split("#", 1)[0].strip()
             if line:
                 out.append(parse_monitor(line, location=location))
+    return out
+
+
+def declared_monitors(compiled: Any) -> list[Monitor]:
+    """The monitors ``compiled`` (a :class:`~opspec.engine.compiled.CompiledPackage`) declares
+    as ``opspec:Monitor``, bound to its names: :class:`ConfigurationError` at the attribute's
+    ``file:line`` when one cannot be read or names something the spec does not have."""
+    from opspec.engine.names import spec_names
+
+    package = compiled.package
+    names = spec_names(compiled)
+    out = []
+    for attribute in getattr(package, "extended_attributes", ()):
+        if getattr(attribute, "name", None) != MONITOR_ATTRIBUTE:
+            continue
+        location = getattr(attribute, "location", None)
+        for monitor in package_monitors((attribute,), path=getattr(package, "source", None)):
+            try:
+                out.append(monitor.bind(names))
+            except ConfigurationError as error:
+                raise ConfigurationError(f"monitor {monitor.text!r}: {error.message}",
+                                         location=location or error.location,
+                                         hint=error.hint) from None
     return out
 
 

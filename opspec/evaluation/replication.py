@@ -4,7 +4,8 @@ Runs in worker processes. Each user ``u`` draws from streams derived from ``(see
 (the engine's ``scope=(u,)`` and :func:`opspec.engine.random.user_stream`), so results do not
 depend on which worker runs which user, nor on how users are chunked: common random numbers
 across designs come from the same rule. A replication returns a small record (metrics, the
-duration observations with their times, outcome counts by day and hour, per-activity counts)
+duration observations with their times, outcome counts by day and hour, per-activity counts,
+violations of the spec's monitors)
 and its trace only when the run exports traces.
 """
 
@@ -36,6 +37,8 @@ class ReplicationRecord:
     outcomes: dict[tuple[str, int, int], int] = field(default_factory=dict)  # metric,day,hour
     # activity -> [offered, completed, omitted, wrong]
     activities: dict[str, list[int]] = field(default_factory=dict)
+    # monitor -> (violations, time of the first, its message); every declared monitor, also 0
+    monitors: dict[str, tuple[int, float | None, str | None]] = field(default_factory=dict)
     wall_s: float = 0.0
     trace: list[dict[str, Any]] | None = None
 
@@ -77,6 +80,7 @@ class _Context:
     manual: tuple[str, ...]
     model: Any
     config: Any
+    monitors: tuple[Any, ...] = ()
 
 
 _CONTEXTS: dict[tuple[str, str, str | None, str], _Context] = {}
@@ -106,7 +110,10 @@ def prepare(spec: str, sha256: str, user_model: str | None, engine: Mapping[str,
         if not lane.empty:
             model.validate_against(lane.manual, choices=lane.choices)
     config = EngineConfig.from_mapping(engine) if engine else EngineConfig()
-    context = _Context(compiled, lane.bind_names, (*lane.manual, *lane.choices), model, config)
+    from opspec.engine.monitors import declared_monitors
+
+    context = _Context(compiled, lane.bind_names, (*lane.manual, *lane.choices), model, config,
+                       tuple(declared_monitors(compiled)))
     _CONTEXTS[key] = context
     return context
 
@@ -134,12 +141,15 @@ def run_user(context: _Context, design: str, user: int, *, seed: int, horizon: f
             for name in context.bind_names:
                 performers[name] = performer
         recorder = ActivityRecorder(context.manual)
+        watches = [m.start(user) for m in context.monitors]
         sim = Simulation(context.compiled, context.config, performers=performers, seed=seed,
-                         scope=(user,), listeners=[recorder], keep_trace=keep_trace,
+                         scope=(user,), listeners=[recorder, *watches], keep_trace=keep_trace,
                          mode_loader=mode_loader_for(context.compiled.package))
         if sim.metrics is not None:
             sim.metrics.keep_times = True
         result = sim.run(until=horizon)
+        for watch in watches:
+            watch.finish(horizon)
     except OpspecError as error:
         return ReplicationRecord(design, user, "failed", error=str(error),
                                  wall_s=time.perf_counter() - start)
@@ -149,6 +159,10 @@ def run_user(context: _Context, design: str, user: int, *, seed: int, horizon: f
                                  wall_s=time.perf_counter() - start)
     record = ReplicationRecord(design, user, "done", metrics=result.metrics,
                                activities=recorder.counts)
+    for watch in watches:
+        first = watch.violations[0] if watch.violations else None
+        record.monitors[watch.monitor.text] = (
+            watch.count, first.time if first else None, first.message if first else None)
     metrics = sim.metrics
     if metrics is not None:
         for name, values in metrics.samples.items():

@@ -13,14 +13,21 @@ from typing import Any
 
 from opspec.evaluation.plan import span
 from opspec.evaluation.store import ResultStore
-from opspec.evaluation.summary import compare_designs, metric_definitions, summarise_design
+from opspec.evaluation.summary import (
+    compare_designs,
+    metric_definitions,
+    summarise_design,
+    summarise_monitors,
+)
 from opspec.evaluation.tables import (
     COMPARE_HEADERS,
     METRIC_HEADERS,
+    MONITOR_HEADERS,
     PER_USER_HEADERS,
     comparison_rows,
     is_rate,
     metric_rows,
+    monitor_rows,
     per_user_rows,
 )
 
@@ -139,10 +146,17 @@ def write_report(store: ResultStore) -> Path:
         spread = per_user_rows(metrics)
         spread_table = (Table(PER_USER_HEADERS, tuple(spread), "How users differ: each "
                               "user's own mean duration or ratio, over users"),) if spread else ()
+        monitors = summarise_monitors(store, design, days)
+        monitor_table = (Table(MONITOR_HEADERS, tuple(monitor_rows(monitors)),
+                               "Safety monitors the spec declares (opspec:Monitor): "
+                               "violations per user-day with 95 % CI (the wider of the exact "
+                               "Poisson and the cluster-robust interval over users)"),
+                         ) if monitors else ()
         sections.append(Section(title, tables=(Table(METRIC_HEADERS,
                                                      tuple(metric_rows(metrics)),
                                                      "Declared metrics of the spec"),
-                                               *spread_table, *activity_table),
+                                               *monitor_table, *spread_table,
+                                               *activity_table),
                                 images=tuple(images), captions=tuple(captions)))
 
     if "B" in designs:

@@ -16,7 +16,9 @@ anyone who opens ``results.sqlite`` in another tool):
 - ``outcome(design, user, metric, day, hour, n)``: count-metric events by day (0-based) and
   hour of day;
 - ``activity(design, user, activity, offered, completed, omitted, wrong)``: the user lane's
-  manual activities.
+  manual activities;
+- ``monitor(design, user, monitor, violations, first_time, first_message)``: one row per
+  monitor the spec declares (``opspec:Monitor``) and user, also when there were none.
 """
 
 from __future__ import annotations
@@ -52,6 +54,10 @@ CREATE TABLE IF NOT EXISTS activity (
     design TEXT NOT NULL, user INTEGER NOT NULL, activity TEXT NOT NULL, offered INTEGER,
     completed INTEGER, omitted INTEGER, wrong INTEGER);
 CREATE INDEX IF NOT EXISTS activity_by_user ON activity (design, user);
+CREATE TABLE IF NOT EXISTS monitor (
+    design TEXT NOT NULL, user INTEGER NOT NULL, monitor TEXT NOT NULL,
+    violations INTEGER NOT NULL, first_time REAL, first_message TEXT);
+CREATE INDEX IF NOT EXISTS monitor_by_user ON monitor (design, user);
 """
 
 FILENAME = "results.sqlite"
@@ -112,7 +118,7 @@ class ResultStore:
             key = (record.design, record.user)
             db.execute("BEGIN IMMEDIATE")
             try:
-                for table in ("sample", "outcome", "activity"):
+                for table in ("sample", "outcome", "activity", "monitor"):
                     db.execute(f"DELETE FROM {table} WHERE design = ? AND user = ?", key)
                 db.execute("INSERT OR REPLACE INTO replication VALUES (?, ?, ?, ?, ?, ?)",
                            (*key, record.status, record.error,
@@ -123,6 +129,8 @@ class ResultStore:
                                [(*key, m, d, h, n) for (m, d, h), n in record.outcomes.items()])
                 db.executemany("INSERT INTO activity VALUES (?, ?, ?, ?, ?, ?, ?)",
                                [(*key, a, *c) for a, c in record.activities.items()])
+                db.executemany("INSERT INTO monitor VALUES (?, ?, ?, ?, ?, ?)",
+                               [(*key, m, *v) for m, v in record.monitors.items()])
                 db.execute("COMMIT")
             except BaseException:
                 # SQLite may already have rolled back (disk full); keep the original error

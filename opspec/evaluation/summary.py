@@ -7,6 +7,7 @@
   of the users' own means (users without observations left out);
 - ratio: ``value`` = Σ numerator / Σ denominator over users with ``ci95``, and ``per_user``
   (the same fields, over the users' own ratios).
+Monitors the spec declares (``opspec:Monitor``) are summarised by :func:`summarise_monitors`.
 Intervals are described in :mod:`opspec.evaluation.statistics`. Quantiles of pooled
 observations are computed in the database, so memory does not grow with the number of users.
 """
@@ -21,7 +22,8 @@ from typing import Any
 from opspec.evaluation.statistics import paired_difference, ratio_estimate
 from opspec.evaluation.store import ResultStore
 
-__all__ = ["compare_designs", "metric_definitions", "summarise_design", "user_pairs"]
+__all__ = ["compare_designs", "metric_definitions", "summarise_design", "summarise_monitors",
+           "user_pairs"]
 
 
 def metric_definitions(store: ResultStore, design: str = "A") -> list[dict[str, Any]]:
@@ -169,5 +171,56 @@ def compare_designs(store: ResultStore, a: str = "A", b: str = "B", level: float
             "kind": definition["kind"], "a": ea.value, "b": eb.value,
             "difference": diff.value, "ci95": diff.ci, "users": len(users),
             "significant": significant,
+        }
+    return out
+
+
+def _users_affected_ci(affected: int, users: int, level: float) -> list[float]:
+    from scipy import stats  # type: ignore[import-untyped]
+
+    ci = stats.binomtest(affected, users).proportion_ci(confidence_level=level, method="exact")
+    return [float(ci.low), float(ci.high)]
+
+
+def summarise_monitors(store: ResultStore, design: str, days: float, level: float = 0.95
+                       ) -> dict[str, dict[str, Any]]:
+    """Per monitor ``design`` declares, over its finished users: ``violations`` (total),
+    ``users`` and ``users_affected`` (with at least one violation) with the share affected and
+    its exact (Clopper-Pearson) interval, and the hazard ``per_user_day`` = violations /
+    (users × days) with ``ci95``. The hazard's interval is the envelope of the exact Poisson
+    (Garwood) interval, which is right when violations are rare and independent and gives a
+    real upper bound when there are none, and the cluster-robust interval over users, which
+    is right when violations cluster in some users (a late reporter violates again and
+    again); the wider of the two is reported. ``first`` is the earliest user's first
+    violation (user, simulated time, message), for finding it in a trace."""
+    from opspec.engine.monitors import poisson_interval
+
+    rows = store.query(
+        "SELECT m.monitor, m.user, m.violations, m.first_time, m.first_message FROM monitor m "
+        "JOIN replication r ON r.design = m.design AND r.user = m.user "
+        "WHERE m.design = ? AND r.status = 'done' ORDER BY m.rowid", (design,))
+    per_monitor: dict[str, list[tuple[int, int, float | None, str | None]]] = {}
+    for monitor, user, count, first_time, first_message in rows:
+        per_monitor.setdefault(str(monitor), []).append(
+            (int(user), int(count), first_time, first_message))
+    out: dict[str, dict[str, Any]] = {}
+    for monitor, users_rows in per_monitor.items():
+        users = len(users_rows)
+        total = sum(c for _, c, _, _ in users_rows)
+        affected = sum(1 for _, c, _, _ in users_rows if c > 0)
+        exposure = users * days
+        rate, p_lo, p_hi = poisson_interval(total, exposure, level)
+        robust = ratio_estimate([(float(c), days) for _, c, _, _ in users_rows], level)
+        lo = p_lo if robust.low is None else min(p_lo, robust.low)
+        hi = p_hi if robust.high is None else max(p_hi, robust.high)
+        first = min(((u, t, m) for u, c, t, m in users_rows if c > 0), default=None,
+                    key=lambda x: x[0])
+        out[monitor] = {
+            "violations": total, "users": users, "users_affected": affected,
+            "share_affected": affected / users if users else None,
+            "share_affected_ci95": _users_affected_ci(affected, users, level) if users else None,
+            "per_user_day": rate, "ci95": [lo, hi],
+            "first": None if first is None else {"user": first[0], "time": first[1],
+                                                 "message": first[2]},
         }
     return out

@@ -7,12 +7,14 @@ from typing import IO, Any
 
 from opspec.evaluation.plan import span
 
-__all__ = ["comparison_rows", "fmt", "is_rate", "metric_rows", "per_user_rows", "print_summary",
-           "table"]
+__all__ = ["comparison_rows", "fmt", "is_rate", "metric_rows", "monitor_rows", "per_user_rows",
+           "print_summary", "table"]
 
 METRIC_HEADERS = ("metric", "kind", "estimate", "95 % CI", "median", "p95", "n")
 PER_USER_HEADERS = ("metric", "users", "mean", "sd", "95 % CI", "median", "p95")
 COMPARE_HEADERS = ("metric", "A", "B", "B − A", "95 % CI", "")
+MONITOR_HEADERS = ("monitor", "violations", "users affected", "per user-day", "95 % CI",
+                   "first violation")
 
 
 def fmt(value: Any, unit: str = "", *, percent: bool = False) -> str:
@@ -78,6 +80,26 @@ def per_user_rows(metrics: Mapping[str, Mapping[str, Any]]) -> list[tuple[str, .
     return rows
 
 
+def _clock(seconds: float) -> str:
+    from opspec.engine.monitors import clock
+
+    return clock(seconds)
+
+
+def monitor_rows(monitors: Mapping[str, Mapping[str, Any]]) -> list[tuple[str, ...]]:
+    """The spec's monitors: violations, users affected (share), hazard per user-day."""
+    rows: list[tuple[str, ...]] = []
+    for name, m in monitors.items():
+        first = m.get("first")
+        where = (f"user {first['user']}, {_clock(first['time'])}" if first
+                 and first.get("time") is not None else "–")
+        share = fmt(m.get("share_affected"), percent=True)
+        affected = f"{m['users_affected']} of {m['users']} ({share})"
+        rows.append((name, str(m["violations"]), affected, fmt(m["per_user_day"]), _ci(m),
+                     where))
+    return rows
+
+
 def comparison_rows(difference: Mapping[str, Mapping[str, Any]]) -> list[tuple[str, ...]]:
     rows: list[tuple[str, ...]] = []
     for name, d in difference.items():
@@ -100,7 +122,8 @@ def table(headers: Sequence[str], rows: Sequence[Sequence[str]]) -> list[str]:
 
 def print_summary(out: IO[str], plan: Any, metrics: Mapping[str, Any],
                   compare: Mapping[str, Any] | None, outcome: Any,
-                  failures: Sequence[tuple[str, int, str]], workers: int) -> None:
+                  failures: Sequence[tuple[str, int, str]], workers: int,
+                  monitors: Mapping[str, Any] | None = None) -> None:
     design = plan.design("A")
     print(f"opspec evaluate: {design.spec}, {plan.users} users x {span(plan.days)}, seed "
           f"{plan.seed}, user model {plan.user_model or 'none'}", file=out)
@@ -111,6 +134,14 @@ def print_summary(out: IO[str], plan: Any, metrics: Mapping[str, Any],
     print(file=out)
     for line in table(METRIC_HEADERS, metric_rows(metrics)):
         print(line, file=out)
+    if monitors:
+        print("\nmonitors (opspec:Monitor in the spec; violations per user-day):", file=out)
+        for line in table(MONITOR_HEADERS, monitor_rows(monitors)):
+            print(line, file=out)
+    if compare is not None and compare.get("monitors"):
+        print("\nmonitors of B:", file=out)
+        for line in table(MONITOR_HEADERS, monitor_rows(compare["monitors"])):
+            print(line, file=out)
     if compare is not None:
         print(f"\ncompared with B = {compare['spec']} (same users, paired):", file=out)
         for line in table(COMPARE_HEADERS, comparison_rows(compare["difference"])):

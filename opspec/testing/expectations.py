@@ -33,6 +33,7 @@ from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from itertools import pairwise
 
+from opspec.engine.monitors import clock
 from opspec.engine.trace import EventKind, TraceEvent
 from opspec.errors import ConfigurationError, SourceLocation
 from opspec.testing.simulate import FIELDS, SimulationResult, SpecNames
@@ -314,11 +315,7 @@ def _metric_line(values: dict[str, object]) -> str:
 
 
 def _time(seconds: float) -> str:
-    day, rest = divmod(seconds, 86_400.0)
-    hours, rest = divmod(rest, 3600.0)
-    minutes, secs = divmod(rest, 60.0)
-    text = f"{int(hours):02d}:{int(minutes):02d}:{secs:04.1f}"
-    return f"day {int(day) + 1} {text}"
+    return clock(seconds)
 
 
 def _span(seconds: float) -> str:

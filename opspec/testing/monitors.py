@@ -35,7 +35,7 @@ from opspec.engine.monitors import (
     NeverWhile,
     Violation,
     clock,
-    package_monitors,
+    declared_monitors,
     parse_monitor,
     parse_subject,
     poisson_interval,
@@ -117,11 +117,8 @@ def monitors_for(compiled: Any, names: Names, extra: Iterable[Monitor | str] | N
                  ) -> list[Monitor]:
     """The spec's declared monitors plus ``extra`` (objects or text), bound to its names
     (:class:`ConfigurationError` listing the names when one is unknown)."""
-    package = getattr(compiled, "package", compiled)
-    declared = package_monitors(getattr(package, "extended_attributes", ()),
-                                path=getattr(package, "source", None))
-    out = []
-    for item in [*declared, *(extra or ())]:
+    out = declared_monitors(compiled)
+    for item in extra or ():
         m = parse_monitor(item) if isinstance(item, str) else item
         if not isinstance(m, Monitor):
             raise ConfigurationError(f"{item!r} is not a monitor",

@@ -11,11 +11,12 @@ wrapper around this module.
 from __future__ import annotations
 
 import dataclasses
-from collections.abc import Iterable, Sequence
+from collections.abc import Callable, Iterable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
 from opspec.errors import Diagnostic, Severity
+from opspec.model import Package
 from opspec.model.checks import check_package
 from opspec.xpdl.loader import load_package
 from opspec.xpdl.reader import DEFAULT_MAX_BYTES
@@ -113,17 +114,24 @@ def _promote(diagnostics: Iterable[Diagnostic]) -> tuple[Diagnostic, ...]:
 
 
 def validate_file(path: str | Path, *, strict: bool = False,
-                  max_bytes: int = DEFAULT_MAX_BYTES) -> FileReport:
+                  max_bytes: int = DEFAULT_MAX_BYTES,
+                  extra: Callable[[Package], Iterable[Diagnostic]] | None = None
+                  ) -> FileReport:
     """Load ``path`` and check its package; never raises for bad input.
 
-    ``strict`` turns every warning (the reader's and the checks') into an error.
+    ``strict`` turns every warning (the reader's and the checks') into an error. ``extra``
+    runs further checks on a package that has no errors so far (layers above this one check
+    what only they understand, e.g. the text of ``opspec:Monitor``).
     """
     result = load_package(path, max_bytes=max_bytes)
     checks: list[Diagnostic] = []
     version = None
     if result.package is not None:
         version = result.package.version.value
-        checks = check_package(result.package, packages=result.packages)
+        checks = list(check_package(result.package, packages=result.packages))
+        if extra is not None and not any(
+                d.severity is Severity.ERROR for d in (*result.diagnostics, *checks)):
+            checks.extend(extra(result.package))
     diagnostics = merge_diagnostics(result.diagnostics, checks)
     if strict:
         diagnostics = _promote(diagnostics)
