@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import argparse
 import contextlib
+import math
 from datetime import UTC, datetime
 from pathlib import Path
 from typing import Any
@@ -28,7 +29,8 @@ def register(subparsers: Any) -> None:
                         help="simulated seconds per wall second at start (default 60; 1 "
                         "with a real device bound)")
     parser.add_argument("--seed", type=int, default=0, help="run seed (default 0)")
-    parser.add_argument("--days", type=float, default=1.0, help="simulated days (default 1)")
+    parser.add_argument("--days", type=float, default=None,
+                        help="simulated days (default: the spec's opspec:RunLength, else 1)")
     parser.add_argument("--user-model", metavar="FILE|PRESET",
                         help="the model that performs your lane when you hand it over "
                         "(default: the spec's companion SPEC.users.toml)")
@@ -50,6 +52,8 @@ def run(args: argparse.Namespace) -> int:
 
     if args.speed is not None and not (args.speed > 0):
         raise ConfigurationError(f"--speed must be positive, not {args.speed:g}")
+    if args.days is not None and not (args.days > 0 and math.isfinite(args.days)):
+        raise ConfigurationError(f"--days must be a positive number, not {args.days:g}")
     package = load_any_spec(args.spec)            # a broken spec opens nothing
     compiled = compile_package(package)
     model_ref = args.user_model or companion_user_model(args.spec)

@@ -11,6 +11,7 @@ words and symbols, never by colour alone. The engine is stepped from this app's 
 from __future__ import annotations
 
 import string
+import time
 from collections.abc import Sequence
 from typing import Any, ClassVar
 
@@ -29,6 +30,11 @@ SPEEDS = {"1": 1.0, "2": 10.0, "3": 60.0, "4": 600.0}
 OFFER_KEYS = string.ascii_lowercase[:6]          # a..f act on the offers shown
 LANES = ("all", "device", "user")
 TICK_S = 0.1
+# The engine runs in slices so that keys (q, ctrl+c, space) are read between them: at most
+# SLICE_STEPS engine events per slice, and slices for at most SLICE_S of wall time per tick.
+SLICE_STEPS = 200
+SLICE_S = 0.08
+KEY_S = 0.25                  # a key's own jump (w, n) may take a little longer
 
 HELP = """\
 [b]opspec walkthrough — keys[/b]
@@ -157,11 +163,31 @@ class WalkthroughApp(App[str | None]):
 
     # ------------------------------------------------------------------ time
     def tick(self, wall_seconds: float) -> None:
-        before = len(self.session.offers)
-        skipping = self.session.skipping
-        self.session.advance(wall_seconds)
-        if not self.session.paused or skipping or len(self.session.offers) != before:
+        session = self.session
+        before = len(session.offers)
+        skipping = session.skipping
+        if skipping or session.paused or session.ended:
+            session.advance(wall_seconds, SLICE_STEPS)
+            self._go_on_skipping()
+        else:
+            self._run_slices(session.now + wall_seconds * session.speed)
+        if not session.paused or skipping or len(session.offers) != before:
             self.refresh_views()
+
+    def _go_on_skipping(self) -> None:
+        """More slices of a skip in progress, for at most SLICE_S of wall time."""
+        session = self.session
+        deadline = time.monotonic() + SLICE_S
+        while (session.skipping and not session.waiting_for_devices
+               and time.monotonic() < deadline):
+            session.advance(0.0, SLICE_STEPS)
+
+    def _run_slices(self, target: float, seconds: float = SLICE_S) -> None:
+        """Step towards simulated ``target`` for at most SLICE_S of wall time (the clock
+        falls behind the speed asked rather than the keys going unread)."""
+        deadline = time.monotonic() + seconds
+        while not self.session.run_to(target, SLICE_STEPS) and time.monotonic() < deadline:
+            pass
 
     def _on_event(self, event: Any) -> None:
         calling = self.session.calling or self.session.board.ringing
@@ -179,15 +205,19 @@ class WalkthroughApp(App[str | None]):
         self.refresh_views()
 
     def action_wait(self) -> None:
-        self.session._run_to(min(self.session.horizon, self.session.now + 30.0))
+        self._run_slices(self.session.now + 30.0, KEY_S)
         self.refresh_views()
 
     def action_next_event(self) -> None:
-        self.session.skip_to_next_event()
+        self.session.skip_to_next_event(SLICE_STEPS)
         self.refresh_views()
 
     def action_until_user(self) -> None:
-        self.session.skip_until_user()
+        if self.session.skipping:           # pressed again: stop where it is
+            self.session.cancel_skip()
+        else:
+            self.session.skip_until_user(SLICE_STEPS)
+            self._go_on_skipping()
         self.refresh_views()
 
     def action_hand_over(self) -> None:
@@ -241,15 +271,18 @@ class WalkthroughApp(App[str | None]):
         if not self._views_ready:
             return
         session = self.session
-        state = "PAUSED" if session.paused else "running"
+        # the state comes first: the line is cut at the right in a narrow terminal
+        state = ("[ENDED]" if session.ended
+                 else "[waiting for the device]" if session.waiting_for_devices
+                 else "skipping... (u: stop)" if session.skipping
+                 else "PAUSED" if session.paused else "running")
         who = ("replaying the recording" if session.replaying
+               else "no user lane" if not session.has_user_lane
                else "model performs your lane" if session.handed_over
                else "you perform the lane")
-        end = ("  [ENDED]" if session.ended
-               else "  [waiting for the device]" if session.waiting_for_devices else "")
         self.query_one("#status", Static).update(Text(
             f"{clock(session.now)}  {session.speed:g}x  {state}  |  {who}  |  "
-            f"{self.spec_title}{end}", no_wrap=True, overflow="ellipsis"))
+            f"{self.spec_title}", no_wrap=True, overflow="ellipsis"))
         self.query_one("#device", Static).update(self._device_text())
         person = self.query_one("#person", Vertical)
         call = self.query_one("#call", Static)
@@ -258,11 +291,10 @@ class WalkthroughApp(App[str | None]):
             call.update(Text("(!) THE DEVICE CALLS YOU", style="bold reverse"))
         else:
             person.remove_class("calling")
-            call.update("" if session.offers else "(nothing to do now: press u to skip "
-                        "until something needs you)")
+            call.update(self._idle_text())
         box = self.query_one("#offers", Vertical)
         box.remove_children()
-        if session.handed_over:
+        if session.handed_over and not session.ended:
             box.mount(Static("The user model is performing. Press h to take over."))
         else:
             lines = []
@@ -275,6 +307,19 @@ class WalkthroughApp(App[str | None]):
             if lines:
                 box.mount(*lines)
         self.query_one("#timeline", Static).update(self._timeline_text())
+
+    def _idle_text(self) -> str:
+        """The person's panel when the device is not calling: one line saying what now."""
+        session = self.session
+        if session.ended:
+            return "(the run has ended: q quits, the recording is kept)"
+        if session.replaying:
+            return "(the recording performs your lane: watch, or press u / n to move on)"
+        if not session.has_user_lane:
+            return "(this spec has no user lane: watch the device; u skips to the end)"
+        if session.handed_over or session.offers:
+            return ""
+        return "(nothing to do now: press u to skip until something needs you)"
 
     def _device_text(self) -> Text:
         session = self.session

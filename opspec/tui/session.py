@@ -32,6 +32,7 @@ from opspec.engine.lanes import user_lane
 from opspec.engine.performers import PerformerSession, WorkItem
 from opspec.engine.simulation import Simulation
 from opspec.engine.trace import TraceEvent
+from opspec.errors import ConfigurationError
 from opspec.tui.devices import DeviceBoard
 from opspec.tui.replay import tagged_action
 
@@ -129,7 +130,7 @@ class _RecordingSession:
 class WalkSession:
     """One walkthrough (see the module docstring)."""
 
-    def __init__(self, compiled: CompiledPackage, *, seed: int = 0, days: float = 1.0,
+    def __init__(self, compiled: CompiledPackage, *, seed: int = 0, days: float | None = None,
                  record: str | Path | None = None, model_factory: Callable[[], Any] | None = None,
                  performers: Mapping[str, Any] | None = None, config: Any = None,
                  replay: Any = None, spec_path: str = "",
@@ -137,7 +138,15 @@ class WalkSession:
                  wall_devices: bool = False) -> None:
         self.compiled = compiled
         self.seed = seed
-        self.horizon = days * DAY
+        if days is not None and not (days > 0 and math.isfinite(days)):
+            raise ConfigurationError(f"--days must be a positive number, not {days:g}",
+                                     hint="e.g. --days 1 (or leave it out for the spec's "
+                                     "opspec:RunLength)")
+        #: where the run ends: ``days``, else the spec's opspec:RunLength (as ``opspec run``
+        #: does), else one day
+        self.horizon = (days * DAY if days is not None
+                        else float(compiled.package.run_length)
+                        if compiled.package.run_length is not None else DAY)
         self.speed = 60.0
         self.paused = False
         self.model_factory = model_factory
@@ -153,6 +162,7 @@ class WalkSession:
         self.wall_devices = wall_devices
         self.device_work: set[tuple[int, str]] = set()      # offered to a device, unanswered
         self.skipping = False                               # a skip until the user goes on
+        self._skip_calls = 0                                # self.calls when it began
         self.calls = 0                                      # user-lane processes started
         self.offers: list[Offer] = []
         self.calling = False                                # the device is calling the user
@@ -161,16 +171,25 @@ class WalkSession:
         self._steps: list[list[str]] = []
         self._trace_file = None
         if self.record_path is not None:
-            self.record_path.parent.mkdir(parents=True, exist_ok=True)
-            self._write_record()
             trace_path = self.record_path.with_suffix(".trace.jsonl")
-            from opspec.engine.trace_sinks import JsonlSink
+            try:
+                self.record_path.parent.mkdir(parents=True, exist_ok=True)
+                self._write_record()
+                from opspec.engine.trace_sinks import JsonlSink
 
-            self._trace_file = JsonlSink(trace_path, {"spec": spec_path, "seed": seed,
-                                                      "walkthrough": True}, flush_every=1)
+                self._trace_file = JsonlSink(trace_path, {"spec": spec_path, "seed": seed,
+                                                          "walkthrough": True}, flush_every=1)
+            except OSError as error:
+                raise ConfigurationError(
+                    f"cannot write the recording {self.record_path}: "
+                    f"{error.strerror or error}",
+                    hint="give --record a path in a folder you can write to, or --no-record"
+                ) from None
         self._deadline_of = {(a.process, a.id): a.deadlines for a in _activities(compiled)
                              if a.deadlines}
         lane = user_lane(compiled)
+        #: the spec has manual activities for the person (vacuum robots may have none)
+        self.has_user_lane = not lane.empty
         self.lane_user = _LaneUser(self)
         bound: dict[str, Any] = dict(performers or {})
         if replay is not None:
@@ -193,20 +212,24 @@ class WalkSession:
     def now(self) -> float:
         return float(self.sim.env.now)
 
-    def advance(self, wall_seconds: float) -> None:
+    def advance(self, wall_seconds: float, budget: int | None = None) -> None:
         """Let ``wall_seconds`` of real time pass at the current speed (unless paused); a
-        skip held up by a real device goes on once the device has answered."""
+        skip in progress (or held up by a real device) goes on instead.
+
+        ``budget`` bounds the engine events stepped in this call (``None``: no bound). The
+        app passes one so that a long skip runs in slices between key presses; a skip not
+        finished keeps :attr:`skipping` set and goes on at the next call."""
         if self.skipping:
             self.sim.drain_posts()
-            self._skip()
+            self._skip(budget)
             return
         if self.ended:
             return
         if self.paused:
             # the clock stands still, but a device's answer is taken at the current time
-            self._run_to(self.now)
+            self._run_to(self.now, budget)
             return
-        self._run_to(min(self.horizon, self.now + wall_seconds * self.speed))
+        self._run_to(min(self.horizon, self.now + wall_seconds * self.speed), budget)
 
     @property
     def waiting_for_devices(self) -> bool:
@@ -214,45 +237,72 @@ class WalkSession:
         skipping simulated time now would jump past its answer."""
         return self.wall_devices and bool(self.device_work)
 
-    def skip_to_next_event(self) -> None:
+    def skip_to_next_event(self, budget: int | None = None) -> None:
         """Jump to the next scheduled event (not while a real device is busy)."""
         if self.waiting_for_devices:
             return
         due = self.sim.peek()
-        self._run_to(min(self.horizon, due if math.isfinite(due) else self.horizon))
+        self._run_to(min(self.horizon, due if math.isfinite(due) else self.horizon), budget)
 
-    def skip_until_user(self) -> None:
+    def skip_until_user(self, budget: int | None = None) -> None:
         """Run until something is offered to the person (or the run ends). With a real
-        device busy the skip pauses until it answers (:meth:`advance` resumes it)."""
+        device busy the skip pauses until it answers. With a ``budget`` (engine events per
+        call) the skip may stop early with :attr:`skipping` still set: :meth:`advance` goes
+        on with it, and :meth:`cancel_skip` abandons it."""
         self.skipping = True
-        self._skip()
+        self._skip_calls = self.calls
+        self._skip(budget)
 
-    def _skip(self) -> None:
+    def cancel_skip(self) -> None:
+        """Stop a skip in progress where it is."""
+        self.skipping = False
+
+    def _skip(self, budget: int | None = None) -> None:
         # with the lane handed over nothing waits for the person: stop at the next call
-        calls = self.calls
+        calls = self._skip_calls
+        left = budget
         while not self.offers and not self.ended and not self.waiting_for_devices and not (
                 self.handed_over and self.calls > calls):
             due = self.sim.peek()
+            target = min(self.horizon, due) if math.isfinite(due) else self.horizon
+            reached, used = self._step_to(target, left)
+            if not reached:
+                return                      # the next slice goes on (skipping stays set)
+            if left is not None:
+                left -= used
+                if left <= 0:
+                    break
             if not math.isfinite(due):
-                self._run_to(self.horizon)
                 break
-            self._run_to(min(self.horizon, due))
         if self.offers or self.ended or (self.handed_over and self.calls > calls):
             self.skipping = False
 
-    def _run_to(self, target: float) -> None:
+    def run_to(self, target: float, budget: int | None = None) -> bool:
+        """Step the engine to simulated time ``target`` (at most ``budget`` events; it
+        stops early at a new offer); ``False`` when the budget ran out first (the clock then
+        stands at the last event stepped, and a later call goes on)."""
+        return self._step_to(min(self.horizon, target), budget)[0]
+
+    _run_to = run_to
+
+    def _step_to(self, target: float, budget: int | None) -> tuple[bool, int]:
         env = self.sim.env
         self.sim.drain_posts()
+        steps = 0
         while not self.offers or target > self.now:
             due = env.peek()
             if due > target:
                 break
+            if budget is not None and steps >= budget:
+                return False, steps
             env.step()
+            steps += 1
         if target > env.now:
             env.run(until=target)
         if self.now >= self.horizon - 1e-9 and not self.ended:
             self.ended = True
             self.sim.check_waiting(horizon=self.horizon)
+        return True, steps
 
     # ------------------------------------------------------------------ the person
     def act(self, offer: Offer) -> None:
