@@ -3,6 +3,7 @@ performer (a script, a user model, or the spec's companion ``SPEC.users.toml``).
 
 from __future__ import annotations
 
+import sys
 from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
@@ -89,7 +90,8 @@ def choose_user(compiled: CompiledPackage, spec_path: str | Path, *, script: str
 
     model = load_user_model(ref)
     if not lane.empty:
-        model.validate_against(lane.manual, choices=lane.choices)
+        for warning in model.validate_against(lane.manual, choices=lane.choices):
+            print(f"opspec: {warning}", file=sys.stderr)
 
     def stochastic(user: int, seed: int) -> tuple[Performer | None, list[TraceListener]]:
         return model.performer(user_stream(seed, user)), []

@@ -132,6 +132,8 @@ def _check_plan(plan: Any) -> dict[str, list[dict[str, Any]]]:
     definitions: dict[str, list[dict[str, Any]]] = {}
     for design in plan.designs:
         context = prepare(design.spec, design.sha256, plan.user_model, plan.engine)
+        for warning in context.warnings:
+            print(f"opspec evaluate: {warning}", file=sys.stderr)
         from opspec.engine.lanes import user_lane
 
         if context.model is None and not user_lane(context.compiled).empty:

@@ -11,7 +11,13 @@ from __future__ import annotations
 from collections.abc import Iterator
 from dataclasses import dataclass
 
-from opspec.engine.compiled import K_GATEWAY, K_MANUAL, CompiledActivity, CompiledPackage
+from opspec.engine.compiled import (
+    K_GATEWAY,
+    K_MANUAL,
+    CompiledActivity,
+    CompiledPackage,
+    CTransition,
+)
 
 __all__ = ["UserLane", "all_activities", "user_lane"]
 
@@ -21,8 +27,11 @@ class UserLane:
     """What the user lane of a package asks of its performer.
 
     - ``bind_names``: participant ids (or lane names) to bind the user performer to;
-    - ``manual``: ids of the manual activities a user performs, in spec order;
-    - ``choices``: deferred-choice activity id → the ids of its alternatives.
+    - ``manual``: ids of the manual activities offered to the user as work items, in spec
+      order;
+    - ``choices``: deferred-choice activity id → the ids of its alternatives. An alternative
+      is *performed by the choice* (the person's pick completes it at once): it is in
+      ``manual`` only when some other transition, or the start, also leads to it.
     """
 
     bind_names: tuple[str, ...]
@@ -46,6 +55,15 @@ def all_activities(compiled: CompiledPackage) -> Iterator[CompiledActivity]:
                     stack.append(act.block)
 
 
+def _branches(act: CompiledActivity) -> tuple[CTransition, ...]:
+    return act.choice or (act.out if act.kind == K_GATEWAY else ())
+
+
+def _choice_branches(activities: tuple[CompiledActivity, ...]) -> set[int]:
+    """Indices of the transitions that are branches of a deferred choice."""
+    return {t.index for act in activities for t in _branches(act)}
+
+
 def user_lane(compiled: CompiledPackage) -> UserLane:
     """The user lane of ``compiled`` (``bind_names`` is ``("user",)`` when nothing names it)."""
     names: dict[str, None] = {}
@@ -55,6 +73,7 @@ def user_lane(compiled: CompiledPackage) -> UserLane:
         stack = [proc.graph]
         while stack:
             graph = stack.pop()
+            chosen = _choice_branches(graph.activities)
             for act in graph.activities:
                 if act.block is not None:
                     stack.append(act.block)
@@ -63,11 +82,13 @@ def user_lane(compiled: CompiledPackage) -> UserLane:
                 name = act.participant or (act.lanes[0] if act.lanes else None)
                 if name:
                     names[name] = None
-                if act.kind == K_MANUAL:
+                offered = act.index in graph.starts or not act.in_slots or any(
+                    t not in chosen for t in act.in_slots)
+                if act.kind == K_MANUAL and offered:
                     manual[act.id] = None
                 # a deferred choice: an event-based gateway, or an activity whose own
                 # outgoing transitions are offered as alternatives after it completes
-                branches = act.choice or (act.out if act.kind == K_GATEWAY else ())
+                branches = _branches(act)
                 alternatives = tuple(graph.activities[t.target].id for t in branches
                                      if graph.activities[t.target].kind == K_MANUAL)
                 if alternatives:

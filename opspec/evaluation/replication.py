@@ -81,6 +81,7 @@ class _Context:
     model: Any
     config: Any
     monitors: tuple[Any, ...] = ()
+    warnings: tuple[Any, ...] = ()          # the user model's, against this spec
 
 
 _CONTEXTS: dict[tuple[str, str, str | None, str], _Context] = {}
@@ -103,17 +104,18 @@ def prepare(spec: str, sha256: str, user_model: str | None, engine: Mapping[str,
     compiled = compile_package(open_spec(spec))
     lane = user_lane(compiled)
     model = None
+    warnings: tuple[Any, ...] = ()
     if user_model is not None:
         from opspec.usermodels.loader import load_user_model
 
         model = load_user_model(user_model)
         if not lane.empty:
-            model.validate_against(lane.manual, choices=lane.choices)
+            warnings = tuple(model.validate_against(lane.manual, choices=lane.choices))
     config = EngineConfig.from_mapping(engine) if engine else EngineConfig()
     from opspec.engine.monitors import declared_monitors
 
     context = _Context(compiled, lane.bind_names, (*lane.manual, *lane.choices), model, config,
-                       tuple(declared_monitors(compiled)))
+                       tuple(declared_monitors(compiled)), warnings)
     _CONTEXTS[key] = context
     return context
 

@@ -164,7 +164,8 @@ class UserModel:
         each deferred-choice id to its alternative ids. Raises :class:`UserModelError` when an
         activity or choice is not covered (naming the file, the missing ids and the fix) or a
         choice model names an alternative the spec does not offer. Returns warnings for
-        activities in the model that the spec does not have (usually typos).
+        activities in the model that the spec does not have (usually typos) and for choices
+        the model leaves to chance (no ``intended`` or ``probabilities``).
         """
         manual = list(dict.fromkeys(manual_activity_ids))
         choice_map = {k: list(v) for k, v in (choices or {}).items()}
@@ -191,8 +192,22 @@ class UserModel:
                     f"choice {choice_id!r} has no alternative {', '.join(map(repr, unknown))}",
                     location=SourceLocation(self.path, key=f"activities.{choice_id}"),
                     hint="the spec offers: " + ", ".join(alternatives))
-        known = set(manual) | set(choice_map)
+        # alternatives are performed by their choice: a model may give them a duration (the
+        # time to carry out that pick), but need not
+        known = set(manual) | set(choice_map) | {a for alts in choice_map.values() for a in alts}
         warnings = []
+        for choice_id, alternatives in choice_map.items():
+            model = self.activity(choice_id)
+            if model.intended is None and not model.probabilities and len(alternatives) > 1:
+                key = f"activities.{choice_id}" if choice_id in self.activities else "defaults"
+                warnings.append(Diagnostic(
+                    SourceLocation(self.path, key=key),
+                    Severity.WARNING, "random-choice",
+                    f"choice {choice_id!r}: the model names no intended alternative, so it "
+                    f"picks one of {', '.join(alternatives)} uniformly at random (and no pick "
+                    "counts as wrong)",
+                    hint=f"give [activities.{choice_id}] intended = \"{alternatives[0]}\" "
+                    "(and a commission for wrong picks) or probabilities, in a model file"))
         for activity_id in self.activities:
             if activity_id not in known:
                 warnings.append(Diagnostic(

@@ -13,7 +13,8 @@ this fixed order for each offered work item:
 3. choice (work items with ``choices``): with ``probabilities``, one uniform; with
    ``intended`` + ``commission`` under its cap, one uniform, and when wrong, one integer if
    there are several wrong alternatives, then one ``recovery`` sample; with neither, one
-   integer (a uniform pick);
+   integer (a uniform pick); then, when the model describes the chosen alternative (e.g.
+   ``press_wrong_button``), one sample of its duration: the time to carry out the pick;
 4. extra delay: one uniform if configured, plus one ``delay.duration`` sample when it occurs;
 5. duration: one sample of the activity's distribution (its own documented draws);
 6. repetition: one uniform if configured, plus one more duration sample when it occurs;
@@ -60,6 +61,7 @@ class StochasticUser:
         self._wrong: dict[tuple[int, str], int] = {}
         self._recovery: dict[tuple[int, str], float] = {}
         self._models: dict[str, ActivityModel] = {}
+        self._alternatives: dict[str, ActivityModel | None] = {}
         self._handover: dict[int, int] = {}      # lane -> key of its last completed item
 
     # ------------------------------------------------------------------ Performer protocol
@@ -103,6 +105,9 @@ class StochasticUser:
         choice: str | None = None
         if item.choices:
             choice, delay = self._choose(item, model, lane)
+            picked = self._alternative(choice)
+            if picked is not None:
+                delay += picked.duration.sample(self.rng) * state.duration_factor
 
         if model.delay is not None and float(self.rng.random()) < model.delay.probability:
             extra = model.delay.duration.sample(self.rng)
@@ -151,6 +156,14 @@ class StochasticUser:
         found = self._models.get(activity)
         if found is None:
             found = self._models[activity] = self.model.activity(activity)
+        return found
+
+    def _alternative(self, activity: str) -> ActivityModel | None:
+        """The model of a choice's alternative, if the user model describes it (cached)."""
+        if activity in self._alternatives:
+            return self._alternatives[activity]
+        found = self.model.activity(activity) if self.model.covers(activity) else None
+        self._alternatives[activity] = found
         return found
 
     def _choose(self, item: WorkItem, model: ActivityModel, lane: int) -> tuple[str, float]:
