@@ -15,7 +15,7 @@ What an activity *is* at run time is one of the ``K_*`` kinds below; the interpr
 from __future__ import annotations
 
 import re
-from collections.abc import Callable, Mapping
+from collections.abc import Callable, Iterable, Mapping
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -73,6 +73,7 @@ __all__ = [
     "CompiledProcess",
     "Evaluator",
     "compile_package",
+    "expand_selectors_over",
 ]
 
 Evaluator = Callable[[Mapping[str, Any], float], Any]
@@ -224,24 +225,35 @@ class CompiledPackage:
         cached = self._want_cache.get(selectors)
         if cached is not None:
             return cached
-        keys: set[tuple[str, str | None, str | None]] = set()
-        pairs: list[tuple[str | None, str | None]] = [(None, None)]
-        for proc in self.processes.values():
-            pairs.append((proc.id, None))
-            stack = [proc.graph]
-            while stack:
-                graph = stack.pop()
-                for act in graph.activities:
-                    pairs.append((proc.id, act.id))
-                    if act.block is not None:
-                        stack.append(act.block)
-        for kind, process, activity in selectors:
-            for pid, aid in pairs:
-                if (process is None or process == pid) and (activity is None or activity == aid):
-                    keys.add((kind, pid, aid))
-        result = frozenset(keys)
+        result = expand_selectors_over(self.processes.values(), selectors)
         self._want_cache[selectors] = result
         return result
+
+
+def expand_selectors_over(
+    processes: Iterable[CompiledProcess],
+    selectors: frozenset[tuple[str, str | None, str | None]], *, package_level: bool = True,
+) -> frozenset[tuple[str, str | None, str | None]]:
+    """(kind, process, activity) keys that ``selectors`` match among ``processes`` (their
+    activities, nested blocks included), plus the package-level ``(kind, None, None)`` keys
+    when ``package_level``. The interpreter calls it again with ``package_level=False`` for
+    the workflows a mode change loads at run time, so listeners see their events too."""
+    keys: set[tuple[str, str | None, str | None]] = set()
+    pairs: list[tuple[str | None, str | None]] = [(None, None)] if package_level else []
+    for proc in processes:
+        pairs.append((proc.id, None))
+        stack = [proc.graph]
+        while stack:
+            graph = stack.pop()
+            for act in graph.activities:
+                pairs.append((proc.id, act.id))
+                if act.block is not None:
+                    stack.append(act.block)
+    for kind, process, activity in selectors:
+        for pid, aid in pairs:
+            if (process is None or process == pid) and (activity is None or activity == aid):
+                keys.add((kind, pid, aid))
+    return frozenset(keys)
 
 
 def _spec_error(message: str, location: SourceLocation | None, hint: str = "") -> SpecError:

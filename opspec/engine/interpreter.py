@@ -39,7 +39,7 @@ from __future__ import annotations
 import dataclasses
 import itertools
 from collections import ChainMap, deque
-from collections.abc import Callable, Mapping, MutableMapping
+from collections.abc import Callable, Iterable, Mapping, MutableMapping
 from types import MappingProxyType
 from typing import Any
 
@@ -154,8 +154,9 @@ class Interpreter:
                 self._all = True
                 break
             selectors.update(wanted)
+        self._selectors = frozenset(selectors)
         self._want = (frozenset() if self._all or not selectors
-                      else compiled.expand_selectors(frozenset(selectors)))
+                      else compiled.expand_selectors(self._selectors))
         # each full listener only receives what it selects (None: everything)
         self._full = [(lst, None if getattr(lst, "selects", None) is None
                        else compiled.expand_selectors(frozenset(lst.selects)))  # type: ignore[attr-defined]
@@ -1295,6 +1296,7 @@ class Interpreter:
                 self.compiled = dataclasses.replace(self.compiled, modes={
                     **self.compiled.modes,
                     mode: self.compiled.modes.get(mode, frozenset()) | frozenset(new)})
+                self._select_loaded(new.values())
                 for proc in new.values():
                     self.arm_process(proc)
         old = self.mode
@@ -1310,6 +1312,22 @@ class Interpreter:
             members = [m for m, procs in self.compiled.modes.items() if proc.id in procs]
             if mode in members and proc.auto_start:
                 self.start_process(proc, trigger=f"mode:{mode}")
+
+    def _select_loaded(self, procs: Iterable[CompiledProcess]) -> None:
+        """Extend the listeners' expanded selectors over workflows loaded at run time (the
+        boot expansion only saw the boot package), so metrics, --timing and traces see their
+        events. Runs once per loaded source, never on the per-event path."""
+        from opspec.engine.compiled import expand_selectors_over
+
+        procs = tuple(procs)
+        if not self._all and self._selectors:
+            self._want = self._want | expand_selectors_over(
+                procs, self._selectors, package_level=False)
+        self._full = [(lst, None if selects is None else selects | expand_selectors_over(
+            procs, frozenset(lst.selects), package_level=False))  # type: ignore[attr-defined]
+            for lst, selects in self._full]
+        self._aflags.clear()                 # cached "nobody wants this" bits may be stale
+        self._pflags.clear()
 
     def arm_process(self, proc: CompiledProcess) -> None:   # pragma: no cover - overridden
         raise NotImplementedError

@@ -279,3 +279,37 @@ def test_workflows_loaded_for_a_mode_stop_when_the_mode_is_left(tmp_path: Path) 
                mode_loader=lambda _source: docking).run(until=6.0)
     assert recorder.seen == [(0.0, "forward"), (1.0, "forward"), (2.0, "stop"), (3.0, "stop"),
                              (4.0, "forward"), (5.0, "forward")]
+
+
+class _Selecting:
+    """A listener that selects some events (like the metrics and --timing do)."""
+
+    def __init__(self, *selects: tuple[str, str | None, str | None]) -> None:
+        self.selects = frozenset(selects)
+        self.seen: list[tuple[float, str, str | None]] = []
+
+    def __call__(self, event: object) -> None:
+        self.seen.append((event.time, event.kind, event.process))  # type: ignore[attr-defined]
+
+
+@pytest.mark.parametrize("dock_source", [False, True], ids=["dock-in-package", "dock-loaded"])
+def test_metrics_and_timing_see_the_workflows_a_mode_change_loads(
+        tmp_path: Path, dock_source: bool) -> None:
+    from opspec.engine.timing import TimingListener
+
+    docking = compiled(tmp_path, [process("park", [assign("halt", ("motor_cmd", '"stop"')),
+                                                   task("park_drive", "drive")], Period="1s",
+                                           fields=[field("motor_cmd", "STRING", '""')])],
+                       applications=["drive"], name="docking")
+    model = cleaning_robot(tmp_path, switch_at=2.5, dock_here=not dock_source,
+                           source=' Source="docking.xpdl"' if dock_source else "")
+    starts = _Selecting(("process.started", None, None))
+    parks = _Selecting(("activity.completed", "park", "park_drive"))
+    timing = TimingListener()
+    result = Simulation(model, performers={"motors": Recorder(["drive"], "motor_cmd")},
+                        listeners=[starts, parks, timing],
+                        mode_loader=lambda _source: docking).run(until=5.0)
+    # the same counts whether the dock workflow is in the package or loaded at 2.5 s
+    assert len(starts.seen) == result.summary["instances"]["started"]
+    assert [t for t, _, _ in parks.seen] == [3.0, 4.0]
+    assert timing.summary()["park"]["completed"] == 2
