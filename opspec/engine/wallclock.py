@@ -3,8 +3,11 @@
 ``simpy.rt.RealtimeEnvironment`` sleeps until its next event, so input arriving meanwhile (a
 key press, a serial line) waits for the sleep to end (1.3 s late in issue 3's measurement).
 Here an asyncio loop sleeps until the next event is due *or* until :meth:`Simulation.post`
-wakes it, whichever comes first; posted callbacks run on the engine's thread, at the current
-simulated time (``now`` is advanced to the wall-clock time first when nothing is due earlier).
+wakes it, whichever comes first; posted callbacks run on the engine's thread, at the simulated
+time that corresponds to the wall clock when they are drained: ``now`` is advanced to
+``start + wall elapsed × speed`` first (capped at ``until``, never backwards). Events already
+due by then run first, so a device's answer is never placed before an event that was due
+earlier, nor (at 1000x) 300 simulated seconds too early because the loop last woke then.
 
 Drift (how late events ran relative to their wall-clock due time) is measured for every
 event and reported once, in the run summary: ``{"events", "mean_s", "p99_s", "max_s", "late_10ms"}``.
@@ -15,6 +18,7 @@ from __future__ import annotations
 
 import asyncio
 import math
+import threading
 import time
 from typing import TYPE_CHECKING, Any
 
@@ -33,7 +37,11 @@ async def drive(sim: Simulation, until: float | None, speed: float) -> dict[str,
     """The asyncio stepping loop (usable inside an existing loop, e.g. the TUI's)."""
     loop = asyncio.get_running_loop()
     woken = asyncio.Event()
+    posted = threading.Event()        # set on the posting thread: callbacks wait to be drained
+    posted.set()                      # whatever came before the loop took over
+
     def wake() -> None:
+        posted.set()
         loop.call_soon_threadsafe(woken.set)
 
     sim.wake = wake
@@ -47,7 +55,19 @@ async def drive(sim: Simulation, until: float | None, speed: float) -> dict[str,
     lateness_samples: list[float] = []      # for the p99 (a float per event: cheap)
     try:
         while True:
-            sim.drain_posts()
+            if posted.is_set():
+                posted.clear()
+                # the simulated time of "now" on the wall clock (never backwards, never
+                # beyond until); callbacks posted from device threads run at that time
+                target = sim_start + (time.perf_counter() - wall_start) * speed  # wall-clock
+                if until is not None:
+                    target = min(target, until)
+                if env.peek() > target:
+                    if target > env.now:
+                        env.run(until=target)     # nothing is due before: only moves now
+                    sim.drain_posts()
+                    continue
+                posted.set()                      # step the overdue events first
             due = env.peek()
             if until is not None and due > until:
                 due = until
