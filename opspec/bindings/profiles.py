@@ -11,6 +11,7 @@ Profiles are plain data: nothing here opens a port or imports pyserial.
 
 from __future__ import annotations
 
+import math
 import os
 import re
 import tomllib
@@ -43,6 +44,11 @@ FallbackAction = Literal["simulate", "abort"]
 _PARITIES: Final = {"none": "N", "even": "E", "odd": "O", "mark": "M", "space": "S"}
 _VID_PID: Final = re.compile(r"([0-9A-Fa-f]{4}):([0-9A-Fa-f]{4})\Z")
 _EMPTY: Final[Mapping[str, Any]] = MappingProxyType({})
+# the longest times a profile may give: a command timeout, settle wait or reconnection delay
+# beyond an hour (a simulated operation beyond a day) is a typo, and threading.Timer and
+# time.sleep overflow on 1e300 (inf and nan are valid TOML floats)
+_MAX_MILLIS: Final = 3_600_000.0
+_MAX_SECONDS: Final = 86_400.0
 
 
 def _empty() -> Mapping[str, Any]:
@@ -239,17 +245,22 @@ class _Table:
         value = self.typed(name, (int, float), "a number of milliseconds", None)
         if value is None:
             return default_s
-        if value < 0:
-            raise self.error(name, f"expected a duration >= 0 ms, got {value}")
+        self.check_finite(name, value, "ms", _MAX_MILLIS)
         return float(value) / 1000.0
 
     def seconds(self, name: str, default_s: float) -> float:
         value = self.typed(name, (int, float), "a number of seconds", None)
         if value is None:
             return default_s
-        if value < 0:
-            raise self.error(name, f"expected a duration >= 0 s, got {value}")
+        self.check_finite(name, value, "s", _MAX_SECONDS)
         return float(value)
+
+    def check_finite(self, name: str, value: float, unit: str, maximum: float) -> None:
+        """TOML has ``inf`` and ``nan``: neither is a time a timer or sleep can take."""
+        if math.isnan(value) or not 0 <= value <= maximum:
+            raise self.error(name, f"expected a duration >= 0 {unit} and at most "
+                             f"{maximum:g} {unit}, got {value}",
+                             hint="write a plain number (not inf or nan), e.g. 500")
 
     def template(self, name: str, default: Any = _MISSING) -> Any:
         if name not in self.data and default is not _MISSING:
@@ -309,6 +320,10 @@ def load_profile(path: str | os.PathLike[str]) -> DeviceProfile:
     except tomllib.TOMLDecodeError as error:
         raise BindingError(f"invalid TOML: {error}", location=SourceLocation(where),
                            hint="fix the syntax; see devices/README.md") from None
+    except UnicodeDecodeError as error:   # TOML files are UTF-8 (tomllib decodes them so)
+        raise BindingError(f"not UTF-8 text: byte 0x{error.object[error.start]:02x} at offset "
+                           f"{error.start} cannot be decoded", location=SourceLocation(where),
+                           hint="save the profile as UTF-8") from None
     return _build(where, data)
 
 

@@ -5,13 +5,16 @@ from __future__ import annotations
 import signal
 import subprocess
 import sys
+from pathlib import Path
 
 import pytest
 import serial
 
 from opspec.cli import main
 
-from .conftest import DEVICES, needs_pty
+from .conftest import DATA, DEVICES, needs_pty
+
+INVALID = DATA / "invalid"
 
 
 def test_list_shows_ports_profiles_and_says_virtual_ports_are_never_listed(
@@ -68,3 +71,14 @@ def test_emulate_on_a_socket_for_a_fixed_duration(capsys: pytest.CaptureFixture[
     out = capsys.readouterr().out
     assert "Emulating range_finder" in out and "socket://127.0.0.1:" in out
     assert "Emulator stopped." in out
+
+
+def test_a_profile_that_is_not_utf8_is_named_not_an_internal_error(
+        capsys: pytest.CaptureFixture[str], tmp_path: Path) -> None:
+    bad = tmp_path / "latin1.toml"
+    bad.write_bytes((INVALID / "not_utf8.toml").read_bytes())
+    for argv in (["devices", "list", "--profiles", str(tmp_path)],
+                 ["devices", "emulate", str(bad), "--duration", "0"]):
+        assert main(argv) == 2
+        err = capsys.readouterr().err
+        assert f"{bad}" in err and "not UTF-8" in err and "internal error" not in err

@@ -106,6 +106,12 @@ INVALID_CASES = [
     ("event_without_action", "events.report", "needs `trigger`"),
     ("fallback_unknown_action", "fallback.then", "\"simulate\" or \"abort\""),
     ("fallback_unknown_participant", "fallback.pump", "names no participant"),
+    ("infinite_timeout", "serial.reply_timeout_ms", "at most 3.6e+06 ms, got inf"),
+    ("nan_timeout", "serial.reply_timeout_ms", "got nan"),
+    ("huge_settle", "serial.settle_ms", "at most 3.6e+06 ms, got 1e+300"),
+    ("infinite_simulated_duration", "operations.alarm_on.simulate.duration_s",
+     "at most 86400 s, got inf"),
+    ("not_utf8", None, "not UTF-8 text: byte 0xe9"),
 ]
 
 
