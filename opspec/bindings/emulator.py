@@ -349,11 +349,15 @@ class SocketEmulator(_Server):
     connection but keeps listening, so a binding can reconnect."""
 
     def __init__(self, device: EmulatedDevice, host: str = "127.0.0.1", port: int = 0) -> None:
+        if not 0 <= port <= 65535:      # socket raises OverflowError, not OSError, for these
+            raise BindingError(f"cannot listen on {host}:{port}: a TCP port is 0 to 65535",
+                               hint="port 0 picks a free port")
         super().__init__(device, f"socket-emulator-{device.profile.name}")
         try:
             self._listener = socket.create_server((host, port))
         except OSError as error:
-            raise BindingError(f"cannot listen on {host}:{port}: {error.strerror}") from None
+            raise BindingError(f"cannot listen on {host}:{port}: {error.strerror or error}"
+                               ) from None
         self.host, self.port = self._listener.getsockname()[:2]
         self._client: socket.socket | None = None
 

@@ -91,9 +91,13 @@ def _emulate(args: argparse.Namespace) -> int:
     elif args.port.startswith("socket://"):
         host, _, port_text = args.port[len("socket://"):].rpartition(":")
         try:
-            server = SocketEmulator(device, host or "127.0.0.1", int(port_text))
+            number = int(port_text)
         except ValueError:
             raise BindingError(f"--port {args.port!r}: expected socket://HOST:PORT") from None
+        if not 0 <= number <= 65535:
+            raise BindingError(f"--port {args.port!r}: port {number} is not a TCP port "
+                               "(0 to 65535)", hint="socket://127.0.0.1:0 picks a free port")
+        server = SocketEmulator(device, host or "127.0.0.1", number)
     else:
         raise BindingError(f"--port {args.port!r}: expected pty or socket://HOST:PORT",
                            hint="the emulator creates the port; bind opspec to what it prints")

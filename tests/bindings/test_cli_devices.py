@@ -10,7 +10,10 @@ from pathlib import Path
 import pytest
 import serial
 
+from opspec.bindings import load_profile
+from opspec.bindings.emulator import EmulatedDevice, SocketEmulator
 from opspec.cli import main
+from opspec.errors import BindingError
 
 from .conftest import DATA, DEVICES, needs_pty
 
@@ -82,3 +85,18 @@ def test_a_profile_that_is_not_utf8_is_named_not_an_internal_error(
         assert main(argv) == 2
         err = capsys.readouterr().err
         assert f"{bad}" in err and "not UTF-8" in err and "internal error" not in err
+
+
+@pytest.mark.parametrize("port", ["99999", "-1"], ids=["above-65535", "negative"])
+def test_emulate_on_a_socket_port_out_of_range_is_a_usage_error(
+        capsys: pytest.CaptureFixture[str], port: str) -> None:
+    assert main(["devices", "emulate", "range_finder", "--port", f"socket://127.0.0.1:{port}",
+                 "--profiles", str(DEVICES)]) == 2
+    err = capsys.readouterr().err
+    assert f"port {port} is not a TCP port (0 to 65535)" in err and "internal error" not in err
+
+
+def test_a_socket_emulator_refuses_a_port_out_of_range() -> None:
+    device = EmulatedDevice(load_profile(DEVICES / "range_finder.toml"))
+    with pytest.raises(BindingError, match=r"127.0.0.1:70000: a TCP port is 0 to 65535"):
+        SocketEmulator(device, "127.0.0.1", 70000)
