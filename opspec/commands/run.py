@@ -69,6 +69,8 @@ def register(subparsers: Any) -> None:
     parser.add_argument("--processor-model", choices=("dedicated", "pooled"),
                         help="override the configuration's processor model")
     parser.add_argument("--workers", type=int, help="override the pooled model's workers")
+    parser.add_argument("--switch-cost", type=float, metavar="SECONDS",
+                        help="override the pooled model's cost of one context switch")
     parser.add_argument("--realtime", action="store_true",
                         help="run against the wall clock (see --speed)")
     parser.add_argument("--speed", type=float, default=None,
@@ -169,7 +171,8 @@ def run(args: argparse.Namespace) -> int:
         print(json.dumps(doc, default=str, allow_nan=False))
     else:
         if timing_summary is not None:
-            _print_timing(out, timing_summary, result.summary.get("pool"))
+            _print_timing(out, timing_summary, result.summary.get("pool"),
+                          result.summary.get("dedicated"))
         _print_summary(out, result, medians, args.trace, device_report,
                        shown=printer.shown if printer else 0)
         _print_monitors(out, monitors)
@@ -208,6 +211,15 @@ def _config(args: argparse.Namespace) -> Any:
         overrides["processor_model"] = args.processor_model
     if args.workers is not None:
         overrides["workers"] = args.workers
+    if args.switch_cost is not None:
+        overrides["switch_cost"] = args.switch_cost
+    model = overrides.get("processor_model", config.processor_model)
+    if model != "pooled" and (args.workers is not None or args.switch_cost is not None):
+        raise ConfigurationError(
+            f"{'--workers' if args.workers is not None else '--switch-cost'} applies to the "
+            "pooled model only; the dedicated model gives every workflow instance its own "
+            "worker (unlimited processors, no switch cost, by design)",
+            hint="add --processor-model pooled to compare N shared workers")
     if args.speed is not None and not (args.realtime or config.realtime or args.bind):
         raise ConfigurationError("--speed only applies with --realtime",
                                  hint="add --realtime, or drop --speed")
@@ -421,6 +433,8 @@ def _json_document(args: argparse.Namespace, package: Any, horizon: float | None
         doc["drift"] = summary["drift"]
     if summary.get("pool"):
         doc["pool"] = summary["pool"]
+    if args.timing and summary.get("dedicated"):
+        doc["dedicated"] = summary["dedicated"]
     if devices is not None:
         doc["devices"] = devices
     return doc
@@ -438,8 +452,8 @@ def _ms(value: Any) -> str:
     return "-" if value is None else f"{value * 1000:.2f}"
 
 
-def _print_timing(out: Any, timing: dict[str, dict[str, Any]], pool: dict[str, Any] | None
-                  ) -> None:
+def _print_timing(out: Any, timing: dict[str, dict[str, Any]], pool: dict[str, Any] | None,
+                  dedicated: dict[str, Any] | None = None) -> None:
     print("\ntiming (milliseconds of simulated time)", file=out)
     print(f"  {'workflow':<20}{'started':>8}{'done':>8}{'misses':>8}{'mean resp':>11}"
           f"{'p95 resp':>10}{'max resp':>10}{'jitter':>9}", file=out)
@@ -451,6 +465,14 @@ def _print_timing(out: Any, timing: dict[str, dict[str, Any]], pool: dict[str, A
         print(f"  pooled model: {pool.get('workers')} worker(s), {pool.get('switches')} context "
               f"switches, busy {_fmt(pool.get('busy_time'))} s, at most "
               f"{pool.get('max_waiting')} waiting", file=out)
+    elif dedicated:
+        print("  dedicated model: one worker per workflow instance (unlimited processors, no "
+              "switch cost, by design)", file=out)
+        print(f"  {dedicated.get('bursts')} CPU bursts, busy {_fmt(dedicated.get('busy_time'))}"
+              f" s, at most {dedicated.get('max_busy')} at once (pooled with that many workers "
+              "and no switch cost waits for none)", file=out)
+    print("  response = completion - start of an instance: declared durations count too",
+          file=out)
 
 
 def _print_summary(out: Any, result: RunResult, medians: dict[str, float], trace: str | None,

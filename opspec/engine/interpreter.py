@@ -76,7 +76,7 @@ from opspec.engine.lifecycle import (
     TERMINATED,
 )
 from opspec.engine.performers import Performer, WorkItem
-from opspec.engine.processors import PooledProcessor
+from opspec.engine.processors import DedicatedProcessor, PooledProcessor
 from opspec.engine.random import Streams
 from opspec.engine.registry import PerformerRegistry
 from opspec.engine.trace import EventKind as EK
@@ -138,6 +138,7 @@ class Interpreter:
         self._resolution = config.timer_resolution
         self._pool = (PooledProcessor(self.env, config.workers, config.priorities,
                                       self._after_cpu, _alive) if config.pooled else None)
+        self._dedicated = DedicatedProcessor()
         self.raised_names: set[str] = set()
         self.mode = compiled.initial_mode
         # trace: listeners with a ``raw`` method get the fields without a TraceEvent object
@@ -575,6 +576,7 @@ class Interpreter:
                                    {"waiting": self._pool.waiting, "priority": level})
                 return
             if act.cpu > 0.0:
+                self._dedicated.burst(self.env._now, act.cpu)
                 ai.waiting = "cpu"
                 self._later(act.cpu, self._after_cpu_cb, ai)
                 return

@@ -10,19 +10,25 @@ if any, elapses without holding a worker).
 The queues are plain deques indexed by level, not ``simpy.PriorityResource``, which re-sorts
 its whole queue on every request (12 us with 20 waiting, 360 us with 5,000; issue 3).
 
-The dedicated model needs no object: every instance has its own worker, so an activity only
-waits for its own ``cpu_demand``.
+The dedicated model (the source's Linux engine) gives every workflow instance its own worker
+thread, so processors are unlimited by design: an activity only waits for its own
+``cpu_demand``, and priorities and switch costs do not apply. :class:`DedicatedProcessor`
+does not schedule anything; it only counts what that design assumes: how many CPU bursts ran
+(each a thread waking for its instance's activity; no switch cost is charged) and how many
+ran at once at most (the processors a real device would need to match the dedicated model,
+the fair ``--workers`` to compare the pooled model against).
 """
 
 from __future__ import annotations
 
+import heapq
 from collections import deque
 from collections.abc import Callable
 from typing import Any
 
 import simpy
 
-__all__ = ["PooledProcessor"]
+__all__ = ["DedicatedProcessor", "PooledProcessor"]
 
 
 class PooledProcessor:
@@ -93,3 +99,33 @@ class PooledProcessor:
                         self.free -= 1
                         self._run(job, cost)
                     break
+
+
+class DedicatedProcessor:
+    """Counts of the dedicated model's CPU use (it schedules nothing).
+
+    ``burst(now, cost)`` records one activity holding its own worker from ``now`` for
+    ``cost`` simulated seconds; ``bursts``, ``busy_time`` and ``max_busy`` (most bursts
+    overlapping at one time) summarise them. Called only for activities with a CPU demand.
+    """
+
+    __slots__ = ("_ends", "bursts", "busy_time", "max_busy")
+
+    def __init__(self) -> None:
+        self._ends: list[float] = []      # end times of the bursts under way (a heap)
+        self.bursts = 0
+        self.busy_time = 0.0
+        self.max_busy = 0
+
+    def burst(self, now: float, cost: float) -> None:
+        ends = self._ends
+        while ends and ends[0] <= now:
+            heapq.heappop(ends)
+        heapq.heappush(ends, now + cost)
+        self.bursts += 1
+        self.busy_time += cost
+        if len(ends) > self.max_busy:
+            self.max_busy = len(ends)
+
+    def summary(self) -> dict[str, float | int]:
+        return {"bursts": self.bursts, "busy_time": self.busy_time, "max_busy": self.max_busy}

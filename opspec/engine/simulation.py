@@ -62,7 +62,8 @@ class RunResult:
     ``summary`` keys: ``time`` (simulated end), ``seed``, ``events`` (trace events emitted),
     ``sim_events`` (SimPy events scheduled), ``instances`` (started/completed/terminated/
     aborted/open), ``deadlocks`` and ``faults`` (lists of dicts with a ``message``),
-    ``stale_completions``, ``drift`` (wall-clock mode) and ``pool`` (pooled model).
+    ``stale_completions``, ``drift`` (wall-clock mode) and ``pool`` (pooled model) or
+    ``dedicated`` (CPU bursts, busy time and most bursts at once; dedicated model).
     """
 
     trace: tuple[TraceEvent, ...] | None
@@ -376,6 +377,8 @@ class Simulation(Interpreter):
             summary["pool"] = {"workers": self.config.workers, "busy_time": self._pool.busy_time,
                                "max_waiting": self._pool.max_waiting,
                                "switches": self._pool.switches}
+        else:
+            summary["dedicated"] = self._dedicated.summary()
         return RunResult(tuple(self.memory.events) if self.memory is not None else None,
                          self.metrics.values() if self.metrics is not None else {}, summary)
 

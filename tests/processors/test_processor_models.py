@@ -120,3 +120,68 @@ def min_response(path: Path) -> float:
     Simulation(load_spec(path), EngineConfig(processor_model="pooled", workers=1),
                listeners=[listener]).run(until=10.0)
     return min(listener.workflows["control"].responses)
+
+
+def test_dedicated_model_counts_its_cpu_bursts_and_the_most_under_way_at_once(tmp_path):
+    path = spec(tmp_path, CONTROL, LOGGER)
+    dedicated, summary = timing(path, until=1.0)
+    # control bursts at 0, 50, ... 950 ms (20), logger at 0, 100, ... 900 ms (10); both at 0
+    assert summary["dedicated"] == {"bursts": 30, "busy_time": pytest.approx(0.7),
+                                    "max_busy": 2}
+    # a pooled run with that many workers and no switch cost waits for nothing
+    pooled, _ = timing(path, until=1.0, processor_model="pooled",
+                       workers=summary["dedicated"]["max_busy"])
+    assert pooled == dedicated
+
+
+def cli(capsys, *args: str) -> tuple[int, str, str]:
+    from opspec.cli import main
+
+    status = main(["run", *args])
+    captured = capsys.readouterr()
+    return status, captured.out, captured.err
+
+
+@pytest.mark.parametrize("option", [["--workers", "3"], ["--switch-cost", "0.01"]],
+                         ids=["workers", "switch-cost"])
+def test_pooled_only_options_with_the_dedicated_model_are_refused(option, capsys):
+    status, _, err = cli(capsys, "specs/vacuum_cleaner.xpdl", "--until", "1", *option)
+    assert status == 2
+    assert "applies to the pooled model only" in err
+    assert "unlimited processors" in err
+
+
+def test_timing_says_the_dedicated_model_has_a_worker_per_instance(capsys):
+    status, out, _ = cli(capsys, "specs/vacuum_cleaner.xpdl", "--until", "5", "--timing",
+                         "--timeline", "none")
+    assert status == 0
+    assert "one worker per workflow instance (unlimited processors" in out
+    assert "at most 3 at once" in out
+
+
+def test_readme_command_shows_pooled_misses_the_dedicated_model_meets(capsys):
+    """README: --processor-model pooled --workers 1 --switch-cost 0.01 on the vacuum."""
+    import json
+
+    common = ["specs/vacuum_cleaner.xpdl", "--until", "60", "--timing", "--json"]
+    status, out, _ = cli(capsys, *common)
+    dedicated = json.loads(out)["timing"]
+    status_pooled, out, _ = cli(capsys, *common, "--processor-model", "pooled", "--workers", "1",
+                                "--switch-cost", "0.01")
+    pooled = json.loads(out)["timing"]
+    assert status == status_pooled == 0
+    assert sum(t["misses"] for t in dedicated.values()) == 0
+    assert pooled["sense"]["misses"] > 0
+
+
+def test_processor_models_benchmark_runs_at_tiny_size(capsys):
+    import importlib.util
+
+    bench = Path(__file__).resolve().parents[2] / "benchmarks" / "processor_models.py"
+    loaded = importlib.util.spec_from_file_location("processor_models_bench", bench)
+    module = importlib.util.module_from_spec(loaded)
+    loaded.loader.exec_module(module)
+    module.main(["--seconds", "2"])
+    out = capsys.readouterr().out
+    assert "dedicated (3 cpu)" in out
+    assert "pooled 1w 1p" in out and "pooled 3w 8p" in out
