@@ -41,6 +41,7 @@ from dataclasses import dataclass
 from typing import Any, NamedTuple
 
 from opspec.errors import ConfigurationError
+from opspec.testing.intervals import _pct
 
 __all__ = [
     "Decision",
@@ -192,10 +193,10 @@ class Decision:
     def message(self) -> str:
         lines = [f"expected {self.claim}",
                  f"  estimate {self.estimate:.4g} {self.detail}".rstrip() + f"; n = {self.n}",
-                 (f"  {self.confidence:.0%} {self.sides} {self.interval} interval "
+                 (f"  {_pct(self.confidence)} {self.sides} {self.interval} interval "
                  f"[{self.lo:.4g}, {self.hi:.4g}]; bound {self.bound}")]
         if self.verdict == "refuted":
-            lines.append(f"  refuted: the claim is false at {self.confidence:.0%} confidence")
+            lines.append(f"  refuted: the claim is false at {_pct(self.confidence)} confidence")
         elif self.verdict == "undecided":
             if self.n == 0:
                 lines.append("  nothing to judge: simulate longer or more users")
@@ -339,7 +340,7 @@ def assert_rate(result: Any, metric: str | tuple[Any, Any], *, at_least: float |
         raise ConfigurationError(f"unknown rate method {method!r}",
                                  hint="use " + " or ".join(RATE_METHODS))
     s, t, subject, units = _rate_counts(result, metric)
-    claim = f"rate {subject} {_bound_text(at_least, at_most)} with {confidence:.0%} confidence"
+    claim = f"rate {subject} {_bound_text(at_least, at_most)} with {_pct(confidence)} confidence"
     decision = _rate_decision(claim, s, t, at_least, at_most, confidence, method,
                               getattr(result, "replications", 1), units)
     _fail(decision, result)
@@ -350,13 +351,15 @@ def assert_mean(result: Any, metric: str, *, at_least: float | None = None,
                 at_most: float | None = None, between: tuple[float, float] | None = None,
                 confidence: float = 0.95, method: str = "t", seed: int = 0) -> Decision:
     """Assert the mean of ``metric``'s per-replication values (``result.samples``), with a
-    Student t or seeded BCa bootstrap interval."""
+    Student t or seeded BCa bootstrap interval. Replications where the metric has no value (a
+    duration never observed) are left out of the mean, and the decision says how many: a
+    mean over the successful runs only says nothing about how often runs fail."""
     __tracebackhide__ = True
     _check_confidence(confidence)
     at_least, at_most = _target(at_least, at_most, between)
     values = result.samples(metric)
     bound = _bound_text(at_least, at_most)
-    claim = f"mean {metric} {bound} with {confidence:.0%} confidence"
+    claim = f"mean {metric} {bound} with {_pct(confidence)} confidence"
     level = _two_sided_level(confidence, at_least, at_most)
     sides = "two-sided" if level == confidence else "one-sided"
     name = "Student t" if method == "t" else "BCa bootstrap"
@@ -381,8 +384,11 @@ def assert_mean(result: Any, metric: str, *, at_least: float | None = None,
 
         needed = _smallest(settles, n)
         needed = None if needed is None else max(n + 1, needed)
+    total = int(getattr(result, "replications", n) or n)
+    left_out = (f"; {total - n} of {total} replications have no value of {metric} and are "
+                "left out: assert how often it is missing separately") if total > n else ""
     decision = Decision(claim, verdict, est, lo, hi, n, confidence, sides, name, bound,
-                        f"(sd {sd:.3g}, {n} replications)", needed)
+                        f"(sd {sd:.3g}, {n} replications{left_out})", needed)
     _fail(decision, result)
     return decision
 
@@ -396,7 +402,7 @@ def assert_quantile(result: Any, metric: str, q: float, *, at_most: float | None
     at_least, at_most = _target(at_least, at_most, None)
     values = result.observations(metric)
     bound = _bound_text(at_least, at_most)
-    claim = f"p{q * 100:g} {metric} {bound} with {confidence:.0%} confidence"
+    claim = f"p{q * 100:g} {metric} {bound} with {_pct(confidence)} confidence"
     level = _two_sided_level(confidence, at_least, at_most)
     sides = "two-sided" if level == confidence else "one-sided"
     est, lo, hi = quantile_interval(values, q, level)
@@ -458,7 +464,7 @@ def assert_rate_sequential(simulate_batch: Callable[[int, int], Any],
         last = simulate_batch(look - 1, size)
         s, t, subject, units = _rate_counts(last, metric)
         successes, trials, users = successes + s, trials + t, users + size
-        claim = (f"rate {subject} {_bound_text(at_least, at_most)} with {confidence:.0%} "
+        claim = (f"rate {subject} {_bound_text(at_least, at_most)} with {_pct(confidence)} "
                  f"confidence (sequential, {look_conf:.4%} per look, up to {max_looks} looks)")
         decision = _rate_decision(claim, successes, trials, at_least, at_most, look_conf,
                                   method, users, units)

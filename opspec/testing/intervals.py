@@ -23,6 +23,11 @@ __all__ = ["decide_mean", "decide_quantile", "decide_rate", "wilson"]
 _MAX_N = 10**9
 
 
+def _pct(level: float) -> str:
+    """A confidence for people: 95%, 99%, 98.75% (never rounded to a level it is not)."""
+    return f"{level * 100:.4g}%"
+
+
 def _stats() -> Any:
     """scipy.stats, imported when first needed (it is slow to import)."""
     import scipy.stats  # type: ignore[import-untyped]
@@ -91,7 +96,7 @@ def decide_rate(text: str, successes: int, trials: int, op: str, a: float, b: fl
     side = "two-sided" if op == "in" else "one-sided"
     lines = [f"expected {text}",
              (f"  estimate {estimate:.4g} ({successes}/{trials} {units}, {replications} "
-              f"replication(s)); {level:.0%} {side} Wilson interval [{lo:.4g}, {hi:.4g}]; "
+              f"replication(s)); {_pct(level)} {side} Wilson interval [{lo:.4g}, {hi:.4g}]; "
               f"bound {_bound_text(op, a, b)}")]
     if verdict == "refuted":
         lines.append("  the claim is false at this confidence")
@@ -146,7 +151,7 @@ def decide_mean(text: str, values: Sequence[float], op: str, a: float, b: float 
         return None
     side = "two-sided" if op == "in" else "one-sided"
     lines = [f"expected {text}",
-             (f"  estimate {mean:.4g} (sd {sd:.3g}, {n} replications); {level:.0%} {side} t "
+             (f"  estimate {mean:.4g} (sd {sd:.3g}, {n} replications); {_pct(level)} {side} t "
               f"interval [{lo:.4g}, {hi:.4g}]; bound {_bound_text(op, a, b)}")]
     if verdict == "refuted":
         lines.append("  the claim is false at this confidence")
@@ -183,7 +188,7 @@ def decide_quantile(text: str, values: Sequence[float], q: float, op: str, a: fl
     estimate = ordered[min(n - 1, max(0, math.ceil(q * n) - 1))]
     side = "two-sided" if op == "in" else "one-sided"
     lines = [f"expected {text}",
-             (f"  estimate {estimate:.4g} ({n} observations); {level:.0%} {side} "
+             (f"  estimate {estimate:.4g} ({n} observations); {_pct(level)} {side} "
               f"order-statistic interval [{lo:.4g}, {hi:.4g}]; bound {_bound_text(op, a, b)}")]
     if verdict == "refuted":
         lines.append("  the claim is false at this confidence")

@@ -41,6 +41,7 @@ from opspec.engine.monitors import (
     poisson_interval,
 )
 from opspec.errors import ConfigurationError
+from opspec.testing.intervals import _pct
 
 __all__ = [
     "Monitor",
@@ -176,7 +177,7 @@ class MonitorReport:
     def __str__(self) -> str:
         if not self.rows:
             return "no monitors"
-        head = f"monitors (hazard: violations per user-day, exact {self.confidence:.0%} interval)"
+        head = f"monitors (hazard: violations per user-day, exact {_pct(self.confidence)} interval)"
         return "\n".join([head, *(f"  {row}" for row in self.rows)])
 
     def describe(self, limit: int = 3) -> str:

@@ -93,11 +93,14 @@ def load_cached(path: Path, config: pytest.Config) -> Any:
         from opspec.engine.compiled import compile_package
         from opspec.xpdl.loader import load_spec
 
+        problem = None
         try:
             package = load_spec(path)
             cache[path] = (package, compile_package(package))
         except OpspecError as error:
-            pytest.fail(f"cannot load the spec: {error}", pytrace=False)
+            problem = f"cannot load the spec: {error}"
+        if problem is not None:          # outside the except: no "during handling" chain
+            pytest.fail(problem, pytrace=False)
     return cache[path]
 
 
@@ -178,7 +181,8 @@ class Simulator:
                             user_model=user_model, seed=self.seed if seed is None else seed,
                             until=until, engine_config=engine_config, **options)
         except OpspecError as error:
-            pytest.fail(f"simulate(): {error}", pytrace=False)
+            problem = f"simulate(): {error}"
+        pytest.fail(problem, pytrace=False)     # outside the except: the message once
 
 
 @pytest.fixture

@@ -325,6 +325,10 @@ def simulate(spec: Package | CompiledPackage | str | Path, *, users: int = 1,
         raise ConfigurationError(f"users must be a whole number >= 1, not {users!r}")
     if days is not None and until is not None:
         raise ConfigurationError("give days or until, not both")
+    if script is not None and user_model is not None:
+        raise ConfigurationError("give script or user_model, not both",
+                                 hint="a script plays one scripted user; a user model draws "
+                                 "stochastic users")
     if until is not None:
         horizon = until
     elif days is not None:

@@ -228,7 +228,11 @@ CORPUS_VERDICTS: dict[str, tuple[str | list[str], bool, str]] = {
         "five XOR splits and two EXCEPTION paths, all reaching an end; no AND join"),
     "jawe10__sample_workflow_process.xpdl": (SOUND, False,
         ("XOR splits closed by XOR joins, the AND split closed by an AND join on parallel "
-        "branches, and an EXCEPTION path to its own end")),
+        "branches, and an EXCEPTION path to its own end. JaWE files it under 'Invalid': "
+        "activity 36's deadline exceptions have no EXCEPTION transition (its transitions 49 "
+        "and 50 test 'notifyException' as plain conditions), so an expired deadline aborts "
+        "the instance; an abort is not a token move (docs/soundness.md, Limits), and "
+        "`opspec validate` reports it")),
     "jawe10__workflow_patterns.xpdl": (SOUND, False,
         ("the 15 WfMC pattern processes: Multiple Choice and Multiple Merge use AND splits "
         "with conditions (any subset of branches), Discriminator and N-out-of-M merge them "

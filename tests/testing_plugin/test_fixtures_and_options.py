@@ -72,6 +72,22 @@ def test_simulate_runs_a_script_given_as_plain_data(project: pytest.Pytester) ->
     project.runpytest().assert_outcomes(passed=1)
 
 
+def test_a_script_and_a_user_model_together_fail_once_with_the_reason(
+        project: pytest.Pytester) -> None:
+    project.makepyfile("""
+        SPEC = "specs/dispenser.xpdl"
+
+        def test_it(spec, simulate):
+            simulate(spec, script=[("never", "press_report")],
+                     user_model="specs/dispenser.users.toml", until=9 * 3600)
+    """)
+    result = project.runpytest()
+    result.assert_outcomes(failed=1)
+    out = result.stdout.str()
+    assert out.count("give script or user_model, not both") == 1
+    assert "During handling" not in out
+
+
 SEEDED = """
     SPEC = "specs/dispenser.xpdl"
 

@@ -125,6 +125,14 @@ def test_too_few_replications_for_a_mean_compute_the_number_from_the_spread() ->
     assert half(needed) < 1.2 - mean <= half(needed - 1)
 
 
+def test_a_mean_over_some_replications_says_how_many_were_left_out() -> None:
+    # 12 carts, 3 never found the patient: their time_to_find has no value
+    result = FakeResult(values=[100.0, 110.0, 90.0, 400.0] * 2 + [95.0], replications=12)
+    with pytest.raises(AssertionError, match=r"3 of 12 replications have no value of "
+                                             r"time_to_find_s and are left out"):
+        assert_mean(result, "time_to_find_s", at_most=100.0)
+
+
 def test_a_mean_of_fewer_than_two_values_cannot_be_decided() -> None:
     with pytest.raises(AssertionError, match="at least 2 replications"):
         assert_mean(FakeResult(values=[1.0]), "alarms", at_least=0.5)
