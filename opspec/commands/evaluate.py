@@ -17,6 +17,7 @@ from datetime import UTC, datetime
 from pathlib import Path
 from typing import Any
 
+from opspec.commands._args import seed
 from opspec.errors import EvaluationError
 
 __all__ = ["register", "run"]
@@ -37,7 +38,7 @@ def register(subparsers: Any) -> None:
     parser.add_argument("--days", type=float, default=None,
                         help="simulated days per user (default: the spec's opspec:RunLength "
                         "if it declares one, else 30)")
-    parser.add_argument("--seed", type=int, default=0, help="run seed (default 0)")
+    parser.add_argument("--seed", type=seed, default=0, help="run seed (default 0)")
     parser.add_argument("--user-model", metavar="FILE|PRESET",
                         help="user model file or preset, 'A,B' to chain (default: the spec's "
                         "companion SPEC.users.toml)")

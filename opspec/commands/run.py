@@ -22,6 +22,7 @@ from collections.abc import Iterator
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
+from opspec.commands._args import seed
 from opspec.errors import ConfigurationError
 
 if TYPE_CHECKING:
@@ -56,7 +57,7 @@ def register(subparsers: Any) -> None:
                         "until nothing is left to do)")
     length.add_argument("--until", metavar="T",
                         help="simulated end time: seconds, or an ISO 8601 duration (PT8H)")
-    parser.add_argument("--seed", type=int, default=0, help="run seed (default 0)")
+    parser.add_argument("--seed", type=seed, default=0, help="run seed (default 0)")
     user = parser.add_mutually_exclusive_group()
     user.add_argument("--script", metavar="FILE",
                       help="a scripted user (TOML/JSON steps, or a recorded walkthrough)")
