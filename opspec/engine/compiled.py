@@ -20,6 +20,7 @@ from dataclasses import dataclass, field
 from typing import Any
 
 from opspec.engine.conditions import compile_condition, compile_expression
+from opspec.engine.coordination import APPLICATION_BUILTINS, application_builtin
 from opspec.engine.sampling import Sampler, make_sampler, parse_duration_text
 from opspec.errors import OpspecError, SourceLocation, SpecError
 from opspec.model import (
@@ -511,8 +512,18 @@ class _Compiler:
             ca.kind = K_COORD
             ca.coordination = act.coordination
             ca.general = False
+        elif ca.application in APPLICATION_BUILTINS and isinstance(body, Task):
+            # a preprocessed push/pull/mode change: run it as the built-in it stands for
+            builtin = application_builtin(ca.application, body.applications[0].actual_parameters)
+            if isinstance(builtin, str):
+                raise _spec_error(f"activity {act.id!r} calls {ca.application!r}, but {builtin}",
+                                  act.location, "write it as opspec preprocess does "
+                                  "(docs/sisarl-xpdl.md)")
+            ca.kind = K_COORD
+            ca.coordination = builtin
+            ca.general = False
         manual_body = isinstance(body, NoImplementation | Task)
-        if manual_body and act.coordination is None and (act.is_manual or ca.user_lane):
+        if manual_body and ca.coordination is None and (act.is_manual or ca.user_lane):
             ca.kind = K_MANUAL
             ca.general = False
         # joins and splits

@@ -19,6 +19,12 @@ mailbox for push/pull data.
   the receiver is ready, and each value is delivered once, oldest first).
 - **mode change**: switches the active workflow set to ``target_mode`` (see
   :meth:`opspec.engine.interpreter.Interpreter.change_mode`).
+
+``opspec preprocess`` writes push, pull and mode change as standard-XPDL tasks calling the
+applications ``opspec.supervisor.push`` / ``opspec.supervisor.pull`` (actual parameters: a
+string literal channel and a data field) and ``opspec.engine.mode_change`` (a string literal
+mode). :func:`application_builtin` turns such a task back into the built-in, so the compiler
+runs a preprocessed spec exactly like the SISARL file it came from.
 """
 
 from __future__ import annotations
@@ -26,7 +32,42 @@ from __future__ import annotations
 from collections.abc import Sequence
 from typing import Any
 
-__all__ = ["arbiter", "superposition", "voter"]
+from opspec.model import CoordinationBuiltIn, CoordinationKind
+from opspec.model.data import ActualParameter
+from opspec.model.expressions import Literal, Name
+
+__all__ = ["APPLICATION_BUILTINS", "application_builtin", "arbiter", "superposition", "voter"]
+
+APPLICATION_BUILTINS = {
+    "opspec.supervisor.push": CoordinationKind.PUSH_DATA,
+    "opspec.supervisor.pull": CoordinationKind.PULL_DATA,
+    "opspec.engine.mode_change": CoordinationKind.MODE_CHANGE,
+}
+"""The applications ``opspec preprocess`` writes for the built-ins standard XPDL lacks."""
+
+
+def application_builtin(application: str, params: Sequence[ActualParameter]
+                        ) -> CoordinationBuiltIn | str | None:
+    """The built-in a preprocessed task calling ``application`` stands for; ``None`` when
+    ``application`` is not one of :data:`APPLICATION_BUILTINS`; a problem (a ``str`` saying
+    what the parameters should be) when the parameters do not fit."""
+    kind = APPLICATION_BUILTINS.get(application)
+    if kind is None:
+        return None
+    values = [p.expression for p in params]
+    literal = values[0] if values else None
+    if not isinstance(literal, Literal) or not isinstance(literal.value, str):
+        what = "mode" if kind is CoordinationKind.MODE_CHANGE else "channel"
+        return f"its first actual parameter must be the {what} as a string literal"
+    if kind is CoordinationKind.MODE_CHANGE:
+        return CoordinationBuiltIn(kind=kind, target_mode=literal.value)
+    field = values[1] if len(values) == 2 else None
+    if not isinstance(field, Name):
+        return "its actual parameters must be a string literal channel and a data field"
+    ref = ".".join(field.path)
+    if kind is CoordinationKind.PUSH_DATA:
+        return CoordinationBuiltIn(kind=kind, channel=literal.value, inputs=(ref,))
+    return CoordinationBuiltIn(kind=kind, channel=literal.value, output=ref)
 
 
 def arbiter(commands: Sequence[Any]) -> Any:
