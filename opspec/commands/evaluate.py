@@ -237,12 +237,13 @@ def run(args: argparse.Namespace) -> int:
         store = ResultStore(out, create=True)
         _store_parameters(store, plan, definitions, __version__)
     with store, contextlib.ExitStack() as stack:
-        on_trace = _trace_writers(stack, store.folder, plan, resumed=args.resume)
+        on_trace = _trace_writers(stack, store.folder, plan)
         progress = make_progress(sys.stderr, quiet=args.quiet or args.json,
                                  label="users" if len(plan.designs) == 1 else "replications")
         try:
             outcome = run_evaluation(plan, store, workers=workers, scheduler=args.scheduler,
-                                     progress=progress, on_trace=on_trace)
+                                     progress=progress, on_trace=on_trace,
+                                     retrace=bool(args.resume and plan.export))
         except KeyboardInterrupt:
             stored = sum(len(store.finished(d.label)) for d in plan.designs)
             print(f"evaluate: stopped; {stored} of {plan.users * len(plan.designs)} "
@@ -304,23 +305,18 @@ def _finite(value: Any) -> Any:
     return value
 
 
-def _trace_writers(stack: contextlib.ExitStack, folder: Path, plan: Any, *, resumed: bool
-                   ) -> Any:
+def _trace_writers(stack: contextlib.ExitStack, folder: Path, plan: Any) -> Any:
     if not plan.export:
         return None
     from opspec.engine.trace import TraceEvent
     from opspec.evaluation.exporters import JsonlTraceWriter, XesWriter
 
-    suffix = ""
-    if resumed:   # never overwrite traces an earlier (interrupted) run wrote
-        n = 1
-        while any((folder / f"traces.resume-{n}.{fmt}").exists() for fmt in plan.export):
-            n += 1
-        suffix = f".resume-{n}"
+    # a resumed run simulates the stored users again for their traces (run_evaluation's
+    # retrace), so each file is written whole again; the interrupted run's .partial goes
     attrs = {"spec": plan.design("A").spec, "seed": str(plan.seed)}
     writers: list[XesWriter | JsonlTraceWriter] = []
     for fmt in plan.export:
-        path = folder / f"traces{suffix}.{fmt}"
+        path = folder / f"traces.{fmt}"
         writer: XesWriter | JsonlTraceWriter = (
             XesWriter(path, log_attributes=attrs) if fmt == "xes"
             else JsonlTraceWriter(path, log_attributes=attrs))

@@ -191,8 +191,12 @@ def _dead_worker(error: BaseException) -> str:
 
 def run_evaluation(plan: EvaluationPlan, store: ResultStore, *, workers: int = 1,
                    scheduler: str | None = None, progress: Progress | None = None,
-                   on_trace: TraceSink | None = None) -> RunOutcome:
+                   on_trace: TraceSink | None = None, retrace: bool = False) -> RunOutcome:
     """Run every replication of ``plan`` not yet stored as done, storing each as it ends.
+
+    ``retrace`` (resuming a run that exports traces): the users already stored are simulated
+    again, only for their traces — the same seed gives the same trace — so that the trace
+    files of the resumed run hold every user, not just the ones run after the interruption.
 
     A worker process that dies (killed, out of memory) breaks its process pool and every chunk
     in flight with it: those chunks run once more in a fresh pool, and what fails again is
@@ -204,14 +208,16 @@ def run_evaluation(plan: EvaluationPlan, store: ResultStore, *, workers: int = 1
     skipped = 0
     # a user-month of the dispenser is ~0.4 MB of trace: small chunks when traces travel back
     most = EXPORT_CHUNK if plan.export else 50
+    stored: set[tuple[str, int]] = set()
     for design in plan.designs:
         finished = store.finished(design.label)
         skipped += len(finished)
-        todo = [u for u in range(plan.users) if u not in finished]
+        stored.update((design.label, u) for u in finished)
+        todo = [u for u in range(plan.users) if retrace or u not in finished]
         pending.extend((design.label, chunk)
                        for chunk in chunks(todo, max(1, workers), most=most))
     total = plan.users * len(plan.designs)
-    progress.start(total, skipped)
+    progress.start(total, 0 if retrace else skipped)
     doc = plan.to_json()
     done = failed = 0
 
@@ -221,6 +227,8 @@ def run_evaluation(plan: EvaluationPlan, store: ResultStore, *, workers: int = 1
             if on_trace is not None and record.trace is not None:
                 on_trace(record)
             record.trace = None
+            if (record.design, record.user) in stored:
+                continue            # re-run for its trace only: the stored result stands
             store.add(record)
             if record.status == "done":
                 done += 1

@@ -220,3 +220,30 @@ def test_a_report_that_cannot_be_written_keeps_the_results_and_resume_writes_it(
     status, doc, _ = evaluate("--resume", "--out", str(out))
     assert status == 0 and Path(doc["report"]).is_file()
     assert doc["metrics"]["doses_due"]["total"] == 3 * 4
+
+
+def test_resumed_export_has_every_users_trace_in_one_file(tmp_path, evaluate):
+    """An export interrupted part-way (users 0-2 stored, their cases in traces.jsonl.partial)
+    and resumed gives one complete traces.jsonl, equal to an uninterrupted run's."""
+    args = [str(SPEC), "--users", "6", "--days", "1", "--seed", "3", "--workers", "1",
+            "--export", "jsonl"]
+    status, _, _ = evaluate(*args, "--out", str(tmp_path / "whole"))
+    assert status == 0
+    whole = (tmp_path / "whole" / "traces.jsonl").read_text(encoding="utf-8")
+    # the interrupted run: the same, with users 3-5 not stored and the trace file cut short
+    cut = tmp_path / "cut"
+    evaluate(*args, "--out", str(cut))
+    with sqlite3.connect(cut / "results.sqlite") as conn:
+        conn.execute("DELETE FROM replication WHERE user >= 3")
+    lines = (cut / "traces.jsonl").read_text(encoding="utf-8").splitlines(keepends=True)
+    (cut / "traces.jsonl").unlink()
+    (cut / "traces.jsonl.partial").write_text("".join(lines[:len(lines) // 2]),
+                                              encoding="utf-8")
+    status, doc, err = evaluate("--resume", "--out", str(cut), "--workers", "1")
+    assert status == 0, err
+    assert (cut / "traces.jsonl").read_text(encoding="utf-8") == whole
+    assert not (cut / "traces.jsonl.partial").exists()
+    # and the resumed results are those of an uninterrupted run (re-traced users not doubled)
+    _, again, _ = evaluate(str(SPEC), "--users", "6", "--days", "1", "--seed", "3",
+                           "--workers", "1", "--out", str(tmp_path / "again"))
+    assert metrics_of(doc) == metrics_of(again)
