@@ -95,6 +95,12 @@ class DeviceBinding:
         self._inflight: _Job | None = None
         self._waiting: list[WorkItem] = []          # passive operations awaiting an event
         self._timed_out: deque[_Job] = deque()       # replies we gave up waiting for
+        # after a timeout the line is held (nothing is sent) until the late reply comes or
+        # the late-reply window passes; ``_resend`` is the job to send again then, if any
+        self._held: _Job | None = None
+        self._resend: _Job | None = None
+        self._hold_timer: threading.Timer | None = None
+        self._holds = 0
         self._seq = 0
         self._closed = threading.Event()
         self._newline = profile.serial.newline.encode()
@@ -180,6 +186,8 @@ class DeviceBinding:
         for job in (*self._queue, self._inflight):
             if job is not None and job.timer is not None:
                 job.timer.cancel()
+        if self._hold_timer is not None:
+            self._hold_timer.cancel()
         reader, self._reader = self._reader, None
         if reader is not None:
             reader.shutdown()
@@ -219,7 +227,8 @@ class DeviceBinding:
     # ------------------------------------------------------------------ sending
     def _pump(self) -> None:
         """Send the next queued command if the line is free (one command at a time)."""
-        while self._inflight is None and self._queue and self._connection == "open":
+        while (self._inflight is None and self._held is None and self._queue
+               and self._connection == "open"):
             job = self._queue.popleft()
             if job.withdrawn:
                 continue
@@ -273,6 +282,11 @@ class DeviceBinding:
                 if template.match(text) is not None:
                     self._answered(job, text, at, None, exception)
                     return
+        held = self._held
+        if job is None and held is not None and self._answers(held.op, text):
+            self._late_reply(held, text, at)
+            self._release(self._holds)          # the line is clean again: go on at once
+            return
         for rule in self.profile.events.values():
             values = rule.line.match(text)
             if values is not None:
@@ -283,10 +297,7 @@ class DeviceBinding:
         if job is not None:
             self._attempt_failed(job, "garbage", f"unexpected reply {text!r} to {job.line!r}")
         elif self._timed_out and self._is_reply(text):
-            late = self._timed_out.popleft()
-            self._fault("late-reply", f"{self._who(late.item)}: reply {text!r} to {late.line!r} "
-                        f"came after its {late.op.timeout_s * 1000:g} ms timeout", item=late.item,
-                        line=late.line, reply=text, latency=at - late.sent_at)
+            self._late_reply(self._timed_out.popleft(), text, at)
         else:
             self._fault("unexpected-line", f"{self._label()}: unexpected line {text!r} from "
                         f"{self.url}", reply=text)
@@ -300,6 +311,19 @@ class DeviceBinding:
                                  f"{message}")
         else:
             self._fault("garbage", f"{self._label()}: {message}")
+
+    def _late_reply(self, late: _Job, text: str, at: float) -> None:
+        """A reply to a command that timed out: a fault, never an answer (its latency is in
+        the fault, not among the round trips)."""
+        if late in self._timed_out:
+            self._timed_out.remove(late)
+        self._fault("late-reply", f"{self._who(late.item)}: reply {text!r} to {late.line!r} "
+                    f"came after its {late.op.timeout_s * 1000:g} ms timeout", item=late.item,
+                    line=late.line, reply=text, latency=at - late.sent_at, attempt=late.attempts)
+
+    @staticmethod
+    def _answers(op: Operation, text: str) -> bool:
+        return any(t.match(text) is not None for t in (*op.ok, *(e[0] for e in op.errors)))
 
     def _is_reply(self, text: str) -> bool:
         return any(t.match(text) is not None
@@ -351,8 +375,40 @@ class DeviceBinding:
         if job is None or job.seq != seq or self._connection == "closed":
             return  # answered (or superseded) meanwhile
         self._timed_out.append(job)
-        self._attempt_failed(job, "timeout", f"{self._who(job.item)}: no reply to {job.line!r} "
-                             f"within {job.op.timeout_s * 1000:g} ms")
+        self._finish(job)
+        fallback = self.profile.fallback_for(job.item.participant)
+        retry = job.attempts <= fallback.retries
+        job.last_fault = "timeout"
+        self._fault("timeout", f"{self._who(job.item)}: no reply to {job.line!r} within "
+                    f"{job.op.timeout_s * 1000:g} ms", item=job.item,
+                    action="retry" if retry else fallback.then, line=job.line,
+                    attempt=job.attempts)
+        if not retry:   # the fallback applies now; the line is still held for the late reply
+            self._give_up(job, f"timeout after {job.attempts} attempt(s)")
+        self._hold(job, job if retry else None, fallback.late_reply_s)
+
+    def _hold(self, job: _Job, resend: _Job | None, window_s: float | None) -> None:
+        """Send nothing until ``job``'s late reply comes or ``window_s`` (default: its
+        timeout) passes; then resend ``resend`` (if any) and the queue."""
+        self._holds += 1
+        self._held, self._resend = job, resend
+        timer = threading.Timer(job.op.timeout_s if window_s is None else window_s,
+                                self.inbox.post, (partial(self._release, self._holds),))
+        timer.daemon = True
+        self._hold_timer = timer
+        timer.start()
+
+    def _release(self, hold: int) -> None:
+        """End the hold ``hold`` (if it is still the current one) and go on sending."""
+        if hold != self._holds or self._held is None:
+            return
+        if self._hold_timer is not None:
+            self._hold_timer.cancel()
+        resend, self._held, self._resend, self._hold_timer = self._resend, None, None, None
+        if resend is not None:
+            self._queue.appendleft(resend)
+        if self._connection == "open":
+            self._pump()
 
     def _attempt_failed(self, job: _Job, fault: str, message: str) -> None:
         """A timeout or garbage: report, then retry or apply the participant's fallback."""
@@ -410,6 +466,13 @@ class DeviceBinding:
         # block (pySerial's socket:// sleeps 0.3 s in close()), which would stall a
         # wall-clock run by thousands of simulated seconds at high speed factors
         dead, self._reader = self._reader, None
+        if self._held is not None:        # a reopened line starts clean: no hold needed
+            self._holds += 1
+            if self._hold_timer is not None:
+                self._hold_timer.cancel()
+            if self._resend is not None:
+                self._queue.appendleft(self._resend)
+            self._held = self._resend = self._hold_timer = None
         job, self._inflight = self._inflight, None
         if job is not None:
             if job.timer is not None:

@@ -153,6 +153,11 @@ class Fallback:
     when that is exhausted, ``then``: ``simulate`` (the participant continues on the
     simulated device) or ``abort`` (the activity fails with ``exception``, following its
     EXCEPTION transition; later activities fail the same way).
+
+    ``late_reply_s``: after a timeout the line is held this long (``None``: the command's own
+    timeout) before anything else is sent, so that a late reply is reported as the timed-out
+    command's ``late-reply`` instead of being taken as the answer to the retry or to the next
+    command (line protocols carry no sequence numbers). A late reply ends the hold early.
     """
 
     retries: int = 1
@@ -160,6 +165,7 @@ class Fallback:
     reconnect_delay_s: float = 0.2
     then: FallbackAction = "simulate"
     exception: str = "DeviceFault"
+    late_reply_s: float | None = None
 
 
 @dataclass(frozen=True, slots=True)
@@ -481,6 +487,8 @@ def _one_fallback(table: _Table, base: Fallback) -> Fallback:
         reconnect_attempts=table.integer("reconnect_attempts", base.reconnect_attempts),
         reconnect_delay_s=table.millis("reconnect_delay_ms", base.reconnect_delay_s),
         then=then, exception=exception,
+        late_reply_s=(table.millis("late_reply_ms", 0.0) if "late_reply_ms" in table.data
+                      else base.late_reply_s),
     )
 
 

@@ -4,13 +4,15 @@
 from __future__ import annotations
 
 from collections.abc import Callable
+from pathlib import Path
 
 import pytest
 
 from opspec.bindings import DEVICE_EXCHANGE, DEVICE_NOTE, DeviceBinding
-from opspec.bindings.profiles import DeviceProfile
+from opspec.bindings.profiles import DeviceProfile, load_profile
 from opspec.engine.performers import Performer
 
+from .conftest import DATA, DEVICES
 from .fakes import FakeSession, item, run_until
 
 Binder = Callable[..., DeviceBinding]
@@ -112,19 +114,45 @@ def test_garbage_is_a_named_fault_and_uses_the_fallback(
     assert "GARBLED" in fault["message"]
 
 
-def test_late_reply_is_a_timeout_then_a_late_reply_fault(
-        binder: Binder, session: FakeSession, fast_profile: DeviceProfile,
-        fast_url: Callable[[str], str]) -> None:
-    binding = binder(["dispenser"], fast_url("late:900"), fast_profile)
+def _profile_with(tmp_path: Path, fallback_line: str) -> tuple[DeviceProfile, str]:
+    """The fast profile with one more line in its last table, ``[fallback.dispenser]``."""
+    path = tmp_path / "test_dispenser.toml"
+    path.write_text((DATA / "test_dispenser.toml").read_text(encoding="utf-8")
+                    + fallback_line + "\n", encoding="utf-8")
+    return load_profile(path), f"emulator://{path}"
+
+
+def test_a_late_reply_is_the_timed_out_commands_not_the_answer_to_the_retry(
+        binder: Binder, session: FakeSession, tmp_path: Path) -> None:
+    # 300 ms timeouts, replies 700 ms late, the line held up to 2 s for a late reply
+    profile, url = _profile_with(tmp_path, "late_reply_ms = 2000")
+    binding = binder(["dispenser"], url + "?fault=late:700", profile)
     drawer = item("dispense", "dispenser", slot=1)
     binding.offer(drawer)
     run_until(binding.inbox, session, lambda: session.faults().count("late-reply") == 2,
               timeout=15)
-    # both attempts timed out (300 ms) long before their replies (900 ms) came
-    assert session.faults() == ["timeout", "timeout", "late-reply", "late-reply"]
+    faults = session.kinds("fault")
+    # before: the first reply answered the retry (a 0.4 s round trip, no fault for it)
+    assert [(f["fault"], f["attempt"]) for f in faults] == [
+        ("timeout", 1), ("late-reply", 1), ("timeout", 2), ("late-reply", 2)]
+    assert [f["action"] for f in faults if f["fault"] == "timeout"] == ["retry", "abort"]
+    assert all(f["latency"] >= 0.7 and f["reply"] == "OK DISPENSED 1"
+               for f in faults if f["fault"] == "late-reply")
+    assert [f[1] for f in session.failed] == ["DispenserFault"]
+    assert binding.latencies == [] and session.kinds(DEVICE_EXCHANGE) == []
+
+
+def test_a_reply_later_than_the_hold_is_still_a_late_reply_fault(
+        binder: Binder, session: FakeSession, tmp_path: Path) -> None:
+    # no retry, the line held only 100 ms: the reply (900 ms) comes with nothing in flight
+    profile, url = _profile_with(tmp_path, "retries = 0\nlate_reply_ms = 100")
+    binding = binder(["dispenser"], url + "?fault=late:900", profile)
+    binding.offer(item("dispense", "dispenser", slot=1))
+    run_until(binding.inbox, session, lambda: "late-reply" in session.faults(), timeout=15)
+    assert session.faults() == ["timeout", "late-reply"]
     assert [f[1] for f in session.failed] == ["DispenserFault"]
     late = session.kinds("fault")[-1]
-    assert late["latency"] > 0.3 and late["reply"] == "OK DISPENSED 1"
+    assert late["reply"] == "OK DISPENSED 1" and late["latency"] >= 0.9
 
 
 def test_disconnect_mid_run_reconnects_and_resends(
@@ -190,3 +218,23 @@ def test_plain_loop_url_echo_is_reported_as_garbage(
     assert session.faults() == ["garbage", "garbage"]
     assert "unexpected reply 'ALARM ON' to 'ALARM ON'" in session.kinds("fault")[0]["message"]
     assert session.completed == [(alarm, None)]  # simulated, after the retry failed too
+
+
+def test_the_shipped_dispenser_never_sends_dispense_twice(
+        binder: Binder, session: FakeSession, tmp_path: Path) -> None:
+    # the shipped profile with its 3 s drawer timeout cut to 200 ms (everything else as shipped)
+    text = (DEVICES / "medication_dispenser.toml").read_text(encoding="utf-8")
+    assert "timeout_ms = 3000" in text
+    path = tmp_path / "medication_dispenser.toml"
+    path.write_text(text.replace("timeout_ms = 3000", "timeout_ms = 200"), encoding="utf-8")
+    binding = binder(["alarm", "dispenser"], f"emulator://{path}?fault=silent",
+                     load_profile(path))
+    binding.offer(item("dispense", "dispenser", slot=1))
+    binding.offer(item("alarm_on"))
+    run_until(binding.inbox, session, lambda: len(session.answered) == 2, timeout=15)
+    device = binding._port.device  # type: ignore[union-attr]  # the emulated board
+    # the drawer: one DISPENSE, then DispenserFault; the alarm: sent, resent, simulated
+    assert device.commands == 1 + 2
+    assert [f[1] for f in session.failed] == ["DispenserFault"]
+    assert [(f["command"], f["action"]) for f in session.kinds("fault")] == [
+        ("DISPENSE 1", "abort"), ("ALARM ON", "retry"), ("ALARM ON", "simulate")]

@@ -62,7 +62,8 @@ def test_dispenser_profile_serves_alarm_and_dispenser_with_button_raising_trg_1(
     assert profile.fallback_for("dispenser").then == "abort"
     assert profile.fallback_for("dispenser").exception == "DispenserFault"
     # per-participant fallback inherits what it does not override
-    assert profile.fallback_for("dispenser").retries == profile.fallback.retries
+    # DISPENSE is not idempotent: never resent (the alarm commands are, once)
+    assert (profile.fallback.retries, profile.fallback_for("dispenser").retries) == (1, 0)
 
 
 def test_operation_is_found_by_application_then_activity() -> None:

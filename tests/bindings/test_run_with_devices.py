@@ -109,16 +109,18 @@ def test_misbehaving_alarm_is_a_named_fault_and_the_alarm_goes_on_simulated(
         fault, named, board, capsys, tmp_path):
     server = board(on="pty", fault=fault, profile=DATA / "test_dispenser.toml")
     trace = tmp_path / "trace.jsonl"
-    # reply timeouts are wall-clock (300 ms): at 20,000x two of them span about 3.3 h
-    status, doc, _ = run(capsys, "--until", "43000", "--realtime", "--speed", "20000",
+    # reply timeouts are wall-clock (300 ms): at 20,000x two of them and the 300 ms hold
+    # for a late reply between them span about 5 h
+    status, doc, _ = run(capsys, "--until", "50000", "--realtime", "--speed", "20000",
                          "--json", "--bind", f"alarm:test_dispenser={server.url}",
                          "--devices", str(DATA), "--trace", str(trace),
                          "--script", script(tmp_path, ("after trg_2 30s", "press_report")))
     faults = doc["devices"]["alarm"]["faults"]
     assert any(f["fault"] == named for f in faults)
     assert doc["devices"]["alarm"]["mode"]["alarm"] == "simulated"
-    # the device's fallback kept the dose going: the user still got it
-    assert doc["metrics"]["doses_taken"]["total"] == 1
+    # the device's fallback kept the dose going: the user still got it (and the 12:00 dose
+    # too, when the faults were over quickly enough)
+    assert doc["metrics"]["doses_taken"]["total"] >= 1
     kinds = [json.loads(line)["kind"] for line in trace.read_text().splitlines()[1:]]
     assert "fault" in kinds and kinds[-1] == "run.ended"
     assert status == 1           # a device fault is a problem worth an exit status
