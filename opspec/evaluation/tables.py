@@ -10,7 +10,7 @@ from opspec.evaluation.plan import span
 __all__ = ["comparison_rows", "fmt", "is_rate", "metric_rows", "monitor_rows", "per_user_rows",
            "print_summary", "table"]
 
-METRIC_HEADERS = ("metric", "kind", "estimate", "95 % CI", "median", "p95", "n")
+METRIC_HEADERS = ("metric", "kind", "estimate", "95 % CI", "sd", "median", "p95", "n")
 PER_USER_HEADERS = ("metric", "users", "mean", "sd", "95 % CI", "median", "p95")
 COMPARE_HEADERS = ("metric", "A", "B", "B − A", "95 % CI", "")
 MONITOR_HEADERS = ("monitor", "violations", "users affected", "per user-day", "95 % CI",
@@ -48,17 +48,19 @@ def metric_rows(metrics: Mapping[str, Mapping[str, Any]]) -> list[tuple[str, ...
     rows: list[tuple[str, ...]] = []
     for name, s in metrics.items():
         kind = s["kind"]
+        # sd: of the users' totals for a count, of all observations for a duration
         if kind == "count":
-            rows.append((name, "count", f"{fmt(s['mean'])} per user", _ci(s),
+            rows.append((name, "count", f"{fmt(s['mean'])} per user", _ci(s), fmt(s["sd"]),
                          fmt(s["median"]), fmt(s["p95"]), f"total {s['total']}"))
         elif kind == "duration":
             unit = s.get("unit") or "s"
             rows.append((name, "duration", fmt(s["mean"], unit), _ci(s, unit),
-                         fmt(s["median"], unit), fmt(s["p95"], unit), str(s["n"])))
+                         fmt(s["sd"], unit), fmt(s["median"], unit), fmt(s["p95"], unit),
+                         str(s["n"])))
         else:
             percent = is_rate(name, s)
             rows.append((name, "ratio", fmt(s["value"], percent=percent),
-                         _ci(s, percent=percent), "–", "–", ""))
+                         _ci(s, percent=percent), "–", "–", "–", ""))
     return rows
 
 
