@@ -36,6 +36,7 @@ from opspec.xpdl.sisarl_values import (
 
 __all__ = [
     "ACTIVITY_DIRECTIVES",
+    "MAX_ATTRIBUTES",
     "PACKAGE_DIRECTIVES",
     "PROCESS_DIRECTIVES",
     "Directive",
@@ -62,6 +63,10 @@ ACTIVITY_DIRECTIVES = ("AutoRun", "PriorityIncrement", "StartTrigger", "EndTrigg
                        "CpuDemand", "Duration", "BuiltIn")
 PACKAGE_DIRECTIVES = ("Metrics", "Modes", "Monitor", "World", "WorldFile", "RunLength")
 
+#: Most attributes one Package, WorkflowProcess or Activity element may carry (XPDL defines
+#: fewer than twenty); more is a damaged or hostile file, reported as ``too-many-attributes``.
+MAX_ATTRIBUTES = 1024
+
 
 def collect(element: etree._Element, ctx: BuildContext, known: tuple[str, ...],
             what: str) -> dict[str, Directive]:
@@ -80,9 +85,23 @@ def collect(element: etree._Element, ctx: BuildContext, known: tuple[str, ...],
                                    "last one counts", "remove one of them"))
         found[directive.name] = directive
 
-    for name, value in element.attrib.items():
-        if name.startswith(f"{{{OPSPEC}}}"):
-            add(Directive(name.split("}", 1)[1], value, None, ctx.loc(element)))
+    # ``attrib.items()`` is quadratic in lxml (each item is looked up from the start of the
+    # element's attribute list): a hostile element with 200,000 attributes took minutes.
+    # ``keys()`` is linear, and only the few opspec-namespaced names are then looked up.
+    count = len(element.attrib)
+    if count > MAX_ATTRIBUTES:
+        ctx.diagnostics.append(_diag(
+            ctx.loc(element), "error", "too-many-attributes",
+            f"{what} has {count:,} attributes, more than the limit of {MAX_ATTRIBUTES}; "
+            "its opspec: attributes were not read",
+            "XPDL elements need a handful of attributes; remove the extra ones (was the "
+            "file generated or damaged?)"))
+    else:
+        prefix = f"{{{OPSPEC}}}"
+        for name in element.keys():
+            if name.startswith(prefix):
+                add(Directive(name[len(prefix):], element.get(name) or "", None,
+                              ctx.loc(element)))
     for ext in grandchildren(element, "ExtendedAttributes", "ExtendedAttribute"):
         name = ext.get("Name") or ""
         if name.startswith(OPSPEC_PREFIX):

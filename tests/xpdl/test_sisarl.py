@@ -351,3 +351,24 @@ def test_run_length_survives_writing_and_reading_back() -> None:
     assert result.package is not None
     again = parse_bytes(write_xpdl(result.package), path="w.xpdl")
     assert again.package is not None and again.package.run_length == 4500.0
+
+
+@pytest.mark.parametrize("where", ["process", "activity"])
+def test_element_with_thousands_of_attributes_is_refused_at_its_line(where: str) -> None:
+    # attrib.items() is quadratic in lxml: 200,000 attributes used to hang the loader
+    many = "".join(f' x{i}="1"' for i in range(5000))
+    result = (load_process(attrs=many) if where == "process"
+              else load_process(activity_attrs=many))
+    errors = [d for d in result.diagnostics if d.code == "too-many-attributes"]
+    assert len(errors) == 1 and errors[0].location.line == 2
+    assert "5,002 attributes" in errors[0].message or "5,001 attributes" in errors[0].message
+    assert "\n" not in str(errors[0])
+
+
+def test_opspec_attributes_under_the_limit_are_all_read() -> None:
+    filler = "".join(f' x{i}="1"' for i in range(500))
+    result = load_process(attrs=f' opspec:Priority="3"{filler}',
+                          activity_attrs=f'{filler} opspec:AutoRun="true"')
+    assert not result.errors, [str(d) for d in result.diagnostics]
+    assert process(result).directives.priority == 3
+    assert activity(result).directives.auto_run is True
