@@ -28,9 +28,19 @@ from opspec.bindings.profiles import default_profiles_dir
 from opspec.bindings.transport import PortInfo
 
 if TYPE_CHECKING:
+    from opspec.engine.compiled import CompiledPackage
+    from opspec.engine.config import EngineConfig
     from opspec.engine.simulation import Simulation
 
 __all__ = ["AttachedDevices", "attach_devices"]
+
+
+#: Wall seconds an emulator-only run takes by default (see AttachedDevices.clock).
+EMULATOR_RUN_S = 60.0
+
+
+def _in_process(url: str | None) -> bool:
+    return url is not None and url.startswith(("emulator://", "loop://"))
 
 
 def _ms(value: float) -> float | None:
@@ -53,8 +63,48 @@ class AttachedDevices:
 
     @property
     def requires_wall_clock(self) -> bool:
-        """Whether a real transport is open, so the run must follow the wall clock."""
+        """Whether a transport is open, so the run must follow the wall clock: the device
+        (real or emulated) answers on its own threads, in wall time."""
         return any(b.requires_wall_clock for b in self.bindings)
+
+    @property
+    def real_devices(self) -> bool:
+        """Whether a transport other than an in-process one (``emulator://``, ``loop://``)
+        is open: a device outside opspec, whose timing is its own."""
+        return any(b.requires_wall_clock and not _in_process(b.url) for b in self.bindings)
+
+    def clock(self, config: EngineConfig, speed: float | None,
+              horizon: float | None) -> tuple[EngineConfig, str | None]:
+        """The engine configuration a run with these devices needs, and a line saying why
+        (``None``: nothing to say). For a run that is not already in wall-clock mode:
+
+        * a real device: wall clock at ``speed`` (default 1x: the device lives in real time);
+        * only in-process emulators: wall clock too, since their replies, late replies,
+          timed events and the profile's timeouts happen on their own threads in wall time,
+          but not at 1x: at ``speed``, by default fast enough that the run takes about a
+          minute (:data:`EMULATOR_RUN_S`), or 60x without a horizon;
+        * no transport open (``auto`` fell back to the simulated device): a plain
+          simulation, and ``speed`` has no effect (said so).
+        """
+        if config.realtime:
+            return config, None
+        if not self.requires_wall_clock:
+            if speed is None:
+                return config, None
+            return config, (f"--speed {speed:g} has no effect: no device port is open (the "
+                            "simulated devices run in simulated time), so this is a plain "
+                            "simulation; add --realtime to follow the wall clock")
+        if self.real_devices:
+            chosen = speed if speed is not None else 1.0
+            return (config.with_options(realtime=True, speed=chosen),
+                    "a real device is bound: running on the wall clock")
+        chosen = speed if speed is not None else (
+            max(1.0, horizon / EMULATOR_RUN_S) if horizon is not None else 60.0)
+        note = ("only in-process emulators are bound: running on the wall clock (their "
+                "replies and the profiles' timeouts are wall time)")
+        if speed is None:
+            note += f", at {chosen:g}x by default (set it with --speed)"
+        return config.with_options(realtime=True, speed=chosen), note
 
     def install(self, sim: Simulation) -> None:
         """Run device callbacks on the engine's thread: every post to the inbox schedules a
@@ -112,13 +162,18 @@ class AttachedDevices:
 
 def attach_devices(bind_args: Sequence[str], profiles_dir: str | Path | None = None, *,
                    settle_s: float | None = None,
-                   ports: Sequence[PortInfo] | None = None) -> AttachedDevices:
+                   ports: Sequence[PortInfo] | None = None,
+                   spec: CompiledPackage | None = None) -> AttachedDevices:
     """Open every ``PARTICIPANT[:PROFILE]=URL`` of ``bind_args`` (profiles from
     ``profiles_dir``, default :func:`default_profiles_dir`). Raises
     :class:`~opspec.errors.BindingError` — with no port left open — for a malformed argument,
-    an unknown participant or profile, or an explicit port that cannot be opened."""
+    an unknown participant or profile, a participant ``spec`` does not have (when given), or
+    an explicit port that cannot be opened."""
     inbox = Inbox()
     folder = Path(profiles_dir) if profiles_dir is not None else default_profiles_dir()
+    participants = None if spec is None else {
+        p.id for p in spec.package.participants} | {
+        p.id for process in spec.package.processes for p in process.participants}
     bindings = bindings_from_args(bind_args, folder, inbox=inbox, settle_s=settle_s,
-                                  ports=ports)
+                                  ports=ports, participants=participants)
     return AttachedDevices(bindings, inbox)

@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import os
 import time
-from collections.abc import Sequence
+from collections.abc import Collection, Sequence
 from pathlib import Path
 
 from opspec.bindings.binding import DeviceBinding
@@ -113,10 +113,20 @@ def _choose(spec: BindSpec, profiles: Sequence[DeviceProfile], folder: Path) -> 
     return serving[0]
 
 
+def _bindable(participants: Collection[str], profiles: Sequence[DeviceProfile]) -> str:
+    served = {name for profile in profiles for name in profile.participants}
+    return ", ".join(sorted(name for name in participants if name in served))
+
+
 def bindings_from_args(specs: Sequence[str], profiles_dir: str | os.PathLike[str], *,
                        inbox: Inbox | None = None, settle_s: float | None = None,
-                       ports: Sequence[PortInfo] | None = None) -> list[DeviceBinding]:
+                       ports: Sequence[PortInfo] | None = None,
+                       participants: Collection[str] | None = None) -> list[DeviceBinding]:
     """Bindings for ``--bind`` arguments, all posting into one ``inbox`` (created if None).
+
+    ``participants``: the spec's participant ids; a ``--bind`` naming another is refused
+    (with the bindable ones: the spec's participants that a profile serves), before any port
+    is opened. ``None`` skips the check (no spec at hand).
 
     Participants bound to the same profile and the same URL share one binding (one port,
     one reader thread). Raises BindingError, before any port stays open, for a malformed
@@ -132,6 +142,11 @@ def bindings_from_args(specs: Sequence[str], profiles_dir: str | os.PathLike[str
     seen: dict[str, str] = {}
     for text in specs:
         spec = parse_bind_spec(text)
+        if participants is not None and spec.participant not in participants:
+            raise BindingError(
+                f"--bind {text!r}: the spec has no participant {spec.participant!r}",
+                hint=f"bindable participants of this spec: "
+                f"{_bindable(participants, profiles) or 'none (no profile serves any)'}")
         if spec.participant in seen:
             raise BindingError(f"participant {spec.participant!r} is bound twice "
                                f"({seen[spec.participant]!r} and {text!r})",
@@ -152,8 +167,8 @@ def bindings_from_args(specs: Sequence[str], profiles_dir: str | os.PathLike[str
         urls[url] = name
     made: list[DeviceBinding] = []
     try:
-        for (_, url), (profile, participants) in groups.items():
-            made.append(bind(participants, url, profile, inbox=shared, settle_s=settle_s,
+        for (_, url), (profile, names) in groups.items():
+            made.append(bind(names, url, profile, inbox=shared, settle_s=settle_s,
                              ports=ports))
     except BindingError:
         for binding in made:

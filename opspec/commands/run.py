@@ -114,9 +114,10 @@ def run(args: argparse.Namespace) -> int:
     performers: dict[str, Any] = bind_user(compiled, performer)
     performers.update(_world_performers(compiled, args.seed))
     with contextlib.ExitStack() as stack:
-        devices = _devices(args, stack)          # a port that won't open stops us here
-        if devices is not None and devices.requires_wall_clock and not config.realtime:
-            config = config.with_options(realtime=True, speed=args.speed or 1.0)
+        devices = _devices(args, stack, compiled)  # a port that won't open stops us here
+        clock_note = None
+        if devices is not None:                  # wall clock for devices, at which speed
+            config, clock_note = devices.clock(config, args.speed, horizon)
         if not args.json:
             length = ("until nothing is left to do" if horizon is None
                       else f"for {_span(horizon)} simulated")
@@ -131,8 +132,8 @@ def run(args: argparse.Namespace) -> int:
             for note in devices.notes:
                 if not args.json:
                     print(f"  device: {note}", file=out)
-            if devices.requires_wall_clock and not args.json and not args.realtime:
-                print("  a real device is bound: running on the wall clock", file=out)
+            if clock_note:
+                print(f"  {clock_note}", file=sys.stderr if args.json else out)
         sink = None
         if args.trace:
             sink = stack.enter_context(_open_sink(JsonlSink, args.trace, {
@@ -269,14 +270,14 @@ def _world_performers(compiled: Any, seed: int) -> dict[str, Any]:
     return dict(world_performers(compiled, seed=seed, user=0))
 
 
-def _devices(args: argparse.Namespace, stack: contextlib.ExitStack) -> Any:
+def _devices(args: argparse.Namespace, stack: contextlib.ExitStack, compiled: Any) -> Any:
     if not args.bind:
         return None
     try:
         from opspec.bindings.attach import attach_devices
     except ImportError:
         raise ConfigurationError("--bind is not available in this build of opspec") from None
-    return stack.enter_context(attach_devices(args.bind, args.devices))
+    return stack.enter_context(attach_devices(args.bind, args.devices, spec=compiled))
 
 
 @contextlib.contextmanager
