@@ -306,3 +306,35 @@ def test_a_misbehaving_alarm_retries_then_goes_on_simulated(
     assert run.report["alarm"]["mode"] == {"alarm": "simulated"}
     assert run.metric("doses_taken") == 1        # the simulated alarm kept the dose going
     assert run.kinds()[-1] == "run.ended"
+
+
+def test_the_clock_of_a_run_depends_on_what_is_bound(board: Any) -> None:
+    base = EngineConfig()
+    url = f"emulator://{DATA / f'{FAST}.toml'}"
+    with attach_devices([f"alarm:{FAST}={url}"], DATA) as devices:
+        assert devices.requires_wall_clock and not devices.real_devices
+        config, note = devices.clock(base, None, 36000.0)
+        # emulators need the wall clock (their replies are wall time) but not 1x
+        assert config.realtime and config.speed == 600.0
+        assert note is not None and "in-process emulators" in note and "600x" in note
+        assert devices.clock(base, 50.0, 36000.0)[0].speed == 50.0
+        assert devices.clock(base, None, None)[0].speed == 60.0
+    server = board(on="socket")
+    with attach_devices([f"alarm:{FAST}={server.url}"], DATA) as devices:
+        assert devices.real_devices
+        config, note = devices.clock(base, None, 36000.0)
+        assert config.realtime and config.speed == 1.0 and note is not None
+        assert "a real device is bound" in note
+    with attach_devices(["alarm=auto"], DEVICES, ports=[]) as devices:
+        assert devices.clock(base, None, 36000.0) == (base, None)
+        config, note = devices.clock(base, 5.0, 36000.0)
+        assert not config.realtime and note is not None and "has no effect" in note
+
+
+def test_attach_refuses_a_participant_the_spec_does_not_have() -> None:
+    compiled = compile_package(load_any_spec(SPEC))
+    with pytest.raises(BindingError, match=r"the spec has no participant 'pump'") as caught:
+        attach_devices(["pump=auto"], DEVICES, spec=compiled)
+    assert "bindable participants of this spec: alarm, dispenser" in str(caught.value)
+    with attach_devices(["alarm=auto"], DEVICES, spec=compiled, ports=[]) as devices:
+        assert set(devices.performers) == {"alarm"}

@@ -155,3 +155,34 @@ def test_device_faults_are_on_the_screen_with_the_fallback_taken(board, capsys, 
     assert "(then simulate)" in output
     assert "using the simulated alarm from now on" in output
     assert "Traceback" not in output
+
+
+def test_bind_of_a_participant_the_spec_lacks_is_a_usage_error_naming_the_bindable_ones(
+        capsys):
+    # before: accepted, announced as "a real device", and a 10 h run on the wall clock at 1x
+    status, _, output = run(capsys, "--timeline", "none",
+                            "--bind", "motors=emulator://cart_motors")
+    assert status == 2
+    assert "--bind 'motors=emulator://cart_motors': the spec has no participant 'motors'" \
+        in output
+    assert "bindable participants of this spec: alarm, dispenser" in output
+    assert "opspec run:" not in output          # nothing ran
+
+
+def test_speed_with_auto_falling_back_to_simulation_says_it_has_no_effect(capsys, tmp_path):
+    status, _, output = run(capsys, "--until", "29700", "--timeline", "none", "--speed", "5",
+                            "--bind", "alarm=auto",
+                            "--script", script(tmp_path, ("after trg_2 30s", "press_report")))
+    assert status == 0
+    assert "--speed 5 has no effect: no device port is open" in output
+    assert "wall clock" not in output.split("--speed 5 has no effect")[0]  # engine line
+
+
+def test_an_in_process_emulator_is_not_called_a_real_device(capsys, tmp_path):
+    status, _, output = run(capsys, "--until", "36000", "--speed", "20000", "--timeline",
+                            "none", "--bind", "alarm=emulator://medication_dispenser",
+                            "--script", script(tmp_path, ("after trg_2 30s", "press_report")))
+    assert status == 0
+    assert "real device" not in output
+    assert "only in-process emulators are bound: running on the wall clock" in output
+    assert "wall clock at 20000x" in output
