@@ -15,16 +15,63 @@ if TYPE_CHECKING:
     from opspec.engine.compiled import CompiledPackage
     from opspec.engine.performers import Performer
     from opspec.engine.trace import TraceListener
+    from opspec.errors import Diagnostic
     from opspec.model import Package
 
-__all__ = ["UserChoice", "choose_user", "companion_user_model", "load_any_spec"]
+__all__ = ["UserChoice", "choose_user", "companion_user_model", "engine_diagnostics",
+           "load_any_spec"]
 
 
 def load_any_spec(path: str | Path) -> Package:
-    """The package in ``path`` (XPDL or ``.wfs``); see :func:`opspec.xpdl.open_spec.open_spec`."""
+    """The package in ``path`` (XPDL or ``.wfs``), refused with every error ``opspec validate``
+    reports (a :class:`~opspec.errors.SpecError` listing them with ``path:line``): the run,
+    evaluate and walkthrough commands never execute a spec that validation rejects.
+    ``.wfs`` scripts (compiled from specs that passed) and paths that are not files open as
+    :func:`opspec.xpdl.open_spec.open_spec` does. The world is checked when it is built."""
     from opspec.xpdl.open_spec import open_spec
 
-    return open_spec(path)
+    target = Path(path)
+    if target.suffix == ".wfs" or not target.is_file():
+        return open_spec(path)
+    from opspec.errors import Severity, SpecError
+    from opspec.xpdl.validate import validate_spec
+
+    package, report = validate_spec(target, extra=engine_diagnostics)
+    errors = [d for d in report.diagnostics if d.severity is Severity.ERROR]
+    if errors or package is None:
+        raise SpecError.from_diagnostics(errors or report.diagnostics)
+    return package
+
+
+def engine_diagnostics(package: Package, *, world: bool = False) -> list[Diagnostic]:
+    """What only the engine and the bindings can judge, as diagnostics: the monitors the
+    spec declares (``bad-monitor``) and, with ``world``, whether its world can be built
+    (``bad-world``: an unknown world, a missing opspec:WorldFile, an unknown parameter, a
+    value of the wrong type, a start inside an obstacle)."""
+    from opspec.engine.compiled import compile_package
+    from opspec.engine.monitors import declared_monitors
+    from opspec.errors import Diagnostic, OpspecError, Severity, SourceLocation
+
+    try:
+        compiled = compile_package(package)
+    except OpspecError:
+        return []             # the structural checks report what keeps it from compiling
+    spec_file = SourceLocation(str(getattr(package, "source", None) or "<spec>"))
+    out: list[Diagnostic] = []
+    try:
+        declared_monitors(compiled)
+    except ConfigurationError as error:
+        out.append(Diagnostic(error.location or spec_file, Severity.ERROR, "bad-monitor",
+                              error.message, error.hint or ""))
+    if world:
+        from opspec.bindings.worlds import world_performers
+
+        try:
+            world_performers(compiled, seed=0, user=0)
+        except ConfigurationError as error:
+            out.append(Diagnostic(error.location or spec_file, Severity.ERROR, "bad-world",
+                                  error.message, error.hint or ""))
+    return out
 
 
 def companion_user_model(spec_path: str | Path) -> Path | None:

@@ -107,9 +107,9 @@ def _new_plan(args: argparse.Namespace) -> Any:
     designs = []
     run_lengths = []
     for label, path in specs:
-        from opspec.xpdl.open_spec import open_spec
+        from opspec.commands._spec import load_any_spec
 
-        package = open_spec(path)             # a broken spec stops here, with path:line
+        package = load_any_spec(path)         # a spec validate rejects stops here, path:line
         run_lengths.append(package.run_length)
         designs.append(Design(label, str(path), file_digest(path)))
     days = args.days

@@ -31,22 +31,11 @@ def register(subparsers: Any) -> None:
 
 
 def engine_checks(package: Any) -> list[Any]:
-    """What only the engine can judge: the monitors the spec declares (``bad-monitor``)."""
-    from opspec.engine.compiled import compile_package
-    from opspec.engine.monitors import declared_monitors
-    from opspec.errors import ConfigurationError, Diagnostic, OpspecError, Severity, SourceLocation
+    """What only the engine and the bindings can judge: the monitors the spec declares
+    (``bad-monitor``) and whether its world can be built (``bad-world``)."""
+    from opspec.commands._spec import engine_diagnostics
 
-    try:
-        compiled = compile_package(package)
-    except OpspecError:
-        return []             # the structural checks report what keeps it from compiling
-    try:
-        declared_monitors(compiled)
-    except ConfigurationError as error:
-        where = error.location or SourceLocation(str(getattr(package, "source", None) or "?"))
-        return [Diagnostic(where, Severity.ERROR, "bad-monitor", error.message,
-                           error.hint or "")]
-    return []
+    return engine_diagnostics(package, world=True)
 
 
 def run(args: argparse.Namespace) -> int:

@@ -8,7 +8,7 @@ parsed, immutable form. Times are seconds (floats) once parsed.
 from __future__ import annotations
 
 import enum
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 from opspec.errors import SourceLocation
 from opspec.model.expressions import Expression
@@ -128,6 +128,7 @@ class Mode:
     workflows: tuple[str, ...] = ()
     initial: bool = False
     source: str | None = None             # href of a package to load when switching, if any
+    location: SourceLocation | None = field(default=None, compare=False)  # where declared
 
 
 class MetricKind(enum.Enum):

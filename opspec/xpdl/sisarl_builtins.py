@@ -194,7 +194,8 @@ def build_modes(directive: Directive, ctx: BuildContext) -> tuple[Mode, ...]:
                 raise _Bad(element, f"Initial must be true or false, not {initial!r}",
                            "write Initial=\"true\"")
             mode = Mode(id=_need(element, "Id"), workflows=tuple((element.get("Workflows") or "").split()),
-                        initial=initial == "true", source=element.get("Source"))
+                        initial=initial == "true", source=element.get("Source"),
+                        location=ctx.loc(element))
         except _Bad as error:
             _report(ctx, error, "bad-mode")
             continue

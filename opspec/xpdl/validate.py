@@ -15,7 +15,7 @@ from collections.abc import Callable, Iterable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
-from opspec.errors import Diagnostic, Severity
+from opspec.errors import Diagnostic, Severity, SourceLocation
 from opspec.model import Package
 from opspec.model.checks import check_package
 from opspec.xpdl.loader import load_package
@@ -25,9 +25,11 @@ __all__ = [
     "SPEC_SUFFIXES",
     "FileReport",
     "merge_diagnostics",
+    "mode_source_diagnostics",
     "spec_files",
     "summary",
     "validate_file",
+    "validate_spec",
 ]
 
 SPEC_SUFFIXES = (".xpdl", ".xml")
@@ -113,6 +115,36 @@ def _promote(diagnostics: Iterable[Diagnostic]) -> tuple[Diagnostic, ...]:
         for d in diagnostics)
 
 
+def mode_source_diagnostics(package: Package, *, max_bytes: int = DEFAULT_MAX_BYTES
+                            ) -> list[Diagnostic]:
+    """Errors of the specs that modes load at run time (``<opspec:Mode Source="…">``,
+    relative to the package's file): a missing file, or the loaded spec's own reader errors,
+    each at the line of the mode (the engine would only find them at the mode change)."""
+    base = Path(package.source).parent if package.source else Path.cwd()
+    out: list[Diagnostic] = []
+    for mode in package.modes:
+        if not mode.source:
+            continue
+        where = mode.location or SourceLocation(package.source or "<spec>")
+        target = base / mode.source
+        if not target.is_file():
+            out.append(Diagnostic(
+                where, Severity.ERROR, "bad-mode",
+                f"mode {mode.id!r} loads {mode.source!r}, which does not exist ({target})",
+                "Source is relative to this spec's folder; fix the name or add the file"))
+            continue
+        loaded = load_package(target, max_bytes=max_bytes)
+        errors = [d for d in loaded.diagnostics if d.severity is Severity.ERROR]
+        if loaded.package is None or errors:
+            first = errors[0] if errors else None
+            out.append(Diagnostic(
+                where, Severity.ERROR, "bad-mode",
+                f"mode {mode.id!r} loads {mode.source!r}, which has errors"
+                + (f" (first: {first})" if first is not None else ""),
+                f"run opspec validate {target}"))
+    return out
+
+
 def validate_file(path: str | Path, *, strict: bool = False,
                   max_bytes: int = DEFAULT_MAX_BYTES,
                   extra: Callable[[Package], Iterable[Diagnostic]] | None = None
@@ -123,19 +155,29 @@ def validate_file(path: str | Path, *, strict: bool = False,
     runs further checks on a package that has no errors so far (layers above this one check
     what only they understand, e.g. the text of ``opspec:Monitor``).
     """
+    return validate_spec(path, strict=strict, max_bytes=max_bytes, extra=extra)[1]
+
+
+def validate_spec(path: str | Path, *, strict: bool = False,
+                  max_bytes: int = DEFAULT_MAX_BYTES,
+                  extra: Callable[[Package], Iterable[Diagnostic]] | None = None
+                  ) -> tuple[Package | None, FileReport]:
+    """:func:`validate_file`, also giving the package it loaded (``None`` when none could be
+    built): the commands that run a spec refuse it when the report is not ``ok``."""
     result = load_package(path, max_bytes=max_bytes)
     checks: list[Diagnostic] = []
     version = None
     if result.package is not None:
         version = result.package.version.value
         checks = list(check_package(result.package, packages=result.packages))
+        checks.extend(mode_source_diagnostics(result.package, max_bytes=max_bytes))
         if extra is not None and not any(
                 d.severity is Severity.ERROR for d in (*result.diagnostics, *checks)):
             checks.extend(extra(result.package))
     diagnostics = merge_diagnostics(result.diagnostics, checks)
     if strict:
         diagnostics = _promote(diagnostics)
-    return FileReport(str(path), version, diagnostics)
+    return result.package, FileReport(str(path), version, diagnostics)
 
 
 def spec_files(paths: Sequence[str | Path]) -> tuple[list[Path], list[str]]:

@@ -172,12 +172,13 @@ def test_spec_given_as_a_folder_is_a_usage_error(capsys):
     assert "give one specification file" in capsys.readouterr().err
 
 
-def test_deadlock_is_reported_with_exit_status_1(tmp_path, capsys):
+def test_a_deadlock_validation_finds_is_refused_before_the_run_with_status_1(capsys):
     deadlock = ROOT / "tests" / "validate" / "data" / "and_join_deadlock.xpdl"
     status = main(["run", str(deadlock)])
-    out = capsys.readouterr().out
+    captured = capsys.readouterr()
     assert status == 1
-    assert "deadlock:" in out and "join" in out
+    assert captured.out == ""                      # nothing ran
+    assert "and_join_deadlock.xpdl:21:" in captured.err and "deadlock" in captured.err
 
 
 def test_compiled_script_runs_like_the_xpdl(tmp_path, capsys):

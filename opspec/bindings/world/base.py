@@ -9,11 +9,40 @@ from typing import Any
 
 import numpy as np
 
-__all__ = ["RobotWorld", "World"]
+__all__ = ["RobotWorld", "World", "check_parameters"]
 
 Tracer = Callable[[str, Mapping[str, Any]], None]
 
 STEP_S = 0.05          # integration step: 5 cm at 1 m/s, well under the robot's size
+
+
+def _is_number(value: Any) -> bool:
+    return isinstance(value, int | float) and not isinstance(value, bool)
+
+
+def check_parameters(*, numbers: Mapping[str, Any] | None = None,
+                     vectors: Mapping[str, tuple[Any, int | None]] | None = None,
+                     boxes: Mapping[str, Any] | None = None) -> None:
+    """Raise ``ValueError`` naming the first parameter of the wrong type: ``numbers`` must be
+    numbers, ``vectors`` (value, length or None) lists of numbers of that length (a ``None``
+    value is allowed), ``boxes`` lists of such [x0, y0, x1, y1] lists. Worlds call it first,
+    so a user reads "width must be a number, not 'wide'", not a Python comparison error."""
+    for name, value in (numbers or {}).items():
+        if not _is_number(value):
+            raise ValueError(f"{name} must be a number, not {value!r}")
+    for name, (value, size) in (vectors or {}).items():
+        if value is None:
+            continue
+        if (isinstance(value, str | bytes) or not hasattr(value, "__len__")
+                or not all(_is_number(v) for v in value)
+                or (size is not None and len(value) != size)):
+            shape = f"a list of {size} numbers" if size else "a list of numbers"
+            raise ValueError(f"{name} must be {shape}, not {value!r}")
+    for name, value in (boxes or {}).items():
+        if isinstance(value, str | bytes) or not hasattr(value, "__iter__"):
+            raise ValueError(f"{name} must be a list of [x0, y0, x1, y1] boxes, not {value!r}")
+        for box in value:
+            check_parameters(vectors={f"each of {name}": (box, 4)})
 
 
 class World:

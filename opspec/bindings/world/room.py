@@ -16,7 +16,7 @@ from typing import Any
 
 import numpy as np
 
-from opspec.bindings.world.base import RobotWorld
+from opspec.bindings.world.base import RobotWorld, check_parameters
 from opspec.bindings.world.geometry import Box, ray_to_box, wrap_angle
 from opspec.bindings.world.robot import Robot
 
@@ -44,6 +44,11 @@ class RoomWorld(RobotWorld):
                  tag: Sequence[float] | None = None, tag_range: float = 0.8,
                  patient_id: str = "patient-17") -> None:
         super().__init__(rng)
+        check_parameters(numbers={"width": width, "height": height, "radius": radius,
+                                  "cell": cell, "range_noise": range_noise,
+                                  "drain_per_s": drain_per_s, "tag_range": tag_range},
+                         vectors={"start": (start, 3), "tag": (tag, 2)},
+                         boxes={"obstacles": obstacles})
         self.radius = float(radius)
         if not (self.radius > 0 and float(cell) > 0):
             raise ValueError(f"radius ({radius}) and cell ({cell}) must be positive")

@@ -18,7 +18,7 @@ from typing import Any
 
 import numpy as np
 
-from opspec.bindings.world.base import RobotWorld
+from opspec.bindings.world.base import RobotWorld, check_parameters
 from opspec.bindings.world.geometry import ray_to_circle_inside, wrap_angle
 from opspec.bindings.world.robot import Robot
 
@@ -31,6 +31,10 @@ class SumoWorld(RobotWorld):
                  range_noise: float = 0.01, drain_per_s: float = 0.02,
                  edge_band: float = 0.3) -> None:
         super().__init__(rng)
+        check_parameters(numbers={"ring_radius": ring_radius, "radius": radius,
+                                  "opponent_speed": opponent_speed,
+                                  "bout_limit_s": bout_limit_s, "range_noise": range_noise,
+                                  "drain_per_s": drain_per_s, "edge_band": edge_band})
         if not (radius > 0 and ring_radius > 4 * radius and bout_limit_s > 0):
             raise ValueError(f"the ring (radius {ring_radius} m) must hold two robots of "
                              f"radius {radius} m apart, and bout_limit_s must be positive")
