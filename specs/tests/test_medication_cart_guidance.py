@@ -5,7 +5,7 @@ from __future__ import annotations
 
 from typing import Any
 
-from opspec.testing import assert_mean, check, happens_before
+from opspec.testing import assert_mean, assert_rate, check, happens_before
 
 SPEC = "../medication_cart_guidance.xpdl"
 
@@ -18,7 +18,11 @@ def test_the_patient_is_confirmed_only_after_tag_and_bar_code(spec: Any,
 
 def test_carts_find_the_patient_within_five_minutes_on_average(spec: Any,
                                                                simulate: Any) -> None:
-    result = simulate(spec, users=4, until=400.0, keep_trace=False)
+    result = simulate(spec, users=10, until=400.0, keep_trace=False)
+    # the mean time is over the carts that found the patient: first, how many did (about
+    # 95 % do within 400 s; "at least half" is then decided for almost every seed)
+    found = result.metrics["patients_found"]["total"]
+    assert_rate(result, (found, result.replications), at_least=0.5, confidence=0.95)
     assert_mean(result, "time_to_find_s", at_most=300.0, confidence=0.95)
 
 
