@@ -1,7 +1,8 @@
 """``opspec compile IN [-o OUT.wfs]``: write the workflow script (``.wfs``) of an XPDL spec.
 
-Exit status: 0 written (warnings are printed), 1 the spec has errors (each printed as
-``path:line: severity: message``; nothing is written), 2 the input cannot be read or the output
+Exit status: 0 written (warnings are printed), 1 the spec has errors, exactly those
+``opspec validate`` reports (each printed as ``path:line: severity: message``; nothing is
+written), 2 the input cannot be read or the output
 cannot be written.
 """
 
@@ -29,6 +30,7 @@ def register(subparsers: Any) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
+    from opspec.commands.validate import engine_checks
     from opspec.errors import SpecError
     from opspec.xpdl.compile import compile_spec, default_output
 
@@ -39,7 +41,7 @@ def run(args: argparse.Namespace) -> int:
         return 2
     target = Path(args.output) if args.output else default_output(source)
     try:
-        result = compile_spec(source, target, strict=args.strict)
+        result = compile_spec(source, target, strict=args.strict, extra=engine_checks)
     except SpecError as error:
         for diagnostic in error.diagnostics or ():
             print(diagnostic, file=sys.stderr)

@@ -5,8 +5,9 @@ ActivitySet of Routes and plain activities) and directives become ``opspec:`` ex
 attributes; the output validates against the official XPDL 2.1 schema (docs/sisarl-xpdl.md,
 section *Preprocessing*).
 
-Exit status: 0 written, 1 the spec (or a built-in in it) has errors (nothing written), 2 the
-input cannot be read or the output cannot be written.
+Exit status: 0 written, 1 the spec has errors (those ``opspec validate`` reports, or a
+built-in that cannot be expanded; nothing written), 2 the input cannot be read or the output
+cannot be written.
 """
 
 from __future__ import annotations
@@ -37,9 +38,10 @@ def default_output(source: Path) -> Path:
 
 
 def run(args: argparse.Namespace) -> int:
+    from opspec.commands.validate import engine_checks
     from opspec.errors import Severity
-    from opspec.xpdl.loader import load_package
     from opspec.xpdl.preprocess import preprocess
+    from opspec.xpdl.validate import validate_spec
     from opspec.xpdl.writer import write_xpdl
 
     source = Path(args.input)
@@ -47,10 +49,10 @@ def run(args: argparse.Namespace) -> int:
         what = "is a folder" if source.is_dir() else "does not exist"
         print(f"opspec preprocess: cannot read {source}: it {what}", file=sys.stderr)
         return 2
-    loaded = load_package(source, strict=args.strict)
-    diagnostics = list(loaded.diagnostics)
-    package = loaded.package
-    if loaded.ok and package is not None:
+    # The spec is refused for exactly the errors `opspec validate` reports.
+    package, report = validate_spec(source, strict=args.strict, extra=engine_checks)
+    diagnostics = list(report.diagnostics)
+    if report.ok and package is not None:
         result = preprocess(package)
         diagnostics.extend(result.diagnostics)
         package = result.package

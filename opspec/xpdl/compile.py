@@ -1,19 +1,22 @@
 """Compile an XPDL specification into a workflow script (``.wfs``) the engine loads directly.
 
-A spec with errors is refused: compiling it would only move the problem to run time. Warnings
-are returned so the caller can print them; the script is still written.
+A spec with errors is refused: compiling it would only move the problem to run time. "Errors"
+are exactly what ``opspec validate`` reports (:func:`opspec.xpdl.validate.validate_spec`: the
+reader's diagnostics plus the structural checks, and whatever ``extra`` checks the caller adds).
+Warnings are returned so the caller can print them; the script is still written.
 """
 
 from __future__ import annotations
 
 import os
+from collections.abc import Callable, Iterable
 from dataclasses import dataclass
 from pathlib import Path
 
-from opspec.errors import Diagnostic, SpecError
+from opspec.errors import Diagnostic, Severity, SpecError
 from opspec.model.codec import write_wfs
 from opspec.model.package import Package
-from opspec.xpdl.loader import load_package
+from opspec.xpdl.validate import validate_spec
 
 __all__ = ["CompileResult", "compile_spec", "default_output"]
 
@@ -37,16 +40,20 @@ def compile_spec(
     output: str | os.PathLike[str] | None = None,
     *,
     strict: bool = False,
+    extra: Callable[[Package], Iterable[Diagnostic]] | None = None,
 ) -> CompileResult:
-    """Load the XPDL in ``source`` and write its ``.wfs`` to ``output`` (default:
-    :func:`default_output`).
+    """Validate the XPDL in ``source`` as ``opspec validate`` does and write its ``.wfs`` to
+    ``output`` (default: :func:`default_output`).
 
     Raises :class:`SpecError` carrying every diagnostic when the spec has errors (``strict``
-    counts warnings as errors); nothing is written then. ``OSError`` from writing propagates.
+    counts warnings as errors; ``extra`` adds checks of layers above, as in
+    :func:`~opspec.xpdl.validate.validate_spec`); nothing is written then. ``OSError`` from
+    writing propagates.
     """
-    result = load_package(Path(source), strict=strict)
-    if not result.ok or result.package is None:
-        raise SpecError.from_diagnostics(result.diagnostics)
+    package, report = validate_spec(Path(source), strict=strict, extra=extra)
+    if package is None or not report.ok:
+        raise SpecError.from_diagnostics(report.diagnostics)
     target = Path(output) if output is not None else default_output(source)
-    write_wfs(result.package, target)
-    return CompileResult(result.package, target, result.diagnostics)
+    write_wfs(package, target)
+    warnings = tuple(d for d in report.diagnostics if d.severity is not Severity.ERROR)
+    return CompileResult(package, target, warnings)

@@ -92,3 +92,42 @@ def test_compile_io_problems_are_one_line_with_exit_2(
     assert main(["compile", str(source), "-o", str(out)]) == 2
     err = capsys.readouterr().err
     assert len(err.strip().splitlines()) == 1 and err.startswith("opspec compile: ")
+
+
+# Errors only the structural checks find (the file itself reads fine): `opspec validate`
+# rejects these, so compile must too (it used to write the script anyway).
+STRUCTURAL_ERRORS = {
+    "dangling-transition": ('From="start_notify" To="timer_done"', 'From="start_notify" To="nowhere"'),
+    "undefined-performer": ('<Performer>user</Performer>', '<Performer>ghost</Performer>'),
+}
+
+
+def _broken_dispenser(tmp_path: Path, case: str) -> Path:
+    old, new = STRUCTURAL_ERRORS[case]
+    text = (SPECS / "medication_dispenser.xpdl").read_text()
+    assert old in text
+    source = tmp_path / f"{case}.xpdl"
+    source.write_text(text.replace(old, new, 1))
+    return source
+
+
+@pytest.mark.parametrize("case", sorted(STRUCTURAL_ERRORS))
+def test_compile_refuses_a_spec_that_validate_rejects(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], case: str
+) -> None:
+    source = _broken_dispenser(tmp_path, case)
+    assert main(["validate", str(source)]) == 1
+    capsys.readouterr()
+    out = tmp_path / "out.wfs"
+    assert main(["compile", str(source), "-o", str(out)]) == 1
+    err = capsys.readouterr().err
+    errors = [line for line in err.splitlines() if ": error: " in line]
+    assert errors and all(line.startswith(f"{source}:") for line in errors)
+    assert all(line.split(":")[1].isdigit() for line in errors)   # path:line
+    assert "nothing written" in err
+    assert not out.exists()
+
+
+@pytest.mark.parametrize("path", sorted(SPECS.glob("*.xpdl")), ids=lambda p: p.name)
+def test_every_bundled_spec_compiles(tmp_path: Path, path: Path) -> None:
+    assert main(["compile", str(path), "-o", str(tmp_path / "out.wfs")]) == 0

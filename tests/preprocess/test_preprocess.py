@@ -346,3 +346,33 @@ def test_the_documented_example_preprocesses_to_valid_xpdl_that_loads_cleanly(
     assert again.package is not None
     assert [without_locations(p.directives) for p in again.package.processes] == [
         without_locations(p.directives) for p in loaded.package.processes]
+
+
+def test_preprocess_refuses_a_spec_that_validate_rejects(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    from opspec.cli import main
+
+    spec = Path(__file__).resolve().parents[2] / "specs" / "medication_dispenser.xpdl"
+    text = spec.read_text()
+    assert 'From="start_notify" To="timer_done"' in text
+    bad = tmp_path / "dangling.xpdl"   # reads fine; only the structural checks object
+    bad.write_text(text.replace('From="start_notify" To="timer_done"',
+                                'From="start_notify" To="nowhere"'))
+    assert main(["validate", str(bad)]) == 1
+    capsys.readouterr()
+    out = tmp_path / "out.xpdl"
+    assert main(["preprocess", str(bad), "-o", str(out)]) == 1
+    err = capsys.readouterr().err
+    assert f"{bad}:84: error: " in err and "'nowhere'" in err
+    assert "nothing written" in err
+    assert not out.exists()
+
+
+@pytest.mark.parametrize(
+    "path", sorted((Path(__file__).resolve().parents[2] / "specs").glob("*.xpdl")),
+    ids=lambda p: p.name)
+def test_every_bundled_spec_preprocesses(tmp_path: Path, path: Path) -> None:
+    from opspec.cli import main
+
+    assert main(["preprocess", str(path), "-o", str(tmp_path / "out.xpdl")]) == 0
