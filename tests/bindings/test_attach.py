@@ -252,20 +252,11 @@ def test_a_socket_that_drops_mid_run_is_reconnected_and_the_dose_is_taken(
 @needs_pty
 def test_a_vanished_drawer_aborts_the_dispense_along_its_exception_transition(
         board: Any, tmp_path: Path) -> None:
-    # the shipped spec has no EXCEPTION flow out of `dispense`; give it one to record a miss
-    text = SPEC.read_text(encoding="utf-8").replace(
-        '<Transition Id="n_taken" From="dispense" To="record_taken"/>',
-        '<Transition Id="n_taken" From="dispense" To="record_taken"/>'
-        '<Transition Id="n_fault" From="dispense" To="record_missed">'
-        '<Condition Type="EXCEPTION">DispenserFault</Condition></Transition>')
-    assert "n_fault" in text
-    spec = tmp_path / "medication_dispenser.xpdl"
-    spec.write_text(text, encoding="utf-8")
+    # the shipped spec: `dispense` --DispenserFault--> record_missed (and the caregiver)
     server = board(fault="disconnect:1", on="pty")
     # until 11:56: closing and reopening the port takes real time (simulated hours here)
     run = simulate([f"alarm:{FAST}={server.url}", f"dispenser:{FAST}={server.url}"],
-                   script(tmp_path, ("after trg_2 30s", "press_report")), spec=spec,
-                   until=43000)
+                   script(tmp_path, ("after trg_2 30s", "press_report")), until=43000)
     assert [(f["fault"], f["action"]) for f in run.faults()] == [
         ("disconnected", "reconnect"), ("reconnect-failed", "abort/simulate")]
     device = run.report["alarm, dispenser"]
@@ -338,3 +329,20 @@ def test_attach_refuses_a_participant_the_spec_does_not_have() -> None:
     assert "bindable participants of this spec: alarm, dispenser" in str(caught.value)
     with attach_devices(["alarm=auto"], DEVICES, spec=compiled, ports=[]) as devices:
         assert set(devices.performers) == {"alarm"}
+
+
+def test_the_shipped_dispenser_profile_and_spec_agree_on_the_drawer_fault(
+        tmp_path: Path) -> None:
+    # the shipped files, a drawer that answers garbage: DispenserFault is handled by the spec
+    profile = load_profile(DEVICES / f"{SHIPPED}.toml")
+    fallback = profile.fallback_for("dispenser")
+    assert (fallback.then, fallback.exception) == ("abort", "DispenserFault")
+    url = f"emulator://{DEVICES / f'{SHIPPED}.toml'}?fault=garbage"
+    run = simulate([f"dispenser={url}"], script(tmp_path, ("after trg_2 30s", "press_report")),
+                   profiles=DEVICES, until=FIRST_DOSE)
+    failed = [e for e in run.result.trace or () if e.kind == "activity.failed"]
+    assert [(e.activity, (e.data or {}).get("exception")) for e in failed] == [
+        ("dispense", "DispenserFault")]
+    assert run.result.summary["instances"].get("aborted", 0) == 0   # before: aborted 1
+    assert run.metric("doses_taken") == 0 and run.metric("doses_missed") == 1
+    assert run.result.summary.get("faults") in (None, [])
