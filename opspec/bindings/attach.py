@@ -60,6 +60,7 @@ class AttachedDevices:
             for participant in binding.participants}
         self.notes: list[str] = [note for b in self.bindings for note in b.notes]
         self._sim: Simulation | None = None
+        self._reported = False
 
     @property
     def requires_wall_clock(self) -> bool:
@@ -123,10 +124,20 @@ class AttachedDevices:
         """Per binding (keyed by its participants, comma-separated): ``profile``, ``url``,
         ``mode`` per participant (``device``/``simulated``/``aborted``), ``latency_ms``
         (``count``, ``mean``, ``p99``, ``max`` of the answered commands' round trips; None
-        without any) and ``faults`` (``at`` simulated seconds, ``fault``, ``message``,
-        ``action``), for the run's summary and JSON."""
+        without any), ``faults`` (``at`` simulated seconds, ``fault``, ``message``,
+        ``action``) and ``pending`` (work the device had not finished: see
+        :meth:`DeviceBinding.pending`), for the run's summary and JSON.
+
+        The first call also traces each binding's unfinished work as one ``device.pending``
+        event (``data``: ``device``, ``port``, ``pending``). It comes after ``run.ended``:
+        the engine has no later hook, and the run *has* ended with the work still open."""
         out: dict[str, Any] = {}
+        trace = not self._reported
+        self._reported = True
         for binding in self.bindings:
+            pending = binding.pending()
+            if trace and pending:
+                binding.trace_pending(pending)
             latency = binding.latency_summary()
             out[", ".join(binding.participants)] = {
                 "profile": binding.profile.name, "url": binding.url,
@@ -135,6 +146,7 @@ class AttachedDevices:
                                "p99": _ms(latency.p99), "max": _ms(latency.max)},
                 "faults": [{k: f.get(k) for k in ("at", "fault", "message", "action")}
                            for f in binding.faults],
+                "pending": pending,
             }
         return out
 

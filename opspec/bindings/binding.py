@@ -36,11 +36,12 @@ from opspec.engine.performers import PerformerSession, WorkItem
 from opspec.engine.trace import EventKind
 from opspec.errors import BindingError
 
-__all__ = ["DEVICE_EVENT", "DEVICE_EXCHANGE", "DEVICE_NOTE", "DeviceBinding"]
+__all__ = ["DEVICE_EVENT", "DEVICE_EXCHANGE", "DEVICE_NOTE", "DEVICE_PENDING", "DeviceBinding"]
 
 DEVICE_EXCHANGE: Final = "device.exchange"   # a command and its reply, with latency
 DEVICE_NOTE: Final = "device.note"           # bound / simulated / reconnected / switched
 DEVICE_EVENT: Final = "device.event"         # an unsolicited line the profile knows
+DEVICE_PENDING: Final = "device.pending"     # work unfinished when the run ended
 
 Mode = Literal["device", "simulated", "aborted"]
 Connection = Literal["open", "reconnecting", "gone", "closed", "none"]
@@ -128,6 +129,37 @@ class DeviceBinding:
 
     def latency_summary(self) -> LatencySummary:
         return summarise(self.latencies)
+
+    def pending(self) -> list[dict[str, Any]]:
+        """The device work not finished yet (asked at the run's end): each entry has
+        ``state`` (``sent``: a command awaits its reply; ``held``: a retry waits out the
+        late-reply window; ``queued``; ``awaiting-event``: a passive operation;
+        ``reconnecting``: the port is being reopened), ``message``, and for work items
+        ``participant``, ``activity``, ``instance`` and ``command``."""
+        out: list[dict[str, Any]] = []
+        if self._connection == "reconnecting":
+            out.append({"state": "reconnecting", "message":
+                        f"{self._label()}: still reconnecting to {self.url}"})
+
+        def entry(state: str, item: WorkItem, line: str | None, what: str) -> None:
+            out.append({"state": state, "participant": item.participant,
+                        "activity": item.activity, "instance": item.instance, "command": line,
+                        "message": f"{self._who(item)}: {item.activity} (instance "
+                                   f"{item.instance}) {what}"})
+
+        job = self._inflight
+        if job is not None and not job.withdrawn:
+            entry("sent", job.item, job.line, f"sent {job.line!r}, no reply yet "
+                  f"(attempt {job.attempts})")
+        if self._resend is not None and not self._resend.withdrawn:
+            entry("held", self._resend.item, self._resend.line,
+                  f"waits to resend {self._resend.line!r} (late-reply window)")
+        for job in self._queue:
+            if not job.withdrawn:
+                entry("queued", job.item, job.line, f"{job.line!r} not sent yet")
+        for item in self._waiting:
+            entry("awaiting-event", item, None, "waits for an event from the device")
+        return out
 
     def attach(self, session: PerformerSession) -> None:
         """Remember the session, report the notes and start reading the port."""
@@ -572,6 +604,12 @@ class DeviceBinding:
         self.faults.append({**data, "at": self._session.now if self._session else None})
         if self._session is not None:
             self._session.trace(EventKind.FAULT, data)
+
+    def trace_pending(self, pending: Sequence[Mapping[str, Any]]) -> None:
+        """Trace ``pending`` (see :meth:`pending`) as one ``device.pending`` event."""
+        if self._session is not None:
+            self._session.trace(DEVICE_PENDING, {"device": self.profile.name, "port": self.url,
+                                                 "pending": [dict(p) for p in pending]})
 
     def _note(self, message: str) -> None:
         if message not in self.notes:

@@ -517,6 +517,8 @@ def _print_summary(out: Any, result: RunResult, medians: dict[str, float], trace
         for fault in faults[:5]:
             print(f"  fault {fault.get('fault')}: {fault.get('message')} "
                   f"(then {fault.get('action')})", file=out)
+        for waiting in info.get("pending") or []:
+            print(f"  unfinished at the end: {waiting.get('message')}", file=out)
     for problem in summary.get("deadlocks") or []:
         print(f"deadlock: {problem.get('message')}", file=out)
     for fault in summary.get("faults") or []:
