@@ -8,7 +8,7 @@ from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
-from scipy import special, stats  # type: ignore[import-untyped]
+from scipy import special  # type: ignore[import-untyped]
 
 from opspec.usermodels.distbase import (
     _STD_NORMAL,
@@ -286,6 +286,8 @@ class TruncatedNormal(Distribution):
             return 0.0
         if x >= self.high:
             return 1.0
+        from scipy import stats  # type: ignore[import-untyped]  # lazy: 2 s to import
+
         return float(stats.truncnorm.cdf(x, *self._ab(), loc=self.loc, scale=self.sd_))
 
     def quantile(self, q: float) -> float:
@@ -359,6 +361,8 @@ class ExGaussian(Distribution):
         object.__setattr__(self, "tau", _positive("tau", self.tau))
 
     def _frozen(self) -> Any:
+        from scipy import stats  # type: ignore[import-untyped]  # lazy: 2 s to import
+
         return stats.exponnorm(self.tau / self.sigma, loc=self.mu, scale=self.sigma)
 
     def sample(self, rng: np.random.Generator) -> float:
