@@ -57,7 +57,8 @@ _DOCTYPE_MARKERS: Final = (
 
 class XmlReadError(SpecError):
     """A file cannot be read as XPDL at all. ``code`` is one of ``io-error``, ``too-big``,
-    ``empty-file``, ``not-well-formed``, ``doctype``, ``unknown-root``, ``unknown-version``."""
+    ``empty-file``, ``not-well-formed``, ``resource-limit``, ``doctype``, ``unknown-root``,
+    ``unknown-version``."""
 
     def __init__(self, code: str, message: str, *, location: SourceLocation, hint: str = "") -> None:
         self.code = code
@@ -201,9 +202,35 @@ def _parse(data: bytes, path: str) -> tuple[etree._Element, list[Diagnostic]]:
     return root, warnings
 
 
+# libxml2's safety limits (huge_tree=False) and what they mean for a spec's author: a
+# well-formed file can hit them, so "fix the XML syntax" would be the wrong advice.
+_LIMITS: Final = (
+    (re.compile(r"excessive depth", re.IGNORECASE),
+     "elements are nested more than 256 levels deep, the XML reader's limit",
+     "XPDL needs a few dozen levels at most: flatten the deeply nested content, often inside "
+     "an ExtendedAttribute, or move it to a file of its own"),
+    (re.compile(r"buffer size limit|text node too long|too long|huge text", re.IGNORECASE),
+     "a text or attribute value is longer than the XML reader's limit of 10,000,000 characters",
+     "keep bulk data out of the spec: put it in a file of its own and refer to it; a value "
+     "this long usually means a damaged or generated file"),
+    (re.compile(r"resource limit|huge input|amplification|memory allocation", re.IGNORECASE),
+     "the XML exceeds a resource limit of the XML reader",
+     "simplify the file: no spec needs anything this large; is it damaged or generated?"),
+)
+
+
+def _one_line(text: str) -> str:
+    return " ".join(text.split())
+
+
 def _not_well_formed(path: str, error: etree.XMLSyntaxError) -> XmlReadError:
     message = error.msg or str(error)
     message = re.sub(r"\s*\(<string>, line \d+\)$", "", message)
+    for pattern, what, hint in _LIMITS:
+        if pattern.search(message):
+            return XmlReadError("resource-limit", what,
+                                location=SourceLocation(path, error.lineno or None), hint=hint)
+    message = _one_line(message)
     return XmlReadError(
         "not-well-formed",
         f"not well-formed XML: {message}",

@@ -193,3 +193,16 @@ def test_a_subflow_missing_from_the_external_packages_is_reported_once(tmp_path:
     report = validate_file(tmp_path / "caller.xpdl")
     about_refill = [d for d in report.diagnostics if "'Refill'" in d.message]
     assert [d.code for d in about_refill] == ["unresolved-subflow"]
+
+
+def test_every_code_the_reader_emits_is_documented() -> None:
+    import re
+
+    root = Path(__file__).resolve().parents[2]
+    reader = (root / "opspec" / "xpdl" / "reader.py").read_text()
+    codes = set(re.findall(r'XmlReadError\(\s*"([a-z-]+)"', reader))
+    sisarl = (root / "opspec" / "xpdl" / "sisarl.py").read_text()
+    codes |= {"too-many-attributes"} & set(re.findall(r'"error", "([a-z-]+)"', sisarl))
+    assert {"doctype", "resource-limit", "too-many-attributes"} <= codes
+    docs = (root / "docs" / "validation.md").read_text()
+    assert sorted(c for c in codes if f"`{c}`" not in docs) == []

@@ -165,4 +165,41 @@ def test_deeply_nested_input_is_refused_not_a_crash() -> None:
     data = b'<Package xmlns="http://www.wfmc.org/2008/XPDL2.1" Id="p">' + b"<a>" * 100_000
     result = parse_bytes(data, path="deep.xpdl")
     assert result.package is None
+    assert result.diagnostics[0].code == "resource-limit"
+
+
+WELL_FORMED_BUT_TOO_MUCH = {
+    "deep-extended-attribute": (
+        b'<Package xmlns="http://www.wfmc.org/2008/XPDL2.1" Id="p">\n<ExtendedAttributes>'
+        b'<ExtendedAttribute Name="x">' + b"<a>" * 2000 + b"</a>" * 2000
+        + b"</ExtendedAttribute></ExtendedAttributes></Package>", "nested more than 256"),
+    "huge-attribute-value": (
+        b'<Package xmlns="http://www.wfmc.org/2008/XPDL2.1" Id="p" Name="'
+        + b"x" * 10_000_100 + b'"/>', "longer than"),
+    "huge-text-node": (
+        b'<Package xmlns="http://www.wfmc.org/2008/XPDL2.1" Id="p"><Description>'
+        + b"x" * 10_000_100 + b"</Description></Package>", "longer than"),
+}
+
+
+@pytest.mark.parametrize("case", sorted(WELL_FORMED_BUT_TOO_MUCH))
+def test_reader_limits_give_their_own_one_line_message_with_a_usable_hint(case: str) -> None:
+    data, says = WELL_FORMED_BUT_TOO_MUCH[case]
+    result = parse_bytes(data, path="big.xpdl")
+    assert result.package is None
+    (diagnostic,) = result.diagnostics
+    assert diagnostic.code == "resource-limit"
+    assert says in diagnostic.message
+    assert diagnostic.location.line is not None
+    text = str(diagnostic)
+    assert "\n" not in text
+    # the user can neither pass XML_PARSE_HUGE nor "fix the syntax" of a well-formed file
+    assert "XML_PARSE_HUGE" not in text and "syntax" not in text
+    assert diagnostic.hint
+
+
+def test_not_well_formed_messages_are_one_line() -> None:
+    result = parse_bytes(b'<Package xmlns="http://www.wfmc.org/2008/XPDL2.1" Id="p">\n<a',
+                         path="cut.xpdl")
     assert result.diagnostics[0].code == "not-well-formed"
+    assert "\n" not in str(result.diagnostics[0])
