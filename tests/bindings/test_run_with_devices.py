@@ -186,3 +186,25 @@ def test_an_in_process_emulator_is_not_called_a_real_device(capsys, tmp_path):
     assert "real device" not in output
     assert "only in-process emulators are bound: running on the wall clock" in output
     assert "wall clock at 20000x" in output
+
+
+def test_a_command_still_unanswered_when_the_run_ends_is_reported(capsys, tmp_path):
+    # ALARM ON goes out at 08:00; the run stops 1200 simulated s (60 ms of wall time) later,
+    # long before the silent board's 500 ms timeout (or its retry)
+    trace = tmp_path / "trace.jsonl"
+    url = "emulator://medication_dispenser?fault=silent"
+    status, doc, _ = run(capsys, "--until", "30000", "--realtime", "--speed", "20000",
+                         "--json", "--trace", str(trace), "--bind", f"alarm={url}",
+                         "--script", script(tmp_path, ("after trg_2 30s", "press_report")))
+    assert status == 0            # unfinished work is reported, not a fault
+    pending = doc["devices"]["alarm"]["pending"]
+    assert pending and {p["state"] for p in pending} <= {"sent", "held"}
+    assert pending[0]["activity"] == "sound_alarm" and pending[0]["command"] == "ALARM ON"
+    events = [json.loads(line) for line in trace.read_text().splitlines()[1:]]
+    (traced,) = [e for e in events if e["kind"] == "device.pending"]
+    assert traced["data"]["pending"][0]["command"] == "ALARM ON"
+    # and on the screen
+    _, _, output = run(capsys, "--until", "30000", "--realtime", "--speed", "20000",
+                       "--timeline", "none", "--bind", f"alarm={url}",
+                       "--script", script(tmp_path, ("after trg_2 30s", "press_report")))
+    assert "unfinished at the end: alarm: sound_alarm (instance" in output
