@@ -190,9 +190,14 @@ class WalkthroughApp(App[str | None]):
             pass
 
     def _on_event(self, event: Any) -> None:
-        calling = self.session.calling or self.session.board.ringing
-        if calling and not self._was_calling:
-            self.bell()                      # the device calls: ring where the terminal can
+        # ring where the terminal can: at every alarm the device sounds (the board has
+        # already seen the event), and when a device that does not signal starts calling
+        session = self.session
+        calling = session.calling
+        alarm = (event.kind == "trigger.raised" and event.lane != "user"
+                 and session.device_signals and session.board.ringing)
+        if alarm or (calling and not self._was_calling and not session.device_signals):
+            self.bell()
         self._was_calling = calling
 
     # ------------------------------------------------------------------ actions
@@ -297,13 +302,19 @@ class WalkthroughApp(App[str | None]):
         if session.handed_over and not session.ended:
             box.mount(Static("The user model is performing. Press h to take over."))
         else:
-            lines = []
-            for n, offer in enumerate(session.offers[:len(OFFER_KEYS)]):
-                what = ("choose: " if offer.choice else "") + offer.label
+            lines: list[Static] = []
+            offers = session.offers
+            labels = [o.label for o in offers]
+            for n, offer in enumerate(offers[:len(OFFER_KEYS)]):
                 line = Text()
                 line.append(f"[{OFFER_KEYS[n]}]", style="bold reverse")
-                line.append(f" {what}")
+                line.append(f" {offer.label}")
+                if labels.count(offer.label) > 1:      # tell identical offers apart
+                    line.append(f" #{offer.item.instance}", style="dim")
                 lines.append(OfferLine(n, line))
+            more = len(offers) - len(OFFER_KEYS)
+            if more > 0:
+                lines.append(Static(f"(+{more} more: x passes on the first)"))
             if lines:
                 box.mount(*lines)
         self.query_one("#timeline", Static).update(self._timeline_text())

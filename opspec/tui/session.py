@@ -23,17 +23,17 @@ import os
 import time
 from collections import deque
 from collections.abc import Callable, Mapping, Sequence
-from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
 from opspec.engine.compiled import CompiledPackage
 from opspec.engine.lanes import user_lane
-from opspec.engine.performers import PerformerSession, WorkItem
+from opspec.engine.performers import WorkItem
 from opspec.engine.simulation import Simulation
 from opspec.engine.trace import TraceEvent
 from opspec.errors import ConfigurationError
 from opspec.tui.devices import DeviceBoard
+from opspec.tui.lane import LaneUser, Offer
 from opspec.tui.replay import tagged_action
 
 __all__ = ["Offer", "WalkSession"]
@@ -41,90 +41,6 @@ __all__ = ["Offer", "WalkSession"]
 DAY = 86_400.0
 _ANSWERED = frozenset({"activity.completed", "activity.omitted", "activity.failed",
                        "activity.withdrawn", "activity.aborted", "deadline.expired"})
-
-
-@dataclass(frozen=True, slots=True)
-class Offer:
-    """Something the person can do now: an activity, or one alternative of a choice."""
-
-    item: WorkItem
-    choice: str | None          # the alternative, for a deferred choice
-
-    @property
-    def label(self) -> str:
-        return self.choice or self.item.label or self.item.activity
-
-    @property
-    def action(self) -> str:
-        """The recorded action, naming the instance (``complete hear_alarm #6``): a replay
-        acts on the same one of several identical offers."""
-        if self.choice:
-            return tagged_action("choose", self.choice, self.item.instance)
-        return tagged_action("complete", self.item.activity, self.item.instance)
-
-
-class _LaneUser:
-    """The user lane's performer: holds offers for the person, or passes them to a model."""
-
-    def __init__(self, session: WalkSession) -> None:
-        self.walk = session
-        self.items: dict[int, WorkItem] = {}
-        self.engine: PerformerSession | None = None
-        self.model: Any = None
-
-    def attach(self, session: PerformerSession) -> None:
-        self.engine = session
-
-    def offer(self, item: WorkItem) -> None:
-        if self.model is not None:
-            self.model.offer(item)
-            return
-        self.items[item.key] = item
-        self.walk._offered(item)
-
-    def withdraw(self, item: WorkItem, reason: str) -> None:
-        self.items.pop(item.key, None)
-        if self.model is not None:
-            self.model.withdraw(item, reason)
-
-
-class _RecordingSession:
-    """The engine session a handed-over model sees: its actions are recorded like the
-    person's, so a replay without the model gives the same trace."""
-
-    def __init__(self, walk: WalkSession, engine: PerformerSession) -> None:
-        self.walk = walk
-        self.engine = engine
-
-    @property
-    def now(self) -> float:
-        return self.engine.now
-
-    def complete(self, item: WorkItem, data: Mapping[str, Any] | None = None,
-                 choice: str | None = None) -> None:
-        self.walk._record(tagged_action("choose", choice, item.instance) if choice
-                          else tagged_action("complete", item.activity, item.instance),
-                          by="model")
-        self.engine.complete(item, data, choice)
-
-    def omit(self, item: WorkItem, reason: str = "") -> None:
-        self.walk._record(tagged_action("omit", item.activity, item.instance), by="model")
-        self.engine.omit(item, reason)
-
-    def fail(self, item: WorkItem, exception: str, message: str = "") -> None:
-        self.walk._record(tagged_action("fail", item.activity, item.instance, exception),
-                          by="model")
-        self.engine.fail(item, exception, message)
-
-    def raise_trigger(self, name: str, data: Mapping[str, Any] | None = None) -> None:
-        self.walk._record(f"raise {name}", by="model")
-        self.engine.raise_trigger(name, data)
-
-    def call_later(self, delay: float, callback: Callable[[], None]) -> None:
-        self.engine.call_later(delay, callback)
-
-    def trace(self, kind: str, data: Mapping[str, Any] | None = None) -> None:
-        self.engine.trace(kind, data)
 
 
 class WalkSession:
@@ -164,8 +80,13 @@ class WalkSession:
         self.skipping = False                               # a skip until the user goes on
         self._skip_calls = 0                                # self.calls when it began
         self.calls = 0                                      # user-lane processes started
+        #: what the person can do now, oldest first (offers of an instance that ended, or
+        #: superseded by the same activity offered in a newer instance, are gone)
         self.offers: list[Offer] = []
-        self.calling = False                                # the device is calling the user
+        self.lapsed = 0                                     # offers superseded so far
+        self._offer_seq = 0                                 # offers made so far
+        self._seq_of: dict[int, int] = {}                   # item key -> its offer number
+        self._skip_from = 0                                 # _offer_seq when the skip began
         self.ended = False
         self.record_path = Path(record) if record is not None else None
         self._steps: list[list[str]] = []
@@ -185,12 +106,18 @@ class WalkSession:
                     f"{error.strerror or error}",
                     hint="give --record a path in a folder you can write to, or --no-record"
                 ) from None
-        self._deadline_of = {(a.process, a.id): a.deadlines for a in _activities(compiled)
+        activities = _activities(compiled)
+        self._deadline_of = {(a.process, a.id): a.deadlines for a in activities
                              if a.deadlines}
+        #: the spec's names for activities (choices are shown by name, not id)
+        self._names = {(a.process, a.id): a.label or a.id for a in activities}
+        #: the device signals the user (an alarm raising a trigger): the banner follows it
+        self.device_signals = any(a.raises is not None and not a.user_lane
+                                  for a in activities)
         lane = user_lane(compiled)
         #: the spec has manual activities for the person (vacuum robots may have none)
         self.has_user_lane = not lane.empty
-        self.lane_user = _LaneUser(self)
+        self.lane_user = LaneUser(self)
         bound: dict[str, Any] = dict(performers or {})
         if replay is not None:
             user: Any = replay
@@ -251,6 +178,7 @@ class WalkSession:
         on with it, and :meth:`cancel_skip` abandons it."""
         self.skipping = True
         self._skip_calls = self.calls
+        self._skip_from = self._offer_seq
         self._skip(budget)
 
     def cancel_skip(self) -> None:
@@ -261,8 +189,9 @@ class WalkSession:
         # with the lane handed over nothing waits for the person: stop at the next call
         calls = self._skip_calls
         left = budget
-        while not self.offers and not self.ended and not self.waiting_for_devices and not (
-                self.handed_over and self.calls > calls):
+        # offers already there when the skip began do not stop it (the person passed them)
+        while not self.has_new_offers(self._skip_from) and not self.ended and (
+                not self.waiting_for_devices) and not (self.handed_over and self.calls > calls):
             due = self.sim.peek()
             target = min(self.horizon, due) if math.isfinite(due) else self.horizon
             reached, used = self._step_to(target, left)
@@ -274,8 +203,13 @@ class WalkSession:
                     break
             if not math.isfinite(due):
                 break
-        if self.offers or self.ended or (self.handed_over and self.calls > calls):
+        if self.has_new_offers(self._skip_from) or self.ended or (
+                self.handed_over and self.calls > calls):
             self.skipping = False
+
+    def has_new_offers(self, since: int) -> bool:
+        """Whether an offer made after the ``since``-th one is waiting for the person."""
+        return any(self._seq_of.get(o.item.key, 0) > since for o in self.offers)
 
     def run_to(self, target: float, budget: int | None = None) -> bool:
         """Step the engine to simulated time ``target`` (at most ``budget`` events; it
@@ -289,7 +223,9 @@ class WalkSession:
         env = self.sim.env
         self.sim.drain_posts()
         steps = 0
-        while not self.offers or target > self.now:
+        since = self._offer_seq
+        # at the target time, stop at a new offer (the person sees it before what follows)
+        while target > self.now or not self.has_new_offers(since):
             due = env.peek()
             if due > target:
                 break
@@ -308,7 +244,7 @@ class WalkSession:
     def act(self, offer: Offer) -> None:
         """The person does ``offer`` now."""
         engine = self.lane_user.engine
-        if engine is None or offer.item.key not in self.lane_user.items:
+        if engine is None or self.handed_over or offer.item.key not in self.lane_user.items:
             return
         self.lane_user.items.pop(offer.item.key, None)
         self._record(offer.action, by="person")
@@ -318,7 +254,7 @@ class WalkSession:
     def ignore(self, offer: Offer) -> None:
         """The person explicitly does not do ``offer`` (omission)."""
         engine = self.lane_user.engine
-        if engine is None or offer.item.key not in self.lane_user.items:
+        if engine is None or self.handed_over or offer.item.key not in self.lane_user.items:
             return
         self.lane_user.items.pop(offer.item.key, None)
         self._record(tagged_action("omit", offer.item.activity, offer.item.instance),
@@ -327,45 +263,77 @@ class WalkSession:
         engine.omit(offer.item, "the person chose not to")
 
     def hand_over(self) -> bool:
-        """Let the user model perform the lane from now on (``False``: no model)."""
-        if self.model_factory is None or self.lane_user.model is not None:
+        """Let the user model perform the lane from now on, starting with what the person
+        is offered now (``False``: no model, or a replay performs the lane)."""
+        if self.model_factory is None or self.replaying or self.handed_over:
             return False
-        engine = self.lane_user.engine
-        model = self.model_factory()
-        if engine is not None:
-            model.attach(_RecordingSession(self, engine))
-        self.lane_user.model = model
-        pending = list(self.lane_user.items.values())
-        self.lane_user.items.clear()
+        current = list({o.item.key: o.item for o in self.offers}.values())
         self.offers.clear()
-        for item in pending:
-            model.offer(item)
+        self.lane_user.hand_over(self.model_factory(), current)
         return True
 
     def take_back(self) -> None:
-        """The person performs the lane again (the model's pending work is withdrawn)."""
-        self.lane_user.model = None
+        """The person performs the lane again: the model's pending work is withdrawn from
+        it (a delayed action of the model does nothing) and offered to the person."""
+        if not self.handed_over:
+            return
+        for item in self.lane_user.take_back():
+            self._offered(item)
 
     @property
     def handed_over(self) -> bool:
         return self.lane_user.model is not None
 
+    @property
+    def calling(self) -> bool:
+        """Whether the device calls the person now: its alarm (or other signal to the
+        user) is on; for a spec whose device does not signal, whether something waits for
+        the person."""
+        if self.device_signals:
+            return self.board.ringing
+        return bool(self.offers) and not self.handed_over
+
     # ------------------------------------------------------------------ engine side
     def _offered(self, item: WorkItem) -> None:
+        # the same activity offered in a newer instance supersedes the older offer (three
+        # ignored alarms leave one "Hear the alarm", the newest); the older one is not
+        # done, it lapses as an untaken action does
+        stale = {o.item.key for o in self.offers
+                 if o.item.process == item.process and o.item.activity == item.activity
+                 and o.item.instance != item.instance}
+        if stale:
+            self.lapsed += len(stale)
+            for key in stale:
+                self.lane_user.items.pop(key, None)
+            self._drop_offers(*stale)
+        self._offer_seq += 1
+        self._seq_of[item.key] = self._offer_seq
         if item.choices:
-            self.offers.extend(Offer(item, choice) for choice in item.choices)
+            self.offers.extend(Offer(item, choice, self._names.get((item.process, choice)))
+                               for choice in item.choices)
         else:
             self.offers.append(Offer(item, None))
 
-    def _drop_offers(self, key: int) -> None:
-        self.offers = [o for o in self.offers if o.item.key != key]
+    def _drop_offers(self, *keys: int) -> None:
+        self.offers = [o for o in self.offers if o.item.key not in keys]
+        for key in keys:
+            self._seq_of.pop(key, None)
+
+    def _drop_instance(self, instance: int) -> None:
+        """An instance ended: what it offered the person goes."""
+        gone = [k for k, i in self.lane_user.items.items() if i.instance == instance]
+        for key in gone:
+            self.lane_user.items.pop(key, None)
+        self._drop_offers(*gone, *(o.item.key for o in self.offers
+                                   if o.item.instance == instance))
 
     def _on_event(self, event: TraceEvent) -> None:
         self.events.append(event)
         kind = event.kind
         if kind == "activity.withdrawn" and event.activity:
-            self.offers = [o for o in self.offers if not (
-                o.item.instance == event.instance and o.item.activity == event.activity)]
+            gone = [o.item.key for o in self.offers if o.item.instance == event.instance
+                    and o.item.activity == event.activity]
+            self._drop_offers(*gone)
             self.lane_user.items = {k: i for k, i in self.lane_user.items.items() if not (
                 i.instance == event.instance and i.activity == event.activity)}
         if event.instance is not None and event.activity and event.lane != "user":
@@ -388,6 +356,7 @@ class WalkSession:
                 self.deadlines.pop((event.instance, event.activity), None)
         if kind.startswith("process.") and kind != "process.started" and (
                 event.instance is not None):
+            self._drop_instance(event.instance)
             self.device_work = {w for w in self.device_work if w[0] != event.instance}
             self.current.pop(event.instance, None)
             self.deadlines = {k: v for k, v in self.deadlines.items()
@@ -401,10 +370,7 @@ class WalkSession:
             prefix = "FAULT: " if kind == "fault" else "note: "
             self.participants[who] = prefix + str(data.get("message", ""))
         if kind == "process.started" and event.lane == "user":
-            self.calling = True
             self.calls += 1
-        if kind == "process.completed" and event.lane == "user":
-            self.calling = False
         for listener in self.listeners:
             listener(event)
 
