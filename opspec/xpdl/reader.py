@@ -150,6 +150,19 @@ def _has_doctype(data: bytes) -> bool:
     return any(marker in head for marker in _DOCTYPE_MARKERS)
 
 
+def _doctype_line(data: bytes) -> int | None:
+    """The 1-based line of the first ``<!DOCTYPE`` in ``data`` (UTF-8 or UTF-16); a DOCTYPE
+    comes before the root element, so the first one is the real one."""
+    head = data
+    for marker, newline in zip(_DOCTYPE_MARKERS,
+                               (b"\n", "\n".encode("utf-16-le"), "\n".encode("utf-16-be")),
+                               strict=True):
+        at = head.find(marker)
+        if at >= 0:
+            return head.count(newline, 0, at) + 1
+    return None
+
+
 def _doctype_error(path: str, line: int | None) -> XmlReadError:
     return XmlReadError(
         "doctype",
@@ -181,7 +194,7 @@ def _parse(data: bytes, path: str) -> tuple[etree._Element, list[Diagnostic]]:
         return etree.fromstring(data, _parser(first)), warnings
     except etree.XMLSyntaxError as error:
         if _has_doctype(data):
-            raise _doctype_error(path, error.lineno) from None
+            raise _doctype_error(path, _doctype_line(data) or error.lineno) from None
         retry = not utf16 and _is_encoding_error(error) and declared in (None, "utf-8", *_ASCII_NAMES)
         if not retry:
             raise _not_well_formed(path, error) from None
@@ -253,7 +266,7 @@ def read_tree(data: bytes, *, path: str, max_bytes: int = DEFAULT_MAX_BYTES) -> 
     root, warnings = _parse(data, path)
     tree = root.getroottree()
     if tree.docinfo.doctype or tree.docinfo.internalDTD is not None:
-        raise _doctype_error(path, 1)
+        raise _doctype_error(path, _doctype_line(data) or 1)
     qname = etree.QName(root)
     line = line_of(root)
     if qname.localname != "Package":

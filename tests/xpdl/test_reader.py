@@ -20,9 +20,9 @@ MINIMAL = b'<Package xmlns="http://www.wfmc.org/2008/XPDL2.1" Id="p"/>'
 @pytest.mark.parametrize(
     ("name", "code", "line"),
     [
-        ("xxe.xpdl", "doctype", 1),
-        ("billion_laughs.xpdl", "doctype", 1),
-        ("external_dtd.xpdl", "doctype", 1),
+        ("xxe.xpdl", "doctype", 2),
+        ("billion_laughs.xpdl", "doctype", 2),
+        ("external_dtd.xpdl", "doctype", 2),
         ("garbage.xpdl", "not-well-formed", 1),
         ("truncated.xpdl", "not-well-formed", 6),
         ("empty.xpdl", "empty-file", None),
@@ -57,6 +57,21 @@ def test_doctype_message_says_how_to_fix() -> None:
         read_xml((DATA / "external_dtd.xpdl").read_bytes(), path="x.xpdl")
     assert info.value.code == "doctype"
     assert "remove the <!DOCTYPE" in str(info.value)
+
+
+@pytest.mark.parametrize("encoding", ["utf-8", "utf-16"])
+@pytest.mark.parametrize("doctype", [
+    '<!DOCTYPE Package SYSTEM "http://example.org/x.dtd">',            # parses: docinfo check
+    '<!DOCTYPE Package [<!ENTITY e SYSTEM "file:///etc/passwd">]>',    # parses
+    '<!DOCTYPE Package [<!ENTITY broken',                               # does not parse
+], ids=["external", "entity", "broken"])
+def test_doctype_error_names_the_doctype_line(doctype: str, encoding: str) -> None:
+    text = ('<?xml version="1.0"?>\n<!-- a comment\nover two lines -->\n' + doctype
+            + '\n<Package xmlns="http://www.wfmc.org/2008/XPDL2.1" Id="p"/>\n')
+    result = parse_bytes(text.encode(encoding), path="d.xpdl")
+    (diagnostic,) = result.diagnostics
+    assert diagnostic.code == "doctype"
+    assert diagnostic.location.line == 4
 
 
 def test_file_over_the_size_limit_is_refused_before_parsing(tmp_path: Path) -> None:
