@@ -138,10 +138,13 @@ def _check_plan(plan: Any) -> dict[str, list[dict[str, Any]]]:
         from opspec.engine.lanes import user_lane
 
         if context.model is None and not user_lane(context.compiled).empty:
+            from opspec.usermodels.loader import preset_names
+
             raise EvaluationError(
                 f"{design.spec}: the spec has a user lane but no user model was given",
-                hint="give --user-model FILE|PRESET (presets: opspec fit --help, "
-                "docs/user-models.md) or put SPEC.users.toml next to the spec")
+                hint="give --user-model FILE|PRESET (presets: "
+                f"{', '.join(preset_names())}; docs/user-models.md) or put SPEC.users.toml "
+                "next to the spec")
         definitions[design.label] = [
             {"name": m.name, "kind": m.kind.value.lower(), "numerator": m.numerator,
              "denominator": m.denominator, "unit": m.unit, "description": m.description}

@@ -65,9 +65,16 @@ FILENAME = "results.sqlite"
 
 def _fail(path: Path, doing: str, error: BaseException) -> EvaluationError:
     reason = getattr(error, "strerror", None) or str(error)
-    return EvaluationError(f"{path}: cannot {doing}: {reason}",
-                           hint="check that the output folder is writable and the disk has "
-                           "room (--out DIR chooses another folder)")
+    if isinstance(error, sqlite3.DatabaseError) and "not a database" in reason:
+        hint = ("the file is damaged or is not an opspec result store; start the run again "
+                "with another --out (the damaged file is left as it is)")
+    elif isinstance(error, sqlite3.OperationalError) and "full" in reason:
+        hint = ("free some space, then `opspec evaluate --resume --out "
+                f"{path.parent}`: every replication stored so far is kept")
+    else:
+        hint = ("check that the output folder is writable and the disk has room; once it "
+                "is, --resume continues a started run (--out DIR chooses another folder)")
+    return EvaluationError(f"{path}: cannot {doing}: {reason}", hint=hint)
 
 
 class ResultStore:

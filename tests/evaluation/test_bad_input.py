@@ -121,3 +121,21 @@ def test_unreachable_scheduler_is_a_clear_error_before_anything_is_written(evalu
     assert status == 2 and doc is None
     assert f"cannot reach the Dask scheduler at tcp://127.0.0.1:{port}" in err
     assert not out.exists()
+
+
+def test_a_damaged_result_store_says_so_and_how_to_go_on(evaluate, tmp_path):
+    out = tmp_path / "out"
+    out.mkdir()
+    (out / "results.sqlite").write_bytes(b"this is not an SQLite database " * 40)
+    status, doc, err = evaluate("--resume", "--out", str(out))
+    assert status == 2 and doc is None
+    assert "results.sqlite: cannot open the result database: file is not a database" in err
+    assert "damaged" in err and "another --out" in err and "Traceback" not in err
+
+
+def test_a_spec_with_a_user_lane_and_no_model_lists_the_presets(evaluate, tmp_path):
+    spec = tmp_path / "lonely.xpdl"
+    spec.write_text(SPEC.read_text(encoding="utf-8"), encoding="utf-8")   # no companion model
+    status, _, err = evaluate(str(spec), "--users", "2", "--out", str(tmp_path / "o"))
+    assert status == 2
+    assert "no user model was given" in err and "dispenser-reference" in err
