@@ -5,8 +5,9 @@ Contract:
 - no network, no DTD loading, no entity expansion (``XMLParser(resolve_entities=False,
   no_network=True, load_dtd=False, huge_tree=False)``), and any ``DOCTYPE`` is rejected outright
   (XPDL never needs one; DTDs are how XXE and entity bombs get in);
-- a size limit (:data:`DEFAULT_MAX_BYTES`, configurable) checked before parsing, and while
-  reading a stream, so a 1 GB file is never read into memory;
+- a size limit (:data:`DEFAULT_MAX_BYTES`; callers pass ``max_bytes``, users set the
+  environment variable :data:`MAX_BYTES_VARIABLE`, which replaces the default) checked before
+  parsing, and while reading a stream, so a 1 GB file is never read into memory;
 - byte-order marks (UTF-8/UTF-16), missing XML declarations and ``ASCII``/``us-ascii``
   declarations on files that really hold UTF-8 are handled; a file that is not valid UTF-8 and
   declares nothing else is read as Latin-1 with a warning;
@@ -17,6 +18,7 @@ Contract:
 
 from __future__ import annotations
 
+import os
 import re
 from dataclasses import dataclass
 from pathlib import Path
@@ -30,8 +32,10 @@ from opspec.xpdl.namespaces import XPDL_NAMESPACES, version_of_namespace
 
 __all__ = [
     "DEFAULT_MAX_BYTES",
+    "MAX_BYTES_VARIABLE",
     "ReadOutcome",
     "XmlReadError",
+    "effective_max_bytes",
     "line_of",
     "read_file",
     "read_limited",
@@ -41,6 +45,9 @@ __all__ = [
 
 #: Default size limit of one specification file (64 MiB).
 DEFAULT_MAX_BYTES: Final = 64 * 1024 * 1024
+#: The environment variable that sets the size limit in bytes instead of the default
+#: (``OPSPEC_MAX_SPEC_BYTES=200000000 opspec validate big.xpdl``; docs/validation.md).
+MAX_BYTES_VARIABLE: Final = "OPSPEC_MAX_SPEC_BYTES"
 
 # libxml2 stores line numbers in 16 bits for some nodes: from 65,535 on they are not trustworthy.
 _LAST_TRUSTED_LINE: Final = 65534
@@ -58,7 +65,7 @@ _DOCTYPE_MARKERS: Final = (
 class XmlReadError(SpecError):
     """A file cannot be read as XPDL at all. ``code`` is one of ``io-error``, ``too-big``,
     ``empty-file``, ``not-well-formed``, ``resource-limit``, ``doctype``, ``unknown-root``,
-    ``unknown-version``."""
+    ``unknown-version``, ``bad-setting``."""
 
     def __init__(self, code: str, message: str, *, location: SourceLocation, hint: str = "") -> None:
         self.code = code
@@ -97,11 +104,34 @@ def _parser(encoding: str | None = None) -> etree.XMLParser:
     )
 
 
+def effective_max_bytes(max_bytes: int, *, path: str = "<spec>") -> int:
+    """``max_bytes``, or the value of :data:`MAX_BYTES_VARIABLE` when the caller left the
+    default. A value that is not a positive whole number is an :class:`XmlReadError`
+    (``bad-setting``) rather than silently ignored."""
+    raw = os.environ.get(MAX_BYTES_VARIABLE, "").strip()
+    if max_bytes != DEFAULT_MAX_BYTES or not raw:
+        return max_bytes
+    try:
+        value = int(raw.replace("_", ""))
+    except ValueError:
+        value = 0
+    if value <= 0:
+        raise XmlReadError(
+            "bad-setting",
+            f"{MAX_BYTES_VARIABLE}={raw!r} is not a positive whole number of bytes",
+            location=SourceLocation(path, 1),
+            hint=f"set e.g. {MAX_BYTES_VARIABLE}=200000000, or unset it for the default "
+            f"of {DEFAULT_MAX_BYTES:,} bytes")
+    return value
+
+
 def read_limited(stream: BinaryIO, *, path: str, max_bytes: int = DEFAULT_MAX_BYTES) -> bytes:
-    """Read a binary stream to its end, refusing it as soon as it exceeds ``max_bytes``.
+    """Read a binary stream to its end, refusing it as soon as it exceeds ``max_bytes``
+    (see :func:`effective_max_bytes`).
 
     At most ``max_bytes`` plus one chunk is ever held in memory.
     """
+    max_bytes = effective_max_bytes(max_bytes, path=path)
     chunks: list[bytes] = []
     total = 0
     while True:
@@ -117,6 +147,7 @@ def read_limited(stream: BinaryIO, *, path: str, max_bytes: int = DEFAULT_MAX_BY
 def read_file(path: str | Path, *, max_bytes: int = DEFAULT_MAX_BYTES) -> bytes:
     """The bytes of a file, checking its size before reading it."""
     shown = str(path)
+    max_bytes = effective_max_bytes(max_bytes, path=shown)
     try:
         size = Path(path).stat().st_size
         if size > max_bytes:
@@ -136,12 +167,14 @@ def read_file(path: str | Path, *, max_bytes: int = DEFAULT_MAX_BYTES) -> bytes:
 
 
 def _too_big(path: str, max_bytes: int) -> XmlReadError:
+    # Line 1: the file as a whole is refused, before any of it is parsed.
     return XmlReadError(
         "too-big",
-        f"file is larger than the limit of {max_bytes:,} bytes",
-        location=SourceLocation(path),
+        f"the file is larger than the limit of {max_bytes:,} bytes, so it was not read",
+        location=SourceLocation(path, 1),
         hint="split the package into several files referenced as ExternalPackages, or raise "
-        "the size limit",
+        f"raise the limit: set the environment variable {MAX_BYTES_VARIABLE} to a number of "
+        "bytes",
     )
 
 
@@ -254,13 +287,14 @@ def _not_well_formed(path: str, error: etree.XMLSyntaxError) -> XmlReadError:
 
 def read_tree(data: bytes, *, path: str, max_bytes: int = DEFAULT_MAX_BYTES) -> ReadOutcome:
     """Parse ``data`` safely and check that it is an XPDL package. Raises :class:`XmlReadError`."""
+    max_bytes = effective_max_bytes(max_bytes, path=path)
     if len(data) > max_bytes:
         raise _too_big(path, max_bytes)
     if not data.strip(b" \t\r\n\x00\xef\xbb\xbf\xff\xfe"):
         raise XmlReadError(
             "empty-file",
-            "the file is empty",
-            location=SourceLocation(path),
+            "the file is empty (no XML in it)",
+            location=SourceLocation(path, 1),
             hint="an XPDL file starts with a <Package> element",
         )
     root, warnings = _parse(data, path)

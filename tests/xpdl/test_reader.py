@@ -25,7 +25,7 @@ MINIMAL = b'<Package xmlns="http://www.wfmc.org/2008/XPDL2.1" Id="p"/>'
         ("external_dtd.xpdl", "doctype", 2),
         ("garbage.xpdl", "not-well-formed", 1),
         ("truncated.xpdl", "not-well-formed", 6),
-        ("empty.xpdl", "empty-file", None),
+        ("empty.xpdl", "empty-file", 1),
         ("wrong_root.xpdl", "unknown-root", 2),
         ("unknown_namespace.xpdl", "unknown-version", 2),
     ],
@@ -81,6 +81,39 @@ def test_file_over_the_size_limit_is_refused_before_parsing(tmp_path: Path) -> N
     assert result.package is None
     assert result.diagnostics[0].code == "too-big"
     assert "1,000 bytes" in result.diagnostics[0].message
+
+
+def test_size_limit_hint_names_the_variable_that_raises_it(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    from opspec.xpdl.reader import DEFAULT_MAX_BYTES, MAX_BYTES_VARIABLE
+
+    big = tmp_path / "big.xpdl"
+    big.write_bytes(MINIMAL + b" " * 5000)
+    monkeypatch.setenv(MAX_BYTES_VARIABLE, "1000")
+    (diagnostic,) = load_package(big).diagnostics     # the default limit, replaced by the variable
+    assert diagnostic.code == "too-big" and diagnostic.location.line == 1
+    assert MAX_BYTES_VARIABLE in diagnostic.hint and "1,000 bytes" in diagnostic.message
+    assert parse_bytes(big.read_bytes(), path="big.xpdl").diagnostics[0].code == "too-big"
+    monkeypatch.setenv(MAX_BYTES_VARIABLE, "100000")
+    assert load_package(big).ok
+    # an explicit max_bytes from a caller wins over the variable
+    assert load_package(big, max_bytes=1000).diagnostics[0].code == "too-big"
+    assert DEFAULT_MAX_BYTES > 100000
+
+
+@pytest.mark.parametrize("value", ["lots", "-5", "0"])
+def test_a_bad_size_limit_setting_is_an_error_not_ignored(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, value: str
+) -> None:
+    from opspec.xpdl.reader import MAX_BYTES_VARIABLE
+
+    spec = tmp_path / "ok.xpdl"
+    spec.write_bytes(MINIMAL)
+    monkeypatch.setenv(MAX_BYTES_VARIABLE, value)
+    (diagnostic,) = load_package(spec).diagnostics
+    assert diagnostic.code == "bad-setting" and MAX_BYTES_VARIABLE in diagnostic.message
+    assert diagnostic.location.line == 1
 
 
 class EndlessStream(io.RawIOBase):
