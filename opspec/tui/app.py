@@ -45,11 +45,11 @@ HELP = """\
   [b]1 2 3 4[/b] speed: real time, 10x, 60x, 600x
   [b]w[/b]       let 30 simulated seconds pass
   [b]n[/b]       skip to the next event
-  [b]u[/b]       skip until something needs you
+  [b]u[/b]       skip until something new needs you (again: stop)
   [b]h[/b]       hand your lane to the user model / take it back
   [b]l[/b]       timeline: all lanes / device / user
   [b]?[/b]       this help
-  [b]q[/b], [b]ctrl+c[/b] quit (the recording is kept; its path is printed)
+  [b]q[/b], [b]ctrl+c[/b], [b]ctrl+q[/b] quit (the recording is kept)
 
 Device panel: (!) an alert (a ringing alarm), (x) a device fault,
 > what a participant is doing now.
@@ -58,7 +58,8 @@ Press escape or ? to close."""
 
 
 class HelpScreen(ModalScreen[None]):
-    BINDINGS: ClassVar = [Binding("escape,question_mark,q", "dismiss", "close")]
+    BINDINGS: ClassVar = [Binding("escape,question_mark", "dismiss", "close"),
+                          Binding("q", "app.quit_walk", "quit")]
     DEFAULT_CSS = """
     HelpScreen { align: center middle; }
     HelpScreen > Static { width: 70; max-width: 100%; border: heavy $accent; padding: 1 2;
@@ -226,7 +227,10 @@ class WalkthroughApp(App[str | None]):
         self.refresh_views()
 
     def action_hand_over(self) -> None:
-        if self.session.handed_over:
+        if self.session.replaying:
+            self.notify("The recording performs your lane: there is nothing to hand over.",
+                        severity="warning")
+        elif self.session.handed_over:
             self.session.take_back()
             self.notify("You perform the user lane again.")
         elif self.session.hand_over():
@@ -369,7 +373,9 @@ class WalkthroughApp(App[str | None]):
         shown = 0
         for event in reversed(self.session.events):
             # the person's (or the model's) actions belong to the user lane
-            shown_lane = "user" if event.kind == "walkthrough.action" else event.lane or ""
+            shown_lane = ("user" if event.kind == "walkthrough.action"
+                          else "device" if event.kind in ("fault", "device.note")
+                          else event.lane or "")
             if event.kind not in _TIMELINE_KINDS or (lane != "all" and shown_lane != lane):
                 continue
             what = f"{event.activity or event.process or ''} {event.kind.split('.')[-1]}"

@@ -297,3 +297,58 @@ async def test_while_the_model_has_the_lane_skipping_stops_at_the_next_call(comp
         assert "model performs your lane" in screen_text(app)
         await pilot.press("n", "n", "n", "u")
         assert 8 * 3600 < session.now <= 12 * 3600
+
+
+@pytest.mark.asyncio
+async def test_q_in_the_help_screen_quits(compiled, tmp_path):
+    record = tmp_path / "h.json"
+    app = WalkthroughApp(WalkSession(compiled, record=record))
+    async with app.run_test(size=(80, 24)) as pilot:
+        await pilot.press("question_mark")
+        await pilot.pause()
+        assert "ctrl+q" in str(app.screen.query_one("#help-text").render())
+        await pilot.press("q")
+        await pilot.pause()
+    assert app.return_value == str(record)
+
+
+@pytest.mark.asyncio
+async def test_a_replay_says_the_recording_performs_and_has_nothing_to_hand_over(
+        compiled, tmp_path, model_factory):
+    record = tmp_path / "walk.json"
+    record.write_text('{"otherwise": "wait", "steps": [["at 28830.0", "complete hear_alarm"]]}',
+                      encoding="utf-8")
+    session = WalkSession(compiled, replay=load_recording(record, compiled),
+                          model_factory=model_factory)
+    app = WalkthroughApp(session)
+    async with app.run_test(size=(80, 24)) as pilot:
+        await start(app, pilot)
+        await pilot.press("h")
+        assert not session.handed_over
+        text = screen_text(app)
+        assert "the recording performs your lane" in text
+        assert "model is performing" not in text and "press u to skip" not in text
+
+
+@pytest.mark.asyncio
+async def test_with_the_lane_handed_over_the_panel_says_only_that(compiled, model_factory):
+    session = WalkSession(compiled, model_factory=model_factory)
+    app = WalkthroughApp(session)
+    async with app.run_test(size=(80, 24)) as pilot:
+        await start(app, pilot)
+        await pilot.press("h")
+        text = screen_text(app)
+        assert "The user model is performing. Press h to take over." in text
+        assert "nothing to do now" not in text
+
+
+@pytest.mark.asyncio
+async def test_a_fault_in_the_timeline_is_in_the_device_lane(compiled):
+    session = WalkSession(compiled)
+    app = WalkthroughApp(session)
+    async with app.run_test(size=(80, 24)) as pilot:
+        await start(app, pilot)
+        session.sim.session.trace("fault", {"fault": "disconnected",
+                                            "device": "medication_dispenser"})
+        await pilot.press("l")                         # device lane only
+        assert "device FAULT medication_dispenser" in str(app.query_one("#timeline").render())
