@@ -85,6 +85,15 @@ def _write_atomically(target: Path, data: bytes) -> None:
     handle, temp = tempfile.mkstemp(prefix=f".{target.name}.", suffix=".tmp",
                                     dir=str(target.parent) or ".")
     try:
+        # mkstemp creates the file 0600: give it the mode of the file it replaces, or that of
+        # an ordinary new file (0666 without the umask).
+        try:
+            mode = target.stat().st_mode & 0o7777
+        except OSError:
+            umask = os.umask(0o022)
+            os.umask(umask)
+            mode = 0o666 & ~umask
+        os.fchmod(handle, mode)
         with os.fdopen(handle, "wb") as stream:
             stream.write(data)
         os.replace(temp, target)

@@ -415,6 +415,17 @@ def loads(text: str | bytes, *, where: str = "<.wfs text>") -> Package:
 # --------------------------------------------------------------------------- files
 
 
+def _file_mode(target: Path) -> int:
+    """The permission bits for writing ``target``: those of the file it replaces, else
+    0666 without the process's umask (as ``open()`` would create it)."""
+    try:
+        return target.stat().st_mode & 0o7777
+    except OSError:
+        umask = os.umask(0o022)
+        os.umask(umask)
+        return 0o666 & ~umask
+
+
 def write_wfs(package: Package, path: str | os.PathLike[str]) -> None:
     """Write ``package`` to ``path`` atomically (a temporary file in the same folder, then a
     rename), so a reader never sees half a script. ``OSError`` propagates (the caller reports
@@ -425,6 +436,9 @@ def write_wfs(package: Package, path: str | os.PathLike[str]) -> None:
         prefix=f".{target.name}.", suffix=".tmp", dir=target.parent if str(target.parent) else "."
     )
     try:
+        # mkstemp creates the file 0600; give it the mode an ordinary new file would get
+        # (0666 minus the umask), or keep the mode of the file it replaces.
+        os.fchmod(handle, _file_mode(target))
         with os.fdopen(handle, "wb") as stream:
             stream.write(text)
             stream.write(b"\n")

@@ -131,3 +131,24 @@ def test_compile_refuses_a_spec_that_validate_rejects(
 @pytest.mark.parametrize("path", sorted(SPECS.glob("*.xpdl")), ids=lambda p: p.name)
 def test_every_bundled_spec_compiles(tmp_path: Path, path: Path) -> None:
     assert main(["compile", str(path), "-o", str(tmp_path / "out.wfs")]) == 0
+
+
+@pytest.mark.parametrize("command", ["compile", "preprocess"])
+def test_written_files_respect_the_umask(tmp_path: Path, command: str) -> None:
+    import os
+    import stat
+
+    out = tmp_path / ("out.wfs" if command == "compile" else "out.xpdl")
+    old = os.umask(0o022)
+    try:
+        assert main([command, str(SPECS / "toy_sumo.xpdl"), "-o", str(out)]) == 0
+        assert stat.S_IMODE(out.stat().st_mode) == 0o644
+        os.umask(0o027)
+        other = out.with_name("other" + out.suffix)
+        assert main([command, str(SPECS / "toy_sumo.xpdl"), "-o", str(other)]) == 0
+        assert stat.S_IMODE(other.stat().st_mode) == 0o640
+        out.chmod(0o664)                       # rewriting keeps the mode the file has
+        assert main([command, str(SPECS / "toy_sumo.xpdl"), "-o", str(out)]) == 0
+        assert stat.S_IMODE(out.stat().st_mode) == 0o664
+    finally:
+        os.umask(old)
