@@ -51,17 +51,47 @@ def build_parser() -> argparse.ArgumentParser:
     for name in COMMAND_MODULES:
         try:
             module = importlib.import_module(name)
+            module.register(subparsers)
         except ModuleNotFoundError as error:
             if error.name == name:  # that command is not built yet
                 continue
-            raise
-        module.register(subparsers)
+            _register_broken(subparsers, name, error)
+        except Exception as error:  # noqa: BLE001 - a broken command must not break the others
+            _register_broken(subparsers, name, error)
     return parser
+
+
+def _register_broken(subparsers: argparse._SubParsersAction[argparse.ArgumentParser],
+                     module: str, error: Exception) -> None:
+    """Stand in for a command whose module fails to import or register: the other commands
+    keep working, and this one says what is wrong in one line when it is used."""
+    command = module.rsplit(".", 1)[-1]
+    if command in subparsers.choices:
+        return
+    reason = " ".join(f"{type(error).__name__}: {error}".split())
+
+    def broken(_args: argparse.Namespace) -> int:
+        print(f"opspec: internal error: the {command!r} command cannot be loaded ({reason}) "
+              "(this is a bug in opspec; rerun with OPSPEC_DEBUG=1 for a traceback and "
+              "report it)", file=sys.stderr)
+        if os.environ.get("OPSPEC_DEBUG"):
+            traceback.print_exception(error)
+        return 70
+
+    parser = subparsers.add_parser(command, help="(unavailable: this command failed to load)",
+                                   add_help=False)
+    parser.add_argument("rest", nargs=argparse.REMAINDER, help=argparse.SUPPRESS)
+    parser.set_defaults(handler=broken)
 
 
 def main(argv: Sequence[str] | None = None) -> int:
     """Entry point of the console script; returns the exit status."""
-    parser = build_parser()
+    try:
+        parser = build_parser()
+    except Exception as error:  # noqa: BLE001 - no traceback reaches a user
+        print(f"opspec: internal error: {' '.join(f'{type(error).__name__}: {error}'.split())} "
+              "(this is a bug in opspec; please report it)", file=sys.stderr)
+        return 70
     args = parser.parse_args(argv)
     handler = getattr(args, "handler", None)
     if handler is None:

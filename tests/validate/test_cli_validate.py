@@ -206,3 +206,20 @@ def test_every_code_the_reader_emits_is_documented() -> None:
     assert {"doctype", "resource-limit", "too-many-attributes"} <= codes
     docs = (root / "docs" / "validation.md").read_text()
     assert sorted(c for c in codes if f"`{c}`" not in docs) == []
+
+
+def test_a_command_module_that_fails_to_import_breaks_only_that_command(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    import opspec.cli
+
+    (tmp_path / "opspec_broken_command_for_test.py").write_text("def register(:\n")
+    monkeypatch.syspath_prepend(str(tmp_path))
+    monkeypatch.setattr(opspec.cli, "COMMAND_MODULES",
+                        (*opspec.cli.COMMAND_MODULES, "opspec_broken_command_for_test"))
+    assert main(["validate", str(DATA / "valid.xpdl")]) == 0
+    capsys.readouterr()
+    assert main(["opspec_broken_command_for_test", "x", "--y"]) == 70
+    err = capsys.readouterr().err
+    assert "Traceback" not in err and len(err.strip().splitlines()) == 1
+    assert "SyntaxError" in err and "cannot be loaded" in err
