@@ -473,6 +473,10 @@ class DeviceBinding:
         for item in [w for w in self._waiting if (w.participant or "") == participant]:
             self._waiting.remove(item)
             self._sim.offer(item)
+        # commands queued for it (the line may stay held for a while) go simulated now too
+        for job in [j for j in self._queue if (j.item.participant or "") == participant]:
+            self._queue.remove(job)
+            self._reroute(job)
 
     def _reroute(self, job: _Job) -> None:
         """A queued job whose participant left the device: simulate it or fail it."""

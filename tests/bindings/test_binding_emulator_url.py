@@ -238,3 +238,16 @@ def test_the_shipped_dispenser_never_sends_dispense_twice(
     assert [f[1] for f in session.failed] == ["DispenserFault"]
     assert [(f["command"], f["action"]) for f in session.kinds("fault")] == [
         ("DISPENSE 1", "abort"), ("ALARM ON", "retry"), ("ALARM ON", "simulate")]
+
+
+def test_commands_queued_for_a_participant_that_goes_simulated_follow_it_at_once(
+        binder: Binder, session: FakeSession, fast_profile: DeviceProfile,
+        fast_url: Callable[[str], str]) -> None:
+    binding = binder(PARTS, fast_url("silent"), fast_profile)
+    first, second = item("alarm_on"), item("alarm_off")
+    binding.offer(first)
+    binding.offer(second)                  # queued behind the unanswered ALARM ON
+    run_until(binding.inbox, session, lambda: bool(session.answered))
+    # the same drain that gave up on the device simulated both (no wait for the line's hold)
+    assert sorted(c[0].key for c in session.completed) == sorted([first.key, second.key])
+    assert binding.pending() == []
