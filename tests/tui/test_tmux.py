@@ -16,8 +16,13 @@ pytestmark = pytest.mark.skipif(shutil.which("tmux") is None,
                                 reason="tmux is not installed (scripts/system-deps.sh installs it)")
 
 
+# a private server: the test never touches the user's own tmux sessions
+SOCKET = f"opspec-test-{uuid.uuid4().hex[:8]}"
+
+
 def tmux(*args: str) -> str:
-    return subprocess.run(["tmux", *args], capture_output=True, text=True, check=True).stdout
+    return subprocess.run(["tmux", "-L", SOCKET, *args], capture_output=True, text=True,
+                          check=True).stdout
 
 
 def wait_for(session: str, text: str, timeout: float = 30.0) -> str:
@@ -53,4 +58,24 @@ def test_walkthrough_in_tmux_shows_the_alarm_and_says_where_the_recording_is(tmp
         assert str(record.name) in said
         assert "complete hear_alarm" in Path(record).read_text(encoding="utf-8")
     finally:
-        subprocess.run(["tmux", "kill-session", "-t", session], capture_output=True, check=False)
+        subprocess.run(["tmux", "-L", SOCKET, "kill-session", "-t", session],
+                       capture_output=True, check=False)
+
+
+def test_q_quits_at_once_while_a_long_skip_runs(tmp_path):
+    session = f"opspec-{uuid.uuid4().hex[:8]}"
+    vacuum = SPEC.parent / "vacuum_cleaner.xpdl"
+    command = (f"{sys.executable} -m opspec.cli walkthrough {vacuum} --no-record; "
+               "echo EXIT=$?")
+    tmux("new-session", "-d", "-s", session, "-x", "80", "-y", "24")
+    try:
+        tmux("set-option", "-t", session, "remain-on-exit", "on")
+        tmux("send-keys", "-t", session, command, "Enter")
+        wait_for(session, "no user lane")
+        tmux("send-keys", "-t", session, "u")          # to the end of a 75-minute run
+        wait_for(session, "skipping")
+        tmux("send-keys", "-t", session, "q")
+        wait_for(session, "EXIT=0", timeout=5.0)       # not after the skip
+    finally:
+        subprocess.run(["tmux", "-L", SOCKET, "kill-session", "-t", session],
+                       capture_output=True, check=False)
