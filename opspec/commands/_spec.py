@@ -27,7 +27,9 @@ def load_any_spec(path: str | Path) -> Package:
     reports (a :class:`~opspec.errors.SpecError` listing them with ``path:line``): the run,
     evaluate and walkthrough commands never execute a spec that validation rejects.
     ``.wfs`` scripts (compiled from specs that passed) and paths that are not files open as
-    :func:`opspec.xpdl.open_spec.open_spec` does. The world is checked when it is built."""
+    :func:`opspec.xpdl.open_spec.open_spec` does. What :func:`engine_diagnostics` adds
+    for validate (monitors, the world) is raised as a located ConfigurationError (exit 2)
+    when the run builds them, as before."""
     from opspec.xpdl.open_spec import open_spec
 
     target = Path(path)
@@ -36,7 +38,7 @@ def load_any_spec(path: str | Path) -> Package:
     from opspec.errors import Severity, SpecError
     from opspec.xpdl.validate import validate_spec
 
-    package, report = validate_spec(target, extra=engine_diagnostics)
+    package, report = validate_spec(target)     # monitors and the world: checked as built
     errors = [d for d in report.diagnostics if d.severity is Severity.ERROR]
     if errors or package is None:
         raise SpecError.from_diagnostics(errors or report.diagnostics)
