@@ -337,8 +337,12 @@ def activity_rates_figure(rows: Sequence[tuple[str, float, float]], path: Path) 
         return _save(fig, path)
 
 
-def comparison_figure(rows: Sequence[tuple[str, float, float, float]], path: Path) -> Path:
-    """Forest plot: each ``(metric, difference B − A, ci_low, ci_high)`` against a zero line.
+def comparison_figure(rows: Sequence[tuple[str, float, float, float]], path: Path,
+                      units: Mapping[str, str] | None = None) -> Path:
+    """Each ``(metric, difference B − A, ci_low, ci_high)`` in its own panel with its own
+    scale and a zero line (metrics differ in unit and size: one shared axis would flatten a
+    rate's ±0.005 next to a latency's −40 s). ``units`` per metric: ``"pp"`` draws a rate's
+    difference in percentage points, other units label the axis.
 
     Differences whose interval excludes zero are drawn filled; the others hollow.
     """
@@ -348,30 +352,32 @@ def comparison_figure(rows: Sequence[tuple[str, float, float, float]], path: Pat
     dropped = len(rows) - len(clean)
     if not clean:
         return _empty(path, title)
-    with _figure(9.0, _bar_height(len(clean))) as fig:
-        ax = fig.add_subplot()
-        positions = list(range(len(clean)))[::-1]
-        ax.axvline(0.0, color="black", linewidth=1.2, linestyle="--", label="no difference")
-        shown_sig = shown_not = False
-        for pos, (name, diff, lo, hi) in zip(positions, clean, strict=True):
+    units = units or {}
+    with _figure(9.0, 0.9 + 0.75 * len(clean)) as fig:
+        axes = fig.subplots(len(clean), 1, squeeze=False)[:, 0]
+        fig.suptitle(title + " (filled: interval excludes 0)")
+        for ax, (name, diff, lo, hi) in zip(axes, clean, strict=True):
+            unit = units.get(name, "")
+            scale = 100.0 if unit == "pp" else 1.0
+            diff, lo, hi = diff * scale, lo * scale, hi * scale
             significant = lo > 0.0 or hi < 0.0
             colour = PALETTE[4] if significant else PALETTE[0]
-            label = None
-            if significant and not shown_sig:
-                label, shown_sig = "interval excludes 0", True
-            elif not significant and not shown_not:
-                label, shown_not = "interval includes 0", True
-            ax.errorbar([diff], [pos], xerr=[[max(diff - lo, 0.0)], [max(hi - diff, 0.0)]],
+            ax.axvline(0.0, color="black", linewidth=1.0, linestyle="--")
+            ax.errorbar([diff], [0.0], xerr=[[max(diff - lo, 0.0)], [max(hi - diff, 0.0)]],
                         fmt="D" if significant else "o", color=colour, ecolor=colour,
                         markerfacecolor=colour if significant else "white", capsize=5,
-                        markersize=7, linewidth=1.8, label=label)
-            ax.annotate(f"{diff:+.4g}  [{lo:+.4g}, {hi:+.4g}]", (hi, pos), xytext=(6, 0),
-                        textcoords="offset points", va="center", fontsize=9)
-        ax.set_yticks(positions, [m for m, *_ in clean])
-        ax.set_ylim(-0.7, len(clean) - 0.3)
-        ax.margins(x=0.3)
-        ax.set_title(title)
-        ax.set_xlabel("difference B − A (in each metric's own unit)")
-        ax.legend(loc="best")
+                        markersize=7, linewidth=1.8)
+            suffix = f" {unit}" if unit else ""
+            ax.annotate(f"{diff:+.4g}{suffix}  [{lo:+.4g}, {hi:+.4g}]", (hi, 0.0),
+                        xytext=(6, 0), textcoords="offset points", va="center", fontsize=9)
+            reach = max(abs(lo), abs(hi))
+            if reach == 0.0:             # the same for every user: no scale to show
+                ax.set_xlim(-1.0, 1.9)
+                ax.set_xticks([])
+            else:
+                ax.set_xlim(-reach * 1.25, reach * 1.9)  # room for the label on the right
+            ax.set_yticks([0.0], [f"{name} ({unit})" if unit else name])
+            ax.set_ylim(-1.0, 1.0)
+            ax.grid(axis="y", visible=False)
         _note_dropped(fig, dropped)
         return _save(fig, path)

@@ -165,7 +165,9 @@ def write_report(store: ResultStore) -> Path:
                 for name, d in difference.items() if d["difference"] is not None]
         rows = [(n, v, lo if lo is not None else v, hi if hi is not None else v)
                 for n, v, lo, hi in rows]
-        compared = ((plots.comparison_figure(rows, figures / "comparison.png"),) if rows
+        units = {name: "pp" if is_rate(name, d) else (d.get("unit") or "")
+                 for name, d in difference.items()}
+        compared = ((plots.comparison_figure(rows, figures / "comparison.png", units),) if rows
                     else ())
         sections.append(Section("B compared with A", paragraphs=(
             ("Differences B − A per metric on the same simulated users (paired); 'differs' "

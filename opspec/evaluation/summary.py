@@ -168,7 +168,9 @@ def compare_designs(store: ResultStore, a: str = "A", b: str = "B", level: float
         significant = (diff.low is not None and diff.high is not None
                        and (diff.low > 0 or diff.high < 0))
         out[definition["name"]] = {
-            "kind": definition["kind"], "a": ea.value, "b": eb.value,
+            "kind": definition["kind"], "unit": definition.get("unit") or (
+                "s" if definition["kind"] == "duration" else None),
+            "a": ea.value, "b": eb.value,
             "difference": diff.value, "ci95": diff.ci, "users": len(users),
             "significant": significant,
         }

@@ -102,12 +102,22 @@ def monitor_rows(monitors: Mapping[str, Mapping[str, Any]]) -> list[tuple[str, .
     return rows
 
 
+def _points(value: Any) -> str:
+    """A difference of two rates in percentage points: ``-0.54 pp``."""
+    return "–" if value is None else f"{value * 100:+.2f} pp"
+
+
 def comparison_rows(difference: Mapping[str, Mapping[str, Any]]) -> list[tuple[str, ...]]:
     rows: list[tuple[str, ...]] = []
     for name, d in difference.items():
         percent = is_rate(name, d)
-        rows.append((name, fmt(d["a"], percent=percent), fmt(d["b"], percent=percent),
-                     fmt(d["difference"], percent=percent), _ci(d, percent=percent),
+        unit = "" if percent else (d.get("unit") or "")
+        diff = _points(d["difference"]) if percent else fmt(d["difference"], unit)
+        low, high = d.get("ci95") or [None, None]
+        ci = (f"[{_points(low)}, {_points(high)}]" if percent and low is not None
+              and high is not None else _ci(d, unit))
+        rows.append((name, fmt(d["a"], unit, percent=percent),
+                     fmt(d["b"], unit, percent=percent), diff, ci,
                      "differs" if d["significant"] else ""))
     return rows
 

@@ -239,3 +239,21 @@ def test_designs_with_different_metrics_compare_only_what_both_declare(evaluate,
     difference = doc["compare"]["difference"]
     assert "caregiver_notified" not in difference and "caregiver_calls" not in difference
     assert difference["doses_due"]["difference"] == 0
+
+
+def test_comparison_table_gives_units_and_rate_differences_in_points(tmp_path, capsys):
+    # B waits 240 s instead of 300 s for the report: latency drops, in seconds
+    spec_b = tmp_path / "shorter_wait.xpdl"
+    spec_b.write_text(SPEC.read_text(encoding="utf-8").replace("PT300S", "PT240S"),
+                      encoding="utf-8")
+    (tmp_path / "shorter_wait.users.toml").write_text(USERS_TOML.read_text(encoding="utf-8"),
+                                                      encoding="utf-8")
+    status = main(["evaluate", str(SPEC), "--compare", str(spec_b), "--users", "40", "--days",
+                   "2", "--workers", "1", "--out", str(tmp_path / "out"), "--quiet"])
+    printed = capsys.readouterr().out.split("compared with B")[1]
+    assert status == 0
+    rows = {line.split()[0]: line for line in printed.splitlines()[3:] if line.strip()}
+    latency = rows["report_latency_s"]
+    assert latency.count(" s") >= 4 and "differs" in latency   # A, B, B − A and the CI
+    assert " pp" in rows["taken_rate"] and "%" in rows["taken_rate"]
+    assert (tmp_path / "out" / "figures" / "comparison.png").stat().st_size > 10_000
