@@ -303,7 +303,9 @@ class WalkthroughApp(App[str | None]):
             call.update(self._idle_text())
         box = self.query_one("#offers", Vertical)
         box.remove_children()
-        if session.handed_over and not session.ended:
+        if session.ended:
+            pass                                # nothing can be done any more
+        elif session.handed_over:
             box.mount(Static("The user model is performing. Press h to take over."))
         else:
             lines: list[Static] = []

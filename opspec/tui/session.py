@@ -244,7 +244,8 @@ class WalkSession:
     def act(self, offer: Offer) -> None:
         """The person does ``offer`` now."""
         engine = self.lane_user.engine
-        if engine is None or self.handed_over or offer.item.key not in self.lane_user.items:
+        if engine is None or self.ended or self.handed_over or (
+                offer.item.key not in self.lane_user.items):
             return
         self.lane_user.items.pop(offer.item.key, None)
         self._record(offer.action, by="person")
@@ -254,7 +255,8 @@ class WalkSession:
     def ignore(self, offer: Offer) -> None:
         """The person explicitly does not do ``offer`` (omission)."""
         engine = self.lane_user.engine
-        if engine is None or self.handed_over or offer.item.key not in self.lane_user.items:
+        if engine is None or self.ended or self.handed_over or (
+                offer.item.key not in self.lane_user.items):
             return
         self.lane_user.items.pop(offer.item.key, None)
         self._record(tagged_action("omit", offer.item.activity, offer.item.instance),

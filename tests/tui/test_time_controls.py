@@ -96,3 +96,18 @@ def test_the_command_refuses_bad_options_with_a_clear_message(args, message, cap
     assert main(["walkthrough", str(SPEC), *args]) == 2
     err = capsys.readouterr().err
     assert message in err and "internal error" not in err
+
+
+@pytest.mark.asyncio
+async def test_after_the_end_nothing_is_offered_and_keys_do_nothing(compiled, tmp_path):
+    session = WalkSession(compiled, days=0.35, record=tmp_path / "end.json")   # to 08:24
+    app = WalkthroughApp(session)
+    async with app.run_test(size=(80, 24)) as pilot:
+        await pilot.press("space")
+        for _ in range(6):                             # 08:00, 08:05, 08:10, the end
+            if not session.ended:
+                await pilot.press("u")
+        assert session.ended and session.offers        # the engine still holds the offer
+        assert not app.query("#offers Static")
+        await pilot.press("a", "x")
+        assert "hear_alarm" not in (tmp_path / "end.json").read_text(encoding="utf-8")
