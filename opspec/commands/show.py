@@ -37,7 +37,9 @@ def register(subparsers: Any) -> None:
         "show", help="print the processes, lanes, participants and activities of a spec",
         description="Print what SPEC holds, as readable text or as Graphviz DOT (one digraph "
         "per process; render with e.g. 'opspec show SPEC --format dot | dot -Tsvg -o out.svg').")
-    parser.add_argument("spec", metavar="SPEC", help="the XPDL specification")
+    parser.add_argument("spec", metavar="SPEC",
+                        help="the XPDL specification, or a workflow script (.wfs) compiled "
+                        "from one")
     parser.add_argument("--format", choices=("text", "dot"), default="text",
                         help="output format (default: text)")
     parser.add_argument("--process", metavar="ID", help="only this process (by Id)")
@@ -49,7 +51,10 @@ def run(args: argparse.Namespace) -> int:
     from opspec.xpdl.dot import package_to_dot
     from opspec.xpdl.loader import load_package
 
-    result = load_package(args.spec)
+    if str(args.spec).endswith(".wfs"):
+        result = _load_script(args.spec)
+    else:
+        result = load_package(args.spec)
     package = result.package
     if package is None:
         for diagnostic in result.diagnostics:
@@ -72,6 +77,29 @@ def run(args: argparse.Namespace) -> int:
     else:
         sys.stdout.write(describe_package(package, process=args.process))
     return 0
+
+
+def _load_script(path: str) -> Any:
+    """A compiled workflow script (``.wfs``) as a :class:`~opspec.xpdl.loader.LoadResult`
+    (compiled only from specs without errors, so it carries no diagnostics)."""
+    from pathlib import Path
+
+    from opspec.errors import Diagnostic, Severity, SourceLocation, SpecError
+    from opspec.model.codec import read_wfs
+    from opspec.xpdl.loader import LoadResult
+
+    if not Path(path).is_file():
+        what = "is a folder" if Path(path).is_dir() else "does not exist"
+        return LoadResult(None, (Diagnostic(SourceLocation(path), Severity.ERROR, "io-error",
+                                            f"cannot read the workflow script: it {what}",
+                                            "check the path"),))
+    try:
+        return LoadResult(read_wfs(path))
+    except SpecError as error:
+        location = error.location or SourceLocation(path, 1)
+        message = error.message.removeprefix(f"{path}: ")
+        return LoadResult(None, (Diagnostic(location, Severity.ERROR, "bad-script", message,
+                                            error.hint or ""),))
 
 
 # --------------------------------------------------------------------------- text

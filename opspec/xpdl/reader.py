@@ -65,7 +65,7 @@ _DOCTYPE_MARKERS: Final = (
 class XmlReadError(SpecError):
     """A file cannot be read as XPDL at all. ``code`` is one of ``io-error``, ``too-big``,
     ``empty-file``, ``not-well-formed``, ``resource-limit``, ``doctype``, ``unknown-root``,
-    ``unknown-version``, ``bad-setting``."""
+    ``unknown-version``, ``compiled-script``, ``bad-setting``."""
 
     def __init__(self, code: str, message: str, *, location: SourceLocation, hint: str = "") -> None:
         self.code = code
@@ -176,6 +176,12 @@ def _too_big(path: str, max_bytes: int) -> XmlReadError:
         f"raise the limit: set the environment variable {MAX_BYTES_VARIABLE} to a number of "
         "bytes",
     )
+
+
+def _is_compiled_script(data: bytes) -> bool:
+    """True for the JSON of an ``opspec compile`` output (docs/wfs-format.md)."""
+    head = data[:512].lstrip()
+    return head.startswith(b"{") and b'"opspec-wfs"' in head
 
 
 def _has_doctype(data: bytes) -> bool:
@@ -296,6 +302,14 @@ def read_tree(data: bytes, *, path: str, max_bytes: int = DEFAULT_MAX_BYTES) -> 
             "the file is empty (no XML in it)",
             location=SourceLocation(path, 1),
             hint="an XPDL file starts with a <Package> element",
+        )
+    if _is_compiled_script(data):
+        raise XmlReadError(
+            "compiled-script",
+            "this is a compiled workflow script (.wfs), not an XPDL file",
+            location=SourceLocation(path, 1),
+            hint="validate the XPDL it was compiled from; opspec show, run and evaluate "
+            "read .wfs scripts directly",
         )
     root, warnings = _parse(data, path)
     tree = root.getroottree()

@@ -204,3 +204,45 @@ def test_timer_start_triggers_show_clock_times_and_period(capsys):
     spec = Path(__file__).resolve().parents[2] / "specs" / "medication_dispenser.xpdl"
     assert main(["show", str(spec)]) == 0
     assert "starts on timer at 08:00, 12:00, 18:00, 22:00 every 1 day" in capsys.readouterr().out
+
+
+def test_show_reads_a_compiled_script_like_its_source(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    from opspec.cli import main
+
+    spec = Path(__file__).resolve().parents[2] / "specs" / "medication_dispenser.xpdl"
+    script = tmp_path / "dispenser.wfs"
+    assert main(["compile", str(spec), "-o", str(script)]) == 0
+    capsys.readouterr()
+    assert main(["show", str(spec)]) == 0
+    from_source = capsys.readouterr().out
+    assert main(["show", str(script)]) == 0
+    assert capsys.readouterr().out == from_source
+
+
+def test_validate_of_a_compiled_script_says_it_takes_xpdl(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    from opspec.cli import main
+
+    spec = Path(__file__).resolve().parents[2] / "specs" / "toy_sumo.xpdl"
+    script = tmp_path / "sumo.wfs"
+    assert main(["compile", str(spec), "-o", str(script)]) == 0
+    capsys.readouterr()
+    assert main(["validate", str(script)]) == 1
+    out = capsys.readouterr().out
+    assert f"{script}:1: error: this is a compiled workflow script (.wfs), not an XPDL" in out
+    assert "Start tag expected" not in out
+
+
+def test_show_of_a_broken_script_is_one_located_error(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    from opspec.cli import main
+
+    script = tmp_path / "cut.wfs"
+    script.write_text('{"format": "opspec-wfs", "version": 1, "pack')
+    assert main(["show", str(script)]) == 1
+    err = capsys.readouterr().err.strip()
+    assert err.startswith(f"{script}:1: error: ") and "\n" not in err
