@@ -339,6 +339,10 @@ def assert_rate(result: Any, metric: str | tuple[Any, Any], *, at_least: float |
     if method not in RATE_METHODS:
         raise ConfigurationError(f"unknown rate method {method!r}",
                                  hint="use " + " or ".join(RATE_METHODS))
+    if (at_least is not None and at_least > 1.0) or (at_most is not None and at_most < 0.0):
+        raise ConfigurationError(
+            f"a rate lies between 0 and 1: {_bound_text(at_least, at_most)} can never hold",
+            hint="write the bound as a fraction (95 % is 0.95)")
     s, t, subject, units = _rate_counts(result, metric)
     claim = f"rate {subject} {_bound_text(at_least, at_most)} with {_pct(confidence)} confidence"
     decision = _rate_decision(claim, s, t, at_least, at_most, confidence, method,

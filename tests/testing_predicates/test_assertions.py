@@ -154,8 +154,9 @@ def test_quantile_claims_pass_refute_or_ask_for_more_observations() -> None:
     (lambda r: assert_rate(r, ("a", "b"), at_least=0.9, confidence=1.0), "below 1"),
     (lambda r: assert_rate(r, ("a", "b"), at_least=0.9, method="wald"), "unknown rate method"),
     (lambda r: assert_mean(r, "x", at_least=2, between=(1, 3)), "not both"),
+    (lambda r: assert_rate(r, ("taken", "due"), at_least=1.5), "can never hold"),
     (lambda r: assert_mean(r, "x", between=(3, 1)), "empty"),
-], ids=["no-bound", "confidence-1", "wald", "both-bounds", "empty-range"])
+], ids=["no-bound", "confidence-1", "wald", "both-bounds", "rate-above-1", "empty-range"])
 def test_bad_arguments_are_configuration_errors(call: Any, match: str) -> None:
     with pytest.raises(ConfigurationError, match=match):
         call(FakeResult(9, 10, values=[1.0, 2.0]))
