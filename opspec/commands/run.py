@@ -497,8 +497,11 @@ def _print_summary(out: Any, result: RunResult, medians: dict[str, float], trace
             print(f"  {name:<{width}}  {text}", file=out)
     counts = summary.get("instances", {})
     parts = ", ".join(f"{k} {v}" for k, v in counts.items() if v)
-    print(f"ended at {clock(summary.get('time', 0.0))}: {summary.get('events', 0)} events"
-          f" ({shown} shown), instances: {parts or 'none'}", file=out)
+    # simulation events do not depend on the options; trace events are only those some
+    # listener (timeline, --trace, --timing, metrics) asked for
+    print(f"ended at {clock(summary.get('time', 0.0))}: {summary.get('sim_events', 0)} "
+          f"simulation events, {summary.get('events', 0)} traced ({shown} shown), "
+          f"instances: {parts or 'none'}", file=out)
     drift = summary.get("drift")
     if drift:
         print(f"wall-clock drift: mean {drift.get('mean_s', 0) * 1000:.2f} ms, "

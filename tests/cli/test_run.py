@@ -258,3 +258,13 @@ def test_a_mode_loads_its_workflows_from_another_spec_at_run_time(tmp_path, caps
     changed = [e for e in events if e.kind == "mode.changed"]
     hello = [e for e in events if e.kind == "process.started" and e.process == "hello"]
     assert [e.time for e in changed] == [5.0] and [e.time for e in hello] == [5.0]
+
+
+def test_the_simulation_event_count_does_not_depend_on_what_is_shown(capsys):
+    vacuum = ROOT / "specs" / "vacuum_cleaner.xpdl"
+    counts = []
+    for options in (["--timeline", "none"], ["--timeline", "all"], ["--timing"]):
+        assert main(["run", str(vacuum), "--until", "20", *options]) == 0
+        last = capsys.readouterr().out.strip().splitlines()[-1]
+        counts.append(last.split(": ", 1)[1].split(" simulation events")[0])
+    assert len(set(counts)) == 1 and int(counts[0]) > 0

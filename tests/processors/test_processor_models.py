@@ -185,3 +185,18 @@ def test_processor_models_benchmark_runs_at_tiny_size(capsys):
     out = capsys.readouterr().out
     assert "dedicated (3 cpu)" in out
     assert "pooled 1w 1p" in out and "pooled 3w 8p" in out
+
+
+def test_table3_benchmark_runs_at_tiny_size_with_the_same_work_in_both_variants(capsys):
+    import importlib.util
+
+    bench = Path(__file__).resolve().parents[2] / "benchmarks" / "table3_overhead.py"
+    loaded = importlib.util.spec_from_file_location("table3_bench", bench)
+    module = importlib.util.module_from_spec(loaded)
+    loaded.loader.exec_module(module)
+    module.main(["--seconds", "30", "--repeat", "1"])
+    rows = [line.split() for line in capsys.readouterr().out.splitlines()
+            if "workflows & engine" in line or "customised code" in line]
+    # each row: [application words...] variant words, activations, CPU s, RSS MiB[, overhead]
+    activations = [int(next(w for w in row if w.isdigit())) for row in rows]
+    assert activations == [300, 300, 300, 300]
