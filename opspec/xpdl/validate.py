@@ -184,17 +184,23 @@ def spec_files(paths: Sequence[str | Path]) -> tuple[list[Path], list[str]]:
     """The files to validate, and a problem line for every argument that cannot be used.
 
     A file argument is taken as it is (whatever its suffix); a folder contributes every
-    ``*.xpdl`` and ``*.xml`` file below it, recursively, sorted. A missing path, or a folder
-    holding no such file, gives a problem. Files named twice are validated once.
+    ``*.xpdl`` and ``*.xml`` file below it, recursively, sorted. A missing path, a folder
+    holding no such file, or a broken symbolic link with such a name in a folder gives a
+    problem. Files named twice are validated once.
     """
     files: list[Path] = []
     problems: list[str] = []
     for raw in paths:
         path = Path(raw)
         if path.is_dir():
-            found = sorted(p for p in path.rglob("*")
-                           if p.suffix.lower() in SPEC_SUFFIXES and p.is_file())
-            if not found:
+            named = sorted(p for p in path.rglob("*") if p.suffix.lower() in SPEC_SUFFIXES)
+            found = [p for p in named if p.is_file()]
+            # A spec-named link whose target is gone is reported, not silently skipped.
+            broken = [p for p in named if p.is_symlink() and not p.exists()]
+            for link in broken:
+                problems.append(f"{link}: broken symbolic link (its target {_target(link)} "
+                                "does not exist)")
+            if not found and not broken:
                 problems.append(f"{path}: no *.xpdl or *.xml file in this folder")
             files.extend(found)
         elif path.exists():
@@ -202,6 +208,13 @@ def spec_files(paths: Sequence[str | Path]) -> tuple[list[Path], list[str]]:
         else:
             problems.append(f"{path}: no such file or folder")
     return list(dict.fromkeys(files)), problems
+
+
+def _target(link: Path) -> str:
+    try:
+        return str(link.readlink())
+    except OSError:
+        return "?"
 
 
 def summary(reports: Sequence[FileReport]) -> str:

@@ -223,3 +223,16 @@ def test_a_command_module_that_fails_to_import_breaks_only_that_command(
     err = capsys.readouterr().err
     assert "Traceback" not in err and len(err.strip().splitlines()) == 1
     assert "SyntaxError" in err and "cannot be loaded" in err
+
+
+@pytest.mark.skipif(os.name != "posix", reason="symbolic links")
+def test_a_folder_scan_reports_a_broken_symlink(tmp_path: Path,
+                                               capsys: pytest.CaptureFixture[str]) -> None:
+    shutil.copy(DATA / "valid.xpdl", tmp_path / "a.xpdl")
+    (tmp_path / "broken.xpdl").symlink_to(tmp_path / "gone.xpdl")
+    assert main(["validate", str(tmp_path)]) == 2
+    captured = capsys.readouterr()
+    assert f"{tmp_path / 'broken.xpdl'}: broken symbolic link" in captured.err
+    assert "1 file checked" in captured.out
+    files, problems = spec_files([tmp_path])
+    assert files == [tmp_path / "a.xpdl"] and len(problems) == 1
