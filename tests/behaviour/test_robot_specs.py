@@ -139,3 +139,21 @@ def test_evaluate_runs_the_vacuum_with_its_own_metrics(tmp_path, capsys):
     assert status == 0
     assert doc["metrics"]["cells_covered"]["total"] > 0
     assert doc["metrics"]["collisions"]["kind"] == "count"
+
+
+@pytest.mark.parametrize("spec, metrics", [
+    ("toy_sumo.xpdl", {"bouts": "count", "bouts_won": "count", "win_rate": "ratio"}),
+    ("medication_cart_guidance.xpdl", {"patients_found": "count", "time_to_find_s": "duration",
+                                       "collisions": "count"}),
+], ids=["sumo", "cart"])
+def test_evaluate_runs_the_sumo_and_the_cart_with_their_own_metrics(tmp_path, capsys, spec,
+                                                                   metrics):
+    status = main(["evaluate", str(SPECS / spec), "--users", "2", "--days", "0.002",
+                   "--workers", "1", "--json", "--out", str(tmp_path / "ev")])
+    doc = json.loads(capsys.readouterr().out)
+    assert status == 0
+    assert {name: doc["metrics"][name]["kind"] for name in metrics} == metrics
+    if spec == "toy_sumo.xpdl":
+        assert doc["metrics"]["bouts"]["total"] >= 1
+    else:
+        assert doc["metrics"]["patients_found"]["total"] >= 1
