@@ -80,6 +80,7 @@ def run(args: argparse.Namespace) -> int:
         # conditions are abstracted, so a spec whose errors leave its control flow readable
         # (a condition opspec cannot parse, a duplicate lane id) is still checked
         package = result.package
+        errors = (*errors, *_run_time_errors(package))
         processes = [p for p in package.processes
                      if args.process is None or p.id == args.process]
         if args.process is not None and not processes:
@@ -95,6 +96,16 @@ def run(args: argparse.Namespace) -> int:
         status = _print(path, reports, errors, as_json=args.json, max_states=args.max_states)
         worst = max(worst, status)
     return worst
+
+
+def _run_time_errors(package: Any) -> list[Diagnostic]:
+    """What ``opspec validate`` finds that a run would only meet later: a mode Source that
+    is missing or broken, a world that cannot be built (a spec error here, as there)."""
+    from opspec.commands._spec import engine_diagnostics
+    from opspec.xpdl.validate import mode_source_diagnostics
+
+    world = [d for d in engine_diagnostics(package, world=True) if d.code == "bad-world"]
+    return [*mode_source_diagnostics(package), *world]
 
 
 def _errors_json(errors: Sequence[Diagnostic]) -> list[dict[str, Any]]:

@@ -117,3 +117,16 @@ def test_every_error_is_listed_when_a_run_is_refused(tmp_path, capsys):
     err = capsys.readouterr().err
     assert "(and 1 more)" in err
     assert "reads 'nosuch'" in err and "mode 'sleep'" in err
+
+
+def test_check_counts_a_missing_mode_source_and_an_unbuildable_world_as_spec_errors(tmp_path,
+                                                                                   capsys):
+    spec = vacuum(tmp_path, WORLD, WORLD.replace("vacuum-room", "moon-base"))
+    text = spec.read_text(encoding="utf-8").replace(MODES, '<opspec:Mode Id="dock" '
+                                                           'Source="nosuch_dock.xpdl"/>')
+    spec.write_text(text, encoding="utf-8")
+    status = main(["check", str(spec)])
+    out = capsys.readouterr().out
+    assert status == 1
+    assert "unknown world 'moon-base'" in out and "nosuch_dock.xpdl" in out
+    assert "2 spec error(s)" in out
