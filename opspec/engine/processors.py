@@ -124,8 +124,7 @@ class DedicatedProcessor:
         heapq.heappush(ends, now + cost)
         self.bursts += 1
         self.busy_time += cost
-        if len(ends) > self.max_busy:
-            self.max_busy = len(ends)
+        self.max_busy = max(self.max_busy, len(ends))
 
     def summary(self) -> dict[str, float | int]:
         return {"bursts": self.bursts, "busy_time": self.busy_time, "max_busy": self.max_busy}
