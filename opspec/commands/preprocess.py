@@ -41,6 +41,7 @@ def run(args: argparse.Namespace) -> int:
     from opspec.commands.validate import engine_checks
     from opspec.errors import Severity
     from opspec.xpdl.preprocess import preprocess
+    from opspec.xpdl.schema_limits import schema_warnings
     from opspec.xpdl.validate import validate_spec
     from opspec.xpdl.writer import write_xpdl
 
@@ -56,6 +57,8 @@ def run(args: argparse.Namespace) -> int:
         result = preprocess(package)
         diagnostics.extend(result.diagnostics)
         package = result.package
+        # The output promises standard XPDL 2.1: say when the schema would still reject it.
+        diagnostics.extend(schema_warnings(package))
     for diagnostic in diagnostics:
         print(diagnostic, file=sys.stderr)
     errors = [d for d in diagnostics if d.severity is Severity.ERROR

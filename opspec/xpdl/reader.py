@@ -259,12 +259,12 @@ def _parse(data: bytes, path: str) -> tuple[etree._Element, list[Diagnostic]]:
 _LIMITS: Final = (
     (re.compile(r"excessive depth", re.IGNORECASE),
      "elements are nested more than 256 levels deep, the XML reader's limit",
-     "XPDL needs a few dozen levels at most: flatten the deeply nested content, often inside "
-     "an ExtendedAttribute, or move it to a file of its own"),
+     ("XPDL needs a few dozen levels at most: flatten the deeply nested content, often "
+      "inside an ExtendedAttribute, or move it to a file of its own")),
     (re.compile(r"buffer size limit|text node too long|too long|huge text", re.IGNORECASE),
      "a text or attribute value is longer than the XML reader's limit of 10,000,000 characters",
-     "keep bulk data out of the spec: put it in a file of its own and refer to it; a value "
-     "this long usually means a damaged or generated file"),
+     ("keep bulk data out of the spec: put it in a file of its own and refer to it; a value "
+      "this long usually means a damaged or generated file")),
     (re.compile(r"resource limit|huge input|amplification|memory allocation", re.IGNORECASE),
      "the XML exceeds a resource limit of the XML reader",
      "simplify the file: no spec needs anything this large; is it damaged or generated?"),

@@ -98,7 +98,7 @@ def collect(element: etree._Element, ctx: BuildContext, known: tuple[str, ...],
             "file generated or damaged?)"))
     else:
         prefix = f"{{{OPSPEC}}}"
-        for name in element.keys():
+        for name in element.keys():  # noqa: SIM118 - iterating an element gives children
             if name.startswith(prefix):
                 add(Directive(name[len(prefix):], element.get(name) or "", None,
                               ctx.loc(element)))

@@ -376,3 +376,49 @@ def test_every_bundled_spec_preprocesses(tmp_path: Path, path: Path) -> None:
     from opspec.cli import main
 
     assert main(["preprocess", str(path), "-o", str(tmp_path / "out.xpdl")]) == 0
+
+
+def test_preprocess_warns_when_its_output_will_not_pass_the_2_1_schema(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    from opspec.cli import main
+
+    source = Path("/work/shared/corpus/xpdl/jawe10__workflow_patterns.xpdl")
+    if not source.is_file():
+        pytest.skip("corpus not available")
+    out = tmp_path / "patterns.xpdl"
+    assert main(["preprocess", str(source), "-o", str(out)]) == 0
+    err = capsys.readouterr().err
+    (warning,) = [line for line in err.splitlines() if "will not be valid XPDL 2.1" in line]
+    assert warning.startswith(f"{source}:") and ": warning: " in warning
+    assert "activity ids 'A', 'B', 'C' and 13 more" in warning
+    assert out.exists()
+    assert main(["preprocess", str(source), "-o", str(tmp_path / "strict.xpdl"),
+                 "--strict"]) == 1
+    assert not (tmp_path / "strict.xpdl").exists()
+
+
+def test_schema_warnings_name_external_subflows_and_shared_process_ids() -> None:
+    from opspec.model.activities import SubFlow
+    from opspec.xpdl.schema_limits import schema_warnings
+
+    calls = Activity(id="call", body=SubFlow(process="elsewhere"))
+    inner = ActivitySet(id="main", activities=(Activity(id="x"),))
+    package = Package(id="pkg", processes=(
+        WorkflowProcess(id="main", activities=(calls,), activity_sets=(inner,)),))
+    messages = [d.message for d in schema_warnings(package)]
+    assert len(messages) == 2
+    assert "'main'" in messages[0] and "one id space" in messages[0]
+    assert "SubFlow calls 'elsewhere'" in messages[1]
+
+
+@pytest.mark.parametrize(
+    "path", sorted((Path(__file__).resolve().parents[2] / "specs").glob("*.xpdl")),
+    ids=lambda p: p.name)
+def test_bundled_specs_preprocess_without_schema_warnings(
+    tmp_path: Path, path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    from opspec.cli import main
+
+    assert main(["preprocess", str(path), "-o", str(tmp_path / "out.xpdl"), "--strict"]) == 0
+    assert "not be valid" not in capsys.readouterr().err
