@@ -65,17 +65,18 @@ def test_walkthrough_in_tmux_shows_the_alarm_and_says_where_the_recording_is(tmp
 def test_q_quits_at_once_while_a_long_skip_runs(tmp_path):
     session = f"opspec-{uuid.uuid4().hex[:8]}"
     vacuum = SPEC.parent / "vacuum_cleaner.xpdl"
-    command = (f"{sys.executable} -m opspec.cli walkthrough {vacuum} --no-record; "
+    # a whole day of the robot: a skip to its end takes minutes of engine time
+    command = (f"{sys.executable} -m opspec.cli walkthrough {vacuum} --days 1 --no-record; "
                "echo EXIT=$?")
     tmux("new-session", "-d", "-s", session, "-x", "80", "-y", "24")
     try:
         tmux("set-option", "-t", session, "remain-on-exit", "on")
         tmux("send-keys", "-t", session, command, "Enter")
         wait_for(session, "no user lane")
-        tmux("send-keys", "-t", session, "u")          # to the end of a 75-minute run
+        tmux("send-keys", "-t", session, "u")          # to the end of the day
         wait_for(session, "skipping")
         tmux("send-keys", "-t", session, "q")
-        wait_for(session, "EXIT=0", timeout=5.0)       # not after the skip
+        wait_for(session, "EXIT=0", timeout=10.0)      # not after the skip
     finally:
         subprocess.run(["tmux", "-L", SOCKET, "kill-session", "-t", session],
                        capture_output=True, check=False)
