@@ -9,6 +9,7 @@ from __future__ import annotations
 import argparse
 import contextlib
 import math
+import sys
 from datetime import UTC, datetime
 from pathlib import Path
 from typing import Any
@@ -82,7 +83,8 @@ def run(args: argparse.Namespace) -> int:
         if args.bind:
             from opspec.bindings.attach import attach_devices
 
-            devices = stack.enter_context(attach_devices(args.bind, args.devices))
+            devices = stack.enter_context(attach_devices(args.bind, args.devices,
+                                                         spec=compiled))
             performers.update(devices.performers)
             notes.extend(devices.notes)
         from opspec.tui.app import WalkthroughApp
@@ -124,7 +126,8 @@ def _model_factory(compiled: Any, ref: Any, seed: int) -> Any:
     model = load_user_model(ref)
     lane = user_lane(compiled)
     if not lane.empty:
-        model.validate_against(lane.manual, choices=lane.choices)
+        for warning in model.validate_against(lane.manual, choices=lane.choices):
+            print(f"opspec walkthrough: {warning}", file=sys.stderr)
     handovers = [0]
 
     def make() -> Any:
