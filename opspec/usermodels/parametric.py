@@ -286,7 +286,7 @@ class TruncatedNormal(Distribution):
             return 0.0
         if x >= self.high:
             return 1.0
-        from scipy import stats  # type: ignore[import-untyped]  # lazy: 2 s to import
+        from scipy import stats  # lazy: importing scipy.stats takes about 2 s
 
         return float(stats.truncnorm.cdf(x, *self._ab(), loc=self.loc, scale=self.sd_))
 
@@ -361,7 +361,7 @@ class ExGaussian(Distribution):
         object.__setattr__(self, "tau", _positive("tau", self.tau))
 
     def _frozen(self) -> Any:
-        from scipy import stats  # type: ignore[import-untyped]  # lazy: 2 s to import
+        from scipy import stats  # lazy: importing scipy.stats takes about 2 s
 
         return stats.exponnorm(self.tau / self.sigma, loc=self.mu, scale=self.sigma)
 
