@@ -26,6 +26,7 @@ __all__ = [
     "FileReport",
     "merge_diagnostics",
     "mode_source_diagnostics",
+    "preprocessed_mode_diagnostics",
     "spec_files",
     "summary",
     "validate_file",
@@ -145,6 +146,36 @@ def mode_source_diagnostics(package: Package, *, max_bytes: int = DEFAULT_MAX_BY
     return out
 
 
+def preprocessed_mode_diagnostics(package: Package) -> list[Diagnostic]:
+    """Mode changes written as preprocessed tasks (``TaskApplication
+    Id="opspec.engine.mode_change"`` with a string literal, see ``opspec preprocess``) to a
+    mode the package does not declare: the check the SISARL built-in gets, for the task the
+    engine runs in its place."""
+    from opspec.model.activities import Task
+    from opspec.model.expressions import Literal
+
+    declared = {mode.id for mode in package.modes}
+    out: list[Diagnostic] = []
+    for process in package.processes:
+        for activity in process.all_activities():
+            body = activity.body
+            if not isinstance(body, Task) or not body.applications:
+                continue
+            call = body.applications[0]
+            if call.application != "opspec.engine.mode_change" or not call.actual_parameters:
+                continue
+            target = call.actual_parameters[0].expression
+            if isinstance(target, Literal) and isinstance(target.value, str) and (
+                    target.value not in declared):
+                out.append(Diagnostic(
+                    activity.location or SourceLocation(package.source or "<spec>"),
+                    Severity.ERROR, "undefined-mode",
+                    f"activity {activity.id!r} in process {process.id!r} changes to mode "
+                    f"{target.value!r}, which the package does not declare",
+                    "declare it in opspec:Modes or fix the target mode"))
+    return out
+
+
 def validate_file(path: str | Path, *, strict: bool = False,
                   max_bytes: int = DEFAULT_MAX_BYTES,
                   extra: Callable[[Package], Iterable[Diagnostic]] | None = None
@@ -171,6 +202,7 @@ def validate_spec(path: str | Path, *, strict: bool = False,
         version = result.package.version.value
         checks = list(check_package(result.package, packages=result.packages))
         checks.extend(mode_source_diagnostics(result.package, max_bytes=max_bytes))
+        checks.extend(preprocessed_mode_diagnostics(result.package))
         if extra is not None and not any(
                 d.severity is Severity.ERROR for d in (*result.diagnostics, *checks)):
             checks.extend(extra(result.package))

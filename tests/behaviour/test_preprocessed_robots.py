@@ -82,3 +82,17 @@ def test_a_preprocessed_call_with_parameters_that_do_not_fit_is_a_spec_error(tmp
                     encoding="utf-8")
     with pytest.raises(SpecError, match="opspec.supervisor.push.*channel as a string literal"):
         compile_package(open_spec(spec))
+
+
+def test_validate_finds_a_preprocessed_mode_change_to_an_undeclared_mode(tmp_path, capsys):
+    from opspec.cli import main
+
+    spec = preprocessed(copy_spec(tmp_path, "vacuum_cleaner"))
+    text = spec.read_text(encoding="utf-8")
+    assert '<ActualParameter>"dock"</ActualParameter>' in text
+    spec.write_text(text.replace('<ActualParameter>"dock"</ActualParameter>',
+                                 '<ActualParameter>"sleep"</ActualParameter>'), encoding="utf-8")
+    assert main(["validate", str(spec)]) == 1
+    out = capsys.readouterr().out
+    assert "changes to mode 'sleep', which the package does not declare" in out
+    assert main(["run", str(spec), "--until", "1"]) == 1
