@@ -155,7 +155,8 @@ def test_a_full_disk_is_a_clear_error_and_leaves_a_sound_database(tmp_path):
         # a disk with room for a few pages more than the empty database
         store.query(f"PRAGMA max_page_count = {pages + 6}")
         with pytest.raises(EvaluationError, match=r"cannot store replication A/\d+: "
-                           r"database or disk is full.*writable"):
+                           r"database or disk is full.*free some space, then `opspec "
+                           r"evaluate --resume"):
             run_evaluation(plan, store, workers=1)
         kept = store.finished("A")
         assert 0 < len(kept) < 30
