@@ -93,7 +93,8 @@ class Step:
     or ``raise`` (a trigger, ``target`` its name). ``delay`` is seconds after the matching
     offer, or, when ``absolute``, the simulated time (an offered activity then acts at
     ``max(offer, time)``). ``data`` is completed data; ``exception`` the name for ``fail``.
-    ``repeat`` steps are never used up.
+    ``repeat`` steps are never used up. ``instance`` (written ``#6`` in the action, as the
+    walkthrough records it) limits the step to offers of that workflow instance.
     """
 
     verb: str
@@ -103,6 +104,7 @@ class Step:
     data: Mapping[str, Any] | None = None
     exception: str = "failed"
     repeat: bool = False
+    instance: int | None = None
 
     @classmethod
     def parse(cls, when: float | str, action: str, *, where: str = "<script>",
@@ -132,9 +134,12 @@ class Step:
         verb, target, rest = words[0], words[1], words[2:]
         data: dict[str, Any] = {}
         exception = "failed"
+        instance = None
         for word in rest:
             key, eq, value = word.partition("=")
-            if eq:
+            if word.startswith("#") and word[1:].isdigit():
+                instance = int(word[1:])
+            elif eq:
                 data[key] = _value(value)
             elif verb == "fail":
                 exception = word
@@ -142,7 +147,7 @@ class Step:
             raise ConfigurationError(f"step time {when!r} is negative",
                                      location=SourceLocation(where))
         return cls(verb, target, delay, absolute or verb == "raise", data or None, exception,
-                   repeat)
+                   repeat, instance)
 
 
 def _value(text: str) -> Any:
@@ -227,6 +232,8 @@ class ScriptedUser(_Base):
         self.offers.append(item)
         for index, step in enumerate(self.steps):
             if index in self._used or step.verb == "raise":
+                continue
+            if step.instance is not None and step.instance != item.instance:
                 continue
             if step.target == item.activity or step.target in item.choices:
                 if not step.repeat:

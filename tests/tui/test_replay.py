@@ -92,3 +92,27 @@ def test_the_walkthrough_command_refuses_a_replay_with_unknown_names(tmp_path, c
     bad.write_text('{"steps": [["at 10", "complete nonexistent_activity"]]}', encoding="utf-8")
     assert main(["walkthrough", str(SPEC), "--replay", str(bad)]) == 2
     assert "nonexistent_activity" in capsys.readouterr().err
+
+
+def test_opspec_run_script_honours_the_instance_tags_too(compiled, tmp_path, capsys):
+    """The same recording through `opspec run --script`: the tagged step waits for its own
+    instance's offer (the 08:10 alarm), not the first hear_alarm offered (08:00)."""
+    from opspec.cli import main
+
+    record = tmp_path / "pick.json"
+    session = WalkSession(compiled, record=record)
+    session.skip_until_user()
+    while session.now < 8 * 3600 + 600:
+        session.skip_to_next_event()
+    offer = newest(session, "hear_alarm")
+    session.act(offer)
+    session.close()
+    trace_file = tmp_path / "run.jsonl"
+    status = main(["run", str(SPEC), "--until", str(9 * 3600), "--script", str(record),
+                   "--trace", str(trace_file), "--json"])
+    capsys.readouterr()
+    assert status == 0
+    heard = [json.loads(line) for line in trace_file.read_text(encoding="utf-8").splitlines()
+             if '"activity.completed"' in line and '"hear_alarm"' in line]
+    assert [(e["instance"], e["time"]) for e in heard] == [(offer.item.instance,
+                                                            pytest.approx(session.now))]
