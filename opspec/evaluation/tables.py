@@ -5,6 +5,7 @@ from __future__ import annotations
 from collections.abc import Mapping, Sequence
 from typing import IO, Any
 
+from opspec.engine.monitors import clock
 from opspec.evaluation.plan import span
 
 __all__ = ["comparison_rows", "fmt", "is_rate", "metric_rows", "monitor_rows", "per_user_rows",
@@ -82,18 +83,12 @@ def per_user_rows(metrics: Mapping[str, Mapping[str, Any]]) -> list[tuple[str, .
     return rows
 
 
-def _clock(seconds: float) -> str:
-    from opspec.engine.monitors import clock
-
-    return clock(seconds)
-
-
 def monitor_rows(monitors: Mapping[str, Mapping[str, Any]]) -> list[tuple[str, ...]]:
     """The spec's monitors: violations, users affected (share), hazard per user-day."""
     rows: list[tuple[str, ...]] = []
     for name, m in monitors.items():
         first = m.get("first")
-        where = (f"user {first['user']}, {_clock(first['time'])}" if first
+        where = (f"user {first['user']}, {clock(first['time'])}" if first
                  and first.get("time") is not None else "–")
         share = fmt(m.get("share_affected"), percent=True)
         affected = f"{m['users_affected']} of {m['users']} ({share})"
