@@ -40,6 +40,7 @@ def default_output(source: Path) -> Path:
 def run(args: argparse.Namespace) -> int:
     from opspec.commands.validate import engine_checks
     from opspec.errors import Severity
+    from opspec.model.codec import write_atomically
     from opspec.xpdl.preprocess import preprocess
     from opspec.xpdl.schema_limits import schema_warnings
     from opspec.xpdl.validate import validate_spec
@@ -72,7 +73,7 @@ def run(args: argparse.Namespace) -> int:
         return 0
     target = Path(args.output) if args.output else default_output(source)
     try:
-        _write_atomically(target, data)
+        write_atomically(target, data)
     except OSError as error:
         print(f"opspec preprocess: cannot write {target}: {error.strerror or error}",
               file=sys.stderr)
@@ -80,29 +81,3 @@ def run(args: argparse.Namespace) -> int:
     print(f"{target}: standard XPDL 2.1 from {source}")
     return 0
 
-
-def _write_atomically(target: Path, data: bytes) -> None:
-    import os
-    import tempfile
-
-    handle, temp = tempfile.mkstemp(prefix=f".{target.name}.", suffix=".tmp",
-                                    dir=str(target.parent) or ".")
-    try:
-        # mkstemp creates the file 0600: give it the mode of the file it replaces, or that of
-        # an ordinary new file (0666 without the umask).
-        try:
-            mode = target.stat().st_mode & 0o7777
-        except OSError:
-            umask = os.umask(0o022)
-            os.umask(umask)
-            mode = 0o666 & ~umask
-        os.fchmod(handle, mode)
-        with os.fdopen(handle, "wb") as stream:
-            stream.write(data)
-        os.replace(temp, target)
-    except BaseException:
-        try:
-            os.unlink(temp)
-        except OSError:
-            pass
-        raise

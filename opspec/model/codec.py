@@ -51,6 +51,7 @@ __all__ = [
     "load",
     "loads",
     "read_wfs",
+    "write_atomically",
     "write_wfs",
 ]
 
@@ -427,11 +428,18 @@ def _file_mode(target: Path) -> int:
 
 
 def write_wfs(package: Package, path: str | os.PathLike[str]) -> None:
-    """Write ``package`` to ``path`` atomically (a temporary file in the same folder, then a
-    rename), so a reader never sees half a script. ``OSError`` propagates (the caller reports
-    it as an I/O problem)."""
+    """Write ``package`` to ``path`` atomically (see :func:`write_atomically`), so a reader
+    never sees half a script. ``OSError`` propagates (the caller reports it as an I/O
+    problem)."""
+    write_atomically(path, dumps(package).encode("ascii") + b"\n")
+
+
+def write_atomically(path: str | os.PathLike[str], data: bytes) -> None:
+    """Write ``data`` to ``path`` through a temporary file in the same folder and a rename, so
+    a reader sees the old file or the whole new one, never half of it. The file gets the mode
+    of the file it replaces, else that of an ordinary new file. ``OSError`` propagates; the
+    temporary file is removed then."""
     target = Path(path)
-    text = dumps(package).encode("ascii")
     handle, temp_name = tempfile.mkstemp(
         prefix=f".{target.name}.", suffix=".tmp", dir=target.parent if str(target.parent) else "."
     )
@@ -440,8 +448,7 @@ def write_wfs(package: Package, path: str | os.PathLike[str]) -> None:
         # (0666 minus the umask), or keep the mode of the file it replaces.
         os.fchmod(handle, _file_mode(target))
         with os.fdopen(handle, "wb") as stream:
-            stream.write(text)
-            stream.write(b"\n")
+            stream.write(data)
         os.replace(temp_name, target)
     except BaseException:
         try:
