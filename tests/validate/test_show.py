@@ -199,23 +199,22 @@ def test_dot_of_one_missing_process_raises_key_error() -> None:
 
 
 def test_timer_start_triggers_show_clock_times_and_period(capsys):
-    from opspec.cli import main
-
-    spec = Path(__file__).resolve().parents[2] / "specs" / "medication_dispenser.xpdl"
-    assert main(["show", str(spec)]) == 0
+    assert main(["show", str(DISPENSER)]) == 0
     assert "starts on timer at 08:00, 12:00, 18:00, 22:00 every 1 day" in capsys.readouterr().out
+
+
+def _compile(spec: Path, script: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """``opspec compile spec -o script``, its output discarded."""
+    assert main(["compile", str(spec), "-o", str(script)]) == 0
+    capsys.readouterr()
 
 
 def test_show_reads_a_compiled_script_like_its_source(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
-    from opspec.cli import main
-
-    spec = Path(__file__).resolve().parents[2] / "specs" / "medication_dispenser.xpdl"
     script = tmp_path / "dispenser.wfs"
-    assert main(["compile", str(spec), "-o", str(script)]) == 0
-    capsys.readouterr()
-    assert main(["show", str(spec)]) == 0
+    _compile(DISPENSER, script, capsys)
+    assert main(["show", str(DISPENSER)]) == 0
     from_source = capsys.readouterr().out
     assert main(["show", str(script)]) == 0
     assert capsys.readouterr().out == from_source
@@ -224,12 +223,8 @@ def test_show_reads_a_compiled_script_like_its_source(
 def test_validate_of_a_compiled_script_says_it_takes_xpdl(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
-    from opspec.cli import main
-
-    spec = Path(__file__).resolve().parents[2] / "specs" / "toy_sumo.xpdl"
     script = tmp_path / "sumo.wfs"
-    assert main(["compile", str(spec), "-o", str(script)]) == 0
-    capsys.readouterr()
+    _compile(ROOT / "specs" / "toy_sumo.xpdl", script, capsys)
     assert main(["validate", str(script)]) == 1
     out = capsys.readouterr().out
     assert f"{script}:1: error: this is a compiled workflow script (.wfs), not an XPDL" in out
@@ -239,8 +234,6 @@ def test_validate_of_a_compiled_script_says_it_takes_xpdl(
 def test_show_of_a_broken_script_is_one_located_error(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
-    from opspec.cli import main
-
     script = tmp_path / "cut.wfs"
     script.write_text('{"format": "opspec-wfs", "version": 1, "pack')
     assert main(["show", str(script)]) == 1
