@@ -6,7 +6,6 @@ one line (issue 2, "Bad input": a clear one-line error naming file:line)."""
 from __future__ import annotations
 
 import contextlib
-import copy
 import io
 import json
 import re
@@ -17,6 +16,7 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 from lxml import etree
+from xml_mutations import mutate_element
 
 from opspec.cli import main
 
@@ -53,22 +53,7 @@ def _mutate(data: bytes, edits: list[tuple[str, float, int]]) -> bytes:
             if raw:
                 raw[int(where * len(raw))] = value
             continue
-        elements = [e for e in root.iter() if isinstance(e.tag, str) and e is not root]
-        if not elements:
-            continue
-        element = elements[int(where * len(elements))]
-        parent = element.getparent()
-        if action == "delete" and parent is not None:
-            parent.remove(element)
-        elif action == "duplicate":
-            element.addnext(copy.deepcopy(element))
-        elif action == "strip":
-            for key in list(element.attrib):
-                del element.attrib[key]
-        elif action == "id":
-            element.set("Id", "x")
-        else:
-            element.text = "@@ not & valid ( ] {"
+        mutate_element(root, action, where)
     return etree.tostring(root) if root is not None else bytes(raw)
 
 
