@@ -358,9 +358,7 @@ class DeviceBinding:
         return any(t.match(text) is not None for t in (*op.ok, *(e[0] for e in op.errors)))
 
     def _is_reply(self, text: str) -> bool:
-        return any(t.match(text) is not None
-                   for op in self.profile.operations.values()
-                   for t in (*op.ok, *(e[0] for e in op.errors)))
+        return any(self._answers(op, text) for op in self.profile.operations.values())
 
     def _answered(self, job: _Job, text: str, at: float, values: Mapping[str, Any] | None,
                   exception: str | None) -> None:
@@ -434,13 +432,18 @@ class DeviceBinding:
         """End the hold ``hold`` (if it is still the current one) and go on sending."""
         if hold != self._holds or self._held is None:
             return
-        if self._hold_timer is not None:
-            self._hold_timer.cancel()
-        resend, self._held, self._resend, self._hold_timer = self._resend, None, None, None
-        if resend is not None:
-            self._queue.appendleft(resend)
+        self._end_hold()
         if self._connection == "open":
             self._pump()
+
+    def _end_hold(self) -> None:
+        """Stop holding the line: the hold timer stops and the command to resend (if any)
+        goes back to the front of the queue."""
+        if self._hold_timer is not None:
+            self._hold_timer.cancel()
+        if self._resend is not None:
+            self._queue.appendleft(self._resend)
+        self._held = self._resend = self._hold_timer = None
 
     def _attempt_failed(self, job: _Job, fault: str, message: str) -> None:
         """A timeout or garbage: report, then retry or apply the participant's fallback."""
@@ -504,11 +507,7 @@ class DeviceBinding:
         dead, self._reader = self._reader, None
         if self._held is not None:        # a reopened line starts clean: no hold needed
             self._holds += 1
-            if self._hold_timer is not None:
-                self._hold_timer.cancel()
-            if self._resend is not None:
-                self._queue.appendleft(self._resend)
-            self._held = self._resend = self._hold_timer = None
+            self._end_hold()
         job, self._inflight = self._inflight, None
         if job is not None:
             if job.timer is not None:
