@@ -405,14 +405,9 @@ class DeviceBinding:
         if job is None or job.seq != seq or self._connection == "closed":
             return  # answered (or superseded) meanwhile
         self._timed_out.append(job)
-        self._finish(job)
+        retry = self._report_attempt(job, "timeout", f"{self._who(job.item)}: no reply to "
+                                     f"{job.line!r} within {job.op.timeout_s * 1000:g} ms")
         fallback = self.profile.fallback_for(job.item.participant)
-        retry = job.attempts <= fallback.retries
-        job.last_fault = "timeout"
-        self._fault("timeout", f"{self._who(job.item)}: no reply to {job.line!r} within "
-                    f"{job.op.timeout_s * 1000:g} ms", item=job.item,
-                    action="retry" if retry else fallback.then, line=job.line,
-                    attempt=job.attempts)
         if not retry:   # the fallback applies now; the line is still held for the late reply
             self._give_up(job, f"timeout after {job.attempts} attempt(s)")
         self._hold(job, job if retry else None, fallback.late_reply_s)
@@ -445,14 +440,21 @@ class DeviceBinding:
             self._queue.appendleft(self._resend)
         self._held = self._resend = self._hold_timer = None
 
-    def _attempt_failed(self, job: _Job, fault: str, message: str) -> None:
-        """A timeout or garbage: report, then retry or apply the participant's fallback."""
+    def _report_attempt(self, job: _Job, fault: str, message: str) -> bool:
+        """End ``job``'s failed attempt and report the fault with what follows; whether
+        it is retried (else the participant's fallback applies)."""
         self._finish(job)
         fallback = self.profile.fallback_for(job.item.participant)
-        action = "retry" if job.attempts <= fallback.retries else fallback.then
+        retry = job.attempts <= fallback.retries
         job.last_fault = fault
-        self._fault(fault, message, item=job.item, action=action, line=job.line,
-                    attempt=job.attempts)
+        self._fault(fault, message, item=job.item, action="retry" if retry else fallback.then,
+                    line=job.line, attempt=job.attempts)
+        return retry
+
+    def _attempt_failed(self, job: _Job, fault: str, message: str) -> None:
+        """Garbage: report, then retry or apply the participant's fallback (through
+        :meth:`_pump`, which gives up on a job out of attempts)."""
+        self._report_attempt(job, fault, message)
         self._queue.appendleft(job)
         self._pump()
 
