@@ -27,7 +27,7 @@ from pathlib import Path
 from typing import Any
 
 from opspec.engine.compiled import CompiledPackage
-from opspec.engine.lanes import user_lane
+from opspec.engine.lanes import all_activities, user_lane
 from opspec.engine.performers import WorkItem
 from opspec.engine.simulation import Simulation
 from opspec.engine.trace import TraceEvent
@@ -106,7 +106,7 @@ class WalkSession:
                     f"{error.strerror or error}",
                     hint="give --record a path in a folder you can write to, or --no-record"
                 ) from None
-        activities = _activities(compiled)
+        activities = list(all_activities(compiled))
         self._deadline_of = {(a.process, a.id): a.deadlines for a in activities
                              if a.deadlines}
         #: the spec's names for activities (choices are shown by name, not id)
@@ -154,9 +154,9 @@ class WalkSession:
             return
         if self.paused:
             # the clock stands still, but a device's answer is taken at the current time
-            self._run_to(self.now, budget)
+            self.run_to(self.now, budget)
             return
-        self._run_to(min(self.horizon, self.now + wall_seconds * self.speed), budget)
+        self.run_to(min(self.horizon, self.now + wall_seconds * self.speed), budget)
 
     @property
     def waiting_for_devices(self) -> bool:
@@ -169,7 +169,7 @@ class WalkSession:
         if self.waiting_for_devices:
             return
         due = self.sim.peek()
-        self._run_to(min(self.horizon, due if math.isfinite(due) else self.horizon), budget)
+        self.run_to(min(self.horizon, due if math.isfinite(due) else self.horizon), budget)
 
     def skip_until_user(self, budget: int | None = None) -> None:
         """Run until something is offered to the person (or the run ends). With a real
@@ -217,7 +217,6 @@ class WalkSession:
         stands at the last event stepped, and a later call goes on)."""
         return self._step_to(min(self.horizon, target), budget)[0]
 
-    _run_to = run_to
 
     def _step_to(self, target: float, budget: int | None) -> tuple[bool, int]:
         env = self.sim.env
@@ -406,8 +405,3 @@ def clock(seconds: float) -> str:
     minutes, secs = divmod(rest, 60)
     return f"d{int(day) + 1} {int(hours):02d}:{int(minutes):02d}:{int(secs):02d}"
 
-
-def _activities(compiled: CompiledPackage) -> list[Any]:
-    from opspec.engine.lanes import all_activities
-
-    return list(all_activities(compiled))

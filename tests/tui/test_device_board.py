@@ -42,7 +42,7 @@ def test_the_alarm_rings_at_eight_until_the_report_and_the_drawer_records_the_do
     assert "alarms=1" in alarm.detail
     assert row(session, "dispenser").status.startswith("> Wait for the user's report")
     act(session, "hear_alarm")
-    session._run_to(session.now + 60)
+    session.run_to(session.now + 60)
     act(session, "walk_to_dispenser")
     act(session, "choose_button", "press_report")
     assert row(session, "alarm").status == "silent"
@@ -54,9 +54,9 @@ def test_the_alarm_rings_at_eight_until_the_report_and_the_drawer_records_the_do
 def test_the_alarm_rings_again_after_each_expired_deadline(compiled):
     session = WalkSession(compiled)
     session.skip_until_user()
-    session._run_to(8 * 3600 + 299)
+    session.run_to(8 * 3600 + 299)
     assert row(session, "alarm").alert
-    session._run_to(8 * 3600 + 301)                # deadline expired, the alarm sounds again
+    session.run_to(8 * 3600 + 301)                # deadline expired, the alarm sounds again
     assert row(session, "alarm").status == "((( RINGING ))) since 08:05"
     assert "alarms=2" in row(session, "alarm").detail
 

@@ -36,15 +36,15 @@ def test_a_replay_acts_on_the_same_instance_when_identical_offers_wait(compiled,
     offer = newest(session, "hear_alarm")         # answer the 08:10 alarm
     session.act(offer)
     for activity in ("walk_to_dispenser", "choose_button"):
-        session._run_to(session.now + 30)
+        session.run_to(session.now + 30)
         session.act(next(o for o in session.offers if o.item.activity == activity))
-    session._run_to(session.now + 600)
+    session.run_to(session.now + 600)
     session.close()
     steps = json.loads(record.read_text(encoding="utf-8"))["steps"]
     assert steps[0][1] == f"complete hear_alarm #{offer.item.instance}"
 
     again = WalkSession(compiled, replay=load_recording(record, compiled))
-    again._run_to(session.now)
+    again.run_to(session.now)
     assert trace(again) == trace(session)         # instances included
 
 
@@ -54,7 +54,7 @@ def test_a_recording_without_instance_tags_still_replays(compiled, tmp_path):
                    ' ["at 28890.0", "complete walk_to_dispenser"],'
                    ' ["at 28890.0", "choose press_report"]]}', encoding="utf-8")
     session = WalkSession(compiled, replay=load_recording(old, compiled))
-    session._run_to(9 * 3600)
+    session.run_to(9 * 3600)
     assert session.sim.metrics.values()["report_latency_s"]["mean"] == pytest.approx(90.0)
 
 

@@ -107,7 +107,7 @@ async def test_recorded_session_replays_to_the_same_trace(compiled, tmp_path):
                 if e.kind.startswith(("activity.", "process.", "trigger."))]
 
     again = WalkSession(compiled, replay=load_recording(record, compiled))
-    again._run_to(session.now)
+    again.run_to(session.now)
     replayed = [(e.time, e.kind, e.instance, e.activity) for e in again.events
                 if e.kind.startswith(("activity.", "process.", "trigger."))]
     assert replayed == original
@@ -228,7 +228,7 @@ def test_a_walkthrough_trace_fits_a_user_model(compiled, tmp_path, capsys):
         for activity in ("hear_alarm", "walk_to_dispenser", "choose_button", "take_pill"):
             if not any(o.item.activity == activity for o in session.offers):
                 session.skip_until_user()
-            session._run_to(session.now + 45)
+            session.run_to(session.now + 45)
             session.act(next(o for o in session.offers if o.item.activity == activity))
     session.close()
     assert json.loads(record.read_text(encoding="utf-8"))["steps"][0] == [
