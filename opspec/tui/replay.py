@@ -52,4 +52,4 @@ def load_recording(path: str | Path, compiled: CompiledPackage | None = None) ->
         names = spec_names(compiled)
         script.check_names(names.activities, names.triggers)
     # each step keeps its "#6" (Step.instance): it acts only on an offer of that instance
-    return ScriptUser(script)
+    return script.performer()
