@@ -107,17 +107,12 @@ def choose_user(compiled: CompiledPackage, spec_path: str | Path, *, script: str
         raise ConfigurationError("give --script or --user-model, not both",
                                  hint="a script plays exact actions; a model draws them")
     if script is not None:
+        from opspec.engine.names import spec_names
         from opspec.testing.script import load_script
 
         plan = load_script(script)
-        from opspec.engine.lanes import all_activities
-
-        triggers = {t.name for a in all_activities(compiled)
-                    for t in (a.raises, a.trigger, a.start_trigger, a.end_trigger)
-                    if t is not None and t.name}
-        triggers |= {t.name for p in compiled.processes.values()
-                     for t in (p.start_trigger, p.end_trigger) if t is not None and t.name}
-        plan.check_names([a.id for a in all_activities(compiled)], sorted(triggers))
+        names = spec_names(compiled)         # the same names simulate(script=...) checks
+        plan.check_names(names.activities, names.triggers)
 
         def scripted(_user: int, _seed: int) -> tuple[Performer | None, list[TraceListener]]:
             performer = plan.performer()
