@@ -109,7 +109,8 @@ def script(tmp_path: Path, *steps: tuple[str, str]) -> str:
 
 
 def simulate(bind: list[str], user: str, *, until: float = FIRST_DOSE, spec: Path = SPEC,
-             profiles: Path = DATA, settle_s: float | None = None) -> Outcome:
+             profiles: Path = DATA, settle_s: float | None = None,
+             speed: float = SPEED) -> Outcome:
     """What ``opspec run --bind`` does, through the public API."""
     compiled = compile_package(load_any_spec(spec))
     performer, listeners = choose_user(compiled, spec, script=user, user_model=None,
@@ -124,7 +125,7 @@ def simulate(bind: list[str], user: str, *, until: float = FIRST_DOSE, spec: Pat
     with attach_devices(bind, profiles, settle_s=settle_s) as devices:
         performers.update(devices.performers)
         config = EngineConfig().with_options(realtime=devices.requires_wall_clock,
-                                             speed=SPEED)
+                                             speed=speed)
         sim = Simulation(compiled, config, performers=performers, seed=1,
                          listeners=[*listeners, device_thread], keep_trace=True)
         devices.install(sim)
@@ -289,9 +290,12 @@ def test_a_line_nobody_expects_is_a_named_fault_and_the_run_goes_on(
 def test_a_misbehaving_alarm_retries_then_goes_on_simulated(
         fault: str, named: str, board: Any, tmp_path: Path) -> None:
     server = board(fault=fault, on="pty")
-    # two 200 ms (wall) timeouts span about 2.2 simulated hours at 20,000x
+    # timeout, hold for a late reply, resend, timeout: 3 x 200 ms (wall) span 3.3 simulated
+    # hours at 20,000x, which left too little slack before 12:00 on a busy CI machine; at
+    # 8,000x they span 1.3 h and the 08:00 alarm's fallback has 2.6 h (1.2 s wall) to spare
     run = simulate([f"alarm:{FAST}={server.url}"],
-                   script(tmp_path, ("after trg_2 30s", "press_report")), until=43000)
+                   script(tmp_path, ("after trg_2 30s", "press_report")), until=43000,
+                   speed=8000.0)
     assert [(f["fault"], f["action"]) for f in run.faults()][:2] == [
         (named, "retry"), (named, "simulate")]
     assert run.report["alarm"]["mode"] == {"alarm": "simulated"}

@@ -21,7 +21,8 @@ USERS = ROOT / "specs" / "medication_dispenser.users.toml"
 def pytester(pytester: pytest.Pytester) -> pytest.Pytester:
     """pytester whose inner runs skip hypothesis's plugin (it costs ~2 s per in-process run
     and these tests do not use it)."""
-    pytester.makeini("[pytest]\naddopts = -p no:hypothesispytest -p no:cacheprovider\n")
+    pytester.makeini("[pytest]\naddopts = -p no:hypothesispytest -p no:cacheprovider\n"
+                      "asyncio_default_fixture_loop_scope = function\n")
     return pytester
 
 

@@ -81,7 +81,8 @@ def test_a_script_and_a_user_model_together_fail_once_with_the_reason(
             simulate(spec, script=[("never", "press_report")],
                      user_model="specs/dispenser.users.toml", until=9 * 3600)
     """)
-    result = project.runpytest()
+    # -rN: no short summary, whose line repeats the message only when the terminal is wide
+    result = project.runpytest("-rN")
     result.assert_outcomes(failed=1)
     out = result.stdout.str()
     assert out.count("give script or user_model, not both") == 1

@@ -37,5 +37,6 @@ def absent_user(dispenser: CompiledPackage) -> SimulationResult:
 
 @pytest.fixture
 def pytester(pytester: pytest.Pytester) -> pytest.Pytester:
-    pytester.makeini("[pytest]\naddopts = -p no:hypothesispytest -p no:cacheprovider\n")
+    pytester.makeini("[pytest]\naddopts = -p no:hypothesispytest -p no:cacheprovider\n"
+                      "asyncio_default_fixture_loop_scope = function\n")
     return pytester
