@@ -10,6 +10,10 @@ peak memory (ru_maxrss) is measured the same way for both:
   core — what one evaluation worker does, without the result store and report;
 - **baseline**: ``../shared/bench/handcoded_simpy.py`` (the scenario written directly in SimPy).
 
+The engine runs as installed: compiled with mypyc (``setup.py``) unless the build is stale or
+``OPSPEC_PURE_PYTHON=1`` is set, which measures the same engine from its Python source. The
+first line of the output says which.
+
 It prints wall time, dose cycles per second and peak RSS of both, the engine/baseline ratio, and
 the outcome statistics of both with 99 % confidence intervals and whether they agree (the two
 draw their random numbers differently, so they agree statistically, not exactly).
@@ -30,6 +34,7 @@ BENCH = ROOT.parent / "shared" / "bench"
 
 _ENGINE = r"""
 import json, resource, sys, time
+import opspec._native
 users, days, seed = int(sys.argv[1]), int(sys.argv[2]), int(sys.argv[3])
 from opspec.engine.compiled import compile_package
 from opspec.engine.lanes import user_lane
@@ -59,7 +64,8 @@ print(json.dumps({"wall_s": wall, "cpu_s": cpu, "cycles": due, "taken": taken,
     "missed": missed, "alarms": alarms, "lat_mean_s": sum(lat) / len(lat),
     "lat_sd_s": (sum((x - sum(lat) / len(lat)) ** 2 for x in lat) / (len(lat) - 1)) ** 0.5,
     "lat_n": len(lat), "lat_p95_s": lat[int(0.95 * (len(lat) - 1))],
-    "peak_rss_mib": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024}))
+    "peak_rss_mib": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024,
+    "engine_build": opspec._native.STATUS}))
 """
 
 _BASELINE = r"""
@@ -114,6 +120,7 @@ def main() -> None:
     cycles = args.users * args.days * 4
     print(f"dispenser-day: {args.users} users x {args.days} days = {cycles} dose cycles, "
           f"seed {args.seed}, median of {args.repeat}")
+    print(f"engine: {engine['engine_build']}")
     print(f"{'':<22}{'wall s':>9}{'cycles/s':>11}{'peak RSS MiB':>14}")
     print(f"{'engine (spec + model)':<22}{e_wall:>9.2f}{cycles / e_wall:>11.0f}"
           f"{max(r['peak_rss_mib'] for r in engines):>14.0f}")

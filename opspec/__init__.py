@@ -4,5 +4,9 @@ their users, for usability evaluation, walkthroughs, specification tests and har
 Importing ``opspec`` stays light: no lxml, Textual or pyserial is imported here.
 """
 
+from opspec import _native
+
+_native.install()      # the engine compiled with mypyc, or from source if that build is stale
+
 __version__ = "0.1.0"
 __all__ = ["__version__"]

@@ -18,7 +18,7 @@ import sys
 import traceback
 from collections.abc import Sequence
 
-from opspec import __version__
+from opspec import __version__, _native
 from opspec.errors import OpspecError, SpecError
 
 __all__ = ["build_parser", "main"]
@@ -46,7 +46,8 @@ def build_parser() -> argparse.ArgumentParser:
         description="Execute operational specifications (XPDL / SISARL-XPDL) of assistive "
         "devices and their users.",
     )
-    parser.add_argument("--version", action="version", version=f"opspec {__version__}")
+    parser.add_argument("--version", action="version",
+                        version=f"opspec {__version__} (engine: {_native.STATUS})")
     subparsers = parser.add_subparsers(dest="command", metavar="COMMAND")
     for name in COMMAND_MODULES:
         try:

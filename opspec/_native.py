@@ -1,0 +1,103 @@
+"""Which engine modules run compiled (mypyc) and which run from their Python source.
+
+``setup.py`` compiles :data:`MODULES` with mypyc when opspec is installed and records each
+source's SHA-256 in ``opspec/_native_build.json``. At ``import opspec`` :func:`install` checks
+that record: when ``OPSPEC_PURE_PYTHON=1`` is set, or when any compiled module's source changed
+since the build (an edit in an editable checkout, a branch switch), *all* of them are imported
+from source instead — a stale build must never shadow the code being edited, and compiled and
+source versions of these modules do not mix (``Simulation`` subclasses ``Interpreter``).
+Either way the results are the same; only the speed differs. ``opspec --version`` says which.
+
+This module imports nothing from opspec: ``setup.py`` runs it before opspec is installed.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import importlib.machinery
+import importlib.util
+import json
+import os
+import sys
+from pathlib import Path
+from typing import Any
+
+#: The modules compiled by mypyc: the interpreter's hot path, per dose cycle.
+MODULES: tuple[str, ...] = (
+    "opspec.engine.compiled",
+    "opspec.engine.conditions",
+    "opspec.engine.instances",
+    "opspec.engine.interpreter",
+    "opspec.engine.lanes",
+    "opspec.engine.lifecycle",
+    "opspec.engine.metrics",
+    "opspec.engine.random",
+    "opspec.engine.sampling",
+    "opspec.engine.simulation",
+    "opspec.engine.timing",
+    "opspec.usermodels.performer",
+)
+STAMP = "_native_build.json"
+ENV = "OPSPEC_PURE_PYTHON"
+
+_PACKAGE_ROOT = Path(__file__).resolve().parent.parent
+
+
+def source_digest(path: Path) -> str:
+    return hashlib.sha256(path.read_bytes()).hexdigest()
+
+
+def _source(module: str) -> Path:
+    return _PACKAGE_ROOT / (module.replace(".", "/") + ".py")
+
+
+def _has_extension(module: str) -> bool:
+    base = _source(module).with_suffix("")
+    return any(Path(f"{base}{suffix}").exists()
+               for suffix in importlib.machinery.EXTENSION_SUFFIXES)
+
+
+def _decide() -> tuple[bool, str]:
+    """(compiled?, why) for this installation."""
+    if os.environ.get(ENV, "").strip() not in ("", "0"):
+        return False, f"pure Python ({ENV} is set)"
+    if not any(_has_extension(module) for module in MODULES):
+        return False, "pure Python (installed without compiling; see setup.py)"
+    try:
+        recorded: dict[str, Any] = json.loads(
+            (_PACKAGE_ROOT / "opspec" / STAMP).read_text(encoding="utf-8"))["modules"]
+    except (OSError, ValueError, KeyError, TypeError):
+        return False, f"pure Python (no valid opspec/{STAMP}: reinstall to compile)"
+    for module in MODULES:
+        try:
+            changed = recorded.get(module) != source_digest(_source(module))
+        except OSError:
+            changed = True
+        if changed:
+            return False, (f"pure Python ({module} changed since it was compiled: reinstall, "
+                           f"e.g. pip install -e ., to compile it again)")
+    return True, f"compiled with mypyc ({len(MODULES)} modules)"
+
+
+class _FromSource:
+    """Meta-path finder importing :data:`MODULES` from their .py files, not the extensions."""
+
+    def find_spec(self, name: str, path: object = None, target: object = None
+                  ) -> importlib.machinery.ModuleSpec | None:
+        if name not in MODULES:
+            return None
+        return importlib.util.spec_from_file_location(name, _source(name))
+
+
+COMPILED = False
+STATUS = "pure Python"
+
+
+def install() -> None:
+    """Decide once per process; route the modules to their source when they must not run
+    compiled (idempotent)."""
+    global COMPILED, STATUS
+    COMPILED, STATUS = _decide()
+    if not COMPILED and not any(isinstance(f, _FromSource) for f in sys.meta_path):
+        if any(_has_extension(module) for module in MODULES):
+            sys.meta_path.insert(0, _FromSource())

@@ -1,0 +1,92 @@
+"""Build the engine's hot modules as C extensions with mypyc (pyproject.toml holds the rest).
+
+The engine is written in plain, typed Python; mypyc compiles the modules listed in
+``opspec/_native.py`` (the interpreter, instances, metrics, the stochastic user's performer…)
+so a simulated dose cycle runs about twice as fast — see ``benchmarks/dispenser_day.py``.
+Nothing else changes: the same source runs uncompiled when
+
+- ``OPSPEC_PURE_PYTHON=1`` is set while installing (nothing is compiled), or
+- there is no C compiler or the compilation fails (a warning says so; the install goes on), or
+- a compiled module's source changed after the build (``opspec._native`` notices at import and
+  runs all of them from source, so an edit in an editable checkout is never shadowed by a
+  stale build; reinstall to compile again).
+
+After compiling, ``opspec/_native_build.json`` records the SHA-256 of each compiled source.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import runpy
+import sys
+from pathlib import Path
+
+from setuptools import setup
+from setuptools.command.build_ext import build_ext
+
+ROOT = Path(__file__).resolve().parent
+NATIVE = runpy.run_path(str(ROOT / "opspec" / "_native.py"))
+MODULES: tuple[str, ...] = NATIVE["MODULES"]
+STAMP: str = NATIVE["STAMP"]
+source_digest = NATIVE["source_digest"]
+
+
+def _wanted() -> bool:
+    return os.environ.get("OPSPEC_PURE_PYTHON", "").strip() in ("", "0")
+
+
+class OptionalNativeBuild(build_ext):
+    """build_ext that records what it compiled, and falls back to pure Python on failure."""
+
+    def run(self) -> None:
+        try:
+            super().run()
+        except Exception as error:  # noqa: BLE001 - any compiler failure: install pure Python
+            self._pure(f"compiling the engine with mypyc failed ({error})")
+            return
+        self._stamp()
+
+    def build_extension(self, ext: object) -> None:
+        try:
+            super().build_extension(ext)  # type: ignore[arg-type]
+        except Exception as error:  # noqa: BLE001
+            raise RuntimeError(str(error)) from error
+
+    def _stamp(self) -> None:
+        digests = {module: source_digest(ROOT / (module.replace(".", "/") + ".py"))
+                   for module in MODULES}
+        text = json.dumps({"compiler": "mypyc", "modules": digests}, indent=1) + "\n"
+        targets = [ROOT / "opspec" / STAMP] if self.inplace else []
+        targets.append(Path(self.build_lib) / "opspec" / STAMP)
+        for target in targets:
+            target.parent.mkdir(parents=True, exist_ok=True)
+            target.write_text(text, encoding="utf-8")
+
+    def _pure(self, why: str) -> None:
+        print(f"warning: {why}; opspec is installed as pure Python (same results, slower "
+              f"engine)", file=sys.stderr)
+        stale = ROOT / "opspec" / STAMP
+        if self.inplace and stale.exists():
+            stale.unlink()
+
+
+def _extensions() -> list[object]:
+    if not _wanted():
+        return []
+    try:
+        from mypyc.build import mypycify
+    except ImportError:
+        print("warning: mypyc is not available; opspec is installed as pure Python",
+              file=sys.stderr)
+        return []
+    paths = [module.replace(".", "/") + ".py" for module in MODULES]
+    try:
+        return list(mypycify(paths, group_name="opspec", opt_level="3", debug_level="0"))
+    except (Exception, SystemExit) as error:  # noqa: BLE001 - mypyc refused the source
+        print(f"warning: mypyc cannot compile the engine ({error}); opspec is installed as "
+              f"pure Python", file=sys.stderr)
+        return []
+
+
+setup(ext_modules=_extensions(), cmdclass={"build_ext": OptionalNativeBuild})

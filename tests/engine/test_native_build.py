@@ -1,0 +1,108 @@
+"""The engine compiled with mypyc (setup.py, opspec/_native.py) and run from source agree, and
+a compiled build whose source changed is never the one that runs."""
+
+from __future__ import annotations
+
+import json
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+from opspec import _native
+
+ROOT = Path(__file__).resolve().parents[2]
+SPEC = ROOT / "specs" / "medication_dispenser.xpdl"
+MODEL = ROOT / "specs" / "medication_dispenser.users.toml"
+
+_PROBE = ("import json, opspec, opspec._native as n, opspec.engine.interpreter as i;"
+          "print(json.dumps([n.COMPILED, n.STATUS, i.__file__]))")
+
+
+def _python(code: str, pure: bool) -> str:
+    env = {k: v for k, v in os.environ.items() if k != _native.ENV}
+    if pure:
+        env[_native.ENV] = "1"
+    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                          env=env, cwd=ROOT, check=True)
+    return done.stdout
+
+
+def _run_json(pure: bool) -> dict[str, object]:
+    code = ("import sys; from opspec.cli import main; sys.argv = ['opspec', 'run', "
+            f"{str(SPEC)!r}, '--days', '4', '--seed', '7', '--user-model', {str(MODEL)!r}, "
+            "'--json']; main()")
+    result = json.loads(_python(code, pure))
+    assert isinstance(result, dict)
+    return result
+
+
+def test_opspec_pure_python_runs_every_module_from_its_source() -> None:
+    compiled, status, interpreter = json.loads(_python(_PROBE, pure=True))
+    assert not compiled and "OPSPEC_PURE_PYTHON is set" in status
+    assert interpreter.endswith("interpreter.py")
+
+
+def test_the_build_runs_compiled_when_it_is_fresh() -> None:
+    compiled, status, interpreter = json.loads(_python(_PROBE, pure=False))
+    if not any(_native._has_extension(m) for m in _native.MODULES):
+        pytest.skip(f"this installation was not compiled: {status}")
+    assert compiled, status
+    assert not interpreter.endswith(".py")
+
+
+def test_compiled_and_source_engines_give_the_same_run() -> None:
+    pure, default = _run_json(pure=True), _run_json(pure=False)
+    assert pure["metrics"] == default["metrics"]
+    assert pure == default
+
+
+def _fake_install(tmp_path: Path, digest_of: dict[str, str] | None) -> None:
+    for module in _native.MODULES:
+        source = tmp_path / (module.replace(".", "/") + ".py")
+        source.parent.mkdir(parents=True, exist_ok=True)
+        source.write_text(f"# {module}\n", encoding="utf-8")
+        source.with_suffix(".cpython-311-x86_64-linux-gnu.so").write_bytes(b"")
+    if digest_of is not None:
+        modules = {m: digest_of.get(m, _native.source_digest(
+            tmp_path / (m.replace(".", "/") + ".py"))) for m in _native.MODULES}
+        (tmp_path / "opspec" / _native.STAMP).write_text(
+            json.dumps({"compiler": "mypyc", "modules": modules}), encoding="utf-8")
+
+
+@pytest.fixture
+def fake_root(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> Path:
+    monkeypatch.setattr(_native, "_PACKAGE_ROOT", tmp_path)
+    monkeypatch.setattr(_native.importlib.machinery, "EXTENSION_SUFFIXES",
+                        [".cpython-311-x86_64-linux-gnu.so"])
+    monkeypatch.delenv(_native.ENV, raising=False)
+    return tmp_path
+
+
+def test_a_fresh_build_is_used(fake_root: Path) -> None:
+    _fake_install(fake_root, {})
+    assert _native._decide() == (True, f"compiled with mypyc ({len(_native.MODULES)} modules)")
+
+
+def test_an_edited_source_sends_every_module_back_to_its_source(fake_root: Path) -> None:
+    _fake_install(fake_root, {"opspec.engine.interpreter": "0" * 64})
+    compiled, why = _native._decide()
+    assert not compiled
+    assert "opspec.engine.interpreter changed since it was compiled" in why
+    assert "pip install -e ." in why
+
+
+def test_a_build_without_its_record_is_not_trusted(fake_root: Path) -> None:
+    _fake_install(fake_root, None)
+    compiled, why = _native._decide()
+    assert not compiled and "reinstall to compile" in why
+
+
+def test_the_finder_loads_source_only_for_the_compiled_modules() -> None:
+    finder = _native._FromSource()
+    spec = finder.find_spec("opspec.engine.interpreter")
+    assert spec is not None and spec.origin is not None
+    assert spec.origin.endswith("opspec/engine/interpreter.py")
+    assert finder.find_spec("opspec.engine.trace") is None
