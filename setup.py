@@ -47,12 +47,6 @@ class OptionalNativeBuild(build_ext):
             return
         self._stamp()
 
-    def build_extension(self, ext: object) -> None:
-        try:
-            super().build_extension(ext)  # type: ignore[arg-type]
-        except Exception as error:  # noqa: BLE001
-            raise RuntimeError(str(error)) from error
-
     def _stamp(self) -> None:
         digests = {module: source_digest(ROOT / (module.replace(".", "/") + ".py"))
                    for module in MODULES}

@@ -98,6 +98,6 @@ def install() -> None:
     compiled (idempotent)."""
     global COMPILED, STATUS
     COMPILED, STATUS = _decide()
-    if not COMPILED and not any(isinstance(f, _FromSource) for f in sys.meta_path):
-        if any(_has_extension(module) for module in MODULES):
-            sys.meta_path.insert(0, _FromSource())
+    if (not COMPILED and not any(isinstance(f, _FromSource) for f in sys.meta_path)
+            and any(_has_extension(module) for module in MODULES)):
+        sys.meta_path.insert(0, _FromSource())
