@@ -7,4 +7,9 @@ bash scripts/system-deps.sh
 python3 -m venv .venv
 .venv/bin/python -m pip install --quiet --upgrade pip
 .venv/bin/python -m pip install --quiet -e '.[test]'
+.venv/bin/opspec --version
+# With a C compiler the install compiles the engine (setup.py); a test checks that it did.
+if [ -z "${OPSPEC_PURE_PYTHON:-}" ] && command -v cc >/dev/null 2>&1; then
+    export OPSPEC_REQUIRE_COMPILED=1
+fi
 exec .venv/bin/python -m pytest "$@"
