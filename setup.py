@@ -16,6 +16,7 @@ After compiling, ``opspec/_native_build.json`` records the SHA-256 of each compi
 
 from __future__ import annotations
 
+import importlib.machinery
 import json
 import os
 import runpy
@@ -40,6 +41,8 @@ class OptionalNativeBuild(build_ext):
     """build_ext that records what it compiled, and falls back to pure Python on failure."""
 
     def run(self) -> None:
+        if self.inplace:
+            _remove_unlisted_extensions()
         try:
             super().run()
         except Exception as error:  # noqa: BLE001 - any compiler failure: install pure Python
@@ -63,6 +66,18 @@ class OptionalNativeBuild(build_ext):
         stale = ROOT / "opspec" / STAMP
         if self.inplace and stale.exists():
             stale.unlink()
+
+
+def _remove_unlisted_extensions() -> None:
+    """Delete compiled modules an earlier build left in the checkout that are no longer in
+    MODULES: Python would import them instead of their source, and opspec._native only guards
+    the listed ones."""
+    listed = {ROOT / (module.replace(".", "/")) for module in MODULES}
+    for suffix in importlib.machinery.EXTENSION_SUFFIXES:
+        for path in (ROOT / "opspec").rglob(f"*{suffix}"):
+            if path.with_name(path.name[: -len(suffix)]) not in listed:
+                print(f"removing {path.relative_to(ROOT)} (no longer compiled)", file=sys.stderr)
+                path.unlink()
 
 
 def _extensions() -> list[object]:
