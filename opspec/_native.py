@@ -41,6 +41,8 @@ MODULES: tuple[str, ...] = (
     "opspec.engine.sampling",
     "opspec.engine.simulation",
     "opspec.engine.timing",
+    "opspec.engine.wakeup",
+    "opspec.engine.workitem",
     "opspec.usermodels.performer",
 )
 STAMP = "_native_build.json"

@@ -7,10 +7,10 @@ Design (for speed, see ``benchmarks/engine_profile.py``):
   none is left (a trampoline: no recursion however long a chain of instant activities is,
   and performers may call back into the session from inside ``offer``).
 * SimPy events exist only where simulated time passes: a timer, a deadline, a duration, a
-  worker's CPU time, a performer's ``call_later``. They are bare ``Timeout`` events with a
-  callback, never a generator process per activity. SimPy cannot cancel a scheduled event,
-  so a timer carries the *generation* of its activity instance and does nothing when the
-  instance has moved on.
+  worker's CPU time, a performer's ``call_later``. They are bare events with a callback
+  (:class:`~opspec.engine.wakeup.Wakeups`), never a generator process per activity. SimPy
+  cannot cancel a scheduled event, so a timer carries the *generation* of its activity
+  instance and does nothing when the instance has moved on.
 * Instantaneous activities (routes, events, tasks without a bound callable, activities with
   no implementation) run without an :class:`~opspec.engine.instances.ActivityInstance`;
   only activities that wait get one.
@@ -81,6 +81,7 @@ from opspec.engine.random import Streams
 from opspec.engine.registry import PerformerRegistry
 from opspec.engine.trace import EventKind as EK
 from opspec.engine.trace import TraceEvent, TraceListener
+from opspec.engine.wakeup import Wakeups
 from opspec.errors import ExecutionError, OpspecError
 from opspec.model import CoordinationKind, Package, ParameterMode
 
@@ -106,6 +107,7 @@ class Interpreter:
         self.compiled = compiled
         self.config = config
         self.env = env if env is not None else simpy.Environment()
+        self._wakeups = Wakeups(self.env)
         self.registry = performers
         self.streams = Streams(seed, scope)
         self.mode_loader = mode_loader
@@ -216,8 +218,7 @@ class Interpreter:
         if self._resolution > 0.0:
             delay = self._align(delay)
         gen = ai.gen
-        timeout = self.env.timeout(max(0.0, delay))
-        timeout.callbacks.append(lambda _e: self._fire(fn, ai, arg, gen))
+        self._wakeups.after(max(0.0, delay), lambda _e: self._fire(fn, ai, arg, gen))
 
     def _fire(self, fn: Callable[[ActivityInstance, Any], None], ai: ActivityInstance,
               arg: Any, gen: int) -> None:
@@ -251,8 +252,7 @@ class Interpreter:
         if delay <= 0.0 and self._draining:
             self._ready.append((_call, callback, None, None))
             return
-        timeout = self.env.timeout(max(0.0, delay))
-        timeout.callbacks.append(lambda _e: self._callback(callback))
+        self._wakeups.after(max(0.0, delay), lambda _e: self._callback(callback))
 
     def _callback(self, callback: Callable[[], None]) -> None:
         callback()

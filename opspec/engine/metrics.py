@@ -14,12 +14,17 @@ from __future__ import annotations
 
 import math
 from collections.abc import Iterable, Mapping
-from typing import Any
+from typing import Any, Final
 
 from opspec.engine.trace import TraceEvent
 from opspec.model import EventSelector, MetricDefinition, MetricKind
 
 __all__ = ["MetricsListener", "percentile", "summarise_durations"]
+
+# What a selector is to its metric (Final: mypyc inlines them).
+_COUNT: Final = 0
+_START: Final = 1
+_END: Final = 2
 
 
 def percentile(values: list[float], q: float) -> float:
@@ -59,22 +64,25 @@ class MetricsListener:
         self.keep_times = False
         self.count_times: dict[str, list[float]] = {}
         self.sample_times: dict[str, list[float]] = {}
-        self._by_kind: dict[str, list[tuple[MetricDefinition, str, EventSelector]]] = {}
+        # kind -> (metric name, role, process, activity, keep the last start): plain values,
+        # not the model's selector objects, because ``raw`` runs for every matching event.
+        self._by_kind: dict[str, list[tuple[str, int, str | None, str | None, bool]]] = {}
         selects: set[tuple[str, str | None, str | None]] = set()
         for metric in self.definitions:
             if metric.kind is MetricKind.COUNT and metric.select is not None:
                 self.counts[metric.name] = 0
-                self._add(metric, metric.select, "count", selects)
+                self._add(metric, metric.select, _COUNT, selects)
             elif metric.kind is MetricKind.DURATION and metric.start and metric.end:
                 self.samples[metric.name] = []
                 self._open[metric.name] = {}
-                self._add(metric, metric.start, "start", selects)
-                self._add(metric, metric.end, "end", selects)
+                self._add(metric, metric.start, _START, selects)
+                self._add(metric, metric.end, _END, selects)
         self.selects = frozenset(selects)
 
-    def _add(self, metric: MetricDefinition, selector: EventSelector, role: str,
+    def _add(self, metric: MetricDefinition, selector: EventSelector, role: int,
              selects: set[tuple[str, str | None, str | None]]) -> None:
-        self._by_kind.setdefault(selector.event, []).append((metric, role, selector))
+        self._by_kind.setdefault(selector.event, []).append(
+            (metric.name, role, selector.process, selector.activity, selector.which == "last"))
         selects.add((selector.event, selector.process, selector.activity))
 
     def __call__(self, event: TraceEvent) -> None:
@@ -88,24 +96,24 @@ class MetricsListener:
         interested = self._by_kind.get(kind)
         if not interested:
             return
-        for metric, role, selector in interested:
-            if not ((selector.process is None or selector.process == process)
-                    and (selector.activity is None or selector.activity == activity)):
+        for name, role, want_process, want_activity, last in interested:
+            if not ((want_process is None or want_process == process)
+                    and (want_activity is None or want_activity == activity)):
                 continue
-            if role == "count":
-                self.counts[metric.name] += 1
+            if role == _COUNT:
+                self.counts[name] += 1
                 if self.keep_times:
-                    self.count_times.setdefault(metric.name, []).append(time)
+                    self.count_times.setdefault(name, []).append(time)
                 continue
             key = instance or 0
-            pending = self._open[metric.name]
-            if role == "start":
-                if selector.which == "last" or key not in pending:
+            pending = self._open[name]
+            if role == _START:
+                if last or key not in pending:
                     pending[key] = time
             elif key in pending:
-                self.samples[metric.name].append(time - pending.pop(key))
+                self.samples[name].append(time - pending.pop(key))
                 if self.keep_times:
-                    self.sample_times.setdefault(metric.name, []).append(time)
+                    self.sample_times.setdefault(name, []).append(time)
 
     def values(self) -> dict[str, dict[str, Any]]:
         """Every declared metric in the shared output shape."""

@@ -9,40 +9,11 @@ users, the TUI, serial devices and Python callables all plug in here.
 from __future__ import annotations
 
 from collections.abc import Callable, Mapping
-from types import MappingProxyType
-from typing import Any, NamedTuple, Protocol, runtime_checkable
+from typing import Any, Protocol, runtime_checkable
+
+from opspec.engine.workitem import WorkItem
 
 __all__ = ["Performer", "PerformerSession", "WorkItem"]
-
-
-class WorkItem(NamedTuple):
-    """An activity instance offered to a performer (immutable).
-
-    ``key`` is unique per run and identifies the offer in every call back to the session.
-    ``choices`` lists alternative activity ids when the person may pick one of several
-    (a deferred choice / event-based gateway); it is empty otherwise. ``duration`` is a draw
-    from the activity's declared duration distribution (``None`` when it declares none), for
-    performers that simulate the work (``SimulatedDevice``).
-
-    A named tuple rather than a frozen dataclass for speed: the engine builds one per offer
-    (several per dose cycle of the dispenser), and a 13-field frozen dataclass costs about
-    2.5 us to construct (``object.__setattr__`` per field) against 0.3 us for a named tuple.
-    Read it by field name; do not rely on its tuple order.
-    """
-
-    key: int
-    process: str
-    instance: int
-    activity: str
-    label: str
-    participant: str | None
-    lane: str | None
-    offered_at: float
-    application: str | None = None
-    data: Mapping[str, Any] = MappingProxyType({})
-    choices: tuple[str, ...] = ()
-    root_instance: int | None = None
-    duration: float | None = None      # drawn from the activity's declared duration, if any
 
 
 class PerformerSession(Protocol):

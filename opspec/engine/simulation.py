@@ -222,13 +222,11 @@ class Simulation(Interpreter):
             return
         if self._resolution > 0.0:
             at = math.ceil(at / self._resolution) * self._resolution
-        timeout = self.env.timeout(max(0.0, at - self.env.now))
-
         def fired(_event: Any) -> None:
             fire(label)
             self._drain()
             self._next_timer(times, fire, label)
-        timeout.callbacks.append(fired)
+        self._wakeups.after(max(0.0, at - self.env.now), fired)
 
     # ------------------------------------------------------------------ control
     def start(self, process_id: str, data: Mapping[str, Any] | None = None) -> int:

@@ -36,7 +36,9 @@ import numpy as np
 
 from opspec.engine.performers import PerformerSession, WorkItem
 from opspec.errors import UserModelError
+from opspec.usermodels.errors import Busy
 from opspec.usermodels.model import ActivityModel, UserModel
+from opspec.usermodels.parametric import Constant
 from opspec.usermodels.routine import RoutineTracker
 
 __all__ = ["StochasticUser"]
@@ -56,11 +58,14 @@ class StochasticUser:
         self.trace_decisions = trace_decisions
         self._session: PerformerSession | None = None
         self._routine = RoutineTracker(model.routine, rng)
+        self._routine_is_trivial = model.routine.is_trivial
+        self._random = rng.random     # bound once: offer draws from it several times a cycle
         self._pending: dict[int, WorkItem] = {}
         self._engaged: set[int] = set()          # lane instances the person is engaged in
         self._wrong: dict[tuple[int, str], int] = {}
         self._recovery: dict[tuple[int, str], float] = {}
         self._models: dict[str, ActivityModel] = {}
+        self._plans: dict[str, _Plan] = {}
         self._alternatives: dict[str, ActivityModel | None] = {}
         self._handover: dict[int, int] = {}      # lane -> key of its last completed item
 
@@ -73,29 +78,36 @@ class StochasticUser:
         session = self._session
         if session is None:
             session = self._require_session()
-        model = self._models.get(item.activity)
-        if model is None:
-            model = self._model_of(item.activity)
-        lane = item.root_instance if item.root_instance is not None else item.instance
+        activity = item.activity
+        plan = self._plans.get(activity)
+        if plan is None:
+            plan = self._plans[activity] = _Plan(activity, self._model_of(activity),
+                                                 self.model.busy)
+        model = plan.model
+        root = item.root_instance
+        lane = root if root is not None else item.instance
         now = session.now
-        state = self._routine.state(now)
-        busy = self.model.busy
+        if self._routine_is_trivial:
+            notice, factor, window, start_at = 1.0, 1.0, None, None
+        else:
+            state = self._routine.state(now)
+            notice, factor = state.notice_factor, state.duration_factor
+            window, start_at = state.window, state.start_at
         self._handover.pop(lane, None)
 
-        if busy is not None and busy.ignores(item.activity) and (
+        if plan.ignored_when_busy and (
                 len(self._engaged) > 1 or (self._engaged and lane not in self._engaged)):
             self._omit(item, lane, "busy")
             return
 
-        omission = model.omission
-        if omission is not None or model.prompt:
-            p_miss = omission.probability if omission is not None else 0.0
-            u = float(self.rng.random())
-            if u >= (1.0 - p_miss) * state.notice_factor:
+        if plan.noticed_or_not:
+            p_miss = plan.p_miss
+            u = float(self._random())
+            if u >= (1.0 - p_miss) * notice:
                 if u >= 1.0 - p_miss:
-                    reason = omission.reason if omission is not None else "not noticed"
-                elif state.window is not None:
-                    reason = state.window
+                    reason = plan.miss_reason
+                elif window is not None:
+                    reason = window
                 else:
                     reason = "adherence"
                 self._omit(item, lane, reason)
@@ -107,32 +119,34 @@ class StochasticUser:
             choice, delay = self._choose(item, model, lane)
             picked = self._alternative(choice)
             if picked is not None:
-                delay += picked.duration.sample(self.rng) * state.duration_factor
+                delay += picked.duration.sample(self.rng) * factor
 
-        if model.delay is not None and float(self.rng.random()) < model.delay.probability:
-            extra = model.delay.duration.sample(self.rng)
+        extra_delay = plan.delay
+        if extra_delay is not None and float(self._random()) < extra_delay.probability:
+            extra = extra_delay.duration.sample(self.rng)
             delay += extra
             self._trace("user.delayed", item, seconds=extra)
 
-        factor = state.duration_factor
-        duration = model.duration.sample(self.rng) * factor
-        if model.repetition is not None and float(
-                self.rng.random()) < model.repetition.probability:
+        constant = plan.constant_duration
+        duration = (constant if constant is not None else model.duration.sample(self.rng)) * factor
+        repetition = plan.repetition
+        if repetition is not None and float(self._random()) < repetition.probability:
             duration += model.duration.sample(self.rng) * factor
             self._trace("user.repeated", item)
-        if (model.commission is not None and not item.choices
-                and float(self.rng.random()) < model.commission.probability):
-            recovery = model.commission.recovery.sample(self.rng)
+        slip = plan.commission
+        if (slip is not None and not item.choices
+                and float(self._random()) < slip.probability):
+            recovery = slip.recovery.sample(self.rng)
             duration += recovery
             self._trace("user.slip", item, recovery=recovery)
 
         start = now
-        if state.start_at is not None:
-            start = state.start_at
+        if start_at is not None:
+            start = start_at
             self._trace("user.deferred", item, until=start)
 
-        if busy is not None:
-            if item.activity in busy.engaged:
+        if plan.engages is not None:
+            if plan.engages:
                 self._engaged.add(lane)
             else:
                 self._engaged.discard(lane)
@@ -176,7 +190,7 @@ class StochasticUser:
             weights = dict(model.probabilities)
             offered = [(c, weights.get(c, 0.0)) for c in choices]
             total = sum(w for _, w in offered)
-            u = float(self.rng.random()) * total
+            u = float(self._random()) * total
             for choice, weight in offered:
                 if u < weight:
                     return choice, owed
@@ -192,7 +206,7 @@ class StochasticUser:
         commission = model.commission
         count = self._wrong.get(key, 0)
         if (commission is not None and count < commission.max_per_instance
-                and float(self.rng.random()) < commission.probability):
+                and float(self._random()) < commission.probability):
             wrong = [c for c in (commission.alternatives or choices)
                      if c != intended and c in choices]
             if wrong:
@@ -252,3 +266,25 @@ class StochasticUser:
             payload: Mapping[str, Any] = {"instance": item.instance, "activity": item.activity,
                                           "process": item.process, **data}
             self._session.trace(kind, payload)
+
+
+class _Plan:
+    """What ``offer`` reads of an activity's model, read once per user and activity: the
+    model's frozen dataclasses are slow to read from compiled code, and ``offer`` runs for
+    every work item. Nothing here draws a random number (the draw order is unchanged)."""
+
+    def __init__(self, activity: str, model: ActivityModel, busy: Busy | None) -> None:
+        self.model = model
+        omission = model.omission
+        self.noticed_or_not = omission is not None or model.prompt
+        self.p_miss = omission.probability if omission is not None else 0.0
+        self.miss_reason = omission.reason if omission is not None else "not noticed"
+        # Constant.sample draws nothing, so skipping the call leaves the stream as it was.
+        self.constant_duration = (model.duration.value if type(model.duration) is Constant
+                                  else None)
+        self.ignored_when_busy = busy is not None and busy.ignores(activity)
+        # None: no busy model; else whether offering this activity engages the person
+        self.engages = None if busy is None else activity in busy.engaged
+        self.delay = model.delay
+        self.repetition = model.repetition
+        self.commission = model.commission

@@ -47,6 +47,9 @@ def test_opspec_pure_python_runs_every_module_from_its_source() -> None:
 
 def test_the_build_runs_compiled_when_it_is_fresh() -> None:
     compiled, status, interpreter = json.loads(_python(_PROBE, pure=False))
+    if not compiled and "changed since it was compiled" in status \
+            and os.environ.get("OPSPEC_REQUIRE_COMPILED") != "1":
+        pytest.skip(f"engine source edited since the build: {status}")
     if not any(_native._has_extension(m) for m in _native.MODULES):
         # scripts/test.sh (what CI runs) has just installed with a C compiler at hand, so there
         # a pure-Python install means the compile failed silently behind pip --quiet.
