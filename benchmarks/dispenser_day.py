@@ -1,6 +1,7 @@
 """dispenser-day: the engine against the hand-coded SimPy baseline, in the same run.
 
     python benchmarks/dispenser_day.py [--users 1000] [--days 30] [--seed 1] [--repeat 1]
+                                       [--instructions N]
 
 Runs the reference scenario (``../shared/bench/SCENARIO.md``) twice, each in its own process so
 peak memory (ru_maxrss) is measured the same way for both:
@@ -17,6 +18,13 @@ first line of the output says which.
 It prints wall time, dose cycles per second and peak RSS of both, the engine/baseline ratio, and
 the outcome statistics of both with 99 % confidence intervals and whether they agree (the two
 draw their random numbers differently, so they agree statistically, not exactly).
+
+Wall time on a shared or virtual machine drifts by tens of percent over minutes, so the ratio
+comes with its pairwise range. ``--instructions N`` adds a ratio that does not drift: the
+instructions (valgrind's callgrind, if installed) each side executes for N more users — the
+difference between runs of 2N and N users, so start-up and imports cancel out. Instructions
+are not time (the engine's code is larger and chases more pointers per instruction), but the
+count is the same on every run, which makes it the number to compare changes by.
 """
 
 from __future__ import annotations
@@ -24,6 +32,8 @@ from __future__ import annotations
 import argparse
 import json
 import math
+import re
+import shutil
 import statistics
 import subprocess
 import sys
@@ -60,9 +70,10 @@ for u in range(users):
     per_user_missed.append(m["doses_missed"]["total"])
 wall, cpu = time.perf_counter() - t0, time.process_time() - c0
 lat.sort()
+lat_mean = sum(lat) / len(lat)
 print(json.dumps({"wall_s": wall, "cpu_s": cpu, "cycles": due, "taken": taken,
-    "missed": missed, "alarms": alarms, "lat_mean_s": sum(lat) / len(lat),
-    "lat_sd_s": (sum((x - sum(lat) / len(lat)) ** 2 for x in lat) / (len(lat) - 1)) ** 0.5,
+    "missed": missed, "alarms": alarms, "lat_mean_s": lat_mean,
+    "lat_sd_s": (sum((x - lat_mean) ** 2 for x in lat) / (len(lat) - 1)) ** 0.5,
     "lat_n": len(lat), "lat_p95_s": lat[int(0.95 * (len(lat) - 1))],
     "peak_rss_mib": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024,
     "engine_build": opspec._native.STATUS}))
@@ -89,6 +100,34 @@ def _run(code: str, *args: str) -> dict[str, float]:
     return json.loads(done.stdout.strip().splitlines()[-1])
 
 
+def _instructions(code: str, *args: str) -> int:
+    """Instructions executed by ``python -c code args`` under callgrind."""
+    done = subprocess.run(["valgrind", "--tool=callgrind", "--callgrind-out-file=/dev/null",
+                           sys.executable, "-c", code, *args], capture_output=True, text=True,
+                          check=False, cwd=ROOT)
+    found = re.search(r"Collected : (\d+)", done.stderr)
+    if done.returncode != 0 or found is None:
+        sys.exit(f"callgrind run failed:\n{done.stderr[-2000:]}")
+    return int(found.group(1))
+
+
+def _instruction_ratio(users: int, days: int, seed: int, spec: str, model: str) -> None:
+    if shutil.which("valgrind") is None:
+        print("\ninstructions: valgrind is not installed (apt-get install valgrind)")
+        return
+    per_side = []
+    for code, lead in ((_ENGINE, ()), (_BASELINE, (str(BENCH),))):
+        tail = (spec, model) if code is _ENGINE else ()
+        counts = [_instructions(code, *lead, str(n), str(days), str(seed), *tail)
+                  for n in (users, 2 * users)]
+        per_side.append(counts[1] - counts[0])
+    engine, base = per_side
+    cycles = users * days * 4
+    print(f"\ninstructions for {users} more users x {days} days (callgrind, 2N - N users): "
+          f"engine {engine / cycles / 1000:.0f}k per dose cycle, baseline "
+          f"{base / cycles / 1000:.0f}k; ratio {engine / base:.2f}x")
+
+
 def wilson(k: float, n: float, z: float) -> tuple[float, float]:
     p = k / n
     centre = (p + z * z / (2 * n)) / (1 + z * z / n)
@@ -102,6 +141,8 @@ def main() -> None:
     parser.add_argument("--days", type=int, default=30)
     parser.add_argument("--seed", type=int, default=1)
     parser.add_argument("--repeat", type=int, default=1, help="median of R runs of each")
+    parser.add_argument("--instructions", type=int, metavar="N", default=0,
+                        help="also count instructions for N more users under callgrind")
     args = parser.parse_args()
     if not (BENCH / "handcoded_simpy.py").is_file():
         sys.exit(f"baseline not found in {BENCH}")
@@ -146,6 +187,8 @@ def main() -> None:
           f"{float(base['alarms_per_dose']):.4f}")
     print(f"  latency p95   engine {engine['lat_p95_s']:.0f} s   baseline "
           f"{float(base['lat_p95_s']):.0f} s")
+    if args.instructions > 0:
+        _instruction_ratio(args.instructions, args.days, args.seed, spec, model)
 
 
 if __name__ == "__main__":
