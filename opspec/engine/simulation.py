@@ -30,10 +30,11 @@ End triggers of a workflow terminate its running instances.
 from __future__ import annotations
 
 import math
+import operator
 import queue
 from collections.abc import Callable, Iterable, Iterator, Mapping
 from dataclasses import dataclass, field
-from typing import Any
+from typing import Any, SupportsFloat, SupportsIndex
 
 import simpy
 
@@ -133,12 +134,15 @@ class Simulation(Interpreter):
 
     def __init__(self, compiled: CompiledPackage | Package, config: EngineConfig | None = None,
                  *, performers: PerformerRegistry | Mapping[str, Performer] | None = None,
-                 seed: int = 0, listeners: Iterable[TraceListener] = (),
+                 seed: SupportsIndex = 0, listeners: Iterable[TraceListener] = (),
                  params: Mapping[str, Any] | None = None, keep_trace: bool = False,
-                 env: simpy.Environment | None = None, scope: Iterable[int] = (),
+                 env: simpy.Environment | None = None, scope: Iterable[SupportsIndex] = (),
                  mode_loader: Callable[[str], CompiledPackage | Package] | None = None) -> None:
         if isinstance(compiled, Package):
             compiled = compile_package(compiled)
+        # Plain ints from here on: the compiled engine accepts nothing else, and a caller's
+        # numpy integers (a seed from an array) should work as they do from source.
+        seed = operator.index(seed)
         self.seed = seed
         self.memory = MemorySink() if keep_trace else None
         self.metrics = MetricsListener(compiled.package.metrics) if (
@@ -150,7 +154,8 @@ class Simulation(Interpreter):
             all_listeners.append(self.memory)
         super().__init__(compiled, config or _DEFAULT_CONFIG,
                          performers=PerformerRegistry.coerce(performers), seed=seed,
-                         listeners=all_listeners, params=params, env=env, scope=tuple(scope),
+                         listeners=all_listeners, params=params, env=env,
+                         scope=tuple(operator.index(k) for k in scope),
                          mode_loader=mode_loader)
         self.session = _Session(self)
         self._booted = False
@@ -318,8 +323,11 @@ class Simulation(Interpreter):
             return False
         return True
 
-    def run(self, until: float | None = None) -> RunResult:
+    def run(self, until: SupportsFloat | None = None) -> RunResult:
         """Run to simulated time ``until`` (or until nothing is scheduled) and summarise."""
+        return self._run(None if until is None else float(until))
+
+    def _run(self, until: float | None) -> RunResult:
         self.boot()
         if until is not None and until < self.env.now:
             raise ExecutionError(f"until ({until}) must not be before the current simulated "

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import numpy as np
+import pytest
 from builders import act, pkg, proc
 from conftest import run
 
@@ -25,6 +26,20 @@ def _trace(seed: int) -> list[dict[str, object]]:
 
 def test_same_seed_gives_an_identical_trace() -> None:
     assert _trace(7) == _trace(7)
+
+
+def test_numpy_integers_work_as_seed_scope_and_until() -> None:
+    # A seed taken from a numpy array must give the ints' run, compiled or not (the compiled
+    # engine itself accepts only Python ints and floats).
+    numpy_run = run(_model(), seed=np.int64(7), until=np.int64(1000), scope=(np.int32(2),))
+    int_run = run(_model(), seed=7, until=1000.0, scope=(2,))
+    assert [e.to_json() for e in numpy_run.trace or ()] == [
+        e.to_json() for e in int_run.trace or ()]
+
+
+def test_a_float_seed_is_refused() -> None:
+    with pytest.raises(TypeError):
+        run(_model(), seed=7.5, until=10.0)  # type: ignore[arg-type]
 
 
 def test_different_seeds_give_different_durations() -> None:
