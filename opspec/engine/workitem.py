@@ -3,7 +3,7 @@
 
 from __future__ import annotations
 
-from collections.abc import Mapping
+from collections.abc import Iterable, Mapping
 from types import MappingProxyType
 from typing import Any, Final
 
@@ -33,7 +33,7 @@ class WorkItem:
     def __init__(self, key: int, process: str, instance: int, activity: str, label: str,
                  participant: str | None, lane: str | None, offered_at: float,
                  application: str | None = None, data: Mapping[str, Any] = _NO_DATA,
-                 choices: tuple[str, ...] = (), root_instance: int | None = None,
+                 choices: Iterable[str] = (), root_instance: int | None = None,
                  duration: float | None = None) -> None:
         self.key: Final = key
         self.process: Final = process
@@ -45,7 +45,7 @@ class WorkItem:
         self.offered_at: Final = offered_at
         self.application: Final = application
         self.data: Final = data
-        self.choices: Final = tuple(choices)
+        self.choices: Final[tuple[str, ...]] = tuple(choices)   # a list from a caller too
         self.root_instance: Final = root_instance
         self.duration: Final = duration
 

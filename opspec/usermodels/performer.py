@@ -64,7 +64,6 @@ class StochasticUser:
         self._engaged: set[int] = set()          # lane instances the person is engaged in
         self._wrong: dict[tuple[int, str], int] = {}
         self._recovery: dict[tuple[int, str], float] = {}
-        self._models: dict[str, ActivityModel] = {}
         self._plans: dict[str, _Plan] = {}
         self._alternatives: dict[str, ActivityModel | None] = {}
         self._handover: dict[int, int] = {}      # lane -> key of its last completed item
@@ -81,13 +80,13 @@ class StochasticUser:
         activity = item.activity
         plan = self._plans.get(activity)
         if plan is None:
-            plan = self._plans[activity] = _Plan(activity, self._model_of(activity),
+            plan = self._plans[activity] = _Plan(activity, self.model.activity(activity),
                                                  self.model.busy)
         model = plan.model
         root = item.root_instance
         lane = root if root is not None else item.instance
         now = session.now
-        if self._routine_is_trivial:
+        if self._routine_is_trivial:    # RoutineTracker.state's own answer, without the call
             notice, factor, window, start_at = 1.0, 1.0, None, None
         else:
             state = self._routine.state(now)
@@ -165,12 +164,6 @@ class StochasticUser:
         if self._session is None:
             raise UserModelError("StochasticUser.offer() called before attach(session)")
         return self._session
-
-    def _model_of(self, activity: str) -> ActivityModel:
-        found = self._models.get(activity)
-        if found is None:
-            found = self._models[activity] = self.model.activity(activity)
-        return found
 
     def _alternative(self, activity: str) -> ActivityModel | None:
         """The model of a choice's alternative, if the user model describes it (cached)."""

@@ -114,3 +114,20 @@ def test_the_finder_loads_source_only_for_the_compiled_modules() -> None:
     assert spec is not None and spec.origin is not None
     assert spec.origin.endswith("opspec/engine/interpreter.py")
     assert finder.find_spec("opspec.engine.trace") is None
+
+
+def test_a_work_item_reads_by_field_and_compares_by_value() -> None:
+    from opspec.engine.performers import WorkItem
+
+    item = WorkItem(1, "notify", 7, "press_report", "Press report", "user", "user", 60.0,
+                    choices=["a", "b"])
+    assert (item.activity, item.choices, item.root_instance, dict(item.data)) == (
+        "press_report", ("a", "b"), None, {})
+    assert item == WorkItem(1, "notify", 7, "press_report", "Press report", "user", "user",
+                            60.0, choices=("a", "b"))
+    assert item != WorkItem(2, "notify", 7, "press_report", "Press report", "user", "user",
+                            60.0, choices=("a", "b"))
+    assert repr(item).startswith("WorkItem(key=1, process='notify', instance=7,")
+    if _native.COMPILED:
+        with pytest.raises(AttributeError):
+            item.key = 2  # type: ignore[misc]
