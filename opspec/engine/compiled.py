@@ -25,7 +25,9 @@ from opspec.engine.sampling import Sampler, make_sampler, parse_duration_text
 from opspec.errors import OpspecError, SourceLocation, SpecError
 from opspec.model import (
     Activity,
+    Binary,
     BlockActivity,
+    Call,
     ConditionKind,
     CoordinationBuiltIn,
     Event,
@@ -35,6 +37,7 @@ from opspec.model import (
     GatewayType,
     Literal,
     LoopKind,
+    MIFlow,
     Name,
     NoImplementation,
     Package,
@@ -43,14 +46,17 @@ from opspec.model import (
     Route,
     SubFlow,
     Task,
+    TaskApplication,
     Transition,
     TriggerKind,
     TriggerRef,
+    Unary,
     WorkflowProcess,
 )
 
 __all__ = [
     "J_AND",
+    "J_COMPLEX",
     "J_OR",
     "J_XOR",
     "K_ASYNC",
@@ -63,9 +69,14 @@ __all__ = [
     "K_SUBFLOW",
     "K_TASK",
     "K_THROW",
+    "MI_ALL",
+    "MI_COMPLEX",
+    "MI_NONE",
+    "MI_ONE",
     "S_AND",
     "S_OR",
     "S_XOR",
+    "CTool",
     "CTransition",
     "CTrigger",
     "CompiledActivity",
@@ -86,8 +97,10 @@ K_NOOP, K_TASK, K_MANUAL, K_SUBFLOW, K_ASYNC, K_CATCH, K_THROW, K_BLOCK, K_COORD
 KIND_NAMES = ("noop", "task", "manual", "subflow", "async-subflow", "catch", "throw", "block",
               "coordination", "event-gateway")
 # joins and splits
-J_XOR, J_AND, J_OR = range(3)
+J_XOR, J_AND, J_OR, J_COMPLEX = range(4)
 S_XOR, S_AND, S_OR = range(3)
+# multi-instance flow conditions: when the token moves on
+MI_NONE, MI_ONE, MI_ALL, MI_COMPLEX = range(4)
 # transition kinds
 T_NONE, T_COND, T_OTHERWISE, T_EXCEPTION, T_DEFAULT = range(5)
 
@@ -121,6 +134,17 @@ class CTransition:
     assignments: tuple[tuple[str, Evaluator], ...]
 
 
+@dataclass(frozen=True, slots=True, eq=False)
+class CTool:
+    """One application a task calls (XPDL 1.0 ``Tool``, 2.x ``TaskApplication``): its
+    parameter mapping and, for a script tool agent's application, the compiled statements
+    (``(variable, expression)`` in order; ``None`` when the application is no script)."""
+
+    application: str
+    params: tuple[tuple[ParameterMode, str, Evaluator | None, str | None], ...] = ()
+    script: tuple[tuple[str, Evaluator], ...] | None = None
+
+
 @dataclass(slots=True, eq=False)
 class CompiledActivity:
     """One activity of a graph, ready to run. Not mutated after compilation."""
@@ -137,6 +161,7 @@ class CompiledActivity:
     lanes: tuple[str, ...] = ()      # names a performer may be bound to, most specific first
     user_lane: bool = False
     join: int = J_XOR
+    join_condition: Evaluator | None = None  # complex joins: fires when it holds
     in_slots: dict[int, int] = field(default_factory=dict)   # transition index -> join slot
     split: int = S_XOR
     out: tuple[CTransition, ...] = ()
@@ -158,7 +183,11 @@ class CompiledActivity:
     subflow: str | None = None
     params: tuple[tuple[ParameterMode, str, Evaluator | None, str | None], ...] = ()
     application: str | None = None
+    tools: tuple[CTool, ...] = ()            # every application of a task, in order
+    toolchain: bool = False                  # several tools or a script: run them in order
     loop: tuple[Evaluator | None, int | None, bool] | None = None
+    # multi-instance: (how many, parallel, MI_* flow condition, ComplexMI_FlowCondition)
+    mi: tuple[Evaluator, bool, int, Evaluator | None] | None = None
     block: CompiledGraph | None = None
     coordination: CoordinationBuiltIn | None = None
     boundary: tuple[int, ...] = ()
@@ -498,12 +527,10 @@ class _Compiler:
                 ca.trigger = trig      # start events: the process start trigger (see below)
         elif isinstance(body, Task):
             if body.applications:
-                ca.application = body.applications[0].application
-                app = self.package.application(ca.application) or next(
-                    (a for a in proc.applications if a.id == ca.application), None)
-                formals = app.formal_parameters if app is not None else ()
-                ca.params = self.params(body.applications[0].actual_parameters, formals, act,
-                                        f"application {ca.application!r}")
+                ca.tools = tuple(self.tool(proc, act, call) for call in body.applications)
+                ca.application = ca.tools[0].application
+                ca.params = ca.tools[0].params
+                ca.toolchain = len(ca.tools) > 1 or ca.tools[0].script is not None
             ca.kind = K_TASK
             ca.general = True
         elif isinstance(body, NoImplementation):
@@ -529,7 +556,17 @@ class _Compiler:
         # joins and splits
         if act.join is not None and len(incoming) > 1:
             ca.join = {GatewayType.AND: J_AND, GatewayType.OR: J_OR,
-                       GatewayType.COMPLEX: J_AND}.get(act.join.type, J_XOR)
+                       GatewayType.COMPLEX: J_COMPLEX}.get(act.join.type, J_XOR)
+            if ca.join == J_COMPLEX:
+                if act.join.condition is None:
+                    raise _spec_error(
+                        f"activity {act.id!r} is a Complex join without an IncomingCondition "
+                        "opspec can evaluate", act.location,
+                        "give the Route an IncomingCondition over activationCount, e.g. "
+                        "\"activationCount >= 1\" for a discriminator")
+                ca.join_condition = self.cond(act.join.condition, act.join.condition_text,
+                                              act.location,
+                                              f"IncomingCondition of activity {act.id!r}")
         ca.in_slots = {ti: slot for slot, ti in enumerate(incoming)}
         ordered = list(outgoing)
         if act.split is not None and act.split.transition_refs:
@@ -541,9 +578,15 @@ class _Compiler:
         ca.exceptions = tuple(t for t in ordered if t.kind == T_EXCEPTION)
         ca.default_exception = next((t for t in ordered if t.kind == T_DEFAULT), None)
         if act.split is not None:
-            ca.split = {GatewayType.AND: S_AND, GatewayType.OR: S_OR}.get(act.split.type, S_XOR)
+            # a diverging complex gateway behaves as an inclusive one (BPMN 2.0 §13.3.6)
+            ca.split = {GatewayType.AND: S_AND, GatewayType.OR: S_OR,
+                        GatewayType.COMPLEX: S_OR}.get(act.split.type, S_XOR)
         elif len(normal) > 1 and all(t.kind == T_NONE for t in normal) and not ca.otherwise:
             ca.split = S_AND      # no split declared, several unconditional: run them all
+        elif len(normal) > 1:
+            # no split declared and some conditions: BPMN conditional sequence flows, every
+            # one whose condition holds is taken (OTHERWISE is the default flow)
+            ca.split = S_OR
         # directives
         ca.start_assign = tuple(
             (a.target, self.expr(a.expression, a.text, a.location, f"assignment to {a.target!r}"))
@@ -575,12 +618,55 @@ class _Compiler:
                 cond = self.cond(act.loop.condition, act.loop.condition_text, act.location,
                                  f"loop condition of activity {act.id!r}")
             ca.loop = (cond, act.loop.maximum, act.loop.test_before)
+        elif act.loop is not None and act.loop.kind is LoopKind.MULTI_INSTANCE:
+            loop = act.loop
+            if loop.condition is None and not loop.condition_text:
+                raise _spec_error(f"multi-instance activity {act.id!r} has no MI_Condition",
+                                  act.location, "write MI_Condition=\"N\" (how many instances)")
+            count = self.expr(loop.condition, loop.condition_text, act.location,
+                              f"MI_Condition of activity {act.id!r}")
+            flow = {MIFlow.NONE: MI_NONE, MIFlow.ONE: MI_ONE, MIFlow.ALL: MI_ALL,
+                    MIFlow.COMPLEX: MI_COMPLEX}[loop.flow]
+            flow_cond = None
+            if flow == MI_COMPLEX:
+                flow_cond = self.cond(loop.flow_condition, loop.flow_condition_text,
+                                      act.location,
+                                      f"ComplexMI_FlowCondition of activity {act.id!r}")
+            ca.mi = (count, loop.parallel, flow, flow_cond)
         # instantaneous under the dedicated model (tasks: unless a callable is bound to the
         # application at run time; general activities: unless the pooled model queues them)
-        ca.plain = (not ca.deadlines and ca.loop is None and ca.sampler is None
+        ca.plain = (not ca.deadlines and ca.loop is None and ca.mi is None and ca.sampler is None
                     and ca.cpu == 0.0 and ca.start_trigger is None and ca.end_trigger is None
                     and not ca.boundary)
-        ca.fast = ca.plain and ca.kind in (K_NOOP, K_THROW, K_TASK, K_ASYNC)
+        ca.fast = ca.plain and ca.kind in (K_NOOP, K_THROW, K_TASK, K_ASYNC) and not (
+            ca.kind == K_TASK and ca.toolchain)
+
+    def tool(self, proc: WorkflowProcess, act: Activity, call: TaskApplication) -> CTool:
+        """One application call of a task: its parameters and, for a script, its statements."""
+        app = self.package.application(call.application) or next(
+            (a for a in proc.applications if a.id == call.application), None)
+        formals = app.formal_parameters if app is not None else ()
+        params = self.params(call.actual_parameters, formals, act,
+                             f"application {call.application!r}")
+        script = None
+        if app is not None and app.script:
+            known = {f.id for f in formals}
+            statements: list[tuple[str, Evaluator]] = []
+            for a in app.script:
+                where = a.location or app.location
+                unknown = sorted(_names(a.expression) - known) if a.expression else []
+                if unknown:
+                    raise _spec_error(
+                        f"script statement {a.text!r} of application {app.id!r} reads "
+                        f"{', '.join(map(repr, unknown))}, which is neither a formal parameter "
+                        "of the application nor set by an earlier statement", where,
+                        "a script sees only its application's formal parameters")
+                statements.append((a.target, self.expr(
+                    a.expression, a.text, where,
+                    f"script statement {a.text!r} of application {app.id!r}")))
+                known.add(a.target)
+            script = tuple(statements)
+        return CTool(application=call.application, params=params, script=script)
 
     def finish_choices(self, graph: CompiledGraph) -> None:
         """Deferred choice on an XOR split: all unconditional branches go to manual
@@ -671,6 +757,24 @@ class _Compiler:
             lane=lane, start_trigger=start, end_trigger=self.trigger_ref(directives.end_trigger),
             auto_start=bool(auto), deadline=directives.deadline, mode=directives.mode,
             location=proc.location)
+
+
+def _names(expression: Expression) -> set[str]:
+    """Roots of the data names ``expression`` reads."""
+    found: set[str] = set()
+    stack: list[Expression] = [expression]
+    while stack:
+        node = stack.pop()
+        if isinstance(node, Name):
+            found.add(node.path[0])
+        elif isinstance(node, Unary):
+            stack.append(node.operand)
+        elif isinstance(node, Binary):
+            stack.append(node.left)
+            stack.append(node.right)
+        elif isinstance(node, Call):
+            stack.extend(node.args)
+    return found
 
 
 def _constant(value: float) -> Evaluator:

@@ -16,7 +16,7 @@ if TYPE_CHECKING:
     from opspec.engine.compiled import CompiledActivity, CompiledGraph, CompiledProcess
     from opspec.engine.performers import WorkItem
 
-__all__ = ["ActivityInstance", "Frame", "ProcessInstance"]
+__all__ = ["ActivityInstance", "Frame", "MultiInstance", "ProcessInstance"]
 
 
 class ProcessInstance:
@@ -69,7 +69,8 @@ class Frame:
     ``parked`` counts tokens waiting at AND/OR joins; the frame is done when both are zero.
     """
 
-    __slots__ = ("graph", "inst", "joins", "live", "ors", "owner", "parked", "running")
+    __slots__ = ("cjoins", "graph", "inst", "joins", "live", "ors", "owed", "owner", "parked",
+                 "running")
 
     def __init__(self, graph: CompiledGraph, inst: ProcessInstance,
                  owner: ActivityInstance | None) -> None:
@@ -81,6 +82,10 @@ class Frame:
         self.joins: dict[int, list[int]] = {}
         self.ors: dict[int, int] = {}
         self.running: dict[int, ActivityInstance] = {}
+        # complex joins: tokens per incoming slot, and the slots owed a token before the
+        # join resets (after it fired; BPMN's "waiting for reset")
+        self.cjoins: dict[int, list[int]] = {}
+        self.owed: dict[int, set[int]] = {}
 
 
 class ActivityInstance:
@@ -101,6 +106,7 @@ class ActivityInstance:
         "item",
         "iteration",
         "key",
+        "mi",
         "performer",
         "started_at",
         "state",
@@ -121,6 +127,21 @@ class ActivityInstance:
         self.choice: tuple[Any, ...] = ()     # deferred choice: the transitions offered
         self.cleanup: list[Callable[[], None]] = []
         self.performer: Any = None
+        self.mi: MultiInstance | None = None
 
     def __repr__(self) -> str:
         return f"<ActivityInstance {self.act.process}.{self.act.id}#{self.key}>"
+
+
+class MultiInstance:
+    """The instances of one multi-instance activity: ``count`` in all, ``started`` and
+    ``completed`` so far, whether the token has ``passed`` on, and the ``members`` running."""
+
+    __slots__ = ("completed", "count", "members", "passed", "started")
+
+    def __init__(self, count: int) -> None:
+        self.count = count
+        self.started = 0
+        self.completed = 0
+        self.passed = False
+        self.members: list[ActivityInstance] = []

@@ -24,6 +24,7 @@ from opspec.model.activities import (
     Deadline,
     Event,
     GatewayType,
+    LoopKind,
     Reference,
     Route,
 )
@@ -210,11 +211,33 @@ def _activity_structure(process: WorkflowProcess, aset: ActivitySet | None, grap
                 report.warning(
                     transition, "condition-without-split",
                     f"Transition {transition.id!r} out of activity {activity.id!r} in {scope} "
-                    f"has a condition, but {activity.id!r} declares no split: XPDL evaluates "
-                    "conditions at splits; opspec treats it as a guard and stops the instance "
-                    "when no transition can be taken",
-                    f"declare <Split Type=\"XOR\"> on {activity.id!r} (with an OTHERWISE "
-                    "transition), or remove the condition")
+                    f"has a condition, but {activity.id!r} declares no split: opspec takes "
+                    "every outgoing transition whose condition holds (BPMN conditional "
+                    "sequence flows, an inclusive split), the OTHERWISE one when none holds, "
+                    "and stops the instance when no transition can be taken",
+                    f"declare <Split Type=\"XOR\"> on {activity.id!r} if only the first "
+                    "transition that holds should be taken")
+                break
+    join = activity.join
+    if (join is not None and join.type is GatewayType.COMPLEX
+            and len(graph.incoming.get(activity.id, ())) > 1 and join.condition is None):
+        text = join.condition_text
+        report.error(activity, "complex-join-without-condition",
+                     f"activity {activity.id!r} in {scope} is a Complex join "
+                     + (f"whose IncomingCondition {text!r} cannot be evaluated"
+                        if text else "without an IncomingCondition") +
+                     ", so opspec cannot tell when it fires",
+                     'give the Route an IncomingCondition over activationCount (e.g. '
+                     'IncomingCondition="activationCount >= 2" for a 2-out-of-M join, '
+                     '"activationCount >= 1" for a discriminator), or use an AND/OR join')
+    loop = activity.loop
+    if (loop is not None and loop.kind is LoopKind.MULTI_INSTANCE and loop.condition is None):
+        report.error(activity, "multi-instance-without-count",
+                     f"activity {activity.id!r} in {scope} is a multi-instance loop "
+                     + (f"whose MI_Condition {loop.condition_text!r} cannot be evaluated"
+                        if loop.condition_text else "without an MI_Condition") +
+                     ", so the number of instances is unknown",
+                     'write MI_Condition="N" (an integer expression over data fields)')
     _unconditional_xor(scope, graph, activity, report)
     _deadlines(scope, activity, outgoing, report)
 

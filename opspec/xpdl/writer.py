@@ -451,6 +451,13 @@ def _write_body(parent: etree._Element, activity: Activity, script_language: str
         attrs = {"GatewayType": _GATEWAY[body.gateway]}
         if body.gateway is GatewayType.EVENT:
             attrs["ExclusiveType"] = "Event"
+        join = activity.join
+        if join is not None and join.type is GatewayType.COMPLEX:
+            text = join.condition_text
+            if text is None and join.condition is not None:
+                text = expression_text(join.condition)
+            if text is not None:
+                attrs["IncomingCondition"] = text
         _sub(parent, "Route", **attrs)
     elif isinstance(body, NoImplementation):
         _sub(_sub(parent, "Implementation"), "No")
@@ -521,8 +528,12 @@ def _write_activity(parent: etree._Element, activity: Activity, script_language:
                  TestTime="Before" if loop.test_before else "After")
         else:
             loop_element = _sub(element, "Loop", LoopType="MultiInstance")
+            flow_condition = loop.flow_condition_text
+            if flow_condition is None and loop.flow_condition is not None:
+                flow_condition = expression_text(loop.flow_condition)
             _sub(loop_element, "LoopMultiInstance", MI_Condition=condition,
-                 MI_Ordering="Sequential")
+                 MI_Ordering="Parallel" if loop.parallel else "Sequential",
+                 MI_FlowCondition=loop.flow.value, ComplexMI_FlowCondition=flow_condition)
     _write_assignments(element, activity.assignments)
     if activity.lane is not None:
         _sub(_sub(element, "NodeGraphicsInfos"), "NodeGraphicsInfo", LaneId=activity.lane)
