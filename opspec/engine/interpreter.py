@@ -135,6 +135,7 @@ class Interpreter:
         self._pullers: dict[str, deque[ActivityInstance]] = {}
         self._perf_cache: dict[CompiledActivity, Performer | None] = {}
         self._apps = performers.applications
+        self._tool_at: dict[int, int] = {}    # activity instance key -> tool offered
         self._pooled = config.pooled
         self._switch = config.switch_cost if config.pooled else 0.0
         self._resolution = config.timer_resolution
@@ -607,7 +608,9 @@ class Interpreter:
         act = ai.act
         kind = act.kind
         inst = ai.frame.inst
-        if kind == K_MANUAL or (kind == K_TASK and act.application in self._apps):
+        if kind == K_TASK and act.toolchain:
+            self._run_tools(ai, 0)
+        elif kind == K_MANUAL or (kind == K_TASK and act.application in self._apps):
             performer = (self._apps[act.application or ""] if kind == K_TASK
                          else self._performer_for(act))
             if performer is None:
@@ -884,6 +887,87 @@ class Interpreter:
             return None
         return out
 
+    # ------------------------------------------------------------------ tools
+    def _run_tools(self, ai: ActivityInstance, index: int) -> None:
+        """Run the task's tools from ``index`` on, in order (XPDL: every ``Tool`` of the
+        activity). A tool whose application is bound to a performer is offered to it as a
+        work item, and the next tool runs when that completes; a script tool runs its
+        statements; any other tool completes at once. The body is done after the last."""
+        act = ai.act
+        tools = act.tools
+        while index < len(tools):
+            tool = tools[index]
+            performer = self._apps.get(tool.application)
+            if performer is not None:
+                data = self._tool_inputs(ai, tool.params)
+                if data is None:
+                    return
+                key = ai.key
+                if key not in self._tool_at:
+                    table = self._tool_at
+                    ai.cleanup.append(lambda: _discard(table, key))
+                self._tool_at[key] = index
+                self._offer(ai, performer, (), data, None, tool.application)
+                return
+            if tool.script is not None and not self._run_script(ai, tool.application,
+                                                                tool.params, tool.script):
+                return
+            index += 1
+        self._ready.append((self._body_done, ai, None, None))
+
+    def _tool_done(self, ai: ActivityInstance, data: Mapping[str, Any] | None,
+                   _unused: Any = None) -> None:
+        """The performer of one tool completed: its outputs, then the next tool."""
+        if ai.state != RUNNING:
+            return
+        inst = ai.frame.inst
+        if inst.state == SUSPENDED:
+            inst.deferred.append((self._tool_done, ai, data, None))
+            return
+        index = self._tool_at.pop(ai.key, 0)
+        if data:
+            for key, value in self._outputs(ai, data, ai.act.tools[index].params).items():
+                self._set(inst, ai.act, key, value)
+        self._run_tools(ai, index + 1)
+
+    def _tool_inputs(self, ai: ActivityInstance,
+                     params: tuple[tuple[ParameterMode, str, Any, str | None], ...]
+                     ) -> dict[str, Any] | None:
+        inst = ai.frame.inst
+        now = self.env._now
+        out: dict[str, Any] = {}
+        try:
+            for _mode, formal, fn, _target in params:
+                if fn is not None:
+                    out[formal] = fn(inst.scope, now)
+        except OpspecError as error:
+            self._fail(ai, "parameter", f"an actual parameter failed: {error.message}")
+            return None
+        return out
+
+    def _run_script(self, ai: ActivityInstance, application: str,
+                    params: tuple[tuple[ParameterMode, str, Any, str | None], ...],
+                    script: tuple[tuple[str, Any], ...]) -> bool:
+        """A script tool agent's application, run as a built-in: IN/INOUT formals take the
+        actual parameters' values (OUT formals start unset), the statements run in order,
+        OUT/INOUT formals are written back to the actual parameters' data fields."""
+        inst = ai.frame.inst
+        now = self.env._now
+        local: dict[str, Any] = {}
+        try:
+            for _mode, formal, fn, _target in params:
+                local[formal] = fn(inst.scope, now) if fn is not None else None
+            for variable, fn in script:
+                local[variable] = fn(local, now)
+        except OpspecError as error:
+            self._fail(ai, "script", f"the script of application {application!r} failed: "
+                       f"{error.message}")
+            return False
+        for mode, formal, _fn, target in params:
+            if mode is not ParameterMode.IN and target is not None:
+                self._set(inst, ai.act, target, local.get(formal))
+        return True
+
     # ------------------------------------------------------------------ waits and triggers
     def _wait_trigger(self, ai: ActivityInstance, trig: CTrigger, handler: Any, arg: Any,
                       persistent: bool = False) -> None:
@@ -1081,11 +1165,13 @@ class Interpreter:
             return performer
 
     def _offer(self, ai: ActivityInstance, performer: Performer, choices: tuple[str, ...],
-               data: Mapping[str, Any] | None, duration: float | None) -> None:
+               data: Mapping[str, Any] | None, duration: float | None,
+               application: str | None = None) -> None:
         act = ai.act
         inst = ai.frame.inst
         item = WorkItem(ai.key, act.process, inst.id, act.id, act.label, act.participant,
-                        act.lane, self.env._now, act.application,
+                        act.lane, self.env._now,
+                        application if application is not None else act.application,
                         data if data is not None else MappingProxyType(inst.data), choices,
                         inst.root, duration)
         ai.item = item
@@ -1175,6 +1261,8 @@ class Interpreter:
                         f"{', '.join(item.choices)}, got {choice!r}",
                         hint="call complete(item, choice=ACTIVITY_ID)", sim_time=self.env._now)
             self._ready.append((self._choose, ai, trans, data))
+        elif ai.key in self._tool_at:
+            self._ready.append((self._tool_done, ai, data, None))
         elif data:
             if ai.act.params:
                 data = self._outputs(ai, data)
@@ -1184,13 +1272,17 @@ class Interpreter:
         if not self._draining:
             self._drain()
 
-    def _outputs(self, ai: ActivityInstance, data: Mapping[str, Any]) -> dict[str, Any]:
+    def _outputs(self, ai: ActivityInstance, data: Mapping[str, Any],
+                 params: tuple[tuple[ParameterMode, str, Any, str | None], ...] | None = None
+                 ) -> dict[str, Any]:
         """Map a performer's results (by formal parameter id) onto the actual data fields;
         keys that are not formal parameters are taken as data field names."""
         out: dict[str, Any] = {}
-        formal_to_target = {f: t for mode, f, _fn, t in ai.act.params
+        if params is None:
+            params = ai.act.params
+        formal_to_target = {f: t for mode, f, _fn, t in params
                             if mode is not ParameterMode.IN and t is not None}
-        inputs_only = {f for mode, f, _fn, _t in ai.act.params if mode is ParameterMode.IN}
+        inputs_only = {f for mode, f, _fn, _t in params if mode is ParameterMode.IN}
         for key, value in data.items():
             if key in formal_to_target:
                 out[formal_to_target[key]] = value

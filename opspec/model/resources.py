@@ -6,7 +6,7 @@ import enum
 from dataclasses import dataclass
 
 from opspec.model.common import Element
-from opspec.model.data import FormalParameter
+from opspec.model.data import Assignment, FormalParameter
 
 __all__ = ["Application", "Lane", "Participant", "ParticipantType", "Pool"]
 
@@ -35,10 +35,17 @@ class Application(Element):
 
     ``kind`` names the XPDL 2.x application type when one was given (``WebService``,
     ``BusinessRule``, ``Script``…), else ``None``.
+
+    ``script`` holds the statements of a JaWE/Shark script tool agent (ExtendedAttributes
+    ``ToolAgentClass=…JavaScriptToolAgent`` or ``…BshToolAgent`` and ``Script="…"``), read as
+    assignments over the formal parameters (and local variables), run in order; empty when the
+    application is no script. The front end derives it from the extended attributes, which
+    stay as written, so writing the package back keeps the script.
     """
 
     formal_parameters: tuple[FormalParameter, ...] = ()
     kind: str | None = None
+    script: tuple[Assignment, ...] = ()
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)

@@ -17,6 +17,7 @@ It runs on the lxml tree after reading and before building, and does two things:
    ``Join/Split@Type`` AND / XOR / OR            Parallel / Exclusive / Inclusive
    ``Route@GatewayType`` AND / XOR / OR          Parallel / Exclusive / Inclusive
    ``Condition`` text                            ``Condition/Expression`` text
+   ``Condition`` text beside ``<Expression/>``   ``Condition/Expression`` text (JaWE, TWE)
    ``Deadline/DeadlineCondition``                ``Deadline/DeadlineDuration``
    ``Trigger="Rule"`` + ``TriggerRule``          ``Trigger="Conditional"`` + ``TriggerConditional``
    ============================================  ==============================================
@@ -131,7 +132,19 @@ def _conditions(index: _Index) -> None:
         parent = condition.getparent()
         if parent is None or etree.QName(parent).localname != "Transition":
             continue
-        if condition.find(_q("Expression")) is not None:
+        expression = condition.find(_q("Expression"))
+        if expression is not None:
+            # JaWE/TWE write the text beside an empty Expression element
+            # (``<Condition Type="CONDITION">x &gt; 1<Expression/></Condition>``): keep it.
+            if "".join(expression.itertext()).strip() or len(expression):
+                continue
+            loose = [condition.text or ""] + [sub.tail or "" for sub in condition]
+            if not "".join(loose).strip():
+                continue
+            expression.text = "".join(loose).strip()
+            condition.text = None
+            for sub in condition:
+                sub.tail = None
             continue
         text = condition.text
         if text is not None and text.strip():

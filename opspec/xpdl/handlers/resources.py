@@ -3,9 +3,12 @@
 from __future__ import annotations
 
 import dataclasses
+from typing import Any
 
 from lxml import etree
 
+from opspec.errors import Diagnostic, Severity
+from opspec.model.data import Assignment
 from opspec.model.resources import Application, Lane, Participant, ParticipantType, Pool
 from opspec.xpdl.handlers.common import (
     BuildContext,
@@ -56,7 +59,42 @@ def build_application(element: etree._Element, ctx: BuildContext) -> Application
         kind = next((local_name(sub) for sub in type_element if isinstance(sub.tag, str)), None)
     parameters = ctx.each(grandchildren(element, "FormalParameters", "FormalParameter"),
                           build_formal_parameter)
-    return Application(formal_parameters=parameters, kind=kind, **fields)
+    return Application(formal_parameters=parameters, kind=kind,
+                       script=_script(fields, ctx), **fields)
+
+
+def _script(fields: dict[str, Any], ctx: BuildContext) -> tuple[Assignment, ...]:
+    """The statements of a JaWE/Shark script tool agent (``ToolAgentClass`` + ``Script``
+    extended attributes); a script opspec cannot run is a ``bad-script`` error at its line."""
+    from opspec.xpdl.conditions import ConditionSyntaxError
+    from opspec.xpdl.scripts import SCRIPT_HINT, is_script_tool_agent, parse_script
+
+    attributes = {a.name: a for a in fields["extended_attributes"]}
+    agent = attributes.get("ToolAgentClass")
+    script = attributes.get("Script")
+    if agent is None or not is_script_tool_agent(agent.value or agent.text):
+        return ()
+    if script is None or not (script.value or script.text or "").strip():
+        ctx.diagnostics.append(Diagnostic(
+            agent.location or ctx.loc(None), Severity.ERROR, "bad-script",
+            f"Application {fields['id']!r} uses the script tool agent {agent.value!r} but has no "
+            "Script extended attribute", 'add <ExtendedAttribute Name="Script" Value="x = 1;"/>'))
+        return ()
+    location = script.location or fields["location"]
+    try:
+        return parse_script(script.value or script.text or "", location=location)
+    except ConditionSyntaxError as error:
+        if "JavaScript" in (agent.value or agent.text or ""):
+            ctx.diagnostics.append(Diagnostic(
+                location, Severity.ERROR, "bad-script",
+                f"Script of Application {fields['id']!r}: {error.message}", SCRIPT_HINT))
+        else:  # BeanShell scripts are Java calling into the Shark API: integrations
+            ctx.diagnostics.append(Diagnostic(
+                location, Severity.WARNING, "script-not-run",
+                f"the BeanShell Script of Application {fields['id']!r} is not run by opspec "
+                f"({error.problem}); a task calling it changes no data unless a performer "
+                "is bound to the application id", SCRIPT_HINT))
+        return ()
 
 
 def _nest(lanes: dict[str, Lane], parents: dict[str, str], order: list[str],
