@@ -30,6 +30,7 @@ class ProcessInstance:
     __slots__ = (
         "data",
         "deferred",
+        "depth",
         "frames",
         "id",
         "parent",
@@ -57,6 +58,7 @@ class ProcessInstance:
         self.started_at = started_at
         self.deferred: list[tuple[Any, ...]] = []
         self.trigger: str | None = None
+        self.depth = 0                        # synchronous subflow calls above this one
 
     def __repr__(self) -> str:
         return f"<ProcessInstance {self.process.id}#{self.id}>"

@@ -48,6 +48,7 @@ import simpy
 from opspec.engine import coordination as coord
 from opspec.engine.compiled import (
     J_AND,
+    J_COMPLEX,
     K_ASYNC,
     K_BLOCK,
     K_CATCH,
@@ -57,6 +58,9 @@ from opspec.engine.compiled import (
     K_SUBFLOW,
     K_TASK,
     K_THROW,
+    MI_ALL,
+    MI_NONE,
+    MI_ONE,
     S_XOR,
     CompiledActivity,
     CompiledPackage,
@@ -65,7 +69,7 @@ from opspec.engine.compiled import (
     CTrigger,
 )
 from opspec.engine.config import EngineConfig
-from opspec.engine.instances import ActivityInstance, Frame, ProcessInstance
+from opspec.engine.instances import ActivityInstance, Frame, MultiInstance, ProcessInstance
 from opspec.engine.lifecycle import (
     ABORTED,
     COMPLETED,
@@ -90,6 +94,9 @@ __all__ = ["Interpreter"]
 _EMPTY: Mapping[str, Any] = MappingProxyType({})
 _NEXT = LIFECYCLE.table
 _CHOICE_DONE = object()
+#: Synchronous subflow calls nested deeper than this end the run's root instance with a
+#: located fault: bounded recursion (a base case) runs, runaway recursion is reported.
+MAX_CALL_DEPTH = 100
 
 
 class Interpreter:
@@ -278,6 +285,8 @@ class Interpreter:
         inst = ProcessInstance(iid, proc, local, scope, priority, parent, root, self.env._now)
         inst.state = RUNNING
         inst.trigger = trigger
+        if parent is not None:
+            inst.depth = parent.frame.inst.depth + 1
         self.live[iid] = inst
         self.counts["started"] += 1
         if self._pflags[proc.id] & 1:
@@ -399,6 +408,15 @@ class Interpreter:
                 for slot in range(len(counts)):
                     counts[slot] -= 1
                 frame.parked -= len(counts) - 1
+            elif join == J_COMPLEX:
+                frame.parked += 1
+                frame.live -= 1
+                if self._complex_arrival(frame, act, act.in_slots[trans.index]):
+                    frame.live += 1
+                    self._start(frame, act)
+                elif frame.live <= 0:
+                    self._pending[frame] = None
+                return
             else:                                   # OR join: resolved when the queue is dry
                 frame.ors[index] = frame.ors.get(index, 0) + 1
                 frame.parked += 1
@@ -406,6 +424,51 @@ class Interpreter:
                 self._pending[frame] = None
                 return
         self._start(frame, act)
+
+    def _complex_arrival(self, frame: Frame, act: CompiledActivity, slot: int) -> bool:
+        """A token (already counted as parked) reaches complex join ``act`` on ``slot``;
+        whether the join fires now (BPMN 2.0 §13.4.4: fire when the activation condition
+        holds, consuming a token of each incoming transition that has one; then ignore one
+        token on each of the others before firing again)."""
+        index = act.index
+        counts = frame.cjoins.get(index)
+        if counts is None:
+            counts = frame.cjoins[index] = [0] * len(act.in_slots)
+        owed = frame.owed.get(index)
+        if owed is not None and slot in owed:       # waiting for reset: this one is ignored
+            owed.discard(slot)
+            frame.parked -= 1
+            if owed:
+                return False
+            del frame.owed[index]
+            return self._complex_fires(frame, act, counts) if any(counts) else False
+        counts[slot] += 1
+        if owed is not None:
+            return False
+        return self._complex_fires(frame, act, counts)
+
+    def _complex_fires(self, frame: Frame, act: CompiledActivity, counts: list[int]) -> bool:
+        inst = frame.inst
+        active = sum(1 for c in counts if c)
+        condition = act.join_condition
+        assert condition is not None
+        try:
+            holds = condition(ChainMap({"activationCount": active}, inst.scope), self.env._now)
+        except OpspecError as error:
+            self.abort(inst, act, f"the IncomingCondition failed: {error.message}")
+            return False
+        if not holds:
+            return False
+        owed = set()
+        for slot, count in enumerate(counts):
+            if count:
+                counts[slot] -= 1
+                frame.parked -= 1
+            else:
+                owed.add(slot)
+        if owed:
+            frame.owed[act.index] = owed
+        return True
 
     def _token_gone(self, frame: Frame) -> None:
         frame.live -= 1
@@ -431,10 +494,14 @@ class Interpreter:
                     frame.live += 1
                     fired = True
                     self._ready.append((self._start_at, frame, join, None))
+            if frame.owed and frame.live <= 0 and not fired:
+                # nothing can deliver the tokens a fired complex join waits for: it resets
+                frame.owed.clear()
             if not fired and frame.live <= 0:
                 if frame.parked:
                     waiting = [frame.graph.activities[i].id
-                               for i, c in list(frame.joins.items()) + list(frame.ors.items())
+                               for i, c in (list(frame.joins.items()) + list(frame.ors.items())
+                                            + list(frame.cjoins.items()))
                                if (c if isinstance(c, int) else any(c))]
                     self.report_deadlock(frame.inst, waiting, "a join waits for branches "
                                          "that can no longer arrive")
@@ -452,7 +519,23 @@ class Interpreter:
         for other, counts in frame.joins.items():
             if other in upstream and any(counts):
                 return False
+        for other, counts in frame.cjoins.items():
+            if other in upstream and any(counts):
+                return False
         return True
+
+    def _too_deep(self, ai: ActivityInstance, target: CompiledProcess) -> None:
+        """Runaway recursion: abort the outermost caller (which ends every nested call)."""
+        root = ai.frame.inst
+        while root.parent is not None:
+            root = root.parent.frame.inst
+        act = ai.act
+        text = (f"{act.where()}: activity {act.id!r} of process {act.process!r} calls "
+                f"{target.id!r} {MAX_CALL_DEPTH + 1} synchronous subflow calls deep at "
+                f"t={self.env._now:.3f} s: the recursion does not reach its base case")
+        self.faults.append({"time": self.env._now, "process": act.process,
+                            "instance": ai.frame.inst.id, "activity": act.id, "message": text})
+        self.end_instance(root, ABORTED, text)
 
     def report_deadlock(self, inst: ProcessInstance, waiting: list[str], why: str) -> None:
         """Record a deadlock of ``inst`` (trace + summary) and abort it."""
@@ -534,6 +617,8 @@ class Interpreter:
             return
         act = ai.act
         inst = ai.frame.inst
+        if act.mi is not None and ai.mi is None and not self._mi_begin(ai):
+            return
         self._emit_act(EK.ACTIVITY_STARTED, inst, act)
         if act.start_assign and not self._assign(inst, act, act.start_assign):
             return
@@ -554,6 +639,100 @@ class Interpreter:
             return
         self._run_body(ai)
 
+    # ------------------------------------------------------------------ multi-instance
+    def _mi_begin(self, ai: ActivityInstance) -> bool:
+        """Start the instances of multi-instance activity ``ai.act``; ``ai`` becomes the
+        first. Each instance holds a token of the frame; the flow condition decides which
+        of them move on (see :meth:`_mi_done`). Returns whether ``ai`` runs now."""
+        act = ai.act
+        frame = ai.frame
+        inst = frame.inst
+        count_fn, parallel, _flow, _cond = act.mi  # type: ignore[misc]
+        try:
+            raw = count_fn(inst.scope, self.env._now)
+        except OpspecError as error:
+            self.abort(inst, act, f"the MI_Condition failed: {error.message}")
+            return False
+        count = raw if isinstance(raw, int) and not isinstance(raw, bool) else (
+            int(raw) if isinstance(raw, float) and raw.is_integer() else -1)
+        if count < 0:
+            self.abort(inst, act, f"the MI_Condition gave {raw!r}, not a number of instances "
+                       "(an integer >= 0)")
+            return False
+        if count == 0:                      # no instance: the activity is done at once
+            self._emit_act(EK.ACTIVITY_STARTED, inst, act)
+            ai.state = COMPLETED
+            ai.gen += 1
+            frame.running.pop(ai.key, None)
+            self._finish(frame, act)
+            return False
+        group = MultiInstance(count)
+        frame.live += count - 1
+        self._mi_join(ai, group)
+        if parallel:
+            for _ in range(count - 1):
+                self._mi_next(frame, act, group)
+        return True
+
+    def _mi_join(self, ai: ActivityInstance, group: MultiInstance) -> None:
+        ai.mi = group
+        ai.iteration = group.started            # the instance's loopCounter
+        group.started += 1
+        group.members.append(ai)
+
+    def _mi_next(self, frame: Frame, act: CompiledActivity, group: MultiInstance) -> None:
+        ai = ActivityInstance(next(self._keys), act, frame, self.env._now)
+        ai.state = RUNNING
+        frame.running[ai.key] = ai
+        self._mi_join(ai, group)
+        self._ready.append((self._activate, ai, None, None))
+
+    def _mi_done(self, ai: ActivityInstance, group: MultiInstance) -> None:
+        """One instance completed: its token moves on or is consumed, per MI_FlowCondition."""
+        act = ai.act
+        frame = ai.frame
+        inst = frame.inst
+        group.completed += 1
+        group.members.remove(ai)
+        _count, parallel, flow, cond = act.mi  # type: ignore[misc]
+        if flow == MI_NONE:
+            moves = True
+        elif flow == MI_ONE:
+            moves = not group.passed
+        elif flow == MI_ALL:
+            moves = group.completed == group.count
+        else:
+            moves = False
+            if not group.passed and cond is not None:
+                counters = {"nrOfInstances": group.count,
+                            "nrOfCompletedInstances": group.completed,
+                            "nrOfActiveInstances": len(group.members)}
+                try:
+                    moves = bool(cond(ChainMap(counters, inst.scope), self.env._now))
+                except OpspecError as error:
+                    self.abort(inst, act, f"the ComplexMI_FlowCondition failed: "
+                               f"{error.message}")
+                    return
+        if not parallel and group.started < group.count and inst.state == RUNNING:
+            self._mi_next(frame, act, group)
+        if moves:
+            group.passed = True
+            self._finish(frame, act)
+            return
+        if act.end_assign and not self._assign(inst, act, act.end_assign):
+            return
+        self._emit_act(EK.ACTIVITY_COMPLETED, inst, act, {"instance": ai.iteration})
+        self._token_gone(frame)
+
+    def _mi_cancel(self, group: MultiInstance, frame: Frame, reason: str) -> None:
+        """An interrupting event ends every instance of the group (the interrupted one
+        included); their tokens, and those of instances not started yet, are consumed."""
+        for member in list(group.members):
+            self._stop(member, TERMINATED, reason)
+        frame.live -= len(group.members) + (group.count - group.started)
+        group.members.clear()
+        group.started = group.count
+
     def _loop_again(self, ai: ActivityInstance) -> bool:
         cond, maximum, _before = ai.act.loop  # type: ignore[misc]
         if maximum is not None and ai.iteration >= maximum:
@@ -569,7 +748,8 @@ class Interpreter:
         act = ai.act
         if act.general or act.cpu:
             if self._pool is not None:
-                level = ai.frame.inst.priority + act.priority_increment
+                level = (ai.frame.inst.priority if act.priority is None
+                         else act.priority) + act.priority_increment
                 cost = self._switch + act.cpu if act.general else act.cpu
                 ai.waiting = "worker"
                 if self._pool.submit(ai, level, cost):
@@ -633,6 +813,9 @@ class Interpreter:
                 return
             target = self.processes[act.subflow]  # type: ignore[index]
             if kind == K_SUBFLOW:
+                if inst.depth >= MAX_CALL_DEPTH:
+                    self._too_deep(ai, target)
+                    return
                 ai.waiting = f"subflow {target.id}"
                 ai.child = self.start_process(target, data, parent=ai)
             else:
@@ -701,6 +884,9 @@ class Interpreter:
             for undo in ai.cleanup:
                 undo()
             ai.cleanup.clear()
+        if ai.mi is not None:
+            self._mi_done(ai, ai.mi)
+            return
         self._finish(frame, ai.act)
 
     def _finish(self, frame: Frame, act: CompiledActivity) -> None:
@@ -734,7 +920,7 @@ class Interpreter:
         if self._aflags[act] & 2:
             self.emit(EK.ACTIVITY_COMPLETED, act.process, inst.id, act.id, act.lane,
                       act.participant)
-        if act.raises is not None:
+        if act.raises is not None and inst.state == RUNNING:
             self.broadcast(act.raises.kind, act.raises.name or "", None, inst, act)
         if act.terminate:
             self.end_instance(inst, TERMINATED, f"end event {act.id!r}", notify_parent=False)
@@ -865,10 +1051,14 @@ class Interpreter:
 
     def _assign(self, inst: ProcessInstance, act: CompiledActivity,
                 assignments: tuple[tuple[str, Any], ...]) -> bool:
+        """Run ``assignments``; ``False`` when the instance ended meanwhile (a failed
+        assignment aborts it; a data change can fire its end trigger): the caller stops."""
         now = self.env._now
         try:
             for target, fn in assignments:
                 self._set(inst, act, target, fn(inst.scope, now))
+                if inst.state != RUNNING:
+                    return False
         except OpspecError as error:
             self.abort(inst, act, f"an assignment failed: {error.message}")
             return False
@@ -1074,7 +1264,12 @@ class Interpreter:
         event = ai.frame.graph.activities[index]
         frame = ai.frame
         if event.interrupting:
+            group = ai.mi
             self._stop(ai, TERMINATED, f"boundary event {event.id!r}")
+            if group is not None:
+                # the interrupted instance keeps its token for the boundary path (below)
+                group.members.remove(ai)
+                self._mi_cancel(group, frame, f"boundary event {event.id!r}")
             frame.live += 1
             self._token_gone(frame)
         frame.live += 1
@@ -1346,7 +1541,9 @@ class Interpreter:
                     self._pullers.setdefault(channel, deque()).append(ai)
                 return
             else:
-                self._ready.append((self._mode_change, spec.target_mode, act, inst))
+                # at once: if the new mode ends this very instance, nothing after the mode
+                # change may run (its completion included)
+                self._mode_change(spec.target_mode, act, inst)
                 self._body_done(ai, None)
                 return
         except (TypeError, ValueError) as error:

@@ -29,6 +29,7 @@ __all__ = [
     "Join",
     "Loop",
     "LoopKind",
+    "MIFlow",
     "Mode",
     "NoImplementation",
     "Reference",
@@ -121,6 +122,14 @@ class Trigger:
     attached_to: str | None = None
     interrupting: bool = True
     catching: bool = True
+    # timers, as read by the front end: ``date`` is a TimeDate (or the start of a repeating
+    # interval ``Rn/start/period``) in seconds, counted from 1970-01-01 when ``calendar`` (the
+    # engine makes the package's earliest calendar date day 1 of the run) else from day 1
+    # 00:00; ``repeat`` is 0 for a plain TimeCycle duration, n for ``Rn/…``, -1 for ``R/…``
+    # (the period is ``duration``).
+    date: float | None = None
+    calendar: bool = False
+    repeat: int = 0
 
 
 @dataclass(frozen=True, slots=True)
@@ -199,18 +208,41 @@ class Deadline:
     location: SourceLocation | None = None
 
 
+class MIFlow(enum.Enum):
+    """``MI_FlowCondition`` of a multi-instance loop: when the token moves on (BPMN 1.2 §9.4)."""
+
+    NONE = "None"            # after every instance (one token each)
+    ONE = "One"              # after the first instance; the others run on, passing nothing
+    ALL = "All"              # after the last instance
+    COMPLEX = "Complex"      # once ``flow_condition`` holds after an instance completes
+
+
 @dataclass(frozen=True, slots=True, kw_only=True)
 class Loop:
+    """``Loop``: a standard loop (``condition``/``maximum``/``test_before``) or a
+    multi-instance loop (``condition`` is the MI_Condition, the number of instances, with
+    ``parallel`` ordering, ``flow`` and the ComplexMI_FlowCondition ``flow_condition``)."""
+
     kind: LoopKind = LoopKind.STANDARD
     condition: Expression | None = None
     condition_text: str | None = None
     maximum: int | None = None
     test_before: bool = False
+    parallel: bool = False
+    flow: MIFlow = MIFlow.ALL
+    flow_condition: Expression | None = None
+    flow_condition_text: str | None = None
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
 class Join:
+    """A join; a Complex join fires when ``condition`` (the gateway's IncomingCondition, over
+    data fields and ``activationCount``, the number of incoming transitions that have
+    delivered a token) holds."""
+
     type: GatewayType = GatewayType.XOR
+    condition: Expression | None = None
+    condition_text: str | None = None
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)

@@ -21,9 +21,9 @@ from pathlib import Path
 from lxml import etree
 
 from opspec.errors import Diagnostic, Severity, SourceLocation
-from opspec.model.activities import Execution, SubFlow
+from opspec.model.activities import Execution, GatewayType, SubFlow
 from opspec.model.package import ExternalPackage, Package
-from opspec.model.process import WorkflowProcess
+from opspec.model.process import ConditionKind, Transition, WorkflowProcess
 
 __all__ = ["Loader", "Resolution", "resolve"]
 
@@ -146,10 +146,50 @@ def _register(package: Package, res: Resolution) -> None:
     res.packages[package.id] = package
 
 
-def _subflows(process: WorkflowProcess) -> Iterator[tuple[SubFlow, SourceLocation | None]]:
+def _subflows(process: WorkflowProcess
+              ) -> Iterator[tuple[SubFlow, SourceLocation | None, bool]]:
+    """Each SubFlow call of ``process``, and whether it *certainly* runs whenever the process
+    does (see :func:`_certain_activities`)."""
+    certain = _certain_activities(process)
     for activity in process.all_activities():
         if isinstance(activity.body, SubFlow):
-            yield activity.body, activity.location
+            yield activity.body, activity.location, activity.id in certain
+
+
+def _certain_activities(process: WorkflowProcess) -> set[str]:
+    """Top-level activities that run in every execution of ``process``: reachable from a
+    start through transitions that are always taken (unconditional ones out of activities
+    whose outgoing transitions are all unconditional, with no split or an AND split), into
+    activities without an AND/OR/complex join. A recursive call outside this set may be
+    avoided by a condition (a base case), so the recursion can end."""
+    activities = {a.id: a for a in process.activities}
+    outgoing: dict[str, list[Transition]] = {}
+    incoming: set[str] = set()
+    for transition in process.transitions:
+        outgoing.setdefault(transition.source, []).append(transition)
+        incoming.add(transition.target)
+    stack = [a for a in activities if a not in incoming]
+    certain: set[str] = set()
+    while stack:
+        current = stack.pop()
+        if current in certain or current not in activities:
+            continue
+        certain.add(current)
+        activity = activities[current]
+        normal = [t for t in outgoing.get(current, ())
+                  if t.condition.kind not in (ConditionKind.EXCEPTION,
+                                              ConditionKind.DEFAULTEXCEPTION)]
+        if activity.split is not None and activity.split.type is not GatewayType.AND and (
+                len(normal) > 1):
+            continue
+        if any(t.condition.kind is not ConditionKind.NONE for t in normal):
+            continue
+        for transition in normal:
+            target = activities.get(transition.target)
+            if target is not None and (target.join is None or target.join.type in (
+                    GatewayType.XOR, GatewayType.EVENT)):
+                stack.append(target.id)
+    return certain
 
 
 def _package_by_ref(ref: str, caller: Package, res: Resolution, load: Loader) -> Package | None:
@@ -175,7 +215,7 @@ def _package_by_ref(ref: str, caller: Package, res: Resolution, load: Loader) ->
 
 
 Node = tuple[str, str]   # (package id, process id)
-Edge = tuple[Node, Execution, SourceLocation | None]
+Edge = tuple[Node, Execution, SourceLocation | None, bool]   # ..., the call always runs
 
 
 def _call_graph(res: Resolution, load: Loader) -> dict[Node, list[Edge]]:
@@ -183,10 +223,10 @@ def _call_graph(res: Resolution, load: Loader) -> dict[Node, list[Edge]]:
     for package in list(res.packages.values()):
         for process in package.processes:
             edges = graph.setdefault((package.id, process.id), [])
-            for subflow, location in _subflows(process):
+            for subflow, location, certain in _subflows(process):
                 target = _target(subflow, package, res, load, location)
                 if target is not None:
-                    edges.append((target, subflow.execution, location))
+                    edges.append((target, subflow.execution, location, certain))
     return graph
 
 
@@ -245,6 +285,10 @@ def _report_cycles(graph: dict[Node, list[Edge]], res: Resolution) -> None:
                     seen_cycles.add(members)
                     loop_edges = [*edges_on_path[index:], edge]
                     sync = all(e[1] is Execution.SYNCHR for e in loop_edges)
+                    if sync and not all(e[3] for e in loop_edges):
+                        # some call of the cycle depends on a condition: a base case can end
+                        # the recursion (the engine limits its depth at run time)
+                        continue
                     names = " -> ".join(f"{p}:{q}" for p, q in (*path[index:], target))
                     res.error(edge[2], "subflow-cycle",
                               f"subflows call each other in a cycle: {names}",

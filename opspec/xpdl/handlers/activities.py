@@ -17,6 +17,7 @@ from opspec.model.activities import (
     Join,
     Loop,
     LoopKind,
+    MIFlow,
     Mode,
     NoImplementation,
     Route,
@@ -106,11 +107,35 @@ def _loop(element: etree._Element, ctx: BuildContext) -> Loop | None:
                     test_before=(attr(detail, "TestTime") or "After").lower() == "before")
     if kind_text == "multiinstance" or (not kind_text and child(loop, "LoopMultiInstance") is not None):
         detail = child(loop, "LoopMultiInstance")
-        text = None
-        if detail is not None:
-            text = attr(detail, "MI_Condition") or _expression_text(child(detail, "MI_Condition"))
+        if detail is None:
+            ctx.error(loop, "bad-multi-instance", "a MultiInstance Loop has no LoopMultiInstance "
+                      "element, so the number of instances is unknown",
+                      'add <LoopMultiInstance MI_Condition="N" MI_Ordering="Parallel"/>')
+            return Loop(kind=LoopKind.MULTI_INSTANCE)
+        text = attr(detail, "MI_Condition") or _expression_text(child(detail, "MI_Condition"))
+        ordering = (attr(detail, "MI_Ordering") or "Sequential").lower()
+        if ordering not in ("sequential", "parallel"):
+            ctx.error(detail, "bad-multi-instance", f"MI_Ordering {ordering!r} is neither "
+                      "Sequential nor Parallel", "write Sequential or Parallel")
+        flow_text = attr(detail, "MI_FlowCondition") or "All"
+        flow = {f.value.lower(): f for f in MIFlow}.get(flow_text.lower())
+        if flow is None:
+            ctx.error(detail, "bad-multi-instance", f"MI_FlowCondition {flow_text!r} is not "
+                      "None, One, All or Complex", "write one of None, One, All, Complex")
+            flow = MIFlow.ALL
+        complex_text = (attr(detail, "ComplexMI_FlowCondition")
+                        or _expression_text(child(detail, "ComplexMI_FlowCondition")))
+        if flow is MIFlow.COMPLEX and not (complex_text or "").strip():
+            ctx.error(detail, "bad-multi-instance", "MI_FlowCondition is Complex but there is no "
+                      "ComplexMI_FlowCondition", "give the condition (over data fields and "
+                      "nrOfInstances, nrOfCompletedInstances, nrOfActiveInstances)")
         return Loop(kind=LoopKind.MULTI_INSTANCE, condition_text=text,
-                    condition=_expression(detail, text, ctx, "multi-instance count"))
+                    condition=_expression(detail, text, ctx, "multi-instance count"),
+                    parallel=ordering == "parallel", flow=flow,
+                    flow_condition_text=complex_text,
+                    flow_condition=(_expression(detail, complex_text, ctx,
+                                                "ComplexMI_FlowCondition")
+                                    if flow is MIFlow.COMPLEX else None))
     return None  # LoopType="None"
 
 
@@ -192,6 +217,11 @@ def build_activity(element: etree._Element, ctx: BuildContext) -> Activity:
         # XPDL 1.0 and Bizagi routes say what they do only through their restrictions.
         derived = (split.type if split else None) or (join.type if join else None) or GatewayType.XOR
         body = dataclasses.replace(body, gateway=derived)
+    if join is not None and join.type is GatewayType.COMPLEX:
+        # XPDL 2.1 writes a complex gateway's activation rule on the Route: IncomingCondition
+        text = attr(body_element, "IncomingCondition") if body_element is not None else None
+        join = dataclasses.replace(join, condition_text=text, condition=_expression(
+            body_element, text, ctx, "IncomingCondition"))
     priority_text = text_of(child(element, "Priority"))
     priority = parse_int(priority_text)
     if priority_text is not None and priority is None:
