@@ -1,0 +1,16 @@
+#!/usr/bin/env bash
+# Create .oracle-venv: a test-only virtualenv holding shoobx.wfmc, the reference Python XPDL
+# engine that tests/patterns/test_oracle.py runs the same XPDL files through (differential
+# testing, issue 16). It is never a dependency of opspec. Idempotent and quiet: does nothing
+# when the venv already imports shoobx.wfmc. About 10 s with PyPI reachable.
+# Usage: bash scripts/oracle-venv.sh [VENV_DIR]   (default: .oracle-venv at the checkout root)
+set -euo pipefail
+cd "$(dirname "$0")/.."
+venv="${1:-.oracle-venv}"
+if [ -x "$venv/bin/python" ] && "$venv/bin/python" -c "import shoobx.wfmc" >/dev/null 2>&1; then
+    exit 0
+fi
+python3 -m venv "$venv"
+"$venv/bin/python" -m pip install --quiet --disable-pip-version-check "shoobx.wfmc>=4.3,<5" 2>&1 \
+    | grep -v "^WARNING: Location" >&2 || true
+"$venv/bin/python" -c "import shoobx.wfmc" 
