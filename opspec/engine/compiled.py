@@ -121,6 +121,9 @@ class CTrigger:
     seconds: Evaluator | None = None       # timer catch events: delay from data
     condition: Evaluator | None = None     # rules
     location: SourceLocation | None = None
+    count: int = -1                        # period: number of firings (-1: no end)
+    planned: bool = False                  # timer: a TimeDate / repeating interval whose
+    #                                        firings are ``offset``, +``every``… (``count``)
 
 
 @dataclass(frozen=True, slots=True, eq=False)
@@ -180,6 +183,7 @@ class CompiledActivity:
     sampler: Sampler | None = None
     cpu: float = 0.0
     priority_increment: int = 0
+    priority: int | None = None              # XPDL Activity/Priority: replaces the workflow's
     subflow: str | None = None
     params: tuple[tuple[ParameterMode, str, Evaluator | None, str | None], ...] = ()
     application: str | None = None
@@ -301,6 +305,11 @@ class _Compiler:
                 for performer in lane.performers:
                     names = tuple(n for n in (lane.id, lane.name) if n)
                     self.participant_lane.setdefault(performer, names)
+        # calendar dates in timers: the earliest one's day is day 1 of the run
+        dates = [a.body.trigger.date for p in package.processes for a in p.all_activities()
+                 if isinstance(a.body, Event) and a.body.trigger.calendar
+                 and a.body.trigger.date is not None]
+        self.anchor = min(d // 86_400.0 for d in dates) * 86_400.0 if dates else 0.0
         self.subflow_targets = {
             a.body.process for p in package.processes for a in p.all_activities()
             if isinstance(a.body, SubFlow)}
@@ -357,6 +366,8 @@ class _Compiler:
             name = trig.name or act.id
             mapped = "signal" if kind is TriggerKind.SIGNAL else "message"
             return CTrigger(kind=mapped, name=name, location=act.location)
+        if kind is TriggerKind.TIMER and (trig.date is not None or trig.repeat != 0):
+            return self.planned_timer(trig, act)
         if kind is TriggerKind.TIMER:
             seconds = None
             if trig.duration is not None or trig.time_cycle or trig.time_date:
@@ -367,6 +378,29 @@ class _Compiler:
             cond = self.cond(trig.condition, None, act.location, f"rule of activity {act.id!r}")
             return CTrigger(kind="rule", condition=cond, location=act.location)
         return None
+
+    def planned_timer(self, trig: Any, act: Activity) -> CTrigger:
+        """A TimeDate or ISO 8601 repeating interval: firings at ``offset``, ``offset +
+        every``… (``count`` of them). A TimeDate fires once at its time; ``Rn/start/P`` first
+        at its start; ``Rn/P`` (no start) first one period after the run starts (BPMN). Waiting
+        in an intermediate event (``seconds``): until the next firing of a dated timer, one
+        period for an interval without a start."""
+        date = None
+        if trig.date is not None:
+            date = float(trig.date) - (self.anchor if trig.calendar else 0.0)
+        if trig.repeat == 0:                       # TimeDate: once
+            moment = date if date is not None else 0.0
+            return CTrigger(kind="timer", offset=moment, every=0.0, count=1, planned=True,
+                            seconds=_until(moment, 0.0, 1), location=act.location)
+        duration = trig.duration
+        if not isinstance(duration, Literal) or not isinstance(duration.value, int | float):
+            raise _spec_error(f"timer of activity {act.id!r} has no period", act.location)
+        period = float(duration.value)
+        count = int(trig.repeat)
+        first = date if date is not None else period
+        wait = _until(first, period, count) if date is not None else _constant(period)
+        return CTrigger(kind="timer", offset=first, every=period, count=count, planned=True,
+                        seconds=wait, location=act.location)
 
     # -- graphs --------------------------------------------------------------------------
     def graph(self, proc: WorkflowProcess, name: str, activities: tuple[Activity, ...],
@@ -600,6 +634,7 @@ class _Compiler:
         ca.start_trigger = self.trigger_ref(directives.start_trigger)
         ca.end_trigger = self.trigger_ref(directives.end_trigger)
         ca.priority_increment = directives.priority_increment
+        ca.priority = act.priority
         ca.cpu = float(directives.cpu_demand or 0.0)
         if directives.duration is not None:
             try:
@@ -734,7 +769,10 @@ class _Compiler:
                 ca = graph.activities[index]
                 if ca.trigger is not None and ca.kind == K_NOOP:
                     trig = ca.trigger
-                    if trig.kind == "timer" and trig.seconds is not None:
+                    if trig.kind == "timer" and trig.planned:
+                        start = CTrigger(kind="period", every=trig.every, offset=trig.offset,
+                                         count=trig.count, location=trig.location)
+                    elif trig.kind == "timer" and trig.seconds is not None:
                         every = float(trig.seconds({}, 0.0))
                         start = CTrigger(kind="period", every=every, offset=every,
                                          location=trig.location)
@@ -775,6 +813,23 @@ def _names(expression: Expression) -> set[str]:
         elif isinstance(node, Call):
             stack.extend(node.args)
     return found
+
+
+def _until(first: float, every: float, count: int) -> Evaluator:
+    """Seconds from ``now`` to the next of the firings ``first + k * every`` (``count`` of
+    them, -1 for no end); 0 when they are all past (a past date fires at once, as BPMN)."""
+    def wait(data: Mapping[str, Any], now: float) -> float:
+        if now <= first:
+            return first - now
+        if every <= 0.0:
+            return 0.0
+        k = int((now - first) // every)
+        if first + k * every < now:
+            k += 1
+        if 0 <= count <= k:
+            return 0.0
+        return first + k * every - now
+    return wait
 
 
 def _constant(value: float) -> Evaluator:

@@ -20,7 +20,10 @@ Start triggers (armed when the run starts, for workflows of the active mode):
   its start event catches nothing (or its ``auto_start`` directive says so);
 * ``timer`` — at each time of day in ``at`` (seconds since midnight) plus ``offset``,
   repeated every ``every`` seconds (one day by default); ``timer:after D`` fires once;
-* ``period`` — at ``offset``, ``offset + every``, …;
+* ``period`` — at ``offset``, ``offset + every``, … (``count`` times when ``count >= 0``):
+  ``opspec:Period`` has offset 0; a start event's TimeCycle ``P`` or ``R/P`` has offset ``P``
+  (BPMN: first one interval after the start), ``Rn/START/P`` has offset START, a TimeDate is
+  one firing at its time (docs/sisarl-xpdl.md, "Timers");
 * ``message``/``signal`` — each time one is raised (never buffered);
 * ``rule`` — each time the condition over package-wide data becomes true.
 
@@ -404,14 +407,17 @@ def _event_count(env: simpy.Environment) -> int:
 def _occurrences(trig: CTrigger, now: float) -> Iterator[float]:
     """Absolute firing times (>= ``now``) of a timer or period trigger."""
     if trig.kind == "period":
+        # firings offset, offset + every, ...: ``count`` of them (-1: no end); armed later
+        # than some of them (a mode change), the past ones are skipped and still counted
         every = trig.every or 0.0
         if every <= 0:
             yield max(now, trig.offset)
             return
         k = max(0, math.ceil((now - trig.offset) / every))
-        while True:
+        while trig.count < 0 or k < trig.count:
             yield trig.offset + k * every
             k += 1
+        return
     if not trig.at:
         if trig.every:
             k = 1

@@ -29,6 +29,8 @@ __all__ = [
     "parse_duration",
     "parse_duration_expression",
     "parse_rate",
+    "parse_time_cycle",
+    "parse_time_date",
     "parse_time_of_day",
 ]
 
@@ -180,3 +182,78 @@ def parse_duration_expression(
     if seconds is not None:
         return Literal(parse_duration(text, location=location))
     return parse_expression(text, location=location, kind="duration")
+
+
+_DATE_TIME = re.compile(
+    r"(?P<date>\d{4}-\d{2}-\d{2})(?:[T ](?P<time>\d{1,2}:\d{2}(?::\d{2}(?:[.,]\d+)?)?))?"
+    r"(?P<zone>Z|[+-]\d{2}(?::?\d{2})?)?", re.IGNORECASE)
+_TIME_ONLY = re.compile(r"T?(?P<time>\d{1,2}:\d{2}(?::\d{2}(?:[.,]\d+)?)?)"
+                        r"(?P<zone>Z|[+-]\d{2}(?::?\d{2})?)?", re.IGNORECASE)
+_TIMER_HINT = ("write a TimeDate as 2026-01-01T08:00:00 or 08:00, a TimeCycle as a duration "
+               "(PT1H) or an ISO 8601 repeating interval (R3/PT7S, R/PT1H, "
+               "R5/2026-01-01T08:00:00/PT1H)")
+
+
+def parse_time_date(text: str, *, location: SourceLocation | None = None
+                    ) -> tuple[float, bool] | None:
+    """A timer's point in time: ``(seconds, calendar)``, or ``None`` when ``text`` is no date.
+
+    ``2026-01-01T08:00:00`` (also with a space, seconds optional, a date alone meaning
+    midnight) gives seconds since 1970-01-01 00:00 and ``calendar=True`` (the engine counts
+    the package's earliest calendar date as day 1 of the run); a time of day ``08:00`` or
+    ``T08:00:00`` gives seconds after day 1 00:00 and ``calendar=False``. A time-zone suffix
+    (``Z``, ``+02:00``) is accepted and ignored: the simulated clock has no time zone.
+    Impossible dates (``2026-02-30``) raise :class:`SpecError`."""
+    import datetime as _dt
+
+    stripped = text.strip()
+    match = _DATE_TIME.fullmatch(stripped)
+    if match is not None:
+        try:
+            day = _dt.date.fromisoformat(match.group("date"))
+        except ValueError:
+            raise _error("date", text, "no such date", location, _TIMER_HINT) from None
+        seconds = 0.0
+        if match.group("time"):
+            seconds = parse_time_of_day(match.group("time").replace(",", "."), location=location)
+        days = (day - _dt.date(1970, 1, 1)).days
+        return days * 86_400.0 + seconds, True
+    match = _TIME_ONLY.fullmatch(stripped)
+    if match is not None:
+        return parse_time_of_day(match.group("time").replace(",", "."), location=location), False
+    return None
+
+
+def parse_time_cycle(text: str, *, location: SourceLocation | None = None
+                     ) -> tuple[int, float, tuple[float, bool] | None] | None:
+    """An ISO 8601 repeating interval ``R[n]/[start/]duration``: ``(repeat, period, start)``
+    where ``repeat`` is the number of firings (``-1``: ``R/…``, unbounded), ``period`` the
+    duration in seconds and ``start`` a :func:`parse_time_date` value or ``None``. ``None``
+    when ``text`` does not start with ``R``. Raises :class:`SpecError` for a malformed one."""
+    stripped = text.strip()
+    if not stripped[:1] in ("R", "r") or "/" not in stripped:
+        return None
+    parts = stripped.split("/")
+    count_text = parts[0][1:]
+    if count_text and not count_text.isdigit():
+        raise _error("repeating interval", text, f"{parts[0]!r} is not R or Rn", location,
+                     _TIMER_HINT)
+    repeat = int(count_text) if count_text else -1
+    if repeat == 0:
+        raise _error("repeating interval", text, "R0 never fires", location, _TIMER_HINT)
+    if len(parts) == 2:
+        start, period_text = None, parts[1]
+    elif len(parts) == 3:
+        start = parse_time_date(parts[1], location=location)
+        if start is None:
+            raise _error("repeating interval", text, f"{parts[1]!r} is not a date-time",
+                         location, _TIMER_HINT)
+        period_text = parts[2]
+    else:
+        raise _error("repeating interval", text, "expected R[n]/[start/]duration", location,
+                     _TIMER_HINT)
+    period = parse_duration(period_text, location=location)
+    if period <= 0:
+        raise _error("repeating interval", text, "the period must be longer than zero",
+                     location, _TIMER_HINT)
+    return repeat, period, start

@@ -9,7 +9,7 @@ from lxml import etree
 
 from opspec.errors import SpecError
 from opspec.model.activities import ActivityBody, Event, EventPosition, Trigger, TriggerKind
-from opspec.model.expressions import Expression
+from opspec.model.expressions import Expression, Literal
 from opspec.xpdl.handlers.common import (
     BuildContext,
     attr,
@@ -89,7 +89,14 @@ def _kind(raw: str | None, element: etree._Element, ctx: BuildContext, what: str
 
 
 def _timer(element: etree._Element, ctx: BuildContext) -> dict[str, Any]:
-    from opspec.xpdl.durations import parse_duration_expression
+    """TimeDate (a point in time: :func:`~opspec.xpdl.durations.parse_time_date`), TimeCycle
+    as an ISO 8601 repeating interval (``R3/PT7S``) or a plain duration; a TimeDate that is no
+    date is read as a duration expression (a delay), as before."""
+    from opspec.xpdl.durations import (
+        parse_duration_expression,
+        parse_time_cycle,
+        parse_time_date,
+    )
 
     timer = child(element, "TriggerTimer")
     if timer is None:
@@ -98,6 +105,24 @@ def _timer(element: etree._Element, ctx: BuildContext) -> dict[str, Any]:
     cycle = _expression_text(child(timer, "TimeCycle")) or attr(timer, "TimeCycle")
     duration: Expression | None = None
     text = cycle or date
+    try:
+        if cycle:
+            repeating = parse_time_cycle(cycle, location=ctx.loc(timer))
+            if repeating is not None:
+                repeat, period, start = repeating
+                found: dict[str, Any] = {"time_date": date, "time_cycle": cycle,
+                                         "duration": Literal(period), "repeat": repeat}
+                if start is not None:
+                    found["date"], found["calendar"] = start
+                return found
+        elif date:
+            moment = parse_time_date(date, location=ctx.loc(timer))
+            if moment is not None:
+                return {"time_date": date, "time_cycle": None, "date": moment[0],
+                        "calendar": moment[1]}
+    except SpecError as error:
+        ctx.error(timer, "bad-timer", error.message, error.hint)
+        return {"time_date": date, "time_cycle": cycle}
     if text:
         try:
             duration = parse_duration_expression(text)
