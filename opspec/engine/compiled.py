@@ -30,6 +30,7 @@ from opspec.model import (
     Call,
     ConditionKind,
     CoordinationBuiltIn,
+    DataField,
     Event,
     EventPosition,
     Execution,
@@ -53,6 +54,7 @@ from opspec.model import (
     Unary,
     WorkflowProcess,
 )
+from opspec.model.data import is_structured, structured_value
 
 __all__ = [
     "J_AND",
@@ -378,6 +380,21 @@ class _Compiler:
             cond = self.cond(trig.condition, None, act.location, f"rule of activity {act.id!r}")
             return CTrigger(kind="rule", condition=cond, location=act.location)
         return None
+
+    def initial(self, data_field: DataField) -> Any:
+        """A data field's initial value: typed by the front end, or, for arrays and records,
+        read from its JSON text (arrays are tuples, records dicts)."""
+        text = data_field.initial_value
+        declarations = self.package.type_declarations
+        if text is None or not is_structured(data_field.type, data_field.is_array, declarations):
+            return data_field.initial
+        try:
+            return structured_value(text, data_field.type, data_field.is_array, declarations)
+        except ValueError as error:
+            raise _spec_error(f"initial value of data field {data_field.id!r}: {error}",
+                              data_field.location,
+                              "write arrays as JSON lists ([1, 2, 3]) and records as JSON "
+                              'objects ({"x": 1})') from None
 
     def planned_timer(self, trig: Any, act: Activity) -> CTrigger:
         """A TimeDate or ISO 8601 repeating interval: firings at ``offset``, ``offset +
@@ -762,7 +779,7 @@ class _Compiler:
         graph = self.graph(proc, proc.id, proc.activities, proc.transitions, lane)
         self.finish_choices(graph)
         data: dict[str, Any] = {f.id: None for f in proc.formal_parameters}
-        data.update({f.id: f.initial for f in proc.data_fields})
+        data.update({f.id: self.initial(f) for f in proc.data_fields})
         start = self.trigger_ref(directives.start_trigger)
         if start is None:
             for index in graph.starts:
@@ -850,6 +867,6 @@ def compile_package(package: Package) -> CompiledPackage:
         initial = next(iter(modes))
     return CompiledPackage(
         id=package.id, source=package.source, package=package, processes=processes,
-        data={f.id: f.initial for f in package.data_fields},
+        data={f.id: compiler.initial(f) for f in package.data_fields},
         throwable=frozenset(compiler.throwable), modes=modes, initial_mode=initial,
         mode_sources={m.id: m.source for m in package.modes if m.source})

@@ -24,6 +24,8 @@ from opspec.model.data import (
     SchemaType,
     TypeDeclaration,
     UnionType,
+    is_structured,
+    structured_value,
 )
 from opspec.xpdl.handlers.common import (
     BuildContext,
@@ -194,7 +196,16 @@ def build_data_field(element: etree._Element, ctx: BuildContext) -> DataField:
     initial_element = child(element, "InitialValue")
     initial_text = None if initial_element is None else (initial_element.text or "").strip() or None
     initial: str | int | float | bool | None = None
-    if initial_text is not None:
+    is_array = parse_bool(attr(element, "IsArray")) or False
+    if initial_text is not None and is_structured(data_type, is_array):
+        try:
+            structured_value(initial_text, data_type, is_array)
+        except ValueError as error:
+            ctx.error(initial_element, "bad-initial-value",
+                      f"initial value of DataField {fields['id']!r}: {error}",
+                      'write arrays as JSON lists ([1, 2, 3]) and records as JSON objects '
+                      '({"x": 1})')
+    elif initial_text is not None:
         initial, understood = typed_value(initial_text, data_type)
         if not understood:
             kind = data_type.kind.value if isinstance(data_type, BasicType) else "its type"
@@ -206,7 +217,7 @@ def build_data_field(element: etree._Element, ctx: BuildContext) -> DataField:
         type=data_type,
         initial_value=initial_text,
         initial=initial,
-        is_array=parse_bool(attr(element, "IsArray")) or False,
+        is_array=is_array,
         correlation=parse_bool(attr(element, "Correlation")) or False,
         read_only=parse_bool(attr(element, "ReadOnly")) or False,
         **fields,
