@@ -251,6 +251,9 @@ class CompiledPackage:
     modes: dict[str, frozenset[str]]
     initial_mode: str | None
     mode_sources: dict[str, str]
+    # (kind, name) -> workflows with an activity that catches it (catch event, event-gateway
+    # branch, boundary event, activity start trigger): where a reply is correlated
+    catchers: dict[tuple[str, str], frozenset[str]] = field(default_factory=dict)
     _want_cache: dict[Any, frozenset[tuple[str, str | None, str | None]]] = field(
         default_factory=dict)
 
@@ -869,4 +872,21 @@ def compile_package(package: Package) -> CompiledPackage:
         id=package.id, source=package.source, package=package, processes=processes,
         data={f.id: compiler.initial(f) for f in package.data_fields},
         throwable=frozenset(compiler.throwable), modes=modes, initial_mode=initial,
-        mode_sources={m.id: m.source for m in package.modes if m.source})
+        mode_sources={m.id: m.source for m in package.modes if m.source},
+        catchers=_catchers(processes.values()))
+
+
+def _catchers(processes: Iterable[CompiledProcess]) -> dict[tuple[str, str], frozenset[str]]:
+    found: dict[tuple[str, str], set[str]] = {}
+    for proc in processes:
+        stack = [proc.graph]
+        while stack:
+            graph = stack.pop()
+            for act in graph.activities:
+                if act.block is not None:
+                    stack.append(act.block)
+                for trig in (act.trigger if act.kind == K_CATCH or act.attached_to >= 0
+                             else None, act.start_trigger):
+                    if trig is not None and trig.kind in ("message", "signal"):
+                        found.setdefault((trig.kind, trig.name or ""), set()).add(proc.id)
+    return {key: frozenset(ids) for key, ids in found.items()}

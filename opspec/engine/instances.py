@@ -34,6 +34,7 @@ class ProcessInstance:
         "frames",
         "id",
         "parent",
+        "partner",
         "priority",
         "process",
         "root",
@@ -59,6 +60,8 @@ class ProcessInstance:
         self.deferred: list[tuple[Any, ...]] = []
         self.trigger: str | None = None
         self.depth = 0                        # synchronous subflow calls above this one
+        # the root instance whose message started this one (replies are correlated to it)
+        self.partner: ProcessInstance | None = None
 
     def __repr__(self) -> str:
         return f"<ProcessInstance {self.process.id}#{self.id}>"

@@ -94,6 +94,8 @@ __all__ = ["Interpreter"]
 _EMPTY: Mapping[str, Any] = MappingProxyType({})
 _NEXT = LIFECYCLE.table
 _CHOICE_DONE = object()
+#: Messages of one name kept with nobody waiting (per receiving instance, or for anyone).
+MESSAGE_BUFFER = 100
 #: Synchronous subflow calls nested deeper than this end the run's root instance with a
 #: located fault: bounded recursion (a base case) runs, runaway recursion is reported.
 MAX_CALL_DEPTH = 100
@@ -139,6 +141,10 @@ class Interpreter:
         self._rule_keys = itertools.count(1)
         self._offers: dict[int, ActivityInstance] = {}
         self._mailboxes: dict[str, deque[Any]] = {}
+        # messages kept until caught: (receiving root instance id or 0, (kind, name)) -> data
+        self._kept: dict[tuple[int, tuple[str, str]],
+                         deque[tuple[Mapping[str, Any] | None]]] = {}
+        self.lost_messages = 0
         self._pullers: dict[str, deque[ActivityInstance]] = {}
         self._perf_cache: dict[CompiledActivity, Performer | None] = {}
         self._apps = performers.applications
@@ -287,6 +293,7 @@ class Interpreter:
         inst.trigger = trigger
         if parent is not None:
             inst.depth = parent.frame.inst.depth + 1
+            inst.partner = parent.frame.inst.partner
         self.live[iid] = inst
         self.counts["started"] += 1
         if self._pflags[proc.id] & 1:
@@ -324,6 +331,8 @@ class Interpreter:
         inst.state = _NEXT[(RUNNING, "complete")]
         inst.frames.clear()          # breaks the instance <-> frame cycle: freed by refcount
         self.live.pop(inst.id, None)
+        if self._kept and inst.parent is None:
+            self._drop_kept(inst)
         self.counts["completed"] += 1
         proc = inst.process
         if self._pflags[proc.id] & 2:
@@ -351,6 +360,8 @@ class Interpreter:
                 self._stop(ai, TERMINATED, reason)
         inst.frames.clear()
         self.live.pop(inst.id, None)
+        if self._kept and inst.parent is None:
+            self._drop_kept(inst)
         proc = inst.process
         self.counts["terminated" if state == TERMINATED else "aborted"] += 1
         kind = EK.PROCESS_TERMINATED if state == TERMINATED else EK.PROCESS_ABORTED
@@ -1095,7 +1106,7 @@ class Interpreter:
                 key = ai.key
                 if key not in self._tool_at:
                     table = self._tool_at
-                    ai.cleanup.append(lambda: _discard(table, key))
+                    ai.cleanup.append(lambda: _discard(table, key))  # noqa: B023 - returns below
                 self._tool_at[key] = index
                 self._offer(ai, performer, (), data, None, tool.application)
                 return
@@ -1165,6 +1176,11 @@ class Interpreter:
         kind = trig.kind
         if kind in ("message", "signal"):
             key = (kind, trig.name or "")
+            if kind == "message" and not persistent and self._kept:
+                kept = self._take_kept(ai.frame.inst, key)
+                if kept is not None:                # it came before we waited: caught now
+                    handler(ai, arg, kept[0])
+                    return
             table = self._waiters.get(key)
             if table is None:
                 table = self._waiters[key] = {}
@@ -1217,8 +1233,11 @@ class Interpreter:
     def broadcast(self, kind: str, name: str, data: Mapping[str, Any] | None,
                   inst: ProcessInstance | None = None, act: CompiledActivity | None = None
                   ) -> None:
-        """Deliver a message/signal to everything waiting for it *now* (never buffered):
-        catch events, event-gateway branches, boundary events, start and end triggers."""
+        """Raise a signal or send a message (see :meth:`_send`).
+
+        A *signal* reaches everything waiting for it now and is not kept: catch events,
+        event-gateway branches, boundary events, start and end triggers.
+        """
         self.raised_names.add(name)
         proc = inst.process.id if inst is not None else None
         aid = act.id if act is not None else None
@@ -1228,6 +1247,9 @@ class Interpreter:
                       act.lane if act else None, act.participant if act else None,
                       {"trigger": kind, "name": name, **(dict(data) if data else {})})
         key = (kind, name)
+        if kind == "message":
+            self._send(key, data, inst, act)
+            return
         table = self._waiters.get(key)
         if table:
             waiting = list(table.values())
@@ -1241,6 +1263,114 @@ class Interpreter:
                 self.start_process(target, self._fields(target, data), trigger=f"{kind}:{name}")
         for target in self._ends.get(key, ()):
             self.terminate_all(target.id, f"end trigger {kind}:{name}")
+
+    # ------------------------------------------------------------------ messages
+    def _send(self, key: tuple[str, str], data: Mapping[str, Any] | None,
+              inst: ProcessInstance | None, act: CompiledActivity | None) -> None:
+        """A message goes to exactly one receiver (BPMN 2.0 §9.3, message flow):
+
+        * a *reply* — thrown by an instance that a message started, named like a message
+          the starting workflow catches — goes to that starting instance only: to the
+          activity of it that waits for it, else it is kept until one does, and it is lost
+          (``trigger.lost``) if that instance has ended;
+        * any other message goes to the activity that has waited longest for it, else it
+          starts the workflows whose start trigger it is, else ends those whose end
+          trigger it is, else it is kept (``trigger.kept``, at most :data:`MESSAGE_BUFFER`
+          per name, the oldest lost first) for the next activity that waits for it.
+        """
+        table = self._waiters.get(key)
+        partner = inst.partner if inst is not None else None
+        if partner is not None and partner.process.id in self.compiled.catchers.get(key, ()):
+            if table:
+                for token, entry in list(table.items()):
+                    ai = entry[0]
+                    if ai.state == RUNNING and ai.frame.inst.root == partner.id:
+                        self._hand(table, token, entry, data)
+                        return
+            if partner.state in (RUNNING, SUSPENDED):
+                self._keep(key, data, inst, act, partner)
+            else:
+                self._lose(key, inst, act, f"the instance it answers ({partner.process.id} "
+                           f"#{partner.id}) has ended")
+            return
+        if table:
+            for token, entry in list(table.items()):
+                if entry[0].state == RUNNING:
+                    self._hand(table, token, entry, data)
+                    return
+        kind, name = key
+        started = False
+        for target in self._starts.get(key, ()):
+            if self.is_active(target.id):
+                child = self.start_process(target, self._fields(target, data),
+                                           trigger=f"{kind}:{name}")
+                child.partner = _root(inst) if inst is not None else None
+                started = True
+        if started:
+            return
+        ended = False
+        for target in self._ends.get(key, ()):
+            if any(i.process.id == target.id for i in self.live.values()):
+                self.terminate_all(target.id, f"end trigger {kind}:{name}")
+                ended = True
+        if not ended:
+            self._keep(key, data, inst, act, None)
+
+    def _hand(self, table: dict[int, tuple[ActivityInstance, Any, Any]], token: int,
+              entry: tuple[ActivityInstance, Any, Any], data: Mapping[str, Any] | None
+              ) -> None:
+        ai, handler, (arg, persistent, _key, _token) = entry
+        if not persistent:
+            table.pop(token, None)
+        handler(ai, arg, data)
+
+    def _keep(self, key: tuple[str, str], data: Mapping[str, Any] | None,
+              inst: ProcessInstance | None, act: CompiledActivity | None,
+              partner: ProcessInstance | None) -> None:
+        box_key = (partner.id if partner is not None else 0, key)
+        box = self._kept.get(box_key)
+        if box is None:
+            box = self._kept[box_key] = deque()
+        if len(box) >= MESSAGE_BUFFER:
+            box.popleft()
+            self._lose(key, inst, act, f"more than {MESSAGE_BUFFER} {key[1]!r} messages were "
+                       "kept with nobody waiting; the oldest is dropped")
+        box.append((data,))
+        self._trigger_event(EK.TRIGGER_KEPT, key, inst, act, {
+            "for": None if partner is None else partner.id, "kept": len(box)})
+
+    def _take_kept(self, waiter: ProcessInstance, key: tuple[str, str]
+                   ) -> tuple[Mapping[str, Any] | None] | None:
+        """The oldest message kept for ``waiter``'s root instance, else for anyone."""
+        for box_key in ((waiter.root, key), (0, key)):
+            box = self._kept.get(box_key)
+            if box:
+                message = box.popleft()
+                if not box:
+                    del self._kept[box_key]
+                return message
+        return None
+
+    def _lose(self, key: tuple[str, str], inst: ProcessInstance | None,
+              act: CompiledActivity | None, why: str) -> None:
+        self.lost_messages += 1
+        self._trigger_event(EK.TRIGGER_LOST, key, inst, act, {"reason": why})
+
+    def _drop_kept(self, root: ProcessInstance) -> None:
+        """``root`` ended: the replies kept for it can never be caught."""
+        for box_key in [k for k in self._kept if k[0] == root.id]:
+            for _message in self._kept.pop(box_key):
+                self._lose(box_key[1], None, None, f"the instance it answers "
+                           f"({root.process.id} #{root.id}) ended before catching it")
+
+    def _trigger_event(self, kind: str, key: tuple[str, str], inst: ProcessInstance | None,
+                       act: CompiledActivity | None, extra: dict[str, Any]) -> None:
+        proc = inst.process.id if inst is not None else None
+        aid = act.id if act is not None else None
+        if self.wants(kind, proc, aid):
+            self.emit(kind, proc, inst.id if inst is not None else None, aid,
+                      act.lane if act else None, act.participant if act else None,
+                      {"trigger": key[0], "name": key[1], **extra})
 
     def _fields(self, proc: CompiledProcess, data: Mapping[str, Any] | None
                 ) -> dict[str, Any] | None:
@@ -1654,6 +1784,12 @@ class _Flags(dict[Any, int]):
 
 def _call(callback: Callable[[], None], _a: Any, _b: Any) -> None:
     callback()
+
+
+def _root(inst: ProcessInstance) -> ProcessInstance:
+    while inst.parent is not None:
+        inst = inst.parent.frame.inst
+    return inst
 
 
 def _discard(table: dict[Any, Any], key: Any) -> None:

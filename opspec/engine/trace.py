@@ -45,6 +45,8 @@ class EventKind:
     ACTIVITY_FAILED: Final = "activity.failed"          # implementation raised / performer failed
     ACTIVITY_ABORTED: Final = "activity.aborted"
     TRIGGER_RAISED: Final = "trigger.raised"            # message / signal sent
+    TRIGGER_KEPT: Final = "trigger.kept"                # message kept: nobody waits for it yet
+    TRIGGER_LOST: Final = "trigger.lost"                # message dropped (see docs/trace-format)
     DEADLINE_EXPIRED: Final = "deadline.expired"
     EXCEPTION_RAISED: Final = "exception.raised"
     DATA_CHANGED: Final = "data.changed"

@@ -1,8 +1,9 @@
-"""Start/end triggers, timers, messages (never buffered), signals, rules, periodic workflows."""
+"""Start/end triggers, timers, messages (one receiver, kept until caught), signals (broadcast,
+never kept), rules, periodic workflows."""
 
 from __future__ import annotations
 
-from builders import act, catch, field, pkg, proc, throw
+from builders import act, catch, deadline, field, pkg, proc, throw
 from conftest import completed, events, run
 
 from opspec.engine.builtin_performers import ScriptedUser
@@ -37,22 +38,51 @@ def test_timer_resolution_delays_timers_to_the_next_multiple() -> None:
     assert events(result, "activity.completed", activity="wait")[0].time == 0.5
 
 
-def test_message_starts_a_workflow_and_completes_a_waiting_catch_event() -> None:
-    model = pkg(proc("a", [catch("d", "timer", seconds=1.0), act("send", raises="message:go")],
-                     [("d", "send")]),
+def test_a_message_goes_to_one_receiver_a_waiting_catch_event_before_a_start_trigger(
+) -> None:
+    """BPMN message flow: one sender, one receiver. The activity already waiting for `go`
+    catches the first; the second, with nobody waiting, starts workflow b."""
+    model = pkg(proc("a", [catch("d", "timer", seconds=1.0), act("send", raises="message:go"),
+                           catch("d2", "timer", seconds=1.0),
+                           act("send_again", raises="message:go")],
+                     [("d", "send"), ("send", "d2"), ("d2", "send_again")]),
                 proc("b", ["first"], start="message:go"),
                 proc("c", [catch("wait", "message", "go"), "after"], [("wait", "after")]))
     result = run(model)
+    assert completed(result, "c") == ["wait", "after"]
+    assert [e.time for e in events(result, "activity.completed", process="c",
+                                   activity="wait")] == [1.0]
+    assert [e.time for e in events(result, "process.started", process="b")] == [2.0]
+
+
+def test_a_signal_reaches_every_listener_and_starts_every_workflow() -> None:
+    model = pkg(proc("a", [catch("d", "timer", seconds=1.0), act("send", raises="signal:go")],
+                     [("d", "send")]),
+                proc("b", ["first"], start="signal:go"),
+                proc("c", [catch("wait", "signal", "go"), "after"], [("wait", "after")]),
+                proc("e", [catch("wait", "signal", "go"), "after"], [("wait", "after")]))
+    result = run(model)
     assert completed(result, "b") == ["first"]
     assert completed(result, "c") == ["wait", "after"]
+    assert completed(result, "e") == ["wait", "after"]
 
 
-def test_messages_are_not_buffered_for_later_listeners() -> None:
-    # the report comes at t=5, the listener only starts listening at t=10
+def test_a_message_sent_before_anyone_waits_is_kept_until_caught() -> None:
+    # the report comes at t=5, the listener only starts listening at t=10: it catches it then
     model = pkg(proc("device", [catch("delay", "timer", seconds=10.0),
                                 catch("wait", "message", "report"), "got_it"],
                      [("delay", "wait"), ("wait", "got_it")]))
     user = ScriptedUser([("at 5", "raise report")])
+    result = run(model, performers={"someone": user}, until=100.0)
+    assert [e.time for e in events(result, "activity.completed", activity="got_it")] == [10.0]
+    assert [e.time for e in events(result, "trigger.kept")] == [5.0]
+
+
+def test_a_signal_sent_before_anyone_waits_is_not_kept() -> None:
+    model = pkg(proc("device", [catch("delay", "timer", seconds=10.0),
+                                catch("wait", "signal", "report"), "got_it"],
+                     [("delay", "wait"), ("wait", "got_it")]))
+    user = ScriptedUser([("at 5", "raise signal:report")])
     result = run(model, performers={"someone": user}, until=100.0)
     assert "got_it" not in completed(result)
     assert events(result, "trigger.raised")[0].time == 5.0
@@ -106,3 +136,40 @@ def test_simulate_needs_a_horizon_for_periodic_packages() -> None:
         simulate(pkg(proc("tick", ["a"], start="period:1")))
     result = simulate(pkg(proc("tick", ["a"], start="period:1")), until=2.5)
     assert result.summary["instances"]["started"] == 3
+
+
+def test_a_reply_goes_to_the_instance_whose_message_started_the_replier() -> None:
+    """Device a alarms at t=0, device b at t=1; each alarm starts its own user, and both
+    users reply `report` (a's after 10 s, b's after 2 s). b's reply at t=3 goes to b, which
+    asked for it, not to a, which has waited longer (correlation by the starting instance)."""
+    def device(name: str, at: str) -> object:
+        return proc(f"dev_{name}", [act("alarm", raises=f"message:alarm_{name}"),
+                                    catch("wait", "message", "report"), "done"],
+                    [("alarm", "wait"), ("wait", "done")], start=f"timer:{at}")
+
+    def user(name: str, think: float) -> object:
+        return proc(f"user_{name}", [catch("think", "timer", seconds=think),
+                                     act("reply", raises="message:report")],
+                    [("think", "reply")], start=f"message:alarm_{name}")
+
+    result = run(pkg(device("a", "0"), device("b", "1"), user("a", 10.0), user("b", 2.0)),
+                 until=50.0)
+    done = {e.process: e.time for e in events(result, "activity.completed", activity="done")}
+    assert done == {"dev_a": 10.0, "dev_b": 3.0}
+
+
+def test_a_reply_to_an_instance_that_has_ended_is_lost_and_says_so() -> None:
+    device = proc("device", [act("alarm", raises="message:alarm"),
+                             catch("wait", "message", "report",
+                                   deadlines=[deadline(2.0, "no_report")]),
+                             "done", "gave_up"],
+                  [("alarm", "wait"), ("wait", "done"), ("wait", "gave_up", "exception:no_report")])
+    user = proc("user", [catch("think", "timer", seconds=5.0),
+                         act("reply", raises="message:report")], [("think", "reply")],
+                start="message:alarm")
+    result = run(pkg(device, user), until=100.0)
+    assert "done" not in completed(result, "device")
+    [lost] = events(result, "trigger.lost")
+    assert lost.time == 5.0 and lost.process == "user"
+    assert "has ended" in lost.data["reason"]
+    assert events(result, "trigger.kept") == []
