@@ -1394,15 +1394,14 @@ class Interpreter:
         event = ai.frame.graph.activities[index]
         frame = ai.frame
         if event.interrupting:
+            # the interrupted activity's token moves on to the boundary path (below)
             group = ai.mi
             self._stop(ai, TERMINATED, f"boundary event {event.id!r}")
             if group is not None:
-                # the interrupted instance keeps its token for the boundary path (below)
                 group.members.remove(ai)
                 self._mi_cancel(group, frame, f"boundary event {event.id!r}")
-            frame.live += 1
-            self._token_gone(frame)
-        frame.live += 1
+        else:
+            frame.live += 1                         # a new token beside the activity
         self._ready.append((self._performed, frame, index, None))
 
     def _deadline(self, ai: ActivityInstance, arg: tuple[bool, str, float]) -> None:

@@ -189,8 +189,6 @@ def test_wcp19_cancel_activity_withdraws_the_enabled_activity() -> None:
     assert done(result).count("C") == 1 and first(result, "C") == 5.0
 
 
-@pytest.mark.xfail(strict=True, reason="issue 16: after a boundary event cancels an activity and "
-                   "every path has reached its end event, the instance never completes (stays open)")
 def test_wcp19_cancel_activity_case_completes_after_the_cancellation_path() -> None:
     result = run("p19_cancel_activity.xpdl", script=[("50", "B")])
     assert outcomes(result, "cancel_activity") == ["completed"], dump(result)
