@@ -19,7 +19,7 @@ import traceback
 from collections.abc import Sequence
 
 from opspec import __version__, _native
-from opspec.errors import OpspecError, SpecError
+from opspec.errors import OpspecError, SpecError, ZeroTimeCycleError
 
 __all__ = ["build_parser", "main"]
 
@@ -105,6 +105,9 @@ def main(argv: Sequence[str] | None = None) -> int:
         print(f"opspec: {error}", file=sys.stderr)
         for diagnostic in error.diagnostics[1:]:
             print(f"  {diagnostic}", file=sys.stderr)
+        return 1
+    except ZeroTimeCycleError as error:         # a problem of the run, not of the usage
+        print(f"opspec: {error}", file=sys.stderr)
         return 1
     except OpspecError as error:
         print(f"opspec: {error}", file=sys.stderr)

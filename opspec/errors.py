@@ -22,6 +22,7 @@ __all__ = [
     "SourceLocation",
     "SpecError",
     "UserModelError",
+    "ZeroTimeCycleError",
 ]
 
 
@@ -157,6 +158,11 @@ class ExecutionError(OpspecError):
     ) -> None:
         self.sim_time = sim_time
         super().__init__(message, location=location, hint=hint)
+
+
+class ZeroTimeCycleError(ExecutionError):
+    """The simulated clock stopped advancing: work keeps running at one instant (a cycle of
+    instantaneous activities, a workflow that starts itself with no delay)."""
 
 
 class BindingError(OpspecError):

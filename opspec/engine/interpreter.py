@@ -38,6 +38,7 @@ from __future__ import annotations
 
 import dataclasses
 import itertools
+import os
 from collections import ChainMap, deque
 from collections.abc import Callable, Iterable, Mapping, MutableMapping
 from types import MappingProxyType
@@ -86,7 +87,7 @@ from opspec.engine.registry import PerformerRegistry
 from opspec.engine.trace import EventKind as EK
 from opspec.engine.trace import TraceEvent, TraceListener
 from opspec.engine.wakeup import Wakeups
-from opspec.errors import ExecutionError, OpspecError
+from opspec.errors import ExecutionError, OpspecError, ZeroTimeCycleError
 from opspec.model import CoordinationKind, Package, ParameterMode
 
 __all__ = ["Interpreter"]
@@ -96,6 +97,11 @@ _NEXT = LIFECYCLE.table
 _CHOICE_DONE = object()
 #: Messages of one name kept with nobody waiting (per receiving instance, or for anyone).
 MESSAGE_BUFFER = 100
+#: Zero-time steps (token moves, instantaneous activities) at one simulated instant before a
+#: run is stopped as a zero-time cycle. Real specifications take tens to thousands; 500,000
+#: take one to a few seconds. ``OPSPEC_MAX_INSTANT_STEPS`` overrides it.
+MAX_INSTANT_STEPS = 500_000
+INSTANT_STEPS_ENV = "OPSPEC_MAX_INSTANT_STEPS"
 #: Synchronous subflow calls nested deeper than this end the run's root instance with a
 #: located fault: bounded recursion (a base case) runs, runaway recursion is reported.
 MAX_CALL_DEPTH = 100
@@ -145,6 +151,10 @@ class Interpreter:
         self._kept: dict[tuple[int, tuple[str, str]],
                          deque[tuple[Mapping[str, Any] | None]]] = {}
         self.lost_messages = 0
+        # the zero-time cycle guard (see _drain)
+        self._instant = -1.0
+        self._instant_steps = 0
+        self.max_instant_steps = _max_instant_steps()
         self._pullers: dict[str, deque[ActivityInstance]] = {}
         self._perf_cache: dict[CompiledActivity, Performer | None] = {}
         self._apps = performers.applications
@@ -207,17 +217,29 @@ class Interpreter:
 
     # ------------------------------------------------------------------ queue
     def _drain(self) -> None:
-        """Run queued zero-time work until none is left (re-entrant calls just return)."""
+        """Run queued zero-time work until none is left (re-entrant calls just return).
+
+        Zero-time work at one simulated instant is counted (across drains, so a storm of
+        zero-delay wakeups counts too); past :data:`MAX_INSTANT_STEPS` the run stops with a
+        :class:`ZeroTimeCycleError` naming the activities that keep coming back."""
         if self._draining:
             return
         self._draining = True
         ready = self._ready
         pop = ready.popleft
+        now = self.env._now
+        if now != self._instant:
+            self._instant = now
+            self._instant_steps = 0
+        steps = self._instant_steps
         try:
             while True:
                 while ready:
                     fn, a, b, c = pop()
                     fn(a, b, c)
+                    steps += 1
+                    if steps > self.max_instant_steps:
+                        self._zero_time_cycle()
                 if not self._pending:
                     break
                 self._resolve_frames()
@@ -225,6 +247,39 @@ class Interpreter:
                     break
         finally:
             self._draining = False
+            self._instant_steps = steps
+
+    def _zero_time_cycle(self) -> None:
+        """Sample what the ready queue keeps running for a while, then stop the run."""
+        seen: dict[tuple[str, int], dict[str, None]] = {}
+        ready = self._ready
+        for _ in range(10_000):
+            if not ready:
+                break
+            fn, a, b, c = ready.popleft()
+            act: CompiledActivity | None = None
+            inst: ProcessInstance | None = None
+            if isinstance(a, Frame):
+                inst = a.inst
+                if isinstance(b, int) and 0 <= b < len(a.graph.activities):
+                    act = a.graph.activities[b]
+            elif isinstance(a, ActivityInstance):
+                inst = a.frame.inst
+                act = a.act
+            if inst is not None and act is not None:
+                seen.setdefault((inst.process.id, inst.id), {})[act.id] = None
+            fn(a, b, c)
+        self._raise_zero_time(seen)
+
+    def _raise_zero_time(self, seen: dict[tuple[str, int], dict[str, None]]) -> None:
+        where = "; ".join(f"process {pid!r} (instance {iid}): {', '.join(acts)}"
+                          for (pid, iid), acts in list(seen.items())[:3]) or "zero-delay events"
+        raise ZeroTimeCycleError(
+            f"the simulated clock stopped advancing at t={self.env._now:.3f} s: "
+            f"{self.max_instant_steps:,} steps ran at that instant, repeating {where}",
+            hint="give the cycle a duration, a wait, or a condition that ends it; "
+                 f"{INSTANT_STEPS_ENV} raises the limit",
+            sim_time=self.env._now)
 
     def _later(self, delay: float, fn: Callable[[ActivityInstance, Any], None],
                ai: ActivityInstance, arg: Any = None) -> None:
@@ -567,12 +622,20 @@ class Interpreter:
         one has no AND/OR join to synchronise at."""
         pooled = self._pooled
         apps = self._apps
+        steps = 0
+        limit = self.max_instant_steps
+        cycle: dict[str, None] = {}
         while act is not None:
             if not act.fast or (act.general and pooled) or (
                     act.kind == K_TASK and act.application in apps):
                 self._start_slow(frame, act)
                 return
             inst = frame.inst
+            steps += 1
+            if steps > limit:                   # a zero-time cycle (see _drain)
+                cycle[act.id] = None
+                if steps > limit + 10_000:
+                    self._raise_zero_time({(inst.process.id, inst.id): cycle})
             if self._aflags[act] & 1:
                 self.emit(EK.ACTIVITY_STARTED, act.process, inst.id, act.id, act.lane,
                           act.participant)
@@ -1783,6 +1846,15 @@ class _Flags(dict[Any, int]):
 
 def _call(callback: Callable[[], None], _a: Any, _b: Any) -> None:
     callback()
+
+
+def _max_instant_steps() -> int:
+    raw = os.environ.get(INSTANT_STEPS_ENV, "")
+    try:
+        value = int(raw) if raw.strip() else MAX_INSTANT_STEPS
+    except ValueError:
+        value = MAX_INSTANT_STEPS
+    return value if value > 0 else MAX_INSTANT_STEPS
 
 
 def _root(inst: ProcessInstance) -> ProcessInstance:

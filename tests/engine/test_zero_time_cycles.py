@@ -1,0 +1,71 @@
+"""Never a silent hang: a run whose simulated clock stops advancing ends with one located
+line naming the workflow, the activities that keep coming back and the simulated time."""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+from test_routing_fidelity import activity, integer_field, spec, transition
+
+from opspec.engine.simulation import Simulation
+from opspec.errors import ZeroTimeCycleError
+from opspec.xpdl.loader import load_spec
+
+
+@pytest.fixture(autouse=True)
+def small_limit(monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.setenv("OPSPEC_MAX_INSTANT_STEPS", "20000")
+
+
+def cycle(tmp_path: Path) -> Path:
+    """B -> C -> B while x == 0, and nothing ever changes x (zero time throughout)."""
+    acts = [activity("A"), activity("B", join="Exclusive"),
+            activity("C", split="Exclusive"), activity("D")]
+    trans = [transition("A", "B"), transition("B", "C"), transition("C", "B", "x == 0"),
+             transition("C", "D", "otherwise")]
+    return spec(tmp_path, acts, trans, integer_field("x", 0))
+
+
+def test_a_cycle_of_instantaneous_activities_stops_the_run_naming_it(tmp_path: Path) -> None:
+    sim = Simulation(load_spec(cycle(tmp_path)))
+    with pytest.raises(ZeroTimeCycleError) as caught:
+        sim.run()
+    message = str(caught.value)
+    assert "stopped advancing at t=0.000 s" in message
+    assert "process 'p' (instance 1): " in message
+    assert {"B", "C"} <= set(message.split("(instance 1): ")[1].split(" (")[0].split(", "))
+    assert caught.value.sim_time == 0.0
+
+
+def test_a_workflow_that_starts_itself_with_no_delay_stops_the_run(tmp_path: Path) -> None:
+    acts = ['<Activity Id="again"><Implementation><SubFlow Id="p" Execution="ASYNCHR"/>'
+            "</Implementation></Activity>"]
+    sim = Simulation(load_spec(spec(tmp_path, acts, [])))
+    with pytest.raises(ZeroTimeCycleError, match="process 'p'"):
+        sim.start("p")          # a subflow target: nothing starts it by itself
+        sim.run(until=10)
+
+
+def test_a_loop_whose_body_takes_no_time_stops_the_run(tmp_path: Path) -> None:
+    loop = ('<Loop LoopType="Standard"><LoopStandard LoopCondition="x == 0" TestTime="Before"/>'
+            "</Loop>")
+    acts = [activity("spin", extra=loop)]
+    sim = Simulation(load_spec(spec(tmp_path, acts, [], integer_field("x", 0))))
+    with pytest.raises(ZeroTimeCycleError, match="spin"):
+        sim.run(until=10)
+
+
+def test_opspec_run_exits_1_with_one_line_and_keeps_the_trace(tmp_path: Path) -> None:
+    trace = tmp_path / "trace.jsonl"
+    done = subprocess.run([sys.executable, "-m", "opspec", "run", str(cycle(tmp_path)),
+                           "--timeline", "none", "--trace", str(trace)],
+                          capture_output=True, text=True, timeout=120,
+                          env={**__import__("os").environ, "OPSPEC_MAX_INSTANT_STEPS": "20000"})
+    assert done.returncode == 1
+    [line] = done.stderr.strip().splitlines()
+    assert line.startswith("opspec: the simulated clock stopped advancing at t=0.000 s")
+    assert "Traceback" not in done.stderr
+    assert trace.read_text().count('"activity.started"') > 1000
