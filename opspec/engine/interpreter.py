@@ -38,7 +38,6 @@ from __future__ import annotations
 
 import dataclasses
 import itertools
-import os
 from collections import ChainMap, deque
 from collections.abc import Callable, Iterable, Mapping, MutableMapping
 from types import MappingProxyType
@@ -87,7 +86,9 @@ from opspec.engine.registry import PerformerRegistry
 from opspec.engine.trace import EventKind as EK
 from opspec.engine.trace import TraceEvent, TraceListener
 from opspec.engine.wakeup import Wakeups
-from opspec.errors import ExecutionError, OpspecError, ZeroTimeCycleError
+from opspec.engine.zero_time import ZeroTimeSampler
+from opspec.engine.zero_time import max_instant_steps as _max_instant_steps
+from opspec.errors import ExecutionError, OpspecError
 from opspec.model import CoordinationKind, Package, ParameterMode
 
 __all__ = ["Interpreter"]
@@ -97,11 +98,6 @@ _NEXT = LIFECYCLE.table
 _CHOICE_DONE = object()
 #: Messages of one name kept with nobody waiting (per receiving instance, or for anyone).
 MESSAGE_BUFFER = 100
-#: Zero-time steps (token moves, instantaneous activities) at one simulated instant before a
-#: run is stopped as a zero-time cycle. Real specifications take tens to thousands; 500,000
-#: take one to a few seconds. ``OPSPEC_MAX_INSTANT_STEPS`` overrides it.
-MAX_INSTANT_STEPS = 500_000
-INSTANT_STEPS_ENV = "OPSPEC_MAX_INSTANT_STEPS"
 #: Synchronous subflow calls nested deeper than this end the run's root instance with a
 #: located fault: bounded recursion (a base case) runs, runaway recursion is reported.
 MAX_CALL_DEPTH = 100
@@ -155,6 +151,8 @@ class Interpreter:
         self._instant = -1.0
         self._instant_steps = 0
         self.max_instant_steps = _max_instant_steps()
+        self._sampler: ZeroTimeSampler | None = None
+        self._start_limit = self.max_instant_steps    # 0 while a sampler names the cycle
         self._pullers: dict[str, deque[ActivityInstance]] = {}
         self._perf_cache: dict[CompiledActivity, Performer | None] = {}
         self._apps = performers.applications
@@ -219,9 +217,11 @@ class Interpreter:
     def _drain(self) -> None:
         """Run queued zero-time work until none is left (re-entrant calls just return).
 
-        Zero-time work at one simulated instant is counted (across drains, so a storm of
-        zero-delay wakeups counts too); past :data:`MAX_INSTANT_STEPS` the run stops with a
-        :class:`ZeroTimeCycleError` naming the activities that keep coming back."""
+        Zero-time work at one simulated instant is counted across drains: each item run and
+        each drain (a SimPy event at this instant, so a storm of zero-delay wakeups that queue
+        nothing counts too). Past ``max_instant_steps`` the run stops with a
+        :class:`~opspec.errors.ZeroTimeCycleError` naming the activities that keep coming
+        back (:mod:`opspec.engine.zero_time`)."""
         if self._draining:
             return
         self._draining = True
@@ -231,15 +231,21 @@ class Interpreter:
         if now != self._instant:
             self._instant = now
             self._instant_steps = 0
-        steps = self._instant_steps
+            if self._sampler is not None:         # the clock moved on: no cycle after all
+                self._sampler = None
+                self._start_limit = self.max_instant_steps
+        steps = self._instant_steps + 1
+        limit = self.max_instant_steps
         try:
+            if steps > limit:
+                self._zero_time(None, None)
             while True:
                 while ready:
                     fn, a, b, c = pop()
-                    fn(a, b, c)
                     steps += 1
-                    if steps > self.max_instant_steps:
-                        self._zero_time_cycle()
+                    if steps > limit:
+                        self._zero_time(a, b)
+                    fn(a, b, c)
                 if not self._pending:
                     break
                 self._resolve_frames()
@@ -249,37 +255,16 @@ class Interpreter:
             self._draining = False
             self._instant_steps = steps
 
-    def _zero_time_cycle(self) -> None:
-        """Sample what the ready queue keeps running for a while, then stop the run."""
-        seen: dict[tuple[str, int], dict[str, None]] = {}
-        ready = self._ready
-        for _ in range(10_000):
-            if not ready:
-                break
-            fn, a, b, c = ready.popleft()
-            act: CompiledActivity | None = None
-            inst: ProcessInstance | None = None
-            if isinstance(a, Frame):
-                inst = a.inst
-                if isinstance(b, int) and 0 <= b < len(a.graph.activities):
-                    act = a.graph.activities[b]
-            elif isinstance(a, ActivityInstance):
-                inst = a.frame.inst
-                act = a.act
-            if inst is not None and act is not None:
-                seen.setdefault((inst.process.id, inst.id), {})[act.id] = None
-            fn(a, b, c)
-        self._raise_zero_time(seen)
-
-    def _raise_zero_time(self, seen: dict[tuple[str, int], dict[str, None]]) -> None:
-        where = "; ".join(f"process {pid!r} (instance {iid}): {', '.join(acts)}"
-                          for (pid, iid), acts in list(seen.items())[:3]) or "zero-delay events"
-        raise ZeroTimeCycleError(
-            f"the simulated clock stopped advancing at t={self.env._now:.3f} s: "
-            f"{self.max_instant_steps:,} steps ran at that instant, repeating {where}",
-            hint="give the cycle a duration, a wait, or a condition that ends it; "
-                 f"{INSTANT_STEPS_ENV} raises the limit",
-            sim_time=self.env._now)
+    def _zero_time(self, a: Any, b: Any) -> None:
+        """A step past the limit at this instant: note what it moves (``a``, ``b`` as in a
+        ready-queue item, or a frame and an activity); stop the run once enough are seen."""
+        now = self.env._now
+        sampler = self._sampler
+        if sampler is None or sampler.at != now:
+            sampler = self._sampler = ZeroTimeSampler(now, self.max_instant_steps)
+            self._start_limit = 0                 # _start notes every activity it carries
+        if sampler.record(a, b):
+            raise sampler.error()
 
     def _later(self, delay: float, fn: Callable[[ActivityInstance, Any], None],
                ai: ActivityInstance, arg: Any = None) -> None:
@@ -623,8 +608,7 @@ class Interpreter:
         pooled = self._pooled
         apps = self._apps
         steps = 0
-        limit = self.max_instant_steps
-        cycle: dict[str, None] = {}
+        limit = self._start_limit
         while act is not None:
             if not act.fast or (act.general and pooled) or (
                     act.kind == K_TASK and act.application in apps):
@@ -633,9 +617,7 @@ class Interpreter:
             inst = frame.inst
             steps += 1
             if steps > limit:                   # a zero-time cycle (see _drain)
-                cycle[act.id] = None
-                if steps > limit + 10_000:
-                    self._raise_zero_time({(inst.process.id, inst.id): cycle})
+                self._zero_time(frame, act)
             if self._aflags[act] & 1:
                 self.emit(EK.ACTIVITY_STARTED, act.process, inst.id, act.id, act.lane,
                           act.participant)
@@ -1846,15 +1828,6 @@ class _Flags(dict[Any, int]):
 
 def _call(callback: Callable[[], None], _a: Any, _b: Any) -> None:
     callback()
-
-
-def _max_instant_steps() -> int:
-    raw = os.environ.get(INSTANT_STEPS_ENV, "")
-    try:
-        value = int(raw) if raw.strip() else MAX_INSTANT_STEPS
-    except ValueError:
-        value = MAX_INSTANT_STEPS
-    return value if value > 0 else MAX_INSTANT_STEPS
 
 
 def _root(inst: ProcessInstance) -> ProcessInstance:
