@@ -11,6 +11,6 @@ if [ -x "$venv/bin/python" ] && "$venv/bin/python" -c "import shoobx.wfmc" >/dev
     exit 0
 fi
 python3 -m venv "$venv"
-"$venv/bin/python" -m pip install --quiet --disable-pip-version-check "shoobx.wfmc>=4.3,<5" 2>&1 \
+"$venv/bin/python" -m pip install --quiet --disable-pip-version-check --retries 1 --timeout 20 "shoobx.wfmc>=4.3,<5" 2>&1 \
     | grep -v "^WARNING: Location" >&2 || true
 "$venv/bin/python" -c "import shoobx.wfmc" 
