@@ -100,6 +100,9 @@ def run(args: argparse.Namespace) -> int:
                               model_factory=factory, performers=performers, replay=replay,
                               spec_path=str(args.spec), device_participants=served,
                               wall_devices=real)
+        if session.failure is not None:        # the run cannot even start (a zero-time cycle)
+            session.close()
+            raise session.failure
         session.speed = args.speed if args.speed is not None else 1.0 if real else 60.0
         if devices is not None:
             devices.install(session.sim)
@@ -111,11 +114,13 @@ def run(args: argparse.Namespace) -> int:
             interrupted = True
         finally:
             session.close()
+    if session.failure is not None:            # shown in the app; said again in one line
+        print(f"opspec: {session.failure}", file=sys.stderr)
     if record is not None:
         print(f"recording: {record}\ntrace: {record.with_suffix('.trace.jsonl')}\n"
               f"replay it with: opspec walkthrough {args.spec} --replay {record}  or  "
               f"opspec run {args.spec} --script {record}")
-    return 130 if interrupted else 0
+    return 130 if interrupted else 1 if session.failure is not None else 0
 
 
 def _model_factory(compiled: Any, ref: Any, seed: int) -> Any:

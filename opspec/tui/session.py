@@ -13,10 +13,15 @@ event loop): SimPy is stepped, never run from another thread.
 - **Recording**: every action (the person's or the model's while handed over) is written at
   once to the recording (a script file ``opspec run --script`` and the test helpers replay),
   and every trace event to ``<recording>.trace.jsonl`` (for ``opspec fit``).
+- **A run that fails** (an :class:`~opspec.errors.ExecutionError` from the engine, such as a
+  zero-time cycle: the simulated clock stopped advancing) ends the session: :attr:`failure`
+  holds the error, :attr:`ended` is set, the timeline shows it as an engine fault, and
+  ``opspec walkthrough`` prints it in one line and exits 1 when the app closes.
 """
 
 from __future__ import annotations
 
+import functools
 import json
 import math
 import os
@@ -24,19 +29,38 @@ import time
 from collections import deque
 from collections.abc import Callable, Mapping, Sequence
 from pathlib import Path
-from typing import Any
+from typing import Any, TypeVar
 
 from opspec.engine.compiled import CompiledPackage
 from opspec.engine.lanes import all_activities, user_lane
 from opspec.engine.performers import WorkItem
 from opspec.engine.simulation import Simulation
 from opspec.engine.trace import TraceEvent
-from opspec.errors import ConfigurationError
+from opspec.errors import ConfigurationError, ExecutionError
 from opspec.tui.devices import DeviceBoard
 from opspec.tui.lane import LaneUser, Offer
 from opspec.tui.replay import tagged_action
 
 __all__ = ["Offer", "WalkSession"]
+
+_F = TypeVar("_F", bound=Callable[..., Any])
+
+
+def _guarded(default: Any = None) -> Callable[[_F], _F]:
+    """Methods that step the engine: an ExecutionError ends the session (see
+    :meth:`WalkSession._fail`) and the method returns ``default``."""
+    def wrap(method: _F) -> _F:
+        @functools.wraps(method)
+        def guarded(self: WalkSession, *args: Any, **kwargs: Any) -> Any:
+            if self.failure is not None:
+                return default
+            try:
+                return method(self, *args, **kwargs)
+            except ExecutionError as error:
+                self._fail(error)
+                return default
+        return guarded  # type: ignore[return-value]
+    return wrap
 
 DAY = 86_400.0
 _ANSWERED = frozenset({"activity.completed", "activity.omitted", "activity.failed",
@@ -88,6 +112,8 @@ class WalkSession:
         self._seq_of: dict[int, int] = {}                   # item key -> its offer number
         self._skip_from = 0                                 # _offer_seq when the skip began
         self.ended = False
+        #: the error that ended the run (a zero-time cycle...), or None
+        self.failure: ExecutionError | None = None
         self.record_path = Path(record) if record is not None else None
         self._steps: list[list[str]] = []
         self._trace_file = None
@@ -132,13 +158,28 @@ class WalkSession:
             listeners.append(self._trace_file)
         self.sim = Simulation(compiled, config, performers=bound, seed=seed, scope=(0,),
                               listeners=listeners)
+        self._boot()
+
+    @_guarded()
+    def _boot(self) -> None:
         self.sim.boot()
+
+    def _fail(self, error: ExecutionError) -> None:
+        """The engine cannot go on: end the session and show why (as an engine fault)."""
+        self.failure = error
+        self.ended = True
+        self.skipping = False
+        at = error.sim_time if error.sim_time is not None else self.now
+        self._on_event(TraceEvent(at, "fault", lane="device", package=self.compiled.id,
+                                  data={"device": "engine", "fault": str(error),
+                                        "message": str(error)}))
 
     # ------------------------------------------------------------------ time
     @property
     def now(self) -> float:
         return float(self.sim.env.now)
 
+    @_guarded()
     def advance(self, wall_seconds: float, budget: int | None = None) -> None:
         """Let ``wall_seconds`` of real time pass at the current speed (unless paused); a
         skip in progress (or held up by a real device) goes on instead.
@@ -164,6 +205,7 @@ class WalkSession:
         skipping simulated time now would jump past its answer."""
         return self.wall_devices and bool(self.device_work)
 
+    @_guarded()
     def skip_to_next_event(self, budget: int | None = None) -> None:
         """Jump to the next scheduled event (not while a real device is busy)."""
         if self.waiting_for_devices:
@@ -171,6 +213,7 @@ class WalkSession:
         due = self.sim.peek()
         self.run_to(min(self.horizon, due if math.isfinite(due) else self.horizon), budget)
 
+    @_guarded()
     def skip_until_user(self, budget: int | None = None) -> None:
         """Run until something is offered to the person (or the run ends). With a real
         device busy the skip pauses until it answers. With a ``budget`` (engine events per
@@ -211,6 +254,7 @@ class WalkSession:
         """Whether an offer made after the ``since``-th one is waiting for the person."""
         return any(self._seq_of.get(o.item.key, 0) > since for o in self.offers)
 
+    @_guarded(True)
     def run_to(self, target: float, budget: int | None = None) -> bool:
         """Step the engine to simulated time ``target`` (at most ``budget`` events; it
         stops early at a new offer); ``False`` when the budget ran out first (the clock then
@@ -240,6 +284,7 @@ class WalkSession:
         return True, steps
 
     # ------------------------------------------------------------------ the person
+    @_guarded()
     def act(self, offer: Offer) -> None:
         """The person does ``offer`` now."""
         engine = self.lane_user.engine
@@ -251,6 +296,7 @@ class WalkSession:
         self._drop_offers(offer.item.key)
         engine.complete(offer.item, None, offer.choice)
 
+    @_guarded()
     def ignore(self, offer: Offer) -> None:
         """The person explicitly does not do ``offer`` (omission)."""
         engine = self.lane_user.engine
@@ -263,6 +309,7 @@ class WalkSession:
         self._drop_offers(offer.item.key)
         engine.omit(offer.item, "the person chose not to")
 
+    @_guarded(False)
     def hand_over(self) -> bool:
         """Let the user model perform the lane from now on, starting with what the person
         is offered now (``False``: no model, or a replay performs the lane)."""
@@ -273,6 +320,7 @@ class WalkSession:
         self.lane_user.hand_over(self.model_factory(), current)
         return True
 
+    @_guarded()
     def take_back(self) -> None:
         """The person performs the lane again: the model's pending work is withdrawn from
         it (a delayed action of the model does nothing) and offered to the person."""
