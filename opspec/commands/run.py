@@ -178,6 +178,9 @@ def run(args: argparse.Namespace) -> int:
         _print_summary(out, result, medians, args.trace, device_report,
                        shown=printer.shown if printer else 0)
         _print_monitors(out, monitors)
+    if sink is not None and sink.truncated is not None:      # the trace file hit its cap
+        print(f"opspec: note: {sink.message()} ({sink.dropped:,} not written)",
+              file=sys.stderr)
     device_faults = any(info.get("faults") for info in (device_report or {}).values())
     problems = result.summary.get("deadlocks") or result.summary.get("faults") or (
         result.summary.get("instances", {}).get("aborted", 0)) or device_faults

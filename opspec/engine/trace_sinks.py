@@ -7,11 +7,17 @@ A JSON Lines trace starts with one header line::
 followed by one :meth:`TraceEvent.to_json` object per line. The file is flushed every
 ``flush_every`` events and on close, so a crash loses at most that many events. See
 ``docs/trace-format.md``.
+
+A trace file never grows past ``max_bytes`` (:data:`TRACE_MAX_BYTES`, 1 GiB, or
+``OPSPEC_TRACE_MAX_BYTES``): the event that would pass it is replaced by one
+``trace.truncated`` line saying so, later events are counted (:attr:`JsonlSink.dropped`) but
+not written, and :attr:`JsonlSink.truncated` tells the command to say so in one line.
 """
 
 from __future__ import annotations
 
 import json
+import os
 from collections.abc import Iterator, Mapping
 from pathlib import Path
 from typing import IO, Any, Self
@@ -19,7 +25,23 @@ from typing import IO, Any, Self
 from opspec.engine.trace import TRACE_FORMAT, TRACE_FORMAT_VERSION, TraceEvent
 from opspec.errors import ExecutionError, SourceLocation
 
-__all__ = ["JsonlSink", "MemorySink", "read_trace", "read_trace_header"]
+__all__ = ["TRACE_MAX_BYTES", "TRACE_MAX_BYTES_ENV", "JsonlSink", "MemorySink", "read_trace",
+           "read_trace_header", "trace_max_bytes"]
+
+#: The most a JSON Lines trace file may hold, in bytes (1 GiB: some 5 million events).
+TRACE_MAX_BYTES = 1 << 30
+#: The environment variable that sets another cap (a positive number of bytes).
+TRACE_MAX_BYTES_ENV = "OPSPEC_TRACE_MAX_BYTES"
+
+
+def trace_max_bytes() -> int:
+    """The cap: ``OPSPEC_TRACE_MAX_BYTES`` when it is a positive integer, else 1 GiB."""
+    raw = os.environ.get(TRACE_MAX_BYTES_ENV, "")
+    try:
+        value = int(raw) if raw.strip() else TRACE_MAX_BYTES
+    except ValueError:
+        value = TRACE_MAX_BYTES
+    return value if value > 0 else TRACE_MAX_BYTES
 
 
 class MemorySink:
@@ -35,26 +57,56 @@ class MemorySink:
 
 
 class JsonlSink:
-    """Writes events to a JSON Lines file. Use as a context manager or call :meth:`close`."""
+    """Writes events to a JSON Lines file. Use as a context manager or call :meth:`close`.
+
+    ``max_bytes`` caps the file (default :func:`trace_max_bytes`); see the module docstring."""
 
     selects = None
 
     def __init__(self, path: str | Path, header: Mapping[str, Any] | None = None,
-                 flush_every: int = 256) -> None:
+                 flush_every: int = 256, max_bytes: int | None = None) -> None:
         self.path = Path(path)
         self._handle: IO[str] = open(self.path, "w", encoding="utf-8")  # noqa: SIM115
         self._flush_every = max(1, flush_every)
         self._pending = 0
+        self.max_bytes = max_bytes if max_bytes is not None else trace_max_bytes()
+        #: the time of the first event not written (the cap was reached), or None
+        self.truncated: float | None = None
+        self.dropped = 0
         head = {"format": TRACE_FORMAT, "version": TRACE_FORMAT_VERSION, **(header or {})}
-        self._handle.write(json.dumps(head, default=str) + "\n")
+        line = json.dumps(head, default=str) + "\n"
+        self._handle.write(line)
         self._handle.flush()
+        self._bytes = len(line)
 
     def __call__(self, event: TraceEvent) -> None:
-        self._handle.write(json.dumps(event.to_json(), default=str, allow_nan=True) + "\n")
+        if self.truncated is not None:
+            self.dropped += 1
+            return
+        line = json.dumps(event.to_json(), default=str, allow_nan=True) + "\n"
+        self._bytes += len(line)         # ensure_ascii: characters are bytes
+        if self._bytes > self.max_bytes:
+            self._truncate(event)
+            return
+        self._handle.write(line)
         self._pending += 1
         if self._pending >= self._flush_every:
             self._handle.flush()
             self._pending = 0
+
+    def _truncate(self, event: TraceEvent) -> None:
+        self.truncated = event.time
+        self.dropped = 1
+        self._handle.write(json.dumps({
+            "seq": event.seq, "time": event.time, "kind": "trace.truncated",
+            "data": {"max_bytes": self.max_bytes, "message": self.message()}}) + "\n")
+        self._handle.flush()
+
+    def message(self) -> str:
+        """One line saying that (and where) the trace was cut, and what to do."""
+        return (f"the trace {self.path} reached its cap of {self.max_bytes:,} bytes at "
+                f"t={self.truncated or 0.0:.3f} s; later events were not written "
+                f"(set {TRACE_MAX_BYTES_ENV} to a larger number of bytes, or run for less time)")
 
     def close(self) -> None:
         if not self._handle.closed:

@@ -12,6 +12,10 @@ The output goes to ``<path>.partial`` and is renamed to ``path`` by :meth:`close
 reader never sees half a file; when the ``with`` block ends with an exception the partial
 file is left in place (closed, for inspection) and ``path`` is not touched.
 
+An export never grows past the trace cap (1 GiB, or ``OPSPEC_TRACE_MAX_BYTES``; see
+``docs/trace-format.md``): the write that would pass it raises an
+:class:`~opspec.errors.EvaluationError` saying so, and the ``.partial`` file is left.
+
 The XES mapping (which events, which lifecycle transitions, timestamps, attribute types) is
 documented in ``docs/xes-export.md``; the constants below are its single source.
 """
@@ -29,6 +33,7 @@ from types import TracebackType
 from typing import IO, Any, Self
 
 from opspec.engine.trace import TRACE_FORMAT, TRACE_FORMAT_VERSION, EventKind, TraceEvent
+from opspec.engine.trace_sinks import TRACE_MAX_BYTES_ENV, trace_max_bytes
 from opspec.errors import EvaluationError
 
 __all__ = [
@@ -128,6 +133,8 @@ class _StreamingWriter:
         self._partial = self.path.with_name(self.path.name + ".partial")
         self.cases = 0
         self.events = 0
+        self.max_bytes = trace_max_bytes()
+        self._bytes = 0
         try:
             self.path.parent.mkdir(parents=True, exist_ok=True)
             self._handle: IO[str] | None = open(  # noqa: SIM115  (closed by close())
@@ -149,6 +156,14 @@ class _StreamingWriter:
 
     def _write(self, text: str) -> None:
         handle = self._check_open()
+        self._bytes += len(text)
+        if self._bytes > self.max_bytes:
+            self._abandon()
+            raise EvaluationError(
+                f"the trace export {self.path} reached its cap of {self.max_bytes:,} bytes "
+                f"after {self.cases:,} case(s); it is left as {self._partial.name}",
+                hint=f"set {TRACE_MAX_BYTES_ENV} to a larger number of bytes, or export "
+                     "fewer users or days")
         try:
             handle.write(text)
         except OSError as error:

@@ -5,6 +5,7 @@ time, and exit 1 — no traceback."""
 
 from __future__ import annotations
 
+import json
 import os
 import subprocess
 import sys
@@ -134,3 +135,56 @@ def test_opspec_testing_simulate_raises_it() -> None:
 
     with pytest.raises(ZeroTimeCycleError, match=r"process 'again' \(.*\): restart"):
         simulate(SPECS / "self_start.xpdl", days=1)
+
+
+def test_until_and_days_bound_a_run_that_never_runs_dry(tmp_path: Path,
+                                                        capsys: pytest.CaptureFixture[str]
+                                                        ) -> None:
+    """B -> C -> B forever, an hour a lap: --until and --days stop it where they say."""
+    text = (SPECS / "cycle.xpdl").read_text().replace(
+        '<Activity Id="C"><Implementation><No/></Implementation>',
+        '<Activity Id="C"><Implementation><No/></Implementation><ExtendedAttributes>'
+        '<ExtendedAttribute Name="opspec:Duration" Value="ConstantParameter(3600)"/>'
+        "</ExtendedAttributes>")
+    laps = tmp_path / "laps.xpdl"
+    laps.write_text(text)
+    for args, end in ((["--until", "PT5H"], 5 * 3600.0), (["--days", "2"], 2 * 86_400.0)):
+        assert main(["run", str(laps), "--json", *args]) == 0
+        assert json.loads(capsys.readouterr().out)["time"] == end
+
+
+def test_a_trace_file_stops_at_its_cap_and_says_so(tmp_path: Path,
+                                                   monkeypatch: pytest.MonkeyPatch,
+                                                   capsys: pytest.CaptureFixture[str]) -> None:
+    from opspec.engine.trace_sinks import read_trace
+
+    monkeypatch.setenv("OPSPEC_TRACE_MAX_BYTES", "20000")
+    trace = tmp_path / "t.jsonl"
+    status = main(["run", str(ROOT / "specs" / "medication_dispenser.xpdl"), "--days", "2",
+                   "--timeline", "none", "--trace", str(trace)])
+    assert status == 0
+    notes = [line for line in capsys.readouterr().err.splitlines() if "cap" in line]
+    assert len(notes) == 1
+    assert notes[0].startswith(f"opspec: note: the trace {trace} reached its cap of 20,000 "
+                               "bytes at t=")
+    assert "OPSPEC_TRACE_MAX_BYTES" in notes[0]
+    events = list(read_trace(trace))
+    assert events[-1].kind == "trace.truncated"
+    assert trace.stat().st_size < 20_000 + 1000      # the cap plus the closing line
+
+
+def test_a_trace_export_stops_at_its_cap(tmp_path: Path,
+                                         monkeypatch: pytest.MonkeyPatch) -> None:
+    from opspec.engine.trace import TraceEvent
+    from opspec.errors import EvaluationError
+    from opspec.evaluation.exporters import JsonlTraceWriter, XesWriter
+
+    monkeypatch.setenv("OPSPEC_TRACE_MAX_BYTES", "5000")
+    events = [TraceEvent(float(i), "activity.started", "p", 1, "a", "device")
+              for i in range(200)]
+    for writer_class in (XesWriter, JsonlTraceWriter):
+        path = tmp_path / f"traces.{writer_class.__name__}"
+        with (pytest.raises(EvaluationError, match="reached its cap of 5,000 bytes"),
+              writer_class(path) as writer):
+            writer.add_case("A/0", events)
+        assert not path.exists()
