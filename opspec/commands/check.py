@@ -93,9 +93,31 @@ def run(args: argparse.Namespace) -> int:
         for process in processes:
             reports.extend(check_process(process, conformance=package.conformance_class,
                                          max_states=args.max_states))
+        reports = _with_zero_time_cycles(package, reports, [p.id for p in processes])
         status = _print(path, reports, errors, as_json=args.json, max_states=args.max_states)
         worst = max(worst, status)
     return worst
+
+
+def _with_zero_time_cycles(package: Any, reports: list[SoundnessReport],
+                           processes: list[str]) -> list[SoundnessReport]:
+    """Add each level's zero-time cycles (warnings, see opspec.engine.zero_time_check); a
+    package the engine cannot compile has its errors printed already and gets none."""
+    from opspec.engine.compiled import compile_package
+    from opspec.engine.zero_time_check import zero_time_cycles
+    from opspec.errors import OpspecError
+    from opspec.model.soundness import SoundnessReport
+
+    try:
+        found = zero_time_cycles(compile_package(package), processes)
+    except OpspecError:
+        return reports
+    out = []
+    for report in reports:
+        mine = tuple(p for p in found if p.process == report.process)
+        out.append(SoundnessReport(report.process, report.states, report.complete,
+                                   report.problems + mine) if mine else report)
+    return out
 
 
 def _run_time_errors(package: Any) -> list[Diagnostic]:
@@ -124,29 +146,40 @@ def _print_unloadable(path: Path, errors: Sequence[Diagnostic], *, as_json: bool
     print(f"{path}: not checked: the file could not be read as XPDL")
 
 
+def _problem_json(p: Any) -> dict[str, Any]:
+    return {"kind": p.kind, "severity": p.severity, "process": p.process,
+            "activity": p.activity, "line": p.line, "message": p.message,
+            "witness": list(p.witness)}
+
+
 def _print(path: Path, reports: list[SoundnessReport], errors: Sequence[Diagnostic], *,
            as_json: bool, max_states: int) -> int:
     """Print one file's verdict; return its exit status (0, 1 or 2). Load ``errors`` make
     it 1 at least (and the file is never called sound)."""
     problems = [p for r in reports for p in r.problems]
+    failing = [p for p in problems if p.severity == "error"]
     undecided = [r for r in reports if not r.complete]
     if as_json:
         print(json.dumps({
-            "path": str(path), "sound": not problems and not undecided and not errors,
+            "path": str(path), "sound": not failing and not undecided and not errors,
             "loaded": True,
             "max_states": max_states,
             "processes": [{"process": r.process, "states": r.states, "complete": r.complete,
-                           "sound": r.sound, "problems": len(r.problems)} for r in reports],
-            "problems": [{"kind": p.kind, "severity": "error", "process": p.process,
-                          "activity": p.activity, "line": p.line, "message": p.message,
-                          "witness": list(p.witness)} for p in problems],
-            "errors": _errors_json(errors)}, ensure_ascii=False))
+                           "sound": r.sound, "problems": sum(
+                               1 for p in r.problems if p.severity == "error")}
+                          for r in reports],
+            "problems": [_problem_json(p) for p in failing],
+            "errors": _errors_json(errors),
+            # warnings (zero-time cycles) only when there are some
+            **({"warnings": cautions} if (cautions := [
+                _problem_json(p) for p in problems if p.severity != "error"]) else {}),
+            }, ensure_ascii=False))
     else:
         for diagnostic in errors:
             print(diagnostic)
         for problem in problems:
             where = f"{path}:{problem.line}" if problem.line else str(path)
-            print(f"{where}: error: {problem.process}: {problem.message}")
+            print(f"{where}: {problem.severity}: {problem.process}: {problem.message}")
             if problem.witness:
                 cyclic = problem.kind == "conformance" and len(problem.witness) > 1 and (
                     problem.witness[0] == problem.witness[-1])
@@ -157,13 +190,17 @@ def _print(path: Path, reports: list[SoundnessReport], errors: Sequence[Diagnost
                 print(f"{path}: warning: {report.process}: more than {max_states} states: "
                       "soundness undecided (raise --max-states, or simplify the process)")
         for report in reports:
-            verdict = ("sound" if report.sound else
-                       f"{len(report.problems)} problem(s)" if report.problems else "undecided")
+            warned = sum(1 for p in report.problems if p.severity != "error")
+            also = f", {warned} warning(s)" if warned else ""
+            verdict = ("sound" + also if report.sound
+                       else f"{len(report.problems) - warned} problem(s)" + also
+                       if len(report.problems) > warned else "undecided" + also)
             print(f"{path}: {report.process}: {verdict} ({report.states} states)")
         sound = sum(1 for r in reports if r.sound)
+        warnings = len(problems) - len(failing)
         print(f"{path}: {sound} of {len(reports)} process level(s) sound, "
-              f"{len(problems)} problem(s)" + (f", {len(errors)} spec error(s) (see "
+              f"{len(failing)} problem(s)" + (f", {warnings} warning(s)" if warnings else "") + (f", {len(errors)} spec error(s) (see "
                                                 "`opspec validate`)" if errors else ""))
-    if problems or errors:
+    if failing or errors:
         return 1
     return 2 if undecided else 0

@@ -20,7 +20,10 @@ problem comes with the shortest witness (the activities fired from the start):
 - **unbounded**: more than :data:`TOKEN_BOUND` tokens on one place (the exploration stops
   there, so dead activities and livelocks are not reported then);
 - **conformance**: a violation of the package's graph conformance class
-  (:mod:`opspec.model.soundness_conformance`).
+  (:mod:`opspec.model.soundness_conformance`);
+- **zero-time-cycle** (a warning): a reachable cycle of instantaneous activities, where a
+  run's clock may stop (found on the compiled package by
+  :mod:`opspec.engine.zero_time_check`; ``opspec check`` adds them).
 
 A level whose exploration stopped at ``max_states`` is *undecided* (``complete`` is False):
 the problems found so far are real, but dead activities and livelocks are not reported, and
@@ -42,7 +45,7 @@ from opspec.model.soundness_net import Marking, TokenNet, join_type
 __all__ = ["KINDS", "TOKEN_BOUND", "Problem", "SoundnessReport", "check_level", "check_process"]
 
 KINDS = ("deadlock", "improper-completion", "livelock", "dead", "and-join-never-fires",
-         "unbounded", "conformance")
+         "unbounded", "conformance", "zero-time-cycle")
 TOKEN_BOUND = 4          # more tokens than this on one place: unbounded
 
 
@@ -50,7 +53,8 @@ TOKEN_BOUND = 4          # more tokens than this on one place: unbounded
 class Problem:
     """One soundness problem: ``kind`` is one of :data:`KINDS`; ``witness`` the activities
     fired from the start (or the cycle / the split and what breaks its block, for
-    conformance; empty for dead activities)."""
+    conformance; empty for dead activities). ``severity`` is ``"error"``, or
+    ``"warning"`` for what may be intended (a zero-time cycle whose conditions let it out)."""
 
     kind: str
     process: str
@@ -58,6 +62,7 @@ class Problem:
     message: str
     witness: tuple[str, ...] = ()
     line: int | None = None
+    severity: str = "error"
 
 
 @dataclass(frozen=True, slots=True)
@@ -72,7 +77,8 @@ class SoundnessReport:
 
     @property
     def sound(self) -> bool:
-        return self.complete and not self.problems
+        """Completely explored and no error (warnings do not make a level unsound)."""
+        return self.complete and not any(p.severity == "error" for p in self.problems)
 
 
 State = tuple[Marking, bool]          # the marking, and whether an end has been reached
