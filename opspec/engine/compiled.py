@@ -169,6 +169,9 @@ class CompiledActivity:
     join_condition: Evaluator | None = None  # complex joins: fires when it holds
     in_slots: dict[int, int] = field(default_factory=dict)   # transition index -> join slot
     split: int = S_XOR
+    # no declared split, or an AND split: when no transition's condition holds the path
+    # ends there (XPDL 1.0 engines, JaWE/Shark); a declared XOR/OR split aborts (BPMN)
+    path_may_end: bool = False
     out: tuple[CTransition, ...] = ()
     otherwise: tuple[CTransition, ...] = ()
     exceptions: tuple[CTransition, ...] = ()
@@ -631,6 +634,7 @@ class _Compiler:
         ca.otherwise = tuple(t for t in ordered if t.kind == T_OTHERWISE)
         ca.exceptions = tuple(t for t in ordered if t.kind == T_EXCEPTION)
         ca.default_exception = next((t for t in ordered if t.kind == T_DEFAULT), None)
+        ca.path_may_end = act.split is None or act.split.type is GatewayType.AND
         if act.split is not None:
             # a diverging complex gateway behaves as an inclusive one (BPMN 2.0 §13.3.6)
             ca.split = {GatewayType.AND: S_AND, GatewayType.OR: S_OR,

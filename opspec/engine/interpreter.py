@@ -1008,6 +1008,9 @@ class Interpreter:
                     if cond is None or cond(scope, now):
                         break
                 else:
+                    if not act.otherwise and act.path_may_end:
+                        self._token_gone(frame)     # no condition holds: this path ends
+                        return None
                     if not act.otherwise:
                         self.abort(inst, act, "no outgoing transition can be taken (no "
                                    "condition holds and there is no OTHERWISE transition)")
@@ -1059,7 +1062,9 @@ class Interpreter:
             except OpspecError as error:
                 self.abort(inst, act, f"a transition condition failed: {error.message}")
                 return
-            if not taken:
+            if not taken and not act.otherwise and act.path_may_end:
+                pass                                # no condition holds: this path ends
+            elif not taken:
                 if not act.otherwise:
                     self.abort(inst, act, "no outgoing transition can be taken (no condition "
                                "holds and there is no OTHERWISE transition)")

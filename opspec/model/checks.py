@@ -214,7 +214,7 @@ def _activity_structure(process: WorkflowProcess, aset: ActivitySet | None, grap
                     f"has a condition, but {activity.id!r} declares no split: opspec takes "
                     "every outgoing transition whose condition holds (BPMN conditional "
                     "sequence flows, an inclusive split), the OTHERWISE one when none holds, "
-                    "and stops the instance when no transition can be taken",
+                    "and ends that path when none can be taken",
                     f"declare <Split Type=\"XOR\"> on {activity.id!r} if only the first "
                     "transition that holds should be taken")
                 break

@@ -261,3 +261,22 @@ def test_implicit_termination_ends_a_path_and_the_case_when_no_path_is_left(
     assert starts(result, "D") == [5.0]
     assert completed_at(result) == [5.0]
     assert result.summary["instances"]["open"] == 0
+
+
+def test_a_path_whose_conditions_all_fail_ends_there_without_a_declared_split(
+        tmp_path: Path) -> None:
+    """JaWE's implicit-termination sample: a conditional transition out of an activity
+    with no split (or an AND split) that does not hold ends that path; the case completes
+    when the other paths do. A declared XOR split with nothing to take still aborts."""
+    acts = [activity("A", split="Parallel"), activity("B"), activity("C", seconds=2),
+            activity("D")]
+    trans = [transition("A", "B", "x &gt; 0"), transition("A", "C"),
+             transition("C", "D", "x &gt; 0")]
+    result = run(spec(tmp_path, acts, trans, integer_field("x", 0)), until=None)
+    assert (starts(result, "B"), starts(result, "C"), starts(result, "D")) == ([], [0.0], [])
+    assert completed_at(result) == [2.0]
+    assert result.summary["faults"] == []
+    acts[2] = activity("C", seconds=2, split="Exclusive")
+    result = run(spec(tmp_path, acts, trans, integer_field("x", 0)), until=None)
+    [fault] = result.summary["faults"]
+    assert "no outgoing transition can be taken" in fault["message"]

@@ -29,9 +29,6 @@ PROCESSES = [
     "WfPIMI1_MI_without_synchronization",
     "WfPIMI2_MI_with_a_priori_known_design_time_knowledge",
 ]
-IMPLICIT = pytest.mark.xfail(strict=True, reason="issue 16: when no condition of a conditional "
-                             "split holds the instance is aborted ('no outgoing transition can be "
-                             "taken') instead of ending that path (implicit termination)")
 
 
 @cache
@@ -41,9 +38,7 @@ def _run(where_to_go: str):  # type: ignore[no-untyped-def]
 
 @pytest.mark.skipif(not FILE.exists(), reason="shared corpus not present (../shared/corpus/xpdl)")
 @pytest.mark.parametrize("where_to_go", ["D", "BC"])
-@pytest.mark.parametrize("process", [
-    pytest.param(p, marks=IMPLICIT) if p == "WfSP2_Implicit_Termination" else p
-    for p in PROCESSES])
+@pytest.mark.parametrize("process", PROCESSES)
 def test_every_process_of_the_jawe_patterns_file_completes(process: str, where_to_go: str) -> None:
     result = _run(where_to_go)
     got = outcomes(result, process)
