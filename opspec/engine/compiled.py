@@ -222,6 +222,10 @@ class CompiledGraph:
     starts: tuple[int, ...] = ()
     by_id: dict[str, int] = field(default_factory=dict)
     has_or_join: bool = False
+    # an ad-hoc activity set run one activity at a time (its starts in order), and its
+    # AdHocCompletionCondition, checked whenever one of its activities has run
+    sequential: bool = False
+    completion: Evaluator | None = None
 
 
 @dataclass(slots=True, eq=False)
@@ -562,6 +566,13 @@ class _Compiler:
                                   f"{body.activity_set!r}", act.location)
             ca.block = self.graph(proc, aset.id, aset.activities, aset.transitions, proc_lane,
                                   body.start_activity)
+            if aset.ad_hoc:
+                ca.block.sequential = aset.ad_hoc_sequential
+                if aset.completion_condition is not None or aset.completion_condition_text:
+                    ca.block.completion = self.cond(
+                        aset.completion_condition, aset.completion_condition_text,
+                        aset.location or act.location,
+                        f"AdHocCompletionCondition of activity set {aset.id!r}")
         elif isinstance(body, Event):
             trig = self.event_trigger(body, act)
             if body.position is EventPosition.INTERMEDIATE:

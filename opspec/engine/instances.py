@@ -75,7 +75,7 @@ class Frame:
     """
 
     __slots__ = ("cjoins", "graph", "inst", "joins", "live", "ors", "owed", "owner", "parked",
-                 "running")
+                 "queue", "running")
 
     def __init__(self, graph: CompiledGraph, inst: ProcessInstance,
                  owner: ActivityInstance | None) -> None:
@@ -91,6 +91,7 @@ class Frame:
         # join resets (after it fired; BPMN's "waiting for reset")
         self.cjoins: dict[int, list[int]] = {}
         self.owed: dict[int, set[int]] = {}
+        self.queue: list[int] = []            # sequential ad-hoc sets: starts still to run
 
 
 class ActivityInstance:

@@ -361,6 +361,10 @@ class Interpreter:
         inst = frame.inst
         owner = frame.owner
         if owner is not None:                       # an activity set finished
+            if frame.queue and inst.state == RUNNING:   # a sequential ad-hoc set: the next
+                frame.live += 1
+                self._ready.append((self._start_at, frame, frame.queue.pop(0), None))
+                return
             if frame in inst.frames:
                 inst.frames.remove(frame)
             owner.child = None
@@ -523,11 +527,38 @@ class Interpreter:
 
     def _token_gone(self, frame: Frame) -> None:
         frame.live -= 1
+        if frame.graph.completion is not None and self._ad_hoc_complete(frame):
+            return
         if frame.live <= 0 or frame.ors:
             if frame.live <= 0 and not frame.parked:
                 self._frame_done(frame)
             else:
                 self._pending[frame] = None
+
+    def _ad_hoc_complete(self, frame: Frame) -> bool:
+        """An ad-hoc set's AdHocCompletionCondition holds once one of its paths ended: the
+        activities still running are cancelled, those not started are dropped, and the set
+        completes (BPMN 2.0 ad-hoc subprocess, cancelRemainingInstances)."""
+        condition = frame.graph.completion
+        owner = frame.owner
+        assert condition is not None
+        if owner is None or owner.state != RUNNING:
+            return False
+        inst = frame.inst
+        try:
+            holds = condition(inst.scope, self.env._now)
+        except OpspecError as error:
+            self.abort(inst, owner.act, f"the AdHocCompletionCondition failed: {error.message}")
+            return True
+        if not holds:
+            return False
+        frame.queue.clear()
+        for ai in list(frame.running.values()):
+            self._stop(ai, TERMINATED, "the ad-hoc set's completion condition holds")
+        frame.live = 0
+        frame.parked = 0
+        self._frame_done(frame)
+        return True
 
     def _resolve_frames(self) -> None:
         """OR joins that nothing can reach any more fire; a frame with only parked tokens
@@ -888,7 +919,11 @@ class Interpreter:
             inst.frames.append(frame)
             ai.child = frame
             ai.waiting = f"activity set {act.block.name}"
-            for index in act.block.starts:
+            starts = act.block.starts
+            if act.block.sequential and starts:       # one at a time, in declared order
+                frame.queue = list(starts[1:])
+                starts = starts[:1]
+            for index in starts:
                 frame.live += 1
                 self._ready.append((self._start_at, frame, index, None))
             if not act.block.starts:

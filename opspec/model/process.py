@@ -52,9 +52,16 @@ class Transition(Element):
 
 @dataclass(frozen=True, slots=True, kw_only=True)
 class ActivitySet(Element):
+    """An activity set (embedded subprocess). An *ad hoc* one (BPMN ad-hoc subprocess) runs
+    its activities in parallel or, with ``ad_hoc_sequential``, one at a time, until
+    ``completion_condition`` holds (default: when all have run)."""
+
     activities: tuple[Activity, ...] = ()
     transitions: tuple[Transition, ...] = ()
     ad_hoc: bool = False
+    ad_hoc_sequential: bool = False
+    completion_condition: Expression | None = None
+    completion_condition_text: str | None = None
 
     def activity(self, activity_id: str) -> Activity | None:
         for activity in self.activities:

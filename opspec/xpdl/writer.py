@@ -586,8 +586,13 @@ def _write_activity_sets(parent: etree._Element, sets: tuple[ActivitySet, ...],
         return
     container = _sub(parent, "ActivitySets")
     for activity_set in sets:
+        completion = activity_set.completion_condition_text
+        if completion is None and activity_set.completion_condition is not None:
+            completion = expression_text(activity_set.completion_condition)
         element = _sub(container, "ActivitySet", Id=activity_set.id, Name=activity_set.name,
-                       AdHoc=_bool(True) if activity_set.ad_hoc else None)
+                       AdHoc=_bool(True) if activity_set.ad_hoc else None,
+                       AdHocOrdering="Sequential" if activity_set.ad_hoc_sequential else None,
+                       AdHocCompletionCondition=completion)
         _write_activities(element, activity_set.activities, script_language)
         _write_transitions(element, activity_set.transitions)
 

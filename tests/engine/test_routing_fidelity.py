@@ -280,3 +280,28 @@ def test_a_path_whose_conditions_all_fail_ends_there_without_a_declared_split(
     result = run(spec(tmp_path, acts, trans, integer_field("x", 0)), until=None)
     [fault] = result.summary["faults"]
     assert "no outgoing transition can be taken" in fault["message"]
+
+
+P17 = Path(__file__).parents[1] / "patterns" / "specs" / "p17_interleaved_parallel_routing.xpdl"
+
+
+@pytest.mark.parametrize(("ordering", "b_c_d", "e"), [
+    ("Sequential", ([1.0], [2.0], []), [4.0]),
+    ("Parallel", ([1.0], [1.0], [1.0]), [3.0]),
+])
+def test_an_ad_hoc_set_stops_when_its_completion_condition_holds(
+        tmp_path: Path, ordering: str, b_c_d: tuple[list[float], ...], e: list[float]) -> None:
+    """BPMN 2.0 ad-hoc subprocess: the completion condition is checked after each inner
+    activity; when it holds the rest is cancelled (running) or never started."""
+    text = P17.read_text().replace('AdHocCompletionCondition="done_n == 3"',
+                                   'AdHocCompletionCondition="done_n == 2"')
+    text = text.replace('AdHocOrdering="Sequential"', f'AdHocOrdering="{ordering}"')
+    path = tmp_path / "adhoc.xpdl"
+    path.write_text(text)
+    result = run(path, until=None)
+    assert (starts(result, "B"), starts(result, "C"), starts(result, "D")) == b_c_d
+    assert starts(result, "E") == e
+    withdrawn_or_stopped = [ev.activity for ev in result.trace or ()
+                            if ev.kind == "activity.completed" and ev.activity == "D"]
+    assert withdrawn_or_stopped == []
+    assert completed_at(result) == [e[0] + 1.0]

@@ -157,8 +157,6 @@ def test_wcp16_deferred_choice_runs_only_the_alternative_the_environment_takes(
     assert outcomes(result, "deferred") == ["completed"]
 
 
-@pytest.mark.xfail(strict=True, reason="issue 16: an AdHoc ActivitySet with AdHocOrdering="
-                   "Sequential runs all its activities at once (B, C, D overlap) instead of one at a time")
 def test_wcp17_interleaved_parallel_routing_runs_each_once_never_two_at_a_time() -> None:
     result = run("p17_interleaved_parallel_routing.xpdl")
     spans = sorted((first(result, a, "activity.started"), first(result, a)) for a in "BCD")

@@ -96,7 +96,16 @@ def _activities(element: etree._Element, ctx: BuildContext) -> dict[str, object]
 
 def _activity_set(element: etree._Element, ctx: BuildContext) -> ActivitySet:
     fields = base_fields(element, ctx, kind="ActivitySet")
-    return ActivitySet(ad_hoc=parse_bool(attr(element, "AdHoc")) or False,
+    ad_hoc = parse_bool(attr(element, "AdHoc")) or False
+    ordering = (attr(element, "AdHocOrdering") or "Parallel").lower()
+    if ad_hoc and ordering not in ("parallel", "sequential"):
+        ctx.error(element, "bad-ad-hoc", f"AdHocOrdering {ordering!r} is neither Parallel nor "
+                  "Sequential", "write Parallel or Sequential")
+    completion = attr(element, "AdHocCompletionCondition") if ad_hoc else None
+    return ActivitySet(ad_hoc=ad_hoc, ad_hoc_sequential=ad_hoc and ordering == "sequential",
+                       completion_condition_text=completion,
+                       completion_condition=parse_condition_element(
+                           element, completion, ctx, "AdHocCompletionCondition"),
                        **_activities(element, ctx), **fields)  # type: ignore[arg-type]
 
 
