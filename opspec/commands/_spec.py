@@ -45,20 +45,27 @@ def load_any_spec(path: str | Path) -> Package:
     return package
 
 
+# The code of what the engine's compilation refuses (compile_package's SpecError).
+NOT_RUNNABLE = "not-runnable"
+
+
 def engine_diagnostics(package: Package, *, world: bool = False) -> list[Diagnostic]:
-    """What only the engine and the bindings can judge, as diagnostics: the monitors the
-    spec declares (``bad-monitor``) and, with ``world``, whether its world can be built
-    (``bad-world``: an unknown world, a missing opspec:WorldFile, an unknown parameter, a
+    """What only the engine and the bindings can judge, as diagnostics: whether the engine
+    compiles the package at all (``not-runnable``: what ``run`` would refuse, at its line),
+    the monitors the spec declares (``bad-monitor``) and, with ``world``, whether its world
+    can be built (``bad-world``: an unknown world, a missing opspec:WorldFile, an unknown parameter, a
     value of the wrong type, a start inside an obstacle)."""
     from opspec.engine.compiled import compile_package
     from opspec.engine.monitors import declared_monitors
     from opspec.errors import Diagnostic, OpspecError, Severity, SourceLocation
 
+    spec_file = SourceLocation(str(getattr(package, "source", None) or "<spec>"))
     try:
         compiled = compile_package(package)
-    except OpspecError:
-        return []             # the structural checks report what keeps it from compiling
-    spec_file = SourceLocation(str(getattr(package, "source", None) or "<spec>"))
+    except OpspecError as error:
+        # what the engine refuses, validate refuses: at its line, as the run would say it
+        return [Diagnostic(error.location or spec_file, Severity.ERROR, NOT_RUNNABLE,
+                           error.message, error.hint or "")]
     out: list[Diagnostic] = []
     try:
         declared_monitors(compiled)

@@ -5,8 +5,10 @@ Each problem prints as ``path:line: error: process: message`` with its witness (
 fired from the start) on the next line, then one line per process level and a summary per
 file; ``--json`` prints one JSON object per file instead (JSON Lines).
 
-A spec whose reader reported errors is still checked when a package could be built (its
-conditions do not matter here); the errors are printed first and make the status 1.
+A spec with errors (any that ``opspec validate`` reports: the reader's, the structural checks'
+such as a dangling transition, what the engine refuses to compile) is still explored when a
+package could be built (its conditions do not matter here), but it is never called sound: the
+errors are printed first and make the status 1.
 
 Exit status: 0 every process level is sound; 1 a problem was found, or a spec has errors; 2 usage or I/O problems (a missing path, an unreadable file, an unknown
 ``--process``), or a state space larger than ``--max-states`` with no problem found (the
@@ -80,7 +82,7 @@ def run(args: argparse.Namespace) -> int:
         # conditions are abstracted, so a spec whose errors leave its control flow readable
         # (a condition opspec cannot parse, a duplicate lane id) is still checked
         package = result.package
-        errors = (*errors, *_run_time_errors(package))
+        errors = _spec_errors(package, errors, result.packages)
         processes = [p for p in package.processes
                      if args.process is None or p.id == args.process]
         if args.process is not None and not processes:
@@ -120,14 +122,24 @@ def _with_zero_time_cycles(package: Any, reports: list[SoundnessReport],
     return out
 
 
-def _run_time_errors(package: Any) -> list[Diagnostic]:
-    """What ``opspec validate`` finds that a run would only meet later: a mode Source that
-    is missing or broken, a world that cannot be built (a spec error here, as there)."""
-    from opspec.commands._spec import engine_diagnostics
-    from opspec.xpdl.validate import mode_source_diagnostics
+def _spec_errors(package: Any, load_errors: Sequence[Diagnostic],
+                 packages: Any) -> list[Diagnostic]:
+    """Every error ``opspec validate`` reports, so that a spec validate refuses is never
+    called sound: the reader's, the structural checks' (a dangling transition, an undefined
+    participant…), a mode Source that is missing or broken, a monitor or a world that cannot
+    be built and, when there is no other error, what the engine refuses to compile."""
+    from opspec.commands._spec import NOT_RUNNABLE, engine_diagnostics
+    from opspec.errors import Severity
+    from opspec.model.checks import check_package
+    from opspec.xpdl.validate import merge_diagnostics, mode_source_diagnostics
 
-    world = [d for d in engine_diagnostics(package, world=True) if d.code == "bad-world"]
-    return [*mode_source_diagnostics(package), *world]
+    structural = [d for d in check_package(package, packages=packages) if d.severity is Severity.ERROR]
+    errors = [*load_errors, *structural, *mode_source_diagnostics(package)]
+    engine = [d for d in engine_diagnostics(package, world=True)
+              if d.severity is Severity.ERROR]
+    if errors:          # what keeps the engine from compiling is most likely listed already
+        engine = [d for d in engine if d.code != NOT_RUNNABLE]
+    return list(merge_diagnostics(errors, engine))
 
 
 def _errors_json(errors: Sequence[Diagnostic]) -> list[dict[str, Any]]:
@@ -198,7 +210,8 @@ def _print(path: Path, reports: list[SoundnessReport], errors: Sequence[Diagnost
             print(f"{path}: {report.process}: {verdict} ({report.states} states)")
         sound = sum(1 for r in reports if r.sound)
         warnings = len(problems) - len(failing)
-        print(f"{path}: {sound} of {len(reports)} process level(s) sound, "
+        verdict = "not sound (the spec has errors): " if errors else ""
+        print(f"{path}: {verdict}{sound} of {len(reports)} process level(s) sound, "
               f"{len(failing)} problem(s)" + (f", {warnings} warning(s)" if warnings else "") + (f", {len(errors)} spec error(s) (see "
                                                 "`opspec validate`)" if errors else ""))
     if failing or errors:

@@ -3,9 +3,10 @@
 ``text`` (the default) prints the package header, participants (human or system), pools and
 lanes, and every process with its directives, data, activities (kind, performer, manual or
 automatic, deadlines) and transitions with their conditions. ``dot`` prints a Graphviz digraph
-per process (:mod:`opspec.xpdl.dot`). Exit status: 0 shown (problems of the spec are mentioned
-on stderr; ``opspec validate`` lists them), 1 the file holds no usable package, 2 the file
-cannot be read or the process does not exist.
+per process (:mod:`opspec.xpdl.dot`). Every error ``opspec validate`` finds is printed on
+stderr (the spec is still shown). Exit status: 0 shown, no errors; 1 shown, but the spec has
+errors (or the file holds no usable package); 2 the file cannot be read or the process does
+not exist.
 """
 
 from __future__ import annotations
@@ -49,12 +50,11 @@ def register(subparsers: Any) -> None:
 def run(args: argparse.Namespace) -> int:
     from opspec.errors import Severity
     from opspec.xpdl.dot import package_to_dot
-    from opspec.xpdl.loader import load_package
 
     if str(args.spec).endswith(".wfs"):
         result = _load_script(args.spec)
     else:
-        result = load_package(args.spec)
+        result = _validated(args.spec)
     package = result.package
     if package is None:
         for diagnostic in result.diagnostics:
@@ -66,17 +66,33 @@ def run(args: argparse.Namespace) -> int:
         print(f"opspec show: {args.spec} has no process {args.process!r} (processes: {known})",
               file=sys.stderr)
         return 2
-    errors = sum(1 for d in result.diagnostics if d.severity is Severity.ERROR)
+    errors = [d for d in result.diagnostics if d.severity is Severity.ERROR]
+    for diagnostic in errors:
+        print(diagnostic, file=sys.stderr)
     if errors:
-        print(f"opspec show: {args.spec} has {errors} error{'s' * (errors != 1)}; "
-              f"run 'opspec validate {args.spec}' for the list", file=sys.stderr)
+        count = len(errors)
+        print(f"opspec show: {args.spec} has {count} error{'s' * (count != 1)} (listed above, "
+              f"as 'opspec validate {args.spec}' reports them); it cannot run",
+              file=sys.stderr)
     if not package.processes:
         print(f"opspec show: {args.spec} declares no process", file=sys.stderr)
     if args.format == "dot":
         sys.stdout.write(package_to_dot(package, process=args.process))
     else:
         sys.stdout.write(describe_package(package, process=args.process))
-    return 0
+    return 1 if errors else 0
+
+
+def _validated(path: str) -> Any:
+    """The XPDL file ``path`` loaded as ``opspec validate`` loads it, as a
+    :class:`~opspec.xpdl.loader.LoadResult` whose diagnostics are every one validate reports
+    (the reader's, the structural checks', what the engine refuses)."""
+    from opspec.commands.validate import engine_checks
+    from opspec.xpdl.loader import LoadResult
+    from opspec.xpdl.validate import validate_spec
+
+    package, report = validate_spec(path, extra=engine_checks)
+    return LoadResult(package, report.diagnostics)
 
 
 def _load_script(path: str) -> Any:

@@ -27,6 +27,7 @@ pytestmark = pytest.mark.filterwarnings("ignore::DeprecationWarning")
 ROOT = Path(__file__).resolve().parents[2]
 DISPENSER = ROOT / "specs" / "medication_dispenser.xpdl"
 DATA = Path(__file__).parent / "data"
+CORPUS = Path(__file__).resolve().parents[3] / "shared" / "corpus" / "xpdl"
 
 
 def _graphs(text: str) -> list[object]:
@@ -77,12 +78,26 @@ def test_show_of_a_missing_or_broken_file(capsys: pytest.CaptureFixture[str]) ->
     assert "not well-formed XML" in capsys.readouterr().err
 
 
-def test_show_of_a_spec_with_errors_still_shows_it_and_says_so(
+def test_show_of_a_spec_with_errors_still_shows_it_lists_them_and_exits_1(
         capsys: pytest.CaptureFixture[str]) -> None:
-    assert main(["show", str(DATA / "bad_condition.xpdl")]) == 0
+    assert main(["show", str(DATA / "bad_condition.xpdl")]) == 1
     captured = capsys.readouterr()
     assert "Process 'Pump'" in captured.out
-    assert "has 1 error; run 'opspec validate" in captured.err
+    assert f"{DATA / 'bad_condition.xpdl'}:24: error: transition condition 'n >>> ('" in (
+        captured.err)
+    assert "has 1 error (listed above" in captured.err
+
+
+def test_show_lists_the_structural_errors_validate_finds(
+        capsys: pytest.CaptureFixture[str]) -> None:
+    spec = CORPUS / "g360__Subprocess4_with_exception.xpdl"
+    if not spec.is_file():
+        pytest.skip("corpus not available")
+    assert main(["validate", str(spec)]) == 1
+    expected = [line for line in capsys.readouterr().out.splitlines() if ": error: " in line]
+    assert main(["show", str(spec)]) == 1
+    listed = [line for line in capsys.readouterr().err.splitlines() if ": error: " in line]
+    assert listed == expected and len(listed) == 6
 
 
 def test_dot_has_one_digraph_per_process_that_parses(
