@@ -542,8 +542,9 @@ class _Compiler:
             lanes.append(proc_lane)
         ca.lanes = tuple(dict.fromkeys(lanes))
         ca.lane = proc_lane or (lanes[0] if lanes else None)
-        participant = self.participants.get(ca.participant or "") or next(
-            (p for p in proc.participants if p.id == ca.participant), None)
+        # a process-level Participant hides a package-level one with its Id
+        participant = next((p for p in proc.participants if p.id == ca.participant),
+                           None) or self.participants.get(ca.participant or "")
         ca.user_lane = any(n.lower() in _USER_LANES for n in ca.lanes) or bool(
             participant is not None and participant.is_human)
         # kind
@@ -713,8 +714,9 @@ class _Compiler:
 
     def tool(self, proc: WorkflowProcess, act: Activity, call: TaskApplication) -> CTool:
         """One application call of a task: its parameters and, for a script, its statements."""
-        app = self.package.application(call.application) or next(
-            (a for a in proc.applications if a.id == call.application), None)
+        # XPDL scoping: a process-level Application hides a package-level one with its Id
+        app = next((a for a in proc.applications if a.id == call.application),
+                   None) or self.package.application(call.application)
         formals = app.formal_parameters if app is not None else ()
         params = self.params(call.actual_parameters, formals, act,
                              f"application {call.application!r}")

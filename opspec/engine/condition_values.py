@@ -173,18 +173,49 @@ def ordered(a: Any, b: Any, op: str) -> bool:
 def _add(a: Any, b: Any) -> Any:
     if isinstance(a, str) or isinstance(b, str):
         return _text(a) + _text(b)
+    if isinstance(a, _VECTORS) or isinstance(b, _VECTORS):
+        return _elementwise(a, b, "+", operator.add, scalar=False)
     return as_number(a, "'+'") + as_number(b, "'+'")
 
 
 def _subtract(a: Any, b: Any) -> Any:
+    if isinstance(a, _VECTORS) or isinstance(b, _VECTORS):
+        return _elementwise(a, b, "-", operator.sub, scalar=False)
     return as_number(a, "'-'") - as_number(b, "'-'")
 
 
 def _multiply(a: Any, b: Any) -> Any:
+    if isinstance(a, _VECTORS) or isinstance(b, _VECTORS):
+        return _elementwise(a, b, "*", operator.mul, scalar=True)
     return as_number(a, "'*'") * as_number(b, "'*'")
 
 
-def _divide(a: Any, b: Any) -> float:
+_VECTORS = (tuple, list)
+
+
+def _elementwise(a: Any, b: Any, op: str, fn: Callable[[Any, Any], Any], *,
+                 scalar: bool) -> tuple[Any, ...]:
+    """Vector arithmetic (array data, e.g. poses): vector op vector of the same length, and
+    for '*' and '/' a number and a vector (each element scaled)."""
+    what = f"'{op}'"
+    if isinstance(a, _VECTORS) and isinstance(b, _VECTORS):
+        if len(a) != len(b):
+            raise Problem(f"cannot {what} vectors of lengths {len(a)} and {len(b)}")
+        return tuple(fn(as_number(x, what), as_number(y, what)) for x, y in zip(a, b))
+    if not scalar:
+        raise Problem(f"{what} needs two numbers or two vectors, got {_show(a)} and {_show(b)}")
+    if isinstance(a, _VECTORS):
+        k = as_number(b, what)
+        return tuple(fn(as_number(x, what), k) for x in a)
+    k = as_number(a, what)
+    return tuple(fn(k, as_number(y, what)) for y in b)
+
+
+def _divide(a: Any, b: Any) -> Any:
+    if isinstance(a, _VECTORS) and not isinstance(b, _VECTORS):
+        if as_number(b, "'/'") == 0:
+            raise Problem(f"division by zero ({_text(a)} / {_text(b)})")
+        return _elementwise(a, b, "/", operator.truediv, scalar=True)
     x, y = as_number(a, "'/'"), as_number(b, "'/'")
     if y == 0:
         raise Problem(f"division by zero ({_text(a)} / {_text(b)})")

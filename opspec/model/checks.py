@@ -82,13 +82,33 @@ def check_process(
     return report.diagnostics
 
 
+def _parameter_fields(process: WorkflowProcess, report: Reporter, scope: str) -> None:
+    """A DataField with the Id of a FormalParameter of the same process is that parameter
+    (one variable, as the WfMC sample engines and Shark treat them): a warning, not an
+    error. The data field's initial value is the default, the caller's value replaces it."""
+    formals = {f.id: f for f in process.formal_parameters if f.id}
+    for data_field in process.data_fields:
+        formal = formals.get(data_field.id)
+        if formal is None:
+            continue
+        line = formal.location.line if formal.location is not None else None
+        at = f" (line {line})" if line is not None else ""
+        report.warning(
+            data_field, "parameter-data-field",
+            f"data field {data_field.id!r} has the Id of formal parameter {formal.id!r}{at} "
+            f"of {scope}: opspec treats them as one variable (the data field's initial value "
+            "until the caller's value replaces it), as the WfMC sample engines do",
+            f"delete the data field, or rename it if it is meant to be a separate variable")
+
+
 def _check_process(process: WorkflowProcess, package: Package, refs: RefChecks,
                    report: Reporter) -> None:
     scope = where(process, None)
     report.duplicates(process.participants, "participant", scope)
     report.duplicates(process.applications, "application", scope)
-    report.duplicates([*process.formal_parameters, *process.data_fields],
-                      "data field or formal parameter", scope)
+    report.duplicates(process.formal_parameters, "formal parameter", scope)
+    report.duplicates(process.data_fields, "data field", scope)
+    _parameter_fields(process, report, scope)
     report.duplicates(process.activity_sets, "activity set", scope)
     refs.process(process)
     used_sets: set[str] = set()

@@ -233,3 +233,18 @@ def test_data_can_be_any_mapping() -> None:
     assert compile_condition(parse_expression("a == 1"))(data, 0.0) is True
     with pytest.raises(ExecutionError, match="'b' does not exist"):
         compile_condition(parse_expression("b == 1"))(data, 0.0)
+
+
+@pytest.mark.parametrize(("text", "expected"), [
+    ("a + b", (11.0, 22.0)), ("b - a", (9.0, 18.0)), ("2 * a", (2.0, 4.0)),
+    ("a * 2", (2.0, 4.0)), ("b / 10", (1.0, 2.0)), ("1 * a + 2 * b", (21.0, 42.0)),
+])
+def test_arithmetic_on_arrays_is_element_wise(run: Runner, text: str,
+                                              expected: tuple[float, ...]) -> None:
+    assert run(text, {"a": (1.0, 2.0), "b": [10.0, 20.0]}) == expected
+
+
+@pytest.mark.parametrize("text", ["a + c", "a + 1", "a / a"])
+def test_array_arithmetic_that_has_no_meaning_is_an_error(run: Runner, text: str) -> None:
+    with pytest.raises(ExecutionError):
+        run(text, {"a": (1.0, 2.0), "c": (1.0, 2.0, 3.0)})
