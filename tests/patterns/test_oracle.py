@@ -51,16 +51,12 @@ def oracle_run(python: Path, path: Path, process: str, args: list | None = None)
     return result
 
 
-REFUSES_PUBLICATION = pytest.mark.xfail(strict=True, reason="issue 16: opspec refuses the WfMC "
-                                        "publication sample at load (activity 'prepare' passes 0 "
-                                        "actual parameters to an application with 1 formal); shoobx runs it")
 REFUSES_DEADLINE = pytest.mark.xfail(strict=True, reason="issue 16: opspec refuses the WfMC deadline "
                                      "sample at load (a Python 'timedelta(...)' Deadline expression); "
                                      "shoobx runs it")
 WFMC = [
     pytest.param("wfmc__subflow.xpdl", "mainflow", [], id="subflow"),
-    pytest.param("wfmc__publication-1.0.xpdl", "Publication", ["bob"], id="publication",
-                 marks=REFUSES_PUBLICATION),
+    pytest.param("wfmc__publication-1.0.xpdl", "Publication", ["bob"], id="publication"),
     pytest.param("wfmc__deadline.xpdl", "deadline", [], id="deadline", marks=REFUSES_DEADLINE),
 ]
 
