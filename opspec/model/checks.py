@@ -23,6 +23,7 @@ from opspec.model.activities import (
     BlockActivity,
     Deadline,
     Event,
+    Execution,
     GatewayType,
     LoopKind,
     Reference,
@@ -98,7 +99,7 @@ def _parameter_fields(process: WorkflowProcess, report: Reporter, scope: str) ->
             f"data field {data_field.id!r} has the Id of formal parameter {formal.id!r}{at} "
             f"of {scope}: opspec treats them as one variable (the data field's initial value "
             "until the caller's value replaces it), as the WfMC sample engines do",
-            f"delete the data field, or rename it if it is meant to be a separate variable")
+            "delete the data field, or rename it if it is meant to be a separate variable")
 
 
 def _check_process(process: WorkflowProcess, package: Package, refs: RefChecks,
@@ -298,6 +299,18 @@ def _deadlines(scope: str, activity: Activity, outgoing: Sequence[Transition],
         if handled:
             continue
         caught = f"exception {name!r}" if name else "its exception"
+        if deadline.execution is Execution.ASYNCHR:
+            # an asynchronous deadline lets the activity run on: unhandled, it does nothing
+            report.warning(
+                deadline.location or activity.location or activity, "unhandled-deadline",
+                f"activity {activity.id!r} in {scope} has an asynchronous deadline "
+                f"({deadline.duration_text}) but no EXCEPTION or DEFAULTEXCEPTION transition "
+                f"catches {caught}: when it expires the activity runs on and nothing else "
+                "happens (an engine's own handler, e.g. a Bonita deadline hook, is not run)",
+                "add a transition out of the activity with <Condition Type=\"EXCEPTION\">"
+                f"{name or ''}</Condition> for the path to start beside it, or delete the "
+                "deadline")
+            continue
         report.error(
             deadline.location or activity.location or activity, "deadline-without-exception-path",
             f"activity {activity.id!r} in {scope} has a deadline ({deadline.duration_text}) but "

@@ -41,20 +41,26 @@ class RefChecks:
 
     # -- package level -----------------------------------------------------------------
     def pools(self) -> None:
-        processes = {p.id for p in self.package.processes}
+        processes = {p.id: p for p in self.package.processes}
         for pool in self.package.pools:
             if pool.process and pool.process not in processes:
                 self.report.warning(
                     pool, "undefined-process",
                     f"pool {pool.id!r} belongs to process {pool.process!r}, which is not in "
                     f"package {self.package.id!r}", "fix the pool's Process attribute")
+            # a lane may name a participant (or performer field) of its pool's own process
+            own = processes.get(pool.process or "")
+            local = set() if own is None else {p.id for p in own.participants} | {
+                f.id for f in own.data_fields if _is_performer(f.type)}
+            known = self.participants | self.performer_fields | local
             for lane in pool.all_lanes():
                 for performer in lane.performers:
-                    if performer not in self.participants | self.performer_fields:
+                    if performer not in known:
+                        inside = f"process {own.id!r}, " if own is not None else ""
                         self.report.error(
                             lane, "undefined-participant",
                             f"lane {lane.id!r} of pool {pool.id!r} names performer "
-                            f"{performer!r}, which is not a participant of package "
+                            f"{performer!r}, which is not a participant of {inside}package "
                             f"{self.package.id!r} or its external packages",
                             f"declare a Participant {performer!r} or fix the lane's Performer")
 
