@@ -18,7 +18,7 @@ from opspec.errors import Diagnostic, Severity, SourceLocation, SpecError
 from opspec.model.package import Package
 from opspec.xpdl.handlers import BuildContext, build_package
 from opspec.xpdl.normalize import normalize
-from opspec.xpdl.reader import DEFAULT_MAX_BYTES, XmlReadError, read_file, read_tree
+from opspec.xpdl.reader import DEFAULT_MAX_BYTES, XmlReadError, exact_lines, read_file, read_tree
 from opspec.xpdl.resolve import resolve
 
 __all__ = ["LoadResult", "load_package", "load_spec", "parse_bytes"]
@@ -67,7 +67,8 @@ def _build(data: bytes, path: str, max_bytes: int) -> tuple[Package | None, list
         return None, [error.diagnostic()]
     ctx = BuildContext(path=path, version=outcome.version, diagnostics=list(outcome.warnings))
     try:
-        package = build_package(normalize(outcome.root), ctx)
+        with exact_lines(outcome):           # lines past 65,534 (libxml2 stores 16 bits)
+            package = build_package(normalize(outcome.root), ctx)
     except (MemoryError, KeyboardInterrupt):
         raise
     except Exception as error:  # noqa: BLE001 - a user never sees a traceback (issue 2)

@@ -32,6 +32,7 @@ from __future__ import annotations
 from lxml import etree
 
 from opspec.xpdl.namespaces import CANONICAL, is_xpdl_namespace, qname
+from opspec.xpdl.reader import copy_line
 
 __all__ = ["normalize"]
 
@@ -85,7 +86,7 @@ def _tools_to_tasks(index: _Index) -> None:
         if not tools:
             continue
         task = etree.Element(_q("Task"))
-        task.sourceline = tools[0].sourceline
+        copy_line(tools[0], task)
         tools[0].addprevious(task)
         for tool in tools:
             tool.tag = _q("TaskApplication")
@@ -101,7 +102,7 @@ def _performers(index: _Index) -> None:
             performers = owner.find(_q("Performers"))
             if performers is None:
                 performers = etree.Element(_q("Performers"))
-                performers.sourceline = loose[0].sourceline
+                copy_line(loose[0], performers)
                 loose[0].addprevious(performers)
             for performer in loose:
                 performers.append(performer)
@@ -150,7 +151,7 @@ def _conditions(index: _Index) -> None:
         if text is not None and text.strip():
             expression = etree.SubElement(condition, _q("Expression"))
             expression.text = text
-            expression.sourceline = condition.sourceline
+            copy_line(condition, expression)
             condition.text = None
 
 

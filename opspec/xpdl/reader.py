@@ -18,9 +18,16 @@ Contract:
 
 from __future__ import annotations
 
+import bisect
+import itertools
 import os
 import re
-from dataclasses import dataclass
+import stat
+import xml.parsers.expat
+from collections.abc import Iterator, Mapping
+from contextlib import contextmanager
+from contextvars import ContextVar
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import BinaryIO, Final
 
@@ -35,8 +42,11 @@ __all__ = [
     "MAX_BYTES_VARIABLE",
     "ReadOutcome",
     "XmlReadError",
+    "copy_line",
     "effective_max_bytes",
+    "exact_lines",
     "line_of",
+    "not_a_file",
     "read_file",
     "read_limited",
     "read_tree",
@@ -49,7 +59,10 @@ DEFAULT_MAX_BYTES: Final = 64 * 1024 * 1024
 #: (``OPSPEC_MAX_SPEC_BYTES=200000000 opspec validate big.xpdl``; docs/validation.md).
 MAX_BYTES_VARIABLE: Final = "OPSPEC_MAX_SPEC_BYTES"
 
-# libxml2 stores line numbers in 16 bits for some nodes: from 65,535 on they are not trustworthy.
+# libxml2 stores an element's line number in 16 bits: from 65,535 on, lxml's ``sourceline`` is
+# a guess (libxml2's XML_PARSE_BIG_LINES borrows the line of a neighbouring text node, which is
+# where that text *ends*). The reader finds the exact lines of such elements itself (see
+# :func:`_big_lines`) and :func:`line_of` looks them up.
 _LAST_TRUSTED_LINE: Final = 65534
 _CHUNK: Final = 1024 * 1024
 
@@ -78,19 +91,60 @@ class XmlReadError(SpecError):
 
 @dataclass(frozen=True, slots=True)
 class ReadOutcome:
-    """A parsed file: its root element, its version and non-fatal reading warnings."""
+    """A parsed file: its root element, its version and non-fatal reading warnings.
+
+    ``lines`` holds the exact line of every element past line 65,534 (empty for shorter
+    files); :func:`line_of` consults it inside :func:`exact_lines`."""
 
     root: etree._Element
     version: XpdlVersion
     warnings: tuple[Diagnostic, ...] = ()
+    lines: Mapping[etree._Element, int] = field(default_factory=dict)
+
+
+# The exact lines of the tree being built (set by :func:`exact_lines`; one per context, so
+# threads and nested loads do not mix them up).
+_EXACT: ContextVar[dict[etree._Element, int] | None] = ContextVar("opspec_exact_lines",
+                                                                  default=None)
+
+
+@contextmanager
+def exact_lines(outcome: ReadOutcome) -> Iterator[None]:
+    """Within this block, :func:`line_of` gives the exact line of the elements of
+    ``outcome`` that lie past line 65,534 (and of elements :func:`copy_line` gave a line)."""
+    token = _EXACT.set(dict(outcome.lines))
+    try:
+        yield
+    finally:
+        _EXACT.reset(token)
 
 
 def line_of(element: object) -> int | None:
-    """The 1-based line of an lxml element, or ``None`` when unknown or untrustworthy."""
+    """The 1-based line of an lxml element, or ``None`` when unknown or untrustworthy.
+
+    Lines up to 65,534 come from libxml2; later ones from the reader's own count, inside
+    :func:`exact_lines` (outside it they are ``None``: libxml2 only guesses them)."""
     line = getattr(element, "sourceline", None)
     if isinstance(line, int) and 0 < line <= _LAST_TRUSTED_LINE:
         return line
+    exact = _EXACT.get()
+    if exact is not None and line is not None:
+        return exact.get(element)  # type: ignore[call-overload, unused-ignore]
     return None
+
+
+def copy_line(source: etree._Element, target: etree._Element) -> None:
+    """Give ``target`` (an element made while normalising) the line of ``source``."""
+    line = line_of(source)
+    if line is None:
+        return
+    if line <= _LAST_TRUSTED_LINE:
+        target.sourceline = line
+        return
+    exact = _EXACT.get()
+    if exact is not None:
+        target.sourceline = 65535          # past libxml2's range: look it up
+        exact[target] = line
 
 
 def _parser(encoding: str | None = None) -> etree.XMLParser:
@@ -144,18 +198,75 @@ def read_limited(stream: BinaryIO, *, path: str, max_bytes: int = DEFAULT_MAX_BY
         chunks.append(chunk)
 
 
+def not_a_file(path: str | os.PathLike[str]) -> str | None:
+    """Why ``path`` cannot be read as a specification without even opening it (``"it does not
+    exist"``, ``"it is a folder"``, ``"it is a named pipe (FIFO), not a regular file"``…), or
+    ``None`` for a regular file (or a link to one). Never blocks: nothing is opened."""
+    try:
+        mode = os.stat(path).st_mode
+    except FileNotFoundError:
+        return "it does not exist"
+    except OSError as error:
+        return f"it cannot be examined: {error.strerror or type(error).__name__}"
+    if stat.S_ISREG(mode):
+        return None
+    if stat.S_ISDIR(mode):
+        return "it is a folder"
+    kind = ("a named pipe (FIFO)" if stat.S_ISFIFO(mode)
+            else "a character device" if stat.S_ISCHR(mode)
+            else "a block device" if stat.S_ISBLK(mode)
+            else "a socket" if stat.S_ISSOCK(mode)
+            else "a special file")
+    return f"it is {kind}, not a regular file"
+
+
+def _open_regular(path: str | Path) -> BinaryIO:
+    """Open a regular file for reading; an :class:`OSError` for anything else. Pipes and
+    devices are refused before they are opened, and the file is opened non-blocking and
+    checked again, so a path swapped for a FIFO in between cannot block either."""
+    reason = not_a_file(path)
+    if reason is not None:
+        raise _NotRegular(reason)
+    flags = os.O_RDONLY | getattr(os, "O_NONBLOCK", 0) | getattr(os, "O_BINARY", 0)
+    descriptor = os.open(path, flags)
+    try:
+        if not stat.S_ISREG(os.fstat(descriptor).st_mode):
+            raise _NotRegular("it is not a regular file")
+        return os.fdopen(descriptor, "rb")
+    except BaseException:
+        os.close(descriptor)
+        raise
+
+
+class _NotRegular(OSError):
+    """A path that is not a regular file (its ``strerror`` says what it is)."""
+
+    def __init__(self, reason: str) -> None:
+        super().__init__(reason)
+        self.strerror = reason
+
+
 def read_file(path: str | Path, *, max_bytes: int = DEFAULT_MAX_BYTES) -> bytes:
-    """The bytes of a file, checking its size before reading it."""
+    """The bytes of a regular file, checking its size before reading it. Folders, pipes,
+    devices and sockets are refused (``io-error``) without blocking."""
     shown = str(path)
     max_bytes = effective_max_bytes(max_bytes, path=shown)
     try:
-        size = Path(path).stat().st_size
-        if size > max_bytes:
-            raise _too_big(shown, max_bytes)
-        with open(path, "rb") as stream:
+        with _open_regular(path) as stream:
+            size = os.fstat(stream.fileno()).st_size
+            if size > max_bytes:
+                raise _too_big(shown, max_bytes)
             return read_limited(stream, path=shown, max_bytes=max_bytes)
     except XmlReadError:
         raise
+    except _NotRegular as error:
+        raise XmlReadError(
+            "io-error",
+            f"cannot read the file: {error.strerror}",
+            location=SourceLocation(shown),
+            hint="give the path of an XPDL file; specs are not read from folders, pipes or "
+            "devices",
+        ) from None
     except OSError as error:
         reason = error.strerror or type(error).__name__
         raise XmlReadError(
@@ -222,7 +333,40 @@ def _is_encoding_error(error: etree.XMLSyntaxError) -> bool:
     return "encoding" in text or "utf-8" in text or "char 0x" in text
 
 
-def _parse(data: bytes, path: str) -> tuple[etree._Element, list[Diagnostic]]:
+def _first_bad_utf8(data: bytes) -> tuple[int, int] | None:
+    """The 1-based line and the value of the first byte that is not valid UTF-8."""
+    try:
+        data.decode("utf-8")
+    except UnicodeDecodeError as error:
+        return data.count(b"\n", 0, error.start) + 1, data[error.start]
+    return None
+
+
+def _encoding_warning(data: bytes, path: str, declared: str | None, line: int | None
+                      ) -> Diagnostic:
+    bad = _first_bad_utf8(data)
+    where = f" (line {bad[0]}: byte 0x{bad[1]:02X})" if bad else ""
+    if bad:
+        line = bad[0]
+    if declared == "utf-8":
+        message = (f"the file declares UTF-8 but is not valid UTF-8{where}; read it as Latin-1")
+        hint = ("save the file as UTF-8, or make its XML declaration name the encoding it "
+                "really uses (e.g. encoding=\"ISO-8859-1\")")
+    elif declared in _ASCII_NAMES:
+        message = (f"the file declares {declared.upper()} but holds bytes that are neither "
+                   f"ASCII nor UTF-8{where}; read it as Latin-1")
+        hint = "add an XML declaration naming the real encoding, or save the file as UTF-8"
+    else:
+        message = (f"the file is not valid UTF-8{where} and declares no other encoding; "
+                   "read it as Latin-1")
+        hint = "add an XML declaration naming the real encoding, or save the file as UTF-8"
+    return Diagnostic(SourceLocation(path, line), Severity.WARNING, "encoding-guessed",
+                      message, hint)
+
+
+def _parse(data: bytes, path: str) -> tuple[etree._Element, list[Diagnostic], str | None]:
+    """The root, the reading warnings, and the encoding the parser was told to use (``None``:
+    the file's own)."""
     warnings: list[Diagnostic] = []
     declared = _declared_encoding(data)
     utf16 = data.startswith((b"\xff\xfe", b"\xfe\xff"))
@@ -230,7 +374,7 @@ def _parse(data: bytes, path: str) -> tuple[etree._Element, list[Diagnostic]]:
     # of ASCII, so reading them as UTF-8 loses nothing and accepts the real content.
     first = "utf-8" if declared in _ASCII_NAMES else None
     try:
-        return etree.fromstring(data, _parser(first)), warnings
+        return etree.fromstring(data, _parser(first)), warnings, first
     except etree.XMLSyntaxError as error:
         if _has_doctype(data):
             raise _doctype_error(path, _doctype_line(data) or error.lineno) from None
@@ -242,16 +386,63 @@ def _parse(data: bytes, path: str) -> tuple[etree._Element, list[Diagnostic]]:
         root = etree.fromstring(data, _parser("iso-8859-1"))
     except etree.XMLSyntaxError:
         raise _not_well_formed(path, original) from None
-    warnings.append(
-        Diagnostic(
-            SourceLocation(path, original.lineno or None),
-            Severity.WARNING,
-            "encoding-guessed",
-            "the file is not valid UTF-8 and declares no other encoding; read it as Latin-1",
-            "add an XML declaration naming the real encoding, or save the file as UTF-8",
-        )
-    )
-    return root, warnings
+    warnings.append(_encoding_warning(data, path, declared, original.lineno or None))
+    return root, warnings, "iso-8859-1"
+
+
+# The rest of a start tag after its "<": what lies outside quotes, then the closing ">".
+_START_TAG_REST = re.compile(rb"""(?:[^>"']+|"[^"]*"|'[^']*')*>""")
+# Elements starting this many lines before the last trusted one are looked up too (a start tag
+# spanning lines can begin below it and end past it).
+_MARGIN: Final = 1000
+
+
+def _big_lines(data: bytes, root: etree._Element, encoding: str | None
+               ) -> dict[etree._Element, int]:
+    """The exact line of every element past libxml2's 16-bit line numbers, found by a second,
+    counting-only parse with expat paired with the tree in document order; empty for short
+    files, or when the two parsers do not see the same elements (then such lines are unknown,
+    as libxml2 leaves them).
+
+    The line given is that of the start tag's closing ``>``, as libxml2 gives below 65,535."""
+    if data.count(b"\n") < _LAST_TRUSTED_LINE:
+        return {}
+    from array import array
+
+    lines = array("q")
+    offsets = array("q")
+    parser = xml.parsers.expat.ParserCreate(encoding)
+
+    def start(_name: str, _attributes: object) -> None:
+        lines.append(parser.CurrentLineNumber)
+        offsets.append(parser.CurrentByteIndex)
+
+    parser.StartElementHandler = start
+    try:
+        parser.Parse(data, True)
+    except (xml.parsers.expat.ExpatError, ValueError, LookupError, UnicodeError):
+        return {}
+    byte_lines = not data.startswith((b"\xff\xfe", b"\xfe\xff", b"\x00<", b"<\x00"))
+    first = bisect.bisect_right(lines, _LAST_TRUSTED_LINE - _MARGIN)
+    elements = root.iter(etree.Element)
+    skipped = sum(1 for _ in itertools.islice(elements, first))
+    if skipped != first:
+        return {}
+    exact: dict[etree._Element, int] = {}
+    for index in range(first, len(lines)):
+        element = next(elements, None)
+        if element is None:
+            return {}
+        line = lines[index]
+        if byte_lines:
+            at = offsets[index]
+            end = _START_TAG_REST.match(data, at + 1)
+            if end is not None:
+                line += data.count(b"\n", at, end.end())
+        exact[element] = line
+    if next(elements, None) is not None:
+        return {}
+    return exact
 
 
 # libxml2's safety limits (huge_tree=False) and what they mean for a spec's author: a
@@ -311,7 +502,7 @@ def read_tree(data: bytes, *, path: str, max_bytes: int = DEFAULT_MAX_BYTES) -> 
             hint="validate the XPDL it was compiled from; opspec show, run and evaluate "
             "read .wfs scripts directly",
         )
-    root, warnings = _parse(data, path)
+    root, warnings, encoding = _parse(data, path)
     tree = root.getroottree()
     if tree.docinfo.doctype or tree.docinfo.internalDTD is not None:
         raise _doctype_error(path, _doctype_line(data) or 1)
@@ -333,7 +524,7 @@ def read_tree(data: bytes, *, path: str, max_bytes: int = DEFAULT_MAX_BYTES) -> 
             location=SourceLocation(path, line),
             hint=f"use one of {known}, or no namespace",
         )
-    return ReadOutcome(root, version, tuple(warnings))
+    return ReadOutcome(root, version, tuple(warnings), _big_lines(data, root, encoding))
 
 
 def read_xml(
