@@ -16,6 +16,7 @@ from opspec.xpdl.handlers.common import (
     grandchildren,
 )
 from opspec.xpdl.handlers.data import build_data_field, build_type_declaration
+from opspec.xpdl.handlers.field_names import resolve_field_names
 from opspec.xpdl.handlers.process import build_process
 from opspec.xpdl.handlers.resources import build_application, build_participant, build_pool
 from opspec.xpdl.sisarl import package_extensions
@@ -55,7 +56,7 @@ def build_package(element: etree._Element, ctx: BuildContext) -> Package:
     fields = base_fields(element, ctx, kind="Package", id_default=stem)
     conformance = child(element, "ConformanceClass")
     script = child(element, "Script")
-    return Package(
+    package = Package(
         version=ctx.version,
         source=ctx.path,
         header=_header(child(element, "PackageHeader")),
@@ -76,3 +77,5 @@ def build_package(element: etree._Element, ctx: BuildContext) -> Package:
         **package_extensions(element, ctx),
         **fields,
     )
+    # TIBCO-style conditions name fields by Name: read as their Ids, with a warning
+    return resolve_field_names(package, ctx.diagnostics)
