@@ -51,6 +51,17 @@ def build_condition(element: etree._Element | None, ctx: BuildContext) -> Condit
     if kind is ConditionKind.CONDITION:
         if text is None:
             return Condition()  # CONDITION with nothing written: unconditional
+        grammar = attr(expression, "ScriptGrammar") if expression is not None else None
+        if grammar is not None and grammar.strip().lower() == "text":
+            # TIBCO's free-text conditions: a label for people, not an expression
+            ctx.warning(element, "text-condition",
+                        f"condition {text!r} is written with ScriptGrammar=\"Text\": a label, "
+                        "not an expression, so the transition is unconditional (at an XOR split "
+                        "whose branches all lead to manual activities of one performer, the "
+                        "performer chooses; otherwise the first unconditional branch is taken)",
+                        "write the condition as an expression over data fields (and drop "
+                        "ScriptGrammar=\"Text\") for opspec to decide the branch")
+            return Condition(text=text)
         parsed = parse_condition_element(expression if expression is not None else element,
                                          text, ctx, "transition condition")
         return Condition(kind=kind, text=text, expression=parsed)
