@@ -9,12 +9,18 @@ Contract:
   Ids of the calling package) or by relative href;
 - reference cycles are reported (``package-cycle``, ``subflow-cycle``) naming the cycle, never
   followed forever: every file is loaded at most once and graph walks are iterative;
-- a missing file is an error at the file:line of the reference.
+- a missing file is an error at the file:line of the reference;
+- files are read only inside the folder tree of the root spec (the folder of the file given to
+  opspec, and every folder below it) and the folders listed in the environment variable
+  :data:`EXTERNAL_PATH_VARIABLE`; an href that leads elsewhere (``/etc/passwd``,
+  ``../../secrets.xpdl``, a link pointing out of the tree) is refused with
+  ``external-package-outside`` before the file is even looked at.
 """
 
 from __future__ import annotations
 
-from collections.abc import Callable, Iterator
+import os
+from collections.abc import Callable, Iterator, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -25,7 +31,12 @@ from opspec.model.activities import Execution, GatewayType, SubFlow
 from opspec.model.package import ExternalPackage, Package
 from opspec.model.process import ConditionKind, Transition, WorkflowProcess
 
-__all__ = ["Loader", "Resolution", "resolve"]
+__all__ = ["EXTERNAL_PATH_VARIABLE", "Loader", "Resolution", "allowed_roots", "outside_roots",
+           "resolve"]
+
+#: Folders, besides the root spec's own folder tree, whose files specs may refer to (separated
+#: by ``os.pathsep``: ``OPSPEC_EXTERNAL_PATH=/opt/xpdl-lib:/srv/shared``; docs/validation.md).
+EXTERNAL_PATH_VARIABLE = "OPSPEC_EXTERNAL_PATH"
 
 #: Loads one file: ``(package or None, diagnostics)``; never raises.
 Loader = Callable[[Path], tuple[Package | None, list[Diagnostic]]]
@@ -41,6 +52,8 @@ class Resolution:
     packages: dict[str, Package] = field(default_factory=dict)
     paths: dict[Path, str] = field(default_factory=dict)     # file -> package id
     diagnostics: list[Diagnostic] = field(default_factory=list)
+    roots: tuple[Path, ...] = ()                              # where files may be read
+    refused: set[str] = field(default_factory=set)            # PackageRefs outside the roots
 
     def error(self, location: SourceLocation | None, code: str, message: str, hint: str,
               severity: Severity = Severity.ERROR) -> None:
@@ -53,6 +66,34 @@ def _key(path: Path) -> Path:
         return path.resolve()
     except (OSError, RuntimeError):
         return path.absolute()
+
+
+def allowed_roots(root_path: Path) -> tuple[Path, ...]:
+    """The folders whose files a spec in ``root_path`` may refer to: its own folder and those
+    listed in :data:`EXTERNAL_PATH_VARIABLE` (each with every folder below it)."""
+    roots = [_key(root_path).parent]
+    for entry in os.environ.get(EXTERNAL_PATH_VARIABLE, "").split(os.pathsep):
+        if entry.strip():
+            roots.append(_key(Path(entry.strip()).expanduser()))
+    return tuple(dict.fromkeys(roots))
+
+
+def outside_roots(target: Path, roots: Sequence[Path]) -> str | None:
+    """``None`` when ``target`` (links followed) lies inside one of ``roots``; otherwise a
+    phrase for the message saying where it really is."""
+    real = _key(target)
+    if any(real.is_relative_to(root) for root in roots):
+        return None
+    shown = str(target) if real == target.absolute() else f"{target}, which is {real}"
+    return shown
+
+
+def _outside_message(href: str, where: str, roots: Sequence[Path]) -> tuple[str, str]:
+    folders = " or ".join(str(r) for r in roots)
+    return (f"{href!r} leads outside the spec's folder ({where}); opspec reads referenced "
+            f"packages only inside {folders}",
+            "copy the package into the spec's folder, or allow its folder with the environment "
+            f"variable {EXTERNAL_PATH_VARIABLE} (docs/validation.md)")
 
 
 def _package_id_of(path: Path) -> str | None:
@@ -69,8 +110,10 @@ def _package_id_of(path: Path) -> str | None:
     return None
 
 
-def _sibling_with_id(base: Path, package_id: str) -> Path | None:
-    """A file beside ``base`` (not ``base`` itself) whose package has Id ``package_id``."""
+def _sibling_with_id(base: Path, package_id: str, roots: Sequence[Path] = ()
+                     ) -> Path | None:
+    """A file beside ``base`` (not ``base`` itself, nor a link leading out of ``roots``) whose
+    package has Id ``package_id``."""
     try:
         candidates = sorted(p for p in base.parent.iterdir() if p.suffix.lower() in _SUFFIXES)
     except OSError:
@@ -78,12 +121,15 @@ def _sibling_with_id(base: Path, package_id: str) -> Path | None:
     for candidate in candidates[:_SIBLING_SCAN_LIMIT]:
         if _key(candidate) == _key(base):
             continue
+        if roots and outside_roots(candidate, roots) is not None:
+            continue
         if candidate.is_file() and _package_id_of(candidate) == package_id:
             return candidate
     return None
 
 
-def _external_target(ext: ExternalPackage, base: Path) -> Path | None:
+def _external_target(ext: ExternalPackage, base: Path, roots: Sequence[Path] = ()
+                     ) -> Path | None:
     href = ext.href.strip()
     if "://" in href:
         return None
@@ -93,7 +139,7 @@ def _external_target(ext: ExternalPackage, base: Path) -> Path | None:
             return target
     for wanted in (ext.id, Path(href).stem if href else ""):
         if wanted:
-            found = _sibling_with_id(base, wanted)
+            found = _sibling_with_id(base, wanted, roots)
             if found is not None:
                 return found
     return None
@@ -110,7 +156,14 @@ def _load_externals(root: Package, root_path: Path, load: Loader, res: Resolutio
                           f"ExternalPackage {ext.href!r} is a URL; opspec never fetches remote files",
                           "download it and refer to it by a relative path", Severity.WARNING)
                 continue
-            target = _external_target(ext, path)
+            href = ext.href.strip()
+            outside = outside_roots(path.parent / href, res.roots) if href else None
+            if outside is not None:
+                message, hint = _outside_message(href, outside, res.roots)
+                res.error(ext.location, "external-package-outside",
+                          f"ExternalPackage {message}", hint)
+                continue
+            target = _external_target(ext, path, res.roots)
             if target is None:
                 res.error(ext.location, "missing-external-package",
                           f"ExternalPackage {ext.href or ext.id!r} not found (looked for "
@@ -202,7 +255,11 @@ def _package_by_ref(ref: str, caller: Package, res: Resolution, load: Loader) ->
                 return res.packages[package_id]
     if caller.source and "://" not in ref:
         target = Path(caller.source).parent / ref
-        if target.is_file():
+        outside = outside_roots(target, res.roots) if res.roots else None
+        if outside is not None:
+            res.refused.add(ref)
+            return None
+        if outside is None and target.is_file():
             key = _key(target)
             if key not in res.paths:
                 loaded, diagnostics = load(target)
@@ -234,6 +291,12 @@ def _target(subflow: SubFlow, caller: Package, res: Resolution, load: Loader,
             location: SourceLocation | None) -> Node | None:
     if subflow.package_ref:
         package = _package_by_ref(subflow.package_ref, caller, res, load)
+        if package is None and subflow.package_ref in res.refused:
+            message, hint = _outside_message(
+                subflow.package_ref, str(Path(caller.source or ".").parent / subflow.package_ref),
+                res.roots)
+            res.error(location, "external-package-outside", f"SubFlow PackageRef {message}", hint)
+            return None
         if package is None:
             res.error(location, "unresolved-subflow",
                       f"SubFlow names package {subflow.package_ref!r}, which is not loaded",
@@ -305,7 +368,7 @@ def _report_cycles(graph: dict[Node, list[Edge]], res: Resolution) -> None:
 
 def resolve(root: Package, root_path: Path, load: Loader) -> Resolution:
     """Load every package ``root`` refers to, resolve SubFlows and report cycles."""
-    res = Resolution()
+    res = Resolution(roots=allowed_roots(root_path))
     res.packages[root.id] = root
     res.paths[_key(root_path)] = root.id
     _load_externals(root, root_path, load, res)

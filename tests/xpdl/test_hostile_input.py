@@ -175,3 +175,96 @@ def test_not_a_file_names_what_the_path_is(tmp_path: Path) -> None:
     assert not_a_file(tmp_path / "missing") == "it does not exist"
     assert "FIFO" in str(not_a_file(fifo))
     assert stat.S_ISFIFO(os.stat(fifo).st_mode)
+
+
+# ---------------------------------------------------------------- ExternalPackage confinement
+
+
+def package_with_external(href: str, *, subflow_ref: str | None = None) -> str:
+    call = ""
+    if subflow_ref is not None:
+        call = ('<WorkflowProcesses><WorkflowProcess Id="main"><Activities>'
+                f'<Activity Id="call"><Implementation><SubFlow Id="helper" PackageRef="{subflow_ref}"/>'
+                "</Implementation></Activity></Activities></WorkflowProcess></WorkflowProcesses>")
+    return (f'<Package xmlns="{XPDL21}" Id="m">\n<ExternalPackages>\n'
+            f'<ExternalPackage Id="lib" href="{href}"/>\n</ExternalPackages>{call}</Package>')
+
+
+LIB = f'<Package xmlns="{XPDL21}" Id="lib"><WorkflowProcesses><WorkflowProcess Id="helper"/></WorkflowProcesses></Package>'
+
+
+@pytest.fixture
+def tree(tmp_path: Path) -> Path:
+    """``outside/lib.xpdl`` beside ``spec/`` (the spec's folder, with ``sub/``)."""
+    (tmp_path / "outside").mkdir()
+    (tmp_path / "outside" / "lib.xpdl").write_text(LIB)
+    (tmp_path / "spec" / "sub").mkdir(parents=True)
+    return tmp_path
+
+
+@pytest.mark.parametrize("href", ["/etc/passwd", "../../../../../../etc/passwd",
+                                  "../outside/lib.xpdl"])
+def test_external_package_outside_the_spec_folder_is_refused(tree: Path, href: str) -> None:
+    main = tree / "spec" / "main.xpdl"
+    main.write_text(package_with_external(href))
+    result = load_package(main)
+    (error,) = result.errors
+    assert error.code == "external-package-outside"
+    assert f"ExternalPackage {href!r} leads outside the spec's folder" in error.message
+    assert "OPSPEC_EXTERNAL_PATH" in error.hint
+    assert error.location.line == 3
+    assert set(result.packages) == {"m"}            # nothing was read
+
+
+def test_a_link_leading_out_of_the_tree_is_refused(tree: Path) -> None:
+    (tree / "spec" / "lib.xpdl").symlink_to(tree / "outside" / "lib.xpdl")
+    main = tree / "spec" / "main.xpdl"
+    main.write_text(package_with_external("lib.xpdl"))
+    (error,) = load_package(main).errors
+    assert error.code == "external-package-outside"
+    assert f"which is {tree / 'outside' / 'lib.xpdl'}" in error.message
+
+
+def test_external_packages_below_and_within_the_tree_resolve(tree: Path) -> None:
+    (tree / "spec" / "lib.xpdl").write_text(LIB)
+    (tree / "spec" / "sub" / "nested.xpdl").write_text(
+        package_with_external("../lib.xpdl").replace('Id="m"', 'Id="nested"'))
+    main = tree / "spec" / "main.xpdl"
+    main.write_text(package_with_external("sub/nested.xpdl").replace('Id="lib"', 'Id="nested"', 1))
+    result = load_package(main)
+    assert result.ok, [str(d) for d in result.diagnostics]
+    assert set(result.packages) == {"m", "nested", "lib"}
+
+
+def test_the_documented_variable_allows_another_folder(
+        tree: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    main = tree / "spec" / "main.xpdl"
+    main.write_text(package_with_external("../outside/lib.xpdl", subflow_ref="lib"))
+    monkeypatch.setenv("OPSPEC_EXTERNAL_PATH", str(tree / "outside"))
+    result = load_package(main)
+    assert result.ok, [str(d) for d in result.diagnostics]
+    assert set(result.packages) == {"m", "lib"}
+
+
+def test_a_subflow_package_ref_outside_the_tree_is_refused(tree: Path) -> None:
+    main = tree / "spec" / "main.xpdl"
+    main.write_text(f'<Package xmlns="{XPDL21}" Id="m"><WorkflowProcesses>'
+                    '<WorkflowProcess Id="main"><Activities><Activity Id="call"><Implementation>'
+                    '<SubFlow Id="helper" PackageRef="../outside/lib.xpdl"/></Implementation>'
+                    "</Activity></Activities></WorkflowProcess></WorkflowProcesses></Package>")
+    result = load_package(main)
+    codes = [d.code for d in result.errors]
+    assert codes == ["external-package-outside"], [str(d) for d in result.diagnostics]
+    assert set(result.packages) == {"m"}
+
+
+def test_validate_refuses_an_external_package_outside_in_one_line(
+        tree: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    from opspec.cli import main as cli
+
+    spec = tree / "spec" / "main.xpdl"
+    spec.write_text(package_with_external("/etc/passwd"))
+    assert cli(["validate", str(spec)]) == 1
+    out = capsys.readouterr().out.splitlines()
+    assert out[0].startswith(f"{spec}:3: error: ExternalPackage '/etc/passwd' leads outside")
+    assert "Traceback" not in "\n".join(out)
