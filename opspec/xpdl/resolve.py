@@ -90,10 +90,11 @@ def outside_roots(target: Path, roots: Sequence[Path]) -> str | None:
 
 def _outside_message(href: str, where: str, roots: Sequence[Path]) -> tuple[str, str]:
     folders = " or ".join(str(r) for r in roots)
-    return (f"{href!r} leads outside the spec's folder ({where}); opspec reads referenced "
-            f"packages only inside {folders}",
-            "copy the package into the spec's folder, or allow its folder with the environment "
+    message = (f"{href!r} leads outside the spec's folder ({where}); opspec reads referenced "
+               f"packages only inside {folders}")
+    hint = ("copy the package into the spec's folder, or allow its folder with the environment "
             f"variable {EXTERNAL_PATH_VARIABLE} (docs/validation.md)")
+    return message, hint
 
 
 def _package_id_of(path: Path) -> str | None:
