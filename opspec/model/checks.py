@@ -205,7 +205,7 @@ def _activity_structure(process: WorkflowProcess, aset: ActivitySet | None, grap
                      f"event {activity.id!r} in {scope} is attached to activity {host!r}, "
                      f"which is not in {scope}", "fix Target/ActivityId of the trigger")
     if activity.split is not None and activity.split.transition_refs:
-        by_id = {t.id: t for t in (process.transitions if aset is None else aset.transitions)}
+        by_id = graph.transition_by_id
         for ref in activity.split.transition_refs:
             transition = by_id.get(ref)
             if transition is None:

@@ -13,7 +13,7 @@ activity: the graph has an implicit edge from the host to each of its boundary e
 from __future__ import annotations
 
 from collections.abc import Iterable, Mapping
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from types import MappingProxyType
 
 from opspec.model.activities import Activity, Event, EventPosition, GatewayType, Route
@@ -40,8 +40,10 @@ class FlowGraph:
     """Adjacency of one process level.
 
     ``outgoing``/``incoming`` map every activity id to its transitions (in file order);
-    ``dangling`` holds the transitions with an end that is not an activity of this level.
-    When ids are duplicated, the first activity with an id wins.
+    ``dangling`` holds the transitions with an end that is not an activity of this level;
+    ``transition_by_id`` maps the Id of each transition of the level, dangling ones included,
+    to it (the last one when Ids are duplicated), built once so that the checks of each split's
+    TransitionRefs stay linear. When ids are duplicated, the first activity with an id wins.
     """
 
     activities: tuple[Activity, ...]
@@ -51,6 +53,8 @@ class FlowGraph:
     outgoing: Mapping[str, tuple[Transition, ...]]
     incoming: Mapping[str, tuple[Transition, ...]]
     boundary: Mapping[str, tuple[str, ...]]
+    transition_by_id: Mapping[str, Transition] = field(
+        default_factory=lambda: MappingProxyType({}))
 
     @classmethod
     def of(cls, activities: Iterable[Activity], transitions: Iterable[Transition]) -> FlowGraph:
@@ -62,7 +66,9 @@ class FlowGraph:
         incoming: dict[str, list[Transition]] = {key: [] for key in by_id}
         kept: list[Transition] = []
         dangling: list[Transition] = []
+        named: dict[str, Transition] = {}
         for transition in transitions:
+            named[transition.id] = transition
             if transition.source in by_id and transition.target in by_id:
                 kept.append(transition)
                 outgoing[transition.source].append(transition)
@@ -82,6 +88,7 @@ class FlowGraph:
             outgoing=_freeze(outgoing),
             incoming=_freeze(incoming),
             boundary=MappingProxyType({k: tuple(v) for k, v in boundary.items()}),
+            transition_by_id=MappingProxyType(named),
         )
 
     def successors(self, activity_id: str) -> tuple[str, ...]:

@@ -79,13 +79,14 @@ def local_name(element: Node) -> str:
 
 
 def child(element: Node, local: str) -> Node | None:
-    return element.find(qname(local, CANONICAL))
+    # iterchildren, not find(): no ElementPath to look up on each of a big file's many calls
+    return next(element.iterchildren(qname(local, CANONICAL)), None)
 
 
 def children(element: Node | None, local: str) -> list[Node]:
     if element is None:
         return []
-    return list(element.findall(qname(local, CANONICAL)))
+    return list(element.iterchildren(qname(local, CANONICAL)))
 
 
 def grandchildren(element: Node, wrapper: str, local: str) -> list[Node]:
