@@ -31,11 +31,28 @@ def register(subparsers: Any) -> None:
 
 
 def engine_checks(package: Any) -> list[Any]:
-    """What only the engine and the bindings can judge: the monitors the spec declares
-    (``bad-monitor``) and whether its world can be built (``bad-world``)."""
-    from opspec.commands._spec import engine_diagnostics
+    """What only the engine and the bindings can judge: whether the engine compiles the
+    package (``not-runnable``: anything ``run``, ``evaluate``, the walkthrough or ``compile``
+    would refuse, at its line), the monitors the spec declares (``bad-monitor``) and whether
+    its world can be built (``bad-world``). A package written for another script language
+    (JaWE's ``Script Type="text/javascript"``) is told so in the hint."""
+    import dataclasses
 
-    return engine_diagnostics(package, world=True)
+    from opspec.commands._spec import NOT_RUNNABLE, engine_diagnostics
+
+    found = engine_diagnostics(package, world=True)
+    language = (getattr(package, "script_language", None) or "").strip()
+    if language and any(word in language.lower() for word in _FOREIGN_SCRIPTS):
+        note = (f"the package declares Script Type {language!r}: opspec evaluates its own "
+                "expression grammar (data fields, arithmetic, comparisons, durations), not "
+                f"{language} code")
+        found = [dataclasses.replace(d, hint=f"{note}; {d.hint}" if d.hint else note)
+                 if d.code == NOT_RUNNABLE else d for d in found]
+    return found
+
+
+# Script languages whose expressions opspec does not evaluate (the package's Script Type).
+_FOREIGN_SCRIPTS = ("javascript", "java", "python", "groovy", "mvel", "ecmascript")
 
 
 def run(args: argparse.Namespace) -> int:

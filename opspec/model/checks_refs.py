@@ -263,8 +263,8 @@ class RefChecks:
             candidates = [self.packages[body.package_ref]]
         else:
             candidates = [self.package, *self.packages.values()]
-        called = next((p.process(body.process) for p in candidates
-                       if p.process(body.process) is not None), None)
+        owner = next((p for p in candidates if p.process(body.process) is not None), None)
+        called = owner.process(body.process) if owner is not None else None
         if called is None:
             self.report.error(
                 activity, "undefined-subflow",
@@ -272,6 +272,16 @@ class RefChecks:
                 f"{self.package.id!r} nor in a package loaded with it",
                 "set the SubFlow Id to a WorkflowProcess Id (declare its package as an "
                 "ExternalPackage if it lives in another file)")
+            return
+        if owner is not self.package and self.package.process(body.process) is None:
+            # the engine runs the processes of one package: it would refuse the call
+            self.report.error(
+                activity, "external-subflow",
+                f"{what} calls process {body.process!r} of external package {owner.id!r} "
+                f"({owner.source or 'another file'}): opspec runs a SubFlow only into a "
+                f"process of its own package {self.package.id!r}; calls into other packages "
+                "are not supported", f"copy process {body.process!r} into this package (or "
+                "run it on its own)")
             return
         formals = called.formal_parameters
         if formals and len(formals) != len(body.actual_parameters):

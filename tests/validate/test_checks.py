@@ -76,8 +76,7 @@ def test_a_duplicate_activity_id_is_an_error_at_the_second_activity() -> None:
 
 @pytest.mark.parametrize(("what", "dup"), [
     ("process", "P"), ("transition", "t1"), ("participant", "pump"),
-    ("data field or formal parameter", "n")], ids=["process", "transition", "participant",
-                                                   "data-field"])
+    ("data field", "n")], ids=["process", "transition", "participant", "data-field"])
 def test_duplicate_ids_are_found_for_every_kind_of_element(what: str, dup: str) -> None:
     if what == "process":
         model = package(process("P"), process("P", line=40))
@@ -88,11 +87,21 @@ def test_duplicate_ids_are_found_for_every_kind_of_element(what: str, dup: str) 
         model = package(participants=(Participant(id="pump", location=loc(3)),
                                       Participant(id="pump", location=loc(5))))
     else:
-        model = package(process(data_fields=(field("n", 20),),
-                                formal_parameters=(FormalParameter(id="n", type=INT,
-                                                                   location=loc(19)),)))
+        model = package(process(data_fields=(field("n", 19), field("n", 20))))
     found = one(check_package(model), "duplicate-id")
     assert found.message.startswith(f"{what} id {dup!r} is used twice in ")
+
+
+def test_a_data_field_with_a_formal_parameters_id_is_one_variable_with_a_warning() -> None:
+    # the WfMC publication sample declares 'publish' both ways; the WfMC engines read one
+    model = package(process(data_fields=(field("n", 20),),
+                            formal_parameters=(FormalParameter(id="n", type=INT,
+                                                               location=loc(19)),)))
+    diagnostics = check_package(model)
+    assert not [d for d in diagnostics if d.code == "duplicate-id"]
+    found = one(diagnostics, "parameter-data-field")
+    assert found.severity is Severity.WARNING and found.location.line == 20
+    assert "formal parameter 'n' (line 19)" in found.message and "one variable" in found.message
 
 
 def test_activity_ids_are_scoped_per_process_and_per_activity_set() -> None:
