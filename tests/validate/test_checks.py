@@ -268,14 +268,18 @@ def test_formal_parameters_and_package_fields_are_in_scope() -> None:
     assert check_package(model) == []
 
 
-def test_a_subflow_to_a_missing_process_is_an_error_unless_a_loaded_package_has_it() -> None:
+def test_a_subflow_to_a_missing_process_is_an_error_and_one_into_another_package_too() -> None:
     call = act("call", 11, body=SubFlow(process="Refill"))
     model = package(process(activities=(start(), call, end()),
                             transitions=(tr("t1", "start", "call"), tr("t2", "call", "end"))))
     found = one(check_package(model), "undefined-subflow")
     assert found.location.line == 11 and "'Refill'" in found.message
+    # found in a loaded package, but the engine runs subflows within one package only
     lib = dataclasses.replace(package(process("Refill")), id="lib")
-    assert check_package(model, packages={"lib": lib, "pkg": model}) == []
+    found = one(check_package(model, packages={"lib": lib, "pkg": model}), "external-subflow")
+    assert found.location.line == 11 and "of external package 'lib'" in found.message
+    assert not [d for d in check_package(model, packages={"lib": lib, "pkg": model})
+                if d.code == "undefined-subflow"]
 
 
 def test_parameter_counts_must_match_the_called_process() -> None:
