@@ -8,8 +8,8 @@ from pathlib import Path
 
 import pytest
 
-from opspec.errors import Severity
 from opspec.commands.validate import engine_checks
+from opspec.errors import Severity
 from opspec.xpdl.validate import validate_file
 
 CORPUS = Path("/work/shared/corpus/xpdl")
