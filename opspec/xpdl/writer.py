@@ -562,7 +562,9 @@ def _write_transitions(parent: etree._Element, transitions: tuple[Transition, ..
             text = _condition_text(condition)
             if condition.kind in (ConditionKind.CONDITION, ConditionKind.NONE):
                 if text is not None:
-                    _sub(condition_element, "Expression", text)
+                    expression = _sub(condition_element, "Expression", text)
+                    if condition.kind is ConditionKind.NONE:    # a label, not an expression
+                        expression.set("ScriptGrammar", "Text")
             elif text is not None:
                 condition_element.text = text
         if transition.description is not None:
