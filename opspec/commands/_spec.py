@@ -27,18 +27,22 @@ def load_any_spec(path: str | Path) -> Package:
     reports (a :class:`~opspec.errors.SpecError` listing them with ``path:line``): the run,
     evaluate and walkthrough commands never execute a spec that validation rejects.
     ``.wfs`` scripts (compiled from specs that passed) and paths that are not files open as
-    :func:`opspec.xpdl.open_spec.open_spec` does. What :func:`engine_diagnostics` adds
+    :func:`opspec.xpdl.open_spec.open_spec` does; a file that cannot be read at all (not a
+    regular file, no permission) is a ConfigurationError (exit status 2). What
+    :func:`engine_diagnostics` adds
     for validate (monitors, the world) is raised as a located ConfigurationError (exit 2)
     when the run builds them, as before."""
-    from opspec.xpdl.open_spec import open_spec
+    from opspec.xpdl.open_spec import open_spec, refuse_unreadable
+    from opspec.xpdl.reader import not_a_file
 
     target = Path(path)
-    if target.suffix == ".wfs" or not target.is_file():
+    if target.suffix == ".wfs" or not_a_file(target) is not None:
         return open_spec(path)
     from opspec.errors import Severity, SpecError
     from opspec.xpdl.validate import validate_spec
 
     package, report = validate_spec(target)     # monitors and the world: checked as built
+    refuse_unreadable(report.diagnostics)       # an unreadable file: exit status 2, not 1
     errors = [d for d in report.diagnostics if d.severity is Severity.ERROR]
     if errors or package is None:
         raise SpecError.from_diagnostics(errors or report.diagnostics)

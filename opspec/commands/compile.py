@@ -2,8 +2,8 @@
 
 Exit status: 0 written (warnings are printed), 1 the spec has errors, exactly those
 ``opspec validate`` reports (each printed as ``path:line: severity: message``; nothing is
-written), 2 the input cannot be read or the output
-cannot be written.
+written), 2 the input cannot be read (missing, a folder, a pipe or device, no permission), the
+output is the input itself, or the output cannot be written.
 """
 
 from __future__ import annotations
@@ -30,16 +30,23 @@ def register(subparsers: Any) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
+    from opspec.commands._files import input_problem, same_file
     from opspec.commands.validate import engine_checks
     from opspec.errors import SpecError
     from opspec.xpdl.compile import compile_spec, default_output
+    from opspec.xpdl.open_spec import IO_CODES
 
     source = Path(args.input)
-    if not source.is_file():
-        what = "is a folder" if source.is_dir() else "does not exist"
-        print(f"opspec compile: cannot read {source}: it {what}", file=sys.stderr)
+    problem = input_problem(source)
+    if problem is not None:
+        print(f"opspec compile: cannot read {source}: {problem}", file=sys.stderr)
         return 2
     target = Path(args.output) if args.output else default_output(source)
+    if same_file(source, target):
+        print(f"opspec compile: the output {target} is the input file itself; refusing to "
+              f"overwrite it (give -o another file, e.g. {source.with_suffix('.wfs').name} "
+              "beside it)", file=sys.stderr)
+        return 2
     try:
         result = compile_spec(source, target, strict=args.strict, extra=engine_checks)
     except SpecError as error:
@@ -47,6 +54,9 @@ def run(args: argparse.Namespace) -> int:
             print(diagnostic, file=sys.stderr)
         if not error.diagnostics:
             print(f"opspec compile: {error}", file=sys.stderr)
+        if any(d.code in IO_CODES for d in error.diagnostics):
+            print(f"opspec compile: cannot read {source}; nothing written", file=sys.stderr)
+            return 2
         print(f"opspec compile: {source} has errors; nothing written", file=sys.stderr)
         return 1
     except OSError as error:

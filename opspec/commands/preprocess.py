@@ -5,8 +5,14 @@ ActivitySet of Routes and plain activities) and directives become ``opspec:`` ex
 attributes; the output validates against the official XPDL 2.1 schema (docs/sisarl-xpdl.md,
 section *Preprocessing*).
 
+Relative companion paths follow the output: ``opspec:WorldFile``, mode sources and
+ExternalPackage hrefs are rewritten to lead from OUT's folder, and ``IN.users.toml`` is copied
+to ``OUT.users.toml`` (:mod:`opspec.xpdl.relocate`). Every output the bundled XPDL 2.1 XSD
+rejects gets a ``not-schema-valid`` warning.
+
 Exit status: 0 written, 1 the spec has errors (those ``opspec validate`` reports, or a
-built-in that cannot be expanded; nothing written), 2 the input cannot be read or the output
+built-in that cannot be expanded; nothing written), 2 the input cannot be read (missing, a
+folder, a pipe or device, no permission), the output is the input itself, or the output
 cannot be written.
 """
 
@@ -38,28 +44,49 @@ def default_output(source: Path) -> Path:
 
 
 def run(args: argparse.Namespace) -> int:
+    from opspec.commands._files import input_problem, same_file
     from opspec.commands.validate import engine_checks
     from opspec.errors import Severity
     from opspec.model.codec import write_atomically
+    from opspec.xpdl.open_spec import IO_CODES
     from opspec.xpdl.preprocess import preprocess
-    from opspec.xpdl.schema_limits import schema_warnings
+    from opspec.xpdl.relocate import relocate
+    from opspec.xpdl.schema import output_schema_warnings
     from opspec.xpdl.validate import validate_spec
     from opspec.xpdl.writer import write_xpdl
 
     source = Path(args.input)
-    if not source.is_file():
-        what = "is a folder" if source.is_dir() else "does not exist"
-        print(f"opspec preprocess: cannot read {source}: it {what}", file=sys.stderr)
+    problem = input_problem(source)
+    if problem is not None:
+        print(f"opspec preprocess: cannot read {source}: {problem}", file=sys.stderr)
+        return 2
+    target = None if args.output == "-" else (
+        Path(args.output) if args.output else default_output(source))
+    if target is not None and same_file(source, target):
+        print(f"opspec preprocess: the output {target} is the input file itself; refusing to "
+              f"overwrite it (give -o another file, e.g. {default_output(source).name})",
+              file=sys.stderr)
         return 2
     # The spec is refused for exactly the errors `opspec validate` reports.
     package, report = validate_spec(source, strict=args.strict, extra=engine_checks)
     diagnostics = list(report.diagnostics)
+    if any(d.code in IO_CODES for d in diagnostics):
+        for diagnostic in diagnostics:
+            print(diagnostic, file=sys.stderr)
+        print(f"opspec preprocess: cannot read {source}; nothing written", file=sys.stderr)
+        return 2
     if report.ok and package is not None:
         result = preprocess(package)
         diagnostics.extend(result.diagnostics)
         package = result.package
-        # The output promises standard XPDL 2.1: say when the schema would still reject it.
-        diagnostics.extend(schema_warnings(package))
+        if target is not None:
+            # Relative companion paths (world file, mode sources, external packages) lead
+            # from the output's folder to the same files.
+            package, moved = relocate(package, source, target)
+            diagnostics.extend(moved)
+        # The output promises standard XPDL 2.1: say when the schema would still reject it
+        # (the known rules in words, anything else the bundled XSD finds as it says it).
+        diagnostics.extend(output_schema_warnings(package, write_xpdl(package)))
     for diagnostic in diagnostics:
         print(diagnostic, file=sys.stderr)
     errors = [d for d in diagnostics if d.severity is Severity.ERROR
@@ -68,10 +95,9 @@ def run(args: argparse.Namespace) -> int:
         print(f"opspec preprocess: {source} has errors; nothing written", file=sys.stderr)
         return 1
     data = write_xpdl(package)
-    if args.output == "-":
+    if target is None:
         sys.stdout.buffer.write(data)
         return 0
-    target = Path(args.output) if args.output else default_output(source)
     try:
         write_atomically(target, data)
     except OSError as error:
@@ -79,5 +105,30 @@ def run(args: argparse.Namespace) -> int:
               file=sys.stderr)
         return 2
     print(f"{target}: standard XPDL 2.1 from {source}")
+    _copy_user_model(source, target)
     return 0
 
+
+def _copy_user_model(source: Path, target: Path) -> None:
+    """Copy the spec's companion ``SPEC.users.toml`` to the output's companion name, so
+    ``opspec evaluate OUT`` draws the same users (an existing different file is kept)."""
+    import shutil
+
+    from opspec.commands._spec import companion_user_model
+
+    model = companion_user_model(source)
+    if model is None:
+        return
+    copy = target.with_name(target.name.removesuffix(target.suffix) + ".users.toml")
+    try:
+        if copy.exists():
+            if copy.read_bytes() != model.read_bytes():
+                print(f"opspec preprocess: kept {copy}, which differs from {model} (the "
+                      "output's user model)", file=sys.stderr)
+            return
+        shutil.copyfile(model, copy)
+    except OSError as error:
+        print(f"opspec preprocess: could not copy the user model {model} to {copy}: "
+              f"{error.strerror or error}", file=sys.stderr)
+        return
+    print(f"{copy}: user model of the output, copied from {model}")

@@ -27,6 +27,9 @@ def register(subparsers: Any) -> None:
     parser.add_argument("--strict", action="store_true", help="treat warnings as errors")
     parser.add_argument("--json", action="store_true",
                         help="print one JSON object per file (JSON Lines)")
+    parser.add_argument("--schema", action="store_true",
+                        help="also validate each file against the bundled WfMC XSD of its "
+                        "XPDL version (1.0, 2.1; docs/validation.md)")
     parser.set_defaults(handler=run)
 
 
@@ -64,6 +67,10 @@ def run(args: argparse.Namespace) -> int:
     reports = []
     for path in files:
         report = validate_file(path, strict=args.strict, extra=engine_checks)
+        if args.schema:
+            from opspec.xpdl.schema import add_schema
+
+            report = add_schema(report, path, strict=args.strict)
         reports.append(report)
         if args.json:
             print(json.dumps(report.to_json(), ensure_ascii=False))

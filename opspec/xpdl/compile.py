@@ -13,7 +13,7 @@ from collections.abc import Callable, Iterable
 from dataclasses import dataclass
 from pathlib import Path
 
-from opspec.errors import Diagnostic, Severity, SpecError
+from opspec.errors import ConfigurationError, Diagnostic, Severity, SpecError
 from opspec.model.codec import write_wfs
 from opspec.model.package import Package
 from opspec.xpdl.validate import validate_spec
@@ -47,13 +47,17 @@ def compile_spec(
 
     Raises :class:`SpecError` carrying every diagnostic when the spec has errors (``strict``
     counts warnings as errors; ``extra`` adds checks of layers above, as in
-    :func:`~opspec.xpdl.validate.validate_spec`); nothing is written then. ``OSError`` from
+    :func:`~opspec.xpdl.validate.validate_spec`); nothing is written then. An ``output`` that
+    is ``source`` itself (or a link to it) is a :class:`ConfigurationError`. ``OSError`` from
     writing propagates.
     """
+    target = Path(output) if output is not None else default_output(source)
+    if target.exists() and Path(source).exists() and os.path.samefile(source, target):
+        raise ConfigurationError(f"the output {target} is the input file itself",
+                                 hint="write the compiled script to another file")
     package, report = validate_spec(Path(source), strict=strict, extra=extra)
     if package is None or not report.ok:
         raise SpecError.from_diagnostics(report.diagnostics)
-    target = Path(output) if output is not None else default_output(source)
     write_wfs(package, target)
     warnings = tuple(d for d in report.diagnostics if d.severity is not Severity.ERROR)
     return CompileResult(package, target, warnings)

@@ -2,33 +2,73 @@
 
 from __future__ import annotations
 
-from collections.abc import Callable
+from collections.abc import Callable, Iterable
 from pathlib import Path
 
-from opspec.errors import ConfigurationError
+from opspec.errors import ConfigurationError, Diagnostic, Severity, SourceLocation, SpecError
 from opspec.model import Package
 
-__all__ = ["mode_loader_for", "open_spec"]
+__all__ = ["IO_CODES", "mode_loader_for", "open_spec", "refuse_unreadable", "unreadable"]
 
 
 def open_spec(path: str | Path) -> Package:
     """The package in ``path`` (``.wfs`` scripts load directly, anything else as XPDL).
 
     Raises :class:`~opspec.errors.SpecError` (with ``path:line``) for a broken spec and
-    :class:`~opspec.errors.ConfigurationError` for a path that is not a readable file.
+    :class:`~opspec.errors.ConfigurationError` (exit status 2) for a path that is not a
+    readable regular file: missing, a folder, a pipe or device (refused without blocking),
+    or unreadable.
     """
+    from opspec.xpdl.reader import not_a_file
+
     target = Path(path)
-    if not target.is_file():
-        what = "a folder" if target.is_dir() else "not found"
+    reason = not_a_file(target)
+    if reason is not None:
+        what = {"it does not exist": "not found", "it is a folder": "a folder"}.get(
+            reason, f"cannot read it: {reason}")
         raise ConfigurationError(f"{target}: {what}; give one specification file",
                                  hint="e.g. specs/medication_dispenser.xpdl")
     if target.suffix == ".wfs":
         from opspec.model.codec import read_wfs
 
+        unreadable(target)
         return read_wfs(target)
-    from opspec.xpdl.loader import load_spec
+    from opspec.xpdl.loader import load_package
 
-    return load_spec(target)
+    result = load_package(target)
+    refuse_unreadable(result.diagnostics)
+    if not result.ok or result.package is None:
+        raise SpecError.from_diagnostics(result.diagnostics or (
+            Diagnostic(SourceLocation(str(path)), Severity.ERROR, "unreadable", "cannot load"),))
+    return result.package
+
+
+#: Diagnostic codes meaning "the file could not be read at all" (exit status 2, not 1).
+IO_CODES = frozenset({"io-error"})
+
+
+def refuse_unreadable(diagnostics: Iterable[Diagnostic]) -> None:
+    """Raise a :class:`ConfigurationError` (exit status 2) for the first diagnostic saying a
+    file could not be read (``io-error``): an I/O problem, not an error in a spec."""
+    for diagnostic in diagnostics:
+        if diagnostic.code in IO_CODES:
+            raise ConfigurationError(diagnostic.message, location=diagnostic.location,
+                                     hint=diagnostic.hint)
+
+
+def unreadable(path: Path) -> None:
+    """Raise a :class:`ConfigurationError` when ``path`` cannot be opened for reading as a
+    regular file (permissions, a pipe); opening never blocks."""
+    from opspec.xpdl.reader import open_regular
+
+    try:
+        with open_regular(path):
+            pass
+    except OSError as error:
+        raise ConfigurationError(
+            f"cannot read the file: {error.strerror or type(error).__name__}",
+            location=SourceLocation(str(path)), hint="check the path and its permissions",
+        ) from None
 
 
 def mode_loader_for(package: Package) -> Callable[[str], Package]:

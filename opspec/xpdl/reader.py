@@ -47,6 +47,7 @@ __all__ = [
     "exact_lines",
     "line_of",
     "not_a_file",
+    "open_regular",
     "read_file",
     "read_limited",
     "read_tree",
@@ -220,7 +221,7 @@ def not_a_file(path: str | os.PathLike[str]) -> str | None:
     return f"it is {kind}, not a regular file"
 
 
-def _open_regular(path: str | Path) -> BinaryIO:
+def open_regular(path: str | Path) -> BinaryIO:
     """Open a regular file for reading; an :class:`OSError` for anything else. Pipes and
     devices are refused before they are opened, and the file is opened non-blocking and
     checked again, so a path swapped for a FIFO in between cannot block either."""
@@ -252,7 +253,7 @@ def read_file(path: str | Path, *, max_bytes: int = DEFAULT_MAX_BYTES) -> bytes:
     shown = str(path)
     max_bytes = effective_max_bytes(max_bytes, path=shown)
     try:
-        with _open_regular(path) as stream:
+        with open_regular(path) as stream:
             size = os.fstat(stream.fileno()).st_size
             if size > max_bytes:
                 raise _too_big(shown, max_bytes)

@@ -1,0 +1,68 @@
+"""Moving a spec to another folder: relative paths to companion files follow it.
+
+A spec names files relative to its own folder: ``opspec:WorldFile`` (the world's parameters),
+``<opspec:Mode Source="…">`` (specs loaded at a mode change) and ``ExternalPackage href``s.
+``opspec preprocess IN -o OUT`` writes ``OUT`` elsewhere, so :func:`relocate` rewrites each
+such path to lead from ``OUT``'s folder to the same file (``../specs/vacuum.world.toml``).
+URLs and absolute paths are left as they are. An ExternalPackage that then lies outside
+``OUT``'s folder tree would be refused when ``OUT`` is read (:mod:`opspec.xpdl.resolve`), so
+that gets a ``relocated-outside`` warning saying how to allow it.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import os
+from pathlib import Path, PurePosixPath
+
+from opspec.errors import Diagnostic, Severity, SourceLocation
+from opspec.model.package import Package
+from opspec.xpdl.resolve import EXTERNAL_PATH_VARIABLE, allowed_roots, outside_roots
+
+__all__ = ["relocate"]
+
+WORLD_FILE = "opspec:WorldFile"
+
+
+def _moved(value: str | None, source_dir: Path, output_dir: Path) -> str | None:
+    """``value`` rewritten to lead from ``output_dir`` to what it named from ``source_dir``
+    (``None`` when it needs no rewrite)."""
+    if not value or "://" in value or Path(value).is_absolute():
+        return None
+    target = os.path.abspath(source_dir / value)
+    moved = os.path.relpath(target, os.path.abspath(output_dir))
+    moved = PurePosixPath(*Path(moved).parts).as_posix()
+    return None if moved == PurePosixPath(value).as_posix() else moved
+
+
+def relocate(package: Package, source: Path, output: Path) -> tuple[Package, list[Diagnostic]]:
+    """``package`` (read from ``source``) with its relative companion paths rewritten for a
+    copy written to ``output``, and warnings for references the copy cannot follow."""
+    source_dir, output_dir = source.parent, output.parent
+    diagnostics: list[Diagnostic] = []
+    attributes = tuple(
+        dataclasses.replace(a, value=_moved(a.value, source_dir, output_dir) or a.value)
+        if a.name == WORLD_FILE else a
+        for a in package.extended_attributes)
+    modes = tuple(
+        dataclasses.replace(m, source=_moved(m.source, source_dir, output_dir) or m.source)
+        for m in package.modes)
+    roots = allowed_roots(output)
+    externals = []
+    for external in package.external_packages:
+        moved = _moved(external.href.strip(), source_dir, output_dir)
+        if moved is None:
+            externals.append(external)
+            continue
+        externals.append(dataclasses.replace(external, href=moved))
+        if outside_roots(output_dir / moved, roots) is not None:
+            diagnostics.append(Diagnostic(
+                external.location or SourceLocation(str(source)), Severity.WARNING,
+                "relocated-outside",
+                f"the output refers to ExternalPackage {external.href!r} as {moved!r}, outside "
+                f"its folder {output_dir}: opspec will not read it from there",
+                f"write the output beside {source.name}, copy the package next to it, or set "
+                f"{EXTERNAL_PATH_VARIABLE}"))
+    relocated = dataclasses.replace(package, extended_attributes=attributes, modes=modes,
+                                    external_packages=tuple(externals))
+    return relocated, diagnostics
