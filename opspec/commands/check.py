@@ -82,7 +82,7 @@ def run(args: argparse.Namespace) -> int:
         # conditions are abstracted, so a spec whose errors leave its control flow readable
         # (a condition opspec cannot parse, a duplicate lane id) is still checked
         package = result.package
-        errors = _spec_errors(package, errors, result.packages)
+        errors = tuple(_spec_errors(package, errors, result.packages))
         processes = [p for p in package.processes
                      if args.process is None or p.id == args.process]
         if args.process is not None and not processes:

@@ -265,7 +265,7 @@ class RefChecks:
             candidates = [self.package, *self.packages.values()]
         owner = next((p for p in candidates if p.process(body.process) is not None), None)
         called = owner.process(body.process) if owner is not None else None
-        if called is None:
+        if owner is None or called is None:
             self.report.error(
                 activity, "undefined-subflow",
                 f"{what} calls process {body.process!r}, which is neither in package "
