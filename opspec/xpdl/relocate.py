@@ -12,7 +12,9 @@ that gets a ``relocated-outside`` warning saying how to allow it.
 from __future__ import annotations
 
 import dataclasses
+import html
 import os
+import re
 from pathlib import Path, PurePosixPath
 
 from opspec.errors import Diagnostic, Severity, SourceLocation
@@ -22,6 +24,8 @@ from opspec.xpdl.resolve import EXTERNAL_PATH_VARIABLE, allowed_roots, outside_r
 __all__ = ["relocate"]
 
 WORLD_FILE = "opspec:WorldFile"
+MODES = "opspec:Modes"
+_SOURCE = re.compile(r"""(\bSource\s*=\s*")([^"]*)(")""")
 
 
 def _moved(value: str | None, source_dir: Path, output_dir: Path) -> str | None:
@@ -40,9 +44,17 @@ def relocate(package: Package, source: Path, output: Path) -> tuple[Package, lis
     copy written to ``output``, and warnings for references the copy cannot follow."""
     source_dir, output_dir = source.parent, output.parent
     diagnostics: list[Diagnostic] = []
+    def mode_source(match: re.Match[str]) -> str:
+        moved = _moved(html.unescape(match.group(2)), source_dir, output_dir)
+        return match.group(0) if moved is None else (
+            f"{match.group(1)}{html.escape(moved, quote=True)}{match.group(3)}")
+
     attributes = tuple(
         dataclasses.replace(a, value=_moved(a.value, source_dir, output_dir) or a.value)
-        if a.name == WORLD_FILE else a
+        if a.name == WORLD_FILE else
+        # the opspec:Modes attribute is written back verbatim: its Source attributes too
+        dataclasses.replace(a, raw_xml=_SOURCE.sub(mode_source, a.raw_xml))
+        if a.name == MODES and a.raw_xml else a
         for a in package.extended_attributes)
     modes = tuple(
         dataclasses.replace(m, source=_moved(m.source, source_dir, output_dir) or m.source)

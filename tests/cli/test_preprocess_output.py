@@ -137,3 +137,17 @@ def test_every_written_output_is_xsd_valid_or_says_it_is_not(
         pytest.skip("refused (validate's errors)")
     valid = schema_for(XPDL21).validate(etree.parse(str(out)))
     assert valid == ("will not be valid XPDL 2.1" not in err), err
+
+
+def test_mode_sources_written_verbatim_are_rewritten_too(tmp_path: Path) -> None:
+    from opspec.model.common import ExtendedAttribute
+    from opspec.xpdl.writer import write_xpdl
+
+    modes = ExtendedAttribute(name="opspec:Modes",
+                              raw_xml='<opspec:Mode xmlns:opspec="urn:opspec:sisarl:1" '
+                                      'Id="dock" Source="dock.xpdl"/>')
+    package = Package(id="p", extended_attributes=(modes,),
+                      modes=(Mode(id="dock", source="dock.xpdl"),))
+    moved, _ = relocate(package, tmp_path / "specs" / "r.xpdl",
+                        tmp_path / "specs" / "sub" / "r.xpdl")
+    assert 'Source="../dock.xpdl"' in write_xpdl(moved).decode()
