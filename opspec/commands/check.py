@@ -10,9 +10,11 @@ such as a dangling transition, what the engine refuses to compile) is still expl
 package could be built (its conditions do not matter here), but it is never called sound: the
 errors are printed first and make the status 1.
 
-Exit status: 0 every process level is sound; 1 a problem was found, or a spec has errors; 2 usage or I/O problems (a missing path, an unreadable file, an unknown
-``--process``), or a state space larger than ``--max-states`` with no problem found (the
-verdict is then undecided, never "sound"). Over several files, the highest status wins.
+Exit status: 0 every process level is sound; 1 a problem was found, a spec has errors, or
+the check ran out of its budget (more than ``--max-states`` states in a level, or out of
+memory): that verdict is *inconclusive*, never "sound"; 2 usage or I/O problems (a missing
+path, an unreadable file, an unknown ``--process``). Over several files, the highest status
+wins. Memory is bounded by ``--max-states`` (docs/soundness.md gives the bound).
 """
 
 from __future__ import annotations
@@ -20,6 +22,7 @@ from __future__ import annotations
 import argparse
 import json
 import sys
+from dataclasses import replace
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -51,7 +54,8 @@ def register(subparsers: Any) -> None:
         "can never run, improper completion, AND-joins that can't fire and unbounded places, "
         "each with a witness path; plus violations of the package's declared graph "
         "conformance class. Exit status: 0 sound, 1 a problem found (or a spec that does "
-        "not load), 2 usage or I/O errors, or a state space larger than --max-states.")
+        "not load, or an inconclusive check: more than --max-states states, or out of "
+        "memory), 2 usage or I/O errors.")
     parser.add_argument("specs", nargs="+", metavar="SPEC", help="spec files or folders")
     parser.add_argument("--json", action="store_true",
                         help="print one JSON object per file (JSON Lines)")
@@ -63,7 +67,7 @@ def register(subparsers: Any) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    from opspec.model.soundness import check_process
+    from opspec.model.soundness import SoundnessReport, check_process
     from opspec.xpdl.loader import load_package
     from opspec.xpdl.validate import IO_CODES, spec_files
 
@@ -92,10 +96,17 @@ def run(args: argparse.Namespace) -> int:
             worst = 2
             continue
         reports: list[SoundnessReport] = []
-        for process in processes:
-            reports.extend(check_process(process, conformance=package.conformance_class,
-                                         max_states=args.max_states))
-        reports = _with_zero_time_cycles(package, reports, [p.id for p in processes])
+        try:
+            for process in processes:
+                reports.extend(check_process(process, conformance=package.conformance_class,
+                                             max_states=args.max_states))
+            reports = _with_zero_time_cycles(package, reports, [p.id for p in processes])
+        except MemoryError:
+            # each level's exploration reports its own; this is what is left (the net of a
+            # huge level, the graph conformance or zero-time analyses): inconclusive too
+            done = {r.process for r in reports}
+            reports = [*reports, *(SoundnessReport(p.id, 0, False, (), stopped="memory")
+                                   for p in processes if p.id not in done)]
         status = _print(path, reports, errors, as_json=args.json, max_states=args.max_states)
         worst = max(worst, status)
     return worst
@@ -108,7 +119,6 @@ def _with_zero_time_cycles(package: Any, reports: list[SoundnessReport],
     from opspec.engine.compiled import compile_package
     from opspec.engine.zero_time_check import zero_time_cycles
     from opspec.errors import OpspecError
-    from opspec.model.soundness import SoundnessReport
 
     try:
         found = zero_time_cycles(compile_package(package), processes)
@@ -117,8 +127,7 @@ def _with_zero_time_cycles(package: Any, reports: list[SoundnessReport],
     out = []
     for report in reports:
         mine = tuple(p for p in found if p.process == report.process)
-        out.append(SoundnessReport(report.process, report.states, report.complete,
-                                   report.problems + mine) if mine else report)
+        out.append(replace(report, problems=report.problems + mine) if mine else report)
     return out
 
 
@@ -166,8 +175,9 @@ def _problem_json(p: Any) -> dict[str, Any]:
 
 def _print(path: Path, reports: list[SoundnessReport], errors: Sequence[Diagnostic], *,
            as_json: bool, max_states: int) -> int:
-    """Print one file's verdict; return its exit status (0, 1 or 2). Load ``errors`` make
-    it 1 at least (and the file is never called sound)."""
+    """Print one file's verdict; return its exit status (0 or 1). Load ``errors`` make it
+    1, and so does an inconclusive level (the budget ran out; the file is never called
+    sound then)."""
     problems = [p for r in reports for p in r.problems]
     failing = [p for p in problems if p.severity == "error"]
     undecided = [r for r in reports if not r.complete]
@@ -176,9 +186,11 @@ def _print(path: Path, reports: list[SoundnessReport], errors: Sequence[Diagnost
             "path": str(path), "sound": not failing and not undecided and not errors,
             "loaded": True,
             "max_states": max_states,
+            "inconclusive": bool(undecided),
             "processes": [{"process": r.process, "states": r.states, "complete": r.complete,
                            "sound": r.sound, "problems": sum(
-                               1 for p in r.problems if p.severity == "error")}
+                               1 for p in r.problems if p.severity == "error"),
+                           **({"stopped": r.stopped} if r.stopped else {})}
                           for r in reports],
             "problems": [_problem_json(p) for p in failing],
             "errors": _errors_json(errors),
@@ -198,15 +210,19 @@ def _print(path: Path, reports: list[SoundnessReport], errors: Sequence[Diagnost
                 label = "cycle" if cyclic else "witness"
                 print(f"    {label}: {' -> '.join(problem.witness)}")
         for report in reports:
-            if not report.complete:
+            if report.stopped == "memory":
+                print(f"{path}: warning: {report.process}: out of memory after "
+                      f"{report.states} states: inconclusive (lower --max-states to stay "
+                      "within this machine's memory, or simplify the process)")
+            elif not report.complete:
                 print(f"{path}: warning: {report.process}: more than {max_states} states: "
-                      "soundness undecided (raise --max-states, or simplify the process)")
+                      "inconclusive (raise --max-states, or simplify the process)")
         for report in reports:
             warned = sum(1 for p in report.problems if p.severity != "error")
             also = f", {warned} warning(s)" if warned else ""
             verdict = ("sound" + also if report.sound
                        else f"{len(report.problems) - warned} problem(s)" + also
-                       if len(report.problems) > warned else "undecided" + also)
+                       if len(report.problems) > warned else "inconclusive" + also)
             print(f"{path}: {report.process}: {verdict} ({report.states} states)")
         sound = sum(1 for r in reports if r.sound)
         warnings = len(problems) - len(failing)
@@ -214,6 +230,4 @@ def _print(path: Path, reports: list[SoundnessReport], errors: Sequence[Diagnost
         print(f"{path}: {verdict}{sound} of {len(reports)} process level(s) sound, "
               f"{len(failing)} problem(s)" + (f", {warnings} warning(s)" if warnings else "") + (f", {len(errors)} spec error(s) (see "
                                                 "`opspec validate`)" if errors else ""))
-    if failing or errors:
-        return 1
-    return 2 if undecided else 0
+    return 1 if failing or errors or undecided else 0

@@ -162,11 +162,14 @@ def _level(name: str, graph: CompiledGraph) -> list[Problem]:
         if acts[i].loop is not None:
             edges[i].append(i)
     problems = []
-    for comp in _components(sorted(instant, key=lambda i: (len(_path_to(reach, i)), i)), edges):
+    depth: dict[int, int] = {}      # BFS depth (the parents are in BFS order): no path walks
+    for node, parent in reach.items():
+        depth[node] = 0 if parent is None else depth[parent] + 1
+    for comp in _components(sorted(instant, key=lambda i: (depth[i], i)), edges):
         members = set(comp)
         if len(comp) == 1 and comp[0] not in edges[comp[0]]:
             continue
-        entry = min(members, key=lambda i: (len(_path_to(reach, i)), i))
+        entry = min(members, key=lambda i: (depth[i], i))
         cycle = _round(edges, members, entry)
         into = _path_to(reach, entry)
         exits = any(j not in members for i in members for j in _successors(acts[i]))

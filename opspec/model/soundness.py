@@ -34,13 +34,13 @@ from __future__ import annotations
 
 from collections import deque
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 from opspec.model.activities import BlockActivity, GatewayType
 from opspec.model.graph import FlowGraph, attached_to, levels
 from opspec.model.process import WorkflowProcess
 from opspec.model.soundness_conformance import conformance_violations
-from opspec.model.soundness_net import Marking, TokenNet, join_type
+from opspec.model.soundness_net import Marking, TokenNet
 
 __all__ = ["KINDS", "TOKEN_BOUND", "Problem", "SoundnessReport", "check_level", "check_process"]
 
@@ -68,12 +68,15 @@ class Problem:
 @dataclass(frozen=True, slots=True)
 class SoundnessReport:
     """The verdict on one process level (``process`` is ``"proc"`` or ``"proc/activity-set"``):
-    ``states`` markings explored; ``complete`` False when ``max_states`` stopped it."""
+    ``states`` markings explored; ``complete`` False when the budget stopped it: then
+    ``stopped`` says which (``"states"``: ``max_states`` markings; ``"memory"``: the machine
+    ran out of memory first), and the verdict is inconclusive."""
 
     process: str
     states: int
     complete: bool
     problems: tuple[Problem, ...]
+    stopped: str | None = None
 
     @property
     def sound(self) -> bool:
@@ -93,14 +96,29 @@ def _line(graph: FlowGraph, activity: str | None) -> int | None:
 
 def check_level(process: str, graph: FlowGraph, starts: tuple[str, ...], *,
                 max_states: int = 100_000) -> SoundnessReport:
-    """Explore one level from ``starts`` and report its problems (conformance aside)."""
+    """Explore one level from ``starts`` and report its problems (conformance aside).
+
+    Memory is bounded by ``max_states``: at most that many states are kept, each with its
+    parent, its successors and a sparse marking (its marked places only), besides the net of
+    the level itself. Should the machine run out of memory first, the level is reported
+    inconclusive (``stopped="memory"``) rather than raising."""
+    try:
+        return _explore(process, graph, starts, max_states)
+    except MemoryError:
+        # the states explored so far are gone with the frame; say so instead of crashing
+        return SoundnessReport(process, 0, False, (), stopped="memory")
+
+
+def _explore(process: str, graph: FlowGraph, starts: tuple[str, ...],
+             max_states: int) -> SoundnessReport:
+    """The exploration: its memory is bounded by ``max_states`` states (see check_level)."""
     net = TokenNet(graph, starts)
     first: State = (net.initial(), False)
     parents: dict[State, tuple[State, str] | None] = {first: None}
     edges: dict[State, list[State]] = {}
     queue = deque([first])
     fired: set[str] = set()
-    marked: set[int] = {p for p, c in enumerate(first[0]) if c}     # places ever marked
+    marked: set[int] = {p for p, _ in first[0]}     # places ever marked
     problems: list[Problem] = []
     complete = True
     unbounded: set[int] = set()
@@ -121,13 +139,13 @@ def check_level(process: str, graph: FlowGraph, starts: tuple[str, ...], *,
         moves = list(net.firings(marking))
         successors: list[State] = []
         edges[state] = successors
-        if not moves and any(marking):
+        if not moves and net.has_tokens(marking):
             stuck_states.append(state)
         for activity_id, after, finished in moves:
             fired.add(activity_id)
             nxt: State = (after, ended or finished)
-            marked.update(p for p, c in enumerate(after) if c)
-            over = next((p for p, c in enumerate(after) if c > TOKEN_BOUND), None)
+            marked.update(p for p, _ in after)
+            over = next((p for p, c in net.token_places(after) if c > TOKEN_BOUND), None)
             if over is not None:
                 if over not in unbounded:
                     unbounded.add(over)
@@ -150,12 +168,12 @@ def check_level(process: str, graph: FlowGraph, starts: tuple[str, ...], *,
     if complete and not unbounded:
         problems.extend(_livelock(process, graph, net, parents, edges, stuck_states, witness))
         problems.extend(_dead(process, graph, net, fired, marked))
-    return SoundnessReport(process, len(parents), complete, tuple(problems))
+    return SoundnessReport(process, len(parents), complete, tuple(problems),
+                           stopped=None if complete else "states")
 
 
 def _holders(net: TokenNet, marking: Marking) -> list[str]:
-    return sorted({net.place_target[p] for p, c in enumerate(marking)
-                   if c and p in net.place_target})
+    return net.holders(marking)
 
 
 def _stuck(process: str, graph: FlowGraph, net: TokenNet, states: list[State],
@@ -185,7 +203,7 @@ def _livelock(process: str, graph: FlowGraph, net: TokenNet,
               parents: dict[State, tuple[State, str] | None], edges: dict[State, list[State]],
               stuck: list[State], witness: Callable[[State], tuple[str, ...]]) -> list[Problem]:
     """States that can reach neither completion nor a stuck state: the first (shortest)."""
-    settled = {s for s in parents if not any(s[0])} | set(stuck)
+    settled = {s for s in parents if not net.has_tokens(s[0])} | set(stuck)
     backward: dict[State, list[State]] = {}
     for source, targets in edges.items():
         for target in targets:
@@ -237,7 +255,15 @@ def _dead(process: str, graph: FlowGraph, net: TokenNet, fired: set[str],
         if activity.id in fired or attached_to(activity) is not None:
             continue     # a boundary event not interrupting anything is not dead code
         inputs = net.inputs[activity.id]
-        if join_type(activity) is GatewayType.AND and len(inputs) > 1:
+        if net.join[activity.id] is GatewayType.COMPLEX:
+            never = [net.places[p] for p in inputs if p not in marked]
+            why = (f"{', '.join(never)} never get(s) a token" if never else
+                   "its IncomingCondition never holds for the tokens that arrive together")
+            out.append(Problem(
+                "dead", process, activity.id,
+                f"complex join {activity.id!r} can never fire: of its incoming transitions, "
+                f"{why}", (), _line(graph, activity.id)))
+        elif net.join[activity.id] is GatewayType.AND and len(inputs) > 1:
             never = [net.places[p] for p in inputs if p not in marked]
             why = (f"{', '.join(never)} never get(s) a token" if never else
                    "each gets tokens, but never all at the same time")
@@ -281,7 +307,6 @@ def check_process(process: WorkflowProcess, *, conformance: str | None = None,
                       for activity, message, witness in
                       conformance_violations(graph, conformance or ""))
         if extra:
-            report = SoundnessReport(report.process, report.states, report.complete,
-                                     report.problems + extra)
+            report = replace(report, problems=report.problems + extra)
         reports.append(report)
     return reports

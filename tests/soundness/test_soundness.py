@@ -333,11 +333,12 @@ def test_cli_prints_path_line_and_witness_and_exits_1(tmp_path, capsys):
     assert f"{spec}:" in out and "deadlock" in out and "witness: start -> X ->" in out
 
 
-def test_cli_state_space_exceeded_exits_2(capsys):
+def test_cli_state_space_exceeded_is_inconclusive_and_exits_1(capsys):
     status = main(["check", "--max-states", "3", str(ROOT / "specs" /
                                                     "medication_dispenser.xpdl")])
-    assert status == 2
-    assert "soundness undecided" in capsys.readouterr().out
+    assert status == 1
+    out = capsys.readouterr().out
+    assert "more than 3 states: inconclusive" in out and ": inconclusive (" in out
 
 
 def test_cli_missing_file_is_a_usage_error(capsys):
@@ -346,7 +347,9 @@ def test_cli_missing_file_is_a_usage_error(capsys):
 
 # ------------------------------------------------------------------ engine rules in the game
 
-COND = {"kind": ConditionKind.CONDITION, "text": "x > 1"}
+def cond(text: str) -> dict:
+    from opspec.xpdl.conditions import parse_condition
+    return {"kind": ConditionKind.CONDITION, "text": text, "expression": parse_condition(text)}
 
 
 def fork_join(split: GatewayType, join: GatewayType, *, conditional: bool = False,
@@ -355,11 +358,12 @@ def fork_join(split: GatewayType, join: GatewayType, *, conditional: bool = Fals
     and an OTHERWISE transition from S."""
     extra = (tr("tw", "S", otherwise_to, kind=ConditionKind.OTHERWISE),) if otherwise_to else ()
     other = (end("other", 16),) if otherwise_to else ()
-    flow = COND if conditional else {}
+    flow_a = cond("x > 1") if conditional else {}
+    flow_b = cond("y > 1") if conditional else {}
     return process(activities=(
         start(), act("S", 11, split=Split(type=split)), act("a", 12), act("b", 13),
         gateway("J", 14, join=join), end(line=15), *other), transitions=(
-        tr("t0", "start", "S"), tr("ta", "S", "a", **flow), tr("tb", "S", "b", **flow),
+        tr("t0", "start", "S"), tr("ta", "S", "a", **flow_a), tr("tb", "S", "b", **flow_b),
         *extra, tr("ja", "a", "J"), tr("jb", "b", "J"), tr("te", "J", "end")))
 
 
@@ -380,13 +384,10 @@ def test_and_split_takes_otherwise_only_when_no_condition_holds():
 
 
 def test_or_split_closed_by_or_join_is_sound_but_by_and_join_deadlocks():
-    assert problems(fork_join(GatewayType.OR, GatewayType.OR)) == []
-    assert "deadlock" in kinds(fork_join(GatewayType.OR, GatewayType.AND))
-
-
-def test_complex_join_waits_like_an_and_join():
-    assert "deadlock" in kinds(fork_join(GatewayType.XOR, GatewayType.COMPLEX))
-    assert problems(fork_join(GatewayType.AND, GatewayType.COMPLEX)) == []
+    assert problems(fork_join(GatewayType.OR, GatewayType.OR, conditional=True)) == []
+    assert "deadlock" in kinds(fork_join(GatewayType.OR, GatewayType.AND, conditional=True))
+    # unconditional flows of an OR split are always taken, as in the engine
+    assert problems(fork_join(GatewayType.OR, GatewayType.AND)) == []
 
 
 def test_terminate_end_event_removes_the_tokens_left_behind():
@@ -491,8 +492,8 @@ def test_cli_json_has_one_object_per_file_with_processes_problems_and_witnesses(
     docs = [json.loads(line) for line in capsys.readouterr().out.splitlines()]
     assert [d["path"] for d in docs] == [str(data), str(spec)]
     bad, good = docs
-    assert set(bad) == {"path", "sound", "loaded", "max_states", "processes", "problems",
-                        "errors"}
+    assert set(bad) == {"path", "sound", "loaded", "max_states", "inconclusive", "processes",
+                        "problems", "errors"}
     assert bad["sound"] is False and good["sound"] is True and good["problems"] == []
     deadlock = next(p for p in bad["problems"] if p["kind"] == "deadlock")
     assert set(deadlock) == {"kind", "severity", "process", "activity", "line", "message",
@@ -526,13 +527,13 @@ def test_cli_rejects_a_max_states_below_one(capsys):
 
 def test_cli_state_space_message_names_the_level_and_the_limit(capsys):
     spec = ROOT / "specs" / "medication_dispenser.xpdl"
-    assert main(["check", "--json", "--max-states", "3", str(spec)]) == 2
+    assert main(["check", "--json", "--max-states", "3", str(spec)]) == 1
     doc = json.loads(capsys.readouterr().out)
-    assert doc["sound"] is False and doc["max_states"] == 3
-    assert any(not p["complete"] for p in doc["processes"])
-    assert main(["check", "--max-states", "3", str(spec)]) == 2
+    assert doc["sound"] is False and doc["max_states"] == 3 and doc["inconclusive"] is True
+    assert any(not p["complete"] and p["stopped"] == "states" for p in doc["processes"])
+    assert main(["check", "--max-states", "3", str(spec)]) == 1
     out = capsys.readouterr().out
-    assert "warning: notify_workflow: more than 3 states: soundness undecided" in out
+    assert "warning: notify_workflow: more than 3 states: inconclusive" in out
 
 
 def test_cli_checks_the_control_flow_of_a_spec_with_reader_errors(tmp_path, capsys):
