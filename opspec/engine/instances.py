@@ -88,10 +88,11 @@ class Frame:
         self.ors: dict[int, int] = {}
         self.running: dict[int, ActivityInstance] = {}
         # complex joins: tokens per incoming slot, and the slots owed a token before the
-        # join resets (after it fired; BPMN's "waiting for reset")
-        self.cjoins: dict[int, list[int]] = {}
-        self.owed: dict[int, set[int]] = {}
-        self.queue: list[int] = []            # sequential ad-hoc sets: starts still to run
+        # join resets (after it fired; BPMN's "waiting for reset"); made when first needed
+        # (a frame per instance: most never have a complex join)
+        self.cjoins: dict[int, list[int]] | None = None
+        self.owed: dict[int, set[int]] | None = None
+        self.queue: list[int] | None = None   # sequential ad-hoc sets: starts still to run
 
 
 class ActivityInstance:

@@ -227,24 +227,20 @@ class Interpreter:
         self._draining = True
         ready = self._ready
         pop = ready.popleft
-        now = self.env._now
-        if now != self._instant:
-            self._instant = now
-            self._instant_steps = 0
-            if self._sampler is not None:         # the clock moved on: no cycle after all
-                self._sampler = None
-                self._start_limit = self.max_instant_steps
+        # Steps are counted without looking at the clock (reading it costs a dictionary
+        # lookup per drain); only past the limit does _past_limit ask whether the clock
+        # moved since the count began (then it starts again) or not (a zero-time cycle).
         steps = self._instant_steps + 1
         limit = self.max_instant_steps
         try:
             if steps > limit:
-                self._zero_time(None, None)
+                steps = self._past_limit(steps, None, None)
             while True:
                 while ready:
                     fn, a, b, c = pop()
                     steps += 1
                     if steps > limit:
-                        self._zero_time(a, b)
+                        steps = self._past_limit(steps, a, b)
                     fn(a, b, c)
                 if not self._pending:
                     break
@@ -254,6 +250,19 @@ class Interpreter:
         finally:
             self._draining = False
             self._instant_steps = steps
+
+    def _past_limit(self, steps: int, a: Any, b: Any) -> int:
+        """The step count passed the limit: a new count if the clock moved since the count
+        began, else a step of a zero-time cycle (see :meth:`_zero_time`)."""
+        now = self.env._now
+        if now != self._instant:
+            self._instant = now
+            if self._sampler is not None:         # the clock moved on: no cycle after all
+                self._sampler = None
+                self._start_limit = self.max_instant_steps
+            return 1
+        self._zero_time(a, b)
+        return steps
 
     def _zero_time(self, a: Any, b: Any) -> None:
         """A step past the limit at this instant: note what it moves (``a``, ``b`` as in a
@@ -486,6 +495,10 @@ class Interpreter:
         holds, consuming a token of each incoming transition that has one; then ignore one
         token on each of the others before firing again)."""
         index = act.index
+        if frame.cjoins is None:
+            frame.cjoins = {}
+            frame.owed = {}
+        assert frame.owed is not None
         counts = frame.cjoins.get(index)
         if counts is None:
             counts = frame.cjoins[index] = [0] * len(act.in_slots)
@@ -521,7 +534,7 @@ class Interpreter:
                 frame.parked -= 1
             else:
                 owed.add(slot)
-        if owed:
+        if owed and frame.owed is not None:
             frame.owed[act.index] = owed
         return True
 
@@ -552,7 +565,8 @@ class Interpreter:
             return True
         if not holds:
             return False
-        frame.queue.clear()
+        if frame.queue:
+            frame.queue.clear()
         for ai in list(frame.running.values()):
             self._stop(ai, TERMINATED, "the ad-hoc set's completion condition holds")
         frame.live = 0
@@ -576,14 +590,14 @@ class Interpreter:
                     frame.live += 1
                     fired = True
                     self._ready.append((self._start_at, frame, join, None))
-            if frame.owed and frame.live <= 0 and not fired:
+            if frame.owed and frame.live <= 0 and not fired:     # (only complex joins)
                 # nothing can deliver the tokens a fired complex join waits for: it resets
                 frame.owed.clear()
             if not fired and frame.live <= 0:
                 if frame.parked:
                     waiting = [frame.graph.activities[i].id
                                for i, c in (list(frame.joins.items()) + list(frame.ors.items())
-                                            + list(frame.cjoins.items()))
+                                            + list((frame.cjoins or {}).items()))
                                if (c if isinstance(c, int) else any(c))]
                     self.report_deadlock(frame.inst, waiting, "a join waits for branches "
                                          "that can no longer arrive")
@@ -601,9 +615,10 @@ class Interpreter:
         for other, counts in frame.joins.items():
             if other in upstream and any(counts):
                 return False
-        for other, counts in frame.cjoins.items():
-            if other in upstream and any(counts):
-                return False
+        if frame.cjoins:
+            for other, counts in frame.cjoins.items():
+                if other in upstream and any(counts):
+                    return False
         return True
 
     def _too_deep(self, ai: ActivityInstance, target: CompiledProcess) -> None:
@@ -1670,7 +1685,7 @@ class Interpreter:
                         f"{', '.join(item.choices)}, got {choice!r}",
                         hint="call complete(item, choice=ACTIVITY_ID)", sim_time=self.env._now)
             self._ready.append((self._choose, ai, trans, data))
-        elif ai.key in self._tool_at:
+        elif ai.act.toolchain and ai.key in self._tool_at:
             self._ready.append((self._tool_done, ai, data, None))
         elif data:
             if ai.act.params:
