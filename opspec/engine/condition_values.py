@@ -171,6 +171,8 @@ def ordered(a: Any, b: Any, op: str) -> bool:
 
 
 def _add(a: Any, b: Any) -> Any:
+    if type(a) in _NUMBERS and type(b) in _NUMBERS:     # the common case, first
+        return a + b
     if isinstance(a, str) or isinstance(b, str):
         return _text(a) + _text(b)
     if isinstance(a, _VECTORS) or isinstance(b, _VECTORS):
@@ -179,18 +181,23 @@ def _add(a: Any, b: Any) -> Any:
 
 
 def _subtract(a: Any, b: Any) -> Any:
+    if type(a) in _NUMBERS and type(b) in _NUMBERS:
+        return a - b
     if isinstance(a, _VECTORS) or isinstance(b, _VECTORS):
         return _elementwise(a, b, "-", operator.sub, scalar=False)
     return as_number(a, "'-'") - as_number(b, "'-'")
 
 
 def _multiply(a: Any, b: Any) -> Any:
+    if type(a) in _NUMBERS and type(b) in _NUMBERS:
+        return a * b
     if isinstance(a, _VECTORS) or isinstance(b, _VECTORS):
         return _elementwise(a, b, "*", operator.mul, scalar=True)
     return as_number(a, "'*'") * as_number(b, "'*'")
 
 
 _VECTORS = (tuple, list)
+_NUMBERS = frozenset({int, float, bool})
 
 
 def _elementwise(a: Any, b: Any, op: str, fn: Callable[[Any, Any], Any], *,
