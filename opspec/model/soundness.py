@@ -32,8 +32,7 @@ it is never called sound.
 
 from __future__ import annotations
 
-from collections import deque
-from collections.abc import Callable
+from array import array
 from dataclasses import dataclass, replace
 
 from opspec.model.activities import BlockActivity, GatewayType
@@ -98,10 +97,12 @@ def check_level(process: str, graph: FlowGraph, starts: tuple[str, ...], *,
                 max_states: int = 100_000) -> SoundnessReport:
     """Explore one level from ``starts`` and report its problems (conformance aside).
 
-    Memory is bounded by ``max_states``: at most that many states are kept, each with its
-    parent, its successors and a sparse marking (its marked places only), besides the net of
-    the level itself. Should the machine run out of memory first, the level is reported
-    inconclusive (``stopped="memory"``) rather than raising."""
+    Memory is bounded by ``max_states``: at most that many states are kept (a state is its
+    marked places and token counts packed in bytes, its parent, the activity fired to reach
+    it and, while the exploration can still be complete, the numbers of its successors),
+    besides the net of the level itself; see docs/soundness.md for the figures. Should the
+    machine run out of memory first, the level is reported inconclusive
+    (``stopped="memory"``) rather than raising."""
     try:
         return _explore(process, graph, starts, max_states)
     except MemoryError:
@@ -109,82 +110,121 @@ def check_level(process: str, graph: FlowGraph, starts: tuple[str, ...], *,
         return SoundnessReport(process, 0, False, (), stopped="memory")
 
 
+def _pack(marking: Marking, ended: bool) -> bytes:
+    """A state as compact bytes: the end flag, then (place, tokens) pairs."""
+    flat = array("I", (1 if ended else 0,))
+    for place, count in marking:
+        flat.append(place)
+        flat.append(count)
+    return flat.tobytes()
+
+
+def _unpack(key: bytes) -> State:
+    flat = array("I")
+    flat.frombytes(key)
+    return tuple(zip(flat[1::2], flat[2::2], strict=True)), bool(flat[0])
+
+
+class _Space:
+    """The explored states, numbered in breadth-first order (which is also the order they
+    are expanded in): ``keys[n]`` the packed state, ``parent[n]`` and ``via[n]`` (the
+    activity fired from the parent, an index into ``names``), and the successors of the
+    expanded states as ``targets[offsets[n]:offsets[n + 1]]``."""
+
+    def __init__(self, first: bytes, names: list[str]) -> None:
+        self.keys: list[bytes] = [first]
+        self.index: dict[bytes, int] = {first: 0}
+        self.parent = array("i", (-1,))
+        self.via = array("i", (-1,))
+        self.names = names
+        self.offsets = array("I", (0,))
+        self.targets = array("I")
+        self.edges = True             # dropped once the exploration cannot be complete
+
+    def witness(self, state: int) -> tuple[str, ...]:
+        path: list[str] = []
+        while self.parent[state] >= 0:
+            path.append(self.names[self.via[state]])
+            state = self.parent[state]
+        return tuple(reversed(path))
+
+    def successors(self, state: int) -> array[int]:
+        return self.targets[self.offsets[state]:self.offsets[state + 1]]
+
+
 def _explore(process: str, graph: FlowGraph, starts: tuple[str, ...],
              max_states: int) -> SoundnessReport:
     """The exploration: its memory is bounded by ``max_states`` states (see check_level)."""
     net = TokenNet(graph, starts)
-    first: State = (net.initial(), False)
-    parents: dict[State, tuple[State, str] | None] = {first: None}
-    edges: dict[State, list[State]] = {}
-    queue = deque([first])
+    names = list(graph.by_id)
+    number = {name: n for n, name in enumerate(names)}
+    space = _Space(_pack(net.initial(), False), names)
     fired: set[str] = set()
-    marked: set[int] = {p for p, _ in first[0]}     # places ever marked
+    marked: set[int] = {p for p, _ in net.initial()}     # places ever marked
     problems: list[Problem] = []
     complete = True
-    unbounded: set[int] = set()
-    stuck_states: list[State] = []
-
-    def witness(state: State) -> tuple[str, ...]:
-        path: list[str] = []
-        link = parents.get(state)
-        while link is not None:
-            previous, fired_activity = link
-            path.append(fired_activity)
-            link = parents.get(previous)
-        return tuple(reversed(path))
-
-    while queue:
-        state = queue.popleft()
-        marking, ended = state
+    unbounded = False
+    stuck_states: list[int] = []
+    cursor = 0
+    while cursor < len(space.keys):
+        state = cursor
+        cursor += 1
+        marking, ended = _unpack(space.keys[state])
         moves = list(net.firings(marking))
-        successors: list[State] = []
-        edges[state] = successors
         if not moves and net.has_tokens(marking):
             stuck_states.append(state)
         for activity_id, after, finished in moves:
             fired.add(activity_id)
-            nxt: State = (after, ended or finished)
             marked.update(p for p, _ in after)
             over = next((p for p, c in net.token_places(after) if c > TOKEN_BOUND), None)
             if over is not None:
-                if over not in unbounded:
-                    unbounded.add(over)
-                    target = net.place_target.get(over)
-                    problems.append(Problem(
-                        "unbounded", process, target,
-                        f"unbounded: tokens pile up on {net.places[over]!r} before {target!r} "
-                        f"(more than {TOKEN_BOUND}): the flow creates tokens faster than it "
-                        "consumes them", (*witness(state), activity_id), _line(graph, target)))
-                queue.clear()        # one is enough: the rest of the space is unbounded too
-                break
-            successors.append(nxt)
-            if nxt not in parents:
-                if len(parents) >= max_states:
-                    complete = False
+                unbounded = True
+                target = net.place_target.get(over)
+                problems.append(Problem(
+                    "unbounded", process, target,
+                    f"unbounded: tokens pile up on {net.places[over]!r} before {target!r} "
+                    f"(more than {TOKEN_BOUND}): the flow creates tokens faster than it "
+                    "consumes them", (*space.witness(state), activity_id),
+                    _line(graph, target)))
+                break             # one is enough: the rest of the space is unbounded too
+            key = _pack(after, ended or finished)
+            nxt = space.index.get(key)
+            if nxt is None:
+                if len(space.keys) >= max_states:
+                    if complete:      # no livelock verdict now: the edges are not needed
+                        complete = False
+                        space.edges = False
+                        space.targets = array("I")
+                        space.offsets = array("I")
                     continue
-                parents[nxt] = (state, activity_id)
-                queue.append(nxt)
-    problems.extend(_stuck(process, graph, net, stuck_states, witness))
+                nxt = len(space.keys)
+                space.keys.append(key)
+                space.index[key] = nxt
+                space.parent.append(state)
+                space.via.append(number[activity_id])
+            if space.edges:
+                space.targets.append(nxt)
+        if unbounded:
+            break
+        if space.edges:
+            space.offsets.append(len(space.targets))
+    problems.extend(_stuck(process, graph, net, space, stuck_states))
     if complete and not unbounded:
-        problems.extend(_livelock(process, graph, net, parents, edges, stuck_states, witness))
+        problems.extend(_livelock(process, graph, net, space, stuck_states))
         problems.extend(_dead(process, graph, net, fired, marked))
-    return SoundnessReport(process, len(parents), complete, tuple(problems),
+    return SoundnessReport(process, len(space.keys), complete, tuple(problems),
                            stopped=None if complete else "states")
 
 
-def _holders(net: TokenNet, marking: Marking) -> list[str]:
-    return net.holders(marking)
-
-
-def _stuck(process: str, graph: FlowGraph, net: TokenNet, states: list[State],
-           witness: Callable[[State], tuple[str, ...]]) -> list[Problem]:
+def _stuck(process: str, graph: FlowGraph, net: TokenNet, space: _Space,
+           states: list[int]) -> list[Problem]:
     """Deadlocks and improper completions, one per set of waiting activities (the first
     found, so the one with the shortest witness)."""
     out: list[Problem] = []
     seen: set[tuple[bool, tuple[str, ...]]] = set()
     for state in states:
-        marking, ended = state
-        waiting = _holders(net, marking)
+        marking, ended = _unpack(space.keys[state])
+        waiting = net.holders(marking)
         if (ended, tuple(waiting)) in seen:
             continue
         seen.add((ended, tuple(waiting)))
@@ -195,27 +235,39 @@ def _stuck(process: str, graph: FlowGraph, net: TokenNet, states: list[State],
         else:
             message = f"deadlock: nothing can fire, tokens wait at {', '.join(waiting)}"
         out.append(Problem("improper-completion" if ended else "deadlock", process, where,
-                           message, witness(state), _line(graph, where)))
+                           message, space.witness(state), _line(graph, where)))
     return out
 
 
-def _livelock(process: str, graph: FlowGraph, net: TokenNet,
-              parents: dict[State, tuple[State, str] | None], edges: dict[State, list[State]],
-              stuck: list[State], witness: Callable[[State], tuple[str, ...]]) -> list[Problem]:
+def _livelock(process: str, graph: FlowGraph, net: TokenNet, space: _Space,
+              stuck: list[int]) -> list[Problem]:
     """States that can reach neither completion nor a stuck state: the first (shortest)."""
-    settled = {s for s in parents if not net.has_tokens(s[0])} | set(stuck)
-    backward: dict[State, list[State]] = {}
-    for source, targets in edges.items():
-        for target in targets:
-            backward.setdefault(target, []).append(source)
-    stack = list(settled)
+    count = len(space.keys)
+    settled = bytearray(count)
+    stack = [n for n in range(count) if not net.has_tokens(_unpack(space.keys[n])[0])]
+    stack.extend(stuck)
+    for n in stack:
+        settled[n] = 1
+    # the edges backwards, as arrays (counting sort by target)
+    starts = array("I", bytes(4 * (count + 1)))
+    for target in space.targets:
+        starts[target + 1] += 1
+    for n in range(count):
+        starts[n + 1] += starts[n]
+    sources = array("I", bytes(4 * len(space.targets)))
+    fill = array("I", starts)
+    for source in range(count):
+        for target in space.successors(source):
+            sources[fill[target]] = source
+            fill[target] += 1
+    del fill
     while stack:
         node = stack.pop()
-        for source in backward.get(node, ()):
-            if source not in settled:
-                settled.add(source)
+        for source in sources[starts[node]:starts[node + 1]]:
+            if not settled[source]:
+                settled[source] = 1
                 stack.append(source)
-    state = next((s for s in parents if s not in settled), None)   # BFS order: shortest
+    state = next((n for n in range(count) if not settled[n]), None)   # BFS order: shortest
     if state is None:
         return []
     # every successor of a lost state is lost too: walk on until a state repeats, so the
@@ -224,28 +276,29 @@ def _livelock(process: str, graph: FlowGraph, net: TokenNet,
     loop: list[str] = []
     seen = {state: 0}
     node = state
-    while edges.get(node):
-        nxt = edges[node][0]
-        walk.append(_fired_between(net, node, nxt))
+    while len(space.successors(node)):
+        nxt = space.successors(node)[0]
+        walk.append(_fired_between(net, space.keys[node], space.keys[nxt]))
         if nxt in seen:
             loop = walk[seen[nxt]:]
             break
         seen[nxt] = len(walk)
         node = nxt
-    active = _holders(net, state[0])
+    active = net.holders(_unpack(space.keys[state])[0])
     where = active[0] if active else None
     names = ", ".join(dict.fromkeys(loop)) or ", ".join(active)
     return [Problem(
         "livelock", process, where,
         "livelock: from here the process can never complete, it loops for ever through "
-        f"{names} (give the loop a way out)", (*witness(state), *walk),
+        f"{names} (give the loop a way out)", (*space.witness(state), *walk),
         _line(graph, where))]
 
 
-def _fired_between(net: TokenNet, before: State, after: State) -> str:
+def _fired_between(net: TokenNet, before: bytes, after: bytes) -> str:
     """The activity whose firing turns ``before`` into ``after``."""
-    return next(activity for activity, marking, _ in net.firings(before[0])
-                if marking == after[0])
+    marking, ended = _unpack(before)
+    return next(activity for activity, result, finished in net.firings(marking)
+                if _pack(result, ended or finished) == after)
 
 
 def _dead(process: str, graph: FlowGraph, net: TokenNet, fired: set[str],
