@@ -11,7 +11,19 @@ run, the median of ``--repeats`` runs of
 - compile (``opspec.model.codec.write_wfs``: model -> JSON -> file),
 - ``.wfs`` load (``opspec.model.codec.read_wfs``), with the share of it spent in ``json.loads``,
 
-and prints the ratio XPDL load / .wfs load. It prints; it asserts nothing.
+and prints the ratio XPDL load / .wfs load.
+
+Then the checks at scale (``--scale``, on by default; ``--no-scale`` skips them), each run as
+``opspec`` in a fresh process so that its peak RSS is its own, with its ratio to lxml's bare
+parse time (``lxml.etree.parse``) of the same file:
+
+- ``opspec validate`` on a generated file of ``--splits`` (50,000) AND splits, each with
+  TransitionRefs (about 19 MB: the issue's "15 MB with 50,000 AND splits");
+- ``opspec check`` on a chain of ``--chain`` (5,000) activities and on ten times that, at
+  the default ``--max-states`` (100,000), and on a 20-way AND split whose 2**20 markings
+  run into that budget (an inconclusive verdict, exit 1).
+
+It prints; it asserts nothing.
 """
 
 from __future__ import annotations
@@ -19,6 +31,7 @@ from __future__ import annotations
 import argparse
 import json
 import statistics
+import subprocess
 import sys
 import tempfile
 import time
@@ -116,6 +129,116 @@ def generated_xpdl(target_bytes: int) -> bytes:
     return write_xpdl(package(max(1, round(target_bytes / per_process))))
 
 
+def and_splits_xpdl(splits: int) -> bytes:
+    """One process: start -> s0 -> s1 -> ... , each s_i an AND split (with TransitionRefs)
+    to s_(i+1) and to a task a_i of its own, which ends its token."""
+    parts = [('<?xml version="1.0" encoding="UTF-8"?>\n<Package xmlns="http://www.wfmc.org/'
+             '2008/XPDL2.1" Id="forks" Name="forks"><PackageHeader><XPDLVersion>2.1'
+             '</XPDLVersion><Vendor>opspec</Vendor><Created>2026-01-01</Created>'
+             '</PackageHeader><WorkflowProcesses><WorkflowProcess Id="forks"><ProcessHeader/>'
+             '<Activities>\n<Activity Id="start"><Event><StartEvent Trigger="None"/></Event>'
+             '</Activity>\n')]
+    parts.extend(
+        f'<Activity Id="s{i}"><Route/><TransitionRestrictions><TransitionRestriction>'
+        f'<Split Type="Parallel"><TransitionRefs><TransitionRef Id="n{i}"/><TransitionRef '
+        f'Id="b{i}"/></TransitionRefs></Split></TransitionRestriction>'
+        f'</TransitionRestrictions></Activity>\n<Activity Id="a{i}"/>\n'
+        for i in range(splits))
+    parts.append(f'<Activity Id="s{splits}"/>\n</Activities><Transitions>\n'
+                 '<Transition Id="t0" From="start" To="s0"/>\n')
+    parts.extend(f'<Transition Id="n{i}" From="s{i}" To="s{i + 1}"/>\n'
+                 f'<Transition Id="b{i}" From="s{i}" To="a{i}"/>\n' for i in range(splits))
+    parts.append("</Transitions></WorkflowProcess></WorkflowProcesses></Package>\n")
+    return "".join(parts).encode()
+
+
+def chain_xpdl(activities: int) -> bytes:
+    """One process: a0 -> a1 -> ... -> a(n-1)."""
+    parts = [('<?xml version="1.0" encoding="UTF-8"?>\n<Package xmlns="http://www.wfmc.org/'
+             '2008/XPDL2.1" Id="chain" Name="chain"><PackageHeader><XPDLVersion>2.1'
+             '</XPDLVersion><Vendor>opspec</Vendor><Created>2026-01-01</Created>'
+             '</PackageHeader><WorkflowProcesses><WorkflowProcess Id="chain"><ProcessHeader/>'
+             '<Activities>\n')]
+    parts.extend(f'<Activity Id="a{i}"/>\n' for i in range(activities))
+    parts.append("</Activities><Transitions>\n")
+    parts.extend(f'<Transition Id="t{i}" From="a{i}" To="a{i + 1}"/>\n'
+                 for i in range(activities - 1))
+    parts.append("</Transitions></WorkflowProcess></WorkflowProcesses></Package>\n")
+    return "".join(parts).encode()
+
+
+def wide_xpdl(branches: int) -> bytes:
+    """start -> S (AND split) -> w0..w(n-1) -> J (AND join) -> end: 2**n markings."""
+    route = ('<Activity Id="{id}"><Route/><TransitionRestrictions><TransitionRestriction>'
+             '<{kind} Type="Parallel"/></TransitionRestriction></TransitionRestrictions>'
+             '</Activity>\n')
+    parts = [('<?xml version="1.0" encoding="UTF-8"?>\n<Package xmlns="http://www.wfmc.org/'
+             '2008/XPDL2.1" Id="wide" Name="wide"><PackageHeader><XPDLVersion>2.1'
+             '</XPDLVersion><Vendor>opspec</Vendor><Created>2026-01-01</Created>'
+             '</PackageHeader><WorkflowProcesses><WorkflowProcess Id="wide"><ProcessHeader/>'
+             '<Activities>\n<Activity Id="start"/>\n'), route.format(id="S", kind="Split"),
+             route.format(id="J", kind="Join"), '<Activity Id="end"/>\n']
+    parts.extend(f'<Activity Id="w{i}"/>\n' for i in range(branches))
+    parts.append('</Activities><Transitions>\n<Transition Id="t0" From="start" To="S"/>\n'
+                 '<Transition Id="te" From="J" To="end"/>\n')
+    parts.extend(f'<Transition Id="a{i}" From="S" To="w{i}"/>\n'
+                 f'<Transition Id="b{i}" From="w{i}" To="J"/>\n' for i in range(branches))
+    parts.append("</Transitions></WorkflowProcess></WorkflowProcesses></Package>\n")
+    return "".join(parts).encode()
+
+
+# peak RSS from VmHWM (reset by exec, unlike ru_maxrss, which a child inherits at fork)
+_MEASURE = """
+import sys, time
+from opspec.cli import main
+start = time.perf_counter()
+status = main(sys.argv[1:])
+seconds = time.perf_counter() - start
+with open("/proc/self/status") as f:
+    peak = next(int(x.split()[1]) for x in f if x.startswith("VmHWM:"))
+print(f"@@ {status} {seconds} {peak}", file=sys.stderr)
+"""
+
+
+def command(label: str, args: list[str], source: Path, repeats: int) -> None:
+    """Run ``opspec ARGS`` in a fresh process (best of ``repeats``): seconds, status, peak
+    RSS, and the ratio to lxml's bare parse of ``source``."""
+    from lxml import etree
+
+    t_lxml = _median_seconds(lambda: etree.parse(str(source)), max(1, repeats))
+    best = None
+    for _ in range(max(1, repeats)):
+        done = subprocess.run([sys.executable, "-c", _MEASURE, *args], capture_output=True,
+                              text=True, check=False)
+        line = next((x for x in done.stderr.splitlines() if x.startswith("@@ ")), None)
+        if line is None:
+            print(f"{label}: failed: {done.stderr.strip()[-300:]}")
+            return
+        _, status, seconds, rss_kb = line.split()
+        if best is None or float(seconds) < best[1]:
+            best = (int(status), float(seconds), int(rss_kb))
+    assert best is not None
+    status, seconds, rss_kb = best
+    print(f"{label}: {source.name} ({source.stat().st_size / 2**20:.1f} MiB)")
+    print(f"  opspec {' '.join(a if '/' not in a else Path(a).name for a in args)}: "
+          f"{seconds:8.2f} s, exit {status}, peak RSS {rss_kb / 1024:6.0f} MiB")
+    print(f"  lxml bare parse {t_lxml * 1e3:9.1f} ms; ratio {seconds / t_lxml:6.1f}x")
+
+
+def scale(work: Path, splits: int, chain: int, repeats: int) -> None:
+    forks = work / f"and_splits_{splits}.xpdl"
+    forks.write_bytes(and_splits_xpdl(splits))
+    command(f"validate, {splits} AND splits", ["validate", str(forks)], forks, repeats)
+    for n in (chain, 10 * chain):
+        path = work / f"chain_{n}.xpdl"
+        path.write_bytes(chain_xpdl(n))
+        command(f"check, a chain of {n} activities", ["check", str(path)], path, repeats)
+    wide = work / "and_20.xpdl"
+    wide.write_bytes(wide_xpdl(20))
+    command("check, a 20-way AND split (2**20 markings: inconclusive at --max-states)",
+            ["check", str(wide)], wide, 1)
+
+
 def bench(label: str, source: Path, work: Path, repeats: int) -> None:
     wfs = work / f"{source.stem}.wfs"
     result = load_package(source)
@@ -142,6 +265,11 @@ def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--repeats", type=int, default=7)
     parser.add_argument("--target-kb", type=int, default=1024)
+    parser.add_argument("--scale", action=argparse.BooleanOptionalAction, default=True,
+                        help="also validate/check the generated big inputs")
+    parser.add_argument("--splits", type=int, default=50_000)
+    parser.add_argument("--chain", type=int, default=5_000)
+    parser.add_argument("--scale-repeats", type=int, default=1)
     args = parser.parse_args(argv)
     with tempfile.TemporaryDirectory() as folder:
         work = Path(folder)
@@ -150,6 +278,8 @@ def main(argv: list[str] | None = None) -> int:
         generated = work / "generated.xpdl"
         generated.write_bytes(generated_xpdl(args.target_kb * 1024))
         bench(f"generated package (~{args.target_kb} KiB)", generated, work, args.repeats)
+        if args.scale:
+            scale(work, args.splits, args.chain, args.scale_repeats)
     print(f"(median of {args.repeats} runs each; Python {sys.version.split()[0]})")
     return 0
 
