@@ -4,8 +4,6 @@ performer (a script, a user model, or the spec's companion ``SPEC.users.toml``).
 from __future__ import annotations
 
 import sys
-from collections.abc import Callable
-from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -14,11 +12,11 @@ from opspec.errors import ConfigurationError
 if TYPE_CHECKING:
     from opspec.engine.compiled import CompiledPackage
     from opspec.engine.performers import Performer
-    from opspec.engine.trace import TraceListener
     from opspec.errors import Diagnostic
     from opspec.model import Package
+    from opspec.runs import User
 
-__all__ = ["UserChoice", "choose_user", "companion_user_model", "engine_diagnostics",
+__all__ = ["bind_user", "choose_user", "companion_user_model", "engine_diagnostics",
            "load_any_spec"]
 
 
@@ -88,30 +86,21 @@ def engine_diagnostics(package: Package, *, world: bool = False) -> list[Diagnos
 
 
 def companion_user_model(spec_path: str | Path) -> Path | None:
-    """``SPEC.users.toml`` next to the spec, if there is one."""
-    path = Path(spec_path)
-    candidate = path.with_name(path.name.removesuffix(path.suffix) + ".users.toml")
-    return candidate if candidate.is_file() else None
+    """``SPEC.users.toml`` next to the spec, if there is one (:mod:`opspec.runs`' rule)."""
+    from opspec.runs import companion_user_model as companion
 
-
-@dataclass(frozen=True)
-class UserChoice:
-    """Who performs the user lane: ``make(user_index, seed)`` builds a fresh performer and
-    the listeners it needs (a scripted user listens to the trace to anchor its steps);
-    ``describe`` says so in words for the run's header."""
-
-    describe: str
-    make: Callable[[int, int], tuple[Performer | None, list[TraceListener]]]
+    return companion(spec_path)
 
 
 def choose_user(compiled: CompiledPackage, spec_path: str | Path, *, script: str | None,
-                user_model: str | None, companion: bool = True) -> UserChoice:
+                user_model: str | None, companion: bool = True) -> User:
     """The user-lane performer the options ask for, checked against the spec before any run.
 
     ``script`` wins over ``user_model``; with neither, the spec's companion user model is used
     when ``companion`` is true and one exists; otherwise nobody performs the user lane.
     """
     from opspec.engine.lanes import user_lane
+    from opspec.runs import User
 
     lane = user_lane(compiled)
     if script is not None and user_model is not None:
@@ -124,34 +113,19 @@ def choose_user(compiled: CompiledPackage, spec_path: str | Path, *, script: str
         plan = load_script(script)
         names = spec_names(compiled)         # the same names simulate(script=...) checks
         plan.check_names(names.activities, names.triggers)
-
-        def scripted(_user: int, _seed: int) -> tuple[Performer | None, list[TraceListener]]:
-            performer = plan.performer()
-            return performer, [performer]
-
-        return UserChoice(f"the script {script}", scripted)
+        return User.script(plan, f"the script {script}")
     ref: str | Path | None = user_model
     if ref is None and companion:
         ref = companion_user_model(spec_path)
     if ref is None:
-        def nobody(_user: int, _seed: int) -> tuple[Performer | None, list[TraceListener]]:
-            return None, []
-
-        text = ("nobody (no --script or --user-model, and no companion .users.toml): "
-                "user-lane activities wait" if not lane.empty else "nobody (no user lane)")
-        return UserChoice(text, nobody)
-    from opspec.engine.random import user_stream
-    from opspec.usermodels.loader import load_user_model
-
-    model = load_user_model(ref)
+        return User.nobody("nobody (no --script or --user-model, and no companion .users.toml): "
+                           "user-lane activities wait" if not lane.empty
+                           else "nobody (no user lane)")
+    user = User.model(ref, f"the user model {ref}")
     if not lane.empty:
-        for warning in model.validate_against(lane.manual, choices=lane.choices):
+        for warning in user.source.validate_against(lane.manual, choices=lane.choices):
             print(f"opspec: {warning}", file=sys.stderr)
-
-    def stochastic(user: int, seed: int) -> tuple[Performer | None, list[TraceListener]]:
-        return model.performer(user_stream(seed, user)), []
-
-    return UserChoice(f"the user model {ref}", stochastic)
+    return user
 
 
 def bind_user(compiled: CompiledPackage, performer: Performer | None) -> dict[str, Any]:

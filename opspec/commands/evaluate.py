@@ -37,7 +37,7 @@ def register(subparsers: Any) -> None:
     parser.add_argument("--users", type=int, default=100, help="simulated users (default 100)")
     parser.add_argument("--days", type=float, default=None,
                         help="simulated days per user (default: the spec's opspec:RunLength "
-                        "if it declares one, else 30)")
+                        "if it declares one, else 1)")
     parser.add_argument("--seed", type=seed, default=0, help="run seed (default 0)")
     parser.add_argument("--user-model", metavar="FILE|PRESET",
                         help="user model file or preset, 'A,B' to chain (default: the spec's "
@@ -114,8 +114,8 @@ def _new_plan(args: argparse.Namespace) -> Any:
         designs.append(Design(label, str(path), file_digest(path)))
     days = args.days
     if days is None:
-        # a robot's run is minutes, a dispenser's life is days: the spec says which
-        days = run_lengths[0] / DAY if run_lengths[0] is not None else 30.0
+        # the one rule of opspec.runs.run_length: the spec's opspec:RunLength, else one day
+        days = run_lengths[0] / DAY if run_lengths[0] is not None else 1.0
     model = args.user_model
     if model is None:
         companion = companion_user_model(args.spec)
@@ -316,7 +316,7 @@ def _trace_writers(stack: contextlib.ExitStack, folder: Path, plan: Any) -> Any:
 
     # a resumed run simulates the stored users again for their traces (run_evaluation's
     # retrace), so each file is written whole again; the interrupted run's .partial goes
-    attrs = {"spec": plan.design("A").spec, "seed": str(plan.seed)}
+    attrs: dict[str, Any] = {"spec": plan.design("A").spec, "seed": plan.seed}
     writers: list[XesWriter | JsonlTraceWriter] = []
     for fmt in plan.export:
         path = folder / f"traces.{fmt}"

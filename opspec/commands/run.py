@@ -53,11 +53,11 @@ def register(subparsers: Any) -> None:
     length = parser.add_mutually_exclusive_group()
     length.add_argument("--days", type=float, metavar="D",
                         help="simulated days to run (default: the spec's opspec:RunLength "
-                        "if it declares one, else 1 for specs with periodic triggers, else "
-                        "until nothing is left to do)")
+                        "if it declares one, else 1)")
     length.add_argument("--until", metavar="T",
                         help="simulated end time: seconds, or an ISO 8601 duration (PT8H)")
-    parser.add_argument("--seed", type=seed, default=0, help="run seed (default 0)")
+    parser.add_argument("--seed", type=seed, default=0,
+                        help="run seed (default 0): draws as user 0 of opspec evaluate --seed")
     user = parser.add_mutually_exclusive_group()
     user.add_argument("--script", metavar="FILE",
                       help="a scripted user (TOML/JSON steps, or a recorded walkthrough)")
@@ -92,43 +92,37 @@ def register(subparsers: Any) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    from opspec.commands._spec import bind_user, choose_user, load_any_spec
-    from opspec.engine.compiled import compile_package
-    from opspec.engine.simulation import Simulation
+    from opspec.commands._spec import choose_user, load_any_spec
     from opspec.engine.trace_sinks import JsonlSink
+    from opspec.runs import build, load, run_length
 
     package = load_any_spec(args.spec)
-    compiled = compile_package(package)
+    spec = load(package)
+    compiled = spec.compiled
     config = _config(args)
-    horizon = _horizon(args, compiled)
+    if args.days is not None and not (args.days > 0 and math.isfinite(args.days)):
+        raise ConfigurationError(f"--days must be a positive number, not {args.days:g}")
+    horizon = run_length(compiled, days=args.days,
+                         until=None if args.until is None else _parse_until(args.until))
     user = choose_user(compiled, args.spec, script=args.script, user_model=args.user_model,
                        companion=not args.no_user)
     out = sys.stdout
     printer = None if args.json or args.timeline == "none" else _Timeline(
         out, brief=args.timeline == "brief", quiet=quiet_activities(compiled))
-    performer, listeners = user.make(0, args.seed)
-    from opspec.engine.monitors import declared_monitors
-
-    watches = [m.start(0) for m in declared_monitors(compiled)]
-    listeners.extend(watches)
-    performers: dict[str, Any] = bind_user(compiled, performer)
-    performers.update(_world_performers(compiled, args.seed))
+    listeners: list[Any] = []
     with contextlib.ExitStack() as stack:
         devices = _devices(args, stack, compiled)  # a port that won't open stops us here
         clock_note = None
         if devices is not None:                  # wall clock for devices, at which speed
             config, clock_note = devices.clock(config, args.speed, horizon)
         if not args.json:
-            length = ("until nothing is left to do" if horizon is None
-                      else f"for {_span(horizon)} simulated")
             print(f"opspec run: {package.name or package.id} ({args.spec}), seed {args.seed}, "
-                  f"{length}", file=out)
+                  f"for {_span(horizon)} simulated", file=out)
             print(f"  user lane: {user.describe}", file=out)
             print(f"  engine: {config.processor_model}"
                   + (f", {config.workers} worker(s)" if config.pooled else "")
                   + (f", wall clock at {config.speed:g}x" if config.realtime else ""), file=out)
         if devices is not None:
-            performers.update(devices.performers)
             for note in devices.notes:
                 if not args.json:
                     print(f"  device: {note}", file=out)
@@ -149,17 +143,11 @@ def run(args: argparse.Namespace) -> int:
             listeners.append(printer)
             if not args.json:
                 print(file=out)
-        from opspec.xpdl.open_spec import mode_loader_for
-
-        sim = Simulation(compiled, config, performers=performers, seed=args.seed,
-                         listeners=listeners, mode_loader=mode_loader_for(package))
-        if devices is not None:
-            devices.install(sim)
-        result = sim.run(until=horizon)
-        for watch in watches:
-            watch.finish(float(result.summary.get("time", horizon or 0.0)))
-        monitors = {w.monitor.text: w.result() for w in watches}
-        medians = _medians(sim)
+        outcome = build(spec, seed=args.seed, user=user, until=horizon, config=config,
+                        listeners=listeners, devices=devices).execute()
+        result = outcome.result
+        monitors = {r.monitor: r for r in outcome.monitors}
+        medians = outcome.medians
         device_report = devices.report() if devices is not None else None
     timing_summary = timing.summary() if timing is not None else None
     if args.json:
@@ -182,9 +170,7 @@ def run(args: argparse.Namespace) -> int:
         print(f"opspec: note: {sink.message()} ({sink.dropped:,} not written)",
               file=sys.stderr)
     device_faults = any(info.get("faults") for info in (device_report or {}).values())
-    problems = result.summary.get("deadlocks") or result.summary.get("faults") or (
-        result.summary.get("instances", {}).get("aborted", 0)) or device_faults
-    return 1 if problems else 0
+    return 1 if outcome.problems or device_faults else 0
 
 
 #: violations listed per monitor (all are counted)
@@ -234,20 +220,6 @@ def _config(args: argparse.Namespace) -> Any:
     return config.with_options(**overrides) if overrides else config
 
 
-def _horizon(args: argparse.Namespace, compiled: Any) -> float | None:
-    if args.days is not None:
-        if not (args.days > 0 and math.isfinite(args.days)):
-            raise ConfigurationError(f"--days must be a positive number, not {args.days:g}")
-        return float(args.days * DAY)
-    if args.until is not None:
-        return _parse_until(args.until)
-    if compiled.package.run_length is not None:
-        return float(compiled.package.run_length)
-    periodic = any(p.start_trigger is not None and p.start_trigger.kind in ("timer", "period")
-                   for p in compiled.processes.values())
-    return DAY if periodic else None
-
-
 def _parse_until(text: str) -> float:
     try:
         value = float(text)
@@ -263,14 +235,6 @@ def _parse_until(text: str) -> float:
     if not (value > 0 and math.isfinite(value)):
         raise ConfigurationError(f"--until must be a positive time, not {text!r}")
     return value
-
-
-def _world_performers(compiled: Any, seed: int) -> dict[str, Any]:
-    try:
-        from opspec.bindings.worlds import world_performers
-    except ImportError:
-        return {}
-    return dict(world_performers(compiled, seed=seed, user=0))
 
 
 def _devices(args: argparse.Namespace, stack: contextlib.ExitStack, compiled: Any) -> Any:
@@ -392,13 +356,6 @@ class _Timeline:
         if event.kind == "exception.raised":   # the deadline line already said it
             return "deadline" not in str((event.data or {}).get("message", ""))
         return True
-
-
-def _medians(sim: Any) -> dict[str, float]:
-    from statistics import median
-
-    samples = sim.metrics.samples if sim.metrics is not None else {}
-    return {name: median(values) for name, values in samples.items() if values}
 
 
 def json_metrics(metrics: dict[str, dict[str, Any]],

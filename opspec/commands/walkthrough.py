@@ -14,6 +14,7 @@ from datetime import UTC, datetime
 from pathlib import Path
 from typing import Any
 
+from opspec.commands._args import seed
 from opspec.errors import ConfigurationError
 
 __all__ = ["register", "run"]
@@ -29,7 +30,8 @@ def register(subparsers: Any) -> None:
     parser.add_argument("--speed", type=float, default=None,
                         help="simulated seconds per wall second at start (default 60; 1 "
                         "with a real device bound)")
-    parser.add_argument("--seed", type=int, default=0, help="run seed (default 0)")
+    parser.add_argument("--seed", type=seed, default=0,
+                        help="run seed (default 0): the run of opspec run --seed")
     parser.add_argument("--days", type=float, default=None,
                         help="simulated days (default: the spec's opspec:RunLength, else 1)")
     parser.add_argument("--user-model", metavar="FILE|PRESET",
@@ -71,14 +73,8 @@ def run(args: argparse.Namespace) -> int:
             f"{Path(args.spec).name.split('.')[0]}-"
             f"{datetime.now(UTC).strftime('%Y%m%d-%H%M%S')}.json"))
     with contextlib.ExitStack() as stack:
-        performers: dict[str, Any] = {}
+        performers: dict[str, Any] = {}          # the world: opspec.runs.build adds it
         notes: list[str] = []
-        try:
-            from opspec.bindings.worlds import world_performers
-
-            performers.update(world_performers(compiled, seed=args.seed, user=0))
-        except ImportError:
-            pass
         devices = None
         if args.bind:
             from opspec.bindings.attach import attach_devices
@@ -136,7 +132,10 @@ def _model_factory(compiled: Any, ref: Any, seed: int) -> Any:
     handovers = [0]
 
     def make() -> Any:
+        # the first hand-over is user 0, as in `opspec run --seed` (handed over from the
+        # start, the walkthrough is that run); each later one a user of its own
         handovers[0] += 1
-        return model.performer(user_stream(seed, 1000 + handovers[0]))
+        user = 0 if handovers[0] == 1 else 1000 + handovers[0]
+        return model.performer(user_stream(seed, user))
 
     return make

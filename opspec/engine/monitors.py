@@ -70,7 +70,7 @@ _KINDS = {"activity": EventKind.ACTIVITY_COMPLETED, "trigger": EventKind.TRIGGER
 
 
 class Names(Protocol):
-    """The names a spec defines (``opspec.testing.simulate.SpecNames`` is one)."""
+    """The names a spec defines (``opspec.testing.simulation.SpecNames`` is one)."""
 
     @property
     def activities(self) -> tuple[str, ...]: ...

@@ -25,8 +25,16 @@ from typing import IO, Any, Self
 from opspec.engine.trace import TRACE_FORMAT, TRACE_FORMAT_VERSION, TraceEvent
 from opspec.errors import ExecutionError, SourceLocation
 
-__all__ = ["TRACE_MAX_BYTES", "TRACE_MAX_BYTES_ENV", "JsonlSink", "MemorySink", "read_trace",
-           "read_trace_header", "trace_max_bytes"]
+__all__ = [
+    "TRACE_MAX_BYTES",
+    "TRACE_MAX_BYTES_ENV",
+    "JsonlSink",
+    "MemorySink",
+    "header_line",
+    "read_trace",
+    "read_trace_header",
+    "trace_max_bytes",
+]
 
 #: The most a JSON Lines trace file may hold, in bytes (1 GiB: some 5 million events).
 TRACE_MAX_BYTES = 1 << 30
@@ -56,6 +64,17 @@ class MemorySink:
         self.events.append(event)
 
 
+def header_line(header: Mapping[str, Any] | None = None, **fixed: Any) -> dict[str, Any]:
+    """A trace file's header object: ``format`` and ``version`` first, then ``fixed`` and
+    ``header``; a ``seed`` is written as an integer whoever writes the file."""
+    head: dict[str, Any] = {"format": TRACE_FORMAT, "version": TRACE_FORMAT_VERSION, **fixed}
+    for key, value in (header or {}).items():
+        head.setdefault(key, value)
+    if "seed" in head and head["seed"] is not None:
+        head["seed"] = int(head["seed"])
+    return head
+
+
 class JsonlSink:
     """Writes events to a JSON Lines file. Use as a context manager or call :meth:`close`.
 
@@ -73,7 +92,7 @@ class JsonlSink:
         #: the time of the first event not written (the cap was reached), or None
         self.truncated: float | None = None
         self.dropped = 0
-        head = {"format": TRACE_FORMAT, "version": TRACE_FORMAT_VERSION, **(header or {})}
+        head = header_line(header)
         line = json.dumps(head, default=str) + "\n"
         self._handle.write(line)
         self._handle.flush()

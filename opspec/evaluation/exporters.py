@@ -32,8 +32,8 @@ from pathlib import Path
 from types import TracebackType
 from typing import IO, Any, Self
 
-from opspec.engine.trace import TRACE_FORMAT, TRACE_FORMAT_VERSION, EventKind, TraceEvent
-from opspec.engine.trace_sinks import TRACE_MAX_BYTES_ENV, trace_max_bytes
+from opspec.engine.trace import TRACE_FORMAT_VERSION, EventKind, TraceEvent
+from opspec.engine.trace_sinks import TRACE_MAX_BYTES_ENV, header_line, trace_max_bytes
 from opspec.errors import EvaluationError
 
 __all__ = [
@@ -206,8 +206,8 @@ class _StreamingWriter:
 class XesWriter(_StreamingWriter):
     """Writes an IEEE 1849-2016 XES log, one ``<trace>`` per case, streaming.
 
-    - ``log_attributes``: log-level string attributes (``concept:name`` defaults to
-      ``"opspec traces"``);
+    - ``log_attributes``: log-level attributes, typed as their values (``seed`` an int;
+      ``concept:name`` defaults to ``"opspec traces"``);
     - ``epoch``: the wall-clock instant of simulated time 0 (timezone-aware; default
       :data:`DEFAULT_EPOCH`, 2026-01-05T00:00:00+00:00);
     - ``kinds``: the opspec event kinds exported (default :data:`DEFAULT_XES_KINDS`; only
@@ -216,7 +216,7 @@ class XesWriter(_StreamingWriter):
       (the activity id is used otherwise).
     """
 
-    def __init__(self, path: Path, *, log_attributes: Mapping[str, str] | None = None,
+    def __init__(self, path: Path, *, log_attributes: Mapping[str, Any] | None = None,
                  epoch: datetime = DEFAULT_EPOCH, kinds: Collection[str] = DEFAULT_XES_KINDS,
                  activity_names: Mapping[tuple[str, str], str] | None = None) -> None:
         if epoch.tzinfo is None or epoch.utcoffset() is None:
@@ -236,7 +236,7 @@ class XesWriter(_StreamingWriter):
         super().__init__(path)
         self._write(self._header(dict(log_attributes or {})))
 
-    def _header(self, log_attributes: dict[str, str]) -> str:
+    def _header(self, log_attributes: dict[str, Any]) -> str:
         lines = ['<?xml version="1.0" encoding="UTF-8"?>',
                  f'<log xes.version="1849-2016" xes.features="" xmlns="{XES_NAMESPACE}">']
         lines += [f'  <extension name="{name}" prefix="{prefix}" '
@@ -374,13 +374,9 @@ class JsonlTraceWriter(_StreamingWriter):
     "data": {attributes}}`` line (readers ignore kinds they do not know).
     """
 
-    def __init__(self, path: Path, *, log_attributes: Mapping[str, str] | None = None) -> None:
+    def __init__(self, path: Path, *, log_attributes: Mapping[str, Any] | None = None) -> None:
         super().__init__(path)
-        head: dict[str, Any] = {"format": TRACE_FORMAT, "version": TRACE_FORMAT_VERSION,
-                                "cases": True}
-        for key, value in (log_attributes or {}).items():
-            if key not in head:
-                head[key] = value
+        head = header_line(log_attributes, cases=True)
         self._write(json.dumps(head, default=str) + "\n")
 
     def add_case(self, case_id: str, events: Iterable[TraceEvent],

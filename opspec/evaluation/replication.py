@@ -1,7 +1,8 @@
 """One replication: one simulated user (with their own device) of one design over the run.
 
 Runs in worker processes. Each user ``u`` draws from streams derived from ``(seed, u)`` only
-(the engine's ``scope=(u,)`` and :func:`opspec.engine.random.user_stream`), so results do not
+(:func:`opspec.runs.build`: the engine's ``scope=(u,)``, the user model's
+:func:`opspec.engine.random.user_stream`, the world's), so results do not
 depend on which worker runs which user, nor on how users are chunked: common random numbers
 across designs come from the same rule. A replication returns a small record (metrics, the
 duration observations with their times, outcome counts by day and hour, per-activity counts,
@@ -75,13 +76,19 @@ class ActivityRecorder:
 
 @dataclass(frozen=True)
 class _Context:
-    compiled: Any
-    bind_names: tuple[str, ...]
+    spec: Any                               # opspec.runs.LoadedSpec
     manual: tuple[str, ...]
-    model: Any
+    user: Any                               # opspec.runs.User of the user model, or None
     config: Any
-    monitors: tuple[Any, ...] = ()
     warnings: tuple[Any, ...] = ()          # the user model's, against this spec
+
+    @property
+    def compiled(self) -> Any:
+        return self.spec.compiled
+
+    @property
+    def model(self) -> Any:
+        return self.user.source if self.user is not None else None
 
 
 _CONTEXTS: dict[tuple[str, str, str | None, str], _Context] = {}
@@ -89,69 +96,43 @@ _CONTEXTS: dict[tuple[str, str, str | None, str], _Context] = {}
 
 def prepare(spec: str, sha256: str, user_model: str | None, engine: Mapping[str, Any]
             ) -> _Context:
-    """Load (once per process) the compiled spec, user model and engine configuration."""
+    """Load (once per process) the spec, user model and engine configuration."""
     import json
 
     key = (spec, sha256, user_model, json.dumps(dict(engine), sort_keys=True))
     found = _CONTEXTS.get(key)
     if found is not None:
         return found
-    from opspec.engine.compiled import compile_package
     from opspec.engine.config import EngineConfig
     from opspec.engine.lanes import user_lane
-    from opspec.xpdl.open_spec import open_spec
+    from opspec.runs import User, load
 
-    compiled = compile_package(open_spec(spec))
-    lane = user_lane(compiled)
-    model = None
+    loaded = load(spec)
+    lane = user_lane(loaded.compiled)
+    user = None
     warnings: tuple[Any, ...] = ()
     if user_model is not None:
-        from opspec.usermodels.loader import load_user_model
-
-        model = load_user_model(user_model)
+        user = User.model(user_model)
         if not lane.empty:
-            warnings = tuple(model.validate_against(lane.manual, choices=lane.choices))
+            warnings = tuple(user.source.validate_against(lane.manual, choices=lane.choices))
     config = EngineConfig.from_mapping(engine) if engine else EngineConfig()
-    from opspec.engine.monitors import declared_monitors
-
-    context = _Context(compiled, lane.bind_names, (*lane.manual, *lane.choices), model, config,
-                       tuple(declared_monitors(compiled)), warnings)
+    context = _Context(loaded, (*lane.manual, *lane.choices), user, config, warnings)
     _CONTEXTS[key] = context
     return context
 
 
-def _world_performers(compiled: Any, seed: int, user: int) -> dict[str, Any]:
-    try:
-        from opspec.bindings.worlds import world_performers
-    except ImportError:
-        return {}
-    return dict(world_performers(compiled, seed=seed, user=user))
-
-
 def run_user(context: _Context, design: str, user: int, *, seed: int, horizon: float,
              keep_trace: bool) -> ReplicationRecord:
-    """Simulate user ``user`` of ``design``; a failure becomes a ``failed`` record."""
-    from opspec.engine.random import user_stream
-    from opspec.engine.simulation import Simulation
-    from opspec.xpdl.open_spec import mode_loader_for
+    """Simulate user ``user`` of ``design`` (built by :func:`opspec.runs.build`, as every
+    run is: user ``user``'s streams); a failure becomes a ``failed`` record."""
+    from opspec.runs import build
 
     start = time.perf_counter()
     try:
-        performers: dict[str, Any] = _world_performers(context.compiled, seed, user)
-        if context.model is not None:
-            performer = context.model.performer(user_stream(seed, user))
-            for name in context.bind_names:
-                performers[name] = performer
         recorder = ActivityRecorder(context.manual)
-        watches = [m.start(user) for m in context.monitors]
-        sim = Simulation(context.compiled, context.config, performers=performers, seed=seed,
-                         scope=(user,), listeners=[recorder, *watches], keep_trace=keep_trace,
-                         mode_loader=mode_loader_for(context.compiled.package))
-        if sim.metrics is not None:
-            sim.metrics.keep_times = True
-        result = sim.run(until=horizon)
-        for watch in watches:
-            watch.finish(horizon)
+        outcome = build(context.spec, seed=seed, user=context.user, user_index=user,
+                        until=horizon, config=context.config, listeners=[recorder],
+                        keep_trace=keep_trace, keep_times=True).execute()
     except OpspecError as error:
         return ReplicationRecord(design, user, "failed", error=str(error),
                                  wall_s=time.perf_counter() - start)
@@ -159,21 +140,20 @@ def run_user(context: _Context, design: str, user: int, *, seed: int, horizon: f
         return ReplicationRecord(design, user, "failed",
                                  error=f"internal error: {type(error).__name__}: {error}",
                                  wall_s=time.perf_counter() - start)
+    result = outcome.result
     record = ReplicationRecord(design, user, "done", metrics=result.metrics,
                                activities=recorder.counts)
-    for watch in watches:
-        first = watch.violations[0] if watch.violations else None
-        record.monitors[watch.monitor.text] = (
-            watch.count, first.time if first else None, first.message if first else None)
-    metrics = sim.metrics
-    if metrics is not None:
-        for name, values in metrics.samples.items():
-            ends = metrics.sample_times.get(name, [])
-            record.samples.extend((name, v, t) for v, t in zip(values, ends, strict=True))
-        for name, times in metrics.count_times.items():
-            for t in times:
-                key = (name, int(t // DAY), int((t % DAY) // 3600))
-                record.outcomes[key] = record.outcomes.get(key, 0) + 1
+    for seen in outcome.monitors:
+        first = seen.violations[0] if seen.violations else None
+        record.monitors[seen.monitor] = (
+            seen.count, first.time if first else None, first.message if first else None)
+    for name, values in outcome.samples.items():
+        ends = outcome.sample_times.get(name, ())
+        record.samples.extend((name, v, t) for v, t in zip(values, ends, strict=True))
+    for name, times in outcome.count_times.items():
+        for t in times:
+            key = (name, int(t // DAY), int((t % DAY) // 3600))
+            record.outcomes[key] = record.outcomes.get(key, 0) + 1
     problems = (result.summary.get("deadlocks") or []) + (result.summary.get("faults") or [])
     if problems:
         record.error = "; ".join(str(p.get("message")) for p in problems[:3])

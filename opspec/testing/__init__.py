@@ -3,7 +3,7 @@
 * :mod:`~opspec.testing.plugin` - the pytest plugin (``spec``/``simulate`` fixtures,
   ``--opspec-seed``, ``--device-url``, scenario-file collection), loaded by pytest through the
   ``pytest11`` entry point;
-* :mod:`~opspec.testing.simulate` - :func:`simulate` for one or many users, and its result;
+* :mod:`~opspec.testing.simulation` - :func:`simulate` for one or many users, and its result;
 * :mod:`~opspec.testing.script` - scripted users as plain data;
 * :mod:`~opspec.testing.expectations` - readable ``then`` lines and :func:`expect`;
 * :mod:`~opspec.testing.scenario` - ``*.scenario.toml`` files;
@@ -58,9 +58,9 @@ __all__ = [
 ]
 
 _WHERE = {
-    "InstanceRun": "opspec.testing.simulate",
-    "SimulationResult": "opspec.testing.simulate",
-    "simulate": "opspec.testing.simulate",
+    "InstanceRun": "opspec.testing.simulation",
+    "SimulationResult": "opspec.testing.simulation",
+    "simulate": "opspec.testing.simulation",
     "Script": "opspec.testing.script",
     "ScriptUser": "opspec.testing.script",
     "load_script": "opspec.testing.script",

@@ -446,7 +446,7 @@ def assert_rate_sequential(simulate_batch: Callable[[int, int], Any],
                            max_users: int = 2000) -> SequentialOutcome:
     """Simulate batches until the rate claim is decided or ``max_users`` are simulated.
 
-    ``simulate_batch(k, n)`` returns a :class:`~opspec.testing.simulate.SimulationResult` of
+    ``simulate_batch(k, n)`` returns a :class:`~opspec.testing.simulation.SimulationResult` of
     ``n`` users, independent of every other batch (e.g. ``simulate(spec, users=n,
     seed=derive_seed(base, str(k)))``). With ``K = ceil(max_users / batch_users)`` looks, each
     look decides at ``1 - (1 - confidence)/K`` on the counts pooled so far (Bonferroni), so

@@ -36,7 +36,7 @@ from itertools import pairwise
 from opspec.engine.monitors import clock
 from opspec.engine.trace import EventKind, TraceEvent
 from opspec.errors import ConfigurationError, SourceLocation
-from opspec.testing.simulate import FIELDS, SimulationResult, SpecNames
+from opspec.testing.simulation import FIELDS, SimulationResult, SpecNames
 
 __all__ = ["Expectation", "expect", "format_events", "parse_expectation"]
 

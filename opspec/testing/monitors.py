@@ -197,7 +197,7 @@ class MonitorReport:
 
 
 def monitor_report(result: Any, confidence: float = 0.95) -> MonitorReport:
-    """The monitor report of a :class:`~opspec.testing.simulate.SimulationResult`."""
+    """The monitor report of a :class:`~opspec.testing.simulation.SimulationResult`."""
     outcomes: Sequence[MonitorResult] = result.monitor_results
     replications = result.replications
     days = (result.horizon or 0.0) / 86_400.0

@@ -5,7 +5,7 @@ Fixtures:
 * ``spec`` - the :class:`~opspec.model.Package` named by ``@pytest.mark.spec("path")`` on the
   test (or its class/module), else by a module-level ``SPEC = "path"``. Paths are tried
   relative to the test file, then to pytest's rootdir. Loaded once per session per file.
-* ``simulate`` - :func:`opspec.testing.simulate.simulate` with the test's seed as default
+* ``simulate`` - :func:`opspec.testing.simulation.simulate` with the test's seed as default
   and paths (spec, user model, script file) resolved like the marker's::
 
       def test_reporting_user_takes_the_dose(spec, simulate):
@@ -133,7 +133,7 @@ def spec(request: pytest.FixtureRequest) -> Any:
 @pytest.fixture
 def opspec_seed(request: pytest.FixtureRequest) -> int:
     """The test's seed: ``--opspec-seed`` mixed with the test id."""
-    from opspec.testing.simulate import derive_seed
+    from opspec.testing.simulation import derive_seed
 
     seed = derive_seed(request.config.getoption("--opspec-seed"), request.node.nodeid)
     request.node.stash[_SEED_KEY] = seed
@@ -141,7 +141,7 @@ def opspec_seed(request: pytest.FixtureRequest) -> int:
 
 
 class Simulator:
-    """The ``simulate`` fixture: :func:`opspec.testing.simulate.simulate` bound to a test.
+    """The ``simulate`` fixture: :func:`opspec.testing.simulation.simulate` bound to a test.
 
     ``seed`` defaults to the test's seed; ``spec`` may be a Package (e.g. the ``spec``
     fixture) or a path; relative paths (spec, ``user_model`` file, ``script`` file) are
@@ -162,7 +162,7 @@ class Simulator:
                  script: Any = None, user_model: Any = None, seed: int | None = None,
                  until: float | None = None, engine_config: Any = None,
                  **options: Any) -> Any:
-        from opspec.testing.simulate import simulate
+        from opspec.testing.simulation import simulate
 
         if spec is None:
             pytest.fail("simulate() needs a spec: simulate(spec, ...) with the 'spec' fixture "
@@ -199,7 +199,7 @@ def simulator_for(request: pytest.FixtureRequest) -> Simulator:
         def reference_users(request):
             return simulator_for(request)(SPEC, users=600, user_model="dispenser-reference")
     """
-    from opspec.testing.simulate import derive_seed
+    from opspec.testing.simulation import derive_seed
 
     seed = derive_seed(request.config.getoption("--opspec-seed"), request.node.nodeid)
     return Simulator(request.config, request.node.path, seed)
@@ -312,7 +312,7 @@ class ScenarioItem(pytest.Item):
 
     def runtest(self) -> None:
         from opspec.testing.scenario import run_scenario
-        from opspec.testing.simulate import derive_seed
+        from opspec.testing.simulation import derive_seed
 
         seed = derive_seed(self.config.getoption("--opspec-seed"), self.nodeid)
         if self.scenario.seed is None:

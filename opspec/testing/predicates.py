@@ -9,7 +9,7 @@
     check(result, (count("dispense") == 1).per_instance("notify_workflow"))
 
 A predicate is judged on each trace of what it is given - a
-:class:`~opspec.testing.simulate.SimulationResult` (every replication), an engine
+:class:`~opspec.testing.simulation.SimulationResult` (every replication), an engine
 :class:`~opspec.engine.simulation.RunResult`, or a plain sequence of
 :class:`~opspec.engine.trace.TraceEvent` - and holds when it holds on every one.
 
@@ -603,7 +603,7 @@ def _names(obj: Any, spec: Any) -> Any:
     if hasattr(spec, "activities") and hasattr(spec, "triggers"):
         return spec
     from opspec.engine.compiled import CompiledPackage, compile_package
-    from opspec.testing.simulate import spec_names
+    from opspec.testing.simulation import spec_names
 
     compiled = spec if isinstance(spec, CompiledPackage) else compile_package(spec)
     return spec_names(compiled)

@@ -187,7 +187,7 @@ def load_scenarios(path: str | Path, *, rootdir: Path | None = None) -> Scenario
         raise _error(path, "spec", f"spec {ref!r} not found",
                      "a path relative to this file or the rootdir")
     from opspec.engine.compiled import compile_package
-    from opspec.testing.simulate import spec_names
+    from opspec.testing.simulation import spec_names
     from opspec.xpdl.loader import load_spec
 
     try:
@@ -251,7 +251,7 @@ def load_scenarios(path: str | Path, *, rootdir: Path | None = None) -> Scenario
 def run_scenario(scenario: Scenario, spec: Any, *, seed: int = 0) -> list[str]:
     """Run ``scenario`` on ``spec`` (a Package or CompiledPackage); return one failure
     message per expectation that does not hold (empty when all do)."""
-    from opspec.testing.simulate import simulate
+    from opspec.testing.simulation import simulate
 
     needs_trace = any(e.form in _TRACE_FORMS for e in scenario.expectations)
     result = simulate(spec, users=scenario.users, days=scenario.days, until=scenario.until,

@@ -124,7 +124,7 @@ class ScriptUser(ScriptedUser):
 
     It is also a trace listener (``selects`` trigger raises and activity completions): the
     caller must pass it in the simulation's ``listeners`` for ``after NAME`` steps to see
-    their anchors (:func:`opspec.testing.simulate.simulate` does).
+    their anchors (:func:`opspec.testing.simulation.simulate` does).
     """
 
     def __init__(self, script: Script) -> None:

@@ -21,20 +21,18 @@ alternative). ``performers`` binds anything else (devices, callables) by partici
 
 from __future__ import annotations
 
-import math
 import zlib
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-from opspec.engine.compiled import CompiledPackage, compile_package
+from opspec.engine.compiled import CompiledPackage
 from opspec.engine.config import EngineConfig
 from opspec.engine.metrics import summarise_durations
 from opspec.engine.names import SpecNames, spec_names
 from opspec.engine.performers import Performer
-from opspec.engine.random import user_stream
-from opspec.engine.simulation import DAY, RunResult, Simulation
+from opspec.engine.simulation import RunResult
 from opspec.engine.trace import EventKind, TraceEvent
 from opspec.errors import ConfigurationError
 from opspec.model import Package
@@ -293,15 +291,6 @@ def _script(ref: Any) -> Script:
     return parse_script(ref)
 
 
-def _world(compiled: CompiledPackage, seed: int, user: int) -> dict[str, Performer]:
-    """The simulated devices of the world the spec declares (``opspec:World``), if any."""
-    try:
-        from opspec.bindings.worlds import world_performers
-    except ImportError:
-        return {}
-    return dict(world_performers(compiled, seed=seed, user=user))
-
-
 def simulate(spec: Package | CompiledPackage | str | Path, *, users: int = 1,
              days: float | None = None, until: float | None = None,
              script: Script | Sequence[Any] | str | Path | None = None,
@@ -318,33 +307,24 @@ def simulate(spec: Package | CompiledPackage | str | Path, *, users: int = 1,
     spec's processes, activities, triggers or metrics when a name is unknown).
     ``monitors`` (monitor objects or their text form, see :mod:`opspec.testing.monitors`) are
     checked in every replication, with those the spec declares (``opspec:Monitor``)."""
-    if isinstance(spec, (str, Path)):
-        spec = load_spec_file(spec)
-    compiled = spec if isinstance(spec, CompiledPackage) else compile_package(spec)
+    from opspec.runs import User, build, load, run_length
+
+    loaded = load(load_spec_file(spec) if isinstance(spec, (str, Path)) else spec)
+    compiled = loaded.compiled
     if isinstance(users, bool) or not isinstance(users, int) or users < 1:
         raise ConfigurationError(f"users must be a whole number >= 1, not {users!r}")
-    if days is not None and until is not None:
-        raise ConfigurationError("give days or until, not both")
     if script is not None and user_model is not None:
         raise ConfigurationError("give script or user_model, not both",
                                  hint="a script plays one scripted user; a user model draws "
                                  "stochastic users")
-    if until is not None:
-        horizon = until
-    elif days is not None:
-        horizon = days * DAY
-    else:                                   # the spec's opspec:RunLength, else one day
-        horizon = compiled.package.run_length or DAY
-    if not (horizon > 0 and math.isfinite(horizon)):
-        raise ConfigurationError(f"the run length must be a positive number of seconds, "
-                                 f"not {horizon!r}")
-    config = (EngineConfig.from_mapping(engine_config) if isinstance(engine_config, Mapping)
-              else engine_config)
+    horizon = run_length(compiled, days=days, until=until)
     names = spec_names(compiled)
-    model = _user_model(user_model) if user_model is not None else None
-    plan = None if model is not None else _script([] if script is None else script)
-    if plan is not None:
+    if user_model is not None:
+        who = User.model(user_model)
+    else:
+        plan = _script([] if script is None else script)
         plan.check_names(names.activities, names.triggers)
+        who = User.script(plan)
     keep = users <= 100 if keep_trace is None else keep_trace
     from opspec.testing.monitors import monitors_for
 
@@ -353,26 +333,13 @@ def simulate(spec: Package | CompiledPackage | str | Path, *, users: int = 1,
     runs: list[RunResult] = []
     pooled: dict[str, list[float]] = {}
     for u in range(users):
-        listeners: list[Any] = [m.start(u) for m in watch]
-        watches = list(listeners)
-        if model is not None:
-            user: Performer = model.performer(user_stream(seed, u))
-        else:
-            assert plan is not None
-            user = scripted = plan.performer()
-            listeners.append(scripted)
-        bindings: dict[str, Performer] = _world(compiled, seed, u)
-        bindings.update({name: user for name in names.user_performers})
-        bindings.update(performers or {})
-        sim = Simulation(compiled, config, performers=bindings, seed=seed, scope=(u,),
-                         listeners=listeners, keep_trace=keep, params=params)
-        runs.append(sim.run(until=horizon))
-        for watcher in watches:
-            watcher.finish(horizon)
-            watched.append(watcher.result())
-        if sim.metrics is not None:
-            for name, values in sim.metrics.samples.items():
-                pooled.setdefault(name, []).extend(values)
+        outcome = build(loaded, seed=seed, user=who, user_index=u, until=horizon,
+                        config=engine_config, performers=performers, params=params,
+                        keep_trace=keep, monitors=watch).execute()
+        runs.append(outcome.result)
+        watched.extend(outcome.monitors)
+        for name, values in outcome.samples.items():
+            pooled.setdefault(name, []).extend(values)
         if progress is not None:
             progress(u + 1)
     return SimulationResult(compiled.package, names, seed, horizon, tuple(runs),

@@ -76,17 +76,17 @@ class WalkSession:
                  replay: Any = None, spec_path: str = "",
                  device_participants: Mapping[str, Sequence[str]] | None = None,
                  wall_devices: bool = False) -> None:
+        from opspec.runs import check_seed, run_length
+
         self.compiled = compiled
-        self.seed = seed
+        self.seed = check_seed(seed)
         if days is not None and not (days > 0 and math.isfinite(days)):
             raise ConfigurationError(f"--days must be a positive number, not {days:g}",
                                      hint="e.g. --days 1 (or leave it out for the spec's "
                                      "opspec:RunLength)")
-        #: where the run ends: ``days``, else the spec's opspec:RunLength (as ``opspec run``
-        #: does), else one day
-        self.horizon = (days * DAY if days is not None
-                        else float(compiled.package.run_length)
-                        if compiled.package.run_length is not None else DAY)
+        #: where the run ends: the one rule of every run (opspec.runs.run_length): ``days``,
+        #: else the spec's opspec:RunLength, else one day
+        self.horizon = run_length(compiled, days=days)
         self.speed = 60.0
         self.paused = False
         self.model_factory = model_factory
@@ -144,20 +144,18 @@ class WalkSession:
         #: the spec has manual activities for the person (vacuum robots may have none)
         self.has_user_lane = not lane.empty
         self.lane_user = LaneUser(self)
-        bound: dict[str, Any] = dict(performers or {})
-        if replay is not None:
-            user: Any = replay
-        else:
-            user = self.lane_user
-        for name in lane.bind_names:
-            bound[name] = user
+        from opspec.runs import User, build
+
+        # the walkthrough is user 0 of its seed, built as every run is (opspec.runs): the
+        # world, the mode loader, the random scope (0,) are those of `opspec run --seed`
+        user = (User.script(replay, "the recording") if replay is not None
+                else User.person(self.lane_user))
         listeners: list[Any] = [self.board, self._on_event]
-        if replay is not None:
-            listeners.append(replay)
         if self._trace_file is not None:
             listeners.append(self._trace_file)
-        self.sim = Simulation(compiled, config, performers=bound, seed=seed, scope=(0,),
-                              listeners=listeners)
+        self.run = build(compiled, seed=self.seed, user=user, until=self.horizon,
+                         config=config, performers=performers, listeners=listeners)
+        self.sim: Simulation = self.run.sim
         self._boot()
 
     @_guarded()

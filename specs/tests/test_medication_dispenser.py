@@ -28,7 +28,7 @@ from opspec.testing import (
     simulator_for,
     within,
 )
-from opspec.testing.simulate import derive_seed
+from opspec.testing.simulation import derive_seed
 
 SPEC = "../medication_dispenser.xpdl"
 USERS = "../medication_dispenser.users.toml"

@@ -131,7 +131,7 @@ def test_opspec_walkthrough_that_cannot_start_exits_1(capsys: pytest.CaptureFixt
 
 
 def test_opspec_testing_simulate_raises_it() -> None:
-    from opspec.testing.simulate import simulate
+    from opspec.testing.simulation import simulate
 
     with pytest.raises(ZeroTimeCycleError, match=r"process 'again' \(.*\): restart"):
         simulate(SPECS / "self_start.xpdl", days=1)

@@ -6,7 +6,7 @@ from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
-from opspec.testing.simulate import SimulationResult, simulate
+from opspec.testing.simulation import SimulationResult, simulate
 
 SPECS = Path(__file__).resolve().parent / "specs"
 

@@ -8,7 +8,7 @@ import pytest
 
 from opspec.errors import ConfigurationError
 from opspec.testing.script import load_script, parse_script
-from opspec.testing.simulate import simulate
+from opspec.testing.simulation import simulate
 
 from .conftest import DISPENSER
 

@@ -8,7 +8,7 @@ import pytest
 import scipy.stats  # noqa: F401  (pytester inner runs must not import numpy/scipy again)
 
 from opspec.engine.compiled import CompiledPackage, compile_package
-from opspec.testing.simulate import SimulationResult, load_spec_file, simulate
+from opspec.testing.simulation import SimulationResult, load_spec_file, simulate
 
 pytest_plugins = ["pytester"]
 

@@ -10,7 +10,7 @@ import pytest
 
 from opspec.engine.compiled import CompiledPackage
 from opspec.testing.golden import compare, normalise
-from opspec.testing.simulate import SimulationResult, simulate
+from opspec.testing.simulation import SimulationResult, simulate
 
 from .conftest import DISPENSER, NINE
 
@@ -86,7 +86,7 @@ def test_ignored_fields_do_not_count(tmp_path: Path, prompt_user: SimulationResu
 
 
 TEST_FILE = f'''
-from opspec.testing.simulate import simulate
+from opspec.testing.simulation import simulate
 
 def test_day(golden):
     result = simulate({str(DISPENSER)!r}, script=[("after trg_2 90s", "press_report")],

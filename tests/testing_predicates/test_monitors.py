@@ -25,7 +25,7 @@ from opspec.testing.monitors import (
     never_happens,
     never_while,
 )
-from opspec.testing.simulate import simulate
+from opspec.testing.simulation import simulate
 
 from .conftest import DISPENSER, NINE
 

@@ -21,7 +21,7 @@ from opspec.testing.predicates import (
     trigger_raised,
     within,
 )
-from opspec.testing.simulate import SimulationResult
+from opspec.testing.simulation import SimulationResult
 
 
 def test_a_user_reporting_90_s_after_the_alarm_responds_within_90_but_not_60_seconds(
@@ -135,7 +135,7 @@ def test_a_cause_whose_window_outlives_the_run_is_not_judged() -> None:
 
 
 def test_predicates_judge_every_replication(dispenser: object) -> None:
-    from opspec.testing.simulate import simulate
+    from opspec.testing.simulation import simulate
 
     result = simulate(dispenser, users=3, days=1,  # type: ignore[arg-type]
                       script=[("never", "press_report")])

@@ -12,7 +12,7 @@ import pytest
 from opspec.cli import main
 from opspec.engine.compiled import compile_package
 from opspec.engine.lanes import user_lane
-from opspec.testing.simulate import simulate
+from opspec.testing.simulation import simulate
 from opspec.usermodels.loader import load_user_model
 from opspec.xpdl.open_spec import open_spec
 

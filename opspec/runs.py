@@ -1,0 +1,396 @@
+"""One module builds every run: spec and seed in, one :class:`RunOutcome` out.
+
+``opspec run``, ``opspec evaluate`` (each replication), :func:`opspec.testing.simulate`,
+scenario files, the walkthrough and its replays all build their simulations here, so the same
+spec, seed and user give the same run through every front door. The public face is
+:func:`run` (also ``opspec.run``)::
+
+    import opspec
+
+    outcome = opspec.run("specs/medication_dispenser.xpdl", seed=1, days=7,
+                         user_model="specs/medication_dispenser.users.toml")
+    outcome.metrics["doses_taken"]          # {"kind": "count", "total": 28}
+    outcome.trace                           # every event (kept by default)
+
+What a run is made of, and the one rule for each (``docs/architecture.md``):
+
+* **the spec** (:func:`load`): a path (XPDL or ``.wfs``), a ``Package`` or a
+  ``CompiledPackage``; the specs its modes name (``<opspec:Mode Source="dock.xpdl">``) are
+  loaded relative to the spec's file when a mode change first enters them;
+* **the seed and the scope**: user ``u`` of a run seeded ``S`` draws from streams keyed
+  ``(S, u)`` only: the engine's random scope is ``(u,)``, the user model's stream is
+  ``user_stream(S, u)`` and the world's is ``named_stream(S, "world/NAME", (u,))``. A single
+  run (``opspec run``, ``opspec.run``, the walkthrough) is user 0, so ``opspec run --seed S``
+  draws the same numbers as user 0 of ``opspec evaluate --seed S``. A seed is a whole number
+  from 0 to 2**63 - 1;
+* **the run length** (:func:`run_length`): ``days`` or ``until`` when given, else the spec's
+  ``opspec:RunLength``, else one simulated day;
+* **the user lane** (:class:`User`): a script, a stochastic user model, a person (the
+  walkthrough) or nobody;
+* **the world** the spec declares (``opspec:World``), **devices** bound to real or emulated
+  hardware (an attached set from :func:`opspec.bindings.attach.attach_devices`), and the
+  **monitors** it declares (``opspec:Monitor``), watched in every run.
+
+:func:`build` assembles a :class:`Run` without starting it (the walkthrough steps it itself;
+devices are installed on it); :meth:`Run.execute` runs it to its length and returns the
+:class:`RunOutcome`.
+"""
+
+from __future__ import annotations
+
+import math
+import operator
+from collections.abc import Callable, Iterable, Mapping, Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import TYPE_CHECKING, Any, Protocol
+
+from opspec.engine.compiled import CompiledPackage, compile_package
+from opspec.engine.config import EngineConfig
+from opspec.engine.simulation import RunResult, Simulation
+from opspec.errors import ConfigurationError
+from opspec.model import Package
+
+if TYPE_CHECKING:
+    from opspec.engine.monitors import Monitor, MonitorResult, MonitorRun
+    from opspec.engine.performers import Performer
+    from opspec.engine.trace import TraceEvent, TraceListener
+
+__all__ = [
+    "DAY",
+    "MAX_SEED",
+    "LoadedSpec",
+    "Run",
+    "RunOutcome",
+    "User",
+    "build",
+    "check_seed",
+    "companion_user_model",
+    "load",
+    "run",
+    "run_length",
+]
+
+DAY = 86_400.0
+#: numpy's SeedSequence takes non-negative integers; 2**63 - 1 keeps seeds in an SQLite integer
+MAX_SEED = 2**63 - 1
+
+
+# ---------------------------------------------------------------------------- the rules
+
+
+def check_seed(seed: Any) -> int:
+    """``seed`` as a plain int: a whole number from 0 to 2**63 - 1 (numpy integers too), else
+    a :class:`ConfigurationError`."""
+    if isinstance(seed, bool):
+        raise ConfigurationError(f"a seed is a whole number, not {seed!r}")
+    try:
+        value = operator.index(seed)
+    except TypeError:
+        raise ConfigurationError(f"a seed is a whole number, not {seed!r}") from None
+    if not 0 <= value <= MAX_SEED:
+        raise ConfigurationError(f"seed {value} is out of range: a seed is a whole number "
+                                 "from 0 to 2**63 - 1")
+    return value
+
+
+def run_length(spec: Package | CompiledPackage, *, days: float | None = None,
+               until: float | None = None) -> float:
+    """How long a run of ``spec`` lasts, in simulated seconds: ``days`` or ``until`` when
+    given, else the spec's ``opspec:RunLength``, else one day. Every front door uses this
+    rule (``opspec run``, ``evaluate``, ``simulate()``, scenario files, the walkthrough)."""
+    if days is not None and until is not None:
+        raise ConfigurationError("give days or until, not both")
+    if days is not None:
+        if isinstance(days, bool) or not (float(days) > 0 and math.isfinite(days)):
+            raise ConfigurationError(f"days must be a positive number, not {days!r}")
+        return float(days) * DAY
+    if until is not None:
+        if isinstance(until, bool) or not (float(until) > 0 and math.isfinite(until)):
+            raise ConfigurationError(f"until must be a positive number of seconds, "
+                                     f"not {until!r}")
+        return float(until)
+    package = spec.package if isinstance(spec, CompiledPackage) else spec
+    if package.run_length is not None:
+        return float(package.run_length)
+    return DAY
+
+
+def companion_user_model(spec_path: str | Path) -> Path | None:
+    """``SPEC.users.toml`` next to the spec, if there is one."""
+    path = Path(spec_path)
+    candidate = path.with_name(path.name.removesuffix(path.suffix) + ".users.toml")
+    return candidate if candidate.is_file() else None
+
+
+# ---------------------------------------------------------------------------- the spec
+
+
+@dataclass(frozen=True, eq=False)
+class LoadedSpec:
+    """A spec ready to run many times: compiled once, its mode loader and declared monitors
+    with it."""
+
+    compiled: CompiledPackage
+    mode_loader: Callable[[str], Package]
+    monitors: tuple[Monitor, ...]
+
+    @property
+    def package(self) -> Package:
+        return self.compiled.package
+
+
+def load(spec: str | Path | Package | CompiledPackage | LoadedSpec) -> LoadedSpec:
+    """The spec ready to run. A path opens as :func:`opspec.xpdl.open_spec.open_spec` does
+    (XPDL or ``.wfs``; a :class:`~opspec.errors.SpecError` with ``path:line`` when broken);
+    the monitors it declares are read here (a located ConfigurationError when one is bad)."""
+    if isinstance(spec, LoadedSpec):
+        return spec
+    from opspec.engine.monitors import declared_monitors
+    from opspec.xpdl.open_spec import mode_loader_for, open_spec
+
+    if isinstance(spec, (str, Path)):
+        spec = open_spec(spec)
+    compiled = spec if isinstance(spec, CompiledPackage) else compile_package(spec)
+    return LoadedSpec(compiled, mode_loader_for(compiled.package),
+                      tuple(declared_monitors(compiled)))
+
+
+# ---------------------------------------------------------------------------- the user lane
+
+
+class _Script(Protocol):
+    """A script (:class:`opspec.testing.script.Script`): makes a fresh scripted user."""
+
+    def performer(self) -> Any: ...
+
+
+@dataclass(frozen=True, eq=False)
+class User:
+    """Who performs the user lane: ``kind`` is ``"script"``, ``"model"``, ``"person"`` or
+    ``"none"``; ``describe`` says so in words (``opspec run`` prints it)."""
+
+    kind: str
+    source: Any = None
+    describe: str = "nobody"
+
+    @classmethod
+    def nobody(cls, describe: str = "nobody") -> User:
+        return cls("none", None, describe)
+
+    @classmethod
+    def script(cls, script: _Script | Any, describe: str = "a script") -> User:
+        """A scripted user: a :class:`~opspec.testing.script.Script` (a fresh performer per
+        run) or a scripted performer made for one run (a walkthrough's replay)."""
+        return cls("script", script, describe)
+
+    @classmethod
+    def model(cls, model: Any, describe: str | None = None) -> User:
+        """A stochastic user: a :class:`~opspec.usermodels.UserModel`, a preset name or the
+        path of a TOML file. User ``u`` of seed ``S`` draws from ``user_stream(S, u)``."""
+        from opspec.usermodels import UserModel, load_user_model
+
+        loaded = model if isinstance(model, UserModel) else load_user_model(model)
+        return cls("model", loaded, describe or (
+            "a user model" if isinstance(model, UserModel) else f"the user model {model}"))
+
+    @classmethod
+    def person(cls, performer: Performer, describe: str = "a person") -> User:
+        """Someone performing the lane through ``performer`` (the walkthrough's lane)."""
+        return cls("person", performer, describe)
+
+    def make(self, user: int, seed: int) -> tuple[Performer | None, list[TraceListener]]:
+        """The performer of user ``user`` in a run seeded ``seed``, and the trace listeners
+        it needs (a scripted user listens to the trace to anchor its steps)."""
+        if self.kind == "model":
+            from opspec.engine.random import user_stream
+
+            return self.source.performer(user_stream(seed, user)), []
+        if self.kind == "script":
+            performer = (self.source if hasattr(self.source, "offer")
+                         else self.source.performer())
+            return performer, [performer]
+        if self.kind == "person":
+            return self.source, []
+        return None, []
+
+
+# ---------------------------------------------------------------------------- the result
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class RunOutcome:
+    """What one run produced.
+
+    ``result`` is the engine's :class:`~opspec.engine.simulation.RunResult` (``trace`` when
+    kept, ``metrics``, ``summary``); ``monitors`` what each monitor saw; ``samples`` every
+    observation of each duration metric, and (``keep_times``) the simulated time of each
+    observation (``sample_times``) and of each counted event (``count_times``).
+    """
+
+    result: RunResult
+    seed: int
+    user: int
+    horizon: float
+    monitors: tuple[MonitorResult, ...] = ()
+    samples: Mapping[str, Sequence[float]] = field(default_factory=dict)
+    sample_times: Mapping[str, Sequence[float]] = field(default_factory=dict)
+    count_times: Mapping[str, Sequence[float]] = field(default_factory=dict)
+
+    @property
+    def trace(self) -> tuple[TraceEvent, ...] | None:
+        return self.result.trace
+
+    @property
+    def metrics(self) -> dict[str, dict[str, Any]]:
+        return self.result.metrics
+
+    @property
+    def summary(self) -> dict[str, Any]:
+        return self.result.summary
+
+    @property
+    def medians(self) -> dict[str, float]:
+        """The median of each duration metric with observations."""
+        from statistics import median
+
+        return {name: median(values) for name, values in self.samples.items() if values}
+
+    @property
+    def problems(self) -> bool:
+        """Whether the run found a problem: a deadlock, a fault or an aborted instance."""
+        summary = self.result.summary
+        return bool(summary.get("deadlocks") or summary.get("faults")
+                    or summary.get("instances", {}).get("aborted", 0))
+
+    def __repr__(self) -> str:
+        return (f"<RunOutcome {self.summary.get('instances')} seed {self.seed} "
+                f"user {self.user}>")
+
+
+# ---------------------------------------------------------------------------- the run
+
+
+class Run:
+    """A run built by :func:`build` and not started yet: :attr:`sim` is its simulation
+    (step it, or install devices on it), :meth:`execute` runs it to :attr:`horizon`."""
+
+    def __init__(self, sim: Simulation, *, horizon: float, seed: int, user: int,
+                 watches: Sequence[MonitorRun], performer: Performer | None) -> None:
+        self.sim = sim
+        self.horizon = horizon
+        self.seed = seed
+        self.user = user
+        self.watches = list(watches)
+        #: the user lane's performer (None: nobody)
+        self.performer = performer
+
+    def execute(self) -> RunOutcome:
+        """Run to the horizon and return what happened."""
+        return self.outcome(self.sim.run(until=self.horizon))
+
+    def outcome(self, result: RunResult | None = None) -> RunOutcome:
+        """The outcome of the run as it ended (``result``: the simulation's, or its result
+        so far): the monitors judge what is still pending at the end."""
+        result = result if result is not None else self.sim.result()
+        end = float(result.summary.get("time", self.horizon))
+        for watch in self.watches:
+            watch.finish(end)
+        metrics = self.sim.metrics
+        samples = {k: tuple(v) for k, v in metrics.samples.items()} if metrics else {}
+        keep = metrics is not None and metrics.keep_times
+        return RunOutcome(
+            result, self.seed, self.user, self.horizon,
+            tuple(w.result() for w in self.watches), samples,
+            {k: tuple(v) for k, v in metrics.sample_times.items()} if keep and metrics else {},
+            {k: tuple(v) for k, v in metrics.count_times.items()} if keep and metrics else {})
+
+
+def _world(compiled: CompiledPackage, seed: int, user: int) -> dict[str, Performer]:
+    """The simulated devices of the world the spec declares (``opspec:World``), if any."""
+    from opspec.bindings.worlds import world_performers
+
+    return dict(world_performers(compiled, seed=seed, user=user))
+
+
+def _config(config: EngineConfig | Mapping[str, Any] | None) -> EngineConfig | None:
+    if config is None or isinstance(config, EngineConfig):
+        return config
+    return EngineConfig.from_mapping(config)
+
+
+def build(spec: str | Path | Package | CompiledPackage | LoadedSpec, *, seed: int = 0,
+          user: User | None = None, user_index: int = 0, days: float | None = None,
+          until: float | None = None, config: EngineConfig | Mapping[str, Any] | None = None,
+          performers: Mapping[str, Performer] | None = None,
+          listeners: Iterable[TraceListener] = (), params: Mapping[str, Any] | None = None,
+          keep_trace: bool = False, keep_times: bool = False, devices: Any = None,
+          monitors: Sequence[Monitor] | None = None) -> Run:
+    """Assemble run ``user_index`` of ``spec`` seeded ``seed`` (see the module docstring for
+    the rules), not started.
+
+    Performers: the world's, then the user lane's (``user``, default nobody), then the
+    ``devices`` (attached devices: their performers are bound and they are installed on the
+    simulation), then ``performers`` (by participant or lane; the last word). ``monitors``
+    replaces the spec's declared monitors when given (pass them along with extra ones).
+    ``listeners`` receive the trace after the user's and the monitors'.
+    """
+    loaded = load(spec)
+    compiled = loaded.compiled
+    seed = check_seed(seed)
+    user_index = operator.index(user_index)
+    horizon = run_length(compiled, days=days, until=until)
+    who = user if user is not None else User.nobody()
+    performer, user_listeners = who.make(user_index, seed)
+    bound: dict[str, Performer] = _world(compiled, seed, user_index)
+    if performer is not None:
+        from opspec.engine.lanes import user_lane
+
+        bound.update(dict.fromkeys(user_lane(compiled).bind_names, performer))
+    if devices is not None:
+        bound.update(devices.performers)
+    bound.update(performers or {})
+    watches = [m.start(user_index) for m in (loaded.monitors if monitors is None
+                                             else monitors)]
+    sim = Simulation(compiled, _config(config), performers=bound, seed=seed,
+                     scope=(user_index,), listeners=[*user_listeners, *watches, *listeners],
+                     params=params, keep_trace=keep_trace, mode_loader=loaded.mode_loader)
+    if keep_times and sim.metrics is not None:
+        sim.metrics.keep_times = True
+    if devices is not None:
+        devices.install(sim)
+    return Run(sim, horizon=horizon, seed=seed, user=user_index, watches=watches,
+               performer=performer)
+
+
+def run(spec: str | Path | Package | CompiledPackage | LoadedSpec, *, seed: int = 0,
+        days: float | None = None, until: float | None = None, user_model: Any = None,
+        script: _Script | None = None, user: User | None = None, user_index: int = 0,
+        config: EngineConfig | Mapping[str, Any] | None = None,
+        performers: Mapping[str, Performer] | None = None,
+        listeners: Iterable[TraceListener] = (), params: Mapping[str, Any] | None = None,
+        keep_trace: bool = True) -> RunOutcome:
+    """Run ``spec`` once, as ``opspec run`` does, and return its :class:`RunOutcome`.
+
+    The user lane: ``user_model`` (a :class:`~opspec.usermodels.UserModel`, preset name or
+    TOML path), or ``script`` (a :class:`~opspec.testing.script.Script`: ``from
+    opspec.testing import load_script``), or ``user`` (a :class:`User`); with none of them,
+    the spec's companion ``SPEC.users.toml`` when ``spec`` is a path that has one, else
+    nobody. ``seed``, ``days``/``until`` and ``user_index`` follow the rules of the module
+    docstring: ``opspec.run(spec, seed=S)`` is user 0 of ``opspec evaluate spec --seed S``.
+    """
+    given = [name for name, value in (("user_model", user_model), ("script", script),
+                                      ("user", user)) if value is not None]
+    if len(given) > 1:
+        raise ConfigurationError(f"give one of user_model, script and user, not "
+                                 f"{' and '.join(given)}")
+    if user_model is not None:
+        user = User.model(user_model)
+    elif script is not None:
+        user = User.script(script)
+    elif user is None and isinstance(spec, (str, Path)):
+        companion = companion_user_model(spec)
+        user = User.model(companion) if companion is not None else None
+    return build(spec, seed=seed, user=user, user_index=user_index, days=days, until=until,
+                 config=config, performers=performers, listeners=listeners, params=params,
+                 keep_trace=keep_trace).execute()
