@@ -591,8 +591,15 @@ class Interpreter:
                     fired = True
                     self._ready.append((self._start_at, frame, join, None))
             if frame.owed and frame.live <= 0 and not fired:     # (only complex joins)
-                # nothing can deliver the tokens a fired complex join waits for: it resets
+                # nothing can deliver the tokens a fired complex join waits for: it resets,
+                # and the tokens that came meanwhile may fire it again at once
                 frame.owed.clear()
+                acts = frame.graph.activities
+                for join, counts in list((frame.cjoins or {}).items()):
+                    if any(counts) and self._complex_fires(frame, acts[join], counts):
+                        frame.live += 1
+                        fired = True
+                        self._ready.append((self._start_at, frame, join, None))
             if not fired and frame.live <= 0:
                 if frame.parked:
                     waiting = [frame.graph.activities[i].id

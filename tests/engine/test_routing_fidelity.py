@@ -305,3 +305,26 @@ def test_an_ad_hoc_set_stops_when_its_completion_condition_holds(
                             if ev.kind == "activity.completed" and ev.activity == "D"]
     assert withdrawn_or_stopped == []
     assert completed_at(result) == [e[0] + 1.0]
+
+
+def test_a_complex_join_reset_because_nothing_else_can_come_fires_on_the_tokens_it_kept(
+        tmp_path: Path) -> None:
+    """Iteration 1 fires the discriminator on B; its other branch (via D) never comes (D's
+    condition fails and that path ends). Iteration 2's B arrives meanwhile and is kept.
+    When nothing is left running, the join resets and fires on it (no deadlock)."""
+    acts = [activity("S"), activity("A", split="Parallel", join="Exclusive"),
+            activity("B", seconds=1), activity("C", seconds=3), activity("D"),
+            activity("J", join="Complex", route='GatewayType="Complex" '
+                     'IncomingCondition="activationCount &gt;= 1"'),
+            activity("E", extra='<Assignments><Assignment><Target>n</Target>'
+                     '<Expression>n + 1</Expression></Assignment></Assignments>'),
+            activity("L", route='GatewayType="Exclusive"', split="Exclusive"), activity("Z")]
+    trans = [transition("S", "A"), transition("A", "B"), transition("A", "C"),
+             transition("B", "J"), transition("C", "D"), transition("D", "J", "n &gt; 100"),
+             transition("J", "E"), transition("E", "L"), transition("L", "A", "n &lt; 2"),
+             transition("L", "Z", "otherwise")]
+    result = run(spec(tmp_path, acts, trans, integer_field("n", 0)), until=None)
+    assert starts(result, "E") == [1.0, 4.0]
+    assert starts(result, "Z") == [4.0]
+    assert result.summary["deadlocks"] == []
+    assert completed_at(result) == [4.0]
