@@ -175,10 +175,10 @@ def test_a_full_disk_is_a_clear_error_and_leaves_a_sound_database(tmp_path):
 
 def test_failed_replications_are_listed_exit_1_and_resume_completes_them(evaluate, tmp_path,
                                                                          monkeypatch):
+    from opspec import runs
     from opspec.errors import ExecutionError
-    from opspec.evaluation import replication
 
-    real = replication._world_performers
+    real = runs._world
 
     def broken_for_user_1(compiled, seed, user):
         if user == 1:
@@ -186,7 +186,7 @@ def test_failed_replications_are_listed_exit_1_and_resume_completes_them(evaluat
         return real(compiled, seed, user)
 
     out = str(tmp_path / "run")
-    monkeypatch.setattr(replication, "_world_performers", broken_for_user_1)
+    monkeypatch.setattr(runs, "_world", broken_for_user_1)
     status, doc, _ = evaluate(str(SPEC), "--users", "3", "--days", "1", "--workers", "1",
                               "--out", out)
     assert status == 1
