@@ -137,6 +137,7 @@ class CTransition:
     condition: Evaluator | None
     exception: str | None
     assignments: tuple[tuple[str, Evaluator], ...]
+    label: str | None = None          # a ScriptGrammar="Text" condition: a label, no test
 
 
 @dataclass(frozen=True, slots=True, eq=False)
@@ -177,6 +178,7 @@ class CompiledActivity:
     exceptions: tuple[CTransition, ...] = ()
     default_exception: CTransition | None = None
     choice: tuple[CTransition, ...] = ()      # deferred choice offered after completion
+    labelled: bool = False                   # the choice is between labelled branches
     start_assign: tuple[tuple[str, Evaluator], ...] = ()
     end_assign: tuple[tuple[str, Evaluator], ...] = ()
     raises: CTrigger | None = None
@@ -467,7 +469,8 @@ class _Compiler:
                                                  f"assignment to {a.target!r}"))
                             for a in tr.assignments)
             ct = CTransition(index=ti, id=tr.id, target=by_id[tr.target], kind=kind,
-                             condition=cond, exception=exc, assignments=assigns)
+                             condition=cond, exception=exc, assignments=assigns,
+                             label=(tr.condition.text or None) if kind == T_NONE else None)
             trans_by_id[tr.id] = ct
             outgoing[by_id[tr.source]].append(ct)
             incoming[by_id[tr.target]].append(ti)
@@ -756,6 +759,11 @@ class _Compiler:
             if all(t.kind == K_MANUAL for t in targets) and len(
                     {(t.participant, t.lanes) for t in targets}) == 1:
                 ca.choice = tuple(branches)
+            elif all(t.label for t in branches):
+                # labels an editor wrote for people (ScriptGrammar="Text"): whoever performs
+                # the deciding activity picks the branch (see Interpreter._offer_choice)
+                ca.choice = tuple(branches)
+                ca.labelled = True
         for ca in acts:
             ca.simple_end = (not ca.end_assign and ca.kind != K_THROW and ca.raises is None
                              and not ca.terminate)

@@ -1625,12 +1625,28 @@ class Interpreter:
             target = acts[trans.target]
             if target.kind == K_CATCH and target.trigger is not None:
                 self._wait_trigger(ai, target.trigger, self._choice_event, trans)
-        if manual:
+        if ai.act.labelled:
+            self._labelled_choice(ai, branches)
+        elif manual:
             performer = self._performer_for(acts[manual[0].target])
             if performer is None:
                 ai.waiting = f"performer for the choice {[acts[t.target].id for t in manual]}"
                 return
             self._offer(ai, performer, tuple(acts[t.target].id for t in manual), None, None)
+
+    def _labelled_choice(self, ai: ActivityInstance, branches: tuple[CTransition, ...]) -> None:
+        """A split between labelled branches: the performer bound to the deciding activity
+        (a person, a script, a user model) picks one; with nobody bound, the branch is drawn
+        uniformly from the activity's random stream (reproducible for a seed)."""
+        act = ai.act
+        acts = ai.frame.graph.activities
+        performer = self.registry.lookup(act.participant, act.lanes)
+        if performer is not None:
+            self._offer(ai, performer, tuple(acts[t.target].id for t in branches), None, None)
+            return
+        rng = self.streams.stream(f"{act.process}/{act.id}")
+        self._ready.append((self._choose, ai, branches[int(rng.integers(len(branches)))],
+                            None))
 
     def _choice_event(self, ai: ActivityInstance, trans: CTransition,
                       data: Mapping[str, Any] | None) -> None:
@@ -1663,7 +1679,8 @@ class Interpreter:
                 return
             self._emit_act(EK.ACTIVITY_COMPLETED, inst, act, {"choice": frame.graph.activities[
                 trans.target].id})
-        self._take(frame, trans, performed=True)
+        # a chosen manual branch *is* performed by the choice; a labelled one then runs
+        self._take(frame, trans, performed=not act.labelled)
         self._token_gone(frame)
 
     def _body_done_data(self, ai: ActivityInstance, data: Mapping[str, Any]) -> None:

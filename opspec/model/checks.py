@@ -276,6 +276,8 @@ def _unconditional_xor(scope: str, graph: FlowGraph, activity: Activity,
     targets = [graph.by_id[t.target] for t in branches]
     if all(t.is_manual or t.performers for t in targets):
         return       # a deferred choice: the performer picks the branch (engine semantics)
+    if all(t.condition.text for t in branches):
+        return       # labelled branches (ScriptGrammar="Text"): the performer picks one
     report.warning(
         activity, "unconditional-xor-branches",
         f"XOR split {activity.id!r} in {scope} has {len(branches)} unconditional transitions "

@@ -328,3 +328,43 @@ def test_a_complex_join_reset_because_nothing_else_can_come_fires_on_the_tokens_
     assert starts(result, "Z") == [4.0]
     assert result.summary["deadlocks"] == []
     assert completed_at(result) == [4.0]
+
+
+def labelled_split(tmp_path: Path, performer: str = "") -> Path:
+    def label(text: str) -> str:
+        return (f'<Condition Type="CONDITION"><Expression ScriptGrammar="Text">{text}'
+                "</Expression></Condition>")
+    acts = [activity("A"), activity("R", route='GatewayType="Exclusive"', split="Exclusive",
+                                    extra=performer), activity("B"), activity("C")]
+    trans = [transition("A", "R"),
+             f'<Transition Id="to_b" From="R" To="B">{label("Approved")}</Transition>',
+             f'<Transition Id="to_c" From="R" To="C">{label("Rejected")}</Transition>']
+    return spec(tmp_path, acts, trans)
+
+
+def test_a_split_between_labelled_branches_takes_one_drawn_from_the_seed(
+        tmp_path: Path) -> None:
+    """TIBCO's ScriptGrammar="Text" conditions are labels for people: with nobody bound to
+    decide, one branch is drawn (reproducibly per seed), never both, never always the first."""
+    path = labelled_split(tmp_path)
+    taken = []
+    for seed in range(20):
+        result = Simulation(load_spec(path), keep_trace=True, seed=seed).run()
+        b, c = starts(result, "B"), starts(result, "C")
+        assert len(b) + len(c) == 1
+        taken.append("B" if b else "C")
+        again = Simulation(load_spec(path), keep_trace=True, seed=seed).run()
+        assert (starts(again, "B"), starts(again, "C")) == (b, c)
+    assert set(taken) == {"B", "C"}
+
+
+def test_a_split_between_labelled_branches_is_offered_to_its_performer(tmp_path: Path) -> None:
+    from opspec.engine.builtin_performers import ScriptedUser
+
+    path = labelled_split(tmp_path, "<Performers><Performer>clerk</Performer></Performers>")
+    user = ScriptedUser([("at 0", "choose C")])
+    result = Simulation(load_spec(path), keep_trace=True,
+                        performers={"clerk": user}).run(until=100)
+    assert (starts(result, "B"), starts(result, "C")) == ([], [0.0])
+    [offer] = [e for e in result.trace or () if e.kind == "activity.offered"]
+    assert offer.activity == "R" and offer.data["choices"] == ["B", "C"]

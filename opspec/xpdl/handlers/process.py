@@ -56,9 +56,9 @@ def build_condition(element: etree._Element | None, ctx: BuildContext) -> Condit
             # TIBCO's free-text conditions: a label for people, not an expression
             ctx.warning(element, "text-condition",
                         f"condition {text!r} is written with ScriptGrammar=\"Text\": a label, "
-                        "not an expression, so the transition is unconditional (at an XOR split "
-                        "whose branches all lead to manual activities of one performer, the "
-                        "performer chooses; otherwise the first unconditional branch is taken)",
+                        "not an expression: at an XOR split whose branches are all labelled, the "
+                        "performer of the deciding activity picks the branch (with nobody bound "
+                        "to it, the branch is drawn at random from the run's seed)",
                         "write the condition as an expression over data fields (and drop "
                         "ScriptGrammar=\"Text\") for opspec to decide the branch")
             return Condition(text=text)
