@@ -268,8 +268,8 @@ class WalkSession:
         # at the target time, stop at a new offer (the person sees it before what follows)
         while target > self.now or not self.has_new_offers(since):
             due = env.peek()
-            if due > target:
-                break
+            if due > target or due >= self.horizon:
+                break       # what falls at the end time is after the run, as in `opspec run`
             if budget is not None and steps >= budget:
                 return False, steps
             env.step()
