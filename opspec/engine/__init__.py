@@ -22,7 +22,6 @@ __all__ = [
     "Simulation",
     "compile_package",
     "read_trace",
-    "simulate",
 ]
 
 _WHERE = {
@@ -39,7 +38,6 @@ _WHERE = {
     "PerformerRegistry": "opspec.engine.registry",
     "RunResult": "opspec.engine.simulation",
     "Simulation": "opspec.engine.simulation",
-    "simulate": "opspec.engine.simulation",
 }
 
 

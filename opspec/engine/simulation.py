@@ -51,10 +51,10 @@ from opspec.engine.registry import PerformerRegistry
 from opspec.engine.trace import EventKind as EK
 from opspec.engine.trace import TraceEvent, TraceListener
 from opspec.engine.trace_sinks import MemorySink
-from opspec.errors import ConfigurationError, ExecutionError
+from opspec.errors import ExecutionError
 from opspec.model import Package
 
-__all__ = ["RunResult", "Simulation", "simulate"]
+__all__ = ["RunResult", "Simulation"]
 
 DAY = 86_400.0
 
@@ -437,25 +437,3 @@ def _occurrences(trig: CTrigger, now: float) -> Iterator[float]:
 
 
 _DEFAULT_CONFIG = EngineConfig()
-
-
-def simulate(package: Package | CompiledPackage, *, days: float | None = None,
-             until: float | None = None, seed: int = 0,
-             performers: PerformerRegistry | Mapping[str, Performer] | None = None,
-             config: EngineConfig | None = None, keep_trace: bool = True,
-             listeners: Iterable[TraceListener] = (),
-             params: Mapping[str, Any] | None = None) -> RunResult:
-    """Compile (if needed), run one simulation for ``days`` or to ``until`` seconds."""
-    if days is not None and until is not None:
-        raise ConfigurationError("give days or until, not both")
-    horizon = days * DAY if days is not None else until
-    compiled = package if isinstance(package, CompiledPackage) else compile_package(package)
-    if horizon is None and any(p.start_trigger is not None and p.start_trigger.kind in (
-            "timer", "period") and (p.start_trigger.every or p.start_trigger.at)
-            for p in compiled.processes.values()):
-        raise ConfigurationError(
-            "this package has periodic start triggers, so it never runs out of events",
-            hint="give days= or until= (opspec run --days D or --until SECONDS)")
-    sim = Simulation(compiled, config, performers=performers, seed=seed, listeners=listeners,
-                     params=params, keep_trace=keep_trace)
-    return sim.run(until=horizon)

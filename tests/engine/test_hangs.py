@@ -11,7 +11,8 @@ from typing import Any
 import pytest
 from builders import act, manual, pkg, proc
 
-from opspec.engine.simulation import Simulation, simulate
+import opspec
+from opspec.engine.simulation import Simulation
 from opspec.engine.zero_time import MAX_INSTANT_STEPS, max_instant_steps
 from opspec.errors import ExecutionError, ZeroTimeCycleError
 from opspec.model import Distribution
@@ -138,7 +139,7 @@ def test_a_limit_that_is_no_positive_integer_falls_back_to_the_default(
 @pytest.mark.usefixtures("small_limit")
 def test_simulate_raises_it_too() -> None:
     with pytest.raises(ZeroTimeCycleError, match="process 'looping'"):
-        simulate(load_spec(SPECS / "loop.xpdl"), days=1)
+        opspec.run(load_spec(SPECS / "loop.xpdl"), days=1)
 
 
 def lasts(seconds: float) -> Distribution:

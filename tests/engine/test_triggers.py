@@ -8,7 +8,6 @@ from conftest import completed, events, run
 
 from opspec.engine.builtin_performers import ScriptedUser
 from opspec.engine.config import EngineConfig
-from opspec.engine.simulation import simulate
 
 DAY = 86_400.0
 
@@ -127,14 +126,11 @@ def test_end_trigger_terminates_running_instances() -> None:
     assert terminated and terminated[0].time == 7.0
 
 
-def test_simulate_needs_a_horizon_for_periodic_packages() -> None:
-    import pytest
+def test_a_periodic_package_runs_one_day_unless_told_otherwise() -> None:
+    from opspec.runs import DAY, build
 
-    from opspec.errors import ConfigurationError
-
-    with pytest.raises(ConfigurationError, match="periodic start triggers"):
-        simulate(pkg(proc("tick", ["a"], start="period:1")))
-    result = simulate(pkg(proc("tick", ["a"], start="period:1")), until=2.5)
+    assert build(pkg(proc("tick", ["a"], start="period:1"))).horizon == DAY
+    result = build(pkg(proc("tick", ["a"], start="period:1")), until=2.5).execute()
     assert result.summary["instances"]["started"] == 3
 
 

@@ -146,11 +146,12 @@ def test_predicates_judge_every_replication(dispenser: object) -> None:
 
 def test_an_engine_run_result_is_judged_and_checked_against_spec_when_given(
         dispenser: CompiledPackage) -> None:
-    from opspec.engine.simulation import simulate as run_engine
+    from opspec.engine.simulation import Simulation
     from opspec.testing.script import parse_script
 
     user = parse_script([("after trg_2 30s", "press_report")]).performer()
-    run = run_engine(dispenser, until=9 * 3600.0, performers={"user": user}, listeners=[user])
+    run = Simulation(dispenser, performers={"user": user}, listeners=[user],
+                     keep_trace=True).run(until=9 * 3600.0)
     assert holds(run, within("sound_alarm", "dispense", 30))
     assert holds(run, never("no_such_activity"))                 # no spec: nothing to check
     with pytest.raises(ConfigurationError, match="no activity, trigger or process 'no_such"):
