@@ -68,7 +68,7 @@ def via_run(tmp_path: Path, spec: Path, user: list[str], days: float | None) -> 
 
 
 def via_evaluate(tmp_path: Path, spec: Path, user: list[str], days: float | None,
-                 users: int = 1) -> dict[str, list[dict]]:
+                 users: int = 2) -> dict[str, list[dict]]:
     out = tmp_path / "evaluation"
     length = ["--days", str(days)] if days is not None else []
     status = main(["evaluate", str(spec), "--users", str(users), "--seed", str(SEED),

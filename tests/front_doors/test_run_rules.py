@@ -38,7 +38,7 @@ def test_every_front_door_defaults_to_the_same_length(tmp_path: Path, capsys) ->
     assert main(["run", str(DISPENSER), "--json", "--no-user"]) in (0, 1)
     assert '"until": 86400.0' in capsys.readouterr().out
     out = tmp_path / "evaluation"
-    assert main(["evaluate", str(DISPENSER), "--users", "1", "--workers", "1",
+    assert main(["evaluate", str(DISPENSER), "--users", "2", "--workers", "1",
                  "--out", str(out), "--json"]) == 0
     assert '"days": 1.0' in capsys.readouterr().out
 
