@@ -8,10 +8,11 @@
     result.value("report_latency_s.p95")   # a pooled scalar
     result.instances("notify_workflow")    # per-instance slices of the trace
 
-Replication ``u`` (one simulated user and their device, a household) is an independent
-:class:`~opspec.engine.simulation.Simulation` with ``scope=(u,)`` and, for a user model, the
-user stream ``default_rng(SeedSequence(seed, spawn_key=(u,)))``: user ``u`` behaves the same
-whatever the number of users, so adding users never changes the first ones.
+Replication ``u`` (one simulated user and their device, a household) is run ``u`` built by
+:func:`opspec.runs.build`, as every run is: the engine's random scope ``(u,)`` and, for a user
+model, the user stream ``default_rng(SeedSequence(seed, spawn_key=(u,)))``. User ``u`` behaves
+the same whatever the number of users, so adding users never changes the first ones, and user
+0 is the run of ``opspec run --seed`` with the same seed.
 
 Who performs the user lane: the ``user_model`` (a :class:`~opspec.usermodels.UserModel`, a
 preset name or a TOML path), else the ``script`` (see :mod:`opspec.testing.script`), else the
