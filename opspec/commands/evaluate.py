@@ -59,6 +59,9 @@ def register(subparsers: Any) -> None:
     parser.add_argument("--json", action="store_true",
                         help="print one JSON object with the results (docs/evaluation.md)")
     parser.add_argument("--quiet", action="store_true", help="no progress output")
+    parser.add_argument("--report-template", metavar="FILE",
+                        help="a Jinja2 template for report.html (start from a copy of "
+                        "opspec/evaluation/templates/report.html.j2)")
     parser.set_defaults(handler=run)
 
 
@@ -145,10 +148,9 @@ def _check_plan(plan: Any) -> dict[str, list[dict[str, Any]]]:
                 hint="give --user-model FILE|PRESET (presets: "
                 f"{', '.join(preset_names())}; docs/user-models.md) or put SPEC.users.toml "
                 "next to the spec")
-        definitions[design.label] = [
-            {"name": m.name, "kind": m.kind.value.lower(), "numerator": m.numerator,
-             "denominator": m.denominator, "unit": m.unit, "description": m.description}
-            for m in context.compiled.package.metrics]
+        from opspec.evaluation.describe import metric_record
+
+        definitions[design.label] = [metric_record(m) for m in context.compiled.package.metrics]
     return definitions
 
 
@@ -261,13 +263,6 @@ def run(args: argparse.Namespace) -> int:
             summarise_monitors,
         )
 
-        try:
-            report = write_report(store)
-        except OSError as error:
-            raise EvaluationError(
-                f"{store.folder}: cannot write the report: {error.strerror or error}",
-                hint="the results are stored; free some space and run `opspec evaluate "
-                f"--resume --out {store.folder}` to write the report again") from None
         metrics = summarise_design(store, "A", plan.days)
         monitors = summarise_monitors(store, "A", plan.days)
         compare = None
@@ -276,6 +271,19 @@ def run(args: argparse.Namespace) -> int:
                        "metrics": summarise_design(store, "B", plan.days),
                        "monitors": summarise_monitors(store, "B", plan.days),
                        "difference": compare_designs(store)}
+        # the report draws on the same summaries: nothing is computed twice
+        summaries: dict[str, dict[str, Any]] = {"A": {"metrics": metrics, "monitors": monitors}}
+        if compare is not None:
+            summaries["B"] = {"metrics": compare["metrics"], "monitors": compare["monitors"],
+                              "difference": compare["difference"]}
+        try:
+            report = write_report(store, summaries,
+                                  template=getattr(args, "report_template", None))
+        except OSError as error:
+            raise EvaluationError(
+                f"{store.folder}: cannot write the report: {error.strerror or error}",
+                hint="the results are stored; free some space and run `opspec evaluate "
+                f"--resume --out {store.folder}` to write the report again") from None
         failures = store.failures()
     if args.json:
         doc = {"spec": plan.design("A").spec, "users": plan.users, "days": plan.days,

@@ -1,8 +1,10 @@
 """Reports people read: one self-contained HTML file, and the same content as Markdown.
 
-A report is a title and a sequence of :class:`Section` values (paragraphs, tables, figures).
-:func:`write_html` writes one file that needs nothing else: the CSS is inline and each PNG
-is embedded as a base64 ``data:`` URI, so the report can be mailed or archived as it is.
+A report is a title and a sequence of :class:`Section` values (paragraphs, lists, tables,
+figures). :func:`write_html` renders them with a Jinja2 template (the bundled
+``templates/report.html.j2``, or a researcher's own copy restyled) into one file that needs
+nothing else: the CSS is inline and each PNG is embedded as a base64 ``data:`` URI, so the
+report can be mailed or archived as it is.
 :func:`write_markdown` writes the same content as GitHub-flavoured Markdown that links the
 PNG files by relative path (keep them next to it).
 
@@ -28,7 +30,7 @@ from pathlib import Path
 
 from opspec.errors import EvaluationError
 
-__all__ = ["Section", "Table", "write_html", "write_markdown"]
+__all__ = ["TEMPLATE", "Section", "Table", "render_html", "write_html", "write_markdown"]
 
 
 @dataclass(frozen=True)
@@ -45,7 +47,8 @@ class Section:
     """One titled part of a report: paragraphs, then tables, then figures (PNG files).
 
     ``captions`` optionally gives each image its caption and alt text (same order as
-    ``images``); without one, the text is derived from the file name.
+    ``images``); without one, the text is derived from the file name. ``items`` is a
+    bulleted list shown after the paragraphs (key findings, assumptions).
     """
 
     title: str
@@ -53,42 +56,11 @@ class Section:
     tables: tuple[Table, ...] = ()
     images: tuple[Path, ...] = ()
     captions: tuple[str, ...] = ()
+    items: tuple[str, ...] = ()
 
 
-_CSS = """
-:root { color-scheme: light; }
-* { box-sizing: border-box; }
-body { margin: 0 auto; max-width: 72rem; padding: 1rem 1.25rem 3rem;
-  font: 1rem/1.55 system-ui, -apple-system, "Segoe UI", Roboto, "Helvetica Neue", Arial,
-  sans-serif; color: #111; background: #fff; }
-h1 { font-size: 1.75rem; line-height: 1.25; margin: 0.5rem 0 1rem; }
-h2 { font-size: 1.35rem; margin: 2.25rem 0 0.75rem; padding-bottom: 0.25rem;
-  border-bottom: 2px solid #0b3d91; }
-p { margin: 0.5rem 0; max-width: 48rem; }
-nav ol { padding-left: 1.25rem; }
-a { color: #0b3d91; }
-a:focus, a:hover { outline: 2px solid #0b3d91; outline-offset: 2px; }
-.table-wrap { overflow-x: auto; margin: 1rem 0; border: 1px solid #bbb; }
-table { border-collapse: collapse; width: 100%; font-variant-numeric: tabular-nums; }
-caption { caption-side: top; text-align: left; font-weight: 600; padding: 0.5rem 0.6rem; }
-th, td { padding: 0.4rem 0.6rem; border-bottom: 1px solid #ccc; text-align: left;
-  vertical-align: top; }
-thead th { background: #e8edf5; border-bottom: 2px solid #555; }
-tbody th { font-weight: 600; }
-tbody tr:nth-child(even) { background: #f6f6f6; }
-td.num { text-align: right; white-space: nowrap; }
-figure { margin: 1.25rem 0; }
-figure img { display: block; max-width: 100%; height: auto; border: 1px solid #ddd; }
-figcaption { font-size: 0.95rem; color: #333; margin-top: 0.35rem; }
-@media (max-width: 40rem) { body { padding: 0.75rem; } h1 { font-size: 1.45rem; } }
-"""
-
-_NUMERIC = re.compile(r"^[\s+\-−]?[\d.,]+(e[+-]?\d+)?\s*(%|s|ms|µs)?$|^\[.*\]$|^(nan|inf)$",
-                      re.IGNORECASE)
-
-
-def _esc(text: object) -> str:
-    return html.escape(str(text), quote=True)
+_NUMERIC = re.compile(r"^(total )?[\s+\-−]?[\d.,]+(e[+-]?\d+)?\s*(%|s|ms|µs|pp|per user)?$"
+                      r"|^\[.*\]$|^(nan|inf|–)$", re.IGNORECASE)
 
 
 def _slug(text: str, index: int) -> str:
@@ -128,61 +100,83 @@ def _write(path: Path, text: str) -> Path:
 
 # ------------------------------------------------------------------------------------ HTML
 
-def _html_table(table: Table) -> list[str]:
-    out = ['<div class="table-wrap" role="region" tabindex="0"'
-           + (f' aria-label="{_esc(table.caption)}">' if table.caption else ">"),
-           "<table>"]
-    if table.caption:
-        out.append(f"<caption>{_esc(table.caption)}</caption>")
-    out.append("<thead><tr>" + "".join(f'<th scope="col">{_esc(h)}</th>'
-                                       for h in table.headers) + "</tr></thead>")
-    out.append("<tbody>")
-    for row in table.rows:
-        cells = []
-        for i, cell in enumerate(row):
-            text = _esc(cell)
-            if i == 0:
-                cells.append(f'<th scope="row">{text}</th>')
-            elif _NUMERIC.match(str(cell).strip() or "x"):
-                cells.append(f'<td class="num">{text}</td>')
-            else:
-                cells.append(f"<td>{text}</td>")
-        out.append("<tr>" + "".join(cells) + "</tr>")
-    out.append("</tbody></table></div>")
-    return out
+#: The bundled template (package data): copy it, restyle it, and pass the copy as
+#: ``template`` (``opspec evaluate --report-template FILE``).
+TEMPLATE = Path(__file__).with_name("templates") / "report.html.j2"
 
 
-def write_html(path: Path, title: str, sections: Sequence[Section]) -> Path:
+def _numeric_columns(table: Table) -> set[int]:
+    """Columns whose every cell is a number (or –): right-aligned. A column that mixes
+    numbers and words stays left-aligned, so it reads as one column."""
+    width = max((len(r) for r in table.rows), default=0)
+    return {i for i in range(1, width)
+            if any(str(r[i]).strip() not in {"", "–"} for r in table.rows if i < len(r))
+            and all(_NUMERIC.match(str(r[i]).strip() or "–") for r in table.rows
+                    if i < len(r))}
+
+
+def _cell(index: int, text: str, numeric: set[int]) -> dict[str, str]:
+    if index == 0:
+        return {"tag": "th", "text": text, "class": ""}
+    return {"tag": "td", "text": text, "class": "num" if index in numeric else ""}
+
+
+def _context(title: str, sections: Sequence[Section]) -> dict[str, object]:
+    """What the template sees: plain data, every string still unescaped (the template
+    environment escapes everything it prints)."""
+    ids = [_slug(s.title, i) for i, s in enumerate(sections, start=1)]
+    out = []
+    for sid, section in zip(ids, sections, strict=True):
+        tables = []
+        for t in section.tables:
+            numeric = _numeric_columns(t)
+            tables.append({"caption": t.caption, "headers": list(t.headers),
+                           "rows": [[_cell(i, str(c), numeric) for i, c in enumerate(row)]
+                                    for row in t.rows]})
+        figures = [{"src": "data:image/png;base64,"
+                    + base64.b64encode(_read_png(image)).decode("ascii"),
+                    "caption": _alt(section, i, image), "name": Path(image).name}
+                   for i, image in enumerate(section.images)]
+        out.append({"id": sid, "title": section.title, "paragraphs": list(section.paragraphs),
+                    "items": list(section.items), "tables": tables, "figures": figures})
+    return {"title": title, "sections": out}
+
+
+def render_html(title: str, sections: Sequence[Section],
+                template: str | Path | None = None) -> str:
+    """The report as one HTML document, rendered by Jinja2 (autoescaping on) from
+    ``template`` (default: the bundled :data:`TEMPLATE`)."""
+    import jinja2
+
+    source = Path(template) if template is not None else TEMPLATE
+    try:
+        text = source.read_text(encoding="utf-8")
+    except OSError as error:
+        raise EvaluationError(f"cannot read the report template {source}: "
+                              f"{error.strerror or error}",
+                              hint="give an existing Jinja2 template (copy "
+                              f"{TEMPLATE} to start from)") from None
+    env = jinja2.Environment(autoescape=True, undefined=jinja2.StrictUndefined,
+                             keep_trailing_newline=True, trim_blocks=True, lstrip_blocks=True)
+    try:
+        return env.from_string(text).render(_context(title, sections))
+    except jinja2.TemplateError as error:
+        line = getattr(error, "lineno", None)
+        raise EvaluationError(f"{source}{f':{line}' if line else ''}: the report template "
+                              f"fails: {error.message or error}",
+                              hint="fix the template, or leave out --report-template to "
+                              "use the bundled one") from None
+
+
+def write_html(path: Path, title: str, sections: Sequence[Section], *,
+               template: str | Path | None = None) -> Path:
     """Write the report as one self-contained HTML file; returns ``path``.
 
-    Raises :class:`~opspec.errors.EvaluationError` when a figure cannot be read or the file
-    cannot be written (the previous report, if any, is then left untouched).
+    Raises :class:`~opspec.errors.EvaluationError` when a figure cannot be read, the
+    template fails or the file cannot be written (the previous report, if any, is then left
+    untouched).
     """
-    parts = ["<!DOCTYPE html>", '<html lang="en">', "<head>", '<meta charset="utf-8">',
-             '<meta name="viewport" content="width=device-width, initial-scale=1">',
-             f"<title>{_esc(title)}</title>", f"<style>{_CSS}</style>", "</head>", "<body>",
-             "<header>", f"<h1>{_esc(title)}</h1>", "</header>"]
-    ids = [_slug(s.title, i) for i, s in enumerate(sections, start=1)]
-    if len(sections) > 1:
-        parts.append('<nav aria-label="Contents"><h2 id="contents">Contents</h2><ol>')
-        parts.extend(f'<li><a href="#{sid}">{_esc(s.title)}</a></li>'
-                     for sid, s in zip(ids, sections, strict=True))
-        parts.append("</ol></nav>")
-    parts.append("<main>")
-    for sid, section in zip(ids, sections, strict=True):
-        parts.append(f'<section aria-labelledby="{sid}">')
-        parts.append(f'<h2 id="{sid}">{_esc(section.title)}</h2>')
-        parts.extend(f"<p>{_esc(p)}</p>" for p in section.paragraphs)
-        for table in section.tables:
-            parts.extend(_html_table(table))
-        for i, image in enumerate(section.images):
-            data = base64.b64encode(_read_png(image)).decode("ascii")
-            alt = _esc(_alt(section, i, image))
-            parts.append(f'<figure><img src="data:image/png;base64,{data}" alt="{alt}">'
-                         f"<figcaption>{alt}</figcaption></figure>")
-        parts.append("</section>")
-    parts.extend(["</main>", "</body>", "</html>", ""])
-    return _write(path, "\n".join(parts))
+    return _write(path, render_html(title, sections, template))
 
 
 # -------------------------------------------------------------------------------- Markdown
@@ -227,6 +221,8 @@ def write_markdown(path: Path, title: str, sections: Sequence[Section]) -> Path:
         lines += [f"## {_md(section.title)}", ""]
         for paragraph in section.paragraphs:
             lines += [_md(paragraph), ""]
+        if section.items:
+            lines += [f"- {_md(item)}" for item in section.items] + [""]
         for table in section.tables:
             lines += _md_table(table)
         for i, image in enumerate(section.images):

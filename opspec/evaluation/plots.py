@@ -39,6 +39,7 @@ __all__ = [
     "comparison_figure",
     "latency_figure",
     "over_days_figure",
+    "per_user_figure",
     "rates_figure",
     "time_of_day_figure",
 ]
@@ -139,8 +140,8 @@ def _percent_axis(ax: Axes, axis: str = "x") -> None:
 
 
 def _fmt(value: float, percent: bool) -> str:
-    if percent:
-        return f"{100.0 * value:.3g} %"
+    if percent:             # as the report's tables print it: the same numbers everywhere
+        return f"{100.0 * value:.2f} %"
     return f"{value:.4g}"
 
 
@@ -162,11 +163,15 @@ def _bar_height(rows: int) -> float:
 
 # --------------------------------------------------------------------------------- figures
 
-def latency_figure(metric: str, values: Sequence[float], path: Path) -> Path:
+def latency_figure(metric: str, values: Sequence[float], path: Path, *,
+                   marks: Mapping[str, float | None] | None = None,
+                   total: int | None = None) -> Path:
     """ECDF (left) and histogram (right) of one duration metric, in seconds.
 
     Mean, median and 95th percentile are marked on both panels with distinct line styles and
-    their values in the legend.
+    their values in the legend. ``marks`` gives them (``mean``, ``median``, ``p95``) computed
+    from every observation when ``values`` is a sample of them; ``total`` is then the number
+    of all observations, and the figure says that it draws a sample.
     """
     import numpy as np
 
@@ -176,11 +181,16 @@ def latency_figure(metric: str, values: Sequence[float], path: Path) -> Path:
     if not data:
         return _empty(path, title)
     arr = np.asarray(data, dtype=float)
-    marks = (("mean", float(arr.mean()), "-", PALETTE[1]),
-             ("median", float(np.median(arr)), "--", PALETTE[2]),
-             ("p95", float(np.percentile(arr, 95)), ":", PALETTE[4]))
+    given = {k: float(v) for k, v in (marks or {}).items() if v is not None}
+    own = {"mean": float(arr.mean()), "median": float(np.median(arr)),
+           "p95": float(np.percentile(arr, 95))}
+    styles = {"mean": ("-", PALETTE[1]), "median": ("--", PALETTE[2]), "p95": (":", PALETTE[4])}
+    drawn = [(name, given.get(name, own[name]), *style) for name, style in styles.items()]
+    sampled = total is not None and total > arr.size
     with _figure(11.0, 4.4) as fig:
-        fig.suptitle(f"{metric}: how long it took ({arr.size} observations)")
+        count = (f"a sample of {arr.size:,} of {total:,} observations" if sampled
+                 else f"{arr.size:,} observations")
+        fig.suptitle(f"{metric}: how long it took ({count})")
         left, right = fig.subplots(1, 2)
         # ECDF: a step function by hand (Axes.ecdf needs matplotlib >= 3.8)
         xs = np.sort(arr)
@@ -196,83 +206,94 @@ def latency_figure(metric: str, values: Sequence[float], path: Path) -> Path:
         right.hist(arr, bins=bins, color=PALETTE[5], edgecolor=PALETTE[0], linewidth=0.6)
         right.set_title("Histogram")
         right.set_xlabel(f"{metric} (seconds)")
-        right.set_ylabel("number of observations")
-        for name, value, style, colour in marks:
+        right.set_ylabel("number of observations" + (" (in the sample)" if sampled else ""))
+        for name, value, style, colour in drawn:
             for ax in (left, right):
                 ax.axvline(value, linestyle=style, color=colour, linewidth=1.8,
                            label=f"{name} = {value:.4g} s" if ax is right else None)
-        right.legend(loc="best", frameon=True)
+        right.legend(loc="best", frameon=True,
+                     title="of all observations" if sampled else None)
         _note_dropped(fig, dropped)
         return _save(fig, path)
 
 
-def rates_figure(rows: Sequence[tuple[str, float, float, float]], path: Path) -> Path:
-    """Each ``(label, estimate, ci_low, ci_high)`` as a point with its 95 % CI as error bars.
+def _panels(fig: Figure, n: int, *, sharex: bool = True) -> list[Axes]:
+    """``n`` stacked panels, each with its own vertical scale."""
+    axes = fig.subplots(n, 1, squeeze=False, sharex=sharex)[:, 0]
+    return list(axes)
 
-    When every number lies in [0, 1] the axis shows percentages.
+
+def rates_figure(rows: Sequence[tuple[str, float, float, float]], path: Path) -> Path:
+    """Each ``(label, estimate, ci_low, ci_high)`` as a point with its 95 % CI as error bars,
+    each in its own panel with its own scale: a rare outcome (0.4 %) is not flattened next to
+    a common one (99.6 %). Panels whose numbers all lie in [0, 1] show percentages.
     """
+    from matplotlib.ticker import MaxNLocator
+
     title = "Outcome rates with 95 % confidence intervals"
     clean = [(_text(label), float(est), float(lo), float(hi)) for label, est, lo, hi in rows
              if all(math.isfinite(float(v)) for v in (est, lo, hi))]
     dropped = len(rows) - len(clean)
     if not clean:
         return _empty(path, title)
-    percent = _is_rate([v for _, est, lo, hi in clean for v in (est, lo, hi)])
-    with _figure(8.5, _bar_height(len(clean))) as fig:
-        ax = fig.add_subplot()
-        positions = list(range(len(clean)))[::-1]  # first row on top
-        for pos, (label, est, lo, hi) in zip(positions, clean, strict=True):
-            ax.errorbar([est], [pos], xerr=[[max(est - lo, 0.0)], [max(hi - est, 0.0)]],
+    with _figure(9.0, 1.3 + 0.95 * len(clean)) as fig:
+        fig.suptitle(f"{title}\n(point = estimate, bar = interval; each on its own scale)")
+        for ax, (label, est, lo, hi) in zip(_panels(fig, len(clean), sharex=False), clean,
+                                            strict=True):
+            percent = _is_rate([est, lo, hi])
+            ax.errorbar([est], [0.0], xerr=[[max(est - lo, 0.0)], [max(hi - est, 0.0)]],
                         fmt="o", color=PALETTE[0], ecolor=PALETTE[0], capsize=5,
                         markersize=7, linewidth=1.8)
             ax.annotate(f"{_fmt(est, percent)}  [{_fmt(lo, percent)}, {_fmt(hi, percent)}]",
-                        (hi, pos), xytext=(6, 0), textcoords="offset points", va="center",
+                        (hi, 0.0), xytext=(6, 0), textcoords="offset points", va="center",
                         fontsize=9)
-        ax.set_yticks(positions, [label for label, *_ in clean])
-        ax.set_ylim(-0.7, len(clean) - 0.3)
-        ax.set_title(f"{title} (point = estimate, bar = interval)")
-        if percent:
-            _percent_axis(ax, "x")
-            ax.set_xlabel("rate (% of opportunities)")
-            upper = max(hi for *_, hi in clean)
-            ax.set_xlim(0.0, min(1.0, upper * 1.35 + 0.01) if upper > 0 else 0.05)
-        else:
-            ax.set_xlabel("value")
-            ax.margins(x=0.25)
+            ax.set_yticks([0.0], [label])
+            ax.set_ylim(-1.0, 1.0)
+            ax.grid(axis="y", visible=False)
+            width = hi - lo if hi > lo else max(abs(est) * 0.1, 1e-6)
+            left, right = lo - 0.6 * width, hi + 1.9 * width   # room for the label
+            if percent:
+                left, right = max(left, 0.0), min(right, 1.0 + 0.9 * width)
+                _percent_axis(ax, "x")
+            ax.set_xlim(left, right)
+            ax.xaxis.set_major_locator(MaxNLocator(6))
+        if all(_is_rate([e, lo, hi]) for _, e, lo, hi in clean):
+            fig.supxlabel("rate (% of opportunities)", fontsize=11)
         _note_dropped(fig, dropped)
         return _save(fig, path)
 
 
 def over_days_figure(series: Mapping[str, Sequence[float]], path: Path) -> Path:
-    """One line per metric: its value on day 1, 2, …, D."""
+    """One panel per metric, each on its own scale: its value on day 1, 2, …, D."""
     title = "Outcomes over the simulated days"
     present = {_text(name): list(vals) for name, vals in series.items() if len(vals) > 0}
     if not present:
         return _empty(path, title)
     longest = max(len(v) for v in present.values())
-    with _figure(9.0, 4.6) as fig:
-        ax = fig.add_subplot()
-        for i, (name, vals) in enumerate(present.items()):
+    with _figure(9.0, 0.9 + 1.45 * len(present)) as fig:
+        fig.suptitle(f"{title}: mean per user on each day")
+        axes = _panels(fig, len(present))
+        for i, (ax, (name, vals)) in enumerate(zip(axes, present.items(), strict=True)):
             days = list(range(1, len(vals) + 1))
             ys = [float(v) if v is not None and math.isfinite(float(v)) else math.nan
                   for v in vals]
             ax.plot(days, ys, color=PALETTE[i % len(PALETTE)],
                     marker=_MARKERS[i % len(_MARKERS)] if longest <= 60 else None,
-                    linestyle=_LINESTYLES[i % len(_LINESTYLES)], linewidth=1.8, label=name)
-        ax.set_title(f"{title}: value of each metric per day")
-        ax.set_xlabel("simulated day")
-        ax.set_ylabel("value per day (metric's own unit)")
-        ax.set_xlim(0.5, longest + 0.5)
+                    markersize=4, linestyle=_LINESTYLES[i % len(_LINESTYLES)], linewidth=1.6)
+            ax.set_ylabel(name, rotation=0, ha="right", va="center")
+            finite = [y for y in ys if math.isfinite(y)]
+            if finite and min(finite) >= 0:
+                ax.set_ylim(bottom=0, top=max(max(finite) * 1.15, 1e-9))
+        axes[-1].set_xlabel("simulated day")
+        axes[-1].set_xlim(0.5, longest + 0.5)
         if longest <= 31:
-            ax.set_xticks(range(1, longest + 1, 1 if longest <= 15 else 2))
-        if all(v >= 0 for vals in present.values() for v in vals if v is not None):
-            ax.set_ylim(bottom=0)
-        _outside_legend(ax)
+            axes[-1].set_xticks(range(1, longest + 1, 1 if longest <= 15 else 2))
         return _save(fig, path)
 
 
 def time_of_day_figure(series: Mapping[str, Sequence[int]], path: Path) -> Path:
-    """One line per metric: how many times it happened in each hour of the day (0 to 23)."""
+    """One panel per metric, each on its own scale: how many times it happened in each hour
+    of the day (0 to 23)."""
     title = "Outcomes by time of day"
     for name, counts in series.items():
         if len(counts) != 24:
@@ -282,20 +303,62 @@ def time_of_day_figure(series: Mapping[str, Sequence[int]], path: Path) -> Path:
     if not present:
         return _empty(path, title)
     hours = list(range(24))
-    with _figure(9.0, 4.6) as fig:
-        ax = fig.add_subplot()
-        for i, (name, counts) in enumerate(present.items()):
-            ax.plot(hours, counts, color=PALETTE[i % len(PALETTE)],
-                    marker=_MARKERS[i % len(_MARKERS)],
-                    linestyle=_LINESTYLES[i % len(_LINESTYLES)], linewidth=1.8,
-                    drawstyle="steps-mid", label=name)
-        ax.set_title(f"{title}: occurrences in each hour")
-        ax.set_xlabel("hour of the simulated day (0–23)")
-        ax.set_ylabel("count (occurrences)")
-        ax.set_xticks(range(0, 24, 2))
-        ax.set_xlim(-0.5, 23.5)
-        ax.set_ylim(bottom=0)
-        _outside_legend(ax)
+    with _figure(9.0, 0.9 + 1.45 * len(present)) as fig:
+        fig.suptitle(f"{title}: occurrences in each hour, all users and days")
+        axes = _panels(fig, len(present))
+        for i, (ax, (name, counts)) in enumerate(zip(axes, present.items(), strict=True)):
+            ax.bar(hours, counts, width=0.8, color=PALETTE[i % len(PALETTE)],
+                   edgecolor="black", linewidth=0.4)
+            ax.set_ylabel(name, rotation=0, ha="right", va="center")
+            ax.set_ylim(0, max(counts) * 1.15)
+        axes[-1].set_xlabel("hour of the simulated day (0–23)")
+        axes[-1].set_xticks(range(0, 24, 2))
+        axes[-1].set_xlim(-0.6, 23.6)
+        return _save(fig, path)
+
+
+def per_user_figure(series: Mapping[str, Sequence[float]], path: Path, *,
+                    units: Mapping[str, str] | None = None) -> Path:
+    """How users differ: per metric, a histogram of each user's own value (their rate, their
+    mean duration), each in its own panel and scale, the mean over users marked.
+    ``units`` per metric: ``"%"`` draws a proportion as a percentage, another unit labels
+    the axis."""
+    import numpy as np
+
+    title = "How users differ"
+    units = units or {}
+    present = {}
+    for name, values in series.items():
+        data, _ = _finite(values)
+        if data:
+            present[name] = data
+    if not present:
+        return _empty(path, title)
+    with _figure(9.0, 0.9 + 2.0 * len(present)) as fig:
+        fig.suptitle(f"{title}: each user's own value, over users")
+        axes = _panels(fig, len(present), sharex=False)
+        for ax, (name, data) in zip(axes, present.items(), strict=True):
+            arr = np.asarray(data, dtype=float)
+            unit = units.get(name, "")
+            scale = 100.0 if unit == "%" else 1.0
+            arr = arr * scale
+            distinct = np.unique(arr)
+            if distinct.size <= 30:     # a few values (0, 1/120, 2/120 …): one bar each
+                step = float(np.min(np.diff(distinct))) if distinct.size > 1 else 1.0
+                counts = [int(np.sum(arr == v)) for v in distinct]
+                ax.bar(distinct, counts, width=step * 0.8, color=PALETTE[5],
+                       edgecolor=PALETTE[0], linewidth=0.6)
+            else:
+                ax.hist(arr, bins="auto", color=PALETTE[5], edgecolor=PALETTE[0],
+                        linewidth=0.6)
+            mean = float(arr.mean())
+            label = f"{mean:.2f} %" if unit == "%" else f"{mean:.4g}{' ' + unit if unit else ''}"
+            ax.axvline(mean, color=PALETTE[1], linewidth=1.8, label=f"mean over users {label}")
+            ax.set_title(_text(name), loc="left", fontsize=11)
+            ax.set_ylabel("users")
+            ax.set_xlabel(f"each user's {_text(name)}"
+                          + (f" ({'%' if unit == '%' else unit})" if unit else ""))
+            ax.legend(loc="upper right", frameon=True)
         return _save(fig, path)
 
 

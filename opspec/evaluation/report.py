@@ -1,16 +1,32 @@
-"""The evaluation report: ``report.html`` (self-contained) and ``report.md`` with PNG figures,
-built from the result store alone (so a resumed or re-reported run gives the same report).
+"""The evaluation report: ``report.html`` (self-contained, rendered from a Jinja2 template a
+researcher can replace) and ``report.md`` with PNG figures, built from the result store alone
+(so a resumed or re-reported run gives the same report).
 
-Figures: each duration metric's distribution (ECDF and histogram), rates with their CIs,
-count outcomes per day and by hour of day, per-activity omission and error rates, and with
-two designs the paired differences.
+What a reader gets, in order: key findings in plain words (estimates with their intervals,
+hazards); what was run; what each metric measures (from which event to which event a
+duration runs, what a count counts); who the simulated users are (every user-model
+parameter, with its source); the estimates (table and figure, each rate on its own scale);
+how users differ (each user's own rate or mean duration: a table and histograms); each
+duration's distribution; counts day by day and by hour (each on its own scale); the user's
+actions per activity; hazards from the spec's monitors (or that none were declared); with
+two designs the paired differences; failed replications; how to read the intervals.
+
+Figures and tables show the same numbers: every figure is drawn once per metric from the
+same summaries as the tables; where a figure draws a sample of many observations its
+caption says so, and the marks in it (mean, median, p95) are of all observations.
 """
 
 from __future__ import annotations
 
+from collections.abc import Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
+from opspec.evaluation.describe import (
+    describe_metric,
+    user_model_notes,
+    user_model_rows,
+)
 from opspec.evaluation.plan import span
 from opspec.evaluation.store import ResultStore
 from opspec.evaluation.summary import (
@@ -18,33 +34,43 @@ from opspec.evaluation.summary import (
     metric_definitions,
     summarise_design,
     summarise_monitors,
+    user_pairs,
 )
 from opspec.evaluation.tables import (
-    COMPARE_HEADERS,
     METRIC_HEADERS,
     MONITOR_HEADERS,
     PER_USER_HEADERS,
     comparison_rows,
+    fmt,
     is_rate,
     metric_rows,
     monitor_rows,
     per_user_rows,
 )
 
-__all__ = ["write_report"]
+__all__ = ["PLOT_SAMPLE", "Summaries", "write_report"]
 
-# Figures show at most this many observations per metric (a deterministic, even thinning);
-# the statistics always use all of them.
+# Figures draw at most this many observations per metric (a deterministic, even thinning,
+# said in the caption); the statistics and the marks in the figure always use all of them.
 PLOT_SAMPLE = 50_000
 
+#: What the evaluate command has already computed, per design label: ``metrics``,
+#: ``monitors``; and ``difference`` for a comparison. Passed in so nothing is computed twice.
+Summaries = Mapping[str, Any]
 
-def _observations(store: ResultStore, design: str, metric: str) -> list[float]:
-    total = store.query("SELECT COUNT(*) FROM sample WHERE design = ? AND metric = ?",
-                        (design, metric))[0][0]
-    step = max(1, -(-int(total) // PLOT_SAMPLE))
-    rows = store.query("SELECT value FROM sample WHERE design = ? AND metric = ? AND "
-                       "rowid % ? = 0", (design, metric, step))
-    return [float(r[0]) for r in rows]
+
+def _observations(store: ResultStore, design: str, metric: str) -> tuple[list[float], int]:
+    """The observations a figure draws (every one, or an even sample) and how many exist."""
+    total = int(store.query("SELECT COUNT(*) FROM sample WHERE design = ? AND metric = ?",
+                            (design, metric))[0][0])
+    step = max(1, -(-total // PLOT_SAMPLE))
+    if step == 1:
+        rows = store.query("SELECT value FROM sample WHERE design = ? AND metric = ?",
+                           (design, metric))
+    else:
+        rows = store.query("SELECT value FROM sample WHERE design = ? AND metric = ? AND "
+                           "rowid % ? = 0", (design, metric, step))
+    return [float(r[0]) for r in rows], total
 
 
 def _per_day(store: ResultStore, design: str, metric: str, days: int, users: int
@@ -60,10 +86,12 @@ def _by_hour(store: ResultStore, design: str, metric: str) -> list[int]:
     return [int(rows.get(h, 0)) for h in range(24)]
 
 
-def _activity_rates(store: ResultStore, design: str) -> list[tuple[str, float, float]]:
+def _activity_rates(store: ResultStore, design: str
+                    ) -> list[tuple[str, int, float, float]]:
     rows = store.query("SELECT activity, SUM(offered), SUM(omitted), SUM(wrong) FROM activity "
                        "WHERE design = ? GROUP BY activity ORDER BY MIN(rowid)", (design,))
-    return [(str(a), (om or 0) / off, (wr or 0) / off) for a, off, om, wr in rows if off]
+    return [(str(a), int(off), (om or 0) / off, (wr or 0) / off)
+            for a, off, om, wr in rows if off]
 
 
 def _users_done(store: ResultStore, design: str) -> int:
@@ -71,117 +99,366 @@ def _users_done(store: ResultStore, design: str) -> int:
                            "status = 'done'", (design,))[0][0])
 
 
-def write_report(store: ResultStore) -> Path:
-    """Write ``report.html``, ``report.md`` and ``figures/*.png`` into the store's folder."""
+# ------------------------------------------------------------------------ what is in words
+
+def _with_selectors(store: ResultStore, design: str, spec: str | None, sha256: str | None
+                    ) -> list[dict[str, Any]]:
+    """The stored definitions; stores written before selectors were kept get them from the
+    spec when it is still the file the run used."""
+    definitions = [dict(d) for d in metric_definitions(store, design)]
+    if not definitions or all("select" in d for d in definitions) or not spec:
+        return definitions
+    try:
+        from opspec.evaluation.describe import metric_record
+        from opspec.evaluation.plan import file_digest
+        from opspec.xpdl.loader import load_spec
+
+        if sha256 and file_digest(spec) != sha256:
+            return definitions
+        declared = {m.name: metric_record(m) for m in load_spec(spec).metrics}
+    except Exception:  # noqa: BLE001 - a report without the detail is still a report
+        return definitions
+    return [{**declared.get(d["name"], {}), **{k: v for k, v in d.items() if v is not None}}
+            for d in definitions]
+
+
+def _user_model_section(store: ResultStore, plan: Mapping[str, Any]) -> Any:
+    from opspec.evaluation.html import Section, Table
+
+    ref = plan.get("user_model")
+    if not ref:
+        return Section("Who the simulated users are", paragraphs=(
+            "No user model: the spec has no user lane, so no person is simulated.",))
+    try:
+        from opspec.evaluation.plan import file_digest
+        from opspec.usermodels.loader import load_user_model
+
+        stored = store.get("user_model_sha256")
+        changed = bool(stored and Path(str(ref)).is_file()
+                       and file_digest(str(ref)) != stored)
+        model = load_user_model(str(ref))
+    except Exception as error:  # noqa: BLE001 - say why, keep the rest of the report
+        return Section("Who the simulated users are", paragraphs=(
+            f"User model {ref}: its parameters cannot be listed here ({error}).",))
+    paragraphs = [(f"User model {model.name} ({ref}). Every activity of the user's lane is "
+                  "performed with these parameters; durations are in seconds of simulated "
+                  "time.")]
+    if changed:
+        paragraphs.append(f"Warning: {ref} has changed since the run started; the table "
+                          "shows the file as it is now, not necessarily what the run used.")
+    return Section("Who the simulated users are", paragraphs=tuple(paragraphs),
+                   tables=(Table(("activity", "duration", "errors", "source"),
+                                 tuple(user_model_rows(model)),
+                                 "User-model parameters per activity"),),
+                   items=tuple(user_model_notes(model)))
+
+
+def _ci_words(summary: Mapping[str, Any], unit: str = "", *, percent: bool = False) -> str:
+    low, high = summary.get("ci95") or [None, None]
+    if low is None or high is None:
+        return ""
+    return (f" (95 % confidence interval {fmt(low, unit, percent=percent)} to "
+            f"{fmt(high, unit, percent=percent)})")
+
+
+def _finding(name: str, s: Mapping[str, Any], definition: Mapping[str, Any]) -> str | None:
+    kind = s["kind"]
+    if kind == "count":
+        if s.get("mean") is None:
+            return None
+        return (f"{name}: {fmt(s['mean'])} per user over the run{_ci_words(s)}, "
+                f"{s['total']:,} in all.")
+    if kind == "duration":
+        unit = s.get("unit") or "s"
+        if s.get("mean") is None:
+            return f"{name}: no observations."
+        return (f"{name}: {fmt(s['mean'], unit)} on average{_ci_words(s, unit)}; half took "
+                f"at most {fmt(s['median'], unit)} and 95 % at most {fmt(s['p95'], unit)} "
+                f"({s['n']:,} observations).")
+    if s.get("value") is None:
+        return None
+    percent = is_rate(name, s)
+    of = (f" of {definition.get('denominator')}" if percent and definition.get("denominator")
+          else f" ({definition.get('numerator')} per {definition.get('denominator')})")
+    return f"{name}: {fmt(s['value'], percent=percent)}{of}{_ci_words(s, percent=percent)}."
+
+
+def _key_findings(users: int, days: float, metrics: Mapping[str, Mapping[str, Any]],
+                  definitions: Sequence[Mapping[str, Any]],
+                  monitors: Mapping[str, Mapping[str, Any]], design_name: str) -> list[str]:
+    by_name = {d["name"]: d for d in definitions}
+    lines = [f"{users:,} simulated users of {design_name}, each followed for {span(days)}."]
+    order = ([n for n, s in metrics.items() if s["kind"] == "ratio"]
+             + [n for n, s in metrics.items() if s["kind"] == "duration"]
+             + [n for n, s in metrics.items() if s["kind"] == "count"])
+    for name in order:
+        sentence = _finding(name, metrics[name], by_name.get(name, {}))
+        if sentence:
+            lines.append(sentence)
+    if not monitors:
+        lines.append("Hazards: the spec declares no safety monitors (opspec:Monitor), so none "
+                     "were watched.")
+    for name, m in monitors.items():
+        low, high = m.get("ci95") or [None, None]
+        interval = (f" (95 % CI {fmt(low)} to {fmt(high)})" if low is not None
+                    and high is not None else "")
+        if m["violations"]:
+            lines.append(f"Hazard {name}: {m['violations']:,} violations in "
+                         f"{m['users_affected']} of {m['users']} users, "
+                         f"{fmt(m['per_user_day'])} per user-day{interval}.")
+        else:
+            lines.append(f"Hazard {name}: never violated; at most {fmt(high)} per user-day "
+                         "(upper 95 % bound)." if high is not None
+                         else f"Hazard {name}: never violated.")
+    return lines
+
+
+# ------------------------------------------------------------------------------ the report
+
+def _design_sections(store: ResultStore, figures: Path, design: str, name: str, days: float,
+                     users: int, metrics: Mapping[str, dict[str, Any]],
+                     monitors: Mapping[str, Any], definitions: Sequence[Mapping[str, Any]],
+                     prefix: str) -> list[Any]:
+    from opspec.evaluation import plots
+    from opspec.evaluation.html import Section, Table
+
+    sections: list[Any] = []
+    # the estimates: the table, and the rates each on its own scale (same numbers)
+    rates = [(n, s["value"], *(s["ci95"] or [s["value"], s["value"]]))
+             for n, s in metrics.items() if is_rate(n, s) and s["value"] is not None]
+    images, captions = [], []
+    if rates:
+        images.append(plots.rates_figure(rates, figures / f"{design}-rates.png"))
+        captions.append("Outcome rates with 95 % confidence intervals, each on its own scale "
+                        "(the same numbers as the table)")
+    sections.append(Section(f"{prefix}Estimates", paragraphs=(
+        ("Counts are per user over the whole run (sd, median and p95 are of the users' "
+        "totals); durations are pooled over all observations; ratios are the sum of the "
+        "numerator over the sum of the denominator over all users."),),
+        tables=(Table(METRIC_HEADERS, tuple(metric_rows(metrics)),
+                      f"Declared metrics of {name}"),),
+        images=tuple(images), captions=tuple(captions)))
+
+    # how users differ: each user's own value
+    spread = per_user_rows(metrics)
+    if spread:
+        series: dict[str, list[float]] = {}
+        units: dict[str, str] = {}
+        for d in definitions:
+            s = metrics.get(d["name"])
+            if s is None or s["kind"] == "count" or not (s.get("per_user") or {}).get("users"):
+                continue
+            values = [y / k for _, (y, k) in user_pairs(store, design, d) if k > 0]
+            label = (f"{d['name']} (mean per user)" if s["kind"] == "duration"
+                     else d["name"])
+            series[label] = values
+            units[label] = ("%" if is_rate(d["name"], s)
+                            else (s.get("unit") or "s") if s["kind"] == "duration" else "")
+        image = plots.per_user_figure(series, figures / f"{design}-per-user.png", units=units)
+        sections.append(Section(f"{prefix}How users differ", paragraphs=(
+            ("Each user's own rate or mean duration, over users: the spread shows how much "
+            "one user's experience can differ from the average."),),
+            tables=(Table(PER_USER_HEADERS, tuple(spread),
+                          "Each user's own mean duration or ratio, over users"),),
+            images=(image,), captions=(
+                ("Distribution over users of each user's own value (a histogram per metric, "
+                "each on its own scale; the line is the mean over users)"),)))
+
+    # durations
+    images, captions = [], []
+    for d in definitions:
+        s = metrics.get(d["name"])
+        if d["kind"] != "duration" or s is None:
+            continue
+        values, total = _observations(store, design, d["name"])
+        marks = {"mean": s.get("mean"), "median": s.get("median"), "p95": s.get("p95")}
+        images.append(plots.latency_figure(d["name"], values,
+                                           figures / f"{design}-{d['name']}.png",
+                                           marks=marks, total=total))
+        caption = f"Distribution of {d['name']}: ECDF (left) and histogram (right)"
+        if total > len(values):
+            caption += (f"; drawn from an even sample of {len(values):,} of the {total:,} "
+                        "observations; mean, median and p95 are of all observations")
+        else:
+            caption += f" of all {total:,} observations"
+        captions.append(caption)
+    if images:
+        sections.append(Section(f"{prefix}Durations", images=tuple(images),
+                                captions=tuple(captions)))
+
+    # counts over time
+    counts = [d["name"] for d in definitions if d["kind"] == "count"]
+    if counts:
+        per_day = {c: _per_day(store, design, c, max(1, round(days)), users) for c in counts}
+        hours = {c: _by_hour(store, design, c) for c in counts}
+        sections.append(Section(f"{prefix}Counts over time", images=(
+            plots.over_days_figure(per_day, figures / f"{design}-days.png"),
+            plots.time_of_day_figure(hours, figures / f"{design}-hours.png")), captions=(
+            ("Count outcomes per user, day by day (mean over users; each metric on its own "
+            "scale, so rare outcomes are visible)"),
+            ("Count outcomes by hour of the day, all users and days (each metric on its own "
+            "scale)"))))
+
+    # the user's actions
+    activity = _activity_rates(store, design)
+    if activity:
+        image = plots.activity_rates_figure([(a, o, w) for a, _, o, w in activity],
+                                            figures / f"{design}-activities.png")
+        sections.append(Section(f"{prefix}The user's actions", paragraphs=(
+            ("For each activity of the user's lane: how often it was asked of the user "
+            "(offered), the share not done (omitted: an alarm not heard, a step forgotten) "
+            "and the share done wrongly (a wrong button chosen)."),),
+            tables=(Table(("activity", "offered", "omitted per offer", "wrong per offer"),
+                          tuple((a, f"{n:,}", fmt(o, percent=True), fmt(w, percent=True))
+                                for a, n, o, w in activity),
+                          "Per-activity rates of the user's lane"),),
+            images=(image,), captions=(
+                ("The user's activities: omission and error rates per offer (the same "
+                "numbers as the table)"),)))
+
+    # hazards
+    if monitors:
+        sections.append(Section(f"{prefix}Hazards", paragraphs=(
+            ("Safety properties the spec declares (opspec:Monitor), watched in every "
+            "replication. The hazard is violations per user-day with a 95 % interval (the "
+            "wider of the exact Poisson and the cluster-robust interval over users)."),),
+            tables=(Table(MONITOR_HEADERS, tuple(monitor_rows(monitors)),
+                          "Safety monitors the spec declares (opspec:Monitor)"),)))
+    else:
+        sections.append(Section(f"{prefix}Hazards", paragraphs=(
+            (f"{name} declares no safety monitors (opspec:Monitor), so no hazards were "
+            "watched. Declare one (for instance min_gap dispense 4h; see "
+            "docs/spec-testing.md) to have it reported here."),)))
+    return sections
+
+
+def write_report(store: ResultStore, summaries: Mapping[str, Summaries] | None = None, *,
+                 template: str | Path | None = None) -> Path:
+    """Write ``report.html``, ``report.md`` and ``figures/*.png`` into the store's folder.
+
+    ``summaries`` per design label (``metrics``, ``monitors``; ``difference`` under ``"B"``)
+    are what the caller already computed; what is missing is computed here. ``template`` is
+    a Jinja2 template to render the HTML with instead of the bundled one.
+    """
     from opspec.evaluation import plots
     from opspec.evaluation.html import Section, Table, write_html, write_markdown
 
+    summaries = summaries or {}
     folder = store.folder
     figures = folder / "figures"
     plan: dict[str, Any] = store.get("plan") or {}
     days = float(plan.get("days", 1))
     designs = [d["label"] for d in plan.get("designs", [])] or ["A"]
     specs = {d["label"]: d["spec"] for d in plan.get("designs", [])}
-    sections = []
-
+    digests = {d["label"]: d.get("sha256") for d in plan.get("designs", [])}
+    names = {label: Path(specs.get(label, "spec")).name for label in designs}
+    if len(set(names.values())) < len(names):         # two files of the same name
+        names = {label: specs.get(label, label) for label in designs}
     done = {d: _users_done(store, d) for d in designs}
     failures = store.failures()
-    run_rows = [("spec (A)", specs.get("A", "?"))]
+
+    per_design: dict[str, tuple[dict[str, Any], dict[str, Any], list[dict[str, Any]]]] = {}
+    for design in designs:
+        given = summaries.get(design) or {}
+        metrics = given.get("metrics")
+        if metrics is None:
+            metrics = summarise_design(store, design, days)
+        monitors = given.get("monitors")
+        if monitors is None:
+            monitors = summarise_monitors(store, design, days)
+        definitions = _with_selectors(store, design, specs.get(design), digests.get(design))
+        per_design[design] = (metrics, monitors, definitions)
+
+    sections: list[Any] = []
+    metrics_a, monitors_a, definitions_a = per_design[designs[0]]
+    findings = _key_findings(done.get(designs[0], 0), days, metrics_a, definitions_a,
+                             monitors_a, names[designs[0]])
+    difference: dict[str, Any] | None = None
+    if "B" in designs:
+        difference = (summaries.get("B") or {}).get("difference")
+        if difference is None:
+            difference = compare_designs(store)
+        differs = [n for n, d in difference.items() if d.get("significant")]
+        findings.append(f"Compared with {names['B']} on the same users: "
+                        + (f"{', '.join(differs)} differ (95 % intervals of the paired "
+                           "differences exclude zero)." if differs
+                           else "no metric differs (every 95 % interval of the paired "
+                           "differences includes zero)."))
+    if failures:
+        findings.append(f"{len(failures)} replication(s) failed and are left out of every "
+                        "number (listed at the end).")
+    sections.append(Section("Key findings", paragraphs=(findings[0],),
+                            items=tuple(findings[1:])))
+
+    total_users = plan.get("users")
+    run_rows = [("specification", specs.get("A", "?"))]
     if "B" in specs:
-        run_rows.append(("compared with (B)", specs["B"]))
-    run_rows += [("users", str(plan.get("users"))), ("simulated time per user", span(days)),
+        run_rows.append(("compared with", specs["B"]))
+    finished = "; ".join(f"{done[d]:,} of {total_users:,}" + (f" ({names[d]})"
+                                                              if len(designs) > 1 else "")
+                         for d in designs) if isinstance(total_users, int) else str(done)
+    run_rows += [("simulated users", f"{total_users:,}" if isinstance(total_users, int)
+                  else str(total_users)),
+                 ("simulated time per user", span(days)),
                  ("seed", str(plan.get("seed"))),
                  ("user model", str(plan.get("user_model") or "none")),
-                 ("replications done", ", ".join(f"{d}: {n}" for d, n in done.items())),
+                 ("users finished", finished),
                  ("replications failed", str(len(failures))),
-                 ("opspec", str(store.get("opspec_version"))),
+                 ("opspec version", str(store.get("opspec_version"))),
                  ("started", str(store.get("started")))]
-    sections.append(Section("Run", paragraphs=(
-        ("Each simulated user is an independent replication with their own random streams; "
-        "designs are compared on the same users (common random numbers). Intervals are 95 % "
-        "confidence intervals over users (cluster-robust for pooled observations; see "
-        "docs/evaluation.md)."),), tables=(Table(("parameter", "value"), tuple(run_rows)),)))
+    sections.append(Section("What was run", paragraphs=(
+        "Each simulated user is an independent replication with their own random streams"
+        + ("; the designs are compared on the same users (common random numbers)."
+           if len(designs) > 1 else "."),), tables=(Table(("parameter", "value"),
+                                                          tuple(run_rows)),)))
 
     for design in designs:
-        metrics = summarise_design(store, design, days)
-        for name, summary in metrics.items():
-            summary["name"] = name
-        title = "Metrics" if len(designs) == 1 else f"Metrics of design {design}"
-        images: list[Path] = []
-        captions: list[str] = []
-        rates = [(name, s["value"], *(s["ci95"] or [None, None])) for name, s in metrics.items()
-                 if is_rate(name, s) and s["value"] is not None]
-        rates = [(n, v, lo if lo is not None else v, hi if hi is not None else v)
-                 for n, v, lo, hi in rates]
-        if rates:
-            images.append(plots.rates_figure(rates, figures / f"{design}-rates.png"))
-            captions.append("Outcome rates with 95 % confidence intervals")
-        definitions = metric_definitions(store, design)
-        for d in definitions:
-            if d["kind"] == "duration":
-                values = _observations(store, design, d["name"])
-                images.append(plots.latency_figure(d["name"], values,
-                                                   figures / f"{design}-{d['name']}.png"))
-                captions.append(f"Distribution of {d['name']} (ECDF and histogram)")
-        counts = [d["name"] for d in definitions if d["kind"] == "count"]
-        if counts:
-            users = done.get(design, 0)
-            per_day = {c: _per_day(store, design, c, max(1, round(days)), users)
-                       for c in counts}
-            images.append(plots.over_days_figure(per_day, figures / f"{design}-days.png"))
-            captions.append("Count outcomes per user, day by day")
-            hours = {c: _by_hour(store, design, c) for c in counts}
-            images.append(plots.time_of_day_figure(hours, figures / f"{design}-hours.png"))
-            captions.append("Count outcomes by hour of day (all users and days)")
-        activity = _activity_rates(store, design)
-        activity_table: tuple[Table, ...] = ()
-        if activity:
-            images.append(plots.activity_rates_figure(activity,
-                                                      figures / f"{design}-activities.png"))
-            captions.append("User-lane activities: omission and error rates per offer")
-            activity_table = (Table(("activity", "omitted per offer", "wrong per offer"),
-                                    tuple((a, f"{o * 100:.2f} %", f"{w * 100:.2f} %")
-                                          for a, o, w in activity),
-                                    "Per-activity rates of the user lane"),)
-        spread = per_user_rows(metrics)
-        spread_table = (Table(PER_USER_HEADERS, tuple(spread), "How users differ: each "
-                              "user's own mean duration or ratio, over users"),) if spread else ()
-        monitors = summarise_monitors(store, design, days)
-        monitor_table = (Table(MONITOR_HEADERS, tuple(monitor_rows(monitors)),
-                               "Safety monitors the spec declares (opspec:Monitor): "
-                               "violations per user-day with 95 % CI (the wider of the exact "
-                               "Poisson and the cluster-robust interval over users)"),
-                         ) if monitors else ()
-        sections.append(Section(title, tables=(Table(METRIC_HEADERS,
-                                                     tuple(metric_rows(metrics)),
-                                                     "Declared metrics of the spec"),
-                                               *monitor_table, *spread_table,
-                                               *activity_table),
-                                images=tuple(images), captions=tuple(captions)))
+        definitions = per_design[design][2]
+        suffix = f" ({names[design]})" if len(designs) > 1 else ""
+        sections.append(Section(f"What each metric measures{suffix}", tables=(Table(
+            ("metric", "kind", "definition"),
+            tuple((d["name"], str(d["kind"]), describe_metric(d)) for d in definitions),
+            "Metrics the spec declares (opspec:Metrics), computed from each user's trace"),)))
+    sections.append(_user_model_section(store, plan))
 
-    if "B" in designs:
-        difference = compare_designs(store)
-        rows = [(name, d["difference"], *(d["ci95"] or [None, None]))
-                for name, d in difference.items() if d["difference"] is not None]
-        rows = [(n, v, lo if lo is not None else v, hi if hi is not None else v)
-                for n, v, lo, hi in rows]
-        units = {name: "pp" if is_rate(name, d) else (d.get("unit") or "")
-                 for name, d in difference.items()}
-        compared = ((plots.comparison_figure(rows, figures / "comparison.png", units),) if rows
-                    else ())
-        sections.append(Section("B compared with A", paragraphs=(
-            ("Differences B − A per metric on the same simulated users (paired); 'differs' "
-            "marks intervals that exclude zero."),),
-            tables=(Table(COMPARE_HEADERS, tuple(comparison_rows(difference))),),
+    for design in designs:
+        metrics, monitors, definitions = per_design[design]
+        prefix = f"{names[design]}: " if len(designs) > 1 else ""
+        sections += _design_sections(store, figures, design, names[design], days,
+                                     done.get(design, 0), metrics, monitors, definitions,
+                                     prefix)
+
+    if difference is not None:
+        rows = [(n, d["difference"], *(d["ci95"] or [d["difference"], d["difference"]]))
+                for n, d in difference.items() if d["difference"] is not None]
+        units = {n: "pp" if is_rate(n, d) else (d.get("unit") or "")
+                 for n, d in difference.items()}
+        compared = ((plots.comparison_figure(rows, figures / "comparison.png", units),)
+                    if rows else ())
+        headers = ("metric", names["A"], names["B"], "difference", "95 % CI", "")
+        sections.append(Section(f"{names['B']} compared with {names['A']}", paragraphs=(
+            (f"Differences {names['B']} − {names['A']} per metric on the same simulated users "
+            "(paired); 'differs' marks intervals that exclude zero."),),
+            tables=(Table(headers, tuple(comparison_rows(difference))),),
             images=compared,
-            captions=("Paired differences with 95 % CIs",) if compared else ()))
+            captions=("Paired differences with 95 % CIs, each on its own scale",)
+            if compared else ()))
 
     if failures:
         sections.append(Section("Failed replications", paragraphs=(
             "Run `opspec evaluate --resume --out <this folder>` to run them again.",),
-            tables=(Table(("design", "user", "error"),
-                          tuple((d, str(u), e) for d, u, e in failures[:200])),)))
+            tables=(Table(("specification", "user", "error"),
+                          tuple((names.get(d, d), str(u), e) for d, u, e in failures[:200])),
+                    )))
 
-    title = f"Evaluation of {Path(specs.get('A', 'spec')).name}"
+    sections.append(Section("How to read the intervals", paragraphs=(
+        ("Users are the independent units: observations within one user are not independent "
+        "(a slow walker is slow at every dose). Intervals are 95 % confidence intervals over "
+        "users: for a count the Student-t interval of the per-user mean; for durations and "
+        "ratios the cluster-robust (delta-method) interval of the ratio estimator Σy / Σn. "
+        "Medians and p95 of durations are of all pooled observations. An interval of "
+        "something that cannot be negative is cut at zero. See docs/evaluation.md."),)))
+
+    title = f"Evaluation of {names[designs[0]]}"
     write_markdown(folder / "report.md", title, sections)
-    return write_html(folder / "report.html", title, sections)
+    return write_html(folder / "report.html", title, sections, template=template)

@@ -207,7 +207,7 @@ def test_a_report_that_cannot_be_written_keeps_the_results_and_resume_writes_it(
 
     from opspec.evaluation import report
 
-    def disk_full(store):
+    def disk_full(store, *args, **kwargs):
         raise OSError(errno.ENOSPC, "No space left on device")
 
     out = tmp_path / "run"
