@@ -314,15 +314,17 @@ class _Table:
 
 def load_profile(path: str | os.PathLike[str]) -> DeviceProfile:
     """Read and validate one profile file; raise BindingError naming file and key."""
+    from opspec.files import open_regular, reason
+
     where = str(path)
     try:
-        with open(path, "rb") as stream:
+        with open_regular(path) as stream:        # a pipe or device never blocks
             data = tomllib.load(stream)
     except FileNotFoundError:
         raise BindingError(f"device profile {where} does not exist",
                            hint="profiles live in devices/; see `opspec devices list`") from None
     except OSError as error:
-        raise BindingError(f"cannot read device profile {where}: {error.strerror}") from None
+        raise BindingError(f"cannot read device profile {where}: {reason(error)}") from None
     except tomllib.TOMLDecodeError as error:
         raise BindingError(f"invalid TOML: {error}", location=SourceLocation(where),
                            hint="fix the syntax; see devices/README.md") from None
@@ -527,7 +529,13 @@ def load_profiles(directory: str | os.PathLike[str]) -> list[DeviceProfile]:
     """Every ``*.toml`` profile in ``directory``, sorted by name; duplicate names raise."""
     folder = Path(directory)
     if not folder.is_dir():
-        raise BindingError(f"device profile directory {folder} does not exist",
+        from opspec.files import not_a_file
+
+        why = not_a_file(folder)
+        kind = ("a regular file" if why is None
+                else why.removeprefix("it is ").removesuffix(", not a regular file"))
+        what = "does not exist" if why == "it does not exist" else f"is {kind}, not a folder"
+        raise BindingError(f"device profile directory {folder} {what}",
                            hint="pass the folder holding the *.toml device profiles")
     profiles = [load_profile(p) for p in sorted(folder.glob("*.toml"))]
     seen: dict[str, str] = {}

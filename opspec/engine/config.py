@@ -94,14 +94,25 @@ class EngineConfig:
     @classmethod
     def load(cls, path: str | Path, **overrides: Any) -> EngineConfig:
         """Read a TOML file (``[engine]`` table or top-level keys), then apply ``overrides``."""
+        from opspec.files import open_regular, reason
+
         text_path = str(path)
         try:
-            with open(path, "rb") as handle:
+            with open_regular(path) as handle:     # a pipe or device never blocks
                 document = tomllib.load(handle)
         except FileNotFoundError:
             raise ConfigurationError(
                 "engine configuration file not found", location=SourceLocation(text_path),
                 hint="check the path given to --engine-config") from None
+        except OSError as error:
+            raise ConfigurationError(
+                f"cannot read the engine configuration: {reason(error)}",
+                location=SourceLocation(text_path)) from None
+        except UnicodeDecodeError as error:
+            raise ConfigurationError(
+                f"not UTF-8 text: byte 0x{error.object[error.start]:02x} at offset "
+                f"{error.start}", location=SourceLocation(text_path),
+                hint="save the configuration as UTF-8") from None
         except tomllib.TOMLDecodeError as error:
             raise ConfigurationError(
                 f"not valid TOML: {error}", location=SourceLocation(text_path),

@@ -170,11 +170,13 @@ def load_scenarios(path: str | Path, *, rootdir: Path | None = None) -> Scenario
     path = Path(path)
     if rootdir is not None and path.is_absolute() and path.is_relative_to(rootdir):
         path = path.relative_to(rootdir)     # messages name the file as the user wrote it
+    from opspec.files import read_text, reason
+
     try:
         full = path if path.is_absolute() or rootdir is None else rootdir / path
-        document = tomllib.loads(full.read_text(encoding="utf-8"))
+        document = tomllib.loads(read_text(full))   # a pipe or device never blocks
     except OSError as error:
-        raise _error(path, None, f"cannot read it: {error.strerror or error}") from None
+        raise _error(path, None, f"cannot read it: {reason(error)}") from None
     except (tomllib.TOMLDecodeError, UnicodeDecodeError) as error:
         raise _error(path, None, f"not valid TOML: {error}") from None
     _unknown(path, "", document, _TOP)

@@ -300,11 +300,13 @@ def _pair(entry: Any, where: str) -> tuple[Any, Any]:
 
 def load_script(path: str | Path) -> Script:
     """Read a script file (TOML, or JSON when the name ends in ``.json``)."""
+    from opspec.files import read_bytes, reason
+
     where = str(path)
     try:
-        raw = Path(path).read_bytes()
+        raw = read_bytes(path)            # a pipe or device is refused, never read (blocks)
     except OSError as error:
-        raise ConfigurationError(f"cannot read the script: {error.strerror or error}",
+        raise ConfigurationError(f"cannot read the script: {reason(error)}",
                                  location=SourceLocation(where)) from None
     try:
         document = (json.loads(raw) if where.endswith(".json")

@@ -22,6 +22,7 @@ Estimated, per activity:
 
 from __future__ import annotations
 
+import io
 import json
 import math
 import warnings
@@ -58,11 +59,14 @@ _ANSWERS = (EventKind.ACTIVITY_COMPLETED, EventKind.ACTIVITY_OMITTED,
 def read_trace(path: str | Path) -> Iterator[TraceEvent]:
     """The events of one JSON Lines trace file, streamed; :class:`UserModelError` naming
     ``path:line`` for an unreadable file, a missing/foreign header or a malformed line."""
+    from opspec.files import open_regular, reason
+
     name = str(path)
     try:
-        handle = open(path, encoding="utf-8")  # noqa: SIM115 - closed in the finally below
+        # a pipe or device is refused, never read (it would block); closed in the finally
+        handle = io.TextIOWrapper(open_regular(path), encoding="utf-8")
     except OSError as error:
-        raise UserModelError(f"cannot read trace: {error.strerror or error}",
+        raise UserModelError(f"cannot read trace: {reason(error)}",
                              location=SourceLocation(name)) from None
     try:
         header_seen = False

@@ -318,11 +318,17 @@ def resolve_preset(name: str) -> Path:
 
 
 def _read(path: Path) -> dict[str, Any]:
+    from opspec.files import read_text, reason
+
     try:
-        text = path.read_text(encoding="utf-8")
+        text = read_text(path)            # a pipe or device is refused, never read (blocks)
     except OSError as error:
-        raise UserModelError(f"cannot read user model: {error.strerror or error}",
+        raise UserModelError(f"cannot read user model: {reason(error)}",
                              location=SourceLocation(str(path))) from None
+    except UnicodeDecodeError as error:
+        raise UserModelError(f"not UTF-8 text: byte 0x{error.object[error.start]:02x} at "
+                             f"offset {error.start}", location=SourceLocation(str(path)),
+                             hint="save the user model as UTF-8") from None
     try:
         return tomllib.loads(text)
     except tomllib.TOMLDecodeError as error:
@@ -348,6 +354,8 @@ def load_user_model(ref: str | Path, *, base: UserModel | None = None) -> UserMo
         return model
     path = Path(text)
     if not path.is_file():
+        if path.exists() and not path.is_dir():    # a pipe or device: say what it is
+            _read(path)
         if path.suffix == ".toml" or "/" in text or "\\" in text:
             raise UserModelError("user model file not found",
                                  location=SourceLocation(text),

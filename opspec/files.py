@@ -1,0 +1,89 @@
+"""Opening the files users name — user models, scripts and recordings, engine configurations,
+traces, scenario files, device profiles, world files — without ever blocking.
+
+A named pipe (FIFO), a device (``/dev/zero``), a socket or a folder given where a file is
+expected is refused before it is opened; a regular file is opened non-blocking and checked
+again, so a path swapped for a pipe in between cannot block either. Failures are
+:class:`OSError` whose ``strerror`` is one phrase for a one-line message (``"it is a named
+pipe (FIFO), not a regular file"``, ``"Permission denied"``): each loader wraps it in its own
+error (exit status 2 at the command line, docs/validation.md).
+
+This module sits at the bottom of the layers (pyproject.toml) so that every loader, the
+engine's included, can use it; it imports nothing of opspec. (:mod:`opspec.xpdl.reader` has
+its own ``not_a_file``/``open_regular`` for specs, with the same phrases.)
+"""
+
+from __future__ import annotations
+
+import os
+import stat
+from typing import BinaryIO
+
+__all__ = ["NotARegularFile", "not_a_file", "open_regular", "read_bytes", "read_text",
+           "reason"]
+
+
+class NotARegularFile(OSError):
+    """A path that is not a regular file (its ``strerror`` says what it is)."""
+
+    def __init__(self, why: str) -> None:
+        super().__init__(why)
+        self.strerror = why
+
+
+def not_a_file(path: str | os.PathLike[str]) -> str | None:
+    """Why ``path`` cannot be read as a file without even opening it (``"it does not exist"``,
+    ``"it is a folder"``, ``"it is a named pipe (FIFO), not a regular file"``…), or ``None``
+    for a regular file (or a link to one). Never blocks: nothing is opened."""
+    try:
+        mode = os.stat(path).st_mode
+    except FileNotFoundError:
+        return "it does not exist"
+    except OSError as error:
+        return f"it cannot be examined: {error.strerror or type(error).__name__}"
+    if stat.S_ISREG(mode):
+        return None
+    if stat.S_ISDIR(mode):
+        return "it is a folder"
+    kind = ("a named pipe (FIFO)" if stat.S_ISFIFO(mode)
+            else "a character device" if stat.S_ISCHR(mode)
+            else "a block device" if stat.S_ISBLK(mode)
+            else "a socket" if stat.S_ISSOCK(mode)
+            else "a special file")
+    return f"it is {kind}, not a regular file"
+
+
+def open_regular(path: str | os.PathLike[str]) -> BinaryIO:
+    """Open a regular file for reading in binary; an :class:`OSError` for anything else
+    (:class:`NotARegularFile` for a pipe, device, socket or folder). Never blocks."""
+    why = not_a_file(path)
+    if why is not None:
+        if why == "it does not exist":
+            raise FileNotFoundError(2, "No such file or directory", os.fspath(path))
+        raise NotARegularFile(why)
+    flags = os.O_RDONLY | getattr(os, "O_NONBLOCK", 0) | getattr(os, "O_BINARY", 0)
+    descriptor = os.open(path, flags)
+    try:
+        if not stat.S_ISREG(os.fstat(descriptor).st_mode):
+            raise NotARegularFile("it is not a regular file")
+        return os.fdopen(descriptor, "rb")
+    except BaseException:
+        os.close(descriptor)
+        raise
+
+
+def read_bytes(path: str | os.PathLike[str]) -> bytes:
+    """The bytes of the regular file ``path``; :class:`OSError` as :func:`open_regular`."""
+    with open_regular(path) as stream:
+        return stream.read()
+
+
+def read_text(path: str | os.PathLike[str], encoding: str = "utf-8") -> str:
+    """The text of the regular file ``path`` (:class:`UnicodeDecodeError` for bad bytes)."""
+    return read_bytes(path).decode(encoding)
+
+
+def reason(error: OSError) -> str:
+    """The phrase of a one-line message for ``error``: ``"Permission denied"``, ``"it is a
+    named pipe (FIFO), not a regular file"``…"""
+    return error.strerror or type(error).__name__
