@@ -1,10 +1,13 @@
 #!/usr/bin/env bash
-# System packages some tests drive for real (tmux for the terminal walkthrough test). Installed
-# only when missing and only when we may (root or passwordless sudo); tests that need a missing
-# tool skip with a message naming this script.
+# System packages some tests drive for real (tmux for the terminal walkthrough test; chromium
+# renders the evaluation report headless in tests/evaluation_output/test_report_browser.py).
+# Installed only when missing and only when we may (root or passwordless sudo); tests that
+# need a missing tool skip with a message naming this script.
 set -uo pipefail
 need=()
 command -v tmux >/dev/null 2>&1 || need+=(tmux)
+command -v chromium >/dev/null 2>&1 || command -v chromium-browser >/dev/null 2>&1 \
+  || command -v google-chrome >/dev/null 2>&1 || need+=(chromium)
 [ ${#need[@]} -eq 0 ] && exit 0
 if [ "$(id -u)" -eq 0 ]; then sudo=""; elif sudo -n true 2>/dev/null; then sudo="sudo -n"; else
   echo "system-deps: missing ${need[*]} and no root: the tests that need them will be skipped" >&2

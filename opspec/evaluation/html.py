@@ -130,7 +130,9 @@ def _context(title: str, sections: Sequence[Section]) -> dict[str, object]:
         tables = []
         for t in section.tables:
             numeric = _numeric_columns(t)
-            tables.append({"caption": t.caption, "headers": list(t.headers),
+            tables.append({"caption": t.caption,
+                           "headers": [{"text": h, "class": "num" if i in numeric else ""}
+                                       for i, h in enumerate(t.headers)],
                            "rows": [[_cell(i, str(c), numeric) for i, c in enumerate(row)]
                                     for row in t.rows]})
         figures = [{"src": "data:image/png;base64,"
