@@ -17,10 +17,17 @@ from __future__ import annotations
 
 import os
 import stat
+from collections.abc import Sequence
+from pathlib import Path
 from typing import BinaryIO
 
-__all__ = ["NotARegularFile", "not_a_file", "open_regular", "read_bytes", "read_text",
-           "reason"]
+__all__ = ["EXTERNAL_PATH_VARIABLE", "NotARegularFile", "allowed_roots", "companion_outside",
+           "not_a_file", "open_regular", "outside_roots", "read_bytes", "read_text", "reason"]
+
+#: Folders, besides the root spec's own folder tree, whose files specs may refer to (separated
+#: by ``os.pathsep``: ``OPSPEC_EXTERNAL_PATH=/opt/xpdl-lib:/srv/shared``; docs/validation.md).
+#: It covers every file a spec names: ExternalPackage hrefs, mode sources, world files.
+EXTERNAL_PATH_VARIABLE = "OPSPEC_EXTERNAL_PATH"
 
 
 class NotARegularFile(OSError):
@@ -87,3 +94,53 @@ def reason(error: OSError) -> str:
     """The phrase of a one-line message for ``error``: ``"Permission denied"``, ``"it is a
     named pipe (FIFO), not a regular file"``…"""
     return error.strerror or type(error).__name__
+
+
+# ---------------------------------------------------------------- files a spec names
+
+
+def _key(path: Path) -> Path:
+    try:
+        return path.resolve()
+    except (OSError, RuntimeError):
+        return path.absolute()
+
+
+def allowed_roots(root_path: str | os.PathLike[str] | None) -> tuple[Path, ...]:
+    """The folders whose files a spec in ``root_path`` may refer to: its own folder (the
+    working folder for a spec that has no file) and those listed in
+    :data:`EXTERNAL_PATH_VARIABLE` (each with every folder below it)."""
+    roots = [_key(Path(root_path)).parent if root_path else _key(Path.cwd())]
+    for entry in os.environ.get(EXTERNAL_PATH_VARIABLE, "").split(os.pathsep):
+        if entry.strip():
+            roots.append(_key(Path(entry.strip()).expanduser()))
+    return tuple(dict.fromkeys(roots))
+
+
+def outside_roots(target: Path, roots: Sequence[Path]) -> str | None:
+    """``None`` when ``target`` (links followed) lies inside one of ``roots``; otherwise a
+    phrase for the message saying where it really is."""
+    real = _key(target)
+    if any(real.is_relative_to(root) for root in roots):
+        return None
+    shown = str(target) if real == target.absolute() else f"{target}, which is {real}"
+    return shown
+
+
+def companion_outside(spec: str | os.PathLike[str] | None, name: str, what: str
+                      ) -> tuple[str, str] | None:
+    """``(message, hint)`` when the file ``name`` that the spec in ``spec`` names (relative to
+    the spec's folder: an ``opspec:Mode Source``, an ``opspec:WorldFile``) leads outside the
+    spec's folder tree and :data:`EXTERNAL_PATH_VARIABLE`; ``None`` when it may be read.
+    ``what`` names the reference in the message (``"opspec:WorldFile"``)."""
+    base = Path(spec).parent if spec else Path.cwd()
+    roots = allowed_roots(spec)
+    where = outside_roots(base / name, roots)
+    if where is None:
+        return None
+    folders = " or ".join(str(r) for r in roots)
+    message = (f"{what} {name!r} leads outside the spec's folder ({where}); opspec reads the "
+               f"files a spec names only inside {folders}")
+    hint = ("copy the file into the spec's folder, or allow its folder with the environment "
+            f"variable {EXTERNAL_PATH_VARIABLE} (docs/validation.md)")
+    return message, hint

@@ -70,15 +70,26 @@ def _file_parameters(compiled: CompiledPackage, world_attr: ExtendedAttribute
     attribute = _attribute(compiled, "opspec:WorldFile")
     if attribute is None or not attribute.value:
         return {}, None
-    path = Path(compiled.package.source or ".").parent / attribute.value
+    from opspec.files import companion_outside, open_regular, reason
+
+    spec = compiled.package.source
+    path = Path(spec or ".").parent / attribute.value
     where = attribute.location or world_attr.location
+    outside = companion_outside(spec, attribute.value, "opspec:WorldFile")
+    if outside is not None:           # refused before the file is even looked at
+        message, hint = outside
+        raise ConfigurationError(message, location=where, hint=hint)
     try:
-        with open(path, "rb") as handle:
+        with open_regular(path) as handle:        # a pipe or device never blocks
             return dict(tomllib.load(handle)), str(path)
     except OSError as error:
-        raise ConfigurationError(f"cannot read the world file {path}: "
-                                 f"{error.strerror or error}", location=where,
+        raise ConfigurationError(f"cannot read the world file {path}: {reason(error)}",
+                                 location=where,
                                  hint="opspec:WorldFile is relative to the spec") from None
+    except UnicodeDecodeError as error:
+        raise ConfigurationError(f"{path}: not UTF-8 text (byte 0x"
+                                 f"{error.object[error.start]:02x} at offset {error.start})",
+                                 location=where) from None
     except tomllib.TOMLDecodeError as error:
         raise ConfigurationError(f"{path}: not valid TOML: {error}", location=where) from None
 

@@ -74,12 +74,31 @@ def unreadable(path: Path) -> None:
 def mode_loader_for(package: Package) -> Callable[[str], Package]:
     """A loader for the specs a package's modes name (``<opspec:Mode Source="dock.xpdl">``),
     relative to the package's own file, each read once. The engine compiles what it returns
-    when the mode is first entered."""
+    when the mode is first entered.
+
+    A Source leading outside the spec's folder tree (and ``OPSPEC_EXTERNAL_PATH``) is refused
+    at once, as ``opspec validate`` refuses it (``mode-source-outside``, a
+    :class:`~opspec.errors.SpecError` at the mode's line), not when the mode is entered; a
+    loader asked for such a file anyway refuses it the same way."""
+    from opspec.files import companion_outside
+
     base = Path(package.source).parent if package.source else Path.cwd()
     cache: dict[str, Package] = {}
 
+    def refuse_outside(source: str, where: SourceLocation | None, what: str) -> None:
+        outside = companion_outside(package.source, source, what)
+        if outside is not None:
+            raise SpecError.from_diagnostics([Diagnostic(
+                where or SourceLocation(package.source or "<spec>"), Severity.ERROR,
+                "mode-source-outside", *outside)])
+
+    for mode in package.modes:
+        if mode.source:
+            refuse_outside(mode.source, mode.location, f"mode {mode.id!r}: Source")
+
     def load(source: str) -> Package:
         if source not in cache:
+            refuse_outside(source, None, "a mode's Source")
             cache[source] = open_spec(base / source)
         return cache[source]
 

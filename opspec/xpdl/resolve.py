@@ -19,7 +19,6 @@ Contract:
 
 from __future__ import annotations
 
-import os
 from collections.abc import Callable, Iterator, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -27,16 +26,13 @@ from pathlib import Path
 from lxml import etree
 
 from opspec.errors import Diagnostic, Severity, SourceLocation
+from opspec.files import EXTERNAL_PATH_VARIABLE, allowed_roots, outside_roots
 from opspec.model.activities import Execution, GatewayType, SubFlow
 from opspec.model.package import ExternalPackage, Package
 from opspec.model.process import ConditionKind, Transition, WorkflowProcess
 
 __all__ = ["EXTERNAL_PATH_VARIABLE", "Loader", "Resolution", "allowed_roots", "outside_roots",
            "resolve"]
-
-#: Folders, besides the root spec's own folder tree, whose files specs may refer to (separated
-#: by ``os.pathsep``: ``OPSPEC_EXTERNAL_PATH=/opt/xpdl-lib:/srv/shared``; docs/validation.md).
-EXTERNAL_PATH_VARIABLE = "OPSPEC_EXTERNAL_PATH"
 
 #: Loads one file: ``(package or None, diagnostics)``; never raises.
 Loader = Callable[[Path], tuple[Package | None, list[Diagnostic]]]
@@ -66,26 +62,6 @@ def _key(path: Path) -> Path:
         return path.resolve()
     except (OSError, RuntimeError):
         return path.absolute()
-
-
-def allowed_roots(root_path: Path) -> tuple[Path, ...]:
-    """The folders whose files a spec in ``root_path`` may refer to: its own folder and those
-    listed in :data:`EXTERNAL_PATH_VARIABLE` (each with every folder below it)."""
-    roots = [_key(root_path).parent]
-    for entry in os.environ.get(EXTERNAL_PATH_VARIABLE, "").split(os.pathsep):
-        if entry.strip():
-            roots.append(_key(Path(entry.strip()).expanduser()))
-    return tuple(dict.fromkeys(roots))
-
-
-def outside_roots(target: Path, roots: Sequence[Path]) -> str | None:
-    """``None`` when ``target`` (links followed) lies inside one of ``roots``; otherwise a
-    phrase for the message saying where it really is."""
-    real = _key(target)
-    if any(real.is_relative_to(root) for root in roots):
-        return None
-    shown = str(target) if real == target.absolute() else f"{target}, which is {real}"
-    return shown
 
 
 def _outside_message(href: str, where: str, roots: Sequence[Path]) -> tuple[str, str]:

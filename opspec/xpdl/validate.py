@@ -22,6 +22,7 @@ from opspec.xpdl.loader import load_package
 from opspec.xpdl.reader import DEFAULT_MAX_BYTES
 
 __all__ = [
+    "MODE_SOURCE_OUTSIDE",
     "SPEC_SUFFIXES",
     "FileReport",
     "merge_diagnostics",
@@ -116,22 +117,35 @@ def _promote(diagnostics: Iterable[Diagnostic]) -> tuple[Diagnostic, ...]:
         for d in diagnostics)
 
 
+#: The code of a mode Source leading outside the spec's folder tree (docs/validation.md).
+MODE_SOURCE_OUTSIDE = "mode-source-outside"
+
+
 def mode_source_diagnostics(package: Package, *, max_bytes: int = DEFAULT_MAX_BYTES
                             ) -> list[Diagnostic]:
     """Errors of the specs that modes load at run time (``<opspec:Mode Source="…">``,
     relative to the package's file): a missing file, or the loaded spec's own reader errors,
     each at the line of the mode (the engine would only find them at the mode change)."""
+    from opspec.files import companion_outside, not_a_file
+
     base = Path(package.source).parent if package.source else Path.cwd()
     out: list[Diagnostic] = []
     for mode in package.modes:
         if not mode.source:
             continue
         where = mode.location or SourceLocation(package.source or "<spec>")
+        outside = companion_outside(package.source, mode.source, f"mode {mode.id!r}: Source")
+        if outside is not None:          # refused before the file is even looked at
+            out.append(Diagnostic(where, Severity.ERROR, MODE_SOURCE_OUTSIDE, *outside))
+            continue
         target = base / mode.source
-        if not target.is_file():
+        why = not_a_file(target)
+        if why is not None:
             out.append(Diagnostic(
                 where, Severity.ERROR, "bad-mode",
-                f"mode {mode.id!r} loads {mode.source!r}, which does not exist ({target})",
+                f"mode {mode.id!r} loads {mode.source!r}, which does not exist ({target})"
+                if why == "it does not exist" else
+                f"mode {mode.id!r} loads {mode.source!r}, which cannot be read: {why}",
                 "Source is relative to this spec's folder; fix the name or add the file"))
             continue
         loaded = load_package(target, max_bytes=max_bytes)
