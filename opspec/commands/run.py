@@ -67,7 +67,7 @@ def register(subparsers: Any) -> None:
                       help="nobody performs the user lane (ignore SPEC.users.toml)")
     parser.add_argument("--trace", metavar="FILE", help="write the full trace as JSON Lines")
     parser.add_argument("--engine-config", metavar="FILE", help="engine configuration TOML")
-    parser.add_argument("--processor-model", choices=("dedicated", "pooled"),
+    parser.add_argument("--processor-model", choices=("dedicated", "pooled", "preemptive"),
                         help="override the configuration's processor model")
     parser.add_argument("--workers", type=int, help="override the pooled model's workers")
     parser.add_argument("--switch-cost", type=float, metavar="SECONDS",
@@ -205,12 +205,12 @@ def _config(args: argparse.Namespace) -> Any:
     if args.switch_cost is not None:
         overrides["switch_cost"] = args.switch_cost
     model = overrides.get("processor_model", config.processor_model)
-    if model != "pooled" and (args.workers is not None or args.switch_cost is not None):
+    if model == "dedicated" and (args.workers is not None or args.switch_cost is not None):
         raise ConfigurationError(
             f"{'--workers' if args.workers is not None else '--switch-cost'} applies to the "
-            "pooled model only; the dedicated model gives every workflow instance its own "
-            "worker (unlimited processors, no switch cost, by design)",
-            hint="add --processor-model pooled to compare N shared workers")
+            "pooled and preemptive models only; the dedicated model gives every workflow "
+            "instance its own worker (unlimited processors, no switch cost, by design)",
+            hint="add --processor-model pooled (or preemptive) to compare N shared processors")
     if args.speed is not None and not (args.realtime or config.realtime or args.bind):
         raise ConfigurationError("--speed only applies with --realtime",
                                  hint="add --realtime, or drop --speed")
@@ -423,7 +423,12 @@ def _print_timing(out: Any, timing: dict[str, dict[str, Any]], pool: dict[str, A
         print(f"  {name:<20}{t['started']:>8}{t['completed']:>8}{t['misses']:>8}"
               f"{_ms(t['response_mean_s']):>11}{_ms(t['response_p95_s']):>10}"
               f"{_ms(t['response_max_s']):>10}{_ms(t['jitter_s']):>9}", file=out)
-    if pool:
+    if pool and pool.get("preemptive"):
+        print(f"  preemptive model: {pool.get('workers')} processor(s), {pool.get('switches')} "
+              f"dispatches, {pool.get('preemptions')} preemption(s), busy "
+              f"{_fmt(pool.get('busy_time'))} s, at most {pool.get('max_waiting')} waiting",
+              file=out)
+    elif pool:
         print(f"  pooled model: {pool.get('workers')} worker(s), {pool.get('switches')} context "
               f"switches, busy {_fmt(pool.get('busy_time'))} s, at most "
               f"{pool.get('max_waiting')} waiting", file=out)

@@ -31,7 +31,7 @@ from opspec.errors import ConfigurationError, SourceLocation
 
 __all__ = ["PROCESSOR_MODELS", "EngineConfig"]
 
-PROCESSOR_MODELS = ("dedicated", "pooled")
+PROCESSOR_MODELS = ("dedicated", "pooled", "preemptive")
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
@@ -42,6 +42,10 @@ class EngineConfig:
       transitions are free, priority increments are ignored) or ``"pooled"`` (``workers``
       workers serve one FIFO queue per priority level; every transition into a general
       activity costs ``switch_cost`` seconds of a worker; ``cpu_demand`` occupies a worker).
+    - ``"preemptive"``: ``workers`` processors scheduled by fixed priority with preemption
+      (the source's Linux engine: a thread per workflow at its priority): a ready activity of
+      a higher level takes a processor from the lowest-level one running, which resumes
+      later (charged ``switch_cost`` again); equal levels are served in arrival order.
     - ``workers``: number of workers of the pooled model (>= 1).
     - ``priorities``: number of priority levels (>= 1); effective priorities are clamped to
       ``0 .. priorities-1`` and the highest level is served first.
@@ -52,7 +56,7 @@ class EngineConfig:
       wall-clock second.
     """
 
-    processor_model: Literal["dedicated", "pooled"] = "dedicated"
+    processor_model: Literal["dedicated", "pooled", "preemptive"] = "dedicated"
     workers: int = 1
     priorities: int = 8
     timer_resolution: float = 0.0
@@ -65,7 +69,9 @@ class EngineConfig:
 
     @property
     def pooled(self) -> bool:
-        return self.processor_model == "pooled"
+        """Whether a shared set of processors schedules the general activities (the pooled
+        and the preemptive model; the dedicated model gives every instance its own)."""
+        return self.processor_model != "dedicated"
 
     @classmethod
     def from_mapping(

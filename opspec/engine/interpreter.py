@@ -80,7 +80,7 @@ from opspec.engine.lifecycle import (
     TERMINATED,
 )
 from opspec.engine.performers import Performer, WorkItem
-from opspec.engine.processors import DedicatedProcessor, PooledProcessor
+from opspec.engine.processors import DedicatedProcessor, PooledProcessor, PreemptiveProcessor
 from opspec.engine.random import Streams
 from opspec.engine.registry import PerformerRegistry
 from opspec.engine.trace import EventKind as EK
@@ -160,8 +160,13 @@ class Interpreter:
         self._pooled = config.pooled
         self._switch = config.switch_cost if config.pooled else 0.0
         self._resolution = config.timer_resolution
-        self._pool = (PooledProcessor(self.env, config.workers, config.priorities,
-                                      self._after_cpu, _alive) if config.pooled else None)
+        self._pool: PooledProcessor | None = None
+        if config.processor_model == "preemptive":
+            self._pool = PreemptiveProcessor(self.env, config.workers, config.priorities,
+                                             self._after_cpu, _alive, config.switch_cost)
+        elif config.pooled:
+            self._pool = PooledProcessor(self.env, config.workers, config.priorities,
+                                         self._after_cpu, _alive)
         self._dedicated = DedicatedProcessor()
         self.raised_names: set[str] = set()
         self.mode = compiled.initial_mode

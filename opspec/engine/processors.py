@@ -28,7 +28,7 @@ from typing import Any
 
 import simpy
 
-__all__ = ["DedicatedProcessor", "PooledProcessor"]
+__all__ = ["DedicatedProcessor", "PooledProcessor", "PreemptiveProcessor"]
 
 
 class PooledProcessor:
@@ -128,3 +128,96 @@ class DedicatedProcessor:
 
     def summary(self) -> dict[str, float | int]:
         return {"bursts": self.bursts, "busy_time": self.busy_time, "max_busy": self.max_busy}
+
+
+class PreemptiveProcessor(PooledProcessor):
+    """``workers`` processors under fixed-priority preemptive scheduling.
+
+    The source design's Linux engine runs a thread per workflow at the workflow's priority;
+    on K processors the K highest-level ready jobs run. A job submitted at a level above the
+    lowest-level running job takes that job's processor at once: the preempted job keeps its
+    remaining demand and waits at the *head* of its level's queue (it came first), and pays
+    ``switch_cost`` again when it resumes. Jobs of equal level never preempt each other.
+
+    Same interface as :class:`PooledProcessor` (``submit`` returns ``True`` when the job had
+    to wait); ``preemptions`` counts the jobs taken off a processor. With one processor and
+    periodic workflows released together, the worst response times equal fixed-priority
+    response-time analysis (tests/processors/test_preemptive.py).
+    """
+
+    __slots__ = ("preemptions", "running", "switch_cost")
+
+    def __init__(self, env: simpy.Environment, workers: int, priorities: int,
+                 on_done: Callable[[Any], None], is_alive: Callable[[Any], bool],
+                 switch_cost: float = 0.0) -> None:
+        super().__init__(env, workers, priorities, on_done, is_alive)
+        self.switch_cost = switch_cost
+        self.preemptions = 0
+        # per running job: [job, level, remaining cost, started at, generation]
+        self.running: list[list[Any]] = []
+
+    def submit(self, job: Any, level: int, cost: float) -> bool:
+        top = len(self.queues) - 1
+        level = 0 if level < 0 else (min(level, top))
+        if self.free > 0:
+            self.free -= 1
+            self._start(job, level, cost)
+            return False
+        now = self.env.now
+        # a job whose demand ends at this very instant completes rather than being preempted
+        # (its completion is an event at the same time, processed right after this one)
+        candidates = [entry for entry in self.running if entry[2] - (now - entry[3]) > 1e-12]
+        victim = min(candidates, key=lambda entry: (entry[1], -entry[3]), default=None)
+        if victim is not None and victim[1] < level:
+            self._preempt(victim)
+            self._start(job, level, cost)
+            return False
+        self.queues[level].append((job, cost))
+        self.waiting += 1
+        self.max_waiting = max(self.max_waiting, self.waiting)
+        return True
+
+    def _start(self, job: Any, level: int, cost: float) -> None:
+        self.switches += 1
+        entry = [job, level, cost, self.env.now, 0]
+        self.running.append(entry)
+        self._arm(entry)
+
+    def _arm(self, entry: list[Any]) -> None:
+        generation = entry[4]
+        timeout = self.env.timeout(max(0.0, entry[2]))
+        timeout.callbacks.append(lambda _event: self._done(entry, generation))
+
+    def _preempt(self, entry: list[Any]) -> None:
+        ran = self.env.now - entry[3]
+        self.busy_time += ran
+        self.running.remove(entry)
+        entry[4] += 1                           # its pending completion is stale now
+        self.preemptions += 1
+        self.free += 1
+        # at the head of its level: it was ready before anything waiting there
+        self.queues[entry[1]].appendleft((entry[0], entry[2] - ran + self.switch_cost))
+        self.waiting += 1
+        self.max_waiting = max(self.max_waiting, self.waiting)
+        self.free -= 1                          # its processor goes to the preempting job
+
+    def _done(self, entry: list[Any], generation: int) -> None:
+        if entry[4] != generation or entry not in self.running:
+            return
+        self.running.remove(entry)
+        self.busy_time += self.env.now - entry[3]
+        self.free += 1
+        self._dispatch_levels()
+        self.on_done(entry[0])
+
+    def _dispatch_levels(self) -> None:
+        while self.free > 0 and self.waiting:
+            for level in range(len(self.queues) - 1, -1, -1):     # highest level first
+                queue = self.queues[level]
+                if queue:
+                    job, cost = queue.popleft()
+                    self.waiting -= 1
+                    if self.is_alive(job):
+                        self.free -= 1
+                        self._start(job, level, cost)
+                    break

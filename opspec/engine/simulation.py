@@ -385,7 +385,9 @@ class Simulation(Interpreter):
         if self._pool is not None:
             summary["pool"] = {"workers": self.config.workers, "busy_time": self._pool.busy_time,
                                "max_waiting": self._pool.max_waiting,
-                               "switches": self._pool.switches}
+                               "switches": self._pool.switches,
+                               "preemptions": getattr(self._pool, "preemptions", 0),
+                               "preemptive": self.config.processor_model == "preemptive"}
         else:
             summary["dedicated"] = self._dedicated.summary()
         return RunResult(tuple(self.memory.events) if self.memory is not None else None,
