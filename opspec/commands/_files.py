@@ -12,7 +12,7 @@ __all__ = ["input_problem", "same_file"]
 def input_problem(path: Path) -> str | None:
     """Why ``path`` cannot be read as the command's input (``"it does not exist"``, ``"it is
     a named pipe (FIFO), not a regular file"``…), or ``None``."""
-    from opspec.xpdl.reader import not_a_file
+    from opspec.files import not_a_file
 
     return not_a_file(path)
 
