@@ -29,6 +29,9 @@ idempotent and safe on files that mix versions. Line numbers of moved elements a
 
 from __future__ import annotations
 
+import itertools
+from collections.abc import Iterator
+
 from lxml import etree
 
 from opspec.xpdl.namespaces import CANONICAL, is_xpdl_namespace, qname
@@ -45,39 +48,56 @@ def _q(local: str) -> str:
 
 
 _Index = dict[str, list[etree._Element]]
+# A tag's fate: (local name, the tag to rename it to or None, opaque?), or None for a foreign
+# (vendor) element. Computed once per distinct tag, not once per element.
+_Kind = tuple[str, str | None, bool] | None
 
 
-def _index(root: etree._Element) -> _Index:
-    """Canonical elements by local name, in document order, outside opaque contents."""
+def _kind(tag: str) -> _Kind:
+    namespace, local = tag[1:].split("}", 1) if tag.startswith("{") else ("", tag)
+    if not is_xpdl_namespace(namespace):
+        return None
+    return local, (_q(local) if namespace != CANONICAL else None), local in _OPAQUE
+
+
+def _skip_subtree(elements: Iterator[object], element: etree._Element) -> None:
+    """Advance ``elements`` (a document-order ``iter()`` that has just yielded ``element``)
+    past ``element``'s descendants."""
+    if len(element):
+        count = sum(1 for _ in element.iterdescendants())
+        next(itertools.islice(elements, count, count), None)
+
+
+def _canonical_index(root: etree._Element) -> _Index:
+    """Rename every element in an XPDL namespace into :data:`CANONICAL` and return the
+    canonical elements by local name, in document order. Foreign (vendor) elements and opaque
+    contents are not entered: they are kept verbatim and not indexed. One pass over the tree
+    (lxml's own ``iter``), the namespace of each distinct tag worked out once."""
     found: _Index = {}
-    prefix = _q("")
-    stack: list[etree._Element] = [root]
-    while stack:
-        element = stack.pop()
+    kinds: dict[str, _Kind] = {}
+    elements = root.iter()
+    for element in elements:
         tag = element.tag
-        if not isinstance(tag, str) or not tag.startswith(prefix):
-            continue  # comments, PIs and foreign (vendor) elements
-        local = tag[len(prefix):]
-        found.setdefault(local, []).append(element)
-        if local not in _OPAQUE:
-            stack.extend(reversed(element))
-    return found
-
-
-def _canonical_namespaces(root: etree._Element) -> None:
-    # Foreign (vendor) elements and opaque contents are not entered: they are kept verbatim.
-    stack: list[etree._Element] = [root]
-    while stack:
-        element = stack.pop()
-        if not isinstance(element.tag, str):
+        if not isinstance(tag, str):
             continue  # comments, processing instructions
-        name = etree.QName(element)
-        if not is_xpdl_namespace(name.namespace):
+        try:
+            kind = kinds[tag]
+        except KeyError:
+            kind = kinds[tag] = _kind(tag)
+        if kind is None:
+            _skip_subtree(elements, element)
             continue
-        if name.namespace != CANONICAL:
-            element.tag = _q(name.localname)
-        if name.localname not in _OPAQUE:
-            stack.extend(element)
+        local, renamed, opaque = kind
+        if renamed is not None:
+            element.tag = renamed
+        bucket = found.get(local)
+        if bucket is None:
+            found[local] = [element]
+        else:
+            bucket.append(element)
+        if opaque:
+            _skip_subtree(elements, element)
+    return found
 
 
 def _tools_to_tasks(index: _Index) -> None:
@@ -93,27 +113,35 @@ def _tools_to_tasks(index: _Index) -> None:
             task.append(tool)
 
 
+def _owned(index: _Index, local: str, owners: tuple[str, ...]) -> dict[etree._Element, list[etree._Element]]:
+    """The ``local`` elements of the index grouped by their parent, for parents whose local
+    name is one of ``owners`` (parents and children in document order)."""
+    tags = {_q(owner) for owner in owners}
+    grouped: dict[etree._Element, list[etree._Element]] = {}
+    for element in index.get(local, ()):
+        parent = element.getparent()
+        if parent is not None and parent.tag in tags:
+            grouped.setdefault(parent, []).append(element)
+    return grouped
+
+
 def _performers(index: _Index) -> None:
-    for tag in ("Activity", "Lane"):
-        for owner in index.get(tag, []):
-            loose = owner.findall(_q("Performer"))
-            if not loose:
-                continue
-            performers = owner.find(_q("Performers"))
-            if performers is None:
-                performers = etree.Element(_q("Performers"))
-                copy_line(loose[0], performers)
-                loose[0].addprevious(performers)
-            for performer in loose:
-                performers.append(performer)
+    # from the loose Performer elements (few, or none in XPDL 2.x files) to their owners
+    for owner, loose in _owned(index, "Performer", ("Activity", "Lane")).items():
+        performers = owner.find(_q("Performers"))
+        if performers is None:
+            performers = etree.Element(_q("Performers"))
+            copy_line(loose[0], performers)
+            loose[0].addprevious(performers)
+        for performer in loose:
+            performers.append(performer)
 
 
 def _modes(index: _Index) -> None:
-    for activity in index.get("Activity", []):
-        for tag in ("StartMode", "FinishMode"):
-            element = activity.find(_q(tag))
-            if element is None:
-                continue
+    # from the (XPDL 1.0) StartMode/FinishMode elements to their activities: the first of each
+    for tag in ("StartMode", "FinishMode"):
+        for activity, elements in _owned(index, tag, ("Activity",)).items():
+            element = elements[0]
             chosen = next((etree.QName(c).localname for c in element if isinstance(c.tag, str)), None)
             if chosen and activity.get(tag) is None:
                 activity.set(tag, chosen)
@@ -184,8 +212,7 @@ def _rules(index: _Index) -> None:
 
 def normalize(root: etree._Element) -> etree._Element:
     """Rewrite ``root`` in place into the canonical namespace and XPDL 2.1 forms; return it."""
-    _canonical_namespaces(root)
-    index = _index(root)
+    index = _canonical_index(root)
     for rewrite in (_tools_to_tasks, _performers, _modes, _gateways, _conditions, _deadlines,
                     _block_ids, _rules):
         rewrite(index)

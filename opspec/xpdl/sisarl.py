@@ -188,21 +188,14 @@ def activity_directives(
     element: etree._Element, ctx: BuildContext
 ) -> tuple[ActivityDirectives, CoordinationBuiltIn | None]:
     """The :class:`ActivityDirectives` and coordination built-in of an ``Activity`` element."""
-    from opspec.xpdl.sisarl_builtins import build_builtin
-
     found = collect(element, ctx, ACTIVITY_DIRECTIVES, "an Activity")
-    values = _apply(found, ctx, {
-        "AutoRun": ("auto_run", lambda d: parse_boolean(d.value, d.location, "AutoRun")),
-        "PriorityIncrement": ("priority_increment",
-                              lambda d: parse_integer(d.value, d.location, "PriorityIncrement")),
-        "StartTrigger": ("start_trigger", lambda d: parse_trigger(d.value, d.location)),
-        "EndTrigger": ("end_trigger", lambda d: parse_trigger(d.value, d.location)),
-        "Raises": ("raises", _raises),
-        "CpuDemand": ("cpu_demand", lambda d: parse_seconds(d.value, d.location, "CpuDemand")),
-        "Duration": ("duration", lambda d: parse_distribution(d.value, d.location)),
-    })
+    if not found:
+        return _NO_ACTIVITY_DIRECTIVES, None
+    values = _apply(found, ctx, _ACTIVITY_PARSERS)
     builtin = None
     if "BuiltIn" in found:
+        from opspec.xpdl.sisarl_builtins import build_builtin
+
         builtin = build_builtin(found["BuiltIn"], ctx)
     return ActivityDirectives(**values), builtin
 
@@ -214,6 +207,20 @@ def _raises(directive: Directive) -> Any:
                                f"{trigger.kind!r}", location=directive.location,
                                hint="write message:NAME or signal:NAME")
     return trigger
+
+
+_ACTIVITY_PARSERS: dict[str, tuple[str, Callable[[Directive], Any]]] = {
+    "AutoRun": ("auto_run", lambda d: parse_boolean(d.value, d.location, "AutoRun")),
+    "PriorityIncrement": ("priority_increment",
+                          lambda d: parse_integer(d.value, d.location, "PriorityIncrement")),
+    "StartTrigger": ("start_trigger", lambda d: parse_trigger(d.value, d.location)),
+    "EndTrigger": ("end_trigger", lambda d: parse_trigger(d.value, d.location)),
+    "Raises": ("raises", _raises),
+    "CpuDemand": ("cpu_demand", lambda d: parse_seconds(d.value, d.location, "CpuDemand")),
+    "Duration": ("duration", lambda d: parse_distribution(d.value, d.location)),
+}
+# An activity without directives (shared: the model is immutable).
+_NO_ACTIVITY_DIRECTIVES = ActivityDirectives()
 
 
 def package_extensions(element: etree._Element, ctx: BuildContext) -> dict[str, Any]:

@@ -64,10 +64,13 @@ def _expression_text(element: etree._Element | None) -> str | None:
 
 
 def _deadlines(element: etree._Element, ctx: BuildContext) -> tuple[Deadline, ...]:
+    found = children(element, "Deadline")
+    if not found:
+        return ()
     from opspec.xpdl.durations import parse_duration_expression
 
     out: list[Deadline] = []
-    for deadline in children(element, "Deadline"):
+    for deadline in found:
         duration_element = child(deadline, "DeadlineDuration")
         text = _expression_text(duration_element) or ""
         duration = None
@@ -155,10 +158,13 @@ def _expression(element: etree._Element | None, text: str | None, ctx: BuildCont
 
 def build_assignments(element: etree._Element, ctx: BuildContext) -> tuple[Assignment, ...]:
     """``element/Assignments/Assignment`` (XPDL 2.1): Target := Expression at AssignTime."""
+    found = grandchildren(element, "Assignments", "Assignment")
+    if not found:
+        return ()
     from opspec.xpdl.conditions import parse_expression
 
     out: list[Assignment] = []
-    for assignment in grandchildren(element, "Assignments", "Assignment"):
+    for assignment in found:
         target = _expression_text(child(assignment, "Target"))
         text = _expression_text(child(assignment, "Expression")) or ""
         if target is None:

@@ -7,7 +7,9 @@ Handlers run on a *normalised* tree (:mod:`opspec.xpdl.normalize`): every XPDL e
 from __future__ import annotations
 
 import copy
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
+from contextlib import contextmanager
+from contextvars import ContextVar
 from dataclasses import dataclass, field
 from typing import Any, TypeAlias, TypeVar
 
@@ -28,6 +30,7 @@ __all__ = [
     "children",
     "extended_attributes",
     "grandchildren",
+    "indexed_children",
     "local_name",
     "parse_bool",
     "parse_int",
@@ -78,15 +81,75 @@ def local_name(element: Node) -> str:
     return tag.rsplit("}", 1)[-1]
 
 
+# The canonical tag of each local name asked for (``{CANONICAL}local``), made once.
+_TAGS: dict[str, str] = {}
+# Inside :func:`indexed_children`: element -> its element children by tag, each element's
+# children walked once however many child()/children() calls ask about them. Bounded: cleared
+# when full (a handler asks about one element and its near descendants at a time).
+_BY_TAG: ContextVar[dict[Node, dict[str, list[Node]]] | None] = ContextVar(
+    "opspec_children_by_tag", default=None)
+_BY_TAG_LIMIT = 256
+
+
+@contextmanager
+def indexed_children() -> Iterator[None]:
+    """Within this block :func:`child` and :func:`children` index each element's children
+    once (the tree must not change meanwhile: handlers only read it)."""
+    token = _BY_TAG.set({})
+    try:
+        yield
+    finally:
+        _BY_TAG.reset(token)
+
+
+def _tag(local: str) -> str:
+    tag = _TAGS.get(local)
+    if tag is None:
+        tag = _TAGS[local] = qname(local, CANONICAL)
+    return tag
+
+
+def _children_by_tag(element: Node) -> dict[str, list[Node]] | None:
+    """``element``'s element children by tag (document order), or ``None`` outside
+    :func:`indexed_children`."""
+    cache = _BY_TAG.get()
+    if cache is None:
+        return None
+    found = cache.get(element)
+    if found is None:
+        if len(cache) >= _BY_TAG_LIMIT:
+            cache.clear()
+        found = {}
+        for sub in element:
+            tag = sub.tag
+            if isinstance(tag, str):
+                bucket = found.get(tag)
+                if bucket is None:
+                    found[tag] = [sub]
+                else:
+                    bucket.append(sub)
+        cache[element] = found
+    return found
+
+
 def child(element: Node, local: str) -> Node | None:
+    if not len(element):
+        return None
+    by_tag = _children_by_tag(element)
+    if by_tag is not None:
+        found = by_tag.get(_tag(local))
+        return found[0] if found else None
     # iterchildren, not find(): no ElementPath to look up on each of a big file's many calls
-    return next(element.iterchildren(qname(local, CANONICAL)), None)
+    return next(element.iterchildren(_tag(local)), None)
 
 
 def children(element: Node | None, local: str) -> list[Node]:
-    if element is None:
+    if element is None or not len(element):
         return []
-    return list(element.iterchildren(qname(local, CANONICAL)))
+    by_tag = _children_by_tag(element)
+    if by_tag is not None:
+        return list(by_tag.get(_tag(local), ()))
+    return list(element.iterchildren(_tag(local)))
 
 
 def grandchildren(element: Node, wrapper: str, local: str) -> list[Node]:
@@ -156,6 +219,8 @@ def _raw_children(element: Node) -> str | None:
 
 def extended_attributes(element: Node, ctx: BuildContext) -> tuple[ExtendedAttribute, ...]:
     """Every ``ExtendedAttributes/ExtendedAttribute`` of ``element``, kept verbatim."""
+    if not len(element):
+        return ()
     out: list[ExtendedAttribute] = []
     for ext in grandchildren(element, "ExtendedAttributes", "ExtendedAttribute"):
         name = ext.get("Name")
@@ -188,7 +253,7 @@ def base_fields(
         element_id = f"<{kind} without Id at line {line}>" if line else f"<{kind} without Id>"
         ctx.error(element, "missing-id", f"{kind} has no Id",
                   f"add an Id attribute to the {kind}")
-    description = child_text(element, "Description")
+    description = child_text(element, "Description") if len(element) else None
     if description is None:
         description = attr(element, "Description")
     return {

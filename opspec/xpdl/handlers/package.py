@@ -14,6 +14,7 @@ from opspec.xpdl.handlers.common import (
     child,
     child_text,
     grandchildren,
+    indexed_children,
 )
 from opspec.xpdl.handlers.data import build_data_field, build_type_declaration
 from opspec.xpdl.handlers.field_names import resolve_field_names
@@ -49,6 +50,12 @@ def _external(element: etree._Element, ctx: BuildContext) -> ExternalPackage:
 
 
 def build_package(element: etree._Element, ctx: BuildContext) -> Package:
+    """The :class:`Package` of a normalised ``Package`` element (the tree is only read)."""
+    with indexed_children():
+        return _package(element, ctx)
+
+
+def _package(element: etree._Element, ctx: BuildContext) -> Package:
     stem = PurePath(ctx.path).stem
     if attr(element, "Id") is None:
         ctx.warning(element, "missing-id", f"Package has no Id; the file name {stem!r} is used",
