@@ -213,6 +213,14 @@ def run(args: argparse.Namespace) -> int:
     workers = args.workers if args.workers is not None else _local_cores()
     if workers < 1:
         raise EvaluationError(f"--workers must be >= 1, not {workers}")
+    if getattr(args, "report_template", None):   # read after the runs: refuse a bad one now
+        from opspec.files import open_regular, reason
+
+        try:
+            open_regular(args.report_template).close()
+        except OSError as error:
+            raise EvaluationError(f"cannot read the report template {args.report_template}: "
+                                  f"{reason(error)}") from None
     if args.scheduler:
         from opspec.evaluation.runner import check_scheduler
 

@@ -150,12 +150,13 @@ def render_html(title: str, sections: Sequence[Section],
     ``template`` (default: the bundled :data:`TEMPLATE`)."""
     import jinja2
 
+    from opspec.files import read_text, reason
+
     source = Path(template) if template is not None else TEMPLATE
     try:
-        text = source.read_text(encoding="utf-8")
+        text = read_text(source)          # a pipe or device is refused, never read (blocks)
     except OSError as error:
-        raise EvaluationError(f"cannot read the report template {source}: "
-                              f"{error.strerror or error}",
+        raise EvaluationError(f"cannot read the report template {source}: {reason(error)}",
                               hint="give an existing Jinja2 template (copy "
                               f"{TEMPLATE} to start from)") from None
     env = jinja2.Environment(autoescape=True, undefined=jinja2.StrictUndefined,

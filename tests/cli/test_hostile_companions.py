@@ -264,6 +264,24 @@ def test_an_unreadable_device_profile_exits_2(tmp_path: Path, deny: Callable[[Pa
         f"opspec: cannot read device profile {profile}: Permission denied")
 
 
+def test_a_report_template_that_cannot_be_read_is_refused_before_the_runs(
+        tmp_path: Path, deny: Callable[[Path], Path],
+        capsys: pytest.CaptureFixture[str]) -> None:
+    fifo = tmp_path / "fifo.html.j2"
+    os.mkfifo(fifo)
+    template = tmp_path / "report.html.j2"
+    template.write_text("<html></html>\n", encoding="utf-8")
+    deny(template)
+    for path, why in ((fifo, "it is a named pipe (FIFO), not a regular file"),
+                      (template, "Permission denied")):
+        status = main(["evaluate", str(SPEC), "--users", "1", "--days", "1", "--out",
+                       str(tmp_path / f"out-{path.stem}"), "--report-template", str(path)])
+        out, err = capsys.readouterr()
+        assert status == 2
+        assert one_line(err) == f"opspec: cannot read the report template {path}: {why}"
+        assert not (tmp_path / f"out-{path.stem}").exists()     # refused before any run
+
+
 def test_an_unreadable_scenario_file_is_refused(tmp_path: Path,
                                                 deny: Callable[[Path], Path]) -> None:
     from opspec.errors import ConfigurationError
