@@ -63,6 +63,10 @@ def register(subparsers: Any) -> None:
                         help="markings explored per process level before giving up "
                         "(default 100000)")
     parser.add_argument("--process", metavar="ID", help="check only the process with this Id")
+    parser.add_argument("--schedulability", action="store_true",
+                        help="also print the fixed-priority response-time analysis of the "
+                        "periodic workflows beside the preemptive engine's simulation of "
+                        "one hyperperiod (one processor)")
     parser.set_defaults(handler=run)
 
 
@@ -108,8 +112,74 @@ def run(args: argparse.Namespace) -> int:
             reports = [*reports, *(SoundnessReport(p.id, 0, False, (), stopped="memory")
                                    for p in processes if p.id not in done)]
         status = _print(path, reports, errors, as_json=args.json, max_states=args.max_states)
+        if getattr(args, "schedulability", False) and not errors:
+            status = max(status, _schedulability(package, as_json=args.json))
         worst = max(worst, status)
     return worst
+
+
+def _schedulability(package: Any, *, as_json: bool) -> int:
+    """Response-time analysis beside a simulation of one hyperperiod from a synchronous
+    release on one preemptive processor; 1 when a workflow misses its deadline."""
+    from opspec.engine.config import EngineConfig
+    from opspec.engine.simulation import Simulation
+    from opspec.model.schedulability import analyse, hyperperiod, tasks_of
+
+    tasks = analyse(tasks_of(package))
+    if not tasks:
+        if not as_json:
+            print("  schedulability: no periodic workflow declares a CpuDemand")
+        return 0
+    horizon = hyperperiod(tasks)
+    config = EngineConfig(processor_model="preemptive", workers=1, switch_cost=0.0,
+                          priorities=max(t.priority for t in tasks) + 1)
+    # the whole package runs (its other workflows take processor time too); the table
+    # follows the periodic ones
+    wanted = {t.workflow for t in tasks}
+    started: dict[int, tuple[str, float]] = {}
+    worst: dict[str, float] = {}
+
+    def listen(event: Any) -> None:
+        if event.process not in wanted:
+            return
+        if event.kind == "process.started":
+            started[event.instance] = (event.process, event.time)
+        elif event.kind == "process.completed" and event.instance in started:
+            _workflow, at = started.pop(event.instance)
+            worst[event.process] = max(worst.get(event.process, 0.0), event.time - at)
+
+    listen.selects = {(k, w, None) for k in ("process.started", "process.completed")  # type: ignore[attr-defined]
+                      for w in wanted}
+    Simulation(package, config, listeners=[listen]).run(until=horizon)
+    unfinished = set()
+    for workflow, at in started.values():       # still running at the horizon: at least
+        worst[workflow] = max(worst.get(workflow, 0.0), horizon - at)
+        unfinished.add(workflow)
+    # a workflow that never ran in the simulation (outside the initial mode) is judged by
+    # the analysis alone
+    misses = [t for t in tasks if t.response is None
+              or worst.get(t.workflow, 0.0) > t.deadline + 1e-9]
+    if as_json:
+        print(json.dumps({"schedulability": [
+            {"workflow": t.workflow, "period_s": t.period, "demand_s": t.demand,
+             "priority": t.priority, "deadline_s": t.deadline, "analysis_s": t.response,
+             "simulated_worst_s": worst.get(t.workflow),
+             "unfinished_at_end": t.workflow in unfinished} for t in tasks],
+            "hyperperiod_s": horizon}))
+    else:
+        print(f"  schedulability (one preemptive processor, fixed priorities, release at 0, "
+              f"simulated over {horizon:g} s):")
+        print(f"    {'workflow':<20}{'prio':>5}{'C s':>9}{'T s':>9}{'D s':>9}"
+              f"{'RTA R s':>10}{'sim max s':>11}  verdict")
+        for t in tasks:
+            simulated = worst.get(t.workflow)
+            shown = ("not run" if simulated is None else
+                     f"{'>= ' if t.workflow in unfinished else ''}{simulated:.4g}")
+            print(f"    {t.workflow:<20}{t.priority:>5}{t.demand:>9.4g}{t.period:>9.4g}"
+                  f"{t.deadline:>9.4g}{(f'{t.response:.4g}' if t.response is not None else '> D'):>10}"
+                  f"{shown:>11}  "
+                  f"{'meets its deadline' if t not in misses else 'MISSES its deadline'}")
+    return 1 if misses else 0
 
 
 def _with_zero_time_cycles(package: Any, reports: list[SoundnessReport],
