@@ -19,10 +19,12 @@ from collections.abc import Callable, Iterable, Mapping
 from dataclasses import dataclass, field
 from typing import Any
 
+from opspec.clock import try_duration
 from opspec.engine.conditions import compile_condition, compile_expression
 from opspec.engine.coordination import APPLICATION_BUILTINS, application_builtin
-from opspec.engine.sampling import Sampler, make_sampler, parse_duration_text
+from opspec.engine.sampling import Sampler, make_sampler
 from opspec.errors import OpspecError, SourceLocation, SpecError
+from opspec.model.bulk import gc_paused
 from opspec.model import (
     Activity,
     Binary,
@@ -338,7 +340,7 @@ class _Compiler:
             if _IDENT.match(stripped) and stripped not in ("true", "false", "null"):
                 expression = Name(tuple(stripped.split(".")))
             else:
-                seconds = parse_duration_text(stripped)
+                seconds = try_duration(stripped)
                 if seconds is None:
                     raise _spec_error(f"{what} {stripped!r} was not understood", location,
                                       "write an expression over data fields")
@@ -358,7 +360,7 @@ class _Compiler:
     def seconds(self, expression: Expression | None, text: str | None,
                 location: SourceLocation | None, what: str) -> Evaluator:
         if expression is None and text is not None:
-            value = parse_duration_text(text)
+            value = try_duration(text)
             if value is not None:
                 return _constant(value)
         return self.expr(expression, text, location, what)
@@ -884,6 +886,11 @@ def _constant(value: float) -> Evaluator:
 def compile_package(package: Package) -> CompiledPackage:
     """Compile ``package`` (fatal problems raise :class:`~opspec.errors.SpecError` with the
     location of the element at fault)."""
+    with gc_paused():       # a big package: no full collections while it is compiled
+        return _compile_package(package)
+
+
+def _compile_package(package: Package) -> CompiledPackage:
     compiler = _Compiler(package)
     processes = {p.id: compiler.process(p) for p in package.processes}
     modes = {m.id: frozenset(m.workflows) for m in package.modes}

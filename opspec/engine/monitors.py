@@ -17,7 +17,8 @@ monitor per line, ``#`` starts a comment) is read by :func:`parse_monitor`::
 A *subject* is an activity id (its completion), a trigger name (raised) or a process id (an
 instance started), resolved against the spec's names by :meth:`Monitor.bind`; it may be made
 explicit: ``activity:dispense``, ``trigger:trg_2``, ``process:notify_workflow``, and
-``a|b`` means either. Durations are ``90``, ``90s``, ``5 min``, ``4h`` or ISO ``PT4H``.
+``a|b`` means either. Durations are read by :mod:`opspec.clock` (``90``, ``90s``, ``5 min``,
+``1h30m``, ``PT4H``), as everywhere else.
 
 Over many runs, violations become a hazard: :func:`poisson_interval` gives the exact
 (Garwood) interval of a rate of events per unit of exposure (e.g. per user-day).
@@ -34,7 +35,7 @@ from collections.abc import Iterable, Sequence
 from dataclasses import dataclass, field, replace
 from typing import Any, Protocol
 
-from opspec.engine.sampling import parse_duration_text
+from opspec.clock import parse_duration, span
 from opspec.engine.trace import EventKind, TraceEvent
 from opspec.errors import ConfigurationError, SourceLocation
 
@@ -164,19 +165,11 @@ def parse_subject(text: str) -> Subject:
 
 
 def _seconds(text: str) -> float:
-    value = parse_duration_text(text)
-    if value is None or not math.isfinite(value) or value <= 0:
+    value = parse_duration(text, error=ConfigurationError)
+    if value <= 0:
         raise ConfigurationError(f"{text!r} is not a positive duration",
                                  hint="write e.g. 90s, 5 min, 4h or PT4H")
     return value
-
-
-def _span(seconds: float) -> str:
-    if seconds >= 3600:
-        return f"{seconds / 3600:g} h"
-    if seconds >= 60:
-        return f"{seconds / 60:g} min"
-    return f"{seconds:g} s"
 
 
 def clock(seconds: float) -> str:
@@ -311,8 +304,8 @@ class _MinGapRun(MonitorRun):
         last, gap = self.last, self.monitor.seconds
         if last is not None and event.time - last.time < gap:
             self.violate(event.time, f"{self.monitor.subject} at {clock(last.time)} and again "
-                         f"at {clock(event.time)}, {_span(event.time - last.time)} apart "
-                         f"(at least {_span(gap)} required)", (last, event))
+                         f"at {clock(event.time)}, {span(event.time - last.time)} apart "
+                         f"(at least {span(gap)} required)", (last, event))
         self.last = event
 
 
@@ -408,9 +401,9 @@ class _MaxCountRun(MonitorRun):
             self.window.popleft()
         if len(self.window) > m.limit:
             self.violate(event.time, f"{m.subject} happened {len(self.window)} times within "
-                         f"{_span(event.time - self.window[0].time)} (from "
+                         f"{span(event.time - self.window[0].time)} (from "
                          f"{clock(self.window[0].time)}); at most {m.limit} per "
-                         f"{_span(m.seconds)} allowed", tuple(self.window)[-SLICE:])
+                         f"{span(m.seconds)} allowed", tuple(self.window)[-SLICE:])
 
 
 @dataclass(frozen=True, slots=True)
@@ -447,7 +440,7 @@ class _ResponseRun(MonitorRun):
             cause = self.pending.popleft()
             due = cause.time + m.seconds
             self.violate(due, f"{m.trigger} at {clock(cause.time)} got no {m.response} "
-                         f"within {_span(m.seconds)} (due by {clock(due)})",
+                         f"within {span(m.seconds)} (due by {clock(due)})",
                          [e for e in self.recent if e.seq >= cause.seq])
 
     def observe(self, event: TraceEvent) -> None:

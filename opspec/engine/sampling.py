@@ -1,4 +1,4 @@
-"""Durations: ISO 8601 / plain-number duration text, and samplers for declared distributions.
+"""Samplers for declared distributions (duration text is read by :mod:`opspec.clock`).
 
 A :class:`~opspec.model.Distribution` (BPSim names such as ``LogNormalDistribution`` or
 opspec's short names such as ``lognormal``) becomes a *sampler*: a function of a numpy
@@ -9,37 +9,15 @@ each activity draws from its own seeded stream (:mod:`opspec.engine.random`).
 from __future__ import annotations
 
 import math
-import re
 from collections.abc import Callable
 
 import numpy as np
 
 from opspec.model import Distribution
 
-__all__ = ["Sampler", "make_sampler", "parse_duration_text"]
+__all__ = ["Sampler", "make_sampler"]
 
 Sampler = Callable[[np.random.Generator], float]
-
-_ISO = re.compile(
-    r"^P(?:(?P<d>\d+(?:\.\d+)?)D)?(?:T(?:(?P<h>\d+(?:\.\d+)?)H)?(?:(?P<m>\d+(?:\.\d+)?)M)?"
-    r"(?:(?P<s>\d+(?:\.\d+)?)S)?)?$")
-_UNITS = {"ms": 0.001, "s": 1.0, "sec": 1.0, "min": 60.0, "m": 60.0, "h": 3600.0,
-          "d": 86400.0}
-_PLAIN = re.compile(r"^(?P<v>\d+(?:\.\d+)?)\s*(?P<u>ms|s|sec|min|m|h|d)?$")
-
-
-def parse_duration_text(text: str) -> float | None:
-    """Seconds from ``PT300S``/``P1DT2H``, ``300``, ``300s``, ``5 min``; ``None`` if unreadable."""
-    body = text.strip()
-    match = _ISO.match(body.upper())
-    if match and body.upper() != "P" and body.upper() != "PT":
-        parts = match.groupdict()
-        return (float(parts["d"] or 0) * 86400 + float(parts["h"] or 0) * 3600
-                + float(parts["m"] or 0) * 60 + float(parts["s"] or 0))
-    match = _PLAIN.match(body.lower())
-    if match:
-        return float(match.group("v")) * _UNITS[match.group("u") or "s"]
-    return None
 
 
 def _p(dist: Distribution, *names: str, default: float | None = None) -> float:

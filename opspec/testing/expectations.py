@@ -288,13 +288,9 @@ def _loc(where: str) -> SourceLocation:
 
 
 def _duration(text: str) -> float:
-    from opspec.errors import OpspecError
-    from opspec.xpdl.durations import parse_duration
+    from opspec.clock import parse_duration
 
-    try:
-        return parse_duration(text)
-    except OpspecError as error:
-        raise ConfigurationError(error.message, hint="write e.g. 300s, 5 min or 4h") from None
+    return parse_duration(text, error=ConfigurationError)
 
 
 def _named(event: TraceEvent, name: str) -> bool:

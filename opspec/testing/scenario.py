@@ -150,13 +150,10 @@ def _until(path: Path, key: str, value: Any) -> float:
     if isinstance(value, bool) or not isinstance(value, (int, float, str)):
         raise _error(path, key, f"until is seconds or a duration, not {value!r}")
     if isinstance(value, str):
-        from opspec.xpdl.durations import parse_duration
+        from opspec.clock import parse_duration
 
-        try:
-            value = parse_duration(value)
-        except OpspecError as error:
-            raise _error(path, key, error.message, "write e.g. 3600, \"9h\" or \"09:00\"") \
-                from None
+        value = parse_duration(value, location=SourceLocation(str(path), key=key),
+                               error=ConfigurationError)
     if value <= 0:
         raise _error(path, key, f"until must be positive, not {value!r}")
     return float(value)

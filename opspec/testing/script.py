@@ -54,7 +54,7 @@ from typing import Any
 from opspec.engine.builtin_performers import ScriptedUser, Step
 from opspec.engine.performers import WorkItem
 from opspec.engine.trace import EventKind, TraceEvent
-from opspec.errors import ConfigurationError, OpspecError, SourceLocation
+from opspec.errors import ConfigurationError, SourceLocation
 
 __all__ = ["DEFAULTS", "Script", "ScriptEntry", "ScriptUser", "load_script", "parse_script"]
 
@@ -155,21 +155,21 @@ class ScriptUser(ScriptedUser):
 
 
 def _seconds(text: str, where: str) -> float:
-    from opspec.xpdl.durations import parse_duration
+    from opspec.clock import parse_duration
 
     cleaned = text.strip().removeprefix("+").strip()
     try:
-        return parse_duration(cleaned)
-    except OpspecError as error:
+        return parse_duration(cleaned, error=ConfigurationError)
+    except ConfigurationError as error:
         raise ConfigurationError(f"cannot read the time {text.strip()!r}: {error.message}",
-                                 location=SourceLocation(where), hint=_HINT) from None
+                                 location=SourceLocation(where), hint=error.hint) from None
 
 
 _AT = re.compile(r"(?P<time>.+?)(?:\s+on\s+day\s+(?P<day>\d+))?", re.IGNORECASE)
 
 
 def _absolute(text: str, where: str) -> float:
-    from opspec.xpdl.durations import parse_time_of_day
+    from opspec.clock import parse_time_of_day
 
     match = _AT.fullmatch(text.strip())
     assert match is not None
@@ -178,11 +178,8 @@ def _absolute(text: str, where: str) -> float:
         raise ConfigurationError(f"day {day} does not exist (the first day is day 1)",
                                  location=SourceLocation(where), hint=_HINT)
     if ":" in clock:
-        try:
-            return (day - 1) * _DAY + parse_time_of_day(clock)
-        except OpspecError as error:
-            raise ConfigurationError(error.message, location=SourceLocation(where),
-                                     hint=_HINT) from None
+        return (day - 1) * _DAY + parse_time_of_day(clock, location=SourceLocation(where),
+                                                     error=ConfigurationError)
     return (day - 1) * _DAY + _seconds(clock, where)
 
 

@@ -19,11 +19,12 @@ multiplied by ``notice_factor_per_day ** d`` (adherence decay) and durations by
 from __future__ import annotations
 
 import math
-import re
 from dataclasses import dataclass, field
 
 import numpy as np
 
+from opspec import clock
+from opspec.errors import UserModelError
 from opspec.usermodels.distributions import ParameterError
 from opspec.usermodels.errors import check_probability
 
@@ -31,19 +32,16 @@ __all__ = ["DAY", "Drift", "Routine", "RoutineState", "RoutineTracker", "Window"
            "parse_time_of_day"]
 
 DAY = 86_400.0
-_HHMM = re.compile(r"^(\d{1,2}):(\d{2})(?::(\d{2}))?$")
 
 
 def parse_time_of_day(param: str, value: object) -> float:
-    """``"07:30"`` / ``"07:30:15"`` / seconds since midnight -> seconds in [0, 86400]."""
+    """``"07:30"`` / ``"07:30:15"`` / ``"7:30 pm"`` (read by :mod:`opspec.clock`, as in specs)
+    or seconds since midnight -> seconds in [0, 86400]."""
     if isinstance(value, str):
-        match = _HHMM.match(value.strip())
-        if match is None:
-            raise ParameterError(param, f"must be a time of day like \"07:30\", got {value!r}")
-        h, m, s = int(match[1]), int(match[2]), int(match[3] or 0)
-        if h > 24 or m > 59 or s > 59 or (h == 24 and (m or s)):
-            raise ParameterError(param, f"is not a time of day: {value!r}")
-        return float(h * 3600 + m * 60 + s)
+        try:
+            return clock.parse_time_of_day(value, error=UserModelError)
+        except UserModelError as error:
+            raise ParameterError(param, error.message, hint=error.hint) from None
     if isinstance(value, bool) or not isinstance(value, (int, float)):
         raise ParameterError(param, f"must be \"HH:MM\" or seconds since midnight, got {value!r}")
     if not 0 <= value <= DAY:

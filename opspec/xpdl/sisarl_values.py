@@ -11,6 +11,7 @@ import math
 import re
 from typing import Final
 
+from opspec.clock import parse_duration, parse_rate, parse_time_of_day
 from opspec.errors import SourceLocation, SpecError
 from opspec.model.sisarl import Distribution, TriggerRef
 
@@ -74,18 +75,11 @@ def _fail(message: str, location: SourceLocation | None, hint: str) -> SisarlVal
 
 
 def parse_seconds(text: str, location: SourceLocation | None, what: str) -> float:
-    """A duration in seconds (``PT0.1S``, ``100ms``, ``0.1``) via the durations module."""
-    from opspec.xpdl.durations import parse_duration
-
+    """A duration in seconds (``PT0.1S``, ``100ms``, ``0.1``), read by :mod:`opspec.clock`."""
     try:
-        seconds = float(parse_duration(text, location=location))
-    except (SpecError, ValueError) as error:
-        raise _fail(f"{what} {text!r} is not a duration: {_detail(error)}", location,
-                    "write an ISO 8601 duration (PT0.1S), a number of seconds (0.1) or 100ms") from None
-    if not math.isfinite(seconds) or seconds < 0:
-        raise _fail(f"{what} {text!r} must be a finite, non-negative duration", location,
-                    "write for example PT5S")
-    return seconds
+        return parse_duration(text, location=location, error=SisarlValueError)
+    except SisarlValueError as error:
+        raise _fail(f"{what}: {error.message}", location, error.hint) from None
 
 
 def parse_period(text: str, location: SourceLocation | None, *, rate: bool) -> float:
@@ -95,16 +89,10 @@ def parse_period(text: str, location: SourceLocation | None, *, rate: bool) -> f
         if seconds <= 0:
             raise _fail(f"period {text!r} must be longer than zero", location, "write e.g. PT0.1S")
         return seconds
-    from opspec.xpdl.durations import parse_rate
-
     try:
-        hertz = float(parse_rate(text, location=location))
-    except (SpecError, ValueError) as error:
-        raise _fail(f"rate {text!r} is not a rate: {_detail(error)}", location,
-                    "write 10Hz, 10/s or 10 (per second)") from None
-    if not math.isfinite(hertz) or hertz <= 0:
-        raise _fail(f"rate {text!r} must be a positive number per second", location, "write e.g. 10Hz")
-    return 1.0 / hertz
+        return 1.0 / parse_rate(text, location=location, error=SisarlValueError)
+    except SisarlValueError as error:
+        raise _fail(f"rate: {error.message}", location, error.hint) from None
 
 
 def parse_boolean(text: str, location: SourceLocation | None, what: str) -> bool:
@@ -131,8 +119,6 @@ def _name(kind: str, rest: str, location: SourceLocation | None) -> str:
 
 
 def _timer(rest: str, location: SourceLocation | None) -> TriggerRef:
-    from opspec.xpdl.durations import parse_time_of_day
-
     body = rest.strip()
     if body.startswith("after"):
         delay = parse_seconds(body[len("after"):].strip(), location, "timer delay")
@@ -143,10 +129,11 @@ def _timer(rest: str, location: SourceLocation | None) -> TriggerRef:
     times: list[float] = []
     for item in times_text.split(","):
         try:
-            times.append(float(parse_time_of_day(item.strip(), location=location)))
-        except (SpecError, ValueError) as error:
-            raise _fail(f"timer time {item.strip()!r} is not a time of day: {_detail(error)}",
-                        location, "write times as HH:MM, e.g. timer:08:00,20:00") from None
+            times.append(parse_time_of_day(item.strip(), location=location,
+                                           error=SisarlValueError))
+        except SisarlValueError as error:
+            raise _fail(f"timer time: {error.message}", location,
+                        "write times as HH:MM, e.g. timer:08:00,20:00") from None
     every = parse_seconds(every_text, location, "timer repetition") if every_text.strip() else 86400.0
     if every <= 0:
         raise _fail("timer repetition must be longer than zero", location, "write e.g. every P1D")

@@ -7,12 +7,8 @@ import pytest
 from opspec.errors import SourceLocation, SpecError
 from opspec.model.expressions import Binary, Literal, Name
 from opspec.xpdl.conditions import ConditionSyntaxError
-from opspec.xpdl.durations import (
-    parse_duration,
-    parse_duration_expression,
-    parse_rate,
-    parse_time_of_day,
-)
+from opspec.clock import parse_duration, parse_rate, parse_time_of_day
+from opspec.xpdl.durations import parse_duration_expression
 
 DURATIONS = [
     ("PT5M", 300.0), ("P1D", 86400.0), ("PT0.5S", 0.5), ("P1DT2H", 93600.0),

@@ -112,7 +112,7 @@ def test_run_lists_the_violations_of_each_monitor(tmp_path, capsys):
 
 @pytest.mark.parametrize("monitor, message", [
     ("min_gap dispence 4h", "the spec has no activity, trigger or process 'dispence'"),
-    ("min_gap dispense whenever", "'whenever' is not a positive duration"),
+    ("min_gap dispense whenever", "cannot read duration 'whenever': not a duration"),
     ("at most twice", "cannot read the monitor 'at most twice'"),
 ], ids=["unknown-name", "bad-duration", "unreadable"])
 def test_validate_reports_a_bad_monitor_at_its_line(monitor, message, tmp_path, capsys):

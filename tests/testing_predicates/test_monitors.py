@@ -69,7 +69,7 @@ def test_monitor_text_forms_catch_exactly_their_violations(
 
 @pytest.mark.parametrize("text, match", [
     ("min_gap dispense", "cannot read the monitor"),
-    ("min_gap dispense soon", "'soon' is not a positive duration"),
+    ("min_gap dispense soon", "cannot read duration 'soon': not a duration"),
     ("always dispense", "monitor forms: 'min_gap A 4h'"),
     ("never trigger:", "cannot read 'trigger:'"),
 ], ids=["no-duration", "bad-duration", "unknown-form", "bad-subject"])

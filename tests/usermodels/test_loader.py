@@ -78,7 +78,7 @@ BAD = {
                              r"one of: duration")),
     "unknown-top-key": ('[activites.walk]\nduration = 3', r"users.toml: activites: unknown key"),
     "bad-window": ('[[routine.windows]]\nname = "asleep"\nstart = "23:00"\nend = "31:00"',
-                   r"routine.windows\[0\].end: is not a time of day"),
+                   r"routine.windows\[0\].end: cannot read time of day '31:00'"),
     "busy-string": ('[busy]\nengaged = "walk"', r"busy.engaged: must be a list"),
     "probabilities-sum": ('[activities.c]\nprobabilities = { a = 0.5, b = 0.6 }',
                           r"activities.c.probabilities: must add up to 1, got 1.1"),

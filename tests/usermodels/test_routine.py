@@ -100,8 +100,8 @@ def test_adherence_decay_shows_in_omissions_with_its_own_reason() -> None:
 
 
 @pytest.mark.parametrize(("kwargs", "message"), [
-    ({"start": "25:00"}, r"start: is not a time of day"),
-    ({"start": "7h"}, r"start: must be a time of day like"),
+    ({"start": "25:00"}, r"start: cannot read time of day '25:00': it is past 24:00"),
+    ({"start": "7h"}, r"start: cannot read time of day '7h': expected HH:MM"),
     ({"notice_factor": 1.5}, r"notice_factor: must be a probability"),
     ({"duration_factor": 0}, r"duration_factor: must be > 0"),
     ({"end": "23:00"}, r"end: must differ from start"),
