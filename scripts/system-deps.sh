@@ -1,11 +1,13 @@
 #!/usr/bin/env bash
 # System packages some tests drive for real (tmux for the terminal walkthrough test; chromium
-# renders the evaluation report headless in tests/evaluation_output/test_report_browser.py).
+# renders the evaluation report headless in tests/evaluation_output/test_report_browser.py;
+# socat makes the pty pair of tests/bindings/test_dispenser_end_to_end.py).
 # Installed only when missing and only when we may (root or passwordless sudo); tests that
 # need a missing tool skip with a message naming this script.
 set -uo pipefail
 need=()
 command -v tmux >/dev/null 2>&1 || need+=(tmux)
+command -v socat >/dev/null 2>&1 || need+=(socat)
 command -v chromium >/dev/null 2>&1 || command -v chromium-browser >/dev/null 2>&1 \
   || command -v google-chrome >/dev/null 2>&1 || need+=(chromium)
 [ ${#need[@]} -eq 0 ] && exit 0
