@@ -7,7 +7,8 @@ section *Preprocessing*).
 
 Relative companion paths follow the output: ``opspec:WorldFile``, mode sources and
 ExternalPackage hrefs are rewritten to lead from OUT's folder, and ``IN.users.toml`` is copied
-to ``OUT.users.toml`` (:mod:`opspec.xpdl.relocate`). Every output the bundled XPDL 2.1 XSD
+to ``OUT.users.toml`` (:mod:`opspec.xpdl.relocate`). A world file that would then lie outside
+OUT's folder tree (where opspec does not read it) is copied beside OUT instead. Every output the bundled XPDL 2.1 XSD
 rejects gets a ``not-schema-valid`` warning.
 
 Exit status: 0 written, 1 the spec has errors (those ``opspec validate`` reports, or a
@@ -75,6 +76,7 @@ def run(args: argparse.Namespace) -> int:
             print(diagnostic, file=sys.stderr)
         print(f"opspec preprocess: cannot read {source}; nothing written", file=sys.stderr)
         return 2
+    copies: list[tuple[Path, Path]] = []          # world files to copy beside the output
     if report.ok and package is not None:
         result = preprocess(package)
         diagnostics.extend(result.diagnostics)
@@ -82,7 +84,7 @@ def run(args: argparse.Namespace) -> int:
         if target is not None:
             # Relative companion paths (world file, mode sources, external packages) lead
             # from the output's folder to the same files.
-            package, moved = relocate(package, source, target)
+            package, moved = relocate(package, source, target, copies=copies)
             diagnostics.extend(moved)
         # The output promises standard XPDL 2.1: say when the schema would still reject it
         # (the known rules in words, anything else the bundled XSD finds as it says it).
@@ -106,13 +108,14 @@ def run(args: argparse.Namespace) -> int:
         return 2
     print(f"{target}: standard XPDL 2.1 from {source}")
     _copy_user_model(source, target)
+    for original, copy in copies:
+        _copy_companion(original, copy, "world file")
     return 0
 
 
 def _copy_user_model(source: Path, target: Path) -> None:
     """Copy the spec's companion ``SPEC.users.toml`` to the output's companion name, so
     ``opspec evaluate OUT`` draws the same users (an existing different file is kept)."""
-    import shutil
 
     from opspec.commands._spec import companion_user_model
 
@@ -120,15 +123,26 @@ def _copy_user_model(source: Path, target: Path) -> None:
     if model is None:
         return
     copy = target.with_name(target.name.removesuffix(target.suffix) + ".users.toml")
+    _copy_companion(model, copy, "user model")
+
+
+def _copy_companion(original: Path, copy: Path, what: str) -> None:
+    """Copy ``original`` to ``copy`` for the output (an existing different file is kept)."""
+    import shutil
+
+    from opspec.commands._files import same_file
+
+    if same_file(original, copy):
+        return
     try:
         if copy.exists():
-            if copy.read_bytes() != model.read_bytes():
-                print(f"opspec preprocess: kept {copy}, which differs from {model} (the "
-                      "output's user model)", file=sys.stderr)
+            if copy.read_bytes() != original.read_bytes():
+                print(f"opspec preprocess: kept {copy}, which differs from {original} (the "
+                      f"output's {what})", file=sys.stderr)
             return
-        shutil.copyfile(model, copy)
+        shutil.copyfile(original, copy)
     except OSError as error:
-        print(f"opspec preprocess: could not copy the user model {model} to {copy}: "
+        print(f"opspec preprocess: could not copy the {what} {original} to {copy}: "
               f"{error.strerror or error}", file=sys.stderr)
         return
-    print(f"{copy}: user model of the output, copied from {model}")
+    print(f"{copy}: {what} of the output, copied from {original}")

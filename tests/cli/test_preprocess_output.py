@@ -30,11 +30,28 @@ def test_a_preprocessed_world_spec_validates_and_runs_from_another_folder(
     root = etree.parse(str(out)).getroot()
     (world_file,) = [e.get("Value") for e in root.iter(f"{{{XPDL21}}}ExtendedAttribute")
                      if e.get("Name") == "opspec:WorldFile"]
-    assert world_file != "vacuum_cleaner.world.toml"
-    assert (out.parent / world_file).resolve() == (SPECS / "vacuum_cleaner.world.toml").resolve()
+    # the original lies outside the output's folder tree, where opspec does not read files a
+    # spec names (docs/validation.md): the world file is copied beside the output
+    assert world_file == "vacuum_cleaner.world.toml"
+    assert (out.parent / world_file).read_bytes() == (
+        SPECS / "vacuum_cleaner.world.toml").read_bytes()
     capsys.readouterr()
     assert main(["validate", str(out)]) == 0, capsys.readouterr().out
     assert main(["run", str(out), "--until", "5"]) == 0
+
+
+def test_a_preprocessed_world_spec_above_the_input_names_the_original(tmp_path: Path) -> None:
+    """Written in a folder whose tree holds the input, the output names the original world
+    file by a rewritten path and nothing is copied."""
+    specs = tmp_path / "specs"
+    specs.mkdir()
+    shutil.copy(SPECS / "vacuum_cleaner.xpdl", specs)
+    shutil.copy(SPECS / "vacuum_cleaner.world.toml", specs)
+    above = tmp_path / "vacuum.xpdl"
+    assert main(["preprocess", str(specs / "vacuum_cleaner.xpdl"), "-o", str(above)]) == 0
+    assert 'Value="specs/vacuum_cleaner.world.toml"' in above.read_text(encoding="utf-8")
+    assert not (tmp_path / "vacuum_cleaner.world.toml").exists()
+    assert main(["validate", str(above)]) == 0
 
 
 def test_output_to_stdout_keeps_paths_as_written(capsys: pytest.CaptureFixture[str],
@@ -77,7 +94,8 @@ def test_relocate_rewrites_mode_sources_and_external_hrefs(tmp_path: Path) -> No
     below, warnings = relocate(package, source, tmp_path / "specs" / "out" / "robot.xpdl")
     assert below.modes[0].source == "../modes/dock.xpdl"
     assert below.external_packages[0].href == "../lib.xpdl"
-    assert [w.code for w in warnings] == ["relocated-outside"]
+    # both now lead out of the output's folder tree: the mode Source and the package
+    assert [w.code for w in warnings] == ["relocated-outside", "relocated-outside"]
     # beside the input: nothing changes; URLs and absolute paths are left alone
     same, _ = relocate(package, source, tmp_path / "specs" / "robot.std.xpdl")
     assert same == package
@@ -137,6 +155,25 @@ def test_every_written_output_is_xsd_valid_or_says_it_is_not(
         pytest.skip("refused (validate's errors)")
     valid = schema_for(XPDL21).validate(etree.parse(str(out)))
     assert valid == ("will not be valid XPDL 2.1" not in err), err
+
+
+def test_relocate_copies_or_warns_for_companions_leading_outside(tmp_path: Path) -> None:
+    from opspec.model.common import ExtendedAttribute
+
+    world = ExtendedAttribute(name="opspec:WorldFile", value="worlds/room.toml")
+    package = Package(id="p", extended_attributes=(world,),
+                      modes=(Mode(id="dock", source="dock.xpdl"),))
+    source, output = tmp_path / "specs" / "r.xpdl", tmp_path / "out" / "r.xpdl"
+    copies: list[tuple[Path, Path]] = []
+    moved, warnings = relocate(package, source, output, copies=copies)
+    assert moved.extended_attributes[0].value == "room.toml"          # copied beside OUT
+    assert copies == [(tmp_path / "specs" / "worlds" / "room.toml", tmp_path / "out" / "room.toml")]
+    assert moved.modes[0].source == "../specs/dock.xpdl"
+    (warning,) = warnings                                               # the mode: not copied
+    assert warning.code == "relocated-outside" and "mode 'dock'" in warning.message
+    moved, warnings = relocate(package, source, output)                 # no copies: warned
+    assert moved.extended_attributes[0].value == "../specs/worlds/room.toml"
+    assert sorted("world file" in w.message for w in warnings) == [False, True]
 
 
 def test_mode_sources_written_verbatim_are_rewritten_too(tmp_path: Path) -> None:
