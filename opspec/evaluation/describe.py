@@ -84,15 +84,16 @@ def describe_metric(definition: Mapping[str, Any]) -> str:
         own += "."
     if kind == "count":
         select = definition.get("select")
-        how = (f"How often {describe_selector(select)} happened per simulated user over the "
-               "whole run." if select else "A count of trace events per simulated user over "
-               "the whole run.")
+        how = (f"Counted in the trace: every {describe_selector(select)[4:]}, per simulated "
+               "user over the whole run." if select else "A count of trace events per "
+               "simulated user over the whole run.")
     elif kind == "duration":
         start, end = definition.get("start"), definition.get("end")
         unit = definition.get("unit") or "s"
         if start and end:
             which = "first" if (start.get("which") or "first") == "first" else "last"
-            how = (f"Time ({unit}) from the {which} {describe_selector(start)[4:]} to "
+            how = (f"Measured in the trace: time ({unit}) from the {which} "
+                   f"{describe_selector(start)[4:]} to "
                    f"{describe_selector(end)}, within the same workflow instance; one "
                    "observation per instance in which both happen.")
         else:

@@ -161,8 +161,15 @@ def _ci_words(summary: Mapping[str, Any], unit: str = "", *, percent: bool = Fal
             f"{fmt(high, unit, percent=percent)})")
 
 
-def _finding(name: str, s: Mapping[str, Any], definition: Mapping[str, Any]) -> str | None:
+def _finding(metric: str, s: Mapping[str, Any], definition: Mapping[str, Any]
+             ) -> str | None:
+    """One estimate in a sentence, named by the spec's own words when it has some."""
     kind = s["kind"]
+    # a ratio's description is a name ("Share of the doses due that were taken"); a count's
+    # or a duration's is a definition, shown in "What each metric measures"
+    words = (str(definition.get("description") or "").strip().rstrip(".")
+             if kind == "ratio" else "")
+    name = f"{words} ({metric})" if words and len(words) <= 80 else metric
     if kind == "count":
         if s.get("mean") is None:
             return None
@@ -177,9 +184,13 @@ def _finding(name: str, s: Mapping[str, Any], definition: Mapping[str, Any]) -> 
                 f"({s['n']:,} observations).")
     if s.get("value") is None:
         return None
-    percent = is_rate(name, s)
-    of = (f" of {definition.get('denominator')}" if percent and definition.get("denominator")
-          else f" ({definition.get('numerator')} per {definition.get('denominator')})")
+    percent = is_rate(metric, s)
+    if words:
+        of = ""
+    elif percent and definition.get("denominator"):
+        of = f" of {definition.get('denominator')}"
+    else:
+        of = f" ({definition.get('numerator')} per {definition.get('denominator')})"
     return f"{name}: {fmt(s['value'], percent=percent)}{of}{_ci_words(s, percent=percent)}."
 
 

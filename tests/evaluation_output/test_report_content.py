@@ -38,18 +38,21 @@ def test_key_findings_state_estimates_with_intervals_in_words(run: Path) -> None
     text = _text(run / "report.html")
     assert "Key findings" in text
     assert "30 simulated users of medication_dispenser.xpdl, each followed for 2 days." in text
-    assert re.search(r"taken_rate: [\d.]+ % of doses_due \(95 % confidence interval "
-                     r"[\d.]+ % to [\d.]+ %\)", text)
-    assert re.search(r"report_latency_s: [\d.]+ s on average \(95 % confidence interval", text)
+    assert re.search(r"Share of the doses due that were taken \(taken_rate\): [\d.]+ % "
+                     r"\(95 % confidence interval [\d.]+ % to [\d.]+ %\)", text)
+    assert re.search(r"report_latency_s: [\d.]+ s on average \(95 % confidence "
+                     r"interval", text)
     assert "the spec declares no safety monitors" in text
 
 
 def test_every_metric_is_defined_in_words(run: Path) -> None:
     text = _text(run / "report.html")
-    assert ("Time (s) from the first start of activity sound_alarm (workflow notify_workflow) "
+    assert ("time (s) from the first start of activity sound_alarm (workflow notify_workflow) "
             "to the completion of activity wait_report (workflow notify_workflow)") in text
-    assert ("How often the completion of activity record_missed (workflow notify_workflow) "
-            "happened") in text
+    assert ("Counted in the trace: every completion of activity record_missed (workflow "
+            "notify_workflow), per simulated user") in text
+    # the spec's own words come first
+    assert "A dose counts as missed when the user has not reported within 300 s" in text
     assert "doses_missed divided by doses_due, both summed over all users" in text
 
 
@@ -168,9 +171,13 @@ def test_words_for_selectors_and_metrics_without_detail() -> None:
         "the omission of activity hear")
     assert describe_metric({"name": "x", "kind": "count", "description": "Pills taken"}
                            ).startswith("Pills taken. A count of trace events")
+    assert describe_metric({"name": "x", "kind": "count", "select": {
+        "event": "process.started", "process": "p"}}) == (
+        "Counted in the trace: every start of workflow p, per simulated user over the whole "
+        "run.")
     last = describe_metric({"name": "d", "kind": "duration", "unit": "s",
                             "start": {"event": "activity.started", "activity": "a",
                                       "which": "last"},
                             "end": {"event": "activity.completed", "activity": "b"}})
-    assert last.startswith("Time (s) from the last start of activity a to the completion of "
+    assert last.startswith("Measured in the trace: time (s) from the last start of activity a to the completion of "
                            "activity b")
