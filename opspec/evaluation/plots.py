@@ -253,8 +253,12 @@ def rates_figure(rows: Sequence[tuple[str, float, float, float]], path: Path) ->
             width = hi - lo if hi > lo else max(abs(est) * 0.1, 1e-6)
             left, right = lo - 0.6 * width, hi + 1.9 * width   # room for the label
             if percent:
+                from matplotlib.ticker import PercentFormatter
+
                 left, right = max(left, 0.0), min(right, 1.0 + 0.9 * width)
-                _percent_axis(ax, "x")
+                step = max((right - left) * 100.0 / 6.0, 1e-9)   # about six ticks
+                ax.xaxis.set_major_formatter(PercentFormatter(
+                    xmax=1.0, decimals=max(0, -math.floor(math.log10(step)))))
             ax.set_xlim(left, right)
             ax.xaxis.set_major_locator(MaxNLocator(6))
         if all(_is_rate([e, lo, hi]) for _, e, lo, hi in clean):
