@@ -24,7 +24,6 @@ from opspec.engine.conditions import compile_condition, compile_expression
 from opspec.engine.coordination import APPLICATION_BUILTINS, application_builtin
 from opspec.engine.sampling import Sampler, make_sampler
 from opspec.errors import OpspecError, SourceLocation, SpecError
-from opspec.model.bulk import gc_paused
 from opspec.model import (
     Activity,
     Binary,
@@ -56,6 +55,7 @@ from opspec.model import (
     Unary,
     WorkflowProcess,
 )
+from opspec.model.bulk import gc_paused
 from opspec.model.data import is_structured, structured_value
 
 __all__ = [
@@ -107,6 +107,16 @@ S_XOR, S_AND, S_OR = range(3)
 MI_NONE, MI_ONE, MI_ALL, MI_COMPLEX = range(4)
 # transition kinds
 T_NONE, T_COND, T_OTHERWISE, T_EXCEPTION, T_DEFAULT = range(5)
+# model kinds -> the above, made once (not a dict literal of enum keys per transition/activity)
+_TRANSITION_KINDS: dict[ConditionKind, int] = {
+    ConditionKind.NONE: T_NONE, ConditionKind.CONDITION: T_COND,
+    ConditionKind.OTHERWISE: T_OTHERWISE, ConditionKind.EXCEPTION: T_EXCEPTION,
+    ConditionKind.DEFAULTEXCEPTION: T_DEFAULT}
+_JOINS: dict[GatewayType, int] = {GatewayType.AND: J_AND, GatewayType.OR: J_OR,
+                                  GatewayType.COMPLEX: J_COMPLEX}
+# a diverging complex gateway behaves as an inclusive one (BPMN 2.0 §13.3.6)
+_SPLITS: dict[GatewayType, int] = {GatewayType.AND: S_AND, GatewayType.OR: S_OR,
+                                   GatewayType.COMPLEX: S_OR}
 
 _IDENT = re.compile(r"^[A-Za-z_][A-Za-z0-9_.]*$")
 _USER_LANES = frozenset({"user", "user_lane", "user lane", "users"})
@@ -454,9 +464,7 @@ class _Compiler:
                     f"transition {tr.id!r} of {name!r} points to activity {missing!r}, which "
                     f"is not in it", tr.location, "activity ids are scoped per process")
             ck = tr.condition.kind
-            kind = {ConditionKind.NONE: T_NONE, ConditionKind.CONDITION: T_COND,
-                    ConditionKind.OTHERWISE: T_OTHERWISE, ConditionKind.EXCEPTION: T_EXCEPTION,
-                    ConditionKind.DEFAULTEXCEPTION: T_DEFAULT}[ck]
+            kind = _TRANSITION_KINDS[ck]
             cond = None
             if kind == T_COND:
                 if tr.condition.expression is None and not (tr.condition.text or "").strip():
@@ -629,8 +637,7 @@ class _Compiler:
             ca.general = False
         # joins and splits
         if act.join is not None and len(incoming) > 1:
-            ca.join = {GatewayType.AND: J_AND, GatewayType.OR: J_OR,
-                       GatewayType.COMPLEX: J_COMPLEX}.get(act.join.type, J_XOR)
+            ca.join = _JOINS.get(act.join.type, J_XOR)
             if ca.join == J_COMPLEX:
                 if act.join.condition is None:
                     raise _spec_error(
@@ -646,16 +653,26 @@ class _Compiler:
         if act.split is not None and act.split.transition_refs:
             rank = {ref: n for n, ref in enumerate(act.split.transition_refs)}
             ordered.sort(key=lambda t: rank.get(t.id, len(rank) + t.index))
-        normal = tuple(t for t in ordered if t.kind in (T_NONE, T_COND))
+        normal_list: list[CTransition] = []
+        otherwise: list[CTransition] = []
+        exceptions: list[CTransition] = []
+        for t in ordered:       # one pass, in order, into the four kinds
+            if t.kind == T_NONE or t.kind == T_COND:
+                normal_list.append(t)
+            elif t.kind == T_OTHERWISE:
+                otherwise.append(t)
+            elif t.kind == T_EXCEPTION:
+                exceptions.append(t)
+            elif ca.default_exception is None:
+                ca.default_exception = t
+        normal = tuple(normal_list)
         ca.out = normal
-        ca.otherwise = tuple(t for t in ordered if t.kind == T_OTHERWISE)
-        ca.exceptions = tuple(t for t in ordered if t.kind == T_EXCEPTION)
-        ca.default_exception = next((t for t in ordered if t.kind == T_DEFAULT), None)
+        ca.otherwise = tuple(otherwise)
+        ca.exceptions = tuple(exceptions)
         ca.path_may_end = act.split is None or act.split.type is GatewayType.AND
         if act.split is not None:
             # a diverging complex gateway behaves as an inclusive one (BPMN 2.0 §13.3.6)
-            ca.split = {GatewayType.AND: S_AND, GatewayType.OR: S_OR,
-                        GatewayType.COMPLEX: S_OR}.get(act.split.type, S_XOR)
+            ca.split = _SPLITS.get(act.split.type, S_XOR)
         elif len(normal) > 1 and all(t.kind == T_NONE for t in normal) and not ca.otherwise:
             ca.split = S_AND      # no split declared, several unconditional: run them all
         elif len(normal) > 1:
@@ -663,12 +680,15 @@ class _Compiler:
             # one whose condition holds is taken (OTHERWISE is the default flow)
             ca.split = S_OR
         # directives
-        ca.start_assign = tuple(
-            (a.target, self.expr(a.expression, a.text, a.location, f"assignment to {a.target!r}"))
-            for a in act.assignments if a.assign_time.lower() == "start")
-        ca.end_assign = tuple(
-            (a.target, self.expr(a.expression, a.text, a.location, f"assignment to {a.target!r}"))
-            for a in act.assignments if a.assign_time.lower() != "start")
+        if act.assignments:
+            ca.start_assign = tuple(
+                (a.target, self.expr(a.expression, a.text, a.location,
+                                     f"assignment to {a.target!r}"))
+                for a in act.assignments if a.assign_time.lower() == "start")
+            ca.end_assign = tuple(
+                (a.target, self.expr(a.expression, a.text, a.location,
+                                     f"assignment to {a.target!r}"))
+                for a in act.assignments if a.assign_time.lower() != "start")
         ca.raises = self.trigger_ref(directives.raises)
         if ca.raises is not None and ca.raises.name:
             self.throwable.add(ca.raises.name)
@@ -683,11 +703,12 @@ class _Compiler:
             except ValueError as error:
                 raise _spec_error(f"duration of activity {act.id!r}: {error}", act.location,
                                   "see docs/sisarl-xpdl.md for the distributions") from None
-        ca.deadlines = tuple(
-            (self.seconds(d.duration, d.duration_text, d.location or act.location,
-                          f"deadline of activity {act.id!r}"),
-             d.execution is Execution.SYNCHR, d.exception_name or "deadline")
-            for d in act.deadlines)
+        if act.deadlines:
+            ca.deadlines = tuple(
+                (self.seconds(d.duration, d.duration_text, d.location or act.location,
+                              f"deadline of activity {act.id!r}"),
+                 d.execution is Execution.SYNCHR, d.exception_name or "deadline")
+                for d in act.deadlines)
         if act.loop is not None and act.loop.kind is LoopKind.STANDARD:
             cond = None
             if act.loop.condition is not None or act.loop.condition_text:

@@ -29,6 +29,7 @@ from opspec.model.activities import (
     Reference,
     Route,
 )
+from opspec.model.bulk import gc_paused
 from opspec.model.checks_refs import RefChecks
 from opspec.model.checks_support import Reporter, quote_list, where
 from opspec.model.common import Element
@@ -58,6 +59,11 @@ def check_package(
     subflow targets, as :func:`opspec.xpdl.load_package` returns them); participants,
     applications and subflow targets found there count as defined. Never raises.
     """
+    with gc_paused():       # a big package: no full collections while it is walked
+        return _check_package(package, packages)
+
+
+def _check_package(package: Package, packages: Mapping[str, Package]) -> list[Diagnostic]:
     report = Reporter(package)
     refs = RefChecks(package, packages, report)
     report.duplicates(package.processes, "process", f"package {package.id!r}")

@@ -15,6 +15,7 @@ from pathlib import Path
 from types import MappingProxyType
 
 from opspec.errors import Diagnostic, Severity, SourceLocation, SpecError
+from opspec.model.bulk import gc_paused
 from opspec.model.package import Package
 from opspec.xpdl.handlers import BuildContext, build_package
 from opspec.xpdl.normalize import normalize
@@ -97,7 +98,8 @@ def parse_bytes(
     data: bytes, *, path: str = "<bytes>", strict: bool = False, max_bytes: int = DEFAULT_MAX_BYTES
 ) -> LoadResult:
     """Load one package from bytes, without resolving references to other files."""
-    package, diagnostics = _build(data, path, max_bytes)
+    with gc_paused():
+        package, diagnostics = _build(data, path, max_bytes)
     packages = MappingProxyType({package.id: package}) if package is not None else _EMPTY
     return LoadResult(package, _strict(diagnostics, strict), packages)
 
@@ -110,8 +112,11 @@ def load_package(
     Never raises for bad input: fatal problems give ``package=None`` and an error diagnostic.
     ``strict`` turns warnings into errors. ``max_bytes`` limits the size of every file read.
     """
-    file = Path(path)
+    with gc_paused():       # a big file: no full collections while its model is built
+        return _load_package(Path(path), strict, max_bytes)
 
+
+def _load_package(file: Path, strict: bool, max_bytes: int) -> LoadResult:
     def load(target: Path) -> tuple[Package | None, list[Diagnostic]]:
         return _load_file(target, max_bytes)
 
