@@ -365,6 +365,9 @@ def write_report(store: ResultStore, summaries: Mapping[str, Summaries] | None =
     names = {label: Path(specs.get(label, "spec")).name for label in designs}
     if len(set(names.values())) < len(names):         # two files of the same name
         names = {label: specs.get(label, label) for label in designs}
+    if len(set(names.values())) < len(names):         # a design compared with itself
+        names = {label: f"{name} ({'first' if i == 0 else 'second'})"
+                 for i, (label, name) in enumerate(names.items())}
     done = {d: _users_done(store, d) for d in designs}
     failures = store.failures()
 
@@ -470,6 +473,6 @@ def write_report(store: ResultStore, summaries: Mapping[str, Summaries] | None =
         "Medians and p95 of durations are of all pooled observations. An interval of "
         "something that cannot be negative is cut at zero. See docs/evaluation.md."),)))
 
-    title = f"Evaluation of {names[designs[0]]}"
+    title = f"Evaluation of {Path(specs.get(designs[0], 'spec')).name}"
     write_markdown(folder / "report.md", title, sections)
     return write_html(folder / "report.html", title, sections, template=template)

@@ -72,6 +72,17 @@ def test_no_internal_labels(run: Path) -> None:
         assert not re.search(r"\bA: \d", text), f"{name} shows an internal design label"
 
 
+def test_two_designs_are_named_by_their_files(tmp_path: Path) -> None:
+    out = tmp_path / "cmp"
+    assert main(["evaluate", str(SPEC), "--compare", str(SPEC), "--users", "8", "--days", "1",
+                 "--workers", "1", "--out", str(out), "--quiet", "--json"]) == 0
+    text = _text(out / "report.html")
+    assert "Evaluation of medication_dispenser.xpdl" in text
+    assert "(second) compared with" in text and "no metric differs" in text
+    assert "(A)" not in text and not re.search(r"\bA: \d", text)
+    assert not re.search(r"\b[AB] − [AB]\b", text)
+
+
 def test_per_user_distributions_and_own_scales_are_shown(run: Path) -> None:
     html = (run / "report.html").read_text(encoding="utf-8")
     assert "How users differ" in html
