@@ -276,7 +276,7 @@ def test_a_report_template_that_cannot_be_read_is_refused_before_the_runs(
                       (template, "Permission denied")):
         status = main(["evaluate", str(SPEC), "--users", "1", "--days", "1", "--out",
                        str(tmp_path / f"out-{path.stem}"), "--report-template", str(path)])
-        out, err = capsys.readouterr()
+        _, err = capsys.readouterr()
         assert status == 2
         assert one_line(err) == f"opspec: cannot read the report template {path}: {why}"
         assert not (tmp_path / f"out-{path.stem}").exists()     # refused before any run
