@@ -20,15 +20,14 @@ explicit: ``activity:dispense``, ``trigger:trg_2``, ``process:notify_workflow``,
 ``a|b`` means either. Durations are read by :mod:`opspec.clock` (``90``, ``90s``, ``5 min``,
 ``1h30m``, ``PT4H``), as everywhere else.
 
-Over many runs, violations become a hazard: :func:`poisson_interval` gives the exact
-(Garwood) interval of a rate of events per unit of exposure (e.g. per user-day).
+Over many runs, violations become a hazard: :func:`opspec.statistics.poisson_interval` gives
+the exact (Garwood) interval of a rate of events per unit of exposure (e.g. per user-day).
 
 Pure Python, no wall clock: importable by any layer above the engine.
 """
 
 from __future__ import annotations
 
-import math
 import re
 from collections import deque
 from collections.abc import Iterable, Sequence
@@ -56,7 +55,6 @@ __all__ = [
     "package_monitors",
     "parse_monitor",
     "parse_subject",
-    "poisson_interval",
 ]
 
 #: the package ExtendedAttribute holding monitors in their text form
@@ -539,43 +537,3 @@ def declared_monitors(compiled: Any) -> list[Monitor]:
                                          location=location or error.location,
                                          hint=error.hint) from None
     return out
-
-
-# ---------------------------------------------------------------- hazards
-def _poisson_cdf(k: int, mean: float) -> float:
-    """P(X <= k) for X ~ Poisson(mean), summed in log space (k is a count of violations)."""
-    if mean <= 0:
-        return 1.0
-    total, term = 0.0, -mean
-    for i in range(k + 1):
-        if i:
-            term += math.log(mean) - math.log(i)
-        total += math.exp(term)
-    return min(1.0, total)
-
-
-def poisson_interval(count: int, exposure: float, confidence: float = 0.95
-                     ) -> tuple[float, float, float]:
-    """``(rate, lo, hi)`` of ``count`` events over ``exposure`` (e.g. user-days): the exact
-    two-sided Garwood interval at ``confidence`` (each tail at most (1-confidence)/2), found
-    by bisection on the Poisson distribution function; ``lo`` is 0 when ``count`` is 0."""
-    if exposure <= 0:
-        raise ConfigurationError(f"the exposure must be positive, not {exposure!r}")
-    if count < 0 or not 0 < confidence < 1:
-        raise ConfigurationError("need count >= 0 and 0 < confidence < 1")
-    tail = (1 - confidence) / 2
-
-    def solve(target: float, k: int) -> float:
-        # the mean at which P(X <= k) == target; P decreases as the mean grows
-        lo, hi = 0.0, max(10.0, 4.0 * (k + 1) + 10.0 * math.sqrt(k + 1))
-        for _ in range(200):
-            mid = (lo + hi) / 2
-            if _poisson_cdf(k, mid) > target:
-                lo = mid
-            else:
-                hi = mid
-        return (lo + hi) / 2
-
-    upper = solve(tail, count)
-    lower = 0.0 if count == 0 else solve(1 - tail, count - 1)
-    return count / exposure, lower / exposure, upper / exposure

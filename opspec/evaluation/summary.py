@@ -8,7 +8,7 @@
 - ratio: ``value`` = Σ numerator / Σ denominator over users with ``ci95``, and ``per_user``
   (the same fields, over the users' own ratios).
 Monitors the spec declares (``opspec:Monitor``) are summarised by :func:`summarise_monitors`.
-Intervals are described in :mod:`opspec.evaluation.statistics`. Quantiles of pooled
+Intervals are described in :mod:`opspec.statistics`. Quantiles of pooled
 observations are computed in the database, so memory does not grow with the number of users.
 """
 
@@ -19,8 +19,8 @@ import statistics as pystats
 from collections.abc import Mapping, Sequence
 from typing import Any
 
-from opspec.evaluation.statistics import paired_difference, ratio_estimate
 from opspec.evaluation.store import ResultStore
+from opspec.statistics import paired_difference, poisson_interval, rate_interval, ratio_estimate
 
 __all__ = ["compare_designs", "metric_definitions", "summarise_design", "summarise_monitors",
            "user_pairs"]
@@ -178,10 +178,8 @@ def compare_designs(store: ResultStore, a: str = "A", b: str = "B", level: float
 
 
 def _users_affected_ci(affected: int, users: int, level: float) -> list[float]:
-    from scipy import stats  # type: ignore[import-untyped]
-
-    ci = stats.binomtest(affected, users).proportion_ci(confidence_level=level, method="exact")
-    return [float(ci.low), float(ci.high)]
+    _, low, high = rate_interval(affected, users, level, method="clopper-pearson")
+    return [low, high]
 
 
 def summarise_monitors(store: ResultStore, design: str, days: float, level: float = 0.95
@@ -195,8 +193,6 @@ def summarise_monitors(store: ResultStore, design: str, days: float, level: floa
     is right when violations cluster in some users (a late reporter violates again and
     again); the wider of the two is reported. ``first`` is the earliest user's first
     violation (user, simulated time, message), for finding it in a trace."""
-    from opspec.engine.monitors import poisson_interval
-
     rows = store.query(
         "SELECT m.monitor, m.user, m.violations, m.first_time, m.first_message FROM monitor m "
         "JOIN replication r ON r.design = m.design AND r.user = m.user "

@@ -15,7 +15,8 @@ on the wrong side too, and otherwise as *undecided*, saying how many replication
 decide it if the estimate stayed where it is. Every message states the estimate, its
 interval, the bound and n.
 
-Intervals (the core functions return ``Estimate(estimate, lo, hi)``, two-sided at the given
+Intervals (from :mod:`opspec.statistics`, re-exported here; they return
+``Estimate(estimate, lo, hi)``, two-sided at the given
 confidence; a one-sided bound at level C is one end of the two-sided interval at 2C-1):
 
 * rates: Wilson score (default; good coverage near 0 and 1) or Clopper-Pearson (exact,
@@ -36,11 +37,20 @@ all looks stays at most ``1 - C``.
 from __future__ import annotations
 
 import math
-from collections.abc import Callable, Sequence
+from collections.abc import Callable
 from dataclasses import dataclass
-from typing import Any, NamedTuple
+from typing import Any
 
 from opspec.errors import ConfigurationError
+from opspec.statistics import (
+    RATE_METHODS,
+    mean_interval,
+    normal_quantile,
+    quantile_interval,
+    rate_interval,
+    t_quantile,
+)
+from opspec.statistics import Interval as Estimate
 from opspec.testing.intervals import _pct
 
 __all__ = [
@@ -58,104 +68,12 @@ __all__ = [
 ]
 
 _MAX_N = 10**9
-RATE_METHODS = ("wilson", "clopper-pearson")
-MEAN_METHODS = ("t", "bootstrap")
-
-
-class Estimate(NamedTuple):
-    """A point estimate and its interval (a tuple, so ``est, lo, hi = ...`` works)."""
-
-    estimate: float
-    lo: float
-    hi: float
-
-
-def _stats() -> Any:
-    import scipy.stats  # type: ignore[import-untyped]
-
-    return scipy.stats
 
 
 def _check_confidence(confidence: float) -> None:
     if not 0.5 <= confidence < 1.0:
         raise ConfigurationError(f"confidence must be at least 0.5 and below 1, not "
                                  f"{confidence!r}", hint="e.g. confidence=0.95")
-
-
-# ---------------------------------------------------------------- the numeric core
-def rate_interval(successes: int, trials: int, confidence: float = 0.95, *,
-                  method: str = "wilson") -> Estimate:
-    """Two-sided interval of a proportion ``successes/trials`` at ``confidence``."""
-    if method not in RATE_METHODS:
-        raise ConfigurationError(f"unknown rate method {method!r}",
-                                 hint="use " + " or ".join(RATE_METHODS))
-    if trials <= 0:
-        return Estimate(math.nan, 0.0, 1.0)
-    if not 0 <= successes <= trials:
-        raise ConfigurationError(f"a rate needs 0 <= successes <= trials, not "
-                                 f"{successes}/{trials}",
-                                 hint="this is not a proportion; use assert_mean for it")
-    p = successes / trials
-    alpha = 1.0 - confidence
-    if method == "clopper-pearson":
-        beta = _stats().beta
-        lo = 0.0 if successes == 0 else float(beta.ppf(alpha / 2, successes,
-                                                       trials - successes + 1))
-        hi = 1.0 if successes == trials else float(beta.ppf(1 - alpha / 2, successes + 1,
-                                                            trials - successes))
-        return Estimate(p, lo, hi)
-    z = float(_stats().norm.ppf(1 - alpha / 2))
-    denom = 1 + z * z / trials
-    centre = (p + z * z / (2 * trials)) / denom
-    half = z * math.sqrt(p * (1 - p) / trials + z * z / (4 * trials * trials)) / denom
-    return Estimate(p, max(0.0, centre - half), min(1.0, centre + half))
-
-
-def mean_interval(values: Sequence[float], confidence: float = 0.95, *, method: str = "t",
-                  seed: int = 0, resamples: int = 9999) -> Estimate:
-    """Two-sided interval of the mean of ``values``: Student t, or a BCa bootstrap seeded
-    with ``seed`` (same values and seed, same interval). Needs at least 2 values."""
-    if method not in MEAN_METHODS:
-        raise ConfigurationError(f"unknown mean method {method!r}",
-                                 hint="use " + " or ".join(MEAN_METHODS))
-    n = len(values)
-    if n < 2:
-        raise ConfigurationError(f"a mean's interval needs at least 2 values, not {n}")
-    mean = math.fsum(values) / n
-    sd = math.sqrt(math.fsum((v - mean) ** 2 for v in values) / (n - 1))
-    if sd == 0:
-        return Estimate(mean, mean, mean)
-    if method == "t":
-        half = float(_stats().t.ppf((1 + confidence) / 2, n - 1)) * sd / math.sqrt(n)
-        return Estimate(mean, mean - half, mean + half)
-    import numpy as np
-
-    res = _stats().bootstrap((np.asarray(values, dtype=float),), np.mean,
-                             confidence_level=confidence, n_resamples=resamples,
-                             method="BCa", random_state=np.random.default_rng(seed))
-    ci = res.confidence_interval
-    return Estimate(mean, float(ci.low), float(ci.high))
-
-
-def quantile_interval(values: Sequence[float], q: float, confidence: float = 0.95
-                      ) -> Estimate:
-    """Distribution-free two-sided interval of the ``q``-quantile: order statistics
-    ``X(l) <= x_q <= X(u)`` with binomial ranks so that each tail has probability at most
-    ``(1 - confidence)/2``; a bound the data cannot give is ``-inf``/``inf``."""
-    if not 0 < q < 1:
-        raise ConfigurationError(f"q must be between 0 and 1, not {q!r}", hint="q=0.95 is p95")
-    n = len(values)
-    if n == 0:
-        return Estimate(math.nan, -math.inf, math.inf)
-    binom = _stats().binom
-    ordered = sorted(values)
-    tail = (1 - confidence) / 2
-    k_lo = int(binom.ppf(tail, n, q))             # 1-based rank of the lower bound
-    k_hi = int(binom.ppf(1 - tail, n, q)) + 1     # 1-based rank of the upper bound
-    lo = ordered[k_lo - 1] if k_lo >= 1 else -math.inf
-    hi = ordered[k_hi - 1] if k_hi <= n else math.inf
-    estimate = ordered[min(n - 1, max(0, math.ceil(q * n) - 1))]
-    return Estimate(estimate, lo, hi)
 
 
 # ---------------------------------------------------------------- deciding
@@ -381,10 +299,8 @@ def assert_mean(result: Any, metric: str, *, at_least: float | None = None,
     sd = math.sqrt(math.fsum((v - mean) ** 2 for v in values) / (n - 1))
     gap = _distance(est, at_least, at_most)
     if verdict == "undecided" and gap > 0 and sd > 0:
-        t = _stats().t
-
         def settles(k: int) -> bool:
-            return float(t.ppf((1 + level) / 2, max(1, k - 1))) * sd / math.sqrt(k) < gap
+            return t_quantile(level, max(1, k - 1)) * sd / math.sqrt(k) < gap
 
         needed = _smallest(settles, n)
         needed = None if needed is None else max(n + 1, needed)
@@ -418,7 +334,7 @@ def assert_quantile(result: Any, metric: str, q: float, *, at_most: float | None
         assert edge is not None
         below = sum(1 for v in values if v <= edge) / max(1, n)
         if n and not math.isclose(below, q):
-            z = float(_stats().norm.ppf((1 + level) / 2))
+            z = normal_quantile((1 + level) / 2)
             needed = max(n + 1, math.ceil(z * z * q * (1 - q) / (below - q) ** 2))
     decision = Decision(claim, verdict, est, lo, hi, n, confidence, sides, "order-statistic",
                         bound, f"({n} observations)", needed, unit="observations")

@@ -5,7 +5,7 @@ level C is at least ``b``; it is refuted when the one-sided upper bound is below
 otherwise the data cannot decide: the message then says how many replications would, if the
 estimate stayed where it is. ``in [a, b]`` uses the two-sided interval at level C.
 
-Intervals: Wilson score for rates (good coverage near 0 and 1, unlike the Wald interval),
+Intervals (:mod:`opspec.statistics`): Wilson score for rates (good coverage near 0 and 1, unlike the Wald interval),
 Student t for means of per-replication values, and the distribution-free order-statistic
 interval (binomial) for quantiles of pooled observations.
 
@@ -16,9 +16,16 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
-from typing import Any
 
-__all__ = ["decide_mean", "decide_quantile", "decide_rate", "wilson"]
+from opspec.statistics import (
+    normal_quantile,
+    one_sided,
+    quantile_interval,
+    rate_interval,
+    t_quantile,
+)
+
+__all__ = ["decide_mean", "decide_quantile", "decide_rate"]
 
 _MAX_N = 10**9
 
@@ -26,28 +33,6 @@ _MAX_N = 10**9
 def _pct(level: float) -> str:
     """A confidence for people: 95%, 99%, 98.75% (never rounded to a level it is not)."""
     return f"{level * 100:.4g}%"
-
-
-def _stats() -> Any:
-    """scipy.stats, imported when first needed (it is slow to import)."""
-    import scipy.stats  # type: ignore[import-untyped]
-
-    return scipy.stats
-
-
-def _z(level: float) -> float:
-    return float(_stats().norm.ppf(level))
-
-
-def wilson(successes: int, trials: int, z: float) -> tuple[float, float]:
-    """The Wilson score interval for ``successes``/``trials`` at normal quantile ``z``."""
-    if trials <= 0:
-        return 0.0, 1.0
-    p = successes / trials
-    denom = 1 + z * z / trials
-    centre = (p + z * z / (2 * trials)) / denom
-    half = z * math.sqrt(p * (1 - p) / trials + z * z / (4 * trials * trials)) / denom
-    return max(0.0, centre - half), min(1.0, centre + half)
 
 
 def _levels(op: str, level: float) -> float:
@@ -84,11 +69,11 @@ def _distance(op: str, a: float, b: float | None, estimate: float) -> float:
 def decide_rate(text: str, successes: int, trials: int, op: str, a: float, b: float | None,
                 level: float, *, units: str = "trials", replications: int = 1) -> str | None:
     """Decide ``successes/trials OP a`` (or ``in [a, b]``) at confidence ``level``."""
-    z = _z(_levels(op, level))
+    two_sided = one_sided(_levels(op, level))       # the interval whose ends are the bounds
     if trials == 0:
         return (f"expected {text}\n  but there were no {units} at all in {replications} "
                 "replication(s): simulate longer or more users")
-    lo, hi = wilson(successes, trials, z)
+    _, lo, hi = rate_interval(successes, trials, two_sided)
     verdict = _verdict(op, a, b, lo, hi)
     if verdict is None:
         return None
@@ -105,7 +90,7 @@ def decide_rate(text: str, successes: int, trials: int, op: str, a: float, b: fl
         lines.append("  too few to decide, and the estimate sits on the bound: no number of "
                      "replications would settle it")
         return "\n".join(lines)
-    needed = _rate_trials(estimate, z, op, a, b, trials)
+    needed = _rate_trials(estimate, two_sided, op, a, b, trials)
     per = trials / max(1, replications)
     reps = math.ceil(needed / per) if per > 0 else needed
     lines.append(f"  too few replications to decide: about {reps} replications "
@@ -113,11 +98,12 @@ def decide_rate(text: str, successes: int, trials: int, op: str, a: float, b: fl
     return "\n".join(lines)
 
 
-def _rate_trials(p: float, z: float, op: str, a: float, b: float | None, start: int) -> int:
+def _rate_trials(p: float, two_sided: float, op: str, a: float, b: float | None, start: int
+                 ) -> int:
     """Smallest trial count (by doubling, then bisection) at which the Wilson interval around
     the same estimate ``p`` decides the claim."""
     def decided(n: int) -> bool:
-        lo, hi = wilson(round(p * n), n, z)
+        _, lo, hi = rate_interval(round(p * n), n, two_sided)
         return _verdict(op, a, b, lo, hi) != "undecided"
 
     hi_n = max(1, start)
@@ -136,14 +122,13 @@ def _rate_trials(p: float, z: float, op: str, a: float, b: float | None, start: 
 def decide_mean(text: str, values: Sequence[float], op: str, a: float, b: float | None,
                 level: float) -> str | None:
     """Decide ``mean(values) OP a`` at confidence ``level`` with a Student t interval."""
-    student = _stats().t
     n = len(values)
     if n < 2:
         return (f"expected {text}\n  but only {n} replication(s) had a value: a mean's "
                 "interval needs at least 2 (try users=30)")
     mean = sum(values) / n
     sd = math.sqrt(sum((v - mean) ** 2 for v in values) / (n - 1))
-    q = float(student.ppf(_levels(op, level), n - 1))
+    q = t_quantile(one_sided(_levels(op, level)), n - 1)
     half = q * sd / math.sqrt(n)
     lo, hi = mean - half, mean + half
     verdict = _verdict(op, a, b, lo, hi)
@@ -171,21 +156,16 @@ def decide_quantile(text: str, values: Sequence[float], q: float, op: str, a: fl
     """Decide ``quantile_q(values) OP a`` with the distribution-free order-statistic
     interval: the ``k``-th smallest value is an upper bound of the ``q``-quantile with
     confidence ``P(Binomial(n, q) < k)``."""
-    binom = _stats().binom
     n = len(values)
     ordered = sorted(values)
     side_level = _levels(op, level)
     if n == 0:
         return f"expected {text}\n  but there were no observations at all"
-    k_hi = int(binom.ppf(side_level, n, q)) + 1          # 1-based rank of the upper bound
-    k_lo = int(binom.ppf(1 - side_level, n, q))          # 1-based rank of the lower bound
-    hi = ordered[k_hi - 1] if k_hi <= n else math.inf
-    lo = ordered[k_lo - 1] if k_lo >= 1 else -math.inf
+    estimate, lo, hi = quantile_interval(ordered, q, one_sided(side_level))
     verdict = _verdict(op, a, b, lo, hi)
     if verdict is None:
         return None
     below = sum(1 for v in ordered if v <= a) / n
-    estimate = ordered[min(n - 1, max(0, math.ceil(q * n) - 1))]
     side = "two-sided" if op == "in" else "one-sided"
     lines = [f"expected {text}",
              (f"  estimate {estimate:.4g} ({n} observations); {_pct(level)} {side} "
@@ -193,7 +173,7 @@ def decide_quantile(text: str, values: Sequence[float], q: float, op: str, a: fl
     if verdict == "refuted":
         lines.append("  the claim is false at this confidence")
     elif op in ("<=", "<", ">=", ">") and not math.isclose(below, q):
-        z = _z(side_level)
+        z = normal_quantile(side_level)
         needed = max(n + 1, math.ceil(z * z * q * (1 - q) / (below - q) ** 2))
         lines.append(f"  too few observations to decide: about {needed} would, if the "
                      f"distribution stays ({below:.1%} of them are now <= {a:g})")

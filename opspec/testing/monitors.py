@@ -38,9 +38,9 @@ from opspec.engine.monitors import (
     declared_monitors,
     parse_monitor,
     parse_subject,
-    poisson_interval,
 )
 from opspec.errors import ConfigurationError
+from opspec.statistics import poisson_interval
 from opspec.testing.intervals import _pct
 
 __all__ = [

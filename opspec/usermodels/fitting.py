@@ -37,6 +37,7 @@ from scipy import stats  # type: ignore[import-untyped]
 
 from opspec.engine.trace import TRACE_FORMAT, TRACE_FORMAT_VERSION, EventKind, TraceEvent
 from opspec.errors import SourceLocation, UserModelError
+from opspec.statistics import rate_interval
 from opspec.usermodels.distributions import Constant, Distribution, ExGaussian, LogNormal
 from opspec.usermodels.errors import Busy, Commission, Omission
 from opspec.usermodels.model import ActivityModel, UserModel
@@ -49,7 +50,6 @@ __all__ = [
     "fit_duration",
     "fit_traces",
     "read_trace",
-    "wilson_interval",
 ]
 
 _ANSWERS = (EventKind.ACTIVITY_COMPLETED, EventKind.ACTIVITY_OMITTED,
@@ -200,18 +200,6 @@ def collect(paths: Sequence[str | Path], lane: str = "user") -> Observations:
     return obs
 
 
-def wilson_interval(successes: int, n: int, z: float = 1.959963984540054
-                    ) -> tuple[float, float]:
-    """Wilson score interval for a binomial proportion (95 % by default)."""
-    if n == 0:
-        return (0.0, 1.0)
-    p = successes / n
-    denom = 1 + z * z / n
-    centre = (p + z * z / (2 * n)) / denom
-    half = z * math.sqrt(p * (1 - p) / n + z * z / (4 * n * n)) / denom
-    return (max(0.0, centre - half), min(1.0, centre + half))
-
-
 @dataclass(frozen=True)
 class ActivityFit:
     """The outcome for one activity: the chosen distribution and why."""
@@ -339,7 +327,8 @@ def fit_traces(paths: Sequence[str | Path], *, lane: str = "user",
         omission_stats = None
         kwargs: dict[str, Any] = {"duration": dist}
         if omitted:
-            lo_hi = wilson_interval(omitted, answered)
+            _, low, high = rate_interval(omitted, answered)
+            lo_hi = (low, high)
             omission_stats = (omitted, answered, lo_hi)
             kwargs["omission"] = Omission(
                 omitted / answered, source=f"fitted: {omitted}/{answered} omitted, Wilson 95 % "

@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 from scipy import stats
 
-from opspec.evaluation.statistics import paired_difference, ratio_estimate
+from opspec.statistics import paired_difference, ratio_estimate
 
 
 def test_count_interval_is_the_t_interval_of_the_per_user_mean():

@@ -13,10 +13,10 @@ from opspec.engine.monitors import (
     MinGap,
     package_monitors,
     parse_monitor,
-    poisson_interval,
 )
 from opspec.engine.trace import TraceEvent
 from opspec.errors import ConfigurationError
+from opspec.statistics import poisson_interval
 from opspec.testing.monitors import (
     assert_no_violations,
     bounded_response,

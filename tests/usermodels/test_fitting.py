@@ -14,7 +14,7 @@ from opspec.errors import UserModelError
 from opspec.usermodels import ActivityModel, UserModel, load_user_model
 from opspec.usermodels.distributions import ExGaussian, LogNormal
 from opspec.usermodels.errors import Omission
-from opspec.usermodels.fitting import fit_duration, fit_traces, wilson_interval
+from opspec.usermodels.fitting import fit_duration, fit_traces
 
 from .fakes import DispenserLane, FakeSession, make_item, write_trace
 
@@ -92,15 +92,6 @@ def test_ex_gaussian_data_pick_the_ex_gaussian_by_aic() -> None:
 def test_lognormal_data_pick_the_lognormal_by_aic() -> None:
     x = LogNormal(math.log(30), 0.8).sample_many(np.random.default_rng(5), 3000)
     assert fit_duration(x.tolist())[1] == "lognormal"
-
-
-@pytest.mark.parametrize(("k", "n"), [(15, 100), (0, 20), (20, 20), (3, 7)],
-                         ids=["15-of-100", "none", "all", "small"])
-def test_wilson_interval_agrees_with_scipy(k: int, n: int) -> None:
-    from scipy.stats import binomtest
-
-    expected = binomtest(k, n).proportion_ci(method="wilson")
-    assert wilson_interval(k, n) == pytest.approx((expected.low, expected.high), abs=1e-9)
 
 
 def test_fitted_choice_probabilities_when_people_end_differently(tmp_path: Path) -> None:
