@@ -180,9 +180,11 @@ def _subflows(process: WorkflowProcess
               ) -> Iterator[tuple[SubFlow, SourceLocation | None, bool]]:
     """Each SubFlow call of ``process``, and whether it *certainly* runs whenever the process
     does (see :func:`_certain_activities`)."""
-    certain = _certain_activities(process)
+    certain: set[str] | None = None       # worked out at the first SubFlow (most have none)
     for activity in process.all_activities():
         if isinstance(activity.body, SubFlow):
+            if certain is None:
+                certain = _certain_activities(process)
             yield activity.body, activity.location, activity.id in certain
 
 
