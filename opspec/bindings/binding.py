@@ -9,8 +9,8 @@ says otherwise, so the binding's state needs no locks.
 Faults are trace events of kind :data:`~opspec.engine.trace.EventKind.FAULT` whose ``data``
 names the fault (``fault``: ``timeout``, ``garbage``, ``unexpected-line``, ``late-reply``,
 ``disconnected``, ``reconnect-failed``, ``unavailable``, ``unknown-operation``,
-``missing-data``) and the ``action`` taken (``retry``, ``reconnect``, ``simulate``, ``abort``,
-``none``). Each exchange is a ``device.exchange`` event carrying its round-trip ``latency``
+``missing-data``, ``device-error``: a declared error reply such as ``ERR JAM``) and the
+``action`` taken (``retry``, ``reconnect``, ``simulate``, ``abort``, ``exception``, ``none``). Each exchange is a ``device.exchange`` event carrying its round-trip ``latency``
 in seconds; notes (bound, switched to simulated, reconnected) are ``device.note`` events.
 """
 
@@ -371,6 +371,11 @@ class DeviceBinding:
         if exception is not None:
             details["exception"] = exception
         self._session_().trace(DEVICE_EXCHANGE, details)
+        if exception is not None:
+            # an answer, but the device could not do the work: counted with the faults
+            self._fault("device-error", f"{self._who(job.item)}: the device answered {text!r} "
+                        f"to {job.line!r} ({exception})", item=job.item, action="exception",
+                        line=job.line, reply=text, exception=exception)
         if not job.withdrawn:
             if exception is None:
                 self._session_().complete(job.item, dict(values) if values else None)
@@ -462,7 +467,11 @@ class DeviceBinding:
         participant = job.item.participant or ""
         fallback = self.profile.fallback_for(participant)
         if fallback.then == "simulate":
-            self._switch_to_simulated(participant, reason)
+            if fallback.scope == "run":
+                self._switch_to_simulated(participant, reason)
+            else:
+                self._note(f"{participant or self.profile.name}: {job.line!r}: {reason}; "
+                           "simulated this once, the next command goes to the device")
             if not job.withdrawn:
                 self._sim.offer(job.item)
         elif not job.withdrawn:

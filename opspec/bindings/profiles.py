@@ -41,6 +41,7 @@ __all__ = [
 
 PROFILE_FORMAT: Final = 1
 FallbackAction = Literal["simulate", "abort"]
+FallbackScope = Literal["run", "command"]
 _PARITIES: Final = {"none": "N", "even": "E", "odd": "O", "mark": "M", "space": "S"}
 _VID_PID: Final = re.compile(r"([0-9A-Fa-f]{4}):([0-9A-Fa-f]{4})\Z")
 _EMPTY: Final[Mapping[str, Any]] = MappingProxyType({})
@@ -154,6 +155,12 @@ class Fallback:
     simulated device) or ``abort`` (the activity fails with ``exception``, following its
     EXCEPTION transition; later activities fail the same way).
 
+    ``scope``: how long ``then`` lasts when a command runs out of retries on a port that is
+    still open (timeouts, garbage): ``run`` (the participant stays simulated for the rest of
+    the run) or ``command`` (only that command is simulated or failed; the next one goes to
+    the device again). A port that could not be reopened is gone for the rest of the run
+    whatever the scope.
+
     ``late_reply_s``: after a timeout the line is held this long (``None``: the command's own
     timeout) before anything else is sent, so that a late reply is reported as the timed-out
     command's ``late-reply`` instead of being taken as the answer to the retry or to the next
@@ -166,6 +173,7 @@ class Fallback:
     then: FallbackAction = "simulate"
     exception: str = "DeviceFault"
     late_reply_s: float | None = None
+    scope: FallbackScope = "run"
 
 
 @dataclass(frozen=True, slots=True)
@@ -480,6 +488,9 @@ def _one_fallback(table: _Table, base: Fallback) -> Fallback:
     then = table.string("then", base.then)
     if then not in ("simulate", "abort"):
         raise table.error("then", f"expected \"simulate\" or \"abort\", got {then!r}")
+    scope = table.string("scope", base.scope)
+    if scope not in ("run", "command"):
+        raise table.error("scope", f"expected \"run\" or \"command\", got {scope!r}")
     exception = table.string("exception", base.exception)
     if not exception.isidentifier():
         raise table.error("exception", f"expected an exception name (an identifier), "
@@ -488,7 +499,7 @@ def _one_fallback(table: _Table, base: Fallback) -> Fallback:
         retries=table.integer("retries", base.retries),
         reconnect_attempts=table.integer("reconnect_attempts", base.reconnect_attempts),
         reconnect_delay_s=table.millis("reconnect_delay_ms", base.reconnect_delay_s),
-        then=then, exception=exception,
+        then=then, exception=exception, scope=scope,
         late_reply_s=(table.millis("late_reply_ms", 0.0) if "late_reply_ms" in table.data
                       else base.late_reply_s),
     )

@@ -51,7 +51,11 @@ def test_error_reply_fails_the_activity_with_the_profiles_exception(
     ((failed, exception, message),) = session.failed
     assert (failed, exception) == (drawer, "DrawerJammed")
     assert "'ERR JAM'" in message
-    assert session.faults() == []  # a declared error is an answer, not a fault
+    # a declared error is an answer (no retry, no fallback), counted as a device-error fault
+    assert session.faults() == ["device-error"]
+    (fault,) = binding.faults
+    assert (fault["action"], fault["exception"], fault["reply"]) == ("exception", "DrawerJammed",
+                                                                     "ERR JAM")
 
 
 def test_no_reply_is_a_timeout_fault_then_a_retry(
