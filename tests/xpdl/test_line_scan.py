@@ -11,16 +11,19 @@ from opspec.xpdl.reader import _byte_scan_lines, _expat_lines, read_tree
 NS = "http://www.wfmc.org/2008/XPDL2.1"
 
 
+_BODY = (
+    "<!-- a comment with <Activity Id=\"no\"/> and > in it -->",
+    "<?pi <not-an-element> ?>",
+    '<Activity Id="a" Name="x > y"/>',
+    "<Activity\n  Id=\"b\"\n  Name='multi\nline'>",
+    "<Description><![CDATA[ <Activity Id=\"cdata\"/> ]]></Description>",
+    "</Activity>",
+    "<Activity Id='c'\n/>",
+)
+
+
 def _document(padding: int) -> bytes:
-    body = "\n".join([
-        "<!-- a comment with <Activity Id=\"no\"/> and > in it -->",
-        "<?pi <not-an-element> ?>",
-        '<Activity Id="a" Name="x > y"/>',
-        "<Activity\n  Id=\"b\"\n  Name='multi\nline'>",
-        "<Description><![CDATA[ <Activity Id=\"cdata\"/> ]]></Description>",
-        "</Activity>",
-        "<Activity Id='c'\n/>",
-    ])
+    body = "\n".join(_BODY)
     return (f'<?xml version="1.0" encoding="UTF-8"?>\n<Package xmlns="{NS}" Id="p">'
             + "\n" * padding + f"<Activities>\n{body}\n</Activities></Package>\n").encode()
 
