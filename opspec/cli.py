@@ -37,6 +37,7 @@ COMMAND_MODULES: tuple[str, ...] = (
     "opspec.commands.walkthrough",
     "opspec.commands.fit",
     "opspec.commands.devices",
+    "opspec.commands.new",
 )
 
 

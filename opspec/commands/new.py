@@ -1,0 +1,92 @@
+"""``opspec new NAME``: start a new specification from a small, runnable template.
+
+Writes the folder ``NAME/`` with ``NAME.xpdl`` (a pill reminder: a device workflow with a timed
+start, a reminder whose wait has a deadline, a retry and an escalation to a caregiver, and the
+user's manual lane), ``NAME.users.toml`` (its user model, picked up by ``opspec run`` and
+``opspec evaluate`` because it sits beside the spec), ``test_NAME.py`` (spec tests for pytest)
+and a ``README.md`` listing the commands to try. The templates are package data
+(``opspec/commands/templates/new/``). Exit status: 0 written; 2 the folder already exists,
+the name is not usable, or the folder cannot be written.
+"""
+
+from __future__ import annotations
+
+import argparse
+import re
+import string
+import sys
+from importlib import resources
+from pathlib import Path
+from typing import Any
+
+__all__ = ["TEMPLATES", "register", "render", "run"]
+
+# template file -> output file name (``$name`` / ``$ident`` substituted in both).
+TEMPLATES: tuple[tuple[str, str], ...] = (
+    ("spec.xpdl.tmpl", "${name}.xpdl"),
+    ("users.toml.tmpl", "${name}.users.toml"),
+    ("test.py.tmpl", "test_${ident}.py"),
+    ("README.md.tmpl", "README.md"),
+)
+
+# A name is used in file names, an XML comment and an XPDL Id: letters, digits, '_', '-', '.'
+# (no '--', which XML comments forbid), starting with a letter or digit.
+_NAME = re.compile(r"[A-Za-z0-9][A-Za-z0-9_.-]*")
+
+
+def register(subparsers: Any) -> None:
+    parser = subparsers.add_parser(
+        "new", help="start a new spec: a small runnable pill reminder, its user model and tests",
+        description="Write the folder NAME/ with NAME.xpdl (a pill reminder: a device "
+        "workflow with a timed start, a reminder with a deadline, a retry and an escalation, "
+        "and the user's manual lane), NAME.users.toml (its user model), test_NAME.py (spec "
+        "tests: run them with 'python -m pytest NAME') and README.md. The spec validates, "
+        "runs and passes its tests as written. Refuses to overwrite an existing folder. "
+        "Exit status: 0 written, 2 the folder exists or cannot be written.")
+    parser.add_argument("name", metavar="NAME",
+                        help="the folder to create; its last part names the files")
+    parser.set_defaults(handler=run)
+
+
+def render(name: str) -> dict[str, str]:
+    """The files of a new spec called ``name``: output file name -> text."""
+    values = {"name": name, "ident": identifier(name)}
+    folder = resources.files("opspec.commands").joinpath("templates", "new")
+    return {string.Template(target).substitute(values):
+            string.Template(folder.joinpath(source).read_text(encoding="utf-8"))
+            .substitute(values)
+            for source, target in TEMPLATES}
+
+
+def identifier(name: str) -> str:
+    """``name`` as a Python identifier and XPDL Id (``pill-box.v2`` -> ``pill_box_v2``)."""
+    ident = re.sub(r"\W", "_", name)
+    return ident if ident[:1].isalpha() or ident[:1] == "_" else f"spec_{ident}"
+
+
+def run(args: argparse.Namespace) -> int:
+    folder = Path(args.name)
+    name = folder.name
+    if not _NAME.fullmatch(name) or "--" in name:
+        print(f"opspec new: {name!r} cannot name a spec: use letters, digits, '_', '-' and "
+              "'.', starting with a letter or digit (e.g. 'pill_reminder')", file=sys.stderr)
+        return 2
+    if folder.exists() or folder.is_symlink():
+        print(f"opspec new: {folder} already exists; nothing written (choose another name or "
+              "move it away)", file=sys.stderr)
+        return 2
+    files = render(name)
+    try:
+        folder.mkdir(parents=True)
+        for file_name, text in files.items():
+            (folder / file_name).write_text(text, encoding="utf-8")
+    except OSError as error:
+        reason = error.strerror or str(error)
+        print(f"opspec new: cannot write {folder}: {reason}", file=sys.stderr)
+        return 2
+    spec = folder / f"{name}.xpdl"
+    print(f"opspec new: wrote {folder}/ ({', '.join(files)})")
+    print(f"  try: opspec run {spec}")
+    print(f"       opspec evaluate {spec} --users 20 --days 2")
+    print(f"       python -m pytest {folder}")
+    return 0
