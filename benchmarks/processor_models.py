@@ -16,11 +16,11 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from opspec.bindings.worlds import world_performers
 from opspec.engine.compiled import compile_package
 from opspec.engine.config import EngineConfig
 from opspec.engine.simulation import Simulation
 from opspec.engine.timing import TimingListener
+from opspec.worlds import world_performers
 from opspec.xpdl.open_spec import open_spec
 
 ROOT = Path(__file__).resolve().parents[1]

@@ -308,7 +308,7 @@ class Run:
 
 def _world(compiled: CompiledPackage, seed: int, user: int) -> dict[str, Performer]:
     """The simulated devices of the world the spec declares (``opspec:World``), if any."""
-    from opspec.bindings.worlds import world_performers
+    from opspec.worlds import world_performers
 
     return dict(world_performers(compiled, seed=seed, user=user))
 

@@ -29,7 +29,7 @@ import serial
 from opspec.bindings.inbox import Inbox
 from opspec.bindings.latency import LatencySummary, summarise
 from opspec.bindings.profiles import DeviceProfile, Operation
-from opspec.bindings.simulated import SimulatedDevice
+from opspec.bindings.simulated import ProfileSimulator
 from opspec.bindings.templates import TemplateError
 from opspec.bindings.transport import LineFramer, LineReaderThread, open_port
 from opspec.engine.performers import PerformerSession, WorkItem
@@ -85,7 +85,7 @@ class DeviceBinding:
         #: simulated time it was reported (None before :meth:`attach`).
         self.faults: list[dict[str, Any]] = []
         self._session: PerformerSession | None = None
-        self._sim = SimulatedDevice(profile)
+        self._sim = ProfileSimulator(profile)
         start: Mode = "device" if port is not None else "simulated"
         self._modes: dict[str, Mode] = {p: start for p in self.participants}
         self._port = port

@@ -11,12 +11,14 @@ from __future__ import annotations
 from opspec.bindings.profiles import DeviceProfile
 from opspec.engine.performers import PerformerSession, WorkItem
 
-__all__ = ["SimulatedDevice"]
+__all__ = ["ProfileSimulator"]
 
 
-class SimulatedDevice:
+class ProfileSimulator:
     """A :class:`~opspec.engine.performers.Performer` playing ``profile``'s device in
-    simulated time. All calls happen on the engine's thread."""
+    simulated time (unlike :class:`opspec.engine.SimulatedDevice`, which knows no profile and
+    completes each activity after its declared duration). All calls happen on the engine's
+    thread."""
 
     def __init__(self, profile: DeviceProfile) -> None:
         self.profile = profile
@@ -53,5 +55,5 @@ class SimulatedDevice:
 
     def _require_session(self) -> PerformerSession:
         if self._session is None:
-            raise RuntimeError("SimulatedDevice.offer() before attach()")
+            raise RuntimeError("ProfileSimulator.offer() before attach()")
         return self._session

@@ -75,7 +75,7 @@ def engine_diagnostics(package: Package, *, world: bool = False) -> list[Diagnos
         out.append(Diagnostic(error.location or spec_file, Severity.ERROR, "bad-monitor",
                               error.message, error.hint or ""))
     if world:
-        from opspec.bindings.worlds import world_performers
+        from opspec.worlds import world_performers
 
         try:
             world_performers(compiled, seed=0, user=0)

@@ -11,7 +11,7 @@ inline, as children of the ``opspec:World`` attribute, which win over the file::
     </ExtendedAttribute>
 
 Keys are the world's constructor parameters (``width``, ``obstacles``…; see
-:class:`~opspec.bindings.world.room.RoomWorld` and :class:`~opspec.bindings.world.sumo.SumoWorld`);
+:class:`~opspec.worlds.room.RoomWorld` and :class:`~opspec.worlds.sumo.SumoWorld`);
 an inline ``Value`` is read as a TOML value (a bare word is a string). :func:`world_performers`
 gives the performers ``opspec run``, ``opspec evaluate``, the walkthrough and the test helpers
 bind: one per world, serving the world's applications by Application id. Each simulated user
@@ -30,10 +30,10 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 from xml.etree import ElementTree
 
-from opspec.bindings.world.base import World
-from opspec.bindings.world.room import RoomWorld
-from opspec.bindings.world.sumo import SumoWorld
 from opspec.errors import ConfigurationError, SourceLocation
+from opspec.worlds.base import World
+from opspec.worlds.room import RoomWorld
+from opspec.worlds.sumo import SumoWorld
 
 if TYPE_CHECKING:
     from opspec.engine.compiled import CompiledPackage
@@ -160,8 +160,8 @@ def world_performers(compiled: CompiledPackage, *, seed: int, user: int
             f"unknown world {name!r}", location=attribute.location or SourceLocation(
                 compiled.package.source or "<spec>"),
             hint=f"known worlds: {', '.join(sorted(WORLDS))}")
-    from opspec.bindings.world.device import WorldDevices
     from opspec.engine.random import named_stream
+    from opspec.worlds.device import WorldDevices
 
     from_file, file = _file_parameters(compiled, attribute)
     inline = _inline_parameters(attribute)

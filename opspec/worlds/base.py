@@ -102,7 +102,7 @@ class RobotWorld(World):
     def op_drive(self, data: Mapping[str, Any]) -> dict[str, Any]:
         """Execute ``motor_cmd``; ``turn_random`` (the random-move manoeuvre) turns to a new
         heading a quarter to three quarters round at once, then stops."""
-        from opspec.bindings.world.geometry import wrap_angle
+        from opspec.worlds.geometry import wrap_angle
 
         command = str(data.get("motor_cmd") or "stop")
         if command == "turn_random":

@@ -4,8 +4,8 @@ from __future__ import annotations
 
 from typing import Any
 
-from opspec.bindings.world.base import World
 from opspec.engine.performers import PerformerSession, WorkItem
+from opspec.worlds.base import World
 
 __all__ = ["WorldDevices"]
 

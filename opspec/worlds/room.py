@@ -16,9 +16,9 @@ from typing import Any
 
 import numpy as np
 
-from opspec.bindings.world.base import RobotWorld, check_parameters
-from opspec.bindings.world.geometry import Box, ray_to_box, wrap_angle
-from opspec.bindings.world.robot import Robot
+from opspec.worlds.base import RobotWorld, check_parameters
+from opspec.worlds.geometry import Box, ray_to_box, wrap_angle
+from opspec.worlds.robot import Robot
 
 __all__ = ["RoomWorld"]
 

@@ -9,10 +9,10 @@ from pathlib import Path
 
 import pytest
 
-from opspec.bindings.worlds import world_performers
 from opspec.engine.compiled import compile_package
 from opspec.engine.simulation import RunResult, Simulation
 from opspec.errors import SpecError
+from opspec.worlds import world_performers
 from opspec.xpdl.open_spec import open_spec
 from opspec.xpdl.preprocess import preprocess_to_xpdl
 

@@ -21,7 +21,7 @@ SPECS = ROOT / "specs"
 sys.path.insert(0, str(ROOT / "tests" / "preprocess"))
 from builtin_models import without_locations
 
-from opspec.bindings.worlds import world_performers
+from opspec.worlds import world_performers
 
 
 def run_spec(path: Path, until: float, seed: int = 0, **kw: Any) -> Any:

@@ -10,13 +10,13 @@ import numpy as np
 import pytest
 from spec_text import compiled, process, task
 
-from opspec.bindings.world.geometry import Box, ray_to_box, ray_to_circle_inside
-from opspec.bindings.world.robot import Robot
-from opspec.bindings.world.room import RoomWorld
-from opspec.bindings.world.sumo import SumoWorld
-from opspec.bindings.worlds import WORLDS, world_parameters, world_performers
 from opspec.engine.simulation import Simulation
 from opspec.errors import ConfigurationError
+from opspec.worlds import WORLDS, world_parameters, world_performers
+from opspec.worlds.geometry import Box, ray_to_box, ray_to_circle_inside
+from opspec.worlds.robot import Robot
+from opspec.worlds.room import RoomWorld
+from opspec.worlds.sumo import SumoWorld
 
 
 def rng(seed: int = 0) -> np.random.Generator:
@@ -61,7 +61,7 @@ def test_motor_commands_move_the_robot_as_the_command_table_says(
 
 def test_a_robot_driving_and_turning_follows_an_exact_arc(monkeypatch: pytest.MonkeyPatch
                                                           ) -> None:
-    from opspec.bindings.world import robot
+    from opspec.worlds import robot
 
     monkeypatch.setitem(robot.COMMANDS, "arc", (1.0, 1.0))     # radius 1 m
     x, y, heading = Robot(0.0, 0.0, 0.0, "arc").pose_after(math.pi / 2)

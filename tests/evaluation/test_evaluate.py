@@ -198,7 +198,7 @@ def test_run_parameters_are_stored_for_other_readers(evaluate, tmp_path):
 
 
 def test_specs_with_a_simulated_world_give_each_user_their_own_world(evaluate, tmp_path):
-    """The vacuum cleaner's room comes from bindings.worlds, one per user from (seed, u):
+    """The vacuum cleaner's room comes from opspec.worlds, one per user from (seed, u):
     users differ, and the results do not depend on the number of workers."""
     spec = SPEC.parent / "vacuum_cleaner.xpdl"
     args = [str(spec), "--users", "3", "--days", "0.003", "--seed", "2"]
