@@ -23,6 +23,7 @@ from __future__ import annotations
 import os
 from typing import Any, Final
 
+from opspec.clock import clock_time
 from opspec.errors import ZeroTimeCycleError
 
 __all__ = ["INSTANT_STEPS_ENV", "MAX_INSTANT_STEPS", "SAMPLE_STEPS", "ZeroTimeSampler",
@@ -115,17 +116,9 @@ class ZeroTimeSampler:
 
     def error(self) -> ZeroTimeCycleError:
         return ZeroTimeCycleError(
-            f"the simulated clock stopped advancing at t={self.at:.3f} s ({_clock(self.at)}): "
+            f"the simulated clock stopped advancing at t={self.at:.3f} s ({clock_time(self.at)}): "
             f"{self.limit:,} steps ran at that instant, {self.describe()}",
             hint="give the cycle a duration, a wait, or a condition that ends it; "
                  f"{INSTANT_STEPS_ENV} raises the limit if this much work at one instant "
                  "is intended",
             sim_time=self.at)
-
-
-def _clock(seconds: float) -> str:
-    """``d1 00:00:00``, as the timeline of ``opspec run`` shows times."""
-    day, rest = divmod(max(0.0, seconds), 86_400.0)
-    hours, rest = divmod(rest, 3600.0)
-    minutes, secs = divmod(rest, 60.0)
-    return f"d{int(day) + 1} {int(hours):02d}:{int(minutes):02d}:{int(secs):02d}"

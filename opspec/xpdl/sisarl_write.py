@@ -11,6 +11,7 @@ import math
 from decimal import Decimal
 from xml.sax.saxutils import quoteattr
 
+from opspec.clock import time_of_day
 from opspec.model import (
     ActivityDirectives,
     CoordinationBuiltIn,
@@ -76,16 +77,6 @@ def number_text(value: float) -> str:
     return f"{Decimal(repr(float(value))):f}"
 
 
-def _time_of_day(seconds: float) -> str:
-    whole = int(seconds)
-    hours, rest = divmod(whole, 3600)
-    minutes, secs = divmod(rest, 60)
-    text = f"{hours:02d}:{minutes:02d}"
-    if secs or seconds != whole:
-        text += f":{secs:02d}" if seconds == whole else f":{secs + seconds - whole:06.3f}"
-    return text
-
-
 def trigger_text(trigger: TriggerRef) -> str:
     """The SISARL trigger syntax of ``trigger`` (``message:trg_1``, ``timer:08:00 every P1D``,
     ``period:PT0.1S offset PT1S``, ``rule:n > 3``)."""
@@ -104,7 +95,7 @@ def trigger_text(trigger: TriggerRef) -> str:
         return text
     if kind == "timer":
         if trigger.at:
-            text = "timer:" + ",".join(_time_of_day(t) for t in trigger.at)
+            text = "timer:" + ",".join(time_of_day(t) for t in trigger.at)
             if trigger.every is not None:
                 text += f" every {duration_text(trigger.every)}"
             return text
