@@ -1,9 +1,12 @@
-"""``opspec show SPEC [--format text|dot] [--process ID]``: what a specification holds.
+"""``opspec show SPEC [--format text|dot|svg|html] [--process ID]``: what a specification holds.
 
 ``text`` (the default) prints the package header, participants (human or system), pools and
 lanes, and every process with its directives, data, activities (kind, performer, manual or
 automatic, deadlines) and transitions with their conditions. ``dot`` prints a Graphviz digraph
-per process (:mod:`opspec.xpdl.dot`). Every error ``opspec validate`` finds is printed on
+per process (:mod:`opspec.xpdl.dot`). ``svg`` and ``html`` draw the whole package in one
+picture: every process with its lanes and the messages between them
+(:mod:`opspec.xpdl.picture`, laid out by Graphviz's ``dot`` program; without it, a one-line
+error with the install hint and exit status 2). Every error ``opspec validate`` finds is printed on
 stderr (the spec is still shown). Exit status: 0 shown, no errors; 1 shown, but the spec has
 errors (or the file holds no usable package); 2 the file cannot be read or the process does
 not exist.
@@ -37,12 +40,16 @@ def register(subparsers: Any) -> None:
     parser = subparsers.add_parser(
         "show", help="print the processes, lanes, participants and activities of a spec",
         description="Print what SPEC holds, as readable text or as Graphviz DOT (one digraph "
-        "per process; render with e.g. 'opspec show SPEC --format dot | dot -Tsvg -o out.svg').")
+        "per process; render with e.g. 'opspec show SPEC --format dot | dot -Tsvg -o out.svg'), "
+        "or draw the whole package - every process with its lanes and the messages between "
+        "them - as SVG or as an HTML page (needs Graphviz's dot program: "
+        "'opspec show SPEC --format html > spec.html').")
     parser.add_argument("spec", metavar="SPEC",
                         help="the XPDL specification, or a workflow script (.wfs) compiled "
                         "from one")
-    parser.add_argument("--format", choices=("text", "dot"), default="text",
-                        help="output format (default: text)")
+    parser.add_argument("--format", choices=("text", "dot", "svg", "html"), default="text",
+                        help="output format (default: text; svg and html: the whole package "
+                        "in one picture)")
     parser.add_argument("--process", metavar="ID", help="only this process (by Id)")
     parser.set_defaults(handler=run)
 
@@ -76,7 +83,12 @@ def run(args: argparse.Namespace) -> int:
               file=sys.stderr)
     if not package.processes:
         print(f"opspec show: {args.spec} declares no process", file=sys.stderr)
-    if args.format == "dot":
+    if args.format in ("svg", "html"):
+        from opspec.xpdl.picture import package_picture_dot, picture_html, render_svg
+
+        svg = render_svg(package_picture_dot(package, process=args.process))
+        sys.stdout.write(svg if args.format == "svg" else picture_html(package, svg))
+    elif args.format == "dot":
         sys.stdout.write(package_to_dot(package, process=args.process))
     else:
         sys.stdout.write(describe_package(package, process=args.process))

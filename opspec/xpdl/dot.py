@@ -18,7 +18,7 @@ found in a file is safe.
 
 from __future__ import annotations
 
-from collections.abc import Iterable
+from collections.abc import Callable, Iterable
 
 from opspec.model.activities import (
     Activity,
@@ -99,9 +99,10 @@ def _owner(process: WorkflowProcess, activity: Activity) -> ActivitySet | None:
     return None
 
 
-def _node(aset: ActivitySet | None, activity_id: str) -> str:
-    """Node names are scoped like activity ids: per activity set."""
-    return quote(activity_id if aset is None else f"{aset.id}::{activity_id}")
+def _node(aset: ActivitySet | None, activity_id: str, scope: str = "") -> str:
+    """Node names are scoped like activity ids: per activity set (and per process, ``scope``,
+    when several processes share one graph)."""
+    return quote(scope + (activity_id if aset is None else f"{aset.id}::{activity_id}"))
 
 
 class _Clusters:
@@ -137,7 +138,9 @@ class _Clusters:
 
 
 def _level(out: list[str], aset: ActivitySet | None, activities: Iterable[Activity],
-           transitions: Iterable[Transition], clusters: _Clusters, indent: str) -> None:
+           transitions: Iterable[Transition], clusters: _Clusters, indent: str,
+           scope: str = "", attributes: Callable[[Activity], str] | None = None) -> None:
+    attributes = attributes or _attributes
     acts = tuple(activities)
     groups: dict[str, list[Activity]] = {}
     loose: list[Activity] = []
@@ -147,24 +150,25 @@ def _level(out: list[str], aset: ActivitySet | None, activities: Iterable[Activi
             groups.setdefault(key, []).append(activity)
         else:
             loose.append(activity)
-    prefix = f"cluster_{aset.id}_" if aset is not None else "cluster_"
+    prefix = f"cluster_{scope}{aset.id}_" if aset is not None else f"cluster_{scope}"
     for key, members in groups.items():
         out.append(f"{indent}subgraph {quote(prefix + key)} {{")
         out.append(f"{indent}  label={quote(clusters.label(key))}; style=rounded; color=gray60;")
         for activity in members:
-            out.append(f"{indent}  {_node(aset, activity.id)} [{_attributes(activity)}];")
+            out.append(f"{indent}  {_node(aset, activity.id, scope)} "
+                       f"[{attributes(activity)}];")
         out.append(f"{indent}}}")
     for activity in loose:
-        out.append(f"{indent}{_node(aset, activity.id)} [{_attributes(activity)}];")
+        out.append(f"{indent}{_node(aset, activity.id, scope)} [{attributes(activity)}];")
     graph = FlowGraph.of(acts, transitions)
     for transition in graph.transitions:
         attrs = _edge_attributes(transition)
         tail = f" [{attrs}]" if attrs else ""
-        out.append(f"{indent}{_node(aset, transition.source)} -> "
-                   f"{_node(aset, transition.target)}{tail};")
+        out.append(f"{indent}{_node(aset, transition.source, scope)} -> "
+                   f"{_node(aset, transition.target, scope)}{tail};")
     for host, events in graph.boundary.items():
         for event in events:
-            out.append(f"{indent}{_node(aset, host)} -> {_node(aset, event)} "
+            out.append(f"{indent}{_node(aset, host, scope)} -> {_node(aset, event, scope)} "
                        "[style=dotted, arrowhead=none];")
 
 
