@@ -75,7 +75,7 @@ def _cli_until(text: str) -> float:
 DURATION_DOORS: dict[str, Callable[[str], float]] = {
     "clock": clock.parse_duration,
     "xpdl-deadline": _deadline,
-    "sisarl-period": lambda text: float(getattr(_directives("Period", text), "period")),
+    "sisarl-period": lambda text: float(_directives("Period", text).period),
     "monitor": _monitor,
     "script-step": lambda text: parse_script([(text, "press_report")]).steps[0].delay,
     "scenario-until": lambda text: _until(Path("s.toml"), "scenario[0].given", text),
@@ -141,7 +141,7 @@ def test_negative_durations_are_refused_alike() -> None:
 # ---------------------------------------------------------------- times of day
 def _timer(text: str) -> float:
     directives = _directives("StartTrigger", f"timer:{text}")
-    trigger = getattr(directives, "start_trigger")
+    trigger = directives.start_trigger
     return float(trigger.at[0])
 
 
