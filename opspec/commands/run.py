@@ -221,17 +221,13 @@ def _config(args: argparse.Namespace) -> Any:
 
 
 def _parse_until(text: str) -> float:
-    try:
-        value = float(text)
-    except ValueError:
-        from opspec.xpdl.durations import parse_duration
+    from opspec.clock import parse_duration
 
-        try:
-            value = parse_duration(text)
-        except Exception:  # noqa: BLE001 - any parse failure is the same usage error
-            raise ConfigurationError(f"--until {text!r} is not a number of seconds or an "
-                                     "ISO 8601 duration", hint="e.g. --until 3600 or "
-                                     "--until PT8H") from None
+    # the one duration grammar (opspec.clock), refused with the same message as everywhere
+    try:
+        value = parse_duration(text, error=ConfigurationError)
+    except ConfigurationError as error:
+        raise ConfigurationError(f"--until: {error.message}", hint=error.hint) from None
     if not (value > 0 and math.isfinite(value)):
         raise ConfigurationError(f"--until must be a positive time, not {text!r}")
     return value

@@ -137,7 +137,7 @@ def test_realtime_at_high_speed_reports_drift(tmp_path, capsys):
 @pytest.mark.parametrize("args, message", [
     (["--speed", "10"], "--speed only applies with --realtime"),
     (["--days", "-1"], "--days must be a positive number"),
-    (["--until", "soon"], "is not a number of seconds or an ISO 8601 duration"),
+    (["--until", "soon"], "--until: cannot read duration 'soon': not a duration"),
     (["--user-model", "no-such-preset"], "no-such-preset"),
     (["--engine-config", "/nonexistent/engine.toml"], "engine.toml"),
 ], ids=["speed-without-realtime", "negative-days", "bad-until", "unknown-preset",

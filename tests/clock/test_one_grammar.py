@@ -102,8 +102,6 @@ REFUSED = {
 }
 #: doors not yet on opspec.clock for refusals; the reason is the fix
 NOT_YET = {
-    "cli-until": "commands/run.py (being rebuilt elsewhere) says its own message: its "
-                 "_parse_until should call clock.parse_duration(text, error=ConfigurationError)",
     "xpdl-deadline": "a Deadline that is no duration is read as an expression over data "
                      "fields, so its refusal is the expression's",
 }
@@ -114,8 +112,6 @@ NOT_YET = {
 def test_every_door_refuses_the_same_durations_with_the_same_message(door: str, text: str
                                                                      ) -> None:
     if door in NOT_YET and text != "1e999":
-        pytest.xfail(NOT_YET[door])
-    if door == "cli-until" and text == "1e999":
         pytest.xfail(NOT_YET[door])
     with pytest.raises(OpspecError) as caught:
         DURATION_DOORS[door](text)
