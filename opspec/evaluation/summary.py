@@ -103,6 +103,36 @@ def _per_user(values: Sequence[float], level: float) -> dict[str, Any]:
             "p95": _percentile(ordered, 0.95)}
 
 
+#: Fewer events than this (or, for a proportion, fewer non-events) and the normal
+#: approximation behind the cluster-robust interval is not to be trusted (the usual np >= 10
+#: rule): the interval is widened to cover the exact Poisson (counts) or Wilson score
+#: (proportions) interval, which never collapses to [0, 0] with no events.
+RARE_EVENTS = 10
+
+
+def _rare_count_ci(ci: list[float | None], total: int, users: int, level: float
+                   ) -> list[float | None]:
+    if users < 1 or total >= RARE_EVENTS:
+        return ci
+    _rate, low, high = poisson_interval(total, float(users), level)
+    return [low if ci[0] is None else min(ci[0], low),
+            high if ci[1] is None else max(ci[1], high)]
+
+
+def _rare_proportion_ci(ci: list[float | None], pairs: Sequence[tuple[float, float]],
+                        level: float) -> list[float | None]:
+    """A ratio of counts that is a proportion (numerator <= denominator for every user, all
+    whole numbers) with few events or few non-events: widened to its Wilson interval."""
+    if not pairs or any(y > n or y < 0 or y != int(y) or n != int(n) for y, n in pairs):
+        return ci
+    events, trials = int(sum(y for y, _ in pairs)), int(sum(n for _, n in pairs))
+    if trials <= 0 or min(events, trials - events) >= RARE_EVENTS:
+        return ci
+    wilson = rate_interval(events, trials, level)
+    return [wilson.lo if ci[0] is None else min(ci[0], wilson.lo),
+            wilson.hi if ci[1] is None else max(ci[1], wilson.hi)]
+
+
 def summarise_design(store: ResultStore, design: str, days: float, level: float = 0.95
                      ) -> dict[str, dict[str, Any]]:
     """Every declared metric of ``design`` summarised (see the module docstring)."""
@@ -116,7 +146,8 @@ def summarise_design(store: ResultStore, design: str, days: float, level: float 
             totals = sorted(y for y, _ in pairs)
             out[name] = {
                 "kind": "count", "total": int(sum(totals)), "users": users,
-                "mean": estimate.value, "sd": _sd(totals), "ci95": estimate.ci,
+                "mean": estimate.value, "sd": _sd(totals),
+                "ci95": _rare_count_ci(estimate.ci, int(sum(totals)), users, level),
                 "median": _percentile(totals, 0.5), "p95": _percentile(totals, 0.95),
                 "per_day": (estimate.value / days) if estimate.value is not None else None,
             }
@@ -139,7 +170,8 @@ def summarise_design(store: ResultStore, design: str, days: float, level: float 
         else:
             ratios = [y / k for y, k in pairs if k > 0]
             out[name] = {
-                "kind": "ratio", "value": estimate.value, "ci95": estimate.ci,
+                "kind": "ratio", "value": estimate.value,
+                "ci95": _rare_proportion_ci(estimate.ci, pairs, level),
                 "numerator": definition.get("numerator"),
                 "denominator": definition.get("denominator"),
                 "per_user": _per_user(ratios, level),
