@@ -513,24 +513,25 @@ class _Compiler:
                     "add a start event (or an activity without incoming transitions) in "
                     "front of the cycle")
         graph.activities = tuple(acts)
-        # OR joins need to know what can still reach them
-        predecessors: dict[int, set[int]] = {i: set() for i in range(len(acts))}
-        for i, outs in outgoing.items():
-            for ct in outs:
-                predecessors[ct.target].add(i)
-        for ca in acts:
-            if ca.join == J_OR:
-                graph.has_or_join = True
-                seen: set[int] = set()
-                stack = list(predecessors[ca.index])
-                while stack:
-                    node = stack.pop()
-                    if node in seen:
-                        continue
-                    seen.add(node)
-                    stack.extend(predecessors[node])
-                seen.discard(ca.index)
-                ca.upstream = frozenset(seen)
+        # OR joins need to know what can still reach them (the predecessors: only if any)
+        if any(ca.join == J_OR for ca in acts):
+            predecessors: dict[int, set[int]] = {i: set() for i in range(len(acts))}
+            for i, outs in outgoing.items():
+                for ct in outs:
+                    predecessors[ct.target].add(i)
+            for ca in acts:
+                if ca.join == J_OR:
+                    graph.has_or_join = True
+                    seen: set[int] = set()
+                    stack = list(predecessors[ca.index])
+                    while stack:
+                        node = stack.pop()
+                        if node in seen:
+                            continue
+                        seen.add(node)
+                        stack.extend(predecessors[node])
+                    seen.discard(ca.index)
+                    ca.upstream = frozenset(seen)
         return graph
 
     def activity(self, proc: WorkflowProcess, act: Activity, ca: CompiledActivity,

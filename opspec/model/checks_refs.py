@@ -38,6 +38,10 @@ class RefChecks:
         self.performer_fields = {f.id for f in package.data_fields if _is_performer(f.type)}
         self.lanes = {lane.id for pool in package.pools for lane in pool.all_lanes()}
         self.modes = {m.id for m in package.modes}
+        # the performers known in the process last asked about (one set per process, not
+        # one per activity)
+        self._performers_of: tuple[WorkflowProcess, set[str]] | None = None
+        self._fields_of: tuple[WorkflowProcess, set[str]] | None = None
 
     # -- package level -----------------------------------------------------------------
     def pools(self) -> None:
@@ -111,8 +115,12 @@ class RefChecks:
 
     # -- process level -----------------------------------------------------------------
     def fields_of(self, process: WorkflowProcess) -> set[str]:
-        return (self.package_fields | {f.id for f in process.data_fields}
-                | {p.id for p in process.formal_parameters})
+        """The data fields and formal parameters an expression of ``process`` may read (the
+        same set for every call about one process; not to be changed by the caller)."""
+        if self._fields_of is None or self._fields_of[0] is not process:
+            self._fields_of = (process, self.package_fields | {f.id for f in process.data_fields}
+                               | {p.id for p in process.formal_parameters})
+        return self._fields_of[1]
 
     def process(self, process: WorkflowProcess) -> None:
         directives = process.directives
@@ -138,9 +146,7 @@ class RefChecks:
                  activity: Activity) -> None:
         scope = where(process, aset)
         what = f"activity {activity.id!r} in {scope}"
-        performers = self.participants | self.performer_fields | {
-            p.id for p in process.participants} | {
-            f.id for f in process.data_fields if _is_performer(f.type)}
+        performers = self._performers(process) if activity.performers else set()
         for performer in activity.performers:
             if performer and performer not in performers:
                 self.report.error(
@@ -179,6 +185,14 @@ class RefChecks:
             self._assignment(process, aset, assignment, f"an assignment of {what}", activity)
         self._directives(process, aset, activity, what)
 
+    def _performers(self, process: WorkflowProcess) -> set[str]:
+        """Participants and performer fields an activity of ``process`` may name."""
+        if self._performers_of is None or self._performers_of[0] is not process:
+            self._performers_of = (process, self.participants | self.performer_fields | {
+                p.id for p in process.participants} | {
+                f.id for f in process.data_fields if _is_performer(f.type)})
+        return self._performers_of[1]
+
     def _directives(self, process: WorkflowProcess, aset: ActivitySet | None,
                     activity: Activity, what: str) -> None:
         directives = activity.directives
@@ -193,7 +207,8 @@ class RefChecks:
                               f"{what} has a negative CPU demand ({directives.cpu_demand:g} s)",
                               "write a duration of zero or more, e.g. PT0.002S")
         for trigger in (directives.start_trigger, directives.end_trigger, directives.raises):
-            self._trigger(process, aset, activity, trigger, f"a trigger of {what}")
+            if trigger is not None:
+                self._trigger(process, aset, activity, trigger, f"a trigger of {what}")
         coordination = activity.coordination
         if coordination is None:
             return
@@ -305,6 +320,8 @@ class RefChecks:
     # -- transitions, assignments, names --------------------------------------------------
     def transition(self, process: WorkflowProcess, aset: ActivitySet | None,
                    transition: Transition) -> None:
+        if transition.condition.expression is None and not transition.assignments:
+            return      # nothing it reads
         what = f"the condition of transition {transition.id!r} in {where(process, aset)}"
         self._names(process, aset, transition, transition.condition.expression, what)
         for assignment in transition.assignments:

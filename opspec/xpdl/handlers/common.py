@@ -28,6 +28,7 @@ __all__ = [
     "child",
     "child_text",
     "children",
+    "children_by_tag",
     "extended_attributes",
     "grandchildren",
     "indexed_children",
@@ -109,47 +110,54 @@ def _tag(local: str) -> str:
     return tag
 
 
-def _children_by_tag(element: Node) -> dict[str, list[Node]] | None:
-    """``element``'s element children by tag (document order), or ``None`` outside
-    :func:`indexed_children`."""
+def _index_children(element: Node, cache: dict[Node, dict[str, list[Node]]]
+                    ) -> dict[str, list[Node]]:
+    """``element``'s element children by tag (document order), remembered in ``cache``."""
+    if len(cache) >= _BY_TAG_LIMIT:
+        cache.clear()
+    found: dict[str, list[Node]] = {}
+    for sub in element:
+        tag = sub.tag
+        if isinstance(tag, str):
+            bucket = found.get(tag)
+            if bucket is None:
+                found[tag] = [sub]
+            else:
+                bucket.append(sub)
+    cache[element] = found
+    return found
+
+
+def children_by_tag(element: Node) -> dict[str, list[Node]] | None:
+    """``element``'s element children by tag (in the order each tag first occurs) inside
+    :func:`indexed_children`; ``None`` outside it. Not to be changed by the caller."""
     cache = _BY_TAG.get()
     if cache is None:
         return None
-    found = cache.get(element)
-    if found is None:
-        if len(cache) >= _BY_TAG_LIMIT:
-            cache.clear()
-        found = {}
-        for sub in element:
-            tag = sub.tag
-            if isinstance(tag, str):
-                bucket = found.get(tag)
-                if bucket is None:
-                    found[tag] = [sub]
-                else:
-                    bucket.append(sub)
-        cache[element] = found
-    return found
+    return cache.get(element) or _index_children(element, cache)
 
 
 def child(element: Node, local: str) -> Node | None:
     if not len(element):
         return None
-    by_tag = _children_by_tag(element)
-    if by_tag is not None:
-        found = by_tag.get(_tag(local))
+    tag = _TAGS.get(local) or _tag(local)
+    cache = _BY_TAG.get()
+    if cache is not None:
+        found = (cache.get(element) or _index_children(element, cache)).get(tag)
         return found[0] if found else None
     # iterchildren, not find(): no ElementPath to look up on each of a big file's many calls
-    return next(element.iterchildren(_tag(local)), None)
+    return next(element.iterchildren(tag), None)
 
 
 def children(element: Node | None, local: str) -> list[Node]:
     if element is None or not len(element):
         return []
-    by_tag = _children_by_tag(element)
-    if by_tag is not None:
-        return list(by_tag.get(_tag(local), ()))
-    return list(element.iterchildren(_tag(local)))
+    tag = _TAGS.get(local) or _tag(local)
+    cache = _BY_TAG.get()
+    if cache is not None:
+        found = (cache.get(element) or _index_children(element, cache)).get(tag)
+        return list(found) if found else []
+    return list(element.iterchildren(tag))
 
 
 def grandchildren(element: Node, wrapper: str, local: str) -> list[Node]:

@@ -33,10 +33,14 @@ from opspec.xpdl.sisarl import process_directives
 __all__ = ["build_condition", "build_process", "build_transition"]
 
 
+# A transition without Condition (shared: the model is immutable).
+_NO_CONDITION = Condition()
+
+
 def build_condition(element: etree._Element | None, ctx: BuildContext) -> Condition:
     """A transition ``Condition`` (its text is in ``Expression`` after normalising)."""
     if element is None:
-        return Condition()
+        return _NO_CONDITION
     expression = child(element, "Expression")
     source = expression if expression is not None else element
     text = "".join(source.itertext()).strip() or None

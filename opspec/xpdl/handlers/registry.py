@@ -13,7 +13,7 @@ from typing import Generic, TypeVar
 
 from lxml import etree
 
-from opspec.xpdl.handlers.common import BuildContext
+from opspec.xpdl.handlers.common import BuildContext, children_by_tag
 from opspec.xpdl.namespaces import CANONICAL, qname
 
 __all__ = ["Handler", "Registry"]
@@ -55,6 +55,18 @@ class Registry(Generic[T]):
 
     def build(self, element: etree._Element, ctx: BuildContext) -> T:
         return self._handlers[str(element.tag)](element, ctx)
+
+    def first(self, parent: etree._Element) -> etree._Element | None:
+        """The first child of ``parent`` with a handler (document order), or ``None``."""
+        by_tag = children_by_tag(parent) if len(parent) else {}
+        if by_tag is None:
+            return next(self.matching(parent), None)
+        # each tag's first child, in the order the tags first occur: the first one handled is
+        # the first handled child
+        for tag, found in by_tag.items():
+            if tag in self._handlers:
+                return found[0]
+        return None
 
     def build_first(self, parent: etree._Element, ctx: BuildContext) -> T | None:
         """Build the first child of ``parent`` with a handler, or ``None`` if none has one."""
