@@ -116,12 +116,20 @@ class FlowGraph:
         blocked = frozenset(avoid)
         seen: set[str] = set()
         stack = [s for s in sources if s in self.by_id and s not in blocked]
+        outgoing, boundary = self.outgoing, self.boundary
         while stack:
             node = stack.pop()
             if node in seen:
                 continue
             seen.add(node)
-            stack.extend(n for n in self.successors(node) if n not in seen and n not in blocked)
+            # the successors (as successors() gives them), without a tuple per node
+            for transition in outgoing.get(node, ()):
+                target = transition.target
+                if target not in seen and target not in blocked:
+                    stack.append(target)
+            for target in boundary.get(node, ()):
+                if target not in seen and target not in blocked:
+                    stack.append(target)
         return frozenset(seen)
 
     def reachable_for_sure(self, source: str, *, avoid: Iterable[str] = ()) -> frozenset[str]:

@@ -53,6 +53,12 @@ _Index = dict[str, list[etree._Element]]
 _Kind = tuple[str, str | None, bool] | None
 
 
+# The local names the rewrites below look up in the index (no other element is listed).
+_INDEXED = frozenset({"Implementation", "Performer", "StartMode", "FinishMode", "Join", "Split",
+                      "Route", "Condition", "Deadline", "BlockActivity", "StartEvent",
+                      "IntermediateEvent"})
+
+
 def _kind(tag: str) -> _Kind:
     namespace, local = tag[1:].split("}", 1) if tag.startswith("{") else ("", tag)
     if not is_xpdl_namespace(namespace):
@@ -70,7 +76,8 @@ def _skip_subtree(elements: Iterator[object], element: etree._Element) -> None:
 
 def _canonical_index(root: etree._Element) -> _Index:
     """Rename every element in an XPDL namespace into :data:`CANONICAL` and return the
-    canonical elements by local name, in document order. Foreign (vendor) elements and opaque
+    canonical elements the rewrites look for (:data:`_INDEXED`) by local name, in document
+    order. Foreign (vendor) elements and opaque
     contents are not entered: they are kept verbatim and not indexed. One pass over the tree
     (lxml's own ``iter``), the namespace of each distinct tag worked out once."""
     found: _Index = {}
@@ -90,11 +97,12 @@ def _canonical_index(root: etree._Element) -> _Index:
         local, renamed, opaque = kind
         if renamed is not None:
             element.tag = renamed
-        bucket = found.get(local)
-        if bucket is None:
-            found[local] = [element]
-        else:
-            bucket.append(element)
+        if local in _INDEXED:
+            bucket = found.get(local)
+            if bucket is None:
+                found[local] = [element]
+            else:
+                bucket.append(element)
         if opaque:
             _skip_subtree(elements, element)
     return found

@@ -32,12 +32,14 @@ from opspec.xpdl.handlers.common import (
     base_fields,
     child,
     children,
+    children_by_tag,
     grandchildren,
     parse_int,
     text_of,
 )
 from opspec.xpdl.handlers.events import parse_condition_element
 from opspec.xpdl.handlers.resources import performers_of
+from opspec.xpdl.namespaces import qname
 from opspec.xpdl.sisarl import activity_directives
 
 __all__ = ["build_activity", "build_assignments"]
@@ -224,8 +226,13 @@ def build_activity(element: etree._Element, ctx: BuildContext) -> Activity:
     if not len(element):
         return _bare_activity(element, ctx)
     fields = base_fields(element, ctx, kind="Activity")
+    tags = children_by_tag(element)       # None outside indexed_children: look for everything
+
+    def has(local: str) -> bool:
+        return tags is None or qname(local) in tags
+
     body, body_element = _body(element, ctx)
-    join, split = _restrictions(element, ctx)
+    join, split = _restrictions(element, ctx) if has("TransitionRestrictions") else (None, None)
     if isinstance(body, Route) and body_element is not None and attr(body_element, "GatewayType") is None:
         # XPDL 1.0 and Bizagi routes say what they do only through their restrictions.
         derived = (split.type if split else None) or (join.type if join else None) or GatewayType.XOR
@@ -236,7 +243,7 @@ def build_activity(element: etree._Element, ctx: BuildContext) -> Activity:
         text = attr(body_element, "IncomingCondition") if body_element is not None else None
         join = dataclasses.replace(join, condition_text=text, condition=_expression(
             body_element, text, ctx, "IncomingCondition"))
-    priority_text = text_of(child(element, "Priority"))
+    priority_text = text_of(child(element, "Priority")) if has("Priority") else None
     priority = parse_int(priority_text)
     if priority_text is not None and priority is None:
         ctx.warning(child(element, "Priority"), "bad-priority",
@@ -245,18 +252,18 @@ def build_activity(element: etree._Element, ctx: BuildContext) -> Activity:
     directives, coordination = activity_directives(element, ctx)
     return Activity(
         body=body,
-        performers=performers_of(element),
+        performers=performers_of(element) if has("Performers") else (),
         start_mode=_mode(element, "StartMode", ctx),
         finish_mode=_mode(element, "FinishMode", ctx),
         priority=priority,
-        deadlines=_deadlines(element, ctx),
-        loop=_loop(element, ctx),
+        deadlines=_deadlines(element, ctx) if has("Deadline") else (),
+        loop=_loop(element, ctx) if has("Loop") else None,
         join=join,
         split=split,
-        lane=_lane(element),
+        lane=_lane(element) if has("NodeGraphicsInfos") else None,
         directives=directives,
         coordination=coordination,
-        assignments=build_assignments(element, ctx),
+        assignments=build_assignments(element, ctx) if has("Assignments") else (),
         **fields,
     )
 

@@ -164,7 +164,9 @@ def grandchildren(element: Node, wrapper: str, local: str) -> list[Node]:
     """``element/wrapper/local`` over every ``wrapper`` (files sometimes repeat wrappers)."""
     out: list[Node] = []
     for group in children(element, wrapper):
-        out.extend(children(group, local))
+        # a wrapper is asked about once: its children are not indexed (one filtered pass)
+        if len(group):
+            out.extend(group.iterchildren(_TAGS.get(local) or _tag(local)))
     return out
 
 
@@ -261,13 +263,14 @@ def base_fields(
         element_id = f"<{kind} without Id at line {line}>" if line else f"<{kind} without Id>"
         ctx.error(element, "missing-id", f"{kind} has no Id",
                   f"add an Id attribute to the {kind}")
-    description = child_text(element, "Description") if len(element) else None
+    nested = len(element)
+    description = child_text(element, "Description") if nested else None
     if description is None:
         description = attr(element, "Description")
     return {
         "id": element_id,
         "name": attr(element, "Name"),
         "description": description,
-        "extended_attributes": extended_attributes(element, ctx),
+        "extended_attributes": extended_attributes(element, ctx) if nested else (),
         "location": ctx.loc(element),
     }

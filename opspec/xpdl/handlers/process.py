@@ -81,6 +81,9 @@ def build_transition(element: etree._Element, ctx: BuildContext) -> Transition:
         if value is None:
             ctx.error(element, "missing-transition-end", f"Transition {fields['id']!r} has no {name}",
                       f"set {name} to the Id of an activity")
+    if not len(element):        # no Condition, no Assignments (most transitions)
+        return Transition(source=source or "", target=target or "", condition=_NO_CONDITION,
+                          **fields)
     return Transition(source=source or "", target=target or "",
                       condition=build_condition(child(element, "Condition"), ctx),
                       assignments=build_assignments(element, ctx), **fields)
