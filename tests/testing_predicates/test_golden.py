@@ -52,7 +52,7 @@ def test_a_different_run_fails_with_counts_and_a_short_unified_diff(
         compare(absent_user, path, max_diff_lines=30)
     text = str(info.value)
     lines = text.splitlines()
-    assert lines[0].startswith(f"the run differs from the golden trace {path}: 62 event(s) "
+    assert lines[0].startswith(f"the run differs from the golden trace {path}: 64 event(s) "
                                "stored, ")
     assert "line(s) missing from this run" in lines[0] and "first difference at event" in lines[0]
     assert lines[1] == f"--- {path} (golden)" and lines[2] == "+++ this run"
