@@ -24,6 +24,30 @@ parse time (``lxml.etree.parse``) of the same file:
   run into that budget (an inconclusive verdict, exit 1).
 
 It prints; it asserts nothing.
+
+Measured (issue 17, "checks scale"; 2 shared cores, Python 3.11.7, lxml 6.1; CPU seconds of
+``opspec validate`` on the 18.3 MiB, 200,000-line file of 50,000 AND splits, 550,000 elements;
+lxml's bare parse 0.24-0.28 s). Before: 11.0-11.5 s. After: 4.5-4.8 s (this script: 4.59 s
+wall, best of 3, ratio 19x, peak RSS 479 MiB), the engine compiled with mypyc or not
+(compile_package is 0.9 s compiled, 1.0 s from source). By stage (CPU seconds, each stage timed alone), before -> after:
+
+=====================================================  ==========  ==========
+stage                                                  before      after
+=====================================================  ==========  ==========
+read + lxml parse                                      0.25 s      0.24 s
+exact lines past 65,535 (reader ``_big_lines``)        0.80 s      0.28 s
+normalize (namespaces, 1.0 -> 2.1 rewrites)            2.14 s      0.20 s
+build the model (``opspec/xpdl/handlers``)             3.82 s      1.82 s
+resolve (external packages, subflow cycles)            0.33 s      0.10 s
+structural checks (``check_package``)                  1.16 s      0.69 s
+``compile_package`` (validate runs it: not-runnable)   2.07 s      1.0 s
+=====================================================  ==========  ==========
+
+About 2 s of the "before" column was the cyclic garbage collector walking the growing model
+(now paused while a package is loaded, checked and compiled: ``opspec.model.bulk``); the rest
+was per-element work: ``etree.QName`` per element and a second full pass in normalize, child
+lookups of one element repeated by every handler, set unions per activity in the checks, a
+dict of enum keys built per transition in the compiler, expat calling Python per element.
 """
 
 from __future__ import annotations
