@@ -54,6 +54,9 @@ class EngineConfig:
     - ``switch_cost``: seconds a pooled worker spends per transition to a general activity.
     - ``realtime`` / ``speed``: run against the wall clock, ``speed`` simulated seconds per
       wall-clock second.
+    - ``message_ttl``: seconds a message nobody waits for is kept for the next activity that
+      waits for it (docs/semantics.md); older ones are lost (``trigger.lost``). ``inf``
+      keeps them until caught or their receiver ends.
     """
 
     processor_model: Literal["dedicated", "pooled", "preemptive"] = "dedicated"
@@ -63,6 +66,7 @@ class EngineConfig:
     switch_cost: float = 0.0
     realtime: bool = False
     speed: float = 1.0
+    message_ttl: float = 60.0
 
     def __post_init__(self) -> None:
         _check(self, None)
@@ -151,10 +155,10 @@ def _check(config: EngineConfig, path: str | None) -> None:
         if isinstance(value, bool) or not isinstance(value, int) or value < 1:
             raise _fail(path, key, f"{key} must be a whole number >= 1, not {value!r}",
                         f"write e.g. {key} = 2")
-    for key in ("timer_resolution", "switch_cost"):
+    for key in ("timer_resolution", "switch_cost", "message_ttl"):
         value = getattr(config, key)
-        if (isinstance(value, bool) or not isinstance(value, int | float)
-                or not math.isfinite(value) or value < 0):
+        if (isinstance(value, bool) or not isinstance(value, int | float) or math.isnan(value)
+                or (not math.isfinite(value) and key != "message_ttl") or value < 0):
             raise _fail(path, key, f"{key} must be a number of seconds >= 0, not {value!r}",
                         f"write e.g. {key} = 0.001")
     if not isinstance(config.realtime, bool):

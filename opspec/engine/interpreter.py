@@ -143,9 +143,10 @@ class Interpreter:
         self._rule_keys = itertools.count(1)
         self._offers: dict[int, ActivityInstance] = {}
         self._mailboxes: dict[str, deque[Any]] = {}
-        # messages kept until caught: (receiving root instance id or 0, (kind, name)) -> data
+        # messages kept until caught: (receiving root instance id or 0, (kind, name)) ->
+        # (data, simulated time it was kept)
         self._kept: dict[tuple[int, tuple[str, str]],
-                         deque[tuple[Mapping[str, Any] | None]]] = {}
+                         deque[tuple[Mapping[str, Any] | None, float]]] = {}
         self.lost_messages = 0
         # the zero-time cycle guard (see _drain)
         self._instant = -1.0
@@ -1447,20 +1448,27 @@ class Interpreter:
             box.popleft()
             self._lose(key, inst, act, f"more than {MESSAGE_BUFFER} {key[1]!r} messages were "
                        "kept with nobody waiting; the oldest is dropped")
-        box.append((data,))
+        box.append((data, self.env._now))
         self._trigger_event(EK.TRIGGER_KEPT, key, inst, act, {
             "for": None if partner is None else partner.id, "kept": len(box)})
 
     def _take_kept(self, waiter: ProcessInstance, key: tuple[str, str]
-                   ) -> tuple[Mapping[str, Any] | None] | None:
-        """The oldest message kept for ``waiter``'s root instance, else for anyone."""
+                   ) -> tuple[Mapping[str, Any] | None, float] | None:
+        """The oldest message kept for ``waiter``'s root instance, else for anyone; messages
+        kept longer than the configured ``message_ttl`` are lost on the way (a button pressed
+        hours before anyone asked is not an answer to the next question)."""
+        now = self.env._now
+        ttl = self.config.message_ttl
         for box_key in ((waiter.root, key), (0, key)):
             box = self._kept.get(box_key)
-            if box:
+            while box:
                 message = box.popleft()
                 if not box:
                     del self._kept[box_key]
-                return message
+                if now - message[1] <= ttl:
+                    return message
+                self._lose(key, None, None, f"kept {now - message[1]:g} s with nobody "
+                           f"catching it (message_ttl {ttl:g} s)")
         return None
 
     def _lose(self, key: tuple[str, str], inst: ProcessInstance | None,

@@ -169,3 +169,20 @@ def test_a_reply_to_an_instance_that_has_ended_is_lost_and_says_so() -> None:
     assert lost.time == 5.0 and lost.process == "user"
     assert "has ended" in lost.data["reason"]
     assert events(result, "trigger.kept") == []
+
+
+def test_a_message_kept_longer_than_message_ttl_is_lost_not_caught() -> None:
+    """A press hours before anyone asks is no answer: kept messages expire after
+    message_ttl (60 s by default), reported as trigger.lost."""
+    model = pkg(proc("device", [catch("delay", "timer", seconds=3600.0),
+                                catch("wait", "message", "report"), "got_it"],
+                     [("delay", "wait"), ("wait", "got_it")]))
+    user = ScriptedUser([("at 5", "raise report")])
+    result = run(model, performers={"someone": user}, until=7200.0)
+    assert "got_it" not in completed(result)
+    [lost] = events(result, "trigger.lost")
+    assert lost.time == 3600.0 and "message_ttl 60 s" in lost.data["reason"]
+    kept_forever = run(model, performers={"someone": ScriptedUser([("at 5", "raise report")])},
+                       until=7200.0, config=EngineConfig(message_ttl=float("inf")))
+    assert [e.time for e in events(kept_forever, "activity.completed",
+                                   activity="got_it")] == [3600.0]
