@@ -364,7 +364,9 @@ def test_preprocess_refuses_a_spec_that_validate_rejects(
     out = tmp_path / "out.xpdl"
     assert main(["preprocess", str(bad), "-o", str(out)]) == 1
     err = capsys.readouterr().err
-    assert f"{bad}:84: error: " in err and "'nowhere'" in err
+    line = next(n for n, text_line in enumerate(text.splitlines(), 1)
+                if 'From="start_notify" To="timer_done"' in text_line)
+    assert f"{bad}:{line}: error: " in err and "'nowhere'" in err
     assert "nothing written" in err
     assert not out.exists()
 
