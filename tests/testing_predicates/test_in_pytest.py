@@ -31,7 +31,7 @@ def test_prompt(spec, simulate):
         "*check(simulate(spec, script=PROMPT*",
         "E * expected within(sound_alarm, press_report, 60 s)",
         "E * but sound_alarm at day 1 08:00:00.0 was not followed by press_report within 60 s*",
-        "E * trace around it (2 marked event(s) of 62):",
+        "E * trace around it (2 marked event(s) of *):",
         "E *>   day 1 08:00:00.0    #2 notify_workflow    activity.completed   sound_alarm",
         "*- opspec -*", "seed * (from --opspec-seed=0 and the test id*"])
     assert "predicates.py" not in result.stdout.str()       # the test line, not opspec's
