@@ -20,7 +20,7 @@ __all__ = ["bind_user", "choose_user", "companion_user_model", "engine_diagnosti
            "load_any_spec"]
 
 
-def load_any_spec(path: str | Path) -> Package:
+def load_any_spec(path: str | Path, *, command: str | None = None) -> Package:
     """The package in ``path`` (XPDL or ``.wfs``), refused with every error ``opspec validate``
     reports (a :class:`~opspec.errors.SpecError` listing them with ``path:line``): the run,
     evaluate and walkthrough commands never execute a spec that validation rejects.
@@ -29,7 +29,11 @@ def load_any_spec(path: str | Path) -> Package:
     regular file, no permission) is a ConfigurationError (exit status 2). What
     :func:`engine_diagnostics` adds
     for validate (monitors, the world) is raised as a located ConfigurationError (exit 2)
-    when the run builds them, as before."""
+    when the run builds them, as before.
+
+    With ``command`` (``"run"``, ``"evaluate"``), the warnings ``opspec validate`` prints for
+    a spec that loads are printed to stderr as ``opspec COMMAND: path:line: warning: ...``:
+    a misspelt directive changes what runs, and must not pass unseen."""
     from opspec.xpdl.open_spec import open_spec, refuse_unreadable
     from opspec.xpdl.reader import not_a_file
 
@@ -44,6 +48,10 @@ def load_any_spec(path: str | Path) -> Package:
     errors = [d for d in report.diagnostics if d.severity is Severity.ERROR]
     if errors or package is None:
         raise SpecError.from_diagnostics(errors or report.diagnostics)
+    if command is not None:
+        for warning in report.diagnostics:
+            if warning.severity is Severity.WARNING:
+                print(f"opspec {command}: {warning}", file=sys.stderr)
     return package
 
 

@@ -8,7 +8,10 @@ participants to serial devices (docs in ``devices/README.md``); a bound real dev
 the run to wall-clock time.
 
 Exit status: 0 the run ended normally; 1 the run found a problem (a deadlock, an aborted
-instance, a device fault); 2 usage, configuration or I/O errors (from the CLI).
+instance, a device fault); 2 usage, configuration or I/O errors (from the CLI). With nobody on
+the user lane (``--no-user``, or no user model at all), user-lane instances still waiting for
+their performer at the end are the expected end of a devices-only run: said in one line, not
+reported as deadlocks, not exit 1.
 """
 
 from __future__ import annotations
@@ -96,7 +99,7 @@ def run(args: argparse.Namespace) -> int:
     from opspec.engine.trace_sinks import JsonlSink
     from opspec.runs import build, load, run_length
 
-    package = load_any_spec(args.spec)
+    package = load_any_spec(args.spec, command="run")
     spec = load(package)
     compiled = spec.compiled
     config = _config(args)
@@ -146,12 +149,17 @@ def run(args: argparse.Namespace) -> int:
         outcome = build(spec, seed=args.seed, user=user, until=horizon, config=config,
                         listeners=listeners, devices=devices).execute()
         result = outcome.result
+        absent = _waiting_for_absent_user(result.summary, compiled, user)
         monitors = {r.monitor: r for r in outcome.monitors}
         medians = outcome.medians
         device_report = devices.report() if devices is not None else None
     timing_summary = timing.summary() if timing is not None else None
     if args.json:
         doc = _json_document(args, package, horizon, result, device_report, medians)
+        if absent:
+            doc["deadlocks"] = [d.get("message") for d in _real_deadlocks(result, absent)]
+            doc["waiting_for_user"] = {"instances": len(absent),
+                                       "note": _absent_note(absent, args.no_user)}
         if monitors:
             doc["monitors"] = {text: {"violations": r.count, "first": [
                 {"time": v.time, "message": v.message} for v in r.violations[:MONITOR_SHOWN]]}
@@ -164,13 +172,52 @@ def run(args: argparse.Namespace) -> int:
             _print_timing(out, timing_summary, result.summary.get("pool"),
                           result.summary.get("dedicated"))
         _print_summary(out, result, medians, args.trace, device_report,
-                       shown=printer.shown if printer else 0)
+                       shown=printer.shown if printer else 0, absent=absent,
+                       no_user=args.no_user)
         _print_monitors(out, monitors)
     if sink is not None and sink.truncated is not None:      # the trace file hit its cap
         print(f"opspec: note: {sink.message()} ({sink.dropped:,} not written)",
               file=sys.stderr)
     device_faults = any(info.get("faults") for info in (device_report or {}).values())
-    return 1 if outcome.problems or device_faults else 0
+    summary = result.summary
+    problems = bool(_real_deadlocks(result, absent) or summary.get("faults")
+                    or summary.get("instances", {}).get("aborted", 0) > len(absent))
+    return 1 if problems or device_faults else 0
+
+
+def _waiting_for_absent_user(summary: dict[str, Any], compiled: Any, user: Any
+                             ) -> list[dict[str, Any]]:
+    """The deadlocks that only say nobody performed the user lane, when nobody was meant to
+    (``--no-user``, or no user model): an instance stopped at the end because every activity
+    it waits on is a user-lane activity waiting for its performer. A device waiting for a user
+    who is absent by choice is the expected end of a devices-only run, not a problem."""
+    if getattr(user, "kind", None) != "none":
+        return []
+    from opspec.engine.lanes import all_activities
+
+    user_acts = {(a.process, a.id) for a in all_activities(compiled) if a.user_lane}
+    absent = []
+    for deadlock in summary.get("deadlocks") or []:
+        waiting = deadlock.get("waiting") or []
+        if waiting and all(
+                (deadlock.get("process"), item.split(" (", 1)[0]) in user_acts
+                and " (performer for " in item for item in waiting):
+            absent.append(deadlock)
+    return absent
+
+
+def _real_deadlocks(result: RunResult, absent: list[dict[str, Any]]) -> list[dict[str, Any]]:
+    return [d for d in result.summary.get("deadlocks") or [] if d not in absent]
+
+
+def _absent_note(absent: list[dict[str, Any]], no_user: bool) -> str:
+    """One line for every user-lane instance left waiting for the absent user."""
+    processes = sorted({str(d.get("process")) for d in absent})
+    activities = sorted({item.split(" (", 1)[0] for d in absent for item in d["waiting"]})
+    why = "--no-user" if no_user else "no user model"
+    return (f"nobody performed the user lane ({why}): {len(absent)} instance(s) of "
+            f"{', '.join(processes)} were left waiting for the user at "
+            f"{', '.join(activities)}, as expected without a user (not a deadlock)")
 
 
 #: violations listed per monitor (all are counted)
@@ -453,7 +500,8 @@ def _print_timing(out: Any, timing: dict[str, dict[str, Any]], pool: dict[str, A
 
 
 def _print_summary(out: Any, result: RunResult, medians: dict[str, float], trace: str | None,
-                   devices: dict[str, Any] | None, *, shown: int) -> None:
+                   devices: dict[str, Any] | None, *, shown: int,
+                   absent: list[dict[str, Any]] | None = None, no_user: bool = False) -> None:
     summary = result.summary
     print(file=out)
     metrics = json_metrics(result.metrics, medians)
@@ -497,7 +545,9 @@ def _print_summary(out: Any, result: RunResult, medians: dict[str, float], trace
                   f"(then {fault.get('action')})", file=out)
         for waiting in info.get("pending") or []:
             print(f"  unfinished at the end: {waiting.get('message')}", file=out)
-    for problem in summary.get("deadlocks") or []:
+    if absent:
+        print(_absent_note(absent, no_user), file=out)
+    for problem in _real_deadlocks(result, absent or []):
         print(f"deadlock: {problem.get('message')}", file=out)
     for fault in summary.get("faults") or []:
         print(f"fault: {fault.get('message')}", file=out)

@@ -9,6 +9,7 @@ The syntax is documented in ``docs/sisarl-xpdl.md``.
 
 from __future__ import annotations
 
+import difflib
 from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
@@ -77,7 +78,7 @@ def collect(element: etree._Element, ctx: BuildContext, known: tuple[str, ...],
         if directive.name not in known:
             ctx.diagnostics.append(_diag(directive.location, "warning", "unknown-directive",
                                    f"unknown directive opspec:{directive.name} on {what}",
-                                   f"known on {what}: {', '.join('opspec:' + k for k in known)}"))
+                                   _unknown_hint(directive.name, known, what)))
             return
         if directive.name in found:
             ctx.diagnostics.append(_diag(directive.location, "warning", "duplicate-directive",
@@ -109,7 +110,56 @@ def collect(element: etree._Element, ctx: BuildContext, known: tuple[str, ...],
             if value is None:
                 value = (ext.text or "").strip()
             add(Directive(name[len(OPSPEC_PREFIX):], value, ext, ctx.loc(ext)))
+        else:
+            meant = _misspelt_prefix(name, known)
+            if meant is not None:
+                # ``opspc:StartTrigger`` or ``StartTrigger``: read by nobody, so the spec
+                # would silently run without it
+                ctx.diagnostics.append(_diag(
+                    ctx.loc(ext), "warning", "unknown-directive",
+                    f"ExtendedAttribute {name!r} on {what} is not an opspec directive and is "
+                    "ignored", f"did you mean opspec:{meant}? (directives are named "
+                    "opspec:NAME)"))
     return found
+
+
+_SCOPES = {"a Package": PACKAGE_DIRECTIVES, "a WorkflowProcess": PROCESS_DIRECTIVES,
+           "an Activity": ACTIVITY_DIRECTIVES}
+
+
+def _closest(name: str, known: tuple[str, ...]) -> str | None:
+    """The known directive ``name`` is most likely a misspelling of (case-insensitive)."""
+    lowered = {k.lower(): k for k in known}
+    close = difflib.get_close_matches(name.lower(), list(lowered), n=1, cutoff=0.75)
+    return lowered[close[0]] if close else None
+
+
+def _unknown_hint(name: str, known: tuple[str, ...], what: str) -> str:
+    """Did you mean the closest known directive, or is it one of another element?"""
+    listing = f"known on {what}: {', '.join('opspec:' + k for k in known)}"
+    close = _closest(name, known)
+    if close is not None:
+        return f"did you mean opspec:{close}? {listing}"
+    elsewhere = [scope for scope, names in _SCOPES.items() if name in names and scope != what]
+    if elsewhere:
+        return (f"opspec:{name} is a directive of {' or '.join(elsewhere)}, not of {what}; "
+                f"{listing}")
+    return listing
+
+
+def _misspelt_prefix(name: str, known: tuple[str, ...]) -> str | None:
+    """The directive an ExtendedAttribute without the ``opspec:`` prefix was meant to be:
+    its last part names a known directive exactly (any case) and its prefix, if any, is close
+    to ``opspec`` (``opspc:Lane``, ``OpSpec.Lane``, ``Lane``). Other tools' names (JaWE's
+    ``JaWE_GRAPH_…``) are left alone."""
+    head, _, tail = name.replace(".", ":").rpartition(":")
+    match = {k.lower(): k for k in known}.get(tail.strip().lower())
+    if match is None:
+        return None
+    prefix = OPSPEC_PREFIX.rstrip(":")
+    if head and not difflib.get_close_matches(head.lower(), [prefix], n=1, cutoff=0.6):
+        return None
+    return match
 
 
 def _diag(location: SourceLocation, severity: str, code: str, message: str, hint: str) -> Diagnostic:
@@ -156,9 +206,12 @@ def _mode_id(directive: Directive) -> str:
     return value
 
 
-def process_directives(element: etree._Element, ctx: BuildContext) -> ProcessDirectives:
-    """The :class:`ProcessDirectives` of a ``WorkflowProcess`` element."""
-    found = collect(element, ctx, PROCESS_DIRECTIVES, "a WorkflowProcess")
+def process_directives(element: etree._Element, ctx: BuildContext,
+                       found: dict[str, Directive] | None = None) -> ProcessDirectives:
+    """The :class:`ProcessDirectives` of a ``WorkflowProcess`` element (``found``: the
+    directives already collected, as the BPMN reader collects them from extensionElements)."""
+    if found is None:
+        found = collect(element, ctx, PROCESS_DIRECTIVES, "a WorkflowProcess")
     if "Deadline" in found and "Latency" in found:
         ctx.diagnostics.append(_diag(found["Latency"].location, "warning", "duplicate-directive",
                                "opspec:Latency is an alias of opspec:Deadline; Deadline counts",
@@ -185,10 +238,12 @@ def process_directives(element: etree._Element, ctx: BuildContext) -> ProcessDir
 
 
 def activity_directives(
-    element: etree._Element, ctx: BuildContext
+    element: etree._Element, ctx: BuildContext, found: dict[str, Directive] | None = None
 ) -> tuple[ActivityDirectives, CoordinationBuiltIn | None]:
-    """The :class:`ActivityDirectives` and coordination built-in of an ``Activity`` element."""
-    found = collect(element, ctx, ACTIVITY_DIRECTIVES, "an Activity")
+    """The :class:`ActivityDirectives` and coordination built-in of an ``Activity`` element
+    (``found``: the directives already collected, see :func:`process_directives`)."""
+    if found is None:
+        found = collect(element, ctx, ACTIVITY_DIRECTIVES, "an Activity")
     if not found:
         return _NO_ACTIVITY_DIRECTIVES, None
     values = _apply(found, ctx, _ACTIVITY_PARSERS)
@@ -223,12 +278,15 @@ _ACTIVITY_PARSERS: dict[str, tuple[str, Callable[[Directive], Any]]] = {
 _NO_ACTIVITY_DIRECTIVES = ActivityDirectives()
 
 
-def package_extensions(element: etree._Element, ctx: BuildContext) -> dict[str, Any]:
+def package_extensions(element: etree._Element, ctx: BuildContext,
+                       found: dict[str, Directive] | None = None) -> dict[str, Any]:
     """``metrics``, ``modes`` and ``run_length`` of a ``Package`` element, as Package
-    keyword arguments."""
+    keyword arguments (``found``: the directives already collected, see
+    :func:`process_directives`)."""
     from opspec.xpdl.sisarl_builtins import build_metrics, build_modes
 
-    found = collect(element, ctx, PACKAGE_DIRECTIVES, "a Package")
+    if found is None:
+        found = collect(element, ctx, PACKAGE_DIRECTIVES, "a Package")
     out: dict[str, Any] = _apply(found, ctx, {"RunLength": ("run_length", _run_length)})
     if "Metrics" in found:
         out["metrics"] = build_metrics(found["Metrics"], ctx)
