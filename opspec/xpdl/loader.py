@@ -19,7 +19,14 @@ from opspec.model.bulk import gc_paused
 from opspec.model.package import Package
 from opspec.xpdl.handlers import BuildContext, build_package
 from opspec.xpdl.normalize import normalize
-from opspec.xpdl.reader import DEFAULT_MAX_BYTES, XmlReadError, exact_lines, read_file, read_tree
+from opspec.xpdl.reader import (
+    DEFAULT_MAX_BYTES,
+    XmlReadError,
+    exact_lines,
+    parse_safely,
+    read_file,
+    xpdl_outcome,
+)
 from opspec.xpdl.resolve import resolve
 
 __all__ = ["LoadResult", "load_package", "load_spec", "parse_bytes"]
@@ -61,15 +68,26 @@ def _internal(path: str, error: BaseException) -> Diagnostic:
 
 
 def _build(data: bytes, path: str, max_bytes: int) -> tuple[Package | None, list[Diagnostic]]:
-    """Read, normalise and build one file; never raises (except MemoryError/KeyboardInterrupt)."""
+    """Read, normalise and build one file; never raises (except MemoryError/KeyboardInterrupt).
+
+    What the file is goes by its content, not its name: a BPMN 2.0 ``definitions`` root is
+    built by :mod:`opspec.xpdl.bpmn` into the same model, anything else is read as XPDL."""
+    from opspec.xpdl.bpmn import BPMN_VERSION, build_bpmn, is_bpmn
+
     try:
-        outcome = read_tree(data, path=path, max_bytes=max_bytes)
+        parsed = parse_safely(data, path=path, max_bytes=max_bytes)
+        bpmn = is_bpmn(parsed.root)
+        outcome = None if bpmn else xpdl_outcome(parsed, path=path)
     except XmlReadError as error:
         return None, [error.diagnostic()]
-    ctx = BuildContext(path=path, version=outcome.version, diagnostics=list(outcome.warnings))
+    version = BPMN_VERSION if outcome is None else outcome.version
+    ctx = BuildContext(path=path, version=version, diagnostics=list(parsed.warnings))
     try:
-        with exact_lines(outcome):           # lines past 65,534 (libxml2 stores 16 bits)
-            package = build_package(normalize(outcome.root), ctx)
+        with exact_lines(parsed):            # lines past 65,534 (libxml2 stores 16 bits)
+            if outcome is None:
+                package = build_bpmn(parsed.root, ctx)
+            else:
+                package = build_package(normalize(outcome.root), ctx)
     except (MemoryError, KeyboardInterrupt):
         raise
     except Exception as error:  # noqa: BLE001 - a user never sees a traceback (issue 2)

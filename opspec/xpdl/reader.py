@@ -40,6 +40,7 @@ from opspec.xpdl.namespaces import XPDL_NAMESPACES, version_of_namespace
 __all__ = [
     "DEFAULT_MAX_BYTES",
     "MAX_BYTES_VARIABLE",
+    "ParsedXml",
     "ReadOutcome",
     "XmlReadError",
     "copy_line",
@@ -48,10 +49,12 @@ __all__ = [
     "line_of",
     "not_a_file",
     "open_regular",
+    "parse_safely",
     "read_file",
     "read_limited",
     "read_tree",
     "read_xml",
+    "xpdl_outcome",
 ]
 
 #: Default size limit of one specification file (64 MiB).
@@ -103,6 +106,17 @@ class ReadOutcome:
     lines: Mapping[etree._Element, int] = field(default_factory=dict)
 
 
+@dataclass(frozen=True, slots=True)
+class ParsedXml:
+    """A file parsed safely, before anyone looked at what its root element is (XPDL
+    ``Package``, BPMN ``definitions``): the root, reading warnings and the exact lines past
+    65,534 (as in :class:`ReadOutcome`)."""
+
+    root: etree._Element
+    warnings: tuple[Diagnostic, ...] = ()
+    lines: Mapping[etree._Element, int] = field(default_factory=dict)
+
+
 # The exact lines of the tree being built (set by :func:`exact_lines`; one per context, so
 # threads and nested loads do not mix them up).
 _EXACT: ContextVar[dict[etree._Element, int] | None] = ContextVar("opspec_exact_lines",
@@ -110,7 +124,7 @@ _EXACT: ContextVar[dict[etree._Element, int] | None] = ContextVar("opspec_exact_
 
 
 @contextmanager
-def exact_lines(outcome: ReadOutcome) -> Iterator[None]:
+def exact_lines(outcome: ReadOutcome | ParsedXml) -> Iterator[None]:
     """Within this block, :func:`line_of` gives the exact line of the elements of
     ``outcome`` that lie past line 65,534 (and of elements :func:`copy_line` gave a line)."""
     token = _EXACT.set(dict(outcome.lines))
@@ -564,6 +578,13 @@ def _not_well_formed(path: str, error: etree.XMLSyntaxError) -> XmlReadError:
 
 def read_tree(data: bytes, *, path: str, max_bytes: int = DEFAULT_MAX_BYTES) -> ReadOutcome:
     """Parse ``data`` safely and check that it is an XPDL package. Raises :class:`XmlReadError`."""
+    return xpdl_outcome(parse_safely(data, path=path, max_bytes=max_bytes), path=path)
+
+
+def parse_safely(data: bytes, *, path: str, max_bytes: int = DEFAULT_MAX_BYTES) -> ParsedXml:
+    """Parse ``data`` with every protection of this module (size, DOCTYPE, no entities, no
+    network, encodings, exact lines), whatever its root element. Raises :class:`XmlReadError`.
+    The BPMN reader (:mod:`opspec.xpdl.bpmn`) reads its files through here too."""
     max_bytes = effective_max_bytes(max_bytes, path=path)
     if len(data) > max_bytes:
         raise _too_big(path, max_bytes)
@@ -572,7 +593,8 @@ def read_tree(data: bytes, *, path: str, max_bytes: int = DEFAULT_MAX_BYTES) -> 
             "empty-file",
             "the file is empty (no XML in it)",
             location=SourceLocation(path, 1),
-            hint="an XPDL file starts with a <Package> element",
+            hint="an XPDL file starts with a <Package> element, a BPMN file with "
+            "<bpmn:definitions>",
         )
     if _is_compiled_script(data):
         raise XmlReadError(
@@ -586,14 +608,23 @@ def read_tree(data: bytes, *, path: str, max_bytes: int = DEFAULT_MAX_BYTES) -> 
     tree = root.getroottree()
     if tree.docinfo.doctype or tree.docinfo.internalDTD is not None:
         raise _doctype_error(path, _doctype_line(data) or 1)
+    return ParsedXml(root, tuple(warnings), _big_lines(data, root, encoding))
+
+
+def xpdl_outcome(parsed: ParsedXml, *, path: str) -> ReadOutcome:
+    """``parsed`` as an XPDL package: its version from the root's namespace. Raises
+    :class:`XmlReadError` when the root is no XPDL ``Package``."""
+    root = parsed.root
     qname = etree.QName(root)
     line = line_of(root)
     if qname.localname != "Package":
         raise XmlReadError(
             "unknown-root",
-            f"root element is <{qname.localname}>, not an XPDL <Package>",
+            f"root element is <{qname.localname}>, not an XPDL <Package> or a BPMN 2.0 "
+            "<definitions>",
             location=SourceLocation(path, line),
-            hint="give opspec an XPDL package file (its root element is Package)",
+            hint="give opspec an XPDL package file (its root element is Package) or a BPMN "
+            "2.0 file (bpmn:definitions, namespace http://www.omg.org/spec/BPMN/20100524/MODEL)",
         )
     version = version_of_namespace(qname.namespace)
     if version is None:
@@ -604,7 +635,7 @@ def read_tree(data: bytes, *, path: str, max_bytes: int = DEFAULT_MAX_BYTES) -> 
             location=SourceLocation(path, line),
             hint=f"use one of {known}, or no namespace",
         )
-    return ReadOutcome(root, version, tuple(warnings), _big_lines(data, root, encoding))
+    return ReadOutcome(root, version, parsed.warnings, parsed.lines)
 
 
 def read_xml(

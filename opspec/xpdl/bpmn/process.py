@@ -1,0 +1,608 @@
+"""BPMN processes into :class:`~opspec.model.process.WorkflowProcess` values: flow nodes,
+sequence flows (conditions, default flows), sub-processes (activity sets), boundary events,
+loops, lanes and performers, data.
+
+Boundary events follow the engine's existing constructs:
+
+* an interrupting boundary **timer** with a ``timeDuration`` is a synchronous ``Deadline`` of
+  the activity it is attached to, a non-interrupting one an asynchronous deadline; its
+  exception path leads to the boundary event, which passes the token on at once (timers with
+  a ``timeDate`` or ``timeCycle`` stay boundary events the engine arms itself);
+* a boundary **error** event catches the activity's failures (a device fault) as an
+  ``EXCEPTION`` path named by the error's ``errorCode`` (no ``errorRef``: every failure,
+  ``DEFAULTEXCEPTION``);
+* **message, signal, conditional and escalation** boundary events are boundary events of
+  the model (interrupting or not, as ``cancelActivity`` says).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterable
+from dataclasses import dataclass, field
+
+from lxml import etree
+
+from opspec.errors import SpecError
+from opspec.model.activities import (
+    Activity,
+    ActivityBody,
+    BlockActivity,
+    Deadline,
+    Event,
+    EventPosition,
+    Execution,
+    GatewayType,
+    Join,
+    Loop,
+    LoopKind,
+    MIFlow,
+    Split,
+    Task,
+    TaskKind,
+    Trigger,
+)
+from opspec.model.data import Assignment, BasicKind, BasicType, DataField
+from opspec.model.expressions import Expression, Literal
+from opspec.model.process import ActivitySet, Condition, ConditionKind, Transition, WorkflowProcess
+from opspec.model.resources import Lane
+from opspec.xpdl.bpmn.common import (
+    BPMN,
+    Defs,
+    expression_text,
+    first,
+    kids,
+    local,
+    namespace,
+    text_of,
+)
+from opspec.xpdl.bpmn.events import definitions_of, read_timer, trigger_of
+from opspec.xpdl.bpmn.extensions import (
+    assignments,
+    data_field,
+    directives,
+    formal_parameter,
+    opspec_named,
+)
+from opspec.xpdl.bpmn.nodes import NODES, build_node
+from opspec.xpdl.handlers.common import parse_int
+from opspec.xpdl.handlers.events import parse_condition_element
+from opspec.xpdl.sisarl import (
+    ACTIVITY_DIRECTIVES,
+    PROCESS_DIRECTIVES,
+    Directive,
+    activity_directives,
+    process_directives,
+)
+
+__all__ = ["BuiltProcess", "build_process", "is_user_name"]
+
+_SUB_PROCESSES = frozenset({"subProcess", "transaction", "adHocSubProcess"})
+# Read elsewhere, or documentation only: no diagnostic.
+_QUIET = frozenset({
+    "laneSet", "documentation", "extensionElements", "dataObject", "dataObjectReference",
+    "dataStoreReference", "textAnnotation", "association", "group", "property", "incoming",
+    "outgoing", "sequenceFlow", "boundaryEvent", "ioSpecification", "ioBinding", "auditing",
+    "monitoring", "supports", "dataInputAssociation", "dataOutputAssociation",
+    "standardLoopCharacteristics", "multiInstanceLoopCharacteristics", "completionCondition",
+    "correlationSubscription", "categoryValue",
+})
+_USER_NAMES = frozenset({"user", "users", "user lane", "user_lane", "the user"})
+_ACTIVITY_STRUCTURE = ("TaskApplication", "ActualParameter", "Assignment", "Execution")
+
+
+def is_user_name(*names: str | None) -> bool:
+    """True when one of ``names`` (a lane's, a pool's, a resource's id or name) names the
+    user: ``User``, ``Users``, ``User lane``… (the names the engine's user lane goes by)."""
+    return any(n is not None and n.strip().lower() in _USER_NAMES for n in names)
+
+
+@dataclass(slots=True)
+class BuiltProcess:
+    """A process and what the package around it needs: its pool's lanes (model lanes, one
+    participant each) and whether a user/manual task fell back on the ``user`` participant."""
+
+    process: WorkflowProcess
+    lanes: tuple[Lane, ...] = ()
+
+
+@dataclass(slots=True)
+class _Boundary:
+    """What the boundary events of one level add to their hosts."""
+
+    deadlines: dict[str, list[Deadline]] = field(default_factory=dict)
+    activities: list[Activity] = field(default_factory=list)
+    transitions: list[Transition] = field(default_factory=list)
+    skipped: set[str] = field(default_factory=set)
+
+
+class _Process:
+    def __init__(self, element: etree._Element, defs: Defs) -> None:
+        self.element = element
+        self.defs = defs
+        self.ctx = defs.ctx
+        self.id = element.get("id") or ""
+        self.sets: list[ActivitySet] = []
+        self.lane_of: dict[str, str] = {}
+        self.pool = defs.pool_of.get(self.id)
+        self.lanes = tuple(lane for lane_set in kids(element, "laneSet")
+                           for lane in self._lane_set(lane_set))
+        self.lane_names: dict[str, str | None] = {}
+        for lane in self._all(self.lanes):
+            self.lane_names[lane.id] = lane.name
+
+    # -- lanes -----------------------------------------------------------------------------
+    def _lane_set(self, lane_set: etree._Element) -> tuple[Lane, ...]:
+        out: list[Lane] = []
+        for lane in kids(lane_set, "lane"):
+            lane_id = lane.get("id") or ""
+            for ref in kids(lane, "flowNodeRef"):
+                node = (ref.text or "").strip()
+                if node:
+                    self.lane_of[node] = lane_id     # nested lanes come later: innermost wins
+            nested: tuple[Lane, ...] = ()
+            for child_set in kids(lane, "childLaneSet"):
+                nested += self._lane_set(child_set)
+            out.append(Lane(id=lane_id, name=lane.get("name"), performers=(lane_id,),
+                            lanes=nested, parent_pool=self.pool[0] if self.pool else None,
+                            location=self.defs.loc(lane)))
+        return tuple(out)
+
+    @staticmethod
+    def _all(lanes: tuple[Lane, ...]) -> Iterable[Lane]:
+        stack = list(lanes)
+        while stack:
+            lane = stack.pop()
+            yield lane
+            stack.extend(lane.lanes)
+
+    # -- performers ------------------------------------------------------------------------
+    def performers(self, element: etree._Element, lane: str | None, manual: bool
+                   ) -> tuple[str, ...]:
+        """Resources the node's ``performer``/``humanPerformer``/``potentialOwner`` name; else
+        its lane; else its pool; a user or manual task not in a lane or pool named for the
+        user is performed by the user (participant ``user``)."""
+        named: list[str] = []
+        for role in ("performer", "humanPerformer", "potentialOwner", "resourceRole"):
+            for assignment in kids(element, role):
+                ref_element = first(assignment, "resourceRef")
+                ref = (text_of(ref_element) or "").strip()
+                if ":" in ref and ref not in self.defs.resources:
+                    ref = ref.split(":", 1)[1]
+                if ref and ref in self.defs.resources:
+                    named.append(ref)
+                elif ref:
+                    self.ctx.error(ref_element, "unknown-reference",
+                                   f"resourceRef {ref!r} names no bpmn:resource of this file",
+                                   f"declare <bpmn:resource id=\"{ref}\"> or fix the reference")
+                else:
+                    self.defs.info(assignment, "performer-expression",
+                                  f"the {local(assignment)} of {self.label(element)} is an "
+                                  "expression, which opspec does not evaluate; its lane or pool "
+                                  "performs it", "name a bpmn:resource with resourceRef")
+        if named:
+            return tuple(dict.fromkeys(named))
+        if manual:
+            pool_name = self.pool[1] if self.pool else None
+            if not (is_user_name(lane, self.lane_names.get(lane or ""))
+                    or (lane is None and is_user_name(self.pool[0] if self.pool else None,
+                                                      pool_name))):
+                self.defs.user_participant = True
+                return ("user",)
+        if lane:
+            return (lane,)
+        if self.pool:
+            return (self.pool[0],)
+        return ()
+
+    def label(self, element: etree._Element) -> str:
+        return f"bpmn:{local(element)} {element.get('id')!r}"
+
+    # -- levels ----------------------------------------------------------------------------
+    def level(self, container: etree._Element, inherited_lane: str | None
+              ) -> tuple[tuple[Activity, ...], tuple[Transition, ...]]:
+        """The activities and transitions of one level (the process, or a sub-process)."""
+        nodes: list[etree._Element] = []
+        flows: list[etree._Element] = []
+        boundaries: list[etree._Element] = []
+        for sub in container:
+            if not isinstance(sub.tag, str):
+                continue
+            name = local(sub)
+            if namespace(sub) != BPMN:
+                self.ctx.warning(sub, "unknown-element",
+                                 f"<{sub.prefix + ':' if sub.prefix else ''}{name}> is not a BPMN "
+                                 f"element; opspec ignores it",
+                                 "put vendor data inside bpmn:extensionElements")
+            elif name in NODES or name in _SUB_PROCESSES:
+                if name in _SUB_PROCESSES and sub.get("triggeredByEvent") == "true":
+                    self.ctx.warning(sub, "unsupported-element",
+                                     f"event sub-process {sub.get('id')!r}: opspec does not run "
+                                     "event sub-processes; it and everything in it are ignored",
+                                     "model it as a boundary event on a sub-process, or as a "
+                                     "workflow with a message or signal start event")
+                    continue
+                nodes.append(sub)
+            elif name == "sequenceFlow":
+                flows.append(sub)
+            elif name == "boundaryEvent":
+                boundaries.append(sub)
+            elif name not in _QUIET:
+                self.ctx.warning(sub, "unsupported-element",
+                                 f"bpmn:{name} is not run by opspec; it is ignored",
+                                 "docs/bpmn.md lists what opspec runs")
+        ids = {node.get("id") or "" for node in nodes}
+        boundary = self.boundaries(boundaries, ids)
+        ids |= {b.id for b in boundary.activities}
+        transitions = self.flows(flows, ids, nodes, boundary.skipped)
+        transitions.extend(boundary.transitions)
+        incoming: dict[str, int] = {}
+        outgoing: dict[str, list[str]] = {}
+        for transition in transitions:
+            incoming[transition.target] = incoming.get(transition.target, 0) + 1
+            outgoing.setdefault(transition.source, []).append(transition.id)
+        activities = [self.activity(node, inherited_lane, boundary, incoming, outgoing)
+                      for node in nodes]
+        activities.extend(boundary.activities)
+        return tuple(activities), tuple(transitions)
+
+    def flows(self, flows: list[etree._Element], ids: set[str], nodes: list[etree._Element],
+              skipped: set[str]) -> list[Transition]:
+        defaults = {node.get("default"): node for node in nodes if node.get("default")}
+        out: list[Transition] = []
+        for flow in flows:
+            flow_id = flow.get("id") or ""
+            ends = {}
+            broken = False
+            for attribute in ("sourceRef", "targetRef"):
+                ref = (flow.get(attribute) or "").strip()
+                ends[attribute] = ref
+                if ref in skipped:
+                    broken = True
+                elif ref not in ids:
+                    broken = True
+                    where = self.defs.by_id.get(ref)
+                    detail = (f"; it is a bpmn:{local(where)}{self.defs.line(where)} of another "
+                              "process or sub-process (a sequence flow stays inside one)"
+                              if where is not None else "")
+                    self.ctx.error(flow, "unknown-reference",
+                                   f"sequence flow {flow_id!r}: {attribute} {ref!r} is no flow "
+                                   f"node of {self.where(flow)}{detail}" if ref else
+                                   f"sequence flow {flow_id!r} has no {attribute}",
+                                   f"set {attribute} to the id of a flow node next to it "
+                                   "(the flow is left out)")
+            if broken:
+                continue
+            condition = self.condition(flow, flow_id in defaults)
+            out.append(Transition(id=flow_id, name=flow.get("name"), source=ends["sourceRef"],
+                                  target=ends["targetRef"], condition=condition,
+                                  assignments=assignments(flow, self.defs),
+                                  description=text_of(first(flow, "documentation")),
+                                  location=self.defs.loc(flow)))
+        for flow_id, node in defaults.items():
+            if flow_id not in {t.id for t in out} and flow_id not in skipped:
+                where = self.defs.by_id.get(flow_id or "")
+                if where is None or local(where) != "sequenceFlow":
+                    self.ctx.error(node, "unknown-reference",
+                                   f"{self.label(node)}: default {flow_id!r} is no sequence flow "
+                                   "of this process", "name one of its outgoing sequence flows")
+        return out
+
+    def where(self, element: etree._Element) -> str:
+        parent = element.getparent()
+        if parent is None or local(parent) == "process":
+            return f"process {self.id!r}"
+        return f"sub-process {parent.get('id')!r}"
+
+    def condition(self, flow: etree._Element, default: bool) -> Condition:
+        expression_element = first(flow, "conditionExpression")
+        text = expression_text(expression_element)
+        if default:
+            if text is not None:
+                self.ctx.warning(expression_element, "default-with-condition",
+                                 f"sequence flow {flow.get('id')!r} is a default flow and has a "
+                                 "condition; the condition is ignored (a default flow is taken "
+                                 "when no other holds)", "remove the condition")
+            return Condition(kind=ConditionKind.OTHERWISE)
+        if text is None:
+            return Condition()
+        parsed = parse_condition_element(expression_element, text, self.ctx,
+                                         f"condition of sequence flow {flow.get('id')!r}")
+        return Condition(kind=ConditionKind.CONDITION, text=text, expression=parsed)
+
+    # -- boundary events -------------------------------------------------------------------
+    def boundaries(self, events: list[etree._Element], hosts: set[str]) -> _Boundary:
+        out = _Boundary()
+        for event in events:
+            event_id = event.get("id") or ""
+            host = (event.get("attachedToRef") or "").strip()
+            interrupting = (event.get("cancelActivity") or "true").strip().lower() != "false"
+            if host not in hosts:
+                where = self.defs.by_id.get(host)
+                self.ctx.error(event, "unknown-reference",
+                               f"boundary event {event_id!r}: attachedToRef {host!r} is no "
+                               f"activity of {self.where(event)}"
+                               + (f" (it is a bpmn:{local(where)}{self.defs.line(where)})"
+                                  if where is not None else ""),
+                               "attach it to an activity next to it (it is left out)")
+                out.skipped.add(event_id)
+                continue
+            found = definitions_of(event, self.defs)
+            kind = local(found[0]) if found else None
+            passing = Event(position=EventPosition.INTERMEDIATE, trigger=Trigger())
+            if kind == "timerEventDefinition":
+                timer = read_timer(found[0], self.defs)
+                if timer is None or timer.kind == "duration":
+                    out.deadlines.setdefault(host, []).append(Deadline(
+                        duration_text=timer.text if timer else "",
+                        duration=timer.duration if timer else None,
+                        execution=Execution.SYNCHR if interrupting else Execution.ASYNCHR,
+                        exception_name=event_id, location=self.defs.loc(found[0])))
+                    self.exception_path(out, event, host, passing, event_id)
+                    continue
+            if kind == "errorEventDefinition":
+                from opspec.xpdl.bpmn.events import named_ref
+
+                code = named_ref(found[0], "errorRef", self.defs.errors, self.defs, "error")[1]
+                if not interrupting:
+                    self.ctx.warning(event, "non-interrupting-error",
+                                     f"boundary error event {event_id!r} is non-interrupting, "
+                                     "which BPMN does not allow; a failure ends the activity",
+                                     "remove cancelActivity=\"false\"")
+                self.exception_path(out, event, host, passing, code)
+                continue
+            if kind in ("compensateEventDefinition", "cancelEventDefinition") or kind is None:
+                what = ("it has no event definition" if kind is None
+                        else f"opspec does not run {kind.removesuffix('EventDefinition')} events")
+                self.ctx.warning(event, "unsupported-element",
+                                 f"boundary event {event_id!r}: {what}; it and its outgoing flows "
+                                 "are ignored", "docs/bpmn.md lists the boundary events opspec "
+                                 "runs")
+                out.skipped.add(event_id)
+                continue
+            trigger = trigger_of(event, self.defs, catching=True, attached_to=host,
+                                 interrupting=interrupting)[0]
+            out.activities.append(self.plain(event, Event(position=EventPosition.INTERMEDIATE,
+                                                          trigger=trigger), host))
+        return out
+
+    def exception_path(self, out: _Boundary, event: etree._Element, host: str,
+                       body: Event, exception: str | None) -> None:
+        """The boundary event as a node reached by an exception path from ``host``."""
+        event_id = event.get("id") or ""
+        kind = ConditionKind.EXCEPTION if exception else ConditionKind.DEFAULTEXCEPTION
+        out.transitions.append(Transition(
+            id=f"{event_id}.exception", source=host, target=event_id,
+            condition=Condition(kind=kind, text=exception, exception_name=exception),
+            location=self.defs.loc(event)))
+        out.activities.append(self.plain(event, body, host))
+
+    def plain(self, event: etree._Element, body: Event, host: str) -> Activity:
+        lane = self.lane_of.get(event.get("id") or "") or self.lane_of.get(host)
+        found, kept = directives(event, self.defs, ACTIVITY_DIRECTIVES, self.label(event))
+        directive_values, coordination = activity_directives(event, self.ctx, found)
+        return Activity(id=event.get("id") or "", name=event.get("name"),
+                        description=text_of(first(event, "documentation")),
+                        extended_attributes=kept, location=self.defs.loc(event), body=body,
+                        performers=self.performers(event, lane, False), lane=lane,
+                        directives=directive_values, coordination=coordination)
+
+    # -- activities ------------------------------------------------------------------------
+    def activity(self, element: etree._Element, inherited_lane: str | None, boundary: _Boundary,
+                 incoming: dict[str, int], outgoing: dict[str, list[str]]) -> Activity:
+        node_id = element.get("id") or ""
+        if not node_id:
+            self.ctx.error(element, "missing-id", f"bpmn:{local(element)} has no id",
+                           "give every flow node an id")
+        name = local(element)
+        lane = self.lane_of.get(node_id) or inherited_lane
+        if name in _SUB_PROCESSES:
+            built_body: ActivityBody = self.sub_process(element, lane)
+            gateway, extra, sends, manual = None, (), None, False
+        else:
+            built = build_node(name, element, self.defs)
+            built_body, gateway, extra = built.body, built.gateway, built.assignments
+            sends, manual = built.sends, built.manual
+        found, kept = directives(element, self.defs, ACTIVITY_DIRECTIVES, self.label(element),
+                                 _ACTIVITY_STRUCTURE)
+        self.message_directives(element, found, sends, built_body)
+        directive_values, coordination = activity_directives(element, self.ctx, found)
+        join = split = None
+        if gateway is not None:
+            join_condition = None
+            join_text = None
+            if gateway is GatewayType.COMPLEX:
+                join_text = expression_text(first(element, "activationCondition"))
+                join_condition = parse_condition_element(
+                    first(element, "activationCondition"), join_text, self.ctx,
+                    "activationCondition")
+            if incoming.get(node_id, 0) > 1:
+                join_type = GatewayType.XOR if gateway is GatewayType.EVENT else gateway
+                join = Join(type=join_type, condition=join_condition, condition_text=join_text)
+            if outgoing.get(node_id):
+                split = Split(type=gateway, transition_refs=self.order(element, outgoing[node_id]))
+        return Activity(
+            id=node_id, name=element.get("name"),
+            description=text_of(first(element, "documentation")),
+            extended_attributes=kept, location=self.defs.loc(element), body=built_body,
+            performers=self.performers(element, lane, manual), lane=lane,
+            deadlines=tuple(boundary.deadlines.get(node_id, ())),
+            loop=self.loop(element), join=join, split=split,
+            directives=directive_values, coordination=coordination,
+            assignments=assignments(element, self.defs) + extra)
+
+    @staticmethod
+    def order(element: etree._Element, flows: list[str]) -> tuple[str, ...]:
+        """The order an exclusive gateway tests its flows in: its ``outgoing`` list (what
+        modellers write, in drawing order), then any other flow in file order."""
+        listed = [(ref.text or "").strip() for ref in kids(element, "outgoing")]
+        ranked = [f for f in listed if f in flows]
+        return tuple(dict.fromkeys([*ranked, *flows]))
+
+    def message_directives(self, element: etree._Element, found: dict[str, Directive],
+                           sends: str | None, body: object) -> None:
+        """Message flows from and to an activity: it raises the message it sends when it
+        completes (``opspec:Raises``) and waits for the message it receives before it starts
+        (``opspec:StartTrigger``). Events and receive tasks carry their messages themselves."""
+        node_id = element.get("id") or ""
+        if isinstance(body, Event):
+            return
+        outgoing = [name for name, _ in self.defs.sends.get(node_id, [])]
+        names = list(dict.fromkeys([*([sends] if sends else []), *outgoing]))
+        if names and "Raises" not in found:
+            flow = self.defs.sends.get(node_id, [(names[0], element)])[0][1]
+            found["Raises"] = Directive("Raises", f"message:{names[0]}", None,
+                                        self.defs.loc(flow))
+            if len(names) > 1:
+                self.ctx.warning(element, "several-messages",
+                                 f"{self.label(element)} sends {len(names)} messages "
+                                 f"({', '.join(names)}); opspec raises only {names[0]!r}",
+                                 "send each message from its own send task or throw event")
+        incoming = [name for name, _ in self.defs.receives.get(node_id, [])]
+        if incoming and "StartTrigger" not in found:
+            flow = self.defs.receives[node_id][0][1]
+            found["StartTrigger"] = Directive("StartTrigger", f"message:{incoming[0]}", None,
+                                              self.defs.loc(flow))
+
+    def sub_process(self, element: etree._Element, lane: str | None) -> BlockActivity:
+        set_id = element.get("id") or ""
+        name = local(element)
+        if name == "transaction":
+            self.ctx.warning(element, "transaction",
+                             f"transaction {set_id!r} runs as a plain sub-process: opspec has no "
+                             "compensation or cancel", "see docs/bpmn.md")
+        activities, transitions = self.level(element, lane)
+        ad_hoc = name == "adHocSubProcess"
+        ordering = (element.get("ordering") or "Parallel").strip().lower()
+        completion_text = expression_text(first(element, "completionCondition")) if ad_hoc else None
+        self.sets.append(ActivitySet(
+            id=set_id, name=element.get("name"), activities=activities, transitions=transitions,
+            ad_hoc=ad_hoc, ad_hoc_sequential=ad_hoc and ordering == "sequential",
+            completion_condition_text=completion_text,
+            completion_condition=parse_condition_element(
+                first(element, "completionCondition"), completion_text, self.ctx,
+                "completionCondition"),
+            location=self.defs.loc(element)))
+        return BlockActivity(activity_set=set_id)
+
+    def loop(self, element: etree._Element) -> Loop | None:
+        standard = first(element, "standardLoopCharacteristics")
+        if standard is not None:
+            condition_element = first(standard, "loopCondition")
+            text = expression_text(condition_element)
+            maximum = parse_int(standard.get("loopMaximum"))
+            if text is None and maximum is None:
+                self.ctx.error(standard, "standard-loop-without-end",
+                               f"the loop of {self.label(element)} has neither a loopCondition "
+                               "nor a loopMaximum, so it never ends",
+                               "add <bpmn:loopCondition> (the activity repeats while it holds) "
+                               "or loopMaximum=\"N\"")
+            return Loop(kind=LoopKind.STANDARD, condition_text=text,
+                        condition=parse_condition_element(condition_element, text, self.ctx,
+                                                          "loopCondition"),
+                        maximum=maximum,
+                        test_before=(standard.get("testBefore") or "").lower() == "true")
+        multi = first(element, "multiInstanceLoopCharacteristics")
+        if multi is None:
+            return None
+        cardinality = first(multi, "loopCardinality")
+        text = expression_text(cardinality)
+        collection = text_of(first(multi, "loopDataInputRef"))
+        if text is None and collection is not None:
+            text = f"len({collection})"
+            self.defs.info(multi, "multi-instance-collection",
+                          f"{self.label(element)} runs one instance per item of {collection!r} "
+                          f"(loopCardinality len({collection})); opspec does not hand each "
+                          "instance its item", "read the item yourself if an instance needs it")
+        completion = first(multi, "completionCondition")
+        completion_text = expression_text(completion)
+        return Loop(kind=LoopKind.MULTI_INSTANCE, condition_text=text,
+                    condition=self.expression(cardinality if cardinality is not None else multi,
+                                              text, "loopCardinality"),
+                    parallel=(multi.get("isSequential") or "false").lower() != "true",
+                    flow=MIFlow.COMPLEX if completion_text else MIFlow.ALL,
+                    flow_condition_text=completion_text,
+                    flow_condition=parse_condition_element(completion, completion_text,
+                                                           self.ctx, "completionCondition"))
+
+    def expression(self, element: etree._Element, text: str | None, what: str
+                   ) -> Expression | None:
+        from opspec.xpdl.conditions import parse_expression
+
+        if text is None:
+            return None
+        try:
+            return parse_expression(text, location=self.defs.loc(element))
+        except (SpecError, ValueError, RecursionError) as error:
+            self.ctx.error(element, "bad-expression", f"{what} {text!r} cannot be understood: "
+                           f"{getattr(error, 'message', error)}",
+                           "write an expression over data fields, e.g. 3 or count + 1")
+            return None
+
+    # -- the process -----------------------------------------------------------------------
+    def build(self) -> BuiltProcess:
+        element = self.element
+        found, kept = directives(element, self.defs, PROCESS_DIRECTIVES,
+                                 f"process {self.id!r}", ("DataField", "FormalParameter"))
+        fields = [data_field(sub, self.defs) for sub in opspec_named(element, "DataField")]
+        for name in ("dataObject", "property"):
+            for sub in kids(element, name):
+                fields.append(DataField(id=sub.get("id") or "", name=sub.get("name"),
+                                        type=BasicType(kind=BasicKind.STRING),
+                                        location=self.defs.loc(sub)))
+        formals = tuple(formal_parameter(sub, self.defs)
+                        for sub in opspec_named(element, "FormalParameter"))
+        activities, transitions = self.level(element, None)
+        process = WorkflowProcess(
+            id=self.id, name=element.get("name"),
+            description=text_of(first(element, "documentation")),
+            extended_attributes=kept, location=self.defs.loc(element),
+            access_level="PUBLIC", data_fields=tuple(fields), formal_parameters=formals,
+            activities=activities, transitions=transitions, activity_sets=tuple(self.sets),
+            directives=process_directives(element, self.ctx, found))
+        return BuiltProcess(_with_script_fields(process, element, self.defs), self.lanes)
+
+
+def _literal_kind(expression: Expression | None) -> BasicKind:
+    if isinstance(expression, Literal):
+        value = expression.value
+        if isinstance(value, bool):
+            return BasicKind.BOOLEAN
+        if isinstance(value, int):
+            return BasicKind.INTEGER
+        if isinstance(value, float):
+            return BasicKind.FLOAT
+    return BasicKind.STRING
+
+
+def _with_script_fields(process: WorkflowProcess, element: etree._Element, defs: Defs
+                        ) -> WorkflowProcess:
+    """BPMN engines create a variable when a script first sets it: a name a script task
+    assigns that no data field or formal parameter declares becomes a data field of the
+    process, starting without a value (typed by the first value assigned to it)."""
+    declared = {f.id for f in (*process.data_fields, *process.formal_parameters)}
+    declared |= defs.package_fields
+    created: dict[str, Assignment] = {}
+    for activity in process.all_activities():
+        if not (isinstance(activity.body, Task) and activity.body.kind is TaskKind.SCRIPT):
+            continue
+        for assignment in activity.assignments:
+            root = assignment.target.split(".", 1)[0]
+            if root and root not in declared and root not in created:
+                created[root] = assignment
+    if not created:
+        return process
+    from dataclasses import replace
+
+    defs.info(element, "script-variables",
+                  f"process {process.id!r}: the variables its script tasks set "
+                  f"({', '.join(created)}) become data fields, starting without a value",
+                  "declare them with opspec:DataField to give them an initial value")
+    extra = tuple(DataField(id=name, type=BasicType(kind=_literal_kind(a.expression)),
+                            location=a.location) for name, a in created.items())
+    return replace(process, data_fields=process.data_fields + extra)
+
+
+def build_process(element: etree._Element, defs: Defs) -> BuiltProcess:
+    """The :class:`WorkflowProcess` of a ``bpmn:process`` element and its pool's lanes."""
+    return _Process(element, defs).build()
+
