@@ -203,9 +203,9 @@ class User:
         """The performer of user ``user`` in a run seeded ``seed``, and the trace listeners
         it needs (a scripted user listens to the trace to anchor its steps)."""
         if self.kind == "model":
-            from opspec.engine.random import user_stream
-
-            return self.source.performer(user_stream(seed, user)), []
+            # user u's own model (a population draws their parameters from a stream of its
+            # own), drawing from user_stream(seed, u)
+            return self.source.performer_for(seed, user), []
         if self.kind == "script":
             performer = (self.source if hasattr(self.source, "offer")
                          else self.source.performer())

@@ -39,20 +39,28 @@ FORMAT = "opspec-user-model"
 FORMAT_VERSION = 1
 
 _TOP_KEYS = ("format", "version", "name", "description", "source", "extends", "defaults",
-             "activities", "busy", "routine", "modifier", "operators")
+             "activities", "busy", "routine", "modifier", "operators",
+             "vary", "correlations", "subgroups")   # the last three: a population
+#: keys of a population (docs/user-models.md, "Populations")
+POPULATION_KEYS = ("vary", "correlations", "subgroups")
 _ACTIVITY_KEYS = ("duration", "omission", "prompt", "commission", "repetition", "delay",
                   "intended", "probabilities", "source")
 
 
 class _Ctx:
-    """The file being read, for error locations."""
+    """The file being read, for error locations; ``prefix`` is put before every key (the
+    table of a subgroup: ``subgroups.mci.``)."""
 
-    def __init__(self, path: str, operators: Mapping[str, float] | None = None) -> None:
+    def __init__(self, path: str, operators: Mapping[str, float] | None = None,
+                 prefix: str = "") -> None:
         self.path = path
         self.operators = dict(operators or {})
+        self.prefix = prefix
 
     def error(self, key: str, message: str, hint: str = "") -> UserModelError:
-        return UserModelError(message, location=SourceLocation(self.path, key=key), hint=hint)
+        return UserModelError(message, location=SourceLocation(
+            self.path, key=f"{self.prefix}{key}" if key else self.prefix.rstrip(".") or None),
+            hint=hint)
 
     def table(self, value: Any, key: str, allowed: tuple[str, ...]) -> Mapping[str, Any]:
         if not isinstance(value, Mapping):
@@ -64,8 +72,8 @@ class _Ctx:
         return value
 
     def wrap(self, key: str, error: ParameterError) -> UserModelError:
-        return UserModelError(error.detail, location=SourceLocation(
-            self.path, key=f"{key}.{error.param}" if key else error.param), hint=error.hint)
+        return self.error(f"{key}.{error.param}" if key else error.param, error.detail,
+                          error.hint)
 
 
 def _string(ctx: _Ctx, value: Any, key: str) -> str:
@@ -256,11 +264,15 @@ def _modifier(ctx: _Ctx, value: Any, name: str) -> Modifier:
 
 
 def parse_user_model(doc: Mapping[str, Any], path: str = "<toml>", *,
-                     base: UserModel | None = None) -> UserModel:
+                     base: UserModel | None = None, key_prefix: str = "") -> UserModel:
     """Build a :class:`UserModel` from a parsed TOML document. ``base`` is the model an
     ``extends`` key or a composition names; this file's activities override the base's, and
-    this file's ``[modifier]`` is then applied to the result."""
-    ctx = _Ctx(path)
+    this file's ``[modifier]`` is then applied to the result. ``[vary]``,
+    ``[[correlations]]`` and ``[subgroups]`` make it a population
+    (:mod:`opspec.usermodels.population_loader`); a file composed on top of a population
+    changes every subgroup's model, and its modifier applies to each person after the draw.
+    ``key_prefix`` is put before every key in error messages (a subgroup's table)."""
+    ctx = _Ctx(path, prefix=key_prefix)
     ctx.table(doc, "", _TOP_KEYS)
     fmt = doc.get("format", FORMAT)
     if fmt != FORMAT:
@@ -294,8 +306,21 @@ def parse_user_model(doc: Mapping[str, Any], path: str = "<toml>", *,
         modifiers=base.modifiers if base else (),
         description=str(doc.get("description", "")), source=str(doc.get("source", "")),
         path=path)
-    if "modifier" in doc:
-        model = model.with_modifier(_modifier(ctx, doc["modifier"], name))
+    modifier = _modifier(ctx, doc["modifier"], name) if "modifier" in doc else None
+    if modifier is not None:
+        model = model.with_modifier(modifier)
+    declares = any(key in doc for key in POPULATION_KEYS)
+    if declares or (base is not None and base.population is not None):
+        from dataclasses import replace
+
+        from opspec.usermodels import population_loader
+
+        if declares:
+            population = population_loader.parse_population(ctx, doc, model, base)
+        else:
+            assert base is not None and base.population is not None
+            population = population_loader.compose(ctx, doc, base.population, modifier)
+        model = replace(model, population=population)
     return model
 
 

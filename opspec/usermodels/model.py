@@ -28,6 +28,7 @@ if TYPE_CHECKING:
     import numpy as np
 
     from opspec.usermodels.performer import StochasticUser
+    from opspec.usermodels.population import Individual, Population
 
 __all__ = ["ActivityModel", "Modifier", "UserModel"]
 
@@ -124,7 +125,12 @@ class Modifier:
 class UserModel:
     """A complete user model. ``activities`` maps activity ids (manual activities and
     choices) to their models; ``default`` covers activities not listed (``None``: every
-    manual activity must be listed). ``path`` says where it was loaded from, for messages."""
+    manual activity must be listed). ``path`` says where it was loaded from, for messages.
+
+    ``population`` (a file with ``[vary]``, ``[[correlations]]`` or ``[subgroups]``) makes
+    the simulated users different people: :meth:`individual` is user ``u``'s own model. This
+    model's own activities are then the typical person's (the file without its variation).
+    """
 
     name: str
     activities: Mapping[str, ActivityModel]
@@ -135,9 +141,24 @@ class UserModel:
     description: str = ""
     source: str = ""
     path: str = "<python>"
+    population: Population | None = None
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "activities", MappingProxyType(dict(self.activities)))
+
+    @property
+    def varies(self) -> bool:
+        """Whether simulated users differ in their parameters (a population)."""
+        return self.population is not None
+
+    def individual(self, seed: int, user: int) -> Individual:
+        """User ``user`` of a run seeded ``seed``: their subgroup, drawn parameters and model
+        (this model itself, unchanged, when there is no population)."""
+        if self.population is None:
+            from opspec.usermodels.population import Individual
+
+            return Individual(None, MappingProxyType({}), self)
+        return self.population.draw(seed, user)
 
     def activity(self, activity_id: str) -> ActivityModel:
         """The model of ``activity_id`` (falling back to ``default``)."""
@@ -169,6 +190,13 @@ class UserModel:
         """
         manual = list(dict.fromkeys(manual_activity_ids))
         choice_map = {k: list(v) for k, v in (choices or {}).items()}
+        if self.population is not None:
+            # every subgroup's model must cover the lane; warnings once each
+            found: dict[str, Diagnostic] = {}
+            for group in self.population.subgroups:
+                for warning in group.model.validate_against(manual, choices=choice_map):
+                    found.setdefault(str(warning), warning)
+            return list(found.values())
         missing = [a for a in [*manual, *choice_map] if not self.covers(a)]
         if missing and not self.activities and self.default is None and self.modifiers:
             raise UserModelError(
@@ -224,11 +252,17 @@ class UserModel:
         return warnings
 
     def with_modifier(self, modifier: Modifier) -> UserModel:
-        """This model with ``modifier`` applied to every activity (and the default)."""
+        """This model with ``modifier`` applied to every activity (and the default). A
+        population's people get it after their parameters are drawn (a drawn median is then
+        slowed like any other)."""
+        population = self.population
+        if population is not None:
+            population = population.then(modifier)
         if modifier.is_identity:
-            return replace(self, modifiers=(*self.modifiers, modifier))
+            return replace(self, modifiers=(*self.modifiers, modifier), population=population)
         return replace(
             self,
+            population=population,
             activities={k: modifier.apply_to(v) for k, v in self.activities.items()},
             default=modifier.apply_to(self.default) if self.default else None,
             modifiers=(*self.modifiers, modifier),
@@ -241,3 +275,12 @@ class UserModel:
         from opspec.usermodels.performer import StochasticUser
 
         return StochasticUser(self, rng, trace_decisions=trace_decisions)
+
+    def performer_for(self, seed: int, user: int, *, trace_decisions: bool = True
+                      ) -> StochasticUser:
+        """The performer of user ``user`` in a run seeded ``seed``: their own model
+        (:meth:`individual`) drawing from ``user_stream(seed, user)``, as every run does."""
+        from opspec.engine.random import user_stream
+
+        return self.individual(seed, user).model.performer(user_stream(seed, user),
+                                                           trace_decisions=trace_decisions)
