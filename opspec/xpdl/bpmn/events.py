@@ -133,9 +133,14 @@ def named_ref(definition: etree._Element, attribute: str, table: dict[str, str],
     return True, table[ref]
 
 
-def _flow_message(event: etree._Element, defs: Defs, catching: bool) -> str | None:
+def _flow_message(event: etree._Element, defs: Defs, catching: bool
+                  ) -> tuple[str | None, bool]:
+    """The message a message flow to (or from) ``event`` carries, and whether the flow names
+    it with a ``messageRef`` (else the flow's name or id stands for it)."""
     flows = (defs.receives if catching else defs.sends).get(event.get("id") or "", [])
-    return flows[0][0] if flows else None
+    if not flows:
+        return None, False
+    return flows[0][0], bool(flows[0][1].get("messageRef"))
 
 
 def trigger_of(event: etree._Element, defs: Defs, *, catching: bool,
@@ -159,10 +164,10 @@ def trigger_of(event: etree._Element, defs: Defs, *, catching: bool,
     timer: Timer | None = None
     if kind is TriggerKind.MESSAGE:
         given, name = named_ref(definition, "messageRef", defs.messages, defs, "message")
-        flow = _flow_message(event, defs, catching)
+        flow, explicit = _flow_message(event, defs, catching)
         if not given:
             name = flow
-        elif name is not None and flow is not None and flow != name:
+        elif name is not None and explicit and flow != name:
             defs.ctx.warning(event, "message-mismatch",
                              f"event {event.get('id')!r} names message {name!r}, but its message "
                              f"flow carries {flow!r}; opspec uses {name!r}",

@@ -240,7 +240,10 @@ class _Process:
         for transition in transitions:
             incoming[transition.target] = incoming.get(transition.target, 0) + 1
             outgoing.setdefault(transition.source, []).append(transition.id)
-        activities = [self.activity(node, inherited_lane, boundary, incoming, outgoing)
+        conditional = {t.source for t in transitions
+                       if t.condition.kind is ConditionKind.CONDITION}
+        activities = [self.activity(node, inherited_lane, boundary, incoming, outgoing,
+                                    conditional)
                       for node in nodes]
         activities.extend(boundary.activities)
         return tuple(activities), tuple(transitions)
@@ -388,7 +391,8 @@ class _Process:
 
     # -- activities ------------------------------------------------------------------------
     def activity(self, element: etree._Element, inherited_lane: str | None, boundary: _Boundary,
-                 incoming: dict[str, int], outgoing: dict[str, list[str]]) -> Activity:
+                 incoming: dict[str, int], outgoing: dict[str, list[str]],
+                 conditional: set[str]) -> Activity:
         node_id = element.get("id") or ""
         if not node_id:
             self.ctx.error(element, "missing-id", f"bpmn:{local(element)} has no id",
@@ -420,6 +424,11 @@ class _Process:
                 join = Join(type=join_type, condition=join_condition, condition_text=join_text)
             if outgoing.get(node_id):
                 split = Split(type=gateway, transition_refs=self.order(element, outgoing[node_id]))
+        elif node_id in conditional:
+            # conditional sequence flows out of an activity: every one whose condition holds
+            # is taken, the default flow when none does (BPMN 2.0 §13.2.1: an inclusive split)
+            split = Split(type=GatewayType.OR,
+                          transition_refs=self.order(element, outgoing[node_id]))
         return Activity(
             id=node_id, name=element.get("name"),
             description=text_of(first(element, "documentation")),
