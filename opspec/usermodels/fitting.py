@@ -24,28 +24,33 @@ from __future__ import annotations
 
 import io
 import json
-import math
-import warnings
 from collections import Counter, defaultdict, deque
 from collections.abc import Iterable, Iterator, Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any
 
 import numpy as np
-from scipy import stats  # type: ignore[import-untyped]
 
 from opspec.engine.trace import TRACE_FORMAT, TRACE_FORMAT_VERSION, EventKind, TraceEvent
 from opspec.errors import SourceLocation, UserModelError
 from opspec.statistics import rate_interval
-from opspec.usermodels.distributions import Constant, Distribution, ExGaussian, LogNormal
+from opspec.usermodels.distributions import Constant, Distribution
 from opspec.usermodels.errors import Busy, Commission, Omission
+from opspec.usermodels.families import CRITERIA, FamilyFit, choose, fit_families
 from opspec.usermodels.model import ActivityModel, UserModel
+from opspec.usermodels.spread import (
+    DurationSpread,
+    OmissionSpread,
+    duration_spread,
+    omission_spread,
+)
 
 __all__ = [
     "ActivityFit",
     "FitResult",
     "Observations",
+    "WrongChoiceLoss",
     "collect",
     "fit_duration",
     "fit_traces",
@@ -121,6 +126,14 @@ class Observations:
     busy_omitted: Counter[str] = field(default_factory=Counter)
     picks: dict[str, list[list[str]]] = field(default_factory=lambda: defaultdict(list))
     engaged: set[str] = field(default_factory=set)
+    #: per activity, per user (file index, run index): durations and (omitted, answered)
+    user_durations: dict[str, dict[tuple[int, int], list[float]]] = field(
+        default_factory=lambda: defaultdict(lambda: defaultdict(list)))
+    user_omissions: dict[str, dict[tuple[int, int], list[int]]] = field(
+        default_factory=lambda: defaultdict(lambda: defaultdict(lambda: [0, 0])))
+    #: per choice activity, per picked alternative: the durations of that pick
+    pick_durations: dict[str, dict[str, list[float]]] = field(
+        default_factory=lambda: defaultdict(lambda: defaultdict(list)))
     events: int = 0
     runs: int = 0
     files: int = 0
@@ -135,7 +148,7 @@ class Observations:
 def collect(paths: Sequence[str | Path], lane: str = "user") -> Observations:
     """Pair offers with answers in ``paths`` for ``lane`` (see the module docstring)."""
     obs = Observations()
-    for path in paths:
+    for file_index, path in enumerate(paths):
         obs.files += 1
         run = 0
         outstanding: dict[tuple[int, Any, str], deque[tuple[float, str]]] = {}
@@ -173,10 +186,15 @@ def collect(paths: Sequence[str | Path], lane: str = "user") -> Observations:
             offered_at, _ = queue.popleft()
             in_progress[key] -= 1
             reason = str(event.data.get("reason", ""))
+            user = (file_index, run)
             if event.kind == EventKind.ACTIVITY_COMPLETED:
-                obs.durations[event.activity].append(max(0.0, event.time - offered_at))
+                took = max(0.0, event.time - offered_at)
+                obs.durations[event.activity].append(took)
+                obs.user_durations[event.activity][user].append(took)
+                obs.user_omissions[event.activity][user][1] += 1
                 choice = event.data.get("choice")
                 if isinstance(choice, str):
+                    obs.pick_durations[event.activity][choice].append(took)
                     pending_choice.pop(inst, None)
                     picks_of.setdefault(inst, {}).setdefault(event.activity, []).append(choice)
             elif event.kind == EventKind.ACTIVITY_OMITTED:
@@ -186,6 +204,9 @@ def collect(paths: Sequence[str | Path], lane: str = "user") -> Observations:
                                        if n > 0 and r == run and i != event.instance)
                 else:
                     obs.omitted[event.activity] += 1
+                    counts = obs.user_omissions[event.activity][user]
+                    counts[0] += 1
+                    counts[1] += 1
         for per_instance in picks_of.values():
             for activity, sequence in per_instance.items():
                 obs.picks[activity].append(sequence)
@@ -201,8 +222,35 @@ def collect(paths: Sequence[str | Path], lane: str = "user") -> Observations:
 
 
 @dataclass(frozen=True)
+class WrongChoiceLoss:
+    """The time a wrong pick costs, apart from the choice's own duration: the mean of the
+    wrong picks' durations minus the mean of the intended picks' (Welch 95 % interval)."""
+
+    choice: str
+    alternatives: tuple[str, ...]
+    wrong: int
+    right: int
+    seconds: float
+    ci: tuple[float, float]
+    distribution: Distribution
+
+    def comment(self) -> str:
+        lo, hi = self.ci
+        return (f"time lost to a wrong choice ({', '.join(self.alternatives)}): "
+                f"{self.seconds:.4g} s (95 % interval [{lo:.4g}, {hi:.4g}]) = mean of "
+                f"{self.wrong} wrong pick(s) - mean of {self.right} intended pick(s); written "
+                "as the wrong alternative's duration")
+
+    def to_json(self) -> dict[str, Any]:
+        return {"choice": self.choice, "alternatives": list(self.alternatives),
+                "wrong_picks": self.wrong, "intended_picks": self.right,
+                "seconds": self.seconds, "ci95": list(self.ci),
+                "distribution": self.distribution.to_params()}
+
+
+@dataclass(frozen=True)
 class ActivityFit:
-    """The outcome for one activity: the chosen distribution and why."""
+    """The outcome for one activity: the chosen distribution, every family's fit, and why."""
 
     activity: str
     n: int
@@ -211,68 +259,80 @@ class ActivityFit:
     aic: dict[str, float]
     omission: tuple[int, int, tuple[float, float]] | None = None  # omitted, answered, CI
     note: str = ""
+    families: tuple[FamilyFit, ...] = ()
+    criterion: str = "aic"
+    duration_spread: DurationSpread | None = None
+    omission_spread: OmissionSpread | None = None
+    wrong_choice: WrongChoiceLoss | None = None
+
+    def family_table(self) -> list[str]:
+        """The comparison of families as aligned text lines (chosen one marked)."""
+        if not self.families:
+            return []
+        best = {c: min(f.score(c) for f in self.families) for c in CRITERIA}
+        rows = [(f"  {'family':<10} {'parameters':<36} {'log L':>11} {'AIC':>10} {'dAIC':>7} "
+                f"{'BIC':>10} {'dBIC':>7}")]
+        for f in sorted(self.families, key=lambda f: f.score(self.criterion)):
+            mark = "  <- chosen" if f.family == self.chosen else ""
+            rows.append(f"  {f.family:<10} {f.describe():<36} {f.log_likelihood:>11.2f} "
+                        f"{f.aic:>10.2f} {f.aic - best['aic']:>7.2f} {f.bic:>10.2f} "
+                        f"{f.bic - best['bic']:>7.2f}{mark}")
+        return rows
 
     def comment(self) -> str:
         lines = [f"{self.activity}: {self.n} observed duration(s); {self.note}".rstrip("; ")]
-        if self.aic:
-            scores = ", ".join(f"{k} AIC = {v:.2f}" for k, v in sorted(self.aic.items(),
-                                                                        key=lambda kv: kv[1]))
-            lines.append(f"duration: {self.chosen} chosen by AIC ({scores})")
+        if self.families:
+            lines.append(f"duration: {self.chosen} chosen by {self.criterion.upper()} (lowest "
+                         "wins; a difference under 2 is no real preference)")
+            lines.extend(self.family_table())
         if self.omission is not None:
             k, n, (lo, hi) = self.omission
             lines.append(f"omission: {k}/{n} = {k / n:.4f}, Wilson 95 % interval "
                          f"[{lo:.4f}, {hi:.4f}]")
+        for part in (self.wrong_choice, self.duration_spread, self.omission_spread):
+            if part is not None:
+                lines.append(part.comment())
         return "\n".join(lines)
 
-
-def _exgauss_mle(x: np.ndarray) -> tuple[ExGaussian, float] | None:
-    m, s = float(x.mean()), float(x.std())
-    skew = float(stats.skew(x))
-    tau0 = s * (max(skew, 0.05) / 2) ** (1 / 3)          # method of moments, kept positive
-    sigma0 = math.sqrt(max(s * s - tau0 * tau0, (0.1 * s) ** 2))
-    mu0 = m - tau0
-    with warnings.catch_warnings(), np.errstate(all="ignore"):
-        warnings.simplefilter("ignore")
-        try:
-            k, loc, scale = stats.exponnorm.fit(x, tau0 / sigma0, loc=mu0, scale=sigma0)
-        except (ValueError, RuntimeError, FloatingPointError):
-            return None
-        ll = float(np.sum(stats.exponnorm.logpdf(x, k, loc=loc, scale=scale)))
-    if not (math.isfinite(ll) and scale > 0 and k > 0):
-        return None
-    return ExGaussian(float(loc), float(scale), float(k * scale)), ll
+    def to_json(self) -> dict[str, Any]:
+        out: dict[str, Any] = {
+            "n": self.n, "chosen": self.chosen, "criterion": self.criterion,
+            "distribution": self.distribution.to_params(), "note": self.note or None,
+            "families": [f.to_json() for f in self.families]}
+        if self.omission is not None:
+            k, n, (lo, hi) = self.omission
+            out["omission"] = {"omitted": k, "answered": n, "rate": k / n, "ci95": [lo, hi]}
+        out["wrong_choice"] = self.wrong_choice.to_json() if self.wrong_choice else None
+        out["between_users"] = {
+            "duration": self.duration_spread.to_json() if self.duration_spread else None,
+            "omission": self.omission_spread.to_json() if self.omission_spread else None}
+        return out
 
 
-def fit_duration(values: Sequence[float]) -> tuple[Distribution, str, dict[str, float], str]:
-    """Best of lognormal (MLE) and ex-Gaussian (MLE) by AIC for ``values`` (seconds).
+def fit_duration(values: Sequence[float], criterion: str = "aic"
+                 ) -> tuple[Distribution, str, dict[str, float], str]:
+    """The best family of :data:`~opspec.usermodels.families.FAMILIES` by ``criterion`` for
+    ``values`` (seconds). Returns ``(distribution, chosen_name, {name: AIC}, note)``.
+    All-equal data give a constant."""
+    dist, chosen, fits, note = _fit_duration(values, criterion)
+    return dist, chosen, {f.family: f.aic for f in fits}, note
 
-    Returns ``(distribution, chosen_name, {name: AIC}, note)``. All-equal data give a
-    constant; fewer than 3 values give a lognormal (an ex-Gaussian needs more)."""
+
+def _fit_duration(values: Sequence[float], criterion: str = "aic"
+                  ) -> tuple[Distribution, str, tuple[FamilyFit, ...], str]:
     x = np.asarray(values, dtype=float)
     if x.size == 0:
-        return Constant(0.0), "constant", {}, "no completed performance: duration 0"
+        return Constant(0.0), "constant", (), "no completed performance: duration 0"
     if x.size == 1 or float(np.ptp(x)) < 1e-9:
-        return Constant(float(x[0])), "constant", {}, "all durations equal"
-    aic: dict[str, float] = {}
-    candidates: dict[str, Distribution] = {}
-    if np.all(x > 0):
-        logs = np.log(x)
-        mu, sigma = float(logs.mean()), float(logs.std())
-        if sigma > 0:
-            ll = float(np.sum(stats.norm.logpdf(logs, mu, sigma) - logs))
-            candidates["lognormal"] = LogNormal(mu, sigma)
-            aic["lognormal"] = 2 * 2 - 2 * ll
-    if x.size >= 3:
-        fitted = _exgauss_mle(x)
-        if fitted is not None:
-            candidates["exgauss"] = fitted[0]
-            aic["exgauss"] = 2 * 3 - 2 * fitted[1]
-    if not candidates:
-        return (Constant(float(x.mean())), "constant", {},
-                "neither lognormal nor ex-Gaussian could be fitted: the mean is used")
-    chosen = min(aic, key=aic.__getitem__)
-    note = "" if np.all(x > 0) else "zero durations present: lognormal not possible"
-    return candidates[chosen], chosen, aic, note
+        return Constant(float(x[0])), "constant", (), "all durations equal"
+    fits = tuple(fit_families(x))
+    if not fits:
+        return (Constant(float(x.mean())), "constant", (),
+                "no family could be fitted: the mean is used")
+    best = choose(fits, criterion)
+    note = "" if np.all(x > 0) else ("zero durations present: only the ex-Gaussian can "
+                                     "describe them")
+    return best.distribution, best.family, fits, note
 
 
 @dataclass(frozen=True)
@@ -285,6 +345,11 @@ class FitResult:
 
     def comments(self) -> dict[str, str]:
         return {f"activities.{f.activity}": f.comment() for f in self.fits}
+
+    def to_json(self) -> dict[str, Any]:
+        return {"events": self.observations.events, "runs": self.observations.runs,
+                "files": self.observations.files,
+                "activities": {f.activity: f.to_json() for f in self.fits}}
 
 
 def _choice_model(picks: list[list[str]]) -> dict[str, Any]:
@@ -310,22 +375,65 @@ def _choice_model(picks: list[list[str]]) -> dict[str, Any]:
     return {"probabilities": (*head, (pairs[-1][0], 1.0 - sum(p for _, p in head)))}
 
 
-def fit_traces(paths: Sequence[str | Path], *, lane: str = "user",
-               name: str = "fitted") -> FitResult:
-    """Fit a :class:`UserModel` for ``lane`` from the trace files ``paths``."""
+def _wrong_choice_loss(choice: str, intended: str, by_pick: dict[str, list[float]],
+                       criterion: str) -> WrongChoiceLoss | None:
+    """Separate the time a wrong pick costs from the choice's own duration."""
+    right = np.asarray(by_pick.get(intended, []), dtype=float)
+    wrong_names = tuple(sorted(p for p in by_pick if p != intended))
+    wrong = np.asarray([v for p in wrong_names for v in by_pick[p]], dtype=float)
+    if right.size == 0 or wrong.size == 0:
+        return None
+    seconds = float(wrong.mean() - right.mean())
+    if wrong.size >= 2 and right.size >= 2 and (wrong.std() > 0 or right.std() > 0):
+        from scipy import stats  # type: ignore[import-untyped]
+
+        test = stats.ttest_ind(wrong, right, equal_var=False)
+        ci = test.confidence_interval(0.95)
+        interval = (float(ci.low), float(ci.high))
+    else:
+        interval = (seconds, seconds)
+    lost = np.maximum(wrong - right.mean(), 0.0)
+    dist, _, _, _ = _fit_duration(lost.tolist(), criterion)
+    return WrongChoiceLoss(choice, wrong_names, int(wrong.size), int(right.size), seconds,
+                           interval, dist)
+
+
+def fit_traces(paths: Sequence[str | Path], *, lane: str = "user", name: str = "fitted",
+               criterion: str = "aic", min_per_user: int = 10) -> FitResult:
+    """Fit a :class:`UserModel` for ``lane`` from the trace files ``paths``: per activity the
+    best duration family by ``criterion`` (``aic`` or ``bic``), omission rates, choices with
+    the time a wrong pick costs, and the between-user spread of users (runs) with at least
+    ``min_per_user`` observations."""
     if not paths:
         raise UserModelError("no trace files given", hint="opspec fit TRACE... -o model.toml")
+    if criterion not in CRITERIA:
+        raise UserModelError(f"unknown selection criterion {criterion!r}",
+                             hint="use --criterion aic or --criterion bic")
     obs = collect(paths, lane)
     origin = f"{len(paths)} trace file(s), {obs.events} events"
     activities: dict[str, ActivityModel] = {}
     fits = []
+    losses: dict[str, WrongChoiceLoss] = {}
     for activity in obs.activities:
         values = obs.durations.get(activity, [])
-        dist, chosen, aic, note = fit_duration(values)
+        kwargs: dict[str, Any] = {}
+        wrong_choice = None
+        if obs.picks.get(activity):
+            kwargs.update(_choice_model(obs.picks[activity]))
+            intended = kwargs.get("intended")
+            if intended is not None and activity in obs.pick_durations:
+                wrong_choice = _wrong_choice_loss(activity, intended,
+                                                  obs.pick_durations[activity], criterion)
+                if wrong_choice is not None:
+                    # the choice's own duration: the intended picks only
+                    values = obs.pick_durations[activity][intended]
+                    for alternative in wrong_choice.alternatives:
+                        losses[alternative] = wrong_choice
+        dist, chosen, families, note = _fit_duration(values, criterion)
         omitted = obs.omitted.get(activity, 0)
-        answered = omitted + len(values)
+        answered = omitted + len(obs.durations.get(activity, []))
         omission_stats = None
-        kwargs: dict[str, Any] = {"duration": dist}
+        kwargs["duration"] = dist
         if omitted:
             _, low, high = rate_interval(omitted, answered)
             lo_hi = (low, high)
@@ -333,13 +441,29 @@ def fit_traces(paths: Sequence[str | Path], *, lane: str = "user",
             kwargs["omission"] = Omission(
                 omitted / answered, source=f"fitted: {omitted}/{answered} omitted, Wilson 95 % "
                 f"interval [{lo_hi[0]:.4f}, {lo_hi[1]:.4f}]")
-        if obs.picks.get(activity):
-            kwargs.update(_choice_model(obs.picks[activity]))
-        aic_text = ", ".join(f"{k} AIC {v:.2f}" for k, v in sorted(aic.items()))
+        by = criterion.upper()
+        scores = ", ".join(f"{f.family} {by} {f.score(criterion):.2f}"
+                           for f in sorted(families, key=lambda f: f.score(criterion)))
         kwargs["source"] = (f"fitted by opspec fit from {origin}: n = {len(values)}, "
-                            f"{chosen}" + (f" by AIC ({aic_text})" if aic else ""))
+                            f"{chosen}" + (f" by {by} ({scores})" if families else ""))
         activities[activity] = ActivityModel(**kwargs)
-        fits.append(ActivityFit(activity, len(values), dist, chosen, aic, omission_stats, note))
+        spread_d = duration_spread(obs.user_durations.get(activity, {}),
+                                   min_per_user=min_per_user,
+                                   family=chosen if families else None)
+        spread_o = omission_spread({u: (c[0], c[1]) for u, c in
+                                    obs.user_omissions.get(activity, {}).items()},
+                                   min_per_user=min_per_user) if omitted else None
+        fits.append(ActivityFit(activity, len(values), dist, chosen,
+                                {f.family: f.aic for f in families}, omission_stats, note,
+                                families, criterion, spread_d, spread_o, wrong_choice))
+    for alternative, loss in losses.items():
+        if obs.durations.get(alternative):
+            continue           # performed as its own activity: its own durations stand
+        old = activities.get(alternative, ActivityModel())
+        activities[alternative] = replace(
+            old, duration=loss.distribution,
+            source=f"fitted by opspec fit: the time a wrong pick at {loss.choice} costs, "
+            f"{loss.seconds:.4g} s on average ({loss.wrong} wrong picks)")
     busy = None
     if obs.busy_omitted:
         engaged = obs.engaged or set(obs.durations) - set(obs.busy_omitted)
