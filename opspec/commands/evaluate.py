@@ -23,6 +23,8 @@ from opspec.errors import EvaluationError
 __all__ = ["register", "run"]
 
 EXPORTS = ("xes", "jsonl")
+DEFAULT_USERS = 100
+DEFAULT_SEED = 0
 
 
 def register(subparsers: Any) -> None:
@@ -34,11 +36,12 @@ def register(subparsers: Any) -> None:
         "plots. The same seed gives the same results whatever the number of workers.")
     parser.add_argument("spec", metavar="SPEC", nargs="?",
                         help="the specification (.xpdl or .wfs); optional with --resume")
-    parser.add_argument("--users", type=int, default=100, help="simulated users (default 100)")
+    parser.add_argument("--users", type=int, default=None,
+                        help=f"simulated users (default {DEFAULT_USERS})")
     parser.add_argument("--days", type=float, default=None,
                         help="simulated days per user (default: the spec's opspec:RunLength "
                         "if it declares one, else 1)")
-    parser.add_argument("--seed", type=seed, default=0, help="run seed (default 0)")
+    parser.add_argument("--seed", type=seed, default=None, help="run seed (default 0)")
     parser.add_argument("--user-model", metavar="FILE|PRESET",
                         help="user model file or preset, 'A,B' to chain (default: the spec's "
                         "companion SPEC.users.toml)")
@@ -49,6 +52,9 @@ def register(subparsers: Any) -> None:
                         help="worker processes (default: all local cores)")
     parser.add_argument("--scheduler", metavar="ADDRESS",
                         help="run on an existing Dask distributed cluster (tcp://host:8786)")
+    parser.add_argument("--scheduler-timeout", type=float, default=None, metavar="SECONDS",
+                        help="with --scheduler: how long to wait for the cluster to have a "
+                        "worker, at the start and whenever all have left (default 60)")
     parser.add_argument("--out", metavar="DIR",
                         help="output folder (default: runs/<spec>-<date-time>)")
     parser.add_argument("--resume", action="store_true",
@@ -112,7 +118,8 @@ def _new_plan(args: argparse.Namespace) -> Any:
     for label, path in specs:
         from opspec.commands._spec import load_any_spec
 
-        package = load_any_spec(path)         # a spec validate rejects stops here, path:line
+        # a spec validate rejects stops here (path:line); its warnings are printed
+        package = load_any_spec(path, command="evaluate")
         run_lengths.append(package.run_length)
         designs.append(Design(label, str(path), file_digest(path)))
     days = args.days
@@ -123,8 +130,10 @@ def _new_plan(args: argparse.Namespace) -> Any:
     if model is None:
         companion = companion_user_model(args.spec)
         model = str(companion) if companion is not None else None
-    return EvaluationPlan(designs=tuple(designs), users=args.users, days=days,
-                          seed=args.seed, user_model=model, engine=_engine(args.engine_config),
+    users = args.users if args.users is not None else DEFAULT_USERS
+    run_seed = args.seed if args.seed is not None else DEFAULT_SEED
+    return EvaluationPlan(designs=tuple(designs), users=users, days=days,
+                          seed=run_seed, user_model=model, engine=_engine(args.engine_config),
                           export=_exports(args.export))
 
 
@@ -186,21 +195,77 @@ def _store_parameters(store: Any, plan: Any, definitions: dict[str, list[dict[st
     store.put("started", datetime.now(UTC).isoformat(timespec="seconds"))
 
 
+def _same_file(given: str | None, stored: str | None) -> bool:
+    """Whether two spellings name the same file (or preset): ``specs/a.xpdl`` and
+    ``./specs/a.xpdl`` do."""
+    if given is None or stored is None:
+        return given == stored
+    if given == stored:
+        return True
+    try:
+        return Path(given).resolve() == Path(stored).resolve() and Path(given).exists()
+    except OSError:
+        return False
+
+
+def _resume_differences(args: argparse.Namespace, plan: Any) -> list[str]:
+    """Each option given with ``--resume`` that differs from the stored run, as
+    ``--users 8 (stored: 4)``: resuming with them would silently mix two runs, or ignore
+    what the user asked for. Options not given take the stored values."""
+    differs: list[str] = []
+    a = plan.design("A")
+    if args.spec is not None and not _same_file(args.spec, a.spec):
+        differs.append(f"SPEC {args.spec} (stored: {a.spec})")
+    if args.users is not None and args.users != plan.users:
+        differs.append(f"--users {args.users} (stored: {plan.users})")
+    if args.days is not None and float(args.days) != float(plan.days):
+        differs.append(f"--days {args.days:g} (stored: {plan.days:g})")
+    if args.seed is not None and args.seed != plan.seed:
+        differs.append(f"--seed {args.seed} (stored: {plan.seed})")
+    if args.user_model is not None and not _same_file(args.user_model, plan.user_model):
+        differs.append(f"--user-model {args.user_model} (stored: "
+                       f"{plan.user_model or 'none'})")
+    if args.compare is not None:
+        b = next((d for d in plan.designs if d.label == "B"), None)
+        if b is None or not _same_file(args.compare, b.spec):
+            differs.append(f"--compare {args.compare} (stored: "
+                           f"{b.spec if b is not None else 'no second design'})")
+    if args.engine_config is not None:
+        engine = _engine(args.engine_config)
+        if json.dumps(engine, sort_keys=True) != json.dumps(dict(plan.engine), sort_keys=True):
+            changed = sorted(k for k in set(engine) | set(plan.engine)
+                             if engine.get(k) != plan.engine.get(k))
+            differs.append(f"--engine-config {args.engine_config} ("
+                           + ", ".join(f"{k} {engine.get(k)!r}, stored "
+                                       f"{plan.engine.get(k)!r}" for k in changed[:4]) + ")")
+    if args.export:
+        export = _exports(args.export)
+        if export != tuple(plan.export):
+            differs.append(f"--export {','.join(export)} (stored: "
+                           f"{','.join(plan.export) or 'none'})")
+    return differs
+
+
 def _check_unchanged(store: Any, plan: Any) -> None:
     """Refuse to resume when a spec or the user-model file changed since the run started:
     the finished and the remaining users would then describe different designs."""
     from opspec.evaluation.plan import file_digest
 
-    changed = [d.spec for d in plan.designs if file_digest(d.spec) != d.sha256]
+    changed = [f"{d.spec} changed since the run started (its content's SHA-256 is now "
+               f"{file_digest(d.spec)[:12]}…, the stored run's {d.sha256[:12]}…)"
+               for d in plan.designs if file_digest(d.spec) != d.sha256]
     stored_model = store.get("user_model_sha256")
-    if stored_model is not None and _user_model_digest(plan) != stored_model:
-        changed.append(str(plan.user_model))
+    if stored_model is not None:
+        now = _user_model_digest(plan)
+        if now != stored_model:
+            changed.append(f"{plan.user_model} changed since the run started (its content's "
+                           f"SHA-256 is now {now[:12] + '…' if now else 'unreadable'}, the "
+                           f"stored run's {stored_model[:12]}…)")
     if changed:
         store.close()
         raise EvaluationError(
-            f"{store.folder}: cannot resume, {', '.join(changed)} changed since the run "
-            "started", hint="restore the files as they were, or start a new run with "
-            "another --out")
+            f"{store.folder}: cannot resume, {'; '.join(changed)}",
+            hint="restore the files as they were, or start a new run with another --out")
 
 
 def run(args: argparse.Namespace) -> int:
@@ -221,24 +286,34 @@ def run(args: argparse.Namespace) -> int:
         except OSError as error:
             raise EvaluationError(f"cannot read the report template {args.report_template}: "
                                   f"{reason(error)}") from None
+    from opspec.evaluation.runner import WORKER_TIMEOUT
+
+    timeout = args.scheduler_timeout if args.scheduler_timeout is not None else WORKER_TIMEOUT
+    if not (timeout > 0 and math.isfinite(timeout)):
+        raise EvaluationError(f"--scheduler-timeout must be a positive number of seconds, "
+                              f"not {timeout:g}")
     if args.scheduler:
         from opspec.evaluation.runner import check_scheduler
 
-        check_scheduler(args.scheduler)
+        check_scheduler(args.scheduler, timeout)
     if args.resume:
         if not args.out:
             raise EvaluationError("--resume needs --out DIR (the folder of the run to finish)")
         store = ResultStore(args.out, create=False)
         plan = EvaluationPlan.from_json(store.get("plan"))
-        if args.spec is not None:
-            differs = _new_plan(args).same_results_as(plan)
-            if differs:
-                store.close()
-                raise EvaluationError(
-                    f"{args.out} holds a run with other {', '.join(differs)}",
-                    hint="resume with the same options (or none: `opspec evaluate --resume "
-                    f"--out {args.out}`), or choose another --out")
+        differs = _resume_differences(args, plan)
+        if differs:
+            store.close()
+            raise EvaluationError(
+                f"{args.out} holds a run with other options; cannot resume it with "
+                + "; ".join(differs),
+                hint="resume with the stored options (or none: `opspec evaluate --resume "
+                f"--out {args.out}`), or start a new run with another --out")
         _check_unchanged(store, plan)
+        from opspec.commands._spec import load_any_spec
+
+        for design in plan.designs:         # the spec's warnings, as a new run shows them
+            load_any_spec(design.spec, command="evaluate")
         _check_plan(plan)
     else:
         plan = _new_plan(args)
@@ -256,7 +331,10 @@ def run(args: argparse.Namespace) -> int:
         try:
             outcome = run_evaluation(plan, store, workers=workers, scheduler=args.scheduler,
                                      progress=progress, on_trace=on_trace,
-                                     retrace=bool(args.resume and plan.export))
+                                     retrace=bool(args.resume and plan.export),
+                                     scheduler_timeout=timeout)
+        except EvaluationError as error:
+            raise _with_resume_hint(error, store, plan) from None
         except KeyboardInterrupt:
             stored = sum(len(store.finished(d.label)) for d in plan.designs)
             print(f"evaluate: stopped; {stored} of {plan.users * len(plan.designs)} "
@@ -269,6 +347,7 @@ def run(args: argparse.Namespace) -> int:
             compare_designs,
             summarise_design,
             summarise_monitors,
+            summarise_population,
         )
 
         metrics = summarise_design(store, "A", plan.days)
@@ -284,6 +363,10 @@ def run(args: argparse.Namespace) -> int:
         if compare is not None:
             summaries["B"] = {"metrics": compare["metrics"], "monitors": compare["monitors"],
                               "difference": compare["difference"]}
+        # a population user model: who the users were, every metric per subgroup
+        population = summarise_population(store, plan.days,
+                                          designs=[d.label for d in plan.designs])
+        summaries["A"]["population"] = population
         try:
             report = write_report(store, summaries,
                                   template=getattr(args, "report_template", None))
@@ -298,7 +381,7 @@ def run(args: argparse.Namespace) -> int:
                "seed": plan.seed, "user_model": plan.user_model, "workers": workers,
                "scheduler": args.scheduler,
                "out": str(store.folder), "report": str(report), "metrics": metrics,
-               "monitors": monitors,
+               "monitors": monitors, "population": population,
                "failed": [{"design": d, "user": u, "error": e} for d, u, e in failures],
                "wall_s": round(outcome.wall_s, 3)}
         if compare is not None:
@@ -308,9 +391,25 @@ def run(args: argparse.Namespace) -> int:
         from opspec.evaluation.tables import print_summary
 
         print_summary(sys.stdout, plan, metrics, compare, outcome, failures, workers,
-                      monitors=monitors)
+                      monitors=monitors, population=population)
         print(f"results: {store.path}\nreport: {report}")
     return 1 if failures else 0
+
+
+def _with_resume_hint(error: EvaluationError, store: Any, plan: Any) -> EvaluationError:
+    """``error`` (the run stopped part-way: a full disk, a cluster without workers) with
+    how much is kept and the command that finishes the run, when it does not say so yet."""
+    if "--resume" in (error.hint or ""):
+        return error
+    try:
+        stored = sum(len(store.finished(d.label)) for d in plan.designs)
+    except EvaluationError:
+        stored = None
+    kept = (f"{stored} of {plan.users * len(plan.designs)} replications are stored"
+            if stored is not None else "every replication stored so far is kept")
+    hint = (f"{error.hint}; " if error.hint else "") + (
+        f"{kept}: `opspec evaluate --resume --out {store.folder}` finishes the run")
+    return EvaluationError(error.message, hint=hint, location=error.location)
 
 
 def _finite(value: Any) -> Any:

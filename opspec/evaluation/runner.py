@@ -54,6 +54,14 @@ TraceSink = Callable[[ReplicationRecord], None]
 # Seconds to wait for a Dask scheduler to answer.
 SCHEDULER_TIMEOUT = 10
 
+#: Default seconds to wait for a Dask cluster to have a worker: at the start, and whenever every
+#: worker has left during the run (``--scheduler-timeout``). A cluster without workers accepts
+#: tasks and never runs them: without this wait the run would hang.
+WORKER_TIMEOUT = 60.0
+
+# Seconds between two looks at the cluster while no chunk finishes.
+_POLL = 1.0
+
 # Users per chunk when traces are exported (each chunk's traces cross to the parent at once).
 EXPORT_CHUNK = 4
 
@@ -81,26 +89,79 @@ def _connect(scheduler: str) -> Any:
                               "scheduler is running") from None
 
 
-def check_scheduler(scheduler: str) -> None:
-    """Connect to the Dask scheduler once and disconnect: called before anything is created,
-    so a wrong address fails without leaving an empty output folder behind."""
-    _connect(scheduler).close()
+def _no_workers(scheduler: str, timeout: float, during: str) -> EvaluationError:
+    return EvaluationError(
+        f"the Dask cluster at {scheduler} has no workers: none {during} in {timeout:g} s",
+        hint=f"start workers (`dask worker {scheduler}`), or wait longer with "
+        "--scheduler-timeout SECONDS")
+
+
+def _wait_for_workers(client: Any, scheduler: str, timeout: float) -> None:
+    """Return once the cluster has a worker; an EvaluationError after ``timeout`` seconds."""
+    try:
+        client.wait_for_workers(1, timeout=timeout)
+    except TimeoutError:
+        raise _no_workers(scheduler, timeout, "joined") from None
+    except Exception as error:  # noqa: BLE001 - a lost scheduler, said plainly
+        if "timed out" in str(error).lower() or "timeout" in type(error).__name__.lower():
+            raise _no_workers(scheduler, timeout, "joined") from None
+        raise EvaluationError(f"lost the Dask scheduler at {scheduler}: {error}") from None
+
+
+def check_scheduler(scheduler: str, timeout: float = WORKER_TIMEOUT) -> None:
+    """Connect to the Dask scheduler and wait until it has a worker (at most ``timeout``
+    seconds), then disconnect: called before anything is created, so a wrong address or a
+    cluster without workers fails without leaving an empty output folder behind."""
+    client = _connect(scheduler)
+    try:
+        _wait_for_workers(client, scheduler, timeout)
+    finally:
+        client.close()
+
+
+class _ClusterWatch:
+    """Called while no chunk finishes: raises once the cluster has had no worker for
+    ``timeout`` seconds (its workers were stopped or died; Dask would wait forever)."""
+
+    def __init__(self, client: Any, scheduler: str, timeout: float) -> None:
+        self.client, self.scheduler, self.timeout = client, scheduler, timeout
+        self._empty_since: float | None = None
+
+    def __call__(self) -> None:
+        try:
+            workers = len(self.client.nthreads())
+        except Exception as error:  # noqa: BLE001 - a lost scheduler, said plainly
+            raise EvaluationError(f"lost the Dask scheduler at {self.scheduler}: "
+                                  f"{error}") from None
+        now = time.monotonic()
+        if workers:
+            self._empty_since = None
+        elif self._empty_since is None:
+            self._empty_since = now
+        elif now - self._empty_since >= self.timeout:
+            raise _no_workers(self.scheduler, self.timeout, "came back")
+
+
+Watch = Callable[[], None]
 
 
 @contextmanager
-def _executor(workers: int, scheduler: str | None) -> Iterator[tuple[cf.Executor | None, int]]:
-    """The executor to use and how many chunks to keep in flight on it (None: in-process)."""
+def _executor(workers: int, scheduler: str | None, timeout: float = WORKER_TIMEOUT
+              ) -> Iterator[tuple[cf.Executor | None, int, Watch | None]]:
+    """The executor to use, how many chunks to keep in flight on it (None: in-process), and
+    what to call while nothing finishes."""
     if scheduler:
         client = _connect(scheduler)
         try:
+            _wait_for_workers(client, scheduler, timeout)
             threads = sum(client.nthreads().values())
             executor = client.get_executor()
-            yield executor, max(2, 2 * threads)
+            yield executor, max(2, 2 * threads), _ClusterWatch(client, scheduler, timeout)
         finally:
             client.close()
         return
     if workers <= 1:
-        yield None, 1
+        yield None, 1, None
         return
     import multiprocessing
 
@@ -110,7 +171,7 @@ def _executor(workers: int, scheduler: str | None) -> Iterator[tuple[cf.Executor
     pool = cf.ProcessPoolExecutor(max_workers=workers, mp_context=context,
                                   initializer=_exit_with_parent, initargs=(os.getpid(),))
     try:
-        yield pool, 2 * workers
+        yield pool, 2 * workers, None
     finally:
         pool.shutdown(wait=True, cancel_futures=True)
 
@@ -136,13 +197,15 @@ Keep = Callable[[list[ReplicationRecord]], None]
 
 
 def _drain(executor: cf.Executor, doc: dict[str, object], pending: Sequence[Chunk],
-           slots: int, keep: Keep) -> list[tuple[str, list[int], str]]:
+           slots: int, keep: Keep, watch: Watch | None = None
+           ) -> list[tuple[str, list[int], str]]:
     """Run ``pending`` chunks on ``executor``, at most ``slots`` in flight, storing each chunk
     as it returns. Returns the chunks lost because the process pool broke (a worker process
     died), with the reason; a chunk whose task raised becomes failed replications.
 
     Keeping only a few chunks in flight bounds the memory of results waiting to be stored
-    (traces, when exporting) whatever the number of users.
+    (traces, when exporting) whatever the number of users. ``watch`` is called about once a
+    second while no chunk finishes (and may raise: a cluster left without workers).
     """
     queue = iter(pending)
     running: dict[cf.Future[list[ReplicationRecord]], Chunk] = {}
@@ -163,7 +226,10 @@ def _drain(executor: cf.Executor, doc: dict[str, object], pending: Sequence[Chun
 
     fill()
     while running:
-        finished, _ = cf.wait(running, return_when=cf.FIRST_COMPLETED)
+        finished, _ = cf.wait(running, timeout=_POLL if watch is not None else None,
+                              return_when=cf.FIRST_COMPLETED)
+        if not finished and watch is not None:
+            watch()
         for future in finished:
             label, users = running.pop(future)
             try:
@@ -191,7 +257,8 @@ def _dead_worker(error: BaseException) -> str:
 
 def run_evaluation(plan: EvaluationPlan, store: ResultStore, *, workers: int = 1,
                    scheduler: str | None = None, progress: Progress | None = None,
-                   on_trace: TraceSink | None = None, retrace: bool = False) -> RunOutcome:
+                   on_trace: TraceSink | None = None, retrace: bool = False,
+                   scheduler_timeout: float = WORKER_TIMEOUT) -> RunOutcome:
     """Run every replication of ``plan`` not yet stored as done, storing each as it ends.
 
     ``retrace`` (resuming a run that exports traces): the users already stored are simulated
@@ -201,6 +268,10 @@ def run_evaluation(plan: EvaluationPlan, store: ResultStore, *, workers: int = 1
     A worker process that dies (killed, out of memory) breaks its process pool and every chunk
     in flight with it: those chunks run once more in a fresh pool, and what fails again is
     stored as failed replications with the reason (``--resume`` runs them again).
+
+    On a Dask cluster (``scheduler``), a cluster that has no worker for ``scheduler_timeout``
+    seconds (at the start, or once all have left) stops the run with an EvaluationError;
+    what finished is stored.
     """
     started = time.perf_counter()
     progress = progress or Progress()
@@ -223,13 +294,16 @@ def run_evaluation(plan: EvaluationPlan, store: ResultStore, *, workers: int = 1
 
     def keep(records: list[ReplicationRecord]) -> None:
         nonlocal done, failed
+        new: list[ReplicationRecord] = []
         for record in records:
             if on_trace is not None and record.trace is not None:
                 on_trace(record)
             record.trace = None
             if (record.design, record.user) in stored:
                 continue            # re-run for its trace only: the stored result stands
-            store.add(record)
+            new.append(record)
+        store.add_many(new)         # the chunk in one transaction (see store.py)
+        for record in new:
             if record.status == "done":
                 done += 1
             else:
@@ -238,7 +312,7 @@ def run_evaluation(plan: EvaluationPlan, store: ResultStore, *, workers: int = 1
 
     try:
         lost: list[tuple[str, list[int], str]] = []
-        with _executor(workers, scheduler) as (executor, slots):
+        with _executor(workers, scheduler, scheduler_timeout) as (executor, slots, watch):
             if executor is None:
                 for label, users in pending:
                     try:
@@ -247,15 +321,16 @@ def run_evaluation(plan: EvaluationPlan, store: ResultStore, *, workers: int = 1
                         records = _failed(label, users, error)
                     keep(records)
             else:
-                lost = _drain(executor, doc, pending, slots, keep)
+                lost = _drain(executor, doc, pending, slots, keep, watch)
         if lost and scheduler is None:
             # one more try in a fresh pool (Dask reschedules lost tasks by itself)
-            with _executor(workers, None) as (executor, slots):
+            with _executor(workers, None) as (executor, slots, _):
                 assert executor is not None
                 lost = _drain(executor, doc, [(label, users) for label, users, _ in lost],
                               slots, keep)
         for label, users, reason in lost:
             keep([ReplicationRecord(label, u, "failed", error=reason) for u in users])
+        store.index()               # once, now that every replication is stored
     finally:
         progress.finish()
     return RunOutcome(done, skipped, failed, time.perf_counter() - started)
