@@ -18,9 +18,10 @@ if TYPE_CHECKING:
     from opspec.model.sisarl import EventSelector, MetricDefinition
     from opspec.usermodels.distbase import Distribution
     from opspec.usermodels.model import ActivityModel, UserModel
+    from opspec.usermodels.population import Population
 
-__all__ = ["describe_metric", "describe_selector", "metric_record", "user_model_notes",
-           "user_model_rows"]
+__all__ = ["correlation_rows", "describe_metric", "describe_selector", "metric_record",
+           "population_notes", "user_model_notes", "user_model_rows", "variation_rows"]
 
 
 def _selector(selector: EventSelector | None) -> dict[str, Any] | None:
@@ -226,8 +227,63 @@ def user_model_notes(model: UserModel) -> list[str]:
                          f"{d.duration_factor_per_day:g} (not below "
                          f"{d.min_duration_factor:g})"
                          + (f"; {d.source.rstrip('.')}." if d.source else "."))
-    notes.append("Every simulated user has these same parameters and differs from the others "
-                 "only by chance (each draws from their own random streams): the spread "
-                 "between users in this report is chance variation, not differences between "
-                 "people.")
+    if model.population is not None:
+        notes.append("The table shows the typical user (the file without its variation): "
+                     "the simulated users differ from it and from each other as the "
+                     "population below says.")
+    else:
+        notes.append("Every simulated user has these same parameters and differs from the "
+                     "others only by chance (each draws from their own random streams): the "
+                     "spread between users in this report is chance variation, not "
+                     "differences between people.")
+    return notes
+
+
+# ------------------------------------------------------------------------------ population
+
+def variation_rows(population: Population) -> list[tuple[str, ...]]:
+    """What differs by person, as the file declares it: (subgroup, share, parameter, per-user
+    distribution, mean, sd, 5-95 % range, source)."""
+    rows: list[tuple[str, ...]] = []
+    for group in population.subgroups:
+        label = group.name or "all users"
+        share = f"{group.share * 100:.3g} %"
+        if not group.varied:
+            rows.append((label, share, "–", "nothing varies", "–", "–", "–",
+                         group.source or "–"))
+        for varied in group.varied:
+            d = varied.distribution
+            rows.append((label, share, varied.name, d.describe(), f"{d.mean:.4g}",
+                         f"{d.sd:.4g}", f"{d.quantile(0.05):.4g} – {d.quantile(0.95):.4g}",
+                         varied.source or "–"))
+    return rows
+
+
+def correlation_rows(population: Population) -> list[tuple[str, ...]]:
+    """The stated correlations: (subgroup, parameters, stated, the Gaussian copula's r,
+    source)."""
+    rows: list[tuple[str, ...]] = []
+    for group in population.subgroups:
+        for c in group.correlations:
+            rows.append((group.name or "all users", f"{c.first} ~ {c.second}",
+                         f"{c.kind} {c.value:g}", f"{c.r:.3f}", c.source or "–"))
+    return rows
+
+
+def population_notes(population: Population) -> list[str]:
+    """The subgroups in sentences (what each is, where it comes from)."""
+    notes = []
+    for group in population.subgroups:
+        if group.name is None:
+            continue
+        words = group.description.rstrip(".") or f"model {group.model.name}"
+        notes.append(f"Subgroup {group.name} ({group.share * 100:.3g} % of users): {words}"
+                     + (f" (source: {group.source.rstrip('.')})." if group.source else "."))
+    if population.after:
+        notes.append("Composed on top of the population, applied to each person after the "
+                     "draw: " + ", ".join(m.name for m in population.after) + ".")
+    notes.append("Each user's subgroup and parameters are drawn once, from a random stream of "
+                 "their own (the same user of the same seed is the same person in every run "
+                 "and in both designs of a comparison); parameters are correlated through a "
+                 "Gaussian copula with the stated rank correlations.")
     return notes

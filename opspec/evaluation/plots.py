@@ -39,8 +39,10 @@ __all__ = [
     "comparison_figure",
     "latency_figure",
     "over_days_figure",
+    "parameters_figure",
     "per_user_figure",
     "rates_figure",
+    "subgroups_figure",
     "time_of_day_figure",
 ]
 
@@ -363,6 +365,69 @@ def per_user_figure(series: Mapping[str, Sequence[float]], path: Path, *,
             ax.set_xlabel(f"each user's {_text(name)}"
                           + (f" ({'%' if unit == '%' else unit})" if unit else ""))
             ax.legend(loc="upper right", frameon=True)
+        return _save(fig, path)
+
+
+def _step_histograms(ax: Axes, groups: Mapping[str, Sequence[float]], scale: float) -> None:
+    """One outline histogram per group on common bins, as the share of the group's users
+    (groups of different sizes compare), each group its own colour and line style."""
+    import numpy as np
+
+    everything = np.concatenate([np.asarray(v, dtype=float) for v in groups.values()]) * scale
+    distinct = np.unique(everything)
+    step = float(np.min(np.diff(distinct))) if distinct.size > 1 else 1.0
+    if distinct.size <= 30 and (distinct[-1] - distinct[0]) / step <= 200:
+        # a few values on a lattice (k/120 of a rate): one even bin per lattice point
+        edges = np.arange(distinct[0] - step / 2, distinct[-1] + step, step)
+    else:
+        edges = np.histogram_bin_edges(everything, bins="auto")
+    for i, (name, values) in enumerate(groups.items()):
+        arr = np.asarray(values, dtype=float) * scale
+        ax.hist(arr, bins=edges, weights=np.full(arr.size, 1.0 / max(arr.size, 1)),
+                histtype="step", linewidth=1.8, color=PALETTE[i % len(PALETTE)],
+                linestyle=_LINESTYLES[i % len(_LINESTYLES)],
+                label=f"{_text(name)} ({arr.size} users)")
+    ax.set_ylabel("share of the group's users")
+
+
+def subgroups_figure(metric: str, groups: Mapping[str, Sequence[float]], path: Path, *,
+                     unit: str = "") -> Path:
+    """The distribution over users of each user's own value of ``metric`` (their missed
+    rate), one outline histogram per subgroup (and all users), as shares of each group's
+    users. ``unit`` ``"%"`` draws a proportion as a percentage."""
+    title = f"{metric}: each user's own value, by subgroup"
+    present = {name: _finite(values)[0] for name, values in groups.items()}
+    present = {name: values for name, values in present.items() if values}
+    if not present:
+        return _empty(path, _text(title))
+    scale = 100.0 if unit == "%" else 1.0
+    with _figure(9.0, 3.8) as fig:
+        ax = fig.add_subplot()
+        _step_histograms(ax, present, scale)
+        ax.set_title(_text(title), loc="left")
+        ax.set_xlabel(f"each user's {_text(metric)}"
+                      + (f" ({'%' if unit == '%' else unit})" if unit else ""))
+        _outside_legend(ax)
+        return _save(fig, path)
+
+
+def parameters_figure(parameters: Mapping[str, Mapping[str, Sequence[float]]], path: Path
+                      ) -> Path:
+    """Who the simulated users are: per drawn parameter (a panel each, its own scale), the
+    values drawn for the users of each subgroup."""
+    title = "Parameters drawn per user"
+    present = {name: {g: _finite(v)[0] for g, v in groups.items() if _finite(v)[0]}
+               for name, groups in parameters.items()}
+    present = {name: groups for name, groups in present.items() if groups}
+    if not present:
+        return _empty(path, title)
+    with _figure(9.0, 0.9 + 2.3 * len(present)) as fig:
+        fig.suptitle(f"{title}, by subgroup (share of the subgroup's users)")
+        for ax, (name, groups) in zip(_panels(fig, len(present), sharex=False),
+                                      present.items(), strict=True):
+            _step_histograms(ax, groups, 1.0)
+            ax.set_title(_text(name), loc="left", fontsize=11)
+            _outside_legend(ax)
         return _save(fig, path)
 
 

@@ -6,8 +6,8 @@ Runs in worker processes. Each user ``u`` draws from streams derived from ``(see
 depend on which worker runs which user, nor on how users are chunked: common random numbers
 across designs come from the same rule. A replication returns a small record (metrics, the
 duration observations with their times, outcome counts by day and hour, per-activity counts,
-violations of the spec's monitors)
-and its trace only when the run exports traces.
+violations of the spec's monitors, and who the user is when the user model is a population:
+their subgroup and drawn parameters) and its trace only when the run exports traces.
 """
 
 from __future__ import annotations
@@ -42,6 +42,9 @@ class ReplicationRecord:
     monitors: dict[str, tuple[int, float | None, str | None]] = field(default_factory=dict)
     wall_s: float = 0.0
     trace: list[dict[str, Any]] | None = None
+    # who the user is, when the user model is a population: (subgroup or None, the
+    # parameters drawn for them as dotted path -> value); None for a model without variation
+    person: tuple[str | None, dict[str, float]] | None = None
 
 
 class ActivityRecorder:
@@ -128,9 +131,20 @@ def run_user(context: _Context, design: str, user: int, *, seed: int, horizon: f
     from opspec.runs import build
 
     start = time.perf_counter()
+    person = None
     try:
+        who = context.user
+        model = context.model
+        if model is not None and model.population is not None:
+            # user u of a population: the person drawn for (seed, u) - the same one
+            # opspec.runs.User.make would draw - run as that person's own model
+            from opspec.runs import User
+
+            drawn = model.individual(seed, user)
+            person = (drawn.subgroup, dict(drawn.parameters))
+            who = User.model(drawn.model, who.describe)
         recorder = ActivityRecorder(context.manual)
-        outcome = build(context.spec, seed=seed, user=context.user, user_index=user,
+        outcome = build(context.spec, seed=seed, user=who, user_index=user,
                         until=horizon, config=context.config, listeners=[recorder],
                         keep_trace=keep_trace, keep_times=True).execute()
     except OpspecError as error:
@@ -142,7 +156,7 @@ def run_user(context: _Context, design: str, user: int, *, seed: int, horizon: f
                                  wall_s=time.perf_counter() - start)
     result = outcome.result
     record = ReplicationRecord(design, user, "done", metrics=result.metrics,
-                               activities=recorder.counts)
+                               activities=recorder.counts, person=person)
     for seen in outcome.monitors:
         first = seen.violations[0] if seen.violations else None
         record.monitors[seen.monitor] = (

@@ -23,29 +23,42 @@ from pathlib import Path
 from typing import Any
 
 from opspec.evaluation.describe import (
+    correlation_rows,
     describe_metric,
+    population_notes,
     user_model_notes,
     user_model_rows,
+    variation_rows,
 )
 from opspec.evaluation.plan import span
 from opspec.evaluation.store import ResultStore
 from opspec.evaluation.summary import (
     compare_designs,
     metric_definitions,
+    subgroup_users,
     summarise_design,
     summarise_monitors,
+    summarise_population,
     user_pairs,
 )
 from opspec.evaluation.tables import (
+    DISTRIBUTION_HEADERS,
     METRIC_HEADERS,
     MONITOR_HEADERS,
+    PARAMETER_HEADERS,
     PER_USER_HEADERS,
+    SUBGROUP_HEADERS,
     comparison_rows,
+    distribution_rows,
     fmt,
     is_rate,
     metric_rows,
     monitor_rows,
+    parameter_rows,
     per_user_rows,
+    subgroup_comparison_rows,
+    subgroup_metric_rows,
+    subgroup_rows,
 )
 
 __all__ = ["PLOT_SAMPLE", "Summaries", "write_report"]
@@ -122,7 +135,66 @@ def _with_selectors(store: ResultStore, design: str, spec: str | None, sha256: s
             for d in definitions]
 
 
-def _user_model_section(store: ResultStore, plan: Mapping[str, Any]) -> Any:
+def _drawn_values(store: ResultStore, design: str, names: Sequence[str]
+                  ) -> dict[str, dict[str, list[float]]]:
+    """Per drawn parameter, per subgroup (or all users), the values drawn for the users."""
+    rows = store.query(
+        "SELECT p.parameter, g.subgroup, p.value FROM person_parameter p JOIN person g ON "
+        "g.design = p.design AND g.user = p.user WHERE p.design = ? ORDER BY p.rowid",
+        (design,))
+    out: dict[str, dict[str, list[float]]] = {n: {} for n in names}
+    for name, group, value in rows:
+        out.setdefault(str(name), {}).setdefault(str(group or "all users"), []).append(
+            float(value))
+    return out
+
+
+def _population_part(store: ResultStore, model: Any, population: Mapping[str, Any] | None,
+                     figures: Path, design: str) -> tuple[list[str], list[Any], list[Path],
+                                                          list[str], list[str]]:
+    """Paragraphs, tables, figures, captions and notes on the population: what the file
+    declares, and who was drawn."""
+    from opspec.evaluation import plots
+    from opspec.evaluation.html import Table
+
+    declared = model.population
+    paragraphs = [("The simulated users are a population: each user's subgroup and some of "
+                  "their parameters are drawn once per user, as declared below; the tables "
+                  "after it show who was drawn.")]
+    tables = [Table(("subgroup", "share", "parameter", "per-user distribution", "mean", "sd",
+                     "5–95 %", "source"), tuple(variation_rows(declared)),
+                    "Parameters that differ by person, as the user-model file declares them")]
+    correlations = correlation_rows(declared)
+    if correlations:
+        tables.append(Table(("subgroup", "parameters", "stated", "copula r", "source"),
+                            tuple(correlations),
+                            "Correlations between a person's parameters (Gaussian copula)"))
+    images: list[Path] = []
+    captions: list[str] = []
+    if population:
+        if population.get("subgroups"):
+            test = population.get("shares_test")
+            tables.append(Table(SUBGROUP_HEADERS, tuple(subgroup_rows(population)),
+                                "Users drawn per subgroup: realised share with its exact 95 % "
+                                "interval, and the share asked for"
+                                + (f" (chi-square test p = {test['p_value']:.3g})"
+                                   if test else "")))
+        tables.append(Table(PARAMETER_HEADERS, tuple(parameter_rows(population)),
+                            "Parameters drawn per user (each user's value is stored with "
+                            "their replication: person_parameter in results.sqlite)"))
+        values = _drawn_values(store, design, list(population.get("parameters") or {}))
+        order = list(population.get("subgroups") or {})      # as the file declares them
+        values = {n: dict(sorted(v.items(), key=lambda kv: order.index(kv[0])
+                                 if kv[0] in order else len(order))) for n, v in values.items()}
+        images.append(plots.parameters_figure(values, figures / "population-parameters.png"))
+        captions.append("The parameters drawn for the simulated users, one panel per "
+                        "parameter, by subgroup (outline histograms, share of each "
+                        "subgroup's users)")
+    return paragraphs, tables, images, captions, population_notes(declared)
+
+
+def _user_model_section(store: ResultStore, plan: Mapping[str, Any], figures: Path,
+                        population: Mapping[str, Any] | None = None) -> Any:
     from opspec.evaluation.html import Section, Table
 
     ref = plan.get("user_model")
@@ -146,11 +218,23 @@ def _user_model_section(store: ResultStore, plan: Mapping[str, Any]) -> Any:
     if changed:
         paragraphs.append(f"Warning: {ref} has changed since the run started; the table "
                           "shows the file as it is now, not necessarily what the run used.")
+    tables = [Table(("activity", "duration", "errors", "source"),
+                    tuple(user_model_rows(model)),
+                    "User-model parameters per activity"
+                    + (" (the typical user)" if model.population is not None else ""))]
+    notes = user_model_notes(model)
+    images: list[Path] = []
+    captions: list[str] = []
+    if model.population is not None:
+        more, extra, images, captions, more_notes = _population_part(
+            store, model, population, figures, str((plan.get("designs") or [{}])[0].get(
+                "label", "A")))
+        paragraphs += more
+        tables += extra
+        notes += more_notes
     return Section("Who the simulated users are", paragraphs=tuple(paragraphs),
-                   tables=(Table(("activity", "duration", "errors", "source"),
-                                 tuple(user_model_rows(model)),
-                                 "User-model parameters per activity"),),
-                   items=tuple(user_model_notes(model)))
+                   tables=tuple(tables), images=tuple(images), captions=tuple(captions),
+                   items=tuple(notes))
 
 
 def _ci_words(summary: Mapping[str, Any], unit: str = "", *, percent: bool = False) -> str:
@@ -224,12 +308,67 @@ def _key_findings(users: int, days: float, metrics: Mapping[str, Mapping[str, An
     return lines
 
 
+def _population_findings(metrics: Mapping[str, Mapping[str, Any]],
+                         population: Mapping[str, Any] | None) -> list[str]:
+    """How users differ in sentences: per rate, how many users had any event and the
+    percentiles of their own rates; per subgroup, the rates."""
+    lines = []
+    for name, s in metrics.items():
+        own = s.get("per_user") or {}
+        if not is_rate(name, s) or not own.get("users") or own.get("share_with_any") is None:
+            continue
+        if own["share_with_any"] in (0.0, 1.0) and name.endswith("taken_rate"):
+            continue
+        low, high = own.get("share_with_any_ci95") or [None, None]
+        lines.append(
+            f"{name} per user: {own['users_with_any']:,} of {own['users']:,} users "
+            f"({fmt(own['share_with_any'], percent=True)}, exact 95 % CI "
+            f"{fmt(low, percent=True)} to {fmt(high, percent=True)}) had a rate above zero; "
+            f"half the users had at most {fmt(own['median'], percent=True)}, 90 % at most "
+            f"{fmt(own['p90'], percent=True)}, 99 % at most {fmt(own['p99'], percent=True)}.")
+    groups = (population or {}).get("subgroups") or {}
+    for group, entry in groups.items():
+        rates = [f"{n} {fmt(m['value'], percent=True)}{_ci_words(m, percent=True)}"
+                 for n, m in (entry.get("metrics") or {}).items()
+                 if is_rate(n, m) and m.get("value") is not None]
+        if rates:
+            lines.append(f"Subgroup {group} ({entry['users']:,} users, "
+                         f"{fmt(entry['share'], percent=True)}): " + "; ".join(rates) + ".")
+    return lines
+
+
 # ------------------------------------------------------------------------------ the report
+
+def _by_subgroup_section(metrics: Mapping[str, Any], population: Mapping[str, Any],
+                         design: str, first: str, prefix: str) -> Any:
+    from opspec.evaluation.html import Section, Table
+
+    key = "metrics" if design == first else f"metrics_{design}"
+    headers, rows = subgroup_metric_rows(metrics, population, key)
+    return Section(f"{prefix}By subgroup", paragraphs=(
+        ("Every metric over all users and over the users of each subgroup (in brackets the "
+         "number of users), each with its 95 % confidence interval computed as for all "
+         "users. A subgroup's interval is wider: it has fewer users."),),
+        tables=(Table(headers, tuple(rows), "Metrics per subgroup: estimate [95 % CI]"),))
+
+
+def _subgroup_rates(store: ResultStore, design: str, definition: Mapping[str, Any],
+                    groups: Sequence[str]) -> dict[str, list[float]]:
+    """Each user's own value of a ratio metric, over all users and per subgroup."""
+    out = {"all users": [y / k for _, (y, k) in user_pairs(store, design, definition)
+                         if k > 0]}
+    for group in groups:
+        members = subgroup_users(store, design, group)
+        out[group] = [y / k for _, (y, k) in user_pairs(store, design, definition, members)
+                      if k > 0]
+    return out
+
 
 def _design_sections(store: ResultStore, figures: Path, design: str, name: str, days: float,
                      users: int, metrics: Mapping[str, dict[str, Any]],
                      monitors: Mapping[str, Any], definitions: Sequence[Mapping[str, Any]],
-                     prefix: str) -> list[Any]:
+                     prefix: str, population: Mapping[str, Any] | None = None,
+                     first: str = "A") -> list[Any]:
     from opspec.evaluation import plots
     from opspec.evaluation.html import Section, Table
 
@@ -249,6 +388,8 @@ def _design_sections(store: ResultStore, figures: Path, design: str, name: str, 
         tables=(Table(METRIC_HEADERS, tuple(metric_rows(metrics)),
                       f"Declared metrics of {name}"),),
         images=tuple(images), captions=tuple(captions)))
+    if population and population.get("subgroups"):
+        sections.append(_by_subgroup_section(metrics, population, design, first, prefix))
 
     # how users differ: each user's own value
     spread = per_user_rows(metrics)
@@ -266,14 +407,41 @@ def _design_sections(store: ResultStore, figures: Path, design: str, name: str, 
             units[label] = ("%" if is_rate(d["name"], s)
                             else (s.get("unit") or "s") if s["kind"] == "duration" else "")
         image = plots.per_user_figure(series, figures / f"{design}-per-user.png", units=units)
+        groups = list((population or {}).get("subgroups") or {})
+        spread_rows = distribution_rows(metrics)
+        images = [image]
+        captions = [("Distribution over users of each user's own value (a histogram per "
+                     "metric, each on its own scale; the line is the mean over users)")]
+        key = "metrics" if design == first else f"metrics_{design}"
+        for group in groups:
+            spread_rows += distribution_rows(
+                (population or {})["subgroups"][group].get(key) or {}, group,
+                informative=True)
+        if groups:
+            for d in definitions:
+                s_ = metrics.get(d["name"])
+                if s_ is None or not is_rate(d["name"], s_) or not (
+                        s_.get("per_user") or {}).get("users"):
+                    continue
+                images.append(plots.subgroups_figure(
+                    d["name"], _subgroup_rates(store, design, d, groups),
+                    figures / f"{design}-{d['name']}-by-subgroup.png", unit="%"))
+                captions.append(f"Each user's own {d['name']}, over the users of each "
+                                "subgroup (outline histograms, share of the group's users)")
         sections.append(Section(f"{prefix}How users differ", paragraphs=(
             ("Each user's own rate or mean duration, over users: the spread shows how much "
-            "one user's experience can differ from the average."),),
+            "one user's experience can differ from the average. 'Users with any' counts the "
+            "users with at least one event (a count) or a rate above zero, with its exact "
+            "(Clopper-Pearson) interval; p50, p90 and p99 are percentiles of the users' own "
+            "values; the between-user sd of a proportion is the sd of the users' true rates "
+            "once each user's binomial noise is taken out (about 0 when users differ only by "
+            "chance)."),),
             tables=(Table(PER_USER_HEADERS, tuple(spread),
-                          "Each user's own mean duration or ratio, over users"),),
-            images=(image,), captions=(
-                ("Distribution over users of each user's own value (a histogram per metric, "
-                "each on its own scale; the line is the mean over users)"),)))
+                          "Each user's own mean duration or ratio, over users"),
+                    Table(DISTRIBUTION_HEADERS, tuple(spread_rows),
+                          "Per-user distributions" + (", overall and by subgroup"
+                                                      if groups else ""))),
+            images=tuple(images), captions=tuple(captions)))
 
     # durations
     images, captions = [], []
@@ -383,10 +551,15 @@ def write_report(store: ResultStore, summaries: Mapping[str, Summaries] | None =
         definitions = _with_selectors(store, design, specs.get(design), digests.get(design))
         per_design[design] = (metrics, monitors, definitions)
 
+    given_a = summaries.get(designs[0]) or {}
+    population = (given_a["population"] if "population" in given_a
+                  else summarise_population(store, days, designs=designs))
+
     sections: list[Any] = []
     metrics_a, monitors_a, definitions_a = per_design[designs[0]]
     findings = _key_findings(done.get(designs[0], 0), days, metrics_a, definitions_a,
                              monitors_a, names[designs[0]])
+    findings += _population_findings(metrics_a, population)
     difference: dict[str, Any] | None = None
     if "B" in designs:
         difference = (summaries.get("B") or {}).get("difference")
@@ -433,14 +606,14 @@ def write_report(store: ResultStore, summaries: Mapping[str, Summaries] | None =
             ("metric", "kind", "definition"),
             tuple((d["name"], str(d["kind"]), describe_metric(d)) for d in definitions),
             "Metrics the spec declares (opspec:Metrics), computed from each user's trace"),)))
-    sections.append(_user_model_section(store, plan))
+    sections.append(_user_model_section(store, plan, figures, population))
 
     for design in designs:
         metrics, monitors, definitions = per_design[design]
         prefix = f"{names[design]}: " if len(designs) > 1 else ""
         sections += _design_sections(store, figures, design, names[design], days,
                                      done.get(design, 0), metrics, monitors, definitions,
-                                     prefix)
+                                     prefix, population, designs[0])
 
     if difference is not None:
         rows = [(n, d["difference"], *(d["ci95"] or [d["difference"], d["difference"]]))
@@ -457,6 +630,15 @@ def write_report(store: ResultStore, summaries: Mapping[str, Summaries] | None =
             images=compared,
             captions=("Paired differences with 95 % CIs, each on its own scale",)
             if compared else ()))
+        if population and population.get("subgroups"):
+            headers, rows = subgroup_comparison_rows(population)
+            sections.append(Section(f"{names['B']} compared with {names['A']}, by subgroup",
+                                    paragraphs=(
+                ("The same paired differences within each subgroup: a design change can "
+                 "help one kind of user and not another. * marks intervals that exclude "
+                 "zero."),), tables=(Table(headers, tuple(rows),
+                                           "Paired differences B − A per subgroup "
+                                           "[95 % CI]"),)))
 
     if failures:
         sections.append(Section("Failed replications", paragraphs=(

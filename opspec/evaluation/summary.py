@@ -1,12 +1,22 @@
 """Per-metric summaries of a stored evaluation (the ``metrics`` of ``opspec evaluate --json``).
 
 - count: ``total`` over all users, and per user ``mean``, ``sd``, ``ci95``, ``median``,
-  ``p95`` of the users' totals (and ``per_day``, the mean per user-day);
+  ``p95``, ``p90``, ``p99`` of the users' totals (and ``per_day``, the mean per user-day),
+  ``users_with_any`` (users with at least one) with ``share_with_any`` and its exact
+  (Clopper-Pearson) ``share_with_any_ci95``;
 - duration: pooled ``n``, ``mean`` (with ``ci95``), ``sd``, ``median``, ``p95`` of all
-  observations, and ``per_user``: ``users``, ``mean``, ``sd``, ``ci95``, ``median``, ``p95``
-  of the users' own means (users without observations left out);
+  observations, and ``per_user``: ``users``, ``mean``, ``sd``, ``ci95``, ``median``, ``p90``,
+  ``p95``, ``p99`` of the users' own means (users without observations left out);
 - ratio: ``value`` = Σ numerator / Σ denominator over users with ``ci95``, and ``per_user``
-  (the same fields, over the users' own ratios).
+  (the same fields over the users' own ratios, plus ``users_with_any``, ``share_with_any``
+  and its exact interval: users whose numerator is not 0; and, for a proportion,
+  ``between_user_sd``: the sd of the users' true rates with the binomial noise of each
+  user's own rate taken out, about 0 when users differ only by chance).
+``summarise_design(..., subgroup=NAME)`` summarises the users of one subgroup of a population
+(the ``person`` table of the store). :func:`summarise_population` says who the users were:
+per subgroup the users (realised share with its exact interval, the share the model asks for,
+and a chi-square test of the shares), the drawn parameters, every metric, and with two
+designs the paired differences.
 Monitors the spec declares (``opspec:Monitor``) are summarised by :func:`summarise_monitors`.
 Intervals are described in :mod:`opspec.statistics`. Quantiles of pooled
 observations are computed in the database, so memory does not grow with the number of users.
@@ -22,8 +32,11 @@ from typing import Any
 from opspec.evaluation.store import ResultStore
 from opspec.statistics import paired_difference, poisson_interval, rate_interval, ratio_estimate
 
-__all__ = ["compare_designs", "metric_definitions", "summarise_design", "summarise_monitors",
-           "user_pairs"]
+__all__ = ["compare_designs", "has_population", "metric_definitions", "subgroup_users",
+           "summarise_design", "summarise_monitors", "summarise_population", "user_pairs"]
+
+#: Percentiles of per-user values reported beside the median (p50).
+PERCENTILES = (("p90", 0.90), ("p95", 0.95), ("p99", 0.99))
 
 
 def metric_definitions(store: ResultStore, design: str = "A") -> list[dict[str, Any]]:
@@ -60,12 +73,41 @@ def _scalar_pair(metric: Mapping[str, Any] | None) -> tuple[float, float]:
     return (float(value), 1.0) if value is not None else (0.0, 0.0)
 
 
-def user_pairs(store: ResultStore, design: str, definition: Mapping[str, Any]
-               ) -> list[tuple[int, tuple[float, float]]]:
-    """Per finished user of ``design``: the (y, n) pair of ``definition``'s metric."""
+def has_population(store: ResultStore) -> bool:
+    """Whether the store holds who each user is (a run with a population user model)."""
+    try:
+        rows = store.query("SELECT 1 FROM person LIMIT 1")
+    except Exception:  # noqa: BLE001 - a store written before populations existed
+        return False
+    return bool(rows)
+
+
+def subgroup_users(store: ResultStore, design: str, subgroup: str | None
+                   ) -> set[int] | None:
+    """The users of ``subgroup`` in ``design`` (None: every user, no filter)."""
+    if subgroup is None:
+        return None
+    return {int(u) for (u,) in store.query(
+        "SELECT user FROM person WHERE design = ? AND subgroup = ?", (design, subgroup))}
+
+
+def _in_subgroup(design: str, subgroup: str | None) -> tuple[str, tuple[Any, ...]]:
+    """An SQL condition on ``user`` (and its parameters) for one subgroup's users."""
+    if subgroup is None:
+        return "", ()
+    return (" AND user IN (SELECT user FROM person WHERE design = ? AND subgroup = ?)",
+            (design, subgroup))
+
+
+def user_pairs(store: ResultStore, design: str, definition: Mapping[str, Any],
+               users: set[int] | None = None) -> list[tuple[int, tuple[float, float]]]:
+    """Per finished user of ``design`` (of ``users`` only, when given): the (y, n) pair of
+    ``definition``'s metric."""
     name = definition["name"]
     out = []
     for user, metrics in store.user_metrics(design):
+        if users is not None and user not in users:
+            continue
         if definition["kind"] == "ratio":
             num, _ = _scalar_pair(metrics.get(definition.get("numerator") or ""))
             den, _ = _scalar_pair(metrics.get(definition.get("denominator") or ""))
@@ -75,14 +117,15 @@ def user_pairs(store: ResultStore, design: str, definition: Mapping[str, Any]
     return out
 
 
-def _pooled_quantile(store: ResultStore, design: str, metric: str, n: int, q: float
-                     ) -> float | None:
+def _pooled_quantile(store: ResultStore, design: str, metric: str, n: int, q: float,
+                     subgroup: str | None = None) -> float | None:
     if n == 0:
         return None
     pos = (n - 1) * q
     lo = math.floor(pos)
-    rows = store.query("SELECT value FROM sample WHERE design = ? AND metric = ? "
-                       "ORDER BY value LIMIT 2 OFFSET ?", (design, metric, lo))
+    where, params = _in_subgroup(design, subgroup)
+    rows = store.query(f"SELECT value FROM sample WHERE design = ? AND metric = ?{where} "
+                       "ORDER BY value LIMIT 2 OFFSET ?", (design, metric, *params, lo))
     values = [float(r[0]) for r in rows]
     if len(values) == 1 or pos == lo:
         return values[0]
@@ -100,7 +143,35 @@ def _per_user(values: Sequence[float], level: float) -> dict[str, Any]:
     estimate = ratio_estimate([(v, 1.0) for v in ordered], level)
     return {"users": len(ordered), "mean": estimate.value, "sd": _sd(ordered),
             "ci95": estimate.ci, "median": _percentile(ordered, 0.5),
-            "p95": _percentile(ordered, 0.95)}
+            **{name: _percentile(ordered, q) for name, q in PERCENTILES}}
+
+
+def _with_any(values: Sequence[float], level: float) -> dict[str, Any]:
+    """Users whose value is not 0, their share and its exact (Clopper-Pearson) interval:
+    the users who had at least one missed dose, say."""
+    users = len(values)
+    hit = sum(1 for v in values if v != 0)
+    if users == 0:
+        return {"users_with_any": 0, "share_with_any": None, "share_with_any_ci95": None}
+    _, low, high = rate_interval(hit, users, level, method="clopper-pearson")
+    return {"users_with_any": hit, "share_with_any": hit / users,
+            "share_with_any_ci95": [low, high]}
+
+
+def _between_user_sd(pairs: Sequence[tuple[float, float]]) -> float | None:
+    """For a proportion: the sd of the users' true rates, by the method of moments — the
+    variance of the users' own rates less the mean binomial variance of a rate measured on
+    ``n`` trials (estimated without bias by ``p(1-p)/(n-1)``). About 0 when every user has
+    the same rate and they differ only by chance; users with fewer than 2 trials are left
+    out."""
+    if any(y > n or y < 0 or y != int(y) or n != int(n) for y, n in pairs):
+        return None
+    rates = [(y / n, n) for y, n in pairs if n >= 2]
+    if len(rates) < 2:
+        return None
+    observed = pystats.variance([p for p, _ in rates])
+    noise = math.fsum(p * (1 - p) / (n - 1) for p, n in rates) / len(rates)
+    return math.sqrt(max(observed - noise, 0.0))
 
 
 #: Fewer events than this (or, for a proportion, fewer non-events) and the normal
@@ -133,13 +204,16 @@ def _rare_proportion_ci(ci: list[float | None], pairs: Sequence[tuple[float, flo
             wilson.hi if ci[1] is None else max(ci[1], wilson.hi)]
 
 
-def summarise_design(store: ResultStore, design: str, days: float, level: float = 0.95
-                     ) -> dict[str, dict[str, Any]]:
-    """Every declared metric of ``design`` summarised (see the module docstring)."""
+def summarise_design(store: ResultStore, design: str, days: float, level: float = 0.95, *,
+                     subgroup: str | None = None) -> dict[str, dict[str, Any]]:
+    """Every declared metric of ``design`` summarised (see the module docstring), over the
+    users of ``subgroup`` only when it is given."""
     out: dict[str, dict[str, Any]] = {}
+    users_of = subgroup_users(store, design, subgroup)
+    where, where_params = _in_subgroup(design, subgroup)
     for definition in metric_definitions(store, design):
         name, kind = definition["name"], definition["kind"]
-        pairs = [p for _, p in user_pairs(store, design, definition)]
+        pairs = [p for _, p in user_pairs(store, design, definition, users_of)]
         estimate = ratio_estimate(pairs, level)
         users = len(pairs)
         if kind == "count":
@@ -150,12 +224,14 @@ def summarise_design(store: ResultStore, design: str, days: float, level: float 
                 "ci95": _rare_count_ci(estimate.ci, int(sum(totals)), users, level),
                 "median": _percentile(totals, 0.5), "p95": _percentile(totals, 0.95),
                 "per_day": (estimate.value / days) if estimate.value is not None else None,
+                "p90": _percentile(totals, 0.90), "p99": _percentile(totals, 0.99),
+                **_with_any(totals, level),
             }
         elif kind == "duration":
             n = int(sum(n for _, n in pairs))
             means = [y / k for y, k in pairs if k > 0]
             sq = store.query("SELECT SUM(value * value) FROM sample WHERE design = ? AND "
-                             "metric = ?", (design, name))
+                             f"metric = ?{where}", (design, name, *where_params))
             sd = None
             if n > 1 and estimate.value is not None and sq and sq[0][0] is not None:
                 var = (float(sq[0][0]) - n * estimate.value ** 2) / (n - 1)
@@ -163,8 +239,8 @@ def summarise_design(store: ResultStore, design: str, days: float, level: float 
             out[name] = {
                 "kind": "duration", "unit": definition.get("unit") or "s", "n": n,
                 "mean": estimate.value, "ci95": estimate.ci, "sd": sd,
-                "median": _pooled_quantile(store, design, name, n, 0.5),
-                "p95": _pooled_quantile(store, design, name, n, 0.95),
+                "median": _pooled_quantile(store, design, name, n, 0.5, subgroup),
+                "p95": _pooled_quantile(store, design, name, n, 0.95, subgroup),
                 "per_user": _per_user(means, level),
             }
         else:
@@ -174,24 +250,28 @@ def summarise_design(store: ResultStore, design: str, days: float, level: float 
                 "ci95": _rare_proportion_ci(estimate.ci, pairs, level),
                 "numerator": definition.get("numerator"),
                 "denominator": definition.get("denominator"),
-                "per_user": _per_user(ratios, level),
+                "per_user": {**_per_user(ratios, level),
+                             **_with_any([y for y, k in pairs if k > 0], level),
+                             "between_user_sd": _between_user_sd(pairs)},
             }
     return out
 
 
-def compare_designs(store: ResultStore, a: str = "A", b: str = "B", level: float = 0.95
-                    ) -> dict[str, dict[str, Any]]:
+def compare_designs(store: ResultStore, a: str = "A", b: str = "B", level: float = 0.95, *,
+                    subgroup: str | None = None) -> dict[str, dict[str, Any]]:
     """Per metric both designs declare alike (same name, kind, numerator and denominator):
-    B − A on the users both designs finished, paired by user."""
+    B − A on the users both designs finished, paired by user (the users of ``subgroup``
+    only, when it is given)."""
     out: dict[str, dict[str, Any]] = {}
+    only = subgroup_users(store, a, subgroup)
     theirs = {d["name"]: d for d in metric_definitions(store, b)}
     for definition in metric_definitions(store, a):
         other = theirs.get(definition["name"])
         if other is None or any(other.get(k) != definition.get(k)
                                 for k in ("kind", "numerator", "denominator")):
             continue
-        pairs_a = dict(user_pairs(store, a, definition))
-        pairs_b = dict(user_pairs(store, b, definition))
+        pairs_a = dict(user_pairs(store, a, definition, only))
+        pairs_b = dict(user_pairs(store, b, definition, only))
         users = sorted(set(pairs_a) & set(pairs_b))
         diff = paired_difference([pairs_a[u] for u in users], [pairs_b[u] for u in users],
                                  level)
@@ -253,4 +333,108 @@ def summarise_monitors(store: ResultStore, design: str, days: float, level: floa
             "first": None if first is None else {"user": first[0], "time": first[1],
                                                  "message": first[2]},
         }
+    return out
+
+
+# ------------------------------------------------------------------------------ population
+
+def _people(store: ResultStore, design: str
+            ) -> tuple[dict[int, str | None], dict[int, dict[str, float]], list[str]]:
+    """Finished users of ``design``: their subgroup, their drawn parameters, and the
+    parameter names in the order they were drawn."""
+    groups = {int(u): g for u, g in store.query(
+        "SELECT p.user, p.subgroup FROM person p JOIN replication r ON r.design = p.design "
+        "AND r.user = p.user WHERE p.design = ? AND r.status = 'done' ORDER BY p.user",
+        (design,))}
+    values: dict[int, dict[str, float]] = {}
+    names: dict[str, None] = {}
+    for user, name, value in store.query(
+            "SELECT user, parameter, value FROM person_parameter WHERE design = ? "
+            "ORDER BY rowid", (design,)):
+        if int(user) in groups:
+            values.setdefault(int(user), {})[str(name)] = float(value)
+            names.setdefault(str(name))
+    return groups, values, list(names)
+
+
+def _parameter_stats(values: Sequence[float]) -> dict[str, Any]:
+    ordered = sorted(values)
+    return {"users": len(ordered), "mean": pystats.fmean(ordered) if ordered else None,
+            "sd": _sd(ordered), "min": ordered[0] if ordered else None,
+            "p5": _percentile(ordered, 0.05), "median": _percentile(ordered, 0.5),
+            "p95": _percentile(ordered, 0.95), "max": ordered[-1] if ordered else None}
+
+
+def _declared(store: ResultStore) -> Any:
+    """The population of the run's user model as the file says it now (for the shares it
+    asks for and the distributions it declares); None when it cannot be loaded."""
+    plan = store.get("plan") or {}
+    ref = plan.get("user_model")
+    if not ref:
+        return None
+    try:
+        from opspec.usermodels.loader import load_user_model
+
+        return load_user_model(str(ref)).population
+    except Exception:  # noqa: BLE001 - the realised numbers stand without the declared ones
+        return None
+
+
+def summarise_population(store: ResultStore, days: float, level: float = 0.95, *,
+                         designs: Sequence[str] = ("A",)) -> dict[str, Any] | None:
+    """Who the simulated users were, when the user model is a population (None otherwise).
+
+    ``parameters``: per drawn parameter, over all users, ``mean``, ``sd``, ``min``, ``p5``,
+    ``median``, ``p95``, ``max``; ``subgroups`` (when the model declares them): per subgroup
+    ``users``, ``share`` with its exact ``share_ci95``, ``expected_share`` (what the model
+    asks for), its ``parameters``, ``metrics`` (as :func:`summarise_design`) of the first
+    design, ``metrics_<label>`` of the others, and ``difference`` (paired, second − first);
+    ``shares_test``: Pearson's chi-square test of the realised subgroup counts against the
+    shares asked for (a small ``p_value`` says the draw does not realise them)."""
+    if not has_population(store):
+        return None
+    first = designs[0]
+    groups, values, names = _people(store, first)
+    if not groups:
+        return None
+    declared = _declared(store)
+    expected = ({g.name: g.share for g in declared.subgroups} if declared is not None
+                else {})
+    out: dict[str, Any] = {
+        "users": len(groups),
+        "parameters": {n: _parameter_stats([v[n] for v in values.values() if n in v])
+                       for n in names},
+        "subgroups": {},
+    }
+    order = [g for g in expected if g is not None] if expected else []
+    order += sorted({g for g in groups.values() if g is not None and g not in order})
+    if not order:
+        return out
+    total = len(groups)
+    counts = {g: sum(1 for x in groups.values() if x == g) for g in order}
+    for name in order:
+        members = [u for u, g in groups.items() if g == name]
+        _, low, high = rate_interval(len(members), total, level, method="clopper-pearson")
+        entry: dict[str, Any] = {
+            "users": len(members), "share": len(members) / total, "share_ci95": [low, high],
+            "expected_share": expected.get(name),
+            "parameters": {n: _parameter_stats([values[u][n] for u in members
+                                                if n in values.get(u, {})]) for n in names},
+            "metrics": summarise_design(store, first, days, level, subgroup=name),
+        }
+        for other in designs[1:]:
+            entry[f"metrics_{other}"] = summarise_design(store, other, days, level,
+                                                         subgroup=name)
+        if len(designs) > 1:
+            entry["difference"] = compare_designs(store, first, designs[1], level,
+                                                  subgroup=name)
+        out["subgroups"][name] = entry
+    if expected and len(order) > 1 and all(expected.get(g) for g in order):
+        from scipy import stats
+
+        asked = math.fsum(expected[g] for g in order)   # 1, within the loader's tolerance
+        test = stats.chisquare([counts[g] for g in order],
+                               [expected[g] / asked * total for g in order])
+        out["shares_test"] = {"chi2": float(test.statistic), "df": len(order) - 1,
+                              "p_value": float(test.pvalue)}
     return out

@@ -8,14 +8,19 @@ from typing import IO, Any
 from opspec.engine.monitors import clock
 from opspec.evaluation.plan import span
 
-__all__ = ["comparison_rows", "fmt", "is_rate", "metric_rows", "monitor_rows", "per_user_rows",
-           "print_summary", "table"]
+__all__ = ["comparison_rows", "distribution_rows", "fmt", "is_rate", "metric_rows",
+           "monitor_rows", "parameter_rows", "per_user_rows", "print_summary",
+           "subgroup_comparison_rows", "subgroup_metric_rows", "subgroup_rows", "table"]
 
 METRIC_HEADERS = ("metric", "kind", "estimate", "95 % CI", "sd", "median", "p95", "n")
 PER_USER_HEADERS = ("metric", "users", "mean", "sd", "95 % CI", "median", "p95")
 COMPARE_HEADERS = ("metric", "A", "B", "B − A", "95 % CI", "")
 MONITOR_HEADERS = ("monitor", "violations", "users affected", "per user-day", "95 % CI",
                    "first violation")
+SUBGROUP_HEADERS = ("subgroup", "users", "share", "asked", "95 % CI (exact)")
+DISTRIBUTION_HEADERS = ("metric", "users", "users with any", "95 % CI (exact)", "p50", "p90",
+                        "p99", "between-user sd")
+PARAMETER_HEADERS = ("parameter", "subgroup", "users", "mean", "sd", "p5", "median", "p95")
 
 
 def fmt(value: Any, unit: str = "", *, percent: bool = False) -> str:
@@ -97,6 +102,114 @@ def monitor_rows(monitors: Mapping[str, Mapping[str, Any]]) -> list[tuple[str, .
     return rows
 
 
+def _estimate(name: str, s: Mapping[str, Any]) -> str:
+    """One metric's estimate with its interval in one cell: ``0.36 % [0.33 %, 0.39 %]``."""
+    kind = s["kind"]
+    percent = is_rate(name, s)
+    unit = (s.get("unit") or "s") if kind == "duration" else ""
+    value = s.get("value") if kind == "ratio" else s.get("mean")
+    ci = _ci(s, unit, percent=percent)
+    return f"{fmt(value, unit, percent=percent)} {ci}" if ci != "–" else fmt(
+        value, unit, percent=percent)
+
+
+def subgroup_rows(population: Mapping[str, Any]) -> list[tuple[str, ...]]:
+    """Per subgroup: users, realised share, the share the model asks for, exact interval."""
+    rows: list[tuple[str, ...]] = []
+    for name, g in (population.get("subgroups") or {}).items():
+        low, high = g.get("share_ci95") or [None, None]
+        rows.append((name, str(g["users"]), fmt(g["share"], percent=True),
+                     fmt(g.get("expected_share"), percent=True),
+                     f"[{fmt(low, percent=True)}, {fmt(high, percent=True)}]"
+                     if low is not None else "–"))
+    return rows
+
+
+def subgroup_metric_rows(metrics: Mapping[str, Mapping[str, Any]],
+                         population: Mapping[str, Any], key: str = "metrics"
+                         ) -> tuple[tuple[str, ...], list[tuple[str, ...]]]:
+    """Headers and rows: every metric over all users and per subgroup (estimate [95 % CI])."""
+    groups = population.get("subgroups") or {}
+    headers = ("metric", "all users", *(f"{n} ({g['users']})" for n, g in groups.items()))
+    rows = []
+    for name, s in metrics.items():
+        cells = [_estimate(name, s)]
+        for g in groups.values():
+            own = (g.get(key) or {}).get(name)
+            cells.append(_estimate(name, own) if own else "–")
+        rows.append((name, *cells))
+    return headers, rows
+
+
+def subgroup_comparison_rows(population: Mapping[str, Any]
+                             ) -> tuple[tuple[str, ...], list[tuple[str, ...]]]:
+    """Headers and rows: the paired difference B − A of each metric per subgroup."""
+    groups = population.get("subgroups") or {}
+    names: list[str] = []
+    for g in groups.values():
+        names += [n for n in g.get("difference") or {} if n not in names]
+    headers = ("metric", *groups)
+    rows = []
+    for name in names:
+        cells = []
+        for g in groups.values():
+            d = (g.get("difference") or {}).get(name)
+            if not d:
+                cells.append("–")
+                continue
+            _, _, diff, ci, _, mark = comparison_rows({name: d})[0]
+            cells.append(f"{diff} {ci}{' *' if mark else ''}")
+        rows.append((name, *cells))
+    return headers, rows
+
+
+def distribution_rows(metrics: Mapping[str, Mapping[str, Any]], label: str = "", *,
+                      informative: bool = False) -> list[tuple[str, ...]]:
+    """How the users' own values are spread: users with at least one event (count) or a
+    non-zero rate (ratio), with its exact interval, and percentiles of the per-user values.
+    ``informative``: only counts some users have and others not (and ratios, durations)."""
+    rows: list[tuple[str, ...]] = []
+    for name, s in metrics.items():
+        kind = s["kind"]
+        own = s if kind == "count" else (s.get("per_user") or {})
+        if not own.get("users"):
+            continue
+        if informative and kind == "count" and own.get("share_with_any") in (0.0, 1.0):
+            continue
+        percent = is_rate(name, s)
+        unit = (s.get("unit") or "s") if kind == "duration" else ""
+        share = own.get("share_with_any")
+        if share is not None:
+            low, high = own.get("share_with_any_ci95") or [None, None]
+            anyone = f"{own['users_with_any']} ({fmt(share, percent=True)})"
+            interval = f"[{fmt(low, percent=True)}, {fmt(high, percent=True)}]"
+        else:
+            anyone = interval = "–"
+        what = {"count": "total per user", "duration": "mean per user",
+                "ratio": "per user"}[kind]
+        rows.append((f"{name} ({what})" + (f" – {label}" if label else ""), str(own["users"]),
+                     anyone, interval,
+                     *(fmt(own.get(p), unit, percent=percent)
+                       for p in ("median", "p90", "p99")),
+                     fmt(own.get("between_user_sd"), percent=percent)
+                     if own.get("between_user_sd") is not None else "–"))
+    return rows
+
+
+def parameter_rows(population: Mapping[str, Any]) -> list[tuple[str, ...]]:
+    """The parameters drawn per user: over all users, then per subgroup."""
+    rows: list[tuple[str, ...]] = []
+    groups = population.get("subgroups") or {}
+    for name, overall in (population.get("parameters") or {}).items():
+        for label, stats in [("all users", overall),
+                             *((g, e["parameters"].get(name)) for g, e in groups.items())]:
+            if not stats or not stats.get("users"):
+                continue
+            rows.append((name, label, str(stats["users"]),
+                         *(fmt(stats.get(k)) for k in ("mean", "sd", "p5", "median", "p95"))))
+    return rows
+
+
 def _points(value: Any) -> str:
     """A difference of two rates in percentage points: ``-0.54 pp``."""
     return "–" if value is None else f"{value * 100:+.2f} pp"
@@ -130,7 +243,8 @@ def table(headers: Sequence[str], rows: Sequence[Sequence[str]]) -> list[str]:
 def print_summary(out: IO[str], plan: Any, metrics: Mapping[str, Any],
                   compare: Mapping[str, Any] | None, outcome: Any,
                   failures: Sequence[tuple[str, int, str]], workers: int,
-                  monitors: Mapping[str, Any] | None = None) -> None:
+                  monitors: Mapping[str, Any] | None = None,
+                  population: Mapping[str, Any] | None = None) -> None:
     design = plan.design("A")
     print(f"opspec evaluate: {design.spec}, {plan.users} users x {span(plan.days)}, seed "
           f"{plan.seed}, user model {plan.user_model or 'none'}", file=out)
@@ -149,10 +263,16 @@ def print_summary(out: IO[str], plan: Any, metrics: Mapping[str, Any],
         print("\nmonitors of B:", file=out)
         for line in table(MONITOR_HEADERS, monitor_rows(compare["monitors"])):
             print(line, file=out)
+    if population:
+        _print_population(out, metrics, population)
     if compare is not None:
         print(f"\ncompared with B = {compare['spec']} (same users, paired):", file=out)
         for line in table(COMPARE_HEADERS, comparison_rows(compare["difference"])):
             print(line, file=out)
+        if population and population.get("subgroups"):
+            print("\nB − A per subgroup (paired; * the 95 % interval excludes 0):", file=out)
+            for line in table(*subgroup_comparison_rows(population)):
+                print(line, file=out)
     if failures:
         print(f"\n{len(failures)} replication(s) failed:", file=out)
         for design_label, user, error in failures[:10]:
@@ -161,3 +281,28 @@ def print_summary(out: IO[str], plan: Any, metrics: Mapping[str, Any],
             print(f"  … and {len(failures) - 10} more", file=out)
         print("run again with --resume --out <folder> to complete them", file=out)
     print(file=out)
+
+
+def _print_population(out: IO[str], metrics: Mapping[str, Any],
+                      population: Mapping[str, Any]) -> None:
+    """The users as a population: subgroups, metrics per subgroup, how users' own values
+    spread, and the parameters drawn for them."""
+    if population.get("subgroups"):
+        test = population.get("shares_test")
+        print("\nusers by subgroup" + (f" (shares asked for vs drawn: chi-square "
+                                       f"p = {test['p_value']:.3g})" if test else "") + ":",
+              file=out)
+        for line in table(SUBGROUP_HEADERS, subgroup_rows(population)):
+            print(line, file=out)
+        print("\nmetrics by subgroup (estimate [95 % CI]):", file=out)
+        for line in table(*subgroup_metric_rows(metrics, population)):
+            print(line, file=out)
+    print("\nhow users differ (each user's own value, over users):", file=out)
+    rows = distribution_rows(metrics, informative=True)
+    for name, g in (population.get("subgroups") or {}).items():
+        rows += distribution_rows(g.get("metrics") or {}, name, informative=True)
+    for line in table(DISTRIBUTION_HEADERS, rows):
+        print(line, file=out)
+    print("\nparameters drawn per user:", file=out)
+    for line in table(PARAMETER_HEADERS, parameter_rows(population)):
+        print(line, file=out)
