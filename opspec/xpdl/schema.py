@@ -37,7 +37,7 @@ from lxml import etree
 from opspec.errors import Diagnostic, Severity, SourceLocation
 from opspec.model.package import Package
 from opspec.xpdl.namespaces import NO_NAMESPACE, XPDL_1_0, XPDL_2_0, XPDL_2_1, XPDL_2_2
-from opspec.xpdl.reader import XmlReadError, read_file, read_tree
+from opspec.xpdl.reader import XmlReadError, read_file
 
 if TYPE_CHECKING:
     from opspec.xpdl.validate import FileReport
@@ -128,9 +128,20 @@ def schema_diagnostics(path: str | Path, *, strict: bool = False) -> list[Diagno
     (code ``schema-invalid``, errors; at most :data:`MAX_ERRORS`, the last one saying how
     many more), or one ``no-schema`` warning when none is bundled for its namespace. A file
     the reader cannot read gives nothing here (validate reports it already)."""
+    from opspec.xpdl.bpmn import is_bpmn
+    from opspec.xpdl.reader import parse_safely, xpdl_outcome
+
     shown = str(path)
     try:
-        root = read_tree(read_file(path), path=shown).root
+        parsed = parse_safely(read_file(path), path=shown)
+        if is_bpmn(parsed.root):
+            return [Diagnostic(SourceLocation(shown, 1), Severity.ERROR if strict else
+                               Severity.WARNING, "no-schema",
+                               "not schema-validated: this is a BPMN 2.0 file, and opspec "
+                               "bundles only the WfMC XPDL schemas",
+                               "validate it against the OMG BPMN 2.0 XSD in an XML tool or "
+                               "your modeller (docs/bpmn.md)")]
+        root = xpdl_outcome(parsed, path=shown).root
     except XmlReadError:
         return []
     try:

@@ -34,7 +34,7 @@ __all__ = [
     "validate_spec",
 ]
 
-SPEC_SUFFIXES = (".xpdl", ".xml")
+SPEC_SUFFIXES = (".xpdl", ".xml", ".bpmn")
 
 # Codes that mean "the file could not be read at all" (exit status 2, not 1).
 IO_CODES = frozenset({"io-error"})
@@ -232,7 +232,8 @@ def spec_files(paths: Sequence[str | Path]) -> tuple[list[Path], list[str]]:
     A file argument is taken as it is (whatever its suffix); a folder contributes every
     ``*.xpdl`` and ``*.xml`` file below it, recursively, sorted. A missing path, a folder
     holding no such file, or a broken symbolic link with such a name in a folder gives a
-    problem. Files named twice are validated once.
+    problem. Files named twice are validated once. (``*.bpmn`` files are BPMN 2.0; what a
+    file holds is decided by its content, so any of them may be either.)
     """
     files: list[Path] = []
     problems: list[str] = []
@@ -247,7 +248,7 @@ def spec_files(paths: Sequence[str | Path]) -> tuple[list[Path], list[str]]:
                 problems.append(f"{link}: broken symbolic link (its target {_target(link)} "
                                 "does not exist)")
             if not found and not broken:
-                problems.append(f"{path}: no *.xpdl or *.xml file in this folder")
+                problems.append(f"{path}: no *.xpdl or *.xml file (or *.bpmn) in this folder")
             files.extend(found)
         elif path.exists():
             files.append(path)

@@ -70,10 +70,11 @@ def opspec_named(element: etree._Element, name: str) -> list[etree._Element]:
 
 def _value(element: etree._Element) -> str:
     value = element.get("Value")
-    if value is None:
-        value = "".join(element.itertext()).strip() if not len(element) else (
-            (element.text or "").strip())
-    return value
+    if value is not None:
+        return str(value)
+    if not len(element):
+        return "".join(element.itertext()).strip()
+    return (element.text or "").strip()
 
 
 def directives(element: etree._Element, defs: Defs, known: tuple[str, ...], what: str,

@@ -399,9 +399,13 @@ class _Process:
                            "give every flow node an id")
         name = local(element)
         lane = self.lane_of.get(node_id) or inherited_lane
+        built_body: ActivityBody
+        gateway: GatewayType | None = None
+        extra: tuple[Assignment, ...] = ()
+        sends: str | None = None
+        manual = False
         if name in _SUB_PROCESSES:
-            built_body: ActivityBody = self.sub_process(element, lane)
-            gateway, extra, sends, manual = None, (), None, False
+            built_body = self.sub_process(element, lane)
         else:
             built = build_node(name, element, self.defs)
             built_body, gateway, extra = built.body, built.gateway, built.assignments
