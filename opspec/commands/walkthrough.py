@@ -1,7 +1,9 @@
 """``opspec walkthrough SPEC``: a person performs the user lane in a terminal UI.
 
 See ``docs/walkthrough.md``. The recording (a script ``opspec run --script`` replays) is
-written as the session goes, with the trace beside it; quitting says where both are.
+written as the session goes, with the trace beside it; quitting prints the summary (the
+spec's metrics, the person's response times), where both files are, and the commands that
+replay the recording.
 """
 
 from __future__ import annotations
@@ -16,6 +18,10 @@ from typing import Any
 
 from opspec.commands._args import seed
 from opspec.errors import ConfigurationError
+
+# the choices, without importing Textual for `opspec --help`
+ON_CALL = ("realtime", "pause", "keep")
+SOUNDS = ("bell", "system", "off")
 
 __all__ = ["register", "run"]
 
@@ -46,6 +52,20 @@ def register(subparsers: Any) -> None:
     parser.add_argument("--bind", action="append", default=[], metavar="PARTICIPANT=URL",
                         help="bind a participant to a serial device (see devices/README.md)")
     parser.add_argument("--devices", metavar="DIR", help="device profile folder")
+    lab = parser.add_argument_group("for a lab session")
+    lab.add_argument("--on-call", choices=ON_CALL, default="realtime",
+                     help="what the clock does when the device calls you (an alarm, an "
+                     "offer): drop to real time until the call is over (default), pause, or "
+                     "keep its speed")
+    lab.add_argument("--large", action="store_true",
+                     help="a layout for a big terminal font: your panel first and full "
+                     "width, tall buttons, the clock in big digits (enlarge the terminal's "
+                     "font too)")
+    lab.add_argument("--high-contrast", action="store_true",
+                     help="white and yellow on black, heavy borders, nothing dimmed")
+    lab.add_argument("--sound", choices=SOUNDS, default="bell",
+                     help="the cue at every alarm: the terminal bell (default), a system "
+                     "sound as well (pw-play, paplay, aplay or afplay), or none")
     parser.set_defaults(handler=run)
 
 
@@ -95,27 +115,34 @@ def run(args: argparse.Namespace) -> int:
         session = WalkSession(compiled, seed=args.seed, days=args.days, record=record,
                               model_factory=factory, performers=performers, replay=replay,
                               spec_path=str(args.spec), device_participants=served,
-                              wall_devices=real)
+                              wall_devices=real, on_call=args.on_call)
         if session.failure is not None:        # the run cannot even start (a zero-time cycle)
             session.close()
             raise session.failure
         session.speed = args.speed if args.speed is not None else 1.0 if real else 60.0
         if devices is not None:
             devices.install(session.sim)
-        app = WalkthroughApp(session, title=package.name or package.id, notes=notes)
+        from opspec.tui.sound import Cue
+
+        cue = Cue(args.sound)
+        if args.sound == "system" and cue.player is None:
+            print("opspec walkthrough: no sound player found (pw-play, paplay, aplay or "
+                  "afplay): the alarm cue is the terminal bell", file=sys.stderr)
+        app = WalkthroughApp(session, title=package.name or package.id, notes=notes,
+                             large=args.large, high_contrast=args.high_contrast, sound=cue)
         interrupted = False
         try:
             app.run()
         except KeyboardInterrupt:          # a SIGINT from outside the terminal's keys
             interrupted = True
         finally:
+            cue.close()
             session.close()
     if session.failure is not None:            # shown in the app; said again in one line
         print(f"opspec: {session.failure}", file=sys.stderr)
-    if record is not None:
-        print(f"recording: {record}\ntrace: {record.with_suffix('.trace.jsonl')}\n"
-              f"replay it with: opspec walkthrough {args.spec} --replay {record}  or  "
-              f"opspec run {args.spec} --script {record}")
+    # the end in words, as the app showed it: metrics, response times, the recording and the
+    # commands that replay it (quoted: they paste as they are)
+    print("\n".join(session.summary_lines()))
     return 130 if interrupted else 1 if session.failure is not None else 0
 
 

@@ -31,7 +31,8 @@ data fields on completion (values are read as JSON, else kept as text).
 So ``[("after trg_2 90s", "press_report")]`` is a user who hears the alarm, walks and presses
 "report" exactly 90 s after the alarm, then takes the pill at once.
 
-A script file is TOML (or JSON) with an optional ``otherwise`` and a ``steps`` list whose
+A script file is TOML or JSON (told from the content: JSON starts with ``{``, whatever
+the file's name) with an optional ``otherwise`` and a ``steps`` list whose
 entries are ``[when, action]`` pairs or tables ``{when = "...", do = "..."}``::
 
     otherwise = "complete"
@@ -56,7 +57,8 @@ from opspec.engine.performers import WorkItem
 from opspec.engine.trace import EventKind, TraceEvent
 from opspec.errors import ConfigurationError, SourceLocation
 
-__all__ = ["DEFAULTS", "Script", "ScriptEntry", "ScriptUser", "load_script", "parse_script"]
+__all__ = ["DEFAULTS", "Script", "ScriptEntry", "ScriptUser", "load_script", "parse_script",
+           "script_format"]
 
 DEFAULTS = ("complete", "omit", "wait")
 _VERBS = ("complete", "choose", "omit", "fail", "raise")
@@ -295,8 +297,17 @@ def _pair(entry: Any, where: str) -> tuple[Any, Any]:
                              location=SourceLocation(where), hint=_HINT)
 
 
+def script_format(raw: bytes, name: str = "") -> str:
+    """``"JSON"`` or ``"TOML"``, told from the content: a JSON script is an object, so it
+    starts with ``{`` — which no TOML document can (a walkthrough recorded with
+    ``--record session.rec`` replays whatever its name). Otherwise the name decides
+    (``.json``: JSON, so a broken JSON file gets JSON's error message), else TOML."""
+    head = raw.lstrip(b"\xef\xbb\xbf \t\r\n")
+    return "JSON" if head.startswith(b"{") or name.lower().endswith(".json") else "TOML"
+
+
 def load_script(path: str | Path) -> Script:
-    """Read a script file (TOML, or JSON when the name ends in ``.json``)."""
+    """Read a script file: TOML, or JSON (told from the content, see :func:`script_format`)."""
     from opspec.files import read_bytes, reason
 
     where = str(path)
@@ -305,13 +316,14 @@ def load_script(path: str | Path) -> Script:
     except OSError as error:
         raise ConfigurationError(f"cannot read the script: {reason(error)}",
                                  location=SourceLocation(where)) from None
+    kind = script_format(raw, where)
     try:
-        document = (json.loads(raw) if where.endswith(".json")
-                    else tomllib.loads(raw.decode("utf-8")))
+        document = json.loads(raw) if kind == "JSON" else tomllib.loads(raw.decode("utf-8"))
     except (ValueError, tomllib.TOMLDecodeError) as error:
-        kind = "JSON" if where.endswith(".json") else "TOML"
         raise ConfigurationError(f"the script is not valid {kind}: {error}",
-                                 location=SourceLocation(where)) from None
+                                 location=SourceLocation(where),
+                                 hint="a script file is TOML (steps = [...]) or a JSON object "
+                                 '({"steps": [...]}, as walkthroughs record)') from None
     if not isinstance(document, dict):
         raise ConfigurationError("a script file is a table with 'steps'",
                                  location=SourceLocation(where))

@@ -4,8 +4,16 @@ Layout (works in 80×24, grows with the terminal): a status line (simulated cloc
 running or paused, who performs the lane); the device panel (what each participant did last,
 running workflow instances and the activity each is in, pending deadlines with a countdown);
 the person's panel (what can be done now, one key each — also clickable — and a banner when
-the device calls); the timeline (newest first, filterable by lane). Every state is said in
-words and symbols, never by colour alone. The engine is stepped from this app's event loop.
+the device calls, and what the person's last action led to); the timeline (newest first,
+filterable by lane). Every state is said in words and symbols, never by colour alone. The
+engine is stepped from this app's event loop. When the run ends, a summary opens (the spec's
+metrics, the person's response times, where the recording is).
+
+For a lab with older participants: ``large`` lays the screen out for a big terminal font
+(the person's panel first and full width, offers as tall bordered buttons, the clock in big
+digits; it works down to 60×20 cells), ``high_contrast`` uses white and yellow on black with
+heavy borders and no dimmed text, and ``sound`` picks the cue at every alarm
+(:mod:`opspec.tui.sound`: the terminal bell, a system sound, or none).
 """
 
 from __future__ import annotations
@@ -18,16 +26,19 @@ from typing import Any, ClassVar
 from rich.text import Text
 from textual.app import App, ComposeResult
 from textual.binding import Binding
-from textual.containers import Horizontal, Vertical
+from textual.containers import Horizontal, Vertical, VerticalScroll
 from textual.screen import ModalScreen
-from textual.widgets import Footer, Static
+from textual.theme import Theme
+from textual.widgets import Digits, Footer, Static
 
 from opspec.tui.session import WalkSession, clock
+from opspec.tui.sound import Cue
 
 __all__ = ["WalkthroughApp"]
 
 SPEEDS = {"1": 1.0, "2": 10.0, "3": 60.0, "4": 600.0}
-OFFER_KEYS = string.ascii_lowercase[:6]          # a..f act on the offers shown
+# the offers shown: every letter no other action uses (h l n q s u w x are taken), a..f first
+OFFER_KEYS = "".join(k for k in string.ascii_lowercase if k not in "hlnqsuwx")
 LANES = ("all", "device", "user")
 TICK_S = 0.1
 # The engine runs in slices so that keys (q, ctrl+c, space) are read between them: at most
@@ -39,7 +50,7 @@ KEY_S = 0.25                  # a key's own jump (w, n) may take a little longer
 HELP = """\
 [b]opspec walkthrough — keys[/b]
 
-  [b]a[/b]–[b]f[/b]     do the action shown next to the letter (or click it)
+  [b]a[/b]–[b]z[/b]     do the action shown next to the letter (or click it)
   [b]x[/b]       do not do the first action (an omission, recorded)
   [b]space[/b]   pause / resume the clock
   [b]1 2 3 4[/b] speed: real time, 10x, 60x, 600x
@@ -47,9 +58,13 @@ HELP = """\
   [b]n[/b]       skip to the next event
   [b]u[/b]       skip until something new needs you (again: stop)
   [b]h[/b]       hand your lane to the user model / take it back
-  [b]l[/b]       timeline: all lanes / device / user
-  [b]?[/b]       this help
+  [b]l[/b]       timeline: all lanes / device / user (/ hidden, with --large)
+  [b]s[/b]       the summary so far (metrics, your response times)
+  [b]?[/b]       this help (the clock stops while it is open)
   [b]q[/b], [b]ctrl+c[/b], [b]ctrl+q[/b] quit (the recording is kept)
+
+When the device calls you, the clock drops to real time (or pauses,
+with --on-call pause) and comes back when the call is over.
 
 Device panel: (!) an alert (a ringing alarm), (x) a device fault,
 > what a participant is doing now.
@@ -70,18 +85,56 @@ class HelpScreen(ModalScreen[None]):
         yield Static(HELP, id="help-text")
 
 
+class SummaryScreen(ModalScreen[None]):
+    """The summary: at the end of the run (it opens by itself), or so far (``s``)."""
+
+    BINDINGS: ClassVar = [Binding("escape,s,space", "dismiss", "close"),
+                          Binding("q", "app.quit_walk", "quit")]
+    DEFAULT_CSS = """
+    SummaryScreen { align: center middle; }
+    SummaryScreen > VerticalScroll { width: 100; max-width: 100%; height: auto;
+                                     max-height: 100%; border: heavy $accent; padding: 0 1;
+                                     background: $surface; }
+    """
+
+    def __init__(self, lines: Sequence[str]) -> None:
+        super().__init__()
+        self.lines = list(lines)
+
+    def compose(self) -> ComposeResult:
+        with VerticalScroll():
+            yield Static(Text("\n".join([*self.lines, "", "q: quit   escape: close"])),
+                         id="summary-text")
+
+
+HIGH_CONTRAST = Theme(
+    name="opspec-high-contrast", dark=True,
+    primary="#FFFF00", secondary="#FFFFFF", accent="#00FFFF", warning="#FFFF00",
+    error="#FF5555", success="#00FF00", foreground="#FFFFFF", background="#000000",
+    surface="#000000", panel="#000000", boost="#333333",
+    variables={"footer-key-foreground": "#FFFF00", "footer-description-foreground": "#FFFFFF",
+               "block-cursor-background": "#FFFF00", "block-cursor-foreground": "#000000"})
+"""White and yellow on black: contrast ratios of 21:1 and 19.6:1 (WCAG AAA asks 7:1)."""
+
+
 class StatusLine(Static):
     """The clock and controls line; it owns the app's tick timer (so the timer dies with
-    the widget and never fires into an unmounted app)."""
+    the widget and never fires into an unmounted app). The simulated clock advances by the
+    wall time that really passed between ticks (a late tick does not slow the clock, so a
+    response timed at 1x is the person's real one)."""
 
     def on_mount(self) -> None:
+        self._last = time.monotonic()
         self.set_interval(TICK_S, self._tick)
 
     def _tick(self) -> None:
+        now = time.monotonic()
+        # at most one second at once (a suspended terminal does not jump the clock)
+        elapsed, self._last = min(1.0, max(0.0, now - self._last)), now
         if self.is_mounted:
             app = self.app
             if isinstance(app, WalkthroughApp):
-                app.tick(TICK_S)
+                app.tick(elapsed)
 
 
 class OfferLine(Static):
@@ -111,13 +164,38 @@ class WalkthroughApp(App[str | None]):
     #device { width: 3fr; text-wrap: nowrap; text-overflow: ellipsis; }
     #person { width: 2fr; }
     #person.calling { border: heavy $warning; }
+    #offers { height: auto; }
+    #aftermath { height: auto; margin-top: 1; text-style: italic; }
     #timeline { height: 1fr; min-height: 5; border: round $secondary; padding: 0 1; }
+    #bigclock { display: none; }
     .offer { height: auto; }
     .offer:hover { background: $boost; }
+
+    /* large: laid out for a big terminal font; the person's panel first, full width */
+    Screen.large #panels { layout: vertical; height: 3fr; }
+    Screen.large #person { width: 1fr; height: 3fr; min-height: 9; }
+    Screen.large #device { width: 1fr; height: 1fr; min-height: 4; }
+    Screen.large #bigclock { display: block; height: 3; width: auto; }
+    Screen.large #timeline { min-height: 3; }
+    Screen.large #timeline.hidden { display: none; }
+    Screen.large .offer { border: heavy $secondary; padding: 0 1; text-style: bold;
+                          margin-bottom: 0; }
+    Screen.large #call, Screen.large #aftermath { text-style: bold; }
+    Screen.large #aftermath { margin-top: 0; }
+
+    /* high contrast: heavy borders everywhere, nothing dimmed */
+    Screen.contrast #device, Screen.contrast #person, Screen.contrast #timeline {
+        border: heavy $foreground; }
+    Screen.contrast #person.calling { border: double $warning; }
+    Screen.contrast #aftermath { text-style: bold; }
     """
+    # the footer shows them in this order and cuts at the right: what a participant needs
+    # first (pause, help, quit), then the coordinator's time controls
     BINDINGS: ClassVar = [
         Binding("space", "pause", "pause"),
-        Binding("1", "speed('1')", "1x", show=False),
+        Binding("question_mark", "help", "help"),
+        Binding("q", "quit_walk", "quit"),
+        Binding("1", "speed('1')", "speed", key_display="1-4"),
         Binding("2", "speed('2')", "10x", show=False),
         Binding("3", "speed('3')", "60x", show=False),
         Binding("4", "speed('4')", "600x", show=False),
@@ -127,20 +205,25 @@ class WalkthroughApp(App[str | None]):
         Binding("h", "hand_over", "model/me"),
         Binding("l", "lane", "lanes", show=False),
         Binding("x", "ignore", "don't", show=False),
-        Binding("question_mark", "help", "help"),
-        Binding("q", "quit_walk", "quit"),
+        Binding("s", "summary", "summary", show=False),
         Binding("ctrl+c,ctrl+q", "quit_walk", "quit", show=False, priority=True),
         *[Binding(k, f"offer({i})", show=False) for i, k in enumerate(OFFER_KEYS)],
     ]
 
     def __init__(self, session: WalkSession, *, title: str = "",
-                 notes: Sequence[str] = ()) -> None:
+                 notes: Sequence[str] = (), large: bool = False, high_contrast: bool = False,
+                 sound: Cue | None = None) -> None:
         super().__init__()
         self.session = session
         self.spec_title = title
         self.notes = list(notes)
+        self.large = large
+        self.high_contrast = high_contrast
+        #: the cue at every alarm (default: the terminal bell)
+        self.cue = sound if sound is not None else Cue("bell")
         self.lane_filter = 0
         self._was_calling = False
+        self._summary_shown = False          # the end-of-run summary opens once
         self._views_ready = False            # set once mounted, cleared when quitting
         session.listeners.append(self._on_event)
 
@@ -150,12 +233,26 @@ class WalkthroughApp(App[str | None]):
         with Horizontal(id="panels"):
             yield Static(id="device")
             with Vertical(id="person"):
+                yield Digits("", id="bigclock")
                 yield Static(id="call")
                 yield Vertical(id="offers")
+                yield Static(id="aftermath")
         yield Static(id="timeline")
         yield Footer()
 
     def on_mount(self) -> None:
+        if self.high_contrast:
+            self.register_theme(HIGH_CONTRAST)
+            self.theme = HIGH_CONTRAST.name
+            self.screen.add_class("contrast")
+        if self.large:
+            self.screen.add_class("large")
+            # the timeline is for the coordinator: hidden until l shows it
+            self.lane_filter = len(LANES)
+            self.query_one("#timeline", Static).add_class("hidden")
+            # the person's panel comes first (on top) when the font is big
+            panels = self.query_one("#panels", Horizontal)
+            panels.move_child(self.query_one("#person"), before=self.query_one("#device"))
         self.query_one("#device", Static).border_title = "Device"
         self.query_one("#person", Vertical).border_title = "You (the user lane)"
         self.query_one("#timeline", Static).border_title = "Timeline (newest first)"
@@ -198,7 +295,7 @@ class WalkthroughApp(App[str | None]):
         alarm = (event.kind == "trigger.raised" and event.lane != "user"
                  and session.device_signals and session.board.ringing)
         if alarm or (calling and not self._was_calling and not session.device_signals):
-            self.bell()
+            self.cue.play(self)
         self._was_calling = calling
 
     # ------------------------------------------------------------------ actions
@@ -211,6 +308,7 @@ class WalkthroughApp(App[str | None]):
         self.refresh_views()
 
     def action_wait(self) -> None:
+        self.session.spoil_timing("waited 30 s with w")
         self._run_slices(self.session.now + 30.0, KEY_S)
         self.refresh_views()
 
@@ -241,7 +339,10 @@ class WalkthroughApp(App[str | None]):
         self.refresh_views()
 
     def action_lane(self) -> None:
-        self.lane_filter = (self.lane_filter + 1) % len(LANES)
+        # large: all, device, user, hidden (the big font leaves little room for it)
+        self.lane_filter = (self.lane_filter + 1) % (len(LANES) + self.large)
+        self.query_one("#timeline", Static).set_class(self.lane_filter == len(LANES),
+                                                      "hidden")
         self.refresh_views()
 
     def action_offer(self, index: int) -> None:
@@ -269,8 +370,25 @@ class WalkthroughApp(App[str | None]):
 
         self.push_screen(HelpScreen(), resume)
 
+    def action_summary(self) -> None:
+        if not isinstance(self.screen, SummaryScreen):
+            self._open_summary()
+
+    def _open_summary(self) -> None:
+        # the clock stands still while the summary is open (and resumes as it was)
+        was_paused = self.session.paused
+        self.session.paused = True
+
+        def resume(_result: None) -> None:
+            self.session.paused = was_paused
+            self.refresh_views()
+
+        session = self.session
+        self.push_screen(SummaryScreen(session.summary_lines(final=session.ended)), resume)
+
     def action_quit_walk(self) -> None:
         self._views_ready = False
+        self.cue.close()
         self.session.close()
         path = self.session.record_path
         self.exit(str(path) if path is not None else None)
@@ -280,6 +398,10 @@ class WalkthroughApp(App[str | None]):
         if not self._views_ready:
             return
         session = self.session
+        if session.ended and not self._summary_shown:
+            self._summary_shown = True           # once: the end of the run in words
+            if not isinstance(self.screen, HelpScreen):
+                self._open_summary()
         # the state comes first: the line is cut at the right in a narrow terminal
         state = ("[ENDED]" if session.ended
                  else "[waiting for the device]" if session.waiting_for_devices
@@ -289,9 +411,13 @@ class WalkthroughApp(App[str | None]):
                else "no user lane" if not session.has_user_lane
                else "model performs your lane" if session.handed_over
                else "you perform the lane")
+        if session.call_mode and state == "running":
+            state = "running in real time: the device calls"
         self.query_one("#status", Static).update(Text(
             f"{clock(session.now)}  {session.speed:g}x  {state}  |  {who}  |  "
             f"{self.spec_title}", no_wrap=True, overflow="ellipsis"))
+        if self.large:
+            self.query_one("#bigclock", Digits).update(clock(session.now)[3:8])
         self.query_one("#device", Static).update(self._device_text())
         person = self.query_one("#person", Vertical)
         call = self.query_one("#call", Static)
@@ -316,13 +442,17 @@ class WalkthroughApp(App[str | None]):
                 line.append(f"[{OFFER_KEYS[n]}]", style="bold reverse")
                 line.append(f" {offer.label}")
                 if labels.count(offer.label) > 1:      # tell identical offers apart
-                    line.append(f" #{offer.item.instance}", style="dim")
+                    line.append(f" #{offer.item.instance}",
+                                style="" if self.high_contrast else "dim")
                 lines.append(OfferLine(n, line))
             more = len(offers) - len(OFFER_KEYS)
             if more > 0:
                 lines.append(Static(f"(+{more} more: x passes on the first)"))
             if lines:
                 box.mount(*lines)
+        self.query_one("#aftermath", Static).update(
+            Text(session.aftermath.text()) if session.person_performs or session.ended
+            else Text())
         self.query_one("#timeline", Static).update(self._timeline_text())
 
     def _idle_text(self) -> str:
@@ -341,7 +471,10 @@ class WalkthroughApp(App[str | None]):
     def _device_text(self) -> Text:
         session = self.session
         text = Text(no_wrap=True, overflow="ellipsis")
-        for row in session.board.rows():
+        rows = session.board.rows()
+        if self.large:                     # little room: what calls for attention first
+            rows.sort(key=lambda row: not row.alert)
+        for row in rows:
             marker = "(x)" if row.status.startswith("FAULT") else "(!)" if row.alert else " * "
             line = Text(no_wrap=True, overflow="ellipsis")
             line.append(f"{marker} {row.id}: ", style="bold")
@@ -352,8 +485,11 @@ class WalkthroughApp(App[str | None]):
                 text.append(f"      {row.detail}\n", style="italic")
         if session.current:
             text.append("Running:\n", style="bold")
-            for instance, (process, activity) in sorted(session.current.items())[:4]:
+            running = sorted(session.current.items())
+            for instance, (process, activity) in running[:4]:
                 text.append(f"  {process}#{instance} at {activity}\n")
+            if len(running) > 4:
+                text.append(f"  (+{len(running) - 4} more)\n")
         for (instance, activity), due in sorted(session.deadlines.items(),
                                                 key=lambda kv: kv[1])[:3]:
             left = max(0.0, due - session.now)
@@ -367,9 +503,12 @@ class WalkthroughApp(App[str | None]):
         return text
 
     def _timeline_text(self) -> Text:
+        if self.lane_filter >= len(LANES):
+            return Text()                                  # hidden (large)
         lane = LANES[self.lane_filter]
         text = Text()
-        text.append(f"showing: {lane} (l: change)\n", style="dim")
+        text.append(f"showing: {lane} (l: change)\n",
+                    style="" if self.high_contrast else "dim")
         # as many events as the box holds (it grows with the terminal)
         rows = max(3, self.query_one("#timeline", Static).content_size.height - 1)
         shown = 0

@@ -122,20 +122,21 @@ class RecordingSession:
             return
         self.walk._record(tagged_action("choose", choice, item.instance) if choice
                           else tagged_action("complete", item.activity, item.instance),
-                          by="model")
+                          by="model", item=item)
         self.engine.complete(item, data, choice)
 
     def omit(self, item: WorkItem, reason: str = "") -> None:
         if not self._take(item):
             return
-        self.walk._record(tagged_action("omit", item.activity, item.instance), by="model")
+        self.walk._record(tagged_action("omit", item.activity, item.instance), by="model",
+                          item=item)
         self.engine.omit(item, reason)
 
     def fail(self, item: WorkItem, exception: str, message: str = "") -> None:
         if not self._take(item):
             return
         self.walk._record(tagged_action("fail", item.activity, item.instance, exception),
-                          by="model")
+                          by="model", item=item)
         self.engine.fail(item, exception, message)
 
     def raise_trigger(self, name: str, data: Mapping[str, Any] | None = None) -> None:

@@ -7,6 +7,15 @@ event loop): SimPy is stepped, never run from another thread.
 - **Time**: :meth:`advance` moves simulated time by ``wall_seconds × speed`` (nothing happens
   while paused); :meth:`skip_to_next_event` jumps to the next scheduled event;
   :meth:`skip_until_user` runs until something is offered to the person (or the run ends).
+- **When the device calls the person** (its alarm rings, or something is offered to a person
+  whose device does not signal) the clock drops to real time (``on_call="realtime"``, the
+  default), pauses (``"pause"``) or goes on as it was (``"keep"``), so a person can answer
+  the first alarm. The speed comes back when the call is over: at once if the person let it
+  pass, else when nothing waits for them any more.
+- **Response times** (:mod:`opspec.tui.timing`): every offer remembers when it reached the
+  person, in simulated and wall time, and whether the clock has run in real time since; the
+  recorded action says how long the person took (wall seconds) and whether the simulated
+  duration is usable for ``opspec fit``.
 - **The person's lane**: work items offered to the user lane wait in :attr:`offers` until the
   person acts (:meth:`act`) — or the device withdraws them (a deadline, another branch). With
   :meth:`hand_over` a user model performs the lane; :meth:`take_back` returns it.
@@ -25,23 +34,33 @@ import functools
 import json
 import math
 import os
+import statistics
 import time
 from collections import deque
 from collections.abc import Callable, Mapping, Sequence
 from pathlib import Path
-from typing import Any, TypeVar
+from typing import TYPE_CHECKING, Any, TypeVar
 
-from opspec.engine.compiled import CompiledPackage
+from opspec.engine.compiled import K_GATEWAY, K_NOOP, CompiledPackage
 from opspec.engine.lanes import all_activities, user_lane
 from opspec.engine.performers import WorkItem
 from opspec.engine.simulation import Simulation
 from opspec.engine.trace import TraceEvent
 from opspec.errors import ConfigurationError, ExecutionError
 from opspec.tui.devices import DeviceBoard
+from opspec.tui.feedback import Aftermath
 from opspec.tui.lane import LaneUser, Offer
 from opspec.tui.replay import tagged_action
+from opspec.tui.summary import metric_lines, replay_commands, response_lines
+from opspec.tui.timing import OfferTimes, Response
 
-__all__ = ["Offer", "WalkSession"]
+if TYPE_CHECKING:
+    from opspec.runs import RunOutcome
+
+__all__ = ["ON_CALL", "Offer", "WalkSession"]
+
+#: what the clock does when the device calls the person (``--on-call``)
+ON_CALL = ("realtime", "pause", "keep")
 
 _F = TypeVar("_F", bound=Callable[..., Any])
 
@@ -75,7 +94,7 @@ class WalkSession:
                  performers: Mapping[str, Any] | None = None, config: Any = None,
                  replay: Any = None, spec_path: str = "",
                  device_participants: Mapping[str, Sequence[str]] | None = None,
-                 wall_devices: bool = False) -> None:
+                 wall_devices: bool = False, on_call: str = "realtime") -> None:
         from opspec.runs import check_seed, run_length
 
         self.compiled = compiled
@@ -87,8 +106,21 @@ class WalkSession:
         #: where the run ends: the one rule of every run (opspec.runs.run_length): ``days``,
         #: else the spec's opspec:RunLength, else one day
         self.horizon = run_length(compiled, days=days)
-        self.speed = 60.0
-        self.paused = False
+        if on_call not in ON_CALL:
+            raise ConfigurationError(f"--on-call takes one of {', '.join(ON_CALL)}, not "
+                                     f"{on_call!r}")
+        self.on_call = on_call
+        #: when each offer reached the person, and whether the clock ran in real time since
+        self.times = OfferTimes()
+        self._speed = 60.0
+        self._paused = False
+        #: the speed the person had before a call dropped the clock to real time
+        self._speed_before_call: float | None = None
+        self._in_call = False                # the device calls the person now
+        self._acted_in_call = False          # ... and the person has answered something
+        self._call_began = False             # set by an event: stop stepping, apply on_call
+        #: the person's actions with their response times (the end-of-run summary)
+        self.responses: list[Response] = []
         self.model_factory = model_factory
         self.events: deque[TraceEvent] = deque(maxlen=2000)
         self.listeners: list[Callable[[TraceEvent], None]] = []
@@ -112,8 +144,12 @@ class WalkSession:
         self._seq_of: dict[int, int] = {}                   # item key -> its offer number
         self._skip_from = 0                                 # _offer_seq when the skip began
         self.ended = False
+        #: instances whose every offer to the person lapsed (not shown as running)
+        self.lapsed_instances: set[int] = set()
         #: the error that ended the run (a zero-time cycle...), or None
         self.failure: ExecutionError | None = None
+        self.spec_path = spec_path
+        self._outcome: RunOutcome | None = None
         self.record_path = Path(record) if record is not None else None
         self._steps: list[list[str]] = []
         self._trace_file = None
@@ -137,6 +173,10 @@ class WalkSession:
                              if a.deadlines}
         #: the spec's names for activities (choices are shown by name, not id)
         self._names = {(a.process, a.id): a.label or a.id for a in activities}
+        #: what the person's last action led to (shown under the offers)
+        self.aftermath = Aftermath(self._label_of, quiet={
+            (a.process, a.id) for a in activities
+            if a.kind in (K_NOOP, K_GATEWAY) and a.sampler is None and not a.raises})
         #: the device signals the user (an alarm raising a trigger): the banner follows it
         self.device_signals = any(a.raises is not None and not a.user_lane
                                   for a in activities)
@@ -161,6 +201,37 @@ class WalkSession:
     @_guarded()
     def _boot(self) -> None:
         self.sim.boot()
+        self._follow_call()
+
+    # ------------------------------------------------------------------ clock state
+    @property
+    def speed(self) -> float:
+        """Simulated seconds per wall second while the clock runs."""
+        return self._speed
+
+    @speed.setter
+    def speed(self, value: float) -> None:
+        if value != self._speed:
+            if self._speed != 1.0:           # what waits was timed faster than real time
+                self.times.spoil(f"the clock ran at {self._speed:g}x", since_before=self.now)
+            self._speed = value
+            self._speed_before_call = None   # the person chose: a call's end leaves it
+
+    @property
+    def paused(self) -> bool:
+        return self._paused
+
+    @paused.setter
+    def paused(self, value: bool) -> None:
+        if value and not self._paused:
+            # the simulated clock stands while the person thinks: the durations of what
+            # waits now would count that time as zero
+            self.times.spoil("the clock was paused")
+        self._paused = value
+
+    def spoil_timing(self, why: str) -> None:
+        """Simulated time jumped (a skip, a wait): what waits now has no real duration."""
+        self.times.spoil(why)
 
     def _fail(self, error: ExecutionError) -> None:
         """The engine cannot go on: end the session and show why (as an engine fault)."""
@@ -205,9 +276,12 @@ class WalkSession:
 
     @_guarded()
     def skip_to_next_event(self, budget: int | None = None) -> None:
-        """Jump to the next scheduled event (not while a real device is busy)."""
-        if self.waiting_for_devices:
+        """Jump to the next scheduled event after now (not while a real device is busy)."""
+        if self.waiting_for_devices or self.ended:
             return
+        self.spoil_timing("skipped to the next event")
+        if self.sim.peek() <= self.now:      # what is due now happens first (no jump)
+            self._step_to(self.now, budget)
         due = self.sim.peek()
         self.run_to(min(self.horizon, due if math.isfinite(due) else self.horizon), budget)
 
@@ -217,6 +291,7 @@ class WalkSession:
         device busy the skip pauses until it answers. With a ``budget`` (engine events per
         call) the skip may stop early with :attr:`skipping` still set: :meth:`advance` goes
         on with it, and :meth:`cancel_skip` abandons it."""
+        self.spoil_timing("skipped ahead")
         self.skipping = True
         self._skip_calls = self.calls
         self._skip_from = self._offer_seq
@@ -274,8 +349,16 @@ class WalkSession:
                 return False, steps
             env.step()
             steps += 1
+            if self._call_began:
+                # the device calls: the clock changes pace from here (on_call)
+                self._follow_call()
+                return True, steps
         if target > env.now:
-            env.run(until=target)
+            # nothing is due before the target: move the clock there with a timeout of our
+            # own (env.run(until=...) would leave its stop event queued at the target, and
+            # the next "next event" would be that one, at the current time)
+            env.timeout(target - env.now)
+            env.step()
         if self.now >= self.horizon - 1e-9 and not self.ended:
             self.ended = True
             self.sim.check_waiting(horizon=self.horizon)
@@ -290,9 +373,10 @@ class WalkSession:
                 offer.item.key not in self.lane_user.items):
             return
         self.lane_user.items.pop(offer.item.key, None)
-        self._record(offer.action, by="person")
+        self._record(offer.action, by="person", item=offer.item, label=offer.label)
         self._drop_offers(offer.item.key)
         engine.complete(offer.item, None, offer.choice)
+        self._follow_call()
 
     @_guarded()
     def ignore(self, offer: Offer) -> None:
@@ -303,9 +387,10 @@ class WalkSession:
             return
         self.lane_user.items.pop(offer.item.key, None)
         self._record(tagged_action("omit", offer.item.activity, offer.item.instance),
-                     by="person")
+                     by="person", item=offer.item, label=f"not: {offer.label}")
         self._drop_offers(offer.item.key)
         engine.omit(offer.item, "the person chose not to")
+        self._follow_call()
 
     @_guarded(False)
     def hand_over(self) -> bool:
@@ -326,6 +411,8 @@ class WalkSession:
             return
         for item in self.lane_user.take_back():
             self._offered(item)
+            # offered to the engine long ago: its duration is not the person's
+            self.times.spoil("taken back from the user model", keys=(item.key,))
 
     @property
     def handed_over(self) -> bool:
@@ -340,6 +427,42 @@ class WalkSession:
             return self.board.ringing
         return bool(self.offers) and not self.handed_over
 
+    def _label_of(self, process: str, activity: str) -> str:
+        return self._names.get((process, activity), activity)
+
+    @property
+    def person_performs(self) -> bool:
+        """Whether a person (not a model, not a recording) performs the user lane now."""
+        return self.has_user_lane and not self.replaying and not self.handed_over
+
+    def _follow_call(self) -> None:
+        """Apply ``on_call`` when a call begins; give the speed back when it is over."""
+        self._call_began = False
+        calling = self.calling and self.person_performs and not self.ended
+        if calling and not self._in_call:
+            self._in_call, self._acted_in_call = True, False
+            if self.on_call == "realtime" and self._speed != 1.0:
+                before = self._speed
+                self.speed = 1.0
+                self._speed_before_call = before
+            elif self.on_call == "pause":
+                self.paused = True
+        elif not calling and self._in_call and (not self._acted_in_call or not self.offers):
+            # over: the person let it pass, or answered and nothing waits any more
+            self._in_call = False
+            if self._speed_before_call is not None:
+                before, self._speed_before_call = self._speed_before_call, None
+                self.speed = before
+
+    @property
+    def call_mode(self) -> str:
+        """What the clock does during this call, in words ("" when there is no call)."""
+        if not self._in_call:
+            return ""
+        if self._speed_before_call is not None:
+            return f"real time while the device calls (was {self._speed_before_call:g}x)"
+        return ""
+
     # ------------------------------------------------------------------ engine side
     def _offered(self, item: WorkItem) -> None:
         # the same activity offered in a newer instance supersedes the older offer (three
@@ -350,11 +473,20 @@ class WalkSession:
                  and o.item.instance != item.instance}
         if stale:
             self.lapsed += len(stale)
+            lapsed = {o.item.instance for o in self.offers if o.item.key in stale}
             for key in stale:
                 self.lane_user.items.pop(key, None)
             self._drop_offers(*stale)
+            # an instance with nothing left for the person has lapsed: it is not running
+            # any more as far as the person can tell (it waits for an answer that will not
+            # come), so it leaves the Running list
+            for instance in lapsed - {i.instance for i in self.lane_user.items.values()}:
+                self.current.pop(instance, None)
+                self.deadlines = {k: v for k, v in self.deadlines.items() if k[0] != instance}
+                self.lapsed_instances.add(instance)
         self._offer_seq += 1
         self._seq_of[item.key] = self._offer_seq
+        self.times.shown(item.key, self.now, paused=self._paused)
         if item.choices:
             self.offers.extend(Offer(item, choice, self._names.get((item.process, choice)))
                                for choice in item.choices)
@@ -365,6 +497,7 @@ class WalkSession:
         self.offers = [o for o in self.offers if o.item.key not in keys]
         for key in keys:
             self._seq_of.pop(key, None)
+            self.times.forget(key)
 
     def _drop_instance(self, instance: int) -> None:
         """An instance ended: what it offered the person goes."""
@@ -388,7 +521,8 @@ class WalkSession:
                 self.device_work.add((event.instance, event.activity))
             elif kind in _ANSWERED:
                 self.device_work.discard((event.instance, event.activity))
-        if event.instance is not None and event.activity:
+        if event.instance is not None and event.activity and (
+                event.instance not in self.lapsed_instances):
             if kind in ("activity.started", "activity.offered"):
                 self.current[event.instance] = (event.process or "", event.activity)
                 for seconds, _sync, _exc in self._deadline_of.get(
@@ -418,15 +552,35 @@ class WalkSession:
             self.participants[who] = prefix + str(data.get("message", ""))
         if kind == "process.started" and event.lane == "user":
             self.calls += 1
+        self.aftermath(event)
+        if not self._in_call and self.calling and self.person_performs:
+            self._call_began = True          # the stepping loop stops and applies on_call
+        elif self._in_call and not self.calling:
+            self._follow_call()
         for listener in self.listeners:
             listener(event)
 
     # ------------------------------------------------------------------ recording
-    def _record(self, action: str, *, by: str) -> None:
+    def _record(self, action: str, *, by: str, item: WorkItem | None = None,
+                label: str = "") -> None:
+        """Write ``action`` to the recording and the trace. For an offered ``item`` the trace
+        says how long the person took (``response_wall_s``, wall seconds since the offer
+        reached them) and whether the simulated duration is real (``usable``: the clock ran
+        in real time throughout; else ``why`` not), which ``opspec fit`` honours."""
         self._steps.append([f"at {self.now!r}", action])
         self._write_record()
-        self.sim.session.trace("walkthrough.action", {
-            "action": action, "by": by, "wall": time.time()})  # wall-clock: the record
+        data: dict[str, Any] = {"action": action, "by": by,
+                                "wall": time.time()}          # wall-clock: the record
+        if item is not None:
+            response = self.times.answered(item.key, self.now, by=by, paused=self._paused,
+                                           speed=self._speed)
+            data.update(instance=item.instance, activity=item.activity,
+                        **response.trace_data())
+            if by == "person":
+                self.responses.append(response.named(label or item.activity, self.now))
+                self._acted_in_call = self._in_call or self._acted_in_call
+                self.aftermath.acted(label or item.activity, item, self.now)
+        self.sim.session.trace("walkthrough.action", data)
 
     def _write_record(self) -> None:
         if self.record_path is None:
@@ -438,6 +592,54 @@ class WalkSession:
         tmp = self.record_path.with_suffix(self.record_path.suffix + ".tmp")
         tmp.write_text(text, encoding="utf-8")
         os.replace(tmp, self.record_path)
+
+    # ------------------------------------------------------------------ the end
+    def outcome(self) -> RunOutcome | None:
+        """What the run produced so far, as ``opspec run`` reports it (taken once: at the
+        end of the run, or when the person quits before it); ``None`` after a failure."""
+        if self._outcome is None and self.failure is None:
+            self._outcome = self.run.outcome()
+        return self._outcome
+
+    def summary_lines(self, *, final: bool = True) -> list[str]:
+        """The session in words: when, the spec's metrics (the numbers
+        ``opspec run SPEC --script RECORDING`` prints), the person's response times, and
+        where the recording is with the commands that replay it. ``final``: the end of the
+        session (the run's outcome is taken, once); else the numbers so far, with the run
+        going on."""
+        if self.failure is not None:
+            head = f"The run failed at {clock(self.now)}: {self.failure}"
+        elif self.ended:
+            head = f"The run ended at {clock(self.horizon)}."
+        elif final:
+            head = (f"Stopped at {clock(self.now)}, before the end of the run "
+                    f"({clock(self.horizon)}).")
+        else:
+            head = f"So far, at {clock(self.now)} (the run ends at {clock(self.horizon)})."
+        lines = [head]
+        metrics: Mapping[str, Mapping[str, Any]] = {}
+        medians: Mapping[str, float] = {}
+        if final or self.ended:
+            outcome = self.outcome()
+            if outcome is not None:
+                metrics, medians = outcome.metrics, outcome.medians
+        elif self.failure is None:
+            # the numbers so far, without ending the run's monitors
+            metrics = self.sim.result().metrics
+            samples = self.sim.metrics.samples if self.sim.metrics is not None else {}
+            medians = {k: statistics.median(v) for k, v in samples.items() if v}
+        if metrics:
+            lines += ["", "The spec's metrics (as opspec run prints them):",
+                      *metric_lines(metrics, medians)]
+        if self.has_user_lane and not self.replaying:
+            lines += ["", "Your response times (wall clock, from the offer to your key):",
+                      *response_lines(self.responses)]
+        if self.record_path is not None:
+            walk, run = replay_commands(self.spec_path or "SPEC", self.record_path)
+            lines += ["", f"Recording: {self.record_path}",
+                      f"Trace (for opspec fit): {self.record_path.with_suffix('.trace.jsonl')}",
+                      f"Replay it with: {walk}", f"           or: {run}"]
+        return lines
 
     def close(self) -> None:
         if self._trace_file is not None:

@@ -7,7 +7,7 @@ from __future__ import annotations
 import pytest
 
 from opspec.engine.performers import WorkItem
-from opspec.tui.app import WalkthroughApp
+from opspec.tui.app import OFFER_KEYS, WalkthroughApp
 from opspec.tui.session import WalkSession
 
 
@@ -60,14 +60,25 @@ async def test_more_offers_than_keys_say_how_many_more_and_twins_show_their_inst
     app = WalkthroughApp(session)
     async with app.run_test(size=(80, 24)) as pilot:
         await pilot.press("space")
-        for key in range(8):
+        extra = len(OFFER_KEYS) + 2                  # every free letter, and 3 more
+        for key in range(extra):
             session._offered(fake_item(key, f"act{key}", f"Do {key}"))
-        session._offered(fake_item(8, "same", "Do 0", process="q"))   # a twin of "Do 0"
+        session._offered(fake_item(extra, "same", "Do 0", process="q"))  # a twin of "Do 0"
         app.refresh_views()
         await pilot.pause()
         shown = [str(w.render()) for w in app.query("#offers Static")]
         assert shown[0] == "[a] Do 0 #100" and shown[5] == "[f] Do 5"
+        # after f the letters go on past those the controls use (h l n q s u w x)
+        assert shown[6] == "[g] Do 6" and shown[7] == "[i] Do 7"
         assert shown[-1] == "(+3 more: x passes on the first)"
+
+
+def test_every_offer_shown_is_one_key_away_and_no_offer_key_is_a_control():
+    controls = {key for b in WalkthroughApp.BINDINGS if not b.action.startswith("offer(")
+                for key in b.key.split(",")}
+    keys = [b.key for b in WalkthroughApp.BINDINGS if b.action.startswith("offer(")]
+    assert keys == list(OFFER_KEYS) and not set(keys) & controls
+    assert len(OFFER_KEYS) == 18                    # a..z less the eight control letters
 
 
 @pytest.mark.asyncio

@@ -32,3 +32,20 @@ def test_alarm_ringing(compiled, snap_compare, size):
 def test_choice_of_buttons_offered(compiled, snap_compare):
     assert snap_compare(paused_app(compiled), press=["u", "a", "w", "w", "w", "a"],
                         terminal_size=(80, 24))
+
+
+def lab_app(compiled) -> WalkthroughApp:
+    session = WalkSession(compiled)
+    session.paused = True
+    return WalkthroughApp(session, title="Smart medication dispenser", large=True,
+                          high_contrast=True)
+
+
+@pytest.mark.parametrize("size", [(64, 20), (80, 24)], ids=["64x20", "80x24"])
+def test_large_high_contrast_alarm(compiled, snap_compare, size):
+    # a big terminal font leaves few cells: the person's panel first, tall buttons
+    assert snap_compare(lab_app(compiled), press=["u"], terminal_size=size)
+
+
+def test_large_high_contrast_after_the_wrong_button(compiled, snap_compare):
+    assert snap_compare(lab_app(compiled), press=["u", "a", "a", "b"], terminal_size=(80, 24))

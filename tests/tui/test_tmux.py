@@ -53,8 +53,10 @@ def test_walkthrough_in_tmux_shows_the_alarm_and_says_where_the_recording_is(tmp
         assert "deadline wait_report (#2) in 05:00" in screen
         tmux("send-keys", "-t", session, "a")
         wait_for(session, "Walk to the dispenser")
+        # the clock dropped to real time at the call: the person can answer the alarm
+        assert "1x" in screen and "real time: the device calls" in screen
         tmux("send-keys", "-t", session, "q")
-        said = wait_for(session, "recording:")
+        said = wait_for(session, "Recording:")
         assert str(record.name) in said
         assert "complete hear_alarm" in Path(record).read_text(encoding="utf-8")
     finally:
