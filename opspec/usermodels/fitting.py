@@ -126,6 +126,8 @@ class Observations:
     busy_omitted: Counter[str] = field(default_factory=Counter)
     picks: dict[str, list[list[str]]] = field(default_factory=lambda: defaultdict(list))
     engaged: set[str] = field(default_factory=set)
+    #: answers a walkthrough marked as not timed in real time (their durations are left out)
+    unusable: Counter[str] = field(default_factory=Counter)
     #: per activity, per user (file index, run index): durations and (omitted, answered)
     user_durations: dict[str, dict[tuple[int, int], list[float]]] = field(
         default_factory=lambda: defaultdict(lambda: defaultdict(list)))
@@ -154,6 +156,7 @@ def collect(paths: Sequence[str | Path], lane: str = "user") -> Observations:
         outstanding: dict[tuple[int, Any, str], deque[tuple[float, str]]] = {}
         in_progress: dict[tuple[int, Any, str], int] = Counter()
         pending_choice: dict[tuple[int, Any], tuple[str, tuple[str, ...]]] = {}
+        unreal: set[tuple[int, Any, str]] = set()     # (run, instance, activity)
         picks_of: dict[tuple[int, Any], dict[str, list[str]]] = {}
         for event in read_trace(path):
             obs.events += 1
@@ -163,6 +166,11 @@ def collect(paths: Sequence[str | Path], lane: str = "user") -> Observations:
                 continue
             if event.lane:
                 obs.lanes_seen.add(event.lane)
+            if event.kind == "walkthrough.action" and event.data.get("usable") is False:
+                # a walkthrough's answer whose simulated duration is not the person's
+                # (docs/walkthrough.md): its duration is not fitted
+                unreal.add((run, event.data.get("instance"), str(event.data.get("activity"))))
+                continue
             if event.activity is None or (event.lane != lane and event.participant != lane):
                 continue
             inst = (run, event.instance)
@@ -189,12 +197,15 @@ def collect(paths: Sequence[str | Path], lane: str = "user") -> Observations:
             user = (file_index, run)
             if event.kind == EventKind.ACTIVITY_COMPLETED:
                 took = max(0.0, event.time - offered_at)
-                obs.durations[event.activity].append(took)
-                obs.user_durations[event.activity][user].append(took)
+                real = _real_duration(unreal, key, obs)
+                if real:
+                    obs.durations[event.activity].append(took)
+                    obs.user_durations[event.activity][user].append(took)
                 obs.user_omissions[event.activity][user][1] += 1
                 choice = event.data.get("choice")
                 if isinstance(choice, str):
-                    obs.pick_durations[event.activity][choice].append(took)
+                    if real:
+                        obs.pick_durations[event.activity][choice].append(took)
                     pending_choice.pop(inst, None)
                     picks_of.setdefault(inst, {}).setdefault(event.activity, []).append(choice)
             elif event.kind == EventKind.ACTIVITY_OMITTED:
@@ -212,9 +223,12 @@ def collect(paths: Sequence[str | Path], lane: str = "user") -> Observations:
                 obs.picks[activity].append(sequence)
     if not obs.durations and not obs.omitted and not obs.busy_omitted:
         seen = ", ".join(sorted(obs.lanes_seen)) or "none"
+        unusable = sum(obs.unusable.values())
         raise UserModelError(
             f"no activity of lane {lane!r} in {len(paths)} trace file(s) "
-            f"({obs.events} events; lanes seen: {seen})",
+            f"({obs.events} events; lanes seen: {seen})" + (
+                f"; {unusable} walkthrough answer(s) left out: not timed in real time"
+                if unusable else ""),
             location=SourceLocation(str(paths[0])) if paths else None,
             hint="record traces of the user lane (for instance a TUI walkthrough), or pick "
             "the lane with --lane")
@@ -246,6 +260,18 @@ class WrongChoiceLoss:
                 "wrong_picks": self.wrong, "intended_picks": self.right,
                 "seconds": self.seconds, "ci95": list(self.ci),
                 "distribution": self.distribution.to_params()}
+
+
+def _real_duration(unreal: set[tuple[int, Any, str]], key: tuple[int, Any, str],
+                   obs: Observations) -> bool:
+    """Whether the answer ``key`` has a real duration. A walkthrough marks those it has not
+    (``walkthrough.action`` with ``usable: false``: the clock was paused, ran faster than real
+    time or jumped, or the user model answered); they are counted in ``obs.unusable``."""
+    if key in unreal:
+        unreal.discard(key)
+        obs.unusable[key[2]] += 1
+        return False
+    return True
 
 
 @dataclass(frozen=True)
