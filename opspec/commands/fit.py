@@ -38,6 +38,17 @@ def register(subparsers: Any) -> None:
     parser.set_defaults(handler=_fit)
 
 
+def _vary_text(vary: dict[str, Any]) -> str:
+    """The ``[vary.activities.ID.PART.PARAM]`` tables of the between-user variation."""
+    import tomli_w
+
+    if not vary:
+        return ""
+    return ("\n# ---- between users: parameters drawn once per simulated user (estimated per "
+            "user, then pooled;\n# docs/fitting.md)\n"
+            + tomli_w.dumps({"vary": {"activities": vary}}))
+
+
 def _fit(args: argparse.Namespace) -> int:
     from opspec.errors import UserModelError
     from opspec.usermodels.fitting import fit_traces, iter_paths
@@ -66,10 +77,11 @@ def _fit(args: argparse.Namespace) -> int:
               "each activity shows.\nOmission rates carry Wilson 95 % intervals. Between-user "
               "spread (users = runs with at least\n"
               f"{args.min_per_user} observations) is in the comments and `opspec fit --json`; "
-              "this file format\nhas no per-user parameters yet, so every simulated user gets "
-              "the pooled values.\nCheck the numbers before relying on them: small samples "
-              "give wide intervals.")
+              "where the data show\nthat users differ, [vary] tables at the end draw those "
+              "parameters per simulated user.\nCheck the numbers before relying on them: "
+              "small samples give wide intervals.")
     text = dump_user_model(result.model, comments=result.comments(), header=header)
+    text += _vary_text(result.vary())
     if out is None:
         sys.stdout.write(text)
         return 0

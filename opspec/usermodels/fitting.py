@@ -24,6 +24,7 @@ from __future__ import annotations
 
 import io
 import json
+import math
 from collections import Counter, defaultdict, deque
 from collections.abc import Iterable, Iterator, Sequence
 from dataclasses import dataclass, field, replace
@@ -35,7 +36,7 @@ import numpy as np
 from opspec.engine.trace import TRACE_FORMAT, TRACE_FORMAT_VERSION, EventKind, TraceEvent
 from opspec.errors import SourceLocation, UserModelError
 from opspec.statistics import rate_interval
-from opspec.usermodels.distributions import Constant, Distribution
+from opspec.usermodels.distributions import Constant, Distribution, Gamma, LogNormal, Weibull
 from opspec.usermodels.errors import Busy, Commission, Omission
 from opspec.usermodels.families import CRITERIA, FamilyFit, choose, fit_families
 from opspec.usermodels.model import ActivityModel, UserModel
@@ -377,6 +378,41 @@ class FitResult:
                 "files": self.observations.files,
                 "activities": {f.activity: f.to_json() for f in self.fits}}
 
+    def vary(self) -> dict[str, dict[str, dict[str, Any]]]:
+        """The between-user variation to write as ``[vary.activities.ID.*]`` tables of the
+        fitted file (``docs/user-models.md``, Populations): per activity, where the data
+        show users differ (a duration spread whose 95 % interval excludes 0; omission rates
+        that fail the chi-square test of one rate for all at 5 %). A lognormal's median, a
+        gamma's or Weibull's scale varies lognormally with the between-user sd; the
+        omission probability by a beta with the between-user mean and sd."""
+        out: dict[str, dict[str, dict[str, Any]]] = {}
+        for fit in self.fits:
+            entry: dict[str, dict[str, Any]] = {}
+            d = fit.duration_spread
+            dist = fit.distribution
+            if d is not None and d.between_sd_ci[0] > 0 and d.between_sd > 0:
+                source = (f"fitted: between-user sd of ln(scale) {d.between_sd:.3f} (95 % "
+                          f"interval [{d.between_sd_ci[0]:.3f}, {d.between_sd_ci[1]:.3f}], "
+                          f"{d.users} users)")
+                if isinstance(dist, LogNormal):
+                    entry["duration"] = {"median": {
+                        "kind": "lognormal", "median": math.exp(dist.mu),
+                        "sigma": d.between_sd, "source": source}}
+                elif isinstance(dist, (Gamma, Weibull)):
+                    entry["duration"] = {"scale": {
+                        "kind": "lognormal", "median": dist.scale, "sigma": d.between_sd,
+                        "source": source}}
+            o = fit.omission_spread
+            if o is not None and o.homogeneity_p < 0.05 and o.beta is not None:
+                entry["omission"] = {"probability": {
+                    "kind": "beta", "mean": o.mean, "sd": o.between_sd,
+                    "source": f"fitted: between-user sd {o.between_sd:.4f} (95 % interval "
+                    f"[{o.between_sd_ci[0]:.4f}, {o.between_sd_ci[1]:.4f}], {o.users} users; "
+                    f"one rate for all: chi-square p = {o.homogeneity_p:.2g})"}}
+            if entry:
+                out[fit.activity] = entry
+        return out
+
 
 def _choice_model(picks: list[list[str]]) -> dict[str, Any]:
     finals = Counter(seq[-1] for seq in picks if seq)
@@ -472,10 +508,19 @@ def fit_traces(paths: Sequence[str | Path], *, lane: str = "user", name: str = "
                            for f in sorted(families, key=lambda f: f.score(criterion)))
         kwargs["source"] = (f"fitted by opspec fit from {origin}: n = {len(values)}, "
                             f"{chosen}" + (f" by {by} ({scores})" if families else ""))
-        activities[activity] = ActivityModel(**kwargs)
         spread_d = duration_spread(obs.user_durations.get(activity, {}),
                                    min_per_user=min_per_user,
                                    family=chosen if families else None)
+        if (isinstance(dist, LogNormal) and spread_d is not None
+                and spread_d.between_sd_ci[0] > 0 and 0 < spread_d.between_sd < dist.sigma):
+            # the pooled sigma holds both within- and between-user spread; the person-level
+            # median varies with between_sd (the [vary] table), so one person's own sigma is
+            # the rest, and the population's spread stays what was observed
+            within = math.sqrt(dist.sigma ** 2 - spread_d.between_sd ** 2)
+            kwargs["duration"] = LogNormal(dist.mu, within)
+            note = (note + "; " if note else "") + (
+                f"sigma {within:.4g} within a user, {spread_d.between_sd:.4g} between users")
+        activities[activity] = ActivityModel(**kwargs)
         spread_o = omission_spread({u: (c[0], c[1]) for u, c in
                                     obs.user_omissions.get(activity, {}).items()},
                                    min_per_user=min_per_user) if omitted else None

@@ -242,3 +242,30 @@ def test_cli_refuses_json_to_standard_output_twice(tmp_path: Path,
     trace = write_population(tmp_path / "g.jsonl", [{"durations": [1.0, 2.0, 3.0]}])
     assert main(["fit", str(trace), "-o", "-", "--json"]) == 2
     assert "both want standard output" in capsys.readouterr().err
+
+
+def test_the_fitted_file_draws_each_user_from_the_estimated_spread(
+        tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """Users who differ (walk median by a lognormal factor, sigma 0.3; omission p ~ Beta(2,
+    18)) give a fitted file with [vary] tables: loaded back, it is a population whose
+    simulated people differ as much as the estimate says, and whose walks pooled over
+    people keep the observed spread (one person's sigma is the within-user part)."""
+    rng = np.random.default_rng(26)
+    users = [{"durations": list(np.exp(rng.normal(math.log(60) + rng.normal(0, 0.3), 0.6,
+                                                   20))),
+              "heard": list(rng.random(60) >= rng.beta(2, 18))} for _ in range(150)]
+    out = tmp_path / "people.users.toml"
+    assert main(["fit", str(write_population(tmp_path / "p.jsonl", users)), "-o",
+                 str(out)]) == 0
+    capsys.readouterr()
+    model = load_user_model(out)
+    population = model.population
+    assert population is not None
+    people = [population.draw(0, u) for u in range(2000)]
+    medians = np.array([p.parameters["activities.walk.duration.median"] for p in people])
+    assert np.std(np.log(medians)) == pytest.approx(0.3, abs=0.06)
+    misses = np.array([p.parameters["activities.hear.omission.probability"] for p in people])
+    assert misses.mean() == pytest.approx(0.1, abs=0.015)
+    assert misses.std() == pytest.approx(0.0655, abs=0.02)
+    own = model.activities["walk"].duration
+    assert isinstance(own, LogNormal) and own.sigma == pytest.approx(0.6, abs=0.04)
