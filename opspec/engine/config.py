@@ -6,8 +6,9 @@ both processor models and the wall-clock mode. It is an immutable value; build i
 arguments or load it from TOML::
 
     [engine]
-    processor_model = "pooled"     # "dedicated" | "pooled"
-    workers = 2
+    processor_model = "pooled"     # "dedicated" | "pooled" | "preemptive" | "priority-queues"
+    workers = 2                    # pooled: workers; preemptive, priority-queues: processors
+    queue_workers = 1              # priority-queues: worker threads per priority queue
     priorities = 4
     timer_resolution = 0.01        # seconds; 0 = exact
     switch_cost = 0.0005           # seconds per transition between general activities (pooled)
@@ -31,7 +32,7 @@ from opspec.errors import ConfigurationError, SourceLocation
 
 __all__ = ["PROCESSOR_MODELS", "EngineConfig"]
 
-PROCESSOR_MODELS = ("dedicated", "pooled", "preemptive")
+PROCESSOR_MODELS = ("dedicated", "pooled", "preemptive", "priority-queues")
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
@@ -46,7 +47,13 @@ class EngineConfig:
       (the source's Linux engine: a thread per workflow at its priority): a ready activity of
       a higher level takes a processor from the lowest-level one running, which resumes
       later (charged ``switch_cost`` again); equal levels are served in arrival order.
-    - ``workers``: number of workers of the pooled model (>= 1).
+    - ``"priority-queues"``: the source's Windows CE engine: a FIFO queue per priority level
+      with ``queue_workers`` worker threads of its own, a leader thread above them that
+      queues work and handles completions, on ``workers`` processors with fixed-priority
+      preemption; every start or resumption of a thread on a processor costs
+      ``switch_cost`` (docs/processor-models.md).
+    - ``workers``: workers of the pooled model, processors of the preemptive and
+      priority-queues models (>= 1); ``queue_workers``: worker threads per queue (>= 1).
     - ``priorities``: number of priority levels (>= 1); effective priorities are clamped to
       ``0 .. priorities-1`` and the highest level is served first.
     - ``timer_resolution``: timers (start triggers, timer events, deadlines) fire on the next
@@ -59,8 +66,9 @@ class EngineConfig:
       keeps them until caught or their receiver ends.
     """
 
-    processor_model: Literal["dedicated", "pooled", "preemptive"] = "dedicated"
+    processor_model: Literal["dedicated", "pooled", "preemptive", "priority-queues"] = "dedicated"
     workers: int = 1
+    queue_workers: int = 1
     priorities: int = 8
     timer_resolution: float = 0.0
     switch_cost: float = 0.0
@@ -92,7 +100,7 @@ class EngineConfig:
                 )
         merged = {f.name: getattr(base or _DEFAULT, f.name) for f in fields(cls)}
         merged.update(values)
-        for key in ("workers", "priorities"):
+        for key in ("workers", "priorities", "queue_workers"):
             if isinstance(merged[key], float) and merged[key].is_integer():
                 merged[key] = int(merged[key])
         config = object.__new__(cls)
@@ -150,7 +158,7 @@ def _check(config: EngineConfig, path: str | None) -> None:
         raise _fail(path, "processor_model",
                     f"processor_model {config.processor_model!r} is not known",
                     f"allowed values: {', '.join(PROCESSOR_MODELS)}")
-    for key in ("workers", "priorities"):
+    for key in ("workers", "priorities", "queue_workers"):
         value = getattr(config, key)
         if isinstance(value, bool) or not isinstance(value, int) or value < 1:
             raise _fail(path, key, f"{key} must be a whole number >= 1, not {value!r}",

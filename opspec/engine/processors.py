@@ -1,11 +1,21 @@
-"""The pooled processor model: N workers, one FIFO queue per priority level.
+"""The processor models: who runs a ready general activity, when, and at what cost.
 
-The source design's Windows CE engine: a leader thread runs built-ins inline and puts ready
-*general* activities into one FIFO queue per priority (workflow priority + activity priority
-increment); workers take the head of the highest non-empty queue; every transition into a
-general activity costs a context switch. Here a worker is held for ``switch_cost`` plus the
-activity's ``cpu_demand`` simulated seconds, then the activity goes on (its declared duration,
-if any, elapses without holding a worker).
+``make_processor`` builds the one a configuration names (docs/processor-models.md):
+
+- ``pooled`` (:class:`PooledProcessor`): N shared non-preemptive workers take the head of the
+  highest non-empty FIFO queue per priority (workflow priority + activity priority
+  increment); a worker is held for ``switch_cost`` plus the activity's ``cpu_demand``
+  simulated seconds, then the activity goes on (its declared duration, if any, elapses
+  without holding a worker). A simplification of the source's Windows CE engine: no leader,
+  no worker per queue, no preemption.
+- ``preemptive`` (:class:`PreemptiveProcessor`): K processors, fixed-priority preemptive
+  scheduling (the source's Linux engine: a thread per workflow at its priority).
+- ``priority-queues`` (:class:`PriorityQueueProcessor`): the source's Windows CE engine as
+  EMWF TR-IIS-08-005 §4.2.2 describes it: a FIFO queue per priority served by its own worker
+  thread(s) at the queue's priority, a leader thread above them that queues work and handles
+  completions, all on K processors with fixed-priority preemption and a cost per context
+  switch.
+- ``dedicated`` (no processor object; :class:`DedicatedProcessor` only counts).
 
 The queues are plain deques indexed by level, not ``simpy.PriorityResource``, which re-sorts
 its whole queue on every request (12 us with 20 waiting, 360 us with 5,000; issue 3).
@@ -24,11 +34,38 @@ from __future__ import annotations
 import heapq
 from collections import deque
 from collections.abc import Callable
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import simpy
 
-__all__ = ["DedicatedProcessor", "PooledProcessor", "PreemptiveProcessor"]
+if TYPE_CHECKING:
+    from opspec.engine.config import EngineConfig
+
+__all__ = ["DedicatedProcessor", "PooledProcessor", "PreemptiveProcessor",
+           "PriorityQueueProcessor", "make_processor"]
+
+
+def make_processor(env: simpy.Environment, config: EngineConfig,
+                   on_done: Callable[[Any], None], is_alive: Callable[[Any], bool]
+                   ) -> PooledProcessor | None:
+    """The shared processors ``config`` asks for (``None``: the dedicated model). Its
+    ``activity_switch`` is the switch cost the engine adds to each general activity's
+    demand (the models that charge their own switches say 0)."""
+    model = config.processor_model
+    pool: PooledProcessor
+    if model == "preemptive":
+        pool = PreemptiveProcessor(env, config.workers, config.priorities, on_done, is_alive,
+                                   config.switch_cost)
+    elif model == "priority-queues":
+        pool = PriorityQueueProcessor(env, config.workers, config.priorities, on_done,
+                                      is_alive, config.switch_cost, config.queue_workers)
+    elif model == "pooled":
+        pool = PooledProcessor(env, config.workers, config.priorities, on_done, is_alive)
+    else:
+        return None
+    if model != "priority-queues":
+        pool.activity_switch = config.switch_cost
+    return pool
 
 
 class PooledProcessor:
@@ -40,6 +77,7 @@ class PooledProcessor:
     """
 
     __slots__ = (
+        "activity_switch",
         "busy_time",
         "env",
         "free",
@@ -62,6 +100,12 @@ class PooledProcessor:
         self.busy_time = 0.0
         self.max_waiting = 0
         self.switches = 0            # activities dispatched to a worker (one switch each)
+        self.activity_switch = 0.0   # what the engine adds to a general activity's demand
+
+    def summary(self) -> dict[str, Any]:
+        """What the run summary reports under ``pool``."""
+        return {"busy_time": self.busy_time, "max_waiting": self.max_waiting,
+                "switches": self.switches}
 
     def submit(self, job: Any, level: int, cost: float) -> bool:
         top = len(self.queues) - 1
@@ -177,6 +221,9 @@ class PreemptiveProcessor(PooledProcessor):
         self.max_waiting = max(self.max_waiting, self.waiting)
         return True
 
+    def summary(self) -> dict[str, Any]:
+        return {**super().summary(), "preemptions": self.preemptions}
+
     def _start(self, job: Any, level: int, cost: float) -> None:
         self.switches += 1
         entry = [job, level, cost, self.env.now, 0]
@@ -221,3 +268,187 @@ class PreemptiveProcessor(PooledProcessor):
                         self.free -= 1
                         self._start(job, level, cost)
                     break
+
+
+class _Thread:
+    """A thread of the priority-queues model: the leader, or a worker holding one work item.
+
+    ``remaining`` is the item's processor demand still to run (the leader has none: its pass
+    is the switch into it); ``order`` breaks ties between threads of one level (the one ready
+    first runs first); ``generation`` makes a segment's completion stale once preempted."""
+
+    __slots__ = ("generation", "job", "level", "order", "remaining", "started")
+
+    def __init__(self, level: int, job: Any, remaining: float, order: int) -> None:
+        self.level = level
+        self.job = job
+        self.remaining = remaining
+        self.order = order
+        self.started = 0.0
+        self.generation = 0
+
+
+class PriorityQueueProcessor(PooledProcessor):
+    """The source's Windows CE engine (EMWF TR-IIS-08-005 §4.2.2) on ``cpus`` processors.
+
+    - A ready general activity becomes a work item in the FIFO queue of its level (workflow
+      priority + priority increment, clamped to ``0 .. priorities-1``).
+    - Each queue has ``queue_workers`` worker threads of its own, at the queue's priority; a
+      free worker takes its queue's head, so one worker per queue runs that level's items
+      one after the other even when a processor is idle.
+    - A leader thread, above every queue, queues the work and handles completions: a worker
+      that finishes an item signals the leader, which — once it has a processor — looks at
+      the completed items in priority order (highest first), carries each one's workflow on
+      (the engine's inline built-ins: no processor time) and queues what that readies. Work
+      readied outside the leader (a timer, a device's answer: the source's helper threads)
+      also wakes the leader, which queues it in the order it arrived, after the completions.
+    - The threads share ``cpus`` processors by fixed priority with preemption (the leader
+      first; equal levels in the order they became ready, never preempting each other).
+      Every time a processor starts or resumes a thread it spends ``switch_cost`` first: so
+      a general activity costs at least two switches (into its worker, back into the leader),
+      a release one more (into the leader), and a preempted item one more when it resumes.
+
+    ``submit`` returns ``True`` when the item found no free worker of its level; ``summary``
+    adds the leader's passes, the preemptions and the processors' count to the pool's.
+    """
+
+    __slots__ = ("_completed", "_in_leader", "_leader", "_leader_busy", "_order",
+                 "_ready", "_released", "_running", "cpus", "idle", "leader_passes",
+                 "preemptions", "queue_workers", "switch_cost")
+
+    def __init__(self, env: simpy.Environment, cpus: int, priorities: int,
+                 on_done: Callable[[Any], None], is_alive: Callable[[Any], bool],
+                 switch_cost: float = 0.0, queue_workers: int = 1) -> None:
+        super().__init__(env, cpus, priorities, on_done, is_alive)
+        self.cpus = cpus
+        self.switch_cost = switch_cost
+        self.queue_workers = queue_workers
+        self.idle = [queue_workers] * priorities       # free workers per level
+        self.preemptions = 0
+        self.leader_passes = 0
+        self._order = 0
+        self._leader = _Thread(priorities, None, 0.0, 0)  # above every queue
+        self._leader_busy = False        # runnable or running
+        self._in_leader = False          # inside the leader's handling (submits queue at once)
+        self._completed: list[tuple[int, int, Any]] = []   # (level, order, job)
+        self._released: list[tuple[Any, int, float]] = []  # (job, level, cost)
+        self._ready: list[_Thread] = []
+        self._running: list[_Thread] = []
+
+    # ---------------------------------------------------------------- the engine's side
+    def submit(self, job: Any, level: int, cost: float) -> bool:
+        top = len(self.queues) - 1
+        level = 0 if level < 0 else (min(level, top))
+        queued = self.idle[level] == 0
+        if self._in_leader:
+            self._enqueue(job, level, cost)
+        else:                             # a helper thread wakes the leader, which queues it
+            self._released.append((job, level, cost))
+            self._wake_leader()
+            self._schedule()
+        return queued
+
+    def summary(self) -> dict[str, Any]:
+        return {**super().summary(), "cpus": self.cpus, "queue_workers": self.queue_workers,
+                "leader_passes": self.leader_passes, "preemptions": self.preemptions}
+
+    # ---------------------------------------------------------------- queues and workers
+    def _next_order(self) -> int:
+        self._order += 1
+        return self._order
+
+    def _enqueue(self, job: Any, level: int, cost: float) -> None:
+        if self.idle[level] > 0:
+            self.idle[level] -= 1
+            self._ready.append(_Thread(level, job, cost, self._next_order()))
+        else:
+            self.queues[level].append((job, cost))
+            self.waiting += 1
+            self.max_waiting = max(self.max_waiting, self.waiting)
+
+    def _worker_free(self, level: int) -> None:
+        """A worker of ``level`` finished its item: it takes the head of its queue."""
+        queue = self.queues[level]
+        while queue:
+            job, cost = queue.popleft()
+            self.waiting -= 1
+            if self.is_alive(job):
+                self._ready.append(_Thread(level, job, cost, self._next_order()))
+                return
+        self.idle[level] += 1
+
+    def _wake_leader(self) -> None:
+        if not self._leader_busy:
+            self._leader_busy = True
+            self._leader.order = self._next_order()
+            self._ready.append(self._leader)
+
+    # ---------------------------------------------------------------- the processors
+    def _schedule(self) -> None:
+        """Give the processors to the highest-priority ready threads, preempting lower ones."""
+        ready = self._ready
+        while ready:
+            best = max(ready, key=lambda t: (t.level, -t.order))
+            if self.free <= 0:
+                now = self.env.now
+                # a thread whose segment ends at this instant completes, it is not preempted
+                victims = [t for t in self._running if t.level < best.level
+                           and t.started + self.switch_cost + t.remaining - now > 1e-12]
+                if not victims:
+                    return
+                self._preempt(min(victims, key=lambda t: (t.level, -t.order)))
+            ready.remove(best)
+            self._start(best)
+
+    def _start(self, thread: _Thread) -> None:
+        self.free -= 1
+        self.switches += 1
+        self._running.append(thread)
+        thread.started = self.env.now
+        thread.generation += 1
+        generation = thread.generation
+        timeout = self.env.timeout(self.switch_cost + thread.remaining)
+        timeout.callbacks.append(lambda _event: self._segment_end(thread, generation))
+
+    def _preempt(self, thread: _Thread) -> None:
+        now = self.env.now
+        ran = now - thread.started
+        thread.remaining = max(0.0, thread.remaining - max(0.0, ran - self.switch_cost))
+        self.busy_time += ran
+        thread.generation += 1                   # its pending segment end is stale now
+        self._running.remove(thread)
+        self.free += 1
+        self.preemptions += 1
+        self._ready.append(thread)               # keeps its order: first among its level
+
+    def _segment_end(self, thread: _Thread, generation: int) -> None:
+        if thread.generation != generation:
+            return
+        self.busy_time += self.env.now - thread.started
+        self._running.remove(thread)
+        self.free += 1
+        if thread is self._leader:
+            self._leader_pass()
+        else:
+            self._completed.append((thread.level, thread.order, thread.job))
+            self._worker_free(thread.level)
+            self._wake_leader()
+        self._schedule()
+
+    def _leader_pass(self) -> None:
+        """The leader has its processor: completions in priority order, then releases."""
+        self.leader_passes += 1
+        completed = sorted(self._completed, key=lambda c: (-c[0], c[1]))
+        released, self._completed, self._released = self._released, [], []
+        self._in_leader = True
+        try:
+            for _level, _order, job in completed:
+                self.on_done(job)
+            for job, level, cost in released:
+                if self.is_alive(job):
+                    self._enqueue(job, level, cost)
+        finally:
+            self._in_leader = False
+            self._leader_busy = False
+        if self._completed or self._released:    # cannot happen within zero time; be safe
+            self._wake_leader()
