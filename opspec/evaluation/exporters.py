@@ -7,14 +7,18 @@ Both writers share one interface::
             xes.add_case(case_id, events, attributes={"user": 3, "seed": 1})
 
 ``add_case`` consumes its events once and writes them at once; nothing but the case being
-written is ever held in memory, so exporting 10,000 users costs what exporting one does.
+written is ever held in memory, so exporting 10,000 users costs what exporting one does. XES is
+written with lxml's incremental writer (``lxml.etree.xmlfile``): every element and attribute
+is serialised and escaped by lxml, never assembled from strings.
 The output goes to ``<path>.partial`` and is renamed to ``path`` by :meth:`close`, so a
 reader never sees half a file; when the ``with`` block ends with an exception the partial
 file is left in place (closed, for inspection) and ``path`` is not touched.
 
 An export never grows past the trace cap (1 GiB, or ``OPSPEC_TRACE_MAX_BYTES``; see
 ``docs/trace-format.md``): the write that would pass it raises an
-:class:`~opspec.errors.EvaluationError` saying so, and the ``.partial`` file is left.
+:class:`~opspec.errors.EvaluationError` saying so, and the ``.partial`` file is left. A write
+the disk refuses (full, gone) is an EvaluationError too, also when it happens while closing
+or abandoning the file: never a bare OSError.
 
 The XES mapping (which events, which lifecycle transitions, timestamps, attribute types) is
 documented in ``docs/xes-export.md``; the constants below are its single source.
@@ -30,11 +34,14 @@ from collections.abc import Collection, Iterable, Mapping
 from datetime import UTC, datetime, timedelta
 from pathlib import Path
 from types import TracebackType
-from typing import IO, Any, Self
+from typing import IO, TYPE_CHECKING, Any, Self
 
 from opspec.engine.trace import TRACE_FORMAT_VERSION, EventKind, TraceEvent
 from opspec.engine.trace_sinks import TRACE_MAX_BYTES_ENV, header_line, trace_max_bytes
 from opspec.errors import EvaluationError
+
+if TYPE_CHECKING:
+    from lxml import etree
 
 __all__ = [
     "DEFAULT_EPOCH",
@@ -43,6 +50,7 @@ __all__ = [
     "XES_NAMESPACE",
     "JsonlTraceWriter",
     "XesWriter",
+    "qualified_name",
 ]
 
 XES_NAMESPACE = "http://www.xes-standard.org/"
@@ -74,17 +82,16 @@ DEFAULT_XES_KINDS: frozenset[str] = frozenset(LIFECYCLE_TRANSITIONS)
 _EXTENSIONS = (("Concept", "concept"), ("Time", "time"), ("Lifecycle", "lifecycle"),
                ("Organizational", "org"))
 
-# characters XML 1.0 cannot carry at all (control characters, surrogates, U+FFFE/U+FFFF)
+# characters XML 1.0 cannot carry at all (control characters, surrogates, U+FFFE/U+FFFF):
+# lxml refuses them, so they become U+FFFD
 _XML_INVALID = re.compile("[\x00-\x08\x0b\x0c\x0e-\x1f\ud800-\udfff\ufffe\uffff]")
-_XML_ATTR_ESCAPES = str.maketrans({"&": "&amp;", "<": "&lt;", ">": "&gt;", '"': "&quot;",
-                                   "\n": "&#10;", "\r": "&#13;", "\t": "&#9;"})
 _XS_NAME = re.compile(r"[A-Za-z_][A-Za-z0-9_.\-:]*")
 _LONG_MIN, _LONG_MAX = -(2**63), 2**63 - 1
 
 
-def _attr(text: object) -> str:
-    """Text as the body of a double-quoted XML attribute (invalid characters become U+FFFD)."""
-    return _XML_INVALID.sub("\ufffd", str(text)).translate(_XML_ATTR_ESCAPES)
+def _text(value: object) -> str:
+    """Text XML can carry (invalid characters become U+FFFD); lxml escapes the rest."""
+    return _XML_INVALID.sub("\ufffd", str(value))
 
 
 def _key(name: str) -> str:
@@ -103,26 +110,61 @@ def _double(value: float) -> str:
     return repr(value)
 
 
-def _typed(key: str, value: Any) -> str | None:
-    """One XES attribute element for a Python value, or None for a missing value."""
+def _typed(key: str, value: Any) -> tuple[str, str, str] | None:
+    """(XES type tag, key, value text) of one attribute for a Python value; None for a
+    missing value."""
     if value is None:
         return None
-    k = _attr(_key(key))
+    k = _text(_key(key))
     if isinstance(value, bool):     # before int: bool is an int subclass
-        return f'<boolean key="{k}" value="{"true" if value else "false"}"/>'
+        return "boolean", k, "true" if value else "false"
     if isinstance(value, int) and _LONG_MIN <= value <= _LONG_MAX:
-        return f'<int key="{k}" value="{value}"/>'
+        return "int", k, str(value)
     if isinstance(value, float):
-        return f'<float key="{k}" value="{_double(value)}"/>'
+        return "float", k, _double(value)
     if isinstance(value, datetime) and value.tzinfo is not None:
-        return f'<date key="{k}" value="{value.isoformat(timespec="milliseconds")}"/>'
+        return "date", k, value.isoformat(timespec="milliseconds")
     if isinstance(value, str):
-        return f'<string key="{k}" value="{_attr(value)}"/>'
+        return "string", k, _text(value)
     try:
         text = json.dumps(value, default=str, sort_keys=True, allow_nan=True)
     except (TypeError, ValueError):
         text = str(value)
-    return f'<string key="{k}" value="{_attr(text)}"/>'
+    return "string", k, _text(text)
+
+
+def _add(parent: etree._Element, attribute: tuple[str, str, str] | None) -> None:
+    if attribute is not None:
+        tag, key, value = attribute
+        from lxml import etree  # lxml loads with the first XES export, not on import
+
+        etree.SubElement(parent, tag, key=key, value=value)
+
+
+def qualified_name(process: str | None, activity: str) -> str:
+    """An activity's name in exports: qualified by its process (``user_workflow/take_pill``),
+    since activity ids are unique only within their process."""
+    return f"{process}/{activity}" if process else activity
+
+
+class _DiskFile:
+    """The binary file under an export: counts bytes against the cap, and turns the disk's
+    refusals (full, gone) into EvaluationErrors naming the export."""
+
+    def __init__(self, owner: _StreamingWriter, handle: IO[bytes]) -> None:
+        self.owner = owner
+        self.handle = handle
+        self.written = 0
+
+    def write(self, data: bytes | str) -> int:
+        raw = data.encode("utf-8") if isinstance(data, str) else data
+        self.written += len(raw)
+        if self.written > self.owner.max_bytes:
+            raise self.owner._over_cap()
+        try:
+            return self.handle.write(raw)
+        except OSError as error:
+            raise self.owner._error(error) from None
 
 
 class _StreamingWriter:
@@ -134,13 +176,16 @@ class _StreamingWriter:
         self.cases = 0
         self.events = 0
         self.max_bytes = trace_max_bytes()
-        self._bytes = 0
         try:
             self.path.parent.mkdir(parents=True, exist_ok=True)
-            self._handle: IO[str] | None = open(  # noqa: SIM115  (closed by close())
-                self._partial, "w", encoding="utf-8", newline="\n")
+            handle = open(self._partial, "wb")  # noqa: SIM115  (closed by close())
         except OSError as error:
             raise self._error(error) from None
+        self._file: _DiskFile | None = _DiskFile(self, handle)
+
+    @property
+    def bytes_written(self) -> int:
+        return self._file.written if self._file is not None else 0
 
     def _error(self, error: OSError) -> EvaluationError:
         return EvaluationError(f"cannot write the trace export {self.path}: "
@@ -148,49 +193,56 @@ class _StreamingWriter:
                                hint="check that the output folder is writable and the disk "
                                     "is not full")
 
-    def _check_open(self) -> IO[str]:
-        if self._handle is None:
+    def _over_cap(self) -> EvaluationError:
+        self._abandon()
+        return EvaluationError(
+            f"the trace export {self.path} reached its cap of {self.max_bytes:,} bytes "
+            f"after {self.cases:,} case(s); it is left as {self._partial.name}",
+            hint=f"set {TRACE_MAX_BYTES_ENV} to a larger number of bytes, or export "
+                 "fewer users or days")
+
+    def _check_open(self) -> _DiskFile:
+        if self._file is None:
             raise EvaluationError(f"the trace export {self.path} is already closed",
                                   hint="add every case before close()")
-        return self._handle
+        return self._file
 
     def _write(self, text: str) -> None:
-        handle = self._check_open()
-        self._bytes += len(text)
-        if self._bytes > self.max_bytes:
-            self._abandon()
-            raise EvaluationError(
-                f"the trace export {self.path} reached its cap of {self.max_bytes:,} bytes "
-                f"after {self.cases:,} case(s); it is left as {self._partial.name}",
-                hint=f"set {TRACE_MAX_BYTES_ENV} to a larger number of bytes, or export "
-                     "fewer users or days")
-        try:
-            handle.write(text)
-        except OSError as error:
-            raise self._error(error) from None
+        self._check_open().write(text)
 
-    def _footer(self) -> str:
-        return ""
+    def _finish(self) -> None:
+        """Write what ends the file (subclasses)."""
 
     def close(self) -> None:
         """Finish the file and move it into place; calling it again does nothing."""
-        if self._handle is None:
+        if self._file is None:
             return
+        file = self._file
         try:
-            self._handle.write(self._footer())
-            self._handle.close()
+            self._finish()
+            file.handle.close()
             os.replace(self._partial, self.path)
         except OSError as error:
             raise self._error(error) from None
         finally:
-            self._handle = None
+            self._file = None
+            if not file.handle.closed:
+                self._close_quietly(file.handle)
 
     def _abandon(self) -> None:
-        if self._handle is not None:
-            try:
-                self._handle.close()
-            finally:
-                self._handle = None
+        """Stop writing: the ``.partial`` file stays as it is, for inspection."""
+        if self._file is not None:
+            handle, self._file = self._file.handle, None
+            self._close_quietly(handle)
+
+    @staticmethod
+    def _close_quietly(handle: IO[bytes]) -> None:
+        # abandoning after an error: a disk that refuses the last buffered bytes too must
+        # not replace the error being raised
+        try:
+            handle.close()
+        except OSError:
+            pass
 
     def __enter__(self) -> Self:
         return self
@@ -204,7 +256,8 @@ class _StreamingWriter:
 
 
 class XesWriter(_StreamingWriter):
-    """Writes an IEEE 1849-2016 XES log, one ``<trace>`` per case, streaming.
+    """Writes an IEEE 1849-2016 XES log, one ``<trace>`` per case, streaming (lxml's
+    incremental writer).
 
     - ``log_attributes``: log-level attributes, typed as their values (``seed`` an int;
       ``concept:name`` defaults to ``"opspec traces"``);
@@ -213,7 +266,7 @@ class XesWriter(_StreamingWriter):
     - ``kinds``: the opspec event kinds exported (default :data:`DEFAULT_XES_KINDS`; only
       kinds in :data:`LIFECYCLE_TRANSITIONS` can be exported);
     - ``activity_names``: optional ``(process id, activity id) → name`` for ``concept:name``
-      (the activity id is used otherwise).
+      (by default the activity id qualified by its process, :func:`qualified_name`).
     """
 
     def __init__(self, path: Path, *, log_attributes: Mapping[str, Any] | None = None,
@@ -230,39 +283,62 @@ class XesWriter(_StreamingWriter):
         self.epoch = epoch
         self.kinds = frozenset(kinds)
         self._names = dict(activity_names or {})
-        self._static: dict[tuple[str, str | None, str | None, str | None, str | None], str] = {}
+        self._static: dict[tuple[str, str | None, str | None, str | None, str | None],
+                           etree._Element] = {}
         self._last_time: float | None = None
         self._last_stamp = ""
         super().__init__(path)
-        self._write(self._header(dict(log_attributes or {})))
+        self._file_context: Any = None     # lxml's xmlfile, entered by hand: a log spans
+        self._log: Any = None              # many add_case calls
+        from lxml import etree
 
-    def _header(self, log_attributes: dict[str, Any]) -> str:
-        lines = ['<?xml version="1.0" encoding="UTF-8"?>',
-                 f'<log xes.version="1849-2016" xes.features="" xmlns="{XES_NAMESPACE}">']
-        lines += [f'  <extension name="{name}" prefix="{prefix}" '
-                  f'uri="{XES_NAMESPACE}{prefix}.xesext"/>' for name, prefix in _EXTENSIONS]
+        try:
+            self._file_context = etree.xmlfile(self._check_open(), encoding="utf-8")
+            self._xml = self._file_context.__enter__()
+            self._xml.write_declaration()
+            self._log = self._xml.element("log", {"xes.version": "1849-2016",
+                                                  "xes.features": ""},
+                                          nsmap={None: XES_NAMESPACE})
+            self._log.__enter__()
+            self._xml.write("\n")
+            self._xml.write(*self._header(dict(log_attributes or {})), pretty_print=True)
+        except BaseException:
+            self._abandon()
+            raise
+
+    def _header(self, log_attributes: dict[str, Any]) -> list[etree._Element]:
+        from lxml import etree
+
+        out: list[etree._Element] = []
+        for name, prefix in _EXTENSIONS:
+            out.append(etree.Element("extension", name=name, prefix=prefix,
+                                     uri=f"{XES_NAMESPACE}{prefix}.xesext"))
+        trace_globals = etree.Element("global", scope="trace")
+        etree.SubElement(trace_globals, "string", key="concept:name", value="UNKNOWN")
+        event_globals = etree.Element("global", scope="event")
         stamp = self.epoch.isoformat(timespec="milliseconds")
-        lines += ['  <global scope="trace">', '    <string key="concept:name" value="UNKNOWN"/>',
-                  "  </global>",
-                  '  <global scope="event">',
-                  '    <string key="concept:name" value="UNKNOWN"/>',
-                  '    <string key="lifecycle:transition" value="complete"/>',
-                  f'    <date key="time:timestamp" value="{stamp}"/>',
-                  '    <string key="opspec:kind" value="unknown"/>',
-                  "  </global>",
-                  '  <classifier name="Activity" keys="concept:name"/>',
-                  ('  <classifier name="ActivityLifecycle" '
-                  'keys="concept:name lifecycle:transition"/>')]
+        for tag, key, value in (("string", "concept:name", "UNKNOWN"),
+                                ("string", "lifecycle:transition", "complete"),
+                                ("date", "time:timestamp", stamp),
+                                ("string", "opspec:kind", "unknown")):
+            etree.SubElement(event_globals, tag, key=key, value=value)
+        out += [trace_globals, event_globals,
+                etree.Element("classifier", name="Activity", keys="concept:name"),
+                etree.Element("classifier", name="ActivityLifecycle",
+                              keys="concept:name lifecycle:transition")]
         attributes: dict[str, Any] = {"concept:name": "opspec traces",
                                       "lifecycle:model": "standard"}
         attributes.update(log_attributes)
         attributes["opspec:epoch"] = self.epoch
         attributes["opspec:trace-format-version"] = TRACE_FORMAT_VERSION
-        lines += [f"  {_typed(k, v)}" for k, v in attributes.items() if v is not None]
-        return "\n".join(lines) + "\n"
+        holder = etree.Element("log")
+        for key, value in attributes.items():
+            _add(holder, _typed(key, value))
+        return out + list(holder)
 
-    def _footer(self) -> str:
-        return "</log>\n"
+    def _finish(self) -> None:
+        self._log.__exit__(None, None, None)
+        self._file_context.__exit__(None, None, None)
 
     def _timestamp(self, seconds: float) -> str:
         return (self.epoch + timedelta(seconds=seconds)).isoformat(timespec="milliseconds")
@@ -272,12 +348,13 @@ class XesWriter(_StreamingWriter):
         if kind == EventKind.PROCESS_ABORTED:
             return f"process:{process}"
         if kind == EventKind.DEADLINE_EXPIRED:
-            return f"deadline:{activity or process}"
+            return f"deadline:{qualified_name(process, activity or process)}"
         if kind == EventKind.FAULT:
-            return f"fault:{activity or event.participant or event.lane or 'run'}"
+            where = activity or event.participant or event.lane or "run"
+            return f"fault:{qualified_name(process, where) if activity else where}"
         if activity is None:
             return kind
-        return self._names.get((process, activity), activity)
+        return self._names.get((process, activity)) or qualified_name(process, activity)
 
     def add_case(self, case_id: str, events: Iterable[TraceEvent],
                  attributes: Mapping[str, Any] | None = None) -> None:
@@ -289,16 +366,22 @@ class XesWriter(_StreamingWriter):
         raises, the writer is abandoned (the ``.partial`` file stays, ``path`` is untouched)
         and the exception propagates: a half-written trace cannot be completed.
         """
-        out = ["  <trace>", f'    <string key="concept:name" value="{_attr(case_id)}"/>']
+        self._check_open()
+        from lxml import etree
+
+        xml = self._xml
+        trace = xml.element("trace")
+        head = etree.Element("trace")
+        etree.SubElement(head, "string", key="concept:name", value=_text(case_id))
         for key, value in (attributes or {}).items():
             if key != "concept:name":
-                element = _typed(key, value)
-                if element is not None:
-                    out.append(f"    {element}")
-        self._write("\n".join(out) + "\n")
+                _add(head, _typed(key, value))
         pending: dict[tuple[int | None, str | None], dict[str, Any]] = {}
         written = 0
         try:
+            trace.__enter__()
+            xml.write("\n")
+            xml.write(*head, pretty_print=True)
             for event in events:
                 if event.kind == EventKind.DATA_CHANGED:
                     pending.setdefault((event.instance, event.activity), {}).update(event.data)
@@ -308,61 +391,68 @@ class XesWriter(_StreamingWriter):
                 data = pending.pop((event.instance, event.activity), None)
                 if event.activity is not None:
                     data = {**pending.pop((event.instance, None), {}), **(data or {})}
-                self._write(self._event(event, data))
+                xml.write(self._event(event, data), pretty_print=True)
                 written += 1
+            trace.__exit__(None, None, None)
+            xml.write("\n")
         except BaseException:
             # half a <trace> cannot be finished into valid XML: stop here, keep the
             # .partial file for inspection, and refuse further cases
             self._abandon()
             raise
-        self._write("  </trace>\n")
         self.cases += 1
         self.events += written
 
-    def _event(self, event: TraceEvent, data: Mapping[str, Any] | None) -> str:
+    def _event(self, event: TraceEvent, data: Mapping[str, Any] | None) -> etree._Element:
         # The attributes that depend only on the model (name, transition, resource, lane,
-        # kind, process, activity) are rendered once per distinct combination and cached:
-        # it is bounded by the size of the spec and makes export about twice as fast.
+        # kind, process, activity) are built once per distinct combination (bounded by the
+        # size of the spec) into a template <event>; each event starts as a copy of it,
+        # about three times faster than building every attribute element again.
         static_key = (event.kind, event.process, event.activity, event.participant, event.lane)
-        head = self._static.get(static_key)
-        if head is None:
-            head = self._static[static_key] = self._static_part(event)
+        template = self._static.get(static_key)
+        if template is None:
+            template = self._static[static_key] = self._template(event)
         if event.time != self._last_time:
             self._last_time = event.time
             self._last_stamp = self._timestamp(event.time)
-        parts = [head,
-                 f'      <date key="time:timestamp" value="{self._last_stamp}"/>',
-                 f'      <float key="opspec:time" value="{_double(float(event.time))}"/>']
-        if event.instance is not None:
-            parts.append(f'      <int key="opspec:instance" value="{int(event.instance)}"/>')
-        fields: dict[str, Any] = {f"opspec:{key}": value for key, value in event.data.items()}
-        for key, value in (data or {}).items():
-            name = key
-            if ":" in key or name in fields:
-                name = f"data:{key}"
-            fields[name] = value
-        for key, value in fields.items():
-            element = _typed(key, value)
-            if element is not None:
-                parts.append(f"      {element}")
-        parts.append("    </event>\n")
-        return "\n".join(parts)
+        from lxml import etree
 
-    def _static_part(self, event: TraceEvent) -> str:
-        parts = ["    <event>",
-                 f'      <string key="concept:name" value="{_attr(self._name(event))}"/>',
-                 (f'      <string key="lifecycle:transition" '
-                 f'value="{LIFECYCLE_TRANSITIONS[event.kind]}"/>')]
+        element = template.__copy__()
+        sub = etree.SubElement
+        sub(element, "date", key="time:timestamp", value=self._last_stamp)
+        sub(element, "float", key="opspec:time", value=_double(float(event.time)))
+        if event.instance is not None:
+            sub(element, "int", key="opspec:instance", value=str(int(event.instance)))
+        if event.data or data:
+            fields: dict[str, Any] = {f"opspec:{key}": value
+                                      for key, value in event.data.items()}
+            for key, value in (data or {}).items():
+                name = key
+                if ":" in key or name in fields:
+                    name = f"data:{key}"
+                fields[name] = value
+            for key, value in fields.items():
+                _add(element, _typed(key, value))
+        return element
+
+    def _template(self, event: TraceEvent) -> etree._Element:
+        from lxml import etree
+
+        element = etree.Element("event")
+        parts = [("string", "concept:name", _text(self._name(event))),
+                 ("string", "lifecycle:transition", LIFECYCLE_TRANSITIONS[event.kind])]
         if event.participant is not None:
-            parts.append(f'      <string key="org:resource" value="{_attr(event.participant)}"/>')
+            parts.append(("string", "org:resource", _text(event.participant)))
         if event.lane is not None:
-            parts.append(f'      <string key="org:group" value="{_attr(event.lane)}"/>')
-        parts.append(f'      <string key="opspec:kind" value="{_attr(event.kind)}"/>')
+            parts.append(("string", "org:group", _text(event.lane)))
+        parts.append(("string", "opspec:kind", _text(event.kind)))
         if event.process is not None:
-            parts.append(f'      <string key="opspec:process" value="{_attr(event.process)}"/>')
+            parts.append(("string", "opspec:process", _text(event.process)))
         if event.activity is not None:
-            parts.append(f'      <string key="opspec:activity" value="{_attr(event.activity)}"/>')
-        return "\n".join(parts)
+            parts.append(("string", "opspec:activity", _text(event.activity)))
+        for part in parts:
+            _add(element, part)
+        return element
 
 
 class JsonlTraceWriter(_StreamingWriter):
@@ -377,7 +467,11 @@ class JsonlTraceWriter(_StreamingWriter):
     def __init__(self, path: Path, *, log_attributes: Mapping[str, Any] | None = None) -> None:
         super().__init__(path)
         head = header_line(log_attributes, cases=True)
-        self._write(json.dumps(head, default=str) + "\n")
+        try:
+            self._write(json.dumps(head, default=str) + "\n")
+        except BaseException:
+            self._abandon()
+            raise
 
     def add_case(self, case_id: str, events: Iterable[TraceEvent],
                  attributes: Mapping[str, Any] | None = None) -> None:

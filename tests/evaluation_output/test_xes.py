@@ -117,11 +117,11 @@ def test_activity_life_cycle_maps_to_standard_transitions(
         tmp_path: Path, dispenser_day: list[TraceEvent]) -> None:
     events = events_of(write_log(tmp_path / "t.xes", {"u": dispenser_day}))
     take_pill = [(e["opspec:kind"], e["lifecycle:transition"]) for e in events
-                 if e["concept:name"] == "take_pill"]
+                 if e["concept:name"] == "user_workflow/take_pill"]
     assert take_pill == [("activity.started", "start"), ("activity.offered", "assign"),
                          ("activity.completed", "complete")]
     hear = {(e["opspec:kind"], e["lifecycle:transition"]) for e in events
-            if e["concept:name"] == "hear_alarm"}
+            if e["concept:name"] == "user_workflow/hear_alarm"}
     assert ("activity.omitted", "manualskip") in hear
 
 
@@ -132,7 +132,7 @@ def test_deadlines_are_events_and_triggers_and_data_changes_are_not(
     assert kinds <= DEFAULT_XES_KINDS
     assert EventKind.TRIGGER_RAISED not in kinds and EventKind.DATA_CHANGED not in kinds
     deadlines = [e for e in events if e["opspec:kind"] == EventKind.DEADLINE_EXPIRED]
-    assert deadlines and {e["concept:name"] for e in deadlines} == {"deadline:wait_report"}
+    assert deadlines and {e["concept:name"] for e in deadlines} == {"deadline:notify_workflow/wait_report"}
     assert all(e["opspec:exception"] == "no_report" for e in deadlines)
     expected = sum(1 for ev in dispenser_day if ev.kind in DEFAULT_XES_KINDS)
     assert len(events) == expected
@@ -143,12 +143,12 @@ def test_data_changes_are_attributes_of_the_completing_event(
     path = write_log(tmp_path / "t.xes", {"u": dispenser_day})
     tree = etree.parse(str(path))
     recorded = [e for e in tree.iterfind(".//x:event", NS)
-                if attrs(e).get("concept:name") == "record_taken"
+                if attrs(e).get("concept:name") == "notify_workflow/record_taken"
                 and attrs(e)["lifecycle:transition"] == "complete"]
     assert len(recorded) == 1
     assert attrs(recorded[0])["outcome"] == "taken"
     alarms = [e.find("x:int[@key='alarms']", NS) for e in tree.iterfind(".//x:event", NS)
-              if attrs(e).get("concept:name") == "sound_alarm"
+              if attrs(e).get("concept:name") == "notify_workflow/sound_alarm"
               and attrs(e)["lifecycle:transition"] == "complete"]
     assert alarms and all(a is not None for a in alarms), "alarms is written as an int"
 
@@ -160,7 +160,7 @@ def test_timestamps_are_simulated_seconds_after_the_epoch(
         stamp = datetime.fromisoformat(event["time:timestamp"])
         assert stamp.utcoffset() == timedelta(0)
         assert stamp == DEFAULT_EPOCH + timedelta(seconds=float(event["opspec:time"]))
-    first_pill = next(e for e in events if e["concept:name"] == "take_pill"
+    first_pill = next(e for e in events if e["concept:name"] == "user_workflow/take_pill"
                       and e["lifecycle:transition"] == "complete")
     assert first_pill["time:timestamp"] == "2026-01-05T08:01:50.000+00:00"
 
@@ -200,7 +200,7 @@ def test_activity_names_replace_ids_in_concept_name(tmp_path: Path,
 def test_resource_and_group_come_from_participant_and_lane(
         tmp_path: Path, dispenser_day: list[TraceEvent]) -> None:
     events = events_of(write_log(tmp_path / "t.xes", {"u": dispenser_day}))
-    pill = next(e for e in events if e["concept:name"] == "take_pill")
+    pill = next(e for e in events if e["concept:name"] == "user_workflow/take_pill")
     assert (pill["org:resource"], pill["org:group"]) == ("user", "user")
     assert any(e.get("org:group") == "device" for e in events)
 
@@ -230,7 +230,7 @@ def test_hostile_strings_and_odd_values_stay_well_formed_and_typed(
     first, second = root.findall(".//x:event", NS)
     values = attrs(first)
     cleaned = HOSTILE.replace("\x00", "\ufffd").replace("\x07", "\ufffd")
-    assert values["concept:name"] == cleaned
+    assert values["concept:name"] == f"p/{cleaned}"       # qualified by its process
     assert values["org:resource"] == cleaned
     assert values["opspec:choice"] == cleaned
     typed = {c.get("key"): c.tag.split("}")[1] for c in first}
@@ -240,7 +240,7 @@ def test_hostile_strings_and_odd_values_stay_well_formed_and_typed(
     assert values["opspec:list"] == '[1, "a"]'
     assert "opspec:none" not in values
     data = attrs(second)
-    assert data["concept:name"] == "b", "a data field cannot overwrite a standard key"
+    assert data["concept:name"] == "p/b", "a data field cannot overwrite a standard key"
     assert data["data:concept:name"] == "spoof"
     assert data["bad_key_"] == "1.5"
 
@@ -328,6 +328,6 @@ def test_pm4py_reads_the_log_back(tmp_path: Path, dispenser_day: list[TraceEvent
     assert frame["case:user"].tolist().count(1) == expected
     completed = pm4py.filter_event_attribute_values(frame, "lifecycle:transition",
                                                     ["complete"], level="event")
-    assert "take_pill" in set(completed["concept:name"])
+    assert "user_workflow/take_pill" in set(completed["concept:name"])
     log = pm4py.read_xes(str(path), return_legacy_log_object=True)
     assert set(log.classifiers) == {"Activity", "ActivityLifecycle"}
