@@ -148,7 +148,6 @@ def run(args: argparse.Namespace) -> int:
 
 def _model_factory(compiled: Any, ref: Any, seed: int) -> Any:
     from opspec.engine.lanes import user_lane
-    from opspec.engine.random import user_stream
     from opspec.usermodels.loader import load_user_model
 
     model = load_user_model(ref)
@@ -163,6 +162,7 @@ def _model_factory(compiled: Any, ref: Any, seed: int) -> Any:
         # start, the walkthrough is that run); each later one a user of its own
         handovers[0] += 1
         user = 0 if handovers[0] == 1 else 1000 + handovers[0]
-        return model.performer(user_stream(seed, user))
+        # user u's own model (a population's person u), drawing from user_stream(seed, u)
+        return model.performer_for(seed, user)
 
     return make
