@@ -70,9 +70,14 @@ def register(subparsers: Any) -> None:
                       help="nobody performs the user lane (ignore SPEC.users.toml)")
     parser.add_argument("--trace", metavar="FILE", help="write the full trace as JSON Lines")
     parser.add_argument("--engine-config", metavar="FILE", help="engine configuration TOML")
-    parser.add_argument("--processor-model", choices=("dedicated", "pooled", "preemptive"),
-                        help="override the configuration's processor model")
-    parser.add_argument("--workers", type=int, help="override the pooled model's workers")
+    parser.add_argument("--processor-model",
+                        choices=("dedicated", "pooled", "preemptive", "priority-queues"),
+                        help="override the configuration's processor model "
+                        "(docs/processor-models.md)")
+    parser.add_argument("--workers", type=int, help="override the pooled model's workers "
+                        "(the processors of the preemptive and priority-queues models)")
+    parser.add_argument("--queue-workers", type=int, metavar="N",
+                        help="priority-queues model: worker threads per priority queue")
     parser.add_argument("--switch-cost", type=float, metavar="SECONDS",
                         help="override the pooled model's cost of one context switch")
     parser.add_argument("--realtime", action="store_true",
@@ -123,7 +128,10 @@ def run(args: argparse.Namespace) -> int:
                   f"for {_span(horizon)} simulated", file=out)
             print(f"  user lane: {user.describe}", file=out)
             print(f"  engine: {config.processor_model}"
-                  + (f", {config.workers} worker(s)" if config.pooled else "")
+                  + (f", {config.workers} worker(s)" if config.processor_model == "pooled" else
+                     f", {config.workers} processor(s)" if config.pooled else "")
+                  + (f", {config.queue_workers} worker(s) per queue"
+                     if config.processor_model == "priority-queues" else "")
                   + (f", wall clock at {config.speed:g}x" if config.realtime else ""), file=out)
         if devices is not None:
             for note in devices.notes:
@@ -252,10 +260,15 @@ def _config(args: argparse.Namespace) -> Any:
     if args.switch_cost is not None:
         overrides["switch_cost"] = args.switch_cost
     model = overrides.get("processor_model", config.processor_model)
+    if args.queue_workers is not None:
+        if model != "priority-queues":
+            raise ConfigurationError("--queue-workers applies to the priority-queues model "
+                                     "only", hint="add --processor-model priority-queues")
+        overrides["queue_workers"] = args.queue_workers
     if model == "dedicated" and (args.workers is not None or args.switch_cost is not None):
         raise ConfigurationError(
             f"{'--workers' if args.workers is not None else '--switch-cost'} applies to the "
-            "pooled and preemptive models only; the dedicated model gives every workflow "
+            "shared-processor models only; the dedicated model gives every workflow "
             "instance its own worker (unlimited processors, no switch cost, by design)",
             hint="add --processor-model pooled (or preemptive) to compare N shared processors")
     if args.speed is not None and not (args.realtime or config.realtime or args.bind):
@@ -453,34 +466,57 @@ def _fmt(value: Any, unit: str = "") -> str:
     return f"{value}{unit}"
 
 
-def _miss_rate(misses: int, n: int) -> str:
-    """The share of instances that missed their deadline, with its Clopper-Pearson interval
-    (exact: a positive upper bound even with no miss)."""
-    if n <= 0:
+def _percent(rate: Any, ci: list[Any]) -> str:
+    """A miss rate with its exact 95 % interval, in percent."""
+    if rate is None:
         return "-"
-    from scipy.stats import binomtest
-
-    low, high = binomtest(min(misses, n), n).proportion_ci(confidence_level=0.95,
-                                                           method="exact")
-    return f"{100 * misses / n:.3g} [{100 * low:.3g}, {100 * high:.3g}]"
+    return f"{100 * rate:.3g} [{100 * ci[0]:.3g}, {100 * ci[1]:.3g}]"
 
 
 def _ms(value: Any) -> str:
     return "-" if value is None else f"{value * 1000:.2f}"
 
 
+def _quantile_ms(t: dict[str, Any], name: str) -> str:
+    """A response percentile in ms with its distribution-free 95 % interval (``?``: a bound
+    too few instances cannot give)."""
+    value = t.get(f"{name}_s")
+    if value is None:
+        return "-"
+    low, high = t.get(f"{name}_ci_s") or (None, None)
+    return (f"{value * 1000:.2f} [{'?' if low is None else f'{low * 1000:.2f}'}, "
+            f"{'?' if high is None else f'{high * 1000:.2f}'}]")
+
+
 def _print_timing(out: Any, timing: dict[str, dict[str, Any]], pool: dict[str, Any] | None,
                   dedicated: dict[str, Any] | None = None) -> None:
-    print("\ntiming (response times in milliseconds of simulated time; misses: instances past "
-          "their deadline, with the miss rate's exact 95 % interval)", file=out)
+    wall = any(t.get("clock") == "wall" for t in timing.values())
+    clock = "wall-clock" if wall else "simulated"
+    print(f"\ntiming (times in milliseconds of {clock} time; percentiles with their "
+          "distribution-free 95 % interval; misses: instances past their deadline, with the "
+          "miss rate's exact 95 % interval)", file=out)
     print(f"  {'workflow':<20}{'started':>8}{'done':>8}{'misses':>8}{'miss % [95 % CI]':>24}"
-          f"{'mean ms':>10}{'p95 ms':>10}{'max ms':>10}{'jitter ms':>11}", file=out)
+          f"{'mean ms':>10}{'max ms':>10}{'jitter ms':>11}", file=out)
     for name, t in timing.items():
         print(f"  {name:<20}{t['started']:>8}{t['completed']:>8}{t['misses']:>8}"
-              f"{_miss_rate(t['misses'], t['started']):>24}"
-              f"{_ms(t['response_mean_s']):>10}{_ms(t['response_p95_s']):>10}"
-              f"{_ms(t['response_max_s']):>10}{_ms(t['jitter_s']):>11}", file=out)
-    if pool and pool.get("preemptive"):
+              f"{_percent(t.get('miss_rate'), t.get('miss_rate_ci') or [0, 0]):>24}"
+              f"{_ms(t['response_mean_s']):>10}{_ms(t['response_max_s']):>10}"
+              f"{_ms(t['jitter_s']):>11}", file=out)
+        print(f"  {'':<20}p50 {_quantile_ms(t, 'response_p50')}  "
+              f"p90 {_quantile_ms(t, 'response_p90')}  p99 {_quantile_ms(t, 'response_p99')}",
+              file=out)
+        if wall and t.get("start_late_max_s") is not None:
+            print(f"  {'':<20}start late vs due (wall clock): mean "
+                  f"{_ms(t['start_late_mean_s'])}, p99 {_ms(t['start_late_p99_s'])}, max "
+                  f"{_ms(t['start_late_max_s'])} ms", file=out)
+    model = (pool or {}).get("model")
+    if pool and model == "priority-queues":
+        print(f"  priority-queues model: {pool.get('cpus')} processor(s), "
+              f"{pool.get('queue_workers')} worker(s) per queue, {pool.get('switches')} context "
+              f"switches ({pool.get('leader_passes')} into the leader), "
+              f"{pool.get('preemptions')} preemption(s), busy {_fmt(pool.get('busy_time'))} s, "
+              f"at most {pool.get('max_waiting')} waiting", file=out)
+    elif pool and pool.get("preemptive"):
         print(f"  preemptive model: {pool.get('workers')} processor(s), {pool.get('switches')} "
               f"dispatches, {pool.get('preemptions')} preemption(s), busy "
               f"{_fmt(pool.get('busy_time'))} s, at most {pool.get('max_waiting')} waiting",
@@ -495,8 +531,8 @@ def _print_timing(out: Any, timing: dict[str, dict[str, Any]], pool: dict[str, A
         print(f"  {dedicated.get('bursts')} CPU bursts, busy {_fmt(dedicated.get('busy_time'))}"
               f" s, at most {dedicated.get('max_busy')} at once (pooled with that many workers "
               "and no switch cost waits for none)", file=out)
-    print("  response = completion - start of an instance: declared durations count too",
-          file=out)
+    print("  response = completion - start of an instance: declared durations count too"
+          + ("; jitter = max - min start lateness" if wall else ""), file=out)
 
 
 def _print_summary(out: Any, result: RunResult, medians: dict[str, float], trace: str | None,

@@ -201,6 +201,7 @@ class CompiledActivity:
     deadlines: tuple[tuple[Evaluator, bool, str], ...] = ()   # (seconds, synchronous, exception)
     sampler: Sampler | None = None
     cpu: float = 0.0
+    cpu_sampler: Sampler | None = None   # CpuDemand as a distribution: drawn per execution
     priority_increment: int = 0
     priority: int | None = None              # XPDL Activity/Priority: replaces the workflow's
     subflow: str | None = None
@@ -698,6 +699,12 @@ class _Compiler:
         ca.priority_increment = directives.priority_increment
         ca.priority = act.priority
         ca.cpu = float(directives.cpu_demand or 0.0)
+        if directives.cpu_distribution is not None:
+            try:
+                ca.cpu_sampler = make_sampler(directives.cpu_distribution)
+            except ValueError as error:
+                raise _spec_error(f"CPU demand of activity {act.id!r}: {error}", act.location,
+                                  "see docs/sisarl-xpdl.md for the distributions") from None
         if directives.duration is not None:
             try:
                 ca.sampler = make_sampler(directives.duration)
@@ -734,7 +741,7 @@ class _Compiler:
         # instantaneous under the dedicated model (tasks: unless a callable is bound to the
         # application at run time; general activities: unless the pooled model queues them)
         ca.plain = (not ca.deadlines and ca.loop is None and ca.mi is None and ca.sampler is None
-                    and ca.cpu == 0.0 and ca.start_trigger is None and ca.end_trigger is None
+                    and ca.cpu == 0.0 and ca.cpu_sampler is None and ca.start_trigger is None and ca.end_trigger is None
                     and not ca.boundary)
         ca.fast = ca.plain and ca.kind in (K_NOOP, K_THROW, K_TASK, K_ASYNC) and not (
             ca.kind == K_TASK and ca.toolchain)

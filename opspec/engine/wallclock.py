@@ -71,6 +71,10 @@ class WallClock:
         """The simulated time that corresponds to the ``time.perf_counter`` value ``wall``."""
         return self.sim_start + (wall - self.wall_start) * self.speed
 
+    def now(self) -> float:
+        """The wall clock now (``time.perf_counter``)."""
+        return _perf()
+
     def lateness(self, sim_time: float) -> float:
         """Wall seconds between now and the time ``sim_time`` was due (negative: early)."""
         return _perf() - self.wall_due(sim_time)

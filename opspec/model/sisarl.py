@@ -84,6 +84,8 @@ class ActivityDirectives:
     start_trigger: TriggerRef | None = None
     end_trigger: TriggerRef | None = None
     cpu_demand: float | None = None       # seconds of processor time (software activities)
+    # processor time drawn per execution, when CpuDemand is a distribution (cpu_demand None)
+    cpu_distribution: Distribution | None = None
     duration: Distribution | None = None  # simulated duration (BPSim ProcessingTime)
     raises: TriggerRef | None = None      # trigger raised when the activity completes
 

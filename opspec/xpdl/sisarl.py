@@ -20,6 +20,7 @@ from opspec.errors import Diagnostic, Severity, SourceLocation
 from opspec.model.sisarl import (
     ActivityDirectives,
     CoordinationBuiltIn,
+    Distribution,
     Mode,
     ProcessDirectives,
 )
@@ -247,12 +248,22 @@ def activity_directives(
     if not found:
         return _NO_ACTIVITY_DIRECTIVES, None
     values = _apply(found, ctx, _ACTIVITY_PARSERS)
+    if isinstance(values.get("cpu_demand"), Distribution):
+        values["cpu_distribution"] = values.pop("cpu_demand")
     builtin = None
     if "BuiltIn" in found:
         from opspec.xpdl.sisarl_builtins import build_builtin
 
         builtin = build_builtin(found["BuiltIn"], ctx)
     return ActivityDirectives(**values), builtin
+
+
+def _cpu_demand(directive: Directive) -> float | Distribution:
+    """Processor time: a duration, or a distribution drawn at every execution."""
+    dist = parse_distribution(directive.value, directive.location)
+    if dist.kind == "ConstantParameter" and len(dist.parameters) == 1:
+        return float(dist.parameters[0][1])
+    return dist
 
 
 def _raises(directive: Directive) -> Any:
@@ -271,7 +282,7 @@ _ACTIVITY_PARSERS: dict[str, tuple[str, Callable[[Directive], Any]]] = {
     "StartTrigger": ("start_trigger", lambda d: parse_trigger(d.value, d.location)),
     "EndTrigger": ("end_trigger", lambda d: parse_trigger(d.value, d.location)),
     "Raises": ("raises", _raises),
-    "CpuDemand": ("cpu_demand", lambda d: parse_seconds(d.value, d.location, "CpuDemand")),
+    "CpuDemand": ("cpu_demand", lambda d: _cpu_demand(d)),
     "Duration": ("duration", lambda d: parse_distribution(d.value, d.location)),
 }
 # An activity without directives (shared: the model is immutable).

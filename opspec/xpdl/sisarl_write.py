@@ -171,6 +171,8 @@ def activity_directive_attributes(directives: ActivityDirectives) -> list[Extend
         out.append(_ea("Raises", trigger_text(directives.raises)))
     if directives.cpu_demand is not None:
         out.append(_ea("CpuDemand", duration_text(directives.cpu_demand)))
+    if directives.cpu_distribution is not None:
+        out.append(_ea("CpuDemand", distribution_text(directives.cpu_distribution)))
     if directives.duration is not None:
         out.append(_ea("Duration", distribution_text(directives.duration)))
     return out

@@ -147,7 +147,7 @@ def cli(capsys, *args: str) -> tuple[int, str, str]:
 def test_pooled_only_options_with_the_dedicated_model_are_refused(option, capsys):
     status, _, err = cli(capsys, "specs/vacuum_cleaner.xpdl", "--until", "1", *option)
     assert status == 2
-    assert "applies to the pooled and preemptive models only" in err
+    assert "applies to the shared-processor models only" in err
     assert "unlimited processors" in err
 
 
