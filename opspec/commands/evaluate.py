@@ -22,7 +22,9 @@ from opspec.errors import EvaluationError
 
 __all__ = ["register", "run"]
 
-EXPORTS = ("xes", "jsonl")
+EXPORTS = ("xes", "jsonl", "ocel")
+#: the file each export format writes, in the output folder
+EXPORT_FILES = {"xes": "traces.xes", "jsonl": "traces.jsonl", "ocel": "traces.jsonocel"}
 DEFAULT_USERS = 100
 DEFAULT_SEED = 0
 
@@ -60,8 +62,13 @@ def register(subparsers: Any) -> None:
     parser.add_argument("--resume", action="store_true",
                         help="finish the evaluation stored in --out (missing or failed users)")
     parser.add_argument("--export", action="append", default=[], metavar="FMT",
-                        help="also write traces: xes (traces.xes), jsonl (traces.jsonl); "
-                        "repeatable or comma-separated")
+                        help="also write traces: xes (traces.xes), jsonl (traces.jsonl), "
+                        "ocel (traces.jsonocel, OCEL 2.0); repeatable or comma-separated")
+    parser.add_argument("--case", choices=("user", "instance", "dose"), default=None,
+                        help="what one case of the xes and jsonl exports is: a simulated "
+                        "user's whole run (default), one workflow instance, or one dose (a "
+                        "started device workflow and everything it set in motion; "
+                        "docs/xes-export.md)")
     parser.add_argument("--json", action="store_true",
                         help="print one JSON object with the results (docs/evaluation.md)")
     parser.add_argument("--quiet", action="store_true", help="no progress output")
@@ -132,9 +139,14 @@ def _new_plan(args: argparse.Namespace) -> Any:
         model = str(companion) if companion is not None else None
     users = args.users if args.users is not None else DEFAULT_USERS
     run_seed = args.seed if args.seed is not None else DEFAULT_SEED
+    export = _exports(args.export)
+    if args.case is not None and not {"xes", "jsonl"} & set(export):
+        raise EvaluationError(f"--case {args.case} applies to the xes and jsonl exports",
+                              hint="add --export xes (or jsonl), or drop --case (OCEL "
+                              "relates each event to every object instead of one case)")
     return EvaluationPlan(designs=tuple(designs), users=users, days=days,
                           seed=run_seed, user_model=model, engine=_engine(args.engine_config),
-                          export=_exports(args.export))
+                          export=export, case=args.case or "user")
 
 
 def _check_plan(plan: Any) -> dict[str, list[dict[str, Any]]]:
@@ -243,6 +255,8 @@ def _resume_differences(args: argparse.Namespace, plan: Any) -> list[str]:
         if export != tuple(plan.export):
             differs.append(f"--export {','.join(export)} (stored: "
                            f"{','.join(plan.export) or 'none'})")
+    if args.case is not None and args.case != plan.case:
+        differs.append(f"--case {args.case} (stored: {plan.case})")
     return differs
 
 
@@ -315,6 +329,12 @@ def run(args: argparse.Namespace) -> int:
         for design in plan.designs:         # the spec's warnings, as a new run shows them
             load_any_spec(design.spec, command="evaluate")
         _check_plan(plan)
+        if plan.export:
+            try:
+                _export_estimate(plan, store.folder, quiet=args.quiet)
+            except EvaluationError:
+                store.close()
+                raise
     else:
         plan = _new_plan(args)
         definitions = _check_plan(plan)
@@ -322,6 +342,8 @@ def run(args: argparse.Namespace) -> int:
         if (out / "results.sqlite").exists():
             raise EvaluationError(f"{out} already holds an evaluation",
                                   hint="add --resume to finish it, or choose another --out")
+        if plan.export:                     # before anything is created
+            _export_estimate(plan, out, quiet=args.quiet)
         store = ResultStore(out, create=True)
         _store_parameters(store, plan, definitions, __version__)
     with store, contextlib.ExitStack() as stack:
@@ -423,28 +445,111 @@ def _finite(value: Any) -> Any:
     return value
 
 
+def _writer(fmt: str, path: Path, plan: Any) -> Any:
+    """The streaming writer of one export format."""
+    from opspec.evaluation.exporters import JsonlTraceWriter, XesWriter
+
+    attrs: dict[str, Any] = {"spec": plan.design("A").spec, "seed": plan.seed,
+                             "case notion": plan.case}
+    if fmt == "xes":
+        return XesWriter(path, log_attributes=attrs)
+    if fmt == "jsonl":
+        return JsonlTraceWriter(path, log_attributes=attrs)
+    from opspec.commands._spec import load_any_spec
+    from opspec.engine.compiled import compile_package
+    from opspec.engine.lanes import user_lane
+    from opspec.evaluation.ocel import OcelWriter, people_of
+
+    package = load_any_spec(plan.design("A").spec)
+    people = people_of(package, user_lane(compile_package(package)).bind_names)
+    return OcelWriter(path, people=people)
+
+
 def _trace_writers(stack: contextlib.ExitStack, folder: Path, plan: Any) -> Any:
     if not plan.export:
         return None
     from opspec.engine.trace import TraceEvent
-    from opspec.evaluation.exporters import JsonlTraceWriter, XesWriter
+    from opspec.evaluation.cases import split_cases
 
     # a resumed run simulates the stored users again for their traces (run_evaluation's
     # retrace), so each file is written whole again; the interrupted run's .partial goes
-    attrs: dict[str, Any] = {"spec": plan.design("A").spec, "seed": plan.seed}
-    writers: list[XesWriter | JsonlTraceWriter] = []
+    cased: list[Any] = []
+    whole: list[Any] = []
     for fmt in plan.export:
-        path = folder / f"traces.{fmt}"
-        writer: XesWriter | JsonlTraceWriter = (
-            XesWriter(path, log_attributes=attrs) if fmt == "xes"
-            else JsonlTraceWriter(path, log_attributes=attrs))
-        stack.enter_context(writer)
-        writers.append(writer)
+        writer = stack.enter_context(_writer(fmt, folder / EXPORT_FILES[fmt], plan))
+        (whole if fmt == "ocel" else cased).append(writer)
 
     def write(record: Any) -> None:
         events = [TraceEvent.from_json(e) for e in record.trace]
-        for writer in writers:
-            writer.add_case(f"{record.design}/{record.user}", events,
-                            {"design": record.design, "user": record.user})
+        base = f"{record.design}/{record.user}"
+        attributes = {"design": record.design, "user": record.user}
+        if cased:
+            for suffix, group in split_cases(events, plan.case):
+                case_id = base if suffix is None else f"{base}/{suffix}"
+                for writer in cased:
+                    writer.add_case(case_id, group, attributes)
+        for writer in whole:
+            writer.add_case(base, events, attributes)
 
     return write
+
+
+def _export_estimate(plan: Any, folder: Path, quiet: bool) -> None:
+    """Say how large each export will be, before the run: one simulated user-day of user 0
+    is exported to a scratch folder and scaled to every user and day. An estimate larger
+    than the disk's free space, or than the trace cap, stops here (exit 2) instead of hours
+    later."""
+    import shutil
+    import tempfile
+
+    from opspec.engine.trace_sinks import TRACE_MAX_BYTES_ENV, trace_max_bytes
+    from opspec.evaluation.plan import DAY
+    from opspec.evaluation.replication import prepare, run_user
+
+    design = plan.designs[0]
+    context = prepare(design.spec, design.sha256, plan.user_model, plan.engine)
+    sample = min(plan.horizon, DAY)
+    record = run_user(context, design.label, 0, seed=plan.seed, horizon=sample,
+                      keep_trace=True)
+    if record.trace is None:
+        return
+    scale = plan.users * len(plan.designs) * plan.horizon / sample
+    sizes: dict[str, float] = {}
+    with tempfile.TemporaryDirectory(prefix="opspec-estimate-") as scratch, \
+            contextlib.ExitStack() as stack:
+        write = _trace_writers(stack, Path(scratch), plan)
+        write(record)
+        stack.close()
+        for fmt in plan.export:
+            sizes[fmt] = (Path(scratch) / EXPORT_FILES[fmt]).stat().st_size * scale
+    total = sum(sizes.values())
+    span = f"{plan.users:,} user(s) x {plan.days:g} day(s)" + (
+        f" x {len(plan.designs)} designs" if len(plan.designs) > 1 else "")
+    if not quiet:
+        for fmt, size in sizes.items():
+            print(f"evaluate: {EXPORT_FILES[fmt]} will be about {_bytes(size)} ({span}; "
+                  "estimated from one simulated user-day)", file=sys.stderr)
+    cap = trace_max_bytes()
+    over = [fmt for fmt, size in sizes.items() if size > cap]
+    if over:
+        raise EvaluationError(
+            f"--export {','.join(over)}: {EXPORT_FILES[over[0]]} would be about "
+            f"{_bytes(sizes[over[0]])}, past the trace cap of {_bytes(cap)}",
+            hint=f"export fewer users or days, or set {TRACE_MAX_BYTES_ENV} to a larger "
+            "number of bytes")
+    where = folder
+    while not where.exists() and where != where.parent:
+        where = where.parent
+    free = shutil.disk_usage(where).free
+    if total > free:
+        raise EvaluationError(
+            f"--export needs about {_bytes(total)} in {folder}, and the disk has "
+            f"{_bytes(free)} free", hint="free some space, export fewer users or days, or "
+            "choose another --out")
+
+
+def _bytes(size: float) -> str:
+    for unit, scale in (("GB", 1e9), ("MB", 1e6), ("kB", 1e3)):
+        if size >= scale:
+            return f"{size / scale:.3g} {unit}"
+    return f"{size:.0f} bytes"

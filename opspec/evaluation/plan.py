@@ -62,6 +62,8 @@ class EvaluationPlan:
     user_model: str | None = None
     engine: Mapping[str, Any] = field(default_factory=dict)
     export: tuple[str, ...] = ()
+    #: what one case of the XES and JSON Lines exports is (opspec.evaluation.cases)
+    case: str = "user"
 
     def __post_init__(self) -> None:
         if isinstance(self.users, bool) or not isinstance(self.users, int) or self.users < 1:
@@ -92,7 +94,7 @@ class EvaluationPlan:
         return cls(designs=tuple(Design(**d) for d in doc["designs"]), users=int(doc["users"]),
                    days=float(doc["days"]), seed=int(doc["seed"]),
                    user_model=doc.get("user_model"), engine=dict(doc.get("engine") or {}),
-                   export=tuple(doc.get("export") or ()))
+                   export=tuple(doc.get("export") or ()), case=str(doc.get("case") or "user"))
 
     def same_results_as(self, other: EvaluationPlan) -> list[str]:
         """What differs between two plans in ways that change results (for ``--resume``)."""
