@@ -280,7 +280,10 @@ class WalkSession:
         if self.waiting_for_devices or self.ended:
             return
         self.spoil_timing("skipped to the next event")
-        if self.sim.peek() <= self.now:      # what is due now happens first (no jump)
+        if self.sim.peek() <= self.now:
+            # what is due now happens first: the stop event SimPy's run(until) leaves queued
+            # at the current time (else "next" would be that, and n would do nothing while
+            # the clock runs), and anything else due now
             self._step_to(self.now, budget)
         due = self.sim.peek()
         self.run_to(min(self.horizon, due if math.isfinite(due) else self.horizon), budget)
@@ -329,9 +332,10 @@ class WalkSession:
 
     @_guarded(True)
     def run_to(self, target: float, budget: int | None = None) -> bool:
-        """Step the engine to simulated time ``target`` (at most ``budget`` events; it
-        stops early at a new offer); ``False`` when the budget ran out first (the clock then
-        stands at the last event stepped, and a later call goes on)."""
+        """Step the engine to simulated time ``target`` (at most ``budget`` events); ``False``
+        when the budget ran out first (the clock then stands at the last event stepped, and a
+        later call goes on). It also stops, returning ``True``, where the device begins to
+        call the person (the clock changes pace there: ``on_call``); step again to go on."""
         return self._step_to(min(self.horizon, target), budget)[0]
 
 
@@ -354,11 +358,10 @@ class WalkSession:
                 self._follow_call()
                 return True, steps
         if target > env.now:
-            # nothing is due before the target: move the clock there with a timeout of our
-            # own (env.run(until=...) would leave its stop event queued at the target, and
-            # the next "next event" would be that one, at the current time)
-            env.timeout(target - env.now)
-            env.step()
+            # SimPy's run(until) stops before what is due at the target (it falls after the
+            # run, as in `opspec run`); it leaves its stop event queued at the target, which
+            # skip_to_next_event steps past
+            env.run(until=target)
         if self.now >= self.horizon - 1e-9 and not self.ended:
             self.ended = True
             self.sim.check_waiting(horizon=self.horizon)

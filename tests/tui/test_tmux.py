@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import shlex
 import shutil
 import subprocess
 import sys
@@ -54,11 +55,20 @@ def test_walkthrough_in_tmux_shows_the_alarm_and_says_where_the_recording_is(tmp
         tmux("send-keys", "-t", session, "a")
         wait_for(session, "Walk to the dispenser")
         # the clock dropped to real time at the call: the person can answer the alarm
-        assert "1x" in screen and "real time: the device calls" in screen
+        assert "08:00:00  1x  PAUSED" in screen          # (paused by the space above)
         tmux("send-keys", "-t", session, "q")
         said = wait_for(session, "Recording:")
         assert str(record.name) in said
         assert "complete hear_alarm" in Path(record).read_text(encoding="utf-8")
+        # the replay command it printed works as printed (opspec run --script)
+        joined = tmux("capture-pane", "-p", "-J", "-t", session)   # wrapped lines joined
+        printed = next(line for line in joined.splitlines()
+                       if line.strip().startswith("or: opspec run"))
+        argv = shlex.split(printed.split(":", 1)[1])
+        done = subprocess.run([sys.executable, "-m", "opspec.cli", *argv[1:], "--timeline",
+                               "none"], capture_output=True, text=True, check=False)
+        assert done.returncode == 0, done.stderr
+        assert "doses_taken" in done.stdout
     finally:
         subprocess.run(["tmux", "-L", SOCKET, "kill-session", "-t", session],
                        capture_output=True, check=False)
@@ -79,6 +89,31 @@ def test_q_quits_at_once_while_a_long_skip_runs(tmp_path):
         wait_for(session, "skipping")
         tmux("send-keys", "-t", session, "q")
         wait_for(session, "EXIT=0", timeout=10.0)      # not after the skip
+    finally:
+        subprocess.run(["tmux", "-L", SOCKET, "kill-session", "-t", session],
+                       capture_output=True, check=False)
+
+
+def test_large_high_contrast_in_a_small_real_terminal(tmp_path):
+    """A big font leaves 64x20 cells: the alarm, the button and the big clock still show."""
+    session = f"opspec-{uuid.uuid4().hex[:8]}"
+    command = (f"{sys.executable} -m opspec.cli walkthrough {SPEC} --no-record --large "
+               "--high-contrast --sound off; echo EXIT=$?")
+    tmux("new-session", "-d", "-s", session, "-x", "64", "-y", "20")
+    try:
+        tmux("set-option", "-t", session, "remain-on-exit", "on")
+        tmux("send-keys", "-t", session, command, "Enter")
+        wait_for(session, "you perform")
+        tmux("send-keys", "-t", session, "u")
+        screen = wait_for(session, "THE DEVICE CALLS YOU")
+        assert "[a] Hear the alarm" in screen and "((( RINGING )))" in screen
+        assert "\u2570\u2500\u256f" in screen                  # the big digits' bottoms
+        tmux("send-keys", "-t", session, "a")
+        tmux("send-keys", "-t", session, "a")
+        tmux("send-keys", "-t", session, "b")
+        wait_for(session, "nothing reached the")
+        tmux("send-keys", "-t", session, "q")
+        wait_for(session, "EXIT=0", timeout=10.0)
     finally:
         subprocess.run(["tmux", "-L", SOCKET, "kill-session", "-t", session],
                        capture_output=True, check=False)

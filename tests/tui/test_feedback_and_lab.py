@@ -1,0 +1,194 @@
+"""What the person sees of their own actions (a wrong button, a report nobody waited for),
+lapsed alarms leaving the Running list, and the lab options: large text, high contrast,
+the sound cue."""
+
+from __future__ import annotations
+
+import wave
+
+import pytest
+
+from opspec.tui.app import HIGH_CONTRAST, WalkthroughApp
+from opspec.tui.session import WalkSession
+from opspec.tui.sound import Cue
+
+ALARM = 8 * 3600.0
+
+
+def run_until(session: WalkSession, target: float) -> None:
+    while session.now < target and not session.ended:
+        session.run_to(target)
+
+
+def offer(session, activity=None, choice=None):
+    return next(o for o in session.offers
+                if (choice is None or o.choice == choice)
+                and (activity is None or o.item.activity == activity))
+
+
+def walk_to_the_buttons(session: WalkSession) -> None:
+    run_until(session, ALARM)
+    session.act(offer(session, "hear_alarm"))
+    session.act(offer(session, "walk_to_dispenser"))
+
+
+def test_a_wrong_button_says_nothing_reached_the_device_and_what_is_asked_again(compiled):
+    session = WalkSession(compiled)
+    walk_to_the_buttons(session)
+    session.act(offer(session, choice="press_wrong_button"))
+    assert session.aftermath.text() == ("you: Press the wrong button at 08:00 -> nothing "
+                                        "reached the device -> asked next: Press a button")
+
+
+def test_the_report_says_what_the_device_did(compiled):
+    session = WalkSession(compiled)
+    walk_to_the_buttons(session)
+    session.act(offer(session, choice="press_report"))
+    text = session.aftermath.text()
+    assert "sent trg_1" in text and "Dispense the dose" in text
+    assert text.endswith("asked next: Take the pill")
+
+
+def test_a_report_nobody_waits_for_says_so(compiled):
+    session = WalkSession(compiled)
+    run_until(session, ALARM)
+    run_until(session, ALARM + 16 * 60)             # the morning dose is missed
+    session.act(offer(session, "hear_alarm"))
+    session.act(offer(session, "walk_to_dispenser"))
+    session.act(offer(session, choice="press_report"))
+    assert "but the device was not waiting for trg_1" in session.aftermath.text()
+
+
+def test_an_unanswered_alarms_instance_leaves_the_running_list(compiled):
+    session = WalkSession(compiled)
+    run_until(session, ALARM)
+    first = offer(session, "hear_alarm").item.instance
+    assert first in session.current
+    run_until(session, ALARM + 301)                 # the 08:05 re-alarm supersedes it
+    assert first not in session.current and first in session.lapsed_instances
+    newer = offer(session, "hear_alarm").item.instance
+    assert newer in session.current and newer != first
+
+
+@pytest.mark.asyncio
+async def test_the_running_list_on_screen_drops_the_lapsed_instance(compiled):
+    session = WalkSession(compiled)
+    session.paused = True
+    app = WalkthroughApp(session)
+    async with app.run_test(size=(100, 30)) as pilot:
+        run_until(session, ALARM + 601)             # three alarms, none answered
+        app.refresh_views()
+        await pilot.pause()
+        device = str(app.query_one("#device").render())
+        assert device.count("user_workflow#") == 1 and "#6 at hear_alarm" in device
+
+
+@pytest.mark.asyncio
+async def test_large_puts_the_person_first_with_a_big_clock_and_tall_buttons(compiled):
+    session = WalkSession(compiled)
+    session.paused = True
+    app = WalkthroughApp(session, large=True)
+    async with app.run_test(size=(64, 20)) as pilot:
+        await pilot.press("u")
+        await pilot.pause()
+        person, device = app.query_one("#person"), app.query_one("#device")
+        assert person.region.y < device.region.y and person.region.width > 60
+        assert app.query_one("#bigclock").display and not app.query_one("#timeline").display
+        button = app.query_one(".offer")
+        assert button.region.height == 3                     # a bordered button
+        assert "(!) alarm: ((( RINGING )))" in str(device.render()).splitlines()[0]
+        await pilot.press("l")                               # the coordinator's timeline
+        await pilot.pause()
+        assert app.query_one("#timeline").display
+
+
+def _luminance(hex_colour: str) -> float:
+    """WCAG 2.x relative luminance (https://www.w3.org/TR/WCAG21/#dfn-relative-luminance)."""
+    channels = [int(hex_colour[i:i + 2], 16) / 255 for i in (1, 3, 5)]
+    linear = [c / 12.92 if c <= 0.04045 else ((c + 0.055) / 1.055) ** 2.4 for c in channels]
+    return 0.2126 * linear[0] + 0.7152 * linear[1] + 0.0722 * linear[2]
+
+
+def _contrast(a: str, b: str) -> float:
+    high, low = sorted((_luminance(a), _luminance(b)), reverse=True)
+    return (high + 0.05) / (low + 0.05)
+
+
+def test_the_high_contrast_colours_pass_wcag_aaa():
+    # WCAG 2.1 success criterion 1.4.6 (AAA): at least 7:1; white on black is 21:1
+    assert _contrast("#FFFFFF", "#000000") == pytest.approx(21.0)
+    for colour in (HIGH_CONTRAST.foreground, HIGH_CONTRAST.primary, HIGH_CONTRAST.warning,
+                   HIGH_CONTRAST.accent):
+        assert _contrast(colour, HIGH_CONTRAST.background) >= 7.0, colour
+
+
+@pytest.mark.asyncio
+async def test_high_contrast_uses_its_theme_and_dims_nothing(compiled):
+    session = WalkSession(compiled)
+    session.paused = True
+    app = WalkthroughApp(session, high_contrast=True)
+    async with app.run_test(size=(80, 24)) as pilot:
+        await pilot.pause()
+        assert app.theme == "opspec-high-contrast"
+        timeline = app.query_one("#timeline").render()
+        assert all("dim" not in str(span.style) for span in timeline.spans)
+
+
+class Bells:
+    def __init__(self) -> None:
+        self.rung = 0
+
+    def bell(self) -> None:
+        self.rung += 1
+
+
+def test_sound_off_is_silent_and_bell_rings():
+    app = Bells()
+    Cue("off").play(app)
+    assert app.rung == 0
+    Cue("bell").play(app)
+    assert app.rung == 1
+
+
+def test_the_system_sound_is_a_real_tone_played_by_the_player(tmp_path):
+    played = tmp_path / "played.wav"
+    player = tmp_path / "player"
+    player.write_text(f'#!/bin/sh\ncp "$1" {played}\n')
+    player.chmod(0o755)
+    cue = Cue("system", player=(str(player),))
+    app = Bells()
+    cue.play(app)
+    assert cue._playing is not None
+    cue._playing.wait(timeout=10)
+    cue.close()
+    assert app.rung == 1                              # the bell too
+    with wave.open(str(played)) as tone:
+        assert (tone.getnchannels(), tone.getframerate()) == (1, 22_050)
+        assert tone.getnframes() / tone.getframerate() == pytest.approx(0.4)
+
+
+def test_a_player_that_cannot_start_leaves_the_bell():
+    cue = Cue("system", player=("/nonexistent/player",))
+    app = Bells()
+    cue.play(app)
+    cue.play(app)
+    assert app.rung == 2 and cue.player is None
+    cue.close()
+
+
+@pytest.mark.asyncio
+async def test_the_alarm_cue_sounds_at_each_alarm(compiled):
+    app_cue = Cue("off")
+    session = WalkSession(compiled)
+    session.paused = True
+    app = WalkthroughApp(session, sound=app_cue)
+    async with app.run_test(size=(80, 24)):
+        run_until(session, ALARM + 601)               # 08:00, 08:05, 08:10
+    assert app_cue.played == 0                        # off: nothing at all
+    counted = Cue("bell")
+    session = WalkSession(compiled)
+    session.paused = True
+    app = WalkthroughApp(session, sound=counted)
+    async with app.run_test(size=(80, 24)):
+        run_until(session, ALARM + 601)
+    assert counted.played == 3
