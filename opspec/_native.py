@@ -30,17 +30,22 @@ from typing import Any
 #: ...)`` and ``Omission("x")`` raised a bare TypeError instead of accepting the time of day or
 #: naming the bad parameter).
 MODULES: tuple[str, ...] = (
+    "opspec.engine.activities",
     "opspec.engine.compiled",
     "opspec.engine.conditions",
+    "opspec.engine.flow",
     "opspec.engine.instances",
     "opspec.engine.interpreter",
     "opspec.engine.lanes",
     "opspec.engine.lifecycle",
     "opspec.engine.metrics",
+    "opspec.engine.offers",
     "opspec.engine.random",
+    "opspec.engine.runstate",
     "opspec.engine.sampling",
     "opspec.engine.simulation",
     "opspec.engine.timing",
+    "opspec.engine.triggers",
     "opspec.engine.wakeup",
     "opspec.engine.workitem",
     "opspec.usermodels.performer",

@@ -35,13 +35,13 @@ from __future__ import annotations
 import math
 import operator
 import queue
-from collections.abc import Callable, Iterable, Iterator, Mapping
+from collections.abc import Callable, Iterable, Mapping
 from dataclasses import dataclass, field
 from typing import Any, SupportsFloat, SupportsIndex
 
 import simpy
 
-from opspec.engine.compiled import CompiledPackage, CompiledProcess, CTrigger, compile_package
+from opspec.engine.compiled import CompiledPackage, compile_package
 from opspec.engine.config import EngineConfig
 from opspec.engine.interpreter import Interpreter
 from opspec.engine.lifecycle import LIFECYCLE, RUNNING, SUSPENDED, TERMINATED
@@ -55,8 +55,6 @@ from opspec.errors import ExecutionError
 from opspec.model import Package
 
 __all__ = ["RunResult", "Simulation"]
-
-DAY = 86_400.0
 
 
 @dataclass(frozen=True, slots=True)
@@ -178,63 +176,8 @@ class Simulation(Interpreter):
             self.emit(EK.RUN_STARTED, data={"seed": self.seed, "package": self.compiled.id,
                                             "processor_model": self.config.processor_model})
         for proc in self.processes.values():
-            self.arm_process(proc)
-        self._drain()
-
-    def arm_process(self, proc: CompiledProcess) -> None:
-        """Arm the start and end triggers of ``proc`` (mode membership checked on firing)."""
-        start = proc.start_trigger
-        if start is None:
-            if proc.auto_start and self.is_active(proc.id):
-                self.start_process(proc, trigger="auto")
-        else:
-            self._arm(start, lambda trig: self._triggered_start(proc, trig))
-        if proc.end_trigger is not None:
-            self._arm(proc.end_trigger, lambda trig: self.terminate_all(
-                proc.id, f"end trigger {trig}"), ends=proc)
-
-    def _triggered_start(self, proc: CompiledProcess, trigger: str) -> None:
-        if self.is_active(proc.id):
-            self.start_process(proc, trigger=trigger)
-
-    def _arm(self, trig: CTrigger, fire: Callable[[str], None],
-             ends: CompiledProcess | None = None) -> None:
-        kind = trig.kind
-        if kind in ("message", "signal"):
-            table = self._ends if ends is not None else self._starts
-            if ends is not None:
-                table.setdefault((kind, trig.name or ""), []).append(ends)
-            else:
-                proc = next(p for p in self.processes.values() if p.start_trigger is trig)
-                table.setdefault((kind, trig.name or ""), []).append(proc)
-        elif kind in ("timer", "period"):
-            times = _occurrences(trig, self.env.now)
-            self._next_timer(times, fire, f"{kind}")
-        elif kind == "rule":
-            condition = trig.condition
-            assert condition is not None
-            state = {"last": False}
-
-            def holds() -> bool:
-                value = bool(condition(self.package_data, self.env.now))
-                rising = value and not state["last"]
-                state["last"] = value
-                return rising
-            key = next(self._rule_keys)
-            self._rules[key] = (holds, lambda: fire("rule"), None)
-
-    def _next_timer(self, times: Iterator[float], fire: Callable[[str], None],
-                    label: str) -> None:
-        at = next(times, None)
-        if at is None:
-            return
-        if self._resolution > 0.0:
-            at = math.ceil(at / self._resolution) * self._resolution
-        def fired(_event: Any) -> None:
-            fire(label)
-            self._drain()
-            self._next_timer(times, fire, label)
-        self._wakeups.after(max(0.0, at - self.env.now), fired)
+            self.triggers.arm_process(proc)
+        self.drain()
 
     # ------------------------------------------------------------------ control
     def start(self, process_id: str, data: Mapping[str, Any] | None = None) -> int:
@@ -245,7 +188,7 @@ class Simulation(Interpreter):
             raise ExecutionError(f"no process {process_id!r} in package {self.compiled.id!r}",
                                  hint="known: " + ", ".join(sorted(self.processes)))
         inst = self.start_process(proc, data, trigger="api")
-        self._drain()
+        self.drain()
         return inst.id
 
     def raise_trigger(self, name: str, data: Mapping[str, Any] | None = None) -> None:
@@ -255,7 +198,7 @@ class Simulation(Interpreter):
             self.broadcast(kind, rest, data)
         else:
             self.broadcast("message", name, data)
-        self._drain()
+        self.drain()
 
     def _instance(self, instance_id: int) -> Any:
         inst = self.live.get(instance_id)
@@ -277,12 +220,12 @@ class Simulation(Interpreter):
         if self.wants(EK.PROCESS_RESUMED, inst.process.id, None):
             self.emit(EK.PROCESS_RESUMED, inst.process.id, inst.id, None, inst.process.lane)
         deferred, inst.deferred = inst.deferred, []
-        self._ready.extend(deferred)      # deferred tokens were still counted as live
-        self._drain()
+        self.ready.extend(deferred)      # deferred tokens were still counted as live
+        self.drain()
 
     def terminate(self, instance_id: int, reason: str = "terminated by request") -> None:
         self.end_instance(self._instance(instance_id), TERMINATED, reason)
-        self._drain()
+        self.drain()
 
     def instance_state(self, instance_id: int) -> str:
         """WfMC state name of a live instance (``running``/``suspended``) or ``finished``."""
@@ -308,7 +251,7 @@ class Simulation(Interpreter):
             callback()
             count += 1
         if count:
-            self._drain()
+            self.drain()
         return count
 
     def peek(self) -> float:
@@ -376,20 +319,19 @@ class Simulation(Interpreter):
         counts = dict(self.counts)
         counts["open"] = len(self.live)
         summary: dict[str, Any] = {
-            "time": self.env.now, "seed": self.seed, "events": self._seq,
+            "time": self.env.now, "seed": self.seed, "events": self.seq,
             "sim_events": _event_count(self.env), "instances": counts,
             "deadlocks": list(self.deadlocks), "faults": list(self.faults),
             "stale_completions": self.stale_completions, "drift": self.drift,
             "mode": self.mode,
         }
-        if self._pool is not None:
-            summary["pool"] = {"workers": self.config.workers, "busy_time": self._pool.busy_time,
-                               "max_waiting": self._pool.max_waiting,
-                               "switches": self._pool.switches,
-                               "preemptions": getattr(self._pool, "preemptions", 0),
+        if self.pool is not None:
+            summary["pool"] = {"workers": self.config.workers, "preemptions": 0,
+                               **self.pool.summary(),
+                               "model": self.config.processor_model,
                                "preemptive": self.config.processor_model == "preemptive"}
         else:
-            summary["dedicated"] = self._dedicated.summary()
+            summary["dedicated"] = self.dedicated.summary()
         return RunResult(tuple(self.memory.events) if self.memory is not None else None,
                          self.metrics.values() if self.metrics is not None else {}, summary)
 
@@ -404,38 +346,6 @@ def _event_count(env: simpy.Environment) -> int:
         return int(text[text.index("(") + 1:text.index(")")])
     except ValueError:
         return 0
-
-
-def _occurrences(trig: CTrigger, now: float) -> Iterator[float]:
-    """Absolute firing times (>= ``now``) of a timer or period trigger."""
-    if trig.kind == "period":
-        # firings offset, offset + every, ...: ``count`` of them (-1: no end); armed later
-        # than some of them (a mode change), the past ones are skipped and still counted
-        every = trig.every or 0.0
-        if every <= 0:
-            yield max(now, trig.offset)
-            return
-        k = max(0, math.ceil((now - trig.offset) / every))
-        while trig.count < 0 or k < trig.count:
-            yield trig.offset + k * every
-            k += 1
-        return
-    if not trig.at:
-        if trig.every:
-            k = 1
-            while True:
-                yield trig.offset + k * trig.every
-                k += 1
-        yield now + trig.offset
-        return
-    every = trig.every or DAY
-    cycle = max(0, math.floor((now - trig.offset) / every))
-    while True:
-        for at in trig.at:
-            t = cycle * every + at + trig.offset
-            if t >= now:
-                yield t
-        cycle += 1
 
 
 _DEFAULT_CONFIG = EngineConfig()

@@ -1,0 +1,646 @@
+"""An activity's life: start, implementation, time, loops and multi-instance, completion.
+
+Instantaneous activities (routes, events, tasks without a bound callable) run in the loop of
+:meth:`Activities.start` without an :class:`~opspec.engine.instances.ActivityInstance`; the
+others get one and go through: start trigger, multi-instance (``MI_Condition`` instances,
+``MI_FlowCondition`` deciding which move on), start assignments, deadlines and boundary
+events armed, loop test (``TestTime`` before), CPU time on a worker, the sampled duration,
+the body by kind (offer to a performer, tools and scripts, subflow call, activity set, catch
+event, coordination), then :meth:`Activities.body_done` (loop again or complete). Failures
+(:meth:`Activities.fail`) and cancellation (:meth:`Activities.stop`) end an instance early."""
+
+from __future__ import annotations
+
+from collections import ChainMap, deque
+from collections.abc import Mapping
+from typing import TYPE_CHECKING, Any
+
+from opspec.engine import coordination as coord
+from opspec.engine.compiled import (
+    K_ASYNC,
+    K_BLOCK,
+    K_CATCH,
+    K_COORD,
+    K_GATEWAY,
+    K_MANUAL,
+    K_SUBFLOW,
+    K_TASK,
+    MI_ALL,
+    MI_NONE,
+    MI_ONE,
+    CompiledActivity,
+    CompiledProcess,
+)
+from opspec.engine.instances import ActivityInstance, Frame, MultiInstance, ProcessInstance
+from opspec.engine.lifecycle import (
+    ABORTED,
+    COMPLETED,
+    RUNNING,
+    SUSPENDED,
+    TERMINATED,
+)
+from opspec.engine.runstate import RunState, discard
+from opspec.engine.trace import EventKind as EK
+from opspec.errors import OpspecError
+from opspec.model import CoordinationKind, ParameterMode
+
+if TYPE_CHECKING:
+    from opspec.engine.flow import Flow
+    from opspec.engine.offers import Offers
+    from opspec.engine.triggers import Triggers
+
+
+#: Synchronous subflow calls nested deeper than this end the run's root instance with a
+#: located fault: bounded recursion (a base case) runs, runaway recursion is reported.
+MAX_CALL_DEPTH = 100
+
+
+class Activities:
+    """An activity's life from start to completion (see the module docstring)."""
+
+    flow: Flow
+    activities: Activities
+    triggers: Triggers
+    offers: Offers
+
+    def __init__(self, state: RunState) -> None:
+        self.state = state
+
+    def connect(self, flow: Flow, activities: Activities, triggers: Triggers,
+                offers: Offers) -> None:
+        """The other parts of the interpreter (they call each other)."""
+        self.flow = flow
+        self.activities = activities
+        self.triggers = triggers
+        self.offers = offers
+
+    def _too_deep(self, ai: ActivityInstance, target: CompiledProcess) -> None:
+        """Runaway recursion: abort the outermost caller (which ends every nested call)."""
+        root = ai.frame.inst
+        while root.parent is not None:
+            root = root.parent.frame.inst
+        act = ai.act
+        text = (f"{act.where()}: activity {act.id!r} of process {act.process!r} calls "
+                f"{target.id!r} {MAX_CALL_DEPTH + 1} synchronous subflow calls deep at "
+                f"t={self.state.env._now:.3f} s: the recursion does not reach its base case")
+        self.state.faults.append({"time": self.state.env._now, "process": act.process,
+                            "instance": ai.frame.inst.id, "activity": act.id, "message": text})
+        self.flow.end_instance(root, ABORTED, text)
+
+    def start(self, frame: Frame, act: CompiledActivity | None) -> None:
+        """Start ``act``. Instantaneous activities run here, in a loop that carries the
+        token straight on to the next activity (no queue round trip) as long as the next
+        one has no AND/OR join to synchronise at."""
+        pooled = self.state.pooled
+        apps = self.state.apps
+        steps = 0
+        limit = self.state.start_limit
+        while act is not None:
+            if not act.fast or (act.general and pooled) or (
+                    act.kind == K_TASK and act.application in apps):
+                self._start_slow(frame, act)
+                return
+            inst = frame.inst
+            steps += 1
+            if steps > limit:                   # a zero-time cycle (see RunState.drain)
+                self.state.zero_time(frame, act)
+            if self.state.aflags[act] & 1:
+                self.state.emit(EK.ACTIVITY_STARTED, act.process, inst.id, act.id, act.lane,
+                          act.participant)
+            if act.start_assign and not self.flow.assign(inst, act, act.start_assign):
+                return
+            if act.kind == K_ASYNC:
+                data = self._params_in(inst, act)
+                if data is None:
+                    return
+                self.flow.start_process(self.state.processes[act.subflow],  # type: ignore[index]
+                                   data, trigger=f"subflow:{act.id}")
+            act = self.flow.done_next(frame, act)
+
+    def _params_in(self, inst: ProcessInstance, act: CompiledActivity
+                   ) -> dict[str, Any] | None:
+        now = self.state.env._now
+        try:
+            return {formal: fn(inst.scope, now)
+                    for _mode, formal, fn, _target in act.params if fn is not None}
+        except OpspecError as error:
+            self.flow.abort(inst, act, f"an actual parameter failed: {error.message}")
+            return None
+
+    def _start_slow(self, frame: Frame, act: CompiledActivity) -> None:
+        ai = ActivityInstance(next(self.state.keys), act, frame, self.state.env._now)
+        ai.state = RUNNING
+        frame.running[ai.key] = ai
+        if act.plain and not (act.general and self.state.pooled):
+            inst = frame.inst
+            if self.state.aflags[act] & 1:
+                self.state.emit(EK.ACTIVITY_STARTED, act.process, inst.id, act.id, act.lane,
+                          act.participant)
+            if act.start_assign and not self.flow.assign(inst, act, act.start_assign):
+                return
+            if act.kind == K_MANUAL and not act.params:
+                performer = self.offers.performer_for(act)
+                if performer is not None:
+                    self.offers.offer(ai, performer, (), None, None)
+                    return
+            self._body(ai)
+            return
+        if act.start_trigger is not None:
+            ai.waiting = f"start trigger {act.start_trigger.kind}:{act.start_trigger.name}"
+            self.triggers.wait_trigger(ai, act.start_trigger, self._activate_cb, None)
+            return
+        self._activate(ai)
+
+    def _activate_cb(self, ai: ActivityInstance, _arg: Any, _data: Any = None) -> None:
+        self.state.ready.append((self._activate, ai, None, None))
+
+    def _activate(self, ai: ActivityInstance, _a: Any = None, _b: Any = None) -> None:
+        if ai.state != RUNNING:
+            return
+        act = ai.act
+        inst = ai.frame.inst
+        if act.mi is not None and ai.mi is None and not self._mi_begin(ai):
+            return
+        self.state.emit_act(EK.ACTIVITY_STARTED, inst, act)
+        if act.start_assign and not self.flow.assign(inst, act, act.start_assign):
+            return
+        now = self.state.env._now
+        for seconds, synchronous, exception in act.deadlines:
+            try:
+                delay = float(seconds(inst.scope, now))
+            except OpspecError as error:
+                self.flow.abort(inst, act, f"deadline cannot be computed: {error.message}")
+                return
+            self.state.later(delay, self.triggers.deadline, ai, (synchronous, exception, delay))
+        for index in act.boundary:
+            event = ai.frame.graph.activities[index]
+            if event.trigger is not None:
+                self.triggers.wait_trigger(ai, event.trigger, self.triggers.boundary, index, persistent=True)
+        if act.loop is not None and act.loop[2] and not self._loop_again(ai):
+            self._complete(ai)
+            return
+        self._run_body(ai)
+
+    def _mi_begin(self, ai: ActivityInstance) -> bool:
+        """Start the instances of multi-instance activity ``ai.act``; ``ai`` becomes the
+        first. Each instance holds a token of the frame; the flow condition decides which
+        of them move on (see :meth:`_mi_done`). Returns whether ``ai`` runs now."""
+        act = ai.act
+        frame = ai.frame
+        inst = frame.inst
+        count_fn, parallel, _flow, _cond = act.mi  # type: ignore[misc]
+        try:
+            raw = count_fn(inst.scope, self.state.env._now)
+        except OpspecError as error:
+            self.flow.abort(inst, act, f"the MI_Condition failed: {error.message}")
+            return False
+        count = raw if isinstance(raw, int) and not isinstance(raw, bool) else (
+            int(raw) if isinstance(raw, float) and raw.is_integer() else -1)
+        if count < 0:
+            self.flow.abort(inst, act, f"the MI_Condition gave {raw!r}, not a number of instances "
+                       "(an integer >= 0)")
+            return False
+        if count == 0:                      # no instance: the activity is done at once
+            self.state.emit_act(EK.ACTIVITY_STARTED, inst, act)
+            ai.state = COMPLETED
+            ai.gen += 1
+            frame.running.pop(ai.key, None)
+            self.flow.finish(frame, act)
+            return False
+        group = MultiInstance(count)
+        frame.live += count - 1
+        self._mi_join(ai, group)
+        if parallel:
+            for _ in range(count - 1):
+                self._mi_next(frame, act, group)
+        return True
+
+    def _mi_join(self, ai: ActivityInstance, group: MultiInstance) -> None:
+        ai.mi = group
+        ai.iteration = group.started            # the instance's loopCounter
+        group.started += 1
+        group.members.append(ai)
+
+    def _mi_next(self, frame: Frame, act: CompiledActivity, group: MultiInstance) -> None:
+        ai = ActivityInstance(next(self.state.keys), act, frame, self.state.env._now)
+        ai.state = RUNNING
+        frame.running[ai.key] = ai
+        self._mi_join(ai, group)
+        self.state.ready.append((self._activate, ai, None, None))
+
+    def _mi_done(self, ai: ActivityInstance, group: MultiInstance) -> None:
+        """One instance completed: its token moves on or is consumed, per MI_FlowCondition."""
+        act = ai.act
+        frame = ai.frame
+        inst = frame.inst
+        group.completed += 1
+        group.members.remove(ai)
+        _count, parallel, flow, cond = act.mi  # type: ignore[misc]
+        if flow == MI_NONE:
+            moves = True
+        elif flow == MI_ONE:
+            moves = not group.passed
+        elif flow == MI_ALL:
+            moves = group.completed == group.count
+        else:
+            moves = False
+            if not group.passed and cond is not None:
+                counters = {"nrOfInstances": group.count,
+                            "nrOfCompletedInstances": group.completed,
+                            "nrOfActiveInstances": len(group.members)}
+                try:
+                    moves = bool(cond(ChainMap(counters, inst.scope), self.state.env._now))
+                except OpspecError as error:
+                    self.flow.abort(inst, act, f"the ComplexMI_FlowCondition failed: "
+                               f"{error.message}")
+                    return
+        if not parallel and group.started < group.count and inst.state == RUNNING:
+            self._mi_next(frame, act, group)
+        if moves:
+            group.passed = True
+            self.flow.finish(frame, act)
+            return
+        if act.end_assign and not self.flow.assign(inst, act, act.end_assign):
+            return
+        self.state.emit_act(EK.ACTIVITY_COMPLETED, inst, act, {"instance": ai.iteration})
+        self.flow.token_gone(frame)
+
+    def mi_cancel(self, group: MultiInstance, frame: Frame, reason: str) -> None:
+        """An interrupting event ends every instance of the group (the interrupted one
+        included); their tokens, and those of instances not started yet, are consumed."""
+        for member in list(group.members):
+            self.stop(member, TERMINATED, reason)
+        frame.live -= len(group.members) + (group.count - group.started)
+        group.members.clear()
+        group.started = group.count
+
+    def _loop_again(self, ai: ActivityInstance) -> bool:
+        cond, maximum, _before = ai.act.loop  # type: ignore[misc]
+        if maximum is not None and ai.iteration >= maximum:
+            return False
+        if cond is None:
+            return maximum is not None
+        inst = ai.frame.inst
+        return bool(cond(inst.scope, self.state.env._now))
+
+    def _run_body(self, ai: ActivityInstance, _a: Any = None, _b: Any = None) -> None:
+        if ai.state != RUNNING:
+            return
+        act = ai.act
+        cpu = act.cpu
+        if act.cpu_sampler is not None:       # CpuDemand as a distribution: its own stream
+            cpu = act.cpu_sampler(self.state.streams.stream(f"{act.process}/{act.id}/cpu"))
+        if act.general or cpu:
+            if self.state.pool is not None:
+                level = (ai.frame.inst.priority if act.priority is None
+                         else act.priority) + act.priority_increment
+                cost = self.state.switch + cpu if act.general else cpu
+                ai.waiting = "worker"
+                if self.state.pool.submit(ai, level, cost):
+                    self.state.emit_act(EK.QUEUED, ai.frame.inst, act,
+                                   {"waiting": self.state.pool.waiting, "priority": level})
+                return
+            if cpu > 0.0:
+                self.state.dedicated.burst(self.state.env._now, cpu)
+                ai.waiting = "cpu"
+                self.state.later(cpu, self._after_cpu_cb, ai)
+                return
+        self.after_cpu(ai)
+
+    def _after_cpu_cb(self, ai: ActivityInstance, _arg: Any) -> None:
+        self.after_cpu(ai)
+
+    def after_cpu(self, ai: ActivityInstance) -> None:
+        if ai.state != RUNNING:
+            return
+        act = ai.act
+        if act.sampler is not None and act.kind != K_MANUAL:
+            delay = act.sampler(self.state.streams.stream(f"{act.process}/{act.id}"))
+            if delay > 0.0:
+                ai.waiting = "duration"
+                self.state.later(delay, self._body_cb, ai)
+                return
+        self._body(ai)
+        if not self.state.draining:
+            self.state.drain()
+
+    def _body_cb(self, ai: ActivityInstance, _arg: Any) -> None:
+        self._body(ai)
+
+    def _body(self, ai: ActivityInstance) -> None:
+        """What the activity does, by kind; ends with :meth:`body_done` (maybe later)."""
+        act = ai.act
+        kind = act.kind
+        inst = ai.frame.inst
+        if kind == K_TASK and act.toolchain:
+            self._run_tools(ai, 0)
+        elif kind == K_MANUAL or (kind == K_TASK and act.application in self.state.apps):
+            performer = (self.state.apps[act.application or ""] if kind == K_TASK
+                         else self.offers.performer_for(act))
+            if performer is None:
+                ai.waiting = (f"performer for participant {act.participant!r}"
+                              f" / lanes {', '.join(act.lanes) or '-'}")
+                self.state.emit_act(EK.ACTIVITY_OFFERED, inst, act, {"performer": None})
+                return
+            data: Mapping[str, Any] | None = None
+            if act.params:
+                data = self._inputs(ai)
+                if data is None:
+                    return
+            duration = None
+            if act.sampler is not None:
+                duration = act.sampler(self.state.streams.stream(f"{act.process}/{act.id}"))
+            self.offers.offer(ai, performer, (), data, duration)
+        elif kind == K_SUBFLOW or kind == K_ASYNC:
+            data = self._inputs(ai)
+            if data is None:
+                return
+            target = self.state.processes[act.subflow]  # type: ignore[index]
+            if kind == K_SUBFLOW:
+                if inst.depth >= MAX_CALL_DEPTH:
+                    self._too_deep(ai, target)
+                    return
+                ai.waiting = f"subflow {target.id}"
+                ai.child = self.flow.start_process(target, data, parent=ai)
+            else:
+                self.flow.start_process(target, data, trigger=f"subflow:{act.id}")
+                self.body_done(ai, None)
+        elif kind == K_CATCH:
+            trig = act.trigger
+            assert trig is not None
+            ai.waiting = f"{trig.kind}:{trig.name}" if trig.name else trig.kind
+            self.triggers.wait_trigger(ai, trig, self.triggers.caught, None)
+        elif kind == K_BLOCK:
+            assert act.block is not None
+            frame = Frame(act.block, inst, ai)
+            inst.frames.append(frame)
+            ai.child = frame
+            ai.waiting = f"activity set {act.block.name}"
+            starts = act.block.starts
+            if act.block.sequential and starts:       # one at a time, in declared order
+                frame.queue = list(starts[1:])
+                starts = starts[:1]
+            for index in starts:
+                frame.live += 1
+                self.state.ready.append((self.flow.start_at, frame, index, None))
+            if not act.block.starts:
+                self.body_done(ai, None)
+        elif kind == K_COORD:
+            self._coordinate(ai)
+        elif kind == K_GATEWAY:
+            self.offers.offer_choice(ai, act.out)
+        else:                                       # noop, throw, task without a callable
+            # queued, not called: a chain of such activities must not grow the stack
+            self.state.ready.append((self.body_done, ai, None, None))
+
+    def body_done(self, ai: ActivityInstance, data: Mapping[str, Any] | None,
+                   _unused: Any = None) -> None:
+        """One execution of the body finished: loop again or complete."""
+        if ai.state != RUNNING:
+            return
+        if ai.frame.inst.state == SUSPENDED:
+            ai.frame.inst.deferred.append((self.body_done, ai, data, None))
+            return
+        if data:
+            inst = ai.frame.inst
+            act = ai.act
+            for key, value in data.items():
+                self.flow.set_field(inst, act, key, value)
+        act = ai.act
+        if act.loop is not None:
+            # each iteration is one execution of the activity: its assignments apply each time
+            inst = ai.frame.inst
+            if act.end_assign and not self.flow.assign(inst, act, act.end_assign):
+                return
+            ai.iteration += 1
+            if ai.iteration > 1_000_000:
+                self.flow.abort(inst, act, "loop ran 1,000,000 times; add a maximum")
+                return
+            if self._loop_again(ai):
+                if act.start_assign and not self.flow.assign(inst, act, act.start_assign):
+                    return
+                self.state.ready.append((self._run_body, ai, None, None))
+                return
+        self._complete(ai)
+
+    def _complete(self, ai: ActivityInstance) -> None:
+        ai.state = COMPLETED
+        ai.gen += 1
+        frame = ai.frame
+        del frame.running[ai.key]
+        if ai.cleanup:
+            for undo in ai.cleanup:
+                undo()
+            ai.cleanup.clear()
+        if ai.mi is not None:
+            self._mi_done(ai, ai.mi)
+            return
+        self.flow.finish(frame, ai.act)
+
+    def _inputs(self, ai: ActivityInstance) -> dict[str, Any] | None:
+        inst = ai.frame.inst
+        now = self.state.env._now
+        out: dict[str, Any] = {}
+        try:
+            for _mode, formal, fn, _target in ai.act.params:
+                if fn is not None:                  # OUT parameters carry nothing in
+                    out[formal] = fn(inst.scope, now)
+        except OpspecError as error:
+            self.fail(ai, "parameter", f"an actual parameter failed: {error.message}")
+            return None
+        return out
+
+    def _run_tools(self, ai: ActivityInstance, index: int) -> None:
+        """Run the task's tools from ``index`` on, in order (XPDL: every ``Tool`` of the
+        activity). A tool whose application is bound to a performer is offered to it as a
+        work item, and the next tool runs when that completes; a script tool runs its
+        statements; any other tool completes at once. The body is done after the last."""
+        act = ai.act
+        tools = act.tools
+        while index < len(tools):
+            tool = tools[index]
+            performer = self.state.apps.get(tool.application)
+            if performer is not None:
+                data = self._tool_inputs(ai, tool.params)
+                if data is None:
+                    return
+                key = ai.key
+                if key not in self.state.tool_at:
+                    table = self.state.tool_at
+                    ai.cleanup.append(lambda: discard(table, key))  # noqa: B023 - returns below
+                self.state.tool_at[key] = index
+                self.offers.offer(ai, performer, (), data, None, tool.application)
+                return
+            if tool.script is not None and not self._run_script(ai, tool.application,
+                                                                tool.params, tool.script):
+                return
+            index += 1
+        self.state.ready.append((self.body_done, ai, None, None))
+
+    def tool_done(self, ai: ActivityInstance, data: Mapping[str, Any] | None,
+                   _unused: Any = None) -> None:
+        """The performer of one tool completed: its outputs, then the next tool."""
+        if ai.state != RUNNING:
+            return
+        inst = ai.frame.inst
+        if inst.state == SUSPENDED:
+            inst.deferred.append((self.tool_done, ai, data, None))
+            return
+        index = self.state.tool_at.pop(ai.key, 0)
+        if data:
+            for key, value in self.outputs(ai, data, ai.act.tools[index].params).items():
+                self.flow.set_field(inst, ai.act, key, value)
+        self._run_tools(ai, index + 1)
+
+    def _tool_inputs(self, ai: ActivityInstance,
+                     params: tuple[tuple[ParameterMode, str, Any, str | None], ...]
+                     ) -> dict[str, Any] | None:
+        inst = ai.frame.inst
+        now = self.state.env._now
+        out: dict[str, Any] = {}
+        try:
+            for _mode, formal, fn, _target in params:
+                if fn is not None:
+                    out[formal] = fn(inst.scope, now)
+        except OpspecError as error:
+            self.fail(ai, "parameter", f"an actual parameter failed: {error.message}")
+            return None
+        return out
+
+    def _run_script(self, ai: ActivityInstance, application: str,
+                    params: tuple[tuple[ParameterMode, str, Any, str | None], ...],
+                    script: tuple[tuple[str, Any], ...]) -> bool:
+        """A script tool agent's application, run as a built-in: IN/INOUT formals take the
+        actual parameters' values (OUT formals start unset), the statements run in order,
+        OUT/INOUT formals are written back to the actual parameters' data fields."""
+        inst = ai.frame.inst
+        now = self.state.env._now
+        local: dict[str, Any] = {}
+        try:
+            for _mode, formal, fn, _target in params:
+                local[formal] = fn(inst.scope, now) if fn is not None else None
+            for variable, fn in script:
+                local[variable] = fn(local, now)
+        except OpspecError as error:
+            self.fail(ai, "script", f"the script of application {application!r} failed: "
+                       f"{error.message}")
+            return False
+        for mode, formal, _fn, target in params:
+            if mode is not ParameterMode.IN and target is not None:
+                self.flow.set_field(inst, ai.act, target, local.get(formal))
+        return True
+
+    def fail(self, ai: ActivityInstance, exception: str, message: str) -> None:
+        act = ai.act
+        frame = ai.frame
+        self.stop(ai, ABORTED, exception)
+        self.state.emit_act(EK.ACTIVITY_FAILED, frame.inst, act,
+                       {"exception": exception, "message": message})
+        self.flow.exception_flow(frame, act, exception, message, False)
+
+    def stop(self, ai: ActivityInstance, state: int, reason: str) -> None:
+        """Cancel ``ai``: it stops waiting, its offer is withdrawn, its children end."""
+        if ai.state != RUNNING and ai.state != SUSPENDED:
+            return
+        ai.state = state
+        ai.gen += 1
+        frame = ai.frame
+        frame.running.pop(ai.key, None)
+        for undo in ai.cleanup:
+            undo()
+        ai.cleanup.clear()
+        item = ai.item
+        if item is not None:
+            ai.item = None
+            self.state.offered.pop(item.key, None)
+            self.state.emit_act(EK.ACTIVITY_WITHDRAWN, frame.inst, ai.act, {"reason": reason})
+            performer = ai.performer
+            if performer is not None:
+                performer.withdraw(item, reason)
+        child = ai.child
+        ai.child = None
+        if isinstance(child, ProcessInstance):
+            child.parent = None
+            self.flow.end_instance(child, TERMINATED, f"caller stopped: {reason}")
+        elif isinstance(child, Frame):
+            for sub in list(child.running.values()):
+                self.stop(sub, TERMINATED, reason)
+            if child in frame.inst.frames:
+                frame.inst.frames.remove(child)
+        for queue in self.state.pullers.values():
+            if ai in queue:
+                queue.remove(ai)
+
+    def outputs(self, ai: ActivityInstance, data: Mapping[str, Any],
+                 params: tuple[tuple[ParameterMode, str, Any, str | None], ...] | None = None
+                 ) -> dict[str, Any]:
+        """Map a performer's results (by formal parameter id) onto the actual data fields;
+        keys that are not formal parameters are taken as data field names."""
+        out: dict[str, Any] = {}
+        if params is None:
+            params = ai.act.params
+        formal_to_target = {f: t for mode, f, _fn, t in params
+                            if mode is not ParameterMode.IN and t is not None}
+        inputs_only = {f for mode, f, _fn, _t in params if mode is ParameterMode.IN}
+        for key, value in data.items():
+            if key in formal_to_target:
+                out[formal_to_target[key]] = value
+            elif key not in inputs_only:
+                out[key] = value
+        return out
+
+    def _coordinate(self, ai: ActivityInstance) -> None:
+        act = ai.act
+        spec = act.coordination
+        assert spec is not None
+        inst = ai.frame.inst
+        scope = inst.scope
+        try:
+            values = [scope[name] for name in spec.inputs]
+        except KeyError as error:
+            self.fail(ai, "coordination", f"data field {error.args[0]!r} does not exist")
+            return
+        kind = spec.kind
+        try:
+            if kind is CoordinationKind.ARBITER:
+                result: Any = coord.arbiter(values)
+            elif kind is CoordinationKind.VOTER:
+                result = coord.voter(values, spec.options)
+            elif kind is CoordinationKind.SUPERPOSITION:
+                result = coord.superposition(values, spec.weights)
+            elif kind is CoordinationKind.PUSH_DATA:
+                self.push_data(spec.channel or act.id, values[0] if len(values) == 1
+                               else tuple(values))
+                self.body_done(ai, None)
+                return
+            elif kind is CoordinationKind.PULL_DATA:
+                channel = spec.channel or act.id
+                box = self.state.mailboxes.get(channel)
+                if box:
+                    self.body_done(ai, {spec.output: box.popleft()} if spec.output else None)
+                else:
+                    ai.waiting = f"pull from mailbox {channel!r}"
+                    self.state.pullers.setdefault(channel, deque()).append(ai)
+                return
+            else:
+                # at once: if the new mode ends this very instance, nothing after the mode
+                # change may run (its completion included)
+                self.triggers.change_mode(spec.target_mode or "", act, inst)
+                self.body_done(ai, None)
+                return
+        except (TypeError, ValueError) as error:
+            self.fail(ai, "coordination", f"{kind.value} failed: {error}")
+            return
+        self.body_done(ai, {spec.output: result} if spec.output else None)
+
+    def push_data(self, channel: str, value: Any) -> None:
+        """Put ``value`` into supervisor mailbox ``channel``; a waiting pull gets it."""
+        pullers = self.state.pullers.get(channel)
+        while pullers:
+            ai = pullers.popleft()
+            if ai.state == RUNNING:
+                output = ai.act.coordination.output if ai.act.coordination else None
+                self.state.ready.append((self.body_done, ai,
+                                    {output: value} if output else None, None))
+                return
+        self.state.mailboxes.setdefault(channel, deque()).append(value)

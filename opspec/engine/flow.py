@@ -1,0 +1,578 @@
+"""Tokens through a workflow's graph: instances, transitions, splits, joins.
+
+A process instance runs its graph in a :class:`~opspec.engine.instances.Frame` (an activity set
+runs in a frame of its own); tokens move between activities as items of the ready queue
+(:meth:`~opspec.engine.runstate.RunState.drain`). This part decides where a token goes when an
+activity completes (:meth:`Flow.done_next`: the split), whether an arriving token starts its
+activity (:meth:`Flow.arrive`: the join), when a frame or an instance is done, deadlocked,
+terminated or aborted, and which EXCEPTION transition a failure follows. The rules are in the
+docstring of :mod:`opspec.engine.interpreter` and in docs/semantics.md."""
+
+from __future__ import annotations
+
+from collections import ChainMap
+from collections.abc import Mapping, MutableMapping
+from typing import TYPE_CHECKING, Any
+
+from opspec.engine.compiled import (
+    J_AND,
+    J_COMPLEX,
+    K_THROW,
+    S_XOR,
+    CompiledActivity,
+    CompiledProcess,
+    CTransition,
+)
+from opspec.engine.instances import ActivityInstance, Frame, ProcessInstance
+from opspec.engine.lifecycle import (
+    ABORTED,
+    LIFECYCLE,
+    RUNNING,
+    STATE_NAMES,
+    SUSPENDED,
+    TERMINATED,
+)
+from opspec.engine.runstate import RunState
+from opspec.engine.trace import EventKind as EK
+from opspec.errors import OpspecError
+from opspec.model import ParameterMode
+
+if TYPE_CHECKING:
+    from opspec.engine.activities import Activities
+    from opspec.engine.offers import Offers
+    from opspec.engine.triggers import Triggers
+
+_NEXT = LIFECYCLE.table
+
+
+class Flow:
+    """Tokens through graphs: process instances, transitions, splits, joins (see the module docstring)."""
+
+    flow: Flow
+    activities: Activities
+    triggers: Triggers
+    offers: Offers
+
+    def __init__(self, state: RunState) -> None:
+        self.state = state
+
+    def connect(self, flow: Flow, activities: Activities, triggers: Triggers,
+                offers: Offers) -> None:
+        """The other parts of the interpreter (they call each other)."""
+        self.flow = flow
+        self.activities = activities
+        self.triggers = triggers
+        self.offers = offers
+
+    def start_process(self, proc: CompiledProcess, data: Mapping[str, Any] | None = None, *,
+                      parent: ActivityInstance | None = None, trigger: str | None = None
+                      ) -> ProcessInstance:
+        """Create and start an instance of ``proc`` (its start activities are queued)."""
+        local = proc.data.copy()
+        if data:
+            local.update(data)
+        scope: MutableMapping[str, Any] = (
+            ChainMap(local, self.state.package_data) if self.state.package_data else local)
+        iid = next(self.state.ids)
+        priority = proc.priority
+        root = iid
+        if parent is not None:
+            root = parent.frame.inst.root
+            priority = max(priority, parent.frame.inst.priority)
+        inst = ProcessInstance(iid, proc, local, scope, priority, parent, root, self.state.env._now)
+        inst.state = RUNNING
+        inst.trigger = trigger
+        if parent is not None:
+            inst.depth = parent.frame.inst.depth + 1
+            inst.partner = parent.frame.inst.partner
+        self.state.live[iid] = inst
+        self.state.counts["started"] += 1
+        if self.state.pflags[proc.id] & 1:
+            self.state.emit(EK.PROCESS_STARTED, proc.id, iid, None, proc.lane, None,
+                      {"trigger": trigger, "parent": parent.frame.inst.id if parent else None})
+        frame = Frame(proc.graph, inst, None)
+        inst.frames.append(frame)
+        for index in proc.graph.starts:
+            frame.live += 1
+            self.state.ready.append((self.start_at, frame, index, None))
+        if not proc.graph.starts:
+            self.state.pending[frame] = None
+        if proc.deadline is not None:
+            self.state.call_at(proc.deadline, lambda: self._process_deadline(inst))
+        return inst
+
+    def _process_deadline(self, inst: ProcessInstance) -> None:
+        if inst.state in (RUNNING, SUSPENDED):
+            proc = inst.process
+            if self.state.wants(EK.DEADLINE_EXPIRED, proc.id, None):
+                self.state.emit(EK.DEADLINE_EXPIRED, proc.id, inst.id, None, proc.lane, None,
+                          {"deadline": proc.deadline, "scope": "process"})
+
+    def _frame_done(self, frame: Frame) -> None:
+        inst = frame.inst
+        owner = frame.owner
+        if owner is not None:                       # an activity set finished
+            if frame.queue and inst.state == RUNNING:   # a sequential ad-hoc set: the next
+                frame.live += 1
+                self.state.ready.append((self.start_at, frame, frame.queue.pop(0), None))
+                return
+            if frame in inst.frames:
+                inst.frames.remove(frame)
+            owner.child = None
+            self.activities.body_done(owner, None)
+            return
+        if inst.state != RUNNING:
+            return
+        inst.state = _NEXT[(RUNNING, "complete")]
+        inst.frames.clear()          # breaks the instance <-> frame cycle: freed by refcount
+        self.state.live.pop(inst.id, None)
+        if self.state.kept and inst.parent is None:
+            self.triggers.drop_kept(inst)
+        self.state.counts["completed"] += 1
+        proc = inst.process
+        if self.state.pflags[proc.id] & 2:
+            self.state.emit(EK.PROCESS_COMPLETED, proc.id, inst.id, None, proc.lane, None,
+                      {"duration": self.state.env._now - inst.started_at})
+        parent = inst.parent
+        if parent is not None and parent.state == RUNNING:
+            parent.child = None
+            out = {}
+            for mode, formal, _fn, target in parent.act.params:
+                if mode is not ParameterMode.IN and target is not None:
+                    out[target] = inst.data.get(formal)
+            self.activities.body_done(parent, out or None)
+
+    def end_instance(self, inst: ProcessInstance, state: int, reason: str,
+                     notify_parent: bool = True) -> None:
+        """Terminate or abort ``inst``: cancel everything it waits for; a waiting caller
+        (synchronous subflow) sees the exception ``terminated``/``aborted``."""
+        if inst.state not in (RUNNING, SUSPENDED) and inst.state != 0:
+            return
+        trigger = "terminate" if state == TERMINATED else "abort"
+        inst.state = LIFECYCLE.next(inst.state, trigger, f"instance {inst.id}")
+        for frame in list(inst.frames):
+            for ai in list(frame.running.values()):
+                self.activities.stop(ai, TERMINATED, reason)
+        inst.frames.clear()
+        self.state.live.pop(inst.id, None)
+        if self.state.kept and inst.parent is None:
+            self.triggers.drop_kept(inst)
+        proc = inst.process
+        self.state.counts["terminated" if state == TERMINATED else "aborted"] += 1
+        kind = EK.PROCESS_TERMINATED if state == TERMINATED else EK.PROCESS_ABORTED
+        if self.state.wants(kind, proc.id, None):
+            self.state.emit(kind, proc.id, inst.id, None, proc.lane, None, {"reason": reason})
+        parent = inst.parent
+        if notify_parent and parent is not None and parent.state == RUNNING:
+            parent.child = None
+            self.activities.fail(parent, STATE_NAMES[state], f"subflow {proc.id!r}: {reason}")
+
+    def abort(self, inst: ProcessInstance, act: CompiledActivity | None, message: str) -> None:
+        """Abort ``inst`` with a located message (recorded as a fault); the run goes on."""
+        where = act.where() if act is not None else (
+            str(inst.process.location) if inst.process.location else "<built in Python>")
+        what = f"activity {act.id!r} of " if act is not None else ""
+        text = (f"{where}: {what}process {inst.process.id!r} (instance {inst.id}) aborted at "
+                f"t={self.state.env._now:.3f} s: {message}")
+        self.state.faults.append({"time": self.state.env._now, "process": inst.process.id,
+                            "instance": inst.id, "activity": act.id if act else None,
+                            "message": text})
+        self.end_instance(inst, ABORTED, text)
+
+    def start_at(self, frame: Frame, index: int, _unused: Any) -> None:
+        inst = frame.inst
+        if inst.state != RUNNING:
+            self._dropped(frame, self.start_at, index, None)
+            return
+        self.activities.start(frame, frame.graph.activities[index])
+
+    def _dropped(self, frame: Frame, fn: Any, a: Any, b: Any) -> None:
+        if frame.inst.state == SUSPENDED:
+            frame.inst.deferred.append((fn, frame, a, b))
+        else:
+            frame.live -= 1
+
+    def _arrive(self, frame: Frame, index: int, trans: CTransition | None) -> None:
+        """A token reaches activity ``index`` through ``trans``."""
+        inst = frame.inst
+        if inst.state != RUNNING or (frame.owner is not None and frame.owner.state != RUNNING):
+            self._dropped(frame, self._arrive, index, trans)
+            return
+        act = frame.graph.activities[index]
+        join = act.join
+        if join and trans is not None:
+            if join == J_AND:
+                counts = frame.joins.get(index)
+                if counts is None:
+                    counts = frame.joins[index] = [0] * len(act.in_slots)
+                counts[act.in_slots[trans.index]] += 1
+                if 0 in counts:
+                    frame.parked += 1
+                    self.token_gone(frame)
+                    return
+                for slot in range(len(counts)):
+                    counts[slot] -= 1
+                frame.parked -= len(counts) - 1
+            elif join == J_COMPLEX:
+                frame.parked += 1
+                frame.live -= 1
+                if self._complex_arrival(frame, act, act.in_slots[trans.index]):
+                    frame.live += 1
+                    self.activities.start(frame, act)
+                elif frame.live <= 0:
+                    self.state.pending[frame] = None
+                return
+            else:                                   # OR join: resolved when the queue is dry
+                frame.ors[index] = frame.ors.get(index, 0) + 1
+                frame.parked += 1
+                frame.live -= 1
+                self.state.pending[frame] = None
+                return
+        self.activities.start(frame, act)
+
+    def _complex_arrival(self, frame: Frame, act: CompiledActivity, slot: int) -> bool:
+        """A token (already counted as parked) reaches complex join ``act`` on ``slot``;
+        whether the join fires now (BPMN 2.0 §13.4.4: fire when the activation condition
+        holds, consuming a token of each incoming transition that has one; then ignore one
+        token on each of the others before firing again)."""
+        index = act.index
+        if frame.cjoins is None:
+            frame.cjoins = {}
+            frame.owed = {}
+        assert frame.owed is not None
+        counts = frame.cjoins.get(index)
+        if counts is None:
+            counts = frame.cjoins[index] = [0] * len(act.in_slots)
+        owed = frame.owed.get(index)
+        if owed is not None and slot in owed:       # waiting for reset: this one is ignored
+            owed.discard(slot)
+            frame.parked -= 1
+            if owed:
+                return False
+            del frame.owed[index]
+            return self._complex_fires(frame, act, counts) if any(counts) else False
+        counts[slot] += 1
+        if owed is not None:
+            return False
+        return self._complex_fires(frame, act, counts)
+
+    def _complex_fires(self, frame: Frame, act: CompiledActivity, counts: list[int]) -> bool:
+        inst = frame.inst
+        active = sum(1 for c in counts if c)
+        condition = act.join_condition
+        assert condition is not None
+        try:
+            holds = condition(ChainMap({"activationCount": active}, inst.scope), self.state.env._now)
+        except OpspecError as error:
+            self.abort(inst, act, f"the IncomingCondition failed: {error.message}")
+            return False
+        if not holds:
+            return False
+        owed = set()
+        for slot, count in enumerate(counts):
+            if count:
+                counts[slot] -= 1
+                frame.parked -= 1
+            else:
+                owed.add(slot)
+        if owed and frame.owed is not None:
+            frame.owed[act.index] = owed
+        return True
+
+    def token_gone(self, frame: Frame) -> None:
+        frame.live -= 1
+        if frame.graph.completion is not None and self._ad_hoc_complete(frame):
+            return
+        if frame.live <= 0 or frame.ors:
+            if frame.live <= 0 and not frame.parked:
+                self._frame_done(frame)
+            else:
+                self.state.pending[frame] = None
+
+    def _ad_hoc_complete(self, frame: Frame) -> bool:
+        """An ad-hoc set's AdHocCompletionCondition holds once one of its paths ended: the
+        activities still running are cancelled, those not started are dropped, and the set
+        completes (BPMN 2.0 ad-hoc subprocess, cancelRemainingInstances)."""
+        condition = frame.graph.completion
+        owner = frame.owner
+        assert condition is not None
+        if owner is None or owner.state != RUNNING:
+            return False
+        inst = frame.inst
+        try:
+            holds = condition(inst.scope, self.state.env._now)
+        except OpspecError as error:
+            self.abort(inst, owner.act, f"the AdHocCompletionCondition failed: {error.message}")
+            return True
+        if not holds:
+            return False
+        if frame.queue:
+            frame.queue.clear()
+        for ai in list(frame.running.values()):
+            self.activities.stop(ai, TERMINATED, "the ad-hoc set's completion condition holds")
+        frame.live = 0
+        frame.parked = 0
+        self._frame_done(frame)
+        return True
+
+    def resolve_frames(self) -> None:
+        """OR joins that nothing can reach any more fire; a frame with only parked tokens
+        left is deadlocked (an AND join that cannot fire)."""
+        frames = list(self.state.pending)
+        self.state.pending.clear()
+        for frame in frames:
+            if frame.inst.state != RUNNING:
+                continue
+            fired = False
+            for join, count in list(frame.ors.items()):
+                if self._or_ready(frame, join):
+                    del frame.ors[join]
+                    frame.parked -= count
+                    frame.live += 1
+                    fired = True
+                    self.state.ready.append((self.start_at, frame, join, None))
+            if frame.owed and frame.live <= 0 and not fired:     # (only complex joins)
+                # nothing can deliver the tokens a fired complex join waits for: it resets,
+                # and the tokens that came meanwhile may fire it again at once
+                frame.owed.clear()
+                acts = frame.graph.activities
+                for join, counts in list((frame.cjoins or {}).items()):
+                    if any(counts) and self._complex_fires(frame, acts[join], counts):
+                        frame.live += 1
+                        fired = True
+                        self.state.ready.append((self.start_at, frame, join, None))
+            if not fired and frame.live <= 0:
+                if frame.parked:
+                    waiting = [frame.graph.activities[i].id
+                               for i, c in (list(frame.joins.items()) + list(frame.ors.items())
+                                            + list((frame.cjoins or {}).items()))
+                               if (c if isinstance(c, int) else any(c))]
+                    self.report_deadlock(frame.inst, waiting, "a join waits for branches "
+                                         "that can no longer arrive")
+                else:
+                    self._frame_done(frame)
+
+    def _or_ready(self, frame: Frame, join: int) -> bool:
+        upstream = frame.graph.activities[join].upstream
+        for ai in frame.running.values():
+            if ai.act.index in upstream:
+                return False
+        for other, count in frame.ors.items():
+            if other != join and count and other in upstream:
+                return False
+        for other, counts in frame.joins.items():
+            if other in upstream and any(counts):
+                return False
+        if frame.cjoins:
+            for other, counts in frame.cjoins.items():
+                if other in upstream and any(counts):
+                    return False
+        return True
+
+    def report_deadlock(self, inst: ProcessInstance, waiting: list[str], why: str) -> None:
+        """Record a deadlock of ``inst`` (trace + summary) and abort it."""
+        proc = inst.process
+        text = (f"deadlock in process {proc.id!r} (instance {inst.id}) at "
+                f"t={self.state.env._now:.3f} s: {why}; waiting: {', '.join(waiting) or '-'}")
+        self.state.deadlocks.append({"time": self.state.env._now, "process": proc.id, "instance": inst.id,
+                               "waiting": waiting, "message": text})
+        if self.state.wants(EK.DEADLOCK, proc.id, None):
+            self.state.emit(EK.DEADLOCK, proc.id, inst.id, None, proc.lane, None,
+                      {"waiting": list(waiting), "message": text})
+        self.end_instance(inst, ABORTED, text)
+
+    def finish(self, frame: Frame, act: CompiledActivity) -> None:
+        """Completion of ``act``, then on to what follows it."""
+        nxt = self.done_next(frame, act)
+        if nxt is not None:
+            self.activities.start(frame, nxt)
+
+    def done_next(self, frame: Frame, act: CompiledActivity) -> CompiledActivity | None:
+        """Complete ``act`` (end assignments, throw/raise, trace) and take its split.
+
+        Returns the activity the token moves on to when it can be started right away (an
+        XOR split or a single transition into an activity without AND/OR join); otherwise
+        the token has been queued, parked or has ended, and ``None`` is returned.
+        """
+        inst = frame.inst
+        if act.simple_end:
+            if self.state.aflags[act] & 2:
+                self.state.emit(EK.ACTIVITY_COMPLETED, act.process, inst.id, act.id, act.lane,
+                          act.participant)
+            nxt = act.next
+            if nxt >= 0:
+                target = frame.graph.activities[nxt]
+                if not target.join:
+                    return target
+            return self._split(frame, act, inst)
+        if act.end_assign and act.loop is None and not self.assign(inst, act, act.end_assign):
+            return None
+        if act.kind == K_THROW and act.trigger is not None:
+            self.triggers.broadcast(act.trigger.kind, act.trigger.name or "", None, inst, act)
+        if self.state.aflags[act] & 2:
+            self.state.emit(EK.ACTIVITY_COMPLETED, act.process, inst.id, act.id, act.lane,
+                      act.participant)
+        if act.raises is not None and inst.state == RUNNING:
+            self.triggers.broadcast(act.raises.kind, act.raises.name or "", None, inst, act)
+        if act.terminate:
+            self.end_instance(inst, TERMINATED, f"end event {act.id!r}", notify_parent=False)
+            parent = inst.parent
+            if parent is not None and parent.state == RUNNING:
+                parent.child = None
+                self.activities.body_done(parent, None)
+            return None
+        if inst.state != RUNNING:
+            return None
+        return self._split(frame, act, inst)
+
+    def _split(self, frame: Frame, act: CompiledActivity, inst: ProcessInstance
+               ) -> CompiledActivity | None:
+        """The split of a completed activity (see :meth:`done_next`)."""
+        acts = frame.graph.activities
+        nxt = act.next
+        if nxt >= 0:
+            target = acts[nxt]
+            if not target.join:
+                return target
+            trans = act.out[0]
+        elif act.split == S_XOR and not act.choice and (act.out or act.otherwise):
+            scope = inst.scope
+            now = self.state.env._now
+            try:
+                for trans in act.out:
+                    cond = trans.condition
+                    if cond is None or cond(scope, now):
+                        break
+                else:
+                    if not act.otherwise and act.path_may_end:
+                        self.token_gone(frame)     # no condition holds: this path ends
+                        return None
+                    if not act.otherwise:
+                        self.abort(inst, act, "no outgoing transition can be taken (no "
+                                   "condition holds and there is no OTHERWISE transition)")
+                        return None
+                    trans = act.otherwise[0]
+            except OpspecError as error:
+                self.abort(inst, act, f"a transition condition failed: {error.message}")
+                return None
+            target = acts[trans.target]
+            if not target.join:
+                if trans.assignments:
+                    for target_name, fn in trans.assignments:
+                        self.set_field(inst, None, target_name, fn(scope, now))
+                return target
+        else:
+            self._leave(frame, act)
+            return None
+        self.take(frame, trans)
+        self.token_gone(frame)
+        return None
+
+    def _leave(self, frame: Frame, act: CompiledActivity) -> None:
+        if act.choice:
+            ai = ActivityInstance(next(self.state.keys), act, frame, self.state.env._now)
+            ai.state = RUNNING
+            frame.running[ai.key] = ai
+            self.offers.offer_choice(ai, act.choice)
+            return
+        outs = act.out
+        if outs or act.otherwise:
+            inst = frame.inst
+            scope = inst.scope
+            now = self.state.env._now
+            taken = False
+            try:
+                if act.split == S_XOR:
+                    for trans in outs:
+                        cond = trans.condition
+                        if cond is None or cond(scope, now):
+                            self.take(frame, trans)
+                            taken = True
+                            break
+                else:
+                    for trans in outs:
+                        cond = trans.condition
+                        if cond is None or cond(scope, now):
+                            self.take(frame, trans)
+                            taken = True
+            except OpspecError as error:
+                self.abort(inst, act, f"a transition condition failed: {error.message}")
+                return
+            if not taken and not act.otherwise and act.path_may_end:
+                pass                                # no condition holds: this path ends
+            elif not taken:
+                if not act.otherwise:
+                    self.abort(inst, act, "no outgoing transition can be taken (no condition "
+                               "holds and there is no OTHERWISE transition)")
+                    return
+                self.take(frame, act.otherwise[0])
+        self.token_gone(frame)
+
+    def take(self, frame: Frame, trans: CTransition, performed: bool = False) -> None:
+        if trans.assignments:
+            inst = frame.inst
+            now = self.state.env._now
+            for target, fn in trans.assignments:
+                self.set_field(inst, None, target, fn(inst.scope, now))
+        frame.live += 1
+        self.state.ready.append((self.performed if performed else self._arrive, frame,
+                            trans.target, trans))
+
+    def performed(self, frame: Frame, index: int, trans: CTransition | None) -> None:
+        """A branch of a deferred choice: the performer's choice (or the caught event) *is*
+        the chosen activity, which completes at once."""
+        inst = frame.inst
+        if inst.state != RUNNING:
+            self._dropped(frame, self.performed, index, trans)
+            return
+        act = frame.graph.activities[index]
+        self.state.emit_act(EK.ACTIVITY_STARTED, inst, act)
+        if act.start_assign and not self.assign(inst, act, act.start_assign):
+            return
+        self.finish(frame, act)
+
+    def set_field(self, inst: ProcessInstance, act: CompiledActivity | None, target: str,
+             value: Any) -> None:
+        if target in inst.data or target not in self.state.package_data:
+            inst.data[target] = value
+        else:
+            self.state.package_data[target] = value
+        if (self.state.aflags[act] & 8 if act is not None
+                else self.state.wants_all or (EK.DATA_CHANGED, inst.process.id, None) in self.state.wanted):
+            self.state.emit(EK.DATA_CHANGED, inst.process.id, inst.id,
+                      act.id if act is not None else None, inst.process.lane, None,
+                      {target: value})
+        if self.state.rules:
+            self.triggers.check_rules()
+
+    def assign(self, inst: ProcessInstance, act: CompiledActivity,
+                assignments: tuple[tuple[str, Any], ...]) -> bool:
+        """Run ``assignments``; ``False`` when the instance ended meanwhile (a failed
+        assignment aborts it; a data change can fire its end trigger): the caller stops."""
+        now = self.state.env._now
+        try:
+            for target, fn in assignments:
+                self.set_field(inst, act, target, fn(inst.scope, now))
+                if inst.state != RUNNING:
+                    return False
+        except OpspecError as error:
+            self.abort(inst, act, f"an assignment failed: {error.message}")
+            return False
+        return True
+
+    def exception_flow(self, frame: Frame, act: CompiledActivity, exception: str,
+                        message: str, beside: bool) -> None:
+        """Follow the EXCEPTION (or DEFAULTEXCEPTION) transition for ``exception``; without
+        one, abort the instance (unless the exception path was to start ``beside``)."""
+        trans = next((t for t in act.exceptions if t.exception in (None, exception)),
+                     act.default_exception)
+        inst = frame.inst
+        if trans is None:
+            if not beside:
+                self.abort(inst, act, message or f"exception {exception!r}")
+            return
+        self.state.emit_act(EK.EXCEPTION_RAISED, inst, act,
+                       {"exception": exception, "transition": trans.id, "message": message})
+        self.take(frame, trans)
+        if not beside:
+            self.token_gone(frame)

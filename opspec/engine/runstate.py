@@ -1,0 +1,298 @@
+"""The state of one run: what the interpreter's parts share.
+
+Everything a run holds lives in one :class:`RunState` (the :class:`~opspec.engine.interpreter.
+Interpreter` is one, and :class:`~opspec.engine.simulation.Simulation` subclasses it): the
+workflow instances, the ready queue of zero-time work and the SimPy wakeups, the waiters for
+triggers, the work items offered, the kept messages and mailboxes, the trace listeners and the
+counters of the summary. The parts (:mod:`~opspec.engine.flow`, :mod:`~opspec.engine.activities`,
+:mod:`~opspec.engine.triggers`, :mod:`~opspec.engine.offers`) hold no state of their own, only
+a reference to this object and to each other.
+
+It also owns the two primitives every part uses: the trace (:meth:`RunState.emit`, built only
+when a listener wants the event) and the clock (:meth:`RunState.drain` runs the ready queue,
+:meth:`RunState.later` and :meth:`RunState.call_at` schedule on SimPy).
+"""
+
+from __future__ import annotations
+
+import itertools
+from collections import deque
+from collections.abc import Callable, Mapping
+from types import MappingProxyType
+from typing import TYPE_CHECKING, Any
+
+import simpy
+
+from opspec.engine.compiled import CompiledActivity, CompiledPackage, CompiledProcess
+from opspec.engine.config import EngineConfig
+from opspec.engine.instances import ActivityInstance, Frame, ProcessInstance
+from opspec.engine.lifecycle import RUNNING, SUSPENDED
+from opspec.engine.performers import Performer
+from opspec.engine.processors import DedicatedProcessor, PooledProcessor
+from opspec.engine.random import Streams
+from opspec.engine.registry import PerformerRegistry
+from opspec.engine.trace import EventKind as EK
+from opspec.engine.trace import TraceEvent, TraceListener
+from opspec.engine.wakeup import Wakeups
+from opspec.engine.zero_time import ZeroTimeSampler
+from opspec.engine.zero_time import max_instant_steps as _max_instant_steps
+from opspec.model import Package
+
+if TYPE_CHECKING:
+    from opspec.engine.flow import Flow
+
+__all__ = ["RunState", "discard"]
+
+_EMPTY: Mapping[str, Any] = MappingProxyType({})
+
+
+class RunState:
+    """The state of one simulation run (see the module docstring)."""
+
+    flow: Flow      # resolves the joins the ready queue leaves pending (set by the Interpreter)
+
+    def __init__(self, compiled: CompiledPackage, config: EngineConfig, *,
+                 performers: PerformerRegistry, seed: int, listeners: list[TraceListener],
+                 params: Mapping[str, Any] | None, env: simpy.Environment | None,
+                 scope: tuple[int, ...], mode_loader: Callable[[str], CompiledPackage | Package] | None
+                 ) -> None:
+        self.compiled = compiled
+        self.config = config
+        self.env = env if env is not None else simpy.Environment()
+        self.wakeups = Wakeups(self.env)
+        self.registry = performers
+        self.streams = Streams(seed, scope)
+        self.mode_loader = mode_loader
+        self.processes: dict[str, CompiledProcess] = compiled.processes
+        self.package_data: dict[str, Any] = dict(compiled.data)
+        if params:
+            self.package_data.update(params)
+        self.ready: deque[tuple[Any, Any, Any, Any]] = deque()
+        self.draining = False
+        self.pending: dict[Frame, None] = {}
+        self.ids = itertools.count(1)
+        self.keys = itertools.count(1)
+        self.live: dict[int, ProcessInstance] = {}
+        self.counts = {"started": 0, "completed": 0, "terminated": 0, "aborted": 0}
+        self.faults: list[dict[str, Any]] = []
+        self.deadlocks: list[dict[str, Any]] = []
+        self.stale_completions = 0
+        self.waiters: dict[tuple[str, str], dict[int, tuple[ActivityInstance, Any, Any]]] = {}
+        self.starts: dict[tuple[str, str], list[CompiledProcess]] = {}
+        self.ends: dict[tuple[str, str], list[CompiledProcess]] = {}
+        self.rules: dict[int, tuple[Any, Any, Any]] = {}       # key -> (cond, handler, arg)
+        self.rule_keys = itertools.count(1)
+        self.offered: dict[int, ActivityInstance] = {}
+        self.mailboxes: dict[str, deque[Any]] = {}
+        # messages kept until caught: (receiving root instance id or 0, (kind, name)) ->
+        # (data, simulated time it was kept)
+        self.kept: dict[tuple[int, tuple[str, str]],
+                         deque[tuple[Mapping[str, Any] | None, float]]] = {}
+        self.lost_messages = 0
+        # the zero-time cycle guard (see drain)
+        self.instant = -1.0
+        self.instant_steps = 0
+        self.max_instant_steps = _max_instant_steps()
+        self.sampler: ZeroTimeSampler | None = None
+        self.start_limit = self.max_instant_steps    # 0 while a sampler names the cycle
+        self.pullers: dict[str, deque[ActivityInstance]] = {}
+        self.performers_of: dict[CompiledActivity, Performer | None] = {}
+        self.apps = performers.applications
+        self.tool_at: dict[int, int] = {}    # activity instance key -> tool offered
+        self.pooled = config.pooled
+        self.switch = config.switch_cost if config.pooled else 0.0
+        self.resolution = config.timer_resolution
+        self.pool: PooledProcessor | None = None     # set by the Interpreter
+        self.dedicated = DedicatedProcessor()
+        self.raised_names: set[str] = set()
+        self.mode = compiled.initial_mode
+        # trace: listeners with a ``raw`` method get the fields without a TraceEvent object
+        self.listeners = [lst for lst in listeners if getattr(lst, "raw", None) is None]
+        self.raw = [lst.raw for lst in listeners  # type: ignore[attr-defined]
+                     if getattr(lst, "raw", None) is not None]
+        self.seq = 0
+        self.pkg = compiled.id
+        self.wants_all = False
+        selectors: set[tuple[str, str | None, str | None]] = set()
+        for listener in listeners:
+            wanted = getattr(listener, "selects", None)
+            if wanted is None:
+                self.wants_all = True
+                break
+            selectors.update(wanted)
+        self.selectors = frozenset(selectors)
+        self.wanted = (frozenset() if self.wants_all or not selectors
+                      else compiled.expand_selectors(self.selectors))
+        # each full listener only receives what it selects (None: everything)
+        self.full = [(lst, None if getattr(lst, "selects", None) is None
+                       else compiled.expand_selectors(frozenset(lst.selects)))  # type: ignore[attr-defined]
+                      for lst in self.listeners]
+        self.aflags = _Flags(self, _ACT_KINDS)      # CompiledActivity -> wanted-kind bits
+        self.pflags = _Flags(self, _PROC_KINDS)     # process id -> wanted-kind bits
+
+    def wants(self, kind: str, process: str | None, activity: str | None) -> bool:
+        return self.wants_all or (kind, process, activity) in self.wanted
+
+    def emit(self, kind: str, process: str | None = None, instance: int | None = None,
+             activity: str | None = None, lane: str | None = None,
+             participant: str | None = None, data: Mapping[str, Any] | None = None) -> None:
+        """Send one trace event to every listener (callers check :meth:`wants` first)."""
+        self.seq += 1
+        now = self.env._now
+        for raw in self.raw:
+            raw(now, kind, process, instance, activity, data)
+        if self.full:
+            event = TraceEvent(now, kind, process, instance, activity, lane, participant,
+                               self.pkg, data if data is not None else _EMPTY, self.seq)
+            for listener, selects in self.full:
+                if selects is None or (kind, process, activity) in selects:
+                    listener(event)
+
+    def emit_act(self, kind: str, inst: ProcessInstance, act: CompiledActivity,
+                  data: Mapping[str, Any] | None = None) -> None:
+        if self.wants_all or (kind, act.process, act.id) in self.wanted:
+            self.emit(kind, act.process, inst.id, act.id, act.lane, act.participant, data)
+
+    def drain(self) -> None:
+        """Run queued zero-time work until none is left (re-entrant calls just return).
+
+        Zero-time work at one simulated instant is counted across drains: each item run and
+        each drain (a SimPy event at this instant, so a storm of zero-delay wakeups that queue
+        nothing counts too). Past ``max_instant_steps`` the run stops with a
+        :class:`~opspec.errors.ZeroTimeCycleError` naming the activities that keep coming
+        back (:mod:`opspec.engine.zero_time`)."""
+        if self.draining:
+            return
+        self.draining = True
+        ready = self.ready
+        pop = ready.popleft
+        # Steps are counted without looking at the clock (reading it costs a dictionary
+        # lookup per drain); only past the limit does _past_limit ask whether the clock
+        # moved since the count began (then it starts again) or not (a zero-time cycle).
+        steps = self.instant_steps + 1
+        limit = self.max_instant_steps
+        try:
+            if steps > limit:
+                steps = self._past_limit(steps, None, None)
+            while True:
+                while ready:
+                    fn, a, b, c = pop()
+                    steps += 1
+                    if steps > limit:
+                        steps = self._past_limit(steps, a, b)
+                    fn(a, b, c)
+                if not self.pending:
+                    break
+                self.flow.resolve_frames()
+                if not ready:
+                    break
+        finally:
+            self.draining = False
+            self.instant_steps = steps
+
+    def _past_limit(self, steps: int, a: Any, b: Any) -> int:
+        """The step count passed the limit: a new count if the clock moved since the count
+        began, else a step of a zero-time cycle (see :meth:`zero_time`)."""
+        now = self.env._now
+        if now != self.instant:
+            self.instant = now
+            if self.sampler is not None:         # the clock moved on: no cycle after all
+                self.sampler = None
+                self.start_limit = self.max_instant_steps
+            return 1
+        self.zero_time(a, b)
+        return steps
+
+    def zero_time(self, a: Any, b: Any) -> None:
+        """A step past the limit at this instant: note what it moves (``a``, ``b`` as in a
+        ready-queue item, or a frame and an activity); stop the run once enough are seen."""
+        now = self.env._now
+        sampler = self.sampler
+        if sampler is None or sampler.at != now:
+            sampler = self.sampler = ZeroTimeSampler(now, self.max_instant_steps)
+            self.start_limit = 0                 # _start notes every activity it carries
+        if sampler.record(a, b):
+            raise sampler.error()
+
+    def later(self, delay: float, fn: Callable[[ActivityInstance, Any], None],
+               ai: ActivityInstance, arg: Any = None) -> None:
+        """Call ``fn(ai, arg)`` after ``delay`` simulated seconds if ``ai`` is still waiting."""
+        if self.resolution > 0.0:
+            delay = self._align(delay)
+        gen = ai.gen
+        self.wakeups.after(max(0.0, delay), lambda _e: self._fire(fn, ai, arg, gen))
+
+    def _fire(self, fn: Callable[[ActivityInstance, Any], None], ai: ActivityInstance,
+              arg: Any, gen: int) -> None:
+        if ai.gen == gen and ai.state == RUNNING:
+            inst = ai.frame.inst
+            if inst.state == SUSPENDED:
+                inst.deferred.append((self._refire, fn, ai, (arg, gen)))
+                return
+            fn(ai, arg)
+            self.drain()
+
+    def _refire(self, fn: Callable[[ActivityInstance, Any], None], ai: ActivityInstance,
+                arg_gen: tuple[Any, int]) -> None:
+        arg, gen = arg_gen
+        if ai.gen == gen and ai.state == RUNNING:
+            fn(ai, arg)
+
+    def _align(self, delay: float) -> float:
+        res = self.resolution
+        now = self.env._now
+        target = -(-(now + delay) // res) * res
+        return max(0.0, target - now)
+
+    def call_at(self, delay: float, callback: Callable[[], None]) -> None:
+        """Run ``callback`` after ``delay`` simulated seconds, then drain.
+
+        A zero delay asked for while zero-time work is being drained (a performer answering
+        an offer at once) goes to the ready queue, after the work queued now, instead of
+        becoming a SimPy event (saves an event per instant answer; the user model answers
+        two or three offers per dose cycle that way)."""
+        if delay <= 0.0 and self.draining:
+            self.ready.append((_call, callback, None, None))
+            return
+        self.wakeups.after(max(0.0, delay), lambda _e: self._callback(callback))
+
+    def _callback(self, callback: Callable[[], None]) -> None:
+        callback()
+        self.drain()
+
+
+_ACT_KINDS = (EK.ACTIVITY_STARTED, EK.ACTIVITY_COMPLETED, EK.ACTIVITY_OFFERED,
+              EK.DATA_CHANGED, EK.TRIGGER_RAISED)
+_PROC_KINDS = (EK.PROCESS_STARTED, EK.PROCESS_COMPLETED)
+
+
+class _Flags(dict[Any, int]):
+    """Which of ``kinds`` some listener wants, as bits, per activity or process id;
+    computed on first use (a hit is a plain dict lookup: cheaper than building a key)."""
+
+    def __init__(self, state: RunState, kinds: tuple[str, ...]) -> None:
+        super().__init__()
+        self._state = state
+        self._kinds = kinds
+
+    def __missing__(self, key: Any) -> int:
+        state = self._state
+        if isinstance(key, str):
+            process, activity = key, None
+        else:
+            process, activity = key.process, key.id
+        bits = 0
+        for n, kind in enumerate(self._kinds):
+            if state.wants(kind, process, activity):
+                bits |= 1 << n
+        self[key] = bits
+        return bits
+
+
+def _call(callback: Callable[[], None], _a: Any, _b: Any) -> None:
+    callback()
+
+
+def discard(table: dict[Any, Any], key: Any) -> None:
+    """Remove ``key`` from ``table`` if it is there (an activity's cleanup)."""
+    table.pop(key, None)

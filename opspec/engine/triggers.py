@@ -1,0 +1,466 @@
+"""What reaches an activity or a workflow from outside its flow: triggers and events.
+
+Catch events, event-gateway branches and boundary events wait for a message, signal, timer or
+rule (:meth:`Triggers.wait_trigger`); throws and raised triggers reach them
+(:meth:`Triggers.broadcast`): a signal reaches every waiter, a message exactly one receiver, is
+kept for a while with nobody waiting, and is lost when nobody can catch it. Deadlines and
+boundary events divert an activity onto its exception path. Start and end triggers of
+workflows are armed here (:meth:`Triggers.arm_process`), and mode changes switch the active
+workflows (:meth:`Triggers.change_mode`), loading a mode's file when it names one."""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from collections import deque
+from collections.abc import Callable, Iterable, Iterator, Mapping
+from typing import TYPE_CHECKING, Any
+
+from opspec.engine.compiled import (
+    CompiledActivity,
+    CompiledPackage,
+    CompiledProcess,
+    CTrigger,
+)
+from opspec.engine.instances import ActivityInstance, ProcessInstance
+from opspec.engine.lifecycle import (
+    RUNNING,
+    SUSPENDED,
+    TERMINATED,
+)
+from opspec.engine.runstate import RunState, discard
+from opspec.engine.trace import EventKind as EK
+from opspec.errors import OpspecError
+
+if TYPE_CHECKING:
+    from opspec.engine.activities import Activities
+    from opspec.engine.flow import Flow
+    from opspec.engine.offers import Offers
+
+
+#: Messages of one name kept with nobody waiting (per receiving instance, or for anyone).
+MESSAGE_BUFFER = 100
+DAY = 86_400.0
+
+
+class Triggers:
+    """Messages, signals, timers, rules, boundary events, deadlines, start/end triggers, modes."""
+
+    flow: Flow
+    activities: Activities
+    triggers: Triggers
+    offers: Offers
+
+    def __init__(self, state: RunState) -> None:
+        self.state = state
+
+    def connect(self, flow: Flow, activities: Activities, triggers: Triggers,
+                offers: Offers) -> None:
+        """The other parts of the interpreter (they call each other)."""
+        self.flow = flow
+        self.activities = activities
+        self.triggers = triggers
+        self.offers = offers
+
+    def wait_trigger(self, ai: ActivityInstance, trig: CTrigger, handler: Any, arg: Any,
+                      persistent: bool = False) -> None:
+        """Arrange ``handler(ai, arg, data)`` when ``trig`` happens while ``ai`` waits."""
+        kind = trig.kind
+        if kind in ("message", "signal"):
+            key = (kind, trig.name or "")
+            if kind == "message" and not persistent and self.state.kept:
+                kept = self._take_kept(ai.frame.inst, key)
+                if kept is not None:                # it came before we waited: caught now
+                    handler(ai, arg, kept[0])
+                    return
+            table = self.state.waiters.get(key)
+            if table is None:
+                table = self.state.waiters[key] = {}
+            token = next(self.state.keys)
+            table[token] = (ai, handler, (arg, persistent, key, token))
+            ai.cleanup.append(lambda: discard(table, token))
+        elif kind in ("timer", "period"):
+            inst = ai.frame.inst
+            if trig.seconds is not None:
+                delay = float(trig.seconds(inst.scope, self.state.env._now))
+            else:
+                delay = trig.offset or (trig.every or 0.0)
+            self.state.later(delay, lambda a, _x: handler(a, arg, None), ai)
+        elif kind == "rule":
+            assert trig.condition is not None
+            inst = ai.frame.inst
+            if trig.condition(inst.scope, self.state.env._now):
+                handler(ai, arg, None)
+                return
+            rkey = next(self.state.rule_keys)
+            condition = trig.condition
+            self.state.rules[rkey] = (lambda: condition(inst.scope, self.state.env._now),
+                                 lambda: handler(ai, arg, None), ai)
+            ai.cleanup.append(lambda: discard(self.state.rules, rkey))
+
+    def check_rules(self) -> None:
+        for rkey, (cond, fire, ai) in list(self.state.rules.items()):
+            if ai is not None and ai.state != RUNNING:
+                self.state.rules.pop(rkey, None)
+                continue
+            try:
+                holds = cond()
+            except OpspecError:
+                continue
+            if holds and rkey in self.state.rules:
+                if ai is not None:
+                    self.state.rules.pop(rkey, None)
+                fire()
+
+    def caught(self, ai: ActivityInstance, _arg: Any, data: Mapping[str, Any] | None) -> None:
+        self.state.ready.append((self.activities.body_done, ai, self._known(ai, data), None))
+
+    def _known(self, ai: ActivityInstance, data: Mapping[str, Any] | None
+               ) -> Mapping[str, Any] | None:
+        if not data:
+            return None
+        fields = ai.frame.inst.data
+        return {k: v for k, v in data.items() if k in fields} or None
+
+    def broadcast(self, kind: str, name: str, data: Mapping[str, Any] | None,
+                  inst: ProcessInstance | None = None, act: CompiledActivity | None = None
+                  ) -> None:
+        """Raise a signal or send a message (see :meth:`_send`).
+
+        A *signal* reaches everything waiting for it now and is not kept: catch events,
+        event-gateway branches, boundary events, start and end triggers.
+        """
+        self.state.raised_names.add(name)
+        proc = inst.process.id if inst is not None else None
+        aid = act.id if act is not None else None
+        if (self.state.aflags[act] & 16 if act is not None
+                else self.state.wants_all or (EK.TRIGGER_RAISED, proc, aid) in self.state.wanted):
+            self.state.emit(EK.TRIGGER_RAISED, proc, inst.id if inst else None, aid,
+                      act.lane if act else None, act.participant if act else None,
+                      {"trigger": kind, "name": name, **(dict(data) if data else {})})
+        key = (kind, name)
+        if kind == "message":
+            self._send(key, data, inst, act)
+            return
+        table = self.state.waiters.get(key)
+        if table:
+            waiting = list(table.values())
+            for ai, handler, (arg, persistent, _k, token) in waiting:
+                if not persistent:
+                    table.pop(token, None)
+                if ai.state == RUNNING:
+                    handler(ai, arg, data)
+        for target in self.state.starts.get(key, ()):
+            if self.is_active(target.id):
+                self.flow.start_process(target, self._fields(target, data), trigger=f"{kind}:{name}")
+        for target in self.state.ends.get(key, ()):
+            self.terminate_all(target.id, f"end trigger {kind}:{name}")
+
+    def _send(self, key: tuple[str, str], data: Mapping[str, Any] | None,
+              inst: ProcessInstance | None, act: CompiledActivity | None) -> None:
+        """A message goes to exactly one receiver (BPMN 2.0 §9.3, message flow):
+
+        * a *reply* — thrown by an instance that a message started, named like a message
+          the starting workflow catches — goes to that starting instance only: to the
+          activity of it that waits for it, else it is kept until one does, and it is lost
+          (``trigger.lost``) if that instance has ended;
+        * any other message goes to the activity that has waited longest for it, else it
+          starts the workflows whose start trigger it is, else ends those whose end
+          trigger it is, else it is kept (``trigger.kept``, at most :data:`MESSAGE_BUFFER`
+          per name, the oldest lost first) for the next activity that waits for it.
+        """
+        table = self.state.waiters.get(key)
+        partner = inst.partner if inst is not None else None
+        if partner is not None and partner.process.id in self.state.compiled.catchers.get(key, ()):
+            if table:
+                for token, entry in list(table.items()):
+                    ai = entry[0]
+                    if ai.state == RUNNING and ai.frame.inst.root == partner.id:
+                        self._hand(table, token, entry, data)
+                        return
+            if partner.state in (RUNNING, SUSPENDED):
+                self._keep(key, data, inst, act, partner)
+            else:
+                self._lose(key, inst, act, f"the instance it answers ({partner.process.id} "
+                           f"#{partner.id}) has ended")
+            return
+        if table:
+            for token, entry in list(table.items()):
+                if entry[0].state == RUNNING:
+                    self._hand(table, token, entry, data)
+                    return
+        kind, name = key
+        started = False
+        for target in self.state.starts.get(key, ()):
+            if self.is_active(target.id):
+                child = self.flow.start_process(target, self._fields(target, data),
+                                           trigger=f"{kind}:{name}")
+                child.partner = _root(inst) if inst is not None else None
+                started = True
+        if started:
+            return
+        ended = False
+        for target in self.state.ends.get(key, ()):
+            if any(i.process.id == target.id for i in self.state.live.values()):
+                self.terminate_all(target.id, f"end trigger {kind}:{name}")
+                ended = True
+        if not ended:
+            self._keep(key, data, inst, act, None)
+
+    def _hand(self, table: dict[int, tuple[ActivityInstance, Any, Any]], token: int,
+              entry: tuple[ActivityInstance, Any, Any], data: Mapping[str, Any] | None
+              ) -> None:
+        ai, handler, (arg, persistent, _key, _token) = entry
+        if not persistent:
+            table.pop(token, None)
+        handler(ai, arg, data)
+
+    def _keep(self, key: tuple[str, str], data: Mapping[str, Any] | None,
+              inst: ProcessInstance | None, act: CompiledActivity | None,
+              partner: ProcessInstance | None) -> None:
+        box_key = (partner.id if partner is not None else 0, key)
+        box = self.state.kept.get(box_key)
+        if box is None:
+            box = self.state.kept[box_key] = deque()
+        if len(box) >= MESSAGE_BUFFER:
+            box.popleft()
+            self._lose(key, inst, act, f"more than {MESSAGE_BUFFER} {key[1]!r} messages were "
+                       "kept with nobody waiting; the oldest is dropped")
+        box.append((data, self.state.env._now))
+        self._trigger_event(EK.TRIGGER_KEPT, key, inst, act, {
+            "for": None if partner is None else partner.id, "kept": len(box)})
+
+    def _take_kept(self, waiter: ProcessInstance, key: tuple[str, str]
+                   ) -> tuple[Mapping[str, Any] | None, float] | None:
+        """The oldest message kept for ``waiter``'s root instance, else for anyone; messages
+        kept longer than the configured ``message_ttl`` are lost on the way (a button pressed
+        hours before anyone asked is not an answer to the next question)."""
+        now = self.state.env._now
+        ttl = self.state.config.message_ttl
+        for box_key in ((waiter.root, key), (0, key)):
+            box = self.state.kept.get(box_key)
+            while box:
+                message = box.popleft()
+                if not box:
+                    del self.state.kept[box_key]
+                if now - message[1] <= ttl:
+                    return message
+                self._lose(key, None, None, f"kept {now - message[1]:g} s with nobody "
+                           f"catching it (message_ttl {ttl:g} s)")
+        return None
+
+    def _lose(self, key: tuple[str, str], inst: ProcessInstance | None,
+              act: CompiledActivity | None, why: str) -> None:
+        self.state.lost_messages += 1
+        self._trigger_event(EK.TRIGGER_LOST, key, inst, act, {"reason": why})
+
+    def drop_kept(self, root: ProcessInstance) -> None:
+        """``root`` ended: the replies kept for it can never be caught."""
+        for box_key in [k for k in self.state.kept if k[0] == root.id]:
+            for _message in self.state.kept.pop(box_key):
+                self._lose(box_key[1], None, None, f"the instance it answers "
+                           f"({root.process.id} #{root.id}) ended before catching it")
+
+    def _trigger_event(self, kind: str, key: tuple[str, str], inst: ProcessInstance | None,
+                       act: CompiledActivity | None, extra: dict[str, Any]) -> None:
+        proc = inst.process.id if inst is not None else None
+        aid = act.id if act is not None else None
+        if self.state.wants(kind, proc, aid):
+            self.state.emit(kind, proc, inst.id if inst is not None else None, aid,
+                      act.lane if act else None, act.participant if act else None,
+                      {"trigger": key[0], "name": key[1], **extra})
+
+    def _fields(self, proc: CompiledProcess, data: Mapping[str, Any] | None
+                ) -> dict[str, Any] | None:
+        if not data:
+            return None
+        return {k: v for k, v in data.items() if k in proc.data} or None
+
+    def terminate_all(self, process_id: str, reason: str) -> None:
+        for inst in [i for i in self.state.live.values() if i.process.id == process_id]:
+            self.flow.end_instance(inst, TERMINATED, reason)
+
+    def is_active(self, process_id: str) -> bool:
+        """Whether ``process_id`` belongs to no mode or to the current mode."""
+        modes = self.state.compiled.modes
+        if not modes:
+            return True
+        member = [m for m, procs in modes.items() if process_id in procs]
+        return not member or self.state.mode in member
+
+    def boundary(self, ai: ActivityInstance, index: int, data: Mapping[str, Any] | None) -> None:
+        event = ai.frame.graph.activities[index]
+        frame = ai.frame
+        if event.interrupting:
+            # the interrupted activity's token moves on to the boundary path (below)
+            group = ai.mi
+            self.activities.stop(ai, TERMINATED, f"boundary event {event.id!r}")
+            if group is not None:
+                group.members.remove(ai)
+                self.activities.mi_cancel(group, frame, f"boundary event {event.id!r}")
+        else:
+            frame.live += 1                         # a new token beside the activity
+        self.state.ready.append((self.flow.performed, frame, index, None))
+
+    def deadline(self, ai: ActivityInstance, arg: tuple[bool, str, float]) -> None:
+        synchronous, exception, delay = arg
+        act = ai.act
+        frame = ai.frame
+        inst = frame.inst
+        self.state.emit_act(EK.DEADLINE_EXPIRED, inst, act,
+                       {"exception": exception, "synchronous": synchronous, "deadline": delay})
+        if synchronous:
+            self.activities.stop(ai, TERMINATED, f"deadline {exception!r}")
+            self.flow.exception_flow(frame, act, exception,
+                                 f"deadline of {delay:g} s expired ({exception!r})", False)
+        else:
+            self.flow.exception_flow(frame, act, exception, "", True)
+
+    def change_mode(self, mode: str, act: CompiledActivity | None = None,
+                    inst: ProcessInstance | None = None) -> None:
+        """Switch the active workflow set: instances of workflows outside the new mode are
+        terminated, their triggers ignored; workflows of the new mode are armed (loaded
+        through ``mode_loader`` first when the mode names a source)."""
+        source = self.state.compiled.mode_sources.get(mode)
+        if source is not None and self.state.mode_loader is not None:
+            loaded = self.state.mode_loader(source)
+            if not isinstance(loaded, CompiledPackage):      # a Package: compile it here
+                from opspec.engine.compiled import compile_package
+
+                loaded = compile_package(loaded)
+            new = {pid: p for pid, p in loaded.processes.items() if pid not in self.state.processes}
+            if new:
+                self.state.processes = {**self.state.processes, **new}
+                # the loaded workflows belong to the mode that loaded them (on a copy: the
+                # compiled package may be shared with other runs)
+                self.state.compiled = dataclasses.replace(self.state.compiled, modes={
+                    **self.state.compiled.modes,
+                    mode: self.state.compiled.modes.get(mode, frozenset()) | frozenset(new)})
+                self._select_loaded(new.values())
+                for proc in new.values():
+                    self.arm_process(proc)
+        old = self.state.mode
+        self.state.mode = mode
+        for live in list(self.state.live.values()):
+            if not self.is_active(live.process.id):
+                self.flow.end_instance(live, TERMINATED, f"mode change {old!r} -> {mode!r}")
+        if self.state.wants(EK.MODE_CHANGED, act.process if act else None, act.id if act else None):
+            self.state.emit(EK.MODE_CHANGED, act.process if act else None, inst.id if inst else None,
+                      act.id if act else None, act.lane if act else None, None,
+                      {"from": old, "to": mode})
+        for proc in self.state.processes.values():
+            members = [m for m, procs in self.state.compiled.modes.items() if proc.id in procs]
+            if mode in members and proc.auto_start:
+                self.flow.start_process(proc, trigger=f"mode:{mode}")
+
+    def _select_loaded(self, procs: Iterable[CompiledProcess]) -> None:
+        """Extend the listeners' expanded selectors over workflows loaded at run time (the
+        boot expansion only saw the boot package), so metrics, --timing and traces see their
+        events. Runs once per loaded source, never on the per-event path."""
+        from opspec.engine.compiled import expand_selectors_over
+
+        procs = tuple(procs)
+        if not self.state.wants_all and self.state.selectors:
+            self.state.wanted = self.state.wanted | expand_selectors_over(
+                procs, self.state.selectors, package_level=False)
+        self.state.full = [(lst, None if selects is None else selects | expand_selectors_over(
+            procs, frozenset(lst.selects), package_level=False))  # type: ignore[attr-defined]
+            for lst, selects in self.state.full]
+        self.state.aflags.clear()                 # cached "nobody wants this" bits may be stale
+        self.state.pflags.clear()
+
+    def arm_process(self, proc: CompiledProcess) -> None:
+        """Arm the start and end triggers of ``proc`` (mode membership checked on firing)."""
+        start = proc.start_trigger
+        if start is None:
+            if proc.auto_start and self.is_active(proc.id):
+                self.flow.start_process(proc, trigger="auto")
+        else:
+            self._arm(start, lambda trig: self._triggered_start(proc, trig))
+        if proc.end_trigger is not None:
+            self._arm(proc.end_trigger, lambda trig: self.terminate_all(
+                proc.id, f"end trigger {trig}"), ends=proc)
+
+    def _triggered_start(self, proc: CompiledProcess, trigger: str) -> None:
+        if self.is_active(proc.id):
+            self.flow.start_process(proc, trigger=trigger)
+
+    def _arm(self, trig: CTrigger, fire: Callable[[str], None],
+             ends: CompiledProcess | None = None) -> None:
+        kind = trig.kind
+        if kind in ("message", "signal"):
+            state = self.state
+            table = state.ends if ends is not None else state.starts
+            if ends is not None:
+                table.setdefault((kind, trig.name or ""), []).append(ends)
+            else:
+                proc = next(p for p in self.state.processes.values() if p.start_trigger is trig)
+                table.setdefault((kind, trig.name or ""), []).append(proc)
+        elif kind in ("timer", "period"):
+            times = _occurrences(trig, self.state.env.now)
+            self._next_timer(times, fire, f"{kind}")
+        elif kind == "rule":
+            condition = trig.condition
+            assert condition is not None
+            last = {"holds": False}
+            run = self.state
+
+            def holds() -> bool:
+                value = bool(condition(run.package_data, run.env.now))
+                rising = value and not last["holds"]
+                last["holds"] = value
+                return rising
+            key = next(self.state.rule_keys)
+            self.state.rules[key] = (holds, lambda: fire("rule"), None)
+
+    def _next_timer(self, times: Iterator[float], fire: Callable[[str], None],
+                    label: str) -> None:
+        at = next(times, None)
+        if at is None:
+            return
+        if self.state.resolution > 0.0:
+            at = math.ceil(at / self.state.resolution) * self.state.resolution
+        def fired(_event: Any) -> None:
+            fire(label)
+            self.state.drain()
+            self._next_timer(times, fire, label)
+        self.state.wakeups.after(max(0.0, at - self.state.env.now), fired)
+
+
+
+def _root(inst: ProcessInstance) -> ProcessInstance:
+    while inst.parent is not None:
+        inst = inst.parent.frame.inst
+    return inst
+
+
+def _occurrences(trig: CTrigger, now: float) -> Iterator[float]:
+    """Absolute firing times (>= ``now``) of a timer or period trigger."""
+    if trig.kind == "period":
+        # firings offset, offset + every, ...: ``count`` of them (-1: no end); armed later
+        # than some of them (a mode change), the past ones are skipped and still counted
+        every = trig.every or 0.0
+        if every <= 0:
+            yield max(now, trig.offset)
+            return
+        k = max(0, math.ceil((now - trig.offset) / every))
+        while trig.count < 0 or k < trig.count:
+            yield trig.offset + k * every
+            k += 1
+        return
+    if not trig.at:
+        if trig.every:
+            k = 1
+            while True:
+                yield trig.offset + k * trig.every
+                k += 1
+        yield now + trig.offset
+        return
+    every = trig.every or DAY
+    cycle = max(0, math.floor((now - trig.offset) / every))
+    while True:
+        for at in trig.at:
+            t = cycle * every + at + trig.offset
+            if t >= now:
+                yield t
+        cycle += 1
