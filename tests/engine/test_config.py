@@ -21,7 +21,8 @@ def test_config_loads_from_an_engine_table_and_applies_overrides(tmp_path: Path)
 @pytest.mark.parametrize(("text", "message"), [
     ("wokers = 2", r"engine.toml: wokers: unknown engine option 'wokers'"),
     ('processor_model = "fast"', (r"processor_model: processor_model 'fast' is not known "
-                                 r"\(allowed values: dedicated, pooled, preemptive\)")),
+                                 r"\(allowed values: dedicated, pooled, preemptive, "
+                                 r"priority-queues\)")),
     ("workers = 0", r"workers: workers must be a whole number >= 1"),
     ("switch_cost = -1.0", r"switch_cost: switch_cost must be a number of seconds >= 0"),
     ("speed = 0", r"speed: speed must be a number > 0"),
