@@ -355,6 +355,7 @@ def run(args: argparse.Namespace) -> int:
                                      progress=progress, on_trace=on_trace,
                                      retrace=bool(args.resume and plan.export),
                                      scheduler_timeout=timeout)
+            stack.close()                   # the exports are finished and moved into place
         except EvaluationError as error:
             raise _with_resume_hint(error, store, plan) from None
         except KeyboardInterrupt:
@@ -363,7 +364,6 @@ def run(args: argparse.Namespace) -> int:
                   f"replications are stored in {store.path}; finish with `opspec evaluate "
                   f"--resume --out {store.folder}`", file=sys.stderr)
             raise
-        stack.close()
         from opspec.evaluation.report import write_report
         from opspec.evaluation.summary import (
             compare_designs,
@@ -392,6 +392,8 @@ def run(args: argparse.Namespace) -> int:
         try:
             report = write_report(store, summaries,
                                   template=getattr(args, "report_template", None))
+        except EvaluationError as error:
+            raise _with_resume_hint(error, store, plan) from None
         except OSError as error:
             raise EvaluationError(
                 f"{store.folder}: cannot write the report: {error.strerror or error}",
@@ -515,13 +517,20 @@ def _export_estimate(plan: Any, folder: Path, quiet: bool) -> None:
         return
     scale = plan.users * len(plan.designs) * plan.horizon / sample
     sizes: dict[str, float] = {}
-    with tempfile.TemporaryDirectory(prefix="opspec-estimate-") as scratch, \
-            contextlib.ExitStack() as stack:
-        write = _trace_writers(stack, Path(scratch), plan)
-        write(record)
-        stack.close()
-        for fmt in plan.export:
-            sizes[fmt] = (Path(scratch) / EXPORT_FILES[fmt]).stat().st_size * scale
+    try:
+        with tempfile.TemporaryDirectory(prefix="opspec-estimate-") as scratch, \
+                contextlib.ExitStack() as stack:
+            write = _trace_writers(stack, Path(scratch), plan)
+            write(record)
+            stack.close()
+            for fmt in plan.export:
+                sizes[fmt] = (Path(scratch) / EXPORT_FILES[fmt]).stat().st_size * scale
+    except (OSError, EvaluationError) as error:
+        # the scratch folder (the system's temporary folder) is not the output's disk
+        if not quiet:
+            print(f"evaluate: the size of the export could not be estimated ({error})",
+                  file=sys.stderr)
+        return
     total = sum(sizes.values())
     span = f"{plan.users:,} user(s) x {plan.days:g} day(s)" + (
         f" x {len(plan.designs)} designs" if len(plan.designs) > 1 else "")
