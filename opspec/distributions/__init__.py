@@ -1,0 +1,66 @@
+"""Duration distributions: one family for activity durations in specs and for user models.
+
+The engine samples an activity's declared ``opspec:Duration`` / CPU demand from these
+(:mod:`opspec.engine.sampling`), and user models draw response times, omissions' delays and
+the like from them (:mod:`opspec.usermodels`): the same kind and parameters mean the same
+distribution and the same draws wherever they are written.
+
+Every distribution is a frozen dataclass whose parameters are checked on construction; a bad
+parameter raises :class:`ParameterError` (a :class:`~opspec.errors.UserModelError`) that names
+the parameter, so a loader can report ``file: dotted.key.param: must be > 0, got -1``.
+
+Contract shared by all of them:
+
+* ``sample(rng) -> float`` draws one value from the given numpy ``Generator``; the number and
+  kind of underlying draws is fixed per distribution (documented on each class), so a run
+  consumes its stream in a reproducible order;
+* ``sample_many(rng, n) -> numpy.ndarray`` draws ``n`` values at once (vectorised);
+* ``mean`` and ``var`` are analytic properties;
+* ``cdf(x)`` and ``quantile(q)`` where they are cheap;
+* ``scaled(factor)`` returns the distribution of ``factor * X`` (age slowing, learning);
+* ``to_params()`` returns the TOML form (``{"kind": ..., ...}``) that :func:`make_distribution`
+  reads back.
+
+Build one from a TOML table with :func:`make_distribution`, or from a spec's BPSim-style
+declaration with :func:`from_model`. The modules: :mod:`~opspec.distributions.base` (the
+contract and the parameter checks), :mod:`~opspec.distributions.parametric` (constant,
+lognormal, gamma, Weibull, truncated normal, exponential, ex-Gaussian),
+:mod:`~opspec.distributions.bounded` (triangular, uniform, empirical, exponential tail),
+:mod:`~opspec.distributions.factory` (the two builders).
+"""
+
+from __future__ import annotations
+
+from opspec.distributions.base import Distribution, FloatArray, ParameterError
+from opspec.distributions.bounded import Empirical, Triangular, Uniform, WithExponentialTail
+from opspec.distributions.factory import KINDS, Declared, from_model, make_distribution
+from opspec.distributions.parametric import (
+    Constant,
+    ExGaussian,
+    Exponential,
+    Gamma,
+    LogNormal,
+    TruncatedNormal,
+    Weibull,
+)
+
+__all__ = [
+    "KINDS",
+    "Constant",
+    "Declared",
+    "Distribution",
+    "Empirical",
+    "ExGaussian",
+    "Exponential",
+    "FloatArray",
+    "Gamma",
+    "LogNormal",
+    "ParameterError",
+    "Triangular",
+    "TruncatedNormal",
+    "Uniform",
+    "Weibull",
+    "WithExponentialTail",
+    "from_model",
+    "make_distribution",
+]

@@ -1,0 +1,111 @@
+"""The base of every duration distribution, its parameter error, and shared helpers.
+
+See :mod:`opspec.distributions` for the contract and the factories.
+"""
+
+from __future__ import annotations
+
+import math
+from abc import ABC, abstractmethod
+from statistics import NormalDist
+from typing import Any
+
+import numpy as np
+import numpy.typing as npt
+
+from opspec.errors import UserModelError
+
+__all__ = ["Distribution", "FloatArray", "ParameterError"]
+
+FloatArray = npt.NDArray[np.float64]
+_STD_NORMAL = NormalDist()
+_SQRT2 = math.sqrt(2.0)
+
+
+class ParameterError(UserModelError):
+    """A distribution parameter is invalid; ``param`` names it (``sigma``), so a loader can
+    prefix the dotted key of the table it came from."""
+
+    def __init__(self, param: str, message: str, *, hint: str = "") -> None:
+        self.param = param
+        self.detail = message
+        super().__init__(f"{param}: {message}", hint=hint)
+
+
+def _finite(param: str, value: float) -> float:
+    if isinstance(value, bool) or not isinstance(value, (int, float)):
+        raise ParameterError(param, f"must be a number, got {value!r}")
+    value = float(value)
+    if math.isnan(value):
+        raise ParameterError(param, "must be a number, got nan")
+    return value
+
+
+def _positive(param: str, value: float) -> float:
+    value = _finite(param, value)
+    if not value > 0 or math.isinf(value):
+        raise ParameterError(param, f"must be > 0, got {value:g}")
+    return value
+
+
+def _non_negative(param: str, value: float) -> float:
+    value = _finite(param, value)
+    if value < 0 or math.isinf(value):
+        raise ParameterError(param, f"must be >= 0, got {value:g}")
+    return value
+
+
+def _phi(z: float) -> float:
+    """Standard normal density."""
+    return math.exp(-0.5 * z * z) / math.sqrt(2.0 * math.pi) if math.isfinite(z) else 0.0
+
+
+def _ncdf(z: float) -> float:
+    """Standard normal CDF, accurate in the lower tail (erfc)."""
+    return 0.5 * math.erfc(-z / _SQRT2)
+
+
+def _check_q(q: float) -> float:
+    if not 0.0 <= q <= 1.0:
+        raise ValueError(f"quantile level must be in [0, 1], got {q}")
+    return q
+
+
+class Distribution(ABC):
+    """Base of every duration distribution (values in seconds)."""
+
+    kind: str = ""
+
+    @abstractmethod
+    def sample(self, rng: np.random.Generator) -> float:
+        """One draw."""
+
+    @abstractmethod
+    def sample_many(self, rng: np.random.Generator, n: int) -> FloatArray:
+        """``n`` draws as a float array."""
+
+    @property
+    @abstractmethod
+    def mean(self) -> float: ...
+
+    @property
+    @abstractmethod
+    def var(self) -> float: ...
+
+    @property
+    def sd(self) -> float:
+        return math.sqrt(self.var)
+
+    def cdf(self, x: float) -> float:
+        raise NotImplementedError(f"{self.kind}: cdf is not available")
+
+    def quantile(self, q: float) -> float:
+        raise NotImplementedError(f"{self.kind}: quantile is not available")
+
+    @abstractmethod
+    def scaled(self, factor: float) -> Distribution:
+        """The distribution of ``factor * X`` (``factor`` > 0)."""
+
+    @abstractmethod
+    def to_params(self) -> dict[str, Any]:
+        """The TOML table form, read back by :func:`make_distribution`."""
