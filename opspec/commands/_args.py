@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import argparse
 
-__all__ = ["seed"]
+__all__ = ["seed", "share", "sweep"]
 
 #: numpy's SeedSequence takes non-negative integers; 2**63 keeps seeds in an SQLite integer
 _MAX_SEED = 2**63 - 1
@@ -19,4 +19,36 @@ def seed(text: str) -> int:
     if not 0 <= value <= _MAX_SEED:
         raise argparse.ArgumentTypeError(f"{value} is out of range: a seed is a whole number "
                                          "from 0 to 2**63 - 1")
+    return value
+
+
+def sweep(text: str) -> tuple[str, tuple[str, ...]]:
+    """``--sweep PARAM=v1,v2,…``: the parameter's name and its values as written (read in the
+    parameter's unit by opspec.evaluation.parameters); ``list`` alone lists the names."""
+    name, equals, values = text.partition("=")
+    if not equals:
+        if text.strip() == "list":
+            return "list", ()
+        raise argparse.ArgumentTypeError(
+            f"{text!r}: write PARAM=v1,v2,... (e.g. spec.notify_workflow.wait_report.deadline="
+            "3min,5min,10min), or 'list' for the parameters the spec and user model have")
+    parts = tuple(v.strip() for v in values.split(","))
+    if not name.strip() or not all(parts):
+        raise argparse.ArgumentTypeError(f"{text!r}: a parameter name and values separated "
+                                         "by commas, none empty (PARAM=v1,v2,...)")
+    return name.strip(), parts
+
+
+def share(text: str) -> float:
+    """A share of users: ``95%`` or ``0.95``, above 0 and at most 1."""
+    stripped = text.strip()
+    percent = stripped.endswith("%")
+    try:
+        value = float(stripped[:-1] if percent else stripped) / (100.0 if percent else 1.0)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{text!r} is not a share: write 95% or "
+                                         "0.95") from None
+    if not 0.0 < value <= 1.0:
+        raise argparse.ArgumentTypeError(f"{text!r}: a share of users lies above 0 and at "
+                                         "most 100%")
     return value

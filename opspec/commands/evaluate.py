@@ -17,7 +17,7 @@ from datetime import UTC, datetime
 from pathlib import Path
 from typing import Any
 
-from opspec.commands._args import seed
+from opspec.commands._args import seed, share, sweep
 from opspec.errors import EvaluationError
 
 __all__ = ["register", "run"]
@@ -49,6 +49,16 @@ def register(subparsers: Any) -> None:
                         "companion SPEC.users.toml)")
     parser.add_argument("--compare", metavar="SPEC2",
                         help="a second design, run on the same simulated users")
+    parser.add_argument("--sweep", type=sweep, metavar="PARAM=V1,V2,...",
+                        help="run one design per value of a spec or user-model parameter, "
+                        "on the same simulated users ('--sweep list' lists the parameters; "
+                        "docs/evaluation.md, Sweeps)")
+    parser.add_argument("--target", action="append", default=[], metavar="'METRIC OP VALUE'",
+                        help="with --sweep: the values that meet it, e.g. 'missed_rate < 1%%' "
+                        "(repeatable)")
+    parser.add_argument("--target-users", type=share, metavar="SHARE",
+                        help="with --target: judge each user's own value, and ask that this "
+                        "share of users (e.g. 95%%) meets the target")
     parser.add_argument("--engine-config", metavar="FILE", help="engine configuration TOML")
     parser.add_argument("--workers", type=int, default=None,
                         help="worker processes (default: all local cores)")
@@ -155,10 +165,14 @@ def _check_plan(plan: Any) -> dict[str, list[dict[str, Any]]]:
     from opspec.evaluation.replication import prepare
 
     definitions: dict[str, list[dict[str, Any]]] = {}
+    shown: set[str] = set()                 # the designs of a sweep share their warnings
     for design in plan.designs:
-        context = prepare(design.spec, design.sha256, plan.user_model, plan.engine)
+        context = prepare(design.spec, design.sha256, plan.user_model, plan.engine,
+                          design.parameters)
         for warning in context.warnings:
-            print(f"opspec evaluate: {warning}", file=sys.stderr)
+            if str(warning) not in shown:
+                shown.add(str(warning))
+                print(f"opspec evaluate: {warning}", file=sys.stderr)
         from opspec.engine.lanes import user_lane
 
         if context.model is None and not user_lane(context.compiled).empty:
@@ -328,7 +342,15 @@ def run(args: argparse.Namespace) -> int:
 
         for design in plan.designs:         # the spec's warnings, as a new run shows them
             load_any_spec(design.spec, command="evaluate")
-        _check_plan(plan)
+        definitions = _check_plan(plan)
+        from opspec.evaluation.sweep import check_targets, resumed_sweep
+
+        try:
+            swept = resumed_sweep(store, plan, args.sweep)
+            check_targets(args.target, args.target_users, definitions["A"], swept)
+        except EvaluationError:
+            store.close()
+            raise
         if plan.export:
             try:
                 _export_estimate(plan, store.folder, quiet=args.quiet)
@@ -337,7 +359,18 @@ def run(args: argparse.Namespace) -> int:
                 raise
     else:
         plan = _new_plan(args)
+        swept = None
+        if args.sweep:
+            from opspec.evaluation.sweep import describe_parameters, plan_sweep
+
+            if args.sweep[0] == "list":
+                print(describe_parameters(plan))
+                return 0
+            plan, swept = plan_sweep(plan, *args.sweep)
         definitions = _check_plan(plan)
+        from opspec.evaluation.sweep import check_targets
+
+        check_targets(args.target, args.target_users, definitions["A"], swept)
         out = Path(args.out) if args.out else _default_out(args.spec)
         if (out / "results.sqlite").exists():
             raise EvaluationError(f"{out} already holds an evaluation",
@@ -346,6 +379,8 @@ def run(args: argparse.Namespace) -> int:
             _export_estimate(plan, out, quiet=args.quiet)
         store = ResultStore(out, create=True)
         _store_parameters(store, plan, definitions, __version__)
+        if swept is not None:
+            store.put("sweep", swept.to_json())
     with store, contextlib.ExitStack() as stack:
         on_trace = _trace_writers(stack, store.folder, plan)
         progress = make_progress(sys.stderr, quiet=args.quiet or args.json,
@@ -375,7 +410,7 @@ def run(args: argparse.Namespace) -> int:
         metrics = summarise_design(store, "A", plan.days)
         monitors = summarise_monitors(store, "A", plan.days)
         compare = None
-        if len(plan.designs) > 1:
+        if any(d.label == "B" for d in plan.designs):
             compare = {"spec": plan.design("B").spec,
                        "metrics": summarise_design(store, "B", plan.days),
                        "monitors": summarise_monitors(store, "B", plan.days),
@@ -386,9 +421,14 @@ def run(args: argparse.Namespace) -> int:
             summaries["B"] = {"metrics": compare["metrics"], "monitors": compare["monitors"],
                               "difference": compare["difference"]}
         # a population user model: who the users were, every metric per subgroup
-        population = summarise_population(store, plan.days,
-                                          designs=[d.label for d in plan.designs])
+        population = summarise_population(store, plan.days, designs=[
+            d.label for d in plan.designs] if swept is None else ["A"])
         summaries["A"]["population"] = population
+        if swept is not None:               # per value, paired against the first; targets
+            from opspec.evaluation.sweep import summarise_sweep
+
+            summaries["sweep"] = summarise_sweep(store, swept, plan.days, args.target,
+                                                 args.target_users)
         try:
             report = write_report(store, summaries,
                                   template=getattr(args, "report_template", None))
@@ -410,12 +450,18 @@ def run(args: argparse.Namespace) -> int:
                "wall_s": round(outcome.wall_s, 3)}
         if compare is not None:
             doc["compare"] = compare
+        if swept is not None:
+            doc["sweep"] = summaries["sweep"]
         print(json.dumps(_finite(doc), allow_nan=False, default=str))
     else:
         from opspec.evaluation.tables import print_summary
 
         print_summary(sys.stdout, plan, metrics, compare, outcome, failures, workers,
                       monitors=monitors, population=population)
+        if swept is not None:
+            from opspec.evaluation.sweep import print_sweep
+
+            print_sweep(sys.stdout, summaries["sweep"], plan.users)
         print(f"results: {store.path}\nreport: {report}")
     return 1 if failures else 0
 
@@ -509,7 +555,8 @@ def _export_estimate(plan: Any, folder: Path, quiet: bool) -> None:
     from opspec.evaluation.replication import prepare, run_user
 
     design = plan.designs[0]
-    context = prepare(design.spec, design.sha256, plan.user_model, plan.engine)
+    context = prepare(design.spec, design.sha256, plan.user_model, plan.engine,
+                      design.parameters)
     sample = min(plan.horizon, DAY)
     record = run_user(context, design.label, 0, seed=plan.seed, horizon=sample,
                       keep_trace=True)

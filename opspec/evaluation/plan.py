@@ -48,6 +48,9 @@ class Design:
     label: str
     spec: str
     sha256: str
+    #: parameter values this design runs with (``--sweep``: ``spec.…`` / ``user.…`` name,
+    #: value; opspec.evaluation.parameters applies them to the spec and the user model)
+    parameters: tuple[tuple[str, Any], ...] = ()
 
 
 @dataclass(frozen=True, slots=True)
@@ -84,14 +87,20 @@ class EvaluationPlan:
 
     def to_json(self) -> dict[str, Any]:
         doc = asdict(self)
-        doc["designs"] = [asdict(d) for d in self.designs]
+        # a design's parameters only when it has some: plans of runs without them read as
+        # they always did
+        doc["designs"] = [{k: v for k, v in asdict(d).items() if k != "parameters"
+                           or d.parameters} for d in self.designs]
         doc["engine"] = dict(self.engine)
         doc["export"] = list(self.export)
         return doc
 
     @classmethod
     def from_json(cls, doc: Mapping[str, Any]) -> EvaluationPlan:
-        return cls(designs=tuple(Design(**d) for d in doc["designs"]), users=int(doc["users"]),
+        designs = tuple(Design(d["label"], d["spec"], d["sha256"],
+                               tuple((str(n), v) for n, v in d.get("parameters") or ()))
+                        for d in doc["designs"])
+        return cls(designs=designs, users=int(doc["users"]),
                    days=float(doc["days"]), seed=int(doc["seed"]),
                    user_model=doc.get("user_model"), engine=dict(doc.get("engine") or {}),
                    export=tuple(doc.get("export") or ()), case=str(doc.get("case") or "user"))

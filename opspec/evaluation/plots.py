@@ -43,6 +43,7 @@ __all__ = [
     "per_user_figure",
     "rates_figure",
     "subgroups_figure",
+    "sweep_figure",
     "time_of_day_figure",
 ]
 
@@ -512,4 +513,67 @@ def comparison_figure(rows: Sequence[tuple[str, float, float, float]], path: Pat
             ax.set_ylim(-1.0, 1.0)
             ax.grid(axis="y", visible=False)
         _note_dropped(fig, dropped)
+        return _save(fig, path)
+
+
+def sweep_figure(parameter: str, xs: Sequence[float], labels: Sequence[str],
+                 series: Mapping[str, tuple[Sequence[float | None], Sequence[float | None],
+                                            Sequence[float | None]]],
+                 path: Path, *, percent: Mapping[str, bool] | None = None,
+                 units: Mapping[str, str] | None = None,
+                 targets: Mapping[str, Sequence[tuple[str, float]]] | None = None,
+                 per_user: Mapping[str, tuple[str, Sequence[float | None]]] | None = None
+                 ) -> Path:
+    """Each metric of a sweep against the swept parameter (``opspec evaluate --sweep``): per
+    metric ``(estimates, ci lows, ci highs)``, one per value at ``xs`` (tick ``labels`` as the
+    values read), each metric in its own panel with its own scale; the estimate as a line with
+    markers, its 95 % interval as a band. ``targets`` draws each target's threshold on its
+    metric's panel (dashed), ``per_user`` a per-user quantile (dotted) that a share-of-users
+    target is judged by."""
+    title = f"Metrics against {parameter}"
+    names = [n for n, (est, _, _) in series.items()
+             if any(e is not None and math.isfinite(float(e)) for e in est)]
+    if not names or not xs:
+        return _empty(path, title)
+    percent, units = percent or {}, units or {}
+    targets, per_user = targets or {}, per_user or {}
+    with _figure(9.0, 1.2 + 2.1 * len(names)) as fig:
+        fig.suptitle(f"{_text(title)}\n(line = estimate, band = 95 % interval; each metric "
+                     "on its own scale)")
+        axes = _panels(fig, len(names), sharex=True)
+        for ax, name in zip(axes, names, strict=True):
+            est, low, high = series[name]
+            scale = 100.0 if percent.get(name) else 1.0
+            keep = [i for i, e in enumerate(est) if e is not None and math.isfinite(float(e))]
+            x = [xs[i] for i in keep]
+            y = [float(est[i]) * scale for i in keep]        # type: ignore[arg-type]
+            band = [i for i in keep if low[i] is not None and high[i] is not None]
+            if band:
+                ax.fill_between([xs[i] for i in band],
+                                [float(low[i]) * scale for i in band],   # type: ignore[arg-type]
+                                [float(high[i]) * scale for i in band],  # type: ignore[arg-type]
+                                color=PALETTE[0], alpha=0.22, linewidth=0,
+                                label="95 % interval")
+            ax.plot(x, y, marker="o", color=PALETTE[0], linewidth=1.8, label="estimate")
+            for i, (text, threshold) in enumerate(targets.get(name, ())):
+                ax.axhline(threshold * scale, color=PALETTE[4], linewidth=1.4,
+                           linestyle=_LINESTYLES[(i + 1) % len(_LINESTYLES)],
+                           label=f"target {_text(text)}")
+            if name in per_user:
+                text, values = per_user[name]
+                points = [(xs[i], float(v) * scale) for i, v in enumerate(values)
+                          if v is not None and math.isfinite(float(v))]
+                if points:
+                    ax.plot([p[0] for p in points], [p[1] for p in points], marker="s",
+                            color=PALETTE[2], linestyle=":", linewidth=1.6,
+                            label=_text(text))
+            unit = "%" if percent.get(name) else units.get(name, "")
+            ax.set_ylabel(f"{_text(name)}" + (f"\n({unit})" if unit else ""), fontsize=10)
+            if percent.get(name):
+                from matplotlib.ticker import PercentFormatter
+
+                ax.yaxis.set_major_formatter(PercentFormatter(xmax=100.0, decimals=None))
+            _outside_legend(ax)
+        axes[-1].set_xticks(list(xs), [_text(label) for label in labels])
+        axes[-1].set_xlabel(_text(parameter))
         return _save(fig, path)

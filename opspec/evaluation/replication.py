@@ -94,15 +94,18 @@ class _Context:
         return self.user.source if self.user is not None else None
 
 
-_CONTEXTS: dict[tuple[str, str, str | None, str], _Context] = {}
+_CONTEXTS: dict[tuple[str, str, str | None, str, str], _Context] = {}
 
 
-def prepare(spec: str, sha256: str, user_model: str | None, engine: Mapping[str, Any]
-            ) -> _Context:
-    """Load (once per process) the spec, user model and engine configuration."""
+def prepare(spec: str, sha256: str, user_model: str | None, engine: Mapping[str, Any],
+            parameters: Sequence[Sequence[Any]] = ()) -> _Context:
+    """Load (once per process) the spec, user model and engine configuration; with
+    ``parameters`` (a design of ``--sweep``: ``(name, value)`` pairs) the spec and the user
+    model changed as :mod:`opspec.evaluation.parameters` says."""
     import json
 
-    key = (spec, sha256, user_model, json.dumps(dict(engine), sort_keys=True))
+    key = (spec, sha256, user_model, json.dumps(dict(engine), sort_keys=True),
+           json.dumps([list(p) for p in parameters]))
     found = _CONTEXTS.get(key)
     if found is not None:
         return found
@@ -118,6 +121,13 @@ def prepare(spec: str, sha256: str, user_model: str | None, engine: Mapping[str,
         user = User.model(user_model)
         if not lane.empty:
             warnings = tuple(user.source.validate_against(lane.manual, choices=lane.choices))
+    if parameters:
+        from opspec.evaluation.parameters import apply_parameters
+
+        loaded, model = apply_parameters(loaded, user.source if user else None, parameters)
+        loaded = load(loaded)
+        if model is not None:
+            user = User.model(model, user.describe if user else None)
     config = EngineConfig.from_mapping(engine) if engine else EngineConfig()
     context = _Context(loaded, (*lane.manual, *lane.choices), user, config, warnings)
     _CONTEXTS[key] = context
@@ -182,7 +192,7 @@ def run_users(plan: Mapping[str, Any], design: str, users: Sequence[int]
     """Worker entry point: replications ``users`` of ``design`` (``plan`` as JSON)."""
     spec = next(d for d in plan["designs"] if d["label"] == design)
     context = prepare(spec["spec"], spec["sha256"], plan.get("user_model"),
-                      plan.get("engine") or {})
+                      plan.get("engine") or {}, spec.get("parameters") or ())
     horizon = float(plan["days"]) * DAY
     keep = bool(plan.get("export"))
     return [run_user(context, design, u, seed=int(plan["seed"]), horizon=horizon,

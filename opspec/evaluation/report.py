@@ -536,11 +536,21 @@ def write_report(store: ResultStore, summaries: Mapping[str, Summaries] | None =
     if len(set(names.values())) < len(names):         # a design compared with itself
         names = {label: f"{name} ({'first' if i == 0 else 'second'})"
                  for i, (label, name) in enumerate(names.items())}
+    # a sweep (--sweep): its designs are the parameter's values, named by them; the
+    # detailed sections describe the first value, the sweep's own sections the others
+    sweep = summaries.get("sweep")
+    if sweep is None and store.get("sweep"):
+        from opspec.evaluation.sweep import Sweep, summarise_sweep
+
+        sweep = summarise_sweep(store, Sweep.from_json(store.get("sweep")), days)
+    detailed = designs[:1] if sweep else designs
+    if sweep:
+        names = {v["design"]: f"{sweep['parameter']} = {v['text']}" for v in sweep["values"]}
     done = {d: _users_done(store, d) for d in designs}
     failures = store.failures()
 
     per_design: dict[str, tuple[dict[str, Any], dict[str, Any], list[dict[str, Any]]]] = {}
-    for design in designs:
+    for design in detailed:
         given = summaries.get(design) or {}
         metrics = given.get("metrics")
         if metrics is None:
@@ -553,7 +563,7 @@ def write_report(store: ResultStore, summaries: Mapping[str, Summaries] | None =
 
     given_a = summaries.get(designs[0]) or {}
     population = (given_a["population"] if "population" in given_a
-                  else summarise_population(store, days, designs=designs))
+                  else summarise_population(store, days, designs=detailed))
 
     sections: list[Any] = []
     metrics_a, monitors_a, definitions_a = per_design[designs[0]]
@@ -571,6 +581,9 @@ def write_report(store: ResultStore, summaries: Mapping[str, Summaries] | None =
                            "differences exclude zero)." if differs
                            else "no metric differs (every 95 % interval of the paired "
                            "differences includes zero)."))
+    if sweep:
+        findings += [a["answer"] for a in sweep["targets"]]
+        findings += [a["users_answer"] for a in sweep["targets"] if a.get("users_answer")]
     if failures:
         findings.append(f"{len(failures)} replication(s) failed and are left out of every "
                         "number (listed at the end).")
@@ -581,6 +594,9 @@ def write_report(store: ResultStore, summaries: Mapping[str, Summaries] | None =
     run_rows = [("specification", specs.get("A", "?"))]
     if "B" in specs:
         run_rows.append(("compared with", specs["B"]))
+    if sweep:
+        run_rows.append(("swept", f"{sweep['parameter']} = "
+                         + ", ".join(v["text"] for v in sweep["values"])))
     finished = "; ".join(f"{done[d]:,} of {total_users:,}" + (f" ({names[d]})"
                                                               if len(designs) > 1 else "")
                          for d in designs) if isinstance(total_users, int) else str(done)
@@ -598,19 +614,23 @@ def write_report(store: ResultStore, summaries: Mapping[str, Summaries] | None =
         + ("; the designs are compared on the same users (common random numbers)."
            if len(designs) > 1 else "."),), tables=(Table(("parameter", "value"),
                                                           tuple(run_rows)),)))
+    if sweep:
+        from opspec.evaluation.sweep import report_sections
 
-    for design in designs:
+        sections += report_sections(sweep, figures, done.get(designs[0], 0))
+
+    for design in detailed:
         definitions = per_design[design][2]
-        suffix = f" ({names[design]})" if len(designs) > 1 else ""
+        suffix = f" ({names[design]})" if len(detailed) > 1 else ""
         sections.append(Section(f"What each metric measures{suffix}", tables=(Table(
             ("metric", "kind", "definition"),
             tuple((d["name"], str(d["kind"]), describe_metric(d)) for d in definitions),
             "Metrics the spec declares (opspec:Metrics), computed from each user's trace"),)))
     sections.append(_user_model_section(store, plan, figures, population))
 
-    for design in designs:
+    for design in detailed:
         metrics, monitors, definitions = per_design[design]
-        prefix = f"{names[design]}: " if len(designs) > 1 else ""
+        prefix = f"{names[design]}: " if len(detailed) > 1 or sweep else ""
         sections += _design_sections(store, figures, design, names[design], days,
                                      done.get(design, 0), metrics, monitors, definitions,
                                      prefix, population, designs[0])
