@@ -300,8 +300,8 @@ def _set_user(model: Any, parameter: Parameter, value: Any) -> Any:
 
     path = tuple(parameter.name.split(".")[1:])
     if path[0] == "modifier":
-        return model.with_modifier(Modifier(name=f"{parameter.name} = {value:g}",
-                                            **{path[1]: float(value)}))
+        factors: dict[str, Any] = {path[1]: float(value)}
+        return model.with_modifier(Modifier(name=f"{parameter.name} = {value:g}", **factors))
     changed = set_parameter(model, path, float(value))
     if model.population is None:
         return changed

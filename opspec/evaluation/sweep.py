@@ -394,7 +394,7 @@ def metric_table(summary: Mapping[str, Any], metric: str) -> list[tuple[str, ...
     """One row per value: the metric's estimate and interval, the paired difference against
     the first value with its interval, and how much narrower the paired interval is than an
     unpaired one (the gain of common random numbers)."""
-    rows = []
+    rows: list[tuple[str, ...]] = []
     for entry in summary["values"]:
         s = entry["metrics"].get(metric)
         d = (entry["difference"] or {}).get(metric) if entry["difference"] else None
