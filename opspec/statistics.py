@@ -241,7 +241,12 @@ def paired_difference(a: Sequence[tuple[float, float]], b: Sequence[tuple[float,
     denominators and fewer than :data:`RARE_DISCORDANT` events differ between them, the
     interval is widened to cover ``[(L_up − U_down)/N, (U_up − L_down)/N]``, the exact
     Poisson (Garwood) bounds of the events B adds (``up``) and removes (``down``) — the
-    paired analogue of the rare-event rule for a single design's counts and rates."""
+    paired analogue of the rare-event rule for a single design's counts and rates.
+
+    Other pairs (durations): on common random numbers most users' values are identical in
+    both designs; with fewer than :data:`RARE_DISCORDANT` users whose values differ the t
+    quantile has (that number − 1) degrees of freedom, and with fewer than 2 there is no
+    interval (``low``/``high`` None): the data cannot say how much the designs differ."""
     if len(a) != len(b):
         raise ValueError("paired designs need the same users")
     users = len(a)
@@ -257,9 +262,20 @@ def paired_difference(a: Sequence[tuple[float, float]], b: Sequence[tuple[float,
          for (ya, na), (yb, nb) in zip(a, b, strict=True)]
     mean_z = sum(z) / users
     var = sum((v - mean_z) ** 2 for v in z) / (users - 1)
-    half = t_quantile(level, users - 1) * math.sqrt(var / users)
-    low, high = diff - half, diff + half
     counts = _discordant(a, b)
+    df = users - 1
+    if counts is None:
+        # Not counts (durations): the variance rests on the users in whom the designs differ
+        # at all; with few of them it has about that many degrees of freedom (Satterthwaite),
+        # and with fewer than two it cannot be estimated - no interval rather than a false
+        # [d, d] (the same users, the same draws: most users' values are identical)
+        differing = sum(1 for pa, pb in zip(a, b, strict=True) if pa != pb)
+        if differing < 2:
+            return RatioEstimate(diff, None, None, users)
+        if differing < RARE_DISCORDANT:
+            df = min(df, differing - 1)
+    half = t_quantile(level, df) * math.sqrt(var / users)
+    low, high = diff - half, diff + half
     if counts is not None and counts[0] + counts[1] < RARE_DISCORDANT:
         up, down, total = counts
         _, up_lo, up_hi = poisson_interval(up, total, level)

@@ -481,7 +481,7 @@ def comparison_figure(rows: Sequence[tuple[str, float, float, float]], path: Pat
     """
     title = "Design B minus design A, with 95 % confidence intervals"
     clean = [(_text(m), float(d), float(lo), float(hi)) for m, d, lo, hi in rows
-             if all(math.isfinite(float(v)) for v in (d, lo, hi))]
+             if all(v is not None and math.isfinite(float(v)) for v in (d, lo, hi))]
     dropped = len(rows) - len(clean)
     if not clean:
         return _empty(path, title)

@@ -76,3 +76,26 @@ def test_rare_paired_counts_cover_the_truth_at_least_nominally() -> None:
         covered_t += (z.mean() - half <= truth <= z.mean() + half)
     assert covered / reps >= 0.95
     assert covered_t / reps < 0.93
+
+
+def test_durations_differing_in_few_users_get_few_degrees_of_freedom_or_none() -> None:
+    """On common random numbers most users' latencies are identical in both designs; the
+    variance of the difference rests on the users where they differ."""
+    same = [(600.0, 5.0)] * 8
+    one = paired_difference([*same, (700.0, 5.0), (650.0, 5.0)],
+                            [*same, (700.0, 5.0), (1750.0, 6.0)])
+    assert one.value is not None and one.value > 0
+    assert one.low is None and one.high is None           # 1 user differs: cannot tell
+    a = [*same, (700.0, 5.0), (650.0, 5.0)]
+    b = [*same, (1720.0, 6.0), (1750.0, 6.0)]
+    two = paired_difference(a, b)
+    from scipy import stats
+
+    wide = two.high - two.low
+    # 2 users differ: t on 1 degree of freedom (12.71), not 9 (2.262)
+    narrow = wide * stats.t.ppf(0.975, 9) / stats.t.ppf(0.975, 1)
+    est_a, est_b = ratio_estimate(a), ratio_estimate(b)
+    z = [(yb - est_b.value * nb) / (sum(n for _, n in b) / 10)
+         - (ya - est_a.value * na) / (sum(n for _, n in a) / 10)
+         for (ya, na), (yb, nb) in zip(a, b, strict=True)]
+    assert narrow == pytest.approx(2 * stats.t.ppf(0.975, 9) * np.std(z, ddof=1) / np.sqrt(10))
