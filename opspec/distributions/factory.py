@@ -1,5 +1,5 @@
 """Building a distribution from its TOML table (user models) or from a spec's declaration
-(``opspec.model.Distribution``, BPSim names such as ``LogNormalDistribution``)."""
+(``opspec.model.DeclaredDistribution``, BPSim names such as ``LogNormalDistribution``)."""
 
 from __future__ import annotations
 
@@ -24,7 +24,7 @@ __all__ = ["KINDS", "Declared", "from_model", "make_distribution"]
 
 
 class Declared(Protocol):
-    """A distribution as a spec declares it: ``opspec.model.Distribution`` (a kind and its
+    """A distribution as a spec declares it: ``opspec.model.DeclaredDistribution`` (a kind and its
     named parameters), without this package depending on the model."""
 
     @property
@@ -194,7 +194,7 @@ _BPSIM_NAMES = {"standardDeviation": "sd", "min": "low", "max": "high"}
 
 
 def from_model(dist: Declared) -> Distribution:
-    """Adapter for the spec model's BPSim-style ``opspec.model.Distribution(kind,
+    """Adapter for the spec model's BPSim-style ``opspec.model.DeclaredDistribution(kind,
     parameters)``: ``ConstantParameter(value)``, ``NormalDistribution(mean,
     standardDeviation)`` (truncated at 0: a duration), ``LogNormalDistribution(mean,
     standardDeviation)`` (moments of the variable itself, as BPSim defines it; ``median``/``mu``

@@ -2,7 +2,7 @@
 whitelisted functions and data-field lookup.
 
 :mod:`opspec.engine.conditions` documents these rules and uses them from both the tree walker
-and the compiled closures, so the two cannot drift apart. Problems raise :class:`Problem`, which
+and the compiled closures, so the two cannot drift apart. Problems raise :class:`ConditionProblem`, which
 the evaluator turns into an :class:`~opspec.errors.ExecutionError` quoting the condition.
 """
 
@@ -23,7 +23,7 @@ __all__ = [
     "FAST_ORDERING",
     "IMPLEMENTATIONS",
     "TIME_HELPERS",
-    "Problem",
+    "ConditionProblem",
     "as_number",
     "equal",
     "lookup",
@@ -38,7 +38,7 @@ _FALSE_TEXTS = frozenset({"", "false", "0"})
 _NUMERIC_TEXT = re.compile(r"[+-]?(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?")
 
 
-class Problem(Exception):
+class ConditionProblem(Exception):
     """Raised deep inside evaluation; turned into an ExecutionError quoting the condition."""
 
 
@@ -102,7 +102,7 @@ def as_number(value: Any, what: str) -> int | float:
         number = numeric_text(value)
         if number is not None:
             return number
-    raise Problem(f"{what} needs a number, got {_show(value)}")
+    raise ConditionProblem(f"{what} needs a number, got {_show(value)}")
 
 
 def _text(value: Any) -> str:
@@ -164,7 +164,7 @@ def ordered(a: Any, b: Any, op: str) -> bool:
     x, y = _ordered_number(a), _ordered_number(b)
     if x is None or y is None:
         culprit = a if x is None else b
-        raise Problem(
+        raise ConditionProblem(
             f"cannot compare {_show(a)} {op} {_show(b)}: {_text(culprit)} is not a number"
         )
     return test(x, y)
@@ -207,10 +207,10 @@ def _elementwise(a: Any, b: Any, op: str, fn: Callable[[Any, Any], Any], *,
     what = f"'{op}'"
     if isinstance(a, _VECTORS) and isinstance(b, _VECTORS):
         if len(a) != len(b):
-            raise Problem(f"cannot {what} vectors of lengths {len(a)} and {len(b)}")
+            raise ConditionProblem(f"cannot {what} vectors of lengths {len(a)} and {len(b)}")
         return tuple(fn(as_number(x, what), as_number(y, what)) for x, y in zip(a, b))
     if not scalar:
-        raise Problem(f"{what} needs two numbers or two vectors, got {_show(a)} and {_show(b)}")
+        raise ConditionProblem(f"{what} needs two numbers or two vectors, got {_show(a)} and {_show(b)}")
     if isinstance(a, _VECTORS):
         k = as_number(b, what)
         return tuple(fn(as_number(x, what), k) for x in a)
@@ -221,18 +221,18 @@ def _elementwise(a: Any, b: Any, op: str, fn: Callable[[Any, Any], Any], *,
 def _divide(a: Any, b: Any) -> Any:
     if isinstance(a, _VECTORS) and not isinstance(b, _VECTORS):
         if as_number(b, "'/'") == 0:
-            raise Problem(f"division by zero ({_text(a)} / {_text(b)})")
+            raise ConditionProblem(f"division by zero ({_text(a)} / {_text(b)})")
         return _elementwise(a, b, "/", operator.truediv, scalar=True)
     x, y = as_number(a, "'/'"), as_number(b, "'/'")
     if y == 0:
-        raise Problem(f"division by zero ({_text(a)} / {_text(b)})")
+        raise ConditionProblem(f"division by zero ({_text(a)} / {_text(b)})")
     return x / y
 
 
 def _remainder(a: Any, b: Any) -> int | float:
     x, y = as_number(a, "'%'"), as_number(b, "'%'")
     if y == 0:
-        raise Problem(f"remainder of a division by zero ({_text(a)} % {_text(b)})")
+        raise ConditionProblem(f"remainder of a division by zero ({_text(a)} % {_text(b)})")
     if isinstance(x, int) and isinstance(y, int):
         r = abs(x) % abs(y)
         return r if x >= 0 else -r
@@ -250,7 +250,7 @@ ARITHMETIC: dict[str, Callable[[Any, Any], Any]] = {
 def _integral(value: Any, what: str) -> float:
     number = float(as_number(value, what))
     if not math.isfinite(number):
-        raise Problem(f"{what} needs a finite number, got {_text(value)}")
+        raise ConditionProblem(f"{what} needs a finite number, got {_text(value)}")
     return number
 
 
@@ -258,7 +258,7 @@ def _round(value: Any, digits: Any = 0) -> int | float:
     number = _integral(value, "round()")
     places = as_number(digits, "round()'s second argument")
     if not isinstance(places, int) or isinstance(places, bool) or abs(places) > 30:
-        raise Problem(f"round() needs a whole number of digits, got {_text(digits)}")
+        raise ConditionProblem(f"round() needs a whole number of digits, got {_text(digits)}")
     rounded = Decimal(repr(number)).quantize(Decimal(1).scaleb(-places), ROUND_HALF_UP)
     return int(rounded) if places <= 0 else float(rounded)
 
@@ -272,7 +272,7 @@ def _to_int(value: Any) -> int:
 def _length(value: Any) -> int:
     if isinstance(value, (str, list, tuple, Mapping)):
         return len(value)
-    raise Problem(f"len() needs a text, list or record, got {_show(value)}")
+    raise ConditionProblem(f"len() needs a text, list or record, got {_show(value)}")
 
 
 def _contains(container: Any, item: Any) -> bool:
@@ -282,7 +282,7 @@ def _contains(container: Any, item: Any) -> bool:
         return any(equal(element, item) for element in container)
     if isinstance(container, Mapping):
         return item in container
-    raise Problem(f"contains() needs a text, list or record, got {_show(container)}")
+    raise ConditionProblem(f"contains() needs a text, list or record, got {_show(container)}")
 
 
 def _extreme(pick_less: bool) -> Callable[..., Any]:
@@ -290,7 +290,7 @@ def _extreme(pick_less: bool) -> Callable[..., Any]:
         if len(values) == 1 and isinstance(values[0], (list, tuple)):
             values = tuple(values[0])
         if not values:
-            raise Problem("min()/max() of an empty list")
+            raise ConditionProblem("min()/max() of an empty list")
         best = values[0]
         for value in values[1:]:
             if _less(value, best) if pick_less else _less(best, value):
@@ -340,7 +340,7 @@ assert set(IMPLEMENTATIONS) | set(TIME_HELPERS) == set(FUNCTIONS), "whitelist an
 def missing_field(data: Mapping[str, Any], name: str) -> NoReturn:
     fields = sorted(str(key) for key in data)
     shown = ", ".join(fields[:30]) + (", ..." if len(fields) > 30 else "")
-    raise Problem(
+    raise ConditionProblem(
         f"data field {name!r} does not exist (fields: {shown or 'none'})"
     )
 
@@ -352,14 +352,14 @@ def _member(value: Any, path: tuple[str, ...], index: int) -> Any:
         if isinstance(value, Mapping):
             if key not in value:
                 keys = ", ".join(sorted(str(k) for k in value)) or "none"
-                raise Problem(
+                raise ConditionProblem(
                     f"record {'.'.join(path[:i])!r} has no member {key!r} (members: {keys})"
                 )
             value = value[key]
         elif key == "length" and isinstance(value, (str, list, tuple)):
             value = len(value)
         else:
-            raise Problem(
+            raise ConditionProblem(
                 f"{'.'.join(path[:i])!r} is {_kind(value)}, so it has no member {key!r}"
             )
     return value

@@ -47,7 +47,7 @@ from opspec.engine.condition_values import (
     FAST_ORDERING,
     IMPLEMENTATIONS,
     TIME_HELPERS,
-    Problem,
+    ConditionProblem,
     as_number,
     equal,
     lookup,
@@ -117,7 +117,7 @@ def evaluate(
     """
     try:
         return _walk(expr, data, clock)
-    except (Problem, *_PYTHON_ERRORS) as problem:
+    except (ConditionProblem, *_PYTHON_ERRORS) as problem:
         now = clock() if clock is not None else None
         raise _fail(expr, problem, location, now) from None
 
@@ -154,24 +154,24 @@ def _walk(expr: Expression, data: Mapping[str, Any], clock: Callable[[], float] 
             return ordered(left, right, op)
         if op in ARITHMETIC:
             return ARITHMETIC[op](left, right)
-        raise Problem(f"unknown operator {op!r}")
+        raise ConditionProblem(f"unknown operator {op!r}")
     if isinstance(expr, Unary):
         value = _walk(expr.operand, data, clock)
         if expr.op == "not":
             return not truthy(value)
         if expr.op == "neg":
             return -as_number(value, "'-'")
-        raise Problem(f"unknown operator {expr.op!r}")
+        raise ConditionProblem(f"unknown operator {expr.op!r}")
     if isinstance(expr, Call):
         if expr.function in TIME_HELPERS:
             if clock is None:
-                raise Problem(f"{expr.function}() needs the simulation clock, none was given")
+                raise ConditionProblem(f"{expr.function}() needs the simulation clock, none was given")
             return TIME_HELPERS[expr.function](clock())
         function = IMPLEMENTATIONS.get(expr.function)
         if function is None:
-            raise Problem(f"unknown function {expr.function!r}")
+            raise ConditionProblem(f"unknown function {expr.function!r}")
         return function(*[_walk(arg, data, clock) for arg in expr.args])
-    raise Problem(f"not an expression node: {expr!r}")
+    raise ConditionProblem(f"not an expression node: {expr!r}")
 
 
 # --------------------------------------------------------------------------- compiler
@@ -189,13 +189,13 @@ def compile_expression(
     """
     try:
         inner = _compile(expr)
-    except Problem as problem:
+    except ConditionProblem as problem:
         raise _fail(expr, problem, location, None) from None
 
     def run(data: Mapping[str, Any], now: float) -> Any:
         try:
             return inner(data, now)
-        except (Problem, *_PYTHON_ERRORS) as problem:
+        except (ConditionProblem, *_PYTHON_ERRORS) as problem:
             raise _fail(expr, problem, location, now) from None
 
     return run
@@ -227,12 +227,12 @@ def _compile(expr: Expression) -> _Fn:
             return lambda data, now: not truthy(operand(data, now))
         if expr.op == "neg":
             return lambda data, now: -as_number(operand(data, now), "'-'")
-        raise Problem(f"unknown operator {expr.op!r}")
+        raise ConditionProblem(f"unknown operator {expr.op!r}")
     if isinstance(expr, Binary):
         return _compile_binary(expr)
     if isinstance(expr, Call):
         return _compile_call(expr)
-    raise Problem(f"not an expression node: {expr!r}")
+    raise ConditionProblem(f"not an expression node: {expr!r}")
 
 
 def _compile_name(path: tuple[str, ...]) -> _Fn:
@@ -279,7 +279,7 @@ def _compile_binary(expr: Binary) -> _Fn:
     if op in ARITHMETIC:
         arithmetic = ARITHMETIC[op]
         return lambda data, now: arithmetic(left(data, now), right(data, now))
-    raise Problem(f"unknown operator {op!r}")
+    raise ConditionProblem(f"unknown operator {op!r}")
 
 
 def _compile_equality(expr: Binary, left: _Fn, right: _Fn, *, negate: bool) -> _Fn:
@@ -377,7 +377,7 @@ def _compile_call(expr: Call) -> _Fn:
         return lambda data, now: helper(now)
     function = IMPLEMENTATIONS.get(expr.function)
     if function is None:
-        raise Problem(f"unknown function {expr.function!r}")
+        raise ConditionProblem(f"unknown function {expr.function!r}")
     args = tuple(_compile(arg) for arg in expr.args)
     if len(args) == 1:
         (only,) = args

@@ -1,6 +1,6 @@
 """Samplers for an activity's declared distributions (duration, CPU demand).
 
-A spec declares them in BPSim style (:class:`~opspec.model.Distribution`: ``LogNormalDistribution
+A spec declares them in BPSim style (:class:`~opspec.model.DeclaredDistribution`: ``LogNormalDistribution
 (mean=2, standardDeviation=0.5)``, ``ConstantParameter(3)``…, or opspec's short names such as
 ``lognormal``); :func:`make_sampler` builds the distribution of :mod:`opspec.distributions` —
 the family user models draw from too, so one kind and its parameters mean one distribution
@@ -15,14 +15,14 @@ from collections.abc import Callable
 
 import numpy as np
 
-from opspec.model import Distribution
+from opspec.model import DeclaredDistribution
 
 __all__ = ["Sampler", "make_sampler"]
 
 Sampler = Callable[[np.random.Generator], float]
 
 
-def make_sampler(dist: Distribution) -> Sampler:
+def make_sampler(dist: DeclaredDistribution) -> Sampler:
     """A sampler for ``dist``; :class:`ValueError` naming the problem if it cannot be built."""
     # imported here: the family needs scipy, which a spec without distributions never loads
     from opspec.distributions import (

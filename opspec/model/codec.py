@@ -87,12 +87,12 @@ TAGS: Mapping[str, type] = {
     "ActualParameter": data.ActualParameter,
     "Assignment": data.Assignment,
     # SISARL
-    "Distribution": sisarl.Distribution,
+    "Distribution": sisarl.DeclaredDistribution,
     "TriggerRef": sisarl.TriggerRef,
     "ProcessDirectives": sisarl.ProcessDirectives,
     "ActivityDirectives": sisarl.ActivityDirectives,
     "CoordinationBuiltIn": sisarl.CoordinationBuiltIn,
-    "WorkflowMode": sisarl.Mode,
+    "WorkflowMode": sisarl.WorkflowMode,
     "EventSelector": sisarl.EventSelector,
     "MetricDefinition": sisarl.MetricDefinition,
     # activities

@@ -9,7 +9,7 @@ from opspec.model.common import Element
 from opspec.model.data import DataField, TypeDeclaration
 from opspec.model.process import WorkflowProcess
 from opspec.model.resources import Application, Participant, Pool
-from opspec.model.sisarl import MetricDefinition, Mode
+from opspec.model.sisarl import MetricDefinition, WorkflowMode
 
 __all__ = ["ExternalPackage", "Package", "PackageHeader", "XpdlVersion"]
 
@@ -62,7 +62,7 @@ class Package(Element):
     processes: tuple[WorkflowProcess, ...] = ()
     external_packages: tuple[ExternalPackage, ...] = ()
     metrics: tuple[MetricDefinition, ...] = ()
-    modes: tuple[Mode, ...] = ()
+    modes: tuple[WorkflowMode, ...] = ()
     run_length: float | None = None            # opspec:RunLength: one run's natural length, s
 
     def process(self, process_id: str) -> WorkflowProcess | None:

@@ -25,11 +25,11 @@ from fractions import Fraction
 from opspec.model.package import Package
 from opspec.model.sisarl import ActivityDirectives
 
-__all__ = ["Task", "analyse", "demand_bound", "hyperperiod", "tasks_of"]
+__all__ = ["PeriodicTask", "analyse", "demand_bound", "hyperperiod", "tasks_of"]
 
 
 @dataclass(frozen=True, slots=True)
-class Task:
+class PeriodicTask:
     """One periodic workflow as the analysis sees it; ``response`` is ``None`` when it
     exceeds the deadline (unschedulable)."""
 
@@ -46,7 +46,7 @@ class Task:
         return self.response is not None
 
 
-def tasks_of(package: Package) -> list[Task]:
+def tasks_of(package: Package) -> list[PeriodicTask]:
     """The periodic workflows with a processor demand, highest priority first."""
     tasks = []
     for process in package.processes:
@@ -61,7 +61,7 @@ def tasks_of(package: Package) -> list[Task]:
             continue
         priority = directives.priority if directives.priority is not None else (
             process.priority or 0)
-        tasks.append(Task(process.id, float(period), float(demand), int(priority),
+        tasks.append(PeriodicTask(process.id, float(period), float(demand), int(priority),
                           float(directives.deadline or period), unbounded=unbounded))
     return sorted(tasks, key=lambda t: (-t.priority, t.workflow))
 
@@ -81,7 +81,7 @@ def demand_bound(directives: ActivityDirectives) -> float | None:
     return None
 
 
-def analyse(tasks: list[Task]) -> list[Task]:
+def analyse(tasks: list[PeriodicTask]) -> list[PeriodicTask]:
     """Each task with its worst-case response time (``None`` past its deadline, or when it
     or a task of higher or equal priority has no bounded demand)."""
     out = []
@@ -100,12 +100,12 @@ def analyse(tasks: list[Task]) -> list[Task]:
                 break
             else:
                 response = nxt
-        out.append(Task(task.workflow, task.period, task.demand, task.priority,
+        out.append(PeriodicTask(task.workflow, task.period, task.demand, task.priority,
                         task.deadline, response, task.unbounded))
     return out
 
 
-def hyperperiod(tasks: list[Task], cap: float = 86_400.0) -> float:
+def hyperperiod(tasks: list[PeriodicTask], cap: float = 86_400.0) -> float:
     """The least common multiple of the periods (as exact fractions of a second), at most
     ``cap`` seconds."""
     if not tasks:

@@ -17,18 +17,18 @@ __all__ = [
     "ActivityDirectives",
     "CoordinationBuiltIn",
     "CoordinationKind",
-    "Distribution",
+    "DeclaredDistribution",
     "EventSelector",
     "MetricDefinition",
     "MetricKind",
-    "Mode",
     "ProcessDirectives",
     "TriggerRef",
+    "WorkflowMode",
 ]
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
-class Distribution:
+class DeclaredDistribution:
     """A stochastic parameter in BPSim style: ``kind`` is a BPSim distribution name
     (``LogNormalDistribution``, ``ConstantParameter``, ``UniformDistribution``…) or an opspec
     name, and ``parameters`` are its named values in declaration order."""
@@ -85,8 +85,8 @@ class ActivityDirectives:
     end_trigger: TriggerRef | None = None
     cpu_demand: float | None = None       # seconds of processor time (software activities)
     # processor time drawn per execution, when CpuDemand is a distribution (cpu_demand None)
-    cpu_distribution: Distribution | None = None
-    duration: Distribution | None = None  # simulated duration (BPSim ProcessingTime)
+    cpu_distribution: DeclaredDistribution | None = None
+    duration: DeclaredDistribution | None = None  # simulated duration (BPSim ProcessingTime)
     raises: TriggerRef | None = None      # trigger raised when the activity completes
 
 
@@ -123,7 +123,7 @@ class CoordinationBuiltIn:
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
-class Mode:
+class WorkflowMode:
     """A named set of workflows active together; a mode change switches between them."""
 
     id: str

@@ -20,9 +20,9 @@ from opspec.errors import Diagnostic, Severity, SourceLocation
 from opspec.model.sisarl import (
     ActivityDirectives,
     CoordinationBuiltIn,
-    Distribution,
-    Mode,
+    DeclaredDistribution,
     ProcessDirectives,
+    WorkflowMode,
 )
 from opspec.xpdl.handlers.common import BuildContext, grandchildren
 from opspec.xpdl.namespaces import OPSPEC, OPSPEC_PREFIX
@@ -248,7 +248,7 @@ def activity_directives(
     if not found:
         return _NO_ACTIVITY_DIRECTIVES, None
     values = _apply(found, ctx, _ACTIVITY_PARSERS)
-    if isinstance(values.get("cpu_demand"), Distribution):
+    if isinstance(values.get("cpu_demand"), DeclaredDistribution):
         values["cpu_distribution"] = values.pop("cpu_demand")
     builtin = None
     if "BuiltIn" in found:
@@ -258,7 +258,7 @@ def activity_directives(
     return ActivityDirectives(**values), builtin
 
 
-def _cpu_demand(directive: Directive) -> float | Distribution:
+def _cpu_demand(directive: Directive) -> float | DeclaredDistribution:
     """Processor time: a duration, or a distribution drawn at every execution."""
     dist = parse_distribution(directive.value, directive.location)
     if dist.kind == "ConstantParameter" and len(dist.parameters) == 1:
@@ -302,6 +302,6 @@ def package_extensions(element: etree._Element, ctx: BuildContext,
     if "Metrics" in found:
         out["metrics"] = build_metrics(found["Metrics"], ctx)
     if "Modes" in found:
-        modes: tuple[Mode, ...] = build_modes(found["Modes"], ctx)
+        modes: tuple[WorkflowMode, ...] = build_modes(found["Modes"], ctx)
         out["modes"] = modes
     return out

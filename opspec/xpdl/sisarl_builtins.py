@@ -15,7 +15,7 @@ from opspec.model.sisarl import (
     EventSelector,
     MetricDefinition,
     MetricKind,
-    Mode,
+    WorkflowMode,
 )
 from opspec.xpdl.handlers.common import BuildContext
 from opspec.xpdl.namespaces import OPSPEC
@@ -179,11 +179,11 @@ def build_metrics(directive: Directive, ctx: BuildContext) -> tuple[MetricDefini
     return tuple(metrics)
 
 
-def build_modes(directive: Directive, ctx: BuildContext) -> tuple[Mode, ...]:
+def build_modes(directive: Directive, ctx: BuildContext) -> tuple[WorkflowMode, ...]:
     container = _container(directive, ctx)
     if container is None:
         return ()
-    modes: list[Mode] = []
+    modes: list[WorkflowMode] = []
     for element in _ours(container):
         try:
             if _local(element) != "Mode":
@@ -193,7 +193,7 @@ def build_modes(directive: Directive, ctx: BuildContext) -> tuple[Mode, ...]:
             if initial not in ("true", "false"):
                 raise _Bad(element, f"Initial must be true or false, not {initial!r}",
                            "write Initial=\"true\"")
-            mode = Mode(id=_need(element, "Id"), workflows=tuple((element.get("Workflows") or "").split()),
+            mode = WorkflowMode(id=_need(element, "Id"), workflows=tuple((element.get("Workflows") or "").split()),
                         initial=initial == "true", source=element.get("Source"),
                         location=ctx.loc(element))
         except _Bad as error:

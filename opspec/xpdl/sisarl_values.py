@@ -13,7 +13,7 @@ from typing import Final
 
 from opspec.clock import parse_duration, parse_rate, parse_time_of_day
 from opspec.errors import SourceLocation, SpecError
-from opspec.model.sisarl import Distribution, TriggerRef
+from opspec.model.sisarl import DeclaredDistribution, TriggerRef
 
 __all__ = [
     "DISTRIBUTIONS",
@@ -38,7 +38,7 @@ _TRIGGER_SYNTAX: Final = (
     "timer:after DURATION | period:DURATION [offset DURATION] | rule:CONDITION"
 )
 
-# Distribution kind -> (positional parameter names, required parameters as alternatives).
+# DeclaredDistribution kind -> (positional parameter names, required parameters as alternatives).
 DISTRIBUTIONS: Final[dict[str, tuple[tuple[str, ...], tuple[tuple[str, ...], ...]]]] = {
     "ConstantParameter": (("value",), (("value",),)),
     "NormalDistribution": (("mean", "standardDeviation"), (("mean",), ("standardDeviation",))),
@@ -197,7 +197,7 @@ def _number(key: str, text: str, kind: str, location: SourceLocation | None) -> 
     return value
 
 
-def parse_distribution(text: str, location: SourceLocation | None = None) -> Distribution:
+def parse_distribution(text: str, location: SourceLocation | None = None) -> DeclaredDistribution:
     """``Name(key=value, …)`` or ``Name(value, …)``; a bare number or duration is a constant."""
     match = _CALL.match(text)
     known = ", ".join(DISTRIBUTIONS)
@@ -207,7 +207,7 @@ def parse_distribution(text: str, location: SourceLocation | None = None) -> Dis
         except SisarlValueError:
             raise _fail(f"{text.strip()!r} is not a distribution", location,
                         f"write Name(key=value, ...) with Name one of {known}") from None
-        return Distribution(kind="ConstantParameter", parameters=(("value", value),))
+        return DeclaredDistribution(kind="ConstantParameter", parameters=(("value", value),))
     kind, body = match.group(1), match.group(2)
     spec = DISTRIBUTIONS.get(kind)
     if spec is None:
@@ -235,4 +235,4 @@ def parse_distribution(text: str, location: SourceLocation | None = None) -> Dis
         if not given & set(group):
             raise _fail(f"{kind} needs parameter {' or '.join(group)}", location,
                         f"write {kind}({', '.join(f'{p}=…' for p in positional)})")
-    return Distribution(kind=kind, parameters=tuple(parameters))
+    return DeclaredDistribution(kind=kind, parameters=tuple(parameters))

@@ -16,7 +16,7 @@ from opspec.model import (
     ActivityDirectives,
     CoordinationBuiltIn,
     CoordinationKind,
-    Distribution,
+    DeclaredDistribution,
     EventSelector,
     Expression,
     ExtendedAttribute,
@@ -103,7 +103,7 @@ def trigger_text(trigger: TriggerRef) -> str:
     return f"{kind}:{trigger.name or ''}"
 
 
-def distribution_text(distribution: Distribution) -> str:
+def distribution_text(distribution: DeclaredDistribution) -> str:
     """``Name(key=value, …)`` (BPSim names where BPSim has them)."""
     parameters = ", ".join(f"{k}={number_text(v)}" for k, v in distribution.parameters)
     return f"{distribution.kind}({parameters})"

@@ -12,7 +12,7 @@ from lxml import etree
 
 from opspec.cli import main
 from opspec.model.package import ExternalPackage, Package
-from opspec.model.sisarl import Mode
+from opspec.model.sisarl import WorkflowMode
 from opspec.xpdl.relocate import relocate
 from opspec.xpdl.schema import schema_for
 
@@ -85,7 +85,7 @@ def test_an_existing_different_user_model_beside_the_output_is_kept(
 
 def test_relocate_rewrites_mode_sources_and_external_hrefs(tmp_path: Path) -> None:
     source = tmp_path / "specs" / "robot.xpdl"
-    package = Package(id="p", modes=(Mode(id="dock", source="modes/dock.xpdl"),),
+    package = Package(id="p", modes=(WorkflowMode(id="dock", source="modes/dock.xpdl"),),
                       external_packages=(ExternalPackage(id="lib", href="lib.xpdl"),))
     above, warnings = relocate(package, source, tmp_path / "robot.xpdl")
     assert above.modes[0].source == "specs/modes/dock.xpdl"
@@ -162,7 +162,7 @@ def test_relocate_copies_or_warns_for_companions_leading_outside(tmp_path: Path)
 
     world = ExtendedAttribute(name="opspec:WorldFile", value="worlds/room.toml")
     package = Package(id="p", extended_attributes=(world,),
-                      modes=(Mode(id="dock", source="dock.xpdl"),))
+                      modes=(WorkflowMode(id="dock", source="dock.xpdl"),))
     source, output = tmp_path / "specs" / "r.xpdl", tmp_path / "out" / "r.xpdl"
     copies: list[tuple[Path, Path]] = []
     moved, warnings = relocate(package, source, output, copies=copies)
@@ -184,7 +184,7 @@ def test_mode_sources_written_verbatim_are_rewritten_too(tmp_path: Path) -> None
                               raw_xml='<opspec:Mode xmlns:opspec="urn:opspec:sisarl:1" '
                                       'Id="dock" Source="dock.xpdl"/>')
     package = Package(id="p", extended_attributes=(modes,),
-                      modes=(Mode(id="dock", source="dock.xpdl"),))
+                      modes=(WorkflowMode(id="dock", source="dock.xpdl"),))
     moved, _ = relocate(package, tmp_path / "specs" / "r.xpdl",
                         tmp_path / "specs" / "sub" / "r.xpdl")
     assert 'Source="../dock.xpdl"' in write_xpdl(moved).decode()

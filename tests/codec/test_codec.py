@@ -34,7 +34,7 @@ from opspec.model import (
     CoordinationKind,
     DataField,
     Deadline,
-    Distribution,
+    DeclaredDistribution,
     Event,
     EventPosition,
     EventSelector,
@@ -179,7 +179,7 @@ def _rich_package() -> Package:
         directives=ActivityDirectives(
             auto_run=False,
             priority_increment=2,
-            duration=Distribution(kind="LogNormalDistribution",
+            duration=DeclaredDistribution(kind="LogNormalDistribution",
                                   parameters=(("mean", 2.0), ("standardDeviation", 0.5))),
             raises=TriggerRef(kind="message", name="trg_1"),
         ),

@@ -8,7 +8,7 @@ from builders import act, pkg, proc
 from conftest import run
 
 from opspec.engine.random import Streams, named_stream, user_stream
-from opspec.model import Distribution
+from opspec.model import DeclaredDistribution as Distribution
 
 LOGNORMAL = Distribution(kind="lognormal", parameters=(("median", 60.0), ("sigma", 0.6)))
 

@@ -15,7 +15,7 @@ import opspec
 from opspec.engine.simulation import Simulation
 from opspec.engine.zero_time import MAX_INSTANT_STEPS, max_instant_steps
 from opspec.errors import ExecutionError, ZeroTimeCycleError
-from opspec.model import Distribution
+from opspec.model import DeclaredDistribution as Distribution
 from opspec.xpdl.loader import load_spec
 
 SPECS = Path(__file__).parent / "hang_specs"

@@ -15,7 +15,7 @@ from scipy import stats
 
 from opspec.distributions import from_model
 from opspec.engine.sampling import make_sampler
-from opspec.model import Distribution
+from opspec.model import DeclaredDistribution as Distribution
 from opspec.usermodels.distributions import TruncatedNormal, make_distribution
 
 DECLARED = [

@@ -15,7 +15,7 @@ from opspec.engine.config import EngineConfig
 from opspec.engine.registry import PerformerRegistry
 from opspec.engine.simulation import Simulation
 from opspec.errors import ConfigurationError
-from opspec.model import Distribution
+from opspec.model import DeclaredDistribution as Distribution
 
 
 def _two_step() -> object:

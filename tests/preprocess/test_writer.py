@@ -11,7 +11,7 @@ from builtin_models import builtin_package, schema_errors, without_locations
 from lxml import etree
 
 from opspec.model import (
-    Distribution,
+    DeclaredDistribution,
     ExtendedAttribute,
     Package,
     ProcessDirectives,
@@ -172,12 +172,12 @@ def test_triggers_are_written_in_the_sisarl_syntax_and_parse_back(trigger: Trigg
 @pytest.mark.parametrize(
     "distribution",
     [
-        Distribution(kind="LogNormalDistribution",
+        DeclaredDistribution(kind="LogNormalDistribution",
                      parameters=(("mean", 2.0), ("standardDeviation", 0.5))),
-        Distribution(kind="ConstantParameter", parameters=(("value", 3.0),)),
-        Distribution(kind="exgauss", parameters=(("mu", 1.0), ("sigma", 0.2), ("tau", 0.7))),
+        DeclaredDistribution(kind="ConstantParameter", parameters=(("value", 3.0),)),
+        DeclaredDistribution(kind="exgauss", parameters=(("mu", 1.0), ("sigma", 0.2), ("tau", 0.7))),
     ],
     ids=lambda d: d.kind,
 )
-def test_distributions_are_written_so_they_parse_back(distribution: Distribution) -> None:
+def test_distributions_are_written_so_they_parse_back(distribution: DeclaredDistribution) -> None:
     assert parse_distribution(distribution_text(distribution)) == distribution

@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from opspec.errors import UserModelError
-from opspec.model import Distribution as ModelDistribution
+from opspec.model import DeclaredDistribution as ModelDistribution
 from opspec.usermodels.distributions import (
     Distribution,
     LogNormal,

@@ -11,7 +11,7 @@ from opspec.errors import Severity
 from opspec.model import (
     Activity,
     CoordinationKind,
-    Distribution,
+    DeclaredDistribution,
     MetricKind,
     WorkflowProcess,
 )
@@ -119,7 +119,7 @@ def test_activity_directives_in_both_forms() -> None:
     assert one.directives.priority_increment == 2
     assert one.directives.cpu_demand == pytest.approx(0.005)
     assert one.directives.raises is not None and one.directives.raises.name == "done"
-    assert one.directives.duration == Distribution(
+    assert one.directives.duration == DeclaredDistribution(
         kind="LogNormalDistribution", parameters=(("mean", 2.0), ("standardDeviation", 0.5)))
     assert _no_locations(one.directives) == _no_locations(two.directives)
 
@@ -157,7 +157,7 @@ def _no_locations(directives: object) -> object:
 )
 def test_distribution_syntax(text: str, expected: tuple[str, tuple[tuple[str, float], ...]]) -> None:
     duration = activity(load_process(activity_eas=ea("Duration", text))).directives.duration
-    assert duration == Distribution(kind=expected[0], parameters=expected[1])
+    assert duration == DeclaredDistribution(kind=expected[0], parameters=expected[1])
 
 
 @pytest.mark.parametrize(
