@@ -86,17 +86,26 @@ def _observations(store: ResultStore, design: str, metric: str) -> tuple[list[fl
     return [float(r[0]) for r in rows], total
 
 
-def _per_day(store: ResultStore, design: str, metric: str, days: int, users: int
-             ) -> list[float]:
-    rows = dict(store.query("SELECT day, SUM(n) FROM outcome WHERE design = ? AND metric = ? "
-                            "GROUP BY day", (design, metric)))
-    return [float(rows.get(d, 0)) / max(users, 1) for d in range(days)]
+def _per_day_all(store: ResultStore, design: str, metrics: list[str], days: int, users: int
+                 ) -> dict[str, list[float]]:
+    """The mean count per user, day by day, of every metric in ``metrics`` (one pass over the
+    outcomes)."""
+    rows: dict[str, dict[int, float]] = {m: {} for m in metrics}
+    for metric, day, n in store.query("SELECT metric, day, SUM(n) FROM outcome WHERE "
+                                      "design = ? GROUP BY metric, day", (design,)):
+        if metric in rows:
+            rows[metric][int(day)] = float(n)
+    return {m: [rows[m].get(d, 0.0) / max(users, 1) for d in range(days)] for m in metrics}
 
 
-def _by_hour(store: ResultStore, design: str, metric: str) -> list[int]:
-    rows = dict(store.query("SELECT hour, SUM(n) FROM outcome WHERE design = ? AND "
-                            "metric = ? GROUP BY hour", (design, metric)))
-    return [int(rows.get(h, 0)) for h in range(24)]
+def _by_hour_all(store: ResultStore, design: str, metrics: list[str]) -> dict[str, list[int]]:
+    """The total count by hour of the day of every metric in ``metrics`` (one pass)."""
+    rows: dict[str, dict[int, int]] = {m: {} for m in metrics}
+    for metric, hour, n in store.query("SELECT metric, hour, SUM(n) FROM outcome WHERE "
+                                       "design = ? GROUP BY metric, hour", (design,)):
+        if metric in rows:
+            rows[metric][int(hour)] = int(n)
+    return {m: [rows[m].get(h, 0) for h in range(24)] for m in metrics}
 
 
 def _activity_rates(store: ResultStore, design: str
@@ -468,8 +477,9 @@ def _design_sections(store: ResultStore, figures: Path, design: str, name: str, 
     # counts over time
     counts = [d["name"] for d in definitions if d["kind"] == "count"]
     if counts:
-        per_day = {c: _per_day(store, design, c, max(1, round(days)), users) for c in counts}
-        hours = {c: _by_hour(store, design, c) for c in counts}
+        # one pass over the outcome table for all metrics, not two per metric (issue 20)
+        per_day = _per_day_all(store, design, counts, max(1, round(days)), users)
+        hours = _by_hour_all(store, design, counts)
         sections.append(Section(f"{prefix}Counts over time", images=(
             plots.over_days_figure(per_day, figures / f"{design}-days.png"),
             plots.time_of_day_figure(hours, figures / f"{design}-hours.png")), captions=(
