@@ -10,13 +10,22 @@
 
 A predicate is judged on each trace of what it is given - a
 :class:`~opspec.testing.simulation.SimulationResult` (every replication), an engine
-:class:`~opspec.engine.simulation.RunResult`, or a plain sequence of
-:class:`~opspec.engine.trace.TraceEvent` - and holds when it holds on every one.
+:class:`~opspec.engine.simulation.RunResult`, a plain sequence of
+:class:`~opspec.engine.trace.TraceEvent`, or the path of a JSON Lines trace written by
+``opspec run --trace`` - and holds when it holds on every one.
 
-Events are named like monitors (:mod:`opspec.engine.monitors`): a bare name is an activity's
-completion, a trigger's raise or a process's start (``activity:``, ``trigger:``, ``process:``
-make it explicit; ``a|b`` is either); :func:`activity_completed`, :func:`event` and any
-``Callable[[TraceEvent], bool]`` select events too. Names are checked against the spec (of a
+The temporal predicates are the properties of :mod:`opspec.engine.properties`, the language
+of monitors: ``within(a, b, 60)`` is ``bounded_response a b 60s``, ``happens_before(a, b)`` is
+``a before b``, ``never(x)`` is ``never x``, ``count(x) <= 4`` is ``count x <= 4``. Each is
+judged by feeding the trace to the evaluator a monitor runs online, so both give the same
+verdict and the same witness on the same run. The text form and monitor objects are
+predicates too: ``holds(result, "min_gap dispense 4h")``, ``check(result,
+min_gap("dispense", hours=4))``.
+
+Events are named like monitors: a bare name is an activity's completion, a trigger's raise or
+a process's start (``activity:``, ``trigger:``, ``process:`` make it explicit; ``a|b`` is
+either); :func:`activity_completed`, :func:`event` and any ``Callable[[TraceEvent], bool]``
+select events too. Names are checked against the spec (of a
 ``SimulationResult``, or ``spec=``): one the spec lacks raises
 :class:`~opspec.errors.ConfigurationError` listing the names it has.
 
@@ -26,13 +35,25 @@ around the violation (marked ``>``), not the whole trace.
 
 from __future__ import annotations
 
-import math
-import operator
+import os
 from collections.abc import Callable, Iterable, Sequence
 from dataclasses import dataclass
 from typing import Any
 
-from opspec.engine.monitors import Subject, clock, parse_subject
+from opspec.engine.properties import (
+    BoundedResponse,
+    CountBound,
+    Eventually,
+    MonitorRun,
+    Never,
+    Precedence,
+    Property,
+    Subject,
+    clock,
+    parse_property,
+    parse_subject,
+    trace_end,
+)
 from opspec.engine.trace import EventKind, TraceEvent
 from opspec.errors import ConfigurationError
 
@@ -130,6 +151,10 @@ class Match(Predicate):
     def __call__(self, event: TraceEvent) -> bool:
         return self._test(event)
 
+    def matches(self, event: TraceEvent) -> bool:
+        """As a property's selector (:class:`~opspec.engine.properties.Selector`)."""
+        return self._test(event)
+
     def describe(self) -> str:
         return self.text
 
@@ -143,10 +168,7 @@ class Match(Predicate):
         return [e for e in events if self._test(e)]
 
     def fail(self, events: Sequence[TraceEvent], end: float) -> Failure | None:
-        if any(self._test(e) for e in events):
-            return None
-        return Failure((f"but {self.text} never happened (the run went to {clock(end)})",),
-                       tuple(events[-BEFORE:]), events)
+        return _Holds(Eventually(self)).fail(events, end)
 
     def witness(self, events: Sequence[TraceEvent]) -> tuple[TraceEvent, ...]:
         return tuple(self.all(events)[:1])
@@ -170,8 +192,14 @@ def _as_match(what: str | Match | Callable[[TraceEvent], bool]) -> Match:
 
 
 def _as_predicate(what: Any) -> Predicate:
+    """A predicate, a property (a monitor), a property's text (it has spaces: ``"never
+    notify_caregiver"``), or an event name (``"dispense"``: it happens)."""
     if isinstance(what, Predicate):
         return what
+    if isinstance(what, Property):
+        return _Holds(what)
+    if isinstance(what, str) and len(what.split()) > 1:
+        return _Holds(parse_property(what))
     return _as_match(what)
 
 
@@ -220,182 +248,106 @@ def event(kind: str, *, activity: str | None = None, process: str | None = None,
     return Match(test, " ".join(parts), subject, process)
 
 
-# ---------------------------------------------------------------- temporal predicates
-class _Eventually(Predicate):
-    def __init__(self, match: Match) -> None:
-        self.match = match
+# ---------------------------------------------------------------- properties as predicates
+class _Holds(Predicate):
+    """A :class:`~opspec.engine.properties.Property` judged on a trace: its events fed to the
+    evaluator a monitor runs online, so the verdict and the witness (the events marked in a
+    failure) are the monitor's. ``label`` is how Python spelt it (``within(a, b, 60 s)``)."""
+
+    def __init__(self, prop: Property, label: str | None = None) -> None:
+        self.property = prop
+        self.label = label
 
     def describe(self) -> str:
-        return f"eventually({self.match.describe()})"
+        return self.label or str(self.property)
 
     def subjects(self) -> tuple[Subject, ...]:
-        return self.match.subjects()
+        out: list[Subject] = []
+        for selector in self.property.subjects():
+            if isinstance(selector, Subject):
+                out.append(selector)
+            elif isinstance(selector, Match):
+                out.extend(selector.subjects())
+        return tuple(out)
 
     def processes(self) -> tuple[str, ...]:
-        return self.match.processes()
+        return tuple(p for s in self.property.subjects() if isinstance(s, Match)
+                     for p in s.processes())
+
+    def judge(self, events: Sequence[TraceEvent], end: float) -> MonitorRun:
+        run = self.property.start()
+        for e in events:
+            run(e)
+        run.finish(end)
+        return run
 
     def fail(self, events: Sequence[TraceEvent], end: float) -> Failure | None:
-        return self.match.fail(events, end)
-
-    def witness(self, events: Sequence[TraceEvent]) -> tuple[TraceEvent, ...]:
-        return self.match.witness(events)
-
-
-class _Never(_Eventually):
-    def describe(self) -> str:
-        return f"never({self.match.describe()})"
-
-    def fail(self, events: Sequence[TraceEvent], end: float) -> Failure | None:
-        hits = self.match.all(events)
-        if not hits:
+        run = self.judge(events, end)
+        if not run.count:
             return None
-        return Failure(((f"but {self.match.describe()} happened {len(hits)} time(s), first at "
-                        f"{clock(hits[0].time)}"),), (hits[0],), events)
+        first = run.violations[0]
+        more = f" (the first of {run.count} violations)" if run.count > 1 else ""
+        return Failure((f"but {first.message}{more}",), first.events, events)
 
     def witness(self, events: Sequence[TraceEvent]) -> tuple[TraceEvent, ...]:
-        return ()
+        return self.judge(events, trace_end(events)).evidence()
 
     def __invert__(self) -> Predicate:
-        return _Eventually(self.match)
+        prop = self.property
+        if isinstance(prop, Never):
+            return _Holds(Eventually(prop.subject), f"eventually({prop.subject})")
+        if isinstance(prop, Eventually):
+            return _Holds(Never(prop.subject), f"never({prop.subject})")
+        return _Not(self)
 
 
 def eventually(what: str | Match | Predicate | Callable[[TraceEvent], bool]) -> Predicate:
     """``what`` happens at least once (a predicate is returned as it is)."""
     if isinstance(what, Predicate) and not isinstance(what, Match):
         return what
-    return _Eventually(_as_match(what))
+    match = _as_match(what)  # type: ignore[arg-type]
+    return _Holds(Eventually(match), f"eventually({match.describe()})")
 
 
 def never(what: str | Match | Predicate | Callable[[TraceEvent], bool]) -> Predicate:
     """``what`` never happens (for a predicate: it does not hold, i.e. ``~what``)."""
     if isinstance(what, Predicate) and not isinstance(what, Match):
         return _Not(what)
-    return _Never(_as_match(what))
-
-
-class _Before(Predicate):
-    def __init__(self, a: Match, b: Match, each: bool) -> None:
-        self.a, self.b, self.each = a, b, each
-
-    def describe(self) -> str:
-        each = ", each=True" if self.each else ""
-        return f"happens_before({self.a.describe()}, {self.b.describe()}{each})"
-
-    def subjects(self) -> tuple[Subject, ...]:
-        return self.a.subjects() + self.b.subjects()
-
-    def processes(self) -> tuple[str, ...]:
-        return self.a.processes() + self.b.processes()
-
-    def fail(self, events: Sequence[TraceEvent], end: float) -> Failure | None:
-        seen_a = seen_b = 0
-        last_a: TraceEvent | None = None
-        for e in events:
-            if self.b(e):
-                if seen_a == 0 or (self.each and seen_a <= seen_b):
-                    if seen_a == 0:
-                        why = f"and no {self.a.describe()} came before it"
-                    else:
-                        why = (f"but only {seen_a} {self.a.describe()} before it (the last at "
-                               f"{clock(last_a.time if last_a else 0.0)}) for {seen_b + 1} "
-                               f"{self.b.describe()}")
-                    focus = (e,) if last_a is None else (last_a, e)
-                    return Failure(((f"but {self.b.describe()} happened at {clock(e.time)} "
-                                    f"{why}"),), focus, events)
-                seen_b += 1
-            if self.a(e):   # an event matching both counts as b first: b needs an earlier a
-                seen_a += 1
-                last_a = e
-        return None
+    match = _as_match(what)  # type: ignore[arg-type]
+    return _Holds(Never(match), f"never({match.describe()})")
 
 
 def happens_before(a: str | Match | Callable[[TraceEvent], bool],
                    b: str | Match | Callable[[TraceEvent], bool], *,
                    each: bool = False) -> Predicate:
-    """No ``b`` before the first ``a`` (``b`` may not happen at all). ``each=True``: every
-    ``b`` has its own earlier ``a`` (the n-th ``b`` comes after the n-th ``a``)."""
-    return _Before(_as_match(a), _as_match(b), each)
-
-
-class _Within(Predicate):
-    def __init__(self, a: Match, b: Match, seconds: float) -> None:
-        self.a, self.b, self.seconds = a, b, seconds
-
-    def describe(self) -> str:
-        return f"within({self.a.describe()}, {self.b.describe()}, {self.seconds:g} s)"
-
-    def subjects(self) -> tuple[Subject, ...]:
-        return self.a.subjects() + self.b.subjects()
-
-    def processes(self) -> tuple[str, ...]:
-        return self.a.processes() + self.b.processes()
-
-    def fail(self, events: Sequence[TraceEvent], end: float) -> Failure | None:
-        responses = [e for e in events if self.b(e)]
-        for cause in (e for e in events if self.a(e)):
-            due = cause.time + self.seconds
-            if due > end:
-                continue          # the run ended before the window closed: not judged
-            after = [e for e in responses if e.seq > cause.seq]
-            if after and after[0].time <= due:
-                continue
-            nxt = (f"; the next came at {clock(after[0].time)}, "
-                   f"{after[0].time - cause.time:g} s after it" if after
-                   else f"; none came before the end ({clock(end)})")
-            return Failure(((f"but {self.a.describe()} at {clock(cause.time)} was not followed "
-                            f"by {self.b.describe()} within {self.seconds:g} s{nxt}"),),
-                           (cause, *after[:1]), events)
-        return None
+    """No ``b`` before the first ``a`` (``b`` may not happen at all; an event that is both
+    precedes itself). ``each=True``: every ``b`` has its own earlier ``a`` (the n-th ``b``
+    comes after the n-th ``a``). The property ``A before B`` (``A before each B``)."""
+    first, then = _as_match(a), _as_match(b)
+    label = (f"happens_before({first.describe()}, {then.describe()}"
+             f"{', each=True' if each else ''})")
+    return _Holds(Precedence(first, then, each), label)
 
 
 def within(a: str | Match | Callable[[TraceEvent], bool],
            b: str | Match | Callable[[TraceEvent], bool], seconds: float) -> Predicate:
-    """Every ``a`` is followed by a ``b`` (later in the trace) at most ``seconds`` later.
-    An ``a`` whose window is cut off by the end of the run is not judged."""
-    if not (seconds >= 0 and math.isfinite(seconds)):
+    """Every ``a`` is followed by a ``b`` at most ``seconds`` later (exactly ``seconds`` is in
+    time; an event that is both answers itself). An ``a`` whose window is cut off by the end
+    of the run is not judged; ``seconds=math.inf``: by the end of the run. The property
+    ``bounded_response A B D`` (``B within D after A``)."""
+    if isinstance(seconds, bool) or not (isinstance(seconds, (int, float)) and seconds >= 0):
         raise ConfigurationError(f"within(): seconds must be >= 0, not {seconds!r}")
-    return _Within(_as_match(a), _as_match(b), float(seconds))
+    cause, response = _as_match(a), _as_match(b)
+    return _Holds(BoundedResponse(cause, response, float(seconds)),
+                  f"within({cause.describe()}, {response.describe()}, {seconds:g} s)")
 
 
 # ---------------------------------------------------------------- counting
-_CMP: dict[str, Callable[[int, float], bool]] = {
-    "==": operator.eq, "!=": operator.ne, "<": operator.lt, "<=": operator.le,
-    ">": operator.gt, ">=": operator.ge}
-
-
-class _Counted(Predicate):
-    def __init__(self, match: Match, op: str, a: float, b: float | None = None) -> None:
-        self.match, self.op, self.a, self.b = match, op, a, b
-
-    def describe(self) -> str:
-        target = (f"between {self.a:g} and {self.b:g}" if self.op == "in"
-                  else f"{self.op} {self.a:g}")
-        return f"count({self.match.describe()}) {target}"
-
-    def subjects(self) -> tuple[Subject, ...]:
-        return self.match.subjects()
-
-    def processes(self) -> tuple[str, ...]:
-        return self.match.processes()
-
-    def _ok(self, n: int) -> bool:
-        if self.op == "in":
-            assert self.b is not None
-            return self.a <= n <= self.b
-        return _CMP[self.op](n, self.a)
-
-    def fail(self, events: Sequence[TraceEvent], end: float) -> Failure | None:
-        hits = self.match.all(events)
-        if self._ok(len(hits)):
-            return None
-        shown = tuple(hits[:3]) + tuple(hits[-2:] if len(hits) > 3 else ())
-        return Failure((f"but it happened {len(hits)} time(s)",), shown, events)
-
-
 class Count:
     """``count(x)``: compare with ``==``, ``!=``, ``<``, ``<=``, ``>``, ``>=``, or use
     :meth:`between`, :meth:`at_least`, :meth:`at_most`; each gives a :class:`Predicate`
-    judged per trace (per replication, or per instance with ``per_instance``)."""
+    judged per trace (per replication, or per instance with ``per_instance``): the property
+    ``count A OP n``."""
 
     __hash__ = None  # type: ignore[assignment]
 
@@ -405,29 +357,35 @@ class Count:
     def __repr__(self) -> str:
         return f"count({self.match.describe()})"
 
+    def _bound(self, op: str, n: object, hi: object = None) -> Predicate:
+        bound = CountBound(self.match, op, _number(n), None if hi is None else _number(hi))
+        target = (f"between {bound.a:g} and {bound.b:g}" if op == "in"
+                  else f"{op} {bound.a:g}")
+        return _Holds(bound, f"count({self.match.describe()}) {target}")
+
     def __eq__(self, n: object) -> Predicate:  # type: ignore[override]
-        return _Counted(self.match, "==", _number(n))
+        return self._bound("==", n)
 
     def __ne__(self, n: object) -> Predicate:  # type: ignore[override]
-        return _Counted(self.match, "!=", _number(n))
+        return self._bound("!=", n)
 
     def __lt__(self, n: float) -> Predicate:
-        return _Counted(self.match, "<", _number(n))
+        return self._bound("<", n)
 
     def __le__(self, n: float) -> Predicate:
-        return _Counted(self.match, "<=", _number(n))
+        return self._bound("<=", n)
 
     def __gt__(self, n: float) -> Predicate:
-        return _Counted(self.match, ">", _number(n))
+        return self._bound(">", n)
 
     def __ge__(self, n: float) -> Predicate:
-        return _Counted(self.match, ">=", _number(n))
+        return self._bound(">=", n)
 
     def between(self, lo: float, hi: float) -> Predicate:
         """``lo <= count <= hi``."""
         if lo > hi:
             raise ConfigurationError(f"count().between({lo}, {hi}): the range is empty")
-        return _Counted(self.match, "in", _number(lo), _number(hi))
+        return self._bound("in", lo, hi)
 
     def at_least(self, n: float) -> Predicate:
         return self >= n
@@ -587,14 +545,19 @@ def _runs(obj: Any) -> list[_Run]:
         return [_Run(f" (replication {i})" if many else "", t,
                      float(horizon) if horizon is not None else _end(t))
                 for i, t in enumerate(traces)]
+    if isinstance(obj, (str, os.PathLike)):               # a stored trace (opspec run --trace)
+        from opspec.engine.trace_sinks import read_trace
+
+        events = list(read_trace(obj))
+        return [_Run("", events, trace_end(events))]
     if isinstance(obj, Sequence) and all(isinstance(e, TraceEvent) for e in obj):
-        return [_Run("", obj, _end(obj))]
-    raise TypeError("expected a SimulationResult, a RunResult or a sequence of TraceEvent, "
-                    f"not {type(obj).__name__}")
+        return [_Run("", obj, trace_end(obj))]
+    raise TypeError("expected a SimulationResult, a RunResult, a sequence of TraceEvent or the "
+                    f"path of a JSON Lines trace, not {type(obj).__name__}")
 
 
 def _end(trace: Sequence[TraceEvent]) -> float:
-    return trace[-1].time if trace else 0.0
+    return trace_end(trace)
 
 
 def _names(obj: Any, spec: Any) -> Any:
@@ -634,7 +597,7 @@ def failures(obj: Any, predicate: Predicate | str | Match, *, spec: Any = None,
             continue
         lines = [f"expected {predicate.describe()}" + run.label,
                  *(f"  {line}" for line in failure.lines)]
-        lines.extend(trace_slice(failure.trace or run.events, failure.focus))
+        lines.extend(failure_slice(failure.trace or run.events, failure.focus))
         out.append("\n".join(lines))
         if first:
             break
@@ -657,6 +620,16 @@ def check(obj: Any, *predicates: Predicate | str | Match, spec: Any = None) -> N
         if seed is not None and hasattr(obj, "replications"):
             messages.append(f"(seed {seed}, {obj.replications} replication(s))")
         raise AssertionError("\n\n".join(messages))
+
+
+def failure_slice(trace: Sequence[TraceEvent], witness: Sequence[TraceEvent]) -> list[str]:
+    """What a failure shows of the trace: the witness events marked in their context, or,
+    when nothing happened to show (``eventually``), how the trace ends."""
+    from opspec.testing.expectations import format_events
+
+    if witness or not trace:
+        return trace_slice(trace, witness)
+    return ["  the trace ends with:", *format_events(list(trace[-BEFORE:]))]
 
 
 def trace_slice(trace: Sequence[TraceEvent], focus: Sequence[TraceEvent]) -> list[str]:

@@ -50,9 +50,9 @@ def _feed(monitor_text: str, events: list[tuple[float, str]], end: float) -> lis
      ["3 times within 59 s"]),
     ("max_count a 2 per 1 min", [(0, "a"), (30, "a"), (60, "a"), (90, "a")], 100, []),
     ("bounded_response a b 10s", [(0, "a"), (5, "b"), (20, "a"), (40, "x")], 50,
-     ["a at day 1 00:00:20.0 got no b within 10 s"]),
+     ["a at day 1 00:00:20.0 was not followed by b within 10 s"]),
     ("bounded_response a b|c 10s", [(0, "a"), (10, "c")], 50, []),
-    ("bounded_response a b 10s", [(0, "a"), (11, "b")], 50, ["got no b within 10 s"]),
+    ("bounded_response a b 10s", [(0, "a"), (11, "b")], 50, ["was not followed by b within 10 s; the next came at day 1 00:00:11.0"]),
     ("bounded_response a b 10s", [(45, "a")], 50, []),      # window cut off by the end
     ("never_while d after m until s", [(0, "m"), (5, "d"), (6, "s"), (7, "d")], 10,
      ["d at day 1 00:00:05.0, after m at day 1 00:00:00.0 and before any s"]),

@@ -1,0 +1,970 @@
+"""One property language for monitors, trace predicates and scenario ``then`` lines.
+
+A :class:`Property` is a claim about one run's trace ("no two dispenses closer than 4 h",
+"every alarm is answered within 15 min"). The same property is
+
+* watched **online** while a simulation runs: :meth:`Property.start` gives a
+  :class:`MonitorRun`, a trace listener with a ``selects`` set (the engine builds only the
+  events it needs) - what ``opspec:Monitor``, ``opspec run``, ``opspec evaluate`` and
+  ``simulate(monitors=...)`` use;
+* judged **offline** over a stored trace: :meth:`Property.judge` feeds the same
+  :class:`MonitorRun` the trace's events one by one - what the trace predicates
+  (:mod:`opspec.testing.predicates`) and the ``then`` lines of scenario files use.
+
+One evaluator, fed the same events, so a monitor and a predicate with the same text give the
+same verdict and the same witness (the events that show a violation) on the same run.
+
+The text form, read by :func:`parse_property` (keywords in any case; ``A``, ``B``, ``C`` are
+subjects, durations are read by :mod:`opspec.clock`: ``90``, ``90s``, ``5 min``, ``1h30m``,
+``PT4H``)::
+
+    never A                          absence: A never happens
+    eventually A                     existence: A happens at least once
+    min_gap A 4h                     no two A closer than 4 h   (also: never A twice within 4h)
+    max_count A 4 per 24h            at most 4 A in any window of 24 h
+    count A <= 4                     the number of A in the run (==, !=, <, <=, >, >=;
+                                     count A in [1, 3])
+    bounded_response A B 15min       every A is followed by a B within 15 min
+                                     (also: B within 15 min after A)
+    response A B                     every A is followed by a B before the run ends
+    A before B                       precedence: no B before the first A
+    A before each B                  every B has an A of its own before it
+    never_while A after B until C    absence between: no A after a B until the next C
+
+A *subject* is an activity id (its completion), a trigger name (raised) or a process id (an
+instance started), resolved against the spec's names by :meth:`Property.bind`; it may be made
+explicit: ``activity:dispense`` or ``activity dispense``, ``trigger:trg_2``,
+``process:notify_workflow``; ``a|b`` means either.
+
+The verdicts follow the specification patterns of Dwyer, Avrunin and Corbett (ICSE 1999) read
+over the finite trace, in its order (``seq``: events at the same instant count in the order
+the engine emitted them), and docs/spec-testing.md ("What a property means") states the
+boundary cases: an event exactly at a bound is in time, an event that is both ``A`` and ``B``
+answers (or precedes) itself, and a time window the end of the run cuts off is *open* - not
+judged - while an untimed obligation (``eventually``, ``response``, ``count ... >=``) still
+open at the end is a violation, because the run is the whole time it talks about.
+
+Pure Python, no wall clock: importable by any layer above the engine.
+"""
+
+from __future__ import annotations
+
+import math
+import operator
+import re
+from collections import deque
+from collections.abc import Callable, Iterable, Sequence
+from dataclasses import dataclass, field, replace
+from typing import Protocol
+
+from opspec.clock import parse_duration, span
+from opspec.engine.trace import EventKind, TraceEvent
+from opspec.errors import ConfigurationError, SourceLocation
+
+__all__ = [
+    "KEEP",
+    "BoundedResponse",
+    "CountBound",
+    "Eventually",
+    "MaxCount",
+    "MinGap",
+    "MonitorResult",
+    "MonitorRun",
+    "Names",
+    "Never",
+    "NeverWhile",
+    "Precedence",
+    "Property",
+    "Selector",
+    "Subject",
+    "Violation",
+    "clock",
+    "parse_property",
+    "parse_subject",
+    "trace_end",
+]
+
+#: violations kept with their witness per run (all are counted)
+KEEP = 50
+#: events a witness of a window (max_count) or a count keeps at most
+SLICE = 8
+
+Selects = frozenset[tuple[str, str | None, str | None]]
+
+
+class Names(Protocol):
+    """The names a spec defines (:class:`opspec.engine.names.SpecNames` is one)."""
+
+    @property
+    def activities(self) -> tuple[str, ...]: ...
+    @property
+    def triggers(self) -> tuple[str, ...]: ...
+    @property
+    def processes(self) -> tuple[str, ...]: ...
+
+
+class Selector(Protocol):
+    """Anything that picks events: a :class:`Subject`, or a predicate's ``Match`` (which
+    may test any field); ``str()`` names it in messages."""
+
+    def matches(self, event: TraceEvent) -> bool: ...
+
+
+def clock(seconds: float) -> str:
+    """``day 1 08:00:00.0`` for simulated seconds (the format of trace listings)."""
+    seconds = round(seconds, 1)         # 59.96 s is shown as the next minute, not "60.0"
+    day, rest = divmod(seconds, 86_400.0)
+    hours, rest = divmod(rest, 3600.0)
+    minutes, secs = divmod(rest, 60.0)
+    return f"day {int(day) + 1} {int(hours):02d}:{int(minutes):02d}:{secs:04.1f}"
+
+
+def trace_end(events: Sequence[TraceEvent]) -> float:
+    """Where a stored trace ends: its ``run.ended`` event (written at the run's horizon),
+    else its last event."""
+    for event in reversed(events):
+        if event.kind == EventKind.RUN_ENDED:
+            return event.time
+    return events[-1].time if events else 0.0
+
+
+# ---------------------------------------------------------------- subjects
+@dataclass(frozen=True, slots=True)
+class Subject:
+    """What a property counts: completions of an activity, raises of a trigger, starts of a
+    process; ``what`` is ``None`` until resolved (then any of the three match).
+    ``alternatives`` holds the others of ``a|b``."""
+
+    name: str
+    what: str | None = None
+    alternatives: tuple[Subject, ...] = ()
+
+    def __str__(self) -> str:
+        own = f"{self.what} {self.name}" if self.what else self.name
+        return " or ".join([own, *map(str, self.alternatives)])
+
+    def matches(self, event: TraceEvent) -> bool:
+        if self._own(event):
+            return True
+        return any(alt.matches(event) for alt in self.alternatives)
+
+    def _own(self, event: TraceEvent) -> bool:
+        what, kind = self.what, event.kind
+        if kind == EventKind.ACTIVITY_COMPLETED:
+            return what in (None, "activity") and event.activity == self.name
+        if kind == EventKind.TRIGGER_RAISED:
+            return what in (None, "trigger") and event.data.get("name") == self.name
+        if kind == EventKind.PROCESS_STARTED:
+            return what in (None, "process") and event.process == self.name
+        return False
+
+    @property
+    def selects(self) -> Selects:
+        """Engine selectors of the events this subject may match."""
+        own: set[tuple[str, str | None, str | None]] = set()
+        if self.what in (None, "activity"):
+            own.add((EventKind.ACTIVITY_COMPLETED, None, self.name))
+        if self.what in (None, "trigger"):
+            own.add((EventKind.TRIGGER_RAISED, None, None))
+        if self.what in (None, "process"):
+            own.add((EventKind.PROCESS_STARTED, self.name, None))
+        for alt in self.alternatives:
+            own |= alt.selects
+        return frozenset(own)
+
+    def spelling(self) -> str:
+        """The text form that reads back as this subject: ``activity:a|b``."""
+        own = f"{self.what}:{self.name}" if self.what else self.name
+        return "|".join([own, *(alt.spelling() for alt in self.alternatives)])
+
+    def bind(self, names: Names) -> Subject:
+        """This subject with ``what`` resolved (activity, then trigger, then process);
+        :class:`ConfigurationError` listing the spec's names when it has no such name."""
+        alternatives = tuple(alt.bind(names) for alt in self.alternatives)
+        table = {"activity": names.activities, "trigger": names.triggers,
+                 "process": names.processes}
+        if self.what is not None:
+            if self.name not in table[self.what]:
+                raise ConfigurationError(
+                    f"the spec has no {self.what} {self.name!r}",
+                    hint=f"its {self.what} names are: {', '.join(table[self.what]) or '(none)'}")
+            return replace(self, alternatives=alternatives)
+        for what, known in table.items():
+            if self.name in known:
+                return Subject(self.name, what, alternatives)
+        raise ConfigurationError(
+            f"the spec has no activity, trigger or process {self.name!r}",
+            hint="its activities are: " + ", ".join(names.activities)
+                 + "; triggers: " + (", ".join(names.triggers) or "(none)")
+                 + "; processes: " + ", ".join(names.processes))
+
+
+_KINDS = ("activity", "trigger", "process")
+_NAME = re.compile(r"[\w.-]+")
+_SPELT = re.compile(r"[\w.:-]+")       # a name after an explicit kind may hold a colon
+_SUBJECT_HINT = ("write a name, optionally prefixed: activity:NAME, trigger:NAME, "
+                 "process:NAME (or 'activity NAME'); 'a|b' for either")
+
+
+def parse_subject(text: str) -> Subject:
+    """``dispense``, ``activity:dispense``, ``activity dispense``, ``trigger:trg_2``,
+    ``process:p``, ``a|b``."""
+    tokens = _tokens(text)
+    subject, end = _subject(tokens, 0)
+    if end != len(tokens):
+        raise ConfigurationError(f"cannot read {text.strip()!r} as an activity, trigger or "
+                                 "process name", hint=_SUBJECT_HINT)
+    return subject
+
+
+def _subject(tokens: Sequence[str], i: int) -> tuple[Subject, int]:
+    parts: list[Subject] = []
+    while True:
+        if i >= len(tokens):
+            raise ConfigurationError("a name is missing", hint=_SUBJECT_HINT)
+        token = tokens[i]
+        what: str | None = None
+        if token.lower() in _KINDS and i + 1 < len(tokens) and _SPELT.fullmatch(tokens[i + 1]):
+            what, name, i = token.lower(), tokens[i + 1], i + 2
+        else:
+            head, colon, rest = token.partition(":")
+            if colon and head.lower() in _KINDS:
+                what, name = head.lower(), rest
+            else:
+                name = token
+            i += 1
+        pattern = _NAME if what is None else _SPELT
+        if not pattern.fullmatch(name):
+            raise ConfigurationError(f"cannot read {token!r} as an activity, trigger or "
+                                     "process name", hint=_SUBJECT_HINT)
+        parts.append(Subject(name, what))
+        if i < len(tokens) and tokens[i] == "|":
+            i += 1
+            continue
+        return replace(parts[0], alternatives=tuple(parts[1:])), i
+
+
+# ---------------------------------------------------------------- violations and runs
+@dataclass(frozen=True, slots=True)
+class Violation:
+    """One violation of the property named ``monitor`` (its text) at simulated ``time`` in
+    ``replication``; ``events`` is its witness: the events that show it (oldest first)."""
+
+    monitor: str
+    time: float
+    message: str
+    events: tuple[TraceEvent, ...] = ()
+    replication: int = 0
+
+    def __str__(self) -> str:
+        return f"{clock(self.time)}: {self.monitor}: {self.message}"
+
+
+@dataclass(frozen=True, slots=True)
+class MonitorResult:
+    """What one property saw in one run: ``count`` violations (the first :data:`KEEP` kept
+    with their witness) and ``open``: obligations whose time window the end of the run cut
+    off (not judged). It holds when ``count`` is 0."""
+
+    monitor: str
+    replication: int
+    count: int
+    violations: tuple[Violation, ...] = ()
+    open: tuple[TraceEvent, ...] = ()
+
+    @property
+    def holds(self) -> bool:
+        return self.count == 0
+
+
+class MonitorRun:
+    """One property evaluated over one run, event by event: a trace listener (online) that
+    is also fed stored traces (offline, :meth:`Property.judge`). Subclasses implement
+    :meth:`observe` (called with the events the property's selectors match, in trace order)
+    and :meth:`finish` when the end of the run decides something."""
+
+    def __init__(self, monitor: Property, replication: int = 0) -> None:
+        self.monitor = monitor
+        self.replication = replication
+        self.selects = monitor.selects
+        self.violations: list[Violation] = []
+        self.count = 0
+        self.open: tuple[TraceEvent, ...] = ()
+        self._relevant = monitor.relevant
+
+    def __call__(self, event: TraceEvent) -> None:
+        if self._relevant(event):
+            self.observe(event)
+
+    def observe(self, event: TraceEvent) -> None:
+        raise NotImplementedError
+
+    def finish(self, end: float) -> None:
+        """The run ended at simulated time ``end`` (judge what is still pending)."""
+
+    def evidence(self) -> tuple[TraceEvent, ...]:
+        """Events showing that the property *holds* (``eventually``: the first occurrence),
+        for a predicate's negation."""
+        return ()
+
+    def result(self) -> MonitorResult:
+        """The frozen outcome (call after :meth:`finish`)."""
+        return MonitorResult(self.monitor.text or self.monitor.describe(), self.replication,
+                             self.count, tuple(self.violations), self.open)
+
+    def violate(self, time: float, message: str, events: Iterable[TraceEvent]) -> None:
+        self.count += 1
+        if len(self.violations) < KEEP:
+            self.violations.append(Violation(self.monitor.text or self.monitor.describe(),
+                                             time, message, tuple(events), self.replication))
+
+
+# ---------------------------------------------------------------- properties
+@dataclass(frozen=True, slots=True)
+class Property:
+    """A claim about one run's trace; ``text`` is its text form (its name in reports; empty
+    for one built in Python without it, then :meth:`describe` writes it)."""
+
+    text: str = field(default="", kw_only=True)
+
+    def subjects(self) -> tuple[Selector, ...]:
+        """What the property refers to, in the order of its fields."""
+        raise NotImplementedError
+
+    def _with(self, subjects: Sequence[Selector]) -> Property:
+        raise NotImplementedError
+
+    def describe(self) -> str:
+        """The text form (``text`` when given)."""
+        raise NotImplementedError
+
+    def __str__(self) -> str:
+        return self.text or self.describe()
+
+    def bind(self, names: Names) -> Property:
+        """This property with its subjects resolved against the spec's names."""
+        return self._with([s.bind(names) if isinstance(s, Subject) else s
+                           for s in self.subjects()])
+
+    @property
+    def selects(self) -> Selects | None:
+        """The engine selectors of the events it needs (``None``: every event, when a
+        subject is a predicate's selector rather than a name)."""
+        out: Selects = frozenset()
+        for subject in self.subjects():
+            if not isinstance(subject, Subject):
+                return None
+            out |= subject.selects
+        return out
+
+    def relevant(self, event: TraceEvent) -> bool:
+        return any(s.matches(event) for s in self.subjects())
+
+    def start(self, replication: int = 0) -> MonitorRun:
+        """A fresh evaluation for one run (a trace listener)."""
+        raise NotImplementedError
+
+    def judge(self, events: Iterable[TraceEvent], end: float | None = None,
+              replication: int = 0) -> MonitorResult:
+        """The verdict over a stored trace: its events fed, in order, to the evaluation a
+        monitor runs online; ``end`` is where the run ended (default :func:`trace_end`)."""
+        run = self.start(replication)
+        events = events if isinstance(events, Sequence) else list(events)
+        for event in events:
+            run(event)
+        run.finish(trace_end(events) if end is None else end)
+        return run.result()
+
+
+@dataclass(frozen=True, slots=True)
+class Never(Property):
+    """Absence: ``subject`` never happens. Each occurrence is a violation."""
+
+    subject: Selector
+
+    def subjects(self) -> tuple[Selector, ...]:
+        return (self.subject,)
+
+    def _with(self, subjects: Sequence[Selector]) -> Property:
+        return replace(self, subject=subjects[0])
+
+    def describe(self) -> str:
+        return f"never {_spell(self.subject)}"
+
+    def start(self, replication: int = 0) -> MonitorRun:
+        return _NeverRun(self, replication)
+
+
+class _NeverRun(MonitorRun):
+    monitor: Never
+
+    def observe(self, event: TraceEvent) -> None:
+        self.violate(event.time, f"{self.monitor.subject} happened at {clock(event.time)}",
+                     (event,))
+
+
+@dataclass(frozen=True, slots=True)
+class Eventually(Property):
+    """Existence: ``subject`` happens at least once in the run (decided at its end)."""
+
+    subject: Selector
+
+    def subjects(self) -> tuple[Selector, ...]:
+        return (self.subject,)
+
+    def _with(self, subjects: Sequence[Selector]) -> Property:
+        return replace(self, subject=subjects[0])
+
+    def describe(self) -> str:
+        return f"eventually {_spell(self.subject)}"
+
+    def start(self, replication: int = 0) -> MonitorRun:
+        return _EventuallyRun(self, replication)
+
+
+class _EventuallyRun(MonitorRun):
+    monitor: Eventually
+
+    def __init__(self, monitor: Eventually, replication: int) -> None:
+        super().__init__(monitor, replication)
+        self.first: TraceEvent | None = None
+
+    def observe(self, event: TraceEvent) -> None:
+        if self.first is None:
+            self.first = event
+
+    def finish(self, end: float) -> None:
+        if self.first is None:
+            self.violate(end, f"{self.monitor.subject} never happened (the run went to "
+                         f"{clock(end)})", ())
+
+    def evidence(self) -> tuple[TraceEvent, ...]:
+        return () if self.first is None else (self.first,)
+
+
+@dataclass(frozen=True, slots=True)
+class MinGap(Property):
+    """No two occurrences of ``subject`` closer than ``seconds`` (exactly ``seconds`` apart
+    is allowed); each occurrence too close to the previous one is a violation."""
+
+    subject: Selector
+    seconds: float
+
+    def subjects(self) -> tuple[Selector, ...]:
+        return (self.subject,)
+
+    def _with(self, subjects: Sequence[Selector]) -> Property:
+        return replace(self, subject=subjects[0])
+
+    def describe(self) -> str:
+        return f"min_gap {_spell(self.subject)} {_duration_text(self.seconds)}"
+
+    def start(self, replication: int = 0) -> MonitorRun:
+        return _MinGapRun(self, replication)
+
+
+class _MinGapRun(MonitorRun):
+    monitor: MinGap
+
+    def __init__(self, monitor: MinGap, replication: int) -> None:
+        super().__init__(monitor, replication)
+        self.last: TraceEvent | None = None
+
+    def observe(self, event: TraceEvent) -> None:
+        last, gap = self.last, self.monitor.seconds
+        if last is not None and event.time - last.time < gap:
+            self.violate(event.time, f"{self.monitor.subject} at {clock(last.time)} and again "
+                         f"at {clock(event.time)}, {span(event.time - last.time)} apart "
+                         f"(at least {span(gap)} required)", (last, event))
+        self.last = event
+
+
+@dataclass(frozen=True, slots=True)
+class MaxCount(Property):
+    """At most ``limit`` occurrences of ``subject`` in any window of ``seconds`` (a window is
+    half-open: two events exactly ``seconds`` apart are never in the same one, as for
+    :class:`MinGap`; ``max_count A 1 per D`` is ``min_gap A D``). Each occurrence that
+    makes a window hold too many is a violation."""
+
+    subject: Selector
+    limit: int
+    seconds: float
+
+    def subjects(self) -> tuple[Selector, ...]:
+        return (self.subject,)
+
+    def _with(self, subjects: Sequence[Selector]) -> Property:
+        return replace(self, subject=subjects[0])
+
+    def describe(self) -> str:
+        return f"max_count {_spell(self.subject)} {self.limit} per {_duration_text(self.seconds)}"
+
+    def start(self, replication: int = 0) -> MonitorRun:
+        return _MaxCountRun(self, replication)
+
+
+class _MaxCountRun(MonitorRun):
+    monitor: MaxCount
+
+    def __init__(self, monitor: MaxCount, replication: int) -> None:
+        super().__init__(monitor, replication)
+        self.window: deque[TraceEvent] = deque()
+
+    def observe(self, event: TraceEvent) -> None:
+        m = self.monitor
+        self.window.append(event)
+        while event.time - self.window[0].time >= m.seconds:
+            self.window.popleft()
+        if len(self.window) > m.limit:
+            self.violate(event.time, f"{m.subject} happened {len(self.window)} times within "
+                         f"{span(event.time - self.window[0].time)} (from "
+                         f"{clock(self.window[0].time)}); at most {m.limit} per "
+                         f"{span(m.seconds)} allowed", tuple(self.window)[-SLICE:])
+
+
+_COMPARE: dict[str, Callable[[float, float], bool]] = {
+    "==": operator.eq, "!=": operator.ne, "<": operator.lt, "<=": operator.le,
+    ">": operator.gt, ">=": operator.ge}
+
+
+@dataclass(frozen=True, slots=True)
+class CountBound(Property):
+    """The number of ``subject`` in the run compares so with ``a`` (``op`` is ``==``, ``!=``,
+    ``<``, ``<=``, ``>``, ``>=``, or ``in`` for ``a <= n <= b``). One violation at most per
+    run: at the occurrence that broke an upper bound, else at the end of the run."""
+
+    subject: Selector
+    op: str
+    a: float
+    b: float | None = None
+
+    def __post_init__(self) -> None:
+        if self.op not in _COMPARE and self.op != "in":
+            raise ConfigurationError(f"unknown comparison {self.op!r}",
+                                     hint="use ==, !=, <, <=, >, >= or in [lo, hi]")
+        if self.op == "in" and (self.b is None or self.a > self.b):
+            raise ConfigurationError(f"count in [{self.a:g}, {self.b or 0:g}]: the range is "
+                                     "empty")
+
+    def subjects(self) -> tuple[Selector, ...]:
+        return (self.subject,)
+
+    def _with(self, subjects: Sequence[Selector]) -> Property:
+        return replace(self, subject=subjects[0])
+
+    def target(self) -> str:
+        """``<= 4``, ``in [1, 3]``."""
+        return f"in [{self.a:g}, {self.b:g}]" if self.op == "in" else f"{self.op} {self.a:g}"
+
+    def describe(self) -> str:
+        return f"count {_spell(self.subject)} {self.target()}"
+
+    def allows(self, n: float) -> bool:
+        if self.op == "in":
+            assert self.b is not None
+            return self.a <= n <= self.b
+        return _COMPARE[self.op](n, self.a)
+
+    def most(self) -> float:
+        """The largest count allowed when the bound is an upper one (else infinity): the
+        occurrence after it is where the claim broke."""
+        if self.op == "in":
+            assert self.b is not None
+            return math.floor(self.b)
+        if self.op in ("<=", "=="):
+            return math.floor(self.a)
+        if self.op == "<":
+            return math.ceil(self.a) - 1
+        return math.inf
+
+    def start(self, replication: int = 0) -> MonitorRun:
+        return _CountRun(self, replication)
+
+
+class _CountRun(MonitorRun):
+    monitor: CountBound
+
+    def __init__(self, monitor: CountBound, replication: int) -> None:
+        super().__init__(monitor, replication)
+        self.n = 0
+        self.most = monitor.most()
+        self.head: list[TraceEvent] = []            # the first 3 occurrences
+        self.tail: deque[TraceEvent] = deque(maxlen=2)
+        self.broke: TraceEvent | None = None
+
+    def observe(self, event: TraceEvent) -> None:
+        self.n += 1
+        if len(self.head) < 3:
+            self.head.append(event)
+        else:
+            self.tail.append(event)
+        if self.broke is None and self.n > self.most:
+            self.broke = event
+
+    def finish(self, end: float) -> None:
+        m = self.monitor
+        if m.allows(self.n):
+            return
+        where = (f" (the one too many at {clock(self.broke.time)})" if self.broke is not None
+                 else f" (the run went to {clock(end)})")
+        self.violate(self.broke.time if self.broke is not None else end,
+                     f"{m.subject} happened {self.n} time(s){where}; count {m.target()} "
+                     "required", (*self.head, *self.tail))
+
+    def evidence(self) -> tuple[TraceEvent, ...]:
+        return (*self.head, *self.tail)
+
+
+@dataclass(frozen=True, slots=True)
+class BoundedResponse(Property):
+    """Every ``trigger`` is followed by a ``response`` within ``seconds`` (a response exactly
+    ``seconds`` later is in time; an event that is both answers itself; one response answers
+    every trigger pending before it). Each unanswered trigger is a violation at its due time,
+    its witness the trigger and the next response, if one came before the end. A window the
+    end of the run cuts off is *open*, not judged. With ``seconds`` infinite (``response A
+    B``) the window is the rest of the run: a trigger unanswered at the end is a violation."""
+
+    trigger: Selector
+    response: Selector
+    seconds: float
+
+    def subjects(self) -> tuple[Selector, ...]:
+        return (self.trigger, self.response)
+
+    def _with(self, subjects: Sequence[Selector]) -> Property:
+        return replace(self, trigger=subjects[0], response=subjects[1])
+
+    def describe(self) -> str:
+        if math.isinf(self.seconds):
+            return f"response {_spell(self.trigger)} {_spell(self.response)}"
+        return f"bounded_response {_spell(self.trigger)} {_spell(self.response)} {_duration_text(self.seconds)}"
+
+    def start(self, replication: int = 0) -> MonitorRun:
+        return _ResponseRun(self, replication)
+
+
+class _ResponseRun(MonitorRun):
+    monitor: BoundedResponse
+
+    def __init__(self, monitor: BoundedResponse, replication: int) -> None:
+        super().__init__(monitor, replication)
+        self.pending: deque[TraceEvent] = deque()
+        # triggers whose window closed unanswered: reported with the next response (their
+        # witness), or at the end; only as many as can still be kept are held back
+        self.overdue: list[TraceEvent] = []
+
+    def _expire(self, now: float) -> None:
+        seconds = self.monitor.seconds
+        while self.pending and self.pending[0].time + seconds < now:
+            cause = self.pending.popleft()
+            if len(self.violations) + len(self.overdue) < KEEP:
+                self.overdue.append(cause)
+            else:
+                self.count += 1               # counted; beyond what is kept anyway
+
+    def _report(self, response: TraceEvent | None, end: float) -> None:
+        m = self.monitor
+        for cause in self.overdue:
+            due = cause.time + m.seconds
+            if response is not None:
+                nxt = (f"; the next came at {clock(response.time)}, "
+                       f"{span(response.time - cause.time)} after it")
+            else:
+                nxt = f"; none came before the end ({clock(end)})"
+            self.violate(due, f"{m.trigger} at {clock(cause.time)} was not followed by "
+                         f"{m.response} within {span(m.seconds)}{nxt}",
+                         (cause,) if response is None else (cause, response))
+        self.overdue.clear()
+
+    def observe(self, event: TraceEvent) -> None:
+        m = self.monitor
+        self._expire(event.time)
+        if m.response.matches(event):
+            if self.overdue:
+                self._report(event, event.time)
+            self.pending.clear()
+        elif m.trigger.matches(event):
+            self.pending.append(event)
+
+    def finish(self, end: float) -> None:
+        m = self.monitor
+        if math.isinf(m.seconds):
+            for cause in self.pending:
+                self.violate(end, f"{m.trigger} at {clock(cause.time)} was not followed by "
+                             f"{m.response} before the end ({clock(end)})", (cause,))
+            self.pending.clear()
+            return
+        # a window that closed before the end is judged; one the end cut off is open (the
+        # run stops before events at its end, so a response at ``end`` was still possible)
+        self._expire(end)
+        self._report(None, end)
+        self.open = tuple(self.pending)
+
+
+@dataclass(frozen=True, slots=True)
+class Precedence(Property):
+    """``first`` precedes ``then``: no ``then`` before the first ``first`` (``then`` need not
+    happen; an event that is both precedes itself). ``each``: every ``then`` has a ``first``
+    of its own before it (the n-th ``then`` comes after the n-th ``first``). Each ``then``
+    without one is a violation."""
+
+    first: Selector
+    then: Selector
+    each: bool = False
+
+    def subjects(self) -> tuple[Selector, ...]:
+        return (self.first, self.then)
+
+    def _with(self, subjects: Sequence[Selector]) -> Property:
+        return replace(self, first=subjects[0], then=subjects[1])
+
+    def describe(self) -> str:
+        return f"{_spell(self.first)} before {'each ' if self.each else ''}{_spell(self.then)}"
+
+    def start(self, replication: int = 0) -> MonitorRun:
+        return _PrecedenceRun(self, replication)
+
+
+class _PrecedenceRun(MonitorRun):
+    monitor: Precedence
+
+    def __init__(self, monitor: Precedence, replication: int) -> None:
+        super().__init__(monitor, replication)
+        self.firsts = 0          # firsts seen
+        self.used = 0            # firsts a then has taken (each=True)
+        self.thens = 0
+        self.last: TraceEvent | None = None
+
+    def observe(self, event: TraceEvent) -> None:
+        m = self.monitor
+        if m.first.matches(event):
+            self.firsts += 1
+            self.last = event
+        if not m.then.matches(event):
+            return
+        self.thens += 1
+        if self.firsts > self.used if m.each else self.firsts > 0:
+            self.used += 1
+            return
+        if self.firsts == 0:
+            why = f"before any {m.first}"
+        else:
+            why = (f"with no {m.first} of its own before it ({self.firsts} {m.first} for "
+                   f"{self.thens} {m.then})")
+        witness = (event,) if self.last is None else (self.last, event)
+        self.violate(event.time, f"{m.then} happened at {clock(event.time)} {why}", witness)
+
+
+@dataclass(frozen=True, slots=True)
+class NeverWhile(Property):
+    """Absence between: ``subject`` never happens after an ``after`` until the next ``until``
+    (the window opens at the first ``after`` and stays open, to the end of the run, until an
+    ``until`` closes it). An event that is the ``after`` opening the window is inside it; one
+    that is the ``until`` closing it is not (Dwyer's "after Q until R" scope)."""
+
+    subject: Selector
+    after: Selector
+    until: Selector
+
+    def subjects(self) -> tuple[Selector, ...]:
+        return (self.subject, self.after, self.until)
+
+    def _with(self, subjects: Sequence[Selector]) -> Property:
+        return replace(self, subject=subjects[0], after=subjects[1], until=subjects[2])
+
+    def describe(self) -> str:
+        return f"never_while {_spell(self.subject)} after {_spell(self.after)} until {_spell(self.until)}"
+
+    def start(self, replication: int = 0) -> MonitorRun:
+        return _NeverWhileRun(self, replication)
+
+
+class _NeverWhileRun(MonitorRun):
+    monitor: NeverWhile
+
+    def __init__(self, monitor: NeverWhile, replication: int) -> None:
+        super().__init__(monitor, replication)
+        self.opened: TraceEvent | None = None
+
+    def observe(self, event: TraceEvent) -> None:
+        m = self.monitor
+        if m.until.matches(event):
+            self.opened = None
+            return
+        if self.opened is None and m.after.matches(event):
+            self.opened = event
+        if self.opened is not None and m.subject.matches(event):
+            self.violate(event.time, f"{m.subject} at {clock(event.time)}, after {m.after} at "
+                         f"{clock(self.opened.time)} and before any {m.until}",
+                         (self.opened, event) if self.opened is not event else (event,))
+
+
+# ---------------------------------------------------------------- the text form
+FORMS = ("'min_gap A 4h' (or 'never A twice within 4h'), 'never A', 'eventually A', "
+         "'max_count A 4 per 24h', 'count A <= 4' (==, !=, <, <=, >, >=, in [lo, hi]), "
+         "'bounded_response A B 15min' (or 'B within 15min after A'), 'response A B', "
+         "'A before B', 'A before each B', 'never_while A after B until C'")
+_KEYWORDS = frozenset({"never", "eventually", "min_gap", "max_count", "count",
+                       "bounded_response", "response", "never_while"})
+_TOKEN = re.compile(r"==|!=|<=|>=|<|>|\[|\]|,|\||[^\s=!<>\[\],|]+|\S")
+_NUMBER = re.compile(r"[-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?")
+
+
+def _tokens(text: str) -> list[str]:
+    return _TOKEN.findall(text)
+
+
+def _spell(selector: Selector) -> str:
+    return selector.spelling() if isinstance(selector, Subject) else str(selector)
+
+
+def _duration_text(seconds: float) -> str:
+    return span(seconds).replace(" days", "d").replace(" day", "d").replace(" ", "")
+
+
+def _seconds(text: str, *, zero: bool = False) -> float:
+    value = parse_duration(text, error=ConfigurationError)
+    if value < 0 or (value == 0 and not zero):
+        raise ConfigurationError(f"{text!r} is not a {'' if zero else 'positive '}duration",
+                                 hint="write e.g. 90s, 5 min, 4h or PT4H")
+    return value
+
+
+class _Syntax(Exception):
+    """The text is not in any property form (not a mistake inside one)."""
+
+
+def _expect(tokens: Sequence[str], i: int, word: str) -> int:
+    if i >= len(tokens) or tokens[i].lower() != word:
+        raise _Syntax
+    return i + 1
+
+
+def _number(tokens: Sequence[str], i: int) -> float:
+    if i >= len(tokens) or not _NUMBER.fullmatch(tokens[i]):
+        raise _Syntax
+    return float(tokens[i])
+
+
+def _rest(tokens: Sequence[str], i: int) -> str:
+    if i >= len(tokens):
+        raise _Syntax
+    return " ".join(tokens[i:])
+
+
+def _read(tokens: list[str], text: str) -> tuple[Property, str | None]:
+    """The property and the text of its duration (if it has one); :class:`_Syntax` when the
+    tokens fit no form, :class:`ConfigurationError` for a mistake inside one."""
+    head = tokens[0].lower() if tokens else ""
+    try:
+        if head in _KEYWORDS:
+            a, i = _subject(tokens, 1)
+        else:
+            a, i = _subject(tokens, 0)
+    except ConfigurationError:
+        if head in _KEYWORDS or (len(tokens) > 1 and tokens[1].lower() in ("within", "before")):
+            raise
+        raise _Syntax from None
+    end = len(tokens)
+    if head == "never":
+        if i == end:
+            return Never(a, text=text), None
+        i = _expect(tokens, _expect(tokens, i, "twice"), "within")
+        gap = _rest(tokens, i)
+        return MinGap(a, _seconds(gap), text=text), gap
+    if head == "eventually" and i == end:
+        return Eventually(a, text=text), None
+    if head == "min_gap":
+        gap = _rest(tokens, i)
+        return MinGap(a, _seconds(gap), text=text), gap
+    if head == "max_count":
+        limit = _number(tokens, i)
+        if limit != int(limit) or limit < 0:
+            raise ConfigurationError(f"{tokens[i]!r} is not a whole number >= 0",
+                                     hint="write e.g. 'max_count dispense 4 per 24h'")
+        gap = _rest(tokens, _expect(tokens, i + 1, "per"))
+        return MaxCount(a, int(limit), _seconds(gap), text=text), None
+    if head == "count":
+        if i < end and tokens[i].lower() == "in":
+            i = _expect(tokens, i + 1, "[")
+            lo = _number(tokens, i)
+            hi = _number(tokens, _expect(tokens, i + 1, ","))
+            if _expect(tokens, i + 3, "]") != end:
+                raise _Syntax
+            return CountBound(a, "in", lo, hi, text=text), None
+        if i < end and tokens[i] in _COMPARE and i + 2 == end:
+            return CountBound(a, tokens[i], _number(tokens, i + 1), text=text), None
+        raise _Syntax
+    if head in ("bounded_response", "response", "never_while"):
+        if head == "never_while":
+            b, i = _subject(tokens, _expect(tokens, i, "after"))
+            c, i = _subject(tokens, _expect(tokens, i, "until"))
+            if i != end:
+                raise _Syntax
+            return NeverWhile(a, b, c, text=text), None
+        b, i = _subject(tokens, i)
+        if head == "response":
+            if i != end:
+                raise _Syntax
+            return BoundedResponse(a, b, math.inf, text=text), None
+        if i < end and tokens[i].lower() == "within":
+            i += 1
+        gap = _rest(tokens, i)
+        return BoundedResponse(a, b, _seconds(gap, zero=True), text=text), gap
+    if head in _KEYWORDS:
+        raise _Syntax
+    word = tokens[i].lower() if i < end else ""
+    if word == "before":
+        each = i + 1 < end and tokens[i + 1].lower() == "each"
+        b, j = _subject(tokens, i + 2 if each else i + 1)
+        if j != end:
+            raise _Syntax
+        return Precedence(a, b, each, text=text), None
+    if word == "within":
+        lowered = [t.lower() for t in tokens]
+        if "after" not in lowered[i + 1:]:
+            raise _Syntax
+        at = end - 1 - lowered[::-1].index("after")
+        gap = " ".join(tokens[i + 1:at])
+        cause, j = _subject(tokens, at + 1)
+        if j != end or not gap:
+            raise _Syntax
+        return BoundedResponse(cause, a, _seconds(gap, zero=True), text=text), gap
+    raise _Syntax
+
+
+def looks_like_property(text: str) -> bool:
+    """Whether ``text`` is written in one of the property forms (it may still hold a
+    mistake, such as a bad duration)."""
+    tokens = _tokens(text)
+    if not tokens:
+        return False
+    try:
+        _read(tokens, text)
+    except _Syntax:
+        return False
+    except ConfigurationError:
+        return True
+    return True
+
+
+def read_property(text: str, *, what: str = "property",
+                  location: SourceLocation | None = None) -> tuple[Property, str | None]:
+    """:func:`parse_property`, and the text of the property's duration (or ``None``)."""
+    cleaned = " ".join(text.split())
+    try:
+        return _read(_tokens(cleaned), cleaned)
+    except _Syntax:
+        raise ConfigurationError(f"cannot read the {what} {cleaned!r}", location=location,
+                                 hint=f"{what} forms: {FORMS}") from None
+    except ConfigurationError as error:
+        raise ConfigurationError(f"{what} {cleaned!r}: {error.message}", location=location,
+                                 hint=error.hint) from None
+
+
+def parse_property(text: str, *, what: str = "property",
+                   location: SourceLocation | None = None) -> Property:
+    """A property from its text form (whitespace is normalised: the cleaned text is its
+    ``text``); :class:`ConfigurationError` at ``location`` when it cannot be read, naming it
+    as a ``what`` ("monitor", "expectation") and listing the forms."""
+    return read_property(text, what=what, location=location)[0]
