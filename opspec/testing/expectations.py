@@ -9,16 +9,21 @@ Each line is one of (keywords in any case; ``OP`` is ``==``, ``!=``, ``<``, ``<=
     never activity notify_caregiver           no completion of it in any replication
     eventually activity record_taken          a completion in every replication
     count activity sound_alarm == 3           completions, summed over replications
-    activity press_report before activity dispense     first completions, in order
+    activity press_report before activity dispense     no dispense before the first report
     activity dispense within 300s after activity sound_alarm
     never activity dispense twice within 4h   no two completions closer than that
     rate doses_taken/doses_due >= 0.95 with 95% confidence
     mean alarms_per_dose in [1.1, 1.25] with 95% confidence
     p95 report_latency_s <= 600 with 95% confidence
 
-``activity X`` may also be ``trigger X`` (a message or signal raised) or ``process X`` (an
-instance started). Metric comparisons use the metrics pooled over all replications; ``==``
-allows a relative error of 1e-9. The statistical lines are decided by
+The trace lines are the property language of monitors (:mod:`opspec.engine.properties`):
+any monitor's text is a ``then`` line too (``min_gap dispense 4h``, ``bounded_response
+sound_alarm dispense 15min``, ``never_while ...``), judged on each replication's trace by the
+evaluator a monitor runs online (same verdict, same witness), and holding when it holds in
+every replication - except ``count``, which sums over the replications like the metric
+lines. ``activity X`` may also be ``trigger X`` (a message or signal raised), ``process X``
+(an instance started) or a bare name. Metric comparisons use the metrics pooled over all
+replications; ``==`` allows a relative error of 1e-9. The statistical lines are decided by
 :mod:`opspec.testing.intervals`: they pass when the one-sided bound at that confidence is on
 the right side, fail when the claim is refuted at that confidence, and otherwise fail saying
 how many replications would decide it.
@@ -31,9 +36,23 @@ import operator
 import re
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
-from itertools import pairwise
 
-from opspec.engine.monitors import clock
+from opspec.engine.properties import (
+    BoundedResponse,
+    CountBound,
+    Eventually,
+    MaxCount,
+    MinGap,
+    Never,
+    NeverWhile,
+    Precedence,
+    Property,
+    Subject,
+    clock,
+    looks_like_property,
+    read_property,
+    trace_end,
+)
 from opspec.engine.trace import EventKind, TraceEvent
 from opspec.errors import ConfigurationError, SourceLocation
 from opspec.testing.simulation import FIELDS, SimulationResult, SpecNames
@@ -47,38 +66,34 @@ _OPS: dict[str, Callable[[float, float], bool]] = {
 }
 _NUM = r"[-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?"
 _OP = r"==|!=|<=|>=|<|>"
-_SUBJECT = r"(?P<{0}kind>activity|trigger|process)\s+(?P<{0}name>[\w.:-]+)"
 _TARGET = rf"(?:(?P<op>{_OP})\s*(?P<num>{_NUM})|in\s*\[\s*(?P<lo>{_NUM})\s*,\s*(?P<hi>{_NUM})\s*\])"
 _CONF = r"\s+with\s+(?P<conf>\d+(?:\.\d+)?)\s*%\s+confidence"
-_FORMS: list[tuple[str, re.Pattern[str]]] = [
+_STATISTICAL: list[tuple[str, re.Pattern[str]]] = [
     ("rate", re.compile(rf"rate\s+(?P<num_m>\w+)\s*/\s*(?P<den_m>\w+)\s*{_TARGET}{_CONF}", re.IGNORECASE)),
     ("mean", re.compile(rf"mean\s+(?P<metric>[\w.]+)\s*{_TARGET}{_CONF}", re.IGNORECASE)),
     ("quantile", re.compile(rf"p(?P<q>\d+(?:\.\d+)?)\s+(?P<metric>\w+)\s*{_TARGET}{_CONF}",
                             re.IGNORECASE)),
-    ("twice", re.compile(rf"never\s+{_SUBJECT.format('a')}\s+twice\s+within\s+(?P<gap>.+)",
-                         re.IGNORECASE)),
-    ("never", re.compile(rf"never\s+{_SUBJECT.format('a')}", re.IGNORECASE)),
-    ("eventually", re.compile(rf"eventually\s+{_SUBJECT.format('a')}", re.IGNORECASE)),
-    ("count", re.compile(rf"count\s+{_SUBJECT.format('a')}\s*{_TARGET}", re.IGNORECASE)),
-    ("within", re.compile(rf"{_SUBJECT.format('b')}\s+within\s+(?P<gap>.+?)\s+after\s+"
-                          rf"{_SUBJECT.format('a')}", re.IGNORECASE)),
-    ("before", re.compile(rf"{_SUBJECT.format('a')}\s+before\s+{_SUBJECT.format('b')}",
-                          re.IGNORECASE)),
-    ("metric", re.compile(rf"(?P<metric>[\w]+(?:\.\w+)?)\s*{_TARGET}", re.IGNORECASE)),
 ]
-_KIND_EVENT = {"activity": EventKind.ACTIVITY_COMPLETED, "trigger": EventKind.TRIGGER_RAISED,
-               "process": EventKind.PROCESS_STARTED}
+_METRIC = re.compile(rf"(?P<metric>[\w]+(?:\.\w+)?)\s*{_TARGET}", re.IGNORECASE)
+#: the name of each trace line's form (``Expectation.form``)
+_PROPERTY_FORMS: dict[type[Property], str] = {
+    Never: "never", Eventually: "eventually", CountBound: "count", Precedence: "before",
+    BoundedResponse: "within", MinGap: "twice", MaxCount: "max_count",
+    NeverWhile: "never_while"}
 _HINT = "see the list of expectation forms in docs/spec-testing.md"
 _SLICE = 12
 
 
 @dataclass(frozen=True, slots=True)
 class Expectation:
-    """One parsed ``then`` line; :meth:`check` returns ``None`` or a failure message."""
+    """One parsed ``then`` line; :meth:`check` returns ``None`` or a failure message.
+    ``property`` is the trace property of a trace line (``None`` for metric and statistical
+    lines); ``groups`` holds the parts of the text (``gap``: a trace line's duration)."""
 
     text: str
     form: str
     groups: dict[str, str]
+    property: Property | None = None
 
     # ------------------------------------------------------------ helpers
     def _target(self) -> tuple[str, float, float | None]:
@@ -99,15 +114,17 @@ class Expectation:
         return _OPS[op](value, a)
 
     def names(self) -> list[tuple[str, str]]:
-        """(what, name) pairs this expectation refers to: metrics, activities, ..."""
+        """(what, name) pairs this expectation refers to: metrics, activities, ...; ``what``
+        is ``"name"`` for a bare name (an activity, trigger or process)."""
         g = self.groups
         out = []
         for key in ("metric", "num_m", "den_m"):
             if g.get(key):
                 out.append(("metric", g[key].split(".")[0]))
-        for prefix in ("a", "b"):
-            if g.get(f"{prefix}kind"):
-                out.append((g[f"{prefix}kind"].lower(), g[f"{prefix}name"]))
+        for selector in self.property.subjects() if self.property is not None else ():
+            if isinstance(selector, Subject):
+                for one in (selector, *selector.alternatives):
+                    out.append((one.what or "name", one.name))
         return out
 
     def check_names(self, names: SpecNames, where: str) -> None:
@@ -115,6 +132,16 @@ class Expectation:
         table = {"metric": names.metrics, "activity": names.activities,
                  "trigger": names.triggers, "process": names.processes}
         for what, name in self.names():
+            if what == "name":
+                if not any(name in known for known in (names.activities, names.triggers,
+                                                       names.processes)):
+                    raise ConfigurationError(
+                        f"{self.text!r} names {name!r}, which the spec does not have as an "
+                        "activity, trigger or process", location=_loc(where),
+                        hint="its activities are: " + ", ".join(names.activities)
+                             + "; triggers: " + (", ".join(names.triggers) or "(none)")
+                             + "; processes: " + ", ".join(names.processes))
+                continue
             if name not in table[what]:
                 known = ", ".join(table[what]) or "(none)"
                 raise ConfigurationError(
@@ -123,6 +150,10 @@ class Expectation:
 
     # ------------------------------------------------------------ checking
     def check(self, result: SimulationResult) -> str | None:
+        if self.property is not None:
+            if self.form == "count":
+                return self._check_count(result)
+            return self._check_property(result)
         return getattr(self, f"_check_{self.form}")(result)  # type: ignore[no-any-return]
 
     def _check_metric(self, result: SimulationResult) -> str | None:
@@ -137,89 +168,39 @@ class Expectation:
                  f"  {name}: {_metric_line(result.metrics[name])}"]
         return _with_slice(lines, result, _metric_events(result, name))
 
-    def _events(self, result: SimulationResult, prefix: str) -> list[list[TraceEvent]]:
-        kind = _KIND_EVENT[self.groups[f"{prefix}kind"].lower()]
-        name = self.groups[f"{prefix}name"]
-        out = []
-        for trace in result.traces:
-            out.append([e for e in trace if e.kind == kind and _named(e, name)])
-        return out
+    def _check_property(self, result: SimulationResult) -> str | None:
+        """Each replication's trace fed to the property's evaluator (the monitor's): the
+        first replication with a violation fails, showing its first violation's witness."""
+        from opspec.testing.predicates import failure_slice
 
-    def _subject(self, prefix: str) -> str:
-        return f"{self.groups[f'{prefix}kind'].lower()} {self.groups[f'{prefix}name']}"
-
-    def _check_never(self, result: SimulationResult) -> str | None:
-        for rep, events in enumerate(self._events(result, "a")):
-            if events:
-                lines = [f"expected {self.text}",
-                         f"  but {self._subject('a')} happened {len(events)} time(s)"
-                         + _in_rep(result, rep) + f", first at {_time(events[0].time)}"]
-                return _with_slice(lines, result, _around(result.traces[rep], events[0]))
-        return None
-
-    def _check_eventually(self, result: SimulationResult) -> str | None:
-        for rep, events in enumerate(self._events(result, "a")):
-            if not events:
-                trace = result.traces[rep]
-                lines = [f"expected {self.text}",
-                         f"  but {self._subject('a')} never happened" + _in_rep(result, rep)
-                         + f" (run to {_time(result.horizon or 0.0)})"]
-                return _with_slice(lines, result, list(trace[-_SLICE:]), "the trace ends with")
+        assert self.property is not None
+        prop = self.property.bind(result.names)
+        for rep, trace in enumerate(result.traces):
+            end = result.horizon if result.horizon is not None else trace_end(trace)
+            verdict = prop.judge(trace, end, replication=rep)
+            if not verdict.count:
+                continue
+            first = verdict.violations[0]
+            more = f" (the first of {verdict.count} violations)" if verdict.count > 1 else ""
+            lines = [f"expected {self.text}", f"  but {first.message}{more}"
+                     + _in_rep(result, rep)]
+            return "\n".join([*lines, *failure_slice(trace, first.events)])
         return None
 
     def _check_count(self, result: SimulationResult) -> str | None:
-        per = [len(events) for events in self._events(result, "a")]
-        total = sum(per)
-        if self._holds(float(total)):
+        """``count A OP n``: the occurrences summed over the replications (like a count
+        metric), each replication counted by the property's subject."""
+        prop = self.property
+        assert isinstance(prop, CountBound)
+        subject = prop.bind(result.names).subject
+        per = [[e for e in trace if subject.matches(e)] for trace in result.traces]
+        total = sum(len(events) for events in per)
+        if prop.allows(total):
             return None
         lines = [f"expected {self.text}", f"  but it happened {total} time(s)"
                  + (f" over {len(per)} replications" if len(per) > 1 else "")]
-        first = next((i for i, n in enumerate(per) if n), None)
-        events = self._events(result, "a")[first] if first is not None else []
-        return _with_slice(lines, result, events[:_SLICE])
-
-    def _check_before(self, result: SimulationResult) -> str | None:
-        firsts, seconds = self._events(result, "a"), self._events(result, "b")
-        for rep, (a, b) in enumerate(zip(firsts, seconds, strict=True)):
-            if b and (not a or a[0].seq > b[0].seq):
-                lines = [f"expected {self.text}",
-                         f"  but {self._subject('b')} happened at {_time(b[0].time)}"
-                         + (f", before {self._subject('a')} ({_time(a[0].time)})" if a
-                            else f" and {self._subject('a')} never did") + _in_rep(result, rep)]
-                return _with_slice(lines, result, _around(result.traces[rep], b[0]))
-        return None
-
-    def _check_within(self, result: SimulationResult) -> str | None:
-        gap = _duration(self.groups["gap"])
-        causes, effects = self._events(result, "a"), self._events(result, "b")
-        end = result.horizon if result.horizon is not None else math.inf
-        for rep, (a, b) in enumerate(zip(causes, effects, strict=True)):
-            for cause in a:
-                if cause.time + gap > end:
-                    continue   # the run ended before the window closed: not decided
-                if not any(cause.time <= e.time <= cause.time + gap and e.seq > cause.seq
-                           for e in b):
-                    lines = [f"expected {self.text}",
-                             f"  but after {self._subject('a')} at {_time(cause.time)}"
-                             f" no {self._subject('b')} followed within {_span(gap)}"
-                             + _in_rep(result, rep)]
-                    window = [e for e in result.traces[rep]
-                              if cause.time <= e.time <= cause.time + gap
-                              and e.instance == cause.instance and e.seq >= cause.seq]
-                    return _with_slice(lines, result, window[:_SLICE])
-        return None
-
-    def _check_twice(self, result: SimulationResult) -> str | None:
-        gap = _duration(self.groups["gap"])
-        for rep, events in enumerate(self._events(result, "a")):
-            for first, second in pairwise(events):
-                if second.time - first.time < gap:
-                    lines = [f"expected {self.text}",
-                             f"  but {self._subject('a')} happened at {_time(first.time)} and "
-                             f"again at {_time(second.time)}, "
-                             f"{_span(second.time - first.time)} apart" + _in_rep(result, rep)]
-                    return _with_slice(lines, result, [first, second])
-        return None
+        first = next((events for events in per if events), [])
+        return _with_slice(lines, result, first[:_SLICE])
 
     def _check_rate(self, result: SimulationResult) -> str | None:
         from opspec.testing.intervals import decide_rate
@@ -253,32 +234,42 @@ def parse_expectation(text: str, *, where: str = "<then>") -> Expectation:
         raise ConfigurationError(f"an expectation is text, not {text!r}", location=_loc(where),
                                  hint='write e.g. "doses_taken == 1"')
     cleaned = " ".join(text.split())
-    for form, pattern in _FORMS:
+    for form, pattern in _STATISTICAL:
         match = pattern.fullmatch(cleaned)
-        if match is None:
-            continue
-        groups = {k: v for k, v in match.groupdict().items() if v is not None}
-        if form in ("metric", "mean") and "." in groups.get("metric", ""):
-            _, field = groups["metric"].split(".", 1)
-            if not any(field in fields for fields in FIELDS.values()):
-                raise ConfigurationError(
-                    f"{text!r}: {field!r} is not a metric field", location=_loc(where),
-                    hint="fields: " + ", ".join(sorted({f for fs in FIELDS.values()
-                                                         for f in fs})))
-        if "conf" in groups and not 50.0 <= float(groups["conf"]) < 100.0:
-            raise ConfigurationError(f"{text!r}: the confidence must be at least 50% and "
-                                     "below 100%", location=_loc(where))
-        if "gap" in groups:
-            try:
-                _duration(groups["gap"])
-            except ConfigurationError as error:
-                raise ConfigurationError(f"{text!r}: {error.message}", location=_loc(where),
-                                         hint=error.hint) from None
-        if "lo" in groups and float(groups["lo"]) > float(groups["hi"]):
-            raise ConfigurationError(f"{text!r}: the interval is empty", location=_loc(where))
-        return Expectation(cleaned, form, groups)
+        if match is not None:
+            return _checked(text, form, match, where)
+    metric = _METRIC.fullmatch(cleaned)
+    if looks_like_property(cleaned):
+        try:
+            prop, gap = read_property(cleaned, what="expectation", location=_loc(where))
+        except ConfigurationError:
+            if metric is None:      # a metric named like a keyword ('count == 3') is one
+                raise
+        else:
+            groups = {"gap": gap} if gap is not None else {}
+            return Expectation(cleaned, _PROPERTY_FORMS[type(prop)], groups, prop)
+    if metric is not None:
+        return _checked(text, "metric", metric, where)
     raise ConfigurationError(f"cannot read the expectation {text!r}", location=_loc(where),
                              hint=_HINT)
+
+
+def _checked(text: str, form: str, match: re.Match[str], where: str) -> Expectation:
+    cleaned = " ".join(text.split())
+    groups = {k: v for k, v in match.groupdict().items() if v is not None}
+    if form in ("metric", "mean") and "." in groups.get("metric", ""):
+        _, field = groups["metric"].split(".", 1)
+        if not any(field in fields for fields in FIELDS.values()):
+            raise ConfigurationError(
+                f"{text!r}: {field!r} is not a metric field", location=_loc(where),
+                hint="fields: " + ", ".join(sorted({f for fs in FIELDS.values()
+                                                     for f in fs})))
+    if "conf" in groups and not 50.0 <= float(groups["conf"]) < 100.0:
+        raise ConfigurationError(f"{text!r}: the confidence must be at least 50% and "
+                                 "below 100%", location=_loc(where))
+    if "lo" in groups and float(groups["lo"]) > float(groups["hi"]):
+        raise ConfigurationError(f"{text!r}: the interval is empty", location=_loc(where))
+    return Expectation(cleaned, form, groups)
 
 
 # ---------------------------------------------------------------- formatting
@@ -293,14 +284,6 @@ def _duration(text: str) -> float:
     return parse_duration(text, error=ConfigurationError)
 
 
-def _named(event: TraceEvent, name: str) -> bool:
-    if event.kind == EventKind.TRIGGER_RAISED:
-        return event.data.get("name") == name
-    if event.kind == EventKind.PROCESS_STARTED:
-        return event.process == name
-    return event.activity == name
-
-
 def _fmt(value: float | None) -> str:
     return "undefined (no samples)" if value is None else f"{value:g}"
 
@@ -312,14 +295,6 @@ def _metric_line(values: dict[str, object]) -> str:
 
 def _time(seconds: float) -> str:
     return clock(seconds)
-
-
-def _span(seconds: float) -> str:
-    if seconds >= 3600:
-        return f"{seconds / 3600:g} h"
-    if seconds >= 60:
-        return f"{seconds / 60:g} min"
-    return f"{seconds:g} s"
 
 
 def _in_rep(result: SimulationResult, rep: int) -> str:
@@ -350,12 +325,6 @@ def _with_slice(lines: list[str], result: SimulationResult, events: Sequence[Tra
         title = title or f"trace ({len(events)} relevant event(s))"
         lines = [*lines, f"  {title}:", *format_events(events)]
     return "\n".join(lines)
-
-
-def _around(trace: Sequence[TraceEvent], event: TraceEvent) -> list[TraceEvent]:
-    """The events of ``event``'s instance up to it, plus the few just before it."""
-    same = [e for e in trace if e.instance == event.instance and e.seq <= event.seq]
-    return same[-_SLICE:]
 
 
 def _metric_events(result: SimulationResult, name: str) -> list[TraceEvent]:

@@ -120,6 +120,11 @@ class Predicate:
         """Events showing why the predicate holds (for a failing ``~p``)."""
         return ()
 
+    def bind(self, names: Any) -> Predicate:
+        """This predicate with its bare names resolved against the spec's (an activity, then
+        a trigger, then a process), as a monitor's are."""
+        return self
+
     def __repr__(self) -> str:
         return self.describe()
 
@@ -147,6 +152,12 @@ class Match(Predicate):
         self.text = text
         self.subject = subject
         self.process = process
+
+    def bind(self, names: Any) -> Match:
+        if self.subject is not None and self._test == self.subject.matches:   # a name
+            bound = self.subject.bind(names)
+            return Match(bound.matches, self.text, bound, self.process)
+        return self
 
     def __call__(self, event: TraceEvent) -> bool:
         return self._test(event)
@@ -291,6 +302,11 @@ class _Holds(Predicate):
 
     def witness(self, events: Sequence[TraceEvent]) -> tuple[TraceEvent, ...]:
         return self.judge(events, trace_end(events)).evidence()
+
+    def bind(self, names: Any) -> Predicate:
+        return _Holds(self.property._with([s.bind(names) if isinstance(s, (Subject, Match))
+                                           else s for s in self.property.subjects()]),
+                      self.label)
 
     def __invert__(self) -> Predicate:
         prop = self.property
@@ -440,6 +456,9 @@ class _All(Predicate):
     def witness(self, events: Sequence[TraceEvent]) -> tuple[TraceEvent, ...]:
         return tuple(e for p in self.parts for e in p.witness(events))[:4]
 
+    def bind(self, names: Any) -> Predicate:
+        return type(self)(tuple(p.bind(names) for p in self.parts))
+
 
 class _Any(_All):
     def __init__(self, parts: tuple[Predicate, ...]) -> None:
@@ -486,6 +505,9 @@ class _Not(Predicate):
     def __invert__(self) -> Predicate:
         return self.inner
 
+    def bind(self, names: Any) -> Predicate:
+        return _Not(self.inner.bind(names))
+
 
 def _paren(p: Predicate) -> str:
     text = p.describe()
@@ -498,6 +520,9 @@ class _PerInstance(Predicate):
 
     def describe(self) -> str:
         return f"per_instance({self.process!r}, {self.inner.describe()})"
+
+    def bind(self, names: Any) -> Predicate:
+        return _PerInstance(self.process, self.inner.bind(names))
 
     def subjects(self) -> tuple[Subject, ...]:
         return self.inner.subjects()
@@ -590,6 +615,7 @@ def failures(obj: Any, predicate: Predicate | str | Match, *, spec: Any = None,
     names = _names(obj, spec)
     if names is not None:
         check_names(predicate, names)
+        predicate = predicate.bind(names)
     out = []
     for run in _runs(obj):
         failure = predicate.fail(run.events, run.end)

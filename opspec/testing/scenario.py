@@ -38,7 +38,6 @@ __all__ = ["Scenario", "ScenarioDocument", "load_scenarios", "run_scenario"]
 
 _TOP = ("spec", "given", "scenario", "description")
 _SCENARIO = ("name", "given", "then", "description")
-_TRACE_FORMS = frozenset({"never", "eventually", "count", "before", "within", "twice"})
 _GIVEN = ("script", "user_model", "users", "days", "until", "seed", "engine", "params")
 
 
@@ -252,7 +251,7 @@ def run_scenario(scenario: Scenario, spec: Any, *, seed: int = 0) -> list[str]:
     message per expectation that does not hold (empty when all do)."""
     from opspec.testing.simulation import simulate
 
-    needs_trace = any(e.form in _TRACE_FORMS for e in scenario.expectations)
+    needs_trace = any(e.property is not None for e in scenario.expectations)   # trace lines
     result = simulate(spec, users=scenario.users, days=scenario.days, until=scenario.until,
                       script=scenario.script, user_model=scenario.user_model,
                       seed=scenario.seed if scenario.seed is not None else seed,

@@ -45,7 +45,7 @@ def test_a_failing_scenario_shows_the_expectation_the_values_and_a_trace_slice(
         "  but alarms = 3",
         "*day 1 08:10:00.0*sound_alarm",
         "*dispenser.scenario.toml: scenario[1].then[1]: expected eventually activity dispense",
-        "  but activity dispense never happened (run to day 1 09:00:00.0)",
+        "  but activity dispense never happened (the run went to day 1 09:00:00.0)",
         "  the trace ends with:",
         "(seed *; 1 replication(s))"]])
     assert "Traceback" not in result.stdout.str()
