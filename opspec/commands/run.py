@@ -170,7 +170,8 @@ def run(args: argparse.Namespace) -> int:
                                        "note": _absent_note(absent, args.no_user)}
         if monitors:
             doc["monitors"] = {text: {"violations": r.count, "first": [
-                {"time": v.time, "message": v.message} for v in r.violations[:MONITOR_SHOWN]]}
+                {"time": v.time, "message": v.message, "events": [e.seq for e in v.events]}
+                for v in r.violations[:MONITOR_SHOWN]]}
                 for text, r in monitors.items()}
         if timing_summary is not None:
             doc["timing"] = timing_summary

@@ -8,7 +8,7 @@ Each line is one of (keywords in any case; ``OP`` is ``==``, ``!=``, ``<``, ``<=
     alarms_per_dose in [1, 1.5]               a closed interval
     never activity notify_caregiver           no completion of it in any replication
     eventually activity record_taken          a completion in every replication
-    count activity sound_alarm == 3           completions, summed over replications
+    count activity sound_alarm == 3           completions, in every replication
     activity press_report before activity dispense     no dispense before the first report
     activity dispense within 300s after activity sound_alarm
     never activity dispense twice within 4h   no two completions closer than that
@@ -20,8 +20,8 @@ The trace lines are the property language of monitors (:mod:`opspec.engine.prope
 any monitor's text is a ``then`` line too (``min_gap dispense 4h``, ``bounded_response
 sound_alarm dispense 15min``, ``never_while ...``), judged on each replication's trace by the
 evaluator a monitor runs online (same verdict, same witness), and holding when it holds in
-every replication - except ``count``, which sums over the replications like the metric
-lines. ``activity X`` may also be ``trigger X`` (a message or signal raised), ``process X``
+every replication (``count`` too: a total over all replications is a count metric's line,
+``alarms == 12``). ``activity X`` may also be ``trigger X`` (a message or signal raised), ``process X``
 (an instance started) or a bare name. Metric comparisons use the metrics pooled over all
 replications; ``==`` allows a relative error of 1e-9. The statistical lines are decided by
 :mod:`opspec.testing.intervals`: they pass when the one-sided bound at that confidence is on
@@ -151,8 +151,6 @@ class Expectation:
     # ------------------------------------------------------------ checking
     def check(self, result: SimulationResult) -> str | None:
         if self.property is not None:
-            if self.form == "count":
-                return self._check_count(result)
             return self._check_property(result)
         return getattr(self, f"_check_{self.form}")(result)  # type: ignore[no-any-return]
 
@@ -186,21 +184,6 @@ class Expectation:
                      + _in_rep(result, rep)]
             return "\n".join([*lines, *failure_slice(trace, first.events)])
         return None
-
-    def _check_count(self, result: SimulationResult) -> str | None:
-        """``count A OP n``: the occurrences summed over the replications (like a count
-        metric), each replication counted by the property's subject."""
-        prop = self.property
-        assert isinstance(prop, CountBound)
-        subject = prop.bind(result.names).subject
-        per = [[e for e in trace if subject.matches(e)] for trace in result.traces]
-        total = sum(len(events) for events in per)
-        if prop.allows(total):
-            return None
-        lines = [f"expected {self.text}", f"  but it happened {total} time(s)"
-                 + (f" over {len(per)} replications" if len(per) > 1 else "")]
-        first = next((events for events in per if events), [])
-        return _with_slice(lines, result, first[:_SLICE])
 
     def _check_rate(self, result: SimulationResult) -> str | None:
         from opspec.testing.intervals import decide_rate

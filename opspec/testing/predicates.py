@@ -321,7 +321,7 @@ def eventually(what: str | Match | Predicate | Callable[[TraceEvent], bool]) -> 
     """``what`` happens at least once (a predicate is returned as it is)."""
     if isinstance(what, Predicate) and not isinstance(what, Match):
         return what
-    match = _as_match(what)  # type: ignore[arg-type]
+    match = _as_match(what)
     return _Holds(Eventually(match), f"eventually({match.describe()})")
 
 
@@ -329,7 +329,7 @@ def never(what: str | Match | Predicate | Callable[[TraceEvent], bool]) -> Predi
     """``what`` never happens (for a predicate: it does not hold, i.e. ``~what``)."""
     if isinstance(what, Predicate) and not isinstance(what, Match):
         return _Not(what)
-    match = _as_match(what)  # type: ignore[arg-type]
+    match = _as_match(what)
     return _Holds(Never(match), f"never({match.describe()})")
 
 
@@ -573,7 +573,7 @@ def _runs(obj: Any) -> list[_Run]:
     if isinstance(obj, (str, os.PathLike)):               # a stored trace (opspec run --trace)
         from opspec.engine.trace_sinks import read_trace
 
-        events = list(read_trace(obj))
+        events = list(read_trace(os.fspath(obj)))
         return [_Run("", events, trace_end(events))]
     if isinstance(obj, Sequence) and all(isinstance(e, TraceEvent) for e in obj):
         return [_Run("", obj, trace_end(obj))]
@@ -591,8 +591,10 @@ def _names(obj: Any, spec: Any) -> Any:
     if hasattr(spec, "activities") and hasattr(spec, "triggers"):
         return spec
     from opspec.engine.compiled import CompiledPackage, compile_package
-    from opspec.testing.simulation import spec_names
+    from opspec.testing.simulation import load_spec_file, spec_names
 
+    if isinstance(spec, (str, os.PathLike)):
+        spec = load_spec_file(os.fspath(spec))
     compiled = spec if isinstance(spec, CompiledPackage) else compile_package(spec)
     return spec_names(compiled)
 
