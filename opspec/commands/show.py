@@ -136,7 +136,7 @@ def describe_package(package: Package, *, process: str | None = None) -> str:
     """The ``text`` format: a compact, indented description of ``package``."""
     out: list[str] = []
     title = f"Package {package.id!r}" + (f" {package.name!r}" if package.name else "")
-    out.append(f"{title}  (XPDL {package.version.value}"
+    out.append(f"{title}  ({package.source_format}"
                + (f", {package.source}" if package.source else "") + ")")
     header = package.header
     facts = [f"vendor {header.vendor}" if header.vendor else "",

@@ -339,7 +339,7 @@ class RefChecks:
                 place, "undefined-data-field",
                 f"{what} sets {target!r}, which is not a data field or formal parameter of "
                 f"{where(process, None)} nor a data field of package {self.package.id!r}",
-                f"declare a DataField {target!r} or fix the assignment's target")
+                self._declare_hint(target, "or fix the assignment's target"))
         self._names(process, aset, place, assignment.expression, what)
 
     def _names(self, process: WorkflowProcess, aset: ActivitySet | None,
@@ -358,11 +358,20 @@ class RefChecks:
             hint = (f"{name!r} is the Name of data field {named[0]!r}; expressions use Ids: "
                     f"write {named[0]!r} (or give the field the Id {name!r})")
         else:
-            hint = f"declare a DataField {name!r} or fix the name"
+            hint = self._declare_hint(name, "or fix the name")
         self.report.error(
             location or process.location, "undefined-data-field",
             f"{what} reads {name!r}, which is not a data field or formal parameter of "
             f"{where(process, None)} nor a data field of package {self.package.id!r}", hint)
+
+    def _declare_hint(self, name: str, tail: str) -> str:
+        """How to declare ``name`` in the notation the spec was written in."""
+        if (self.package.header.source_format or "").startswith("BPMN"):
+            return (f"declare it: a bpmn:dataObject or bpmn:property with id {name!r}, a "
+                    "camunda:formField of a user task or start event, a camunda:inputOutput "
+                    f"parameter, or an opspec:DataField; or set it in a script task, {tail} "
+                    "(docs/bpmn.md, Data)")
+        return f"declare a DataField {name!r} {tail}"
 
 
 def _is_performer(data_type: object) -> bool:

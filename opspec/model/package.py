@@ -30,6 +30,11 @@ class XpdlVersion(enum.Enum):
 
 @dataclass(frozen=True, slots=True, kw_only=True)
 class PackageHeader:
+    """The package's header. ``source_format`` names what the file was written in when it
+    is not XPDL (``"BPMN 2.0"``: the model is then XPDL 2.1's reading of it, and
+    :attr:`Package.version` stays 2.1); ``None`` for XPDL, whose version is
+    :attr:`Package.version`."""
+
     xpdl_version: str | None = None
     vendor: str | None = None
     created: str | None = None
@@ -38,6 +43,7 @@ class PackageHeader:
     documentation: str | None = None
     cost_unit: str | None = None
     priority_unit: str | None = None
+    source_format: str | None = None
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
@@ -64,6 +70,11 @@ class Package(Element):
     metrics: tuple[MetricDefinition, ...] = ()
     modes: tuple[WorkflowMode, ...] = ()
     run_length: float | None = None            # opspec:RunLength: one run's natural length, s
+
+    @property
+    def source_format(self) -> str:
+        """What the file was written in: ``"XPDL 2.1"``, ``"BPMN 2.0"``…"""
+        return self.header.source_format or f"XPDL {self.version.value}"
 
     def process(self, process_id: str) -> WorkflowProcess | None:
         for process in self.processes:

@@ -48,7 +48,8 @@ class FileReport:
     """The outcome of validating one file.
 
     ``version`` is the XPDL version read from the root namespace (``"1.0"``, ``"2.1"``,
-    ``"none"``…) or ``None`` when no package could be built. ``diagnostics`` may include
+    ``"none"``…), ``"BPMN 2.0"`` for a BPMN file, or ``None`` when no package could be
+    built. ``diagnostics`` may include
     problems of other files the package refers to (each carries its own path).
     """
 
@@ -213,7 +214,8 @@ def validate_spec(path: str | Path, *, strict: bool = False,
     checks: list[Diagnostic] = []
     version = None
     if result.package is not None:
-        version = result.package.version.value
+        # a BPMN file is reported as such ("BPMN 2.0"), not as the XPDL version of its model
+        version = result.package.header.source_format or result.package.version.value
         checks = list(check_package(result.package, packages=result.packages))
         checks.extend(mode_source_diagnostics(result.package, max_bytes=max_bytes))
         checks.extend(preprocessed_mode_diagnostics(result.package))

@@ -11,6 +11,7 @@ from typing import Final
 from lxml import etree
 
 from opspec.errors import Severity, SourceLocation
+from opspec.model.data import BasicKind, ParameterMode
 from opspec.xpdl.handlers.common import BuildContext
 from opspec.xpdl.namespaces import OPSPEC
 
@@ -114,6 +115,8 @@ class Defs:
     else id); ``human`` holds the ids of resources some ``humanPerformer`` or
     ``potentialOwner`` names. ``sends``/``receives`` map a flow node id to the message a
     message flow from/to it carries; ``pool_of`` maps a process id to its pool's participant.
+    ``item_kinds`` maps an itemDefinition's id to the basic type of its ``structureRef``;
+    ``process_io`` a process id to its ``ioSpecification``'s inputs (IN) and outputs (OUT).
     """
 
     ctx: BuildContext
@@ -129,6 +132,8 @@ class Defs:
     pool_of: dict[str, tuple[str, str | None]] = field(default_factory=dict)
     user_participant: bool = False       # some user/manual task falls back on "user"
     package_fields: set[str] = field(default_factory=set)
+    item_kinds: dict[str, BasicKind] = field(default_factory=dict)
+    process_io: dict[str, list[tuple[str, ParameterMode]]] = field(default_factory=dict)
 
     def info(self, element: etree._Element | None, code: str, message: str,
              hint: str = "") -> None:

@@ -13,7 +13,6 @@ from opspec.errors import SpecError
 from opspec.model.activities import Trigger, TriggerKind
 from opspec.model.expressions import Expression, Literal
 from opspec.xpdl.bpmn.common import Defs, bpmn_children, expression_text, first, local
-from opspec.xpdl.handlers.events import parse_condition_element
 
 __all__ = ["KINDS", "Timer", "definitions_of", "named_ref", "read_timer", "trigger_of"]
 
@@ -183,8 +182,10 @@ def trigger_of(event: etree._Element, defs: Defs, *, catching: bool,
     elif kind is TriggerKind.RULE:
         condition = first(definition, "condition")
         text = expression_text(condition)
-        common["condition"] = parse_condition_element(
-            condition if condition is not None else definition, text, defs.ctx,
+        from opspec.xpdl.bpmn.scripts import bpmn_condition
+
+        common["condition"] = bpmn_condition(
+            condition if condition is not None else definition, text, defs,
             "event condition")
         if text is None:
             defs.ctx.error(definition, "bad-condition", "the conditional event has no "

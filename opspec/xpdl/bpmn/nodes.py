@@ -123,30 +123,17 @@ def _task(kind: TaskKind | None) -> Callable[[etree._Element, Defs], Built]:
 
 def _script(element: etree._Element, defs: Defs, applications: tuple[object, ...]) -> Built:
     """A script task: its script runs as assignments when it is written in the subset of
-    :mod:`opspec.xpdl.scripts` (one assignment per line or per ``;``); otherwise a
-    ``script-not-run`` warning, and the task runs without changing data."""
-    from opspec.errors import SpecError
-    from opspec.xpdl.scripts import parse_script
+    :mod:`.scripts` (assignments, one per line or per ``;``, Python tuple assignments);
+    anything else is a ``bad-script`` error at the statement's line."""
+    from opspec.xpdl.bpmn.scripts import read_script
 
     script_element = first(element, "script")
     text = text_of(script_element)
     body = Task(kind=TaskKind.SCRIPT, script=text,
                 applications=applications)  # type: ignore[arg-type]
-    if text is None:
+    if text is None or script_element is None:
         return Built(body)
-    lines = [line.strip() for line in text.splitlines() if line.strip()]
-    joined = "; ".join(line.rstrip(";") for line in lines)
-    try:
-        statements = parse_script(joined, location=defs.loc(script_element))
-    except (SpecError, ValueError, RecursionError) as error:
-        reason = getattr(error, "problem", None) or getattr(error, "message", str(error))
-        defs.ctx.warning(script_element, "script-not-run",
-                         f"the script of {_label(element)} is not one opspec runs ({reason}); "
-                         "the task runs without changing any data",
-                         "opspec runs scripts made of assignments (x = expression, one per line "
-                         "or separated by ;) over data fields; set data with them, or with "
-                         "opspec:Assignment elements (docs/bpmn.md)")
-        return Built(body)
+    statements, _ok = read_script(script_element, defs, _label(element))
     return Built(body, assignments=statements)
 
 
@@ -156,8 +143,18 @@ def _call(element: etree._Element, defs: Defs) -> Built:
         defs.ctx.error(element, "missing-subflow-target",
                        f"{_label(element)} has no calledElement, so it calls nothing",
                        "set calledElement to the id of the process to call")
+    actuals = actual_parameters(element, defs)
+    if not actuals and defs.process_io.get(called):
+        # BPMN engines copy a called process's inputs and outputs by name (the called
+        # process's ioSpecification): the caller's data field of the same id
+        from opspec.model.data import ActualParameter
+        from opspec.model.expressions import Name
+
+        location = defs.loc(element)
+        actuals = tuple(ActualParameter(text=name, expression=Name((name,)), location=location)
+                        for name, _mode in defs.process_io[called])
     return Built(SubFlow(process=called, execution=execution(element, defs),
-                         actual_parameters=actual_parameters(element, defs)))
+                         actual_parameters=actuals))
 
 
 def _receive(element: etree._Element, defs: Defs) -> Built:

@@ -24,13 +24,17 @@ from opspec.xpdl.bpmn.common import (
     tag,
     text_of,
 )
+from opspec.xpdl.bpmn.data import CAMUNDA, index_data
 from opspec.xpdl.bpmn.extensions import application, data_field, directives, opspec_named
 from opspec.xpdl.bpmn.process import BuiltProcess, build_process, is_user_name
 from opspec.xpdl.handlers.common import BuildContext
 from opspec.xpdl.namespaces import OPSPEC
 from opspec.xpdl.sisarl import PACKAGE_DIRECTIVES, package_extensions
 
-__all__ = ["build_definitions"]
+__all__ = ["BPMN_FORMAT", "build_definitions"]
+
+#: What ``validate`` and ``show`` report a BPMN file as (the model stays XPDL 2.1's reading).
+BPMN_FORMAT = "BPMN 2.0"
 
 # Root children read elsewhere or harmless: no diagnostic.
 _ROOT_QUIET = frozenset({
@@ -92,18 +96,28 @@ def _index(root: etree._Element, defs: Defs) -> None:
 
 def _vendor_extensions(root: etree._Element, defs: Defs) -> None:
     """One ``vendor-extension`` note per foreign namespace in extensionElements (Camunda,
-    Zeebe, Signavio, SpiffWorkflow…): kept in the file, not run."""
+    Zeebe, Signavio, SpiffWorkflow…): kept in the file, not run — except Camunda's form
+    fields and input/output parameters, which are the process's data (:mod:`.data`)."""
     first_seen: dict[str, etree._Element] = {}
     for extensions in root.iter(tag("extensionElements")):
         for sub in extensions:
-            if isinstance(sub.tag, str) and namespace(sub) not in (OPSPEC, BPMN):
-                first_seen.setdefault(namespace(sub), sub)
+            if not isinstance(sub.tag, str) or namespace(sub) in (OPSPEC, BPMN):
+                continue
+            if namespace(sub) == CAMUNDA and local(sub) in _CAMUNDA_READ:
+                continue
+            first_seen.setdefault(namespace(sub), sub)
     for space, element in first_seen.items():
         shown = f"{element.prefix}:{local(element)}" if element.prefix else local(element)
+        read = (" (camunda:formData and camunda:inputOutput are read as data)"
+                if space == CAMUNDA else "")
         defs.info(element, "vendor-extension",
-                  f"extension elements of {space} (first <{shown}>) are not run: opspec runs "
-                  "the BPMN elements and its own opspec: extensions",
+                  f"extension elements of {space} (first <{shown}>) are not run{read}: opspec "
+                  "runs the BPMN elements and its own opspec: extensions",
                   "docs/bpmn.md says how to write what opspec should run")
+
+
+# Camunda extension elements opspec reads (the data of the process).
+_CAMUNDA_READ = frozenset({"formData", "inputOutput"})
 
 
 def _collaboration(root: etree._Element, defs: Defs) -> list[tuple[str, str | None, str | None,
@@ -175,6 +189,7 @@ def build_definitions(root: etree._Element, ctx: BuildContext) -> Package:
         _modernise(root)
     defs = Defs(ctx)
     _index(root, defs)
+    index_data(root, defs)
     _vendor_extensions(root, defs)
     for sub in root:
         if not isinstance(sub.tag, str):
@@ -237,7 +252,7 @@ def build_definitions(root: etree._Element, ctx: BuildContext) -> Package:
         source=ctx.path,
         header=PackageHeader(vendor=" ".join(x for x in (root.get("exporter"),
                                                         root.get("exporterVersion")) if x)
-                             or None),
+                             or None, source_format=BPMN_FORMAT),
         participants=tuple(participants),
         applications=applications,
         data_fields=package_fields,

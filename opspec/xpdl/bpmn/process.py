@@ -36,6 +36,8 @@ from opspec.model.activities import (
     Loop,
     LoopKind,
     MIFlow,
+    Mode,
+    NoImplementation,
     Split,
     Task,
     TaskKind,
@@ -55,6 +57,7 @@ from opspec.xpdl.bpmn.common import (
     namespace,
     text_of,
 )
+from opspec.xpdl.bpmn.data import activity_data, process_fields
 from opspec.xpdl.bpmn.events import definitions_of, read_timer, trigger_of
 from opspec.xpdl.bpmn.extensions import (
     assignments,
@@ -64,8 +67,8 @@ from opspec.xpdl.bpmn.extensions import (
     opspec_named,
 )
 from opspec.xpdl.bpmn.nodes import NODES, build_node
+from opspec.xpdl.bpmn.scripts import bpmn_condition
 from opspec.xpdl.handlers.common import parse_int
-from opspec.xpdl.handlers.events import parse_condition_element
 from opspec.xpdl.sisarl import (
     ACTIVITY_DIRECTIVES,
     PROCESS_DIRECTIVES,
@@ -127,6 +130,8 @@ class _Process:
         self.lanes = tuple(lane for lane_set in kids(element, "laneSet")
                            for lane in self._lane_set(lane_set))
         self.lane_names: dict[str, str | None] = {}
+        self.created: dict[str, DataField] = {}      # fields forms, outputs, parameters add
+        self.reads: list[tuple[str, etree._Element, str]] = []
         for lane in self._all(self.lanes):
             self.lane_names[lane.id] = lane.name
 
@@ -308,7 +313,7 @@ class _Process:
             return Condition(kind=ConditionKind.OTHERWISE)
         if text is None:
             return Condition()
-        parsed = parse_condition_element(expression_element, text, self.ctx,
+        parsed = bpmn_condition(expression_element, text, self.defs,
                                          f"condition of sequence flow {flow.get('id')!r}")
         return Condition(kind=ConditionKind.CONDITION, text=text, expression=parsed)
 
@@ -414,14 +419,27 @@ class _Process:
                                  _ACTIVITY_STRUCTURE)
         self.message_directives(element, found, sends, built_body)
         directive_values, coordination = activity_directives(element, self.ctx, found)
+        data = activity_data(element, self.defs, self.label(element))
+        for created in data.fields:
+            self.created.setdefault(created.id, created)
+        self.reads.extend((name, where, self.label(element)) for name, where in data.reads)
+        start_mode = Mode.AUTOMATIC
+        if name == "task" and isinstance(built_body, NoImplementation) and data.writes:
+            # SpiffWorkflow's plain task waits for someone; one whose outputs nothing in the
+            # file computes must: its performer supplies them when completing it
+            manual, start_mode = True, Mode.MANUAL
+            self.defs.info(element, "task-supplies-data",
+                           f"{self.label(element)} writes {', '.join(data.writes)}, which "
+                           "nothing in the file computes: it waits for its performer, whose "
+                           "completion supplies the value", "docs/bpmn.md, Data")
         join = split = None
         if gateway is not None:
             join_condition = None
             join_text = None
             if gateway is GatewayType.COMPLEX:
                 join_text = expression_text(first(element, "activationCondition"))
-                join_condition = parse_condition_element(
-                    first(element, "activationCondition"), join_text, self.ctx,
+                join_condition = bpmn_condition(
+                    first(element, "activationCondition"), join_text, self.defs,
                     "activationCondition")
             if incoming.get(node_id, 0) > 1:
                 join_type = GatewayType.XOR if gateway is GatewayType.EVENT else gateway
@@ -438,10 +456,11 @@ class _Process:
             description=text_of(first(element, "documentation")),
             extended_attributes=kept, location=self.defs.loc(element), body=built_body,
             performers=self.performers(element, lane, manual), lane=lane,
+            start_mode=start_mode,
             deadlines=tuple(boundary.deadlines.get(node_id, ())),
             loop=self.loop(element), join=join, split=split,
             directives=directive_values, coordination=coordination,
-            assignments=assignments(element, self.defs) + extra)
+            assignments=assignments(element, self.defs) + extra + tuple(data.assignments))
 
     @staticmethod
     def order(element: etree._Element, flows: list[str]) -> tuple[str, ...]:
@@ -491,8 +510,8 @@ class _Process:
             id=set_id, name=element.get("name"), activities=activities, transitions=transitions,
             ad_hoc=ad_hoc, ad_hoc_sequential=ad_hoc and ordering == "sequential",
             completion_condition_text=completion_text,
-            completion_condition=parse_condition_element(
-                first(element, "completionCondition"), completion_text, self.ctx,
+            completion_condition=bpmn_condition(
+                first(element, "completionCondition"), completion_text, self.defs,
                 "completionCondition"),
             location=self.defs.loc(element)))
         return BlockActivity(activity_set=set_id)
@@ -510,7 +529,7 @@ class _Process:
                                "add <bpmn:loopCondition> (the activity repeats while it holds) "
                                "or loopMaximum=\"N\"")
             return Loop(kind=LoopKind.STANDARD, condition_text=text,
-                        condition=parse_condition_element(condition_element, text, self.ctx,
+                        condition=bpmn_condition(condition_element, text, self.defs,
                                                           "loopCondition"),
                         maximum=maximum,
                         test_before=(standard.get("testBefore") or "").lower() == "true")
@@ -534,8 +553,8 @@ class _Process:
                     parallel=(multi.get("isSequential") or "false").lower() != "true",
                     flow=MIFlow.COMPLEX if completion_text else MIFlow.ALL,
                     flow_condition_text=completion_text,
-                    flow_condition=parse_condition_element(completion, completion_text,
-                                                           self.ctx, "completionCondition"))
+                    flow_condition=bpmn_condition(completion, completion_text, self.defs,
+                                                  "completionCondition"))
 
     def expression(self, element: etree._Element, text: str | None, what: str
                    ) -> Expression | None:
@@ -557,14 +576,16 @@ class _Process:
         found, kept = directives(element, self.defs, PROCESS_DIRECTIVES,
                                  f"process {self.id!r}", ("DataField", "FormalParameter"))
         fields = [data_field(sub, self.defs) for sub in opspec_named(element, "DataField")]
-        for name in ("dataObject", "property"):
-            for sub in kids(element, name):
-                fields.append(DataField(id=sub.get("id") or "", name=sub.get("name"),
-                                        type=BasicType(kind=BasicKind.STRING),
-                                        location=self.defs.loc(sub)))
+        bpmn_fields, bpmn_formals = process_fields(element, self.defs)
+        given = {f.id for f in fields}
+        fields.extend(f for f in bpmn_fields if f.id not in given)
         formals = tuple(formal_parameter(sub, self.defs)
                         for sub in opspec_named(element, "FormalParameter"))
+        given = {f.id for f in formals}
+        formals += tuple(f for f in bpmn_formals if f.id not in given)
         activities, transitions = self.level(element, None)
+        declared = {f.id for f in (*fields, *formals)} | self.defs.package_fields
+        fields.extend(f for name, f in self.created.items() if name not in declared)
         process = WorkflowProcess(
             id=self.id, name=element.get("name"),
             description=text_of(first(element, "documentation")),
@@ -572,7 +593,23 @@ class _Process:
             access_level="PUBLIC", data_fields=tuple(fields), formal_parameters=formals,
             activities=activities, transitions=transitions, activity_sets=tuple(self.sets),
             directives=process_directives(element, self.ctx, found))
-        return BuiltProcess(_with_script_fields(process, element, self.defs), self.lanes)
+        process = _with_script_fields(process, element, self.defs)
+        self.check_reads(process)
+        return BuiltProcess(process, self.lanes)
+
+    def check_reads(self, process: WorkflowProcess) -> None:
+        """A task's ``dataInput`` without an association takes the process's variable of its
+        name (as SpiffWorkflow does): something must declare or set it."""
+        known = {f.id for f in (*process.data_fields, *process.formal_parameters)}
+        known |= self.defs.package_fields
+        for name, where, label in self.reads:
+            if name not in known:
+                self.ctx.error(where, "undefined-data-field",
+                               f"{label} takes its dataInput {name!r} from the process, but "
+                               f"nothing in process {self.id!r} declares or sets {name!r}",
+                               "declare a bpmn:dataObject or bpmn:property with that id, set it "
+                               "in a script task or a form field, or feed the input with a "
+                               "bpmn:dataInputAssociation")
 
 
 def _literal_kind(expression: Expression | None) -> BasicKind:
