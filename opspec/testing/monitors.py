@@ -14,8 +14,11 @@ them in every run as well::
 
     <ExtendedAttribute Name="opspec:Monitor" Value="min_gap dispense 4h"/>
 
-The listener classes and the text form live in :mod:`opspec.engine.monitors` (usable by any
-layer); this module adds the constructors tests use and the report.
+A monitor is a property of the one property language (:mod:`opspec.engine.properties`, usable
+by any layer): its text is also a trace predicate (``holds(result, "min_gap dispense 4h")``)
+and a scenario ``then`` line, judged on stored traces by the same evaluator, and a monitor
+object is a predicate too (``check(result, min_gap("dispense", hours=4))``). This module adds
+the constructors tests use and the report.
 """
 
 from __future__ import annotations

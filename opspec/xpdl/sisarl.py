@@ -64,6 +64,8 @@ PROCESS_DIRECTIVES = ("Period", "Rate", "Priority", "Deadline", "Latency", "Star
 ACTIVITY_DIRECTIVES = ("AutoRun", "PriorityIncrement", "StartTrigger", "EndTrigger", "Raises",
                        "CpuDemand", "Duration", "BuiltIn")
 PACKAGE_DIRECTIVES = ("Metrics", "Modes", "Monitor", "World", "WorldFile", "RunLength")
+#: directives that may be given more than once, every one counting (one monitor per attribute)
+REPEATABLE = frozenset({"Monitor"})
 
 #: Most attributes one Package, WorkflowProcess or Activity element may carry (XPDL defines
 #: fewer than twenty); more is a damaged or hostile file, reported as ``too-many-attributes``.
@@ -81,7 +83,7 @@ def collect(element: etree._Element, ctx: BuildContext, known: tuple[str, ...],
                                    f"unknown directive opspec:{directive.name} on {what}",
                                    _unknown_hint(directive.name, known, what)))
             return
-        if directive.name in found:
+        if directive.name in found and directive.name not in REPEATABLE:
             ctx.diagnostics.append(_diag(directive.location, "warning", "duplicate-directive",
                                    f"opspec:{directive.name} is given twice on {what}; the "
                                    "last one counts", "remove one of them"))

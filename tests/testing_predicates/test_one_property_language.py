@@ -377,3 +377,22 @@ def test_a_stored_trace_is_judged_by_its_path(tmp_path: Path) -> None:
     with pytest.raises(AssertionError, match=r"(?s)notify_caregiver happened at day 1 "
                                              r"08:15:00.0.*>.*activity.completed +notify_caregiver"):
         check(trace, "never notify_caregiver")
+
+
+def test_several_monitor_attributes_all_count_and_validate_without_a_warning(
+        tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    text = DISPENSER.read_text(encoding="utf-8").replace(
+        '<ExtendedAttribute Name="opspec:Metrics">',
+        '<ExtendedAttribute Name="opspec:Monitor" Value="min_gap dispense 4h"/>\n'
+        '    <ExtendedAttribute Name="opspec:Monitor" Value="count sound_alarm &lt;= 3"/>\n'
+        '    <ExtendedAttribute Name="opspec:Metrics">', 1)
+    spec = tmp_path / "two.xpdl"
+    spec.write_text(text, encoding="utf-8")
+    assert main(["validate", str(spec)]) == 0
+    assert "0 warnings" in capsys.readouterr().out
+    assert main(["run", str(spec), "--until", "13:00", "--json"]) == 0
+    monitors = json.loads(capsys.readouterr().out)["monitors"]
+    assert list(monitors) == ["min_gap dispense 4h", "count sound_alarm <= 3"]
+    # nobody reports: three alarms at 08:00, three at 12:00, the 4th is the one too many
+    (first,) = monitors["count sound_alarm <= 3"]["first"]
+    assert first["time"] == 12 * 3600 and "happened 6 time(s)" in first["message"]
