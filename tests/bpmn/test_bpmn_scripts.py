@@ -133,3 +133,9 @@ def test_conditions_outside_the_grammar_are_refused_naming_the_construct(
     errors = _errors(_spec(tmp_path, "x = 1", condition))
     assert [(code, line) for code, line, _ in errors] == [("bad-condition", 13)], errors
     assert named in errors[0][2]
+
+
+def test_javascript_declarations_and_increments_run(tmp_path: Path) -> None:
+    path = _spec(tmp_path, "var x = 0;\nx++;\nlet y = 'a'")
+    assert _errors(path) == []
+    assert _end(path) == "yes"

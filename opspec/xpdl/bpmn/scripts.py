@@ -316,7 +316,7 @@ def _statement(statement: _Statement, defs: Defs, line: int | None
     location = SourceLocation(defs.ctx.path, line)
     equals = _assignment_at(body)
     if equals is not None:
-        left = body[:equals].rstrip()
+        left = re.sub(r"^(var|let|const)\s+", "", body[:equals].rstrip())
         right = body[equals + 1:]
         if _assignment_at(right) is not None:
             return "a chained assignment (a = b = …) is not in the subset opspec runs"
