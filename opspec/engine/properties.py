@@ -637,7 +637,8 @@ class BoundedResponse(Property):
     def describe(self) -> str:
         if math.isinf(self.seconds):
             return f"response {_spell(self.trigger)} {_spell(self.response)}"
-        return f"bounded_response {_spell(self.trigger)} {_spell(self.response)} {_duration_text(self.seconds)}"
+        return (f"bounded_response {_spell(self.trigger)} {_spell(self.response)} "
+                f"{_duration_text(self.seconds)}")
 
     def start(self, replication: int = 0) -> MonitorRun:
         return _ResponseRun(self, replication)
@@ -773,7 +774,8 @@ class NeverWhile(Property):
         return replace(self, subject=subjects[0], after=subjects[1], until=subjects[2])
 
     def describe(self) -> str:
-        return f"never_while {_spell(self.subject)} after {_spell(self.after)} until {_spell(self.until)}"
+        return (f"never_while {_spell(self.subject)} after {_spell(self.after)} "
+                f"until {_spell(self.until)}")
 
     def start(self, replication: int = 0) -> MonitorRun:
         return _NeverWhileRun(self, replication)

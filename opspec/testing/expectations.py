@@ -21,8 +21,8 @@ any monitor's text is a ``then`` line too (``min_gap dispense 4h``, ``bounded_re
 sound_alarm dispense 15min``, ``never_while ...``), judged on each replication's trace by the
 evaluator a monitor runs online (same verdict, same witness), and holding when it holds in
 every replication (``count`` too: a total over all replications is a count metric's line,
-``alarms == 12``). ``activity X`` may also be ``trigger X`` (a message or signal raised), ``process X``
-(an instance started) or a bare name. Metric comparisons use the metrics pooled over all
+``alarms == 12``). ``activity X`` may also be ``trigger X`` (a message or signal raised),
+``process X`` (an instance started) or a bare name. Metric comparisons use the metrics pooled over all
 replications; ``==`` allows a relative error of 1e-9. The statistical lines are decided by
 :mod:`opspec.testing.intervals`: they pass when the one-sided bound at that confidence is on
 the right side, fail when the claim is refuted at that confidence, and otherwise fail saying
