@@ -36,7 +36,7 @@ from opspec.model.resources import Application
 from opspec.xpdl.bpmn.common import Defs, first, is_opspec, local
 from opspec.xpdl.handlers.common import raw_xml
 from opspec.xpdl.handlers.data import typed_value
-from opspec.xpdl.sisarl import Directive, collect
+from opspec.xpdl.sisarl import REPEATABLE, Directive, collect
 
 __all__ = [
     "STRUCTURE",
@@ -101,7 +101,7 @@ def directives(element: etree._Element, defs: Defs, known: tuple[str, ...], what
                         + ", ".join(f"opspec:{k}" for k in (*known, *structure))
                         + " (docs/bpmn.md)")
             continue
-        if name in found:
+        if name in found and name not in REPEATABLE:
             ctx.warning(sub, "duplicate-directive",
                         f"opspec:{name} is given twice on {what}; the last one counts",
                         "remove one of them")
