@@ -324,11 +324,8 @@ def _open_sink(factory: Any, path: str, header: dict[str, Any]) -> Iterator[Any]
 
 def clock(seconds: float) -> str:
     """``d1 08:00:00`` (day 1 is the first day) or ``d1 08:00:00.250`` with fractions."""
-    day, rest = divmod(seconds, DAY)
-    hours, rest = divmod(rest, 3600)
-    minutes, secs = divmod(rest, 60)
-    frac = f"{secs:06.3f}" if abs(secs - round(secs)) > 1e-6 else f"{round(secs):02d}"
-    return f"d{int(day) + 1} {int(hours):02d}:{int(minutes):02d}:{frac}"
+    from opspec.clock import clock_time
+    return clock_time(seconds)
 
 
 def _span(seconds: float) -> str:

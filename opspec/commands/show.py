@@ -214,9 +214,8 @@ def _trigger(trigger: TriggerRef) -> str:
 
 def _clock(seconds: float) -> str:
     """Seconds after midnight as ``08:00`` (or ``08:00:30``)."""
-    minutes, secs = divmod(seconds, 60)
-    hours, minutes = divmod(int(minutes), 60)
-    return f"{hours:02d}:{minutes:02d}" + (f":{secs:02g}" if secs else "")
+    from opspec.clock import time_of_day
+    return time_of_day(seconds)
 
 
 def _span(seconds: float) -> str:

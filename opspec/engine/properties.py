@@ -57,7 +57,7 @@ from collections.abc import Callable, Iterable, Sequence
 from dataclasses import dataclass, field, replace
 from typing import Protocol
 
-from opspec.clock import parse_duration, span
+from opspec.clock import clock_time, parse_duration, span
 from opspec.engine.trace import EventKind, TraceEvent
 from opspec.errors import ConfigurationError, SourceLocation
 
@@ -111,12 +111,9 @@ class Selector(Protocol):
 
 
 def clock(seconds: float) -> str:
-    """``day 1 08:00:00.0`` for simulated seconds (the format of trace listings)."""
-    seconds = round(seconds, 1)         # 59.96 s is shown as the next minute, not "60.0"
-    day, rest = divmod(seconds, 86_400.0)
-    hours, rest = divmod(rest, 3600.0)
-    minutes, secs = divmod(rest, 60.0)
-    return f"day {int(day) + 1} {int(hours):02d}:{int(minutes):02d}:{secs:04.1f}"
+    """``d1 08:00:00`` for simulated seconds: :func:`opspec.clock.clock_time`, the one way
+    opspec shows a point of the run (kept under this name for the predicates' imports)."""
+    return clock_time(seconds)
 
 
 def trace_end(events: Sequence[TraceEvent]) -> float:

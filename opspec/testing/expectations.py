@@ -277,7 +277,7 @@ def _metric_line(values: dict[str, object]) -> str:
 
 
 def _time(seconds: float) -> str:
-    return clock(seconds)
+    return clock(seconds)       # d1 08:00:00, or d1 08:00:00.250: padded to 15 in listings
 
 
 def _in_rep(result: SimulationResult, rep: int) -> str:
@@ -297,7 +297,7 @@ def format_events(events: Sequence[TraceEvent]) -> list[str]:
                 detail = f"  ({key}: {e.data[key]})"
                 break
         inst = f"#{e.instance}" if e.instance is not None else ""
-        out.append(f"    {_time(e.time)}  {inst:>4} {e.process or '':<18} {e.kind:<20} "
+        out.append(f"    {_time(e.time):<15}  {inst:>4} {e.process or '':<18} {e.kind:<20} "
                    f"{what}{detail}".rstrip())
     return out
 

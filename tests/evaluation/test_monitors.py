@@ -43,7 +43,7 @@ def test_evaluation_reports_each_monitor_as_a_hazard_per_user_day(evaluate, tmp_
     assert tight["per_user_day"] == pytest.approx(tight["violations"] / 60)
     lo, hi = tight["ci95"]
     assert 0 < lo < tight["per_user_day"] < hi
-    assert tight["first"]["message"].startswith("activity dispense at day")
+    assert tight["first"]["message"].startswith("activity dispense at d1 ")
     assert loose["violations"] == 0 and loose["users_affected"] == 0
     # no violation still bounds the hazard: the exact Poisson upper limit, 3.689 / 60 user-days
     assert loose["ci95"] == [0.0, pytest.approx(3.689 / 60, rel=1e-3)]
@@ -126,6 +126,9 @@ def test_validate_reports_a_bad_monitor_at_its_line(monitor, message, tmp_path, 
 
 
 def test_times_in_messages_never_show_sixty_seconds():
-    assert clock(12 * 3600 + 59.96) == "day 1 12:01:00.0"
-    assert clock(86_399.97) == "day 2 00:00:00.0"
-    assert clock(8 * 3600 + 0.04) == "day 1 08:00:00.0"
+    # times are shown to the millisecond (opspec.clock.clock_time); what rounds up rounds
+    # into the next minute or day, never to ":60"
+    assert clock(12 * 3600 + 59.96) == "d1 12:00:59.960"
+    assert clock(12 * 3600 + 59.9996) == "d1 12:01:00"
+    assert clock(86_399.9997) == "d2 00:00:00"
+    assert clock(8 * 3600 + 0.04) == "d1 08:00:00.040"

@@ -43,9 +43,9 @@ def test_a_failing_scenario_shows_the_expectation_the_values_and_a_trace_slice(
     result.stdout.fnmatch_lines([_literal(line) for line in [
         "*dispenser.scenario.toml: scenario[1].then[0]: expected alarms == 1",
         "  but alarms = 3",
-        "*day 1 08:10:00.0*sound_alarm",
+        "*d1 08:10:00*sound_alarm",
         "*dispenser.scenario.toml: scenario[1].then[1]: expected eventually activity dispense",
-        "  but activity dispense never happened (the run went to day 1 09:00:00.0)",
+        "  but activity dispense never happened (the run went to d1 09:00:00)",
         "  the trace ends with:",
         "(seed *; 1 replication(s))"]])
     assert "Traceback" not in result.stdout.str()

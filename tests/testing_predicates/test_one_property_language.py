@@ -374,8 +374,8 @@ def test_a_stored_trace_is_judged_by_its_path(tmp_path: Path) -> None:
                  "--trace", str(trace), "--timeline", "none"]) == 0
     assert not holds(trace, "never notify_caregiver")
     assert holds(trace, "notify_caregiver within 15 min after process:notify_workflow")
-    with pytest.raises(AssertionError, match=r"(?s)notify_caregiver happened at day 1 08:15:"
-                                             r"00.0.*>.*activity.completed +notify_caregiver"):
+    with pytest.raises(AssertionError, match=r"(?s)notify_caregiver happened at d1 08:15:"
+                                             r"00.*>.*activity.completed +notify_caregiver"):
         check(trace, "never notify_caregiver")
 
 
