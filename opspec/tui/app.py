@@ -31,7 +31,7 @@ from textual.screen import ModalScreen
 from textual.theme import Theme
 from textual.widgets import Digits, Footer, Static
 
-from opspec.tui.session import WalkSession, clock
+from opspec.tui.session import WalkSession, clock, time_of_day_shown
 from opspec.tui.sound import Cue
 
 __all__ = ["WalkthroughApp"]
@@ -417,7 +417,7 @@ class WalkthroughApp(App[str | None]):
             f"{clock(session.now)}  {session.speed:g}x  {state}  |  {who}  |  "
             f"{self.spec_title}", no_wrap=True, overflow="ellipsis"))
         if self.large:
-            self.query_one("#bigclock", Digits).update(clock(session.now)[3:8])
+            self.query_one("#bigclock", Digits).update(time_of_day_shown(session.now)[:5])
         self.query_one("#device", Static).update(self._device_text())
         person = self.query_one("#person", Vertical)
         call = self.query_one("#call", Static)
@@ -529,7 +529,7 @@ class WalkthroughApp(App[str | None]):
             elif event.kind == "walkthrough.action":
                 data = event.data or {}
                 what = f"{'you' if data.get('by') == 'person' else 'model'}: {data.get('action')}"
-            text.append(f"{clock(event.time)[3:]}  {shown_lane:<6} {what}\n")
+            text.append(f"{time_of_day_shown(event.time)}  {shown_lane:<6} {what}\n")
             shown += 1
             if shown >= rows:
                 break

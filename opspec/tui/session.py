@@ -41,6 +41,7 @@ from collections.abc import Callable, Mapping, Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, TypeVar
 
+from opspec.clock import clock_time
 from opspec.engine.compiled import K_GATEWAY, K_NOOP, CompiledPackage
 from opspec.engine.lanes import all_activities, user_lane
 from opspec.engine.performers import WorkItem
@@ -547,7 +548,7 @@ class WalkSession:
                               if k[0] != event.instance}
         if kind == "activity.completed" and event.participant and event.lane != "user":
             self.participants[event.participant] = (
-                f"{event.activity} at {clock(event.time)[3:]}")
+                f"{event.activity} at {time_of_day_shown(event.time)}")
         if kind in ("fault", "device.note"):
             data = event.data or {}
             who = str(data.get("participant") or data.get("device") or "device")
@@ -651,8 +652,11 @@ class WalkSession:
 
 
 def clock(seconds: float) -> str:
-    day, rest = divmod(seconds, DAY)
-    hours, rest = divmod(rest, 3600)
-    minutes, secs = divmod(rest, 60)
-    return f"d{int(day) + 1} {int(hours):02d}:{int(minutes):02d}:{int(secs):02d}"
+    """``d1 08:00:00``: :func:`opspec.clock.clock_time` to the whole second (the walkthrough
+    shows the clock ticking, not its milliseconds)."""
+    return clock_time(math.floor(seconds))
 
+
+def time_of_day_shown(seconds: float) -> str:
+    """``08:00:00``: :func:`clock` without its day (for day 10 and later too)."""
+    return clock(seconds).split(" ", 1)[1]
