@@ -21,6 +21,7 @@ WCAG AA), and a layout that reflows on a phone (tables scroll sideways inside th
 from __future__ import annotations
 
 import base64
+import contextlib
 import html
 import os
 import re
@@ -86,12 +87,14 @@ def _read_png(image: Path) -> bytes:
 
 def _write(path: Path, text: str) -> Path:
     path = Path(path)
+    tmp = path.with_name(path.name + ".tmp")
     try:
         path.parent.mkdir(parents=True, exist_ok=True)
-        tmp = path.with_name(path.name + ".tmp")
         tmp.write_text(text, encoding="utf-8")
         os.replace(tmp, path)   # never leave a half-written report behind
     except OSError as error:
+        with contextlib.suppress(OSError):
+            tmp.unlink(missing_ok=True)     # nor the part of it that did fit
         raise EvaluationError(f"cannot write the report {path}: {error.strerror or error}",
                               hint="check that the output folder is writable and the disk "
                                    "is not full") from None
