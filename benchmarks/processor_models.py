@@ -1,6 +1,9 @@
 """The processor models under load: the vacuum cleaner's periodic workflows (5 Hz sense,
-avoid, manoeuvre and arbitrate with CPU demand and deadlines) under the dedicated model and the
-pooled model with 1-3 workers, 1 or 8 priority levels and a context-switch cost.
+avoid, manoeuvre and arbitrate with CPU demand and deadlines) under each processor model: the
+dedicated model, the pooled model with 1-3 workers and 1 or 8 priority levels, and the source's
+two engines on 1-2 processors (preemptive: a thread per workflow at fixed priority, as on Linux;
+priority-queues: a FIFO queue per priority with its worker and a leader, as on Windows CE),
+each with a context-switch cost.
 
     python benchmarks/processor_models.py [--spec specs/vacuum_cleaner.xpdl] [--seconds 300]
         [--switch-ms 10]
@@ -39,9 +42,14 @@ def main(argv: list[str] | None = None) -> None:
             configs.append((f"pooled {workers}w {priorities}p", EngineConfig(
                 processor_model="pooled", workers=workers, priorities=priorities,
                 switch_cost=args.switch_ms / 1000)))
+    for model in ("preemptive", "priority-queues"):
+        for cpus in (1, 2):
+            configs.append((f"{model} {cpus}cpu", EngineConfig(
+                processor_model=model, workers=cpus, priorities=8,
+                switch_cost=args.switch_ms / 1000)))
     print(f"{Path(args.spec).name}, {args.seconds:g} s simulated, switch cost "
-          f"{args.switch_ms:g} ms (pooled); times in ms")
-    header = (f"{'model':<18}{'workflow':<12}{'done':>6}{'misses':>7}{'mean':>8}{'max':>8}"
+          f"{args.switch_ms:g} ms (all but dedicated); times in ms")
+    header = (f"{'model':<22}{'workflow':<12}{'done':>6}{'misses':>7}{'mean':>8}{'max':>8}"
               f"{'jitter':>8}{'switches':>10}")
     print(header)
     print("-" * len(header))
@@ -56,7 +64,7 @@ def main(argv: list[str] | None = None) -> None:
         for n, (name, t) in enumerate(timing.summary().items()):
             if name in ("battery", "dock", "wander"):
                 continue
-            print(f"{label if n == 0 else '':<18}{name:<12}{t['completed']:>6}{t['misses']:>7}"
+            print(f"{label if n == 0 else '':<22}{name:<12}{t['completed']:>6}{t['misses']:>7}"
                   f"{(t['response_mean_s'] or 0) * 1e3:>8.1f}"
                   f"{(t['response_max_s'] or 0) * 1e3:>8.1f}{(t['jitter_s'] or 0) * 1e3:>8.1f}"
                   f"{switches if n == 0 else '':>10}")
