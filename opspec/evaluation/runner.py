@@ -26,11 +26,11 @@ from opspec.evaluation.plan import EvaluationPlan
 from opspec.evaluation.replication import ReplicationRecord, run_users
 from opspec.evaluation.store import ResultStore
 
-__all__ = ["Progress", "RunOutcome", "check_scheduler", "chunks", "run_evaluation"]
+__all__ = ["EvaluationOutcome", "Progress", "check_scheduler", "chunks", "run_evaluation"]
 
 
 @dataclass(frozen=True, slots=True)
-class RunOutcome:
+class EvaluationOutcome:
     """How the run went: replications done now, already stored, failed, and wall time."""
 
     done: int
@@ -258,7 +258,7 @@ def _dead_worker(error: BaseException) -> str:
 def run_evaluation(plan: EvaluationPlan, store: ResultStore, *, workers: int = 1,
                    scheduler: str | None = None, progress: Progress | None = None,
                    on_trace: TraceSink | None = None, retrace: bool = False,
-                   scheduler_timeout: float = WORKER_TIMEOUT) -> RunOutcome:
+                   scheduler_timeout: float = WORKER_TIMEOUT) -> EvaluationOutcome:
     """Run every replication of ``plan`` not yet stored as done, storing each as it ends.
 
     ``retrace`` (resuming a run that exports traces): the users already stored are simulated
@@ -333,4 +333,4 @@ def run_evaluation(plan: EvaluationPlan, store: ResultStore, *, workers: int = 1
         store.index()               # once, now that every replication is stored
     finally:
         progress.finish()
-    return RunOutcome(done, skipped, failed, time.perf_counter() - started)
+    return EvaluationOutcome(done, skipped, failed, time.perf_counter() - started)
