@@ -329,14 +329,9 @@ def clock(seconds: float) -> str:
 
 
 def _span(seconds: float) -> str:
-    if seconds >= DAY and seconds % DAY == 0:
-        days = int(seconds // DAY)
-        return f"{days} day{'s' if days != 1 else ''}"
-    if seconds >= 3600:
-        return f"{seconds / 3600:g} h"
-    if seconds >= 60 and seconds % 60 == 0:
-        return f"{seconds / 60:g} min"
-    return f"{seconds:g} s"
+    """A length of time for people: :func:`opspec.clock.span` (``2 days``, ``4 h``, ``15 min``)."""
+    from opspec.clock import span
+    return span(seconds)
 
 
 def timeline_line(event: TraceEvent) -> str:

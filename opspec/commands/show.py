@@ -219,11 +219,9 @@ def _clock(seconds: float) -> str:
 
 
 def _span(seconds: float) -> str:
-    for unit, size in (("day", 86_400), ("h", 3_600), ("min", 60)):
-        if seconds >= size and seconds % size == 0:
-            count = int(seconds // size)
-            return f"{count} {unit}" + ("s" if unit == "day" and count != 1 else "")
-    return f"{seconds:g} s"
+    """A length of time for people: :func:`opspec.clock.span` (``2 days``, ``4 h``, ``15 min``)."""
+    from opspec.clock import span
+    return span(seconds)
 
 
 def _directives(directives: ProcessDirectives) -> str:
