@@ -17,8 +17,11 @@ from conftest import SPEC, USERS_TOML, metrics_of
 
 def test_interrupted_run_resumes_to_the_same_results(tmp_path, evaluate):
     out = tmp_path / "killed"
-    cmd = [sys.executable, "-m", "opspec.cli", "evaluate", str(SPEC), "--users", "40",
-           "--days", "6", "--seed", "9", "--workers", "2", "--out", str(out), "--quiet"]
+    # 200 users x 20 days: long enough that the run is still going when 5 users are stored, on a
+    # fast idle machine too (40 users x 6 days, compiled, ended within 1.5 s, once between two
+    # looks at the store, since the store now writes a chunk per transaction)
+    cmd = [sys.executable, "-m", "opspec.cli", "evaluate", str(SPEC), "--users", "200",
+           "--days", "20", "--seed", "9", "--workers", "2", "--out", str(out), "--quiet"]
     proc = subprocess.Popen(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
                             env={**os.environ, "PYTHONPATH": str(SPEC.parents[1])})
     db = out / "results.sqlite"
@@ -37,7 +40,7 @@ def test_interrupted_run_resumes_to_the_same_results(tmp_path, evaluate):
     workers = _children(proc.pid)
     proc.kill()
     proc.wait()
-    assert 5 <= stored < 40, "the run should have been killed part-way"
+    assert 5 <= stored < 200, f"the run should have been killed part-way ({stored} stored)"
     # the pool's workers do not outlive the killed run
     assert workers, "the run should have started its worker pool"
     deadline = time.monotonic() + 30
@@ -46,7 +49,7 @@ def test_interrupted_run_resumes_to_the_same_results(tmp_path, evaluate):
     assert not [w for w in workers if Path(f"/proc/{w}").exists()], "orphaned workers"
     status, resumed, err = evaluate("--resume", "--out", str(out), "--workers", "2")
     assert status == 0, err
-    _, whole, _ = evaluate(str(SPEC), "--users", "40", "--days", "6", "--seed", "9",
+    _, whole, _ = evaluate(str(SPEC), "--users", "200", "--days", "20", "--seed", "9",
                            "--workers", "2", "--out", str(tmp_path / "whole"))
     assert metrics_of(resumed) == metrics_of(whole)
 
