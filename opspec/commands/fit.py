@@ -8,6 +8,8 @@ import sys
 from pathlib import Path
 from typing import Any
 
+from opspec.usermodels.persons import PERSON_FROM
+
 __all__ = ["register"]
 
 
@@ -30,8 +32,26 @@ def register(subparsers: Any) -> None:
     parser.add_argument("--criterion", choices=("aic", "bic"), default="aic",
                         help="how the duration family is chosen (default: aic)")
     parser.add_argument("--min-per-user", type=int, default=10, metavar="N",
-                        help="observations a user (run) needs to count in the between-user "
+                        help="observations a person needs to count in the between-user "
                         "spread (default: 10)")
+    who = parser.add_argument_group(
+        "whose sessions", "several sessions of one participant are one person: in the "
+        "between-user spread and in the bootstrap of --draws (docs/fitting.md)")
+    who.add_argument("--person", action="append", default=[], metavar="FILE=ID",
+                     help="the sessions in FILE are participant ID (repeatable)")
+    who.add_argument("--person-pattern", metavar="REGEX",
+                     help="the participant is the first group of REGEX found in each file's "
+                     "path, e.g. '(P\\d+)' for recordings/P07-day2.jsonl")
+    who.add_argument("--person-from", choices=PERSON_FROM, default="auto",
+                     help="otherwise: the trace header's 'person' key (header), each file "
+                     "(file), its folder's name (folder), each run (run); auto (default): "
+                     "the header's key where there is one, else each run")
+    parser.add_argument("--draws", type=int, default=200, metavar="B",
+                        help="bootstrap redraws of the fitted parameters written to the "
+                        "model's [uncertainty] table, for `opspec evaluate "
+                        "--input-uncertainty` (default: 200; 0: none)")
+    parser.add_argument("--seed", type=int, default=0,
+                        help="seed of the bootstrap redraws (default: 0)")
     parser.add_argument("--json", action="store_true",
                         help="print the fit (every family's AIC/BIC, intervals, between-user "
                         "spread) as one JSON object instead of the summary")
@@ -49,6 +69,32 @@ def _vary_text(vary: dict[str, Any]) -> str:
             + tomli_w.dumps({"vary": {"activities": vary}}))
 
 
+def _sessions_per_person(obs: Any) -> dict[str, int]:
+    counts: dict[str, int] = {}
+    for person in obs.person_of.values():
+        counts[person] = counts.get(person, 0) + 1
+    return counts
+
+
+def _persons_line(obs: Any, source: str) -> str:
+    """``3 persons, 7 sessions (P01 3, P02 2, P03 2)``: who the sessions were."""
+    counts = _sessions_per_person(obs)
+    shown = ", ".join(f"{p} {n}" for p, n in list(counts.items())[:8])
+    more = f", ... {len(counts) - 8} more" if len(counts) > 8 else ""
+    how = {"auto": "", "run": "; each run a person"}.get(source, f"; by {source}")
+    return (f"{len(counts)} person(s), {obs.sessions} session(s)"
+            + (f" ({shown}{more})" if any(n > 1 for n in counts.values()) else "") + how)
+
+
+def _uncertainty_text(draws: Any) -> str:
+    """The ``[uncertainty]`` table: the bootstrap redraws of the fitted parameters."""
+    if draws is None:
+        return ""
+    return ("\n# ---- parameter uncertainty: each draw is the model refitted to a bootstrap "
+            "resample of the\n# traces; `opspec evaluate --input-uncertainty B` runs draws "
+            "1..B (docs/fitting.md)\n" + draws.to_text())
+
+
 def _fit(args: argparse.Namespace) -> int:
     from opspec.errors import UserModelError
     from opspec.usermodels.fitting import fit_traces, iter_paths
@@ -60,6 +106,12 @@ def _fit(args: argparse.Namespace) -> int:
     if args.json and args.output == "-":
         raise UserModelError("--json and -o - both want standard output",
                              hint="write the model to a file with -o FILE")
+    if args.draws < 0:
+        raise UserModelError(f"--draws must be 0 or more, not {args.draws}")
+    from opspec.usermodels.persons import PersonRule, parse_person_options
+
+    persons = PersonRule(args.person_from, args.person_pattern,
+                         parse_person_options(args.person))
     paths = iter_paths(args.traces)
     if not paths:
         raise UserModelError("no trace files found in " + ", ".join(args.traces),
@@ -67,21 +119,27 @@ def _fit(args: argparse.Namespace) -> int:
     out = Path(args.output) if args.output != "-" else None
     name = args.name or (out.stem.removesuffix(".users") if out else "fitted")
     result = fit_traces(paths, lane=args.lane, name=name, criterion=args.criterion,
-                        min_per_user=args.min_per_user)
+                        min_per_user=args.min_per_user, persons=persons)
+    obs = result.observations
+    from opspec.usermodels.bootstrap import parameter_draws
+
+    draws = parameter_draws(result, args.draws, seed=args.seed) if args.draws else None
     by = args.criterion.upper()
     header = (f"User model fitted by `opspec fit` from {len(paths)} trace file(s) "
-              f"({result.observations.events} events, {result.observations.runs} run(s), "
-              f"lane {args.lane!r}).\n"
+              f"({obs.events} events, {obs.sessions} session(s) of {len(obs.persons)} "
+              f"person(s), lane {args.lane!r}).\n"
+              f"Persons: {_persons_line(obs, args.person_from)}.\n"
               "Durations: lognormal, gamma, Weibull and ex-Gaussian were fitted to each activity "
               f"by maximum\nlikelihood; the one with the lowest {by} is used, as the table above "
               "each activity shows.\nOmission rates carry Wilson 95 % intervals. Between-user "
-              "spread (users = runs with at least\n"
+              "spread (persons with at least\n"
               f"{args.min_per_user} observations) is in the comments and `opspec fit --json`; "
               "where the data show\nthat users differ, [vary] tables at the end draw those "
               "parameters per simulated user.\nCheck the numbers before relying on them: "
               "small samples give wide intervals.")
     text = dump_user_model(result.model, comments=result.comments(), header=header)
     text += _vary_text(result.vary())
+    text += _uncertainty_text(draws)
     if out is None:
         sys.stdout.write(text)
         return 0
@@ -94,12 +152,22 @@ def _fit(args: argparse.Namespace) -> int:
     load_user_model(out)  # the file must read back; a failure here is a bug worth reporting
     if args.json:
         doc = {"model": str(out), "lane": args.lane, "criterion": args.criterion,
-               "min_per_user": args.min_per_user, **result.to_json()}
+               "min_per_user": args.min_per_user, **result.to_json(),
+               "persons": {"count": len(obs.persons), "sessions": obs.sessions,
+                           "from": args.person_from,
+                           "sessions_per_person": _sessions_per_person(obs)},
+               "uncertainty": None if draws is None else {
+                   "draws": draws.count, "resampled": draws.resampled, "seed": draws.seed,
+                   "parameters": draws.summary()}}
         print(json.dumps(doc, indent=1, default=str))
         return 0
     for fit in result.fits:
         print(fit.comment())
         print()
     activities = ", ".join(f.activity for f in result.fits)
+    print(f"persons: {_persons_line(obs, args.person_from)}")
+    if draws is not None:
+        print(f"parameter uncertainty: {draws.count} bootstrap redraws resampling "
+              f"{draws.resampled} ([uncertainty]; opspec evaluate --input-uncertainty B)")
     print(f"wrote {out} ({len(result.fits)} activities: {activities})")
     return 0

@@ -26,7 +26,7 @@ import io
 import json
 import math
 from collections import Counter, defaultdict, deque
-from collections.abc import Iterable, Iterator, Sequence
+from collections.abc import Iterable, Iterator, Mapping, Sequence
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any
@@ -40,6 +40,7 @@ from opspec.usermodels.distributions import Constant, Distribution, Gamma, LogNo
 from opspec.usermodels.errors import Busy, Commission, Omission
 from opspec.usermodels.families import CRITERIA, FamilyFit, choose, fit_families
 from opspec.usermodels.model import ActivityModel, UserModel
+from opspec.usermodels.persons import PersonRule
 from opspec.usermodels.spread import (
     DurationSpread,
     OmissionSpread,
@@ -137,6 +138,14 @@ class Observations:
     #: per choice activity, per picked alternative: the durations of that pick
     pick_durations: dict[str, dict[str, list[float]]] = field(
         default_factory=lambda: defaultdict(lambda: defaultdict(list)))
+    #: the same per session (file index, run index): the picks of each instance, and per
+    #: picked alternative its durations (what a person-level bootstrap resamples)
+    user_picks: dict[str, dict[tuple[int, int], list[list[str]]]] = field(
+        default_factory=lambda: defaultdict(lambda: defaultdict(list)))
+    user_pick_durations: dict[str, dict[str, dict[tuple[int, int], list[float]]]] = field(
+        default_factory=lambda: defaultdict(lambda: defaultdict(lambda: defaultdict(list))))
+    #: who each session (file index, run index) is (opspec.usermodels.persons)
+    person_of: dict[tuple[int, int], str] = field(default_factory=dict)
     events: int = 0
     runs: int = 0
     files: int = 0
@@ -147,12 +156,46 @@ class Observations:
         names = set(self.durations) | set(self.omitted) | set(self.busy_omitted)
         return sorted(names)
 
+    @property
+    def persons(self) -> list[str]:
+        """The persons the sessions belong to, in order of appearance."""
+        return list(dict.fromkeys(self.person_of.values()))
 
-def collect(paths: Sequence[str | Path], lane: str = "user") -> Observations:
-    """Pair offers with answers in ``paths`` for ``lane`` (see the module docstring)."""
+    @property
+    def sessions(self) -> int:
+        return len(self.person_of)
+
+    def person(self, session: tuple[int, int]) -> str:
+        return self.person_of.get(session, f"{session[0]}#{session[1]}")
+
+    def lists_by_person(self, per_session: Mapping[tuple[int, int], Sequence[Any]]
+                        ) -> dict[str, list[Any]]:
+        """Per-session lists (durations, pick sequences) concatenated per person."""
+        out: dict[str, list[Any]] = {}
+        for session, values in per_session.items():
+            out.setdefault(self.person(session), []).extend(values)
+        return out
+
+    def counts_by_person(self, per_session: Mapping[tuple[int, int], Sequence[int]]
+                         ) -> dict[str, tuple[int, int]]:
+        """Per-session ``[omitted, answered]`` added up per person."""
+        out: dict[str, tuple[int, int]] = {}
+        for session, (k, n) in per_session.items():
+            k0, n0 = out.get(self.person(session), (0, 0))
+            out[self.person(session)] = (k0 + k, n0 + n)
+        return out
+
+
+def collect(paths: Sequence[str | Path], lane: str = "user",
+            persons: PersonRule | None = None) -> Observations:
+    """Pair offers with answers in ``paths`` for ``lane`` (see the module docstring);
+    ``persons`` says whose each session is (default: the header's ``person``, else each run
+    a person of its own)."""
     obs = Observations()
+    rule = persons or PersonRule()
     for file_index, path in enumerate(paths):
         obs.files += 1
+        whose = rule.of_file(Path(path))
         run = 0
         outstanding: dict[tuple[int, Any, str], deque[tuple[float, str]]] = {}
         in_progress: dict[tuple[int, Any, str], int] = Counter()
@@ -164,6 +207,8 @@ def collect(paths: Sequence[str | Path], lane: str = "user") -> Observations:
             if event.kind == EventKind.RUN_STARTED:
                 run += 1
                 obs.runs += 1
+                obs.person_of[(file_index, run)] = (
+                    whose if whose is not None else f"{Path(path).name}#{run}")
                 continue
             if event.lane:
                 obs.lanes_seen.add(event.lane)
@@ -207,6 +252,7 @@ def collect(paths: Sequence[str | Path], lane: str = "user") -> Observations:
                 if isinstance(choice, str):
                     if real:
                         obs.pick_durations[event.activity][choice].append(took)
+                        obs.user_pick_durations[event.activity][choice][user].append(took)
                     pending_choice.pop(inst, None)
                     picks_of.setdefault(inst, {}).setdefault(event.activity, []).append(choice)
             elif event.kind == EventKind.ACTIVITY_OMITTED:
@@ -219,9 +265,13 @@ def collect(paths: Sequence[str | Path], lane: str = "user") -> Observations:
                     counts = obs.user_omissions[event.activity][user]
                     counts[0] += 1
                     counts[1] += 1
-        for per_instance in picks_of.values():
+        for (picked_in, _), per_instance in picks_of.items():
             for activity, sequence in per_instance.items():
                 obs.picks[activity].append(sequence)
+                obs.user_picks[activity][(file_index, picked_in)].append(sequence)
+        if run == 0:                    # a trace without run.started: one session
+            obs.person_of[(file_index, 0)] = (whose if whose is not None
+                                              else f"{Path(path).name}#0")
     if not obs.durations and not obs.omitted and not obs.busy_omitted:
         seen = ", ".join(sorted(obs.lanes_seen)) or "none"
         unusable = sum(obs.unusable.values())
@@ -461,17 +511,21 @@ def _wrong_choice_loss(choice: str, intended: str, by_pick: dict[str, list[float
 
 
 def fit_traces(paths: Sequence[str | Path], *, lane: str = "user", name: str = "fitted",
-               criterion: str = "aic", min_per_user: int = 10) -> FitResult:
+               criterion: str = "aic", min_per_user: int = 10,
+               persons: PersonRule | None = None) -> FitResult:
     """Fit a :class:`UserModel` for ``lane`` from the trace files ``paths``: per activity the
     best duration family by ``criterion`` (``aic`` or ``bic``), omission rates, choices with
-    the time a wrong pick costs, and the between-user spread of users (runs) with at least
-    ``min_per_user`` observations."""
+    the time a wrong pick costs, and the between-user spread of persons with at least
+    ``min_per_user`` observations (``persons`` says whose each session is: several sessions
+    of one participant are one person; :mod:`opspec.usermodels.persons`)."""
     if not paths:
         raise UserModelError("no trace files given", hint="opspec fit TRACE... -o model.toml")
     if criterion not in CRITERIA:
         raise UserModelError(f"unknown selection criterion {criterion!r}",
                              hint="use --criterion aic or --criterion bic")
-    obs = collect(paths, lane)
+    if persons is not None:
+        persons.check_used([Path(p) for p in paths])
+    obs = collect(paths, lane, persons)
     origin = f"{len(paths)} trace file(s), {obs.events} events"
     activities: dict[str, ActivityModel] = {}
     fits = []
@@ -508,7 +562,7 @@ def fit_traces(paths: Sequence[str | Path], *, lane: str = "user", name: str = "
                            for f in sorted(families, key=lambda f: f.score(criterion)))
         kwargs["source"] = (f"fitted by opspec fit from {origin}: n = {len(values)}, "
                             f"{chosen}" + (f" by {by} ({scores})" if families else ""))
-        spread_d = duration_spread(obs.user_durations.get(activity, {}),
+        spread_d = duration_spread(obs.lists_by_person(obs.user_durations.get(activity, {})),
                                    min_per_user=min_per_user,
                                    family=chosen if families else None)
         if (isinstance(dist, LogNormal) and spread_d is not None
@@ -521,8 +575,7 @@ def fit_traces(paths: Sequence[str | Path], *, lane: str = "user", name: str = "
             note = (note + "; " if note else "") + (
                 f"sigma {within:.4g} within a user, {spread_d.between_sd:.4g} between users")
         activities[activity] = ActivityModel(**kwargs)
-        spread_o = omission_spread({u: (c[0], c[1]) for u, c in
-                                    obs.user_omissions.get(activity, {}).items()},
+        spread_o = omission_spread(obs.counts_by_person(obs.user_omissions.get(activity, {})),
                                    min_per_user=min_per_user) if omitted else None
         fits.append(ActivityFit(activity, len(values), dist, chosen,
                                 {f.family: f.aic for f in families}, omission_stats, note,

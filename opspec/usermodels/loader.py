@@ -40,7 +40,8 @@ FORMAT_VERSION = 1
 
 _TOP_KEYS = ("format", "version", "name", "description", "source", "extends", "defaults",
              "activities", "busy", "routine", "modifier", "operators",
-             "vary", "correlations", "subgroups")   # the last three: a population
+             "vary", "correlations", "subgroups",   # these three: a population
+             "uncertainty")   # parameter redraws of a fitted model (usermodels.uncertainty)
 #: keys of a population (docs/user-models.md, "Populations")
 POPULATION_KEYS = ("vary", "correlations", "subgroups")
 _ACTIVITY_KEYS = ("duration", "omission", "prompt", "commission", "repetition", "delay",
@@ -309,6 +310,10 @@ def parse_user_model(doc: Mapping[str, Any], path: str = "<toml>", *,
     modifier = _modifier(ctx, doc["modifier"], name) if "modifier" in doc else None
     if modifier is not None:
         model = model.with_modifier(modifier)
+    if "uncertainty" in doc:         # checked here, so a bad table names the file at load
+        from opspec.usermodels.uncertainty import ParameterDraws
+
+        ParameterDraws.from_table(doc["uncertainty"], path)
     declares = any(key in doc for key in POPULATION_KEYS)
     if declares or (base is not None and base.population is not None):
         from dataclasses import replace

@@ -1,0 +1,287 @@
+"""Redraws of a fitted model's parameters by the bootstrap (``opspec fit --draws B``).
+
+A model fitted from 40 observations is not known, only estimated. The simulation literature
+carries that into the output by running the simulation at parameters redrawn from their
+sampling distribution — Barton & Schruben's direct bootstrap (Barton & Schruben 2001,
+"Resampling methods for input modeling", Proc. Winter Simulation Conference; Barton,
+Nelson & Xie 2014, INFORMS J. Computing 26(1)). The redraws are made here, once, from the
+traces; :mod:`opspec.usermodels.uncertainty` keeps them in the model file and
+:mod:`opspec.evaluation.input_uncertainty` runs them.
+
+Why a nonparametric bootstrap and not the MLE with its covariance: the fitted parameters
+include rates (omission, commission: bounded, skewed near 0 with few events), the time a
+wrong pick costs (a difference of means) and duration families whose parameters are far from
+normal at n = 40 (a lognormal's sigma, an ex-Gaussian's tau); resampling the data and fitting
+again, exactly as ``opspec fit`` fits, gives every one of them its own sampling distribution
+and their correlations without a formula per parameter.
+
+What is resampled (Davison & Hinkley 1997, *Bootstrap Methods and their Application*,
+section 3.8, two-stage data): the independent units are **persons**, not sessions nor single
+observations — the sessions of one person share their speed and their forgetfulness. With at
+least :data:`MIN_PERSONS` persons, persons are drawn with replacement and keep all their
+observations (Davison & Hinkley's recommended strategy when there are enough clusters). With
+fewer (one participant recorded for a week), between-person differences cannot be estimated
+at all and each person's observations are resampled within that person.
+
+Each resample is fitted as the data were: the duration family ``opspec fit`` chose (AIC/BIC
+on the whole data) is fitted again by maximum likelihood — the choice of family is not
+redrawn —, a rate is events / trials of the resample, the time lost to a wrong pick the
+difference of means. A resample that cannot be fitted (too few distinct durations) keeps the
+estimate for that parameter and is counted in ``failed``. Rates the data show no event of
+(no omission in 40 offers) are not written by ``opspec fit``, hence not redrawn.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+
+from opspec.usermodels.distributions import Constant, Gamma, LogNormal, Weibull
+from opspec.usermodels.families import fit_family
+from opspec.usermodels.uncertainty import ParameterDraws
+
+if TYPE_CHECKING:
+    from opspec.usermodels.fitting import FitResult
+
+__all__ = ["MIN_PERSONS", "parameter_draws"]
+
+#: fewer persons than this and observations are resampled within each person
+MIN_PERSONS = 5
+
+_STREAM = 0x1F17_0019          # the bootstrap's own stream, apart from the spread's
+
+
+@dataclass
+class _Data:
+    """One person's (or one resample's) observations of one activity."""
+
+    durations: list[float] = field(default_factory=list)
+    omitted: int = 0
+    answered: int = 0
+    picks: list[list[str]] = field(default_factory=list)
+    by_pick: dict[str, list[float]] = field(default_factory=dict)
+
+    def add(self, other: _Data) -> None:
+        self.durations.extend(other.durations)
+        self.omitted += other.omitted
+        self.answered += other.answered
+        self.picks.extend(other.picks)
+        for pick, values in other.by_pick.items():
+            self.by_pick.setdefault(pick, []).extend(values)
+
+    def within(self, rng: np.random.Generator) -> _Data:
+        """This person's observations resampled with replacement."""
+        def again(values: Sequence[Any]) -> list[Any]:
+            if not values:
+                return []
+            return [values[i] for i in rng.integers(0, len(values), len(values))]
+
+        omitted = (int(rng.binomial(self.answered, self.omitted / self.answered))
+                   if self.answered else 0)
+        return _Data(again(self.durations), omitted, self.answered, again(self.picks),
+                     {p: again(v) for p, v in self.by_pick.items()})
+
+
+def _family(dist: Any) -> str | None:
+    if isinstance(dist, LogNormal):
+        return "lognormal"
+    if isinstance(dist, Gamma):
+        return "gamma"
+    if isinstance(dist, Weibull):
+        return "weibull"
+    if dist.to_params().get("kind") == "exgauss":
+        return "exgauss"
+    return None
+
+
+def _refit(family: str, values: Sequence[float]) -> dict[str, float] | None:
+    """The family's maximum-likelihood parameters, in the model file's words."""
+    x = np.asarray(values, dtype=float)
+    if x.size < 2 or float(np.ptp(x)) <= 0:
+        return None
+    if family == "lognormal":                  # the MLE in closed form (scipy's, faster)
+        if not np.all(x > 0):
+            return None
+        logs = np.log(x)
+        return {"median": float(math.exp(logs.mean())), "sigma": float(logs.std())}
+    fitted = fit_family(family, x)
+    return fitted.named_parameters() if fitted is not None else None
+
+
+@dataclass(frozen=True)
+class _Target:
+    """One group of parameters one statistic of the data gives."""
+
+    activity: str                      # whose data
+    kind: str                          # duration | omission | commission | loss
+    prefix: str                        # the parameter path before the parameter's name
+    family: str | None = None
+    intended: str | None = None        # duration of a choice: its intended picks only
+    between: float = 0.0               # lognormal: the sigma written is the within-person part
+
+
+def _targets(result: FitResult) -> list[_Target]:
+    from opspec.usermodels.population import dotted
+
+    model = result.model
+    out: list[_Target] = []
+    for fit in result.fits:
+        own = model.activities.get(fit.activity)
+        if own is None:
+            continue
+        base = dotted(("activities", fit.activity))
+        family = _family(own.duration)
+        if fit.families and family is not None:
+            intended = own.intended if fit.wrong_choice is not None else None
+            between = 0.0
+            if (family == "lognormal" and isinstance(own.duration, LogNormal)
+                    and isinstance(fit.distribution, LogNormal)
+                    and own.duration.sigma < fit.distribution.sigma - 1e-12):
+                between = math.sqrt(fit.distribution.sigma ** 2 - own.duration.sigma ** 2)
+            out.append(_Target(fit.activity, "duration", f"{base}.duration", family,
+                               intended, between))
+        if own.omission is not None:
+            out.append(_Target(fit.activity, "omission", f"{base}.omission.probability"))
+        if own.commission is not None and own.intended is not None:
+            out.append(_Target(fit.activity, "commission", f"{base}.commission.probability",
+                               intended=own.intended))
+        loss = fit.wrong_choice
+        if loss is not None:
+            for alternative in loss.alternatives:
+                if result.observations.durations.get(alternative):
+                    continue                # its own durations were fitted
+                written = model.activities[alternative].duration
+                out.append(_Target(fit.activity, "loss",
+                                   dotted(("activities", alternative, "duration")),
+                                   _family(written) if not isinstance(written, Constant)
+                                   else None, intended=own.intended))
+    return out
+
+
+def _values(target: _Target, data: _Data) -> dict[str, float] | None:
+    """The parameters ``target`` gives on ``data`` (path -> value); None: cannot be fitted."""
+    from opspec.usermodels.fitting import _choice_model
+
+    if target.kind == "duration":
+        values = (data.by_pick.get(target.intended, []) if target.intended is not None
+                  else data.durations)
+        assert target.family is not None
+        found = _refit(target.family, values)
+        if found is None:
+            return None
+        if target.between > 0:
+            found["sigma"] = math.sqrt(max(found["sigma"] ** 2 - target.between ** 2,
+                                           (0.05 * found["sigma"]) ** 2))
+        return {f"{target.prefix}.{k}": v for k, v in found.items()}
+    if target.kind == "omission":
+        if not data.answered:
+            return None
+        return {target.prefix: data.omitted / data.answered}
+    if target.kind == "commission":
+        if not data.picks:
+            return None
+        model = _choice_model(data.picks)
+        if model.get("intended") != target.intended:
+            return None
+        commission = model.get("commission")
+        return {target.prefix: commission.probability if commission is not None else 0.0}
+    right = data.by_pick.get(target.intended or "", [])
+    wrong = [v for p, vs in data.by_pick.items() if p != target.intended for v in vs]
+    if not right or not wrong:
+        return None
+    lost = np.maximum(np.asarray(wrong) - float(np.mean(right)), 0.0)
+    if target.family is None:
+        return {f"{target.prefix}.value": float(lost.mean())}
+    found = _refit(target.family, lost.tolist())
+    return None if found is None else {f"{target.prefix}.{k}": v for k, v in found.items()}
+
+
+def _per_person(result: FitResult, activities: Sequence[str]) -> dict[str, dict[str, _Data]]:
+    obs = result.observations
+    people: dict[str, dict[str, _Data]] = {p: {} for p in obs.persons}
+
+    def data(session: tuple[int, int], activity: str) -> _Data:
+        return people.setdefault(obs.person(session), {}).setdefault(activity, _Data())
+
+    for activity in activities:
+        for session, values in obs.user_durations.get(activity, {}).items():
+            data(session, activity).durations.extend(values)
+        for session, (k, n) in obs.user_omissions.get(activity, {}).items():
+            d = data(session, activity)
+            d.omitted += k
+            d.answered += n
+        for session, sequences in obs.user_picks.get(activity, {}).items():
+            data(session, activity).picks.extend(sequences)
+        for pick, per_session in obs.user_pick_durations.get(activity, {}).items():
+            for session, values in per_session.items():
+                data(session, activity).by_pick.setdefault(pick, []).extend(values)
+    return {p: d for p, d in people.items() if d}
+
+
+def parameter_draws(result: FitResult, draws: int, *, seed: int = 0) -> ParameterDraws | None:
+    """``draws`` bootstrap redraws of the fitted parameters of ``result`` (None when the model
+    has no fitted parameter to redraw: only constants). Same traces and seed, same draws."""
+    targets = _targets(result)
+    if not targets or draws < 1:
+        return None
+    # every order below is fixed (sorted, or as first seen in the traces): the same traces
+    # and seed draw the same resamples whatever the hash seed of the process
+    activities = sorted({t.activity for t in targets})
+    people = _per_person(result, activities)
+    names = list(people)
+    whole = {a: _Data() for a in activities}
+    for person in names:
+        for activity, d in people[person].items():
+            whole[activity].add(d)
+    estimate: dict[str, float] = {}
+    for target in targets:
+        found = _values(target, whole[target.activity])
+        if found is not None:
+            estimate.update(found)
+    parameters = tuple(estimate)
+    if not parameters:
+        return None
+    by_persons = len(names) >= MIN_PERSONS
+    rng = np.random.default_rng(np.random.SeedSequence([int(seed), _STREAM]))
+    rows = []
+    failed = 0
+    for _ in range(draws):
+        sample = {a: _Data() for a in whole}
+        if by_persons:
+            chosen = [names[i] for i in rng.integers(0, len(names), len(names))]
+            for person in chosen:
+                for activity, d in people[person].items():
+                    sample[activity].add(d)
+        else:
+            for person in names:
+                for activity, d in people[person].items():
+                    sample[activity].add(d.within(rng))
+        row = dict(estimate)
+        for target in targets:
+            found = _values(target, sample[target.activity])
+            if found is None:
+                failed += 1
+                continue
+            row.update({k: v for k, v in found.items() if k in row})
+        rows.append(tuple(row[p] for p in parameters))
+    # a parameter every resample gives the same (a constant loss) is no uncertainty
+    keep = [i for i in range(len(parameters)) if any(r[i] != estimate[parameters[i]]
+                                                     for r in rows)]
+    if not keep:
+        return None
+    parameters = tuple(parameters[i] for i in keep)
+    rows = [tuple(r[i] for i in keep) for r in rows]
+    obs = result.observations
+    resampled = ("persons" if by_persons else "observations within each person")
+    source = (f"opspec fit: {draws} nonparametric bootstrap redraws (Barton & Schruben 2001) "
+              f"resampling {resampled} ({len(names)} person(s), {obs.sessions} session(s); "
+              f"Davison & Hinkley 1997, 3.8), each fitted as the data were (family kept)"
+              + (f"; {failed} parameter fit(s) of a resample failed and kept the estimate"
+                 if failed else ""))
+    return ParameterDraws(parameters, tuple(estimate[p] for p in parameters), tuple(rows),
+                          method="bootstrap", resampled=resampled, persons=len(names),
+                          sessions=obs.sessions, seed=int(seed), source=source)
