@@ -188,7 +188,8 @@ def test_the_dispenser_with_real_world_adherence_misses_what_the_closed_form_say
 
 PRESETS = ["dispenser-reference", "dispenser-older-adults", "dispenser-oldest-old",
            "dispenser-adherence", "dispenser-reference,older-adults",
-           "dispenser-reference,older-adults,mci", "klm"]
+           "dispenser-reference,older-adults,mci", "klm", "reaction-time-young",
+           "reaction-time-older", "reaction-time-by-age"]
 
 
 @pytest.mark.parametrize("preset", PRESETS)
