@@ -59,6 +59,14 @@ def register(subparsers: Any) -> None:
     parser.add_argument("--target-users", type=share, metavar="SHARE",
                         help="with --target: judge each user's own value, and ask that this "
                         "share of users (e.g. 95%%) meets the target")
+    parser.add_argument("--input-uncertainty", type=int, default=None, metavar="B",
+                        help="also run B parameter draws of a model fitted by `opspec fit`, "
+                        "each on users of its own, and report each metric's interval with "
+                        "the fitted parameters' uncertainty (docs/evaluation.md, Input "
+                        "uncertainty)")
+    parser.add_argument("--users-per-draw", type=int, default=None, metavar="M",
+                        help="with --input-uncertainty: users per parameter draw (default: "
+                        "--users / B, at least 10)")
     parser.add_argument("--engine-config", metavar="FILE", help="engine configuration TOML")
     parser.add_argument("--workers", type=int, default=None,
                         help="worker processes (default: all local cores)")
@@ -154,9 +162,19 @@ def _new_plan(args: argparse.Namespace) -> Any:
         raise EvaluationError(f"--case {args.case} applies to the xes and jsonl exports",
                               hint="add --export xes (or jsonl), or drop --case (OCEL "
                               "relates each event to every object instead of one case)")
+    draws = args.input_uncertainty or 0
+    if args.users_per_draw is not None and not draws:
+        raise EvaluationError("--users-per-draw goes with --input-uncertainty B")
+    per_draw = 0
+    if draws:
+        from opspec.evaluation.input_uncertainty import default_users_per_draw
+
+        per_draw = (args.users_per_draw if args.users_per_draw is not None
+                    else default_users_per_draw(users, draws))
     return EvaluationPlan(designs=tuple(designs), users=users, days=days,
                           seed=run_seed, user_model=model, engine=_engine(args.engine_config),
-                          export=export, case=args.case or "user")
+                          export=export, case=args.case or "user",
+                          input_uncertainty=draws, users_per_draw=per_draw)
 
 
 def _check_plan(plan: Any) -> dict[str, list[dict[str, Any]]]:
@@ -186,6 +204,10 @@ def _check_plan(plan: Any) -> dict[str, list[dict[str, Any]]]:
         from opspec.evaluation.describe import metric_record
 
         definitions[design.label] = [metric_record(m) for m in context.compiled.package.metrics]
+    if plan.input_uncertainty:          # the fitted model's draws: there, and enough of them
+        from opspec.evaluation.input_uncertainty import check_draws
+
+        check_draws(plan)
     return definitions
 
 
@@ -271,6 +293,12 @@ def _resume_differences(args: argparse.Namespace, plan: Any) -> list[str]:
                            f"{','.join(plan.export) or 'none'})")
     if args.case is not None and args.case != plan.case:
         differs.append(f"--case {args.case} (stored: {plan.case})")
+    if args.input_uncertainty is not None and args.input_uncertainty != plan.input_uncertainty:
+        differs.append(f"--input-uncertainty {args.input_uncertainty} (stored: "
+                       f"{plan.input_uncertainty or 'none'})")
+    if args.users_per_draw is not None and args.users_per_draw != plan.users_per_draw:
+        differs.append(f"--users-per-draw {args.users_per_draw} (stored: "
+                       f"{plan.users_per_draw or 'none'})")
     return differs
 
 
@@ -424,6 +452,11 @@ def run(args: argparse.Namespace) -> int:
         population = summarise_population(store, plan.days, designs=[
             d.label for d in plan.designs] if swept is None else ["A"])
         summaries["A"]["population"] = population
+        from opspec.evaluation.input_uncertainty import summarise_input_uncertainty
+
+        uncertainty = summarise_input_uncertainty(
+            store, plan, metrics, compare=compare["difference"] if compare else None)
+        summaries["A"]["input_uncertainty"] = uncertainty
         if swept is not None:               # per value, paired against the first; targets
             from opspec.evaluation.sweep import summarise_sweep
 
@@ -446,6 +479,7 @@ def run(args: argparse.Namespace) -> int:
                "scheduler": args.scheduler,
                "out": str(store.folder), "report": str(report), "metrics": metrics,
                "monitors": monitors, "population": population,
+               "input_uncertainty": uncertainty,
                "failed": [{"design": d, "user": u, "error": e} for d, u, e in failures],
                "wall_s": round(outcome.wall_s, 3)}
         if compare is not None:
@@ -458,6 +492,9 @@ def run(args: argparse.Namespace) -> int:
 
         print_summary(sys.stdout, plan, metrics, compare, outcome, failures, workers,
                       monitors=monitors, population=population)
+        from opspec.evaluation.input_uncertainty import print_input_uncertainty
+
+        print_input_uncertainty(sys.stdout, uncertainty)
         if swept is not None:
             from opspec.evaluation.sweep import print_sweep
 

@@ -67,6 +67,10 @@ class EvaluationPlan:
     export: tuple[str, ...] = ()
     #: what one case of the XES and JSON Lines exports is (opspec.evaluation.cases)
     case: str = "user"
+    #: ``--input-uncertainty B``: parameter draws of the fitted user model to run, each on
+    #: ``users_per_draw`` users of its own (opspec.evaluation.input_uncertainty); 0: none
+    input_uncertainty: int = 0
+    users_per_draw: int = 0
 
     def __post_init__(self) -> None:
         if isinstance(self.users, bool) or not isinstance(self.users, int) or self.users < 1:
@@ -93,6 +97,8 @@ class EvaluationPlan:
                            or d.parameters} for d in self.designs]
         doc["engine"] = dict(self.engine)
         doc["export"] = list(self.export)
+        if not self.input_uncertainty:      # plans without draws read as they always did
+            del doc["input_uncertainty"], doc["users_per_draw"]
         return doc
 
     @classmethod
@@ -103,11 +109,14 @@ class EvaluationPlan:
         return cls(designs=designs, users=int(doc["users"]),
                    days=float(doc["days"]), seed=int(doc["seed"]),
                    user_model=doc.get("user_model"), engine=dict(doc.get("engine") or {}),
-                   export=tuple(doc.get("export") or ()), case=str(doc.get("case") or "user"))
+                   export=tuple(doc.get("export") or ()), case=str(doc.get("case") or "user"),
+                   input_uncertainty=int(doc.get("input_uncertainty") or 0),
+                   users_per_draw=int(doc.get("users_per_draw") or 0))
 
     def same_results_as(self, other: EvaluationPlan) -> list[str]:
         """What differs between two plans in ways that change results (for ``--resume``)."""
         mine, theirs = self.to_json(), other.to_json()
-        return [key for key in ("designs", "users", "days", "seed", "user_model", "engine")
-                if json.dumps(mine[key], sort_keys=True) != json.dumps(theirs[key],
-                                                                        sort_keys=True)]
+        return [key for key in ("designs", "users", "days", "seed", "user_model", "engine",
+                                "input_uncertainty", "users_per_draw")
+                if json.dumps(mine.get(key), sort_keys=True) != json.dumps(theirs.get(key),
+                                                                            sort_keys=True)]

@@ -190,6 +190,10 @@ def run_user(context: _Context, design: str, user: int, *, seed: int, horizon: f
 def run_users(plan: Mapping[str, Any], design: str, users: Sequence[int]
               ) -> list[ReplicationRecord]:
     """Worker entry point: replications ``users`` of ``design`` (``plan`` as JSON)."""
+    if design.endswith("~draws"):       # users of the fitted model's parameter draws
+        from opspec.evaluation.input_uncertainty import run_draw_users
+
+        return run_draw_users(plan, design, users)
     spec = next(d for d in plan["designs"] if d["label"] == design)
     context = prepare(spec["spec"], spec["sha256"], plan.get("user_model"),
                       plan.get("engine") or {}, spec.get("parameters") or ())

@@ -670,6 +670,12 @@ def write_report(store: ResultStore, summaries: Mapping[str, Summaries] | None =
                                            "Paired differences B − A per subgroup "
                                            "[95 % CI]"),)))
 
+    if plan.get("input_uncertainty"):      # the fitted model's parameter draws
+        from opspec.evaluation.input_uncertainty import report_section
+
+        sections.append(report_section(store, given_a, (summaries.get("B") or {}).get(
+            "difference") if "B" in designs else None))
+
     if failures:
         sections.append(Section("Failed replications", paragraphs=(
             "Run `opspec evaluate --resume --out <this folder>` to run them again.",),

@@ -280,6 +280,7 @@ def run_evaluation(plan: EvaluationPlan, store: ResultStore, *, workers: int = 1
     # a user-month of the dispenser is ~0.4 MB of trace: small chunks when traces travel back
     most = EXPORT_CHUNK if plan.export else 50
     stored: set[tuple[str, int]] = set()
+    not_retraced = 0
     for design in plan.designs:
         finished = store.finished(design.label)
         skipped += len(finished)
@@ -287,8 +288,18 @@ def run_evaluation(plan: EvaluationPlan, store: ResultStore, *, workers: int = 1
         todo = [u for u in range(plan.users) if retrace or u not in finished]
         pending.extend((design.label, chunk)
                        for chunk in chunks(todo, max(1, workers), most=most))
-    total = plan.users * len(plan.designs)
-    progress.start(total, 0 if retrace else skipped)
+    if plan.input_uncertainty:      # the parameter draws' users (never traced)
+        from opspec.evaluation.input_uncertainty import draw_users, draws_label
+
+        for design in plan.designs:
+            label = draws_label(design.label)
+            finished = store.finished(label)
+            skipped += len(finished)
+            not_retraced += len(finished)
+            pending.extend((label, chunk) for chunk in chunks(
+                [u for u in draw_users(plan) if u not in finished], max(1, workers)))
+    total = (plan.users + plan.input_uncertainty * plan.users_per_draw) * len(plan.designs)
+    progress.start(total, not_retraced if retrace else skipped)
     doc = plan.to_json()
     done = failed = 0
 

@@ -1,0 +1,394 @@
+"""Input uncertainty: an evaluation's intervals when the user model was fitted, not known.
+
+``opspec evaluate --input-uncertainty B`` (a user model written by ``opspec fit``, whose
+``[uncertainty]`` table holds bootstrap redraws of its parameters:
+:mod:`opspec.usermodels.uncertainty`) runs, beside the ordinary evaluation at the point
+estimates, ``B`` *parameter draws*, each on a batch of ``m`` users of its own (``m`` =
+``--users-per-draw``). This is the direct bootstrap of Barton & Schruben (2001, "Resampling
+methods for input modeling", Proc. Winter Simulation Conference) with the variance split of
+Ankenman & Nelson (2012, "A quick assessment of input uncertainty", Proc. WSC; Barton,
+Nelson & Xie 2014, "Quantifying input uncertainty via simulation confidence intervals",
+INFORMS J. Computing 26(1)):
+
+* each batch ``b`` gives the metric's estimate ``θ_b`` (the same cluster-robust ratio as the
+  ordinary summary) and its simulation variance ``s_b²``;
+* the variance of ``θ_b`` over batches is the parameters' variance plus the batches'
+  simulation noise (a random-effects model), so the **parameter variance** is
+  ``σ_I² = var_b(θ_b) − mean_b(s_b²)`` (at least 0);
+* the interval **with parameter uncertainty** is ``θ̂ ± t·sqrt(se² + σ_I²)`` around the
+  ordinary estimate ``θ̂`` (whose simulation variance is ``se²``), t on the
+  Welch-Satterthwaite degrees of freedom of the two parts (U − 1 and B − 1); never narrower
+  than the ordinary interval;
+* the **parameter share** ``σ_I² / (se² + σ_I²)``: how much of the widened interval's
+  variance the fitted parameters cause, the rest being simulation noise — more users shrink
+  only the rest;
+* the direct bootstrap's percentile interval of the ``θ_b`` is reported too (it also holds
+  the batches' simulation noise: conservative when ``m`` is small, crude below B = 40).
+
+Users and streams: user ``u`` of a run seeded ``S`` always draws from ``(S, u)``
+(:mod:`opspec.evaluation.replication`). The ordinary users are ``0 .. U−1`` as ever, so the
+ordinary results are byte for byte those of a run without ``--input-uncertainty``; draw
+``b`` (1-based) runs users ``U + (b−1)·m .. U + b·m − 1``, stored under the design label
+``A~draws`` (``B~draws`` with ``--compare``: the same users and the same draw, so paired
+differences keep their common random numbers). A user's draw depends on ``(U, m, u)`` only:
+the same seed gives the same results whatever the number of workers.
+"""
+
+from __future__ import annotations
+
+import math
+import statistics as pystats
+from collections.abc import Mapping, Sequence
+from dataclasses import replace
+from typing import IO, Any
+
+from opspec.errors import EvaluationError, OpspecError
+
+__all__ = ["SUFFIX", "base_design", "check_draws", "draw_of", "draw_users", "draws_label",
+           "print_input_uncertainty", "run_draw_users", "summarise_input_uncertainty"]
+
+#: the store's design label of design X's parameter draws is X + SUFFIX
+SUFFIX = "~draws"
+#: users per draw when --users-per-draw is not given: the ordinary run's users spread over
+#: the draws (so the draws cost about as much as the ordinary run), at least this many
+MIN_USERS_PER_DRAW = 10
+
+
+def draws_label(label: str) -> str:
+    return f"{label}{SUFFIX}"
+
+
+def base_design(label: str) -> str | None:
+    """``A`` for ``A~draws``; None for an ordinary design label."""
+    return label[:-len(SUFFIX)] if label.endswith(SUFFIX) else None
+
+
+def default_users_per_draw(users: int, draws: int) -> int:
+    return max(MIN_USERS_PER_DRAW, math.ceil(users / max(draws, 1)))
+
+
+def draw_users(plan: Any) -> range:
+    """The user indices of every draw's batch (after the ordinary users)."""
+    return range(plan.users, plan.users + plan.input_uncertainty * plan.users_per_draw)
+
+
+def draw_of(users: int, per_draw: int, user: int) -> int:
+    """The draw (1-based) user ``user`` runs, ``users`` being the ordinary users."""
+    return 1 + (user - users) // per_draw
+
+
+# ---------------------------------------------------------------------------- checking
+
+def check_draws(plan: Any) -> Any:
+    """The parameter draws of the plan's user model, checked against what the plan asks
+    (an EvaluationError saying what to do otherwise)."""
+    from opspec.usermodels.uncertainty import read_parameter_draws
+
+    if plan.input_uncertainty < 2:
+        raise EvaluationError(f"--input-uncertainty needs at least 2 draws, not "
+                              f"{plan.input_uncertainty}",
+                              hint="20 to 100 draws is usual (the variance between draws "
+                              "needs several)")
+    if plan.users_per_draw < 2:
+        raise EvaluationError(f"--users-per-draw must be at least 2, not "
+                              f"{plan.users_per_draw}",
+                              hint="each draw's simulation noise is estimated from its users")
+    if plan.user_model is None:
+        raise EvaluationError("--input-uncertainty needs a fitted user model",
+                              hint="fit one with `opspec fit TRACES -o model.users.toml` and "
+                              "give it with --user-model")
+    if any(d.parameters for d in plan.designs):
+        raise EvaluationError("--input-uncertainty and --sweep cannot be combined",
+                              hint="evaluate the value of interest with --input-uncertainty "
+                              "on its own")
+    found = read_parameter_draws(plan.user_model)
+    if found is None:
+        raise EvaluationError(
+            f"{plan.user_model} holds no parameter draws (no [uncertainty] table)",
+            hint="fit the model with `opspec fit` (it writes 200 draws; --draws B for "
+            "more), or drop --input-uncertainty")
+    draws, _ = found
+    if plan.input_uncertainty > draws.count:
+        raise EvaluationError(
+            f"--input-uncertainty {plan.input_uncertainty}: {draws.path} holds "
+            f"{draws.count} parameter draws", hint=f"ask for at most {draws.count}, or fit "
+            f"again with --draws {plan.input_uncertainty}")
+    return draws
+
+
+# ----------------------------------------------------------------------------- running
+
+_DRAWN: dict[tuple[Any, ...], Any] = {}
+
+
+def _context(plan: Mapping[str, Any], base: Mapping[str, Any], draw: int) -> Any:
+    """The replication context of design ``base`` with the user model of draw ``draw``
+    (loaded once per process and draw)."""
+    from opspec.evaluation.replication import prepare
+    from opspec.runs import User
+    from opspec.usermodels.uncertainty import drawn_model, read_parameter_draws
+
+    ref = str(plan["user_model"])
+    context = prepare(base["spec"], base["sha256"], ref, plan.get("engine") or {})
+    key = (id(context), ref, draw)
+    found = _DRAWN.get(key)
+    if found is None:
+        located = _DRAWN.get((ref,))
+        if located is None:
+            located = _DRAWN[(ref,)] = read_parameter_draws(ref)
+        if located is None:
+            raise EvaluationError(f"{ref} holds no parameter draws")
+        draws, index = located
+        model = drawn_model(ref, draws, index, draw)
+        describe = context.user.describe if context.user is not None else None
+        found = _DRAWN[key] = replace(context, user=User.model(model, describe))
+    return found
+
+
+def run_draw_users(plan: Mapping[str, Any], label: str, users: Sequence[int]) -> list[Any]:
+    """Worker entry point for the users of ``label`` (``A~draws``): each user simulated with
+    their draw's model, on their own streams (no traces are kept)."""
+    from opspec.evaluation.replication import DAY, ReplicationRecord, run_user
+
+    base_label = base_design(label)
+    base = next(d for d in plan["designs"] if d["label"] == base_label)
+    horizon = float(plan["days"]) * DAY
+    ordinary, per_draw = int(plan["users"]), int(plan["users_per_draw"])
+    records = []
+    for u in users:
+        draw = draw_of(ordinary, per_draw, u)
+        try:
+            context = _context(plan, base, draw)
+        except OpspecError as error:
+            records.append(ReplicationRecord(label, u, "failed", error=f"draw {draw}: "
+                                             f"{error}"))
+            continue
+        records.append(run_user(context, label, u, seed=int(plan["seed"]), horizon=horizon,
+                                keep_trace=False))
+    return records
+
+
+# --------------------------------------------------------------------------- summarising
+
+def _estimate(pairs: Sequence[tuple[float, float]]) -> tuple[float, float] | None:
+    """``(Σy/Σn, its cluster-robust variance)`` (the delta method of
+    :func:`opspec.statistics.ratio_estimate`); None without two users or any denominator."""
+    users = len(pairs)
+    total = math.fsum(n for _, n in pairs)
+    if users < 2 or total <= 0:
+        return None
+    r = math.fsum(y for y, _ in pairs) / total
+    nbar = total / users
+    resid = math.fsum((y - r * n) ** 2 for y, n in pairs)
+    return r, resid / (users * (users - 1)) / nbar ** 2
+
+
+def _difference(a: Sequence[tuple[float, float]], b: Sequence[tuple[float, float]]
+                ) -> tuple[float, float] | None:
+    """``(r_B − r_A, its paired variance)`` on the same users."""
+    ea, eb = _estimate(a), _estimate(b)
+    if ea is None or eb is None:
+        return None
+    users = len(a)
+    na, nb = math.fsum(n for _, n in a) / users, math.fsum(n for _, n in b) / users
+    z = [(yb - eb[0] * mb) / nb - (ya - ea[0] * ma) / na
+         for (ya, ma), (yb, mb) in zip(a, b, strict=True)]
+    return eb[0] - ea[0], pystats.variance(z) / users
+
+
+def _percentile(ordered: Sequence[float], q: float) -> float:
+    pos = (len(ordered) - 1) * q
+    lo = math.floor(pos)
+    hi = min(lo + 1, len(ordered) - 1)
+    return ordered[lo] + (ordered[hi] - ordered[lo]) * (pos - lo)
+
+
+def _combine(estimate: float | None, ordinary: Sequence[float | None] | None,
+             simulation: float | None, users: int, batches: Sequence[tuple[float, float]],
+             level: float, *, proportion: bool = False) -> dict[str, Any]:
+    """The widened interval of one metric (see the module docstring)."""
+    from opspec.statistics import t_quantile
+
+    out: dict[str, Any] = {"estimate": estimate, "ci95": list(ordinary) if ordinary else None,
+                           "draws": len(batches)}
+    if estimate is None or simulation is None or len(batches) < 2:
+        return {**out, "ci95_with_parameters": None, "direct_bootstrap_ci95": None,
+                "variance": None, "parameter_share": None}
+    values = [v for v, _ in batches]
+    between = pystats.variance(values)
+    noise = pystats.fmean(s for _, s in batches)
+    parameters = max(between - noise, 0.0)
+    total = simulation + parameters
+    b = len(batches)
+    if total > 0:
+        denominator = ((simulation ** 2 / (users - 1) if users > 1 else 0.0)
+                       + parameters ** 2 / (b - 1))
+        df = total ** 2 / denominator if denominator > 0 else float(users - 1)
+        half = t_quantile(level, max(1, math.floor(df))) * math.sqrt(total)
+    else:
+        df, half = float(users - 1), 0.0
+    low, high = estimate - half, estimate + half
+    if ordinary and ordinary[0] is not None and ordinary[1] is not None:
+        if ordinary[0] >= 0 and low < 0 and estimate >= 0:
+            low = 0.0           # as the ordinary interval: a rate cannot be negative
+        low, high = min(low, ordinary[0]), max(high, ordinary[1])
+    if proportion:
+        high = min(high, 1.0)
+    ordered = sorted(values)
+    alpha = (1 - level) / 2
+    return {**out, "ci95_with_parameters": [low, high],
+            "direct_bootstrap_ci95": [_percentile(ordered, alpha),
+                                      _percentile(ordered, 1 - alpha)],
+            "variance": {"parameters": parameters, "simulation": simulation,
+                         "between_draws": between, "within_draws": noise},
+            "parameter_share": parameters / total if total > 0 else 0.0,
+            "df": df}
+
+
+def _proportion(pairs: Sequence[tuple[float, float]]) -> bool:
+    """Whether every user's (y, n) is a count of events out of n trials (a rate <= 1)."""
+    return bool(pairs) and all(0 <= y <= n and y == int(y) and n == int(n) and n > 0
+                               or n == 0 for y, n in pairs) and any(y < n for y, n in pairs)
+
+
+def _batches(store: Any, plan: Any, label: str, definition: Mapping[str, Any]
+             ) -> dict[int, dict[int, tuple[float, float]]]:
+    """Per draw, per user of its batch: the metric's (y, n) pair."""
+    from opspec.evaluation.summary import user_pairs
+
+    out: dict[int, dict[int, tuple[float, float]]] = {}
+    for user, pair in user_pairs(store, draws_label(label), definition):
+        out.setdefault(draw_of(plan.users, plan.users_per_draw, user), {})[user] = pair
+    return out
+
+
+def summarise_input_uncertainty(store: Any, plan: Any, metrics: Mapping[str, Any],
+                                level: float = 0.95, *, design: str = "A",
+                                compare: Mapping[str, Any] | None = None
+                                ) -> dict[str, Any] | None:
+    """Per metric of ``design`` (``metrics``: its ordinary summary): the ordinary ``ci95``,
+    ``ci95_with_parameters``, ``direct_bootstrap_ci95``, the ``variance`` split and the
+    ``parameter_share``; with ``compare`` (the ordinary paired differences) the same for
+    each difference B − A. None for a run without parameter draws."""
+    if not plan.input_uncertainty:
+        return None
+    from opspec.evaluation.summary import metric_definitions, user_pairs
+
+    out: dict[str, Any] = {"draws": plan.input_uncertainty,
+                           "users_per_draw": plan.users_per_draw,
+                           "method": "direct bootstrap (Barton & Schruben 2001) with the "
+                           "random-effects variance split of Ankenman & Nelson (2012)",
+                           "metrics": {}}
+    for definition in metric_definitions(store, design):
+        name = definition["name"]
+        ordinary = metrics.get(name) or {}
+        pairs = [p for _, p in user_pairs(store, design, definition)]
+        plain = _estimate(pairs)
+        batches = [e for users in _batches(store, plan, design, definition).values()
+                   if (e := _estimate(list(users.values()))) is not None]
+        estimate = ordinary.get("value", ordinary.get("mean"))
+        out["metrics"][name] = _combine(estimate, ordinary.get("ci95"),
+                                        plain[1] if plain else None, len(pairs), batches,
+                                        level, proportion=_proportion(pairs))
+    if compare:
+        out["difference"] = {}
+        theirs = {d["name"]: d for d in metric_definitions(store, "B")}
+        for definition in metric_definitions(store, design):
+            name = definition["name"]
+            if name not in compare or name not in theirs:
+                continue
+            a = dict(user_pairs(store, design, definition))
+            b = dict(user_pairs(store, "B", theirs[name]))
+            common = sorted(set(a) & set(b))
+            plain = _difference([a[u] for u in common], [b[u] for u in common])
+            batch_a = _batches(store, plan, design, definition)
+            batch_b = _batches(store, plan, "B", theirs[name])
+            batches = []
+            for draw, users_a in batch_a.items():
+                users_b = batch_b.get(draw, {})
+                both = sorted(set(users_a) & set(users_b))
+                found = _difference([users_a[u] for u in both], [users_b[u] for u in both])
+                if found is not None:
+                    batches.append(found)
+            entry = compare[name]
+            out["difference"][name] = _combine(entry.get("difference"), entry.get("ci95"),
+                                               plain[1] if plain else None, len(common),
+                                               batches, level)
+    return out
+
+
+# ------------------------------------------------------------------------------ printing
+
+def _number(value: float | None) -> str:
+    return "-" if value is None else f"{value:.4g}"
+
+
+def _interval(ci: Sequence[float | None] | None) -> str:
+    if not ci or ci[0] is None or ci[1] is None:
+        return "-"
+    return f"[{_number(ci[0])}, {_number(ci[1])}]"
+
+
+HEADERS = ("metric", "estimate", "95 % CI (simulation)", "95 % CI (+ parameters)",
+           "direct bootstrap", "from parameters")
+
+
+def _rows(summary: Mapping[str, Any]) -> list[tuple[str, ...]]:
+    rows: list[tuple[str, ...]] = []
+    for section, prefix in (("metrics", ""), ("difference", "B - A: ")):
+        for name, entry in (summary.get(section) or {}).items():
+            share = entry.get("parameter_share")
+            rows.append((prefix + name, _number(entry.get("estimate")),
+                         _interval(entry.get("ci95")),
+                         _interval(entry.get("ci95_with_parameters")),
+                         _interval(entry.get("direct_bootstrap_ci95")),
+                         "-" if share is None else f"{100 * share:.0f} %"))
+    return rows
+
+
+def _title(summary: Mapping[str, Any]) -> str:
+    return (f"{summary['draws']} parameter draws of the fitted model x "
+            f"{summary['users_per_draw']} users each ({summary['method']})")
+
+
+def report_section(store: Any, given: Mapping[str, Any],
+                   difference: Mapping[str, Any] | None) -> Any:
+    """The report's section on input uncertainty (``given``: design A's summaries)."""
+    from opspec.evaluation.html import Section, Table
+    from opspec.evaluation.plan import EvaluationPlan
+
+    summary = given.get("input_uncertainty")
+    if summary is None:
+        from opspec.evaluation.summary import compare_designs, summarise_design
+
+        plan = EvaluationPlan.from_json(store.get("plan"))
+        metrics = given.get("metrics") or summarise_design(store, "A", plan.days)
+        if difference is None and any(d.label == "B" for d in plan.designs):
+            difference = compare_designs(store)
+        summary = summarise_input_uncertainty(store, plan, metrics, compare=difference)
+    assert summary is not None
+    return Section("With the fitted model's parameter uncertainty", paragraphs=(
+        ("The user model was fitted from recorded traces, so its parameters are estimates. "
+        f"{_title(summary)}: each draw is the model refitted to a bootstrap resample of "
+        "the traces, run on users of its own. 'from parameters' is the share of the "
+        "widened interval's variance due to the parameters; more simulated users narrow "
+        "only the rest, more recorded observations narrow this part. See "
+        "docs/evaluation.md, Input uncertainty."),),
+        tables=(Table(HEADERS, tuple(_rows(summary)),
+                      "Ordinary 95 % intervals (simulation noise only) and intervals that "
+                      "include the fitted parameters' uncertainty"),))
+
+
+def print_input_uncertainty(out: IO[str], summary: Mapping[str, Any] | None) -> None:
+    """The table of ordinary and widened intervals, after the ordinary summary."""
+    if not summary:
+        return
+    rows = [HEADERS, *_rows(summary)]
+    widths = [max(len(r[i]) for r in rows) for i in range(len(rows[0]))]
+    print(f"\nInput uncertainty: {_title(summary)}", file=out)
+    for row in rows:
+        print("  " + "  ".join(c.ljust(w) if i == 0 else c.rjust(w)
+                               for i, (c, w) in enumerate(zip(row, widths, strict=True))),
+              file=out)
+    print("  'from parameters': the share of the widened interval's variance due to the "
+          "fitted parameters;\n  more users narrow only the rest.", file=out)
