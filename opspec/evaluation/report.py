@@ -86,26 +86,24 @@ def _observations(store: ResultStore, design: str, metric: str) -> tuple[list[fl
     return [float(r[0]) for r in rows], total
 
 
-def _per_day_all(store: ResultStore, design: str, metrics: list[str], days: int, users: int
-                 ) -> dict[str, list[float]]:
-    """The mean count per user, day by day, of every metric in ``metrics`` (one pass over the
-    outcomes)."""
-    rows: dict[str, dict[int, float]] = {m: {} for m in metrics}
-    for metric, day, n in store.query("SELECT metric, day, SUM(n) FROM outcome WHERE "
-                                      "design = ? GROUP BY metric, day", (design,)):
-        if metric in rows:
-            rows[metric][int(day)] = float(n)
-    return {m: [rows[m].get(d, 0.0) / max(users, 1) for d in range(days)] for m in metrics}
-
-
-def _by_hour_all(store: ResultStore, design: str, metrics: list[str]) -> dict[str, list[int]]:
-    """The total count by hour of the day of every metric in ``metrics`` (one pass)."""
-    rows: dict[str, dict[int, int]] = {m: {} for m in metrics}
-    for metric, hour, n in store.query("SELECT metric, hour, SUM(n) FROM outcome WHERE "
-                                       "design = ? GROUP BY metric, hour", (design,)):
-        if metric in rows:
-            rows[metric][int(hour)] = int(n)
-    return {m: [rows[m].get(h, 0) for h in range(24)] for m in metrics}
+def _outcomes_all(store: ResultStore, design: str, metrics: list[str], days: int, users: int
+                  ) -> tuple[dict[str, list[float]], dict[str, list[int]]]:
+    """Per metric in ``metrics``: its mean count per user on each day, and its total count in
+    each hour of the day. One pass over the outcome table (its largest: a row per user, metric,
+    day and hour), summed by SQLite to at most metrics x days x 24 rows."""
+    by_day: dict[str, dict[int, float]] = {m: {} for m in metrics}
+    by_hour: dict[str, dict[int, int]] = {m: {} for m in metrics}
+    for metric, day, hour, n in store.query(
+            "SELECT metric, day, hour, SUM(n) FROM outcome WHERE design = ? "
+            "GROUP BY metric, day, hour", (design,)):
+        if metric in by_day:
+            day_counts, hour_counts = by_day[metric], by_hour[metric]
+            day_counts[int(day)] = day_counts.get(int(day), 0.0) + float(n)
+            hour_counts[int(hour)] = hour_counts.get(int(hour), 0) + int(n)
+    per_day = {m: [by_day[m].get(d, 0.0) / max(users, 1) for d in range(days)]
+               for m in metrics}
+    per_hour = {m: [by_hour[m].get(h, 0) for h in range(24)] for m in metrics}
+    return per_day, per_hour
 
 
 def _activity_rates(store: ResultStore, design: str
@@ -478,8 +476,7 @@ def _design_sections(store: ResultStore, figures: Path, design: str, name: str, 
     counts = [d["name"] for d in definitions if d["kind"] == "count"]
     if counts:
         # one pass over the outcome table for all metrics, not two per metric (issue 20)
-        per_day = _per_day_all(store, design, counts, max(1, round(days)), users)
-        hours = _by_hour_all(store, design, counts)
+        per_day, hours = _outcomes_all(store, design, counts, max(1, round(days)), users)
         sections.append(Section(f"{prefix}Counts over time", images=(
             plots.over_days_figure(per_day, figures / f"{design}-days.png"),
             plots.time_of_day_figure(hours, figures / f"{design}-hours.png")), captions=(
