@@ -272,14 +272,34 @@ def read_parameter_draws(ref: str | Path) -> tuple[ParameterDraws, int] | None:
     return None
 
 
+#: the models loaded up to the fitted part, by reference and the parts' file states (a
+#: worker runs many draws of one file: it is read once, not once per draw)
+_LOADED: dict[tuple[Any, ...], Any] = {}
+
+
+def _state(part: str) -> tuple[str, int, int]:
+    try:
+        found = Path(part).stat()
+    except OSError:
+        return part, 0, 0
+    return part, found.st_mtime_ns, found.st_size
+
+
 def drawn_model(ref: str, draws: ParameterDraws, index: int, draw: int) -> Any:
     """The model ``ref`` names with draw ``draw`` applied to its part ``index`` (the fitted
     file), before the parts composed on top of it (their modifiers then apply as usual)."""
     from opspec.usermodels.loader import load_user_model
 
-    model = None
-    for i, part in enumerate(p.strip() for p in ref.split(",")):
+    parts = [p.strip() for p in ref.split(",")]
+    key = tuple(_state(p) for p in parts[:index + 1])
+    model = _LOADED.get(key)
+    if model is None:
+        for part in parts[:index + 1]:
+            model = load_user_model(part, base=model)
+        if len(_LOADED) > 16:
+            _LOADED.clear()
+        _LOADED[key] = model
+    model = draws.apply(model, draw)
+    for part in parts[index + 1:]:
         model = load_user_model(part, base=model)
-        if i == index:
-            model = draws.apply(model, draw)
     return model
