@@ -24,6 +24,7 @@ from collections.abc import Sequence
 from typing import Any, ClassVar
 
 from rich.text import Text
+from textual import events
 from textual.app import App, ComposeResult
 from textual.binding import Binding
 from textual.containers import Horizontal, Vertical, VerticalScroll
@@ -40,6 +41,7 @@ SPEEDS = {"1": 1.0, "2": 10.0, "3": 60.0, "4": 600.0}
 # the offers shown: every letter no other action uses (h l n q s u w x are taken), a..f first
 OFFER_KEYS = "".join(k for k in string.ascii_lowercase if k not in "hlnqsuwx")
 LANES = ("all", "device", "user")
+FOOTER_SPACED_WIDTH = 84      # the footer's keys with their padding (tests/tui checks 80 fits)
 TICK_S = 0.1
 # The engine runs in slices so that keys (q, ctrl+c, space) are read between them: at most
 # SLICE_STEPS engine events per slice, and slices for at most SLICE_S of wall time per tick.
@@ -55,7 +57,7 @@ HELP = """\
   [b]space[/b]   pause / resume the clock
   [b]1 2 3 4[/b] speed: real time, 10x, 60x, 600x
   [b]w[/b]       let 30 simulated seconds pass
-  [b]n[/b]       skip to the next event
+  [b]n[/b]       step: skip to the next event
   [b]u[/b]       skip until something new needs you (again: stop)
   [b]h[/b]       hand your lane to the user model / take it back
   [b]l[/b]       timeline: all lanes / device / user (/ hidden, with --large)
@@ -105,6 +107,14 @@ class SummaryScreen(ModalScreen[None]):
         with VerticalScroll():
             yield Static(Text("\n".join([*self.lines, "", "q: quit   escape: close"])),
                          id="summary-text")
+
+
+class FittingFooter(Footer):
+    """The footer, its keys closed up on a terminal narrower than the spaced-out footer, so
+    that every key stays visible (80 x 24 is the usual lab terminal)."""
+
+    def on_resize(self, event: events.Resize) -> None:
+        self.compact = event.size.width < FOOTER_SPACED_WIDTH
 
 
 HIGH_CONTRAST = Theme(
@@ -200,7 +210,7 @@ class WalkthroughApp(App[str | None]):
         Binding("3", "speed('3')", "60x", show=False),
         Binding("4", "speed('4')", "600x", show=False),
         Binding("w", "wait", "wait 30s"),
-        Binding("n", "next_event", "next event"),
+        Binding("n", "next_event", "step"),
         Binding("u", "until_user", "until me"),
         Binding("h", "hand_over", "model/me"),
         Binding("l", "lane", "lanes", show=False),
@@ -238,7 +248,7 @@ class WalkthroughApp(App[str | None]):
                 yield Vertical(id="offers")
                 yield Static(id="aftermath")
         yield Static(id="timeline")
-        yield Footer()
+        yield FittingFooter()
 
     def on_mount(self) -> None:
         if self.high_contrast:
