@@ -213,7 +213,8 @@ def latency_figure(metric: str, values: Sequence[float], path: Path, *,
         left.set_ylim(0.0, 1.02)
         _percent_axis(left, "y")
         bins: Any = "auto" if np.ptp(arr) > 0 else 1
-        right.hist(arr, bins=bins, color=PALETTE[5], edgecolor=PALETTE[0], linewidth=0.6)
+        right.hist(arr, bins=bins, histtype="stepfilled", color=PALETTE[5], edgecolor=PALETTE[0],
+                   linewidth=0.8)
         right.set_title("Histogram")
         right.set_xlabel(f"{metric} (seconds)")
         right.set_ylabel("number of observations" + (" (in the sample)" if sampled else ""))
