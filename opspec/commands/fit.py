@@ -6,9 +6,12 @@ import argparse
 import json
 import sys
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from opspec.usermodels.persons import PERSON_FROM
+
+if TYPE_CHECKING:
+    from opspec.usermodels.uncertainty import ParameterDraws
 
 __all__ = ["register"]
 
@@ -86,7 +89,7 @@ def _persons_line(obs: Any, source: str) -> str:
             + (f" ({shown}{more})" if any(n > 1 for n in counts.values()) else "") + how)
 
 
-def _uncertainty_text(draws: Any) -> str:
+def _uncertainty_text(draws: ParameterDraws | None) -> str:
     """The ``[uncertainty]`` table: the bootstrap redraws of the fitted parameters."""
     if draws is None:
         return ""

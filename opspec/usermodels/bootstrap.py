@@ -21,7 +21,12 @@ observations — the sessions of one person share their speed and their forgetfu
 least :data:`MIN_PERSONS` persons, persons are drawn with replacement and keep all their
 observations (Davison & Hinkley's recommended strategy when there are enough clusters). With
 fewer (one participant recorded for a week), between-person differences cannot be estimated
-at all and each person's observations are resampled within that person.
+at all and each person's durations are resampled within that person, while each rate
+(omission, commission) is drawn from its Jeffreys posterior Beta(k + 1/2, n - k + 1/2)
+(Chick 2001, "Input distribution selection for simulation experiments: accounting for input
+uncertainty", Operations Research 49(5)): resampling 20 prompts with 2 omissions would spread
+the rate like the Wald interval, which covers far less than it says at such counts (Brown,
+Cai & DasGupta 2001, Statistical Science 16(2)); the Jeffreys interval keeps its level.
 
 Each resample is fitted as the data were: the duration family ``opspec fit`` chose (AIC/BIC
 on the whole data) is fitted again by maximum likelihood — the choice of family is not
@@ -74,15 +79,14 @@ class _Data:
             self.by_pick.setdefault(pick, []).extend(values)
 
     def within(self, rng: np.random.Generator) -> _Data:
-        """This person's observations resampled with replacement."""
+        """This person's durations resampled with replacement; the counts behind the rates
+        are kept (their rates are drawn from the Jeffreys posterior, see :func:`_rate`)."""
         def again(values: Sequence[Any]) -> list[Any]:
             if not values:
                 return []
             return [values[i] for i in rng.integers(0, len(values), len(values))]
 
-        omitted = (int(rng.binomial(self.answered, self.omitted / self.answered))
-                   if self.answered else 0)
-        return _Data(again(self.durations), omitted, self.answered, again(self.picks),
+        return _Data(again(self.durations), self.omitted, self.answered, list(self.picks),
                      {p: again(v) for p, v in self.by_pick.items()})
 
 
@@ -162,8 +166,32 @@ def _targets(result: FitResult) -> list[_Target]:
     return out
 
 
-def _values(target: _Target, data: _Data) -> dict[str, float] | None:
-    """The parameters ``target`` gives on ``data`` (path -> value); None: cannot be fitted."""
+def _rate(events: int, trials: int, rng: np.random.Generator | None) -> float:
+    """A rate of ``events`` in ``trials``: the estimate, or (``rng``) a draw from its
+    Jeffreys posterior Beta(events + 1/2, trials - events + 1/2) (Chick 2001's posterior
+    draws of input parameters). Resampling one person's 20 prompts would give the Wald
+    interval's spread, far too narrow with one or two events (Brown, Cai & DasGupta 2001);
+    the Jeffreys draws have the coverage of the Jeffreys interval and are not stuck at 0."""
+    if rng is None:
+        return events / trials
+    return float(rng.beta(events + 0.5, trials - events + 0.5))
+
+
+def _wrong_picks(picks: Sequence[Sequence[str]], intended: str) -> tuple[int, int]:
+    """(wrong picks, eligible offers) as :func:`~opspec.usermodels.fitting._choice_model`
+    counts them: at most as many wrong picks per instance as the most seen in one."""
+    wrong_counts = [sum(1 for c in seq if c != intended) for seq in picks]
+    cap = max(wrong_counts, default=0)
+    if cap == 0:
+        return 0, sum(1 for seq in picks if seq)
+    return (sum(min(w, cap) for w in wrong_counts),
+            sum(min(len(seq), cap) for seq in picks))
+
+
+def _values(target: _Target, data: _Data, rng: np.random.Generator | None = None
+            ) -> dict[str, float] | None:
+    """The parameters ``target`` gives on ``data`` (path -> value); None: cannot be fitted.
+    With ``rng`` (observations resampled within persons) rates are posterior draws."""
     from opspec.usermodels.fitting import _choice_model
 
     if target.kind == "duration":
@@ -180,20 +208,24 @@ def _values(target: _Target, data: _Data) -> dict[str, float] | None:
     if target.kind == "omission":
         if not data.answered:
             return None
-        return {target.prefix: data.omitted / data.answered}
+        return {target.prefix: _rate(data.omitted, data.answered, rng)}
     if target.kind == "commission":
         if not data.picks:
             return None
+        if rng is not None:
+            assert target.intended is not None
+            wrong, eligible = _wrong_picks(data.picks, target.intended)
+            return {target.prefix: _rate(wrong, eligible, rng)} if eligible else None
         model = _choice_model(data.picks)
         if model.get("intended") != target.intended:
             return None
         commission = model.get("commission")
         return {target.prefix: commission.probability if commission is not None else 0.0}
     right = data.by_pick.get(target.intended or "", [])
-    wrong = [v for p, vs in data.by_pick.items() if p != target.intended for v in vs]
-    if not right or not wrong:
+    wrong_times = [v for p, vs in data.by_pick.items() if p != target.intended for v in vs]
+    if not right or not wrong_times:
         return None
-    lost = np.maximum(np.asarray(wrong) - float(np.mean(right)), 0.0)
+    lost = np.maximum(np.asarray(wrong_times) - float(np.mean(right)), 0.0)
     if target.family is None:
         return {f"{target.prefix}.value": float(lost.mean())}
     found = _refit(target.family, lost.tolist())
@@ -262,7 +294,7 @@ def parameter_draws(result: FitResult, draws: int, *, seed: int = 0) -> Paramete
                     sample[activity].add(d.within(rng))
         row = dict(estimate)
         for target in targets:
-            found = _values(target, sample[target.activity])
+            found = _values(target, sample[target.activity], None if by_persons else rng)
             if found is None:
                 failed += 1
                 continue
@@ -280,6 +312,8 @@ def parameter_draws(result: FitResult, draws: int, *, seed: int = 0) -> Paramete
     source = (f"opspec fit: {draws} nonparametric bootstrap redraws (Barton & Schruben 2001) "
               f"resampling {resampled} ({len(names)} person(s), {obs.sessions} session(s); "
               f"Davison & Hinkley 1997, 3.8), each fitted as the data were (family kept)"
+              + ("" if by_persons else "; rates drawn from their Jeffreys posterior "
+                 "(Chick 2001)")
               + (f"; {failed} parameter fit(s) of a resample failed and kept the estimate"
                  if failed else ""))
     return ParameterDraws(parameters, tuple(estimate[p] for p in parameters), tuple(rows),

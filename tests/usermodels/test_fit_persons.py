@@ -129,16 +129,26 @@ def test_one_person_in_many_sessions_is_one_person(tmp_path: Path) -> None:
     assert as_runs.users == 12 and as_runs.between_sd_ci[0] == 0.0
 
 
-def test_the_omission_rate_is_redrawn_with_its_binomial_spread(tmp_path: Path) -> None:
-    """One person, 6 omissions in 40 prompts: the redrawn rates have the binomial sd
-    sqrt(p (1 - p) / n) = 0.0565 of a rate measured on 40 trials."""
+def test_the_omission_rate_is_redrawn_from_its_jeffreys_posterior(tmp_path: Path) -> None:
+    """One person, 6 omissions in 40 prompts: the redrawn rates follow the Jeffreys
+    posterior Beta(6.5, 34.5): mean 6.5/41 = 0.1585, sd sqrt(ab/((a+b)^2 (a+b+1))) =
+    0.0564 - about the binomial sd sqrt(p (1 - p) / n) = 0.0565 of a rate on 40 trials.
+    And 1 omission in 20 prompts does not give draws stuck near 0.05 (the Wald spread):
+    their 97.5 % point is the upper end of the Jeffreys interval as Brown, Cai & DasGupta
+    (2001, section 4.1.2) define it, the Beta(1.5, 19.5) quantile 0.2108."""
     heard = [False] * 6 + [True] * 34
     path = write_session(tmp_path / "s.jsonl", [50.0, 61.0, 70.0, 55.0], heard, "P1")
     draws = parameter_draws(fit_traces([path]), 1000, seed=3)
     column = [row[draws.parameters.index("activities.hear.omission.probability")]
               for row in draws.draws]
-    assert np.mean(column) == pytest.approx(0.15, abs=0.01)
-    assert np.std(column) == pytest.approx(math.sqrt(0.15 * 0.85 / 40), rel=0.1)
+    assert np.mean(column) == pytest.approx(6.5 / 41, abs=0.006)
+    assert np.std(column) == pytest.approx(0.0564, rel=0.1)
+    path = write_session(tmp_path / "t.jsonl", [50.0, 61.0, 70.0, 55.0],
+                         [False] + [True] * 19, "P1")
+    draws = parameter_draws(fit_traces([path]), 2000, seed=4)
+    column = [row[draws.parameters.index("activities.hear.omission.probability")]
+              for row in draws.draws]
+    assert np.percentile(column, 97.5) == pytest.approx(0.2108, abs=0.015)
 
 
 def test_fit_cli_names_persons_and_writes_loadable_redraws(tmp_path: Path, capsys) -> None:
