@@ -13,12 +13,16 @@ B is the same spec with a fourth alarm (``alarms < 4``), run on the same users (
 numbers, as ``--compare`` does), whose closed form is the same formula with four 300 s windows;
 the paired differences B - A are checked against the difference of the closed forms.
 
-It prints, per number of users and metric, the share of repetitions whose interval covered the
-truth (a repetition without an interval - a paired difference of durations in fewer than two
-users - counts as not covered, and is counted under "no CI"), and the band a correct 95 % interval lands in with probability 0.95 over this many
-repetitions (binomial): coverage outside the band is evidence of a wrong interval, inside the
-band is not proof of a right one. Runs repetitions on ``--workers`` processes (each repetition
-on one core, one user after another): about 13 minutes of CPU at the defaults.
+It prints, per number of users and metric, the mean of the repetitions' estimates beside the
+truth (a difference there is the simulation's, not the interval's), the share of repetitions
+whose interval covered the truth (a repetition without an interval - a paired difference of
+durations in fewer than two users - counts as not covered, and is counted under "no CI"), and
+the band a correct 95 % interval lands in with probability 0.95 over this many repetitions
+(binomial): coverage outside the band is evidence of a wrong interval, inside the band is not
+proof of a right one. Repetition r at the i-th user count has seed 19,000 + 1,000 i + r. Runs
+repetitions on ``--workers`` processes (each repetition on one core, one user after another):
+about 13 minutes of CPU at the defaults. Which interval a proportion gets was chosen on a
+faster model, ``benchmarks/proportion_coverage.py``.
 """
 
 from __future__ import annotations
@@ -181,6 +185,8 @@ def run(repetitions: int, user_counts: Sequence[int], days: float, workers: int,
         for part in ("A", "B", "B-A"):
             for metric in METRICS:
                 cis = [rep[part][metric][1] for rep in results[n]]
+                estimates = [rep[part][metric][0] for rep in results[n]
+                             if rep[part][metric][0] is not None]
                 covered = sum(_covers(ci, truth[part][metric]) for ci in cis)
                 missing = sum(1 for ci in cis if None in ci)
                 widths = [ci[1] - ci[0] for ci in cis if None not in ci]
@@ -189,6 +195,8 @@ def run(repetitions: int, user_counts: Sequence[int], days: float, workers: int,
                               "truth": truth[part][metric], "coverage": covered / len(cis),
                               "truth_above_interval": below / len(cis),
                               "no_interval": missing,
+                              "mean_estimate": (sum(estimates) / len(estimates)
+                                                if estimates else None),
                               "mean_width": sum(widths) / len(widths) if widths else None})
     return {"repetitions": repetitions, "days": days, "users": list(user_counts),
             "band": acceptance_band(repetitions), "wall_s": time.perf_counter() - started,
@@ -202,13 +210,14 @@ def print_table(result: dict[str, Any]) -> None:
           f"{result['wall_s']:.0f} s")
     print(f"(a correct 95 % interval lands in [{100 * low:.1f} %, {100 * high:.1f} %] with "
           "probability 0.95; target band 93-97 %)\n")
-    print(f"{'users':>5}  {'design':<6}  {'metric':<17}  {'truth':>11}  {'coverage':>8}  "
-          f"{'truth>hi':>8}  {'no CI':>6}  {'mean width':>11}")
+    print(f"{'users':>5}  {'design':<6}  {'metric':<17}  {'truth':>11}  {'mean est.':>11}  "
+          f"{'coverage':>8}  {'truth>hi':>8}  {'no CI':>6}  {'mean width':>11}")
     for row in result["table"]:
         flag = "" if 0.93 <= row["coverage"] <= 0.97 else "  <- outside 93-97 %"
         width = "-" if row["mean_width"] is None else f"{row['mean_width']:.4g}"
+        estimate = "-" if row["mean_estimate"] is None else f"{row['mean_estimate']:.5g}"
         print(f"{row['users']:>5}  {row['design']:<6}  {row['metric']:<17}  "
-              f"{row['truth']:>11.5g}  {100 * row['coverage']:>7.1f}%  "
+              f"{row['truth']:>11.5g}  {estimate:>11}  {100 * row['coverage']:>7.1f}%  "
               f"{100 * row['truth_above_interval']:>7.1f}%  {row['no_interval']:>6}  "
               f"{width:>11}{flag}")
 

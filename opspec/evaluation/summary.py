@@ -9,7 +9,7 @@
   ``p95``, ``p99`` of the users' own means (users without observations left out);
 - ratio: ``value`` = Σ numerator / Σ denominator over users with ``ci95`` (for a proportion
   of counts, such as missed / due doses, Wilson's score interval on the effective number of
-  trials, :func:`proportion_interval`; otherwise the cluster-robust t interval), and ``per_user``
+  trials, :func:`opspec.evaluation.proportions.proportion_interval`; otherwise the cluster-robust t interval), and ``per_user``
   (the same fields over the users' own ratios, plus ``users_with_any``, ``share_with_any``
   and its exact interval: users whose numerator is not 0; and, for a proportion,
   ``between_user_sd``: the sd of the users' true rates with the binomial noise of each
@@ -31,19 +31,12 @@ import statistics as pystats
 from collections.abc import Mapping, Sequence
 from typing import Any
 
+from opspec.evaluation.proportions import is_proportion, proportion_interval
 from opspec.evaluation.store import ResultStore
-from opspec.statistics import (
-    normal_quantile,
-    paired_difference,
-    poisson_interval,
-    rate_interval,
-    ratio_estimate,
-    t_quantile,
-)
+from opspec.statistics import paired_difference, poisson_interval, rate_interval, ratio_estimate
 
-__all__ = ["compare_designs", "effective_trials", "has_population", "metric_definitions",
-           "proportion_interval", "subgroup_users", "summarise_design", "summarise_monitors",
-           "summarise_population", "user_pairs"]
+__all__ = ["compare_designs", "has_population", "metric_definitions", "subgroup_users",
+           "summarise_design", "summarise_monitors", "summarise_population", "user_pairs"]
 
 #: Percentiles of per-user values reported beside the median (p50).
 PERCENTILES = (("p90", 0.90), ("p95", 0.95), ("p99", 0.99))
@@ -187,7 +180,7 @@ def _between_user_sd(pairs: Sequence[tuple[float, float]]) -> float | None:
 #: Fewer events than this and the normal approximation behind the cluster-robust interval of
 #: a count is not to be trusted (the usual np >= 10 rule): the interval is widened to cover
 #: the exact Poisson (Garwood) interval, which never collapses to [0, 0] with no events.
-#: (Proportions of counts have their own interval, :func:`proportion_interval`.)
+#: (Proportions of counts have their own interval, :mod:`opspec.evaluation.proportions`.)
 RARE_EVENTS = 10
 
 
@@ -198,61 +191,6 @@ def _rare_count_ci(ci: list[float | None], total: int, users: int, level: float
     _rate, low, high = poisson_interval(total, float(users), level)
     return [low if ci[0] is None else min(ci[0], low),
             high if ci[1] is None else max(ci[1], high)]
-
-
-def _is_proportion(pairs: Sequence[tuple[float, float]]) -> bool:
-    """Whole numbers of events out of whole numbers of trials (missed out of due doses)."""
-    return bool(pairs) and all(0 <= y <= n and y == int(y) and n == int(n) for y, n in pairs)
-
-
-def _wilson(p: float, n: float, z: float) -> tuple[float, float]:
-    """Wilson's (1927) score interval of a proportion ``p`` observed on ``n`` trials (``n``
-    need not be whole: an effective sample size), with normal quantile ``z``."""
-    a = z * z / n
-    centre = (p + a / 2) / (1 + a)
-    half = z * math.sqrt(p * (1 - p) / n + a / (4 * n)) / (1 + a)
-    return (0.0 if p <= 0 else max(0.0, centre - half),
-            1.0 if p >= 1 else min(1.0, centre + half))
-
-
-def effective_trials(pairs: Sequence[tuple[float, float]], level: float = 0.95) -> float:
-    """How many independent trials the users' pooled trials are worth (Kish's effective
-    sample size ``n/deff``): ``p(1-p) / v`` with ``v`` the binomial variance of the pooled
-    proportion ``p`` plus the between-user excess of the cluster-robust (ratio-estimator)
-    variance over it, that excess scaled by ``(t[U-1]/z)²`` because it is estimated from
-    only U users (Korn & Graubard's 1998 degrees-of-freedom adjustment, applied to the part
-    of the variance that is estimated). Never more than the pooled trials: Korn & Graubard
-    truncate the design effect at 1, since users who look more alike than chance would make
-    them do not make a dose worth more than one trial. The pooled trials when ``p`` is 0 or
-    1 or there are fewer than 2 users (nothing to estimate the excess from)."""
-    users = len(pairs)
-    trials = math.fsum(n for _, n in pairs)
-    p = math.fsum(y for y, _ in pairs) / trials
-    if users < 2 or not 0 < p < 1:
-        return trials
-    nbar = trials / users
-    cluster = math.fsum((y - p * n) ** 2 for y, n in pairs) / (users * (users - 1) * nbar ** 2)
-    binomial = p * (1 - p) / trials
-    df_factor = (t_quantile(level, users - 1) / normal_quantile(0.5 + level / 2)) ** 2
-    return p * (1 - p) / (binomial + df_factor * max(cluster - binomial, 0.0))
-
-
-def proportion_interval(pairs: Sequence[tuple[float, float]], level: float = 0.95
-                        ) -> list[float | None]:
-    """The interval of a pooled proportion ``Σy/Σn`` over users (events out of trials per
-    user): the Wilson score interval on the effective number of trials
-    (:func:`effective_trials`; Franco, Little, Louis & Slud 2019 recommend Wilson on the
-    effective sample size for clustered proportions). With users who differ only by chance
-    it is Wilson's interval of the pooled doses, right for rare events and never [0, 0]
-    (0 of 40: [0 %, 8.76 %]); when users differ (overdispersion) it widens by the design
-    effect, and as the between-user variance dominates it tends to the cluster-robust
-    t interval. ``[None, None]`` without trials."""
-    trials = math.fsum(n for _, n in pairs)
-    if trials <= 0:
-        return [None, None]
-    p = math.fsum(y for y, _ in pairs) / trials
-    low, high = _wilson(p, effective_trials(pairs, level), normal_quantile(0.5 + level / 2))
-    return [low, high]
 
 
 def summarise_design(store: ResultStore, design: str, days: float, level: float = 0.95, *,
@@ -298,7 +236,7 @@ def summarise_design(store: ResultStore, design: str, days: float, level: float 
             ratios = [y / k for y, k in pairs if k > 0]
             out[name] = {
                 "kind": "ratio", "value": estimate.value,
-                "ci95": (proportion_interval(pairs, level) if _is_proportion(pairs)
+                "ci95": (proportion_interval(pairs, level) if is_proportion(pairs)
                          else estimate.ci),
                 "numerator": definition.get("numerator"),
                 "denominator": definition.get("denominator"),

@@ -17,7 +17,7 @@ import math
 import numpy as np
 import pytest
 
-from opspec.evaluation.summary import effective_trials, proportion_interval
+from opspec.evaluation.proportions import effective_trials, proportion_interval
 
 #: the reference user's missed-dose probability (shared/bench/analytic.py, 3 alarms)
 P_MISSED = 0.0034562262209500982
@@ -28,7 +28,6 @@ P_MISSED = 0.0034562262209500982
     (81, 263, (0.2553, 0.3662)),
     (15, 148, (0.0624, 0.1605)),
     (0, 20, (0.0, 0.1611)),
-    (1, 29, (0.0061, 0.1718)),
 ])
 def test_users_who_do_not_differ_get_wilsons_interval(events: int, trials: int,
                                                       expected: tuple[float, float]) -> None:
@@ -39,6 +38,22 @@ def test_users_who_do_not_differ_get_wilsons_interval(events: int, trials: int,
         split = proportion_interval([(0.0, trials / 4)] * 4)
         assert split == pytest.approx(list(expected), abs=6e-5)
         assert split[1] > 0          # never [0 %, 0 %]
+
+
+def test_one_or_two_events_get_the_modified_wilson_bound() -> None:
+    """Brown, Cai & DasGupta (2001, Stat Sci 16:101, section 4.1.1): with x = 1 or 2 events
+    the lower bound is the one-sided Poisson one, lambda_x / n with lambda_1 = 0.051 and
+    lambda_2 = 0.355 at 95 %; the upper bound stays Wilson's (Newcombe 1998: 1/29 ->
+    0.1718), and the same holds mirrored near n."""
+    low, high = proportion_interval([(1.0, 29.0)])
+    assert low == pytest.approx(0.051 / 29, rel=0.01)
+    assert high == pytest.approx(0.1718, abs=6e-5)
+    low, _ = proportion_interval([(1.0, 1000.0), (1.0, 1000.0)])
+    assert low == pytest.approx(0.355 / 2000, rel=0.01)
+    _, high = proportion_interval([(1000.0, 1000.0), (999.0, 1000.0)])
+    assert high == pytest.approx(1 - 0.051 / 2000, rel=1e-6)
+    # from 3 events on, Wilson's own bound, above the Poisson one
+    assert proportion_interval([(3.0, 1000.0)])[0] > 0.818 / 1000
 
 
 def test_users_more_alike_than_chance_do_not_narrow_the_interval() -> None:
@@ -92,6 +107,17 @@ def test_rare_events_are_covered_95_percent_of_the_time(users: int, trials: int)
     rng = np.random.default_rng(19_000 + users + trials)
     coverage = _coverage(rng, 2000, users, trials, lambda k: np.full(k, P_MISSED), P_MISSED)
     assert 0.93 <= coverage <= 0.97, coverage
+
+
+def test_a_fraction_of_an_event_expected_is_still_covered() -> None:
+    """The four-alarm dispenser (0.052 % missed) over 7 days at 10 users: 0.15 missed doses
+    expected in 280. Wilson's lower bound for one event (0.18/280) is above the truth, so
+    plain Wilson covers only when there is no event (86.5 %); the modified bound covers 0
+    and 1 event (99.0 %: the lattice allows nothing between 86.5 and 99.0 %)."""
+    p = 0.0005186876829259557
+    rng = np.random.default_rng(7)
+    coverage = _coverage(rng, 2000, 10, 28, lambda k: np.full(k, p), p)
+    assert coverage >= 0.98, coverage
 
 
 def _beta(mean: float, sd: float):

@@ -7,10 +7,15 @@ dispenser with a fourth alarm (B) on the same users, as `opspec evaluate --compa
 them; the truth is SCENARIO.md's closed form (shared/bench/analytic.py, with four windows
 for B). Over 1,000 repetitions a correct 95 % interval covers in 93.6-96.3 % of them with
 probability 0.95, below 93 % with probability about 0.002: below 93 % is evidence of a wrong
-interval. Rare-event rules make some intervals conservative by design (missed rate, paired
-counts), so for those only the lower bound is checked; a paired difference of durations
-without an interval (the designs differed in fewer than two users) is left out of its
-coverage and counted.
+interval. The missed rate's interval (Wilson on the effective number of trials) must also not
+be grossly conservative: the rule it replaced (the wider of the t and the Wilson interval
+below 10 events) covered 99.9 % here. Two rows sit on a lattice and are only checked from
+below: B's missed rate expects 0.15 missed doses in 280, and the interval covers 0 and 1
+event and no more (99.0 % of repetitions; Wilson's unmodified lower bound for one event was
+above the truth: 86.5 %), and paired differences of counts keep their
+conservative exact-Poisson rule for fewer than 10 discordant events. A paired difference of
+durations without an interval (the designs differed in fewer than two users) is left out of
+its coverage and counted.
 """
 
 from __future__ import annotations
@@ -43,8 +48,10 @@ def test_intervals_cover_the_closed_form_at_10_users() -> None:
         given = 1000 - row["no_interval"]
         coverage = row["coverage"] * 1000 / given
         assert coverage >= 0.93, (design, metric, coverage)
-        if metric != "missed_rate" and design != "B-A":
-            # the cluster-robust t intervals: not grossly conservative either
-            assert coverage <= 0.975, (design, metric, coverage)
+        if design == "A" or (design == "B" and metric != "missed_rate"):
+            # not grossly conservative either (A's missed rate: 94 % expected, 0.97 expected
+            # events on a lattice; the cluster-robust t intervals 94.5 %)
+            limit = 0.97 if metric == "missed_rate" else 0.975
+            assert coverage <= limit, (design, metric, coverage)
         if design != "B-A" or metric != "report_latency_s":
             assert row["no_interval"] == 0, (design, metric)
