@@ -41,8 +41,13 @@ PERSON_KEY = "person"
 def _header(path: Path) -> dict[str, object]:
     """The first JSON line of a trace file (an empty dict when it cannot be read: the trace
     reader then says what is wrong with the file, naming it)."""
+    import io
+
+    from opspec.files import open_regular
+
     try:
-        with open(path, encoding="utf-8") as handle:
+        # a pipe or device is refused, never read (it would block); read_trace then says so
+        with io.TextIOWrapper(open_regular(path), encoding="utf-8") as handle:
             for line in handle:
                 if line.strip():
                     head = json.loads(line)
