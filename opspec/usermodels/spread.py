@@ -73,9 +73,9 @@ class DurationSpread:
 
     def comment(self) -> str:
         lo, hi = self.between_sd_ci
-        lines = [(f"between users ({self.users} with enough data): sd of ln(mean duration) "
-                 f"{self.observed_sd:.3f} observed, {self.sampling_sd:.3f} expected from "
-                 f"sampling alone -> between-user sd of ln(scale) {self.between_sd:.3f} "
+        lines = [(f"between users ({self.users} persons with enough data): sd of ln(mean "
+                 f"duration) {self.observed_sd:.3f} observed, {self.sampling_sd:.3f} expected "
+                 f"from sampling alone -> between-user sd of ln(scale) {self.between_sd:.3f} "
                  f"(95 % bootstrap interval [{lo:.3f}, {hi:.3f}])"),
                  (f"  per-user distribution: every duration x F, F ~ lognormal(median 1, "
                  f"sigma {self.between_sd:.3f})"),
@@ -147,7 +147,7 @@ class OmissionSpread:
 
     def comment(self) -> str:
         lo, hi = self.between_sd_ci
-        text = (f"omission between users ({self.users}): rates sd {self.observed_sd:.4f} "
+        text = (f"omission between users ({self.users} persons): rates sd {self.observed_sd:.4f} "
                 f"observed, between-user sd {self.between_sd:.4f} (95 % bootstrap interval "
                 f"[{lo:.4f}, {hi:.4f}]); same rate for everyone: chi-square p = "
                 f"{self.homogeneity_p:.3g}")
