@@ -1,7 +1,8 @@
 """Do the 95 % intervals of ``opspec evaluate`` cover the truth 95 % of the time? (issue 19)
 
     python benchmarks/interval_coverage.py [--repetitions 200] [--users 10 20 100]
-                                           [--days 30] [--workers 2] [--json FILE]
+                                           [--days 30] [--workers 2] [--seed 19000]
+                                           [--json FILE]
 
 The truth is the closed form of the reference scenario (``../shared/bench/SCENARIO.md``,
 ``analytic.py``): missed rate 0.3456 %, 1.1762 alarms per dose, 122.2 s mean report latency.
@@ -19,7 +20,8 @@ whose interval covered the truth (a repetition without an interval - a paired di
 durations in fewer than two users - counts as not covered, and is counted under "no CI"), and
 the band a correct 95 % interval lands in with probability 0.95 over this many repetitions
 (binomial): coverage outside the band is evidence of a wrong interval, inside the band is not
-proof of a right one. Repetition r at the i-th user count has seed 19,000 + 1,000 i + r. Runs
+proof of a right one. Repetition r at the i-th user count has seed 19,000 + 1,000 i + r
+(``--seed`` moves the 19,000: another set of independent repetitions). Runs
 repetitions on ``--workers`` processes (each repetition on one core, one user after another):
 about 13 minutes of CPU at the defaults. Which interval a proportion gets was chosen on a
 faster model, ``benchmarks/proportion_coverage.py``.
@@ -228,13 +230,16 @@ def main() -> None:
     parser.add_argument("--users", type=int, nargs="+", default=[10, 20, 100])
     parser.add_argument("--days", type=float, default=30.0)
     parser.add_argument("--workers", type=int, default=2)
+    parser.add_argument("--seed", type=int, default=19_000,
+                        help="repetition r at the i-th user count has seed SEED + 1000 i + r "
+                             "(default: %(default)s)")
     parser.add_argument("--json", metavar="FILE", help="also write the table as JSON")
     parser.add_argument("--bench", metavar="DIR", default=str(BENCH),
                         help="the folder of SCENARIO.md and analytic.py (default: %(default)s)")
     args = parser.parse_args()
     if not (Path(args.bench) / "analytic.py").is_file():
         parser.error(f"no analytic.py in {args.bench}: give --bench DIR (shared/bench)")
-    result = run(args.repetitions, args.users, args.days, args.workers,
+    result = run(args.repetitions, args.users, args.days, args.workers, seed0=args.seed,
                  bench=Path(args.bench))
     print_table(result)
     if args.json:
