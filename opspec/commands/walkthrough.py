@@ -11,6 +11,7 @@ from __future__ import annotations
 import argparse
 import contextlib
 import math
+import re
 import sys
 from datetime import UTC, datetime
 from pathlib import Path
@@ -24,6 +25,21 @@ ON_CALL = ("realtime", "pause", "keep")
 SOUNDS = ("bell", "system", "off")
 
 __all__ = ["register", "run"]
+
+
+def _person(text: str) -> str:
+    """A participant identifier as --person takes it: printable, on one line."""
+    person = text.strip()
+    if not person or not person.isprintable():
+        raise argparse.ArgumentTypeError(
+            f"{text!r} is not a participant identifier: give printable text on one line, "
+            "e.g. --person P07")
+    return person
+
+
+def _file_safe(person: str) -> str:
+    """The identifier as part of a file name (anything but letters, digits, - and _ is _)."""
+    return re.sub(r"[^A-Za-z0-9_-]", "_", person)
 
 
 def register(subparsers: Any) -> None:
@@ -57,6 +73,10 @@ def register(subparsers: Any) -> None:
                      help="what the clock does when the device calls you (an alarm, an "
                      "offer): drop to real time until the call is over (default), pause, or "
                      "keep its speed")
+    lab.add_argument("--person", metavar="ID", type=_person,
+                     help="the participant's identifier (e.g. P07): written into the "
+                     "recording's trace and its file name, so that opspec fit counts "
+                     "several sessions of one participant as one person")
     lab.add_argument("--large", action="store_true",
                      help="a layout for a big terminal font: your panel first and full "
                      "width, tall buttons, the clock in big digits (enlarge the terminal's "
@@ -88,9 +108,10 @@ def run(args: argparse.Namespace) -> int:
         # checked against the spec like `opspec run --script` (a misspelt name would never
         # match an offer)
         replay = load_recording(args.replay, compiled)
+    who = f"{_file_safe(args.person)}-" if args.person else ""
     record = None if args.no_record or args.replay else Path(
         args.record or Path("walkthroughs") / (
-            f"{Path(args.spec).name.split('.')[0]}-"
+            f"{Path(args.spec).name.split('.')[0]}-{who}"
             f"{datetime.now(UTC).strftime('%Y%m%d-%H%M%S')}.json"))
     with contextlib.ExitStack() as stack:
         performers: dict[str, Any] = {}          # the world: opspec.runs.build adds it
@@ -115,7 +136,7 @@ def run(args: argparse.Namespace) -> int:
         session = WalkSession(compiled, seed=args.seed, days=args.days, record=record,
                               model_factory=factory, performers=performers, replay=replay,
                               spec_path=str(args.spec), device_participants=served,
-                              wall_devices=real, on_call=args.on_call)
+                              wall_devices=real, on_call=args.on_call, person=args.person)
         if session.failure is not None:        # the run cannot even start (a zero-time cycle)
             session.close()
             raise session.failure

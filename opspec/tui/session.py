@@ -95,7 +95,8 @@ class WalkSession:
                  performers: Mapping[str, Any] | None = None, config: Any = None,
                  replay: Any = None, spec_path: str = "",
                  device_participants: Mapping[str, Sequence[str]] | None = None,
-                 wall_devices: bool = False, on_call: str = "realtime") -> None:
+                 wall_devices: bool = False, on_call: str = "realtime",
+                 person: str | None = None) -> None:
         from opspec.runs import check_seed, run_length
 
         self.compiled = compiled
@@ -150,6 +151,7 @@ class WalkSession:
         #: the error that ended the run (a zero-time cycle...), or None
         self.failure: ExecutionError | None = None
         self.spec_path = spec_path
+        self.person = person
         self._outcome: RunOutcome | None = None
         self.record_path = Path(record) if record is not None else None
         self._steps: list[list[str]] = []
@@ -161,8 +163,12 @@ class WalkSession:
                 self._write_record()
                 from opspec.engine.trace_sinks import JsonlSink
 
-                self._trace_file = JsonlSink(trace_path, {"spec": spec_path, "seed": seed,
-                                                          "walkthrough": True}, flush_every=1)
+                header: dict[str, Any] = {"spec": spec_path, "seed": seed, "walkthrough": True}
+                if person is not None:
+                    # whose session this is: opspec fit counts a participant's sessions as
+                    # one person (docs/trace-format.md, "person")
+                    header["person"] = person
+                self._trace_file = JsonlSink(trace_path, header, flush_every=1)
             except OSError as error:
                 raise ConfigurationError(
                     f"cannot write the recording {self.record_path}: "
@@ -641,7 +647,8 @@ class WalkSession:
         if self.record_path is not None:
             walk, run = replay_commands(self.spec_path or "SPEC", self.record_path)
             lines += ["", f"Recording: {self.record_path}",
-                      f"Trace (for opspec fit): {self.record_path.with_suffix('.trace.jsonl')}",
+                      f"Trace (for opspec fit): {self.record_path.with_suffix('.trace.jsonl')}"
+                      + (f" (person {self.person})" if self.person is not None else ""),
                       f"Replay it with: {walk}", f"           or: {run}"]
         return lines
 

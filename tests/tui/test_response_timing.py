@@ -124,3 +124,37 @@ def test_fit_leaves_out_what_was_not_timed_in_real_time(compiled, tmp_path):
     assert obs.durations["walk_to_dispenser"] == [pytest.approx(9.0)]
     assert "choose_button" not in obs.durations and obs.unusable["choose_button"] == 1
     assert obs.picks["choose_button"] == [["press_report"]]  # the choice itself still counts
+
+
+def test_sessions_of_one_participant_count_as_one_person_in_fit(compiled, tmp_path):
+    """`walkthrough --person P07` writes the person into the trace header: two sessions of
+    P07 and one of P09 are two persons, three sessions, for opspec fit."""
+    traces = []
+    for name, person, took in (("a.json", "P07", 4.0), ("b.json", "P07", 6.0),
+                               ("c.json", "P09", 5.0)):
+        session, wall = at_alarm(compiled, tmp_path, name, person=person)
+        real_seconds(session, wall, took)
+        session.act(offer(session, "hear_alarm"))
+        session.close()
+        trace = session.record_path.with_suffix(".trace.jsonl")
+        assert json.loads(trace.read_text().splitlines()[0])["person"] == person
+        traces.append(trace)
+    obs = collect(traces)
+    assert obs.persons == ["P07", "P09"]
+    assert obs.sessions == 3
+    by_person = obs.lists_by_person(obs.user_durations["hear_alarm"])
+    assert sorted(by_person["P07"]) == [pytest.approx(4.0), pytest.approx(6.0)]
+    assert by_person["P09"] == [pytest.approx(5.0)]
+
+
+def test_without_person_each_session_is_its_own_person(compiled, tmp_path):
+    traces = []
+    for name in ("a.json", "b.json"):
+        session, wall = at_alarm(compiled, tmp_path, name)
+        real_seconds(session, wall, 3.0)
+        session.act(offer(session, "hear_alarm"))
+        session.close()
+        trace = session.record_path.with_suffix(".trace.jsonl")
+        assert "person" not in json.loads(trace.read_text().splitlines()[0])
+        traces.append(trace)
+    assert len(collect(traces).persons) == 2
