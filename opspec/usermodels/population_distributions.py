@@ -40,12 +40,20 @@ from typing import Any
 
 import numpy as np
 import numpy.typing as npt
-from scipy import special, stats  # type: ignore[import-untyped]
+from scipy import special  # type: ignore[import-untyped]
 
 from opspec.usermodels.distbase import ParameterError
 
 __all__ = ["CORRELATION_KINDS", "PER_USER_KINDS", "PerUserDistribution",
            "copula", "copula_correlation", "draw_copula", "make_per_user", "smallest_eigenvalue"]
+
+
+def _stats() -> Any:
+    """scipy.stats, imported when a population is built: a user model without one never
+    needs it, and importing it is a third of a second of every command's start."""
+    from scipy import stats  # type: ignore[import-untyped]
+
+    return stats
 
 FloatArray = npt.NDArray[np.float64]
 
@@ -157,30 +165,30 @@ def _beta(t: _Table) -> Any:
                                  hint="a beta's sd is below that bound; a smaller sd, or "
                                  "give a and b")
         concentration = mean * (1 - mean) / sd**2 - 1
-        return stats.beta(mean * concentration, (1 - mean) * concentration)
-    return stats.beta(t.take("a"), t.take("b"))
+        return _stats().beta(mean * concentration, (1 - mean) * concentration)
+    return _stats().beta(t.take("a"), t.take("b"))
 
 
 def _lognormal(t: _Table) -> Any:
     if t.has("median"):
         median = t.take("median")
-        return stats.lognorm(s=t.take("sigma"), scale=median)
+        return _stats().lognorm(s=t.take("sigma"), scale=median)
     if t.has("mu"):
         mu = t.take("mu", _number)
-        return stats.lognorm(s=t.take("sigma"), scale=math.exp(mu))
+        return _stats().lognorm(s=t.take("sigma"), scale=math.exp(mu))
     mean, sd = t.take("mean"), t.take("sd")
     ratio = 1 + (sd / mean) ** 2
-    return stats.lognorm(s=math.sqrt(math.log(ratio)), scale=mean / math.sqrt(ratio))
+    return _stats().lognorm(s=math.sqrt(math.log(ratio)), scale=mean / math.sqrt(ratio))
 
 
 def _gamma(t: _Table) -> Any:
     if t.has("mean"):
         mean, sd = t.take("mean"), t.take("sd")
-        return stats.gamma((mean / sd) ** 2, scale=sd**2 / mean)
+        return _stats().gamma((mean / sd) ** 2, scale=sd**2 / mean)
     shape = t.take("shape")
     if t.has("rate"):
-        return stats.gamma(shape, scale=1 / t.take("rate"))
-    return stats.gamma(shape, scale=t.take("scale"))
+        return _stats().gamma(shape, scale=1 / t.take("rate"))
+    return _stats().gamma(shape, scale=t.take("scale"))
 
 
 def _normal(t: _Table) -> Any:
@@ -190,15 +198,15 @@ def _normal(t: _Table) -> Any:
     if not low < high:
         raise ParameterError("high", f"must be > low ({low:g}), got {high:g}")
     if math.isinf(low) and math.isinf(high):
-        return stats.norm(mean, sd)
-    return stats.truncnorm((low - mean) / sd, (high - mean) / sd, loc=mean, scale=sd)
+        return _stats().norm(mean, sd)
+    return _stats().truncnorm((low - mean) / sd, (high - mean) / sd, loc=mean, scale=sd)
 
 
 def _uniform(t: _Table) -> Any:
     low, high = t.take("low", _location), t.take("high", _location)
     if not low < high:
         raise ParameterError("high", f"must be > low ({low:g}), got {high:g}")
-    return stats.uniform(loc=low, scale=high - low)
+    return _stats().uniform(loc=low, scale=high - low)
 
 
 def _triangular(t: _Table) -> Any:
@@ -209,11 +217,11 @@ def _triangular(t: _Table) -> Any:
     if not low <= mode <= high:
         raise ParameterError("mode", f"must be within [low, high] = [{low:g}, {high:g}], "
                              f"got {mode:g}")
-    return stats.triang((mode - low) / (high - low), loc=low, scale=high - low)
+    return _stats().triang((mode - low) / (high - low), loc=low, scale=high - low)
 
 
 def _weibull(t: _Table) -> Any:
-    return stats.weibull_min(t.take("shape"), scale=t.take("scale"))
+    return _stats().weibull_min(t.take("shape"), scale=t.take("scale"))
 
 
 _BUILDERS: dict[str, tuple[Callable[[_Table], Any], str]] = {
@@ -268,7 +276,7 @@ def copula(correlation: FloatArray) -> Any:
     k = correlation.shape[0]
     if k == 0:
         return None
-    return stats.multivariate_normal(mean=np.zeros(k), cov=correlation, allow_singular=True)
+    return _stats().multivariate_normal(mean=np.zeros(k), cov=correlation, allow_singular=True)
 
 
 def draw_copula(law: Any, rng: np.random.Generator) -> FloatArray:
