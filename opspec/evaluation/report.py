@@ -40,6 +40,7 @@ from opspec.evaluation.summary import (
     summarise_monitors,
     summarise_population,
     user_pairs,
+    user_pairs_by_metric,
 )
 from opspec.evaluation.tables import (
     DISTRIBUTION_HEADERS,
@@ -403,11 +404,13 @@ def _design_sections(store: ResultStore, figures: Path, design: str, name: str, 
     if spread:
         series: dict[str, list[float]] = {}
         units: dict[str, str] = {}
-        for d in definitions:
-            s = metrics.get(d["name"])
-            if s is None or s["kind"] == "count" or not (s.get("per_user") or {}).get("users"):
-                continue
-            values = [y / k for _, (y, k) in user_pairs(store, design, d) if k > 0]
+        shown = [d for d in definitions
+                 if (s := metrics.get(d["name"])) is not None and s["kind"] != "count"
+                 and (s.get("per_user") or {}).get("users")]
+        by_metric = user_pairs_by_metric(store, design, shown)
+        for d in shown:
+            s = metrics[d["name"]]
+            values = [y / k for _, (y, k) in by_metric[d["name"]] if k > 0]
             label = (f"{d['name']} (mean per user)" if s["kind"] == "duration"
                      else d["name"])
             series[label] = values

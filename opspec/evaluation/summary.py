@@ -106,17 +106,28 @@ def user_pairs(store: ResultStore, design: str, definition: Mapping[str, Any],
                users: set[int] | None = None) -> list[tuple[int, tuple[float, float]]]:
     """Per finished user of ``design`` (of ``users`` only, when given): the (y, n) pair of
     ``definition``'s metric."""
-    name = definition["name"]
-    out = []
+    return user_pairs_by_metric(store, design, [definition], users)[definition["name"]]
+
+
+def user_pairs_by_metric(store: ResultStore, design: str,
+                         definitions: Sequence[Mapping[str, Any]], users: set[int] | None = None
+                         ) -> dict[str, list[tuple[int, tuple[float, float]]]]:
+    """:func:`user_pairs` of every metric in ``definitions``, by name, from one reading of
+    the users' stored metrics (each user's are one JSON object: read and parsed once, not
+    once per metric)."""
+    out: dict[str, list[tuple[int, tuple[float, float]]]] = {
+        d["name"]: [] for d in definitions}
     for user, metrics in store.user_metrics(design):
         if users is not None and user not in users:
             continue
-        if definition["kind"] == "ratio":
-            num, _ = _scalar_pair(metrics.get(definition.get("numerator") or ""))
-            den, _ = _scalar_pair(metrics.get(definition.get("denominator") or ""))
-            out.append((user, (num, den)))
-        else:
-            out.append((user, _scalar_pair(metrics.get(name))))
+        for definition in definitions:
+            if definition["kind"] == "ratio":
+                num, _ = _scalar_pair(metrics.get(definition.get("numerator") or ""))
+                den, _ = _scalar_pair(metrics.get(definition.get("denominator") or ""))
+                pair = (num, den)
+            else:
+                pair = _scalar_pair(metrics.get(definition["name"]))
+            out[definition["name"]].append((user, pair))
     return out
 
 
@@ -200,9 +211,11 @@ def summarise_design(store: ResultStore, design: str, days: float, level: float 
     out: dict[str, dict[str, Any]] = {}
     users_of = subgroup_users(store, design, subgroup)
     where, where_params = _in_subgroup(design, subgroup)
-    for definition in metric_definitions(store, design):
+    definitions = metric_definitions(store, design)
+    by_metric = user_pairs_by_metric(store, design, definitions, users_of)
+    for definition in definitions:
         name, kind = definition["name"], definition["kind"]
-        pairs = [p for _, p in user_pairs(store, design, definition, users_of)]
+        pairs = [p for _, p in by_metric[name]]
         estimate = ratio_estimate(pairs, level)
         users = len(pairs)
         if kind == "count":
@@ -255,13 +268,14 @@ def compare_designs(store: ResultStore, a: str = "A", b: str = "B", level: float
     out: dict[str, dict[str, Any]] = {}
     only = subgroup_users(store, a, subgroup)
     theirs = {d["name"]: d for d in metric_definitions(store, b)}
-    for definition in metric_definitions(store, a):
-        other = theirs.get(definition["name"])
-        if other is None or any(other.get(k) != definition.get(k)
-                                for k in ("kind", "numerator", "denominator")):
-            continue
-        pairs_a = dict(user_pairs(store, a, definition, only))
-        pairs_b = dict(user_pairs(store, b, definition, only))
+    alike = [d for d in metric_definitions(store, a)
+             if (other := theirs.get(d["name"])) is not None
+             and all(other.get(k) == d.get(k) for k in ("kind", "numerator", "denominator"))]
+    of_a = user_pairs_by_metric(store, a, alike, only)
+    of_b = user_pairs_by_metric(store, b, alike, only)
+    for definition in alike:
+        pairs_a = dict(of_a[definition["name"]])
+        pairs_b = dict(of_b[definition["name"]])
         users = sorted(set(pairs_a) & set(pairs_b))
         diff = paired_difference([pairs_a[u] for u in users], [pairs_b[u] for u in users],
                                  level)
