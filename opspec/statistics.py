@@ -123,10 +123,13 @@ def poisson_interval(count: int, exposure: float, confidence: float = 0.95
         raise ConfigurationError(f"the exposure must be positive, not {exposure!r}")
     if count < 0 or not 0 < confidence < 1:
         raise ConfigurationError("need count >= 0 and 0 < confidence < 1")
-    chi2 = _stats().chi2
+    # chi2.ppf(q, 2c) / 2 is the gamma quantile gammaincinv(c, q) (scipy.stats computes chi2's
+    # ppf with it): the same numbers without importing scipy.stats
+    from scipy import special  # type: ignore[import-untyped]
+
     tail = (1 - confidence) / 2
-    lower = 0.0 if count == 0 else float(chi2.ppf(tail, 2 * count)) / 2
-    upper = float(chi2.ppf(1 - tail, 2 * count + 2)) / 2
+    lower = 0.0 if count == 0 else float(special.gammaincinv(count, tail))
+    upper = float(special.gammaincinv(count + 1, 1 - tail))
     return count / exposure, lower / exposure, upper / exposure
 
 

@@ -82,9 +82,9 @@ MODIFIED_WILSON_EVENTS = 2
 
 def _poisson_lower(events: int, level: float) -> float:
     """λ with P(Poisson(λ) >= events) = 1 - level: the one-sided Poisson lower bound."""
-    from scipy import stats  # type: ignore[import-untyped]
+    from scipy import special  # type: ignore[import-untyped]  # chi2.ppf(q, 2k)/2, exactly
 
-    return float(stats.chi2.ppf(1 - level, 2 * events)) / 2
+    return float(special.gammaincinv(events, 1 - level))
 
 
 def proportion_interval(pairs: Pairs, level: float = 0.95) -> list[float | None]:
