@@ -54,11 +54,9 @@ CREATE TABLE IF NOT EXISTS replication (
 CREATE TABLE IF NOT EXISTS sample (
     design TEXT NOT NULL, user INTEGER NOT NULL, metric TEXT NOT NULL, value REAL NOT NULL,
     time REAL NOT NULL);
-CREATE INDEX IF NOT EXISTS sample_by_user ON sample (design, user);
 CREATE TABLE IF NOT EXISTS outcome (
     design TEXT NOT NULL, user INTEGER NOT NULL, metric TEXT NOT NULL, day INTEGER NOT NULL,
     hour INTEGER NOT NULL, n INTEGER NOT NULL);
-CREATE INDEX IF NOT EXISTS outcome_by_user ON outcome (design, user);
 CREATE TABLE IF NOT EXISTS activity (
     design TEXT NOT NULL, user INTEGER NOT NULL, activity TEXT NOT NULL, offered INTEGER,
     completed INTEGER, omitted INTEGER, wrong INTEGER);
@@ -79,6 +77,16 @@ CREATE INDEX IF NOT EXISTS person_parameter_by_user ON person_parameter (design,
 # the run, this index of values in random order rewrote most of its pages in every batch (143
 # MB written instead of 62 MB for 1,000 users x 30 days).
 _SAMPLE_INDEX = "CREATE INDEX IF NOT EXISTS sample_by_metric ON sample (design, metric, value)"
+
+# The two largest tables' rows by user (a user-month of the dispenser is 120 samples and 360
+# outcome rows): not kept while a fresh run stores (no user of it has earlier rows to replace,
+# and keeping them cost a third of the store's time), built with the sample index at the end,
+# and at once when a store with replications is opened again (--resume replaces failed users'
+# rows through them).
+_USER_INDEXES = """
+CREATE INDEX IF NOT EXISTS sample_by_user ON sample (design, user);
+CREATE INDEX IF NOT EXISTS outcome_by_user ON outcome (design, user);
+"""
 
 FILENAME = "results.sqlite"
 
@@ -122,6 +130,13 @@ class ResultStore:
             self._db.execute("PRAGMA journal_mode=WAL")
             self._db.execute("PRAGMA synchronous=NORMAL")
             self._db.executescript(_SCHEMA)
+            #: a store with results already (a resumed run): any stored user's rows may be
+            #: replaced, so every stored user is deleted first, through the user indexes
+            self._had_results = any(
+                self._db.execute(f"SELECT 1 FROM {table} LIMIT 1").fetchone() is not None
+                for table in ("replication", "sample", "outcome"))
+            if self._had_results:
+                self._db.executescript(_USER_INDEXES)
         except sqlite3.Error as error:
             raise _fail(self.path, "open the result database", error) from None
 
@@ -176,11 +191,14 @@ class ResultStore:
         keys = [(r.design, r.user) for r in records]
         db.execute("BEGIN IMMEDIATE")
         try:
-            # an earlier attempt's rows (a failed replication) are replaced whole; where there
-            # are none, each DELETE is one index lookup and writes nothing
+            # an earlier attempt's rows (a failed replication) are replaced whole. In a store
+            # that was empty when opened, only a user stored earlier in this run can have rows
+            # (found by the replication's primary key); in one opened with results, any can.
+            again = keys if self._had_results else [key for key in keys if db.execute(
+                "SELECT 1 FROM replication WHERE design = ? AND user = ?", key).fetchone()]
             for table in ("sample", "outcome", "activity", "monitor", "person",
-                          "person_parameter"):
-                db.executemany(f"DELETE FROM {table} WHERE design = ? AND user = ?", keys)
+                          "person_parameter") if again else ():
+                db.executemany(f"DELETE FROM {table} WHERE design = ? AND user = ?", again)
             db.executemany("INSERT OR REPLACE INTO replication VALUES (?, ?, ?, ?, ?, ?)",
                            [(r.design, r.user, r.status, r.error,
                              json.dumps(r.metrics, allow_nan=True), r.wall_s)
@@ -212,8 +230,10 @@ class ResultStore:
 
     def index(self) -> None:
         """Build the indexes readers need that are not kept during the run (the sample
-        values by metric: quantiles, histograms); nothing to do when they exist."""
-        self._write(lambda db: db.execute(_SAMPLE_INDEX), "index the stored samples")
+        values by metric: quantiles, histograms; samples and outcomes by user); nothing to
+        do when they exist."""
+        self._write(lambda db: db.executescript(_USER_INDEXES + _SAMPLE_INDEX + ";"),
+                    "index the stored results")
 
     def failures(self) -> list[tuple[str, int, str]]:
         rows = self.query("SELECT design, user, error FROM replication "

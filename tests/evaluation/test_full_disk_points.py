@@ -111,7 +111,7 @@ def point(name: str, monkeypatch: pytest.MonkeyPatch, out: Path) -> None:
         real_write = store.ResultStore._write
 
         def write(self, action, doing):
-            if doing == "index the stored samples":
+            if doing == "index the stored results":
                 return real_write(self, _sqlite_full, doing)
             return real_write(self, action, doing)
         monkeypatch.setattr(store.ResultStore, "_write", write)
