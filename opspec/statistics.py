@@ -69,7 +69,7 @@ def one_sided(level: float) -> float:
 
 def normal_quantile(p: float) -> float:
     """The standard normal quantile: ``normal_quantile(0.975)`` is 1.95996…"""
-    from scipy import special  # type: ignore[import-untyped]  # norm.ppf's own function
+    from scipy import special  # norm.ppf's own function
 
     return float(special.ndtri(p))
 
@@ -79,7 +79,7 @@ def t_quantile(level: float, df: int) -> float:
     (``inf`` when there are none)."""
     # scipy.special's stdtrit is what scipy.stats.t.ppf computes, without importing
     # scipy.stats (a third of a second of `opspec evaluate` when nothing else needs it)
-    from scipy import special  # type: ignore[import-untyped]
+    from scipy import special
 
     return float(special.stdtrit(df, 0.5 + level / 2.0)) if df > 0 else math.inf
 
@@ -103,7 +103,7 @@ def rate_interval(successes: int, trials: int, confidence: float = 0.95, *,
         # betaincinv (what scipy.stats.beta.ppf computes; binomtest root-finds the same ends):
         # an evaluation's summaries need nothing else from scipy.stats, a third of a second
         # to import.
-        from scipy import special  # type: ignore[import-untyped]
+        from scipy import special
 
         k, n, tail = int(successes), int(trials), (1.0 - confidence) / 2.0
         low = 0.0 if k == 0 else float(special.betaincinv(k, n - k + 1, tail))
@@ -125,7 +125,7 @@ def poisson_interval(count: int, exposure: float, confidence: float = 0.95
         raise ConfigurationError("need count >= 0 and 0 < confidence < 1")
     # chi2.ppf(q, 2c) / 2 is the gamma quantile gammaincinv(c, q) (scipy.stats computes chi2's
     # ppf with it): the same numbers without importing scipy.stats
-    from scipy import special  # type: ignore[import-untyped]
+    from scipy import special
 
     tail = (1 - confidence) / 2
     lower = 0.0 if count == 0 else float(special.gammaincinv(count, tail))

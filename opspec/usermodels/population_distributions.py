@@ -51,7 +51,7 @@ __all__ = ["CORRELATION_KINDS", "PER_USER_KINDS", "PerUserDistribution",
 def _stats() -> Any:
     """scipy.stats, imported when a population is built: a user model without one never
     needs it, and importing it is a third of a second of every command's start."""
-    from scipy import stats  # type: ignore[import-untyped]
+    from scipy import stats
 
     return stats
 
