@@ -79,10 +79,10 @@ CREATE INDEX IF NOT EXISTS person_parameter_by_user ON person_parameter (design,
 _SAMPLE_INDEX = "CREATE INDEX IF NOT EXISTS sample_by_metric ON sample (design, metric, value)"
 
 # The two largest tables' rows by user (a user-month of the dispenser is 120 samples and 360
-# outcome rows): not kept while a fresh run stores (no user of it has earlier rows to replace,
-# and keeping them cost a third of the store's time), built with the sample index at the end,
-# and at once when a store with replications is opened again (--resume replaces failed users'
-# rows through them).
+# outcome rows), for --resume, which replaces failed users' rows through them: never built by
+# a fresh run (no user of it has earlier rows to replace; kept during the run they cost a
+# third of the store's time, built at its end a quarter), built when a store with
+# replications is opened again, whether the run before it finished or was killed.
 _USER_INDEXES = """
 CREATE INDEX IF NOT EXISTS sample_by_user ON sample (design, user);
 CREATE INDEX IF NOT EXISTS outcome_by_user ON outcome (design, user);
@@ -229,11 +229,9 @@ class ResultStore:
             raise
 
     def index(self) -> None:
-        """Build the indexes readers need that are not kept during the run (the sample
-        values by metric: quantiles, histograms; samples and outcomes by user); nothing to
-        do when they exist."""
-        self._write(lambda db: db.executescript(_USER_INDEXES + _SAMPLE_INDEX + ";"),
-                    "index the stored results")
+        """Build the index readers need that is not kept during the run (the sample values
+        by metric: quantiles, histograms); nothing to do when it exists."""
+        self._write(lambda db: db.execute(_SAMPLE_INDEX), "index the stored results")
 
     def failures(self) -> list[tuple[str, int, str]]:
         rows = self.query("SELECT design, user, error FROM replication "

@@ -121,3 +121,16 @@ def test_importing_the_output_modules_loads_no_heavy_library() -> None:
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
                          check=True)
     assert out.stdout.strip() == "[]"
+
+
+@pytest.mark.parametrize("draw", [
+    lambda series, p: plots.over_days_figure(series, p),
+    lambda series, p: plots.time_of_day_figure(series, p),
+], ids=["over-days", "time-of-day"])
+def test_an_outcome_that_never_happened_gets_no_panel_but_a_note(draw, tmp_path: Path) -> None:
+    # a panel of zeros would be drawn on a made-up scale (0 to 1e-9) and read as data
+    happened = [0] * 8 + [30] + [0] * 15
+    alone = draw({"alarms": happened}, tmp_path / "alone.png")
+    both = draw({"alarms": happened, "device_faults": [0] * 24}, tmp_path / "both.png")
+    assert assert_valid_png(both) == assert_valid_png(alone)     # no second panel
+    assert both.read_bytes() != alone.read_bytes()               # the note names it
