@@ -90,13 +90,11 @@ def _observations(store: ResultStore, design: str, metric: str) -> tuple[list[fl
 def _outcomes_all(store: ResultStore, design: str, metrics: list[str], days: int, users: int
                   ) -> tuple[dict[str, list[float]], dict[str, list[int]]]:
     """Per metric in ``metrics``: its mean count per user on each day, and its total count in
-    each hour of the day. One pass over the outcome table (its largest: a row per user, metric,
-    day and hour), summed by SQLite to at most metrics x days x 24 rows."""
+    each hour of the day, from the outcome rows summed over users (at most metrics x days x 24
+    sums, kept by the store while it stores, or one pass over its largest table)."""
     by_day: dict[str, dict[int, float]] = {m: {} for m in metrics}
     by_hour: dict[str, dict[int, int]] = {m: {} for m in metrics}
-    for metric, day, hour, n in store.query(
-            "SELECT metric, day, hour, SUM(n) FROM outcome WHERE design = ? "
-            "GROUP BY metric, day, hour", (design,)):
+    for metric, day, hour, n in store.outcome_sums(design):
         if metric in by_day:
             day_counts, hour_counts = by_day[metric], by_hour[metric]
             day_counts[int(day)] = day_counts.get(int(day), 0.0) + float(n)
@@ -652,7 +650,8 @@ def write_report(store: ResultStore, summaries: Mapping[str, Summaries] | None =
                  for n, d in difference.items()}
         compared = ((plots.comparison_figure(rows, figures / "comparison.png", units),)
                     if rows else ())
-        headers = ("metric", names["A"], names["B"], "difference", "95 % CI", "")
+        headers: tuple[str, ...] = ("metric", names["A"], names["B"], "difference", "95 % CI",
+                                    "")
         sections.append(Section(f"{names['B']} compared with {names['A']}", paragraphs=(
             (f"Differences {names['B']} − {names['A']} per metric on the same simulated users "
             "(paired); 'differs' marks intervals that exclude zero."),),

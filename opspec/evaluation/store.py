@@ -137,6 +137,12 @@ class ResultStore:
                 for table in ("replication", "sample", "outcome"))
             if self._had_results:
                 self._db.executescript(_USER_INDEXES)
+            #: per design, the outcome rows summed over users by (metric, day, hour), kept
+            #: while a fresh store stores: what the report's counts-over-time figures read,
+            #: without a pass over the largest table. None once any user's earlier rows
+            #: were replaced (or the store had results when opened): then read from the table.
+            self._outcome_sums: dict[str, dict[tuple[str, int, int], int]] | None = (
+                None if self._had_results else {})
         except sqlite3.Error as error:
             raise _fail(self.path, "open the result database", error) from None
 
@@ -227,11 +233,28 @@ class ResultStore:
             if db.in_transaction:
                 db.execute("ROLLBACK")
             raise
+        if again:
+            self._outcome_sums = None
+        elif self._outcome_sums is not None:
+            for r in records:
+                sums = self._outcome_sums.setdefault(r.design, {})
+                for key, n in r.outcomes.items():
+                    sums[key] = sums.get(key, 0) + n
 
     def index(self) -> None:
         """Build the index readers need that is not kept during the run (the sample values
         by metric: quantiles, histograms); nothing to do when it exists."""
         self._write(lambda db: db.execute(_SAMPLE_INDEX), "index the stored results")
+
+    def outcome_sums(self, design: str) -> list[tuple[str, int, int, int]]:
+        """``(metric, day, hour, n)``: the outcome rows of ``design`` summed over users, from
+        the running sums of this store's writes when they are all there is, else from the
+        table."""
+        if self._outcome_sums is not None:
+            return [(m, d, h, n) for (m, d, h), n in self._outcome_sums.get(design, {}).items()]
+        return [(str(m), int(d), int(h), int(n)) for m, d, h, n in self.query(
+            "SELECT metric, day, hour, SUM(n) FROM outcome WHERE design = ? "
+            "GROUP BY metric, day, hour", (design,))]
 
     def failures(self) -> list[tuple[str, int, str]]:
         rows = self.query("SELECT design, user, error FROM replication "
