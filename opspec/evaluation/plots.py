@@ -172,12 +172,11 @@ def _note_dropped(fig: Figure, dropped: int) -> None:
                  color="#444444", ha="left", va="bottom")
 
 
-def _note_never(fig: Figure, names: Sequence[str]) -> None:
-    """Say which metrics are not drawn because they never happened: a panel of zeros on a
-    made-up scale would only look like data."""
-    if names:
-        fig.text(0.01, 0.005, f"never happened, not drawn: {', '.join(names)}", fontsize=9,
-                 color="#444444", ha="left", va="bottom")
+def _never(names: Sequence[str]) -> str:
+    """A second title line naming the metrics not drawn because they never happened (a
+    panel of zeros on a made-up scale would only look like data); in the title, where the
+    layout makes room for it, however many there are."""
+    return f"\n(never happened, so not drawn: {', '.join(names)})" if names else ""
 
 
 def _outside_legend(ax: Axes) -> None:
@@ -307,7 +306,7 @@ def over_days_figure(series: Mapping[str, Sequence[float]], path: Path) -> Path:
         return _empty(path, title + (": every outcome was 0 on every day" if never else ""))
     longest = max(len(v) for v in present.values())
     with _figure(9.0, 0.9 + 1.45 * len(present)) as fig:
-        fig.suptitle(f"{title}: mean per user on each day")
+        fig.suptitle(f"{title}: mean per user on each day{_never(never)}")
         axes = _panels(fig, len(present))
         for i, (ax, (name, vals)) in enumerate(zip(axes, present.items(), strict=True)):
             days = list(range(1, len(vals) + 1))
@@ -324,7 +323,6 @@ def over_days_figure(series: Mapping[str, Sequence[float]], path: Path) -> Path:
         axes[-1].set_xlim(0.5, longest + 0.5)
         if longest <= 31:
             axes[-1].set_xticks(range(1, longest + 1, 1 if longest <= 15 else 2))
-        _note_never(fig, never)
         return _save(fig, path)
 
 
@@ -340,19 +338,18 @@ def time_of_day_figure(series: Mapping[str, Sequence[int]], path: Path) -> Path:
     never = [_text(name) for name, c in series.items() if not any(c)]
     if not present:
         return _empty(path, title + (": no outcome ever happened" if never else ""))
-    hours = list(range(24))
     with _figure(9.0, 0.9 + 1.45 * len(present)) as fig:
-        fig.suptitle(f"{title}: occurrences in each hour, all users and days")
+        fig.suptitle(f"{title}: occurrences in each hour, all users and days{_never(never)}")
         axes = _panels(fig, len(present))
         for i, (ax, (name, counts)) in enumerate(zip(axes, present.items(), strict=True)):
-            ax.bar(hours, counts, width=0.8, color=PALETTE[i % len(PALETTE)],
-                   edgecolor="black", linewidth=0.4)
+            # each hour is the bin [h, h+1): one outlined step patch, not 24 bar artists
+            ax.stairs(counts, range(25), fill=True, facecolor=PALETTE[i % len(PALETTE)],
+                      edgecolor="black", linewidth=0.6)
             ax.set_ylabel(name, rotation=0, ha="right", va="center")
             ax.set_ylim(0, max(counts) * 1.15)
-        axes[-1].set_xlabel("hour of the simulated day (0–23)")
-        axes[-1].set_xticks(range(0, 24, 2))
-        axes[-1].set_xlim(-0.6, 23.6)
-        _note_never(fig, never)
+        axes[-1].set_xlabel("hour of the simulated day (each bar from h:00 to h:59)")
+        axes[-1].set_xticks(range(0, 25, 2))
+        axes[-1].set_xlim(0, 24)
         return _save(fig, path)
 
 
@@ -387,9 +384,9 @@ def per_user_figure(series: Mapping[str, Sequence[float]], path: Path, *,
                 counts = [int(np.sum(arr == v)) for v in distinct]
                 ax.bar(distinct, counts, width=step * 0.8, color=PALETTE[5],
                        edgecolor=PALETTE[0], linewidth=0.6)
-            else:
-                ax.hist(arr, bins="auto", color=PALETTE[5], edgecolor=PALETTE[0],
-                        linewidth=0.6)
+            else:               # one outlined patch, not a rectangle per bin
+                ax.hist(arr, bins="auto", histtype="stepfilled", color=PALETTE[5],
+                        edgecolor=PALETTE[0], linewidth=0.8)
             mean = float(arr.mean())
             label = f"{mean:.2f} %" if unit == "%" else f"{mean:.4g}{' ' + unit if unit else ''}"
             # the mean in the panel's title, not in a legend box: a box in a corner hid the
