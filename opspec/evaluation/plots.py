@@ -487,6 +487,12 @@ def activity_rates_figure(rows: Sequence[tuple[str, float, float]], path: Path) 
             ax.bar_label(bars, labels=[_fmt(b.get_width(), percent) for b in bars],
                          padding=3, fontsize=9)
         ax.set_yticks(centres, [a for a, *_ in clean])
+        # a rule between activities, none through them: a grid line at each name ran
+        # between its two bars, and a 0 % label seemed to belong to the next activity
+        ax.grid(axis="y", visible=False)
+        for c in centres[:-1]:
+            ax.axhline(c - 0.5, color="#999999", linewidth=0.6)
+        ax.set_ylim(-0.5, n - 0.5)
         ax.set_title(f"{title} (share of the times it was asked for)")
         if percent:
             _percent_axis(ax, "x")
