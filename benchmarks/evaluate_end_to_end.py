@@ -29,6 +29,7 @@ from __future__ import annotations
 import argparse
 import json
 import resource
+import statistics
 import subprocess
 import sys
 import tempfile
@@ -111,11 +112,15 @@ def main() -> None:
     runners = {"baseline (hand-coded SimPy)": baseline, "engine alone": engine_alone,
                "opspec evaluate, end to end": end_to_end}
     best: dict[str, tuple[float, float]] = {}
+    paired: list[float] = []        # end to end / engine alone (CPU) within each round
     for _ in range(max(1, args.repeat)):
+        this: dict[str, float] = {}
         for name, runner in runners.items():      # interleaved: load drifts hit all alike
             cpu, wall = runner(args.users, args.days, args.seed)
+            this[name] = cpu
             old = best.get(name)
             best[name] = (min(cpu, old[0]), min(wall, old[1])) if old else (cpu, wall)
+        paired.append(this["opspec evaluate, end to end"] / this["engine alone"])
     _, _, version = _measure([sys.executable, "-m", "opspec", "--version"])
     print(" ".join(version.split()))
     print(f"medication dispenser, {args.users:,} users x {args.days} days, one worker, "
@@ -128,6 +133,9 @@ def main() -> None:
           f"{e2e[1] / engine[1]:.2f} (wall); goal <= 1.3")
     print(f"engine alone / baseline:   {engine[0] / base[0]:.2f} (CPU), "
           f"{engine[1] / base[1]:.2f} (wall)")
+    if len(paired) > 1:     # on a machine whose speed drifts, the fastest runs may not pair
+        print(f"end to end / engine alone within each round (CPU): median "
+              f"{statistics.median(paired):.2f}, range {min(paired):.2f}-{max(paired):.2f}")
     if args.profile:
         end_to_end(args.users, args.days, args.seed, profile=args.profile)
         print(f"profile of one end-to-end run: {args.profile} (python -m pstats)")

@@ -321,8 +321,10 @@ def over_days_figure(series: Mapping[str, Sequence[float]], path: Path) -> Path:
                 ax.set_ylim(bottom=0, top=max(max(finite) * 1.15, 1e-9))
         axes[-1].set_xlabel("simulated day")
         axes[-1].set_xlim(0.5, longest + 0.5)
-        if longest <= 31:
-            axes[-1].set_xticks(range(1, longest + 1, 1 if longest <= 15 else 2))
+        if longest <= 10:
+            axes[-1].set_xticks(range(1, longest + 1))
+        elif longest <= 31:     # day 1 and every fifth: a grid a reader counts along
+            axes[-1].set_xticks([1, *range(5, longest + 1, 5)])
         return _save(fig, path)
 
 
@@ -348,7 +350,7 @@ def time_of_day_figure(series: Mapping[str, Sequence[int]], path: Path) -> Path:
             ax.set_ylabel(name, rotation=0, ha="right", va="center")
             ax.set_ylim(0, max(counts) * 1.15)
         axes[-1].set_xlabel("hour of the simulated day (each bar from h:00 to h:59)")
-        axes[-1].set_xticks(range(0, 25, 2))
+        axes[-1].set_xticks(range(0, 25, 3))
         axes[-1].set_xlim(0, 24)
         return _save(fig, path)
 
