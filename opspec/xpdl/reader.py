@@ -34,6 +34,7 @@ from typing import BinaryIO, Final
 from lxml import etree
 
 from opspec.errors import Diagnostic, Severity, SourceLocation, SpecError
+from opspec.files import not_a_file
 from opspec.model.package import XpdlVersion
 from opspec.xpdl.namespaces import XPDL_NAMESPACES, version_of_namespace
 
@@ -211,28 +212,6 @@ def read_limited(stream: BinaryIO, *, path: str, max_bytes: int = DEFAULT_MAX_BY
         if total > max_bytes:
             raise _too_big(path, max_bytes)
         chunks.append(chunk)
-
-
-def not_a_file(path: str | os.PathLike[str]) -> str | None:
-    """Why ``path`` cannot be read as a specification without even opening it (``"it does not
-    exist"``, ``"it is a folder"``, ``"it is a named pipe (FIFO), not a regular file"``…), or
-    ``None`` for a regular file (or a link to one). Never blocks: nothing is opened."""
-    try:
-        mode = os.stat(path).st_mode
-    except FileNotFoundError:
-        return "it does not exist"
-    except OSError as error:
-        return f"it cannot be examined: {error.strerror or type(error).__name__}"
-    if stat.S_ISREG(mode):
-        return None
-    if stat.S_ISDIR(mode):
-        return "it is a folder"
-    kind = ("a named pipe (FIFO)" if stat.S_ISFIFO(mode)
-            else "a character device" if stat.S_ISCHR(mode)
-            else "a block device" if stat.S_ISBLK(mode)
-            else "a socket" if stat.S_ISSOCK(mode)
-            else "a special file")
-    return f"it is {kind}, not a regular file"
 
 
 def open_regular(path: str | Path) -> BinaryIO:
