@@ -40,6 +40,7 @@ MODULES: tuple[str, ...] = (
     "opspec.engine.lifecycle",
     "opspec.engine.metrics",
     "opspec.engine.offers",
+    "opspec.engine.part",
     "opspec.engine.random",
     "opspec.engine.runstate",
     "opspec.engine.sampling",

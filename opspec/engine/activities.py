@@ -13,7 +13,7 @@ from __future__ import annotations
 
 from collections import ChainMap, deque
 from collections.abc import Mapping
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 from opspec.engine import coordination as coord
 from opspec.engine.compiled import (
@@ -39,40 +39,19 @@ from opspec.engine.lifecycle import (
     SUSPENDED,
     TERMINATED,
 )
-from opspec.engine.runstate import RunState, discard
+from opspec.engine.part import Part
+from opspec.engine.runstate import discard
 from opspec.engine.trace import EventKind as EK
 from opspec.errors import OpspecError
 from opspec.model import CoordinationKind, ParameterMode
-
-if TYPE_CHECKING:
-    from opspec.engine.flow import Flow
-    from opspec.engine.offers import Offers
-    from opspec.engine.triggers import Triggers
-
 
 #: Synchronous subflow calls nested deeper than this end the run's root instance with a
 #: located fault: bounded recursion (a base case) runs, runaway recursion is reported.
 MAX_CALL_DEPTH = 100
 
 
-class Activities:
+class Activities(Part):
     """An activity's life from start to completion (see the module docstring)."""
-
-    flow: Flow
-    activities: Activities
-    triggers: Triggers
-    offers: Offers
-
-    def __init__(self, state: RunState) -> None:
-        self.state = state
-
-    def connect(self, flow: Flow, activities: Activities, triggers: Triggers,
-                offers: Offers) -> None:
-        """The other parts of the interpreter (they call each other)."""
-        self.flow = flow
-        self.activities = activities
-        self.triggers = triggers
-        self.offers = offers
 
     def _too_deep(self, ai: ActivityInstance, target: CompiledProcess) -> None:
         """Runaway recursion: abort the outermost caller (which ends every nested call)."""

@@ -12,7 +12,7 @@ from __future__ import annotations
 
 from collections import ChainMap
 from collections.abc import Mapping, MutableMapping
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 from opspec.engine.compiled import (
     J_AND,
@@ -32,37 +32,16 @@ from opspec.engine.lifecycle import (
     SUSPENDED,
     TERMINATED,
 )
-from opspec.engine.runstate import RunState
+from opspec.engine.part import Part
 from opspec.engine.trace import EventKind as EK
 from opspec.errors import OpspecError
 from opspec.model import ParameterMode
 
-if TYPE_CHECKING:
-    from opspec.engine.activities import Activities
-    from opspec.engine.offers import Offers
-    from opspec.engine.triggers import Triggers
-
 _NEXT = LIFECYCLE.table
 
 
-class Flow:
+class Flow(Part):
     """Tokens through graphs: process instances, transitions, splits, joins (see the module docstring)."""
-
-    flow: Flow
-    activities: Activities
-    triggers: Triggers
-    offers: Offers
-
-    def __init__(self, state: RunState) -> None:
-        self.state = state
-
-    def connect(self, flow: Flow, activities: Activities, triggers: Triggers,
-                offers: Offers) -> None:
-        """The other parts of the interpreter (they call each other)."""
-        self.flow = flow
-        self.activities = activities
-        self.triggers = triggers
-        self.offers = offers
 
     def start_process(self, proc: CompiledProcess, data: Mapping[str, Any] | None = None, *,
                       parent: ActivityInstance | None = None, trigger: str | None = None

@@ -10,7 +10,7 @@ from __future__ import annotations
 
 from collections.abc import Mapping
 from types import MappingProxyType
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 from opspec.engine.compiled import (
     K_CATCH,
@@ -25,36 +25,14 @@ from opspec.engine.lifecycle import (
     RUNNING,
     TERMINATED,
 )
+from opspec.engine.part import Part
 from opspec.engine.performers import Performer, WorkItem
-from opspec.engine.runstate import RunState
 from opspec.engine.trace import EventKind as EK
 from opspec.errors import ExecutionError
 
-if TYPE_CHECKING:
-    from opspec.engine.activities import Activities
-    from opspec.engine.flow import Flow
-    from opspec.engine.triggers import Triggers
 
-
-
-class Offers:
+class Offers(Part):
     """Work items to performers and their answers (see the module docstring)."""
-
-    flow: Flow
-    activities: Activities
-    triggers: Triggers
-    offers: Offers
-
-    def __init__(self, state: RunState) -> None:
-        self.state = state
-
-    def connect(self, flow: Flow, activities: Activities, triggers: Triggers,
-                offers: Offers) -> None:
-        """The other parts of the interpreter (they call each other)."""
-        self.flow = flow
-        self.activities = activities
-        self.triggers = triggers
-        self.offers = offers
 
     def performer_for(self, act: CompiledActivity) -> Performer | None:
         if act in self.state.performers_of:

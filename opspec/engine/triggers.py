@@ -14,7 +14,7 @@ import dataclasses
 import math
 from collections import deque
 from collections.abc import Callable, Iterable, Iterator, Mapping
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 from opspec.engine.compiled import (
     CompiledActivity,
@@ -28,39 +28,18 @@ from opspec.engine.lifecycle import (
     SUSPENDED,
     TERMINATED,
 )
-from opspec.engine.runstate import RunState, discard
+from opspec.engine.part import Part
+from opspec.engine.runstate import discard
 from opspec.engine.trace import EventKind as EK
 from opspec.errors import OpspecError
-
-if TYPE_CHECKING:
-    from opspec.engine.activities import Activities
-    from opspec.engine.flow import Flow
-    from opspec.engine.offers import Offers
-
 
 #: Messages of one name kept with nobody waiting (per receiving instance, or for anyone).
 MESSAGE_BUFFER = 100
 DAY = 86_400.0
 
 
-class Triggers:
+class Triggers(Part):
     """Messages, signals, timers, rules, boundary events, deadlines, start/end triggers, modes."""
-
-    flow: Flow
-    activities: Activities
-    triggers: Triggers
-    offers: Offers
-
-    def __init__(self, state: RunState) -> None:
-        self.state = state
-
-    def connect(self, flow: Flow, activities: Activities, triggers: Triggers,
-                offers: Offers) -> None:
-        """The other parts of the interpreter (they call each other)."""
-        self.flow = flow
-        self.activities = activities
-        self.triggers = triggers
-        self.offers = offers
 
     def wait_trigger(self, ai: ActivityInstance, trig: CTrigger, handler: Any, arg: Any,
                       persistent: bool = False) -> None:
