@@ -20,3 +20,22 @@ def _inner_pytest_runs_leave_the_snapshot_plugin_alone(request: pytest.FixtureRe
     folder. Putting the outer value back after each pytester test keeps the outer one."""
     if "pytester" in request.fixturenames and "TEXTUAL_SNAPSHOT_TEMPDIR" in os.environ:
         monkeypatch.setenv("TEXTUAL_SNAPSHOT_TEMPDIR", os.environ["TEXTUAL_SNAPSHOT_TEMPDIR"])
+
+
+@pytest.fixture
+def load_benchmark():
+    """``load_benchmark("interval_coverage")``: the module ``benchmarks/<name>.py`` (a script,
+    not a package), for the tests that run a benchmark's own measurement."""
+    import importlib.util
+    from pathlib import Path
+
+    folder = Path(__file__).resolve().parents[1] / "benchmarks"
+
+    def load(name: str):
+        spec = importlib.util.spec_from_file_location(f"benchmark_{name}", folder / f"{name}.py")
+        assert spec is not None and spec.loader is not None
+        module = importlib.util.module_from_spec(spec)
+        spec.loader.exec_module(module)
+        return module
+
+    return load

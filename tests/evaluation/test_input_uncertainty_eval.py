@@ -10,7 +10,6 @@ benchmarks/input_uncertainty_coverage.py for the full table.
 from __future__ import annotations
 
 import contextlib
-import importlib.util
 import io
 import sqlite3
 from pathlib import Path
@@ -22,7 +21,6 @@ from opspec.cli import main
 
 ROOT = Path(__file__).resolve().parents[2]
 SPEC = ROOT / "specs" / "medication_dispenser.xpdl"
-BENCHMARK = ROOT / "benchmarks" / "input_uncertainty_coverage.py"
 SHARED = ROOT.parent / "shared" / "bench" / "analytic.py"
 
 
@@ -141,24 +139,17 @@ def test_the_variance_split_recovers_known_components() -> None:
     assert out["parameter_share"] == pytest.approx(4 / 4.0025, abs=0.01)
 
 
-def _benchmark():
-    spec = importlib.util.spec_from_file_location("input_uncertainty_coverage", BENCHMARK)
-    assert spec is not None and spec.loader is not None
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module
-
 
 @pytest.mark.slow
 @pytest.mark.skipif(not SHARED.is_file(), reason="needs ../shared/bench (the closed form)")
-def test_widened_intervals_cover_the_true_models_metric() -> None:
+def test_widened_intervals_cover_the_true_models_metric(load_benchmark) -> None:
     """40 repetitions of: record 7 days of one person following the reference user (about
     28 walks and 33 alarms), fit, evaluate 40 users x 5 days with 20 parameter draws x 10
     users. The truth is the closed
     form for the reference (true) parameters. The ordinary intervals, which take the fitted
     parameters for the truth, cover it far less often than 95 %; the widened ones cover it
     about as often as they say."""
-    result = _benchmark().run(repetitions=40, trace_days=7.0, users=40, days=5.0, draws=20,
+    result = load_benchmark("input_uncertainty_coverage").run(repetitions=40, trace_days=7.0, users=40, days=5.0, draws=20,
                               per_draw=10, workers=1, seed0=41_000)
     rows = {r["metric"]: r for r in result["table"]}
     for metric in ("alarms_per_dose", "report_latency_s"):

@@ -174,26 +174,16 @@ def test_readme_command_shows_pooled_misses_the_dedicated_model_meets(capsys):
     assert pooled["sense"]["misses"] > 0
 
 
-def test_processor_models_benchmark_runs_at_tiny_size(capsys):
-    import importlib.util
-
-    bench = Path(__file__).resolve().parents[2] / "benchmarks" / "processor_models.py"
-    loaded = importlib.util.spec_from_file_location("processor_models_bench", bench)
-    module = importlib.util.module_from_spec(loaded)
-    loaded.loader.exec_module(module)
+def test_processor_models_benchmark_runs_at_tiny_size(capsys, load_benchmark):
+    module = load_benchmark("processor_models")
     module.main(["--seconds", "2"])
     out = capsys.readouterr().out
     assert "dedicated (3 cpu)" in out
     assert "pooled 1w 1p" in out and "pooled 3w 8p" in out
 
 
-def test_table3_benchmark_runs_at_tiny_size_with_the_same_work_in_both_variants(capsys):
-    import importlib.util
-
-    bench = Path(__file__).resolve().parents[2] / "benchmarks" / "table3_overhead.py"
-    loaded = importlib.util.spec_from_file_location("table3_bench", bench)
-    module = importlib.util.module_from_spec(loaded)
-    loaded.loader.exec_module(module)
+def test_table3_benchmark_runs_at_tiny_size_with_the_same_work_in_both_variants(capsys, load_benchmark):
+    module = load_benchmark("table3_overhead")
     module.main(["--seconds", "30", "--repeat", "1"])
     rows = [line.split() for line in capsys.readouterr().out.splitlines()
             if "workflows & engine" in line or "customised code" in line]

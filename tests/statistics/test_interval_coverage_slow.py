@@ -20,28 +20,19 @@ its coverage and counted.
 
 from __future__ import annotations
 
-import importlib.util
 from pathlib import Path
 
 import pytest
 
 ROOT = Path(__file__).resolve().parents[2]
-BENCHMARK = ROOT / "benchmarks" / "interval_coverage.py"
 SHARED = ROOT.parent / "shared" / "bench" / "analytic.py"
 
-
-def _benchmark():
-    spec = importlib.util.spec_from_file_location("interval_coverage", BENCHMARK)
-    assert spec is not None and spec.loader is not None
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module
 
 
 @pytest.mark.slow
 @pytest.mark.skipif(not SHARED.is_file(), reason="needs ../shared/bench (the closed form)")
-def test_intervals_cover_the_closed_form_at_10_users() -> None:
-    result = _benchmark().run(repetitions=1000, user_counts=[10], days=7.0, workers=1,
+def test_intervals_cover_the_closed_form_at_10_users(load_benchmark) -> None:
+    result = load_benchmark("interval_coverage").run(repetitions=1000, user_counts=[10], days=7.0, workers=1,
                               seed0=7_000)
     rows = {(r["design"], r["metric"]): r for r in result["table"]}
     for (design, metric), row in rows.items():
