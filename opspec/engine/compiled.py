@@ -150,6 +150,7 @@ class CTransition:
     exception: str | None
     assignments: tuple[tuple[str, Evaluator], ...]
     label: str | None = None          # a ScriptGrammar="Text" condition: a label, no test
+    probability: float = -1.0         # drawn with this probability (undecided gateway); < 0: none
 
 
 @dataclass(frozen=True, slots=True, eq=False)
@@ -191,6 +192,7 @@ class CompiledActivity:
     default_exception: CTransition | None = None
     choice: tuple[CTransition, ...] = ()      # deferred choice offered after completion
     labelled: bool = False                   # the choice is between labelled branches
+    drawn: tuple[CTransition, ...] = ()      # an undecided gateway's branches, drawn at random
     start_assign: tuple[tuple[str, Evaluator], ...] = ()
     end_assign: tuple[tuple[str, Evaluator], ...] = ()
     raises: CTrigger | None = None
@@ -481,7 +483,8 @@ class _Compiler:
                             for a in tr.assignments)
             ct = CTransition(index=ti, id=tr.id, target=by_id[tr.target], kind=kind,
                              condition=cond, exception=exc, assignments=assigns,
-                             label=(tr.condition.text or None) if kind == T_NONE else None)
+                             label=(tr.condition.text or None) if kind == T_NONE else None,
+                             probability=-1.0 if tr.probability is None else tr.probability)
             trans_by_id[tr.id] = ct
             outgoing[by_id[tr.source]].append(ct)
             incoming[by_id[tr.target]].append(ti)
@@ -681,6 +684,10 @@ class _Compiler:
             # no split declared and some conditions: BPMN conditional sequence flows, every
             # one whose condition holds is taken (OTHERWISE is the default flow)
             ca.split = S_OR
+        if ca.split in (S_XOR, S_OR) and any(t.probability >= 0.0 for t in ordered):
+            # a gateway the spec leaves undecided: its branches are drawn with the declared
+            # probabilities (the reader gives every branch one), never by file order
+            ca.drawn = tuple(t for t in ordered if t.kind in (T_NONE, T_COND, T_OTHERWISE))
         # directives
         if act.assignments:
             ca.start_assign = tuple(

@@ -134,6 +134,8 @@ class Defs:
     package_fields: set[str] = field(default_factory=set)
     item_kinds: dict[str, BasicKind] = field(default_factory=dict)
     process_io: dict[str, list[tuple[str, ParameterMode]]] = field(default_factory=dict)
+    probabilities: dict[str, float] = field(default_factory=dict)   # BPSim / QBP, by flow id
+    probability_source: dict[str, str] = field(default_factory=dict)
 
     def info(self, element: etree._Element | None, code: str, message: str,
              hint: str = "") -> None:

@@ -57,6 +57,7 @@ from opspec.xpdl.bpmn.common import (
     namespace,
     text_of,
 )
+from opspec.xpdl.bpmn.branches import decide_undecided
 from opspec.xpdl.bpmn.data import activity_data, process_fields
 from opspec.xpdl.bpmn.events import definitions_of, read_timer, trigger_of
 from opspec.xpdl.bpmn.extensions import (
@@ -239,6 +240,8 @@ class _Process:
         boundary = self.boundaries(boundaries, ids)
         ids |= {b.id for b in boundary.activities}
         transitions = self.flows(flows, ids, nodes, boundary.skipped)
+        transitions = decide_undecided(nodes, transitions,
+                                       {f.get("id") or "": f for f in flows}, self.defs)
         transitions.extend(boundary.transitions)
         incoming: dict[str, int] = {}
         outgoing: dict[str, list[str]] = {}
