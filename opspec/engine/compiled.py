@@ -56,6 +56,7 @@ from opspec.model import (
     WorkflowProcess,
 )
 from opspec.model.bulk import gc_paused
+from opspec.model.checks_support import names_read
 from opspec.model.data import is_structured, structured_value
 
 __all__ = [
@@ -193,6 +194,7 @@ class CompiledActivity:
     choice: tuple[CTransition, ...] = ()      # deferred choice offered after completion
     labelled: bool = False                   # the choice is between labelled branches
     drawn: tuple[CTransition, ...] = ()      # an undecided gateway's branches, drawn at random
+    inputs: tuple[str, ...] = ()             # run inputs its conditions read: drawn while unset
     start_assign: tuple[tuple[str, Evaluator], ...] = ()
     end_assign: tuple[tuple[str, Evaluator], ...] = ()
     raises: CTrigger | None = None
@@ -327,6 +329,11 @@ class _Compiler:
     def __init__(self, package: Package) -> None:
         self.package = package
         self.throwable: set[str] = set()
+        # package data fields a BPMN diagram's conditions read but nothing sets: a gateway
+        # deciding on one is drawn at random while the run is not given its value
+        self.run_inputs = frozenset(
+            f.id for f in package.data_fields
+            if any(e.name == "opspec:RunInput" for e in f.extended_attributes))
         self.participants = {p.id: p for p in package.participants}
         self.participant_lane: dict[str, tuple[str, ...]] = {}
         for pool in package.pools:
@@ -487,6 +494,11 @@ class _Compiler:
                              probability=-1.0 if tr.probability is None else tr.probability)
             trans_by_id[tr.id] = ct
             outgoing[by_id[tr.source]].append(ct)
+            if tr.probability is not None and self.run_inputs and tr.condition.expression:
+                reads = [n for n in names_read(tr.condition.expression) if n in self.run_inputs]
+                if reads:
+                    source = acts[by_id[tr.source]]
+                    source.inputs = tuple(dict.fromkeys((*source.inputs, *reads)))
             incoming[by_id[tr.target]].append(ti)
         for i, act in enumerate(activities):
             self.activity(proc, act, acts[i], acts, by_id, outgoing[i], incoming[i],

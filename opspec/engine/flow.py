@@ -454,7 +454,7 @@ class Flow(Part):
             frame.running[ai.key] = ai
             self.offers.offer_choice(ai, act.choice)
             return
-        if act.drawn:
+        if act.drawn and (not act.inputs or self._inputs_missing(act)):
             self._draw(frame, act)
             self.token_gone(frame)
             return
@@ -490,6 +490,14 @@ class Flow(Part):
                     return
                 self.take(frame, act.otherwise[0])
         self.token_gone(frame)
+
+    def _inputs_missing(self, act: CompiledActivity) -> bool:
+        """Whether a run input the gateway's conditions read has no value in this run."""
+        data = self.state.package_data
+        for name in act.inputs:
+            if data.get(name) is None:
+                return True
+        return False
 
     def _draw(self, frame: Frame, act: CompiledActivity) -> None:
         """The branches of a gateway the spec leaves undecided, drawn from the gateway's own

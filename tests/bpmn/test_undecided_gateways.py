@@ -232,3 +232,70 @@ def test_the_probabilities_survive_conversion_to_xpdl(tmp_path: Path) -> None:
     assert shares == pytest.approx({"yes": 0.8, "no": 0.2})
     counts = _choices(xpdl)
     assert _inside(counts["yes"], 0.8)
+
+
+CAMUNDA_NS = 'xmlns:camunda="http://camunda.org/schema/1.0/bpmn"'
+
+
+def _scored(tmp_path: Path) -> Path:
+    """Camunda's loan-approval shape: the application sets ``score`` at run time."""
+    yes = ('<bpmn:conditionExpression xsi:type="bpmn:tFormalExpression">${score &gt; 50}'
+           '</bpmn:conditionExpression>')
+    no = ('<bpmn:conditionExpression xsi:type="bpmn:tFormalExpression">${score &lt;= 50}'
+          '</bpmn:conditionExpression>')
+    text = _diagram(yes=yes, no=no, extra_ns=CAMUNDA_NS +
+                    ' xmlns:xsi="http://www.w3.org/2001/XMLSchema-instance"')
+    return _write(tmp_path, text)
+
+
+def test_a_variable_the_application_sets_is_a_run_input_not_an_error(tmp_path: Path) -> None:
+    path = _scored(tmp_path)
+    _package, report = validate_spec(path)
+    assert not [d for d in report.diagnostics if d.severity is Severity.ERROR]
+    inputs = _diagnostics(path, "run-input")
+    assert len(inputs) == 1 and "'score'" in inputs[0][2] and inputs[0][1] == 9      # the flow whose condition reads it
+    gateway = _diagnostics(path, "undecided-gateway")
+    assert gateway and gateway[0][1] == 8 and "score" in gateway[0][2]
+
+
+def test_a_run_input_given_decides_by_the_conditions(tmp_path: Path) -> None:
+    path = _scored(tmp_path)
+    high = opspec.run(path, seed=1, until=3600, params={"score": 70})
+    low = opspec.run(path, seed=1, until=3600, params={"score": 20})
+    taken_high = {e.activity for e in high.trace if e.kind == "activity.completed"}
+    taken_low = {e.activity for e in low.trace if e.kind == "activity.completed"}
+    assert "done" in taken_high and "remind" not in taken_high
+    assert "remind" in taken_low and "done" not in taken_low
+    assert not [e for e in high.trace if e.kind == "branch.chosen"]
+
+
+def test_a_run_input_not_given_is_drawn_at_random_and_traced(tmp_path: Path) -> None:
+    counts = _choices(_scored(tmp_path))
+    assert _inside(counts["yes"], 0.5) and _inside(counts["no"], 0.5)
+
+
+def test_param_on_the_command_line_gives_a_run_input_typed_and_checked(tmp_path: Path) -> None:
+    import json
+    import subprocess
+    import sys
+
+    path = _scored(tmp_path)
+
+    def run(*options: str) -> subprocess.CompletedProcess[str]:
+        return subprocess.run([sys.executable, "-m", "opspec", "run", str(path), "--until",
+                               "PT1H", "--json", *options], capture_output=True, text=True,
+                              timeout=120)
+
+    trace = tmp_path / "trace.jsonl"
+    given = run("--param", "score=70", "--trace", str(trace))
+    assert given.returncode == 0, given.stderr
+    assert json.loads(given.stdout)["instances"]["completed"] == 59    # one a minute
+    events = [json.loads(line) for line in trace.read_text().splitlines()]
+    completed = {e.get("activity") for e in events if e.get("kind") == "activity.completed"}
+    assert "done" in completed and "remind" not in completed      # score 70 > 50
+    assert not [e for e in events if e.get("kind") == "branch.chosen"]
+    misspelt = run("--param", "scor=70")
+    assert misspelt.returncode == 2 and "did you mean 'score'" in misspelt.stderr
+    assert "Traceback" not in misspelt.stderr
+    wrong_type = run("--param", "score=high")
+    assert wrong_type.returncode == 2 and "score is an integer" in wrong_type.stderr

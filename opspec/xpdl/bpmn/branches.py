@@ -23,7 +23,7 @@ from opspec.xpdl.bpmn.extensions import opspec_named
 from opspec.xpdl.namespaces import OPSPEC
 from opspec.xpdl.sisarl_values import parse_probability
 
-__all__ = ["decide_undecided"]
+__all__ = ["decide_undecided", "fallback_probabilities", "with_probability"]
 
 _GATEWAYS = {"exclusiveGateway": "exclusive", "inclusiveGateway": "inclusive"}
 _TOLERANCE = 1e-6
@@ -46,10 +46,10 @@ def decide_undecided(nodes: Iterable[etree._Element], transitions: list[Transiti
         given.update(_probabilities(node, kind, out, flows, defs))
     if not given:
         return transitions
-    return [_with(t, given[t.id]) if t.id in given else t for t in transitions]
+    return [with_probability(t, given[t.id]) if t.id in given else t for t in transitions]
 
 
-def _with(transition: Transition, probability: float) -> Transition:
+def with_probability(transition: Transition, probability: float) -> Transition:
     kept = tuple(e for e in transition.extended_attributes
                  if e.name not in ("opspec:Probability", "Probability"))
     written = ExtendedAttribute(name="opspec:Probability", value=_number(probability))
@@ -57,8 +57,19 @@ def _with(transition: Transition, probability: float) -> Transition:
                                extended_attributes=(*kept, written))
 
 
+def fallback_probabilities(node: etree._Element, out: list[Transition], defs: Defs,
+                           inputs: tuple[str, ...]) -> dict[str, float]:
+    """The probabilities that decide the flows ``out`` of ``node`` while the run inputs its
+    conditions read have no value (:mod:`.run_inputs`)."""
+    kind = _GATEWAYS.get(local(node), "inclusive")    # conditional flows out of a task: OR
+    flows = {t.id: element for t in out
+             if (element := defs.by_id.get(t.id)) is not None}
+    return _probabilities(node, kind, out, flows, defs, inputs)
+
+
 def _probabilities(gateway: etree._Element, kind: str, out: list[Transition],
-                   flows: dict[str, etree._Element], defs: Defs) -> dict[str, float]:
+                   flows: dict[str, etree._Element], defs: Defs,
+                   inputs: tuple[str, ...] = ()) -> dict[str, float]:
     declared: dict[str, float] = {}
     sources: set[str] = set()
     for transition in out:
@@ -71,7 +82,9 @@ def _probabilities(gateway: etree._Element, kind: str, out: list[Transition],
             declared[transition.id] = defs.probabilities[transition.id]
             sources.add(defs.probability_source.get(transition.id, "the file"))
     missing = [t.id for t in out if t.id not in declared]
-    label = f"{kind} gateway {gateway.get('name') or gateway.get('id')!r}"
+    named = gateway.get('name') or gateway.get('id')
+    label = (f"{kind} gateway {named!r}" if local(gateway) in _GATEWAYS
+             else f"the conditional flows out of {local(gateway)} {named!r}")
     labels = [f"{t.id} ({t.name!r})" if t.name else t.id for t in out]
     result = dict(declared)
     if kind == "exclusive":
@@ -105,7 +118,19 @@ def _probabilities(gateway: etree._Element, kind: str, out: list[Transition],
     # an exclusive gateway's one flow without a probability gets what the others leave: that
     # is implied, not a default; any other missing probability is opspec's choice, said
     implied = kind == "exclusive" and len(missing) == 1 and bool(declared)
-    if missing and not implied:
+    if inputs:
+        given_by = (f"the probabilities of {' and '.join(sorted(sources))}" if declared and
+                    not missing else "equal probabilities" if not declared else
+                    "the probabilities given and the rest shared equally")
+        defs.ctx.warning(gateway, "undecided-gateway",
+                         f"{label} is decided by conditions over run inputs "
+                         f"({', '.join(inputs)}) that nothing in the diagram sets: in a run "
+                         f"not given them, opspec decides it at random with {given_by} "
+                         f"({shares}); it {how}, and each draw is a branch.chosen trace event",
+                         f"give the run inputs with --param NAME=VALUE, or each flow its "
+                         "probability (opspec:Probability, BPSim, QBP) (docs/bpmn.md, Run "
+                         "inputs)")
+    elif missing and not implied:
         what = ("no condition on any flow" if not any(t.name for t in out) else
                 f"only labels, no conditions, on its flows ({', '.join(labels)})")
         defs.ctx.warning(gateway, "undecided-gateway",

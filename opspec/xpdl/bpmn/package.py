@@ -27,6 +27,7 @@ from opspec.xpdl.bpmn.common import (
 from opspec.xpdl.bpmn.data import CAMUNDA, index_data
 from opspec.xpdl.bpmn.extensions import application, data_field, directives, opspec_named
 from opspec.xpdl.bpmn.process import BuiltProcess, build_process, is_user_name
+from opspec.xpdl.bpmn.run_inputs import with_run_inputs
 from opspec.xpdl.bpmn.simulation import BPSIM_NAMESPACES, QBP, read_simulation_parameters
 from opspec.xpdl.handlers.common import BuildContext
 from opspec.xpdl.namespaces import OPSPEC
@@ -267,6 +268,7 @@ def build_definitions(root: etree._Element, ctx: BuildContext) -> Package:
     known = {p.id for p in participants}
     if defs.user_participant and "user" not in known:
         participants.append(Participant(id="user", name="User", type=ParticipantType.HUMAN))
+    processes, run_inputs = with_run_inputs([b.process for b in built], package_fields, defs)
     found, kept = directives(root, defs, PACKAGE_DIRECTIVES, "the definitions",
                              ("DataField", "Application"))
     extensions = package_extensions(root, ctx, found)
@@ -284,8 +286,8 @@ def build_definitions(root: etree._Element, ctx: BuildContext) -> Package:
                              or None, source_format=BPMN_FORMAT),
         participants=tuple(participants),
         applications=applications,
-        data_fields=package_fields,
+        data_fields=package_fields + run_inputs,
         pools=model_pools,
-        processes=tuple(b.process for b in built),
+        processes=tuple(processes),
         **extensions,
     )
