@@ -21,6 +21,7 @@ __all__ = [
     "Defs",
     "bpmn_children",
     "expression_text",
+    "is_juel",
     "first",
     "kids",
     "local",
@@ -88,6 +89,12 @@ def text_of(element: etree._Element | None) -> str | None:
 _JUEL = re.compile(r"^[$#]\{(?P<inner>.*)\}$", re.DOTALL)
 # "PT5M" or 'PT5M': SpiffWorkflow writes timer values as Python string literals.
 _QUOTED = re.compile(r"""^(?P<q>["'])(?P<inner>[^"']*)(?P=q)$""")
+
+
+def is_juel(element: etree._Element | None) -> bool:
+    """Whether ``element``'s expression is wrapped as Camunda's JUEL (``${…}``, ``#{…}``)."""
+    text = text_of(element)
+    return text is not None and _JUEL.match(text) is not None
 
 
 def expression_text(element: etree._Element | None, *, unquote: bool = False) -> str | None:
