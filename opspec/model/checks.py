@@ -279,6 +279,8 @@ def _unconditional_xor(scope: str, graph: FlowGraph, activity: Activity,
                 if t.condition.kind is ConditionKind.NONE]
     if len(branches) < 2:
         return
+    if all(t.probability is not None for t in branches):
+        return       # drawn with branch probabilities (said where the reader set them)
     targets = [graph.by_id[t.target] for t in branches]
     if all(t.is_manual or t.performers for t in targets):
         return       # a deferred choice: the performer picks the branch (engine semantics)

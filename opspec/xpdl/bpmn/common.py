@@ -143,6 +143,7 @@ class Defs:
     process_io: dict[str, list[tuple[str, ParameterMode]]] = field(default_factory=dict)
     probabilities: dict[str, float] = field(default_factory=dict)   # BPSim / QBP, by flow id
     probability_source: dict[str, str] = field(default_factory=dict)
+    data_names: dict[str, str] = field(default_factory=dict)   # a data object's name -> its id
 
     def info(self, element: etree._Element | None, code: str, message: str,
              hint: str = "") -> None:
