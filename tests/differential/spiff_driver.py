@@ -4,6 +4,7 @@ and print, for each, the flow nodes it completed and how the run ended, as JSON.
 Run inside the test-only venv (scripts/spiff-venv.sh), never inside opspec's:
 
     .spiff-venv/bin/python tests/differential/spiff_driver.py A.bpmn B.bpmn ...
+    echo '[{"file": "A.bpmn", "data": {"x": null}}]' | .spiff-venv/bin/python spiff_driver.py
 
 One process runs every file (the test pays the interpreter's start once). For each file it
 prints one JSON line: ``{"file": path, "loaded": bool, "error": str|null, "state":
@@ -12,12 +13,15 @@ prints one JSON line: ``{"file": path, "loaded": bool, "error": str|null, "state
 
 How a file is run, the same way opspec's side of tests/differential/test_spiff.py runs it:
 
-- the process to run: the file's collaboration (every executable participant, as SpiffWorkflow's
-  ``get_collaboration`` starts them) when it has one, else every executable process that no call
-  activity of the file calls, each in its own workflow;
-- no initial data: the workflow's data is what the file itself sets;
+- the processes to run: every process that no call activity of the file calls (of a
+  collaboration's pools, the executable ones, as SpiffWorkflow's ``get_collaboration`` starts
+  them), all in one workflow, so that messages flow between them; a process that a call
+  activity calls runs as that call only, as in SpiffWorkflow's own tests of these files;
+- the initial data given with the file (the test gives the data fields opspec reads from the
+  file, with their initial values, null when they have none: form field defaults, data
+  objects; SpiffWorkflow's own parser reads no Camunda form), else none;
 - every ready user or manual task (and plain ``task``, which SpiffWorkflow leaves to a person)
-  is completed at once, in the engine's task order, without data (SpiffWorkflow's
+  is completed at once, one at a time in the engine's task order, without data (SpiffWorkflow's
   ``task.run()``); a service task without an implementation, which SpiffWorkflow leaves
   waiting for the application, is answered at once;
 - script tasks run in SpiffWorkflow's Python script engine;
@@ -35,7 +39,7 @@ from datetime import datetime, timedelta, timezone
 
 HORIZON = 86_400.0       # one day of virtual time, as opspec's default run length
 MAX_STEPS = 2_000        # rounds of user-task completions and clock jumps per file
-MAX_COMPLETIONS = 2_000  # flow-node completions per file before it counts as a livelock
+MAX_COMPLETIONS = 120    # flow-node completions per file before it counts as a livelock
 WALL_LIMIT = 10          # seconds of real time per file before it counts as a hang
 EPOCH = datetime(2026, 1, 1, tzinfo=timezone.utc)
 
@@ -93,39 +97,61 @@ def record_completions(completed: list[str]) -> None:
 
 
 def workflows_of(path: str):
-    """The workflows a run of the file starts (see the module docstring)."""
+    """The processes a run of the file starts and the one workflow that runs them (see the
+    module docstring)."""
     from SpiffWorkflow.bpmn.parser import BpmnParser
+    from SpiffWorkflow.bpmn.parser.util import full_tag
+    from SpiffWorkflow.bpmn.specs.bpmn_process_spec import BpmnProcessSpec
     from SpiffWorkflow.bpmn.workflow import BpmnWorkflow
 
     parser = BpmnParser()
     parser.add_bpmn_file(path)
+    ids = list(parser.process_parsers)    # get_process_ids() leaves out non-executable ones
+    called: set[str] = set()
+    for process_id in ids:
+        parsed = parser.get_process_parser(process_id)
+        if parsed.process_executable:
+            called |= set(parser.get_subprocess_specs(process_id,
+                                                      require_call_activity_specs=False))
+    roots = [pid for pid in ids if pid not in called]
     if parser.collaborations:
-        name = sorted(parser.collaborations)[0]
-        spec, subprocesses = parser.get_collaboration(name)
-        return [name], [BpmnWorkflow(spec, subprocesses)]
-    # a process that a call activity of the file calls runs as that call, not on its own
-    specs = parser.find_all_specs()
-    called = set()
-    for process_id in specs:
-        called |= set(parser.get_subprocess_specs(process_id, require_call_activity_specs=False))
-    roots = [pid for pid in parser.get_process_ids()
-             if pid not in called and parser.get_process_parser(pid).process_executable]
-    return roots, [BpmnWorkflow(parser.get_spec(pid), parser.get_subprocess_specs(pid))
-                   for pid in roots]
+        # the pools of a collaboration: SpiffWorkflow starts the executable ones
+        pools = {p for members in parser.collaborations.values() for p in members}
+        roots = [pid for pid in roots
+                 if pid not in pools or parser.get_process_parser(pid).process_executable]
+    if not roots:
+        raise ValueError("no process to start: every process is called by a call activity")
+    if len(roots) == 1:
+        return roots, BpmnWorkflow(parser.get_spec(roots[0]),
+                                   parser.get_subprocess_specs(roots[0]))
+    # several processes start together, as SpiffWorkflow's get_collaboration starts the pools
+    # of a collaboration: one workflow, so that messages flow between them
+    spec = BpmnProcessSpec("differential")
+    subprocesses = {}
+    participant = parser._get_parser_class(full_tag("callActivity"))[1]
+    for pid in roots:
+        subprocesses[pid] = parser.get_spec(pid)
+        subprocesses.update(parser.get_subprocess_specs(pid))
+        spec.start.connect_or_add_trigger(participant(spec, pid, pid), subprocesses[pid])
+    return roots, BpmnWorkflow(spec, subprocesses)
 
 
 def next_timer(workflow) -> datetime | None:
+    """The earliest moment a waiting timer fires: SpiffWorkflow keeps it in the waiting task's
+    ``event_value`` (an ISO date-time, or a cycle's ``next``), also for the timers of an
+    event-based gateway, whose pending event carries no value."""
     moments = []
-    for event in workflow.waiting_events():
-        value = event.value
-        if isinstance(value, str):
-            try:
-                moment = datetime.fromisoformat(value)
-            except ValueError:
-                continue
-            if moment.tzinfo is None:
-                moment = moment.replace(tzinfo=timezone.utc)
-            moments.append(moment)
+    for task in list(workflow.event_manager.tasks.values()):
+        value = task.internal_data.get("event_value")
+        if isinstance(value, dict):
+            value = value.get("next") if value.get("cycles") != 0 else None
+        if not isinstance(value, str):
+            continue
+        try:
+            moment = datetime.fromisoformat(value)
+        except ValueError:
+            continue
+        moments.append(moment if moment.tzinfo else moment.replace(tzinfo=timezone.utc))
     return min(moments) if moments else None
 
 
@@ -145,9 +171,12 @@ def run_workflow(workflow) -> str:
         waiting_services = [t for t in workflow.get_tasks(state=TaskState.STARTED)
                             if isinstance(t.task_spec, ServiceTask)]
         if ready or waiting_services:
-            for task in ready:
-                if task.state == TaskState.READY:
-                    task.run()
+            # one at a time, each followed by what it causes (opspec's performer is served in
+            # the same way): completing every ready task before the engine moves would let
+            # a task finish that the first one's terminate end event cancels
+            if ready:
+                ready[0].run()
+                continue
             for task in waiting_services:
                 if task.state == TaskState.STARTED:
                     task.complete()
@@ -162,7 +191,7 @@ def run_workflow(workflow) -> str:
     return "waiting"
 
 
-def run_file(path: str) -> dict:
+def run_file(path: str, data: dict) -> dict:
     completed: list[str] = []
     result = {"file": path, "loaded": False, "error": None, "state": "error",
               "completed": completed, "processes": [], "clock": 0.0}
@@ -171,14 +200,12 @@ def run_file(path: str) -> dict:
     try:
         signal.alarm(WALL_LIMIT)
         try:
-            processes, workflows = workflows_of(path)
+            processes, workflow = workflows_of(path)
+            for task in workflow.get_tasks(spec_name="Start"):
+                task.data.update(data)
             result["processes"] = processes
             result["loaded"] = True
-            states = [run_workflow(workflow) for workflow in workflows]
-            if not states:
-                result["error"] = "no executable process that no call activity calls"
-            result["state"] = ("error" if not states or "error" in states else "completed"
-                               if all(s == "completed" for s in states) else "waiting")
+            result["state"] = run_workflow(workflow)
         finally:
             signal.alarm(0)
     except Hang as exc:
@@ -199,9 +226,11 @@ def main() -> int:
     install_clock()
     from SpiffWorkflow.task import Task
     pristine = Task._set_state
-    for path in sys.argv[1:]:
+    runs = ([{"file": path} for path in sys.argv[1:]] if len(sys.argv) > 1
+            else json.load(sys.stdin))
+    for one in runs:
         Task._set_state = pristine
-        print(json.dumps(run_file(path)), flush=True)
+        print(json.dumps(run_file(one["file"], one.get("data") or {})), flush=True)
     return 0
 
 
