@@ -4,7 +4,7 @@ and print, for each, the flow nodes it completed and how the run ended, as JSON.
 Run inside the test-only venv (scripts/spiff-venv.sh), never inside opspec's:
 
     .spiff-venv/bin/python tests/differential/spiff_driver.py A.bpmn B.bpmn ...
-    echo '[{"file": "A.bpmn", "data": {"x": null}}]' | .spiff-venv/bin/python spiff_driver.py
+    echo '[{"file": "A.bpmn", "data": {"x": null}, "delay": 3600}]' | .spiff-venv/bin/python spiff_driver.py
 
 One process runs every file (the test pays the interpreter's start once). For each file it
 prints one JSON line: ``{"file": path, "loaded": bool, "error": str|null, "state":
@@ -20,11 +20,13 @@ How a file is run, the same way opspec's side of tests/differential/test_spiff.p
 - the initial data given with the file (the test gives the data fields opspec reads from the
   file, with their initial values, null when they have none: form field defaults, data
   objects; SpiffWorkflow's own parser reads no Camunda form), else none;
-- every ready user or manual task (and plain ``task``, which SpiffWorkflow leaves to a person)
-  is completed at once, one at a time in the engine's task order, without data (SpiffWorkflow's
-  ``task.run()``); a service task without an implementation, which SpiffWorkflow leaves
+- every ready user or manual task is completed ``delay`` seconds (of the run's entry; 0 by
+  default) after it became ready, a plain ``task`` (which SpiffWorkflow leaves to a person, and
+  opspec runs by itself) at once; one at a time, in the order they are due, then the engine's
+  task order, without data (SpiffWorkflow's ``task.run()``); a service task without an implementation, which SpiffWorkflow leaves
   waiting for the application, is answered at once;
-- script tasks run in SpiffWorkflow's Python script engine;
+- script tasks run in SpiffWorkflow's Python script engine, with the two helpers its own timer
+  tests register (``script_engine``);
 - timers: the clock is virtual (``datetime.now`` of SpiffWorkflow's timer module is replaced),
   it starts at 2026-01-01T00:00:00Z and jumps to the next timer's moment whenever nothing else
   can move, never sleeping, up to ``HORIZON`` seconds.
@@ -32,6 +34,7 @@ How a file is run, the same way opspec's side of tests/differential/test_spiff.p
 
 from __future__ import annotations
 
+import contextlib
 import json
 import signal
 import sys
@@ -96,6 +99,22 @@ def record_completions(completed: list[str]) -> None:
     Task._set_state = _set_state
 
 
+def script_engine():
+    """SpiffWorkflow's Python script engine with the helpers its own timer tests register
+    (``custom_function``, a call counter, and ``timedelta``), so that their scripts run as in
+    SpiffWorkflow's suite; opspec skips the output statements that call them."""
+    from SpiffWorkflow.bpmn.script_engine import PythonScriptEngine, TaskDataEnvironment
+
+    calls = [0]
+
+    def custom_function():
+        calls[0] += 1
+        return calls[0]
+
+    return PythonScriptEngine(environment=TaskDataEnvironment(
+        {"custom_function": custom_function, "timedelta": timedelta}))
+
+
 def workflows_of(path: str):
     """The processes a run of the file starts and the one workflow that runs them (see the
     module docstring)."""
@@ -123,7 +142,8 @@ def workflows_of(path: str):
         raise ValueError("no process to start: every process is called by a call activity")
     if len(roots) == 1:
         return roots, BpmnWorkflow(parser.get_spec(roots[0]),
-                                   parser.get_subprocess_specs(roots[0]))
+                                   parser.get_subprocess_specs(roots[0]),
+                                   script_engine=script_engine())
     # several processes start together, as SpiffWorkflow's get_collaboration starts the pools
     # of a collaboration: one workflow, so that messages flow between them
     spec = BpmnProcessSpec("differential")
@@ -133,7 +153,7 @@ def workflows_of(path: str):
         subprocesses[pid] = parser.get_spec(pid)
         subprocesses.update(parser.get_subprocess_specs(pid))
         spec.start.connect_or_add_trigger(participant(spec, pid, pid), subprocesses[pid])
-    return roots, BpmnWorkflow(spec, subprocesses)
+    return roots, BpmnWorkflow(spec, subprocesses, script_engine=script_engine())
 
 
 def next_timer(workflow) -> datetime | None:
@@ -155,10 +175,13 @@ def next_timer(workflow) -> datetime | None:
     return min(moments) if moments else None
 
 
-def run_workflow(workflow) -> str:
+def run_workflow(workflow, delay: float) -> str:
+    from SpiffWorkflow.bpmn.specs.mixins.manual_task import ManualTask
     from SpiffWorkflow.bpmn.specs.mixins.service_task import ServiceTask
+    from SpiffWorkflow.bpmn.specs.mixins.user_task import UserTask
     from SpiffWorkflow.util.task import TaskState
 
+    due: dict = {}          # task id -> when the performer completes it
     for _ in range(MAX_STEPS):
         workflow.do_engine_steps()
         workflow.refresh_timers()
@@ -166,34 +189,43 @@ def run_workflow(workflow) -> str:
         if workflow.get_tasks(state=TaskState.ERROR):
             return "error"
         ready = workflow.get_tasks(state=TaskState.READY, manual=True)
+        for task in ready:
+            # a person takes ``delay`` for a user or manual task; a plain task, which
+            # SpiffWorkflow also leaves to someone, runs by itself in opspec: at once
+            person = isinstance(task.task_spec, (UserTask, ManualTask))
+            due.setdefault(task.id, Clock.now + timedelta(seconds=delay if person else 0))
+        ready = sorted((t for t in ready if due[t.id] <= Clock.now), key=lambda t: due[t.id])
         # a service task without an implementation waits (STARTED) for the application to
         # answer; the application answers at once, as opspec runs such a task
         waiting_services = [t for t in workflow.get_tasks(state=TaskState.STARTED)
                             if isinstance(t.task_spec, ServiceTask)]
-        if ready or waiting_services:
+        if ready:
             # one at a time, each followed by what it causes (opspec's performer is served in
             # the same way): completing every ready task before the engine moves would let
             # a task finish that the first one's terminate end event cancels
-            if ready:
-                ready[0].run()
-                continue
+            ready[0].run()
+            continue
+        if waiting_services:
             for task in waiting_services:
                 if task.state == TaskState.STARTED:
                     task.complete()
             continue
         if workflow.is_completed():
             return "completed"
-        moment = next_timer(workflow)
+        pending = [due[t.id] for t in workflow.get_tasks(state=TaskState.READY, manual=True)]
+        timer = next_timer(workflow)
+        moment = min([*pending, *([timer + timedelta(microseconds=1)] if timer else [])],
+                     default=None)
         if moment is None or moment >= EPOCH + timedelta(seconds=HORIZON):
             return "waiting"
-        # SpiffWorkflow fires a timer when its moment is strictly before now
-        Clock.now = max(Clock.now, moment) + timedelta(microseconds=1)
+        # SpiffWorkflow fires a timer when its moment is strictly before now (hence 1 us)
+        Clock.now = max(Clock.now, moment)
     return "waiting"
 
 
-def run_file(path: str, data: dict) -> dict:
+def run_file(path: str, data: dict, delay: float) -> dict:
     completed: list[str] = []
-    result = {"file": path, "loaded": False, "error": None, "state": "error",
+    result = {"file": path, "delay": delay, "loaded": False, "error": None, "state": "error",
               "completed": completed, "processes": [], "clock": 0.0}
     Clock.now = EPOCH
     record_completions(completed)
@@ -205,7 +237,7 @@ def run_file(path: str, data: dict) -> dict:
                 task.data.update(data)
             result["processes"] = processes
             result["loaded"] = True
-            result["state"] = run_workflow(workflow)
+            result["state"] = run_workflow(workflow, delay)
         finally:
             signal.alarm(0)
     except Hang as exc:
@@ -230,7 +262,10 @@ def main() -> int:
             else json.load(sys.stdin))
     for one in runs:
         Task._set_state = pristine
-        print(json.dumps(run_file(one["file"], one.get("data") or {})), flush=True)
+        # what the files' scripts print goes to stderr: stdout carries the JSON lines only
+        with contextlib.redirect_stdout(sys.stderr):
+            result = run_file(one["file"], one.get("data") or {}, one.get("delay", 0.0))
+        print(json.dumps(result), flush=True)
     return 0
 
 

@@ -2,13 +2,16 @@
 
 Every BPMN file of SpiffWorkflow's own test suite (``data/spiff/``, README.md there says from
 which commit) runs through both engines with the same data — the data fields the file
-declares, with their initial values (``declared_data``) — the same performer — every user or manual task completed at once — and the same
-virtual clock (one day, no real sleeping). Each run gives the same facts: the flow nodes it
-completed (by id, as a multiset: BPMN 2.0 orders nothing between parallel paths at one
-instant) and how it ended (``completed``, ``waiting``, ``error``, ``hang``).
+declares, with their initial values (``declared_data``) — the same performer and the same
+virtual clock (one day, no real sleeping). The performer completes every user and manual
+task, one at a time and setting no data, at once or an hour after it is offered (``MODES``:
+the second lets boundary timers on user tasks fire). Each run gives the same facts: the flow
+nodes it completed (by id, as a multiset: BPMN 2.0 orders nothing between parallel paths at
+one instant) and how it ended (``completed``, ``waiting`` — an opspec deadlock included, as
+SpiffWorkflow leaves such an instance waiting —, ``error``, ``hang``).
 
 SpiffWorkflow runs in its own test-only venv, ``.spiff-venv`` (``scripts/spiff-venv.sh``; never
-a dependency of opspec), through ``spiff_driver.py``, one subprocess for every file. When the
+a dependency of opspec), through ``spiff_driver.py``, one subprocess for every file and mode. When the
 venv is absent this module creates it (set ``OPSPEC_NO_ORACLE=1`` to skip instead); when it
 cannot be made the comparisons are skipped saying why.
 
@@ -23,6 +26,7 @@ states the agreement count and every disagreement; a test keeps it in step with 
 
 from __future__ import annotations
 
+import functools
 import json
 import os
 import re
@@ -52,6 +56,9 @@ FILES = sorted(p.relative_to(DATA).as_posix() for p in DATA.rglob("*")
                if p.name.endswith((".bpmn", ".bpmn20.xml")))
 
 HORIZON = 86_400.0        # one day of virtual time (spiff_driver.HORIZON)
+# how long the performer takes for each user or manual task: at once, and an hour (longer than
+# every timer of the files but one, so that boundary timers on user tasks fire)
+MODES = {"at_once": 0.0, "patient": 3_600.0}
 MAX_COMPLETIONS = 120     # more flow-node completions is a livelock (spiff_driver too)
 BPMN_NS = {"http://www.omg.org/spec/BPMN/20100524/MODEL", "http://schema.omg.org/spec/BPMN/2.0"}
 FLOW_NODES = {
@@ -91,12 +98,17 @@ class Verdict:
                 f"SpiffWorkflow only {self.missing}, by opspec only {self.extra}")
 
 
+@functools.cache
+def validated(path: Path) -> tuple[Any, Any]:
+    return validate_spec(path)
+
+
 def declared_data(path: Path) -> dict[str, Any]:
     """The data fields opspec reads from the file (of the package and of every process), with
     their initial values, null when they have none: the same data both engines start with.
     SpiffWorkflow's own parser reads none of the Camunda form fields that declare most of
     them, so without this it would stop at the first condition over a form field."""
-    package, _report = validate_spec(path)
+    package, _report = validated(path)
     if package is None:
         return {}
     fields = [*package.data_fields, *(f for p in package.processes for f in p.data_fields)]
@@ -118,16 +130,20 @@ def flow_node_ids(path: Path) -> set[str]:
     return ids
 
 
-class _AtOnce:
-    """The performer of every user and manual task: completes each offer at once (the first
-    alternative of a choice), setting no data, as the driver's ``task.run()`` does."""
+class _Person:
+    """The performer of every user and manual task: completes each offer ``delay`` seconds
+    after it is made (the first alternative of a choice), setting no data, as the driver's
+    ``task.run()`` does."""
+
+    def __init__(self, delay: float) -> None:
+        self.delay = delay
 
     def attach(self, session: Any) -> None:
         self.session = session
 
     def offer(self, item: Any) -> None:
         session = self.session
-        session.call_later(0.0, lambda: session.complete(
+        session.call_later(self.delay, lambda: session.complete(
             item, choice=item.choices[0] if item.choices else None))
 
     def withdraw(self, item: Any, reason: str) -> None:
@@ -138,10 +154,10 @@ class _Livelock(Exception):
     pass
 
 
-def opspec_facts(path: Path) -> Facts:
+def opspec_facts(path: Path, delay: float = 0.0) -> Facts:
     """opspec's run of the file through its public API: validate, then ``opspec.run`` with the
-    at-once performer for the user lane and every human participant, for ``HORIZON``."""
-    package, report = validate_spec(path)
+    performer for the user lane and every human participant, for ``HORIZON``."""
+    package, report = validated(path)
     errors = [d for d in report.diagnostics if d.severity is Severity.ERROR]
     if errors or package is None:
         first = errors[0] if errors else None
@@ -169,9 +185,9 @@ def opspec_facts(path: Path) -> Facts:
                     tops[event.instance] = "waiting" if reason.startswith("deadlock") else "error"
                     reasons.append(reason)
 
-    performers = {p.id: _AtOnce() for p in package.participants if p.is_human}
+    performers = {p.id: _Person(delay) for p in package.participants if p.is_human}
     try:
-        opspec.run(path, user=User.person(_AtOnce()), performers=performers, until=HORIZON,
+        opspec.run(path, user=User.person(_Person(delay)), performers=performers, until=HORIZON,
                    listeners=[listen], keep_trace=False)
     except _Livelock as exc:
         return Facts(True, "hang", tuple(completed), str(exc))
@@ -198,16 +214,25 @@ def verdict(path: Path, spiff: Facts, ours: Facts) -> Verdict:
     return Verdict(kind, spiff, ours, missing, extra)
 
 
-def known() -> dict[str, tuple[str, dict[str, str]]]:
-    """``{file: (class, entry)}`` from known_disagreements.toml."""
+def known(mode: str = "at_once") -> dict[str, tuple[str, dict[str, str]]]:
+    """``{file: (class, entry)}`` from known_disagreements.toml for one performer ``mode``: the
+    top-level tables are the at-once performer's; ``[patient.CLASS."FILE"]`` lists where the
+    patient performer's class differs from it."""
     table = tomllib.loads(KNOWN.read_text(encoding="utf-8"))
-    assert set(table) <= set(CLASSES), f"unknown sections {set(table) - set(CLASSES)}"
-    return {name: (kind, entry) for kind in CLASSES for name, entry in table.get(kind, {}).items()}
+    assert set(table) <= {*CLASSES, "patient"}, f"unknown sections {set(table)}"
+    assert set(table.get("patient", {})) <= set(CLASSES)
+    found = {name: (kind, entry) for kind in CLASSES
+             for name, entry in table.get(kind, {}).items()}
+    if mode == "patient":
+        patient = table.get("patient", {})
+        found.update({name: (kind, entry) for kind in CLASSES
+                      for name, entry in patient.get(kind, {}).items()})
+    return found
 
 
 @pytest.fixture(scope="module")
-def spiff() -> dict[str, Facts]:
-    """SpiffWorkflow's facts for every file: one subprocess of the driver."""
+def spiff() -> dict[tuple[str, str], Facts]:
+    """SpiffWorkflow's facts for every file and performer mode: one subprocess of the driver."""
     if not PYTHON.exists():
         if os.environ.get("OPSPEC_NO_ORACLE"):
             pytest.skip("no .spiff-venv and OPSPEC_NO_ORACLE is set (bash scripts/spiff-venv.sh "
@@ -217,18 +242,21 @@ def spiff() -> dict[str, Facts]:
         if made.returncode != 0:
             pytest.skip("the SpiffWorkflow venv could not be made (no PyPI?): "
                         + (made.stderr.strip().splitlines() or ["?"])[-1])
-    runs = [{"file": str(DATA / name), "data": declared_data(DATA / name)} for name in FILES]
+    runs = [{"file": str(DATA / name), "data": declared_data(DATA / name), "delay": delay}
+            for delay in MODES.values() for name in FILES]
     done = subprocess.run([str(PYTHON), str(HERE / "spiff_driver.py")], input=json.dumps(runs),
                           capture_output=True, text=True, timeout=300, check=False,
                           env={**os.environ, "TZ": "UTC"})
     assert done.returncode == 0, f"the SpiffWorkflow driver failed:\n{done.stderr[-3000:]}"
+    modes = {delay: mode for mode, delay in MODES.items()}
     facts = {}
     for line in done.stdout.splitlines():
         row = json.loads(line)
         name = Path(row["file"]).relative_to(DATA).as_posix()
-        facts[name] = Facts(row["loaded"], row["state"] if row["loaded"] else "refused",
-                            tuple(row["completed"]), row["error"])
-    assert set(facts) == set(FILES)
+        facts[modes[row["delay"]], name] = Facts(
+            row["loaded"], row["state"] if row["loaded"] else "refused",
+            tuple(row["completed"]), row["error"])
+    assert set(facts) == {(mode, name) for mode in MODES for name in FILES}
     return facts
 
 
@@ -240,28 +268,30 @@ def test_the_data_is_every_bpmn_file_of_spiffworkflows_suite_and_says_where_it_i
 
 
 def test_every_known_entry_names_a_file_and_says_why() -> None:
-    for name, (kind, entry) in known().items():
-        assert name in FILES, f"{name} in known_disagreements.toml is no file of data/spiff"
-        assert entry.get("reason"), f"{name}: no reason"
-        if kind == "disagree":
-            assert re.search(r"§\d+(\.\d+)*", entry.get("section", "")), \
-                f"{name}: a disagreement names the BPMN 2.0 section that decides it"
-            assert entry.get("right") in ("opspec", "SpiffWorkflow", "both", "neither"), name
+    for mode in MODES:
+        for name, (kind, entry) in known(mode).items():
+            assert name in FILES, f"{name} in known_disagreements.toml is no file of data/spiff"
+            assert entry.get("reason"), f"{name}: no reason"
+            if kind == "disagree":
+                assert re.search(r"§\d+(\.\d+)*", entry.get("section", "")), \
+                    f"{name}: a disagreement names the BPMN 2.0 section that decides it"
+                assert entry.get("right") in ("opspec", "SpiffWorkflow", "both", "neither"), name
 
 
+@pytest.mark.parametrize("mode", MODES)
 @pytest.mark.parametrize("name", FILES)
 def test_file_runs_as_in_spiffworkflow_or_as_the_known_list_says(
-        spiff: dict[str, Facts], name: str) -> None:
+        spiff: dict[tuple[str, str], Facts], name: str, mode: str) -> None:
     """Both engines run the file by BPMN 2.0 chapter 13 ("the execution semantics ... describe
     a clear and precise understanding of the operation of the elements", §13.1): the same flow
     nodes complete and the instance ends the same way — or the file is listed, with why."""
     path = DATA / name
-    found = verdict(path, spiff[name], opspec_facts(path))
-    listed = known().get(name)
+    found = verdict(path, spiff[mode, name], opspec_facts(path, MODES[mode]))
+    listed = known(mode).get(name)
     if listed is None:
-        assert found.kind == "agree", f"new: {found.explain()}"
+        assert found.kind == "agree", f"new ({mode}): {found.explain()}"
     else:
-        assert found.kind == listed[0], (f"{name} is listed as {listed[0]} "
+        assert found.kind == listed[0], (f"{name} ({mode}) is listed as {listed[0]} "
                                         f"({listed[1]['reason']}) but is now {found.explain()}")
 
 
@@ -270,12 +300,14 @@ def test_docs_state_the_agreement_count_and_every_disagreement() -> None:
     heading = "## Differential check against SpiffWorkflow"
     assert heading in text
     section = text.split(heading, 1)[1]
-    listed = known()
-    agree = len(FILES) - len(listed)
-    count = {kind: sum(1 for k, _ in listed.values() if k == kind) for kind in CLASSES}
-    assert f"**{agree}** of the {len(FILES)} files" in section
-    for kind in CLASSES:
-        assert f"{kind.replace('_', ' ')}: **{count[kind]}**" in section, kind
-    for name, (kind, _entry) in listed.items():
-        if kind == "disagree":
-            assert f"`{name}`" in section, f"{name} is not in docs/semantics.md's section"
+    for mode in MODES:
+        listed = known(mode)
+        agree = len(FILES) - len(listed)
+        count = {kind: sum(1 for k, _ in listed.values() if k == kind) for kind in CLASSES}
+        line = next((ln for ln in section.splitlines() if ln.startswith(f"| {mode} |")), "")
+        assert line, f"the counts of the {mode} performer are not in the section"
+        cells = [cell.strip(" *") for cell in line.split("|")[2:-1]]
+        assert cells == [str(agree)] + [str(count[kind]) for kind in CLASSES], (mode, cells)
+        for name, (kind, _entry) in listed.items():
+            if kind == "disagree":
+                assert f"`{name}`" in section, f"{name} is not in docs/semantics.md's section"
