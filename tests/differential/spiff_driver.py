@@ -4,15 +4,18 @@ and print, for each, the flow nodes it completed and how the run ended, as JSON.
 Run inside the test-only venv (scripts/spiff-venv.sh), never inside opspec's:
 
     .spiff-venv/bin/python tests/differential/spiff_driver.py A.bpmn B.bpmn ...
-    echo '[{"file": "A.bpmn", "data": {"x": null}, "delay": 3600}]' | .spiff-venv/bin/python spiff_driver.py
+    echo '[{"file": "A.bpmn", "data": {"x": null}, "delay": 3600, "parser": "camunda"}]' \
+        | .spiff-venv/bin/python tests/differential/spiff_driver.py
 
-One process runs every file (the test pays the interpreter's start once). For each file it
-prints one JSON line: ``{"file": path, "loaded": bool, "error": str|null, "state":
+One process runs every file (the test pays the interpreter's start once). For each run it
+prints one JSON line: ``{"file": path, "delay": seconds, "loaded": bool, "error": str|null, "state":
 "completed"|"waiting"|"error"|"hang", "completed": [flow node ids in completion order],
 "processes": [process ids run], "clock": seconds of virtual time used}``.
 
 How a file is run, the same way opspec's side of tests/differential/test_spiff.py runs it:
 
+- the parser: ``parser`` of the entry (``bpmn``, ``camunda``, ``spiff``: the one SpiffWorkflow's
+  tests of that folder use);
 - the processes to run: every process that no call activity of the file calls (of a
   collaboration's pools, the executable ones, as SpiffWorkflow's ``get_collaboration`` starts
   them), all in one workflow, so that messages flow between them; a process that a call
@@ -20,13 +23,13 @@ How a file is run, the same way opspec's side of tests/differential/test_spiff.p
 - the initial data given with the file (the test gives the data fields opspec reads from the
   file, with their initial values, null when they have none: form field defaults, data
   objects; SpiffWorkflow's own parser reads no Camunda form), else none;
-- every ready user or manual task is completed ``delay`` seconds (of the run's entry; 0 by
+- every ready user or manual task is completed ``delay`` seconds (given with the file; 0 by
   default) after it became ready, a plain ``task`` (which SpiffWorkflow leaves to a person, and
-  opspec runs by itself) at once; one at a time, in the order they are due, then the engine's
-  task order, without data (SpiffWorkflow's ``task.run()``); a service task without an implementation, which SpiffWorkflow leaves
-  waiting for the application, is answered at once;
+  opspec runs by itself) at once; one at a time, in the order they are due, then in the order
+  they became ready, without data (SpiffWorkflow's ``task.run()``); a service task without an
+  implementation, which SpiffWorkflow leaves waiting for the application, is answered at once;
 - script tasks run in SpiffWorkflow's Python script engine, with the two helpers its own timer
-  tests register (``script_engine``);
+  tests register; a service it calls answers at once (``script_engine``);
 - timers: the clock is virtual (``datetime.now`` of SpiffWorkflow's timer module is replaced),
   it starts at 2026-01-01T00:00:00Z and jumps to the next timer's moment whenever nothing else
   can move, never sleeping, up to ``HORIZON`` seconds.
@@ -102,7 +105,9 @@ def record_completions(completed: list[str]) -> None:
 def script_engine():
     """SpiffWorkflow's Python script engine with the helpers its own timer tests register
     (``custom_function``, a call counter, and ``timedelta``), so that their scripts run as in
-    SpiffWorkflow's suite; opspec skips the output statements that call them."""
+    SpiffWorkflow's suite (opspec skips the output statements that call them), and a service
+    that answers every call at once with an empty JSON object (opspec runs a service task as
+    completing by itself)."""
     from SpiffWorkflow.bpmn.script_engine import PythonScriptEngine, TaskDataEnvironment
 
     calls = [0]
@@ -111,19 +116,35 @@ def script_engine():
         calls[0] += 1
         return calls[0]
 
-    return PythonScriptEngine(environment=TaskDataEnvironment(
+    class Environment(TaskDataEnvironment):
+        def call_service(self, context, **kwargs):
+            return "{}"
+
+    return PythonScriptEngine(environment=Environment(
         {"custom_function": custom_function, "timedelta": timedelta}))
 
 
-def workflows_of(path: str):
+def parser_for(kind: str):
+    """The parser SpiffWorkflow's own tests read the file with: the plain BPMN parser for its
+    ``bpmn`` tests, the Camunda or the Spiff-extensions parser for those folders."""
+    if kind == "camunda":
+        from SpiffWorkflow.camunda.parser.CamundaParser import CamundaParser
+        return CamundaParser()
+    if kind == "spiff":
+        from SpiffWorkflow.spiff.parser.process import SpiffBpmnParser
+        return SpiffBpmnParser()
+    from SpiffWorkflow.bpmn.parser import BpmnParser
+    return BpmnParser()
+
+
+def workflows_of(path: str, kind: str = "bpmn"):
     """The processes a run of the file starts and the one workflow that runs them (see the
     module docstring)."""
-    from SpiffWorkflow.bpmn.parser import BpmnParser
     from SpiffWorkflow.bpmn.parser.util import full_tag
     from SpiffWorkflow.bpmn.specs.bpmn_process_spec import BpmnProcessSpec
     from SpiffWorkflow.bpmn.workflow import BpmnWorkflow
 
-    parser = BpmnParser()
+    parser = parser_for(kind)
     parser.add_bpmn_file(path)
     ids = list(parser.process_parsers)    # get_process_ids() leaves out non-executable ones
     called: set[str] = set()
@@ -181,7 +202,7 @@ def run_workflow(workflow, delay: float) -> str:
     from SpiffWorkflow.bpmn.specs.mixins.user_task import UserTask
     from SpiffWorkflow.util.task import TaskState
 
-    due: dict = {}          # task id -> when the performer completes it
+    due: dict = {}          # task id -> (when the performer completes it, order offered)
     for _ in range(MAX_STEPS):
         workflow.do_engine_steps()
         workflow.refresh_timers()
@@ -193,8 +214,11 @@ def run_workflow(workflow, delay: float) -> str:
             # a person takes ``delay`` for a user or manual task; a plain task, which
             # SpiffWorkflow also leaves to someone, runs by itself in opspec: at once
             person = isinstance(task.task_spec, (UserTask, ManualTask))
-            due.setdefault(task.id, Clock.now + timedelta(seconds=delay if person else 0))
-        ready = sorted((t for t in ready if due[t.id] <= Clock.now), key=lambda t: due[t.id])
+            due.setdefault(task.id, (Clock.now + timedelta(seconds=delay if person else 0),
+                                     len(due)))
+        # first due, first served; at one moment in the order offered (opspec's performer
+        # is called back in that order too)
+        ready = sorted((t for t in ready if due[t.id][0] <= Clock.now), key=lambda t: due[t.id])
         # a service task without an implementation waits (STARTED) for the application to
         # answer; the application answers at once, as opspec runs such a task
         waiting_services = [t for t in workflow.get_tasks(state=TaskState.STARTED)
@@ -212,7 +236,7 @@ def run_workflow(workflow, delay: float) -> str:
             continue
         if workflow.is_completed():
             return "completed"
-        pending = [due[t.id] for t in workflow.get_tasks(state=TaskState.READY, manual=True)]
+        pending = [due[t.id][0] for t in workflow.get_tasks(state=TaskState.READY, manual=True)]
         timer = next_timer(workflow)
         moment = min([*pending, *([timer + timedelta(microseconds=1)] if timer else [])],
                      default=None)
@@ -223,7 +247,7 @@ def run_workflow(workflow, delay: float) -> str:
     return "waiting"
 
 
-def run_file(path: str, data: dict, delay: float) -> dict:
+def run_file(path: str, data: dict, delay: float, kind: str = "bpmn") -> dict:
     completed: list[str] = []
     result = {"file": path, "delay": delay, "loaded": False, "error": None, "state": "error",
               "completed": completed, "processes": [], "clock": 0.0}
@@ -232,7 +256,7 @@ def run_file(path: str, data: dict, delay: float) -> dict:
     try:
         signal.alarm(WALL_LIMIT)
         try:
-            processes, workflow = workflows_of(path)
+            processes, workflow = workflows_of(path, kind)
             for task in workflow.get_tasks(spec_name="Start"):
                 task.data.update(data)
             result["processes"] = processes
@@ -264,7 +288,8 @@ def main() -> int:
         Task._set_state = pristine
         # what the files' scripts print goes to stderr: stdout carries the JSON lines only
         with contextlib.redirect_stdout(sys.stderr):
-            result = run_file(one["file"], one.get("data") or {}, one.get("delay", 0.0))
+            result = run_file(one["file"], one.get("data") or {}, one.get("delay", 0.0),
+                              one.get("parser", "bpmn"))
         print(json.dumps(result), flush=True)
     return 0
 

@@ -61,12 +61,13 @@ HORIZON = 86_400.0        # one day of virtual time (spiff_driver.HORIZON)
 MODES = {"at_once": 0.0, "patient": 3_600.0}
 MAX_COMPLETIONS = 120     # more flow-node completions is a livelock (spiff_driver too)
 BPMN_NS = {"http://www.omg.org/spec/BPMN/20100524/MODEL", "http://schema.omg.org/spec/BPMN/2.0"}
-FLOW_NODES = {
+PEOPLE = frozenset({"userTask", "manualTask"})   # the tasks a person performs
+FLOW_NODES = frozenset({
     "task", "userTask", "manualTask", "serviceTask", "scriptTask", "sendTask", "receiveTask",
     "businessRuleTask", "callActivity", "subProcess", "transaction", "adHocSubProcess",
     "startEvent", "endEvent", "intermediateCatchEvent", "intermediateThrowEvent",
     "boundaryEvent", "exclusiveGateway", "parallelGateway", "inclusiveGateway",
-    "complexGateway", "eventBasedGateway"}
+    "complexGateway", "eventBasedGateway"})
 CLASSES = ("disagree", "only_spiff", "only_opspec", "neither")
 
 
@@ -98,6 +99,14 @@ class Verdict:
                 f"SpiffWorkflow only {self.missing}, by opspec only {self.extra}")
 
 
+def parser_of(name: str) -> str:
+    """SpiffWorkflow's parser for a file: its tests read ``camunda/`` and ``spiff/`` (copies of
+    ``tests/SpiffWorkflow/camunda/data`` and ``spiff/data``) with the parser of those
+    extensions, the rest (``bpmn/data``) with the plain BPMN parser."""
+    first = name.split("/", 1)[0]
+    return first if first in ("camunda", "spiff") and "/" in name else "bpmn"
+
+
 @functools.cache
 def validated(path: Path) -> tuple[Any, Any]:
     return validate_spec(path)
@@ -116,7 +125,7 @@ def declared_data(path: Path) -> dict[str, Any]:
             if isinstance(f.initial, (str, int, float, bool, type(None)))}
 
 
-def flow_node_ids(path: Path) -> set[str]:
+def flow_node_ids(path: Path, kinds: frozenset[str] = FLOW_NODES) -> set[str]:
     """The ids of the file's flow nodes: what both engines' completions are compared on (each
     engine's own bookkeeping nodes, opspec's routes and SpiffWorkflow's participant tasks, are
     not in the file)."""
@@ -125,26 +134,29 @@ def flow_node_ids(path: Path) -> set[str]:
         if not isinstance(element.tag, str) or "}" not in element.tag:
             continue
         namespace, _, local = element.tag[1:].partition("}")
-        if namespace in BPMN_NS and local in FLOW_NODES and element.get("id"):
+        if namespace in BPMN_NS and local in kinds and element.get("id"):
             ids.add(element.get("id"))
     return ids
 
 
 class _Person:
-    """The performer of every user and manual task: completes each offer ``delay`` seconds
-    after it is made (the first alternative of a choice), setting no data, as the driver's
-    ``task.run()`` does."""
+    """The performer of every participant: completes each user or manual task (``people``)
+    ``delay`` seconds after it is offered, any other offer (a task in a lane bound to it) at
+    once; the first alternative of a choice; no data. SpiffWorkflow's driver does the same
+    (``task.run()``), whatever the lane."""
 
-    def __init__(self, delay: float) -> None:
+    def __init__(self, delay: float, people: frozenset[str]) -> None:
         self.delay = delay
+        self.people = people
 
     def attach(self, session: Any) -> None:
         self.session = session
 
     def offer(self, item: Any) -> None:
         session = self.session
-        session.call_later(self.delay, lambda: session.complete(
-            item, choice=item.choices[0] if item.choices else None))
+        session.call_later(self.delay if item.activity in self.people else 0.0,
+                           lambda: session.complete(
+                               item, choice=item.choices[0] if item.choices else None))
 
     def withdraw(self, item: Any, reason: str) -> None:
         pass
@@ -156,7 +168,7 @@ class _Livelock(Exception):
 
 def opspec_facts(path: Path, delay: float = 0.0) -> Facts:
     """opspec's run of the file through its public API: validate, then ``opspec.run`` with the
-    performer for the user lane and every human participant, for ``HORIZON``."""
+    performer for the user lane and every participant, for ``HORIZON``."""
     package, report = validated(path)
     errors = [d for d in report.diagnostics if d.severity is Severity.ERROR]
     if errors or package is None:
@@ -185,9 +197,11 @@ def opspec_facts(path: Path, delay: float = 0.0) -> Facts:
                     tops[event.instance] = "waiting" if reason.startswith("deadlock") else "error"
                     reasons.append(reason)
 
-    performers = {p.id: _Person(delay) for p in package.participants if p.is_human}
+    people = frozenset(flow_node_ids(path, PEOPLE))
+    performers = {p.id: _Person(delay, people) for p in package.participants}
     try:
-        opspec.run(path, user=User.person(_Person(delay)), performers=performers, until=HORIZON,
+        opspec.run(path, user=User.person(_Person(delay, people)), performers=performers,
+                   until=HORIZON,
                    listeners=[listen], keep_trace=False)
     except _Livelock as exc:
         return Facts(True, "hang", tuple(completed), str(exc))
@@ -242,8 +256,8 @@ def spiff() -> dict[tuple[str, str], Facts]:
         if made.returncode != 0:
             pytest.skip("the SpiffWorkflow venv could not be made (no PyPI?): "
                         + (made.stderr.strip().splitlines() or ["?"])[-1])
-    runs = [{"file": str(DATA / name), "data": declared_data(DATA / name), "delay": delay}
-            for delay in MODES.values() for name in FILES]
+    runs = [{"file": str(DATA / name), "data": declared_data(DATA / name), "delay": delay,
+             "parser": parser_of(name)} for delay in MODES.values() for name in FILES]
     done = subprocess.run([str(PYTHON), str(HERE / "spiff_driver.py")], input=json.dumps(runs),
                           capture_output=True, text=True, timeout=300, check=False,
                           env={**os.environ, "TZ": "UTC"})
@@ -262,7 +276,7 @@ def spiff() -> dict[tuple[str, str], Facts]:
 
 def test_the_data_is_every_bpmn_file_of_spiffworkflows_suite_and_says_where_it_is_from() -> None:
     readme = (DATA / "README.md").read_text(encoding="utf-8")
-    assert len(FILES) == 106
+    assert len(FILES) == 147   # bpmn/data 106, camunda/data 18, spiff/data 23
     for name in ("sartography/SpiffWorkflow", "LGPL", "8c6e00f6e2d85d93a1022341f4c479f23fbb0f41"):
         assert name in readme
 
