@@ -115,8 +115,8 @@ def validated(path: Path) -> tuple[Any, Any]:
 def declared_data(path: Path) -> dict[str, Any]:
     """The data fields opspec reads from the file (of the package and of every process), with
     their initial values, null when they have none: the same data both engines start with.
-    SpiffWorkflow's own parser reads none of the Camunda form fields that declare most of
-    them, so without this it would stop at the first condition over a form field."""
+    SpiffWorkflow puts no form field's default (nor a data object without value) into the
+    data, so without this it would stop at the first condition over a form field."""
     package, _report = validated(path)
     if package is None:
         return {}
@@ -228,6 +228,7 @@ def verdict(path: Path, spiff: Facts, ours: Facts) -> Verdict:
     return Verdict(kind, spiff, ours, missing, extra)
 
 
+@functools.cache
 def known(mode: str = "at_once") -> dict[str, tuple[str, dict[str, str]]]:
     """``{file: (class, entry)}`` from known_disagreements.toml for one performer ``mode``: the
     top-level tables are the at-once performer's; ``[patient.CLASS."FILE"]`` lists where the
@@ -296,9 +297,9 @@ def test_every_known_entry_names_a_file_and_says_why() -> None:
 @pytest.mark.parametrize("name", FILES)
 def test_file_runs_as_in_spiffworkflow_or_as_the_known_list_says(
         spiff: dict[tuple[str, str], Facts], name: str, mode: str) -> None:
-    """Both engines run the file by BPMN 2.0 chapter 13 ("the execution semantics ... describe
-    a clear and precise understanding of the operation of the elements", §13.1): the same flow
-    nodes complete and the instance ends the same way — or the file is listed, with why."""
+    """Two engines that both run the file by BPMN 2.0 chapter 13 (BPMN Execution Semantics)
+    complete the same flow nodes and end the same way — or the file is listed, with why and,
+    where both run it, the section of the standard that decides between them."""
     path = DATA / name
     found = verdict(path, spiff[mode, name], opspec_facts(path, MODES[mode]))
     listed = known(mode).get(name)
