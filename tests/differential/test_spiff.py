@@ -248,15 +248,16 @@ def known(mode: str = "at_once") -> dict[str, tuple[str, dict[str, str]]]:
 @pytest.fixture(scope="module")
 def spiff() -> dict[tuple[str, str], Facts]:
     """SpiffWorkflow's facts for every file and performer mode: one subprocess of the driver."""
-    if not PYTHON.exists():
-        if os.environ.get("OPSPEC_NO_ORACLE"):
-            pytest.skip("no .spiff-venv and OPSPEC_NO_ORACLE is set (bash scripts/spiff-venv.sh "
-                        "makes it)")
-        made = subprocess.run(["bash", str(ROOT / "scripts" / "spiff-venv.sh")],
-                              capture_output=True, text=True, timeout=600, check=False)
-        if made.returncode != 0:
-            pytest.skip("the SpiffWorkflow venv could not be made (no PyPI?): "
-                        + (made.stderr.strip().splitlines() or ["?"])[-1])
+    if not PYTHON.exists() and os.environ.get("OPSPEC_NO_ORACLE"):
+        pytest.skip("no .spiff-venv and OPSPEC_NO_ORACLE is set (bash scripts/spiff-venv.sh "
+                    "makes it)")
+    # idempotent: a fraction of a second when the venv imports SpiffWorkflow, and it repairs
+    # a venv left half made (no PyPI the first time)
+    made = subprocess.run(["bash", str(ROOT / "scripts" / "spiff-venv.sh")],
+                          capture_output=True, text=True, timeout=600, check=False)
+    if made.returncode != 0:
+        pytest.skip("the SpiffWorkflow venv could not be made (no PyPI?): "
+                    + (made.stderr.strip().splitlines() or ["?"])[-1])
     runs = [{"file": str(DATA / name), "data": declared_data(DATA / name), "delay": delay,
              "parser": parser_of(name)} for delay in MODES.values() for name in FILES]
     done = subprocess.run([str(PYTHON), str(HERE / "spiff_driver.py")], input=json.dumps(runs),
