@@ -139,6 +139,7 @@ class CTrigger:
     count: int = -1                        # period: number of firings (-1: no end)
     planned: bool = False                  # timer: a TimeDate / repeating interval whose
     #                                        firings are ``offset``, +``every``… (``count``)
+    interval: Sampler | None = None        # arrival: the inter-arrival time, drawn each time
 
 
 @dataclass(frozen=True, slots=True, eq=False)
@@ -393,6 +394,21 @@ class _Compiler:
             condition = self.cond(ref.condition, None, ref.location, "rule trigger")
         return CTrigger(kind=ref.kind, name=ref.name, at=tuple(sorted(ref.at)), every=ref.every,
                         offset=ref.offset, condition=condition, location=ref.location)
+
+    def arrivals(self, proc: WorkflowProcess) -> CTrigger:
+        """Stochastic arrivals: the first instance when armed, then one after each
+        inter-arrival time drawn from the process's own stream (``arrivals/PROCESS``)."""
+        directives = proc.directives
+        assert directives.arrival is not None
+        try:
+            interval = make_sampler(directives.arrival)
+        except ValueError as error:
+            raise _spec_error(f"inter-arrival time of process {proc.id!r}: {error}",
+                              proc.location, "see docs/sisarl-xpdl.md for the distributions"
+                              ) from None
+        count = directives.arrival_count
+        return CTrigger(kind="arrival", name=proc.id, interval=interval,
+                        count=-1 if count is None else count, location=proc.location)
 
     def event_trigger(self, event: Event, act: Activity) -> CTrigger | None:
         trig = event.trigger
@@ -859,6 +875,8 @@ class _Compiler:
         data: dict[str, Any] = {f.id: None for f in proc.formal_parameters}
         data.update({f.id: self.initial(f) for f in proc.data_fields})
         start = self.trigger_ref(directives.start_trigger)
+        if start is None and directives.arrival is not None:
+            start = self.arrivals(proc)
         if start is None:
             for index in graph.starts:
                 ca = graph.activities[index]

@@ -213,6 +213,9 @@ def build_definitions(root: etree._Element, ctx: BuildContext) -> Package:
     simulation = read_simulation_parameters(root, defs)
     defs.probabilities.update(simulation.probabilities)
     defs.probability_source.update(simulation.source)
+    defs.durations.update(simulation.durations)
+    defs.duration_source.update(simulation.duration_source)
+    defs.arrivals.update(simulation.arrivals)
     for sub in root:
         if not isinstance(sub.tag, str):
             continue
@@ -224,8 +227,9 @@ def build_definitions(root: etree._Element, ctx: BuildContext) -> Package:
                                     if isinstance(e.tag, str))):
             defs.info(sub, "simulation-parameters",
                       "simulation parameters (BPSim or QBP): opspec reads their branch "
-                      "probabilities; their durations, arrival rates and resources are not "
-                      "read", "give durations with opspec:Duration (docs/bpmn.md)")
+                      "probabilities, task durations and arrivals; resources, costs and "
+                      "calendars are not read (a warning names each)",
+                      "docs/bpmn.md, Simulation parameters")
             continue
         what = f"bpmn:{local(sub)}" if space == BPMN else f"<{local(sub)}> ({space})"
         ctx.warning(sub, "unsupported-element", f"{what} is not run by opspec; it is ignored",
