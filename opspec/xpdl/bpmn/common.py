@@ -150,6 +150,7 @@ class Defs:
     duration_source: dict[str, str] = field(default_factory=dict)
     arrivals: dict[str, tuple[DeclaredDistribution, int | None, str]] = field(
         default_factory=dict)
+    call_aliases: dict[str, str] = field(default_factory=dict)  # tns:proc -> proc (:mod:`.imports`)
 
     def info(self, element: etree._Element | None, code: str, message: str,
              hint: str = "") -> None:

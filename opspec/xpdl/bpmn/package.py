@@ -26,6 +26,7 @@ from opspec.xpdl.bpmn.common import (
 )
 from opspec.xpdl.bpmn.data import CAMUNDA, index_data
 from opspec.xpdl.bpmn.extensions import application, data_field, directives, opspec_named
+from opspec.xpdl.bpmn.imports import processes_elsewhere
 from opspec.xpdl.bpmn.process import BuiltProcess, build_process, is_user_name
 from opspec.xpdl.bpmn.run_inputs import with_run_inputs
 from opspec.xpdl.bpmn.simulation import BPSIM_NAMESPACES, QBP, read_simulation_parameters
@@ -216,6 +217,8 @@ def build_definitions(root: etree._Element, ctx: BuildContext) -> Package:
     defs.durations.update(simulation.durations)
     defs.duration_source.update(simulation.duration_source)
     defs.arrivals.update(simulation.arrivals)
+    imported = processes_elsewhere(root, defs)
+    defs.call_aliases.update(imported.aliases)
     for sub in root:
         if not isinstance(sub.tag, str):
             continue
@@ -273,6 +276,13 @@ def build_definitions(root: etree._Element, ctx: BuildContext) -> Package:
     if defs.user_participant and "user" not in known:
         participants.append(Participant(id="user", name="User", type=ParticipantType.HUMAN))
     processes, run_inputs = with_run_inputs([b.process for b in built], package_fields, defs)
+    # processes called from other files (:mod:`.imports`), with what they need
+    processes = [*processes, *imported.processes]
+    known = {p.id for p in participants}
+    participants.extend(p for p in imported.participants if p.id not in known)
+    given = {f.id for f in (*package_fields, *run_inputs)}
+    run_inputs = (*run_inputs, *(f for f in imported.data_fields if f.id not in given))
+    model_pools = (*model_pools, *imported.pools)
     found, kept = directives(root, defs, PACKAGE_DIRECTIVES, "the definitions",
                              ("DataField", "Application"))
     extensions = package_extensions(root, ctx, found)
