@@ -428,3 +428,37 @@ def test_arrivals_and_durations_are_written_out_as_opspec_directives_and_read_ba
     xpdl_run = _starts_and_cycles(xpdl, until=1000 * MIN, seed=2)
     assert len(bpmn_run[0]) == 30
     assert bpmn_run[:2] == xpdl_run[:2]
+
+
+def test_the_scenario_duration_is_the_run_length(tmp_path: Path) -> None:
+    """BPSim's ScenarioParameters Duration says how long the simulation runs: arrivals every
+    10 min over a scenario of 2 hours (in the base unit, min) are 12 cases, at 0 … 110 min."""
+    scenario = ('<bpsim:ScenarioParameters baseTimeUnit="min"><bpsim:Duration>'
+                '<bpsim:FloatingParameter value="120"/></bpsim:Duration>'
+                "</bpsim:ScenarioParameters>"
+                + _arrivals('<bpsim:FloatingParameter value="10"/>'))
+    path = _write(tmp_path, _bpsim(scenario))
+    result = load_package(path)
+    assert result.package is not None and result.package.run_length == 7200.0
+    outcome = opspec.run(path, seed=1)                 # no length given: the scenario's
+    assert len([e for e in outcome.trace if e.kind == "process.started"]) == 12
+
+
+def test_a_scenario_with_probabilities_only_says_nothing_about_time_units(
+        tmp_path: Path) -> None:
+    scenario = _element("f1", "<bpsim:ControlParameters><bpsim:Probability>"
+                        '<bpsim:FloatingParameter value="1"/></bpsim:Probability>'
+                        "</bpsim:ControlParameters>")
+    path = _write(tmp_path, _bpsim("<bpsim:ScenarioParameters/>" + scenario))
+    assert not _codes(path, "bpsim-time-unit")
+
+
+def test_arrivals_into_a_process_with_two_start_events_are_said_to_start_both(
+        tmp_path: Path) -> None:
+    """opspec starts a process, and so every start event of it: BPSim meant one."""
+    text = _bpsim('<bpsim:ScenarioParameters baseTimeUnit="min"/>'
+                  + _arrivals('<bpsim:FloatingParameter value="10"/>'),
+                  process_extra='\n    <bpmn:startEvent id="other"/>')
+    path = _write(tmp_path, text)
+    assert any("2 start events" in m for _s, _l, m in
+               _codes(path, "unread-simulation-parameter"))

@@ -286,6 +286,8 @@ def build_definitions(root: etree._Element, ctx: BuildContext) -> Package:
     found, kept = directives(root, defs, PACKAGE_DIRECTIVES, "the definitions",
                              ("DataField", "Application"))
     extensions = package_extensions(root, ctx, found)
+    if simulation.run_length and extensions.get("run_length") is None:
+        extensions["run_length"] = simulation.run_length[0]     # BPSim's scenario Duration
     stem = PurePath(ctx.path).stem
     return Package(
         id=(root.get("id") or "").strip() or stem,

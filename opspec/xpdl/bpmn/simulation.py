@@ -63,6 +63,7 @@ class SimulationParameters:
     durations: dict[str, DeclaredDistribution] = field(default_factory=dict)
     duration_source: dict[str, str] = field(default_factory=dict)
     arrivals: dict[str, Arrival] = field(default_factory=dict)
+    run_length: list[float] = field(default_factory=list)     # BPSim's scenario Duration, if any
 
 
 def read_simulation_parameters(root: etree._Element, defs: Defs) -> SimulationParameters:
@@ -104,6 +105,8 @@ class _Bpsim:
         self.defs = defs
         self.out = out
         self.unit = 0.001
+        # where the scenario leaves its time unit to BPSim's default (said at the first time)
+        self.no_unit: etree._Element | None = scenario
         self.unread: dict[str, list[etree._Element]] = {}
 
     def read(self) -> None:
@@ -127,20 +130,46 @@ class _Bpsim:
 
     def scenario_parameters(self, parameters: etree._Element) -> None:
         raw = parameters.get("baseTimeUnit")
-        if raw is None:
-            self.defs.info(parameters, "bpsim-time-unit",
-                           "the BPSim scenario gives no baseTimeUnit: its times are read in "
-                           "milliseconds, BPSim's default", 'set baseTimeUnit="min" (or s, '
-                           "hour, day) to say what its numbers count")
-        elif raw.strip() in BPSIM_TIME_UNITS:
+        self.no_unit = parameters
+        if raw is not None and raw.strip() in BPSIM_TIME_UNITS:
             self.unit = BPSIM_TIME_UNITS[raw.strip()]
-        else:
+            self.no_unit = None
+        elif raw is not None:
+            self.no_unit = None
             self.defs.ctx.warning(parameters, UNREAD,
                                   f"BPSim baseTimeUnit {raw!r} is no BPSim time unit; opspec "
                                   "reads the scenario's times in milliseconds",
                                   "write ms, s, min, hour, day or year")
         for sub in _children(parameters):
-            self.unread.setdefault(f"ScenarioParameters/{local(sub)}", []).append(sub)
+            if local(sub) == "Duration":
+                self.duration(sub)
+            else:
+                self.unread.setdefault(f"ScenarioParameters/{local(sub)}", []).append(sub)
+
+    def times(self, parameter: etree._Element, what: str) -> DeclaredDistribution | None:
+        """``parameter``'s value in seconds; the first time read without a base time unit,
+        an info says the numbers are taken as milliseconds (BPSim's default)."""
+        values = _children(parameter)
+        if self.no_unit is not None and values and local(values[0]) != "DurationParameter":
+            self.defs.info(self.no_unit, "bpsim-time-unit",
+                           "the BPSim scenario gives no baseTimeUnit: its times are read in "
+                           "milliseconds, BPSim's default", 'set baseTimeUnit="min" (or s, '
+                           "hour, day) on bpsim:ScenarioParameters to say what its numbers "
+                           "count")
+            self.no_unit = None
+        return bpsim_distribution(parameter, self.unit, self.defs, what)
+
+    def duration(self, parameter: etree._Element) -> None:
+        """The scenario's Duration: how long a run lasts (as opspec:RunLength)."""
+        dist = self.times(parameter, "BPSim scenario duration")
+        if dist is None:
+            return
+        if dist.kind != "ConstantParameter" or not dist.parameters or dist.parameters[0][1] <= 0:
+            self.defs.ctx.warning(parameter, UNREAD, "BPSim scenario duration: opspec takes a "
+                                  "run length from a constant above 0 only; it is not read",
+                                  "give a FloatingParameter or a DurationParameter")
+            return
+        self.out.run_length.append(dist.parameters[0][1])
 
     def element_parameters(self, parameters: etree._Element) -> None:
         ref = (parameters.get("elementRef") or "").strip()
@@ -184,7 +213,7 @@ class _Bpsim:
         if not _names_a(target, TIMED, parameter, ref, "a processing time", "task", self.defs):
             return
         what = f"BPSim processing time of {ref!r}"
-        dist = bpsim_distribution(parameter, self.unit, self.defs, what)
+        dist = self.times(parameter, what)
         if dist is not None:
             self.out.durations.setdefault(ref, dist)
             self.out.duration_source.setdefault(ref, "BPSim")
@@ -201,7 +230,7 @@ class _Bpsim:
                                   "InterTriggerTimer says how many, not when; opspec does not "
                                   "read it", "give the InterTriggerTimer too")
             return
-        dist = bpsim_distribution(timer, self.unit, self.defs, what)
+        dist = self.times(timer, what)
         if dist is None or not _positive_mean(dist, timer, self.defs, what):
             return
         how_many = bpsim_count(count, self.defs, what) if count is not None else None
@@ -240,6 +269,12 @@ def _start_process(target: etree._Element | None, where: etree._Element, ref: st
                          "only a process by arrivals, so it is ignored",
                          "give it to the start event of a process")
         return None
+    starts = [c for c in _children(parent) if local(c) == "startEvent"]
+    if len(starts) > 1:
+        defs.ctx.warning(where, UNREAD, f"{what} is given for start event {ref!r}, but process "
+                         f"{parent.get('id')!r} has {len(starts)} start events: each arrival "
+                         "starts the process, and so a token at every one of them",
+                         "keep one start event, or move the others into their own process")
     definitions = [c for c in _children(target) if local(c).endswith("EventDefinition")
                    or local(c) == "eventDefinitionRef"]
     if definitions:
