@@ -1,0 +1,363 @@
+"""The semantics gate: every element and attribute of a spec that the construct registry
+(:mod:`opspec.xpdl.constructs`) marks WARNS or REFUSES, reported at its file:line.
+
+The loader runs it on the file as read (before the XPDL normalising pass renames elements),
+so ``opspec validate``, ``run``, ``evaluate``, ``check`` and the walkthrough all see the same
+diagnostics: a warning says what opspec does instead of what the standard says, an error
+refuses the file. A condition of :data:`CONDITIONS` decides, from the element, its value and
+the document around it, whether an entry applies (a quantity of 1 is the default, so it is
+quiet; a quantity of 2 is not).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Iterable, Iterator
+from dataclasses import dataclass, field
+
+from lxml import etree
+
+from opspec.errors import Diagnostic, Severity, SourceLocation
+from opspec.xpdl.constructs import BPMN, XPDL, Construct, Kind, constructs_for
+from opspec.xpdl.namespaces import is_xpdl_namespace
+from opspec.xpdl.reader import line_of
+
+__all__ = ["CONDITIONS", "Finding", "gate_diagnostics", "gate_findings"]
+
+_BPMN_NAMESPACES = frozenset({BPMN, "http://schema.omg.org/spec/BPMN/2.0"})
+# Contents kept as written and never run: not walked.
+_OPAQUE = frozenset({"ExtendedAttribute", "SchemaType", "extensionElements", "documentation"})
+_USER_NAMES = frozenset({"user", "user_lane", "user lane", "users"})
+_BPMN_SUBS = frozenset({"subProcess", "adHocSubProcess", "transaction"})
+
+
+def _local(element: etree._Element) -> str:
+    return str(element.tag).rsplit("}", 1)[-1]
+
+
+def _namespace(element: etree._Element) -> str:
+    tag = str(element.tag)
+    return tag[1:].split("}", 1)[0] if tag.startswith("{") else ""
+
+
+def _children(element: etree._Element, *names: str) -> Iterator[etree._Element]:
+    for child in element:
+        if isinstance(child.tag, str) and _local(child) in names:
+            yield child
+
+
+@dataclass(slots=True)
+class _Doc:
+    """What conditions need to know about the document around an element, computed once."""
+
+    root: etree._Element
+    by_id: dict[str, etree._Element] = field(default_factory=dict)
+    incoming: dict[str, int] = field(default_factory=dict)
+    participant_types: dict[str, str] = field(default_factory=dict)
+
+    def __post_init__(self) -> None:
+        for element in self.root.iter():
+            if not isinstance(element.tag, str):
+                continue
+            name = _local(element)
+            ident = element.get("id") or element.get("Id")
+            if ident:
+                self.by_id.setdefault(ident, element)
+            if name == "sequenceFlow":
+                target = (element.get("targetRef") or "").strip()
+                self.incoming[target] = self.incoming.get(target, 0) + 1
+            elif name == "Transition":
+                target = (element.get("To") or "").strip()
+                self.incoming[target] = self.incoming.get(target, 0) + 1
+            elif name == "Participant" and element.get("Id"):
+                kind = next(_children(element, "ParticipantType"), None)
+                self.participant_types[element.get("Id") or ""] = (
+                    (kind.get("Type") if kind is not None else None) or "ROLE").upper()
+
+
+_Condition = Callable[[etree._Element, str | None, _Doc], bool]
+
+
+def _is(text: str) -> _Condition:
+    return lambda element, value, doc: (value or "").strip().lower() == text
+
+
+def _not_one(element: etree._Element, value: str | None, doc: _Doc) -> bool:
+    text = (value or "").strip()
+    return bool(text) and text not in ("1", "+1", "01")
+
+
+def _parent_is(*names: str) -> _Condition:
+    def check(element: etree._Element, value: str | None, doc: _Doc) -> bool:
+        parent = element.getparent()
+        return parent is not None and _local(parent) in names
+
+    return check
+
+
+def _ancestors(element: etree._Element) -> Iterator[etree._Element]:
+    parent = element.getparent()
+    while parent is not None:
+        yield parent
+        parent = parent.getparent()
+
+
+def _in_event_sub_process(element: etree._Element, value: str | None, doc: _Doc) -> bool:
+    return any(_local(a) in _BPMN_SUBS and (a.get("triggeredByEvent") or "").lower() == "true"
+               for a in _ancestors(element))
+
+
+def _bpmn_join(element: etree._Element, value: str | None, doc: _Doc) -> bool:
+    return doc.incoming.get(element.get("id") or "", 0) > 1
+
+
+def _inclusive(text: str | None) -> bool:
+    return (text or "").strip().lower() in ("inclusive", "or")
+
+
+def _xpdl_or_join(element: etree._Element, value: str | None, doc: _Doc) -> bool:
+    if _local(element) == "Join":
+        return _inclusive(element.get("Type"))
+    # a Route: its activity's Join (if any) reports; else the gateway joins what arrives
+    activity = element.getparent()
+    if activity is None or not _inclusive(element.get("GatewayType") or element.get("Type")):
+        return False
+    has_join = any(_local(e) == "Join" for e in activity.iter() if isinstance(e.tag, str))
+    return not has_join and doc.incoming.get(activity.get("Id") or "", 0) > 1
+
+
+def _terminate_in_sub_process(element: etree._Element, value: str | None, doc: _Doc) -> bool:
+    parent = element.getparent()
+    return (parent is not None and _local(parent) == "endEvent"
+            and any(_local(a) in _BPMN_SUBS for a in _ancestors(parent)))
+
+
+def _terminate_in_activity_set(element: etree._Element, value: str | None, doc: _Doc) -> bool:
+    return ((value or "").strip().lower() == "terminate"
+            and any(_local(a) == "ActivitySet" for a in _ancestors(element)))
+
+
+def _start_events(container: etree._Element) -> list[etree._Element]:
+    return list(_children(container, "startEvent"))
+
+
+def _several_starts(element: etree._Element, value: str | None, doc: _Doc) -> bool:
+    if _local(element) == "startEvent":
+        parent = element.getparent()
+        if parent is None or _in_event_sub_process(element, None, doc):
+            return False
+        if _local(parent) in _BPMN_SUBS:
+            return False            # a sub-process's start events all start with it
+        return len(_start_events(parent)) > 1
+    # XPDL: Activities/Activity/Event/StartEvent, counted per Activities (a process or a set)
+    try:
+        activities = element.getparent().getparent().getparent()  # type: ignore[union-attr]
+    except AttributeError:
+        return False
+    if activities is None or _local(activities) != "Activities":
+        return False
+    owner = activities.getparent()
+    if owner is not None and _local(owner) == "ActivitySet":
+        return False
+    count = sum(1 for activity in _children(activities, "Activity")
+                for event in _children(activity, "Event")
+                for _start in _children(event, "StartEvent"))
+    return count > 1
+
+
+_DEFINITIONS = frozenset({
+    "messageEventDefinition", "timerEventDefinition", "signalEventDefinition",
+    "conditionalEventDefinition", "errorEventDefinition", "escalationEventDefinition",
+    "terminateEventDefinition", "linkEventDefinition", "compensateEventDefinition",
+    "cancelEventDefinition", "eventDefinitionRef"})
+
+
+def _several_definitions(element: etree._Element, value: str | None, doc: _Doc) -> bool:
+    return sum(1 for child in element
+               if isinstance(child.tag, str) and _local(child) in _DEFINITIONS) > 1
+
+
+def _timer_on_multi_instance(element: etree._Element, value: str | None, doc: _Doc) -> bool:
+    if not any(True for _ in _children(element, "timerEventDefinition")):
+        return False
+    host = doc.by_id.get((element.get("attachedToRef") or "").strip())
+    return host is not None and any(True for _ in _children(
+        host, "multiInstanceLoopCharacteristics"))
+
+
+def _non_interrupting_boundary(element: etree._Element, value: str | None, doc: _Doc) -> bool:
+    definition = element.getparent()
+    event = definition.getparent() if definition is not None else None
+    return (event is not None and _local(event) == "boundaryEvent"
+            and (event.get("cancelActivity") or "").strip().lower() == "false")
+
+
+def _attached_timer(element: etree._Element, value: str | None, doc: _Doc) -> bool:
+    timer = element.getparent()
+    event = timer.getparent() if timer is not None else None
+    return (event is not None and _local(event) == "IntermediateEvent"
+            and bool((event.get("Target") or "").strip()))
+
+
+def _throws(element: etree._Element, value: str | None, doc: _Doc) -> bool:
+    parent = element.getparent()
+    return ((element.get("CatchThrow") or "").strip().upper() == "THROW"
+            or (parent is not None and _local(parent) == "EndEvent"))
+
+
+def _manual_mode(activity: etree._Element) -> bool:
+    for mode in ("StartMode", "FinishMode"):
+        if (activity.get(mode) or "").strip().lower() == "manual":
+            return True
+        for child in _children(activity, mode):      # XPDL 1.0 <StartMode><Manual/>
+            if any(True for _ in _children(child, "Manual")):
+                return True
+    for attribute in activity.iter():
+        if (isinstance(attribute.tag, str) and _local(attribute) == "ExtendedAttribute"
+                and (attribute.get("Name") or "") in ("AutoRun", "opspec:AutoRun")
+                and (attribute.get("Value") or "").strip().lower() == "false"):
+            return True
+    return False
+
+
+def _role_without_implementation(element: etree._Element, value: str | None, doc: _Doc
+                                 ) -> bool:
+    implementation = next(_children(element, "Implementation"), None)
+    if implementation is None:
+        return False
+    if any(_local(child) != "No" for child in implementation if isinstance(child.tag, str)):
+        return False
+    performers = [(p.text or "").strip() for p in element.iter()
+                  if isinstance(p.tag, str) and _local(p) == "Performer"]
+    performers = [p for p in performers if p]
+    if not performers or _manual_mode(element):
+        return False
+    if any(p.lower() in _USER_NAMES for p in performers):
+        return False
+    # a HUMAN participant's activity is offered to the user lane (manual work): only ROLE
+    # (and other non-human) performers make it run by itself
+    kinds = [doc.participant_types.get(p) for p in performers]
+    return all(kind is not None and kind == "ROLE" for kind in kinds)
+
+
+#: Condition name (a registry entry's ``when``) -> test of (element, attribute value, doc).
+CONDITIONS: dict[str, _Condition] = {
+    "true": _is("true"),
+    "false": _is("false"),
+    "not-one": _not_one,
+    "not-all": lambda e, v, d: (v or "All").strip() != "All",
+    "parallel": _is("parallel"),
+    "present": lambda e, v, d: True,
+    "join": _bpmn_join,
+    "inclusive-join": _xpdl_or_join,
+    "in-event-sub-process": _in_event_sub_process,
+    "in-multi-instance": _parent_is("multiInstanceLoopCharacteristics"),
+    "in-sub-process": _terminate_in_sub_process,
+    "in-end-event": _parent_is("endEvent", "EndEvent"),
+    "in-start-event": _parent_is("startEvent"),
+    "in-throw-event": _parent_is("intermediateThrowEvent"),
+    "in-boundary-event": _parent_is("boundaryEvent"),
+    "several-starts": _several_starts,
+    "several-definitions": _several_definitions,
+    "timer-on-multi-instance": _timer_on_multi_instance,
+    "non-interrupting-boundary": _non_interrupting_boundary,
+    "attached-timer": _attached_timer,
+    "terminate-in-activity-set": _terminate_in_activity_set,
+    "throws": _throws,
+    "human-without-implementation": _role_without_implementation,
+}
+
+
+def _applies(construct: Construct, element: etree._Element, value: str | None,
+             doc: _Doc) -> bool:
+    if construct.kind is Kind.RUNS:
+        return False
+    if construct.when is None:
+        return True
+    return CONDITIONS[construct.when](element, value, doc)
+
+
+def _walk(root: etree._Element) -> Iterator[etree._Element]:
+    stack = [root]
+    while stack:
+        element = stack.pop()
+        yield element
+        if _local(element) in _OPAQUE:
+            continue
+        stack.extend(reversed([c for c in element if isinstance(c.tag, str)]))
+
+
+def _label(namespace: str, element: etree._Element, attribute: str | None) -> str:
+    prefix = "bpmn:" if namespace == BPMN else ""
+    ident = element.get("id") or element.get("Id")
+    name = f"{prefix}{_local(element)}" + (f" {ident!r}" if ident else "")
+    return f"{name} {attribute}={element.get(attribute)!r}" if attribute else name
+
+
+def _diagnostic(path: str, construct: Construct, element: etree._Element,
+                attribute: str | None) -> Diagnostic:
+    severity = Severity.ERROR if construct.kind is Kind.REFUSES else Severity.WARNING
+    verb = "is refused" if construct.kind is Kind.REFUSES else "does not run as its standard says"
+    hint = construct.hint or f"docs/semantics.md lists what opspec runs ({construct.key})"
+    return Diagnostic(SourceLocation(path, line_of(element)), severity, construct.code,
+                      f"{_label(construct.namespace, element, attribute)} {verb}: "
+                      f"{construct.text} [{construct.section}]", hint)
+
+
+@dataclass(frozen=True, slots=True)
+class Finding:
+    """A gate diagnostic and the reader codes that, at the same line, already say it."""
+
+    diagnostic: Diagnostic
+    reported_by: tuple[str, ...] = ()
+
+
+def gate_findings(root: etree._Element, path: str) -> list[Finding]:
+    """A finding for every element and attribute of the document at ``root`` that the
+    registry marks WARNS or REFUSES (when its condition holds). Run it on the tree as read,
+    before the reader rewrites it."""
+    bpmn = _namespace(root) in _BPMN_NAMESPACES
+    doc = _Doc(root)
+    out: list[Finding] = []
+    for element in _walk(root):
+        space = _namespace(element)
+        if bpmn:
+            key = BPMN if space in _BPMN_NAMESPACES else None
+        else:
+            key = XPDL if is_xpdl_namespace(space) else None
+        if key is None:
+            continue
+        name = _local(element)
+        found: list[tuple[Construct, str | None]] = [(c, None) for c in constructs_for(key, name)]
+        for attribute in element.attrib:
+            if "}" not in attribute:
+                found.extend((c, attribute) for c in constructs_for(key, name, attribute))
+        for construct, attribute in found:
+            value = element.get(attribute) if attribute else None
+            if _applies(construct, element, value, doc):
+                out.append(Finding(_diagnostic(path, construct, element, attribute),
+                                   construct.reported_by))
+    return out
+
+
+def gate_diagnostics(findings: Iterable[Finding], reported: Iterable[Diagnostic] = ()
+                     ) -> list[Diagnostic]:
+    """The findings' diagnostics, less those the reader already gave (``reported``): an entry
+    whose ``reported_by`` code the reader reported at the same line, as severely."""
+    said: dict[tuple[int | None, str], set[Severity]] = {}
+    for diagnostic in reported:
+        said.setdefault((diagnostic.location.line, diagnostic.code), set()).add(
+            diagnostic.severity)
+    out: list[Diagnostic] = []
+    for finding in findings:
+        diagnostic = finding.diagnostic
+        enough = _AT_LEAST[diagnostic.severity]
+        if any(said.get((diagnostic.location.line, code), set()) & enough
+               for code in finding.reported_by):
+            continue
+        out.append(diagnostic)
+    return out
+
+
+_AT_LEAST = {Severity.WARNING: {Severity.WARNING, Severity.ERROR},
+             Severity.ERROR: {Severity.ERROR}, Severity.INFO: {Severity.INFO, Severity.WARNING,
+                                                              Severity.ERROR}}
