@@ -79,6 +79,14 @@ class Schema:
             parent = parent.getparent()
         return None
 
+    def abstract(self, element: etree._Element) -> bool:
+        """An abstract element, or one of an abstract type: never written in a file (its
+        concrete substitutes carry its attributes)."""
+        if element.get("abstract") == "true":
+            return True
+        named = self.types.get(self._local(element.get("type") or ""))
+        return named is not None and named.get("abstract") == "true"
+
     def pairs(self) -> set[tuple[str, str | None]]:
         """``(element, None)`` for every element declared, and ``(element, attribute)`` for
         every attribute its type has."""
@@ -91,8 +99,8 @@ class Schema:
             declarations.extend(group.iter(_q("element")))
         for element in declarations:
             name = element.get("name")
-            if name is None:
-                continue                        # a ref: listed where it is declared
+            if name is None or self.abstract(element):
+                continue            # a ref (listed where declared), or abstract (never written)
             out.add((name, None))
             complex_type = element.find(_q("complexType"))
             if complex_type is None and element.get("type"):
