@@ -331,9 +331,13 @@ def gate_findings(root: etree._Element, path: str) -> list[Finding]:
         for attribute in element.attrib:
             if "}" not in attribute:
                 found.extend((c, attribute) for c in constructs_for(key, name, attribute))
+        said = False
         for construct, attribute in found:
             value = element.get(attribute) if attribute else None
+            if attribute and construct.when is None and said:
+                continue        # ignored with its element, which is already reported
             if _applies(construct, element, value, doc):
+                said = said or attribute is None
                 out.append(Finding(_diagnostic(path, construct, element, attribute),
                                    construct.reported_by))
     return out
