@@ -424,7 +424,6 @@ _BPMN: tuple[Construct, ...] = (
     _c("bpmn-import-attrs", BPMN, "import", "location", W, "not read", "§8.3.1"),
 )
 
-_XPDL_ACTIVITY_ATTRS = "Activity"
 
 # XPDL 2.1 (WfMC-TC-1025, 2008) and 2.2: section numbers of XPDL 2.1.
 _XPDL: tuple[Construct, ...] = (
