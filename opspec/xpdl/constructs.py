@@ -205,6 +205,12 @@ _BPMN: tuple[Construct, ...] = (
        "read as 1: one token leaves on each outgoing flow (BPMN: completionQuantity tokens)",
        "§10.2.1, §13.3.2", when="not-one",
        hint="draw a parallel gateway after the activity to produce several tokens"),
+    _c("bpmn-orphaned-node", BPMN, f"{_ACTIVITIES} {_GATEWAYS} intermediateCatchEvent "
+       "intermediateThrowEvent endEvent", None, W,
+       "every sequence flow into it comes from something opspec ignores (a compensation or "
+       "cancel boundary event), so it has no incoming flow and starts with the instance "
+       "(BPMN: a node with incoming sequence flows waits for a token)", "§13.2, §13.5.3",
+       when="fed-only-by-ignored"),
     _c("bpmn-compensation-activity", BPMN, _ACTIVITIES, "isForCompensation", W,
        "opspec has no compensation: this is an ordinary activity (one no sequence flow leads "
        "to starts with the instance)", "§10.2.1, §13.5.5", when="true"),
@@ -892,6 +898,7 @@ _WHEN_TEXT = {
     "attached-timer": "of a timer attached to an activity",
     "terminate-in-activity-set": "Terminate, in an activity set",
     "throws": "thrown",
+    "fed-only-by-ignored": "all its incoming flows come from ignored elements",
     "human-without-implementation": "no implementation, performed by HUMAN or ROLE",
 }
 

@@ -53,6 +53,7 @@ class _Doc:
     by_id: dict[str, etree._Element] = field(default_factory=dict)
     incoming: dict[str, int] = field(default_factory=dict)
     participant_types: dict[str, str] = field(default_factory=dict)
+    sources: dict[str, list[str]] = field(default_factory=dict)   # target -> flow sources
 
     def __post_init__(self) -> None:
         for element in self.root.iter():
@@ -65,6 +66,8 @@ class _Doc:
             if name == "sequenceFlow":
                 target = (element.get("targetRef") or "").strip()
                 self.incoming[target] = self.incoming.get(target, 0) + 1
+                self.sources.setdefault(target, []).append(
+                    (element.get("sourceRef") or "").strip())
             elif name == "Transition":
                 target = (element.get("To") or "").strip()
                 self.incoming[target] = self.incoming.get(target, 0) + 1
@@ -198,6 +201,23 @@ def _attached_timer(element: etree._Element, value: str | None, doc: _Doc) -> bo
             and bool((event.get("Target") or "").strip()))
 
 
+_IGNORED_BOUNDARIES = frozenset({"compensateEventDefinition", "cancelEventDefinition"})
+
+
+def _ignored_source(source: etree._Element | None) -> bool:
+    """A node whose outgoing sequence flows the BPMN reader leaves out: a boundary event
+    with a compensation or cancel definition, or with none."""
+    if source is None or _local(source) != "boundaryEvent":
+        return False
+    kinds = {_local(c) for c in source if isinstance(c.tag, str)} & _DEFINITIONS
+    return not kinds or bool(kinds & _IGNORED_BOUNDARIES) and len(kinds) == 1
+
+
+def _fed_only_by_ignored(element: etree._Element, value: str | None, doc: _Doc) -> bool:
+    sources = doc.sources.get(element.get("id") or "", [])
+    return bool(sources) and all(_ignored_source(doc.by_id.get(s)) for s in sources)
+
+
 def _throws(element: etree._Element, value: str | None, doc: _Doc) -> bool:
     parent = element.getparent()
     return ((element.get("CatchThrow") or "").strip().upper() == "THROW"
@@ -263,6 +283,7 @@ CONDITIONS: dict[str, _Condition] = {
     "attached-timer": _attached_timer,
     "terminate-in-activity-set": _terminate_in_activity_set,
     "throws": _throws,
+    "fed-only-by-ignored": _fed_only_by_ignored,
     "human-without-implementation": _role_without_implementation,
 }
 

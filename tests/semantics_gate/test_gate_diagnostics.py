@@ -224,3 +224,19 @@ def test_strict_refuses_a_file_that_runs_differently(tmp_path, capsys):
     assert main(["validate", str(spec)]) == 0
     assert main(["validate", "--strict", str(spec)]) == 1
     assert "error: bpmn:task 'a' startQuantity='2'" in capsys.readouterr().out
+
+
+def test_a_node_fed_only_by_an_ignored_boundary_event_is_reported():
+    """BPMN 2.0 §10.4.2: "All Flow Objects that do not have an incoming Sequence Flow (i.e.,
+    are not a target of a Sequence Flow) SHALL be instantiated when the Process is
+    instantiated." A task whose only incoming flow leaves a compensation boundary event has
+    an incoming flow, so it must not start with the instance; opspec drops that flow (it has
+    no compensation), so the task would start at once: said at its line."""
+    data = _bpmn('<startEvent id="s"/>\n<task id="a"/>\n'
+                 '<boundaryEvent id="b" attachedToRef="a"><compensateEventDefinition/>'
+                 '</boundaryEvent>\n<task id="undo"/>\n'
+                 '<sequenceFlow id="f0" sourceRef="s" targetRef="a"/>\n'
+                 '<sequenceFlow id="f1" sourceRef="b" targetRef="undo"/>\n')
+    found = [(line, code) for line, code, _m in _gate(data)]
+    assert (_line(data, '<task id="undo"'), "runs-differently") in found
+    assert (_line(data, '<task id="a"'), "runs-differently") not in found
