@@ -605,6 +605,10 @@ _XPDL: tuple[Construct, ...] = (
        "path starts beside it (ASYNCHR)", "§7.6.8"),
     _c("xpdl-deadline-execution", XPDL, "Deadline", "Execution", R, "SYNCHR or ASYNCHR",
        "§7.6.8"),
+    _c("xpdl-mi-deadline", XPDL, "Deadline", None, W,
+       "a deadline of a multi-instance activity runs for each instance (BPMN §13.5.3: an event "
+       "attached to a multi-instance activity belongs to the activity as a whole)",
+       "§7.6.8; BPMN §13.5.3", when="on-multi-instance"),
     _c("xpdl-data", XPDL, "DataFields DataField FormalParameters FormalParameter "
        "ActualParameters ActualParameter InitialValue Assignments Assignment Target "
        "DataType BasicType DeclaredType SchemaType ExternalReference RecordType UnionType "
@@ -898,6 +902,7 @@ _WHEN_TEXT = {
     "attached-timer": "of a timer attached to an activity",
     "terminate-in-activity-set": "Terminate, in an activity set",
     "throws": "thrown",
+    "on-multi-instance": "of a multi-instance activity",
     "fed-only-by-ignored": "all its incoming flows come from ignored elements",
     "human-without-implementation": "no implementation, performed by HUMAN or ROLE",
 }

@@ -218,6 +218,17 @@ def _fed_only_by_ignored(element: etree._Element, value: str | None, doc: _Doc) 
     return bool(sources) and all(_ignored_source(doc.by_id.get(s)) for s in sources)
 
 
+def _on_multi_instance(element: etree._Element, value: str | None, doc: _Doc) -> bool:
+    activity = element.getparent()
+    if activity is None:
+        return False
+    for loop in _children(activity, "Loop"):
+        if ((loop.get("LoopType") or "").lower() == "multiinstance"
+                or any(True for _ in _children(loop, "LoopMultiInstance"))):
+            return True
+    return False
+
+
 def _throws(element: etree._Element, value: str | None, doc: _Doc) -> bool:
     parent = element.getparent()
     return ((element.get("CatchThrow") or "").strip().upper() == "THROW"
@@ -283,6 +294,7 @@ CONDITIONS: dict[str, _Condition] = {
     "attached-timer": _attached_timer,
     "terminate-in-activity-set": _terminate_in_activity_set,
     "throws": _throws,
+    "on-multi-instance": _on_multi_instance,
     "fed-only-by-ignored": _fed_only_by_ignored,
     "human-without-implementation": _role_without_implementation,
 }
@@ -311,6 +323,11 @@ def _label(namespace: str, element: etree._Element, attribute: str | None) -> st
     prefix = "bpmn:" if namespace == BPMN else ""
     ident = element.get("id") or element.get("Id")
     name = f"{prefix}{_local(element)}" + (f" {ident!r}" if ident else "")
+    if not ident:       # a part of something that has an id: say whose (TaskSend of 'notify')
+        owner = next((a for a in _ancestors(element) if a.get("id") or a.get("Id")), None)
+        if owner is not None and owner.getparent() is not None:
+            name += (f" of {prefix}{_local(owner)} "
+                     f"{owner.get('id') or owner.get('Id')!r}")
     return f"{name} {attribute}={element.get(attribute)!r}" if attribute else name
 
 

@@ -240,3 +240,61 @@ def test_a_node_fed_only_by_an_ignored_boundary_event_is_reported():
     found = [(line, code) for line, code, _m in _gate(data)]
     assert (_line(data, '<task id="undo"'), "runs-differently") in found
     assert (_line(data, '<task id="a"'), "runs-differently") not in found
+
+
+def _xpdl(activities: str, transitions: str = "", sets: str = "") -> bytes:
+    return (f'<Package xmlns="{XPDL21}" Id="pk">\n<WorkflowProcesses>\n'
+            f'<WorkflowProcess Id="w">{sets}<Activities>\n{activities}</Activities>\n'
+            f'<Transitions>{transitions}</Transitions></WorkflowProcess>\n'
+            '</WorkflowProcesses>\n</Package>\n').encode()
+
+
+def _xpdl_gate(data: bytes) -> list[tuple[int | None, str, str]]:
+    result = parse_bytes(data, path="f.xpdl")
+    return [(d.location.line, d.code, d.message) for d in result.diagnostics
+            if d.code in ("runs-differently", "not-run")]
+
+
+def test_xpdl_several_start_events_are_reported():
+    """BPMN 2.0 §10.4.2, which XPDL 2.1's events follow: "Each Start Event is an independent
+    Event. That is, a Process instance SHALL be generated when the Start Event is
+    triggered." Two XPDL start events in one process are said; one is quiet."""
+    one = '<Activity Id="s1"><Event><StartEvent Trigger="None"/></Event></Activity>\n'
+    two = one + '<Activity Id="s2"><Event><StartEvent Trigger="None"/></Event></Activity>\n'
+    assert _xpdl_gate(_xpdl(one)) == []
+    assert [line for line, _c, _m in _xpdl_gate(_xpdl(two))] == [4, 5]
+
+
+def test_xpdl_terminate_inside_an_activity_set_is_reported():
+    """BPMN 2.0 §13.5.6: "For a “terminate” End Event, the Sub-Process is abnormally
+    terminated." An XPDL activity set is the embedded sub-process of its block activity;
+    opspec ends the whole instance there, which is said; at the process level it is quiet."""
+    sets = ('<ActivitySets><ActivitySet Id="set"><Activities>\n'
+            '<Activity Id="inner"><Event><EndEvent Result="Terminate"/></Event></Activity>\n'
+            '</Activities></ActivitySet></ActivitySets>')
+    data = _xpdl('<Activity Id="outer"><Event><EndEvent Result="Terminate"/></Event>'
+                 '</Activity>\n', sets=sets)
+    found = _xpdl_gate(data)
+    assert [(line, code) for line, code, _m in found] == [(4, "runs-differently")]
+
+
+def test_xpdl_inclusive_join_and_attached_cycle_and_mi_deadline_are_reported():
+    """BPMN 2.0 Table 13.3: "Upon execution, a token is consumed from each incoming Sequence
+    Flow that has a token" (the OR join); Table 10.101: a timeCycle is a "recurring time
+    interval"; §13.5.3: a boundary event on a multi-instance activity cancels "all its
+    instances" (it belongs to the activity as a whole). Each XPDL counterpart is said."""
+    data = _xpdl(
+        '<Activity Id="j"><Route GatewayType="Inclusive"/><TransitionRestrictions>'
+        '<TransitionRestriction><Join Type="Inclusive"/></TransitionRestriction>'
+        '</TransitionRestrictions></Activity>\n'
+        '<Activity Id="t"><Event><IntermediateEvent Trigger="Timer" Target="m"><TriggerTimer>'
+        '<TimeCycle>R/PT1M</TimeCycle></TriggerTimer></IntermediateEvent></Event></Activity>\n'
+        '<Activity Id="m"><Implementation><No/></Implementation><Loop LoopType="MultiInstance">'
+        '<LoopMultiInstance MI_Condition="2"/></Loop><Deadline Execution="SYNCHR">'
+        '<DeadlineDuration>PT1M</DeadlineDuration><ExceptionName>late</ExceptionName>'
+        '</Deadline></Activity>\n')
+    found = _xpdl_gate(data)
+    assert [(line, code) for line, code, _m in found] == [
+        (4, "runs-differently"), (5, "runs-differently"), (6, "runs-differently")]
+    assert "Table 13.3" in found[0][2] and "fires once" in found[1][2]
+    assert "for each instance" in found[2][2]
