@@ -30,6 +30,7 @@ __all__ = [
     "BPMNDI_NAMESPACES",
     "CONSTRUCTS",
     "INERT",
+    "REPORTED",
     "XPDL",
     "Construct",
     "Inert",
@@ -849,6 +850,25 @@ def _index() -> Mapping[tuple[str, str, str | None], tuple[Construct, ...]]:
 
 _BY_KEY = _index()
 _EMPTY: tuple[Construct, ...] = ()
+
+
+def _reported() -> Mapping[tuple[str, str], tuple[tuple[str | None, Construct], ...]]:
+    """What the gate looks at: per (namespace, element), its WARNS and REFUSES entries, of the
+    element (attribute ``None``) and of its attributes."""
+    out: dict[tuple[str, str], list[tuple[str | None, Construct]]] = {}
+    for construct in CONSTRUCTS:
+        if construct.kind is Kind.RUNS:
+            continue
+        for element in construct.elements:
+            out.setdefault((construct.namespace, element), []).append(
+                (construct.attribute, construct))
+    # the element's own entries first: an attribute ignored with its element is then quiet
+    return MappingProxyType({key: tuple(sorted(found, key=lambda f: f[0] is not None))
+                             for key, found in out.items()})
+
+
+#: (namespace, element) -> ((attribute or None, entry), ...) for WARNS and REFUSES entries.
+REPORTED = _reported()
 
 
 def constructs_for(namespace: str, element: str, attribute: str | None = None

@@ -12,12 +12,12 @@ quiet; a quantity of 2 is not).
 from __future__ import annotations
 
 from collections.abc import Callable, Iterable, Iterator
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 from lxml import etree
 
 from opspec.errors import Diagnostic, Severity, SourceLocation
-from opspec.xpdl.constructs import BPMN, XPDL, Construct, Kind, constructs_for
+from opspec.xpdl.constructs import BPMN, REPORTED, XPDL, Construct, Kind
 from opspec.xpdl.namespaces import is_xpdl_namespace
 from opspec.xpdl.reader import line_of
 
@@ -45,36 +45,64 @@ def _children(element: etree._Element, *names: str) -> Iterator[etree._Element]:
             yield child
 
 
-@dataclass(slots=True)
 class _Doc:
-    """What conditions need to know about the document around an element, computed once."""
+    """What conditions need to know about the document around an element, each part computed
+    once, on first use (most files need none of it)."""
 
-    root: etree._Element
-    by_id: dict[str, etree._Element] = field(default_factory=dict)
-    incoming: dict[str, int] = field(default_factory=dict)
-    participant_types: dict[str, str] = field(default_factory=dict)
-    sources: dict[str, list[str]] = field(default_factory=dict)   # target -> flow sources
+    def __init__(self, root: etree._Element) -> None:
+        self.root = root
+        self._by_id: dict[str, etree._Element] | None = None
+        self._flows: tuple[dict[str, int], dict[str, list[str]]] | None = None
+        self._participants: dict[str, str] | None = None
 
-    def __post_init__(self) -> None:
-        for element in self.root.iter():
-            if not isinstance(element.tag, str):
-                continue
-            name = _local(element)
-            ident = element.get("id") or element.get("Id")
-            if ident:
-                self.by_id.setdefault(ident, element)
-            if name == "sequenceFlow":
-                target = (element.get("targetRef") or "").strip()
-                self.incoming[target] = self.incoming.get(target, 0) + 1
-                self.sources.setdefault(target, []).append(
-                    (element.get("sourceRef") or "").strip())
-            elif name == "Transition":
-                target = (element.get("To") or "").strip()
-                self.incoming[target] = self.incoming.get(target, 0) + 1
-            elif name == "Participant" and element.get("Id"):
-                kind = next(_children(element, "ParticipantType"), None)
-                self.participant_types[element.get("Id") or ""] = (
-                    (kind.get("Type") if kind is not None else None) or "ROLE").upper()
+    @property
+    def by_id(self) -> dict[str, etree._Element]:
+        if self._by_id is None:
+            found: dict[str, etree._Element] = {}
+            for element in self.root.iter(etree.Element):
+                ident = element.get("id") or element.get("Id")
+                if ident:
+                    found.setdefault(ident, element)
+            self._by_id = found
+        return self._by_id
+
+    def _flow_index(self) -> tuple[dict[str, int], dict[str, list[str]]]:
+        if self._flows is None:
+            incoming: dict[str, int] = {}
+            sources: dict[str, list[str]] = {}
+            for flow in self.root.iter("{*}sequenceFlow"):
+                target = (flow.get("targetRef") or "").strip()
+                incoming[target] = incoming.get(target, 0) + 1
+                sources.setdefault(target, []).append((flow.get("sourceRef") or "").strip())
+            for transition in self.root.iter("{*}Transition", "Transition"):
+                target = (transition.get("To") or "").strip()
+                incoming[target] = incoming.get(target, 0) + 1
+            self._flows = incoming, sources
+        return self._flows
+
+    @property
+    def incoming(self) -> dict[str, int]:
+        """Flow node id -> number of sequence flows (transitions) into it."""
+        return self._flow_index()[0]
+
+    @property
+    def sources(self) -> dict[str, list[str]]:
+        """Flow node id -> the sources of the sequence flows into it."""
+        return self._flow_index()[1]
+
+    @property
+    def participant_types(self) -> dict[str, str]:
+        """XPDL participant Id -> its ParticipantType (ROLE when not given)."""
+        if self._participants is None:
+            found: dict[str, str] = {}
+            for participant in self.root.iter("{*}Participant", "Participant"):
+                ident = participant.get("Id")
+                if ident:
+                    kind = next(_children(participant, "ParticipantType"), None)
+                    found[ident] = ((kind.get("Type") if kind is not None else None)
+                                    or "ROLE").upper()
+            self._participants = found
+        return self._participants
 
 
 _Condition = Callable[[etree._Element, str | None, _Doc], bool]
@@ -309,14 +337,9 @@ def _applies(construct: Construct, element: etree._Element, value: str | None,
     return CONDITIONS[construct.when](element, value, doc)
 
 
-def _walk(root: etree._Element) -> Iterator[etree._Element]:
-    stack = [root]
-    while stack:
-        element = stack.pop()
-        yield element
-        if _local(element) in _OPAQUE:
-            continue
-        stack.extend(reversed([c for c in element if isinstance(c.tag, str)]))
+def _opaque(element: etree._Element) -> bool:
+    """Inside content kept as written and never run (vendor data, documentation)."""
+    return any(_local(a) in _OPAQUE for a in _ancestors(element))
 
 
 def _label(namespace: str, element: etree._Element, attribute: str | None) -> str:
@@ -354,31 +377,41 @@ def gate_findings(root: etree._Element, path: str) -> list[Finding]:
     registry marks WARNS or REFUSES (when its condition holds). Run it on the tree as read,
     before the reader rewrites it."""
     bpmn = _namespace(root) in _BPMN_NAMESPACES
+    key = BPMN if bpmn else XPDL
+    tags = _TAGS[key]
     doc = _Doc(root)
     out: list[Finding] = []
-    for element in _walk(root):
-        space = _namespace(element)
-        if bpmn:
-            key = BPMN if space in _BPMN_NAMESPACES else None
-        else:
-            key = XPDL if is_xpdl_namespace(space) else None
-        if key is None:
+    # lxml finds the few elements the registry reports (any namespace), in document order
+    for element in root.iter(*tags):
+        tag = str(element.tag)
+        space, _, name = tag[1:].partition("}") if tag[0] == "{" else ("", "", tag)
+        if not (space in _BPMN_NAMESPACES if bpmn else is_xpdl_namespace(space)):
             continue
-        name = _local(element)
-        found: list[tuple[Construct, str | None]] = [(c, None) for c in constructs_for(key, name)]
-        for attribute in element.attrib:
-            if "}" not in attribute:
-                found.extend((c, attribute) for c in constructs_for(key, name, attribute))
+        entries = REPORTED.get((key, name))
+        if not entries:
+            continue
         said = False
-        for construct, attribute in found:
-            value = element.get(attribute) if attribute else None
+        for attribute, construct in entries:
+            if attribute is not None and attribute not in element.attrib:
+                continue
             if attribute and construct.when is None and said:
                 continue        # ignored with its element, which is already reported
+            value = element.get(attribute) if attribute else None
             if _applies(construct, element, value, doc):
+                if _opaque(element):
+                    break
                 said = said or attribute is None
                 out.append(Finding(_diagnostic(path, construct, element, attribute),
                                    construct.reported_by))
     return out
+
+
+def _tags(namespace: str) -> tuple[str, ...]:
+    names = sorted({name for space, name in REPORTED if space == namespace})
+    return (*(f"{{*}}{name}" for name in names), *names)
+
+
+_TAGS = {BPMN: _tags(BPMN), XPDL: _tags(XPDL)}
 
 
 def gate_diagnostics(findings: Iterable[Finding], reported: Iterable[Diagnostic] = ()
