@@ -529,9 +529,10 @@ _XPDL: tuple[Construct, ...] = (
     _c("xpdl-transaction-protocol", XPDL, "Transaction", "TransactionProtocol", W, "ignored",
        "§7.6"),
     _c("xpdl-manual-without-implementation", XPDL, "Activity", None, W,
-       "an activity with no implementation performed by a HUMAN or ROLE participant runs by "
-       "itself in zero time (XPDL 2.1: it is manual work for its performer)", "§7.6.5.1, §7.7",
-       when="human-without-implementation",
+       "an activity with no implementation performed by a ROLE participant runs by itself in "
+       "zero time (it is manual work for its performer; a HUMAN participant's is offered to "
+       "the user lane)", "§7.6.5.1, §7.7",
+       when="role-without-implementation",
        hint="set StartMode=\"Manual\" or put the activity in the user lane"),
     _c("xpdl-loops", XPDL, "Loop LoopStandard LoopMultiInstance LoopCondition MI_Condition "
        "ComplexMI_FlowCondition", None, R, "standard and multi-instance loops", "§7.6.3"),
@@ -924,7 +925,7 @@ _WHEN_TEXT = {
     "throws": "thrown",
     "on-multi-instance": "of a multi-instance activity",
     "fed-only-by-ignored": "all its incoming flows come from ignored elements",
-    "human-without-implementation": "no implementation, performed by HUMAN or ROLE",
+    "role-without-implementation": "no implementation, performed by a ROLE participant",
 }
 
 

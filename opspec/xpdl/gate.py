@@ -324,7 +324,7 @@ CONDITIONS: dict[str, _Condition] = {
     "throws": _throws,
     "on-multi-instance": _on_multi_instance,
     "fed-only-by-ignored": _fed_only_by_ignored,
-    "human-without-implementation": _role_without_implementation,
+    "role-without-implementation": _role_without_implementation,
 }
 
 
