@@ -580,8 +580,8 @@ _XPDL: tuple[Construct, ...] = (
     _c("xpdl-timer-cycle-attr", XPDL, "TriggerTimer", "TimeCycle", R, "a repeating cycle",
        "§7.6.2"),
     _c("xpdl-boundary-cycle", XPDL, "TimeCycle", None, W,
-       "a timer with a cycle attached to an activity fires once, at the cycle's first firing "
-       "(BPMN §10.4.5: a non-interrupting one fires at every cycle)", "§7.6.2",
+       "a non-interrupting timer with a cycle attached to an activity fires once, at the "
+       "cycle's first firing (BPMN §10.4.5: at every cycle while the activity runs)", "§7.6.2",
        when="attached-timer"),
     _c("xpdl-catch-throw", XPDL, "TriggerResultMessage TriggerResultSignal TriggerResultLink",
        "CatchThrow", R, "whether the event waits or raises", "§7.6.2"),
@@ -920,7 +920,7 @@ _WHEN_TEXT = {
     "several-definitions": "with several event definitions",
     "timer-on-multi-instance": "a timer on a multi-instance activity",
     "non-interrupting-boundary": "of a non-interrupting boundary timer",
-    "attached-timer": "of a timer attached to an activity",
+    "attached-timer": "of a non-interrupting timer attached to an activity",
     "terminate-in-activity-set": "Terminate, in an activity set",
     "throws": "thrown",
     "on-multi-instance": "of a multi-instance activity",

@@ -225,8 +225,11 @@ def _non_interrupting_boundary(element: etree._Element, value: str | None, doc: 
 def _attached_timer(element: etree._Element, value: str | None, doc: _Doc) -> bool:
     timer = element.getparent()
     event = timer.getparent() if timer is not None else None
+    interrupting = (event.get("Interrupting") or event.get("IsInterrupting") or "true"
+                    ) if event is not None else "true"
     return (event is not None and _local(event) == "IntermediateEvent"
-            and bool((event.get("Target") or "").strip()))
+            and bool((event.get("Target") or "").strip())
+            and interrupting.strip().lower() == "false")
 
 
 _IGNORED_BOUNDARIES = frozenset({"compensateEventDefinition", "cancelEventDefinition"})
