@@ -157,12 +157,12 @@ _BPMN: tuple[Construct, ...] = (
     _c("bpmn-script", BPMN, "script", None, R,
        "the script runs as assignments (opspec's subset; anything else is a bad-script error)",
        "§10.2.3"),
-    _c("bpmn-languages", BPMN,
-       "scriptTask", "scriptFormat", R, "opspec reads scripts in its own subset whatever language is named",
-       "§10.2.3"),
+    _c("bpmn-languages", BPMN, "scriptTask", "scriptFormat", R,
+       "opspec reads scripts in its own subset whatever language is named", "§10.2.3"),
     _c("bpmn-expression-language", BPMN,
-       "condition formalExpression transformation messagePath dataPath", "language", R, "opspec reads expressions in its own grammar whatever language is named; "
-       "one it cannot read is a bad-condition error", "§10.3.1"),
+       "condition formalExpression transformation messagePath dataPath", "language", R,
+       "opspec reads expressions in its own grammar whatever language is named; one it "
+       "cannot read is a bad-condition error", "§10.3.1"),
     _c("bpmn-expression-language-default", BPMN, "definitions", "expressionLanguage", R,
        "as language", "§10.3.1"),
     _c("bpmn-call-activity", BPMN, "callActivity", None, R,
@@ -170,7 +170,8 @@ _BPMN: tuple[Construct, ...] = (
     _c("bpmn-called-element", BPMN, "callActivity", "calledElement", R,
        "the process called", "§10.2.5"),
     _c("bpmn-sub-process", BPMN, "subProcess", None, R,
-       "an embedded sub-process: its flow runs in the instance of its parent", "§10.2.5, §13.3.4"),
+       "an embedded sub-process: its flow runs in the instance of its parent",
+       "§10.2.5, §13.3.4"),
     _c("bpmn-event-sub-process", BPMN, _SUBS, "triggeredByEvent", X,
        "opspec does not run event sub-processes (it would ignore it and everything in it "
        "while the rest runs)", "§10.2.5, §13.5.4", when="true",
@@ -747,8 +748,9 @@ INERT: tuple[Inert, ...] = (
           ("itemRef", "structureRef", "evaluatesToTypeRef"),
           "payload and result types: opspec's data is dynamically typed",
           include_elements=False),
-    Inert(BPMN, ("interface", "operation", "operationRef", "inMessageRef", "outMessageRef", "errorRef",
-                 "endPoint", "endPointRef", "interfaceRef", "partnerEntity", "partnerRole",
+    Inert(BPMN, ("interface", "operation", "operationRef", "inMessageRef", "outMessageRef",
+                 "errorRef", "endPoint", "endPointRef", "interfaceRef", "partnerEntity",
+                 "partnerRole",
                  "participantRef"), ("*",),
           "service interfaces and partners: opspec simulates services (bound devices, "
           "performers), BPMN §8.3.10"),
@@ -938,9 +940,10 @@ def markdown_table() -> str:
         if construct.kind is Kind.RUNS:
             continue
         standard = "BPMN 2.0" if construct.namespace == BPMN else "XPDL 2.1"
-        lines.append(
-            f"| {standard} | {_names(construct)} | {_WHEN_TEXT.get(construct.when, construct.when)} "
-            f"| {construct.kind.value} | {construct.text.replace('|', '/')} | {construct.section} |")
+        when = _WHEN_TEXT.get(construct.when, construct.when)
+        text = construct.text.replace("|", "/")
+        lines.append(f"| {standard} | {_names(construct)} | {when} | {construct.kind.value} "
+                     f"| {text} | {construct.section} |")
     return "\n".join(lines) + "\n"
 
 
