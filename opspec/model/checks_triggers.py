@@ -83,33 +83,45 @@ def trigger_name_diagnostics(package: Package, packages: Mapping[str, Package]
     everything = {package.id: package, **packages}
     thrown, caught = _uses(everything.values())
     own_thrown, own_caught = _uses((package,))
-    names_thrown = {(u.kind, u.name) for u in thrown}
-    names_caught = {(u.kind, u.name) for u in caught}
     fallback = SourceLocation(package.source or "<spec>")
+    return [*_unmatched(own_thrown, caught, _NOT_CAUGHT, fallback),
+            *_unmatched(own_caught, thrown, _NOT_THROWN, fallback)]
+
+
+@dataclass(frozen=True, slots=True)
+class _Side:
+    """How one side's unmatched names are reported: the code, the verb and the hint."""
+
+    code: str
+    verb: str                 # "throws" / "waits for"
+    missing: str              # "catches" / "throws"
+    hint: str                 # "{fix}" stands for "fix the name (to 'x')"
+
+
+_NOT_CAUGHT = _Side(CODE_NOT_CAUGHT, "throws", "catches",
+                    "catch it (a catching event, a start trigger) or {fix}; a device or the "
+                    "API may still catch it")
+_NOT_THROWN = _Side(CODE_NOT_THROWN, "waits for", "throws",
+                    "{fix} unless a device, a script, a user model or the API sends it")
+
+
+def _unmatched(uses: list[_Use], partners: list[_Use], side: _Side,
+               fallback: SourceLocation) -> list[Diagnostic]:
+    """A warning for each name of ``uses`` (once per name) that no use of ``partners`` has,
+    naming the closest name the partners do have."""
+    have = {(u.kind, u.name) for u in partners}
     out: list[Diagnostic] = []
-    seen: set[tuple[str, str, str]] = set()
-    for use in own_thrown:
+    seen: set[tuple[str, str]] = set()
+    for use in uses:
         key = (use.kind, use.name)
-        if key in names_caught or ("thrown", *key) in seen:
+        if key in have or key in seen:
             continue
-        seen.add(("thrown", *key))
-        close = _closest(use.name, (n for k, n in names_caught if k == use.kind))
+        seen.add(key)
+        close = _closest(use.name, (n for k, n in have if k == use.kind))
+        fix = "fix the name" + (f" to {close!r}" if close else "")
         out.append(Diagnostic(
-            use.location or fallback, Severity.WARNING, CODE_NOT_CAUGHT,
-            f"{use.what} throws {use.kind} {use.name!r}, which nothing in the spec catches"
-            + (f"; did you mean {close!r}?" if close else ""),
-            f"catch it (a catching event, a start trigger) or fix the name"
-            + (f" to {close!r}" if close else "") + "; a device or the API may still catch it"))
-    for use in own_caught:
-        key = (use.kind, use.name)
-        if key in names_thrown or ("caught", *key) in seen:
-            continue
-        seen.add(("caught", *key))
-        close = _closest(use.name, (n for k, n in names_thrown if k == use.kind))
-        out.append(Diagnostic(
-            use.location or fallback, Severity.WARNING, CODE_NOT_THROWN,
-            f"{use.what} waits for {use.kind} {use.name!r}, which nothing in the spec throws"
-            + (f"; did you mean {close!r}?" if close else ""),
-            ("fix the name" + (f" to {close!r}" if close else "")
-             + " unless a device, a script, a user model or the API sends it")))
+            use.location or fallback, Severity.WARNING, side.code,
+            f"{use.what} {side.verb} {use.kind} {use.name!r}, which nothing in the spec "
+            f"{side.missing}" + (f"; did you mean {close!r}?" if close else ""),
+            side.hint.format(fix=fix)))
     return out

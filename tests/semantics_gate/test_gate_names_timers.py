@@ -80,6 +80,19 @@ def test_sequence_flows_without_an_id_load_and_route(tmp_path):
     assert "high" in done and "low" not in done
 
 
+def _validate_and_run(path: Path) -> tuple[object, bool]:
+    """What ``opspec validate`` says (with the engine's checks, as the command runs them) and
+    whether ``opspec.run`` runs the spec."""
+    from opspec.commands.validate import engine_checks
+
+    report = validate_file(path, extra=engine_checks)
+    try:
+        opspec.run(path, days=1)
+    except OpspecError:
+        return report, False
+    return report, True
+
+
 TIMERS = ["PT5M", "R3/PT10M", "2026-01-01T08:00:00", "every day", "0 0/5 * * * ?", "",
           "R3/2026-13-45T00:00:00/PT1S", "delay", "delay * 2"]
 
@@ -97,14 +110,7 @@ def test_validate_and_run_agree_about_every_timer(tmp_path, kind, text):
                  f'<intermediateCatchEvent id="w"><timerEventDefinition><{kind}>{text}'
                  f'</{kind}></timerEventDefinition></intermediateCatchEvent>\n'
                  '<sequenceFlow id="f1" sourceRef="s" targetRef="w"/>\n')
-    from opspec.commands.validate import engine_checks
-
-    report = validate_file(path, extra=engine_checks)
-    try:
-        opspec.run(path, days=1)
-        ran = True
-    except OpspecError:
-        ran = False
+    report, ran = _validate_and_run(path)
     assert report.ok == ran, report.lines()
     if not report.ok:
         assert any(d.location.line == 5 for d in report.diagnostics
@@ -126,12 +132,5 @@ def test_validate_and_run_agree_about_every_xpdl_timer(tmp_path, kind, text):
         f'{text}</{kind}></TriggerTimer></IntermediateEvent></Event></Activity>\n'
         '</Activities></WorkflowProcess>\n</WorkflowProcesses>\n</Package>\n',
         encoding="utf-8")
-    from opspec.commands.validate import engine_checks
-
-    report = validate_file(path, extra=engine_checks)
-    try:
-        opspec.run(path, days=1)
-        ran = True
-    except OpspecError:
-        ran = False
+    report, ran = _validate_and_run(path)
     assert report.ok == ran, report.lines()
