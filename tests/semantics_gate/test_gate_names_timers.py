@@ -9,7 +9,7 @@ import pytest
 
 import opspec
 from opspec.errors import OpspecError, Severity
-from opspec.xpdl.validate import validate_file
+from opspec.xpdl.validate import FileReport, validate_file
 
 BPMN = "http://www.omg.org/spec/BPMN/20100524/MODEL"
 
@@ -80,7 +80,7 @@ def test_sequence_flows_without_an_id_load_and_route(tmp_path):
     assert "high" in done and "low" not in done
 
 
-def _validate_and_run(path: Path) -> tuple[object, bool]:
+def _validate_and_run(path: Path) -> tuple[FileReport, bool]:
     """What ``opspec validate`` says (with the engine's checks, as the command runs them) and
     whether ``opspec.run`` runs the spec."""
     from opspec.commands.validate import engine_checks
