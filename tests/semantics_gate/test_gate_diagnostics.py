@@ -299,3 +299,16 @@ def test_xpdl_inclusive_join_and_attached_cycle_and_mi_deadline_are_reported():
         (4, "runs-differently"), (5, "runs-differently"), (6, "runs-differently")]
     assert "Table 13.3" in found[0][2] and "fires once" in found[1][2]
     assert "for each instance" in found[2][2]
+
+
+def test_warnings_reach_the_walkthrough(tmp_path):
+    """The walkthrough loads through the same gate and shows the warnings as notes on its
+    screen (load_any_spec hands them over)."""
+    from opspec.commands._spec import load_any_spec
+
+    spec = tmp_path / "q.bpmn"
+    spec.write_bytes(_bpmn('<startEvent id="s"/>\n<task id="a" startQuantity="2"/>\n'
+                           '<sequenceFlow id="f" sourceRef="s" targetRef="a"/>\n'))
+    shown: list[str] = []
+    load_any_spec(spec, warnings=shown)
+    assert any(f"{spec}:4: warning: bpmn:task 'a' startQuantity='2'" in s for s in shown)
