@@ -134,3 +134,22 @@ def test_validate_and_run_agree_about_every_xpdl_timer(tmp_path, kind, text):
         encoding="utf-8")
     report, ran = _validate_and_run(path)
     assert report.ok == ran, report.lines()
+
+
+@pytest.mark.parametrize("timer", ["<timeDate/>", "<timeDuration>  </timeDuration>", ""])
+def test_a_timer_without_a_time_is_said_to_fire_at_once(tmp_path, timer):
+    """A timer with no time (bpmn.io draws them so) runs, and fires at once: validate says so
+    at its line instead of "never fires", and run does exactly that."""
+    path = _bpmn(tmp_path, '<startEvent id="s"/>\n'
+                 f'<intermediateCatchEvent id="w"><timerEventDefinition>{timer}'
+                 '</timerEventDefinition></intermediateCatchEvent>\n<task id="a"/>\n'
+                 '<sequenceFlow id="f1" sourceRef="s" targetRef="w"/>\n'
+                 '<sequenceFlow id="f2" sourceRef="w" targetRef="a"/>\n')
+    report, ran = _validate_and_run(path)
+    [said] = [d for d in report.diagnostics if d.code == "bad-timer"]
+    assert said.severity is Severity.WARNING and "fires" in said.message and "at once" in \
+        said.message and said.location.line == 4
+    assert ran
+    done = {e.activity: e.time for e in opspec.run(path, days=1).trace
+            if e.kind == "activity.completed"}
+    assert done["a"] == 0

@@ -134,9 +134,10 @@ def _timer(element: etree._Element, ctx: BuildContext) -> dict[str, Any]:
                       "expression over data fields, a date (2026-01-01T08:00:00) or a cycle "
                       "(R3/PT10M)")
     else:
-        ctx.error(timer, "bad-timer", "the timer has no TimeDate or TimeCycle, so it cannot "
-                  "run",
-                  "give it a TimeCycle (PT5M, R3/PT10M) or a TimeDate (2026-01-01T08:00:00)")
+        # vendor exports draw timers they never configure: they run, and fire at once
+        ctx.warning(timer, "bad-timer", "the timer has no TimeDate or TimeCycle: opspec fires "
+                    "it at once", "give it a TimeCycle (PT5M, R3/PT10M) or a TimeDate "
+                    "(2026-01-01T08:00:00)")
     return {"time_date": date, "time_cycle": cycle, "duration": duration}
 
 
