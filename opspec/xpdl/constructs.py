@@ -30,7 +30,9 @@ __all__ = [
     "BPMNDI_NAMESPACES",
     "CONSTRUCTS",
     "INERT",
+    "NOT_RUN",
     "REPORTED",
+    "RUNS_DIFFERENTLY",
     "XPDL",
     "Construct",
     "Inert",
@@ -49,6 +51,11 @@ BPMNDI_NAMESPACES = (
     "http://www.omg.org/spec/DD/20100524/DC",
     "http://www.omg.org/spec/DD/20100524/DI",
 )
+
+
+#: The codes of the gate's diagnostics: a construct run differently (warning), refused (error).
+RUNS_DIFFERENTLY = "runs-differently"
+NOT_RUN = "not-run"
 
 
 class Kind(enum.Enum):
@@ -79,7 +86,7 @@ class Construct:
     @property
     def code(self) -> str:
         """The diagnostic code validate reports it under."""
-        return "not-run" if self.kind is Kind.REFUSES else "runs-differently"
+        return NOT_RUN if self.kind is Kind.REFUSES else RUNS_DIFFERENTLY
 
 
 @dataclass(frozen=True, slots=True)

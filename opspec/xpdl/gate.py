@@ -17,11 +17,20 @@ from dataclasses import dataclass
 from lxml import etree
 
 from opspec.errors import Diagnostic, Severity, SourceLocation
-from opspec.xpdl.constructs import BPMN, REPORTED, XPDL, Construct, Kind
+from opspec.xpdl.constructs import (
+    BPMN,
+    NOT_RUN,
+    REPORTED,
+    RUNS_DIFFERENTLY,
+    XPDL,
+    Construct,
+    Kind,
+)
 from opspec.xpdl.namespaces import is_xpdl_namespace
 from opspec.xpdl.reader import line_of
 
-__all__ = ["CONDITIONS", "Finding", "gate_diagnostics", "gate_findings"]
+__all__ = ["CONDITIONS", "NOT_RUN", "RUNS_DIFFERENTLY", "Finding", "gate_diagnostics",
+           "gate_findings"]
 
 _BPMN_NAMESPACES = frozenset({BPMN, "http://schema.omg.org/spec/BPMN/2.0"})
 # Contents kept as written and never run: not walked.

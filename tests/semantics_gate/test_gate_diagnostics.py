@@ -312,3 +312,14 @@ def test_warnings_reach_the_walkthrough(tmp_path):
     shown: list[str] = []
     load_any_spec(spec, warnings=shown)
     assert any(f"{spec}:4: warning: bpmn:task 'a' startQuantity='2'" in s for s in shown)
+
+
+def test_check_says_where_it_runs_differently(tmp_path, capsys):
+    """`opspec check` judges soundness of what opspec runs; a construct that runs differently
+    from its standard is said beside the verdict, not passed over."""
+    spec = tmp_path / "q.bpmn"
+    spec.write_bytes(_bpmn('<startEvent id="s"/>\n<task id="a" startQuantity="2"/>\n'
+                           '<sequenceFlow id="f" sourceRef="s" targetRef="a"/>\n'))
+    main(["check", str(spec)])
+    captured = capsys.readouterr()
+    assert f"opspec check: {spec}:4: warning: bpmn:task 'a' startQuantity='2'" in captured.err
