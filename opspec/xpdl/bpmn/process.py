@@ -133,6 +133,7 @@ class _Process:
         self.lane_names: dict[str, str | None] = {}
         self.created: dict[str, DataField] = {}      # fields forms, outputs, parameters add
         self.reads: list[tuple[str, etree._Element, str]] = []
+        self.synthetic: set[str] = set()          # ids given to sequence flows without one
         for lane in self._all(self.lanes):
             self.lane_names[lane.id] = lane.name
 
@@ -283,6 +284,10 @@ class _Process:
                                    "(the flow is left out)")
             if broken:
                 continue
+            if not flow_id:
+                # BPMN lets a sequence flow nothing refers to go without an id; the model
+                # needs one per transition (splits order their flows by id)
+                flow_id = self.flow_id(ends["sourceRef"], ends["targetRef"])
             condition = self.condition(flow, flow_id in defaults)
             out.append(Transition(id=flow_id, name=flow.get("name"), source=ends["sourceRef"],
                                   target=ends["targetRef"], condition=condition,
@@ -297,6 +302,17 @@ class _Process:
                                    f"{self.label(node)}: default {flow_id!r} is no sequence flow "
                                    "of this process", "name one of its outgoing sequence flows")
         return out
+
+    def flow_id(self, source: str, target: str) -> str:
+        """An id for a sequence flow written without one: ``source->target`` (``#2``… when
+        two such flows join the same nodes), never an id of the file."""
+        base = f"{source}->{target}"
+        candidate, n = base, 1
+        while candidate in self.defs.by_id or candidate in self.synthetic:
+            n += 1
+            candidate = f"{base}#{n}"
+        self.synthetic.add(candidate)
+        return candidate
 
     def where(self, element: etree._Element) -> str:
         parent = element.getparent()
