@@ -356,6 +356,15 @@ class _Process:
             found = definitions_of(event, self.defs)
             kind = local(found[0]) if found else None
             passing = Event(position=EventPosition.INTERMEDIATE, trigger=Trigger())
+            if kind == "timerEventDefinition" and not any(
+                    expression_text(first(found[0], k)) for k in _TIMER_KINDS):
+                # no time at all: an intermediate timer fires at once (said), but a boundary
+                # timer that fired at once would cut its activity off before it began
+                self.ctx.error(found[0], "bad-timer",
+                               f"boundary timer {event_id!r} has no timeDuration, timeDate or "
+                               "timeCycle, so when it interrupts its activity is not said",
+                               "give it a time, e.g. <bpmn:timeDuration>PT2H</bpmn:timeDuration>")
+                continue
             if kind == "timerEventDefinition":
                 timer = read_timer(found[0], self.defs)
                 if timer is None or timer.kind == "duration":
@@ -629,6 +638,9 @@ class _Process:
                                "declare a bpmn:dataObject or bpmn:property with that id, set it "
                                "in a script task or a form field, or feed the input with a "
                                "bpmn:dataInputAssociation")
+
+
+_TIMER_KINDS = ("timeDuration", "timeDate", "timeCycle")
 
 
 def _literal_kind(expression: Expression | None) -> BasicKind:
