@@ -393,6 +393,7 @@ def gate_findings(root: etree._Element, path: str) -> list[Finding]:
     tags = _TAGS[key]
     doc = _Doc(root)
     out: list[Finding] = []
+    said_at: dict[str, set[etree._Element]] = {}    # entry key -> elements reported
     # lxml finds the few elements the registry reports (any namespace), in document order
     for element in root.iter(*tags):
         tag = str(element.tag)
@@ -412,6 +413,13 @@ def gate_findings(root: etree._Element, path: str) -> list[Finding]:
             if _applies(construct, element, value, doc):
                 if _opaque(element):
                     break
+                if attribute is None:
+                    # InputSets/InputSet/Input: the outermost element of a group says it
+                    mine = said_at.setdefault(construct.key, set())
+                    mine.add(element)
+                    if any(a in mine for a in _ancestors(element)):
+                        said = True
+                        continue
                 said = said or attribute is None
                 out.append(Finding(_diagnostic(path, construct, element, attribute),
                                    construct.reported_by))

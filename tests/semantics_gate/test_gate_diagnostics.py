@@ -323,3 +323,11 @@ def test_check_says_where_it_runs_differently(tmp_path, capsys):
     main(["check", str(spec)])
     captured = capsys.readouterr()
     assert f"opspec check: {spec}:4: warning: bpmn:task 'a' startQuantity='2'" in captured.err
+
+
+def test_a_group_is_reported_once_at_its_outermost_element():
+    """InputSets/InputSet/Input all fall under one entry: the outermost element says it, so a
+    vendor export's input sets give one warning each, not one per nested element."""
+    data = _xpdl('<Activity Id="a"><Implementation><No/></Implementation>\n<InputSets>'
+                 '<InputSet>\n<Input ArtifactId="x"/>\n</InputSet></InputSets></Activity>\n')
+    assert [line for line, _c, _m in _xpdl_gate(data)] == [5]
