@@ -76,7 +76,9 @@ def _check_package(package: Package, packages: Mapping[str, Package]) -> list[Di
     refs.sisarl()
     for process in package.processes:
         _check_process(process, package, refs, report)
-    return report.diagnostics
+    from opspec.model.checks_triggers import trigger_name_diagnostics
+
+    return [*report.diagnostics, *trigger_name_diagnostics(package, packages)]
 
 
 def check_process(

@@ -135,6 +135,7 @@ class _Process:
         self.lane_names: dict[str, str | None] = {}
         self.created: dict[str, DataField] = {}      # fields forms, outputs, parameters add
         self.reads: list[tuple[str, etree._Element, str]] = []
+        self.synthetic: set[str] = set()          # ids given to sequence flows without one
         for lane in self._all(self.lanes):
             self.lane_names[lane.id] = lane.name
 
@@ -285,6 +286,10 @@ class _Process:
                                    "(the flow is left out)")
             if broken:
                 continue
+            if not flow_id:
+                # BPMN lets a sequence flow nothing refers to go without an id; the model
+                # needs one per transition (splits order their flows by id)
+                flow_id = self.flow_id(ends["sourceRef"], ends["targetRef"])
             condition = self.condition(flow, flow_id in defaults)
             out.append(Transition(id=flow_id, name=flow.get("name"), source=ends["sourceRef"],
                                   target=ends["targetRef"], condition=condition,
@@ -299,6 +304,17 @@ class _Process:
                                    f"{self.label(node)}: default {flow_id!r} is no sequence flow "
                                    "of this process", "name one of its outgoing sequence flows")
         return out
+
+    def flow_id(self, source: str, target: str) -> str:
+        """An id for a sequence flow written without one: ``source->target`` (``#2``… when
+        two such flows join the same nodes), never an id of the file."""
+        base = f"{source}->{target}"
+        candidate, n = base, 1
+        while candidate in self.defs.by_id or candidate in self.synthetic:
+            n += 1
+            candidate = f"{base}#{n}"
+        self.synthetic.add(candidate)
+        return candidate
 
     def where(self, element: etree._Element) -> str:
         parent = element.getparent()
@@ -342,6 +358,15 @@ class _Process:
             found = definitions_of(event, self.defs)
             kind = local(found[0]) if found else None
             passing = Event(position=EventPosition.INTERMEDIATE, trigger=Trigger())
+            if kind == "timerEventDefinition" and not any(
+                    expression_text(first(found[0], k)) for k in _TIMER_KINDS):
+                # no time at all: an intermediate timer fires at once (said), but a boundary
+                # timer that fired at once would cut its activity off before it began
+                self.ctx.error(found[0], "bad-timer",
+                               f"boundary timer {event_id!r} has no timeDuration, timeDate or "
+                               "timeCycle, so when it interrupts its activity is not said",
+                               "give it a time, e.g. <bpmn:timeDuration>PT2H</bpmn:timeDuration>")
+                continue
             if kind == "timerEventDefinition":
                 timer = read_timer(found[0], self.defs)
                 if timer is None or timer.kind == "duration":
@@ -646,6 +671,9 @@ class _Process:
                                "declare a bpmn:dataObject or bpmn:property with that id, set it "
                                "in a script task or a form field, or feed the input with a "
                                "bpmn:dataInputAssociation")
+
+
+_TIMER_KINDS = ("timeDuration", "timeDate", "timeCycle")
 
 
 def _literal_kind(expression: Expression | None) -> BasicKind:
