@@ -223,8 +223,6 @@ def build_definitions(root: etree._Element, ctx: BuildContext) -> Package:
         if not isinstance(sub.tag, str):
             continue
         space = namespace(sub)
-        if space in _DI_NAMESPACES or (space == BPMN and local(sub) in _ROOT_QUIET):
-            continue
         if space == QBP or (space == BPMN and local(sub) == "relationship"
                             and any(namespace(e) in BPSIM_NAMESPACES for e in sub.iter()
                                     if isinstance(e.tag, str))):
@@ -233,6 +231,8 @@ def build_definitions(root: etree._Element, ctx: BuildContext) -> Package:
                       "probabilities, task durations and arrivals; resources, costs and "
                       "calendars are not read (a warning names each)",
                       "docs/bpmn.md, Simulation parameters")
+            continue
+        if space in _DI_NAMESPACES or (space == BPMN and local(sub) in _ROOT_QUIET):
             continue
         what = f"bpmn:{local(sub)}" if space == BPMN else f"<{local(sub)}> ({space})"
         ctx.warning(sub, "unsupported-element", f"{what} is not run by opspec; it is ignored",
