@@ -13,6 +13,8 @@ from __future__ import annotations
 
 from pathlib import Path
 
+import pytest
+
 import opspec
 from opspec.errors import Severity
 from opspec.xpdl.validate import validate_spec
@@ -125,3 +127,31 @@ def test_files_calling_each_other_are_each_read_once(tmp_path: Path) -> None:
     assert not _errors(path)
     done = _completions(path)
     assert (180.0, "reorder", None) in done and (180.0, "take_order", None) in done
+
+
+def test_each_file_beside_the_diagram_is_searched_once(
+        tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    """A folder of 30 diagrams that call processes no file holds: every other file is parsed
+    once to be searched for both of d00's calls (not once per call)."""
+    from opspec.xpdl.bpmn import imports
+
+    for n in range(30):
+        (tmp_path / f"d{n:02}.bpmn").write_text(
+            _caller(f"missing_{n}").replace('id="take_order"', f'id="p{n}"'), encoding="utf-8")
+    # d00 calls two missing processes: still one parse of each other file
+    (tmp_path / "d00.bpmn").write_text(_caller("missing_a").replace(
+        '<bpmn:sequenceFlow id="f2" sourceRef="call" targetRef="e"/>',
+        '<bpmn:sequenceFlow id="f2" sourceRef="call" targetRef="call2"/>'
+        '<bpmn:callActivity id="call2" calledElement="missing_b"/>'
+        '<bpmn:sequenceFlow id="f3" sourceRef="call2" targetRef="e"/>'), encoding="utf-8")
+    parsed: list[Path] = []
+    real = imports._parse
+
+    def counting(path: Path) -> object:
+        parsed.append(path)
+        return real(path)
+
+    monkeypatch.setattr(imports, "_parse", counting)
+    errors = _errors(tmp_path / "d00.bpmn")
+    assert ("undefined-subflow", 7) in {(code, line) for code, line, _m in errors}
+    assert len(parsed) == len(set(parsed)) == 29

@@ -45,6 +45,10 @@ _SIBLING_LIMIT: Final = 200
 _SUFFIXES: Final = (".bpmn", ".bpmn20.xml", ".xml")
 # the files being read, innermost last: a file is never read again while it is being read
 _READING: ContextVar[tuple[Path, ...]] = ContextVar("opspec_bpmn_reading", default=())
+# the process ids of each file looked into while one diagram is read: every file is parsed at
+# most once to be searched, however many calls and files look for processes
+_SEEN: ContextVar[dict[Path, frozenset[str]] | None] = ContextVar("opspec_bpmn_seen",
+                                                                  default=None)
 
 
 @dataclass(slots=True)
@@ -83,6 +87,7 @@ def processes_elsewhere(root: etree._Element, defs: Defs) -> Imported:
     roots = allowed_roots(here)
     reading = _READING.get()
     token = _READING.set((*reading, _key(here)))
+    seen_token = _SEEN.set({}) if _SEEN.get() is None else None
     try:
         imports = _imports(root, here, roots, defs)
         taken: dict[str, WorkflowProcess] = {}
@@ -100,6 +105,8 @@ def processes_elsewhere(root: etree._Element, defs: Defs) -> Imported:
                     break
     finally:
         _READING.reset(token)
+        if seen_token is not None:
+            _SEEN.reset(seen_token)
     for process in out.processes:
         defs.process_io[process.id] = [(f.id, f.mode) for f in process.formal_parameters]
     return out
@@ -155,12 +162,19 @@ def _siblings(here: Path, roots: tuple[Path, ...], skip: list[Path]) -> Iterator
 def _find(process_id: str, imports: list[Path], here: Path, roots: tuple[Path, ...],
           defs: Defs, call: etree._Element) -> Package | None:
     """The package of the first imported, else sibling, BPMN file holding ``process_id``."""
+    seen = _SEEN.get()
     for candidate in (*imports, *_siblings(here, roots, imports)):
-        if _key(candidate) in _READING.get():
+        key = _key(candidate)
+        if key in _READING.get():
             continue                      # being read: a cycle of files, not followed
+        if seen is not None and key in seen and process_id not in seen[key]:
+            continue
         root = _parse(candidate)
-        if root is None or not any(p.get("id") == process_id
-                                   for p in root.iterchildren(tag("process"))):
+        ids = frozenset(p.get("id") or "" for p in root.iterchildren(tag("process"))) \
+            if root is not None else frozenset()
+        if seen is not None:
+            seen[key] = ids
+        if root is None or process_id not in ids:
             continue
         return _build(candidate, root, defs, call, process_id)
     return None
