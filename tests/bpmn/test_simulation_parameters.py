@@ -462,3 +462,43 @@ def test_arrivals_into_a_process_with_two_start_events_are_said_to_start_both(
     path = _write(tmp_path, text)
     assert any("2 start events" in m for _s, _l, m in
                _codes(path, "unread-simulation-parameter"))
+
+
+def test_result_requests_beside_a_value_do_not_hide_it(tmp_path: Path) -> None:
+    """BPSim lets a parameter hold result requests (statistics asked of the simulator) beside
+    its value, as Trisotech and Cardanit write them: the value is read, the requests are said
+    once, as an info."""
+    path = _write(tmp_path, _bpsim('<bpsim:ScenarioParameters baseTimeUnit="min"/>'
+                                   + _processing("<bpsim:ResultRequest>mean</bpsim:ResultRequest>"
+                                                 '<bpsim:FloatingParameter value="5"/>')))
+    assert _task_duration(path) == DeclaredDistribution(kind="ConstantParameter",
+                                                        parameters=(("value", 300.0),))
+    said = _codes(path, "unread-simulation-parameter")
+    assert [(s, "ResultRequest" in m) for s, _l, m in said] == [(Severity.INFO, True)]
+
+
+@pytest.mark.parametrize(("attributes", "said"), [
+    ('type="EXPONENTIAL" mean="0" arg1="0" arg2="0"', "mean must be > 0"),
+    ('type="HISTOGRAM" mean="600" arg1="0" arg2="0"', "'HISTOGRAM'"),
+    ('type="GAMMA" mean="600" arg1="0" arg2="0"', "arg1 (the variance)"),
+    ('type="NORMAL" mean="six hundred" arg1="60" arg2="0"', "'six hundred' is not a number"),
+])
+def test_qbp_arrivals_opspec_cannot_draw_are_said_and_not_run(
+        tmp_path: Path, attributes: str, said: str) -> None:
+    text = LOAN.read_text(encoding="utf-8").replace(
+        'type="EXPONENTIAL" mean="0" arg1="600" arg2="0"', attributes)
+    path = _write(tmp_path, text)
+    warnings = [(line, m) for s, line, m in _codes(path, "unread-simulation-parameter")
+                if s is Severity.WARNING and said in m]
+    assert [line for line, _m in warnings] == [_line_of(path, "arrivalRateDistribution")]
+    starts, _cycles, triggers = _starts_and_cycles(path, until=86_400.0)
+    assert triggers == ["auto"]             # no arrivals: the process starts once, as drawn
+
+
+def test_an_inter_trigger_time_of_0_is_refused_rather_than_run(tmp_path: Path) -> None:
+    """Arrivals 0 apart would start instances without end at one instant."""
+    path = _write(tmp_path, _bpsim('<bpsim:ScenarioParameters baseTimeUnit="min"/>'
+                                   + _arrivals('<bpsim:FloatingParameter value="0"/>')))
+    assert any("inter-arrival time is 0" in m for _s, _l, m in
+               _codes(path, "unread-simulation-parameter"))
+    assert _starts_and_cycles(path, until=600.0)[2] == ["auto"]

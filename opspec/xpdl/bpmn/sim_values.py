@@ -33,7 +33,7 @@ from opspec.errors import SpecError
 from opspec.model.sisarl import DeclaredDistribution
 from opspec.xpdl.bpmn.common import Defs, local
 
-__all__ = ["BPSIM_TIME_UNITS", "UNREAD", "bpsim_count", "bpsim_distribution",
+__all__ = ["BPSIM_TIME_UNITS", "UNREAD", "bpsim_count", "bpsim_distribution", "bpsim_values",
            "qbp_distribution"]
 
 #: BPSim's ``TimeUnit`` values in seconds (a year of 365 days).
@@ -105,12 +105,18 @@ def _checked(dist: DeclaredDistribution, element: etree._Element, defs: Defs,
     return dist
 
 
+def bpsim_values(parameter: etree._Element) -> list[etree._Element]:
+    """The parameter values of a BPSim parameter: its element children but the
+    ``ResultRequest``s (which ask a simulator for results, and hold no value)."""
+    return [v for v in parameter if isinstance(v.tag, str) and local(v) != "ResultRequest"]
+
+
 def bpsim_distribution(parameter: etree._Element, unit: float, defs: Defs,
                        what: str) -> DeclaredDistribution | None:
     """The value of a BPSim parameter (``bpsim:ProcessingTime``…) in seconds, ``unit`` being
     the seconds of the scenario's base time unit; ``None`` (with a warning) when there is none
     opspec can read."""
-    values = [v for v in parameter if isinstance(v.tag, str)]
+    values = bpsim_values(parameter)
     if not values:
         defs.ctx.warning(parameter, UNREAD, f"{what}: {local(parameter)} holds no value; "
                          "opspec runs without it", "give it a FloatingParameter or a "
@@ -172,7 +178,7 @@ def bpsim_distribution(parameter: etree._Element, unit: float, defs: Defs,
 
 def bpsim_count(parameter: etree._Element, defs: Defs, what: str) -> int | None:
     """A BPSim count (``bpsim:TriggerCount``): a whole number of 0 or more."""
-    values = [v for v in parameter if isinstance(v.tag, str)]
+    values = bpsim_values(parameter)
     if not values or local(values[0]) not in _CONSTANTS:
         defs.ctx.warning(parameter, UNREAD, f"{what}: {local(parameter)} is not a "
                          "NumericParameter; opspec does not read it",

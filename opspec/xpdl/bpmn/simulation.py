@@ -35,6 +35,7 @@ from opspec.xpdl.bpmn.sim_values import (
     UNREAD,
     bpsim_count,
     bpsim_distribution,
+    bpsim_values,
     qbp_distribution,
 )
 from opspec.xpdl.sisarl_values import parse_probability
@@ -122,6 +123,13 @@ class _Bpsim:
                 self.unread.setdefault(name, []).append(sub)
         for kind, elements in self.unread.items():
             more = f" (and {len(elements) - 1} more)" if len(elements) > 1 else ""
+            if kind == "ResultRequest":
+                self.defs.info(elements[0], UNREAD,
+                               f"BPSim ResultRequest{more} asks for statistics opspec does not "
+                               "compute as such: it reports its own metrics",
+                               "declare opspec:Metrics, or use opspec evaluate (docs/"
+                               "evaluation.md)")
+                continue
             self.defs.ctx.warning(
                 elements[0], UNREAD,
                 f"BPSim {kind}{more} is not read by opspec: the run does without it",
@@ -149,7 +157,7 @@ class _Bpsim:
     def times(self, parameter: etree._Element, what: str) -> DeclaredDistribution | None:
         """``parameter``'s value in seconds; the first time read without a base time unit,
         an info says the numbers are taken as milliseconds (BPSim's default)."""
-        values = _children(parameter)
+        values = bpsim_values(parameter)
         if self.no_unit is not None and values and local(values[0]) != "DurationParameter":
             self.defs.info(self.no_unit, "bpsim-time-unit",
                            "the BPSim scenario gives no baseTimeUnit: its times are read in "
@@ -177,9 +185,15 @@ class _Bpsim:
         timer = count = None
         for group in _children(parameters):
             kind = local(group)
+            requests = [r for r in group.iter() if isinstance(r.tag, str)
+                        and local(r) == "ResultRequest"]
+            if requests:     # asks a simulator for statistics: opspec has its own metrics
+                self.unread.setdefault("ResultRequest", []).extend(requests)
             if kind == "ControlParameters":
                 for parameter in _children(group):
                     name = local(parameter)
+                    if not bpsim_values(parameter):
+                        continue                     # result requests only
                     if name == "Probability":
                         self.probability(parameter, ref)
                     elif name == "InterTriggerTimer":
@@ -191,6 +205,8 @@ class _Bpsim:
                             parameter)
             elif kind == "TimeParameters":
                 for parameter in _children(group):
+                    if not bpsim_values(parameter):
+                        continue                     # result requests only
                     if local(parameter) == "ProcessingTime":
                         self.processing_time(parameter, ref, target)
                     else:
@@ -202,7 +218,7 @@ class _Bpsim:
             self.arrival(parameters, ref, target, timer, count)
 
     def probability(self, parameter: etree._Element, ref: str) -> None:
-        for value_element in _children(parameter):
+        for value_element in bpsim_values(parameter):
             if value_element.get("value"):
                 _put(self.out, self.defs, value_element, ref, value_element.get("value") or "",
                      "BPSim")
