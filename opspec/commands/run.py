@@ -19,7 +19,6 @@ from __future__ import annotations
 import argparse
 import contextlib
 import json
-import math
 import sys
 from collections.abc import Iterator
 from pathlib import Path
@@ -33,8 +32,6 @@ if TYPE_CHECKING:
     from opspec.engine.trace import TraceEvent
 
 __all__ = ["json_metrics", "register", "run", "timeline_line"]
-
-DAY = 86_400.0
 
 # Kinds shown in the default (brief) timeline: what a reader follows; the full trace has all.
 BRIEF_KINDS = frozenset({
@@ -100,20 +97,21 @@ def register(subparsers: Any) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    from opspec.commands._spec import choose_user, load_any_spec
     from opspec.engine.trace_sinks import JsonlSink
-    from opspec.runs import build, load, run_length
+    from opspec.request import RunRequest, prepare
+    from opspec.run_rules import check_days, parse_until
 
-    package = load_any_spec(args.spec, command="run")
-    spec = load(package)
-    compiled = spec.compiled
+    if args.days is not None:
+        check_days(args.days, name="--days")
+    prepared = prepare(RunRequest(
+        args.spec, seed=args.seed, days=args.days,
+        until=None if args.until is None else parse_until(args.until, name="--until"),
+        script=args.script, user_model=args.user_model, no_user=args.no_user))
+    for warning in prepared.warnings:
+        print(f"opspec run: {warning}", file=sys.stderr)
+    package, compiled = prepared.package, prepared.compiled
+    horizon, user = prepared.horizon, prepared.user
     config = _config(args)
-    if args.days is not None and not (args.days > 0 and math.isfinite(args.days)):
-        raise ConfigurationError(f"--days must be a positive number, not {args.days:g}")
-    horizon = run_length(compiled, days=args.days,
-                         until=None if args.until is None else _parse_until(args.until))
-    user = choose_user(compiled, args.spec, script=args.script, user_model=args.user_model,
-                       companion=not args.no_user)
     out = sys.stdout
     printer = None if args.json or args.timeline == "none" else _Timeline(
         out, brief=args.timeline == "brief", quiet=quiet_activities(compiled))
@@ -154,8 +152,8 @@ def run(args: argparse.Namespace) -> int:
             listeners.append(printer)
             if not args.json:
                 print(file=out)
-        outcome = build(spec, seed=args.seed, user=user, until=horizon, config=config,
-                        listeners=listeners, devices=devices).execute()
+        outcome = prepared.but(config=config, listeners=tuple(listeners),
+                               devices=devices).build().execute()
         result = outcome.result
         absent = _waiting_for_absent_user(result.summary, compiled, user)
         monitors = {r.monitor: r for r in outcome.monitors}
@@ -279,19 +277,6 @@ def _config(args: argparse.Namespace) -> Any:
         overrides["realtime"] = True
         overrides["speed"] = args.speed if args.speed is not None else 1.0
     return config.with_options(**overrides) if overrides else config
-
-
-def _parse_until(text: str) -> float:
-    from opspec.clock import parse_duration
-
-    # the one duration grammar (opspec.clock), refused with the same message as everywhere
-    try:
-        value = parse_duration(text, error=ConfigurationError)
-    except ConfigurationError as error:
-        raise ConfigurationError(f"--until: {error.message}", hint=error.hint) from None
-    if not (value > 0 and math.isfinite(value)):
-        raise ConfigurationError(f"--until must be a positive time, not {text!r}")
-    return value
 
 
 def _devices(args: argparse.Namespace, stack: contextlib.ExitStack, compiled: Any) -> Any:
