@@ -236,8 +236,8 @@ def _user(request: RunRequest, loaded: LoadedSpec, path: Path | None
         ("script", request.script), ("user_model", request.user_model),
         ("user", request.user), ("no_user", request.no_user or None)) if value is not None]
     if len(given) > 1:
-        raise ConfigurationError(f"give one of script, user_model, user and no_user, not "
-                                 f"{' and '.join(given)}",
+        raise ConfigurationError(f"give {given[0]} or {given[1]}, not both" if len(given) == 2
+                                 else f"give one of {', '.join(given)}, not all of them",
                                  hint="a script plays exact actions; a model draws them")
     if request.user is not None:
         return request.user, (), None
