@@ -24,7 +24,6 @@ Every mistake is reported when the file is collected, as ``path: key: what (how 
 
 from __future__ import annotations
 
-import tomllib
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -163,15 +162,10 @@ def load_scenarios(path: str | Path, *, rootdir: Path | None = None) -> Scenario
     path = Path(path)
     if rootdir is not None and path.is_absolute() and path.is_relative_to(rootdir):
         path = path.relative_to(rootdir)     # messages name the file as the user wrote it
-    from opspec.files import read_text, reason
+    from opspec.toml_files import read_toml
 
-    try:
-        full = path if path.is_absolute() or rootdir is None else rootdir / path
-        document = tomllib.loads(read_text(full))   # a pipe or device never blocks
-    except OSError as error:
-        raise _error(path, None, f"cannot read it: {reason(error)}") from None
-    except (tomllib.TOMLDecodeError, UnicodeDecodeError) as error:
-        raise _error(path, None, f"not valid TOML: {error}") from None
+    full = path if path.is_absolute() or rootdir is None else rootdir / path
+    document = read_toml(full, what="the scenario file", location=SourceLocation(str(path)))
     _unknown(path, "", document, _TOP)
     ref = document.get("spec")
     if not isinstance(ref, str):

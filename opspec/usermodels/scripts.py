@@ -46,7 +46,6 @@ from __future__ import annotations
 
 import json
 import re
-import tomllib
 from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass, replace
 from pathlib import Path
@@ -309,6 +308,7 @@ def script_format(raw: bytes, name: str = "") -> str:
 def load_script(path: str | Path) -> Script:
     """Read a script file: TOML, or JSON (told from the content, see :func:`script_format`)."""
     from opspec.files import read_bytes, reason
+    from opspec.toml_files import parse_toml
 
     where = str(path)
     try:
@@ -317,13 +317,14 @@ def load_script(path: str | Path) -> Script:
         raise ConfigurationError(f"cannot read the script: {reason(error)}",
                                  location=SourceLocation(where)) from None
     kind = script_format(raw, where)
+    hint = ('a script file is TOML (steps = [...]) or a JSON object ({"steps": [...]}, as '
+            "walkthroughs record)")
     try:
-        document = json.loads(raw) if kind == "JSON" else tomllib.loads(raw.decode("utf-8"))
-    except (ValueError, tomllib.TOMLDecodeError) as error:
+        document = (json.loads(raw) if kind == "JSON" else
+                    parse_toml(raw.decode("utf-8"), where=where, what="the script", hint=hint))
+    except ValueError as error:        # JSON, or bytes that are not UTF-8
         raise ConfigurationError(f"the script is not valid {kind}: {error}",
-                                 location=SourceLocation(where),
-                                 hint="a script file is TOML (steps = [...]) or a JSON object "
-                                 '({"steps": [...]}, as walkthroughs record)') from None
+                                 location=SourceLocation(where), hint=hint) from None
     if not isinstance(document, dict):
         raise ConfigurationError("a script file is a table with 'steps'",
                                  location=SourceLocation(where))
