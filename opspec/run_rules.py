@@ -23,13 +23,9 @@ MAX_SEED = 2**63 - 1
 
 
 def check_seed(seed: Any) -> int:
-    """``seed`` as a plain int: a whole number from 0 to 2**63 - 1 (numpy integers and, from
-    the command line, decimal text too), else a :class:`ConfigurationError`."""
-    if isinstance(seed, str):
-        try:
-            seed = int(seed.strip())
-        except ValueError:
-            raise ConfigurationError(f"{seed!r} is not a whole number") from None
+    """``seed`` as a plain int: a whole number from 0 to 2**63 - 1 (numpy integers too; not
+    text, which the command line turns into a number first), else a
+    :class:`ConfigurationError`."""
     if isinstance(seed, bool):
         raise ConfigurationError(f"a seed is a whole number, not {seed!r}")
     try:

@@ -12,7 +12,11 @@ def seed(text: str) -> int:
     from opspec.run_rules import check_seed
 
     try:
-        return check_seed(text)
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{text!r} is not a whole number") from None
+    try:
+        return check_seed(value)
     except ConfigurationError as error:
         raise argparse.ArgumentTypeError(error.message) from None
 
