@@ -52,7 +52,7 @@ from opspec.model import Package
 from opspec.run_rules import DAY, MAX_SEED, check_seed, run_length
 
 if TYPE_CHECKING:
-    from opspec.engine.monitors import Monitor, MonitorResult, MonitorRun
+    from opspec.properties.monitors import Monitor, MonitorResult, MonitorRun
     from opspec.engine.performers import Performer
     from opspec.engine.trace import TraceEvent, TraceListener
 
@@ -96,7 +96,7 @@ def load(spec: str | Path | Package | CompiledPackage | LoadedSpec) -> LoadedSpe
     the monitors it declares are read here (a located ConfigurationError when one is bad)."""
     if isinstance(spec, LoadedSpec):
         return spec
-    from opspec.engine.monitors import declared_monitors
+    from opspec.properties.monitors import declared_monitors
     from opspec.xpdl.open_spec import mode_loader_for, open_spec
 
     if isinstance(spec, (str, Path)):

@@ -16,7 +16,7 @@ Each line is one of (keywords in any case; ``OP`` is ``==``, ``!=``, ``<``, ``<=
     mean alarms_per_dose in [1.1, 1.25] with 95% confidence
     p95 report_latency_s <= 600 with 95% confidence
 
-The trace lines are the property language of monitors (:mod:`opspec.engine.properties`):
+The trace lines are the property language of monitors (:mod:`opspec.properties.language`):
 any monitor's text is a ``then`` line too (``min_gap dispense 4h``, ``bounded_response
 sound_alarm dispense 15min``, ``never_while ...``), judged on each replication's trace by the
 evaluator a monitor runs online (same verdict, same witness), and holding when it holds in
@@ -37,7 +37,7 @@ import re
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 
-from opspec.engine.properties import (
+from opspec.properties.language import (
     BoundedResponse,
     CountBound,
     Eventually,

@@ -15,7 +15,7 @@ from pathlib import Path
 import pytest
 
 from opspec import clock
-from opspec.engine.monitors import MinGap, parse_monitor
+from opspec.properties.monitors import MinGap, parse_monitor
 from opspec.errors import OpspecError
 from opspec.testing.expectations import parse_expectation
 from opspec.testing.scenario import _until

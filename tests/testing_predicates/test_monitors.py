@@ -8,7 +8,7 @@ import pytest
 import scipy.stats
 
 from opspec.engine.compiled import CompiledPackage
-from opspec.engine.monitors import (
+from opspec.properties.monitors import (
     BoundedResponse,
     MinGap,
     package_monitors,
