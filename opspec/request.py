@@ -43,6 +43,9 @@ __all__ = ["PreparedRun", "RunRequest", "companion_user_model", "gate", "open_ga
            "prepare", "run", "scripted_user"]
 
 _EMPTY: Mapping[str, Any] = MappingProxyType({})
+#: the parts of a request that prepare() decides from (the rest goes to runs.build as it is)
+_DECIDED = frozenset({"spec", "seed", "days", "until", "script", "user_model", "user",
+                      "no_user"})
 
 
 @dataclass(frozen=True, eq=False)
@@ -113,6 +116,10 @@ class PreparedRun:
     def but(self, **changes: Any) -> PreparedRun:
         """The same decided run with the request's ``changes`` that decide nothing (a door's
         listeners, its devices, the engine configuration a bound device's clock sets)."""
+        decided = sorted(set(changes) & _DECIDED)
+        if decided:
+            raise ConfigurationError(f"prepare() decided {', '.join(decided)} already",
+                                     hint="fill a new RunRequest and prepare it")
         return replace(self, request=self.request.but(**changes))
 
     @property

@@ -360,3 +360,28 @@ def test_a_script_naming_an_activity_the_spec_lacks_is_refused_by_every_door(
     assert "press_reprot" in first and "press_report" in first      # what it has instead
     for door, text in messages.items():
         assert "'press_reprot'" in text and "press_report" in text, f"{door}: {text}"
+
+
+def test_a_request_cannot_change_once_a_door_has_filled_it() -> None:
+    """A request is immutable all the way down (its performers, listeners and params too),
+    and a prepared run takes a door's listeners but not a new seed, spec or user."""
+    import dataclasses
+
+    from opspec.errors import ConfigurationError
+    from opspec.request import RunRequest, prepare
+
+    performers: dict[str, Any] = {}
+    request = RunRequest(DISPENSER, seed=3, performers=performers, listeners=[print])
+    performers["alarm"] = object()                 # the door's dict changes afterwards...
+    assert "alarm" not in request.performers       # ...the request does not
+    with pytest.raises(dataclasses.FrozenInstanceError):
+        request.seed = 4                           # type: ignore[misc]
+    with pytest.raises(TypeError):
+        request.performers["alarm"] = object()     # type: ignore[index]
+    prepared = prepare(request)
+    assert prepared.seed == 3 and prepared.horizon == 86_400.0
+    assert prepared.user.kind == "model"           # the companion SPEC.users.toml
+    assert prepared.but(listeners=()).request.listeners == ()
+    for decided in ({"seed": 4}, {"spec": DISPENSER}, {"no_user": True}):
+        with pytest.raises(ConfigurationError, match="decided"):
+            prepared.but(**decided)
