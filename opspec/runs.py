@@ -52,9 +52,10 @@ from opspec.model import Package
 from opspec.run_rules import DAY, MAX_SEED, check_seed, run_length
 
 if TYPE_CHECKING:
-    from opspec.properties.monitors import Monitor, MonitorResult, MonitorRun
     from opspec.engine.performers import Performer
     from opspec.engine.trace import TraceEvent, TraceListener
+    from opspec.properties.language import MonitorResult, MonitorRun
+    from opspec.properties.monitors import Monitor
 
 __all__ = [
     "DAY",

@@ -5,7 +5,7 @@ from __future__ import annotations
 from collections.abc import Mapping, Sequence
 from typing import IO, Any
 
-from opspec.properties.monitors import clock
+from opspec.properties.language import clock
 from opspec.evaluation.plan import span
 
 __all__ = ["comparison_rows", "distribution_rows", "fmt", "is_rate", "metric_rows",

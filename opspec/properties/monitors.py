@@ -32,48 +32,10 @@ from collections.abc import Iterable
 from typing import Any
 
 from opspec.errors import ConfigurationError, SourceLocation
-from opspec.properties.language import (
-    BoundedResponse,
-    CountBound,
-    Eventually,
-    MaxCount,
-    MinGap,
-    MonitorResult,
-    MonitorRun,
-    Names,
-    Never,
-    NeverWhile,
-    Precedence,
-    Property,
-    Subject,
-    Violation,
-    clock,
-    parse_property,
-    parse_subject,
-)
+from opspec.properties.language import Property, parse_property
 
-__all__ = [
-    "MONITOR_ATTRIBUTE",
-    "BoundedResponse",
-    "CountBound",
-    "Eventually",
-    "MaxCount",
-    "MinGap",
-    "Monitor",
-    "MonitorResult",
-    "MonitorRun",
-    "Names",
-    "Never",
-    "NeverWhile",
-    "Precedence",
-    "Subject",
-    "Violation",
-    "clock",
-    "declared_monitors",
-    "package_monitors",
-    "parse_monitor",
-    "parse_subject",
-]
+__all__ = ["MONITOR_ATTRIBUTE", "Monitor", "declared_monitors", "package_monitors",
+           "parse_monitor"]
 
 #: the package ExtendedAttribute holding monitors in their text form
 MONITOR_ATTRIBUTE = "opspec:Monitor"

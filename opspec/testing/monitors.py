@@ -27,21 +27,19 @@ from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
 from typing import Any
 
-from opspec.properties.monitors import (
+from opspec.properties.language import (
     BoundedResponse,
     MaxCount,
     MinGap,
-    Monitor,
     MonitorResult,
     Names,
     Never,
     NeverWhile,
     Violation,
     clock,
-    declared_monitors,
-    parse_monitor,
     parse_subject,
 )
+from opspec.properties.monitors import Monitor, declared_monitors, parse_monitor
 from opspec.errors import ConfigurationError
 from opspec.statistics import poisson_interval
 from opspec.testing.intervals import _pct

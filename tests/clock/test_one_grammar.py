@@ -15,7 +15,8 @@ from pathlib import Path
 import pytest
 
 from opspec import clock
-from opspec.properties.monitors import MinGap, parse_monitor
+from opspec.properties.language import MinGap
+from opspec.properties.monitors import parse_monitor
 from opspec.errors import OpspecError
 from opspec.testing.expectations import parse_expectation
 from opspec.testing.scenario import _until

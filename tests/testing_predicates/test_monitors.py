@@ -8,12 +8,8 @@ import pytest
 import scipy.stats
 
 from opspec.engine.compiled import CompiledPackage
-from opspec.properties.monitors import (
-    BoundedResponse,
-    MinGap,
-    package_monitors,
-    parse_monitor,
-)
+from opspec.properties.language import BoundedResponse, MinGap
+from opspec.properties.monitors import package_monitors, parse_monitor
 from opspec.engine.trace import TraceEvent
 from opspec.errors import ConfigurationError
 from opspec.statistics import poisson_interval
