@@ -42,8 +42,8 @@ def engine_diagnostics(package: Package, *, world: bool = False) -> list[Diagnos
     can be built (``bad-world``: an unknown world, a missing opspec:WorldFile, an unknown parameter, a
     value of the wrong type, a start inside an obstacle)."""
     from opspec.engine.compiled import compile_package
-    from opspec.properties.monitors import declared_monitors
     from opspec.errors import Diagnostic, OpspecError, Severity, SourceLocation
+    from opspec.properties.monitors import declared_monitors
 
     spec_file = SourceLocation(str(getattr(package, "source", None) or "<spec>"))
     try:

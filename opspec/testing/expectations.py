@@ -37,6 +37,8 @@ import re
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 
+from opspec.engine.trace import TraceEvent
+from opspec.errors import ConfigurationError, SourceLocation
 from opspec.properties.language import (
     BoundedResponse,
     CountBound,
@@ -52,8 +54,6 @@ from opspec.properties.language import (
     read_property,
     trace_end,
 )
-from opspec.engine.trace import TraceEvent
-from opspec.errors import ConfigurationError, SourceLocation
 from opspec.testing.simulation import FIELDS, SimulationResult, SpecNames
 
 __all__ = ["Expectation", "expect", "format_events", "parse_expectation"]

@@ -27,6 +27,7 @@ from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
 from typing import Any
 
+from opspec.errors import ConfigurationError
 from opspec.properties.language import (
     BoundedResponse,
     MaxCount,
@@ -40,7 +41,6 @@ from opspec.properties.language import (
     parse_subject,
 )
 from opspec.properties.monitors import Monitor, declared_monitors, parse_monitor
-from opspec.errors import ConfigurationError
 from opspec.statistics import poisson_interval
 from opspec.testing.intervals import _pct
 

@@ -40,6 +40,8 @@ from collections.abc import Callable, Iterable, Sequence
 from dataclasses import dataclass
 from typing import Any
 
+from opspec.engine.trace import EventKind, TraceEvent
+from opspec.errors import ConfigurationError
 from opspec.properties.language import (
     BoundedResponse,
     CountBound,
@@ -54,8 +56,6 @@ from opspec.properties.language import (
     parse_subject,
     trace_end,
 )
-from opspec.engine.trace import EventKind, TraceEvent
-from opspec.errors import ConfigurationError
 
 __all__ = [
     "Count",

@@ -18,13 +18,13 @@ from opspec.bindings import load_profile
 from opspec.bindings.attach import AttachedDevices, attach_devices
 from opspec.bindings.emulator import Behaviour, EmulatedDevice, PtyEmulator, Reply, SocketEmulator
 from opspec.commands._spec import load_any_spec
-from opspec.engine.lanes import user_lane
-from opspec.request import scripted_user
 from opspec.engine.compiled import compile_package
 from opspec.engine.config import EngineConfig
+from opspec.engine.lanes import user_lane
 from opspec.engine.simulation import RunResult, Simulation
 from opspec.engine.trace import TraceEvent
 from opspec.errors import BindingError
+from opspec.request import scripted_user
 
 from .conftest import DATA, DEVICES, needs_pty
 

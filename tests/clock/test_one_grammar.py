@@ -10,14 +10,13 @@ from __future__ import annotations
 
 import re
 from collections.abc import Callable
-from pathlib import Path
 
 import pytest
 
 from opspec import clock
+from opspec.errors import OpspecError
 from opspec.properties.language import MinGap
 from opspec.properties.monitors import parse_monitor
-from opspec.errors import OpspecError
 from opspec.testing.expectations import parse_expectation
 from opspec.testing.scenario import _until
 from opspec.testing.script import parse_script
