@@ -201,13 +201,13 @@ def open_gated(path: str | Path) -> tuple[Package, tuple[Any, ...]]:
     from opspec.errors import Severity, SpecError
     from opspec.xpdl.validate import validate_spec
 
-    package, report = validate_spec(target)     # monitors and the world: checked as built
+    valid, report = validate_spec(target)       # monitors and the world: checked as built
     refuse_unreadable(report.diagnostics)       # an unreadable file: exit status 2, not 1
     errors = [d for d in report.diagnostics if d.severity is Severity.ERROR]
-    if errors or package is None:
+    if errors or valid is None:
         raise SpecError.from_diagnostics(errors or report.diagnostics)
-    _passed(package)
-    return package, tuple(d for d in report.diagnostics if d.severity is Severity.WARNING)
+    _passed(valid)
+    return valid, tuple(d for d in report.diagnostics if d.severity is Severity.WARNING)
 
 
 def _spec(spec: Any) -> tuple[LoadedSpec, tuple[Any, ...], Path | None]:
@@ -217,7 +217,7 @@ def _spec(spec: Any) -> tuple[LoadedSpec, tuple[Any, ...], Path | None]:
     if isinstance(spec, LoadedSpec):
         return spec, (), _source(spec.package)
     if isinstance(spec, (str, os.PathLike)):
-        package, warnings = open_gated(spec)
+        package, warnings = open_gated(Path(spec))
         return load(package), warnings, Path(spec)
     gate(spec.package if isinstance(spec, CompiledPackage) else spec)
     return load(spec), (), _source(spec.package if isinstance(spec, CompiledPackage)
@@ -275,7 +275,7 @@ def scripted_user(script: Any, compiled: Any) -> User:
     from opspec.usermodels.scripts import Script, load_script, parse_script
 
     if isinstance(script, (str, os.PathLike)):
-        plan, describe = load_script(script), f"the script {script}"
+        plan, describe = load_script(Path(script)), f"the script {script}"
     elif isinstance(script, Script):
         plan, describe = script, "a script"
     else:

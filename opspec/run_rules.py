@@ -49,7 +49,7 @@ def check_days(days: Any, *, name: str = "days") -> float:
         shown = f"{days:g}" if isinstance(days, float) else repr(days)
         raise ConfigurationError(f"{name} must be a positive number, not {shown}",
                                  hint=f"e.g. {name} 1 (or leave it out for the spec's "
-                                 "opspec:RunLength)" if name.startswith("--") else None)
+                                 "opspec:RunLength)" if name.startswith("--") else "")
     return float(days)
 
 

@@ -55,7 +55,7 @@ import re
 from collections import deque
 from collections.abc import Callable, Iterable, Sequence
 from dataclasses import dataclass, field, replace
-from typing import ClassVar, Protocol
+from typing import Any, ClassVar, Protocol
 
 from opspec.clock import clock_time, parse_duration, span
 from opspec.engine.trace import EventKind, TraceEvent
@@ -334,7 +334,8 @@ class Property:
         return tuple(getattr(self, name) for name in self._subject_fields)
 
     def _with(self, subjects: Sequence[Selector]) -> Property:
-        return replace(self, **dict(zip(self._subject_fields, subjects, strict=True)))
+        changes: dict[str, Any] = dict(zip(self._subject_fields, subjects, strict=True))
+        return replace(self, **changes)
 
     def describe(self) -> str:
         """The text form (``text`` when given)."""

@@ -50,4 +50,5 @@ def load_recording(path: str | Path, compiled: CompiledPackage | None = None) ->
     from opspec.request import scripted_user
 
     # each step keeps its "#6" (Step.instance): it acts only on an offer of that instance
-    return scripted_user(path, compiled).source.performer()
+    performer: ScriptUser = scripted_user(path, compiled).source.performer()
+    return performer
