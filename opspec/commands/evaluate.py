@@ -49,6 +49,11 @@ def register(subparsers: Any) -> None:
                         "companion SPEC.users.toml)")
     parser.add_argument("--compare", metavar="SPEC2",
                         help="a second design, run on the same simulated users")
+    parser.add_argument("--param", action="append", default=[], metavar="NAME=VALUE",
+                        help="a value for a package data field of type integer, float or "
+                        "boolean, such as a BPMN diagram's run input (a variable its "
+                        "conditions read that nothing sets; repeatable; docs/bpmn.md, Run "
+                        "inputs)")
     parser.add_argument("--sweep", type=sweep, metavar="PARAM=V1,V2,...",
                         help="run one design per value of a spec or user-model parameter, "
                         "on the same simulated users ('--sweep list' lists the parameters; "
@@ -147,7 +152,13 @@ def _new_plan(args: argparse.Namespace) -> Any:
     model = a.user_model
     for _label, path in specs[1:]:
         prepare(RunRequest(path, days=args.days, user_model=model, no_user=model is None))
-    designs = [Design(label, str(path), file_digest(path)) for label, path in specs]
+    # --param: a value of a package data field (a BPMN diagram's run input) for every design,
+    # applied as a parameter of one value (what --sweep applies per design)
+    from opspec.commands._params import parse_params
+
+    fixed = tuple((f"spec.{name}", value)
+                  for name, value in parse_params(args.param, a.package).items())
+    designs = [Design(label, str(path), file_digest(path), fixed) for label, path in specs]
     days = float(args.days) if args.days is not None else a.horizon / DAY
     users = args.users if args.users is not None else DEFAULT_USERS
     run_seed = args.seed if args.seed is not None else DEFAULT_SEED
