@@ -486,6 +486,10 @@ def run(args: argparse.Namespace) -> int:
             doc["compare"] = compare
         if swept is not None:
             doc["sweep"] = summaries["sweep"]
+        from opspec.statistics.methods import describe, methods_in
+
+        # what every "ci95_method" above means: its recipe and references
+        doc["interval_methods"] = describe(methods_in(doc))
         print(json.dumps(_finite(doc), allow_nan=False, default=str))
     else:
         from opspec.evaluation.tables import print_summary

@@ -519,6 +519,28 @@ def _design_sections(store: ResultStore, figures: Path, design: str, name: str, 
     return sections
 
 
+def _methods_section(summaries: Any) -> Any:
+    """How every interval in the report was computed: each method that appears in it, with
+    its recipe and references (the same words as ``--json`` and docs/evaluation.md), so the
+    report stands on its own."""
+    from opspec.evaluation.html import Section, Table
+    from opspec.statistics.methods import METHODS, methods_in
+
+    used = methods_in(summaries)
+    rows = tuple((METHODS[m].name, METHODS[m].definition, "; ".join(METHODS[m].references))
+                 for m in used)
+    return Section("How the intervals were computed", paragraphs=(
+        ("Every interval is a two-sided 95 % confidence interval. The simulated users are the "
+         "independent units: observations within one user are not independent (a slow walker "
+         "is slow at every dose), so each metric is reduced to one pair (y, n) per user and "
+         "the intervals are over users. The 'CI method' column of each table names the "
+         "method below; an interval of something that cannot be negative is cut at zero. "
+         "Medians and p95 of durations are of all pooled observations, by linear "
+         "interpolation; per-user percentiles are of the users' own values."),),
+        tables=(Table(("method", "definition", "references"), rows,
+                      "The interval methods used in this report"),) if rows else ())
+
+
 def write_report(store: ResultStore, summaries: Mapping[str, Summaries] | None = None, *,
                  template: str | Path | None = None) -> Path:
     """Write ``report.html``, ``report.md`` and ``figures/*.png`` into the store's folder.
@@ -651,7 +673,7 @@ def write_report(store: ResultStore, summaries: Mapping[str, Summaries] | None =
         compared = ((plots.comparison_figure(rows, figures / "comparison.png", units),)
                     if rows else ())
         headers: tuple[str, ...] = ("metric", names["A"], names["B"], "difference", "95 % CI",
-                                    "")
+                                    "CI method", "")
         sections.append(Section(f"{names['B']} compared with {names['A']}", paragraphs=(
             (f"Differences {names['B']} − {names['A']} per metric on the same simulated users "
             "(paired); 'differs' marks intervals that exclude zero."),),
@@ -682,13 +704,7 @@ def write_report(store: ResultStore, summaries: Mapping[str, Summaries] | None =
                           tuple((names.get(d, d), str(u), e) for d, u, e in failures[:200])),
                     )))
 
-    sections.append(Section("How to read the intervals", paragraphs=(
-        ("Users are the independent units: observations within one user are not independent "
-        "(a slow walker is slow at every dose). Intervals are 95 % confidence intervals over "
-        "users: for a count the Student-t interval of the per-user mean; for durations and "
-        "ratios the cluster-robust (delta-method) interval of the ratio estimator Σy / Σn. "
-        "Medians and p95 of durations are of all pooled observations. An interval of "
-        "something that cannot be negative is cut at zero. See docs/evaluation.md."),)))
+    sections.append(_methods_section([per_design, summaries]))
 
     title = f"Evaluation of {Path(specs.get(designs[0], 'spec')).name}"
     write_markdown(folder / "report.md", title, sections)

@@ -44,7 +44,7 @@ from opspec.engine.monitors import (
 )
 from opspec.errors import ConfigurationError
 from opspec.statistics import poisson_interval
-from opspec.testing.intervals import _pct
+from opspec.statistics.claims import confidence_text
 
 __all__ = [
     "Monitor",
@@ -180,7 +180,7 @@ class MonitorReport:
     def __str__(self) -> str:
         if not self.rows:
             return "no monitors"
-        head = f"monitors (hazard: violations per user-day, exact {_pct(self.confidence)} interval)"
+        head = f"monitors (hazard: violations per user-day, exact {confidence_text(self.confidence)} interval)"
         return "\n".join([head, *(f"  {row}" for row in self.rows)])
 
     def describe(self, limit: int = 3) -> str:
