@@ -82,7 +82,8 @@ def decide_rate(text: str, successes: int, trials: int, op: str, a: float, b: fl
     side = "two-sided" if op == "in" else "one-sided"
     lines = [f"expected {text}",
              (f"  estimate {estimate:.4g} ({successes}/{trials} {units}, {replications} "
-              f"replication(s)); {confidence_text(level)} {side} Wilson interval [{lo:.4g}, {hi:.4g}]; "
+              f"replication(s)); {confidence_text(level)} {side} Wilson interval "
+              f"[{lo:.4g}, {hi:.4g}]; "
               f"bound {_bound_text(op, a, b)}")]
     if verdict == "refuted":
         lines.append("  the claim is false at this confidence")
@@ -137,7 +138,8 @@ def decide_mean(text: str, values: Sequence[float], op: str, a: float, b: float 
         return None
     side = "two-sided" if op == "in" else "one-sided"
     lines = [f"expected {text}",
-             (f"  estimate {mean:.4g} (sd {sd:.3g}, {n} replications); {confidence_text(level)} {side} t "
+             (f"  estimate {mean:.4g} (sd {sd:.3g}, {n} replications); "
+              f"{confidence_text(level)} {side} t "
               f"interval [{lo:.4g}, {hi:.4g}]; bound {_bound_text(op, a, b)}")]
     if verdict == "refuted":
         lines.append("  the claim is false at this confidence")

@@ -95,7 +95,8 @@ METHODS: Mapping[str, Method] = {m.id: m for m in (
     Method("welch-t", "Welch t",
            "a difference of two designs as if on different users: Welch's t",
            "a difference of two designs as if the designs had run on different users: "
-           "(r_B − r_A) ± t[0.975; ν]·√(v_A + v_B), v the cluster-robust variances, ν Welch's degrees of "
+           "(r_B − r_A) ± t[0.975; ν]·√(v_A + v_B), v the cluster-robust variances, "
+           "ν Welch's degrees of "
            "freedom (v_A + v_B)² / ((v_A² + v_B²)/(U−1)).",
            (_T, "Welch (1947), Biometrika 34:28–35")),
     Method("paired-t-few", "paired t, few",
