@@ -87,6 +87,10 @@ def register(subparsers: Any) -> None:
                         "user's whole run (default), one workflow instance, or one dose (a "
                         "started device workflow and everything it set in motion; "
                         "docs/xes-export.md)")
+    parser.add_argument("--figures", choices=("svg", "pdf", "png"), default="svg",
+                        help="the format of the report's figures in OUT/figures/: svg "
+                        "(vector, the default), pdf (vector, for LaTeX; SVG twins beside them "
+                        "for the HTML report) or png (200 dpi); the HTML report inlines SVG")
     parser.add_argument("--json", action="store_true",
                         help="print one JSON object with the results (docs/evaluation.md)")
     parser.add_argument("--quiet", action="store_true", help="no progress output")
@@ -464,7 +468,8 @@ def run(args: argparse.Namespace) -> int:
                                                  args.target_users)
         try:
             report = write_report(store, summaries,
-                                  template=getattr(args, "report_template", None))
+                                  template=getattr(args, "report_template", None),
+                                  figures=getattr(args, "figures", "svg"))
         except EvaluationError as error:
             raise _with_resume_hint(error, store, plan) from None
         except OSError as error:

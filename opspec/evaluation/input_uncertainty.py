@@ -340,8 +340,10 @@ def report_section(store: Any, given: Mapping[str, Any],
         f"{_title(summary)}: each draw is the model refitted to a bootstrap resample of "
         "the traces, run on users of its own. 'from parameters' is the share of the "
         "widened interval's variance due to the parameters; more simulated users narrow "
-        "only the rest, more recorded observations narrow this part. See "
-        "docs/evaluation.md, Input uncertainty."),),
+        "only the rest, more recorded observations narrow this part. The widened "
+        "interval adds the between-draw variance of the estimates, less their "
+        "within-draw (simulation) variance, to the ordinary variance, on Satterthwaite's "
+        "degrees of freedom, and covers the ordinary interval."),),
         tables=(Table(HEADERS, tuple(_rows(summary)),
                       "Ordinary 95 % intervals (simulation noise only) and intervals that "
                       "include the fitted parameters' uncertainty"),))

@@ -11,6 +11,7 @@ from dataclasses import dataclass
 from opspec.statistics.intervals import poisson_interval, t_quantile
 
 __all__ = ["RARE_DISCORDANT", "RARE_EVENTS", "RatioEstimate", "count_estimate",
+           "count_estimate_from_sums",
            "hazard_estimate", "paired_difference", "paired_variance", "ratio_estimate",
            "ratio_variance", "unpaired_difference"]
 
@@ -204,6 +205,28 @@ def count_estimate(totals: Sequence[float], level: float = 0.95) -> RatioEstimat
         estimate.value, low if estimate.low is None else min(estimate.low, low),
         high if estimate.high is None else max(estimate.high, high), estimate.users,
         "t+garwood")
+
+
+def count_estimate_from_sums(total: float, squares: float, users: int, level: float = 0.95
+                             ) -> RatioEstimate:
+    """:func:`count_estimate` from the users' sum ``Σy`` and sum of squares ``Σy²`` alone (a
+    count per user on one day, summed as the results are stored): the same t interval of
+    the mean, and the same widening to the Garwood interval below :data:`RARE_EVENTS`."""
+    if users < 1:
+        return RatioEstimate(None, None, None, 0, None)
+    mean = total / users
+    low = high = None
+    method: str | None = None
+    if users >= 2:
+        variance = max(0.0, (squares - users * mean * mean) / (users - 1))
+        half = t_quantile(level, users - 1) * math.sqrt(variance / users)
+        low, high, method = max(0.0, mean - half), mean + half, "t"
+    if total < RARE_EVENTS:
+        _rate, p_low, p_high = poisson_interval(int(total), float(users), level)
+        low = p_low if low is None else min(low, p_low)
+        high = p_high if high is None else max(high, p_high)
+        method = "t+garwood" if method else None
+    return RatioEstimate(mean, low, high, users, method)
 
 
 def hazard_estimate(counts: Sequence[int], exposure_each: float, level: float = 0.95
