@@ -45,7 +45,8 @@ COMMAND_MODULES: tuple[str, ...] = (
 def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(
         prog="opspec",
-        description="Execute operational specifications (XPDL / SISARL-XPDL) of assistive "
+        description="Execute operational specifications (XPDL / SISARL-XPDL, or BPMN 2.0) of "
+        "assistive "
         "devices and their users.",
     )
     parser.add_argument("--version", action="version",

@@ -37,7 +37,8 @@ def register(subparsers: Any) -> None:
         "as it finishes, and write OUT/report.html with metrics, confidence intervals and "
         "plots. The same seed gives the same results whatever the number of workers.")
     parser.add_argument("spec", metavar="SPEC", nargs="?",
-                        help="the specification (.xpdl or .wfs); optional with --resume")
+                        help="the specification (.xpdl, .bpmn or a compiled .wfs); optional "
+                        "with --resume")
     parser.add_argument("--users", type=int, default=None,
                         help=f"simulated users (default {DEFAULT_USERS})")
     parser.add_argument("--days", type=float, default=None,

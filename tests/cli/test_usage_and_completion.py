@@ -42,3 +42,21 @@ def test_the_shell_completes_commands_and_their_options(tmp_path):
     assert [c.strip() for c in _complete("opspec eva", tmp_path)] == ["evaluate"]
     options = _complete("opspec evaluate --us", tmp_path)
     assert {"--users", "--user-model", "--users-per-draw"} <= {c.strip() for c in options}
+
+
+@pytest.mark.parametrize("command", [[], ["run"], ["evaluate"], ["validate"]])
+def test_the_help_texts_name_bpmn(command, capsys):
+    """BPMN 2.0 files run, evaluate and validate like XPDL ones (docs/bpmn.md); the help of
+    each command that takes a spec says so."""
+    with pytest.raises(SystemExit):
+        main([*command, "--help"])
+    out = " ".join(capsys.readouterr().out.split())
+    assert "BPMN 2.0" in out or ".bpmn" in out
+
+
+def test_validate_a_folder_finds_bpmn_files(tmp_path, capsys):
+    (tmp_path / "dispenser.bpmn").write_bytes((ROOT / "specs" / "medication_dispenser.bpmn")
+                                              .read_bytes())
+    status = main(["validate", str(tmp_path)])
+    out = capsys.readouterr().out
+    assert "1 file checked" in out and status in (0, 1)
