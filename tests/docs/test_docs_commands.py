@@ -125,10 +125,9 @@ def _normalise(text: str) -> str:
 
 def _matches(shown: str, printed: str) -> bool:
     """``printed`` is ``shown``, where a line ``...`` in ``shown`` stands for any lines."""
-    parts = [re.escape(p) for p in re.split(r"^[ \t]*\.\.\.[ \t]*$", _normalise(shown),
-                                            flags=re.M)]
-    return re.fullmatch(r"(.*\n)?".join(parts) if len(parts) > 1 else parts[0],
-                        _normalise(printed), re.S) is not None
+    pattern = "".join(r"(?:[^\n]*\n)*" if line.strip() == "..." else re.escape(line) + r"\n"
+                      for line in _normalise(shown).splitlines())
+    return re.fullmatch(pattern, _normalise(printed) + "\n") is not None
 
 
 def _environment(folder: Path) -> dict[str, str]:
@@ -181,3 +180,25 @@ def test_the_page_shows_what_the_command_prints(page: Path, example: Example) ->
 
 def test_every_page_with_commands_is_read() -> None:
     assert {p.name for p, _ in EXAMPLES} >= {"README.md", "tutorial.md"}
+
+
+def test_tutorial_files_are_the_pages_blocks() -> None:
+    """The tutorial's step folders hold what its page shows: the first spec and the user
+    model and scripts whole, every later XML fragment line for line in its step's spec (a
+    fragment shows what changes; the folder is the spec with the change made)."""
+    page = (ROOT / "docs" / "tutorial.md").read_text(encoding="utf-8")
+    blocks = re.findall(r"```(\w*)\n(.*?)```", page, re.S)
+    xml = [text for lang, text in blocks if lang == "xml"]
+    toml = [text for lang, text in blocks if lang == "toml"]
+    folder = ROOT / "tests" / "docs" / "tutorial"
+    assert (folder / "step1" / "pill.xpdl").read_text(encoding="utf-8") == xml[0]
+    assert (folder / "step2" / "answer.toml").read_text(encoding="utf-8") == toml[0]
+    assert (folder / "step6" / "pill.users.toml").read_text(encoding="utf-8") == toml[1]
+    assert (folder / "step6" / "test_pill.py").read_text(encoding="utf-8") == next(
+        text for lang, text in blocks if lang == "python")
+    for fragment, step in zip(xml[1:], ["step2", "step2", "step3", "step4", "step5", "step6"],
+                              strict=True):
+        spec = (folder / step / "pill.xpdl").read_text(encoding="utf-8").splitlines()
+        missing = [line for line in fragment.splitlines() if line.strip()
+                   and line not in spec]
+        assert not missing, f"{step}/pill.xpdl lacks {missing[:3]}"

@@ -128,7 +128,7 @@ def test_json_document_has_the_documented_shape(evaluate, tmp_path):
     assert doc["failed"] == []
     report = Path(doc["report"])
     html = report.read_text(encoding="utf-8")
-    assert report.name == "report.html" and "data:image/png;base64," in html
+    assert report.name == "report.html" and "<svg" in html
     assert "report_latency_s" in html and "How users differ" in html
     assert (report.parent / "report.md").is_file()
 
@@ -261,4 +261,4 @@ def test_comparison_table_gives_units_and_rate_differences_in_points(tmp_path, c
     latency = rows["report_latency_s"]
     assert latency.count(" s") >= 4 and "differs" in latency   # A, B, B − A and the CI
     assert " pp" in rows["taken_rate"] and "%" in rows["taken_rate"]
-    assert (tmp_path / "out" / "figures" / "comparison.png").stat().st_size > 10_000
+    assert (tmp_path / "out" / "figures" / "comparison.svg").stat().st_size > 10_000
