@@ -83,11 +83,12 @@ def register(subparsers: Any) -> None:
     parser.add_argument("--export", action="append", default=[], metavar="FMT",
                         help="also write traces: xes (traces.xes), jsonl (traces.jsonl), "
                         "ocel (traces.jsonocel, OCEL 2.0); repeatable or comma-separated")
-    parser.add_argument("--case", choices=("user", "instance", "dose"), default=None,
-                        help="what one case of the xes and jsonl exports is: a simulated "
-                        "user's whole run (default), one workflow instance, or one dose (a "
-                        "started device workflow and everything it set in motion; "
-                        "docs/xes-export.md)")
+    parser.add_argument("--case", choices=("chain", "user", "instance", "dose"), default=None,
+                        help="what one case of the xes and jsonl exports is: chain (the "
+                        "default: a root device workflow's run and everything it set in "
+                        "motion, named after that workflow; 'dose' is an earlier name), a "
+                        "simulated user's whole run, or one workflow instance "
+                        "(docs/xes-export.md)")
     parser.add_argument("--figures", choices=("svg", "pdf", "png"), default="svg",
                         help="the format of the report's figures in OUT/figures/: svg "
                         "(vector, the default), pdf (vector, for LaTeX; SVG twins beside them "
@@ -178,7 +179,7 @@ def _new_plan(args: argparse.Namespace) -> Any:
                     else default_users_per_draw(users, draws))
     return EvaluationPlan(designs=tuple(designs), users=users, days=days,
                           seed=run_seed, user_model=model, engine=_engine(args.engine_config),
-                          export=export, case=args.case or "user",
+                          export=export, case=args.case or "chain",
                           input_uncertainty=draws, users_per_draw=per_draw)
 
 
