@@ -105,8 +105,10 @@ def main(argv: Sequence[str] | None = None) -> int:
               "(this is a bug in opspec; please report it)", file=sys.stderr)
         return 70
     if "_ARGCOMPLETE" in os.environ:       # the shell asks for completions, then exits
-        import argcomplete
-
+        try:
+            import argcomplete
+        except ImportError:                 # an install older than the dependency
+            return 0
         argcomplete.autocomplete(parser)
     args, unknown = parser.parse_known_args(argv)
     if unknown:

@@ -39,6 +39,7 @@ def _complete(line: str, tmp_path: Path) -> list[str]:
 
 
 def test_the_shell_completes_commands_and_their_options(tmp_path):
+    pytest.importorskip("argcomplete", reason="argcomplete is a dependency: pip install -e .")
     assert [c.strip() for c in _complete("opspec eva", tmp_path)] == ["evaluate"]
     options = _complete("opspec evaluate --us", tmp_path)
     assert {"--users", "--user-model", "--users-per-draw"} <= {c.strip() for c in options}
