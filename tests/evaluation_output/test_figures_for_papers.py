@@ -110,3 +110,21 @@ def test_an_unknown_figure_format_is_refused(capsys: pytest.CaptureFixture[str])
         main(["evaluate", str(SPEC), "--figures", "gif"])
     assert exit_.value.code == 2
     assert "invalid choice: 'gif'" in capsys.readouterr().err
+
+
+def test_routine_windows_read_as_clock_times(tmp_path: Path) -> None:
+    """The report's user-model notes give a routine window as the times of day the model
+    file wrote (23:00–07:00), not as seconds after midnight (82800.0–25200.0)."""
+    from opspec.evaluation.describe import user_model_notes
+    from opspec.usermodels.loader import load_user_model
+
+    path = tmp_path / "routine.users.toml"
+    path.write_text('format = "opspec-user-model"\nversion = 1\nname = "routine"\n'
+                    '[[routine.windows]]\nname = "asleep"\nstart = "23:00"\nend = "07:00"\n'
+                    'notice_factor = 0.25\n[[routine.windows]]\nname = "lunch"\n'
+                    'start = "12:30"\nend = "13:15:30"\nnotice_factor = 0.5\n'
+                    '[activities.hear]\nduration = 1\n', encoding="utf-8")
+    notes = " ".join(user_model_notes(load_user_model(path)))
+    assert "Routine window asleep (23:00–07:00)" in notes
+    assert "Routine window lunch (12:30–13:15:30)" in notes
+    assert "82800" not in notes and "45000" not in notes
