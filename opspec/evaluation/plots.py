@@ -330,19 +330,24 @@ def rates_figure(rows: Sequence[tuple[str, float, float, float]], path: Path) ->
             percent = _is_rate([est, lo, hi])
             ax.errorbar([est], [0.0], xerr=[[max(est - lo, 0.0)], [max(hi - est, 0.0)]],
                         fmt="o", color=PALETTE[0], ecolor=PALETTE[0], capsize=5,
-                        markersize=7, linewidth=1.8)
-            ax.annotate(f"{_fmt(est, percent)}  [{_fmt(lo, percent)}, {_fmt(hi, percent)}]",
-                        (hi, 0.0), xytext=(6, 0), textcoords="offset points", va="center",
-                        fontsize=9)
+                        markersize=7, linewidth=1.8, clip_on=False)
             ax.set_yticks([0.0], [label])
             ax.set_ylim(-1.0, 1.0)
             ax.grid(axis="y", visible=False)
             width = hi - lo if hi > lo else max(abs(est) * 0.1, 1e-6)
             left, right = lo - 0.6 * width, hi + 1.9 * width   # room for the label
+            # a rate's axis stays within [0, 100] %: near 100 % the label goes to the left
+            on_left = percent and right > 1.0
+            if on_left:
+                left, right = lo - 1.9 * width, hi + 0.6 * width
+            text = f"{_fmt(est, percent)}  [{_fmt(lo, percent)}, {_fmt(hi, percent)}]"
+            ax.annotate(text, (lo, 0.0) if on_left else (hi, 0.0),
+                        xytext=(-6 if on_left else 6, 0), textcoords="offset points",
+                        va="center", ha="right" if on_left else "left", fontsize=9)
             if percent:
                 from matplotlib.ticker import PercentFormatter
 
-                left, right = max(left, 0.0), min(right, 1.0 + 0.9 * width)
+                left, right = max(left, 0.0), min(right, 1.0)
                 step = max((right - left) * 100.0 / 6.0, 1e-9)   # about six ticks
                 ax.xaxis.set_major_formatter(PercentFormatter(
                     xmax=1.0, decimals=max(0, -math.floor(math.log10(step)))))

@@ -70,6 +70,10 @@ def test_figures_carry_no_titles_and_label_axes_in_words(
     for ax in rate_axes:
         low, high = ax.get_xlim()
         assert 0.0 <= low and high <= 100.0
+    # the rates' panels never leave [0, 100] % either (a 99.6 % taken rate included)
+    for ax in drawn["A-rates"].axes:
+        low, high = ax.get_xlim()
+        assert 0.0 <= low and high <= 1.0
     # day-by-day panels: a band (the day's interval) behind each line that is drawn
     days = drawn["A-days"]
     assert all(ax.collections for ax in days.axes)
