@@ -72,6 +72,8 @@ def register(subparsers: Any) -> None:
 
 def run(args: argparse.Namespace) -> int:
     from opspec.model.soundness import SoundnessReport, check_process
+    from opspec.errors import Severity
+    from opspec.xpdl.gate import RUNS_DIFFERENTLY
     from opspec.xpdl.loader import load_package
     from opspec.xpdl.validate import IO_CODES, spec_files
 
@@ -87,6 +89,10 @@ def run(args: argparse.Namespace) -> int:
             io = any(d.code in IO_CODES for d in result.diagnostics)
             worst = max(worst, 2 if io else 1)
             continue
+        for warning in result.diagnostics:
+            # soundness is of what opspec runs: say where that differs from the standard
+            if warning.code == RUNS_DIFFERENTLY and warning.severity is Severity.WARNING:
+                print(f"opspec check: {warning}", file=sys.stderr)
         # conditions are abstracted, so a spec whose errors leave its control flow readable
         # (a condition opspec cannot parse, a duplicate lane id) is still checked
         package = result.package
@@ -122,7 +128,6 @@ def _schedulability(package: Any, *, as_json: bool) -> int:
     """Response-time analysis beside a simulation of one hyperperiod from a synchronous
     release on one preemptive processor; 1 when a workflow misses its deadline."""
     from opspec.engine.config import EngineConfig
-    from opspec.engine.simulation import Simulation
     from opspec.model.schedulability import analyse, hyperperiod, tasks_of
 
     tasks = analyse(tasks_of(package))
@@ -150,7 +155,11 @@ def _schedulability(package: Any, *, as_json: bool) -> int:
 
     listen.selects = {(k, w, None) for k in ("process.started", "process.completed")  # type: ignore[attr-defined]
                       for w in wanted}
-    Simulation(package, config, listeners=[listen]).run(until=horizon)
+    from opspec.request import RunRequest, prepare
+
+    # one run as every door makes it (its world, seed 0), nobody on the user lane
+    prepare(RunRequest(package, until=horizon, no_user=True, config=config,
+                       listeners=(listen,))).execute()
     unfinished = set()
     for workflow, at in started.values():       # still running at the horizon: at least
         worst[workflow] = max(worst.get(workflow, 0.0), horizon - at)

@@ -56,6 +56,7 @@ from opspec.model import (
     WorkflowProcess,
 )
 from opspec.model.bulk import gc_paused
+from opspec.model.checks_support import names_read
 from opspec.model.data import is_structured, structured_value
 
 __all__ = [
@@ -138,6 +139,7 @@ class CTrigger:
     count: int = -1                        # period: number of firings (-1: no end)
     planned: bool = False                  # timer: a TimeDate / repeating interval whose
     #                                        firings are ``offset``, +``every``… (``count``)
+    interval: Sampler | None = None        # arrival: the inter-arrival time, drawn each time
 
 
 @dataclass(frozen=True, slots=True, eq=False)
@@ -150,6 +152,7 @@ class CTransition:
     exception: str | None
     assignments: tuple[tuple[str, Evaluator], ...]
     label: str | None = None          # a ScriptGrammar="Text" condition: a label, no test
+    probability: float = -1.0         # drawn with this probability (undecided gateway); < 0: none
 
 
 @dataclass(frozen=True, slots=True, eq=False)
@@ -191,6 +194,8 @@ class CompiledActivity:
     default_exception: CTransition | None = None
     choice: tuple[CTransition, ...] = ()      # deferred choice offered after completion
     labelled: bool = False                   # the choice is between labelled branches
+    drawn: tuple[CTransition, ...] = ()      # an undecided gateway's branches, drawn at random
+    inputs: tuple[str, ...] = ()             # run inputs its conditions read: drawn while unset
     start_assign: tuple[tuple[str, Evaluator], ...] = ()
     end_assign: tuple[tuple[str, Evaluator], ...] = ()
     raises: CTrigger | None = None
@@ -325,6 +330,11 @@ class _Compiler:
     def __init__(self, package: Package) -> None:
         self.package = package
         self.throwable: set[str] = set()
+        # package data fields a BPMN diagram's conditions read but nothing sets: a gateway
+        # deciding on one is drawn at random while the run is not given its value
+        self.run_inputs = frozenset(
+            f.id for f in package.data_fields
+            if any(e.name == "opspec:RunInput" for e in f.extended_attributes))
         self.participants = {p.id: p for p in package.participants}
         self.participant_lane: dict[str, tuple[str, ...]] = {}
         for pool in package.pools:
@@ -384,6 +394,21 @@ class _Compiler:
             condition = self.cond(ref.condition, None, ref.location, "rule trigger")
         return CTrigger(kind=ref.kind, name=ref.name, at=tuple(sorted(ref.at)), every=ref.every,
                         offset=ref.offset, condition=condition, location=ref.location)
+
+    def arrivals(self, proc: WorkflowProcess) -> CTrigger:
+        """Stochastic arrivals: the first instance when armed, then one after each
+        inter-arrival time drawn from the process's own stream (``arrivals/PROCESS``)."""
+        directives = proc.directives
+        assert directives.arrival is not None
+        try:
+            interval = make_sampler(directives.arrival)
+        except ValueError as error:
+            raise _spec_error(f"inter-arrival time of process {proc.id!r}: {error}",
+                              proc.location, "see docs/sisarl-xpdl.md for the distributions"
+                              ) from None
+        count = directives.arrival_count
+        return CTrigger(kind="arrival", name=proc.id, interval=interval,
+                        count=-1 if count is None else count, location=proc.location)
 
     def event_trigger(self, event: Event, act: Activity) -> CTrigger | None:
         trig = event.trigger
@@ -481,9 +506,15 @@ class _Compiler:
                             for a in tr.assignments)
             ct = CTransition(index=ti, id=tr.id, target=by_id[tr.target], kind=kind,
                              condition=cond, exception=exc, assignments=assigns,
-                             label=(tr.condition.text or None) if kind == T_NONE else None)
+                             label=(tr.condition.text or None) if kind == T_NONE else None,
+                             probability=-1.0 if tr.probability is None else tr.probability)
             trans_by_id[tr.id] = ct
             outgoing[by_id[tr.source]].append(ct)
+            if tr.probability is not None and self.run_inputs and tr.condition.expression:
+                reads = [n for n in names_read(tr.condition.expression) if n in self.run_inputs]
+                if reads:
+                    source = acts[by_id[tr.source]]
+                    source.inputs = tuple(dict.fromkeys((*source.inputs, *reads)))
             incoming[by_id[tr.target]].append(ti)
         for i, act in enumerate(activities):
             self.activity(proc, act, acts[i], acts, by_id, outgoing[i], incoming[i],
@@ -681,6 +712,10 @@ class _Compiler:
             # no split declared and some conditions: BPMN conditional sequence flows, every
             # one whose condition holds is taken (OTHERWISE is the default flow)
             ca.split = S_OR
+        if ca.split in (S_XOR, S_OR) and any(t.probability >= 0.0 for t in ordered):
+            # a gateway the spec leaves undecided: its branches are drawn with the declared
+            # probabilities (the reader gives every branch one), never by file order
+            ca.drawn = tuple(t for t in ordered if t.kind in (T_NONE, T_COND, T_OTHERWISE))
         # directives
         if act.assignments:
             ca.start_assign = tuple(
@@ -840,6 +875,8 @@ class _Compiler:
         data: dict[str, Any] = {f.id: None for f in proc.formal_parameters}
         data.update({f.id: self.initial(f) for f in proc.data_fields})
         start = self.trigger_ref(directives.start_trigger)
+        if start is None and directives.arrival is not None:
+            start = self.arrivals(proc)
         if start is None:
             for index in graph.starts:
                 ca = graph.activities[index]

@@ -5,8 +5,8 @@ from __future__ import annotations
 from collections.abc import Mapping, Sequence
 from typing import IO, Any
 
-from opspec.engine.monitors import clock
 from opspec.evaluation.plan import span
+from opspec.properties.language import clock
 from opspec.statistics.methods import METHODS, methods_in
 
 __all__ = ["comparison_rows", "distribution_rows", "fmt", "is_rate", "method_legend",

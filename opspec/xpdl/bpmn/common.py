@@ -12,6 +12,7 @@ from lxml import etree
 
 from opspec.errors import Severity, SourceLocation
 from opspec.model.data import BasicKind, ParameterMode
+from opspec.model.sisarl import DeclaredDistribution
 from opspec.xpdl.handlers.common import BuildContext
 from opspec.xpdl.namespaces import OPSPEC
 
@@ -21,6 +22,7 @@ __all__ = [
     "Defs",
     "bpmn_children",
     "expression_text",
+    "is_juel",
     "first",
     "kids",
     "local",
@@ -90,6 +92,12 @@ _JUEL = re.compile(r"^[$#]\{(?P<inner>.*)\}$", re.DOTALL)
 _QUOTED = re.compile(r"""^(?P<q>["'])(?P<inner>[^"']*)(?P=q)$""")
 
 
+def is_juel(element: etree._Element | None) -> bool:
+    """Whether ``element``'s expression is wrapped as Camunda's JUEL (``${…}``, ``#{…}``)."""
+    text = text_of(element)
+    return text is not None and _JUEL.match(text) is not None
+
+
 def expression_text(element: etree._Element | None, *, unquote: bool = False) -> str | None:
     """The text of a ``tFormalExpression``: the JUEL wrapper ``${…}`` of Camunda removed, and
     with ``unquote`` the quotes of a Python string literal (SpiffWorkflow's ``"PT5M"``)."""
@@ -134,6 +142,15 @@ class Defs:
     package_fields: set[str] = field(default_factory=set)
     item_kinds: dict[str, BasicKind] = field(default_factory=dict)
     process_io: dict[str, list[tuple[str, ParameterMode]]] = field(default_factory=dict)
+    probabilities: dict[str, float] = field(default_factory=dict)   # BPSim / QBP, by flow id
+    probability_source: dict[str, str] = field(default_factory=dict)
+    data_names: dict[str, str] = field(default_factory=dict)   # a data object's name -> its id
+    # BPSim / QBP processing times by activity id, and arrivals by process id (:mod:`.simulation`)
+    durations: dict[str, DeclaredDistribution] = field(default_factory=dict)
+    duration_source: dict[str, str] = field(default_factory=dict)
+    arrivals: dict[str, tuple[DeclaredDistribution, int | None, str]] = field(
+        default_factory=dict)
+    call_aliases: dict[str, str] = field(default_factory=dict)  # tns:proc -> proc (:mod:`.imports`)
 
     def info(self, element: etree._Element | None, code: str, message: str,
              hint: str = "") -> None:

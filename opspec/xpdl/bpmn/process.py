@@ -17,6 +17,7 @@ Boundary events follow the engine's existing constructs:
 
 from __future__ import annotations
 
+import dataclasses
 from collections.abc import Iterable
 from dataclasses import dataclass, field
 
@@ -47,6 +48,7 @@ from opspec.model.data import Assignment, BasicKind, BasicType, DataField
 from opspec.model.expressions import Expression, Literal
 from opspec.model.process import ActivitySet, Condition, ConditionKind, Transition, WorkflowProcess
 from opspec.model.resources import Lane
+from opspec.model.sisarl import ActivityDirectives, ProcessDirectives
 from opspec.xpdl.bpmn.common import (
     BPMN,
     Defs,
@@ -57,6 +59,7 @@ from opspec.xpdl.bpmn.common import (
     namespace,
     text_of,
 )
+from opspec.xpdl.bpmn.branches import decide_undecided
 from opspec.xpdl.bpmn.data import activity_data, process_fields
 from opspec.xpdl.bpmn.events import definitions_of, read_timer, trigger_of
 from opspec.xpdl.bpmn.extensions import (
@@ -132,6 +135,7 @@ class _Process:
         self.lane_names: dict[str, str | None] = {}
         self.created: dict[str, DataField] = {}      # fields forms, outputs, parameters add
         self.reads: list[tuple[str, etree._Element, str]] = []
+        self.synthetic: set[str] = set()          # ids given to sequence flows without one
         for lane in self._all(self.lanes):
             self.lane_names[lane.id] = lane.name
 
@@ -239,6 +243,8 @@ class _Process:
         boundary = self.boundaries(boundaries, ids)
         ids |= {b.id for b in boundary.activities}
         transitions = self.flows(flows, ids, nodes, boundary.skipped)
+        transitions = decide_undecided(nodes, transitions,
+                                       {f.get("id") or "": f for f in flows}, self.defs)
         transitions.extend(boundary.transitions)
         incoming: dict[str, int] = {}
         outgoing: dict[str, list[str]] = {}
@@ -280,6 +286,10 @@ class _Process:
                                    "(the flow is left out)")
             if broken:
                 continue
+            if not flow_id:
+                # BPMN lets a sequence flow nothing refers to go without an id; the model
+                # needs one per transition (splits order their flows by id)
+                flow_id = self.flow_id(ends["sourceRef"], ends["targetRef"])
             condition = self.condition(flow, flow_id in defaults)
             out.append(Transition(id=flow_id, name=flow.get("name"), source=ends["sourceRef"],
                                   target=ends["targetRef"], condition=condition,
@@ -294,6 +304,17 @@ class _Process:
                                    f"{self.label(node)}: default {flow_id!r} is no sequence flow "
                                    "of this process", "name one of its outgoing sequence flows")
         return out
+
+    def flow_id(self, source: str, target: str) -> str:
+        """An id for a sequence flow written without one: ``source->target`` (``#2``… when
+        two such flows join the same nodes), never an id of the file."""
+        base = f"{source}->{target}"
+        candidate, n = base, 1
+        while candidate in self.defs.by_id or candidate in self.synthetic:
+            n += 1
+            candidate = f"{base}#{n}"
+        self.synthetic.add(candidate)
+        return candidate
 
     def where(self, element: etree._Element) -> str:
         parent = element.getparent()
@@ -337,6 +358,15 @@ class _Process:
             found = definitions_of(event, self.defs)
             kind = local(found[0]) if found else None
             passing = Event(position=EventPosition.INTERMEDIATE, trigger=Trigger())
+            if kind == "timerEventDefinition" and not any(
+                    expression_text(first(found[0], k)) for k in _TIMER_KINDS):
+                # no time at all: an intermediate timer fires at once (said), but a boundary
+                # timer that fired at once would cut its activity off before it began
+                self.ctx.error(found[0], "bad-timer",
+                               f"boundary timer {event_id!r} has no timeDuration, timeDate or "
+                               "timeCycle, so when it interrupts its activity is not said",
+                               "give it a time, e.g. <bpmn:timeDuration>PT2H</bpmn:timeDuration>")
+                continue
             if kind == "timerEventDefinition":
                 timer = read_timer(found[0], self.defs)
                 if timer is None or timer.kind == "duration":
@@ -419,6 +449,7 @@ class _Process:
                                  _ACTIVITY_STRUCTURE)
         self.message_directives(element, found, sends, built_body)
         directive_values, coordination = activity_directives(element, self.ctx, found)
+        directive_values = self.simulated_duration(element, node_id, directive_values)
         data = activity_data(element, self.defs, self.label(element))
         for created in data.fields:
             self.created.setdefault(created.id, created)
@@ -461,6 +492,21 @@ class _Process:
             loop=self.loop(element), join=join, split=split,
             directives=directive_values, coordination=coordination,
             assignments=assignments(element, self.defs) + extra + tuple(data.assignments))
+
+    def simulated_duration(self, element: etree._Element, node_id: str,
+                           given: ActivityDirectives) -> ActivityDirectives:
+        """The task's duration from the file's BPSim or QBP parameters (:mod:`.simulation`)
+        when it has no ``opspec:Duration`` of its own; its own wins, said in an info."""
+        drawn = self.defs.durations.get(node_id)
+        if drawn is None:
+            return given
+        source = self.defs.duration_source.get(node_id, "the file")
+        if given.duration is not None:
+            self.defs.info(element, "duration-given-twice",
+                           f"{self.label(element)} has its own opspec:Duration, which wins "
+                           f"over the {source} duration", "")
+            return given
+        return dataclasses.replace(given, duration=drawn)
 
     @staticmethod
     def order(element: etree._Element, flows: list[str]) -> tuple[str, ...]:
@@ -592,10 +638,25 @@ class _Process:
             extended_attributes=kept, location=self.defs.loc(element),
             access_level="PUBLIC", data_fields=tuple(fields), formal_parameters=formals,
             activities=activities, transitions=transitions, activity_sets=tuple(self.sets),
-            directives=process_directives(element, self.ctx, found))
+            directives=self.arrivals(process_directives(element, self.ctx, found)))
         process = _with_script_fields(process, element, self.defs)
         self.check_reads(process)
         return BuiltProcess(process, self.lanes)
+
+    def arrivals(self, given: ProcessDirectives) -> ProcessDirectives:
+        """The process's arrivals from the file's BPSim or QBP parameters, unless its own
+        ``opspec:Arrival`` or ``opspec:StartTrigger`` says how it starts."""
+        found = self.defs.arrivals.get(self.id)
+        if found is None:
+            return given
+        distribution, count, source = found
+        if given.arrival is not None or given.start_trigger is not None:
+            own = "opspec:Arrival" if given.arrival is not None else "opspec:StartTrigger"
+            self.defs.info(self.element, "arrivals-given-twice",
+                           f"process {self.id!r} has its own {own}, which wins over the "
+                           f"{source} arrivals", "")
+            return given
+        return dataclasses.replace(given, arrival=distribution, arrival_count=count)
 
     def check_reads(self, process: WorkflowProcess) -> None:
         """A task's ``dataInput`` without an association takes the process's variable of its
@@ -610,6 +671,9 @@ class _Process:
                                "declare a bpmn:dataObject or bpmn:property with that id, set it "
                                "in a script task or a form field, or feed the input with a "
                                "bpmn:dataInputAssociation")
+
+
+_TIMER_KINDS = ("timeDuration", "timeDate", "timeCycle")
 
 
 def _literal_kind(expression: Expression | None) -> BasicKind:
