@@ -136,6 +136,7 @@ def _environment(folder: Path) -> dict[str, str]:
            if not k.startswith(("PYTEST_", "TEXTUAL_", "COLUMNS", "LINES"))}
     env["PATH"] = bin_dir + os.pathsep + env.get("PATH", "")
     env["OPSPEC_PURE_PYTHON"] = env.get("OPSPEC_PURE_PYTHON", "1")
+    env["PYTHONUNBUFFERED"] = "1"
     return env
 
 
@@ -156,9 +157,10 @@ def _run(example: Example, block: Block, work: Path) -> str | None:
     env = _environment(work)
     for command, shown in block.commands:
         text = command.split(" #", 1)[0].strip()          # a trailing comment explains
-        done = subprocess.run(shlex.split(text), cwd=work, env=env, capture_output=True,
-                              text=True, timeout=600, check=False)
-        printed = done.stdout + done.stderr
+        # stderr into stdout, unbuffered: the two interleave as on a terminal
+        done = subprocess.run(shlex.split(text), cwd=work, env=env, stdout=subprocess.PIPE,
+                              stderr=subprocess.STDOUT, text=True, timeout=600, check=False)
+        printed = done.stdout
         if done.returncode != block.status:
             return (f"{example.path}:{example.line}: `{text}` exited {done.returncode}, the "
                     f"page says {block.status}\n{printed}")
