@@ -15,7 +15,7 @@ given mean and sd, and the truth is the Beta mean. It prints the share of repeti
 - ``wilson``: Wilson on the pooled trials (every dose independent);
 - ``kg``: Wilson on Korn & Graubard's (1998) effective sample size ``n/deff`` (deff >= 1);
 - ``kg-df``: the same with their degrees-of-freedom adjustment ``n_eff·(z/t[U-1])²``;
-- ``opspec``: :func:`opspec.evaluation.proportions.proportion_interval` — ``kg`` with the
+- ``opspec``: :func:`opspec.statistics.proportions.proportion_interval` — ``kg`` with the
   adjustment applied to the between-user excess of the variance only, and Brown, Cai &
   DasGupta's (2001) Poisson bound for 1 or 2 events (checked here to give the same bounds
   as the vectorised formula on the first repetitions of every case).
@@ -35,7 +35,7 @@ from scipy import stats
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
-from opspec.evaluation.proportions import MODIFIED_WILSON_EVENTS, proportion_interval
+from opspec.statistics.proportions import MODIFIED_WILSON_EVENTS, proportion_interval
 
 P_THREE_ALARMS = 0.0034562262209500982
 P_FOUR_ALARMS = 0.0005186876829259557

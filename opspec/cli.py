@@ -1,3 +1,4 @@
+# PYTHON_ARGCOMPLETE_OK  (argcomplete's global completion looks for this line)
 """The ``opspec`` command: the composition root.
 
 Each subcommand lives in its own module under :mod:`opspec.commands` and exposes
@@ -44,7 +45,8 @@ COMMAND_MODULES: tuple[str, ...] = (
 def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(
         prog="opspec",
-        description="Execute operational specifications (XPDL / SISARL-XPDL) of assistive "
+        description="Execute operational specifications (XPDL / SISARL-XPDL, or BPMN 2.0) of "
+        "assistive "
         "devices and their users.",
     )
     parser.add_argument("--version", action="version",
@@ -86,6 +88,14 @@ def _register_broken(subparsers: argparse._SubParsersAction[argparse.ArgumentPar
     parser.set_defaults(handler=broken)
 
 
+def _subparsers(parser: argparse.ArgumentParser) -> dict[str, argparse.ArgumentParser]:
+    """The subcommands' parsers by name."""
+    for action in parser._actions:  # argparse keeps no public handle on them
+        if isinstance(action, argparse._SubParsersAction):
+            return dict(action.choices)
+    return {}
+
+
 def main(argv: Sequence[str] | None = None) -> int:
     """Entry point of the console script; returns the exit status."""
     try:
@@ -94,7 +104,18 @@ def main(argv: Sequence[str] | None = None) -> int:
         print(f"opspec: internal error: {' '.join(f'{type(error).__name__}: {error}'.split())} "
               "(this is a bug in opspec; please report it)", file=sys.stderr)
         return 70
-    args = parser.parse_args(argv)
+    if "_ARGCOMPLETE" in os.environ:       # the shell asks for completions, then exits
+        try:
+            import argcomplete
+        except ImportError:                 # an install older than the dependency
+            return 0
+        argcomplete.autocomplete(parser)
+    args, unknown = parser.parse_known_args(argv)
+    if unknown:
+        # the subcommand's own usage, not the top-level one: what the mistyped option
+        # belongs to and what it accepts
+        own = _subparsers(parser).get(getattr(args, "command", None) or "")
+        (own or parser).error(f"unrecognized arguments: {' '.join(unknown)}")
     handler = getattr(args, "handler", None)
     if handler is None:
         parser.print_help()

@@ -2,9 +2,10 @@
 
 from __future__ import annotations
 
-import math
-from collections.abc import Iterable, Sequence
+from collections.abc import Iterable
 from dataclasses import dataclass
+
+from opspec.statistics.percentiles import nearest_rank
 
 __all__ = ["LatencySummary", "summarise"]
 
@@ -27,17 +28,11 @@ class LatencySummary:
                 f"p99 {self.p99 * 1e3:.3f} ms, max {self.max * 1e3:.3f} ms")
 
 
-def _quantile(ordered: Sequence[float], q: float) -> float:
-    # nearest-rank: the smallest sample with at least q of the samples at or below it
-    rank = max(1, math.ceil(q * len(ordered)))
-    return ordered[rank - 1]
-
-
 def summarise(samples: Iterable[float]) -> LatencySummary:
     """Mean, median, 99th percentile (nearest rank) and maximum of ``samples``."""
     ordered = sorted(samples)
     if not ordered:
         nan = float("nan")
         return LatencySummary(0, nan, nan, nan, nan)
-    return LatencySummary(len(ordered), sum(ordered) / len(ordered), _quantile(ordered, 0.5),
-                          _quantile(ordered, 0.99), ordered[-1])
+    return LatencySummary(len(ordered), sum(ordered) / len(ordered), nearest_rank(ordered, 0.5),
+                          nearest_rank(ordered, 0.99), ordered[-1])

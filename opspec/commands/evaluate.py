@@ -37,7 +37,8 @@ def register(subparsers: Any) -> None:
         "as it finishes, and write OUT/report.html with metrics, confidence intervals and "
         "plots. The same seed gives the same results whatever the number of workers.")
     parser.add_argument("spec", metavar="SPEC", nargs="?",
-                        help="the specification (.xpdl or .wfs); optional with --resume")
+                        help="the specification (.xpdl, .bpmn or a compiled .wfs); optional "
+                        "with --resume")
     parser.add_argument("--users", type=int, default=None,
                         help=f"simulated users (default {DEFAULT_USERS})")
     parser.add_argument("--days", type=float, default=None,
@@ -87,11 +88,16 @@ def register(subparsers: Any) -> None:
     parser.add_argument("--export", action="append", default=[], metavar="FMT",
                         help="also write traces: xes (traces.xes), jsonl (traces.jsonl), "
                         "ocel (traces.jsonocel, OCEL 2.0); repeatable or comma-separated")
-    parser.add_argument("--case", choices=("user", "instance", "dose"), default=None,
-                        help="what one case of the xes and jsonl exports is: a simulated "
-                        "user's whole run (default), one workflow instance, or one dose (a "
-                        "started device workflow and everything it set in motion; "
-                        "docs/xes-export.md)")
+    parser.add_argument("--case", choices=("chain", "user", "instance", "dose"), default=None,
+                        help="what one case of the xes and jsonl exports is: chain (the "
+                        "default: a root device workflow's run and everything it set in "
+                        "motion, named after that workflow; 'dose' is an earlier name), a "
+                        "simulated user's whole run, or one workflow instance "
+                        "(docs/xes-export.md)")
+    parser.add_argument("--figures", choices=("svg", "pdf", "png"), default="svg",
+                        help="the format of the report's figures in OUT/figures/: svg "
+                        "(vector, the default), pdf (vector, for LaTeX; SVG twins beside them "
+                        "for the HTML report) or png (200 dpi); the HTML report inlines SVG")
     parser.add_argument("--json", action="store_true",
                         help="print one JSON object with the results (docs/evaluation.md)")
     parser.add_argument("--quiet", action="store_true", help="no progress output")
@@ -178,7 +184,7 @@ def _new_plan(args: argparse.Namespace) -> Any:
                     else default_users_per_draw(users, draws))
     return EvaluationPlan(designs=tuple(designs), users=users, days=days,
                           seed=run_seed, user_model=model, engine=_engine(args.engine_config),
-                          export=export, case=args.case or "user",
+                          export=export, case=args.case or "chain",
                           input_uncertainty=draws, users_per_draw=per_draw)
 
 
@@ -465,7 +471,8 @@ def run(args: argparse.Namespace) -> int:
                                                  args.target_users)
         try:
             report = write_report(store, summaries,
-                                  template=getattr(args, "report_template", None))
+                                  template=getattr(args, "report_template", None),
+                                  figures=getattr(args, "figures", "svg"))
         except EvaluationError as error:
             raise _with_resume_hint(error, store, plan) from None
         except OSError as error:
@@ -487,6 +494,10 @@ def run(args: argparse.Namespace) -> int:
             doc["compare"] = compare
         if swept is not None:
             doc["sweep"] = summaries["sweep"]
+        from opspec.statistics.methods import describe, methods_in
+
+        # what every "ci95_method" above means: its recipe and references
+        doc["interval_methods"] = describe(methods_in(doc))
         print(json.dumps(_finite(doc), allow_nan=False, default=str))
     else:
         from opspec.evaluation.tables import print_summary

@@ -1,11 +1,13 @@
 """``opspec new NAME``: start a new specification from a small, runnable template.
 
-Writes the folder ``NAME/`` with ``NAME.xpdl`` (a pill reminder: a device workflow with a timed
-start, a reminder whose wait has a deadline, a retry and an escalation to a caregiver, and the
-user's manual lane), ``NAME.users.toml`` (its user model, picked up by ``opspec run`` and
+Writes the folder ``NAME/`` with ``NAME.xpdl`` (``--template pill``, the default: a pill
+reminder — a device workflow with a timed start, a reminder whose wait has a deadline, a retry
+and an escalation to a caregiver, and the user's manual lane; ``--template stove``: a stove
+guard — the device watches, the user must confirm, the guard escalates by cutting the power),
+``NAME.users.toml`` (its user model, picked up by ``opspec run`` and
 ``opspec evaluate`` because it sits beside the spec), ``test_NAME.py`` (spec tests for pytest)
 and a ``README.md`` listing the commands to try. The templates are package data
-(``opspec/commands/templates/new/``). Exit status: 0 written; 2 the folder already exists,
+(``opspec/commands/templates/new/<template>/``). Exit status: 0 written; 2 the folder already exists,
 the name is not usable, or the folder cannot be written.
 """
 
@@ -19,7 +21,15 @@ from importlib import resources
 from pathlib import Path
 from typing import Any
 
-__all__ = ["TEMPLATES", "register", "render", "run"]
+__all__ = ["SHAPES", "TEMPLATES", "register", "render", "run"]
+
+#: The device shapes ``opspec new --template`` offers: name -> what it is.
+SHAPES: dict[str, str] = {
+    "pill": "a pill reminder: beeps at 09:00 and 21:00, waits for 'taken', beeps again, "
+            "then tells the caregiver",
+    "stove": "a stove guard: watches the stove, asks the user to confirm, alerts again, then "
+             "cuts the power and tells the caregiver",
+}
 
 # template file -> output file name (``$name`` / ``$ident`` substituted in both).
 TEMPLATES: tuple[tuple[str, str], ...] = (
@@ -36,22 +46,28 @@ _NAME = re.compile(r"[A-Za-z0-9][A-Za-z0-9_.-]*")
 
 def register(subparsers: Any) -> None:
     parser = subparsers.add_parser(
-        "new", help="start a new spec: a small runnable pill reminder, its user model and tests",
-        description="Write the folder NAME/ with NAME.xpdl (a pill reminder: a device "
-        "workflow with a timed start, a reminder with a deadline, a retry and an escalation, "
-        "and the user's manual lane), NAME.users.toml (its user model), test_NAME.py (spec "
+        "new", help="start a new spec: a small runnable device (pill reminder or stove guard), "
+        "its user model and tests",
+        description="Write the folder NAME/ with NAME.xpdl (a pill reminder by default: a "
+        "device workflow with a timed start, a reminder with a deadline, a retry and an "
+        "escalation, and the user's manual lane; --template stove: a stove guard), "
+        "NAME.users.toml (its user model), test_NAME.py (spec "
         "tests: run them with 'python -m pytest NAME') and README.md. The spec validates, "
         "runs and passes its tests as written. Refuses to overwrite an existing folder. "
         "Exit status: 0 written, 2 the folder exists or cannot be written.")
     parser.add_argument("name", metavar="NAME",
                         help="the folder to create; its last part names the files")
+    parser.add_argument("--template", choices=tuple(SHAPES), default="pill",
+                        help="the device to start from: " + "; ".join(
+                            f"{k}: {v}" for k, v in SHAPES.items()) + " (default: pill)")
     parser.set_defaults(handler=run)
 
 
-def render(name: str) -> dict[str, str]:
-    """The files of a new spec called ``name``: output file name -> text."""
+def render(name: str, template: str = "pill") -> dict[str, str]:
+    """The files of a new spec called ``name`` from ``template`` (:data:`SHAPES`): output
+    file name -> text."""
     values = {"name": name, "ident": identifier(name)}
-    folder = resources.files("opspec.commands").joinpath("templates", "new")
+    folder = resources.files("opspec.commands").joinpath("templates", "new", template)
     return {string.Template(target).substitute(values):
             string.Template(folder.joinpath(source).read_text(encoding="utf-8"))
             .substitute(values)
@@ -75,7 +91,7 @@ def run(args: argparse.Namespace) -> int:
         print(f"opspec new: {folder} already exists; nothing written (choose another name or "
               "move it away)", file=sys.stderr)
         return 2
-    files = render(name)
+    files = render(name, getattr(args, "template", "pill"))
     try:
         folder.mkdir(parents=True)
         for file_name, text in files.items():

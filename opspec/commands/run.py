@@ -46,11 +46,12 @@ BRIEF_KINDS = frozenset({
 def register(subparsers: Any) -> None:
     parser = subparsers.add_parser(
         "run", help="run one simulation of a spec and show what happened",
-        description="Run SPEC (XPDL or .wfs) once on the simulated clock, device workflows "
-        "and the user lane together, and print a timeline, the spec's metrics and a summary "
-        "(or one JSON object with --json). Exit status: 0 normal end; 1 a deadlock, an "
+        description="Run SPEC (XPDL, BPMN 2.0 or .wfs) once on the simulated clock, device "
+        "workflows and the user lane together, and print a timeline, the spec's metrics and "
+        "a summary (or one JSON object with --json). Exit status: 0 normal end; 1 a deadlock, an "
         "aborted instance or a device fault; 2 usage or configuration errors.")
-    parser.add_argument("spec", metavar="SPEC", help="the specification (.xpdl or .wfs)")
+    parser.add_argument("spec", metavar="SPEC",
+                        help="the specification (.xpdl, .bpmn or a compiled .wfs)")
     length = parser.add_mutually_exclusive_group()
     length.add_argument("--days", type=float, metavar="D",
                         help="simulated days to run (default: the spec's opspec:RunLength "

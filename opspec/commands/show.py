@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import argparse
 import sys
+from pathlib import Path
 from typing import Any
 
 from opspec.model.activities import (
@@ -43,7 +44,8 @@ def register(subparsers: Any) -> None:
         "per process; render with e.g. 'opspec show SPEC --format dot | dot -Tsvg -o out.svg'), "
         "or draw the whole package - every process with its lanes and the messages between "
         "them - as SVG or as an HTML page (needs Graphviz's dot program: "
-        "'opspec show SPEC --format html > spec.html').")
+        "'opspec show SPEC --format html -o spec.html', which writes the file only when the "
+        "picture is drawn).")
     parser.add_argument("spec", metavar="SPEC",
                         help="the XPDL specification, or a workflow script (.wfs) compiled "
                         "from one")
@@ -51,6 +53,10 @@ def register(subparsers: Any) -> None:
                         help="output format (default: text; svg and html: the whole package "
                         "in one picture)")
     parser.add_argument("--process", metavar="ID", help="only this process (by Id)")
+    parser.add_argument("-o", "--output", metavar="FILE",
+                        help="write to FILE instead of the standard output; nothing is "
+                        "written (no empty file) when the output cannot be made, e.g. "
+                        "without Graphviz")
     parser.set_defaults(handler=run)
 
 
@@ -87,12 +93,32 @@ def run(args: argparse.Namespace) -> int:
         from opspec.xpdl.picture import package_picture_dot, picture_html, render_svg
 
         svg = render_svg(package_picture_dot(package, process=args.process))
-        sys.stdout.write(svg if args.format == "svg" else picture_html(package, svg))
+        text = svg if args.format == "svg" else picture_html(package, svg)
     elif args.format == "dot":
-        sys.stdout.write(package_to_dot(package, process=args.process))
+        text = package_to_dot(package, process=args.process)
     else:
-        sys.stdout.write(describe_package(package, process=args.process))
+        text = describe_package(package, process=args.process)
+    if getattr(args, "output", None):
+        _write_whole(Path(args.output), text)
+    else:
+        sys.stdout.write(text)
     return 1 if errors else 0
+
+
+def _write_whole(path: Path, text: str) -> None:
+    """``text`` into ``path`` all at once (a temporary file renamed over it): a failure
+    leaves no empty or half-written file."""
+    import os
+
+    from opspec.errors import ConfigurationError
+
+    tmp = path.with_name(f".{path.name}.tmp")
+    try:
+        tmp.write_text(text, encoding="utf-8")
+        os.replace(tmp, path)
+    except OSError as error:
+        tmp.unlink(missing_ok=True)
+        raise ConfigurationError(f"cannot write {path}: {error.strerror or error}") from None
 
 
 def _validated(path: str) -> Any:

@@ -18,9 +18,10 @@ __all__ = ["register", "run"]
 
 def register(subparsers: Any) -> None:
     parser = subparsers.add_parser(
-        "validate", help="check XPDL / SISARL-XPDL specifications and report every problem",
-        description="Load each PATH (a file, or a folder: every *.xpdl and *.xml below it, "
-        "sorted), run the structural checks and report every problem at once as "
+        "validate", help="check XPDL / SISARL-XPDL or BPMN 2.0 specifications and report every "
+        "problem",
+        description="Load each PATH (a file, or a folder: every *.xpdl, *.xml and *.bpmn below "
+        "it, sorted), run the structural checks and report every problem at once as "
         "'path:line: severity: message (hint)'. Codes are listed in docs/validation.md. "
         "Exit status: 0 no errors, 1 errors in a spec, 2 usage or I/O problems.")
     parser.add_argument("paths", nargs="+", metavar="PATH", help="spec files or folders")

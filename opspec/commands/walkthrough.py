@@ -128,6 +128,9 @@ def run(args: argparse.Namespace) -> int:
                                                          spec=compiled))
             performers.update(devices.performers)
             notes.extend(devices.notes)
+        # Textual would wait for keys that never come (< /dev/null, a pipe): refused below,
+        # once the spec is known to start (its own error first), with nothing recorded
+        terminal = sys.stdin.isatty() and sys.stdout.isatty()
         from opspec.tui.app import WalkthroughApp
         from opspec.tui.session import WalkSession
 
@@ -137,13 +140,21 @@ def run(args: argparse.Namespace) -> int:
                 binding.participants)
         # a real device answers in wall time: start in real time unless told otherwise
         real = devices is not None and devices.requires_wall_clock
-        session = WalkSession(compiled, seed=args.seed, days=args.days, record=record,
+        session = WalkSession(compiled, seed=args.seed, days=args.days,
+                              record=record if terminal else None,
                               model_factory=factory, performers=performers, replay=replay,
                               spec_path=str(args.spec), device_participants=served,
                               wall_devices=real, on_call=args.on_call, person=args.person)
         if session.failure is not None:        # the run cannot even start (a zero-time cycle)
             session.close()
             raise session.failure
+        if not terminal:
+            session.close()
+            raise ConfigurationError(
+                "the walkthrough needs a terminal to read your keys from and draw on, and "
+                f"its standard {'input' if not sys.stdin.isatty() else 'output'} is not one",
+                hint=f"run it in a terminal; without a person, 'opspec run {args.spec} "
+                "--script FILE' plays a script or a recorded walkthrough")
         session.speed = args.speed if args.speed is not None else 1.0 if real else 60.0
         if devices is not None:
             devices.install(session.sim)

@@ -12,12 +12,12 @@ The output shape is shared with ``opspec evaluate --json``.
 
 from __future__ import annotations
 
-import math
 from collections.abc import Iterable, Mapping
 from typing import Any, Final
 
 from opspec.engine.trace import TraceEvent
 from opspec.model import EventSelector, MetricDefinition, MetricKind
+from opspec.statistics.percentiles import linear
 
 __all__ = ["MetricsListener", "percentile", "summarise_durations"]
 
@@ -29,13 +29,7 @@ _END: Final = 2
 
 def percentile(values: list[float], q: float) -> float:
     """Linear-interpolation percentile (numpy's default), ``q`` in 0..100."""
-    ordered = sorted(values)
-    if not ordered:
-        return math.nan
-    pos = (len(ordered) - 1) * q / 100.0
-    lo = math.floor(pos)
-    hi = min(lo + 1, len(ordered) - 1)
-    return ordered[lo] + (ordered[hi] - ordered[lo]) * (pos - lo)
+    return linear(sorted(values), q / 100.0)
 
 
 def summarise_durations(samples: list[float]) -> dict[str, Any]:

@@ -14,6 +14,8 @@ from __future__ import annotations
 from collections.abc import Mapping
 from typing import TYPE_CHECKING, Any
 
+from opspec.clock import time_of_day
+
 if TYPE_CHECKING:
     from opspec.model.sisarl import EventSelector, MetricDefinition
     from opspec.usermodels.distbase import Distribution
@@ -217,7 +219,9 @@ def user_model_notes(model: UserModel) -> list[str]:
     routine = model.routine
     if not routine.is_trivial:
         for w in routine.windows:
-            notes.append(f"Routine window {w.name} ({w.start}–{w.end}): noticing × "
+            # w.start/w.end are seconds after midnight: shown as the clock times they are
+            notes.append(f"Routine window {w.name} ({time_of_day(w.start)}–"
+                         f"{time_of_day(w.end)}): noticing × "
                          f"{w.notice_factor:g}, durations × {w.duration_factor:g}"
                          + (f"; {w.source.rstrip('.')}." if w.source else "."))
         d = routine.drift

@@ -3,8 +3,9 @@
 A report is a title and a sequence of :class:`Section` values (paragraphs, lists, tables,
 figures). :func:`write_html` renders them with a Jinja2 template (the bundled
 ``templates/report.html.j2``, or a researcher's own copy restyled) into one file that needs
-nothing else: the CSS is inline and each PNG is embedded as a base64 ``data:`` URI, so the
-report can be mailed or archived as it is.
+nothing else: the CSS is inline, each SVG figure is inlined as markup (matplotlib wrote it
+from our own data; its text is XML-escaped) and each PNG is embedded as a base64 ``data:``
+URI, so the report can be mailed or archived as it is.
 :func:`write_markdown` writes the same content as GitHub-flavoured Markdown that links the
 PNG files by relative path (keep them next to it).
 
@@ -76,6 +77,29 @@ def _alt(section: Section, index: int, image: Path) -> str:
     return f"{section.title}: figure {words}" if words else f"{section.title}: figure"
 
 
+_SVG_START = re.compile(r"<svg\b")
+
+
+def _figure(section: Section, index: int, image: Path) -> dict[str, object]:
+    """What the template needs of one figure: an SVG's markup, to be inlined (vector, and
+    its text stays searchable), or a PNG as a ``data:`` URI; the caption; the file name."""
+    import markupsafe   # jinja2's own
+
+    caption = _alt(section, index, image)
+    if Path(image).suffix.lower() == ".svg":
+        data = _read_png(image)
+        text = data.decode("utf-8")
+        start = _SVG_START.search(text)       # without the XML declaration and DOCTYPE
+        svg = markupsafe.Markup(text[start.start():] if start else text)
+        # src too: a template written for <img src> keeps working
+        return {"svg": svg, "src": "data:image/svg+xml;base64,"
+                + base64.b64encode(data).decode("ascii"), "caption": caption,
+                "name": Path(image).name}
+    return {"svg": "", "src": "data:image/png;base64,"
+            + base64.b64encode(_read_png(image)).decode("ascii"),
+            "caption": caption, "name": Path(image).name}
+
+
 def _read_png(image: Path) -> bytes:
     try:
         return Path(image).read_bytes()
@@ -138,10 +162,7 @@ def _context(title: str, sections: Sequence[Section]) -> dict[str, object]:
                                        for i, h in enumerate(t.headers)],
                            "rows": [[_cell(i, str(c), numeric) for i, c in enumerate(row)]
                                     for row in t.rows]})
-        figures = [{"src": "data:image/png;base64,"
-                    + base64.b64encode(_read_png(image)).decode("ascii"),
-                    "caption": _alt(section, i, image), "name": Path(image).name}
-                   for i, image in enumerate(section.images)]
+        figures = [_figure(section, i, image) for i, image in enumerate(section.images)]
         out.append({"id": sid, "title": section.title, "paragraphs": list(section.paragraphs),
                     "items": list(section.items), "tables": tables, "figures": figures})
     return {"title": title, "sections": out}

@@ -43,6 +43,8 @@ from dataclasses import replace
 from typing import IO, Any
 
 from opspec.errors import EvaluationError, OpspecError
+from opspec.statistics.clustered import paired_variance, ratio_variance
+from opspec.statistics.percentiles import linear
 
 __all__ = ["SUFFIX", "base_design", "check_draws", "draw_of", "draw_users", "draws_label",
            "print_input_uncertainty", "run_draw_users", "summarise_input_uncertainty"]
@@ -170,39 +172,6 @@ def run_draw_users(plan: Mapping[str, Any], label: str, users: Sequence[int]) ->
 
 # --------------------------------------------------------------------------- summarising
 
-def _estimate(pairs: Sequence[tuple[float, float]]) -> tuple[float, float] | None:
-    """``(Σy/Σn, its cluster-robust variance)`` (the delta method of
-    :func:`opspec.statistics.ratio_estimate`); None without two users or any denominator."""
-    users = len(pairs)
-    total = math.fsum(n for _, n in pairs)
-    if users < 2 or total <= 0:
-        return None
-    r = math.fsum(y for y, _ in pairs) / total
-    nbar = total / users
-    resid = math.fsum((y - r * n) ** 2 for y, n in pairs)
-    return r, resid / (users * (users - 1)) / nbar ** 2
-
-
-def _difference(a: Sequence[tuple[float, float]], b: Sequence[tuple[float, float]]
-                ) -> tuple[float, float] | None:
-    """``(r_B − r_A, its paired variance)`` on the same users."""
-    ea, eb = _estimate(a), _estimate(b)
-    if ea is None or eb is None:
-        return None
-    users = len(a)
-    na, nb = math.fsum(n for _, n in a) / users, math.fsum(n for _, n in b) / users
-    z = [(yb - eb[0] * mb) / nb - (ya - ea[0] * ma) / na
-         for (ya, ma), (yb, mb) in zip(a, b, strict=True)]
-    return eb[0] - ea[0], pystats.variance(z) / users
-
-
-def _percentile(ordered: Sequence[float], q: float) -> float:
-    pos = (len(ordered) - 1) * q
-    lo = math.floor(pos)
-    hi = min(lo + 1, len(ordered) - 1)
-    return ordered[lo] + (ordered[hi] - ordered[lo]) * (pos - lo)
-
-
 def _combine(estimate: float | None, ordinary: Sequence[float | None] | None,
              simulation: float | None, users: int, batches: Sequence[tuple[float, float]],
              level: float, *, proportion: bool = False) -> dict[str, Any]:
@@ -237,8 +206,7 @@ def _combine(estimate: float | None, ordinary: Sequence[float | None] | None,
     ordered = sorted(values)
     alpha = (1 - level) / 2
     return {**out, "ci95_with_parameters": [low, high],
-            "direct_bootstrap_ci95": [_percentile(ordered, alpha),
-                                      _percentile(ordered, 1 - alpha)],
+            "direct_bootstrap_ci95": [linear(ordered, alpha), linear(ordered, 1 - alpha)],
             "variance": {"parameters": parameters, "simulation": simulation,
                          "between_draws": between, "within_draws": noise},
             "parameter_share": parameters / total if total > 0 else 0.0,
@@ -283,9 +251,9 @@ def summarise_input_uncertainty(store: Any, plan: Any, metrics: Mapping[str, Any
         name = definition["name"]
         ordinary = metrics.get(name) or {}
         pairs = [p for _, p in user_pairs(store, design, definition)]
-        plain = _estimate(pairs)
+        plain = ratio_variance(pairs)
         batches = [e for users in _batches(store, plan, design, definition).values()
-                   if (e := _estimate(list(users.values()))) is not None]
+                   if (e := ratio_variance(list(users.values()))) is not None]
         estimate = ordinary.get("value", ordinary.get("mean"))
         out["metrics"][name] = _combine(estimate, ordinary.get("ci95"),
                                         plain[1] if plain else None, len(pairs), batches,
@@ -300,14 +268,14 @@ def summarise_input_uncertainty(store: Any, plan: Any, metrics: Mapping[str, Any
             a = dict(user_pairs(store, design, definition))
             b = dict(user_pairs(store, "B", theirs[name]))
             common = sorted(set(a) & set(b))
-            plain = _difference([a[u] for u in common], [b[u] for u in common])
+            plain = paired_variance([a[u] for u in common], [b[u] for u in common])
             batch_a = _batches(store, plan, design, definition)
             batch_b = _batches(store, plan, "B", theirs[name])
             batches = []
             for draw, users_a in batch_a.items():
                 users_b = batch_b.get(draw, {})
                 both = sorted(set(users_a) & set(users_b))
-                found = _difference([users_a[u] for u in both], [users_b[u] for u in both])
+                found = paired_variance([users_a[u] for u in both], [users_b[u] for u in both])
                 if found is not None:
                     batches.append(found)
             entry = compare[name]
@@ -372,8 +340,10 @@ def report_section(store: Any, given: Mapping[str, Any],
         f"{_title(summary)}: each draw is the model refitted to a bootstrap resample of "
         "the traces, run on users of its own. 'from parameters' is the share of the "
         "widened interval's variance due to the parameters; more simulated users narrow "
-        "only the rest, more recorded observations narrow this part. See "
-        "docs/evaluation.md, Input uncertainty."),),
+        "only the rest, more recorded observations narrow this part. The widened "
+        "interval adds the between-draw variance of the estimates, less their "
+        "within-draw (simulation) variance, to the ordinary variance, on Satterthwaite's "
+        "degrees of freedom, and covers the ordinary interval."),),
         tables=(Table(HEADERS, tuple(_rows(summary)),
                       "Ordinary 95 % intervals (simulation noise only) and intervals that "
                       "include the fitted parameters' uncertainty"),))

@@ -65,7 +65,7 @@ class EvaluationPlan:
     engine: Mapping[str, Any] = field(default_factory=dict)
     export: tuple[str, ...] = ()
     #: what one case of the XES and JSON Lines exports is (opspec.evaluation.cases)
-    case: str = "user"
+    case: str = "chain"
     #: ``--input-uncertainty B``: parameter draws of the fitted user model to run, each on
     #: ``users_per_draw`` users of its own (opspec.evaluation.input_uncertainty); 0: none
     input_uncertainty: int = 0

@@ -1,7 +1,10 @@
-"""The evaluation's figures: one PNG per function, readable by people who did not run it.
+"""The evaluation's figures: one per function, fit for a paper and readable by people who did
+not run it.
 
-Every function draws one figure, writes it as a PNG to ``path`` (parent folders are created)
-and returns ``path``. Empty input never raises: the figure then says "no observations", so a
+Every function draws one figure, writes it to ``path`` (parent folders are created) in the
+format :func:`figure_format` chose, else the one ``path``'s suffix names — SVG (vector: the
+report inlines it; the report's default), PDF, or PNG at :data:`DPI` — and returns the path
+written (with PDF, an SVG twin beside it, which is returned: the HTML report shows that one). Empty input never raises: the figure then says "no observations", so a
 report of a run in which nothing happened still has all its pictures. Non-finite values
 (NaN, ±inf) are left out and counted in the figure's note.
 
@@ -9,8 +12,11 @@ Conventions, so every figure reads the same way:
 
 - colours from the Okabe-Ito palette (distinguishable with the common colour-vision
   deficiencies), and each series also differs by marker or line style, never by colour alone;
-- axis labels carry units (seconds, %, count); titles say what the reader sees;
-- rates whose estimates and intervals all lie in [0, 1] are shown as percentages.
+- axis labels are words with units (seconds, %, count); a figure has no title: the report's
+  caption says what the reader sees (a journal sets its own), panels are labelled on their
+  axes;
+- rates whose estimates and intervals all lie in [0, 1] are shown as percentages, on axes
+  that never leave [0, 100] %.
 
 matplotlib is imported inside the functions, so ``import opspec.evaluation`` stays light. We
 draw on :class:`matplotlib.figure.Figure` objects with the Agg canvas instead of pyplot: no
@@ -23,6 +29,7 @@ from __future__ import annotations
 import math
 from collections.abc import Iterator, Mapping, Sequence
 from contextlib import contextmanager
+from contextvars import ContextVar
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -34,9 +41,11 @@ if TYPE_CHECKING:
 
 __all__ = [
     "DPI",
+    "FORMATS",
     "PALETTE",
     "activity_rates_figure",
     "comparison_figure",
+    "figure_format",
     "latency_figure",
     "over_days_figure",
     "parameters_figure",
@@ -47,7 +56,14 @@ __all__ = [
     "time_of_day_figure",
 ]
 
-DPI = 110
+#: Resolution of PNG figures (journals ask for at least 200-300 dpi for line art in raster).
+DPI = 200
+#: What ``opspec evaluate --figures`` can write: vector SVG (the default; inlined in the HTML
+#: report), vector PDF (for LaTeX), or PNG at :data:`DPI`.
+FORMATS = ("svg", "pdf", "png")
+#: The format :func:`figure_format` chose; None: the one ``path``'s suffix names (PNG for an
+#: unknown suffix).
+_FORMAT: ContextVar[str | None] = ContextVar("opspec_figure_format", default=None)
 
 #: Okabe & Ito (2008), "Color Universal Design": safe for deuteranopia, protanopia, tritanopia.
 PALETTE: tuple[str, ...] = (
@@ -75,12 +91,26 @@ _RC: dict[str, Any] = {
     "grid.alpha": 0.3,
     "axes.spines.top": False,
     "axes.spines.right": False,
+    "svg.hashsalt": "opspec",   # the same ids in every run: the report's bytes are reproducible
 }
 
 NO_OBSERVATIONS = "no observations"
 
 
 # --------------------------------------------------------------------------------- helpers
+
+@contextmanager
+def figure_format(name: str) -> Iterator[None]:
+    """Within this block, figures are written as ``name`` (one of :data:`FORMATS`)."""
+    if name not in FORMATS:
+        raise EvaluationError(f"unknown figure format {name!r}",
+                              hint="use " + ", ".join(FORMATS))
+    token = _FORMAT.set(name)
+    try:
+        yield
+    finally:
+        _FORMAT.reset(token)
+
 
 @contextmanager
 def _figure(width: float, height: float) -> Iterator[Figure]:
@@ -98,7 +128,10 @@ def _figure(width: float, height: float) -> Iterator[Figure]:
 
 
 def _save(fig: Figure, path: Path) -> Path:
-    path = Path(path)
+    fmt = _FORMAT.get() or (Path(path).suffix.lstrip(".").lower() or "png")
+    if fmt not in FORMATS:
+        fmt = "png"
+    path = Path(path).with_suffix(f".{fmt}")
     # Lay the figure out once and freeze it there: with a layout engine attached, savefig
     # draws twice (a pass to lay out, then the drawing, which lays out again). The frozen
     # positions are the same, so are the pixels, at about two thirds of the cost.
@@ -106,25 +139,38 @@ def _save(fig: Figure, path: Path) -> Path:
     if engine is not None:
         engine.execute(fig)
         fig.set_layout_engine(None)
-    from PIL import Image
-
     fig.patch.set_facecolor("white")
-    canvas = fig.canvas
-    canvas.draw()
-    width, height = canvas.get_width_height(physical=True)
-    # RGB rather than matplotlib's RGBA (the background is opaque white: a quarter less to
-    # compress), at zlib level 3: half the encoding time of level 6, and files no larger
-    # than matplotlib's own RGBA at level 6.
-    image = Image.frombuffer("RGBA", (width, height), canvas.buffer_rgba(),  # type: ignore[attr-defined]
-                             "raw", "RGBA", 0, 1).convert("RGB")
     try:
         path.parent.mkdir(parents=True, exist_ok=True)
-        image.save(path, format="png", compress_level=3)
+        if fmt == "png":
+            _save_png(fig, path)
+            return path
+        # no dates in the files: the same results give the same bytes
+        fig.savefig(path, format=fmt, metadata={"Date": None} if fmt == "svg"
+                    else {"CreationDate": None, "ModDate": None})
+        if fmt == "pdf":            # the HTML report shows vector figures inline: SVG
+            twin = path.with_suffix(".svg")
+            fig.savefig(twin, format="svg", metadata={"Date": None})
+            return twin
     except OSError as error:
         raise EvaluationError(f"cannot write the figure {path}: {error.strerror or error}",
                               hint="check that the output folder exists, is writable and "
                                    "the disk is not full") from None
     return path
+
+
+def _save_png(fig: Figure, path: Path) -> None:
+    from PIL import Image
+
+    canvas = fig.canvas
+    canvas.draw()
+    width, height = canvas.get_width_height(physical=True)
+    # RGB rather than matplotlib's RGBA (the background is opaque white: a quarter less to
+    # compress), at zlib level 3: half the encoding time of level 6, and files no larger
+    # than matplotlib's own RGBA at level 6. The resolution is stored (pHYs) for layout tools.
+    image = Image.frombuffer("RGBA", (width, height), canvas.buffer_rgba(),  # type: ignore[attr-defined]
+                             "raw", "RGBA", 0, 1).convert("RGB")
+    image.save(path, format="png", compress_level=3, dpi=(DPI, DPI))
 
 
 def _finite(values: Sequence[float]) -> tuple[list[float], int]:
@@ -173,10 +219,16 @@ def _note_dropped(fig: Figure, dropped: int) -> None:
 
 
 def _never(names: Sequence[str]) -> str:
-    """A second title line naming the metrics not drawn because they never happened (a
-    panel of zeros on a made-up scale would only look like data); in the title, where the
-    layout makes room for it, however many there are."""
-    return f"\n(never happened, so not drawn: {', '.join(names)})" if names else ""
+    """A note naming the metrics not drawn because they never happened (a panel of zeros on
+    a made-up scale would only look like data)."""
+    return f"never happened, so not drawn: {', '.join(names)}" if names else ""
+
+
+def _note(fig: Figure, text: str) -> None:
+    """A small note under the figure (what is not drawn, a sample): part of the figure, as
+    the caption cannot know it."""
+    if text:
+        fig.supxlabel(text, fontsize=9, color="#444444", ha="left", x=0.01)
 
 
 def _outside_legend(ax: Axes) -> None:
@@ -193,17 +245,19 @@ def _bar_height(rows: int) -> float:
 
 def latency_figure(metric: str, values: Sequence[float], path: Path, *,
                    marks: Mapping[str, float | None] | None = None,
-                   total: int | None = None) -> Path:
+                   total: int | None = None, label: str | None = None,
+                   unit: str = "s") -> Path:
     """ECDF (left) and histogram (right) of one duration metric, in seconds.
 
     Mean, median and 95th percentile are marked on both panels with distinct line styles and
     their values in the legend. ``marks`` gives them (``mean``, ``median``, ``p95``) computed
     from every observation when ``values`` is a sample of them; ``total`` is then the number
-    of all observations, and the figure says that it draws a sample.
+    of all observations, and the figure says that it draws a sample. ``label`` is the
+    metric in words for the axes (default: its name), ``unit`` its unit.
     """
     import numpy as np
 
-    metric = _text(metric)
+    metric = _text(label or metric)
     title = f"{metric}: distribution of durations"
     data, dropped = _finite(values)
     if not data:
@@ -218,15 +272,20 @@ def latency_figure(metric: str, values: Sequence[float], path: Path, *,
     with _figure(11.0, 4.4) as fig:
         count = (f"a sample of {arr.size:,} of {total:,} observations" if sampled
                  else f"{arr.size:,} observations")
-        fig.suptitle(f"{metric}: how long it took ({count})")
+        _note(fig, count if sampled else "")
         left, right = fig.subplots(1, 2)
-        # ECDF: a step function by hand (Axes.ecdf needs matplotlib >= 3.8)
+        # ECDF: a step function by hand (Axes.ecdf needs matplotlib >= 3.8), at most 2,000
+        # steps (quantiles 1/2000 apart): finer than a printed figure shows, and a vector
+        # figure stays small
         xs = np.sort(arr)
         ys = np.arange(1, xs.size + 1) / xs.size
+        if xs.size > 2000:
+            keep = np.unique(np.linspace(0, xs.size - 1, 2000).round().astype(int))
+            xs, ys = xs[keep], ys[keep]
         left.step(np.concatenate(([xs[0]], xs)), np.concatenate(([0.0], ys)), where="post",
                   color=PALETTE[0], linewidth=2, label="share done within x")
         left.set_title("Cumulative share of observations")
-        left.set_xlabel(f"{metric} (seconds)")
+        left.set_xlabel(f"{metric} ({unit})")
         left.set_ylabel("share of observations (%)")
         left.set_ylim(0.0, 1.02)
         _percent_axis(left, "y")
@@ -234,12 +293,12 @@ def latency_figure(metric: str, values: Sequence[float], path: Path, *,
         right.hist(arr, bins=bins, histtype="stepfilled", color=PALETTE[5], edgecolor=PALETTE[0],
                    linewidth=0.8)
         right.set_title("Histogram")
-        right.set_xlabel(f"{metric} (seconds)")
+        right.set_xlabel(f"{metric} ({unit})")
         right.set_ylabel("number of observations" + (" (in the sample)" if sampled else ""))
         for name, value, style, colour in drawn:
             for ax in (left, right):
                 ax.axvline(value, linestyle=style, color=colour, linewidth=1.8,
-                           label=f"{name} = {value:.4g} s" if ax is right else None)
+                           label=f"{name} = {value:.4g} {unit}" if ax is right else None)
         right.legend(loc="best", frameon=True,
                      title="of all observations" if sampled else None)
         _note_dropped(fig, dropped)
@@ -266,25 +325,29 @@ def rates_figure(rows: Sequence[tuple[str, float, float, float]], path: Path) ->
     if not clean:
         return _empty(path, title)
     with _figure(9.0, 1.3 + 0.95 * len(clean)) as fig:
-        fig.suptitle(f"{title}\n(point = estimate, bar = interval; each on its own scale)")
         for ax, (label, est, lo, hi) in zip(_panels(fig, len(clean), sharex=False), clean,
                                             strict=True):
             percent = _is_rate([est, lo, hi])
             ax.errorbar([est], [0.0], xerr=[[max(est - lo, 0.0)], [max(hi - est, 0.0)]],
                         fmt="o", color=PALETTE[0], ecolor=PALETTE[0], capsize=5,
-                        markersize=7, linewidth=1.8)
-            ax.annotate(f"{_fmt(est, percent)}  [{_fmt(lo, percent)}, {_fmt(hi, percent)}]",
-                        (hi, 0.0), xytext=(6, 0), textcoords="offset points", va="center",
-                        fontsize=9)
+                        markersize=7, linewidth=1.8, clip_on=False)
             ax.set_yticks([0.0], [label])
             ax.set_ylim(-1.0, 1.0)
             ax.grid(axis="y", visible=False)
             width = hi - lo if hi > lo else max(abs(est) * 0.1, 1e-6)
             left, right = lo - 0.6 * width, hi + 1.9 * width   # room for the label
+            # a rate's axis stays within [0, 100] %: near 100 % the label goes to the left
+            on_left = percent and right > 1.0
+            if on_left:
+                left, right = lo - 1.9 * width, hi + 0.6 * width
+            text = f"{_fmt(est, percent)}  [{_fmt(lo, percent)}, {_fmt(hi, percent)}]"
+            ax.annotate(text, (lo, 0.0) if on_left else (hi, 0.0),
+                        xytext=(-6 if on_left else 6, 0), textcoords="offset points",
+                        va="center", ha="right" if on_left else "left", fontsize=9)
             if percent:
                 from matplotlib.ticker import PercentFormatter
 
-                left, right = max(left, 0.0), min(right, 1.0 + 0.9 * width)
+                left, right = max(left, 0.0), min(right, 1.0)
                 step = max((right - left) * 100.0 / 6.0, 1e-9)   # about six ticks
                 ax.xaxis.set_major_formatter(PercentFormatter(
                     xmax=1.0, decimals=max(0, -math.floor(math.log10(step)))))
@@ -296,8 +359,12 @@ def rates_figure(rows: Sequence[tuple[str, float, float, float]], path: Path) ->
         return _save(fig, path)
 
 
-def over_days_figure(series: Mapping[str, Sequence[float]], path: Path) -> Path:
-    """One panel per metric, each on its own scale: its value on day 1, 2, …, D."""
+def over_days_figure(series: Mapping[str, Sequence[float]], path: Path, *,
+                     bands: Mapping[str, Sequence[tuple[float | None, float | None]]]
+                     | None = None) -> Path:
+    """One panel per metric, each on its own scale: its value on day 1, 2, …, D, with the
+    95 % interval of each day as a band when ``bands`` gives them (per metric, per day)."""
+    bands = {_text(name): list(b) for name, b in (bands or {}).items()}
     title = "Outcomes over the simulated days"
     present = {_text(name): list(vals) for name, vals in series.items() if len(vals) > 0}
     never = [name for name, vals in present.items() if all(v == 0 for v in vals)]
@@ -306,7 +373,7 @@ def over_days_figure(series: Mapping[str, Sequence[float]], path: Path) -> Path:
         return _empty(path, title + (": every outcome was 0 on every day" if never else ""))
     longest = max(len(v) for v in present.values())
     with _figure(9.0, 0.9 + 1.45 * len(present)) as fig:
-        fig.suptitle(f"{title}: mean per user on each day{_never(never)}")
+        _note(fig, _never(never))
         axes = _panels(fig, len(present))
         for i, (ax, (name, vals)) in enumerate(zip(axes, present.items(), strict=True)):
             days = list(range(1, len(vals) + 1))
@@ -315,8 +382,17 @@ def over_days_figure(series: Mapping[str, Sequence[float]], path: Path) -> Path:
             ax.plot(days, ys, color=PALETTE[i % len(PALETTE)],
                     marker=_MARKERS[i % len(_MARKERS)] if longest <= 60 else None,
                     markersize=4, linestyle=_LINESTYLES[i % len(_LINESTYLES)], linewidth=1.6)
-            ax.set_ylabel(name, rotation=0, ha="right", va="center")
-            finite = [y for y in ys if math.isfinite(y)]
+            band = bands.get(name)
+            if band and len(band) == len(vals):
+                lows = [math.nan if lo is None else float(lo) for lo, _ in band]
+                highs = [math.nan if hi is None else float(hi) for _, hi in band]
+                ax.fill_between(days, lows, highs, color=PALETTE[i % len(PALETTE)],
+                                alpha=0.2, linewidth=0, step=None)
+                ys_all = ys + [h for h in highs if math.isfinite(h)]
+            else:
+                ys_all = ys
+            ax.set_ylabel(f"{name}\n(per user)", rotation=0, ha="right", va="center")
+            finite = [y for y in ys_all if math.isfinite(y)]
             if finite and min(finite) >= 0:
                 ax.set_ylim(bottom=0, top=max(max(finite) * 1.15, 1e-9))
         axes[-1].set_xlabel("simulated day")
@@ -341,7 +417,7 @@ def time_of_day_figure(series: Mapping[str, Sequence[int]], path: Path) -> Path:
     if not present:
         return _empty(path, title + (": no outcome ever happened" if never else ""))
     with _figure(9.0, 0.9 + 1.45 * len(present)) as fig:
-        fig.suptitle(f"{title}: occurrences in each hour, all users and days{_never(never)}")
+        _note(fig, _never(never))
         axes = _panels(fig, len(present))
         for i, (ax, (name, counts)) in enumerate(zip(axes, present.items(), strict=True)):
             # each hour is the bin [h, h+1): one outlined step patch, not 24 bar artists
@@ -373,7 +449,6 @@ def per_user_figure(series: Mapping[str, Sequence[float]], path: Path, *,
     if not present:
         return _empty(path, title)
     with _figure(9.0, 0.9 + 2.0 * len(present)) as fig:
-        fig.suptitle(f"{title}: each user's own value, over users")
         axes = _panels(fig, len(present), sharex=False)
         for ax, (name, data) in zip(axes, present.items(), strict=True):
             arr = np.asarray(data, dtype=float)
@@ -381,14 +456,21 @@ def per_user_figure(series: Mapping[str, Sequence[float]], path: Path, *,
             scale = 100.0 if unit == "%" else 1.0
             arr = arr * scale
             distinct = np.unique(arr)
-            if distinct.size <= 30:     # a few values (0, 1/120, 2/120 …): one bar each
-                step = float(np.min(np.diff(distinct))) if distinct.size > 1 else 1.0
+            if distinct.size <= 30:
+                # a few values (0, 1 of 28 doses, 2 of 28 …): each value users had is a
+                # thin bar of its own at that value, not a bin around it (a bin's width
+                # would claim values nobody can have, below 0 % or above 100 %)
                 counts = [int(np.sum(arr == v)) for v in distinct]
-                ax.bar(distinct, counts, width=step * 0.8, color=PALETTE[5],
-                       edgecolor=PALETTE[0], linewidth=0.6)
+                ax.vlines(distinct, 0, counts, colors=PALETTE[0], linewidth=5,
+                          clip_on=False)
+                ax.set_ylim(0, max(counts) * 1.1)
             else:               # one outlined patch, not a rectangle per bin
                 ax.hist(arr, bins="auto", histtype="stepfilled", color=PALETTE[5],
                         edgecolor=PALETTE[0], linewidth=0.8)
+            if unit == "%":     # a rate's axis stays within [0, 100] %
+                low, high = float(arr.min()), float(arr.max())
+                pad = max((high - low) * 0.05, 0.5)
+                ax.set_xlim(max(0.0, low - pad), min(100.0, high + pad))
             mean = float(arr.mean())
             label = f"{mean:.2f} %" if unit == "%" else f"{mean:.4g}{' ' + unit if unit else ''}"
             # the mean in the panel's title, not in a legend box: a box in a corner hid the
@@ -438,7 +520,6 @@ def subgroups_figure(metric: str, groups: Mapping[str, Sequence[float]], path: P
     with _figure(9.0, 3.8) as fig:
         ax = fig.add_subplot()
         _step_histograms(ax, present, scale)
-        ax.set_title(_text(title), loc="left")
         ax.set_xlabel(f"each user's {_text(metric)}"
                       + (f" ({'%' if unit == '%' else unit})" if unit else ""))
         _outside_legend(ax)
@@ -456,7 +537,6 @@ def parameters_figure(parameters: Mapping[str, Mapping[str, Sequence[float]]], p
     if not present:
         return _empty(path, title)
     with _figure(9.0, 0.9 + 2.3 * len(present)) as fig:
-        fig.suptitle(f"{title}, by subgroup (share of the subgroup's users)")
         for ax, (name, groups) in zip(_panels(fig, len(present), sharex=False),
                                       present.items(), strict=True):
             _step_histograms(ax, groups, 1.0)
@@ -465,11 +545,15 @@ def parameters_figure(parameters: Mapping[str, Mapping[str, Sequence[float]]], p
         return _save(fig, path)
 
 
-def activity_rates_figure(rows: Sequence[tuple[str, float, float]], path: Path) -> Path:
-    """Grouped horizontal bars: omission rate and error rate of each (manual) activity."""
+def activity_rates_figure(rows: Sequence[tuple[Any, ...]], path: Path) -> Path:
+    """Grouped horizontal bars: omission rate and error rate of each (manual) activity,
+    ``(activity, omission, error)`` or, with their 95 % intervals drawn as error bars,
+    ``(activity, omission, error, (low, high), (low, high))``."""
     title = "Omission and error rates per activity"
-    clean = [(_text(a), float(o), float(e)) for a, o, e in rows
-             if math.isfinite(float(o)) and math.isfinite(float(e))]
+    clean = [(_text(r[0]), float(r[1]), float(r[2])) for r in rows
+             if math.isfinite(float(r[1])) and math.isfinite(float(r[2]))]
+    intervals = [(r[3], r[4]) for r in rows if len(r) == 5
+                 and math.isfinite(float(r[1])) and math.isfinite(float(r[2]))]
     dropped = len(rows) - len(clean)
     if not clean:
         return _empty(path, title)
@@ -485,9 +569,25 @@ def activity_rates_figure(rows: Sequence[tuple[str, float, float]], path: Path) 
         error = ax.barh([c - height / 2 for c in centres], [e for *_, e in clean],
                         height=height, color=PALETTE[0], edgecolor="black", linewidth=0.5,
                         hatch="//", label="error rate (done wrongly)")
-        for bars in (omission, error):
-            ax.bar_label(bars, labels=[_fmt(b.get_width(), percent) for b in bars],
-                         padding=3, fontsize=9)
+        tops = [max(o, e) for _, o, e in clean]
+        ends = [[b.get_width() for b in omission], [b.get_width() for b in error]]
+        if len(intervals) == n:
+            for offset, k in ((height / 2, 0), (-height / 2, 1)):
+                ests = [clean[i][1 + k] for i in range(n)]
+                lows = [max(0.0, ests[i] - (intervals[i][k][0] or 0.0)) for i in range(n)]
+                highs = [max(0.0, (intervals[i][k][1] or 0.0) - ests[i]) for i in range(n)]
+                ax.errorbar(ests, [c + offset for c in centres], xerr=[lows, highs],
+                            fmt="none", ecolor="black", capsize=3, linewidth=1.0)
+            tops = [max(o, e, intervals[i][0][1] or 0.0, intervals[i][1][1] or 0.0)
+                    for i, (_, o, e) in enumerate(clean)]
+            ends = [[max(clean[i][1 + k], intervals[i][k][1] or 0.0) for i in range(n)]
+                    for k in (0, 1)]
+        # each value just past its bar, or past its interval when it has one
+        for bars, at in zip((omission, error), ends, strict=True):
+            for bar, x in zip(bars, at, strict=True):
+                ax.annotate(_fmt(bar.get_width(), percent),
+                            (x, bar.get_y() + bar.get_height() / 2), xytext=(4, 0),
+                            textcoords="offset points", va="center", fontsize=9)
         ax.set_yticks(centres, [a for a, *_ in clean])
         # a rule between activities, none through them: a grid line at each name ran
         # between its two bars, and a 0 % label seemed to belong to the next activity
@@ -495,11 +595,10 @@ def activity_rates_figure(rows: Sequence[tuple[str, float, float]], path: Path) 
         for c in centres[:-1]:
             ax.axhline(c - 0.5, color="#999999", linewidth=0.6)
         ax.set_ylim(-0.5, n - 0.5)
-        ax.set_title(f"{title} (share of the times it was asked for)")
         if percent:
             _percent_axis(ax, "x")
-            ax.set_xlabel("rate (% of offers)")
-            top = max(max(o, e) for _, o, e in clean)
+            ax.set_xlabel("rate (% of the times it was asked for)")
+            top = max(tops)
             ax.set_xlim(0.0, min(1.0, top * 1.3 + 0.01) if top > 0 else 0.05)
         else:
             ax.set_xlabel("rate")
@@ -527,7 +626,6 @@ def comparison_figure(rows: Sequence[tuple[str, float, float, float]], path: Pat
     units = units or {}
     with _figure(9.0, 0.9 + 0.75 * len(clean)) as fig:
         axes = fig.subplots(len(clean), 1, squeeze=False)[:, 0]
-        fig.suptitle(title + " (filled: interval excludes 0)")
         for ax, (name, diff, lo, hi) in zip(axes, clean, strict=True):
             unit = units.get(name, "")
             scale = 100.0 if unit == "pp" else 1.0
@@ -577,8 +675,6 @@ def sweep_figure(parameter: str, xs: Sequence[float], labels: Sequence[str],
     percent, units = percent or {}, units or {}
     targets, per_user = targets or {}, per_user or {}
     with _figure(9.0, 1.2 + 2.1 * len(names)) as fig:
-        fig.suptitle(f"{_text(title)}\n(line = estimate, band = 95 % interval; each metric "
-                     "on its own scale)")
         axes = _panels(fig, len(names), sharex=True)
         for ax, name in zip(axes, names, strict=True):
             est, low, high = series[name]

@@ -53,6 +53,7 @@ from opspec.evaluation.tables import (
     distribution_rows,
     fmt,
     is_rate,
+    method_name,
     metric_rows,
     monitor_rows,
     parameter_rows,
@@ -105,12 +106,60 @@ def _outcomes_all(store: ResultStore, design: str, metrics: list[str], days: int
     return per_day, per_hour
 
 
-def _activity_rates(store: ResultStore, design: str
-                    ) -> list[tuple[str, int, float, float]]:
-    rows = store.query("SELECT activity, SUM(offered), SUM(omitted), SUM(wrong) FROM activity "
-                       "WHERE design = ? GROUP BY activity ORDER BY MIN(rowid)", (design,))
-    return [(str(a), int(off), (om or 0) / off, (wr or 0) / off)
-            for a, off, om, wr in rows if off]
+def _day_intervals(store: ResultStore, design: str, metrics: list[str], days: int,
+                   users: int) -> dict[str, list[tuple[float | None, float | None]]]:
+    """Per metric in ``metrics``: the 95 % interval of its mean count per user on each day
+    (as a count metric's over the run: t over users, widened to Garwood with fewer than 10
+    events), from the sums and sums of squares over users the store keeps."""
+    from opspec.statistics import count_estimate_from_sums
+
+    totals: dict[tuple[str, int], float] = {}
+    for metric, day, _hour, n in store.outcome_sums(design):
+        totals[(metric, int(day))] = totals.get((metric, int(day)), 0.0) + float(n)
+    squares = {(m, int(d)): float(q) for m, d, q in store.outcome_day_squares(design)}
+    out = {}
+    for m in metrics:
+        out[m] = []
+        for d in range(days):
+            e = count_estimate_from_sums(totals.get((m, d), 0.0), squares.get((m, d), 0.0),
+                                         users)
+            out[m].append((e.low, e.high))
+    return out
+
+
+def _activity_rates(store: ResultStore, design: str) -> list[dict[str, Any]]:
+    """Per manual activity: offered, the omission and error rates per offer, and their
+    intervals over users (each user's omissions of their offers: a proportion pooled over
+    users, as a metric's missed rate, method ``wilson-neff``)."""
+    from opspec.statistics import proportion_interval
+
+    per: dict[str, list[tuple[int, int, int]]] = {}
+    for activity, offered, omitted, wrong in store.query(
+            "SELECT activity, offered, omitted, wrong FROM activity WHERE design = ? "
+            "ORDER BY rowid", (design,)):
+        per.setdefault(str(activity), []).append(
+            (int(offered or 0), int(omitted or 0), int(wrong or 0)))
+    out = []
+    for activity, users in per.items():
+        offered = sum(o for o, _, _ in users)
+        if not offered:
+            continue
+        out.append({"activity": activity, "offered": offered,
+                    "omission": sum(m for _, m, _ in users) / offered,
+                    "error": sum(w for _, _, w in users) / offered,
+                    "omission_ci95": proportion_interval([(m, o) for o, m, _ in users]),
+                    "error_ci95": proportion_interval([(w, o) for o, _, w in users]),
+                    "ci95_method": "wilson-neff"})
+    return out
+
+
+def words(name: str, unit: str | None = None) -> str:
+    """A metric's name as words for an axis: ``report_latency_s`` with unit ``s`` is
+    "report latency" (the unit goes in the axis label's brackets, not twice)."""
+    text = name.replace("_", " ").strip()
+    if unit and text.endswith(f" {unit}"):
+        text = text[: -len(unit) - 1]
+    return text
 
 
 def _users_done(store: ResultStore, design: str) -> int:
@@ -392,7 +441,8 @@ def _design_sections(store: ResultStore, figures: Path, design: str, name: str, 
         "totals); durations are pooled over all observations; ratios are the sum of the "
         "numerator over the sum of the denominator over all users."),),
         tables=(Table(METRIC_HEADERS, tuple(metric_rows(metrics)),
-                      f"Declared metrics of {name}"),),
+                      f"Declared metrics of {name}: {users:,} simulated users × "
+                      f"{span(days)} each"),),
         images=tuple(images), captions=tuple(captions)))
     if population and population.get("subgroups"):
         sections.append(_by_subgroup_section(metrics, population, design, first, prefix))
@@ -409,8 +459,8 @@ def _design_sections(store: ResultStore, figures: Path, design: str, name: str, 
         for d in shown:
             s = metrics[d["name"]]
             values = [y / k for _, (y, k) in by_metric[d["name"]] if k > 0]
-            label = (f"{d['name']} (mean per user)" if s["kind"] == "duration"
-                     else d["name"])
+            label = (f"{words(d['name'], s.get('unit') or 's')}, mean per user"
+                     if s["kind"] == "duration" else words(d["name"]))
             series[label] = values
             units[label] = ("%" if is_rate(d["name"], s)
                             else (s.get("unit") or "s") if s["kind"] == "duration" else "")
@@ -459,10 +509,15 @@ def _design_sections(store: ResultStore, figures: Path, design: str, name: str, 
             continue
         values, total = _observations(store, design, d["name"])
         marks = {"mean": s.get("mean"), "median": s.get("median"), "p95": s.get("p95")}
+        unit = s.get("unit") or "s"
         images.append(plots.latency_figure(d["name"], values,
                                            figures / f"{design}-{d['name']}.png",
-                                           marks=marks, total=total))
-        caption = f"Distribution of {d['name']}: ECDF (left) and histogram (right)"
+                                           marks=marks, total=total,
+                                           label=words(d["name"], unit), unit=unit))
+        caption = (f"Distribution of {d['name']}"
+                   + (f" ({d['description'].rstrip('.')})" if d.get("description") else "")
+                   + ": the share of observations done within x (left) and histogram "
+                   "(right); mean, median and p95 marked")
         if total > len(values):
             caption += (f"; drawn from an even sample of {len(values):,} of the {total:,} "
                         "observations; mean, median and p95 are of all observations")
@@ -478,30 +533,47 @@ def _design_sections(store: ResultStore, figures: Path, design: str, name: str, 
     if counts:
         # one pass over the outcome table for all metrics, not two per metric (issue 20)
         per_day, hours = _outcomes_all(store, design, counts, max(1, round(days)), users)
+        bands = _day_intervals(store, design, counts, max(1, round(days)), users)
+        per_day = {words(n): v for n, v in per_day.items()}
+        bands = {words(n): v for n, v in bands.items()}
+        hours = {words(n): v for n, v in hours.items()}
         sections.append(Section(f"{prefix}Counts over time", images=(
-            plots.over_days_figure(per_day, figures / f"{design}-days.png"),
+            plots.over_days_figure(per_day, figures / f"{design}-days.png", bands=bands),
             plots.time_of_day_figure(hours, figures / f"{design}-hours.png")), captions=(
-            ("Count outcomes per user, day by day (mean over users; each metric on its own "
-            "scale, so rare outcomes are visible)"),
+            ("Count outcomes per user, day by day: the mean over users (line) and its 95 % "
+            "interval (band; t over users, widened to the exact Poisson interval on days "
+            "with fewer than 10 events); each metric on its own scale, so rare outcomes are "
+            "visible"),
             ("Count outcomes by hour of the day, all users and days (each metric on its own "
             "scale)"))))
 
     # the user's actions
     activity = _activity_rates(store, design)
     if activity:
-        image = plots.activity_rates_figure([(a, o, w) for a, _, o, w in activity],
-                                            figures / f"{design}-activities.png")
+        image = plots.activity_rates_figure(
+            [(r["activity"], r["omission"], r["error"], r["omission_ci95"], r["error_ci95"])
+             for r in activity], figures / f"{design}-activities.png")
+
+        def rate(value: float, ci: Sequence[float | None]) -> str:
+            return (f"{fmt(value, percent=True)} [{fmt(ci[0], percent=True)}, "
+                    f"{fmt(ci[1], percent=True)}]")
+
         sections.append(Section(f"{prefix}The user's actions", paragraphs=(
             ("For each activity of the user's lane: how often it was asked of the user "
             "(offered), the share not done (omitted: an alarm not heard, a step forgotten) "
-            "and the share done wrongly (a wrong button chosen)."),),
-            tables=(Table(("activity", "offered", "omitted per offer", "wrong per offer"),
-                          tuple((a, f"{n:,}", fmt(o, percent=True), fmt(w, percent=True))
-                                for a, n, o, w in activity),
+            "and the share done wrongly (a wrong button chosen), with 95 % intervals over "
+            "users."),),
+            tables=(Table(("activity", "offered", "omitted per offer [95 % CI]",
+                           "wrong per offer [95 % CI]", "CI method"),
+                          tuple((r["activity"], f"{r['offered']:,}",
+                                 rate(r["omission"], r["omission_ci95"]),
+                                 rate(r["error"], r["error_ci95"]), method_name(r))
+                                for r in activity),
                           "Per-activity rates of the user's lane"),),
             images=(image,), captions=(
-                ("The user's activities: omission and error rates per offer (the same "
-                "numbers as the table)"),)))
+                ("The user's activities: omission and error rates per offer, in % of the "
+                 "times each was asked for, with 95 % intervals (the same numbers as the "
+                 "table)"),)))
 
     # hazards
     if monitors:
@@ -514,19 +586,57 @@ def _design_sections(store: ResultStore, figures: Path, design: str, name: str, 
     else:
         sections.append(Section(f"{prefix}Hazards", paragraphs=(
             (f"{name} declares no safety monitors (opspec:Monitor), so no hazards were "
-            "watched. Declare one (for instance min_gap dispense 4h; see "
-            "docs/spec-testing.md) to have it reported here."),)))
+            "watched. Declare one as an ExtendedAttribute of the spec's package, "
+            "opspec:Monitor, with a property such as 'min_gap dispense 4h' (two dispenses "
+            "never less than 4 hours apart), to have its violations counted here."),)))
     return sections
 
 
+def _methods_section(summaries: Any, sections: Sequence[Any]) -> Any:
+    """How every interval in the report was computed: each method that appears in it, with
+    its recipe and references (the same words as ``--json`` and docs/evaluation.md), so the
+    report stands on its own."""
+    from opspec.evaluation.html import Section, Table
+    from opspec.statistics.methods import METHODS, methods_in
+
+    named = {m.name: m.id for m in METHODS.values()}
+    shown = {named[row[i]] for section in sections for table in section.tables
+             if "CI method" in table.headers
+             for row in table.rows for i in [table.headers.index("CI method")]
+             if i < len(row) and row[i] in named}
+    used = [m for m in METHODS if m in shown or m in methods_in(summaries)]
+    rows = tuple((METHODS[m].name, METHODS[m].definition, "; ".join(METHODS[m].references))
+                 for m in used)
+    return Section("How the intervals were computed", paragraphs=(
+        ("Every interval is a two-sided 95 % confidence interval. The simulated users are the "
+         "independent units: observations within one user are not independent (a slow walker "
+         "is slow at every dose), so each metric is reduced to one pair (y, n) per user and "
+         "the intervals are over users. The 'CI method' column of each table names the "
+         "method below; an interval of something that cannot be negative is cut at zero. "
+         "Medians and p95 of durations are of all pooled observations, by linear "
+         "interpolation; per-user percentiles are of the users' own values."),),
+        tables=(Table(("method", "definition", "references"), rows,
+                      "The interval methods used in this report"),) if rows else ())
+
+
 def write_report(store: ResultStore, summaries: Mapping[str, Summaries] | None = None, *,
-                 template: str | Path | None = None) -> Path:
-    """Write ``report.html``, ``report.md`` and ``figures/*.png`` into the store's folder.
+                 template: str | Path | None = None, figures: str = "svg") -> Path:
+    """Write ``report.html``, ``report.md`` and ``figures/*.svg`` (or ``.pdf`` beside SVG
+    twins, or ``.png``: ``figures``, :data:`opspec.evaluation.plots.FORMATS`) into the
+    store's folder.
 
     ``summaries`` per design label (``metrics``, ``monitors``; ``difference`` under ``"B"``)
     are what the caller already computed; what is missing is computed here. ``template`` is
     a Jinja2 template to render the HTML with instead of the bundled one.
     """
+    from opspec.evaluation import plots
+
+    with plots.figure_format(figures):
+        return _write_report(store, summaries, template)
+
+
+def _write_report(store: ResultStore, summaries: Mapping[str, Summaries] | None,
+                  template: str | Path | None) -> Path:
     from opspec.evaluation import plots
     from opspec.evaluation.html import Section, Table, write_html, write_markdown
 
@@ -651,7 +761,7 @@ def write_report(store: ResultStore, summaries: Mapping[str, Summaries] | None =
         compared = ((plots.comparison_figure(rows, figures / "comparison.png", units),)
                     if rows else ())
         headers: tuple[str, ...] = ("metric", names["A"], names["B"], "difference", "95 % CI",
-                                    "")
+                                    "CI method", "")
         sections.append(Section(f"{names['B']} compared with {names['A']}", paragraphs=(
             (f"Differences {names['B']} − {names['A']} per metric on the same simulated users "
             "(paired); 'differs' marks intervals that exclude zero."),),
@@ -682,13 +792,7 @@ def write_report(store: ResultStore, summaries: Mapping[str, Summaries] | None =
                           tuple((names.get(d, d), str(u), e) for d, u, e in failures[:200])),
                     )))
 
-    sections.append(Section("How to read the intervals", paragraphs=(
-        ("Users are the independent units: observations within one user are not independent "
-        "(a slow walker is slow at every dose). Intervals are 95 % confidence intervals over "
-        "users: for a count the Student-t interval of the per-user mean; for durations and "
-        "ratios the cluster-robust (delta-method) interval of the ratio estimator Σy / Σn. "
-        "Medians and p95 of durations are of all pooled observations. An interval of "
-        "something that cannot be negative is cut at zero. See docs/evaluation.md."),)))
+    sections.append(_methods_section([per_design, summaries], sections))
 
     title = f"Evaluation of {Path(specs.get(designs[0], 'spec')).name}"
     write_markdown(folder / "report.md", title, sections)

@@ -163,6 +163,9 @@ class ResultStore:
             #: were replaced (or the store had results when opened): then read from the table.
             self._outcome_sums: dict[str, dict[tuple[str, int, int], int]] | None = (
                 None if self._had_results else {})
+            #: likewise, per design, Σ over users of (the user's count on a day)², by
+            #: (metric, day): the day-by-day figures' intervals, without that pass either
+            self._day_squares: dict[str, dict[tuple[str, int], int]] = {}
         except sqlite3.Error as error:
             raise _fail(self.path, "open the result database", error) from None
 
@@ -253,8 +256,13 @@ class ResultStore:
         elif self._outcome_sums is not None:
             for r in records:
                 sums = self._outcome_sums.setdefault(r.design, {})
+                days: dict[tuple[str, int], int] = {}
                 for key, n in r.outcomes.items():
                     sums[key] = sums.get(key, 0) + n
+                    days[key[:2]] = days.get(key[:2], 0) + n
+                squares = self._day_squares.setdefault(r.design, {})
+                for key, n in days.items():
+                    squares[key] = squares.get(key, 0) + n * n
 
     def index(self) -> None:
         """Build the index readers need that is not kept during the run (the sample values
@@ -270,6 +278,17 @@ class ResultStore:
         return [(str(m), int(d), int(h), int(n)) for m, d, h, n in self.query(
             "SELECT metric, day, hour, SUM(n) FROM outcome WHERE design = ? "
             "GROUP BY metric, day, hour", (design,))]
+
+    def outcome_day_squares(self, design: str) -> list[tuple[str, int, int]]:
+        """``(metric, day, Σ_u n_u²)``: each user's count of a metric on a day, squared and
+        summed over users (with :meth:`outcome_sums`, the day's mean and its variance over
+        users), kept while storing like the sums, else from the table."""
+        if self._outcome_sums is not None:
+            return [(m, d, q) for (m, d), q in self._day_squares.get(design, {}).items()]
+        return [(str(m), int(d), int(q)) for m, d, q in self.query(
+            "SELECT metric, day, SUM(t * t) FROM (SELECT metric, day, user, SUM(n) AS t "
+            "FROM outcome WHERE design = ? GROUP BY metric, day, user) GROUP BY metric, day",
+            (design,))]
 
     def failures(self) -> list[tuple[str, int, str]]:
         rows = self.query("SELECT design, user, error FROM replication "

@@ -9,7 +9,8 @@
   ``p95``, ``p99`` of the users' own means (users without observations left out);
 - ratio: ``value`` = Σ numerator / Σ denominator over users with ``ci95`` (for a proportion
   of counts, such as missed / due doses, Wilson's score interval on the effective number of
-  trials, :func:`opspec.evaluation.proportions.proportion_interval`; otherwise the cluster-robust t interval), and ``per_user``
+  trials, :func:`opspec.statistics.proportions.proportion_interval`; otherwise the
+  cluster-robust t interval), and ``per_user``
   (the same fields over the users' own ratios, plus ``users_with_any``, ``share_with_any``
   and its exact interval: users whose numerator is not 0; and, for a proportion,
   ``between_user_sd``: the sd of the users' true rates with the binomial noise of each
@@ -20,7 +21,8 @@ per subgroup the users (realised share with its exact interval, the share the mo
 and a chi-square test of the shares), the drawn parameters, every metric, and with two
 designs the paired differences.
 Monitors the spec declares (``opspec:Monitor``) are summarised by :func:`summarise_monitors`.
-Intervals are described in :mod:`opspec.statistics`. Quantiles of pooled
+Every interval carries the id of its method (``ci95_method``, ``share_with_any_ci95_method``…;
+:mod:`opspec.statistics.methods`). Quantiles of pooled
 observations are computed in the database, so memory does not grow with the number of users.
 """
 
@@ -31,9 +33,17 @@ import statistics as pystats
 from collections.abc import Mapping, Sequence
 from typing import Any
 
-from opspec.evaluation.proportions import is_proportion, proportion_interval
 from opspec.evaluation.store import ResultStore
-from opspec.statistics import paired_difference, poisson_interval, rate_interval, ratio_estimate
+from opspec.statistics import (
+    count_estimate,
+    hazard_estimate,
+    is_proportion,
+    paired_difference,
+    proportion_interval,
+    rate_interval,
+    ratio_estimate,
+)
+from opspec.statistics.percentiles import interpolation_point, linear
 
 __all__ = ["compare_designs", "has_population", "metric_definitions", "subgroup_users",
            "summarise_design", "summarise_monitors", "summarise_population", "user_pairs"]
@@ -54,12 +64,7 @@ def metric_definitions(store: ResultStore, design: str = "A") -> list[dict[str, 
 
 
 def _percentile(ordered: Sequence[float], q: float) -> float | None:
-    if not ordered:
-        return None
-    pos = (len(ordered) - 1) * q
-    lo = math.floor(pos)
-    hi = min(lo + 1, len(ordered) - 1)
-    return ordered[lo] + (ordered[hi] - ordered[lo]) * (pos - lo)
+    return linear(ordered, q) if ordered else None
 
 
 def _scalar_pair(metric: Mapping[str, Any] | None) -> tuple[float, float]:
@@ -135,15 +140,14 @@ def _pooled_quantile(store: ResultStore, design: str, metric: str, n: int, q: fl
                      subgroup: str | None = None) -> float | None:
     if n == 0:
         return None
-    pos = (n - 1) * q
-    lo = math.floor(pos)
+    lo, frac = interpolation_point(n, q)
     where, params = _in_subgroup(design, subgroup)
     rows = store.query(f"SELECT value FROM sample WHERE design = ? AND metric = ?{where} "
                        "ORDER BY value LIMIT 2 OFFSET ?", (design, metric, *params, lo))
     values = [float(r[0]) for r in rows]
-    if len(values) == 1 or pos == lo:
+    if len(values) == 1 or frac == 0:
         return values[0]
-    return values[0] + (values[1] - values[0]) * (pos - lo)
+    return values[0] + (values[1] - values[0]) * frac
 
 
 def _sd(values: Sequence[float]) -> float | None:
@@ -156,7 +160,8 @@ def _per_user(values: Sequence[float], level: float) -> dict[str, Any]:
     ordered = sorted(values)
     estimate = ratio_estimate([(v, 1.0) for v in ordered], level)
     return {"users": len(ordered), "mean": estimate.value, "sd": _sd(ordered),
-            "ci95": estimate.ci, "median": _percentile(ordered, 0.5),
+            "ci95": estimate.ci, "ci95_method": estimate.method,
+            "median": _percentile(ordered, 0.5),
             **{name: _percentile(ordered, q) for name, q in PERCENTILES}}
 
 
@@ -166,10 +171,12 @@ def _with_any(values: Sequence[float], level: float) -> dict[str, Any]:
     users = len(values)
     hit = sum(1 for v in values if v != 0)
     if users == 0:
-        return {"users_with_any": 0, "share_with_any": None, "share_with_any_ci95": None}
+        return {"users_with_any": 0, "share_with_any": None, "share_with_any_ci95": None,
+                "share_with_any_ci95_method": None}
     _, low, high = rate_interval(hit, users, level, method="clopper-pearson")
     return {"users_with_any": hit, "share_with_any": hit / users,
-            "share_with_any_ci95": [low, high]}
+            "share_with_any_ci95": [low, high],
+            "share_with_any_ci95_method": "clopper-pearson"}
 
 
 def _between_user_sd(pairs: Sequence[tuple[float, float]]) -> float | None:
@@ -188,22 +195,6 @@ def _between_user_sd(pairs: Sequence[tuple[float, float]]) -> float | None:
     return math.sqrt(max(observed - noise, 0.0))
 
 
-#: Fewer events than this and the normal approximation behind the cluster-robust interval of
-#: a count is not to be trusted (the usual np >= 10 rule): the interval is widened to cover
-#: the exact Poisson (Garwood) interval, which never collapses to [0, 0] with no events.
-#: (Proportions of counts have their own interval, :mod:`opspec.evaluation.proportions`.)
-RARE_EVENTS = 10
-
-
-def _rare_count_ci(ci: list[float | None], total: int, users: int, level: float
-                   ) -> list[float | None]:
-    if users < 1 or total >= RARE_EVENTS:
-        return ci
-    _rate, low, high = poisson_interval(total, float(users), level)
-    return [low if ci[0] is None else min(ci[0], low),
-            high if ci[1] is None else max(ci[1], high)]
-
-
 def summarise_design(store: ResultStore, design: str, days: float, level: float = 0.95, *,
                      subgroup: str | None = None) -> dict[str, dict[str, Any]]:
     """Every declared metric of ``design`` summarised (see the module docstring), over the
@@ -220,10 +211,11 @@ def summarise_design(store: ResultStore, design: str, days: float, level: float 
         users = len(pairs)
         if kind == "count":
             totals = sorted(y for y, _ in pairs)
+            counted = count_estimate(totals, level)
             out[name] = {
                 "kind": "count", "total": int(sum(totals)), "users": users,
-                "mean": estimate.value, "sd": _sd(totals),
-                "ci95": _rare_count_ci(estimate.ci, int(sum(totals)), users, level),
+                "mean": counted.value, "sd": _sd(totals),
+                "ci95": counted.ci, "ci95_method": counted.method,
                 "median": _percentile(totals, 0.5), "p95": _percentile(totals, 0.95),
                 "per_day": (estimate.value / days) if estimate.value is not None else None,
                 "p90": _percentile(totals, 0.90), "p99": _percentile(totals, 0.99),
@@ -240,17 +232,23 @@ def summarise_design(store: ResultStore, design: str, days: float, level: float 
                 sd = math.sqrt(max(var, 0.0))
             out[name] = {
                 "kind": "duration", "unit": definition.get("unit") or "s", "n": n,
-                "mean": estimate.value, "ci95": estimate.ci, "sd": sd,
+                "users": users, "mean": estimate.value, "ci95": estimate.ci,
+                "ci95_method": estimate.method, "sd": sd,
                 "median": _pooled_quantile(store, design, name, n, 0.5, subgroup),
                 "p95": _pooled_quantile(store, design, name, n, 0.95, subgroup),
                 "per_user": _per_user(means, level),
             }
         else:
             ratios = [y / k for y, k in pairs if k > 0]
+            proportion = is_proportion(pairs)
+            ci = proportion_interval(pairs, level) if proportion else estimate.ci
             out[name] = {
-                "kind": "ratio", "value": estimate.value,
-                "ci95": (proportion_interval(pairs, level) if is_proportion(pairs)
-                         else estimate.ci),
+                "kind": "ratio", "value": estimate.value, "users": users,
+                "numerator_total": sum(y for y, _ in pairs),
+                "denominator_total": sum(k for _, k in pairs),
+                "ci95": ci,
+                "ci95_method": (None if ci[0] is None else
+                                "wilson-neff" if proportion else estimate.method),
                 "numerator": definition.get("numerator"),
                 "denominator": definition.get("denominator"),
                 "per_user": {**_per_user(ratios, level),
@@ -287,7 +285,8 @@ def compare_designs(store: ResultStore, a: str = "A", b: str = "B", level: float
             "kind": definition["kind"], "unit": definition.get("unit") or (
                 "s" if definition["kind"] == "duration" else None),
             "a": ea.value, "b": eb.value,
-            "difference": diff.value, "ci95": diff.ci, "users": len(users),
+            "difference": diff.value, "ci95": diff.ci, "ci95_method": diff.method,
+            "users": len(users),
             "significant": significant,
         }
     return out
@@ -322,18 +321,15 @@ def summarise_monitors(store: ResultStore, design: str, days: float, level: floa
         users = len(users_rows)
         total = sum(c for _, c, _, _ in users_rows)
         affected = sum(1 for _, c, _, _ in users_rows if c > 0)
-        exposure = users * days
-        rate, p_lo, p_hi = poisson_interval(total, exposure, level)
-        robust = ratio_estimate([(float(c), days) for _, c, _, _ in users_rows], level)
-        lo = p_lo if robust.low is None else min(p_lo, robust.low)
-        hi = p_hi if robust.high is None else max(p_hi, robust.high)
+        hazard = hazard_estimate([c for _, c, _, _ in users_rows], days, level)
         first = min(((u, t, m) for u, c, t, m in users_rows if c > 0), default=None,
                     key=lambda x: x[0])
         out[monitor] = {
             "violations": total, "users": users, "users_affected": affected,
             "share_affected": affected / users if users else None,
             "share_affected_ci95": _users_affected_ci(affected, users, level) if users else None,
-            "per_user_day": rate, "ci95": [lo, hi],
+            "share_affected_ci95_method": "clopper-pearson" if users else None,
+            "per_user_day": hazard.value, "ci95": hazard.ci, "ci95_method": hazard.method,
             "first": None if first is None else {"user": first[0], "time": first[1],
                                                  "message": first[2]},
         }
@@ -421,6 +417,7 @@ def summarise_population(store: ResultStore, days: float, level: float = 0.95, *
         _, low, high = rate_interval(len(members), total, level, method="clopper-pearson")
         entry: dict[str, Any] = {
             "users": len(members), "share": len(members) / total, "share_ci95": [low, high],
+            "share_ci95_method": "clopper-pearson",
             "expected_share": expected.get(name),
             "parameters": {n: _parameter_stats([values[u][n] for u in members
                                                 if n in values.get(u, {})]) for n in names},

@@ -13,7 +13,6 @@ under ``sweep``, so ``--resume`` finishes and reports it like any run.
 
 from __future__ import annotations
 
-import math
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, replace
 from pathlib import Path
@@ -24,6 +23,8 @@ from opspec.evaluation.parameters import Parameter, describe_value, parse_value,
 from opspec.evaluation.plan import Design, EvaluationPlan
 from opspec.evaluation.store import ResultStore
 from opspec.evaluation.targets import Target, parse_target, share_verdict, verdict
+from opspec.statistics.clustered import unpaired_difference
+from opspec.statistics.percentiles import nearest_rank
 
 __all__ = ["Sweep", "describe_parameters", "plan_sweep", "print_sweep", "report_sections",
            "summarise_sweep"]
@@ -140,35 +141,6 @@ def plan_sweep(plan: EvaluationPlan, name: str, texts: Sequence[str]) -> tuple[
 # --------------------------------------------------------------------------- the summary
 
 
-def _se(pairs: Sequence[tuple[float, float]]) -> float | None:
-    """The cluster-robust standard error of Σy/Σn (as opspec.statistics.ratio_estimate)."""
-    users = len(pairs)
-    total = sum(n for _, n in pairs)
-    if users < 2 or total <= 0:
-        return None
-    r = sum(y for y, _ in pairs) / total
-    nbar = total / users
-    return math.sqrt(sum((y - r * n) ** 2 for y, n in pairs) / (users * (users - 1))) / nbar
-
-
-def _unpaired(a: Sequence[tuple[float, float]], b: Sequence[tuple[float, float]],
-              difference: float | None, level: float) -> list[float | None]:
-    """The interval the difference would have with independent users for each value: the
-    two designs' standard errors combined as if independent, with Welch's degrees of
-    freedom. Beside the paired interval it shows what common random numbers gained."""
-    from opspec.statistics import t_quantile
-
-    sa, sb = _se(a), _se(b)
-    if difference is None or sa is None or sb is None:
-        return [None, None]
-    spread = math.sqrt(sa * sa + sb * sb)
-    if spread == 0.0:
-        return [difference, difference]
-    df = spread**4 / ((sa**4 + sb**4) / (len(a) - 1))
-    half = t_quantile(level, max(1, int(df))) * spread
-    return [difference - half, difference + half]
-
-
 def _differences(store: ResultStore, reference: str, design: str, level: float
                  ) -> dict[str, dict[str, Any]]:
     from opspec.evaluation.summary import compare_designs, metric_definitions, user_pairs
@@ -181,8 +153,11 @@ def _differences(store: ResultStore, reference: str, design: str, level: float
         pa = dict(user_pairs(store, reference, definition))
         pb = dict(user_pairs(store, design, definition))
         users = sorted(set(pa) & set(pb))
-        entry["unpaired_ci95"] = _unpaired([pa[u] for u in users], [pb[u] for u in users],
-                                           entry["difference"], level)
+        # what the difference's interval would be on independent users (Welch): beside the
+        # paired interval it shows what common random numbers gained
+        unpaired = unpaired_difference([pa[u] for u in users], [pb[u] for u in users], level)
+        entry["unpaired_ci95"] = unpaired.ci
+        entry["unpaired_ci95_method"] = unpaired.method
     return out
 
 
@@ -211,9 +186,7 @@ def _per_user_quantile(values: Sequence[float], share: float, below: bool) -> fl
     between them would describe nobody."""
     if not values:
         return None
-    ordered = sorted(values)
-    rank = max(1, math.ceil(share * len(ordered) - 1e-9))
-    return ordered[rank - 1] if below else ordered[len(ordered) - rank]
+    return nearest_rank(sorted(values), share, from_top=not below)
 
 
 def _target_summary(store: ResultStore, sweep: Sweep, target: Target,

@@ -7,16 +7,19 @@ from typing import IO, Any
 
 from opspec.evaluation.plan import span
 from opspec.properties.language import clock
+from opspec.statistics.methods import METHODS, methods_in
 
-__all__ = ["comparison_rows", "distribution_rows", "fmt", "is_rate", "metric_rows",
+__all__ = ["comparison_rows", "distribution_rows", "fmt", "is_rate", "method_legend",
+           "method_name", "metric_rows",
            "monitor_rows", "parameter_rows", "per_user_rows", "print_summary",
            "subgroup_comparison_rows", "subgroup_metric_rows", "subgroup_rows", "table"]
 
-METRIC_HEADERS = ("metric", "kind", "estimate", "95 % CI", "sd", "median", "p95", "n")
+METRIC_HEADERS = ("metric", "kind", "estimate", "95 % CI", "CI method", "sd", "median", "p95",
+                  "users", "pooled")
 PER_USER_HEADERS = ("metric", "users", "mean", "sd", "95 % CI", "median", "p95")
-COMPARE_HEADERS = ("metric", "A", "B", "B − A", "95 % CI", "")
+COMPARE_HEADERS = ("metric", "A", "B", "B − A", "95 % CI", "CI method", "")
 MONITOR_HEADERS = ("monitor", "violations", "users affected", "per user-day", "95 % CI",
-                   "first violation")
+                   "CI method", "first violation")
 SUBGROUP_HEADERS = ("subgroup", "users", "share", "asked", "95 % CI (exact)")
 DISTRIBUTION_HEADERS = ("metric", "users", "users with any", "95 % CI (exact)", "p50", "p90",
                         "p99", "between-user sd")
@@ -50,24 +53,58 @@ def _ci(summary: Mapping[str, Any], unit: str = "", *, percent: bool = False) ->
     return f"[{fmt(low, unit, percent=percent)}, {fmt(high, unit, percent=percent)}]"
 
 
+def method_name(summary: Mapping[str, Any], key: str = "ci95_method") -> str:
+    """The short name of the method of a summary's interval (``–`` without one)."""
+    method = METHODS.get(summary.get(key) or "")
+    return method.name if method else "–"
+
+
+def _count(value: Any) -> str:
+    """A pooled total: a whole number without ``.0``."""
+    return "–" if value is None else (f"{value:g}" if isinstance(value, float)
+                                      and not value.is_integer() else str(int(value)))
+
+
 def metric_rows(metrics: Mapping[str, Mapping[str, Any]]) -> list[tuple[str, ...]]:
+    """One row per metric. ``users``: the simulated users the estimate is over; ``pooled``:
+    what was pooled over them — the events of a count, the observations of a duration, the
+    numerator of the denominator of a ratio."""
     rows: list[tuple[str, ...]] = []
     for name, s in metrics.items():
         kind = s["kind"]
+        users = _count(s.get("users"))
         # sd: of the users' totals for a count, of all observations for a duration
         if kind == "count":
-            rows.append((name, "count", f"{fmt(s['mean'])} per user", _ci(s), fmt(s["sd"]),
-                         fmt(s["median"]), fmt(s["p95"]), f"total {s['total']}"))
+            rows.append((name, "count", f"{fmt(s['mean'])} per user", _ci(s), method_name(s),
+                         fmt(s["sd"]), fmt(s["median"]), fmt(s["p95"]), users,
+                         f"{s['total']} events"))
         elif kind == "duration":
             unit = s.get("unit") or "s"
-            rows.append((name, "duration", fmt(s["mean"], unit), _ci(s, unit),
+            rows.append((name, "duration", fmt(s["mean"], unit), _ci(s, unit), method_name(s),
                          fmt(s["sd"], unit), fmt(s["median"], unit), fmt(s["p95"], unit),
-                         str(s["n"])))
+                         users, f"{s['n']} obs."))
         else:
             percent = is_rate(name, s)
+            pooled = (f"{_count(s.get('numerator_total'))} of "
+                      f"{_count(s.get('denominator_total'))}"
+                      if s.get("denominator_total") is not None else "–")
             rows.append((name, "ratio", fmt(s["value"], percent=percent),
-                         _ci(s, percent=percent), "–", "–", "–", ""))
+                         _ci(s, percent=percent), method_name(s), "–", "–", "–", users,
+                         pooled))
     return rows
+
+
+def method_legend(summaries: Any, keys: Sequence[str] | None = ("ci95_method",)
+                  ) -> list[str]:
+    """One line per interval method used in ``summaries`` (under the names ``keys``; None:
+    any): its name, what it is and where it comes from (the full recipe is in ``--json``
+    and the report)."""
+    lines = []
+    for method_id in methods_in(summaries, keys):
+        m = METHODS[method_id]
+        lines.append(f"  {m.name}: {m.summary} "
+                     f"({m.cited})")
+    return lines
 
 
 def per_user_rows(metrics: Mapping[str, Mapping[str, Any]]) -> list[tuple[str, ...]]:
@@ -98,7 +135,7 @@ def monitor_rows(monitors: Mapping[str, Mapping[str, Any]]) -> list[tuple[str, .
         share = fmt(m.get("share_affected"), percent=True)
         affected = f"{m['users_affected']} of {m['users']} ({share})"
         rows.append((name, str(m["violations"]), affected, fmt(m["per_user_day"]), _ci(m),
-                     where))
+                     method_name(m), where))
     return rows
 
 
@@ -157,7 +194,7 @@ def subgroup_comparison_rows(population: Mapping[str, Any]
             if not d:
                 cells.append("–")
                 continue
-            _, _, diff, ci, _, mark = comparison_rows({name: d})[0]
+            _, _, diff, ci, _, _, mark = comparison_rows({name: d})[0]
             cells.append(f"{diff} {ci}{' *' if mark else ''}")
         rows.append((name, *cells))
     return headers, rows
@@ -225,7 +262,7 @@ def comparison_rows(difference: Mapping[str, Mapping[str, Any]]) -> list[tuple[s
         ci = (f"[{_points(low)}, {_points(high)}]" if percent and low is not None
               and high is not None else _ci(d, unit))
         rows.append((name, fmt(d["a"], unit, percent=percent),
-                     fmt(d["b"], unit, percent=percent), diff, ci,
+                     fmt(d["b"], unit, percent=percent), diff, ci, method_name(d),
                      "differs" if d["significant"] else ""))
     return rows
 
@@ -280,6 +317,14 @@ def print_summary(out: IO[str], plan: Any, metrics: Mapping[str, Any],
         if len(failures) > 10:
             print(f"  … and {len(failures) - 10} more", file=out)
         print("run again with --resume --out <folder> to complete them", file=out)
+    # the intervals the tables above show (the exact shares of users only with a population)
+    legend = method_legend([metrics, monitors, compare, population],
+                           None if population else ("ci95_method",))
+    if legend:
+        print(f"\n95 % intervals over the {plan.users} users (the independent units):",
+              file=out)
+        for line in legend:
+            print(line, file=out)
     print(file=out)
 
 

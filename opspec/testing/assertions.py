@@ -51,7 +51,7 @@ from opspec.statistics import (
     t_quantile,
 )
 from opspec.statistics import Interval as Estimate
-from opspec.testing.intervals import _pct
+from opspec.statistics.claims import confidence_text
 
 __all__ = [
     "Decision",
@@ -111,10 +111,10 @@ class Decision:
     def message(self) -> str:
         lines = [f"expected {self.claim}",
                  f"  estimate {self.estimate:.4g} {self.detail}".rstrip() + f"; n = {self.n}",
-                 (f"  {_pct(self.confidence)} {self.sides} {self.interval} interval "
+                 (f"  {confidence_text(self.confidence)} {self.sides} {self.interval} interval "
                  f"[{self.lo:.4g}, {self.hi:.4g}]; bound {self.bound}")]
         if self.verdict == "refuted":
-            lines.append(f"  refuted: the claim is false at {_pct(self.confidence)} confidence")
+            lines.append(f"  refuted: the claim is false at {confidence_text(self.confidence)} confidence")
         elif self.verdict == "undecided":
             if self.n == 0:
                 lines.append("  nothing to judge: simulate longer or more users")
@@ -262,7 +262,7 @@ def assert_rate(result: Any, metric: str | tuple[Any, Any], *, at_least: float |
             f"a rate lies between 0 and 1: {_bound_text(at_least, at_most)} can never hold",
             hint="write the bound as a fraction (95 % is 0.95)")
     s, t, subject, units = _rate_counts(result, metric)
-    claim = f"rate {subject} {_bound_text(at_least, at_most)} with {_pct(confidence)} confidence"
+    claim = f"rate {subject} {_bound_text(at_least, at_most)} with {confidence_text(confidence)} confidence"
     decision = _rate_decision(claim, s, t, at_least, at_most, confidence, method,
                               getattr(result, "replications", 1), units)
     _fail(decision, result)
@@ -281,7 +281,7 @@ def assert_mean(result: Any, metric: str, *, at_least: float | None = None,
     at_least, at_most = _target(at_least, at_most, between)
     values = result.samples(metric)
     bound = _bound_text(at_least, at_most)
-    claim = f"mean {metric} {bound} with {_pct(confidence)} confidence"
+    claim = f"mean {metric} {bound} with {confidence_text(confidence)} confidence"
     level = _two_sided_level(confidence, at_least, at_most)
     sides = "two-sided" if level == confidence else "one-sided"
     name = "Student t" if method == "t" else "BCa bootstrap"
@@ -322,7 +322,7 @@ def assert_quantile(result: Any, metric: str, q: float, *, at_most: float | None
     at_least, at_most = _target(at_least, at_most, None)
     values = result.observations(metric)
     bound = _bound_text(at_least, at_most)
-    claim = f"p{q * 100:g} {metric} {bound} with {_pct(confidence)} confidence"
+    claim = f"p{q * 100:g} {metric} {bound} with {confidence_text(confidence)} confidence"
     level = _two_sided_level(confidence, at_least, at_most)
     sides = "two-sided" if level == confidence else "one-sided"
     est, lo, hi = quantile_interval(values, q, level)
@@ -384,7 +384,7 @@ def assert_rate_sequential(simulate_batch: Callable[[int, int], Any],
         last = simulate_batch(look - 1, size)
         s, t, subject, units = _rate_counts(last, metric)
         successes, trials, users = successes + s, trials + t, users + size
-        claim = (f"rate {subject} {_bound_text(at_least, at_most)} with {_pct(confidence)} "
+        claim = (f"rate {subject} {_bound_text(at_least, at_most)} with {confidence_text(confidence)} "
                  f"confidence (sequential, {look_conf:.4%} per look, up to {max_looks} looks)")
         decision = _rate_decision(claim, successes, trials, at_least, at_most, look_conf,
                                   method, users, units)

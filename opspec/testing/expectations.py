@@ -24,7 +24,7 @@ every replication (``count`` too: a total over all replications is a count metri
 ``alarms == 12``). ``activity X`` may also be ``trigger X`` (a message or signal raised),
 ``process X`` (an instance started) or a bare name. Metric comparisons use the metrics pooled over all
 replications; ``==`` allows a relative error of 1e-9. The statistical lines are decided by
-:mod:`opspec.testing.intervals`: they pass when the one-sided bound at that confidence is on
+:mod:`opspec.statistics.claims`: they pass when the one-sided bound at that confidence is on
 the right side, fail when the claim is refuted at that confidence, and otherwise fail saying
 how many replications would decide it.
 """
@@ -185,7 +185,7 @@ class Expectation:
         return None
 
     def _check_rate(self, result: SimulationResult) -> str | None:
-        from opspec.testing.intervals import decide_rate
+        from opspec.statistics.claims import decide_rate
 
         num, den = self.groups["num_m"], self.groups["den_m"]
         successes, trials = result.value(num), result.value(den)
@@ -195,14 +195,14 @@ class Expectation:
                            replications=result.replications)
 
     def _check_mean(self, result: SimulationResult) -> str | None:
-        from opspec.testing.intervals import decide_mean
+        from opspec.statistics.claims import decide_mean
 
         op, a, b = self._target()
         return decide_mean(self.text, result.samples(self.groups["metric"]), op, a, b,
                            float(self.groups["conf"]) / 100.0)
 
     def _check_quantile(self, result: SimulationResult) -> str | None:
-        from opspec.testing.intervals import decide_quantile
+        from opspec.statistics.claims import decide_quantile
 
         op, a, b = self._target()
         return decide_quantile(self.text, result.observations(self.groups["metric"]),

@@ -42,7 +42,7 @@ from opspec.properties.language import (
 )
 from opspec.properties.monitors import Monitor, declared_monitors, parse_monitor
 from opspec.statistics import poisson_interval
-from opspec.testing.intervals import _pct
+from opspec.statistics.claims import confidence_text
 
 __all__ = [
     "Monitor",
@@ -178,7 +178,7 @@ class MonitorReport:
     def __str__(self) -> str:
         if not self.rows:
             return "no monitors"
-        head = f"monitors (hazard: violations per user-day, exact {_pct(self.confidence)} interval)"
+        head = f"monitors (hazard: violations per user-day, exact {confidence_text(self.confidence)} interval)"
         return "\n".join([head, *(f"  {row}" for row in self.rows)])
 
     def describe(self, limit: int = 3) -> str:

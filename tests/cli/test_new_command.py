@@ -1,5 +1,6 @@
-"""`opspec new NAME`: a small spec, its user model and its tests that validate, run, evaluate,
-pass `opspec check` and pass their own tests as written; an existing folder is never touched."""
+"""`opspec new NAME [--template pill|stove]`: a small spec, its user model and its tests that
+validate, run, evaluate, pass `opspec check` and pass their own tests as written; an existing
+folder is never touched."""
 
 from __future__ import annotations
 
@@ -12,14 +13,27 @@ from pathlib import Path
 import pytest
 
 from opspec.cli import main
-from opspec.commands.new import TEMPLATES, identifier, render
+from opspec.commands.new import SHAPES, TEMPLATES, identifier, render
+
+#: Per template: the metric counting the device's sessions (one per dose / cooking session),
+#: how many a day, the two outcomes that partition them, and the ratio the evaluation shows.
+SHAPE = {
+    "pill": ("doses_due", 2, ("doses_taken", "doses_missed"), "taken_rate"),
+    "stove": ("sessions", 1, ("confirmed", "power_cuts"), "cut_rate"),
+}
+
+
+@pytest.fixture(scope="module", params=sorted(SHAPES))
+def template(request: pytest.FixtureRequest) -> str:
+    return str(request.param)
 
 
 @pytest.fixture(scope="module")
-def scaffold(tmp_path_factory: pytest.TempPathFactory) -> Path:
-    """One generated folder shared by the tests that only read it."""
-    folder = tmp_path_factory.mktemp("new") / "pill-box"
-    assert main(["new", str(folder)]) == 0
+def scaffold(tmp_path_factory: pytest.TempPathFactory, template: str) -> Path:
+    """One generated folder per template, shared by the tests that only read it."""
+    folder = tmp_path_factory.mktemp(f"new-{template}") / "pill-box"
+    args = ["new", str(folder)] + (["--template", template] if template != "pill" else [])
+    assert main(args) == 0
     return folder
 
 
@@ -43,21 +57,22 @@ def test_is_sound(scaffold: Path, capsys: pytest.CaptureFixture[str]) -> None:
     assert "2 of 2 process level(s) sound, 0 problem(s)" in capsys.readouterr().out
 
 
-def test_runs_a_day_with_its_user_model(scaffold: Path,
+def test_runs_a_day_with_its_user_model(scaffold: Path, template: str,
                                         capsys: pytest.CaptureFixture[str]) -> None:
+    sessions, per_day, (good, bad), _ = SHAPE[template]
     assert main(["run", str(scaffold / "pill-box.xpdl"), "--json"]) == 0
     metrics = json.loads(capsys.readouterr().out)["metrics"]
-    assert metrics["doses_due"]["total"] == 2           # 09:00 and 21:00
-    assert metrics["doses_taken"]["total"] + metrics["doses_missed"]["total"] == 2
+    assert metrics[sessions]["total"] == per_day     # 09:00 and 21:00; dinner at 18:00
+    assert metrics[good]["total"] + metrics[bad]["total"] == per_day
 
 
-def test_evaluates_20_users_over_2_days(scaffold: Path, tmp_path: Path,
+def test_evaluates_20_users_over_2_days(scaffold: Path, tmp_path: Path, template: str,
                                         capsys: pytest.CaptureFixture[str]) -> None:
     status = main(["evaluate", str(scaffold / "pill-box.xpdl"), "--users", "20", "--days", "2",
                    "--out", str(tmp_path / "run"), "--workers", "1"])
     assert status == 0, capsys.readouterr().err
     out = capsys.readouterr().out
-    assert "20 users x 2 days" in out and "taken_rate" in out
+    assert "20 users x 2 days" in out and SHAPE[template][3] in out
     assert (tmp_path / "run" / "report.html").is_file()
 
 
@@ -101,7 +116,27 @@ def test_names_become_identifiers() -> None:
     assert identifier("2pills") == "spec_2pills"
 
 
-def test_templates_are_package_data_and_fully_substituted() -> None:
-    files = render("demo")
+@pytest.mark.parametrize("shape", sorted(SHAPES))
+def test_templates_are_package_data_and_fully_substituted(shape: str) -> None:
+    files = render("demo", shape)
     assert len(files) == len(TEMPLATES)
     assert all("${" not in text for text in files.values())
+
+
+def test_an_unknown_template_is_a_usage_error_naming_the_choices(
+        tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    with pytest.raises(SystemExit) as exit_:
+        main(["new", str(tmp_path / "x"), "--template", "toaster"])
+    assert exit_.value.code == 2
+    assert "invalid choice: 'toaster' (choose from 'pill', 'stove')" in capsys.readouterr().err
+    assert not (tmp_path / "x").exists()
+
+
+def test_pytest_comes_with_opspec_not_only_with_its_test_extras() -> None:
+    """The spec tests `opspec new` writes (and the README's "Specs as tests") run on pytest,
+    the host of opspec's pytest plugin: it must be a dependency of the plain install."""
+    import tomllib
+
+    project = tomllib.loads((Path(__file__).resolve().parents[2] / "pyproject.toml")
+                            .read_text(encoding="utf-8"))["project"]
+    assert any(d.replace(" ", "").startswith("pytest>") for d in project["dependencies"])

@@ -5,6 +5,7 @@ Faults are in test_faults.py, bad input in test_bad_input.py."""
 from __future__ import annotations
 
 import json
+import re
 import sqlite3
 from pathlib import Path
 
@@ -128,7 +129,7 @@ def test_json_document_has_the_documented_shape(evaluate, tmp_path):
     assert doc["failed"] == []
     report = Path(doc["report"])
     html = report.read_text(encoding="utf-8")
-    assert report.name == "report.html" and "data:image/png;base64," in html
+    assert report.name == "report.html" and "<svg" in html
     assert "report_latency_s" in html and "How users differ" in html
     assert (report.parent / "report.md").is_file()
 
@@ -161,12 +162,12 @@ def test_a_shorter_re_alert_interval_sounds_more_alarms_for_the_same_users(evalu
     assert alarms["ci95"][0] > 0
 
 
-def test_exports_write_one_case_per_user(evaluate, tmp_path):
+def test_exports_write_one_case_per_user_when_asked(evaluate, tmp_path):
     from opspec.engine.trace_sinks import read_trace
 
     out = tmp_path / "exp"
     status, _doc, _ = evaluate(str(SPEC), "--users", "3", "--days", "1", "--workers", "2",
-                              "--export", "xes,jsonl", "--out", str(out))
+                              "--export", "xes,jsonl", "--case", "user", "--out", str(out))
     assert status == 0
     cases = {e.data.get("case") for e in read_trace(out / "traces.jsonl")
              if e.kind != "case.started"} | {
@@ -261,4 +262,20 @@ def test_comparison_table_gives_units_and_rate_differences_in_points(tmp_path, c
     latency = rows["report_latency_s"]
     assert latency.count(" s") >= 4 and "differs" in latency   # A, B, B − A and the CI
     assert " pp" in rows["taken_rate"] and "%" in rows["taken_rate"]
-    assert (tmp_path / "out" / "figures" / "comparison.png").stat().st_size > 10_000
+    assert (tmp_path / "out" / "figures" / "comparison.svg").stat().st_size > 10_000
+
+
+def test_exports_cut_cases_by_chain_by_default_named_after_the_specs_workflow(
+        evaluate, tmp_path):
+    """The default case is one a process-discovery algorithm learns from: one run of the
+    device's root workflow with everything it set in motion, named after that workflow of
+    the spec (the dispenser's timer_workflow: one case per due dose)."""
+    out = tmp_path / "exp"
+    status, doc, _ = evaluate(str(SPEC), "--users", "2", "--days", "1", "--workers", "1",
+                              "--export", "xes", "--out", str(out))
+    assert status == 0
+    xes = (out / "traces.xes").read_text(encoding="utf-8")
+    assert xes.count("<trace>") == doc["metrics"]["doses_due"]["total"] == 8
+    names = re.findall(r'<trace>\s*<string key="concept:name" value="([^"]+)"', xes)
+    assert len(names) == 8 and all(re.fullmatch(r"A/[01]/timer_workflow#\d+", n)
+                                   for n in names), names[:3]

@@ -136,7 +136,7 @@ def test_a_population_run_reports_subgroups_everywhere(evaluate, tmp_path, capsy
     report = (out / "report.md").read_text(encoding="utf-8")
     for words in ("Parameters that differ by person", "Users drawn per subgroup",
                   "## By subgroup", "Per-user distributions, overall and by subgroup",
-                  "missed_rate-by-subgroup.png", "population-parameters.png"):
+                  "missed_rate-by-subgroup.svg", "population-parameters.svg"):
         assert words.replace("_", r"\_") in report or words in report
     # and the terminal table too
     assert main(["evaluate", "--resume", "--out", str(out)]) == 0

@@ -17,7 +17,7 @@ import math
 import numpy as np
 import pytest
 
-from opspec.evaluation.proportions import effective_trials, proportion_interval
+from opspec.statistics.proportions import effective_trials, proportion_interval
 
 #: the reference user's missed-dose probability (shared/bench/analytic.py, 3 alarms)
 P_MISSED = 0.0034562262209500982

@@ -47,7 +47,7 @@ def test_a_report_redrawn_from_the_reopened_store_has_the_same_count_figures(
                               "--workers", "1", "--out", str(out))
     assert status == 0, err
     figures = {name: (out / "figures" / name).read_bytes()
-               for name in ("A-days.png", "A-hours.png")}
+               for name in ("A-days.svg", "A-hours.svg")}
     status, _, err = evaluate("--resume", "--out", str(out), "--workers", "1")
     assert status == 0, err
     for name, before in figures.items():

@@ -97,7 +97,7 @@ def test_the_report_draws_the_sweep_and_resume_reports_it_again(capsys, tmp_path
     assert "target missed_rate < 1%" in printed
     html = (out / "report.html").read_text(encoding="utf-8")
     assert "Sweep of spec.notify_workflow.wait_report.deadline" in html
-    assert (out / "figures" / "sweep.png").stat().st_size > 10_000
+    assert (out / "figures" / "sweep.svg").stat().st_size > 10_000
     with sqlite3.connect(out / "results.sqlite") as db:
         designs = [d for (d,) in db.execute("SELECT DISTINCT design FROM replication "
                                             "ORDER BY design")]

@@ -23,7 +23,8 @@ USERS, DAYS = 3, 2
 
 @pytest.fixture(scope="module")
 def run(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, dict, str]:
-    """3 users x 2 days exported as OCEL, XES per dose and JSONL per dose, in one run."""
+    """3 users x 2 days exported as OCEL, XES and JSONL, in one run: the XES and JSONL cases
+    are chains by default (one per dose of the dispenser)."""
     out = tmp_path_factory.mktemp("ocel") / "run"
     import contextlib
     import io
@@ -32,7 +33,7 @@ def run(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, dict, str]:
     with contextlib.redirect_stdout(stdout), contextlib.redirect_stderr(stderr):
         status = main(["evaluate", str(SPEC), "--users", str(USERS), "--days", str(DAYS),
                        "--seed", "4", "--out", str(out), "--export", "ocel,xes,jsonl",
-                       "--case", "dose", "--workers", "1", "--json"])
+                       "--workers", "1", "--json"])
     assert status == 0, stderr.getvalue()
     return out, json.loads(stdout.getvalue()), stderr.getvalue()
 

@@ -73,18 +73,24 @@ def test_the_report_renders_in_a_headless_browser(chromium: str, report: Path,
 
 def test_every_figure_in_the_report_decodes_in_the_browser(chromium: str, report: Path,
                                                            tmp_path: Path) -> None:
-    # the report has no script; a copy gets one that counts images that failed to decode
+    # the report has no script; a copy gets one that counts figures the browser did not
+    # draw: an inline SVG (the report's default) laid out with no size or nothing in it, an
+    # image that failed to decode
     probe = tmp_path / "probe.html"
     html = report.read_text(encoding="utf-8")
     script = ("<script>window.addEventListener('load', () => {"
               "const imgs = [...document.images];"
-              "const broken = imgs.filter(i => !i.complete || i.naturalWidth === 0);"
+              "const svgs = [...document.querySelectorAll('figure svg')];"
+              "const broken = imgs.filter(i => !i.complete || i.naturalWidth === 0).length"
+              " + svgs.filter(s => { const r = s.getBoundingClientRect();"
+              " return r.width < 100 || r.height < 50"
+              " || s.querySelectorAll('path, use').length === 0; }).length;"
               "document.body.setAttribute('data-probe', "
-              "`images=${imgs.length} broken=${broken.length}`);});</script>")
+              "`images=${imgs.length + svgs.length} broken=${broken}`);});</script>")
     probe.write_text(html.replace("</body>", script + "</body>"), encoding="utf-8")
     done = _browser(chromium, "--virtual-time-budget=10000", "--dump-dom", probe.as_uri())
     found = re.search(r'data-probe="images=(\d+) broken=(\d+)"', done.stdout)
     assert found, f"the page did not load: {done.stderr[-2000:]}"
     images, broken = int(found.group(1)), int(found.group(2))
-    assert images == html.count("<img ") and images >= 6
+    assert images == html.count("<img ") + html.count("<svg") and images >= 6
     assert broken == 0, f"{broken} of {images} figures did not decode"

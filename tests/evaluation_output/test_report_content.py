@@ -87,14 +87,14 @@ def test_per_user_distributions_and_own_scales_are_shown(run: Path) -> None:
     html = (run / "report.html").read_text(encoding="utf-8")
     assert "How users differ" in html
     assert "Distribution over users of each user&#39;s own value" in html
-    assert (run / "figures" / "A-per-user.png").is_file()
+    assert (run / "figures" / "A-per-user.svg").is_file()
     assert "each metric on its own scale, so rare outcomes are visible" in html
 
 
 def test_markdown_says_the_same(run: Path) -> None:
     md = (run / "report.md").read_text(encoding="utf-8")
     assert "## Key findings" in md and "## Who the simulated users are" in md
-    assert "figures/A-per-user.png" in md
+    assert "figures/A-per-user.svg" in md
 
 
 def test_figures_draw_the_tables_numbers_and_say_when_they_sample(
@@ -104,9 +104,9 @@ def test_figures_draw_the_tables_numbers_and_say_when_they_sample(
     seen: dict[str, object] = {}
     original = plots.latency_figure
 
-    def spy(metric, values, path, *, marks=None, total=None):  # type: ignore[no-untyped-def]
+    def spy(metric, values, path, *, marks=None, total=None, **words):  # type: ignore[no-untyped-def]
         seen.update(metric=metric, n=len(values), marks=marks, total=total)
-        return original(metric, values, path, marks=marks, total=total)
+        return original(metric, values, path, marks=marks, total=total, **words)
 
     monkeypatch.setattr(plots, "latency_figure", spy)
     monkeypatch.setattr(report_module, "PLOT_SAMPLE", 50)
@@ -150,7 +150,7 @@ def test_a_researchers_template_restyles_the_report(run: Path, tmp_path: Path) -
     assert status == 0
     html = (run / "report.html").read_text(encoding="utf-8")
     assert html.startswith("<html><body class=mine><h1>Evaluation of medication_dispenser")
-    assert "<h2>Key findings</h2>" in html and "data:image/png;base64," in html
+    assert "<h2>Key findings</h2>" in html and "data:image/svg+xml;base64," in html
     # back to the bundled template
     assert main(["evaluate", "--resume", "--out", str(run), "--quiet", "--json"]) == 0
     assert "<!DOCTYPE html>" in (run / "report.html").read_text(encoding="utf-8")

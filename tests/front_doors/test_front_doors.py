@@ -72,8 +72,8 @@ def via_evaluate(tmp_path: Path, spec: Path, user: list[str], days: float | None
     out = tmp_path / "evaluation"
     length = ["--days", str(days)] if days is not None else []
     status = main(["evaluate", str(spec), "--users", str(users), "--seed", str(SEED),
-                   *user, *length, "--workers", "1", "--export", "jsonl", "--out", str(out),
-                   "--json"])
+                   *user, *length, "--workers", "1", "--export", "jsonl", "--case", "user",
+                   "--out", str(out), "--json"])
     assert status == 0
     header, events = _file(out / "traces.jsonl")
     assert header["seed"] == SEED and isinstance(header["seed"], int)

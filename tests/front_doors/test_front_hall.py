@@ -133,7 +133,8 @@ def scenario_file(folder: Path, spec: Path, ask: Ask,
 def cli_evaluate(folder: Path, spec: Path, ask: Ask) -> list[dict]:
     out = folder / "evaluation"
     args = ["evaluate", str(spec), "--users", "1", "--seed", str(ask.seed), "--workers", "1",
-            "--export", "jsonl", "--out", str(out), "--json", *_engine_file(folder, ask)]
+            "--export", "jsonl", "--case", "user", "--out", str(out), "--json",
+            *_engine_file(folder, ask)]
     args += ["--days", str(ask.days)] if ask.days is not None else []
     args += ["--user-model", ask.user_model] if ask.user_model else []
     assert main(args) == 0

@@ -1,18 +1,12 @@
-"""Confidence intervals, on ``scipy.stats``: the one statistics module of opspec.
-
-Spec tests (:mod:`opspec.testing`), evaluation reports (:mod:`opspec.evaluation`) and user-model
-fitting (:mod:`opspec.usermodels.fitting`) all take their intervals from here:
+"""Intervals of one sample, on ``scipy``: proportions, Poisson rates, means, quantiles.
 
 * :func:`rate_interval` — a proportion: Wilson score (good coverage near 0 and 1, unlike the
-  Wald interval) or Clopper-Pearson (exact, conservative), ``scipy.stats.binomtest``;
+  Wald interval) or Clopper-Pearson (exact, conservative);
 * :func:`poisson_interval` — a rate of events per unit of exposure (violations per user-day):
   the exact (Garwood) interval, from the chi-square distribution;
 * :func:`mean_interval` — a mean of independent values: Student t, or a seeded BCa bootstrap;
 * :func:`quantile_interval` — a quantile of pooled observations: the distribution-free
-  order-statistic interval (binomial ranks; any continuous distribution);
-* :func:`ratio_estimate`, :func:`paired_difference` — a ratio ``Σy/Σn`` over users (the
-  independent replications of an evaluation) with the cluster-robust (delta-method) t
-  interval, and the paired difference of two designs on the same users.
+  order-statistic interval (binomial ranks; any continuous distribution).
 
 Every interval is two-sided at ``confidence``; a one-sided bound at level C is one end of the
 two-sided interval at ``2C - 1`` (:func:`one_sided`). scipy is imported when first needed (it
@@ -23,7 +17,6 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
-from dataclasses import dataclass
 from typing import Any, NamedTuple
 
 from opspec.errors import ConfigurationError
@@ -32,15 +25,12 @@ __all__ = [
     "MEAN_METHODS",
     "RATE_METHODS",
     "Interval",
-    "RatioEstimate",
     "mean_interval",
     "normal_quantile",
     "one_sided",
-    "paired_difference",
     "poisson_interval",
     "quantile_interval",
     "rate_interval",
-    "ratio_estimate",
     "t_quantile",
 ]
 
@@ -180,125 +170,3 @@ def quantile_interval(values: Sequence[float], q: float, confidence: float = 0.9
     hi = ordered[k_hi - 1] if k_hi <= n else math.inf
     estimate = ordered[min(n - 1, max(0, math.ceil(q * n) - 1))]
     return Interval(estimate, lo, hi)
-
-
-# ---------------------------------------------------------------- ratios over users
-@dataclass(frozen=True, slots=True)
-class RatioEstimate:
-    """``Σy/Σn`` over users with its interval; ``users`` counts those contributing
-    (``n_u > 0``). ``None`` where there is nothing to estimate."""
-
-    value: float | None
-    low: float | None
-    high: float | None
-    users: int
-
-    @property
-    def ci(self) -> list[float | None]:
-        return [self.low, self.high]
-
-
-def ratio_estimate(pairs: Sequence[tuple[float, float]], level: float = 0.95) -> RatioEstimate:
-    """Users are the independent replications; observations within a user are not (one slow
-    walker has many slow doses). Each user ``u`` gives a pair ``(y_u, n_u)`` — a count:
-    (total, 1); a duration: (sum of observations, number of them); a ratio: (numerator,
-    denominator) — and the estimate is ``r = Σy/Σn`` with the cluster-robust (delta-method)
-    standard error ``se(r)² = Σ (y_u − r·n_u)² / (U·(U−1)·n̄²)``, ``n̄ = Σn/U``, and a
-    Student-t interval on U−1 degrees of freedom (for counts exactly the t interval of the
-    per-user mean). ``None`` values when Σn is 0; no interval with fewer than 2 users."""
-    users = len(pairs)
-    total_n = sum(n for _, n in pairs)
-    if users == 0 or total_n <= 0:
-        return RatioEstimate(None, None, None, 0)
-    r = sum(y for y, _ in pairs) / total_n
-    contributing = sum(1 for _, n in pairs if n > 0)
-    if users < 2:
-        return RatioEstimate(r, None, None, contributing)
-    nbar = total_n / users
-    resid = sum((y - r * n) ** 2 for y, n in pairs)
-    se = math.sqrt(resid / (users * (users - 1))) / nbar
-    half = t_quantile(level, users - 1) * se
-    low = r - half
-    if low < 0.0 and all(y >= 0.0 for y, _ in pairs):
-        # counts, durations and ratios of counts cannot be negative; with few users the t
-        # interval would say they might be (a count of collisions "from -1.3 to 7.8")
-        low = 0.0
-    return RatioEstimate(r, low, r + half, contributing)
-
-
-#: Fewer discordant events than this (events one design has and the other has not, summed
-#: over users) and a paired difference of counts is not left to the t interval: with a
-#: handful of events the per-user differences are mostly zero and the t interval is too
-#: narrow (89 % coverage at 10 users, ``benchmarks/interval_coverage.py``) or [0, 0].
-RARE_DISCORDANT = 10
-
-
-def _discordant(a: Sequence[tuple[float, float]], b: Sequence[tuple[float, float]]
-                ) -> tuple[int, int, float] | None:
-    """``(up, down, N)`` when both designs count whole events over the same denominators
-    (``n_A,u == n_B,u``: a count per user, or a ratio of counts such as missed/due): ``up``
-    events more in B than in A summed over users, ``down`` fewer, ``N = Σn``. None when the
-    pairs are not counts (durations)."""
-    up = down = 0
-    total = 0.0
-    for (ya, na), (yb, nb) in zip(a, b, strict=True):
-        if na != nb or ya < 0 or yb < 0 or ya != int(ya) or yb != int(yb):
-            return None
-        diff = int(yb) - int(ya)
-        up += max(diff, 0)
-        down += max(-diff, 0)
-        total += na
-    return (up, down, total) if total > 0 else None
-
-
-def paired_difference(a: Sequence[tuple[float, float]], b: Sequence[tuple[float, float]],
-                      level: float = 0.95) -> RatioEstimate:
-    """``r_B − r_A`` for the same users (same order) with a paired delta-method interval:
-    the linearised per-user contributions ``(y_u − r·n_u)/n̄`` of each design, differenced
-    per user.
-
-    Rare discordant events: when both designs count whole events over the same
-    denominators and fewer than :data:`RARE_DISCORDANT` events differ between them, the
-    interval is widened to cover ``[(L_up − U_down)/N, (U_up − L_down)/N]``, the exact
-    Poisson (Garwood) bounds of the events B adds (``up``) and removes (``down``) — the
-    paired analogue of the rare-event rule for a single design's counts and rates.
-
-    Other pairs (durations): on common random numbers most users' values are identical in
-    both designs; with fewer than :data:`RARE_DISCORDANT` users whose values differ the t
-    quantile has (that number − 1) degrees of freedom, and with fewer than 2 there is no
-    interval (``low``/``high`` None): the data cannot say how much the designs differ."""
-    if len(a) != len(b):
-        raise ValueError("paired designs need the same users")
-    users = len(a)
-    est_a, est_b = ratio_estimate(a, level), ratio_estimate(b, level)
-    if est_a.value is None or est_b.value is None:
-        return RatioEstimate(None, None, None, 0)
-    diff = est_b.value - est_a.value
-    if users < 2:
-        return RatioEstimate(diff, None, None, users)
-    nbar_a = sum(n for _, n in a) / users
-    nbar_b = sum(n for _, n in b) / users
-    z = [(yb - est_b.value * nb) / nbar_b - (ya - est_a.value * na) / nbar_a
-         for (ya, na), (yb, nb) in zip(a, b, strict=True)]
-    mean_z = sum(z) / users
-    var = sum((v - mean_z) ** 2 for v in z) / (users - 1)
-    counts = _discordant(a, b)
-    df = users - 1
-    if counts is None:
-        # Not counts (durations): the variance rests on the users in whom the designs differ
-        # at all; with few of them it has about that many degrees of freedom (Satterthwaite),
-        # and with fewer than two it cannot be estimated - no interval rather than a false
-        # [d, d] (the same users, the same draws: most users' values are identical)
-        differing = sum(1 for pa, pb in zip(a, b, strict=True) if pa != pb)
-        if differing < 2:
-            return RatioEstimate(diff, None, None, users)
-        if differing < RARE_DISCORDANT:
-            df = min(df, differing - 1)
-    half = t_quantile(level, df) * math.sqrt(var / users)
-    low, high = diff - half, diff + half
-    if counts is not None and counts[0] + counts[1] < RARE_DISCORDANT:
-        up, down, total = counts
-        _, up_lo, up_hi = poisson_interval(up, total, level)
-        _, down_lo, down_hi = poisson_interval(down, total, level)
-        low, high = min(low, up_lo - down_hi), max(high, up_hi - down_lo)
-    return RatioEstimate(diff, low, high, users)

@@ -1,11 +1,12 @@
-"""Deciding the statistical ``then`` lines of scenario files: pass, refuted, or too few runs.
+"""Deciding a statistical claim (scenario files' ``then`` lines): pass, refuted, or too few runs.
 
 A claim "X >= b with C confidence" passes when the one-sided lower confidence bound of X at
 level C is at least ``b``; it is refuted when the one-sided upper bound is below ``b``; and
 otherwise the data cannot decide: the message then says how many replications would, if the
 estimate stayed where it is. ``in [a, b]`` uses the two-sided interval at level C.
 
-Intervals (:mod:`opspec.statistics`): Wilson score for rates (good coverage near 0 and 1, unlike the Wald interval),
+Intervals (:mod:`opspec.statistics.intervals`): Wilson score for rates (good coverage near 0
+and 1, unlike the Wald interval),
 Student t for means of per-replication values, and the distribution-free order-statistic
 interval (binomial) for quantiles of pooled observations.
 
@@ -17,7 +18,7 @@ from __future__ import annotations
 import math
 from collections.abc import Sequence
 
-from opspec.statistics import (
+from opspec.statistics.intervals import (
     normal_quantile,
     one_sided,
     quantile_interval,
@@ -25,12 +26,12 @@ from opspec.statistics import (
     t_quantile,
 )
 
-__all__ = ["decide_mean", "decide_quantile", "decide_rate"]
+__all__ = ["confidence_text", "decide_mean", "decide_quantile", "decide_rate"]
 
 _MAX_N = 10**9
 
 
-def _pct(level: float) -> str:
+def confidence_text(level: float) -> str:
     """A confidence for people: 95%, 99%, 98.75% (never rounded to a level it is not)."""
     return f"{level * 100:.4g}%"
 
@@ -81,7 +82,8 @@ def decide_rate(text: str, successes: int, trials: int, op: str, a: float, b: fl
     side = "two-sided" if op == "in" else "one-sided"
     lines = [f"expected {text}",
              (f"  estimate {estimate:.4g} ({successes}/{trials} {units}, {replications} "
-              f"replication(s)); {_pct(level)} {side} Wilson interval [{lo:.4g}, {hi:.4g}]; "
+              f"replication(s)); {confidence_text(level)} {side} Wilson interval "
+              f"[{lo:.4g}, {hi:.4g}]; "
               f"bound {_bound_text(op, a, b)}")]
     if verdict == "refuted":
         lines.append("  the claim is false at this confidence")
@@ -136,7 +138,8 @@ def decide_mean(text: str, values: Sequence[float], op: str, a: float, b: float 
         return None
     side = "two-sided" if op == "in" else "one-sided"
     lines = [f"expected {text}",
-             (f"  estimate {mean:.4g} (sd {sd:.3g}, {n} replications); {_pct(level)} {side} t "
+             (f"  estimate {mean:.4g} (sd {sd:.3g}, {n} replications); "
+              f"{confidence_text(level)} {side} t "
               f"interval [{lo:.4g}, {hi:.4g}]; bound {_bound_text(op, a, b)}")]
     if verdict == "refuted":
         lines.append("  the claim is false at this confidence")
@@ -168,7 +171,7 @@ def decide_quantile(text: str, values: Sequence[float], q: float, op: str, a: fl
     below = sum(1 for v in ordered if v <= a) / n
     side = "two-sided" if op == "in" else "one-sided"
     lines = [f"expected {text}",
-             (f"  estimate {estimate:.4g} ({n} observations); {_pct(level)} {side} "
+             (f"  estimate {estimate:.4g} ({n} observations); {confidence_text(level)} {side} "
               f"order-statistic interval [{lo:.4g}, {hi:.4g}]; bound {_bound_text(op, a, b)}")]
     if verdict == "refuted":
         lines.append("  the claim is false at this confidence")

@@ -1,5 +1,5 @@
 """The interval of a proportion pooled over users: missed of due doses (docs/evaluation.md,
-"Rare events").
+"Rare events"; method ``"wilson-neff"`` of :mod:`opspec.statistics.methods`).
 
 Users are clusters of trials (the doses of one person are not independent when people
 differ), and the events are often rare (a missed dose in 300). Both are handled the way the
@@ -15,7 +15,8 @@ from __future__ import annotations
 import math
 from collections.abc import Sequence
 
-from opspec.statistics import normal_quantile, t_quantile
+from opspec.statistics.clustered import ratio_variance
+from opspec.statistics.intervals import normal_quantile, t_quantile
 
 __all__ = ["effective_trials", "is_proportion", "proportion_interval"]
 
@@ -37,36 +38,25 @@ def _wilson(p: float, n: float, z: float) -> tuple[float, float]:
             1.0 if p >= 1 else min(1.0, centre + half))
 
 
-def _variance_share(independent: float, residuals: Sequence[float], trials: float,
-                    level: float) -> float:
-    """``independent / v``: the share of the variance the trials would have if independent,
-    where ``v`` adds the between-user excess of the cluster-robust variance over it (from
-    the users' ``residuals``), scaled by ``(t[U-1]/z)²`` because it is estimated from only U
-    users (Korn & Graubard's 1998 degrees-of-freedom adjustment, applied to the part of the
-    variance that is estimated). At most 1: Korn & Graubard truncate the design effect at 1,
-    since users who look more alike than chance would make them do not make a trial worth
-    more than one."""
-    users = len(residuals)
-    if users < 2 or independent <= 0:
-        return 1.0
-    nbar = trials / users
-    cluster = math.fsum(r * r for r in residuals) / (users * (users - 1) * nbar ** 2)
-    df_factor = (t_quantile(level, users - 1) / normal_quantile(0.5 + level / 2)) ** 2
-    return independent / (independent + df_factor * max(cluster - independent, 0.0))
-
-
 def effective_trials(pairs: Pairs, level: float = 0.95) -> float:
     """How many independent trials the users' pooled trials are worth (Kish's effective
-    sample size ``n/deff``): ``p(1-p) / v`` with ``v`` the binomial variance of the pooled
-    proportion ``p`` plus the between-user excess (:func:`_variance_share`). The pooled
-    trials when ``p`` is 0 or 1 or there are fewer than 2 users (nothing to estimate the
-    excess from)."""
+    sample size ``n/deff``): ``p(1-p) / v``, where ``v`` is the binomial variance of the
+    pooled proportion ``p`` plus the between-user excess of the cluster-robust variance over
+    it, scaled by ``(t[U-1]/z)²`` because it is estimated from only U users (Korn &
+    Graubard's 1998 degrees-of-freedom adjustment, applied to the part of the variance that
+    is estimated). At most the pooled trials: Korn & Graubard truncate the design effect at
+    1, since users who look more alike than chance would make them do not make a trial
+    worth more than one. The pooled trials when ``p`` is 0 or 1 or there are fewer than 2
+    users (nothing to estimate the excess from)."""
     trials = math.fsum(n for _, n in pairs)
     p = math.fsum(y for y, _ in pairs) / trials
-    if not 0 < p < 1:
+    estimated = ratio_variance(pairs)
+    if not 0 < p < 1 or estimated is None:
         return trials
-    return trials * _variance_share(p * (1 - p) / trials, [y - p * n for y, n in pairs],
-                                    trials, level)
+    independent = p * (1 - p) / trials
+    df_factor = (t_quantile(level, len(pairs) - 1) / normal_quantile(0.5 + level / 2)) ** 2
+    return trials * independent / (independent
+                                   + df_factor * max(estimated[1] - independent, 0.0))
 
 
 #: Brown, Cai & DasGupta's (2001) modification of Wilson's interval near 0 (and n): with 1 or

@@ -1,0 +1,36 @@
+"""From a fresh virtual environment, the README's first command's kind of install (opspec
+alone, no extras) gives a working spec-test setup: `opspec new NAME` writes a project whose
+tests pass right away. Slow (a whole install, a few minutes): run with ``-m slow``."""
+
+from __future__ import annotations
+
+import os
+import subprocess
+import sys
+import venv
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parents[2]
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("template", ["pill", "stove"])
+def test_a_new_project_passes_its_tests_in_a_fresh_venv(tmp_path: Path, template: str) -> None:
+    env_dir = tmp_path / "venv"
+    venv.create(env_dir, with_pip=True)
+    python = env_dir / "bin" / "python"
+    env = {k: v for k, v in os.environ.items()
+           if not k.startswith(("PYTEST_", "TEXTUAL_", "VIRTUAL_ENV"))}
+    env["OPSPEC_PURE_PYTHON"] = "1"
+    subprocess.run([str(python), "-m", "pip", "install", "-q", str(ROOT)], env=env,
+                   check=True, timeout=1200, capture_output=True)
+    subprocess.run([str(env_dir / "bin" / "opspec"), "new", "mine", "--template", template],
+                   cwd=tmp_path, env=env, check=True, timeout=120, capture_output=True)
+    done = subprocess.run([str(python), "-m", "pytest", "-q", "-p", "no:cacheprovider"],
+                          cwd=tmp_path / "mine", env=env, capture_output=True, text=True,
+                          timeout=600, check=False)
+    assert done.returncode == 0, done.stdout + done.stderr
+    assert "3 passed" in done.stdout
+    assert sys.executable not in done.stdout
