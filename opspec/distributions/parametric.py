@@ -8,7 +8,6 @@ from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
-from scipy import special  # type: ignore[import-untyped]
 
 from opspec.distributions.base import (
     _STD_NORMAL,
@@ -153,9 +152,13 @@ class Gamma(Distribution):
         return self.shape * self.scale**2
 
     def cdf(self, x: float) -> float:
+        from scipy import special  # type: ignore[import-untyped,unused-ignore]  # lazy: 0.3 s at start-up
+
         return float(special.gammainc(self.shape, x / self.scale)) if x > 0 else 0.0
 
     def quantile(self, q: float) -> float:
+        from scipy import special  # type: ignore[import-untyped,unused-ignore]  # lazy: 0.3 s at start-up
+
         return float(special.gammaincinv(self.shape, _check_q(q))) * self.scale
 
     def scaled(self, factor: float) -> Gamma:
@@ -256,6 +259,8 @@ class TruncatedNormal(Distribution):
         return self._from_uniform(float(rng.random()))
 
     def sample_many(self, rng: np.random.Generator, n: int) -> FloatArray:
+        from scipy import special  # type: ignore[import-untyped,unused-ignore]  # lazy: 0.3 s at start-up
+
         a, b = self._ab()
         u = rng.random(n)
         if a > 0:

@@ -12,14 +12,16 @@ seeded stream (:mod:`opspec.engine.random`).
 from __future__ import annotations
 
 from collections.abc import Callable
-
-import numpy as np
+from typing import TYPE_CHECKING
 
 from opspec.model import DeclaredDistribution
 
+if TYPE_CHECKING:   # NumPy only when a spec declares a distribution (`opspec validate` never)
+    import numpy as np
+
 __all__ = ["Sampler", "make_sampler"]
 
-Sampler = Callable[[np.random.Generator], float]
+Sampler = Callable[["np.random.Generator"], float]
 
 
 def make_sampler(dist: DeclaredDistribution) -> Sampler:

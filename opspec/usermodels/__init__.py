@@ -14,16 +14,44 @@
 The format is documented in ``docs/user-models.md``.
 """
 
-from opspec.usermodels.distributions import Distribution, from_model, make_distribution
-from opspec.usermodels.loader import (
-    dump_user_model,
-    load_user_model,
-    parse_user_model,
-    preset_names,
-    resolve_preset,
-)
-from opspec.usermodels.model import ActivityModel, Modifier, UserModel
-from opspec.usermodels.performer import StochasticUser
+from __future__ import annotations
+
+import importlib
+from typing import TYPE_CHECKING, Any
+
+if TYPE_CHECKING:
+    from opspec.usermodels.distributions import Distribution, from_model, make_distribution
+    from opspec.usermodels.loader import (
+        dump_user_model,
+        load_user_model,
+        parse_user_model,
+        preset_names,
+        resolve_preset,
+    )
+    from opspec.usermodels.model import ActivityModel, Modifier, UserModel
+    from opspec.usermodels.performer import StochasticUser
+
+# Each name is imported from its module when first used (PEP 562), not with the package: the
+# distributions need NumPy and SciPy (about half a second), and `opspec validate` or the
+# parser of every command imports `opspec.usermodels.persons` only.
+_HOME = {
+    "Distribution": "distributions", "from_model": "distributions",
+    "make_distribution": "distributions",
+    "dump_user_model": "loader", "load_user_model": "loader", "parse_user_model": "loader",
+    "preset_names": "loader", "resolve_preset": "loader",
+    "ActivityModel": "model", "Modifier": "model", "UserModel": "model",
+    "StochasticUser": "performer",
+}
+
+
+def __getattr__(name: str) -> Any:
+    home = _HOME.get(name)
+    if home is None:
+        raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+    value = getattr(importlib.import_module(f"{__name__}.{home}"), name)
+    globals()[name] = value
+    return value
+
 
 __all__ = [
     "ActivityModel",

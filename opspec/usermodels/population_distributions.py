@@ -40,7 +40,6 @@ from typing import Any
 
 import numpy as np
 import numpy.typing as npt
-from scipy import special  # type: ignore[import-untyped]
 
 from opspec.usermodels.distbase import ParameterError
 
@@ -51,7 +50,7 @@ __all__ = ["CORRELATION_KINDS", "PER_USER_KINDS", "PerUserDistribution",
 def _stats() -> Any:
     """scipy.stats, imported when a population is built: a user model without one never
     needs it, and importing it is a third of a second of every command's start."""
-    from scipy import stats
+    from scipy import stats  # type: ignore[import-untyped,unused-ignore]
 
     return stats
 
@@ -93,6 +92,8 @@ class PerUserDistribution:
     def from_normal(self, z: float) -> float:
         """The parameter value whose normal score is ``z``: the quantile of Phi(z), taken
         from the upper tail for z > 0 so that precision is kept in both tails."""
+        from scipy import special  # type: ignore[import-untyped,unused-ignore]  # loaded with self.frozen
+
         if z <= 0.0:
             return float(self.frozen.ppf(special.ndtr(z)))
         return float(self.frozen.isf(special.ndtr(-z)))

@@ -5,9 +5,10 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable, Mapping
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
-import numpy as np
+if TYPE_CHECKING:   # annotations only: `opspec validate` loads no NumPy
+    import numpy as np
 
 __all__ = ["RobotWorld", "World", "check_parameters"]
 

@@ -12,13 +12,14 @@ from __future__ import annotations
 
 import math
 from collections.abc import Mapping, Sequence
-from typing import Any
-
-import numpy as np
+from typing import TYPE_CHECKING, Any
 
 from opspec.worlds.base import RobotWorld, check_parameters
 from opspec.worlds.geometry import Box, ray_to_box, wrap_angle
 from opspec.worlds.robot import Robot
+
+if TYPE_CHECKING:   # annotations only: `opspec validate` loads no NumPy
+    import numpy as np
 
 __all__ = ["RoomWorld"]
 

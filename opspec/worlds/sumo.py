@@ -14,13 +14,14 @@ from __future__ import annotations
 
 import math
 from collections.abc import Mapping
-from typing import Any
-
-import numpy as np
+from typing import TYPE_CHECKING, Any
 
 from opspec.worlds.base import RobotWorld, check_parameters
 from opspec.worlds.geometry import ray_to_circle_inside, wrap_angle
 from opspec.worlds.robot import Robot
+
+if TYPE_CHECKING:   # annotations only: `opspec validate` loads no NumPy
+    import numpy as np
 
 __all__ = ["SumoWorld"]
 

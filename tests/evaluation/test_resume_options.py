@@ -4,6 +4,9 @@ workers is an error after a timeout, never a hang."""
 
 from __future__ import annotations
 
+import contextlib
+import io
+import json
 import shutil
 import sqlite3
 import threading
@@ -15,13 +18,25 @@ from conftest import SPEC, USERS_TOML, metrics_of
 from opspec.cli import main
 
 
+@pytest.fixture(scope="module")
+def stored_once(tmp_path_factory):
+    """A finished run of 3 users x 1 day, seed 5, the companion user model: evaluated once
+    for the module (most of its cost is the fixed cost of the report), copied for each test."""
+    out = tmp_path_factory.mktemp("stored") / "run"
+    stdout, stderr = io.StringIO(), io.StringIO()
+    with contextlib.redirect_stdout(stdout), contextlib.redirect_stderr(stderr):
+        status = main(["evaluate", str(SPEC), "--users", "3", "--days", "1", "--seed", "5",
+                       "--out", str(out), "--workers", "1", "--json"])
+    assert status == 0, stderr.getvalue()
+    return out, json.loads(stdout.getvalue())
+
+
 @pytest.fixture
-def stored(tmp_path, evaluate):
-    """A finished run of 3 users x 1 day, seed 5, the companion user model."""
+def stored(stored_once, tmp_path):
+    """A test's own copy of the finished run (a test may resume or change it)."""
+    original, doc = stored_once
     out = tmp_path / "run"
-    status, doc, err = evaluate(str(SPEC), "--users", "3", "--days", "1", "--seed", "5",
-                                "--out", str(out), "--workers", "1")
-    assert status == 0, err
+    shutil.copytree(original, out)
     return out, doc
 
 

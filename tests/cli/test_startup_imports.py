@@ -1,0 +1,47 @@
+"""Each command imports what it needs when it needs it (issue 31, start-up): checking a spec
+loads no numerical library, and running the dispenser loads NumPy (its random streams) but not
+SciPy or Matplotlib. What is checked is the set of modules the command's interpreter ended with,
+not a time (benchmarks/startup.py measures the time)."""
+
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[2]
+SPEC = str(ROOT / "specs" / "medication_dispenser.xpdl")
+
+# Run the command in a fresh interpreter (this one has imported everything the other tests
+# needed), then print which of the heavy packages it imported.
+PROBE = """
+import contextlib, io, json, sys
+from opspec.cli import main
+with contextlib.redirect_stdout(io.StringIO()):
+    status = main(sys.argv[1:])
+heavy = sorted({name.split(".")[0] for name in sys.modules} & {"numpy", "scipy", "matplotlib",
+               "textual", "simpy", "dask", "jsonschema"})
+print(json.dumps({"status": status, "heavy": heavy}))
+"""
+
+
+def imported(*argv: str) -> tuple[int, list[str]]:
+    done = subprocess.run([sys.executable, "-c", PROBE, *argv], capture_output=True, text=True,
+                          cwd=ROOT, check=False)
+    assert done.returncode == 0, done.stderr
+    found = json.loads(done.stdout.strip().splitlines()[-1])
+    return found["status"], found["heavy"]
+
+
+def test_validate_imports_no_numpy_scipy_or_matplotlib():
+    status, heavy = imported("validate", SPEC)
+    assert status == 0
+    assert heavy == []
+
+
+def test_run_of_the_dispenser_imports_numpy_for_its_streams_but_not_scipy():
+    status, heavy = imported("run", SPEC, "--days", "1", "--seed", "1")
+    assert status == 0
+    assert "numpy" in heavy and "simpy" in heavy     # the probe sees what was imported
+    assert "scipy" not in heavy and "matplotlib" not in heavy and "textual" not in heavy
