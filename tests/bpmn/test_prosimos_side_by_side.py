@@ -12,8 +12,8 @@ hand, a cycle takes 300 + 0.7 × 900 = 930 s on average and 70 % of the cases ar
 
 Prosimos runs in its own test-only venv, ``.prosimos-venv`` (``scripts/prosimos-venv.sh``;
 never a dependency of opspec), through ``prosimos_driver.py``. When the venv is absent this
-module creates it (set ``OPSPEC_NO_ORACLE=1`` to skip instead); when it cannot be made the
-comparison is skipped saying why.
+module creates it when ``OPSPEC_PROSIMOS=1`` is set (it is about 850 MB, so CI does not);
+otherwise, or when it cannot be made, the comparison is skipped saying why.
 """
 
 from __future__ import annotations
@@ -41,9 +41,12 @@ ASSESS = "Assess eligibility"
 
 @pytest.fixture(scope="module")
 def prosimos_cases(tmp_path_factory: pytest.TempPathFactory) -> list[dict[str, object]]:
-    if not PYTHON.exists() and os.environ.get("OPSPEC_NO_ORACLE"):
-        pytest.skip("no .prosimos-venv and OPSPEC_NO_ORACLE is set (bash "
-                    "scripts/prosimos-venv.sh makes it)")
+    if not PYTHON.exists() and (os.environ.get("OPSPEC_NO_ORACLE")
+                                or not os.environ.get("OPSPEC_PROSIMOS")):
+        # Prosimos's venv is about 850 MB (pandas, scipy, …): CI (10 minutes in all) does not
+        # make it; the comparison runs wherever it exists, and its numbers are in docs/bpmn.md
+        pytest.skip("no .prosimos-venv: run bash scripts/prosimos-venv.sh (or set "
+                    "OPSPEC_PROSIMOS=1) to compare with Prosimos")
     made = subprocess.run(["bash", str(ROOT / "scripts" / "prosimos-venv.sh")],
                           capture_output=True, text=True, timeout=900, check=False)
     if made.returncode != 0:
