@@ -36,6 +36,7 @@ COMMAND_MODULES: tuple[str, ...] = (
     "opspec.commands.check",
     "opspec.commands.walkthrough",
     "opspec.commands.fit",
+    "opspec.commands.model_check",
     "opspec.commands.devices",
     "opspec.commands.new",
 )

@@ -1,0 +1,234 @@
+"""``opspec model-check MODEL TRACE...``: does the model predict people it was not fitted on?
+
+Exit status 0 when no item misfits, 1 when one does (each named with its statistic,
+p-value and what the people did against what the model predicts), 2 for a usage or input
+problem. docs/fitting.md, *Checking a model against new people*.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+from collections.abc import Sequence
+from dataclasses import dataclass
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+from opspec.usermodels.persons import PERSON_FROM
+
+if TYPE_CHECKING:
+    from opspec.usermodels.checking import CheckReport
+    from opspec.usermodels.model import UserModel
+    from opspec.usermodels.persons import PersonRule
+
+__all__ = ["CheckOptions", "add_person_options", "check_model", "register"]
+
+
+def add_person_options(parser: Any) -> None:
+    """``--person``, ``--person-pattern``, ``--person-from``: whose each session is."""
+    who = parser.add_argument_group(
+        "whose sessions", "several sessions of one participant are one person "
+        "(docs/fitting.md)")
+    who.add_argument("--person", action="append", default=[], metavar="FILE=ID",
+                     help="the sessions in FILE are participant ID (repeatable)")
+    who.add_argument("--person-pattern", metavar="REGEX",
+                     help="the participant is the first group of REGEX found in each file's "
+                     "path, e.g. '(P\\d+)'")
+    who.add_argument("--person-from", choices=PERSON_FROM, default="auto",
+                     help="otherwise: the trace header's 'person' key (header), each file, "
+                     "its folder's name, each run; auto (default): the header's key where "
+                     "there is one, else each run")
+
+
+def register(subparsers: Any) -> None:
+    parser = subparsers.add_parser(
+        "model-check", help="check a user model against people it was not fitted on",
+        description="Compare traces or walkthrough recordings of people NOT used to fit "
+        "MODEL with what MODEL predicts, per user-lane activity (durations: Anderson-"
+        "Darling by parametric bootstrap, the population's between-person spread and the "
+        "parameters' [uncertainty] included; omission, commission and repetition rates: "
+        "exact binomial / beta-binomial) and, with --spec, per outcome metric of the spec "
+        "(predictive intervals from runs of the spec with the model). Holm's adjustment "
+        "keeps the chance of any false misfit at --level. Exit 0: nothing misfits; 1: "
+        "something does (docs/fitting.md).")
+    parser.add_argument("model", metavar="MODEL",
+                        help="user model: a TOML file (fitted or hand-written, a population "
+                        "included), a preset, or A,B compositions")
+    parser.add_argument("traces", nargs="+", metavar="TRACE",
+                        help="trace files (.jsonl) of held-out people, or folders of them")
+    parser.add_argument("--spec", metavar="SPEC",
+                        help="also check the spec's outcome metrics: the spec run with the "
+                        "model gives predictive intervals for what these people showed")
+    parser.add_argument("--days", type=float, metavar="D",
+                        help="with --spec: simulated days of each run, as long as the "
+                        "people's sessions (default: the spec's run length)")
+    parser.add_argument("--runs", type=int, default=200, metavar="N",
+                        help="with --spec: simulated people for the metrics (default: 200)")
+    parser.add_argument("--level", type=float, default=0.05,
+                        help="family-wise error level (default: 0.05)")
+    parser.add_argument("--replicates", type=int, default=399, metavar="B",
+                        help="simulated groups of people for the bootstrap and the predictive "
+                        "rates (default: 399)")
+    parser.add_argument("--no-parameter-uncertainty", action="store_true",
+                        help="ignore the model's [uncertainty] redraws: take its parameters "
+                        "as known")
+    parser.add_argument("--lane", default="user",
+                        help="lane or participant checked (default: user)")
+    parser.add_argument("--seed", type=int, default=0, help="seed (default: 0)")
+    parser.add_argument("--json", action="store_true", help="print the check as JSON")
+    parser.add_argument("--report", metavar="DIR",
+                        help="write DIR/model-check.html: the verdict, QQ plots per activity "
+                        "and intervals per metric")
+    add_person_options(parser)
+    parser.set_defaults(handler=_model_check)
+
+
+@dataclass(frozen=True)
+class CheckOptions:
+    level: float = 0.05
+    replicates: int = 399
+    seed: int = 0
+    lane: str = "user"
+    parameter_uncertainty: bool = True
+    spec: str | None = None
+    days: float | None = None
+    runs: int = 200
+
+
+class _ComposedDraws:
+    """Parameter redraws of the fitted part of a composed reference (``fitted.toml,mci``):
+    draw ``d`` is the reference loaded with that part's draw ``d`` (opspec evaluate
+    --input-uncertainty's rule)."""
+
+    def __init__(self, ref: str, draws: Any, index: int) -> None:
+        self.ref, self.draws, self.index = ref, draws, index
+        self.count = draws.count
+
+    def apply(self, model: Any, draw: int) -> Any:
+        from opspec.usermodels.uncertainty import drawn_model
+
+        return drawn_model(self.ref, self.draws, self.index, draw)
+
+
+def _draws(ref: str) -> Any:
+    from opspec.usermodels.uncertainty import read_parameter_draws
+
+    found = read_parameter_draws(ref)
+    if found is None:
+        return None
+    draws, index = found
+    if "," not in ref:
+        return draws
+    return _ComposedDraws(ref, draws, index)
+
+
+def _check_options(options: CheckOptions) -> None:
+    from opspec.errors import UserModelError
+
+    if not 0 < options.level < 1:
+        raise UserModelError(f"--level must be between 0 and 1, not {options.level:g}",
+                             hint="for instance --level 0.05")
+    if options.replicates < 19:
+        raise UserModelError(f"--replicates must be at least 19, not {options.replicates}",
+                             hint="a bootstrap p-value is at least 1/(B+1): take 399 or more "
+                             "so that Holm can reach small levels")
+    if options.runs < 2:
+        raise UserModelError(f"--runs must be at least 2, not {options.runs}")
+
+
+def check_model(model: UserModel, model_ref: str | None, paths: Sequence[Path],
+                options: CheckOptions, persons: PersonRule | None = None) -> CheckReport:
+    """Check ``model`` against the traces ``paths`` (what ``opspec model-check`` prints)."""
+    from opspec.usermodels.checking import (
+        CheckReport,
+        check_observations,
+        count_decisions,
+        finish,
+    )
+    from opspec.usermodels.fitting import collect
+
+    _check_options(options)
+    if persons is not None:
+        persons.check_used(list(paths))
+    obs = collect(paths, options.lane, persons)
+    draws = (_draws(model_ref) if options.parameter_uncertainty and model_ref else None)
+    repeated, traced = count_decisions(paths, obs)
+    items, notes = check_observations(model, obs, replicates=options.replicates,
+                                      seed=options.seed, draws=draws, repeated=repeated,
+                                      decisions_traced=traced)
+    if options.spec is not None:
+        from opspec.commands._spec import load_any_spec
+        from opspec.evaluation.predictive import (
+            metric_items,
+            observed_metrics,
+            predicted_metrics,
+        )
+
+        package = load_any_spec(options.spec, command="model-check")
+        definitions = package.metrics
+        if not definitions:
+            notes.append(f"{options.spec} declares no outcome metrics (opspec:Metrics): "
+                         "only the activities were checked")
+        else:
+            observed = observed_metrics(paths, definitions, obs.person_of)
+            predicted = predicted_metrics(package, model, runs=options.runs,
+                                          seed=options.seed, days=options.days, draws=draws)
+            units = {m.name: getattr(m, "unit", None) or "" for m in definitions}
+            more, more_notes = metric_items(observed, predicted, seed=options.seed,
+                                            units=units)
+            items.extend(more)
+            notes.extend(more_notes)
+    if not items:
+        from opspec.errors import UserModelError
+
+        raise UserModelError("nothing to check: the traces hold no activity the model "
+                             "describes", hint="check --lane and that MODEL is the model of "
+                             "these traces' spec")
+    uncertainty = ("none in the model (its parameters taken as known)" if draws is None
+                   else f"{draws.count} redraws of its [uncertainty] table, one per "
+                   "simulated group")
+    if draws is None and not options.parameter_uncertainty:
+        uncertainty = "ignored (--no-parameter-uncertainty)"
+    return CheckReport(finish(items, options.level), options.level, len(obs.persons),
+                       obs.sessions, options.replicates, options.seed, uncertainty,
+                       tuple(notes))
+
+
+def _model_check(args: argparse.Namespace) -> int:
+    from opspec.usermodels.fitting import iter_paths
+    from opspec.usermodels.loader import load_user_model
+    from opspec.usermodels.persons import PersonRule, parse_person_options
+
+    from opspec.errors import UserModelError
+
+    paths = iter_paths(args.traces)
+    if not paths:
+        raise UserModelError("no trace files found in " + ", ".join(args.traces),
+                             hint="give .jsonl trace files or folders holding them")
+    model = load_user_model(args.model)
+    persons = PersonRule(args.person_from, args.person_pattern,
+                         parse_person_options(args.person))
+    options = CheckOptions(level=args.level, replicates=args.replicates, seed=args.seed,
+                           lane=args.lane,
+                           parameter_uncertainty=not args.no_parameter_uncertainty,
+                           spec=args.spec, days=args.days, runs=args.runs)
+    report = check_model(model, args.model, paths, options, persons)
+    written = None
+    if args.report:
+        from opspec.evaluation.model_check_report import write_report
+
+        written = write_report(report, args.report,
+                               title=f"Model check: {args.model} against "
+                               f"{report.persons} held-out person(s)")
+    if args.json:
+        doc = {"model": args.model, "traces": [str(p) for p in paths], **report.to_json(),
+               "report": str(written) if written else None}
+        print(json.dumps(doc, indent=1))
+    else:
+        print(f"model {args.model} against {report.persons} person(s), {report.sessions} "
+              f"session(s) in {len(paths)} trace file(s)")
+        for line in report.lines():
+            print(line)
+        if written:
+            print(f"report: {written}")
+    return 0 if report.fits else 1
