@@ -13,7 +13,7 @@ from opspec.usermodels.persons import PERSON_FROM
 if TYPE_CHECKING:
     from opspec.usermodels.uncertainty import ParameterDraws
 
-__all__ = ["register"]
+__all__ = ["fitted_text", "register"]
 
 
 def register(subparsers: Any) -> None:
@@ -98,10 +98,19 @@ def _uncertainty_text(draws: ParameterDraws | None) -> str:
             "1..B (docs/fitting.md)\n" + draws.to_text())
 
 
+def fitted_text(result: Any, draws: ParameterDraws | None, header: str = "") -> str:
+    """The model file ``opspec fit`` writes for ``result``: the model with its comments, the
+    ``[vary]`` tables and the ``[uncertainty]`` redraws."""
+    from opspec.usermodels.loader import dump_user_model
+
+    text = dump_user_model(result.model, comments=result.comments(), header=header)
+    return text + _vary_text(result.vary()) + _uncertainty_text(draws)
+
+
 def _fit(args: argparse.Namespace) -> int:
     from opspec.errors import UserModelError
     from opspec.usermodels.fitting import fit_traces, iter_paths
-    from opspec.usermodels.loader import dump_user_model, load_user_model
+    from opspec.usermodels.loader import load_user_model
 
     if args.min_per_user < 2:
         raise UserModelError(f"--min-per-user must be at least 2, not {args.min_per_user}",
@@ -140,9 +149,7 @@ def _fit(args: argparse.Namespace) -> int:
               "where the data show\nthat users differ, [vary] tables at the end draw those "
               "parameters per simulated user.\nCheck the numbers before relying on them: "
               "small samples give wide intervals.")
-    text = dump_user_model(result.model, comments=result.comments(), header=header)
-    text += _vary_text(result.vary())
-    text += _uncertainty_text(draws)
+    text = fitted_text(result, draws, header)
     if out is None:
         sys.stdout.write(text)
         return 0

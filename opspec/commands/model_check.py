@@ -152,7 +152,10 @@ def check_model(model: UserModel, model_ref: str | None, paths: Sequence[Path],
         persons.check_used(list(paths))
     obs = collect(paths, options.lane, persons)
     draws = (_draws(model_ref) if options.parameter_uncertainty and model_ref else None)
-    repeated, traced = count_decisions(paths, obs)
+    repeated: dict[str, dict[str, int]] = {}
+    traced = False
+    if any(a.repetition is not None for a in model.activities.values()):
+        repeated, traced = count_decisions(paths, obs)
     items, notes = check_observations(model, obs, replicates=options.replicates,
                                       seed=options.seed, draws=draws, repeated=repeated,
                                       decisions_traced=traced)

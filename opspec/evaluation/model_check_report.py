@@ -73,7 +73,8 @@ def _interval(item: Any) -> str:
             label="their mean")
     ax.set_yticks([0, 1], ["mean", "people"])
     ax.set_ylim(-0.8, 1.8)
-    ax.set_title(item.name + (f" ({item.unit})" if item.unit else ""), fontsize=10)
+    ax.set_title(item.name + (f" ({item.unit})" if item.unit else "")
+                 + (" (rate per offer)" if item.kind != "metric" else ""), fontsize=10)
     ax.legend(fontsize=6, loc="upper center", ncol=2, bbox_to_anchor=(0.5, -0.25))
     fig.tight_layout()
     return _svg(fig)
@@ -93,7 +94,7 @@ def write_report(report: Any, directory: str | Path, *, title: str) -> Path:
     for item in report.items:
         if item.kind == "duration" and item.figure.get("observed"):
             figures.append((item, _qq(item), "QQ plot: observed against predicted quantiles"))
-        elif item.kind == "metric":
+        elif item.kind == "metric" or "person_low" in item.figure:
             figures.append((item, _interval(item), "the people's values and the model's "
                             "predictive intervals"))
     figs = "\n".join(f"<figure>{svg}<figcaption>{e(item.name)}: {e(caption)}</figcaption>"

@@ -22,12 +22,11 @@ it counts a population's between-person spread and the parameters' estimation un
 as what they are — variation the model predicts.
 
 **Rates** (omission per offer, commission per eligible pick at a choice, repetition per
-completion): the total count of the held-out people against its predictive distribution,
-the convolution over people of each person's count distribution — exact binomial for one
-rate for all; beta-binomial when a population draws the rate per person from a beta;
-otherwise the binomial mixed over the rates of the simulated people (a Monte Carlo
-estimate of that mixture). The two-sided p-value sums the outcomes no more likely than the
-observed one (the rule of ``scipy.stats.binomtest``).
+completion): with one rate for everyone, the pooled count against the exact binomial
+(``scipy.stats.binomtest``); when people differ, the mean of the people's own rates against
+its predictive distribution — each person's count beta-binomial when a population draws the
+rate from a beta, otherwise binomial with a rate drawn from the simulated people's (see
+:func:`check_rate` for why the counts are not pooled then).
 
 **Family-wise error**: Holm's step-down adjustment over every item checked
 (:mod:`opspec.usermodels.holm`); an item misfits when its adjusted p-value is at most the
@@ -62,7 +61,6 @@ __all__ = [
     "anderson_darling",
     "check_observations",
     "finish",
-    "rate_pmf",
 ]
 
 #: size of the pooled predictive sample a duration is compared with (its empirical CDF)
@@ -109,12 +107,21 @@ class CheckItem:
                 f"p = {_fmt_p(self.p)}, Holm-adjusted p = {_fmt_p(self.p_holm)}")
 
     @property
+    def pooled(self) -> bool:
+        """A rate item tested on the pooled count (one rate for everyone)."""
+        return self.test.startswith("exact binomial")
+
+    @property
     def statistic_label(self) -> str:
-        return {"duration": "A²", "metric": "mean"}.get(self.kind, "count")
+        if self.kind in _RATES:
+            return "count" if self.pooled else "mean rate"
+        return {"duration": "A²", "metric": "mean"}.get(self.kind, "value")
 
     @property
     def observed_label(self) -> str:
-        return {"duration": "median", "metric": "mean per person"}.get(self.kind, "rate")
+        if self.kind in _RATES:
+            return "rate" if self.pooled else "mean rate per person"
+        return {"duration": "median", "metric": "mean per person"}.get(self.kind, "value")
 
     def to_json(self) -> dict[str, Any]:
         return {"item": self.name, "kind": self.kind, "activity": self.activity,
@@ -203,12 +210,20 @@ def finish(items: Sequence[CheckItem], level: float) -> tuple[CheckItem, ...]:
 # ------------------------------------------------------------------ the predictive people
 
 
+#: distinct groups of simulated people drawn (a population's person costs milliseconds to
+#: draw); replicate ``b`` reuses group ``b mod DISTINCT_GROUPS`` with fresh observations
+DISTINCT_GROUPS = 100
+
+
 class PredictivePeople:
     """``replicates`` groups of ``size`` simulated people, each group under one parameter
     redraw of ``draws`` (when given) and each person drawn from the population.
 
-    Person ``j`` of group ``b`` is user ``b * size + j`` of the population seeded ``seed``
-    (the population's own stream), so the same seed gives the same people.
+    Person ``j`` of group ``g`` is user ``g * size + j`` of the population seeded ``seed``
+    (the population's own stream), so the same seed gives the same people. At most
+    :data:`DISTINCT_GROUPS` groups are drawn; replicate ``b`` is group ``b mod`` that, whose
+    observations are drawn afresh for each replicate (the Monte Carlo p-value stays an
+    unbiased estimate; its between-person part rests on that many groups).
     """
 
     def __init__(self, model: UserModel, size: int, replicates: int, seed: int,
@@ -218,22 +233,19 @@ class PredictivePeople:
         self.replicates = replicates
         self.draws = draws
         self.seed = seed
-        identical = model.population is None and draws is None
-        groups: list[list[UserModel]] = []
-        for b in range(replicates):
-            base = model if draws is None else draws.apply(model, 1 + b % draws.count)
-            if identical:
-                groups.append([model] * size)
-            elif base.population is None:
-                groups.append([base] * size)
+        distinct: list[list[UserModel]] = []
+        for g in range(min(replicates, DISTINCT_GROUPS)):
+            base = model if draws is None else draws.apply(model, 1 + g % draws.count)
+            if base.population is None:
+                distinct.append([base] * size)
             else:
-                groups.append([base.individual(seed, b * size + j).model
-                               for j in range(size)])
-        self.groups = groups
-        self.identical = identical
+                distinct.append([base.individual(seed, g * size + j).model
+                                 for j in range(size)])
+        self.distinct = distinct
+        self.groups = [distinct[b % len(distinct)] for b in range(replicates)]
 
     def people(self) -> list[UserModel]:
-        return [p for g in self.groups for p in g]
+        return [p for g in self.distinct for p in g]
 
 
 # ------------------------------------------------------------------ durations
@@ -343,69 +355,68 @@ def check_duration(activity: str, observed: Mapping[str, Sequence[float]],
 # ------------------------------------------------------------------ rates
 
 
-def _minlike_p(pmf: np.ndarray, k: int) -> float:
-    """Two-sided p-value: the probability of every outcome no more likely than ``k``."""
-    if k >= pmf.size:
-        return 0.0
-    return float(min(1.0, pmf[pmf <= pmf[k] * (1 + 1e-7)].sum()))
-
-
-def rate_pmf(trials: Sequence[int], probabilities: np.ndarray | None = None, *,
-             beta: tuple[float, float] | None = None) -> np.ndarray:
-    """The distribution of the total count over people with ``trials`` each: binomial with
-    the one rate of ``probabilities`` (one value), beta-binomial with ``beta`` = (a, b), or
-    the binomial mixed over ``probabilities`` (the simulated people's rates)."""
-    from scipy import stats  # type: ignore[import-untyped]
-
-    total = np.ones(1)
-    cache: dict[int, np.ndarray] = {}
-    for n in trials:
-        one = cache.get(n)
-        if one is None:
-            k = np.arange(n + 1)
-            if beta is not None:
-                one = stats.betabinom.pmf(k, n, *beta)
-            else:
-                assert probabilities is not None
-                q = np.asarray(probabilities, float)
-                one = stats.binom.pmf(k[None, :], n, q[:, None]).mean(axis=0)
-            cache[n] = one = np.asarray(one, float)
-        total = np.convolve(total, one)
-    return total / total.sum()
+#: simulated groups for the predictive distribution of a population's mean rate
+RATE_GROUPS = 20_000
 
 
 def check_rate(name: str, kind: str, activity: str, counts: Mapping[str, tuple[int, int]],
-               rates: np.ndarray, beta: tuple[float, float] | None) -> CheckItem:
-    """Observed total count against its predictive distribution (see the module docstring);
-    ``rates`` are the simulated people's probabilities, ``beta`` a population's exact
-    per-person law when it has one."""
-    from scipy import stats
+               rates: np.ndarray, beta: tuple[float, float] | None,
+               rng: np.random.Generator) -> CheckItem:
+    """Observed counts against their predictive distribution; ``rates`` are the simulated
+    people's probabilities, ``beta`` a population's exact per-person law when it has one.
+
+    One rate for everyone: the pooled count of all trials, exact binomial test. People who
+    differ: the *mean of the people's own rates* ``k_p / n_p``, against the same mean for
+    groups whose person ``p`` has ``k ~ BetaBinomial(n_p, a, b)`` (or ``Binomial(n_p, q)``
+    with ``q`` one of the simulated people's rates). Pooling counts would be wrong here: the
+    number of offers depends on what the person does (a missed alarm rings again), so the
+    people who miss most are offered most, and a pooled rate weighs them more than the
+    model's per-person rate does."""
+    from scipy import stats  # type: ignore[import-untyped]
 
     used = {p: kn for p, kn in counts.items() if kn[1] > 0}
     k = sum(c for c, _ in used.values())
     n = sum(t for _, t in used.values())
-    trials = [t for _, t in used.values()]
+    trials = np.array([t for _, t in used.values()])
+    own = np.array([c / t for c, t in used.values()])
     one_rate = rates.size > 0 and float(np.ptp(rates)) == 0.0
     if one_rate:
         q = float(rates[0])
-        pmf = stats.binom.pmf(np.arange(n + 1), n, q)
-        test = "exact binomial"
+        test, statistic, observed = "exact binomial of the pooled count", float(k), k / n
         p = float(stats.binomtest(k, n, q).pvalue) if 0.0 < q < 1.0 else (
             1.0 if k == round(q * n) else 0.0)
+        low, high = (stats.binom.ppf([0.025, 0.975], n, q) / n if 0.0 < q < 1.0
+                     else np.array([q, q]))
+        centre = q
+        singles = stats.binom.ppf([0.025, 0.975], int(np.median(trials)), q) / max(
+            1, int(np.median(trials)))
     else:
-        pmf = rate_pmf(trials, rates, beta=beta)
-        test = ("exact beta-binomial (the population's per-person beta)" if beta is not None
-                else f"binomial mixed over {rates.size} simulated people's rates")
-        p = _minlike_p(pmf, k)
-    cdf = np.cumsum(pmf)
-    low = int(np.searchsorted(cdf, 0.025))
-    high = int(np.searchsorted(cdf, 0.975))
-    mean = float(np.dot(np.arange(pmf.size), pmf))
-    return CheckItem(name, kind, activity, test, float(k), p, len(used), n,
-                     {"value": k / n, "count": float(k), "trials": float(n)},
-                     {"value": mean / n, "low": low / n, "high": min(high, n) / n,
-                      "count": mean}, "",
-                     {"pmf": pmf.tolist(), "observed": k, "trials": n})
+        draws = np.empty((RATE_GROUPS, trials.size))
+        for j, t in enumerate(trials):
+            if beta is not None:
+                draws[:, j] = stats.betabinom.rvs(int(t), *beta, size=RATE_GROUPS,
+                                                  random_state=rng) / t
+            else:
+                q = rates[rng.integers(0, rates.size, size=RATE_GROUPS)]
+                draws[:, j] = rng.binomial(int(t), q) / t
+        groups = draws.mean(axis=1)
+        statistic = observed = float(own.mean())
+        below = int(np.sum(groups <= observed + 1e-12))
+        above = int(np.sum(groups >= observed - 1e-12))
+        p = min(1.0, 2 * (1 + min(below, above)) / (RATE_GROUPS + 1))
+        test = ("mean of the people's own rates, beta-binomial predictive (the "
+                "population's per-person beta)" if beta is not None else
+                f"mean of the people's own rates, binomial mixed over {rates.size} "
+                "simulated people's rates")
+        low, high = np.percentile(groups, [2.5, 97.5])
+        centre = float(groups.mean())
+        singles = np.percentile(draws[:, 0], [2.5, 97.5])
+    return CheckItem(name, kind, activity, test, statistic, p, len(used), n,
+                     {"value": observed, "count": float(k), "trials": float(n)},
+                     {"value": centre, "low": float(low), "high": float(high)}, "",
+                     {"people": own.tolist(), "groups_low": float(low),
+                      "groups_high": float(high), "person_low": float(singles[0]),
+                      "person_high": float(singles[1])})
 
 
 def _beta_law(model: UserModel, path: tuple[str, ...]) -> tuple[float, float] | None:
@@ -501,7 +512,7 @@ def check_observations(model: UserModel, obs: Observations, *, replicates: int =
             beta = (_beta_law(model, ("activities", activity, "omission", "probability"))
                     if draws is None else None)
             items.append(check_rate(f"{activity} omission", "omission", activity, omissions,
-                                    rates, beta))
+                                    rates, beta, _stream(seed, f"omission/{activity}")))
         if am.intended is not None and obs.user_picks.get(activity):
             cap = am.commission.max_per_instance if am.commission is not None else 1
             by_person = obs.lists_by_person(obs.user_picks[activity])
@@ -512,7 +523,8 @@ def check_observations(model: UserModel, obs: Observations, *, replicates: int =
                 beta = (_beta_law(model, ("activities", activity, "commission",
                                           "probability")) if draws is None else None)
                 items.append(check_rate(f"{activity} commission", "commission", activity,
-                                        counts, rates, beta))
+                                        counts, rates, beta,
+                                        _stream(seed, f"commission/{activity}")))
         elif am.probabilities and obs.picks.get(activity):
             notes.append(f"{activity}: a choice by fixed probabilities is not checked")
         if am.repetition is not None:
@@ -528,7 +540,8 @@ def check_observations(model: UserModel, obs: Observations, *, replicates: int =
                 beta = (_beta_law(model, ("activities", activity, "repetition",
                                           "probability")) if draws is None else None)
                 items.append(check_rate(f"{activity} repetition", "repetition", activity,
-                                        counts, rates, beta))
+                                        counts, rates, beta,
+                                        _stream(seed, f"repetition/{activity}")))
     return items, notes
 
 
