@@ -58,6 +58,22 @@ def register(subparsers: Any) -> None:
     parser.add_argument("--json", action="store_true",
                         help="print the fit (every family's AIC/BIC, intervals, between-user "
                         "spread) as one JSON object instead of the summary")
+    cv = parser.add_argument_group(
+        "cross-validation", "--holdout K: split the persons into K folds; for each, fit "
+        "on the others and check the model on the fold (opspec model-check); one verdict "
+        "over all folds, Holm-adjusted; exit 1 when something misfits (docs/fitting.md)")
+    cv.add_argument("--holdout", type=int, metavar="K",
+                    help="K-fold cross-validation by person")
+    cv.add_argument("--level", type=float, default=0.05,
+                    help="family-wise error level of the verdict (default: 0.05)")
+    cv.add_argument("--replicates", type=int, default=399, metavar="B",
+                    help="simulated groups of each check (default: 399)")
+    cv.add_argument("--spec", metavar="SPEC",
+                    help="also check the spec's outcome metrics on each fold")
+    cv.add_argument("--days", type=float, metavar="D",
+                    help="with --spec: simulated days of each run (default: the spec's)")
+    cv.add_argument("--runs", type=int, default=200, metavar="N",
+                    help="with --spec: simulated people for the metrics (default: 200)")
     parser.set_defaults(handler=_fit)
 
 
@@ -124,6 +140,11 @@ def _fit(args: argparse.Namespace) -> int:
 
     persons = PersonRule(args.person_from, args.person_pattern,
                          parse_person_options(args.person))
+    if args.holdout is not None:        # refuse bad options before the first fit
+        from opspec.commands.model_check import CheckOptions, check_options
+
+        check_options(CheckOptions(level=args.level, replicates=args.replicates,
+                                   runs=args.runs))
     paths = iter_paths(args.traces)
     if not paths:
         raise UserModelError("no trace files found in " + ", ".join(args.traces),
@@ -160,6 +181,8 @@ def _fit(args: argparse.Namespace) -> int:
         raise UserModelError(f"cannot write the model: {error.strerror or error}",
                              hint="choose a writable path with -o") from None
     load_user_model(out)  # the file must read back; a failure here is a bug worth reporting
+    holdout = _holdout(args, paths, persons) if args.holdout is not None else None
+    status = 0 if holdout is None or holdout.fits else 1
     if args.json:
         doc = {"model": str(out), "lane": args.lane, "criterion": args.criterion,
                "min_per_user": args.min_per_user, **result.to_json(),
@@ -168,9 +191,10 @@ def _fit(args: argparse.Namespace) -> int:
                            "sessions_per_person": _sessions_per_person(obs)},
                "uncertainty": None if draws is None else {
                    "draws": draws.count, "resampled": draws.resampled, "seed": draws.seed,
-                   "parameters": draws.summary()}}
+                   "parameters": draws.summary()},
+               "holdout": None if holdout is None else holdout.to_json()}
         print(json.dumps(doc, indent=1, default=str))
-        return 0
+        return status
     for fit in result.fits:
         print(fit.comment())
         print()
@@ -180,4 +204,30 @@ def _fit(args: argparse.Namespace) -> int:
         print(f"parameter uncertainty: {draws.count} bootstrap redraws resampling "
               f"{draws.resampled} ([uncertainty]; opspec evaluate --input-uncertainty B)")
     print(f"wrote {out} ({len(result.fits)} activities: {activities})")
-    return 0
+    if holdout is not None:
+        print()
+        for line in holdout.lines():
+            print(line)
+    return status
+
+
+def _holdout(args: argparse.Namespace, paths: list[Path], persons: Any) -> Any:
+    """``--holdout K``: each fold fitted as this command fits (same options), then checked."""
+    import tempfile
+
+    from opspec.commands.model_check import CheckOptions, cross_validate
+    from opspec.usermodels.bootstrap import parameter_draws
+    from opspec.usermodels.fitting import fit_traces
+
+    def fit(train: list[Path], model_path: Path, who: Any) -> None:
+        result = fit_traces(train, lane=args.lane, name=model_path.stem,
+                            criterion=args.criterion, min_per_user=args.min_per_user,
+                            persons=who)
+        draws = parameter_draws(result, args.draws, seed=args.seed) if args.draws else None
+        model_path.write_text(fitted_text(result, draws), encoding="utf-8")
+
+    options = CheckOptions(level=args.level, replicates=args.replicates, seed=args.seed,
+                           lane=args.lane, spec=args.spec, days=args.days, runs=args.runs)
+    with tempfile.TemporaryDirectory(prefix="opspec-holdout-") as work:
+        return cross_validate(paths, persons, args.holdout, fit=fit, options=options,
+                              work=Path(work))

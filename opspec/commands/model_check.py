@@ -21,7 +21,8 @@ if TYPE_CHECKING:
     from opspec.usermodels.model import UserModel
     from opspec.usermodels.persons import PersonRule
 
-__all__ = ["CheckOptions", "add_person_options", "check_model", "register"]
+__all__ = ["CheckOptions", "CrossValidation", "add_person_options", "check_model", "check_options",
+           "cross_validate", "register"]
 
 
 def add_person_options(parser: Any) -> None:
@@ -122,7 +123,7 @@ def _draws(ref: str) -> Any:
     return _ComposedDraws(ref, draws, index)
 
 
-def _check_options(options: CheckOptions) -> None:
+def check_options(options: CheckOptions) -> None:
     from opspec.errors import UserModelError
 
     if not 0 < options.level < 1:
@@ -147,7 +148,7 @@ def check_model(model: UserModel, model_ref: str | None, paths: Sequence[Path],
     )
     from opspec.usermodels.fitting import collect
 
-    _check_options(options)
+    check_options(options)
     if persons is not None:
         persons.check_used(list(paths))
     obs = collect(paths, options.lane, persons)
@@ -235,3 +236,115 @@ def _model_check(args: argparse.Namespace) -> int:
         if written:
             print(f"report: {written}")
     return 0 if report.fits else 1
+
+
+@dataclass(frozen=True)
+class CrossValidation:
+    """``opspec fit --holdout K``: per fold, the persons held out and the check of the model
+    fitted without them; Holm over every item of every fold gives one verdict."""
+
+    folds: tuple[tuple[tuple[str, ...], CheckReport], ...]
+    level: float
+
+    @property
+    def items(self) -> list[tuple[int, Any]]:
+        return [(f, item) for f, (_, report) in enumerate(self.folds) for item in report.items]
+
+    def adjusted(self) -> list[tuple[int, Any, float]]:
+        from opspec.usermodels.holm import holm_adjust
+
+        pairs = self.items
+        return [(f, item, a) for (f, item), a in zip(
+            pairs, holm_adjust([item.p for _, item in pairs]), strict=True)]
+
+    @property
+    def misfits(self) -> list[tuple[int, Any, float]]:
+        return [(f, i, a) for f, i, a in self.adjusted() if a <= self.level]
+
+    @property
+    def fits(self) -> bool:
+        return not self.misfits
+
+    def lines(self) -> list[str]:
+        k = len(self.folds)
+        out = []
+        for f, (held, report) in enumerate(self.folds):
+            names = ", ".join(held[:6]) + (" ..." if len(held) > 6 else "")
+            flagged = ", ".join(i.name for i in report.misfits) or "nothing misfits"
+            out.append(f"fold {f + 1}/{k}: fitted without {len(held)} person(s) ({names}), "
+                       f"checked on them: {flagged}")
+        total = len(self.items)
+        for f, item, a in self.misfits:
+            out.append(f"MISFIT fold {f + 1}: {item.describe().split(': ', 1)[1]}; Holm over "
+                       f"all folds: p = {a:.3g}")
+        verdict = ("the fitted model predicts held-out people: none of "
+                   f"{total} item(s) over {k} folds misfits" if self.fits else
+                   f"{len(self.misfits)} of {total} item(s) over {k} folds misfit: "
+                   + ", ".join(sorted({i.name for _, i, _ in self.misfits})))
+        out.append(f"cross-validated verdict ({k}-fold by person; Holm over all {total} "
+                   f"items, family-wise level {self.level:g}): {verdict}")
+        return out
+
+    def to_json(self) -> dict[str, Any]:
+        adjusted = self.adjusted()
+        return {"folds": [{"held_out": list(held), **report.to_json()}
+                          for held, report in self.folds],
+                "level": self.level, "fits": self.fits,
+                "family_wise": {"method": "holm", "items": len(adjusted),
+                                "over": "every item of every fold"},
+                "misfits": [{"fold": f + 1, "item": i.name, "p_holm_all_folds": a}
+                            for f, i, a in self.misfits]}
+
+
+def cross_validate(paths: Sequence[Path], persons: PersonRule, k: int, *,
+                   fit: Any, options: CheckOptions, work: Path) -> CrossValidation:
+    """Fit on all persons but one fold, check on that fold, for each of ``k`` folds.
+    ``fit(train_paths, model_path, persons)`` writes the model fitted on ``train_paths`` (as ``opspec
+    fit`` would); persons are assigned to folds at random (``options.seed``)."""
+    import numpy as np
+
+    from opspec.errors import UserModelError
+    from opspec.usermodels.fitting import collect
+    from opspec.usermodels.loader import load_user_model
+
+    check_options(options)
+    obs = collect(paths, options.lane, persons)
+    files: dict[int, set[str]] = {}
+    for (file_index, _), person in obs.person_of.items():
+        files.setdefault(file_index, set()).add(person)
+    shared = [str(paths[i]) for i, who in files.items() if len(who) > 1]
+    if shared:
+        raise UserModelError(
+            f"--holdout splits by person, but {shared[0]} holds sessions of "
+            f"{len(files[paths.index(Path(shared[0]))])} persons",
+            hint="give each person's sessions their own files, or say whose a file is "
+            "(--person-from file, --person-from header, --person FILE=ID)")
+    people = obs.persons
+    if not 2 <= k <= len(people) or len(people) - -(-len(people) // k) < 3:
+        raise UserModelError(
+            f"--holdout {k} cannot split {len(people)} person(s) into folds",
+            hint="each fold needs one person or more and the rest three or more to fit on: "
+            f"use 2 to {max(2, len(people))} folds with enough persons")
+    order = [people[i] for i in np.random.default_rng(options.seed).permutation(len(people))]
+    folds = []
+    for f in range(k):
+        held = tuple(sorted(order[f::k]))
+        test = [p for i, p in enumerate(paths) if files.get(i, set()) & set(held)]
+        train = [p for i, p in enumerate(paths) if not files.get(i, set()) & set(held)]
+        model_path = work / f"fold{f + 1}.users.toml"
+        fit(train, model_path, _named(train, paths, files))
+        model = load_user_model(model_path)
+        folds.append((held, check_model(model, str(model_path), test, options,
+                                        _named(test, paths, files))))
+    return CrossValidation(tuple(folds), options.level)
+
+
+def _named(subset: Sequence[Path], paths: Sequence[Path], files: dict[int, set[str]]
+           ) -> PersonRule:
+    """The persons of ``subset`` named file by file (each file is one person's), so a part
+    of the traces keeps the persons the whole had."""
+    from opspec.usermodels.persons import PersonRule
+
+    index = {str(p): i for i, p in enumerate(paths)}
+    return PersonRule("auto", None, {str(p): next(iter(files[index[str(p)]]))
+                                     for p in subset if index[str(p)] in files})
