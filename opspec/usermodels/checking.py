@@ -210,8 +210,11 @@ def finish(items: Sequence[CheckItem], level: float) -> tuple[CheckItem, ...]:
 # ------------------------------------------------------------------ the predictive people
 
 
-#: distinct groups of simulated people drawn (a population's person costs milliseconds to
-#: draw); replicate ``b`` reuses group ``b mod DISTINCT_GROUPS`` with fresh observations
+#: simulated people drawn for a population without parameter redraws (a person costs
+#: milliseconds to draw); each replicate group takes its people at random from them
+POOL_SIZE = 1000
+#: distinct groups drawn under parameter redraws; replicate ``b`` reuses group
+#: ``b mod DISTINCT_GROUPS`` with fresh observations
 DISTINCT_GROUPS = 100
 
 
@@ -219,11 +222,12 @@ class PredictivePeople:
     """``replicates`` groups of ``size`` simulated people, each group under one parameter
     redraw of ``draws`` (when given) and each person drawn from the population.
 
-    Person ``j`` of group ``g`` is user ``g * size + j`` of the population seeded ``seed``
-    (the population's own stream), so the same seed gives the same people. At most
-    :data:`DISTINCT_GROUPS` groups are drawn; replicate ``b`` is group ``b mod`` that, whose
-    observations are drawn afresh for each replicate (the Monte Carlo p-value stays an
-    unbiased estimate; its between-person part rests on that many groups).
+    Without redraws, people are drawn once into a pool of :data:`POOL_SIZE` (users ``0 …``
+    of the population seeded ``seed``, its own stream) and each group takes ``size`` of
+    them at random: the groups are as varied as the population. With redraws the people of
+    one group must share its redraw, so :data:`DISTINCT_GROUPS` groups are drawn (group
+    ``g`` under redraw ``1 + g mod B``) and replicate ``b`` is group ``b mod`` that, its
+    observations drawn afresh.
     """
 
     def __init__(self, model: UserModel, size: int, replicates: int, seed: int,
@@ -234,15 +238,28 @@ class PredictivePeople:
         self.draws = draws
         self.seed = seed
         distinct: list[list[UserModel]] = []
-        for g in range(min(replicates, DISTINCT_GROUPS)):
-            base = model if draws is None else draws.apply(model, 1 + g % draws.count)
-            if base.population is None:
-                distinct.append([base] * size)
+        if draws is None:
+            if model.population is None:
+                distinct = [[model] * size]
+                self.groups = [distinct[0]] * replicates
             else:
-                distinct.append([base.individual(seed, g * size + j).model
-                                 for j in range(size)])
+                pool = [model.individual(seed, u).model
+                        for u in range(min(POOL_SIZE, replicates * size))]
+                distinct = [pool]
+                rng = _stream(seed, "people")
+                self.groups = [[pool[i] for i in rng.choice(len(pool), size,
+                                                            replace=len(pool) < size)]
+                               for _ in range(replicates)]
+        else:
+            for g in range(min(replicates, DISTINCT_GROUPS)):
+                base = draws.apply(model, 1 + g % draws.count)
+                if base.population is None:
+                    distinct.append([base] * size)
+                else:
+                    distinct.append([base.individual(seed, g * size + j).model
+                                     for j in range(size)])
+            self.groups = [distinct[b % len(distinct)] for b in range(replicates)]
         self.distinct = distinct
-        self.groups = [distinct[b % len(distinct)] for b in range(replicates)]
 
     def people(self) -> list[UserModel]:
         return [p for g in self.distinct for p in g]
