@@ -275,8 +275,8 @@ class CrossValidation:
                        f"checked on them: {flagged}")
         total = len(self.items)
         for f, item, a in self.misfits:
-            out.append(f"MISFIT fold {f + 1}: {item.describe().split(': ', 1)[1]}; Holm over "
-                       f"all folds: p = {a:.3g}")
+            out.append(f"MISFIT fold {f + 1}: {item.name}: {item.comparison()}; {item.test}, "
+                       f"p = {item.p:.3g}; Holm over all folds: p = {a:.3g}")
         verdict = ("the fitted model predicts held-out people: none of "
                    f"{total} item(s) over {k} folds misfits" if self.fits else
                    f"{len(self.misfits)} of {total} item(s) over {k} folds misfit: "

@@ -88,7 +88,7 @@ def write_report(report: Any, directory: str | Path, *, title: str) -> Path:
     rows = "\n".join(
         f"{misfit_row if i.misfit else '<tr>'}<td>{'MISFIT' if i.misfit else 'fits'}"
         f"</td><td>{e(i.name)}</td><td>{e(i.test)}</td><td>{i.statistic:.4g}</td>"
-        f"<td>{i.p:.3g}</td><td>{i.p_holm:.3g}</td><td>{e(i.describe().split(': ', 1)[1])}"
+        f"<td>{i.p:.3g}</td><td>{i.p_holm:.3g}</td><td>{e(i.comparison())}"
         "</td></tr>" for i in report.items)
     figures = []
     for item in report.items:

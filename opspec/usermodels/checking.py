@@ -94,13 +94,17 @@ class CheckItem:
     p_holm: float = math.nan
     misfit: bool = False
 
-    def describe(self) -> str:
-        """One line: the verdict, what was observed against what was predicted, the test."""
+    def comparison(self) -> str:
+        """What was observed against what the model predicts for a group of this size."""
         o, p = self.observed, self.predicted
         fmt = _fmt_rate if self.kind in _RATES else _fmt_value
-        what = (f"observed {self.observed_label} {fmt(o['value'], self.unit)}, predicted "
+        return (f"observed {self.observed_label} {fmt(o['value'], self.unit)}, predicted "
                 f"{fmt(p['value'], self.unit)} (95 % of groups of {self.persons}: "
                 f"[{fmt(p['low'], self.unit)}, {fmt(p['high'], self.unit)}])")
+
+    def describe(self) -> str:
+        """One line: the verdict, what was observed against what was predicted, the test."""
+        what = self.comparison()
         verdict = "MISFIT" if self.misfit else "fits  "
         return (f"{verdict} {self.name}: {what}; {self.test}: {self.statistic_label} = "
                 f"{self.statistic:.4g}, "
@@ -508,7 +512,7 @@ def check_observations(model: UserModel, obs: Observations, *, replicates: int =
                      "of the per-activity checks, which pool all times of day; with --spec "
                      "the outcome metrics check it as a whole")
     for activity in activities:
-        if activity not in model.activities and not model.covers(activity):
+        if not model.covers(activity):
             continue
         am = model.activity(activity)
         # durations: a choice's own time is that of its intended picks (as opspec fit)
