@@ -199,11 +199,10 @@ def check_model(model: UserModel, model_ref: str | None, paths: Sequence[Path],
 
 
 def _model_check(args: argparse.Namespace) -> int:
+    from opspec.errors import UserModelError
     from opspec.usermodels.fitting import iter_paths
     from opspec.usermodels.loader import load_user_model
     from opspec.usermodels.persons import PersonRule, parse_person_options
-
-    from opspec.errors import UserModelError
 
     paths = iter_paths(args.traces)
     if not paths:

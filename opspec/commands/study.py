@@ -33,8 +33,13 @@ def register(subparsers: Any) -> None:
 
 def _study(args: argparse.Namespace) -> int:
     from opspec.commands._spec import load_any_spec
-    from opspec.tui.study import finish_session, load_protocol, session_app, summary, \
-        summary_lines
+    from opspec.tui.study import (
+        finish_session,
+        load_protocol,
+        session_app,
+        summary,
+        summary_lines,
+    )
 
     protocol = load_protocol(args.protocol)
     for variant in protocol.variants:          # a broken spec opens no session

@@ -39,7 +39,6 @@ from __future__ import annotations
 import json
 import math
 import tomllib
-from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -426,6 +425,3 @@ def summary_lines(doc: dict[str, Any]) -> list[str]:
                          f"{num(m['difference'])} (95 % CI [{num(lo)}, {num(hi)}])")
     return lines
 
-
-def participants_left(protocol: Protocol) -> Sequence[str]:
-    return [p for p in protocol.participants if protocol.pending(p)]
