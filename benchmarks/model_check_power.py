@@ -67,10 +67,10 @@ def wilson(k: int, n: int) -> str:
     return f"{k}/{n} = {k / n:.3f} (Wilson 95 % [{low:.3f}, {high:.3f}])"
 
 
-def run_true(reps: int, work: Path) -> None:
+def run_true(reps: int, work: Path, start: int = 0) -> None:
     truth = population(work, "truth", 60.0, 0.15)
     alarms, flagged = 0, Counter[str]()
-    for r in range(reps):
+    for r in range(start, start + reps):
         traces = people(truth, work / f"true{r}", 10, seed=10_000 + r)
         fits, names = check(truth, traces, seed=r)
         alarms += not fits
@@ -136,11 +136,16 @@ def main() -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     parser.add_argument("mode", choices=("true", "fitted", "power"))
     parser.add_argument("--reps", type=int, default=100)
+    parser.add_argument("--start", type=int, default=0,
+                        help="true: the first repetition (to split the repetitions over "
+                        "processes)")
     args = parser.parse_args()
     start = time.perf_counter()
     with tempfile.TemporaryDirectory() as tmp:
-        {"true": run_true, "fitted": run_fitted, "power": run_power}[args.mode](
-            args.reps, Path(tmp))
+        if args.mode == "true":
+            run_true(args.reps, Path(tmp), args.start)
+        else:
+            {"fitted": run_fitted, "power": run_power}[args.mode](args.reps, Path(tmp))
     print(f"({time.perf_counter() - start:.0f} s)")
     return 0
 
