@@ -80,14 +80,14 @@ def run_true(reps: int, work: Path, start: int = 0) -> None:
           f"{dict(flagged)}")
 
 
-def run_fitted(reps: int, work: Path) -> None:
+def run_fitted(reps: int, work: Path, start: int = 0) -> None:
     from opspec.commands.fit import fitted_text
     from opspec.usermodels.bootstrap import parameter_draws
     from opspec.usermodels.fitting import fit_traces
 
     truth = population(work, "truth", 60.0, 0.15)
     alarms, flagged = 0, Counter[str]()
-    for r in range(reps):
+    for r in range(start, start + reps):
         traces = people(truth, work / f"fit{r}", 40, seed=20_000 + r)
         result = fit_traces(traces[:30], name="fitted")
         draws = parameter_draws(result, 100, seed=r)
@@ -137,15 +137,16 @@ def main() -> int:
     parser.add_argument("mode", choices=("true", "fitted", "power"))
     parser.add_argument("--reps", type=int, default=100)
     parser.add_argument("--start", type=int, default=0,
-                        help="true: the first repetition (to split the repetitions over "
-                        "processes)")
+                        help="true, fitted: the first repetition (to split the repetitions "
+                        "over processes)")
     args = parser.parse_args()
     start = time.perf_counter()
     with tempfile.TemporaryDirectory() as tmp:
-        if args.mode == "true":
-            run_true(args.reps, Path(tmp), args.start)
+        if args.mode == "power":
+            run_power(args.reps, Path(tmp))
         else:
-            {"fitted": run_fitted, "power": run_power}[args.mode](args.reps, Path(tmp))
+            {"true": run_true, "fitted": run_fitted}[args.mode](args.reps, Path(tmp),
+                                                                args.start)
     print(f"({time.perf_counter() - start:.0f} s)")
     return 0
 
