@@ -8,7 +8,7 @@ import sys
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-from opspec.usermodels.persons import PERSON_FROM
+from opspec.commands.model_check import add_person_options
 
 if TYPE_CHECKING:
     from opspec.usermodels.uncertainty import ParameterDraws
@@ -37,18 +37,7 @@ def register(subparsers: Any) -> None:
     parser.add_argument("--min-per-user", type=int, default=10, metavar="N",
                         help="observations a person needs to count in the between-user "
                         "spread (default: 10)")
-    who = parser.add_argument_group(
-        "whose sessions", "several sessions of one participant are one person: in the "
-        "between-user spread and in the bootstrap of --draws (docs/fitting.md)")
-    who.add_argument("--person", action="append", default=[], metavar="FILE=ID",
-                     help="the sessions in FILE are participant ID (repeatable)")
-    who.add_argument("--person-pattern", metavar="REGEX",
-                     help="the participant is the first group of REGEX found in each file's "
-                     "path, e.g. '(P\\d+)' for recordings/P07-day2.jsonl")
-    who.add_argument("--person-from", choices=PERSON_FROM, default="auto",
-                     help="otherwise: the trace header's 'person' key (header), each file "
-                     "(file), its folder's name (folder), each run (run); auto (default): "
-                     "the header's key where there is one, else each run")
+    add_person_options(parser, "in the between-user spread and in the bootstrap of --draws")
     parser.add_argument("--draws", type=int, default=200, metavar="B",
                         help="bootstrap redraws of the fitted parameters written to the "
                         "model's [uncertainty] table, for `opspec evaluate "

@@ -25,20 +25,21 @@ __all__ = ["CheckOptions", "CrossValidation", "add_person_options", "check_model
            "cross_validate", "register"]
 
 
-def add_person_options(parser: Any) -> None:
-    """``--person``, ``--person-pattern``, ``--person-from``: whose each session is."""
+def add_person_options(parser: Any, counted: str = "") -> None:
+    """``--person``, ``--person-pattern``, ``--person-from``: whose each session is
+    (``counted``: where that matters, for the group's description)."""
     who = parser.add_argument_group(
-        "whose sessions", "several sessions of one participant are one person "
-        "(docs/fitting.md)")
+        "whose sessions", "several sessions of one participant are one person"
+        + (f": {counted}" if counted else "") + " (docs/fitting.md)")
     who.add_argument("--person", action="append", default=[], metavar="FILE=ID",
                      help="the sessions in FILE are participant ID (repeatable)")
     who.add_argument("--person-pattern", metavar="REGEX",
                      help="the participant is the first group of REGEX found in each file's "
-                     "path, e.g. '(P\\d+)'")
+                     "path, e.g. '(P\\d+)' for recordings/P07-day2.jsonl")
     who.add_argument("--person-from", choices=PERSON_FROM, default="auto",
-                     help="otherwise: the trace header's 'person' key (header), each file, "
-                     "its folder's name, each run; auto (default): the header's key where "
-                     "there is one, else each run")
+                     help="otherwise: the trace header's 'person' key (header), each file "
+                     "(file), its folder's name (folder), each run (run); auto (default): "
+                     "the header's key where there is one, else each run")
 
 
 def register(subparsers: Any) -> None:
@@ -80,7 +81,7 @@ def register(subparsers: Any) -> None:
     parser.add_argument("--report", metavar="DIR",
                         help="write DIR/model-check.html: the verdict, QQ plots per activity "
                         "and intervals per metric")
-    add_person_options(parser)
+    add_person_options(parser, "in the simulated groups the people are compared with")
     parser.set_defaults(handler=_model_check)
 
 

@@ -460,19 +460,19 @@ def _beta_law(model: UserModel, path: tuple[str, ...]) -> tuple[float, float] | 
     return (m * common, (1 - m) * common) if common > 0 else None
 
 
-def _omission_probability(person: UserModel, activity: str) -> float:
-    am = person.activity(activity)
-    return am.omission.probability if am.omission is not None else 0.0
+def _rate_item(kind: str, activity: str, counts: Mapping[str, tuple[int, int]],
+               model: UserModel, everyone: Sequence[UserModel],
+               draws: ParameterDraws | None, seed: int) -> CheckItem:
+    """The check of ``activity``'s ``kind`` (omission, commission, repetition) rate."""
+    def probability(person: UserModel) -> float:
+        part = getattr(person.activity(activity), kind)
+        return part.probability if part is not None else 0.0
 
-
-def _commission_probability(person: UserModel, activity: str) -> float:
-    am = person.activity(activity)
-    return am.commission.probability if am.commission is not None else 0.0
-
-
-def _repetition_probability(person: UserModel, activity: str) -> float:
-    am = person.activity(activity)
-    return am.repetition.probability if am.repetition is not None else 0.0
+    rates = np.array([probability(p) for p in everyone])
+    beta = (_beta_law(model, ("activities", activity, kind, "probability"))
+            if draws is None else None)
+    return check_rate(f"{activity} {kind}", kind, activity, counts, rates, beta,
+                      _stream(seed, f"{kind}/{activity}"))
 
 
 def commission_counts(sequences: Sequence[Sequence[str]], intended: str, cap: int
@@ -529,23 +529,16 @@ def check_observations(model: UserModel, obs: Observations, *, replicates: int =
                 items.append(checked)
         omissions = obs.counts_by_person(obs.user_omissions.get(activity, {}))
         if omissions and (am.omission is not None or obs.omitted.get(activity)):
-            rates = np.array([_omission_probability(p, activity) for p in everyone])
-            beta = (_beta_law(model, ("activities", activity, "omission", "probability"))
-                    if draws is None else None)
-            items.append(check_rate(f"{activity} omission", "omission", activity, omissions,
-                                    rates, beta, _stream(seed, f"omission/{activity}")))
+            items.append(_rate_item("omission", activity, omissions, model, everyone, draws,
+                                    seed))
         if am.intended is not None and obs.user_picks.get(activity):
             cap = am.commission.max_per_instance if am.commission is not None else 1
             by_person = obs.lists_by_person(obs.user_picks[activity])
             counts = {p: commission_counts(seqs, am.intended, cap)
                       for p, seqs in by_person.items()}
             if am.commission is not None or any(w for w, _ in counts.values()):
-                rates = np.array([_commission_probability(p, activity) for p in everyone])
-                beta = (_beta_law(model, ("activities", activity, "commission",
-                                          "probability")) if draws is None else None)
-                items.append(check_rate(f"{activity} commission", "commission", activity,
-                                        counts, rates, beta,
-                                        _stream(seed, f"commission/{activity}")))
+                items.append(_rate_item("commission", activity, counts, model, everyone,
+                                        draws, seed))
         elif am.probabilities and obs.picks.get(activity):
             notes.append(f"{activity}: a choice by fixed probabilities is not checked")
         if am.repetition is not None:
@@ -557,12 +550,8 @@ def check_observations(model: UserModel, obs: Observations, *, replicates: int =
                 completions = {p: n - k for p, (k, n) in omissions.items()}
                 seen = (repeated or {}).get(activity, {})
                 counts = {p: (min(seen.get(p, 0), c), c) for p, c in completions.items()}
-                rates = np.array([_repetition_probability(p, activity) for p in everyone])
-                beta = (_beta_law(model, ("activities", activity, "repetition",
-                                          "probability")) if draws is None else None)
-                items.append(check_rate(f"{activity} repetition", "repetition", activity,
-                                        counts, rates, beta,
-                                        _stream(seed, f"repetition/{activity}")))
+                items.append(_rate_item("repetition", activity, counts, model, everyone,
+                                        draws, seed))
     return items, notes
 
 
