@@ -36,7 +36,9 @@ COMMAND_MODULES: tuple[str, ...] = (
     "opspec.commands.evaluate",
     "opspec.commands.check",
     "opspec.commands.walkthrough",
+    "opspec.commands.study",
     "opspec.commands.fit",
+    "opspec.commands.model_check",
     "opspec.commands.devices",
     "opspec.commands.new",
 )

@@ -8,12 +8,12 @@ import sys
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-from opspec.usermodels.persons import PERSON_FROM
+from opspec.commands.model_check import add_person_options
 
 if TYPE_CHECKING:
     from opspec.usermodels.uncertainty import ParameterDraws
 
-__all__ = ["register"]
+__all__ = ["fitted_text", "register"]
 
 
 def register(subparsers: Any) -> None:
@@ -37,18 +37,7 @@ def register(subparsers: Any) -> None:
     parser.add_argument("--min-per-user", type=int, default=10, metavar="N",
                         help="observations a person needs to count in the between-user "
                         "spread (default: 10)")
-    who = parser.add_argument_group(
-        "whose sessions", "several sessions of one participant are one person: in the "
-        "between-user spread and in the bootstrap of --draws (docs/fitting.md)")
-    who.add_argument("--person", action="append", default=[], metavar="FILE=ID",
-                     help="the sessions in FILE are participant ID (repeatable)")
-    who.add_argument("--person-pattern", metavar="REGEX",
-                     help="the participant is the first group of REGEX found in each file's "
-                     "path, e.g. '(P\\d+)' for recordings/P07-day2.jsonl")
-    who.add_argument("--person-from", choices=PERSON_FROM, default="auto",
-                     help="otherwise: the trace header's 'person' key (header), each file "
-                     "(file), its folder's name (folder), each run (run); auto (default): "
-                     "the header's key where there is one, else each run")
+    add_person_options(parser, "in the between-user spread and in the bootstrap of --draws")
     parser.add_argument("--draws", type=int, default=200, metavar="B",
                         help="bootstrap redraws of the fitted parameters written to the "
                         "model's [uncertainty] table, for `opspec evaluate "
@@ -58,6 +47,22 @@ def register(subparsers: Any) -> None:
     parser.add_argument("--json", action="store_true",
                         help="print the fit (every family's AIC/BIC, intervals, between-user "
                         "spread) as one JSON object instead of the summary")
+    cv = parser.add_argument_group(
+        "cross-validation", "--holdout K: split the persons into K folds; for each, fit "
+        "on the others and check the model on the fold (opspec model-check); one verdict "
+        "over all folds, Holm-adjusted; exit 1 when something misfits (docs/fitting.md)")
+    cv.add_argument("--holdout", type=int, metavar="K",
+                    help="K-fold cross-validation by person")
+    cv.add_argument("--level", type=float, default=0.05,
+                    help="family-wise error level of the verdict (default: 0.05)")
+    cv.add_argument("--replicates", type=int, default=399, metavar="B",
+                    help="simulated groups of each check (default: 399)")
+    cv.add_argument("--spec", metavar="SPEC",
+                    help="also check the spec's outcome metrics on each fold")
+    cv.add_argument("--days", type=float, metavar="D",
+                    help="with --spec: simulated days of each run (default: the spec's)")
+    cv.add_argument("--runs", type=int, default=200, metavar="N",
+                    help="with --spec: simulated people for the metrics (default: 200)")
     parser.set_defaults(handler=_fit)
 
 
@@ -98,10 +103,19 @@ def _uncertainty_text(draws: ParameterDraws | None) -> str:
             "1..B (docs/fitting.md)\n" + draws.to_text())
 
 
+def fitted_text(result: Any, draws: ParameterDraws | None, header: str = "") -> str:
+    """The model file ``opspec fit`` writes for ``result``: the model with its comments, the
+    ``[vary]`` tables and the ``[uncertainty]`` redraws."""
+    from opspec.usermodels.loader import dump_user_model
+
+    text = dump_user_model(result.model, comments=result.comments(), header=header)
+    return text + _vary_text(result.vary()) + _uncertainty_text(draws)
+
+
 def _fit(args: argparse.Namespace) -> int:
     from opspec.errors import UserModelError
     from opspec.usermodels.fitting import fit_traces, iter_paths
-    from opspec.usermodels.loader import dump_user_model, load_user_model
+    from opspec.usermodels.loader import load_user_model
 
     if args.min_per_user < 2:
         raise UserModelError(f"--min-per-user must be at least 2, not {args.min_per_user}",
@@ -115,6 +129,11 @@ def _fit(args: argparse.Namespace) -> int:
 
     persons = PersonRule(args.person_from, args.person_pattern,
                          parse_person_options(args.person))
+    if args.holdout is not None:        # refuse bad options before the first fit
+        from opspec.commands.model_check import CheckOptions, check_options
+
+        check_options(CheckOptions(level=args.level, replicates=args.replicates,
+                                   runs=args.runs))
     paths = iter_paths(args.traces)
     if not paths:
         raise UserModelError("no trace files found in " + ", ".join(args.traces),
@@ -140,9 +159,7 @@ def _fit(args: argparse.Namespace) -> int:
               "where the data show\nthat users differ, [vary] tables at the end draw those "
               "parameters per simulated user.\nCheck the numbers before relying on them: "
               "small samples give wide intervals.")
-    text = dump_user_model(result.model, comments=result.comments(), header=header)
-    text += _vary_text(result.vary())
-    text += _uncertainty_text(draws)
+    text = fitted_text(result, draws, header)
     if out is None:
         sys.stdout.write(text)
         return 0
@@ -153,6 +170,8 @@ def _fit(args: argparse.Namespace) -> int:
         raise UserModelError(f"cannot write the model: {error.strerror or error}",
                              hint="choose a writable path with -o") from None
     load_user_model(out)  # the file must read back; a failure here is a bug worth reporting
+    holdout = _holdout(args, paths, persons) if args.holdout is not None else None
+    status = 0 if holdout is None or holdout.fits else 1
     if args.json:
         doc = {"model": str(out), "lane": args.lane, "criterion": args.criterion,
                "min_per_user": args.min_per_user, **result.to_json(),
@@ -161,9 +180,10 @@ def _fit(args: argparse.Namespace) -> int:
                            "sessions_per_person": _sessions_per_person(obs)},
                "uncertainty": None if draws is None else {
                    "draws": draws.count, "resampled": draws.resampled, "seed": draws.seed,
-                   "parameters": draws.summary()}}
+                   "parameters": draws.summary()},
+               "holdout": None if holdout is None else holdout.to_json()}
         print(json.dumps(doc, indent=1, default=str))
-        return 0
+        return status
     for fit in result.fits:
         print(fit.comment())
         print()
@@ -173,4 +193,30 @@ def _fit(args: argparse.Namespace) -> int:
         print(f"parameter uncertainty: {draws.count} bootstrap redraws resampling "
               f"{draws.resampled} ([uncertainty]; opspec evaluate --input-uncertainty B)")
     print(f"wrote {out} ({len(result.fits)} activities: {activities})")
-    return 0
+    if holdout is not None:
+        print()
+        for line in holdout.lines():
+            print(line)
+    return status
+
+
+def _holdout(args: argparse.Namespace, paths: list[Path], persons: Any) -> Any:
+    """``--holdout K``: each fold fitted as this command fits (same options), then checked."""
+    import tempfile
+
+    from opspec.commands.model_check import CheckOptions, cross_validate
+    from opspec.usermodels.bootstrap import parameter_draws
+    from opspec.usermodels.fitting import fit_traces
+
+    def fit(train: list[Path], model_path: Path, who: Any) -> None:
+        result = fit_traces(train, lane=args.lane, name=model_path.stem,
+                            criterion=args.criterion, min_per_user=args.min_per_user,
+                            persons=who)
+        draws = parameter_draws(result, args.draws, seed=args.seed) if args.draws else None
+        model_path.write_text(fitted_text(result, draws), encoding="utf-8")
+
+    options = CheckOptions(level=args.level, replicates=args.replicates, seed=args.seed,
+                           lane=args.lane, spec=args.spec, days=args.days, runs=args.runs)
+    with tempfile.TemporaryDirectory(prefix="opspec-holdout-") as work:
+        return cross_validate(paths, persons, args.holdout, fit=fit, options=options,
+                              work=Path(work))

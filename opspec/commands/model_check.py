@@ -1,0 +1,350 @@
+"""``opspec model-check MODEL TRACE...``: does the model predict people it was not fitted on?
+
+Exit status 0 when no item misfits, 1 when one does (each named with its statistic,
+p-value and what the people did against what the model predicts), 2 for a usage or input
+problem. docs/fitting.md, *Checking a model against new people*.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+from collections.abc import Sequence
+from dataclasses import dataclass
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+from opspec.usermodels.persons import PERSON_FROM
+
+if TYPE_CHECKING:
+    from opspec.usermodels.checking import CheckReport
+    from opspec.usermodels.model import UserModel
+    from opspec.usermodels.persons import PersonRule
+
+__all__ = ["CheckOptions", "CrossValidation", "add_person_options", "check_model", "check_options",
+           "cross_validate", "register"]
+
+
+def add_person_options(parser: Any, counted: str = "") -> None:
+    """``--person``, ``--person-pattern``, ``--person-from``: whose each session is
+    (``counted``: where that matters, for the group's description)."""
+    who = parser.add_argument_group(
+        "whose sessions", "several sessions of one participant are one person"
+        + (f": {counted}" if counted else "") + " (docs/fitting.md)")
+    who.add_argument("--person", action="append", default=[], metavar="FILE=ID",
+                     help="the sessions in FILE are participant ID (repeatable)")
+    who.add_argument("--person-pattern", metavar="REGEX",
+                     help="the participant is the first group of REGEX found in each file's "
+                     "path, e.g. '(P\\d+)' for recordings/P07-day2.jsonl")
+    who.add_argument("--person-from", choices=PERSON_FROM, default="auto",
+                     help="otherwise: the trace header's 'person' key (header), each file "
+                     "(file), its folder's name (folder), each run (run); auto (default): "
+                     "the header's key where there is one, else each run")
+
+
+def register(subparsers: Any) -> None:
+    parser = subparsers.add_parser(
+        "model-check", help="check a user model against people it was not fitted on",
+        description="Compare traces or walkthrough recordings of people NOT used to fit "
+        "MODEL with what MODEL predicts, per user-lane activity (durations: Anderson-"
+        "Darling by parametric bootstrap, the population's between-person spread and the "
+        "parameters' [uncertainty] included; omission, commission and repetition rates: "
+        "exact binomial / beta-binomial) and, with --spec, per outcome metric of the spec "
+        "(predictive intervals from runs of the spec with the model). Holm's adjustment "
+        "keeps the chance of any false misfit at --level. Exit 0: nothing misfits; 1: "
+        "something does (docs/fitting.md).")
+    parser.add_argument("model", metavar="MODEL",
+                        help="user model: a TOML file (fitted or hand-written, a population "
+                        "included), a preset, or A,B compositions")
+    parser.add_argument("traces", nargs="+", metavar="TRACE",
+                        help="trace files (.jsonl) of held-out people, or folders of them")
+    parser.add_argument("--spec", metavar="SPEC",
+                        help="also check the spec's outcome metrics: the spec run with the "
+                        "model gives predictive intervals for what these people showed")
+    parser.add_argument("--days", type=float, metavar="D",
+                        help="with --spec: simulated days of each run, as long as the "
+                        "people's sessions (default: the spec's run length)")
+    parser.add_argument("--runs", type=int, default=200, metavar="N",
+                        help="with --spec: simulated people for the metrics (default: 200)")
+    parser.add_argument("--level", type=float, default=0.05,
+                        help="family-wise error level (default: 0.05)")
+    parser.add_argument("--replicates", type=int, default=399, metavar="B",
+                        help="simulated groups of people for the bootstrap and the predictive "
+                        "rates (default: 399)")
+    parser.add_argument("--no-parameter-uncertainty", action="store_true",
+                        help="ignore the model's [uncertainty] redraws: take its parameters "
+                        "as known")
+    parser.add_argument("--lane", default="user",
+                        help="lane or participant checked (default: user)")
+    parser.add_argument("--seed", type=int, default=0, help="seed (default: 0)")
+    parser.add_argument("--json", action="store_true", help="print the check as JSON")
+    parser.add_argument("--report", metavar="DIR",
+                        help="write DIR/model-check.html: the verdict, QQ plots per activity "
+                        "and intervals per metric")
+    add_person_options(parser, "in the simulated groups the people are compared with")
+    parser.set_defaults(handler=_model_check)
+
+
+@dataclass(frozen=True)
+class CheckOptions:
+    level: float = 0.05
+    replicates: int = 399
+    seed: int = 0
+    lane: str = "user"
+    parameter_uncertainty: bool = True
+    spec: str | None = None
+    days: float | None = None
+    runs: int = 200
+
+
+class _ComposedDraws:
+    """Parameter redraws of the fitted part of a composed reference (``fitted.toml,mci``):
+    draw ``d`` is the reference loaded with that part's draw ``d`` (opspec evaluate
+    --input-uncertainty's rule)."""
+
+    def __init__(self, ref: str, draws: Any, index: int) -> None:
+        self.ref, self.draws, self.index = ref, draws, index
+        self.count = draws.count
+
+    def apply(self, model: Any, draw: int) -> Any:
+        from opspec.usermodels.uncertainty import drawn_model
+
+        return drawn_model(self.ref, self.draws, self.index, draw)
+
+
+def _draws(ref: str) -> Any:
+    from opspec.usermodels.uncertainty import read_parameter_draws
+
+    found = read_parameter_draws(ref)
+    if found is None:
+        return None
+    draws, index = found
+    if "," not in ref:
+        return draws
+    return _ComposedDraws(ref, draws, index)
+
+
+def check_options(options: CheckOptions) -> None:
+    from opspec.errors import UserModelError
+
+    if not 0 < options.level < 1:
+        raise UserModelError(f"--level must be between 0 and 1, not {options.level:g}",
+                             hint="for instance --level 0.05")
+    if options.replicates < 19:
+        raise UserModelError(f"--replicates must be at least 19, not {options.replicates}",
+                             hint="a bootstrap p-value is at least 1/(B+1): take 399 or more "
+                             "so that Holm can reach small levels")
+    if options.runs < 2:
+        raise UserModelError(f"--runs must be at least 2, not {options.runs}")
+
+
+def check_model(model: UserModel, model_ref: str | None, paths: Sequence[Path],
+                options: CheckOptions, persons: PersonRule | None = None) -> CheckReport:
+    """Check ``model`` against the traces ``paths`` (what ``opspec model-check`` prints)."""
+    from opspec.usermodels.checking import (
+        CheckReport,
+        check_observations,
+        count_decisions,
+        finish,
+    )
+    from opspec.usermodels.fitting import collect
+
+    check_options(options)
+    if persons is not None:
+        persons.check_used(list(paths))
+    obs = collect(paths, options.lane, persons)
+    draws = (_draws(model_ref) if options.parameter_uncertainty and model_ref else None)
+    repeated: dict[str, dict[str, int]] = {}
+    traced = False
+    if any(a.repetition is not None for a in model.activities.values()):
+        repeated, traced = count_decisions(paths, obs)
+    items, notes = check_observations(model, obs, replicates=options.replicates,
+                                      seed=options.seed, draws=draws, repeated=repeated,
+                                      decisions_traced=traced)
+    if options.spec is not None:
+        from opspec.commands._spec import load_any_spec
+        from opspec.evaluation.predictive import (
+            metric_items,
+            observed_metrics,
+            predicted_metrics,
+        )
+
+        package = load_any_spec(options.spec, command="model-check")
+        definitions = package.metrics
+        if not definitions:
+            notes.append(f"{options.spec} declares no outcome metrics (opspec:Metrics): "
+                         "only the activities were checked")
+        else:
+            observed = observed_metrics(paths, definitions, obs.person_of)
+            predicted = predicted_metrics(package, model, runs=options.runs,
+                                          seed=options.seed, days=options.days, draws=draws)
+            units = {m.name: getattr(m, "unit", None) or "" for m in definitions}
+            more, more_notes = metric_items(observed, predicted, seed=options.seed,
+                                            units=units)
+            items.extend(more)
+            notes.extend(more_notes)
+    if not items:
+        from opspec.errors import UserModelError
+
+        raise UserModelError("nothing to check: the traces hold no activity the model "
+                             "describes", hint="check --lane and that MODEL is the model of "
+                             "these traces' spec")
+    uncertainty = ("none in the model (its parameters taken as known)" if draws is None
+                   else f"{draws.count} redraws of its [uncertainty] table, one per "
+                   "simulated group")
+    if draws is None and not options.parameter_uncertainty:
+        uncertainty = "ignored (--no-parameter-uncertainty)"
+    return CheckReport(finish(items, options.level), options.level, len(obs.persons),
+                       obs.sessions, options.replicates, options.seed, uncertainty,
+                       tuple(notes))
+
+
+def _model_check(args: argparse.Namespace) -> int:
+    from opspec.errors import UserModelError
+    from opspec.usermodels.fitting import iter_paths
+    from opspec.usermodels.loader import load_user_model
+    from opspec.usermodels.persons import PersonRule, parse_person_options
+
+    paths = iter_paths(args.traces)
+    if not paths:
+        raise UserModelError("no trace files found in " + ", ".join(args.traces),
+                             hint="give .jsonl trace files or folders holding them")
+    model = load_user_model(args.model)
+    persons = PersonRule(args.person_from, args.person_pattern,
+                         parse_person_options(args.person))
+    options = CheckOptions(level=args.level, replicates=args.replicates, seed=args.seed,
+                           lane=args.lane,
+                           parameter_uncertainty=not args.no_parameter_uncertainty,
+                           spec=args.spec, days=args.days, runs=args.runs)
+    report = check_model(model, args.model, paths, options, persons)
+    written = None
+    if args.report:
+        from opspec.evaluation.model_check_report import write_report
+
+        written = write_report(report, args.report,
+                               title=f"Model check: {args.model} against "
+                               f"{report.persons} held-out person(s)")
+    if args.json:
+        doc = {"model": args.model, "traces": [str(p) for p in paths], **report.to_json(),
+               "report": str(written) if written else None}
+        print(json.dumps(doc, indent=1))
+    else:
+        print(f"model {args.model} against {report.persons} person(s), {report.sessions} "
+              f"session(s) in {len(paths)} trace file(s)")
+        for line in report.lines():
+            print(line)
+        if written:
+            print(f"report: {written}")
+    return 0 if report.fits else 1
+
+
+@dataclass(frozen=True)
+class CrossValidation:
+    """``opspec fit --holdout K``: per fold, the persons held out and the check of the model
+    fitted without them; Holm over every item of every fold gives one verdict."""
+
+    folds: tuple[tuple[tuple[str, ...], CheckReport], ...]
+    level: float
+
+    @property
+    def items(self) -> list[tuple[int, Any]]:
+        return [(f, item) for f, (_, report) in enumerate(self.folds) for item in report.items]
+
+    def adjusted(self) -> list[tuple[int, Any, float]]:
+        from opspec.usermodels.holm import holm_adjust
+
+        pairs = self.items
+        return [(f, item, a) for (f, item), a in zip(
+            pairs, holm_adjust([item.p for _, item in pairs]), strict=True)]
+
+    @property
+    def misfits(self) -> list[tuple[int, Any, float]]:
+        return [(f, i, a) for f, i, a in self.adjusted() if a <= self.level]
+
+    @property
+    def fits(self) -> bool:
+        return not self.misfits
+
+    def lines(self) -> list[str]:
+        k = len(self.folds)
+        out = []
+        for f, (held, report) in enumerate(self.folds):
+            names = ", ".join(held[:6]) + (" ..." if len(held) > 6 else "")
+            flagged = ", ".join(i.name for i in report.misfits) or "nothing misfits"
+            out.append(f"fold {f + 1}/{k}: fitted without {len(held)} person(s) ({names}), "
+                       f"checked on them: {flagged}")
+        total = len(self.items)
+        for f, item, a in self.misfits:
+            out.append(f"MISFIT fold {f + 1}: {item.name}: {item.comparison()}; {item.test}, "
+                       f"p = {item.p:.3g}; Holm over all folds: p = {a:.3g}")
+        verdict = ("the fitted model predicts held-out people: none of "
+                   f"{total} item(s) over {k} folds misfits" if self.fits else
+                   f"{len(self.misfits)} of {total} item(s) over {k} folds misfit: "
+                   + ", ".join(sorted({i.name for _, i, _ in self.misfits})))
+        out.append(f"cross-validated verdict ({k}-fold by person; Holm over all {total} "
+                   f"items, family-wise level {self.level:g}): {verdict}")
+        return out
+
+    def to_json(self) -> dict[str, Any]:
+        adjusted = self.adjusted()
+        return {"folds": [{"held_out": list(held), **report.to_json()}
+                          for held, report in self.folds],
+                "level": self.level, "fits": self.fits,
+                "family_wise": {"method": "holm", "items": len(adjusted),
+                                "over": "every item of every fold"},
+                "misfits": [{"fold": f + 1, "item": i.name, "p_holm_all_folds": a}
+                            for f, i, a in self.misfits]}
+
+
+def cross_validate(paths: Sequence[Path], persons: PersonRule, k: int, *,
+                   fit: Any, options: CheckOptions, work: Path) -> CrossValidation:
+    """Fit on all persons but one fold, check on that fold, for each of ``k`` folds.
+    ``fit(train_paths, model_path, persons)`` writes the model fitted on ``train_paths`` (as ``opspec
+    fit`` would); persons are assigned to folds at random (``options.seed``)."""
+    import numpy as np
+
+    from opspec.errors import UserModelError
+    from opspec.usermodels.fitting import collect
+    from opspec.usermodels.loader import load_user_model
+
+    check_options(options)
+    obs = collect(paths, options.lane, persons)
+    files: dict[int, set[str]] = {}
+    for (file_index, _), person in obs.person_of.items():
+        files.setdefault(file_index, set()).add(person)
+    shared = [str(paths[i]) for i, who in files.items() if len(who) > 1]
+    if shared:
+        raise UserModelError(
+            f"--holdout splits by person, but {shared[0]} holds sessions of "
+            f"{len(files[paths.index(Path(shared[0]))])} persons",
+            hint="give each person's sessions their own files, or say whose a file is "
+            "(--person-from file, --person-from header, --person FILE=ID)")
+    people = obs.persons
+    if not 2 <= k <= len(people) or len(people) - -(-len(people) // k) < 3:
+        raise UserModelError(
+            f"--holdout {k} cannot split {len(people)} person(s) into folds",
+            hint="each fold needs one person or more and the rest three or more to fit on: "
+            f"use 2 to {max(2, len(people))} folds with enough persons")
+    order = [people[i] for i in np.random.default_rng(options.seed).permutation(len(people))]
+    folds = []
+    for f in range(k):
+        held = tuple(sorted(order[f::k]))
+        test = [p for i, p in enumerate(paths) if files.get(i, set()) & set(held)]
+        train = [p for i, p in enumerate(paths) if not files.get(i, set()) & set(held)]
+        model_path = work / f"fold{f + 1}.users.toml"
+        fit(train, model_path, _named(train, paths, files))
+        model = load_user_model(model_path)
+        folds.append((held, check_model(model, str(model_path), test, options,
+                                        _named(test, paths, files))))
+    return CrossValidation(tuple(folds), options.level)
+
+
+def _named(subset: Sequence[Path], paths: Sequence[Path], files: dict[int, set[str]]
+           ) -> PersonRule:
+    """The persons of ``subset`` named file by file (each file is one person's), so a part
+    of the traces keeps the persons the whole had."""
+    from opspec.usermodels.persons import PersonRule
+
+    index = {str(p): i for i, p in enumerate(paths)}
+    return PersonRule("auto", None, {str(p): next(iter(files[index[str(p)]]))
+                                     for p in subset if index[str(p)] in files})

@@ -1,0 +1,427 @@
+"""A walkthrough study: participants, design variants in counterbalanced orders, every
+session recorded under its participant and variant (``opspec study PROTOCOL.toml``).
+
+The protocol (TOML, paths relative to it)::
+
+    [study]
+    name = "dispenser: re-alarm after 5 or 2 minutes"
+    days = 1                      # simulated days of each session (default: each spec's)
+    speed = 60                    # simulated seconds per wall second at start
+    seed = 0                      # every session runs the variant's spec with this seed
+    recordings = "recordings"     # RECORDINGS/<participant>/<variant>.json (+ .trace.jsonl)
+
+    [[variants]]
+    id = "A"
+    spec = "specs/medication_dispenser.xpdl"
+    told = "The dispenser will ring when a dose is due. Take your pills as at home."
+
+    [[variants]]
+    id = "B"
+    spec = "dispenser-2min.xpdl"
+    told = "..."
+
+    participants = ["P01", "P02", "P03"]     # (under [study])
+
+Orders are counterbalanced by a Latin square: participant ``i`` (in file order) takes row
+``i mod rows`` of a Williams design (Williams 1949), in which every variant comes first
+equally often and, for an even number of variants, follows every other variant equally
+often; for an odd number the square and its mirror image are used (2k rows).
+
+A session is done when its run reached its end: a ``.done`` file beside the recording says
+so. A session that breaks off (the participant quits early, the terminal closes) keeps its
+recording as ``<variant>.partial-N.json`` and is started again the next time the participant
+resumes (``opspec study PROTOCOL --participant P02`` goes on with the first session not
+done).
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import tomllib
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+from opspec.errors import ConfigurationError, SourceLocation
+
+__all__ = ["Protocol", "Session", "Variant", "latin_square", "load_protocol"]
+
+
+@dataclass(frozen=True)
+class Variant:
+    id: str
+    spec: Path
+    told: str = ""
+
+
+@dataclass(frozen=True)
+class Session:
+    """One participant's session of one variant: where its files are."""
+
+    participant: str
+    variant: Variant
+    position: int                # 1-based, in the participant's order
+    recording: Path
+
+    @property
+    def trace(self) -> Path:
+        return self.recording.with_suffix(".trace.jsonl")
+
+    @property
+    def done_marker(self) -> Path:
+        return self.recording.with_suffix(".done")
+
+    @property
+    def done(self) -> bool:
+        return self.done_marker.is_file()
+
+
+def latin_square(k: int) -> list[list[int]]:
+    """The rows of a Williams design for ``k`` conditions (each a permutation of
+    ``range(k)``): first row 0, 1, k−1, 2, k−2, …, each next row that plus one mod k; for odd
+    ``k`` followed by the mirror image of each row."""
+    first: list[int] = [0]
+    low, high = 1, k - 1
+    while len(first) < k:
+        first.append(low)
+        low += 1
+        if len(first) < k:
+            first.append(high)
+            high -= 1
+    rows = [[(c + r) % k for c in first] for r in range(k)]
+    if k % 2 == 1:
+        rows += [list(reversed(row)) for row in rows]
+    return rows
+
+
+@dataclass(frozen=True)
+class Protocol:
+    name: str
+    path: Path
+    variants: tuple[Variant, ...]
+    participants: tuple[str, ...]
+    recordings: Path
+    days: float | None = None
+    speed: float = 60.0
+    seed: int = 0
+
+    def order(self, participant: str) -> list[Variant]:
+        """The variants ``participant`` performs, in their counterbalanced order."""
+        if participant not in self.participants:
+            raise ConfigurationError(
+                f"participant {participant!r} is not in the protocol",
+                location=SourceLocation(str(self.path), key="study.participants"),
+                hint="the protocol's participants: " + ", ".join(self.participants))
+        rows = latin_square(len(self.variants))
+        row = rows[self.participants.index(participant) % len(rows)]
+        return [self.variants[i] for i in row]
+
+    def sessions(self, participant: str) -> list[Session]:
+        safe = _file_safe(participant)
+        return [Session(participant, v, i + 1, self.recordings / safe / f"{v.id}.json")
+                for i, v in enumerate(self.order(participant))]
+
+    def pending(self, participant: str) -> list[Session]:
+        return [s for s in self.sessions(participant) if not s.done]
+
+
+def _file_safe(text: str) -> str:
+    import re
+
+    return re.sub(r"[^A-Za-z0-9_-]", "_", text)
+
+
+def load_protocol(path: str | Path) -> Protocol:
+    """Read and check a protocol; every problem names ``file`` and the key."""
+    source = Path(path)
+    where = str(source)
+
+    def bad(key: str, message: str, hint: str = "") -> ConfigurationError:
+        return ConfigurationError(message, location=SourceLocation(where, key=key), hint=hint)
+
+    try:
+        data = tomllib.loads(source.read_text(encoding="utf-8"))
+    except OSError as error:
+        raise ConfigurationError(f"cannot read the protocol: {error.strerror or error}",
+                                 location=SourceLocation(where)) from None
+    except tomllib.TOMLDecodeError as error:
+        raise ConfigurationError(f"not valid TOML: {error}",
+                                 location=SourceLocation(where)) from None
+    study = data.get("study", {})
+    if not isinstance(study, dict):
+        raise bad("study", "must be a table")
+    unknown = sorted(set(study) - {"name", "days", "speed", "seed", "recordings",
+                                   "participants"})
+    if unknown:
+        raise bad(f"study.{unknown[0]}", f"unknown key {unknown[0]!r}",
+                  "keys of [study]: name, days, speed, seed, recordings, participants")
+    people = study.get("participants")
+    if (not isinstance(people, list) or not people
+            or not all(isinstance(p, str) and p.strip() and p.isprintable() for p in people)):
+        raise bad("study.participants", "must list the participants' identifiers",
+                  'for example participants = ["P01", "P02", "P03"]')
+    if len(set(people)) != len(people):
+        raise bad("study.participants", "lists a participant twice")
+    variants = data.get("variants")
+    if not isinstance(variants, list) or len(variants) < 1:
+        raise bad("variants", "needs at least one [[variants]] table with id and spec")
+    out: list[Variant] = []
+    for i, v in enumerate(variants):
+        key = f"variants[{i}]"
+        if not isinstance(v, dict) or not isinstance(v.get("id"), str) or not v["id"]:
+            raise bad(f"{key}.id", "each variant needs an id (text)")
+        if not isinstance(v.get("spec"), str):
+            raise bad(f"{key}.spec", "each variant needs the path of its spec")
+        spec = (source.parent / v["spec"]).resolve()
+        if not spec.is_file():
+            raise bad(f"{key}.spec", f"no spec at {spec}",
+                      "paths in a protocol are relative to the protocol's file")
+        told = v.get("told", "")
+        if not isinstance(told, str):
+            raise bad(f"{key}.told", "must be the text the participant reads before")
+        out.append(Variant(v["id"], spec, told))
+    if len({v.id for v in out}) != len(out):
+        raise bad("variants", "two variants share an id")
+    days = study.get("days")
+    if days is not None and (isinstance(days, bool) or not isinstance(days, (int, float))
+                             or not (days > 0 and math.isfinite(days))):
+        raise bad("study.days", f"must be a positive number of days, not {days!r}")
+    speed = study.get("speed", 60.0)
+    if isinstance(speed, bool) or not isinstance(speed, (int, float)) or not speed > 0:
+        raise bad("study.speed", f"must be a positive number, not {speed!r}")
+    seed = study.get("seed", 0)
+    if isinstance(seed, bool) or not isinstance(seed, int) or seed < 0:
+        raise bad("study.seed", f"must be a whole number >= 0, not {seed!r}")
+    recordings = source.parent / str(study.get("recordings", "recordings"))
+    return Protocol(str(study.get("name", source.stem)), source, tuple(out), tuple(people),
+                    recordings, None if days is None else float(days), float(speed), seed)
+
+
+# ------------------------------------------------------------------ one session
+
+
+def _briefing_app(base: Any) -> Any:
+    """The walkthrough app with the variant's briefing shown first (the clock waits)."""
+    from textual.app import ComposeResult
+    from textual.binding import Binding
+    from textual.containers import Vertical
+    from textual.screen import ModalScreen
+    from textual.widgets import Static
+
+    class Briefing(ModalScreen[None]):
+        """What the participant is told before the session; Enter starts it."""
+
+        BINDINGS = [Binding("enter", "start", "start")]
+        DEFAULT_CSS = """Briefing { align: center middle; }
+        #brief { width: 70; height: auto; border: heavy $accent; padding: 1 2;
+                 background: $panel; }"""
+
+        def __init__(self, title: str, text: str) -> None:
+            super().__init__()
+            self.title_text, self.text = title, text
+
+        def compose(self) -> ComposeResult:
+            with Vertical(id="brief"):
+                yield Static(self.title_text, id="brief-title")
+                yield Static(self.text or "(nothing to read for this session)",
+                             id="brief-text")
+                yield Static("Press Enter to begin.", id="brief-go")
+
+        def action_start(self) -> None:
+            self.dismiss(None)
+
+    class StudySessionApp(base):  # type: ignore[misc, valid-type]
+        def __init__(self, session: Any, *, briefing: tuple[str, str], **kwargs: Any
+                     ) -> None:
+            super().__init__(session, **kwargs)
+            self.briefing = briefing
+
+        def on_mount(self) -> None:
+            super().on_mount()
+            self.session.paused = True
+
+            def begin(_result: None) -> None:
+                self.session.paused = False
+
+            self.push_screen(Briefing(*self.briefing), begin)
+
+    return StudySessionApp
+
+
+def session_app(protocol: Protocol, session: Session) -> tuple[Any, Any]:
+    """The app of ``session`` and its :class:`~opspec.tui.session.WalkSession` (recording to
+    the session's place; a broken-off earlier attempt moved aside first)."""
+    from opspec.engine.compiled import compile_package
+    from opspec.tui.app import WalkthroughApp
+    from opspec.tui.session import WalkSession
+    from opspec.xpdl.open_spec import open_spec
+
+    _move_partial(session)
+    package = open_spec(session.variant.spec)
+    compiled = compile_package(package)
+    from opspec.runs import companion_user_model
+
+    model_ref = companion_user_model(session.variant.spec)
+    factory = None
+    if model_ref is not None:
+        from opspec.usermodels.loader import load_user_model
+
+        model = load_user_model(model_ref)
+        factory = lambda: model.performer_for(protocol.seed, 0)  # noqa: E731
+    walk = WalkSession(compiled, seed=protocol.seed, days=protocol.days,
+                       record=session.recording, model_factory=factory,
+                       spec_path=str(session.variant.spec), person=session.participant)
+    walk.speed = protocol.speed
+    total = len(protocol.variants)
+    title = (f"{protocol.name}: session {session.position} of {total} "
+             f"(participant {session.participant})")
+    app = _briefing_app(WalkthroughApp)(walk, title=package.name or package.id,
+                                        briefing=(title, session.variant.told))
+    return app, walk
+
+
+def _move_partial(session: Session) -> None:
+    """A broken-off attempt's recording and trace, kept as ``VARIANT.partial-N.*``."""
+    if session.done or not (session.recording.exists() or session.trace.exists()):
+        return
+    n = 1
+    while session.recording.with_name(f"{session.variant.id}.partial-{n}.json").exists() or \
+            session.recording.with_name(f"{session.variant.id}.partial-{n}.trace.jsonl"
+                                        ).exists():
+        n += 1
+    for old, suffix in ((session.recording, ".json"), (session.trace, ".trace.jsonl")):
+        if old.exists():
+            old.replace(old.with_name(f"{session.variant.id}.partial-{n}{suffix}"))
+
+
+def finish_session(session: Session, walk: Any) -> bool:
+    """After the app closed: mark the session done when its run reached the end."""
+    if not walk.ended or walk.failure is not None:
+        return False
+    session.done_marker.write_text(json.dumps({
+        "participant": session.participant, "variant": session.variant.id,
+        "position": session.position, "spec": str(session.variant.spec),
+        "recording": session.recording.name, "trace": session.trace.name}, indent=1) + "\n",
+        encoding="utf-8")
+    return True
+
+
+# ------------------------------------------------------------------ the summary
+
+
+def _pairs(listener: Any) -> dict[str, tuple[float, float]]:
+    """Per metric of one session, the (numerator, denominator) pair ``opspec evaluate
+    --compare`` pairs by user: a count (total, 1), a duration (sum, n), a ratio (its
+    numerator's value, its denominator's)."""
+    from opspec.model import MetricKind
+
+    values = listener.values()
+    out: dict[str, tuple[float, float]] = {}
+
+    def scalar(name: str | None) -> float | None:
+        v = values.get(name or "")
+        if v is None:
+            return None
+        result = (v.get("total") if v["kind"] == "count" else v.get("mean")
+                  if v["kind"] == "duration" else v.get("value"))
+        return None if result is None else float(result)
+
+    for metric in listener.definitions:
+        if metric.kind is MetricKind.COUNT:
+            out[metric.name] = (float(values[metric.name]["total"]), 1.0)
+        elif metric.kind is MetricKind.DURATION:
+            samples = listener.samples.get(metric.name, [])
+            if samples:
+                out[metric.name] = (float(sum(samples)), float(len(samples)))
+        elif metric.kind is MetricKind.RATIO:
+            num, den = scalar(metric.numerator), scalar(metric.denominator)
+            if num is not None and den:
+                out[metric.name] = (num, den)
+    return out
+
+
+def session_pairs(session: Session) -> dict[str, tuple[float, float]]:
+    """The metric pairs of a done session, replayed from its trace."""
+    from opspec.engine.metrics import MetricsListener
+    from opspec.engine.trace_sinks import read_trace
+    from opspec.xpdl.open_spec import open_spec
+
+    listener = MetricsListener(open_spec(session.variant.spec).metrics)
+    for event in read_trace(session.trace):
+        listener(event)
+    return _pairs(listener)
+
+
+def summary(protocol: Protocol) -> dict[str, Any]:
+    """Per variant, each metric over the participants who finished it; per pair of variants,
+    the paired difference over the participants who finished both (``opspec evaluate
+    --compare``'s statistics: a ratio over users with its delta-method interval)."""
+    from opspec.statistics import paired_difference, ratio_estimate
+
+    done: dict[str, dict[str, dict[str, tuple[float, float]]]] = {}
+    status: dict[str, dict[str, bool]] = {}
+    for participant in protocol.participants:
+        status[participant] = {}
+        for s in protocol.sessions(participant):
+            status[participant][s.variant.id] = s.done
+            if s.done:
+                done.setdefault(s.variant.id, {})[participant] = session_pairs(s)
+    variants: dict[str, Any] = {}
+    for v in protocol.variants:
+        people = done.get(v.id, {})
+        metrics: dict[str, Any] = {}
+        names = sorted({m for pairs in people.values() for m in pairs})
+        for name in names:
+            pairs = [p[name] for p in people.values() if name in p]
+            estimate = ratio_estimate(pairs)
+            metrics[name] = {"value": estimate.value, "ci95": list(estimate.ci),
+                             "participants": len(pairs)}
+        variants[v.id] = {"participants": len(people), "metrics": metrics}
+    comparisons = []
+    ids = [v.id for v in protocol.variants]
+    for i, a in enumerate(ids):
+        for b in ids[i + 1:]:
+            both = sorted(set(done.get(a, {})) & set(done.get(b, {})))
+            rows: dict[str, Any] = {}
+            names = sorted({m for p in both for m in done[a][p]} &
+                           {m for p in both for m in done[b][p]})
+            for name in names:
+                who = [p for p in both if name in done[a][p] and name in done[b][p]]
+                if len(who) < 2:
+                    continue
+                diff = paired_difference([done[a][p][name] for p in who],
+                                         [done[b][p][name] for p in who])
+                rows[name] = {"a": ratio_estimate([done[a][p][name] for p in who]).value,
+                              "b": ratio_estimate([done[b][p][name] for p in who]).value,
+                              "difference": diff.value, "ci95": list(diff.ci),
+                              "participants": len(who)}
+            comparisons.append({"a": a, "b": b, "participants": both, "metrics": rows})
+    return {"study": protocol.name, "status": status, "variants": variants,
+            "comparisons": comparisons}
+
+
+def summary_lines(doc: dict[str, Any]) -> list[str]:
+    def num(x: Any) -> str:
+        return "-" if x is None else f"{x:.4g}"
+
+    lines = [f"study {doc['study']}"]
+    for participant, sessions in doc["status"].items():
+        lines.append(f"  {participant}: " + ", ".join(
+            f"{v} {'done' if ok else 'to do'}" for v, ok in sessions.items()))
+    for vid, v in doc["variants"].items():
+        lines.append(f"variant {vid} ({v['participants']} participant(s) finished):")
+        for name, m in v["metrics"].items():
+            lo, hi = m["ci95"]
+            lines.append(f"  {name}: {num(m['value'])} (95 % CI [{num(lo)}, {num(hi)}])")
+    for c in doc["comparisons"]:
+        lines.append(f"{c['b']} - {c['a']}, paired over {len(c['participants'])} "
+                     "participant(s) who did both:")
+        if not c["metrics"]:
+            lines.append("  (needs two participants or more who did both)")
+        for name, m in c["metrics"].items():
+            lo, hi = m["ci95"]
+            lines.append(f"  {name}: {num(m['a'])} -> {num(m['b'])}, difference "
+                         f"{num(m['difference'])} (95 % CI [{num(lo)}, {num(hi)}])")
+    return lines
+
