@@ -252,22 +252,18 @@ def _briefing_app(base: Any) -> Any:
 def session_app(protocol: Protocol, session: Session) -> tuple[Any, Any]:
     """The app of ``session`` and its :class:`~opspec.tui.session.WalkSession` (recording to
     the session's place; a broken-off earlier attempt moved aside first)."""
-    from opspec.engine.compiled import compile_package
+    from opspec.request import RunRequest, prepare
     from opspec.tui.app import WalkthroughApp
     from opspec.tui.session import WalkSession
-    from opspec.xpdl.open_spec import open_spec
 
     _move_partial(session)
-    package = open_spec(session.variant.spec)
-    compiled = compile_package(package)
-    from opspec.runs import companion_user_model
-
-    model_ref = companion_user_model(session.variant.spec)
+    # the front hall decides the session as every door does: the spec through validate's
+    # gate, and the model a hand-over goes to (the companion SPEC.users.toml, if any)
+    prepared = prepare(RunRequest(session.variant.spec, seed=protocol.seed, days=protocol.days))
+    package, compiled = prepared.package, prepared.compiled
+    model = prepared.user.source if prepared.user.kind == "model" else None
     factory = None
-    if model_ref is not None:
-        from opspec.usermodels.loader import load_user_model
-
-        model = load_user_model(model_ref)
+    if model is not None:
         factory = lambda: model.performer_for(protocol.seed, 0)  # noqa: E731
     walk = WalkSession(compiled, seed=protocol.seed, days=protocol.days,
                        record=session.recording, model_factory=factory,
