@@ -473,6 +473,9 @@ def run(args: argparse.Namespace) -> int:
                 hint="the results are stored; free some space and run `opspec evaluate "
                 f"--resume --out {store.folder}` to write the report again") from None
         failures = store.failures()
+        counts = _replication_counts(store, plan, failures)
+    from opspec.evaluation.failures import kind_of
+
     if args.json:
         doc = {"spec": plan.design("A").spec, "users": plan.users, "days": plan.days,
                "seed": plan.seed, "user_model": plan.user_model, "workers": workers,
@@ -480,7 +483,9 @@ def run(args: argparse.Namespace) -> int:
                "out": str(store.folder), "report": str(report), "metrics": metrics,
                "monitors": monitors, "population": population,
                "input_uncertainty": uncertainty,
-               "failed": [{"design": d, "user": u, "error": e} for d, u, e in failures],
+               "replications": counts,
+               "failed": [{"design": d, "user": u, "error": e, "kind": kind_of(e)}
+                          for d, u, e in failures],
                "wall_s": round(outcome.wall_s, 3)}
         if compare is not None:
             doc["compare"] = compare
@@ -501,6 +506,16 @@ def run(args: argparse.Namespace) -> int:
             print_sweep(sys.stdout, summaries["sweep"], plan.users)
         print(f"results: {store.path}\nreport: {report}")
     return 1 if failures else 0
+
+
+def _replication_counts(store: Any, plan: Any, failures: list[tuple[str, int, str]]
+                        ) -> dict[str, Any]:
+    """Replications planned, complete (what every number is computed from) and failed."""
+    complete = {d.label: len(store.finished(d.label)) for d in plan.designs}
+    return {"planned": plan.users * len(plan.designs), "complete": sum(complete.values()),
+            "complete_by_design": complete,
+            "failed": sum(1 for d, _, _ in failures if d in complete),
+            "metrics_from": "complete replications only"}
 
 
 def _with_resume_hint(error: EvaluationError, store: Any, plan: Any) -> EvaluationError:

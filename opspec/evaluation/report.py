@@ -676,8 +676,11 @@ def write_report(store: ResultStore, summaries: Mapping[str, Summaries] | None =
             "difference") if "B" in designs else None))
 
     if failures:
+        from opspec.evaluation.failures import advice
+
+        todo = advice(failures)
         sections.append(Section("Failed replications", paragraphs=(
-            "Run `opspec evaluate --resume --out <this folder>` to run them again.",),
+            f"They are left out of every number above. {todo[:1].upper()}{todo[1:]}.",),
             tables=(Table(("specification", "user", "error"),
                           tuple((names.get(d, d), str(u), e) for d, u, e in failures[:200])),
                     )))
