@@ -15,14 +15,16 @@ its own ``not_a_file``/``open_regular`` for specs, with the same phrases.)
 
 from __future__ import annotations
 
+import hashlib
 import os
+import re
 import stat
 from collections.abc import Sequence
 from pathlib import Path
 from typing import BinaryIO
 
 __all__ = ["EXTERNAL_PATH_VARIABLE", "NotARegularFile", "allowed_roots", "companion_outside",
-           "not_a_file", "open_regular", "outside_roots", "read_bytes", "read_text", "reason"]
+           "file_name", "not_a_file", "open_regular", "outside_roots", "read_bytes", "read_text", "reason"]
 
 #: Folders, besides the root spec's own folder tree, whose files specs may refer to (separated
 #: by ``os.pathsep``: ``OPSPEC_EXTERNAL_PATH=/opt/xpdl-lib:/srv/shared``; docs/validation.md).
@@ -144,3 +146,21 @@ def companion_outside(spec: str | os.PathLike[str] | None, name: str, what: str
     hint = ("copy the file into the spec's folder, or allow its folder with the environment "
             f"variable {EXTERNAL_PATH_VARIABLE} (docs/validation.md)")
     return message, hint
+
+
+# ---------------------------------------------------------------- names from a spec
+
+
+_UNSAFE = re.compile(r"[^A-Za-z0-9_.-]+")
+
+
+def file_name(name: str, most: int = 80) -> str:
+    """``name`` (from a spec: a metric's Name) as one safe component of a file name: letters,
+    digits, ``_``, ``-`` and inner dots only, so ``../../x`` or ``a/b`` cannot lead out of the
+    folder it is written in. A simple name stays as it is; any other gets a short digest of
+    the original, so two names that differ only in what was replaced stay two files."""
+    safe = _UNSAFE.sub("_", name).strip("._-")[:most]
+    if safe and safe == name:
+        return safe
+    digest = hashlib.sha256(name.encode("utf-8", "surrogatepass")).hexdigest()[:8]
+    return f"{safe or 'name'}-{digest}"

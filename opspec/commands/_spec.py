@@ -76,7 +76,13 @@ def engine_diagnostics(package: Package, *, world: bool = False) -> list[Diagnos
         # what the engine refuses, validate refuses: at its line, as the run would say it
         return [Diagnostic(error.location or spec_file, Severity.ERROR, NOT_RUNNABLE,
                            error.message, error.hint or "")]
-    out: list[Diagnostic] = []
+    out: list[Diagnostic] = [
+        Diagnostic(metric.location or spec_file, Severity.WARNING, "metric-name",
+                   f"metric name {metric.name!r} is not a simple identifier; the file names "
+                   "of its figures (opspec evaluate) use a changed name",
+                   "name metrics with letters, digits and '_', starting with a letter, "
+                   "such as doses_missed")
+        for metric in getattr(package, "metrics", ()) if not _simple(metric.name)]
     try:
         declared_monitors(compiled)
     except ConfigurationError as error:
@@ -91,6 +97,11 @@ def engine_diagnostics(package: Package, *, world: bool = False) -> list[Diagnos
             out.append(Diagnostic(error.location or spec_file, Severity.ERROR, "bad-world",
                                   error.message, error.hint or ""))
     return out
+
+
+def _simple(name: str) -> bool:
+    """A simple identifier: ASCII letters, digits and ``_``, not starting with a digit."""
+    return name.isascii() and name.isidentifier()
 
 
 def companion_user_model(spec_path: str | Path) -> Path | None:

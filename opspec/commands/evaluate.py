@@ -18,7 +18,7 @@ from pathlib import Path
 from typing import Any
 
 from opspec.commands._args import seed, share, sweep
-from opspec.errors import EvaluationError
+from opspec.errors import EvaluationError, OpspecError
 
 __all__ = ["register", "run"]
 
@@ -371,6 +371,11 @@ def run(args: argparse.Namespace) -> int:
         for design in plan.designs:         # the spec's warnings, as a new run shows them
             load_any_spec(design.spec, command="evaluate")
         definitions = _check_plan(plan)
+        try:
+            _refuse_inputs_in_out(args, plan, store.folder)
+        except OpspecError:
+            store.close()
+            raise
         from opspec.evaluation.sweep import check_targets, resumed_sweep
 
         try:
@@ -403,6 +408,7 @@ def run(args: argparse.Namespace) -> int:
         if (out / "results.sqlite").exists():
             raise EvaluationError(f"{out} already holds an evaluation",
                                   hint="add --resume to finish it, or choose another --out")
+        _refuse_inputs_in_out(args, plan, out)
         if plan.export:                     # before anything is created
             _export_estimate(plan, out, quiet=args.quiet)
         store = ResultStore(out, create=True)
@@ -506,6 +512,35 @@ def run(args: argparse.Namespace) -> int:
             print_sweep(sys.stdout, summaries["sweep"], plan.users)
         print(f"results: {store.path}\nreport: {report}")
     return 1 if failures else 0
+
+
+#: what an evaluation writes into its output folder besides the exports and figures/
+OUT_FILES = ("results.sqlite", "results.sqlite-wal", "results.sqlite-shm", "report.html",
+             "report.md")
+
+
+def _refuse_inputs_in_out(args: argparse.Namespace, plan: Any, out: Path) -> None:
+    """No file the evaluation writes into ``out`` may be one it reads (exit 2, both
+    named): a report template named ``OUT/report.html``, a spec in ``OUT/figures/``…"""
+    from opspec.commands._files import refuse_overwrite, spec_inputs
+    from opspec.evaluation.replication import prepare
+
+    reads: list[Any] = []
+    for design in plan.designs:
+        what = "SPEC" if design.label == "A" else f"design {design.label}"
+        reads.append((what, design.spec))
+        # loaded once per process already (_check_plan): the same context, from its cache
+        package = prepare(design.spec, design.sha256, plan.user_model, plan.engine,
+                          design.parameters).compiled.package
+        reads.extend(spec_inputs(design.spec, package))
+    reads += [("--report-template", getattr(args, "report_template", None)),
+              ("--engine-config", args.engine_config)]
+    if plan.user_model and Path(plan.user_model).exists():
+        reads.append(("the user model", plan.user_model))
+    writes = [(f"--out {out}: {name}", out / name) for name in (
+        *OUT_FILES, *(EXPORT_FILES[f] for f in plan.export),
+        *(EXPORT_FILES[f] + ".partial" for f in plan.export))]
+    refuse_overwrite("evaluate", writes, reads, folders=[(f"--out {out}", out / "figures")])
 
 
 def _replication_counts(store: Any, plan: Any, failures: list[tuple[str, int, str]]

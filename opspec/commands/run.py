@@ -105,6 +105,8 @@ def run(args: argparse.Namespace) -> int:
     from opspec.runs import build, load, run_length
 
     package = load_any_spec(args.spec, command="run")
+    if args.trace:
+        _refuse_trace_over_input(args, package)
     spec = load(package)
     compiled = spec.compiled
     config = _config(args)
@@ -213,6 +215,19 @@ def _waiting_for_absent_user(summary: dict[str, Any], compiled: Any, user: Any
                 and " (performer for " in item for item in waiting):
             absent.append(deadlock)
     return absent
+
+
+def _refuse_trace_over_input(args: argparse.Namespace, package: Any) -> None:
+    """``--trace`` may not name a file this run reads (exit 2, both named)."""
+    from opspec.commands._files import refuse_overwrite, spec_inputs
+    from opspec.commands._spec import companion_user_model
+
+    reads = [("SPEC", args.spec), ("--script", args.script),
+             ("--user-model", args.user_model if args.user_model and Path(
+                 args.user_model).exists() else None),
+             ("the companion user model", companion_user_model(args.spec)),
+             ("--engine-config", args.engine_config), *spec_inputs(args.spec, package)]
+    refuse_overwrite("run", [("--trace", args.trace)], reads)
 
 
 def _real_deadlocks(result: RunResult, absent: list[dict[str, Any]]) -> list[dict[str, Any]]:

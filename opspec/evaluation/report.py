@@ -61,6 +61,7 @@ from opspec.evaluation.tables import (
     subgroup_metric_rows,
     subgroup_rows,
 )
+from opspec.files import file_name
 
 __all__ = ["PLOT_SAMPLE", "Summaries", "write_report"]
 
@@ -433,7 +434,7 @@ def _design_sections(store: ResultStore, figures: Path, design: str, name: str, 
                     continue
                 images.append(plots.subgroups_figure(
                     d["name"], _subgroup_rates(store, design, d, groups),
-                    figures / f"{design}-{d['name']}-by-subgroup.png", unit="%"))
+                    figures / f"{design}-{file_name(d['name'])}-by-subgroup.png", unit="%"))
                 captions.append(f"Each user's own {d['name']}, over the users of each "
                                 "subgroup (outline histograms, share of the group's users)")
         sections.append(Section(f"{prefix}How users differ", paragraphs=(
@@ -460,7 +461,7 @@ def _design_sections(store: ResultStore, figures: Path, design: str, name: str, 
         values, total = _observations(store, design, d["name"])
         marks = {"mean": s.get("mean"), "median": s.get("median"), "p95": s.get("p95")}
         images.append(plots.latency_figure(d["name"], values,
-                                           figures / f"{design}-{d['name']}.png",
+                                           figures / f"{design}-{file_name(d['name'])}.png",
                                            marks=marks, total=total))
         caption = f"Distribution of {d['name']}: ECDF (left) and histogram (right)"
         if total > len(values):
