@@ -23,6 +23,7 @@ from typing import Any, Final, Literal
 
 from opspec.bindings.templates import LineTemplate, TemplateError
 from opspec.errors import BindingError, SourceLocation
+from opspec.files import toml_load
 
 __all__ = [
     "PROFILE_FORMAT",
@@ -327,7 +328,7 @@ def load_profile(path: str | os.PathLike[str]) -> DeviceProfile:
     where = str(path)
     try:
         with open_regular(path) as stream:        # a pipe or device never blocks
-            data = tomllib.load(stream)
+            data = toml_load(stream)      # nesting bounded (opspec.files)
     except FileNotFoundError:
         raise BindingError(f"device profile {where} does not exist",
                            hint="profiles live in devices/; see `opspec devices list`") from None

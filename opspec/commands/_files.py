@@ -12,7 +12,7 @@ from typing import Any
 
 from opspec.errors import ConfigurationError
 
-__all__ = ["Named", "input_problem", "overwrite_problem", "refuse_overwrite", "same_file",
+__all__ = ["Named", "check_nesting", "input_problem", "overwrite_problem", "refuse_overwrite", "same_file",
            "spec_inputs"]
 
 #: a file as the command line names it: (the option or argument, e.g. ``"--trace"``, path)
@@ -97,3 +97,25 @@ def spec_inputs(spec: str | os.PathLike[str], package: Any) -> list[Named]:
         if mode.source:
             found.append((f"the Source of its mode {mode.id!r}", base / mode.source))
     return found
+
+
+def check_nesting(path: str | os.PathLike[str], what: str) -> None:
+    """A :class:`ConfigurationError` at ``path`` when the TOML file nests deeper than opspec
+    reads (:data:`opspec.files.MAX_NESTING`), for readers that parse with ``tomllib`` itself
+    (the engine configuration): Python's parser recurses once per level, and 100,000 ``[``
+    would end in an internal error. Anything else wrong is left for the reader to say."""
+    import tomllib
+
+    from opspec.errors import SourceLocation
+    from opspec.files import MAX_NESTING, read_text, toml_loads
+
+    try:
+        toml_loads(read_text(path))
+    except tomllib.TOMLDecodeError as error:
+        if "nest too deeply" in str(error):
+            raise ConfigurationError(f"{what} is not valid TOML: {error}",
+                                     location=SourceLocation(str(path)),
+                                     hint="check the brackets: opspec reads at most "
+                                     f"{MAX_NESTING} levels") from None
+    except (OSError, UnicodeDecodeError):
+        pass

@@ -128,6 +128,9 @@ def _engine(path: str | None) -> dict[str, Any]:
         return {}
     from opspec.engine.config import EngineConfig
 
+    from opspec.commands._files import check_nesting
+
+    check_nesting(path, "the engine configuration")
     return asdict(EngineConfig.load(path))
 
 

@@ -267,6 +267,10 @@ def _print_monitors(out: Any, monitors: dict[str, Any]) -> None:
 def _config(args: argparse.Namespace) -> Any:
     from opspec.engine.config import EngineConfig
 
+    if args.engine_config:
+        from opspec.commands._files import check_nesting
+
+        check_nesting(args.engine_config, "the engine configuration")
     config = EngineConfig.load(args.engine_config) if args.engine_config else EngineConfig()
     overrides: dict[str, Any] = {}
     if args.processor_model:

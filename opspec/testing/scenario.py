@@ -31,6 +31,7 @@ from pathlib import Path
 from typing import Any
 
 from opspec.errors import ConfigurationError, OpspecError, SourceLocation
+from opspec.files import toml_loads
 from opspec.testing.expectations import Expectation, parse_expectation
 from opspec.testing.script import Script, load_script, parse_script
 
@@ -170,7 +171,7 @@ def load_scenarios(path: str | Path, *, rootdir: Path | None = None) -> Scenario
 
     try:
         full = path if path.is_absolute() or rootdir is None else rootdir / path
-        document = tomllib.loads(read_text(full))   # a pipe or device never blocks
+        document = toml_loads(read_text(full))   # a pipe or device never blocks
     except OSError as error:
         raise _error(path, None, f"cannot read it: {reason(error)}") from None
     except (tomllib.TOMLDecodeError, UnicodeDecodeError) as error:

@@ -56,6 +56,7 @@ from opspec.engine.builtin_performers import ScriptedUser, Step
 from opspec.engine.performers import WorkItem
 from opspec.engine.trace import EventKind, TraceEvent
 from opspec.errors import ConfigurationError, SourceLocation
+from opspec.files import json_loads, toml_loads
 
 __all__ = ["DEFAULTS", "Script", "ScriptEntry", "ScriptUser", "load_script", "parse_script",
            "script_format"]
@@ -318,7 +319,7 @@ def load_script(path: str | Path) -> Script:
                                  location=SourceLocation(where)) from None
     kind = script_format(raw, where)
     try:
-        document = json.loads(raw) if kind == "JSON" else tomllib.loads(raw.decode("utf-8"))
+        document = json_loads(raw) if kind == "JSON" else toml_loads(raw.decode("utf-8"))
     except (ValueError, tomllib.TOMLDecodeError) as error:
         raise ConfigurationError(f"the script is not valid {kind}: {error}",
                                  location=SourceLocation(where),

@@ -18,6 +18,7 @@ from typing import Any
 import tomli_w
 
 from opspec.errors import SourceLocation, UserModelError
+from opspec.files import toml_loads
 from opspec.usermodels.distributions import Distribution, ParameterError, make_distribution
 from opspec.usermodels.errors import Busy, Commission, ExtraDelay, Omission, Repetition
 from opspec.usermodels.model import ActivityModel, Modifier, UserModel
@@ -360,7 +361,7 @@ def _read(path: Path) -> dict[str, Any]:
                              f"offset {error.start}", location=SourceLocation(str(path)),
                              hint="save the user model as UTF-8") from None
     try:
-        return tomllib.loads(text)
+        return toml_loads(text)
     except tomllib.TOMLDecodeError as error:
         raise UserModelError(f"not valid TOML: {error}", location=SourceLocation(str(path)),
                              hint="check quotes, brackets and '=' signs near that line"

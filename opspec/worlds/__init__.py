@@ -31,6 +31,7 @@ from typing import TYPE_CHECKING, Any
 from xml.etree import ElementTree
 
 from opspec.errors import ConfigurationError, SourceLocation
+from opspec.files import toml_load, toml_loads
 from opspec.worlds.base import World
 from opspec.worlds.room import RoomWorld
 from opspec.worlds.sumo import SumoWorld
@@ -81,7 +82,7 @@ def _file_parameters(compiled: CompiledPackage, world_attr: ExtendedAttribute
         raise ConfigurationError(message, location=where, hint=hint)
     try:
         with open_regular(path) as handle:        # a pipe or device never blocks
-            return dict(tomllib.load(handle)), str(path)
+            return dict(toml_load(handle)), str(path)
     except OSError as error:
         raise ConfigurationError(f"cannot read the world file {path}: {reason(error)}",
                                  location=where,
@@ -111,7 +112,7 @@ def _inline_parameters(attribute: ExtendedAttribute) -> dict[str, Any]:
                 location=attribute.location)
         text = element.get("Value", "")
         try:
-            params[element.get("Name", "")] = tomllib.loads(f"v = {text}")["v"]
+            params[element.get("Name", "")] = toml_loads(f"v = {text}")["v"]
         except tomllib.TOMLDecodeError:
             params[element.get("Name", "")] = text          # a bare word: a string
     return params
