@@ -25,8 +25,9 @@ from collections.abc import Iterable, Sequence
 from pathlib import Path
 from typing import Any, BinaryIO
 
-__all__ = ["EXTERNAL_PATH_VARIABLE", "NotARegularFile", "allowed_roots", "companion_outside",
-           "MAX_NESTING", "file_name", "json_loads", "not_a_file", "toml_load", "toml_loads", "open_regular", "outside_roots", "read_bytes", "read_text", "reason"]
+__all__ = ["EXTERNAL_PATH_VARIABLE", "MAX_NESTING", "NotARegularFile", "allowed_roots",
+           "companion_outside", "file_name", "json_loads", "not_a_file", "open_regular",
+           "outside_roots", "read_bytes", "read_text", "reason", "toml_load", "toml_loads"]
 
 #: Folders, besides the root spec's own folder tree, whose files specs may refer to (separated
 #: by ``os.pathsep``: ``OPSPEC_EXTERNAL_PATH=/opt/xpdl-lib:/srv/shared``; docs/validation.md).

@@ -12,8 +12,8 @@ from typing import Any
 
 from opspec.errors import ConfigurationError
 
-__all__ = ["Named", "check_nesting", "input_problem", "overwrite_problem", "refuse_overwrite", "same_file",
-           "spec_inputs"]
+__all__ = ["Named", "check_nesting", "input_problem", "overwrite_problem", "refuse_overwrite",
+           "same_file", "spec_inputs"]
 
 #: a file as the command line names it: (the option or argument, e.g. ``"--trace"``, path)
 Named = tuple[str, "str | os.PathLike[str] | None"]

@@ -79,3 +79,43 @@ def test_a_corrupt_wfs_is_a_located_error(value, tmp_path, capsys) -> None:
                    encoding="utf-8")
     err = _located(capsys, ["run", str(wfs), "--until", "60"], wfs)
     assert "corrupt workflow script" in err and len(err) < 2000
+
+
+def _model(path: Path, text: str) -> Path:
+    path.parent.mkdir(parents=True, exist_ok=True)
+    path.write_text(text, encoding="utf-8")
+    return path
+
+
+@pytest.mark.parametrize(("files", "start", "says"), [
+    ({"self.toml": 'extends = "self.toml"\n'}, "self.toml", "is this file itself"),
+    ({"a.toml": 'extends = "b.toml"\n', "b.toml": 'extends = "c.toml"\n',
+      "c.toml": 'extends = "a.toml"\n'}, "a.toml", "a cycle"),
+    ({"m/out.toml": 'extends = "../secret.toml"\n', "secret.toml": 'name = "x"\n'},
+     "m/out.toml", "leads outside the user model's folder"),
+    ({"abs.toml": 'extends = "/etc/hostname"\n'}, "abs.toml", "leads outside"),
+], ids=["itself", "cycle", "relative-outside", "absolute"])
+def test_user_model_extends_cycles_and_escapes_are_located_errors(files, start, says,
+                                                                  tmp_path, capsys) -> None:
+    for name, text in files.items():
+        _model(tmp_path / name, text)
+    model = tmp_path / start
+    err = _located(capsys, ["run", str(SPEC), "--user-model", str(model), "--until", "60"],
+                   model)
+    assert says in err and "extends" in err
+
+
+def test_extends_inside_the_folder_and_its_allowed_roots_still_work(tmp_path, monkeypatch,
+                                                                     capsys) -> None:
+    from opspec.usermodels.loader import load_user_model
+
+    users = ROOT / "specs" / "medication_dispenser.users.toml"
+    shutil.copy(users, tmp_path / "base.toml")
+    child = _model(tmp_path / "sub" / "child.toml", 'extends = "../base.toml"\n')
+    # the folder tree of the model is its own folder: ../ leaves it
+    with pytest.raises(Exception, match="leads outside"):
+        load_user_model(child)
+    monkeypatch.setenv("OPSPEC_EXTERNAL_PATH", str(tmp_path))
+    assert load_user_model(child).activities == load_user_model(users).activities
+    sibling = _model(tmp_path / "sibling.toml", 'extends = "base.toml"\n')
+    assert load_user_model(sibling).activities == load_user_model(users).activities
