@@ -39,7 +39,11 @@ def load_any_spec(path: str | Path, *, command: str | None = None) -> Package:
 
     target = Path(path)
     if target.suffix == ".wfs" or not_a_file(target) is not None:
-        return open_spec(path)
+        opened = open_spec(path)
+        deep = nesting_problem(opened)
+        if deep is not None:
+            raise deep
+        return opened
     from opspec.errors import Severity, SpecError
     from opspec.xpdl.validate import validate_spec
 
@@ -48,6 +52,9 @@ def load_any_spec(path: str | Path, *, command: str | None = None) -> Package:
     errors = [d for d in report.diagnostics if d.severity is Severity.ERROR]
     if errors or package is None:
         raise SpecError.from_diagnostics(errors or report.diagnostics)
+    deep = nesting_problem(package)
+    if deep is not None:
+        raise deep
     if command is not None:
         for warning in report.diagnostics:
             if warning.severity is Severity.WARNING:
@@ -70,6 +77,10 @@ def engine_diagnostics(package: Package, *, world: bool = False) -> list[Diagnos
     from opspec.errors import Diagnostic, OpspecError, Severity, SourceLocation
 
     spec_file = SourceLocation(str(getattr(package, "source", None) or "<spec>"))
+    deep = nesting_problem(package)
+    if deep is not None:        # the compiler follows blocks recursively: stop before it
+        return [Diagnostic(deep.location or spec_file, Severity.ERROR, NOT_RUNNABLE,
+                           deep.message, deep.hint)]
     try:
         compiled = compile_package(package)
     except OpspecError as error:
@@ -97,6 +108,41 @@ def engine_diagnostics(package: Package, *, world: bool = False) -> list[Diagnos
             out.append(Diagnostic(error.location or spec_file, Severity.ERROR, "bad-world",
                                   error.message, error.hint or ""))
     return out
+
+
+#: How deeply BlockActivities may nest (a block whose activity set holds a block…). Real
+#: specs nest a few levels; the compiler and the soundness check follow blocks recursively.
+MAX_BLOCK_NESTING = 100
+
+
+def nesting_problem(package: Package) -> SpecError | None:
+    """A located :class:`SpecError` when a process nests BlockActivities more than
+    :data:`MAX_BLOCK_NESTING` deep (found without recursion), else ``None``."""
+    from opspec.errors import SpecError
+    from opspec.model.activities import BlockActivity
+
+    for process in getattr(package, "processes", ()):
+        sets = {s.id: s for s in process.activity_sets}
+        stack = [(a, 1) for a in process.activities]
+        # the deepest each set was entered at: a set entered again no deeper is not walked
+        # again, so blocks sharing sets cost at most MAX_BLOCK_NESTING walks of each set
+        deepest: dict[str, int] = {}
+        while stack:
+            activity, depth = stack.pop()
+            body = activity.body
+            if not isinstance(body, BlockActivity) or body.activity_set not in sets:
+                continue
+            if deepest.get(body.activity_set, 0) >= depth:
+                continue
+            deepest[body.activity_set] = depth
+            if depth > MAX_BLOCK_NESTING:
+                return SpecError(
+                    f"process {process.id!r}: BlockActivity {activity.id!r} is nested more "
+                    f"than {MAX_BLOCK_NESTING} blocks deep (or its blocks refer to each "
+                    "other in a cycle)", location=activity.location,
+                    hint="flatten the embedded subprocesses, or call a subflow instead")
+            stack.extend((a, depth + 1) for a in sets[body.activity_set].activities)
+    return None
 
 
 def _simple(name: str) -> bool:
