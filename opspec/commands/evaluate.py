@@ -92,7 +92,11 @@ def register(subparsers: Any) -> None:
     parser.add_argument("--quiet", action="store_true", help="no progress output")
     parser.add_argument("--report-template", metavar="FILE",
                         help="a Jinja2 template for report.html (start from a copy of "
-                        "opspec/evaluation/templates/report.html.j2)")
+                        "opspec/evaluation/templates/report.html.j2). A template is code: it "
+                        "runs sandboxed, and one in the spec's own folder (it may have come "
+                        "with the spec) is refused unless --trust-spec-template is given")
+    parser.add_argument("--trust-spec-template", action="store_true",
+                        help="allow a --report-template that lies in the spec's folder")
     parser.set_defaults(handler=run)
 
 
@@ -340,6 +344,7 @@ def run(args: argparse.Namespace) -> int:
     if getattr(args, "report_template", None):   # read after the runs: refuse a bad one now
         from opspec.files import open_regular, reason
 
+        _refuse_spec_template(args)
         try:
             open_regular(args.report_template).close()
         except OSError as error:
@@ -515,6 +520,27 @@ def run(args: argparse.Namespace) -> int:
             print_sweep(sys.stdout, summaries["sweep"], plan.users)
         print(f"results: {store.path}\nreport: {report}")
     return 1 if failures else 0
+
+
+def _refuse_spec_template(args: argparse.Namespace) -> None:
+    """A report template is code: one that lies in a spec's folder tree (it may have come
+    with a spec from elsewhere) is used only when the user says so."""
+    if getattr(args, "trust_spec_template", False):
+        return
+    template = Path(args.report_template)
+    for option, spec in (("SPEC", args.spec), ("--compare", args.compare)):
+        if not spec:
+            continue
+        try:
+            inside = template.resolve().is_relative_to(Path(spec).resolve().parent)
+        except (OSError, RuntimeError):
+            inside = False
+        if inside:
+            raise EvaluationError(
+                f"--report-template {template} lies in the folder of {option} {spec}; a "
+                "template is code, and one that came with a spec is not used unless asked",
+                hint="check the template, then add --trust-spec-template (or keep your "
+                "templates in a folder of your own)")
 
 
 #: what an evaluation writes into its output folder besides the exports and figures/
