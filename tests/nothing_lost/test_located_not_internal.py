@@ -162,3 +162,22 @@ def test_a_few_nested_blocks_still_run(tmp_path, capsys) -> None:
     spec = _nested_blocks(tmp_path / "three.xpdl", 3)
     assert main(["check", str(spec)]) == 0
     assert main(["run", str(spec), "--until", "10"]) == 0
+
+
+def test_show_refuses_to_hand_graphviz_a_huge_picture(tmp_path, capsys) -> None:
+    n = 3000
+    acts = "".join(f'<Activity Id="a{i}"><Implementation><No/></Implementation></Activity>'
+                   for i in range(n))
+    trs = "".join(f'<Transition Id="t{i}" From="a{i}" To="a{i + 1}"/>' for i in range(n - 1))
+    spec = tmp_path / "big.xpdl"
+    spec.write_text(
+        '<?xml version="1.0" encoding="UTF-8"?>\n<Package xmlns="http://www.wfmc.org/2008/'
+        'XPDL2.1" Id="big" Name="big"><PackageHeader><XPDLVersion>2.1</XPDLVersion><Vendor>t'
+        "</Vendor><Created>2026-01-01</Created></PackageHeader><WorkflowProcesses>"
+        f'<WorkflowProcess Id="p"><ProcessHeader/><Activities>{acts}</Activities>'
+        f"<Transitions>{trs}</Transitions></WorkflowProcess></WorkflowProcesses></Package>",
+        encoding="utf-8")
+    for fmt in ("svg", "html"):
+        assert main(["show", str(spec), "--format", fmt]) == 2
+        err = capsys.readouterr().err
+        assert "more than the 4,000 Graphviz is given to lay out" in err and str(spec) in err
