@@ -130,9 +130,8 @@ def _default_out(spec: str) -> Path:
 def _engine(path: str | None) -> dict[str, Any]:
     if path is None:
         return {}
-    from opspec.engine.config import EngineConfig
-
     from opspec.commands._files import check_nesting
+    from opspec.engine.config import EngineConfig
 
     check_nesting(path, "the engine configuration")
     return asdict(EngineConfig.load(path))
