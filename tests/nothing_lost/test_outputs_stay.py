@@ -71,8 +71,11 @@ def test_evaluate_refuses_an_output_folder_that_holds_its_inputs(spec: Path, tmp
     assert not (out / "results.sqlite").exists()
     template = out / "report.html"
     template.write_text("{{ title }}", encoding="utf-8")
+    # (the template lies in the spec's folder too: trusted here, so the overwrite is what
+    # refuses it)
     _refused(capsys, ["evaluate", str(spec), "--users", "1", "--days", "1", "--workers",
-                      "1", "--out", str(out), "--report-template", str(template)], template)
+                      "1", "--out", str(out), "--report-template", str(template),
+                      "--trust-spec-template"], template)
 
 
 def test_a_metric_name_cannot_lead_a_figure_out_of_the_folder(spec: Path, tmp_path: Path,
