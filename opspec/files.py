@@ -15,14 +15,19 @@ its own ``not_a_file``/``open_regular`` for specs, with the same phrases.)
 
 from __future__ import annotations
 
+import hashlib
+import json
 import os
+import re
 import stat
-from collections.abc import Sequence
+import tomllib
+from collections.abc import Iterable, Sequence
 from pathlib import Path
-from typing import BinaryIO
+from typing import Any, BinaryIO
 
-__all__ = ["EXTERNAL_PATH_VARIABLE", "NotARegularFile", "allowed_roots", "companion_outside",
-           "not_a_file", "open_regular", "outside_roots", "read_bytes", "read_text", "reason"]
+__all__ = ["EXTERNAL_PATH_VARIABLE", "MAX_NESTING", "NotARegularFile", "allowed_roots",
+           "companion_outside", "file_name", "json_loads", "not_a_file", "open_regular",
+           "outside_roots", "read_bytes", "read_text", "reason", "toml_load", "toml_loads"]
 
 #: Folders, besides the root spec's own folder tree, whose files specs may refer to (separated
 #: by ``os.pathsep``: ``OPSPEC_EXTERNAL_PATH=/opt/xpdl-lib:/srv/shared``; docs/validation.md).
@@ -144,3 +149,96 @@ def companion_outside(spec: str | os.PathLike[str] | None, name: str, what: str
     hint = ("copy the file into the spec's folder, or allow its folder with the environment "
             f"variable {EXTERNAL_PATH_VARIABLE} (docs/validation.md)")
     return message, hint
+
+
+# ---------------------------------------------------------------- names from a spec
+
+
+_UNSAFE = re.compile(r"[^A-Za-z0-9_.-]+")
+
+
+def file_name(name: str, most: int = 80) -> str:
+    """``name`` (from a spec: a metric's Name) as one safe component of a file name: letters,
+    digits, ``_``, ``-`` and inner dots only, so ``../../x`` or ``a/b`` cannot lead out of the
+    folder it is written in. A simple name stays as it is; any other gets a short digest of
+    the original, so two names that differ only in what was replaced stay two files."""
+    safe = _UNSAFE.sub("_", name).strip("._-")[:most]
+    if safe and safe == name:
+        return safe
+    digest = hashlib.sha256(name.encode("utf-8", "surrogatepass")).hexdigest()[:8]
+    return f"{safe or 'name'}-{digest}"
+
+
+# ---------------------------------------------------------------- TOML and JSON, bounded
+
+#: How deeply arrays and tables (objects) may nest in a TOML or JSON file opspec reads. No
+#: file of opspec nests more than a handful of levels; Python's parsers recurse once per
+#: level, and a file of 100,000 ``[`` would end in a RecursionError (an internal error).
+MAX_NESTING = 64
+
+#: Digits an integer of a JSON file may have (Python refuses to convert more than 4,300,
+#: with a ValueError that is not a JSONDecodeError).
+MAX_DIGITS = 4300
+
+
+def _too_deep(document: object, most: int = MAX_NESTING) -> bool:
+    """Whether ``document`` (parsed) nests deeper than ``most`` levels (no recursion)."""
+    stack: list[tuple[object, int]] = [(document, 0)]
+    while stack:
+        value, depth = stack.pop()
+        if isinstance(value, dict):
+            children: Iterable[object] = value.values()
+        elif isinstance(value, list):
+            children = value
+        else:
+            continue
+        if depth >= most:
+            return True
+        stack.extend((child, depth + 1) for child in children)
+    return False
+
+
+_NESTED = (f"arrays and tables nest too deeply (opspec reads at most {MAX_NESTING} levels)")
+
+
+def toml_loads(text: str) -> dict[str, Any]:
+    """``tomllib.loads(text)``, with nesting beyond :data:`MAX_NESTING` a
+    ``tomllib.TOMLDecodeError`` like any other syntax error (the callers' messages name
+    the file), never a RecursionError."""
+    try:
+        document = tomllib.loads(text)
+    except RecursionError:
+        raise tomllib.TOMLDecodeError(_NESTED) from None
+    if _too_deep(document):
+        raise tomllib.TOMLDecodeError(_NESTED)
+    return document
+
+
+def toml_load(stream: BinaryIO) -> dict[str, Any]:
+    """:func:`toml_loads` of a binary stream, as ``tomllib.load`` reads one (UTF-8)."""
+    data = stream.read()
+    try:
+        text = data.decode()
+    except AttributeError:
+        raise TypeError("toml_load needs a binary stream") from None
+    return toml_loads(text)
+
+
+def json_loads(text: str | bytes, *, most: int = MAX_NESTING) -> Any:
+    """``json.loads(text)``, with nesting beyond ``most`` levels or an integer of more
+    than :data:`MAX_DIGITS` digits a ``json.JSONDecodeError`` like any other syntax error,
+    never a RecursionError or a bare ValueError."""
+    nested = f"arrays and objects nest too deeply (opspec reads at most {most} levels)"
+    doc = text if isinstance(text, str) else text.decode("utf-8", "surrogateescape")
+    try:
+        value = json.loads(text)
+    except RecursionError:
+        raise json.JSONDecodeError(nested, doc, 0) from None
+    except json.JSONDecodeError:
+        raise
+    except ValueError as error:         # an integer past Python's conversion limit
+        raise json.JSONDecodeError(f"a number is too large to read ({error})", doc,
+                                   0) from None
+    if _too_deep(value, most):
+        raise json.JSONDecodeError(nested, doc, 0)
+    return value

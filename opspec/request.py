@@ -197,6 +197,7 @@ def open_gated(path: str | Path) -> tuple[Package, tuple[Any, ...]]:
     if target.suffix == ".wfs" or not_a_file(target) is not None:
         package = open_spec(path)
         _passed(package)
+        _not_too_deep(package)
         return package, ()
     from opspec.errors import Severity, SpecError
     from opspec.xpdl.validate import validate_spec
@@ -207,7 +208,18 @@ def open_gated(path: str | Path) -> tuple[Package, tuple[Any, ...]]:
     if errors or valid is None:
         raise SpecError.from_diagnostics(errors or report.diagnostics)
     _passed(valid)
+    _not_too_deep(valid)
     return valid, tuple(d for d in report.diagnostics if d.severity is Severity.WARNING)
+
+
+def _not_too_deep(package: Package) -> None:
+    """Blocks nested past :data:`~opspec.model.nesting.MAX_BLOCK_NESTING` are refused at
+    their line before anything follows them recursively (the compiler, the soundness check)."""
+    from opspec.model.nesting import nesting_problem
+
+    deep = nesting_problem(package)
+    if deep is not None:
+        raise deep
 
 
 def _spec(spec: Any) -> tuple[LoadedSpec, tuple[Any, ...], Path | None]:

@@ -12,6 +12,13 @@ names the fault (``fault``: ``timeout``, ``garbage``, ``unexpected-line``, ``lat
 ``missing-data``, ``device-error``: a declared error reply such as ``ERR JAM``) and the
 ``action`` taken (``retry``, ``reconnect``, ``simulate``, ``abort``, ``exception``, ``none``). Each exchange is a ``device.exchange`` event carrying its round-trip ``latency``
 in seconds; notes (bound, switched to simulated, reconnected) are ``device.note`` events.
+
+Noise during a command (a debug line the profile does not ignore, a partial or garbled
+frame) does not end the command's attempt: a command such as ``DISPENSE`` may have been
+carried out, and retrying it or applying the fallback (a dose recorded as missed) on the
+first stray line would lose the reply that follows. The attempt waits for its reply until
+its timeout: a reply after noise is read (the noise reported as a fault, action ``none``);
+noise and no reply is ``garbage`` at the timeout, then the retry or the fallback.
 """
 
 from __future__ import annotations
@@ -20,7 +27,7 @@ import threading
 import time
 from collections import deque
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from functools import partial
 from typing import Any, Final, Literal, Self
 
@@ -60,6 +67,10 @@ class _Job:
     timer: threading.Timer | None = None
     withdrawn: bool = False
     last_fault: str = ""
+    # what the device sent during this attempt that was not its reply, as (fault, message):
+    # the attempt goes on, since a valid reply may still follow (noise lines, a partial
+    # frame); reported with the reply, or as the attempt's failure at its timeout
+    noise: list[tuple[str, str]] = field(default_factory=list)
 
 
 class DeviceBinding:
@@ -327,7 +338,10 @@ class DeviceBinding:
         if any(t.match(text) is not None for t in self.profile.ignore):
             return
         if job is not None:
-            self._attempt_failed(job, "garbage", f"unexpected reply {text!r} to {job.line!r}")
+            # not (yet) the reply: a debug line, a partial frame, a device's noise. The
+            # command may well have been carried out (a drawer that dispensed), so the
+            # attempt waits on for its reply; only its timeout ends it.
+            job.noise.append(("unexpected-line", f"unexpected reply {text!r} to {job.line!r}"))
         elif self._timed_out and self._is_reply(text):
             self._late_reply(self._timed_out.popleft(), text, at)
         else:
@@ -338,9 +352,8 @@ class DeviceBinding:
         if gen != self._generation or self._connection == "closed":
             return
         message = f"garbled data from {self.url} ({why}): {raw[:40]!r}"
-        if self._inflight is not None:
-            self._attempt_failed(self._inflight, "garbage", f"{self._who(self._inflight.item)}: "
-                                 f"{message}")
+        if self._inflight is not None:       # the reply may follow (see _on_line)
+            self._inflight.noise.append(("garbage", message))
         else:
             self._fault("garbage", f"{self._label()}: {message}")
 
@@ -363,6 +376,14 @@ class DeviceBinding:
     def _answered(self, job: _Job, text: str, at: float, values: Mapping[str, Any] | None,
                   exception: str | None) -> None:
         self._finish(job)
+        if job.noise:       # the reply came after noise: read, and the noise reported
+            kind, first = job.noise[0]
+            more = f" (and {len(job.noise) - 1} more line(s))" if len(job.noise) > 1 else ""
+            self._fault("garbage" if any(k == "garbage" for k, _ in job.noise) else kind,
+                        f"{self._who(job.item)}: {first}{more} before the reply {text!r}, "
+                        "which was read", item=job.item, line=job.line, reply=text,
+                        attempt=job.attempts)
+            job.noise.clear()
         latency = at - job.sent_at
         self.latencies.append(latency)
         details: dict[str, Any] = {"device": self.profile.name, "participant": job.item.participant,
@@ -410,8 +431,17 @@ class DeviceBinding:
         if job is None or job.seq != seq or self._connection == "closed":
             return  # answered (or superseded) meanwhile
         self._timed_out.append(job)
-        retry = self._report_attempt(job, "timeout", f"{self._who(job.item)}: no reply to "
-                                     f"{job.line!r} within {job.op.timeout_s * 1000:g} ms")
+        if job.noise:       # it answered only with noise: garbage, as a garbled reply is
+            kind, first = job.noise[0]
+            more = f" (and {len(job.noise) - 1} more line(s))" if len(job.noise) > 1 else ""
+            job.noise.clear()
+            retry = self._report_attempt(
+                job, "garbage", f"{self._who(job.item)}: {first}{more}, and no valid reply "
+                f"within {job.op.timeout_s * 1000:g} ms")
+        else:
+            retry = self._report_attempt(job, "timeout", f"{self._who(job.item)}: no reply "
+                                         f"to {job.line!r} within "
+                                         f"{job.op.timeout_s * 1000:g} ms")
         fallback = self.profile.fallback_for(job.item.participant)
         if not retry:   # the fallback applies now; the line is still held for the late reply
             self._give_up(job, f"timeout after {job.attempts} attempt(s)")
@@ -455,13 +485,6 @@ class DeviceBinding:
         self._fault(fault, message, item=job.item, action="retry" if retry else fallback.then,
                     line=job.line, attempt=job.attempts)
         return retry
-
-    def _attempt_failed(self, job: _Job, fault: str, message: str) -> None:
-        """Garbage: report, then retry or apply the participant's fallback (through
-        :meth:`_pump`, which gives up on a job out of attempts)."""
-        self._report_attempt(job, fault, message)
-        self._queue.appendleft(job)
-        self._pump()
 
     def _give_up(self, job: _Job, reason: str) -> None:
         participant = job.item.participant or ""

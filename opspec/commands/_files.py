@@ -1,12 +1,22 @@
-"""Checks the commands that read one spec and write another file share: the input is a regular
-file (pipes and devices are refused without blocking) and the output is not the input."""
+"""Checks every command makes on the files it is given: the input is a regular file (pipes and
+devices are refused without blocking), and no output option names a file the same command
+reads (``opspec run --trace SPEC`` would replace the spec with its own trace):
+:func:`refuse_overwrite`, the one check every command that writes a file makes."""
 
 from __future__ import annotations
 
 import os
+from collections.abc import Iterable
 from pathlib import Path
+from typing import Any
 
-__all__ = ["input_problem", "same_file"]
+from opspec.errors import ConfigurationError
+
+__all__ = ["Named", "check_nesting", "input_problem", "overwrite_problem", "refuse_overwrite",
+           "same_file", "spec_inputs"]
+
+#: a file as the command line names it: (the option or argument, e.g. ``"--trace"``, path)
+Named = tuple[str, "str | os.PathLike[str] | None"]
 
 
 def input_problem(path: Path) -> str | None:
@@ -27,3 +37,85 @@ def same_file(source: Path, target: Path) -> bool:
             return source.resolve() == target.resolve()
         except (OSError, RuntimeError):
             return False
+
+
+def _inside(path: Path, folder: Path) -> bool:
+    try:
+        return path.resolve().is_relative_to(folder.resolve())
+    except (OSError, RuntimeError):
+        return False
+
+
+def overwrite_problem(command: str, writes: Iterable[Named], reads: Iterable[Named], *,
+                      folders: Iterable[Named] = (), example: str = "") -> str | None:
+    """The message when a file the command writes (``writes``), or a file inside a folder it
+    fills (``folders``: every file there may be replaced), is one the command reads
+    (``reads``), naming both; ``None`` when none is. ``example``: a file name to suggest."""
+    instead = f", e.g. {example}" if example else ""
+    inputs = [(what, Path(path)) for what, path in reads if path]
+    for what, path in writes:
+        if not path:
+            continue
+        target = Path(path)
+        for read_as, source in inputs:
+            if same_file(source, target):
+                shown = (f"{target}" if str(target) == str(source)
+                         else f"{target} (the same file as {source})")
+                return (f"opspec {command}: {what} {shown} is the file this command reads as "
+                        f"{read_as}; refusing to overwrite it (give {what} another file"
+                        f"{instead})")
+    for what, path in folders:
+        if not path:
+            continue
+        for read_as, source in inputs:
+            if _inside(source, Path(path)):
+                return (f"opspec {command}: {what} writes into {path}, which holds "
+                        f"{source}, a file this command reads as {read_as}; refusing to "
+                        f"overwrite it (move {read_as} out of it, or choose another folder)")
+    return None
+
+
+def refuse_overwrite(command: str, writes: Iterable[Named], reads: Iterable[Named], *,
+                     folders: Iterable[Named] = (), example: str = "") -> None:
+    """Raise a :class:`ConfigurationError` (exit status 2, nothing written) when an output
+    would replace an input (:func:`overwrite_problem`)."""
+    problem = overwrite_problem(command, writes, reads, folders=folders, example=example)
+    if problem is not None:
+        raise ConfigurationError(problem.removeprefix(f"opspec {command}: "))
+
+
+def spec_inputs(spec: str | os.PathLike[str], package: Any) -> list[Named]:
+    """The files a run of the spec at ``spec`` reads besides the spec: its world file
+    (``opspec:WorldFile``) and the specs its modes load (``opspec:Mode Source``), relative to
+    the spec's folder."""
+    base = Path(spec).parent
+    found: list[Named] = []
+    for attribute in getattr(package, "extended_attributes", ()):
+        if attribute.name == "opspec:WorldFile" and attribute.value:
+            found.append(("its opspec:WorldFile", base / attribute.value))
+    for mode in getattr(package, "modes", ()):
+        if mode.source:
+            found.append((f"the Source of its mode {mode.id!r}", base / mode.source))
+    return found
+
+
+def check_nesting(path: str | os.PathLike[str], what: str) -> None:
+    """A :class:`ConfigurationError` at ``path`` when the TOML file nests deeper than opspec
+    reads (:data:`opspec.files.MAX_NESTING`), for readers that parse with ``tomllib`` itself
+    (the engine configuration): Python's parser recurses once per level, and 100,000 ``[``
+    would end in an internal error. Anything else wrong is left for the reader to say."""
+    import tomllib
+
+    from opspec.errors import SourceLocation
+    from opspec.files import MAX_NESTING, read_text, toml_loads
+
+    try:
+        toml_loads(read_text(path))
+    except tomllib.TOMLDecodeError as error:
+        if "nest too deeply" in str(error):
+            raise ConfigurationError(f"{what} is not valid TOML: {error}",
+                                     location=SourceLocation(str(path)),
+                                     hint="check the brackets: opspec reads at most "
+                                     f"{MAX_NESTING} levels") from None
+    except (OSError, UnicodeDecodeError):
+        pass

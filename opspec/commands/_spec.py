@@ -8,12 +8,14 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from opspec.errors import ConfigurationError
+from opspec.model.nesting import MAX_BLOCK_NESTING, nesting_problem
 
 if TYPE_CHECKING:
     from opspec.errors import Diagnostic
     from opspec.model import Package
 
-__all__ = ["engine_diagnostics", "load_any_spec"]
+__all__ = ["MAX_BLOCK_NESTING", "companion_user_model", "engine_diagnostics", "load_any_spec",
+           "nesting_problem"]
 
 
 def load_any_spec(path: str | Path, *, command: str | None = None,
@@ -50,13 +52,23 @@ def engine_diagnostics(package: Package, *, world: bool = False) -> list[Diagnos
     from opspec.properties.monitors import declared_monitors
 
     spec_file = SourceLocation(str(getattr(package, "source", None) or "<spec>"))
+    deep = nesting_problem(package)
+    if deep is not None:        # the compiler follows blocks recursively: stop before it
+        return [Diagnostic(deep.location or spec_file, Severity.ERROR, NOT_RUNNABLE,
+                           deep.message, deep.hint)]
     try:
         compiled = compile_package(package)
     except OpspecError as error:
         # what the engine refuses, validate refuses: at its line, as the run would say it
         return [Diagnostic(error.location or spec_file, Severity.ERROR, NOT_RUNNABLE,
                            error.message, error.hint or "")]
-    out: list[Diagnostic] = []
+    out: list[Diagnostic] = [
+        Diagnostic(metric.location or spec_file, Severity.WARNING, "metric-name",
+                   f"metric name {metric.name!r} is not a simple identifier; the file names "
+                   "of its figures (opspec evaluate) use a changed name",
+                   "name metrics with letters, digits and '_', starting with a letter, "
+                   "such as doses_missed")
+        for metric in getattr(package, "metrics", ()) if not _simple(metric.name)]
     try:
         declared_monitors(compiled)
     except ConfigurationError as error:
@@ -71,3 +83,15 @@ def engine_diagnostics(package: Package, *, world: bool = False) -> list[Diagnos
             out.append(Diagnostic(error.location or spec_file, Severity.ERROR, "bad-world",
                                   error.message, error.hint or ""))
     return out
+
+
+def _simple(name: str) -> bool:
+    """A simple identifier: ASCII letters, digits and ``_``, not starting with a digit."""
+    return name.isascii() and name.isidentifier()
+
+
+def companion_user_model(spec_path: str | Path) -> Path | None:
+    """``SPEC.users.toml`` next to the spec, if there is one (the front hall's rule)."""
+    from opspec.request import companion_user_model as companion
+
+    return companion(spec_path)

@@ -97,6 +97,14 @@ def run(args: argparse.Namespace) -> int:
         # (a condition opspec cannot parse, a duplicate lane id) is still checked
         package = result.package
         errors = tuple(_spec_errors(package, errors, result.packages))
+        from opspec.commands._spec import nesting_problem
+
+        if nesting_problem(package) is not None:
+            # blocks nested past what the compiler and the exploration follow (listed
+            # among the errors): nothing can be checked
+            _print_unloadable(path, errors, as_json=args.json)
+            worst = max(worst, 1)
+            continue
         processes = [p for p in package.processes
                      if args.process is None or p.id == args.process]
         if args.process is not None and not processes:

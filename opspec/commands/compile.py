@@ -30,7 +30,7 @@ def register(subparsers: Any) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    from opspec.commands._files import input_problem, same_file
+    from opspec.commands._files import input_problem, overwrite_problem
     from opspec.commands.validate import engine_checks
     from opspec.errors import SpecError
     from opspec.xpdl.compile import compile_spec, default_output
@@ -42,10 +42,14 @@ def run(args: argparse.Namespace) -> int:
         print(f"opspec compile: cannot read {source}: {problem}", file=sys.stderr)
         return 2
     target = Path(args.output) if args.output else default_output(source)
-    if same_file(source, target):
-        print(f"opspec compile: the output {target} is the input file itself; refusing to "
-              f"overwrite it (give -o another file, e.g. {source.with_suffix('.wfs').name} "
-              "beside it)", file=sys.stderr)
+    from opspec.commands._spec import companion_user_model
+
+    overwrite = overwrite_problem("compile", [("-o", target)],
+                                  [("IN", source), ("IN's companion user model",
+                                                    companion_user_model(source))],
+                                  example=f"{source.with_suffix('.wfs').name} beside it")
+    if overwrite is not None:
+        print(overwrite, file=sys.stderr)
         return 2
     try:
         result = compile_spec(source, target, strict=args.strict, extra=engine_checks)

@@ -18,7 +18,7 @@ from pathlib import Path
 from typing import Any
 
 from opspec.commands._args import seed, share, sweep
-from opspec.errors import EvaluationError
+from opspec.errors import EvaluationError, OpspecError
 
 __all__ = ["register", "run"]
 
@@ -103,7 +103,11 @@ def register(subparsers: Any) -> None:
     parser.add_argument("--quiet", action="store_true", help="no progress output")
     parser.add_argument("--report-template", metavar="FILE",
                         help="a Jinja2 template for report.html (start from a copy of "
-                        "opspec/evaluation/templates/report.html.j2)")
+                        "opspec/evaluation/templates/report.html.j2). A template is code: it "
+                        "runs sandboxed, and one in the spec's own folder (it may have come "
+                        "with the spec) is refused unless --trust-spec-template is given")
+    parser.add_argument("--trust-spec-template", action="store_true",
+                        help="allow a --report-template that lies in the spec's folder")
     parser.set_defaults(handler=run)
 
 
@@ -137,8 +141,10 @@ def _default_out(spec: str) -> Path:
 def _engine(path: str | None) -> dict[str, Any]:
     if path is None:
         return {}
+    from opspec.commands._files import check_nesting
     from opspec.engine.config import EngineConfig
 
+    check_nesting(path, "the engine configuration")
     return asdict(EngineConfig.load(path))
 
 
@@ -348,6 +354,7 @@ def run(args: argparse.Namespace) -> int:
     if getattr(args, "report_template", None):   # read after the runs: refuse a bad one now
         from opspec.files import open_regular, reason
 
+        _refuse_spec_template(args)
         try:
             open_regular(args.report_template).close()
         except OSError as error:
@@ -378,6 +385,11 @@ def run(args: argparse.Namespace) -> int:
                 f"--out {args.out}`), or start a new run with another --out")
         _check_unchanged(store, plan)
         definitions = _check_plan(plan)     # the specs' warnings, as a new run shows them
+        try:
+            _refuse_inputs_in_out(args, plan, store.folder)
+        except OpspecError:
+            store.close()
+            raise
         from opspec.evaluation.sweep import check_targets, resumed_sweep
 
         try:
@@ -410,6 +422,7 @@ def run(args: argparse.Namespace) -> int:
         if (out / "results.sqlite").exists():
             raise EvaluationError(f"{out} already holds an evaluation",
                                   hint="add --resume to finish it, or choose another --out")
+        _refuse_inputs_in_out(args, plan, out)
         if plan.export:                     # before anything is created
             _export_estimate(plan, out, quiet=args.quiet)
         store = ResultStore(out, create=True)
@@ -481,6 +494,9 @@ def run(args: argparse.Namespace) -> int:
                 hint="the results are stored; free some space and run `opspec evaluate "
                 f"--resume --out {store.folder}` to write the report again") from None
         failures = store.failures()
+        counts = _replication_counts(store, plan, failures)
+    from opspec.evaluation.failures import kind_of
+
     if args.json:
         doc = {"spec": plan.design("A").spec, "users": plan.users, "days": plan.days,
                "seed": plan.seed, "user_model": plan.user_model, "workers": workers,
@@ -488,7 +504,9 @@ def run(args: argparse.Namespace) -> int:
                "out": str(store.folder), "report": str(report), "metrics": metrics,
                "monitors": monitors, "population": population,
                "input_uncertainty": uncertainty,
-               "failed": [{"design": d, "user": u, "error": e} for d, u, e in failures],
+               "replications": counts,
+               "failed": [{"design": d, "user": u, "error": e, "kind": kind_of(e)}
+                          for d, u, e in failures],
                "wall_s": round(outcome.wall_s, 3)}
         if compare is not None:
             doc["compare"] = compare
@@ -513,6 +531,66 @@ def run(args: argparse.Namespace) -> int:
             print_sweep(sys.stdout, summaries["sweep"], plan.users)
         print(f"results: {store.path}\nreport: {report}")
     return 1 if failures else 0
+
+
+def _refuse_spec_template(args: argparse.Namespace) -> None:
+    """A report template is code: one that lies in a spec's folder tree (it may have come
+    with a spec from elsewhere) is used only when the user says so."""
+    if getattr(args, "trust_spec_template", False):
+        return
+    template = Path(args.report_template)
+    for option, spec in (("SPEC", args.spec), ("--compare", args.compare)):
+        if not spec:
+            continue
+        try:
+            inside = template.resolve().is_relative_to(Path(spec).resolve().parent)
+        except (OSError, RuntimeError):
+            inside = False
+        if inside:
+            raise EvaluationError(
+                f"--report-template {template} lies in the folder of {option} {spec}; a "
+                "template is code, and one that came with a spec is not used unless asked",
+                hint="check the template, then add --trust-spec-template (or keep your "
+                "templates in a folder of your own)")
+
+
+#: what an evaluation writes into its output folder besides the exports and figures/
+OUT_FILES = ("results.sqlite", "results.sqlite-wal", "results.sqlite-shm", "report.html",
+             "report.md")
+
+
+def _refuse_inputs_in_out(args: argparse.Namespace, plan: Any, out: Path) -> None:
+    """No file the evaluation writes into ``out`` may be one it reads (exit 2, both
+    named): a report template named ``OUT/report.html``, a spec in ``OUT/figures/``…"""
+    from opspec.commands._files import refuse_overwrite, spec_inputs
+    from opspec.evaluation.replication import prepare
+
+    reads: list[Any] = []
+    for design in plan.designs:
+        what = "SPEC" if design.label == "A" else f"design {design.label}"
+        reads.append((what, design.spec))
+        # loaded once per process already (_check_plan): the same context, from its cache
+        package = prepare(design.spec, design.sha256, plan.user_model, plan.engine,
+                          design.parameters).compiled.package
+        reads.extend(spec_inputs(design.spec, package))
+    reads += [("--report-template", getattr(args, "report_template", None)),
+              ("--engine-config", args.engine_config)]
+    if plan.user_model and Path(plan.user_model).exists():
+        reads.append(("the user model", plan.user_model))
+    writes = [(f"--out {out}: {name}", out / name) for name in (
+        *OUT_FILES, *(EXPORT_FILES[f] for f in plan.export),
+        *(EXPORT_FILES[f] + ".partial" for f in plan.export))]
+    refuse_overwrite("evaluate", writes, reads, folders=[(f"--out {out}", out / "figures")])
+
+
+def _replication_counts(store: Any, plan: Any, failures: list[tuple[str, int, str]]
+                        ) -> dict[str, Any]:
+    """Replications planned, complete (what every number is computed from) and failed."""
+    complete = {d.label: len(store.finished(d.label)) for d in plan.designs}
+    return {"planned": plan.users * len(plan.designs), "complete": sum(complete.values()),
+            "complete_by_design": complete,
+            "failed": sum(1 for d, _, _ in failures if d in complete),
+            "metrics_from": "complete replications only"}
 
 
 def _with_resume_hint(error: EvaluationError, store: Any, plan: Any) -> EvaluationError:

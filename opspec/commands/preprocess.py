@@ -45,7 +45,7 @@ def default_output(source: Path) -> Path:
 
 
 def run(args: argparse.Namespace) -> int:
-    from opspec.commands._files import input_problem, same_file
+    from opspec.commands._files import input_problem, overwrite_problem
     from opspec.commands.validate import engine_checks
     from opspec.errors import Severity
     from opspec.model.codec import write_atomically
@@ -63,10 +63,14 @@ def run(args: argparse.Namespace) -> int:
         return 2
     target = None if args.output == "-" else (
         Path(args.output) if args.output else default_output(source))
-    if target is not None and same_file(source, target):
-        print(f"opspec preprocess: the output {target} is the input file itself; refusing to "
-              f"overwrite it (give -o another file, e.g. {default_output(source).name})",
-              file=sys.stderr)
+    from opspec.commands._spec import companion_user_model
+
+    overwrite = overwrite_problem("preprocess", [("-o", target)],
+                                  [("IN", source), ("IN's companion user model",
+                                                    companion_user_model(source))],
+                                  example=default_output(source).name)
+    if overwrite is not None:
+        print(overwrite, file=sys.stderr)
         return 2
     # The spec is refused for exactly the errors `opspec validate` reports.
     package, report = validate_spec(source, strict=args.strict, extra=engine_checks)

@@ -118,6 +118,8 @@ def run(args: argparse.Namespace) -> int:
         print(f"opspec run: {warning}", file=sys.stderr)
     package, compiled = prepared.package, prepared.compiled
     horizon, user = prepared.horizon, prepared.user
+    if args.trace:
+        _refuse_trace_over_input(args, package)
     params = parse_params(args.param, package) or None      # a bad value stops us before the run
     config = _config(args)
     out = sys.stdout
@@ -221,6 +223,19 @@ def _waiting_for_absent_user(summary: dict[str, Any], compiled: Any, user: Any
     return absent
 
 
+def _refuse_trace_over_input(args: argparse.Namespace, package: Any) -> None:
+    """``--trace`` may not name a file this run reads (exit 2, both named)."""
+    from opspec.commands._files import refuse_overwrite, spec_inputs
+    from opspec.commands._spec import companion_user_model
+
+    reads = [("SPEC", args.spec), ("--script", args.script),
+             ("--user-model", args.user_model if args.user_model and Path(
+                 args.user_model).exists() else None),
+             ("the companion user model", companion_user_model(args.spec)),
+             ("--engine-config", args.engine_config), *spec_inputs(args.spec, package)]
+    refuse_overwrite("run", [("--trace", args.trace)], reads)
+
+
 def _real_deadlocks(result: RunResult, absent: list[dict[str, Any]]) -> list[dict[str, Any]]:
     return [d for d in result.summary.get("deadlocks") or [] if d not in absent]
 
@@ -258,6 +273,10 @@ def _print_monitors(out: Any, monitors: dict[str, Any]) -> None:
 def _config(args: argparse.Namespace) -> Any:
     from opspec.engine.config import EngineConfig
 
+    if args.engine_config:
+        from opspec.commands._files import check_nesting
+
+        check_nesting(args.engine_config, "the engine configuration")
     config = EngineConfig.load(args.engine_config) if args.engine_config else EngineConfig()
     overrides: dict[str, Any] = {}
     if args.processor_model:

@@ -92,7 +92,9 @@ def run(args: argparse.Namespace) -> int:
     if args.format in ("svg", "html"):
         from opspec.xpdl.picture import package_picture_dot, picture_html, render_svg
 
-        svg = render_svg(package_picture_dot(package, process=args.process))
+        dot_text = package_picture_dot(package, process=args.process)
+        _refuse_huge_picture(args, dot_text)
+        svg = render_svg(dot_text, timeout=PICTURE_SECONDS)
         text = svg if args.format == "svg" else picture_html(package, svg)
     elif args.format == "dot":
         text = package_to_dot(package, process=args.process)
@@ -362,3 +364,23 @@ def _condition(transition: Transition) -> str:
     if condition.kind is ConditionKind.DEFAULTEXCEPTION:
         return "  [default exception]"
     return ""
+
+
+#: The largest picture handed to Graphviz, in lines of its input (about one per node and
+#: edge): the layout's time and memory grow faster than the graph (a package of some
+#: 10,000 activities took minutes and gigabytes), and such a picture is unreadable anyway.
+PICTURE_MOST_LINES = 4000
+#: How long Graphviz may lay out a picture.
+PICTURE_SECONDS = 60.0
+
+
+def _refuse_huge_picture(args: argparse.Namespace, dot_text: str) -> None:
+    lines = dot_text.count("\n")
+    if lines > PICTURE_MOST_LINES:
+        from opspec.errors import ConfigurationError
+
+        raise ConfigurationError(
+            f"{args.spec}: the picture has {lines:,} nodes and edges, more than the "
+            f"{PICTURE_MOST_LINES:,} Graphviz is given to lay out",
+            hint="draw one process with --process ID, or write the graph with --format dot "
+            "and lay it out yourself")

@@ -117,6 +117,15 @@ def run(args: argparse.Namespace) -> int:
         args.record or Path("walkthroughs") / (
             f"{Path(args.spec).name.split('.')[0]}-{who}"
             f"{datetime.now(UTC).strftime('%Y%m%d-%H%M%S')}.json"))
+    if record is not None:
+        from opspec.commands._files import refuse_overwrite, spec_inputs
+
+        # the recording and its trace beside it (tui.session) may not replace an input
+        refuse_overwrite("walkthrough", [
+            ("--record", record), ("--record's trace", record.with_suffix(".trace.jsonl"))], [
+            ("SPEC", args.spec),
+            ("the user model", model_ref if model_ref and Path(model_ref).exists() else None),
+            *spec_inputs(args.spec, package)])
     with contextlib.ExitStack() as stack:
         performers: dict[str, Any] = {}          # the world: opspec.runs.build adds it
         notes: list[str] = list(spec_warnings)

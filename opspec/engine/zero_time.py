@@ -12,8 +12,9 @@ milliseconds) the run stops with a :class:`~opspec.errors.ZeroTimeCycleError` th
 processes, the activities that keep coming back and the simulated time.
 
 Real specifications take tens to a few thousand steps at one instant (the dispenser: under
-100); 500,000 take about one second from the Python source and less compiled, so a hang ends
-within seconds while no real run comes near the limit. ``OPSPEC_MAX_INSTANT_STEPS`` sets
+100). The limit is 50,000: a workflow that starts itself asynchronously piles up an instance
+(and, with the trace kept, its events) per step, and 500,000 steps of that took a minute and
+a gigabyte; 50,000 take a few seconds and some 150 MB, and no real run comes near them. ``OPSPEC_MAX_INSTANT_STEPS`` sets
 another limit (read when a simulation is created); ``Simulation.max_instant_steps`` sets it
 for one simulation.
 """
@@ -30,11 +31,11 @@ __all__ = ["INSTANT_STEPS_ENV", "MAX_INSTANT_STEPS", "SAMPLE_STEPS", "ZeroTimeSa
            "max_instant_steps"]
 
 #: Zero-time steps at one simulated instant before a run is stopped as a zero-time cycle.
-MAX_INSTANT_STEPS: Final = 500_000
+MAX_INSTANT_STEPS: Final = 50_000
 #: The environment variable that overrides :data:`MAX_INSTANT_STEPS` (a positive integer).
 INSTANT_STEPS_ENV: Final = "OPSPEC_MAX_INSTANT_STEPS"
 #: Steps past the limit watched to name what the cycle runs.
-SAMPLE_STEPS: Final = 10_000
+SAMPLE_STEPS: Final = 2_000
 
 _MAX_PROCESSES = 3
 _MAX_ACTIVITIES = 8

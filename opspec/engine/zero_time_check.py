@@ -7,7 +7,7 @@ reports only cycles that certainly take no time:
 
 - every activity of the cycle is *instantaneous* under the dedicated processor model: no
   implementation, a route, a throwing or none event, or an asynchronous subflow start, with no
-  duration, CPU demand, deadline, start/end trigger, boundary event, multi-instance loop or
+  duration (or one whose draws are all under :data:`ZENO_SECONDS`: a Zeno cycle), CPU demand, deadline, start/end trigger, boundary event, multi-instance loop or
   AND/OR/complex join (tasks are left out: a callable bound at run time may take time; so are
   manual activities, catching events, timers and synchronous subflows, which wait);
 - the cycle is reachable from a start of its level (conditions abstracted: any branch);
@@ -42,10 +42,34 @@ __all__ = ["KIND", "zero_time_cycles"]
 KIND = "zero-time-cycle"
 
 
+#: A duration every draw of which is shorter than this many seconds is taken as no time: a
+#: cycle through it moves the clock by so little per round (1e-17 s in a fuzzed spec) that
+#: the run is Zeno, stuck at one instant as surely as a cycle of no time at all.
+ZENO_SECONDS = 1e-9
+# draws of a duration's sampler looked at (seeded: the same answer every time)
+_PROBES = 32
+
+
+def _negligible(act: CompiledActivity) -> bool:
+    """Whether ``act``'s declared duration is no duration: every probe draw is under
+    :data:`ZENO_SECONDS` (none declared: trivially)."""
+    sampler = act.sampler
+    if sampler is None:
+        return True
+    import numpy as np
+
+    rng = np.random.default_rng(0)
+    try:
+        return all(sampler(rng) < ZENO_SECONDS for _ in range(_PROBES))
+    except Exception:  # noqa: BLE001 - a sampler that cannot draw: judged at run time
+        return False
+
+
 def _instant_body(act: CompiledActivity) -> bool:
-    """Instantaneous apart from a standard loop (which makes it a cycle of its own)."""
+    """Instantaneous apart from a standard loop (which makes it a cycle of its own); a
+    duration too short to move the clock (:data:`ZENO_SECONDS`) counts as none."""
     return (act.kind in (K_NOOP, K_THROW, K_ASYNC) and not act.deadlines and act.mi is None
-            and act.sampler is None and act.cpu == 0.0 and act.start_trigger is None
+            and _negligible(act) and act.cpu == 0.0 and act.start_trigger is None
             and act.end_trigger is None and not act.boundary and act.attached_to < 0
             and not act.choice and not act.terminate and act.coordination is None
             and (act.join == J_XOR or len(act.in_slots) <= 1))

@@ -183,8 +183,13 @@ def render_html(title: str, sections: Sequence[Section],
         raise EvaluationError(f"cannot read the report template {source}: {reason(error)}",
                               hint="give an existing Jinja2 template (copy "
                               f"{TEMPLATE} to start from)") from None
-    env = jinja2.Environment(autoescape=True, undefined=jinja2.StrictUndefined,
-                             keep_trailing_newline=True, trim_blocks=True, lstrip_blocks=True)
+    from jinja2.sandbox import SandboxedEnvironment
+
+    # a template is code: sandboxed, it sees the report's data and cannot reach Python's
+    # internals (no ``''.__class__.__mro__``, no calls of unsafe methods)
+    env = SandboxedEnvironment(autoescape=True, undefined=jinja2.StrictUndefined,
+                               keep_trailing_newline=True, trim_blocks=True,
+                               lstrip_blocks=True)
     try:
         return env.from_string(text).render(_context(title, sections))
     except jinja2.TemplateError as error:

@@ -31,7 +31,9 @@ class ReplicationRecord:
 
     design: str
     user: int
-    status: str                                   # "done" | "failed"
+    # "done" | "failed": failed also when the run had a run-time fault or a deadlock
+    # (opspec.evaluation.failures); its metrics are kept, its other rows are not stored
+    status: str
     error: str | None = None
     metrics: dict[str, dict[str, Any]] = field(default_factory=dict)
     samples: list[tuple[str, float, float]] = field(default_factory=list)  # metric, value, t
@@ -138,7 +140,8 @@ def prepare(spec: str, sha256: str, user_model: str | None, engine: Mapping[str,
 def run_user(context: _Context, design: str, user: int, *, seed: int, horizon: float,
              keep_trace: bool) -> ReplicationRecord:
     """Simulate user ``user`` of ``design`` (built by :func:`opspec.runs.build`, as every
-    run is: user ``user``'s streams); a failure becomes a ``failed`` record."""
+    run is: user ``user``'s streams); a failure (an error, a run-time fault, a deadlock:
+    :mod:`opspec.evaluation.failures`) becomes a ``failed`` record."""
     from opspec.runs import build
 
     start = time.perf_counter()
@@ -166,7 +169,12 @@ def run_user(context: _Context, design: str, user: int, *, seed: int, horizon: f
                                  error=f"internal error: {type(error).__name__}: {error}",
                                  wall_s=time.perf_counter() - start)
     result = outcome.result
-    record = ReplicationRecord(design, user, "done", metrics=result.metrics,
+    from opspec.evaluation.failures import run_problem
+
+    # a run-time fault or deadlock fails the replication (its metrics are not the spec's)
+    problem = run_problem(result.summary)
+    record = ReplicationRecord(design, user, "done" if problem is None else "failed",
+                               error=problem, metrics=result.metrics,
                                activities=recorder.counts, person=person)
     for seen in outcome.monitors:
         first = seen.violations[0] if seen.violations else None
@@ -179,9 +187,6 @@ def run_user(context: _Context, design: str, user: int, *, seed: int, horizon: f
         for t in times:
             key = (name, int(t // DAY), int((t % DAY) // 3600))
             record.outcomes[key] = record.outcomes.get(key, 0) + 1
-    problems = (result.summary.get("deadlocks") or []) + (result.summary.get("faults") or [])
-    if problems:
-        record.error = "; ".join(str(p.get("message")) for p in problems[:3])
     if keep_trace and result.trace is not None:
         record.trace = [event.to_json() for event in result.trace]
     record.wall_s = time.perf_counter() - start

@@ -62,6 +62,7 @@ from opspec.evaluation.tables import (
     subgroup_metric_rows,
     subgroup_rows,
 )
+from opspec.files import file_name
 
 __all__ = ["PLOT_SAMPLE", "Summaries", "write_report"]
 
@@ -483,7 +484,7 @@ def _design_sections(store: ResultStore, figures: Path, design: str, name: str, 
                     continue
                 images.append(plots.subgroups_figure(
                     d["name"], _subgroup_rates(store, design, d, groups),
-                    figures / f"{design}-{d['name']}-by-subgroup.png", unit="%"))
+                    figures / f"{design}-{file_name(d['name'])}-by-subgroup.png", unit="%"))
                 captions.append(f"Each user's own {d['name']}, over the users of each "
                                 "subgroup (outline histograms, share of the group's users)")
         sections.append(Section(f"{prefix}How users differ", paragraphs=(
@@ -511,7 +512,7 @@ def _design_sections(store: ResultStore, figures: Path, design: str, name: str, 
         marks = {"mean": s.get("mean"), "median": s.get("median"), "p95": s.get("p95")}
         unit = s.get("unit") or "s"
         images.append(plots.latency_figure(d["name"], values,
-                                           figures / f"{design}-{d['name']}.png",
+                                           figures / f"{design}-{file_name(d['name'])}.png",
                                            marks=marks, total=total,
                                            label=words(d["name"], unit), unit=unit))
         caption = (f"Distribution of {d['name']}"
@@ -786,8 +787,11 @@ def _write_report(store: ResultStore, summaries: Mapping[str, Summaries] | None,
             "difference") if "B" in designs else None))
 
     if failures:
+        from opspec.evaluation.failures import advice
+
+        todo = advice(failures)
         sections.append(Section("Failed replications", paragraphs=(
-            "Run `opspec evaluate --resume --out <this folder>` to run them again.",),
+            f"They are left out of every number above. {todo[:1].upper()}{todo[1:]}.",),
             tables=(Table(("specification", "user", "error"),
                           tuple((names.get(d, d), str(u), e) for d, u, e in failures[:200])),
                     )))

@@ -17,6 +17,10 @@ anyone who opens ``results.sqlite`` in another tool):
   ``user_model``, ``user_model_sha256``, ``opspec_version``, ``started``;
 - ``replication(design, user, status, error, metrics, wall_s)``: one row per user and design,
   ``metrics`` the user's declared metrics as JSON (the ``opspec run --json`` shape);
+  ``status`` ``failed`` when the replication could not run or had a run-time fault or a
+  deadlock (``error`` then starts ``fault:`` / ``deadlock:`` and names the first one's
+  file:line; :mod:`opspec.evaluation.failures`); the tables below hold complete
+  (``done``) replications only;
 - ``sample(design, user, metric, value, time)``: every duration observation, ``time`` the
   simulated time it ended;
 - ``outcome(design, user, metric, day, hour, n)``: count-metric events by day (0-based) and
@@ -184,8 +188,10 @@ class ResultStore:
 
     def finished(self, design: str) -> set[int]:
         """Users of ``design`` whose replication is stored as done."""
-        rows = self.query(
-            "SELECT user FROM replication WHERE design = ? AND status = 'done'", (design,))
+        # done with an error: a run-time fault stored as done before faults failed a
+        # replication; --resume runs it again rather than accept it
+        rows = self.query("SELECT user FROM replication WHERE design = ? AND status = 'done' "
+                          "AND error IS NULL", (design,))
         return {int(r[0]) for r in rows}
 
     def add(self, record: ReplicationRecord) -> None:
@@ -232,15 +238,18 @@ class ResultStore:
                            [(r.design, r.user, r.status, r.error,
                              json.dumps(r.metrics, allow_nan=True), r.wall_s)
                             for r in records])
-            _insert(db, "sample", [(r.design, r.user, m, v, t) for r in records
+            # a failed replication keeps its metrics (its replication row) and nothing
+            # else: every reader of the other tables reads complete replications only
+            complete = [r for r in records if r.status == "done"]
+            _insert(db, "sample", [(r.design, r.user, m, v, t) for r in complete
                                    for m, v, t in r.samples])
-            _insert(db, "outcome", [(r.design, r.user, m, d, h, n) for r in records
+            _insert(db, "outcome", [(r.design, r.user, m, d, h, n) for r in complete
                                     for (m, d, h), n in r.outcomes.items()])
-            _insert(db, "activity", [(r.design, r.user, a, *c) for r in records
+            _insert(db, "activity", [(r.design, r.user, a, *c) for r in complete
                                      for a, c in r.activities.items()])
-            _insert(db, "monitor", [(r.design, r.user, m, *v) for r in records
+            _insert(db, "monitor", [(r.design, r.user, m, *v) for r in complete
                                     for m, v in r.monitors.items()])
-            people = [r for r in records if r.person is not None]    # a population's users
+            people = [r for r in complete if r.person is not None]    # a population's users
             _insert(db, "person", [(r.design, r.user, r.person[0]) for r in people
                                    if r.person])
             _insert(db, "person_parameter", [(r.design, r.user, n, v) for r in people
@@ -254,7 +263,7 @@ class ResultStore:
         if again:
             self._outcome_sums = None
         elif self._outcome_sums is not None:
-            for r in records:
+            for r in complete:
                 sums = self._outcome_sums.setdefault(r.design, {})
                 days: dict[tuple[str, int], int] = {}
                 for key, n in r.outcomes.items():
@@ -291,14 +300,16 @@ class ResultStore:
             (design,))]
 
     def failures(self) -> list[tuple[str, int, str]]:
+        """``(design, user, error)`` of every failed replication (also one stored as done
+        with an error by an older opspec: a run-time fault), by design and user."""
         rows = self.query("SELECT design, user, error FROM replication "
-                          "WHERE status != 'done' ORDER BY design, user")
+                          "WHERE status != 'done' OR error IS NOT NULL ORDER BY design, user")
         return [(str(d), int(u), str(e)) for d, u, e in rows]
 
     def user_metrics(self, design: str) -> Iterator[tuple[int, dict[str, dict[str, Any]]]]:
-        """(user, metrics) of every finished replication of ``design``, by user."""
+        """(user, metrics) of every complete replication of ``design``, by user."""
         rows = self.query("SELECT user, metrics FROM replication WHERE design = ? AND "
-                          "status = 'done' ORDER BY user", (design,))
+                          "status = 'done' AND error IS NULL ORDER BY user", (design,))
         for user, metrics in rows:
             yield int(user), json.loads(metrics)
 

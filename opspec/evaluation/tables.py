@@ -285,10 +285,16 @@ def print_summary(out: IO[str], plan: Any, metrics: Mapping[str, Any],
     design = plan.design("A")
     print(f"opspec evaluate: {design.spec}, {plan.users} users x {span(plan.days)}, seed "
           f"{plan.seed}, user model {plan.user_model or 'none'}", file=out)
-    ran = f"{outcome.done} replications in {outcome.wall_s:.1f} s on {workers} worker(s)"
+    ran = (f"{outcome.done + outcome.failed} replications in {outcome.wall_s:.1f} s on "
+           f"{workers} worker(s)")
     if outcome.skipped:
         ran += f" ({outcome.skipped} already stored)"
     print(ran, file=out)
+    if failures:
+        planned = (plan.users + plan.input_uncertainty * plan.users_per_draw) * len(
+            plan.designs)
+        print(f"{len(failures)} of {planned} replications FAILED (listed below); every "
+              "number here is of the complete replications only", file=out)
     print(file=out)
     for line in table(METRIC_HEADERS, metric_rows(metrics)):
         print(line, file=out)
@@ -311,12 +317,18 @@ def print_summary(out: IO[str], plan: Any, metrics: Mapping[str, Any],
             for line in table(*subgroup_comparison_rows(population)):
                 print(line, file=out)
     if failures:
-        print(f"\n{len(failures)} replication(s) failed:", file=out)
+        from opspec.evaluation.failures import advice, kind_of
+
+        kinds: dict[str, int] = {}
+        for _, _, error in failures:
+            kinds[kind_of(error)] = kinds.get(kind_of(error), 0) + 1
+        print(f"\n{len(failures)} replication(s) failed ("
+              + ", ".join(f"{n} {k}" for k, n in sorted(kinds.items())) + "):", file=out)
         for design_label, user, error in failures[:10]:
             print(f"  {design_label}/{user}: {error}", file=out)
         if len(failures) > 10:
             print(f"  … and {len(failures) - 10} more", file=out)
-        print("run again with --resume --out <folder> to complete them", file=out)
+        print(advice(failures), file=out)
     # the intervals the tables above show (the exact shares of users only with a population)
     legend = method_legend([metrics, monitors, compare, population],
                            None if population else ("ci95_method",))

@@ -388,17 +388,38 @@ def load(obj: Any, *, where: str = "<.wfs document>") -> Package:
         raise SpecError(f"{where}: {error.message}", hint=error.hint) from None
     except _CorruptError as error:
         raise SpecError(
-            f"{where}: corrupt workflow script: {error}",
+            f"{where}: corrupt workflow script: {_short(str(error))}",
+            hint="recompile the XPDL with `opspec compile`",
+        ) from None
+    except (RecursionError, ValueError, OverflowError) as error:
+        # nested past what the decoder can follow, or a number no field can hold
+        raise SpecError(
+            f"{where}: corrupt workflow script: {type(error).__name__}: "
+            f"{_short(str(error))}",
             hint="recompile the XPDL with `opspec compile`",
         ) from None
     package_value: Package = result
     return package_value
 
 
+def _short(text: str, most: int = 200) -> str:
+    """``text`` cut to ``most`` characters (a corrupt value may be megabytes long)."""
+    return text if len(text) <= most else f"{text[:most]}… ({len(text):,} characters)"
+
+
+#: How deeply a ``.wfs`` document may nest (the dispenser's is 13 levels; each nested block
+#: activity adds a few): deeper is refused as not one of ours, before the decoder recurses.
+WFS_MAX_NESTING = 200
+
+
 def loads(text: str | bytes, *, where: str = "<.wfs text>") -> Package:
     """:func:`load` of JSON text; corrupt JSON is a :class:`SpecError` with its line."""
+    from opspec.files import json_loads
+
     try:
-        obj = json.loads(text)
+        # a compiled package nests a few dozen levels; far deeper is not one of ours, and
+        # would only exhaust the decoder's recursion (a number past Python's limit likewise)
+        obj = json_loads(text, most=WFS_MAX_NESTING)
     except json.JSONDecodeError as error:
         raise SpecError(
             f"corrupt workflow script (invalid JSON: {error.msg})",

@@ -35,6 +35,7 @@ import numpy as np
 
 from opspec.engine.trace import TRACE_FORMAT, TRACE_FORMAT_VERSION, EventKind, TraceEvent
 from opspec.errors import SourceLocation, UserModelError
+from opspec.files import json_loads
 from opspec.statistics import rate_interval
 from opspec.usermodels.distributions import Constant, Distribution, Gamma, LogNormal, Weibull
 from opspec.usermodels.errors import Busy, Commission, Omission
@@ -81,7 +82,7 @@ def read_trace(path: str | Path) -> Iterator[TraceEvent]:
             if not line.strip():
                 continue
             try:
-                obj = json.loads(line)
+                obj = json_loads(line)
             except json.JSONDecodeError as error:
                 raise UserModelError(f"not valid JSON: {error.msg}",
                                      location=SourceLocation(name, number),

@@ -8,6 +8,7 @@ a comma-separated composition ``BASE,MODIFIER,...`` (``specs/x.users.toml,older-
 
 from __future__ import annotations
 
+import contextvars
 import math
 import tomllib
 from collections.abc import Mapping
@@ -18,6 +19,7 @@ from typing import Any
 import tomli_w
 
 from opspec.errors import SourceLocation, UserModelError
+from opspec.files import toml_loads
 from opspec.usermodels.distributions import Distribution, ParameterError, make_distribution
 from opspec.usermodels.errors import Busy, Commission, ExtraDelay, Omission, Repetition
 from opspec.usermodels.model import ActivityModel, Modifier, UserModel
@@ -286,9 +288,7 @@ def parse_user_model(doc: Mapping[str, Any], path: str = "<toml>", *,
     if "operators" in doc:
         ctx.operators = _operators(ctx, doc["operators"])
     if base is None and "extends" in doc:
-        ref = _string(ctx, doc["extends"], "extends")
-        local = Path(path).parent / ref
-        base = load_user_model(str(local) if local.is_file() else ref)
+        base = load_named(ctx, _string(ctx, doc["extends"], "extends"), path)
     activities: dict[str, ActivityModel] = dict(base.activities) if base else {}
     raw_activities = doc.get("activities", {})
     ctx.table(raw_activities, "activities", tuple(raw_activities)
@@ -327,6 +327,55 @@ def parse_user_model(doc: Mapping[str, Any], path: str = "<toml>", *,
             population = population_loader.compose(ctx, doc, base.population, modifier)
         model = replace(model, population=population)
     return model
+
+
+#: How many files an ``extends`` chain may pass through (A extends B extends C…).
+MAX_EXTENDS = 32
+
+# the files being extended, outermost first, while their bases load (a cycle comes back to
+# one of them)
+_EXTENDING: contextvars.ContextVar[tuple[Path, ...]] = contextvars.ContextVar(
+    "opspec_user_model_extending", default=())
+
+
+def load_named(ctx: _Ctx, ref: str, path: str, key: str = "extends",
+              base: UserModel | None = None) -> UserModel:
+    """The model ``extends = ref`` (or another ``key``: a subgroup's ``extends`` and
+    ``apply``, loaded on ``base``) names in the file ``path``: a file relative to it, read
+    only inside its folder tree and :data:`opspec.files.EXTERNAL_PATH_VARIABLE` (as a spec's
+    ExternalPackage), or a preset; an ``extends`` that comes back to a file being extended,
+    or a chain of more than :data:`MAX_EXTENDS` files, is a located error."""
+    from opspec.files import EXTERNAL_PATH_VARIABLE, allowed_roots, outside_roots
+
+    here = Path(path)
+    local = here.parent / ref
+    word = key.rsplit(".", 1)[-1]
+    chain = _EXTENDING.get()
+    own = here.resolve() if here.is_file() else None
+    if own is not None and own in chain:
+        shown = " -> ".join(str(p) for p in (*chain[chain.index(own):], own))
+        raise ctx.error(key, f"{word} {ref!r} comes back to {path}: a cycle ({shown})",
+                        hint="a user model may extend another, never itself")
+    if len(chain) >= MAX_EXTENDS:
+        raise ctx.error(key, f"{word} {ref!r}: more than {MAX_EXTENDS} user models extend "
+                        "one another", hint="shorten the chain of extends")
+    if local.is_file() or Path(ref).is_absolute() or "/" in ref or "\\" in ref:
+        roots = allowed_roots(path)
+        where = outside_roots(local, roots)
+        if where is not None:
+            raise ctx.error(key, f"{word} {ref!r} leads outside the user model's folder "
+                            f"({where}); opspec reads the files a user model names "
+                            f"only inside {' or '.join(str(r) for r in roots)}",
+                            hint="copy the base model beside this one, or allow its folder "
+                            f"with the environment variable {EXTERNAL_PATH_VARIABLE}")
+        if local.resolve() == own:
+            raise ctx.error(key, f"{word} {ref!r} is this file itself",
+                            hint="a user model may extend another, never itself")
+    token = _EXTENDING.set((*chain, own) if own is not None else chain)
+    try:
+        return load_user_model(str(local) if local.is_file() else ref, base=base)
+    finally:
+        _EXTENDING.reset(token)
 
 
 def preset_names() -> list[str]:

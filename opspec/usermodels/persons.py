@@ -30,6 +30,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from opspec.errors import SourceLocation, UserModelError
+from opspec.files import json_loads
 
 __all__ = ["PERSON_FROM", "PERSON_KEY", "PersonRule", "parse_person_options"]
 
@@ -50,7 +51,7 @@ def _header(path: Path) -> dict[str, object]:
         with io.TextIOWrapper(open_regular(path), encoding="utf-8") as handle:
             for line in handle:
                 if line.strip():
-                    head = json.loads(line)
+                    head = json_loads(line)
                     return head if isinstance(head, dict) else {}
     except (OSError, UnicodeDecodeError, json.JSONDecodeError):
         return {}

@@ -25,7 +25,7 @@ from typing import Any
 import numpy as np
 
 from opspec.usermodels.distributions import ParameterError
-from opspec.usermodels.loader import POPULATION_KEYS, _Ctx, load_user_model, parse_user_model
+from opspec.usermodels.loader import POPULATION_KEYS, _Ctx, load_named, parse_user_model
 from opspec.usermodels.model import Modifier, UserModel
 from opspec.usermodels.population import (
     Correlation,
@@ -248,11 +248,6 @@ def _subgroup(ctx: _Ctx, name: str | None, share: float, model: UserModel, varie
 # --------------------------------------------------------------------------- reading
 
 
-def _resolve(path: str, ref: str) -> str:
-    local = Path(path).parent / ref
-    return str(local) if local.is_file() else ref
-
-
 def _subgroup_model(ctx: _Ctx, table: Mapping[str, Any], key: str, name: str,
                     top: UserModel, path: str) -> UserModel:
     """The subgroup's model: ``extends`` (default: the file's own model), then each of
@@ -262,7 +257,7 @@ def _subgroup_model(ctx: _Ctx, table: Mapping[str, Any], key: str, name: str,
         ref = table["extends"]
         if not isinstance(ref, str):
             raise ctx.error(f"{key}.extends", f"must be a model file or preset, got {ref!r}")
-        model = load_user_model(_resolve(path, ref))
+        model = load_named(ctx, ref, path, f"{key}.extends")
     refs = table.get("apply", [])
     if isinstance(refs, str):
         refs = [refs]
@@ -270,7 +265,7 @@ def _subgroup_model(ctx: _Ctx, table: Mapping[str, Any], key: str, name: str,
         raise ctx.error(f"{key}.apply", "must be a list of model files or presets",
                         hint='for example apply = ["mci"]')
     for ref in refs:
-        model = load_user_model(_resolve(path, ref), base=model)
+        model = load_named(ctx, ref, path, f"{key}.apply", base=model)
     if model.population is not None:
         raise ctx.error(key, f"subgroup {name} is built on a population model "
                         f"({model.path})", hint="a subgroup is one kind of person: extend "

@@ -31,6 +31,7 @@ from typing import TYPE_CHECKING, Any
 from xml.etree import ElementTree
 
 from opspec.errors import ConfigurationError, SourceLocation
+from opspec.files import toml_load, toml_loads
 from opspec.worlds.base import World
 from opspec.worlds.room import RoomWorld
 from opspec.worlds.sumo import SumoWorld
@@ -102,7 +103,7 @@ def _inline_parameters(attribute: ExtendedAttribute) -> dict[str, Any]:
                 location=attribute.location)
         text = element.get("Value", "")
         try:
-            params[element.get("Name", "")] = tomllib.loads(f"v = {text}")["v"]
+            params[element.get("Name", "")] = toml_loads(f"v = {text}")["v"]
         except tomllib.TOMLDecodeError:
             params[element.get("Name", "")] = text          # a bare word: a string
     return params

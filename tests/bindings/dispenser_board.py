@@ -12,7 +12,9 @@ Protocol (115200 8N1, lines end with "\\n"):
 
 The simulated user presses *report* once per dose, ``--press-ms`` after the first ALARM ON
 of that dose (a DISPENSE ends the dose). Faults: ``--garbage N`` answers the first N commands
-with garbled bytes (``--noise``: unsolicited junk after the first DISPENSE);
+with garbled bytes (``--noise``: unsolicited junk after the first DISPENSE;
+``--noise-before``: noise lines, a garbled and a cut-off frame before each DISPENSE reply,
+which then comes in two pieces);
 ``--late-ms MS --late-count N`` sends the first N replies MS late;
 ``--jam`` / ``--empty`` make every DISPENSE fail; ``--unplug-on PREFIX --socat-pid PID`` pulls
 the cable (kills socat, so both ends of the pair vanish) when a command starting with PREFIX
@@ -45,6 +47,9 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--noise", action="store_true",
                         help="send a debug line, an unknown line and a garbled line 10 ms "
                         "after answering the first DISPENSE")
+    parser.add_argument("--noise-before", action="store_true",
+                        help="before each reply to DISPENSE: a debug line, an unknown line, "
+                        "a garbled line and a cut-off frame, then the reply in two pieces")
     parser.add_argument("--late-ms", type=float, default=0.0)
     parser.add_argument("--late-count", type=int, default=0)
     parser.add_argument("--jam", action="store_true")
@@ -130,6 +135,13 @@ def main(argv: list[str] | None = None) -> int:
             if commands <= args.garbage:
                 reply = GARBLED
             delay = args.late_ms / 1000 if commands <= args.late_count else 0.0
+            if args.noise_before and line.startswith("DISPENSE "):
+                # what a board with a chatty motor driver sends: noise, then the reply
+                for noise in (b"# motor 1840 ms\n", b"HELLO THERE\n", GARBLED, b"OK DISP\n"):
+                    send(noise, delay)
+                    delay += 0.01
+                send(reply[:5], delay)               # the reply, in two pieces
+                reply, delay = reply[5:], delay + 0.01
             send(reply, delay)
             if noisy and line.startswith("DISPENSE "):
                 noisy = False

@@ -343,8 +343,11 @@ def test_the_shipped_dispenser_profile_and_spec_agree_on_the_drawer_fault(
     fallback = profile.fallback_for("dispenser")
     assert (fallback.then, fallback.exception) == ("abort", "DispenserFault")
     url = f"emulator://{DEVICES / f'{SHIPPED}.toml'}?fault=garbage"
+    # garbage alone ends the attempt at its timeout (3 s wall: a reply may follow noise),
+    # 24,000 simulated seconds at 8,000x: the 08:00 dose's fallback comes at about 14:40,
+    # 1.6 s (wall) before the run ends at 18:20; the noon dose's DISPENSE waits behind it
     run = simulate([f"dispenser={url}"], script(tmp_path, ("after trg_2 30s", "press_report")),
-                   profiles=DEVICES, until=FIRST_DOSE)
+                   profiles=DEVICES, until=66000.0, speed=8000.0)
     failed = [e for e in run.result.trace or () if e.kind == "activity.failed"]
     assert [(e.activity, (e.data or {}).get("exception")) for e in failed] == [
         ("dispense", "DispenserFault")]

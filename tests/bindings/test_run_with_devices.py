@@ -146,7 +146,9 @@ def test_auto_without_a_device_falls_back_to_simulated_and_says_so(capsys, tmp_p
 @needs_pty
 def test_device_faults_are_on_the_screen_with_the_fallback_taken(board, capsys, tmp_path):
     server = board(on="pty", fault="garbage", profile=DATA / "test_dispenser.toml")
-    status, _, output = run(capsys, "--until", "43000", "--realtime", "--speed", "20000",
+    # garbage ends an attempt at its timeout (a reply may follow noise): timeout, hold,
+    # resend, timeout, 3 x 300 ms (wall), 2 simulated hours at 8,000x before 12:00
+    status, _, output = run(capsys, "--until", "43000", "--realtime", "--speed", "8000",
                             "--timeline", "brief", "--bind", f"alarm:test_dispenser={server.url}",
                             "--devices", str(DATA),
                             "--script", script(tmp_path, ("after trg_2 30s", "press_report")))

@@ -151,7 +151,7 @@ def test_compile_never_overwrites_its_input(tmp_path: Path, capsys: pytest.Captu
     before = spec.read_bytes()
     assert main(["compile", str(spec), "-o", str(spec)]) == 2
     err = capsys.readouterr().err
-    assert err.count("\n") == 1 and "is the input file itself; refusing to overwrite it" in err
+    assert err.count("\n") == 1 and "is the file this command reads as IN; refusing to overwrite it" in err
     assert spec.read_bytes() == before
 
 
@@ -190,7 +190,7 @@ def test_preprocess_never_overwrites_its_input(tmp_path: Path,
     before = spec.read_bytes()
     assert main(["preprocess", str(spec), "-o", str(spec)]) == 2
     err = capsys.readouterr().err
-    assert err.count("\n") == 1 and "is the input file itself; refusing to overwrite it" in err
+    assert err.count("\n") == 1 and "is the file this command reads as IN; refusing to overwrite it" in err
     assert spec.read_bytes() == before
     (tmp_path / "link.xpdl").symlink_to(spec)
     assert main(["preprocess", str(spec), "-o", str(tmp_path / "link.xpdl")]) == 2

@@ -193,7 +193,7 @@ def test_failed_replications_are_listed_exit_1_and_resume_completes_them(evaluat
     status, doc, _ = evaluate(str(SPEC), "--users", "3", "--days", "1", "--workers", "1",
                               "--out", out)
     assert status == 1
-    assert doc["failed"] == [{"design": "A", "user": 1,
+    assert doc["failed"] == [{"design": "A", "user": 1, "kind": "error",
                               "error": "the simulated device fell over"}]
     assert doc["metrics"]["doses_due"]["users"] == 2
     html = Path(doc["report"]).read_text(encoding="utf-8")

@@ -22,6 +22,13 @@ MANUAL = ["hear_alarm", "walk_to_dispenser", "press_report", "press_wrong_button
 CHOICES = {"choose_button": ["press_report", "press_wrong_button"]}
 
 OMISSION = "activities.hear_alarm.omission.probability"
+
+
+@pytest.fixture(autouse=True)
+def _specs_may_be_extended(monkeypatch: pytest.MonkeyPatch) -> None:
+    """The population files below (in tmp_path) extend the dispenser's model in specs/: a
+    folder a user model may name only when OPSPEC_EXTERNAL_PATH allows it."""
+    monkeypatch.setenv("OPSPEC_EXTERNAL_PATH", str(USERS.parent))
 WALK = "activities.walk_to_dispenser.duration.median"
 
 
