@@ -28,8 +28,10 @@ def parse_toml(text: str, *, where: str, error: type[OpspecError] = Configuratio
     """The document in ``text`` (read from ``where``); a syntax error is ``error`` with
     tomllib's message, which names the line and column (``what`` in front: ``the script is
     not valid TOML: …``)."""
+    from opspec.files import toml_loads
+
     try:
-        return tomllib.loads(text)
+        return toml_loads(text)           # nesting bounded: a syntax error, never recursion
     except tomllib.TOMLDecodeError as problem:
         said = f"{what} is not valid TOML" if what else "not valid TOML"
         raise error(_named(f"{said}: {problem}", where, location),

@@ -105,6 +105,7 @@ def run(args: argparse.Namespace) -> int:
     package, compiled = prepared.package, prepared.compiled
     model = prepared.user.source if prepared.user.kind == "model" else None
     factory = _model_factory(model, prepared.seed) if model is not None else None
+    model_ref = prepared.user_model          # its file, if it came from one
     replay = None
     if args.replay:
         from opspec.tui.replay import load_recording
@@ -140,6 +141,8 @@ def run(args: argparse.Namespace) -> int:
         # Textual would wait for keys that never come (< /dev/null, a pipe): refused below,
         # once the spec is known to start (its own error first), with nothing recorded
         terminal = sys.stdin.isatty() and sys.stdout.isatty()
+        if record is not None and not terminal:
+            _check_record_folder(record)        # an option's own error comes first
         from opspec.tui.app import WalkthroughApp
         from opspec.tui.session import WalkSession
 
@@ -189,6 +192,16 @@ def run(args: argparse.Namespace) -> int:
     # commands that replay it (quoted: they paste as they are)
     print("\n".join(session.summary_lines()))
     return 130 if interrupted else 1 if session.failure is not None else 0
+
+
+def _check_record_folder(record: Path) -> None:
+    """The folder ``--record`` writes to can be made (what the session would do first)."""
+    try:
+        record.parent.mkdir(parents=True, exist_ok=True)
+    except OSError as error:
+        raise ConfigurationError(
+            f"cannot write the recording {record}: {error.strerror or error}",
+            hint="give --record a path in a folder you can write to, or --no-record") from None
 
 
 def _model_factory(model: Any, seed: int) -> Any:

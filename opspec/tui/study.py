@@ -38,7 +38,6 @@ from __future__ import annotations
 
 import json
 import math
-import tomllib
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -140,14 +139,10 @@ def load_protocol(path: str | Path) -> Protocol:
     def bad(key: str, message: str, hint: str = "") -> ConfigurationError:
         return ConfigurationError(message, location=SourceLocation(where, key=key), hint=hint)
 
-    try:
-        data = tomllib.loads(source.read_text(encoding="utf-8"))
-    except OSError as error:
-        raise ConfigurationError(f"cannot read the protocol: {error.strerror or error}",
-                                 location=SourceLocation(where)) from None
-    except tomllib.TOMLDecodeError as error:
-        raise ConfigurationError(f"not valid TOML: {error}",
-                                 location=SourceLocation(where)) from None
+    from opspec.toml_files import read_toml
+
+    # the one reader of TOML people write: a pipe never blocks, nesting is bounded
+    data = read_toml(source, what="the protocol")
     study = data.get("study", {})
     if not isinstance(study, dict):
         raise bad("study", "must be a table")

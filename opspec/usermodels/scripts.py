@@ -44,7 +44,6 @@ entries are ``[when, action]`` pairs or tables ``{when = "...", do = "..."}``::
 
 from __future__ import annotations
 
-import json
 import re
 from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass, replace
@@ -55,6 +54,7 @@ from opspec.engine.builtin_performers import ScriptedUser, Step
 from opspec.engine.performers import WorkItem
 from opspec.engine.trace import EventKind, TraceEvent
 from opspec.errors import ConfigurationError, SourceLocation
+from opspec.files import json_loads
 
 __all__ = ["DEFAULTS", "Script", "ScriptEntry", "ScriptUser", "load_script", "parse_script",
            "script_format"]
@@ -320,7 +320,7 @@ def load_script(path: str | Path) -> Script:
     hint = ('a script file is TOML (steps = [...]) or a JSON object ({"steps": [...]}, as '
             "walkthroughs record)")
     try:
-        document = (json.loads(raw) if kind == "JSON" else
+        document = (json_loads(raw) if kind == "JSON" else   # nesting bounded (opspec.files)
                     parse_toml(raw.decode("utf-8"), where=where, what="the script", hint=hint))
     except ValueError as error:        # JSON, or bytes that are not UTF-8
         raise ConfigurationError(f"the script is not valid {kind}: {error}",
