@@ -160,7 +160,7 @@ class Flow(Part):
 
     def start_at(self, frame: Frame, index: int, _unused: Any) -> None:
         inst = frame.inst
-        if inst.state != RUNNING:
+        if inst.state != RUNNING or (frame.owner is not None and frame.owner.state != RUNNING):
             self._dropped(frame, self.start_at, index, None)
             return
         self.activities.start(frame, frame.graph.activities[index])
@@ -267,6 +267,32 @@ class Flow(Part):
                 self._frame_done(frame)
             else:
                 self.state.pending[frame] = None
+
+    def terminate_frame(self, frame: Frame, reason: str) -> None:
+        """A terminate end event inside an activity set (an embedded sub-process) ends that
+        sub-process only (BPMN 2.0 §13.5.6, §13.3.4): what still runs in it is stopped, its
+        queued and parked tokens are dropped, and its block activity completes, so the
+        parent's flow goes on after it."""
+        owner = frame.owner
+        assert owner is not None
+        if frame.queue:
+            frame.queue.clear()
+        for ai in list(frame.running.values()):
+            self.activities.stop(ai, TERMINATED, reason)
+        # tokens still in the ready queue see the frame is gone (its owner no longer runs)
+        frame.live = 0
+        frame.parked = 0
+        frame.joins.clear()
+        frame.ors.clear()
+        if frame.cjoins:
+            frame.cjoins.clear()
+        if frame.owed:
+            frame.owed.clear()
+        self.state.pending.pop(frame, None)
+        if frame in frame.inst.frames:
+            frame.inst.frames.remove(frame)
+        owner.child = None
+        self.activities.body_done(owner, None)
 
     def _ad_hoc_complete(self, frame: Frame) -> bool:
         """An ad-hoc set's AdHocCompletionCondition holds once one of its paths ended: the
@@ -394,6 +420,9 @@ class Flow(Part):
         if act.raises is not None and inst.state == RUNNING:
             self.triggers.broadcast(act.raises.kind, act.raises.name or "", None, inst, act)
         if act.terminate:
+            if frame.owner is not None:
+                self.terminate_frame(frame, f"end event {act.id!r}")
+                return None
             self.end_instance(inst, TERMINATED, f"end event {act.id!r}", notify_parent=False)
             parent = inst.parent
             if parent is not None and parent.state == RUNNING:
@@ -501,7 +530,7 @@ class Flow(Part):
         """A branch of a deferred choice: the performer's choice (or the caught event) *is*
         the chosen activity, which completes at once."""
         inst = frame.inst
-        if inst.state != RUNNING:
+        if inst.state != RUNNING or (frame.owner is not None and frame.owner.state != RUNNING):
             self._dropped(frame, self.performed, index, trans)
             return
         act = frame.graph.activities[index]
