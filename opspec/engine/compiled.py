@@ -217,7 +217,9 @@ class CompiledActivity:
     boundary: tuple[int, ...] = ()
     attached_to: int = -1
     interrupting: bool = True
-    upstream: frozenset[int] = frozenset()  # OR joins: activities that can reach this one
+    # OR joins: per incoming slot, the activities from which that slot's transition can be
+    # reached without passing through the join (BPMN 2.0 Table 13.3's directed paths)
+    or_reach: tuple[frozenset[int], ...] = ()
     fast: bool = False                       # instantaneous without any wait (no ActInst)
     plain: bool = False                      # waits, but without deadline/loop/trigger/boundary
     next: int = -1                           # the one unconditional successor, if that is all
@@ -514,25 +516,32 @@ class _Compiler:
                     "add a start event (or an activity without incoming transitions) in "
                     "front of the cycle")
         graph.activities = tuple(acts)
-        # OR joins need to know what can still reach them (the predecessors: only if any)
+        # OR joins need to know, per incoming transition, what can still reach it without
+        # passing through the join (only if there are any)
         if any(ca.join == J_OR for ca in acts):
             predecessors: dict[int, set[int]] = {i: set() for i in range(len(acts))}
             for i, outs in outgoing.items():
                 for ct in outs:
                     predecessors[ct.target].add(i)
             for ca in acts:
+                if ca.attached_to >= 0:     # a boundary event's token comes from its host
+                    predecessors[ca.index].add(ca.attached_to)
+            sources = {ct.index: i for i, outs in outgoing.items() for ct in outs}
+            for ca in acts:
                 if ca.join == J_OR:
                     graph.has_or_join = True
-                    seen: set[int] = set()
-                    stack = list(predecessors[ca.index])
-                    while stack:
-                        node = stack.pop()
-                        if node in seen:
-                            continue
-                        seen.add(node)
-                        stack.extend(predecessors[node])
-                    seen.discard(ca.index)
-                    ca.upstream = frozenset(seen)
+                    reach: list[frozenset[int]] = [frozenset()] * len(ca.in_slots)
+                    for ti, slot in ca.in_slots.items():
+                        seen: set[int] = set()
+                        stack = [sources[ti]]
+                        while stack:
+                            node = stack.pop()
+                            if node in seen or node == ca.index:
+                                continue
+                            seen.add(node)
+                            stack.extend(predecessors[node])
+                        reach[slot] = frozenset(seen)
+                    ca.or_reach = tuple(reach)
         return graph
 
     def activity(self, proc: WorkflowProcess, act: Activity, ca: CompiledActivity,

@@ -202,7 +202,10 @@ class Flow(Part):
                     self.state.pending[frame] = None
                 return
             else:                                   # OR join: resolved when the queue is dry
-                frame.ors[index] = frame.ors.get(index, 0) + 1
+                tokens = frame.ors.get(index)
+                if tokens is None:
+                    tokens = frame.ors[index] = [0] * len(act.in_slots)
+                tokens[act.in_slots[trans.index]] += 1
                 frame.parked += 1
                 frame.live -= 1
                 self.state.pending[frame] = None
@@ -329,10 +332,18 @@ class Flow(Part):
             if frame.inst.state != RUNNING:
                 continue
             fired = False
-            for join, count in list(frame.ors.items()):
-                if self._or_ready(frame, join):
-                    del frame.ors[join]
-                    frame.parked -= count
+            for join, tokens in list(frame.ors.items()):
+                if self._or_ready(frame, join, tokens):
+                    # one activation consumes one token of each incoming transition that
+                    # has one (BPMN 2.0 Table 13.3); tokens left over wait for the next
+                    for slot, count in enumerate(tokens):
+                        if count:
+                            tokens[slot] = count - 1
+                            frame.parked -= 1
+                    if not any(tokens):
+                        del frame.ors[join]
+                    else:
+                        self.state.pending[frame] = None
                     frame.live += 1
                     fired = True
                     self.state.ready.append((self.start_at, frame, join, None))
@@ -357,20 +368,26 @@ class Flow(Part):
                 else:
                     self._frame_done(frame)
 
-    def _or_ready(self, frame: Frame, join: int) -> bool:
-        upstream = frame.graph.activities[join].upstream
+    def _or_ready(self, frame: Frame, join: int, tokens: list[int]) -> bool:
+        """Whether OR join ``join`` is activated (BPMN 2.0 Table 13.3): some incoming
+        transition has a token, and every token elsewhere in the frame that can reach an
+        incoming transition without one (not passing through the join) can also reach one
+        that has a token."""
+        if not any(tokens):
+            return False
+        reach = frame.graph.activities[join].or_reach
         for ai in frame.running.values():
-            if ai.act.index in upstream:
+            if _or_blocks(reach, tokens, ai.act.index):
                 return False
-        for other, count in frame.ors.items():
-            if other != join and count and other in upstream:
+        for other, waiting in frame.ors.items():
+            if other != join and any(waiting) and _or_blocks(reach, tokens, other):
                 return False
         for other, counts in frame.joins.items():
-            if other in upstream and any(counts):
+            if any(counts) and _or_blocks(reach, tokens, other):
                 return False
         if frame.cjoins:
             for other, counts in frame.cjoins.items():
-                if other in upstream and any(counts):
+                if any(counts) and _or_blocks(reach, tokens, other):
                     return False
         return True
 
@@ -584,3 +601,15 @@ class Flow(Part):
         self.take(frame, trans)
         if not beside:
             self.token_gone(frame)
+
+
+def _or_blocks(reach: tuple[frozenset[int], ...], tokens: list[int], node: int) -> bool:
+    """A token at ``node`` holds an OR join back when it can reach an incoming transition
+    that has no token and none that has one."""
+    blocked = False
+    for slot, nodes in enumerate(reach):
+        if node in nodes:
+            if tokens[slot]:
+                return False
+            blocked = True
+    return blocked

@@ -85,7 +85,7 @@ class Frame:
         self.live = 0
         self.parked = 0
         self.joins: dict[int, list[int]] = {}
-        self.ors: dict[int, int] = {}
+        self.ors: dict[int, list[int]] = {}   # OR joins: tokens per incoming slot
         self.running: dict[int, ActivityInstance] = {}
         # complex joins: tokens per incoming slot, and the slots owed a token before the
         # join resets (after it fired; BPMN's "waiting for reset"); made when first needed
