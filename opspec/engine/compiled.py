@@ -138,6 +138,8 @@ class CTrigger:
     count: int = -1                        # period: number of firings (-1: no end)
     planned: bool = False                  # timer: a TimeDate / repeating interval whose
     #                                        firings are ``offset``, +``every``… (``count``)
+    anchored: bool = False                 # planned: ``offset`` is a date (else the firings
+    #                                        count from when the timer is armed)
 
 
 @dataclass(frozen=True, slots=True, eq=False)
@@ -444,7 +446,7 @@ class _Compiler:
         first = date if date is not None else period
         wait = _until(first, period, count) if date is not None else _constant(period)
         return CTrigger(kind="timer", offset=first, every=period, count=count, planned=True,
-                        seconds=wait, location=act.location)
+                        seconds=wait, location=act.location, anchored=date is not None)
 
     # -- graphs --------------------------------------------------------------------------
     def graph(self, proc: WorkflowProcess, name: str, activities: tuple[Activity, ...],

@@ -60,6 +60,17 @@ class Triggers(Part):
             ai.cleanup.append(lambda: discard(table, token))
         elif kind in ("timer", "period"):
             inst = ai.frame.inst
+            every = trig.every or 0.0
+            if persistent and trig.planned and every > 0.0 and trig.count != 1:
+                # a boundary timer with a timeCycle: every cycle while the activity runs
+                now = self.state.env._now
+                if trig.anchored:
+                    first = max(0, math.ceil((now - trig.offset) / every))
+                    self._cycle(ai, trig, handler, arg, trig.offset, first, trig.count)
+                else:
+                    self._cycle(ai, trig, handler, arg, now, 1,
+                                trig.count + 1 if trig.count >= 0 else -1)
+                return
             if trig.seconds is not None:
                 delay = float(trig.seconds(inst.scope, self.state.env._now))
             else:
@@ -76,6 +87,22 @@ class Triggers(Part):
             self.state.rules[rkey] = (lambda: condition(inst.scope, self.state.env._now),
                                  lambda: handler(ai, arg, None), ai)
             ai.cleanup.append(lambda: discard(self.state.rules, rkey))
+
+    def _cycle(self, ai: ActivityInstance, trig: CTrigger, handler: Any, arg: Any,
+               base: float, k: int, end: int) -> None:
+        """Fire boundary timer ``trig`` at ``base + k * every`` and, while ``ai`` still runs
+        (a non-interrupting event), at each following cycle before ``end`` (-1: no end):
+        BPMN 2.0 §10.4.5, a timeCycle "R3/PT10M" fires three times, ten minutes apart."""
+        if 0 <= end <= k:
+            return
+        every = trig.every or 0.0
+        delay = base + k * every - self.state.env._now
+
+        def fired(target: ActivityInstance, _unused: Any) -> None:
+            handler(target, arg, None)
+            if target.state == RUNNING:
+                self._cycle(target, trig, handler, arg, base, k + 1, end)
+        self.state.later(delay, fired, ai)
 
     def check_rules(self) -> None:
         for rkey, (cond, fire, ai) in list(self.state.rules.items()):
