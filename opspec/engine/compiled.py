@@ -262,6 +262,9 @@ class CompiledProcess:
     deadline: float | None
     mode: str | None
     location: SourceLocation | None
+    # several start events with a trigger (BPMN 2.0 §10.4.2: each one independent): each
+    # trigger with the start event it starts an instance at (only that one's path runs)
+    start_events: tuple[tuple[CTrigger, int], ...] = ()
 
 
 @dataclass(slots=True, eq=False)
@@ -851,21 +854,16 @@ class _Compiler:
         data: dict[str, Any] = {f.id: None for f in proc.formal_parameters}
         data.update({f.id: self.initial(f) for f in proc.data_fields})
         start = self.trigger_ref(directives.start_trigger)
+        start_events: tuple[tuple[CTrigger, int], ...] = ()
         if start is None:
-            for index in graph.starts:
-                ca = graph.activities[index]
-                if ca.trigger is not None and ca.kind == K_NOOP:
-                    trig = ca.trigger
-                    if trig.kind == "timer" and trig.planned:
-                        start = CTrigger(kind="period", every=trig.every, offset=trig.offset,
-                                         count=trig.count, location=trig.location)
-                    elif trig.kind == "timer" and trig.seconds is not None:
-                        every = float(trig.seconds({}, 0.0))
-                        start = CTrigger(kind="period", every=every, offset=every,
-                                         location=trig.location)
-                    else:
-                        start = trig
-                    break
+            start_events = tuple((_start_trigger(graph.activities[index].trigger), index)
+                                 for index in graph.starts
+                                 if graph.activities[index].trigger is not None
+                                 and graph.activities[index].kind == K_NOOP)
+            if start_events:
+                start = start_events[0][0]
+            if len(start_events) < 2:
+                start_events = ()
         if start is None and directives.period is not None:
             start = CTrigger(kind="period", every=directives.period, location=proc.location)
         if start is not None and start.kind == "timer" and not start.at and start.every:
@@ -881,7 +879,20 @@ class _Compiler:
             formals=tuple((f.id, f.mode) for f in proc.formal_parameters), priority=priority,
             lane=lane, start_trigger=start, end_trigger=self.trigger_ref(directives.end_trigger),
             auto_start=bool(auto), deadline=directives.deadline, mode=directives.mode,
-            location=proc.location)
+            location=proc.location, start_events=start_events)
+
+
+def _start_trigger(trig: CTrigger | None) -> CTrigger:
+    """The process start trigger a start event's trigger stands for: a timer start fires
+    periodically when it is a cycle (or, as a duration, every that long)."""
+    assert trig is not None
+    if trig.kind == "timer" and trig.planned:
+        return CTrigger(kind="period", every=trig.every, offset=trig.offset, count=trig.count,
+                        location=trig.location)
+    if trig.kind == "timer" and trig.seconds is not None:
+        every = float(trig.seconds({}, 0.0))
+        return CTrigger(kind="period", every=every, offset=every, location=trig.location)
+    return trig
 
 
 def _names(expression: Expression) -> set[str]:

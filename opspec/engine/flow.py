@@ -44,9 +44,10 @@ class Flow(Part):
     """Tokens through graphs: process instances, transitions, splits, joins (see the module docstring)."""
 
     def start_process(self, proc: CompiledProcess, data: Mapping[str, Any] | None = None, *,
-                      parent: ActivityInstance | None = None, trigger: str | None = None
-                      ) -> ProcessInstance:
-        """Create and start an instance of ``proc`` (its start activities are queued)."""
+                      parent: ActivityInstance | None = None, trigger: str | None = None,
+                      start: int = -1) -> ProcessInstance:
+        """Create and start an instance of ``proc``: its start activities are queued, or
+        only ``start`` when one of several triggered start events started it."""
         local = proc.data.copy()
         if data:
             local.update(data)
@@ -71,9 +72,13 @@ class Flow(Part):
                       {"trigger": trigger, "parent": parent.frame.inst.id if parent else None})
         frame = Frame(proc.graph, inst, None)
         inst.frames.append(frame)
-        for index in proc.graph.starts:
+        if start >= 0:
             frame.live += 1
-            self.state.ready.append((self.start_at, frame, index, None))
+            self.state.ready.append((self.start_at, frame, start, None))
+        else:
+            for index in proc.graph.starts:
+                frame.live += 1
+                self.state.ready.append((self.start_at, frame, index, None))
         if not proc.graph.starts:
             self.state.pending[frame] = None
         if proc.deadline is not None:

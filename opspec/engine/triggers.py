@@ -156,9 +156,10 @@ class Triggers(Part):
                     table.pop(token, None)
                 if ai.state == RUNNING:
                     handler(ai, arg, data)
-        for target in self.state.starts.get(key, ()):
+        for target, start in self.state.starts.get(key, ()):
             if self.is_active(target.id):
-                self.flow.start_process(target, self._fields(target, data), trigger=f"{kind}:{name}")
+                self.flow.start_process(target, self._fields(target, data),
+                                        trigger=f"{kind}:{name}", start=start)
         for target in self.state.ends.get(key, ()):
             self.terminate_all(target.id, f"end trigger {kind}:{name}")
 
@@ -197,10 +198,10 @@ class Triggers(Part):
                     return
         kind, name = key
         started = False
-        for target in self.state.starts.get(key, ()):
+        for target, start in self.state.starts.get(key, ()):
             if self.is_active(target.id):
                 child = self.flow.start_process(target, self._fields(target, data),
-                                           trigger=f"{kind}:{name}")
+                                                trigger=f"{kind}:{name}", start=start)
                 child.partner = _root(inst) if inst is not None else None
                 started = True
         if started:
@@ -378,30 +379,36 @@ class Triggers(Part):
     def arm_process(self, proc: CompiledProcess) -> None:
         """Arm the start and end triggers of ``proc`` (mode membership checked on firing)."""
         start = proc.start_trigger
-        if start is None:
+        if proc.start_events:
+            # several start events: each starts its own instance, with only its path
+            for trig, index in proc.start_events:
+                self._arm(trig, self._starter(proc, index), starts=(proc, index))
+        elif start is None:
             if proc.auto_start and self.is_active(proc.id):
                 self.flow.start_process(proc, trigger="auto")
         else:
-            self._arm(start, lambda trig: self._triggered_start(proc, trig))
+            self._arm(start, lambda trig: self._triggered_start(proc, trig), starts=(proc, -1))
         if proc.end_trigger is not None:
             self._arm(proc.end_trigger, lambda trig: self.terminate_all(
                 proc.id, f"end trigger {trig}"), ends=proc)
 
-    def _triggered_start(self, proc: CompiledProcess, trigger: str) -> None:
+    def _starter(self, proc: CompiledProcess, start: int) -> Callable[[str], None]:
+        return lambda label: self._triggered_start(proc, label, start)
+
+    def _triggered_start(self, proc: CompiledProcess, trigger: str, start: int = -1) -> None:
         if self.is_active(proc.id):
-            self.flow.start_process(proc, trigger=trigger)
+            self.flow.start_process(proc, trigger=trigger, start=start)
 
     def _arm(self, trig: CTrigger, fire: Callable[[str], None],
-             ends: CompiledProcess | None = None) -> None:
+             ends: CompiledProcess | None = None,
+             starts: tuple[CompiledProcess, int] | None = None) -> None:
         kind = trig.kind
         if kind in ("message", "signal"):
             state = self.state
-            table = state.ends if ends is not None else state.starts
             if ends is not None:
-                table.setdefault((kind, trig.name or ""), []).append(ends)
-            else:
-                proc = next(p for p in self.state.processes.values() if p.start_trigger is trig)
-                table.setdefault((kind, trig.name or ""), []).append(proc)
+                state.ends.setdefault((kind, trig.name or ""), []).append(ends)
+            elif starts is not None:
+                state.starts.setdefault((kind, trig.name or ""), []).append(starts)
         elif kind in ("timer", "period"):
             times = _occurrences(trig, self.state.env.now)
             self._next_timer(times, fire, f"{kind}")
