@@ -200,6 +200,7 @@ class CompiledActivity:
     start_trigger: CTrigger | None = None
     end_trigger: CTrigger | None = None
     terminate: bool = False                  # end event with Terminate result
+    error: str | None = None                 # error end event: its error code ("": none)
     deadlines: tuple[tuple[Evaluator, bool, str], ...] = ()   # (seconds, synchronous, exception)
     sampler: Sampler | None = None
     cpu: float = 0.0
@@ -617,6 +618,8 @@ class _Compiler:
                 result = (body.result or "").lower()
                 if result == "terminate" or body.trigger.kind is TriggerKind.TERMINATE:
                     ca.terminate = True
+                elif result == "error" or body.trigger.kind is TriggerKind.ERROR:
+                    ca.error = body.trigger.name or ""
                 elif result in ("message", "signal") and trig is not None:
                     ca.kind = K_THROW
                     ca.trigger = trig
@@ -811,7 +814,7 @@ class _Compiler:
                 ca.labelled = True
         for ca in acts:
             ca.simple_end = (not ca.end_assign and ca.kind != K_THROW and ca.raises is None
-                             and not ca.terminate)
+                             and not ca.terminate and ca.error is None)
             only = ca.out[0] if len(ca.out) == 1 else None
             if (only is not None and only.kind == T_NONE and not only.assignments
                     and not ca.otherwise and not ca.choice and not ca.terminate):

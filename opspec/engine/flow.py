@@ -276,6 +276,23 @@ class Flow(Part):
             else:
                 self.state.pending[frame] = None
 
+    def throw_error(self, frame: Frame, act: CompiledActivity, code: str) -> None:
+        """An error end event: the nearest enclosing sub-process or call activity with a
+        boundary error event (an EXCEPTION path) for ``code``, else one catching every error,
+        is cancelled and takes that path (BPMN 2.0 §10.4.1, §13.5.3). Uncaught, the error
+        aborts the instance that threw it (and so its callers) with a located fault."""
+        what = f"error {code!r}" if code else "an error without a code"
+        holder = frame.owner if frame.owner is not None else frame.inst.parent
+        while holder is not None:
+            if holder.state == RUNNING and _catches(holder.act, code):
+                self.activities.fail(holder, code or "error",
+                                     f"{what} thrown by end event {act.id!r}")
+                return
+            up = holder.frame
+            holder = up.owner if up.owner is not None else up.inst.parent
+        self.abort(frame.inst, act, f"{what} thrown by this end event is caught by no "
+                   "boundary error event of an enclosing sub-process or call activity")
+
     def terminate_frame(self, frame: Frame, reason: str) -> None:
         """A terminate end event inside an activity set (an embedded sub-process) ends that
         sub-process only (BPMN 2.0 §13.5.6, §13.3.4): what still runs in it is stopped, its
@@ -441,6 +458,9 @@ class Flow(Part):
                       act.participant)
         if act.raises is not None and inst.state == RUNNING:
             self.triggers.broadcast(act.raises.kind, act.raises.name or "", None, inst, act)
+        if act.error is not None:
+            self.throw_error(frame, act, act.error)
+            return None
         if act.terminate:
             if frame.owner is not None:
                 self.terminate_frame(frame, f"end event {act.id!r}")
@@ -594,8 +614,10 @@ class Flow(Part):
                         message: str, beside: bool) -> None:
         """Follow the EXCEPTION (or DEFAULTEXCEPTION) transition for ``exception``; without
         one, abort the instance (unless the exception path was to start ``beside``)."""
-        trans = next((t for t in act.exceptions if t.exception in (None, exception)),
-                     act.default_exception)
+        # the transition named for the exception, else one for every exception
+        trans = next((t for t in act.exceptions if t.exception == exception),
+                     next((t for t in act.exceptions if t.exception is None),
+                          act.default_exception))
         inst = frame.inst
         if trans is None:
             if not beside:
@@ -618,3 +640,10 @@ def _or_blocks(reach: tuple[frozenset[int], ...], tokens: list[int], node: int) 
                 return False
             blocked = True
     return blocked
+
+
+def _catches(act: CompiledActivity, code: str) -> bool:
+    """Whether ``act`` has an exception path (a boundary error event) for error ``code``."""
+    if act.default_exception is not None:
+        return True
+    return any(t.exception is None or t.exception == code for t in act.exceptions)
