@@ -362,10 +362,15 @@ class _Process:
                 what = ("it has no event definition" if kind is None
                         else f"opspec does not run {kind.removesuffix('EventDefinition')} events")
                 self.ctx.warning(event, "unsupported-element",
-                                 f"boundary event {event_id!r}: {what}; it and its outgoing flows "
-                                 "are ignored", "docs/bpmn.md lists the boundary events opspec "
-                                 "runs")
-                out.skipped.add(event_id)
+                                 f"boundary event {event_id!r}: {what}; it never fires, so its "
+                                 "outgoing flows never carry a token",
+                                 "docs/bpmn.md lists the boundary events opspec runs")
+                # kept as a boundary event that never fires: the nodes its flows lead to keep
+                # their incoming flows, so none of them starts when the process does
+                out.activities.append(self.plain(event, Event(
+                    position=EventPosition.INTERMEDIATE,
+                    trigger=Trigger(catching=True, attached_to=host,
+                                    interrupting=interrupting)), host))
                 continue
             trigger = trigger_of(event, self.defs, catching=True, attached_to=host,
                                  interrupting=interrupting)[0]
