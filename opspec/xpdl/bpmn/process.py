@@ -220,11 +220,15 @@ class _Process:
                                  "put vendor data inside bpmn:extensionElements")
             elif name in NODES or name in _SUB_PROCESSES:
                 if name in _SUB_PROCESSES and sub.get("triggeredByEvent") == "true":
-                    self.ctx.warning(sub, "unsupported-element",
-                                     f"event sub-process {sub.get('id')!r}: opspec does not run "
-                                     "event sub-processes; it and everything in it are ignored",
-                                     "model it as a boundary event on a sub-process, or as a "
-                                     "workflow with a message or signal start event")
+                    # refused, not skipped: a run without the handler the modeller drew would
+                    # look plausible and be wrong whenever its event happens
+                    self.ctx.error(sub, "unsupported-element",
+                                   f"event sub-process {sub.get('id')!r}: opspec does not run "
+                                   "event sub-processes (BPMN 2.0 §10.2.5), so it cannot run "
+                                   "this process as drawn",
+                                   "model it as a boundary event on a sub-process that holds "
+                                   "the rest of the process, or as a workflow with a message or "
+                                   "signal start event")
                     continue
                 nodes.append(sub)
             elif name == "sequenceFlow":
