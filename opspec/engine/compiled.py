@@ -74,6 +74,7 @@ __all__ = [
     "K_TASK",
     "K_THROW",
     "MI_ALL",
+    "MI_CANCEL",
     "MI_COMPLEX",
     "MI_NONE",
     "MI_ONE",
@@ -105,6 +106,7 @@ J_XOR, J_AND, J_OR, J_COMPLEX = range(4)
 S_XOR, S_AND, S_OR = range(3)
 # multi-instance flow conditions: when the token moves on
 MI_NONE, MI_ONE, MI_ALL, MI_COMPLEX = range(4)
+MI_CANCEL = 4    # BPMN completionCondition: like MI_COMPLEX, and the rest are cancelled
 # transition kinds
 T_NONE, T_COND, T_OTHERWISE, T_EXCEPTION, T_DEFAULT = range(5)
 # model kinds -> the above, made once (not a dict literal of enum keys per transition/activity)
@@ -750,7 +752,9 @@ class _Compiler:
             flow = {MIFlow.NONE: MI_NONE, MIFlow.ONE: MI_ONE, MIFlow.ALL: MI_ALL,
                     MIFlow.COMPLEX: MI_COMPLEX}[loop.flow]
             flow_cond = None
-            if flow == MI_COMPLEX:
+            if flow == MI_COMPLEX and loop.cancel_remaining:
+                flow = MI_CANCEL
+            if flow == MI_COMPLEX or flow == MI_CANCEL:
                 flow_cond = self.cond(loop.flow_condition, loop.flow_condition_text,
                                       act.location,
                                       f"ComplexMI_FlowCondition of activity {act.id!r}")

@@ -302,7 +302,11 @@ class Triggers(Part):
             # the interrupted activity's token moves on to the boundary path (below)
             group = ai.mi
             self.activities.stop(ai, TERMINATED, f"boundary event {event.id!r}")
-            if group is not None:
+            if group is not None and ai is group.holder:
+                # the whole multi-instance activity: every instance ends, one token moves on
+                self.activities.mi_cancel(group, frame, f"boundary event {event.id!r}")
+                frame.live += 1
+            elif group is not None:
                 group.members.remove(ai)
                 self.activities.mi_cancel(group, frame, f"boundary event {event.id!r}")
         else:
@@ -317,7 +321,12 @@ class Triggers(Part):
         self.state.emit_act(EK.DEADLINE_EXPIRED, inst, act,
                        {"exception": exception, "synchronous": synchronous, "deadline": delay})
         if synchronous:
+            group = ai.mi
             self.activities.stop(ai, TERMINATED, f"deadline {exception!r}")
+            if group is not None and ai is group.holder:
+                # the whole multi-instance activity: every instance ends, one token moves on
+                self.activities.mi_cancel(group, frame, f"deadline {exception!r}")
+                frame.live += 1
             self.flow.exception_flow(frame, act, exception,
                                  f"deadline of {delay:g} s expired ({exception!r})", False)
         else:

@@ -221,7 +221,8 @@ class MIFlow(enum.Enum):
 class Loop:
     """``Loop``: a standard loop (``condition``/``maximum``/``test_before``) or a
     multi-instance loop (``condition`` is the MI_Condition, the number of instances, with
-    ``parallel`` ordering, ``flow`` and the ComplexMI_FlowCondition ``flow_condition``)."""
+    ``parallel`` ordering, ``flow`` and the ComplexMI_FlowCondition ``flow_condition``;
+    ``cancel_remaining`` when it is BPMN's completionCondition)."""
 
     kind: LoopKind = LoopKind.STANDARD
     condition: Expression | None = None
@@ -232,6 +233,9 @@ class Loop:
     flow: MIFlow = MIFlow.ALL
     flow_condition: Expression | None = None
     flow_condition_text: str | None = None
+    # BPMN's completionCondition: once it holds, the instances still running are cancelled
+    # and those not started never start (XPDL's ComplexMI_FlowCondition lets them run on)
+    cancel_remaining: bool = False
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)

@@ -563,7 +563,8 @@ class _Process:
                     flow=MIFlow.COMPLEX if completion_text else MIFlow.ALL,
                     flow_condition_text=completion_text,
                     flow_condition=bpmn_condition(completion, completion_text, self.defs,
-                                                  "completionCondition"))
+                                                  "completionCondition"),
+                    cancel_remaining=completion_text is not None)
 
     def expression(self, element: etree._Element, text: str | None, what: str
                    ) -> Expression | None:
