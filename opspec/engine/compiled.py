@@ -61,6 +61,7 @@ from opspec.model.data import is_structured, structured_value
 __all__ = [
     "J_AND",
     "J_COMPLEX",
+    "J_COUNT",
     "J_OR",
     "J_XOR",
     "K_ASYNC",
@@ -103,6 +104,7 @@ KIND_NAMES = ("noop", "task", "manual", "subflow", "async-subflow", "catch", "th
               "coordination", "event-gateway")
 # joins and splits
 J_XOR, J_AND, J_OR, J_COMPLEX = range(4)
+J_COUNT = 4      # StartQuantity > 1 without another join: starts once per N arriving tokens
 S_XOR, S_AND, S_OR = range(3)
 # multi-instance flow conditions: when the token moves on
 MI_NONE, MI_ONE, MI_ALL, MI_COMPLEX = range(4)
@@ -154,6 +156,7 @@ class CTransition:
     exception: str | None
     assignments: tuple[tuple[str, Evaluator], ...]
     label: str | None = None          # a ScriptGrammar="Text" condition: a label, no test
+    tokens: int = 1                   # tokens sent along it: Quantity x CompletionQuantity
 
 
 @dataclass(frozen=True, slots=True, eq=False)
@@ -203,6 +206,7 @@ class CompiledActivity:
     end_trigger: CTrigger | None = None
     terminate: bool = False                  # end event with Terminate result
     error: str | None = None                 # error end event: its error code ("": none)
+    start_quantity: int = 1                  # J_COUNT: the tokens one start consumes
     deadlines: tuple[tuple[Evaluator, bool, str], ...] = ()   # (seconds, synchronous, exception)
     sampler: Sampler | None = None
     cpu: float = 0.0
@@ -491,7 +495,8 @@ class _Compiler:
                             for a in tr.assignments)
             ct = CTransition(index=ti, id=tr.id, target=by_id[tr.target], kind=kind,
                              condition=cond, exception=exc, assignments=assigns,
-                             label=(tr.condition.text or None) if kind == T_NONE else None)
+                             label=(tr.condition.text or None) if kind == T_NONE else None,
+                             tokens=tr.quantity * activities[by_id[tr.source]].completion_quantity)
             trans_by_id[tr.id] = ct
             outgoing[by_id[tr.source]].append(ct)
             incoming[by_id[tr.target]].append(ti)
@@ -669,6 +674,9 @@ class _Compiler:
                 ca.join_condition = self.cond(act.join.condition, act.join.condition_text,
                                               act.location,
                                               f"IncomingCondition of activity {act.id!r}")
+        if act.start_quantity > 1 and ca.join == J_XOR:
+            ca.join = J_COUNT
+            ca.start_quantity = act.start_quantity
         ca.in_slots = {ti: slot for slot, ti in enumerate(incoming)}
         ordered = list(outgoing)
         if act.split is not None and act.split.transition_refs:
@@ -821,6 +829,7 @@ class _Compiler:
                              and not ca.terminate and ca.error is None)
             only = ca.out[0] if len(ca.out) == 1 else None
             if (only is not None and only.kind == T_NONE and not only.assignments
+                    and only.tokens == 1
                     and not ca.otherwise and not ca.choice and not ca.terminate):
                 ca.next = only.target
 

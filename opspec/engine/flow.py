@@ -17,6 +17,7 @@ from typing import Any
 from opspec.engine.compiled import (
     J_AND,
     J_COMPLEX,
+    J_COUNT,
     K_THROW,
     S_XOR,
     CompiledActivity,
@@ -197,6 +198,17 @@ class Flow(Part):
                 for slot in range(len(counts)):
                     counts[slot] -= 1
                 frame.parked -= len(counts) - 1
+            elif join == J_COUNT:                  # StartQuantity: N tokens, one start
+                counts = frame.joins.get(index)
+                if counts is None:
+                    counts = frame.joins[index] = [0]
+                counts[0] += 1
+                if counts[0] < act.start_quantity:
+                    frame.parked += 1
+                    self.token_gone(frame)
+                    return
+                counts[0] = 0
+                frame.parked -= act.start_quantity - 1
             elif join == J_COMPLEX:
                 frame.parked += 1
                 frame.live -= 1
@@ -506,7 +518,7 @@ class Flow(Part):
                 self.abort(inst, act, f"a transition condition failed: {error.message}")
                 return None
             target = acts[trans.target]
-            if not target.join:
+            if not target.join and trans.tokens == 1:
                 if trans.assignments:
                     for target_name, fn in trans.assignments:
                         self.set_field(inst, None, target_name, fn(scope, now))
@@ -567,6 +579,10 @@ class Flow(Part):
         frame.live += 1
         self.state.ready.append((self.performed if performed else self._arrive, frame,
                             trans.target, trans))
+        if trans.tokens > 1:                # a thread split (WCP-42): one token each
+            for _ in range(trans.tokens - 1):
+                frame.live += 1
+                self.state.ready.append((self._arrive, frame, trans.target, trans))
 
     def performed(self, frame: Frame, index: int, trans: CTransition | None) -> None:
         """A branch of a deferred choice: the performer's choice (or the caught event) *is*

@@ -274,6 +274,11 @@ class Activity(Element):
     directives: ActivityDirectives = ActivityDirectives()
     coordination: CoordinationBuiltIn | None = None
     assignments: tuple[Assignment, ...] = ()
+    # XPDL 2.1 StartQuantity / CompletionQuantity, BPMN startQuantity / completionQuantity:
+    # the tokens that must arrive before it starts (thread merge, WCP-41), and the tokens it
+    # sends down each outgoing transition it takes (thread split, WCP-42)
+    start_quantity: int = 1
+    completion_quantity: int = 1
 
     @property
     def is_route(self) -> bool:

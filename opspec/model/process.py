@@ -48,6 +48,7 @@ class Transition(Element):
     target: str
     condition: Condition = Condition()
     assignments: tuple[Assignment, ...] = ()
+    quantity: int = 1          # XPDL 2.1 Transition Quantity: tokens sent along it each time
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)

@@ -68,7 +68,7 @@ from opspec.xpdl.bpmn.extensions import (
 )
 from opspec.xpdl.bpmn.nodes import NODES, build_node
 from opspec.xpdl.bpmn.scripts import bpmn_condition
-from opspec.xpdl.handlers.common import parse_int
+from opspec.xpdl.handlers.common import parse_int, quantity
 from opspec.xpdl.sisarl import (
     ACTIVITY_DIRECTIVES,
     PROCESS_DIRECTIVES,
@@ -469,7 +469,9 @@ class _Process:
             deadlines=tuple(boundary.deadlines.get(node_id, ())),
             loop=self.loop(element), join=join, split=split,
             directives=directive_values, coordination=coordination,
-            assignments=assignments(element, self.defs) + extra + tuple(data.assignments))
+            assignments=assignments(element, self.defs) + extra + tuple(data.assignments),
+            start_quantity=quantity(element, "startQuantity", self.ctx),
+            completion_quantity=quantity(element, "completionQuantity", self.ctx))
 
     @staticmethod
     def order(element: etree._Element, flows: list[str]) -> tuple[str, ...]:
