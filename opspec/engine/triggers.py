@@ -240,10 +240,13 @@ class Triggers(Part):
     def _take_kept(self, waiter: ProcessInstance, key: tuple[str, str]
                    ) -> tuple[Mapping[str, Any] | None, float] | None:
         """The oldest message kept for ``waiter``'s root instance, else for anyone; messages
-        kept longer than the configured ``message_ttl`` are lost on the way (a button pressed
-        hours before anyone asked is not an answer to the next question)."""
+        kept longer than the spec's ``opspec:MessageTTL`` (or the engine option
+        ``message_ttl``) are lost on the way (a button pressed hours before anyone asked is not
+        an answer to the next question); without either, a message waits for its catcher."""
         now = self.state.env._now
         ttl = self.state.config.message_ttl
+        if ttl is None:        # the spec's opspec:MessageTTL, else until caught
+            ttl = self.state.compiled.package.message_ttl or math.inf
         for box_key in ((waiter.root, key), (0, key)):
             box = self.state.kept.get(box_key)
             while box:
