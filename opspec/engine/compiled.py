@@ -14,6 +14,7 @@ What an activity *is* at run time is one of the ``K_*`` kinds below; the interpr
 
 from __future__ import annotations
 
+import datetime
 import re
 from collections.abc import Callable, Iterable, Mapping
 from dataclasses import dataclass, field
@@ -350,6 +351,17 @@ class _Compiler:
         dates = [a.body.trigger.date for p in package.processes for a in p.all_activities()
                  if isinstance(a.body, Event) and a.body.trigger.calendar
                  and a.body.trigger.date is not None]
+        # ... and so are the dates data fields hold for a timeDate that reads them
+        for proc in package.processes:
+            fields = {f.id: f for f in (*package.data_fields, *proc.data_fields)}
+            for a in proc.all_activities():
+                trig = a.body.trigger if isinstance(a.body, Event) else None
+                if (trig is not None and trig.time_date and trig.date is None
+                        and isinstance(trig.duration, Name) and len(trig.duration.path) == 1):
+                    held = fields.get(trig.duration.path[0])
+                    moment = _moment(held.initial_value) if held is not None else None
+                    if moment is not None:
+                        dates.append(moment)
         self.anchor = min(d // 86_400.0 for d in dates) * 86_400.0 if dates else 0.0
         self.subflow_targets = {
             a.body.process for p in package.processes for a in p.all_activities()
@@ -414,6 +426,10 @@ class _Compiler:
             if trig.duration is not None or trig.time_cycle or trig.time_date:
                 seconds = self.seconds(trig.duration, trig.time_cycle or trig.time_date,
                                        act.location, f"timer of activity {act.id!r}")
+                if trig.time_date and not trig.time_cycle:
+                    # a timeDate read from data: the date its value holds (or, as XPDL
+                    # engines read a number there, a delay)
+                    seconds = _date_or_delay(seconds, self.anchor, trig.time_date)
             return CTrigger(kind="timer", seconds=seconds, location=act.location)
         if kind is TriggerKind.RULE:
             cond = self.cond(trig.condition, None, act.location, f"rule of activity {act.id!r}")
@@ -943,6 +959,45 @@ def _until(first: float, every: float, count: int) -> Evaluator:
         if 0 <= count <= k:
             return 0.0
         return first + k * every - now
+    return wait
+
+
+_EPOCH = datetime.datetime(1970, 1, 1)
+
+
+def _moment(value: Any) -> float | None:
+    """Seconds since 1970-01-01 of an ISO 8601 date(-time) text, date or datetime (the
+    simulated clock has no time zone: a zone suffix is ignored); ``None`` for anything else."""
+    if isinstance(value, str):
+        text = value.strip()
+        if len(text) < 10 or not text[:4].isdigit() or text[4:5] != "-":
+            return None
+        try:
+            value = datetime.datetime.fromisoformat(text.replace("Z", "+00:00"))
+        except ValueError:
+            return None
+    if isinstance(value, datetime.datetime):
+        return (value.replace(tzinfo=None) - _EPOCH).total_seconds()
+    if isinstance(value, datetime.date):
+        return float((value - _EPOCH.date()).days * 86_400)
+    return None
+
+
+def _date_or_delay(inner: Evaluator, anchor: float, text: str) -> Evaluator:
+    """Seconds from ``now`` to the date a timeDate expression's value holds (0 when past:
+    a past date fires at once); a number is a delay in seconds."""
+    def wait(data: Mapping[str, Any], now: float) -> float:
+        value = inner(data, now)
+        if isinstance(value, int | float) and not isinstance(value, bool):
+            return float(value)
+        moment = _moment(value)
+        if moment is None:
+            delay = try_duration(value) if isinstance(value, str) else None
+            if delay is not None:
+                return delay
+            raise OpspecError(f"the timeDate {text!r} gave {value!r}, which is no date: write "
+                              "an ISO 8601 date-time such as 2026-01-01T08:00:00")
+        return max(0.0, moment - anchor - now)
     return wait
 
 
