@@ -973,7 +973,7 @@ def _moment(value: Any) -> float | None:
         if len(text) < 10 or not text[:4].isdigit() or text[4:5] != "-":
             return None
         try:
-            value = datetime.datetime.fromisoformat(text.replace("Z", "+00:00"))
+            value = datetime.datetime.fromisoformat(text)
         except ValueError:
             return None
     if isinstance(value, datetime.datetime):

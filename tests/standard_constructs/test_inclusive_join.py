@@ -5,6 +5,7 @@ from __future__ import annotations
 
 from .conftest import completed, kinds, run
 
+
 def _join_firings(name: str) -> list[float]:
     outcome = run(name, until=60)
     assert [e.kind for e in outcome.trace if e.kind.startswith("process.")] == [
