@@ -19,6 +19,8 @@ fi
 # tests/patterns/test_oracle.py compares with shoobx.wfmc in a test-only venv (never an opspec
 # dependency); without it (no PyPI) those tests skip saying why.
 bash scripts/oracle-venv.sh || echo "scripts/oracle-venv.sh failed: the oracle tests will be skipped" >&2
+# tests/differential/test_spiff.py: SpiffWorkflow, the same way (a test-only venv)
+bash scripts/spiff-venv.sh || echo "scripts/spiff-venv.sh failed: the SpiffWorkflow differential tests will be skipped" >&2
 if [ -z "${OPSPEC_PURE_PYTHON:-}" ] && command -v cc >/dev/null 2>&1; then
     # The compiled and the pure-Python engine must be one behaviour: the tests that run the
     # engine also run from source (one folder per call: folders share the module name

@@ -20,7 +20,8 @@ __all__ = ["bind_user", "choose_user", "companion_user_model", "engine_diagnosti
            "load_any_spec"]
 
 
-def load_any_spec(path: str | Path, *, command: str | None = None) -> Package:
+def load_any_spec(path: str | Path, *, command: str | None = None,
+                  warnings: list[str] | None = None) -> Package:
     """The package in ``path`` (XPDL or ``.wfs``), refused with every error ``opspec validate``
     reports (a :class:`~opspec.errors.SpecError` listing them with ``path:line``): the run,
     evaluate and walkthrough commands never execute a spec that validation rejects.
@@ -33,7 +34,8 @@ def load_any_spec(path: str | Path, *, command: str | None = None) -> Package:
 
     With ``command`` (``"run"``, ``"evaluate"``), the warnings ``opspec validate`` prints for
     a spec that loads are printed to stderr as ``opspec COMMAND: path:line: warning: ...``:
-    a misspelt directive changes what runs, and must not pass unseen."""
+    a misspelt directive changes what runs, and must not pass unseen. ``warnings``, when
+    given, receives each warning's text (the walkthrough shows them on its screen)."""
     from opspec.xpdl.open_spec import open_spec, refuse_unreadable
     from opspec.xpdl.reader import not_a_file
 
@@ -48,10 +50,12 @@ def load_any_spec(path: str | Path, *, command: str | None = None) -> Package:
     errors = [d for d in report.diagnostics if d.severity is Severity.ERROR]
     if errors or package is None:
         raise SpecError.from_diagnostics(errors or report.diagnostics)
-    if command is not None:
-        for warning in report.diagnostics:
-            if warning.severity is Severity.WARNING:
+    for warning in report.diagnostics:
+        if warning.severity is Severity.WARNING:
+            if command is not None:
                 print(f"opspec {command}: {warning}", file=sys.stderr)
+            if warnings is not None:
+                warnings.append(str(warning))
     return package
 
 

@@ -72,6 +72,8 @@ def register(subparsers: Any) -> None:
 
 def run(args: argparse.Namespace) -> int:
     from opspec.model.soundness import SoundnessReport, check_process
+    from opspec.errors import Severity
+    from opspec.xpdl.gate import RUNS_DIFFERENTLY
     from opspec.xpdl.loader import load_package
     from opspec.xpdl.validate import IO_CODES, spec_files
 
@@ -87,6 +89,10 @@ def run(args: argparse.Namespace) -> int:
             io = any(d.code in IO_CODES for d in result.diagnostics)
             worst = max(worst, 2 if io else 1)
             continue
+        for warning in result.diagnostics:
+            # soundness is of what opspec runs: say where that differs from the standard
+            if warning.code == RUNS_DIFFERENTLY and warning.severity is Severity.WARNING:
+                print(f"opspec check: {warning}", file=sys.stderr)
         # conditions are abstracted, so a spec whose errors leave its control flow readable
         # (a condition opspec cannot parse, a duplicate lane id) is still checked
         package = result.package

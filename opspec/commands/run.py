@@ -68,6 +68,10 @@ def register(subparsers: Any) -> None:
                       help="a stochastic user model (file or preset; 'A,B' chains a modifier)")
     user.add_argument("--no-user", action="store_true",
                       help="nobody performs the user lane (ignore SPEC.users.toml)")
+    parser.add_argument("--param", action="append", default=[], metavar="NAME=VALUE",
+                        help="a value for a package data field, such as a BPMN diagram's run "
+                        "input (a variable its conditions read that nothing sets; "
+                        "repeatable; docs/bpmn.md, Run inputs)")
     parser.add_argument("--trace", metavar="FILE", help="write the full trace as JSON Lines")
     parser.add_argument("--engine-config", metavar="FILE", help="engine configuration TOML")
     parser.add_argument("--processor-model",
@@ -100,12 +104,14 @@ def register(subparsers: Any) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
+    from opspec.commands._params import parse_params
     from opspec.commands._spec import choose_user, load_any_spec
     from opspec.engine.trace_sinks import JsonlSink
     from opspec.runs import build, load, run_length
 
     package = load_any_spec(args.spec, command="run")
     spec = load(package)
+    params = parse_params(args.param, package) or None      # a bad value stops us before the run
     compiled = spec.compiled
     config = _config(args)
     if args.days is not None and not (args.days > 0 and math.isfinite(args.days)):
@@ -155,7 +161,8 @@ def run(args: argparse.Namespace) -> int:
             if not args.json:
                 print(file=out)
         outcome = build(spec, seed=args.seed, user=user, until=horizon, config=config,
-                        listeners=listeners, devices=devices).execute()
+                        listeners=listeners, devices=devices,
+                        params=params).execute()
         result = outcome.result
         absent = _waiting_for_absent_user(result.summary, compiled, user)
         monitors = {r.monitor: r for r in outcome.monitors}

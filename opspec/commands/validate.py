@@ -24,7 +24,9 @@ def register(subparsers: Any) -> None:
         "'path:line: severity: message (hint)'. Codes are listed in docs/validation.md. "
         "Exit status: 0 no errors, 1 errors in a spec, 2 usage or I/O problems.")
     parser.add_argument("paths", nargs="+", metavar="PATH", help="spec files or folders")
-    parser.add_argument("--strict", action="store_true", help="treat warnings as errors")
+    parser.add_argument("--strict", action="store_true",
+                        help="treat warnings as errors: among them everything opspec runs "
+                        "differently from its standard (runs-differently, docs/semantics.md)")
     parser.add_argument("--json", action="store_true",
                         help="print one JSON object per file (JSON Lines)")
     parser.add_argument("--schema", action="store_true",

@@ -97,7 +97,8 @@ def run(args: argparse.Namespace) -> int:
         raise ConfigurationError(f"--speed must be positive, not {args.speed:g}")
     if args.days is not None and not (args.days > 0 and math.isfinite(args.days)):
         raise ConfigurationError(f"--days must be a positive number, not {args.days:g}")
-    package = load_any_spec(args.spec)            # a broken spec opens nothing
+    spec_warnings: list[str] = []                 # shown as notes: what runs differently
+    package = load_any_spec(args.spec, warnings=spec_warnings)   # a broken spec opens nothing
     compiled = compile_package(package)
     model_ref = args.user_model or companion_user_model(args.spec)
     factory = _model_factory(compiled, model_ref, args.seed) if model_ref else None
@@ -115,7 +116,7 @@ def run(args: argparse.Namespace) -> int:
             f"{datetime.now(UTC).strftime('%Y%m%d-%H%M%S')}.json"))
     with contextlib.ExitStack() as stack:
         performers: dict[str, Any] = {}          # the world: opspec.runs.build adds it
-        notes: list[str] = []
+        notes: list[str] = list(spec_warnings)
         devices = None
         if args.bind:
             from opspec.bindings.attach import attach_devices

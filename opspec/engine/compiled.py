@@ -57,6 +57,7 @@ from opspec.model import (
     WorkflowProcess,
 )
 from opspec.model.bulk import gc_paused
+from opspec.model.checks_support import names_read
 from opspec.model.data import is_structured, structured_value
 
 __all__ = [
@@ -157,6 +158,7 @@ class CTransition:
     exception: str | None
     assignments: tuple[tuple[str, Evaluator], ...]
     label: str | None = None          # a ScriptGrammar="Text" condition: a label, no test
+    probability: float = -1.0         # drawn with this probability (undecided gateway); < 0: none
     tokens: int = 1                   # tokens sent along it: Quantity x CompletionQuantity
 
 
@@ -199,6 +201,8 @@ class CompiledActivity:
     default_exception: CTransition | None = None
     choice: tuple[CTransition, ...] = ()      # deferred choice offered after completion
     labelled: bool = False                   # the choice is between labelled branches
+    drawn: tuple[CTransition, ...] = ()      # an undecided gateway's branches, drawn at random
+    inputs: tuple[str, ...] = ()             # run inputs its conditions read: drawn while unset
     start_assign: tuple[tuple[str, Evaluator], ...] = ()
     end_assign: tuple[tuple[str, Evaluator], ...] = ()
     raises: CTrigger | None = None
@@ -340,6 +344,11 @@ class _Compiler:
     def __init__(self, package: Package) -> None:
         self.package = package
         self.throwable: set[str] = set()
+        # package data fields a BPMN diagram's conditions read but nothing sets: a gateway
+        # deciding on one is drawn at random while the run is not given its value
+        self.run_inputs = frozenset(
+            f.id for f in package.data_fields
+            if any(e.name == "opspec:RunInput" for e in f.extended_attributes))
         self.participants = {p.id: p for p in package.participants}
         self.participant_lane: dict[str, tuple[str, ...]] = {}
         for pool in package.pools:
@@ -429,7 +438,8 @@ class _Compiler:
                 if trig.time_date and not trig.time_cycle:
                     # a timeDate read from data: the date its value holds (or, as XPDL
                     # engines read a number there, a delay)
-                    seconds = _date_or_delay(seconds, self.anchor, trig.time_date)
+                    seconds = _date_or_delay(seconds, self.anchor, trig.time_date,
+                                             act.location, act.id)
             return CTrigger(kind="timer", seconds=seconds, location=act.location)
         if kind is TriggerKind.RULE:
             cond = self.cond(trig.condition, None, act.location, f"rule of activity {act.id!r}")
@@ -512,9 +522,15 @@ class _Compiler:
             ct = CTransition(index=ti, id=tr.id, target=by_id[tr.target], kind=kind,
                              condition=cond, exception=exc, assignments=assigns,
                              label=(tr.condition.text or None) if kind == T_NONE else None,
+                             probability=-1.0 if tr.probability is None else tr.probability,
                              tokens=tr.quantity * activities[by_id[tr.source]].completion_quantity)
             trans_by_id[tr.id] = ct
             outgoing[by_id[tr.source]].append(ct)
+            if tr.probability is not None and self.run_inputs and tr.condition.expression:
+                reads = [n for n in names_read(tr.condition.expression) if n in self.run_inputs]
+                if reads:
+                    source = acts[by_id[tr.source]]
+                    source.inputs = tuple(dict.fromkeys((*source.inputs, *reads)))
             incoming[by_id[tr.target]].append(ti)
         for i, act in enumerate(activities):
             self.activity(proc, act, acts[i], acts, by_id, outgoing[i], incoming[i],
@@ -724,6 +740,10 @@ class _Compiler:
             # no split declared and some conditions: BPMN conditional sequence flows, every
             # one whose condition holds is taken (OTHERWISE is the default flow)
             ca.split = S_OR
+        if ca.split in (S_XOR, S_OR) and any(t.probability >= 0.0 for t in ordered):
+            # a gateway the spec leaves undecided: its branches are drawn with the declared
+            # probabilities (the reader gives every branch one), never by file order
+            ca.drawn = tuple(t for t in ordered if t.kind in (T_NONE, T_COND, T_OTHERWISE))
         # directives
         if act.assignments:
             ca.start_assign = tuple(
@@ -983,7 +1003,8 @@ def _moment(value: Any) -> float | None:
     return None
 
 
-def _date_or_delay(inner: Evaluator, anchor: float, text: str) -> Evaluator:
+def _date_or_delay(inner: Evaluator, anchor: float, text: str,
+                   location: SourceLocation | None, activity: str) -> Evaluator:
     """Seconds from ``now`` to the date a timeDate expression's value holds (0 when past:
     a past date fires at once); a number is a delay in seconds."""
     def wait(data: Mapping[str, Any], now: float) -> float:
@@ -995,8 +1016,9 @@ def _date_or_delay(inner: Evaluator, anchor: float, text: str) -> Evaluator:
             delay = try_duration(value) if isinstance(value, str) else None
             if delay is not None:
                 return delay
-            raise OpspecError(f"the timeDate {text!r} gave {value!r}, which is no date: write "
-                              "an ISO 8601 date-time such as 2026-01-01T08:00:00")
+            raise OpspecError(f"the timeDate {text!r} of activity {activity!r} gave {value!r}, "
+                              "which is no date", location=location,
+                              hint="give it an ISO 8601 date-time such as 2026-01-01T08:00:00")
         return max(0.0, moment - anchor - now)
     return wait
 

@@ -497,7 +497,7 @@ class Flow(Part):
             if not target.join:
                 return target
             trans = act.out[0]
-        elif act.split == S_XOR and not act.choice and (act.out or act.otherwise):
+        elif act.split == S_XOR and not act.choice and not act.drawn and (act.out or act.otherwise):
             scope = inst.scope
             now = self.state.env._now
             try:
@@ -537,6 +537,10 @@ class Flow(Part):
             frame.running[ai.key] = ai
             self.offers.offer_choice(ai, act.choice)
             return
+        if act.drawn and (not act.inputs or self._inputs_missing(act)):
+            self._draw(frame, act)
+            self.token_gone(frame)
+            return
         outs = act.out
         if outs or act.otherwise:
             inst = frame.inst
@@ -569,6 +573,44 @@ class Flow(Part):
                     return
                 self.take(frame, act.otherwise[0])
         self.token_gone(frame)
+
+    def _inputs_missing(self, act: CompiledActivity) -> bool:
+        """Whether a run input the gateway's conditions read has no value in this run."""
+        data = self.state.package_data
+        for name in act.inputs:
+            if data.get(name) is None:
+                return True
+        return False
+
+    def _draw(self, frame: Frame, act: CompiledActivity) -> None:
+        """The branches of a gateway the spec leaves undecided, drawn from the gateway's own
+        seeded stream with the declared probabilities (docs/bpmn.md, Undecided gateways): an
+        exclusive gateway takes one; an inclusive one takes each with its probability, drawn
+        again until at least one is taken (so the shares given are conditional on that)."""
+        rng = self.state.streams.stream(f"branch:{act.process}:{act.id}")
+        drawn = act.drawn
+        picks: list[CTransition] = []
+        if act.split == S_XOR:
+            u = float(rng.random())
+            total = 0.0
+            picks.append(drawn[-1])
+            for trans in drawn:
+                total += trans.probability
+                if u < total:
+                    picks[0] = trans
+                    break
+        else:
+            for _attempt in range(1000):
+                picks = [t for t in drawn if float(rng.random()) < t.probability]
+                if picks:
+                    break
+            else:
+                picks = [max(drawn, key=lambda t: t.probability)]
+        inst = frame.inst
+        for trans in picks:
+            self.state.emit_act(EK.BRANCH_CHOSEN, inst, act,
+                                {"flow": trans.id, "probability": trans.probability})
+            self.take(frame, trans)
 
     def take(self, frame: Frame, trans: CTransition, performed: bool = False) -> None:
         if trans.assignments:

@@ -54,6 +54,7 @@ class EventKind:
     FAULT: Final = "fault"                              # device faults, performer faults
     DEADLOCK: Final = "deadlock"
     QUEUED: Final = "activity.queued"                   # pooled model: waiting for a worker
+    BRANCH_CHOSEN: Final = "branch.chosen"              # an undecided gateway drew its branch
 
 
 @dataclass(frozen=True, slots=True)

@@ -72,11 +72,7 @@ class Triggers(Part):
                                 trig.count + 1 if trig.count >= 0 else -1)
                 return
             if trig.seconds is not None:
-                try:
-                    delay = float(trig.seconds(inst.scope, self.state.env._now))
-                except OpspecError as error:
-                    self.flow.abort(inst, ai.act, f"the timer cannot be set: {error.message}")
-                    return
+                delay = float(trig.seconds(inst.scope, self.state.env._now))
             else:
                 delay = trig.offset or (trig.every or 0.0)
             self.state.later(delay, lambda a, _x: handler(a, arg, None), ai)

@@ -76,7 +76,9 @@ def _check_package(package: Package, packages: Mapping[str, Package]) -> list[Di
     refs.sisarl()
     for process in package.processes:
         _check_process(process, package, refs, report)
-    return report.diagnostics
+    from opspec.model.checks_triggers import trigger_name_diagnostics
+
+    return [*report.diagnostics, *trigger_name_diagnostics(package, packages)]
 
 
 def check_process(
@@ -279,6 +281,8 @@ def _unconditional_xor(scope: str, graph: FlowGraph, activity: Activity,
                 if t.condition.kind is ConditionKind.NONE]
     if len(branches) < 2:
         return
+    if all(t.probability is not None for t in branches):
+        return       # drawn with branch probabilities (said where the reader set them)
     targets = [graph.by_id[t.target] for t in branches]
     if all(t.is_manual or t.performers for t in targets):
         return       # a deferred choice: the performer picks the branch (engine semantics)

@@ -44,10 +44,16 @@ class Condition:
 
 @dataclass(frozen=True, slots=True, kw_only=True)
 class Transition(Element):
+    """A sequence flow. ``probability`` is set on the flows out of a gateway whose choice the
+    spec leaves undecided (no condition opspec can evaluate): the gateway then draws its
+    branch with these probabilities (a simulation parameter: BPSim, QBP, ``opspec:Probability``,
+    or uniform with a warning), as simulation tools for process models do."""
+
     source: str
     target: str
     condition: Condition = Condition()
     assignments: tuple[Assignment, ...] = ()
+    probability: float | None = None
     quantity: int = 1          # XPDL 2.1 Transition Quantity: tokens sent along it each time
 
 

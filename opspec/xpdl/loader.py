@@ -73,6 +73,7 @@ def _build(data: bytes, path: str, max_bytes: int) -> tuple[Package | None, list
     What the file is goes by its content, not its name: a BPMN 2.0 ``definitions`` root is
     built by :mod:`opspec.xpdl.bpmn` into the same model, anything else is read as XPDL."""
     from opspec.xpdl.bpmn import BPMN_VERSION, build_bpmn, is_bpmn
+    from opspec.xpdl.gate import gate_diagnostics, gate_findings
 
     try:
         parsed = parse_safely(data, path=path, max_bytes=max_bytes)
@@ -84,6 +85,8 @@ def _build(data: bytes, path: str, max_bytes: int) -> tuple[Package | None, list
     ctx = BuildContext(path=path, version=version, diagnostics=list(parsed.warnings))
     try:
         with exact_lines(parsed):            # lines past 65,534 (libxml2 stores 16 bits)
+            # the semantics gate reads the file as written, before the build rewrites it
+            findings = gate_findings(parsed.root if outcome is None else outcome.root, path)
             if outcome is None:
                 package = build_bpmn(parsed.root, ctx)
             else:
@@ -92,7 +95,7 @@ def _build(data: bytes, path: str, max_bytes: int) -> tuple[Package | None, list
         raise
     except Exception as error:  # noqa: BLE001 - a user never sees a traceback (issue 2)
         return None, [*ctx.diagnostics, _internal(path, error)]
-    return package, ctx.diagnostics
+    return package, [*ctx.diagnostics, *gate_diagnostics(findings, ctx.diagnostics)]
 
 
 def _load_file(path: Path, max_bytes: int) -> tuple[Package | None, list[Diagnostic]]:

@@ -23,6 +23,7 @@ __all__ = [
     "parse_distribution",
     "parse_integer",
     "parse_period",
+    "parse_probability",
     "parse_seconds",
     "parse_trigger",
 ]
@@ -236,3 +237,19 @@ def parse_distribution(text: str, location: SourceLocation | None = None) -> Dec
             raise _fail(f"{kind} needs parameter {' or '.join(group)}", location,
                         f"write {kind}({', '.join(f'{p}=…' for p in positional)})")
     return DeclaredDistribution(kind=kind, parameters=tuple(parameters))
+
+
+def parse_probability(raw: str) -> float | None:
+    """``raw`` as a branch probability (``0.25``, ``25%``), or ``None`` when it is none: a
+    gateway's branch probabilities (``opspec:Probability``, BPSim, QBP: docs/bpmn.md)."""
+    text = raw.strip()
+    scale = 1.0
+    if text.endswith("%"):
+        text, scale = text[:-1].strip(), 0.01
+    try:
+        value = float(text) * scale
+    except ValueError:
+        return None
+    if not math.isfinite(value) or value < 0.0 or value > 1.0:
+        return None
+    return value

@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import pytest
 
+from opspec.errors import OpspecError
+
 from .conftest import completed, kinds, run
 
 
@@ -24,10 +26,11 @@ def test_time_date_from_a_data_field_fires_at_that_date(due: str | None, fires: 
     assert [e.time for e in kinds(outcome, "process.completed")] == [fires]
 
 
-def test_a_value_that_is_no_date_fails_the_instance_with_a_located_fault() -> None:
-    """A timeDate whose value is no date is never read as some default: the instance is
-    aborted with a fault naming the timer and the value."""
-    outcome = run("time_date_from_data.bpmn", until=86400, params={"due": "tomorrow"})
-    (fault,) = outcome.summary["faults"]
-    assert "until_due" in fault["message"] and "'tomorrow'" in fault["message"]
-    assert "no date" in fault["message"]
+def test_a_value_that_is_no_date_stops_the_run_with_a_located_error() -> None:
+    """A timeDate whose value is no date is never read as some default: the run stops with an
+    error that names the timer's value and says what to write (as for any timer opspec
+    cannot set: validate and run agree about timers)."""
+    with pytest.raises(OpspecError) as caught:
+        run("time_date_from_data.bpmn", until=86400, params={"due": "tomorrow"})
+    assert "'tomorrow'" in caught.value.message and "no date" in caught.value.message
+    assert "time_date_from_data.bpmn:8" in str(caught.value)

@@ -21,6 +21,7 @@ __all__ = [
     "Defs",
     "bpmn_children",
     "expression_text",
+    "is_juel",
     "first",
     "kids",
     "local",
@@ -90,6 +91,12 @@ _JUEL = re.compile(r"^[$#]\{(?P<inner>.*)\}$", re.DOTALL)
 _QUOTED = re.compile(r"""^(?P<q>["'])(?P<inner>[^"']*)(?P=q)$""")
 
 
+def is_juel(element: etree._Element | None) -> bool:
+    """Whether ``element``'s expression is wrapped as Camunda's JUEL (``${…}``, ``#{…}``)."""
+    text = text_of(element)
+    return text is not None and _JUEL.match(text) is not None
+
+
 def expression_text(element: etree._Element | None, *, unquote: bool = False) -> str | None:
     """The text of a ``tFormalExpression``: the JUEL wrapper ``${…}`` of Camunda removed, and
     with ``unquote`` the quotes of a Python string literal (SpiffWorkflow's ``"PT5M"``)."""
@@ -134,6 +141,9 @@ class Defs:
     package_fields: set[str] = field(default_factory=set)
     item_kinds: dict[str, BasicKind] = field(default_factory=dict)
     process_io: dict[str, list[tuple[str, ParameterMode]]] = field(default_factory=dict)
+    probabilities: dict[str, float] = field(default_factory=dict)   # BPSim / QBP, by flow id
+    probability_source: dict[str, str] = field(default_factory=dict)
+    data_names: dict[str, str] = field(default_factory=dict)   # a data object's name -> its id
 
     def info(self, element: etree._Element | None, code: str, message: str,
              hint: str = "") -> None:

@@ -98,6 +98,12 @@ def index_data(root: etree._Element, defs: Defs) -> None:
         kind = _STRUCTURES.get(_bare(structure).lower()) or _STRUCTURES.get(structure.lower())
         if kind is not None and item.get("id"):
             defs.item_kinds[item.get("id") or ""] = kind
+    for element in root.iter(tag("dataObject"), tag("property"), tag("dataObjectReference")):
+        target = element.get("dataObjectRef") if local(element) == "dataObjectReference" \
+            else element.get("id")
+        name = " ".join((element.get("name") or "").split())
+        if target and name and name != target:
+            defs.data_names.setdefault(name, target.strip())
     for process in kids(root, "process"):
         spec = first(process, "ioSpecification")
         if spec is not None:

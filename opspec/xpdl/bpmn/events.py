@@ -66,8 +66,9 @@ class Timer:
 
 
 def read_timer(definition: etree._Element, defs: Defs) -> Timer | None:
-    """The timer of a ``timerEventDefinition``; unreadable values are ``bad-timer``
-    diagnostics (the timer then never fires, as XPDL's)."""
+    """The timer of a ``timerEventDefinition``. An unreadable value is a ``bad-timer`` error
+    (the engine could not run it either: validate and run agree, as for XPDL's); a timer with
+    no time is a ``bad-timer`` warning saying what the engine does with it: fire at once."""
     from opspec.xpdl.durations import (
         parse_duration_expression,
         parse_time_cycle,
@@ -81,8 +82,8 @@ def read_timer(definition: etree._Element, defs: Defs) -> Timer | None:
             continue
         text = expression_text(element, unquote=True)
         if text is None:
-            ctx.warning(element, "bad-timer", f"{kind} is empty; the timer never fires",
-                        _TIMER_HINT)
+            ctx.warning(element, "bad-timer", f"{kind} is empty: opspec fires the timer at "
+                        "once", _TIMER_HINT)
             return None
         where = defs.loc(element)
         try:
@@ -109,12 +110,12 @@ def read_timer(definition: etree._Element, defs: Defs) -> Timer | None:
             duration = parse_duration_expression(text, location=where)
         except (SpecError, ValueError, RecursionError) as error:
             message = getattr(error, "message", str(error))
-            ctx.warning(element, "bad-timer", f"{message}; the timer never fires in a "
-                        "simulation", _TIMER_HINT)
+            ctx.error(element, "bad-timer", f"{message}, so the timer cannot run",
+                      _TIMER_HINT)
             return None
         return Timer("duration", text, {"duration": duration}, duration)
     ctx.warning(definition, "bad-timer", "the timer has no timeDuration, timeDate or "
-                "timeCycle; it never fires", _TIMER_HINT)
+                "timeCycle: opspec fires it at once", _TIMER_HINT)
     return None
 
 

@@ -27,6 +27,8 @@ from opspec.xpdl.bpmn.common import (
 from opspec.xpdl.bpmn.data import CAMUNDA, index_data
 from opspec.xpdl.bpmn.extensions import application, data_field, directives, opspec_named
 from opspec.xpdl.bpmn.process import BuiltProcess, build_process, is_user_name
+from opspec.xpdl.bpmn.run_inputs import with_run_inputs
+from opspec.xpdl.bpmn.simulation import BPSIM_NAMESPACES, QBP, read_simulation_parameters
 from opspec.xpdl.handlers.common import BuildContext
 from opspec.xpdl.namespaces import OPSPEC
 from opspec.xpdl.sisarl import PACKAGE_DIRECTIVES, package_extensions
@@ -61,7 +63,7 @@ def _index(root: etree._Element, defs: Defs) -> None:
     is an error (BPMN ids are unique in a file)."""
     ctx = defs.ctx
     prefix = f"{{{BPMN}}}"
-    for element in root.iter():
+    for element in _outside_extensions(root):
         raw = element.tag
         if not isinstance(raw, str) or not raw.startswith(prefix):
             continue
@@ -94,6 +96,21 @@ def _index(root: etree._Element, defs: Defs) -> None:
                 defs.human.add(ref.split(":", 1)[-1] if ref not in defs.resources else ref)
 
 
+def _outside_extensions(root: etree._Element) -> list[etree._Element]:
+    """Every element of the file but those inside ``extensionElements``: a modeller's own
+    data there may repeat ids (Visual Paradigm does) without being BPMN elements that
+    anything refers to; BPMN's uniqueness of ids is about the model's elements."""
+    out: list[etree._Element] = []
+    extensions = tag("extensionElements")
+    stack = [root]
+    while stack:
+        element = stack.pop()
+        out.append(element)
+        if element.tag != extensions:
+            stack.extend(reversed([c for c in element if isinstance(c.tag, str)]))
+    return out
+
+
 def _vendor_extensions(root: etree._Element, defs: Defs) -> None:
     """One ``vendor-extension`` note per foreign namespace in extensionElements (Camunda,
     Zeebe, Signavio, SpiffWorkflow…): kept in the file, not run — except Camunda's form
@@ -101,8 +118,10 @@ def _vendor_extensions(root: etree._Element, defs: Defs) -> None:
     first_seen: dict[str, etree._Element] = {}
     for extensions in root.iter(tag("extensionElements")):
         for sub in extensions:
-            if not isinstance(sub.tag, str) or namespace(sub) in (OPSPEC, BPMN):
+            if not isinstance(sub.tag, str) or namespace(sub) in (OPSPEC, BPMN, QBP):
                 continue
+            if namespace(sub) in BPSIM_NAMESPACES:
+                continue                 # simulation parameters: read_simulation_parameters
             if namespace(sub) == CAMUNDA and local(sub) in _CAMUNDA_READ:
                 continue
             first_seen.setdefault(namespace(sub), sub)
@@ -191,11 +210,22 @@ def build_definitions(root: etree._Element, ctx: BuildContext) -> Package:
     _index(root, defs)
     index_data(root, defs)
     _vendor_extensions(root, defs)
+    simulation = read_simulation_parameters(root, defs)
+    defs.probabilities.update(simulation.probabilities)
+    defs.probability_source.update(simulation.source)
     for sub in root:
         if not isinstance(sub.tag, str):
             continue
         space = namespace(sub)
         if space in _DI_NAMESPACES or (space == BPMN and local(sub) in _ROOT_QUIET):
+            continue
+        if space == QBP or (space == BPMN and local(sub) == "relationship"
+                            and any(namespace(e) in BPSIM_NAMESPACES for e in sub.iter()
+                                    if isinstance(e.tag, str))):
+            defs.info(sub, "simulation-parameters",
+                      "simulation parameters (BPSim or QBP): opspec reads their branch "
+                      "probabilities; their durations, arrival rates and resources are not "
+                      "read", "give durations with opspec:Duration (docs/bpmn.md)")
             continue
         what = f"bpmn:{local(sub)}" if space == BPMN else f"<{local(sub)}> ({space})"
         ctx.warning(sub, "unsupported-element", f"{what} is not run by opspec; it is ignored",
@@ -238,6 +268,7 @@ def build_definitions(root: etree._Element, ctx: BuildContext) -> Package:
     known = {p.id for p in participants}
     if defs.user_participant and "user" not in known:
         participants.append(Participant(id="user", name="User", type=ParticipantType.HUMAN))
+    processes, run_inputs = with_run_inputs([b.process for b in built], package_fields, defs)
     found, kept = directives(root, defs, PACKAGE_DIRECTIVES, "the definitions",
                              ("DataField", "Application"))
     extensions = package_extensions(root, ctx, found)
@@ -255,8 +286,8 @@ def build_definitions(root: etree._Element, ctx: BuildContext) -> Package:
                              or None, source_format=BPMN_FORMAT),
         participants=tuple(participants),
         applications=applications,
-        data_fields=package_fields,
+        data_fields=package_fields + run_inputs,
         pools=model_pools,
-        processes=tuple(b.process for b in built),
+        processes=tuple(processes),
         **extensions,
     )

@@ -57,6 +57,7 @@ from opspec.xpdl.bpmn.common import (
     namespace,
     text_of,
 )
+from opspec.xpdl.bpmn.branches import decide_undecided
 from opspec.xpdl.bpmn.data import activity_data, process_fields
 from opspec.xpdl.bpmn.events import definitions_of, read_timer, trigger_of
 from opspec.xpdl.bpmn.extensions import (
@@ -132,6 +133,7 @@ class _Process:
         self.lane_names: dict[str, str | None] = {}
         self.created: dict[str, DataField] = {}      # fields forms, outputs, parameters add
         self.reads: list[tuple[str, etree._Element, str]] = []
+        self.synthetic: set[str] = set()          # ids given to sequence flows without one
         for lane in self._all(self.lanes):
             self.lane_names[lane.id] = lane.name
 
@@ -220,15 +222,11 @@ class _Process:
                                  "put vendor data inside bpmn:extensionElements")
             elif name in NODES or name in _SUB_PROCESSES:
                 if name in _SUB_PROCESSES and sub.get("triggeredByEvent") == "true":
-                    # refused, not skipped: a run without the handler the modeller drew would
-                    # look plausible and be wrong whenever its event happens
-                    self.ctx.error(sub, "unsupported-element",
-                                   f"event sub-process {sub.get('id')!r}: opspec does not run "
-                                   "event sub-processes (BPMN 2.0 §10.2.5), so it cannot run "
-                                   "this process as drawn",
-                                   "model it as a boundary event on a sub-process that holds "
-                                   "the rest of the process, or as a workflow with a message or "
-                                   "signal start event")
+                    self.ctx.warning(sub, "unsupported-element",
+                                     f"event sub-process {sub.get('id')!r}: opspec does not run "
+                                     "event sub-processes; it and everything in it are ignored",
+                                     "model it as a boundary event on a sub-process, or as a "
+                                     "workflow with a message or signal start event")
                     continue
                 nodes.append(sub)
             elif name == "sequenceFlow":
@@ -243,6 +241,8 @@ class _Process:
         boundary = self.boundaries(boundaries, ids)
         ids |= {b.id for b in boundary.activities}
         transitions = self.flows(flows, ids, nodes, boundary.skipped)
+        transitions = decide_undecided(nodes, transitions,
+                                       {f.get("id") or "": f for f in flows}, self.defs)
         transitions.extend(boundary.transitions)
         incoming: dict[str, int] = {}
         outgoing: dict[str, list[str]] = {}
@@ -284,6 +284,10 @@ class _Process:
                                    "(the flow is left out)")
             if broken:
                 continue
+            if not flow_id:
+                # BPMN lets a sequence flow nothing refers to go without an id; the model
+                # needs one per transition (splits order their flows by id)
+                flow_id = self.flow_id(ends["sourceRef"], ends["targetRef"])
             condition = self.condition(flow, flow_id in defaults)
             out.append(Transition(id=flow_id, name=flow.get("name"), source=ends["sourceRef"],
                                   target=ends["targetRef"], condition=condition,
@@ -298,6 +302,17 @@ class _Process:
                                    f"{self.label(node)}: default {flow_id!r} is no sequence flow "
                                    "of this process", "name one of its outgoing sequence flows")
         return out
+
+    def flow_id(self, source: str, target: str) -> str:
+        """An id for a sequence flow written without one: ``source->target`` (``#2``… when
+        two such flows join the same nodes), never an id of the file."""
+        base = f"{source}->{target}"
+        candidate, n = base, 1
+        while candidate in self.defs.by_id or candidate in self.synthetic:
+            n += 1
+            candidate = f"{base}#{n}"
+        self.synthetic.add(candidate)
+        return candidate
 
     def where(self, element: etree._Element) -> str:
         parent = element.getparent()
@@ -341,6 +356,15 @@ class _Process:
             found = definitions_of(event, self.defs)
             kind = local(found[0]) if found else None
             passing = Event(position=EventPosition.INTERMEDIATE, trigger=Trigger())
+            if kind == "timerEventDefinition" and not any(
+                    expression_text(first(found[0], k)) for k in _TIMER_KINDS):
+                # no time at all: an intermediate timer fires at once (said), but a boundary
+                # timer that fired at once would cut its activity off before it began
+                self.ctx.error(found[0], "bad-timer",
+                               f"boundary timer {event_id!r} has no timeDuration, timeDate or "
+                               "timeCycle, so when it interrupts its activity is not said",
+                               "give it a time, e.g. <bpmn:timeDuration>PT2H</bpmn:timeDuration>")
+                continue
             if kind == "timerEventDefinition":
                 timer = read_timer(found[0], self.defs)
                 if timer is None or timer.kind == "duration":
@@ -622,6 +646,9 @@ class _Process:
                                "declare a bpmn:dataObject or bpmn:property with that id, set it "
                                "in a script task or a form field, or feed the input with a "
                                "bpmn:dataInputAssociation")
+
+
+_TIMER_KINDS = ("timeDuration", "timeDate", "timeCycle")
 
 
 def _literal_kind(expression: Expression | None) -> BasicKind:

@@ -30,7 +30,9 @@ from lxml import etree
 from opspec.errors import Diagnostic, Severity, SourceLocation, SpecError
 from opspec.model.data import Assignment
 from opspec.model.expressions import Expression
-from opspec.xpdl.bpmn.common import Defs
+from opspec.xpdl.bpmn.common import Defs, is_juel
+from opspec.xpdl.bpmn.dialects import from_dialects
+from opspec.xpdl.bpmn.juel import from_juel
 
 __all__ = ["bpmn_condition", "construct_of", "read_script"]
 
@@ -223,8 +225,9 @@ def bpmn_condition(element: etree._Element | None, text: str | None, defs: Defs,
 
     if text is None or not text.strip():
         return None
+    source = from_dialects(from_juel(text) if is_juel(element) else text, defs.data_names)
     try:
-        return parse_condition(_is_rewrites(text), location=defs.loc(element))
+        return parse_condition(_is_rewrites(source), location=defs.loc(element))
     except (SpecError, ValueError, RecursionError) as error:
         detail = getattr(error, "message", str(error))
         construct = construct_of(text)

@@ -127,9 +127,17 @@ def _timer(element: etree._Element, ctx: BuildContext) -> dict[str, Any]:
         try:
             duration = parse_duration_expression(text)
         except (SpecError, ValueError, RecursionError):
-            ctx.warning(timer, "bad-timer", f"timer {text!r} is not a duration opspec understands; "
-                        "the timer never fires in a simulation",
-                        "write an ISO 8601 duration (PT5M), a number of seconds or 5min")
+            # an error, as the engine refuses to run it (validate and run agree)
+            ctx.error(timer, "bad-timer", f"timer {text!r} is not a duration, date or cycle "
+                      "opspec understands, so the spec cannot run",
+                      "write an ISO 8601 duration (PT5M), a number of seconds, 5min, an "
+                      "expression over data fields, a date (2026-01-01T08:00:00) or a cycle "
+                      "(R3/PT10M)")
+    else:
+        # vendor exports draw timers they never configure: they run, and fire at once
+        ctx.warning(timer, "bad-timer", "the timer has no TimeDate or TimeCycle: opspec fires "
+                    "it at once", "give it a TimeCycle (PT5M, R3/PT10M) or a TimeDate "
+                    "(2026-01-01T08:00:00)")
     return {"time_date": date, "time_cycle": cycle, "duration": duration}
 
 

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from typing import Any
+
 from lxml import etree
 
 from opspec.model.process import (
@@ -30,6 +32,7 @@ from opspec.xpdl.handlers.data import build_data_field, build_formal_parameter
 from opspec.xpdl.handlers.events import parse_condition_element
 from opspec.xpdl.handlers.resources import build_application, build_participant
 from opspec.xpdl.sisarl import process_directives
+from opspec.xpdl.sisarl_values import parse_probability
 
 __all__ = ["build_condition", "build_process", "build_transition"]
 
@@ -88,7 +91,24 @@ def build_transition(element: etree._Element, ctx: BuildContext) -> Transition:
                           quantity=tokens, **fields)
     return Transition(source=source or "", target=target or "",
                       condition=build_condition(child(element, "Condition"), ctx),
-                      assignments=build_assignments(element, ctx), quantity=tokens, **fields)
+                      assignments=build_assignments(element, ctx), quantity=tokens,
+                      probability=_probability(element, fields, ctx), **fields)
+
+
+def _probability(element: etree._Element, fields: dict[str, Any], ctx: BuildContext
+                 ) -> float | None:
+    """The branch probability an ``opspec:Probability`` extended attribute gives (what
+    opspec writes for a BPMN gateway the diagram left undecided: docs/bpmn.md)."""
+    for extended in fields.get("extended_attributes", ()):
+        if extended.name in ("opspec:Probability", "Probability"):
+            raw = extended.value if extended.value is not None else (extended.text or "")
+            value = parse_probability(raw)
+            if value is None:
+                ctx.error(element, "bad-probability",
+                          f"opspec:Probability {raw!r} of transition {fields['id']!r} is not a "
+                          "number between 0 and 1", "write a probability such as 0.25")
+            return value
+    return None
 
 
 def _transition_elements(element: etree._Element, ctx: BuildContext) -> list[etree._Element]:

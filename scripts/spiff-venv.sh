@@ -1,0 +1,18 @@
+#!/usr/bin/env bash
+# Create .spiff-venv: a test-only virtualenv holding SpiffWorkflow, the maintained Python BPMN
+# engine that tests/differential/test_spiff.py runs SpiffWorkflow's own BPMN test files through
+# beside opspec (differential testing, issue 32). It is never a dependency of opspec.
+# Idempotent and quiet: does nothing when the venv already imports SpiffWorkflow. About 10 s
+# with PyPI reachable.
+# Usage: bash scripts/spiff-venv.sh [VENV_DIR]   (default: .spiff-venv at the checkout root)
+set -euo pipefail
+cd "$(dirname "$0")/.."
+venv="${1:-.spiff-venv}"
+if [ -x "$venv/bin/python" ] && "$venv/bin/python" -c "import SpiffWorkflow.bpmn" >/dev/null 2>&1; then
+    exit 0
+fi
+python3 -m venv "$venv"
+# 3.x: the version whose test data tests/differential/data/spiff/ holds (README.md there)
+"$venv/bin/python" -m pip install --quiet --disable-pip-version-check --retries 1 --timeout 20 "SpiffWorkflow==3.2.0" 2>&1 \
+    | grep -v "^WARNING: Location" >&2 || true
+"$venv/bin/python" -c "import SpiffWorkflow.bpmn"
