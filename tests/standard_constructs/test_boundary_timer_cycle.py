@@ -27,6 +27,15 @@ def test_non_interrupting_cycle_fires_at_every_cycle_while_the_activity_runs() -
         (2100.0, "work"), (2100.0, "end")]
 
 
+def test_the_same_in_xpdl() -> None:
+    """XPDL 2.1 takes its TriggerTimer TimeCycle from BPMN (an ISO 8601 recurring interval);
+    a timer IntermediateEvent attached to an activity (Target) that does not interrupt it
+    (Interrupting="false", XPDL 2.2's attribute) fires at every cycle as the BPMN one does."""
+    assert _path("boundary_cycle_noninterrupting.xpdl") == [
+        (600.0, "remind"), (1200.0, "remind"), (1800.0, "remind"),
+        (2100.0, "work"), (2100.0, "end")]
+
+
 def test_the_repetition_count_bounds_the_firings() -> None:
     """BPMN 2.0 Table 10.101: timeCycle is an "ISO-8601 … recurring time interval"; in ISO
     8601 "Rn/duration" is n repetitions of the interval: "R2/PT10M" is two repetitions of ten
