@@ -277,6 +277,10 @@ class CompiledProcess:
     # several start events with a trigger (BPMN 2.0 §10.4.2: each one independent): each
     # trigger with the start event it starts an instance at (only that one's path runs)
     start_events: tuple[tuple[CTrigger, int], ...] = ()
+    # with several triggered start events: where an instance called as a subflow starts (its
+    # none start events; BPMN 2.0 §13.3.4: the triggered ones "are ignored when the Process
+    # is called from another Process")
+    called_starts: tuple[int, ...] = ()
 
 
 @dataclass(slots=True, eq=False)
@@ -914,7 +918,7 @@ class _Compiler:
                                  and graph.activities[index].kind == K_NOOP)
             if start_events:
                 start = start_events[0][0]
-            if len(start_events) < 2:
+            if len(graph.starts) < 2:      # one start: it is the process's start trigger
                 start_events = ()
         if start is None and directives.period is not None:
             start = CTrigger(kind="period", every=directives.period, location=proc.location)
@@ -931,7 +935,9 @@ class _Compiler:
             formals=tuple((f.id, f.mode) for f in proc.formal_parameters), priority=priority,
             lane=lane, start_trigger=start, end_trigger=self.trigger_ref(directives.end_trigger),
             auto_start=bool(auto), deadline=directives.deadline, mode=directives.mode,
-            location=proc.location, start_events=start_events)
+            location=proc.location, start_events=start_events,
+            called_starts=tuple(i for i in graph.starts
+                                if not any(i == index for _t, index in start_events)))
 
 
 def _start_trigger(trig: CTrigger | None) -> CTrigger:

@@ -77,11 +77,15 @@ class Flow(Part):
             frame.live += 1
             self.state.ready.append((self.start_at, frame, start, None))
         else:
-            for index in proc.graph.starts:
+            starts = proc.graph.starts
+            if proc.start_events and (parent is not None
+                                      or (trigger or "").startswith("subflow:")):
+                starts = proc.called_starts      # called: its none start events only
+            for index in starts:
                 frame.live += 1
                 self.state.ready.append((self.start_at, frame, index, None))
-        if not proc.graph.starts:
-            self.state.pending[frame] = None
+            if not starts:
+                self.state.pending[frame] = None
         if proc.deadline is not None:
             self.state.call_at(proc.deadline, lambda: self._process_deadline(inst))
         return inst

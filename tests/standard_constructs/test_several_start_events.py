@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import pytest
 
-from .conftest import completed, run
+from .conftest import completed, kinds, run
 
 
 @pytest.mark.parametrize("name", ["several_start_events.bpmn", "several_start_events.xpdl"])
@@ -30,3 +30,21 @@ def test_each_start_event_starts_its_own_instance_with_only_its_path(name: str) 
     assert sorted(instances.values()) == [["every_hour", "hourly", "end_hourly"]] * 2 + [
         ["on_call", "answer", "end_answer"]]
     assert completed(outcome, "p")[0] == (600.0, "on_call")
+
+
+def test_a_called_process_starts_at_its_none_start_event_only() -> None:
+    """BPMN 2.0 §13.3.4 (Sub-Process / Call Activity): "the global Process that is called MAY
+    also have non-empty Start Events. These non-empty Start Events are alternative to the
+    empty Start Event and hence they are ignored when the Process is called from another
+    Process." And a timer start event's instance runs only its own path (§10.4.2).
+
+    "main" calls "p" at t=0: that instance runs "from_call" only; the timer start makes its
+    own instances at 1 h and 2 h, which run "hourly" only."""
+    outcome = run("start_events_when_called.bpmn", until=9000)
+    instances: dict[int, list[str]] = {}
+    for event in outcome.trace:
+        if event.process == "p" and event.kind == "activity.completed":
+            instances.setdefault(event.instance or 0, []).append(event.activity or "")
+    assert sorted(instances.values()) == [["every_hour", "hourly", "end_hourly"]] * 2 + [
+        ["s_none", "from_call", "end_call"]]
+    assert [e.process for e in kinds(outcome, "process.completed")][:2] == ["p", "main"]
