@@ -15,8 +15,6 @@ from opspec import _native
 
 _native.install()      # the engine compiled with mypyc, or from source if that build is stale
 
-import os
-from pathlib import Path
 from typing import Any
 
 __version__ = "0.1.0"
@@ -26,24 +24,24 @@ __all__ = ["RunOutcome", "User", "__version__", "run"]
 _RUNS = frozenset({"RunOutcome", "User"})
 
 
-def run(spec: Any, *, script: Any = None, **options: Any) -> Any:
+def run(spec: Any, **options: Any) -> Any:
     """Run ``spec`` once, as ``opspec run`` does, and return its ``opspec.RunOutcome`` (typed
     ``Any`` here so that ``import opspec`` imports nothing of the layers below): the public
     way to run a spec from Python (docs/architecture.md).
 
-    The options are those of :func:`opspec.runs.run` (``seed``, ``days``, ``until``,
-    ``user_model``, ``user``, ``user_index``, ``config``, ``performers``, ``listeners``,
-    ``params``, ``keep_trace``). ``script`` is, as with ``opspec run --script``, the path of a
-    script file (TOML or JSON), or a loaded :class:`~opspec.testing.script.Script`.
+    The options are those of :func:`opspec.request.run` (``seed``, ``days``, ``until``,
+    ``user_model``, ``script``, ``user``, ``no_user``, ``user_index``, ``config``,
+    ``performers``, ``listeners``, ``params``, ``keep_trace``): the request every front door
+    fills, decided by the same rules (the spec gate of ``opspec validate``, the companion
+    user model, scripts checked against the spec). ``script`` is, as with ``opspec run
+    --script``, the path of a script file (TOML or JSON), a loaded
+    :class:`~opspec.usermodels.scripts.Script` or its steps.
     """
     import importlib
 
     # imported by name, as the lazy names below: this package's root sits above every layer
     # (it is the public door), while opspec.model.codec imports the root for __version__
-    if isinstance(script, (str, os.PathLike)):
-        # the script reader lives with the spec tests (opspec.testing), above opspec.runs
-        script = importlib.import_module("opspec.testing.script").load_script(Path(script))
-    return importlib.import_module("opspec.runs").run(spec, script=script, **options)
+    return importlib.import_module("opspec.request").run(spec, **options)
 
 
 def __getattr__(name: str) -> Any:

@@ -26,7 +26,9 @@ day), optionally followed by ``am``/``pm``.
 Rates: ``10``, ``10Hz``, ``2.5 kHz``, ``10/s``, ``6 per minute``, ``3/h``, ``2/day``.
 
 Writing: :func:`clock_time` (``d1 08:00:00``, the timeline of ``opspec run``, traces and
-violations), :func:`time_of_day` (``08:00``) and :func:`span` (``4 h``, ``90 s``).
+violations), :func:`time_of_day` (``08:00``), :func:`span` (``4 h``, ``90 s``) and
+:func:`figure` (a measured value as ``opspec run`` and the walkthrough print a metric:
+``97.49 s``). A trace event as a line of text is :mod:`opspec.engine.trace_text`'s.
 
 Pure Python, depends only on :mod:`opspec.errors`: every layer may use it, the engine too.
 """
@@ -44,6 +46,7 @@ __all__ = [
     "DURATION_HINT",
     "ErrorClass",
     "clock_time",
+    "figure",
     "is_duration",
     "parse_duration",
     "parse_rate",
@@ -261,3 +264,13 @@ def span(seconds: float) -> str:
             plural = "s" if unit == "day" and count != 1 else ""
             return f"{count:g} {unit}{plural}"
     return f"{seconds:g} s"
+
+
+def figure(value: object, unit: str = "") -> str:
+    """A measured value for people, as ``opspec run`` prints a metric: 4 significant digits
+    for a float (``97.49 s``), a count as it is, ``-`` for none (a mean of no samples)."""
+    if value is None:
+        return "-"
+    if isinstance(value, float):
+        return f"{value:.4g}{unit}"
+    return f"{value}{unit}"

@@ -1,9 +1,9 @@
-"""One module builds every run: spec and seed in, one :class:`RunOutcome` out.
+"""One module builds every run: a decided request in, one :class:`RunOutcome` out.
 
-``opspec run``, ``opspec evaluate`` (each replication), :func:`opspec.testing.simulate`,
-scenario files, the walkthrough and its replays all build their simulations here, so the same
-spec, seed and user give the same run through every front door. The public face is
-:func:`run` (also ``opspec.run``)::
+Every front door fills an :class:`opspec.request.RunRequest`; :func:`opspec.request.prepare`
+decides it (the spec gate, the user, the seed, the length) and builds its runs here, so the
+same spec, seed and user give the same run through every door. The public face is
+:func:`opspec.run` (:func:`opspec.request.run`)::
 
     import opspec
 
@@ -15,16 +15,17 @@ spec, seed and user give the same run through every front door. The public face 
 What a run is made of, and the one rule for each (``docs/architecture.md``):
 
 * **the spec** (:func:`load`): a path (XPDL or ``.wfs``), a ``Package`` or a
-  ``CompiledPackage``; the specs its modes name (``<opspec:Mode Source="dock.xpdl">``) are
+  ``CompiledPackage``, compiled (the gate that refuses what ``opspec validate`` refuses is
+  :func:`opspec.request.prepare`'s); the specs its modes name (``<opspec:Mode Source="dock.xpdl">``) are
   loaded relative to the spec's file when a mode change first enters them;
 * **the seed and the scope**: user ``u`` of a run seeded ``S`` draws from streams keyed
   ``(S, u)`` only: the engine's random scope is ``(u,)``, the user model's stream is
   ``user_stream(S, u)`` and the world's is ``named_stream(S, "world/NAME", (u,))``. A single
   run (``opspec run``, ``opspec.run``, the walkthrough) is user 0, so ``opspec run --seed S``
   draws the same numbers as user 0 of ``opspec evaluate --seed S``. A seed is a whole number
-  from 0 to 2**63 - 1;
-* **the run length** (:func:`run_length`): ``days`` or ``until`` when given, else the spec's
-  ``opspec:RunLength``, else one simulated day;
+  from 0 to 2**63 - 1 (:func:`opspec.run_rules.check_seed`);
+* **the run length** (:func:`opspec.run_rules.run_length`): ``days`` or ``until`` when given,
+  else the spec's ``opspec:RunLength``, else one simulated day;
 * **the user lane** (:class:`User`): a script, a stochastic user model, a person (the
   walkthrough) or nobody;
 * **the world** the spec declares (``opspec:World``), **devices** bound to real or emulated
@@ -38,7 +39,6 @@ devices are installed on it); :meth:`Run.execute` runs it to its length and retu
 
 from __future__ import annotations
 
-import math
 import operator
 from collections.abc import Callable, Iterable, Mapping, Sequence
 from dataclasses import dataclass, field
@@ -48,13 +48,14 @@ from typing import TYPE_CHECKING, Any, Protocol
 from opspec.engine.compiled import CompiledPackage, compile_package
 from opspec.engine.config import EngineConfig
 from opspec.engine.simulation import RunResult, Simulation
-from opspec.errors import ConfigurationError
 from opspec.model import Package
+from opspec.run_rules import DAY, MAX_SEED, check_seed, run_length
 
 if TYPE_CHECKING:
-    from opspec.engine.monitors import Monitor, MonitorResult, MonitorRun
     from opspec.engine.performers import Performer
     from opspec.engine.trace import TraceEvent, TraceListener
+    from opspec.properties.language import MonitorResult, MonitorRun
+    from opspec.properties.monitors import Monitor
 
 __all__ = [
     "DAY",
@@ -65,62 +66,12 @@ __all__ = [
     "User",
     "build",
     "check_seed",
-    "companion_user_model",
     "load",
-    "run",
     "run_length",
 ]
 
-DAY = 86_400.0
-#: numpy's SeedSequence takes non-negative integers; 2**63 - 1 keeps seeds in an SQLite integer
-MAX_SEED = 2**63 - 1
-
-
-# ---------------------------------------------------------------------------- the rules
-
-
-def check_seed(seed: Any) -> int:
-    """``seed`` as a plain int: a whole number from 0 to 2**63 - 1 (numpy integers too), else
-    a :class:`ConfigurationError`."""
-    if isinstance(seed, bool):
-        raise ConfigurationError(f"a seed is a whole number, not {seed!r}")
-    try:
-        value = operator.index(seed)
-    except TypeError:
-        raise ConfigurationError(f"a seed is a whole number, not {seed!r}") from None
-    if not 0 <= value <= MAX_SEED:
-        raise ConfigurationError(f"seed {value} is out of range: a seed is a whole number "
-                                 "from 0 to 2**63 - 1")
-    return value
-
-
-def run_length(spec: Package | CompiledPackage, *, days: float | None = None,
-               until: float | None = None) -> float:
-    """How long a run of ``spec`` lasts, in simulated seconds: ``days`` or ``until`` when
-    given, else the spec's ``opspec:RunLength``, else one day. Every front door uses this
-    rule (``opspec run``, ``evaluate``, ``simulate()``, scenario files, the walkthrough)."""
-    if days is not None and until is not None:
-        raise ConfigurationError("give days or until, not both")
-    if days is not None:
-        if isinstance(days, bool) or not (float(days) > 0 and math.isfinite(days)):
-            raise ConfigurationError(f"days must be a positive number, not {days!r}")
-        return float(days) * DAY
-    if until is not None:
-        if isinstance(until, bool) or not (float(until) > 0 and math.isfinite(until)):
-            raise ConfigurationError(f"until must be a positive number of seconds, "
-                                     f"not {until!r}")
-        return float(until)
-    package = spec.package if isinstance(spec, CompiledPackage) else spec
-    if package.run_length is not None:
-        return float(package.run_length)
-    return DAY
-
-
-def companion_user_model(spec_path: str | Path) -> Path | None:
-    """``SPEC.users.toml`` next to the spec, if there is one."""
-    path = Path(spec_path)
-    candidate = path.with_name(path.name.removesuffix(path.suffix) + ".users.toml")
-    return candidate if candidate.is_file() else None
+# the rules of a run's numbers (the seed, the run length) are opspec.run_rules'; named here too
+# because a run is made of them
 
 
 # ---------------------------------------------------------------------------- the spec
@@ -146,7 +97,7 @@ def load(spec: str | Path | Package | CompiledPackage | LoadedSpec) -> LoadedSpe
     the monitors it declares are read here (a located ConfigurationError when one is bad)."""
     if isinstance(spec, LoadedSpec):
         return spec
-    from opspec.engine.monitors import declared_monitors
+    from opspec.properties.monitors import declared_monitors
     from opspec.xpdl.open_spec import mode_loader_for, open_spec
 
     if isinstance(spec, (str, Path)):
@@ -160,7 +111,7 @@ def load(spec: str | Path | Package | CompiledPackage | LoadedSpec) -> LoadedSpe
 
 
 class _Script(Protocol):
-    """A script (:class:`opspec.testing.script.Script`): makes a fresh scripted user."""
+    """A script (:class:`opspec.usermodels.scripts.Script`): makes a fresh scripted user."""
 
     def performer(self) -> Any: ...
 
@@ -180,7 +131,7 @@ class User:
 
     @classmethod
     def script(cls, script: _Script | Any, describe: str = "a script") -> User:
-        """A scripted user: a :class:`~opspec.testing.script.Script` (a fresh performer per
+        """A scripted user: a :class:`~opspec.usermodels.scripts.Script` (a fresh performer per
         run) or a scripted performer made for one run (a walkthrough's replay)."""
         return cls("script", script, describe)
 
@@ -361,36 +312,3 @@ def build(spec: str | Path | Package | CompiledPackage | LoadedSpec, *, seed: in
         devices.install(sim)
     return Run(sim, horizon=horizon, seed=seed, user=user_index, watches=watches,
                performer=performer)
-
-
-def run(spec: str | Path | Package | CompiledPackage | LoadedSpec, *, seed: int = 0,
-        days: float | None = None, until: float | None = None, user_model: Any = None,
-        script: _Script | None = None, user: User | None = None, user_index: int = 0,
-        config: EngineConfig | Mapping[str, Any] | None = None,
-        performers: Mapping[str, Performer] | None = None,
-        listeners: Iterable[TraceListener] = (), params: Mapping[str, Any] | None = None,
-        keep_trace: bool = True) -> RunOutcome:
-    """Run ``spec`` once, as ``opspec run`` does, and return its :class:`RunOutcome`.
-
-    The user lane: ``user_model`` (a :class:`~opspec.usermodels.UserModel`, preset name or
-    TOML path), or ``script`` (a :class:`~opspec.testing.script.Script`: ``from
-    opspec.testing import load_script``), or ``user`` (a :class:`User`); with none of them,
-    the spec's companion ``SPEC.users.toml`` when ``spec`` is a path that has one, else
-    nobody. ``seed``, ``days``/``until`` and ``user_index`` follow the rules of the module
-    docstring: ``opspec.run(spec, seed=S)`` is user 0 of ``opspec evaluate spec --seed S``.
-    """
-    given = [name for name, value in (("user_model", user_model), ("script", script),
-                                      ("user", user)) if value is not None]
-    if len(given) > 1:
-        raise ConfigurationError(f"give one of user_model, script and user, not "
-                                 f"{' and '.join(given)}")
-    if user_model is not None:
-        user = User.model(user_model)
-    elif script is not None:
-        user = User.script(script)
-    elif user is None and isinstance(spec, (str, Path)):
-        companion = companion_user_model(spec)
-        user = User.model(companion) if companion is not None else None
-    return build(spec, seed=seed, user=user, user_index=user_index, days=days, until=until,
-                 config=config, performers=performers, listeners=listeners, params=params,
-                 keep_trace=keep_trace).execute()

@@ -14,7 +14,6 @@ from __future__ import annotations
 import math
 import os
 import re
-import tomllib
 from collections.abc import Iterable, Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -322,24 +321,13 @@ class _Table:
 
 def load_profile(path: str | os.PathLike[str]) -> DeviceProfile:
     """Read and validate one profile file; raise BindingError naming file and key."""
-    from opspec.files import open_regular, reason
+    from opspec.toml_files import read_toml
 
     where = str(path)
-    try:
-        with open_regular(path) as stream:        # a pipe or device never blocks
-            data = tomllib.load(stream)
-    except FileNotFoundError:
-        raise BindingError(f"device profile {where} does not exist",
-                           hint="profiles live in devices/; see `opspec devices list`") from None
-    except OSError as error:
-        raise BindingError(f"cannot read device profile {where}: {reason(error)}") from None
-    except tomllib.TOMLDecodeError as error:
-        raise BindingError(f"invalid TOML: {error}", location=SourceLocation(where),
-                           hint="fix the syntax; see devices/README.md") from None
-    except UnicodeDecodeError as error:   # TOML files are UTF-8 (tomllib decodes them so)
-        raise BindingError(f"not UTF-8 text: byte 0x{error.object[error.start]:02x} at offset "
-                           f"{error.start} cannot be decoded", location=SourceLocation(where),
-                           hint="save the profile as UTF-8") from None
+    data = read_toml(path, what=f"device profile {where}", error=BindingError,
+                     syntax_hint="fix the syntax; see devices/README.md", missing=(
+                         f"device profile {where} does not exist",
+                         "profiles live in devices/; see `opspec devices list`"))
     return _build(where, data)
 
 

@@ -6,20 +6,19 @@ import argparse
 
 __all__ = ["seed", "share", "sweep"]
 
-#: numpy's SeedSequence takes non-negative integers; 2**63 keeps seeds in an SQLite integer
-_MAX_SEED = 2**63 - 1
-
-
 def seed(text: str) -> int:
-    """A run seed: a whole number from 0 to 2**63 - 1."""
+    """A run seed: the rule of every door (:func:`opspec.run_rules.check_seed`)."""
+    from opspec.errors import ConfigurationError
+    from opspec.run_rules import check_seed
+
     try:
         value = int(text)
     except ValueError:
         raise argparse.ArgumentTypeError(f"{text!r} is not a whole number") from None
-    if not 0 <= value <= _MAX_SEED:
-        raise argparse.ArgumentTypeError(f"{value} is out of range: a seed is a whole number "
-                                         "from 0 to 2**63 - 1")
-    return value
+    try:
+        return check_seed(value)
+    except ConfigurationError as error:
+        raise argparse.ArgumentTypeError(error.message) from None
 
 
 def sweep(text: str) -> tuple[str, tuple[str, ...]]:

@@ -128,7 +128,6 @@ def _schedulability(package: Any, *, as_json: bool) -> int:
     """Response-time analysis beside a simulation of one hyperperiod from a synchronous
     release on one preemptive processor; 1 when a workflow misses its deadline."""
     from opspec.engine.config import EngineConfig
-    from opspec.engine.simulation import Simulation
     from opspec.model.schedulability import analyse, hyperperiod, tasks_of
 
     tasks = analyse(tasks_of(package))
@@ -156,7 +155,11 @@ def _schedulability(package: Any, *, as_json: bool) -> int:
 
     listen.selects = {(k, w, None) for k in ("process.started", "process.completed")  # type: ignore[attr-defined]
                       for w in wanted}
-    Simulation(package, config, listeners=[listen]).run(until=horizon)
+    from opspec.request import RunRequest, prepare
+
+    # one run as every door makes it (its world, seed 0), nobody on the user lane
+    prepare(RunRequest(package, until=horizon, no_user=True, config=config,
+                       listeners=(listen,))).execute()
     unfinished = set()
     for workflow, at in started.values():       # still running at the horizon: at least
         worst[workflow] = max(worst.get(workflow, 0.0), horizon - at)

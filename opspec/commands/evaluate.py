@@ -49,6 +49,11 @@ def register(subparsers: Any) -> None:
                         "companion SPEC.users.toml)")
     parser.add_argument("--compare", metavar="SPEC2",
                         help="a second design, run on the same simulated users")
+    parser.add_argument("--param", action="append", default=[], metavar="NAME=VALUE",
+                        help="a value for a package data field of type integer, float or "
+                        "boolean, such as a BPMN diagram's run input (a variable its "
+                        "conditions read that nothing sets; repeatable; docs/bpmn.md, Run "
+                        "inputs)")
     parser.add_argument("--sweep", type=sweep, metavar="PARAM=V1,V2,...",
                         help="run one design per value of a spec or user-model parameter, "
                         "on the same simulated users ('--sweep list' lists the parameters; "
@@ -132,29 +137,29 @@ def _engine(path: str | None) -> dict[str, Any]:
 
 
 def _new_plan(args: argparse.Namespace) -> Any:
-    from opspec.commands._spec import companion_user_model
     from opspec.evaluation.plan import DAY, Design, EvaluationPlan, file_digest
+    from opspec.request import RunRequest, prepare
+    from opspec.run_rules import check_days
 
     if args.spec is None:
         raise EvaluationError("give the SPEC to evaluate (or --resume --out DIR)")
+    if args.days is not None:
+        check_days(args.days, name="--days")
     specs = [("A", args.spec)] + ([("B", args.compare)] if args.compare else [])
-    designs = []
-    run_lengths = []
-    for label, path in specs:
-        from opspec.commands._spec import load_any_spec
+    # each design fills the request of every door: a spec validate rejects stops here
+    # (path:line); design A decides the run length and the user model of both
+    a = prepare(RunRequest(args.spec, days=args.days, user_model=args.user_model))
+    model = a.user_model
+    for _label, path in specs[1:]:
+        prepare(RunRequest(path, days=args.days, user_model=model, no_user=model is None))
+    # --param: a value of a package data field (a BPMN diagram's run input) for every design,
+    # applied as a parameter of one value (what --sweep applies per design)
+    from opspec.commands._params import parse_params
 
-        # a spec validate rejects stops here (path:line); its warnings are printed
-        package = load_any_spec(path, command="evaluate")
-        run_lengths.append(package.run_length)
-        designs.append(Design(label, str(path), file_digest(path)))
-    days = args.days
-    if days is None:
-        # the one rule of opspec.runs.run_length: the spec's opspec:RunLength, else one day
-        days = run_lengths[0] / DAY if run_lengths[0] is not None else 1.0
-    model = args.user_model
-    if model is None:
-        companion = companion_user_model(args.spec)
-        model = str(companion) if companion is not None else None
+    fixed = tuple((f"spec.{name}", value)
+                  for name, value in parse_params(args.param, a.package).items())
+    designs = [Design(label, str(path), file_digest(path), fixed) for label, path in specs]
+    days = float(args.days) if args.days is not None else a.horizon / DAY
     users = args.users if args.users is not None else DEFAULT_USERS
     run_seed = args.seed if args.seed is not None else DEFAULT_SEED
     export = _exports(args.export)
@@ -366,11 +371,7 @@ def run(args: argparse.Namespace) -> int:
                 hint="resume with the stored options (or none: `opspec evaluate --resume "
                 f"--out {args.out}`), or start a new run with another --out")
         _check_unchanged(store, plan)
-        from opspec.commands._spec import load_any_spec
-
-        for design in plan.designs:         # the spec's warnings, as a new run shows them
-            load_any_spec(design.spec, command="evaluate")
-        definitions = _check_plan(plan)
+        definitions = _check_plan(plan)     # the specs' warnings, as a new run shows them
         from opspec.evaluation.sweep import check_targets, resumed_sweep
 
         try:

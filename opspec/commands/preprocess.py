@@ -117,7 +117,7 @@ def _copy_user_model(source: Path, target: Path) -> None:
     """Copy the spec's companion ``SPEC.users.toml`` to the output's companion name, so
     ``opspec evaluate OUT`` draws the same users (an existing different file is kept)."""
 
-    from opspec.commands._spec import companion_user_model
+    from opspec.request import companion_user_model
 
     model = companion_user_model(source)
     if model is None:

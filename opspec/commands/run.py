@@ -19,12 +19,12 @@ from __future__ import annotations
 import argparse
 import contextlib
 import json
-import math
 import sys
 from collections.abc import Iterator
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
+from opspec.clock import clock_time, figure, span
 from opspec.commands._args import seed
 from opspec.errors import ConfigurationError
 
@@ -33,8 +33,6 @@ if TYPE_CHECKING:
     from opspec.engine.trace import TraceEvent
 
 __all__ = ["json_metrics", "register", "run", "timeline_line"]
-
-DAY = 86_400.0
 
 # Kinds shown in the default (brief) timeline: what a reader follows; the full trace has all.
 BRIEF_KINDS = frozenset({
@@ -105,21 +103,22 @@ def register(subparsers: Any) -> None:
 
 def run(args: argparse.Namespace) -> int:
     from opspec.commands._params import parse_params
-    from opspec.commands._spec import choose_user, load_any_spec
     from opspec.engine.trace_sinks import JsonlSink
-    from opspec.runs import build, load, run_length
+    from opspec.request import RunRequest, prepare
+    from opspec.run_rules import check_days, parse_until
 
-    package = load_any_spec(args.spec, command="run")
-    spec = load(package)
+    if args.days is not None:
+        check_days(args.days, name="--days")
+    prepared = prepare(RunRequest(
+        args.spec, seed=args.seed, days=args.days,
+        until=None if args.until is None else parse_until(args.until, name="--until"),
+        script=args.script, user_model=args.user_model, no_user=args.no_user))
+    for warning in prepared.warnings:
+        print(f"opspec run: {warning}", file=sys.stderr)
+    package, compiled = prepared.package, prepared.compiled
+    horizon, user = prepared.horizon, prepared.user
     params = parse_params(args.param, package) or None      # a bad value stops us before the run
-    compiled = spec.compiled
     config = _config(args)
-    if args.days is not None and not (args.days > 0 and math.isfinite(args.days)):
-        raise ConfigurationError(f"--days must be a positive number, not {args.days:g}")
-    horizon = run_length(compiled, days=args.days,
-                         until=None if args.until is None else _parse_until(args.until))
-    user = choose_user(compiled, args.spec, script=args.script, user_model=args.user_model,
-                       companion=not args.no_user)
     out = sys.stdout
     printer = None if args.json or args.timeline == "none" else _Timeline(
         out, brief=args.timeline == "brief", quiet=quiet_activities(compiled))
@@ -131,7 +130,7 @@ def run(args: argparse.Namespace) -> int:
             config, clock_note = devices.clock(config, args.speed, horizon)
         if not args.json:
             print(f"opspec run: {package.name or package.id} ({args.spec}), seed {args.seed}, "
-                  f"for {_span(horizon)} simulated", file=out)
+                  f"for {span(horizon)} simulated", file=out)
             print(f"  user lane: {user.describe}", file=out)
             print(f"  engine: {config.processor_model}"
                   + (f", {config.workers} worker(s)" if config.processor_model == "pooled" else
@@ -160,9 +159,8 @@ def run(args: argparse.Namespace) -> int:
             listeners.append(printer)
             if not args.json:
                 print(file=out)
-        outcome = build(spec, seed=args.seed, user=user, until=horizon, config=config,
-                        listeners=listeners, devices=devices,
-                        params=params).execute()
+        outcome = prepared.but(config=config, listeners=tuple(listeners),
+                               devices=devices, params=params).build().execute()
         result = outcome.result
         absent = _waiting_for_absent_user(result.summary, compiled, user)
         monitors = {r.monitor: r for r in outcome.monitors}
@@ -248,7 +246,7 @@ def _print_monitors(out: Any, monitors: dict[str, Any]) -> None:
             continue
         print(f"monitor {text}: {result.count} violation(s)", file=out)
         for violation in result.violations[:MONITOR_SHOWN]:
-            print(f"  {clock(violation.time)}: {violation.message}", file=out)
+            print(f"  {clock_time(violation.time)}: {violation.message}", file=out)
         if result.count > MONITOR_SHOWN:
             print(f"  … and {result.count - MONITOR_SHOWN} more", file=out)
 
@@ -288,19 +286,6 @@ def _config(args: argparse.Namespace) -> Any:
     return config.with_options(**overrides) if overrides else config
 
 
-def _parse_until(text: str) -> float:
-    from opspec.clock import parse_duration
-
-    # the one duration grammar (opspec.clock), refused with the same message as everywhere
-    try:
-        value = parse_duration(text, error=ConfigurationError)
-    except ConfigurationError as error:
-        raise ConfigurationError(f"--until: {error.message}", hint=error.hint) from None
-    if not (value > 0 and math.isfinite(value)):
-        raise ConfigurationError(f"--until must be a positive time, not {text!r}")
-    return value
-
-
 def _devices(args: argparse.Namespace, stack: contextlib.ExitStack, compiled: Any) -> Any:
     if not args.bind:
         return None
@@ -329,52 +314,11 @@ def _open_sink(factory: Any, path: str, header: dict[str, Any]) -> Iterator[Any]
 # ---------------------------------------------------------------------------- output
 
 
-def clock(seconds: float) -> str:
-    """``d1 08:00:00`` (day 1 is the first day) or ``d1 08:00:00.250`` with fractions."""
-    from opspec.clock import clock_time
-    return clock_time(seconds)
-
-
-def _span(seconds: float) -> str:
-    """A length of time for people: :func:`opspec.clock.span` (``2 days``, ``4 h``, ``15 min``)."""
-    from opspec.clock import span
-    return span(seconds)
-
-
 def timeline_line(event: TraceEvent) -> str:
-    """One readable line: time, lane, process#instance, what happened, key details."""
-    data = event.data or {}
-    kind = event.kind
-    what: str
-    if kind == "trigger.raised":
-        what = f"trigger {data.get('name', '?')} raised" + (
-            f" by {event.activity}" if event.activity else "")
-    elif kind.startswith("activity."):
-        verb = kind.split(".", 1)[1]
-        what = f"{event.activity} {verb}"
-        if data.get("choice"):
-            what += f" (chose {data['choice']})"
-    elif kind.startswith("process."):
-        what = f"{event.process} {kind.split('.', 1)[1]}"
-    elif kind == "deadline.expired":
-        what = f"deadline of {event.activity} expired"
-    elif kind == "exception.raised":
-        what = f"exception {data.get('exception', '?')} at {event.activity}"
-    else:
-        what = kind + (f" {event.activity}" if event.activity else "")
-    details = ("reason", "message", "latency") + (
-        () if kind == "exception.raised" else ("exception",))
-    for key in details:
-        if key in data:
-            value = data[key]
-            if isinstance(value, float):
-                value = f"{value:g}"
-            what += f"  [{key}: {value}]"
-            break
-    where = f"{event.process or ''}#{event.instance}" if event.instance is not None else (
-        event.process or "")
-    lane = event.lane or ("" if event.process is None else "device")
-    return f"{clock(event.time):>16}  {lane:<7} {where:<24} {what}"
+    """One readable line: :func:`opspec.engine.trace_text.timeline_line`."""
+    from opspec.engine.trace_text import timeline_line as line
+
+    return line(event)
 
 
 def quiet_activities(compiled: Any) -> frozenset[tuple[str, str]]:
@@ -458,14 +402,6 @@ def _json_document(args: argparse.Namespace, package: Any, horizon: float | None
     return doc
 
 
-def _fmt(value: Any, unit: str = "") -> str:
-    if value is None:
-        return "-"
-    if isinstance(value, float):
-        return f"{value:.4g}{unit}"
-    return f"{value}{unit}"
-
-
 def _percent(rate: Any, ci: list[Any]) -> str:
     """A miss rate with its exact 95 % interval, in percent."""
     if rate is None:
@@ -514,21 +450,21 @@ def _print_timing(out: Any, timing: dict[str, dict[str, Any]], pool: dict[str, A
         print(f"  priority-queues model: {pool.get('cpus')} processor(s), "
               f"{pool.get('queue_workers')} worker(s) per queue, {pool.get('switches')} context "
               f"switches ({pool.get('leader_passes')} into the leader), "
-              f"{pool.get('preemptions')} preemption(s), busy {_fmt(pool.get('busy_time'))} s, "
+              f"{pool.get('preemptions')} preemption(s), busy {figure(pool.get('busy_time'))} s, "
               f"at most {pool.get('max_waiting')} waiting", file=out)
     elif pool and pool.get("preemptive"):
         print(f"  preemptive model: {pool.get('workers')} processor(s), {pool.get('switches')} "
               f"dispatches, {pool.get('preemptions')} preemption(s), busy "
-              f"{_fmt(pool.get('busy_time'))} s, at most {pool.get('max_waiting')} waiting",
+              f"{figure(pool.get('busy_time'))} s, at most {pool.get('max_waiting')} waiting",
               file=out)
     elif pool:
         print(f"  pooled model: {pool.get('workers')} worker(s), {pool.get('switches')} context "
-              f"switches, busy {_fmt(pool.get('busy_time'))} s, at most "
+              f"switches, busy {figure(pool.get('busy_time'))} s, at most "
               f"{pool.get('max_waiting')} waiting", file=out)
     elif dedicated:
         print("  dedicated model: one worker per workflow instance (unlimited processors, no "
               "switch cost, by design)", file=out)
-        print(f"  {dedicated.get('bursts')} CPU bursts, busy {_fmt(dedicated.get('busy_time'))}"
+        print(f"  {dedicated.get('bursts')} CPU bursts, busy {figure(dedicated.get('busy_time'))}"
               f" s, at most {dedicated.get('max_busy')} at once (pooled with that many workers "
               "and no switch cost waits for none)", file=out)
     print("  response = completion - start of an instance: declared durations count too"
@@ -549,16 +485,16 @@ def _print_summary(out: Any, result: RunResult, medians: dict[str, float], trace
                 text = f"{value['total']}"
             elif value["kind"] == "duration":
                 text = (f"n {value['n']}" if not value["n"] else
-                        f"mean {_fmt(value['mean'], ' s')}, median {_fmt(value['median'], ' s')}"
-                        f", p95 {_fmt(value['p95'], ' s')}, n {value['n']}")
+                        f"mean {figure(value['mean'], ' s')}, median {figure(value['median'], ' s')}"
+                        f", p95 {figure(value['p95'], ' s')}, n {value['n']}")
             else:
-                text = _fmt(value.get("value"))
+                text = figure(value.get("value"))
             print(f"  {name:<{width}}  {text}", file=out)
     counts = summary.get("instances", {})
     parts = ", ".join(f"{k} {v}" for k, v in counts.items() if v)
     # simulation events do not depend on the options; trace events are only those some
     # listener (timeline, --trace, --timing, metrics) asked for
-    print(f"ended at {clock(summary.get('time', 0.0))}: {summary.get('sim_events', 0)} "
+    print(f"ended at {clock_time(summary.get('time', 0.0))}: {summary.get('sim_events', 0)} "
           f"simulation events, {summary.get('events', 0)} traced ({shown} shown), "
           f"instances: {parts or 'none'}", file=out)
     drift = summary.get("drift")

@@ -202,26 +202,16 @@ def _parameter(parameter: FormalParameter) -> str:
 
 
 def _trigger(trigger: TriggerRef) -> str:
+    from opspec.clock import span, time_of_day
+
     if trigger.name:
         return f"{trigger.kind}:{trigger.name}"
     text = trigger.kind
     if trigger.at:
-        text += " at " + ", ".join(_clock(t) for t in trigger.at)
+        text += " at " + ", ".join(time_of_day(t) for t in trigger.at)
     if trigger.every is not None:
-        text += f" every {_span(trigger.every)}"
+        text += f" every {span(trigger.every)}"
     return text
-
-
-def _clock(seconds: float) -> str:
-    """Seconds after midnight as ``08:00`` (or ``08:00:30``)."""
-    from opspec.clock import time_of_day
-    return time_of_day(seconds)
-
-
-def _span(seconds: float) -> str:
-    """A length of time for people: :func:`opspec.clock.span` (``2 days``, ``4 h``, ``15 min``)."""
-    from opspec.clock import span
-    return span(seconds)
 
 
 def _directives(directives: ProcessDirectives) -> str:

@@ -10,7 +10,6 @@ from __future__ import annotations
 
 import argparse
 import contextlib
-import math
 import re
 import sys
 from datetime import UTC, datetime
@@ -90,18 +89,22 @@ def register(subparsers: Any) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    from opspec.commands._spec import companion_user_model, load_any_spec
-    from opspec.engine.compiled import compile_package
+    from opspec.request import RunRequest, prepare
+    from opspec.run_rules import check_days
 
     if args.speed is not None and not (args.speed > 0):
         raise ConfigurationError(f"--speed must be positive, not {args.speed:g}")
-    if args.days is not None and not (args.days > 0 and math.isfinite(args.days)):
-        raise ConfigurationError(f"--days must be a positive number, not {args.days:g}")
-    spec_warnings: list[str] = []                 # shown as notes: what runs differently
-    package = load_any_spec(args.spec, warnings=spec_warnings)   # a broken spec opens nothing
-    compiled = compile_package(package)
-    model_ref = args.user_model or companion_user_model(args.spec)
-    factory = _model_factory(compiled, model_ref, args.seed) if model_ref else None
+    if args.days is not None:
+        check_days(args.days, name="--days")
+    # the person performs the lane; the request's user is the model they hand it over to
+    # (--user-model, else the companion SPEC.users.toml), checked against the spec
+    prepared = prepare(RunRequest(args.spec, seed=args.seed, days=args.days,
+                                  user_model=args.user_model))   # a broken spec opens nothing
+    # validate's warnings (what runs differently) are shown as notes on the screen
+    spec_warnings: list[str] = [str(w) for w in prepared.warnings]
+    package, compiled = prepared.package, prepared.compiled
+    model = prepared.user.source if prepared.user.kind == "model" else None
+    factory = _model_factory(model, prepared.seed) if model is not None else None
     replay = None
     if args.replay:
         from opspec.tui.replay import load_recording
@@ -168,15 +171,8 @@ def run(args: argparse.Namespace) -> int:
     return 130 if interrupted else 1 if session.failure is not None else 0
 
 
-def _model_factory(compiled: Any, ref: Any, seed: int) -> Any:
-    from opspec.engine.lanes import user_lane
-    from opspec.usermodels.loader import load_user_model
-
-    model = load_user_model(ref)
-    lane = user_lane(compiled)
-    if not lane.empty:
-        for warning in model.validate_against(lane.manual, choices=lane.choices):
-            print(f"opspec walkthrough: {warning}", file=sys.stderr)
+def _model_factory(model: Any, seed: int) -> Any:
+    """The performers of the hand-overs to ``model`` (a UserModel)."""
     handovers = [0]
 
     def make() -> Any:

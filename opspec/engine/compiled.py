@@ -146,6 +146,7 @@ class CTrigger:
     #                                        firings are ``offset``, +``every``… (``count``)
     anchored: bool = False                 # planned: ``offset`` is a date (else the firings
     #                                        count from when the timer is armed)
+    interval: Sampler | None = None        # arrival: the inter-arrival time, drawn each time
 
 
 @dataclass(frozen=True, slots=True, eq=False)
@@ -423,6 +424,21 @@ class _Compiler:
             condition = self.cond(ref.condition, None, ref.location, "rule trigger")
         return CTrigger(kind=ref.kind, name=ref.name, at=tuple(sorted(ref.at)), every=ref.every,
                         offset=ref.offset, condition=condition, location=ref.location)
+
+    def arrivals(self, proc: WorkflowProcess) -> CTrigger:
+        """Stochastic arrivals: the first instance when armed, then one after each
+        inter-arrival time drawn from the process's own stream (``arrivals/PROCESS``)."""
+        directives = proc.directives
+        assert directives.arrival is not None
+        try:
+            interval = make_sampler(directives.arrival)
+        except ValueError as error:
+            raise _spec_error(f"inter-arrival time of process {proc.id!r}: {error}",
+                              proc.location, "see docs/sisarl-xpdl.md for the distributions"
+                              ) from None
+        count = directives.arrival_count
+        return CTrigger(kind="arrival", name=proc.id, interval=interval,
+                        count=-1 if count is None else count, location=proc.location)
 
     def event_trigger(self, event: Event, act: Activity) -> CTrigger | None:
         trig = event.trigger
@@ -911,6 +927,8 @@ class _Compiler:
         data.update({f.id: self.initial(f) for f in proc.data_fields})
         start = self.trigger_ref(directives.start_trigger)
         start_events: tuple[tuple[CTrigger, int], ...] = ()
+        if start is None and directives.arrival is not None:
+            start = self.arrivals(proc)
         if start is None:
             start_events = tuple((_start_trigger(graph.activities[index].trigger), index)
                                  for index in graph.starts

@@ -424,6 +424,8 @@ class Triggers(Part):
         elif kind in ("timer", "period"):
             times = _occurrences(trig, self.state.env.now)
             self._next_timer(times, fire, f"{kind}")
+        elif kind == "arrival":
+            self._next_arrival(trig, fire, 0, 0.0)
         elif kind == "rule":
             condition = trig.condition
             assert condition is not None
@@ -451,6 +453,28 @@ class Triggers(Part):
             self._next_timer(times, fire, label)
         self.state.wakeups.after(max(0.0, at - self.state.env.now), fired)
 
+
+
+    def _next_arrival(self, trig: CTrigger, fire: Callable[[str], None], made: int,
+                      gap: float) -> None:
+        """Arrival ``made + 1`` of a stochastic arrival process, ``gap`` seconds from now;
+        the next gap is drawn when it fires, from the process's own stream, so a seed gives
+        the same arrivals whatever else the run draws."""
+        if 0 <= trig.count <= made:
+            return
+        state = self.state
+        at = state.env.now + max(0.0, gap)
+        if state.resolution > 0.0:
+            at = math.ceil(at / state.resolution) * state.resolution
+
+        def fired(_event: Any) -> None:
+            fire("arrival")
+            state.drain()
+            interval = trig.interval
+            assert interval is not None
+            drawn = interval(state.streams.stream(f"arrivals/{trig.name}"))
+            self._next_arrival(trig, fire, made + 1, drawn)
+        state.wakeups.after(max(0.0, at - state.env.now), fired)
 
 
 def _root(inst: ProcessInstance) -> ProcessInstance:

@@ -8,7 +8,6 @@ from __future__ import annotations
 
 import hashlib
 import json
-import math
 from collections.abc import Mapping
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
@@ -75,9 +74,13 @@ class EvaluationPlan:
     def __post_init__(self) -> None:
         if isinstance(self.users, bool) or not isinstance(self.users, int) or self.users < 1:
             raise EvaluationError(f"--users must be a whole number >= 1, not {self.users!r}")
-        if not (isinstance(self.days, (int, float)) and math.isfinite(self.days)
-                and self.days > 0):
-            raise EvaluationError(f"--days must be a positive number, not {self.days!r}")
+        from opspec.errors import ConfigurationError
+        from opspec.run_rules import check_days
+
+        try:                                # a stored plan too: the one rule of days
+            check_days(self.days, name="--days")
+        except ConfigurationError as error:
+            raise EvaluationError(error.message) from None
 
     @property
     def horizon(self) -> float:

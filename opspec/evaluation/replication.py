@@ -111,16 +111,17 @@ def prepare(spec: str, sha256: str, user_model: str | None, engine: Mapping[str,
         return found
     from opspec.engine.config import EngineConfig
     from opspec.engine.lanes import user_lane
+    from opspec.request import RunRequest
+    from opspec.request import prepare as decide
     from opspec.runs import User, load
 
-    loaded = load(spec)
+    # the front hall decides the spec (validate's gate) and the user model (checked against
+    # the spec's user lane), in the command and in every worker alike
+    prepared = decide(RunRequest(spec, user_model=user_model, no_user=user_model is None))
+    loaded = prepared.spec
     lane = user_lane(loaded.compiled)
-    user = None
-    warnings: tuple[Any, ...] = ()
-    if user_model is not None:
-        user = User.model(user_model)
-        if not lane.empty:
-            warnings = tuple(user.source.validate_against(lane.manual, choices=lane.choices))
+    user = prepared.user if prepared.user.kind == "model" else None
+    warnings: tuple[Any, ...] = prepared.warnings
     if parameters:
         from opspec.evaluation.parameters import apply_parameters
 

@@ -129,7 +129,8 @@ def plan_sweep(plan: EvaluationPlan, name: str, texts: Sequence[str]) -> tuple[
                               "(PARAM=v1,v2,…)", hint="a sweep compares values with the "
                               "first; for one value, a plain run does")
     a = plan.design("A")
-    designs = tuple(Design(v.design, a.spec, a.sha256, ((parameter.name, v.value),))
+    kept = tuple(p for p in a.parameters if p[0] != parameter.name)    # --param values
+    designs = tuple(Design(v.design, a.spec, a.sha256, (*kept, (parameter.name, v.value)))
                     for v in values)
     sweep = Sweep(parameter.name, parameter.unit, parameter.what, parameter.current,
                   tuple(values))

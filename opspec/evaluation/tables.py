@@ -5,8 +5,8 @@ from __future__ import annotations
 from collections.abc import Mapping, Sequence
 from typing import IO, Any
 
-from opspec.engine.monitors import clock
 from opspec.evaluation.plan import span
+from opspec.properties.language import clock
 
 __all__ = ["comparison_rows", "distribution_rows", "fmt", "is_rate", "metric_rows",
            "monitor_rows", "parameter_rows", "per_user_rows", "print_summary",

@@ -73,6 +73,11 @@ class ProcessDirectives:
     auto_start: bool | None = None        # start at engine start (None: only when triggered)
     lane: str | None = None               # "device" or "user" role of the process, if declared
     mode: str | None = None               # the mode this workflow belongs to, if any
+    # stochastic arrivals (opspec:Arrival; BPSim InterTriggerTimer, QBP arrivalRateDistribution
+    # in BPMN): an instance when the run starts, then one after each inter-arrival time drawn
+    # from ``arrival`` (seconds), ``arrival_count`` instances in all (None: no end)
+    arrival: DeclaredDistribution | None = None
+    arrival_count: int | None = None
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)

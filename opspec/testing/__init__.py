@@ -4,7 +4,8 @@
   ``--opspec-seed``, ``--device-url``, scenario-file collection), loaded by pytest through the
   ``pytest11`` entry point;
 * :mod:`~opspec.testing.simulation` - :func:`simulate` for one or many users, and its result;
-* :mod:`~opspec.testing.script` - scripted users as plain data;
+* :mod:`~opspec.usermodels.scripts` (also as ``opspec.testing.script``) - scripted users as
+  plain data;
 * :mod:`~opspec.testing.expectations` - readable ``then`` lines and :func:`expect`;
 * :mod:`~opspec.testing.scenario` - ``*.scenario.toml`` files;
 * :mod:`~opspec.testing.predicates` - trace predicates (``holds``, ``check``, ``within``, ...);
@@ -61,10 +62,10 @@ _WHERE = {
     "InstanceRun": "opspec.testing.simulation",
     "SimulationResult": "opspec.testing.simulation",
     "simulate": "opspec.testing.simulation",
-    "Script": "opspec.testing.script",
-    "ScriptUser": "opspec.testing.script",
-    "load_script": "opspec.testing.script",
-    "parse_script": "opspec.testing.script",
+    "Script": "opspec.usermodels.scripts",
+    "ScriptUser": "opspec.usermodels.scripts",
+    "load_script": "opspec.usermodels.scripts",
+    "parse_script": "opspec.usermodels.scripts",
     "expect": "opspec.testing.expectations",
     "parse_expectation": "opspec.testing.expectations",
     "load_scenarios": "opspec.testing.scenario",

@@ -16,7 +16,7 @@ Each line is one of (keywords in any case; ``OP`` is ``==``, ``!=``, ``<``, ``<=
     mean alarms_per_dose in [1.1, 1.25] with 95% confidence
     p95 report_latency_s <= 600 with 95% confidence
 
-The trace lines are the property language of monitors (:mod:`opspec.engine.properties`):
+The trace lines are the property language of monitors (:mod:`opspec.properties.language`):
 any monitor's text is a ``then`` line too (``min_gap dispense 4h``, ``bounded_response
 sound_alarm dispense 15min``, ``never_while ...``), judged on each replication's trace by the
 evaluator a monitor runs online (same verdict, same witness), and holding when it holds in
@@ -37,7 +37,9 @@ import re
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 
-from opspec.engine.properties import (
+from opspec.engine.trace import TraceEvent
+from opspec.errors import ConfigurationError, SourceLocation
+from opspec.properties.language import (
     BoundedResponse,
     CountBound,
     Eventually,
@@ -48,13 +50,10 @@ from opspec.engine.properties import (
     Precedence,
     Property,
     Subject,
-    clock,
     looks_like_property,
     read_property,
     trace_end,
 )
-from opspec.engine.trace import EventKind, TraceEvent
-from opspec.errors import ConfigurationError, SourceLocation
 from opspec.testing.simulation import FIELDS, SimulationResult, SpecNames
 
 __all__ = ["Expectation", "expect", "format_events", "parse_expectation"]
@@ -276,30 +275,15 @@ def _metric_line(values: dict[str, object]) -> str:
                      for k, v in values.items() if k != "kind")
 
 
-def _time(seconds: float) -> str:
-    return clock(seconds)       # d1 08:00:00, or d1 08:00:00.250: padded to 15 in listings
-
-
 def _in_rep(result: SimulationResult, rep: int) -> str:
     return f" (replication {rep})" if result.replications > 1 else ""
 
 
 def format_events(events: Sequence[TraceEvent]) -> list[str]:
-    """One short line per event: time, instance, process, kind, activity, key data."""
-    out = []
-    for e in events:
-        what = e.activity or ""
-        if e.kind == EventKind.TRIGGER_RAISED:
-            what = f"{e.data.get('name', '?')}" + (f" (by {e.activity})" if e.activity else "")
-        detail = ""
-        for key in ("exception", "reason", "message", "choice"):
-            if key in e.data:
-                detail = f"  ({key}: {e.data[key]})"
-                break
-        inst = f"#{e.instance}" if e.instance is not None else ""
-        out.append(f"    {_time(e.time):<15}  {inst:>4} {e.process or '':<18} {e.kind:<20} "
-                   f"{what}{detail}".rstrip())
-    return out
+    """One short line per event (:func:`opspec.engine.trace_text.listing_line`)."""
+    from opspec.engine.trace_text import listing_line
+
+    return [listing_line(e) for e in events]
 
 
 def _with_slice(lines: list[str], result: SimulationResult, events: Sequence[TraceEvent],

@@ -14,7 +14,7 @@ them in every run as well::
 
     <ExtendedAttribute Name="opspec:Monitor" Value="min_gap dispense 4h"/>
 
-A monitor is a property of the one property language (:mod:`opspec.engine.properties`, usable
+A monitor is a property of the one property language (:mod:`opspec.properties.language`, usable
 by any layer): its text is also a trace predicate (``holds(result, "min_gap dispense 4h")``)
 and a scenario ``then`` line, judged on stored traces by the same evaluator, and a monitor
 object is a predicate too (``check(result, min_gap("dispense", hours=4))``). This module adds
@@ -27,22 +27,20 @@ from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
 from typing import Any
 
-from opspec.engine.monitors import (
+from opspec.errors import ConfigurationError
+from opspec.properties.language import (
     BoundedResponse,
     MaxCount,
     MinGap,
-    Monitor,
     MonitorResult,
     Names,
     Never,
     NeverWhile,
     Violation,
     clock,
-    declared_monitors,
-    parse_monitor,
     parse_subject,
 )
-from opspec.errors import ConfigurationError
+from opspec.properties.monitors import Monitor, declared_monitors, parse_monitor
 from opspec.statistics import poisson_interval
 from opspec.testing.intervals import _pct
 
@@ -77,7 +75,7 @@ def _span_text(seconds: float) -> str:
 
 def monitor(text: str) -> Monitor:
     """A monitor from its text form (``"min_gap dispense 4h"``, see
-    :mod:`opspec.engine.monitors`)."""
+    :mod:`opspec.properties.monitors`)."""
     return parse_monitor(text)
 
 

@@ -86,16 +86,18 @@ def resolve_path(ref: str | Path, config: pytest.Config, near: Path | None) -> P
 
 
 def load_cached(path: Path, config: pytest.Config) -> Any:
-    """The package of ``path``, loaded once per session; a broken spec fails the test with
-    its ``path:line`` message (no traceback)."""
+    """The package of ``path`` (XPDL, BPMN or ``.wfs``), loaded once per session; a spec
+    ``opspec validate`` refuses fails the test with its ``path:line`` message (no
+    traceback)."""
     cache = config.stash[_SPECS_KEY]
     if path not in cache:
         from opspec.engine.compiled import compile_package
-        from opspec.xpdl.loader import load_spec
+        from opspec.request import open_gated
 
         problem = None
         try:
-            package = load_spec(path)
+            # the front hall's gate: refused as `opspec validate` refuses it, any form
+            package = open_gated(path)[0]
             cache[path] = (package, compile_package(package))
         except OpspecError as error:
             problem = f"cannot load the spec: {error}"

@@ -14,7 +14,7 @@ A predicate is judged on each trace of what it is given - a
 :class:`~opspec.engine.trace.TraceEvent`, or the path of a JSON Lines trace written by
 ``opspec run --trace`` - and holds when it holds on every one.
 
-The temporal predicates are the properties of :mod:`opspec.engine.properties`, the language
+The temporal predicates are the properties of :mod:`opspec.properties.language`, the language
 of monitors: ``within(a, b, 60)`` is ``bounded_response a b 60s``, ``happens_before(a, b)`` is
 ``a before b``, ``never(x)`` is ``never x``, ``count(x) <= 4`` is ``count x <= 4``. Each is
 judged by feeding the trace to the evaluator a monitor runs online, so both give the same
@@ -40,7 +40,9 @@ from collections.abc import Callable, Iterable, Sequence
 from dataclasses import dataclass
 from typing import Any
 
-from opspec.engine.properties import (
+from opspec.engine.trace import EventKind, TraceEvent
+from opspec.errors import ConfigurationError
+from opspec.properties.language import (
     BoundedResponse,
     CountBound,
     Eventually,
@@ -54,8 +56,6 @@ from opspec.engine.properties import (
     parse_subject,
     trace_end,
 )
-from opspec.engine.trace import EventKind, TraceEvent
-from opspec.errors import ConfigurationError
 
 __all__ = [
     "Count",
@@ -163,7 +163,7 @@ class Match(Predicate):
         return self._test(event)
 
     def matches(self, event: TraceEvent) -> bool:
-        """As a property's selector (:class:`~opspec.engine.properties.Selector`)."""
+        """As a property's selector (:class:`~opspec.properties.language.Selector`)."""
         return self._test(event)
 
     def describe(self) -> str:
@@ -261,7 +261,7 @@ def event(kind: str, *, activity: str | None = None, process: str | None = None,
 
 # ---------------------------------------------------------------- properties as predicates
 class _Holds(Predicate):
-    """A :class:`~opspec.engine.properties.Property` judged on a trace: its events fed to the
+    """A :class:`~opspec.properties.language.Property` judged on a trace: its events fed to the
     evaluator a monitor runs online, so the verdict and the witness (the events marked in a
     failure) are the monitor's. ``label`` is how Python spelt it (``within(a, b, 60 s)``)."""
 

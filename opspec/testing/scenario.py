@@ -24,7 +24,6 @@ Every mistake is reported when the file is collected, as ``path: key: what (how 
 
 from __future__ import annotations
 
-import tomllib
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -32,7 +31,7 @@ from typing import Any
 
 from opspec.errors import ConfigurationError, OpspecError, SourceLocation
 from opspec.testing.expectations import Expectation, parse_expectation
-from opspec.testing.script import Script, load_script, parse_script
+from opspec.usermodels.scripts import Script, load_script, parse_script
 
 __all__ = ["Scenario", "ScenarioDocument", "load_scenarios", "run_scenario"]
 
@@ -118,21 +117,23 @@ def _given(path: Path, key: str, table: Any, rootdir: Path | None) -> dict[str, 
             out["user_model"] = load_user_model(found or ref)
         except OpspecError as error:
             raise _error(path, f"{key}.user_model", str(error)) from None
-    for name in ("users", "seed"):
+    if "users" in table:
+        value = table["users"]
+        if isinstance(value, bool) or not isinstance(value, int) or value < 1:
+            raise _error(path, f"{key}.users", f"users must be a whole number >= 1, not "
+                         f"{value!r}")
+        out["users"] = value
+    from opspec.run_rules import check_days, check_seed
+
+    for name, rule in (("seed", check_seed), ("days", check_days), ("until", _until)):
         if name in table:
-            value = table[name]
-            if isinstance(value, bool) or not isinstance(value, int) or value < (
-                    1 if name == "users" else 0):
-                raise _error(path, f"{key}.{name}", f"{name} must be a whole number"
-                             + (" >= 1" if name == "users" else " >= 0") + f", not {value!r}")
-            out[name] = value
-    if "days" in table:
-        value = table["days"]
-        if isinstance(value, bool) or not isinstance(value, (int, float)) or value <= 0:
-            raise _error(path, f"{key}.days", f"days must be a positive number, not {value!r}")
-        out["days"] = float(value)
-    if "until" in table:
-        out["until"] = _until(path, f"{key}.until", table["until"])
+            if name == "seed" and not isinstance(table[name], int):   # not text: TOML ints
+                raise _error(path, f"{key}.seed", f"a seed is a whole number, not "
+                             f"{table[name]!r}")
+            try:
+                out[name] = rule(table[name])
+            except ConfigurationError as error:
+                raise _error(path, f"{key}.{name}", error.message, error.hint or "") from None
     for name in ("engine", "params"):
         if name in table:
             if not isinstance(table[name], Mapping):
@@ -145,17 +146,12 @@ def _given(path: Path, key: str, table: Any, rootdir: Path | None) -> dict[str, 
     return out
 
 
-def _until(path: Path, key: str, value: Any) -> float:
+def _until(value: Any) -> float:
     if isinstance(value, bool) or not isinstance(value, (int, float, str)):
-        raise _error(path, key, f"until is seconds or a duration, not {value!r}")
-    if isinstance(value, str):
-        from opspec.clock import parse_duration
+        raise ConfigurationError(f"until is seconds or a duration, not {value!r}")
+    from opspec.run_rules import parse_until
 
-        value = parse_duration(value, location=SourceLocation(str(path), key=key),
-                               error=ConfigurationError)
-    if value <= 0:
-        raise _error(path, key, f"until must be positive, not {value!r}")
-    return float(value)
+    return parse_until(value)
 
 
 def load_scenarios(path: str | Path, *, rootdir: Path | None = None) -> ScenarioDocument:
@@ -166,15 +162,10 @@ def load_scenarios(path: str | Path, *, rootdir: Path | None = None) -> Scenario
     path = Path(path)
     if rootdir is not None and path.is_absolute() and path.is_relative_to(rootdir):
         path = path.relative_to(rootdir)     # messages name the file as the user wrote it
-    from opspec.files import read_text, reason
+    from opspec.toml_files import read_toml
 
-    try:
-        full = path if path.is_absolute() or rootdir is None else rootdir / path
-        document = tomllib.loads(read_text(full))   # a pipe or device never blocks
-    except OSError as error:
-        raise _error(path, None, f"cannot read it: {reason(error)}") from None
-    except (tomllib.TOMLDecodeError, UnicodeDecodeError) as error:
-        raise _error(path, None, f"not valid TOML: {error}") from None
+    full = path if path.is_absolute() or rootdir is None else rootdir / path
+    document = read_toml(full, what="the scenario file", location=SourceLocation(str(path)))
     _unknown(path, "", document, _TOP)
     ref = document.get("spec")
     if not isinstance(ref, str):
@@ -185,11 +176,11 @@ def load_scenarios(path: str | Path, *, rootdir: Path | None = None) -> Scenario
         raise _error(path, "spec", f"spec {ref!r} not found",
                      "a path relative to this file or the rootdir")
     from opspec.engine.compiled import compile_package
+    from opspec.request import open_gated
     from opspec.testing.simulation import spec_names
-    from opspec.xpdl.loader import load_spec
 
     try:
-        names = spec_names(compile_package(load_spec(spec_path)))
+        names = spec_names(compile_package(open_gated(spec_path)[0]))
     except OpspecError as error:
         raise _error(path, "spec", f"the spec does not load: {error}") from None
     defaults = _given(path, "given", document.get("given", {}), rootdir)

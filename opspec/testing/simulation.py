@@ -14,10 +14,14 @@ model, the user stream ``default_rng(SeedSequence(seed, spawn_key=(u,)))``. User
 the same whatever the number of users, so adding users never changes the first ones, and user
 0 is the run of ``opspec run --seed`` with the same seed.
 
+``simulate`` only fills an :class:`opspec.request.RunRequest`: the spec gate, the user, the
+seed and the run length follow the rules of every other door (``opspec run``, ``opspec.run``).
 Who performs the user lane: the ``user_model`` (a :class:`~opspec.usermodels.UserModel`, a
-preset name or a TOML path), else the ``script`` (see :mod:`opspec.testing.script`), else the
-cooperative user ``script=[]`` (every offer completed at once, a choice takes its first
-alternative). ``performers`` binds anything else (devices, callables) by participant or lane.
+preset name or a TOML path), or the ``script`` (see :mod:`opspec.usermodels.scripts`; ``[]`` is
+the cooperative user: every offer completed at once, a choice takes its first alternative),
+or nobody (``no_user=True``); with none of them, the spec's companion ``SPEC.users.toml`` when
+its file has one, else nobody, as ``opspec run`` does. ``performers`` binds anything else
+(devices, callables) by participant or lane.
 """
 
 from __future__ import annotations
@@ -37,10 +41,9 @@ from opspec.engine.simulation import RunResult
 from opspec.engine.trace import EventKind, TraceEvent
 from opspec.errors import ConfigurationError
 from opspec.model import Package
-from opspec.testing.script import Script, load_script, parse_script
 
 if TYPE_CHECKING:
-    from opspec.usermodels import UserModel
+    from opspec.usermodels.scripts import Script
 
 __all__ = [
     "FIELDS",
@@ -65,10 +68,11 @@ def derive_seed(base: int, text: str) -> int:
 
 
 def load_spec_file(path: str | Path) -> Package:
-    """Load an XPDL spec (``SpecError`` with ``path:line`` when it is broken)."""
-    from opspec.xpdl.loader import load_spec
+    """Load a spec (XPDL, BPMN or ``.wfs``), refused as ``opspec validate`` refuses it
+    (``SpecError`` with ``path:line``): :func:`opspec.request.open_gated`."""
+    from opspec.request import open_gated
 
-    return load_spec(path)
+    return open_gated(path)[0]
 
 
 @dataclass(frozen=True, slots=True)
@@ -278,20 +282,6 @@ def _pooled_scalar(values: Mapping[str, Any] | None) -> float | None:
     return None if value is None else float(value)
 
 
-def _user_model(ref: Any) -> UserModel:
-    from opspec.usermodels import UserModel, load_user_model
-
-    if isinstance(ref, UserModel):
-        return ref
-    return load_user_model(ref)
-
-
-def _script(ref: Any) -> Script:
-    if isinstance(ref, (str, Path)):
-        return load_script(ref)
-    return parse_script(ref)
-
-
 def simulate(spec: Package | CompiledPackage | str | Path, *, users: int = 1,
              days: float | None = None, until: float | None = None,
              script: Script | Sequence[Any] | str | Path | None = None,
@@ -301,48 +291,38 @@ def simulate(spec: Package | CompiledPackage | str | Path, *, users: int = 1,
              keep_trace: bool | None = None,
              params: Mapping[str, Any] | None = None,
              progress: Callable[[int], None] | None = None,
-             monitors: Sequence[Any] | None = None) -> SimulationResult:
+             monitors: Sequence[Any] | None = None,
+             no_user: bool = False) -> SimulationResult:
     """Run ``spec`` for ``users`` independent users, ``days`` days or to ``until`` seconds
     (default: the spec's ``opspec:RunLength``, else one day); see the module docstring. ``keep_trace`` defaults to keeping traces of up to 100
     users. Raises :class:`~opspec.errors.OpspecError` subclasses for bad arguments (naming the
     spec's processes, activities, triggers or metrics when a name is unknown).
     ``monitors`` (monitor objects or their text form, see :mod:`opspec.testing.monitors`) are
     checked in every replication, with those the spec declares (``opspec:Monitor``)."""
-    from opspec.runs import User, build, load, run_length
-
-    loaded = load(load_spec_file(spec) if isinstance(spec, (str, Path)) else spec)
-    compiled = loaded.compiled
-    if isinstance(users, bool) or not isinstance(users, int) or users < 1:
-        raise ConfigurationError(f"users must be a whole number >= 1, not {users!r}")
-    if script is not None and user_model is not None:
-        raise ConfigurationError("give script or user_model, not both",
-                                 hint="a script plays one scripted user; a user model draws "
-                                 "stochastic users")
-    horizon = run_length(compiled, days=days, until=until)
-    names = spec_names(compiled)
-    if user_model is not None:
-        who = User.model(user_model)
-    else:
-        plan = _script([] if script is None else script)
-        plan.check_names(names.activities, names.triggers)
-        who = User.script(plan)
-    keep = users <= 100 if keep_trace is None else keep_trace
+    from opspec.request import RunRequest, prepare
     from opspec.testing.monitors import monitors_for
 
-    watch = monitors_for(compiled, names, monitors)
+    if isinstance(users, bool) or not isinstance(users, int) or users < 1:
+        raise ConfigurationError(f"users must be a whole number >= 1, not {users!r}")
+    prepared = prepare(RunRequest(
+        spec, seed=seed, days=days, until=until, script=script, user_model=user_model,
+        no_user=no_user, config=engine_config, performers=performers or {}, params=params,
+        keep_trace=users <= 100 if keep_trace is None else keep_trace))
+    compiled = prepared.compiled
+    names = spec_names(compiled)
+    prepared = prepared.but(monitors=tuple(monitors_for(compiled, names, monitors)))
     watched: list[Any] = []
     runs: list[RunResult] = []
     pooled: dict[str, list[float]] = {}
     for u in range(users):
-        outcome = build(loaded, seed=seed, user=who, user_index=u, until=horizon,
-                        config=engine_config, performers=performers, params=params,
-                        keep_trace=keep, monitors=watch).execute()
+        outcome = prepared.build(u).execute()
         runs.append(outcome.result)
         watched.extend(outcome.monitors)
         for name, values in outcome.samples.items():
             pooled.setdefault(name, []).extend(values)
         if progress is not None:
             progress(u + 1)
+    horizon = prepared.horizon
     return SimulationResult(compiled.package, names, seed, horizon, tuple(runs),
                             _pool(runs, pooled, compiled.package),
                             {k: tuple(v) for k, v in pooled.items()}, tuple(watched))

@@ -1,6 +1,6 @@
 """Replaying a walkthrough recording: the same offers acted on, so the same trace.
 
-A recording is a script (:mod:`opspec.testing.script`) whose actions name the workflow
+A recording is a script (:mod:`opspec.usermodels.scripts`) whose actions name the workflow
 instance they were done in: ``complete hear_alarm #6``. The script language keeps the ``#6``
 (``Step.instance``): a tagged step is used only for an offer of instance 6, in a walkthrough's
 ``--replay`` and in ``opspec run --script`` alike. When three identical "Hear the alarm" offers wait and the person took the
@@ -14,7 +14,7 @@ import re
 from pathlib import Path
 
 from opspec.engine.compiled import CompiledPackage
-from opspec.testing.script import ScriptUser, load_script
+from opspec.usermodels.scripts import ScriptUser, load_script
 
 __all__ = ["instance_tag", "load_recording", "tagged_action"]
 
@@ -45,11 +45,10 @@ def load_recording(path: str | Path, compiled: CompiledPackage | None = None) ->
 
     Raises :class:`~opspec.errors.ConfigurationError` (unreadable file, bad step, a name the
     spec does not have)."""
-    script = load_script(path)
-    if compiled is not None:
-        from opspec.engine.names import spec_names
+    if compiled is None:
+        return load_script(path).performer()
+    from opspec.request import scripted_user
 
-        names = spec_names(compiled)
-        script.check_names(names.activities, names.triggers)
     # each step keeps its "#6" (Step.instance): it acts only on an offer of that instance
-    return script.performer()
+    performer: ScriptUser = scripted_user(path, compiled).source.performer()
+    return performer

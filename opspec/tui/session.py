@@ -97,14 +97,10 @@ class WalkSession:
                  device_participants: Mapping[str, Sequence[str]] | None = None,
                  wall_devices: bool = False, on_call: str = "realtime",
                  person: str | None = None) -> None:
-        from opspec.runs import check_seed, run_length
+        from opspec.run_rules import check_seed, run_length
 
         self.compiled = compiled
         self.seed = check_seed(seed)
-        if days is not None and not (days > 0 and math.isfinite(days)):
-            raise ConfigurationError(f"--days must be a positive number, not {days:g}",
-                                     hint="e.g. --days 1 (or leave it out for the spec's "
-                                     "opspec:RunLength)")
         #: where the run ends: the one rule of every run (opspec.runs.run_length): ``days``,
         #: else the spec's opspec:RunLength, else one day
         self.horizon = run_length(compiled, days=days)

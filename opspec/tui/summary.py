@@ -18,18 +18,10 @@ from pathlib import Path
 from statistics import median
 from typing import Any
 
+from opspec.clock import figure
 from opspec.tui.timing import Response
 
 __all__ = ["metric_lines", "replay_commands", "response_lines"]
-
-
-def _fmt(value: Any, unit: str = "") -> str:
-    # as `opspec run` prints a metric: 4 significant digits for floats
-    if value is None:
-        return "-"
-    if isinstance(value, float):
-        return f"{value:.4g}{unit}"
-    return f"{value}{unit}"
 
 
 def metric_lines(metrics: Mapping[str, Mapping[str, Any]],
@@ -46,11 +38,11 @@ def metric_lines(metrics: Mapping[str, Mapping[str, Any]],
         elif kind == "duration":
             n = value.get("n", 0)
             text = (f"n {n}" if not n else
-                    f"mean {_fmt(value.get('mean'), ' s')}, median "
-                    f"{_fmt(medians.get(name), ' s')}, p95 {_fmt(value.get('p95'), ' s')}, "
+                    f"mean {figure(value.get('mean'), ' s')}, median "
+                    f"{figure(medians.get(name), ' s')}, p95 {figure(value.get('p95'), ' s')}, "
                     f"n {n}")
         else:
-            text = _fmt(value.get("value"))
+            text = figure(value.get("value"))
         lines.append(f"  {name:<{width}}  {text}")
     return lines
 

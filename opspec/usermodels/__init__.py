@@ -1,4 +1,4 @@
-"""Stochastic user models: the performers of a spec's manual user lane.
+"""The performers of a spec's manual user lane: stochastic user models and scripted users.
 
 * :mod:`~opspec.usermodels.distributions` - validated duration distributions (also usable
   for activity durations by the engine, via :func:`from_model`);
@@ -7,6 +7,8 @@
 * :mod:`~opspec.usermodels.model` - :class:`UserModel`, :class:`ActivityModel`, :class:`Modifier`;
 * :mod:`~opspec.usermodels.performer` - :class:`StochasticUser`, the Performer;
 * :mod:`~opspec.usermodels.loader` - TOML files and bundled presets;
+* :mod:`~opspec.usermodels.scripts` - scripted users (exact actions: ``opspec run --script``,
+  spec tests, a walkthrough's recording);
 * :mod:`~opspec.usermodels.fitting` - estimating a model from recorded traces.
 
 The format is documented in ``docs/user-models.md``.

@@ -348,23 +348,9 @@ def resolve_preset(name: str) -> Path:
 
 
 def _read(path: Path) -> dict[str, Any]:
-    from opspec.files import read_text, reason
+    from opspec.toml_files import read_toml
 
-    try:
-        text = read_text(path)            # a pipe or device is refused, never read (blocks)
-    except OSError as error:
-        raise UserModelError(f"cannot read user model: {reason(error)}",
-                             location=SourceLocation(str(path))) from None
-    except UnicodeDecodeError as error:
-        raise UserModelError(f"not UTF-8 text: byte 0x{error.object[error.start]:02x} at "
-                             f"offset {error.start}", location=SourceLocation(str(path)),
-                             hint="save the user model as UTF-8") from None
-    try:
-        return tomllib.loads(text)
-    except tomllib.TOMLDecodeError as error:
-        raise UserModelError(f"not valid TOML: {error}", location=SourceLocation(str(path)),
-                             hint="check quotes, brackets and '=' signs near that line"
-                             ) from None
+    return read_toml(path, what="user model", error=UserModelError)
 
 
 def load_user_model(ref: str | Path, *, base: UserModel | None = None) -> UserModel:

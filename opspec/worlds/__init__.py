@@ -70,7 +70,7 @@ def _file_parameters(compiled: CompiledPackage, world_attr: ExtendedAttribute
     attribute = _attribute(compiled, "opspec:WorldFile")
     if attribute is None or not attribute.value:
         return {}, None
-    from opspec.files import companion_outside, open_regular, reason
+    from opspec.files import companion_outside
 
     spec = compiled.package.source
     path = Path(spec or ".").parent / attribute.value
@@ -79,19 +79,10 @@ def _file_parameters(compiled: CompiledPackage, world_attr: ExtendedAttribute
     if outside is not None:           # refused before the file is even looked at
         message, hint = outside
         raise ConfigurationError(message, location=where, hint=hint)
-    try:
-        with open_regular(path) as handle:        # a pipe or device never blocks
-            return dict(tomllib.load(handle)), str(path)
-    except OSError as error:
-        raise ConfigurationError(f"cannot read the world file {path}: {reason(error)}",
-                                 location=where,
-                                 hint="opspec:WorldFile is relative to the spec") from None
-    except UnicodeDecodeError as error:
-        raise ConfigurationError(f"{path}: not UTF-8 text (byte 0x"
-                                 f"{error.object[error.start]:02x} at offset {error.start})",
-                                 location=where) from None
-    except tomllib.TOMLDecodeError as error:
-        raise ConfigurationError(f"{path}: not valid TOML: {error}", location=where) from None
+    from opspec.toml_files import read_toml
+
+    return read_toml(path, what=f"the world file {path}", location=where,
+                     hint="opspec:WorldFile is relative to the spec"), str(path)
 
 
 def _inline_parameters(attribute: ExtendedAttribute) -> dict[str, Any]:

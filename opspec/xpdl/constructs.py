@@ -585,6 +585,16 @@ _XPDL: tuple[Construct, ...] = (
        "TriggerResultMessage Message TriggerResultSignal TriggerResultLink TriggerEscalation",
        None, R, "message, timer, conditional, signal, link triggers", "§7.6.2"),
     _c("xpdl-timer-attrs", XPDL, "TriggerTimer", "TimeDate", R, "a date", "§7.6.2"),
+    _c("xpdl-time-date-expression", XPDL, "TimeDate", None, W,
+       "a TimeDate that is no date but a data field or expression is read as a number of "
+       "seconds to wait, not as a date: a field holding an ISO date stops the run with an "
+       "error (BPMN §10.4.5: a timeDate is a date and time)", "§7.6.2; BPMN §10.4.5",
+       when="not-a-date", hint="write the date itself (2026-01-01T08:00:00), or a "
+       "TimeCycle with the delay in seconds"),
+    _c("xpdl-time-date-expression-attr", XPDL, "TriggerTimer", "TimeDate", W,
+       "a TimeDate that is no date but a data field or expression is read as a number of "
+       "seconds to wait, not as a date (BPMN §10.4.5: a timeDate is a date and time)",
+       "§7.6.2; BPMN §10.4.5", when="not-a-date"),
     _c("xpdl-timer-cycle-attr", XPDL, "TriggerTimer", "TimeCycle", R, "a repeating cycle",
        "§7.6.2"),
     _c("xpdl-boundary-cycle", XPDL, "TimeCycle", None, W,
@@ -932,6 +942,7 @@ _WHEN_TEXT = {
     "attached-timer": "of a non-interrupting timer attached to an activity",
     "terminate-in-activity-set": "Terminate, in an activity set",
     "throws": "thrown",
+    "not-a-date": "a data field or expression, not a date",
     "on-multi-instance": "of a multi-instance activity",
     "fed-only-by-ignored": "all its incoming flows come from ignored elements",
     "role-without-implementation": "no implementation, performed by a ROLE participant",

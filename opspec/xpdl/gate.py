@@ -269,6 +269,23 @@ def _on_multi_instance(element: etree._Element, value: str | None, doc: _Doc) ->
     return False
 
 
+def _not_a_date(element: etree._Element, value: str | None, doc: _Doc) -> bool:
+    """A TimeDate (element text or attribute) that is neither empty nor a date or time of
+    day: the reader reads it as a delay expression."""
+    from opspec.errors import SpecError
+    from opspec.xpdl.durations import parse_time_date
+
+    if value is None:
+        value = "".join(element.itertext())
+    text = value.strip()
+    if not text:
+        return False
+    try:
+        return parse_time_date(text) is None
+    except SpecError:
+        return False            # an impossible date: the reader's bad-timer error says it
+
+
 def _throws(element: etree._Element, value: str | None, doc: _Doc) -> bool:
     parent = element.getparent()
     return ((element.get("CatchThrow") or "").strip().upper() == "THROW"
@@ -334,6 +351,7 @@ CONDITIONS: dict[str, _Condition] = {
     "attached-timer": _attached_timer,
     "terminate-in-activity-set": _terminate_in_activity_set,
     "throws": _throws,
+    "not-a-date": _not_a_date,
     "on-multi-instance": _on_multi_instance,
     "fed-only-by-ignored": _fed_only_by_ignored,
     "role-without-implementation": _role_without_implementation,
@@ -393,6 +411,7 @@ def gate_findings(root: etree._Element, path: str) -> list[Finding]:
     tags = _TAGS[key]
     doc = _Doc(root)
     out: list[Finding] = []
+    said_at: dict[str, set[etree._Element]] = {}    # entry key -> elements reported
     # lxml finds the few elements the registry reports (any namespace), in document order
     for element in root.iter(*tags):
         tag = str(element.tag)
@@ -412,6 +431,13 @@ def gate_findings(root: etree._Element, path: str) -> list[Finding]:
             if _applies(construct, element, value, doc):
                 if _opaque(element):
                     break
+                if attribute is None:
+                    # InputSets/InputSet/Input: the outermost element of a group says it
+                    mine = said_at.setdefault(construct.key, set())
+                    mine.add(element)
+                    if any(a in mine for a in _ancestors(element)):
+                        said = True
+                        continue
                 said = said or attribute is None
                 out.append(Finding(_diagnostic(path, construct, element, attribute),
                                    construct.reported_by))

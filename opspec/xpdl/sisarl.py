@@ -60,7 +60,7 @@ class Directive:
 
 
 PROCESS_DIRECTIVES = ("Period", "Rate", "Priority", "Deadline", "Latency", "StartTrigger",
-                      "EndTrigger", "AutoStart", "Lane", "Mode")
+                      "EndTrigger", "AutoStart", "Lane", "Mode", "Arrival", "ArrivalCount")
 ACTIVITY_DIRECTIVES = ("AutoRun", "PriorityIncrement", "StartTrigger", "EndTrigger", "Raises",
                        "CpuDemand", "Duration", "BuiltIn")
 PACKAGE_DIRECTIVES = ("Metrics", "Modes", "Monitor", "World", "WorldFile", "RunLength",
@@ -247,8 +247,19 @@ def process_directives(element: etree._Element, ctx: BuildContext,
         "AutoStart": ("auto_start", lambda d: parse_boolean(d.value, d.location, "AutoStart")),
         "Lane": ("lane", _lane),
         "Mode": ("mode", _mode_id),
+        "Arrival": ("arrival", lambda d: parse_distribution(d.value, d.location)),
+        "ArrivalCount": ("arrival_count", _arrival_count),
     })
     return ProcessDirectives(**values)
+
+
+def _arrival_count(directive: Directive) -> int:
+    count = parse_integer(directive.value, directive.location, "ArrivalCount")
+    if count < 0:
+        raise SisarlValueError(f"ArrivalCount {directive.value.strip()!r} is negative",
+                               location=directive.location,
+                               hint="write how many instances arrive in all, e.g. 100")
+    return count
 
 
 def activity_directives(

@@ -153,6 +153,10 @@ def process_directive_attributes(directives: ProcessDirectives) -> list[Extended
         out.append(_ea("Lane", directives.lane))
     if directives.mode is not None:
         out.append(_ea("Mode", directives.mode))
+    if directives.arrival is not None:
+        out.append(_ea("Arrival", distribution_text(directives.arrival)))
+    if directives.arrival_count is not None:
+        out.append(_ea("ArrivalCount", str(directives.arrival_count)))
     return out
 
 

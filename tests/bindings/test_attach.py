@@ -17,12 +17,14 @@ import pytest
 from opspec.bindings import load_profile
 from opspec.bindings.attach import AttachedDevices, attach_devices
 from opspec.bindings.emulator import Behaviour, EmulatedDevice, PtyEmulator, Reply, SocketEmulator
-from opspec.commands._spec import bind_user, choose_user, load_any_spec
+from opspec.commands._spec import load_any_spec
 from opspec.engine.compiled import compile_package
 from opspec.engine.config import EngineConfig
+from opspec.engine.lanes import user_lane
 from opspec.engine.simulation import RunResult, Simulation
 from opspec.engine.trace import TraceEvent
 from opspec.errors import BindingError
+from opspec.request import scripted_user
 
 from .conftest import DATA, DEVICES, needs_pty
 
@@ -113,9 +115,8 @@ def simulate(bind: list[str], user: str, *, until: float = FIRST_DOSE, spec: Pat
              speed: float = SPEED) -> Outcome:
     """What ``opspec run --bind`` does, through the public API."""
     compiled = compile_package(load_any_spec(spec))
-    performer, listeners = choose_user(compiled, spec, script=user, user_model=None,
-                                       companion=False).make(0, 1)
-    performers: dict[str, Any] = bind_user(compiled, performer)
+    performer, listeners = scripted_user(user, compiled).make(0, 1)
+    performers: dict[str, Any] = dict.fromkeys(user_lane(compiled).bind_names, performer)
     threads: set[int] = set()
 
     def device_thread(event: TraceEvent) -> None:

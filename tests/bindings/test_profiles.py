@@ -88,7 +88,7 @@ def test_profiles_serving_and_resolve_by_name() -> None:
 
 # (file stem, dotted key named in the message, words of the message)
 INVALID_CASES = [
-    ("syntax_error", None, "invalid TOML"),
+    ("syntax_error", None, "not valid TOML"),
     ("missing_format", "format", "required key is missing"),
     ("unsupported_format", "format", "unsupported profile format 7"),
     ("missing_participants", "participants", "required key is missing"),

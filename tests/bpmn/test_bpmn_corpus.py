@@ -47,7 +47,6 @@ REFUSED = {
     "spiff_standard_loop_invalid.bpmn": "standard-loop-without-end",   # ParseStandardLoop
     "spiff_Subprocess-Not-Found.bpmn20.xml": "missing-subflow-target",
     "spiff_call_activity_end_event.bpmn": "undefined-subflow",           # process in another file
-    "spiff_io_spec_parent.bpmn": "undefined-subflow",                    # process in another file
     "spiff_ScriptTest.bpmn": "bad-script",                 # dicts, lists, def: not our grammar
     "camunda_loan-granting.bpmn": "multi-instance-without-count",  # camunda:collection
 }
@@ -55,8 +54,9 @@ REFUSED = {
 # How many of the files load, and how many of those run (a user completing every offer after
 # 1 s: no run error, no aborted instance, a process completes). Before BPMN data was read
 # (commit 576c6e5) 23 of these 38 loaded and 19 ran, 4 of them without running their scripts;
-# before run inputs and undecided gateways (issue 28), 26 loaded and 20 ran.
-LOADED, RAN = 29, 22
+# before run inputs and undecided gateways (issue 28), 26 loaded and 20 ran; before call
+# activities into other files (issue 28), 29 loaded and 22 ran.
+LOADED, RAN = 30, 23
 
 
 @pytest.mark.parametrize("name", sorted(REFUSED))
@@ -64,6 +64,19 @@ def test_files_with_errors_are_refused_for_the_right_reason(name: str) -> None:
     _package, report = validate_spec(DATA / name)
     assert not report.ok
     assert REFUSED[name] in {d.code for d in report.diagnostics if d.severity is Severity.ERROR}
+
+
+def test_spiff_call_activity_into_a_sibling_file_passes_data_both_ways() -> None:
+    # SpiffWorkflow IOSpecTest (io_spec_parent.bpmn calls "subprocess" of io_spec.bpmn): the
+    # called process is found in the file beside the caller; its ioSpecification takes in_1,
+    # in_2 from the caller and hands out_1, out_2 back; "unused" stays the caller's
+    outcome = opspec.run(DATA / "spiff_io_spec_parent.bpmn")
+    parent: dict[str, object] = {}
+    for event in outcome.trace:
+        if event.kind == "data.changed" and event.process == "parent":
+            parent.update(event.data)
+    assert parent == {"in_1": 1, "in_2": "hello world", "unused": True, "out_1": 2,
+                      "out_2": "HELLO WORLD"}
 
 
 def _completed(outcome: opspec.RunOutcome, process: str) -> list[tuple[float, str]]:

@@ -299,3 +299,21 @@ def test_param_on_the_command_line_gives_a_run_input_typed_and_checked(tmp_path:
     assert "Traceback" not in misspelt.stderr
     wrong_type = run("--param", "score=high")
     assert wrong_type.returncode == 2 and "score is an integer" in wrong_type.stderr
+
+
+def test_evaluate_param_gives_every_simulated_user_the_run_input(tmp_path: Path) -> None:
+    import json
+
+    from opspec.cli import main
+
+    path = _scored(tmp_path)
+    out = tmp_path / "evaluation"
+    code = main(["evaluate", str(path), "--param", "score=20", "--users", "3", "--days",
+                 "0.01", "--out", str(out), "--export", "jsonl", "--workers", "1"])
+    assert code == 0
+    events = [json.loads(line) for line in (out / "traces.jsonl").read_text().splitlines()]
+    completed = [e.get("activity") for e in events if e.get("kind") == "activity.completed"]
+    asked = completed.count("ask")
+    assert asked >= 3 * 10                                    # one a minute, 14.4 minutes
+    assert completed.count("remind") == asked and "done" not in completed   # 20 <= 50
+    assert not [e for e in events if e.get("kind") == "branch.chosen"]

@@ -290,7 +290,7 @@ def test_an_unreadable_scenario_file_is_refused(tmp_path: Path,
     path = tmp_path / "x.scenario.toml"
     path.write_text('spec = "x.xpdl"\n', encoding="utf-8")
     deny(path)
-    with pytest.raises(ConfigurationError, match="cannot read it: Permission denied"):
+    with pytest.raises(ConfigurationError, match="cannot read the scenario file: Permission denied"):
         load_scenarios(path)
 
 

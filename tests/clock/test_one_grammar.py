@@ -10,13 +10,13 @@ from __future__ import annotations
 
 import re
 from collections.abc import Callable
-from pathlib import Path
 
 import pytest
 
 from opspec import clock
-from opspec.engine.monitors import MinGap, parse_monitor
 from opspec.errors import OpspecError
+from opspec.properties.language import MinGap
+from opspec.properties.monitors import parse_monitor
 from opspec.testing.expectations import parse_expectation
 from opspec.testing.scenario import _until
 from opspec.testing.script import parse_script
@@ -67,9 +67,9 @@ def _expectation(text: str) -> float:
 
 
 def _cli_until(text: str) -> float:
-    from opspec.commands.run import _parse_until
+    from opspec.run_rules import parse_until
 
-    return _parse_until(text)
+    return parse_until(text, name="--until")
 
 
 DURATION_DOORS: dict[str, Callable[[str], float]] = {
@@ -78,7 +78,7 @@ DURATION_DOORS: dict[str, Callable[[str], float]] = {
     "sisarl-period": lambda text: float(_directives("Period", text).period),
     "monitor": _monitor,
     "script-step": lambda text: parse_script([(text, "press_report")]).steps[0].delay,
-    "scenario-until": lambda text: _until(Path("s.toml"), "scenario[0].given", text),
+    "scenario-until": _until,
     "expectation": _expectation,
     "cli-until": _cli_until,
 }

@@ -11,7 +11,7 @@ import pytest
 from conftest import SPEC, USERS_TOML
 
 from opspec.cli import main
-from opspec.engine.monitors import clock
+from opspec.properties.language import clock
 
 ANCHOR = "  <ExtendedAttributes>\n    <ExtendedAttribute Name=\"opspec:Metrics\">"
 

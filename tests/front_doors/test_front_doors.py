@@ -124,12 +124,13 @@ def via_walkthrough(tmp_path: Path, spec: Path, days: float | None, *,
     """The walkthrough session, the lane handed to the model from the start (the model's
     first hand-over is user 0), or replaying a script; stepped to the end of the run."""
     from opspec.commands.walkthrough import _model_factory
+    from opspec.usermodels import load_user_model
 
     compiled = compile_package(open_spec(spec))
     record = tmp_path / "walk.json"
     session = WalkSession(
         compiled, seed=SEED, days=days, record=None if script else record,
-        model_factory=_model_factory(compiled, model, SEED) if model else None,
+        model_factory=_model_factory(load_user_model(model), SEED) if model else None,
         replay=load_recording(script, compiled) if script else None)
     trace_file = tmp_path / "walk.trace.jsonl"
     if script:      # a replay records nothing: keep its trace with a listener

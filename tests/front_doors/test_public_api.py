@@ -68,10 +68,10 @@ def test_every_name_in_all_imports_and_is_of_its_kind(module: str) -> None:
 
 def test_the_documented_import_paths() -> None:
     from opspec import RunOutcome, User, run
+    from opspec.request import run as run_spec
     from opspec.runs import RunOutcome as Outcome
-    from opspec.runs import run as run_spec
 
-    # opspec.run reads a script path (as `opspec run --script` does), then is opspec.runs.run
+    # opspec.run is opspec.request.run: it fills the one request every door fills
     assert inspect.isfunction(run) and inspect.isfunction(run_spec)
     assert RunOutcome is Outcome and inspect.isclass(User)
     assert inspect.signature(run_spec).return_annotation in ("RunOutcome", RunOutcome)

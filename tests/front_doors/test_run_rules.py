@@ -75,5 +75,5 @@ def test_opspec_run_uses_the_companion_user_model_like_the_command() -> None:
     assert taken == 1                                 # the 08:00 dose, by the companion model
     nobody = opspec.run(DISPENSER, seed=2, until=9 * 3600, user=User.nobody())
     assert nobody.metrics["doses_taken"]["total"] == 0
-    with pytest.raises(ConfigurationError, match="not user_model and script"):
+    with pytest.raises(ConfigurationError, match="give script or user_model, not both"):
         opspec.run(DISPENSER, user_model="x", script=object())  # type: ignore[arg-type]

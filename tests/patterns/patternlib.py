@@ -13,9 +13,11 @@ SPECS = Path(__file__).resolve().parent / "specs"
 
 def run(name: str | Path, *, script: Sequence[tuple[Any, str]] | None = None,
         until: float = 3600.0, **kwargs: Any) -> SimulationResult:
-    """Run ``specs/NAME`` (or a path) for one user until ``until`` simulated seconds."""
+    """Run ``specs/NAME`` (or a path) for one user until ``until`` simulated seconds; the user
+    lane is the script, by default the cooperative user ``[]`` (every offer at once), as the
+    oracle runs every activity."""
     path = Path(name) if isinstance(name, Path) else SPECS / name
-    return simulate(str(path), script=list(script) if script is not None else None,
+    return simulate(str(path), script=list(script) if script is not None else [],
                     until=until, seed=1, keep_trace=True, **kwargs)
 
 

@@ -324,3 +324,23 @@ def test_check_says_where_it_runs_differently(tmp_path, capsys):
     main(["check", str(spec)])
     captured = capsys.readouterr()
     assert f"opspec check: {spec}:4: warning: bpmn:task 'a' startQuantity='2'" in captured.err
+
+
+def test_a_group_is_reported_once_at_its_outermost_element():
+    """InputSets/InputSet/Input all fall under one entry: the outermost element says it, so a
+    vendor export's input sets give one warning each, not one per nested element."""
+    data = _xpdl('<Activity Id="a"><Implementation><No/></Implementation>\n<InputSets>'
+                 '<InputSet>\n<Input ArtifactId="x"/>\n</InputSet></InputSets></Activity>\n')
+    assert [line for line, _c, _m in _xpdl_gate(data)] == [5]
+
+
+def test_a_time_date_that_is_no_date_is_reported():
+    """BPMN 2.0 Table 10.101: "The return type of the attribute timeDate MUST conform to the
+    ISO-8601 format for date and time representations." An XPDL TimeDate naming a data field
+    is read by opspec as a delay in seconds, not as the date the field holds: said at its
+    line; a TimeDate that is a date is quiet."""
+    timer = ('<Activity Id="t"><Event><IntermediateEvent Trigger="Timer"><TriggerTimer>'
+             '<TimeDate>{}</TimeDate></TriggerTimer></IntermediateEvent></Event></Activity>\n')
+    assert _xpdl_gate(_xpdl(timer.format("2026-01-01T08:00:00"))) == []
+    [(line, code, message)] = _xpdl_gate(_xpdl(timer.format("when")))
+    assert (line, code) == (4, "runs-differently") and "not as a date" in message

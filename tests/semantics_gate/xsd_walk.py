@@ -71,13 +71,10 @@ class Schema:
     def _owner(node: etree._Element) -> etree._Element | None:
         """The complexType, attributeGroup or element whose declaration ``node`` belongs to."""
         parent = node.getparent()
-        while parent is not None:
-            if parent.tag in (_q("complexType"), _q("attributeGroup")):
-                if parent.get("name") is not None or parent.getparent() is None:
-                    return parent
-                return parent
+        while parent is not None and parent.tag not in (_q("complexType"),
+                                                        _q("attributeGroup")):
             parent = parent.getparent()
-        return None
+        return parent
 
     def abstract(self, element: etree._Element) -> bool:
         """An abstract element, or one of an abstract type: never written in a file (its

@@ -8,14 +8,10 @@ import pytest
 import scipy.stats
 
 from opspec.engine.compiled import CompiledPackage
-from opspec.engine.monitors import (
-    BoundedResponse,
-    MinGap,
-    package_monitors,
-    parse_monitor,
-)
 from opspec.engine.trace import TraceEvent
 from opspec.errors import ConfigurationError
+from opspec.properties.language import BoundedResponse, MinGap
+from opspec.properties.monitors import package_monitors, parse_monitor
 from opspec.statistics import poisson_interval
 from opspec.testing.monitors import (
     assert_no_violations,

@@ -20,5 +20,6 @@ def compiled():
 @pytest.fixture
 def model_factory(compiled):
     from opspec.commands.walkthrough import _model_factory
+    from opspec.usermodels import load_user_model
 
-    return _model_factory(compiled, USERS, 0)
+    return _model_factory(load_user_model(USERS), 0)

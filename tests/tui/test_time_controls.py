@@ -34,7 +34,7 @@ def test_the_run_is_as_long_as_the_specs_run_length_unless_days_say_otherwise(va
 
 @pytest.mark.parametrize("days", [0, -1, float("inf")], ids=["zero", "negative", "infinite"])
 def test_days_that_are_not_positive_are_refused(compiled, days):
-    with pytest.raises(ConfigurationError, match="--days must be a positive number"):
+    with pytest.raises(ConfigurationError, match="days must be a positive number"):
         WalkSession(compiled, days=days)
 
 

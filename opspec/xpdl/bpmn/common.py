@@ -12,6 +12,7 @@ from lxml import etree
 
 from opspec.errors import Severity, SourceLocation
 from opspec.model.data import BasicKind, ParameterMode
+from opspec.model.sisarl import DeclaredDistribution
 from opspec.xpdl.handlers.common import BuildContext
 from opspec.xpdl.namespaces import OPSPEC
 
@@ -144,6 +145,12 @@ class Defs:
     probabilities: dict[str, float] = field(default_factory=dict)   # BPSim / QBP, by flow id
     probability_source: dict[str, str] = field(default_factory=dict)
     data_names: dict[str, str] = field(default_factory=dict)   # a data object's name -> its id
+    # BPSim / QBP processing times by activity id, and arrivals by process id (:mod:`.simulation`)
+    durations: dict[str, DeclaredDistribution] = field(default_factory=dict)
+    duration_source: dict[str, str] = field(default_factory=dict)
+    arrivals: dict[str, tuple[DeclaredDistribution, int | None, str]] = field(
+        default_factory=dict)
+    call_aliases: dict[str, str] = field(default_factory=dict)  # tns:proc -> proc (:mod:`.imports`)
 
     def info(self, element: etree._Element | None, code: str, message: str,
              hint: str = "") -> None:

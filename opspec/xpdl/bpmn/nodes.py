@@ -139,6 +139,7 @@ def _script(element: etree._Element, defs: Defs, applications: tuple[object, ...
 
 def _call(element: etree._Element, defs: Defs) -> Built:
     called = (element.get("calledElement") or "").strip()
+    called = defs.call_aliases.get(called, called)     # tns:proc of an imported file
     if not called:
         defs.ctx.error(element, "missing-subflow-target",
                        f"{_label(element)} has no calledElement, so it calls nothing",

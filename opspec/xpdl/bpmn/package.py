@@ -26,6 +26,7 @@ from opspec.xpdl.bpmn.common import (
 )
 from opspec.xpdl.bpmn.data import CAMUNDA, index_data
 from opspec.xpdl.bpmn.extensions import application, data_field, directives, opspec_named
+from opspec.xpdl.bpmn.imports import processes_elsewhere
 from opspec.xpdl.bpmn.process import BuiltProcess, build_process, is_user_name
 from opspec.xpdl.bpmn.run_inputs import with_run_inputs
 from opspec.xpdl.bpmn.simulation import BPSIM_NAMESPACES, QBP, read_simulation_parameters
@@ -213,19 +214,25 @@ def build_definitions(root: etree._Element, ctx: BuildContext) -> Package:
     simulation = read_simulation_parameters(root, defs)
     defs.probabilities.update(simulation.probabilities)
     defs.probability_source.update(simulation.source)
+    defs.durations.update(simulation.durations)
+    defs.duration_source.update(simulation.duration_source)
+    defs.arrivals.update(simulation.arrivals)
+    imported = processes_elsewhere(root, defs)
+    defs.call_aliases.update(imported.aliases)
     for sub in root:
         if not isinstance(sub.tag, str):
             continue
         space = namespace(sub)
-        if space in _DI_NAMESPACES or (space == BPMN and local(sub) in _ROOT_QUIET):
-            continue
         if space == QBP or (space == BPMN and local(sub) == "relationship"
                             and any(namespace(e) in BPSIM_NAMESPACES for e in sub.iter()
                                     if isinstance(e.tag, str))):
             defs.info(sub, "simulation-parameters",
                       "simulation parameters (BPSim or QBP): opspec reads their branch "
-                      "probabilities; their durations, arrival rates and resources are not "
-                      "read", "give durations with opspec:Duration (docs/bpmn.md)")
+                      "probabilities, task durations and arrivals; resources, costs and "
+                      "calendars are not read (a warning names each)",
+                      "docs/bpmn.md, Simulation parameters")
+            continue
+        if space in _DI_NAMESPACES or (space == BPMN and local(sub) in _ROOT_QUIET):
             continue
         what = f"bpmn:{local(sub)}" if space == BPMN else f"<{local(sub)}> ({space})"
         ctx.warning(sub, "unsupported-element", f"{what} is not run by opspec; it is ignored",
@@ -269,9 +276,18 @@ def build_definitions(root: etree._Element, ctx: BuildContext) -> Package:
     if defs.user_participant and "user" not in known:
         participants.append(Participant(id="user", name="User", type=ParticipantType.HUMAN))
     processes, run_inputs = with_run_inputs([b.process for b in built], package_fields, defs)
+    # processes called from other files (:mod:`.imports`), with what they need
+    processes = [*processes, *imported.processes]
+    known = {p.id for p in participants}
+    participants.extend(p for p in imported.participants if p.id not in known)
+    given = {f.id for f in (*package_fields, *run_inputs)}
+    run_inputs = (*run_inputs, *(f for f in imported.data_fields if f.id not in given))
+    model_pools = (*model_pools, *imported.pools)
     found, kept = directives(root, defs, PACKAGE_DIRECTIVES, "the definitions",
                              ("DataField", "Application"))
     extensions = package_extensions(root, ctx, found)
+    if simulation.run_length and extensions.get("run_length") is None:
+        extensions["run_length"] = simulation.run_length[0]     # BPSim's scenario Duration
     stem = PurePath(ctx.path).stem
     return Package(
         id=(root.get("id") or "").strip() or stem,

@@ -17,6 +17,7 @@ Boundary events follow the engine's existing constructs:
 
 from __future__ import annotations
 
+import dataclasses
 from collections.abc import Iterable
 from dataclasses import dataclass, field
 
@@ -47,6 +48,7 @@ from opspec.model.data import Assignment, BasicKind, BasicType, DataField
 from opspec.model.expressions import Expression, Literal
 from opspec.model.process import ActivitySet, Condition, ConditionKind, Transition, WorkflowProcess
 from opspec.model.resources import Lane
+from opspec.model.sisarl import ActivityDirectives, ProcessDirectives
 from opspec.xpdl.bpmn.common import (
     BPMN,
     Defs,
@@ -452,6 +454,7 @@ class _Process:
                                  _ACTIVITY_STRUCTURE)
         self.message_directives(element, found, sends, built_body)
         directive_values, coordination = activity_directives(element, self.ctx, found)
+        directive_values = self.simulated_duration(element, node_id, directive_values)
         data = activity_data(element, self.defs, self.label(element))
         for created in data.fields:
             self.created.setdefault(created.id, created)
@@ -496,6 +499,21 @@ class _Process:
             assignments=assignments(element, self.defs) + extra + tuple(data.assignments),
             start_quantity=quantity(element, "startQuantity", self.ctx),
             completion_quantity=quantity(element, "completionQuantity", self.ctx))
+
+    def simulated_duration(self, element: etree._Element, node_id: str,
+                           given: ActivityDirectives) -> ActivityDirectives:
+        """The task's duration from the file's BPSim or QBP parameters (:mod:`.simulation`)
+        when it has no ``opspec:Duration`` of its own; its own wins, said in an info."""
+        drawn = self.defs.durations.get(node_id)
+        if drawn is None:
+            return given
+        source = self.defs.duration_source.get(node_id, "the file")
+        if given.duration is not None:
+            self.defs.info(element, "duration-given-twice",
+                           f"{self.label(element)} has its own opspec:Duration, which wins "
+                           f"over the {source} duration", "")
+            return given
+        return dataclasses.replace(given, duration=drawn)
 
     @staticmethod
     def order(element: etree._Element, flows: list[str]) -> tuple[str, ...]:
@@ -628,10 +646,25 @@ class _Process:
             extended_attributes=kept, location=self.defs.loc(element),
             access_level="PUBLIC", data_fields=tuple(fields), formal_parameters=formals,
             activities=activities, transitions=transitions, activity_sets=tuple(self.sets),
-            directives=process_directives(element, self.ctx, found))
+            directives=self.arrivals(process_directives(element, self.ctx, found)))
         process = _with_script_fields(process, element, self.defs)
         self.check_reads(process)
         return BuiltProcess(process, self.lanes)
+
+    def arrivals(self, given: ProcessDirectives) -> ProcessDirectives:
+        """The process's arrivals from the file's BPSim or QBP parameters, unless its own
+        ``opspec:Arrival`` or ``opspec:StartTrigger`` says how it starts."""
+        found = self.defs.arrivals.get(self.id)
+        if found is None:
+            return given
+        distribution, count, source = found
+        if given.arrival is not None or given.start_trigger is not None:
+            own = "opspec:Arrival" if given.arrival is not None else "opspec:StartTrigger"
+            self.defs.info(self.element, "arrivals-given-twice",
+                           f"process {self.id!r} has its own {own}, which wins over the "
+                           f"{source} arrivals", "")
+            return given
+        return dataclasses.replace(given, arrival=distribution, arrival_count=count)
 
     def check_reads(self, process: WorkflowProcess) -> None:
         """A task's ``dataInput`` without an association takes the process's variable of its

@@ -55,7 +55,7 @@ import re
 from collections import deque
 from collections.abc import Callable, Iterable, Sequence
 from dataclasses import dataclass, field, replace
-from typing import Protocol
+from typing import Any, ClassVar, Protocol
 
 from opspec.clock import clock_time, parse_duration, span
 from opspec.engine.trace import EventKind, TraceEvent
@@ -324,12 +324,18 @@ class Property:
 
     text: str = field(default="", kw_only=True)
 
+    #: how a run of this property is evaluated (a MonitorRun subclass)
+    _run: ClassVar[type[MonitorRun]]
+    #: the fields that are subjects, in order
+    _subject_fields: ClassVar[tuple[str, ...]] = ("subject",)
+
     def subjects(self) -> tuple[Selector, ...]:
         """What the property refers to, in the order of its fields."""
-        raise NotImplementedError
+        return tuple(getattr(self, name) for name in self._subject_fields)
 
     def _with(self, subjects: Sequence[Selector]) -> Property:
-        raise NotImplementedError
+        changes: dict[str, Any] = dict(zip(self._subject_fields, subjects, strict=True))
+        return replace(self, **changes)
 
     def describe(self) -> str:
         """The text form (``text`` when given)."""
@@ -359,7 +365,7 @@ class Property:
 
     def start(self, replication: int = 0) -> MonitorRun:
         """A fresh evaluation for one run (a trace listener)."""
-        raise NotImplementedError
+        return self._run(self, replication)
 
     def judge(self, events: Iterable[TraceEvent], end: float | None = None,
               replication: int = 0) -> MonitorResult:
@@ -373,25 +379,6 @@ class Property:
         return run.result()
 
 
-@dataclass(frozen=True, slots=True)
-class Never(Property):
-    """Absence: ``subject`` never happens. Each occurrence is a violation."""
-
-    subject: Selector
-
-    def subjects(self) -> tuple[Selector, ...]:
-        return (self.subject,)
-
-    def _with(self, subjects: Sequence[Selector]) -> Property:
-        return replace(self, subject=subjects[0])
-
-    def describe(self) -> str:
-        return f"never {_spell(self.subject)}"
-
-    def start(self, replication: int = 0) -> MonitorRun:
-        return _NeverRun(self, replication)
-
-
 class _NeverRun(MonitorRun):
     monitor: Never
 
@@ -401,22 +388,15 @@ class _NeverRun(MonitorRun):
 
 
 @dataclass(frozen=True, slots=True)
-class Eventually(Property):
-    """Existence: ``subject`` happens at least once in the run (decided at its end)."""
+class Never(Property):
+    """Absence: ``subject`` never happens. Each occurrence is a violation."""
+
+    _run: ClassVar[type[MonitorRun]] = _NeverRun
 
     subject: Selector
 
-    def subjects(self) -> tuple[Selector, ...]:
-        return (self.subject,)
-
-    def _with(self, subjects: Sequence[Selector]) -> Property:
-        return replace(self, subject=subjects[0])
-
     def describe(self) -> str:
-        return f"eventually {_spell(self.subject)}"
-
-    def start(self, replication: int = 0) -> MonitorRun:
-        return _EventuallyRun(self, replication)
+        return f"never {_spell(self.subject)}"
 
 
 class _EventuallyRun(MonitorRun):
@@ -440,24 +420,15 @@ class _EventuallyRun(MonitorRun):
 
 
 @dataclass(frozen=True, slots=True)
-class MinGap(Property):
-    """No two occurrences of ``subject`` closer than ``seconds`` (exactly ``seconds`` apart
-    is allowed); each occurrence too close to the previous one is a violation."""
+class Eventually(Property):
+    """Existence: ``subject`` happens at least once in the run (decided at its end)."""
+
+    _run: ClassVar[type[MonitorRun]] = _EventuallyRun
 
     subject: Selector
-    seconds: float
-
-    def subjects(self) -> tuple[Selector, ...]:
-        return (self.subject,)
-
-    def _with(self, subjects: Sequence[Selector]) -> Property:
-        return replace(self, subject=subjects[0])
 
     def describe(self) -> str:
-        return f"min_gap {_spell(self.subject)} {_duration_text(self.seconds)}"
-
-    def start(self, replication: int = 0) -> MonitorRun:
-        return _MinGapRun(self, replication)
+        return f"eventually {_spell(self.subject)}"
 
 
 class _MinGapRun(MonitorRun):
@@ -477,27 +448,17 @@ class _MinGapRun(MonitorRun):
 
 
 @dataclass(frozen=True, slots=True)
-class MaxCount(Property):
-    """At most ``limit`` occurrences of ``subject`` in any window of ``seconds`` (a window is
-    half-open: two events exactly ``seconds`` apart are never in the same one, as for
-    :class:`MinGap`; ``max_count A 1 per D`` is ``min_gap A D``). Each occurrence that
-    makes a window hold too many is a violation."""
+class MinGap(Property):
+    """No two occurrences of ``subject`` closer than ``seconds`` (exactly ``seconds`` apart
+    is allowed); each occurrence too close to the previous one is a violation."""
+
+    _run: ClassVar[type[MonitorRun]] = _MinGapRun
 
     subject: Selector
-    limit: int
     seconds: float
 
-    def subjects(self) -> tuple[Selector, ...]:
-        return (self.subject,)
-
-    def _with(self, subjects: Sequence[Selector]) -> Property:
-        return replace(self, subject=subjects[0])
-
     def describe(self) -> str:
-        return f"max_count {_spell(self.subject)} {self.limit} per {_duration_text(self.seconds)}"
-
-    def start(self, replication: int = 0) -> MonitorRun:
-        return _MaxCountRun(self, replication)
+        return f"min_gap {_spell(self.subject)} {_duration_text(self.seconds)}"
 
 
 class _MaxCountRun(MonitorRun):
@@ -525,57 +486,20 @@ _COMPARE: dict[str, Callable[[float, float], bool]] = {
 
 
 @dataclass(frozen=True, slots=True)
-class CountBound(Property):
-    """The number of ``subject`` in the run compares so with ``a`` (``op`` is ``==``, ``!=``,
-    ``<``, ``<=``, ``>``, ``>=``, or ``in`` for ``a <= n <= b``). One violation at most per
-    run: at the occurrence that broke an upper bound, else at the end of the run."""
+class MaxCount(Property):
+    """At most ``limit`` occurrences of ``subject`` in any window of ``seconds`` (a window is
+    half-open: two events exactly ``seconds`` apart are never in the same one, as for
+    :class:`MinGap`; ``max_count A 1 per D`` is ``min_gap A D``). Each occurrence that
+    makes a window hold too many is a violation."""
+
+    _run: ClassVar[type[MonitorRun]] = _MaxCountRun
 
     subject: Selector
-    op: str
-    a: float
-    b: float | None = None
-
-    def __post_init__(self) -> None:
-        if self.op not in _COMPARE and self.op != "in":
-            raise ConfigurationError(f"unknown comparison {self.op!r}",
-                                     hint="use ==, !=, <, <=, >, >= or in [lo, hi]")
-        if self.op == "in" and (self.b is None or self.a > self.b):
-            raise ConfigurationError(f"count in [{self.a:g}, {self.b or 0:g}]: the range is "
-                                     "empty")
-
-    def subjects(self) -> tuple[Selector, ...]:
-        return (self.subject,)
-
-    def _with(self, subjects: Sequence[Selector]) -> Property:
-        return replace(self, subject=subjects[0])
-
-    def target(self) -> str:
-        """``<= 4``, ``in [1, 3]``."""
-        return f"in [{self.a:g}, {self.b:g}]" if self.op == "in" else f"{self.op} {self.a:g}"
+    limit: int
+    seconds: float
 
     def describe(self) -> str:
-        return f"count {_spell(self.subject)} {self.target()}"
-
-    def allows(self, n: float) -> bool:
-        if self.op == "in":
-            assert self.b is not None
-            return self.a <= n <= self.b
-        return _COMPARE[self.op](n, self.a)
-
-    def most(self) -> float:
-        """The largest count allowed when the bound is an upper one (else infinity): the
-        occurrence after it is where the claim broke."""
-        if self.op == "in":
-            assert self.b is not None
-            return math.floor(self.b)
-        if self.op in ("<=", "=="):
-            return math.floor(self.a)
-        if self.op == "<":
-            return math.ceil(self.a) - 1
-        return math.inf
-
-    def start(self, replication: int = 0) -> MonitorRun:
-        return _CountRun(self, replication)
+        return f"max_count {_spell(self.subject)} {self.limit} per {_duration_text(self.seconds)}"
 
 
 class _CountRun(MonitorRun):
@@ -613,32 +537,50 @@ class _CountRun(MonitorRun):
 
 
 @dataclass(frozen=True, slots=True)
-class BoundedResponse(Property):
-    """Every ``trigger`` is followed by a ``response`` within ``seconds`` (a response exactly
-    ``seconds`` later is in time; an event that is both answers itself; one response answers
-    every trigger pending before it). Each unanswered trigger is a violation at its due time,
-    its witness the trigger and the next response, if one came before the end. A window the
-    end of the run cuts off is *open*, not judged. With ``seconds`` infinite (``response A
-    B``) the window is the rest of the run: a trigger unanswered at the end is a violation."""
+class CountBound(Property):
+    """The number of ``subject`` in the run compares so with ``a`` (``op`` is ``==``, ``!=``,
+    ``<``, ``<=``, ``>``, ``>=``, or ``in`` for ``a <= n <= b``). One violation at most per
+    run: at the occurrence that broke an upper bound, else at the end of the run."""
 
-    trigger: Selector
-    response: Selector
-    seconds: float
+    _run: ClassVar[type[MonitorRun]] = _CountRun
 
-    def subjects(self) -> tuple[Selector, ...]:
-        return (self.trigger, self.response)
+    subject: Selector
+    op: str
+    a: float
+    b: float | None = None
 
-    def _with(self, subjects: Sequence[Selector]) -> Property:
-        return replace(self, trigger=subjects[0], response=subjects[1])
+    def __post_init__(self) -> None:
+        if self.op not in _COMPARE and self.op != "in":
+            raise ConfigurationError(f"unknown comparison {self.op!r}",
+                                     hint="use ==, !=, <, <=, >, >= or in [lo, hi]")
+        if self.op == "in" and (self.b is None or self.a > self.b):
+            raise ConfigurationError(f"count in [{self.a:g}, {self.b or 0:g}]: the range is "
+                                     "empty")
+
+    def target(self) -> str:
+        """``<= 4``, ``in [1, 3]``."""
+        return f"in [{self.a:g}, {self.b:g}]" if self.op == "in" else f"{self.op} {self.a:g}"
 
     def describe(self) -> str:
-        if math.isinf(self.seconds):
-            return f"response {_spell(self.trigger)} {_spell(self.response)}"
-        return (f"bounded_response {_spell(self.trigger)} {_spell(self.response)} "
-                f"{_duration_text(self.seconds)}")
+        return f"count {_spell(self.subject)} {self.target()}"
 
-    def start(self, replication: int = 0) -> MonitorRun:
-        return _ResponseRun(self, replication)
+    def allows(self, n: float) -> bool:
+        if self.op == "in":
+            assert self.b is not None
+            return self.a <= n <= self.b
+        return _COMPARE[self.op](n, self.a)
+
+    def most(self) -> float:
+        """The largest count allowed when the bound is an upper one (else infinity): the
+        occurrence after it is where the claim broke."""
+        if self.op == "in":
+            assert self.b is not None
+            return math.floor(self.b)
+        if self.op in ("<=", "=="):
+            return math.floor(self.a)
+        if self.op == "<":
+            return math.ceil(self.a) - 1
+        return math.inf
 
 
 class _ResponseRun(MonitorRun):
@@ -700,27 +642,26 @@ class _ResponseRun(MonitorRun):
 
 
 @dataclass(frozen=True, slots=True)
-class Precedence(Property):
-    """``first`` precedes ``then``: no ``then`` before the first ``first`` (``then`` need not
-    happen; an event that is both precedes itself). ``each``: every ``then`` has a ``first``
-    of its own before it (the n-th ``then`` comes after the n-th ``first``). Each ``then``
-    without one is a violation."""
+class BoundedResponse(Property):
+    """Every ``trigger`` is followed by a ``response`` within ``seconds`` (a response exactly
+    ``seconds`` later is in time; an event that is both answers itself; one response answers
+    every trigger pending before it). Each unanswered trigger is a violation at its due time,
+    its witness the trigger and the next response, if one came before the end. A window the
+    end of the run cuts off is *open*, not judged. With ``seconds`` infinite (``response A
+    B``) the window is the rest of the run: a trigger unanswered at the end is a violation."""
 
-    first: Selector
-    then: Selector
-    each: bool = False
+    _run: ClassVar[type[MonitorRun]] = _ResponseRun
+    _subject_fields: ClassVar[tuple[str, ...]] = ("trigger", "response")
 
-    def subjects(self) -> tuple[Selector, ...]:
-        return (self.first, self.then)
-
-    def _with(self, subjects: Sequence[Selector]) -> Property:
-        return replace(self, first=subjects[0], then=subjects[1])
+    trigger: Selector
+    response: Selector
+    seconds: float
 
     def describe(self) -> str:
-        return f"{_spell(self.first)} before {'each ' if self.each else ''}{_spell(self.then)}"
-
-    def start(self, replication: int = 0) -> MonitorRun:
-        return _PrecedenceRun(self, replication)
+        if math.isinf(self.seconds):
+            return f"response {_spell(self.trigger)} {_spell(self.response)}"
+        return (f"bounded_response {_spell(self.trigger)} {_spell(self.response)} "
+                f"{_duration_text(self.seconds)}")
 
 
 class _PrecedenceRun(MonitorRun):
@@ -754,28 +695,21 @@ class _PrecedenceRun(MonitorRun):
 
 
 @dataclass(frozen=True, slots=True)
-class NeverWhile(Property):
-    """Absence between: ``subject`` never happens after an ``after`` until the next ``until``
-    (the window opens at the first ``after`` and stays open, to the end of the run, until an
-    ``until`` closes it). An event that is the ``after`` opening the window is inside it; one
-    that is the ``until`` closing it is not (Dwyer's "after Q until R" scope)."""
+class Precedence(Property):
+    """``first`` precedes ``then``: no ``then`` before the first ``first`` (``then`` need not
+    happen; an event that is both precedes itself). ``each``: every ``then`` has a ``first``
+    of its own before it (the n-th ``then`` comes after the n-th ``first``). Each ``then``
+    without one is a violation."""
 
-    subject: Selector
-    after: Selector
-    until: Selector
+    _run: ClassVar[type[MonitorRun]] = _PrecedenceRun
+    _subject_fields: ClassVar[tuple[str, ...]] = ("first", "then")
 
-    def subjects(self) -> tuple[Selector, ...]:
-        return (self.subject, self.after, self.until)
-
-    def _with(self, subjects: Sequence[Selector]) -> Property:
-        return replace(self, subject=subjects[0], after=subjects[1], until=subjects[2])
+    first: Selector
+    then: Selector
+    each: bool = False
 
     def describe(self) -> str:
-        return (f"never_while {_spell(self.subject)} after {_spell(self.after)} "
-                f"until {_spell(self.until)}")
-
-    def start(self, replication: int = 0) -> MonitorRun:
-        return _NeverWhileRun(self, replication)
+        return f"{_spell(self.first)} before {'each ' if self.each else ''}{_spell(self.then)}"
 
 
 class _NeverWhileRun(MonitorRun):
@@ -796,6 +730,25 @@ class _NeverWhileRun(MonitorRun):
             self.violate(event.time, f"{m.subject} at {clock(event.time)}, after {m.after} at "
                          f"{clock(self.opened.time)} and before any {m.until}",
                          (self.opened, event) if self.opened is not event else (event,))
+
+
+@dataclass(frozen=True, slots=True)
+class NeverWhile(Property):
+    """Absence between: ``subject`` never happens after an ``after`` until the next ``until``
+    (the window opens at the first ``after`` and stays open, to the end of the run, until an
+    ``until`` closes it). An event that is the ``after`` opening the window is inside it; one
+    that is the ``until`` closing it is not (Dwyer's "after Q until R" scope)."""
+
+    _run: ClassVar[type[MonitorRun]] = _NeverWhileRun
+    _subject_fields: ClassVar[tuple[str, ...]] = ("subject", "after", "until")
+
+    subject: Selector
+    after: Selector
+    until: Selector
+
+    def describe(self) -> str:
+        return (f"never_while {_spell(self.subject)} after {_spell(self.after)} "
+                f"until {_spell(self.until)}")
 
 
 # ---------------------------------------------------------------- the text form

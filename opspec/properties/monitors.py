@@ -1,10 +1,10 @@
 """Monitors: the properties a spec declares (``opspec:Monitor``), watched while a run happens.
 
-A monitor is a :class:`~opspec.engine.properties.Property` ("no dispense within 4 h of the
+A monitor is a :class:`~opspec.properties.language.Property` ("no dispense within 4 h of the
 previous one") watched online: :meth:`Monitor.start` gives a fresh :class:`MonitorRun` for one
 run, a trace listener with a ``selects`` attribute (so the engine builds only the events the
 monitor needs) that records each :class:`Violation` with its time and its witness. The
-language, the classes and the evaluator are :mod:`opspec.engine.properties`, shared with the
+language, the classes and the evaluator are :mod:`opspec.properties.language`, shared with the
 trace predicates and scenario ``then`` lines that judge stored traces: the same text gives the
 same verdict and witness online and offline. This module reads the spec's declarations.
 
@@ -23,7 +23,7 @@ and every other form of the property language (``eventually A``, ``count A <= 4`
 Over many runs, violations become a hazard: :func:`opspec.statistics.poisson_interval` gives
 the exact (Garwood) interval of a rate of events per unit of exposure (e.g. per user-day).
 
-Pure Python, no wall clock: importable by any layer above the engine.
+Pure Python, no wall clock: importable by any layer above the property language.
 """
 
 from __future__ import annotations
@@ -31,49 +31,11 @@ from __future__ import annotations
 from collections.abc import Iterable
 from typing import Any
 
-from opspec.engine.properties import (
-    BoundedResponse,
-    CountBound,
-    Eventually,
-    MaxCount,
-    MinGap,
-    MonitorResult,
-    MonitorRun,
-    Names,
-    Never,
-    NeverWhile,
-    Precedence,
-    Property,
-    Subject,
-    Violation,
-    clock,
-    parse_property,
-    parse_subject,
-)
 from opspec.errors import ConfigurationError, SourceLocation
+from opspec.properties.language import Property, parse_property
 
-__all__ = [
-    "MONITOR_ATTRIBUTE",
-    "BoundedResponse",
-    "CountBound",
-    "Eventually",
-    "MaxCount",
-    "MinGap",
-    "Monitor",
-    "MonitorResult",
-    "MonitorRun",
-    "Names",
-    "Never",
-    "NeverWhile",
-    "Precedence",
-    "Subject",
-    "Violation",
-    "clock",
-    "declared_monitors",
-    "package_monitors",
-    "parse_monitor",
-    "parse_subject",
-]
+__all__ = ["MONITOR_ATTRIBUTE", "Monitor", "declared_monitors", "package_monitors",
+           "parse_monitor"]
 
 #: the package ExtendedAttribute holding monitors in their text form
 MONITOR_ATTRIBUTE = "opspec:Monitor"

@@ -1,0 +1,53 @@
+"""The property language: claims about one run's trace, with their text, meaning and evaluation.
+
+* :mod:`~opspec.properties.language` - the text form (``min_gap dispense 4h``,
+  ``bounded_response sound_alarm dispense 15 min``), the property classes and the one
+  evaluator, fed events online (while a run happens) or offline (over a stored trace);
+* :mod:`~opspec.properties.monitors` - the monitors a spec declares (``opspec:Monitor``),
+  watched in every run (:func:`opspec.runs.build`).
+
+The trace predicates of spec tests (:mod:`opspec.testing.predicates`) and the ``then`` lines
+of scenario files are this language too (docs/spec-testing.md, "One property language"). It
+sits above the engine (it reads the engine's trace events and a compiled spec's names) and
+below the run builder.
+"""
+
+from opspec.properties.language import (
+    BoundedResponse,
+    CountBound,
+    Eventually,
+    MaxCount,
+    MinGap,
+    MonitorResult,
+    MonitorRun,
+    Never,
+    NeverWhile,
+    Precedence,
+    Property,
+    Subject,
+    Violation,
+    parse_property,
+    parse_subject,
+)
+from opspec.properties.monitors import Monitor, declared_monitors, parse_monitor
+
+__all__ = [
+    "BoundedResponse",
+    "CountBound",
+    "Eventually",
+    "MaxCount",
+    "MinGap",
+    "Monitor",
+    "MonitorResult",
+    "MonitorRun",
+    "Never",
+    "NeverWhile",
+    "Precedence",
+    "Property",
+    "Subject",
+    "Violation",
+    "declared_monitors",
+    "parse_monitor",
+    "parse_property",
+    "parse_subject",
+]

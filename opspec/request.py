@@ -1,0 +1,317 @@
+"""The front hall: every door fills one :class:`RunRequest`, and :func:`prepare` decides it.
+
+``opspec run``, ``opspec evaluate`` (and its workers), ``opspec walkthrough``,
+``opspec check --schedulability``, :func:`opspec.run`, :func:`opspec.testing.simulate` (so the
+pytest fixture and scenario files) only say what they were asked; :func:`prepare` applies the
+one rule for each part of a run and hands the result to :func:`opspec.runs.build`:
+
+* **the spec gate** — a path opens whatever its form (XPDL, BPMN 2.0, a compiled ``.wfs``)
+  and is refused with every error ``opspec validate`` reports (``path:line``); a package given
+  in memory is refused with the errors of the same structural checks. Its warnings come back
+  in :attr:`PreparedRun.warnings` for the door to show;
+* **the seed and the run length** — :mod:`opspec.run_rules`;
+* **the user lane** — ``script`` (a path, a :class:`~opspec.usermodels.scripts.Script` or its
+  steps; every name it uses must be the spec's), ``user_model`` (a preset, a TOML path or a
+  :class:`~opspec.usermodels.UserModel`, checked against the spec's user lane), ``user`` (a
+  prepared :class:`~opspec.runs.User`: a person, a replay) or ``no_user``; with none of them,
+  the spec's companion ``SPEC.users.toml`` when its file has one, else nobody.
+
+A :class:`PreparedRun` builds user ``u`` of the run as often as a door needs
+(:meth:`PreparedRun.build`), so a door running many users prepares once.
+"""
+
+from __future__ import annotations
+
+import os
+from collections.abc import Iterable, Mapping, Sequence
+from dataclasses import dataclass, field, replace
+from pathlib import Path
+from types import MappingProxyType
+from typing import TYPE_CHECKING, Any
+
+from opspec.errors import ConfigurationError
+from opspec.run_rules import check_seed, run_length
+
+if TYPE_CHECKING:
+    from opspec.engine.config import EngineConfig
+    from opspec.engine.performers import Performer
+    from opspec.engine.trace import TraceListener
+    from opspec.model import Package
+    from opspec.runs import LoadedSpec, Run, RunOutcome, User
+
+__all__ = ["PreparedRun", "RunRequest", "companion_user_model", "gate", "open_gated",
+           "prepare", "run", "scripted_user"]
+
+_EMPTY: Mapping[str, Any] = MappingProxyType({})
+#: the parts of a request that prepare() decides from (the rest goes to runs.build as it is)
+_DECIDED = frozenset({"spec", "seed", "days", "until", "script", "user_model", "user",
+                      "no_user"})
+
+
+@dataclass(frozen=True, eq=False)
+class RunRequest:
+    """What a door was asked for, as it was asked (nothing decided yet).
+
+    ``spec`` is a path (XPDL, BPMN or ``.wfs``), a ``Package``, a ``CompiledPackage`` or a
+    :class:`~opspec.runs.LoadedSpec` (already through the gate). ``days`` or ``until``
+    (seconds, or a duration as text: ``PT8H``) give the length. At most one of ``script``,
+    ``user_model``, ``user`` and ``no_user`` says who performs the user lane. The rest goes to
+    :func:`opspec.runs.build` as it is.
+    """
+
+    spec: Any
+    seed: Any = 0
+    days: Any = None
+    until: Any = None
+    script: Any = None
+    user_model: Any = None
+    user: User | None = None
+    no_user: bool = False
+    config: EngineConfig | Mapping[str, Any] | None = None
+    performers: Mapping[str, Performer] = field(default_factory=dict)
+    listeners: tuple[TraceListener, ...] = ()
+    params: Mapping[str, Any] | None = None
+    keep_trace: bool = False
+    keep_times: bool = False
+    monitors: tuple[Any, ...] | None = None
+    devices: Any = None
+
+    def __post_init__(self) -> None:
+        # immutable all the way down: a door cannot change a request after handing it in
+        object.__setattr__(self, "performers", MappingProxyType(dict(self.performers or {})))
+        object.__setattr__(self, "listeners", tuple(self.listeners))
+        if self.params is not None:
+            object.__setattr__(self, "params", MappingProxyType(dict(self.params)))
+        if self.monitors is not None:
+            object.__setattr__(self, "monitors", tuple(self.monitors))
+
+    def but(self, **changes: Any) -> RunRequest:
+        """The same request with ``changes`` (a door adding its listeners)."""
+        return replace(self, **changes)
+
+
+@dataclass(frozen=True, eq=False)
+class PreparedRun:
+    """A request decided: the spec through the gate and compiled, the seed, the run length
+    in seconds, who performs the user lane, and the warnings a door shows."""
+
+    request: RunRequest
+    spec: LoadedSpec
+    seed: int
+    horizon: float
+    user: User
+    #: validate's warnings on the spec (``path:line: warning: …``) and the user model's
+    #: against the spec's user lane, in that order
+    warnings: tuple[Any, ...] = ()
+    #: the file the spec came from, when it came from one
+    path: Path | None = field(default=None)
+    #: the reference (a preset name or a TOML path) of the user model performing the lane,
+    #: when it was named so (an evaluation stores it to resume and sends it to its workers)
+    user_model: str | None = None
+
+    @property
+    def compiled(self) -> Any:
+        return self.spec.compiled
+
+    def but(self, **changes: Any) -> PreparedRun:
+        """The same decided run with the request's ``changes`` that decide nothing (a door's
+        listeners, its devices, the engine configuration a bound device's clock sets)."""
+        decided = sorted(set(changes) & _DECIDED)
+        if decided:
+            raise ConfigurationError(f"prepare() decided {', '.join(decided)} already",
+                                     hint="fill a new RunRequest and prepare it")
+        return replace(self, request=self.request.but(**changes))
+
+    @property
+    def package(self) -> Package:
+        return self.spec.package
+
+    def build(self, user_index: int = 0, *, user: User | None = None,
+              listeners: Iterable[TraceListener] = (), devices: Any = None) -> Run:
+        """Run ``user_index`` of this request, built by :func:`opspec.runs.build` and not
+        started; ``user`` replaces the prepared one (a population's drawn person),
+        ``listeners`` and ``devices`` are added to the request's."""
+        from opspec.runs import build
+
+        request = self.request
+        return build(self.spec, seed=self.seed, user=user or self.user, user_index=user_index,
+                     until=self.horizon, config=request.config,
+                     performers=request.performers,
+                     listeners=[*request.listeners, *listeners], params=request.params,
+                     keep_trace=request.keep_trace, keep_times=request.keep_times,
+                     devices=devices if devices is not None else request.devices,
+                     monitors=request.monitors)
+
+    def execute(self, user_index: int = 0) -> RunOutcome:
+        """Build run ``user_index`` and run it to its length."""
+        return self.build(user_index).execute()
+
+
+# ---------------------------------------------------------------------------- the spec
+
+
+def companion_user_model(spec_path: str | Path | None) -> Path | None:
+    """``SPEC.users.toml`` next to the spec's file, if there is one."""
+    if spec_path is None:
+        return None
+    path = Path(spec_path)
+    candidate = path.with_name(path.name.removesuffix(path.suffix) + ".users.toml")
+    return candidate if candidate.is_file() else None
+
+
+#: packages through the gate (by identity, held so that an id is never reused): a spec
+#: fixture's package simulated by every test of a module is checked once
+_PASSED: dict[int, Any] = {}
+_PASSED_MAX = 64
+
+
+def _passed(package: Any) -> None:
+    if len(_PASSED) >= _PASSED_MAX:
+        _PASSED.pop(next(iter(_PASSED)))
+    _PASSED[id(package)] = package
+
+
+def gate(package: Package) -> None:
+    """Refuse an in-memory package with the structural errors ``opspec validate`` reports
+    (a :class:`~opspec.errors.SpecError` listing them with their places)."""
+    if _PASSED.get(id(package)) is package:
+        return
+    from opspec.errors import Severity, SpecError
+    from opspec.model.checks import check_package
+
+    errors = [d for d in check_package(package) if d.severity is Severity.ERROR]
+    if errors:
+        raise SpecError.from_diagnostics(errors)
+    _passed(package)
+
+
+def open_gated(path: str | Path) -> tuple[Package, tuple[Any, ...]]:
+    """The package in ``path`` and validate's warnings on it, refused with every error
+    ``opspec validate`` reports. ``.wfs`` scripts (compiled from specs that passed) and
+    paths that are not files open as :func:`opspec.xpdl.open_spec.open_spec` does (a file
+    that cannot be read at all is a ConfigurationError: exit status 2)."""
+    from opspec.files import not_a_file
+    from opspec.xpdl.open_spec import open_spec, refuse_unreadable
+
+    target = Path(path)
+    if target.suffix == ".wfs" or not_a_file(target) is not None:
+        package = open_spec(path)
+        _passed(package)
+        return package, ()
+    from opspec.errors import Severity, SpecError
+    from opspec.xpdl.validate import validate_spec
+
+    valid, report = validate_spec(target)       # monitors and the world: checked as built
+    refuse_unreadable(report.diagnostics)       # an unreadable file: exit status 2, not 1
+    errors = [d for d in report.diagnostics if d.severity is Severity.ERROR]
+    if errors or valid is None:
+        raise SpecError.from_diagnostics(errors or report.diagnostics)
+    _passed(valid)
+    return valid, tuple(d for d in report.diagnostics if d.severity is Severity.WARNING)
+
+
+def _spec(spec: Any) -> tuple[LoadedSpec, tuple[Any, ...], Path | None]:
+    from opspec.engine.compiled import CompiledPackage
+    from opspec.runs import LoadedSpec, load
+
+    if isinstance(spec, LoadedSpec):
+        return spec, (), _source(spec.package)
+    if isinstance(spec, (str, os.PathLike)):
+        package, warnings = open_gated(Path(spec))
+        return load(package), warnings, Path(spec)
+    gate(spec.package if isinstance(spec, CompiledPackage) else spec)
+    return load(spec), (), _source(spec.package if isinstance(spec, CompiledPackage)
+                                   else spec)
+
+
+def _source(package: Any) -> Path | None:
+    source = getattr(package, "source", None)
+    return Path(source) if source else None
+
+
+# ---------------------------------------------------------------------------- the user
+
+
+def _user(request: RunRequest, loaded: LoadedSpec, path: Path | None
+          ) -> tuple[User, tuple[Any, ...], str | None]:
+    """Who performs the user lane, the user model's warnings against the spec, and the
+    model's reference when it was named by one."""
+    from opspec.engine.lanes import user_lane
+    from opspec.runs import User
+
+    given = [name for name, value in (
+        ("script", request.script), ("user_model", request.user_model),
+        ("user", request.user), ("no_user", request.no_user or None)) if value is not None]
+    if len(given) > 1:
+        raise ConfigurationError(f"give {given[0]} or {given[1]}, not both" if len(given) == 2
+                                 else f"give one of {', '.join(given)}, not all of them",
+                                 hint="a script plays exact actions; a model draws them")
+    if request.user is not None:
+        return request.user, (), None
+    lane = user_lane(loaded.compiled)
+    if request.script is not None:
+        return scripted_user(request.script, loaded.compiled), (), None
+    ref = request.user_model
+    if ref is None and not request.no_user:
+        ref = companion_user_model(path)
+    if ref is None:
+        why = ("--no-user" if request.no_user
+               else "no --script or --user-model, and no companion .users.toml")
+        return User.nobody(f"nobody ({why}): user-lane activities wait" if not lane.empty
+                           else "nobody (no user lane)"), (), None
+    user = User.model(ref)
+    named = str(ref) if isinstance(ref, (str, os.PathLike)) else None
+    if lane.empty:
+        return user, (), named
+    return user, tuple(user.source.validate_against(lane.manual, choices=lane.choices)), named
+
+
+def scripted_user(script: Any, compiled: Any) -> User:
+    """A scripted user (a script file's path, a Script or its steps), every activity and
+    trigger it names checked against the spec ``compiled`` (a misspelt name would never
+    match an offer): ``opspec run --script``, the walkthrough's ``--replay``, ``simulate``."""
+    from opspec.engine.names import spec_names
+    from opspec.runs import User
+    from opspec.usermodels.scripts import Script, load_script, parse_script
+
+    if isinstance(script, (str, os.PathLike)):
+        plan, describe = load_script(Path(script)), f"the script {script}"
+    elif isinstance(script, Script):
+        plan, describe = script, "a script"
+    else:
+        plan, describe = parse_script(script), "a script"
+    names = spec_names(compiled)
+    plan.check_names(names.activities, names.triggers)
+    return User.script(plan, describe)
+
+
+# ---------------------------------------------------------------------------- prepare
+
+
+def prepare(request: RunRequest) -> PreparedRun:
+    """Decide ``request`` (see the module docstring): every bad input is refused here,
+    before anything runs, with the same message through every door."""
+    seed = check_seed(request.seed)
+    loaded, spec_warnings, path = _spec(request.spec)
+    horizon = run_length(loaded.compiled, days=request.days, until=request.until)
+    user, user_warnings, named = _user(request, loaded, path)
+    return PreparedRun(request, loaded, seed, horizon, user,
+                       (*spec_warnings, *user_warnings), path, named)
+
+
+def run(spec: Any, *, seed: Any = 0, days: Any = None, until: Any = None,
+        user_model: Any = None, script: Any = None, user: User | None = None,
+        no_user: bool = False, user_index: int = 0,
+        config: EngineConfig | Mapping[str, Any] | None = None,
+        performers: Mapping[str, Performer] | None = None,
+        listeners: Sequence[TraceListener] = (), params: Mapping[str, Any] | None = None,
+        keep_trace: bool = True) -> RunOutcome:
+    """Run ``spec`` once, as ``opspec run`` does, and return its
+    :class:`~opspec.runs.RunOutcome` (``opspec.run``): the request's rules are those of the
+    module docstring; ``opspec.run(spec, seed=S)`` is user 0 of
+    ``opspec evaluate spec --seed S``."""
+    request = RunRequest(spec, seed=seed, days=days, until=until, script=script,
+                         user_model=user_model, user=user, no_user=no_user, config=config,
+                         performers=performers or _EMPTY, listeners=tuple(listeners),
+                         params=params, keep_trace=keep_trace)
+    return prepare(request).execute(user_index)
