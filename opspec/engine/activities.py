@@ -26,6 +26,7 @@ from opspec.engine.compiled import (
     K_SUBFLOW,
     K_TASK,
     MI_ALL,
+    MI_CANCEL,
     MI_NONE,
     MI_ONE,
     CompiledActivity,
@@ -144,17 +145,23 @@ class Activities(Part):
         if act.start_assign and not self.flow.assign(inst, act, act.start_assign):
             return
         now = self.state.env._now
-        for seconds, synchronous, exception in act.deadlines:
-            try:
-                delay = float(seconds(inst.scope, now))
-            except OpspecError as error:
-                self.flow.abort(inst, act, f"deadline cannot be computed: {error.message}")
-                return
-            self.state.later(delay, self.triggers.deadline, ai, (synchronous, exception, delay))
-        for index in act.boundary:
-            event = ai.frame.graph.activities[index]
-            if event.trigger is not None:
-                self.triggers.wait_trigger(ai, event.trigger, self.triggers.boundary, index, persistent=True)
+        # a multi-instance activity's deadlines and boundary events are the whole activity's:
+        # armed once, on the group's holder, when its first instance starts
+        armed = ai if ai.mi is None else (ai.mi.holder if ai.iteration == 0 else None)
+        if armed is not None:
+            for seconds, synchronous, exception in act.deadlines:
+                try:
+                    delay = float(seconds(inst.scope, now))
+                except OpspecError as error:
+                    self.flow.abort(inst, act, f"deadline cannot be computed: {error.message}")
+                    return
+                self.state.later(delay, self.triggers.deadline, armed,
+                                 (synchronous, exception, delay))
+            for index in act.boundary:
+                event = ai.frame.graph.activities[index]
+                if event.trigger is not None:
+                    self.triggers.wait_trigger(armed, event.trigger, self.triggers.boundary,
+                                               index, persistent=True)
         if act.loop is not None and act.loop[2] and not self._loop_again(ai):
             self._complete(ai)
             return
@@ -187,6 +194,11 @@ class Activities(Part):
             self.flow.finish(frame, act)
             return False
         group = MultiInstance(count)
+        if act.deadlines or act.boundary:
+            holder = ActivityInstance(next(self.state.keys), act, frame, self.state.env._now)
+            holder.state = RUNNING
+            holder.mi = group
+            group.holder = holder
         frame.live += count - 1
         self._mi_join(ai, group)
         if parallel:
@@ -214,6 +226,8 @@ class Activities(Part):
         inst = frame.inst
         group.completed += 1
         group.members.remove(ai)
+        if group.completed == group.count and group.holder is not None:
+            self.mi_release(group)
         _count, parallel, flow, cond = act.mi  # type: ignore[misc]
         if flow == MI_NONE:
             moves = True
@@ -233,6 +247,13 @@ class Activities(Part):
                     self.flow.abort(inst, act, f"the ComplexMI_FlowCondition failed: "
                                f"{error.message}")
                     return
+        if moves and flow == MI_CANCEL:
+            # BPMN 2.0 §13.3.7: the completionCondition "cancels the remaining Activity
+            # instances and produces a token"
+            self.mi_cancel(group, frame, "the completionCondition holds")
+            group.passed = True
+            self.flow.finish(frame, act)
+            return
         if not parallel and group.started < group.count and inst.state == RUNNING:
             self._mi_next(frame, act, group)
         if moves:
@@ -252,6 +273,18 @@ class Activities(Part):
         frame.live -= len(group.members) + (group.count - group.started)
         group.members.clear()
         group.started = group.count
+        if group.holder is not None:
+            self.mi_release(group)
+
+    def mi_release(self, group: MultiInstance) -> None:
+        """The multi-instance activity is over: its deadlines and boundary events end."""
+        holder = group.holder
+        if holder is not None and holder.state == RUNNING:
+            holder.state = COMPLETED
+            holder.gen += 1
+            for undo in holder.cleanup:
+                undo()
+            holder.cleanup.clear()
 
     def _loop_again(self, ai: ActivityInstance) -> bool:
         cond, maximum, _before = ai.act.loop  # type: ignore[misc]
@@ -528,6 +561,10 @@ class Activities(Part):
         for undo in ai.cleanup:
             undo()
         ai.cleanup.clear()
+        group = ai.mi
+        if (group is not None and group.holder is not None and ai is not group.holder
+                and not any(m.state == RUNNING for m in group.members)):
+            self.mi_release(group)
         item = ai.item
         if item is not None:
             ai.item = None

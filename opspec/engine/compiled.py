@@ -14,6 +14,7 @@ What an activity *is* at run time is one of the ``K_*`` kinds below; the interpr
 
 from __future__ import annotations
 
+import datetime
 import re
 from collections.abc import Callable, Iterable, Mapping
 from dataclasses import dataclass, field
@@ -62,6 +63,7 @@ from opspec.model.data import is_structured, structured_value
 __all__ = [
     "J_AND",
     "J_COMPLEX",
+    "J_COUNT",
     "J_OR",
     "J_XOR",
     "K_ASYNC",
@@ -75,6 +77,7 @@ __all__ = [
     "K_TASK",
     "K_THROW",
     "MI_ALL",
+    "MI_CANCEL",
     "MI_COMPLEX",
     "MI_NONE",
     "MI_ONE",
@@ -103,9 +106,11 @@ KIND_NAMES = ("noop", "task", "manual", "subflow", "async-subflow", "catch", "th
               "coordination", "event-gateway")
 # joins and splits
 J_XOR, J_AND, J_OR, J_COMPLEX = range(4)
+J_COUNT = 4      # StartQuantity > 1 without another join: starts once per N arriving tokens
 S_XOR, S_AND, S_OR = range(3)
 # multi-instance flow conditions: when the token moves on
 MI_NONE, MI_ONE, MI_ALL, MI_COMPLEX = range(4)
+MI_CANCEL = 4    # BPMN completionCondition: like MI_COMPLEX, and the rest are cancelled
 # transition kinds
 T_NONE, T_COND, T_OTHERWISE, T_EXCEPTION, T_DEFAULT = range(5)
 # model kinds -> the above, made once (not a dict literal of enum keys per transition/activity)
@@ -139,6 +144,8 @@ class CTrigger:
     count: int = -1                        # period: number of firings (-1: no end)
     planned: bool = False                  # timer: a TimeDate / repeating interval whose
     #                                        firings are ``offset``, +``every``… (``count``)
+    anchored: bool = False                 # planned: ``offset`` is a date (else the firings
+    #                                        count from when the timer is armed)
     interval: Sampler | None = None        # arrival: the inter-arrival time, drawn each time
 
 
@@ -153,6 +160,7 @@ class CTransition:
     assignments: tuple[tuple[str, Evaluator], ...]
     label: str | None = None          # a ScriptGrammar="Text" condition: a label, no test
     probability: float = -1.0         # drawn with this probability (undecided gateway); < 0: none
+    tokens: int = 1                   # tokens sent along it: Quantity x CompletionQuantity
 
 
 @dataclass(frozen=True, slots=True, eq=False)
@@ -203,6 +211,8 @@ class CompiledActivity:
     start_trigger: CTrigger | None = None
     end_trigger: CTrigger | None = None
     terminate: bool = False                  # end event with Terminate result
+    error: str | None = None                 # error end event: its error code ("": none)
+    start_quantity: int = 1                  # J_COUNT: the tokens one start consumes
     deadlines: tuple[tuple[Evaluator, bool, str], ...] = ()   # (seconds, synchronous, exception)
     sampler: Sampler | None = None
     cpu: float = 0.0
@@ -222,7 +232,9 @@ class CompiledActivity:
     boundary: tuple[int, ...] = ()
     attached_to: int = -1
     interrupting: bool = True
-    upstream: frozenset[int] = frozenset()  # OR joins: activities that can reach this one
+    # OR joins: per incoming slot, the activities from which that slot's transition can be
+    # reached without passing through the join (BPMN 2.0 Table 13.3's directed paths)
+    or_reach: tuple[frozenset[int], ...] = ()
     fast: bool = False                       # instantaneous without any wait (no ActInst)
     plain: bool = False                      # waits, but without deadline/loop/trigger/boundary
     next: int = -1                           # the one unconditional successor, if that is all
@@ -263,6 +275,13 @@ class CompiledProcess:
     deadline: float | None
     mode: str | None
     location: SourceLocation | None
+    # several start events with a trigger (BPMN 2.0 §10.4.2: each one independent): each
+    # trigger with the start event it starts an instance at (only that one's path runs)
+    start_events: tuple[tuple[CTrigger, int], ...] = ()
+    # with several triggered start events: where an instance called as a subflow starts (its
+    # none start events; BPMN 2.0 §13.3.4: the triggered ones "are ignored when the Process
+    # is called from another Process")
+    called_starts: tuple[int, ...] = ()
 
 
 @dataclass(slots=True, eq=False)
@@ -346,6 +365,17 @@ class _Compiler:
         dates = [a.body.trigger.date for p in package.processes for a in p.all_activities()
                  if isinstance(a.body, Event) and a.body.trigger.calendar
                  and a.body.trigger.date is not None]
+        # ... and so are the dates data fields hold for a timeDate that reads them
+        for proc in package.processes:
+            fields = {f.id: f for f in (*package.data_fields, *proc.data_fields)}
+            for a in proc.all_activities():
+                trig = a.body.trigger if isinstance(a.body, Event) else None
+                if (trig is not None and trig.time_date and trig.date is None
+                        and isinstance(trig.duration, Name) and len(trig.duration.path) == 1):
+                    held = fields.get(trig.duration.path[0])
+                    moment = _moment(held.initial_value) if held is not None else None
+                    if moment is not None:
+                        dates.append(moment)
         self.anchor = min(d // 86_400.0 for d in dates) * 86_400.0 if dates else 0.0
         self.subflow_targets = {
             a.body.process for p in package.processes for a in p.all_activities()
@@ -425,6 +455,11 @@ class _Compiler:
             if trig.duration is not None or trig.time_cycle or trig.time_date:
                 seconds = self.seconds(trig.duration, trig.time_cycle or trig.time_date,
                                        act.location, f"timer of activity {act.id!r}")
+                if trig.time_date and not trig.time_cycle:
+                    # a timeDate read from data: the date its value holds (or, as XPDL
+                    # engines read a number there, a delay)
+                    seconds = _date_or_delay(seconds, self.anchor, trig.time_date,
+                                             act.location, act.id)
             return CTrigger(kind="timer", seconds=seconds, location=act.location)
         if kind is TriggerKind.RULE:
             cond = self.cond(trig.condition, None, act.location, f"rule of activity {act.id!r}")
@@ -467,7 +502,7 @@ class _Compiler:
         first = date if date is not None else period
         wait = _until(first, period, count) if date is not None else _constant(period)
         return CTrigger(kind="timer", offset=first, every=period, count=count, planned=True,
-                        seconds=wait, location=act.location)
+                        seconds=wait, location=act.location, anchored=date is not None)
 
     # -- graphs --------------------------------------------------------------------------
     def graph(self, proc: WorkflowProcess, name: str, activities: tuple[Activity, ...],
@@ -507,7 +542,8 @@ class _Compiler:
             ct = CTransition(index=ti, id=tr.id, target=by_id[tr.target], kind=kind,
                              condition=cond, exception=exc, assignments=assigns,
                              label=(tr.condition.text or None) if kind == T_NONE else None,
-                             probability=-1.0 if tr.probability is None else tr.probability)
+                             probability=-1.0 if tr.probability is None else tr.probability,
+                             tokens=tr.quantity * activities[by_id[tr.source]].completion_quantity)
             trans_by_id[tr.id] = ct
             outgoing[by_id[tr.source]].append(ct)
             if tr.probability is not None and self.run_inputs and tr.condition.expression:
@@ -545,25 +581,32 @@ class _Compiler:
                     "add a start event (or an activity without incoming transitions) in "
                     "front of the cycle")
         graph.activities = tuple(acts)
-        # OR joins need to know what can still reach them (the predecessors: only if any)
+        # OR joins need to know, per incoming transition, what can still reach it without
+        # passing through the join (only if there are any)
         if any(ca.join == J_OR for ca in acts):
             predecessors: dict[int, set[int]] = {i: set() for i in range(len(acts))}
             for i, outs in outgoing.items():
                 for ct in outs:
                     predecessors[ct.target].add(i)
             for ca in acts:
+                if ca.attached_to >= 0:     # a boundary event's token comes from its host
+                    predecessors[ca.index].add(ca.attached_to)
+            sources = {ct.index: i for i, outs in outgoing.items() for ct in outs}
+            for ca in acts:
                 if ca.join == J_OR:
                     graph.has_or_join = True
-                    seen: set[int] = set()
-                    stack = list(predecessors[ca.index])
-                    while stack:
-                        node = stack.pop()
-                        if node in seen:
-                            continue
-                        seen.add(node)
-                        stack.extend(predecessors[node])
-                    seen.discard(ca.index)
-                    ca.upstream = frozenset(seen)
+                    reach: list[frozenset[int]] = [frozenset()] * len(ca.in_slots)
+                    for ti, slot in ca.in_slots.items():
+                        seen: set[int] = set()
+                        stack = [sources[ti]]
+                        while stack:
+                            node = stack.pop()
+                            if node in seen or node == ca.index:
+                                continue
+                            seen.add(node)
+                            stack.extend(predecessors[node])
+                        reach[slot] = frozenset(seen)
+                    ca.or_reach = tuple(reach)
         return graph
 
     def activity(self, proc: WorkflowProcess, act: Activity, ca: CompiledActivity,
@@ -634,6 +677,8 @@ class _Compiler:
                 result = (body.result or "").lower()
                 if result == "terminate" or body.trigger.kind is TriggerKind.TERMINATE:
                     ca.terminate = True
+                elif result == "error" or body.trigger.kind is TriggerKind.ERROR:
+                    ca.error = body.trigger.name or ""
                 elif result in ("message", "signal") and trig is not None:
                     ca.kind = K_THROW
                     ca.trigger = trig
@@ -681,6 +726,9 @@ class _Compiler:
                 ca.join_condition = self.cond(act.join.condition, act.join.condition_text,
                                               act.location,
                                               f"IncomingCondition of activity {act.id!r}")
+        if act.start_quantity > 1 and ca.join == J_XOR:
+            ca.join = J_COUNT
+            ca.start_quantity = act.start_quantity
         ca.in_slots = {ti: slot for slot, ti in enumerate(incoming)}
         ordered = list(outgoing)
         if act.split is not None and act.split.transition_refs:
@@ -768,7 +816,9 @@ class _Compiler:
             flow = {MIFlow.NONE: MI_NONE, MIFlow.ONE: MI_ONE, MIFlow.ALL: MI_ALL,
                     MIFlow.COMPLEX: MI_COMPLEX}[loop.flow]
             flow_cond = None
-            if flow == MI_COMPLEX:
+            if flow == MI_COMPLEX and loop.cancel_remaining:
+                flow = MI_CANCEL
+            if flow == MI_COMPLEX or flow == MI_CANCEL:
                 flow_cond = self.cond(loop.flow_condition, loop.flow_condition_text,
                                       act.location,
                                       f"ComplexMI_FlowCondition of activity {act.id!r}")
@@ -832,9 +882,10 @@ class _Compiler:
                 ca.labelled = True
         for ca in acts:
             ca.simple_end = (not ca.end_assign and ca.kind != K_THROW and ca.raises is None
-                             and not ca.terminate)
+                             and not ca.terminate and ca.error is None)
             only = ca.out[0] if len(ca.out) == 1 else None
             if (only is not None and only.kind == T_NONE and not only.assignments
+                    and only.tokens == 1
                     and not ca.otherwise and not ca.choice and not ca.terminate):
                 ca.next = only.target
 
@@ -875,23 +926,18 @@ class _Compiler:
         data: dict[str, Any] = {f.id: None for f in proc.formal_parameters}
         data.update({f.id: self.initial(f) for f in proc.data_fields})
         start = self.trigger_ref(directives.start_trigger)
+        start_events: tuple[tuple[CTrigger, int], ...] = ()
         if start is None and directives.arrival is not None:
             start = self.arrivals(proc)
         if start is None:
-            for index in graph.starts:
-                ca = graph.activities[index]
-                if ca.trigger is not None and ca.kind == K_NOOP:
-                    trig = ca.trigger
-                    if trig.kind == "timer" and trig.planned:
-                        start = CTrigger(kind="period", every=trig.every, offset=trig.offset,
-                                         count=trig.count, location=trig.location)
-                    elif trig.kind == "timer" and trig.seconds is not None:
-                        every = float(trig.seconds({}, 0.0))
-                        start = CTrigger(kind="period", every=every, offset=every,
-                                         location=trig.location)
-                    else:
-                        start = trig
-                    break
+            start_events = tuple((_start_trigger(graph.activities[index].trigger), index)
+                                 for index in graph.starts
+                                 if graph.activities[index].trigger is not None
+                                 and graph.activities[index].kind == K_NOOP)
+            if start_events:
+                start = start_events[0][0]
+            if len(graph.starts) < 2:      # one start: it is the process's start trigger
+                start_events = ()
         if start is None and directives.period is not None:
             start = CTrigger(kind="period", every=directives.period, location=proc.location)
         if start is not None and start.kind == "timer" and not start.at and start.every:
@@ -907,7 +953,22 @@ class _Compiler:
             formals=tuple((f.id, f.mode) for f in proc.formal_parameters), priority=priority,
             lane=lane, start_trigger=start, end_trigger=self.trigger_ref(directives.end_trigger),
             auto_start=bool(auto), deadline=directives.deadline, mode=directives.mode,
-            location=proc.location)
+            location=proc.location, start_events=start_events,
+            called_starts=tuple(i for i in graph.starts
+                                if not any(i == index for _t, index in start_events)))
+
+
+def _start_trigger(trig: CTrigger | None) -> CTrigger:
+    """The process start trigger a start event's trigger stands for: a timer start fires
+    periodically when it is a cycle (or, as a duration, every that long)."""
+    assert trig is not None
+    if trig.kind == "timer" and trig.planned:
+        return CTrigger(kind="period", every=trig.every, offset=trig.offset, count=trig.count,
+                        location=trig.location)
+    if trig.kind == "timer" and trig.seconds is not None:
+        every = float(trig.seconds({}, 0.0))
+        return CTrigger(kind="period", every=every, offset=every, location=trig.location)
+    return trig
 
 
 def _names(expression: Expression) -> set[str]:
@@ -942,6 +1003,47 @@ def _until(first: float, every: float, count: int) -> Evaluator:
         if 0 <= count <= k:
             return 0.0
         return first + k * every - now
+    return wait
+
+
+_EPOCH = datetime.datetime(1970, 1, 1)
+
+
+def _moment(value: Any) -> float | None:
+    """Seconds since 1970-01-01 of an ISO 8601 date(-time) text, date or datetime (the
+    simulated clock has no time zone: a zone suffix is ignored); ``None`` for anything else."""
+    if isinstance(value, str):
+        text = value.strip()
+        if len(text) < 10 or not text[:4].isdigit() or text[4:5] != "-":
+            return None
+        try:
+            value = datetime.datetime.fromisoformat(text)
+        except ValueError:
+            return None
+    if isinstance(value, datetime.datetime):
+        return (value.replace(tzinfo=None) - _EPOCH).total_seconds()
+    if isinstance(value, datetime.date):
+        return float((value - _EPOCH.date()).days * 86_400)
+    return None
+
+
+def _date_or_delay(inner: Evaluator, anchor: float, text: str,
+                   location: SourceLocation | None, activity: str) -> Evaluator:
+    """Seconds from ``now`` to the date a timeDate expression's value holds (0 when past:
+    a past date fires at once); a number is a delay in seconds."""
+    def wait(data: Mapping[str, Any], now: float) -> float:
+        value = inner(data, now)
+        if isinstance(value, int | float) and not isinstance(value, bool):
+            return float(value)
+        moment = _moment(value)
+        if moment is None:
+            delay = try_duration(value) if isinstance(value, str) else None
+            if delay is not None:
+                return delay
+            raise OpspecError(f"the timeDate {text!r} of activity {activity!r} gave {value!r}, "
+                              "which is no date", location=location,
+                              hint="give it an ISO 8601 date-time such as 2026-01-01T08:00:00")
+        return max(0.0, moment - anchor - now)
     return wait
 
 

@@ -62,8 +62,10 @@ class EngineConfig:
     - ``realtime`` / ``speed``: run against the wall clock, ``speed`` simulated seconds per
       wall-clock second.
     - ``message_ttl``: seconds a message nobody waits for is kept for the next activity that
-      waits for it (docs/semantics.md); older ones are lost (``trigger.lost``). ``inf``
-      keeps them until caught or their receiver ends.
+      waits for it (docs/semantics.md); older ones are lost (``trigger.lost``). ``None`` (the
+      default): what the spec's ``opspec:MessageTTL`` says, and without it messages are kept
+      until caught or their receiver ends (BPMN: a message waits for its catcher); ``inf``
+      keeps them so whatever the spec says.
     """
 
     processor_model: Literal["dedicated", "pooled", "preemptive", "priority-queues"] = "dedicated"
@@ -74,7 +76,7 @@ class EngineConfig:
     switch_cost: float = 0.0
     realtime: bool = False
     speed: float = 1.0
-    message_ttl: float = 60.0
+    message_ttl: float | None = None
 
     def __post_init__(self) -> None:
         _check(self, None)
@@ -165,6 +167,8 @@ def _check(config: EngineConfig, path: str | None) -> None:
                         f"write e.g. {key} = 2")
     for key in ("timer_resolution", "switch_cost", "message_ttl"):
         value = getattr(config, key)
+        if value is None and key == "message_ttl":
+            continue
         if (isinstance(value, bool) or not isinstance(value, int | float) or math.isnan(value)
                 or (not math.isfinite(value) and key != "message_ttl") or value < 0):
             raise _fail(path, key, f"{key} must be a number of seconds >= 0, not {value!r}",

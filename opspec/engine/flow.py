@@ -17,6 +17,7 @@ from typing import Any
 from opspec.engine.compiled import (
     J_AND,
     J_COMPLEX,
+    J_COUNT,
     K_THROW,
     S_XOR,
     CompiledActivity,
@@ -44,9 +45,10 @@ class Flow(Part):
     """Tokens through graphs: process instances, transitions, splits, joins (see the module docstring)."""
 
     def start_process(self, proc: CompiledProcess, data: Mapping[str, Any] | None = None, *,
-                      parent: ActivityInstance | None = None, trigger: str | None = None
-                      ) -> ProcessInstance:
-        """Create and start an instance of ``proc`` (its start activities are queued)."""
+                      parent: ActivityInstance | None = None, trigger: str | None = None,
+                      start: int = -1) -> ProcessInstance:
+        """Create and start an instance of ``proc``: its start activities are queued, or
+        only ``start`` when one of several triggered start events started it."""
         local = proc.data.copy()
         if data:
             local.update(data)
@@ -71,11 +73,19 @@ class Flow(Part):
                       {"trigger": trigger, "parent": parent.frame.inst.id if parent else None})
         frame = Frame(proc.graph, inst, None)
         inst.frames.append(frame)
-        for index in proc.graph.starts:
+        if start >= 0:
             frame.live += 1
-            self.state.ready.append((self.start_at, frame, index, None))
-        if not proc.graph.starts:
-            self.state.pending[frame] = None
+            self.state.ready.append((self.start_at, frame, start, None))
+        else:
+            starts = proc.graph.starts
+            if proc.start_events and (parent is not None
+                                      or (trigger or "").startswith("subflow:")):
+                starts = proc.called_starts      # called: its none start events only
+            for index in starts:
+                frame.live += 1
+                self.state.ready.append((self.start_at, frame, index, None))
+            if not starts:
+                self.state.pending[frame] = None
         if proc.deadline is not None:
             self.state.call_at(proc.deadline, lambda: self._process_deadline(inst))
         return inst
@@ -160,7 +170,7 @@ class Flow(Part):
 
     def start_at(self, frame: Frame, index: int, _unused: Any) -> None:
         inst = frame.inst
-        if inst.state != RUNNING:
+        if inst.state != RUNNING or (frame.owner is not None and frame.owner.state != RUNNING):
             self._dropped(frame, self.start_at, index, None)
             return
         self.activities.start(frame, frame.graph.activities[index])
@@ -192,6 +202,17 @@ class Flow(Part):
                 for slot in range(len(counts)):
                     counts[slot] -= 1
                 frame.parked -= len(counts) - 1
+            elif join == J_COUNT:                  # StartQuantity: N tokens, one start
+                counts = frame.joins.get(index)
+                if counts is None:
+                    counts = frame.joins[index] = [0]
+                counts[0] += 1
+                if counts[0] < act.start_quantity:
+                    frame.parked += 1
+                    self.token_gone(frame)
+                    return
+                counts[0] = 0
+                frame.parked -= act.start_quantity - 1
             elif join == J_COMPLEX:
                 frame.parked += 1
                 frame.live -= 1
@@ -202,7 +223,10 @@ class Flow(Part):
                     self.state.pending[frame] = None
                 return
             else:                                   # OR join: resolved when the queue is dry
-                frame.ors[index] = frame.ors.get(index, 0) + 1
+                tokens = frame.ors.get(index)
+                if tokens is None:
+                    tokens = frame.ors[index] = [0] * len(act.in_slots)
+                tokens[act.in_slots[trans.index]] += 1
                 frame.parked += 1
                 frame.live -= 1
                 self.state.pending[frame] = None
@@ -268,6 +292,49 @@ class Flow(Part):
             else:
                 self.state.pending[frame] = None
 
+    def throw_error(self, frame: Frame, act: CompiledActivity, code: str) -> None:
+        """An error end event: the nearest enclosing sub-process or call activity with a
+        boundary error event (an EXCEPTION path) for ``code``, else one catching every error,
+        is cancelled and takes that path (BPMN 2.0 §10.4.1, §13.5.3). Uncaught, the error
+        aborts the instance that threw it (and so its callers) with a located fault."""
+        what = f"error {code!r}" if code else "an error without a code"
+        holder = frame.owner if frame.owner is not None else frame.inst.parent
+        while holder is not None:
+            if holder.state == RUNNING and _catches(holder.act, code):
+                self.activities.fail(holder, code or "error",
+                                     f"{what} thrown by end event {act.id!r}")
+                return
+            up = holder.frame
+            holder = up.owner if up.owner is not None else up.inst.parent
+        self.abort(frame.inst, act, f"{what} thrown by this end event is caught by no "
+                   "boundary error event of an enclosing sub-process or call activity")
+
+    def terminate_frame(self, frame: Frame, reason: str) -> None:
+        """A terminate end event inside an activity set (an embedded sub-process) ends that
+        sub-process only (BPMN 2.0 §13.5.6, §13.3.4): what still runs in it is stopped, its
+        queued and parked tokens are dropped, and its block activity completes, so the
+        parent's flow goes on after it."""
+        owner = frame.owner
+        assert owner is not None
+        if frame.queue:
+            frame.queue.clear()
+        for ai in list(frame.running.values()):
+            self.activities.stop(ai, TERMINATED, reason)
+        # tokens still in the ready queue see the frame is gone (its owner no longer runs)
+        frame.live = 0
+        frame.parked = 0
+        frame.joins.clear()
+        frame.ors.clear()
+        if frame.cjoins:
+            frame.cjoins.clear()
+        if frame.owed:
+            frame.owed.clear()
+        self.state.pending.pop(frame, None)
+        if frame in frame.inst.frames:
+            frame.inst.frames.remove(frame)
+        owner.child = None
+        self.activities.body_done(owner, None)
+
     def _ad_hoc_complete(self, frame: Frame) -> bool:
         """An ad-hoc set's AdHocCompletionCondition holds once one of its paths ended: the
         activities still running are cancelled, those not started are dropped, and the set
@@ -303,10 +370,18 @@ class Flow(Part):
             if frame.inst.state != RUNNING:
                 continue
             fired = False
-            for join, count in list(frame.ors.items()):
-                if self._or_ready(frame, join):
-                    del frame.ors[join]
-                    frame.parked -= count
+            for join, tokens in list(frame.ors.items()):
+                if self._or_ready(frame, join, tokens):
+                    # one activation consumes one token of each incoming transition that
+                    # has one (BPMN 2.0 Table 13.3); tokens left over wait for the next
+                    for slot, count in enumerate(tokens):
+                        if count:
+                            tokens[slot] = count - 1
+                            frame.parked -= 1
+                    if not any(tokens):
+                        del frame.ors[join]
+                    else:
+                        self.state.pending[frame] = None
                     frame.live += 1
                     fired = True
                     self.state.ready.append((self.start_at, frame, join, None))
@@ -331,20 +406,26 @@ class Flow(Part):
                 else:
                     self._frame_done(frame)
 
-    def _or_ready(self, frame: Frame, join: int) -> bool:
-        upstream = frame.graph.activities[join].upstream
+    def _or_ready(self, frame: Frame, join: int, tokens: list[int]) -> bool:
+        """Whether OR join ``join`` is activated (BPMN 2.0 Table 13.3): some incoming
+        transition has a token, and every token elsewhere in the frame that can reach an
+        incoming transition without one (not passing through the join) can also reach one
+        that has a token."""
+        if not any(tokens):
+            return False
+        reach = frame.graph.activities[join].or_reach
         for ai in frame.running.values():
-            if ai.act.index in upstream:
+            if _or_blocks(reach, tokens, ai.act.index):
                 return False
-        for other, count in frame.ors.items():
-            if other != join and count and other in upstream:
+        for other, waiting in frame.ors.items():
+            if other != join and any(waiting) and _or_blocks(reach, tokens, other):
                 return False
         for other, counts in frame.joins.items():
-            if other in upstream and any(counts):
+            if any(counts) and _or_blocks(reach, tokens, other):
                 return False
         if frame.cjoins:
             for other, counts in frame.cjoins.items():
-                if other in upstream and any(counts):
+                if any(counts) and _or_blocks(reach, tokens, other):
                     return False
         return True
 
@@ -393,7 +474,13 @@ class Flow(Part):
                       act.participant)
         if act.raises is not None and inst.state == RUNNING:
             self.triggers.broadcast(act.raises.kind, act.raises.name or "", None, inst, act)
+        if act.error is not None:
+            self.throw_error(frame, act, act.error)
+            return None
         if act.terminate:
+            if frame.owner is not None:
+                self.terminate_frame(frame, f"end event {act.id!r}")
+                return None
             self.end_instance(inst, TERMINATED, f"end event {act.id!r}", notify_parent=False)
             parent = inst.parent
             if parent is not None and parent.state == RUNNING:
@@ -435,7 +522,7 @@ class Flow(Part):
                 self.abort(inst, act, f"a transition condition failed: {error.message}")
                 return None
             target = acts[trans.target]
-            if not target.join:
+            if not target.join and trans.tokens == 1:
                 if trans.assignments:
                     for target_name, fn in trans.assignments:
                         self.set_field(inst, None, target_name, fn(scope, now))
@@ -538,12 +625,16 @@ class Flow(Part):
         frame.live += 1
         self.state.ready.append((self.performed if performed else self._arrive, frame,
                             trans.target, trans))
+        if trans.tokens > 1:                # a thread split (WCP-42): one token each
+            for _ in range(trans.tokens - 1):
+                frame.live += 1
+                self.state.ready.append((self._arrive, frame, trans.target, trans))
 
     def performed(self, frame: Frame, index: int, trans: CTransition | None) -> None:
         """A branch of a deferred choice: the performer's choice (or the caught event) *is*
         the chosen activity, which completes at once."""
         inst = frame.inst
-        if inst.state != RUNNING:
+        if inst.state != RUNNING or (frame.owner is not None and frame.owner.state != RUNNING):
             self._dropped(frame, self.performed, index, trans)
             return
         act = frame.graph.activities[index]
@@ -585,8 +676,10 @@ class Flow(Part):
                         message: str, beside: bool) -> None:
         """Follow the EXCEPTION (or DEFAULTEXCEPTION) transition for ``exception``; without
         one, abort the instance (unless the exception path was to start ``beside``)."""
-        trans = next((t for t in act.exceptions if t.exception in (None, exception)),
-                     act.default_exception)
+        # the transition named for the exception, else one for every exception
+        trans = next((t for t in act.exceptions if t.exception == exception),
+                     next((t for t in act.exceptions if t.exception is None),
+                          act.default_exception))
         inst = frame.inst
         if trans is None:
             if not beside:
@@ -597,3 +690,22 @@ class Flow(Part):
         self.take(frame, trans)
         if not beside:
             self.token_gone(frame)
+
+
+def _or_blocks(reach: tuple[frozenset[int], ...], tokens: list[int], node: int) -> bool:
+    """A token at ``node`` holds an OR join back when it can reach an incoming transition
+    that has no token and none that has one."""
+    blocked = False
+    for slot, nodes in enumerate(reach):
+        if node in nodes:
+            if tokens[slot]:
+                return False
+            blocked = True
+    return blocked
+
+
+def _catches(act: CompiledActivity, code: str) -> bool:
+    """Whether ``act`` has an exception path (a boundary error event) for error ``code``."""
+    if act.default_exception is not None:
+        return True
+    return any(t.exception is None or t.exception == code for t in act.exceptions)

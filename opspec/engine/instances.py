@@ -85,7 +85,7 @@ class Frame:
         self.live = 0
         self.parked = 0
         self.joins: dict[int, list[int]] = {}
-        self.ors: dict[int, int] = {}
+        self.ors: dict[int, list[int]] = {}   # OR joins: tokens per incoming slot
         self.running: dict[int, ActivityInstance] = {}
         # complex joins: tokens per incoming slot, and the slots owed a token before the
         # join resets (after it fired; BPMN's "waiting for reset"); made when first needed
@@ -142,9 +142,11 @@ class ActivityInstance:
 
 class MultiInstance:
     """The instances of one multi-instance activity: ``count`` in all, ``started`` and
-    ``completed`` so far, whether the token has ``passed`` on, and the ``members`` running."""
+    ``completed`` so far, whether the token has ``passed`` on, and the ``members`` running.
+    ``holder`` stands for the activity as a whole while any instance runs: its deadlines and
+    boundary events are armed on it, once for all the instances (BPMN 2.0 §13.3.7)."""
 
-    __slots__ = ("completed", "count", "members", "passed", "started")
+    __slots__ = ("completed", "count", "holder", "members", "passed", "started")
 
     def __init__(self, count: int) -> None:
         self.count = count
@@ -152,3 +154,4 @@ class MultiInstance:
         self.completed = 0
         self.passed = False
         self.members: list[ActivityInstance] = []
+        self.holder: ActivityInstance | None = None

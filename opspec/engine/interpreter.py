@@ -43,8 +43,10 @@ Semantics (XPDL / SISARL, see ``docs/trace-format.md`` for what each step record
 
 * Joins: XOR (or none) starts the activity for every arriving token; AND waits for one token
   on *each* incoming transition and consumes one from each (per loop iteration, so cycles
-  work; the last arriving branch performs the merge); OR waits for the tokens that can still
-  arrive: it fires when no running activity and no parked token upstream of it is left.
+  work; the last arriving branch performs the merge); OR fires as BPMN 2.0 Table 13.3 says:
+  once no token elsewhere can still reach an incoming transition without a token (unless it
+  can also reach one with a token), consuming one token from each incoming transition that
+  has one (tokens left over make the next activation).
 * Splits: XOR takes the first CONDITION that holds (or unconditional transition) in declared
   order, else the OTHERWISE transition; AND takes every unconditional transition and every
   condition that holds; OR takes every condition that holds, else OTHERWISE. No split and

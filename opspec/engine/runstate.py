@@ -78,7 +78,8 @@ class RunState:
         self.deadlocks: list[dict[str, Any]] = []
         self.stale_completions = 0
         self.waiters: dict[tuple[str, str], dict[int, tuple[ActivityInstance, Any, Any]]] = {}
-        self.starts: dict[tuple[str, str], list[CompiledProcess]] = {}
+        # message/signal -> the workflows it starts, each with its start event (-1: all)
+        self.starts: dict[tuple[str, str], list[tuple[CompiledProcess, int]]] = {}
         self.ends: dict[tuple[str, str], list[CompiledProcess]] = {}
         self.rules: dict[int, tuple[Any, Any, Any]] = {}       # key -> (cond, handler, arg)
         self.rule_keys = itertools.count(1)

@@ -60,6 +60,17 @@ class Triggers(Part):
             ai.cleanup.append(lambda: discard(table, token))
         elif kind in ("timer", "period"):
             inst = ai.frame.inst
+            every = trig.every or 0.0
+            if persistent and trig.planned and every > 0.0 and trig.count != 1:
+                # a boundary timer with a timeCycle: every cycle while the activity runs
+                now = self.state.env._now
+                if trig.anchored:
+                    first = max(0, math.ceil((now - trig.offset) / every))
+                    self._cycle(ai, trig, handler, arg, trig.offset, first, trig.count)
+                else:
+                    self._cycle(ai, trig, handler, arg, now, 1,
+                                trig.count + 1 if trig.count >= 0 else -1)
+                return
             if trig.seconds is not None:
                 delay = float(trig.seconds(inst.scope, self.state.env._now))
             else:
@@ -76,6 +87,22 @@ class Triggers(Part):
             self.state.rules[rkey] = (lambda: condition(inst.scope, self.state.env._now),
                                  lambda: handler(ai, arg, None), ai)
             ai.cleanup.append(lambda: discard(self.state.rules, rkey))
+
+    def _cycle(self, ai: ActivityInstance, trig: CTrigger, handler: Any, arg: Any,
+               base: float, k: int, end: int) -> None:
+        """Fire boundary timer ``trig`` at ``base + k * every`` and, while ``ai`` still runs
+        (a non-interrupting event), at each following cycle before ``end`` (-1: no end):
+        BPMN 2.0 §10.4.5, a timeCycle "R3/PT10M" fires three times, ten minutes apart."""
+        if 0 <= end <= k:
+            return
+        every = trig.every or 0.0
+        delay = base + k * every - self.state.env._now
+
+        def fired(target: ActivityInstance, _unused: Any) -> None:
+            handler(target, arg, None)
+            if target.state == RUNNING:
+                self._cycle(target, trig, handler, arg, base, k + 1, end)
+        self.state.later(delay, fired, ai)
 
     def check_rules(self) -> None:
         for rkey, (cond, fire, ai) in list(self.state.rules.items()):
@@ -129,9 +156,10 @@ class Triggers(Part):
                     table.pop(token, None)
                 if ai.state == RUNNING:
                     handler(ai, arg, data)
-        for target in self.state.starts.get(key, ()):
+        for target, start in self.state.starts.get(key, ()):
             if self.is_active(target.id):
-                self.flow.start_process(target, self._fields(target, data), trigger=f"{kind}:{name}")
+                self.flow.start_process(target, self._fields(target, data),
+                                        trigger=f"{kind}:{name}", start=start)
         for target in self.state.ends.get(key, ()):
             self.terminate_all(target.id, f"end trigger {kind}:{name}")
 
@@ -170,10 +198,10 @@ class Triggers(Part):
                     return
         kind, name = key
         started = False
-        for target in self.state.starts.get(key, ()):
+        for target, start in self.state.starts.get(key, ()):
             if self.is_active(target.id):
                 child = self.flow.start_process(target, self._fields(target, data),
-                                           trigger=f"{kind}:{name}")
+                                                trigger=f"{kind}:{name}", start=start)
                 child.partner = _root(inst) if inst is not None else None
                 started = True
         if started:
@@ -212,10 +240,13 @@ class Triggers(Part):
     def _take_kept(self, waiter: ProcessInstance, key: tuple[str, str]
                    ) -> tuple[Mapping[str, Any] | None, float] | None:
         """The oldest message kept for ``waiter``'s root instance, else for anyone; messages
-        kept longer than the configured ``message_ttl`` are lost on the way (a button pressed
-        hours before anyone asked is not an answer to the next question)."""
+        kept longer than the spec's ``opspec:MessageTTL`` (or the engine option
+        ``message_ttl``) are lost on the way (a button pressed hours before anyone asked is not
+        an answer to the next question); without either, a message waits for its catcher."""
         now = self.state.env._now
         ttl = self.state.config.message_ttl
+        if ttl is None:        # the spec's opspec:MessageTTL, else until caught
+            ttl = self.state.compiled.package.message_ttl or math.inf
         for box_key in ((waiter.root, key), (0, key)):
             box = self.state.kept.get(box_key)
             while box:
@@ -274,7 +305,11 @@ class Triggers(Part):
             # the interrupted activity's token moves on to the boundary path (below)
             group = ai.mi
             self.activities.stop(ai, TERMINATED, f"boundary event {event.id!r}")
-            if group is not None:
+            if group is not None and ai is group.holder:
+                # the whole multi-instance activity: every instance ends, one token moves on
+                self.activities.mi_cancel(group, frame, f"boundary event {event.id!r}")
+                frame.live += 1
+            elif group is not None:
                 group.members.remove(ai)
                 self.activities.mi_cancel(group, frame, f"boundary event {event.id!r}")
         else:
@@ -289,7 +324,12 @@ class Triggers(Part):
         self.state.emit_act(EK.DEADLINE_EXPIRED, inst, act,
                        {"exception": exception, "synchronous": synchronous, "deadline": delay})
         if synchronous:
+            group = ai.mi
             self.activities.stop(ai, TERMINATED, f"deadline {exception!r}")
+            if group is not None and ai is group.holder:
+                # the whole multi-instance activity: every instance ends, one token moves on
+                self.activities.mi_cancel(group, frame, f"deadline {exception!r}")
+                frame.live += 1
             self.flow.exception_flow(frame, act, exception,
                                  f"deadline of {delay:g} s expired ({exception!r})", False)
         else:
@@ -351,30 +391,36 @@ class Triggers(Part):
     def arm_process(self, proc: CompiledProcess) -> None:
         """Arm the start and end triggers of ``proc`` (mode membership checked on firing)."""
         start = proc.start_trigger
-        if start is None:
+        if proc.start_events:
+            # several start events: each starts its own instance, with only its path
+            for trig, index in proc.start_events:
+                self._arm(trig, self._starter(proc, index), starts=(proc, index))
+        elif start is None:
             if proc.auto_start and self.is_active(proc.id):
                 self.flow.start_process(proc, trigger="auto")
         else:
-            self._arm(start, lambda trig: self._triggered_start(proc, trig))
+            self._arm(start, lambda trig: self._triggered_start(proc, trig), starts=(proc, -1))
         if proc.end_trigger is not None:
             self._arm(proc.end_trigger, lambda trig: self.terminate_all(
                 proc.id, f"end trigger {trig}"), ends=proc)
 
-    def _triggered_start(self, proc: CompiledProcess, trigger: str) -> None:
+    def _starter(self, proc: CompiledProcess, start: int) -> Callable[[str], None]:
+        return lambda label: self._triggered_start(proc, label, start)
+
+    def _triggered_start(self, proc: CompiledProcess, trigger: str, start: int = -1) -> None:
         if self.is_active(proc.id):
-            self.flow.start_process(proc, trigger=trigger)
+            self.flow.start_process(proc, trigger=trigger, start=start)
 
     def _arm(self, trig: CTrigger, fire: Callable[[str], None],
-             ends: CompiledProcess | None = None) -> None:
+             ends: CompiledProcess | None = None,
+             starts: tuple[CompiledProcess, int] | None = None) -> None:
         kind = trig.kind
         if kind in ("message", "signal"):
             state = self.state
-            table = state.ends if ends is not None else state.starts
             if ends is not None:
-                table.setdefault((kind, trig.name or ""), []).append(ends)
-            else:
-                proc = next(p for p in self.state.processes.values() if p.start_trigger is trig)
-                table.setdefault((kind, trig.name or ""), []).append(proc)
+                state.ends.setdefault((kind, trig.name or ""), []).append(ends)
+            elif starts is not None:
+                state.starts.setdefault((kind, trig.name or ""), []).append(starts)
         elif kind in ("timer", "period"):
             times = _occurrences(trig, self.state.env.now)
             self._next_timer(times, fire, f"{kind}")

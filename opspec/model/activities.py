@@ -221,7 +221,8 @@ class MIFlow(enum.Enum):
 class Loop:
     """``Loop``: a standard loop (``condition``/``maximum``/``test_before``) or a
     multi-instance loop (``condition`` is the MI_Condition, the number of instances, with
-    ``parallel`` ordering, ``flow`` and the ComplexMI_FlowCondition ``flow_condition``)."""
+    ``parallel`` ordering, ``flow`` and the ComplexMI_FlowCondition ``flow_condition``;
+    ``cancel_remaining`` when it is BPMN's completionCondition)."""
 
     kind: LoopKind = LoopKind.STANDARD
     condition: Expression | None = None
@@ -232,6 +233,9 @@ class Loop:
     flow: MIFlow = MIFlow.ALL
     flow_condition: Expression | None = None
     flow_condition_text: str | None = None
+    # BPMN's completionCondition: once it holds, the instances still running are cancelled
+    # and those not started never start (XPDL's ComplexMI_FlowCondition lets them run on)
+    cancel_remaining: bool = False
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
@@ -270,6 +274,11 @@ class Activity(Element):
     directives: ActivityDirectives = ActivityDirectives()
     coordination: CoordinationBuiltIn | None = None
     assignments: tuple[Assignment, ...] = ()
+    # XPDL 2.1 StartQuantity / CompletionQuantity, BPMN startQuantity / completionQuantity:
+    # the tokens that must arrive before it starts (thread merge, WCP-41), and the tokens it
+    # sends down each outgoing transition it takes (thread split, WCP-42)
+    start_quantity: int = 1
+    completion_quantity: int = 1
 
     @property
     def is_route(self) -> bool:

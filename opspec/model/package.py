@@ -70,6 +70,8 @@ class Package(Element):
     metrics: tuple[MetricDefinition, ...] = ()
     modes: tuple[WorkflowMode, ...] = ()
     run_length: float | None = None            # opspec:RunLength: one run's natural length, s
+    # opspec:MessageTTL: how long a message nobody waits for is kept (s); None: until caught
+    message_ttl: float | None = None
 
     @property
     def source_format(self) -> str:

@@ -54,6 +54,7 @@ class Transition(Element):
     condition: Condition = Condition()
     assignments: tuple[Assignment, ...] = ()
     probability: float | None = None
+    quantity: int = 1          # XPDL 2.1 Transition Quantity: tokens sent along it each time
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)

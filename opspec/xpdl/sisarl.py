@@ -63,7 +63,8 @@ PROCESS_DIRECTIVES = ("Period", "Rate", "Priority", "Deadline", "Latency", "Star
                       "EndTrigger", "AutoStart", "Lane", "Mode", "Arrival", "ArrivalCount")
 ACTIVITY_DIRECTIVES = ("AutoRun", "PriorityIncrement", "StartTrigger", "EndTrigger", "Raises",
                        "CpuDemand", "Duration", "BuiltIn")
-PACKAGE_DIRECTIVES = ("Metrics", "Modes", "Monitor", "World", "WorldFile", "RunLength")
+PACKAGE_DIRECTIVES = ("Metrics", "Modes", "Monitor", "World", "WorldFile", "RunLength",
+                      "MessageTTL")
 #: directives that may be given more than once, every one counting (one monitor per attribute)
 REPEATABLE = frozenset({"Monitor"})
 
@@ -201,6 +202,16 @@ def _run_length(directive: Directive) -> float:
     return seconds
 
 
+def _message_ttl(directive: Directive) -> float:
+    seconds = parse_seconds(directive.value, directive.location, "message time to live")
+    if seconds <= 0:
+        raise SisarlValueError(f"message time to live {directive.value!r} must be longer than "
+                               "zero", location=directive.location,
+                               hint="write e.g. PT60S (leave it out to keep messages until "
+                               "caught)")
+    return seconds
+
+
 def _mode_id(directive: Directive) -> str:
     value = directive.value.strip()
     if not value:
@@ -304,14 +315,15 @@ _NO_ACTIVITY_DIRECTIVES = ActivityDirectives()
 
 def package_extensions(element: etree._Element, ctx: BuildContext,
                        found: dict[str, Directive] | None = None) -> dict[str, Any]:
-    """``metrics``, ``modes`` and ``run_length`` of a ``Package`` element, as Package
+    """``metrics``, ``modes``, ``run_length`` and ``message_ttl`` of a ``Package`` element, as Package
     keyword arguments (``found``: the directives already collected, see
     :func:`process_directives`)."""
     from opspec.xpdl.sisarl_builtins import build_metrics, build_modes
 
     if found is None:
         found = collect(element, ctx, PACKAGE_DIRECTIVES, "a Package")
-    out: dict[str, Any] = _apply(found, ctx, {"RunLength": ("run_length", _run_length)})
+    out: dict[str, Any] = _apply(found, ctx, {"RunLength": ("run_length", _run_length),
+                                              "MessageTTL": ("message_ttl", _message_ttl)})
     if "Metrics" in found:
         out["metrics"] = build_metrics(found["Metrics"], ctx)
     if "Modes" in found:

@@ -246,4 +246,6 @@ def package_directive_attributes(package: Package) -> list[ExtendedAttribute]:
         out.append(_ea("Modes", raw_xml="".join(_mode_xml(m) for m in package.modes)))
     if package.run_length is not None:
         out.append(_ea("RunLength", value=f"PT{package.run_length!r}S"))
+    if package.message_ttl is not None:
+        out.append(_ea("MessageTTL", value=f"PT{package.message_ttl!r}S"))
     return out

@@ -484,6 +484,10 @@ def _write_activity(parent: etree._Element, activity: Activity, script_language:
         element.set("StartMode", activity.start_mode.value)
     if activity.finish_mode.value != "Automatic":
         element.set("FinishMode", activity.finish_mode.value)
+    if activity.start_quantity != 1:
+        element.set("StartQuantity", str(activity.start_quantity))
+    if activity.completion_quantity != 1:
+        element.set("CompletionQuantity", str(activity.completion_quantity))
     if activity.description is not None:
         _sub(element, "Description", activity.description)
     _write_body(element, activity, script_language)
@@ -554,6 +558,8 @@ def _write_transitions(parent: etree._Element, transitions: tuple[Transition, ..
     for transition in transitions:
         element = _sub(container, "Transition", Id=transition.id, From=transition.source,
                        To=transition.target, Name=transition.name)
+        if transition.quantity != 1:
+            element.set("Quantity", str(transition.quantity))
         condition = transition.condition
         if condition.kind is not ConditionKind.NONE or condition.text:
             condition_element = _sub(element, "Condition")

@@ -208,12 +208,13 @@ def test_warnings_reach_run(tmp_path, capsys):
     """Every front door uses validate's gate: ``opspec run`` prints the warning, with its
     file:line, before it runs."""
     spec = tmp_path / "q.bpmn"
-    spec.write_bytes(_bpmn('<startEvent id="s"/>\n<task id="a" startQuantity="2"/>\n'
+    spec.write_bytes(_bpmn('<startEvent id="s"/>\n<task id="a" isForCompensation="true"/>\n'
                            '<sequenceFlow id="f" sourceRef="s" targetRef="a"/>\n'))
     status = main(["run", str(spec), "--timeline", "none"])
     captured = capsys.readouterr()
     assert status == 0
-    assert f"{spec}:4: warning: bpmn:task 'a' startQuantity='2' does not run" in captured.err
+    assert f"{spec}:4: warning: bpmn:task 'a' isForCompensation='true' does not run" in \
+        captured.err
 
 
 def test_strict_refuses_a_file_that_runs_differently(tmp_path, capsys):

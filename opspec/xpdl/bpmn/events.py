@@ -100,8 +100,11 @@ def read_timer(definition: etree._Element, defs: Defs) -> Timer | None:
             if kind == "timeDate":
                 moment = parse_time_date(text, location=where)
                 if moment is None:
-                    raise SpecError(f"cannot read timeDate {text!r}: it is no date or time",
-                                    location=where)
+                    # an expression (a data field holding an ISO date): the engine fires at
+                    # the date its value holds when the timer is armed
+                    expression = parse_duration_expression(text, location=where)
+                    return Timer("date", text, {"time_date": text, "duration": expression},
+                                 expression)
                 return Timer("date", text, {"time_date": text, "date": moment[0],
                                             "calendar": moment[1]})
             duration = parse_duration_expression(text, location=where)

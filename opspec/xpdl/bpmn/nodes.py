@@ -188,8 +188,9 @@ def _start(element: etree._Element, defs: Defs) -> Built:
 
 def _end(element: etree._Element, defs: Defs) -> Built:
     trigger, definition, _timer = trigger_of(element, defs, catching=False)
-    if trigger.kind in (TriggerKind.ERROR, TriggerKind.ESCALATION, TriggerKind.CANCEL,
-                        TriggerKind.COMPENSATION):
+    # an error end event runs as BPMN defines it (the engine hands the error to the nearest
+    # enclosing boundary error event); the others end their path and say so
+    if trigger.kind in (TriggerKind.ESCALATION, TriggerKind.CANCEL, TriggerKind.COMPENSATION):
         defs.ctx.warning(definition, "unsupported-event",
                          f"{_label(element)} throws {trigger.kind.value}: opspec ends the path "
                          "there but does not hand the "

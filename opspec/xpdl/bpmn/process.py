@@ -71,7 +71,7 @@ from opspec.xpdl.bpmn.extensions import (
 )
 from opspec.xpdl.bpmn.nodes import NODES, build_node
 from opspec.xpdl.bpmn.scripts import bpmn_condition
-from opspec.xpdl.handlers.common import parse_int
+from opspec.xpdl.handlers.common import parse_int, quantity
 from opspec.xpdl.sisarl import (
     ACTIVITY_DIRECTIVES,
     PROCESS_DIRECTIVES,
@@ -392,10 +392,15 @@ class _Process:
                 what = ("it has no event definition" if kind is None
                         else f"opspec does not run {kind.removesuffix('EventDefinition')} events")
                 self.ctx.warning(event, "unsupported-element",
-                                 f"boundary event {event_id!r}: {what}; it and its outgoing flows "
-                                 "are ignored", "docs/bpmn.md lists the boundary events opspec "
-                                 "runs")
-                out.skipped.add(event_id)
+                                 f"boundary event {event_id!r}: {what}; it never fires, so its "
+                                 "outgoing flows never carry a token",
+                                 "docs/bpmn.md lists the boundary events opspec runs")
+                # kept as a boundary event that never fires: the nodes its flows lead to keep
+                # their incoming flows, so none of them starts when the process does
+                out.activities.append(self.plain(event, Event(
+                    position=EventPosition.INTERMEDIATE,
+                    trigger=Trigger(catching=True, attached_to=host,
+                                    interrupting=interrupting)), host))
                 continue
             trigger = trigger_of(event, self.defs, catching=True, attached_to=host,
                                  interrupting=interrupting)[0]
@@ -491,7 +496,9 @@ class _Process:
             deadlines=tuple(boundary.deadlines.get(node_id, ())),
             loop=self.loop(element), join=join, split=split,
             directives=directive_values, coordination=coordination,
-            assignments=assignments(element, self.defs) + extra + tuple(data.assignments))
+            assignments=assignments(element, self.defs) + extra + tuple(data.assignments),
+            start_quantity=quantity(element, "startQuantity", self.ctx),
+            completion_quantity=quantity(element, "completionQuantity", self.ctx))
 
     def simulated_duration(self, element: etree._Element, node_id: str,
                            given: ActivityDirectives) -> ActivityDirectives:
@@ -600,7 +607,8 @@ class _Process:
                     flow=MIFlow.COMPLEX if completion_text else MIFlow.ALL,
                     flow_condition_text=completion_text,
                     flow_condition=bpmn_condition(completion, completion_text, self.defs,
-                                                  "completionCondition"))
+                                                  "completionCondition"),
+                    cancel_remaining=completion_text is not None)
 
     def expression(self, element: etree._Element, text: str | None, what: str
                    ) -> Expression | None:

@@ -35,6 +35,7 @@ from opspec.xpdl.handlers.common import (
     children_by_tag,
     grandchildren,
     parse_int,
+    quantity,
     text_of,
 )
 from opspec.xpdl.handlers.events import parse_condition_element
@@ -264,6 +265,8 @@ def build_activity(element: etree._Element, ctx: BuildContext) -> Activity:
         directives=directives,
         coordination=coordination,
         assignments=build_assignments(element, ctx) if has("Assignments") else (),
+        start_quantity=quantity(element, "StartQuantity", ctx),
+        completion_quantity=quantity(element, "CompletionQuantity", ctx),
         **fields,
     )
 
@@ -279,5 +282,7 @@ def _bare_activity(element: etree._Element, ctx: BuildContext) -> Activity:
         finish_mode=_mode(element, "FinishMode", ctx),
         directives=directives,
         coordination=coordination,
+        start_quantity=quantity(element, "StartQuantity", ctx),
+        completion_quantity=quantity(element, "CompletionQuantity", ctx),
         **fields,
     )

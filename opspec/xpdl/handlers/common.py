@@ -35,6 +35,7 @@ __all__ = [
     "local_name",
     "parse_bool",
     "parse_int",
+    "quantity",
     "raw_xml",
     "text_of",
 ]
@@ -200,6 +201,21 @@ def parse_bool(text: str | None) -> bool | None:
     if lowered in ("false", "0", "no"):
         return False
     return None
+
+
+def quantity(element: Node, name: str, ctx: BuildContext) -> int:
+    """A token quantity attribute (XPDL StartQuantity, CompletionQuantity, Transition
+    Quantity; BPMN startQuantity, completionQuantity): 1 when absent; anything but a whole
+    number >= 1 is a ``bad-quantity`` error (read as 1, never silently)."""
+    text = attr(element, name)
+    if text is None:
+        return 1
+    value = parse_int(text)
+    if value is None or value < 1:
+        ctx.error(element, "bad-quantity", f"{name} {text!r} is not a whole number of tokens "
+                  "(1 or more)", f"write {name}=\"2\", or leave it out for 1")
+        return 1
+    return value
 
 
 def parse_int(text: str | None) -> int | None:

@@ -26,6 +26,7 @@ from opspec.xpdl.handlers.common import (
     local_name,
     parse_bool,
     parse_int,
+    quantity,
 )
 from opspec.xpdl.handlers.data import build_data_field, build_formal_parameter
 from opspec.xpdl.handlers.events import parse_condition_element
@@ -84,12 +85,13 @@ def build_transition(element: etree._Element, ctx: BuildContext) -> Transition:
         if value is None:
             ctx.error(element, "missing-transition-end", f"Transition {fields['id']!r} has no {name}",
                       f"set {name} to the Id of an activity")
+    tokens = quantity(element, "Quantity", ctx)
     if not len(element):        # no Condition, no Assignments (most transitions)
         return Transition(source=source or "", target=target or "", condition=_NO_CONDITION,
-                          **fields)
+                          quantity=tokens, **fields)
     return Transition(source=source or "", target=target or "",
                       condition=build_condition(child(element, "Condition"), ctx),
-                      assignments=build_assignments(element, ctx),
+                      assignments=build_assignments(element, ctx), quantity=tokens,
                       probability=_probability(element, fields, ctx), **fields)
 
 
