@@ -202,23 +202,19 @@ _BPMN: tuple[Construct, ...] = (
        "cancelRemainingInstances is false (BPMN: they complete first)", "§10.2.5", when="false"),
     _c("bpmn-completion-condition", BPMN, "completionCondition", None, R,
        "ad-hoc sub-process: it completes when the condition holds", "§10.2.5, §13.3.5"),
-    _c("bpmn-mi-completion-condition", BPMN, "completionCondition", None, W,
-       "once the condition holds the token moves on, but the remaining instances run on to "
-       "their end (BPMN §13.3.7: they are cancelled)", "§10.2.8, §13.3.7",
-       when="in-multi-instance"),
-    _c("bpmn-quantities", BPMN, _ACTIVITIES, "startQuantity", W,
-       "read as 1: the activity starts on every token that arrives (BPMN: it waits for "
-       "startQuantity tokens)", "§10.2.1, §13.3.2", when="not-one",
-       hint="draw a parallel gateway before the activity to wait for several tokens"),
-    _c("bpmn-completion-quantity", BPMN, _ACTIVITIES, "completionQuantity", W,
-       "read as 1: one token leaves on each outgoing flow (BPMN: completionQuantity tokens)",
-       "§10.2.1, §13.3.2", when="not-one",
-       hint="draw a parallel gateway after the activity to produce several tokens"),
+    _c("bpmn-mi-completion-condition", BPMN, "completionCondition", None, R,
+       "once the condition holds the token moves on and the remaining instances are cancelled",
+       "§10.2.8, §13.3.7", when="in-multi-instance"),
+    _c("bpmn-quantities", BPMN, _ACTIVITIES, "startQuantity", R,
+       "the activity waits for startQuantity tokens (thread merge, WCP-41)", "§10.2.1, §13.3.2",
+       when="not-one"),
+    _c("bpmn-completion-quantity", BPMN, _ACTIVITIES, "completionQuantity", R,
+       "completionQuantity tokens leave on each outgoing flow (thread split, WCP-42)",
+       "§10.2.1, §13.3.2", when="not-one"),
     _c("bpmn-orphaned-node", BPMN, f"{_ACTIVITIES} {_GATEWAYS} intermediateCatchEvent "
-       "intermediateThrowEvent endEvent", None, W,
-       "every sequence flow into it comes from something opspec ignores (a compensation or "
-       "cancel boundary event), so it has no incoming flow and starts with the instance "
-       "(BPMN: a node with incoming sequence flows waits for a token)", "§13.2, §13.5.3",
+       "intermediateThrowEvent endEvent", None, R,
+       "a node whose every incoming flow comes from a boundary event that never fires "
+       "(compensation, cancel) waits for a token, so never starts", "§13.2, §13.5.3",
        when="fed-only-by-ignored"),
     _c("bpmn-compensation-activity", BPMN, _ACTIVITIES, "isForCompensation", W,
        "opspec has no compensation: this is an ordinary activity (one no sequence flow leads "
@@ -256,11 +252,10 @@ _BPMN: tuple[Construct, ...] = (
        "exclusive: the first flow whose condition holds; parallel: all flows / waits for all; "
        "complex: activationCondition; event-based: the first event wins; inclusive split: "
        "every flow whose condition holds", "§10.5, §13.4"),
-    _c("bpmn-or-join", BPMN, "inclusiveGateway", None, W,
-       "the inclusive join fires once no running activity or waiting join upstream can still "
-       "send it a token, consuming every token that has arrived, also several on one incoming "
-       "flow (BPMN Table 13.3: one token from each incoming flow that has one; the others wait "
-       "for its next activation)", "§13.4.3, Table 13.3", when="join"),
+    _c("bpmn-or-join", BPMN, "inclusiveGateway", None, R,
+       "the inclusive join fires per activation: one token from each incoming flow that has "
+       "one (left-over tokens are the next activation), held back only by a token whose every "
+       "path leads to an incoming flow without one", "§13.4.3, Table 13.3", when="join"),
     _c("bpmn-activation-condition", BPMN, "activationCondition", None, R,
        "the complex join fires when it holds", "§13.4.4"),
     _c("bpmn-event-gateway-instantiate", BPMN, "eventBasedGateway", "instantiate", W,
@@ -274,11 +269,11 @@ _BPMN: tuple[Construct, ...] = (
        "start, end, catching and throwing events with the trigger of their definition",
        "§10.4, §13.5"),
     _c("bpmn-several-starts", BPMN, "startEvent", None, W,
-       "the process has several start events: one instance starts at all of them together, "
-       "and a timer or message start starts every start event's path (BPMN §10.4.2: each start "
-       "event starts its own instance, and only its own path runs)", "§10.4.2, §13.5.1",
-       when="several-starts",
-       hint="draw one start event per process, or one process per start event"),
+       "each timer, message or signal start starts its own instance with only its own path; "
+       "but a process started without a trigger (auto-started, from the API) starts all its "
+       "start paths together in one instance (BPMN §10.4.2: each start event its own)",
+       "§10.4.2, §13.5.1", when="several-starts",
+       hint="draw one none start event per process, or one process per start event"),
     _c("bpmn-several-definitions", BPMN, "startEvent intermediateCatchEvent boundaryEvent",
        None, W, "only the first event definition counts (BPMN: any one of them triggers it)",
        "§10.4.5", when="several-definitions", reported_by=("multiple-event-definitions",)),
@@ -291,26 +286,25 @@ _BPMN: tuple[Construct, ...] = (
     _c("bpmn-cancel-activity", BPMN, "boundaryEvent", "cancelActivity", R,
        "true: the activity is interrupted; false: the boundary path starts beside it",
        "§10.4.5, §13.5.3"),
-    _c("bpmn-mi-boundary-timer", BPMN, "boundaryEvent", None, W,
-       "a boundary timer on a multi-instance activity fires for each instance (BPMN §13.3.7: "
-       "once for the whole activity)", "§13.3.7", when="timer-on-multi-instance"),
+    _c("bpmn-mi-boundary-timer", BPMN, "boundaryEvent", None, R,
+       "a boundary timer on a multi-instance activity fires once for the whole activity",
+       "§13.3.7", when="timer-on-multi-instance"),
     _c("bpmn-message", BPMN, "messageEventDefinition message messageFlow", None, R,
        "a message goes to one receiver; a message flow's source raises it, its target waits "
        "for it", "§8.4.2, §10.4.5"),
-    _c("bpmn-message-ttl", BPMN, "message", None, W,
-       "a message nobody waits for is kept only 60 s of simulated time (the engine option "
-       "message_ttl), then lost (BPMN keeps it for its catcher)", "§10.4.5",
-       hint=_TTL_HINT),
+    _c("bpmn-message-ttl", BPMN, "message", None, R,
+       "a message nobody waits for yet is kept for its catcher (up to 100 per name, then a "
+       "trigger.lost event; a time to live only from opspec:MessageTTL)", "§10.4.5"),
     _c("bpmn-signal", BPMN, "signal signalEventDefinition", None, R,
        "broadcast to every catcher waiting at that instant", "§10.4.5"),
     _c("bpmn-signal-ref", BPMN, "signalEventDefinition", "signalRef", R,
        "the signal thrown or awaited", "§10.4.5"),
     _c("bpmn-timer", BPMN, "timerEventDefinition timeDate timeDuration timeCycle", None, R,
        "a timer: a date, a duration, or a repeating cycle (ISO 8601)", "§10.4.5"),
-    _c("bpmn-boundary-cycle", BPMN, "timeCycle", None, W,
-       "a non-interrupting boundary timer with a timeCycle fires once, at the cycle's first "
-       "firing (BPMN §10.4.5: at every cycle while its activity runs)", "§10.4.5, §13.5.3",
-       when="non-interrupting-boundary"),
+    _c("bpmn-boundary-cycle", BPMN, "timeCycle", None, R,
+       "a non-interrupting boundary timer with a timeCycle fires at every cycle while its "
+       "activity runs (Rn/ bounds the firings); an interrupting one fires once", "§10.4.5, "
+       "§13.5.3", when="non-interrupting-boundary"),
     _c("bpmn-conditional", BPMN, "conditionalEventDefinition condition", None, R,
        "fires when its condition becomes true", "§10.4.5"),
     _c("bpmn-error", BPMN, "error errorEventDefinition", None, R,
@@ -320,9 +314,14 @@ _BPMN: tuple[Construct, ...] = (
        "§10.4.5"),
     _c("bpmn-error-code", BPMN, "error", "errorCode", R, "the failure's exception name",
        "§10.4.5"),
-    _c("bpmn-error-end", BPMN, "errorEventDefinition escalationEventDefinition "
+    _c("bpmn-error-end", BPMN, "errorEventDefinition", None, R,
+       "the error is caught by the nearest enclosing sub-process or call activity with a "
+       "boundary error event for it (its errorCode, else a catch-all), which is cancelled and "
+       "takes its exception flow; uncaught, the instance is aborted with a located fault",
+       "§10.4.3, §13.5.3", when="in-end-event"),
+    _c("bpmn-escalation-end", BPMN, "escalationEventDefinition "
        "cancelEventDefinition compensateEventDefinition", None, W,
-       "the end event ends its path; the error (escalation, cancel, compensation) is not handed "
+       "the end event ends its path; the escalation (cancel, compensation) is not handed "
        "to a boundary event of an enclosing sub-process or call activity (BPMN §13.5.3: the "
        "nearest enclosing boundary event catches it)", "§10.4.3, §13.5.3", when="in-end-event",
        reported_by=("unsupported-event",)),
@@ -350,11 +349,10 @@ _BPMN: tuple[Construct, ...] = (
        "ignored: opspec has no compensation", "§10.4.5"),
     _c("bpmn-terminate", BPMN, "terminateEventDefinition", None, R,
        "the process instance ends: every activity of it stops", "§10.4.3, §13.5.6"),
-    _c("bpmn-terminate-sub-process", BPMN, "terminateEventDefinition", None, W,
-       "a terminate end event inside an embedded sub-process ends the whole process instance "
-       "(BPMN §13.5.6: only the sub-process; its parent goes on)", "§13.5.6, §13.3.4",
-       when="in-sub-process",
-       hint="end the sub-process's paths with none end events"),
+    _c("bpmn-terminate-sub-process", BPMN, "terminateEventDefinition", None, R,
+       "a terminate end event inside an embedded sub-process ends that sub-process only: "
+       "everything in it stops and the parent goes on", "§13.5.6, §13.3.4",
+       when="in-sub-process"),
     _c("bpmn-link", BPMN, "linkEventDefinition", None, R,
        "a throwing link event continues at the catching one of the same name", "§10.4.5"),
     _c("bpmn-link-name", BPMN, "linkEventDefinition", "name", R, "pairs throw and catch",
@@ -447,8 +445,8 @@ _XPDL: tuple[Construct, ...] = (
        "§7.5, §7.6"),
     _c("xpdl-transition-ends", XPDL, "Transition", "From", R, "the source activity", "§7.6.9"),
     _c("xpdl-transition-to", XPDL, "Transition", "To", R, "the target activity", "§7.6.9"),
-    _c("xpdl-transition-quantity", XPDL, "Transition", "Quantity", W,
-       "read as 1: one token passes (XPDL 2.1: Quantity tokens)", "§7.6.9", when="not-one"),
+    _c("xpdl-transition-quantity", XPDL, "Transition", "Quantity", R,
+       "Quantity tokens pass", "§7.6.9", when="not-one"),
     _c("xpdl-conditions", XPDL, "Condition Expression", None, R,
        "CONDITION, OTHERWISE, EXCEPTION, DEFAULTEXCEPTION transitions", "§7.6.9.1"),
     _c("xpdl-condition-type", XPDL, "Condition", "Type", R, "the kind of condition",
@@ -468,11 +466,10 @@ _XPDL: tuple[Construct, ...] = (
        "ignored: a complex split takes every transition whose condition holds", "§7.6.4"),
     _c("xpdl-route-instantiate", XPDL, "Route TaskReceive", "Instantiate", W,
        "ignored: the event does not start new instances", "§7.6.4", when="true"),
-    _c("xpdl-or-join", XPDL, "Join Route", None, W,
-       "the inclusive join fires once no running activity or waiting join upstream can still "
-       "send it a token, consuming every token that has arrived, also several on one incoming "
-       "transition (BPMN Table 13.3: one token from each incoming flow that has one)",
-       "§7.6.9.2; BPMN Table 13.3", when="inclusive-join"),
+    _c("xpdl-or-join", XPDL, "Join Route", None, R,
+       "the inclusive join fires per activation as BPMN Table 13.3 defines (XPDL is silent): "
+       "one token from each incoming transition that has one", "§7.6.9.2; BPMN Table 13.3",
+       when="inclusive-join"),
     _c("xpdl-implementations", XPDL, "Implementation No Task TaskManual TaskUser TaskService "
        "TaskScript Script TaskApplication TaskBusinessRule SubFlow Reference BlockActivity "
        "ActivitySets ActivitySet", None, R,
@@ -519,12 +516,12 @@ _XPDL: tuple[Construct, ...] = (
        "Manual: the activity waits for its performer", "§7.6"),
     _c("xpdl-finish-mode", XPDL, "Activity", "FinishMode", R,
        "Manual: the activity waits for its performer", "§7.6"),
-    _c("xpdl-quantities", XPDL, "Activity", "StartQuantity", W,
-       "read as 1: the activity starts on every token that arrives (XPDL 2.1: it waits for "
-       "StartQuantity tokens)", "§7.6", when="not-one"),
-    _c("xpdl-completion-quantity", XPDL, "Activity", "CompletionQuantity", W,
-       "read as 1: one token leaves on each outgoing transition (XPDL 2.1: CompletionQuantity "
-       "tokens)", "§7.6", when="not-one"),
+    _c("xpdl-quantities", XPDL, "Activity", "StartQuantity", R,
+       "the activity waits for StartQuantity tokens (thread merge, WCP-41)", "§7.6",
+       when="not-one"),
+    _c("xpdl-completion-quantity", XPDL, "Activity", "CompletionQuantity", R,
+       "CompletionQuantity tokens leave on each outgoing transition (thread split, WCP-42)",
+       "§7.6", when="not-one"),
     _c("xpdl-compensation", XPDL, "Activity", "IsForCompensation", W,
        "opspec has no compensation: this is an ordinary activity", "§7.6", when="true"),
     _c("xpdl-transaction", XPDL, "Activity", "IsATransaction", W,
@@ -563,21 +560,21 @@ _XPDL: tuple[Construct, ...] = (
        "ignored: the loop counter is not written to a data field", "§7.6.3"),
     _c("xpdl-events", XPDL, "Event StartEvent EndEvent IntermediateEvent", None, R,
        "start, end and intermediate events with their trigger or result", "§7.6.2"),
-    _c("xpdl-several-starts", XPDL, "StartEvent", None, W,
-       "the process has several start events: one instance starts at all of them together "
-       "(XPDL 2.1 / BPMN §10.4.2: each start event starts its own instance)", "§7.6.2",
-       when="several-starts"),
+    _c("xpdl-several-starts", XPDL, "StartEvent", None, R,
+       "several start events are independent: each triggered start starts its own instance, "
+       "and only its own path runs", "§7.6.2", when="several-starts"),
     _c("xpdl-event-trigger", XPDL, "StartEvent IntermediateEvent", "Trigger", R, "its trigger",
        "§7.6.2"),
     _c("xpdl-event-result", XPDL, "EndEvent", "Result", R,
        "None, Message, Signal, Terminate, Error…", "§7.6.2"),
-    _c("xpdl-terminate-block", XPDL, "EndEvent", "Result", W,
-       "a terminate end event inside an activity set ends the whole process instance "
-       "(BPMN §13.5.6: only the embedded sub-process)", "§7.6.2; BPMN §13.5.6",
+    _c("xpdl-terminate-block", XPDL, "EndEvent", "Result", R,
+       "a terminate end event inside an activity set ends that block only; the parent goes on "
+       "(XPDL is silent: BPMN §13.5.6 followed)", "§7.6.2; BPMN §13.5.6",
        when="terminate-in-activity-set"),
-    _c("xpdl-error-end", XPDL, "ResultError", None, W,
-       "the end event ends its path; the error is not handed to an enclosing block activity's "
-       "exception transition (BPMN §13.5.3)", "§7.6.2; BPMN §13.5.3", when="in-end-event"),
+    _c("xpdl-error-end", XPDL, "ResultError", None, R,
+       "the error is caught by the nearest enclosing block or subflow activity's exception "
+       "transition for it (else a catch-all); uncaught, the instance is aborted with a "
+       "located fault", "§7.6.2; BPMN §13.5.3", when="in-end-event"),
     _c("xpdl-error-code", XPDL, "ResultError", "ErrorCode", R, "the error caught", "§7.6.2"),
     _c("xpdl-boundary-target", XPDL, "IntermediateEvent", "Target", R,
        "the activity the event is attached to", "§7.6.2"),
@@ -597,10 +594,9 @@ _XPDL: tuple[Construct, ...] = (
        "§7.6.2; BPMN §10.4.5", when="not-a-date"),
     _c("xpdl-timer-cycle-attr", XPDL, "TriggerTimer", "TimeCycle", R, "a repeating cycle",
        "§7.6.2"),
-    _c("xpdl-boundary-cycle", XPDL, "TimeCycle", None, W,
-       "a non-interrupting timer with a cycle attached to an activity fires once, at the "
-       "cycle's first firing (BPMN §10.4.5: at every cycle while the activity runs)", "§7.6.2",
-       when="attached-timer"),
+    _c("xpdl-boundary-cycle", XPDL, "TimeCycle", None, R,
+       "a non-interrupting timer with a cycle attached to an activity fires at every cycle "
+       "while the activity runs", "§7.6.2", when="attached-timer"),
     _c("xpdl-catch-throw", XPDL, "TriggerResultMessage TriggerResultSignal TriggerResultLink",
        "CatchThrow", R, "whether the event waits or raises", "§7.6.2"),
     _c("xpdl-signal-name", XPDL, "TriggerResultSignal TriggerResultLink", "Name", R,
@@ -608,11 +604,10 @@ _XPDL: tuple[Construct, ...] = (
     _c("xpdl-conditional-name", XPDL, "TriggerConditional", "ConditionName", R,
        "the condition", "§7.6.2"),
     _c("xpdl-rule-name", XPDL, "TriggerRule", "RuleName", R, "the rule", "§7.6.2"),
-    _c("xpdl-message-ttl", XPDL, "TriggerResultMessage", None, W,
-       "a message nobody waits for is kept only 60 s of simulated time (the engine option "
-       "message_ttl), then lost (BPMN keeps it for its catcher)", "§7.6.2; BPMN §10.4.5",
-       when="throws",
-       hint=_TTL_HINT),
+    _c("xpdl-message-ttl", XPDL, "TriggerResultMessage", None, R,
+       "a message nobody waits for yet is kept for its catcher (up to 100 per name, then a "
+       "trigger.lost event; a time to live only from opspec:MessageTTL)", "§7.6.2; BPMN §10.4.5",
+       when="throws"),
     _c("xpdl-multiple-triggers", XPDL, "TriggerMultiple TriggerIntermediateMultiple "
        "ResultMultiple", None, W, "only the first trigger counts", "§7.6.2"),
     _c("xpdl-compensation-trigger", XPDL, "TriggerResultCompensation TriggerResultCancel",
@@ -625,9 +620,8 @@ _XPDL: tuple[Construct, ...] = (
        "path starts beside it (ASYNCHR)", "§7.6.8"),
     _c("xpdl-deadline-execution", XPDL, "Deadline", "Execution", R, "SYNCHR or ASYNCHR",
        "§7.6.8"),
-    _c("xpdl-mi-deadline", XPDL, "Deadline", None, W,
-       "a deadline of a multi-instance activity runs for each instance (BPMN §13.5.3: an event "
-       "attached to a multi-instance activity belongs to the activity as a whole)",
+    _c("xpdl-mi-deadline", XPDL, "Deadline", None, R,
+       "a deadline of a multi-instance activity belongs to the activity as a whole (armed once)",
        "§7.6.8; BPMN §13.5.3", when="on-multi-instance"),
     _c("xpdl-data", XPDL, "DataFields DataField FormalParameters FormalParameter "
        "ActualParameters ActualParameter InitialValue Assignments Assignment Target "
