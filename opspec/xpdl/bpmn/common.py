@@ -23,6 +23,7 @@ __all__ = [
     "bpmn_children",
     "expression_text",
     "is_juel",
+    "literal_kind",
     "first",
     "kids",
     "local",
@@ -90,6 +91,22 @@ def text_of(element: etree._Element | None) -> str | None:
 _JUEL = re.compile(r"^[$#]\{(?P<inner>.*)\}$", re.DOTALL)
 # "PT5M" or 'PT5M': SpiffWorkflow writes timer values as Python string literals.
 _QUOTED = re.compile(r"""^(?P<q>["'])(?P<inner>[^"']*)(?P=q)$""")
+
+
+def literal_kind(expression: object) -> BasicKind:
+    """The basic type a literal's value has (STRING for anything but a number or boolean):
+    what a variable a script sets, or a condition compares, is typed as."""
+    from opspec.model.expressions import Literal
+
+    if isinstance(expression, Literal):
+        value = expression.value
+        if isinstance(value, bool):
+            return BasicKind.BOOLEAN
+        if isinstance(value, int):
+            return BasicKind.INTEGER
+        if isinstance(value, float):
+            return BasicKind.FLOAT
+    return BasicKind.STRING
 
 
 def is_juel(element: etree._Element | None) -> bool:

@@ -45,7 +45,7 @@ from opspec.model.activities import (
     Trigger,
 )
 from opspec.model.data import Assignment, BasicKind, BasicType, DataField
-from opspec.model.expressions import Expression, Literal
+from opspec.model.expressions import Expression
 from opspec.model.process import ActivitySet, Condition, ConditionKind, Transition, WorkflowProcess
 from opspec.model.resources import Lane
 from opspec.model.sisarl import ActivityDirectives, ProcessDirectives
@@ -55,6 +55,7 @@ from opspec.xpdl.bpmn.common import (
     expression_text,
     first,
     kids,
+    literal_kind,
     local,
     namespace,
     text_of,
@@ -684,18 +685,6 @@ class _Process:
 _TIMER_KINDS = ("timeDuration", "timeDate", "timeCycle")
 
 
-def _literal_kind(expression: Expression | None) -> BasicKind:
-    if isinstance(expression, Literal):
-        value = expression.value
-        if isinstance(value, bool):
-            return BasicKind.BOOLEAN
-        if isinstance(value, int):
-            return BasicKind.INTEGER
-        if isinstance(value, float):
-            return BasicKind.FLOAT
-    return BasicKind.STRING
-
-
 def _with_script_fields(process: WorkflowProcess, element: etree._Element, defs: Defs
                         ) -> WorkflowProcess:
     """BPMN engines create a variable when a script first sets it: a name a script task
@@ -719,7 +708,7 @@ def _with_script_fields(process: WorkflowProcess, element: etree._Element, defs:
                   f"process {process.id!r}: the variables its script tasks set "
                   f"({', '.join(created)}) become data fields, starting without a value",
                   "declare them with opspec:DataField to give them an initial value")
-    extra = tuple(DataField(id=name, type=BasicType(kind=_literal_kind(a.expression)),
+    extra = tuple(DataField(id=name, type=BasicType(kind=literal_kind(a.expression)),
                             location=a.location) for name, a in created.items())
     return replace(process, data_fields=process.data_fields + extra)
 

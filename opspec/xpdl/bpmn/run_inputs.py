@@ -23,7 +23,7 @@ from opspec.model.data import BasicKind, BasicType, DataField
 from opspec.model.expressions import Binary, Expression, Literal, Name, Unary
 from opspec.model.process import ConditionKind, Transition, WorkflowProcess
 from opspec.xpdl.bpmn.branches import fallback_probabilities, with_probability
-from opspec.xpdl.bpmn.common import Defs
+from opspec.xpdl.bpmn.common import Defs, literal_kind
 
 __all__ = ["RUN_INPUT", "with_run_inputs"]
 
@@ -84,14 +84,7 @@ def _kind_of(name: str, expression: Expression | None) -> BasicKind:
         if isinstance(node, Binary):
             for mine, other in ((node.left, node.right), (node.right, node.left)):
                 if isinstance(mine, Name) and mine.path[0] == name and isinstance(other, Literal):
-                    value = other.value
-                    if isinstance(value, bool):
-                        return BasicKind.BOOLEAN
-                    if isinstance(value, int):
-                        return BasicKind.INTEGER
-                    if isinstance(value, float):
-                        return BasicKind.FLOAT
-                    return BasicKind.STRING
+                    return literal_kind(other)
             stack.extend((node.left, node.right))
         elif isinstance(node, Unary):
             stack.append(node.operand)
