@@ -195,7 +195,7 @@ class RunState:
         """The step count passed the limit: a new count if the clock moved since the count
         began, else a step of a zero-time cycle (see :meth:`zero_time`)."""
         now = self.env._now
-        if now != self.instant:
+        if not _same_instant(now, self.instant):
             self.instant = now
             if self.sampler is not None:         # the clock moved on: no cycle after all
                 self.sampler = None
@@ -209,7 +209,7 @@ class RunState:
         ready-queue item, or a frame and an activity); stop the run once enough are seen."""
         now = self.env._now
         sampler = self.sampler
-        if sampler is None or sampler.at != now:
+        if sampler is None or not _same_instant(now, sampler.at):
             sampler = self.sampler = ZeroTimeSampler(now, self.max_instant_steps)
             self.start_limit = 0                 # _start notes every activity it carries
         if sampler.record(a, b):
@@ -260,6 +260,13 @@ class RunState:
     def _callback(self, callback: Callable[[], None]) -> None:
         callback()
         self.drain()
+
+
+def _same_instant(now: float, then: float) -> bool:
+    """Whether the clock has not really moved from ``then`` to ``now``: a Zeno run that
+    creeps by 1e-17 s a step (durations too short to matter, a fuzzed spec's) counts as one
+    instant, so the zero-time guard stops it as it stops a cycle of no time at all."""
+    return abs(now - then) <= 1e-9 * max(1.0, abs(now))
 
 
 _ACT_KINDS = (EK.ACTIVITY_STARTED, EK.ACTIVITY_COMPLETED, EK.ACTIVITY_OFFERED,

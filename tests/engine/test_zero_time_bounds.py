@@ -38,3 +38,16 @@ def test_the_guards_limit_is_tens_of_thousands_of_steps() -> None:
     # a self-starting workflow piles up an instance per step: 500,000 steps took a minute
     # and a gigabyte with the trace kept (docs in opspec/engine/zero_time.py)
     assert MAX_INSTANT_STEPS + SAMPLE_STEPS <= 60_000
+
+
+def test_a_run_whose_clock_creeps_is_stopped_like_a_zero_time_cycle(tmp_path: Path,
+                                                                   capsys) -> None:
+    """A Zeno run (each round 1e-17 s: the clock never reaches a second) is stopped by the
+    run-time guard with the cycle named, as a cycle of no time is (issue 33); one of real
+    duration runs to its end."""
+    assert main(["run", str(_cycle(tmp_path, 1e-17)), "--days", "1", "--timeline",
+                 "none"]) == 1
+    err = capsys.readouterr().err
+    assert "clock stopped advancing" in err and "Traceback" not in err
+    assert main(["run", str(_cycle(tmp_path, 1.0)), "--until", "PT10M", "--timeline",
+                 "none"]) == 0
