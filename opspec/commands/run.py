@@ -192,14 +192,15 @@ def run(args: argparse.Namespace) -> int:
                        shown=printer.shown if printer else 0, absent=absent,
                        no_user=args.no_user)
         _print_monitors(out, monitors)
-    if sink is not None and sink.truncated is not None:      # the trace file hit its cap
-        print(f"opspec: note: {sink.message()} ({sink.dropped:,} not written)",
-              file=sys.stderr)
+    trace_lost = sink is not None and sink.failure is not None
+    if sink is not None and sink.truncated is not None:      # the cap, or a full disk
+        print(f"opspec: {'error' if trace_lost else 'note'}: {sink.message()} "
+              f"({sink.dropped:,} not written)", file=sys.stderr)
     device_faults = any(info.get("faults") for info in (device_report or {}).values())
     summary = result.summary
     problems = bool(_real_deadlocks(result, absent) or summary.get("faults")
                     or summary.get("instances", {}).get("aborted", 0) > len(absent))
-    return 1 if problems or device_faults else 0
+    return 1 if problems or device_faults or trace_lost else 0
 
 
 def _waiting_for_absent_user(summary: dict[str, Any], compiled: Any, user: Any

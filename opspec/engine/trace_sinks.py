@@ -92,6 +92,9 @@ class JsonlSink:
         #: the time of the first event not written (the cap was reached), or None
         self.truncated: float | None = None
         self.dropped = 0
+        #: why writing failed (a full disk, a lost device), or None: the run goes on and
+        #: its results are reported; the trace ends where the failure was
+        self.failure: str | None = None
         head = header_line(header)
         line = json.dumps(head, default=str) + "\n"
         self._handle.write(line)
@@ -107,11 +110,19 @@ class JsonlSink:
         if self._bytes > self.max_bytes:
             self._truncate(event)
             return
-        self._handle.write(line)
-        self._pending += 1
-        if self._pending >= self._flush_every:
-            self._handle.flush()
-            self._pending = 0
+        try:
+            self._handle.write(line)
+            self._pending += 1
+            if self._pending >= self._flush_every:
+                self._handle.flush()
+                self._pending = 0
+        except OSError as error:           # a disk that fills: keep the run, end the trace
+            self._failed(event.time, error)
+
+    def _failed(self, time: float, error: OSError) -> None:
+        self.truncated = time
+        self.dropped = max(1, self.dropped)
+        self.failure = error.strerror or str(error)
 
     def _truncate(self, event: TraceEvent) -> None:
         self.truncated = event.time
@@ -123,14 +134,25 @@ class JsonlSink:
 
     def message(self) -> str:
         """One line saying that (and where) the trace was cut, and what to do."""
+        if self.failure is not None:
+            return (f"writing the trace {self.path} failed at t={self.truncated or 0.0:.3f} s "
+                    f"({self.failure}); the events from then on are not in it (free space "
+                    "where it goes, or give --trace another place)")
         return (f"the trace {self.path} reached its cap of {self.max_bytes:,} bytes at "
                 f"t={self.truncated or 0.0:.3f} s; later events were not written "
                 f"(set {TRACE_MAX_BYTES_ENV} to a larger number of bytes, or run for less time)")
 
     def close(self) -> None:
         if not self._handle.closed:
-            self._handle.flush()
-            self._handle.close()
+            try:
+                self._handle.flush()
+            except OSError as error:
+                if self.failure is None:
+                    self._failed(self.truncated or 0.0, error)
+            try:
+                self._handle.close()
+            except OSError:
+                pass                       # what could not be written is said in .failure
 
     def __enter__(self) -> Self:
         return self
