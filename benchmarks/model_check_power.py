@@ -20,6 +20,7 @@ Each rate is printed with its Wilson 95 % interval.
 from __future__ import annotations
 
 import argparse
+import os
 import sys
 import tempfile
 import time
@@ -29,6 +30,9 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parent.parent
 SPEC = ROOT / "specs" / "medication_dispenser.xpdl"
 BASE = ROOT / "specs" / "medication_dispenser.users.toml"
+# the populations written below extend BASE from a temporary folder: a user model may name a
+# file outside its folder only where OPSPEC_EXTERNAL_PATH allows it
+os.environ.setdefault("OPSPEC_EXTERNAL_PATH", str(BASE.parent))
 DAYS = 14
 
 

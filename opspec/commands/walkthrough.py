@@ -141,7 +141,7 @@ def run(args: argparse.Namespace) -> int:
         # Textual would wait for keys that never come (< /dev/null, a pipe): refused below,
         # once the spec is known to start (its own error first), with nothing recorded
         terminal = sys.stdin.isatty() and sys.stdout.isatty()
-        if record is not None and not terminal:
+        if args.record and record is not None and not terminal:
             _check_record_folder(record)        # an option's own error comes first
         from opspec.tui.app import WalkthroughApp
         from opspec.tui.session import WalkSession
@@ -195,13 +195,20 @@ def run(args: argparse.Namespace) -> int:
 
 
 def _check_record_folder(record: Path) -> None:
-    """The folder ``--record`` writes to can be made (what the session would do first)."""
+    """The folder ``--record`` writes to can be made (what the session would do first);
+    folders made to find out are removed again, so a refused walkthrough leaves nothing."""
+    missing = [p for p in (record.parent, *record.parent.parents) if not p.exists()]
     try:
         record.parent.mkdir(parents=True, exist_ok=True)
     except OSError as error:
         raise ConfigurationError(
             f"cannot write the recording {record}: {error.strerror or error}",
             hint="give --record a path in a folder you can write to, or --no-record") from None
+    for folder in missing:                    # innermost first
+        try:
+            folder.rmdir()
+        except OSError:
+            break
 
 
 def _model_factory(model: Any, seed: int) -> Any:

@@ -14,6 +14,7 @@ benchmarks/model_check_power.py (docs/fitting.md).
 from __future__ import annotations
 
 import json
+from collections.abc import Iterator
 from pathlib import Path
 
 import pytest
@@ -24,6 +25,15 @@ from opspec.evaluation.predictive import write_person_traces
 HERE = Path(__file__).resolve().parent
 SPEC = HERE.parents[1] / "specs" / "medication_dispenser.xpdl"
 DAYS = 7
+
+
+@pytest.fixture(scope="module", autouse=True)
+def _specs_may_be_extended() -> Iterator[None]:
+    """The test populations extend the bundled dispenser model in specs/, outside their
+    folder: a user model may name it only when OPSPEC_EXTERNAL_PATH allows it (issue 33)."""
+    with pytest.MonkeyPatch.context() as patch:
+        patch.setenv("OPSPEC_EXTERNAL_PATH", str(SPEC.parent))
+        yield
 
 
 @pytest.fixture(scope="module")
