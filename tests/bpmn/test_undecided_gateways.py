@@ -317,3 +317,31 @@ def test_evaluate_param_gives_every_simulated_user_the_run_input(tmp_path: Path)
     assert asked >= 3 * 10                                    # one a minute, 14.4 minutes
     assert completed.count("remind") == asked and "done" not in completed   # 20 <= 50
     assert not [e for e in events if e.get("kind") == "branch.chosen"]
+
+
+def test_a_scenario_file_gives_a_run_input_in_its_given_params(tmp_path: Path) -> None:
+    from opspec.testing.scenario import load_scenarios, run_scenario
+
+    _scored(tmp_path)
+    (tmp_path / "loan.scenario.toml").write_text('''spec = "diagram.bpmn"
+
+[[scenario]]
+name = "a high score is never reminded"
+given = { params = { score = 70 }, until = "PT10M" }
+then = ["never activity remind"]
+
+[[scenario]]
+name = "a low score is never done"
+given = { params = { score = 20 }, until = "PT10M" }
+then = ["never activity done"]
+
+[[scenario]]
+name = "a low score said to be never reminded fails"
+given = { params = { score = 20 }, until = "PT10M" }
+then = ["never activity remind"]
+''', encoding="utf-8")
+    document = load_scenarios(tmp_path / "loan.scenario.toml")
+    spec = tmp_path / "diagram.bpmn"
+    outcomes = [run_scenario(s, spec, seed=1) for s in document.scenarios]
+    assert outcomes[0] == [] and outcomes[1] == []
+    assert outcomes[2]                       # the conditions decided: remind happened

@@ -5,7 +5,7 @@ A modeller's diagram is drawn for an application that sets process variables at 
 real diagrams; inventing a value would run something the diagram does not say. opspec makes
 each such variable a **run input**: a package data field without a value (marked
 ``opspec:RunInput``), which a run is given with ``--param NAME=VALUE`` (``params=`` in Python,
-``[params]`` in a scenario). Until one is given, the gateways whose conditions read it are
+``params`` in a scenario's ``given``). Until one is given, the gateways whose conditions read it are
 decided at random by branch probabilities (:mod:`.branches`): said at the condition's line,
 never silent.
 """
@@ -102,8 +102,8 @@ def _say(defs: Defs, name: str, transition: Transition, process: WorkflowProcess
                      f"run time): it is a run input; until a run is given a value, the choice "
                      f"it decides is drawn at random (the shares are said at the gateway)",
                      f"give it with --param {name}=VALUE (run, evaluate), params={{'{name}': "
-                     "...} from Python or [params] in a scenario; or declare it "
-                     "(docs/bpmn.md, Run inputs)")
+                     "...} from Python or given = { params = {...} } in a scenario; or "
+                     "declare it (docs/bpmn.md, Run inputs)")
 
 
 def _with_fallbacks(process: WorkflowProcess, reading: dict[str, list[str]], defs: Defs
