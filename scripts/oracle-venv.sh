@@ -7,10 +7,5 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 venv="${1:-.oracle-venv}"
-if [ -x "$venv/bin/python" ] && "$venv/bin/python" -c "import shoobx.wfmc" >/dev/null 2>&1; then
-    exit 0
-fi
-python3 -m venv "$venv"
-"$venv/bin/python" -m pip install --quiet --disable-pip-version-check --retries 1 --timeout 20 "shoobx.wfmc>=4.3,<5" 2>&1 \
-    | grep -v "^WARNING: Location" >&2 || true
-"$venv/bin/python" -c "import shoobx.wfmc" 
+source scripts/test-venv.sh
+test_venv "$venv" "shoobx.wfmc>=4.3,<5" shoobx.wfmc

@@ -8,6 +8,7 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 venv="${1:-.prosimos-venv}"
+source scripts/test-venv.sh
 if [ -x "$venv/bin/python" ] && "$venv/bin/python" -c "import prosimos.simulation_engine" >/dev/null 2>&1; then
     exit 0
 fi
@@ -16,7 +17,4 @@ if ! "$python" -c 'import sys; sys.exit(0 if (3, 9) <= sys.version_info[:2] <= (
     echo "Prosimos needs Python 3.9 to 3.11; $("$python" --version 2>&1) found (set PROSIMOS_PYTHON)" >&2
     exit 1
 fi
-"$python" -m venv "$venv"
-"$venv/bin/python" -m pip install --quiet --disable-pip-version-check --retries 1 --timeout 30 "prosimos>=2.0,<3" 2>&1 \
-    | grep -v "^WARNING: Location" >&2 || true
-"$venv/bin/python" -c "import prosimos.simulation_engine"
+test_venv "$venv" "prosimos>=2.0,<3" prosimos.simulation_engine "$python"

@@ -8,11 +8,6 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 venv="${1:-.spiff-venv}"
-if [ -x "$venv/bin/python" ] && "$venv/bin/python" -c "import SpiffWorkflow.bpmn" >/dev/null 2>&1; then
-    exit 0
-fi
-python3 -m venv "$venv"
+source scripts/test-venv.sh
 # 3.x: the version whose test data tests/differential/data/spiff/ holds (README.md there)
-"$venv/bin/python" -m pip install --quiet --disable-pip-version-check --retries 1 --timeout 20 "SpiffWorkflow==3.2.0" 2>&1 \
-    | grep -v "^WARNING: Location" >&2 || true
-"$venv/bin/python" -c "import SpiffWorkflow.bpmn"
+test_venv "$venv" "SpiffWorkflow==3.2.0" SpiffWorkflow.bpmn

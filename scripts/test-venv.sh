@@ -1,0 +1,18 @@
+#!/usr/bin/env bash
+# One way to make a test-only virtualenv holding another engine that opspec's differential
+# tests run the same files through (shoobx.wfmc, SpiffWorkflow, Prosimos): never a dependency
+# of opspec. Sourced by scripts/oracle-venv.sh, spiff-venv.sh and prosimos-venv.sh.
+#   test_venv VENV REQUIREMENT IMPORT [PYTHON]
+# Idempotent and quiet: does nothing when VENV already imports IMPORT; otherwise makes it with
+# PYTHON (default python3) and installs REQUIREMENT from PyPI, then checks the import (a
+# non-zero exit status when PyPI cannot be reached: the tests then skip saying why).
+test_venv() {
+    local venv="$1" requirement="$2" module="$3" python="${4:-python3}"
+    if [ -x "$venv/bin/python" ] && "$venv/bin/python" -c "import $module" >/dev/null 2>&1; then
+        return 0
+    fi
+    "$python" -m venv "$venv"
+    "$venv/bin/python" -m pip install --quiet --disable-pip-version-check --retries 1 \
+        --timeout 30 "$requirement" 2>&1 | grep -v "^WARNING: Location" >&2 || true
+    "$venv/bin/python" -c "import $module"
+}
