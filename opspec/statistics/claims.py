@@ -16,7 +16,7 @@ Each ``decide_*`` returns ``None`` when the claim holds, else the failure messag
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 
 from opspec.statistics.intervals import (
     normal_quantile,
@@ -108,17 +108,29 @@ def _rate_trials(p: float, two_sided: float, op: str, a: float, b: float | None,
         _, lo, hi = rate_interval(round(p * n), n, two_sided)
         return _verdict(op, a, b, lo, hi) != "undecided"
 
-    hi_n = max(1, start)
-    while not decided(hi_n) and hi_n < _MAX_N:
-        hi_n *= 2
-    lo_n = max(1, hi_n // 2)
-    while lo_n + 1 < hi_n:
-        mid = (lo_n + hi_n) // 2
+    needed = smallest_deciding(decided, start)
+    return _MAX_N if needed is None else needed
+
+
+def smallest_deciding(decided: Callable[[int], bool], start: int) -> int | None:
+    """Smallest n >= start with ``decided(n)`` (doubling, then bisection); None past 1e9.
+    How many trials or replications a claim needs (scenario ``then`` lines and the spec-test
+    assertions alike)."""
+    hi = max(1, start)
+    while not decided(hi):
+        hi *= 2
+        if hi > _MAX_N:
+            return None
+    lo = max(1, hi // 2)
+    if lo == hi or decided(lo):
+        return lo
+    while lo + 1 < hi:
+        mid = (lo + hi) // 2
         if decided(mid):
-            hi_n = mid
+            hi = mid
         else:
-            lo_n = mid
-    return hi_n
+            lo = mid
+    return hi
 
 
 def decide_mean(text: str, values: Sequence[float], op: str, a: float, b: float | None,

@@ -51,7 +51,7 @@ from opspec.statistics import (
     t_quantile,
 )
 from opspec.statistics import Interval as Estimate
-from opspec.statistics.claims import confidence_text
+from opspec.statistics.claims import confidence_text, smallest_deciding
 
 __all__ = [
     "Decision",
@@ -67,7 +67,6 @@ __all__ = [
     "rate_interval",
 ]
 
-_MAX_N = 10**9
 
 
 def _check_confidence(confidence: float) -> None:
@@ -169,25 +168,6 @@ def _distance(estimate: float, at_least: float | None, at_most: float | None) ->
     return min(gaps)
 
 
-def _smallest(decided: Callable[[int], bool], start: int) -> int | None:
-    """Smallest n >= start with ``decided(n)`` (doubling, then bisection); None if > 1e9."""
-    hi = max(1, start)
-    while not decided(hi):
-        hi *= 2
-        if hi > _MAX_N:
-            return None
-    lo = max(1, hi // 2)
-    if lo == hi or decided(lo):
-        return lo
-    while lo + 1 < hi:
-        mid = (lo + hi) // 2
-        if decided(mid):
-            hi = mid
-        else:
-            lo = mid
-    return hi
-
-
 def _rate_decision(claim: str, successes: int, trials: int, at_least: float | None,
                    at_most: float | None, confidence: float, method: str, replications: int,
                    units: str) -> Decision:
@@ -206,7 +186,7 @@ def _rate_decision(claim: str, successes: int, trials: int, at_least: float | No
             _, a, b = rate_interval(round(est * n), n, level, method=method)
             return decide(a, b, at_least, at_most) != "undecided"
 
-        trials_needed = _smallest(settles, trials)
+        trials_needed = smallest_deciding(settles, trials)
         if trials_needed is not None:
             per = trials / max(1, replications)
             needed = max(replications + 1, math.ceil(trials_needed / per))
@@ -302,7 +282,7 @@ def assert_mean(result: Any, metric: str, *, at_least: float | None = None,
         def settles(k: int) -> bool:
             return t_quantile(level, max(1, k - 1)) * sd / math.sqrt(k) < gap
 
-        needed = _smallest(settles, n)
+        needed = smallest_deciding(settles, n)
         needed = None if needed is None else max(n + 1, needed)
     total = int(getattr(result, "replications", n) or n)
     left_out = (f"; {total - n} of {total} replications have no value of {metric} and are "
