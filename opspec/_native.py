@@ -31,6 +31,7 @@ from typing import Any
 #: naming the bad parameter).
 MODULES: tuple[str, ...] = (
     "opspec.engine.activities",
+    "opspec.engine.clock",
     "opspec.engine.compiled",
     "opspec.engine.conditions",
     "opspec.engine.flow",
@@ -47,7 +48,6 @@ MODULES: tuple[str, ...] = (
     "opspec.engine.simulation",
     "opspec.engine.timing",
     "opspec.engine.triggers",
-    "opspec.engine.wakeup",
     "opspec.engine.workitem",
     "opspec.usermodels.performer",
 )

@@ -62,8 +62,8 @@ class Activities(Part):
         act = ai.act
         text = (f"{act.where()}: activity {act.id!r} of process {act.process!r} calls "
                 f"{target.id!r} {MAX_CALL_DEPTH + 1} synchronous subflow calls deep at "
-                f"t={self.state.env._now:.3f} s: the recursion does not reach its base case")
-        self.state.faults.append({"time": self.state.env._now, "process": act.process,
+                f"t={self.state.env.now:.3f} s: the recursion does not reach its base case")
+        self.state.faults.append({"time": self.state.env.now, "process": act.process,
                             "instance": ai.frame.inst.id, "activity": act.id, "message": text})
         self.flow.end_instance(root, ABORTED, text)
 
@@ -99,7 +99,7 @@ class Activities(Part):
 
     def _params_in(self, inst: ProcessInstance, act: CompiledActivity
                    ) -> dict[str, Any] | None:
-        now = self.state.env._now
+        now = self.state.env.now
         try:
             return {formal: fn(inst.scope, now)
                     for _mode, formal, fn, _target in act.params if fn is not None}
@@ -108,7 +108,7 @@ class Activities(Part):
             return None
 
     def _start_slow(self, frame: Frame, act: CompiledActivity) -> None:
-        ai = ActivityInstance(next(self.state.keys), act, frame, self.state.env._now)
+        ai = ActivityInstance(next(self.state.keys), act, frame, self.state.env.now)
         ai.state = RUNNING
         frame.running[ai.key] = ai
         if act.plain and not (act.general and self.state.pooled):
@@ -144,7 +144,7 @@ class Activities(Part):
         self.state.emit_act(EK.ACTIVITY_STARTED, inst, act)
         if act.start_assign and not self.flow.assign(inst, act, act.start_assign):
             return
-        now = self.state.env._now
+        now = self.state.env.now
         # a multi-instance activity's deadlines and boundary events are the whole activity's:
         # armed once, on the group's holder, when its first instance starts
         armed = ai if ai.mi is None else (ai.mi.holder if ai.iteration == 0 else None)
@@ -176,7 +176,7 @@ class Activities(Part):
         inst = frame.inst
         count_fn, parallel, _flow, _cond = act.mi  # type: ignore[misc]
         try:
-            raw = count_fn(inst.scope, self.state.env._now)
+            raw = count_fn(inst.scope, self.state.env.now)
         except OpspecError as error:
             self.flow.abort(inst, act, f"the MI_Condition failed: {error.message}")
             return False
@@ -195,7 +195,7 @@ class Activities(Part):
             return False
         group = MultiInstance(count)
         if act.deadlines or act.boundary:
-            holder = ActivityInstance(next(self.state.keys), act, frame, self.state.env._now)
+            holder = ActivityInstance(next(self.state.keys), act, frame, self.state.env.now)
             holder.state = RUNNING
             holder.mi = group
             group.holder = holder
@@ -213,7 +213,7 @@ class Activities(Part):
         group.members.append(ai)
 
     def _mi_next(self, frame: Frame, act: CompiledActivity, group: MultiInstance) -> None:
-        ai = ActivityInstance(next(self.state.keys), act, frame, self.state.env._now)
+        ai = ActivityInstance(next(self.state.keys), act, frame, self.state.env.now)
         ai.state = RUNNING
         frame.running[ai.key] = ai
         self._mi_join(ai, group)
@@ -242,7 +242,7 @@ class Activities(Part):
                             "nrOfCompletedInstances": group.completed,
                             "nrOfActiveInstances": len(group.members)}
                 try:
-                    moves = bool(cond(ChainMap(counters, inst.scope), self.state.env._now))
+                    moves = bool(cond(ChainMap(counters, inst.scope), self.state.env.now))
                 except OpspecError as error:
                     self.flow.abort(inst, act, f"the ComplexMI_FlowCondition failed: "
                                f"{error.message}")
@@ -293,7 +293,7 @@ class Activities(Part):
         if cond is None:
             return maximum is not None
         inst = ai.frame.inst
-        return bool(cond(inst.scope, self.state.env._now))
+        return bool(cond(inst.scope, self.state.env.now))
 
     def _run_body(self, ai: ActivityInstance, _a: Any = None, _b: Any = None) -> None:
         if ai.state != RUNNING:
@@ -313,7 +313,7 @@ class Activities(Part):
                                    {"waiting": self.state.pool.waiting, "priority": level})
                 return
             if cpu > 0.0:
-                self.state.dedicated.burst(self.state.env._now, cpu)
+                self.state.dedicated.burst(self.state.env.now, cpu)
                 ai.waiting = "cpu"
                 self.state.later(cpu, self._after_cpu_cb, ai)
                 return
@@ -451,7 +451,7 @@ class Activities(Part):
 
     def _inputs(self, ai: ActivityInstance) -> dict[str, Any] | None:
         inst = ai.frame.inst
-        now = self.state.env._now
+        now = self.state.env.now
         out: dict[str, Any] = {}
         try:
             for _mode, formal, fn, _target in ai.act.params:
@@ -508,7 +508,7 @@ class Activities(Part):
                      params: tuple[tuple[ParameterMode, str, Any, str | None], ...]
                      ) -> dict[str, Any] | None:
         inst = ai.frame.inst
-        now = self.state.env._now
+        now = self.state.env.now
         out: dict[str, Any] = {}
         try:
             for _mode, formal, fn, _target in params:
@@ -526,7 +526,7 @@ class Activities(Part):
         actual parameters' values (OUT formals start unset), the statements run in order,
         OUT/INOUT formals are written back to the actual parameters' data fields."""
         inst = ai.frame.inst
-        now = self.state.env._now
+        now = self.state.env.now
         local: dict[str, Any] = {}
         try:
             for _mode, formal, fn, _target in params:

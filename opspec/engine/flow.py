@@ -60,7 +60,7 @@ class Flow(Part):
         if parent is not None:
             root = parent.frame.inst.root
             priority = max(priority, parent.frame.inst.priority)
-        inst = ProcessInstance(iid, proc, local, scope, priority, parent, root, self.state.env._now)
+        inst = ProcessInstance(iid, proc, local, scope, priority, parent, root, self.state.env.now)
         inst.state = RUNNING
         inst.trigger = trigger
         if parent is not None:
@@ -121,7 +121,7 @@ class Flow(Part):
         proc = inst.process
         if self.state.pflags[proc.id] & 2:
             self.state.emit(EK.PROCESS_COMPLETED, proc.id, inst.id, None, proc.lane, None,
-                      {"duration": self.state.env._now - inst.started_at})
+                      {"duration": self.state.env.now - inst.started_at})
         parent = inst.parent
         if parent is not None and parent.state == RUNNING:
             parent.child = None
@@ -162,8 +162,8 @@ class Flow(Part):
             str(inst.process.location) if inst.process.location else "<built in Python>")
         what = f"activity {act.id!r} of " if act is not None else ""
         text = (f"{where}: {what}process {inst.process.id!r} (instance {inst.id}) aborted at "
-                f"t={self.state.env._now:.3f} s: {message}")
-        self.state.faults.append({"time": self.state.env._now, "process": inst.process.id,
+                f"t={self.state.env.now:.3f} s: {message}")
+        self.state.faults.append({"time": self.state.env.now, "process": inst.process.id,
                             "instance": inst.id, "activity": act.id if act else None,
                             "message": text})
         self.end_instance(inst, ABORTED, text)
@@ -265,7 +265,7 @@ class Flow(Part):
         condition = act.join_condition
         assert condition is not None
         try:
-            holds = condition(ChainMap({"activationCount": active}, inst.scope), self.state.env._now)
+            holds = condition(ChainMap({"activationCount": active}, inst.scope), self.state.env.now)
         except OpspecError as error:
             self.abort(inst, act, f"the IncomingCondition failed: {error.message}")
             return False
@@ -346,7 +346,7 @@ class Flow(Part):
             return False
         inst = frame.inst
         try:
-            holds = condition(inst.scope, self.state.env._now)
+            holds = condition(inst.scope, self.state.env.now)
         except OpspecError as error:
             self.abort(inst, owner.act, f"the AdHocCompletionCondition failed: {error.message}")
             return True
@@ -433,8 +433,8 @@ class Flow(Part):
         """Record a deadlock of ``inst`` (trace + summary) and abort it."""
         proc = inst.process
         text = (f"deadlock in process {proc.id!r} (instance {inst.id}) at "
-                f"t={self.state.env._now:.3f} s: {why}; waiting: {', '.join(waiting) or '-'}")
-        self.state.deadlocks.append({"time": self.state.env._now, "process": proc.id, "instance": inst.id,
+                f"t={self.state.env.now:.3f} s: {why}; waiting: {', '.join(waiting) or '-'}")
+        self.state.deadlocks.append({"time": self.state.env.now, "process": proc.id, "instance": inst.id,
                                "waiting": waiting, "message": text})
         if self.state.wants(EK.DEADLOCK, proc.id, None):
             self.state.emit(EK.DEADLOCK, proc.id, inst.id, None, proc.lane, None,
@@ -503,7 +503,7 @@ class Flow(Part):
             trans = act.out[0]
         elif act.split == S_XOR and not act.choice and not act.drawn and (act.out or act.otherwise):
             scope = inst.scope
-            now = self.state.env._now
+            now = self.state.env.now
             try:
                 for trans in act.out:
                     cond = trans.condition
@@ -536,7 +536,7 @@ class Flow(Part):
 
     def _leave(self, frame: Frame, act: CompiledActivity) -> None:
         if act.choice:
-            ai = ActivityInstance(next(self.state.keys), act, frame, self.state.env._now)
+            ai = ActivityInstance(next(self.state.keys), act, frame, self.state.env.now)
             ai.state = RUNNING
             frame.running[ai.key] = ai
             self.offers.offer_choice(ai, act.choice)
@@ -549,7 +549,7 @@ class Flow(Part):
         if outs or act.otherwise:
             inst = frame.inst
             scope = inst.scope
-            now = self.state.env._now
+            now = self.state.env.now
             taken = False
             try:
                 if act.split == S_XOR:
@@ -619,7 +619,7 @@ class Flow(Part):
     def take(self, frame: Frame, trans: CTransition, performed: bool = False) -> None:
         if trans.assignments:
             inst = frame.inst
-            now = self.state.env._now
+            now = self.state.env.now
             for target, fn in trans.assignments:
                 self.set_field(inst, None, target, fn(inst.scope, now))
         frame.live += 1
@@ -661,7 +661,7 @@ class Flow(Part):
                 assignments: tuple[tuple[str, Any], ...]) -> bool:
         """Run ``assignments``; ``False`` when the instance ended meanwhile (a failed
         assignment aborts it; a data change can fire its end trigger): the caller stops."""
-        now = self.state.env._now
+        now = self.state.env.now
         try:
             for target, fn in assignments:
                 self.set_field(inst, act, target, fn(inst.scope, now))

@@ -2,7 +2,7 @@
 
 A :class:`Performer` is offered :class:`WorkItem` values and answers through the
 :class:`PerformerSession` the engine gives it: complete, omit, fail, raise a trigger, or ask to
-be called back later in *simulated* time. Performers never see SimPy: user models, scripted
+be called back later in *simulated* time. Performers never see the clock: user models, scripted
 users, the TUI, serial devices and Python callables all plug in here.
 """
 

@@ -2,7 +2,7 @@
 
 Everything a run holds lives in one :class:`RunState` (the :class:`~opspec.engine.interpreter.
 Interpreter` is one, and :class:`~opspec.engine.simulation.Simulation` subclasses it): the
-workflow instances, the ready queue of zero-time work and the SimPy wakeups, the waiters for
+workflow instances, the ready queue of zero-time work and the clock, the waiters for
 triggers, the work items offered, the kept messages and mailboxes, the trace listeners and the
 counters of the summary. The parts (:mod:`~opspec.engine.flow`, :mod:`~opspec.engine.activities`,
 :mod:`~opspec.engine.triggers`, :mod:`~opspec.engine.offers`) hold no state of their own, only
@@ -10,7 +10,7 @@ a reference to this object and to each other.
 
 It also owns the two primitives every part uses: the trace (:meth:`RunState.emit`, built only
 when a listener wants the event) and the clock (:meth:`RunState.drain` runs the ready queue,
-:meth:`RunState.later` and :meth:`RunState.call_at` schedule on SimPy).
+:meth:`RunState.later` and :meth:`RunState.call_at` schedule on the :class:`~opspec.engine.clock.Clock`).
 """
 
 from __future__ import annotations
@@ -21,8 +21,7 @@ from collections.abc import Callable, Mapping
 from types import MappingProxyType
 from typing import TYPE_CHECKING, Any
 
-import simpy
-
+from opspec.engine.clock import Clock
 from opspec.engine.compiled import CompiledActivity, CompiledPackage, CompiledProcess
 from opspec.engine.config import EngineConfig
 from opspec.engine.instances import ActivityInstance, Frame, ProcessInstance
@@ -33,7 +32,6 @@ from opspec.engine.random import Streams
 from opspec.engine.registry import PerformerRegistry
 from opspec.engine.trace import EventKind as EK
 from opspec.engine.trace import TraceEvent, TraceListener
-from opspec.engine.wakeup import Wakeups
 from opspec.engine.zero_time import ZeroTimeSampler
 from opspec.engine.zero_time import max_instant_steps as _max_instant_steps
 from opspec.model import Package
@@ -53,13 +51,12 @@ class RunState:
 
     def __init__(self, compiled: CompiledPackage, config: EngineConfig, *,
                  performers: PerformerRegistry, seed: int, listeners: list[TraceListener],
-                 params: Mapping[str, Any] | None, env: simpy.Environment | None,
+                 params: Mapping[str, Any] | None, env: Clock | None,
                  scope: tuple[int, ...], mode_loader: Callable[[str], CompiledPackage | Package] | None
                  ) -> None:
         self.compiled = compiled
         self.config = config
-        self.env = env if env is not None else simpy.Environment()
-        self.wakeups = Wakeups(self.env)
+        self.env = env if env is not None else Clock()
         self.registry = performers
         self.streams = Streams(seed, scope)
         self.mode_loader = mode_loader
@@ -139,7 +136,7 @@ class RunState:
              participant: str | None = None, data: Mapping[str, Any] | None = None) -> None:
         """Send one trace event to every listener (callers check :meth:`wants` first)."""
         self.seq += 1
-        now = self.env._now
+        now = self.env.now
         for raw in self.raw:
             raw(now, kind, process, instance, activity, data)
         if self.full:
@@ -158,7 +155,7 @@ class RunState:
         """Run queued zero-time work until none is left (re-entrant calls just return).
 
         Zero-time work at one simulated instant is counted across drains: each item run and
-        each drain (a SimPy event at this instant, so a storm of zero-delay wakeups that queue
+        each drain (a clock event at this instant, so a storm of zero-delay wakeups that queue
         nothing counts too). Past ``max_instant_steps`` the run stops with a
         :class:`~opspec.errors.ZeroTimeCycleError` naming the activities that keep coming
         back (:mod:`opspec.engine.zero_time`)."""
@@ -194,7 +191,7 @@ class RunState:
     def _past_limit(self, steps: int, a: Any, b: Any) -> int:
         """The step count passed the limit: a new count if the clock moved since the count
         began, else a step of a zero-time cycle (see :meth:`zero_time`)."""
-        now = self.env._now
+        now = self.env.now
         if not _same_instant(now, self.instant):
             self.instant = now
             if self.sampler is not None:         # the clock moved on: no cycle after all
@@ -207,7 +204,7 @@ class RunState:
     def zero_time(self, a: Any, b: Any) -> None:
         """A step past the limit at this instant: note what it moves (``a``, ``b`` as in a
         ready-queue item, or a frame and an activity); stop the run once enough are seen."""
-        now = self.env._now
+        now = self.env.now
         sampler = self.sampler
         if sampler is None or not _same_instant(now, sampler.at):
             sampler = self.sampler = ZeroTimeSampler(now, self.max_instant_steps)
@@ -221,7 +218,7 @@ class RunState:
         if self.resolution > 0.0:
             delay = self._align(delay)
         gen = ai.gen
-        self.wakeups.after(max(0.0, delay), lambda _e: self._fire(fn, ai, arg, gen))
+        self.env.after(max(0.0, delay), lambda: self._fire(fn, ai, arg, gen))
 
     def _fire(self, fn: Callable[[ActivityInstance, Any], None], ai: ActivityInstance,
               arg: Any, gen: int) -> None:
@@ -241,7 +238,7 @@ class RunState:
 
     def _align(self, delay: float) -> float:
         res = self.resolution
-        now = self.env._now
+        now = self.env.now
         target = -(-(now + delay) // res) * res
         return max(0.0, target - now)
 
@@ -250,12 +247,12 @@ class RunState:
 
         A zero delay asked for while zero-time work is being drained (a performer answering
         an offer at once) goes to the ready queue, after the work queued now, instead of
-        becoming a SimPy event (saves an event per instant answer; the user model answers
+        becoming a clock event (saves an event per instant answer; the user model answers
         two or three offers per dose cycle that way)."""
         if delay <= 0.0 and self.draining:
             self.ready.append((_call, callback, None, None))
             return
-        self.wakeups.after(max(0.0, delay), lambda _e: self._callback(callback))
+        self.env.after(max(0.0, delay), lambda: self._callback(callback))
 
     def _callback(self, callback: Callable[[], None]) -> None:
         callback()

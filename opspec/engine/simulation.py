@@ -39,8 +39,7 @@ from collections.abc import Callable, Iterable, Mapping
 from dataclasses import dataclass, field
 from typing import Any, SupportsFloat, SupportsIndex
 
-import simpy
-
+from opspec.engine.clock import Clock, EmptySchedule
 from opspec.engine.compiled import CompiledPackage, compile_package
 from opspec.engine.config import EngineConfig
 from opspec.engine.interpreter import Interpreter
@@ -62,7 +61,7 @@ class RunResult:
     """What a run produced: the trace (if kept), the declared metrics and a summary.
 
     ``summary`` keys: ``time`` (simulated end), ``seed``, ``events`` (trace events emitted),
-    ``sim_events`` (SimPy events scheduled), ``instances`` (started/completed/terminated/
+    ``sim_events`` (clock events scheduled), ``instances`` (started/completed/terminated/
     aborted/open), ``deadlocks`` and ``faults`` (lists of dicts with a ``message``),
     ``stale_completions``, ``drift`` (wall-clock mode) and ``pool`` (pooled model) or
     ``dedicated`` (CPU bursts, busy time and most bursts at once; dedicated model).
@@ -118,7 +117,7 @@ class _Session:
 
 
 class Simulation(Interpreter):
-    """One run of a compiled package on a SimPy clock.
+    """One run of a compiled package on a simulated clock.
 
     - ``performers``: a :class:`PerformerRegistry` or a mapping from participant ids / lane
       names to performers (a ``CallablePerformer`` also binds its Application ids).
@@ -128,7 +127,7 @@ class Simulation(Interpreter):
       events nobody selects are never built.
     - ``params``: overrides of package-wide data fields.
     - ``keep_trace``: keep every event in memory (``RunResult.trace``).
-    - ``env``: share a SimPy environment with other simulations (independent households).
+    - ``env``: share a :class:`~opspec.engine.clock.Clock` with other simulations (independent households).
     - ``scope``: the household index path, prefixed to every random stream.
     - ``mode_loader``: loads the package a mode's ``source`` names, for run-time mode loads.
     """
@@ -137,7 +136,7 @@ class Simulation(Interpreter):
                  *, performers: PerformerRegistry | Mapping[str, Performer] | None = None,
                  seed: SupportsIndex = 0, listeners: Iterable[TraceListener] = (),
                  params: Mapping[str, Any] | None = None, keep_trace: bool = False,
-                 env: simpy.Environment | None = None, scope: Iterable[SupportsIndex] = (),
+                 env: Clock | None = None, scope: Iterable[SupportsIndex] = (),
                  mode_loader: Callable[[str], CompiledPackage | Package] | None = None) -> None:
         if isinstance(compiled, Package):
             compiled = compile_package(compiled)
@@ -260,12 +259,12 @@ class Simulation(Interpreter):
         return float(self.env.peek())
 
     def step(self) -> bool:
-        """Process posted input and one SimPy event; ``False`` when nothing was left."""
+        """Process posted input and one clock event; ``False`` when nothing was left."""
         self.boot()
         self.drain_posts()
         try:
             self.env.step()
-        except simpy.core.EmptySchedule:
+        except EmptySchedule:
             return False
         return True
 
@@ -320,7 +319,7 @@ class Simulation(Interpreter):
         counts["open"] = len(self.live)
         summary: dict[str, Any] = {
             "time": self.env.now, "seed": self.seed, "events": self.seq,
-            "sim_events": _event_count(self.env), "instances": counts,
+            "sim_events": self.env.scheduled, "instances": counts,
             "deadlocks": list(self.deadlocks), "faults": list(self.faults),
             "stale_completions": self.stale_completions, "drift": self.drift,
             "mode": self.mode,
@@ -334,18 +333,6 @@ class Simulation(Interpreter):
             summary["dedicated"] = self.dedicated.summary()
         return RunResult(tuple(self.memory.events) if self.memory is not None else None,
                          self.metrics.values() if self.metrics is not None else {}, summary)
-
-
-def _event_count(env: simpy.Environment) -> int:
-    counter = getattr(env, "_eid", None)
-    if counter is None:
-        return 0
-    # itertools.count's repr shows the next value without consuming it
-    text = repr(counter)
-    try:
-        return int(text[text.index("(") + 1:text.index(")")])
-    except ValueError:
-        return 0
 
 
 _DEFAULT_CONFIG = EngineConfig()

@@ -2,7 +2,7 @@
 
 The interpreter counts zero-time steps at the current simulated instant: every item its ready
 queue runs, every instantaneous activity its fast path carries a token through, and every
-drain (so a storm of zero-delay SimPy events that queue nothing counts too). The count starts
+drain (so a storm of zero-delay clock events that queue nothing counts too). The count starts
 again whenever the clock moves. On the hot path that is one integer increment and compare per
 step; nothing else happens until the count passes :data:`MAX_INSTANT_STEPS`.
 
@@ -56,7 +56,7 @@ class ZeroTimeSampler:
 
     :meth:`record` takes the two first arguments of a ready-queue item (a frame and an
     activity index, an activity instance, ...) or a frame and the activity itself, or
-    ``(None, None)`` for a drain (a SimPy event at this instant); it returns ``True`` once
+    ``(None, None)`` for a drain (a clock event at this instant); it returns ``True`` once
     enough steps have been seen for :meth:`error` to name the cycle.
     """
 
@@ -64,7 +64,7 @@ class ZeroTimeSampler:
         self.at = at
         self.limit = limit
         self.steps = 0
-        self.events = 0                   # drains: SimPy events at this instant
+        self.events = 0                   # drains: clock events at this instant
         # process id -> activity -> (order key), and the instance ids seen per process
         self.activities: dict[str, dict[str, tuple[int, str]]] = {}
         self.instances: dict[str, set[int]] = {}
