@@ -710,7 +710,8 @@ class _Compiler:
             ca.coordination = builtin
             ca.general = False
         manual_body = isinstance(body, NoImplementation | Task)
-        if manual_body and ca.coordination is None and (act.is_manual or ca.user_lane):
+        if manual_body and ca.coordination is None and (
+                ca.user_lane or self.package.is_manual_work(act, proc, body)):
             ca.kind = K_MANUAL
             ca.general = False
         # joins and splits

@@ -533,12 +533,12 @@ _XPDL: tuple[Construct, ...] = (
        "§7.6"),
     _c("xpdl-transaction-protocol", XPDL, "Transaction", "TransactionProtocol", W, "ignored",
        "§7.6"),
-    _c("xpdl-manual-without-implementation", XPDL, "Activity", None, W,
-       "an activity with no implementation performed by a ROLE participant runs by itself in "
-       "zero time (it is manual work for its performer; a HUMAN participant's is offered to "
-       "the user lane)", "§7.6.5.1, §7.7",
-       when="role-without-implementation",
-       hint="set StartMode=\"Manual\" or put the activity in the user lane"),
+    _c("xpdl-manual-without-implementation", XPDL, "Activity", None, R,
+       "an activity with no implementation (\"implemented by manual procedures\") performed "
+       "by a HUMAN or ROLE participant is manual work: it is offered to its participant's or "
+       "lane's performer (a HUMAN one's to the user lane), and waits, reported as waiting "
+       "work, while none is bound; opspec:AutoRun=\"true\" makes it automatic",
+       "§7.6.5.1, §7.7", when="role-without-implementation"),
     _c("xpdl-loops", XPDL, "Loop LoopStandard LoopMultiInstance LoopCondition MI_Condition "
        "ComplexMI_FlowCondition", None, R, "standard and multi-instance loops", "§7.6.3"),
     _c("xpdl-loop-type", XPDL, "Loop", "LoopType", R, "Standard or MultiInstance", "§7.6.3"),
