@@ -73,6 +73,7 @@ class Flow(Part):
                       {"trigger": trigger, "parent": parent.frame.inst.id if parent else None})
         frame = Frame(proc.graph, inst, None)
         inst.frames.append(frame)
+        self.state.start_counted(frame)
         if start >= 0:
             frame.live += 1
             self.state.ready.append((self.start_at, frame, start, None))
