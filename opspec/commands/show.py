@@ -313,7 +313,7 @@ def _activity(activity: Activity, process: WorkflowProcess, package: Package) ->
     if activity.performers:
         parts.append("by " + ", ".join(_performer(p, process, package)
                                        for p in activity.performers))
-    parts.append("manual" if activity.is_manual else "automatic")
+    parts.append("manual" if package.is_manual_work(activity, process) else "automatic")
     if activity.join is not None:
         parts.append(f"join {activity.join.type.value}")
     if activity.split is not None:

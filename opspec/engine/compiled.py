@@ -710,7 +710,8 @@ class _Compiler:
             ca.coordination = builtin
             ca.general = False
         manual_body = isinstance(body, NoImplementation | Task)
-        if manual_body and ca.coordination is None and (act.is_manual or ca.user_lane):
+        if manual_body and ca.coordination is None and (
+                ca.user_lane or self.package.is_manual_work(act, proc, body)):
             ca.kind = K_MANUAL
             ca.general = False
         # joins and splits
@@ -943,9 +944,18 @@ class _Compiler:
         if start is not None and start.kind == "timer" and not start.at and start.every:
             start = CTrigger(kind="period", every=start.every, offset=start.offset,
                              location=start.location)
+        # several start events: the untriggered (none) ones are where an instance started
+        # without a trigger begins (auto-start, API, call; BPMN 2.0 §13.3.4)
+        called_starts = tuple(i for i in graph.starts
+                              if not any(i == index for _t, index in start_events))
         auto = directives.auto_start
         if auto is None:
-            auto = start is None and proc.id not in self.subflow_targets
+            # a none start event beside triggered ones starts an instance as a process with
+            # only none start events does (BPMN 2.0 §10.4.2: each start event is independent)
+            auto = ((start is None or (bool(start_events) and any(
+                        _is_start_event(proc.activity(graph.activities[i].id))
+                        for i in called_starts)))
+                    and proc.id not in self.subflow_targets)
         priority = directives.priority if directives.priority is not None else (
             proc.priority or 0)
         return CompiledProcess(
@@ -953,9 +963,12 @@ class _Compiler:
             formals=tuple((f.id, f.mode) for f in proc.formal_parameters), priority=priority,
             lane=lane, start_trigger=start, end_trigger=self.trigger_ref(directives.end_trigger),
             auto_start=bool(auto), deadline=directives.deadline, mode=directives.mode,
-            location=proc.location, start_events=start_events,
-            called_starts=tuple(i for i in graph.starts
-                                if not any(i == index for _t, index in start_events)))
+            location=proc.location, start_events=start_events, called_starts=called_starts)
+
+
+def _is_start_event(activity: Activity | None) -> bool:
+    return (activity is not None and isinstance(activity.body, Event)
+            and activity.body.position is EventPosition.START)
 
 
 def _start_trigger(trig: CTrigger | None) -> CTrigger:

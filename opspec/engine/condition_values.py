@@ -170,30 +170,52 @@ def ordered(a: Any, b: Any, op: str) -> bool:
     return test(x, y)
 
 
+#: Values a spec's arithmetic may make (issue 33: a script that doubles a value each step must
+#: stop with a located error, not exhaust memory): texts up to MAX_TEXT characters, integers
+#: below 2**MAX_INT_BITS in magnitude (floats overflow to inf by themselves).
+MAX_TEXT = 1_000_000
+MAX_INT_BITS = 1024
+_MAX_INT = 1 << MAX_INT_BITS
+
+
+def _bounded(value: Any, op: str) -> Any:
+    if type(value) is int and not -_MAX_INT < value < _MAX_INT:
+        raise ConditionProblem(
+            f"the integer {op} makes has more than {MAX_INT_BITS} bits: a value that grows "
+            "without bound (does something double it on every step?)")
+    return value
+
+
 def _add(a: Any, b: Any) -> Any:
     if type(a) in _NUMBERS and type(b) in _NUMBERS:     # the common case, first
-        return a + b
+        return _bounded(a + b, "'+'")
     if isinstance(a, str) or isinstance(b, str):
-        return _text(a) + _text(b)
+        x, y = _text(a), _text(b)
+        if len(x) + len(y) > MAX_TEXT:
+            raise ConditionProblem(
+                f"'+' would make a text of {len(x) + len(y):,} characters, more than "
+                f"{MAX_TEXT:,}: a value that grows without bound (does something append to it "
+                "on every step?)")
+        return x + y
     if isinstance(a, _VECTORS) or isinstance(b, _VECTORS):
         return _elementwise(a, b, "+", operator.add, scalar=False)
-    return as_number(a, "'+'") + as_number(b, "'+'")
+    return _bounded(as_number(a, "'+'") + as_number(b, "'+'"), "'+'")
 
 
 def _subtract(a: Any, b: Any) -> Any:
     if type(a) in _NUMBERS and type(b) in _NUMBERS:
-        return a - b
+        return _bounded(a - b, "'-'")
     if isinstance(a, _VECTORS) or isinstance(b, _VECTORS):
         return _elementwise(a, b, "-", operator.sub, scalar=False)
-    return as_number(a, "'-'") - as_number(b, "'-'")
+    return _bounded(as_number(a, "'-'") - as_number(b, "'-'"), "'-'")
 
 
 def _multiply(a: Any, b: Any) -> Any:
     if type(a) in _NUMBERS and type(b) in _NUMBERS:
-        return a * b
+        return _bounded(a * b, "'*'")
     if isinstance(a, _VECTORS) or isinstance(b, _VECTORS):
         return _elementwise(a, b, "*", operator.mul, scalar=True)
-    return as_number(a, "'*'") * as_number(b, "'*'")
+    return _bounded(as_number(a, "'*'") * as_number(b, "'*'"), "'*'")
 
 
 _VECTORS = (tuple, list)

@@ -73,14 +73,16 @@ class Flow(Part):
                       {"trigger": trigger, "parent": parent.frame.inst.id if parent else None})
         frame = Frame(proc.graph, inst, None)
         inst.frames.append(frame)
+        self.state.start_counted(frame)
         if start >= 0:
             frame.live += 1
             self.state.ready.append((self.start_at, frame, start, None))
         else:
             starts = proc.graph.starts
-            if proc.start_events and (parent is not None
-                                      or (trigger or "").startswith("subflow:")):
-                starts = proc.called_starts      # called: its none start events only
+            if proc.start_events:
+                # not started by one of its triggered start events (called, auto-started,
+                # from the API): at its none start events only (BPMN 2.0 §13.3.4)
+                starts = proc.called_starts or starts
             for index in starts:
                 frame.live += 1
                 self.state.ready.append((self.start_at, frame, index, None))

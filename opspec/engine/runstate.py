@@ -32,7 +32,12 @@ from opspec.engine.random import Streams
 from opspec.engine.registry import PerformerRegistry
 from opspec.engine.trace import EventKind as EK
 from opspec.engine.trace import TraceEvent, TraceListener
-from opspec.engine.zero_time import ZeroTimeSampler
+from opspec.engine.zero_time import (
+    MAX_INSTANT_STARTS,
+    MAX_INSTANT_STEPS,
+    SAMPLE_STARTS,
+    ZeroTimeSampler,
+)
 from opspec.engine.zero_time import max_instant_steps as _max_instant_steps
 from opspec.model import Package
 
@@ -93,6 +98,14 @@ class RunState:
         self.max_instant_steps = _max_instant_steps()
         self.sampler: ZeroTimeSampler | None = None
         self.start_limit = self.max_instant_steps    # 0 while a sampler names the cycle
+        # workflow instances started at one instant (each holds memory until it ends: a
+        # workflow that starts itself asynchronously must be stopped long before the step
+        # limit; see start_counted)
+        self.starts_at = -1.0
+        self.instant_starts = 0
+        # (OPSPEC_MAX_INSTANT_STEPS scales both limits)
+        self.max_instant_starts = max(
+            1, self.max_instant_steps * MAX_INSTANT_STARTS // MAX_INSTANT_STEPS)
         self.pullers: dict[str, deque[ActivityInstance]] = {}
         self.performers_of: dict[CompiledActivity, Performer | None] = {}
         self.apps = performers.applications
@@ -201,16 +214,17 @@ class RunState:
         self.zero_time(a, b)
         return steps
 
-    def zero_time(self, a: Any, b: Any) -> None:
+    def zero_time(self, a: Any, b: Any, starts: int = 0) -> None:
         """A step past the limit at this instant: note what it moves (``a``, ``b`` as in a
-        ready-queue item, or a frame and an activity); stop the run once enough are seen."""
+        ready-queue item, or a frame and an activity); stop the run once enough are seen.
+        ``starts``: the instances started at this instant, when they are what passed a limit."""
         now = self.env.now
         sampler = self.sampler
         if sampler is None or not _same_instant(now, sampler.at):
             sampler = self.sampler = ZeroTimeSampler(now, self.max_instant_steps)
             self.start_limit = 0                 # _start notes every activity it carries
-        if sampler.record(a, b):
-            raise sampler.error()
+        if sampler.record(a, b) or starts >= self.max_instant_starts + SAMPLE_STARTS:
+            raise sampler.error(starts)
 
     def later(self, delay: float, fn: Callable[[ActivityInstance, Any], None],
                ai: ActivityInstance, arg: Any = None) -> None:
@@ -257,6 +271,21 @@ class RunState:
     def _callback(self, callback: Callable[[], None]) -> None:
         callback()
         self.drain()
+
+    def start_counted(self, frame: Frame) -> None:
+        """A workflow instance was started (``frame`` its top frame): past
+        ``max_instant_starts`` instances at one instant, a zero-time cycle that piles up
+        instances (a workflow starting itself asynchronously), stopped and named like any
+        zero-time cycle, within seconds and some tens of megabytes."""
+        now = self.env.now
+        if not _same_instant(now, self.starts_at):
+            self.starts_at = now
+            self.instant_starts = 1
+            return
+        self.instant_starts += 1
+        if self.instant_starts > self.max_instant_starts:
+            starts = frame.graph.starts
+            self.zero_time(frame, starts[0] if starts else None, self.instant_starts)
 
 
 def _same_instant(now: float, then: float) -> bool:

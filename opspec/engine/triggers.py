@@ -395,6 +395,8 @@ class Triggers(Part):
             # several start events: each starts its own instance, with only its path
             for trig, index in proc.start_events:
                 self._arm(trig, self._starter(proc, index), starts=(proc, index))
+            if proc.auto_start and proc.called_starts and self.is_active(proc.id):
+                self.flow.start_process(proc, trigger="auto")    # its none start events
         elif start is None:
             if proc.auto_start and self.is_active(proc.id):
                 self.flow.start_process(proc, trigger="auto")

@@ -5,10 +5,11 @@ from __future__ import annotations
 import enum
 from dataclasses import dataclass
 
+from opspec.model.activities import Activity, ActivityBody, NoImplementation
 from opspec.model.common import Element
 from opspec.model.data import DataField, TypeDeclaration
 from opspec.model.process import WorkflowProcess
-from opspec.model.resources import Application, Participant, Pool
+from opspec.model.resources import Application, Participant, ParticipantType, Pool
 from opspec.model.sisarl import MetricDefinition, WorkflowMode
 
 __all__ = ["ExternalPackage", "Package", "PackageHeader", "XpdlVersion"]
@@ -26,6 +27,10 @@ class XpdlVersion(enum.Enum):
     @property
     def is_1_0(self) -> bool:
         return self is XpdlVersion.V1_0
+
+
+# participants whose work without an implementation is manual (XPDL 2.1 §7.6.5.1, §7.7)
+_PERSONS = frozenset({ParticipantType.HUMAN, ParticipantType.ROLE})
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
@@ -89,6 +94,28 @@ class Package(Element):
             if participant.id == participant_id:
                 return participant
         return None
+
+    def is_manual_work(self, activity: Activity, process: WorkflowProcess | None = None,
+                       body: ActivityBody | None = None) -> bool:
+        """Whether ``activity`` waits for its performer rather than running by itself.
+
+        Beside what :attr:`Activity.is_manual` says (a manual start mode, a manual or user
+        task, opspec:AutoRun), XPDL 2.1 §7.6.5.1 says an activity with no implementation is
+        "implemented by manual procedures": performed by a person (a HUMAN or ROLE
+        participant) it is manual work. A BPMN abstract task, read into the same model as no
+        implementation, is not (BPMN 2.0 §10.2.3), nor is one opspec:AutoRun makes automatic.
+        ``body`` is the body that runs when it is not the activity's own (a Reference's).
+        """
+        if activity.is_manual:
+            return True
+        body = activity.body if body is None else body
+        if (not isinstance(body, NoImplementation) or activity.directives.auto_run is not None
+                or not activity.performers or self.source_format.upper().startswith("BPMN")):
+            return False
+        name = activity.performers[0]
+        participant = next((p for p in (process.participants if process else ())
+                            if p.id == name), None) or self.participant(name)
+        return participant is not None and participant.type in _PERSONS
 
     def application(self, application_id: str) -> Application | None:
         for application in self.applications:

@@ -268,12 +268,19 @@ _BPMN: tuple[Construct, ...] = (
     _c("bpmn-events", BPMN, _EVENTS, None, R,
        "start, end, catching and throwing events with the trigger of their definition",
        "§10.4, §13.5"),
-    _c("bpmn-several-starts", BPMN, "startEvent", None, W,
-       "each timer, message or signal start starts its own instance with only its own path; "
-       "but a process started without a trigger (auto-started, from the API) starts all its "
-       "start paths together in one instance (BPMN §10.4.2: each start event its own)",
-       "§10.4.2, §13.5.1", when="several-starts",
-       hint="draw one none start event per process, or one process per start event"),
+    _c("bpmn-several-starts", BPMN, "startEvent", None, R,
+       "several start events are independent: each timer, message or signal start starts its "
+       "own instance in which only its own path runs; an instance started without a trigger "
+       "(auto-started like a process with only a none start event, from the API, or called) "
+       "begins at the none start events only", "§10.4.2, §13.3.4", when="several-starts"),
+    _c("bpmn-several-none-starts", BPMN, "startEvent", None, W,
+       "the none start events of a process all start together, in one instance, whenever it "
+       "is instantiated (BPMN 2.0 §10.4.2 instantiates \"all Flow Objects that do not have an "
+       "incoming Sequence Flow\" but also says each start event is independent and that a "
+       "called process triggers only one of several none start events; SpiffWorkflow runs "
+       "the first only)", "§10.4.2, §13.3.4", when="several-none-starts",
+       hint="draw one none start event and a parallel gateway after it, or one process per "
+       "start event"),
     _c("bpmn-several-definitions", BPMN, "startEvent intermediateCatchEvent boundaryEvent",
        None, W, "only the first event definition counts (BPMN: any one of them triggers it)",
        "§10.4.5", when="several-definitions", reported_by=("multiple-event-definitions",)),
@@ -533,12 +540,12 @@ _XPDL: tuple[Construct, ...] = (
        "§7.6"),
     _c("xpdl-transaction-protocol", XPDL, "Transaction", "TransactionProtocol", W, "ignored",
        "§7.6"),
-    _c("xpdl-manual-without-implementation", XPDL, "Activity", None, W,
-       "an activity with no implementation performed by a ROLE participant runs by itself in "
-       "zero time (it is manual work for its performer; a HUMAN participant's is offered to "
-       "the user lane)", "§7.6.5.1, §7.7",
-       when="role-without-implementation",
-       hint="set StartMode=\"Manual\" or put the activity in the user lane"),
+    _c("xpdl-manual-without-implementation", XPDL, "Activity", None, R,
+       "an activity with no implementation (\"implemented by manual procedures\") performed "
+       "by a HUMAN or ROLE participant is manual work: it is offered to its participant's or "
+       "lane's performer (a HUMAN one's to the user lane), and waits, reported as waiting "
+       "work, while none is bound; opspec:AutoRun=\"true\" makes it automatic",
+       "§7.6.5.1, §7.7", when="role-without-implementation"),
     _c("xpdl-loops", XPDL, "Loop LoopStandard LoopMultiInstance LoopCondition MI_Condition "
        "ComplexMI_FlowCondition", None, R, "standard and multi-instance loops", "§7.6.3"),
     _c("xpdl-loop-type", XPDL, "Loop", "LoopType", R, "Standard or MultiInstance", "§7.6.3"),
@@ -562,7 +569,9 @@ _XPDL: tuple[Construct, ...] = (
        "start, end and intermediate events with their trigger or result", "§7.6.2"),
     _c("xpdl-several-starts", XPDL, "StartEvent", None, R,
        "several start events are independent: each triggered start starts its own instance, "
-       "and only its own path runs", "§7.6.2", when="several-starts"),
+       "and only its own path runs; an instance started without a trigger begins at the "
+       "StartEvents with Trigger None, all of them (as XPDL 1.0 engines start every activity "
+       "without incoming transitions)", "§7.6.2", when="several-starts"),
     _c("xpdl-event-trigger", XPDL, "StartEvent IntermediateEvent", "Trigger", R, "its trigger",
        "§7.6.2"),
     _c("xpdl-event-result", XPDL, "EndEvent", "Result", R,
@@ -930,6 +939,7 @@ _WHEN_TEXT = {
     "in-throw-event": "in an intermediate throw event",
     "in-boundary-event": "in a boundary event",
     "several-starts": "several in one process",
+    "several-none-starts": "several without an event definition in one process",
     "several-definitions": "with several event definitions",
     "timer-on-multi-instance": "a timer on a multi-instance activity",
     "non-interrupting-boundary": "of a non-interrupting boundary timer",

@@ -204,6 +204,19 @@ def _several_starts(element: etree._Element, value: str | None, doc: _Doc) -> bo
     return count > 1
 
 
+def _several_none_starts(element: etree._Element, value: str | None, doc: _Doc) -> bool:
+    """A BPMN start event without an event definition in a process with another one."""
+    if _is_triggered(element) or not _several_starts(element, value, doc):
+        return False
+    parent = element.getparent()
+    assert parent is not None
+    return sum(1 for start in _start_events(parent) if not _is_triggered(start)) > 1
+
+
+def _is_triggered(start: etree._Element) -> bool:
+    return any(isinstance(child.tag, str) and _local(child) in _DEFINITIONS for child in start)
+
+
 _DEFINITIONS = frozenset({
     "messageEventDefinition", "timerEventDefinition", "signalEventDefinition",
     "conditionalEventDefinition", "errorEventDefinition", "escalationEventDefinition",
@@ -345,6 +358,7 @@ CONDITIONS: dict[str, _Condition] = {
     "in-throw-event": _parent_is("intermediateThrowEvent"),
     "in-boundary-event": _parent_is("boundaryEvent"),
     "several-starts": _several_starts,
+    "several-none-starts": _several_none_starts,
     "several-definitions": _several_definitions,
     "timer-on-multi-instance": _timer_on_multi_instance,
     "non-interrupting-boundary": _non_interrupting_boundary,

@@ -10,7 +10,7 @@ from typing import Any
 
 import pytest
 
-from opspec.engine.builtin_performers import CallablePerformer
+from opspec.engine.builtin_performers import CallablePerformer, SimulatedDevice
 from opspec.engine.config import EngineConfig
 from opspec.engine.simulation import Simulation
 from opspec.errors import SpecError
@@ -188,7 +188,9 @@ def test_a_script_reading_a_name_that_is_no_formal_is_refused_at_compile_time() 
 
 def test_the_jawe_patterns_file_counts_its_discriminator_branches() -> None:
     """The JaWE workflow_patterns file in the corpus: its discriminator resets and counts
-    its branches with JavaScript tool agents and completes."""
+    its branches with JavaScript tool agents and completes. Its work items (no
+    implementation, the ROLE participant "test") are manual work (XPDL 2.1 §7.6.5.1:
+    "implemented by manual procedures"): a performer bound to "test" completes each at once."""
     from pathlib import Path
 
     path = Path(__file__).parents[2].parent / "shared/corpus/xpdl/jawe10__workflow_patterns.xpdl"
@@ -200,7 +202,7 @@ def test_the_jawe_patterns_file_counts_its_discriminator_branches() -> None:
     assert result.package is not None
     package = dataclasses.replace(result.package, processes=tuple(
         p for p in result.package.processes if p.id == "WfABSP4_Discriminator"))
-    run_result = run(package)
+    run_result = run(package, performers={"test": SimulatedDevice()})
     changes = data_changes(run_result)
     assert changes[:2] == [("ResetDiscriminator", {"availableBranchesToAccessE": 1}),
                            ("ResetDiscriminator", {"openedBranchesAfterA": 0})]

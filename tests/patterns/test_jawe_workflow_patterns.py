@@ -10,6 +10,11 @@ branches, whose next conditions (whereToGo == "D" / "E") then fail, again leavin
 BPMN 2.0 (section 13.3.3) would instead raise an exception when no condition of an inclusive
 split holds; the issue asks this file to run to completion, so the Shark semantics its author
 wrote down are the expectation. The run is bounded by ``until`` (and the engine's zero-time cycle detector).
+
+The work items (``Implementation/No``, performed by the ROLE participant "test", each described
+"Just press 'Complete' button") are manual work, XPDL 2.1 §7.6.5.1: an activity with no
+implementation is "implemented by manual procedures". The run binds a performer to "test" that
+completes each one as soon as it is offered, as the file's tester pressing Complete would.
 """
 
 from __future__ import annotations
@@ -19,6 +24,8 @@ from functools import cache
 import pytest
 from conftest import CORPUS
 from patternlib import dump, outcomes, run
+
+from opspec.engine.builtin_performers import SimulatedDevice
 
 FILE = CORPUS / "jawe10__workflow_patterns.xpdl"
 PROCESSES = [
@@ -33,7 +40,8 @@ PROCESSES = [
 
 @cache
 def _run(where_to_go: str):  # type: ignore[no-untyped-def]
-    return run(FILE, until=3600, params={"whereToGo": where_to_go})
+    return run(FILE, until=3600, params={"whereToGo": where_to_go},
+               performers={"test": SimulatedDevice()})
 
 
 @pytest.mark.skipif(not FILE.exists(), reason="shared corpus not present (../shared/corpus/xpdl)")

@@ -48,3 +48,41 @@ def test_a_called_process_starts_at_its_none_start_event_only() -> None:
     assert sorted(instances.values()) == [["every_hour", "hourly", "end_hourly"]] * 2 + [
         ["s_none", "from_call", "end_call"]]
     assert [e.process for e in kinds(outcome, "process.completed")][:2] == ["p", "main"]
+
+
+def _instances(outcome: object) -> list[list[str]]:
+    found: dict[int, list[str]] = {}
+    for event in outcome.trace:  # type: ignore[attr-defined]
+        if event.process == "p" and event.kind == "activity.completed":
+            found.setdefault(event.instance or 0, []).append(event.activity or "")
+    return sorted(found.values())
+
+
+def test_a_none_start_beside_a_message_start_starts_its_own_instance() -> None:
+    """BPMN 2.0 §10.4.2 (Start Event): "Each Start Event is an independent event. That is, a
+    Process instance SHALL be generated when the Start Event is triggered." The none start
+    event "begin" starts the instance the run begins with (as in a process with only a none
+    start event), which runs "open" only; the message "call" at 10 min starts another, which
+    runs "answer" only. Before, the none start event beside a triggered one started nothing."""
+    outcome = run("none_beside_message_start.bpmn", until=3600)
+    started = [(e.time, e.data["trigger"]) for e in outcome.trace
+               if e.process == "p" and e.kind == "process.started"]
+    assert started == [(0.0, "auto"), (600.0, "message:call")]
+    assert _instances(outcome) == [["begin", "open", "end_open"],
+                                   ["on_call", "answer", "end_answer"]]
+
+
+def test_the_api_starts_a_process_at_its_none_start_events_only() -> None:
+    """BPMN 2.0 §10.4.2: a triggered start event starts an instance "when the Start Event is
+    triggered", not otherwise. An instance started from the API (no trigger) begins at the
+    none start event: "on_call", whose message never came, does not run with it."""
+    from opspec.engine.simulation import Simulation
+    from opspec.xpdl.loader import load_spec
+
+    from .conftest import DATA
+
+    simulation = Simulation(load_spec(DATA / "none_beside_message_start.bpmn"),
+                            keep_trace=True)
+    simulation.start("p")
+    result = simulation.run(until=60)
+    assert _instances(result) == [["begin", "open", "end_open"]] * 2

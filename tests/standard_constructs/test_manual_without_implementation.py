@@ -1,0 +1,54 @@
+"""An XPDL activity with no implementation performed by a person is manual work: it is offered
+to its performer, or waits for one, and is never an automatic zero-time step."""
+
+from __future__ import annotations
+
+from opspec.engine.builtin_performers import SimulatedDevice
+from opspec.xpdl.loader import load_spec
+
+from .conftest import DATA, completed, kinds, run
+
+
+def test_manual_work_waits_for_its_performer_and_is_reported_as_waiting() -> None:
+    """XPDL 2.1 (WfMC-TC-1025) §7.6.5.1, No Implementation: an activity whose
+    Implementation is "No" is "implemented by manual procedures"; §7.7: a ROLE or HUMAN
+    participant is a person who performs it.
+
+    With nobody bound for the nurse (a ROLE participant: XPDL's
+    default type), "check" is offered at 15 s to no performer and waits; at the horizon the
+    run reports it as waiting work. The SYSTEM participant's "log", the unperformed "note" and
+    the nurse's "auto" (opspec:AutoRun="true") run by themselves for their 5 s."""
+    outcome = run("manual_without_implementation.xpdl", until=100)
+    assert completed(outcome) == [(0, "start"), (5.0, "log"), (10.0, "note"), (15.0, "auto")]
+    offered = [(e.time, e.activity, e.data) for e in kinds(outcome, "activity.offered")]
+    assert offered == [(15.0, "check", {"performer": None})]
+    (waiting,) = outcome.summary["deadlocks"]
+    assert waiting["waiting"] == ["check (performer for participant 'nurse' / lanes -)"]
+    assert outcome.problems
+
+
+def test_manual_work_is_offered_to_the_bound_performer() -> None:
+    """XPDL 2.1 (WfMC-TC-1025) §7.6.5.1, No Implementation: an activity whose
+    Implementation is "No" is "implemented by manual procedures"; §7.7: a ROLE or HUMAN
+    participant is a person who performs it.
+
+    Bound to a performer, the nurse's "check" is offered to it
+    (not run by the engine) and completes when the performer does, after its 5 s."""
+    outcome = run("manual_without_implementation.xpdl", until=100,
+                  performers={"nurse": SimulatedDevice()})
+    assert completed(outcome)[-2:] == [(20.0, "check"), (20.0, "end")]
+    assert [e.activity for e in kinds(outcome, "activity.offered")] == ["check"]
+    assert not outcome.summary["deadlocks"]
+
+
+def test_show_and_the_model_call_it_manual() -> None:
+    """XPDL 2.1 (WfMC-TC-1025) §7.6.5.1, No Implementation: an activity whose
+    Implementation is "No" is "implemented by manual procedures"; §7.7: a ROLE or HUMAN
+    participant is a person who performs it.
+
+    What the model says of each activity (show, the pictures) is
+    what the run does."""
+    package = load_spec(DATA / "manual_without_implementation.xpdl")
+    (process,) = package.processes
+    manual = {a.id for a in process.activities if package.is_manual_work(a, process)}
+    assert manual == {"check"}
