@@ -1,34 +1,42 @@
-"""`opspec evaluate` end to end against its own simulations and the hand-coded baseline.
+"""`opspec evaluate` end to end against the hand-coded baseline, in the same run.
 
-On one worker, for N users x D days of the medication dispenser (1,000 x 30 by default), each
-in a fresh interpreter:
+For N users x D days of the medication dispenser (1,000 x 30 by default), each in a fresh
+interpreter, in interleaved rounds (baseline, engine alone, evaluate, ... : a load that drifts
+hits all alike):
 
 - **baseline**: the hand-coded SimPy model of the same scenario
-  (``../shared/bench/handcoded_simpy.py``);
-- **engine alone**: the replications ``opspec evaluate`` runs, and nothing else — every
+  (``shared/bench/handcoded_simpy.py`` beside the checkout or a folder above it, or
+  ``$OPSPEC_BENCH``);
+- **engine alone**: the replications ``opspec evaluate`` runs, and nothing else - every
   user's run of ``opspec.evaluation.replication.run_users`` (spec loaded once, the user model
   drawing, metrics, per-activity counts), results thrown away;
-- **end to end**: ``opspec evaluate SPEC --workers 1`` as a user runs it: the same
+- **evaluate --workers 1**: ``opspec evaluate SPEC --workers 1`` as a user runs it: the same
   replications, the result store (``results.sqlite``), the summaries and the report
-  (``report.html`` with its figures).
+  (``report.html`` with its figures);
+- **evaluate --workers W** (``--workers 1,2``): the same on W worker processes, for the
+  wall-time speed-up (honest only on a machine whose cores are otherwise idle).
 
-It prints CPU seconds (user + system of the child process: what the work costs, steady on a
-busy machine) and wall seconds, and two ratios measured in this one run: end to end / engine
-alone (the overhead of storing and reporting; goal: at most 1.3) and engine alone / baseline
-(the cost of executing a specification instead of hand-written code). ``--repeat R`` runs
-each R times and keeps the fastest; ``--profile FILE`` also writes a cProfile of one end-to-
-end run (``python -m pstats FILE``). The first line says which engine ran (compiled with
-mypyc, or from source after an edit): the children import opspec the way ``python -m``
-does, from the current folder first, so run it from the checkout whose engine you measure.
+CPU time is user + system of the child and of the processes it waited for (its pool's
+workers), from ``os.wait4``: what the work costs, steadier than wall time on a busy machine.
+Each round prints its ratios against the baseline of the same round; the summary gives their
+median and range (goals of issue 31: evaluate --workers 1 at most 1.5x the baseline; workers 2
+at least 1.8x faster than 1). The load average before and after is printed with them.
 
-    python benchmarks/evaluate_end_to_end.py [--users 1000] [--days 30] [--repeat 1]
+``--memory 10000,100000`` instead runs ``evaluate --days 1`` for each number of users and
+prints the peak and final resident memory of the evaluate process itself (not its workers;
+goal: flat from 10,000 to 100,000 users). ``--profile FILE`` also writes a CPU-time cProfile
+of one ``evaluate --workers 1`` (``python -m pstats FILE``). The first line says which engine
+ran (compiled with mypyc, or from source): run it from the checkout whose engine you measure.
+
+    python benchmarks/evaluate_end_to_end.py [--users 1000] [--days 30] [--rounds 3]
+        [--workers 1,2] [--memory 10000,100000] [--profile FILE]
 """
 
 from __future__ import annotations
 
 import argparse
 import json
-import resource
+import os
 import statistics
 import subprocess
 import sys
@@ -39,7 +47,16 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parents[1]
 SPEC = ROOT / "specs" / "medication_dispenser.xpdl"
 USERS_TOML = ROOT / "specs" / "medication_dispenser.users.toml"
-BASELINE = ROOT.parent / "shared" / "bench" / "handcoded_simpy.py"
+
+
+def _baseline_script() -> Path | None:
+    """``shared/bench/handcoded_simpy.py`` in ``$OPSPEC_BENCH`` or beside a folder above."""
+    env = os.environ.get("OPSPEC_BENCH")
+    places = [Path(env)] if env else []
+    places += [parent / "shared" / "bench" for parent in ROOT.parents]
+    return next((p / "handcoded_simpy.py" for p in places
+                 if (p / "handcoded_simpy.py").is_file()), None)
+
 
 # The replications of `opspec evaluate --workers 1`, in the chunks it sends, and nothing else.
 _ENGINE = """
@@ -57,44 +74,128 @@ for chunk in chunks(list(range(users)), 1):
 assert done == users, done
 """
 
-
-def _measure(cmd: list[str], cwd: Path | None = None) -> tuple[float, float, str]:
-    """(CPU seconds, wall seconds, stdout) of one child process."""
-    before = resource.getrusage(resource.RUSAGE_CHILDREN)
-    start = time.perf_counter()
-    out = subprocess.run(cmd, check=False, capture_output=True, text=True, cwd=cwd)
-    wall = time.perf_counter() - start
-    after = resource.getrusage(resource.RUSAGE_CHILDREN)
-    if out.returncode != 0:
-        sys.exit(f"failed ({out.returncode}): {' '.join(cmd)}\n{out.stderr}")
-    cpu = (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime)
-    return cpu, wall, out.stdout
-
-
-def baseline(users: int, days: int, seed: int) -> tuple[float, float]:
-    cpu, wall, _ = _measure([sys.executable, str(BASELINE), "--users", str(users), "--days",
-                             str(days), "--seed", str(seed)], cwd=BASELINE.parent)
-    return cpu, wall
+# `opspec evaluate` as the command line runs it, then this process's own memory: its peak
+# (ru_maxrss: the run, the summaries and the report) and what it holds at the end.
+_EVALUATE = """
+import json, resource, sys
+from opspec.cli import main
+status = main(sys.argv[1:])
+with open("/proc/self/statm") as statm:
+    now = int(statm.read().split()[1]) * resource.getpagesize() / 2**20
+peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
+print("@@memory " + json.dumps({"peak_mib": peak, "end_mib": now}), file=sys.stderr)
+sys.exit(status)
+"""
 
 
-def engine_alone(users: int, days: int, seed: int) -> tuple[float, float]:
-    cpu, wall, _ = _measure([sys.executable, "-c", _ENGINE, str(SPEC), str(USERS_TOML),
-                             str(users), str(days), str(seed)])
-    return cpu, wall
+class Measured:
+    """CPU and wall seconds, the stdout and stderr of one child process."""
+
+    def __init__(self, cmd: list[str], cwd: Path | None = None) -> None:
+        start = time.perf_counter()
+        with tempfile.TemporaryFile("w+") as out, tempfile.TemporaryFile("w+") as err:
+            child = subprocess.Popen(cmd, cwd=cwd, stdout=out, stderr=err, text=True)
+            _, status, usage = os.wait4(child.pid, 0)
+            child.returncode = os.waitstatus_to_exitcode(status)
+            self.wall = time.perf_counter() - start
+            out.seek(0)
+            err.seek(0)
+            self.stdout, self.stderr = out.read(), err.read()
+        if child.returncode != 0:
+            sys.exit(f"failed ({child.returncode}): {' '.join(cmd)}\n{self.stderr}")
+        self.cpu = usage.ru_utime + usage.ru_stime
 
 
-def end_to_end(users: int, days: int, seed: int, profile: str | None = None
-               ) -> tuple[float, float]:
+def baseline(script: Path, users: int, days: int, seed: int) -> Measured:
+    return Measured([sys.executable, str(script), "--users", str(users), "--days", str(days),
+                     "--seed", str(seed)], cwd=script.parent)
+
+
+def engine_alone(users: int, days: int, seed: int) -> Measured:
+    return Measured([sys.executable, "-c", _ENGINE, str(SPEC), str(USERS_TOML), str(users),
+                     str(days), str(seed)], cwd=ROOT)
+
+
+def evaluate(users: int, days: int, seed: int, workers: int, profile: str | None = None
+             ) -> tuple[Measured, dict[str, float]]:
+    """One ``opspec evaluate`` and the memory of its own process."""
     with tempfile.TemporaryDirectory() as tmp:
-        run = [sys.executable] + (["-m", "cProfile", "-o", profile] if profile else []) + [
-            "-m", "opspec", "evaluate", str(SPEC), "--users", str(users), "--days",
-            str(days), "--seed", str(seed), "--workers", "1", "--user-model",
-            str(USERS_TOML), "--quiet", "--json", "--out", str(Path(tmp) / "run")]
-        cpu, wall, out = _measure(run)
-        doc = json.loads(out)
-        assert doc["metrics"]["doses_due"]["users"] == users
+        args = ["evaluate", str(SPEC), "--users", str(users), "--days", str(days), "--seed",
+                str(seed), "--workers", str(workers), "--user-model", str(USERS_TOML),
+                "--quiet", "--json", "--out", str(Path(tmp) / "run")]
+        if profile:
+            prof = ("import cProfile, sys, time\nfrom opspec.cli import main\n"
+                    "p = cProfile.Profile(time.process_time)\n"
+                    "status = p.runcall(main, sys.argv[2:])\n"
+                    "p.dump_stats(sys.argv[1])\nsys.exit(status)\n")
+            run = Measured([sys.executable, "-c", prof, profile, *args], cwd=ROOT)
+        else:
+            run = Measured([sys.executable, "-c", _EVALUATE, *args], cwd=ROOT)
+        doc = json.loads(run.stdout)
+        assert doc["metrics"]["doses_due"]["users"] == users, doc["replications"]
         assert (Path(tmp) / "run" / "report.html").is_file()
-    return cpu, wall
+    memory: dict[str, float] = {}
+    for line in run.stderr.splitlines():
+        if line.startswith("@@memory "):
+            memory = json.loads(line.split(" ", 1)[1])
+    return run, memory
+
+
+def _load() -> str:
+    one, five, _ = os.getloadavg()
+    return f"load {one:.1f} (5 min {five:.1f}) on {os.cpu_count()} cores"
+
+
+def _spread(values: list[float]) -> str:
+    if len(values) == 1:
+        return f"{values[0]:.2f}"
+    return f"{statistics.median(values):.2f} (range {min(values):.2f}-{max(values):.2f})"
+
+
+def speed(args: argparse.Namespace, script: Path) -> None:
+    workers = [int(w) for w in args.workers.split(",")]
+    names = ["baseline", "engine alone", *(f"evaluate --workers {w}" for w in workers)]
+    cpu: dict[str, list[float]] = {n: [] for n in names}
+    wall: dict[str, list[float]] = {n: [] for n in names}
+    print(f"medication dispenser, {args.users:,} users x {args.days} days, seed {args.seed}, "
+          f"{args.rounds} interleaved round(s); {_load()}")
+    print(f"{'round':<7}" + "".join(f"{n:>24}" for n in names) + "   (CPU s / wall s)")
+    for round_ in range(1, args.rounds + 1):
+        runs = [baseline(script, args.users, args.days, args.seed),
+                engine_alone(args.users, args.days, args.seed),
+                *(evaluate(args.users, args.days, args.seed, w)[0] for w in workers)]
+        for name, run in zip(names, runs, strict=True):
+            cpu[name].append(run.cpu)
+            wall[name].append(run.wall)
+        print(f"{round_:<7}" + "".join(f"{f'{r.cpu:.2f} / {r.wall:.2f}':>24}" for r in runs))
+    base = cpu["baseline"]
+    print(f"ratios, median of the rounds' own (each against its round's baseline); {_load()}")
+    for name in names[1:]:
+        ratios = [c / b for c, b in zip(cpu[name], base, strict=True)]
+        goal = "   goal <= 1.5" if name == "evaluate --workers 1" else ""
+        print(f"  {name + ' / baseline (CPU)':<44}{_spread(ratios)}{goal}")
+    if "evaluate --workers 1" in cpu:
+        over = [e / g for e, g in zip(cpu["evaluate --workers 1"], cpu["engine alone"],
+                                      strict=True)]
+        print(f"  {'evaluate --workers 1 / engine alone (CPU)':<44}{_spread(over)}")
+        for w in workers:
+            if w > 1:
+                gain = [a / b for a, b in zip(wall["evaluate --workers 1"],
+                                              wall[f"evaluate --workers {w}"], strict=True)]
+                print(f"  {f'speed-up of --workers {w} over 1 (wall)':<44}{_spread(gain)}"
+                      "   goal >= 1.8 on 2 idle cores")
+
+
+def memory(args: argparse.Namespace) -> None:
+    sizes = [int(n) for n in args.memory.split(",")]
+    workers = max(int(w) for w in args.workers.split(","))
+    print(f"medication dispenser, 1 day, seed {args.seed}, --workers {workers}: memory of the "
+          f"evaluate process itself; {_load()}")
+    print(f"{'users':>9}{'peak MiB':>10}{'end MiB':>9}{'CPU s':>9}{'wall s':>9}")
+    for users in sizes:
+        run, mem = evaluate(users, 1, args.seed, workers)
+        print(f"{users:>9,}{mem['peak_mib']:>10.1f}{mem['end_mib']:>9.1f}{run.cpu:>9.1f}"
+              f"{run.wall:>9.1f}")
 
 
 def main() -> None:
@@ -102,43 +203,27 @@ def main() -> None:
     parser.add_argument("--users", type=int, default=1000)
     parser.add_argument("--days", type=int, default=30)
     parser.add_argument("--seed", type=int, default=1)
-    parser.add_argument("--repeat", type=int, default=1,
-                        help="runs of each; the fastest counts (default 1)")
+    parser.add_argument("--rounds", type=int, default=3, help="interleaved rounds (default 3)")
+    parser.add_argument("--workers", default="1",
+                        help="comma-separated worker counts of evaluate (default 1)")
+    parser.add_argument("--memory", metavar="USERS,...",
+                        help="instead: memory of evaluate --days 1 at these numbers of users")
     parser.add_argument("--profile", metavar="FILE",
-                        help="also write a cProfile of one end-to-end run to FILE")
+                        help="also write a CPU-time cProfile of one evaluate --workers 1")
     args = parser.parse_args()
-    if not BASELINE.is_file():
-        sys.exit(f"baseline not found: {BASELINE}")
-    runners = {"baseline (hand-coded SimPy)": baseline, "engine alone": engine_alone,
-               "opspec evaluate, end to end": end_to_end}
-    best: dict[str, tuple[float, float]] = {}
-    paired: list[float] = []        # end to end / engine alone (CPU) within each round
-    for _ in range(max(1, args.repeat)):
-        this: dict[str, float] = {}
-        for name, runner in runners.items():      # interleaved: load drifts hit all alike
-            cpu, wall = runner(args.users, args.days, args.seed)
-            this[name] = cpu
-            old = best.get(name)
-            best[name] = (min(cpu, old[0]), min(wall, old[1])) if old else (cpu, wall)
-        paired.append(this["opspec evaluate, end to end"] / this["engine alone"])
-    _, _, version = _measure([sys.executable, "-m", "opspec", "--version"])
+    version = Measured([sys.executable, "-m", "opspec", "--version"], cwd=ROOT).stdout
     print(" ".join(version.split()))
-    print(f"medication dispenser, {args.users:,} users x {args.days} days, one worker, "
-          f"fastest of {max(1, args.repeat)}")
-    print(f"{'':<30}{'CPU s':>8}{'wall s':>9}")
-    for name, (cpu, wall) in best.items():
-        print(f"{name:<30}{cpu:>8.2f}{wall:>9.2f}")
-    base, engine, e2e = best.values()
-    print(f"end to end / engine alone: {e2e[0] / engine[0]:.2f} (CPU), "
-          f"{e2e[1] / engine[1]:.2f} (wall); goal <= 1.3")
-    print(f"engine alone / baseline:   {engine[0] / base[0]:.2f} (CPU), "
-          f"{engine[1] / base[1]:.2f} (wall)")
-    if len(paired) > 1:     # on a machine whose speed drifts, the fastest runs may not pair
-        print(f"end to end / engine alone within each round (CPU): median "
-              f"{statistics.median(paired):.2f}, range {min(paired):.2f}-{max(paired):.2f}")
+    if args.memory:
+        memory(args)
+    else:
+        script = _baseline_script()
+        if script is None:
+            sys.exit("baseline not found: put shared/bench/handcoded_simpy.py beside a folder "
+                     "above this checkout, or set OPSPEC_BENCH to its folder")
+        speed(args, script)
     if args.profile:
-        end_to_end(args.users, args.days, args.seed, profile=args.profile)
-        print(f"profile of one end-to-end run: {args.profile} (python -m pstats)")
+        evaluate(args.users, args.days, args.seed, 1, profile=args.profile)
+        print(f"profile of one evaluate --workers 1: {args.profile} (python -m pstats)")
 
 
 if __name__ == "__main__":

@@ -49,9 +49,18 @@ class ReplicationRecord:
     person: tuple[str | None, dict[str, float]] | None = None
 
 
+#: The column of the activity table each event kind counts in: offered, completed, omitted,
+#: wrong (``user.wrong_choice``, ``user.slip``).
+_COLUMN = {"activity.offered": 0, "activity.completed": 1, "user.omitted": 2,
+           **dict.fromkeys(USER_KINDS_WRONG, 3)}
+
+
 class ActivityRecorder:
     """Counts, per manual activity of the user lane, offers, completions, omissions and wrong
-    actions (``user.wrong_choice``, ``user.slip``), selecting only the events it needs."""
+    actions (``user.wrong_choice``, ``user.slip``), selecting only the events it needs.
+
+    A raw listener (:meth:`raw`): the engine hands it each event's fields without building a
+    trace-event object for it, which the dispenser's user lane emits four of per dose."""
 
     def __init__(self, manual: Sequence[str]) -> None:
         self.counts: dict[str, list[int]] = {a: [0, 0, 0, 0] for a in manual}
@@ -63,20 +72,25 @@ class ActivityRecorder:
             selects.add((kind, None, None))
         self.selects = frozenset(selects)
 
-    def __call__(self, event: Any) -> None:
-        kind = event.kind
-        activity = event.activity or (event.data or {}).get("activity")
-        row = self.counts.get(activity) if activity is not None else None
-        if row is None:
+    def raw(self, time: float, kind: str, process: str | None, instance: int | None,
+            activity: str | None, data: Mapping[str, Any] | None = None) -> None:
+        """Count one event from its fields. The engine sends a raw listener every event any
+        listener selects, so the kind is checked here (the activity too: the user events
+        name theirs in ``data``)."""
+        column = _COLUMN.get(kind)
+        if column is None:
             return
-        if kind == "activity.offered":
-            row[0] += 1
-        elif kind == "activity.completed":
-            row[1] += 1
-        elif kind == "user.omitted":
-            row[2] += 1
-        else:
-            row[3] += 1
+        if not activity:
+            activity = data.get("activity") if data else None
+            if activity is None:
+                return
+        row = self.counts.get(activity)
+        if row is not None:
+            row[column] += 1
+
+    def __call__(self, event: Any) -> None:
+        self.raw(event.time, event.kind, event.process, event.instance, event.activity,
+                 event.data)
 
 
 @dataclass(frozen=True)
