@@ -22,7 +22,6 @@ Keys may also sit at the top level of the file. Unknown keys and bad values rais
 from __future__ import annotations
 
 import math
-import tomllib
 from collections.abc import Mapping
 from dataclasses import dataclass, fields
 from pathlib import Path
@@ -114,29 +113,11 @@ class EngineConfig:
     @classmethod
     def load(cls, path: str | Path, **overrides: Any) -> EngineConfig:
         """Read a TOML file (``[engine]`` table or top-level keys), then apply ``overrides``."""
-        from opspec.files import open_regular, reason
+        from opspec.toml_files import read_toml
 
         text_path = str(path)
-        try:
-            with open_regular(path) as handle:     # a pipe or device never blocks
-                document = tomllib.load(handle)
-        except FileNotFoundError:
-            raise ConfigurationError(
-                "engine configuration file not found", location=SourceLocation(text_path),
-                hint="check the path given to --engine-config") from None
-        except OSError as error:
-            raise ConfigurationError(
-                f"cannot read the engine configuration: {reason(error)}",
-                location=SourceLocation(text_path)) from None
-        except UnicodeDecodeError as error:
-            raise ConfigurationError(
-                f"not UTF-8 text: byte 0x{error.object[error.start]:02x} at offset "
-                f"{error.start}", location=SourceLocation(text_path),
-                hint="save the configuration as UTF-8") from None
-        except tomllib.TOMLDecodeError as error:
-            raise ConfigurationError(
-                f"not valid TOML: {error}", location=SourceLocation(text_path),
-                hint="fix the syntax (see https://toml.io)") from None
+        # bounded (size, nesting) and located like every TOML file people write
+        document = read_toml(path, what="the engine configuration")
         table = document.get("engine", document)
         if not isinstance(table, dict):
             raise ConfigurationError("[engine] must be a table",

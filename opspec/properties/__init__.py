@@ -3,11 +3,14 @@
 * :mod:`~opspec.properties.language` - the text form (``min_gap dispense 4h``,
   ``bounded_response sound_alarm dispense 15 min``), the property classes and the one
   evaluator, fed events online (while a run happens) or offline (over a stored trace);
+* :mod:`~opspec.properties.vocabulary` - the language in Python: one set of constructors
+  (``never``, ``within``, ``min_gap``, ``count(...) <= n``...) whose objects are monitors and
+  trace predicates alike;
 * :mod:`~opspec.properties.monitors` - the monitors a spec declares (``opspec:Monitor``),
   watched in every run (:func:`opspec.runs.build`).
 
-The trace predicates of spec tests (:mod:`opspec.testing.predicates`) and the ``then`` lines
-of scenario files are this language too (docs/spec-testing.md, "One property language"). It
+The trace predicates of spec tests (judged by :mod:`opspec.testing.predicates`) and the
+``then`` lines of scenario files are this language too (docs/spec-testing.md, "One property language"). It
 sits above the engine (it reads the engine's trace events and a compiled spec's names) and
 below the run builder.
 """

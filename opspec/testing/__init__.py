@@ -8,10 +8,14 @@
   plain data;
 * :mod:`~opspec.testing.expectations` - readable ``then`` lines and :func:`expect`;
 * :mod:`~opspec.testing.scenario` - ``*.scenario.toml`` files;
-* :mod:`~opspec.testing.predicates` - trace predicates (``holds``, ``check``, ``within``, ...);
+* :mod:`~opspec.properties.vocabulary` - the property language in Python, one set of
+  constructors for monitors and trace predicates (``within``, ``never``, ``min_gap``, ...);
+* :mod:`~opspec.testing.predicates` - judging them on results (``holds``, ``check``);
 * :mod:`~opspec.testing.golden` - golden traces with readable diffs;
 * :mod:`~opspec.testing.assertions` - statistical assertions and their numeric core;
-* :mod:`~opspec.testing.monitors` - safety monitors checked during every simulated run.
+* :mod:`~opspec.testing.monitors` - the report of the monitors watched in every simulated run
+  (``never_happens`` and ``bounded_response`` are deprecated spellings of ``never`` and
+  ``within``).
 
 Names are loaded lazily so that importing :mod:`opspec.testing` stays light (no pytest, no
 numpy until used). The guide is ``docs/spec-testing.md``.
@@ -27,6 +31,7 @@ __all__ = [
     "ScriptUser",
     "SimulationResult",
     "activity_completed",
+    "activity_started",
     "assert_mean",
     "assert_no_violations",
     "assert_quantile",
@@ -70,29 +75,30 @@ _WHERE = {
     "parse_expectation": "opspec.testing.expectations",
     "load_scenarios": "opspec.testing.scenario",
     "simulator_for": "opspec.testing.plugin",
-    "activity_completed": "opspec.testing.predicates",
+    "activity_completed": "opspec.properties.vocabulary",
     "check": "opspec.testing.predicates",
-    "count": "opspec.testing.predicates",
-    "event": "opspec.testing.predicates",
-    "eventually": "opspec.testing.predicates",
-    "happens_before": "opspec.testing.predicates",
+    "count": "opspec.properties.vocabulary",
+    "event": "opspec.properties.vocabulary",
+    "eventually": "opspec.properties.vocabulary",
+    "happens_before": "opspec.properties.vocabulary",
     "holds": "opspec.testing.predicates",
-    "never": "opspec.testing.predicates",
-    "per_instance": "opspec.testing.predicates",
-    "process_started": "opspec.testing.predicates",
-    "trigger_raised": "opspec.testing.predicates",
-    "within": "opspec.testing.predicates",
+    "never": "opspec.properties.vocabulary",
+    "per_instance": "opspec.properties.vocabulary",
+    "process_started": "opspec.properties.vocabulary",
+    "trigger_raised": "opspec.properties.vocabulary",
+    "within": "opspec.properties.vocabulary",
     "assert_mean": "opspec.testing.assertions",
     "assert_quantile": "opspec.testing.assertions",
     "assert_rate": "opspec.testing.assertions",
     "assert_rate_sequential": "opspec.testing.assertions",
+    "activity_started": "opspec.properties.vocabulary",
     "assert_no_violations": "opspec.testing.monitors",
     "bounded_response": "opspec.testing.monitors",
-    "max_count_per": "opspec.testing.monitors",
-    "min_gap": "opspec.testing.monitors",
-    "monitor": "opspec.testing.monitors",
+    "max_count_per": "opspec.properties.vocabulary",
+    "min_gap": "opspec.properties.vocabulary",
+    "monitor": "opspec.properties.vocabulary",
     "never_happens": "opspec.testing.monitors",
-    "never_while": "opspec.testing.monitors",
+    "never_while": "opspec.properties.vocabulary",
 }
 
 

@@ -15,32 +15,33 @@ them in every run as well::
     <ExtendedAttribute Name="opspec:Monitor" Value="min_gap dispense 4h"/>
 
 A monitor is a property of the one property language (:mod:`opspec.properties.language`, usable
-by any layer): its text is also a trace predicate (``holds(result, "min_gap dispense 4h")``)
-and a scenario ``then`` line, judged on stored traces by the same evaluator, and a monitor
-object is a predicate too (``check(result, min_gap("dispense", hours=4))``). This module adds
-the constructors tests use and the report.
+by any layer), built with the one Python vocabulary (:mod:`opspec.properties.vocabulary`:
+``min_gap``, ``never``, ``within``, ``count``..., re-exported here and by
+:mod:`opspec.testing`): the same object is a trace predicate (``check(result,
+min_gap("dispense", hours=4))``) and its text a scenario ``then`` line, judged on stored traces
+by the same evaluator. This module adds the report (``never_happens`` and
+``bounded_response`` remain as deprecated spellings of ``never`` and ``within``).
 """
 
 from __future__ import annotations
 
+import warnings
 from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
 from typing import Any
 
 from opspec.errors import ConfigurationError
-from opspec.properties.language import (
-    BoundedResponse,
-    MaxCount,
-    MinGap,
-    MonitorResult,
-    Names,
-    Never,
-    NeverWhile,
-    Violation,
-    clock,
-    parse_subject,
-)
+from opspec.properties.language import MonitorResult, Names, Property, Violation, clock
 from opspec.properties.monitors import Monitor, declared_monitors, parse_monitor
+from opspec.properties.vocabulary import (
+    Predicate,
+    max_count_per,
+    min_gap,
+    monitor,
+    never,
+    never_while,
+    within,
+)
 from opspec.statistics import poisson_interval
 from opspec.statistics.claims import confidence_text
 
@@ -61,68 +62,32 @@ __all__ = [
 ]
 
 
-def _seconds(seconds: float, minutes: float, hours: float) -> float:
-    total = float(seconds) + 60.0 * minutes + 3600.0 * hours
-    if not total > 0:
-        raise ConfigurationError("a monitor's time must be positive",
-                                 hint="give seconds=, minutes= or hours=")
-    return total
+def never_happens(subject: str) -> Predicate:
+    """Deprecated spelling of :func:`~opspec.properties.vocabulary.never` (the same property,
+    ``never A``)."""
+    warnings.warn("never_happens() is deprecated: use never()", DeprecationWarning,
+                  stacklevel=2)
+    return never(subject)
 
 
-def _span_text(seconds: float) -> str:
-    return f"{seconds / 3600:g}h" if seconds >= 3600 else f"{seconds:g}s"
+def bounded_response(trigger: str, response: str, seconds: float) -> Predicate:
+    """Deprecated spelling of :func:`~opspec.properties.vocabulary.within` (the same property,
+    ``bounded_response A B D``)."""
+    warnings.warn("bounded_response() is deprecated: use within()", DeprecationWarning,
+                  stacklevel=2)
+    return within(trigger, response, seconds)
 
 
-def monitor(text: str) -> Monitor:
-    """A monitor from its text form (``"min_gap dispense 4h"``, see
-    :mod:`opspec.properties.monitors`)."""
-    return parse_monitor(text)
-
-
-def min_gap(subject: str, *, seconds: float = 0, minutes: float = 0, hours: float = 0
-            ) -> Monitor:
-    """No two ``subject`` closer than the given time: ``min_gap("dispense", hours=4)``."""
-    gap = _seconds(seconds, minutes, hours)
-    return MinGap(parse_subject(subject), gap, text=f"min_gap {subject} {_span_text(gap)}")
-
-
-def never_happens(subject: str) -> Monitor:
-    """``subject`` never happens."""
-    return Never(parse_subject(subject), text=f"never {subject}")
-
-
-def never_while(subject: str, *, after: str, until: str) -> Monitor:
-    """``subject`` never happens after an ``after`` and before the next ``until``."""
-    return NeverWhile(parse_subject(subject), parse_subject(after), parse_subject(until),
-                      text=f"never_while {subject} after {after} until {until}")
-
-
-def max_count_per(subject: str, limit: int, *, seconds: float = 0, minutes: float = 0,
-                  hours: float = 0) -> Monitor:
-    """At most ``limit`` ``subject`` in any window of the given length."""
-    if isinstance(limit, bool) or not isinstance(limit, int) or limit < 0:
-        raise ConfigurationError(f"max_count_per(): limit must be a whole number >= 0, "
-                                 f"not {limit!r}")
-    window = _seconds(seconds, minutes, hours)
-    return MaxCount(parse_subject(subject), limit, window,
-                    text=f"max_count {subject} {limit} per {_span_text(window)}")
-
-
-def bounded_response(trigger: str, response: str, seconds: float) -> Monitor:
-    """Every ``trigger`` is answered by a ``response`` within ``seconds``."""
-    gap = _seconds(seconds, 0, 0)
-    return BoundedResponse(parse_subject(trigger), parse_subject(response), gap,
-                           text=f"bounded_response {trigger} {response} {gap:g}s")
-
-
-def monitors_for(compiled: Any, names: Names, extra: Iterable[Monitor | str] | None
-                 ) -> list[Monitor]:
-    """The spec's declared monitors plus ``extra`` (objects or text), bound to its names
-    (:class:`ConfigurationError` listing the names when one is unknown)."""
+def monitors_for(compiled: Any, names: Names,
+                 extra: Iterable[Predicate | Property | str] | None) -> list[Monitor]:
+    """The spec's declared monitors plus ``extra`` (the vocabulary's objects, properties or
+    their text), bound to its names (:class:`ConfigurationError` listing the names when one
+    is unknown)."""
     out = declared_monitors(compiled)
     for item in extra or ():
-        m = parse_monitor(item) if isinstance(item, str) else item
-        if not isinstance(m, Monitor):
+        m = (parse_monitor(item) if isinstance(item, str)
+             else item.monitor() if isinstance(item, Predicate) else item)
+        if not isinstance(m, Property):
             raise ConfigurationError(f"{item!r} is not a monitor",
                                      hint="pass monitor objects (min_gap(...), ...) or their "
                                           "text form ('min_gap dispense 4h')")

@@ -30,7 +30,7 @@ def test_prompt(spec, simulate):
     result.stdout.fnmatch_lines([
         "*check(simulate(spec, script=PROMPT*",
         "E * expected within(sound_alarm, press_report, 60 s)",
-        "E * but sound_alarm at d1 08:00:00 was not followed by press_report within 1 min*",
+        "E * but activity sound_alarm at d1 08:00:00 was not followed by activity press_report within 1 min*",
         "E * trace around it (2 marked event(s) of *):",
         "E *>   d1 08:00:00        #2 notify_workflow    activity.completed   sound_alarm",
         "*- opspec -*", "seed * (from --opspec-seed=0 and the test id*"])

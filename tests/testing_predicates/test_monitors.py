@@ -13,13 +13,13 @@ from opspec.errors import ConfigurationError
 from opspec.properties.language import BoundedResponse, MinGap
 from opspec.properties.monitors import package_monitors, parse_monitor
 from opspec.statistics import poisson_interval
-from opspec.testing.monitors import (
+from opspec.testing import (
     assert_no_violations,
-    bounded_response,
     max_count_per,
     min_gap,
-    never_happens,
+    never,
     never_while,
+    within,
 )
 from opspec.testing.simulation import simulate
 
@@ -94,11 +94,12 @@ def test_the_4_hour_gap_is_broken_by_a_late_then_prompt_report_and_3h45m_is_not(
 
 def test_python_constructors_build_the_same_monitors_as_the_text_form() -> None:
     assert min_gap("dispense", hours=4) == parse_monitor("min_gap dispense 4h")
-    assert bounded_response("a", "b", 60) == BoundedResponse(
+    assert within("a", "b", 60) == BoundedResponse(
         *parse_monitor("bounded_response a b 60s").subjects(), 60.0,
         text="bounded_response a b 60s")
+    assert within("a", "b", 60).text == "bounded_response a b 1min"
     assert max_count_per("a", 4, hours=24).text == "max_count a 4 per 24h"
-    assert never_happens("a").text == "never a"
+    assert never("a").text == "never a"
     assert never_while("a", after="b", until="c") == parse_monitor(
         "never_while a after b until c")
     assert isinstance(parse_monitor("min_gap   dispense    PT4H"), MinGap)

@@ -74,7 +74,7 @@ def test_a_failed_within_shows_the_violation_and_the_next_response_not_the_whole
         check(prompt_user, within("sound_alarm", "press_report", 60))
     text = str(info.value)
     assert text.startswith("expected within(sound_alarm, press_report, 60 s)")
-    assert ("sound_alarm at d1 08:00:00 was not followed by press_report within 1 min; "
+    assert ("activity sound_alarm at d1 08:00:00 was not followed by activity press_report within 1 min; "
             "the next came at d1 08:01:30, 1.5 min after it") in text
     marked = [line for line in text.splitlines() if line.startswith(">")]
     assert len(marked) == 2 and "sound_alarm" in marked[0] and "press_report" in marked[1]
@@ -93,13 +93,13 @@ def test_a_failed_never_marks_the_first_occurrence(prompt_user: SimulationResult
 
 def test_a_failed_per_instance_names_the_instance(absent_user: SimulationResult) -> None:
     with pytest.raises(AssertionError, match=r"in notify_workflow instance #2 \(started d1 "
-                                             r"08:00:00\):\n  but sound_alarm happened 3 time"):
+                                             r"08:00:00\):\n  but activity sound_alarm happened 3 time"):
         check(absent_user, per_instance("notify_workflow", count("sound_alarm") <= 2))
 
 
 def test_a_failed_alternative_lists_why_each_part_failed(prompt_user: SimulationResult) -> None:
     with pytest.raises(AssertionError, match="none of the alternatives holds:\n"
-                       r".*count\(sound_alarm\) == 2: but sound_alarm happened 1 time"):
+                       r".*count\(sound_alarm\) == 2: but activity sound_alarm happened 1 time"):
         check(prompt_user, (count("sound_alarm") == 2) | never("dispense"))
 
 
