@@ -183,6 +183,12 @@ def _new_plan(args: argparse.Namespace) -> Any:
         raise EvaluationError(f"--users {users}: {args.params} has {len(inputs.rows)} rows, "
                               "one per simulated user", hint=f"give --users {len(inputs.rows)} "
                               "or fewer, or add rows")
+    per_user = [n for n, _t, _i in inputs.draws] + [n for row in inputs.rows for n in row]
+    if args.sweep and args.sweep[0].removeprefix("spec.") in per_user:
+        raise EvaluationError(f"--sweep {args.sweep[0]}: {args.sweep[0].removeprefix('spec.')} "
+                              "is drawn per user (--param NAME~…) or read from --params, "
+                              "which would override every swept value",
+                              hint="sweep it, or draw it, not both")
     if (inputs.draws or inputs.rows) and args.input_uncertainty:
         raise EvaluationError("--input-uncertainty runs users of its own: it does not take "
                               "drawn run inputs or a data file's rows",

@@ -151,3 +151,15 @@ def test_bad_values_are_refused_naming_the_file_and_line(
     err = capsys.readouterr().err
     assert code == 2 and said in err, err
     assert "Traceback" not in err
+
+
+def test_a_json_list_gives_rows_and_a_swept_drawn_input_is_refused(
+        diagram: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    rows = tmp_path / "users.json"
+    rows.write_text('[{"score": 80}, {"score": 10}]', encoding="utf-8")
+    assert _evaluate(diagram, tmp_path / "out", "--params", str(rows)) == {0: "done",
+                                                                           1: "remind"}
+    code = main(["evaluate", str(diagram), "--days", "0.001", "--out", str(tmp_path / "sw"),
+                 "--param", "score~uniform(0, 100)", "--sweep", "spec.score=10,90"])
+    err = capsys.readouterr().err
+    assert code == 2 and "would override every swept value" in err
