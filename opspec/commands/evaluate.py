@@ -54,7 +54,11 @@ def register(subparsers: Any) -> None:
                         help="a value for a package data field of type integer, float or "
                         "boolean, such as a BPMN diagram's run input (a variable its "
                         "conditions read that nothing sets; repeatable; docs/bpmn.md, Run "
-                        "inputs)")
+                        "inputs); NAME~DISTRIBUTION draws one per simulated user "
+                        "('score~uniform(0, 100)')")
+    parser.add_argument("--params", metavar="FILE",
+                        help="run-input values from a .toml/.json file (NAME = value or a "
+                        "distribution table) or a .csv file of one row per simulated user")
     parser.add_argument("--sweep", type=sweep, metavar="PARAM=V1,V2,...",
                         help="run one design per value of a spec or user-model parameter, "
                         "on the same simulated users ('--sweep list' lists the parameters; "
@@ -151,6 +155,7 @@ def _engine(path: str | None) -> dict[str, Any]:
 def _new_plan(args: argparse.Namespace) -> Any:
     from opspec.evaluation.plan import DAY, Design, EvaluationPlan, file_digest
     from opspec.request import RunRequest, prepare
+    from opspec.run_inputs import RunInputs
     from opspec.run_rules import check_days
 
     if args.spec is None:
@@ -166,13 +171,28 @@ def _new_plan(args: argparse.Namespace) -> Any:
         prepare(RunRequest(path, days=args.days, user_model=model, no_user=model is None))
     # --param: a value of a package data field (a BPMN diagram's run input) for every design,
     # applied as a parameter of one value (what --sweep applies per design)
-    from opspec.commands._params import parse_params
+    # draws and a data file's rows are per simulated user (opspec.run_inputs), in the plan
+    from opspec.commands._params import read_run_inputs
 
-    fixed = tuple((f"spec.{name}", value)
-                  for name, value in parse_params(args.param, a.package).items())
+    inputs = read_run_inputs(args.param, args.params, a.package)
+    fixed = tuple((f"spec.{name}", value) for name, value in inputs.values)
     designs = [Design(label, str(path), file_digest(path), fixed) for label, path in specs]
     days = float(args.days) if args.days is not None else a.horizon / DAY
-    users = args.users if args.users is not None else DEFAULT_USERS
+    users = args.users if args.users is not None else (len(inputs.rows) or DEFAULT_USERS)
+    if inputs.rows and users > len(inputs.rows):
+        raise EvaluationError(f"--users {users}: {args.params} has {len(inputs.rows)} rows, "
+                              "one per simulated user", hint=f"give --users {len(inputs.rows)} "
+                              "or fewer, or add rows")
+    per_user = [n for n, _t, _i in inputs.draws] + [n for row in inputs.rows for n in row]
+    if args.sweep and args.sweep[0].removeprefix("spec.") in per_user:
+        raise EvaluationError(f"--sweep {args.sweep[0]}: {args.sweep[0].removeprefix('spec.')} "
+                              "is drawn per user (--param NAME~…) or read from --params, "
+                              "which would override every swept value",
+                              hint="sweep it, or draw it, not both")
+    if (inputs.draws or inputs.rows) and args.input_uncertainty:
+        raise EvaluationError("--input-uncertainty runs users of its own: it does not take "
+                              "drawn run inputs or a data file's rows",
+                              hint="give the run inputs values (--param NAME=VALUE)")
     run_seed = args.seed if args.seed is not None else DEFAULT_SEED
     export = _exports(args.export)
     if args.case is not None and not {"xes", "jsonl"} & set(export):
@@ -191,7 +211,10 @@ def _new_plan(args: argparse.Namespace) -> Any:
     return EvaluationPlan(designs=tuple(designs), users=users, days=days,
                           seed=run_seed, user_model=model, engine=_engine(args.engine_config),
                           export=export, case=args.case or "chain",
-                          input_uncertainty=draws, users_per_draw=per_draw)
+                          input_uncertainty=draws, users_per_draw=per_draw,
+                          run_inputs=RunInputs(draws=inputs.draws, rows=inputs.rows,
+                                               source=inputs.source).to_json()
+                          if inputs.draws or inputs.rows else {})
 
 
 def _check_plan(plan: Any) -> dict[str, list[dict[str, Any]]]:

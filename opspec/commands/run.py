@@ -69,8 +69,12 @@ def register(subparsers: Any) -> None:
                       help="nobody performs the user lane (ignore SPEC.users.toml)")
     parser.add_argument("--param", action="append", default=[], metavar="NAME=VALUE",
                         help="a value for a package data field, such as a BPMN diagram's run "
-                        "input (a variable its conditions read that nothing sets; "
-                        "repeatable; docs/bpmn.md, Run inputs)")
+                        "input (a variable its conditions read that nothing sets), or "
+                        "NAME~DISTRIBUTION ('score~uniform(0, 100)': drawn from the seed); "
+                        "repeatable; docs/bpmn.md, Run inputs")
+    parser.add_argument("--params", metavar="FILE",
+                        help="run-input values from a .toml/.json file (NAME = value or a "
+                        "distribution table) or a .csv file (the run takes its first row)")
     parser.add_argument("--trace", metavar="FILE", help="write the full trace as JSON Lines")
     parser.add_argument("--engine-config", metavar="FILE", help="engine configuration TOML")
     parser.add_argument("--processor-model",
@@ -103,7 +107,7 @@ def register(subparsers: Any) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    from opspec.commands._params import parse_params
+    from opspec.commands._params import read_run_inputs
     from opspec.engine.trace_sinks import JsonlSink
     from opspec.request import RunRequest, prepare
     from opspec.run_rules import check_days, parse_until
@@ -120,7 +124,10 @@ def run(args: argparse.Namespace) -> int:
     horizon, user = prepared.horizon, prepared.user
     if args.trace:
         _refuse_trace_over_input(args, package)
-    params = parse_params(args.param, package) or None      # a bad value stops us before the run
+    # a bad value stops us before the run; the lone run is run 0 of its seed (as user 0 of
+    # opspec evaluate --seed): drawn values and a data file's first row
+    inputs = read_run_inputs(args.param, args.params, package)
+    params = inputs.for_run(args.seed, 0) or None
     config = _config(args)
     out = sys.stdout
     printer = None if args.json or args.timeline == "none" else _Timeline(
@@ -135,6 +142,9 @@ def run(args: argparse.Namespace) -> int:
             print(f"opspec run: {package.name or package.id} ({args.spec}), seed {args.seed}, "
                   f"for {span(horizon)} simulated", file=out)
             print(f"  user lane: {user.describe}", file=out)
+            if inputs.draws or inputs.rows:
+                print(f"  run inputs: {inputs.describe()}; this run: "
+                      + ", ".join(f"{k} = {v!r}" for k, v in (params or {}).items()), file=out)
             print(f"  engine: {config.processor_model}"
                   + (f", {config.workers} worker(s)" if config.processor_model == "pooled" else
                      f", {config.workers} processor(s)" if config.pooled else "")
@@ -172,6 +182,8 @@ def run(args: argparse.Namespace) -> int:
     timing_summary = timing.summary() if timing is not None else None
     if args.json:
         doc = _json_document(args, package, horizon, result, device_report, medians)
+        if params:
+            doc["params"] = params
         if absent:
             doc["deadlocks"] = [d.get("message") for d in _real_deadlocks(result, absent)]
             doc["waiting_for_user"] = {"instances": len(absent),

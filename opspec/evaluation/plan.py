@@ -70,6 +70,9 @@ class EvaluationPlan:
     #: ``users_per_draw`` users of its own (opspec.evaluation.input_uncertainty); 0: none
     input_uncertainty: int = 0
     users_per_draw: int = 0
+    #: run inputs drawn per simulated user or read from a data file's rows
+    #: (:class:`opspec.run_inputs.RunInputs` as JSON; fixed values are design parameters)
+    run_inputs: Mapping[str, Any] = field(default_factory=dict)
 
     def __post_init__(self) -> None:
         if isinstance(self.users, bool) or not isinstance(self.users, int) or self.users < 1:
@@ -102,6 +105,10 @@ class EvaluationPlan:
         doc["export"] = list(self.export)
         if not self.input_uncertainty:      # plans without draws read as they always did
             del doc["input_uncertainty"], doc["users_per_draw"]
+        if not self.run_inputs:             # plans without them read as they always did
+            del doc["run_inputs"]
+        else:
+            doc["run_inputs"] = dict(self.run_inputs)
         return doc
 
     @classmethod
@@ -114,12 +121,13 @@ class EvaluationPlan:
                    user_model=doc.get("user_model"), engine=dict(doc.get("engine") or {}),
                    export=tuple(doc.get("export") or ()), case=str(doc.get("case") or "user"),
                    input_uncertainty=int(doc.get("input_uncertainty") or 0),
-                   users_per_draw=int(doc.get("users_per_draw") or 0))
+                   users_per_draw=int(doc.get("users_per_draw") or 0),
+                   run_inputs=dict(doc.get("run_inputs") or {}))
 
     def same_results_as(self, other: EvaluationPlan) -> list[str]:
         """What differs between two plans in ways that change results (for ``--resume``)."""
         mine, theirs = self.to_json(), other.to_json()
         return [key for key in ("designs", "users", "days", "seed", "user_model", "engine",
-                                "input_uncertainty", "users_per_draw")
+                                "input_uncertainty", "users_per_draw", "run_inputs")
                 if json.dumps(mine.get(key), sort_keys=True) != json.dumps(theirs.get(key),
                                                                             sort_keys=True)]

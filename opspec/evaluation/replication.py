@@ -152,7 +152,7 @@ def prepare(spec: str, sha256: str, user_model: str | None, engine: Mapping[str,
 
 
 def run_user(context: _Context, design: str, user: int, *, seed: int, horizon: float,
-             keep_trace: bool) -> ReplicationRecord:
+             keep_trace: bool, inputs: Any = None) -> ReplicationRecord:
     """Simulate user ``user`` of ``design`` (built by :func:`opspec.runs.build`, as every
     run is: user ``user``'s streams); a failure (an error, a run-time fault, a deadlock:
     :mod:`opspec.evaluation.failures`) becomes a ``failed`` record."""
@@ -174,7 +174,8 @@ def run_user(context: _Context, design: str, user: int, *, seed: int, horizon: f
         recorder = ActivityRecorder(context.manual)
         outcome = build(context.spec, seed=seed, user=who, user_index=user,
                         until=horizon, config=context.config, listeners=[recorder],
-                        keep_trace=keep_trace, keep_times=True).execute()
+                        keep_trace=keep_trace, keep_times=True,
+                        params=inputs.for_run(seed, user) if inputs else None).execute()
     except OpspecError as error:
         return ReplicationRecord(design, user, "failed", error=str(error),
                                  wall_s=time.perf_counter() - start)
@@ -219,5 +220,8 @@ def run_users(plan: Mapping[str, Any], design: str, users: Sequence[int]
                       plan.get("engine") or {}, spec.get("parameters") or ())
     horizon = float(plan["days"]) * DAY
     keep = bool(plan.get("export"))
+    from opspec.run_inputs import RunInputs
+
+    inputs = RunInputs.from_json(plan.get("run_inputs"))     # drawn per user u, or row u
     return [run_user(context, design, u, seed=int(plan["seed"]), horizon=horizon,
-                     keep_trace=keep) for u in users]
+                     keep_trace=keep, inputs=inputs) for u in users]

@@ -285,6 +285,11 @@ def print_summary(out: IO[str], plan: Any, metrics: Mapping[str, Any],
     design = plan.design("A")
     print(f"opspec evaluate: {design.spec}, {plan.users} users x {span(plan.days)}, seed "
           f"{plan.seed}, user model {plan.user_model or 'none'}", file=out)
+    if getattr(plan, "run_inputs", None):
+        from opspec.run_inputs import RunInputs
+
+        print(f"run inputs per user: {RunInputs.from_json(plan.run_inputs).describe()}",
+              file=out)
     ran = (f"{outcome.done + outcome.failed} replications in {outcome.wall_s:.1f} s on "
            f"{workers} worker(s)")
     if outcome.skipped:

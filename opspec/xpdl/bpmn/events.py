@@ -13,6 +13,7 @@ from opspec.errors import SpecError
 from opspec.model.activities import Trigger, TriggerKind
 from opspec.model.expressions import Expression, Literal
 from opspec.xpdl.bpmn.common import Defs, bpmn_children, expression_text, first, local
+from opspec.xpdl.bpmn.cron import cron_cycle
 
 __all__ = ["KINDS", "Timer", "definitions_of", "named_ref", "read_timer", "trigger_of"]
 
@@ -32,7 +33,7 @@ KINDS: dict[str, TriggerKind] = {
 
 _TIMER_HINT = ("write timeDuration as an ISO 8601 duration (PT5M), timeDate as "
                "2026-01-01T08:00:00 and timeCycle as R3/PT10M or R/2026-01-01T08:00:00/P1D "
-               "(cron expressions are not read)")
+               "(a cron expression is read when it fires every day at evenly spaced times)")
 
 
 def definitions_of(event: etree._Element, defs: Defs) -> list[etree._Element]:
@@ -89,6 +90,12 @@ def read_timer(definition: etree._Element, defs: Defs) -> Timer | None:
         try:
             if kind == "timeCycle":
                 cycle = parse_time_cycle(text, location=where)
+                iso = cron_cycle(text, where) if cycle is None else None
+                if iso is not None:     # a cron expression that is a fixed period
+                    cycle = parse_time_cycle(iso, location=where)
+                    defs.info(element, "cron-timer", f"the cron timeCycle {text!r} is read "
+                              f"as {iso}: from {iso.split('/')[1][1:]} of day 1 of the run, "
+                              "then every period, as the cron fires each day")
                 if cycle is None:
                     raise SpecError(f"cannot read timeCycle {text!r}", location=where)
                 repeat, period, start = cycle

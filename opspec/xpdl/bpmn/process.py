@@ -61,7 +61,7 @@ from opspec.xpdl.bpmn.common import (
     text_of,
 )
 from opspec.xpdl.bpmn.branches import decide_undecided
-from opspec.xpdl.bpmn.data import activity_data, process_fields
+from opspec.xpdl.bpmn.data import CAMUNDA, activity_data, process_fields
 from opspec.xpdl.bpmn.events import definitions_of, read_timer, trigger_of
 from opspec.xpdl.bpmn.extensions import (
     assignments,
@@ -593,6 +593,8 @@ class _Process:
         cardinality = first(multi, "loopCardinality")
         text = expression_text(cardinality)
         collection = text_of(first(multi, "loopDataInputRef"))
+        if text is None and collection is None and self.over_vendor_collection(element, multi):
+            return None         # refused at its line; the file does not run
         if text is None and collection is not None:
             text = f"len({collection})"
             self.defs.info(multi, "multi-instance-collection",
@@ -610,6 +612,41 @@ class _Process:
                     flow_condition=bpmn_condition(completion, completion_text, self.defs,
                                                   "completionCondition"),
                     cancel_remaining=completion_text is not None)
+
+    def over_vendor_collection(self, element: etree._Element, multi: etree._Element) -> bool:
+        """Refuses, at its line, a multi-instance over a vendor's collection (Camunda's
+        ``camunda:collection``/``elementVariable``, Zeebe's ``inputCollection``/
+        ``inputElement``); whether there was one.
+
+        Each instance must see its own item in the element variable. opspec's instances of an
+        activity share their process instance's one data scope (the engine has no variable
+        per activity instance), so parallel instances — a sub-process whose body waits, a
+        task with a duration — would read one another's item: running it would decide
+        differently from the diagram without saying so. And a list is no value a run is
+        given (run inputs are numbers, booleans and text)."""
+        zeebe = next((sub for sub in multi.iter() if isinstance(sub.tag, str)
+                      and local(sub) == "loopCharacteristics"
+                      and "zeebe" in (etree.QName(sub).namespace or "")), None)
+        items = multi.get(f"{{{CAMUNDA}}}collection")
+        variable = multi.get(f"{{{CAMUNDA}}}elementVariable")
+        vendor = "camunda:collection", "camunda:elementVariable"
+        if items is None and zeebe is not None:
+            items, variable = zeebe.get("inputCollection"), zeebe.get("inputElement")
+            vendor = "zeebe:inputCollection", "zeebe:inputElement"
+        if items is None:
+            return False
+        each = (f", each instance reading its item as {variable!r} ({vendor[1]})"
+                if variable else "")
+        self.ctx.error(multi, "multi-instance-without-count",
+                       f"{self.label(element)} runs one instance per item of the list "
+                       f"{items.strip()!r} ({vendor[0]}){each}: opspec does not run it, as "
+                       "its instances share one data scope per process instance (no variable "
+                       "per instance, so parallel instances would read one another's item) "
+                       "and a list is not a value a run is given",
+                       "give the number of items as <bpmn:loopCardinality> and the choice "
+                       "each item makes as branch probabilities (opspec:Probability on the "
+                       "flows it decides: docs/bpmn.md, Undecided gateways)")
+        return True
 
     def expression(self, element: etree._Element, text: str | None, what: str
                    ) -> Expression | None:

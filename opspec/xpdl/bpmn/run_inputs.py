@@ -4,8 +4,9 @@ A modeller's diagram is drawn for an application that sets process variables at 
 (Camunda's ``${score > 50}``, ``${skipParallel}``). Refusing such a file would refuse most
 real diagrams; inventing a value would run something the diagram does not say. opspec makes
 each such variable a **run input**: a package data field without a value (marked
-``opspec:RunInput``), which a run is given with ``--param NAME=VALUE`` (``params=`` in Python,
-``params`` in a scenario's ``given``). Until one is given, the gateways whose conditions read it are
+``opspec:RunInput``), which a run is given with ``--param NAME=VALUE``, a distribution
+(``--param NAME~DIST``) or a data file (``--params FILE``: :mod:`opspec.commands._params`),
+``params=`` in Python, ``params`` in a scenario's ``given``. Until one is given, the gateways whose conditions read it are
 decided at random by branch probabilities (:mod:`.branches`): said at the condition's line,
 never silent.
 """
@@ -101,9 +102,11 @@ def _say(defs: Defs, name: str, transition: Transition, process: WorkflowProcess
                      f"nothing in process {process.id!r} sets (the application would set it at "
                      f"run time): it is a run input; until a run is given a value, the choice "
                      f"it decides is drawn at random (the shares are said at the gateway)",
-                     f"give it with --param {name}=VALUE (run, evaluate), params={{'{name}': "
-                     "...} from Python or given = { params = {...} } in a scenario; or "
-                     "declare it (docs/bpmn.md, Run inputs)")
+                     f"give it with --param {name}=VALUE, a distribution (--param "
+                     f"'{name}~uniform(0, 100)'), or a data file (--params FILE.csv: one row "
+                     f"per simulated user) to run and evaluate; params={{'{name}': ...}} from "
+                     "Python or given = { params = {...} } in a scenario; or declare it "
+                     "(docs/bpmn.md, Run inputs)")
 
 
 def _with_fallbacks(process: WorkflowProcess, reading: dict[str, list[str]], defs: Defs
