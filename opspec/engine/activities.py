@@ -11,7 +11,7 @@ event, coordination), then :meth:`Activities.body_done` (loop again or complete)
 
 from __future__ import annotations
 
-from collections import ChainMap, deque
+from collections import deque
 from collections.abc import Mapping
 from typing import Any
 
@@ -25,13 +25,10 @@ from opspec.engine.compiled import (
     K_MANUAL,
     K_SUBFLOW,
     K_TASK,
-    MI_ALL,
-    MI_CANCEL,
-    MI_NONE,
-    MI_ONE,
     CompiledActivity,
     CompiledProcess,
 )
+from opspec.engine import multi_instance
 from opspec.engine.instances import ActivityInstance, Frame, MultiInstance, ProcessInstance
 from opspec.engine.lifecycle import (
     ABORTED,
@@ -129,17 +126,17 @@ class Activities(Part):
             ai.waiting = f"start trigger {act.start_trigger.kind}:{act.start_trigger.name}"
             self.triggers.wait_trigger(ai, act.start_trigger, self._activate_cb, None)
             return
-        self._activate(ai)
+        self.activate(ai)
 
     def _activate_cb(self, ai: ActivityInstance, _arg: Any, _data: Any = None) -> None:
-        self.state.ready.append((self._activate, ai, None, None))
+        self.state.ready.append((self.activate, ai, None, None))
 
-    def _activate(self, ai: ActivityInstance, _a: Any = None, _b: Any = None) -> None:
+    def activate(self, ai: ActivityInstance, _a: Any = None, _b: Any = None) -> None:
         if ai.state != RUNNING:
             return
         act = ai.act
         inst = ai.frame.inst
-        if act.mi is not None and ai.mi is None and not self._mi_begin(ai):
+        if act.mi is not None and ai.mi is None and not multi_instance.begin(self, ai):
             return
         self.state.emit_act(EK.ACTIVITY_STARTED, inst, act)
         if act.start_assign and not self.flow.assign(inst, act, act.start_assign):
@@ -167,124 +164,10 @@ class Activities(Part):
             return
         self._run_body(ai)
 
-    def _mi_begin(self, ai: ActivityInstance) -> bool:
-        """Start the instances of multi-instance activity ``ai.act``; ``ai`` becomes the
-        first. Each instance holds a token of the frame; the flow condition decides which
-        of them move on (see :meth:`_mi_done`). Returns whether ``ai`` runs now."""
-        act = ai.act
-        frame = ai.frame
-        inst = frame.inst
-        count_fn, parallel, _flow, _cond = act.mi  # type: ignore[misc]
-        try:
-            raw = count_fn(inst.scope, self.state.env.now)
-        except OpspecError as error:
-            self.flow.abort(inst, act, f"the MI_Condition failed: {error.message}")
-            return False
-        count = raw if isinstance(raw, int) and not isinstance(raw, bool) else (
-            int(raw) if isinstance(raw, float) and raw.is_integer() else -1)
-        if count < 0:
-            self.flow.abort(inst, act, f"the MI_Condition gave {raw!r}, not a number of instances "
-                       "(an integer >= 0)")
-            return False
-        if count == 0:                      # no instance: the activity is done at once
-            self.state.emit_act(EK.ACTIVITY_STARTED, inst, act)
-            ai.state = COMPLETED
-            ai.gen += 1
-            frame.running.pop(ai.key, None)
-            self.flow.finish(frame, act)
-            return False
-        group = MultiInstance(count)
-        if act.deadlines or act.boundary:
-            holder = ActivityInstance(next(self.state.keys), act, frame, self.state.env.now)
-            holder.state = RUNNING
-            holder.mi = group
-            group.holder = holder
-        frame.live += count - 1
-        self._mi_join(ai, group)
-        if parallel:
-            for _ in range(count - 1):
-                self._mi_next(frame, act, group)
-        return True
-
-    def _mi_join(self, ai: ActivityInstance, group: MultiInstance) -> None:
-        ai.mi = group
-        ai.iteration = group.started            # the instance's loopCounter
-        group.started += 1
-        group.members.append(ai)
-
-    def _mi_next(self, frame: Frame, act: CompiledActivity, group: MultiInstance) -> None:
-        ai = ActivityInstance(next(self.state.keys), act, frame, self.state.env.now)
-        ai.state = RUNNING
-        frame.running[ai.key] = ai
-        self._mi_join(ai, group)
-        self.state.ready.append((self._activate, ai, None, None))
-
-    def _mi_done(self, ai: ActivityInstance, group: MultiInstance) -> None:
-        """One instance completed: its token moves on or is consumed, per MI_FlowCondition."""
-        act = ai.act
-        frame = ai.frame
-        inst = frame.inst
-        group.completed += 1
-        group.members.remove(ai)
-        if group.completed == group.count and group.holder is not None:
-            self.mi_release(group)
-        _count, parallel, flow, cond = act.mi  # type: ignore[misc]
-        if flow == MI_NONE:
-            moves = True
-        elif flow == MI_ONE:
-            moves = not group.passed
-        elif flow == MI_ALL:
-            moves = group.completed == group.count
-        else:
-            moves = False
-            if not group.passed and cond is not None:
-                counters = {"nrOfInstances": group.count,
-                            "nrOfCompletedInstances": group.completed,
-                            "nrOfActiveInstances": len(group.members)}
-                try:
-                    moves = bool(cond(ChainMap(counters, inst.scope), self.state.env.now))
-                except OpspecError as error:
-                    self.flow.abort(inst, act, f"the ComplexMI_FlowCondition failed: "
-                               f"{error.message}")
-                    return
-        if moves and flow == MI_CANCEL:
-            # BPMN 2.0 §13.3.7: the completionCondition "cancels the remaining Activity
-            # instances and produces a token"
-            self.mi_cancel(group, frame, "the completionCondition holds")
-            group.passed = True
-            self.flow.finish(frame, act)
-            return
-        if not parallel and group.started < group.count and inst.state == RUNNING:
-            self._mi_next(frame, act, group)
-        if moves:
-            group.passed = True
-            self.flow.finish(frame, act)
-            return
-        if act.end_assign and not self.flow.assign(inst, act, act.end_assign):
-            return
-        self.state.emit_act(EK.ACTIVITY_COMPLETED, inst, act, {"instance": ai.iteration})
-        self.flow.token_gone(frame)
-
     def mi_cancel(self, group: MultiInstance, frame: Frame, reason: str) -> None:
-        """An interrupting event ends every instance of the group (the interrupted one
-        included); their tokens, and those of instances not started yet, are consumed."""
-        for member in list(group.members):
-            self.stop(member, TERMINATED, reason)
-        frame.live -= len(group.members) + (group.count - group.started)
-        group.members.clear()
-        group.started = group.count
-        if group.holder is not None:
-            self.mi_release(group)
-
-    def mi_release(self, group: MultiInstance) -> None:
-        """The multi-instance activity is over: its deadlines and boundary events end."""
-        holder = group.holder
-        if holder is not None and holder.state == RUNNING:
-            holder.state = COMPLETED
-            holder.gen += 1
-            for undo in holder.cleanup:
-                undo()
-            holder.cleanup.clear()
+        """An interrupting event ends every instance of a multi-instance group
+        (:func:`opspec.engine.multi_instance.cancel`)."""
+        multi_instance.cancel(self, group, frame, reason)
 
     def _loop_again(self, ai: ActivityInstance) -> bool:
         cond, maximum, _before = ai.act.loop  # type: ignore[misc]
@@ -445,7 +328,7 @@ class Activities(Part):
                 undo()
             ai.cleanup.clear()
         if ai.mi is not None:
-            self._mi_done(ai, ai.mi)
+            multi_instance.done(self, ai, ai.mi)
             return
         self.flow.finish(frame, ai.act)
 
@@ -564,7 +447,7 @@ class Activities(Part):
         group = ai.mi
         if (group is not None and group.holder is not None and ai is not group.holder
                 and not any(m.state == RUNNING for m in group.members)):
-            self.mi_release(group)
+            multi_instance.release(group)
         item = ai.item
         if item is not None:
             ai.item = None

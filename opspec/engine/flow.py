@@ -24,6 +24,7 @@ from opspec.engine.compiled import (
     CompiledProcess,
     CTransition,
 )
+from opspec.engine import joins
 from opspec.engine.instances import ActivityInstance, Frame, ProcessInstance
 from opspec.engine.lifecycle import (
     ABORTED,
@@ -99,7 +100,7 @@ class Flow(Part):
                 self.state.emit(EK.DEADLINE_EXPIRED, proc.id, inst.id, None, proc.lane, None,
                           {"deadline": proc.deadline, "scope": "process"})
 
-    def _frame_done(self, frame: Frame) -> None:
+    def frame_done(self, frame: Frame) -> None:
         inst = frame.inst
         owner = frame.owner
         if owner is not None:                       # an activity set finished
@@ -218,7 +219,7 @@ class Flow(Part):
             elif join == J_COMPLEX:
                 frame.parked += 1
                 frame.live -= 1
-                if self._complex_arrival(frame, act, act.in_slots[trans.index]):
+                if joins.complex_arrival(self, frame, act, act.in_slots[trans.index]):
                     frame.live += 1
                     self.activities.start(frame, act)
                 elif frame.live <= 0:
@@ -235,62 +236,13 @@ class Flow(Part):
                 return
         self.activities.start(frame, act)
 
-    def _complex_arrival(self, frame: Frame, act: CompiledActivity, slot: int) -> bool:
-        """A token (already counted as parked) reaches complex join ``act`` on ``slot``;
-        whether the join fires now (BPMN 2.0 §13.4.4: fire when the activation condition
-        holds, consuming a token of each incoming transition that has one; then ignore one
-        token on each of the others before firing again)."""
-        index = act.index
-        if frame.cjoins is None:
-            frame.cjoins = {}
-            frame.owed = {}
-        assert frame.owed is not None
-        counts = frame.cjoins.get(index)
-        if counts is None:
-            counts = frame.cjoins[index] = [0] * len(act.in_slots)
-        owed = frame.owed.get(index)
-        if owed is not None and slot in owed:       # waiting for reset: this one is ignored
-            owed.discard(slot)
-            frame.parked -= 1
-            if owed:
-                return False
-            del frame.owed[index]
-            return self._complex_fires(frame, act, counts) if any(counts) else False
-        counts[slot] += 1
-        if owed is not None:
-            return False
-        return self._complex_fires(frame, act, counts)
-
-    def _complex_fires(self, frame: Frame, act: CompiledActivity, counts: list[int]) -> bool:
-        inst = frame.inst
-        active = sum(1 for c in counts if c)
-        condition = act.join_condition
-        assert condition is not None
-        try:
-            holds = condition(ChainMap({"activationCount": active}, inst.scope), self.state.env.now)
-        except OpspecError as error:
-            self.abort(inst, act, f"the IncomingCondition failed: {error.message}")
-            return False
-        if not holds:
-            return False
-        owed = set()
-        for slot, count in enumerate(counts):
-            if count:
-                counts[slot] -= 1
-                frame.parked -= 1
-            else:
-                owed.add(slot)
-        if owed and frame.owed is not None:
-            frame.owed[act.index] = owed
-        return True
-
     def token_gone(self, frame: Frame) -> None:
         frame.live -= 1
         if frame.graph.completion is not None and self._ad_hoc_complete(frame):
             return
         if frame.live <= 0 or frame.ors:
             if frame.live <= 0 and not frame.parked:
-                self._frame_done(frame)
+                self.frame_done(frame)
             else:
                 self.state.pending[frame] = None
 
@@ -360,76 +312,13 @@ class Flow(Part):
             self.activities.stop(ai, TERMINATED, "the ad-hoc set's completion condition holds")
         frame.live = 0
         frame.parked = 0
-        self._frame_done(frame)
+        self.frame_done(frame)
         return True
 
     def resolve_frames(self) -> None:
         """OR joins that nothing can reach any more fire; a frame with only parked tokens
-        left is deadlocked (an AND join that cannot fire)."""
-        frames = list(self.state.pending)
-        self.state.pending.clear()
-        for frame in frames:
-            if frame.inst.state != RUNNING:
-                continue
-            fired = False
-            for join, tokens in list(frame.ors.items()):
-                if self._or_ready(frame, join, tokens):
-                    # one activation consumes one token of each incoming transition that
-                    # has one (BPMN 2.0 Table 13.3); tokens left over wait for the next
-                    for slot, count in enumerate(tokens):
-                        if count:
-                            tokens[slot] = count - 1
-                            frame.parked -= 1
-                    if not any(tokens):
-                        del frame.ors[join]
-                    else:
-                        self.state.pending[frame] = None
-                    frame.live += 1
-                    fired = True
-                    self.state.ready.append((self.start_at, frame, join, None))
-            if frame.owed and frame.live <= 0 and not fired:     # (only complex joins)
-                # nothing can deliver the tokens a fired complex join waits for: it resets,
-                # and the tokens that came meanwhile may fire it again at once
-                frame.owed.clear()
-                acts = frame.graph.activities
-                for join, counts in list((frame.cjoins or {}).items()):
-                    if any(counts) and self._complex_fires(frame, acts[join], counts):
-                        frame.live += 1
-                        fired = True
-                        self.state.ready.append((self.start_at, frame, join, None))
-            if not fired and frame.live <= 0:
-                if frame.parked:
-                    waiting = [frame.graph.activities[i].id
-                               for i, c in (list(frame.joins.items()) + list(frame.ors.items())
-                                            + list((frame.cjoins or {}).items()))
-                               if (c if isinstance(c, int) else any(c))]
-                    self.report_deadlock(frame.inst, waiting, "a join waits for branches "
-                                         "that can no longer arrive")
-                else:
-                    self._frame_done(frame)
-
-    def _or_ready(self, frame: Frame, join: int, tokens: list[int]) -> bool:
-        """Whether OR join ``join`` is activated (BPMN 2.0 Table 13.3): some incoming
-        transition has a token, and every token elsewhere in the frame that can reach an
-        incoming transition without one (not passing through the join) can also reach one
-        that has a token."""
-        if not any(tokens):
-            return False
-        reach = frame.graph.activities[join].or_reach
-        for ai in frame.running.values():
-            if _or_blocks(reach, tokens, ai.act.index):
-                return False
-        for other, waiting in frame.ors.items():
-            if other != join and any(waiting) and _or_blocks(reach, tokens, other):
-                return False
-        for other, counts in frame.joins.items():
-            if any(counts) and _or_blocks(reach, tokens, other):
-                return False
-        if frame.cjoins:
-            for other, counts in frame.cjoins.items():
-                if any(counts) and _or_blocks(reach, tokens, other):
-                    return False
-        return True
+        left is deadlocked (:func:`opspec.engine.joins.resolve_frames`)."""
+        joins.resolve_frames(self)
 
     def report_deadlock(self, inst: ProcessInstance, waiting: list[str], why: str) -> None:
         """Record a deadlock of ``inst`` (trace + summary) and abort it."""
@@ -692,18 +581,6 @@ class Flow(Part):
         self.take(frame, trans)
         if not beside:
             self.token_gone(frame)
-
-
-def _or_blocks(reach: tuple[frozenset[int], ...], tokens: list[int], node: int) -> bool:
-    """A token at ``node`` holds an OR join back when it can reach an incoming transition
-    that has no token and none that has one."""
-    blocked = False
-    for slot, nodes in enumerate(reach):
-        if node in nodes:
-            if tokens[slot]:
-                return False
-            blocked = True
-    return blocked
 
 
 def _catches(act: CompiledActivity, code: str) -> bool:

@@ -1,4 +1,4 @@
-"""Wall-clock mode: step a plain SimPy environment from an asyncio loop.
+"""Wall-clock mode: step the engine's clock from an asyncio loop.
 
 ``simpy.rt.RealtimeEnvironment`` sleeps until its next event, so input arriving meanwhile (a
 key press, a serial line) waits for the sleep to end (1.3 s late in issue 3's measurement).
@@ -93,44 +93,72 @@ def run_realtime(sim: Simulation, until: float | None, speed: float) -> dict[str
     return asyncio.run(drive(sim, until, speed))
 
 
-async def drive(sim: Simulation, until: float | None, speed: float) -> dict[str, Any]:
-    """The asyncio stepping loop (usable inside an existing loop, e.g. the TUI's)."""
-    global _ACTIVE
-    loop = asyncio.get_running_loop()
-    posted = threading.Event()        # set on the posting thread: callbacks wait to be drained
-    posted.set()                      # whatever came before the loop took over
-    arrivals: deque[float] = deque()  # wall time of each post not drained yet (posting thread)
-    waiter: list[asyncio.Future[None] | None] = [None]
+class _Posts:
+    """Input posted from other threads (:meth:`Simulation.post`), and sleeping in the loop
+    until some arrives or a time passes, whichever comes first."""
 
-    def resolve() -> None:
-        future = waiter[0]
+    def __init__(self, loop: asyncio.AbstractEventLoop) -> None:
+        self.loop = loop
+        self.posted = threading.Event()   # set on the posting thread: callbacks to drain
+        self.posted.set()                 # whatever came before the loop took over
+        self.arrivals: deque[float] = deque()   # wall time of each post not drained yet
+        self.waiter: asyncio.Future[None] | None = None
+
+    def resolve(self) -> None:
+        future = self.waiter
         if future is not None and not future.done():
             future.set_result(None)
 
-    def wake() -> None:               # on the posting thread
-        arrivals.append(_perf())
-        posted.set()
-        loop.call_soon_threadsafe(resolve)
+    def wake(self) -> None:               # on the posting thread
+        self.arrivals.append(_perf())
+        self.posted.set()
+        self.loop.call_soon_threadsafe(self.resolve)
 
-    async def sleep(seconds: float | None) -> None:
+    async def sleep(self, seconds: float | None) -> None:
         """Sleep ``seconds`` (``None``: until a post), or less if something is posted."""
-        future: asyncio.Future[None] = loop.create_future()
-        waiter[0] = future
-        if posted.is_set():           # a post between the check and now: don't sleep
+        future: asyncio.Future[None] = self.loop.create_future()
+        self.waiter = future
+        if self.posted.is_set():          # a post between the check and now: don't sleep
             future.set_result(None)
-        handle = None if seconds is None else loop.call_later(seconds, resolve)
+        handle = None if seconds is None else self.loop.call_later(seconds, self.resolve)
         try:
             await future
         finally:
-            waiter[0] = None
+            self.waiter = None
             if handle is not None:
                 handle.cancel()
 
+
+def _drain_posts(sim: Simulation, posts: _Posts, clock: WallClock,
+                 until: float | None) -> bool:
+    """Posted callbacks run at the simulated time of the first one's arrival (never
+    backwards, never beyond ``until``), after the events due before it: whether they ran
+    (``False``: an event is due before the post arrived; step it first, it is overdue)."""
+    env = sim.env
+    arrivals = posts.arrivals
+    target = clock.sim_at(arrivals[0] if arrivals else _perf())
+    if until is not None:
+        target = min(target, until)
+    if env.peek() <= target:
+        return False
+    if target > env.now:
+        env.run(until=target)     # nothing is due before: only moves now
+    for _ in range(len(arrivals)):
+        arrivals.popleft()
+    sim.drain_posts()
+    return True
+
+
+async def drive(sim: Simulation, until: float | None, speed: float) -> dict[str, Any]:
+    """The asyncio stepping loop (usable inside an existing loop, e.g. the TUI's)."""
+    global _ACTIVE
+    posts = _Posts(asyncio.get_running_loop())
+    posted = posts.posted
     coarse, spin = COARSE_S, SPIN_S    # read once (benchmarks/realtime_drift.py sets 0, 0)
     env = sim.env
     clock = WallClock(env.now, _perf(), speed)
     previous, _ACTIVE = _ACTIVE, clock
-    sim.wake = wake
+    sim.wake = posts.wake
     lateness = array("d")              # one double per event, for the percentiles
     late_max = 0.0
     pending = False                    # posted callbacks wait for the events due before them
@@ -140,34 +168,21 @@ async def drive(sim: Simulation, until: float | None, speed: float) -> dict[str,
             if posted.is_set():
                 posted.clear()
                 pending = True
-            if pending:
-                # posted callbacks run at the simulated time of the first one's arrival
-                # (never backwards, never beyond until), after the events due before it
-                target = clock.sim_at(arrivals[0] if arrivals else _perf())
-                if until is not None:
-                    target = min(target, until)
-                if env.peek() > target:
-                    if target > env.now:
-                        env.run(until=target)     # nothing is due before: only moves now
-                    for _ in range(len(arrivals)):
-                        arrivals.popleft()
-                    pending = False
-                    sim.drain_posts()
-                    continue
-                # else: an event is due before the post arrived: step it first (it is
-                # overdue, so none of the waiting below happens)
+            if pending and _drain_posts(sim, posts, clock, until):
+                pending = False
+                continue
             due = env.peek()
             if until is not None and due > until:
                 due = until
             if due == math.inf:
                 if not sim.live:
                     break
-                await sleep(None)
+                await posts.sleep(None)
                 continue
             wall_due = clock.wall_due(due)
             delay = wall_due - _perf()
             if delay > coarse:
-                await sleep(delay - coarse)
+                await posts.sleep(delay - coarse)
                 continue                          # re-check: input may have arrived
             if delay > spin and posted.wait(delay - spin):
                 continue                          # input arrived first: handle it now
