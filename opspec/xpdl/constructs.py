@@ -179,15 +179,21 @@ _BPMN: tuple[Construct, ...] = (
     _c("bpmn-sub-process", BPMN, "subProcess", None, R,
        "an embedded sub-process: its flow runs in the instance of its parent",
        "§10.2.5, §13.3.4"),
+    _c("bpmn-event-sub-process-runs", BPMN, "subProcess", "triggeredByEvent", R,
+       "an event sub-process with one timer or message start event starts each time its "
+       "trigger occurs while its parent is active; an interrupting one cancels the parent's "
+       "other work first, a non-interrupting one runs beside it (as a boundary event on the "
+       "parent's contents)", "§10.2.5, §13.5.4", when="true"),
     _c("bpmn-event-sub-process", BPMN, _SUBS, "triggeredByEvent", X,
-       "opspec does not run event sub-processes (it would ignore it and everything in it "
-       "while the rest runs)", "§10.2.5, §13.5.4", when="true",
-       reported_by=("unsupported-element",),
-       hint="model it as a boundary event on a sub-process, or as a workflow with a message "
-       "or signal start event"),
+       "opspec runs only event sub-processes with one timer or message start event, in a "
+       "level whose own start events are none start events; not this one (it would ignore it "
+       "and everything in it while the rest runs)", "§10.2.5, §13.5.4",
+       when="refused-event-sub-process", reported_by=("unsupported-element",),
+       hint="give it one timer or message start event, or model it as a boundary event on a "
+       "sub-process, or as a workflow with a message or signal start event"),
     _c("bpmn-event-sub-process-start", BPMN, "startEvent", "isInterrupting", X,
-       "only the start event of an event sub-process has it, and opspec does not run event "
-       "sub-processes", "§10.4.2, §13.5.4", when="in-event-sub-process"),
+       "only the start event of an event sub-process has it, and opspec does not run this "
+       "event sub-process", "§10.4.2, §13.5.4", when="in-refused-event-sub-process"),
     _c("bpmn-transaction", BPMN, "transaction", None, W,
        "runs as a plain sub-process: no compensation, no cancel", "§10.2.5, §13.3.4",
        reported_by=("transaction",)),
@@ -932,6 +938,8 @@ _WHEN_TEXT = {
     "join": "as a join (several incoming flows)",
     "inclusive-join": "an inclusive join",
     "in-event-sub-process": "in an event sub-process",
+    "refused-event-sub-process": "true, with a start event other than one timer or message",
+    "in-refused-event-sub-process": "in an event sub-process opspec does not run",
     "in-multi-instance": "of a multi-instance loop",
     "in-sub-process": "in an embedded sub-process",
     "in-end-event": "in an end event",

@@ -123,6 +123,11 @@ class _Clusters:
                         *process.participants]
         for participant in participants:
             self.labels["by:" + participant.id] = participant.label
+        # what waits for its performer, as the run does (an XPDL activity without an
+        # implementation performed by a person included)
+        self.manual = frozenset(
+            a.id for a in process.all_activities()
+            if (package.is_manual_work(a, process) if package is not None else a.is_manual))
 
     def key(self, activity: Activity) -> str | None:
         if activity.lane:
@@ -139,7 +144,7 @@ class _Clusters:
 
 def _level(out: list[str], aset: ActivitySet | None, activities: Iterable[Activity],
            transitions: Iterable[Transition], clusters: _Clusters, indent: str,
-           scope: str = "", attributes: Callable[[Activity], str] | None = None) -> None:
+           scope: str = "", attributes: Callable[[Activity, bool], str] | None = None) -> None:
     attributes = attributes or _attributes
     acts = tuple(activities)
     groups: dict[str, list[Activity]] = {}
@@ -156,10 +161,10 @@ def _level(out: list[str], aset: ActivitySet | None, activities: Iterable[Activi
         out.append(f"{indent}  label={quote(clusters.label(key))}; style=rounded; color=gray60;")
         for activity in members:
             out.append(f"{indent}  {_node(aset, activity.id, scope)} "
-                       f"[{attributes(activity)}];")
+                       f"[{attributes(activity, activity.id in clusters.manual)}];")
         out.append(f"{indent}}}")
     for activity in loose:
-        out.append(f"{indent}{_node(aset, activity.id, scope)} [{attributes(activity)}];")
+        out.append(f"{indent}{_node(aset, activity.id, scope)} [{attributes(activity, activity.id in clusters.manual)}];")
     graph = FlowGraph.of(acts, transitions)
     for transition in graph.transitions:
         attrs = _edge_attributes(transition)
@@ -172,7 +177,8 @@ def _level(out: list[str], aset: ActivitySet | None, activities: Iterable[Activi
                        "[style=dotted, arrowhead=none];")
 
 
-def _attributes(activity: Activity) -> str:
+def _attributes(activity: Activity, manual: bool | None = None) -> str:
+    """``manual``: whether it waits for its performer (default: what the activity says)."""
     body = activity.body
     label = _short(activity.label)
     attrs: list[str] = []
@@ -198,7 +204,7 @@ def _attributes(activity: Activity) -> str:
         attrs += ["shape=box", 'style="rounded"']
         if isinstance(body, Task) and body.applications:
             label = f"{label}\n[{body.applications[0].application}]"
-    if activity.is_manual:
+    if activity.is_manual if manual is None else manual:
         attrs = [a for a in attrs if not a.startswith("style=")]
         style = "rounded,filled,bold" if not isinstance(body, Event | Route) else "filled,bold"
         attrs += [f'style="{style}"', f'fillcolor="{MANUAL_FILL}"']

@@ -17,6 +17,7 @@ from dataclasses import dataclass
 from lxml import etree
 
 from opspec.errors import Diagnostic, Severity, SourceLocation
+from opspec.xpdl.bpmn.event_subprocesses import is_event_sub_process, runnable_event_sub_process
 from opspec.xpdl.constructs import (
     BPMN,
     NOT_RUN,
@@ -144,6 +145,18 @@ def _ancestors(element: etree._Element) -> Iterator[etree._Element]:
 def _in_event_sub_process(element: etree._Element, value: str | None, doc: _Doc) -> bool:
     return any(_local(a) in _BPMN_SUBS and (a.get("triggeredByEvent") or "").lower() == "true"
                for a in _ancestors(element))
+
+
+def _refused_event_sub_process(element: etree._Element, value: str | None, doc: _Doc
+                               ) -> bool:
+    return ((value or "").strip().lower() == "true"
+            and not runnable_event_sub_process(element))
+
+
+def _in_refused_event_sub_process(element: etree._Element, value: str | None, doc: _Doc
+                                  ) -> bool:
+    host = next((a for a in _ancestors(element) if is_event_sub_process(a)), None)
+    return host is not None and not runnable_event_sub_process(host)
 
 
 def _bpmn_join(element: etree._Element, value: str | None, doc: _Doc) -> bool:
@@ -351,6 +364,8 @@ CONDITIONS: dict[str, _Condition] = {
     "join": _bpmn_join,
     "inclusive-join": _xpdl_or_join,
     "in-event-sub-process": _in_event_sub_process,
+    "refused-event-sub-process": _refused_event_sub_process,
+    "in-refused-event-sub-process": _in_refused_event_sub_process,
     "in-multi-instance": _parent_is("multiInstanceLoopCharacteristics"),
     "in-sub-process": _terminate_in_sub_process,
     "in-end-event": _parent_is("endEvent", "EndEvent"),

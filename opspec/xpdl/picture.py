@@ -188,12 +188,12 @@ def _left(lines: list[str]) -> str:
     return "".join(quote(line)[1:-1] + "\\l" for line in lines).join('""')
 
 
-def _picture_attributes(activity: Activity) -> str:
+def _picture_attributes(activity: Activity, manual: bool | None = None) -> str:
     """As :mod:`opspec.xpdl.dot` draws an activity, but events are small circles labelled
     beside them (BPMN's look, and the picture stays compact) and deadlines are spelled out."""
     body = activity.body
     if not isinstance(body, Event):
-        return _attributes(activity).replace("\u23f1 ", "deadline ")
+        return _attributes(activity, manual).replace("\u23f1 ", "deadline ")
     label = _short(activity.label)
     kind = body.trigger.kind
     if kind is not TriggerKind.NONE:

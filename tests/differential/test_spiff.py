@@ -69,6 +69,17 @@ FLOW_NODES = frozenset({
     "boundaryEvent", "exclusiveGateway", "parallelGateway", "inclusiveGateway",
     "complexGateway", "eventBasedGateway"})
 CLASSES = ("disagree", "only_spiff", "only_opspec", "neither")
+#: What SpiffWorkflow's own tests of these files hand the engine, handed to both engines: the
+#: run inputs (names only a condition reads, which the file never sets; opspec would draw their
+#: gateways at random, SpiffWorkflow read them as null) and what SpiffWorkflow's payload
+#: expressions read (``payload``; opspec does not run them, so only SpiffWorkflow reads it).
+#: ``approved``: the approver's answer, which SpiffWorkflow's message carries into
+#: ``ApprovalResult`` (camunda:resultVariable, which opspec does not read).
+GIVEN: dict[str, dict[str, Any]] = {
+    "camunda/message_test.bpmn": {"ApprovalResult": "Yes", "approved": "Yes"},
+    "spiff/error_event_payload.bpmn": {"error": True, "payload": "ERROR!"},
+    "spiff/escalation_event_payload.bpmn": {"escalation": True, "payload": "ERROR!"},
+}
 
 
 @dataclass(frozen=True)
@@ -166,9 +177,16 @@ class _Livelock(Exception):
     pass
 
 
+def given(path: Path) -> dict[str, Any]:
+    """The values of :data:`GIVEN` for the file that opspec reads (its data fields)."""
+    values = GIVEN.get(path.relative_to(DATA).as_posix(), {})
+    return {name: value for name, value in values.items() if name in declared_data(path)}
+
+
 def opspec_facts(path: Path, delay: float = 0.0) -> Facts:
     """opspec's run of the file through its public API: validate, then ``opspec.run`` with the
-    performer for the user lane and every participant, for ``HORIZON``."""
+    performer for the user lane and every participant, and the values :data:`GIVEN` for it,
+    for ``HORIZON``."""
     package, report = validated(path)
     errors = [d for d in report.diagnostics if d.severity is Severity.ERROR]
     if errors or package is None:
@@ -201,7 +219,7 @@ def opspec_facts(path: Path, delay: float = 0.0) -> Facts:
     performers = {p.id: _Person(delay, people) for p in package.participants}
     try:
         opspec.run(path, user=User.person(_Person(delay, people)), performers=performers,
-                   until=HORIZON,
+                   until=HORIZON, params=given(path) or None,
                    listeners=[listen], keep_trace=False)
     except _Livelock as exc:
         return Facts(True, "hang", tuple(completed), str(exc))
@@ -258,7 +276,8 @@ def spiff() -> dict[tuple[str, str], Facts]:
     if made.returncode != 0:
         pytest.skip("the SpiffWorkflow venv could not be made (no PyPI?): "
                     + (made.stderr.strip().splitlines() or ["?"])[-1])
-    runs = [{"file": str(DATA / name), "data": declared_data(DATA / name), "delay": delay,
+    runs = [{"file": str(DATA / name), "data": {**declared_data(DATA / name),
+                                                 **GIVEN.get(name, {})}, "delay": delay,
              "parser": parser_of(name)} for delay in MODES.values() for name in FILES]
     done = subprocess.run([str(PYTHON), str(HERE / "spiff_driver.py")], input=json.dumps(runs),
                           capture_output=True, text=True, timeout=300, check=False,

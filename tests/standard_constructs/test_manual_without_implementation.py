@@ -4,6 +4,7 @@ to its performer, or waits for one, and is never an automatic zero-time step."""
 from __future__ import annotations
 
 from opspec.engine.builtin_performers import SimulatedDevice
+from opspec.xpdl.dot import package_to_dot
 from opspec.xpdl.loader import load_spec
 
 from .conftest import DATA, completed, kinds, run
@@ -52,3 +53,5 @@ def test_show_and_the_model_call_it_manual() -> None:
     (process,) = package.processes
     manual = {a.id for a in process.activities if package.is_manual_work(a, process)}
     assert manual == {"check"}
+    drawn = package_to_dot(package)
+    assert [line.split()[0] for line in drawn.splitlines() if "(manual)" in line] == ['"check"']

@@ -49,6 +49,7 @@ from opspec.model.expressions import Expression
 from opspec.model.process import ActivitySet, Condition, ConditionKind, Transition, WorkflowProcess
 from opspec.model.resources import Lane
 from opspec.model.sisarl import ActivityDirectives, ProcessDirectives
+from opspec.xpdl.bpmn.branches import decide_undecided
 from opspec.xpdl.bpmn.common import (
     BPMN,
     Defs,
@@ -62,6 +63,7 @@ from opspec.xpdl.bpmn.common import (
 )
 from opspec.xpdl.bpmn.branches import decide_undecided
 from opspec.xpdl.bpmn.data import CAMUNDA, activity_data, process_fields
+from opspec.xpdl.bpmn.event_subprocesses import hoist_event_sub_processes
 from opspec.xpdl.bpmn.events import definitions_of, read_timer, trigger_of
 from opspec.xpdl.bpmn.extensions import (
     assignments,
@@ -214,6 +216,7 @@ class _Process:
         nodes: list[etree._Element] = []
         flows: list[etree._Element] = []
         boundaries: list[etree._Element] = []
+        hoist_event_sub_processes(container)
         for sub in container:
             if not isinstance(sub.tag, str):
                 continue
@@ -226,8 +229,10 @@ class _Process:
             elif name in NODES or name in _SUB_PROCESSES:
                 if name in _SUB_PROCESSES and sub.get("triggeredByEvent") == "true":
                     self.ctx.warning(sub, "unsupported-element",
-                                     f"event sub-process {sub.get('id')!r}: opspec does not run "
-                                     "event sub-processes; it and everything in it are ignored",
+                                     f"event sub-process {sub.get('id')!r}: opspec runs only "
+                                     "those with one timer or message start event (in a level "
+                                     "without triggered start events); it and everything in it "
+                                     "are ignored",
                                      "model it as a boundary event on a sub-process, or as a "
                                      "workflow with a message or signal start event")
                     continue
