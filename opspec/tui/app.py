@@ -32,6 +32,7 @@ from textual.screen import ModalScreen
 from textual.theme import Theme
 from textual.widgets import Digits, Footer, Static
 
+from opspec.engine.lane_labels import lane_labels
 from opspec.tui.session import WalkSession, clock, time_of_day_shown
 from opspec.tui.sound import Cue
 
@@ -232,6 +233,8 @@ class WalkthroughApp(App[str | None]):
         #: the cue at every alarm (default: the terminal bell)
         self.cue = sound if sound is not None else Cue("bell")
         self.lane_filter = 0
+        #: the timeline's lane column: the spec's lane names, one width for all lines
+        self._lanes = lane_labels(session.compiled)
         self._was_calling = False
         self._summary_shown = False          # the end-of-run summary opens once
         self._views_ready = False            # set once mounted, cleared when quitting
@@ -516,18 +519,26 @@ class WalkthroughApp(App[str | None]):
         if self.lane_filter >= len(LANES):
             return Text()                                  # hidden (large)
         lane = LANES[self.lane_filter]
-        text = Text()
+        lanes = self._lanes
+        text = Text(no_wrap=True, overflow="ellipsis")
         text.append(f"showing: {lane} (l: change)\n",
                     style="" if self.high_contrast else "dim")
         # as many events as the box holds (it grows with the terminal)
         rows = max(3, self.query_one("#timeline", Static).content_size.height - 1)
         shown = 0
         for event in reversed(self.session.events):
-            # the person's (or the model's) actions belong to the user lane
-            shown_lane = ("user" if event.kind == "walkthrough.action"
-                          else "device" if event.kind in ("fault", "device.note")
-                          else event.lane or "")
-            if event.kind not in _TIMELINE_KINDS or (lane != "all" and shown_lane != lane):
+            if event.kind not in _TIMELINE_KINDS:
+                continue
+            # the person's (or the model's) actions belong to the user lane, faults and
+            # device notes to the device; the rest to the lane the spec puts them in, by
+            # its name (a BPMN lane "Resident" whose work is manual is the user lane)
+            if event.kind == "walkthrough.action":
+                users, label = True, "user"
+            elif event.kind in ("fault", "device.note"):
+                users, label = False, "device"
+            else:
+                users, label = lanes.is_user(event), lanes.label(event)
+            if lane != "all" and users != (lane == "user"):
                 continue
             what = f"{event.activity or event.process or ''} {event.kind.split('.')[-1]}"
             if event.kind == "trigger.raised":
@@ -539,7 +550,7 @@ class WalkthroughApp(App[str | None]):
             elif event.kind == "walkthrough.action":
                 data = event.data or {}
                 what = f"{'you' if data.get('by') == 'person' else 'model'}: {data.get('action')}"
-            text.append(f"{time_of_day_shown(event.time)}  {shown_lane:<6} {what}\n")
+            text.append(f"{time_of_day_shown(event.time)}  {label:<{lanes.width}} {what}\n")
             shown += 1
             if shown >= rows:
                 break
