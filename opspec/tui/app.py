@@ -485,8 +485,17 @@ class WalkthroughApp(App[str | None]):
         session = self.session
         text = Text(no_wrap=True, overflow="ellipsis")
         rows = session.board.rows()
-        if self.large:                     # little room: what calls for attention first
+        deadlines = Text()
+        for (instance, activity), due in sorted(session.deadlines.items(),
+                                                key=lambda kv: kv[1])[:3]:
+            left = max(0.0, due - session.now)
+            deadlines.append(f"deadline {activity} (#{instance}) in {int(left // 60):02d}:"
+                             f"{int(left % 60):02d}\n", style="bold")
+        if self.large:
+            # little room (a big font, 80 x 24 leaves the panel four lines): what is running
+            # out first, the countdowns, then what calls for attention, then the rest
             rows.sort(key=lambda row: not row.alert)
+            text.append_text(deadlines)
         for row in rows:
             marker = "(x)" if row.status.startswith("FAULT") else "(!)" if row.alert else " * "
             line = Text(no_wrap=True, overflow="ellipsis")
@@ -503,11 +512,8 @@ class WalkthroughApp(App[str | None]):
                 text.append(f"  {process}#{instance} at {activity}\n")
             if len(running) > 4:
                 text.append(f"  (+{len(running) - 4} more)\n")
-        for (instance, activity), due in sorted(session.deadlines.items(),
-                                                key=lambda kv: kv[1])[:3]:
-            left = max(0.0, due - session.now)
-            text.append(f"deadline {activity} (#{instance}) in {int(left // 60):02d}:"
-                        f"{int(left % 60):02d}\n", style="bold")
+        if not self.large:
+            text.append_text(deadlines)
         for note in self.notes:
             if note not in session.board.notes_seen:   # traced notes are on the participants
                 text.append(f"note: {note}\n")
