@@ -131,7 +131,8 @@ def run(args: argparse.Namespace) -> int:
     config = _config(args)
     out = sys.stdout
     printer = None if args.json or args.timeline == "none" else _Timeline(
-        out, brief=args.timeline == "brief", quiet=quiet_activities(compiled))
+        out, brief=args.timeline == "brief", quiet=quiet_activities(compiled),
+        lanes=_lane_labels(compiled))
     listeners: list[Any] = []
     with contextlib.ExitStack() as stack:
         devices = _devices(args, stack, compiled)  # a port that won't open stops us here
@@ -347,11 +348,18 @@ def _open_sink(factory: Any, path: str, header: dict[str, Any]) -> Iterator[Any]
 # ---------------------------------------------------------------------------- output
 
 
-def timeline_line(event: TraceEvent) -> str:
-    """One readable line: :func:`opspec.engine.trace_text.timeline_line`."""
+def timeline_line(event: TraceEvent, lanes: Any = None) -> str:
+    """One readable line: :func:`opspec.engine.trace_text.timeline_line` (``lanes``: the
+    spec's :func:`opspec.engine.lane_labels.lane_labels`, for its lane names and widths)."""
     from opspec.engine.trace_text import timeline_line as line
 
-    return line(event)
+    return line(event) if lanes is None else line(event, lanes)
+
+
+def _lane_labels(compiled: Any) -> Any:
+    from opspec.engine.lane_labels import lane_labels
+
+    return lane_labels(compiled)
 
 
 def quiet_activities(compiled: Any) -> frozenset[tuple[str, str]]:
@@ -367,8 +375,10 @@ def quiet_activities(compiled: Any) -> frozenset[tuple[str, str]]:
 class _Timeline:
     """A trace listener printing the timeline as the run goes (nothing is held back)."""
 
-    def __init__(self, out: Any, *, brief: bool, quiet: frozenset[tuple[str, str]]) -> None:
+    def __init__(self, out: Any, *, brief: bool, quiet: frozenset[tuple[str, str]],
+                 lanes: Any = None) -> None:
         self.out = out
+        self.lanes = lanes
         self.selects = None
         self.brief = brief
         self.quiet = quiet
@@ -378,7 +388,7 @@ class _Timeline:
         if self.brief and not self._worth_showing(event):
             return
         self.shown += 1
-        print(timeline_line(event), file=self.out)
+        print(timeline_line(event, self.lanes), file=self.out)
 
     def _worth_showing(self, event: TraceEvent) -> bool:
         if event.kind not in BRIEF_KINDS:

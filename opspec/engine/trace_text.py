@@ -13,8 +13,10 @@ from __future__ import annotations
 from typing import TYPE_CHECKING
 
 from opspec.clock import clock_time
+from opspec.engine.lane_labels import PLAIN
 
 if TYPE_CHECKING:
+    from opspec.engine.lane_labels import LaneLabels
     from opspec.engine.trace import TraceEvent
 
 __all__ = ["listing_line", "timeline_line", "what_happened"]
@@ -55,12 +57,12 @@ def what_happened(event: TraceEvent) -> str:
     return what
 
 
-def timeline_line(event: TraceEvent) -> str:
-    """One readable line: time, lane, process#instance, what happened, key details."""
-    where = f"{event.process or ''}#{event.instance}" if event.instance is not None else (
-        event.process or "")
-    lane = event.lane or ("" if event.process is None else "device")
-    return f"{clock_time(event.time):>16}  {lane:<7} {where:<24} {what_happened(event)}"
+def timeline_line(event: TraceEvent, lanes: LaneLabels = PLAIN) -> str:
+    """One readable line: time, lane, process#instance, what happened, key details. ``lanes``
+    (:func:`opspec.engine.lane_labels.lane_labels` of the spec) names the lanes as the spec
+    does and sizes the columns so that they line up with and without lanes."""
+    return (f"{clock_time(event.time):>16}  {lanes.label(event):<{lanes.width}} "
+            f"{lanes.where(event)} {what_happened(event)}")
 
 
 def listing_line(event: TraceEvent) -> str:

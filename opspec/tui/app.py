@@ -32,6 +32,7 @@ from textual.screen import ModalScreen
 from textual.theme import Theme
 from textual.widgets import Digits, Footer, Static
 
+from opspec.engine.lane_labels import lane_labels
 from opspec.tui.session import WalkSession, clock, time_of_day_shown
 from opspec.tui.sound import Cue
 
@@ -232,6 +233,8 @@ class WalkthroughApp(App[str | None]):
         #: the cue at every alarm (default: the terminal bell)
         self.cue = sound if sound is not None else Cue("bell")
         self.lane_filter = 0
+        #: the timeline's lane column: the spec's lane names, one width for all lines
+        self._lanes = lane_labels(session.compiled)
         self._was_calling = False
         self._summary_shown = False          # the end-of-run summary opens once
         self._views_ready = False            # set once mounted, cleared when quitting
@@ -482,8 +485,17 @@ class WalkthroughApp(App[str | None]):
         session = self.session
         text = Text(no_wrap=True, overflow="ellipsis")
         rows = session.board.rows()
-        if self.large:                     # little room: what calls for attention first
+        deadlines = Text()
+        for (instance, activity), due in sorted(session.deadlines.items(),
+                                                key=lambda kv: kv[1])[:3]:
+            left = max(0.0, due - session.now)
+            deadlines.append(f"deadline {activity} (#{instance}) in {int(left // 60):02d}:"
+                             f"{int(left % 60):02d}\n", style="bold")
+        if self.large:
+            # little room (a big font, 80 x 24 leaves the panel four lines): what is running
+            # out first, the countdowns, then what calls for attention, then the rest
             rows.sort(key=lambda row: not row.alert)
+            text.append_text(deadlines)
         for row in rows:
             marker = "(x)" if row.status.startswith("FAULT") else "(!)" if row.alert else " * "
             line = Text(no_wrap=True, overflow="ellipsis")
@@ -500,11 +512,8 @@ class WalkthroughApp(App[str | None]):
                 text.append(f"  {process}#{instance} at {activity}\n")
             if len(running) > 4:
                 text.append(f"  (+{len(running) - 4} more)\n")
-        for (instance, activity), due in sorted(session.deadlines.items(),
-                                                key=lambda kv: kv[1])[:3]:
-            left = max(0.0, due - session.now)
-            text.append(f"deadline {activity} (#{instance}) in {int(left // 60):02d}:"
-                        f"{int(left % 60):02d}\n", style="bold")
+        if not self.large:
+            text.append_text(deadlines)
         for note in self.notes:
             if note not in session.board.notes_seen:   # traced notes are on the participants
                 text.append(f"note: {note}\n")
@@ -516,18 +525,26 @@ class WalkthroughApp(App[str | None]):
         if self.lane_filter >= len(LANES):
             return Text()                                  # hidden (large)
         lane = LANES[self.lane_filter]
-        text = Text()
+        lanes = self._lanes
+        text = Text(no_wrap=True, overflow="ellipsis")
         text.append(f"showing: {lane} (l: change)\n",
                     style="" if self.high_contrast else "dim")
         # as many events as the box holds (it grows with the terminal)
         rows = max(3, self.query_one("#timeline", Static).content_size.height - 1)
         shown = 0
         for event in reversed(self.session.events):
-            # the person's (or the model's) actions belong to the user lane
-            shown_lane = ("user" if event.kind == "walkthrough.action"
-                          else "device" if event.kind in ("fault", "device.note")
-                          else event.lane or "")
-            if event.kind not in _TIMELINE_KINDS or (lane != "all" and shown_lane != lane):
+            if event.kind not in _TIMELINE_KINDS:
+                continue
+            # the person's (or the model's) actions belong to the user lane, faults and
+            # device notes to the device; the rest to the lane the spec puts them in, by
+            # its name (a BPMN lane "Resident" whose work is manual is the user lane)
+            if event.kind == "walkthrough.action":
+                users, label = True, "user"
+            elif event.kind in ("fault", "device.note"):
+                users, label = False, "device"
+            else:
+                users, label = lanes.is_user(event), lanes.label(event)
+            if lane != "all" and users != (lane == "user"):
                 continue
             what = f"{event.activity or event.process or ''} {event.kind.split('.')[-1]}"
             if event.kind == "trigger.raised":
@@ -539,7 +556,7 @@ class WalkthroughApp(App[str | None]):
             elif event.kind == "walkthrough.action":
                 data = event.data or {}
                 what = f"{'you' if data.get('by') == 'person' else 'model'}: {data.get('action')}"
-            text.append(f"{time_of_day_shown(event.time)}  {shown_lane:<6} {what}\n")
+            text.append(f"{time_of_day_shown(event.time)}  {label:<{lanes.width}} {what}\n")
             shown += 1
             if shown >= rows:
                 break

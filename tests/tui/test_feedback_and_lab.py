@@ -4,6 +4,8 @@ the sound cue."""
 
 from __future__ import annotations
 
+import html
+import re
 import wave
 
 import pytest
@@ -96,10 +98,34 @@ async def test_large_puts_the_person_first_with_a_big_clock_and_tall_buttons(com
         assert app.query_one("#bigclock").display and not app.query_one("#timeline").display
         button = app.query_one(".offer")
         assert button.region.height == 3                     # a bordered button
-        assert "(!) alarm: ((( RINGING )))" in str(device.render()).splitlines()[0]
+        first = str(device.render()).splitlines()[:2]     # the countdown, then the alarm
+        assert first[0].startswith("deadline wait_report") and "(!) alarm: ((( RINGING )))" in first[1]
         await pilot.press("l")                               # the coordinator's timeline
         await pilot.pause()
         assert app.query_one("#timeline").display
+
+
+@pytest.mark.asyncio
+async def test_large_at_80x24_keeps_the_deadline_countdown_in_sight(compiled):
+    """--large in the usual lab terminal: the device panel has four lines, and the countdown
+    to the device's deadline is among the lines shown (not cut off below the alarm)."""
+    session = WalkSession(compiled)
+    session.paused = True
+    app = WalkthroughApp(session, large=True)
+    async with app.run_test(size=(80, 24)) as pilot:
+        await pilot.press("u")                               # 08:00: the alarm, 5 min to go
+        await pilot.pause()
+        device = app.query_one("#device")
+        visible = str(device.render()).splitlines()[:device.content_size.height]
+        assert "deadline wait_report (#2) in 05:00" in visible
+        assert any("(!) alarm: ((( RINGING )))" in line for line in visible)
+        await pilot.press("w", "w", "w")                     # 90 s pass
+        await pilot.pause()
+        visible = str(device.render()).splitlines()[:device.content_size.height]
+        assert "deadline wait_report (#2) in 03:30" in visible
+        # and it is on the screen, not only in the widget
+        screen = html.unescape(re.sub(r"<[^>]+>", "", app.export_screenshot()))
+        assert "deadline wait_report (#2) in 03:30" in screen.replace("\xa0", " ")
 
 
 def _luminance(hex_colour: str) -> float:

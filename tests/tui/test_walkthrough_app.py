@@ -274,10 +274,10 @@ async def test_an_offer_is_done_by_clicking_it_and_the_timeline_filters_lanes(co
         await pilot.pause()
         assert session.offers[0].item.activity == "walk_to_dispenser"
         timeline = app.query_one("#timeline")
-        assert "user   you: complete hear_alarm" in str(timeline.render())
+        assert "user    you: complete hear_alarm" in str(timeline.render())
         await pilot.press("l")                          # device only
         shown = str(timeline.render())
-        assert "showing: device" in shown and "device trigger trg_2 raised" in shown
+        assert "showing: device" in shown and "device  trigger trg_2 raised" in shown
         assert " user " not in shown
         await pilot.press("l")                          # user only
         shown = str(timeline.render())
@@ -351,4 +351,4 @@ async def test_a_fault_in_the_timeline_is_in_the_device_lane(compiled):
         session.sim.session.trace("fault", {"fault": "disconnected",
                                             "device": "medication_dispenser"})
         await pilot.press("l")                         # device lane only
-        assert "device FAULT medication_dispenser" in str(app.query_one("#timeline").render())
+        assert "device  FAULT medication_dispenser" in str(app.query_one("#timeline").render())
