@@ -43,6 +43,16 @@ __all__ = ["PreparedRun", "RunRequest", "companion_user_model", "gate", "open_ga
            "prepare", "run", "scripted_user"]
 
 _EMPTY: Mapping[str, Any] = MappingProxyType({})
+
+
+def __getattr__(name: str) -> Any:
+    # the spec gate lives with the spec loader (opspec.runs.load), so no load skips it;
+    # named here too, loaded on first use (importing the front hall stays light)
+    if name in ("gate", "open_gated"):
+        import opspec.runs
+
+        return getattr(opspec.runs, name)
+    raise AttributeError(f"module 'opspec.request' has no attribute {name!r}")
 #: the parts of a request that prepare() decides from (the rest goes to runs.build as it is)
 _DECIDED = frozenset({"spec", "seed", "days", "until", "script", "user_model", "user",
                       "no_user"})
@@ -140,7 +150,7 @@ class PreparedRun:
                      listeners=[*request.listeners, *listeners], params=request.params,
                      keep_trace=request.keep_trace, keep_times=request.keep_times,
                      devices=devices if devices is not None else request.devices,
-                     monitors=request.monitors)
+                     monitors=request.monitors, warnings=self.warnings)
 
     def execute(self, user_index: int = 0) -> RunOutcome:
         """Build run ``user_index`` and run it to its length."""
@@ -159,81 +169,16 @@ def companion_user_model(spec_path: str | Path | None) -> Path | None:
     return candidate if candidate.is_file() else None
 
 
-#: packages through the gate (by identity, held so that an id is never reused): a spec
-#: fixture's package simulated by every test of a module is checked once
-_PASSED: dict[int, Any] = {}
-_PASSED_MAX = 64
-
-
-def _passed(package: Any) -> None:
-    if len(_PASSED) >= _PASSED_MAX:
-        _PASSED.pop(next(iter(_PASSED)))
-    _PASSED[id(package)] = package
-
-
-def gate(package: Package) -> None:
-    """Refuse an in-memory package with the structural errors ``opspec validate`` reports
-    (a :class:`~opspec.errors.SpecError` listing them with their places)."""
-    if _PASSED.get(id(package)) is package:
-        return
-    from opspec.errors import Severity, SpecError
-    from opspec.model.checks import check_package
-
-    errors = [d for d in check_package(package) if d.severity is Severity.ERROR]
-    if errors:
-        raise SpecError.from_diagnostics(errors)
-    _passed(package)
-
-
-def open_gated(path: str | Path) -> tuple[Package, tuple[Any, ...]]:
-    """The package in ``path`` and validate's warnings on it, refused with every error
-    ``opspec validate`` reports. ``.wfs`` scripts (compiled from specs that passed) and
-    paths that are not files open as :func:`opspec.xpdl.open_spec.open_spec` does (a file
-    that cannot be read at all is a ConfigurationError: exit status 2)."""
-    from opspec.files import not_a_file
-    from opspec.xpdl.open_spec import open_spec, refuse_unreadable
-
-    target = Path(path)
-    if target.suffix == ".wfs" or not_a_file(target) is not None:
-        package = open_spec(path)
-        _passed(package)
-        _not_too_deep(package)
-        return package, ()
-    from opspec.errors import Severity, SpecError
-    from opspec.xpdl.validate import validate_spec
-
-    valid, report = validate_spec(target)       # monitors and the world: checked as built
-    refuse_unreadable(report.diagnostics)       # an unreadable file: exit status 2, not 1
-    errors = [d for d in report.diagnostics if d.severity is Severity.ERROR]
-    if errors or valid is None:
-        raise SpecError.from_diagnostics(errors or report.diagnostics)
-    _passed(valid)
-    _not_too_deep(valid)
-    return valid, tuple(d for d in report.diagnostics if d.severity is Severity.WARNING)
-
-
-def _not_too_deep(package: Package) -> None:
-    """Blocks nested past :data:`~opspec.model.nesting.MAX_BLOCK_NESTING` are refused at
-    their line before anything follows them recursively (the compiler, the soundness check)."""
-    from opspec.model.nesting import nesting_problem
-
-    deep = nesting_problem(package)
-    if deep is not None:
-        raise deep
-
-
 def _spec(spec: Any) -> tuple[LoadedSpec, tuple[Any, ...], Path | None]:
-    from opspec.engine.compiled import CompiledPackage
+    """The spec through the gate (:func:`opspec.runs.load`), validate's warnings on it and
+    its file."""
     from opspec.runs import LoadedSpec, load
 
     if isinstance(spec, LoadedSpec):
-        return spec, (), _source(spec.package)
-    if isinstance(spec, (str, os.PathLike)):
-        package, warnings = open_gated(Path(spec))
-        return load(package), warnings, Path(spec)
-    gate(spec.package if isinstance(spec, CompiledPackage) else spec)
-    return load(spec), (), _source(spec.package if isinstance(spec, CompiledPackage)
-                                   else spec)
+        return spec, spec.warnings, _source(spec.package)
+    loaded = load(spec)
+    path = Path(spec) if isinstance(spec, (str, os.PathLike)) else _source(loaded.package)
+    return loaded, loaded.warnings, path
 
 
 def _source(package: Any) -> Path | None:

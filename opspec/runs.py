@@ -40,6 +40,7 @@ devices are installed on it); :meth:`Run.execute` runs it to its length and retu
 from __future__ import annotations
 
 import operator
+import os
 from collections.abc import Callable, Iterable, Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -66,7 +67,10 @@ __all__ = [
     "User",
     "build",
     "check_seed",
+    "gate",
     "load",
+    "open_gated",
+    "run_problem",
     "run_length",
 ]
 
@@ -79,32 +83,103 @@ __all__ = [
 
 @dataclass(frozen=True, eq=False)
 class LoadedSpec:
-    """A spec ready to run many times: compiled once, its mode loader and declared monitors
-    with it."""
+    """A spec through the gate and ready to run many times: compiled once, its mode loader,
+    its declared monitors and validate's warnings on it with it."""
 
     compiled: CompiledPackage
     mode_loader: Callable[[str], Package]
     monitors: tuple[Monitor, ...]
+    #: validate's warnings on the spec's file (``path:line: warning: …``)
+    warnings: tuple[Any, ...] = ()
 
     @property
     def package(self) -> Package:
         return self.compiled.package
 
 
+#: packages through the gate (by identity, held so that an id is never reused): a spec
+#: fixture's package simulated by every test of a module is checked once
+_PASSED: dict[int, Any] = {}
+_PASSED_MAX = 64
+
+
+def _passed(package: Any) -> None:
+    if len(_PASSED) >= _PASSED_MAX:
+        _PASSED.pop(next(iter(_PASSED)))
+    _PASSED[id(package)] = package
+
+
+def gate(package: Package) -> None:
+    """Refuse an in-memory package with the structural errors ``opspec validate`` reports
+    (a :class:`~opspec.errors.SpecError` listing them with their places)."""
+    if _PASSED.get(id(package)) is package:
+        return
+    from opspec.errors import Severity, SpecError
+    from opspec.model.checks import check_package
+
+    errors = [d for d in check_package(package) if d.severity is Severity.ERROR]
+    if errors:
+        raise SpecError.from_diagnostics(errors)
+    _passed(package)
+
+
+def open_gated(path: str | Path) -> tuple[Package, tuple[Any, ...]]:
+    """The package in ``path`` and validate's warnings on it, refused with every error
+    ``opspec validate`` reports. ``.wfs`` scripts (compiled from specs that passed) and
+    paths that are not files open as :func:`opspec.xpdl.open_spec.open_spec` does (a file
+    that cannot be read at all is a ConfigurationError: exit status 2)."""
+    from opspec.files import not_a_file
+    from opspec.xpdl.open_spec import open_spec, refuse_unreadable
+
+    target = Path(path)
+    if target.suffix == ".wfs" or not_a_file(target) is not None:
+        package = open_spec(path)
+        _passed(package)
+        _not_too_deep(package)
+        return package, ()
+    from opspec.errors import Severity, SpecError
+    from opspec.xpdl.validate import validate_spec
+
+    valid, report = validate_spec(target)       # monitors and the world: checked as built
+    refuse_unreadable(report.diagnostics)       # an unreadable file: exit status 2, not 1
+    errors = [d for d in report.diagnostics if d.severity is Severity.ERROR]
+    if errors or valid is None:
+        raise SpecError.from_diagnostics(errors or report.diagnostics)
+    _passed(valid)
+    _not_too_deep(valid)
+    return valid, tuple(d for d in report.diagnostics if d.severity is Severity.WARNING)
+
+
+def _not_too_deep(package: Package) -> None:
+    """Blocks nested past :data:`~opspec.model.nesting.MAX_BLOCK_NESTING` are refused at
+    their line before anything follows them recursively (the compiler, the soundness check)."""
+    from opspec.model.nesting import nesting_problem
+
+    deep = nesting_problem(package)
+    if deep is not None:
+        raise deep
+
+
 def load(spec: str | Path | Package | CompiledPackage | LoadedSpec) -> LoadedSpec:
-    """The spec ready to run. A path opens as :func:`opspec.xpdl.open_spec.open_spec` does
-    (XPDL or ``.wfs``; a :class:`~opspec.errors.SpecError` with ``path:line`` when broken);
-    the monitors it declares are read here (a located ConfigurationError when one is bad)."""
+    """The spec through the gate and ready to run: no run is built from a spec ``opspec
+    validate`` refuses, whoever asks. A path opens whatever its form (XPDL, BPMN, ``.wfs``:
+    :func:`open_gated`, refused with validate's errors, ``path:line``); a package or a
+    compiled package given in memory is refused with the errors of the same structural checks
+    (:func:`gate`). The monitors it declares are read here (a located ConfigurationError
+    when one is bad)."""
     if isinstance(spec, LoadedSpec):
         return spec
     from opspec.properties.monitors import declared_monitors
-    from opspec.xpdl.open_spec import mode_loader_for, open_spec
+    from opspec.xpdl.open_spec import mode_loader_for
 
-    if isinstance(spec, (str, Path)):
-        spec = open_spec(spec)
+    warnings: tuple[Any, ...] = ()
+    if isinstance(spec, (str, os.PathLike)):
+        spec, warnings = open_gated(Path(spec))
+    else:
+        gate(spec.package if isinstance(spec, CompiledPackage) else spec)
     compiled = spec if isinstance(spec, CompiledPackage) else compile_package(spec)
     return LoadedSpec(compiled, mode_loader_for(compiled.package),
-                      tuple(declared_monitors(compiled)))
+                      tuple(declared_monitors(compiled)), warnings)
 
 
 # ---------------------------------------------------------------------------- the user lane
@@ -176,7 +251,10 @@ class RunOutcome:
     ``result`` is the engine's :class:`~opspec.engine.simulation.RunResult` (``trace`` when
     kept, ``metrics``, ``summary``); ``monitors`` what each monitor saw; ``samples`` every
     observation of each duration metric, and (``keep_times``) the simulated time of each
-    observation (``sample_times``) and of each counted event (``count_times``).
+    observation (``sample_times``) and of each counted event (``count_times``); ``warnings``
+    what the front hall found doubtful in the request (validate's warnings on the spec, the
+    user model's against the spec's user lane: ``path:line: warning: …``), for the door to
+    show; ``problem`` the run-time fault or deadlock that cut the run short, if any.
     """
 
     result: RunResult
@@ -187,6 +265,14 @@ class RunOutcome:
     samples: Mapping[str, Sequence[float]] = field(default_factory=dict)
     sample_times: Mapping[str, Sequence[float]] = field(default_factory=dict)
     count_times: Mapping[str, Sequence[float]] = field(default_factory=dict)
+    warnings: tuple[Any, ...] = ()
+
+    @property
+    def problem(self) -> str | None:
+        """The run-time fault or deadlock of this run (``fault: file:line: …``, the first one
+        and how many more), or None: such a run's metrics are not the spec's
+        (:func:`run_problem`)."""
+        return run_problem(self.result.summary)
 
     @property
     def trace(self) -> tuple[TraceEvent, ...] | None:
@@ -227,8 +313,11 @@ class Run:
     (step it, or install devices on it), :meth:`execute` runs it to :attr:`horizon`."""
 
     def __init__(self, sim: Simulation, *, horizon: float, seed: int, user: int,
-                 watches: Sequence[MonitorRun], performer: Performer | None) -> None:
+                 watches: Sequence[MonitorRun], performer: Performer | None,
+                 warnings: tuple[Any, ...] = ()) -> None:
         self.sim = sim
+        #: what the front hall found doubtful in the request (RunOutcome.warnings)
+        self.warnings = warnings
         self.horizon = horizon
         self.seed = seed
         self.user = user
@@ -254,7 +343,8 @@ class Run:
             result, self.seed, self.user, self.horizon,
             tuple(w.result() for w in self.watches), samples,
             {k: tuple(v) for k, v in metrics.sample_times.items()} if keep and metrics else {},
-            {k: tuple(v) for k, v in metrics.count_times.items()} if keep and metrics else {})
+            {k: tuple(v) for k, v in metrics.count_times.items()} if keep and metrics else {},
+            self.warnings)
 
 
 def _world(compiled: CompiledPackage, seed: int, user: int) -> dict[str, Performer]:
@@ -276,7 +366,8 @@ def build(spec: str | Path | Package | CompiledPackage | LoadedSpec, *, seed: in
           performers: Mapping[str, Performer] | None = None,
           listeners: Iterable[TraceListener] = (), params: Mapping[str, Any] | None = None,
           keep_trace: bool = False, keep_times: bool = False, devices: Any = None,
-          monitors: Sequence[Monitor] | None = None) -> Run:
+          monitors: Sequence[Monitor] | None = None,
+          warnings: tuple[Any, ...] | None = None) -> Run:
     """Assemble run ``user_index`` of ``spec`` seeded ``seed`` (see the module docstring for
     the rules), not started.
 
@@ -284,7 +375,8 @@ def build(spec: str | Path | Package | CompiledPackage | LoadedSpec, *, seed: in
     ``devices`` (attached devices: their performers are bound and they are installed on the
     simulation), then ``performers`` (by participant or lane; the last word). ``monitors``
     replaces the spec's declared monitors when given (pass them along with extra ones).
-    ``listeners`` receive the trace after the user's and the monitors'.
+    ``listeners`` receive the trace after the user's and the monitors'. ``warnings`` (default:
+    validate's on the spec) go to the outcome.
     """
     loaded = load(spec)
     compiled = loaded.compiled
@@ -311,4 +403,24 @@ def build(spec: str | Path | Package | CompiledPackage | LoadedSpec, *, seed: in
     if devices is not None:
         devices.install(sim)
     return Run(sim, horizon=horizon, seed=seed, user=user_index, watches=watches,
-               performer=performer)
+               performer=performer,
+               warnings=loaded.warnings if warnings is None else tuple(warnings))
+
+
+# ---------------------------------------------------------------------------- a run's problem
+
+
+def run_problem(summary: Mapping[str, Any]) -> str | None:
+    """The problem of a run whose summary lists run-time faults or deadlocks: the first one's
+    located message (``fault: file:line: …``) and how many more, or None for a sound run.
+    Such a run was cut short, so its metrics are not the spec's: ``opspec evaluate`` fails the
+    replication, ``simulate()`` names it and judges no statistic over it."""
+    for kind, key in (("fault", "faults"), ("deadlock", "deadlocks")):
+        found: Sequence[Mapping[str, Any]] = summary.get(key) or []
+        if found:
+            more = len(found) - 1
+            text = f"{kind}: {found[0].get('message')}"
+            if more:
+                text += f" (and {more} more {kind}{'s' if more > 1 else ''} in this run)"
+            return text
+    return None

@@ -13,7 +13,7 @@ from typing import Any
 from opspec.errors import ConfigurationError
 
 __all__ = ["Named", "check_nesting", "input_problem", "overwrite_problem", "refuse_overwrite",
-           "same_file", "spec_inputs"]
+           "same_file", "spec_inputs", "translation_problem"]
 
 #: a file as the command line names it: (the option or argument, e.g. ``"--trace"``, path)
 Named = tuple[str, "str | os.PathLike[str] | None"]
@@ -25,6 +25,22 @@ def input_problem(path: Path) -> str | None:
     from opspec.files import not_a_file
 
     return not_a_file(path)
+
+
+def translation_problem(command: str, source: Path, target: Path | None, *,
+                        example: str) -> str | None:
+    """Why ``opspec COMMAND IN -o OUT`` (a translation: ``compile``, ``preprocess``) cannot
+    run: IN (``source``) cannot be read, or OUT (``target``; None: standard output) would
+    replace IN or IN's companion user model. None when it can."""
+    problem = input_problem(source)
+    if problem is not None:
+        return f"opspec {command}: cannot read {source}: {problem}"
+    from opspec.commands._spec import companion_user_model
+
+    return overwrite_problem(command, [("-o", target)],
+                             [("IN", source), ("IN's companion user model",
+                                               companion_user_model(source))],
+                             example=example)
 
 
 def same_file(source: Path, target: Path) -> bool:

@@ -30,26 +30,18 @@ def register(subparsers: Any) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    from opspec.commands._files import input_problem, overwrite_problem
+    from opspec.commands._files import translation_problem
     from opspec.commands.validate import engine_checks
     from opspec.errors import SpecError
     from opspec.xpdl.compile import compile_spec, default_output
     from opspec.xpdl.open_spec import IO_CODES
 
     source = Path(args.input)
-    problem = input_problem(source)
-    if problem is not None:
-        print(f"opspec compile: cannot read {source}: {problem}", file=sys.stderr)
-        return 2
     target = Path(args.output) if args.output else default_output(source)
-    from opspec.commands._spec import companion_user_model
-
-    overwrite = overwrite_problem("compile", [("-o", target)],
-                                  [("IN", source), ("IN's companion user model",
-                                                    companion_user_model(source))],
+    problem = translation_problem("compile", source, target,
                                   example=f"{source.with_suffix('.wfs').name} beside it")
-    if overwrite is not None:
-        print(overwrite, file=sys.stderr)
+    if problem is not None:
+        print(problem, file=sys.stderr)
         return 2
     try:
         result = compile_spec(source, target, strict=args.strict, extra=engine_checks)

@@ -45,7 +45,7 @@ def default_output(source: Path) -> Path:
 
 
 def run(args: argparse.Namespace) -> int:
-    from opspec.commands._files import input_problem, overwrite_problem
+    from opspec.commands._files import translation_problem
     from opspec.commands.validate import engine_checks
     from opspec.errors import Severity
     from opspec.model.codec import write_atomically
@@ -57,20 +57,12 @@ def run(args: argparse.Namespace) -> int:
     from opspec.xpdl.writer import write_xpdl
 
     source = Path(args.input)
-    problem = input_problem(source)
-    if problem is not None:
-        print(f"opspec preprocess: cannot read {source}: {problem}", file=sys.stderr)
-        return 2
     target = None if args.output == "-" else (
         Path(args.output) if args.output else default_output(source))
-    from opspec.commands._spec import companion_user_model
-
-    overwrite = overwrite_problem("preprocess", [("-o", target)],
-                                  [("IN", source), ("IN's companion user model",
-                                                    companion_user_model(source))],
+    problem = translation_problem("preprocess", source, target,
                                   example=default_output(source).name)
-    if overwrite is not None:
-        print(overwrite, file=sys.stderr)
+    if problem is not None:
+        print(problem, file=sys.stderr)
         return 2
     # The spec is refused for exactly the errors `opspec validate` reports.
     package, report = validate_spec(source, strict=args.strict, extra=engine_checks)

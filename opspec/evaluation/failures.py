@@ -13,28 +13,16 @@ written before kinds existed read the same way.
 
 from __future__ import annotations
 
-from collections.abc import Mapping, Sequence
-from typing import Any
+from collections.abc import Sequence
+
+# what makes a run's metrics not the spec's is decided once, for every door
+from opspec.runs import run_problem
 
 __all__ = ["DEADLOCK", "ERROR", "FAULT", "advice", "kind_of", "run_problem"]
 
 FAULT = "fault"
 DEADLOCK = "deadlock"
 ERROR = "error"
-
-
-def run_problem(summary: Mapping[str, Any]) -> str | None:
-    """The error of a run whose summary lists run-time faults or deadlocks (the first one's
-    located message, ``file:line: …``, and how many more), or None for a sound run."""
-    for kind, key in ((FAULT, "faults"), (DEADLOCK, "deadlocks")):
-        found: Sequence[Mapping[str, Any]] = summary.get(key) or []
-        if found:
-            more = len(found) - 1
-            text = f"{kind}: {found[0].get('message')}"
-            if more:
-                text += f" (and {more} more {kind}{'s' if more > 1 else ''} in this run)"
-            return text
-    return None
 
 
 def kind_of(error: str | None) -> str:

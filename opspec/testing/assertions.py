@@ -249,6 +249,20 @@ def assert_rate(result: Any, metric: str | tuple[Any, Any], *, at_least: float |
     return decision
 
 
+def _claim(subject: str, confidence: float, at_least: float | None, at_most: float | None,
+           between: tuple[float, float] | None
+           ) -> tuple[float | None, float | None, str, str, float, str]:
+    """The parts every interval claim is stated with: its bounds (checked), the bound and the
+    claim in words, the interval's level and whether it is one- or two-sided."""
+    _check_confidence(confidence)
+    at_least, at_most = _target(at_least, at_most, between)
+    bound = _bound_text(at_least, at_most)
+    level = _two_sided_level(confidence, at_least, at_most)
+    return (at_least, at_most, bound,
+            f"{subject} {bound} with {confidence_text(confidence)} confidence", level,
+            "two-sided" if level == confidence else "one-sided")
+
+
 def assert_mean(result: Any, metric: str, *, at_least: float | None = None,
                 at_most: float | None = None, between: tuple[float, float] | None = None,
                 confidence: float = 0.95, method: str = "t", seed: int = 0) -> Decision:
@@ -257,13 +271,9 @@ def assert_mean(result: Any, metric: str, *, at_least: float | None = None,
     duration never observed) are left out of the mean, and the decision says how many: a
     mean over the successful runs only says nothing about how often runs fail."""
     __tracebackhide__ = True
-    _check_confidence(confidence)
-    at_least, at_most = _target(at_least, at_most, between)
+    at_least, at_most, bound, claim, level, sides = _claim(
+        f"mean {metric}", confidence, at_least, at_most, between)
     values = result.samples(metric)
-    bound = _bound_text(at_least, at_most)
-    claim = f"mean {metric} {bound} with {confidence_text(confidence)} confidence"
-    level = _two_sided_level(confidence, at_least, at_most)
-    sides = "two-sided" if level == confidence else "one-sided"
     name = "Student t" if method == "t" else "BCa bootstrap"
     n = len(values)
     if n < 2:
@@ -298,13 +308,9 @@ def assert_quantile(result: Any, metric: str, q: float, *, at_most: float | None
     """Assert the ``q``-quantile of every observation of a duration metric
     (``result.observations``) with the distribution-free order-statistic interval."""
     __tracebackhide__ = True
-    _check_confidence(confidence)
-    at_least, at_most = _target(at_least, at_most, None)
+    at_least, at_most, bound, claim, level, sides = _claim(
+        f"p{q * 100:g} {metric}", confidence, at_least, at_most, None)
     values = result.observations(metric)
-    bound = _bound_text(at_least, at_most)
-    claim = f"p{q * 100:g} {metric} {bound} with {confidence_text(confidence)} confidence"
-    level = _two_sided_level(confidence, at_least, at_most)
-    sides = "two-sided" if level == confidence else "one-sided"
     est, lo, hi = quantile_interval(values, q, level)
     verdict = decide(lo, hi, at_least, at_most)
     n = len(values)

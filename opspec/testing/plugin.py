@@ -41,11 +41,15 @@ __all__ = [
     "pytest_addoption",
     "pytest_collect_file",
     "pytest_configure",
+    "pytest_terminal_summary",
     "simulator_for",
 ]
 
 _SEED_KEY = pytest.StashKey[int]()
 _SPECS_KEY = pytest.StashKey[dict[Path, Any]]()
+#: the front hall's warnings on what a test simulated (validate's on the spec, the user
+#: model's), per test and over the session: shown in the report and at the end
+_WARNED_KEY = pytest.StashKey[dict[str, None]]()
 
 
 def pytest_addoption(parser: pytest.Parser) -> None:
@@ -69,6 +73,22 @@ def pytest_configure(config: pytest.Config) -> None:
     config.addinivalue_line(
         "markers", "hardware: needs a real serial device (--device-url)")
     config.stash[_SPECS_KEY] = {}
+    config.stash[_WARNED_KEY] = {}
+
+
+def _warned(node: pytest.Item | None, config: pytest.Config, result: Any) -> None:
+    """Keep ``result``'s warnings and failed replications for the test's report (a simulated
+    spec's warnings are otherwise seen by nobody: a test rarely prints them)."""
+    lines = [f"warning: {w}" if "warning" not in str(w) else str(w)
+             for w in getattr(result, "warnings", ())]
+    for line in lines:
+        config.stash[_WARNED_KEY][line] = None
+    if node is not None:
+        seen = node.stash.setdefault(_WARNED_KEY, {})
+        for line in lines:
+            seen[line] = None
+        for failed in getattr(result, "failed", ()):
+            seen[f"failed {failed}"] = None
 
 
 # ---------------------------------------------------------------- paths and specs
@@ -86,19 +106,19 @@ def resolve_path(ref: str | Path, config: pytest.Config, near: Path | None) -> P
 
 
 def load_cached(path: Path, config: pytest.Config) -> Any:
-    """The package of ``path`` (XPDL, BPMN or ``.wfs``), loaded once per session; a spec
-    ``opspec validate`` refuses fails the test with its ``path:line`` message (no
-    traceback)."""
+    """The package of ``path`` (XPDL, BPMN or ``.wfs``) and the spec ready to run (an
+    :class:`opspec.runs.LoadedSpec`, with validate's warnings on it), loaded once per
+    session; a spec ``opspec validate`` refuses fails the test with its ``path:line`` message
+    (no traceback)."""
     cache = config.stash[_SPECS_KEY]
     if path not in cache:
-        from opspec.engine.compiled import compile_package
-        from opspec.request import open_gated
+        from opspec.runs import load
 
         problem = None
         try:
             # the front hall's gate: refused as `opspec validate` refuses it, any form
-            package = open_gated(path)[0]
-            cache[path] = (package, compile_package(package))
+            loaded = load(path)
+            cache[path] = (loaded.package, loaded)
         except OpspecError as error:
             problem = f"cannot load the spec: {error}"
         if problem is not None:          # outside the except: no "during handling" chain
@@ -107,9 +127,10 @@ def load_cached(path: Path, config: pytest.Config) -> Any:
 
 
 def _compiled_for(package: Any, config: pytest.Config) -> Any:
-    for cached, compiled in config.stash[_SPECS_KEY].values():
+    """The loaded spec of the ``spec`` fixture's package (its warnings come with it)."""
+    for cached, loaded in config.stash[_SPECS_KEY].values():
         if cached is package:
-            return compiled
+            return loaded
     return package
 
 
@@ -152,10 +173,12 @@ class Simulator:
     traceback.
     """
 
-    def __init__(self, config: pytest.Config, near: Path | None, seed: int) -> None:
+    def __init__(self, config: pytest.Config, near: Path | None, seed: int,
+                 node: pytest.Item | None = None) -> None:
         self.config = config
         self.near = near
         self.seed = seed
+        self.node = node
 
     def __repr__(self) -> str:
         return f"<simulate fixture, seed {self.seed}>"
@@ -179,18 +202,21 @@ class Simulator:
         if isinstance(script, (str, Path)):
             script = resolve_path(script, self.config, self.near)
         try:
-            return simulate(spec, users=users, days=days, script=script,
-                            user_model=user_model, seed=self.seed if seed is None else seed,
-                            until=until, engine_config=engine_config, **options)
+            result = simulate(spec, users=users, days=days, script=script,
+                              user_model=user_model, seed=self.seed if seed is None else seed,
+                              until=until, engine_config=engine_config, **options)
         except OpspecError as error:
             problem = f"simulate(): {error}"
+        else:
+            _warned(self.node, self.config, result)
+            return result
         pytest.fail(problem, pytrace=False)     # outside the except: the message once
 
 
 @pytest.fixture
 def simulate(request: pytest.FixtureRequest, opspec_seed: int) -> Simulator:
     """Run a spec; see :class:`Simulator`."""
-    return Simulator(request.config, request.node.path, opspec_seed)
+    return Simulator(request.config, request.node.path, opspec_seed, request.node)
 
 
 def simulator_for(request: pytest.FixtureRequest) -> Simulator:
@@ -260,11 +286,25 @@ def pytest_runtest_makereport(item: pytest.Item, call: pytest.CallInfo[None]
         # fix it; the test line that caused it is enough context (no opspec internals)
         report.longrepr = _opspec_error_repr(item, call.excinfo)
     seed = item.stash.get(_SEED_KEY, None)
+    lines = []
     if seed is not None and report.failed:
         base = item.config.getoption("--opspec-seed")
-        text = (f"seed {seed} (from --opspec-seed={base} and the test id; "
-                "simulate(seed=...) overrides it)")
-        report.sections.append(("opspec", text))
+        lines.append(f"seed {seed} (from --opspec-seed={base} and the test id; "
+                     "simulate(seed=...) overrides it)")
+    if report.when == "call":
+        lines.extend(item.stash.get(_WARNED_KEY, {}))
+    if lines:
+        report.sections.append(("opspec", "\n".join(lines)))
+
+
+def pytest_terminal_summary(terminalreporter: Any) -> None:
+    """The warnings on every spec simulated in the session, once each, at the end (where
+    pytest lists its own warnings): a spec's doubtful construct is not lost in a green run."""
+    warned = terminalreporter.config.stash.get(_WARNED_KEY, {})
+    if warned:
+        terminalreporter.write_sep("=", "opspec: warnings on the specs simulated")
+        for line in warned:
+            terminalreporter.write_line(line)
 
 
 def _opspec_error_repr(item: pytest.Item, excinfo: pytest.ExceptionInfo[BaseException]
@@ -321,7 +361,8 @@ class ScenarioItem(pytest.Item):
             self.stash[_SEED_KEY] = seed
         package = load_cached(self.scenario.spec_path, self.config)[1]
         try:
-            failures = run_scenario(self.scenario, package, seed=seed)
+            failures = run_scenario(self.scenario, package, seed=seed,
+                                    seen=lambda result: _warned(self, self.config, result))
         except OpspecError as error:
             raise ScenarioFailure(f"{self.scenario.where}: {error}") from None
         if failures:

@@ -44,51 +44,19 @@ from typing import Any
 from opspec.engine.trace import TraceEvent
 from opspec.errors import ConfigurationError
 from opspec.properties.language import trace_end
-from opspec.properties.vocabulary import (
-    Count,
-    Match,
-    Predicate,
-    activity_completed,
-    activity_started,
-    as_predicate,
-    count,
-    event,
-    eventually,
-    happens_before,
-    max_count_per,
-    min_gap,
-    monitor,
-    never,
-    never_while,
-    per_instance,
-    process_started,
-    trigger_raised,
-    within,
-)
+from opspec.properties import vocabulary
+from opspec.properties.vocabulary import Match, Predicate, as_predicate
 
-__all__ = [
-    "Count",
-    "Match",
-    "Predicate",
-    "activity_completed",
-    "activity_started",
-    "check",
-    "count",
-    "event",
-    "eventually",
-    "failures",
-    "happens_before",
-    "holds",
-    "max_count_per",
-    "min_gap",
-    "monitor",
-    "never",
-    "never_while",
-    "per_instance",
-    "process_started",
-    "trigger_raised",
-    "within",
-]
+#: the judging here; the predicates themselves are the one vocabulary's, handed out here too
+__all__ = ["check", "failure_slice", "failures", "holds", "trace_slice",
+           *vocabulary.__all__]
+
+
+def __getattr__(name: str) -> Any:
+    if name in vocabulary.__all__:
+        return getattr(vocabulary, name)
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+
 
 #: events shown before / after each focus event of a failure, and at most in all
 BEFORE, AFTER, MAX_LINES = 4, 2, 14

@@ -24,7 +24,7 @@ Every mistake is reported when the file is collected, as ``path: key: what (how 
 
 from __future__ import annotations
 
-from collections.abc import Mapping, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -238,9 +238,12 @@ def load_scenarios(path: str | Path, *, rootdir: Path | None = None) -> Scenario
     return ScenarioDocument(path, spec_path, tuple(scenarios))
 
 
-def run_scenario(scenario: Scenario, spec: Any, *, seed: int = 0) -> list[str]:
-    """Run ``scenario`` on ``spec`` (a Package or CompiledPackage); return one failure
-    message per expectation that does not hold (empty when all do)."""
+def run_scenario(scenario: Scenario, spec: Any, *, seed: int = 0,
+                 seen: Callable[[Any], None] | None = None) -> list[str]:
+    """Run ``scenario`` on ``spec`` (a Package, CompiledPackage or LoadedSpec); return one
+    failure message per expectation that does not hold (empty when all do). ``seen`` gets
+    the simulation's result (its warnings, its failed replications). A replication a fault
+    cut short fails the scenario, naming the fault's file:line."""
     from opspec.testing.simulation import simulate
 
     needs_trace = any(e.property is not None for e in scenario.expectations)   # trace lines
@@ -249,6 +252,13 @@ def run_scenario(scenario: Scenario, spec: Any, *, seed: int = 0) -> list[str]:
                       seed=scenario.seed if scenario.seed is not None else seed,
                       engine_config=scenario.engine or None, params=scenario.params or None,
                       keep_trace=True if needs_trace else None)
+    if seen is not None:
+        seen(result)
+    if result.failed:       # runs cut short by a fault: no line of them is the spec's
+        from opspec.testing.simulation import failed_text
+
+        return [f"{scenario.where}: {failed_text(result.failed, result.replications)}",
+                f"(seed {result.seed}; {result.replications} replication(s))"]
     failures = []
     for number, expectation in enumerate(scenario.expectations):
         message = expectation.check(result)

@@ -47,6 +47,8 @@ if TYPE_CHECKING:
 
 __all__ = [
     "FIELDS",
+    "FailedReplication",
+    "FailedReplications",
     "InstanceRun",
     "SimulationResult",
     "SpecNames",
@@ -100,6 +102,41 @@ _ENDS = {EventKind.PROCESS_COMPLETED: "completed", EventKind.PROCESS_TERMINATED:
          EventKind.PROCESS_ABORTED: "aborted"}
 
 
+@dataclass(frozen=True, slots=True)
+class FailedReplication:
+    """A replication a run-time fault or a deadlock cut short: ``problem`` is the first one's
+    located message (``fault: spec.xpdl:216: activity 'R': … division by zero``)."""
+
+    replication: int
+    problem: str
+
+    def __str__(self) -> str:
+        return f"replication {self.replication}: {self.problem}"
+
+
+class FailedReplications(AssertionError):
+    """A statistic was asked of a result whose replications include failed ones: their runs
+    were cut short, so any number pooled over them would not be the spec's (an aborted dose
+    is neither taken nor missed). An ``AssertionError``: the spec fails the test."""
+
+
+#: failed replications named in a message, at most
+_NAMED = 5
+
+
+def failed_text(failed: Sequence[FailedReplication], replications: int) -> str:
+    """What a result's failed replications say: how many, each with its fault's file:line,
+    and what to do."""
+    lines = [f"{len(failed)} of {replications} replication(s) failed: a run-time fault or a "
+             "deadlock of the spec cut them short, so no statistic over them is judged"]
+    lines.extend(f"  {f}" for f in failed[:_NAMED])
+    if len(failed) > _NAMED:
+        lines.append(f"  ... and {len(failed) - _NAMED} more")
+    lines.append("fix the spec at the file:line named (result.failed lists them; "
+                 "result.traces shows what happened)")
+    return "\n".join(lines)
+
+
 @dataclass(frozen=True, slots=True, eq=False)
 class SimulationResult:
     """What :func:`simulate` produced: one :class:`RunResult` per replication, pooled metrics.
@@ -107,6 +144,13 @@ class SimulationResult:
     ``metrics`` has the engine's shape (``{"doses_taken": {"kind": "count", "total": 3}}``),
     pooled over replications: counts summed, durations summarised over every sample, ratios
     recomputed from the pooled metrics. ``per_replication`` holds each replication's own.
+
+    ``failed`` lists the replications a run-time fault or a deadlock cut short (as
+    ``opspec evaluate`` fails them): while there is one, every statistic (:meth:`value`,
+    :meth:`samples`, :meth:`counts`, :meth:`observations`, so every statistical assertion and
+    scenario line) raises :class:`FailedReplications` naming the faults instead of computing
+    over truncated runs. ``warnings`` are the front hall's on the spec and the user model
+    (``path:line: warning: …``; the pytest plugin shows them).
     """
 
     spec: Package
@@ -118,6 +162,21 @@ class SimulationResult:
     durations: dict[str, tuple[float, ...]] = field(default_factory=dict)
     #: what each monitor saw in each replication (see :mod:`opspec.testing.monitors`)
     monitor_results: tuple[Any, ...] = ()
+    #: the replications a run-time fault or a deadlock cut short
+    failed: tuple[FailedReplication, ...] = ()
+    #: validate's warnings on the spec and the user model's against its user lane
+    warnings: tuple[Any, ...] = ()
+
+    @property
+    def complete(self) -> int:
+        """How many replications ran to their end without a fault or a deadlock."""
+        return len(self.runs) - len(self.failed)
+
+    def _judgeable(self) -> None:
+        __tracebackhide__ = True
+        if self.failed:
+            raise FailedReplications(failed_text(self.failed, self.replications)
+                                     + f"\n(seed {self.seed})")
 
     def monitor_report(self, confidence: float = 0.95) -> Any:
         """Monitor violations, per monitor, with a hazard (violations per user-day) and its
@@ -127,8 +186,9 @@ class SimulationResult:
         return monitor_report(self, confidence=confidence)
 
     def __repr__(self) -> str:
-        return (f"<SimulationResult {self.spec.id}: {self.replications} replication(s), "
-                f"seed {self.seed}>")
+        failed = f", {len(self.failed)} failed" if self.failed else ""
+        return (f"<SimulationResult {self.spec.id}: {self.replications} replication(s)"
+                f"{failed}, seed {self.seed}>")
 
     @property
     def users(self) -> int:
@@ -193,12 +253,14 @@ class SimulationResult:
         """A pooled scalar: ``"doses_taken"`` (a count's total), ``"report_latency_s"`` (a
         duration's mean), ``"report_latency_s.p95"``, ``"alarms_per_dose"`` (a ratio's value).
         ``None`` when undefined (a mean of no samples)."""
+        self._judgeable()
         name, part = self._split(metric)
         return self._scalar(self.metrics[name], part)
 
     def samples(self, metric: str) -> list[float]:
         """One value per replication (same spelling as :meth:`value`), skipping replications
         where it is undefined (a duration with no sample, a ratio over zero)."""
+        self._judgeable()
         name, part = self._split(metric)
         out = []
         for run in self.runs:
@@ -210,6 +272,7 @@ class SimulationResult:
     def counts(self, numerator: str, denominator: str) -> tuple[int, int]:
         """Pooled ``(successes, trials)`` of two count metrics, for rate assertions
         (``counts("doses_taken", "doses_due")``)."""
+        self._judgeable()
         pair = []
         for metric in (numerator, denominator):
             name, _ = self._split(metric)
@@ -221,6 +284,7 @@ class SimulationResult:
 
     def observations(self, metric: str) -> list[float]:
         """Every sample of a duration metric, pooled over replications (for quantiles)."""
+        self._judgeable()
         name, _ = self._split(metric)
         if self.metrics[name]["kind"] != "duration":
             raise ConfigurationError(f"metric {name!r} is a {self.metrics[name]['kind']}, "
@@ -313,10 +377,13 @@ def simulate(spec: Package | CompiledPackage | str | Path, *, users: int = 1,
     prepared = prepared.but(monitors=tuple(monitors_for(compiled, names, monitors)))
     watched: list[Any] = []
     runs: list[RunResult] = []
+    failed: list[FailedReplication] = []
     pooled: dict[str, list[float]] = {}
     for u in range(users):
         outcome = prepared.build(u).execute()
         runs.append(outcome.result)
+        if outcome.problem is not None:
+            failed.append(FailedReplication(u, outcome.problem))
         watched.extend(outcome.monitors)
         for name, values in outcome.samples.items():
             pooled.setdefault(name, []).extend(values)
@@ -325,4 +392,5 @@ def simulate(spec: Package | CompiledPackage | str | Path, *, users: int = 1,
     horizon = prepared.horizon
     return SimulationResult(compiled.package, names, seed, horizon, tuple(runs),
                             _pool(runs, pooled, compiled.package),
-                            {k: tuple(v) for k, v in pooled.items()}, tuple(watched))
+                            {k: tuple(v) for k, v in pooled.items()}, tuple(watched),
+                            tuple(failed), prepared.warnings)

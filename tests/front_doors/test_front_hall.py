@@ -23,6 +23,7 @@ import tomli_w
 from test_front_doors import DOOR_ONLY, _file, _plain, _same
 
 import opspec
+from opspec import runs
 from opspec.cli import main
 from opspec.errors import OpspecError
 from opspec.testing import simulate
@@ -284,10 +285,15 @@ def test_a_spec_validate_refuses_is_refused_by_every_door_with_the_same_message(
         "pytest simulate fixture": _refusal(
             lambda: Simulator(request.config, None, 0)(two_defaults)),
         "scenario file": _refusal(lambda: load_scenarios(scenario)),
+        # the run builder's own doors: the gate is in the loader, so no caller skips it
+        "runs.load(path)": _refusal(lambda: runs.load(two_defaults)),
+        "runs.build(path)": _refusal(lambda: runs.build(two_defaults)),
+        "runs.build(package)": _refusal(lambda: runs.build(load_spec(two_defaults))),
     })
     for door, text in messages.items():
         assert message in text, f"{door} said: {text}"
-        if door not in ("simulate(package)", "opspec.run(package)", "check"):
+        if door not in ("simulate(package)", "opspec.run(package)", "check",
+                        "runs.build(package)"):
             assert where in text, f"{door} did not name {where}: {text}"
 
 
