@@ -61,7 +61,6 @@ from opspec.xpdl.bpmn.common import (
     namespace,
     text_of,
 )
-from opspec.xpdl.bpmn.branches import decide_undecided
 from opspec.xpdl.bpmn.data import CAMUNDA, activity_data, process_fields
 from opspec.xpdl.bpmn.event_subprocesses import hoist_event_sub_processes
 from opspec.xpdl.bpmn.events import definitions_of, read_timer, trigger_of
