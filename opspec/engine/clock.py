@@ -10,9 +10,11 @@ The order is SimPy's, so traces are the same as when the engine ran on SimPy: by
 at equal times in the order they were scheduled (SimPy's ``(time, priority, event id)`` with
 every event at NORMAL priority). :meth:`Clock.run` with ``until`` stops, as SimPy's does,
 *before* anything due at ``until`` (it falls after the run) and leaves the clock at
-``now + (until - now)`` — the same float SimPy computes for its stop event. :attr:`Clock.scheduled`
-counts as SimPy's event ids did, that stop included, so a run's summary ("N simulation
-events") is unchanged too.
+``now + (until - now)`` — the same float SimPy computes for its stop event — with that stop
+still queued, as SimPy leaves it (so ``peek`` after a run gives ``until`` and the deadlock
+check sees a run stopped at its horizon, not a dry one). :attr:`Clock.scheduled` counts as
+SimPy's event ids did, the stop and its requeueing included, so a run's summary ("N
+simulation events") is unchanged too.
 """
 
 from __future__ import annotations
@@ -77,9 +79,21 @@ class Clock:
             raise ValueError(f"until ({until}) must be after the current simulated time "
                              f"({self.now})")
         stop = self.now + (until - self.now)
+        # SimPy's stop event: before anything else due at ``stop`` (a negative sequence)
         self.scheduled += 1
-        while heap and heap[0][0] < stop:
+        heappush(heap, (stop, -self.scheduled, _nothing))
+        while heap[0][0] < stop:
             when, _seq, callback = heappop(heap)
             self.now = when
             callback()
+        heappop(heap)
         self.now = stop
+        # ... which SimPy puts back once it has stopped the run: it stays queued at ``stop``
+        # (``peek`` gives ``stop``, the next ``step`` takes it and does nothing), so what
+        # looks at the queue after a run (the deadlock check, stepping) sees what it saw
+        self.scheduled += 1
+        heappush(heap, (stop, -self.scheduled, _nothing))
+
+
+def _nothing() -> None:
+    """The stop mark of :meth:`Clock.run`: nothing happens when it is reached."""

@@ -54,11 +54,36 @@ def test_run_until_stops_before_what_falls_at_until_and_moves_the_clock_there() 
     for delay in (0.5, 2.0, 2.5):
         clock.after(delay, lambda: fired.append(clock.now))
     clock.run(until=2.0)
-    assert fired == [0.5] and clock.now == 2.0 and clock.peek() == 2.0
+    assert fired == [0.5] and clock.now == 2.0
     clock.run(until=10.0)
-    assert fired == [0.5, 2.0, 2.5] and clock.now == 10.0 and clock.peek() == math.inf
-    # as SimPy counts its event ids: three callbacks and the two stops of run(until)
-    assert clock.scheduled == 5
+    assert fired == [0.5, 2.0, 2.5] and clock.now == 10.0
+    # as SimPy counts its event ids: three callbacks, and per run(until) its stop event and
+    # the stop put back on the queue
+    assert clock.scheduled == 7
+
+
+def test_after_a_run_until_the_queue_looks_as_simpys_does() -> None:
+    """SimPy leaves its stop event queued at ``until`` after ``run(until)``: ``peek`` gives
+    ``until`` (so a run stopped at its horizon is not taken for one where nothing is
+    scheduled any more), and the next ``step`` takes it without doing anything."""
+    env = simpy.Environment()
+    clock = Clock()
+    seen_env: list[float] = []
+    seen_clock: list[float] = []
+    env.timeout(5.0).callbacks.append(lambda _e: seen_env.append(env.now))
+    clock.after(5.0, lambda: seen_clock.append(clock.now))
+    env.run(until=3.0)
+    clock.run(until=3.0)
+    assert clock.peek() == env.peek() == 3.0
+    env.step()
+    clock.step()
+    assert clock.now == env.now == 3.0 and seen_clock == seen_env == []
+    assert clock.peek() == env.peek() == 5.0
+    env.run(until=8.0)
+    clock.run(until=8.0)
+    assert seen_clock == seen_env == [5.0]
+    assert clock.peek() == env.peek() == 8.0
+    assert clock.scheduled == int(repr(env._eid)[6:-1])     # SimPy's next event id
 
 
 def test_run_until_the_past_or_present_is_refused_and_step_on_nothing_raises() -> None:
@@ -69,7 +94,7 @@ def test_run_until_the_past_or_present_is_refused_and_step_on_nothing_raises() -
         clock.step()
     clock.after(1.0, lambda: None)
     clock.step()
-    assert clock.now == 6.0 and clock.pending() == 0
+    assert clock.now == 6.0 and clock.pending() == 0 and clock.peek() == math.inf
 
 
 def test_the_clock_stops_where_simpy_stops_to_the_last_bit() -> None:

@@ -42,3 +42,15 @@ def test_waiting_at_the_end_of_the_horizon_is_not_a_deadlock() -> None:
     result = run(model, performers={"user": user}, until=600.0)
     assert result.summary["deadlocks"] == []
     assert result.summary["instances"]["open"] == 1
+
+
+def test_a_run_stopped_at_its_horizon_reports_no_catch_deadlock_even_with_nothing_queued() -> None:
+    """At the horizon, waiting is normal unless an activity waits for a performer that does
+    not exist (Simulation.check_waiting): a catch event nobody throws is still waiting when
+    the run's length is reached, even with nothing else scheduled (the clock keeps the
+    run's stop queued at the horizon, as SimPy's did)."""
+    model = pkg(proc("p", [catch("wait_report", "message", "trg_1"), "after"],
+                     [("wait_report", "after")]))
+    result = run(model, until=600.0)
+    assert result.summary["deadlocks"] == []
+    assert result.summary["time"] == 600.0
