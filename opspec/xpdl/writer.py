@@ -19,6 +19,7 @@ application types other than Script/Xslt/Form, ``business-rule`` tasks (written 
 
 from __future__ import annotations
 
+import dataclasses
 import re
 from collections.abc import Iterable
 
@@ -695,8 +696,38 @@ def _write_type_declaration(parent: etree._Element, declaration: TypeDeclaration
 
 def write_xpdl(package: Package) -> bytes:
     """``package`` as a standard XPDL 2.1 document (UTF-8, with an XML declaration)."""
-    root = build_tree(package)
+    root = build_tree(_abstract_tasks_automatic(package))
     etree.cleanup_namespaces(root, keep_ns_prefixes=["opspec"])
     data: bytes = etree.tostring(root, xml_declaration=True, encoding="UTF-8",
                                  pretty_print=True)
     return data
+
+
+
+def _abstract_tasks_automatic(package: Package) -> Package:
+    """A package read from BPMN, its abstract tasks (no implementation) automatic in writing.
+
+    BPMN 2.0 §10.2.3: a Task "not further specified" runs by itself, while XPDL 2.1 §7.6.5.1
+    reads an activity without an implementation performed by a person (a lane's ROLE
+    participant) as manual work; so the XPDL written says opspec:AutoRun="true" for each such
+    activity, and runs as the BPMN file did."""
+    if not package.source_format.upper().startswith("BPMN"):
+        return package
+    # the same package, read as XPDL reads it: which activities would turn into manual work
+    as_xpdl = dataclasses.replace(package, header=dataclasses.replace(
+        package.header, source_format=None))
+
+    def automatic(activities: tuple[Activity, ...], process: WorkflowProcess
+                  ) -> tuple[Activity, ...]:
+        return tuple(
+            dataclasses.replace(a, directives=dataclasses.replace(a.directives, auto_run=True))
+            if isinstance(a.body, NoImplementation) and a.directives.auto_run is None
+            and not a.is_manual and as_xpdl.is_manual_work(a, process) else a
+            for a in activities)
+
+    processes = tuple(dataclasses.replace(
+        process, activities=automatic(process.activities, process),
+        activity_sets=tuple(dataclasses.replace(s, activities=automatic(s.activities, process))
+                            for s in process.activity_sets))
+        for process in package.processes)
+    return dataclasses.replace(package, processes=processes)

@@ -55,3 +55,24 @@ def test_show_and_the_model_call_it_manual() -> None:
     assert manual == {"check"}
     drawn = package_to_dot(package)
     assert [line.split()[0] for line in drawn.splitlines() if "(manual)" in line] == ['"check"']
+
+
+def test_a_bpmn_file_written_as_xpdl_keeps_its_abstract_tasks_automatic(tmp_path) -> None:
+    """BPMN 2.0 §10.2.3 (Task): an abstract task, one "not further specified", runs by itself;
+    XPDL 2.1 §7.6.5.1 reads an activity without an implementation performed by a lane's ROLE
+    participant as manual work. The bundled BPMN dispenser written as XPDL (`opspec
+    preprocess`) says opspec:AutoRun="true" for its abstract tasks, and runs as the BPMN file
+    does: the same doses, the same instances."""
+    import opspec
+    from opspec.xpdl.writer import write_xpdl
+
+    source = DATA.parents[2] / "specs" / "medication_dispenser.bpmn"
+    written = tmp_path / "medication_dispenser.xpdl"      # its user model beside it, as
+    written.write_bytes(write_xpdl(load_spec(source)))    # preprocess copies it
+    users = source.with_name("medication_dispenser.users.toml")
+    written.with_name(users.name).write_bytes(users.read_bytes())
+    assert b"opspec:AutoRun" in written.read_bytes()
+    runs = [opspec.run(path, seed=0, days=2) for path in (source, written)]
+    assert runs[0].summary["instances"] == runs[1].summary["instances"]
+    assert runs[0].metrics == runs[1].metrics
+    assert runs[1].summary["deadlocks"] == []
