@@ -117,27 +117,10 @@ class RunState:
         self.dedicated = DedicatedProcessor()
         self.raised_names: set[str] = set()
         self.mode = compiled.initial_mode
-        # trace: listeners with a ``raw`` method get the fields without a TraceEvent object
-        self.listeners = [lst for lst in listeners if getattr(lst, "raw", None) is None]
-        self.raw = [lst.raw for lst in listeners  # type: ignore[attr-defined]
-                     if getattr(lst, "raw", None) is not None]
         self.seq = 0
         self.pkg = compiled.id
-        self.wants_all = False
-        selectors: set[tuple[str, str | None, str | None]] = set()
-        for listener in listeners:
-            wanted = getattr(listener, "selects", None)
-            if wanted is None:
-                self.wants_all = True
-                break
-            selectors.update(wanted)
-        self.selectors = frozenset(selectors)
-        self.wanted = (frozenset() if self.wants_all or not selectors
-                      else compiled.expand_selectors(self.selectors))
-        # each full listener only receives what it selects (None: everything)
-        self.full = [(lst, None if getattr(lst, "selects", None) is None
-                       else compiled.expand_selectors(frozenset(lst.selects)))  # type: ignore[attr-defined]
-                      for lst in self.listeners]
+        (self.listeners, self.raw, self.wants_all, self.selectors, self.wanted,
+         self.full) = _listener_tables(listeners, compiled)
         self.aflags = _Flags(self, _ACT_KINDS)      # CompiledActivity -> wanted-kind bits
         self.pflags = _Flags(self, _PROC_KINDS)     # process id -> wanted-kind bits
 
@@ -330,3 +313,34 @@ def _call(callback: Callable[[], None], _a: Any, _b: Any) -> None:
 def discard(table: dict[Any, Any], key: Any) -> None:
     """Remove ``key`` from ``table`` if it is there (an activity's cleanup)."""
     table.pop(key, None)
+
+
+_Selector = tuple[str, str | None, str | None]      # (kind, process, activity)
+
+
+def _listener_tables(listeners: list[TraceListener], compiled: CompiledPackage) -> tuple[
+        list[TraceListener], list[Callable[..., None]], bool,
+        frozenset[_Selector], frozenset[_Selector],
+        list[tuple[TraceListener, frozenset[_Selector] | None]]]:
+    """Who hears what: the full listeners (a ``raw`` method gets the fields without a
+    TraceEvent object), whether any wants everything, and the (kind, process, activity)
+    selectors the others asked for, expanded over the compiled package."""
+    full_listeners = [lst for lst in listeners if getattr(lst, "raw", None) is None]
+    raw = [lst.raw for lst in listeners  # type: ignore[attr-defined]
+           if getattr(lst, "raw", None) is not None]
+    wants_all = False
+    selectors: set[_Selector] = set()
+    for listener in listeners:
+        wanted = getattr(listener, "selects", None)
+        if wanted is None:
+            wants_all = True
+            break
+        selectors.update(wanted)
+    chosen = frozenset(selectors)
+    expanded = (frozenset() if wants_all or not selectors
+                else compiled.expand_selectors(chosen))
+    # each full listener only receives what it selects (None: everything)
+    full = [(lst, None if getattr(lst, "selects", None) is None
+             else compiled.expand_selectors(frozenset(lst.selects)))  # type: ignore[attr-defined]
+            for lst in full_listeners]
+    return full_listeners, raw, wants_all, chosen, expanded, full
