@@ -10,16 +10,18 @@ Objects of one simulated user (design ``A``, user 3 → ids ending in ``A/3``):
 
 - ``user A/3``: the simulated user (type ``user``);
 - ``device A/3``: the user's device, everything the device lane does (type ``device``);
-- ``dose A/3/timer_workflow#1``: one chain of workflow instances (:mod:`.cases`: for the
-  dispenser, one dose; type ``dose``);
+- ``A/3/timer_workflow#1``: one chain of workflow instances (:mod:`.cases`: for the
+  dispenser, one dose; for a stove guard, one cooking session), typed after the spec's own
+  workflow that starts the chain (``timer_workflow``, ``guard_workflow``): the same id as
+  the chain's case in the XES and JSONL exports;
 - one object per other person the spec declares (a ``HUMAN`` participant that does not
   perform the user lane, e.g. ``caregiver A/3``; its type is the participant id).
 
 Event relationships (qualifiers): the user — ``performed by`` for user-lane events, ``for``
-otherwise; the device — ``performed by`` for the other lanes' events; the dose — ``part of``;
+otherwise; the device — ``performed by`` for the other lanes' events; the chain — ``part of``;
 another person — ``performed by`` when they perform the activity, ``concerns`` when the
 activity names them (its id, name or application mentions the participant's id or name:
-``notify_caregiver``). Object-to-object: the device, each dose and each other person relate
+``notify_caregiver``). Object-to-object: the device, each chain and each other person relate
 to the user (``belongs to``, ``for``, ``cares for``).
 
 The events are those of the XES export (:data:`.exporters.DEFAULT_XES_KINDS`), typed
@@ -125,8 +127,8 @@ class OcelWriter(_StreamingWriter):
         self.objects = 0
         self._ids = 0
         self._event_types: dict[str, dict[str, str]] = {}
-        self._object_types: dict[str, dict[str, str]] = {
-            "user": {}, "device": {}, "dose": {}}
+        # the chains' types (their root workflows) are declared as they first occur
+        self._object_types: dict[str, dict[str, str]] = {"user": {}, "device": {}}
         for kind in self.people.others.values():
             self._object_types.setdefault(kind, {})
         self._first_event = True
@@ -176,7 +178,7 @@ class OcelWriter(_StreamingWriter):
         self._object(device, "device", {}, [(user, "belongs to")])
         others: dict[str, str] = {}
         chains = ChainTracker()
-        doses: set[int] = set()
+        chained: set[int] = set()
         written = 0
         try:
             for event in events:
@@ -188,13 +190,14 @@ class OcelWriter(_StreamingWriter):
                     relations.append((device, "performed by"))
                 root = chains.root(event.instance)
                 if root is not None:
-                    dose = f"dose {case_id}/{chains.name(root)}"
-                    if root not in doses:
-                        doses.add(root)
-                        self._object(dose, "dose", {"process": chains.name(root).split("#")[0],
-                                                    "instance": root},
+                    chain = f"{case_id}/{chains.name(root)}"
+                    if root not in chained:
+                        chained.add(root)
+                        process = chains.name(root).split("#")[0]
+                        self._object(chain, self._chain_type(process),
+                                     {"process": process, "instance": root},
                                      [(user, "for"), (device, "on")])
-                    relations.append((dose, "part of"))
+                    relations.append((chain, "part of"))
                 for person, qualifier in self._people(event):
                     oid = others.get(person)
                     if oid is None:
@@ -209,6 +212,12 @@ class OcelWriter(_StreamingWriter):
             raise
         self.cases += 1
         self.events += written
+
+    def _chain_type(self, process: str) -> str:
+        """A chain's object type: its root workflow's id, unless a workflow is named like
+        one of the other types (``user``, ``device``, a person's participant id)."""
+        taken = {"user", "device", *self.people.others.values()}
+        return process if process not in taken else f"{process} workflow"
 
     def _people(self, event: TraceEvent) -> list[tuple[str, str]]:
         found: list[tuple[str, str]] = []
