@@ -99,6 +99,10 @@ NO_OBSERVATIONS = "no observations"
 
 # --------------------------------------------------------------------------------- helpers
 
+#: the percent sign as the tables write it ("99.61 %"): after a space, on the axes too
+PERCENT = " %"
+
+
 @contextmanager
 def figure_format(name: str) -> Iterator[None]:
     """Within this block, figures are written as ``name`` (one of :data:`FORMATS`)."""
@@ -203,7 +207,7 @@ def _percent_axis(ax: Axes, axis: str = "x") -> None:
     from matplotlib.ticker import PercentFormatter
 
     target = ax.xaxis if axis == "x" else ax.yaxis
-    target.set_major_formatter(PercentFormatter(xmax=1.0, decimals=None))
+    target.set_major_formatter(PercentFormatter(xmax=1.0, decimals=None, symbol=PERCENT))
 
 
 def _fmt(value: float, percent: bool) -> str:
@@ -350,7 +354,7 @@ def rates_figure(rows: Sequence[tuple[str, float, float, float]], path: Path) ->
                 left, right = max(left, 0.0), min(right, 1.0)
                 step = max((right - left) * 100.0 / 6.0, 1e-9)   # about six ticks
                 ax.xaxis.set_major_formatter(PercentFormatter(
-                    xmax=1.0, decimals=max(0, -math.floor(math.log10(step)))))
+                    xmax=1.0, decimals=max(0, -math.floor(math.log10(step))), symbol=PERCENT))
             ax.set_xlim(left, right)
             ax.xaxis.set_major_locator(MaxNLocator(6))
         if all(_is_rate([e, lo, hi]) for _, e, lo, hi in clean):
@@ -423,7 +427,9 @@ def time_of_day_figure(series: Mapping[str, Sequence[int]], path: Path) -> Path:
             # each hour is the bin [h, h+1): one outlined step patch, not 24 bar artists
             ax.stairs(counts, range(25), fill=True, facecolor=PALETTE[i % len(PALETTE)],
                       edgecolor="black", linewidth=0.6)
-            ax.set_ylabel(name, rotation=0, ha="right", va="center")
+            # the quantity in words: events of all users and days (the day-by-day panels
+            # say "per user"; these are totals)
+            ax.set_ylabel(f"{name}\n(events, all users)", rotation=0, ha="right", va="center")
             ax.set_ylim(0, max(counts) * 1.15)
         axes[-1].set_xlabel("hour of the simulated day (each bar from h:00 to h:59)")
         axes[-1].set_xticks(range(0, 25, 3))
@@ -707,7 +713,8 @@ def sweep_figure(parameter: str, xs: Sequence[float], labels: Sequence[str],
             if percent.get(name):
                 from matplotlib.ticker import PercentFormatter
 
-                ax.yaxis.set_major_formatter(PercentFormatter(xmax=100.0, decimals=None))
+                ax.yaxis.set_major_formatter(PercentFormatter(xmax=100.0, decimals=None,
+                                                              symbol=PERCENT))
             _outside_legend(ax)
         axes[-1].set_xticks(list(xs), [_text(label) for label in labels])
         axes[-1].set_xlabel(_text(parameter))
