@@ -65,10 +65,25 @@ class People:
     user: frozenset[str] = frozenset({"user"})
     others: Mapping[str, str] = field(default_factory=dict)
     mentions: Mapping[tuple[str, str], tuple[str, ...]] = field(default_factory=dict)
+    #: the user lane's work as the compiled spec has it: activities ``(process, activity)``
+    #: and whole workflows (a user workflow's own start and end), whatever its lane is called
+    user_activities: frozenset[tuple[str, str]] = frozenset()
+    user_processes: frozenset[str] = frozenset()
+
+    def performs(self, event: TraceEvent) -> bool:
+        """Whether ``event`` is the user lane's (the simulated user performs it)."""
+        if event.lane == "user":
+            return True
+        if event.activity is None:
+            return (event.process or "") in self.user_processes
+        return (event.process or "", event.activity) in self.user_activities
 
 
-def people_of(package: Any, user_participants: Iterable[str]) -> People:
-    """The :class:`People` of a loaded package (:class:`opspec.model.Package`)."""
+def people_of(package: Any, user_participants: Iterable[str],
+              compiled: Any = None) -> People:
+    """The :class:`People` of a loaded package (:class:`opspec.model.Package`); with its
+    ``compiled`` package, which events are the user lane's work (a BPMN lane "Resident", a
+    user workflow with no lane directive)."""
     user = frozenset(user_participants)
     humans = [p for p in getattr(package, "participants", ())
               if getattr(p, "is_human", False) and p.id not in user]
@@ -87,7 +102,12 @@ def people_of(package: Any, user_participants: Iterable[str]) -> People:
                                      for w in names))
             if concerned:
                 mentions[(process.id, activity.id)] = concerned
-    return People(user, others, mentions)
+    if compiled is None:
+        return People(user, others, mentions)
+    from opspec.engine.lane_labels import lane_labels
+
+    lanes = lane_labels(compiled)
+    return People(user, others, mentions, lanes.user_activities, lanes.user_processes)
 
 
 _INT_RANGE = (-(2**63), 2**63 - 1)
@@ -185,8 +205,9 @@ class OcelWriter(_StreamingWriter):
                 chains.see(event)
                 if event.kind not in self.kinds:
                     continue
-                relations = [(user, "performed by" if event.lane == "user" else "for")]
-                if event.lane != "user":
+                by_user = self.people.performs(event)
+                relations = [(user, "performed by" if by_user else "for")]
+                if not by_user:
                     relations.append((device, "performed by"))
                 root = chains.root(event.instance)
                 if root is not None:

@@ -218,3 +218,30 @@ def test_an_interrupted_ocel_export_leaves_only_the_partial_file(tmp_path):
     with pytest.raises(RuntimeError), OcelWriter(path) as writer:
         writer.add_case("A/0", broken())
     assert not path.exists() and (tmp_path / "t.jsonocel.partial").exists()
+
+
+def test_ocel_relates_a_user_workflows_events_to_the_user_whatever_its_lanes_say(tmp_path):
+    """The pill template's user workflow has no opspec:Lane directive: its events carry no
+    lane, yet they are the user's work (its activities are manual, performed by the HUMAN
+    participant). OCEL 2.0 relationships qualify how an object takes part in an event; the
+    user ``performed by``, not the device."""
+    import contextlib
+    import io
+
+    assert main(["new", str(tmp_path / "pill"), "--template", "pill"]) == 0
+    with contextlib.redirect_stdout(io.StringIO()), contextlib.redirect_stderr(io.StringIO()):
+        assert main(["evaluate", str(tmp_path / "pill" / "pill.xpdl"), "--users", "2",
+                     "--days", "1", "--workers", "1", "--out", str(tmp_path / "run"),
+                     "--export", "ocel", "--quiet"]) == 0
+    doc = json.loads((tmp_path / "run" / "traces.jsonocel").read_text(encoding="utf-8"))
+    users = [e for e in doc["events"] if e["type"].startswith("user_workflow")]
+    device = [e for e in doc["events"] if e["type"].startswith("reminder_workflow")]
+    assert users and device
+    for event in users:
+        qualifiers = {r["objectId"].split(" ")[0]: r["qualifier"]
+                      for r in event["relationships"]}
+        assert qualifiers.get("user") == "performed by" and "device" not in qualifiers, event
+    for event in device:
+        qualifiers = {r["objectId"].split(" ")[0]: r["qualifier"]
+                      for r in event["relationships"]}
+        assert qualifiers.get("device") == "performed by" and qualifiers["user"] == "for"
