@@ -210,10 +210,12 @@ def _percent_axis(ax: Axes, axis: str = "x") -> None:
     target.set_major_formatter(PercentFormatter(xmax=1.0, decimals=None, symbol=PERCENT))
 
 
-def _fmt(value: float, percent: bool) -> str:
-    if percent:             # as the report's tables print it: the same numbers everywhere
-        return f"{100.0 * value:.2f} %"
-    return f"{value:.4g}"
+def _fmt(value: float, percent: bool, unit: str = "") -> str:
+    """A number as the report's tables print it (:func:`.tables.fmt`): the same numbers
+    everywhere (tests/evaluation_output/test_figure_numbers.py compares them)."""
+    from opspec.evaluation.tables import fmt
+
+    return fmt(float(value), unit, percent=percent)
 
 
 def _note_dropped(fig: Figure, dropped: int) -> None:
@@ -469,7 +471,13 @@ def per_user_figure(series: Mapping[str, Sequence[float]], path: Path, *,
                 counts = [int(np.sum(arr == v)) for v in distinct]
                 ax.vlines(distinct, 0, counts, colors=PALETTE[0], linewidth=5,
                           clip_on=False)
-                ax.set_ylim(0, max(counts) * 1.1)
+                # each bar's number of users above it: one user at 7 % next to 180 at 0 %
+                # is a bar too short to see, and a reader should not have to guess it
+                for value, count in zip(distinct, counts, strict=True):
+                    ax.annotate(f"{count}", (float(value), count), xytext=(0, 2),
+                                textcoords="offset points", ha="center", va="bottom",
+                                fontsize=8)
+                ax.set_ylim(0, max(counts) * 1.2)
             else:               # one outlined patch, not a rectangle per bin
                 ax.hist(arr, bins="auto", histtype="stepfilled", color=PALETTE[5],
                         edgecolor=PALETTE[0], linewidth=0.8)
@@ -478,7 +486,7 @@ def per_user_figure(series: Mapping[str, Sequence[float]], path: Path, *,
                 pad = max((high - low) * 0.05, 0.5)
                 ax.set_xlim(max(0.0, low - pad), min(100.0, high + pad))
             mean = float(arr.mean())
-            label = f"{mean:.2f} %" if unit == "%" else f"{mean:.4g}{' ' + unit if unit else ''}"
+            label = _fmt(mean / scale, unit == "%", "" if unit == "%" else unit)
             # the mean in the panel's title, not in a legend box: a box in a corner hid the
             # tallest bar when most users sit at one end (a taken rate near 100 %)
             ax.axvline(mean, color=PALETTE[1], linewidth=1.8, linestyle="--")

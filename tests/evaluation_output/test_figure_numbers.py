@@ -107,6 +107,22 @@ def test_each_users_own_values_are_the_per_user_tables(report: lxml_html.HtmlEle
     assert means and set(means) == set(rows), (means, rows)
     for label, mean in means.items():
         assert mean == rows[label]["mean"], label
+    # a panel of discrete values labels each bar with its number of users (drawn after the
+    # axis' "users" label, before the panel's title): together, every user of the table
+    counted: dict[str, int] = {}
+    bars: list[int] = []
+    for text in texts:
+        if text == "users":
+            bars = []
+        elif re.fullmatch(r"\d+", text):
+            bars.append(int(text))
+        elif (match := re.fullmatch(r"(.+?)(, mean per user)?: mean over users .*", text)):
+            if bars:
+                counted[match.group(1)] = sum(bars)
+            bars = []
+    assert counted, "no panel of discrete values labels its bars"
+    for label, users in counted.items():
+        assert users == int(rows[label]["users"]), label
 
 
 def test_a_durations_marks_are_the_estimates_tables(report: lxml_html.HtmlElement) -> None:
