@@ -659,7 +659,8 @@ def _writer(fmt: str, path: Path, plan: Any) -> Any:
     from opspec.evaluation.ocel import OcelWriter, people_of
 
     package = load_any_spec(plan.design("A").spec)
-    people = people_of(package, user_lane(compile_package(package)).bind_names)
+    compiled = compile_package(package)
+    people = people_of(package, user_lane(compiled).bind_names, compiled)
     return OcelWriter(path, people=people)
 
 

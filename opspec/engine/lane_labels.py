@@ -49,6 +49,8 @@ class LaneLabels:
     process_lane: dict[str, str]
     user_activities: frozenset[tuple[str, str]]
     width: int = WIDTH
+    #: workflows that are the user lane's as a whole (their own start, end, deadlock)
+    user_processes: frozenset[str] = frozenset()
     where_width: int = WHERE
 
     def label(self, event: Any) -> str:
@@ -59,7 +61,7 @@ class LaneLabels:
             return _cut(self.names.get(lane, lane), self.width)
         if event.process is None:
             return ""
-        if self.is_user(event):
+        if event.activity is not None and self.is_user(event):
             return USER
         return _cut(self.process_lane.get(event.process, DEVICE), self.width)
 
@@ -67,7 +69,9 @@ class LaneLabels:
         """Whether ``event`` is the user lane's (its activity is, or its lane is ``user``)."""
         if event.lane == USER:
             return True
-        return (event.process or "", event.activity or "") in self.user_activities
+        if event.activity is None:
+            return (event.process or "") in self.user_processes
+        return (event.process or "", event.activity) in self.user_activities
 
     def where(self, event: Any) -> str:
         """``process#instance`` (or the process alone), padded to the column's width."""
@@ -103,6 +107,17 @@ def lane_labels(compiled: CompiledPackage) -> LaneLabels:
         if act.lane:
             per_process.setdefault(act.process, set()).add(names.get(act.lane, act.lane))
     process_lane: dict[str, str] = {}
+    # a workflow is the user's when every activity placed in a lane is the user lane's; its
+    # activities in no lane (an end event drawn outside the lane) are then the user's too
+    every: dict[str, list[bool]] = {}
+    for act in activities:
+        if act.lanes:
+            every.setdefault(act.process, []).append(act.user_lane)
+    user_processes = frozenset(
+        pid for pid, proc in compiled.processes.items()
+        if proc.lane == USER or (every.get(pid) and all(every[pid])))
+    user.update((act.process, act.id) for act in activities
+                if not act.lanes and act.process in user_processes)
     for pid, proc in compiled.processes.items():
         if proc.lane:
             process_lane[pid] = names.get(proc.lane, proc.lane)
@@ -111,7 +126,8 @@ def lane_labels(compiled: CompiledPackage) -> LaneLabels:
         elif per_process.get(pid):
             process_lane[pid] = ""               # its events belong to no single lane
         else:
-            process_lane[pid] = USER if any(p == pid for p, _a in user) else DEVICE
+            process_lane[pid] = USER if pid in user_processes or any(
+                p == pid for p, _a in user) else DEVICE
     shown = {DEVICE, *process_lane.values(), *names.values(),
              *(lane for labels in per_process.values() for lane in labels)}
     if user:
@@ -121,4 +137,4 @@ def lane_labels(compiled: CompiledPackage) -> LaneLabels:
     where = min(MAX_WHERE, max((len(pid) for pid in compiled.processes), default=0) + 5)
     return LaneLabels(names=names, process_lane=process_lane,
                       user_activities=frozenset(user), width=width,
-                      where_width=max(where, WHERE))
+                      where_width=max(where, WHERE), user_processes=user_processes)

@@ -10,16 +10,18 @@ Objects of one simulated user (design ``A``, user 3 → ids ending in ``A/3``):
 
 - ``user A/3``: the simulated user (type ``user``);
 - ``device A/3``: the user's device, everything the device lane does (type ``device``);
-- ``dose A/3/timer_workflow#1``: one chain of workflow instances (:mod:`.cases`: for the
-  dispenser, one dose; type ``dose``);
+- ``A/3/timer_workflow#1``: one chain of workflow instances (:mod:`.cases`: for the
+  dispenser, one dose; for a stove guard, one cooking session), typed after the spec's own
+  workflow that starts the chain (``timer_workflow``, ``guard_workflow``): the same id as
+  the chain's case in the XES and JSONL exports;
 - one object per other person the spec declares (a ``HUMAN`` participant that does not
   perform the user lane, e.g. ``caregiver A/3``; its type is the participant id).
 
 Event relationships (qualifiers): the user — ``performed by`` for user-lane events, ``for``
-otherwise; the device — ``performed by`` for the other lanes' events; the dose — ``part of``;
+otherwise; the device — ``performed by`` for the other lanes' events; the chain — ``part of``;
 another person — ``performed by`` when they perform the activity, ``concerns`` when the
 activity names them (its id, name or application mentions the participant's id or name:
-``notify_caregiver``). Object-to-object: the device, each dose and each other person relate
+``notify_caregiver``). Object-to-object: the device, each chain and each other person relate
 to the user (``belongs to``, ``for``, ``cares for``).
 
 The events are those of the XES export (:data:`.exporters.DEFAULT_XES_KINDS`), typed
@@ -63,10 +65,25 @@ class People:
     user: frozenset[str] = frozenset({"user"})
     others: Mapping[str, str] = field(default_factory=dict)
     mentions: Mapping[tuple[str, str], tuple[str, ...]] = field(default_factory=dict)
+    #: the user lane's work as the compiled spec has it: activities ``(process, activity)``
+    #: and whole workflows (a user workflow's own start and end), whatever its lane is called
+    user_activities: frozenset[tuple[str, str]] = frozenset()
+    user_processes: frozenset[str] = frozenset()
+
+    def performs(self, event: TraceEvent) -> bool:
+        """Whether ``event`` is the user lane's (the simulated user performs it)."""
+        if event.lane == "user":
+            return True
+        if event.activity is None:
+            return (event.process or "") in self.user_processes
+        return (event.process or "", event.activity) in self.user_activities
 
 
-def people_of(package: Any, user_participants: Iterable[str]) -> People:
-    """The :class:`People` of a loaded package (:class:`opspec.model.Package`)."""
+def people_of(package: Any, user_participants: Iterable[str],
+              compiled: Any = None) -> People:
+    """The :class:`People` of a loaded package (:class:`opspec.model.Package`); with its
+    ``compiled`` package, which events are the user lane's work (a BPMN lane "Resident", a
+    user workflow with no lane directive)."""
     user = frozenset(user_participants)
     humans = [p for p in getattr(package, "participants", ())
               if getattr(p, "is_human", False) and p.id not in user]
@@ -85,7 +102,12 @@ def people_of(package: Any, user_participants: Iterable[str]) -> People:
                                      for w in names))
             if concerned:
                 mentions[(process.id, activity.id)] = concerned
-    return People(user, others, mentions)
+    if compiled is None:
+        return People(user, others, mentions)
+    from opspec.engine.lane_labels import lane_labels
+
+    lanes = lane_labels(compiled)
+    return People(user, others, mentions, lanes.user_activities, lanes.user_processes)
 
 
 _INT_RANGE = (-(2**63), 2**63 - 1)
@@ -125,8 +147,8 @@ class OcelWriter(_StreamingWriter):
         self.objects = 0
         self._ids = 0
         self._event_types: dict[str, dict[str, str]] = {}
-        self._object_types: dict[str, dict[str, str]] = {
-            "user": {}, "device": {}, "dose": {}}
+        # the chains' types (their root workflows) are declared as they first occur
+        self._object_types: dict[str, dict[str, str]] = {"user": {}, "device": {}}
         for kind in self.people.others.values():
             self._object_types.setdefault(kind, {})
         self._first_event = True
@@ -176,25 +198,27 @@ class OcelWriter(_StreamingWriter):
         self._object(device, "device", {}, [(user, "belongs to")])
         others: dict[str, str] = {}
         chains = ChainTracker()
-        doses: set[int] = set()
+        chained: set[int] = set()
         written = 0
         try:
             for event in events:
                 chains.see(event)
                 if event.kind not in self.kinds:
                     continue
-                relations = [(user, "performed by" if event.lane == "user" else "for")]
-                if event.lane != "user":
+                by_user = self.people.performs(event)
+                relations = [(user, "performed by" if by_user else "for")]
+                if not by_user:
                     relations.append((device, "performed by"))
                 root = chains.root(event.instance)
                 if root is not None:
-                    dose = f"dose {case_id}/{chains.name(root)}"
-                    if root not in doses:
-                        doses.add(root)
-                        self._object(dose, "dose", {"process": chains.name(root).split("#")[0],
-                                                    "instance": root},
+                    chain = f"{case_id}/{chains.name(root)}"
+                    if root not in chained:
+                        chained.add(root)
+                        process = chains.name(root).split("#")[0]
+                        self._object(chain, self._chain_type(process),
+                                     {"process": process, "instance": root},
                                      [(user, "for"), (device, "on")])
-                    relations.append((dose, "part of"))
+                    relations.append((chain, "part of"))
                 for person, qualifier in self._people(event):
                     oid = others.get(person)
                     if oid is None:
@@ -209,6 +233,12 @@ class OcelWriter(_StreamingWriter):
             raise
         self.cases += 1
         self.events += written
+
+    def _chain_type(self, process: str) -> str:
+        """A chain's object type: its root workflow's id, unless a workflow is named like
+        one of the other types (``user``, ``device``, a person's participant id)."""
+        taken = {"user", "device", *self.people.others.values()}
+        return process if process not in taken else f"{process} workflow"
 
     def _people(self, event: TraceEvent) -> list[tuple[str, str]]:
         found: list[tuple[str, str]] = []

@@ -99,6 +99,10 @@ NO_OBSERVATIONS = "no observations"
 
 # --------------------------------------------------------------------------------- helpers
 
+#: the percent sign as the tables write it ("99.61 %"): after a space, on the axes too
+PERCENT = " %"
+
+
 @contextmanager
 def figure_format(name: str) -> Iterator[None]:
     """Within this block, figures are written as ``name`` (one of :data:`FORMATS`)."""
@@ -203,13 +207,15 @@ def _percent_axis(ax: Axes, axis: str = "x") -> None:
     from matplotlib.ticker import PercentFormatter
 
     target = ax.xaxis if axis == "x" else ax.yaxis
-    target.set_major_formatter(PercentFormatter(xmax=1.0, decimals=None))
+    target.set_major_formatter(PercentFormatter(xmax=1.0, decimals=None, symbol=PERCENT))
 
 
-def _fmt(value: float, percent: bool) -> str:
-    if percent:             # as the report's tables print it: the same numbers everywhere
-        return f"{100.0 * value:.2f} %"
-    return f"{value:.4g}"
+def _fmt(value: float, percent: bool, unit: str = "") -> str:
+    """A number as the report's tables print it (:func:`.tables.fmt`): the same numbers
+    everywhere (tests/evaluation_output/test_figure_numbers.py compares them)."""
+    from opspec.evaluation.tables import fmt
+
+    return fmt(float(value), unit, percent=percent)
 
 
 def _note_dropped(fig: Figure, dropped: int) -> None:
@@ -350,7 +356,7 @@ def rates_figure(rows: Sequence[tuple[str, float, float, float]], path: Path) ->
                 left, right = max(left, 0.0), min(right, 1.0)
                 step = max((right - left) * 100.0 / 6.0, 1e-9)   # about six ticks
                 ax.xaxis.set_major_formatter(PercentFormatter(
-                    xmax=1.0, decimals=max(0, -math.floor(math.log10(step)))))
+                    xmax=1.0, decimals=max(0, -math.floor(math.log10(step))), symbol=PERCENT))
             ax.set_xlim(left, right)
             ax.xaxis.set_major_locator(MaxNLocator(6))
         if all(_is_rate([e, lo, hi]) for _, e, lo, hi in clean):
@@ -423,7 +429,9 @@ def time_of_day_figure(series: Mapping[str, Sequence[int]], path: Path) -> Path:
             # each hour is the bin [h, h+1): one outlined step patch, not 24 bar artists
             ax.stairs(counts, range(25), fill=True, facecolor=PALETTE[i % len(PALETTE)],
                       edgecolor="black", linewidth=0.6)
-            ax.set_ylabel(name, rotation=0, ha="right", va="center")
+            # the quantity in words: events of all users and days (the day-by-day panels
+            # say "per user"; these are totals)
+            ax.set_ylabel(f"{name}\n(events, all users)", rotation=0, ha="right", va="center")
             ax.set_ylim(0, max(counts) * 1.15)
         axes[-1].set_xlabel("hour of the simulated day (each bar from h:00 to h:59)")
         axes[-1].set_xticks(range(0, 25, 3))
@@ -463,7 +471,13 @@ def per_user_figure(series: Mapping[str, Sequence[float]], path: Path, *,
                 counts = [int(np.sum(arr == v)) for v in distinct]
                 ax.vlines(distinct, 0, counts, colors=PALETTE[0], linewidth=5,
                           clip_on=False)
-                ax.set_ylim(0, max(counts) * 1.1)
+                # each bar's number of users above it: one user at 7 % next to 180 at 0 %
+                # is a bar too short to see, and a reader should not have to guess it
+                for value, count in zip(distinct, counts, strict=True):
+                    ax.annotate(f"{count}", (float(value), count), xytext=(0, 2),
+                                textcoords="offset points", ha="center", va="bottom",
+                                fontsize=8)
+                ax.set_ylim(0, max(counts) * 1.2)
             else:               # one outlined patch, not a rectangle per bin
                 ax.hist(arr, bins="auto", histtype="stepfilled", color=PALETTE[5],
                         edgecolor=PALETTE[0], linewidth=0.8)
@@ -472,7 +486,7 @@ def per_user_figure(series: Mapping[str, Sequence[float]], path: Path, *,
                 pad = max((high - low) * 0.05, 0.5)
                 ax.set_xlim(max(0.0, low - pad), min(100.0, high + pad))
             mean = float(arr.mean())
-            label = f"{mean:.2f} %" if unit == "%" else f"{mean:.4g}{' ' + unit if unit else ''}"
+            label = _fmt(mean / scale, unit == "%", "" if unit == "%" else unit)
             # the mean in the panel's title, not in a legend box: a box in a corner hid the
             # tallest bar when most users sit at one end (a taken rate near 100 %)
             ax.axvline(mean, color=PALETTE[1], linewidth=1.8, linestyle="--")
@@ -707,7 +721,8 @@ def sweep_figure(parameter: str, xs: Sequence[float], labels: Sequence[str],
             if percent.get(name):
                 from matplotlib.ticker import PercentFormatter
 
-                ax.yaxis.set_major_formatter(PercentFormatter(xmax=100.0, decimals=None))
+                ax.yaxis.set_major_formatter(PercentFormatter(xmax=100.0, decimals=None,
+                                                              symbol=PERCENT))
             _outside_legend(ax)
         axes[-1].set_xticks(list(xs), [_text(label) for label in labels])
         axes[-1].set_xlabel(_text(parameter))

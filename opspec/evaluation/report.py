@@ -430,7 +430,7 @@ def _design_sections(store: ResultStore, figures: Path, design: str, name: str, 
 
     sections: list[Any] = []
     # the estimates: the table, and the rates each on its own scale (same numbers)
-    rates = [(n, s["value"], *(s["ci95"] or [s["value"], s["value"]]))
+    rates = [(words(n), s["value"], *(s["ci95"] or [s["value"], s["value"]]))
              for n, s in metrics.items() if is_rate(n, s) and s["value"] is not None]
     images, captions = [], []
     if rates:

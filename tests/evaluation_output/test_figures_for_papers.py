@@ -39,7 +39,7 @@ def test_the_html_report_inlines_vector_figures(run: Path) -> None:
     assert html.count("<svg") == len(figures)
     assert "data:image/png" not in html
     # self-contained: nothing points the reader to files they do not have
-    assert "docs/" not in re.sub(r"<svg.*?</svg>", "", html, flags=re.S)
+    assert "docs/" not in re.sub(r"<svg.*?</svg>", "", html, flags=re.DOTALL)
 
 
 def test_figures_carry_no_titles_and_label_axes_in_words(

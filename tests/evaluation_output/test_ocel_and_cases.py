@@ -76,12 +76,17 @@ def test_ocel_events_and_objects_match_the_trace_and_the_metrics(run):
     assert kinds == Counter(e["kind"] for e in exported)
     types = Counter(o["type"] for o in ocel["objects"])
     assert types["user"] == USERS and types["device"] == USERS
-    # one dose object per dose the dispenser announced (the spec's own doses_due metric)
-    assert types["dose"] == doc["metrics"]["doses_due"]["total"] == USERS * DAYS * 4
-    # every event concerns its user; device-lane events their device
+    # one object per dose the dispenser announced (the spec's own doses_due metric), typed
+    # after the spec's own workflow that starts a dose, not a word opspec made up
+    assert types["timer_workflow"] == doc["metrics"]["doses_due"]["total"] == USERS * DAYS * 4
+    assert {"user", "device", "timer_workflow"} <= set(types) <= {
+        "user", "device", "timer_workflow", "caregiver"}
+    # every event concerns its user and is part of a chain, whose id is its XES/JSONL case
+    cases = {e["case"] for e in jsonl_events(out / "traces.jsonl")}
     for event in ocel["events"]:
-        related = {r["objectId"].split(" ")[0] for r in event["relationships"]}
-        assert "user" in related and "dose" in related
+        related = {r["objectId"] for r in event["relationships"]}
+        assert any(o.startswith("user ") for o in related)
+        assert len(related & cases) == 1
 
 
 def test_pm4py_reads_the_ocel_log(run):
@@ -93,7 +98,8 @@ def test_pm4py_reads_the_ocel_log(run):
     trace = jsonl_events(out / "traces.jsonl")
     assert len(ocel.events) == sum(1 for e in trace if e["kind"] in DEFAULT_XES_KINDS)
     counts = ocel.objects["ocel:type"].value_counts().to_dict()
-    assert counts == {"dose": doc["metrics"]["doses_due"]["total"], "user": USERS,
+    counts.pop("caregiver", None)            # only when a dose was missed
+    assert counts == {"timer_workflow": doc["metrics"]["doses_due"]["total"], "user": USERS,
                       "device": USERS}
 
 
@@ -212,3 +218,30 @@ def test_an_interrupted_ocel_export_leaves_only_the_partial_file(tmp_path):
     with pytest.raises(RuntimeError), OcelWriter(path) as writer:
         writer.add_case("A/0", broken())
     assert not path.exists() and (tmp_path / "t.jsonocel.partial").exists()
+
+
+def test_ocel_relates_a_user_workflows_events_to_the_user_whatever_its_lanes_say(tmp_path):
+    """The pill template's user workflow has no opspec:Lane directive: its events carry no
+    lane, yet they are the user's work (its activities are manual, performed by the HUMAN
+    participant). OCEL 2.0 relationships qualify how an object takes part in an event; the
+    user ``performed by``, not the device."""
+    import contextlib
+    import io
+
+    assert main(["new", str(tmp_path / "pill"), "--template", "pill"]) == 0
+    with contextlib.redirect_stdout(io.StringIO()), contextlib.redirect_stderr(io.StringIO()):
+        assert main(["evaluate", str(tmp_path / "pill" / "pill.xpdl"), "--users", "2",
+                     "--days", "1", "--workers", "1", "--out", str(tmp_path / "run"),
+                     "--export", "ocel", "--quiet"]) == 0
+    doc = json.loads((tmp_path / "run" / "traces.jsonocel").read_text(encoding="utf-8"))
+    users = [e for e in doc["events"] if e["type"].startswith("user_workflow")]
+    device = [e for e in doc["events"] if e["type"].startswith("reminder_workflow")]
+    assert users and device
+    for event in users:
+        qualifiers = {r["objectId"].split(" ")[0]: r["qualifier"]
+                      for r in event["relationships"]}
+        assert qualifiers.get("user") == "performed by" and "device" not in qualifiers, event
+    for event in device:
+        qualifiers = {r["objectId"].split(" ")[0]: r["qualifier"]
+                      for r in event["relationships"]}
+        assert qualifiers.get("device") == "performed by" and qualifiers["user"] == "for"
