@@ -7,6 +7,8 @@ from __future__ import annotations
 
 import math
 from abc import ABC, abstractmethod
+from collections.abc import Callable
+from dataclasses import fields
 from statistics import NormalDist
 from typing import Any
 
@@ -53,6 +55,13 @@ def _non_negative(param: str, value: float) -> float:
     if value < 0 or math.isinf(value):
         raise ParameterError(param, f"must be >= 0, got {value:g}")
     return value
+
+
+def _check_fields(instance: object, **checks: Callable[[str, float], float]) -> None:
+    """Check (and normalise to float) each named parameter of a frozen dataclass in
+    ``__post_init__``: ``_check_fields(self, shape=_positive, scale=_positive)``."""
+    for name, check in checks.items():
+        object.__setattr__(instance, name, check(name, getattr(instance, name)))
 
 
 def _phi(z: float) -> float:
@@ -106,6 +115,8 @@ class Distribution(ABC):
     def scaled(self, factor: float) -> Distribution:
         """The distribution of ``factor * X`` (``factor`` > 0)."""
 
-    @abstractmethod
     def to_params(self) -> dict[str, Any]:
-        """The TOML table form, read back by :func:`make_distribution`."""
+        """The TOML table form, read back by :func:`make_distribution`: the kind and each
+        parameter under its field's name (a class whose TOML names differ overrides this)."""
+        return {"kind": self.kind,
+                **{f.name: getattr(self, f.name) for f in fields(self) if f.init}}  # type: ignore[arg-type]

@@ -15,6 +15,7 @@ from opspec.distributions.base import (
     Distribution,
     FloatArray,
     ParameterError,
+    _check_fields,
     _check_q,
     _finite,
     _non_negative,
@@ -86,9 +87,6 @@ class Triangular(Distribution):
         f = _positive("factor", factor)
         return Triangular(self.low * f, self.mode * f, self.high * f)
 
-    def to_params(self) -> dict[str, Any]:
-        return {"kind": "triangular", "low": self.low, "mode": self.mode, "high": self.high}
-
 
 @dataclass(frozen=True, slots=True)
 class Uniform(Distribution):
@@ -129,9 +127,6 @@ class Uniform(Distribution):
     def scaled(self, factor: float) -> Uniform:
         f = _positive("factor", factor)
         return Uniform(self.low * f, self.high * f)
-
-    def to_params(self) -> dict[str, Any]:
-        return {"kind": "uniform", "low": self.low, "high": self.high}
 
 
 @dataclass(frozen=True, slots=True)
@@ -206,7 +201,7 @@ class WithExponentialTail(Distribution):
     kind = "with_tail"
 
     def __post_init__(self) -> None:
-        object.__setattr__(self, "tau", _positive("tau", self.tau))
+        _check_fields(self, tau=_positive)
 
     def sample(self, rng: np.random.Generator) -> float:
         return self.base.sample(rng) + float(rng.exponential(self.tau))

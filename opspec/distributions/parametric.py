@@ -14,6 +14,7 @@ from opspec.distributions.base import (
     Distribution,
     FloatArray,
     ParameterError,
+    _check_fields,
     _check_q,
     _finite,
     _ncdf,
@@ -34,7 +35,7 @@ class Constant(Distribution):
     kind = "constant"
 
     def __post_init__(self) -> None:
-        object.__setattr__(self, "value", _non_negative("value", self.value))
+        _check_fields(self, value=_non_negative)
 
     def sample(self, rng: np.random.Generator) -> float:
         return self.value
@@ -60,9 +61,6 @@ class Constant(Distribution):
     def scaled(self, factor: float) -> Constant:
         return Constant(self.value * factor)
 
-    def to_params(self) -> dict[str, Any]:
-        return {"kind": "constant", "value": self.value}
-
 
 @dataclass(frozen=True, slots=True)
 class LogNormal(Distribution):
@@ -73,8 +71,7 @@ class LogNormal(Distribution):
     kind = "lognormal"
 
     def __post_init__(self) -> None:
-        object.__setattr__(self, "mu", _finite("mu", self.mu))
-        object.__setattr__(self, "sigma", _positive("sigma", self.sigma))
+        _check_fields(self, mu=_finite, sigma=_positive)
 
     @classmethod
     def from_median(cls, median: float, sigma: float) -> LogNormal:
@@ -134,8 +131,7 @@ class Gamma(Distribution):
     kind = "gamma"
 
     def __post_init__(self) -> None:
-        object.__setattr__(self, "shape", _positive("shape", self.shape))
-        object.__setattr__(self, "scale", _positive("scale", self.scale))
+        _check_fields(self, shape=_positive, scale=_positive)
 
     def sample(self, rng: np.random.Generator) -> float:
         return float(rng.gamma(self.shape, self.scale))
@@ -164,9 +160,6 @@ class Gamma(Distribution):
     def scaled(self, factor: float) -> Gamma:
         return Gamma(self.shape, self.scale * _positive("factor", factor))
 
-    def to_params(self) -> dict[str, Any]:
-        return {"kind": "gamma", "shape": self.shape, "scale": self.scale}
-
 
 @dataclass(frozen=True, slots=True)
 class Weibull(Distribution):
@@ -177,8 +170,7 @@ class Weibull(Distribution):
     kind = "weibull"
 
     def __post_init__(self) -> None:
-        object.__setattr__(self, "shape", _positive("shape", self.shape))
-        object.__setattr__(self, "scale", _positive("scale", self.scale))
+        _check_fields(self, shape=_positive, scale=_positive)
 
     def sample(self, rng: np.random.Generator) -> float:
         return self.scale * float(rng.weibull(self.shape))
@@ -204,9 +196,6 @@ class Weibull(Distribution):
 
     def scaled(self, factor: float) -> Weibull:
         return Weibull(self.shape, self.scale * _positive("factor", factor))
-
-    def to_params(self) -> dict[str, Any]:
-        return {"kind": "weibull", "shape": self.shape, "scale": self.scale}
 
 
 @dataclass(frozen=True, slots=True)
@@ -361,9 +350,7 @@ class ExGaussian(Distribution):
     kind = "exgauss"
 
     def __post_init__(self) -> None:
-        object.__setattr__(self, "mu", _finite("mu", self.mu))
-        object.__setattr__(self, "sigma", _positive("sigma", self.sigma))
-        object.__setattr__(self, "tau", _positive("tau", self.tau))
+        _check_fields(self, mu=_finite, sigma=_positive, tau=_positive)
 
     def _frozen(self) -> Any:
         from scipy import stats  # lazy: importing scipy.stats takes about 2 s
@@ -396,6 +383,3 @@ class ExGaussian(Distribution):
     def scaled(self, factor: float) -> ExGaussian:
         f = _positive("factor", factor)
         return ExGaussian(self.mu * f, self.sigma * f, self.tau * f)
-
-    def to_params(self) -> dict[str, Any]:
-        return {"kind": "exgauss", "mu": self.mu, "sigma": self.sigma, "tau": self.tau}

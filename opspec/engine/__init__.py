@@ -6,7 +6,7 @@ Import what you need from the submodules; the names below are loaded lazily so t
 
 from __future__ import annotations
 
-from typing import Any
+from opspec.lazy_names import lazy_names
 
 __all__ = [
     "CallablePerformer",
@@ -41,10 +41,4 @@ _WHERE = {
 }
 
 
-def __getattr__(name: str) -> Any:
-    module = _WHERE.get(name)
-    if module is None:
-        raise AttributeError(f"module 'opspec.engine' has no attribute {name!r}")
-    import importlib
-
-    return getattr(importlib.import_module(module), name)
+__getattr__ = lazy_names(__name__, _WHERE)

@@ -23,7 +23,7 @@ numpy until used). The guide is ``docs/spec-testing.md``.
 
 from __future__ import annotations
 
-from typing import Any
+from opspec.lazy_names import lazy_names
 
 __all__ = [
     "InstanceRun",
@@ -102,10 +102,4 @@ _WHERE = {
 }
 
 
-def __getattr__(name: str) -> Any:
-    module = _WHERE.get(name)
-    if module is None:
-        raise AttributeError(f"module 'opspec.testing' has no attribute {name!r}")
-    import importlib
-
-    return getattr(importlib.import_module(module), name)
+__getattr__ = lazy_names(__name__, _WHERE)
