@@ -1,14 +1,18 @@
 """``opspec study PROTOCOL.toml``: the sessions of a walkthrough study, and its summary.
 
 ``--participant ID`` runs that participant's sessions not done yet, in their counterbalanced
-order, each after its briefing; without it, the study's status, the summary per variant and
-the paired comparison of the designs (docs/walkthrough.md, *A study*).
+order, each after its briefing (``--next``: only the first of them); ``--serve`` serves one
+link per participant, whose browser runs the same sessions (opspec.tui.study_serve); without
+either, the study's status, the summary per variant and the paired comparison of the designs
+(docs/walkthrough.md, *A study*).
 """
 
 from __future__ import annotations
 
 import argparse
 import json
+import os
+import sys
 from typing import Any
 
 __all__ = ["register"]
@@ -26,13 +30,29 @@ def register(subparsers: Any) -> None:
     parser.add_argument("protocol", metavar="PROTOCOL.toml", help="the study protocol")
     parser.add_argument("--participant", metavar="ID",
                         help="run this participant's sessions that are not done yet")
+    parser.add_argument("--next", action="store_true",
+                        help="with --participant: run only their next session not done")
     parser.add_argument("--json", action="store_true",
                         help="print the summary as JSON (without --participant)")
+    web = parser.add_argument_group("participants in a browser")
+    web.add_argument("--serve", action="store_true",
+                     help="serve the sessions over HTTP: print one link per participant, "
+                     "whose browser runs their sessions; recordings are written here "
+                     "(needs the study extra: pip install 'opspec[study]')")
+    web.add_argument("--host", default="127.0.0.1",
+                     help="with --serve: the address to listen on (default 127.0.0.1, this "
+                     "machine only; 0.0.0.0 for other machines)")
+    web.add_argument("--port", type=int, default=8000,
+                     help="with --serve: the port (default 8000; 0: any free one)")
+    web.add_argument("--public-url", metavar="URL",
+                     help="with --serve: the address participants reach the server at, "
+                     "when not host:port (a proxy or tunnel in front)")
     parser.set_defaults(handler=_study)
 
 
 def _study(args: argparse.Namespace) -> int:
     from opspec.commands._spec import load_any_spec
+    from opspec.errors import ConfigurationError
     from opspec.tui.study import (
         finish_session,
         load_protocol,
@@ -44,15 +64,32 @@ def _study(args: argparse.Namespace) -> int:
     protocol = load_protocol(args.protocol)
     for variant in protocol.variants:          # a broken spec opens no session
         load_any_spec(variant.spec)
+    if args.serve:
+        if args.participant is not None:
+            raise ConfigurationError("--serve serves every participant's link: leave out "
+                             "--participant")
+        if not 0 <= args.port <= 65535:
+            raise ConfigurationError(f"--port must be 0..65535, not {args.port}")
+        try:
+            from opspec.tui.study_serve import serve_study
+        except ImportError as error:
+            raise ConfigurationError(f"--serve needs textual-serve ({error.name} is missing)",
+                             hint="pip install 'opspec[study]'") from None
+        return serve_study(protocol, host=args.host, port=args.port,
+                           public_url=args.public_url)
+    if args.next and args.participant is None:
+        raise ConfigurationError("--next runs one participant's next session: give --participant")
+    # in a browser session stdout carries the app's screen: say the outcome on stderr
+    say = sys.stderr if "web_driver" in os.environ.get("TEXTUAL_DRIVER", "") else sys.stdout
     if args.participant is None:
         doc = summary(protocol)
         print(json.dumps(doc, indent=1) if args.json else "\n".join(summary_lines(doc)))
         return 0
     pending = protocol.pending(args.participant)
     if not pending:
-        print(f"participant {args.participant}: every session is done")
+        print(f"participant {args.participant}: every session is done", file=say)
         return 0
-    for session in pending:
+    for session in pending[:1] if args.next else pending:
         app, walk = session_app(protocol, session)
         try:
             app.run()
@@ -64,10 +101,10 @@ def _study(args: argparse.Namespace) -> int:
             print(f"participant {args.participant}, session {session.position} "
                   f"({session.variant.id}) broke off before its end; its recording is kept "
                   f"as a partial one. Resume with: opspec study {args.protocol} "
-                  f"--participant {args.participant}")
+                  f"--participant {args.participant}", file=say)
             return 1
         print(f"participant {args.participant}, session {session.position} "
-              f"({session.variant.id}) done: {session.recording}")
+              f"({session.variant.id}) done: {session.recording}", file=say)
     if not any(protocol.pending(p) for p in protocol.participants):
-        print("\n".join(summary_lines(summary(protocol))))
+        print("\n".join(summary_lines(summary(protocol))), file=say)
     return 0

@@ -7,16 +7,13 @@ from __future__ import annotations
 
 import asyncio
 import json
-import shutil
 from pathlib import Path
 
 import pytest
 
 from opspec.cli import main
 from opspec.tui.study import finish_session, latin_square, load_protocol, session_app, summary
-
-ROOT = Path(__file__).resolve().parents[2]
-SPEC = ROOT / "specs" / "medication_dispenser.xpdl"
+from study_sessions import perform
 
 
 def test_williams_squares_balance_first_places_and_carry_over() -> None:
@@ -36,56 +33,6 @@ def test_williams_squares_balance_first_places_and_carry_over() -> None:
         assert all(pairs.count(p) == (1 if k % 2 == 0 else 2) for p in follows)
 
 
-@pytest.fixture
-def protocol_file(tmp_path: Path) -> Path:
-    quick = tmp_path / "dispenser-30s.xpdl"
-    quick.write_text(SPEC.read_text(encoding="utf-8").replace("PT300S", "PT30S"),
-                     encoding="utf-8")
-    shutil.copy(SPEC.with_name("medication_dispenser.users.toml"),
-                tmp_path / "dispenser-30s.users.toml")
-    protocol = tmp_path / "study.toml"
-    protocol.write_text(f"""
-[study]
-name = "re-alarm after 5 minutes or 30 seconds"
-days = 1
-seed = 4
-recordings = "rec"
-participants = ["P01", "P02", "P03"]
-
-[[variants]]
-id = "A"
-spec = "{SPEC}"
-told = "Variant A: the dispenser rings when a dose is due. Take your pills as at home."
-
-[[variants]]
-id = "B"
-spec = "dispenser-30s.xpdl"
-told = "Variant B: the same dispenser; it may ring again sooner."
-""", encoding="utf-8")
-    return protocol
-
-
-async def _perform(app, walk, *, until_end: bool = True) -> str:
-    """The participant reads the briefing, starts, hands the lane to the model (a stand-in
-    for their own key presses) and skips to the end; or quits half-way."""
-    async with app.run_test(size=(100, 30)) as pilot:
-        await pilot.pause()
-        told = str(app.screen.query_one("#brief-text").render())
-        assert walk.paused                           # the clock waits for the briefing
-        await pilot.press("enter")
-        assert not walk.paused
-        await pilot.press("h")
-        if until_end:
-            for _ in range(500):                     # a bound, not a time limit
-                if walk.ended:
-                    break
-                await pilot.press("u")
-                await pilot.pause()
-            assert walk.ended
-        await pilot.press("q")
-    return told
-
-
 def test_three_participants_two_variants(protocol_file: Path, capsys) -> None:
     protocol = load_protocol(protocol_file)
     assert [v.id for v in protocol.order("P01")] == ["A", "B"]
@@ -95,14 +42,14 @@ def test_three_participants_two_variants(protocol_file: Path, capsys) -> None:
     # P03 breaks off their first session half-way
     first = protocol.pending("P03")[0]
     app, walk = session_app(protocol, first)
-    asyncio.run(_perform(app, walk, until_end=False))
+    asyncio.run(perform(app, walk, until_end=False))
     assert not finish_session(first, walk)
     assert protocol.pending("P03")[0] == first                      # still to do
 
     for participant in protocol.participants:
         for session in protocol.pending(participant):
             app, walk = session_app(protocol, session)
-            told = asyncio.run(_perform(app, walk))
+            told = asyncio.run(perform(app, walk))
             assert told == session.variant.told
             assert finish_session(session, walk)
     rec = protocol.recordings
