@@ -1,0 +1,131 @@
+"""periodic-path: a robot-rate spec through the engine beside a bare SimPy loop of its periods.
+
+    python benchmarks/periodic_path.py [--spec specs/vacuum_cleaner.xpdl] [--seconds 3600]
+                                       [--rounds 5]
+
+Runs, each in its own process and interleaved round after round (engine, loop, engine, …: the
+speed of a shared machine drifts over minutes):
+
+- **engine**: the spec with its world (``SPEC.world.toml``) for ``--seconds`` simulated
+  seconds, built through the front hall as ``opspec run`` builds it (the spec is loaded and
+  compiled before the clock starts);
+- **bare SimPy loop**: one SimPy process per periodic workflow of the spec, each doing
+  nothing but ``yield env.timeout(period)`` at that workflow's period and offset — the floor
+  of what any executor of those periods pays for its clock.
+
+It prints, per round and as the median, the CPU seconds of each, the events each scheduled
+per CPU second (the engine's are every timed callback of the run: periods, CPU demand,
+durations, deadlines, world steps; the loop's are its timeouts) and the ratio of the two
+CPU times. Results in docs/engine-performance.md.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import statistics
+import subprocess
+import sys
+from pathlib import Path
+from typing import Any
+
+ROOT = Path(__file__).resolve().parents[1]
+
+_ENGINE = r"""
+import json, sys, time
+import opspec._native
+from opspec.request import RunRequest, prepare
+spec, seconds = sys.argv[1], float(sys.argv[2])
+prepared = prepare(RunRequest(spec=spec, until=seconds, no_user=True))
+run = prepared.build(0)
+c0 = time.process_time()
+outcome = run.execute()
+cpu = time.process_time() - c0
+summary = outcome.result.summary
+print(json.dumps({"cpu_s": cpu, "events": summary["sim_events"],
+                  "instances": summary["instances"]["started"],
+                  "build": opspec._native.STATUS}))
+"""
+
+_LOOP = r"""
+import json, sys, time
+import simpy
+seconds = float(sys.argv[1])
+periods = json.loads(sys.argv[2])
+env = simpy.Environment()
+def periodic(offset, every):
+    yield env.timeout(offset)
+    while True:
+        yield env.timeout(every)
+for offset, every in periods:
+    env.process(periodic(offset, every))
+c0 = time.process_time()
+env.run(until=seconds)
+cpu = time.process_time() - c0
+events = int(repr(env._eid).split("(")[1].rstrip(")"))   # SimPy's event ids handed out
+print(json.dumps({"cpu_s": cpu, "events": events}))
+"""
+
+
+def periods(spec: str) -> list[tuple[float, float]]:
+    """(offset, period) of every periodic workflow of ``spec`` in its initial mode."""
+    from opspec.engine.compiled import compile_package
+    from opspec.xpdl.open_spec import open_spec
+
+    compiled = compile_package(open_spec(spec))
+    active = compiled.modes.get(compiled.initial_mode or "", None)
+    found = []
+    for proc in compiled.processes.values():
+        trig = proc.start_trigger
+        if trig is None or trig.kind != "period" or not trig.every:
+            continue
+        if active is not None and proc.mode is not None and proc.id not in active:
+            continue
+        found.append((float(trig.offset), float(trig.every)))
+    return found
+
+
+def _run(code: str, *args: str) -> dict[str, Any]:
+    done = subprocess.run([sys.executable, "-c", code, *args], capture_output=True, text=True,
+                          check=False, cwd=ROOT)
+    if done.returncode != 0:
+        sys.exit(f"benchmark process failed:\n{done.stderr}")
+    result: dict[str, Any] = json.loads(done.stdout.strip().splitlines()[-1])
+    return result
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--spec", default=str(ROOT / "specs" / "vacuum_cleaner.xpdl"))
+    parser.add_argument("--seconds", type=float, default=3600.0)
+    parser.add_argument("--rounds", type=int, default=5)
+    args = parser.parse_args()
+    found = periods(args.spec)
+    if not found:
+        sys.exit(f"{args.spec} has no periodic workflow in its initial mode")
+    engines, loops = [], []
+    for _ in range(args.rounds):
+        engines.append(_run(_ENGINE, args.spec, str(args.seconds)))
+        loops.append(_run(_LOOP, str(args.seconds), json.dumps(found)))
+    print(f"periodic-path: {Path(args.spec).name}, {args.seconds:g} simulated s, periods "
+          + ", ".join(f"{every:g} s" for _o, every in found) + f"; {args.rounds} rounds")
+    print(f"engine: {engines[0]['build']}")
+    print(f"{'round':<7}{'engine CPU s':>13}{'events':>9}{'events/s':>11}"
+          f"{'loop CPU s':>12}{'events':>9}{'events/s':>11}{'ratio':>8}")
+    ratios = []
+    for n, (e, b) in enumerate(zip(engines, loops, strict=True), 1):
+        e_cpu, b_cpu = float(e["cpu_s"]), float(b["cpu_s"])
+        ratios.append(e_cpu / b_cpu)
+        print(f"{n:<7}{e_cpu:>13.3f}{e['events']:>9}{int(e['events']) / e_cpu:>11.0f}"
+              f"{b_cpu:>12.3f}{b['events']:>9}{int(b['events']) / b_cpu:>11.0f}"
+              f"{ratios[-1]:>8.1f}")
+    e_med = statistics.median(float(e["cpu_s"]) for e in engines)
+    b_med = statistics.median(float(b["cpu_s"]) for b in loops)
+    print(f"median: engine {e_med:.3f} CPU s ({int(engines[0]['events']) / e_med:,.0f} events/s, "
+          f"{engines[0]['instances']} workflow instances), bare SimPy loop {b_med:.3f} CPU s "
+          f"({int(loops[0]['events']) / b_med:,.0f} events/s); engine / loop "
+          f"{statistics.median(ratios):.1f}x (paired median)")
+
+
+if __name__ == "__main__":
+    main()
