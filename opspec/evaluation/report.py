@@ -36,11 +36,12 @@ from opspec.evaluation.summary import (
     compare_designs,
     metric_definitions,
     subgroup_users,
+    summarise_activities,
     summarise_design,
     summarise_monitors,
     summarise_population,
     user_pairs,
-    user_pairs_by_metric,
+    user_values,
 )
 from opspec.evaluation.tables import (
     DISTRIBUTION_HEADERS,
@@ -129,29 +130,9 @@ def _day_intervals(store: ResultStore, design: str, metrics: list[str], days: in
 
 
 def _activity_rates(store: ResultStore, design: str) -> list[dict[str, Any]]:
-    """Per manual activity: offered, the omission and error rates per offer, and their
-    intervals over users (each user's omissions of their offers: a proportion pooled over
-    users, as a metric's missed rate, method ``wilson-neff``)."""
-    from opspec.statistics import proportion_interval
-
-    per: dict[str, list[tuple[int, int, int]]] = {}
-    for activity, offered, omitted, wrong in store.query(
-            "SELECT activity, offered, omitted, wrong FROM activity WHERE design = ? "
-            "ORDER BY rowid", (design,)):
-        per.setdefault(str(activity), []).append(
-            (int(offered or 0), int(omitted or 0), int(wrong or 0)))
-    out = []
-    for activity, users in per.items():
-        offered = sum(o for o, _, _ in users)
-        if not offered:
-            continue
-        out.append({"activity": activity, "offered": offered,
-                    "omission": sum(m for _, m, _ in users) / offered,
-                    "error": sum(w for _, _, w in users) / offered,
-                    "omission_ci95": proportion_interval([(m, o) for o, m, _ in users]),
-                    "error_ci95": proportion_interval([(w, o) for o, _, w in users]),
-                    "ci95_method": "wilson-neff"})
-    return out
+    """Per manual activity: offered, omission and error rates per offer with their intervals
+    (:func:`opspec.evaluation.summary.summarise_activities`)."""
+    return summarise_activities(store, design)
 
 
 def words(name: str, unit: str | None = None) -> str:
@@ -456,10 +437,10 @@ def _design_sections(store: ResultStore, figures: Path, design: str, name: str, 
         shown = [d for d in definitions
                  if (s := metrics.get(d["name"])) is not None and s["kind"] != "count"
                  and (s.get("per_user") or {}).get("users")]
-        by_metric = user_pairs_by_metric(store, design, shown)
+        by_metric = user_values(store, design, shown).pairs
         for d in shown:
             s = metrics[d["name"]]
-            values = [y / k for _, (y, k) in by_metric[d["name"]] if k > 0]
+            values = [y / k for y, k in by_metric[d["name"]] if k > 0]
             label = (f"{words(d['name'], s.get('unit') or 's')}, mean per user"
                      if s["kind"] == "duration" else words(d["name"]))
             series[label] = values

@@ -308,9 +308,9 @@ class ResultStore:
 
     def user_metrics(self, design: str) -> Iterator[tuple[int, dict[str, dict[str, Any]]]]:
         """(user, metrics) of every complete replication of ``design``, by user."""
-        rows = self.query("SELECT user, metrics FROM replication WHERE design = ? AND "
-                          "status = 'done' AND error IS NULL ORDER BY user", (design,))
-        for user, metrics in rows:
+        for user, metrics in self.rows("SELECT user, metrics FROM replication WHERE design = ? "
+                                       "AND status = 'done' AND error IS NULL ORDER BY user",
+                                       (design,)):
             yield int(user), json.loads(metrics)
 
     def query(self, sql: str, params: tuple[Any, ...] = ()) -> list[tuple[Any, ...]]:
@@ -318,6 +318,17 @@ class ResultStore:
         an EvaluationError with the resume hint."""
         try:
             return list(self._db.execute(sql, params))
+        except sqlite3.Error as error:
+            raise _fail(self.path, "read the stored results", error) from None
+
+    def rows(self, sql: str, params: tuple[Any, ...] = (), batch: int = 1000
+             ) -> Iterator[tuple[Any, ...]]:
+        """Rows of a read, streamed a batch at a time (the memory of one batch, whatever the
+        number of users); a failure is an EvaluationError as with :meth:`query`."""
+        try:
+            cursor = self._db.execute(sql, params)
+            while chunk := cursor.fetchmany(batch):
+                yield from chunk
         except sqlite3.Error as error:
             raise _fail(self.path, "read the stored results", error) from None
 

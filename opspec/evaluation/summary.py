@@ -30,7 +30,9 @@ from __future__ import annotations
 
 import math
 import statistics as pystats
-from collections.abc import Mapping, Sequence
+from array import array
+from collections.abc import Iterator, Mapping, Sequence
+from dataclasses import dataclass
 from typing import Any
 
 from opspec.evaluation.store import ResultStore
@@ -45,8 +47,9 @@ from opspec.statistics import (
 )
 from opspec.statistics.percentiles import interpolation_point, linear
 
-__all__ = ["compare_designs", "has_population", "metric_definitions", "subgroup_users",
-           "summarise_design", "summarise_monitors", "summarise_population", "user_pairs"]
+__all__ = ["Pairs", "UserValues", "compare_designs", "has_population", "metric_definitions",
+           "subgroup_users", "summarise_activities", "summarise_design", "summarise_monitors",
+           "summarise_population", "user_pairs", "user_values"]
 
 #: Percentiles of per-user values reported beside the median (p50).
 PERCENTILES = (("p90", 0.90), ("p95", 0.95), ("p99", 0.99))
@@ -107,33 +110,89 @@ def _in_subgroup(design: str, subgroup: str | None) -> tuple[str, tuple[Any, ...
             (design, subgroup))
 
 
+class Pairs(Sequence[tuple[float, float]]):
+    """The ``(y, n)`` pairs of one metric over users, held as two arrays of doubles (16 bytes
+    per user, where a list of tuples takes about 120): a sequence of pairs to the statistics,
+    which only iterate over it and take its length."""
+
+    __slots__ = ("n", "y")
+
+    def __init__(self, y: array[float] | None = None, n: array[float] | None = None) -> None:
+        self.y = y if y is not None else array("d")
+        self.n = n if n is not None else array("d")
+
+    def __len__(self) -> int:
+        return len(self.y)
+
+    def __iter__(self) -> Iterator[tuple[float, float]]:
+        return zip(self.y, self.n)
+
+    def __getitem__(self, index: Any) -> Any:
+        if isinstance(index, slice):
+            return Pairs(self.y[index], self.n[index])
+        return self.y[index], self.n[index]
+
+
+@dataclass(frozen=True, slots=True)
+class UserValues:
+    """Each finished user's ``(y, n)`` pair of every metric read (:func:`user_values`):
+    ``users`` in user order, and per metric name its :class:`Pairs` in the same order."""
+
+    users: array[int]
+    pairs: Mapping[str, Pairs]
+
+    def of(self, name: str) -> list[tuple[int, tuple[float, float]]]:
+        """``(user, (y, n))`` of metric ``name`` as a list (what :func:`user_pairs` gives)."""
+        return list(zip(self.users, self.pairs[name], strict=True))
+
+
+def user_values(store: ResultStore, design: str, definitions: Sequence[Mapping[str, Any]],
+                users: set[int] | None = None) -> UserValues:
+    """Per finished user of ``design`` (of ``users`` only, when given), the (y, n) pair of
+    every metric in ``definitions``, from one streamed reading of the users' stored metrics
+    (each user's one JSON object, parsed once for all metrics): the memory is the arrays', 16
+    bytes per user and metric, never the stored rows'."""
+    ids = array("q")
+    out = {d["name"]: Pairs() for d in definitions}
+    plan = []
+    for definition in definitions:
+        column = out[definition["name"]]
+        if definition["kind"] == "ratio":
+            plan.append((column.y.append, column.n.append, True,
+                         definition.get("numerator") or "", definition.get("denominator") or ""))
+        else:
+            plan.append((column.y.append, column.n.append, False, definition["name"], ""))
+    for user, metrics in store.user_metrics(design):
+        if users is not None and user not in users:
+            continue
+        ids.append(user)
+        for put_y, put_n, ratio, first, second in plan:
+            if ratio:
+                num, _ = _scalar_pair(metrics.get(first))
+                den, _ = _scalar_pair(metrics.get(second))
+                put_y(num)
+                put_n(den)
+            else:
+                y, n = _scalar_pair(metrics.get(first))
+                put_y(y)
+                put_n(n)
+    return UserValues(ids, out)
+
+
 def user_pairs(store: ResultStore, design: str, definition: Mapping[str, Any],
                users: set[int] | None = None) -> list[tuple[int, tuple[float, float]]]:
     """Per finished user of ``design`` (of ``users`` only, when given): the (y, n) pair of
     ``definition``'s metric."""
-    return user_pairs_by_metric(store, design, [definition], users)[definition["name"]]
+    return user_values(store, design, [definition], users).of(definition["name"])
 
 
 def user_pairs_by_metric(store: ResultStore, design: str,
                          definitions: Sequence[Mapping[str, Any]], users: set[int] | None = None
                          ) -> dict[str, list[tuple[int, tuple[float, float]]]]:
     """:func:`user_pairs` of every metric in ``definitions``, by name, from one reading of
-    the users' stored metrics (each user's are one JSON object: read and parsed once, not
-    once per metric)."""
-    out: dict[str, list[tuple[int, tuple[float, float]]]] = {
-        d["name"]: [] for d in definitions}
-    for user, metrics in store.user_metrics(design):
-        if users is not None and user not in users:
-            continue
-        for definition in definitions:
-            if definition["kind"] == "ratio":
-                num, _ = _scalar_pair(metrics.get(definition.get("numerator") or ""))
-                den, _ = _scalar_pair(metrics.get(definition.get("denominator") or ""))
-                pair = (num, den)
-            else:
-                pair = _scalar_pair(metrics.get(definition["name"]))
-            out[definition["name"]].append((user, pair))
-    return out
+    the users' stored metrics (:func:`user_values`, as lists)."""
+    values = user_values(store, design, definitions, users)
+    return {d["name"]: values.of(d["name"]) for d in definitions}
 
 
 def _pooled_quantile(store: ResultStore, design: str, metric: str, n: int, q: float,
@@ -203,10 +262,10 @@ def summarise_design(store: ResultStore, design: str, days: float, level: float 
     users_of = subgroup_users(store, design, subgroup)
     where, where_params = _in_subgroup(design, subgroup)
     definitions = metric_definitions(store, design)
-    by_metric = user_pairs_by_metric(store, design, definitions, users_of)
+    by_metric = user_values(store, design, definitions, users_of).pairs
     for definition in definitions:
         name, kind = definition["name"], definition["kind"]
-        pairs = [p for _, p in by_metric[name]]
+        pairs = by_metric[name]
         estimate = ratio_estimate(pairs, level)
         users = len(pairs)
         if kind == "count":
@@ -289,6 +348,38 @@ def compare_designs(store: ResultStore, a: str = "A", b: str = "B", level: float
             "users": len(users),
             "significant": significant,
         }
+    return out
+
+
+def summarise_activities(store: ResultStore, design: str) -> list[dict[str, Any]]:
+    """Per manual activity of the user's lane (in the order first stored): ``offered``, the
+    ``omission`` and ``error`` rates per offer, and their intervals over users (each user's
+    omissions of their offers: a proportion pooled over users, as a metric's missed rate,
+    method ``wilson-neff``). Activities never offered are left out. Read streaming into
+    arrays: 24 bytes per user and activity."""
+    from opspec.statistics import proportion_interval
+
+    per: dict[str, tuple[array[float], array[float], array[float]]] = {}
+    for activity, offered, omitted, wrong in store.rows(
+            "SELECT activity, offered, omitted, wrong FROM activity WHERE design = ? "
+            "ORDER BY rowid", (design,)):
+        columns = per.get(str(activity))
+        if columns is None:
+            columns = per[str(activity)] = (array("d"), array("d"), array("d"))
+        columns[0].append(int(offered or 0))
+        columns[1].append(int(omitted or 0))
+        columns[2].append(int(wrong or 0))
+    out = []
+    for activity, (offers, omissions, wrongs) in per.items():
+        offered = int(sum(offers))
+        if not offered:
+            continue
+        out.append({"activity": activity, "offered": offered,
+                    "omission": int(sum(omissions)) / offered,
+                    "error": int(sum(wrongs)) / offered,
+                    "omission_ci95": proportion_interval(Pairs(omissions, offers)),
+                    "error_ci95": proportion_interval(Pairs(wrongs, offers)),
+                    "ci95_method": "wilson-neff"})
     return out
 
 

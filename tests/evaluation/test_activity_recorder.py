@@ -5,10 +5,10 @@ from __future__ import annotations
 
 from collections import Counter
 
+from conftest import SPEC, USERS_TOML
+
 from opspec.evaluation.plan import file_digest
 from opspec.evaluation.replication import ActivityRecorder, prepare, run_user
-
-from conftest import SPEC, USERS_TOML
 
 
 def _counts_in_trace(trace: list[dict], manual: tuple[str, ...]) -> dict[str, list[int]]:
