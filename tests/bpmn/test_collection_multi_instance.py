@@ -1,0 +1,156 @@
+"""A multi-instance over a list given as data (Camunda's ``camunda:collection`` with
+``camunda:elementVariable``; Zeebe's ``inputCollection``/``inputElement``) runs one instance
+per item, each instance seeing its own item under the element variable (issue 28).
+
+Camunda 7's reference (Multiple Instance, "camunda:collection"): "a new instance is created
+for each element of the collection" and "camunda:elementVariable: the name of the variable to
+which each element is assigned" — each instance sees its own element, not a neighbour's.
+BPMN 2.0 §10.2.8 (MultiInstanceLoopCharacteristics, loopDataInputRef): "The number of items
+in the collection determines the number of Activity instances."
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+
+import opspec
+from opspec.errors import Severity
+from opspec.xpdl.validate import validate_spec
+
+DIAGRAM = Path(__file__).parent / "data" / "camunda_mi_collection.bpmn"
+
+
+def _final(outcome: opspec.RunOutcome, name: str) -> object:
+    values = [e.data[name] for e in outcome.trace
+              if e.kind == "data.changed" and name in e.data]
+    return values[-1] if values else None
+
+
+def _completed(outcome: opspec.RunOutcome, activity: str) -> list[float]:
+    return [e.time for e in outcome.trace
+            if e.kind == "activity.completed" and e.activity == activity]
+
+
+def test_each_instance_sees_its_own_item() -> None:
+    """Parallel instances of 10 s each end at the same instant: each adds its own score
+    (1 + 2 + 3 = 6; instances sharing one variable would all add the last item, 9).
+    Sequential instances run in the collection's order: appending each as a digit gives 123.
+    """
+    _package, report = validate_spec(DIAGRAM)
+    assert report.ok, report.lines()
+    outcome = opspec.run(DIAGRAM, until=100)
+    assert _final(outcome, "total") == 6
+    assert _completed(outcome, "weigh") == [10.0, 10.0, 10.0]
+    assert _final(outcome, "order") == 123
+    assert len(_completed(outcome, "append")) == 3
+
+
+def test_the_completion_condition_reads_the_completed_instances_item() -> None:
+    """BPMN 2.0 (MultiInstanceLoopCharacteristics), completionCondition: "This attribute
+    defines a boolean Expression that when evaluated to true, cancels the remaining Activity
+    instances and produces a token." — ``${s == 2}`` holds once the instance with item 2
+    completes, so the sequential instance for item 3 never starts: 12."""
+    outcome = opspec.run(DIAGRAM, until=100)
+    assert _final(outcome, "stopped") == 12
+    assert [e.kind for e in outcome.trace if e.kind.startswith("process.")] == [
+        "process.started", "process.completed"]
+
+
+def test_the_element_variable_is_not_left_in_the_process_data() -> None:
+    """Camunda: the element variable is local to the instance; after the activity, nothing
+    wrote it into the process's data."""
+    outcome = opspec.run(DIAGRAM, until=100)
+    assert not any("score" in e.data or "s" in e.data for e in outcome.trace
+                   if e.kind == "data.changed")
+
+
+def _variant(tmp_path: Path, fields: str, loop: str) -> Path:
+    path = tmp_path / "collection.bpmn"
+    path.write_text(f"""<?xml version="1.0" encoding="UTF-8"?>
+<bpmn:definitions xmlns:bpmn="http://www.omg.org/spec/BPMN/20100524/MODEL"
+    xmlns:camunda="http://camunda.org/schema/1.0/bpmn"
+    xmlns:zeebe="http://camunda.org/schema/zeebe/1.0" xmlns:opspec="urn:opspec:sisarl:1"
+    id="d" targetNamespace="t">
+  <bpmn:process id="p" isExecutable="true">
+    <bpmn:extensionElements>{fields}
+      <opspec:DataField Id="total" Type="INTEGER" InitialValue="0"/>
+    </bpmn:extensionElements>
+    <bpmn:startEvent id="start"/>
+    <bpmn:sequenceFlow id="f0" sourceRef="start" targetRef="each"/>
+    <bpmn:scriptTask id="each" scriptFormat="python">
+      {loop}
+      <bpmn:script>total = total + score</bpmn:script>
+    </bpmn:scriptTask>
+    <bpmn:sequenceFlow id="f1" sourceRef="each" targetRef="end"/>
+    <bpmn:endEvent id="end"/>
+  </bpmn:process>
+</bpmn:definitions>
+""", encoding="utf-8")
+    return path
+
+
+CAMUNDA = ('<bpmn:multiInstanceLoopCharacteristics camunda:collection="${scores}" '
+           'camunda:elementVariable="score"/>')
+ZEEBE = ('<bpmn:multiInstanceLoopCharacteristics><bpmn:extensionElements>'
+         '<zeebe:loopCharacteristics inputCollection="= scores" inputElement="score"/>'
+         '</bpmn:extensionElements></bpmn:multiInstanceLoopCharacteristics>')
+
+
+def _list(value: str) -> str:
+    return f'<opspec:DataField Id="scores" Type="INTEGER" IsArray="true" InitialValue="{value}"/>'
+
+
+@pytest.mark.parametrize("loop", [CAMUNDA, ZEEBE], ids=["camunda", "zeebe"])
+def test_zeebe_and_camunda_run_alike(tmp_path: Path, loop: str) -> None:
+    outcome = opspec.run(_variant(tmp_path, _list("[4, 5]"), loop))
+    assert _final(outcome, "total") == 9
+    assert len(_completed(outcome, "each")) == 2
+
+
+def test_an_empty_collection_completes_the_activity_at_once(tmp_path: Path) -> None:
+    """BPMN 2.0 §10.2.8, loopDataInputRef: "The number of items in the collection determines
+    the number of Activity instances" — none here. With no instance the activity has nothing
+    to wait for: it completes at once and the token moves on (as Camunda 7 does for an empty
+    collection); no script runs."""
+    outcome = opspec.run(_variant(tmp_path, _list("[]"), CAMUNDA))
+    assert _final(outcome, "total") is None
+    assert _completed(outcome, "end") == [0.0]
+    assert [e.kind for e in outcome.trace if e.kind.startswith("process.")] == [
+        "process.started", "process.completed"]
+
+
+def _errors(path: Path) -> list[tuple[str, int | None, str]]:
+    _package, report = validate_spec(path)
+    return [(d.code, d.location.line, d.message) for d in report.diagnostics
+            if d.severity is Severity.ERROR]
+
+
+@pytest.mark.parametrize(("fields", "says"), [
+    ("", "its collection 'scores' is no data field"),
+    ('<opspec:DataField Id="scores" Type="INTEGER" InitialValue="3"/>',
+     "its collection 'scores' is not a list"),
+])
+def test_a_missing_or_non_list_collection_is_refused_at_its_line(
+        tmp_path: Path, fields: str, says: str) -> None:
+    errors = _errors(_variant(tmp_path, fields, CAMUNDA))
+    assert [(code, line) for code, line, _ in errors] == [("multi-instance-without-count", 13)]
+    assert says in errors[0][2]
+
+
+def test_a_sub_process_over_a_collection_is_refused_at_its_line(tmp_path: Path) -> None:
+    """The activities inside a sub-process read their process instance's data, not the
+    instance's own item: parallel instances would read one another's, so opspec refuses."""
+    path = _variant(tmp_path, _list("[1, 2]"), CAMUNDA)
+    text = path.read_text(encoding="utf-8").replace(
+        '<bpmn:scriptTask id="each" scriptFormat="python">',
+        '<bpmn:subProcess id="each"><bpmn:scriptTask id="inner">').replace(
+        "</bpmn:scriptTask>", "</bpmn:scriptTask></bpmn:subProcess>")
+    # the loop belongs to the sub-process: move it out of the inner task
+    text = text.replace(CAMUNDA, "").replace('<bpmn:subProcess id="each">',
+                                             '<bpmn:subProcess id="each">' + CAMUNDA)
+    path.write_text(text, encoding="utf-8")
+    errors = _errors(path)
+    assert [code for code, _, _ in errors] == ["multi-instance-without-count"]
+    assert "subProcess" in errors[0][2]
