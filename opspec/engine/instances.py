@@ -8,7 +8,7 @@ cycle, so they stay small and cheap. Life-cycle states are ints from
 from __future__ import annotations
 
 from collections import ChainMap
-from collections.abc import Callable, Mapping, MutableMapping
+from collections.abc import Callable, MutableMapping
 from typing import TYPE_CHECKING, Any
 
 from opspec.engine.lifecycle import NOT_STARTED
@@ -141,7 +141,7 @@ class ActivityInstance:
         # instance only, over its process instance's data (see :meth:`scope`)
         self.local: dict[str, Any] | None = None
 
-    def scope(self) -> Mapping[str, Any]:
+    def scope(self) -> MutableMapping[str, Any]:
         """The data this instance reads: its process instance's, under its own element
         when it is one instance of a collection multi-instance. Writes go to the process
         instance's data (``set_field``), which the overlay shows through."""

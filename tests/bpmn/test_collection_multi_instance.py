@@ -12,6 +12,7 @@ in the collection determines the number of Activity instances."
 from __future__ import annotations
 
 from pathlib import Path
+from typing import Any
 
 import pytest
 
@@ -154,3 +155,42 @@ def test_a_sub_process_over_a_collection_is_refused_at_its_line(tmp_path: Path) 
     errors = _errors(path)
     assert [code for code, _, _ in errors] == ["multi-instance-without-count"]
     assert "subProcess" in errors[0][2]
+
+
+class Recorder:
+    """A user who completes each offered work item a second later, noting the item each
+    instance's work item carries."""
+
+    def __init__(self) -> None:
+        self.seen: list[tuple[float, object]] = []
+
+    def attach(self, session: Any) -> None:
+        self.session = session
+
+    def offer(self, item: Any) -> None:
+        self.seen.append((self.session.now, item.data.get("score")))
+        self.session.call_later(1.0, lambda: self.session.complete(item, None))
+
+    def withdraw(self, item: Any, reason: str) -> None:
+        pass
+
+
+@pytest.mark.parametrize(("sequential", "offered"), [
+    ("false", [(0.0, 1), (0.0, 2), (0.0, 3)]),
+    ("true", [(0.0, 1), (1.0, 2), (2.0, 3)]),
+])
+def test_each_work_item_carries_its_own_item(tmp_path: Path, sequential: str,
+                                              offered: list[tuple[float, int]]) -> None:
+    """The performer of each instance's work item sees that instance's element: all three
+    at once in parallel, one after another (in the list's order) when sequential."""
+    loop = CAMUNDA.replace("/>", f' isSequential="{sequential}"/>')
+    path = _variant(tmp_path, _list("[1, 2, 3]"), loop)
+    path.write_text(path.read_text(encoding="utf-8").replace(
+        '<bpmn:scriptTask id="each" scriptFormat="python">', '<bpmn:userTask id="each">').replace(
+        "<bpmn:script>total = total + score</bpmn:script>\n    </bpmn:scriptTask>",
+        "</bpmn:userTask>"), encoding="utf-8")
+    user = Recorder()
+    outcome = opspec.run(path, performers={"user": user})
+    assert user.seen == offered
+    assert [e.kind for e in outcome.trace if e.kind.startswith("process.")] == [
+        "process.started", "process.completed"]

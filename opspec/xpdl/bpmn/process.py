@@ -719,7 +719,8 @@ class _Process:
                         for sub in opspec_named(element, "FormalParameter"))
         given = {f.id for f in formals}
         formals += tuple(f for f in bpmn_formals if f.id not in given)
-        self.declared = {f.id: f for f in (*fields, *formals)}
+        self.declared = {f.id: f for f in fields}
+        self.declared.update((f.id, f) for f in formals)
         activities, transitions = self.level(element, None)
         declared = {f.id for f in (*fields, *formals)} | self.defs.package_fields
         fields.extend(f for name, f in self.created.items() if name not in declared)
