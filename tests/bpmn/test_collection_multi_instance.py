@@ -11,6 +11,9 @@ in the collection determines the number of Activity instances."
 
 from __future__ import annotations
 
+import json
+import subprocess
+from collections import Counter
 from pathlib import Path
 from typing import Any
 
@@ -194,3 +197,62 @@ def test_each_work_item_carries_its_own_item(tmp_path: Path, sequential: str,
     assert user.seen == offered
     assert [e.kind for e in outcome.trace if e.kind.startswith("process.")] == [
         "process.started", "process.completed"]
+
+
+# -- beside SpiffWorkflow ------------------------------------------------------------------
+
+ROOT = Path(__file__).resolve().parents[2]
+SPIFF = ROOT / ".spiff-venv" / "bin" / "python"
+SPIFF_FILE = ROOT / "tests/differential/data/spiff/camunda/parallel_multiinstance_collection.bpmn"
+
+
+def _spiff(path: Path, items: list[int]) -> list[str]:
+    if not SPIFF.exists():
+        pytest.skip("no .spiff-venv (bash scripts/spiff-venv.sh makes it)")
+    entry = {"file": str(path), "data": {"input_data": items}, "delay": 0, "parser": "camunda"}
+    done = subprocess.run([str(SPIFF), str(ROOT / "tests/differential/spiff_driver.py")],
+                          input=json.dumps([entry]), capture_output=True, text=True,
+                          timeout=120, check=True)
+    result = json.loads(done.stdout.splitlines()[-1])
+    assert result["state"] == "completed", result
+    return list(result["completed"])
+
+
+def _declared(tmp_path: Path, items: list[int], sequential: bool) -> Path:
+    """SpiffWorkflow's own collection diagram, with the list its test hands the workflow
+    declared as opspec data (SpiffWorkflow's Camunda parser ignores the opspec element)."""
+    text = SPIFF_FILE.read_text(encoding="utf-8").replace(
+        '<bpmn:process id="main" isExecutable="true">',
+        '<bpmn:process id="main" isExecutable="true"><bpmn:extensionElements>'
+        '<opspec:DataField xmlns:opspec="urn:opspec:sisarl:1" Id="input_data" Type="INTEGER" '
+        f'IsArray="true" InitialValue="{json.dumps(items)}"/></bpmn:extensionElements>')
+    if sequential:
+        text = text.replace('camunda:collection=', 'isSequential="true" camunda:collection=')
+    path = tmp_path / ("seq.bpmn" if sequential else "par.bpmn")
+    path.write_text(text, encoding="utf-8")
+    return path
+
+
+@pytest.mark.parametrize("sequential", [False, True], ids=["parallel", "sequential"])
+def test_as_many_instances_as_spiffworkflow_runs(tmp_path: Path, sequential: bool) -> None:
+    """SpiffWorkflow 3.2.0 (Camunda parser) given input_data = [1, 2, 3] completes any_task
+    three times and ends; opspec, with input_data declared as that list, runs the same flow
+    nodes as often (a multiset: BPMN orders nothing between parallel instances)."""
+    path = _declared(tmp_path, [1, 2, 3], sequential)
+    outcome = opspec.run(path)
+    ours = [e.activity for e in outcome.trace if e.kind == "activity.completed"]
+    assert Counter(ours) == Counter(_spiff(path, [1, 2, 3])) == Counter(
+        {"StartEvent_1": 1, "any_task": 3, "Event_1xk7z3g": 1})
+
+
+def test_an_empty_collection_ends_as_in_spiffworkflow(tmp_path: Path) -> None:
+    """Given input_data = [], SpiffWorkflow runs no instance of any_task and ends; so does
+    opspec (its trace records the activity, of no instance, completed once at t = 0, which
+    SpiffWorkflow's list of completed tasks does not)."""
+    path = _declared(tmp_path, [], False)
+    outcome = opspec.run(path)
+    ours = [e.activity for e in outcome.trace if e.kind == "activity.completed"]
+    assert _spiff(path, []) == ["StartEvent_1", "Event_1xk7z3g"]
+    assert ours == ["StartEvent_1", "any_task", "Event_1xk7z3g"]
+    assert not any(e.kind == "activity.completed" and "instance" in e.data
+                   for e in outcome.trace)
