@@ -23,7 +23,7 @@ import opspec
 from opspec.errors import Severity
 from opspec.xpdl.validate import validate_spec
 
-DIAGRAM = Path(__file__).parent / "data" / "camunda_mi_collection.bpmn"
+DIAGRAM = Path(__file__).parent / "data" / "written" / "camunda_mi_collection.bpmn"
 
 
 def _final(outcome: opspec.RunOutcome, name: str) -> object:
@@ -256,3 +256,15 @@ def test_an_empty_collection_ends_as_in_spiffworkflow(tmp_path: Path) -> None:
     assert ours == ["StartEvent_1", "any_task", "Event_1xk7z3g"]
     assert not any(e.kind == "activity.completed" and "instance" in e.data
                    for e in outcome.trace)
+
+
+def test_without_an_element_variable_one_instance_runs_per_item(tmp_path: Path) -> None:
+    """Camunda 7: elementVariable is optional; without it the instances are counted by the
+    collection and read no item."""
+    loop = CAMUNDA.replace(' camunda:elementVariable="score"', "")
+    path = _variant(tmp_path, _list("[4, 5, 6]"), loop)
+    path.write_text(path.read_text(encoding="utf-8").replace("total + score", "total + 1"),
+                    encoding="utf-8")
+    _package, report = validate_spec(path)
+    assert report.ok, report.lines()
+    assert _final(opspec.run(path), "total") == 3

@@ -630,10 +630,11 @@ class _Process:
                     element_variable=variable)
 
     def vendor_collection(self, element: etree._Element, multi: etree._Element
-                          ) -> tuple[str, str] | bool:
+                          ) -> tuple[str, str | None] | bool:
         """A multi-instance over a vendor's collection (Camunda's ``camunda:collection``/
         ``elementVariable``, Zeebe's ``inputCollection``/``inputElement``): the data field
-        holding the list and the element variable's name; ``True`` when there is none,
+        holding the list and the element variable's name (without one: the list's length and
+        ``None``: one instance per item, none reading it); ``True`` when there is none,
         ``False`` when it is refused at its line.
 
         Each instance sees its own item under the element variable, over its process
@@ -663,10 +664,10 @@ class _Process:
             why = (f"its collection {items.strip()!r} ({vendor[0]}) is no data field's name",
                    "name the data field holding the list, e.g. ${scores} (a field with "
                    "IsArray=\"true\")")
-        elif not variable or not _NAME.match(variable.strip()):
-            why = (f"it names no element variable ({vendor[1]}) for its instances' item",
-                   f"add {vendor[1]}=\"item\"")
-        elif local(element) != "task" and not local(element).endswith("Task"):
+        elif variable is not None and not _NAME.match(variable.strip()):
+            why = (f"its element variable {variable!r} ({vendor[1]}) is no name",
+                   f"write {vendor[1]}=\"item\"")
+        elif variable and local(element) != "task" and not local(element).endswith("Task"):
             why = (f"it is a {local(element)}: the activities inside read their process "
                    f"instance's data, not each instance's own {variable.strip()!r}, so "
                    "parallel instances would read one another's item",
@@ -689,7 +690,8 @@ class _Process:
                            f"{self.label(element)} runs one instance per item of a list, but "
                            f"{why[0]}", why[1])
             return False
-        assert variable is not None
+        if not variable:        # one instance per item, none reading it
+            return f"len({text})", None
         return text, variable.strip()
 
     def expression(self, element: etree._Element, text: str | None, what: str
