@@ -143,6 +143,17 @@ def test_a_missing_or_non_list_collection_is_refused_at_its_line(
     assert says in errors[0][2]
 
 
+def test_a_package_field_that_is_no_list_is_refused_at_its_line(tmp_path: Path) -> None:
+    path = _variant(tmp_path, "", CAMUNDA)
+    path.write_text(path.read_text(encoding="utf-8").replace(
+        '<bpmn:process id="p"', '<bpmn:extensionElements><opspec:DataField Id="scores" '
+        'Type="INTEGER" InitialValue="3"/></bpmn:extensionElements><bpmn:process id="p"'),
+        encoding="utf-8")
+    errors = _errors(path)
+    assert [(code, line) for code, line, _ in errors] == [("multi-instance-without-count", 13)]
+    assert "its collection 'scores' is not a list" in errors[0][2]
+
+
 def test_a_sub_process_over_a_collection_is_refused_at_its_line(tmp_path: Path) -> None:
     """The activities inside a sub-process read their process instance's data, not the
     instance's own item: parallel instances would read one another's, so opspec refuses."""

@@ -672,8 +672,8 @@ class _Process:
                    f"instance's data, not each instance's own {variable.strip()!r}, so "
                    "parallel instances would read one another's item",
                    "put the multi-instance on the task that uses the item")
-        found = self.declared.get(text)
-        if why is None and found is None and text not in self.defs.package_fields:
+        found = self.declared.get(text) or self.defs.package_data.get(text)
+        if why is None and found is None:
             why = (f"its collection {text!r} is no data field",
                    f"declare the list: <opspec:DataField Id={text!r} Type=\"INTEGER\" "
                    "IsArray=\"true\" InitialValue=\"[1, 2, 3]\"/>")
