@@ -5,8 +5,10 @@ per item, each instance seeing its own item under the element variable (issue 28
 Camunda 7's reference (Multiple Instance, "camunda:collection"): "a new instance is created
 for each element of the collection" and "camunda:elementVariable: the name of the variable to
 which each element is assigned" — each instance sees its own element, not a neighbour's.
-BPMN 2.0 §10.2.8 (MultiInstanceLoopCharacteristics, loopDataInputRef): "The number of items
-in the collection determines the number of Activity instances."
+BPMN 2.0 §10.2.8, Table 10.29 (MultiInstanceLoopCharacteristics, loopDataInputRef): "This
+DataInput is used to determine the number of Activity instances, one Activity instance per item
+in the collection of data stored in that DataInput element." — Camunda's collection is the
+same rule with the list named by an expression.
 """
 
 from __future__ import annotations
@@ -114,10 +116,10 @@ def test_zeebe_and_camunda_run_alike(tmp_path: Path, loop: str) -> None:
 
 
 def test_an_empty_collection_completes_the_activity_at_once(tmp_path: Path) -> None:
-    """BPMN 2.0 §10.2.8, loopDataInputRef: "The number of items in the collection determines
-    the number of Activity instances" — none here. With no instance the activity has nothing
-    to wait for: it completes at once and the token moves on (as Camunda 7 does for an empty
-    collection); no script runs."""
+    """BPMN 2.0 Table 10.29, loopDataInputRef: "one Activity instance per item in the
+    collection" — none here. §13.3.7 says nothing more of zero instances; with none the
+    activity has nothing to wait for: it completes at once and the token moves on (as Camunda 7
+    and SpiffWorkflow do for an empty collection, below); no script runs."""
     outcome = opspec.run(_variant(tmp_path, _list("[]"), CAMUNDA))
     assert _final(outcome, "total") is None
     assert _completed(outcome, "end") == [0.0]
