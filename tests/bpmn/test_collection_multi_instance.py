@@ -2,9 +2,11 @@
 ``camunda:elementVariable``; Zeebe's ``inputCollection``/``inputElement``) runs one instance
 per item, each instance seeing its own item under the element variable (issue 28).
 
-Camunda 7's reference (Multiple Instance, "camunda:collection"): "a new instance is created
-for each element of the collection" and "camunda:elementVariable: the name of the variable to
-which each element is assigned" — each instance sees its own element, not a neighbour's.
+Camunda's reference (docs.camunda.io, Multi-instance): "one instance for every element of the
+inputCollection is created (sequentially or in parallel)"; in parallel "The instances are
+executed concurrently and independently from each other"; sequentially "When one instance is
+completed, a new instance is created for the next element in the inputCollection" — each
+instance sees its own element (inputElement / camunda:elementVariable), not a neighbour's.
 BPMN 2.0 §10.2.8, Table 10.29 (MultiInstanceLoopCharacteristics, loopDataInputRef): "This
 DataInput is used to determine the number of Activity instances, one Activity instance per item
 in the collection of data stored in that DataInput element." — Camunda's collection is the
