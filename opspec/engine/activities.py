@@ -139,7 +139,7 @@ class Activities(Part):
         if act.mi is not None and ai.mi is None and not multi_instance.begin(self, ai):
             return
         self.state.emit_act(EK.ACTIVITY_STARTED, inst, act)
-        if act.start_assign and not self.flow.assign(inst, act, act.start_assign):
+        if act.start_assign and not self.flow.assign(inst, act, act.start_assign, ai.scope()):
             return
         now = self.state.env.now
         # a multi-instance activity's deadlines and boundary events are the whole activity's:
@@ -333,13 +333,13 @@ class Activities(Part):
         self.flow.finish(frame, ai.act)
 
     def _inputs(self, ai: ActivityInstance) -> dict[str, Any] | None:
-        inst = ai.frame.inst
+        reads = ai.scope()
         now = self.state.env.now
         out: dict[str, Any] = {}
         try:
             for _mode, formal, fn, _target in ai.act.params:
                 if fn is not None:                  # OUT parameters carry nothing in
-                    out[formal] = fn(inst.scope, now)
+                    out[formal] = fn(reads, now)
         except OpspecError as error:
             self.fail(ai, "parameter", f"an actual parameter failed: {error.message}")
             return None
@@ -390,13 +390,13 @@ class Activities(Part):
     def _tool_inputs(self, ai: ActivityInstance,
                      params: tuple[tuple[ParameterMode, str, Any, str | None], ...]
                      ) -> dict[str, Any] | None:
-        inst = ai.frame.inst
+        reads = ai.scope()
         now = self.state.env.now
         out: dict[str, Any] = {}
         try:
             for _mode, formal, fn, _target in params:
                 if fn is not None:
-                    out[formal] = fn(inst.scope, now)
+                    out[formal] = fn(reads, now)
         except OpspecError as error:
             self.fail(ai, "parameter", f"an actual parameter failed: {error.message}")
             return None
@@ -411,9 +411,10 @@ class Activities(Part):
         inst = ai.frame.inst
         now = self.state.env.now
         local: dict[str, Any] = {}
+        reads = ai.scope()
         try:
             for _mode, formal, fn, _target in params:
-                local[formal] = fn(inst.scope, now) if fn is not None else None
+                local[formal] = fn(reads, now) if fn is not None else None
             for variable, fn in script:
                 local[variable] = fn(local, now)
         except OpspecError as error:
@@ -493,7 +494,7 @@ class Activities(Part):
         spec = act.coordination
         assert spec is not None
         inst = ai.frame.inst
-        scope = inst.scope
+        scope = ai.scope()
         try:
             values = [scope[name] for name in spec.inputs]
         except KeyError as error:

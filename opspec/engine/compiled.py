@@ -178,6 +178,9 @@ class CompiledActivity:
     loop: tuple[Evaluator | None, int | None, bool] | None = None
     # multi-instance: (how many, parallel, MI_* flow condition, ComplexMI_FlowCondition)
     mi: tuple[Evaluator, bool, int, Evaluator | None] | None = None
+    # a collection multi-instance (Camunda's elementVariable): ``mi``'s first evaluator gives
+    # the list, and each instance sees its own item under this name
+    mi_element: str | None = None
     block: CompiledGraph | None = None
     coordination: CoordinationBuiltIn | None = None
     boundary: tuple[int, ...] = ()

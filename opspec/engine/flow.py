@@ -332,13 +332,18 @@ class Flow(Part):
                       {"waiting": list(waiting), "message": text})
         self.end_instance(inst, ABORTED, text)
 
-    def finish(self, frame: Frame, act: CompiledActivity) -> None:
-        """Completion of ``act``, then on to what follows it."""
-        nxt = self.done_next(frame, act)
+    def finish(self, frame: Frame, act: CompiledActivity,
+               local: dict[str, Any] | None = None, assigns: bool = True) -> None:
+        """Completion of ``act``, then on to what follows it (``local``: the element of the
+        collection multi-instance's instance that completes it, seen by its end assignments;
+        ``assigns`` false: a multi-instance of no instance, whose end assignments never run)."""
+        nxt = self.done_next(frame, act, local, assigns)
         if nxt is not None:
             self.activities.start(frame, nxt)
 
-    def done_next(self, frame: Frame, act: CompiledActivity) -> CompiledActivity | None:
+    def done_next(self, frame: Frame, act: CompiledActivity,
+                  local: dict[str, Any] | None = None, assigns: bool = True
+                  ) -> CompiledActivity | None:
         """Complete ``act`` (end assignments, throw/raise, trace) and take its split.
 
         Returns the activity the token moves on to when it can be started right away (an
@@ -356,7 +361,8 @@ class Flow(Part):
                 if not target.join:
                     return target
             return self._split(frame, act, inst)
-        if act.end_assign and act.loop is None and not self.assign(inst, act, act.end_assign):
+        if act.end_assign and act.loop is None and assigns and not self.assign(
+                inst, act, act.end_assign, inst.scope if local is None else ChainMap(local, inst.scope)):
             return None
         if act.kind == K_THROW and act.trigger is not None:
             self.triggers.broadcast(act.trigger.kind, act.trigger.name or "", None, inst, act)
@@ -549,13 +555,16 @@ class Flow(Part):
             self.triggers.check_rules()
 
     def assign(self, inst: ProcessInstance, act: CompiledActivity,
-                assignments: tuple[tuple[str, Any], ...]) -> bool:
-        """Run ``assignments``; ``False`` when the instance ended meanwhile (a failed
-        assignment aborts it; a data change can fire its end trigger): the caller stops."""
+                assignments: tuple[tuple[str, Any], ...],
+                scope: Mapping[str, Any] | None = None) -> bool:
+        """Run ``assignments`` (reading ``scope``, by default the instance's data); ``False``
+        when the instance ended meanwhile (a failed assignment aborts it; a data change can
+        fire its end trigger): the caller stops."""
         now = self.state.env.now
+        reads = inst.scope if scope is None else scope
         try:
             for target, fn in assignments:
-                self.set_field(inst, act, target, fn(inst.scope, now))
+                self.set_field(inst, act, target, fn(reads, now))
                 if inst.state != RUNNING:
                     return False
         except OpspecError as error:

@@ -7,6 +7,7 @@ cycle, so they stay small and cheap. Life-cycle states are ints from
 
 from __future__ import annotations
 
+from collections import ChainMap
 from collections.abc import Callable, MutableMapping
 from typing import TYPE_CHECKING, Any
 
@@ -113,6 +114,7 @@ class ActivityInstance:
         "item",
         "iteration",
         "key",
+        "local",
         "mi",
         "performer",
         "started_at",
@@ -135,6 +137,17 @@ class ActivityInstance:
         self.cleanup: list[Callable[[], None]] = []
         self.performer: Any = None
         self.mi: MultiInstance | None = None
+        # a collection multi-instance's own element ({elementVariable: item}), seen by this
+        # instance only, over its process instance's data (see :meth:`scope`)
+        self.local: dict[str, Any] | None = None
+
+    def scope(self) -> MutableMapping[str, Any]:
+        """The data this instance reads: its process instance's, under its own element
+        when it is one instance of a collection multi-instance. Writes go to the process
+        instance's data (``set_field``), which the overlay shows through."""
+        if self.local is None:
+            return self.frame.inst.scope
+        return ChainMap(self.local, self.frame.inst.scope)
 
     def __repr__(self) -> str:
         return f"<ActivityInstance {self.act.process}.{self.act.id}#{self.key}>"
@@ -146,10 +159,11 @@ class MultiInstance:
     ``holder`` stands for the activity as a whole while any instance runs: its deadlines and
     boundary events are armed on it, once for all the instances (BPMN 2.0 §13.3.7)."""
 
-    __slots__ = ("completed", "count", "holder", "members", "passed", "started")
+    __slots__ = ("completed", "count", "holder", "items", "members", "passed", "started")
 
-    def __init__(self, count: int) -> None:
+    def __init__(self, count: int, items: tuple[Any, ...] | None = None) -> None:
         self.count = count
+        self.items = items            # a collection multi-instance's list, one item each
         self.started = 0
         self.completed = 0
         self.passed = False

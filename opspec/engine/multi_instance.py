@@ -7,7 +7,7 @@ of a group share one holder for the activity's deadlines and boundary events."""
 from __future__ import annotations
 
 from collections import ChainMap
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 from opspec.engine.compiled import MI_ALL, MI_CANCEL, MI_NONE, MI_ONE, CompiledActivity
 from opspec.engine.instances import ActivityInstance, Frame, MultiInstance
@@ -34,6 +34,14 @@ def begin(acts: Activities, ai: ActivityInstance) -> bool:
     except OpspecError as error:
         acts.flow.abort(inst, act, f"the MI_Condition failed: {error.message}")
         return False
+    items: tuple[Any, ...] | None = None
+    if act.mi_element is not None:      # one instance per item of the list (Camunda collection)
+        if not isinstance(raw, (tuple, list)):
+            acts.flow.abort(inst, act, f"the multi-instance collection gave {raw!r}, not a "
+                            "list (one instance per item)")
+            return False
+        items = tuple(raw)
+        raw = len(items)
     count = raw if isinstance(raw, int) and not isinstance(raw, bool) else (
         int(raw) if isinstance(raw, float) and raw.is_integer() else -1)
     if count < 0:
@@ -45,25 +53,28 @@ def begin(acts: Activities, ai: ActivityInstance) -> bool:
         ai.state = COMPLETED
         ai.gen += 1
         frame.running.pop(ai.key, None)
-        acts.flow.finish(frame, act)
+        # its assignments are each instance's (as its start assignments, never run here)
+        acts.flow.finish(frame, act, None, False)
         return False
-    group = MultiInstance(count)
+    group = MultiInstance(count, items)
     if act.deadlines or act.boundary:
         holder = ActivityInstance(next(acts.state.keys), act, frame, acts.state.env.now)
         holder.state = RUNNING
         holder.mi = group
         group.holder = holder
     frame.live += count - 1
-    _join(ai, group)
+    _join(ai, group, act.mi_element)
     if parallel:
         for _ in range(count - 1):
             _next(acts, frame, act, group)
     return True
 
 
-def _join(ai: ActivityInstance, group: MultiInstance) -> None:
+def _join(ai: ActivityInstance, group: MultiInstance, element: str | None) -> None:
     ai.mi = group
     ai.iteration = group.started            # the instance's loopCounter
+    if element is not None and group.items is not None:
+        ai.local = {element: group.items[group.started]}    # its own item, nobody else's
     group.started += 1
     group.members.append(ai)
 
@@ -72,7 +83,7 @@ def _next(acts: Activities, frame: Frame, act: CompiledActivity, group: MultiIns
     ai = ActivityInstance(next(acts.state.keys), act, frame, acts.state.env.now)
     ai.state = RUNNING
     frame.running[ai.key] = ai
-    _join(ai, group)
+    _join(ai, group, act.mi_element)
     acts.state.ready.append((acts.activate, ai, None, None))
 
 
@@ -99,7 +110,7 @@ def done(acts: Activities, ai: ActivityInstance, group: MultiInstance) -> None:
                         "nrOfCompletedInstances": group.completed,
                         "nrOfActiveInstances": len(group.members)}
             try:
-                moves = bool(cond(ChainMap(counters, inst.scope), acts.state.env.now))
+                moves = bool(cond(ChainMap(counters, ai.scope()), acts.state.env.now))
             except OpspecError as error:
                 acts.flow.abort(inst, act, f"the ComplexMI_FlowCondition failed: "
                            f"{error.message}")
@@ -109,15 +120,15 @@ def done(acts: Activities, ai: ActivityInstance, group: MultiInstance) -> None:
         # instances and produces a token"
         cancel(acts, group, frame, "the completionCondition holds")
         group.passed = True
-        acts.flow.finish(frame, act)
+        acts.flow.finish(frame, act, ai.local)
         return
     if not parallel and group.started < group.count and inst.state == RUNNING:
         _next(acts, frame, act, group)
     if moves:
         group.passed = True
-        acts.flow.finish(frame, act)
+        acts.flow.finish(frame, act, ai.local)
         return
-    if act.end_assign and not acts.flow.assign(inst, act, act.end_assign):
+    if act.end_assign and not acts.flow.assign(inst, act, act.end_assign, ai.scope()):
         return
     acts.state.emit_act(EK.ACTIVITY_COMPLETED, inst, act, {"instance": ai.iteration})
     acts.flow.token_gone(frame)

@@ -8,6 +8,7 @@ items that were withdrawn meanwhile are counted as stale and otherwise ignored."
 
 from __future__ import annotations
 
+from collections import ChainMap
 from collections.abc import Mapping
 from types import MappingProxyType
 from typing import Any
@@ -52,7 +53,9 @@ class Offers(Part):
         item = WorkItem(ai.key, act.process, inst.id, act.id, act.label, act.participant,
                         act.lane, self.state.env.now,
                         application if application is not None else act.application,
-                        data if data is not None else MappingProxyType(inst.data), choices,
+                        data if data is not None else MappingProxyType(
+                            inst.data if ai.local is None else ChainMap(ai.local, inst.data)),
+                        choices,
                         inst.root, duration)
         ai.item = item
         ai.performer = performer

@@ -236,6 +236,10 @@ class Loop:
     # BPMN's completionCondition: once it holds, the instances still running are cancelled
     # and those not started never start (XPDL's ComplexMI_FlowCondition lets them run on)
     cancel_remaining: bool = False
+    # a multi-instance over a collection (Camunda's collection/elementVariable): ``condition``
+    # gives the list, one instance per item, and each instance reads its own item under this
+    # name (no other instance sees it)
+    element_variable: str | None = None
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)

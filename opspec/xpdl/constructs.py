@@ -239,7 +239,8 @@ _BPMN: tuple[Construct, ...] = (
     _c("bpmn-mi-collection", BPMN, "loopDataInputRef inputDataItem", None, W,
        "one instance per item of the collection, but no instance is handed its item",
        "§10.2.8, §13.3.7", reported_by=("multi-instance-collection",),
-       hint="read the item from the collection with the loop counter"),
+       hint="on a task, camunda:collection with camunda:elementVariable hands each instance "
+            "its own item (docs/bpmn.md, Multi-instance over a collection)"),
     _c("bpmn-mi-output", BPMN, "loopDataOutputRef outputDataItem", None, W,
        "ignored: the instances' outputs are not collected", "§10.2.8"),
     _c("bpmn-mi-behavior", BPMN, "multiInstanceLoopCharacteristics", "behavior", W,

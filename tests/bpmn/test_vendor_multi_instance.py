@@ -1,12 +1,9 @@
 """A multi-instance over a vendor's collection (Camunda's ``camunda:collection`` with
-``camunda:elementVariable``, Zeebe's ``inputCollection``/``inputElement``) is refused once, at
-the line of its ``multiInstanceLoopCharacteristics``, saying why (issue 28: "runs over a list
-given as data ... or refused at its line").
-
-Camunda 7's reference: "camunda:collection ... a new instance is created for each element of
-the collection; camunda:elementVariable: the name of the variable to which each element is
-assigned" — each instance sees its own element. opspec's instances of one activity share one
-data scope (docs/bpmn.md), so running it would let parallel instances read one another's item.
+``camunda:elementVariable``, Zeebe's ``inputCollection``/``inputElement``) whose list no data
+field holds (the application would set it) is refused once, at the line of its
+``multiInstanceLoopCharacteristics``, saying what to declare (issue 28: "runs over a list
+given as data ... or refused at its line"). Run over a declared list:
+test_collection_multi_instance.py.
 """
 
 from __future__ import annotations
@@ -51,5 +48,5 @@ def test_a_collection_multi_instance_is_refused_at_its_line_once(tmp_path: Path,
     assert len(errors) == 1, [str(e) for e in errors]
     error = errors[0]
     assert error.code == "multi-instance-without-count" and error.location.line == 9
-    assert "creditScores" in error.message and "'score'" in error.message
-    assert "one data scope" in error.message and "loopCardinality" in (error.hint or "")
+    assert "its collection 'creditScores' is no data field" in error.message
+    assert 'IsArray="true"' in (error.hint or "")

@@ -399,6 +399,7 @@ def _multi_instance(c: Context, site: Site) -> None:
         flow_cond = c.cond(loop.flow_condition, loop.flow_condition_text, act.location,
                            f"ComplexMI_FlowCondition of activity {act.id!r}")
     ca.mi = (count, loop.parallel, flow, flow_cond)
+    ca.mi_element = loop.element_variable
 
 
 def _speed(c: Context, site: Site) -> None:

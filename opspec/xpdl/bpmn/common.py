@@ -11,7 +11,7 @@ from typing import Final
 from lxml import etree
 
 from opspec.errors import Severity, SourceLocation
-from opspec.model.data import BasicKind, ParameterMode
+from opspec.model.data import BasicKind, DataField, ParameterMode
 from opspec.model.sisarl import DeclaredDistribution
 from opspec.xpdl.handlers.common import BuildContext
 from opspec.xpdl.namespaces import OPSPEC
@@ -157,6 +157,7 @@ class Defs:
     pool_of: dict[str, tuple[str, str | None]] = field(default_factory=dict)
     user_participant: bool = False       # some user/manual task falls back on "user"
     package_fields: set[str] = field(default_factory=set)
+    package_data: dict[str, DataField] = field(default_factory=dict)     # the same, by id
     item_kinds: dict[str, BasicKind] = field(default_factory=dict)
     process_io: dict[str, list[tuple[str, ParameterMode]]] = field(default_factory=dict)
     probabilities: dict[str, float] = field(default_factory=dict)   # BPSim / QBP, by flow id

@@ -240,6 +240,7 @@ def build_definitions(root: etree._Element, ctx: BuildContext) -> Package:
     pools = _collaboration(root, defs)
     package_fields = tuple(data_field(sub, defs) for sub in opspec_named(root, "DataField"))
     defs.package_fields = {f.id for f in package_fields}
+    defs.package_data = {f.id: f for f in package_fields}
     applications = tuple(application(sub, defs) for sub in opspec_named(root, "Application"))
     built: list[BuiltProcess] = [build_process(p, defs) for p in kids(root, "process")]
     if not built:

@@ -18,6 +18,7 @@ Boundary events follow the engine's existing constructs:
 from __future__ import annotations
 
 import dataclasses
+import re
 from collections.abc import Iterable
 from dataclasses import dataclass, field
 
@@ -44,7 +45,7 @@ from opspec.model.activities import (
     TaskKind,
     Trigger,
 )
-from opspec.model.data import Assignment, BasicKind, BasicType, DataField
+from opspec.model.data import Assignment, BasicKind, BasicType, DataField, FormalParameter
 from opspec.model.expressions import Expression
 from opspec.model.process import ActivitySet, Condition, ConditionKind, Transition, WorkflowProcess
 from opspec.model.resources import Lane
@@ -97,6 +98,8 @@ _QUIET = frozenset({
 _USER_NAMES = frozenset({"user", "users", "user lane", "user_lane", "the user"})
 _ACTIVITY_STRUCTURE = ("TaskApplication", "ActualParameter", "Assignment", "Execution")
 
+_NAME = re.compile(r"^[A-Za-z_]\w*$")
+
 
 def is_user_name(*names: str | None) -> bool:
     """True when one of ``names`` (a lane's, a pool's, a resource's id or name) names the
@@ -137,6 +140,9 @@ class _Process:
         self.lane_names: dict[str, str | None] = {}
         self.created: dict[str, DataField] = {}      # fields forms, outputs, parameters add
         self.reads: list[tuple[str, etree._Element, str]] = []
+        # collection multi-instances' element variables, and the fields they may read
+        self.collections: list[DataField] = []
+        self.declared: dict[str, DataField | FormalParameter] = {}
         self.synthetic: set[str] = set()          # ids given to sequence flows without one
         for lane in self._all(self.lanes):
             self.lane_names[lane.id] = lane.name
@@ -597,8 +603,13 @@ class _Process:
         cardinality = first(multi, "loopCardinality")
         text = expression_text(cardinality)
         collection = text_of(first(multi, "loopDataInputRef"))
-        if text is None and collection is None and self.over_vendor_collection(element, multi):
-            return None         # refused at its line; the file does not run
+        variable = None
+        if text is None and collection is None:
+            vendor = self.vendor_collection(element, multi)
+            if vendor is False:
+                return None     # refused at its line; the file does not run
+            if vendor is not True:
+                text, variable = vendor
         if text is None and collection is not None:
             text = f"len({collection})"
             self.defs.info(multi, "multi-instance-collection",
@@ -615,19 +626,25 @@ class _Process:
                     flow_condition_text=completion_text,
                     flow_condition=bpmn_condition(completion, completion_text, self.defs,
                                                   "completionCondition"),
-                    cancel_remaining=completion_text is not None)
+                    cancel_remaining=completion_text is not None,
+                    element_variable=variable)
 
-    def over_vendor_collection(self, element: etree._Element, multi: etree._Element) -> bool:
-        """Refuses, at its line, a multi-instance over a vendor's collection (Camunda's
-        ``camunda:collection``/``elementVariable``, Zeebe's ``inputCollection``/
-        ``inputElement``); whether there was one.
+    def vendor_collection(self, element: etree._Element, multi: etree._Element
+                          ) -> tuple[str, str | None] | bool:
+        """A multi-instance over a vendor's collection (Camunda's ``camunda:collection``/
+        ``elementVariable``, Zeebe's ``inputCollection``/``inputElement``): the data field
+        holding the list and the element variable's name (without one: the list's length and
+        ``None``: one instance per item, none reading it); ``True`` when there is none,
+        ``False`` when it is refused at its line.
 
-        Each instance must see its own item in the element variable. opspec's instances of an
-        activity share their process instance's one data scope (the engine has no variable
-        per activity instance), so parallel instances — a sub-process whose body waits, a
-        task with a duration — would read one another's item: running it would decide
-        differently from the diagram without saying so. And a list is no value a run is
-        given (run inputs are numbers, booleans and text)."""
+        Each instance sees its own item under the element variable, over its process
+        instance's data (the engine's per-instance overlay), so parallel instances never
+        read one another's item. Only a task's instances have it: the activities inside a
+        sub-process read their process instance's data, not the overlay, so a sub-process
+        or call activity over a collection is refused rather than run with a shared item.
+        The collection must be a list data field of the process (or the package); the element
+        variable becomes a field of the element's type (so the scripts and conditions reading
+        it pass the checks), which each instance reads from its own overlay instead."""
         zeebe = next((sub for sub in multi.iter() if isinstance(sub.tag, str)
                       and local(sub) == "loopCharacteristics"
                       and "zeebe" in (etree.QName(sub).namespace or "")), None)
@@ -638,19 +655,44 @@ class _Process:
             items, variable = zeebe.get("inputCollection"), zeebe.get("inputElement")
             vendor = "zeebe:inputCollection", "zeebe:inputElement"
         if items is None:
+            return True
+        text = items.strip()
+        text = text[2:-1].strip() if text.startswith("${") and text.endswith("}") else (
+            text[1:].strip() if text.startswith("=") else text)
+        why = None
+        if not _NAME.match(text):
+            why = (f"its collection {items.strip()!r} ({vendor[0]}) is no data field's name",
+                   "name the data field holding the list, e.g. ${scores} (a field with "
+                   "IsArray=\"true\")")
+        elif variable is not None and not _NAME.match(variable.strip()):
+            why = (f"its element variable {variable!r} ({vendor[1]}) is no name",
+                   f"write {vendor[1]}=\"item\"")
+        elif variable and local(element) != "task" and not local(element).endswith("Task"):
+            why = (f"it is a {local(element)}: the activities inside read their process "
+                   f"instance's data, not each instance's own {variable.strip()!r}, so "
+                   "parallel instances would read one another's item",
+                   "put the multi-instance on the task that uses the item")
+        found = self.declared.get(text) or self.defs.package_data.get(text)
+        if why is None and found is None:
+            why = (f"its collection {text!r} is no data field",
+                   f"declare the list: <opspec:DataField Id={text!r} Type=\"INTEGER\" "
+                   "IsArray=\"true\" InitialValue=\"[1, 2, 3]\"/>")
+        elif why is None and found is not None and not found.is_array:
+            why = (f"its collection {text!r} is not a list (IsArray is not true)",
+                   f"declare {text!r} with IsArray=\"true\" and a JSON list value")
+        if variable and _NAME.match(variable.strip()):     # refused or not: no second error
+            element_type = (found.type if found is not None and found.is_array
+                            else BasicType(kind=BasicKind.STRING))
+            self.collections.append(DataField(id=variable.strip(), type=element_type,
+                                              location=self.defs.loc(multi)))
+        if why is not None:
+            self.ctx.error(multi, "multi-instance-without-count",
+                           f"{self.label(element)} runs one instance per item of a list, but "
+                           f"{why[0]}", why[1])
             return False
-        each = (f", each instance reading its item as {variable!r} ({vendor[1]})"
-                if variable else "")
-        self.ctx.error(multi, "multi-instance-without-count",
-                       f"{self.label(element)} runs one instance per item of the list "
-                       f"{items.strip()!r} ({vendor[0]}){each}: opspec does not run it, as "
-                       "its instances share one data scope per process instance (no variable "
-                       "per instance, so parallel instances would read one another's item) "
-                       "and a list is not a value a run is given",
-                       "give the number of items as <bpmn:loopCardinality> and the choice "
-                       "each item makes as branch probabilities (opspec:Probability on the "
-                       "flows it decides: docs/bpmn.md, Undecided gateways)")
-        return True
+        if not variable:        # one instance per item, none reading it
+            return f"len({text})", None
+        return text, variable.strip()
 
     def expression(self, element: etree._Element, text: str | None, what: str
                    ) -> Expression | None:
@@ -679,9 +721,16 @@ class _Process:
                         for sub in opspec_named(element, "FormalParameter"))
         given = {f.id for f in formals}
         formals += tuple(f for f in bpmn_formals if f.id not in given)
+        self.declared = {f.id: f for f in fields}
+        self.declared.update((f.id, f) for f in formals)
         activities, transitions = self.level(element, None)
         declared = {f.id for f in (*fields, *formals)} | self.defs.package_fields
         fields.extend(f for name, f in self.created.items() if name not in declared)
+        declared |= {f.id for f in fields}
+        for element_field in self.collections:     # one field for each name, however many use it
+            if element_field.id not in declared:
+                declared.add(element_field.id)
+                fields.append(element_field)
         process = WorkflowProcess(
             id=self.id, name=element.get("name"),
             description=text_of(first(element, "documentation")),
