@@ -9,8 +9,8 @@ pipe (FIFO), not a regular file"``, ``"Permission denied"``): each loader wraps 
 error (exit status 2 at the command line, docs/validation.md).
 
 This module sits at the bottom of the layers (pyproject.toml) so that every loader, the
-engine's included, can use it; it imports nothing of opspec. (:mod:`opspec.xpdl.reader` has
-its own ``not_a_file``/``open_regular`` for specs, with the same phrases.)
+engine's included, can use it; it imports nothing of opspec. (:mod:`opspec.xpdl.reader` reads
+specs through these too, adding its size limit and XPDL-specific messages.)
 """
 
 from __future__ import annotations
