@@ -38,6 +38,7 @@ from opspec.xpdl.handlers.common import (
     parse_bool,
     parse_int,
     raw_xml,
+    required_attr,
     text_of,
 )
 from opspec.xpdl.handlers.registry import Registry
@@ -86,12 +87,9 @@ def _basic(element: etree._Element, ctx: BuildContext) -> DataType:
 
 @DATA_TYPES.register("DeclaredType")
 def _declared(element: etree._Element, ctx: BuildContext) -> DataType:
-    ref = attr(element, "Id")
-    if ref is None:
-        ctx.error(element, "missing-id", "DeclaredType has no Id",
-                  "set Id to the Id of a TypeDeclaration")
-        ref = ""
-    return DeclaredType(ref=ref)
+    return DeclaredType(ref=required_attr(element, "Id", ctx, "missing-id",
+                                          "DeclaredType has no Id",
+                                          "set Id to the Id of a TypeDeclaration"))
 
 
 @DATA_TYPES.register("SchemaType")
