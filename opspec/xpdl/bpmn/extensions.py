@@ -35,7 +35,7 @@ from opspec.model.data import (
 from opspec.model.resources import Application
 from opspec.xpdl.bpmn.common import Defs, first, is_opspec, local
 from opspec.xpdl.handlers.common import raw_xml
-from opspec.xpdl.handlers.data import typed_value
+from opspec.xpdl.handlers.data import actual_parameter, typed_value
 from opspec.xpdl.sisarl import REPEATABLE, Directive, collect
 
 __all__ = [
@@ -182,17 +182,7 @@ def application(element: etree._Element, defs: Defs) -> Application:
 
 
 def _actual(element: etree._Element, defs: Defs) -> ActualParameter:
-    from opspec.xpdl.conditions import parse_expression
-
-    text = "".join(element.itertext()).strip()
-    location = defs.loc(element)
-    expression = None
-    if text:
-        try:
-            expression = parse_expression(text, location=location)
-        except (SpecError, ValueError, RecursionError):
-            expression = None          # kept as text, as XPDL keeps opaque parameters
-    return ActualParameter(text=text, expression=expression, location=location)
+    return actual_parameter(element, defs.loc(element))
 
 
 def actual_parameters(element: etree._Element, defs: Defs) -> tuple[ActualParameter, ...]:
