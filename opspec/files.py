@@ -9,8 +9,8 @@ pipe (FIFO), not a regular file"``, ``"Permission denied"``): each loader wraps 
 error (exit status 2 at the command line, docs/validation.md).
 
 This module sits at the bottom of the layers (pyproject.toml) so that every loader, the
-engine's included, can use it; it imports nothing of opspec. (:mod:`opspec.xpdl.reader` has
-its own ``not_a_file``/``open_regular`` for specs, with the same phrases.)
+engine's included, can use it; it imports nothing of opspec. (:mod:`opspec.xpdl.reader` reads
+specs through these too, adding its size limit and XPDL-specific messages.)
 """
 
 from __future__ import annotations
@@ -27,7 +27,8 @@ from typing import Any, BinaryIO
 
 __all__ = ["EXTERNAL_PATH_VARIABLE", "MAX_NESTING", "NotARegularFile", "allowed_roots",
            "companion_outside", "file_name", "json_loads", "not_a_file", "open_regular",
-           "outside_roots", "read_bytes", "read_text", "reason", "toml_load", "toml_loads"]
+           "outside_message", "outside_roots", "read_bytes", "read_text", "reason", "toml_load",
+           "toml_loads"]
 
 #: Folders, besides the root spec's own folder tree, whose files specs may refer to (separated
 #: by ``os.pathsep``: ``OPSPEC_EXTERNAL_PATH=/opt/xpdl-lib:/srv/shared``; docs/validation.md).
@@ -143,10 +144,19 @@ def companion_outside(spec: str | os.PathLike[str] | None, name: str, what: str
     where = outside_roots(base / name, roots)
     if where is None:
         return None
+    return outside_message(f"{what} {name!r}", where, roots)
+
+
+def outside_message(reference: str, where: str, roots: Sequence[Path], *,
+                    files: str = "the files a spec names", thing: str = "the file"
+                    ) -> tuple[str, str]:
+    """``(message, hint)`` refusing ``reference`` (``"opspec:WorldFile 'w.toml'"``), which
+    leads outside the spec's folder to ``where`` (from :func:`outside_roots`): opspec reads
+    ``files`` only inside ``roots``; the hint says to copy ``thing`` in or allow its folder."""
     folders = " or ".join(str(r) for r in roots)
-    message = (f"{what} {name!r} leads outside the spec's folder ({where}); opspec reads the "
-               f"files a spec names only inside {folders}")
-    hint = ("copy the file into the spec's folder, or allow its folder with the environment "
+    message = (f"{reference} leads outside the spec's folder ({where}); opspec reads {files} "
+               f"only inside {folders}")
+    hint = (f"copy {thing} into the spec's folder, or allow its folder with the environment "
             f"variable {EXTERNAL_PATH_VARIABLE} (docs/validation.md)")
     return message, hint
 

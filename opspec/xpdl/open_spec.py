@@ -59,7 +59,7 @@ def refuse_unreadable(diagnostics: Iterable[Diagnostic]) -> None:
 def unreadable(path: Path) -> None:
     """Raise a :class:`ConfigurationError` when ``path`` cannot be opened for reading as a
     regular file (permissions, a pipe); opening never blocks."""
-    from opspec.xpdl.reader import open_regular
+    from opspec.files import open_regular
 
     try:
         with open_regular(path):

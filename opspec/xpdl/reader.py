@@ -22,7 +22,6 @@ import bisect
 import itertools
 import os
 import re
-import stat
 import xml.parsers.expat
 from collections.abc import Iterator, Mapping
 from contextlib import contextmanager
@@ -34,7 +33,7 @@ from typing import BinaryIO, Final
 from lxml import etree
 
 from opspec.errors import Diagnostic, Severity, SourceLocation, SpecError
-from opspec.files import not_a_file
+from opspec.files import NotARegularFile, not_a_file, open_regular
 from opspec.model.package import XpdlVersion
 from opspec.xpdl.namespaces import XPDL_NAMESPACES, version_of_namespace
 
@@ -49,7 +48,6 @@ __all__ = [
     "exact_lines",
     "line_of",
     "not_a_file",
-    "open_regular",
     "parse_safely",
     "read_file",
     "read_limited",
@@ -214,32 +212,6 @@ def read_limited(stream: BinaryIO, *, path: str, max_bytes: int = DEFAULT_MAX_BY
         chunks.append(chunk)
 
 
-def open_regular(path: str | Path) -> BinaryIO:
-    """Open a regular file for reading; an :class:`OSError` for anything else. Pipes and
-    devices are refused before they are opened, and the file is opened non-blocking and
-    checked again, so a path swapped for a FIFO in between cannot block either."""
-    reason = not_a_file(path)
-    if reason is not None:
-        raise _NotRegular(reason)
-    flags = os.O_RDONLY | getattr(os, "O_NONBLOCK", 0) | getattr(os, "O_BINARY", 0)
-    descriptor = os.open(path, flags)
-    try:
-        if not stat.S_ISREG(os.fstat(descriptor).st_mode):
-            raise _NotRegular("it is not a regular file")
-        return os.fdopen(descriptor, "rb")
-    except BaseException:
-        os.close(descriptor)
-        raise
-
-
-class _NotRegular(OSError):
-    """A path that is not a regular file (its ``strerror`` says what it is)."""
-
-    def __init__(self, reason: str) -> None:
-        super().__init__(reason)
-        self.strerror = reason
-
-
 def read_file(path: str | Path, *, max_bytes: int = DEFAULT_MAX_BYTES) -> bytes:
     """The bytes of a regular file, checking its size before reading it. Folders, pipes,
     devices and sockets are refused (``io-error``) without blocking."""
@@ -253,10 +225,11 @@ def read_file(path: str | Path, *, max_bytes: int = DEFAULT_MAX_BYTES) -> bytes:
             return read_limited(stream, path=shown, max_bytes=max_bytes)
     except XmlReadError:
         raise
-    except _NotRegular as error:
+    except (NotARegularFile, FileNotFoundError) as error:
+        why = "it does not exist" if isinstance(error, FileNotFoundError) else error.strerror
         raise XmlReadError(
             "io-error",
-            f"cannot read the file: {error.strerror}",
+            f"cannot read the file: {why}",
             location=SourceLocation(shown),
             hint="give the path of an XPDL file; specs are not read from folders, pipes or "
             "devices",

@@ -26,7 +26,7 @@ from pathlib import Path
 from lxml import etree
 
 from opspec.errors import Diagnostic, Severity, SourceLocation
-from opspec.files import EXTERNAL_PATH_VARIABLE, allowed_roots, outside_roots
+from opspec.files import EXTERNAL_PATH_VARIABLE, allowed_roots, outside_message, outside_roots
 from opspec.model.activities import Execution, GatewayType, SubFlow
 from opspec.model.package import ExternalPackage, Package
 from opspec.model.process import ConditionKind, Transition, WorkflowProcess
@@ -64,13 +64,9 @@ def _key(path: Path) -> Path:
         return path.absolute()
 
 
-def _outside_message(href: str, where: str, roots: Sequence[Path]) -> tuple[str, str]:
-    folders = " or ".join(str(r) for r in roots)
-    message = (f"{href!r} leads outside the spec's folder ({where}); opspec reads referenced "
-               f"packages only inside {folders}")
-    hint = ("copy the package into the spec's folder, or allow its folder with the environment "
-            f"variable {EXTERNAL_PATH_VARIABLE} (docs/validation.md)")
-    return message, hint
+def _outside_message(reference: str, where: str, roots: Sequence[Path]) -> tuple[str, str]:
+    return outside_message(reference, where, roots, files="referenced packages",
+                           thing="the package")
 
 
 def _package_id_of(path: Path) -> str | None:
@@ -136,9 +132,9 @@ def _load_externals(root: Package, root_path: Path, load: Loader, res: Resolutio
             href = ext.href.strip()
             outside = outside_roots(path.parent / href, res.roots) if href else None
             if outside is not None:
-                message, hint = _outside_message(href, outside, res.roots)
-                res.error(ext.location, "external-package-outside",
-                          f"ExternalPackage {message}", hint)
+                message, hint = _outside_message(f"ExternalPackage {href!r}", outside,
+                                                 res.roots)
+                res.error(ext.location, "external-package-outside", message, hint)
                 continue
             target = _external_target(ext, path, res.roots)
             if target is None:
@@ -272,9 +268,9 @@ def _target(subflow: SubFlow, caller: Package, res: Resolution, load: Loader,
         package = _package_by_ref(subflow.package_ref, caller, res, load)
         if package is None and subflow.package_ref in res.refused:
             message, hint = _outside_message(
-                subflow.package_ref, str(Path(caller.source or ".").parent / subflow.package_ref),
-                res.roots)
-            res.error(location, "external-package-outside", f"SubFlow PackageRef {message}", hint)
+                f"SubFlow PackageRef {subflow.package_ref!r}",
+                str(Path(caller.source or ".").parent / subflow.package_ref), res.roots)
+            res.error(location, "external-package-outside", message, hint)
             return None
         if package is None:
             res.error(location, "unresolved-subflow",

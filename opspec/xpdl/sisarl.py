@@ -194,22 +194,22 @@ def _lane(directive: Directive) -> str:
     return value
 
 
-def _run_length(directive: Directive) -> float:
-    seconds = parse_seconds(directive.value, directive.location, "run length")
+def _positive_seconds(directive: Directive, what: str, hint: str) -> float:
+    """The duration ``directive`` states, in seconds; zero or less is an error naming ``what``."""
+    seconds = parse_seconds(directive.value, directive.location, what)
     if seconds <= 0:
-        raise SisarlValueError(f"run length {directive.value!r} must be longer than zero",
-                               location=directive.location, hint="write e.g. PT1H")
+        raise SisarlValueError(f"{what} {directive.value!r} must be longer than zero",
+                               location=directive.location, hint=hint)
     return seconds
+
+
+def _run_length(directive: Directive) -> float:
+    return _positive_seconds(directive, "run length", "write e.g. PT1H")
 
 
 def _message_ttl(directive: Directive) -> float:
-    seconds = parse_seconds(directive.value, directive.location, "message time to live")
-    if seconds <= 0:
-        raise SisarlValueError(f"message time to live {directive.value!r} must be longer than "
-                               "zero", location=directive.location,
-                               hint="write e.g. PT60S (leave it out to keep messages until "
-                               "caught)")
-    return seconds
+    return _positive_seconds(directive, "message time to live",
+                             "write e.g. PT60S (leave it out to keep messages until caught)")
 
 
 def _mode_id(directive: Directive) -> str:

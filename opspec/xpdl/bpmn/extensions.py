@@ -20,7 +20,6 @@ from __future__ import annotations
 
 from lxml import etree
 
-from opspec.errors import SpecError
 from opspec.model.activities import Execution, TaskApplication
 from opspec.model.common import ExtendedAttribute
 from opspec.model.data import (
@@ -34,8 +33,9 @@ from opspec.model.data import (
 )
 from opspec.model.resources import Application
 from opspec.xpdl.bpmn.common import Defs, first, is_opspec, local
+from opspec.xpdl.handlers.activities import build_assignment
 from opspec.xpdl.handlers.common import raw_xml
-from opspec.xpdl.handlers.data import typed_value
+from opspec.xpdl.handlers.data import actual_parameter, typed_value
 from opspec.xpdl.sisarl import REPEATABLE, Directive, collect
 
 __all__ = [
@@ -182,17 +182,7 @@ def application(element: etree._Element, defs: Defs) -> Application:
 
 
 def _actual(element: etree._Element, defs: Defs) -> ActualParameter:
-    from opspec.xpdl.conditions import parse_expression
-
-    text = "".join(element.itertext()).strip()
-    location = defs.loc(element)
-    expression = None
-    if text:
-        try:
-            expression = parse_expression(text, location=location)
-        except (SpecError, ValueError, RecursionError):
-            expression = None          # kept as text, as XPDL keeps opaque parameters
-    return ActualParameter(text=text, expression=expression, location=location)
+    return actual_parameter(element, defs.loc(element))
 
 
 def actual_parameters(element: etree._Element, defs: Defs) -> tuple[ActualParameter, ...]:
@@ -229,8 +219,6 @@ def execution(element: etree._Element, defs: Defs) -> Execution:
 
 def assignments(element: etree._Element, defs: Defs) -> tuple[Assignment, ...]:
     """``<opspec:Assignment Target AssignTime>expression</opspec:Assignment>`` children."""
-    from opspec.xpdl.conditions import parse_expression
-
     out: list[Assignment] = []
     for sub in opspec_named(element, "Assignment"):
         target = (sub.get("Target") or "").strip()
@@ -239,15 +227,6 @@ def assignments(element: etree._Element, defs: Defs) -> tuple[Assignment, ...]:
             defs.ctx.warning(sub, "bad-assignment", "opspec:Assignment has no Target; it is "
                              "ignored", "add Target=\"data_field\"")
             continue
-        expression = None
-        if text:
-            try:
-                expression = parse_expression(text, location=defs.loc(sub))
-            except (SpecError, ValueError, RecursionError) as error:
-                defs.ctx.warning(sub, "bad-assignment", f"assignment to {target!r} of {text!r} "
-                                 f"cannot be understood: {getattr(error, 'message', error)}",
-                                 "write an expression over data fields")
-        out.append(Assignment(target=target, text=text, expression=expression,
-                              assign_time=(sub.get("AssignTime") or "End").strip(),
-                              location=defs.loc(sub)))
+        out.append(build_assignment(sub, defs.ctx, target, text,
+                                    (sub.get("AssignTime") or "End").strip()))
     return tuple(out)

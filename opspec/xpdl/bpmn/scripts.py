@@ -23,6 +23,7 @@ membership test ``in``, a conditional expression, a list or dict literal, item a
 from __future__ import annotations
 
 import re
+from collections.abc import Iterator
 from dataclasses import dataclass
 
 from lxml import etree
@@ -123,31 +124,9 @@ def _split(text: str) -> tuple[list[_Statement], int | None]:
     return out, opened if depth else None
 
 
-def _top_level(text: str, separator: str) -> list[tuple[str, int]]:
-    """``text`` split at ``separator`` characters outside brackets and strings, with the
-    offset of each piece."""
-    pieces: list[tuple[str, int]] = []
-    depth, quote, begin = 0, None, 0
-    for i, ch in enumerate(text):
-        if quote is not None:
-            if ch == quote and text[i - 1] != "\\":
-                quote = None
-        elif ch in "'\"":
-            quote = ch
-        elif ch in "([{":
-            depth += 1
-        elif ch in ")]}":
-            depth -= 1
-        elif ch == separator and depth == 0:
-            pieces.append((text[begin:i], begin))
-            begin = i + 1
-    pieces.append((text[begin:], begin))
-    return pieces
-
-
-def _assignment_at(text: str) -> int | None:
-    """Index of the ``=`` of an assignment (not ``==``, ``<=``, ``+=``…) outside brackets and
-    strings, or ``None``."""
+def _top_level_characters(text: str) -> Iterator[tuple[int, str]]:
+    """The characters of ``text`` (with their index) that stand outside brackets and strings,
+    brackets and quotes themselves left out."""
     depth, quote = 0, None
     for i, ch in enumerate(text):
         if quote is not None:
@@ -159,7 +138,28 @@ def _assignment_at(text: str) -> int | None:
             depth += 1
         elif ch in ")]}":
             depth -= 1
-        elif ch == "=" and depth == 0:
+        elif depth == 0:
+            yield i, ch
+
+
+def _top_level(text: str, separator: str) -> list[tuple[str, int]]:
+    """``text`` split at ``separator`` characters outside brackets and strings, with the
+    offset of each piece."""
+    pieces: list[tuple[str, int]] = []
+    begin = 0
+    for i, ch in _top_level_characters(text):
+        if ch == separator:
+            pieces.append((text[begin:i], begin))
+            begin = i + 1
+    pieces.append((text[begin:], begin))
+    return pieces
+
+
+def _assignment_at(text: str) -> int | None:
+    """Index of the ``=`` of an assignment (not ``==``, ``<=``, ``+=``…) outside brackets and
+    strings, or ``None``."""
+    for i, ch in _top_level_characters(text):
+        if ch == "=":
             before = text[i - 1] if i else ""
             after = text[i + 1] if i + 1 < len(text) else ""
             if after != "=" and before not in "=!<>+-*/%":

@@ -43,7 +43,7 @@ from opspec.xpdl.handlers.resources import performers_of
 from opspec.xpdl.namespaces import qname
 from opspec.xpdl.sisarl import activity_directives
 
-__all__ = ["build_activity", "build_assignments"]
+__all__ = ["build_activity", "build_assignment", "build_assignments"]
 
 
 def _mode(element: etree._Element, name: str, ctx: BuildContext) -> Mode:
@@ -162,10 +162,6 @@ def _expression(element: etree._Element | None, text: str | None, ctx: BuildCont
 def build_assignments(element: etree._Element, ctx: BuildContext) -> tuple[Assignment, ...]:
     """``element/Assignments/Assignment`` (XPDL 2.1): Target := Expression at AssignTime."""
     found = grandchildren(element, "Assignments", "Assignment")
-    if not found:
-        return ()
-    from opspec.xpdl.conditions import parse_expression
-
     out: list[Assignment] = []
     for assignment in found:
         target = _expression_text(child(assignment, "Target"))
@@ -174,18 +170,27 @@ def build_assignments(element: etree._Element, ctx: BuildContext) -> tuple[Assig
             ctx.warning(assignment, "bad-assignment", "Assignment has no Target; it is ignored",
                         "add <Target>data_field</Target>")
             continue
-        expression = None
-        if text:
-            try:
-                expression = parse_expression(text, location=ctx.loc(assignment))
-            except (SpecError, ValueError, RecursionError) as error:
-                ctx.warning(assignment, "bad-assignment", f"assignment to {target!r} of {text!r} "
-                            f"cannot be understood: {getattr(error, 'message', error)}",
-                            "write an expression over data fields")
-        out.append(Assignment(target=target, text=text, expression=expression,
-                              assign_time=attr(assignment, "AssignTime") or "End",
-                              location=ctx.loc(assignment)))
+        out.append(build_assignment(assignment, ctx, target, text,
+                                    attr(assignment, "AssignTime") or "End"))
     return tuple(out)
+
+
+def build_assignment(element: etree._Element, ctx: BuildContext, target: str, text: str,
+                     assign_time: str) -> Assignment:
+    """``target := text`` (an XPDL Assignment or a BPMN ``opspec:Assignment``); text that is
+    no expression is a ``bad-assignment`` warning and kept as text only."""
+    from opspec.xpdl.conditions import parse_expression
+
+    expression = None
+    if text:
+        try:
+            expression = parse_expression(text, location=ctx.loc(element))
+        except (SpecError, ValueError, RecursionError) as error:
+            ctx.warning(element, "bad-assignment", f"assignment to {target!r} of {text!r} "
+                        f"cannot be understood: {getattr(error, 'message', error)}",
+                        "write an expression over data fields")
+    return Assignment(target=target, text=text, expression=expression, assign_time=assign_time,
+                      location=ctx.loc(element))
 
 
 def _restrictions(element: etree._Element, ctx: BuildContext) -> tuple[Join | None, Split | None]:

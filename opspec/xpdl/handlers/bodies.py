@@ -18,7 +18,14 @@ from opspec.model.activities import (
     TaskApplication,
     TaskKind,
 )
-from opspec.xpdl.handlers.common import BuildContext, attr, child, children, text_of
+from opspec.xpdl.handlers.common import (
+    BuildContext,
+    attr,
+    child,
+    children,
+    required_attr,
+    text_of,
+)
 from opspec.xpdl.handlers.data import build_actual_parameters
 from opspec.xpdl.handlers.events import EVENTS
 from opspec.xpdl.handlers.registry import Registry
@@ -71,11 +78,9 @@ def _route(element: etree._Element, ctx: BuildContext) -> ActivityBody:
 
 @BODIES.register("BlockActivity")
 def _block(element: etree._Element, ctx: BuildContext) -> ActivityBody:
-    set_id = attr(element, "ActivitySetId")
-    if set_id is None:
-        ctx.error(element, "missing-activity-set", "BlockActivity names no ActivitySetId",
-                  "set ActivitySetId to the Id of an ActivitySet of this process")
-        set_id = ""
+    set_id = required_attr(element, "ActivitySetId", ctx, "missing-activity-set",
+                           "BlockActivity names no ActivitySetId",
+                           "set ActivitySetId to the Id of an ActivitySet of this process")
     return BlockActivity(activity_set=set_id, start_activity=attr(element, "StartActivityId"))
 
 
@@ -102,11 +107,9 @@ def _no(element: etree._Element, ctx: BuildContext) -> ActivityBody:
 
 @IMPLEMENTATIONS.register("SubFlow")
 def _subflow(element: etree._Element, ctx: BuildContext) -> ActivityBody:
-    process = attr(element, "Id")
-    if process is None:
-        ctx.error(element, "missing-subflow-target", "SubFlow names no process (its Id is missing)",
-                  "set Id to the Id of the WorkflowProcess to call")
-        process = ""
+    process = required_attr(element, "Id", ctx, "missing-subflow-target",
+                            "SubFlow names no process (its Id is missing)",
+                            "set Id to the Id of the WorkflowProcess to call")
     raw = (attr(element, "Execution") or "SYNCHR").upper()
     try:
         execution = Execution(raw)
@@ -135,11 +138,9 @@ def _task(element: etree._Element, ctx: BuildContext) -> ActivityBody:
 
 
 def _application(element: etree._Element, ctx: BuildContext) -> TaskApplication:
-    application = attr(element, "Id")
-    if application is None:
-        ctx.error(element, "missing-application", "TaskApplication names no application",
-                  "set Id to the Id of an Application")
-        application = ""
+    application = required_attr(element, "Id", ctx, "missing-application",
+                                "TaskApplication names no application",
+                                "set Id to the Id of an Application")
     return TaskApplication(application=application, package_ref=attr(element, "PackageRef"),
                            actual_parameters=build_actual_parameters(element, ctx))
 

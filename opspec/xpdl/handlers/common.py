@@ -37,6 +37,7 @@ __all__ = [
     "parse_int",
     "quantity",
     "raw_xml",
+    "required_attr",
     "text_of",
 ]
 
@@ -190,6 +191,18 @@ def attr(element: Node, name: str) -> str | None:
         return None
     value = value.strip()
     return value or None
+
+
+def required_attr(element: Node, name: str, ctx: BuildContext, code: str, message: str,
+                  hint: str) -> str:
+    """The value of an attribute the element cannot do without (the Id a reference names);
+    when it is absent or blank, a located ``code`` error and ``""``, so that reading goes on
+    and every other error of the spec is reported too."""
+    value = attr(element, name)
+    if value is None:
+        ctx.error(element, code, message, hint)
+        return ""
+    return value
 
 
 def parse_bool(text: str | None) -> bool | None:

@@ -5,7 +5,7 @@ from __future__ import annotations
 
 from lxml import etree
 
-from opspec.errors import SpecError
+from opspec.errors import SourceLocation, SpecError
 from opspec.model.data import (
     ActualParameter,
     ArrayType,
@@ -38,12 +38,14 @@ from opspec.xpdl.handlers.common import (
     parse_bool,
     parse_int,
     raw_xml,
+    required_attr,
     text_of,
 )
 from opspec.xpdl.handlers.registry import Registry
 
 __all__ = [
     "DATA_TYPES",
+    "actual_parameter",
     "build_actual_parameters",
     "build_data_field",
     "build_data_type",
@@ -86,12 +88,9 @@ def _basic(element: etree._Element, ctx: BuildContext) -> DataType:
 
 @DATA_TYPES.register("DeclaredType")
 def _declared(element: etree._Element, ctx: BuildContext) -> DataType:
-    ref = attr(element, "Id")
-    if ref is None:
-        ctx.error(element, "missing-id", "DeclaredType has no Id",
-                  "set Id to the Id of a TypeDeclaration")
-        ref = ""
-    return DeclaredType(ref=ref)
+    return DeclaredType(ref=required_attr(element, "Id", ctx, "missing-id",
+                                          "DeclaredType has no Id",
+                                          "set Id to the Id of a TypeDeclaration"))
 
 
 @DATA_TYPES.register("SchemaType")
@@ -243,20 +242,22 @@ def build_formal_parameter(element: etree._Element, ctx: BuildContext) -> Formal
 
 
 def build_actual_parameters(owner: etree._Element, ctx: BuildContext) -> tuple[ActualParameter, ...]:
-    """``owner/ActualParameters/ActualParameter``: text as written plus, when it parses, an
-    expression (a parameter that is no expression is kept as text, without a diagnostic, since
-    many engines pass opaque strings)."""
+    """``owner/ActualParameters/ActualParameter``, each as :func:`actual_parameter` reads it."""
+    return tuple(actual_parameter(parameter, ctx.loc(parameter))
+                 for parameter in grandchildren(owner, "ActualParameters", "ActualParameter"))
+
+
+def actual_parameter(element: etree._Element, location: SourceLocation) -> ActualParameter:
+    """One ``ActualParameter`` (XPDL, or a BPMN extension's): its text as written plus, when
+    it parses, an expression; a parameter that is no expression is kept as text, without a
+    diagnostic, since many engines pass opaque strings."""
     from opspec.xpdl.conditions import parse_expression
 
-    out: list[ActualParameter] = []
-    for parameter in grandchildren(owner, "ActualParameters", "ActualParameter"):
-        text = "".join(parameter.itertext()).strip()
-        location = ctx.loc(parameter)
-        expression = None
-        if text:
-            try:
-                expression = parse_expression(text, location=location)
-            except (SpecError, ValueError):
-                expression = None
-        out.append(ActualParameter(text=text, expression=expression, location=location))
-    return tuple(out)
+    text = "".join(element.itertext()).strip()
+    expression = None
+    if text:
+        try:
+            expression = parse_expression(text, location=location)
+        except (SpecError, ValueError, RecursionError):
+            expression = None
+    return ActualParameter(text=text, expression=expression, location=location)
