@@ -9,12 +9,14 @@ person (lognormal, sigma 0.25) and whose chance of missing an alarm varies by pe
 sd 0.08) — and checks them at family-wise level 0.05 (399 bootstrap groups):
 
 * ``true``: 10 people against the true population model: the false-alarm rate;
-* ``fitted``: a model fitted (``opspec fit``, 100 parameter redraws) on 30 people, checked
-  on 10 others: the false-alarm rate of the whole fit-then-check procedure;
+* ``fitted``: a model fitted (``opspec fit``, its default 200 parameter redraws) on 30
+  people, checked on 10 others: the false-alarm rate of the whole fit-then-check procedure;
 * ``power``: 10 (or 20) people of a different population against the true model, for
   several sizes of misfit: the detection rate, and which items were flagged.
 
-Each rate is printed with its Wilson 95 % interval.
+Each rate is printed with its exact (Clopper-Pearson) 95 % interval. ``--start`` and
+``--reps`` split the repetitions over processes (each repetition has its own seeds); the
+``rep N:`` lines of several runs add up (``--tally FILE...`` counts them).
 """
 
 from __future__ import annotations
@@ -64,11 +66,12 @@ def check(model_path: Path, traces: list[Path], seed: int) -> tuple[bool, list[s
     return report.fits, [i.name for i in report.misfits]
 
 
-def wilson(k: int, n: int) -> str:
-    from opspec.statistics import rate_interval
+def exact(k: int, n: int) -> str:
+    """``k/n`` with its Clopper-Pearson ("exact") 95 % interval (scipy's binomtest)."""
+    from scipy.stats import binomtest
 
-    _, low, high = rate_interval(k, n)
-    return f"{k}/{n} = {k / n:.3f} (Wilson 95 % [{low:.3f}, {high:.3f}])"
+    ci = binomtest(k, n).proportion_ci(0.95, method="exact")
+    return f"{k}/{n} = {k / n:.3f} (Clopper-Pearson 95 % [{ci.low:.3f}, {ci.high:.3f}])"
 
 
 def run_true(reps: int, work: Path, start: int = 0) -> None:
@@ -80,7 +83,7 @@ def run_true(reps: int, work: Path, start: int = 0) -> None:
         alarms += not fits
         flagged.update(names)
         print(f"  rep {r}: {'fits' if fits else 'MISFIT ' + ', '.join(names)}", flush=True)
-    print(f"true model, 10 people: false alarms {wilson(alarms, reps)}; items flagged: "
+    print(f"true model, 10 people: false alarms {exact(alarms, reps)}; items flagged: "
           f"{dict(flagged)}")
 
 
@@ -94,14 +97,14 @@ def run_fitted(reps: int, work: Path, start: int = 0) -> None:
     for r in range(start, start + reps):
         traces = people(truth, work / f"fit{r}", 40, seed=20_000 + r)
         result = fit_traces(traces[:30], name="fitted")
-        draws = parameter_draws(result, 100, seed=r)
+        draws = parameter_draws(result, 200, seed=r)
         fitted = work / f"fit{r}" / "fitted.users.toml"
         fitted.write_text(fitted_text(result, draws), encoding="utf-8")
         fits, names = check(fitted, traces[30:], seed=r)
         alarms += not fits
         flagged.update(names)
         print(f"  rep {r}: {'fits' if fits else 'MISFIT ' + ', '.join(names)}", flush=True)
-    print(f"fitted on 30, checked on 10: false alarms {wilson(alarms, reps)}; items "
+    print(f"fitted on 30, checked on 10: false alarms {exact(alarms, reps)}; items "
           f"flagged: {dict(flagged)}")
 
 
@@ -127,8 +130,8 @@ def run_power(reps: int, work: Path) -> None:
             flagged.update(names)
             print(f"  {label}, {count} people, rep {r}: "
                   f"{'fits' if fits else 'MISFIT ' + ', '.join(names)}", flush=True)
-        rows.append((label, count, wilson(caught, reps), dict(flagged)))
-        print(f"{label}, {count} people: detected {wilson(caught, reps)}; flagged "
+        rows.append((label, count, exact(caught, reps), dict(flagged)))
+        print(f"{label}, {count} people: detected {exact(caught, reps)}; flagged "
               f"{dict(flagged)}", flush=True)
     print("\n| misfit | people | detected (power) | items flagged |\n|---|---|---|---|")
     for label, count, rate, flagged in rows:
@@ -136,15 +139,36 @@ def run_power(reps: int, work: Path) -> None:
               + ", ".join(f"{k} {v}" for k, v in flagged.items()) + " |")
 
 
+def tally(paths: list[str]) -> None:
+    """The false-alarm rate of the ``rep N:`` lines of earlier runs' outputs (one mode's)."""
+    import re
+
+    seen: dict[int, list[str]] = {}
+    for path in paths:
+        for line in Path(path).read_text(encoding="utf-8").splitlines():
+            found = re.match(r"\s+rep (\d+): (fits|MISFIT (.*))$", line)
+            if found:
+                seen[int(found.group(1))] = ([] if found.group(2) == "fits"
+                                             else found.group(3).split(", "))
+    flagged = Counter(name for names in seen.values() for name in names)
+    alarms = sum(1 for names in seen.values() if names)
+    print(f"{len(seen)} repetitions: false alarms {exact(alarms, len(seen))}; items "
+          f"flagged: {dict(flagged)}")
+
+
 def main() -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    parser.add_argument("mode", choices=("true", "fitted", "power"))
+    parser.add_argument("mode", choices=("true", "fitted", "power", "tally"))
+    parser.add_argument("outputs", nargs="*", help="tally: the outputs of earlier runs")
     parser.add_argument("--reps", type=int, default=100)
     parser.add_argument("--start", type=int, default=0,
                         help="true, fitted: the first repetition (to split the repetitions "
                         "over processes)")
     args = parser.parse_args()
     start = time.perf_counter()
+    if args.mode == "tally":
+        tally(args.outputs)
+        return 0
     with tempfile.TemporaryDirectory() as tmp:
         if args.mode == "power":
             run_power(args.reps, Path(tmp))

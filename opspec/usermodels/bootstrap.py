@@ -40,7 +40,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
@@ -126,6 +126,9 @@ class _Target:
     family: str | None = None
     intended: str | None = None        # duration of a choice: its intended picks only
     between: float = 0.0               # lognormal: the sigma written is the within-person part
+    #: a population's omission rate (``[vary]``): the mean of the own rates of the persons
+    #: with at least this many offers, as the fit takes it; 0: the rate of the pooled counts
+    own_rates_min: int = 0
 
 
 def _targets(result: FitResult) -> list[_Target]:
@@ -133,10 +136,25 @@ def _targets(result: FitResult) -> list[_Target]:
 
     model = result.model
     out: list[_Target] = []
+    vary = result.vary()
     for fit in result.fits:
         own = model.activities.get(fit.activity)
         if own is None:
             continue
+        # how much people differ is estimated from 30 persons as loosely as their mean
+        # (a between-person sd's interval easily spans a factor of two): it is redrawn too,
+        # or a check of new people would take a spread that came out small for the truth
+        written = vary.get(fit.activity, {})
+        for param in written.get("duration", {}):
+            spread = fit.duration_spread
+            out.append(_Target(fit.activity, "duration spread",
+                               f"vary.activities.{fit.activity}.duration.{param}.sigma",
+                               own_rates_min=spread.min_per_user if spread else 10))
+        if "omission" in written:
+            spread_o = fit.omission_spread
+            out.append(_Target(fit.activity, "omission spread",
+                               f"vary.activities.{fit.activity}.omission.probability.sd",
+                               own_rates_min=spread_o.min_per_user if spread_o else 10))
         base = dotted(("activities", fit.activity))
         family = _family(own.duration)
         if fit.families and family is not None:
@@ -149,7 +167,10 @@ def _targets(result: FitResult) -> list[_Target]:
             out.append(_Target(fit.activity, "duration", f"{base}.duration", family,
                                intended, between))
         if own.omission is not None:
-            out.append(_Target(fit.activity, "omission", f"{base}.omission.probability"))
+            spread = fit.omission_spread
+            out.append(_Target(fit.activity, "omission", f"{base}.omission.probability",
+                               own_rates_min=spread.min_per_user
+                               if spread is not None and spread.varies else 0))
         if own.commission is not None and own.intended is not None:
             out.append(_Target(fit.activity, "commission", f"{base}.commission.probability",
                                intended=own.intended))
@@ -232,6 +253,32 @@ def _values(target: _Target, data: _Data, rng: np.random.Generator | None = None
     return None if found is None else {f"{target.prefix}.{k}": v for k, v in found.items()}
 
 
+def _own_rates_mean(target: _Target, persons: Sequence[dict[str, _Data]],
+                    rng: np.random.Generator | None) -> dict[str, float] | None:
+    """A population's omission rate on ``persons`` (one entry per person drawn, repeats
+    included): the mean of their own rates, as the fit centres its ``[vary]`` beta; with
+    ``rng`` each own rate is a draw from its Jeffreys posterior."""
+    rates = [_rate(d.omitted, d.answered, rng) for person in persons
+             if (d := person.get(target.activity)) is not None
+             and d.answered >= target.own_rates_min]
+    return {target.prefix: float(np.mean(rates))} if rates else None
+
+
+def _spread(target: _Target, persons: Sequence[dict[str, _Data]]) -> dict[str, float] | None:
+    """A ``[vary]`` spread on ``persons`` (one entry per person drawn, repeats included),
+    estimated as the fit estimates it (:mod:`opspec.usermodels.spread`)."""
+    from opspec.usermodels.spread import duration_between_sd, omission_between_sd
+
+    data = [d for person in persons if (d := person.get(target.activity)) is not None]
+    if target.kind == "duration spread":
+        found = duration_between_sd([d.durations for d in data],
+                                    min_per_user=target.own_rates_min)
+    else:
+        found = omission_between_sd([(d.omitted, d.answered) for d in data],
+                                    min_per_user=target.own_rates_min)
+    return None if found is None else {target.prefix: found}
+
+
 def _per_person(result: FitResult, activities: Sequence[str]) -> dict[str, dict[str, _Data]]:
     obs = result.observations
     people: dict[str, dict[str, _Data]] = {p: {} for p in obs.persons}
@@ -270,8 +317,25 @@ def parameter_draws(result: FitResult, draws: int, *, seed: int = 0) -> Paramete
         for activity, d in people[person].items():
             whole[activity].add(d)
     estimate: dict[str, float] = {}
+
+    def values(target: _Target, data: _Data, persons: Sequence[dict[str, _Data]],
+               draw: np.random.Generator | None) -> dict[str, float] | None:
+        if target.kind.endswith(" spread"):
+            return _spread(target, persons)
+        if target.own_rates_min:
+            return _own_rates_mean(target, persons, draw)
+        if target.kind == "duration" and target.between > 0 and spread_of.get(target.activity):
+            # the within-person sigma is what the resample's between-person part leaves
+            found = _spread(spread_of[target.activity], persons)
+            if found:
+                target = replace(target, between=next(iter(found.values())))
+        return _values(target, data, draw)
+
+    spread_of = {t.activity: t for t in targets if t.kind == "duration spread"}
+
+    everyone = [people[p] for p in names]
     for target in targets:
-        found = _values(target, whole[target.activity])
+        found = values(target, whole[target.activity], everyone, None)
         if found is not None:
             estimate.update(found)
     parameters = tuple(estimate)
@@ -284,17 +348,16 @@ def parameter_draws(result: FitResult, draws: int, *, seed: int = 0) -> Paramete
     for _ in range(draws):
         sample = {a: _Data() for a in whole}
         if by_persons:
-            chosen = [names[i] for i in rng.integers(0, len(names), len(names))]
-            for person in chosen:
-                for activity, d in people[person].items():
-                    sample[activity].add(d)
+            chosen = [people[names[i]] for i in rng.integers(0, len(names), len(names))]
         else:
-            for person in names:
-                for activity, d in people[person].items():
-                    sample[activity].add(d.within(rng))
+            chosen = [{a: d.within(rng) for a, d in people[p].items()} for p in names]
+        for person in chosen:
+            for activity, d in person.items():
+                sample[activity].add(d)
         row = dict(estimate)
         for target in targets:
-            found = _values(target, sample[target.activity], None if by_persons else rng)
+            found = values(target, sample[target.activity], chosen,
+                           None if by_persons else rng)
             if found is None:
                 failed += 1
                 continue

@@ -217,9 +217,6 @@ def finish(items: Sequence[CheckItem], level: float) -> tuple[CheckItem, ...]:
 #: simulated people drawn for a population without parameter redraws (a person costs
 #: milliseconds to draw); each replicate group takes its people at random from them
 POOL_SIZE = 1000
-#: distinct groups drawn under parameter redraws; replicate ``b`` reuses group
-#: ``b mod DISTINCT_GROUPS`` with fresh observations
-DISTINCT_GROUPS = 100
 
 
 class PredictivePeople:
@@ -229,9 +226,12 @@ class PredictivePeople:
     Without redraws, people are drawn once into a pool of :data:`POOL_SIZE` (users ``0 …``
     of the population seeded ``seed``, its own stream) and each group takes ``size`` of
     them at random: the groups are as varied as the population. With redraws the people of
-    one group must share its redraw, so :data:`DISTINCT_GROUPS` groups are drawn (group
-    ``g`` under redraw ``1 + g mod B``) and replicate ``b`` is group ``b mod`` that, its
-    observations drawn afresh.
+    one group share its redraw — that is what parameter uncertainty means for a group: all
+    its people are off in the same direction — so every replicate group is drawn on its own
+    (group ``b`` under redraw ``1 + b mod B``, its own people). Reusing a few groups for
+    many replicates would make the replicates dependent, and the bootstrap p-value
+    ``(1 + #exceed) / (B + 1)`` then too small: it would count one unusual group several
+    times. ``bases[b]`` is group ``b``'s model (the redrawn one, before people are drawn).
     """
 
     def __init__(self, model: UserModel, size: int, replicates: int, seed: int,
@@ -242,6 +242,7 @@ class PredictivePeople:
         self.draws = draws
         self.seed = seed
         distinct: list[list[UserModel]] = []
+        self.bases: list[UserModel] = []
         if draws is None:
             if model.population is None:
                 distinct = [[model] * size]
@@ -255,14 +256,19 @@ class PredictivePeople:
                                                             replace=len(pool) < size)]
                                for _ in range(replicates)]
         else:
-            for g in range(min(replicates, DISTINCT_GROUPS)):
-                base = draws.apply(model, 1 + g % draws.count)
+            applied: dict[int, UserModel] = {}
+            for g in range(replicates):
+                index = 1 + g % draws.count
+                base = applied.get(index)
+                if base is None:
+                    base = applied[index] = draws.apply(model, index)
+                self.bases.append(base)
                 if base.population is None:
                     distinct.append([base] * size)
                 else:
                     distinct.append([base.individual(seed, g * size + j).model
                                      for j in range(size)])
-            self.groups = [distinct[b % len(distinct)] for b in range(replicates)]
+            self.groups = distinct
         self.distinct = distinct
 
     def people(self) -> list[UserModel]:
@@ -382,9 +388,11 @@ RATE_GROUPS = 20_000
 
 def check_rate(name: str, kind: str, activity: str, counts: Mapping[str, tuple[int, int]],
                rates: np.ndarray, beta: tuple[float, float] | None,
-               rng: np.random.Generator) -> CheckItem:
+               rng: np.random.Generator, *, grouped: RateGroups | None = None) -> CheckItem:
     """Observed counts against their predictive distribution; ``rates`` are the simulated
-    people's probabilities, ``beta`` a population's exact per-person law when it has one.
+    people's probabilities, ``beta`` a population's exact per-person law when it has one;
+    ``grouped`` (under parameter redraws): the law of each replicate group, whose people
+    share its redraw.
 
     One rate for everyone: the pooled count of all trials, exact binomial test. People who
     differ: the *mean of the people's own rates* ``k_p / n_p``, against the same mean for
@@ -400,7 +408,7 @@ def check_rate(name: str, kind: str, activity: str, counts: Mapping[str, tuple[i
     n = sum(t for _, t in used.values())
     trials = np.array([t for _, t in used.values()])
     own = np.array([c / t for c, t in used.values()])
-    one_rate = rates.size > 0 and float(np.ptp(rates)) == 0.0
+    one_rate = grouped is None and rates.size > 0 and float(np.ptp(rates)) == 0.0
     if one_rate:
         q = float(rates[0])
         test, statistic, observed = "exact binomial of the pooled count", float(k), k / n
@@ -413,8 +421,12 @@ def check_rate(name: str, kind: str, activity: str, counts: Mapping[str, tuple[i
             1, int(np.median(trials)))
     else:
         draws = np.empty((RATE_GROUPS, trials.size))
+        which = (rng.integers(0, grouped.count, size=RATE_GROUPS) if grouped is not None
+                 else None)
         for j, t in enumerate(trials):
-            if beta is not None:
+            if grouped is not None:
+                draws[:, j] = rng.binomial(int(t), grouped.person_rates(which, j, rng)) / t
+            elif beta is not None:
                 draws[:, j] = stats.betabinom.rvs(int(t), *beta, size=RATE_GROUPS,
                                                   random_state=rng) / t
             else:
@@ -425,7 +437,10 @@ def check_rate(name: str, kind: str, activity: str, counts: Mapping[str, tuple[i
         below = int(np.sum(groups <= observed + 1e-12))
         above = int(np.sum(groups >= observed - 1e-12))
         p = min(1.0, 2 * (1 + min(below, above)) / (RATE_GROUPS + 1))
-        test = ("mean of the people's own rates, beta-binomial predictive (the "
+        test = (f"mean of the people's own rates, binomial in {grouped.count} simulated "
+                f"groups, each under one parameter redraw ({grouped.law})"
+                if grouped is not None else
+                "mean of the people's own rates, beta-binomial predictive (the "
                 "population's per-person beta)" if beta is not None else
                 f"mean of the people's own rates, binomial mixed over {rates.size} "
                 "simulated people's rates")
@@ -460,19 +475,58 @@ def _beta_law(model: UserModel, path: tuple[str, ...]) -> tuple[float, float] | 
     return (m * common, (1 - m) * common) if common > 0 else None
 
 
+@dataclass(frozen=True)
+class RateGroups:
+    """Under parameter redraws, the per-person law of a rate in each replicate group: a
+    beta ``(a[g], b[g])`` for every group when the redrawn population draws the rate from
+    one (a person's rate then drawn afresh for every simulated group), else the rates of
+    group ``g``'s own simulated people (``rates[g, j]``)."""
+
+    a: np.ndarray | None
+    b: np.ndarray | None
+    rates: np.ndarray
+
+    @property
+    def count(self) -> int:
+        return int(self.rates.shape[0])
+
+    @property
+    def law(self) -> str:
+        return ("each person's rate from the redrawn population's beta" if self.a is not None
+                else "each person's rate that of one of the group's simulated people")
+
+    def person_rates(self, which: np.ndarray, j: int, rng: np.random.Generator) -> np.ndarray:
+        """Person ``j``'s rate in simulated groups that use the replicate groups ``which``."""
+        if self.a is not None and self.b is not None:
+            return rng.beta(self.a[which], self.b[which])
+        return self.rates[which, j % self.rates.shape[1]]
+
+
+def _probability(person: UserModel, activity: str, kind: str) -> float:
+    part = getattr(person.activity(activity), kind)
+    return part.probability if part is not None else 0.0
+
+
 def _rate_item(kind: str, activity: str, counts: Mapping[str, tuple[int, int]],
-               model: UserModel, everyone: Sequence[UserModel],
+               model: UserModel, people: PredictivePeople,
                draws: ParameterDraws | None, seed: int) -> CheckItem:
     """The check of ``activity``'s ``kind`` (omission, commission, repetition) rate."""
-    def probability(person: UserModel) -> float:
-        part = getattr(person.activity(activity), kind)
-        return part.probability if part is not None else 0.0
-
-    rates = np.array([probability(p) for p in everyone])
-    beta = (_beta_law(model, ("activities", activity, kind, "probability"))
-            if draws is None else None)
+    path = ("activities", activity, kind, "probability")
+    rates = np.array([_probability(p, activity, kind) for p in people.people()])
+    beta = _beta_law(model, path) if draws is None else None
+    grouped = None
+    if draws is not None:
+        laws = [_beta_law(base, path) for base in people.bases]
+        per_group = np.array([[_probability(p, activity, kind) for p in group]
+                              for group in people.distinct])
+        if all(law is not None for law in laws):
+            grouped = RateGroups(np.array([law[0] for law in laws if law is not None]),
+                                 np.array([law[1] for law in laws if law is not None]),
+                                 per_group)
+        else:
+            grouped = RateGroups(None, None, per_group)
     return check_rate(f"{activity} {kind}", kind, activity, counts, rates, beta,
-                      _stream(seed, f"{kind}/{activity}"))
+                      _stream(seed, f"{kind}/{activity}"), grouped=grouped)
 
 
 def commission_counts(sequences: Sequence[Sequence[str]], intended: str, cap: int
@@ -501,7 +555,6 @@ def check_observations(model: UserModel, obs: Observations, *, replicates: int =
     notes: list[str] = []
     persons = obs.persons
     people = PredictivePeople(model, max(1, len(persons)), replicates, seed, draws)
-    everyone = people.people()
     items: list[CheckItem] = []
     activities = sorted(set(obs.activities) | set(obs.picks))
     uncovered = [a for a in activities if not model.covers(a)]
@@ -529,7 +582,7 @@ def check_observations(model: UserModel, obs: Observations, *, replicates: int =
                 items.append(checked)
         omissions = obs.counts_by_person(obs.user_omissions.get(activity, {}))
         if omissions and (am.omission is not None or obs.omitted.get(activity)):
-            items.append(_rate_item("omission", activity, omissions, model, everyone, draws,
+            items.append(_rate_item("omission", activity, omissions, model, people, draws,
                                     seed))
         if am.intended is not None and obs.user_picks.get(activity):
             cap = am.commission.max_per_instance if am.commission is not None else 1
@@ -537,7 +590,7 @@ def check_observations(model: UserModel, obs: Observations, *, replicates: int =
             counts = {p: commission_counts(seqs, am.intended, cap)
                       for p, seqs in by_person.items()}
             if am.commission is not None or any(w for w, _ in counts.values()):
-                items.append(_rate_item("commission", activity, counts, model, everyone,
+                items.append(_rate_item("commission", activity, counts, model, people,
                                         draws, seed))
         elif am.probabilities and obs.picks.get(activity):
             notes.append(f"{activity}: a choice by fixed probabilities is not checked")
@@ -550,7 +603,7 @@ def check_observations(model: UserModel, obs: Observations, *, replicates: int =
                 completions = {p: n - k for p, (k, n) in omissions.items()}
                 seen = (repeated or {}).get(activity, {})
                 counts = {p: (min(seen.get(p, 0), c), c) for p, c in completions.items()}
-                items.append(_rate_item("repetition", activity, counts, model, everyone,
+                items.append(_rate_item("repetition", activity, counts, model, people,
                                         draws, seed))
     return items, notes
 

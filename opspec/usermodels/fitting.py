@@ -454,7 +454,7 @@ class FitResult:
                         "kind": "lognormal", "median": dist.scale, "sigma": d.between_sd,
                         "source": source}}
             o = fit.omission_spread
-            if o is not None and o.homogeneity_p < 0.05 and o.beta is not None:
+            if o is not None and o.varies:
                 entry["omission"] = {"probability": {
                     "kind": "beta", "mean": o.mean, "sd": o.between_sd,
                     "source": f"fitted: between-user sd {o.between_sd:.4f} (95 % interval "
@@ -575,9 +575,17 @@ def fit_traces(paths: Sequence[str | Path], *, lane: str = "user", name: str = "
             kwargs["duration"] = LogNormal(dist.mu, within)
             note = (note + "; " if note else "") + (
                 f"sigma {within:.4g} within a user, {spread_d.between_sd:.4g} between users")
-        activities[activity] = ActivityModel(**kwargs)
         spread_o = omission_spread(obs.counts_by_person(obs.user_omissions.get(activity, {})),
                                    min_per_user=min_per_user) if omitted else None
+        if spread_o is not None and spread_o.varies:
+            # people differ: the rate a person has is drawn around the mean of the people's
+            # own rates, not the pooled one (a missed prompt is offered again, so the pooled
+            # rate weighs the forgetful more than the population draws them)
+            kwargs["omission"] = replace(
+                kwargs["omission"], probability=spread_o.mean,
+                source=f"fitted: mean of {spread_o.users} persons' own rates "
+                f"(pooled {omitted}/{answered} = {omitted / answered:.4f})")
+        activities[activity] = ActivityModel(**kwargs)
         fits.append(ActivityFit(activity, len(values), dist, chosen,
                                 {f.family: f.aic for f in families}, omission_stats, note,
                                 families, criterion, spread_d, spread_o, wrong_choice))

@@ -12,9 +12,12 @@ DerSimonian & Laird 1986, and of the beta-binomial):
   between-user variance of the log *scale* of the user's durations, whatever the family. The
   per-user distribution is then a factor ``F ~ lognormal(median 1, sigma = tau)`` multiplying
   every duration of that user;
-* omissions: per-user rates ``p_u = k_u / n_u``; ``var(p_u)`` minus ``p(1-p) mean(1/n_u)``
-  is the between-user variance; the per-user distribution is ``Beta(a, b)`` with that mean
-  and variance. A chi-square test of homogeneity says whether users differ at all.
+* omissions: per-user rates ``p_u = k_u / n_u``; their mean ``p`` is the centre of the
+  per-user distribution (not the pooled ``sum k / sum n``: a missed prompt is offered again,
+  so the forgetful are offered most and a pooled rate weighs them more than the per-person
+  rate a population draws); ``var(p_u)`` minus ``mean(p_u (1 - p_u) / (n_u - 1))`` (each
+  term an unbiased estimate of that user's sampling variance) is the between-user variance;
+  the per-user distribution is ``Beta(a, b)`` with that mean and variance. A chi-square test of homogeneity says whether users differ at all.
 
 Both come with a 95 % interval from a seeded percentile bootstrap over users (the same
 traces give the same interval). Fewer than 3 users with enough data: no estimate.
@@ -23,13 +26,14 @@ traces give the same interval). Fewer than 3 users with enough data: no estimate
 from __future__ import annotations
 
 import math
-from collections.abc import Mapping, Sequence
+from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
 
-__all__ = ["DurationSpread", "OmissionSpread", "duration_spread", "omission_spread"]
+__all__ = ["DurationSpread", "OmissionSpread", "duration_between_sd", "duration_spread",
+           "omission_between_sd", "omission_spread"]
 
 #: bootstrap resamples of users for the intervals of the between-user spread
 RESAMPLES = 999
@@ -59,6 +63,7 @@ class DurationSpread:
     between_sd_ci: tuple[float, float]
     user_means: dict[str, float] = field(default_factory=dict)    # p5/p50/p95 of means
     parameters: dict[str, dict[str, float]] = field(default_factory=dict)  # per-user fits
+    min_per_user: int = 10        # the observations a user needed to count
 
     def to_json(self) -> dict[str, Any]:
         return {"users": self.users, "observed_sd_log_mean": self.observed_sd,
@@ -92,13 +97,10 @@ def duration_spread(per_user: Mapping[Any, Sequence[float]], *, min_per_user: in
     """Between-user variation of durations (module docstring); ``family`` (a name of
     :data:`opspec.usermodels.families.FAMILIES`) is also fitted per user to report the
     spread of its parameters."""
-    groups = [np.asarray(v, dtype=float) for v in per_user.values()
-              if len(v) >= min_per_user and np.all(np.asarray(v, dtype=float) > 0)]
+    groups = _duration_groups(per_user.values(), min_per_user)
     if len(groups) < 3:
         return None
-    means = np.array([g.mean() for g in groups])
-    logs = np.log(means)
-    within = np.array([g.var(ddof=1) / (g.size * g.mean() ** 2) for g in groups])
+    means, logs, within = _log_means(groups)
 
     def between(idx: np.ndarray) -> float:
         return math.sqrt(max(0.0, float(np.var(logs[idx], ddof=1)) - float(within[idx].mean())))
@@ -120,7 +122,44 @@ def duration_spread(per_user: Mapping[Any, Sequence[float]], *, min_per_user: in
         users=len(groups), observed_sd=float(np.std(logs, ddof=1)),
         sampling_sd=math.sqrt(float(within.mean())), between_sd=between(every),
         between_sd_ci=_bootstrap(between, len(groups), seed),
-        user_means=_summary(means), parameters=parameters)
+        user_means=_summary(means), parameters=parameters, min_per_user=min_per_user)
+
+
+def _duration_groups(per_user: Iterable[Sequence[float]], min_per_user: int
+                     ) -> list[np.ndarray]:
+    return [np.asarray(v, dtype=float) for v in per_user
+            if len(v) >= min_per_user and np.all(np.asarray(v, dtype=float) > 0)]
+
+
+def _log_means(groups: Sequence[np.ndarray]) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    means = np.array([g.mean() for g in groups])
+    within = np.array([g.var(ddof=1) / (g.size * g.mean() ** 2) for g in groups])
+    return means, np.log(means), within
+
+
+def duration_between_sd(per_user: Iterable[Sequence[float]], *, min_per_user: int = 10
+                        ) -> float | None:
+    """The between-user sd of ln(scale) alone, as :func:`duration_spread` estimates it (for
+    the bootstrap's redraws: each resample of persons gives its own)."""
+    groups = _duration_groups(per_user, min_per_user)
+    if len(groups) < 3:
+        return None
+    _, logs, within = _log_means(groups)
+    return math.sqrt(max(0.0, float(np.var(logs, ddof=1)) - float(within.mean())))
+
+
+def omission_between_sd(per_user: Iterable[tuple[int, int]], *, min_per_user: int = 10
+                        ) -> float | None:
+    """The between-user sd of an omission rate alone, as :func:`omission_spread` estimates
+    it (for the bootstrap's redraws)."""
+    pairs = [(k, n) for k, n in per_user if n >= min_per_user]
+    if len(pairs) < 3:
+        return None
+    k = np.array([p[0] for p in pairs], dtype=float)
+    n = np.array([p[1] for p in pairs], dtype=float)
+    rates = k / n
+    sampling = rates * (1 - rates) / np.maximum(n - 1, 1)
+    return math.sqrt(max(0.0, float(np.var(rates, ddof=1)) - float(sampling.mean())))
 
 
 @dataclass(frozen=True)
@@ -128,13 +167,19 @@ class OmissionSpread:
     """How much users differ in how often they omit one activity."""
 
     users: int
-    mean: float
+    mean: float                   # the mean of the users' own rates (the beta's mean)
     observed_sd: float
     between_sd: float
     between_sd_ci: tuple[float, float]
     homogeneity_p: float          # chi-square test that every user has the same rate
     beta: tuple[float, float] | None   # (a, b) of the per-user distribution, None: no spread
     user_rates: dict[str, float] = field(default_factory=dict)
+    min_per_user: int = 10        # the offers a user needed to count
+
+    @property
+    def varies(self) -> bool:
+        """Users differ (one rate for all rejected at 5 %) and a beta describes them."""
+        return self.homogeneity_p < 0.05 and self.beta is not None
 
     def to_json(self) -> dict[str, Any]:
         return {"users": self.users, "mean": self.mean, "observed_sd": self.observed_sd,
@@ -168,12 +213,13 @@ def omission_spread(per_user: Mapping[Any, tuple[int, int]], *, min_per_user: in
     n = np.array([p[1] for p in pairs], dtype=float)
     rates = k / n
 
+    sampling = rates * (1 - rates) / np.maximum(n - 1, 1)
+
     def between_var(idx: np.ndarray) -> float:
-        p = float(k[idx].sum() / n[idx].sum())
-        return float(np.var(rates[idx], ddof=1)) - p * (1 - p) * float((1 / n[idx]).mean())
+        return float(np.var(rates[idx], ddof=1)) - float(sampling[idx].mean())
 
     every = np.arange(len(pairs))
-    mean = float(k.sum() / n.sum())
+    mean = float(rates.mean())
     var_b = max(0.0, between_var(every))
     beta = None
     if var_b > 0 and 0 < mean < 1 and var_b < mean * (1 - mean):
@@ -191,4 +237,5 @@ def omission_spread(per_user: Mapping[Any, tuple[int, int]], *, min_per_user: in
         between_sd=math.sqrt(var_b),
         between_sd_ci=_bootstrap(lambda idx: math.sqrt(max(0.0, between_var(idx))),
                                  len(pairs), seed),
-        homogeneity_p=p_value, beta=beta, user_rates=_summary(rates))
+        homogeneity_p=p_value, beta=beta, user_rates=_summary(rates),
+        min_per_user=min_per_user)

@@ -222,25 +222,49 @@ def _recentred(dist: Any, value: float) -> Any:
                          "normal with a median or mean")
 
 
+def _respread(dist: Any, name: str, value: float) -> Any:
+    """A per-person distribution with its spread ``name`` (a lognormal's sigma, a beta's
+    sd) set to ``value`` (its centre kept; a beta's sd kept valid)."""
+    from opspec.usermodels.population_distributions import make_per_user
+
+    params = dict(dist.params)
+    if name not in params:
+        raise ParameterError(name, f"a {dist.kind} per-person distribution has no {name}",
+                             hint="fit the model again")
+    value = max(float(value), 1e-6)
+    if dist.kind == "beta":
+        centre = float(params.get("mean", 0.5))
+        value = min(value, 0.999 * math.sqrt(centre * (1 - centre)))
+    params[name] = value
+    return make_per_user({"kind": dist.kind, **params})
+
+
 def _apply(model: Any, changes: Sequence[tuple[tuple[str, ...], float]]) -> Any:
     from opspec.usermodels.population import set_parameter
 
     own = model
     for path, value in changes:
-        own = set_parameter(own, path, value)
+        if path[0] != "vary":
+            own = set_parameter(own, path, value)
     population = model.population
     if population is None:
+        if any(path[0] == "vary" for path, _ in changes):
+            raise ParameterError("vary", "redraws a [vary] spread, but the model has no "
+                                 "population", hint="fit the model again")
         return own
     groups = []
     for group in population.subgroups:
         sub = group.model
         varied = list(group.varied)
         for path, value in changes:
-            hit = next((i for i, v in enumerate(varied) if v.path == path), None)
+            spread = path[0] == "vary"
+            target = path[1:-1] if spread else path
+            hit = next((i for i, v in enumerate(varied) if v.path == target), None)
             if hit is not None:
-                varied[hit] = replace(varied[hit],
-                                      distribution=_recentred(varied[hit].distribution, value))
-            else:
+                dist = varied[hit].distribution
+                varied[hit] = replace(varied[hit], distribution=(
+                    _respread(dist, path[-1], value) if spread else _recentred(dist, value)))
+            elif not spread:
                 sub = set_parameter(sub, path, value)
         groups.append(replace(group, model=sub, varied=tuple(varied)))
     return replace(own, population=replace(population, subgroups=tuple(groups)))

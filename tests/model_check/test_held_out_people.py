@@ -123,3 +123,29 @@ def test_the_slow_people_miss_more_doses_than_the_spec_run_with_the_model(people
     doc = json.loads(capsys.readouterr().out)
     assert status == 1
     assert "metric report_latency_s" in doc["misfits"]
+
+
+def test_the_fitted_redraws_carry_how_much_people_differ(people) -> None:
+    """From 30 persons how much people differ is estimated about as loosely as their mean
+    (Davison & Hinkley 1997, 3.8: two-stage data are resampled by their units, and every
+    statistic of the resample is computed again): the redraws of the fitted population
+    carry its between-person spreads too, and a redraw sets them in the model it draws."""
+    from opspec.usermodels.loader import load_user_model
+    from opspec.usermodels.uncertainty import read_parameter_draws
+
+    found = read_parameter_draws(str(people["fitted"]))
+    assert found is not None
+    draws, _ = found
+    walk = "vary.activities.walk_to_dispenser.duration.median.sigma"
+    alarm = "vary.activities.hear_alarm.omission.probability.sd"
+    assert {walk, alarm} <= set(draws.parameters)
+    values = [draws.values(d + 1) for d in range(draws.count)]
+    spreads = [v[walk] for v in values]
+    assert min(spreads) < draws.estimates[draws.parameters.index(walk)] < max(spreads)
+    drawn = draws.apply(load_user_model(people["fitted"]), 1)
+    varied = {v.path: v.distribution.params for g in drawn.population.subgroups
+              for v in g.varied}
+    assert varied[("activities", "walk_to_dispenser", "duration", "median")]["sigma"] == \
+        pytest.approx(values[0][walk])
+    assert varied[("activities", "hear_alarm", "omission", "probability")]["sd"] == \
+        pytest.approx(values[0][alarm])

@@ -84,3 +84,49 @@ def test_commission_trials_count_the_picks_that_could_go_wrong() -> None:
     sequences = [["ok"], ["wrong", "ok"], ["wrong", "wrong", "ok"], ["ok"]]
     assert commission_counts(sequences[:2] + [["ok"]], "ok", cap=1) == (1, 3)
     assert commission_counts(sequences, "ok", cap=2) == (3, 1 + 2 + 2 + 1)
+
+
+def test_a_groups_people_share_its_parameter_redraw() -> None:
+    """Parameter uncertainty is one error of the whole fitted model: all people of a
+    simulated group are off in the same direction (Gelman et al., *Bayesian Data Analysis*,
+    posterior predictive replications: "each replicated data set drawn under one draw of the
+    parameters"). Redraws at 5 % and 15 % of one rate for everyone: a group of ten people
+    at 15 % each is one the model predicts half the time; mixing the redraws person by
+    person instead would make every group's mean about 10 % and call it a misfit."""
+    from opspec.usermodels.checking import RateGroups
+
+    trials = {f"P{i}": 100 for i in range(10)}
+    counts = {p: (15, n) for p, n in trials.items()}
+    groups = RateGroups(None, None, np.repeat(np.array([[0.05], [0.15]]), 10, axis=1))
+    shared = check_rate("x commission", "commission", "x", counts, np.array([0.05, 0.15]),
+                        None, np.random.default_rng(1), grouped=groups)
+    assert shared.p > 0.3
+    assert shared.predicted["low"] < 0.07 and shared.predicted["high"] > 0.13
+    mixed = check_rate("x commission", "commission", "x", counts,
+                       np.repeat([0.05, 0.15], 500), None, np.random.default_rng(1))
+    assert mixed.p < 0.02 and mixed.predicted["high"] < 0.15   # what sharing avoids
+
+
+def test_a_population_omission_centre_is_the_mean_of_the_peoples_own_rates() -> None:
+    """A missed prompt is offered again, so the forgetful are offered most: their pooled
+    rate sum(k)/sum(n) weighs them more than the population's per-person rate, whose mean is
+    the mean of the people's own rates k_p/n_p (what the check compares, and the centre of
+    the beta a population draws). Beta-binomial moments (Kleinman 1973): between-person
+    variance = var(k_p/n_p) minus the mean sampling variance p_p(1-p_p)/n_p."""
+    from opspec.usermodels.spread import omission_spread
+
+    rng = np.random.default_rng(7)
+    rates = rng.beta(1.0, 4.0, 400)                       # mean 0.2, sd 0.163
+    pairs = {}
+    for person, p in enumerate(rates):
+        misses = rng.geometric(1 - p, 50) - 1             # each of 50 doses rings until heard
+        pairs[person] = (int(misses.sum()), int(50 + misses.sum()))
+    spread = omission_spread(pairs)
+    assert spread is not None and spread.varies
+    own = np.mean([k / n for k, n in pairs.values()])
+    pooled = sum(k for k, _ in pairs.values()) / sum(n for _, n in pairs.values())
+    assert spread.mean == pytest.approx(own)
+    # the people's own rates average what they were drawn with; the pooled rate sits high
+    assert abs(spread.mean - rates.mean()) < 0.01
+    assert pooled - rates.mean() > 0.04
+    assert spread.between_sd == pytest.approx(float(np.sqrt(4 / (25 * 6))), rel=0.1)
