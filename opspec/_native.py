@@ -22,8 +22,9 @@ import sys
 from pathlib import Path
 from typing import Any
 
-#: The modules compiled by mypyc: the interpreter's hot path, per dose cycle. Measured and left
-#: out: condition_values (slower compiled), the distributions (slotted frozen dataclasses that
+#: The modules compiled by mypyc: the interpreter's hot path, per dose cycle. Left out: clock
+#: (its Clock subclasses simpy.Environment, and a native class cannot inherit a Python one);
+#: measured and left out: condition_values (slower compiled), the distributions (slotted frozen dataclasses that
 #: mypyc cannot subclass), processors (a mypyc internal error), monitors (mypyc rejects an
 #: overridden attribute type), the user model's data classes (errors, model, routine: ~5 % faster
 #: compiled, but mypyc enforces their annotations at construction, so ``Window("out", "14:00",
@@ -31,7 +32,6 @@ from typing import Any
 #: naming the bad parameter).
 MODULES: tuple[str, ...] = (
     "opspec.engine.activities",
-    "opspec.engine.clock",
     "opspec.engine.compiled",
     "opspec.engine.compiling.constructs",
     "opspec.engine.compiling.context",

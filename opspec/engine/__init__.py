@@ -1,4 +1,4 @@
-"""The engine: compiled packages executed on a simulated clock (``clock``) (see ``simulation``).
+"""The engine: compiled packages executed on a SimPy clock (``clock``) (see ``simulation``).
 
 Import what you need from the submodules; the names below are loaded lazily so that
 ``import opspec.engine`` stays light.

@@ -101,7 +101,7 @@ class ActivityInstance:
     waiting for a worker, looping, under a deadline.
 
     ``gen`` is bumped whenever the instance stops waiting, so stale timer callbacks that still
-    sit on the clock's heap recognise they are obsolete (nothing is taken off the heap).
+    sit in SimPy's queue recognise they are obsolete (SimPy cannot cancel a scheduled event).
     """
 
     __slots__ = (

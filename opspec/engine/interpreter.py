@@ -27,17 +27,15 @@ Design (for speed, see ``benchmarks/engine_profile.py``):
   left (a trampoline: no recursion however long a chain of instant activities is, and
   performers may call back into the session from inside ``offer``).
 * Clock events exist only where simulated time passes: a timer, a deadline, a duration, a
-  worker's CPU time, a performer's ``call_later``. They are bare events with a callback
-  (:class:`~opspec.engine.clock.Clock`), never a generator process per activity. The clock
-  does not cancel a scheduled event, so a timer carries the *generation* of its activity
+  worker's CPU time, a performer's ``call_later``. They are SimPy timeouts with a callback
+  (``env.timeout(delay).callbacks``, :mod:`opspec.engine.clock`), never a generator process
+  per activity. SimPy cannot cancel a scheduled event, so a timer carries the *generation* of its activity
   instance and does nothing when the instance has moved on.
 * Instantaneous activities (routes, events, tasks without a bound callable, activities with
   no implementation) run without an :class:`~opspec.engine.instances.ActivityInstance`;
   only activities that wait get one.
 * Trace events are built only when some listener wants that (kind, process, activity);
   a listener with a ``raw`` method (the metrics) gets the fields without any event object.
-* The hot paths read ``env.now`` rather than the ``env.now`` property: same value, one
-  function call less, several times per activity.
 
 Semantics (XPDL / SISARL, see ``docs/trace-format.md`` for what each step records):
 
@@ -62,8 +60,9 @@ from __future__ import annotations
 from collections.abc import Callable, Mapping
 from typing import Any
 
+import simpy
+
 from opspec.engine.activities import MAX_CALL_DEPTH, Activities
-from opspec.engine.clock import Clock
 from opspec.engine.compiled import CompiledActivity, CompiledPackage, CompiledProcess
 from opspec.engine.config import EngineConfig
 from opspec.engine.flow import Flow
@@ -94,7 +93,7 @@ class Interpreter(RunState):
 
     def __init__(self, compiled: CompiledPackage, config: EngineConfig, *,
                  performers: PerformerRegistry, seed: int, listeners: list[TraceListener],
-                 params: Mapping[str, Any] | None, env: Clock | None,
+                 params: Mapping[str, Any] | None, env: simpy.Environment | None,
                  scope: tuple[int, ...],
                  mode_loader: Callable[[str], CompiledPackage | Package] | None) -> None:
         super().__init__(compiled, config, performers=performers, seed=seed,

@@ -36,7 +36,8 @@ from collections import deque
 from collections.abc import Callable
 from typing import TYPE_CHECKING, Any
 
-from opspec.engine.clock import Clock
+import simpy
+
 
 
 if TYPE_CHECKING:
@@ -46,7 +47,7 @@ __all__ = ["DedicatedProcessor", "PooledProcessor", "PreemptiveProcessor",
            "PriorityQueueProcessor", "make_processor"]
 
 
-def make_processor(env: Clock, config: EngineConfig,
+def make_processor(env: simpy.Environment, config: EngineConfig,
                    on_done: Callable[[Any], None], is_alive: Callable[[Any], bool]
                    ) -> PooledProcessor | None:
     """The shared processors ``config`` asks for (``None``: the dedicated model). Its
@@ -90,7 +91,7 @@ class PooledProcessor:
         "waiting",
     )
 
-    def __init__(self, env: Clock, workers: int, priorities: int,
+    def __init__(self, env: simpy.Environment, workers: int, priorities: int,
                  on_done: Callable[[Any], None], is_alive: Callable[[Any], bool]) -> None:
         self.env = env
         self.free = workers
@@ -124,7 +125,7 @@ class PooledProcessor:
         self.switches += 1
         self.busy_time += cost
         if cost > 0.0:
-            self.env.after(cost, lambda: self._finished(job))
+            self.env.timeout(cost).callbacks.append(lambda _e: self._finished(job))
         else:
             self._finished(job)
 
@@ -191,7 +192,7 @@ class PreemptiveProcessor(PooledProcessor):
 
     __slots__ = ("preemptions", "running", "switch_cost")
 
-    def __init__(self, env: Clock, workers: int, priorities: int,
+    def __init__(self, env: simpy.Environment, workers: int, priorities: int,
                  on_done: Callable[[Any], None], is_alive: Callable[[Any], bool],
                  switch_cost: float = 0.0) -> None:
         super().__init__(env, workers, priorities, on_done, is_alive)
@@ -232,7 +233,8 @@ class PreemptiveProcessor(PooledProcessor):
 
     def _arm(self, entry: list[Any]) -> None:
         generation = entry[4]
-        self.env.after(max(0.0, entry[2]), lambda: self._done(entry, generation))
+        self.env.timeout(max(0.0, entry[2])).callbacks.append(
+            lambda _e: self._done(entry, generation))
 
     def _preempt(self, entry: list[Any]) -> None:
         ran = self.env.now - entry[3]
@@ -315,7 +317,7 @@ class PriorityQueueProcessor(PooledProcessor):
                  "_ready", "_released", "_running", "cpus", "idle", "leader_passes",
                  "preemptions", "queue_workers", "switch_cost")
 
-    def __init__(self, env: Clock, cpus: int, priorities: int,
+    def __init__(self, env: simpy.Environment, cpus: int, priorities: int,
                  on_done: Callable[[Any], None], is_alive: Callable[[Any], bool],
                  switch_cost: float = 0.0, queue_workers: int = 1) -> None:
         super().__init__(env, cpus, priorities, on_done, is_alive)
@@ -406,8 +408,8 @@ class PriorityQueueProcessor(PooledProcessor):
         thread.started = self.env.now
         thread.generation += 1
         generation = thread.generation
-        self.env.after(self.switch_cost + thread.remaining,
-                       lambda: self._segment_end(thread, generation))
+        self.env.timeout(self.switch_cost + thread.remaining).callbacks.append(
+            lambda _e: self._segment_end(thread, generation))
 
     def _preempt(self, thread: _Thread) -> None:
         now = self.env.now

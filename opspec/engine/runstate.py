@@ -10,7 +10,8 @@ a reference to this object and to each other.
 
 It also owns the two primitives every part uses: the trace (:meth:`RunState.emit`, built only
 when a listener wants the event) and the clock (:meth:`RunState.drain` runs the ready queue,
-:meth:`RunState.later` and :meth:`RunState.call_at` schedule on the :class:`~opspec.engine.clock.Clock`).
+:meth:`RunState.later` and :meth:`RunState.call_at` schedule SimPy timeouts on ``env``,
+by default a :class:`~opspec.engine.clock.Clock`).
 """
 
 from __future__ import annotations
@@ -20,6 +21,8 @@ from collections import deque
 from collections.abc import Callable, Mapping
 from types import MappingProxyType
 from typing import TYPE_CHECKING, Any
+
+import simpy
 
 from opspec.engine.clock import Clock
 from opspec.engine.compiled import CompiledActivity, CompiledPackage, CompiledProcess
@@ -56,7 +59,7 @@ class RunState:
 
     def __init__(self, compiled: CompiledPackage, config: EngineConfig, *,
                  performers: PerformerRegistry, seed: int, listeners: list[TraceListener],
-                 params: Mapping[str, Any] | None, env: Clock | None,
+                 params: Mapping[str, Any] | None, env: simpy.Environment | None,
                  scope: tuple[int, ...], mode_loader: Callable[[str], CompiledPackage | Package] | None
                  ) -> None:
         self.compiled = compiled
@@ -215,7 +218,8 @@ class RunState:
         if self.resolution > 0.0:
             delay = self._align(delay)
         gen = ai.gen
-        self.env.after(max(0.0, delay), lambda: self._fire(fn, ai, arg, gen))
+        self.env.timeout(max(0.0, delay)).callbacks.append(
+            lambda _e: self._fire(fn, ai, arg, gen))
 
     def _fire(self, fn: Callable[[ActivityInstance, Any], None], ai: ActivityInstance,
               arg: Any, gen: int) -> None:
@@ -249,7 +253,8 @@ class RunState:
         if delay <= 0.0 and self.draining:
             self.ready.append((_call, callback, None, None))
             return
-        self.env.after(max(0.0, delay), lambda: self._callback(callback))
+        self.env.timeout(max(0.0, delay)).callbacks.append(
+            lambda _e: self._callback(callback))
 
     def _callback(self, callback: Callable[[], None]) -> None:
         callback()

@@ -39,7 +39,9 @@ from collections.abc import Callable, Iterable, Mapping
 from dataclasses import dataclass, field
 from typing import Any, SupportsFloat, SupportsIndex
 
-from opspec.engine.clock import Clock, EmptySchedule
+import simpy
+
+from opspec.engine.clock import EmptySchedule, events_scheduled
 from opspec.engine.compiled import CompiledPackage, compile_package
 from opspec.engine.config import EngineConfig
 from opspec.engine.interpreter import Interpreter
@@ -61,7 +63,8 @@ class RunResult:
     """What a run produced: the trace (if kept), the declared metrics and a summary.
 
     ``summary`` keys: ``time`` (simulated end), ``seed``, ``events`` (trace events emitted),
-    ``sim_events`` (clock events scheduled), ``instances`` (started/completed/terminated/
+    ``sim_events`` (SimPy events scheduled on the clock; ``None`` on a caller's plain
+    :class:`simpy.Environment`), ``instances`` (started/completed/terminated/
     aborted/open), ``deadlocks`` and ``faults`` (lists of dicts with a ``message``),
     ``stale_completions``, ``drift`` (wall-clock mode) and ``pool`` (pooled model) or
     ``dedicated`` (CPU bursts, busy time and most bursts at once; dedicated model).
@@ -127,7 +130,9 @@ class Simulation(Interpreter):
       events nobody selects are never built.
     - ``params``: overrides of package-wide data fields.
     - ``keep_trace``: keep every event in memory (``RunResult.trace``).
-    - ``env``: share a :class:`~opspec.engine.clock.Clock` with other simulations (independent households).
+    - ``env``: a :class:`simpy.Environment` to run on, e.g. one shared with other simulations
+      (independent households); by default a new :class:`~opspec.engine.clock.Clock` (a
+      SimPy environment that counts its events: ``sim_events`` is ``None`` on any other).
     - ``scope``: the household index path, prefixed to every random stream.
     - ``mode_loader``: loads the package a mode's ``source`` names, for run-time mode loads.
     """
@@ -136,7 +141,7 @@ class Simulation(Interpreter):
                  *, performers: PerformerRegistry | Mapping[str, Performer] | None = None,
                  seed: SupportsIndex = 0, listeners: Iterable[TraceListener] = (),
                  params: Mapping[str, Any] | None = None, keep_trace: bool = False,
-                 env: Clock | None = None, scope: Iterable[SupportsIndex] = (),
+                 env: simpy.Environment | None = None, scope: Iterable[SupportsIndex] = (),
                  mode_loader: Callable[[str], CompiledPackage | Package] | None = None) -> None:
         if isinstance(compiled, Package):
             compiled = compile_package(compiled)
@@ -319,7 +324,7 @@ class Simulation(Interpreter):
         counts["open"] = len(self.live)
         summary: dict[str, Any] = {
             "time": self.env.now, "seed": self.seed, "events": self.seq,
-            "sim_events": self.env.scheduled, "instances": counts,
+            "sim_events": events_scheduled(self.env), "instances": counts,
             "deadlocks": list(self.deadlocks), "faults": list(self.faults),
             "stale_completions": self.stale_completions, "drift": self.drift,
             "mode": self.mode,

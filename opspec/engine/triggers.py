@@ -449,11 +449,11 @@ class Triggers(Part):
             return
         if self.state.resolution > 0.0:
             at = math.ceil(at / self.state.resolution) * self.state.resolution
-        def fired() -> None:
+        def fired(_event: object) -> None:
             fire(label)
             self.state.drain()
             self._next_timer(times, fire, label)
-        self.state.env.after(max(0.0, at - self.state.env.now), fired)
+        self.state.env.timeout(max(0.0, at - self.state.env.now)).callbacks.append(fired)
 
 
 
@@ -469,14 +469,14 @@ class Triggers(Part):
         if state.resolution > 0.0:
             at = math.ceil(at / state.resolution) * state.resolution
 
-        def fired() -> None:
+        def fired(_event: object) -> None:
             fire("arrival")
             state.drain()
             interval = trig.interval
             assert interval is not None
             drawn = interval(state.streams.stream(f"arrivals/{trig.name}"))
             self._next_arrival(trig, fire, made + 1, drawn)
-        state.env.after(max(0.0, at - state.env.now), fired)
+        state.env.timeout(max(0.0, at - state.env.now)).callbacks.append(fired)
 
 
 def _root(inst: ProcessInstance) -> ProcessInstance:
