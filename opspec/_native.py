@@ -98,12 +98,28 @@ def _decide() -> tuple[bool, str]:
     return True, f"compiled with mypyc ({len(MODULES)} modules)"
 
 
+def _left_compiled() -> frozenset[str]:
+    """Modules an earlier build compiled that are no longer in :data:`MODULES` (a module
+    taken out of the list, then a branch switch or a pull in an editable checkout): their
+    stale extension would shadow the source, since Python prefers an extension module."""
+    try:
+        recorded = json.loads((_PACKAGE_ROOT / "opspec" / STAMP).read_text(encoding="utf-8"))
+        built = set(recorded["modules"])
+    except (OSError, ValueError, KeyError, TypeError):
+        return frozenset()
+    return frozenset(m for m in built - set(MODULES) if _has_extension(m))
+
+
 class _FromSource:
-    """Meta-path finder importing :data:`MODULES` from their .py files, not the extensions."""
+    """Meta-path finder importing modules from their .py files, not the extensions: the
+    :data:`MODULES` when they must not run compiled, and always those no longer in it."""
+
+    def __init__(self, modules: frozenset[str]) -> None:
+        self.modules = modules
 
     def find_spec(self, name: str, path: object = None, target: object = None
                   ) -> importlib.machinery.ModuleSpec | None:
-        if name not in MODULES:
+        if name not in self.modules:
             return None
         return importlib.util.spec_from_file_location(name, _source(name))
 
@@ -117,6 +133,10 @@ def install() -> None:
     compiled (idempotent)."""
     global COMPILED, STATUS
     COMPILED, STATUS = _decide()
-    if (not COMPILED and not any(isinstance(f, _FromSource) for f in sys.meta_path)
-            and any(_has_extension(module) for module in MODULES)):
-        sys.meta_path.insert(0, _FromSource())
+    if any(isinstance(f, _FromSource) for f in sys.meta_path):
+        return
+    routed = set(_left_compiled())
+    if not COMPILED and any(_has_extension(module) for module in MODULES):
+        routed.update(MODULES)
+    if routed:
+        sys.meta_path.insert(0, _FromSource(frozenset(routed)))

@@ -108,12 +108,30 @@ def test_a_build_without_its_record_is_not_trusted(fake_root: Path) -> None:
     assert not compiled and "reinstall to compile" in why
 
 
-def test_the_finder_loads_source_only_for_the_compiled_modules() -> None:
-    finder = _native._FromSource()
+def test_the_finder_loads_source_only_for_the_modules_it_routes() -> None:
+    finder = _native._FromSource(frozenset(_native.MODULES))
     spec = finder.find_spec("opspec.engine.interpreter")
     assert spec is not None and spec.origin is not None
     assert spec.origin.endswith("opspec/engine/interpreter.py")
     assert finder.find_spec("opspec.engine.trace") is None
+
+
+def test_a_module_no_longer_compiled_runs_from_source_though_its_old_build_remains(
+        fake_root: Path) -> None:
+    """A module taken out of MODULES (opspec.engine.clock was, when its Clock came to subclass
+    simpy.Environment) keeps its extension file in an editable checkout until it is rebuilt;
+    Python prefers an extension to the source beside it, so without routing, the stale build
+    would run instead of the code (an ImportError for any name added since)."""
+    _fake_install(fake_root, {})
+    stamp = fake_root / "opspec" / _native.STAMP
+    record = json.loads(stamp.read_text(encoding="utf-8"))
+    record["modules"]["opspec.engine.old_module"] = "0" * 64
+    stamp.write_text(json.dumps(record), encoding="utf-8")
+    old = fake_root / "opspec" / "engine" / "old_module.py"
+    old.write_text("# now pure Python\n", encoding="utf-8")
+    old.with_suffix(".cpython-311-x86_64-linux-gnu.so").write_bytes(b"")
+    assert _native._left_compiled() == {"opspec.engine.old_module"}
+    assert _native._decide()[0]           # the modules still listed run compiled
 
 
 def test_a_work_item_reads_by_field_and_compares_by_value() -> None:
