@@ -8,9 +8,15 @@
 # the install of every dependency and the making of the oracle venvs. pip does not byte-compile
 # what it installs (PIP_NO_COMPILE): that was most of its CPU (scipy, matplotlib, dask, ...),
 # and Python compiles each module the first time it is imported, which the tests do for a
-# small part of those packages.
+# small part of those packages. That needs Python to keep what it compiled (__pycache__,
+# ignored by git), so PYTHONDONTWRITEBYTECODE is unset here: with it set, every process
+# compiled its imports again -- each of the suite's `python -m opspec.cli` subprocesses
+# opspec's modules each time (0.7 instead of 0.44 CPU-s for `run --days 1`), every pytest
+# process the assertion rewriting of every test module it collects (most of the 20 CPU-s
+# a collection of the whole suite takes).
 set -euo pipefail
 cd "$(dirname "$0")/.."
+unset PYTHONDONTWRITEBYTECODE
 export PIP_NO_COMPILE=1
 bash scripts/system-deps.sh
 python3 -m venv .venv
