@@ -80,8 +80,19 @@ def _remove_unlisted_extensions() -> None:
                 path.unlink()
 
 
+#: setup.py commands that only describe the package: pip runs this file for them before it
+#: builds (egg_info for the build requirements, dist_info for the metadata), and mypyc's type
+#: check and C generation (about 12 CPU-s) need not run for them.
+_METADATA_ONLY = frozenset({"egg_info", "dist_info"})
+
+
+def _builds() -> bool:
+    commands = [argument for argument in sys.argv[1:] if not argument.startswith("-")]
+    return not commands or commands[0] not in _METADATA_ONLY
+
+
 def _extensions() -> list[object]:
-    if not _wanted():
+    if not _wanted() or not _builds():
         return []
     try:
         from mypyc.build import mypycify

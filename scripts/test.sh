@@ -3,24 +3,54 @@
 # and exactly what CI runs (.ci/run). Idempotent: reuses .venv when it is already there, and
 # compiles the engine only when it is not already compiled from the current sources (after
 # the README's first command, the installation it made is reused: no second 1.5-minute build).
+#
+# The set-up keeps both cores busy: the compile (mypy, then one long gcc: one core) runs beside
+# the install of every dependency and the making of the oracle venvs. pip does not byte-compile
+# what it installs (PIP_NO_COMPILE): that was most of its CPU (scipy, matplotlib, dask, ...),
+# and Python compiles each module the first time it is imported, which the tests do for a
+# small part of those packages. That needs Python to keep what it compiled (__pycache__,
+# ignored by git), so PYTHONDONTWRITEBYTECODE is unset here: with it set, every process
+# compiled its imports again -- each of the suite's `python -m opspec.cli` subprocesses
+# opspec's modules each time (0.7 instead of 0.44 CPU-s for `run --days 1`), every pytest
+# process the assertion rewriting of every test module it collects (most of the 20 CPU-s
+# a collection of the whole suite takes).
 set -euo pipefail
 cd "$(dirname "$0")/.."
+unset PYTHONDONTWRITEBYTECODE
+export PIP_NO_COMPILE=1
 bash scripts/system-deps.sh
 python3 -m venv .venv
 .venv/bin/python -m pip install --quiet --upgrade pip
+logs="$(mktemp -d)"
+trap 'rm -rf "$logs"' EXIT
+# tests/patterns/test_oracle.py compares with shoobx.wfmc in a test-only venv (never an opspec
+# dependency), tests/differential/test_spiff.py with SpiffWorkflow the same way; without them
+# (no PyPI) those tests skip saying why. Both are made while opspec installs.
+{ bash scripts/oracle-venv.sh \
+    || echo "scripts/oracle-venv.sh failed: the oracle tests will be skipped"; } \
+    >"$logs/oracle.log" 2>&1 & oracle=$!
+{ bash scripts/spiff-venv.sh \
+    || echo "scripts/spiff-venv.sh failed: the SpiffWorkflow differential tests will be skipped"; } \
+    >"$logs/spiff.log" 2>&1 & spiff=$!
 if .venv/bin/python -c 'import sys, opspec._native as n; sys.exit(0 if n._decide()[0] else 1)' \
         2>/dev/null && [ -z "${OPSPEC_PURE_PYTHON:-}" ]; then
     # compiled and current: add the test extras only
     .venv/bin/python scripts/extras.py test | xargs .venv/bin/python -m pip install --quiet
 else
-    .venv/bin/python -m pip install --quiet -e '.[test]'
+    # opspec alone (and the compile, unless OPSPEC_PURE_PYTHON is set or there is no C
+    # compiler) in the background; every dependency and test extra meanwhile. They touch
+    # different files of .venv: `--no-deps` installs nothing but opspec.
+    .venv/bin/python -m pip install --quiet --no-deps -e . >"$logs/build.log" 2>&1 & build=$!
+    .venv/bin/python scripts/extras.py --dependencies test \
+        | xargs .venv/bin/python -m pip install --quiet
+    built=0
+    wait "$build" || built=$?
+    cat "$logs/build.log" >&2
+    [ "$built" -eq 0 ] || { echo "installing opspec failed (above)" >&2; exit 1; }
 fi
 .venv/bin/opspec --version
-# tests/patterns/test_oracle.py compares with shoobx.wfmc in a test-only venv (never an opspec
-# dependency); without it (no PyPI) those tests skip saying why.
-bash scripts/oracle-venv.sh || echo "scripts/oracle-venv.sh failed: the oracle tests will be skipped" >&2
-# tests/differential/test_spiff.py: SpiffWorkflow, the same way (a test-only venv)
-bash scripts/spiff-venv.sh || echo "scripts/spiff-venv.sh failed: the SpiffWorkflow differential tests will be skipped" >&2
+wait "$oracle" "$spiff" || true
+cat "$logs/oracle.log" "$logs/spiff.log" >&2
 # Both passes use every core: `-n auto` (pytest-xdist) in the compiled pass, two pytest
 # processes side by side in the pass from source. OPSPEC_TEST_WORKERS=N (or `-n N` among the
 # arguments, which pytest reads last) sets the workers; 0 runs in this process.
@@ -40,7 +70,6 @@ if [ -z "${OPSPEC_PURE_PYTHON:-}" ] && command -v cc >/dev/null 2>&1; then
     # statistic over such runs can tell apart. (It took 150 of the pass's 300 s, loaded.)
     # Two folders per pytest process (the folders' conftest modules share one name, so the
     # pairs are ones that collect together) and the two processes side by side.
-    logs="$(mktemp -d)"
     pure() {
         OPSPEC_PURE_PYTHON=1 .venv/bin/python -m pytest -q -p no:cacheprovider "$@" \
             >"$logs/${1//\//_}.log" 2>&1
@@ -51,12 +80,13 @@ if [ -z "${OPSPEC_PURE_PYTHON:-}" ] && command -v cc >/dev/null 2>&1; then
     failed=0
     wait "$first" || failed=1
     wait "$second" || failed=1
-    for log in "$logs"/*.log; do cat "$log"; done
-    rm -rf "$logs"
+    cat "$logs"/tests_*.log
     if [ "$failed" -ne 0 ]; then
         echo "the pure-Python engine failed (above): the compiled pass does not run" >&2
         exit 1
     fi
     export OPSPEC_REQUIRE_COMPILED=1
 fi
+rm -rf "$logs"
+trap - EXIT
 exec .venv/bin/python -m pytest -n "$workers" --dist worksteal "$@"
