@@ -163,6 +163,8 @@ class CompiledActivity:
     end_trigger: CTrigger | None = None
     terminate: bool = False                  # end event with Terminate result
     error: str | None = None                 # error end event: its error code ("": none)
+    escalation: str | None = None            # escalation end/throw event: its code ("": none)
+    catches_escalation: str | None = None    # boundary escalation event: its code ("": any)
     start_quantity: int = 1                  # J_COUNT: the tokens one start consumes
     deadlines: tuple[tuple[Evaluator, bool, str], ...] = ()   # (seconds, synchronous, exception)
     sampler: Sampler | None = None

@@ -333,9 +333,15 @@ _BPMN: tuple[Construct, ...] = (
        "boundary error event for it (its errorCode, else a catch-all), which is cancelled and "
        "takes its exception flow; uncaught, the instance is aborted with a located fault",
        "§10.4.3, §13.5.3", when="in-end-event"),
-    _c("bpmn-escalation-end", BPMN, "escalationEventDefinition "
-       "cancelEventDefinition compensateEventDefinition", None, W,
-       "the end event ends its path; the escalation (cancel, compensation) is not handed "
+    _c("bpmn-escalation-end", BPMN, "escalationEventDefinition", None, R,
+       "the escalation is caught by the nearest enclosing sub-process or call activity with a "
+       "boundary escalation event for it (its escalationCode, else one without escalationRef): "
+       "an interrupting one cancels that activity and takes its flow, a non-interrupting one "
+       "starts its flow while the activity goes on; the end event ends its path, and an "
+       "escalation nothing catches changes nothing else", "§10.4.3, §13.5.3",
+       when="in-end-event"),
+    _c("bpmn-cancel-end", BPMN, "cancelEventDefinition compensateEventDefinition", None, W,
+       "the end event ends its path; the cancellation (compensation) is not handed "
        "to a boundary event of an enclosing sub-process or call activity (BPMN §13.5.3: the "
        "nearest enclosing boundary event catches it)", "§10.4.3, §13.5.3", when="in-end-event",
        reported_by=("unsupported-event",)),
@@ -344,12 +350,16 @@ _BPMN: tuple[Construct, ...] = (
        "a start event of this kind only an event sub-process can catch; opspec waits for a "
        "message of that name", "§10.4.2", when="in-start-event",
        reported_by=("unsupported-event",)),
-    _c("bpmn-error-throw", BPMN, "escalationEventDefinition compensateEventDefinition "
-       "errorEventDefinition", None, W,
+    _c("bpmn-escalation-throw", BPMN, "escalationEventDefinition", None, R,
+       "the escalation is handed to the nearest enclosing boundary escalation event for it, as "
+       "from an escalation end event, and the token goes on along the throw event's flow",
+       "§10.4.4, §13.5.3", when="in-throw-event"),
+    _c("bpmn-error-throw", BPMN, "compensateEventDefinition errorEventDefinition", None, W,
        "raised as a message of that name (a boundary event waiting for it catches it)",
        "§10.4.4", when="in-throw-event", reported_by=("unsupported-event",)),
     _c("bpmn-escalation", BPMN, "escalation escalationEventDefinition", None, R,
-       "a boundary escalation event waits for the escalation of that name", "§10.4.5"),
+       "a boundary escalation event catches the escalations of that code thrown inside its "
+       "activity (without escalationRef: every one)", "§10.4.5, §13.5.3"),
     _c("bpmn-escalation-ref", BPMN, "escalationEventDefinition", "escalationRef", R,
        "the escalation", "§10.4.5"),
     _c("bpmn-escalation-code", BPMN, "escalation", "escalationCode", R, "its name",

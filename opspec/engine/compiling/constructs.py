@@ -182,6 +182,15 @@ def _block(c: Context, site: Site) -> None:
 def _event(c: Context, site: Site) -> None:
     body, ca = site.body, site.ca
     trig = c.event_trigger(body, site.act)
+    if body.trigger.kind is TriggerKind.ESCALATION and body.position is not EventPosition.START:
+        # handed to the nearest enclosing boundary escalation event, not broadcast as a
+        # message (BPMN 2.0 §10.4.3, §13.5.3): see Flow.throw_escalation
+        if body.trigger.attached_to:
+            ca.catches_escalation = body.trigger.name or ""
+            return
+        if not body.trigger.catching:
+            ca.escalation = body.trigger.name or ""
+            return
     if body.position is EventPosition.INTERMEDIATE:
         if trig is not None and not body.trigger.catching and trig.kind in (
                 "message", "signal"):

@@ -122,7 +122,8 @@ class Compiler(Context):
                 ca.labelled = True
         for ca in acts:
             ca.simple_end = (not ca.end_assign and ca.kind != K_THROW and ca.raises is None
-                             and not ca.terminate and ca.error is None)
+                             and not ca.terminate and ca.error is None
+                             and ca.escalation is None)
             only = ca.out[0] if len(ca.out) == 1 else None
             if (only is not None and only.kind == T_NONE and not only.assignments
                     and only.tokens == 1

@@ -188,9 +188,9 @@ def _start(element: etree._Element, defs: Defs) -> Built:
 
 def _end(element: etree._Element, defs: Defs) -> Built:
     trigger, definition, _timer = trigger_of(element, defs, catching=False)
-    # an error end event runs as BPMN defines it (the engine hands the error to the nearest
-    # enclosing boundary error event); the others end their path and say so
-    if trigger.kind in (TriggerKind.ESCALATION, TriggerKind.CANCEL, TriggerKind.COMPENSATION):
+    # error and escalation end events run as BPMN defines them (the engine hands them to the
+    # nearest enclosing boundary event for them); the others end their path and say so
+    if trigger.kind in (TriggerKind.CANCEL, TriggerKind.COMPENSATION):
         defs.ctx.warning(definition, "unsupported-event",
                          f"{_label(element)} throws {trigger.kind.value}: opspec ends the path "
                          "there but does not hand the "
@@ -210,8 +210,7 @@ def _intermediate(catching: bool) -> Callable[[etree._Element, Defs], Built]:
                              f"{_label(element)} catches nothing (no event definition); it "
                              "passes the token on at once", "give it a message, timer, signal "
                              "or conditional event definition")
-        if not catching and trigger.kind in (TriggerKind.COMPENSATION, TriggerKind.ERROR,
-                                             TriggerKind.ESCALATION):
+        if not catching and trigger.kind in (TriggerKind.COMPENSATION, TriggerKind.ERROR):
             defs.ctx.warning(definition, "unsupported-event",
                              f"{_label(element)} throws {trigger.kind.value}, which opspec raises "
                              "as a message of that name (a boundary event waiting for it "
