@@ -24,16 +24,9 @@ from opspec.engine.compiled import (
     CompiledProcess,
     CTransition,
 )
-from opspec.engine import joins
+from opspec.engine import escalations, joins
 from opspec.engine.instances import ActivityInstance, Frame, ProcessInstance
-from opspec.engine.lifecycle import (
-    ABORTED,
-    LIFECYCLE,
-    RUNNING,
-    STATE_NAMES,
-    SUSPENDED,
-    TERMINATED,
-)
+from opspec.engine.lifecycle import ABORTED, LIFECYCLE, RUNNING, STATE_NAMES, SUSPENDED, TERMINATED
 from opspec.engine.part import Part
 from opspec.engine.trace import EventKind as EK
 from opspec.errors import OpspecError
@@ -263,23 +256,6 @@ class Flow(Part):
         self.abort(frame.inst, act, f"{what} thrown by this end event is caught by no "
                    "boundary error event of an enclosing sub-process or call activity")
 
-    def throw_escalation(self, frame: Frame, act: CompiledActivity, code: str) -> None:
-        """An escalation end or intermediate throw event: the nearest enclosing sub-process or
-        call activity with a boundary escalation event for ``code`` (else one without
-        escalationRef, which catches every escalation) fires that event (BPMN 2.0 §10.4.3,
-        §13.5.3): an interrupting one cancels the activity and takes its flow, a
-        non-interrupting one starts its flow beside the activity. Uncaught, nothing happens:
-        unlike an error, an escalation is not critical, and the thrower's path goes on."""
-        holder = frame.owner if frame.owner is not None else frame.inst.parent
-        while holder is not None:
-            if holder.state == RUNNING:
-                index = _escalation_catcher(holder, code)
-                if index >= 0:
-                    self.triggers.boundary(holder, index, None)
-                    return
-            up = holder.frame
-            holder = up.owner if up.owner is not None else up.inst.parent
-
     def terminate_frame(self, frame: Frame, reason: str) -> None:
         """A terminate end event inside an activity set (an embedded sub-process) ends that
         sub-process only (BPMN 2.0 §13.5.6, §13.3.4): what still runs in it is stopped, its
@@ -391,11 +367,8 @@ class Flow(Part):
         if act.error is not None:
             self.throw_error(frame, act, act.error)
             return None
-        if act.escalation is not None:
-            self.throw_escalation(frame, act, act.escalation)
-            if inst.state != RUNNING or (frame.owner is not None
-                                         and frame.owner.state != RUNNING):
-                return None                 # an interrupting catcher cancelled this scope
+        if act.escalation is not None and not escalations.throw(self, frame, act.escalation):
+            return None                     # an interrupting catcher cancelled this scope
         if act.terminate:
             if frame.owner is not None:
                 self.terminate_frame(frame, f"end event {act.id!r}")
@@ -619,17 +592,3 @@ def _catches(act: CompiledActivity, code: str) -> bool:
     if act.default_exception is not None:
         return True
     return any(t.exception is None or t.exception == code for t in act.exceptions)
-
-
-def _escalation_catcher(ai: ActivityInstance, code: str) -> int:
-    """The boundary escalation event of ``ai`` for escalation ``code``, else its catch-all
-    (no escalationRef); -1 when it has neither."""
-    events = ai.frame.graph.activities
-    anyone = -1
-    for index in ai.act.boundary:
-        caught = events[index].catches_escalation
-        if caught == code:
-            return index
-        if caught == "" and anyone < 0:
-            anyone = index
-    return anyone

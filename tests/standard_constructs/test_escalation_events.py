@@ -84,9 +84,24 @@ def test_an_intermediate_throw_is_caught_and_an_uncaught_escalation_changes_noth
     assert not kinds(outcome, "process.aborted") and not outcome.summary["faults"]
 
 
+def test_an_escalation_crosses_a_call_activity_whose_process_goes_on() -> None:
+    """BPMN 2.0 §10.4.1 (as above: "forwarded ... to the innermost enclosing scope
+    instance"); §10.2.5 (Call Activity): the called process runs as the call activity's
+    content. The escalation thrown in the called process "child" at t=2 is caught by the
+    non-interrupting boundary escalation event of "call": "handle" runs at t=2 while "child"
+    goes on ("more", t=5); "call" then completes and "main" takes its normal flow."""
+    outcome = run("escalation_through_call_activity.bpmn", until=60)
+    times = {name: t for t, name in completed(outcome)}
+    assert times["raise"] == times["caught"] == times["handle"] == 2.0
+    assert times["more"] == times["c_end"] == times["call"] == times["end"] == 5.0
+    assert sorted(e.process for e in kinds(outcome, "process.completed")) == ["child", "main"]
+    assert not kinds(outcome, "process.terminated")
+
+
 def test_validate_no_longer_warns_about_escalation_events() -> None:
     """Escalation end and throw events run as BPMN 2.0 defines them, so validate says nothing
     about them (before, it warned that the escalation was not handed on)."""
-    for name in ("escalation_end_event.bpmn", "escalation_throw.bpmn"):
+    for name in ("escalation_end_event.bpmn", "escalation_throw.bpmn",
+                 "escalation_through_call_activity.bpmn"):
         _package, report = validate_spec(DATA / name)
         assert not report.diagnostics, report.lines()

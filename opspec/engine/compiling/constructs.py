@@ -184,11 +184,11 @@ def _event(c: Context, site: Site) -> None:
     trig = c.event_trigger(body, site.act)
     if body.trigger.kind is TriggerKind.ESCALATION and body.position is not EventPosition.START:
         # handed to the nearest enclosing boundary escalation event, not broadcast as a
-        # message (BPMN 2.0 §10.4.3, §13.5.3): see Flow.throw_escalation
+        # message (BPMN 2.0 §10.4.3, §13.5.3): see opspec.engine.escalations
         if body.trigger.attached_to:
             ca.catches_escalation = body.trigger.name or ""
             return
-        if not body.trigger.catching:
+        if body.position is EventPosition.END or not body.trigger.catching:
             ca.escalation = body.trigger.name or ""
             return
     if body.position is EventPosition.INTERMEDIATE:
