@@ -753,9 +753,11 @@ def _write_report(store: ResultStore, summaries: Mapping[str, Summaries] | None,
                                      prefix, population, designs[0])
 
     if difference is not None:
-        rows = [(n, d["difference"], *(d["ci95"] or [d["difference"], d["difference"]]))
+        # each panel names its metric as the other figures do (report latency, not its id)
+        rows = [(metric_label(n, d), d["difference"],
+                 *(d["ci95"] or [d["difference"], d["difference"]]))
                 for n, d in difference.items() if d["difference"] is not None]
-        units = {n: "pp" if is_rate(n, d) else (d.get("unit") or "")
+        units = {metric_label(n, d): "pp" if is_rate(n, d) else (d.get("unit") or "")
                  for n, d in difference.items()}
         compared = ((plots.comparison_figure(rows, figures / "comparison.png", units),)
                     if rows else ())

@@ -95,6 +95,9 @@ def test_two_designs_are_named_by_their_files(tmp_path: Path) -> None:
     assert "(second) compared with" in text and "no metric differs" in text
     assert "(A)" not in text and not re.search(r"\bA: \d", text)
     assert not re.search(r"\b[AB] − [AB]\b", text)
+    # the comparison figure names each metric as the other figures do, not by its id
+    html = (out / "report.html").read_text(encoding="utf-8")
+    assert "taken rate (pp)" in html and "taken_rate (pp)" not in html
 
 
 def test_per_user_distributions_and_own_scales_are_shown(run: Path) -> None:
