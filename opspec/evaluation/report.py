@@ -375,7 +375,8 @@ def _population_findings(metrics: Mapping[str, Mapping[str, Any]],
             continue
         low, high = own.get("share_with_any_ci95") or [None, None]
         lines.append(
-            f"{_sentence_start(metric_label(name, s))} per user: {own['users_with_any']:,} of {own['users']:,} users "
+            f"{_sentence_start(metric_label(name, s))} per user: "
+            f"{own['users_with_any']:,} of {own['users']:,} users "
             f"({fmt(own['share_with_any'], percent=True)}, exact 95 % CI "
             f"{fmt(low, percent=True)} to {fmt(high, percent=True)}) had a rate above zero; "
             f"half the users had at most {fmt(own['median'], percent=True)}, 90 % at most "
@@ -481,7 +482,7 @@ def _design_sections(store: ResultStore, figures: Path, design: str, name: str, 
                         s_.get("per_user") or {}).get("users"):
                     continue
                 images.append(plots.subgroups_figure(
-                    d["name"], _subgroup_rates(store, design, d, groups),
+                    metric_label(d["name"], s_), _subgroup_rates(store, design, d, groups),
                     figures / f"{design}-{file_name(d['name'])}-by-subgroup.png", unit="%"))
                 captions.append(f"Each user's own {words(d['name'])}, over the users of each "
                                 "subgroup (outline histograms, share of the group's users)")
