@@ -649,19 +649,22 @@ def _writer(fmt: str, path: Path, plan: Any) -> Any:
 
     attrs: dict[str, Any] = {"spec": plan.design("A").spec, "seed": plan.seed,
                              "case notion": plan.case}
-    if fmt == "xes":
-        return XesWriter(path, log_attributes=attrs)
     if fmt == "jsonl":
         return JsonlTraceWriter(path, log_attributes=attrs)
     from opspec.commands._spec import load_any_spec
     from opspec.engine.compiled import compile_package
+    from opspec.engine.lane_labels import lane_labels
     from opspec.engine.lanes import user_lane
     from opspec.evaluation.ocel import OcelWriter, people_of
 
     package = load_any_spec(plan.design("A").spec)
     compiled = compile_package(package)
+    # org:group names a lane as the timeline does: its name, its id where it has none
+    lanes = lane_labels(compiled).names
+    if fmt == "xes":
+        return XesWriter(path, log_attributes=attrs, lane_names=lanes)
     people = people_of(package, user_lane(compiled).bind_names, compiled)
-    return OcelWriter(path, people=people)
+    return OcelWriter(path, people=people, lane_names=lanes)
 
 
 def _trace_writers(stack: contextlib.ExitStack, folder: Path, plan: Any) -> Any:

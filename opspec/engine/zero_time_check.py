@@ -17,7 +17,11 @@ reports only cycles that certainly take no time:
 
 Whether a run actually goes round forever depends on data (a counted loop ends), so each
 finding is a warning with its witness: the activities from the start into the cycle, then
-once round it.
+once round it. One is certain and so an error: workflows that start each other through no
+choice at all (each from its only start, every step on the way unconditional). Such a
+package can never finish: van der Aalst's soundness asks that "for any case, the procedure
+will terminate eventually" (option to complete), and every instance started leaves a new one
+behind at the same instant, so ``check`` calls it not sound.
 """
 
 from __future__ import annotations
@@ -31,6 +35,8 @@ from opspec.engine.compiled import (
     K_ASYNC,
     K_NOOP,
     K_THROW,
+    S_AND,
+    T_NONE,
     CompiledActivity,
     CompiledGraph,
     CompiledPackage,
@@ -77,6 +83,20 @@ def _instant_body(act: CompiledActivity) -> bool:
 
 def _successors(act: CompiledActivity) -> list[int]:
     return list(dict.fromkeys(t.target for t in (*act.out, *act.otherwise)))
+
+
+def _unconditional(act: CompiledActivity) -> bool:
+    """Whether every token leaving ``act`` takes each of its transitions: no condition, no
+    drawn branch, no default, and one transition or an AND split."""
+    return (not act.otherwise and bool(act.out) and (len(act.out) == 1 or act.split == S_AND)
+            and all(t.kind == T_NONE and t.condition is None and t.probability < 0
+                    and t.exception is None for t in act.out))
+
+
+def _certain(graph: CompiledGraph, path: list[int]) -> bool:
+    """Whether every run of the graph goes along ``path`` (from its only start)."""
+    return (len(graph.starts) == 1 and path[0] == graph.starts[0]
+            and all(_unconditional(graph.activities[i]) for i in path[:-1]))
 
 
 def _line(act: CompiledActivity) -> int | None:
@@ -218,6 +238,7 @@ def _level(name: str, graph: CompiledGraph) -> list[Problem]:
 def _spawns(compiled: CompiledPackage) -> list[Problem]:
     """Workflows that start each other asynchronously, instantaneously from their starts."""
     calls: dict[str, dict[str, list[str]]] = {}       # process -> callee -> witness
+    certain: set[tuple[str, str]] = set()               # (caller, callee) on every run
     for pid, proc in compiled.processes.items():
         graph = proc.graph
         parents: dict[int, int | None] = {s: None for s in graph.starts
@@ -227,8 +248,11 @@ def _spawns(compiled: CompiledPackage) -> list[Problem]:
             at = queue.popleft()
             act = graph.activities[at]
             if act.kind == K_ASYNC and act.subflow in compiled.processes:
+                path = _path_to(parents, at)
                 calls.setdefault(pid, {}).setdefault(
-                    act.subflow, [graph.activities[i].id for i in _path_to(parents, at)])
+                    act.subflow, [graph.activities[i].id for i in path])
+                if _certain(graph, path):
+                    certain.add((pid, act.subflow))
             for nxt in _successors(act):
                 if nxt not in parents and _instant_body(graph.activities[nxt]):
                     parents[nxt] = at
@@ -250,18 +274,26 @@ def _spawns(compiled: CompiledPackage) -> list[Problem]:
         witness.append(witness[0])                  # and round again
         first = compiled.processes[ring[0]]
         act = first.graph.activities[first.graph.by_id[calls[ring[0]][ring[1]][-1]]]
+        # the ring found is one of possibly several in the component: it is certain when
+        # each of its starts is
+        sure = all(pair in certain for pair in itertools.pairwise(ring))
         problems.append(Problem(
             KIND, ring[0], act.id,
             f"workflows start each other asynchronously with no delay: "
             f"{' -> '.join(ring)}; each start is instantaneous, so once one runs, "
             "instances are spawned without end at one instant (a run then stops with a "
-            "zero-time cycle error)", tuple(witness), _line(act), severity="warning"))
+            "zero-time cycle error)" + (
+                "; no condition on the way stops it, so the workflow can never complete "
+                "(not sound: option to complete; put a delay or a condition before the "
+                "start)" if sure else ""),
+            tuple(witness), _line(act), severity="error" if sure else "warning"))
     return problems
 
 
 def zero_time_cycles(compiled: CompiledPackage,
                      processes: Iterable[str] | None = None) -> list[Problem]:
-    """The zero-time cycles of ``processes`` (default: every process), as warnings."""
+    """The zero-time cycles of ``processes`` (default: every process): warnings, and errors
+    for the workflows certain to start each other without end (see the module docstring)."""
     wanted = set(compiled.processes if processes is None else processes)
     problems: list[Problem] = []
     for pid in sorted(wanted & set(compiled.processes)):

@@ -269,12 +269,15 @@ class XesWriter(_StreamingWriter):
     - ``kinds``: the opspec event kinds exported (default :data:`DEFAULT_XES_KINDS`; only
       kinds in :data:`LIFECYCLE_TRANSITIONS` can be exported);
     - ``activity_names``: optional ``(process id, activity id) → name`` for ``concept:name``
-      (by default the activity id qualified by its process, :func:`qualified_name`).
+      (by default the activity id qualified by its process, :func:`qualified_name`);
+    - ``lane_names``: optional lane id → the lane's name for ``org:group`` (a lane without
+      one stays its id; :func:`opspec.engine.lane_labels.lane_labels` reads them).
     """
 
     def __init__(self, path: Path, *, log_attributes: Mapping[str, Any] | None = None,
                  epoch: datetime = DEFAULT_EPOCH, kinds: Collection[str] = DEFAULT_XES_KINDS,
-                 activity_names: Mapping[tuple[str, str], str] | None = None) -> None:
+                 activity_names: Mapping[tuple[str, str], str] | None = None,
+                 lane_names: Mapping[str, str] | None = None) -> None:
         if epoch.tzinfo is None or epoch.utcoffset() is None:
             raise EvaluationError(f"XES epoch {epoch.isoformat()} has no time zone",
                                   hint="give a timezone-aware datetime, e.g. "
@@ -286,6 +289,7 @@ class XesWriter(_StreamingWriter):
         self.epoch = epoch
         self.kinds = frozenset(kinds)
         self._names = dict(activity_names or {})
+        self._lanes = dict(lane_names or {})
         self._static: dict[tuple[str, str | None, str | None, str | None, str | None, bool],
                            _Template] = {}
         self._last_time: float | None = None
@@ -449,7 +453,8 @@ class XesWriter(_StreamingWriter):
         if event.participant is not None:
             parts.append(("string", "org:resource", _text(event.participant)))
         if event.lane is not None:
-            parts.append(("string", "org:group", _text(event.lane)))
+            parts.append(("string", "org:group",
+                          _text(self._lanes.get(event.lane, event.lane))))
         parts.append(("string", "opspec:kind", _text(event.kind)))
         if event.process is not None:
             parts.append(("string", "opspec:process", _text(event.process)))

@@ -133,15 +133,18 @@ class OcelWriter(_StreamingWriter):
 
     ``epoch`` is the wall-clock instant of simulated time 0 (as for XES); ``kinds`` the event
     kinds exported (default: those of the XES export); ``people`` who performs the user lane
-    and who else the spec declares (:func:`people_of`).
+    and who else the spec declares (:func:`people_of`); ``lane_names`` lane id → the lane's
+    name for ``org:group`` (a lane without one stays its id).
     """
 
     def __init__(self, path: Path, *, log_attributes: Mapping[str, Any] | None = None,
                  epoch: datetime = DEFAULT_EPOCH, kinds: Collection[str] = DEFAULT_XES_KINDS,
-                 people: People | None = None) -> None:
+                 people: People | None = None,
+                 lane_names: Mapping[str, str] | None = None) -> None:
         self.epoch = epoch
         self.kinds = frozenset(kinds) & frozenset(LIFECYCLE_TRANSITIONS)
         self.people = people or People()
+        self._lanes = dict(lane_names or {})
         # OCEL 2.0 has no log-level attributes: ``log_attributes`` is accepted for the
         # writers' one interface and not written
         self.objects = 0
@@ -261,7 +264,7 @@ class OcelWriter(_StreamingWriter):
         if event.participant is not None:
             values["org:resource"] = event.participant
         if event.lane is not None:
-            values["org:group"] = event.lane
+            values["org:group"] = self._lanes.get(event.lane, event.lane)
         for key, value in (event.data or {}).items():
             values[f"opspec:{key}"] = value
         attrs = []

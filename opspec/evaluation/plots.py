@@ -478,6 +478,10 @@ def per_user_figure(series: Mapping[str, Sequence[float]], path: Path, *,
                                 textcoords="offset points", ha="center", va="bottom",
                                 fontsize=8)
                 ax.set_ylim(0, max(counts) * 1.2)
+                # the y axis set off to the left: a bar at the axis' lowest value (most
+                # users at 0 %) is otherwise drawn under the axis line and cannot be seen,
+                # and widening the axis instead would show a rate below 0 %
+                ax.spines["left"].set_position(("outward", 8))
             else:               # one outlined patch, not a rectangle per bin
                 ax.hist(arr, bins="auto", histtype="stepfilled", color=PALETTE[5],
                         edgecolor=PALETTE[0], linewidth=0.8)

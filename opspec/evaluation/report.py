@@ -144,6 +144,17 @@ def words(name: str, unit: str | None = None) -> str:
     return text
 
 
+def metric_label(name: str, summary: Mapping[str, Any]) -> str:
+    """A metric as the report's prose names it: the same words as its figure's axis
+    (:func:`words`), so a reader meets "report latency", never ``report_latency_s``."""
+    unit = summary.get("unit") or ("s" if summary.get("kind") == "duration" else None)
+    return words(name, unit)
+
+
+def _sentence_start(text: str) -> str:
+    return text[:1].upper() + text[1:]
+
+
 def _users_done(store: ResultStore, design: str) -> int:
     return int(store.query("SELECT COUNT(*) FROM replication WHERE design = ? AND "
                            "status = 'done'", (design,))[0][0])
@@ -290,7 +301,8 @@ def _finding(metric: str, s: Mapping[str, Any], definition: Mapping[str, Any]
     # or a duration's is a definition, shown in "What each metric measures"
     words = (str(definition.get("description") or "").strip().rstrip(".")
              if kind == "ratio" else "")
-    name = f"{words} ({metric})" if words and len(words) <= 80 else metric
+    name = (words if words and len(words) <= 80
+            else _sentence_start(metric_label(metric, s)))
     if kind == "count":
         if s.get("mean") is None:
             return None
@@ -309,10 +321,15 @@ def _finding(metric: str, s: Mapping[str, Any], definition: Mapping[str, Any]
     if words:
         of = ""
     elif percent and definition.get("denominator"):
-        of = f" of {definition.get('denominator')}"
+        of = f" of {_words_of(definition.get('denominator'))}"
     else:
-        of = f" ({definition.get('numerator')} per {definition.get('denominator')})"
+        of = (f" ({_words_of(definition.get('numerator'))} per "
+              f"{_words_of(definition.get('denominator'))})")
     return f"{name}: {fmt(s['value'], percent=percent)}{of}{_ci_words(s, percent=percent)}."
+
+
+def _words_of(metric: Any) -> str:
+    return words(str(metric)) if metric else "?"
 
 
 def _key_findings(users: int, days: float, metrics: Mapping[str, Mapping[str, Any]],
@@ -358,14 +375,15 @@ def _population_findings(metrics: Mapping[str, Mapping[str, Any]],
             continue
         low, high = own.get("share_with_any_ci95") or [None, None]
         lines.append(
-            f"{name} per user: {own['users_with_any']:,} of {own['users']:,} users "
+            f"{_sentence_start(metric_label(name, s))} per user: "
+            f"{own['users_with_any']:,} of {own['users']:,} users "
             f"({fmt(own['share_with_any'], percent=True)}, exact 95 % CI "
             f"{fmt(low, percent=True)} to {fmt(high, percent=True)}) had a rate above zero; "
             f"half the users had at most {fmt(own['median'], percent=True)}, 90 % at most "
             f"{fmt(own['p90'], percent=True)}, 99 % at most {fmt(own['p99'], percent=True)}.")
     groups = (population or {}).get("subgroups") or {}
     for group, entry in groups.items():
-        rates = [f"{n} {fmt(m['value'], percent=True)}{_ci_words(m, percent=True)}"
+        rates = [f"{metric_label(n, m)} {fmt(m['value'], percent=True)}{_ci_words(m, percent=True)}"
                  for n, m in (entry.get("metrics") or {}).items()
                  if is_rate(n, m) and m.get("value") is not None]
         if rates:
@@ -441,8 +459,8 @@ def _design_sections(store: ResultStore, figures: Path, design: str, name: str, 
         for d in shown:
             s = metrics[d["name"]]
             values = [y / k for y, k in by_metric[d["name"]] if k > 0]
-            label = (f"{words(d['name'], s.get('unit') or 's')}, mean per user"
-                     if s["kind"] == "duration" else words(d["name"]))
+            label = (f"{metric_label(d['name'], s)}, mean per user"
+                     if s["kind"] == "duration" else metric_label(d["name"], s))
             series[label] = values
             units[label] = ("%" if is_rate(d["name"], s)
                             else (s.get("unit") or "s") if s["kind"] == "duration" else "")
@@ -464,9 +482,9 @@ def _design_sections(store: ResultStore, figures: Path, design: str, name: str, 
                         s_.get("per_user") or {}).get("users"):
                     continue
                 images.append(plots.subgroups_figure(
-                    d["name"], _subgroup_rates(store, design, d, groups),
+                    metric_label(d["name"], s_), _subgroup_rates(store, design, d, groups),
                     figures / f"{design}-{file_name(d['name'])}-by-subgroup.png", unit="%"))
-                captions.append(f"Each user's own {d['name']}, over the users of each "
+                captions.append(f"Each user's own {words(d['name'])}, over the users of each "
                                 "subgroup (outline histograms, share of the group's users)")
         sections.append(Section(f"{prefix}How users differ", paragraphs=(
             ("Each user's own rate or mean duration, over users: the spread shows how much "
@@ -495,8 +513,8 @@ def _design_sections(store: ResultStore, figures: Path, design: str, name: str, 
         images.append(plots.latency_figure(d["name"], values,
                                            figures / f"{design}-{file_name(d['name'])}.png",
                                            marks=marks, total=total,
-                                           label=words(d["name"], unit), unit=unit))
-        caption = (f"Distribution of {d['name']}"
+                                           label=metric_label(d["name"], s), unit=unit))
+        caption = (f"Distribution of {metric_label(d['name'], s)}"
                    + (f" ({d['description'].rstrip('.')})" if d.get("description") else "")
                    + ": the share of observations done within x (left) and histogram "
                    "(right); mean, median and p95 marked")
@@ -736,9 +754,11 @@ def _write_report(store: ResultStore, summaries: Mapping[str, Summaries] | None,
                                      prefix, population, designs[0])
 
     if difference is not None:
-        rows = [(n, d["difference"], *(d["ci95"] or [d["difference"], d["difference"]]))
+        # each panel names its metric as the other figures do (report latency, not its id)
+        rows = [(metric_label(n, d), d["difference"],
+                 *(d["ci95"] or [d["difference"], d["difference"]]))
                 for n, d in difference.items() if d["difference"] is not None]
-        units = {n: "pp" if is_rate(n, d) else (d.get("unit") or "")
+        units = {metric_label(n, d): "pp" if is_rate(n, d) else (d.get("unit") or "")
                  for n, d in difference.items()}
         compared = ((plots.comparison_figure(rows, figures / "comparison.png", units),)
                     if rows else ())

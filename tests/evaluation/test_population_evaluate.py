@@ -6,6 +6,7 @@ JSON, report) — and a model without variation gives exactly what it gave befor
 from __future__ import annotations
 
 import math
+import re
 import sqlite3
 from pathlib import Path
 
@@ -138,6 +139,10 @@ def test_a_population_run_reports_subgroups_everywhere(evaluate, tmp_path, capsy
                   "## By subgroup", "Per-user distributions, overall and by subgroup",
                   "missed_rate-by-subgroup.svg", "population-parameters.svg"):
         assert words.replace("_", r"\_") in report or words in report
+    # metrics named in words there, as in their figures (missed rate, not missed_rate)
+    assert re.search(r"Subgroup MCI \([\d,]+ users, [\d.]+ %\): [^\n]*missed rate [\d.]+ %",
+                     report), report
+    assert "Each user's own missed rate, over the users of each subgroup" in report
     # and the terminal table too
     assert main(["evaluate", "--resume", "--out", str(out)]) == 0
     text = capsys.readouterr().out

@@ -130,7 +130,8 @@ def test_a_durations_marks_are_the_estimates_tables(report: lxml_html.HtmlElemen
     durations = [m for m, row in estimates.items() if row["kind"] == "duration"]
     assert durations
     for metric in durations:
-        texts = figure_texts(report, f"Distribution of {metric}")
+        # the caption names the metric as its axis does (report_latency_s: "report latency")
+        texts = figure_texts(report, f"Distribution of {words(metric).removesuffix(' s')}")
         marks = dict(re.fullmatch(r"(mean|median|p95) = (.+)", t).groups()  # type: ignore[union-attr]
                      for t in texts if re.fullmatch(r"(mean|median|p95) = .+", t))
         row = estimates[metric]

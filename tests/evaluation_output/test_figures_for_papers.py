@@ -70,6 +70,16 @@ def test_figures_carry_no_titles_and_label_axes_in_words(
     for ax in rate_axes:
         low, high = ax.get_xlim()
         assert 0.0 <= low and high <= 100.0
+    # ... and a bar at 0 % (most users never miss a dose) is not drawn under the y axis' line
+    renderer = per_user.canvas.get_renderer()
+    at_zero = [ax for ax in rate_axes
+               if any(s[0][0] == 0.0 for s in ax.collections[0].get_segments())]
+    assert at_zero, "no per-user rate panel has a bar at 0 %"
+    for ax in at_zero:
+        bar = ax.collections[0]
+        half = bar.get_linewidth()[0] * per_user.dpi / 72.0 / 2.0
+        axis_line = ax.spines["left"].get_window_extent(renderer).x1
+        assert axis_line < ax.transData.transform((0.0, 0.0))[0] - half
     # the rates' panels never leave [0, 100] % either (a 99.6 % taken rate included)
     for ax in drawn["A-rates"].axes:
         low, high = ax.get_xlim()

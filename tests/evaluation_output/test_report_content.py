@@ -38,11 +38,25 @@ def test_key_findings_state_estimates_with_intervals_in_words(run: Path) -> None
     text = _text(run / "report.html")
     assert "Key findings" in text
     assert "30 simulated users of medication_dispenser.xpdl, each followed for 2 days." in text
-    assert re.search(r"Share of the doses due that were taken \(taken_rate\): [\d.]+ % "
+    assert re.search(r"Share of the doses due that were taken: [\d.]+ % "
                      r"\(95 % confidence interval [\d.]+ % to [\d.]+ %\)", text)
-    assert re.search(r"report_latency_s: [\d.]+ s on average \(95 % confidence "
+    assert re.search(r"Report latency: [\d.]+ s on average \(95 % confidence "
                      r"interval", text)
+    assert re.search(r"Doses missed: [\d.]+ per user over the run", text)
     assert "the spec declares no safety monitors" in text
+
+
+def test_findings_name_metrics_in_the_words_of_their_figures(run: Path) -> None:
+    """A finding names a metric as its figure's axis does ("report latency", the unit said
+    with the value), never by its identifier (report_latency_s): the reader of a paper has
+    not read the spec."""
+    for name in ("report.html", "report.md"):
+        text = _text(run / name)
+        findings = (text.split("Key findings")[-1].split("What was run")[0]
+                    .replace("medication_dispenser.xpdl", "the spec"))
+        assert "Report latency:" in findings and "Missed rate per user:" in findings
+        identifiers = re.findall(r"\b[a-z]+(?:_[a-z0-9]+)+\b", findings)
+        assert not identifiers, f"{name}: findings name metrics by id: {identifiers}"
 
 
 def test_every_metric_is_defined_in_words(run: Path) -> None:
@@ -81,6 +95,9 @@ def test_two_designs_are_named_by_their_files(tmp_path: Path) -> None:
     assert "(second) compared with" in text and "no metric differs" in text
     assert "(A)" not in text and not re.search(r"\bA: \d", text)
     assert not re.search(r"\b[AB] − [AB]\b", text)
+    # the comparison figure names each metric as the other figures do, not by its id
+    html = (out / "report.html").read_text(encoding="utf-8")
+    assert "taken rate (pp)" in html and "taken_rate (pp)" not in html
 
 
 def test_per_user_distributions_and_own_scales_are_shown(run: Path) -> None:

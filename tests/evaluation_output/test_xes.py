@@ -331,3 +331,40 @@ def test_pm4py_reads_the_log_back(tmp_path: Path, dispenser_day: list[TraceEvent
     assert "user_workflow/take_pill" in set(completed["concept:name"])
     log = pm4py.read_xes(str(path), return_legacy_log_object=True)
     assert set(log.classifiers) == {"Activity", "ActivityLifecycle"}
+
+
+# ------------------------------------------------------------------------ lanes by name
+
+KITCHEN = Path(__file__).resolve().parents[1] / "tui" / "data" / "kitchen_lanes.bpmn"
+
+
+def test_org_group_is_the_lanes_name_in_xes_and_ocel(tmp_path: Path) -> None:
+    """The XES Organizational extension: "group — The group within the organizational
+    structure" (IEEE 1849-2016, org:group). A process-mining tool shows this string to the
+    analyst, so a BPMN lane's name ("Stove guard appliance"), not its XML id (guard_lane),
+    as the text timeline shows it; a lane without a name keeps its id."""
+    import json
+
+    from opspec.cli import main
+
+    out = tmp_path / "run"
+    assert main(["evaluate", str(KITCHEN), "--users", "2", "--days", "1", "--workers", "1",
+                 "--user-model", "klm", "--export", "xes,ocel", "--out", str(out),
+                 "--quiet"]) == 0
+    groups = {e["opspec:activity"]: e.get("org:group") for e in events_of(out / "traces.xes")
+              if e.get("opspec:activity")}
+    assert groups.get("sense_heat") == "Stove guard appliance", groups
+    assert groups.get("confirm") == "Resident", groups
+    ocel = json.loads((out / "traces.jsonocel").read_text(encoding="utf-8"))
+    ocel_groups = {a["value"] for e in ocel["events"] for a in e["attributes"]
+                   if a["name"] == "org:group"}
+    assert ocel_groups == {"Stove guard appliance", "Resident"}, ocel_groups
+
+
+def test_org_group_keeps_a_lane_id_without_a_name(tmp_path: Path,
+                                                   dispenser_day: list[TraceEvent]) -> None:
+    """Lanes named only for some: the named one by its name, the other by its id."""
+    events = events_of(write_log(tmp_path / "t.xes", {"u": dispenser_day},
+                                 lane_names={"device": "Dispenser"}))
+    groups = {e.get("org:group") for e in events}
+    assert "Dispenser" in groups and "user" in groups and "device" not in groups
