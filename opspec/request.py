@@ -81,6 +81,9 @@ class RunRequest:
     performers: Mapping[str, Performer] = field(default_factory=dict)
     listeners: tuple[TraceListener, ...] = ()
     params: Mapping[str, Any] | None = None
+    #: branch probabilities given at run time (gateway -> flow -> probability,
+    #: :mod:`opspec.branch_choices`), applied to the spec before it is compiled
+    branches: Mapping[str, Mapping[str, float]] | None = None
     keep_trace: bool = False
     keep_times: bool = False
     monitors: tuple[Any, ...] | None = None
@@ -181,6 +184,20 @@ def _spec(spec: Any) -> tuple[LoadedSpec, tuple[Any, ...], Path | None]:
     return loaded, loaded.warnings, path
 
 
+def _with_branches(loaded: LoadedSpec, branches: Any) -> LoadedSpec:
+    """``loaded`` recompiled with the run-time branch probabilities (before compile, so the
+    run, its workers and its seed see one spec)."""
+    from opspec.branch_choices import gateway_lines, with_branches
+    from opspec.runs import load
+
+    changed = load(with_branches(loaded.package, branches))
+    # the file's warning about the shares it would draw no longer holds for these gateways
+    lines = gateway_lines(loaded.package, branches)
+    kept = tuple(w for w in loaded.warnings if getattr(w, "code", None) != "undecided-gateway"
+                 or getattr(getattr(w, "location", None), "line", None) not in lines)
+    return replace(changed, warnings=kept)
+
+
 def _source(package: Any) -> Path | None:
     source = getattr(package, "source", None)
     return Path(source) if source else None
@@ -250,6 +267,9 @@ def prepare(request: RunRequest) -> PreparedRun:
     before anything runs, with the same message through every door."""
     seed = check_seed(request.seed)
     loaded, spec_warnings, path = _spec(request.spec)
+    if request.branches:
+        loaded = _with_branches(loaded, request.branches)
+        spec_warnings = loaded.warnings
     horizon = run_length(loaded.compiled, days=request.days, until=request.until)
     user, user_warnings, named = _user(request, loaded, path)
     return PreparedRun(request, loaded, seed, horizon, user,
@@ -262,6 +282,7 @@ def run(spec: Any, *, seed: Any = 0, days: Any = None, until: Any = None,
         config: EngineConfig | Mapping[str, Any] | None = None,
         performers: Mapping[str, Performer] | None = None,
         listeners: Sequence[TraceListener] = (), params: Mapping[str, Any] | None = None,
+        branches: Mapping[str, Mapping[str, float]] | None = None,
         keep_trace: bool = True) -> RunOutcome:
     """Run ``spec`` once, as ``opspec run`` does, and return its
     :class:`~opspec.runs.RunOutcome` (``opspec.run``): the request's rules are those of the
@@ -270,5 +291,5 @@ def run(spec: Any, *, seed: Any = 0, days: Any = None, until: Any = None,
     request = RunRequest(spec, seed=seed, days=days, until=until, script=script,
                          user_model=user_model, user=user, no_user=no_user, config=config,
                          performers=performers or _EMPTY, listeners=tuple(listeners),
-                         params=params, keep_trace=keep_trace)
+                         params=params, branches=branches, keep_trace=keep_trace)
     return prepare(request).execute(user_index)

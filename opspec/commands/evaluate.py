@@ -56,6 +56,11 @@ def register(subparsers: Any) -> None:
                         "conditions read that nothing sets; repeatable; docs/bpmn.md, Run "
                         "inputs); NAME~DISTRIBUTION draws one per simulated user "
                         "('score~uniform(0, 100)')")
+    parser.add_argument("--branch", action="append", default=[],
+                        metavar="GATEWAY=FLOW:P[,FLOW:P...]",
+                        help="branch probabilities for a gateway the diagram leaves undecided "
+                        "(by id or name, as validate prints them), replacing the file's; "
+                        "repeatable; docs/bpmn.md, Undecided gateways")
     parser.add_argument("--params", metavar="FILE",
                         help="run-input values from a .toml/.json file (NAME = value or a "
                         "distribution table) or a .csv file of one row per simulated user")
@@ -165,10 +170,15 @@ def _new_plan(args: argparse.Namespace) -> Any:
     specs = [("A", args.spec)] + ([("B", args.compare)] if args.compare else [])
     # each design fills the request of every door: a spec validate rejects stops here
     # (path:line); design A decides the run length and the user model of both
-    a = prepare(RunRequest(args.spec, days=args.days, user_model=args.user_model))
+    from opspec.branch_choices import parse_branch_options
+
+    branches = parse_branch_options(args.branch)
+    a = prepare(RunRequest(args.spec, days=args.days, user_model=args.user_model,
+                           branches=branches or None))
     model = a.user_model
     for _label, path in specs[1:]:
-        prepare(RunRequest(path, days=args.days, user_model=model, no_user=model is None))
+        prepare(RunRequest(path, days=args.days, user_model=model, no_user=model is None,
+                           branches=branches or None))
     # --param: a value of a package data field (a BPMN diagram's run input) for every design,
     # applied as a parameter of one value (what --sweep applies per design)
     # draws and a data file's rows are per simulated user (opspec.run_inputs), in the plan
@@ -214,7 +224,7 @@ def _new_plan(args: argparse.Namespace) -> Any:
                           input_uncertainty=draws, users_per_draw=per_draw,
                           run_inputs=RunInputs(draws=inputs.draws, rows=inputs.rows,
                                                source=inputs.source).to_json()
-                          if inputs.draws or inputs.rows else {})
+                          if inputs.draws or inputs.rows else {}, branches=branches)
 
 
 def _check_plan(plan: Any) -> dict[str, list[dict[str, Any]]]:
@@ -226,7 +236,7 @@ def _check_plan(plan: Any) -> dict[str, list[dict[str, Any]]]:
     shown: set[str] = set()                 # the designs of a sweep share their warnings
     for design in plan.designs:
         context = prepare(design.spec, design.sha256, plan.user_model, plan.engine,
-                          design.parameters)
+                          design.parameters, plan.branches or None)
         for warning in context.warnings:
             if str(warning) not in shown:
                 shown.add(str(warning))
@@ -594,7 +604,7 @@ def _refuse_inputs_in_out(args: argparse.Namespace, plan: Any, out: Path) -> Non
         reads.append((what, design.spec))
         # loaded once per process already (_check_plan): the same context, from its cache
         package = prepare(design.spec, design.sha256, plan.user_model, plan.engine,
-                          design.parameters).compiled.package
+                          design.parameters, plan.branches or None).compiled.package
         reads.extend(spec_inputs(design.spec, package))
     reads += [("--report-template", getattr(args, "report_template", None)),
               ("--engine-config", args.engine_config)]
@@ -710,7 +720,7 @@ def _export_estimate(plan: Any, folder: Path, quiet: bool) -> None:
 
     design = plan.designs[0]
     context = prepare(design.spec, design.sha256, plan.user_model, plan.engine,
-                      design.parameters)
+                      design.parameters, plan.branches or None)
     sample = min(plan.horizon, DAY)
     record = run_user(context, design.label, 0, seed=plan.seed, horizon=sample,
                       keep_trace=True)

@@ -72,6 +72,11 @@ def register(subparsers: Any) -> None:
                         "input (a variable its conditions read that nothing sets), or "
                         "NAME~DISTRIBUTION ('score~uniform(0, 100)': drawn from the seed); "
                         "repeatable; docs/bpmn.md, Run inputs")
+    parser.add_argument("--branch", action="append", default=[],
+                        metavar="GATEWAY=FLOW:P[,FLOW:P...]",
+                        help="branch probabilities for a gateway the diagram leaves undecided "
+                        "(by id or name, as validate prints them), replacing the file's; "
+                        "repeatable; docs/bpmn.md, Undecided gateways")
     parser.add_argument("--params", metavar="FILE",
                         help="run-input values from a .toml/.json file (NAME = value or a "
                         "distribution table) or a .csv file (the run takes its first row)")
@@ -107,6 +112,7 @@ def register(subparsers: Any) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
+    from opspec.branch_choices import parse_branch_options
     from opspec.commands._params import read_run_inputs
     from opspec.engine.trace_sinks import JsonlSink
     from opspec.request import RunRequest, prepare
@@ -117,7 +123,8 @@ def run(args: argparse.Namespace) -> int:
     prepared = prepare(RunRequest(
         args.spec, seed=args.seed, days=args.days,
         until=None if args.until is None else parse_until(args.until, name="--until"),
-        script=args.script, user_model=args.user_model, no_user=args.no_user))
+        script=args.script, user_model=args.user_model, no_user=args.no_user,
+        branches=parse_branch_options(args.branch) or None))
     for warning in prepared.warnings:
         print(f"opspec run: {warning}", file=sys.stderr)
     package, compiled = prepared.package, prepared.compiled

@@ -131,7 +131,8 @@ def _context(plan: Mapping[str, Any], base: Mapping[str, Any], draw: int) -> Any
     from opspec.usermodels.uncertainty import drawn_model, read_parameter_draws
 
     ref = str(plan["user_model"])
-    context = prepare(base["spec"], base["sha256"], ref, plan.get("engine") or {})
+    context = prepare(base["spec"], base["sha256"], ref, plan.get("engine") or {}, (),
+                      plan.get("branches") or None)
     key = (id(context), ref, draw)
     found = _DRAWN.get(key)
     if found is None:

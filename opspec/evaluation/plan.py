@@ -73,6 +73,9 @@ class EvaluationPlan:
     #: run inputs drawn per simulated user or read from a data file's rows
     #: (:class:`opspec.run_inputs.RunInputs` as JSON; fixed values are design parameters)
     run_inputs: Mapping[str, Any] = field(default_factory=dict)
+    #: ``--branch``: branch probabilities of undecided gateways, gateway -> flow -> P
+    #: (:mod:`opspec.branch_choices`), applied to every design before it is compiled
+    branches: Mapping[str, Mapping[str, float]] = field(default_factory=dict)
 
     def __post_init__(self) -> None:
         if isinstance(self.users, bool) or not isinstance(self.users, int) or self.users < 1:
@@ -109,6 +112,10 @@ class EvaluationPlan:
             del doc["run_inputs"]
         else:
             doc["run_inputs"] = dict(self.run_inputs)
+        if not self.branches:               # plans without them read as they always did
+            del doc["branches"]
+        else:
+            doc["branches"] = {g: dict(f) for g, f in self.branches.items()}
         return doc
 
     @classmethod
@@ -122,12 +129,15 @@ class EvaluationPlan:
                    export=tuple(doc.get("export") or ()), case=str(doc.get("case") or "user"),
                    input_uncertainty=int(doc.get("input_uncertainty") or 0),
                    users_per_draw=int(doc.get("users_per_draw") or 0),
-                   run_inputs=dict(doc.get("run_inputs") or {}))
+                   run_inputs=dict(doc.get("run_inputs") or {}),
+                   branches={str(g): {str(k): float(v) for k, v in f.items()}
+                             for g, f in (doc.get("branches") or {}).items()})
 
     def same_results_as(self, other: EvaluationPlan) -> list[str]:
         """What differs between two plans in ways that change results (for ``--resume``)."""
         mine, theirs = self.to_json(), other.to_json()
         return [key for key in ("designs", "users", "days", "seed", "user_model", "engine",
-                                "input_uncertainty", "users_per_draw", "run_inputs")
+                                "input_uncertainty", "users_per_draw", "run_inputs",
+                                "branches")
                 if json.dumps(mine.get(key), sort_keys=True) != json.dumps(theirs.get(key),
                                                                             sort_keys=True)]

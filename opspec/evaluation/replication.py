@@ -114,14 +114,17 @@ _CONTEXTS: dict[tuple[str, str, str | None, str, str], _Context] = {}
 
 
 def prepare(spec: str, sha256: str, user_model: str | None, engine: Mapping[str, Any],
-            parameters: Sequence[Sequence[Any]] = ()) -> _Context:
+            parameters: Sequence[Sequence[Any]] = (),
+            branches: Mapping[str, Mapping[str, float]] | None = None) -> _Context:
     """Load (once per process) the spec, user model and engine configuration; with
     ``parameters`` (a design of ``--sweep``: ``(name, value)`` pairs) the spec and the user
-    model changed as :mod:`opspec.evaluation.parameters` says."""
+    model changed as :mod:`opspec.evaluation.parameters` says; ``branches`` (``--branch``)
+    applied to the spec before it is compiled."""
     import json
 
     key = (spec, sha256, user_model, json.dumps(dict(engine), sort_keys=True),
-           json.dumps([list(p) for p in parameters]))
+           json.dumps([list(p) for p in parameters]),
+           json.dumps(branches or {}, sort_keys=True))
     found = _CONTEXTS.get(key)
     if found is not None:
         return found
@@ -133,7 +136,8 @@ def prepare(spec: str, sha256: str, user_model: str | None, engine: Mapping[str,
 
     # the front hall decides the spec (validate's gate) and the user model (checked against
     # the spec's user lane), in the command and in every worker alike
-    prepared = decide(RunRequest(spec, user_model=user_model, no_user=user_model is None))
+    prepared = decide(RunRequest(spec, user_model=user_model, no_user=user_model is None,
+                                 branches=branches or None))
     loaded = prepared.spec
     lane = user_lane(loaded.compiled)
     user = prepared.user if prepared.user.kind == "model" else None
@@ -217,7 +221,8 @@ def run_users(plan: Mapping[str, Any], design: str, users: Sequence[int]
         return run_draw_users(plan, design, users)
     spec = next(d for d in plan["designs"] if d["label"] == design)
     context = prepare(spec["spec"], spec["sha256"], plan.get("user_model"),
-                      plan.get("engine") or {}, spec.get("parameters") or ())
+                      plan.get("engine") or {}, spec.get("parameters") or (),
+                      plan.get("branches") or None)
     horizon = float(plan["days"]) * DAY
     keep = bool(plan.get("export"))
     from opspec.run_inputs import RunInputs

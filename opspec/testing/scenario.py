@@ -17,7 +17,8 @@
 a TOML path), ``users`` (independent simulated users, default 1), ``days`` (default 1) or
 ``until`` (seconds or a duration such as ``"9h"`` / ``"09:00"``), ``seed`` (default: the
 test's seed), ``engine`` (engine options, as in ``[engine]`` of a config file), ``params``
-(package data overrides). ``then`` lines are :mod:`opspec.testing.expectations`.
+(package data overrides), ``branches`` (``{ GATEWAY = { FLOW = P } }``: branch
+probabilities of undecided gateways, as ``--branch``). ``then`` lines are :mod:`opspec.testing.expectations`.
 
 Every mistake is reported when the file is collected, as ``path: key: what (how to fix)``.
 """
@@ -38,7 +39,8 @@ __all__ = ["Scenario", "ScenarioDocument", "load_scenarios", "run_scenario"]
 
 _TOP = ("spec", "given", "scenario", "description")
 _SCENARIO = ("name", "given", "then", "description")
-_GIVEN = ("script", "user_model", "users", "days", "until", "seed", "engine", "params")
+_GIVEN = ("script", "user_model", "users", "days", "until", "seed", "engine", "params",
+          "branches")
 
 
 @dataclass(frozen=True, slots=True)
@@ -57,6 +59,8 @@ class Scenario:
     seed: int | None = None
     engine: Mapping[str, Any] = field(default_factory=dict)
     params: Mapping[str, Any] = field(default_factory=dict)
+    #: branch probabilities of undecided gateways (:mod:`opspec.branch_choices`)
+    branches: Mapping[str, Mapping[str, float]] = field(default_factory=dict)
     description: str = ""
 
 
@@ -140,6 +144,13 @@ def _given(path: Path, key: str, table: Any, rootdir: Path | None) -> dict[str, 
             if not isinstance(table[name], Mapping):
                 raise _error(path, f"{key}.{name}", f"{name} is a table")
             out[name] = dict(table[name])
+    if "branches" in table:
+        from opspec.branch_choices import check_branches
+
+        try:
+            out["branches"] = check_branches(table["branches"], "branches")
+        except ConfigurationError as error:
+            raise _error(path, f"{key}.branches", error.message, error.hint or "") from None
     if "engine" in out:
         from opspec.engine.config import EngineConfig
 
@@ -234,6 +245,7 @@ def load_scenarios(path: str | Path, *, rootdir: Path | None = None) -> Scenario
             user_model=given.get("user_model"), users=given.get("users", 1),
             days=given.get("days"), until=given.get("until"), seed=given.get("seed"),
             engine=given.get("engine", {}), params=given.get("params", {}),
+            branches=given.get("branches", {}),
             description=str(entry.get("description", ""))))
     return ScenarioDocument(path, spec_path, tuple(scenarios))
 
@@ -251,6 +263,7 @@ def run_scenario(scenario: Scenario, spec: Any, *, seed: int = 0,
                       script=scenario.script, user_model=scenario.user_model,
                       seed=scenario.seed if scenario.seed is not None else seed,
                       engine_config=scenario.engine or None, params=scenario.params or None,
+                      branches=scenario.branches or None,
                       keep_trace=True if needs_trace else None)
     if seen is not None:
         seen(result)

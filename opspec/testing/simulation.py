@@ -354,6 +354,7 @@ def simulate(spec: Package | CompiledPackage | str | Path, *, users: int = 1,
              performers: Mapping[str, Performer] | None = None,
              keep_trace: bool | None = None,
              params: Mapping[str, Any] | None = None,
+             branches: Mapping[str, Mapping[str, float]] | None = None,
              progress: Callable[[int], None] | None = None,
              monitors: Sequence[Any] | None = None,
              no_user: bool = False) -> SimulationResult:
@@ -371,7 +372,7 @@ def simulate(spec: Package | CompiledPackage | str | Path, *, users: int = 1,
     prepared = prepare(RunRequest(
         spec, seed=seed, days=days, until=until, script=script, user_model=user_model,
         no_user=no_user, config=engine_config, performers=performers or {}, params=params,
-        keep_trace=users <= 100 if keep_trace is None else keep_trace))
+        branches=branches or None, keep_trace=users <= 100 if keep_trace is None else keep_trace))
     compiled = prepared.compiled
     names = spec_names(compiled)
     prepared = prepared.but(monitors=tuple(monitors_for(compiled, names, monitors)))
