@@ -51,3 +51,12 @@ def share(text: str) -> float:
         raise argparse.ArgumentTypeError(f"{text!r}: a share of users lies above 0 and at "
                                          "most 100%")
     return value
+
+
+def add_branch_option(parser: argparse.ArgumentParser) -> None:
+    """``--branch``, the same for every command that runs a spec (run, evaluate)."""
+    parser.add_argument("--branch", action="append", default=[],
+                        metavar="GATEWAY=FLOW:P[,FLOW:P...]",
+                        help="branch probabilities for a gateway the diagram leaves undecided "
+                        "(by id or name, as validate prints them), replacing the file's; "
+                        "repeatable; docs/bpmn.md, Undecided gateways")

@@ -17,7 +17,7 @@ from datetime import UTC, datetime
 from pathlib import Path
 from typing import Any
 
-from opspec.commands._args import seed, share, sweep
+from opspec.commands._args import add_branch_option, seed, share, sweep
 from opspec.errors import EvaluationError, OpspecError
 
 __all__ = ["register", "run"]
@@ -56,11 +56,7 @@ def register(subparsers: Any) -> None:
                         "conditions read that nothing sets; repeatable; docs/bpmn.md, Run "
                         "inputs); NAME~DISTRIBUTION draws one per simulated user "
                         "('score~uniform(0, 100)')")
-    parser.add_argument("--branch", action="append", default=[],
-                        metavar="GATEWAY=FLOW:P[,FLOW:P...]",
-                        help="branch probabilities for a gateway the diagram leaves undecided "
-                        "(by id or name, as validate prints them), replacing the file's; "
-                        "repeatable; docs/bpmn.md, Undecided gateways")
+    add_branch_option(parser)
     parser.add_argument("--params", metavar="FILE",
                         help="run-input values from a .toml/.json file (NAME = value or a "
                         "distribution table) or a .csv file of one row per simulated user")

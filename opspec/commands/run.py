@@ -25,7 +25,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from opspec.clock import clock_time, figure, span
-from opspec.commands._args import seed
+from opspec.commands._args import add_branch_option, seed
 from opspec.errors import ConfigurationError
 
 if TYPE_CHECKING:
@@ -72,11 +72,7 @@ def register(subparsers: Any) -> None:
                         "input (a variable its conditions read that nothing sets), or "
                         "NAME~DISTRIBUTION ('score~uniform(0, 100)': drawn from the seed); "
                         "repeatable; docs/bpmn.md, Run inputs")
-    parser.add_argument("--branch", action="append", default=[],
-                        metavar="GATEWAY=FLOW:P[,FLOW:P...]",
-                        help="branch probabilities for a gateway the diagram leaves undecided "
-                        "(by id or name, as validate prints them), replacing the file's; "
-                        "repeatable; docs/bpmn.md, Undecided gateways")
+    add_branch_option(parser)
     parser.add_argument("--params", metavar="FILE",
                         help="run-input values from a .toml/.json file (NAME = value or a "
                         "distribution table) or a .csv file (the run takes its first row)")

@@ -9,34 +9,11 @@ from __future__ import annotations
 
 import json
 import re
-import shutil
 import sqlite3
 from pathlib import Path
 
-import pytest
 
 from opspec.cli import main
-
-ROOT = Path(__file__).resolve().parents[2]
-SPEC = ROOT / "specs" / "medication_dispenser.xpdl"
-# the second re-alarm (alarms == 2) divides by zero: the dispenser's rarest branch
-BROKEN = "alarms &lt; 3 and 1 / (alarms - 2) &gt; -99"
-
-
-@pytest.fixture
-def broken_spec(tmp_path: Path) -> Path:
-    text = SPEC.read_text(encoding="utf-8")
-    assert text.count("<Expression>alarms &lt; 3</Expression>") == 1
-    spec = tmp_path / "medication_dispenser.xpdl"
-    spec.write_text(text.replace("<Expression>alarms &lt; 3</Expression>",
-                                 f"<Expression>{BROKEN}</Expression>"), encoding="utf-8")
-    shutil.copy(SPEC.with_name("medication_dispenser.users.toml"), tmp_path)
-    return spec
-
-
-def _line_of_activity_r(spec: Path) -> int:
-    lines = spec.read_text(encoding="utf-8").splitlines()
-    return next(i for i, line in enumerate(lines, 1) if '<Activity Id="R"' in line)
 
 
 def _evaluate(capsys, *args: str) -> tuple[int, str, str]:
@@ -50,13 +27,13 @@ def _total(metrics: dict, name: str) -> int:
 
 
 def test_a_fault_on_a_rare_branch_fails_the_evaluation_and_loses_no_dose(
-        broken_spec: Path, tmp_path: Path, capsys) -> None:
+        broken_spec: Path, fault_site: str, tmp_path: Path, capsys) -> None:
     out = tmp_path / "run"
     status, stdout, _ = _evaluate(capsys, str(broken_spec), "--users", "6", "--days", "3",
                                   "--seed", "2", "--workers", "1", "--out", str(out), "--json")
     assert status == 1
     doc = json.loads(stdout)
-    where = f"{broken_spec}:{_line_of_activity_r(broken_spec)}"
+    where = fault_site
     counts = doc["replications"]
     assert counts["planned"] == 6 and counts["failed"] == len(doc["failed"]) >= 1
     assert counts["complete"] + counts["failed"] == 6 and counts["complete"] >= 1

@@ -12,7 +12,6 @@ from __future__ import annotations
 
 import json
 import re
-import shutil
 from pathlib import Path
 
 import pytest
@@ -23,33 +22,15 @@ from opspec.testing import assert_mean, assert_rate, simulate
 from opspec.testing.scenario import load_scenarios, run_scenario
 from opspec.testing.simulation import FailedReplications
 
-ROOT = Path(__file__).resolve().parents[2]
-SPEC = ROOT / "specs" / "medication_dispenser.xpdl"
-BROKEN = "alarms &lt; 3 and 1 / (alarms - 2) &gt; -99"
+SPEC = Path(__file__).resolve().parents[2] / "specs" / "medication_dispenser.xpdl"
 USERS, DAYS, SEED = 6, 3, 2            # some of these users reach the second re-alarm
 
 
-@pytest.fixture
-def broken_spec(tmp_path: Path) -> Path:
-    text = SPEC.read_text(encoding="utf-8")
-    assert text.count("<Expression>alarms &lt; 3</Expression>") == 1
-    spec = tmp_path / "medication_dispenser.xpdl"
-    spec.write_text(text.replace("<Expression>alarms &lt; 3</Expression>",
-                                 f"<Expression>{BROKEN}</Expression>"), encoding="utf-8")
-    shutil.copy(SPEC.with_name("medication_dispenser.users.toml"), tmp_path)
-    return spec
-
-
-def _where(spec: Path) -> str:
-    lines = spec.read_text(encoding="utf-8").splitlines()
-    line = next(i for i, text in enumerate(lines, 1) if '<Activity Id="R"' in text)
-    return f"{spec}:{line}"
-
-
 def test_simulate_fails_the_same_replications_as_evaluate_and_names_the_fault(
-        broken_spec: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+        broken_spec: Path, fault_site: str, tmp_path: Path,
+        capsys: pytest.CaptureFixture[str]) -> None:
     result = simulate(broken_spec, users=USERS, days=DAYS, seed=SEED)   # the companion users
-    where = _where(broken_spec)
+    where = fault_site
     assert 1 <= len(result.failed) < USERS and result.complete == USERS - len(result.failed)
     for failed in result.failed:
         assert failed.problem.startswith(f"fault: {where}: activity 'R'")
@@ -71,9 +52,10 @@ def test_simulate_fails_the_same_replications_as_evaluate_and_names_the_fault(
         result.failed[0].problem)
 
 
-def test_no_statistic_is_computed_over_runs_a_fault_cut_short(broken_spec: Path) -> None:
+def test_no_statistic_is_computed_over_runs_a_fault_cut_short(broken_spec: Path,
+                                                              fault_site: str) -> None:
     result = simulate(broken_spec, users=USERS, days=DAYS, seed=SEED)
-    where = re.escape(_where(broken_spec))
+    where = re.escape(fault_site)
     said = rf"(?s)\d of {USERS} replication\(s\) failed.*replication \d+: fault: {where}: "
     for statistic in (lambda: result.value("doses_missed"),
                       lambda: result.samples("doses_taken"),
@@ -90,7 +72,7 @@ def test_no_statistic_is_computed_over_runs_a_fault_cut_short(broken_spec: Path)
     assert result.per_replication[result.failed[0].replication]["doses_due"]["total"] > 0
 
 
-def test_a_scenario_over_runs_with_a_fault_fails_naming_it(broken_spec: Path,
+def test_a_scenario_over_runs_with_a_fault_fails_naming_it(broken_spec: Path, fault_site: str,
                                                           tmp_path: Path) -> None:
     scenario_file = tmp_path / "missed.scenario.toml"
     scenario_file.write_text(
@@ -101,7 +83,7 @@ def test_a_scenario_over_runs_with_a_fault_fails_naming_it(broken_spec: Path,
     failures = run_scenario(scenario, broken_spec)
     assert failures, "a scenario over runs cut short by a fault must not pass"
     assert re.search(rf"\d of {USERS} replication\(s\) failed", failures[0])
-    assert f"fault: {_where(broken_spec)}: activity 'R'" in failures[0]
+    assert f"fault: {fault_site}: activity 'R'" in failures[0]
 
 
 def test_a_sound_spec_has_no_failed_replications(tmp_path: Path) -> None:
