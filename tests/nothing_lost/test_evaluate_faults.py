@@ -12,7 +12,6 @@ import re
 import sqlite3
 from pathlib import Path
 
-
 from opspec.cli import main
 
 
