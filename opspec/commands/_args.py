@@ -1,10 +1,133 @@
-"""Argument types shared by the subcommands (argparse turns their errors into usage errors)."""
+"""What the subcommands declare alike, written once: how a command is added (its module
+docstring is its ``--help``), the options several commands share, and the argument types
+(argparse turns their errors into usage errors)."""
 
 from __future__ import annotations
 
 import argparse
+import inspect
+from typing import Any
 
-__all__ = ["seed", "share", "sweep"]
+__all__ = ["add_branch_option", "add_check_options", "add_days", "add_device_options",
+           "add_engine_config", "add_json", "add_lane", "add_run_inputs", "add_seed",
+           "add_spec", "add_strict", "add_translation", "add_user_model", "command", "seed",
+           "share", "sweep"]
+
+#: what --days means when it is left out, wherever a spec is run
+SPEC_RUN_LENGTH = "the spec's opspec:RunLength if it declares one, else 1"
+
+
+def command(subparsers: Any, name: str, doc: str | None) -> argparse.ArgumentParser:
+    """Add command ``name`` whose documentation is ``doc``, its module's docstring (as click
+    does: a command's help is its documentation). The first paragraph, a sentence, is the
+    one-line help ``opspec --help`` lists; the whole text, as written, is ``--help``'s
+    description."""
+    text = inspect.cleandoc(doc or "")
+    summary = " ".join(text.split("\n\n", 1)[0].split()).removesuffix(".")
+    return subparsers.add_parser(name, help=summary[:1].lower() + summary[1:],
+                                 description=text,
+                                 formatter_class=argparse.RawDescriptionHelpFormatter)
+
+
+def add_spec(parser: argparse.ArgumentParser, *, optional: str = "") -> None:
+    """The SPEC every command that opens one takes (``optional``: when it may be left out)."""
+    parser.add_argument("spec", metavar="SPEC", nargs="?" if optional else None,
+                        help="the specification (.xpdl, .bpmn or a compiled .wfs)"
+                        + (f"; optional {optional}" if optional else ""))
+
+
+def add_days(parser: Any, *, what: str = "", when: str = "") -> None:
+    """``--days``: ``what`` the days are of, ``when`` the option counts (``with --spec: ``)."""
+    parser.add_argument("--days", type=float, default=None, metavar="D",
+                        help=f"{when}simulated days{what} (default: {SPEC_RUN_LENGTH})")
+
+
+def add_seed(parser: argparse.ArgumentParser, *, default: int | None = 0,
+             what: str = "run seed") -> None:
+    """``--seed``, a whole number from 0 to 2**63 - 1 (:func:`seed`) whatever it seeds."""
+    parser.add_argument("--seed", type=seed, default=default, help=f"{what} (default 0)")
+
+
+def add_json(parser: argparse.ArgumentParser, what: str) -> None:
+    """``--json``: print ``what`` instead of the text."""
+    parser.add_argument("--json", action="store_true", help=f"print {what}")
+
+
+def add_user_model(parser: Any, *, role: str = "") -> None:
+    """``--user-model`` (``role``: what the model does in this command)."""
+    parser.add_argument("--user-model", metavar="FILE|PRESET",
+                        help=f"{role}a user model file or preset; 'A,B' chains a modifier "
+                        "(default: the spec's companion SPEC.users.toml)")
+
+
+def add_run_inputs(parser: argparse.ArgumentParser, *, per_user: bool) -> None:
+    """The values a run reads that the spec leaves open (--param, --params, --branch);
+    ``per_user``: drawn per simulated user (evaluate) rather than once (run)."""
+    parser.add_argument("--param", action="append", default=[], metavar="NAME=VALUE",
+                        help="a value for a package data field, such as a BPMN diagram's run "
+                        "input (a variable its conditions read that nothing sets), or "
+                        "NAME~DISTRIBUTION ('score~uniform(0, 100)': drawn from the seed"
+                        + (", one per simulated user" if per_user else "")
+                        + "); repeatable; docs/bpmn.md, Run inputs")
+    add_branch_option(parser)
+    parser.add_argument("--params", metavar="FILE",
+                        help="run-input values from a .toml/.json file (NAME = value or a "
+                        "distribution table) or a .csv file ("
+                        + ("one row per simulated user" if per_user
+                           else "the run takes its first row") + ")")
+
+
+def add_engine_config(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("--engine-config", metavar="FILE", help="engine configuration TOML")
+
+
+def add_device_options(parser: argparse.ArgumentParser) -> None:
+    """``--bind`` and ``--devices``: real or emulated devices in place of participants."""
+    parser.add_argument("--bind", action="append", default=[], metavar="PARTICIPANT=URL",
+                        help="bind a participant to a serial device URL or 'auto' "
+                        "(repeatable; see devices/README.md)")
+    parser.add_argument("--devices", metavar="DIR",
+                        help="folder of device profiles for --bind (default: devices/)")
+
+
+def add_translation(parser: argparse.ArgumentParser, source: str, output: str,
+                    default: str) -> None:
+    """IN, ``-o OUT`` and ``--strict`` of a command that translates a spec into another file
+    (compile, preprocess): ``source`` is what IN is, ``output`` OUT's metavar and ``default``
+    where OUT goes when it is left out."""
+    parser.add_argument("input", metavar="IN", help=f"the {source} specification")
+    parser.add_argument("-o", "--output", metavar=output,
+                        help=f"where to write (default: {default})")
+    add_strict(parser)
+
+
+def add_strict(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("--strict", action="store_true",
+                        help="treat warnings as errors: among them everything opspec runs "
+                        "differently from its standard (runs-differently, docs/semantics.md)")
+
+
+def add_lane(parser: argparse.ArgumentParser, done: str) -> None:
+    """``--lane``: the lane or participant whose activities are ``done`` (fitted, checked)."""
+    parser.add_argument("--lane", default="user",
+                        help=f"lane or participant whose activities are {done} (default: user)")
+
+
+def add_check_options(parser: Any, *, level_of: str) -> None:
+    """How a user model is checked against people (opspec model-check, and opspec fit's
+    cross-validation, which runs that check on each fold)."""
+    parser.add_argument("--level", type=float, default=0.05,
+                        help=f"family-wise error level of {level_of} (default: 0.05)")
+    parser.add_argument("--replicates", type=int, default=399, metavar="B",
+                        help="simulated groups of people for the bootstrap and the predictive "
+                        "rates (default: 399)")
+    parser.add_argument("--spec", metavar="SPEC",
+                        help="also check the spec's outcome metrics: the spec run with the "
+                        "model gives predictive intervals for what these people showed")
+    add_days(parser, what=" of each run, as long as the people's sessions", when="with --spec: ")
+    parser.add_argument("--runs", type=int, default=200, metavar="N",
+                        help="with --spec: simulated people for the metrics (default: 200)")
+
 
 def seed(text: str) -> int:
     """A run seed: the rule of every door (:func:`opspec.run_rules.check_seed`)."""

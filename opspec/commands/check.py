@@ -1,20 +1,25 @@
-"""``opspec check SPEC... [--json] [--max-states N] [--process ID]``: soundness of each
-process's control flow (see docs/soundness.md and :mod:`opspec.model.soundness`).
+"""Check the soundness of each process (deadlocks, livelocks, dead activities, improper
+completion, graph conformance).
 
-Each problem prints as ``path:line: error: process: message`` with its witness (the activities
+Explore each process's control flow with data abstracted (every conditional branch may be
+taken) and report deadlocks, livelocks, activities that can never run, improper completion,
+AND-joins that can't fire and unbounded places, each with a witness path; plus violations of
+the package's declared graph conformance class (docs/soundness.md, opspec.model.soundness).
+
+Each problem prints as 'path:line: error: process: message' with its witness (the activities
 fired from the start) on the next line, then one line per process level and a summary per
-file; ``--json`` prints one JSON object per file instead (JSON Lines).
+file; --json prints one JSON object per file instead (JSON Lines).
 
-A spec with errors (any that ``opspec validate`` reports: the reader's, the structural checks'
+A spec with errors (any that opspec validate reports: the reader's, the structural checks'
 such as a dangling transition, what the engine refuses to compile) is still explored when a
 package could be built (its conditions do not matter here), but it is never called sound: the
 errors are printed first and make the status 1.
 
-Exit status: 0 every process level is sound; 1 a problem was found, a spec has errors, or
-the check ran out of its budget (more than ``--max-states`` states in a level, or out of
-memory): that verdict is *inconclusive*, never "sound"; 2 usage or I/O problems (a missing
-path, an unreadable file, an unknown ``--process``). Over several files, the highest status
-wins. Memory is bounded by ``--max-states`` (docs/soundness.md gives the bound).
+Exit status: 0 every process level is sound; 1 a problem was found, a spec has errors, or the
+check ran out of its budget (more than --max-states states in a level, or out of memory): that
+verdict is inconclusive, never "sound"; 2 usage or I/O problems (a missing path, an unreadable
+file, an unknown --process). Over several files, the highest status wins. Memory is bounded
+by --max-states (docs/soundness.md gives the bound).
 """
 
 from __future__ import annotations
@@ -25,6 +30,8 @@ import sys
 from dataclasses import replace
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
+
+from opspec.commands._args import add_json, command
 
 if TYPE_CHECKING:
     from collections.abc import Sequence
@@ -46,19 +53,9 @@ def _positive(text: str) -> int:
 
 
 def register(subparsers: Any) -> None:
-    parser = subparsers.add_parser(
-        "check", help="check the soundness of each process (deadlocks, livelocks, dead "
-        "activities, improper completion, graph conformance)",
-        description="Explore each process's control flow with data abstracted (every "
-        "conditional branch may be taken) and report deadlocks, livelocks, activities that "
-        "can never run, improper completion, AND-joins that can't fire and unbounded places, "
-        "each with a witness path; plus violations of the package's declared graph "
-        "conformance class. Exit status: 0 sound, 1 a problem found (or a spec that does "
-        "not load, or an inconclusive check: more than --max-states states, or out of "
-        "memory), 2 usage or I/O errors.")
+    parser = command(subparsers, "check", __doc__)
     parser.add_argument("specs", nargs="+", metavar="SPEC", help="spec files or folders")
-    parser.add_argument("--json", action="store_true",
-                        help="print one JSON object per file (JSON Lines)")
+    add_json(parser, "one JSON object per file (JSON Lines)")
     parser.add_argument("--max-states", type=_positive, default=100_000, metavar="N",
                         help="markings explored per process level before giving up "
                         "(default 100000)")

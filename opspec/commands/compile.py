@@ -1,9 +1,12 @@
-"""``opspec compile IN [-o OUT.wfs]``: write the workflow script (``.wfs``) of an XPDL spec.
+"""Compile an XPDL spec into a workflow script (.wfs) the engine loads.
 
-Exit status: 0 written (warnings are printed), 1 the spec has errors, exactly those
-``opspec validate`` reports (each printed as ``path:line: severity: message``; nothing is
-written), 2 the input cannot be read (missing, a folder, a pipe or device, no permission), the
-output is the input itself, or the output cannot be written.
+Load IN (XPDL or SISARL-XPDL), refuse it if it has errors, and write its compiled workflow
+script (versioned JSON, docs/wfs-format.md).
+
+Exit status: 0 written (warnings are printed); 1 the spec has errors, exactly those opspec
+validate reports (each printed as 'path:line: severity: message'; nothing is written); 2 the
+input cannot be read (missing, a folder, a pipe or device, no permission), the output is the
+input itself, or the output cannot be written.
 """
 
 from __future__ import annotations
@@ -13,19 +16,14 @@ import sys
 from pathlib import Path
 from typing import Any
 
+from opspec.commands._args import add_translation, command
+
 __all__ = ["register"]
 
 
 def register(subparsers: Any) -> None:
-    parser = subparsers.add_parser(
-        "compile", help="compile an XPDL spec into a workflow script (.wfs) the engine loads",
-        description="Load IN (XPDL or SISARL-XPDL), refuse it if it has errors, and write its "
-        "compiled workflow script (versioned JSON, docs/wfs-format.md).")
-    parser.add_argument("input", metavar="IN", help="the XPDL specification")
-    parser.add_argument("-o", "--output", metavar="OUT.wfs",
-                        help="where to write the script (default: IN with the suffix .wfs)")
-    parser.add_argument("--strict", action="store_true",
-                        help="treat warnings as errors")
+    parser = command(subparsers, "compile", __doc__)
+    add_translation(parser, "XPDL", "OUT.wfs", "IN with the suffix .wfs")
     parser.set_defaults(handler=run)
 
 

@@ -1,5 +1,8 @@
-"""``opspec devices``: list serial ports and the profiles matching them, and emulate a
-profile's device on a pseudo-terminal or a socket."""
+"""List serial ports and device profiles; emulate a device.
+
+List serial ports and the profiles matching them, and emulate a profile's device on a
+pseudo-terminal or a socket. Device profiles live in devices/ (see devices/README.md).
+"""
 
 from __future__ import annotations
 
@@ -8,13 +11,13 @@ import sys
 import threading
 from typing import Any
 
+from opspec.commands._args import command
+
 __all__ = ["register"]
 
 
 def register(subparsers: Any) -> None:
-    parser = subparsers.add_parser(
-        "devices", help="list serial ports and device profiles; emulate a device",
-        description="Device profiles live in devices/ (see devices/README.md).")
+    parser = command(subparsers, "devices", __doc__)
     parser.set_defaults(handler=lambda args: (parser.print_help(), 2)[1])
     sub = parser.add_subparsers(dest="devices_command", metavar="ACTION")
 

@@ -1,9 +1,13 @@
-"""``opspec evaluate SPEC``: many simulated users over many days, stored, summarised, reported.
+"""Evaluate a spec with many simulated users; report with CIs and plots.
 
-See ``docs/evaluation.md``. Exit status: 0 every replication finished; 1 some failed (listed;
-``--resume`` runs them again) or the spec is broken; 2 usage, configuration or I/O errors.
+Run SPEC for N simulated users x D days (each user an independent replication with their own
+random streams), store every result in OUT/results.sqlite as it finishes, and write
+OUT/report.html with metrics, confidence intervals and plots. The same seed gives the same
+results whatever the number of workers (docs/evaluation.md).
+
+Exit status: 0 every replication finished; 1 some failed (listed; --resume runs them again) or
+the spec is broken; 2 usage, configuration or I/O errors.
 """
-
 from __future__ import annotations
 
 import argparse
@@ -17,7 +21,7 @@ from datetime import UTC, datetime
 from pathlib import Path
 from typing import Any
 
-from opspec.commands._args import add_branch_option, seed, share, sweep
+from opspec.commands import _args
 from opspec.errors import EvaluationError, OpspecError
 
 __all__ = ["register", "run"]
@@ -30,44 +34,24 @@ DEFAULT_SEED = 0
 
 
 def register(subparsers: Any) -> None:
-    parser = subparsers.add_parser(
-        "evaluate", help="evaluate a spec with many simulated users; report with CIs and plots",
-        description="Run SPEC for N simulated users x D days (each user an independent "
-        "replication with their own random streams), store every result in OUT/results.sqlite "
-        "as it finishes, and write OUT/report.html with metrics, confidence intervals and "
-        "plots. The same seed gives the same results whatever the number of workers.")
-    parser.add_argument("spec", metavar="SPEC", nargs="?",
-                        help="the specification (.xpdl, .bpmn or a compiled .wfs); optional "
-                        "with --resume")
+    parser = _args.command(subparsers, "evaluate", __doc__)
+    _args.add_spec(parser, optional="with --resume")
     parser.add_argument("--users", type=int, default=None,
                         help=f"simulated users (default {DEFAULT_USERS})")
-    parser.add_argument("--days", type=float, default=None,
-                        help="simulated days per user (default: the spec's opspec:RunLength "
-                        "if it declares one, else 1)")
-    parser.add_argument("--seed", type=seed, default=None, help="run seed (default 0)")
-    parser.add_argument("--user-model", metavar="FILE|PRESET",
-                        help="user model file or preset, 'A,B' to chain (default: the spec's "
-                        "companion SPEC.users.toml)")
+    _args.add_days(parser, what=" per user")
+    _args.add_seed(parser, default=None)
+    _args.add_user_model(parser)
     parser.add_argument("--compare", metavar="SPEC2",
                         help="a second design, run on the same simulated users")
-    parser.add_argument("--param", action="append", default=[], metavar="NAME=VALUE",
-                        help="a value for a package data field of type integer, float or "
-                        "boolean, such as a BPMN diagram's run input (a variable its "
-                        "conditions read that nothing sets; repeatable; docs/bpmn.md, Run "
-                        "inputs); NAME~DISTRIBUTION draws one per simulated user "
-                        "('score~uniform(0, 100)')")
-    add_branch_option(parser)
-    parser.add_argument("--params", metavar="FILE",
-                        help="run-input values from a .toml/.json file (NAME = value or a "
-                        "distribution table) or a .csv file of one row per simulated user")
-    parser.add_argument("--sweep", type=sweep, metavar="PARAM=V1,V2,...",
+    _args.add_run_inputs(parser, per_user=True)
+    parser.add_argument("--sweep", type=_args.sweep, metavar="PARAM=V1,V2,...",
                         help="run one design per value of a spec or user-model parameter, "
                         "on the same simulated users ('--sweep list' lists the parameters; "
                         "docs/evaluation.md, Sweeps)")
     parser.add_argument("--target", action="append", default=[], metavar="'METRIC OP VALUE'",
                         help="with --sweep: the values that meet it, e.g. 'missed_rate < 1%%' "
                         "(repeatable)")
-    parser.add_argument("--target-users", type=share, metavar="SHARE",
+    parser.add_argument("--target-users", type=_args.share, metavar="SHARE",
                         help="with --target: judge each user's own value, and ask that this "
                         "share of users (e.g. 95%%) meets the target")
     parser.add_argument("--input-uncertainty", type=int, default=None, metavar="B",
@@ -78,7 +62,7 @@ def register(subparsers: Any) -> None:
     parser.add_argument("--users-per-draw", type=int, default=None, metavar="M",
                         help="with --input-uncertainty: users per parameter draw (default: "
                         "--users / B, at least 10)")
-    parser.add_argument("--engine-config", metavar="FILE", help="engine configuration TOML")
+    _args.add_engine_config(parser)
     parser.add_argument("--workers", type=int, default=None,
                         help="worker processes (default: all local cores)")
     parser.add_argument("--scheduler", metavar="ADDRESS",
@@ -103,8 +87,7 @@ def register(subparsers: Any) -> None:
                         help="the format of the report's figures in OUT/figures/: svg "
                         "(vector, the default), pdf (vector, for LaTeX; SVG twins beside them "
                         "for the HTML report) or png (200 dpi); the HTML report inlines SVG")
-    parser.add_argument("--json", action="store_true",
-                        help="print one JSON object with the results (docs/evaluation.md)")
+    _args.add_json(parser, "one JSON object with the results (docs/evaluation.md)")
     parser.add_argument("--quiet", action="store_true", help="no progress output")
     parser.add_argument("--report-template", metavar="FILE",
                         help="a Jinja2 template for report.html (start from a copy of "

@@ -1,4 +1,11 @@
-"""``opspec fit TRACE... -o model.toml``: estimate a user model from recorded traces."""
+"""Estimate a user model from recorded traces.
+
+Read JSON Lines traces (opspec run --trace, opspec evaluate --export jsonl, TUI walkthroughs),
+estimate per manual activity a duration distribution (lognormal, gamma, Weibull or
+ex-Gaussian by maximum likelihood, chosen by AIC or BIC; the comparison is printed), omission
+rates with Wilson intervals, choice probabilities with the time a wrong pick costs, and how
+much users (runs) differ; write a user-model TOML file (docs/fitting.md).
+"""
 
 from __future__ import annotations
 
@@ -8,6 +15,7 @@ import sys
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
+from opspec.commands import _args
 from opspec.commands.model_check import add_person_options
 
 if TYPE_CHECKING:
@@ -17,20 +25,12 @@ __all__ = ["fitted_text", "register"]
 
 
 def register(subparsers: Any) -> None:
-    parser = subparsers.add_parser(
-        "fit", help="estimate a user model from recorded traces",
-        description="Read JSON Lines traces (opspec run --trace, opspec evaluate --export "
-        "jsonl, TUI walkthroughs), estimate per manual activity a duration distribution "
-        "(lognormal, gamma, Weibull or ex-Gaussian by maximum likelihood, chosen by AIC or "
-        "BIC; the comparison is printed), omission rates with Wilson intervals, choice "
-        "probabilities with the time a wrong pick costs, and how much users (runs) differ; "
-        "write a user-model TOML file (docs/fitting.md).")
+    parser = _args.command(subparsers, "fit", __doc__)
     parser.add_argument("traces", nargs="+", metavar="TRACE",
                         help="trace files (.jsonl), or folders holding them")
     parser.add_argument("-o", "--output", required=True, metavar="MODEL.toml",
                         help="where to write the fitted model ('-' for standard output)")
-    parser.add_argument("--lane", default="user",
-                        help="lane or participant whose activities are fitted (default: user)")
+    _args.add_lane(parser, "fitted")
     parser.add_argument("--name", help="model name (default: the output file's stem)")
     parser.add_argument("--criterion", choices=("aic", "bic"), default="aic",
                         help="how the duration family is chosen (default: aic)")
@@ -42,27 +42,16 @@ def register(subparsers: Any) -> None:
                         help="bootstrap redraws of the fitted parameters written to the "
                         "model's [uncertainty] table, for `opspec evaluate "
                         "--input-uncertainty` (default: 200; 0: none)")
-    parser.add_argument("--seed", type=int, default=0,
-                        help="seed of the bootstrap redraws (default: 0)")
-    parser.add_argument("--json", action="store_true",
-                        help="print the fit (every family's AIC/BIC, intervals, between-user "
-                        "spread) as one JSON object instead of the summary")
+    _args.add_seed(parser, what="seed of the bootstrap redraws")
+    _args.add_json(parser, "the fit (every family's AIC/BIC, intervals, between-user "
+                   "spread) as one JSON object instead of the summary")
     cv = parser.add_argument_group(
         "cross-validation", "--holdout K: split the persons into K folds; for each, fit "
         "on the others and check the model on the fold (opspec model-check); one verdict "
         "over all folds, Holm-adjusted; exit 1 when something misfits (docs/fitting.md)")
     cv.add_argument("--holdout", type=int, metavar="K",
                     help="K-fold cross-validation by person")
-    cv.add_argument("--level", type=float, default=0.05,
-                    help="family-wise error level of the verdict (default: 0.05)")
-    cv.add_argument("--replicates", type=int, default=399, metavar="B",
-                    help="simulated groups of each check (default: 399)")
-    cv.add_argument("--spec", metavar="SPEC",
-                    help="also check the spec's outcome metrics on each fold")
-    cv.add_argument("--days", type=float, metavar="D",
-                    help="with --spec: simulated days of each run (default: the spec's)")
-    cv.add_argument("--runs", type=int, default=200, metavar="N",
-                    help="with --spec: simulated people for the metrics (default: 200)")
+    _args.add_check_options(cv, level_of="the verdict")
     parser.set_defaults(handler=_fit)
 
 

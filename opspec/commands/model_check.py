@@ -1,10 +1,16 @@
-"""``opspec model-check MODEL TRACE...``: does the model predict people it was not fitted on?
+"""Check a user model against people it was not fitted on.
 
-Exit status 0 when no item misfits, 1 when one does (each named with its statistic,
-p-value and what the people did against what the model predicts), 2 for a usage or input
-problem. docs/fitting.md, *Checking a model against new people*.
+Compare traces or walkthrough recordings of people NOT used to fit MODEL with what MODEL
+predicts, per user-lane activity (durations: Anderson-Darling by parametric bootstrap, the
+population's between-person spread and the parameters' [uncertainty] included; omission,
+commission and repetition rates: exact binomial / beta-binomial) and, with --spec, per outcome
+metric of the spec (predictive intervals from runs of the spec with the model). Holm's
+adjustment keeps the chance of any false misfit at --level.
+
+Exit status: 0 no item misfits; 1 one does (each named with its statistic, p-value and what
+the people did against what the model predicts); 2 a usage or input problem. docs/fitting.md,
+Checking a model against new people.
 """
-
 from __future__ import annotations
 
 import argparse
@@ -14,6 +20,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
+from opspec.commands import _args
 from opspec.usermodels.persons import PERSON_FROM
 
 if TYPE_CHECKING:
@@ -43,41 +50,19 @@ def add_person_options(parser: Any, counted: str = "") -> None:
 
 
 def register(subparsers: Any) -> None:
-    parser = subparsers.add_parser(
-        "model-check", help="check a user model against people it was not fitted on",
-        description="Compare traces or walkthrough recordings of people NOT used to fit "
-        "MODEL with what MODEL predicts, per user-lane activity (durations: Anderson-"
-        "Darling by parametric bootstrap, the population's between-person spread and the "
-        "parameters' [uncertainty] included; omission, commission and repetition rates: "
-        "exact binomial / beta-binomial) and, with --spec, per outcome metric of the spec "
-        "(predictive intervals from runs of the spec with the model). Holm's adjustment "
-        "keeps the chance of any false misfit at --level. Exit 0: nothing misfits; 1: "
-        "something does (docs/fitting.md).")
+    parser = _args.command(subparsers, "model-check", __doc__)
     parser.add_argument("model", metavar="MODEL",
                         help="user model: a TOML file (fitted or hand-written, a population "
                         "included), a preset, or A,B compositions")
     parser.add_argument("traces", nargs="+", metavar="TRACE",
                         help="trace files (.jsonl) of held-out people, or folders of them")
-    parser.add_argument("--spec", metavar="SPEC",
-                        help="also check the spec's outcome metrics: the spec run with the "
-                        "model gives predictive intervals for what these people showed")
-    parser.add_argument("--days", type=float, metavar="D",
-                        help="with --spec: simulated days of each run, as long as the "
-                        "people's sessions (default: the spec's run length)")
-    parser.add_argument("--runs", type=int, default=200, metavar="N",
-                        help="with --spec: simulated people for the metrics (default: 200)")
-    parser.add_argument("--level", type=float, default=0.05,
-                        help="family-wise error level (default: 0.05)")
-    parser.add_argument("--replicates", type=int, default=399, metavar="B",
-                        help="simulated groups of people for the bootstrap and the predictive "
-                        "rates (default: 399)")
+    _args.add_check_options(parser, level_of="the verdict")
     parser.add_argument("--no-parameter-uncertainty", action="store_true",
                         help="ignore the model's [uncertainty] redraws: take its parameters "
                         "as known")
-    parser.add_argument("--lane", default="user",
-                        help="lane or participant checked (default: user)")
-    parser.add_argument("--seed", type=int, default=0, help="seed (default: 0)")
-    parser.add_argument("--json", action="store_true", help="print the check as JSON")
+    _args.add_lane(parser, "checked")
+    _args.add_seed(parser, what="seed of the simulated groups")
+    _args.add_json(parser, "the check as JSON")
     parser.add_argument("--report", metavar="DIR",
                         help="write DIR/model-check.html: the verdict, QQ plots per activity "
                         "and intervals per metric")

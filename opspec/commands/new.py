@@ -1,14 +1,17 @@
-"""``opspec new NAME``: start a new specification from a small, runnable template.
+"""Start a new spec: a small runnable device (pill reminder or stove guard), its user
+model and tests.
 
-Writes the folder ``NAME/`` with ``NAME.xpdl`` (``--template pill``, the default: a pill
-reminder — a device workflow with a timed start, a reminder whose wait has a deadline, a retry
-and an escalation to a caregiver, and the user's manual lane; ``--template stove``: a stove
-guard — the device watches, the user must confirm, the guard escalates by cutting the power),
-``NAME.users.toml`` (its user model, picked up by ``opspec run`` and
-``opspec evaluate`` because it sits beside the spec), ``test_NAME.py`` (spec tests for pytest)
-and a ``README.md`` listing the commands to try. The templates are package data
-(``opspec/commands/templates/new/<template>/``). Exit status: 0 written; 2 the folder already exists,
-the name is not usable, or the folder cannot be written.
+Write the folder NAME/ with NAME.xpdl (--template pill, the default: a pill reminder - a
+device workflow with a timed start, a reminder whose wait has a deadline, a retry and an
+escalation to a caregiver, and the user's manual lane; --template stove: a stove guard - the
+device watches, the user must confirm, the guard escalates by cutting the power),
+NAME.users.toml (its user model, picked up by opspec run and opspec evaluate because it sits
+beside the spec), test_NAME.py (spec tests: run them with 'python -m pytest NAME') and a
+README.md listing the commands to try. The spec validates, runs and passes its tests as
+written. The templates are package data (opspec/commands/templates/new/<template>/).
+
+Exit status: 0 written; 2 the folder already exists (it is never overwritten), the name is
+not usable, or the folder cannot be written.
 """
 
 from __future__ import annotations
@@ -20,6 +23,8 @@ import sys
 from importlib import resources
 from pathlib import Path
 from typing import Any
+
+from opspec.commands._args import command
 
 __all__ = ["SHAPES", "TEMPLATES", "register", "render", "run"]
 
@@ -45,16 +50,7 @@ _NAME = re.compile(r"[A-Za-z0-9][A-Za-z0-9_.-]*")
 
 
 def register(subparsers: Any) -> None:
-    parser = subparsers.add_parser(
-        "new", help="start a new spec: a small runnable device (pill reminder or stove guard), "
-        "its user model and tests",
-        description="Write the folder NAME/ with NAME.xpdl (a pill reminder by default: a "
-        "device workflow with a timed start, a reminder with a deadline, a retry and an "
-        "escalation, and the user's manual lane; --template stove: a stove guard), "
-        "NAME.users.toml (its user model), test_NAME.py (spec "
-        "tests: run them with 'python -m pytest NAME') and README.md. The spec validates, "
-        "runs and passes its tests as written. Refuses to overwrite an existing folder. "
-        "Exit status: 0 written, 2 the folder exists or cannot be written.")
+    parser = command(subparsers, "new", __doc__)
     parser.add_argument("name", metavar="NAME",
                         help="the folder to create; its last part names the files")
     parser.add_argument("--template", choices=tuple(SHAPES), default="pill",

@@ -1,20 +1,21 @@
-"""``opspec preprocess IN [-o OUT.xpdl]``: SISARL-XPDL -> standard XPDL 2.1.
+"""Translate SISARL-XPDL built-ins and directives into standard XPDL 2.1.
 
-Coordination built-ins become compound built-in activities (BlockActivity + generated
-ActivitySet of Routes and plain activities) and directives become ``opspec:`` extended
-attributes; the output validates against the official XPDL 2.1 schema (docs/sisarl-xpdl.md,
-section *Preprocessing*).
+Load IN, expand each coordination built-in (arbiter, voter, superposition, push/pull data,
+mode change) into a compound built-in activity (BlockActivity + generated ActivitySet of
+Routes and plain activities), turn directives into opspec: extended attributes, and write
+standard XPDL 2.1 to OUT, valid against the official XPDL 2.1 schema (docs/sisarl-xpdl.md,
+Preprocessing).
 
-Relative companion paths follow the output: ``opspec:WorldFile``, mode sources and
-ExternalPackage hrefs are rewritten to lead from OUT's folder, and ``IN.users.toml`` is copied
-to ``OUT.users.toml`` (:mod:`opspec.xpdl.relocate`). A world file that would then lie outside
-OUT's folder tree (where opspec does not read it) is copied beside OUT instead. Every output the bundled XPDL 2.1 XSD
-rejects gets a ``not-schema-valid`` warning.
+Relative companion paths follow the output: opspec:WorldFile, mode sources and
+ExternalPackage hrefs are rewritten to lead from OUT's folder, and IN.users.toml is copied to
+OUT.users.toml (opspec.xpdl.relocate). A world file that would then lie outside OUT's folder
+tree (where opspec does not read it) is copied beside OUT instead. Every output the bundled
+XPDL 2.1 XSD rejects gets a not-schema-valid warning.
 
-Exit status: 0 written, 1 the spec has errors (those ``opspec validate`` reports, or a
-built-in that cannot be expanded; nothing written), 2 the input cannot be read (missing, a
-folder, a pipe or device, no permission), the output is the input itself, or the output
-cannot be written.
+Exit status: 0 written; 1 the spec has errors (those opspec validate reports, or a built-in
+that cannot be expanded; nothing written); 2 the input cannot be read (missing, a folder, a
+pipe or device, no permission), the output is the input itself, or the output cannot be
+written.
 """
 
 from __future__ import annotations
@@ -24,19 +25,14 @@ import sys
 from pathlib import Path
 from typing import Any
 
+from opspec.commands._args import add_translation, command
+
 __all__ = ["register"]
 
 
 def register(subparsers: Any) -> None:
-    parser = subparsers.add_parser(
-        "preprocess", help="translate SISARL-XPDL built-ins and directives into standard XPDL 2.1",
-        description="Load IN, expand each coordination built-in (arbiter, voter, "
-        "superposition, push/pull data, mode change) into a compound built-in activity and "
-        "write standard XPDL 2.1 to OUT.")
-    parser.add_argument("input", metavar="IN", help="the SISARL-XPDL specification")
-    parser.add_argument("-o", "--output", metavar="OUT.xpdl",
-                        help="where to write (default: IN with '.std.xpdl'; '-' for stdout)")
-    parser.add_argument("--strict", action="store_true", help="treat warnings as errors")
+    parser = command(subparsers, "preprocess", __doc__)
+    add_translation(parser, "SISARL-XPDL", "OUT.xpdl", "IN with '.std.xpdl'; '-' for stdout")
     parser.set_defaults(handler=run)
 
 

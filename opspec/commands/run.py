@@ -1,19 +1,21 @@
-"""``opspec run SPEC``: one simulation of a spec, as a readable timeline or one JSON object.
+"""Run one simulation of a spec and show what happened.
 
-The user lane is performed by ``--script FILE`` (exact actions), ``--user-model FILE|PRESET``
-(a stochastic user), or by default the spec's companion ``SPEC.users.toml`` when there is one.
-``--trace FILE`` streams every event to JSON Lines as the run goes (flushed on every exit
-path, so an interrupted run keeps what happened). ``--bind PARTICIPANT=URL`` binds
-participants to serial devices (docs in ``devices/README.md``); a bound real device switches
-the run to wall-clock time.
+Run SPEC (XPDL, BPMN 2.0 or .wfs) once on the simulated clock, device workflows and the user
+lane together, and print a timeline, the spec's metrics and a summary (or one JSON object with
+--json).
+
+The user lane is performed by --script FILE (exact actions), --user-model FILE|PRESET (a
+stochastic user), or by default the spec's companion SPEC.users.toml when there is one.
+--trace FILE streams every event to JSON Lines as the run goes (flushed on every exit path, so
+an interrupted run keeps what happened). --bind PARTICIPANT=URL binds participants to serial
+devices (devices/README.md); a bound real device switches the run to wall-clock time.
 
 Exit status: 0 the run ended normally; 1 the run found a problem (a deadlock, an aborted
-instance, a device fault); 2 usage, configuration or I/O errors (from the CLI). With nobody on
-the user lane (``--no-user``, or no user model at all), user-lane instances still waiting for
-their performer at the end are the expected end of a devices-only run: said in one line, not
-reported as deadlocks, not exit 1.
+instance, a device fault); 2 usage, configuration or I/O errors. With nobody on the user lane
+(--no-user, or no user model at all), user-lane instances still waiting for their performer at
+the end are the expected end of a devices-only run: said in one line, not reported as
+deadlocks, not exit 1.
 """
-
 from __future__ import annotations
 
 import argparse
@@ -25,7 +27,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from opspec.clock import clock_time, figure, span
-from opspec.commands._args import add_branch_option, seed
+from opspec.commands import _args
 from opspec.errors import ConfigurationError
 
 if TYPE_CHECKING:
@@ -44,40 +46,22 @@ BRIEF_KINDS = frozenset({
 
 
 def register(subparsers: Any) -> None:
-    parser = subparsers.add_parser(
-        "run", help="run one simulation of a spec and show what happened",
-        description="Run SPEC (XPDL, BPMN 2.0 or .wfs) once on the simulated clock, device "
-        "workflows and the user lane together, and print a timeline, the spec's metrics and "
-        "a summary (or one JSON object with --json). Exit status: 0 normal end; 1 a deadlock, an "
-        "aborted instance or a device fault; 2 usage or configuration errors.")
-    parser.add_argument("spec", metavar="SPEC",
-                        help="the specification (.xpdl, .bpmn or a compiled .wfs)")
+    parser = _args.command(subparsers, "run", __doc__)
+    _args.add_spec(parser)
     length = parser.add_mutually_exclusive_group()
-    length.add_argument("--days", type=float, metavar="D",
-                        help="simulated days to run (default: the spec's opspec:RunLength "
-                        "if it declares one, else 1)")
+    _args.add_days(length, what=" to run")
     length.add_argument("--until", metavar="T",
                         help="simulated end time: seconds, or an ISO 8601 duration (PT8H)")
-    parser.add_argument("--seed", type=seed, default=0,
-                        help="run seed (default 0): draws as user 0 of opspec evaluate --seed")
+    _args.add_seed(parser, what="run seed: draws as user 0 of opspec evaluate --seed")
     user = parser.add_mutually_exclusive_group()
     user.add_argument("--script", metavar="FILE",
                       help="a scripted user (TOML/JSON steps, or a recorded walkthrough)")
-    user.add_argument("--user-model", metavar="FILE|PRESET",
-                      help="a stochastic user model (file or preset; 'A,B' chains a modifier)")
+    _args.add_user_model(user, role="a stochastic user: ")
     user.add_argument("--no-user", action="store_true",
                       help="nobody performs the user lane (ignore SPEC.users.toml)")
-    parser.add_argument("--param", action="append", default=[], metavar="NAME=VALUE",
-                        help="a value for a package data field, such as a BPMN diagram's run "
-                        "input (a variable its conditions read that nothing sets), or "
-                        "NAME~DISTRIBUTION ('score~uniform(0, 100)': drawn from the seed); "
-                        "repeatable; docs/bpmn.md, Run inputs")
-    add_branch_option(parser)
-    parser.add_argument("--params", metavar="FILE",
-                        help="run-input values from a .toml/.json file (NAME = value or a "
-                        "distribution table) or a .csv file (the run takes its first row)")
+    _args.add_run_inputs(parser, per_user=False)
     parser.add_argument("--trace", metavar="FILE", help="write the full trace as JSON Lines")
-    parser.add_argument("--engine-config", metavar="FILE", help="engine configuration TOML")
+    _args.add_engine_config(parser)
     parser.add_argument("--processor-model",
                         choices=("dedicated", "pooled", "preemptive", "priority-queues"),
                         help="override the configuration's processor model "
@@ -92,18 +76,13 @@ def register(subparsers: Any) -> None:
                         help="run against the wall clock (see --speed)")
     parser.add_argument("--speed", type=float, default=None,
                         help="with --realtime: simulated seconds per wall second (default 1)")
-    parser.add_argument("--bind", action="append", default=[], metavar="PARTICIPANT=URL",
-                        help="bind a participant to a serial device URL or 'auto' "
-                        "(repeatable; see devices/README.md)")
-    parser.add_argument("--devices", metavar="DIR",
-                        help="folder of device profiles for --bind (default: devices/)")
+    _args.add_device_options(parser)
     parser.add_argument("--timeline", choices=("brief", "all", "none"), default="brief",
                         help="which events the printed timeline shows (default brief)")
     parser.add_argument("--timing", action="store_true",
                         help="report per-workflow response times, jitter, deadline misses "
                         "and the pooled model's context switches")
-    parser.add_argument("--json", action="store_true",
-                        help="print one JSON object (metrics shaped as opspec evaluate --json)")
+    _args.add_json(parser, "one JSON object (metrics shaped as opspec evaluate --json)")
     parser.set_defaults(handler=run)
 
 

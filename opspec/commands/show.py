@@ -1,15 +1,18 @@
-"""``opspec show SPEC [--format text|dot|svg|html] [--process ID]``: what a specification holds.
+"""Print the processes, lanes, participants and activities of a spec.
 
-``text`` (the default) prints the package header, participants (human or system), pools and
-lanes, and every process with its directives, data, activities (kind, performer, manual or
-automatic, deadlines) and transitions with their conditions. ``dot`` prints a Graphviz digraph
-per process (:mod:`opspec.xpdl.dot`). ``svg`` and ``html`` draw the whole package in one
-picture: every process with its lanes and the messages between them
-(:mod:`opspec.xpdl.picture`, laid out by Graphviz's ``dot`` program; without it, a one-line
-error with the install hint and exit status 2). Every error ``opspec validate`` finds is printed on
-stderr (the spec is still shown). Exit status: 0 shown, no errors; 1 shown, but the spec has
-errors (or the file holds no usable package); 2 the file cannot be read or the process does
-not exist.
+Print what SPEC holds, as readable text or as Graphviz DOT, or draw the whole package as SVG
+or as an HTML page. text (the default) prints the package header, participants (human or
+system), pools and lanes, and every process with its directives, data, activities (kind,
+performer, manual or automatic, deadlines) and transitions with their conditions. dot prints a
+Graphviz digraph per process (opspec.xpdl.dot; render it with e.g.
+'opspec show SPEC --format dot | dot -Tsvg -o out.svg'). svg and html draw every process with
+its lanes and the messages between them in one picture (opspec.xpdl.picture, laid out by
+Graphviz's dot program: 'opspec show SPEC --format html -o spec.html' writes the file only
+when the picture is drawn; without dot, a one-line error with the install hint and exit
+status 2). Every error opspec validate finds is printed on stderr (the spec is still shown).
+
+Exit status: 0 shown, no errors; 1 shown, but the spec has errors (or the file holds no usable
+package); 2 the file cannot be read or the process does not exist.
 """
 
 from __future__ import annotations
@@ -19,6 +22,7 @@ import sys
 from pathlib import Path
 from typing import Any
 
+from opspec.commands._args import add_spec, command
 from opspec.model.activities import (
     Activity,
     BlockActivity,
@@ -38,17 +42,8 @@ __all__ = ["describe_package", "register", "run"]
 
 
 def register(subparsers: Any) -> None:
-    parser = subparsers.add_parser(
-        "show", help="print the processes, lanes, participants and activities of a spec",
-        description="Print what SPEC holds, as readable text or as Graphviz DOT (one digraph "
-        "per process; render with e.g. 'opspec show SPEC --format dot | dot -Tsvg -o out.svg'), "
-        "or draw the whole package - every process with its lanes and the messages between "
-        "them - as SVG or as an HTML page (needs Graphviz's dot program: "
-        "'opspec show SPEC --format html -o spec.html', which writes the file only when the "
-        "picture is drawn).")
-    parser.add_argument("spec", metavar="SPEC",
-                        help="the XPDL specification, or a workflow script (.wfs) compiled "
-                        "from one")
+    parser = command(subparsers, "show", __doc__)
+    add_spec(parser)
     parser.add_argument("--format", choices=("text", "dot", "svg", "html"), default="text",
                         help="output format (default: text; svg and html: the whole package "
                         "in one picture)")

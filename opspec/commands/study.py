@@ -1,10 +1,14 @@
-"""``opspec study PROTOCOL.toml``: the sessions of a walkthrough study, and its summary.
+"""Run the sessions of a walkthrough study and compare the designs.
 
-``--participant ID`` runs that participant's sessions not done yet, in their counterbalanced
-order, each after its briefing (``--next``: only the first of them); ``--serve`` serves one
-link per participant, whose browser runs the same sessions (opspec.tui.study_serve); without
-either, the study's status, the summary per variant and the paired comparison of the designs
-(docs/walkthrough.md, *A study*).
+Participants perform the spec variants of PROTOCOL in counterbalanced (Latin square) orders,
+each session a walkthrough recorded under RECORDINGS/PARTICIPANT/VARIANT.json; a session that
+breaks off is started again when the participant resumes.
+
+--participant ID runs that participant's sessions not done yet, in their counterbalanced
+order, each after its briefing (--next: only the first of them); --serve serves one link per
+participant, whose browser runs the same sessions (opspec.tui.study_serve). Without either:
+which sessions are done, the metrics per variant and the paired comparison of the variants
+(the statistics of opspec evaluate --compare; docs/walkthrough.md, A study).
 """
 
 from __future__ import annotations
@@ -15,25 +19,19 @@ import os
 import sys
 from typing import Any
 
+from opspec.commands._args import add_json, command
+
 __all__ = ["register"]
 
 
 def register(subparsers: Any) -> None:
-    parser = subparsers.add_parser(
-        "study", help="run the sessions of a walkthrough study and compare the designs",
-        description="Participants perform the spec variants of PROTOCOL in counterbalanced "
-        "(Latin square) orders, each session a walkthrough recorded under "
-        "RECORDINGS/PARTICIPANT/VARIANT.json; a session that breaks off is started again "
-        "when the participant resumes. Without --participant: which sessions are done, the "
-        "metrics per variant and the paired comparison of the variants (the statistics of "
-        "opspec evaluate --compare).")
+    parser = command(subparsers, "study", __doc__)
     parser.add_argument("protocol", metavar="PROTOCOL.toml", help="the study protocol")
     parser.add_argument("--participant", metavar="ID",
                         help="run this participant's sessions that are not done yet")
     parser.add_argument("--next", action="store_true",
                         help="with --participant: run only their next session not done")
-    parser.add_argument("--json", action="store_true",
-                        help="print the summary as JSON (without --participant)")
+    add_json(parser, "the summary as JSON (without --participant)")
     web = parser.add_argument_group("participants in a browser")
     web.add_argument("--serve", action="store_true",
                      help="serve the sessions over HTTP: print one link per participant, "

@@ -1,9 +1,12 @@
-"""``opspec validate PATH... [--strict] [--json]``: report every problem of specification files.
+"""Check XPDL / SISARL-XPDL or BPMN 2.0 specifications and report every problem.
 
-Each problem prints as ``path:line: severity: message (hint)``, followed by a summary line;
-``--json`` prints one JSON object per file instead (JSON Lines, see
-:meth:`opspec.xpdl.validate.FileReport.to_json`). Exit status: 0 no errors, 1 errors in a
-spec, 2 usage or I/O (a path that does not exist, an unreadable file, a folder without specs).
+Load each PATH (a file, or a folder: every *.xpdl, *.xml and *.bpmn below it, sorted), run the
+structural checks and report every problem at once as 'path:line: severity: message (hint)',
+followed by a summary line; --json prints one JSON object per file instead (JSON Lines,
+opspec.xpdl.validate.FileReport.to_json). Codes are listed in docs/validation.md.
+
+Exit status: 0 no errors; 1 errors in a spec; 2 usage or I/O (a path that does not exist, an
+unreadable file, a folder without specs).
 """
 
 from __future__ import annotations
@@ -13,23 +16,16 @@ import json
 import sys
 from typing import Any
 
+from opspec.commands._args import add_json, add_strict, command
+
 __all__ = ["register", "run"]
 
 
 def register(subparsers: Any) -> None:
-    parser = subparsers.add_parser(
-        "validate", help="check XPDL / SISARL-XPDL or BPMN 2.0 specifications and report every "
-        "problem",
-        description="Load each PATH (a file, or a folder: every *.xpdl, *.xml and *.bpmn below "
-        "it, sorted), run the structural checks and report every problem at once as "
-        "'path:line: severity: message (hint)'. Codes are listed in docs/validation.md. "
-        "Exit status: 0 no errors, 1 errors in a spec, 2 usage or I/O problems.")
+    parser = command(subparsers, "validate", __doc__)
     parser.add_argument("paths", nargs="+", metavar="PATH", help="spec files or folders")
-    parser.add_argument("--strict", action="store_true",
-                        help="treat warnings as errors: among them everything opspec runs "
-                        "differently from its standard (runs-differently, docs/semantics.md)")
-    parser.add_argument("--json", action="store_true",
-                        help="print one JSON object per file (JSON Lines)")
+    add_strict(parser)
+    add_json(parser, "one JSON object per file (JSON Lines)")
     parser.add_argument("--schema", action="store_true",
                         help="also validate each file against the bundled WfMC XSD of its "
                         "XPDL version (1.0, 2.1; docs/validation.md)")

@@ -1,11 +1,13 @@
-"""``opspec walkthrough SPEC``: a person performs the user lane in a terminal UI.
+"""Perform a spec's user lane yourself in a terminal UI.
 
-See ``docs/walkthrough.md``. The recording (a script ``opspec run --script`` replays) is
-written as the session goes, with the trace beside it; quitting prints the summary (the
-spec's metrics, the person's response times), where both files are, and the commands that
-replay the recording.
+Run SPEC's device workflows on a simulated clock while you perform the user lane: see what the
+device does, act with one key, control time, hand your lane to a user model and back. Press ?
+in the app for the keys (docs/walkthrough.md).
+
+The recording (a script opspec run --script replays) is written as the session goes, with the
+trace beside it; quitting prints the summary (the spec's metrics, the person's response
+times), where both files are, and the commands that replay the recording.
 """
-
 from __future__ import annotations
 
 import argparse
@@ -16,7 +18,7 @@ from datetime import UTC, datetime
 from pathlib import Path
 from typing import Any
 
-from opspec.commands._args import seed
+from opspec.commands import _args
 from opspec.errors import ConfigurationError
 
 # the choices, without importing Textual for `opspec --help`
@@ -42,31 +44,21 @@ def _file_safe(person: str) -> str:
 
 
 def register(subparsers: Any) -> None:
-    parser = subparsers.add_parser(
-        "walkthrough", help="perform a spec's user lane yourself in a terminal UI",
-        description="Run SPEC's device workflows on a simulated clock while you perform the "
-        "user lane: see what the device does, act with one key, control time, hand your lane "
-        "to a user model and back. Press ? in the app for the keys.")
-    parser.add_argument("spec", metavar="SPEC", help="the specification (.xpdl or .wfs)")
+    parser = _args.command(subparsers, "walkthrough", __doc__)
+    _args.add_spec(parser)
     parser.add_argument("--speed", type=float, default=None,
                         help="simulated seconds per wall second at start (default 60; 1 "
                         "with a real device bound)")
-    parser.add_argument("--seed", type=seed, default=0,
-                        help="run seed (default 0): the run of opspec run --seed")
-    parser.add_argument("--days", type=float, default=None,
-                        help="simulated days (default: the spec's opspec:RunLength, else 1)")
-    parser.add_argument("--user-model", metavar="FILE|PRESET",
-                        help="the model that performs your lane when you hand it over "
-                        "(default: the spec's companion SPEC.users.toml)")
+    _args.add_seed(parser, what="run seed: the run of opspec run --seed")
+    _args.add_days(parser)
+    _args.add_user_model(parser, role="what performs your lane when you hand it over: ")
     parser.add_argument("--record", metavar="FILE",
                         help="where to write the recording (default "
                         "walkthroughs/<spec>-<date-time>.json)")
     parser.add_argument("--no-record", action="store_true", help="do not record")
     parser.add_argument("--replay", metavar="FILE",
                         help="replay a recording (or any script) instead of performing")
-    parser.add_argument("--bind", action="append", default=[], metavar="PARTICIPANT=URL",
-                        help="bind a participant to a serial device (see devices/README.md)")
-    parser.add_argument("--devices", metavar="DIR", help="device profile folder")
+    _args.add_device_options(parser)
     lab = parser.add_argument_group("for a lab session")
     lab.add_argument("--on-call", choices=ON_CALL, default="realtime",
                      help="what the clock does when the device calls you (an alarm, an "
