@@ -4,150 +4,22 @@ Everything the front end reads ends up here; the engine runs these values. A mod
 built in plain Python (tests do) and round-trips through the ``.wfs`` JSON form.
 """
 
-from opspec.model.activities import (
-    Activity,
-    ActivityBody,
-    BlockActivity,
-    Deadline,
-    Event,
-    EventPosition,
-    Execution,
-    GatewayType,
-    Join,
-    Loop,
-    LoopKind,
-    MIFlow,
-    Mode,
-    NoImplementation,
-    Reference,
-    Route,
-    Split,
-    SubFlow,
-    Task,
-    TaskApplication,
-    TaskKind,
-    Trigger,
-    TriggerKind,
-)
-from opspec.model.common import Element, ExtendedAttribute, find_extended
-from opspec.model.data import (
-    ActualParameter,
-    ArrayType,
-    Assignment,
-    BasicKind,
-    BasicType,
-    DataField,
-    DataType,
-    DeclaredType,
-    EnumerationType,
-    ExternalReferenceType,
-    FormalParameter,
-    ListType,
-    ParameterMode,
-    RecordMember,
-    RecordType,
-    SchemaType,
-    TypeDeclaration,
-    UnionType,
-)
-from opspec.model.expressions import Binary, Call, Expression, Literal, Name, Unary
-from opspec.model.package import ExternalPackage, Package, PackageHeader, XpdlVersion
-from opspec.model.process import (
-    ActivitySet,
-    Condition,
-    ConditionKind,
-    ProcessHeader,
-    Transition,
-    WorkflowProcess,
-)
-from opspec.model.resources import Application, Lane, Participant, ParticipantType, Pool
-from opspec.model.sisarl import (
-    ActivityDirectives,
-    CoordinationBuiltIn,
-    CoordinationKind,
-    DeclaredDistribution,
-    EventSelector,
-    MetricDefinition,
-    MetricKind,
-    ProcessDirectives,
-    TriggerRef,
-    WorkflowMode,
-)
+# The public names are each module's own ``__all__``, written once there.
+from opspec.model import activities, common, data, expressions, package, process, resources, sisarl
+from opspec.model.activities import *  # noqa: F403
+from opspec.model.common import *  # noqa: F403
+from opspec.model.data import *  # noqa: F403
+from opspec.model.expressions import *  # noqa: F403
+from opspec.model.package import *  # noqa: F403
+from opspec.model.process import *  # noqa: F403
+from opspec.model.resources import *  # noqa: F403
+from opspec.model.sisarl import *  # noqa: F403
 
-__all__ = [
-    "Activity",
-    "ActivityBody",
-    "ActivityDirectives",
-    "ActivitySet",
-    "ActualParameter",
-    "Application",
-    "ArrayType",
-    "Assignment",
-    "BasicKind",
-    "BasicType",
-    "Binary",
-    "BlockActivity",
-    "Call",
-    "Condition",
-    "ConditionKind",
-    "CoordinationBuiltIn",
-    "CoordinationKind",
-    "DataField",
-    "DataType",
-    "Deadline",
-    "DeclaredDistribution",
-    "DeclaredType",
-    "Element",
-    "EnumerationType",
-    "Event",
-    "EventPosition",
-    "EventSelector",
-    "Execution",
-    "Expression",
-    "ExtendedAttribute",
-    "ExternalPackage",
-    "ExternalReferenceType",
-    "FormalParameter",
-    "GatewayType",
-    "Join",
-    "Lane",
-    "ListType",
-    "Literal",
-    "Loop",
-    "LoopKind",
-    "MIFlow",
-    "MetricDefinition",
-    "MetricKind",
-    "Mode",
-    "Name",
-    "NoImplementation",
-    "Package",
-    "PackageHeader",
-    "ParameterMode",
-    "Participant",
-    "ParticipantType",
-    "Pool",
-    "ProcessDirectives",
-    "ProcessHeader",
-    "RecordMember",
-    "RecordType",
-    "Reference",
-    "Route",
-    "SchemaType",
-    "Split",
-    "SubFlow",
-    "Task",
-    "TaskApplication",
-    "TaskKind",
-    "Transition",
-    "Trigger",
-    "TriggerKind",
-    "TriggerRef",
-    "TypeDeclaration",
-    "Unary",
-    "UnionType",
-    "WorkflowMode",
-    "WorkflowProcess",
-    "XpdlVersion",
-    "find_extended",
-]
+__all__ = list(activities.__all__)
+__all__ += common.__all__
+__all__ += data.__all__
+__all__ += expressions.__all__
+__all__ += package.__all__
+__all__ += process.__all__
+__all__ += resources.__all__
+__all__ += sisarl.__all__
