@@ -373,22 +373,19 @@ class WalkthroughApp(App[str | None]):
             self.refresh_views()
 
     def action_help(self) -> None:
-        # the clock stands still while the person reads (and resumes as it was)
-        was_paused = self.session.paused
-        self.session.paused = True
-
-        def resume(_result: None) -> None:
-            self.session.paused = was_paused
-            self.refresh_views()
-
-        self.push_screen(HelpScreen(), resume)
+        self._push_paused(HelpScreen())
 
     def action_summary(self) -> None:
         if not isinstance(self.screen, SummaryScreen):
             self._open_summary()
 
     def _open_summary(self) -> None:
-        # the clock stands still while the summary is open (and resumes as it was)
+        session = self.session
+        self._push_paused(SummaryScreen(session.summary_lines(final=session.ended)))
+
+    def _push_paused(self, screen: ModalScreen[None]) -> None:
+        """Show ``screen`` over the app: the clock stands still while the person reads it,
+        and resumes as it was when it closes."""
         was_paused = self.session.paused
         self.session.paused = True
 
@@ -396,8 +393,7 @@ class WalkthroughApp(App[str | None]):
             self.session.paused = was_paused
             self.refresh_views()
 
-        session = self.session
-        self.push_screen(SummaryScreen(session.summary_lines(final=session.ended)), resume)
+        self.push_screen(screen, resume)
 
     def action_quit_walk(self) -> None:
         self._views_ready = False

@@ -44,7 +44,7 @@ from typing import TYPE_CHECKING, Any, TypeVar
 from opspec.clock import clock_time
 from opspec.engine.compiled import K_GATEWAY, K_NOOP, CompiledPackage
 from opspec.engine.lanes import all_activities, user_lane
-from opspec.engine.performers import WorkItem
+from opspec.engine.performers import PerformerSession, WorkItem
 from opspec.engine.simulation import Simulation
 from opspec.engine.trace import TraceEvent
 from opspec.errors import ConfigurationError, ExecutionError
@@ -374,29 +374,32 @@ class WalkSession:
     @_guarded()
     def act(self, offer: Offer) -> None:
         """The person does ``offer`` now."""
-        engine = self.lane_user.engine
-        if engine is None or self.ended or self.handed_over or (
-                offer.item.key not in self.lane_user.items):
-            return
-        self.lane_user.items.pop(offer.item.key, None)
-        self._record(offer.action, by="person", item=offer.item, label=offer.label)
-        self._drop_offers(offer.item.key)
-        engine.complete(offer.item, None, offer.choice)
-        self._follow_call()
+        engine = self._take(offer, offer.action, offer.label)
+        if engine is not None:
+            engine.complete(offer.item, None, offer.choice)
+            self._follow_call()
 
     @_guarded()
     def ignore(self, offer: Offer) -> None:
         """The person explicitly does not do ``offer`` (omission)."""
+        engine = self._take(offer, tagged_action("omit", offer.item.activity,
+                                                 offer.item.instance), f"not: {offer.label}")
+        if engine is not None:
+            engine.omit(offer.item, "the person chose not to")
+            self._follow_call()
+
+    def _take(self, offer: Offer, action: str, label: str) -> PerformerSession | None:
+        """The person answers ``offer`` with ``action``: recorded and the offer withdrawn;
+        the lane's engine to tell, or None when the offer no longer stands (the run ended,
+        the lane was handed over, or it was answered already)."""
         engine = self.lane_user.engine
         if engine is None or self.ended or self.handed_over or (
                 offer.item.key not in self.lane_user.items):
-            return
+            return None
         self.lane_user.items.pop(offer.item.key, None)
-        self._record(tagged_action("omit", offer.item.activity, offer.item.instance),
-                     by="person", item=offer.item, label=f"not: {offer.label}")
+        self._record(action, by="person", item=offer.item, label=label)
         self._drop_offers(offer.item.key)
-        engine.omit(offer.item, "the person chose not to")
-        self._follow_call()
+        return engine
 
     @_guarded(False)
     def hand_over(self) -> bool:
