@@ -48,12 +48,11 @@ def check_probability(param: str, value: object) -> float:
 
 
 @dataclass(frozen=True, slots=True)
-class Omission:
-    """With ``probability`` the prompt is not noticed / the step is forgotten."""
+class _Chance:
+    """An error that happens with ``probability``, checked on construction (a number in
+    [0, 1]); the first field of each kind below."""
 
     probability: float
-    reason: str = "not noticed"
-    source: str | None = None
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "probability", check_probability("probability",
@@ -61,7 +60,15 @@ class Omission:
 
 
 @dataclass(frozen=True, slots=True)
-class Commission:
+class Omission(_Chance):
+    """With ``probability`` the prompt is not noticed / the step is forgotten."""
+
+    reason: str = "not noticed"
+    source: str | None = None
+
+
+@dataclass(frozen=True, slots=True)
+class Commission(_Chance):
     """A wrong action with ``probability``.
 
     At a choice: a wrong alternative is picked - one of ``alternatives`` (empty: every offered
@@ -71,15 +78,13 @@ class Commission:
     ``recovery`` time added to the activity's duration.
     """
 
-    probability: float
     recovery: Distribution = field(default_factory=lambda: Constant(0.0))
     alternatives: tuple[str, ...] = ()
     max_per_instance: int = 1
     source: str | None = None
 
     def __post_init__(self) -> None:
-        object.__setattr__(self, "probability", check_probability("probability",
-                                                                  self.probability))
+        _Chance.__post_init__(self)
         if (isinstance(self.max_per_instance, bool) or not isinstance(self.max_per_instance, int)
                 or self.max_per_instance < 1):
             raise ParameterError("max_per_instance",
@@ -88,28 +93,18 @@ class Commission:
 
 
 @dataclass(frozen=True, slots=True)
-class Repetition:
+class Repetition(_Chance):
     """With ``probability`` the action is done twice (a second duration is drawn)."""
 
-    probability: float
     source: str | None = None
-
-    def __post_init__(self) -> None:
-        object.__setattr__(self, "probability", check_probability("probability",
-                                                                  self.probability))
 
 
 @dataclass(frozen=True, slots=True)
-class ExtraDelay:
+class ExtraDelay(_Chance):
     """With ``probability`` the person starts late by a draw of ``duration``."""
 
-    probability: float
     duration: Distribution
     source: str | None = None
-
-    def __post_init__(self) -> None:
-        object.__setattr__(self, "probability", check_probability("probability",
-                                                                  self.probability))
 
 
 @dataclass(frozen=True, slots=True)
