@@ -31,36 +31,14 @@ lognormal, gamma, Weibull, truncated normal, exponential, ex-Gaussian),
 
 from __future__ import annotations
 
-from opspec.distributions.base import Distribution, FloatArray, ParameterError
-from opspec.distributions.bounded import Empirical, Triangular, Uniform, WithExponentialTail
-from opspec.distributions.factory import KINDS, Declared, from_model, make_distribution
-from opspec.distributions.parametric import (
-    Constant,
-    ExGaussian,
-    Exponential,
-    Gamma,
-    LogNormal,
-    TruncatedNormal,
-    Weibull,
-)
+# The public names are each module's own ``__all__``, written once there.
+from opspec.distributions import base, bounded, factory, parametric
+from opspec.distributions.base import *  # noqa: F403
+from opspec.distributions.bounded import *  # noqa: F403
+from opspec.distributions.factory import *  # noqa: F403
+from opspec.distributions.parametric import *  # noqa: F403
 
-__all__ = [
-    "KINDS",
-    "Constant",
-    "Declared",
-    "Distribution",
-    "Empirical",
-    "ExGaussian",
-    "Exponential",
-    "FloatArray",
-    "Gamma",
-    "LogNormal",
-    "ParameterError",
-    "Triangular",
-    "TruncatedNormal",
-    "Uniform",
-    "Weibull",
-    "WithExponentialTail",
-    "from_model",
-    "make_distribution",
-]
+__all__ = list(base.__all__)
+__all__ += bounded.__all__
+__all__ += factory.__all__
+__all__ += parametric.__all__

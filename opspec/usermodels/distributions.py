@@ -6,40 +6,7 @@ home: :mod:`opspec.distributions`); this module keeps the names user-model code 
 
 from __future__ import annotations
 
-from opspec.distributions import (
-    KINDS,
-    Constant,
-    Distribution,
-    Empirical,
-    ExGaussian,
-    Exponential,
-    Gamma,
-    LogNormal,
-    ParameterError,
-    Triangular,
-    TruncatedNormal,
-    Uniform,
-    Weibull,
-    WithExponentialTail,
-    from_model,
-    make_distribution,
-)
+from opspec import distributions as _family
+from opspec.distributions import *  # noqa: F403
 
-__all__ = [
-    "KINDS",
-    "Constant",
-    "Distribution",
-    "Empirical",
-    "ExGaussian",
-    "Exponential",
-    "Gamma",
-    "LogNormal",
-    "ParameterError",
-    "Triangular",
-    "TruncatedNormal",
-    "Uniform",
-    "Weibull",
-    "WithExponentialTail",
-    "from_model",
-    "make_distribution",
-]
+__all__ = list(_family.__all__)

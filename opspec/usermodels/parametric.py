@@ -3,15 +3,7 @@ family for the engine and user models); these names stay importable from here.""
 
 from __future__ import annotations
 
-from opspec.distributions.parametric import (
-    Constant,
-    ExGaussian,
-    Exponential,
-    Gamma,
-    LogNormal,
-    TruncatedNormal,
-    Weibull,
-)
+from opspec.distributions import parametric as _parametric
+from opspec.distributions.parametric import *  # noqa: F403
 
-__all__ = ["Constant", "ExGaussian", "Exponential", "Gamma", "LogNormal", "TruncatedNormal",
-           "Weibull"]
+__all__ = list(_parametric.__all__)
