@@ -24,6 +24,7 @@ bound device supplies it.
 
 from __future__ import annotations
 
+from collections.abc import Iterator
 from dataclasses import dataclass, field
 
 from lxml import etree
@@ -282,18 +283,27 @@ def _expression(element: etree._Element | None, defs: Defs, what: str) -> Expres
     return bpmn_condition(element, expression_text(element), defs, what)
 
 
+def _named(parent: etree._Element, attribute: str, kinds: tuple[str, ...], defs: Defs,
+           label: str, hint: str) -> Iterator[tuple[etree._Element, str]]:
+    """The camunda elements of ``kinds`` in ``parent``, each with its ``attribute`` (the
+    variable it sets); one without it is reported (missing-id, ``hint``) and skipped."""
+    for element in parent:
+        if not (isinstance(element.tag, str) and local(element) in kinds):
+            continue
+        name = (element.get(attribute) or "").strip()
+        if not name:
+            defs.ctx.error(element, "missing-id",
+                           f"{label}: a camunda:{local(element)} has no {attribute}", hint)
+            continue
+        yield element, name
+
+
 def _form(form: etree._Element, owner: etree._Element, defs: Defs, out: ActivityData,
           label: str) -> None:
     """``camunda:formData``: one field per ``camunda:formField`` (type and default)."""
     described: list[str] = []
-    for form_field in form:
-        if not (isinstance(form_field.tag, str) and local(form_field) == "formField"):
-            continue
-        name = (form_field.get("id") or "").strip()
-        if not name:
-            defs.ctx.error(form_field, "missing-id", f"{label}: a camunda:formField has no id",
-                           "give the form field the id of the variable it sets")
-            continue
+    for form_field, name in _named(form, "id", ("formField",), defs, label,
+                                   "give the form field the id of the variable it sets"):
         raw_type = (form_field.get("type") or "string").strip()
         kind = _FORM_TYPES.get(raw_type.lower())
         if kind is None:
@@ -349,18 +359,10 @@ def _parameters(io: etree._Element, defs: Defs, out: ActivityData, label: str,
     """``camunda:inputParameter`` (set when the activity starts) and
     ``camunda:outputParameter`` (when it ends); a connector's input parameters are the
     connector's own inputs, not process data."""
-    for parameter in io:
-        if not isinstance(parameter.tag, str):
-            continue
+    kinds = ("outputParameter",) if connector else ("inputParameter", "outputParameter")
+    for parameter, name in _named(io, "name", kinds, defs, label,
+                                  "give it the name of the variable it sets"):
         kind = local(parameter)
-        if kind not in ("inputParameter", "outputParameter") or (
-                connector and kind == "inputParameter"):
-            continue
-        name = (parameter.get("name") or "").strip()
-        if not name:
-            defs.ctx.error(parameter, "missing-id", f"{label}: a camunda:{kind} has no name",
-                           "give it the name of the variable it sets")
-            continue
         when = "Start" if kind == "inputParameter" else "End"
         out.fields.append(DataField(id=name, type=BasicType(kind=BasicKind.STRING),
                                     location=defs.loc(parameter)))

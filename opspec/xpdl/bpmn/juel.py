@@ -27,8 +27,9 @@ naming the construct (docs/bpmn.md, Scripts and conditions).
 from __future__ import annotations
 
 import re
+from collections.abc import Callable
 
-__all__ = ["from_juel"]
+__all__ = ["from_juel", "outside_strings"]
 
 _OPERATORS = {"eq": "==", "ne": "!=", "lt": "<", "gt": ">", "le": "<=", "ge": ">="}
 _STRING = r"""("(?:[^"\\]|\\.)*"|'(?:[^'\\]|\\.)*')"""
@@ -47,8 +48,6 @@ _NAME = re.compile(r"^[A-Za-z_]\w*$")
 def from_juel(text: str) -> str:
     """``text`` (the inside of ``${…}``) rewritten into opspec's condition grammar where it
     is a pure read and comparison; the rest is kept as written for the parser to refuse."""
-    parts: list[str] = []
-    last = 0
     # string literals are kept whole; the rewrites apply to what lies between them, after a
     # first pass for the constructs whose arguments are string literals
     text = _GET_VARIABLE.sub(lambda m: _variable(m.group(1)) or m.group(0), text)
@@ -56,11 +55,19 @@ def from_juel(text: str) -> str:
     text = _PROP.sub(lambda m: _property(m.group(1)) or m.group(0), text)
     text = _VALUE.sub("", text)
     text = _EQUALS.sub(r"(\1 == \2)", text)
-    for match in _STRINGS.finditer(text):
-        parts.append(_plain(text[last:match.start()]))
+    return outside_strings(text, _STRINGS, _plain)
+
+
+def outside_strings(text: str, strings: re.Pattern[str], rewrite: Callable[[str], str]) -> str:
+    """``text`` with ``rewrite`` applied to what lies between its string literals (matches of
+    ``strings``), the literals kept whole."""
+    parts: list[str] = []
+    last = 0
+    for match in strings.finditer(text):
+        parts.append(rewrite(text[last:match.start()]))
         parts.append(match.group(0))
         last = match.end()
-    parts.append(_plain(text[last:]))
+    parts.append(rewrite(text[last:]))
     return "".join(parts)
 
 

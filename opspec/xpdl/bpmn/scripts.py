@@ -33,7 +33,7 @@ from opspec.model.data import Assignment
 from opspec.model.expressions import Expression
 from opspec.xpdl.bpmn.common import Defs, is_juel
 from opspec.xpdl.bpmn.dialects import from_dialects
-from opspec.xpdl.bpmn.juel import from_juel
+from opspec.xpdl.bpmn.juel import from_juel, outside_strings
 
 __all__ = ["bpmn_condition", "construct_of", "read_script"]
 
@@ -202,14 +202,7 @@ def construct_of(text: str) -> str | None:
 
 def _is_rewrites(text: str) -> str:
     """Python's ``is not`` / ``is`` as ``!=`` / ``==`` outside strings, keeping columns."""
-    parts: list[str] = []
-    last = 0
-    for match in _STRINGS.finditer(text):
-        parts.append(_is_plain(text[last:match.start()]))
-        parts.append(match.group(0))
-        last = match.end()
-    parts.append(_is_plain(text[last:]))
-    return "".join(parts)
+    return outside_strings(text, _STRINGS, _is_plain)
 
 
 def _is_plain(text: str) -> str:
