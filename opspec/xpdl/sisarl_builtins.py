@@ -4,7 +4,8 @@
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING
+from collections.abc import Callable
+from typing import TYPE_CHECKING, TypeVar
 
 from lxml import etree
 
@@ -24,6 +25,8 @@ if TYPE_CHECKING:
     from opspec.xpdl.sisarl import Directive
 
 __all__ = ["BUILT_INS", "build_builtin", "build_metrics", "build_modes"]
+
+_T = TypeVar("_T")
 
 BUILT_INS = ("Arbiter", "Voter", "Superposition", "PushData", "PullData", "ModeChange")
 _METRICS = ("Count", "Duration", "Ratio")
@@ -160,52 +163,52 @@ def _metric(element: etree._Element, location: SourceLocation) -> MetricDefiniti
                f"use one of {', '.join('opspec:' + m for m in _METRICS)}")
 
 
-def build_metrics(directive: Directive, ctx: BuildContext) -> tuple[MetricDefinition, ...]:
+def _declarations(directive: Directive, ctx: BuildContext, build: Callable[[etree._Element], _T],
+                  key: Callable[[_T], str], code: str, noun: str, hint: str) -> tuple[_T, ...]:
+    """Each element the directive's container holds, built by ``build``; one that is bad, or
+    whose ``key`` an earlier one has already, is reported as ``code`` and left out."""
     container = _container(directive, ctx)
     if container is None:
         return ()
-    metrics: list[MetricDefinition] = []
+    built: list[_T] = []
     for element in _ours(container):
         try:
-            metric = _metric(element, ctx.loc(element))
+            item = build(element)
         except _Bad as error:
-            _report(ctx, error, "bad-metric")
+            _report(ctx, error, code)
             continue
-        if any(m.name == metric.name for m in metrics):
-            _report(ctx, _Bad(element, f"metric {metric.name!r} is declared twice",
-                              "give every metric its own Name"), "bad-metric")
+        if any(key(b) == key(item) for b in built):
+            _report(ctx, _Bad(element, f"{noun} {key(item)!r} is declared twice", hint), code)
             continue
-        metrics.append(metric)
-    return tuple(metrics)
+        built.append(item)
+    return tuple(built)
+
+
+def build_metrics(directive: Directive, ctx: BuildContext) -> tuple[MetricDefinition, ...]:
+    return _declarations(directive, ctx, lambda element: _metric(element, ctx.loc(element)),
+                         lambda metric: metric.name, "bad-metric", "metric",
+                         "give every metric its own Name")
+
+
+def _mode(element: etree._Element, ctx: BuildContext) -> WorkflowMode:
+    if _local(element) != "Mode":
+        raise _Bad(element, f"opspec:Modes may only hold opspec:Mode, not opspec:{_local(element)}",
+                   "write <opspec:Mode Id=... Workflows=.../>")
+    initial = (element.get("Initial") or "false").strip().lower()
+    if initial not in ("true", "false"):
+        raise _Bad(element, f"Initial must be true or false, not {initial!r}",
+                   "write Initial=\"true\"")
+    return WorkflowMode(id=_need(element, "Id"),
+                        workflows=tuple((element.get("Workflows") or "").split()),
+                        initial=initial == "true", source=element.get("Source"),
+                        location=ctx.loc(element))
 
 
 def build_modes(directive: Directive, ctx: BuildContext) -> tuple[WorkflowMode, ...]:
-    container = _container(directive, ctx)
-    if container is None:
-        return ()
-    modes: list[WorkflowMode] = []
-    for element in _ours(container):
-        try:
-            if _local(element) != "Mode":
-                raise _Bad(element, f"opspec:Modes may only hold opspec:Mode, not opspec:{_local(element)}",
-                           "write <opspec:Mode Id=... Workflows=.../>")
-            initial = (element.get("Initial") or "false").strip().lower()
-            if initial not in ("true", "false"):
-                raise _Bad(element, f"Initial must be true or false, not {initial!r}",
-                           "write Initial=\"true\"")
-            mode = WorkflowMode(id=_need(element, "Id"), workflows=tuple((element.get("Workflows") or "").split()),
-                        initial=initial == "true", source=element.get("Source"),
-                        location=ctx.loc(element))
-        except _Bad as error:
-            _report(ctx, error, "bad-mode")
-            continue
-        if any(m.id == mode.id for m in modes):
-            _report(ctx, _Bad(element, f"mode {mode.id!r} is declared twice", "give every mode its own Id"),
-                    "bad-mode")
-            continue
-        modes.append(mode)
+    modes = _declarations(directive, ctx, lambda element: _mode(element, ctx),
+                          lambda mode: mode.id, "bad-mode", "mode", "give every mode its own Id")
     if modes and sum(m.initial for m in modes) > 1:
         ctx.diagnostics.append(Diagnostic(directive.location, Severity.ERROR, "bad-mode",
                                           "more than one mode is Initial=\"true\"",
                                           "mark exactly one mode as initial"))
-    return tuple(modes)
+    return modes
