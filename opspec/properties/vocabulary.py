@@ -49,23 +49,7 @@ from typing import Any
 
 from opspec.engine.trace import EventKind, TraceEvent
 from opspec.errors import ConfigurationError
-from opspec.properties.language import (
-    BoundedResponse,
-    CountBound,
-    Eventually,
-    MaxCount,
-    MinGap,
-    MonitorRun,
-    Never,
-    NeverWhile,
-    Precedence,
-    Property,
-    Subject,
-    clock,
-    parse_property,
-    parse_subject,
-    trace_end,
-)
+from opspec.properties import language
 
 __all__ = [
     "Count",
@@ -108,7 +92,7 @@ class Predicate:
     def describe(self) -> str:
         raise NotImplementedError
 
-    def subjects(self) -> tuple[Subject, ...]:
+    def subjects(self) -> tuple[language.Subject, ...]:
         """Named things this predicate refers to (checked against the spec)."""
         return ()
 
@@ -129,7 +113,7 @@ class Predicate:
         a trigger, then a process), as a monitor's are."""
         return self
 
-    def monitor(self) -> Property:
+    def monitor(self) -> language.Property:
         """This predicate as a monitor, watched while a run happens: the one property it is.
         A combination (``&``, ``|``, ``~``, ``per_instance``) is judged on stored traces only:
         :class:`ConfigurationError` saying to pass its parts as separate monitors."""
@@ -160,13 +144,13 @@ class Match(Predicate):
     """A selector of events; as a predicate it means "happens at least once"."""
 
     def __init__(self, test: Callable[[TraceEvent], bool], text: str,
-                 subject: Subject | None = None, process: str | None = None) -> None:
+                 subject: language.Subject | None = None, process: str | None = None) -> None:
         self._test = test
         self.text = text
         self.subject = subject
         self.process = process
 
-    def selector(self) -> Subject | Match:
+    def selector(self) -> language.Subject | Match:
         """What a property built from this selects by: the name itself when it is one (so
         the property equals its text form's, and a monitor of it asks the engine for the
         events it needs only), else this selector."""
@@ -190,7 +174,7 @@ class Match(Predicate):
     def describe(self) -> str:
         return self.text
 
-    def subjects(self) -> tuple[Subject, ...]:
+    def subjects(self) -> tuple[language.Subject, ...]:
         return (self.subject,) if self.subject is not None else ()
 
     def processes(self) -> tuple[str, ...]:
@@ -200,19 +184,19 @@ class Match(Predicate):
         return [e for e in events if self._test(e)]
 
     def fail(self, events: Sequence[TraceEvent], end: float) -> Failure | None:
-        return _Holds(Eventually(self.selector())).fail(events, end)
+        return _Holds(language.Eventually(self.selector())).fail(events, end)
 
     def witness(self, events: Sequence[TraceEvent]) -> tuple[TraceEvent, ...]:
         return tuple(self.all(events)[:1])
 
-    def monitor(self) -> Property:
-        return Eventually(self.selector())
+    def monitor(self) -> language.Property:
+        return language.Eventually(self.selector())
 
     def __invert__(self) -> Predicate:
         return never(self)
 
 
-def _subject_match(subject: Subject) -> Match:
+def _subject_match(subject: language.Subject) -> Match:
     return Match(subject.matches, str(subject), subject)
 
 
@@ -220,7 +204,7 @@ def _as_match(what: str | Match | Callable[[TraceEvent], bool]) -> Match:
     if isinstance(what, Match):
         return what
     if isinstance(what, str):
-        return _subject_match(parse_subject(what))
+        return _subject_match(language.parse_subject(what))
     if callable(what):
         return Match(what, getattr(what, "__name__", repr(what)))
     raise TypeError(f"expected an event name, a Match or a callable, not {what!r}")
@@ -231,10 +215,10 @@ def as_predicate(what: Any) -> Predicate:
     notify_caregiver"``), or an event name (``"dispense"``: it happens)."""
     if isinstance(what, Predicate):
         return what
-    if isinstance(what, Property):
+    if isinstance(what, language.Property):
         return _Holds(what)
     if isinstance(what, str) and len(what.split()) > 1:
-        return _Holds(parse_property(what))
+        return _Holds(language.parse_property(what))
     return _as_match(what)
 
 
@@ -242,7 +226,8 @@ def _selector(kind: str, what: str, name: str, process: str | None,
               test: Callable[[TraceEvent], bool]) -> Match:
     in_process = f" in {process}" if process else ""
     return Match(lambda e: e.kind == kind and test(e) and (process is None or e.process == process),
-                 f"{what} {name} {kind.split('.')[1]}{in_process}", Subject(name, what), process)
+                 f"{what} {name} {kind.split('.')[1]}{in_process}", language.Subject(name, what),
+                 process)
 
 
 def activity_completed(name: str, *, process: str | None = None) -> Match:
@@ -279,7 +264,7 @@ def event(kind: str, *, activity: str | None = None, process: str | None = None,
 
     parts = [kind, *(x for x in (activity, process and f"in {process}") if x),
              *(f"{k}={v!r}" for k, v in data.items())]
-    subject = Subject(activity, "activity") if activity else None
+    subject = language.Subject(activity, "activity") if activity else None
     return Match(test, " ".join(parts), subject, process)
 
 
@@ -289,7 +274,7 @@ class _Holds(Predicate):
     evaluator a monitor runs online, so the verdict and the witness (the events marked in a
     failure) are the monitor's. ``label`` is how Python spelt it (``within(a, b, 60 s)``)."""
 
-    def __init__(self, prop: Property, label: str | None = None) -> None:
+    def __init__(self, prop: language.Property, label: str | None = None) -> None:
         # named by its text form as the user spelt it (a bound property spells its names
         # with their kind), so a monitor's report and assert_no_violations use that name
         self.property = prop if prop.text else replace(prop, text=prop.describe())
@@ -300,14 +285,14 @@ class _Holds(Predicate):
         """The property's text form (its name in monitor reports)."""
         return str(self.property)
 
-    def monitor(self) -> Property:
+    def monitor(self) -> language.Property:
         return self.property
 
     def __eq__(self, other: object) -> bool:
         # the same property is the same claim, however it was spelt (its text aside)
         if isinstance(other, _Holds):
             other = other.property
-        if isinstance(other, Property):
+        if isinstance(other, language.Property):
             return replace(self.property, text="") == replace(other, text="")
         return NotImplemented
 
@@ -317,10 +302,10 @@ class _Holds(Predicate):
     def describe(self) -> str:
         return self.label or str(self.property)
 
-    def subjects(self) -> tuple[Subject, ...]:
-        out: list[Subject] = []
+    def subjects(self) -> tuple[language.Subject, ...]:
+        out: list[language.Subject] = []
         for selector in self.property.subjects():
-            if isinstance(selector, Subject):
+            if isinstance(selector, language.Subject):
                 out.append(selector)
             elif isinstance(selector, Match):
                 out.extend(selector.subjects())
@@ -330,7 +315,7 @@ class _Holds(Predicate):
         return tuple(p for s in self.property.subjects() if isinstance(s, Match)
                      for p in s.processes())
 
-    def judge(self, events: Sequence[TraceEvent], end: float) -> MonitorRun:
+    def judge(self, events: Sequence[TraceEvent], end: float) -> language.MonitorRun:
         run = self.property.start()
         for e in events:
             run(e)
@@ -346,19 +331,20 @@ class _Holds(Predicate):
         return Failure((f"but {first.message}{more}",), first.events, events)
 
     def witness(self, events: Sequence[TraceEvent]) -> tuple[TraceEvent, ...]:
-        return self.judge(events, trace_end(events)).evidence()
+        return self.judge(events, language.trace_end(events)).evidence()
 
     def bind(self, names: Any) -> Predicate:
-        return _Holds(self.property._with([s.bind(names) if isinstance(s, (Subject, Match))
+        return _Holds(self.property._with([s.bind(names)
+                                           if isinstance(s, (language.Subject, Match))
                                            else s for s in self.property.subjects()]),
                       self.label)
 
     def __invert__(self) -> Predicate:
         prop = self.property
-        if isinstance(prop, Never):
-            return _Holds(Eventually(prop.subject), f"eventually({prop.subject})")
-        if isinstance(prop, Eventually):
-            return _Holds(Never(prop.subject), f"never({prop.subject})")
+        if isinstance(prop, language.Never):
+            return _Holds(language.Eventually(prop.subject), f"eventually({prop.subject})")
+        if isinstance(prop, language.Eventually):
+            return _Holds(language.Never(prop.subject), f"never({prop.subject})")
         return _Not(self)
 
 
@@ -367,7 +353,7 @@ def eventually(what: str | Match | Predicate | Callable[[TraceEvent], bool]) -> 
     if isinstance(what, Predicate) and not isinstance(what, Match):
         return what
     match = _as_match(what)
-    return _Holds(Eventually(match.selector()), f"eventually({match.describe()})")
+    return _Holds(language.Eventually(match.selector()), f"eventually({match.describe()})")
 
 
 def never(what: str | Match | Predicate | Callable[[TraceEvent], bool]) -> Predicate:
@@ -375,7 +361,7 @@ def never(what: str | Match | Predicate | Callable[[TraceEvent], bool]) -> Predi
     if isinstance(what, Predicate) and not isinstance(what, Match):
         return _Not(what)
     match = _as_match(what)
-    return _Holds(Never(match.selector()), f"never({match.describe()})")
+    return _Holds(language.Never(match.selector()), f"never({match.describe()})")
 
 
 def happens_before(a: str | Match | Callable[[TraceEvent], bool],
@@ -387,7 +373,7 @@ def happens_before(a: str | Match | Callable[[TraceEvent], bool],
     first, then = _as_match(a), _as_match(b)
     label = (f"happens_before({first.describe()}, {then.describe()}"
              f"{', each=True' if each else ''})")
-    return _Holds(Precedence(first.selector(), then.selector(), each), label)
+    return _Holds(language.Precedence(first.selector(), then.selector(), each), label)
 
 
 def within(a: str | Match | Callable[[TraceEvent], bool],
@@ -399,7 +385,7 @@ def within(a: str | Match | Callable[[TraceEvent], bool],
     if isinstance(seconds, bool) or not (isinstance(seconds, (int, float)) and seconds >= 0):
         raise ConfigurationError(f"within(): seconds must be >= 0, not {seconds!r}")
     cause, response = _as_match(a), _as_match(b)
-    return _Holds(BoundedResponse(cause.selector(), response.selector(), float(seconds)),
+    return _Holds(language.BoundedResponse(cause.selector(), response.selector(), float(seconds)),
                   f"within({cause.describe()}, {response.describe()}, {seconds:g} s)")
 
 
@@ -419,8 +405,8 @@ class Count:
         return f"count({self.match.describe()})"
 
     def _bound(self, op: str, n: object, hi: object = None) -> Predicate:
-        bound = CountBound(self.match.selector(), op, _number(n),
-                           None if hi is None else _number(hi))
+        bound = language.CountBound(self.match.selector(), op, _number(n),
+                                    None if hi is None else _number(hi))
         target = (f"between {bound.a:g} and {bound.b:g}" if op == "in"
                   else f"{op} {bound.a:g}")
         return _Holds(bound, f"count({self.match.describe()}) {target}")
@@ -485,7 +471,7 @@ class _All(Predicate):
     def describe(self) -> str:
         return " & ".join(_paren(p) for p in self.parts)
 
-    def subjects(self) -> tuple[Subject, ...]:
+    def subjects(self) -> tuple[language.Subject, ...]:
         return tuple(s for p in self.parts for s in p.subjects())
 
     def processes(self) -> tuple[str, ...]:
@@ -536,7 +522,7 @@ class _Not(Predicate):
     def describe(self) -> str:
         return f"~{_paren(self.inner)}"
 
-    def subjects(self) -> tuple[Subject, ...]:
+    def subjects(self) -> tuple[language.Subject, ...]:
         return self.inner.subjects()
 
     def processes(self) -> tuple[str, ...]:
@@ -570,7 +556,7 @@ class _PerInstance(Predicate):
     def bind(self, names: Any) -> Predicate:
         return _PerInstance(self.process, self.inner.bind(names))
 
-    def subjects(self) -> tuple[Subject, ...]:
+    def subjects(self) -> tuple[language.Subject, ...]:
         return self.inner.subjects()
 
     def processes(self) -> tuple[str, ...]:
@@ -589,7 +575,7 @@ class _PerInstance(Predicate):
             failure = self.inner.fail(own, end)
             if failure is not None:
                 head = (f"in {self.process} instance #{own[0].instance} (started "
-                        f"{clock(own[0].time)}):")
+                        f"{language.clock(own[0].time)}):")
                 return Failure((head, *failure.lines), failure.focus, own)
         return None
 
@@ -618,21 +604,22 @@ def _span_text(seconds: float) -> str:
 def monitor(text: str) -> Predicate:
     """A property from its text form (``"min_gap dispense 4h"``, any form of
     :mod:`opspec.properties.language`)."""
-    return _Holds(parse_property(text, what="monitor"))
+    return _Holds(language.parse_property(text, what="monitor"))
 
 
 def min_gap(subject: str, *, seconds: float = 0, minutes: float = 0, hours: float = 0
             ) -> Predicate:
     """No two ``subject`` closer than the given time: ``min_gap("dispense", hours=4)``."""
     gap = _seconds("min_gap", seconds, minutes, hours)
-    return _Holds(MinGap(parse_subject(subject), gap,
-                         text=f"min_gap {subject} {_span_text(gap)}"))
+    return _Holds(language.MinGap(language.parse_subject(subject), gap,
+                                  text=f"min_gap {subject} {_span_text(gap)}"))
 
 
 def never_while(subject: str, *, after: str, until: str) -> Predicate:
     """``subject`` never happens after an ``after`` and before the next ``until``."""
-    return _Holds(NeverWhile(parse_subject(subject), parse_subject(after), parse_subject(until),
-                             text=f"never_while {subject} after {after} until {until}"))
+    return _Holds(language.NeverWhile(
+        language.parse_subject(subject), language.parse_subject(after),
+        language.parse_subject(until), text=f"never_while {subject} after {after} until {until}"))
 
 
 def max_count_per(subject: str, limit: int, *, seconds: float = 0, minutes: float = 0,
@@ -642,5 +629,5 @@ def max_count_per(subject: str, limit: int, *, seconds: float = 0, minutes: floa
         raise ConfigurationError(f"max_count_per(): limit must be a whole number >= 0, "
                                  f"not {limit!r}")
     window = _seconds("max_count_per", seconds, minutes, hours)
-    return _Holds(MaxCount(parse_subject(subject), limit, window,
-                           text=f"max_count {subject} {limit} per {_span_text(window)}"))
+    return _Holds(language.MaxCount(language.parse_subject(subject), limit, window,
+                                    text=f"max_count {subject} {limit} per {_span_text(window)}"))
