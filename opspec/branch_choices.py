@@ -25,7 +25,6 @@ from typing import Any
 from opspec.errors import ConfigurationError
 from opspec.model import Package
 from opspec.model.activities import Activity, GatewayType
-from opspec.model.common import ExtendedAttribute
 from opspec.model.process import ConditionKind, Transition
 
 __all__ = ["Branches", "check_branches", "gateway_lines", "parse_branch_options",
@@ -114,7 +113,7 @@ def _apply(package: Package, name: str, given: Mapping[str, float], where: str) 
     if exclusive:
         chosen = _exclusive(out, chosen, label)
     probabilities = {t.id: chosen.get(t.id, t.probability) for t in out}
-    changed = {t.id: _with_probability(t, probabilities[t.id]) for t in out}
+    changed = {t.id: t.with_probability(probabilities[t.id]) for t in out}
     return _replace_transitions(package, process, changed)
 
 
@@ -197,14 +196,6 @@ def _named(activity: Activity) -> str:
 def _transitions(process: Any) -> list[Transition]:
     return [*process.transitions,
             *(t for s in process.activity_sets for t in s.transitions)]
-
-
-def _with_probability(transition: Transition, probability: float) -> Transition:
-    kept = tuple(e for e in transition.extended_attributes
-                 if e.name not in ("opspec:Probability", "Probability"))
-    written = ExtendedAttribute(name="opspec:Probability", value=repr(probability))
-    return dataclasses.replace(transition, probability=probability,
-                               extended_attributes=(*kept, written))
 
 
 def _replace_transitions(package: Package, process: Any, changed: Mapping[str, Transition]

@@ -2,11 +2,12 @@
 
 from __future__ import annotations
 
+import dataclasses
 import enum
 from dataclasses import dataclass
 
 from opspec.model.activities import Activity
-from opspec.model.common import Element
+from opspec.model.common import Element, ExtendedAttribute
 from opspec.model.data import Assignment, DataField, FormalParameter
 from opspec.model.expressions import Expression
 from opspec.model.resources import Application, Participant
@@ -55,6 +56,17 @@ class Transition(Element):
     assignments: tuple[Assignment, ...] = ()
     probability: float | None = None
     quantity: int = 1          # XPDL 2.1 Transition Quantity: tokens sent along it each time
+
+    def with_probability(self, probability: float, text: str | None = None) -> Transition:
+        """This flow taken with ``probability``, written as its ``opspec:Probability``
+        extended attribute (``text``, else ``repr(probability)``) in place of any earlier
+        one, so that the spec written out says what runs."""
+        kept = tuple(e for e in self.extended_attributes
+                     if e.name not in ("opspec:Probability", "Probability"))
+        written = ExtendedAttribute(name="opspec:Probability",
+                                    value=repr(probability) if text is None else text)
+        return dataclasses.replace(self, probability=probability,
+                                   extended_attributes=(*kept, written))
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)

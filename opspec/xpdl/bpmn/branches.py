@@ -11,12 +11,10 @@ and says which at the gateway's line. Every draw is a ``branch.chosen`` trace ev
 
 from __future__ import annotations
 
-import dataclasses
 from collections.abc import Iterable
 
 from lxml import etree
 
-from opspec.model.common import ExtendedAttribute
 from opspec.model.process import ConditionKind, Transition
 from opspec.xpdl.bpmn.common import Defs, local
 from opspec.xpdl.bpmn.extensions import opspec_named
@@ -50,11 +48,7 @@ def decide_undecided(nodes: Iterable[etree._Element], transitions: list[Transiti
 
 
 def with_probability(transition: Transition, probability: float) -> Transition:
-    kept = tuple(e for e in transition.extended_attributes
-                 if e.name not in ("opspec:Probability", "Probability"))
-    written = ExtendedAttribute(name="opspec:Probability", value=_number(probability))
-    return dataclasses.replace(transition, probability=probability,
-                               extended_attributes=(*kept, written))
+    return transition.with_probability(probability, _number(probability))
 
 
 def fallback_probabilities(node: etree._Element, out: list[Transition], defs: Defs,
