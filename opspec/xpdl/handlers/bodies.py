@@ -23,6 +23,7 @@ from opspec.xpdl.handlers.common import (
     attr,
     child,
     children,
+    enum_attr,
     required_attr,
     text_of,
 )
@@ -110,13 +111,8 @@ def _subflow(element: etree._Element, ctx: BuildContext) -> ActivityBody:
     process = required_attr(element, "Id", ctx, "missing-subflow-target",
                             "SubFlow names no process (its Id is missing)",
                             "set Id to the Id of the WorkflowProcess to call")
-    raw = (attr(element, "Execution") or "SYNCHR").upper()
-    try:
-        execution = Execution(raw)
-    except ValueError:
-        ctx.warning(element, "bad-execution", f"unknown SubFlow Execution {raw!r}; SYNCHR assumed",
-                    "use SYNCHR or ASYNCHR")
-        execution = Execution.SYNCHR
+    execution = enum_attr(element, "Execution", Execution.SYNCHR, ctx, "bad-execution",
+                          "SubFlow Execution", "use SYNCHR or ASYNCHR")
     return SubFlow(process=process, execution=execution,
                    actual_parameters=build_actual_parameters(element, ctx),
                    package_ref=attr(element, "PackageRef"))

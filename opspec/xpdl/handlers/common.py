@@ -7,6 +7,7 @@ Handlers run on a *normalised* tree (:mod:`opspec.xpdl.normalize`): every XPDL e
 from __future__ import annotations
 
 import copy
+import enum
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 from contextvars import ContextVar
@@ -29,6 +30,7 @@ __all__ = [
     "child_text",
     "children",
     "children_by_tag",
+    "enum_attr",
     "extended_attributes",
     "grandchildren",
     "indexed_children",
@@ -42,6 +44,7 @@ __all__ = [
 ]
 
 T = TypeVar("T")
+E = TypeVar("E", bound=enum.Enum)
 Node: TypeAlias = etree._Element
 
 
@@ -203,6 +206,22 @@ def required_attr(element: Node, name: str, ctx: BuildContext, code: str, messag
         ctx.error(element, code, message, hint)
         return ""
     return value
+
+
+def enum_attr(element: Node, name: str, default: E, ctx: BuildContext, code: str,
+              what: str, hint: str) -> E:
+    """Attribute ``name`` as a member of ``default``'s enumeration (its value upper-cased);
+    ``default`` when it is absent, and when it is unknown too, with a located ``code``
+    warning that names ``what``."""
+    raw = attr(element, name)
+    if raw is None:
+        return default
+    try:
+        return type(default)(raw.upper())
+    except ValueError:
+        ctx.warning(element, code, f"unknown {what} {raw.upper()!r}; {default.value} assumed",
+                    hint)
+        return default
 
 
 def parse_bool(text: str | None) -> bool | None:

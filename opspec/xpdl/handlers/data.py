@@ -34,6 +34,7 @@ from opspec.xpdl.handlers.common import (
     child,
     child_text,
     children,
+    enum_attr,
     grandchildren,
     parse_bool,
     parse_int,
@@ -225,13 +226,8 @@ def build_data_field(element: etree._Element, ctx: BuildContext) -> DataField:
 
 def build_formal_parameter(element: etree._Element, ctx: BuildContext) -> FormalParameter:
     fields = base_fields(element, ctx, kind="FormalParameter")
-    raw_mode = (attr(element, "Mode") or "IN").upper()
-    try:
-        mode = ParameterMode(raw_mode)
-    except ValueError:
-        ctx.warning(element, "bad-parameter-mode", f"unknown parameter Mode {raw_mode!r}; IN assumed",
-                    "use IN, OUT or INOUT")
-        mode = ParameterMode.IN
+    mode = enum_attr(element, "Mode", ParameterMode.IN, ctx, "bad-parameter-mode",
+                     "parameter Mode", "use IN, OUT or INOUT")
     return FormalParameter(
         type=build_data_type(element, ctx, "FormalParameter"),
         mode=mode,
