@@ -76,29 +76,25 @@ MODE_CHANGE_APPLICATION = "opspec.engine.mode_change"
 _STRING = BasicType(kind=BasicKind.STRING)
 _INTEGER = BasicType(kind=BasicKind.INTEGER)
 
+
+def _application(app_id: str, name: str, description: str,
+                 *parameters: tuple[str, ParameterMode]) -> Application:
+    """A built-in application whose formal parameters (name, mode) are all text."""
+    return Application(id=app_id, name=name, description=description, formal_parameters=tuple(
+        FormalParameter(id=p, type=_STRING, mode=mode) for p, mode in parameters))
+
+
+_IN, _OUT = ParameterMode.IN, ParameterMode.OUT
 # The applications the generated tasks call; added to the package when it lacks them.
 _APPLICATIONS = (
-    Application(
-        id=PUSH_APPLICATION, name="Push data to a supervisor channel",
-        description="opspec built-in: hold VALUE in CHANNEL until a receiver pulls it",
-        formal_parameters=(
-            FormalParameter(id="channel", type=_STRING, mode=ParameterMode.IN),
-            FormalParameter(id="value", type=_STRING, mode=ParameterMode.IN),
-        ),
-    ),
-    Application(
-        id=PULL_APPLICATION, name="Pull data from a supervisor channel",
-        description="opspec built-in: take the value held in CHANNEL into VALUE",
-        formal_parameters=(
-            FormalParameter(id="channel", type=_STRING, mode=ParameterMode.IN),
-            FormalParameter(id="value", type=_STRING, mode=ParameterMode.OUT),
-        ),
-    ),
-    Application(
-        id=MODE_CHANGE_APPLICATION, name="Change the device mode",
-        description="opspec built-in: switch the running workflows to those of MODE",
-        formal_parameters=(FormalParameter(id="mode", type=_STRING, mode=ParameterMode.IN),),
-    ),
+    _application(PUSH_APPLICATION, "Push data to a supervisor channel",
+                 "opspec built-in: hold VALUE in CHANNEL until a receiver pulls it",
+                 ("channel", _IN), ("value", _IN)),
+    _application(PULL_APPLICATION, "Pull data from a supervisor channel",
+                 "opspec built-in: take the value held in CHANNEL into VALUE",
+                 ("channel", _IN), ("value", _OUT)),
+    _application(MODE_CHANGE_APPLICATION, "Change the device mode",
+                 "opspec built-in: switch the running workflows to those of MODE", ("mode", _IN)),
 )
 
 
