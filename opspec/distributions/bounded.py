@@ -35,17 +35,13 @@ class Triangular(Distribution):
     kind = "triangular"
 
     def __post_init__(self) -> None:
-        low = _non_negative("low", self.low)
-        mode = _finite("mode", self.mode)
-        high = _finite("high", self.high)
+        _check_fields(self, low=_non_negative, mode=_finite, high=_finite)
+        low, mode, high = self.low, self.mode, self.high
         if not low < high:
             raise ParameterError("high", f"must be > low ({low:g}), got {high:g}")
         if not low <= mode <= high:
             raise ParameterError("mode", f"must be within [low, high] = [{low:g}, {high:g}], "
                                  f"got {mode:g}")
-        object.__setattr__(self, "low", low)
-        object.__setattr__(self, "mode", mode)
-        object.__setattr__(self, "high", high)
 
     def sample(self, rng: np.random.Generator) -> float:
         return self.quantile(float(rng.random()))
@@ -97,12 +93,10 @@ class Uniform(Distribution):
     kind = "uniform"
 
     def __post_init__(self) -> None:
-        low = _non_negative("low", self.low)
-        high = _finite("high", self.high)
-        if not low < high or math.isinf(high):
-            raise ParameterError("high", f"must be finite and > low ({low:g}), got {high:g}")
-        object.__setattr__(self, "low", low)
-        object.__setattr__(self, "high", high)
+        _check_fields(self, low=_non_negative, high=_finite)
+        if not self.low < self.high or math.isinf(self.high):
+            raise ParameterError("high", f"must be finite and > low ({self.low:g}), got "
+                                 f"{self.high:g}")
 
     def sample(self, rng: np.random.Generator) -> float:
         return self.low + (self.high - self.low) * float(rng.random())

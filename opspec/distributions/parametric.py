@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, Self
 
 import numpy as np
 
@@ -123,15 +123,25 @@ class LogNormal(Distribution):
 
 
 @dataclass(frozen=True, slots=True)
-class Gamma(Distribution):
-    """Gamma with ``shape`` k and ``scale`` θ (mean kθ). numpy's gamma sampler per draw."""
+class _ShapeScale(Distribution):
+    """A family of a ``shape`` and a ``scale``, both > 0; ``factor * X`` is the same shape
+    with the scale times ``factor``."""
 
     shape: float
     scale: float
-    kind = "gamma"
 
     def __post_init__(self) -> None:
         _check_fields(self, shape=_positive, scale=_positive)
+
+    def scaled(self, factor: float) -> Self:
+        return type(self)(self.shape, self.scale * _positive("factor", factor))
+
+
+@dataclass(frozen=True, slots=True)
+class Gamma(_ShapeScale):
+    """Gamma with ``shape`` k and ``scale`` θ (mean kθ). numpy's gamma sampler per draw."""
+
+    kind = "gamma"
 
     def sample(self, rng: np.random.Generator) -> float:
         return float(rng.gamma(self.shape, self.scale))
@@ -157,20 +167,12 @@ class Gamma(Distribution):
 
         return float(special.gammaincinv(self.shape, _check_q(q))) * self.scale
 
-    def scaled(self, factor: float) -> Gamma:
-        return Gamma(self.shape, self.scale * _positive("factor", factor))
-
 
 @dataclass(frozen=True, slots=True)
-class Weibull(Distribution):
+class Weibull(_ShapeScale):
     """Weibull with ``shape`` k and ``scale`` λ. One numpy Weibull draw per sample."""
 
-    shape: float
-    scale: float
     kind = "weibull"
-
-    def __post_init__(self) -> None:
-        _check_fields(self, shape=_positive, scale=_positive)
 
     def sample(self, rng: np.random.Generator) -> float:
         return self.scale * float(rng.weibull(self.shape))
@@ -193,9 +195,6 @@ class Weibull(Distribution):
     def quantile(self, q: float) -> float:
         _check_q(q)
         return math.inf if q == 1.0 else self.scale * (-math.log1p(-q)) ** (1.0 / self.shape)
-
-    def scaled(self, factor: float) -> Weibull:
-        return Weibull(self.shape, self.scale * _positive("factor", factor))
 
 
 @dataclass(frozen=True, slots=True)
