@@ -113,6 +113,21 @@ def people_of(package: Any, user_participants: Iterable[str],
 _INT_RANGE = (-(2**63), 2**63 - 1)
 
 
+def _attributes(values: Mapping[str, Any], declared: dict[str, str],
+                **extra: Any) -> list[dict[str, Any]]:
+    """The OCEL attribute entries of the ``values`` that are set (with ``extra`` keys, such as
+    an object attribute's time), each one's type added to ``declared`` (the first seen
+    stays)."""
+    entries = []
+    for name, value in values.items():
+        if value is None:
+            continue
+        kind_of, json_value = _typed(value)
+        declared.setdefault(name, kind_of)
+        entries.append({"name": name, **extra, "value": json_value})
+    return entries
+
+
 def _typed(value: Any) -> tuple[str, Any]:
     """(OCEL attribute type, JSON value) of a Python value."""
     if isinstance(value, bool):
@@ -171,13 +186,7 @@ class OcelWriter(_StreamingWriter):
                 relationships: Iterable[tuple[str, str]] = ()) -> None:
         stamp = self.epoch.isoformat(timespec="milliseconds")
         declared = self._object_types.setdefault(kind, {})
-        attrs = []
-        for name, value in attributes.items():
-            if value is None:
-                continue
-            kind_of, json_value = _typed(value)
-            declared.setdefault(name, kind_of)
-            attrs.append({"name": name, "time": stamp, "value": json_value})
+        attrs = _attributes(attributes, declared, time=stamp)
         doc = {"id": oid, "type": kind, "attributes": attrs,
                "relationships": [{"objectId": o, "qualifier": q} for o, q in relationships]}
         assert self._objects_file is not None
@@ -267,13 +276,7 @@ class OcelWriter(_StreamingWriter):
             values["org:group"] = self._lanes.get(event.lane, event.lane)
         for key, value in (event.data or {}).items():
             values[f"opspec:{key}"] = value
-        attrs = []
-        for key, value in values.items():
-            if value is None:
-                continue
-            kind_of, json_value = _typed(value)
-            declared.setdefault(key, kind_of)
-            attrs.append({"name": key, "value": json_value})
+        attrs = _attributes(values, declared)
         self._ids += 1
         doc = {"id": f"e{self._ids}", "type": kind,
                "time": (self.epoch + timedelta(seconds=float(event.time))).isoformat(
