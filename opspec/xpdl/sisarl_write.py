@@ -7,8 +7,11 @@ value with :mod:`opspec.xpdl.sisarl_values` (the writer tests check it).
 
 from __future__ import annotations
 
+import dataclasses
 import math
+from collections.abc import Callable
 from decimal import Decimal
+from typing import Any
 from xml.sax.saxutils import quoteattr
 
 from opspec.clock import time_of_day
@@ -134,52 +137,43 @@ def _attr_xml(local: str, attributes: dict[str, str | None], children: str = "")
     return f"<opspec:{local}{attrs}>{children}</opspec:{local}>"
 
 
+# What each directive field is written as: (field, opspec: name, its text), in the order the
+# writer puts them; a process's and an activity's directives each have some of these fields.
+_DIRECTIVES: tuple[tuple[str, str, Callable[[Any], str]], ...] = (
+    ("period", "Period", duration_text),
+    ("priority", "Priority", str),
+    ("deadline", "Deadline", duration_text),
+    ("auto_run", "AutoRun", _bool),
+    ("priority_increment", "PriorityIncrement", str),
+    ("start_trigger", "StartTrigger", trigger_text),
+    ("end_trigger", "EndTrigger", trigger_text),
+    ("auto_start", "AutoStart", _bool),
+    ("lane", "Lane", str),
+    ("mode", "Mode", str),
+    ("arrival", "Arrival", distribution_text),
+    ("arrival_count", "ArrivalCount", str),
+    ("raises", "Raises", trigger_text),
+    ("cpu_demand", "CpuDemand", duration_text),
+    ("cpu_distribution", "CpuDemand", distribution_text),
+    ("duration", "Duration", distribution_text),
+)
+
+
+def _stated(directives: ProcessDirectives | ActivityDirectives) -> list[ExtendedAttribute]:
+    """The ``opspec:`` extended attributes of the directives that differ from their default."""
+    defaults = {f.name: f.default for f in dataclasses.fields(directives)}
+    return [_ea(name, text(getattr(directives, field))) for field, name, text in _DIRECTIVES
+            if field in defaults and getattr(directives, field) != defaults[field]]
+
+
 def process_directive_attributes(directives: ProcessDirectives) -> list[ExtendedAttribute]:
     """The ``opspec:`` extended attributes that state ``directives`` (defaults left out)."""
-    out: list[ExtendedAttribute] = []
-    if directives.period is not None:
-        out.append(_ea("Period", duration_text(directives.period)))
-    if directives.priority is not None:
-        out.append(_ea("Priority", str(directives.priority)))
-    if directives.deadline is not None:
-        out.append(_ea("Deadline", duration_text(directives.deadline)))
-    if directives.start_trigger is not None:
-        out.append(_ea("StartTrigger", trigger_text(directives.start_trigger)))
-    if directives.end_trigger is not None:
-        out.append(_ea("EndTrigger", trigger_text(directives.end_trigger)))
-    if directives.auto_start is not None:
-        out.append(_ea("AutoStart", _bool(directives.auto_start)))
-    if directives.lane is not None:
-        out.append(_ea("Lane", directives.lane))
-    if directives.mode is not None:
-        out.append(_ea("Mode", directives.mode))
-    if directives.arrival is not None:
-        out.append(_ea("Arrival", distribution_text(directives.arrival)))
-    if directives.arrival_count is not None:
-        out.append(_ea("ArrivalCount", str(directives.arrival_count)))
-    return out
+    return _stated(directives)
 
 
 def activity_directive_attributes(directives: ActivityDirectives) -> list[ExtendedAttribute]:
     """The ``opspec:`` extended attributes that state activity ``directives``."""
-    out: list[ExtendedAttribute] = []
-    if directives.auto_run is not None:
-        out.append(_ea("AutoRun", _bool(directives.auto_run)))
-    if directives.priority_increment:
-        out.append(_ea("PriorityIncrement", str(directives.priority_increment)))
-    if directives.start_trigger is not None:
-        out.append(_ea("StartTrigger", trigger_text(directives.start_trigger)))
-    if directives.end_trigger is not None:
-        out.append(_ea("EndTrigger", trigger_text(directives.end_trigger)))
-    if directives.raises is not None:
-        out.append(_ea("Raises", trigger_text(directives.raises)))
-    if directives.cpu_demand is not None:
-        out.append(_ea("CpuDemand", duration_text(directives.cpu_demand)))
-    if directives.cpu_distribution is not None:
-        out.append(_ea("CpuDemand", distribution_text(directives.cpu_distribution)))
-    if directives.duration is not None:
-        out.append(_ea("Duration", distribution_text(directives.duration)))
-    return out
+    return _stated(directives)
 
 
 def builtin_attribute(builtin: CoordinationBuiltIn) -> ExtendedAttribute:
