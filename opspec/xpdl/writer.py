@@ -21,7 +21,8 @@ from __future__ import annotations
 
 import dataclasses
 import re
-from collections.abc import Iterable
+from collections.abc import Iterable, Iterator, Sequence
+from typing import TypeVar
 
 from lxml import etree
 
@@ -89,6 +90,8 @@ __all__ = [
     "write_xpdl",
 ]
 
+T = TypeVar("T")
+
 XPDL21 = "http://www.wfmc.org/2008/XPDL2.1"
 XPDL10 = "http://www.wfmc.org/2002/XPDL1.0"
 OPSPEC = "urn:opspec:sisarl:1"
@@ -107,6 +110,17 @@ def _sub(parent: etree._Element, local: str, text: str | None = None, **attrs: s
     if text is not None:
         element.text = text
     return element
+
+
+def _each(parent: etree._Element, wrapper: str,
+          items: Sequence[T]) -> Iterator[tuple[etree._Element, T]]:
+    """Each of ``items`` with the ``wrapper`` element written for them (XPDL's
+    ``<DataFields>``, ``<Transitions>``…); no wrapper at all when there are none."""
+    if not items:
+        return
+    container = _sub(parent, wrapper)
+    for item in items:
+        yield container, item
 
 
 def _bool(value: bool) -> str:
@@ -136,10 +150,7 @@ def _append_raw_xml(element: etree._Element, raw_xml: str) -> None:
 
 def _write_extended(parent: etree._Element, attributes: Iterable[ExtendedAttribute]) -> None:
     attributes = list(attributes)
-    if not attributes:
-        return
-    container = _sub(parent, "ExtendedAttributes")
-    for attribute in attributes:
+    for container, attribute in _each(parent, "ExtendedAttributes", attributes):
         element = _sub(container, "ExtendedAttribute", Name=attribute.name, Value=attribute.value)
         if attribute.text is not None:
             element.text = attribute.text
@@ -190,10 +201,7 @@ def _write_data_type(parent: etree._Element, data_type: DataType) -> None:
 
 
 def _write_data_fields(parent: etree._Element, fields: tuple[DataField, ...]) -> None:
-    if not fields:
-        return
-    container = _sub(parent, "DataFields")
-    for field in fields:
+    for container, field in _each(parent, "DataFields", fields):
         element = _sub(container, "DataField", Id=field.id, Name=field.name,
                        ReadOnly=_bool(True) if field.read_only else None,
                        IsArray=_bool(True) if field.is_array else None,
@@ -209,10 +217,7 @@ def _write_data_fields(parent: etree._Element, fields: tuple[DataField, ...]) ->
 
 
 def _write_formal_parameters(parent: etree._Element, parameters: tuple[FormalParameter, ...]) -> None:
-    if not parameters:
-        return
-    container = _sub(parent, "FormalParameters")
-    for parameter in parameters:
+    for container, parameter in _each(parent, "FormalParameters", parameters):
         element = _sub(container, "FormalParameter", Id=parameter.id, Mode=parameter.mode.value,
                        Name=parameter.name,
                        Required=_bool(True) if parameter.required else None,
@@ -223,10 +228,7 @@ def _write_formal_parameters(parent: etree._Element, parameters: tuple[FormalPar
 
 
 def _write_actual_parameters(parent: etree._Element, parameters: tuple[ActualParameter, ...]) -> None:
-    if not parameters:
-        return
-    container = _sub(parent, "ActualParameters")
-    for parameter in parameters:
+    for container, parameter in _each(parent, "ActualParameters", parameters):
         text = parameter.text
         if not text and parameter.expression is not None:
             text = expression_text(parameter.expression)
@@ -234,10 +236,7 @@ def _write_actual_parameters(parent: etree._Element, parameters: tuple[ActualPar
 
 
 def _write_assignments(parent: etree._Element, assignments: tuple[Assignment, ...]) -> None:
-    if not assignments:
-        return
-    container = _sub(parent, "Assignments")
-    for assignment in assignments:
+    for container, assignment in _each(parent, "Assignments", assignments):
         element = _sub(container, "Assignment", AssignTime=assignment.assign_time)
         _sub(element, "Target", assignment.target)
         text = assignment.text
@@ -250,10 +249,7 @@ def _write_assignments(parent: etree._Element, assignments: tuple[Assignment, ..
 
 
 def _write_participants(parent: etree._Element, participants: tuple[Participant, ...]) -> None:
-    if not participants:
-        return
-    container = _sub(parent, "Participants")
-    for participant in participants:
+    for container, participant in _each(parent, "Participants", participants):
         element = _sub(container, "Participant", Id=participant.id, Name=participant.name)
         _sub(element, "ParticipantType", Type=participant.type.value)
         if participant.description is not None:
@@ -265,10 +261,7 @@ _APPLICATION_TYPES = {"Script", "Xslt", "Form"}  # the XPDL 2.1 types with no re
 
 
 def _write_applications(parent: etree._Element, applications: tuple[Application, ...]) -> None:
-    if not applications:
-        return
-    container = _sub(parent, "Applications")
-    for application in applications:
+    for container, application in _each(parent, "Applications", applications):
         element = _sub(container, "Application", Id=application.id, Name=application.name)
         if application.description is not None:
             _sub(element, "Description", application.description)
@@ -289,10 +282,7 @@ def _flatten_lanes(lanes: tuple[Lane, ...]) -> list[Lane]:
 
 
 def _write_pools(parent: etree._Element, pools: tuple[Pool, ...]) -> None:
-    if not pools:
-        return
-    container = _sub(parent, "Pools")
-    for pool in pools:
+    for container, pool in _each(parent, "Pools", pools):
         element = _sub(container, "Pool", Id=pool.id, Name=pool.name, Process=pool.process,
                        Participant=pool.participant, BoundaryVisible=_bool(pool.boundary_visible))
         if pool.lanes:
@@ -553,10 +543,7 @@ def _condition_text(condition: Condition) -> str | None:
 
 
 def _write_transitions(parent: etree._Element, transitions: tuple[Transition, ...]) -> None:
-    if not transitions:
-        return
-    container = _sub(parent, "Transitions")
-    for transition in transitions:
+    for container, transition in _each(parent, "Transitions", transitions):
         element = _sub(container, "Transition", Id=transition.id, From=transition.source,
                        To=transition.target, Name=transition.name)
         if transition.quantity != 1:
@@ -582,19 +569,13 @@ def _write_transitions(parent: etree._Element, transitions: tuple[Transition, ..
 
 def _write_activities(parent: etree._Element, activities: tuple[Activity, ...],
                       script_language: str | None) -> None:
-    if not activities:
-        return
-    container = _sub(parent, "Activities")
-    for activity in activities:
+    for container, activity in _each(parent, "Activities", activities):
         _write_activity(container, activity, script_language)
 
 
 def _write_activity_sets(parent: etree._Element, sets: tuple[ActivitySet, ...],
                          script_language: str | None) -> None:
-    if not sets:
-        return
-    container = _sub(parent, "ActivitySets")
-    for activity_set in sets:
+    for container, activity_set in _each(parent, "ActivitySets", sets):
         completion = activity_set.completion_condition_text
         if completion is None and activity_set.completion_condition is not None:
             completion = expression_text(activity_set.completion_condition)
