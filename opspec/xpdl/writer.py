@@ -227,22 +227,23 @@ def _write_formal_parameters(parent: etree._Element, parameters: tuple[FormalPar
             _sub(element, "Description", parameter.description)
 
 
+def _as_written(value: ActualParameter | Assignment) -> str | None:
+    """An expression's text as the spec wrote it, else as opspec prints the parsed one."""
+    if not value.text and value.expression is not None:
+        return expression_text(value.expression)
+    return value.text
+
+
 def _write_actual_parameters(parent: etree._Element, parameters: tuple[ActualParameter, ...]) -> None:
     for container, parameter in _each(parent, "ActualParameters", parameters):
-        text = parameter.text
-        if not text and parameter.expression is not None:
-            text = expression_text(parameter.expression)
-        _sub(container, "ActualParameter", text)
+        _sub(container, "ActualParameter", _as_written(parameter))
 
 
 def _write_assignments(parent: etree._Element, assignments: tuple[Assignment, ...]) -> None:
     for container, assignment in _each(parent, "Assignments", assignments):
         element = _sub(container, "Assignment", AssignTime=assignment.assign_time)
         _sub(element, "Target", assignment.target)
-        text = assignment.text
-        if not text and assignment.expression is not None:
-            text = expression_text(assignment.expression)
-        _sub(element, "Expression", text)
+        _sub(element, "Expression", _as_written(assignment))
 
 
 # --------------------------------------------------------------------------- resources
