@@ -2,11 +2,13 @@
 
 from __future__ import annotations
 
+from collections.abc import Iterable
 from dataclasses import dataclass, field
+from typing import TypeVar
 
 from opspec.errors import SourceLocation
 
-__all__ = ["Element", "ExtendedAttribute", "find_extended"]
+__all__ = ["Element", "ExtendedAttribute", "find_by_id", "find_extended"]
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
@@ -48,4 +50,15 @@ def find_extended(
     for attribute in attributes:
         if attribute.name == name:
             return attribute
+    return None
+
+
+_E = TypeVar("_E", bound=Element)
+
+
+def find_by_id(elements: Iterable[_E], element_id: str) -> _E | None:
+    """The first of ``elements`` whose id is ``element_id``, or None."""
+    for element in elements:
+        if element.id == element_id:
+            return element
     return None

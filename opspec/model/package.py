@@ -6,7 +6,7 @@ import enum
 from dataclasses import dataclass
 
 from opspec.model.activities import Activity, ActivityBody, NoImplementation
-from opspec.model.common import Element
+from opspec.model.common import Element, find_by_id
 from opspec.model.data import DataField, TypeDeclaration
 from opspec.model.process import WorkflowProcess
 from opspec.model.resources import Application, Participant, ParticipantType, Pool
@@ -84,16 +84,10 @@ class Package(Element):
         return self.header.source_format or f"XPDL {self.version.value}"
 
     def process(self, process_id: str) -> WorkflowProcess | None:
-        for process in self.processes:
-            if process.id == process_id:
-                return process
-        return None
+        return find_by_id(self.processes, process_id)
 
     def participant(self, participant_id: str) -> Participant | None:
-        for participant in self.participants:
-            if participant.id == participant_id:
-                return participant
-        return None
+        return find_by_id(self.participants, participant_id)
 
     def is_manual_work(self, activity: Activity, process: WorkflowProcess | None = None,
                        body: ActivityBody | None = None) -> bool:
@@ -118,7 +112,4 @@ class Package(Element):
         return participant is not None and participant.type in _PERSONS
 
     def application(self, application_id: str) -> Application | None:
-        for application in self.applications:
-            if application.id == application_id:
-                return application
-        return None
+        return find_by_id(self.applications, application_id)

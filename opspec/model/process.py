@@ -7,7 +7,7 @@ import enum
 from dataclasses import dataclass
 
 from opspec.model.activities import Activity
-from opspec.model.common import Element, ExtendedAttribute
+from opspec.model.common import Element, ExtendedAttribute, find_by_id
 from opspec.model.data import Assignment, DataField, FormalParameter
 from opspec.model.expressions import Expression
 from opspec.model.resources import Application, Participant
@@ -83,10 +83,7 @@ class ActivitySet(Element):
     completion_condition_text: str | None = None
 
     def activity(self, activity_id: str) -> Activity | None:
-        for activity in self.activities:
-            if activity.id == activity_id:
-                return activity
-        return None
+        return find_by_id(self.activities, activity_id)
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
@@ -120,16 +117,10 @@ class WorkflowProcess(Element):
 
     def activity(self, activity_id: str) -> Activity | None:
         """The top-level activity with this id (activity-set members are not searched)."""
-        for activity in self.activities:
-            if activity.id == activity_id:
-                return activity
-        return None
+        return find_by_id(self.activities, activity_id)
 
     def activity_set(self, set_id: str) -> ActivitySet | None:
-        for activity_set in self.activity_sets:
-            if activity_set.id == set_id:
-                return activity_set
-        return None
+        return find_by_id(self.activity_sets, set_id)
 
     def all_activities(self) -> tuple[Activity, ...]:
         """Top-level activities followed by those of every activity set."""
