@@ -24,9 +24,10 @@ def command(subparsers: Any, name: str, doc: str | None) -> argparse.ArgumentPar
     description."""
     text = inspect.cleandoc(doc or "")
     summary = " ".join(text.split("\n\n", 1)[0].split()).removesuffix(".")
-    return subparsers.add_parser(name, help=summary[:1].lower() + summary[1:],
-                                 description=text,
-                                 formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser: argparse.ArgumentParser = subparsers.add_parser(
+        name, help=summary[:1].lower() + summary[1:], description=text,
+        formatter_class=argparse.RawDescriptionHelpFormatter)
+    return parser
 
 
 def add_spec(parser: argparse.ArgumentParser, *, optional: str = "") -> None:

@@ -18,7 +18,12 @@ __all__ = ["register"]
 
 def register(subparsers: Any) -> None:
     parser = command(subparsers, "devices", __doc__)
-    parser.set_defaults(handler=lambda args: (parser.print_help(), 2)[1])
+
+    def usage(_args: argparse.Namespace) -> int:      # no ACTION: the actions, status 2
+        parser.print_help()
+        return 2
+
+    parser.set_defaults(handler=usage)
     sub = parser.add_subparsers(dest="devices_command", metavar="ACTION")
 
     listing = sub.add_parser("list", help="show serial ports and which profiles match them")

@@ -38,7 +38,8 @@ from opspec.distributions.bounded import *  # noqa: F403
 from opspec.distributions.factory import *  # noqa: F403
 from opspec.distributions.parametric import *  # noqa: F403
 
-__all__ = list(base.__all__)
+__all__: list[str] = []
+__all__ += base.__all__
 __all__ += bounded.__all__
 __all__ += factory.__all__
 __all__ += parametric.__all__

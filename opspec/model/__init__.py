@@ -15,7 +15,8 @@ from opspec.model.process import *  # noqa: F403
 from opspec.model.resources import *  # noqa: F403
 from opspec.model.sisarl import *  # noqa: F403
 
-__all__ = list(activities.__all__)
+__all__: list[str] = []
+__all__ += activities.__all__
 __all__ += common.__all__
 __all__ += data.__all__
 __all__ += expressions.__all__

@@ -6,7 +6,40 @@ home: :mod:`opspec.distributions`); this module keeps the names user-model code 
 
 from __future__ import annotations
 
-from opspec import distributions as _family
-from opspec.distributions import *  # noqa: F403
+from opspec.distributions import (
+    KINDS,
+    Constant,
+    Distribution,
+    Empirical,
+    ExGaussian,
+    Exponential,
+    Gamma,
+    LogNormal,
+    ParameterError,
+    Triangular,
+    TruncatedNormal,
+    Uniform,
+    Weibull,
+    WithExponentialTail,
+    from_model,
+    make_distribution,
+)
 
-__all__ = list(_family.__all__)
+__all__ = [
+    "KINDS",
+    "Constant",
+    "Distribution",
+    "Empirical",
+    "ExGaussian",
+    "Exponential",
+    "Gamma",
+    "LogNormal",
+    "ParameterError",
+    "Triangular",
+    "TruncatedNormal",
+    "Uniform",
+    "Weibull",
+    "WithExponentialTail",
+    "from_model",
+    "make_distribution",
+]

@@ -6,4 +6,5 @@ from __future__ import annotations
 from opspec.distributions import parametric as _parametric
 from opspec.distributions.parametric import *  # noqa: F403
 
-__all__ = list(_parametric.__all__)
+__all__: list[str] = []
+__all__ += _parametric.__all__
