@@ -1,0 +1,55 @@
+"""Each command's ``--help`` is its documentation, written once: the description is the command
+module's docstring and the line ``opspec --help`` lists is that docstring's first sentence
+(as click does); an option several commands take reads the same in each."""
+
+from __future__ import annotations
+
+import importlib
+import inspect
+
+import pytest
+
+from opspec.cli import COMMAND_MODULES, _subparsers, build_parser
+
+
+def _commands() -> dict[str, tuple[object, object]]:
+    parsers = _subparsers(build_parser())
+    out = {}
+    for module_name in COMMAND_MODULES:
+        module = importlib.import_module(module_name)
+        name = module_name.rsplit(".", 1)[-1].replace("_", "-")
+        out[name] = (module, parsers[name])
+    return out
+
+
+@pytest.mark.parametrize("name", sorted(_commands()))
+def test_the_description_is_the_module_docstring(name):
+    module, parser = _commands()[name]
+    assert parser.description == inspect.cleandoc(module.__doc__)
+    summary = " ".join(parser.description.split("\n\n")[0].split()).removesuffix(".")
+    listed = build_parser().format_help()
+    assert " ".join(listed.split()).find(summary[:1].lower() + summary[1:60]) >= 0
+
+
+def _help_of(parser, option: str) -> str | None:
+    for action in parser._actions:
+        if option in action.option_strings:
+            return action.help
+    return None
+
+
+def test_days_says_the_same_default_wherever_a_spec_is_run():
+    texts = {name: _help_of(parser, "--days") for name, (_, parser) in _commands().items()}
+    texts = {name: text for name, text in texts.items() if text is not None}
+    assert {"run", "evaluate", "walkthrough", "fit", "model-check"} <= set(texts)
+    for text in texts.values():
+        assert text.endswith("(default: the spec's opspec:RunLength if it declares one, else 1)")
+
+
+def test_every_seed_is_checked_by_the_one_seed_rule(capsys):
+    for command in (["run", "x.xpdl"], ["fit", "t.jsonl", "-o", "m.toml"],
+                    ["model-check", "m.toml", "t.jsonl"]):
+        with pytest.raises(SystemExit) as exit_:
+            build_parser().parse_args([*command, "--seed", "-1"])
+        assert exit_.value.code == 2
+        assert "a seed is a whole number from 0 to 2**63 - 1" in capsys.readouterr().err
