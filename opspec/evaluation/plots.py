@@ -66,9 +66,11 @@ FORMATS = ("svg", "pdf", "png")
 #: The format :func:`figure_format` chose; None: the one ``path``'s suffix names (PNG for an
 #: unknown suffix).
 _FORMAT: ContextVar[str | None] = ContextVar("opspec_figure_format", default=None)
+#: A figure asked for within :func:`drawn_by`: the figure function (undecorated), its
+#: arguments and the format it is to be written in.
+_Job = tuple[Any, tuple[Any, ...], dict[str, Any], str | None]
 #: Within :func:`drawn_by`: the figures asked for, drawn at the block's end.
-_QUEUE: ContextVar[list[tuple[str, tuple[Any, ...], dict[str, Any], str | None]] | None] = \
-    ContextVar("opspec_figure_queue", default=None)
+_QUEUE: ContextVar[list[_Job] | None] = ContextVar("opspec_figure_queue", default=None)
 
 #: Okabe & Ito (2008), "Color Universal Design": safe for deuteranopia, protanopia, tritanopia.
 PALETTE: tuple[str, ...] = (
@@ -130,10 +132,13 @@ def drawn_by(workers: int) -> Iterator[None]:
     """Within this block, the figure functions return the path they will write at once and
     the figures are drawn at the block's end, by up to ``workers`` processes side by side
     (each figure is independent of the others; the same bytes as drawn one after another).
-    With one worker, or one figure, they are drawn here, one after another. ``opspec
+    With one worker they are drawn as they are asked for (nothing queued). ``opspec
     evaluate --workers W`` draws its report's figures so: what runs after the replications
     runs on one core otherwise, and with two workers it was most of the wall time saved."""
-    queue: list[tuple[str, tuple[Any, ...], dict[str, Any], str | None]] = []
+    if workers <= 1:                # drawn as they are asked for, as without this block
+        yield
+        return
+    queue: list[_Job] = []
     token = _QUEUE.set(queue)
     try:
         yield
@@ -142,8 +147,7 @@ def drawn_by(workers: int) -> Iterator[None]:
     _draw(queue, workers)
 
 
-def _draw(queue: Sequence[tuple[str, tuple[Any, ...], dict[str, Any], str | None]],
-          workers: int) -> None:
+def _draw(queue: Sequence[_Job], workers: int) -> None:
     global _JOBS
     if workers > 1 and len(queue) > 1:
         import concurrent.futures as cf
@@ -171,16 +175,15 @@ def _draw(queue: Sequence[tuple[str, tuple[Any, ...], dict[str, Any], str | None
 
 
 #: The queue :func:`_draw` hands to the processes it forks.
-_JOBS: Sequence[tuple[str, tuple[Any, ...], dict[str, Any], str | None]] = ()
+_JOBS: Sequence[_Job] = ()
 
 
 def _draw_job(index: int) -> None:
     _draw_one(_JOBS[index])
 
 
-def _draw_one(job: tuple[str, tuple[Any, ...], dict[str, Any], str | None]) -> None:
-    name, args, kwargs, fmt = job
-    draw = globals()[name].__wrapped__
+def _draw_one(job: _Job) -> None:
+    draw, args, kwargs, fmt = job
     if fmt is None:
         draw(*args, **kwargs)
         return
@@ -211,7 +214,7 @@ def _queueable(draw: _Draw) -> _Draw:
         queue = _QUEUE.get()
         if queue is None:
             return draw(*args, **kwargs)
-        queue.append((draw.__name__, args, kwargs, _FORMAT.get()))
+        queue.append((draw, args, kwargs, _FORMAT.get()))
         path, fmt = _written(signature.bind(*args, **kwargs).arguments["path"])
         return path.with_suffix(".svg") if fmt == "pdf" else path
 
