@@ -495,9 +495,11 @@ def run(args: argparse.Namespace) -> int:
             summaries["sweep"] = summarise_sweep(store, swept, plan.days, args.target,
                                                  args.target_users)
         try:
+            # the figures drawn side by side on this machine's cores, as the users were
             report = write_report(store, summaries,
                                   template=getattr(args, "report_template", None),
-                                  figures=getattr(args, "figures", "svg"))
+                                  figures=getattr(args, "figures", "svg"),
+                                  workers=min(workers, _local_cores()))
         except EvaluationError as error:
             raise _with_resume_hint(error, store, plan) from None
         except OSError as error:

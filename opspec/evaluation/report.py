@@ -450,15 +450,21 @@ def _design_sections(store: ResultStore, figures: Path, design: str, name: str, 
     # how users differ: each user's own value
     spread = per_user_rows(metrics)
     if spread:
-        series: dict[str, list[float]] = {}
+        series: dict[str, Any] = {}
         units: dict[str, str] = {}
         shown = [d for d in definitions
                  if (s := metrics.get(d["name"])) is not None and s["kind"] != "count"
                  and (s.get("per_user") or {}).get("users")]
         by_metric = user_values(store, design, shown).pairs
+        import numpy as np
+
         for d in shown:
             s = metrics[d["name"]]
-            values = [y / k for y, k in by_metric[d["name"]] if k > 0]
+            # each user's y / k as an array of doubles, not a list of float objects (a
+            # fifth of the memory: the figure holds every metric's at once)
+            pairs = by_metric[d["name"]]
+            y, k = np.frombuffer(pairs.y, dtype=float), np.frombuffer(pairs.n, dtype=float)
+            values = y[k > 0] / k[k > 0]
             label = (f"{metric_label(d['name'], s)}, mean per user"
                      if s["kind"] == "duration" else metric_label(d["name"], s))
             series[label] = values
@@ -620,25 +626,31 @@ def _methods_section(summaries: Any, sections: Sequence[Any]) -> Any:
 
 
 def write_report(store: ResultStore, summaries: Mapping[str, Summaries] | None = None, *,
-                 template: str | Path | None = None, figures: str = "svg") -> Path:
+                 template: str | Path | None = None, figures: str = "svg",
+                 workers: int = 1) -> Path:
     """Write ``report.html``, ``report.md`` and ``figures/*.svg`` (or ``.pdf`` beside SVG
     twins, or ``.png``: ``figures``, :data:`opspec.evaluation.plots.FORMATS`) into the
     store's folder.
 
     ``summaries`` per design label (``metrics``, ``monitors``; ``difference`` under ``"B"``)
     are what the caller already computed; what is missing is computed here. ``template`` is
-    a Jinja2 template to render the HTML with instead of the bundled one.
+    a Jinja2 template to render the HTML with instead of the bundled one. The figures are
+    drawn by up to ``workers`` processes side by side (:func:`.plots.drawn_by`).
     """
     from opspec.evaluation import plots
+    from opspec.evaluation.html import write_html, write_markdown
 
     with plots.figure_format(figures):
-        return _write_report(store, summaries, template)
+        with plots.drawn_by(workers):
+            title, sections = _report_sections(store, summaries)
+        write_markdown(store.folder / "report.md", title, sections)
+        return write_html(store.folder / "report.html", title, sections, template=template)
 
 
-def _write_report(store: ResultStore, summaries: Mapping[str, Summaries] | None,
-                  template: str | Path | None) -> Path:
+def _report_sections(store: ResultStore, summaries: Mapping[str, Summaries] | None
+                     ) -> tuple[str, list[Any]]:
     from opspec.evaluation import plots
-    from opspec.evaluation.html import Section, Table, write_html, write_markdown
+    from opspec.evaluation.html import Section, Table
 
     summaries = summaries or {}
     folder = store.folder
@@ -799,6 +811,4 @@ def _write_report(store: ResultStore, summaries: Mapping[str, Summaries] | None,
 
     sections.append(_methods_section([per_design, summaries], sections))
 
-    title = f"Evaluation of {Path(specs.get(designs[0], 'spec')).name}"
-    write_markdown(folder / "report.md", title, sections)
-    return write_html(folder / "report.html", title, sections, template=template)
+    return f"Evaluation of {Path(specs.get(designs[0], 'spec')).name}", sections

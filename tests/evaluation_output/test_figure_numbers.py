@@ -3,10 +3,9 @@
 A reader of a paper compares a figure's labels with the table next to it; a figure that says
 99.6 % where the table says 99.61 %, or that was drawn from another computation, is an error
 a reviewer finds. The report is read as a reader gets it (report.html, figures inline as
-SVG): the tables' cells and each figure's texts (matplotlib writes a figure's texts as glyph
-outlines, each preceded by a comment holding the text; a ``<text>`` element is read as
-well), and each number a figure states as a value — not an axis tick — is looked up in the
-table it belongs to:
+SVG): the tables' cells and each figure's texts (``<text>`` elements; glyph outlines, each
+preceded by a comment holding the text, are read as well), and each number a figure states
+as a value — not an axis tick — is looked up in the table it belongs to:
 
 - the outcome rates: each panel's "estimate [low, high]" is the estimates table's estimate
   and 95 % CI of the metric the panel is labelled with;

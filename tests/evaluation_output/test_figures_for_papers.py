@@ -42,6 +42,20 @@ def test_the_html_report_inlines_vector_figures(run: Path) -> None:
     assert "docs/" not in re.sub(r"<svg.*?</svg>", "", html, flags=re.DOTALL)
 
 
+def test_figure_texts_are_text_a_reader_can_search_and_copy(run: Path) -> None:
+    """A figure's words and numbers are SVG ``<text>`` (found by the browser's search, copied
+    into a paper, corrected by a journal's editor), in the font the layout was measured with
+    and a sans-serif where that font is missing; not glyph outlines."""
+    from lxml import etree
+
+    svg = etree.parse(str(run / "figures" / "A-report_latency_s.svg"))
+    texts = svg.getroot().findall(".//{http://www.w3.org/2000/svg}text")
+    words = " ".join("".join(t.itertext()) for t in texts)
+    assert "report latency (s)" in words and "Histogram" in words
+    assert all("'DejaVu Sans'" in t.get("style", "") and "sans-serif" in t.get("style", "")
+               for t in texts)
+
+
 def test_figures_carry_no_titles_and_label_axes_in_words(
         run: Path, monkeypatch: pytest.MonkeyPatch, tmp_path: Path) -> None:
     """Capture every figure the report draws and read its texts."""

@@ -134,3 +134,35 @@ def test_an_outcome_that_never_happened_gets_no_panel_but_a_note(draw, tmp_path:
     both = draw({"alarms": happened, "device_faults": [0] * 24}, tmp_path / "both.png")
     assert assert_valid_png(both) == assert_valid_png(alone)     # no second panel
     assert both.read_bytes() != alone.read_bytes()               # the note names it
+
+
+def test_figures_drawn_side_by_side_are_the_figures_drawn_one_after_another(
+        tmp_path: Path) -> None:
+    """``opspec evaluate --workers 2`` draws its report's figures in two processes: the
+    files, their names and their bytes are those drawn one after another."""
+    names = ("latency", "rates", "over-days", "activity-rates")
+    alone = [NORMAL[n](tmp_path / "alone" / f"{n}.svg") for n in names]
+    with plots.drawn_by(2):
+        together = [NORMAL[n](tmp_path / "together" / f"{n}.svg") for n in names]
+        assert not any(path.exists() for path in together)      # drawn at the block's end
+    assert [p.name for p in together] == [p.name for p in alone]
+    assert [p.read_bytes() for p in together] == [p.read_bytes() for p in alone]
+
+
+def test_pdf_figures_side_by_side_return_the_svg_twin_the_report_shows(tmp_path: Path) -> None:
+    with plots.figure_format("pdf"), plots.drawn_by(2):
+        twins = [NORMAL[n](tmp_path / f"{n}.png") for n in ("rates", "comparison")]
+    assert [p.name for p in twins] == ["rates.svg", "comparison.svg"]
+    assert all(p.is_file() and p.with_suffix(".pdf").read_bytes().startswith(b"%PDF")
+               for p in twins)
+
+
+def test_a_figure_that_cannot_be_written_side_by_side_is_an_evaluation_error(
+        tmp_path: Path) -> None:
+    blocker = tmp_path / "file"
+    blocker.write_text("not a folder")
+    with (pytest.raises(EvaluationError, match=r"cannot write the figure .*rates\.png"),
+          plots.drawn_by(2)):
+        plots.rates_figure([("x", 0.5, 0.4, 0.6)], tmp_path / "fine.png")
+        plots.rates_figure([("x", 0.5, 0.4, 0.6)], blocker / "rates.png")
+    assert (tmp_path / "fine.png").is_file()
