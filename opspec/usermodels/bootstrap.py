@@ -31,7 +31,12 @@ Cai & DasGupta 2001, Statistical Science 16(2)); the Jeffreys interval keeps its
 Each resample is fitted as the data were: the duration family ``opspec fit`` chose (AIC/BIC
 on the whole data) is fitted again by maximum likelihood — the choice of family is not
 redrawn —, a rate is events / trials of the resample, the time lost to a wrong pick the
-difference of means. A resample that cannot be fitted (too few distinct durations) keeps the
+difference of means. A population's centre and between-person spread (``[vary]``) are
+not resampled but drawn from their posterior under the normal random-effects model
+(:class:`_PersonLevel`): a percentile bootstrap of 30 persons gives them normal tails with
+(P - 1)/P of their variance, and groups of new people simulated under it are too alike —
+``opspec model-check`` of a freshly fitted model then calls misfits above its level
+(docs/fitting.md). A resample that cannot be fitted (too few distinct durations) keeps the
 estimate for that parameter and is counted in ``failed``. Rates the data show no event of
 (no omission in 40 offers) are not written by ``opspec fit``, hence not redrawn.
 """
