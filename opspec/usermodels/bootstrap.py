@@ -31,7 +31,12 @@ Cai & DasGupta 2001, Statistical Science 16(2)); the Jeffreys interval keeps its
 Each resample is fitted as the data were: the duration family ``opspec fit`` chose (AIC/BIC
 on the whole data) is fitted again by maximum likelihood — the choice of family is not
 redrawn —, a rate is events / trials of the resample, the time lost to a wrong pick the
-difference of means. A resample that cannot be fitted (too few distinct durations) keeps the
+difference of means. A population's centre and between-person spread (``[vary]``) are
+not resampled but drawn from their posterior under the normal random-effects model
+(:class:`_PersonLevel`): a percentile bootstrap of 30 persons gives them normal tails with
+(P - 1)/P of their variance, and groups of new people simulated under it are too alike —
+``opspec model-check`` of a freshly fitted model then calls misfits above its level
+(docs/fitting.md). A resample that cannot be fitted (too few distinct durations) keeps the
 estimate for that parameter and is counted in ``failed``. Rates the data show no event of
 (no omission in 40 offers) are not written by ``opspec fit``, hence not redrawn.
 """
@@ -279,6 +284,62 @@ def _spread(target: _Target, persons: Sequence[dict[str, _Data]]) -> dict[str, f
     return None if found is None else {target.prefix: found}
 
 
+@dataclass(frozen=True)
+class _PersonLevel:
+    """A population's varied parameter as the normal random-effects model sees it: the
+    persons' own values (log mean durations, own omission rates) have mean ``centre`` (on
+    the log scale for a duration: ``log=True``) and variance ``between² + sampling``, of
+    which ``moments`` holds the estimate from ``moments.users`` persons."""
+
+    spread: str                        # vary.activities.ID.….sigma / .sd
+    centre: str                        # activities.ID.duration.PARAM / .omission.probability
+    estimate: float                    # the centre as fitted
+    log: bool
+    moments: Any                       # opspec.usermodels.spread.PersonMoments
+
+    def draw(self, rng: np.random.Generator) -> dict[str, float]:
+        """One draw of (centre, between-person sd) from their posterior under the
+        reference prior p(centre, V) ∝ 1/V of V = between² + sampling (Gelman et al.,
+        *Bayesian Data Analysis*, 3rd ed., §3.2): V = (P - 1) s² / χ²(P - 1), the centre
+        normal around its estimate with variance V / P, the between-person variance what V
+        leaves above the sampling part. Its predictive for the mean of a new group is
+        Student's t — the classical prediction interval of a future sample's mean."""
+        m = self.moments
+        persons = m.users
+        total = (persons - 1) * m.observed / max(float(rng.chisquare(persons - 1)), 1e-12)
+        between = math.sqrt(max(total - m.sampling, 0.0))
+        shift = math.sqrt(total / persons) * float(rng.standard_normal())
+        if self.log:
+            centre = self.estimate * math.exp(shift)
+        else:
+            centre = min(max(self.estimate + shift, 1e-6), 1 - 1e-6)
+        return {self.spread: between, self.centre: centre}
+
+
+def _person_levels(targets: Sequence[_Target], persons: Sequence[dict[str, _Data]],
+                   estimate: dict[str, float]) -> list[_PersonLevel]:
+    """The varied parameters whose centre and spread are drawn from their posterior."""
+    from opspec.usermodels.spread import duration_moments, omission_moments
+
+    out = []
+    for target in targets:
+        if not target.kind.endswith(" spread"):
+            continue
+        data = [d for person in persons if (d := person.get(target.activity)) is not None]
+        centre = target.prefix.removeprefix("vary.").rsplit(".", 1)[0]
+        if target.kind == "duration spread":
+            moments = duration_moments([d.durations for d in data],
+                                       min_per_user=target.own_rates_min)
+        else:
+            moments = omission_moments([(d.omitted, d.answered) for d in data],
+                                       min_per_user=target.own_rates_min)
+        if moments is None or centre not in estimate or moments.observed <= 0:
+            continue
+        out.append(_PersonLevel(target.prefix, centre, estimate[centre],
+                                target.kind == "duration spread", moments))
+    return out
+
+
 def _per_person(result: FitResult, activities: Sequence[str]) -> dict[str, dict[str, _Data]]:
     obs = result.observations
     people: dict[str, dict[str, _Data]] = {p: {} for p in obs.persons}
@@ -343,6 +404,14 @@ def parameter_draws(result: FitResult, draws: int, *, seed: int = 0) -> Paramete
         return None
     by_persons = len(names) >= MIN_PERSONS
     rng = np.random.default_rng(np.random.SeedSequence([int(seed), _STREAM]))
+    # a population's centres and spreads: drawn from their posterior (_PersonLevel.draw),
+    # not resampled — a percentile bootstrap of 30 persons centres a between-person variance
+    # at (P-1)/P of a downward-biased estimate and lacks the long upper tail a variance
+    # estimated from 30 persons has: groups of new people simulated under it are too alike
+    # (docs/fitting.md, what the check can detect)
+    levels = _person_levels(targets, everyone, estimate)
+    drawn = {path for level in levels for path in (level.spread, level.centre)}
+    level_rng = np.random.default_rng(np.random.SeedSequence([int(seed), _STREAM, 1]))
     rows = []
     failed = 0
     for _ in range(draws):
@@ -356,12 +425,16 @@ def parameter_draws(result: FitResult, draws: int, *, seed: int = 0) -> Paramete
                 sample[activity].add(d)
         row = dict(estimate)
         for target in targets:
+            if target.prefix in drawn:
+                continue
             found = values(target, sample[target.activity], chosen,
                            None if by_persons else rng)
             if found is None:
                 failed += 1
                 continue
-            row.update({k: v for k, v in found.items() if k in row})
+            row.update({k: v for k, v in found.items() if k in row and k not in drawn})
+        for level in levels:
+            row.update(level.draw(level_rng))
         rows.append(tuple(row[p] for p in parameters))
     # a parameter every resample gives the same (a constant loss) is no uncertainty
     keep = [i for i in range(len(parameters)) if any(r[i] != estimate[parameters[i]]

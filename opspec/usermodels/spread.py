@@ -32,8 +32,9 @@ from typing import Any
 
 import numpy as np
 
-__all__ = ["DurationSpread", "OmissionSpread", "duration_between_sd", "duration_spread",
-           "omission_between_sd", "omission_spread"]
+__all__ = ["DurationSpread", "OmissionSpread", "PersonMoments", "duration_between_sd",
+           "duration_moments", "duration_spread", "omission_between_sd", "omission_moments",
+           "omission_spread"]
 
 #: bootstrap resamples of users for the intervals of the between-user spread
 RESAMPLES = 999
@@ -137,21 +138,37 @@ def _log_means(groups: Sequence[np.ndarray]) -> tuple[np.ndarray, np.ndarray, np
     return means, np.log(means), within
 
 
-def duration_between_sd(per_user: Iterable[Sequence[float]], *, min_per_user: int = 10
-                        ) -> float | None:
-    """The between-user sd of ln(scale) alone, as :func:`duration_spread` estimates it (for
-    the bootstrap's redraws: each resample of persons gives its own)."""
+@dataclass(frozen=True)
+class PersonMoments:
+    """What a between-person spread is estimated from: ``users`` persons' own values (the
+    log of a person's mean duration, or a person's own omission rate), their ``observed``
+    variance over persons (ddof 1) and the ``sampling`` part of it (the mean of each
+    person's own sampling variance). The between-person variance is their difference."""
+
+    users: int
+    observed: float
+    sampling: float
+
+    @property
+    def between_sd(self) -> float:
+        return math.sqrt(max(0.0, self.observed - self.sampling))
+
+
+def duration_moments(per_user: Iterable[Sequence[float]], *, min_per_user: int = 10
+                     ) -> PersonMoments | None:
+    """The persons' log mean durations' variance and its sampling part (None: fewer than 3
+    persons with ``min_per_user`` positive durations)."""
     groups = _duration_groups(per_user, min_per_user)
     if len(groups) < 3:
         return None
     _, logs, within = _log_means(groups)
-    return math.sqrt(max(0.0, float(np.var(logs, ddof=1)) - float(within.mean())))
+    return PersonMoments(len(groups), float(np.var(logs, ddof=1)), float(within.mean()))
 
 
-def omission_between_sd(per_user: Iterable[tuple[int, int]], *, min_per_user: int = 10
-                        ) -> float | None:
-    """The between-user sd of an omission rate alone, as :func:`omission_spread` estimates
-    it (for the bootstrap's redraws)."""
+def omission_moments(per_user: Iterable[tuple[int, int]], *, min_per_user: int = 10
+                     ) -> PersonMoments | None:
+    """The persons' own omission rates' variance and its sampling part (None: fewer than 3
+    persons with ``min_per_user`` offers)."""
     pairs = [(k, n) for k, n in per_user if n >= min_per_user]
     if len(pairs) < 3:
         return None
@@ -159,7 +176,22 @@ def omission_between_sd(per_user: Iterable[tuple[int, int]], *, min_per_user: in
     n = np.array([p[1] for p in pairs], dtype=float)
     rates = k / n
     sampling = rates * (1 - rates) / np.maximum(n - 1, 1)
-    return math.sqrt(max(0.0, float(np.var(rates, ddof=1)) - float(sampling.mean())))
+    return PersonMoments(len(pairs), float(np.var(rates, ddof=1)), float(sampling.mean()))
+
+
+def duration_between_sd(per_user: Iterable[Sequence[float]], *, min_per_user: int = 10
+                        ) -> float | None:
+    """The between-user sd of ln(scale) alone, as :func:`duration_spread` estimates it."""
+    found = duration_moments(per_user, min_per_user=min_per_user)
+    return None if found is None else found.between_sd
+
+
+def omission_between_sd(per_user: Iterable[tuple[int, int]], *, min_per_user: int = 10
+                        ) -> float | None:
+    """The between-user sd of an omission rate alone, as :func:`omission_spread` estimates
+    it."""
+    found = omission_moments(per_user, min_per_user=min_per_user)
+    return None if found is None else found.between_sd
 
 
 @dataclass(frozen=True)
