@@ -10,8 +10,10 @@ repetition here does what a researcher does, with a known truth:
 1. records ``--trace-days`` days of ONE person following the reference user model
    (``dispenser-reference``: SCENARIO.md's user; 7 days = 28 doses, some 33 alarms and 28
    walks) on the reference dispenser (``specs/medication_dispenser.xpdl``), with its own seed;
-2. fits a model to that trace with ``opspec fit`` (which writes 200 bootstrap redraws of
-   the fitted parameters);
+2. fits a model to that trace with ``opspec fit --draws B``: the B bootstrap redraws of the
+   fitted parameters that step 3 uses (the redraws are one seeded sequence, so they are the
+   first B of the 200 a plain ``opspec fit`` writes: the same numbers, without fitting the
+   180 redraws evaluate never reads -- most of a repetition's CPU);
 3. evaluates the fitted model with ``opspec evaluate --users U --days D
    --input-uncertainty B`` (the same plan, runner and summaries, without the report).
 
@@ -76,11 +78,13 @@ def record_trace(path: Path, days: float, seed: int) -> Path:
     return path
 
 
-def fit(trace: Path, out: Path, seed: int) -> Path:
+def fit(trace: Path, out: Path, seed: int, draws: int = 200) -> Path:
+    """``opspec fit TRACE -o OUT --seed S --draws B``."""
     from opspec.cli import main
 
     with contextlib.redirect_stdout(io.StringIO()):
-        code = main(["fit", str(trace), "-o", str(out), "--seed", str(seed)])
+        code = main(["fit", str(trace), "-o", str(out), "--seed", str(seed),
+                     "--draws", str(draws)])
     if code != 0:
         raise RuntimeError(f"opspec fit failed ({code}) on {trace}")
     return out
@@ -126,7 +130,7 @@ def repetition(index: int, trace_days: float, users: int, days: float, draws: in
     seed = seed0 + index
     with tempfile.TemporaryDirectory(prefix="opspec-iu-rep-") as tmp:
         trace = record_trace(Path(tmp) / "person.jsonl", trace_days, seed)
-        model = fit(trace, Path(tmp) / "fitted.users.toml", seed)
+        model = fit(trace, Path(tmp) / "fitted.users.toml", seed, draws)
         return evaluate(model, users, days, draws, per_draw, seed + 500_000)
 
 

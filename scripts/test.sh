@@ -51,6 +51,8 @@ fi
 .venv/bin/opspec --version
 wait "$oracle" "$spiff" || true
 cat "$logs/oracle.log" "$logs/spiff.log" >&2
+# each phase's start in seconds since this script began, so a CI log shows where time goes
+echo "== set up done after ${SECONDS} s"
 # Both passes use every core: `-n auto` (pytest-xdist) in the compiled pass, two pytest
 # processes side by side in the pass from source. OPSPEC_TEST_WORKERS=N (or `-n N` among the
 # arguments, which pytest reads last) sets the workers; 0 runs in this process.
@@ -74,7 +76,8 @@ if [ -z "${OPSPEC_PURE_PYTHON:-}" ] && command -v cc >/dev/null 2>&1; then
         OPSPEC_PURE_PYTHON=1 .venv/bin/python -m pytest -q -p no:cacheprovider "$@" \
             >"$logs/${1//\//_}.log" 2>&1
     }
-    echo "== pure Python engine: tests/engine tests/conditions tests/patterns tests/behaviour"
+    echo "== pure Python engine: tests/engine tests/conditions tests/patterns tests/behaviour" \
+        "(at ${SECONDS} s)"
     pure tests/engine tests/conditions & first=$!
     pure tests/patterns tests/behaviour & second=$!
     failed=0
@@ -89,4 +92,5 @@ if [ -z "${OPSPEC_PURE_PYTHON:-}" ] && command -v cc >/dev/null 2>&1; then
 fi
 rm -rf "$logs"
 trap - EXIT
+echo "== the whole suite, compiled (at ${SECONDS} s)"
 exec .venv/bin/python -m pytest -n "$workers" --dist worksteal "$@"

@@ -14,6 +14,7 @@ from opspec.bindings import DeviceBinding, bind, load_profile
 from opspec.bindings.emulator import Behaviour, EmulatedDevice, PtyEmulator, SocketEmulator
 from opspec.bindings.profiles import DeviceProfile
 
+from .board_runs import BoardRun, run_all
 from .fakes import FakeSession
 
 DEVICES = Path(__file__).resolve().parents[2] / "devices"
@@ -91,3 +92,10 @@ def emulate() -> Iterator[Callable[..., PtyEmulator | SocketEmulator]]:
     yield start
     for server in servers:
         server.stop()
+
+
+@pytest.fixture(scope="session")
+def board_runs(tmp_path_factory: pytest.TempPathFactory) -> dict[str, BoardRun]:
+    """Every scenario of board_runs.SCENARIOS, run side by side once per test process (the
+    tests that ask need socat and a pty: they skip before asking)."""
+    return run_all(tmp_path_factory.mktemp("board-runs"))

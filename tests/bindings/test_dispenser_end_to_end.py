@@ -4,31 +4,20 @@ pseudo-terminal pair made by socat: a clean run, garbage, late replies, a jammed
 empty slot, an unplugged cable and a press before any alarm. In every case each due dose
 ends as taken or missed (taken + missed = due), and a device fault reaches the caregiver.
 
-Each run goes from 00:00 to 11:40 simulated at 5000x (about 9 s of wall time plus the
-profile's 2 s settle after opening the port): one dose, at 08:00, slot 1.
+Each run goes from 00:00 to 11:40 simulated at 5000x: one dose, at 08:00, slot 1. The runs
+are made side by side, each with a board and a pty pair of its own (board_runs.py, the
+``board_runs`` fixture): they wait on the wall clock, so together they take the time of one.
 """
 
 from __future__ import annotations
 
-import json
 import shutil
-import subprocess
-import sys
-import time
-from collections.abc import Iterator
-from pathlib import Path
 from typing import Any
 
 import pytest
 
-from opspec.cli import main
-
+from .board_runs import BoardRun
 from .conftest import needs_pty
-
-ROOT = Path(__file__).resolve().parents[2]
-SPEC = ROOT / "specs" / "medication_dispenser.xpdl"
-BOARD = Path(__file__).with_name("dispenser_board.py")
-RUN = ["--until", "42000", "--realtime", "--speed", "5000", "--no-user"]
 
 pytestmark = [
     needs_pty,
@@ -37,71 +26,9 @@ pytestmark = [
 ]
 
 
-class Rig:
-    """A socat pty pair (host end for opspec, board end for the board process)."""
-
-    def __init__(self, folder: Path) -> None:
-        self.host = folder / "host"
-        self.board_end = folder / "board"
-        self.socat = subprocess.Popen(
-            ["socat", f"pty,link={self.host},raw,echo=0",
-             f"pty,link={self.board_end},raw,echo=0"],
-            stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
-        deadline = time.monotonic() + 5
-        while not (self.host.exists() and self.board_end.exists()):
-            if time.monotonic() > deadline or self.socat.poll() is not None:
-                raise RuntimeError("socat did not make the pty pair")
-            time.sleep(0.02)
-        self.board: subprocess.Popen[str] | None = None
-
-    def start_board(self, *options: str) -> None:
-        self.board = subprocess.Popen(
-            [sys.executable, str(BOARD), str(self.board_end), "--socat-pid",
-             str(self.socat.pid), *options], stdout=subprocess.PIPE, text=True)
-        assert self.board.stdout is not None
-        assert self.board.stdout.readline().strip() == "READY"
-
-    def board_log(self) -> list[str]:
-        assert self.board is not None
-        if self.board.poll() is None:
-            self.board.terminate()
-        out, _ = self.board.communicate(timeout=5)
-        return out.splitlines()
-
-    def stop(self) -> None:
-        for proc in (self.board, self.socat):
-            if proc is not None and proc.poll() is None:
-                proc.terminate()
-                proc.wait(timeout=5)
-
-
-@pytest.fixture
-def rig(tmp_path: Path) -> Iterator[Rig]:
-    made = Rig(tmp_path)
-    try:
-        yield made
-    finally:
-        made.stop()
-
-
-def run(rig: Rig, capsys: pytest.CaptureFixture[str], tmp_path: Path,
-        *options: str, engine: str = "") -> tuple[int, dict[str, Any], list[dict[str, Any]],
-                                                  list[str]]:
-    """Start the board with ``options``, run the spec bound to it (``engine``: engine
-    configuration TOML); the exit status, the JSON document, the trace and the board's log."""
-    rig.start_board(*options)
-    trace = tmp_path / "trace.jsonl"
-    extra: list[str] = []
-    if engine:
-        config = tmp_path / "engine.toml"
-        config.write_text(engine, encoding="utf-8")
-        extra = ["--engine-config", str(config)]
-    status = main(["run", str(SPEC), *RUN, *extra, "--json", "--trace", str(trace),
-                   "--bind", f"alarm={rig.host}", "--bind", f"dispenser={rig.host}"])
-    captured = capsys.readouterr()
-    doc = json.loads(captured.out)
-    events = [json.loads(line) for line in trace.read_text(encoding="utf-8").splitlines()]
-    return status, doc, events, rig.board_log()
+def unpack(run: BoardRun) -> tuple[dict[str, Any], list[dict[str, Any]], list[str]]:
+    """The run's JSON document, trace and board log."""
+    return run.doc, run.events, run.log
 
 
 def totals(doc: dict[str, Any]) -> dict[str, int]:
@@ -136,8 +63,8 @@ def assert_every_dose_decided(doc: dict[str, Any], events: list[dict[str, Any]])
     assert all("'user_workflow'" in d for d in doc.get("deadlocks") or []), doc["deadlocks"]
 
 
-def test_clean_board_the_morning_dose_is_taken_from_slot_1(rig, capsys, tmp_path):
-    _, doc, events, log = run(rig, capsys, tmp_path)
+def test_clean_board_the_morning_dose_is_taken_from_slot_1(board_runs):
+    doc, events, log = unpack(board_runs["clean"])
     assert_every_dose_decided(doc, events)
     assert totals(doc)["doses_taken"] == 1
     assert "RX DISPENSE 1" in log                   # the morning dose's slot, not "DISPENSE 1"
@@ -145,12 +72,11 @@ def test_clean_board_the_morning_dose_is_taken_from_slot_1(rig, capsys, tmp_path
     assert device(doc)["mode"] == {"alarm": "device", "dispenser": "device"}
 
 
-def test_garbage_is_a_fault_then_a_retry_and_the_dose_is_taken(rig, capsys, tmp_path):
+def test_garbage_is_a_fault_then_a_retry_and_the_dose_is_taken(board_runs):
     # the garbled answer ends its attempt at the 500 ms timeout (a reply may follow noise),
     # over an hour simulated at 5000x: the press 20 ms after the first ALARM ON is kept
     # for the dose's wait (as in the late-reply test below)
-    _, doc, events, log = run(rig, capsys, tmp_path, "--garbage", "1", "--noise",
-                              engine="message_ttl = 86400\n")
+    doc, events, log = unpack(board_runs["garbage"])     # --garbage 1 --noise, KEEP_A_DAY
     assert_every_dose_decided(doc, events)
     assert totals(doc)["doses_taken"] == 1
     kinds = fault_kinds(doc)
@@ -159,15 +85,13 @@ def test_garbage_is_a_fault_then_a_retry_and_the_dose_is_taken(rig, capsys, tmp_
     assert device(doc)["mode"]["alarm"] == "device"
 
 
-def test_a_late_reply_and_a_press_during_the_retry_the_press_is_not_lost(
-        rig, capsys, tmp_path):
+def test_a_late_reply_and_a_press_during_the_retry_the_press_is_not_lost(board_runs):
     # ALARM ON's reply comes 800 ms late (timeout 500 ms): timeout, late-reply, retry. The
     # user presses 20 ms after the first ALARM ON, while nothing waits for the report yet:
     # the message is kept and the dose's wait catches it. (At this test's 5000x speed the
     # retry's wall-clock second is over an hour of simulated time: longer than the default
     # message_ttl of 60 s, so the test keeps messages for a day.)
-    _, doc, events, log = run(rig, capsys, tmp_path, "--late-ms", "800",
-                              "--late-count", "1", engine="message_ttl = 86400\n")
+    doc, events, log = unpack(board_runs["late-reply"])  # --late-ms 800 --late-count 1
     assert_every_dose_decided(doc, events)
     assert totals(doc)["doses_taken"] == 1
     kinds = fault_kinds(doc)
@@ -177,8 +101,8 @@ def test_a_late_reply_and_a_press_during_the_retry_the_press_is_not_lost(
     assert device(doc)["mode"]["alarm"] == "device"  # one failed attempt does not switch
 
 
-def test_a_jammed_drawer_is_a_missed_dose_and_the_caregiver_is_told(rig, capsys, tmp_path):
-    _, doc, events, log = run(rig, capsys, tmp_path, "--jam")
+def test_a_jammed_drawer_is_a_missed_dose_and_the_caregiver_is_told(board_runs):
+    doc, events, log = unpack(board_runs["jam"])
     assert_every_dose_decided(doc, events)
     assert totals(doc)["doses_missed"] == 1
     assert totals(doc)["caregiver_notified"] == 1
@@ -187,8 +111,8 @@ def test_a_jammed_drawer_is_a_missed_dose_and_the_caregiver_is_told(rig, capsys,
     assert "RX DISPENSE 1" in log
 
 
-def test_an_empty_slot_is_a_missed_dose_and_the_caregiver_is_told(rig, capsys, tmp_path):
-    _, doc, events, _ = run(rig, capsys, tmp_path, "--empty")
+def test_an_empty_slot_is_a_missed_dose_and_the_caregiver_is_told(board_runs):
+    doc, events, _ = unpack(board_runs["empty"])
     assert_every_dose_decided(doc, events)
     assert totals(doc)["doses_missed"] == totals(doc)["caregiver_notified"] == 1
     assert completed(events, "drawer_empty")
@@ -196,8 +120,8 @@ def test_an_empty_slot_is_a_missed_dose_and_the_caregiver_is_told(rig, capsys, t
 
 
 def test_an_unplugged_cable_at_dispense_is_a_missed_dose_and_the_caregiver_is_told(
-        rig, capsys, tmp_path):
-    _, doc, events, log = run(rig, capsys, tmp_path, "--unplug-on", "DISPENSE")
+        board_runs):
+    doc, events, log = unpack(board_runs["unplug"])
     assert "UNPLUG" in log
     assert_every_dose_decided(doc, events)
     assert totals(doc)["doses_missed"] == totals(doc)["caregiver_notified"] == 1
@@ -208,11 +132,13 @@ def test_an_unplugged_cable_at_dispense_is_a_missed_dose_and_the_caregiver_is_to
 
 
 def test_a_press_long_before_the_alarm_is_lost_and_does_not_report_the_next_dose(
-        rig, capsys, tmp_path):
+        board_runs):
     # documented in devices/README.md: the board's presses are plain messages; one with
     # nothing waiting is kept for message_ttl (60 s) and then lost, so a press hours before
     # the 08:00 alarm does not count as taking that dose (here nobody presses again: missed)
-    _, doc, events, _ = run(rig, capsys, tmp_path, "--press-at-ms", "3500", "--no-press")
+    # (--press-at-ms 3500 --no-press: the board starts once the run has opened the port,
+    # so the press comes 1.5 s into the run after the 2 s settle: about 02:05 simulated)
+    doc, events, _ = unpack(board_runs["early-press"])
     assert_every_dose_decided(doc, events)
     assert totals(doc)["doses_taken"] == 0 and totals(doc)["doses_missed"] == 1
     kept = [e for e in events if e.get("kind") == "trigger.kept"]

@@ -2,8 +2,8 @@
 Count of ``fault`` trace events), so ``opspec run`` and ``opspec evaluate`` report them from
 the spec, and the number is the one the run summary gives per device.
 
-Runs against the independent board process over a socat pty pair (see
-test_dispenser_end_to_end.py, whose rig this reuses): garbage with noise (faults the binding
+Reads the runs against the independent board process over socat pty pairs that
+test_dispenser_end_to_end.py reads too (board_runs.py): garbage with noise (faults the binding
 recovers from by retrying: the dose is still taken) and a jammed drawer (a fault that ends the
 dose as missed).
 """
@@ -17,8 +17,9 @@ import pytest
 
 from opspec.cli import main
 
+from .board_runs import SPEC
 from .conftest import needs_pty
-from .test_dispenser_end_to_end import SPEC, device, rig, run, totals  # noqa: F401  (fixture)
+from .test_dispenser_end_to_end import device, totals
 
 pytestmark = [
     needs_pty,
@@ -28,14 +29,14 @@ pytestmark = [
 
 
 @pytest.mark.parametrize(("board", "outcome"), [
-    (("--garbage", "1", "--noise"), "doses_taken"),
-    (("--jam",), "doses_missed"),
+    ("garbage", "doses_taken"),     # --garbage 1 --noise, messages kept a day
+    ("jam", "doses_missed"),        # --jam
 ])
 def test_the_spec_counts_the_device_faults_the_run_summary_reports(
-        rig, capsys, tmp_path, board, outcome):  # noqa: F811  (the imported fixture)
+        board_runs, board, outcome):
     # garbage is retried at its timeout, over an hour simulated at 5000x: the user's early
     # press is kept for the dose's wait (test_dispenser_end_to_end.py, the garbage test)
-    _, doc, events, _ = run(rig, capsys, tmp_path, *board, engine="message_ttl = 86400\n")
+    doc, events = board_runs[board].doc, board_runs[board].events
     faults = device(doc)["faults"]
     assert faults, "the board was told to misbehave: the binding must report faults"
     assert doc["metrics"]["device_faults"] == {"kind": "count", "total": len(faults)}

@@ -1,5 +1,5 @@
 """A valid reply after noise is read: the independent board (dispenser_board.py, over a socat
-pty pair) answers DISPENSE with a debug line, an unknown line, a garbled line and a cut-off
+pty pair: board_runs.py) answers DISPENSE with a debug line, an unknown line, a garbled line and a cut-off
 frame first, then the real reply in two pieces. The drawer dispensed, so the dose is taken,
 never recorded as missed, DISPENSE is sent once (it is not idempotent: a resend could drop a
 second dose), and the noise is reported as device faults, not lost.
@@ -15,13 +15,7 @@ import shutil
 import pytest
 
 from .conftest import needs_pty
-from .test_dispenser_end_to_end import (  # noqa: F401  (rig is a fixture)
-    assert_every_dose_decided,
-    device,
-    rig,
-    run,
-    totals,
-)
+from .test_dispenser_end_to_end import assert_every_dose_decided, device, totals
 
 pytestmark = [
     needs_pty,
@@ -30,9 +24,9 @@ pytestmark = [
 ]
 
 
-def test_a_reply_after_noise_and_partial_frames_is_read_and_the_dose_is_taken(
-        rig, capsys, tmp_path):  # noqa: F811  (the imported fixture)
-    _, doc, events, log = run(rig, capsys, tmp_path, "--noise-before")
+def test_a_reply_after_noise_and_partial_frames_is_read_and_the_dose_is_taken(board_runs):
+    run = board_runs["noise-before"]                # the board's --noise-before
+    doc, events, log = run.doc, run.events, run.log
     assert_every_dose_decided(doc, events)
     assert totals(doc)["doses_taken"] == 1 and totals(doc)["doses_missed"] == 0
     assert log.count("RX DISPENSE 1") == 1          # read, not resent
