@@ -54,7 +54,7 @@ class Flow(Part):
         if parent is not None:
             root = parent.frame.inst.root
             priority = max(priority, parent.frame.inst.priority)
-        inst = ProcessInstance(iid, proc, local, scope, priority, parent, root, self.state.env.now)
+        inst = ProcessInstance(iid, proc, local, scope, priority, parent, root, self.state.now)
         inst.state = RUNNING
         inst.trigger = trigger
         if parent is not None:
@@ -117,7 +117,7 @@ class Flow(Part):
         proc = inst.process
         if self.state.pflags[proc.id] & 2:
             self.state.emit(EK.PROCESS_COMPLETED, proc.id, inst.id, None, proc.lane, None,
-                      {"duration": self.state.env.now - inst.started_at})
+                      {"duration": self.state.now - inst.started_at})
         parent = inst.parent
         if parent is not None and parent.state == RUNNING:
             parent.child = None
@@ -158,8 +158,8 @@ class Flow(Part):
             str(inst.process.location) if inst.process.location else "<built in Python>")
         what = f"activity {act.id!r} of " if act is not None else ""
         text = (f"{where}: {what}process {inst.process.id!r} (instance {inst.id}) aborted at "
-                f"t={self.state.env.now:.3f} s: {message}")
-        self.state.faults.append({"time": self.state.env.now, "process": inst.process.id,
+                f"t={self.state.now:.3f} s: {message}")
+        self.state.faults.append({"time": self.state.now, "process": inst.process.id,
                             "instance": inst.id, "activity": act.id if act else None,
                             "message": text})
         self.end_instance(inst, ABORTED, text)
@@ -293,7 +293,7 @@ class Flow(Part):
             return False
         inst = frame.inst
         try:
-            holds = condition(inst.scope, self.state.env.now)
+            holds = condition(inst.scope, self.state.now)
         except OpspecError as error:
             self.abort(inst, owner.act, f"the AdHocCompletionCondition failed: {error.message}")
             return True
@@ -317,8 +317,8 @@ class Flow(Part):
         """Record a deadlock of ``inst`` (trace + summary) and abort it."""
         proc = inst.process
         text = (f"deadlock in process {proc.id!r} (instance {inst.id}) at "
-                f"t={self.state.env.now:.3f} s: {why}; waiting: {', '.join(waiting) or '-'}")
-        self.state.deadlocks.append({"time": self.state.env.now, "process": proc.id, "instance": inst.id,
+                f"t={self.state.now:.3f} s: {why}; waiting: {', '.join(waiting) or '-'}")
+        self.state.deadlocks.append({"time": self.state.now, "process": proc.id, "instance": inst.id,
                                "waiting": waiting, "message": text})
         if self.state.wants(EK.DEADLOCK, proc.id, None):
             self.state.emit(EK.DEADLOCK, proc.id, inst.id, None, proc.lane, None,
@@ -395,7 +395,7 @@ class Flow(Part):
             trans = act.out[0]
         elif act.split == S_XOR and not act.choice and not act.drawn and (act.out or act.otherwise):
             scope = inst.scope
-            now = self.state.env.now
+            now = self.state.now
             try:
                 for trans in act.out:
                     cond = trans.condition
@@ -428,7 +428,7 @@ class Flow(Part):
 
     def _leave(self, frame: Frame, act: CompiledActivity) -> None:
         if act.choice:
-            ai = ActivityInstance(next(self.state.keys), act, frame, self.state.env.now)
+            ai = ActivityInstance(next(self.state.keys), act, frame, self.state.now)
             ai.state = RUNNING
             frame.running[ai.key] = ai
             self.offers.offer_choice(ai, act.choice)
@@ -441,7 +441,7 @@ class Flow(Part):
         if outs or act.otherwise:
             inst = frame.inst
             scope = inst.scope
-            now = self.state.env.now
+            now = self.state.now
             taken = False
             try:
                 if act.split == S_XOR:
@@ -511,7 +511,7 @@ class Flow(Part):
     def take(self, frame: Frame, trans: CTransition, performed: bool = False) -> None:
         if trans.assignments:
             inst = frame.inst
-            now = self.state.env.now
+            now = self.state.now
             for target, fn in trans.assignments:
                 self.set_field(inst, None, target, fn(inst.scope, now))
         frame.live += 1
@@ -555,7 +555,7 @@ class Flow(Part):
         """Run ``assignments`` (reading ``scope``, by default the instance's data); ``False``
         when the instance ended meanwhile (a failed assignment aborts it; a data change can
         fire its end trigger): the caller stops."""
-        now = self.state.env.now
+        now = self.state.now
         reads = inst.scope if scope is None else scope
         try:
             for target, fn in assignments:

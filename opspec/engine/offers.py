@@ -51,7 +51,7 @@ class Offers(Part):
         act = ai.act
         inst = ai.frame.inst
         item = WorkItem(ai.key, act.process, inst.id, act.id, act.label, act.participant,
-                        act.lane, self.state.env.now,
+                        act.lane, self.state.now,
                         application if application is not None else act.application,
                         data if data is not None else MappingProxyType(
                             inst.data if ai.local is None else ChainMap(ai.local, inst.data)),
@@ -159,7 +159,7 @@ class Offers(Part):
                     raise ExecutionError(
                         f"work item {item.key} ({item.activity}) needs a choice among "
                         f"{', '.join(item.choices)}, got {choice!r}",
-                        hint="call complete(item, choice=ACTIVITY_ID)", sim_time=self.state.env.now)
+                        hint="call complete(item, choice=ACTIVITY_ID)", sim_time=self.state.now)
             self.state.ready.append((self._choose, ai, trans, data))
         elif ai.act.toolchain and ai.key in self.state.tool_at:
             self.state.ready.append((self.activities.tool_done, ai, data, None))

@@ -20,7 +20,7 @@ import itertools
 from collections import deque
 from collections.abc import Callable, Mapping
 from types import MappingProxyType
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, final
 
 import simpy
 
@@ -65,6 +65,12 @@ class RunState:
         self.compiled = compiled
         self.config = config
         self.env = env if env is not None else Clock()
+        # The time, as the engine reads it: SimPy's ``env.now`` is a Python property, read
+        # once per timed callback the engine handles (:meth:`enter`) and at each call from
+        # outside one (:meth:`sync`) instead of at every use (some 38 a dose cycle).
+        self.now = float(self.env.now)
+        self.inside = False         # handling one of its own timed callbacks: now is fresh
+        self.sim_events = 0         # timeouts scheduled (the summary's sim_events)
         self.registry = performers
         self.streams = Streams(seed, scope)
         self.mode_loader = mode_loader
@@ -135,7 +141,7 @@ class RunState:
              participant: str | None = None, data: Mapping[str, Any] | None = None) -> None:
         """Send one trace event to every listener (callers check :meth:`wants` first)."""
         self.seq += 1
-        now = self.env.now
+        now = self.now
         for raw in self.raw:
             raw(now, kind, process, instance, activity, data)
         if self.full:
@@ -212,24 +218,44 @@ class RunState:
         if sampler.record(a, b) or starts >= self.max_instant_starts + SAMPLE_STARTS:
             raise sampler.error(starts)
 
+    def sync(self) -> None:
+        """Control enters the engine from outside its own timed callbacks (a performer
+        answering from a SimPy process or the TUI, ``run``/``step``, a device's post): read
+        the clock, which may have moved since the engine last looked."""
+        if not self.inside:
+            self.now = float(self.env.now)
+
+    def enter(self) -> bool:
+        """A timed callback of this run starts: the clock moved to its time. Returns whether
+        one was already running (a nested entry leaves the flag to the outer one)."""
+        self.now = float(self.env.now)
+        outer = self.inside
+        self.inside = True
+        return outer
+
     def later(self, delay: float, fn: Callable[[ActivityInstance, Any], None],
                ai: ActivityInstance, arg: Any = None) -> None:
         """Call ``fn(ai, arg)`` after ``delay`` simulated seconds if ``ai`` is still waiting."""
         if self.resolution > 0.0:
             delay = self._align(delay)
-        gen = ai.gen
-        self.env.timeout(max(0.0, delay)).callbacks.append(
-            lambda _e: self._fire(fn, ai, arg, gen))
+        self.sim_events += 1
+        self.env.timeout(max(0.0, delay)).callbacks.append(_Later(self, fn, ai, arg))
 
-    def _fire(self, fn: Callable[[ActivityInstance, Any], None], ai: ActivityInstance,
-              arg: Any, gen: int) -> None:
+    def fire(self, fn: Callable[[ActivityInstance, Any], None], ai: ActivityInstance,
+             arg: Any, gen: int) -> None:
+        """A :meth:`later` callback is due (nothing to do, not even a look at the clock,
+        when ``ai`` has moved on: a deadline that lost its race)."""
         if ai.gen == gen and ai.state == RUNNING:
-            inst = ai.frame.inst
-            if inst.state == SUSPENDED:
-                inst.deferred.append((self._refire, fn, ai, (arg, gen)))
-                return
-            fn(ai, arg)
-            self.drain()
+            outer = self.enter()
+            try:
+                inst = ai.frame.inst
+                if inst.state == SUSPENDED:
+                    inst.deferred.append((self._refire, fn, ai, (arg, gen)))
+                    return
+                fn(ai, arg)
+                self.drain()
+            finally:
+                self.inside = outer
 
     def _refire(self, fn: Callable[[ActivityInstance, Any], None], ai: ActivityInstance,
                 arg_gen: tuple[Any, int]) -> None:
@@ -239,7 +265,7 @@ class RunState:
 
     def _align(self, delay: float) -> float:
         res = self.resolution
-        now = self.env.now
+        now = self.now
         target = -(-(now + delay) // res) * res
         return max(0.0, target - now)
 
@@ -253,19 +279,30 @@ class RunState:
         if delay <= 0.0 and self.draining:
             self.ready.append((_call, callback, None, None))
             return
-        self.env.timeout(max(0.0, delay)).callbacks.append(
-            lambda _e: self._callback(callback))
+        self.sim_events += 1
+        self.env.timeout(max(0.0, delay)).callbacks.append(_CallAt(self, callback, True))
 
-    def _callback(self, callback: Callable[[], None]) -> None:
-        callback()
-        self.drain()
+    def timer(self, delay: float, callback: Callable[[], None]) -> None:
+        """Run ``callback`` after ``delay`` simulated seconds (it drains itself, if it
+        must: the processors' and the start timers' callbacks)."""
+        self.sim_events += 1
+        self.env.timeout(max(0.0, delay)).callbacks.append(_CallAt(self, callback, False))
+
+    def called(self, callback: Callable[[], None], drain: bool) -> None:
+        outer = self.enter()
+        try:
+            callback()
+            if drain:
+                self.drain()
+        finally:
+            self.inside = outer
 
     def start_counted(self, frame: Frame) -> None:
         """A workflow instance was started (``frame`` its top frame): past
         ``max_instant_starts`` instances at one instant, a zero-time cycle that piles up
         instances (a workflow starting itself asynchronously), stopped and named like any
         zero-time cycle, within seconds and some tens of megabytes."""
-        now = self.env.now
+        now = self.now
         if not _same_instant(now, self.starts_at):
             self.starts_at = now
             self.instant_starts = 1
@@ -313,6 +350,36 @@ class _Flags(dict[Any, int]):
 
 def _call(callback: Callable[[], None], _a: Any, _b: Any) -> None:
     callback()
+
+
+@final
+class _Later:
+    """The SimPy callback of :meth:`RunState.later` (a small object, not a closure: one
+    allocation instead of two per timeout)."""
+
+    def __init__(self, state: RunState, fn: Callable[[ActivityInstance, Any], None],
+                 ai: ActivityInstance, arg: Any) -> None:
+        self.state = state
+        self.fn = fn
+        self.ai = ai
+        self.arg = arg
+        self.gen = ai.gen
+
+    def __call__(self, _event: Any) -> None:
+        self.state.fire(self.fn, self.ai, self.arg, self.gen)
+
+
+@final
+class _CallAt:
+    """The SimPy callback of :meth:`RunState.call_at` and :meth:`RunState.timer`."""
+
+    def __init__(self, state: RunState, callback: Callable[[], None], drain: bool) -> None:
+        self.state = state
+        self.callback = callback
+        self.drain = drain
+
+    def __call__(self, _event: Any) -> None:
+        self.state.called(self.callback, self.drain)
 
 
 def discard(table: dict[Any, Any], key: Any) -> None:
