@@ -81,7 +81,7 @@ class Activities(Part):
             steps += 1
             if steps > limit:                   # a zero-time cycle (see RunState.drain)
                 self.state.zero_time(frame, act)
-            if self.state.aflags[act] & 1:
+            if self.state.act_bits(act) & 1:
                 self.state.emit(EK.ACTIVITY_STARTED, act.process, inst.id, act.id, act.lane,
                           act.participant)
             if act.start_assign and not self.flow.assign(inst, act, act.start_assign):
@@ -110,7 +110,7 @@ class Activities(Part):
         frame.running[ai.key] = ai
         if act.plain and not (act.general and self.state.pooled):
             inst = frame.inst
-            if self.state.aflags[act] & 1:
+            if self.state.act_bits(act) & 1:
                 self.state.emit(EK.ACTIVITY_STARTED, act.process, inst.id, act.id, act.lane,
                           act.participant)
             if act.start_assign and not self.flow.assign(inst, act, act.start_assign):

@@ -215,6 +215,9 @@ class CompiledActivity:
     plain: bool = False                      # waits, but without deadline/loop/trigger/boundary
     next: int = -1                           # the one unconditional successor, if that is all
     simple_end: bool = False                 # completes with no assignment/throw/raise/terminate
+    # which trace kinds the run's listeners want of it, as bits, with the selection they were
+    # computed for (RunState.act_bits): one attribute read on the hot path, not a lookup
+    flag_cache: tuple[object, int] | None = None
 
     def where(self) -> str:
         return str(self.location) if self.location is not None else "<built in Python>"
@@ -258,6 +261,7 @@ class CompiledProcess:
     # none start events; BPMN 2.0 §13.3.4: the triggered ones "are ignored when the Process
     # is called from another Process")
     called_starts: tuple[int, ...] = ()
+    flag_cache: tuple[object, int] | None = None    # as CompiledActivity.flag_cache
 
 
 @dataclass(slots=True, eq=False)

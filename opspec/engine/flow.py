@@ -12,7 +12,7 @@ from __future__ import annotations
 
 from collections import ChainMap
 from collections.abc import Mapping, MutableMapping
-from typing import Any
+from typing import Any, Final
 
 from opspec.engine.compiled import (
     J_AND,
@@ -33,6 +33,10 @@ from opspec.errors import OpspecError
 from opspec.model import ParameterMode
 
 _NEXT = LIFECYCLE.table
+# Final: module statics in the compiled engine, where a plain global is a dictionary lookup
+_COMPLETED_FROM_RUNNING: Final = _NEXT[(RUNNING, "complete")]
+_IN: Final = ParameterMode.IN
+_CHAIN: Final = ChainMap
 
 
 class Flow(Part):
@@ -47,7 +51,7 @@ class Flow(Part):
         if data:
             local.update(data)
         scope: MutableMapping[str, Any] = (
-            ChainMap(local, self.state.package_data) if self.state.package_data else local)
+            _CHAIN(local, self.state.package_data) if self.state.package_data else local)
         iid = next(self.state.ids)
         priority = proc.priority
         root = iid
@@ -62,7 +66,7 @@ class Flow(Part):
             inst.partner = parent.frame.inst.partner
         self.state.live[iid] = inst
         self.state.counts["started"] += 1
-        if self.state.pflags[proc.id] & 1:
+        if self.state.proc_bits(proc) & 1:
             self.state.emit(EK.PROCESS_STARTED, proc.id, iid, None, proc.lane, None,
                       {"trigger": trigger, "parent": parent.frame.inst.id if parent else None})
         frame = Frame(proc.graph, inst, None)
@@ -108,14 +112,14 @@ class Flow(Part):
             return
         if inst.state != RUNNING:
             return
-        inst.state = _NEXT[(RUNNING, "complete")]
+        inst.state = _COMPLETED_FROM_RUNNING
         inst.frames.clear()          # breaks the instance <-> frame cycle: freed by refcount
         self.state.live.pop(inst.id, None)
         if self.state.kept and inst.parent is None:
             self.triggers.drop_kept(inst)
         self.state.counts["completed"] += 1
         proc = inst.process
-        if self.state.pflags[proc.id] & 2:
+        if self.state.proc_bits(proc) & 2:
             self.state.emit(EK.PROCESS_COMPLETED, proc.id, inst.id, None, proc.lane, None,
                       {"duration": self.state.now - inst.started_at})
         parent = inst.parent
@@ -123,7 +127,7 @@ class Flow(Part):
             parent.child = None
             out = {}
             for mode, formal, _fn, target in parent.act.params:
-                if mode is not ParameterMode.IN and target is not None:
+                if mode is not _IN and target is not None:
                     out[target] = inst.data.get(formal)
             self.activities.body_done(parent, out or None)
 
@@ -345,7 +349,7 @@ class Flow(Part):
         """
         inst = frame.inst
         if act.simple_end:
-            if self.state.aflags[act] & 2:
+            if self.state.act_bits(act) & 2:
                 self.state.emit(EK.ACTIVITY_COMPLETED, act.process, inst.id, act.id, act.lane,
                           act.participant)
             nxt = act.next
@@ -359,7 +363,7 @@ class Flow(Part):
             return None
         if act.kind == K_THROW and act.trigger is not None:
             self.triggers.broadcast(act.trigger.kind, act.trigger.name or "", None, inst, act)
-        if self.state.aflags[act] & 2:
+        if self.state.act_bits(act) & 2:
             self.state.emit(EK.ACTIVITY_COMPLETED, act.process, inst.id, act.id, act.lane,
                       act.participant)
         if act.raises is not None and inst.state == RUNNING:
@@ -541,7 +545,7 @@ class Flow(Part):
             inst.data[target] = value
         else:
             self.state.package_data[target] = value
-        if (self.state.aflags[act] & 8 if act is not None
+        if (self.state.act_bits(act) & 8 if act is not None
                 else self.state.wants_all or (EK.DATA_CHANGED, inst.process.id, None) in self.state.wanted):
             self.state.emit(EK.DATA_CHANGED, inst.process.id, inst.id,
                       act.id if act is not None else None, inst.process.lane, None,

@@ -130,11 +130,41 @@ class RunState:
         self.pkg = compiled.id
         (self.listeners, self.raw, self.wants_all, self.selectors, self.wanted,
          self.full) = _listener_tables(listeners, compiled)
-        self.aflags = _Flags(self, _ACT_KINDS)      # CompiledActivity -> wanted-kind bits
-        self.pflags = _Flags(self, _PROC_KINDS)     # process id -> wanted-kind bits
+        # which selection the wanted-kind bits cached on activities and processes are of
+        self.flag_key = _flag_key(self.wants_all, self.wanted)
 
     def wants(self, kind: str, process: str | None, activity: str | None) -> bool:
         return self.wants_all or (kind, process, activity) in self.wanted
+
+    def act_bits(self, act: CompiledActivity) -> int:
+        """Which of ``_ACT_KINDS`` some listener wants of ``act``, as bits (computed once per
+        listener selection and kept on the activity)."""
+        cached = act.flag_cache
+        if cached is not None and cached[0] is self.flag_key:
+            return cached[1]
+        bits = self._bits(_ACT_KINDS, act.process, act.id)
+        act.flag_cache = (self.flag_key, bits)
+        return bits
+
+    def proc_bits(self, proc: CompiledProcess) -> int:
+        """Which of ``_PROC_KINDS`` some listener wants of ``proc``, as bits."""
+        cached = proc.flag_cache
+        if cached is not None and cached[0] is self.flag_key:
+            return cached[1]
+        bits = self._bits(_PROC_KINDS, proc.id, None)
+        proc.flag_cache = (self.flag_key, bits)
+        return bits
+
+    def _bits(self, kinds: tuple[str, ...], process: str, activity: str | None) -> int:
+        bits = 0
+        for n, kind in enumerate(kinds):
+            if self.wants(kind, process, activity):
+                bits |= 1 << n
+        return bits
+
+    def reselect(self) -> None:
+        """The listeners' selection changed (workflows loaded at run time)."""
+        self.flag_key = _flag_key(self.wants_all, self.wanted)
 
     def emit(self, kind: str, process: str | None = None, instance: int | None = None,
              activity: str | None = None, lane: str | None = None,
@@ -325,27 +355,20 @@ _ACT_KINDS = (EK.ACTIVITY_STARTED, EK.ACTIVITY_COMPLETED, EK.ACTIVITY_OFFERED,
 _PROC_KINDS = (EK.PROCESS_STARTED, EK.PROCESS_COMPLETED)
 
 
-class _Flags(dict[Any, int]):
-    """Which of ``kinds`` some listener wants, as bits, per activity or process id;
-    computed on first use (a hit is a plain dict lookup: cheaper than building a key)."""
+_FLAG_KEYS: dict[tuple[bool, frozenset[Any]], object] = {}
 
-    def __init__(self, state: RunState, kinds: tuple[str, ...]) -> None:
-        super().__init__()
-        self._state = state
-        self._kinds = kinds
 
-    def __missing__(self, key: Any) -> int:
-        state = self._state
-        if isinstance(key, str):
-            process, activity = key, None
-        else:
-            process, activity = key.process, key.id
-        bits = 0
-        for n, kind in enumerate(self._kinds):
-            if state.wants(kind, process, activity):
-                bits |= 1 << n
-        self[key] = bits
-        return bits
+def _flag_key(wants_all: bool, wanted: frozenset[Any]) -> object:
+    """One object per distinct listener selection: runs that select the same events share
+    the bits cached on a compiled package's activities (households run one after another
+    on one package)."""
+    key = (wants_all, wanted)
+    found = _FLAG_KEYS.get(key)
+    if found is None:
+        if len(_FLAG_KEYS) > 1000:           # a long-lived process with many selections
+            _FLAG_KEYS.clear()
+        found = _FLAG_KEYS[key] = object()
+    return found
 
 
 def _call(callback: Callable[[], None], _a: Any, _b: Any) -> None:

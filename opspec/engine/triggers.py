@@ -139,7 +139,7 @@ class Triggers(Part):
         self.state.raised_names.add(name)
         proc = inst.process.id if inst is not None else None
         aid = act.id if act is not None else None
-        if (self.state.aflags[act] & 16 if act is not None
+        if (self.state.act_bits(act) & 16 if act is not None
                 else self.state.wants_all or (EK.TRIGGER_RAISED, proc, aid) in self.state.wanted):
             self.state.emit(EK.TRIGGER_RAISED, proc, inst.id if inst else None, aid,
                       act.lane if act else None, act.participant if act else None,
@@ -385,8 +385,7 @@ class Triggers(Part):
         self.state.full = [(lst, None if selects is None else selects | expand_selectors_over(
             procs, frozenset(lst.selects), package_level=False))  # type: ignore[attr-defined]
             for lst, selects in self.state.full]
-        self.state.aflags.clear()                 # cached "nobody wants this" bits may be stale
-        self.state.pflags.clear()
+        self.state.reselect()                     # cached "nobody wants this" bits may be stale
 
     def arm_process(self, proc: CompiledProcess) -> None:
         """Arm the start and end triggers of ``proc`` (mode membership checked on firing)."""
