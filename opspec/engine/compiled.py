@@ -25,6 +25,7 @@ from opspec.model import CoordinationBuiltIn, Package, ParameterMode
 from opspec.model.bulk import gc_paused
 
 __all__ = [
+    "FlagCache",
     "J_AND",
     "J_COMPLEX",
     "J_COUNT",
@@ -145,6 +146,17 @@ class CTool:
     script: tuple[tuple[str, Evaluator], ...] | None = None
 
 
+class FlagCache:
+    """Which trace kinds a run's listeners want of an activity or process, as bits, and the
+    listener selection they were computed for (one object: set in one store)."""
+
+    __slots__ = ("bits", "key")
+
+    def __init__(self, key: object, bits: int) -> None:
+        self.key = key
+        self.bits = bits
+
+
 @dataclass(slots=True, eq=False)
 class CompiledActivity:
     """One activity of a graph, ready to run. Not mutated after compilation."""
@@ -217,7 +229,7 @@ class CompiledActivity:
     simple_end: bool = False                 # completes with no assignment/throw/raise/terminate
     # which trace kinds the run's listeners want of it, as bits, with the selection they were
     # computed for (RunState.act_bits): one attribute read on the hot path, not a lookup
-    flag_cache: tuple[object, int] | None = None
+    flag_cache: FlagCache | None = None
 
     def where(self) -> str:
         return str(self.location) if self.location is not None else "<built in Python>"
@@ -261,7 +273,7 @@ class CompiledProcess:
     # none start events; BPMN 2.0 §13.3.4: the triggered ones "are ignored when the Process
     # is called from another Process")
     called_starts: tuple[int, ...] = ()
-    flag_cache: tuple[object, int] | None = None    # as CompiledActivity.flag_cache
+    flag_cache: FlagCache | None = None    # as CompiledActivity.flag_cache
 
 
 @dataclass(slots=True, eq=False)

@@ -25,7 +25,12 @@ from typing import TYPE_CHECKING, Any, final
 import simpy
 
 from opspec.engine.clock import Clock
-from opspec.engine.compiled import CompiledActivity, CompiledPackage, CompiledProcess
+from opspec.engine.compiled import (
+    CompiledActivity,
+    CompiledPackage,
+    CompiledProcess,
+    FlagCache,
+)
 from opspec.engine.config import EngineConfig
 from opspec.engine.instances import ActivityInstance, Frame, ProcessInstance
 from opspec.engine.lifecycle import RUNNING, SUSPENDED
@@ -140,19 +145,19 @@ class RunState:
         """Which of ``_ACT_KINDS`` some listener wants of ``act``, as bits (computed once per
         listener selection and kept on the activity)."""
         cached = act.flag_cache
-        if cached is not None and cached[0] is self.flag_key:
-            return cached[1]
+        if cached is not None and cached.key is self.flag_key:
+            return cached.bits
         bits = self._bits(_ACT_KINDS, act.process, act.id)
-        act.flag_cache = (self.flag_key, bits)
+        act.flag_cache = FlagCache(self.flag_key, bits)
         return bits
 
     def proc_bits(self, proc: CompiledProcess) -> int:
         """Which of ``_PROC_KINDS`` some listener wants of ``proc``, as bits."""
         cached = proc.flag_cache
-        if cached is not None and cached[0] is self.flag_key:
-            return cached[1]
+        if cached is not None and cached.key is self.flag_key:
+            return cached.bits
         bits = self._bits(_PROC_KINDS, proc.id, None)
-        proc.flag_cache = (self.flag_key, bits)
+        proc.flag_cache = FlagCache(self.flag_key, bits)
         return bits
 
     def _bits(self, kinds: tuple[str, ...], process: str, activity: str | None) -> int:
