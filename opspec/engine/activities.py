@@ -59,8 +59,8 @@ class Activities(Part):
         act = ai.act
         text = (f"{act.where()}: activity {act.id!r} of process {act.process!r} calls "
                 f"{target.id!r} {MAX_CALL_DEPTH + 1} synchronous subflow calls deep at "
-                f"t={self.state.env.now:.3f} s: the recursion does not reach its base case")
-        self.state.faults.append({"time": self.state.env.now, "process": act.process,
+                f"t={self.state.now:.3f} s: the recursion does not reach its base case")
+        self.state.faults.append({"time": self.state.now, "process": act.process,
                             "instance": ai.frame.inst.id, "activity": act.id, "message": text})
         self.flow.end_instance(root, ABORTED, text)
 
@@ -81,7 +81,7 @@ class Activities(Part):
             steps += 1
             if steps > limit:                   # a zero-time cycle (see RunState.drain)
                 self.state.zero_time(frame, act)
-            if self.state.aflags[act] & 1:
+            if self.state.act_bits(act) & 1:
                 self.state.emit(EK.ACTIVITY_STARTED, act.process, inst.id, act.id, act.lane,
                           act.participant)
             if act.start_assign and not self.flow.assign(inst, act, act.start_assign):
@@ -96,7 +96,7 @@ class Activities(Part):
 
     def _params_in(self, inst: ProcessInstance, act: CompiledActivity
                    ) -> dict[str, Any] | None:
-        now = self.state.env.now
+        now = self.state.now
         try:
             return {formal: fn(inst.scope, now)
                     for _mode, formal, fn, _target in act.params if fn is not None}
@@ -105,12 +105,12 @@ class Activities(Part):
             return None
 
     def _start_slow(self, frame: Frame, act: CompiledActivity) -> None:
-        ai = ActivityInstance(next(self.state.keys), act, frame, self.state.env.now)
+        ai = ActivityInstance(next(self.state.keys), act, frame, self.state.now)
         ai.state = RUNNING
         frame.running[ai.key] = ai
         if act.plain and not (act.general and self.state.pooled):
             inst = frame.inst
-            if self.state.aflags[act] & 1:
+            if self.state.act_bits(act) & 1:
                 self.state.emit(EK.ACTIVITY_STARTED, act.process, inst.id, act.id, act.lane,
                           act.participant)
             if act.start_assign and not self.flow.assign(inst, act, act.start_assign):
@@ -141,7 +141,7 @@ class Activities(Part):
         self.state.emit_act(EK.ACTIVITY_STARTED, inst, act)
         if act.start_assign and not self.flow.assign(inst, act, act.start_assign, ai.scope()):
             return
-        now = self.state.env.now
+        now = self.state.now
         # a multi-instance activity's deadlines and boundary events are the whole activity's:
         # armed once, on the group's holder, when its first instance starts
         armed = ai if ai.mi is None else (ai.mi.holder if ai.iteration == 0 else None)
@@ -176,7 +176,7 @@ class Activities(Part):
         if cond is None:
             return maximum is not None
         inst = ai.frame.inst
-        return bool(cond(inst.scope, self.state.env.now))
+        return bool(cond(inst.scope, self.state.now))
 
     def _run_body(self, ai: ActivityInstance, _a: Any = None, _b: Any = None) -> None:
         if ai.state != RUNNING:
@@ -196,7 +196,7 @@ class Activities(Part):
                                    {"waiting": self.state.pool.waiting, "priority": level})
                 return
             if cpu > 0.0:
-                self.state.dedicated.burst(self.state.env.now, cpu)
+                self.state.dedicated.burst(self.state.now, cpu)
                 ai.waiting = "cpu"
                 self.state.later(cpu, self._after_cpu_cb, ai)
                 return
@@ -334,7 +334,7 @@ class Activities(Part):
 
     def _inputs(self, ai: ActivityInstance) -> dict[str, Any] | None:
         reads = ai.scope()
-        now = self.state.env.now
+        now = self.state.now
         out: dict[str, Any] = {}
         try:
             for _mode, formal, fn, _target in ai.act.params:
@@ -391,7 +391,7 @@ class Activities(Part):
                      params: tuple[tuple[ParameterMode, str, Any, str | None], ...]
                      ) -> dict[str, Any] | None:
         reads = ai.scope()
-        now = self.state.env.now
+        now = self.state.now
         out: dict[str, Any] = {}
         try:
             for _mode, formal, fn, _target in params:
@@ -409,7 +409,7 @@ class Activities(Part):
         actual parameters' values (OUT formals start unset), the statements run in order,
         OUT/INOUT formals are written back to the actual parameters' data fields."""
         inst = ai.frame.inst
-        now = self.state.env.now
+        now = self.state.now
         local: dict[str, Any] = {}
         reads = ai.scope()
         try:

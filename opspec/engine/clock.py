@@ -10,12 +10,13 @@ SimPy's private state (``tests/engine/test_engine_shape.py`` checks that). Time 
 order of a run is SimPy's ``(time, priority, event id)`` and ``run(until)`` stops before what
 falls at ``until`` as SimPy does.
 
-:class:`Clock` is the environment a run makes when it is given none. It adds one thing SimPy
-does not offer publicly: :attr:`Clock.scheduled`, how many events were scheduled on it (the
-run summary's ``sim_events``, "N simulation events"), counted by overriding the public
-:meth:`simpy.Environment.schedule` every event goes through — the same number SimPy's event
-ids reach, its ``run(until)`` stop event and the stop's requeueing included. It starts at the
-float ``0.0`` (SimPy's default is the int ``0``), so a trace writes time 0 as ``0.0``.
+:class:`Clock` is the environment a run makes when it is given none. The run summary's
+``sim_events`` ("N simulation events") is the number of events SimPy's event ids reach on it:
+the engine counts the timeouts it schedules itself (``RunState.sim_events``: a native counter,
+where overriding :meth:`simpy.Environment.schedule` cost a Python call and a ``super()`` per
+event), and :attr:`Clock.scheduled` counts the two events of each ``run(until)`` (its stop
+event and the stop's requeueing). It starts at the float ``0.0`` (SimPy's default is the
+int ``0``), so a trace writes time 0 as ``0.0``.
 
 A caller may pass any :class:`simpy.Environment` instead, e.g. one shared by the simulations
 of several households (``Simulation(..., env=env)``); the engine then schedules on it the
@@ -32,27 +33,31 @@ from typing import Any
 
 import simpy
 from simpy.core import EmptySchedule
-from simpy.events import NORMAL, EventPriority
 
 __all__ = ["Clock", "EmptySchedule", "events_scheduled"]
 
 
 class Clock(simpy.Environment):
-    """A SimPy environment that counts the events scheduled on it (:attr:`scheduled`)."""
+    """A SimPy environment that counts the stop events of its ``run(until)`` calls
+    (:attr:`scheduled`); the run counts its own timeouts (``RunState.sim_events``)."""
 
     def __init__(self, initial_time: float = 0.0) -> None:
         super().__init__(float(initial_time))
-        #: events scheduled so far (every one: timeouts, and run(until)'s stop events)
+        #: events SimPy scheduled for run(until): the stop event, and the stop put back
+        #: once it has stopped the run
         self.scheduled = 0
 
-    def schedule(self, event: simpy.Event, priority: EventPriority = NORMAL,
-                 delay: float = 0) -> None:
+    def run(self, until: Any = None) -> Any:
+        if until is None or isinstance(until, simpy.Event) or float(until) <= self.now:
+            return super().run(until)
         self.scheduled += 1
-        super().schedule(event, priority, delay)
+        value = super().run(until)
+        self.scheduled += 1
+        return value
 
 
 def events_scheduled(env: simpy.Environment) -> int | None:
-    """How many events were scheduled on ``env`` (``None``: a plain SimPy environment does
-    not say)."""
+    """How many stop events ``run(until)`` scheduled on ``env`` (``None``: a plain SimPy
+    environment does not say)."""
     scheduled: Any = getattr(env, "scheduled", None)
     return scheduled if isinstance(scheduled, int) else None

@@ -17,7 +17,7 @@ from __future__ import annotations
 
 from collections.abc import Callable, Iterable, Mapping
 from dataclasses import dataclass, field
-from typing import Any
+from typing import Any, Final
 
 from opspec.engine.sampling import Sampler
 from opspec.errors import SourceLocation
@@ -25,6 +25,7 @@ from opspec.model import CoordinationBuiltIn, Package, ParameterMode
 from opspec.model.bulk import gc_paused
 
 __all__ = [
+    "FlagCache",
     "J_AND",
     "J_COMPLEX",
     "J_COUNT",
@@ -64,19 +65,39 @@ Evaluator = Callable[[Mapping[str, Any], float], Any]
 """A compiled expression: ``fn(data, now) -> value``."""
 
 # activity kinds
-K_NOOP, K_TASK, K_MANUAL, K_SUBFLOW, K_ASYNC, K_CATCH, K_THROW, K_BLOCK, K_COORD, K_GATEWAY = (
-    range(10))
+K_NOOP: Final = 0
+K_TASK: Final = 1
+K_MANUAL: Final = 2
+K_SUBFLOW: Final = 3
+K_ASYNC: Final = 4
+K_CATCH: Final = 5
+K_THROW: Final = 6
+K_BLOCK: Final = 7
+K_COORD: Final = 8
+K_GATEWAY: Final = 9
 KIND_NAMES = ("noop", "task", "manual", "subflow", "async-subflow", "catch", "throw", "block",
               "coordination", "event-gateway")
 # joins and splits
-J_XOR, J_AND, J_OR, J_COMPLEX = range(4)
-J_COUNT = 4      # StartQuantity > 1 without another join: starts once per N arriving tokens
-S_XOR, S_AND, S_OR = range(3)
+J_XOR: Final = 0
+J_AND: Final = 1
+J_OR: Final = 2
+J_COMPLEX: Final = 3
+J_COUNT: Final = 4      # StartQuantity > 1 without another join: starts once per N arriving tokens
+S_XOR: Final = 0
+S_AND: Final = 1
+S_OR: Final = 2
 # multi-instance flow conditions: when the token moves on
-MI_NONE, MI_ONE, MI_ALL, MI_COMPLEX = range(4)
-MI_CANCEL = 4    # BPMN completionCondition: like MI_COMPLEX, and the rest are cancelled
+MI_NONE: Final = 0
+MI_ONE: Final = 1
+MI_ALL: Final = 2
+MI_COMPLEX: Final = 3
+MI_CANCEL: Final = 4    # BPMN completionCondition: like MI_COMPLEX, and the rest are cancelled
 # transition kinds
-T_NONE, T_COND, T_OTHERWISE, T_EXCEPTION, T_DEFAULT = range(5)
+T_NONE: Final = 0
+T_COND: Final = 1
+T_OTHERWISE: Final = 2
+T_EXCEPTION: Final = 3
+T_DEFAULT: Final = 4
 
 
 @dataclass(frozen=True, slots=True, eq=False)
@@ -123,6 +144,17 @@ class CTool:
     application: str
     params: tuple[tuple[ParameterMode, str, Evaluator | None, str | None], ...] = ()
     script: tuple[tuple[str, Evaluator], ...] | None = None
+
+
+class FlagCache:
+    """Which trace kinds a run's listeners want of an activity or process, as bits, and the
+    listener selection they were computed for (one object: set in one store)."""
+
+    __slots__ = ("bits", "key")
+
+    def __init__(self, key: object, bits: int) -> None:
+        self.key = key
+        self.bits = bits
 
 
 @dataclass(slots=True, eq=False)
@@ -195,6 +227,9 @@ class CompiledActivity:
     plain: bool = False                      # waits, but without deadline/loop/trigger/boundary
     next: int = -1                           # the one unconditional successor, if that is all
     simple_end: bool = False                 # completes with no assignment/throw/raise/terminate
+    # which trace kinds the run's listeners want of it, as bits, with the selection they were
+    # computed for (RunState.act_bits): one attribute read on the hot path, not a lookup
+    flag_cache: FlagCache | None = None
 
     def where(self) -> str:
         return str(self.location) if self.location is not None else "<built in Python>"
@@ -238,6 +273,7 @@ class CompiledProcess:
     # none start events; BPMN 2.0 §13.3.4: the triggered ones "are ignored when the Process
     # is called from another Process")
     called_starts: tuple[int, ...] = ()
+    flag_cache: FlagCache | None = None    # as CompiledActivity.flag_cache
 
 
 @dataclass(slots=True, eq=False)

@@ -12,7 +12,7 @@ from __future__ import annotations
 
 from collections import ChainMap
 from collections.abc import Mapping, MutableMapping
-from typing import Any
+from typing import Any, Final
 
 from opspec.engine.compiled import (
     J_AND,
@@ -33,6 +33,10 @@ from opspec.errors import OpspecError
 from opspec.model import ParameterMode
 
 _NEXT = LIFECYCLE.table
+# Final: module statics in the compiled engine, where a plain global is a dictionary lookup
+_COMPLETED_FROM_RUNNING: Final = _NEXT[(RUNNING, "complete")]
+_IN: Final = ParameterMode.IN
+_CHAIN: Final = ChainMap
 
 
 class Flow(Part):
@@ -47,14 +51,14 @@ class Flow(Part):
         if data:
             local.update(data)
         scope: MutableMapping[str, Any] = (
-            ChainMap(local, self.state.package_data) if self.state.package_data else local)
+            _CHAIN(local, self.state.package_data) if self.state.package_data else local)
         iid = next(self.state.ids)
         priority = proc.priority
         root = iid
         if parent is not None:
             root = parent.frame.inst.root
             priority = max(priority, parent.frame.inst.priority)
-        inst = ProcessInstance(iid, proc, local, scope, priority, parent, root, self.state.env.now)
+        inst = ProcessInstance(iid, proc, local, scope, priority, parent, root, self.state.now)
         inst.state = RUNNING
         inst.trigger = trigger
         if parent is not None:
@@ -62,7 +66,7 @@ class Flow(Part):
             inst.partner = parent.frame.inst.partner
         self.state.live[iid] = inst
         self.state.counts["started"] += 1
-        if self.state.pflags[proc.id] & 1:
+        if self.state.proc_bits(proc) & 1:
             self.state.emit(EK.PROCESS_STARTED, proc.id, iid, None, proc.lane, None,
                       {"trigger": trigger, "parent": parent.frame.inst.id if parent else None})
         frame = Frame(proc.graph, inst, None)
@@ -108,22 +112,22 @@ class Flow(Part):
             return
         if inst.state != RUNNING:
             return
-        inst.state = _NEXT[(RUNNING, "complete")]
+        inst.state = _COMPLETED_FROM_RUNNING
         inst.frames.clear()          # breaks the instance <-> frame cycle: freed by refcount
         self.state.live.pop(inst.id, None)
         if self.state.kept and inst.parent is None:
             self.triggers.drop_kept(inst)
         self.state.counts["completed"] += 1
         proc = inst.process
-        if self.state.pflags[proc.id] & 2:
+        if self.state.proc_bits(proc) & 2:
             self.state.emit(EK.PROCESS_COMPLETED, proc.id, inst.id, None, proc.lane, None,
-                      {"duration": self.state.env.now - inst.started_at})
+                      {"duration": self.state.now - inst.started_at})
         parent = inst.parent
         if parent is not None and parent.state == RUNNING:
             parent.child = None
             out = {}
             for mode, formal, _fn, target in parent.act.params:
-                if mode is not ParameterMode.IN and target is not None:
+                if mode is not _IN and target is not None:
                     out[target] = inst.data.get(formal)
             self.activities.body_done(parent, out or None)
 
@@ -158,8 +162,8 @@ class Flow(Part):
             str(inst.process.location) if inst.process.location else "<built in Python>")
         what = f"activity {act.id!r} of " if act is not None else ""
         text = (f"{where}: {what}process {inst.process.id!r} (instance {inst.id}) aborted at "
-                f"t={self.state.env.now:.3f} s: {message}")
-        self.state.faults.append({"time": self.state.env.now, "process": inst.process.id,
+                f"t={self.state.now:.3f} s: {message}")
+        self.state.faults.append({"time": self.state.now, "process": inst.process.id,
                             "instance": inst.id, "activity": act.id if act else None,
                             "message": text})
         self.end_instance(inst, ABORTED, text)
@@ -293,7 +297,7 @@ class Flow(Part):
             return False
         inst = frame.inst
         try:
-            holds = condition(inst.scope, self.state.env.now)
+            holds = condition(inst.scope, self.state.now)
         except OpspecError as error:
             self.abort(inst, owner.act, f"the AdHocCompletionCondition failed: {error.message}")
             return True
@@ -317,8 +321,8 @@ class Flow(Part):
         """Record a deadlock of ``inst`` (trace + summary) and abort it."""
         proc = inst.process
         text = (f"deadlock in process {proc.id!r} (instance {inst.id}) at "
-                f"t={self.state.env.now:.3f} s: {why}; waiting: {', '.join(waiting) or '-'}")
-        self.state.deadlocks.append({"time": self.state.env.now, "process": proc.id, "instance": inst.id,
+                f"t={self.state.now:.3f} s: {why}; waiting: {', '.join(waiting) or '-'}")
+        self.state.deadlocks.append({"time": self.state.now, "process": proc.id, "instance": inst.id,
                                "waiting": waiting, "message": text})
         if self.state.wants(EK.DEADLOCK, proc.id, None):
             self.state.emit(EK.DEADLOCK, proc.id, inst.id, None, proc.lane, None,
@@ -345,7 +349,7 @@ class Flow(Part):
         """
         inst = frame.inst
         if act.simple_end:
-            if self.state.aflags[act] & 2:
+            if self.state.act_bits(act) & 2:
                 self.state.emit(EK.ACTIVITY_COMPLETED, act.process, inst.id, act.id, act.lane,
                           act.participant)
             nxt = act.next
@@ -359,7 +363,7 @@ class Flow(Part):
             return None
         if act.kind == K_THROW and act.trigger is not None:
             self.triggers.broadcast(act.trigger.kind, act.trigger.name or "", None, inst, act)
-        if self.state.aflags[act] & 2:
+        if self.state.act_bits(act) & 2:
             self.state.emit(EK.ACTIVITY_COMPLETED, act.process, inst.id, act.id, act.lane,
                       act.participant)
         if act.raises is not None and inst.state == RUNNING:
@@ -395,7 +399,7 @@ class Flow(Part):
             trans = act.out[0]
         elif act.split == S_XOR and not act.choice and not act.drawn and (act.out or act.otherwise):
             scope = inst.scope
-            now = self.state.env.now
+            now = self.state.now
             try:
                 for trans in act.out:
                     cond = trans.condition
@@ -428,7 +432,7 @@ class Flow(Part):
 
     def _leave(self, frame: Frame, act: CompiledActivity) -> None:
         if act.choice:
-            ai = ActivityInstance(next(self.state.keys), act, frame, self.state.env.now)
+            ai = ActivityInstance(next(self.state.keys), act, frame, self.state.now)
             ai.state = RUNNING
             frame.running[ai.key] = ai
             self.offers.offer_choice(ai, act.choice)
@@ -441,7 +445,7 @@ class Flow(Part):
         if outs or act.otherwise:
             inst = frame.inst
             scope = inst.scope
-            now = self.state.env.now
+            now = self.state.now
             taken = False
             try:
                 if act.split == S_XOR:
@@ -511,7 +515,7 @@ class Flow(Part):
     def take(self, frame: Frame, trans: CTransition, performed: bool = False) -> None:
         if trans.assignments:
             inst = frame.inst
-            now = self.state.env.now
+            now = self.state.now
             for target, fn in trans.assignments:
                 self.set_field(inst, None, target, fn(inst.scope, now))
         frame.live += 1
@@ -541,7 +545,7 @@ class Flow(Part):
             inst.data[target] = value
         else:
             self.state.package_data[target] = value
-        if (self.state.aflags[act] & 8 if act is not None
+        if (self.state.act_bits(act) & 8 if act is not None
                 else self.state.wants_all or (EK.DATA_CHANGED, inst.process.id, None) in self.state.wanted):
             self.state.emit(EK.DATA_CHANGED, inst.process.id, inst.id,
                       act.id if act is not None else None, inst.process.lane, None,
@@ -555,7 +559,7 @@ class Flow(Part):
         """Run ``assignments`` (reading ``scope``, by default the instance's data); ``False``
         when the instance ended meanwhile (a failed assignment aborts it; a data change can
         fire its end trigger): the caller stops."""
-        now = self.state.env.now
+        now = self.state.now
         reads = inst.scope if scope is None else scope
         try:
             for target, fn in assignments:

@@ -107,7 +107,7 @@ class Interpreter(RunState):
             part.connect(flow, activities, triggers, offers)
         # the processor model (opspec/engine/processors.py) and the switch cost the engine
         # adds to each general activity (0 where the model charges its own switches)
-        self.pool = make_processor(self.env, config, activities.after_cpu, _alive)
+        self.pool = make_processor(self.env, config, activities.after_cpu, _alive, self.timer)
         self.switch = self.pool.activity_switch if self.pool is not None else 0.0
 
     # ------------------------------------------------------------------ instances
@@ -115,19 +115,23 @@ class Interpreter(RunState):
                       parent: ActivityInstance | None = None, trigger: str | None = None
                       ) -> ProcessInstance:
         """Create and start an instance of ``proc`` (its start activities are queued)."""
+        self.sync()
         return self.flow.start_process(proc, data, parent=parent, trigger=trigger)
 
     def end_instance(self, inst: ProcessInstance, state: int, reason: str,
                      notify_parent: bool = True) -> None:
         """Terminate or abort ``inst`` (see :meth:`opspec.engine.flow.Flow.end_instance`)."""
+        self.sync()
         self.flow.end_instance(inst, state, reason, notify_parent)
 
     def abort(self, inst: ProcessInstance, act: CompiledActivity | None, message: str) -> None:
         """Abort ``inst`` with a located message (recorded as a fault); the run goes on."""
+        self.sync()
         self.flow.abort(inst, act, message)
 
     def report_deadlock(self, inst: ProcessInstance, waiting: list[str], why: str) -> None:
         """Record a deadlock of ``inst`` (trace + summary) and abort it."""
+        self.sync()
         self.flow.report_deadlock(inst, waiting, why)
 
     # ------------------------------------------------------------------ triggers
@@ -135,9 +139,11 @@ class Interpreter(RunState):
                   inst: ProcessInstance | None = None, act: CompiledActivity | None = None
                   ) -> None:
         """Raise a signal or send a message (:meth:`opspec.engine.triggers.Triggers.broadcast`)."""
+        self.sync()
         self.triggers.broadcast(kind, name, data, inst, act)
 
     def terminate_all(self, process_id: str, reason: str) -> None:
+        self.sync()
         self.triggers.terminate_all(process_id, reason)
 
     def is_active(self, process_id: str) -> bool:
@@ -147,21 +153,26 @@ class Interpreter(RunState):
     def change_mode(self, mode: str, act: CompiledActivity | None = None,
                     inst: ProcessInstance | None = None) -> None:
         """Switch the active workflow set (:meth:`opspec.engine.triggers.Triggers.change_mode`)."""
+        self.sync()
         self.triggers.change_mode(mode, act, inst)
 
     def push_data(self, channel: str, value: Any) -> None:
         """Put ``value`` into supervisor mailbox ``channel``; a waiting pull gets it."""
+        self.sync()
         self.activities.push_data(channel, value)
 
     # ------------------------------------------------------------------ performers' answers
     def performer_complete(self, item: WorkItem, data: Mapping[str, Any] | None,
                            choice: str | None) -> None:
+        self.sync()
         self.offers.performer_complete(item, data, choice)
 
     def performer_omit(self, item: WorkItem, reason: str) -> None:
+        self.sync()
         self.offers.performer_omit(item, reason)
 
     def performer_fail(self, item: WorkItem, exception: str, message: str) -> None:
+        self.sync()
         self.offers.performer_fail(item, exception, message)
 
 

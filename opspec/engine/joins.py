@@ -53,7 +53,7 @@ def complex_fires(flow: Flow, frame: Frame, act: CompiledActivity, counts: list[
     condition = act.join_condition
     assert condition is not None
     try:
-        holds = condition(ChainMap({"activationCount": active}, inst.scope), flow.state.env.now)
+        holds = condition(ChainMap({"activationCount": active}, inst.scope), flow.state.now)
     except OpspecError as error:
         flow.abort(inst, act, f"the IncomingCondition failed: {error.message}")
         return False

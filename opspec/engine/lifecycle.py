@@ -16,6 +16,7 @@ from __future__ import annotations
 
 from collections.abc import Mapping
 from types import MappingProxyType
+from typing import Final
 
 from opspec.errors import ExecutionError
 
@@ -32,7 +33,12 @@ __all__ = [
     "LifeCycle",
 ]
 
-NOT_STARTED, RUNNING, SUSPENDED, COMPLETED, TERMINATED, ABORTED = range(6)
+NOT_STARTED: Final = 0
+RUNNING: Final = 1
+SUSPENDED: Final = 2
+COMPLETED: Final = 3
+TERMINATED: Final = 4
+ABORTED: Final = 5
 STATE_NAMES = ("not_started", "running", "suspended", "completed", "terminated", "aborted")
 TRIGGERS = ("start", "suspend", "resume", "complete", "terminate", "abort")
 

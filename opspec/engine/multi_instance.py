@@ -30,7 +30,7 @@ def begin(acts: Activities, ai: ActivityInstance) -> bool:
     inst = frame.inst
     count_fn, parallel, _flow, _cond = act.mi  # type: ignore[misc]
     try:
-        raw = count_fn(inst.scope, acts.state.env.now)
+        raw = count_fn(inst.scope, acts.state.now)
     except OpspecError as error:
         acts.flow.abort(inst, act, f"the MI_Condition failed: {error.message}")
         return False
@@ -58,7 +58,7 @@ def begin(acts: Activities, ai: ActivityInstance) -> bool:
         return False
     group = MultiInstance(count, items)
     if act.deadlines or act.boundary:
-        holder = ActivityInstance(next(acts.state.keys), act, frame, acts.state.env.now)
+        holder = ActivityInstance(next(acts.state.keys), act, frame, acts.state.now)
         holder.state = RUNNING
         holder.mi = group
         group.holder = holder
@@ -80,7 +80,7 @@ def _join(ai: ActivityInstance, group: MultiInstance, element: str | None) -> No
 
 
 def _next(acts: Activities, frame: Frame, act: CompiledActivity, group: MultiInstance) -> None:
-    ai = ActivityInstance(next(acts.state.keys), act, frame, acts.state.env.now)
+    ai = ActivityInstance(next(acts.state.keys), act, frame, acts.state.now)
     ai.state = RUNNING
     frame.running[ai.key] = ai
     _join(ai, group, act.mi_element)
@@ -110,7 +110,7 @@ def done(acts: Activities, ai: ActivityInstance, group: MultiInstance) -> None:
                         "nrOfCompletedInstances": group.completed,
                         "nrOfActiveInstances": len(group.members)}
             try:
-                moves = bool(cond(ChainMap(counters, ai.scope()), acts.state.env.now))
+                moves = bool(cond(ChainMap(counters, ai.scope()), acts.state.now))
             except OpspecError as error:
                 acts.flow.abort(inst, act, f"the ComplexMI_FlowCondition failed: "
                            f"{error.message}")

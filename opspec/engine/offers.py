@@ -11,7 +11,7 @@ from __future__ import annotations
 from collections import ChainMap
 from collections.abc import Mapping
 from types import MappingProxyType
-from typing import Any
+from typing import Any, Final
 
 from opspec.engine.compiled import (
     K_CATCH,
@@ -30,6 +30,9 @@ from opspec.engine.part import Part
 from opspec.engine.performers import Performer, WorkItem
 from opspec.engine.trace import EventKind as EK
 from opspec.errors import ExecutionError
+
+# Final: a module static in the compiled engine, where a plain global is a dictionary lookup
+_PROXY: Final = MappingProxyType
 
 
 class Offers(Part):
@@ -51,9 +54,9 @@ class Offers(Part):
         act = ai.act
         inst = ai.frame.inst
         item = WorkItem(ai.key, act.process, inst.id, act.id, act.label, act.participant,
-                        act.lane, self.state.env.now,
+                        act.lane, self.state.now,
                         application if application is not None else act.application,
-                        data if data is not None else MappingProxyType(
+                        data if data is not None else _PROXY(
                             inst.data if ai.local is None else ChainMap(ai.local, inst.data)),
                         choices,
                         inst.root, duration)
@@ -61,7 +64,7 @@ class Offers(Part):
         ai.performer = performer
         ai.waiting = "performer"
         self.state.offered[ai.key] = ai
-        if self.state.aflags[act] & 4:
+        if self.state.act_bits(act) & 4:
             self.state.emit(EK.ACTIVITY_OFFERED, act.process, inst.id, act.id, act.lane,
                       act.participant, {"choices": list(choices)} if choices else None)
         performer.offer(item)
@@ -159,7 +162,7 @@ class Offers(Part):
                     raise ExecutionError(
                         f"work item {item.key} ({item.activity}) needs a choice among "
                         f"{', '.join(item.choices)}, got {choice!r}",
-                        hint="call complete(item, choice=ACTIVITY_ID)", sim_time=self.state.env.now)
+                        hint="call complete(item, choice=ACTIVITY_ID)", sim_time=self.state.now)
             self.state.ready.append((self._choose, ai, trans, data))
         elif ai.act.toolchain and ai.key in self.state.tool_at:
             self.state.ready.append((self.activities.tool_done, ai, data, None))

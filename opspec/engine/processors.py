@@ -43,16 +43,35 @@ import simpy
 if TYPE_CHECKING:
     from opspec.engine.config import EngineConfig
 
+#: schedules ``callback()`` after a delay in simulated seconds
+Timer = Callable[[float, Callable[[], None]], None]
+
+
+class _SimpyTimer:
+    """A timer on a bare SimPy environment (a processor built outside a run)."""
+
+    __slots__ = ("env",)
+
+    def __init__(self, env: simpy.Environment) -> None:
+        self.env = env
+
+    def __call__(self, delay: float, callback: Callable[[], None]) -> None:
+        self.env.timeout(delay).callbacks.append(lambda _e: callback())
+
+
 __all__ = ["DedicatedProcessor", "PooledProcessor", "PreemptiveProcessor",
            "PriorityQueueProcessor", "make_processor"]
 
 
 def make_processor(env: simpy.Environment, config: EngineConfig,
-                   on_done: Callable[[Any], None], is_alive: Callable[[Any], bool]
-                   ) -> PooledProcessor | None:
+                   on_done: Callable[[Any], None], is_alive: Callable[[Any], bool],
+                   timer: Timer | None = None) -> PooledProcessor | None:
     """The shared processors ``config`` asks for (``None``: the dedicated model). Its
     ``activity_switch`` is the switch cost the engine adds to each general activity's
-    demand (the models that charge their own switches say 0)."""
+    demand (the models that charge their own switches say 0). ``timer(delay, callback)``
+    schedules the processors' timeouts (the run's :meth:`RunState.timer
+    <opspec.engine.runstate.RunState.timer>`, which counts them and tells the engine the
+    time; by default a plain SimPy timeout on ``env``)."""
     model = config.processor_model
     pool: PooledProcessor
     if model == "preemptive":
@@ -65,6 +84,8 @@ def make_processor(env: simpy.Environment, config: EngineConfig,
         pool = PooledProcessor(env, config.workers, config.priorities, on_done, is_alive)
     else:
         return None
+    if timer is not None:
+        pool.timer = timer
     if model != "priority-queues":
         pool.activity_switch = config.switch_cost
     return pool
@@ -82,6 +103,7 @@ class PooledProcessor:
         "activity_switch",
         "busy_time",
         "env",
+        "timer",
         "free",
         "is_alive",
         "max_waiting",
@@ -94,6 +116,7 @@ class PooledProcessor:
     def __init__(self, env: simpy.Environment, workers: int, priorities: int,
                  on_done: Callable[[Any], None], is_alive: Callable[[Any], bool]) -> None:
         self.env = env
+        self.timer: Timer = _SimpyTimer(env)
         self.free = workers
         self.queues: list[deque[tuple[Any, float]]] = [deque() for _ in range(priorities)]
         self.waiting = 0
@@ -125,7 +148,7 @@ class PooledProcessor:
         self.switches += 1
         self.busy_time += cost
         if cost > 0.0:
-            self.env.timeout(cost).callbacks.append(lambda _e: self._finished(job))
+            self.timer(cost, lambda: self._finished(job))
         else:
             self._finished(job)
 
@@ -233,8 +256,7 @@ class PreemptiveProcessor(PooledProcessor):
 
     def _arm(self, entry: list[Any]) -> None:
         generation = entry[4]
-        self.env.timeout(max(0.0, entry[2])).callbacks.append(
-            lambda _e: self._done(entry, generation))
+        self.timer(max(0.0, entry[2]), lambda: self._done(entry, generation))
 
     def _preempt(self, entry: list[Any]) -> None:
         ran = self.env.now - entry[3]
@@ -408,8 +430,8 @@ class PriorityQueueProcessor(PooledProcessor):
         thread.started = self.env.now
         thread.generation += 1
         generation = thread.generation
-        self.env.timeout(self.switch_cost + thread.remaining).callbacks.append(
-            lambda _e: self._segment_end(thread, generation))
+        self.timer(self.switch_cost + thread.remaining,
+                   lambda: self._segment_end(thread, generation))
 
     def _preempt(self, thread: _Thread) -> None:
         now = self.env.now

@@ -20,12 +20,17 @@ import itertools
 from collections import deque
 from collections.abc import Callable, Mapping
 from types import MappingProxyType
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, final
 
 import simpy
 
 from opspec.engine.clock import Clock
-from opspec.engine.compiled import CompiledActivity, CompiledPackage, CompiledProcess
+from opspec.engine.compiled import (
+    CompiledActivity,
+    CompiledPackage,
+    CompiledProcess,
+    FlagCache,
+)
 from opspec.engine.config import EngineConfig
 from opspec.engine.instances import ActivityInstance, Frame, ProcessInstance
 from opspec.engine.lifecycle import RUNNING, SUSPENDED
@@ -65,6 +70,12 @@ class RunState:
         self.compiled = compiled
         self.config = config
         self.env = env if env is not None else Clock()
+        # The time, as the engine reads it: SimPy's ``env.now`` is a Python property, read
+        # once per timed callback the engine handles (:meth:`enter`) and at each call from
+        # outside one (:meth:`sync`) instead of at every use (some 38 a dose cycle).
+        self.now = float(self.env.now)
+        self.inside = False         # handling one of its own timed callbacks: now is fresh
+        self.sim_events = 0         # timeouts scheduled (the summary's sim_events)
         self.registry = performers
         self.streams = Streams(seed, scope)
         self.mode_loader = mode_loader
@@ -124,18 +135,48 @@ class RunState:
         self.pkg = compiled.id
         (self.listeners, self.raw, self.wants_all, self.selectors, self.wanted,
          self.full) = _listener_tables(listeners, compiled)
-        self.aflags = _Flags(self, _ACT_KINDS)      # CompiledActivity -> wanted-kind bits
-        self.pflags = _Flags(self, _PROC_KINDS)     # process id -> wanted-kind bits
+        # which selection the wanted-kind bits cached on activities and processes are of
+        self.flag_key = _flag_key(self.wants_all, self.wanted)
 
     def wants(self, kind: str, process: str | None, activity: str | None) -> bool:
         return self.wants_all or (kind, process, activity) in self.wanted
+
+    def act_bits(self, act: CompiledActivity) -> int:
+        """Which of ``_ACT_KINDS`` some listener wants of ``act``, as bits (computed once per
+        listener selection and kept on the activity)."""
+        cached = act.flag_cache
+        if cached is not None and cached.key is self.flag_key:
+            return cached.bits
+        bits = self._bits(_ACT_KINDS, act.process, act.id)
+        act.flag_cache = FlagCache(self.flag_key, bits)
+        return bits
+
+    def proc_bits(self, proc: CompiledProcess) -> int:
+        """Which of ``_PROC_KINDS`` some listener wants of ``proc``, as bits."""
+        cached = proc.flag_cache
+        if cached is not None and cached.key is self.flag_key:
+            return cached.bits
+        bits = self._bits(_PROC_KINDS, proc.id, None)
+        proc.flag_cache = FlagCache(self.flag_key, bits)
+        return bits
+
+    def _bits(self, kinds: tuple[str, ...], process: str, activity: str | None) -> int:
+        bits = 0
+        for n, kind in enumerate(kinds):
+            if self.wants(kind, process, activity):
+                bits |= 1 << n
+        return bits
+
+    def reselect(self) -> None:
+        """The listeners' selection changed (workflows loaded at run time)."""
+        self.flag_key = _flag_key(self.wants_all, self.wanted)
 
     def emit(self, kind: str, process: str | None = None, instance: int | None = None,
              activity: str | None = None, lane: str | None = None,
              participant: str | None = None, data: Mapping[str, Any] | None = None) -> None:
         """Send one trace event to every listener (callers check :meth:`wants` first)."""
         self.seq += 1
-        now = self.env.now
+        now = self.now
         for raw in self.raw:
             raw(now, kind, process, instance, activity, data)
         if self.full:
@@ -212,24 +253,44 @@ class RunState:
         if sampler.record(a, b) or starts >= self.max_instant_starts + SAMPLE_STARTS:
             raise sampler.error(starts)
 
+    def sync(self) -> None:
+        """Control enters the engine from outside its own timed callbacks (a performer
+        answering from a SimPy process or the TUI, ``run``/``step``, a device's post): read
+        the clock, which may have moved since the engine last looked."""
+        if not self.inside:
+            self.now = float(self.env.now)
+
+    def enter(self) -> bool:
+        """A timed callback of this run starts: the clock moved to its time. Returns whether
+        one was already running (a nested entry leaves the flag to the outer one)."""
+        self.now = float(self.env.now)
+        outer = self.inside
+        self.inside = True
+        return outer
+
     def later(self, delay: float, fn: Callable[[ActivityInstance, Any], None],
                ai: ActivityInstance, arg: Any = None) -> None:
         """Call ``fn(ai, arg)`` after ``delay`` simulated seconds if ``ai`` is still waiting."""
         if self.resolution > 0.0:
             delay = self._align(delay)
-        gen = ai.gen
-        self.env.timeout(max(0.0, delay)).callbacks.append(
-            lambda _e: self._fire(fn, ai, arg, gen))
+        self.sim_events += 1
+        self.env.timeout(max(0.0, delay)).callbacks.append(_Later(self, fn, ai, arg))
 
-    def _fire(self, fn: Callable[[ActivityInstance, Any], None], ai: ActivityInstance,
-              arg: Any, gen: int) -> None:
+    def fire(self, fn: Callable[[ActivityInstance, Any], None], ai: ActivityInstance,
+             arg: Any, gen: int) -> None:
+        """A :meth:`later` callback is due (nothing to do, not even a look at the clock,
+        when ``ai`` has moved on: a deadline that lost its race)."""
         if ai.gen == gen and ai.state == RUNNING:
-            inst = ai.frame.inst
-            if inst.state == SUSPENDED:
-                inst.deferred.append((self._refire, fn, ai, (arg, gen)))
-                return
-            fn(ai, arg)
-            self.drain()
+            outer = self.enter()
+            try:
+                inst = ai.frame.inst
+                if inst.state == SUSPENDED:
+                    inst.deferred.append((self._refire, fn, ai, (arg, gen)))
+                    return
+                fn(ai, arg)
+                self.drain()
+            finally:
+                self.inside = outer
 
     def _refire(self, fn: Callable[[ActivityInstance, Any], None], ai: ActivityInstance,
                 arg_gen: tuple[Any, int]) -> None:
@@ -239,7 +300,7 @@ class RunState:
 
     def _align(self, delay: float) -> float:
         res = self.resolution
-        now = self.env.now
+        now = self.now
         target = -(-(now + delay) // res) * res
         return max(0.0, target - now)
 
@@ -253,19 +314,30 @@ class RunState:
         if delay <= 0.0 and self.draining:
             self.ready.append((_call, callback, None, None))
             return
-        self.env.timeout(max(0.0, delay)).callbacks.append(
-            lambda _e: self._callback(callback))
+        self.sim_events += 1
+        self.env.timeout(max(0.0, delay)).callbacks.append(_CallAt(self, callback, True))
 
-    def _callback(self, callback: Callable[[], None]) -> None:
-        callback()
-        self.drain()
+    def timer(self, delay: float, callback: Callable[[], None]) -> None:
+        """Run ``callback`` after ``delay`` simulated seconds (it drains itself, if it
+        must: the processors' and the start timers' callbacks)."""
+        self.sim_events += 1
+        self.env.timeout(max(0.0, delay)).callbacks.append(_CallAt(self, callback, False))
+
+    def called(self, callback: Callable[[], None], drain: bool) -> None:
+        outer = self.enter()
+        try:
+            callback()
+            if drain:
+                self.drain()
+        finally:
+            self.inside = outer
 
     def start_counted(self, frame: Frame) -> None:
         """A workflow instance was started (``frame`` its top frame): past
         ``max_instant_starts`` instances at one instant, a zero-time cycle that piles up
         instances (a workflow starting itself asynchronously), stopped and named like any
         zero-time cycle, within seconds and some tens of megabytes."""
-        now = self.env.now
+        now = self.now
         if not _same_instant(now, self.starts_at):
             self.starts_at = now
             self.instant_starts = 1
@@ -288,31 +360,54 @@ _ACT_KINDS = (EK.ACTIVITY_STARTED, EK.ACTIVITY_COMPLETED, EK.ACTIVITY_OFFERED,
 _PROC_KINDS = (EK.PROCESS_STARTED, EK.PROCESS_COMPLETED)
 
 
-class _Flags(dict[Any, int]):
-    """Which of ``kinds`` some listener wants, as bits, per activity or process id;
-    computed on first use (a hit is a plain dict lookup: cheaper than building a key)."""
+_FLAG_KEYS: dict[tuple[bool, frozenset[Any]], object] = {}
 
-    def __init__(self, state: RunState, kinds: tuple[str, ...]) -> None:
-        super().__init__()
-        self._state = state
-        self._kinds = kinds
 
-    def __missing__(self, key: Any) -> int:
-        state = self._state
-        if isinstance(key, str):
-            process, activity = key, None
-        else:
-            process, activity = key.process, key.id
-        bits = 0
-        for n, kind in enumerate(self._kinds):
-            if state.wants(kind, process, activity):
-                bits |= 1 << n
-        self[key] = bits
-        return bits
+def _flag_key(wants_all: bool, wanted: frozenset[Any]) -> object:
+    """One object per distinct listener selection: runs that select the same events share
+    the bits cached on a compiled package's activities (households run one after another
+    on one package)."""
+    key = (wants_all, wanted)
+    found = _FLAG_KEYS.get(key)
+    if found is None:
+        if len(_FLAG_KEYS) > 1000:           # a long-lived process with many selections
+            _FLAG_KEYS.clear()
+        found = _FLAG_KEYS[key] = object()
+    return found
 
 
 def _call(callback: Callable[[], None], _a: Any, _b: Any) -> None:
     callback()
+
+
+@final
+class _Later:
+    """The SimPy callback of :meth:`RunState.later` (a small object, not a closure: one
+    allocation instead of two per timeout)."""
+
+    def __init__(self, state: RunState, fn: Callable[[ActivityInstance, Any], None],
+                 ai: ActivityInstance, arg: Any) -> None:
+        self.state = state
+        self.fn = fn
+        self.ai = ai
+        self.arg = arg
+        self.gen = ai.gen
+
+    def __call__(self, _event: Any) -> None:
+        self.state.fire(self.fn, self.ai, self.arg, self.gen)
+
+
+@final
+class _CallAt:
+    """The SimPy callback of :meth:`RunState.call_at` and :meth:`RunState.timer`."""
+
+    def __init__(self, state: RunState, callback: Callable[[], None], drain: bool) -> None:
+        self.state = state
+        self.callback = callback
+        self.drain = drain
+
+    def __call__(self, _event: Any) -> None:
+        self.state.called(self.callback, self.drain)
 
 
 def discard(table: dict[Any, Any], key: Any) -> None:

@@ -95,7 +95,9 @@ class _Session:
 
     @property
     def now(self) -> float:
-        return self._sim.env.now
+        sim = self._sim
+        sim.sync()
+        return sim.now
 
     def complete(self, item: WorkItem, data: Mapping[str, Any] | None = None,
                  choice: str | None = None) -> None:
@@ -116,6 +118,7 @@ class _Session:
     def trace(self, kind: str, data: Mapping[str, Any] | None = None) -> None:
         sim = self._sim
         if sim.wants(kind, None, None):
+            sim.sync()
             sim.emit(kind, data=dict(data) if data else None)
 
 
@@ -174,6 +177,7 @@ class Simulation(Interpreter):
         if self._booted:
             return
         self._booted = True
+        self.sync()
         for performer in self.registry.performers():
             performer.attach(self.session)
         if self.wants(EK.RUN_STARTED, None, None):
@@ -191,7 +195,7 @@ class Simulation(Interpreter):
         if proc is None:
             raise ExecutionError(f"no process {process_id!r} in package {self.compiled.id!r}",
                                  hint="known: " + ", ".join(sorted(self.processes)))
-        inst = self.start_process(proc, data, trigger="api")
+        inst = self.start_process(proc, data, trigger="api")    # (reads the clock)
         self.drain()
         return inst.id
 
@@ -214,12 +218,14 @@ class Simulation(Interpreter):
     def suspend(self, instance_id: int) -> None:
         """Suspend an instance: nothing of it moves until :meth:`resume`."""
         inst = self._instance(instance_id)
+        self.sync()
         inst.state = LIFECYCLE.next(inst.state, "suspend", f"instance {instance_id}")
         if self.wants(EK.PROCESS_SUSPENDED, inst.process.id, None):
             self.emit(EK.PROCESS_SUSPENDED, inst.process.id, inst.id, None, inst.process.lane)
 
     def resume(self, instance_id: int) -> None:
         inst = self._instance(instance_id)
+        self.sync()
         inst.state = LIFECYCLE.next(inst.state, "resume", f"instance {instance_id}")
         if self.wants(EK.PROCESS_RESUMED, inst.process.id, None):
             self.emit(EK.PROCESS_RESUMED, inst.process.id, inst.id, None, inst.process.lane)
@@ -246,6 +252,7 @@ class Simulation(Interpreter):
             wake()
 
     def drain_posts(self) -> int:
+        self.sync()
         count = 0
         while True:
             try:
@@ -291,6 +298,7 @@ class Simulation(Interpreter):
             self.env.run()
         elif until > self.env.now:
             self.env.run(until=until)
+        self.sync()                      # run(until) stopped the clock at until
         self.check_waiting(horizon=until)
         if self.wants(EK.RUN_ENDED, None, None):
             self.emit(EK.RUN_ENDED, data={"open": len(self.live),
@@ -318,13 +326,20 @@ class Simulation(Interpreter):
             if waiting:
                 self.report_deadlock(inst, [f"{a} ({w})" for a, w in waiting], why)
 
+    def _sim_events(self) -> int | None:
+        """SimPy events scheduled for this run: its timeouts and, on its own
+        :class:`~opspec.engine.clock.Clock`, the clock's ``run(until)`` stop events (``None``
+        on a caller's plain SimPy environment)."""
+        stops = events_scheduled(self.env)
+        return None if stops is None else self.sim_events + stops
+
     def result(self) -> RunResult:
         """The result so far (metrics are computed incrementally)."""
         counts = dict(self.counts)
         counts["open"] = len(self.live)
         summary: dict[str, Any] = {
             "time": self.env.now, "seed": self.seed, "events": self.seq,
-            "sim_events": events_scheduled(self.env), "instances": counts,
+            "sim_events": self._sim_events(), "instances": counts,
             "deadlocks": list(self.deadlocks), "faults": list(self.faults),
             "stale_completions": self.stale_completions, "drift": self.drift,
             "mode": self.mode,

@@ -63,7 +63,7 @@ class Triggers(Part):
             every = trig.every or 0.0
             if persistent and trig.planned and every > 0.0 and trig.count != 1:
                 # a boundary timer with a timeCycle: every cycle while the activity runs
-                now = self.state.env.now
+                now = self.state.now
                 if trig.anchored:
                     first = max(0, math.ceil((now - trig.offset) / every))
                     self._cycle(ai, trig, handler, arg, trig.offset, first, trig.count)
@@ -72,19 +72,19 @@ class Triggers(Part):
                                 trig.count + 1 if trig.count >= 0 else -1)
                 return
             if trig.seconds is not None:
-                delay = float(trig.seconds(inst.scope, self.state.env.now))
+                delay = float(trig.seconds(inst.scope, self.state.now))
             else:
                 delay = trig.offset or (trig.every or 0.0)
             self.state.later(delay, lambda a, _x: handler(a, arg, None), ai)
         elif kind == "rule":
             assert trig.condition is not None
             inst = ai.frame.inst
-            if trig.condition(inst.scope, self.state.env.now):
+            if trig.condition(inst.scope, self.state.now):
                 handler(ai, arg, None)
                 return
             rkey = next(self.state.rule_keys)
             condition = trig.condition
-            self.state.rules[rkey] = (lambda: condition(inst.scope, self.state.env.now),
+            self.state.rules[rkey] = (lambda: condition(inst.scope, self.state.now),
                                  lambda: handler(ai, arg, None), ai)
             ai.cleanup.append(lambda: discard(self.state.rules, rkey))
 
@@ -96,7 +96,7 @@ class Triggers(Part):
         if 0 <= end <= k:
             return
         every = trig.every or 0.0
-        delay = base + k * every - self.state.env.now
+        delay = base + k * every - self.state.now
 
         def fired(target: ActivityInstance, _unused: Any) -> None:
             handler(target, arg, None)
@@ -139,7 +139,7 @@ class Triggers(Part):
         self.state.raised_names.add(name)
         proc = inst.process.id if inst is not None else None
         aid = act.id if act is not None else None
-        if (self.state.aflags[act] & 16 if act is not None
+        if (self.state.act_bits(act) & 16 if act is not None
                 else self.state.wants_all or (EK.TRIGGER_RAISED, proc, aid) in self.state.wanted):
             self.state.emit(EK.TRIGGER_RAISED, proc, inst.id if inst else None, aid,
                       act.lane if act else None, act.participant if act else None,
@@ -233,7 +233,7 @@ class Triggers(Part):
             box.popleft()
             self._lose(key, inst, act, f"more than {MESSAGE_BUFFER} {key[1]!r} messages were "
                        "kept with nobody waiting; the oldest is dropped")
-        box.append((data, self.state.env.now))
+        box.append((data, self.state.now))
         self._trigger_event(EK.TRIGGER_KEPT, key, inst, act, {
             "for": None if partner is None else partner.id, "kept": len(box)})
 
@@ -243,7 +243,7 @@ class Triggers(Part):
         kept longer than the spec's ``opspec:MessageTTL`` (or the engine option
         ``message_ttl``) are lost on the way (a button pressed hours before anyone asked is not
         an answer to the next question); without either, a message waits for its catcher."""
-        now = self.state.env.now
+        now = self.state.now
         ttl = self.state.config.message_ttl
         if ttl is None:        # the spec's opspec:MessageTTL, else until caught
             ttl = self.state.compiled.package.message_ttl or math.inf
@@ -385,8 +385,7 @@ class Triggers(Part):
         self.state.full = [(lst, None if selects is None else selects | expand_selectors_over(
             procs, frozenset(lst.selects), package_level=False))  # type: ignore[attr-defined]
             for lst, selects in self.state.full]
-        self.state.aflags.clear()                 # cached "nobody wants this" bits may be stale
-        self.state.pflags.clear()
+        self.state.reselect()                     # cached "nobody wants this" bits may be stale
 
     def arm_process(self, proc: CompiledProcess) -> None:
         """Arm the start and end triggers of ``proc`` (mode membership checked on firing)."""
@@ -424,7 +423,7 @@ class Triggers(Part):
             elif starts is not None:
                 state.starts.setdefault((kind, trig.name or ""), []).append(starts)
         elif kind in ("timer", "period"):
-            times = _occurrences(trig, self.state.env.now)
+            times = _occurrences(trig, self.state.now)
             self._next_timer(times, fire, f"{kind}")
         elif kind == "arrival":
             self._next_arrival(trig, fire, 0, 0.0)
@@ -435,7 +434,7 @@ class Triggers(Part):
             run = self.state
 
             def holds() -> bool:
-                value = bool(condition(run.package_data, run.env.now))
+                value = bool(condition(run.package_data, run.now))
                 rising = value and not last["holds"]
                 last["holds"] = value
                 return rising
@@ -449,11 +448,11 @@ class Triggers(Part):
             return
         if self.state.resolution > 0.0:
             at = math.ceil(at / self.state.resolution) * self.state.resolution
-        def fired(_event: object) -> None:
+        def fired() -> None:
             fire(label)
             self.state.drain()
             self._next_timer(times, fire, label)
-        self.state.env.timeout(max(0.0, at - self.state.env.now)).callbacks.append(fired)
+        self.state.timer(max(0.0, at - self.state.now), fired)
 
 
 
@@ -465,18 +464,18 @@ class Triggers(Part):
         if 0 <= trig.count <= made:
             return
         state = self.state
-        at = state.env.now + max(0.0, gap)
+        at = state.now + max(0.0, gap)
         if state.resolution > 0.0:
             at = math.ceil(at / state.resolution) * state.resolution
 
-        def fired(_event: object) -> None:
+        def fired() -> None:
             fire("arrival")
             state.drain()
             interval = trig.interval
             assert interval is not None
             drawn = interval(state.streams.stream(f"arrivals/{trig.name}"))
             self._next_arrival(trig, fire, made + 1, drawn)
-        state.env.timeout(max(0.0, at - state.env.now)).callbacks.append(fired)
+        state.timer(max(0.0, at - state.now), fired)
 
 
 def _root(inst: ProcessInstance) -> ProcessInstance:

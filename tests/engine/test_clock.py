@@ -22,10 +22,10 @@ SPECS = Path(__file__).resolve().parents[2] / "specs"
 DAY = 86400.0
 
 
-def test_the_clock_is_a_simpy_environment_that_counts_every_event_scheduled_on_it() -> None:
-    """``sim_events`` counts what SimPy schedules: each timeout, and per ``run(until)`` the
-    stop event SimPy schedules and puts back once it has stopped (so ``peek`` after a run
-    gives ``until``: a run stopped at its horizon is not taken for one with nothing left)."""
+def test_the_clock_is_a_simpy_environment_that_counts_the_stop_events_of_run_until() -> None:
+    """Per ``run(until)`` SimPy schedules a stop event and puts it back once it has stopped
+    (so ``peek`` after a run gives ``until``: a run stopped at its horizon is not taken for
+    one with nothing left); the clock counts those, the run its own timeouts."""
     clock = Clock()
     assert isinstance(clock, simpy.Environment) and clock.now == 0.0
     fired: list[float] = []
@@ -35,10 +35,37 @@ def test_the_clock_is_a_simpy_environment_that_counts_every_event_scheduled_on_i
     assert fired == [0.5] and clock.now == 2.0 and clock.peek() == 2.0
     clock.run(until=10.0)
     assert fired == [0.5, 2.0, 2.5] and clock.now == 10.0
-    assert clock.scheduled == events_scheduled(clock) == 3 + 2 + 2
+    assert clock.scheduled == events_scheduled(clock) == 2 + 2
     assert events_scheduled(simpy.Environment()) is None
 
 
+class _SchedulingCounted(Clock):
+    """Counts every event scheduled on it, as SimPy's event ids do (what ``sim_events``
+    counted before the engine counted its own timeouts)."""
+
+    def __init__(self) -> None:
+        super().__init__()
+        self.every = 0
+
+    def schedule(self, event: simpy.Event, priority: simpy.events.EventPriority = simpy.events.NORMAL,
+                 delay: float = 0) -> None:
+        self.every += 1
+        super().schedule(event, priority, delay)
+
+
+def test_sim_events_is_every_event_simpy_scheduled_for_the_run() -> None:
+    """"N simulation events" is the number of events SimPy scheduled on the run's clock: the
+    run's timeouts (durations, deadlines, the user's answers, periodic timers) and the two
+    events of each ``run(until)``, over several runs of one simulation."""
+    compiled = compile_package(open_spec(SPECS / "medication_dispenser.xpdl"))
+    model = load_user_model(SPECS / "medication_dispenser.users.toml")
+    user = model.performer(user_stream(3, 0))
+    clock = _SchedulingCounted()
+    sim = Simulation(compiled, performers={n: user for n in user_lane(compiled).bind_names},
+                     seed=3, env=clock)
+    sim.run(until=DAY)
+    result = sim.run(until=3 * DAY)
+    assert result.summary["sim_events"] == clock.every > 30
 def test_time_zero_is_a_float_and_step_on_nothing_raises_simpys_empty_schedule() -> None:
     """A trace writes the start of a run as ``0.0`` (SimPy's own default is the int 0)."""
     clock = Clock()
@@ -77,3 +104,36 @@ def test_households_sharing_one_plain_simpy_environment_run_as_they_run_alone() 
     together = _household_runs(shared=True)
     assert all(len(trace) > 50 for trace in alone)
     assert together == alone
+
+
+def _waiter() -> Simulation:
+    """A workflow that waits for message ``go`` and then for its user (``a``)."""
+    from builders import catch, manual, pkg, proc
+
+    from opspec.engine.builtin_performers import ScriptedUser
+
+    return Simulation(pkg(proc("p", [catch("w", "message", "go"), manual("a")], [("w", "a")])),
+                      performers={"user": ScriptedUser([])}, keep_trace=True,
+                      env=simpy.Environment())
+
+
+def test_the_engine_reads_the_time_when_called_from_outside_its_own_callbacks() -> None:
+    """The engine keeps the time it last read from ``env.now``; a call from a SimPy process
+    of the caller's (no engine event moved the clock) and a start after ``run(until)`` (the
+    stop event moved it) must see the clock where it is, not where the engine last was."""
+    sim = _waiter()
+    env = sim.env
+    sim.run(until=5.0)                       # nothing of the engine's happens by then
+
+    def caller() -> object:
+        yield env.timeout(7.0)
+        sim.raise_trigger("go")              # at 12, from a process the engine never saw
+    env.process(caller())
+    env.run(until=20.0)
+    started = sim.start("p")                 # at 20, after a run(until) of the caller's
+    trace = sim.result().trace
+    assert trace is not None
+    times = {(e.kind, e.activity, e.instance): e.time for e in trace}
+    assert times[("activity.completed", "w", 1)] == 12.0
+    assert times[("process.started", None, started)] == 20.0
+    assert sim.session.now == 20.0
