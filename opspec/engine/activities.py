@@ -319,14 +319,8 @@ class Activities(Part):
         self._complete(ai)
 
     def _complete(self, ai: ActivityInstance) -> None:
-        ai.state = COMPLETED
-        ai.gen += 1
+        ai.leave(COMPLETED)
         frame = ai.frame
-        del frame.running[ai.key]
-        if ai.cleanup:
-            for undo in ai.cleanup:
-                undo()
-            ai.cleanup.clear()
         if ai.mi is not None:
             multi_instance.done(self, ai, ai.mi)
             return
@@ -438,13 +432,8 @@ class Activities(Part):
         """Cancel ``ai``: it stops waiting, its offer is withdrawn, its children end."""
         if ai.state != RUNNING and ai.state != SUSPENDED:
             return
-        ai.state = state
-        ai.gen += 1
+        ai.leave(state)
         frame = ai.frame
-        frame.running.pop(ai.key, None)
-        for undo in ai.cleanup:
-            undo()
-        ai.cleanup.clear()
         group = ai.mi
         if (group is not None and group.holder is not None and ai is not group.holder
                 and not any(m.state == RUNNING for m in group.members)):

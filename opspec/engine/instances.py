@@ -141,6 +141,20 @@ class ActivityInstance:
         # instance only, over its process instance's data (see :meth:`scope`)
         self.local: dict[str, Any] | None = None
 
+    def leave(self, state: int) -> None:
+        """End this instance in ``state``: it stops waiting (``gen``: stale timers see it),
+        leaves its frame's running set, and its cleanups (armed boundary events, deadlines,
+        listeners) are undone. Completion, cancellation and a choice's losing branch all
+        end an instance this one way."""
+        self.state = state
+        self.gen += 1
+        self.frame.running.pop(self.key, None)
+        cleanup = self.cleanup
+        if cleanup:
+            for undo in cleanup:
+                undo()
+            cleanup.clear()
+
     def scope(self) -> MutableMapping[str, Any]:
         """The data this instance reads: its process instance's, under its own element
         when it is one instance of a collection multi-instance. Writes go to the process

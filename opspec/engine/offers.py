@@ -119,13 +119,8 @@ class Offers(Part):
             self.state.offered.pop(item.key, None)
             if ai.performer is not None:
                 ai.performer.withdraw(item, "another branch of the choice happened")
-        ai.state = COMPLETED
-        ai.gen += 1
+        ai.leave(COMPLETED)
         frame = ai.frame
-        frame.running.pop(ai.key, None)
-        for undo in ai.cleanup:
-            undo()
-        ai.cleanup.clear()
         act = ai.act
         if act.kind == K_GATEWAY and not act.choice:
             # the gateway itself completes now (its own split is the choice)

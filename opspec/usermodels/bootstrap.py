@@ -56,6 +56,7 @@ from opspec.usermodels.uncertainty import ParameterDraws
 
 if TYPE_CHECKING:
     from opspec.usermodels.fitting import FitResult
+    from opspec.usermodels.spread import PersonMoments
 
 __all__ = ["MIN_PERSONS", "parameter_draws"]
 
@@ -272,16 +273,20 @@ def _own_rates_mean(target: _Target, persons: Sequence[dict[str, _Data]],
 def _spread(target: _Target, persons: Sequence[dict[str, _Data]]) -> dict[str, float] | None:
     """A ``[vary]`` spread on ``persons`` (one entry per person drawn, repeats included),
     estimated as the fit estimates it (:mod:`opspec.usermodels.spread`)."""
-    from opspec.usermodels.spread import duration_between_sd, omission_between_sd
+    found = _moments(target, persons)
+    return None if found is None else {target.prefix: found.between_sd}
+
+
+def _moments(target: _Target, persons: Sequence[dict[str, _Data]]) -> PersonMoments | None:
+    """What ``target``'s between-person spread is estimated from, on ``persons``: their log
+    mean durations or their own omission rates (:mod:`opspec.usermodels.spread`)."""
+    from opspec.usermodels.spread import duration_moments, omission_moments
 
     data = [d for person in persons if (d := person.get(target.activity)) is not None]
     if target.kind == "duration spread":
-        found = duration_between_sd([d.durations for d in data],
-                                    min_per_user=target.own_rates_min)
-    else:
-        found = omission_between_sd([(d.omitted, d.answered) for d in data],
-                                    min_per_user=target.own_rates_min)
-    return None if found is None else {target.prefix: found}
+        return duration_moments([d.durations for d in data], min_per_user=target.own_rates_min)
+    return omission_moments([(d.omitted, d.answered) for d in data],
+                            min_per_user=target.own_rates_min)
 
 
 @dataclass(frozen=True)
@@ -319,20 +324,12 @@ class _PersonLevel:
 def _person_levels(targets: Sequence[_Target], persons: Sequence[dict[str, _Data]],
                    estimate: dict[str, float]) -> list[_PersonLevel]:
     """The varied parameters whose centre and spread are drawn from their posterior."""
-    from opspec.usermodels.spread import duration_moments, omission_moments
-
     out = []
     for target in targets:
         if not target.kind.endswith(" spread"):
             continue
-        data = [d for person in persons if (d := person.get(target.activity)) is not None]
         centre = target.prefix.removeprefix("vary.").rsplit(".", 1)[0]
-        if target.kind == "duration spread":
-            moments = duration_moments([d.durations for d in data],
-                                       min_per_user=target.own_rates_min)
-        else:
-            moments = omission_moments([(d.omitted, d.answered) for d in data],
-                                       min_per_user=target.own_rates_min)
+        moments = _moments(target, persons)
         if moments is None or centre not in estimate or moments.observed <= 0:
             continue
         out.append(_PersonLevel(target.prefix, centre, estimate[centre],

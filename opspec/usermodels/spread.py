@@ -32,8 +32,8 @@ from typing import Any
 
 import numpy as np
 
-__all__ = ["DurationSpread", "OmissionSpread", "PersonMoments", "duration_between_sd",
-           "duration_moments", "duration_spread", "omission_between_sd", "omission_moments",
+__all__ = ["DurationSpread", "OmissionSpread", "PersonMoments",
+           "duration_moments", "duration_spread", "omission_moments",
            "omission_spread"]
 
 #: bootstrap resamples of users for the intervals of the between-user spread
@@ -169,29 +169,29 @@ def omission_moments(per_user: Iterable[tuple[int, int]], *, min_per_user: int =
                      ) -> PersonMoments | None:
     """The persons' own omission rates' variance and its sampling part (None: fewer than 3
     persons with ``min_per_user`` offers)."""
+    found = _omission_counts(per_user, min_per_user)
+    if found is None:
+        return None
+    k, n = found
+    rates, sampling = _rates(k, n)
+    return PersonMoments(len(rates), float(np.var(rates, ddof=1)), float(sampling.mean()))
+
+
+def _omission_counts(per_user: Iterable[tuple[int, int]], min_per_user: int
+                     ) -> tuple[np.ndarray, np.ndarray] | None:
+    """The ``(omitted, offered)`` counts of the persons with ``min_per_user`` offers, as
+    arrays (None: fewer than 3 such persons)."""
     pairs = [(k, n) for k, n in per_user if n >= min_per_user]
     if len(pairs) < 3:
         return None
-    k = np.array([p[0] for p in pairs], dtype=float)
-    n = np.array([p[1] for p in pairs], dtype=float)
+    return (np.array([p[0] for p in pairs], dtype=float),
+            np.array([p[1] for p in pairs], dtype=float))
+
+
+def _rates(k: np.ndarray, n: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Each person's own rate and its binomial sampling variance."""
     rates = k / n
-    sampling = rates * (1 - rates) / np.maximum(n - 1, 1)
-    return PersonMoments(len(pairs), float(np.var(rates, ddof=1)), float(sampling.mean()))
-
-
-def duration_between_sd(per_user: Iterable[Sequence[float]], *, min_per_user: int = 10
-                        ) -> float | None:
-    """The between-user sd of ln(scale) alone, as :func:`duration_spread` estimates it."""
-    found = duration_moments(per_user, min_per_user=min_per_user)
-    return None if found is None else found.between_sd
-
-
-def omission_between_sd(per_user: Iterable[tuple[int, int]], *, min_per_user: int = 10
-                        ) -> float | None:
-    """The between-user sd of an omission rate alone, as :func:`omission_spread` estimates
-    it."""
-    found = omission_moments(per_user, min_per_user=min_per_user)
-    return None if found is None else found.between_sd
+    return rates, rates * (1 - rates) / np.maximum(n - 1, 1)
 
 
 @dataclass(frozen=True)
@@ -238,19 +238,16 @@ class OmissionSpread:
 def omission_spread(per_user: Mapping[Any, tuple[int, int]], *, min_per_user: int = 10,
                     seed: int = 0) -> OmissionSpread | None:
     """Between-user variation of an omission rate from per-user ``(omitted, answered)``."""
-    pairs = [(k, n) for k, n in per_user.values() if n >= min_per_user]
-    if len(pairs) < 3:
+    found = _omission_counts(per_user.values(), min_per_user)
+    if found is None:
         return None
-    k = np.array([p[0] for p in pairs], dtype=float)
-    n = np.array([p[1] for p in pairs], dtype=float)
-    rates = k / n
-
-    sampling = rates * (1 - rates) / np.maximum(n - 1, 1)
+    k, n = found
+    rates, sampling = _rates(k, n)
 
     def between_var(idx: np.ndarray) -> float:
         return float(np.var(rates[idx], ddof=1)) - float(sampling[idx].mean())
 
-    every = np.arange(len(pairs))
+    every = np.arange(len(rates))
     mean = float(rates.mean())
     var_b = max(0.0, between_var(every))
     beta = None
@@ -265,9 +262,9 @@ def omission_spread(per_user: Mapping[Any, tuple[int, int]], *, min_per_user: in
     else:
         p_value = 1.0
     return OmissionSpread(
-        users=len(pairs), mean=mean, observed_sd=float(np.std(rates, ddof=1)),
+        users=len(rates), mean=mean, observed_sd=float(np.std(rates, ddof=1)),
         between_sd=math.sqrt(var_b),
         between_sd_ci=_bootstrap(lambda idx: math.sqrt(max(0.0, between_var(idx))),
-                                 len(pairs), seed),
+                                 len(rates), seed),
         homogeneity_p=p_value, beta=beta, user_rates=_summary(rates),
         min_per_user=min_per_user)

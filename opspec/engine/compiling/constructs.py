@@ -359,23 +359,25 @@ def _time(c: Context, site: Site) -> None:
     directives = act.directives
     ca.cpu = float(directives.cpu_demand or 0.0)
     if directives.cpu_distribution is not None:
-        try:
-            ca.cpu_sampler = make_sampler(directives.cpu_distribution)
-        except ValueError as error:
-            raise spec_error(f"CPU demand of activity {act.id!r}: {error}", act.location,
-                             _SAMPLERS_HINT) from None
+        ca.cpu_sampler = _sampler(directives.cpu_distribution, "CPU demand", act)
     if directives.duration is not None:
-        try:
-            ca.sampler = make_sampler(directives.duration)
-        except ValueError as error:
-            raise spec_error(f"duration of activity {act.id!r}: {error}", act.location,
-                             _SAMPLERS_HINT) from None
+        ca.sampler = _sampler(directives.duration, "duration", act)
     if act.deadlines:
         ca.deadlines = tuple(
             (c.seconds(d.duration, d.duration_text, d.location or act.location,
                        f"deadline of activity {act.id!r}"),
              d.execution is Execution.SYNCHR, d.exception_name or "deadline")
             for d in act.deadlines)
+
+
+def _sampler(distribution: Any, what: str, act: Activity) -> Any:
+    """A sampler of the activity's ``what`` (its duration or CPU demand), or the spec error
+    naming the activity and its line."""
+    try:
+        return make_sampler(distribution)
+    except ValueError as error:
+        raise spec_error(f"{what} of activity {act.id!r}: {error}", act.location,
+                         _SAMPLERS_HINT) from None
 
 
 def _loop(c: Context, site: Site) -> None:
