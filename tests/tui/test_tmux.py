@@ -26,15 +26,18 @@ def tmux(*args: str) -> str:
                           check=True).stdout
 
 
-def wait_for(session: str, text: str, timeout: float = 30.0) -> str:
+def wait_for(session: str, *texts: str, timeout: float = 30.0) -> str:
+    """The screen once every one of ``texts`` shows on it (a frame Textual is still drawing
+    may show some of them only: look again rather than judge a half-drawn screen)."""
     deadline = time.monotonic() + timeout
     screen = ""
     while time.monotonic() < deadline:
         screen = tmux("capture-pane", "-p", "-t", session)
-        if text in screen:
+        if all(text in screen for text in texts):
             return screen
         time.sleep(0.2)
-    raise AssertionError(f"{text!r} never appeared; the screen was:\n{screen}")
+    missing = [text for text in texts if text not in screen]
+    raise AssertionError(f"{missing!r} never appeared; the screen was:\n{screen}")
 
 
 def test_walkthrough_in_tmux_shows_the_alarm_and_says_where_the_recording_is(tmp_path):
@@ -48,7 +51,8 @@ def test_walkthrough_in_tmux_shows_the_alarm_and_says_where_the_recording_is(tmp
         wait_for(session, "you perform the lane")
         tmux("send-keys", "-t", session, "space")
         tmux("send-keys", "-t", session, "u")
-        screen = wait_for(session, "THE DEVICE CALLS YOU")
+        screen = wait_for(session, "THE DEVICE CALLS YOU", "Hear the alarm",
+                          "alarm: ((( RINGING ))) since 08:00")
         assert "Hear the alarm" in screen and "08:00:00" in screen
         assert "alarm: ((( RINGING ))) since 08:00" in screen      # the device panel
         assert "deadline wait_report (#2) in 05:00" in screen
@@ -105,9 +109,9 @@ def test_large_high_contrast_in_a_small_real_terminal(tmp_path):
         tmux("send-keys", "-t", session, command, "Enter")
         wait_for(session, "you perform")
         tmux("send-keys", "-t", session, "u")
-        screen = wait_for(session, "THE DEVICE CALLS YOU")
-        assert "[a] Hear the alarm" in screen and "((( RINGING )))" in screen
-        assert "\u2570\u2500\u256f" in screen                  # the big digits' bottoms
+        # the alarm, its button and the big digits' bottoms, all on the 64x20 screen at once
+        wait_for(session, "THE DEVICE CALLS YOU", "[a] Hear the alarm", "((( RINGING )))",
+                 "\u2570\u2500\u256f")
         tmux("send-keys", "-t", session, "a")
         tmux("send-keys", "-t", session, "a")
         tmux("send-keys", "-t", session, "b")
