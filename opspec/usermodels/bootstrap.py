@@ -36,7 +36,12 @@ not resampled but drawn from their posterior under the normal random-effects mod
 (:class:`_PersonLevel`): a percentile bootstrap of 30 persons gives them normal tails with
 (P - 1)/P of their variance, and groups of new people simulated under it are too alike —
 ``opspec model-check`` of a freshly fitted model then calls misfits above its level
-(docs/fitting.md). A resample that cannot be fitted (too few distinct durations) keeps the
+(docs/fitting.md). So is the centre of a parameter everyone shares (a lognormal
+duration's median, an omission or commission rate without ``[vary]``), from the same
+posterior with the persons' own values (:func:`_shared_level`): whether or not people
+differ, their own values' spread holds the estimate's error, and the t-based draws keep the
+tails a check of new people needs (a lognormal's sigma and the other duration families are
+still resampled). A resample that cannot be fitted (too few distinct durations) keeps the
 estimate for that parameter and is counted in ``failed``. Rates the data show no event of
 (no omission in 40 offers) are not written by ``opspec fit``, hence not redrawn.
 """
@@ -291,12 +296,14 @@ def _moments(target: _Target, persons: Sequence[dict[str, _Data]]) -> PersonMome
 
 @dataclass(frozen=True)
 class _PersonLevel:
-    """A population's varied parameter as the normal random-effects model sees it: the
-    persons' own values (log mean durations, own omission rates) have mean ``centre`` (on
-    the log scale for a duration: ``log=True``) and variance ``between² + sampling``, of
-    which ``moments`` holds the estimate from ``moments.users`` persons."""
+    """A parameter as the normal random-effects model over persons sees it: the persons' own
+    values (log mean durations, own rates) have mean ``centre`` (on the log scale for a
+    duration: ``log=True``) and variance ``between² + sampling``, of which ``moments`` holds
+    the estimate from ``moments.users`` persons. ``spread`` names a population's
+    between-person sd (``[vary]``); None for a parameter everyone shares (one pill time, one
+    commission rate for all): then only its centre is drawn."""
 
-    spread: str                        # vary.activities.ID.….sigma / .sd
+    spread: str | None                 # vary.activities.ID.….sigma / .sd; None: no [vary]
     centre: str                        # activities.ID.duration.PARAM / .omission.probability
     estimate: float                    # the centre as fitted
     log: bool
@@ -312,18 +319,50 @@ class _PersonLevel:
         m = self.moments
         persons = m.users
         total = (persons - 1) * m.observed / max(float(rng.chisquare(persons - 1)), 1e-12)
-        between = math.sqrt(max(total - m.sampling, 0.0))
         shift = math.sqrt(total / persons) * float(rng.standard_normal())
         if self.log:
             centre = self.estimate * math.exp(shift)
         else:
             centre = min(max(self.estimate + shift, 1e-6), 1 - 1e-6)
-        return {self.spread: between, self.centre: centre}
+        if self.spread is None:
+            return {self.centre: centre}
+        return {self.spread: math.sqrt(max(total - m.sampling, 0.0)), self.centre: centre}
+
+
+def _shared_level(target: _Target, persons: Sequence[dict[str, _Data]],
+                  estimate: dict[str, float]) -> _PersonLevel | None:
+    """A parameter without a population whose centre is drawn as a population's is: a
+    lognormal's median (not a choice's intended-pick time) and a rate everyone shares.
+
+    Why not the percentile bootstrap of persons: its draws of a mean have normal tails and
+    (P - 1)/P of its variance — at 30 persons the predictive of a new group's mean is then
+    narrower than Student's t in exactly the tails Holm reaches into (p <= 0.0125 of four
+    items). The spread of the persons' own values (which holds the sampling error whether or
+    not people differ) gives the t-based posterior instead."""
+    from opspec.usermodels.spread import duration_moments, omission_moments
+
+    data = [d for person in persons if (d := person.get(target.activity)) is not None]
+    if (target.kind == "duration" and target.family == "lognormal" and target.between == 0
+            and target.intended is None):
+        centre = f"{target.prefix}.median"
+        moments = duration_moments([d.durations for d in data])
+    elif target.kind == "commission" and target.intended is not None:
+        centre = target.prefix
+        moments = omission_moments([_wrong_picks(d.picks, target.intended) for d in data])
+    elif target.kind == "omission" and not target.own_rates_min:
+        centre = target.prefix
+        moments = omission_moments([(d.omitted, d.answered) for d in data])
+    else:
+        return None
+    if moments is None or moments.observed <= 0 or centre not in estimate:
+        return None
+    return _PersonLevel(None, centre, estimate[centre], target.kind == "duration", moments)
 
 
 def _person_levels(targets: Sequence[_Target], persons: Sequence[dict[str, _Data]],
-                   estimate: dict[str, float]) -> list[_PersonLevel]:
-    """The varied parameters whose centre and spread are drawn from their posterior."""
+                   estimate: dict[str, float], shared: bool) -> list[_PersonLevel]:
+    """The parameters whose centre (and a population's spread) are drawn from their
+    posterior; ``shared``: those without a population too (enough persons to resample)."""
     out = []
     for target in targets:
         if not target.kind.endswith(" spread"):
@@ -334,6 +373,13 @@ def _person_levels(targets: Sequence[_Target], persons: Sequence[dict[str, _Data
             continue
         out.append(_PersonLevel(target.prefix, centre, estimate[centre],
                                 target.kind == "duration spread", moments))
+    varied = {t.activity for t in targets if t.kind.endswith(" spread")}
+    for target in targets if shared else ():
+        if target.activity in varied and target.kind in ("duration", "omission"):
+            continue                    # a population's centre: drawn above
+        level = _shared_level(target, persons, estimate)
+        if level is not None:
+            out.append(level)
     return out
 
 
@@ -405,9 +451,10 @@ def parameter_draws(result: FitResult, draws: int, *, seed: int = 0) -> Paramete
     # not resampled — a percentile bootstrap of 30 persons centres a between-person variance
     # at (P-1)/P of a downward-biased estimate and lacks the long upper tail a variance
     # estimated from 30 persons has: groups of new people simulated under it are too alike
-    # (docs/fitting.md, what the check can detect)
-    levels = _person_levels(targets, everyone, estimate)
-    drawn = {path for level in levels for path in (level.spread, level.centre)}
+    # (docs/fitting.md, what the check can detect); so are the centres of the parameters
+    # everyone shares (a pill time, a commission rate), whose bootstrap lacks Student's tails
+    levels = _person_levels(targets, everyone, estimate, by_persons)
+    drawn = {path for level in levels for path in (level.spread, level.centre) if path}
     level_rng = np.random.default_rng(np.random.SeedSequence([int(seed), _STREAM, 1]))
     rows = []
     failed = 0
@@ -445,6 +492,8 @@ def parameter_draws(result: FitResult, draws: int, *, seed: int = 0) -> Paramete
     source = (f"opspec fit: {draws} nonparametric bootstrap redraws (Barton & Schruben 2001) "
               f"resampling {resampled} ({len(names)} person(s), {obs.sessions} session(s); "
               f"Davison & Hinkley 1997, 3.8), each fitted as the data were (family kept)"
+              + ("; centres and between-person spreads drawn from their posterior over "
+                 "persons (Gelman et al. 2013, 3.2)" if levels else "")
               + ("" if by_persons else "; rates drawn from their Jeffreys posterior "
                  "(Chick 2001)")
               + (f"; {failed} parameter fit(s) of a resample failed and kept the estimate"

@@ -68,3 +68,34 @@ def test_a_populations_centre_is_redrawn_with_students_t_tails(tmp_path: Path) -
     total = np.median(spread ** 2 + sampling)
     expected = 7 * person_rates.var(ddof=1) / stats.chi2.median(7)
     assert abs(total / expected - 1) < 0.08, (total, expected)
+
+
+def test_a_shared_rate_and_time_are_redrawn_with_students_t_tails(tmp_path: Path) -> None:
+    """Eight persons who do not differ (one omission rate 0.15, one walk time for all): the
+    fit writes no population, and a new group's rate and log walk time are predicted from
+    eight persons as a t(7) interval says (Hahn & Meeker 1991) — the redrawn rate and
+    log-median, standardised by the persons' own values' sd over √8, have the tails of t(7)
+    (97.5 % point 2.36), where a percentile bootstrap of the eight gives about 1.83."""
+    rng = np.random.default_rng(7)
+    paths = [write_session(tmp_path / f"P{i:02d}.jsonl",
+                           list(np.exp(rng.normal(math.log(60), 0.3, 40))),
+                           list(rng.random(200) >= 0.15), person=f"P{i:02d}")
+             for i in range(8)]
+    result = fit_traces(paths, name="fitted")
+    assert result.model.population is None
+    draws = parameter_draws(result, 4000, seed=1)
+    assert draws is not None and draws.resampled == "persons"
+    obs = result.observations
+    counts = obs.counts_by_person(obs.user_omissions["hear"])
+    own = {"activities.hear.omission.probability":
+           np.array([k / n for k, n in counts.values()]),
+           # one session per person: a session's walks are that person's
+           "activities.walk.duration.median": np.log([np.mean(v) for v in
+                                                       obs.user_durations["walk"].values()])}
+    for name, values in own.items():
+        column = np.array([row[draws.parameters.index(name)] for row in draws.draws])
+        estimate = draws.estimates[draws.parameters.index(name)]
+        shift = np.log(column / estimate) if "duration" in name else column - estimate
+        standardised = shift / (values.std(ddof=1) / math.sqrt(8))
+        q975 = float(np.quantile(np.abs(standardised), 0.95))
+        assert abs(q975 - stats.t.ppf(0.975, 7)) < 0.2, (name, q975)
