@@ -39,3 +39,31 @@ def load_benchmark():
         return module
 
     return load
+
+
+#: the names a Chromium (or Chrome) executable goes by
+CHROMIUM_NAMES = ("chromium", "chromium-browser", "google-chrome", "google-chrome-stable")
+
+
+@pytest.fixture(scope="session")
+def chromium() -> str:
+    """A headless-capable Chromium for the tests that look at opspec's output in a real
+    browser (the report, a study served over HTTP): found on PATH, else installed by
+    ``scripts/system-deps.sh`` (the project's own files install what a test needs), else the
+    test is skipped saying why."""
+    import shutil
+    import subprocess
+    from pathlib import Path
+
+    def find() -> str | None:
+        return next((found for name in CHROMIUM_NAMES if (found := shutil.which(name))), None)
+
+    found = find()
+    if found is None:
+        script = Path(__file__).resolve().parents[1] / "scripts" / "system-deps.sh"
+        subprocess.run(["bash", str(script)], check=False, capture_output=True, timeout=900)
+        found = find()
+    if found is None:
+        pytest.skip("no Chromium and it cannot be installed here (scripts/system-deps.sh "
+                    "needs root or passwordless sudo and apt-get)")
+    return found

@@ -8,7 +8,6 @@ it is missing the test runs that script once, and skips only when it still canno
 from __future__ import annotations
 
 import re
-import shutil
 import subprocess
 from pathlib import Path
 
@@ -18,24 +17,6 @@ from opspec.cli import main
 
 ROOT = Path(__file__).resolve().parents[2]
 SPEC = ROOT / "specs" / "medication_dispenser.xpdl"
-NAMES = ("chromium", "chromium-browser", "google-chrome", "google-chrome-stable")
-
-
-def _find() -> str | None:
-    return next((found for name in NAMES if (found := shutil.which(name))), None)
-
-
-@pytest.fixture(scope="session")
-def chromium() -> str:
-    found = _find()
-    if found is None:
-        subprocess.run(["bash", str(ROOT / "scripts" / "system-deps.sh")], check=False,
-                       capture_output=True, timeout=900)
-        found = _find()
-    if found is None:
-        pytest.skip("no Chromium and it cannot be installed here (scripts/system-deps.sh "
-                    "needs root or passwordless sudo and apt-get)")
-    return found
 
 
 def _browser(chromium: str, *args: str) -> subprocess.CompletedProcess[str]:

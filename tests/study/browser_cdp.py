@@ -11,21 +11,14 @@ from __future__ import annotations
 
 import asyncio
 import json
-import shutil
 import subprocess
 import tempfile
 import time
 from pathlib import Path
 from typing import Any
 
-NAMES = ("chromium", "chromium-browser", "google-chrome", "google-chrome-stable")
-
 #: the key events of the keys a walkthrough participant uses: (key, code, keyCode, text)
 KEYS = {"enter": ("Enter", "Enter", 13, "\r"), "space": (" ", "Space", 32, " ")}
-
-
-def find_chromium() -> str | None:
-    return next((found for name in NAMES if (found := shutil.which(name))), None)
 
 
 class Browser:

@@ -31,20 +31,7 @@ ROOT = Path(__file__).resolve().parents[2]
 pytest.importorskip("textual_serve", reason="opspec study --serve needs the study extra: "
                     "pip install 'opspec[study]' (in the test extra)")
 
-from browser_cdp import Browser, find_chromium  # noqa: E402
-
-
-@pytest.fixture(scope="module")
-def chromium() -> str:
-    found = find_chromium()
-    if found is None:
-        subprocess.run(["bash", str(ROOT / "scripts" / "system-deps.sh")], check=False,
-                       capture_output=True, timeout=900)
-        found = find_chromium()
-    if found is None:
-        pytest.skip("no Chromium and it cannot be installed here (scripts/system-deps.sh "
-                    "needs root or passwordless sudo and apt-get)")
-    return found
+from browser_cdp import Browser  # noqa: E402
 
 
 class Served:
