@@ -18,12 +18,12 @@ from opspec.cli import main
 def test_same_seed_gives_the_same_results_with_one_or_two_workers(evaluate, tmp_path):
     args = [str(SPEC), "--users", "12", "--days", "3", "--seed", "5"]
     s1, one, _ = evaluate(*args, "--workers", "1", "--out", str(tmp_path / "w1"))
-    s2, two, _ = evaluate(*args, "--workers", "2", "--out", str(tmp_path / "w2"))
+    s2, two, _ = evaluate(*args, "--workers", "2", "--out", str(tmp_path / "w2"), report=False)
     assert s1 == s2 == 0
     assert one["workers"] == 1 and two["workers"] == 2
     assert metrics_of(one) == metrics_of(two)
     _, other, _ = evaluate(str(SPEC), "--users", "12", "--days", "3", "--seed", "6",
-                           "--workers", "1", "--out", str(tmp_path / "s6"))
+                           "--workers", "1", "--out", str(tmp_path / "s6"), report=False)
     assert metrics_of(other) != metrics_of(one)
 
 
@@ -35,7 +35,8 @@ def test_dask_cluster_gives_the_same_results_as_local_workers(processes, workers
                                                               tmp_path):
     distributed = pytest.importorskip("distributed")
     args = [str(SPEC), "--users", "6", "--days", "2", "--seed", "3"]
-    _, local, _ = evaluate(*args, "--workers", "1", "--out", str(tmp_path / "local"))
+    _, local, _ = evaluate(*args, "--workers", "1", "--out", str(tmp_path / "local"),
+                           report=False)
     with distributed.LocalCluster(n_workers=workers, threads_per_worker=1,
                                   processes=processes, dashboard_address=None) as cluster:
         status, remote, _ = evaluate(*args, "--scheduler", cluster.scheduler_address,
@@ -136,8 +137,10 @@ def test_json_document_has_the_documented_shape(evaluate, tmp_path):
 
 def test_identical_designs_compared_on_the_same_users_differ_by_exactly_zero(evaluate,
                                                                               tmp_path):
+    # no report: test_comparison_table_gives_units_and_rate_differences_in_points draws one
     status, doc, _ = evaluate(str(SPEC), "--compare", str(SPEC), "--users", "8", "--days",
-                              "2", "--workers", "1", "--out", str(tmp_path / "same"))
+                              "2", "--workers", "1", "--out", str(tmp_path / "same"),
+                              report=False)
     assert status == 0
     for name, diff in doc["compare"]["difference"].items():
         if diff["difference"] is not None:
@@ -155,7 +158,8 @@ def test_a_shorter_re_alert_interval_sounds_more_alarms_for_the_same_users(evalu
     shorter.write_text(SPEC.read_text(encoding="utf-8").replace("PT300S", "PT150S"),
                        encoding="utf-8")
     status, doc, _ = evaluate(str(SPEC), "--compare", str(shorter), "--users", "40",
-                              "--days", "10", "--seed", "2", "--out", str(tmp_path / "cmp"))
+                              "--days", "10", "--seed", "2", "--out", str(tmp_path / "cmp"),
+                              report=False)
     assert status == 0
     alarms = doc["compare"]["difference"]["alarms_per_dose"]
     assert alarms["difference"] > 0 and alarms["significant"]
@@ -167,7 +171,8 @@ def test_exports_write_one_case_per_user_when_asked(evaluate, tmp_path):
 
     out = tmp_path / "exp"
     status, _doc, _ = evaluate(str(SPEC), "--users", "3", "--days", "1", "--workers", "2",
-                              "--export", "xes,jsonl", "--case", "user", "--out", str(out))
+                              "--export", "xes,jsonl", "--case", "user", "--out", str(out),
+                              report=False)
     assert status == 0
     cases = {e.data.get("case") for e in read_trace(out / "traces.jsonl")
              if e.kind != "case.started"} | {
@@ -193,7 +198,7 @@ def test_summary_table_on_a_terminal_run(tmp_path, capsys):
 def test_run_parameters_are_stored_for_other_readers(evaluate, tmp_path):
     out = tmp_path / "run"
     assert evaluate(str(SPEC), "--users", "2", "--days", "1", "--seed", "4", "--out",
-                    str(out))[0] == 0
+                    str(out), report=False)[0] == 0
     with sqlite3.connect(out / "results.sqlite") as conn:
         run = {k: json.loads(v) for k, v in conn.execute("SELECT key, value FROM run")}
     assert run["spec"] == str(SPEC) and len(run["spec_sha256"]) == 64
@@ -210,7 +215,8 @@ def test_specs_with_a_simulated_world_give_each_user_their_own_world(evaluate, t
     args = [str(spec), "--users", "3", "--days", "0.003", "--seed", "2"]
     status, one, err = evaluate(*args, "--workers", "1", "--out", str(tmp_path / "w1"))
     assert status == 0, err
-    _, two, _ = evaluate(*args, "--workers", "2", "--out", str(tmp_path / "w2"))
+    _, two, _ = evaluate(*args, "--workers", "2", "--out", str(tmp_path / "w2"),
+                         report=False)
     assert metrics_of(one) == metrics_of(two)
     covered = one["metrics"]["cells_covered"]
     assert covered["total"] > 0 and covered["sd"] > 0
@@ -220,7 +226,7 @@ def test_a_spec_with_a_run_length_is_evaluated_over_that_length(evaluate, tmp_pa
     """The cart declares opspec:RunLength PT10M: one run is ten minutes, not 30 days."""
     spec = SPEC.parent / "medication_cart_guidance.xpdl"
     status, doc, err = evaluate(str(spec), "--users", "2", "--workers", "1",
-                                "--out", str(tmp_path / "cart"))
+                                "--out", str(tmp_path / "cart"), report=False)
     assert status == 0, err
     assert doc["days"] == pytest.approx(600 / 86400)
     assert doc["metrics"]["patients_found"]["total"] == 2
@@ -272,7 +278,7 @@ def test_exports_cut_cases_by_chain_by_default_named_after_the_specs_workflow(
     the spec (the dispenser's timer_workflow: one case per due dose)."""
     out = tmp_path / "exp"
     status, doc, _ = evaluate(str(SPEC), "--users", "2", "--days", "1", "--workers", "1",
-                              "--export", "xes", "--out", str(out))
+                              "--export", "xes", "--out", str(out), report=False)
     assert status == 0
     xes = (out / "traces.xes").read_text(encoding="utf-8")
     assert xes.count("<trace>") == doc["metrics"]["doses_due"]["total"] == 8

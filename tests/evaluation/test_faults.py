@@ -50,7 +50,7 @@ def test_interrupted_run_resumes_to_the_same_results(tmp_path, evaluate):
     status, resumed, err = evaluate("--resume", "--out", str(out), "--workers", "2")
     assert status == 0, err
     _, whole, _ = evaluate(str(SPEC), "--users", "200", "--days", "20", "--seed", "9",
-                           "--workers", "2", "--out", str(tmp_path / "whole"))
+                           "--workers", "2", "--out", str(tmp_path / "whole"), report=False)
     assert metrics_of(resumed) == metrics_of(whole)
 
 
@@ -231,12 +231,13 @@ def test_resumed_export_has_every_users_trace_in_one_file(tmp_path, evaluate):
     and resumed gives one complete traces.jsonl, equal to an uninterrupted run's."""
     args = [str(SPEC), "--users", "6", "--days", "1", "--seed", "3", "--workers", "1",
             "--export", "jsonl"]
-    status, _, _ = evaluate(*args, "--out", str(tmp_path / "whole"))
+    # no report but the resumed run's: the exports and results are what is compared
+    status, _, _ = evaluate(*args, "--out", str(tmp_path / "whole"), report=False)
     assert status == 0
     whole = (tmp_path / "whole" / "traces.jsonl").read_text(encoding="utf-8")
     # the interrupted run: the same, with users 3-5 not stored and the trace file cut short
     cut = tmp_path / "cut"
-    evaluate(*args, "--out", str(cut))
+    evaluate(*args, "--out", str(cut), report=False)
     with sqlite3.connect(cut / "results.sqlite") as conn:
         conn.execute("DELETE FROM replication WHERE user >= 3")
     lines = (cut / "traces.jsonl").read_text(encoding="utf-8").splitlines(keepends=True)
@@ -249,5 +250,5 @@ def test_resumed_export_has_every_users_trace_in_one_file(tmp_path, evaluate):
     assert not (cut / "traces.jsonl.partial").exists()
     # and the resumed results are those of an uninterrupted run (re-traced users not doubled)
     _, again, _ = evaluate(str(SPEC), "--users", "6", "--days", "1", "--seed", "3",
-                           "--workers", "1", "--out", str(tmp_path / "again"))
+                           "--workers", "1", "--out", str(tmp_path / "again"), report=False)
     assert metrics_of(doc) == metrics_of(again)

@@ -89,7 +89,7 @@ probability = {{ kind = "beta", a = {a}, b = {b} }}
 def test_without_variation_the_between_user_sd_is_about_zero(evaluate, tmp_path):
     spec = one_alarm_spec(tmp_path, "")
     status, doc, _ = evaluate(str(spec), "--users", "200", "--days", "20", "--seed", "19",
-                              "--workers", "1", "--out", str(tmp_path / "o"))
+                              "--workers", "1", "--out", str(tmp_path / "o"), report=False)
     assert status == 0 and doc["population"] is None
     missed = doc["metrics"]["doses_missed"]
     # binomial: variance n p (1 - p) = 7.5 within sampling error, sd of rates ~ 0
@@ -154,7 +154,8 @@ def test_the_same_seed_gives_the_same_people_with_one_or_two_workers(evaluate, t
     args = [str(SPEC), "--user-model", str(POPULATION), "--users", "16", "--days", "1",
             "--seed", "4"]
     _, one, _ = evaluate(*args, "--workers", "1", "--out", str(tmp_path / "w1"))
-    _, two, _ = evaluate(*args, "--workers", "2", "--out", str(tmp_path / "w2"))
+    _, two, _ = evaluate(*args, "--workers", "2", "--out", str(tmp_path / "w2"),
+                         report=False)
 
     def people(folder: str) -> list[tuple]:
         db = sqlite3.connect(tmp_path / folder / "results.sqlite")
@@ -197,7 +198,7 @@ def test_a_model_without_variation_runs_exactly_as_before(evaluate, tmp_path):
     seed, days, users = 11, 2, 6
     status, doc, _ = evaluate(str(SPEC), "--users", str(users), "--days", str(days),
                               "--seed", str(seed), "--workers", "1",
-                              "--out", str(tmp_path / "o"))
+                              "--out", str(tmp_path / "o"), report=False)
     assert status == 0 and doc["population"] is None
     db = sqlite3.connect(tmp_path / "o" / "results.sqlite")
     assert db.execute("SELECT COUNT(*) FROM person").fetchone()[0] == 0

@@ -55,10 +55,13 @@ def pill_spec(tmp_path: Path, beeps: int = 1) -> Path:
 
 
 def sweep_of(evaluate, tmp_path: Path, spec: Path, *args: str, users: int = 150,
-             days: int = 20, workers: int = 1, out: str = "o") -> dict:
+             days: int = 20, workers: int = 1, out: str = "o", report: bool = False) -> dict:
+    """The sweep's JSON document. No report unless asked (``report=True``): these tests read
+    the numbers; test_sweep_inputs.py reads a sweep's report, and the two tests here that
+    draw one (a spec parameter's sweep, a sweep with per-user targets) check it is written."""
     status, doc, err = evaluate(str(spec), "--users", str(users), "--days", str(days),
                                 "--seed", "7", "--workers", str(workers),
-                                "--out", str(tmp_path / out), *args)
+                                "--out", str(tmp_path / out), *args, report=report)
     assert status == 0, err
     return doc
 
@@ -90,7 +93,9 @@ def test_swept_number_of_beeps_gives_p_to_the_k(evaluate, tmp_path):
     """A spec parameter (a data field's initial value): k beeps, missed rate 0.25^k; a
     deadline shorter than the walk misses every dose (the spec's deadline is swept too)."""
     spec = pill_spec(tmp_path, beeps=2)
-    doc = sweep_of(evaluate, tmp_path, spec, "--sweep", "spec.reminder_workflow.max_beeps=1,2,3")
+    doc = sweep_of(evaluate, tmp_path, spec, "--sweep", "spec.reminder_workflow.max_beeps=1,2,3",
+                   report=True)
+    assert Path(doc["report"]).is_file()
     for entry in doc["sweep"]["values"]:
         k = entry["value"]
         low, high = entry["metrics"]["missed_rate"]["ci95"]
@@ -127,7 +132,8 @@ def test_the_same_seed_gives_the_same_sweep_on_one_and_two_workers(evaluate, tmp
     spec = pill_spec(tmp_path, beeps=2)
     args = ("--sweep", "user.activities.walk_to_box.duration.value=10s,8 min,20min",
             "--target", "missed_rate < 10%", "--target-users", "90%")
-    one = sweep_of(evaluate, tmp_path, spec, *args, users=40, days=5, out="w1")
+    one = sweep_of(evaluate, tmp_path, spec, *args, users=40, days=5, out="w1", report=True)
+    assert Path(one["report"]).is_file()
     two = sweep_of(evaluate, tmp_path, spec, *args, users=40, days=5, workers=2, out="w2")
     assert one["sweep"] == two["sweep"]
     # and the walk matters as it must: 20 minutes never reaches the box within two 10-minute
