@@ -47,7 +47,8 @@ def test_unwritable_output_folder_is_a_clear_error(evaluate, tmp_path):
 
 def test_existing_results_need_resume_and_resume_refuses_other_options(evaluate, tmp_path):
     out = str(tmp_path / "run")
-    assert evaluate(str(SPEC), "--users", "2", "--days", "1", "--out", out)[0] == 0
+    # drawn by the resume at the end
+    assert evaluate(str(SPEC), "--users", "2", "--days", "1", "--out", out, report=False)[0] == 0
     status, _, err = evaluate(str(SPEC), "--users", "2", "--days", "1", "--out", out)
     assert status == 2 and "already holds an evaluation" in err
     status, _, err = evaluate(str(SPEC), "--users", "3", "--days", "1", "--out", out,
@@ -97,7 +98,7 @@ def test_resume_refuses_a_spec_changed_since_the_run_started(evaluate, tmp_path)
     spec.write_text(SPEC.read_text(encoding="utf-8"), encoding="utf-8")
     out = str(tmp_path / "run")
     assert evaluate(str(spec), "--users", "2", "--days", "1", "--user-model",
-                    str(USERS_TOML), "--out", out)[0] == 0
+                    str(USERS_TOML), "--out", out, report=False)[0] == 0
     spec.write_text(SPEC.read_text(encoding="utf-8").replace("PT300S", "PT600S"),
                     encoding="utf-8")
     status, _, err = evaluate("--resume", "--out", out)
