@@ -21,6 +21,17 @@ pytestmark = pytest.mark.skipif(shutil.which("tmux") is None,
 SOCKET = f"opspec-test-{uuid.uuid4().hex[:8]}"
 
 
+@pytest.fixture(autouse=True)
+def _a_server_of_its_own():
+    """Each test its own tmux server. With one server for the module, killing a test's last
+    session shut the server down while the next test's `new-session` could already be
+    talking to it (a loaded clean-clone run: `new-session` exit status 1)."""
+    global SOCKET
+    SOCKET = f"opspec-test-{uuid.uuid4().hex[:8]}"
+    yield
+    subprocess.run(["tmux", "-L", SOCKET, "kill-server"], capture_output=True, check=False)
+
+
 def tmux(*args: str) -> str:
     return subprocess.run(["tmux", "-L", SOCKET, *args], capture_output=True, text=True,
                           check=True).stdout
