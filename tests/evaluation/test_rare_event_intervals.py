@@ -5,9 +5,9 @@ the exact Poisson (Garwood) bound, 3.689 events over 10 users; never [0, 0]."""
 
 from __future__ import annotations
 
+import contextlib
+import io
 import json
-import subprocess
-import sys
 from pathlib import Path
 
 import pytest
@@ -17,13 +17,21 @@ ROOT = Path(__file__).resolve().parents[2]
 
 @pytest.fixture(scope="module")
 def summary(tmp_path_factory: pytest.TempPathFactory) -> dict:
+    """The metrics of `opspec evaluate --json`; the report is not drawn (these tests read the
+    intervals; tests/evaluation_output reads a report's)."""
+    from opspec.cli import main
+
     out = tmp_path_factory.mktemp("rare")
-    done = subprocess.run([sys.executable, "-m", "opspec", "evaluate",
-                           str(ROOT / "specs" / "medication_dispenser.xpdl"), "--users", "10",
-                           "--days", "1", "--out", str(out), "--json", "--workers", "1"],
-                          capture_output=True, text=True, timeout=300, check=False)
-    assert done.returncode == 0, done.stderr
-    return json.loads(done.stdout)["metrics"]
+    printed = io.StringIO()
+    with pytest.MonkeyPatch.context() as patch, contextlib.redirect_stdout(printed), \
+            contextlib.redirect_stderr(io.StringIO()):
+        patch.setattr("opspec.evaluation.report.write_report",
+                      lambda store, *_args, **_kwargs: store.folder / "report.html")
+        status = main(["evaluate", str(ROOT / "specs" / "medication_dispenser.xpdl"),
+                       "--users", "10", "--days", "1", "--out", str(out), "--json",
+                       "--workers", "1"])
+    assert status == 0
+    return json.loads(printed.getvalue())["metrics"]
 
 
 def test_no_missed_dose_still_gives_a_positive_upper_bound(summary: dict) -> None:
