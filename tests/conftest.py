@@ -67,3 +67,16 @@ def chromium() -> str:
         pytest.skip("no Chromium and it cannot be installed here (scripts/system-deps.sh "
                     "needs root or passwordless sudo and apt-get)")
     return found
+
+
+def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item]) -> None:
+    """The tests marked ``slow`` (tens of seconds each) run first. On xdist's workers
+    (`-n auto --dist worksteal`, scripts/test.sh) each worker starts with its share of the
+    collection in order and an idle worker takes from the end of another's: with the long
+    tests at the front, the last tests left are short ones and the workers finish together,
+    instead of one worker running a long test alone at the end. Otherwise the order is
+    kept (a module's tests stay together, so its module fixtures are made once)."""
+    slow = [item for item in items if item.get_closest_marker("slow") is not None]
+    if slow:
+        chosen = set(map(id, slow))
+        items[:] = slow + [item for item in items if id(item) not in chosen]

@@ -33,6 +33,7 @@ def test_williams_squares_balance_first_places_and_carry_over() -> None:
         assert all(pairs.count(p) == (1 if k % 2 == 0 else 2) for p in follows)
 
 
+@pytest.mark.slow          # seven Textual sessions
 def test_three_participants_two_variants(protocol_file: Path, capsys) -> None:
     protocol = load_protocol(protocol_file)
     assert [v.id for v in protocol.order("P01")] == ["A", "B"]
