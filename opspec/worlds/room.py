@@ -14,8 +14,8 @@ import math
 from collections.abc import Mapping, Sequence
 from typing import TYPE_CHECKING, Any
 
-from opspec.worlds.base import RobotWorld, check_parameters
-from opspec.worlds.geometry import Box, ray_to_box, wrap_angle
+from opspec.worlds.base import STEP_S, RobotWorld, check_parameters
+from opspec.worlds.geometry import Box, ray_to_box_along, wrap_angle
 from opspec.worlds.robot import Robot
 
 if TYPE_CHECKING:   # annotations only: `opspec validate` loads no NumPy
@@ -78,6 +78,17 @@ class RoomWorld(RobotWorld):
         self.bumped = False
         self.in_contact = False
         self.collisions = 0
+        # What _advance needs of the fixed geometry, computed once with _free's arithmetic:
+        # the box the robot's centre may be in, each obstacle grown by the robot's radius.
+        r = self.radius
+        self._inside = (self.room.x0 + r, self.room.x1 - r, self.room.y0 + r,
+                        self.room.y1 - r)
+        self._grown = tuple((o.x0 - r, o.x1 + r, o.y0 - r, o.y1 + r) for o in self.obstacles)
+        # per cell range of _cover's loops, its cells (in the room) not yet covered, in the
+        # loops' order; cells are only ever added, so the others can add nothing again
+        self._uncovered: dict[tuple[int, int, int, int], tuple[tuple[int, int], ...]] = {}
+        # the heading object _advance last found wrap_angle leaves as it is
+        self._settled: float | None = None
         self._cover()
 
     # ------------------------------------------------------------------ motion
@@ -87,6 +98,91 @@ class RoomWorld(RobotWorld):
                 self.room.y0 + r <= y <= self.room.y1 - r):
             return False
         return not any(o.contains(x, y, margin=r) for o in self.obstacles)
+
+    def _advance(self, now: float) -> None:
+        """World.advance's steps, the same floats as :meth:`_step` taken one by one: the
+        motor command cannot change between two device operations, so driving straight
+        (or standing) and turning on the spot are loops over local variables, and
+        :meth:`_cover` runs only where some cell within reach may still be uncovered.
+        Driving along an arc takes the steps one by one."""
+        robot = self.robot
+        v, w = robot.velocity()
+        if abs(w) >= 1e-12:
+            if v != 0.0:
+                super()._advance(now)           # an arc: no command of the bundled specs
+                return
+            self._turn_in_place(now, w)
+            return
+        limit = now - 1e-12
+        t = self.time
+        x: float = robot.x
+        y: float = robot.y
+        heading: float = robot.heading
+        cos_h, sin_h = math.cos(heading), math.sin(heading)
+        # each step sets the heading to wrap_angle(heading): ``after`` is that, ``settled``
+        # once it no longer changes (bit for bit, sign of zero included)
+        after: float
+        if heading is self._settled:
+            after, settled = heading, True
+        else:
+            after = wrap_angle(heading)
+            settled = _same(after, heading)
+        stop = robot.command == "stop"
+        in_contact = self.in_contact
+        x_lo, x_hi, y_lo, y_hi = self._inside
+        grown = self._grown
+        uncovered = self._uncovered
+        reach, cell = self.radius, self.cell
+        while t < limit:
+            rest = now - t
+            dt = STEP_S if rest > STEP_S else rest      # min(STEP_S, now - t)
+            nx = x + v * dt * cos_h
+            ny = y + v * dt * sin_h
+            if not settled:
+                heading = after
+                cos_h, sin_h = math.cos(heading), math.sin(heading)
+                after = wrap_angle(heading)
+                settled = _same(after, heading)
+            if nx == x and ny == y:
+                if stop:
+                    in_contact = False
+            elif x_lo <= nx <= x_hi and y_lo <= ny <= y_hi and _clear(nx, ny, grown):
+                x, y = nx, ny
+                in_contact = False
+                key = (int((x - reach) // cell), int((x + reach) // cell),
+                       int((y - reach) // cell), int((y + reach) // cell))
+                cells = uncovered.get(key)
+                if cells is None or cells:
+                    robot.x, robot.y, robot.heading = x, y, heading
+                    self.time, self.in_contact = t, in_contact
+                    self._cover_within(key, cells)
+            else:
+                self.bumped = True
+                if not in_contact:
+                    in_contact = True
+                    self.collisions += 1
+                    robot.heading, self.time, self.in_contact = heading, t, in_contact
+                    self.trace("world.collision", x=round(x, 3), y=round(y, 3))
+            t += dt
+        robot.x, robot.y, robot.heading = x, y, heading
+        self.time, self.in_contact = t, in_contact
+        if settled:
+            self._settled = heading
+
+    def _turn_in_place(self, now: float, w: float) -> None:
+        """Steps of a command that turns without driving (``turn_left``…): :meth:`_step`
+        with the position, the contact and the coverage left as they are."""
+        robot = self.robot
+        limit = now - 1e-12
+        t, heading = self.time, robot.heading
+        while t < limit:
+            rest = now - t
+            dt = STEP_S if rest > STEP_S else rest
+            heading = wrap_angle(heading + w * dt)
+            t += dt
+        if robot.command == "stop":
+            self.in_contact = False
+        robot.heading, self.time = heading, t
 
     def _step(self, dt: float) -> None:
         robot = self.robot
@@ -118,6 +214,25 @@ class RoomWorld(RobotWorld):
                     self.covered.add((cx, cy))
                     self.trace("world.covered", cell=[cx, cy])
 
+    def _cover_within(self, key: tuple[int, int, int, int],
+                      cells: tuple[tuple[int, int], ...] | None) -> None:
+        """:meth:`_cover` at the robot's position, whose loops' cell range is ``key``,
+        looking only at the range's ``cells`` not covered when last looked (all of them when
+        ``None``): the same cells, in the same order, are covered and traced."""
+        if cells is None:
+            cx0, cx1, cy0, cy1 = key
+            cells = tuple((cx, cy) for cx in range(max(cx0, 0), min(cx1 + 1, self.cells_x))
+                          for cy in range(max(cy0, 0), min(cy1 + 1, self.cells_y)))
+        robot, cell, reach = self.robot, self.cell, self.radius
+        covered = self.covered
+        for cx, cy in cells:
+            centre_x, centre_y = (cx + 0.5) * cell, (cy + 0.5) * cell
+            if (centre_x - robot.x) ** 2 + (centre_y - robot.y) ** 2 <= reach ** 2 + (
+                    cell / 2) ** 2 and (cx, cy) not in covered:
+                covered.add((cx, cy))
+                self.trace("world.covered", cell=[cx, cy])
+        self._uncovered[key] = tuple(c for c in cells if c not in covered)
+
     def _announce(self) -> None:
         for cx, cy in sorted(self.covered):
             self.trace("world.covered", cell=[cx, cy])
@@ -130,9 +245,11 @@ class RoomWorld(RobotWorld):
     # ------------------------------------------------------------------ devices
     def op_read_range(self, _data: Mapping[str, Any]) -> dict[str, Any]:
         robot = self.robot
-        best = ray_to_box(robot.x, robot.y, robot.heading, self.room, inside=True)
+        x, y = robot.x, robot.y
+        dx, dy = math.cos(robot.heading), math.sin(robot.heading)
+        best = ray_to_box_along(x, y, dx, dy, self.room, inside=True)
         for box in self.obstacles:
-            best = min(best, ray_to_box(robot.x, robot.y, robot.heading, box, inside=False))
+            best = min(best, ray_to_box_along(x, y, dx, dy, box, inside=False))
         distance = max(0.0, best - self.radius + float(self.rng.normal(0.0, self.range_noise)))
         return {"distance": round(distance, 4)}
 
@@ -153,3 +270,16 @@ class RoomWorld(RobotWorld):
 
     def op_scan_barcode(self, _data: Mapping[str, Any]) -> dict[str, Any]:
         return {"patient_id": self.patient_id if self._near_tag() else ""}
+
+
+def _clear(x: float, y: float, grown: tuple[tuple[float, float, float, float], ...]) -> bool:
+    """Whether (x, y) is outside every grown obstacle (``_free``'s ``not any(...)``)."""
+    for x0, x1, y0, y1 in grown:
+        if x0 <= x <= x1 and y0 <= y <= y1:
+            return False
+    return True
+
+
+def _same(a: float, b: float) -> bool:
+    """Equal bit for bit (``-0.0`` is not ``0.0`` here: the next step's sine would differ)."""
+    return a == b and math.copysign(1.0, a) == math.copysign(1.0, b)
