@@ -15,13 +15,15 @@ from collections.abc import Mapping, Sequence
 from typing import TYPE_CHECKING, Any
 
 from opspec.worlds.base import STEP_S, RobotWorld, check_parameters
-from opspec.worlds.geometry import Box, ray_to_box_along, wrap_angle
-from opspec.worlds.robot import Robot
+from opspec.worlds.geometry import Box, wrap_angle
+from opspec.worlds.robot import COMMANDS, Robot
 
 if TYPE_CHECKING:   # annotations only: `opspec validate` loads no NumPy
     import numpy as np
 
 __all__ = ["RoomWorld"]
+
+_STILL = (0.0, 0.0)         # Robot.velocity() of a command it does not know
 
 
 def _box(corners: Sequence[float]) -> Box:
@@ -84,6 +86,8 @@ class RoomWorld(RobotWorld):
         self._inside = (self.room.x0 + r, self.room.x1 - r, self.room.y0 + r,
                         self.room.y1 - r)
         self._grown = tuple((o.x0 - r, o.x1 + r, o.y0 - r, o.y1 + r) for o in self.obstacles)
+        # the room and the obstacles as op_read_range's ray meets them (ray_to_box_along)
+        self._boxes = tuple(_ray_box(box) for box in (self.room, *self.obstacles))
         # per cell range of _cover's loops, its cells (in the room) not yet covered, in the
         # loops' order; cells are only ever added, so the others can add nothing again
         self._uncovered: dict[tuple[int, int, int, int], tuple[tuple[int, int], ...]] = {}
@@ -106,7 +110,7 @@ class RoomWorld(RobotWorld):
         :meth:`_cover` runs only where some cell within reach may still be uncovered.
         Driving along an arc takes the steps one by one."""
         robot = self.robot
-        v, w = robot.velocity()
+        v, w = COMMANDS.get(robot.command, _STILL)          # robot.velocity()
         if abs(w) >= 1e-12:
             if v != 0.0:
                 super()._advance(now)           # an arc: no command of the bundled specs
@@ -146,7 +150,15 @@ class RoomWorld(RobotWorld):
             if nx == x and ny == y:
                 if stop:
                     in_contact = False
-            elif x_lo <= nx <= x_hi and y_lo <= ny <= y_hi and _clear(nx, ny, grown):
+                t += dt
+                continue
+            free = x_lo <= nx <= x_hi and y_lo <= ny <= y_hi     # _free, inline
+            if free:
+                for gx0, gx1, gy0, gy1 in grown:
+                    if gx0 <= nx <= gx1 and gy0 <= ny <= gy1:
+                        free = False
+                        break
+            if free:
                 x, y = nx, ny
                 in_contact = False
                 key = (int((x - reach) // cell), int((x + reach) // cell),
@@ -245,11 +257,7 @@ class RoomWorld(RobotWorld):
     # ------------------------------------------------------------------ devices
     def op_read_range(self, _data: Mapping[str, Any]) -> dict[str, Any]:
         robot = self.robot
-        x, y = robot.x, robot.y
-        dx, dy = math.cos(robot.heading), math.sin(robot.heading)
-        best = ray_to_box_along(x, y, dx, dy, self.room, inside=True)
-        for box in self.obstacles:
-            best = min(best, ray_to_box_along(x, y, dx, dy, box, inside=False))
+        best = _distance_ahead(robot.x, robot.y, robot.heading, self._boxes)
         distance = max(0.0, best - self.radius + float(self.rng.normal(0.0, self.range_noise)))
         return {"distance": round(distance, 4)}
 
@@ -272,12 +280,42 @@ class RoomWorld(RobotWorld):
         return {"patient_id": self.patient_id if self._near_tag() else ""}
 
 
-def _clear(x: float, y: float, grown: tuple[tuple[float, float, float, float], ...]) -> bool:
-    """Whether (x, y) is outside every grown obstacle (``_free``'s ``not any(...)``)."""
-    for x0, x1, y0, y1 in grown:
-        if x0 <= x <= x1 and y0 <= y <= y1:
-            return False
-    return True
+_RayBox = tuple[float, float, float, float, float, float, float, float]
+
+
+def _ray_box(box: Box) -> _RayBox:
+    """A box's sides and the 1e-9 tolerance ray_to_box_along puts around them."""
+    return (box.x0, box.y0, box.x1, box.y1,
+            box.y0 - 1e-9, box.y1 + 1e-9, box.x0 - 1e-9, box.x1 + 1e-9)
+
+
+def _distance_ahead(x: float, y: float, heading: float, boxes: tuple[_RayBox, ...]) -> float:
+    """``ray_to_box_along`` to the room's walls from inside (``boxes[0]``), then to each
+    obstacle's faces from outside, the nearest of them: the same arithmetic in one loop."""
+    dx, dy = math.cos(heading), math.sin(heading)
+    along_x, along_y = abs(dx) > 1e-12, abs(dy) > 1e-12
+    best = math.inf
+    inside = True
+    for x0, y0, x1, y1, y0_lo, y1_hi, x0_lo, x1_hi in boxes:
+        if not inside and x0 <= x <= x1 and y0 <= y <= y1:
+            best = 0.0 if 0.0 < best else best      # min(best, 0.0): touching an obstacle
+            continue
+        nearest = math.inf
+        if along_x:
+            for edge_x in (x0, x1):
+                t = (edge_x - x) / dx
+                if t > 1e-9 and y0_lo <= y + t * dy <= y1_hi and t < nearest:
+                    nearest = t
+        if along_y:
+            for edge_y in (y0, y1):
+                t = (edge_y - y) / dy
+                if t > 1e-9 and x0_lo <= x + t * dx <= x1_hi and t < nearest:
+                    nearest = t
+        if inside:
+            best, inside = nearest, False
+        elif nearest < best:
+            best = nearest
+    return best
 
 
 def _same(a: float, b: float) -> bool:

@@ -103,3 +103,22 @@ def test_an_arc_command_takes_the_steps_one_by_one(monkeypatch: pytest.MonkeyPat
     reference = _OneStepAtATime(np.random.default_rng(2), obstacles=())
     script = [(0.0, "drive", "arc"), (4.0, "read_range", ""), (9.5, "read_bump", "")]
     assert _bits(_drive(fast, script)) == _bits(_drive(reference, script))
+
+
+def test_the_range_finder_reads_what_ray_to_box_says_bit_for_bit() -> None:
+    """``op_read_range`` (one loop over the room and its obstacles) against the geometry's
+    ``ray_to_box``: the room's walls from inside, the nearest obstacle face from outside,
+    0 from inside an obstacle; from poses all over the room, headings all round."""
+    from opspec.worlds.geometry import ray_to_box
+
+    world = RoomWorld(np.random.default_rng(0), range_noise=0.0)
+    rng = np.random.default_rng(7)
+    for _ in range(3000):
+        x, y = float(rng.uniform(0.0, 5.0)), float(rng.uniform(0.0, 4.0))
+        heading = float(rng.choice([0.0, math.pi / 2, -math.pi, rng.uniform(-4.0, 4.0)]))
+        world.robot.x, world.robot.y, world.robot.heading = x, y, heading
+        best = ray_to_box(x, y, heading, world.room, inside=True)
+        for box in world.obstacles:
+            best = min(best, ray_to_box(x, y, heading, box, inside=False))
+        expected = round(max(0.0, best - world.radius + 0.0), 4)
+        assert world.op_read_range({})["distance"].hex() == expected.hex(), (x, y, heading)
