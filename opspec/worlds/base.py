@@ -8,15 +8,15 @@ from collections.abc import Callable, Mapping
 from typing import TYPE_CHECKING, Any
 
 from opspec.worlds.geometry import wrap_angle
+from opspec.worlds.stepping import STEP_S
 
 if TYPE_CHECKING:   # annotations only: `opspec validate` loads no NumPy
     import numpy as np
 
-__all__ = ["RobotWorld", "World", "check_parameters"]
+__all__ = ["STEP_S", "RobotWorld", "World", "check_parameters"]
 
 Tracer = Callable[[str, Mapping[str, Any]], None]
 
-STEP_S = 0.05          # integration step: 5 cm at 1 m/s, well under the robot's size
 
 
 def _is_number(value: Any) -> bool:

@@ -17,6 +17,7 @@ from typing import TYPE_CHECKING, Any
 from opspec.worlds.base import STEP_S, RobotWorld, check_parameters
 from opspec.worlds.geometry import Box, wrap_angle
 from opspec.worlds.robot import COMMANDS, Robot
+from opspec.worlds.stepping import COVER, DONE, Straight
 
 if TYPE_CHECKING:   # annotations only: `opspec validate` loads no NumPy
     import numpy as np
@@ -86,6 +87,7 @@ class RoomWorld(RobotWorld):
         self._inside = (self.room.x0 + r, self.room.x1 - r, self.room.y0 + r,
                         self.room.y1 - r)
         self._grown = tuple((o.x0 - r, o.x1 + r, o.y0 - r, o.y1 + r) for o in self.obstacles)
+        self._straight = Straight(self._inside, list(self._grown), self.radius, self.cell)
         # the room and the obstacles as op_read_range's ray meets them (ray_to_box_along)
         self._boxes = tuple(_ray_box(box) for box in (self.room, *self.obstacles))
         # per cell range of _cover's loops, its cells (in the room) not yet covered, in the
@@ -106,8 +108,8 @@ class RoomWorld(RobotWorld):
     def _advance(self, now: float) -> None:
         """World.advance's steps, the same floats as :meth:`_step` taken one by one: the
         motor command cannot change between two device operations, so driving straight
-        (or standing) and turning on the spot are loops over local variables, and
-        :meth:`_cover` runs only where some cell within reach may still be uncovered.
+        (or standing) is :class:`~opspec.worlds.stepping.Straight`'s loop and turning on the
+        spot one over the heading; :meth:`_cover` looks only at cells still uncovered.
         Driving along an arc takes the steps one by one."""
         robot = self.robot
         v, w = COMMANDS.get(robot.command, _STILL)          # robot.velocity()
@@ -117,12 +119,7 @@ class RoomWorld(RobotWorld):
                 return
             self._turn_in_place(now, w)
             return
-        limit = now - 1e-12
-        t = self.time
-        x: float = robot.x
-        y: float = robot.y
         heading: float = robot.heading
-        cos_h, sin_h = math.cos(heading), math.sin(heading)
         # each step sets the heading to wrap_angle(heading): ``after`` is that, ``settled``
         # once it no longer changes (bit for bit, sign of zero included)
         after: float
@@ -131,54 +128,30 @@ class RoomWorld(RobotWorld):
         else:
             after = wrap_angle(heading)
             settled = _same(after, heading)
+        straight = self._straight
+        straight.start(self.time, robot.x, robot.y, heading, after, settled, self.in_contact)
         stop = robot.command == "stop"
-        in_contact = self.in_contact
-        x_lo, x_hi, y_lo, y_hi = self._inside
-        grown = self._grown
         uncovered = self._uncovered
-        reach, cell = self.radius, self.cell
-        while t < limit:
-            rest = now - t
-            dt = STEP_S if rest > STEP_S else rest      # min(STEP_S, now - t)
-            nx = x + v * dt * cos_h
-            ny = y + v * dt * sin_h
-            if not settled:
-                heading = after
-                cos_h, sin_h = math.cos(heading), math.sin(heading)
-                after = wrap_angle(heading)
-                settled = _same(after, heading)
-            if nx == x and ny == y:
-                if stop:
-                    in_contact = False
-                t += dt
-                continue
-            free = x_lo <= nx <= x_hi and y_lo <= ny <= y_hi     # _free, inline
-            if free:
-                for gx0, gx1, gy0, gy1 in grown:
-                    if gx0 <= nx <= gx1 and gy0 <= ny <= gy1:
-                        free = False
-                        break
-            if free:
-                x, y = nx, ny
-                in_contact = False
-                key = (int((x - reach) // cell), int((x + reach) // cell),
-                       int((y - reach) // cell), int((y + reach) // cell))
-                cells = uncovered.get(key)
-                if cells is None or cells:
-                    robot.x, robot.y, robot.heading = x, y, heading
-                    self.time, self.in_contact = t, in_contact
-                    self._cover_within(key, cells)
+        while True:
+            code = straight.run(now, v, stop, uncovered)
+            if code == DONE:
+                break
+            # the world as _step leaves it at this step, its time that of the step's start
+            robot.x, robot.y, robot.heading = straight.x, straight.y, straight.heading
+            self.time, self.in_contact = straight.t_step, straight.in_contact
+            if code == COVER:
+                key = straight.key
+                self._cover_within(key, uncovered.get(key))
             else:
                 self.bumped = True
-                if not in_contact:
-                    in_contact = True
-                    self.collisions += 1
-                    robot.heading, self.time, self.in_contact = heading, t, in_contact
-                    self.trace("world.collision", x=round(x, 3), y=round(y, 3))
-            t += dt
-        robot.x, robot.y, robot.heading = x, y, heading
-        self.time, self.in_contact = t, in_contact
-        if settled:
+                self.collisions += 1
+                self.trace("world.collision", x=round(straight.x, 3), y=round(straight.y, 3))
+        heading = straight.heading
+        robot.x, robot.y, robot.heading = straight.x, straight.y, heading
+        self.time, self.in_contact = straight.t, straight.in_contact
+        if straight.bumped:
+            self.bumped = True
+        if straight.settled:
             self._settled = heading
 
     def _turn_in_place(self, now: float, w: float) -> None:

@@ -4,7 +4,9 @@ contacts, coverage and trace, whatever the commands and the times the devices ar
 
 A run's trace must not depend on how the world was stepped: `opspec run` of the robot specs
 writes the same trace as before the fast path (checked by hand when it was written, and by
-tests/engine/test_native_every_spec.py between the compiled and the source engine)."""
+tests/engine/test_native_every_spec.py between the compiled and the source engine). In the
+compiled pass the loop (opspec/worlds/stepping.py) runs compiled by mypyc and is compared
+here with the interpreted ``_step``: the same floats, compiled or not."""
 
 from __future__ import annotations
 
