@@ -1,7 +1,7 @@
 """periodic-path: a robot-rate spec through the engine beside a bare SimPy loop of its periods.
 
     python benchmarks/periodic_path.py [--spec specs/vacuum_cleaner.xpdl] [--seconds 3600]
-                                       [--rounds 5]
+                                       [--rounds 5] [--against CHECKOUT]
 
 Runs, each in its own process and interleaved round after round (engine, loop, engine, …: the
 speed of a shared machine drifts over minutes):
@@ -15,14 +15,23 @@ speed of a shared machine drifts over minutes):
 
 It prints, per round and as the median, the CPU seconds of each, the events each scheduled
 per CPU second (the engine's are every timed callback of the run: periods, CPU demand,
-durations, deadlines, world steps; the loop's are its timeouts) and the ratio of the two
-CPU times. Results in docs/engine-performance.md.
+durations, deadlines; the world is stepped when a device is used, not by events of its own;
+the loop's are its timeouts) and the ratio of the two CPU times.
+
+``--against CHECKOUT`` also runs, in the same rounds, the engine of another checkout of
+opspec (its own compiled modules if it has current ones, else its source; e.g. a
+``git worktree`` of main) and prints this engine's CPU over that one's, paired per round:
+how much faster a change made the periodic path, measured side by side on a shared machine.
+Both must give the same outcome (instances started, the spec's metrics), else the
+comparison stops.
+Results in docs/engine-performance.md.
 """
 
 from __future__ import annotations
 
 import argparse
 import json
+import os
 import statistics
 import subprocess
 import sys
@@ -44,6 +53,7 @@ cpu = time.process_time() - c0
 summary = outcome.result.summary
 print(json.dumps({"cpu_s": cpu, "events": summary["sim_events"],
                   "instances": summary["instances"]["started"],
+                  "outcome": json.dumps(outcome.result.metrics, sort_keys=True),
                   "build": opspec._native.STATUS}))
 """
 
@@ -85,9 +95,13 @@ def periods(spec: str) -> list[tuple[float, float]]:
     return found
 
 
-def _run(code: str, *args: str) -> dict[str, Any]:
+def _run(code: str, *args: str, checkout: Path | None = None) -> dict[str, Any]:
+    env = None
+    if checkout is not None:         # that checkout's opspec first on the path
+        env = {**os.environ, "PYTHONPATH": os.pathsep.join(
+            [str(checkout), *filter(None, [os.environ.get("PYTHONPATH")])])}
     done = subprocess.run([sys.executable, "-c", code, *args], capture_output=True, text=True,
-                          check=False, cwd=ROOT)
+                          check=False, cwd=checkout or ROOT, env=env)
     if done.returncode != 0:
         sys.exit(f"benchmark process failed:\n{done.stderr}")
     result: dict[str, Any] = json.loads(done.stdout.strip().splitlines()[-1])
@@ -99,15 +113,24 @@ def main() -> None:
     parser.add_argument("--spec", default=str(ROOT / "specs" / "vacuum_cleaner.xpdl"))
     parser.add_argument("--seconds", type=float, default=3600.0)
     parser.add_argument("--rounds", type=int, default=5)
+    parser.add_argument("--against", type=Path, default=None, metavar="CHECKOUT",
+                        help="also run the engine of this other opspec checkout, interleaved")
     args = parser.parse_args()
-    found = periods(args.spec)
+    spec = str(Path(args.spec).resolve())
+    found = periods(spec)
     if not found:
         sys.exit(f"{args.spec} has no periodic workflow in its initial mode")
-    engines, loops = [], []
-    for _ in range(args.rounds):
-        engines.append(_run(_ENGINE, args.spec, str(args.seconds)))
+    engines, loops, others = [], [], []
+    for n in range(args.rounds):
+        # the order within a round alternates, so neither side always runs first
+        first_other = args.against is not None and n % 2 == 1
+        if first_other:
+            others.append(_run(_ENGINE, spec, str(args.seconds), checkout=args.against))
+        engines.append(_run(_ENGINE, spec, str(args.seconds)))
         loops.append(_run(_LOOP, str(args.seconds), json.dumps(found)))
-    print(f"periodic-path: {Path(args.spec).name}, {args.seconds:g} simulated s, periods "
+        if args.against is not None and not first_other:
+            others.append(_run(_ENGINE, spec, str(args.seconds), checkout=args.against))
+    print(f"periodic-path: {Path(spec).name}, {args.seconds:g} simulated s, periods "
           + ", ".join(f"{every:g} s" for _o, every in found) + f"; {args.rounds} rounds")
     print(f"engine: {engines[0]['build']}")
     print(f"{'round':<7}{'engine CPU s':>13}{'events':>9}{'events/s':>11}"
@@ -121,10 +144,29 @@ def main() -> None:
               f"{ratios[-1]:>8.1f}")
     e_med = statistics.median(float(e["cpu_s"]) for e in engines)
     b_med = statistics.median(float(b["cpu_s"]) for b in loops)
+    instances = int(engines[0]["instances"])
     print(f"median: engine {e_med:.3f} CPU s ({int(engines[0]['events']) / e_med:,.0f} events/s, "
-          f"{engines[0]['instances']} workflow instances), bare SimPy loop {b_med:.3f} CPU s "
+          f"{instances} workflow instances, {instances / e_med:,.0f} instances/s), "
+          f"bare SimPy loop {b_med:.3f} CPU s "
           f"({int(loops[0]['events']) / b_med:,.0f} events/s); engine / loop "
           f"{statistics.median(ratios):.1f}x (paired median)")
+    if others:
+        _against(args.against, engines, others)
+
+
+def _against(checkout: Path, engines: list[dict[str, Any]],
+             others: list[dict[str, Any]]) -> None:
+    ours = {(e["instances"], e["outcome"]) for e in engines}
+    theirs = {(o["instances"], o["outcome"]) for o in others}
+    if ours != theirs or len(ours) != 1:
+        sys.exit(f"the engine of {checkout} gave another outcome (instances, metrics): "
+                 f"{sorted(theirs)} against {sorted(ours)}")
+    pairs = [float(e["cpu_s"]) / float(o["cpu_s"]) for e, o in zip(engines, others,
+                                                                   strict=True)]
+    o_med = statistics.median(float(o["cpu_s"]) for o in others)
+    print(f"against {checkout} ({others[0]['build']}): its engine {o_med:.3f} CPU s "
+          f"(median); this engine / that one {statistics.median(pairs):.2f}x (paired median; "
+          f"pairs {min(pairs):.2f}x-{max(pairs):.2f}x)")
 
 
 if __name__ == "__main__":

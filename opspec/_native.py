@@ -56,6 +56,7 @@ MODULES: tuple[str, ...] = (
     "opspec.engine.triggers",
     "opspec.engine.workitem",
     "opspec.usermodels.performer",
+    "opspec.worlds.stepping",
 )
 STAMP = "_native_build.json"
 ENV = "OPSPEC_PURE_PYTHON"

@@ -7,14 +7,16 @@ import math
 from collections.abc import Callable, Mapping
 from typing import TYPE_CHECKING, Any
 
+from opspec.worlds.geometry import wrap_angle
+from opspec.worlds.stepping import STEP_S
+
 if TYPE_CHECKING:   # annotations only: `opspec validate` loads no NumPy
     import numpy as np
 
-__all__ = ["RobotWorld", "World", "check_parameters"]
+__all__ = ["STEP_S", "RobotWorld", "World", "check_parameters"]
 
 Tracer = Callable[[str, Mapping[str, Any]], None]
 
-STEP_S = 0.05          # integration step: 5 cm at 1 m/s, well under the robot's size
 
 
 def _is_number(value: Any) -> bool:
@@ -70,9 +72,18 @@ class World:
             # the first use, once the tracer is attached, so counts from the trace are whole
             self._announced = True
             self._announce()
-        while self.time < now - 1e-12:
+        if self.time < now - 1e-12:
+            self._advance(now)
+
+    def _advance(self, now: float) -> None:
+        """Step from ``self.time`` to ``now``: steps of ``STEP_S``, the last one shorter.
+        A subclass may take the same steps faster (with the same arithmetic, so the same
+        floats: a run's trace must not depend on how the world was stepped)."""
+        limit = now - 1e-12
+        step = self._step
+        while self.time < limit:
             dt = min(STEP_S, now - self.time)
-            self._step(dt)
+            step(dt)
             self.time += dt
 
     def _step(self, dt: float) -> None:
@@ -103,8 +114,6 @@ class RobotWorld(World):
     def op_drive(self, data: Mapping[str, Any]) -> dict[str, Any]:
         """Execute ``motor_cmd``; ``turn_random`` (the random-move manoeuvre) turns to a new
         heading a quarter to three quarters round at once, then stops."""
-        from opspec.worlds.geometry import wrap_angle
-
         command = str(data.get("motor_cmd") or "stop")
         if command == "turn_random":
             self.robot.heading = wrap_angle(

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from collections.abc import Callable, Mapping
 from typing import Any
 
 from opspec.engine.performers import PerformerSession, WorkItem
@@ -19,6 +20,11 @@ class WorldDevices:
         self.world = world
         self.applications: dict[str, None] = dict.fromkeys(world.applications())
         self._session: PerformerSession | None = None
+        # Application id -> the world's bound ``op_`` method, looked up once (World.operation
+        # builds the name and looks it up on every call); a world that answers operations its
+        # own way (overrides ``operation``) is asked every time
+        self._handlers: dict[str, Callable[[Mapping[str, Any]], dict[str, Any]]] | None = (
+            {} if type(world).operation is World.operation else None)
 
     def attach(self, session: PerformerSession) -> None:
         self._session = session
@@ -27,10 +33,18 @@ class WorldDevices:
     def offer(self, item: WorkItem) -> None:
         session = self._session
         assert session is not None, "attach() first"
-        self.world.advance(session.now)
+        world = self.world
+        world.advance(session.now)
         application = item.application or item.activity
+        handlers = self._handlers
+        handler = None if handlers is None else handlers.get(application)
+        if handler is None and handlers is not None:
+            handler = getattr(world, f"op_{application}", None)
+            if handler is not None:
+                handlers[application] = handler
         try:
-            data: dict[str, Any] = self.world.operation(application, item.data)
+            data: dict[str, Any] = (world.operation(application, item.data) if handler is None
+                                    else handler(item.data))
         except KeyError:
             session.fail(item, "DeviceError",
                          f"the simulated world has no device operation {application!r}")

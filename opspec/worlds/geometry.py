@@ -5,7 +5,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-__all__ = ["Box", "ray_to_box", "ray_to_circle_inside", "wrap_angle"]
+__all__ = ["Box", "ray_to_box", "ray_to_box_along", "ray_to_circle_inside", "wrap_angle"]
 
 
 @dataclass(frozen=True, slots=True)
@@ -31,20 +31,27 @@ def ray_to_box(x: float, y: float, heading: float, box: Box, *, inside: bool) ->
     """Distance along the ray from (x, y) at ``heading`` to the box's boundary: its walls seen
     from inside (``inside=True``, a room) or its faces seen from outside (an obstacle);
     ``inf`` when the ray misses."""
-    dx, dy = math.cos(heading), math.sin(heading)
+    return ray_to_box_along(x, y, math.cos(heading), math.sin(heading), box, inside=inside)
+
+
+def ray_to_box_along(x: float, y: float, dx: float, dy: float, box: Box, *,
+                     inside: bool) -> float:
+    """:func:`ray_to_box` along the unit direction ``(dx, dy)`` (one ray against several
+    boxes computes its direction once)."""
+    x0, y0, x1, y1 = box.x0, box.y0, box.x1, box.y1
+    if not inside and x0 <= x <= x1 and y0 <= y <= y1:
+        return 0.0                                  # from inside an obstacle: touching it
     best = math.inf
-    for edge_x in (box.x0, box.x1):
-        if abs(dx) > 1e-12:
+    if abs(dx) > 1e-12:
+        for edge_x in (x0, x1):
             t = (edge_x - x) / dx
-            if t > 1e-9 and box.y0 - 1e-9 <= y + t * dy <= box.y1 + 1e-9:
-                best = min(best, t)
-    for edge_y in (box.y0, box.y1):
-        if abs(dy) > 1e-12:
+            if t > 1e-9 and y0 - 1e-9 <= y + t * dy <= y1 + 1e-9 and t < best:
+                best = t
+    if abs(dy) > 1e-12:
+        for edge_y in (y0, y1):
             t = (edge_y - y) / dy
-            if t > 1e-9 and box.x0 - 1e-9 <= x + t * dx <= box.x1 + 1e-9:
-                best = min(best, t)
-    if not inside and box.contains(x, y):
-        return 0.0
+            if t > 1e-9 and x0 - 1e-9 <= x + t * dx <= x1 + 1e-9 and t < best:
+                best = t
     return best
 
 

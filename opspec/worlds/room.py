@@ -14,14 +14,17 @@ import math
 from collections.abc import Mapping, Sequence
 from typing import TYPE_CHECKING, Any
 
-from opspec.worlds.base import RobotWorld, check_parameters
-from opspec.worlds.geometry import Box, ray_to_box, wrap_angle
-from opspec.worlds.robot import Robot
+from opspec.worlds.base import STEP_S, RobotWorld, check_parameters
+from opspec.worlds.geometry import Box, wrap_angle
+from opspec.worlds.robot import COMMANDS, Robot
+from opspec.worlds.stepping import COVER, DONE, Straight
 
 if TYPE_CHECKING:   # annotations only: `opspec validate` loads no NumPy
     import numpy as np
 
 __all__ = ["RoomWorld"]
+
+_STILL = (0.0, 0.0)         # Robot.velocity() of a command it does not know
 
 
 def _box(corners: Sequence[float]) -> Box:
@@ -78,6 +81,20 @@ class RoomWorld(RobotWorld):
         self.bumped = False
         self.in_contact = False
         self.collisions = 0
+        # What _advance needs of the fixed geometry, computed once with _free's arithmetic:
+        # the box the robot's centre may be in, each obstacle grown by the robot's radius.
+        r = self.radius
+        self._inside = (self.room.x0 + r, self.room.x1 - r, self.room.y0 + r,
+                        self.room.y1 - r)
+        self._grown = tuple((o.x0 - r, o.x1 + r, o.y0 - r, o.y1 + r) for o in self.obstacles)
+        self._straight = Straight(self._inside, list(self._grown), self.radius, self.cell)
+        # the room and the obstacles as op_read_range's ray meets them (ray_to_box_along)
+        self._boxes = tuple(_ray_box(box) for box in (self.room, *self.obstacles))
+        # per cell range of _cover's loops, its cells (in the room) not yet covered, in the
+        # loops' order; cells are only ever added, so the others can add nothing again
+        self._uncovered: dict[tuple[int, int, int, int], tuple[tuple[int, int], ...]] = {}
+        # the heading object _advance last found wrap_angle leaves as it is
+        self._settled: float | None = None
         self._cover()
 
     # ------------------------------------------------------------------ motion
@@ -87,6 +104,70 @@ class RoomWorld(RobotWorld):
                 self.room.y0 + r <= y <= self.room.y1 - r):
             return False
         return not any(o.contains(x, y, margin=r) for o in self.obstacles)
+
+    def _advance(self, now: float) -> None:
+        """World.advance's steps, the same floats as :meth:`_step` taken one by one: the
+        motor command cannot change between two device operations, so driving straight
+        (or standing) is :class:`~opspec.worlds.stepping.Straight`'s loop and turning on the
+        spot one over the heading; :meth:`_cover` looks only at cells still uncovered.
+        Driving along an arc takes the steps one by one."""
+        robot = self.robot
+        v, w = COMMANDS.get(robot.command, _STILL)          # robot.velocity()
+        if abs(w) >= 1e-12:
+            if v != 0.0:
+                super()._advance(now)           # an arc: no command of the bundled specs
+                return
+            self._turn_in_place(now, w)
+            return
+        heading: float = robot.heading
+        # each step sets the heading to wrap_angle(heading): ``after`` is that, ``settled``
+        # once it no longer changes (bit for bit, sign of zero included)
+        after: float
+        if heading is self._settled:
+            after, settled = heading, True
+        else:
+            after = wrap_angle(heading)
+            settled = _same(after, heading)
+        straight = self._straight
+        straight.start(self.time, robot.x, robot.y, heading, after, settled, self.in_contact)
+        stop = robot.command == "stop"
+        uncovered = self._uncovered
+        while True:
+            code = straight.run(now, v, stop, uncovered)
+            if code == DONE:
+                break
+            # the world as _step leaves it at this step, its time that of the step's start
+            robot.x, robot.y, robot.heading = straight.x, straight.y, straight.heading
+            self.time, self.in_contact = straight.t_step, straight.in_contact
+            if code == COVER:
+                key = straight.key
+                self._cover_within(key, uncovered.get(key))
+            else:
+                self.bumped = True
+                self.collisions += 1
+                self.trace("world.collision", x=round(straight.x, 3), y=round(straight.y, 3))
+        heading = straight.heading
+        robot.x, robot.y, robot.heading = straight.x, straight.y, heading
+        self.time, self.in_contact = straight.t, straight.in_contact
+        if straight.bumped:
+            self.bumped = True
+        if straight.settled:
+            self._settled = heading
+
+    def _turn_in_place(self, now: float, w: float) -> None:
+        """Steps of a command that turns without driving (``turn_left``…): :meth:`_step`
+        with the position, the contact and the coverage left as they are."""
+        robot = self.robot
+        limit = now - 1e-12
+        t, heading = self.time, robot.heading
+        while t < limit:
+            rest = now - t
+            dt = STEP_S if rest > STEP_S else rest
+            heading = wrap_angle(heading + w * dt)
+            t += dt
+        if robot.command == "stop":
+            self.in_contact = False
+        robot.heading, self.time = heading, t
 
     def _step(self, dt: float) -> None:
         robot = self.robot
@@ -118,6 +199,25 @@ class RoomWorld(RobotWorld):
                     self.covered.add((cx, cy))
                     self.trace("world.covered", cell=[cx, cy])
 
+    def _cover_within(self, key: tuple[int, int, int, int],
+                      cells: tuple[tuple[int, int], ...] | None) -> None:
+        """:meth:`_cover` at the robot's position, whose loops' cell range is ``key``,
+        looking only at the range's ``cells`` not covered when last looked (all of them when
+        ``None``): the same cells, in the same order, are covered and traced."""
+        if cells is None:
+            cx0, cx1, cy0, cy1 = key
+            cells = tuple((cx, cy) for cx in range(max(cx0, 0), min(cx1 + 1, self.cells_x))
+                          for cy in range(max(cy0, 0), min(cy1 + 1, self.cells_y)))
+        robot, cell, reach = self.robot, self.cell, self.radius
+        covered = self.covered
+        for cx, cy in cells:
+            centre_x, centre_y = (cx + 0.5) * cell, (cy + 0.5) * cell
+            if (centre_x - robot.x) ** 2 + (centre_y - robot.y) ** 2 <= reach ** 2 + (
+                    cell / 2) ** 2 and (cx, cy) not in covered:
+                covered.add((cx, cy))
+                self.trace("world.covered", cell=[cx, cy])
+        self._uncovered[key] = tuple(c for c in cells if c not in covered)
+
     def _announce(self) -> None:
         for cx, cy in sorted(self.covered):
             self.trace("world.covered", cell=[cx, cy])
@@ -130,9 +230,7 @@ class RoomWorld(RobotWorld):
     # ------------------------------------------------------------------ devices
     def op_read_range(self, _data: Mapping[str, Any]) -> dict[str, Any]:
         robot = self.robot
-        best = ray_to_box(robot.x, robot.y, robot.heading, self.room, inside=True)
-        for box in self.obstacles:
-            best = min(best, ray_to_box(robot.x, robot.y, robot.heading, box, inside=False))
+        best = _distance_ahead(robot.x, robot.y, robot.heading, self._boxes)
         distance = max(0.0, best - self.radius + float(self.rng.normal(0.0, self.range_noise)))
         return {"distance": round(distance, 4)}
 
@@ -153,3 +251,46 @@ class RoomWorld(RobotWorld):
 
     def op_scan_barcode(self, _data: Mapping[str, Any]) -> dict[str, Any]:
         return {"patient_id": self.patient_id if self._near_tag() else ""}
+
+
+_RayBox = tuple[float, float, float, float, float, float, float, float]
+
+
+def _ray_box(box: Box) -> _RayBox:
+    """A box's sides and the 1e-9 tolerance ray_to_box_along puts around them."""
+    return (box.x0, box.y0, box.x1, box.y1,
+            box.y0 - 1e-9, box.y1 + 1e-9, box.x0 - 1e-9, box.x1 + 1e-9)
+
+
+def _distance_ahead(x: float, y: float, heading: float, boxes: tuple[_RayBox, ...]) -> float:
+    """``ray_to_box_along`` to the room's walls from inside (``boxes[0]``), then to each
+    obstacle's faces from outside, the nearest of them: the same arithmetic in one loop."""
+    dx, dy = math.cos(heading), math.sin(heading)
+    along_x, along_y = abs(dx) > 1e-12, abs(dy) > 1e-12
+    best = math.inf
+    inside = True
+    for x0, y0, x1, y1, y0_lo, y1_hi, x0_lo, x1_hi in boxes:
+        if not inside and x0 <= x <= x1 and y0 <= y <= y1:
+            best = 0.0 if 0.0 < best else best      # min(best, 0.0): touching an obstacle
+            continue
+        nearest = math.inf
+        if along_x:
+            for edge_x in (x0, x1):
+                t = (edge_x - x) / dx
+                if t > 1e-9 and y0_lo <= y + t * dy <= y1_hi and t < nearest:
+                    nearest = t
+        if along_y:
+            for edge_y in (y0, y1):
+                t = (edge_y - y) / dy
+                if t > 1e-9 and x0_lo <= x + t * dx <= x1_hi and t < nearest:
+                    nearest = t
+        if inside:
+            best, inside = nearest, False
+        elif nearest < best:
+            best = nearest
+    return best
+
+
+def _same(a: float, b: float) -> bool:
+    """Equal bit for bit (``-0.0`` is not ``0.0`` here: the next step's sine would differ)."""
+    return a == b and math.copysign(1.0, a) == math.copysign(1.0, b)
