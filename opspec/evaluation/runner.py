@@ -240,6 +240,7 @@ def _drain(executor: cf.Executor, doc: dict[str, object], pending: Sequence[Chun
                 return
 
     fill()
+    _while_workers_start()
     while running:
         finished, _ = cf.wait(running, timeout=_POLL if watch is not None else None,
                               return_when=cf.FIRST_COMPLETED)
@@ -258,6 +259,20 @@ def _drain(executor: cf.Executor, doc: dict[str, object], pending: Sequence[Chun
             del records
         fill()
     return lost
+
+
+def _while_workers_start() -> None:
+    """What this process would do after the replications, done now that the workers have
+    their first chunks: the summaries' interval functions load scipy.special (about 0.3
+    CPU-s), which otherwise ran after the last chunk while the workers' cores stood idle.
+    The workers were forked before it, so they do not pay for it; the numbers are the
+    same whenever it is loaded."""
+    try:
+        from opspec.statistics.intervals import t_quantile
+
+        t_quantile(0.95, 1)
+    except Exception:  # noqa: BLE001 - the summaries load it again and say what is wrong
+        pass
 
 
 def _failed(label: str, users: Sequence[int], error: Exception) -> list[ReplicationRecord]:
