@@ -166,7 +166,12 @@ _POOL: ContextVar[tuple[Any, int] | None] = ContextVar("opspec_drawing_pool", de
 
 
 def _warm_up() -> None:
-    """A drawing process's start: matplotlib imported, its default font found and loaded."""
+    """A drawing process's start: Ctrl-C left to the evaluate process (which stops the
+    pool; no traceback from each drawing process), matplotlib imported, its default font
+    found and loaded."""
+    import signal
+
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
     try:
         _import_matplotlib()
         from matplotlib import font_manager
