@@ -248,12 +248,18 @@ def _on_started(pool: Any, queue: Sequence[_Job]) -> bool:
         if _FIGURES.get(name) is not draw:
             return False
         named.append((name, args, kwargs, fmt))
+    import concurrent.futures as cf
+
+    futures = []
     try:
-        for future in [pool.submit(_draw_named, *job) for job in named]:
-            future.result()
-    except Exception:  # noqa: BLE001 - drawn again by the caller, where an error is plain
+        for job in named:
+            futures.append(pool.submit(_draw_named, *job))
+    except Exception:  # noqa: BLE001 - a process gone: drawn again by the caller
         return False
-    return True
+    finally:
+        # every figure sent is finished before the caller may draw it again
+        cf.wait(futures)
+    return all(future.exception() is None for future in futures)
 
 
 #: Every figure function (undecorated), by name: what a started drawing process is sent.
