@@ -178,7 +178,7 @@ def _warm_up() -> None:
         from matplotlib.ft2font import FT2Font
 
         FT2Font(font_manager.findfont(font_manager.FontProperties()))
-    except Exception:  # noqa: BLE001 - a figure drawn later says what is wrong
+    except Exception:  # noqa: BLE001, S110 - a figure drawn later says what is wrong
         pass
 
 
@@ -350,7 +350,7 @@ def _import_matplotlib() -> None:
         for name in _MATPLOTLIB_MODULES:
             importlib.import_module(name)
         return
-    import matplotlib.artist as artist
+    from matplotlib import artist
 
     hook = artist.Artist.__dict__.get("_update_set_signature_and_docstring")
     if not isinstance(hook, classmethod):       # another matplotlib: import as it is

@@ -271,7 +271,7 @@ def _while_workers_start() -> None:
         from opspec.statistics.intervals import t_quantile
 
         t_quantile(0.95, 1)
-    except Exception:  # noqa: BLE001 - the summaries load it again and say what is wrong
+    except Exception:  # noqa: BLE001, S110 - the summaries load it again, and say why
         pass
 
 

@@ -5,6 +5,7 @@ be those drawn one after another, and what could not be sent to them is still dr
 from __future__ import annotations
 
 from pathlib import Path
+
 import pytest
 
 from opspec.errors import EvaluationError
