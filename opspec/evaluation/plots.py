@@ -352,18 +352,18 @@ def _import_matplotlib() -> None:
         return
     from matplotlib import artist
 
-    hook = artist.Artist.__dict__.get("_update_set_signature_and_docstring")
+    step = "_update_set_signature_and_docstring"     # matplotlib's private name for it
+    hook = artist.Artist.__dict__.get(step)
     if not isinstance(hook, classmethod):       # another matplotlib: import as it is
         hook = None
     else:
-        artist.Artist._update_set_signature_and_docstring = classmethod(  # type: ignore[assignment]
-            _light_set_docs)
+        setattr(artist.Artist, step, classmethod(_light_set_docs))
     try:
         for name in _MATPLOTLIB_MODULES:
             importlib.import_module(name)
     finally:
         if hook is not None:
-            artist.Artist._update_set_signature_and_docstring = hook  # type: ignore[method-assign]
+            setattr(artist.Artist, step, hook)
 
 
 @contextmanager
