@@ -23,9 +23,16 @@ def _figures(folder: Path) -> list[Path]:
                                  marks={"mean": 80.0, "median": 79.0, "p95": 126.0})]
 
 
-def test_started_processes_draw_the_figures_drawn_one_after_another(tmp_path: Path) -> None:
+def test_started_processes_draw_the_figures_drawn_one_after_another(
+        tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
     alone = _figures(tmp_path / "alone")
     with plots.drawing_processes(2):
+        # what this process (or processes forked from it now) would draw with: it must not
+        # be needed, the started processes draw every figure
+        def not_here(job: object) -> None:
+            raise AssertionError("drawn outside the started processes")
+
+        monkeypatch.setattr(plots, "_draw_one", not_here)
         with plots.drawn_by(2):
             together = _figures(tmp_path / "together")
             assert not any(p.exists() for p in together)   # queued, drawn at the end
