@@ -280,6 +280,7 @@ def _draw_job(index: int) -> None:
 
 
 def _draw_one(job: _Job) -> None:
+    _import_matplotlib()
     draw, args, kwargs, fmt = job
     if fmt is None:
         draw(*args, **kwargs)
@@ -311,6 +312,8 @@ def _queueable(draw: _Draw) -> _Draw:
     def figure(*args: Any, **kwargs: Any) -> Path:
         queue = _QUEUE.get()
         if queue is None:
+            # before the figure's own imports of matplotlib's parts (its ticker, say)
+            _import_matplotlib()
             return draw(*args, **kwargs)
         queue.append((draw, args, kwargs, _FORMAT.get()))
         path, fmt = _written(signature.bind(*args, **kwargs).arguments["path"])
