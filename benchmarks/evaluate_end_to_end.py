@@ -20,7 +20,11 @@ CPU time is user + system of the child and of the processes it waited for (its p
 workers), from ``os.wait4``: what the work costs, steadier than wall time on a busy machine.
 Each round prints its ratios against the baseline of the same round; the summary gives their
 median and range (goals of issue 31: evaluate --workers 1 at most 1.5x the baseline; workers 2
-at least 1.8x faster than 1). The load average before and after is printed with them.
+at least 1.8x faster than 1). The load average before and after is printed with them. For
+each ``evaluate --workers W`` it also prints the CPU of its parts - start-up, the evaluate
+process storing beside its workers and the workers' own, the tail after the replications,
+the report's drawing processes - and from them an estimate of the speed-up of W workers over
+1 on W idle cores (``estimated_wall``), which a machine others load cannot show in wall time.
 
 ``--memory 10000,100000`` instead runs ``evaluate --days 1`` for each number of users and
 prints the peak and final resident memory of the evaluate process itself (not its workers;
@@ -43,6 +47,7 @@ import sys
 import tempfile
 import time
 from pathlib import Path
+from typing import Any
 
 ROOT = Path(__file__).resolve().parents[1]
 SPEC = ROOT / "specs" / "medication_dispenser.xpdl"
@@ -76,14 +81,39 @@ assert done == users, done
 
 # `opspec evaluate` as the command line runs it, then this process's own memory: its peak
 # (ru_maxrss: the run, the summaries and the report) and what it holds at the end.
+# Also the CPU of each part (the phases of an estimate of the wall time on idle cores): this
+# process before the replications, during them and after them; the processes it waited for
+# (the replication workers; the report's drawing processes) until the replications ended and
+# after.
 _EVALUATE = """
-import json, resource, sys
+import json, resource, sys, time
+import opspec.evaluation.runner as runner
 from opspec.cli import main
+
+def cpu(who):
+    usage = resource.getrusage(who)
+    return usage.ru_utime + usage.ru_stime
+
+marks = {}
+replications = runner.run_evaluation
+
+def timed(*args, **kwargs):
+    marks["before"] = cpu(resource.RUSAGE_SELF)
+    try:
+        return replications(*args, **kwargs)
+    finally:
+        marks["during"] = cpu(resource.RUSAGE_SELF) - marks["before"]
+        marks["workers"] = cpu(resource.RUSAGE_CHILDREN)
+
+runner.run_evaluation = timed
 status = main(sys.argv[1:])
+marks["after"] = cpu(resource.RUSAGE_SELF) - marks["before"] - marks["during"]
+marks["drawing"] = cpu(resource.RUSAGE_CHILDREN) - marks["workers"]
 with open("/proc/self/statm") as statm:
     now = int(statm.read().split()[1]) * resource.getpagesize() / 2**20
 peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
-print("@@memory " + json.dumps({"peak_mib": peak, "end_mib": now}), file=sys.stderr)
+print("@@memory " + json.dumps({"peak_mib": peak, "end_mib": now, "cpu": marks}),
+      file=sys.stderr)
 sys.exit(status)
 """
 
@@ -116,8 +146,19 @@ def engine_alone(users: int, days: int, seed: int) -> Measured:
                      str(days), str(seed)], cwd=ROOT)
 
 
+def estimated_wall(phases: dict[str, float], workers: int) -> float:
+    """The wall time of one evaluate on ``workers`` idle cores, from the CPU of its parts:
+    start-up alone, the replications' workers and this process's storing shared over the
+    cores, this process's tail (summaries, tables), the figures' processes shared over the
+    cores. An upper bound where the tail overlaps the figures' start (W > 1); what a
+    machine loaded by others cannot show in wall time."""
+    cores = max(1, workers)
+    return (phases["before"] + (phases["workers"] + phases["during"]) / cores
+            + phases["after"] + phases["drawing"] / cores)
+
+
 def evaluate(users: int, days: int, seed: int, workers: int, profile: str | None = None
-             ) -> tuple[Measured, dict[str, float]]:
+             ) -> tuple[Measured, dict[str, Any]]:
     """One ``opspec evaluate`` and the memory of its own process."""
     with tempfile.TemporaryDirectory() as tmp:
         args = ["evaluate", str(SPEC), "--users", str(users), "--days", str(days), "--seed",
@@ -134,7 +175,7 @@ def evaluate(users: int, days: int, seed: int, workers: int, profile: str | None
         doc = json.loads(run.stdout)
         assert doc["metrics"]["doses_due"]["users"] == users, doc["replications"]
         assert (Path(tmp) / "run" / "report.html").is_file()
-    memory: dict[str, float] = {}
+    memory: dict[str, Any] = {}
     for line in run.stderr.splitlines():
         if line.startswith("@@memory "):
             memory = json.loads(line.split(" ", 1)[1])
@@ -157,13 +198,20 @@ def speed(args: argparse.Namespace, script: Path) -> None:
     names = ["baseline", "engine alone", *(f"evaluate --workers {w}" for w in workers)]
     cpu: dict[str, list[float]] = {n: [] for n in names}
     wall: dict[str, list[float]] = {n: [] for n in names}
+    estimate: dict[int, list[float]] = {w: [] for w in workers}
+    parts: dict[int, list[dict[str, float]]] = {w: [] for w in workers}
     print(f"medication dispenser, {args.users:,} users x {args.days} days, seed {args.seed}, "
           f"{args.rounds} interleaved round(s); {_load()}")
     print(f"{'round':<7}" + "".join(f"{n:>24}" for n in names) + "   (CPU s / wall s)")
     for round_ in range(1, args.rounds + 1):
+        evaluated = [evaluate(args.users, args.days, args.seed, w) for w in workers]
         runs = [baseline(script, args.users, args.days, args.seed),
                 engine_alone(args.users, args.days, args.seed),
-                *(evaluate(args.users, args.days, args.seed, w)[0] for w in workers)]
+                *(run for run, _ in evaluated)]
+        for w, (_, memory) in zip(workers, evaluated, strict=True):
+            if "cpu" in memory:
+                parts[w].append(memory["cpu"])
+                estimate[w].append(estimated_wall(memory["cpu"], w))
         for name, run in zip(names, runs, strict=True):
             cpu[name].append(run.cpu)
             wall[name].append(run.wall)
@@ -184,6 +232,17 @@ def speed(args: argparse.Namespace, script: Path) -> None:
                                               wall[f"evaluate --workers {w}"], strict=True)]
                 print(f"  {f'speed-up of --workers {w} over 1 (wall)':<44}{_spread(gain)}"
                       "   goal >= 1.8 on 2 idle cores")
+                if estimate[1] and estimate[w]:
+                    est = [a / b for a, b in zip(estimate[1], estimate[w], strict=True)]
+                    print(f"  {f'  estimated on {w} idle cores (CPU per part)':<44}"
+                          f"{_spread(est)}")
+    for w in workers:
+        if parts[w]:
+            mean = {k: statistics.median(p[k] for p in parts[w]) for k in parts[w][0]}
+            print(f"  evaluate --workers {w}, CPU s by part (median): start-up "
+                  f"{mean['before']:.2f}, storing {mean['during']:.2f} beside the workers' "
+                  f"{mean['workers']:.2f}, tail {mean['after']:.2f}, figures' processes "
+                  f"{mean['drawing']:.2f}")
 
 
 def memory(args: argparse.Namespace) -> None:

@@ -459,6 +459,11 @@ def run(args: argparse.Namespace) -> int:
                   f"replications are stored in {store.path}; finish with `opspec evaluate "
                   f"--resume --out {store.folder}`", file=sys.stderr)
             raise
+        from opspec.evaluation import plots
+
+        # the report's drawing processes start now and import matplotlib on the cores the
+        # replications left, while the summaries below are worked out (--workers W > 1)
+        stack.enter_context(plots.drawing_processes(min(workers, _local_cores())))
         from opspec.evaluation.report import write_report
         from opspec.evaluation.summary import (
             compare_designs,

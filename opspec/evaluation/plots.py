@@ -46,6 +46,7 @@ __all__ = [
     "PALETTE",
     "activity_rates_figure",
     "comparison_figure",
+    "drawing_processes",
     "drawn_by",
     "figure_format",
     "latency_figure",
@@ -128,13 +129,72 @@ def figure_format(name: str) -> Iterator[None]:
 
 
 @contextmanager
+def drawing_processes(workers: int) -> Iterator[None]:
+    """Start up to ``workers`` drawing processes now, for the :func:`drawn_by` blocks within
+    this one: each imports matplotlib (and loads its font) while this process still works
+    out what to draw. ``opspec evaluate --workers W`` starts them as its replications end,
+    so that matplotlib is ready, on a core the replications no longer use, by the time the
+    summaries and the report's tables are done. Nothing happens with one worker or where
+    processes cannot be forked."""
+    import os
+
+    if workers <= 1 or not hasattr(os, "fork") or _POOL.get() is not None:
+        yield
+        return
+    import concurrent.futures as cf
+    import multiprocessing
+
+    pool = cf.ProcessPoolExecutor(max_workers=workers, initializer=_warm_up,
+                                  mp_context=multiprocessing.get_context("fork"))
+    try:
+        for _ in range(workers):            # forks them all now (not at the first figure)
+            pool.submit(_ready)
+    except Exception:  # noqa: BLE001 - no processes: the figures are drawn as before
+        pool.shutdown(wait=False, cancel_futures=True)
+        yield
+        return
+    token = _POOL.set((pool, workers))
+    try:
+        yield
+    finally:
+        _POOL.reset(token)
+        pool.shutdown(wait=True, cancel_futures=True)
+
+
+#: Within :func:`drawing_processes`: its pool and how many processes it has.
+_POOL: ContextVar[tuple[Any, int] | None] = ContextVar("opspec_drawing_pool", default=None)
+
+
+def _warm_up() -> None:
+    """A drawing process's start: Ctrl-C left to the evaluate process (which stops the
+    pool; no traceback from each drawing process), matplotlib imported, its default font
+    found and loaded."""
+    import signal
+
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+    try:
+        _import_matplotlib()
+        from matplotlib import font_manager
+        from matplotlib.ft2font import FT2Font
+
+        FT2Font(font_manager.findfont(font_manager.FontProperties()))
+    except Exception:  # noqa: BLE001, S110 - a figure drawn later says what is wrong
+        pass
+
+
+def _ready() -> None:
+    """The task that makes the pool fork its processes."""
+
+
+@contextmanager
 def drawn_by(workers: int) -> Iterator[None]:
     """Within this block, the figure functions return the path they will write at once and
     the figures are drawn at the block's end, by up to ``workers`` processes side by side
-    (each figure is independent of the others; the same bytes as drawn one after another).
-    With one worker they are drawn as they are asked for (nothing queued). ``opspec
-    evaluate --workers W`` draws its report's figures so: what runs after the replications
-    runs on one core otherwise, and with two workers it was most of the wall time saved."""
+    (each figure is independent of the others; the same bytes as drawn one after another),
+    those of an enclosing :func:`drawing_processes` when there is one. With one worker
+    they are drawn as they are asked for (nothing queued). ``opspec evaluate --workers W``
+    draws its report's figures so: what runs after the replications runs on one core
+    otherwise, and with two workers it was most of the wall time saved."""
     if workers <= 1:                # drawn as they are asked for, as without this block
         yield
         return
@@ -150,6 +210,9 @@ def drawn_by(workers: int) -> Iterator[None]:
 def _draw(queue: Sequence[_Job], workers: int) -> None:
     global _JOBS
     if workers > 1 and len(queue) > 1:
+        started = _POOL.get()
+        if started is not None and _on_started(started[0], queue):
+            return
         import concurrent.futures as cf
         import multiprocessing
         import os
@@ -174,6 +237,40 @@ def _draw(queue: Sequence[_Job], workers: int) -> None:
         _draw_one(job)
 
 
+def _on_started(pool: Any, queue: Sequence[_Job]) -> bool:
+    """Draw ``queue`` on the processes :func:`drawing_processes` started, the figure
+    functions sent by name (they were forked before the figures were asked for). False
+    when that cannot be done (a figure function replaced by another, a process gone, a
+    figure that failed): the caller draws them as before, where an error is plain."""
+    named = []
+    for draw, args, kwargs, fmt in queue:
+        name = getattr(draw, "__name__", "")
+        if _FIGURES.get(name) is not draw:
+            return False
+        named.append((name, args, kwargs, fmt))
+    import concurrent.futures as cf
+
+    futures = []
+    try:
+        for job in named:
+            futures.append(pool.submit(_draw_named, *job))
+    except Exception:  # noqa: BLE001 - a process gone: drawn again by the caller
+        return False
+    finally:
+        # every figure sent is finished before the caller may draw it again
+        cf.wait(futures)
+    return all(future.exception() is None for future in futures)
+
+
+#: Every figure function (undecorated), by name: what a started drawing process is sent.
+_FIGURES: dict[str, Any] = {}
+
+
+def _draw_named(name: str, args: tuple[Any, ...], kwargs: dict[str, Any], fmt: str | None
+                ) -> None:
+    _draw_one((_FIGURES[name], args, kwargs, fmt))
+
+
 #: The queue :func:`_draw` hands to the processes it forks.
 _JOBS: Sequence[_Job] = ()
 
@@ -183,6 +280,7 @@ def _draw_job(index: int) -> None:
 
 
 def _draw_one(job: _Job) -> None:
+    _import_matplotlib()
     draw, args, kwargs, fmt = job
     if fmt is None:
         draw(*args, **kwargs)
@@ -208,11 +306,14 @@ def _queueable(draw: _Draw) -> _Draw:
     import inspect
 
     signature = inspect.signature(draw)
+    _FIGURES[draw.__name__] = draw
 
     @functools.wraps(draw)
     def figure(*args: Any, **kwargs: Any) -> Path:
         queue = _QUEUE.get()
         if queue is None:
+            # before the figure's own imports of matplotlib's parts (its ticker, say)
+            _import_matplotlib()
             return draw(*args, **kwargs)
         queue.append((draw, args, kwargs, _FORMAT.get()))
         path, fmt = _written(signature.bind(*args, **kwargs).arguments["path"])
@@ -221,9 +322,57 @@ def _queueable(draw: _Draw) -> _Draw:
     return figure
 
 
+#: The modules of matplotlib the figures use, imported by :func:`_import_matplotlib`.
+_MATPLOTLIB_MODULES = ("matplotlib.figure", "matplotlib.backends.backend_agg",
+                       "matplotlib.backends.backend_svg", "matplotlib.ticker", "cycler")
+
+
+def _light_set_docs(cls: Any) -> None:
+    """What matplotlib's ``Artist._update_set_signature_and_docstring`` does for a new artist
+    class, less the signature and the docstring of its ``set()``: the flag that makes its
+    subclasses get a ``set()`` of their own (so ``set()`` behaves exactly as before)."""
+    cls.set._autogenerated_signature = True
+
+
+@functools.cache
+def _import_matplotlib() -> None:
+    """Import what the figures use, once per process, without writing the docstrings.
+
+    matplotlib writes, for each of its ~100 artist classes as it defines them, a signature
+    and a docstring of the class's ``set()`` listing every property (``ArtistInspector``
+    over the class's methods): a third of its import, about 0.15 CPU-s, in every process
+    that draws, for help text no figure uses. When this process has not imported
+    matplotlib yet, its classes are defined with that step reduced to the flag ``set()``
+    needs (:func:`_light_set_docs`); the step is restored afterwards, so classes defined
+    later (a user's own) get their docstrings as usual. ``set()`` itself works as before;
+    only ``help(Line2D.set)`` is shorter. Any other state: imported as usual."""
+    import importlib
+    import sys
+
+    if "matplotlib.artist" in sys.modules:
+        for name in _MATPLOTLIB_MODULES:
+            importlib.import_module(name)
+        return
+    from matplotlib import artist
+
+    step = "_update_set_signature_and_docstring"     # matplotlib's private name for it
+    hook = artist.Artist.__dict__.get(step)
+    if not isinstance(hook, classmethod):       # another matplotlib: import as it is
+        hook = None
+    else:
+        setattr(artist.Artist, step, classmethod(_light_set_docs))
+    try:
+        for name in _MATPLOTLIB_MODULES:
+            importlib.import_module(name)
+    finally:
+        if hook is not None:
+            setattr(artist.Artist, step, hook)
+
+
 @contextmanager
 def _figure(width: float, height: float) -> Iterator[Figure]:
     """A fresh Agg-backed figure under opspec's style (fonts, grid, palette)."""
+    _import_matplotlib()
     import matplotlib
     from cycler import cycler
     from matplotlib.backends.backend_agg import FigureCanvasAgg

@@ -1,0 +1,69 @@
+"""``opspec evaluate --workers W`` starts the report's drawing processes as its replications
+end (``plots.drawing_processes``), before it knows what to draw: the figures they draw must
+be those drawn one after another, and what could not be sent to them is still drawn."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+
+from opspec.errors import EvaluationError
+from opspec.evaluation import plots
+
+RATES = [("doses missed", 0.0034, 0.001, 0.008), ("doses taken", 0.95, 0.93, 0.97)]
+DAYS = {"doses_taken": [4, 3, 4, 4, 2], "doses_missed": [0, 1, 0, 0, 2]}
+LATENCIES = [30.0 + (i * 37 % 101) for i in range(300)]
+
+
+def _figures(folder: Path) -> list[Path]:
+    return [plots.rates_figure(RATES, folder / "rates.svg"),
+            plots.over_days_figure(DAYS, folder / "days.svg"),
+            plots.latency_figure("report_latency_s", LATENCIES, folder / "latency.svg",
+                                 marks={"mean": 80.0, "median": 79.0, "p95": 126.0})]
+
+
+def test_started_processes_draw_the_figures_drawn_one_after_another(
+        tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    alone = _figures(tmp_path / "alone")
+    with plots.drawing_processes(2):
+        # what this process (or processes forked from it now) would draw with: it must not
+        # be needed, the started processes draw every figure
+        def not_here(job: object) -> None:
+            raise AssertionError("drawn outside the started processes")
+
+        monkeypatch.setattr(plots, "_draw_one", not_here)
+        with plots.drawn_by(2):
+            together = _figures(tmp_path / "together")
+            assert not any(p.exists() for p in together)   # queued, drawn at the end
+        assert all(p.is_file() for p in together)           # drawn before the block ends
+    assert [p.read_bytes() for p in together] == [p.read_bytes() for p in alone]
+
+
+def test_a_figure_function_made_after_the_processes_started_is_still_drawn(
+        tmp_path: Path) -> None:
+    """A figure function the started processes do not know (made after they were forked: a
+    user's own figure) is drawn all the same, and so are the others."""
+    with plots.drawing_processes(2):
+
+        @plots._queueable
+        def dots_figure(values: list[float], path: Path) -> Path:
+            return plots.rates_figure([("dots", *values)], path)
+
+        with plots.drawn_by(2):
+            mine = dots_figure([0.5, 0.4, 0.6], tmp_path / "dots.svg")
+            paths = _figures(tmp_path)
+    assert mine.is_file() and all(p.is_file() for p in paths)
+    assert mine.read_bytes() == plots.rates_figure([("dots", 0.5, 0.4, 0.6)],
+                                                   tmp_path / "again.svg").read_bytes()
+
+
+def test_a_figure_that_cannot_be_written_is_still_a_plain_error(tmp_path: Path) -> None:
+    blocker = tmp_path / "file"
+    blocker.write_text("not a folder")
+    with (plots.drawing_processes(2),
+          pytest.raises(EvaluationError, match=r"cannot write the figure .*rates\.svg"),
+          plots.drawn_by(2)):
+        plots.rates_figure(RATES, tmp_path / "fine.svg")
+        plots.rates_figure(RATES, blocker / "rates.svg")
+    assert (tmp_path / "fine.svg").is_file()
