@@ -1,6 +1,8 @@
 from __future__ import annotations
 
 import json
+from collections.abc import Iterator
+from contextlib import contextmanager
 from pathlib import Path
 
 import pytest
@@ -26,12 +28,19 @@ def evaluate(capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
         with monkeypatch.context() as patch:
             if not report:
                 patch.setattr("opspec.evaluation.report.write_report", _report_not_drawn)
+                # nor start the processes that would draw it (--workers 2)
+                patch.setattr("opspec.evaluation.plots.drawing_processes", _no_drawing)
             status = main(["evaluate", *args, "--json"])
         captured = capsys.readouterr()
         doc = json.loads(captured.out) if captured.out.strip() else None
         return status, doc, captured.err
 
     return run
+
+
+@contextmanager
+def _no_drawing(_workers: int) -> Iterator[None]:
+    yield
 
 
 def _report_not_drawn(store, summaries=None, **_options) -> Path:
