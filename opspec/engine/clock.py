@@ -33,19 +33,41 @@ from typing import Any
 
 import simpy
 from simpy.core import EmptySchedule
+from simpy.events import NORMAL, URGENT
 
 __all__ = ["Clock", "EmptySchedule", "events_scheduled"]
 
 
 class Clock(simpy.Environment):
     """A SimPy environment that counts the stop events of its ``run(until)`` calls
-    (:attr:`scheduled`); the run counts its own timeouts (``RunState.sim_events``)."""
+    (:attr:`scheduled`; the run counts its own timeouts, ``RunState.sim_events``) and that one
+    run may drive with its own timer heap (:attr:`owner`, :mod:`opspec.engine.timers`): the
+    clock tells that run about every event anything else schedules on it, before SimPy
+    numbers it, and reports the run's time while the run is ahead of SimPy's clock."""
 
     def __init__(self, initial_time: float = 0.0) -> None:
         super().__init__(float(initial_time))
         #: events SimPy scheduled for run(until): the stop event, and the stop put back
         #: once it has stopped the run
         self.scheduled = 0
+        #: the run keeping its timed callbacks on its own heap (opspec.engine.timers.Timers)
+        self.owner: Any = None
+
+    @property
+    def now(self) -> Any:
+        """The current simulated time (the owner's while it runs ahead of SimPy's clock)."""
+        owner = self.owner
+        if owner is not None and owner.lagging:
+            return owner.now
+        return _SIMPY_NOW(self)
+
+    def schedule(self, event: simpy.Event, priority: Any = NORMAL, delay: Any = 0) -> None:
+        """SimPy's ``schedule``, after telling the owner (its entries due at the same instant
+        come first: they were scheduled first)."""
+        owner = self.owner
+        if owner is not None and not owner.scheduling:
+            owner.foreign(priority == URGENT, float(delay))
+        simpy.Environment.schedule(self, event, priority, delay)
 
     def run(self, until: Any = None) -> Any:
         if until is None or isinstance(until, simpy.Event) or float(until) <= self.now:
@@ -54,6 +76,9 @@ class Clock(simpy.Environment):
         value = super().run(until)
         self.scheduled += 1
         return value
+
+
+_SIMPY_NOW: Any = simpy.Environment.now.fget  # type: ignore[attr-defined]  # the property's getter
 
 
 def events_scheduled(env: simpy.Environment) -> int | None:
