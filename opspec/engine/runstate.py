@@ -10,8 +10,9 @@ a reference to this object and to each other.
 
 It also owns the two primitives every part uses: the trace (:meth:`RunState.emit`, built only
 when a listener wants the event) and the clock (:meth:`RunState.drain` runs the ready queue,
-:meth:`RunState.later` and :meth:`RunState.call_at` schedule SimPy timeouts on ``env``,
-by default a :class:`~opspec.engine.clock.Clock`).
+:meth:`RunState.later` and :meth:`RunState.call_at` schedule timed callbacks on the run's
+clock, ``env``, by default a :class:`~opspec.engine.clock.Clock`, through its base
+:class:`~opspec.engine.timers.Timers`: its own heap, or a SimPy timeout each).
 """
 
 from __future__ import annotations
