@@ -37,8 +37,8 @@ from opspec.engine.lifecycle import RUNNING, SUSPENDED
 from opspec.engine.performers import Performer
 from opspec.engine.processors import DedicatedProcessor, PooledProcessor
 from opspec.engine.random import Streams
-from opspec.engine.timers import Timed, Timers
 from opspec.engine.registry import PerformerRegistry
+from opspec.engine.timers import Timed, Timers
 from opspec.engine.trace import EventKind as EK
 from opspec.engine.trace import TraceEvent, TraceListener
 from opspec.engine.zero_time import (

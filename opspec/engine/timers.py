@@ -216,8 +216,7 @@ class Timers:
         if self.lagging:
             self.catch_up()
         at = float(self.env.now) + delay
-        if at < self.horizon:
-            self.horizon = at
+        self.horizon = min(self.horizon, at)
         if self.ticking and at == self.now:
             self.shared = True      # it comes before what this instant schedules from now on
         if urgent:
