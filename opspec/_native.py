@@ -52,6 +52,7 @@ MODULES: tuple[str, ...] = (
     "opspec.engine.runstate",
     "opspec.engine.sampling",
     "opspec.engine.simulation",
+    "opspec.engine.timers",
     "opspec.engine.timing",
     "opspec.engine.triggers",
     "opspec.engine.workitem",

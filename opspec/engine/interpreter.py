@@ -27,9 +27,10 @@ Design (for speed, see ``benchmarks/engine_profile.py``):
   left (a trampoline: no recursion however long a chain of instant activities is, and
   performers may call back into the session from inside ``offer``).
 * Clock events exist only where simulated time passes: a timer, a deadline, a duration, a
-  worker's CPU time, a performer's ``call_later``. They are SimPy timeouts with a callback
-  (``env.timeout(delay).callbacks``, :mod:`opspec.engine.clock`), never a generator process
-  per activity. SimPy cannot cancel a scheduled event, so a timer carries the *generation* of its activity
+  worker's CPU time, a performer's ``call_later``. They are timed callbacks on the run's
+  own heap, one SimPy timeout at a time driving it (a timeout each on a plain SimPy
+  environment: :mod:`opspec.engine.timers`), never a generator process per activity.
+  Neither cancels a scheduled event, so a timer carries the *generation* of its activity
   instance and does nothing when the instance has moved on.
 * Instantaneous activities (routes, events, tasks without a bound callable, activities with
   no implementation) run without an :class:`~opspec.engine.instances.ActivityInstance`;

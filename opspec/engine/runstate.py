@@ -10,8 +10,9 @@ a reference to this object and to each other.
 
 It also owns the two primitives every part uses: the trace (:meth:`RunState.emit`, built only
 when a listener wants the event) and the clock (:meth:`RunState.drain` runs the ready queue,
-:meth:`RunState.later` and :meth:`RunState.call_at` schedule SimPy timeouts on ``env``,
-by default a :class:`~opspec.engine.clock.Clock`).
+:meth:`RunState.later` and :meth:`RunState.call_at` schedule timed callbacks on the run's
+clock, ``env``, by default a :class:`~opspec.engine.clock.Clock`, through its base
+:class:`~opspec.engine.timers.Timers`: its own heap, or a SimPy timeout each).
 """
 
 from __future__ import annotations
@@ -24,7 +25,6 @@ from typing import TYPE_CHECKING, Any, final
 
 import simpy
 
-from opspec.engine.clock import Clock
 from opspec.engine.compiled import (
     CompiledActivity,
     CompiledPackage,
@@ -38,6 +38,7 @@ from opspec.engine.performers import Performer
 from opspec.engine.processors import DedicatedProcessor, PooledProcessor
 from opspec.engine.random import Streams
 from opspec.engine.registry import PerformerRegistry
+from opspec.engine.timers import Timed, Timers
 from opspec.engine.trace import EventKind as EK
 from opspec.engine.trace import TraceEvent, TraceListener
 from opspec.engine.zero_time import (
@@ -57,7 +58,7 @@ __all__ = ["RunState", "discard"]
 _EMPTY: Mapping[str, Any] = MappingProxyType({})
 
 
-class RunState:
+class RunState(Timers):
     """The state of one simulation run (see the module docstring)."""
 
     flow: Flow      # resolves the joins the ready queue leaves pending (set by the Interpreter)
@@ -67,14 +68,9 @@ class RunState:
                  params: Mapping[str, Any] | None, env: simpy.Environment | None,
                  scope: tuple[int, ...], mode_loader: Callable[[str], CompiledPackage | Package] | None
                  ) -> None:
+        super().__init__(env)
         self.compiled = compiled
         self.config = config
-        self.env = env if env is not None else Clock()
-        # The time, as the engine reads it: SimPy's ``env.now`` is a Python property, read
-        # once per timed callback the engine handles (:meth:`enter`) and at each call from
-        # outside one (:meth:`sync`) instead of at every use (some 38 a dose cycle).
-        self.now = float(self.env.now)
-        self.inside = False         # handling one of its own timed callbacks: now is fresh
         self.sim_events = 0         # timeouts scheduled (the summary's sim_events)
         self.registry = performers
         self.streams = Streams(seed, scope)
@@ -231,7 +227,7 @@ class RunState:
     def _past_limit(self, steps: int, a: Any, b: Any) -> int:
         """The step count passed the limit: a new count if the clock moved since the count
         began, else a step of a zero-time cycle (see :meth:`zero_time`)."""
-        now = self.env.now
+        now = self.now
         if not _same_instant(now, self.instant):
             self.instant = now
             if self.sampler is not None:         # the clock moved on: no cycle after all
@@ -245,7 +241,7 @@ class RunState:
         """A step past the limit at this instant: note what it moves (``a``, ``b`` as in a
         ready-queue item, or a frame and an activity); stop the run once enough are seen.
         ``starts``: the instances started at this instant, when they are what passed a limit."""
-        now = self.env.now
+        now = self.now
         sampler = self.sampler
         if sampler is None or not _same_instant(now, sampler.at):
             sampler = self.sampler = ZeroTimeSampler(now, self.max_instant_steps)
@@ -253,44 +249,35 @@ class RunState:
         if sampler.record(a, b) or starts >= self.max_instant_starts + SAMPLE_STARTS:
             raise sampler.error(starts)
 
-    def sync(self) -> None:
-        """Control enters the engine from outside its own timed callbacks (a performer
-        answering from a SimPy process or the TUI, ``run``/``step``, a device's post): read
-        the clock, which may have moved since the engine last looked."""
-        if not self.inside:
-            self.now = float(self.env.now)
-
-    def enter(self) -> bool:
-        """A timed callback of this run starts: the clock moved to its time. Returns whether
-        one was already running (a nested entry leaves the flag to the outer one)."""
-        self.now = float(self.env.now)
-        outer = self.inside
-        self.inside = True
-        return outer
-
     def later(self, delay: float, fn: Callable[[ActivityInstance, Any], None],
                ai: ActivityInstance, arg: Any = None) -> None:
         """Call ``fn(ai, arg)`` after ``delay`` simulated seconds if ``ai`` is still waiting."""
         if self.resolution > 0.0:
             delay = self._align(delay)
         self.sim_events += 1
-        self.env.timeout(max(0.0, delay)).callbacks.append(_Later(self, fn, ai, arg))
+        self.schedule_timed(max(0.0, delay), _Later(self, fn, ai, arg))
 
     def fire(self, fn: Callable[[ActivityInstance, Any], None], ai: ActivityInstance,
              arg: Any, gen: int) -> None:
-        """A :meth:`later` callback is due (nothing to do, not even a look at the clock,
-        when ``ai`` has moved on: a deadline that lost its race)."""
+        """A :meth:`later` callback is due as a SimPy timeout's (nothing to do, not even a
+        look at the clock, when ``ai`` has moved on: a deadline that lost its race)."""
         if ai.gen == gen and ai.state == RUNNING:
             outer = self.enter()
             try:
-                inst = ai.frame.inst
-                if inst.state == SUSPENDED:
-                    inst.deferred.append((self._refire, fn, ai, (arg, gen)))
-                    return
-                fn(ai, arg)
-                self.drain()
+                self.fired(fn, ai, arg, gen)
             finally:
                 self.inside = outer
+
+    def fired(self, fn: Callable[[ActivityInstance, Any], None], ai: ActivityInstance,
+              arg: Any, gen: int) -> None:
+        """A :meth:`later` callback is due, the time set."""
+        if ai.gen == gen and ai.state == RUNNING:
+            inst = ai.frame.inst
+            if inst.state == SUSPENDED:
+                inst.deferred.append((self._refire, fn, ai, (arg, gen)))
+                return
+            fn(ai, arg)
+            self.drain()
 
     def _refire(self, fn: Callable[[ActivityInstance, Any], None], ai: ActivityInstance,
                 arg_gen: tuple[Any, int]) -> None:
@@ -315,13 +302,13 @@ class RunState:
             self.ready.append((_call, callback, None, None))
             return
         self.sim_events += 1
-        self.env.timeout(max(0.0, delay)).callbacks.append(_CallAt(self, callback, True))
+        self.schedule_timed(max(0.0, delay), _CallAt(self, callback, True))
 
     def timer(self, delay: float, callback: Callable[[], None]) -> None:
         """Run ``callback`` after ``delay`` simulated seconds (it drains itself, if it
         must: the processors' and the start timers' callbacks)."""
         self.sim_events += 1
-        self.env.timeout(max(0.0, delay)).callbacks.append(_CallAt(self, callback, False))
+        self.schedule_timed(max(0.0, delay), _CallAt(self, callback, False))
 
     def called(self, callback: Callable[[], None], drain: bool) -> None:
         outer = self.enter()
@@ -381,8 +368,8 @@ def _call(callback: Callable[[], None], _a: Any, _b: Any) -> None:
 
 
 @final
-class _Later:
-    """The SimPy callback of :meth:`RunState.later` (a small object, not a closure: one
+class _Later(Timed):
+    """The timed callback of :meth:`RunState.later` (a small object, not a closure: one
     allocation instead of two per timeout)."""
 
     def __init__(self, state: RunState, fn: Callable[[ActivityInstance, Any], None],
@@ -393,18 +380,26 @@ class _Later:
         self.arg = arg
         self.gen = ai.gen
 
+    def go(self) -> None:
+        self.state.fired(self.fn, self.ai, self.arg, self.gen)
+
     def __call__(self, _event: Any) -> None:
         self.state.fire(self.fn, self.ai, self.arg, self.gen)
 
 
 @final
-class _CallAt:
-    """The SimPy callback of :meth:`RunState.call_at` and :meth:`RunState.timer`."""
+class _CallAt(Timed):
+    """The timed callback of :meth:`RunState.call_at` and :meth:`RunState.timer`."""
 
     def __init__(self, state: RunState, callback: Callable[[], None], drain: bool) -> None:
         self.state = state
         self.callback = callback
         self.drain = drain
+
+    def go(self) -> None:
+        self.callback()
+        if self.drain:
+            self.state.drain()
 
     def __call__(self, _event: Any) -> None:
         self.state.called(self.callback, self.drain)

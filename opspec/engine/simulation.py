@@ -294,10 +294,14 @@ class Simulation(Interpreter):
             from opspec.engine.wallclock import run_realtime
 
             self.drift = run_realtime(self, until, self.config.speed)
-        elif until is None:
-            self.env.run()
-        elif until > self.env.now:
-            self.env.run(until=until)
+        elif until is None or until > self.env.now:
+            # the run's own timers may go ahead of SimPy's clock (opspec/engine/timers.py),
+            # not with a shared processor model (it reads env.now itself)
+            self.ahead = self.heaped and self.pool is None
+            try:
+                self.env.run(until=until)
+            finally:
+                self.ahead = False
         self.sync()                      # run(until) stopped the clock at until
         self.check_waiting(horizon=until)
         if self.wants(EK.RUN_ENDED, None, None):

@@ -1,0 +1,245 @@
+"""A run's timed callbacks: its own small heap, driven by one SimPy timeout at a time.
+
+Every wait in simulated time of a run (a duration, a deadline, a periodic timer, a worker's
+CPU time, a performer's ``call_later``) is a :class:`Timed` entry. On a plain
+:class:`simpy.Environment` each entry is a SimPy timeout of its own
+(``env.timeout(delay).callbacks.append(entry)``), as before. On a
+:class:`~opspec.engine.clock.Clock` the run owns (the one it makes by default), entries go
+on a heap of ``(time, sequence, entry)`` in compiled code instead, and one SimPy timeout at
+a time, at the heap's earliest time, wakes the run (the *driver*): a SimPy ``Timeout``,
+its scheduling and its step are Python code, thousands of instructions each from compiled
+code, and most of a run's timers never need one.
+
+The order is SimPy's to the last event. Entries at one instant run in the order they were
+scheduled, as SimPy's event ids order them; the clock tells the run about every event
+anything else schedules on it (:meth:`Timers.foreign`, from ``Clock.schedule``) *before*
+SimPy numbers it, and the run gives its entries due at that event's instant SimPy timeouts
+of their own there (they were scheduled first, so they come first), and stops working
+through an instant something else now shares. Which entries a driver runs:
+
+* stepping (``env.step()``: the walkthrough, wall-clock runs, a caller's own loop), exactly
+  one, so each SimPy step is one timed callback as before;
+* inside :meth:`~opspec.engine.simulation.Simulation.run` (``ahead``), every entry due before
+  anything else on SimPy's queue (the stop of ``run(until)``, another household's or
+  process's event): the run moves on through its own instants without a SimPy event for
+  each. SimPy's clock then lags behind the run's; the clock reports the run's time while it
+  does (``Clock.now``), and before anything else is scheduled on it, or when the driver
+  returns, SimPy's clock is moved to the run's time (``run`` until a timeout at that time),
+  so whatever is scheduled next, by anyone, counts from the right time.
+
+Not with a shared processor model (the processors read ``env.now`` themselves): then the
+run steps one entry per driver. A lost race (a deadline whose activity completed) costs a
+heap entry and a generation check, no SimPy event.
+"""
+
+from __future__ import annotations
+
+import math
+from heapq import heapify, heappop, heappush
+from typing import Any, Final, final
+
+import simpy
+
+from opspec.engine.clock import Clock
+
+__all__ = ["Timed", "Timers", "exact_delay"]
+
+INF: Final = math.inf
+
+
+class Timed:
+    """A timed callback of a run: :meth:`go` from the run's heap (the run has set its time),
+    ``__call__`` as a SimPy timeout's callback (it reads the time itself)."""
+
+    def go(self) -> None:
+        raise NotImplementedError
+
+    def __call__(self, _event: Any) -> None:
+        raise NotImplementedError
+
+
+@final
+class _Driver:
+    """The SimPy callback that wakes the run (``gen``: which driver; older ones do nothing)."""
+
+    def __init__(self, timers: Timers, gen: int) -> None:
+        self.timers = timers
+        self.gen = gen
+
+    def __call__(self, _event: Any) -> None:
+        self.timers.tick(self.gen)
+
+
+def exact_delay(base: float, target: float) -> float:
+    """The delay SimPy must be given at time ``base`` for an event at exactly ``target``
+    (SimPy adds: ``base + (target - base)`` can be an ulp off ``target``)."""
+    delay = target - base
+    for _ in range(8):
+        at = base + delay
+        if at == target:
+            break
+        delay = math.nextafter(delay, INF if at < target else -INF)
+    return max(0.0, delay)
+
+
+class Timers:
+    """The clock side of a run's state (:class:`~opspec.engine.runstate.RunState` extends
+    it): the time as the run reads it, and its timed callbacks (see the module docstring)."""
+
+    def __init__(self, env: simpy.Environment | None) -> None:
+        clock = env if env is not None else Clock()
+        self.env: simpy.Environment = clock
+        # The time, as the engine reads it: SimPy's ``env.now`` is a Python property, read
+        # when a timed callback starts (:meth:`enter`; none at all for the heap's entries)
+        # and at each call from outside one (:meth:`sync`), not at every use.
+        self.now = float(clock.now)
+        self.inside = False         # handling one of its own timed callbacks: now is fresh
+        self.heap: list[tuple[float, int, Timed]] = []
+        # a heap only on a Clock no other run drives (the clock reports the others' events)
+        self.heaped = False
+        if isinstance(clock, Clock) and clock.owner is None:
+            clock.owner = self
+            self.heaped = True
+        self.order = 0              # the sequence of the heap's entries
+        self.armed_at = INF         # the time of the driver that is valid, if any
+        self.driver = 0             # which driver is valid
+        self.ticking = False        # a driver is running entries
+        self.ahead = False          # inside Simulation.run: may go ahead of SimPy's clock
+        self.lagging = False        # SimPy's clock is behind self.now (see Clock.now)
+        self.horizon = INF          # the earliest event anything else has on SimPy's queue
+        self.shared = False         # something else is due at the instant being run
+        self.scheduling = False     # the run is scheduling on the clock itself
+
+    def sync(self) -> None:
+        """Control enters the engine from outside its own timed callbacks (a performer
+        answering from a SimPy process or the TUI, ``run``/``step``, a device's post): read
+        the clock, which may have moved since the engine last looked."""
+        if not self.inside:
+            self.now = float(self.env.now)
+
+    def enter(self) -> bool:
+        """A timed callback of this run starts as a SimPy timeout's callback: the clock moved
+        to its time. Returns whether one was already running (a nested entry leaves the flag
+        to the outer one)."""
+        self.now = float(self.env.now)
+        outer = self.inside
+        self.inside = True
+        return outer
+
+    def schedule_timed(self, delay: float, entry: Timed) -> None:
+        """``entry`` is due ``delay`` (>= 0) simulated seconds from now."""
+        if not self.heaped:
+            self.env.timeout(delay).callbacks.append(entry)
+            return
+        if not self.inside:
+            self.now = float(self.env.now)
+        at = self.now + delay
+        self.order += 1
+        heappush(self.heap, (at, self.order, entry))
+        if at < self.armed_at and not self.ticking:
+            self.arm()
+
+    def arm(self) -> None:
+        """Have SimPy wake the run at the heap's earliest time, unless a driver will by then."""
+        heap = self.heap
+        if not heap:
+            return
+        at = heap[0][0]
+        if at >= self.armed_at:
+            return
+        self.driver += 1
+        self.armed_at = at
+        env = self.env
+        self.scheduling = True
+        try:
+            env.timeout(exact_delay(float(env.now), at)).callbacks.append(
+                _Driver(self, self.driver))
+        finally:
+            self.scheduling = False
+
+    def tick(self, gen: int) -> None:
+        """The driver ``gen`` is due: run the entries due (one when stepping)."""
+        if gen != self.driver:
+            return                  # superseded by an earlier driver, or its instant shared
+        at = self.armed_at
+        self.armed_at = INF
+        heap = self.heap
+        if not heap or heap[0][0] != at:
+            self.arm()
+            return
+        ahead = self.ahead
+        if ahead:
+            self.horizon = float(self.env.peek())
+        outer = self.inside
+        self.inside = True
+        self.ticking = True
+        self.shared = False
+        try:
+            self._run_due(heap, ahead)
+        finally:
+            self.inside = outer
+            self.ticking = False
+            self.horizon = INF
+            if self.lagging:
+                self.catch_up()
+            self.arm()
+
+    def _run_due(self, heap: list[tuple[float, int, Timed]], ahead: bool) -> None:
+        while True:
+            at, _, entry = heappop(heap)
+            self.now = at
+            entry.go()
+            if not ahead or not heap or self.shared:
+                return
+            following = heap[0][0]
+            if following != at:
+                if not following < self.horizon:
+                    return          # something else comes first: SimPy's turn
+                self.lagging = True
+
+    def catch_up(self) -> None:
+        """Move SimPy's clock to the run's time (it went ahead: see the module docstring)."""
+        self.lagging = False
+        env = self.env
+        base = float(env.now)
+        if self.now > base:
+            self.scheduling = True
+            try:
+                stop = env.timeout(exact_delay(base, self.now))
+            finally:
+                self.scheduling = False
+            env.run(until=stop)     # nothing else is due before it (that is why it lagged)
+
+    def foreign(self, urgent: bool, delay: float) -> None:
+        """Something else is being scheduled on the run's clock, ``delay`` from now (the clock
+        calls this before SimPy numbers the event)."""
+        if self.lagging:
+            self.catch_up()
+        at = float(self.env.now) + delay
+        self.horizon = min(self.horizon, at)
+        if self.ticking and at == self.now:
+            self.shared = True      # it comes before what this instant schedules from now on
+        if urgent:
+            return                  # before every timeout of its instant anyway
+        # entries due at its instant were scheduled before it, so they come first
+        if any(entry[0] == at for entry in self.heap):
+            self._give_to_simpy(at)
+        if self.armed_at == at:
+            self.driver += 1        # what is scheduled at ``at`` from now on comes after it
+            self.armed_at = INF
+            if not self.ticking:
+                self.arm()
+
+    def _give_to_simpy(self, at: float) -> None:
+        heap = self.heap
+        due = sorted(entry for entry in heap if entry[0] == at)
+        heap[:] = [entry for entry in heap if entry[0] != at]
+        heapify(heap)
+        env = self.env
+        delay = exact_delay(float(env.now), at)
+        self.scheduling = True
+        try:
+            for entry in due:
+                env.timeout(delay).callbacks.append(entry[2])
+        finally:
+            self.scheduling = False
