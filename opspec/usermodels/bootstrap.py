@@ -32,10 +32,13 @@ Each resample is fitted as the data were: the duration family ``opspec fit`` cho
 on the whole data) is fitted again by maximum likelihood — the choice of family is not
 redrawn —, a rate is events / trials of the resample, the time lost to a wrong pick the
 difference of means. A population's centre and between-person spread (``[vary]``) are
-not resampled but drawn from their posterior under the normal random-effects model
-(:class:`_PersonLevel`): a percentile bootstrap of 30 persons gives them normal tails with
-(P - 1)/P of their variance, and groups of new people simulated under it are too alike —
-``opspec model-check`` of a freshly fitted model then calls misfits above its level
+not resampled but drawn from their posterior — under the normal random-effects model of
+the persons' log mean times for a duration (:class:`_PersonLevel`), under the hierarchical
+beta-binomial model of their counts for a rate (:class:`_RateLevel`: own rates near 0 are
+skewed, and the normal model's symmetric draws are too narrow above a low estimate): a
+percentile bootstrap of 30 persons gives them normal tails with (P - 1)/P of their
+variance, and groups of new people simulated under it are too alike — ``opspec
+model-check`` of a freshly fitted model then calls misfits above its level
 (docs/fitting.md). So is the centre of a parameter everyone shares (a lognormal
 duration's median, an omission or commission rate without ``[vary]``), from the same
 posterior with the persons' own values (:func:`_shared_level`): whether or not people
@@ -537,7 +540,8 @@ def parameter_draws(result: FitResult, draws: int, *, seed: int = 0) -> Paramete
               f"resampling {resampled} ({len(names)} person(s), {obs.sessions} session(s); "
               f"Davison & Hinkley 1997, 3.8), each fitted as the data were (family kept)"
               + ("; centres and between-person spreads drawn from their posterior over "
-                 "persons (Gelman et al. 2013, 3.2)" if levels else "")
+                 "persons (Gelman et al. 2013: 3.2 for times, 5.3's beta-binomial for "
+                 "rates)" if levels else "")
               + ("" if by_persons else "; rates drawn from their Jeffreys posterior "
                  "(Chick 2001)")
               + (f"; {failed} parameter fit(s) of a resample failed and kept the estimate"
