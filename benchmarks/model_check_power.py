@@ -11,6 +11,8 @@ sd 0.08) — and checks them at family-wise level 0.05 (399 bootstrap groups):
 * ``true``: 10 people against the true population model: the false-alarm rate;
 * ``fitted``: a model fitted (``opspec fit``, its default 200 parameter redraws) on 30
   people, checked on 10 others: the false-alarm rate of the whole fit-then-check procedure;
+* ``fitted-power``: the model of ``fitted``'s repetition r against 10 people whose walk is
+  1.5x slower, and 10 who miss 30 % of the alarms: the power of the whole procedure;
 * ``ttest``: the same 40 people as ``fitted`` (same seeds), each item instead compared by
   the textbook two-sample t-test of the 30 persons' against the 10 persons' own values
   (omission and commission rates, log mean walk and pill times), Holm over the four: how
@@ -20,7 +22,8 @@ sd 0.08) — and checks them at family-wise level 0.05 (399 bootstrap groups):
 
 Each rate is printed with its exact (Clopper-Pearson) 95 % interval. ``--start`` and
 ``--reps`` split the repetitions over processes (each repetition has its own seeds); the
-``rep N:`` lines of several runs add up (``--tally FILE...`` counts them).
+``rep N:`` lines of several runs add up (``tally FILE...`` counts them). ``--detail FILE``
+appends each check's items (p-values, and which way the people differed) as JSON lines.
 """
 
 from __future__ import annotations
@@ -61,12 +64,29 @@ def people(model: Path, directory: Path, count: int, seed: int) -> list[Path]:
                                days=DAYS)
 
 
-def check(model_path: Path, traces: list[Path], seed: int) -> tuple[bool, list[str]]:
+#: where ``check`` appends one JSON line per check (``--detail``), None: nowhere
+DETAIL: list[Path] = []
+
+
+def check(model_path: Path, traces: list[Path], seed: int, **about: object
+          ) -> tuple[bool, list[str]]:
     from opspec.commands.model_check import CheckOptions, check_model
     from opspec.usermodels.loader import load_user_model
 
     report = check_model(load_user_model(model_path), str(model_path), traces,
                          CheckOptions(seed=seed))
+    if DETAIL:
+        import json
+
+        # per item: p, Holm-adjusted p, and whether the people did more (or took longer)
+        # than the model predicts — which way the false alarms go tells a skewed predictive
+        items = {i.name: {"p": i.p, "p_holm": i.p_holm, "observed": i.observed["value"],
+                          "predicted": i.predicted["value"],
+                          "above": i.observed["value"] > i.predicted["value"]}
+                 for i in report.items}
+        with DETAIL[0].open("a", encoding="utf-8") as out:
+            out.write(json.dumps({**about, "seed": seed, "fits": report.fits,
+                                  "items": items}) + "\n")
     return report.fits, [i.name for i in report.misfits]
 
 
@@ -91,25 +111,58 @@ def run_true(reps: int, work: Path, start: int = 0) -> None:
           f"{dict(flagged)}")
 
 
-def run_fitted(reps: int, work: Path, start: int = 0) -> None:
+def fitted_model(truth: Path, work: Path, r: int) -> tuple[Path, list[Path]]:
+    """Repetition ``r``'s model fitted (``opspec fit``, 200 redraws) on 30 people of
+    ``truth`` (seed 20,000 + r), and the traces of 10 more people of it."""
     from opspec.commands.fit import fitted_text
     from opspec.usermodels.bootstrap import parameter_draws
     from opspec.usermodels.fitting import fit_traces
 
+    traces = people(truth, work / f"fit{r}", 40, seed=20_000 + r)
+    result = fit_traces(traces[:30], name="fitted")
+    draws = parameter_draws(result, 200, seed=r)
+    fitted = work / f"fit{r}" / "fitted.users.toml"
+    fitted.write_text(fitted_text(result, draws), encoding="utf-8")
+    return fitted, traces[30:]
+
+
+def run_fitted(reps: int, work: Path, start: int = 0) -> None:
     truth = population(work, "truth", 60.0, 0.15)
     alarms, flagged = 0, Counter[str]()
     for r in range(start, start + reps):
-        traces = people(truth, work / f"fit{r}", 40, seed=20_000 + r)
-        result = fit_traces(traces[:30], name="fitted")
-        draws = parameter_draws(result, 200, seed=r)
-        fitted = work / f"fit{r}" / "fitted.users.toml"
-        fitted.write_text(fitted_text(result, draws), encoding="utf-8")
-        fits, names = check(fitted, traces[30:], seed=r)
+        fitted, held_out = fitted_model(truth, work, r)
+        fits, names = check(fitted, held_out, seed=r, mode="fitted", rep=r)
         alarms += not fits
         flagged.update(names)
         print(f"  rep {r}: {'fits' if fits else 'MISFIT ' + ', '.join(names)}", flush=True)
     print(f"fitted on 30, checked on 10: false alarms {exact(alarms, reps)}; items "
           f"flagged: {dict(flagged)}")
+
+
+FITTED_SIZES = (("walk 1.5x slower", 90.0, 0.15), ("30 % of alarms missed", 60.0, 0.30))
+
+
+def run_fitted_power(reps: int, work: Path, start: int = 0) -> None:
+    """The power of fit-then-check: repetition r's fitted model (as ``fitted``) against 10
+    people of a population whose walk is 1.5x slower, and 10 who miss 30 % of the alarms
+    (seed 30,000 + r)."""
+    truth = population(work, "truth", 60.0, 0.15)
+    others = [(label, population(work, f"other{i}", walk, omission))
+              for i, (label, walk, omission) in enumerate(FITTED_SIZES)]
+    caught, flagged = Counter[str](), {label: Counter[str]() for label, _ in others}
+    for r in range(start, start + reps):
+        fitted, _ = fitted_model(truth, work, r)
+        for index, (label, other) in enumerate(others):
+            traces = people(other, work / f"power{index}-{r}", 10, seed=30_000 + r)
+            fits, names = check(fitted, traces, seed=r, mode="fitted-power", rep=r,
+                                misfit=label)
+            caught[label] += not fits
+            flagged[label].update(names)
+            print(f"  {label}, rep {r}: {'fits' if fits else 'MISFIT ' + ', '.join(names)}",
+                  flush=True)
+    for label, _ in others:
+        print(f"fitted on 30, {label}, 10 people: detected {exact(caught[label], reps)}; "
+              f"flagged {dict(flagged[label])}")
 
 
 def run_ttest(reps: int, work: Path, start: int = 0) -> None:
@@ -195,13 +248,19 @@ def tally(paths: list[str]) -> None:
 
 def main() -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    parser.add_argument("mode", choices=("true", "fitted", "ttest", "power", "tally"))
+    parser.add_argument("mode", choices=("true", "fitted", "fitted-power", "ttest", "power",
+                                         "tally"))
     parser.add_argument("outputs", nargs="*", help="tally: the outputs of earlier runs")
     parser.add_argument("--reps", type=int, default=100)
     parser.add_argument("--start", type=int, default=0,
                         help="true, fitted, ttest: the first repetition (to split the "
                         "repetitions over processes)")
+    parser.add_argument("--detail", metavar="FILE",
+                        help="append one JSON line per check: every item's p-value, "
+                        "Holm-adjusted p-value and whether the people were above the model")
     args = parser.parse_args()
+    if args.detail:
+        DETAIL.append(Path(args.detail))
     start = time.perf_counter()
     if args.mode == "tally":
         tally(args.outputs)
@@ -210,7 +269,8 @@ def main() -> int:
         if args.mode == "power":
             run_power(args.reps, Path(tmp))
         else:
-            modes = {"true": run_true, "fitted": run_fitted, "ttest": run_ttest}
+            modes = {"true": run_true, "fitted": run_fitted, "ttest": run_ttest,
+                     "fitted-power": run_fitted_power}
             modes[args.mode](args.reps, Path(tmp), args.start)
     print(f"({time.perf_counter() - start:.0f} s)")
     return 0

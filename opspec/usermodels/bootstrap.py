@@ -32,10 +32,13 @@ Each resample is fitted as the data were: the duration family ``opspec fit`` cho
 on the whole data) is fitted again by maximum likelihood — the choice of family is not
 redrawn —, a rate is events / trials of the resample, the time lost to a wrong pick the
 difference of means. A population's centre and between-person spread (``[vary]``) are
-not resampled but drawn from their posterior under the normal random-effects model
-(:class:`_PersonLevel`): a percentile bootstrap of 30 persons gives them normal tails with
-(P - 1)/P of their variance, and groups of new people simulated under it are too alike —
-``opspec model-check`` of a freshly fitted model then calls misfits above its level
+not resampled but drawn from their posterior — under the normal random-effects model of
+the persons' log mean times for a duration (:class:`_PersonLevel`), under the hierarchical
+beta-binomial model of their counts for a rate (:class:`_RateLevel`: own rates near 0 are
+skewed, and the normal model's symmetric draws are too narrow above a low estimate): a
+percentile bootstrap of 30 persons gives them normal tails with (P - 1)/P of their
+variance, and groups of new people simulated under it are too alike — ``opspec
+model-check`` of a freshly fitted model then calls misfits above its level
 (docs/fitting.md). So is the centre of a parameter everyone shares (a lognormal
 duration's median, an omission or commission rate without ``[vary]``), from the same
 posterior with the persons' own values (:func:`_shared_level`): whether or not people
@@ -61,6 +64,7 @@ from opspec.usermodels.uncertainty import ParameterDraws
 
 if TYPE_CHECKING:
     from opspec.usermodels.fitting import FitResult
+    from opspec.usermodels.rate_posterior import RatePosterior
     from opspec.usermodels.spread import PersonMoments
 
 __all__ = ["MIN_PERSONS", "parameter_draws"]
@@ -329,8 +333,36 @@ class _PersonLevel:
         return {self.spread: math.sqrt(max(total - m.sampling, 0.0)), self.centre: centre}
 
 
+@dataclass(frozen=True)
+class _RateLevel:
+    """A rate over persons (a population's omission centre and spread, or a rate everyone
+    shares: its centre only) drawn from the posterior of the hierarchical beta-binomial
+    model of the persons' counts (:mod:`opspec.usermodels.rate_posterior`), not from the
+    normal model of their own rates: own rates near 0 are skewed, their mean and variance
+    go together, and the normal model's draws are then too narrow exactly when the
+    estimate came out low."""
+
+    spread: str | None
+    centre: str
+    posterior: RatePosterior
+
+    def draw(self, rng: np.random.Generator) -> dict[str, float]:
+        mean, sd = self.posterior.draw(rng)
+        if self.spread is None:
+            return {self.centre: mean}
+        return {self.spread: sd, self.centre: mean}
+
+
+def _rate_level(spread: str | None, centre: str, counts: Sequence[tuple[int, int]]
+                ) -> _RateLevel | None:
+    from opspec.usermodels.rate_posterior import rate_posterior
+
+    posterior = rate_posterior(counts)
+    return None if posterior is None else _RateLevel(spread, centre, posterior)
+
+
 def _shared_level(target: _Target, persons: Sequence[dict[str, _Data]],
-                  estimate: dict[str, float]) -> _PersonLevel | None:
+                  estimate: dict[str, float]) -> _PersonLevel | _RateLevel | None:
     """A parameter without a population whose centre is drawn as a population's is: a
     lognormal's median (not a choice's intended-pick time) and a rate everyone shares.
 
@@ -338,8 +370,9 @@ def _shared_level(target: _Target, persons: Sequence[dict[str, _Data]],
     (P - 1)/P of its variance — at 30 persons the predictive of a new group's mean is then
     narrower than Student's t in exactly the tails Holm reaches into (p <= 0.0125 of four
     items). The spread of the persons' own values (which holds the sampling error whether or
-    not people differ) gives the t-based posterior instead."""
-    from opspec.usermodels.spread import duration_moments, omission_moments
+    not people differ) gives the t-based posterior instead; a rate's centre comes from the
+    beta-binomial posterior of the persons' counts (:class:`_RateLevel`)."""
+    from opspec.usermodels.spread import duration_moments
 
     data = [d for person in persons if (d := person.get(target.activity)) is not None]
     if (target.kind == "duration" and target.family == "lognormal" and target.between == 0
@@ -347,11 +380,14 @@ def _shared_level(target: _Target, persons: Sequence[dict[str, _Data]],
         centre = f"{target.prefix}.median"
         moments = duration_moments([d.durations for d in data])
     elif target.kind == "commission" and target.intended is not None:
-        centre = target.prefix
-        moments = omission_moments([_wrong_picks(d.picks, target.intended) for d in data])
+        if target.prefix not in estimate:
+            return None
+        return _rate_level(None, target.prefix,
+                           [_wrong_picks(d.picks, target.intended) for d in data])
     elif target.kind == "omission" and not target.own_rates_min:
-        centre = target.prefix
-        moments = omission_moments([(d.omitted, d.answered) for d in data])
+        if target.prefix not in estimate:
+            return None
+        return _rate_level(None, target.prefix, [(d.omitted, d.answered) for d in data])
     else:
         return None
     if moments is None or moments.observed <= 0 or centre not in estimate:
@@ -360,14 +396,25 @@ def _shared_level(target: _Target, persons: Sequence[dict[str, _Data]],
 
 
 def _person_levels(targets: Sequence[_Target], persons: Sequence[dict[str, _Data]],
-                   estimate: dict[str, float], shared: bool) -> list[_PersonLevel]:
+                   estimate: dict[str, float], shared: bool
+                   ) -> list[_PersonLevel | _RateLevel]:
     """The parameters whose centre (and a population's spread) are drawn from their
     posterior; ``shared``: those without a population too (enough persons to resample)."""
-    out = []
+    out: list[_PersonLevel | _RateLevel] = []
     for target in targets:
         if not target.kind.endswith(" spread"):
             continue
         centre = target.prefix.removeprefix("vary.").rsplit(".", 1)[0]
+        if target.kind == "omission spread":
+            if centre not in estimate:
+                continue
+            rate = _rate_level(target.prefix, centre, [
+                (d.omitted, d.answered) for person in persons
+                if (d := person.get(target.activity)) is not None
+                and d.answered >= target.own_rates_min])
+            if rate is not None:
+                out.append(rate)
+            continue
         moments = _moments(target, persons)
         if moments is None or centre not in estimate or moments.observed <= 0:
             continue
@@ -493,7 +540,8 @@ def parameter_draws(result: FitResult, draws: int, *, seed: int = 0) -> Paramete
               f"resampling {resampled} ({len(names)} person(s), {obs.sessions} session(s); "
               f"Davison & Hinkley 1997, 3.8), each fitted as the data were (family kept)"
               + ("; centres and between-person spreads drawn from their posterior over "
-                 "persons (Gelman et al. 2013, 3.2)" if levels else "")
+                 "persons (Gelman et al. 2013: 3.2 for times, 5.3's beta-binomial for "
+                 "rates)" if levels else "")
               + ("" if by_persons else "; rates drawn from their Jeffreys posterior "
                  "(Chick 2001)")
               + (f"; {failed} parameter fit(s) of a resample failed and kept the estimate"
