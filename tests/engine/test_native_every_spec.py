@@ -1,8 +1,8 @@
 """Every shipped spec runs the same, event for event, on the compiled engine and from source.
 
 This is what lets scripts/test.sh re-run only the engine's own folders from source: the long,
-statistical tests of specs/tests (robots at 10 ms periods with their worlds, the dispenser
-with its users) exercise the compiled modules along the same paths as one run of each spec,
+statistical tests of specs/tests (robots at 5 Hz with their worlds, the dispenser with its
+users) exercise the compiled modules along the same paths as one run of each spec,
 and two engines that write byte-identical traces for that run -- every activity start and end,
 every work item, every world reading, at the same simulated instant, drawing the same random
 numbers -- cannot disagree on a statistic computed from such runs. Each spec of specs/ is
@@ -25,12 +25,12 @@ ROOT = Path(__file__).resolve().parents[2]
 SPECS = sorted([*ROOT.glob("specs/*.xpdl"), *ROOT.glob("specs/*.bpmn")])
 # The shortest runs whose traces hold every kind of event (each activity started and
 # completed, each data change, each world event) that the longer runs this test used to make
-# hold -- a spec with a periodic device (a world) 5 simulated minutes at seed 3, a day-scale
-# spec 200 days: a periodic spec 120 s (12,000 10 ms periods; its robot still engages, backs
-# up, turns away, confirms the patient, loses a bout), a day-scale spec 30 days with its own
-# users at seed 2 (120 doses, one of them missed: the caregiver is notified, the rare path
-# of the dispenser). Checked when these were chosen: the set of (kind, process, activity,
-# lane, data fields) of each trace equals that of the longer run.
+# (a spec with a world 300 s, a day-scale spec 200 days) hold: a periodic spec 120 s at seed 3
+# (about 2,500 instances at 5, 2 and 1 Hz; its robot still engages, backs up, turns away,
+# confirms the patient, loses a bout), a day-scale spec 30 days with its own users at seed 2
+# (120 doses, one of them missed: the caregiver is notified, the rare path of the
+# dispenser). Checked when these were chosen: the set of (kind, process, activity, lane,
+# data fields) of each trace equals that of the longer run.
 ROBOT_HORIZON = ["--until", "120", "--seed", "3"]
 DAY_HORIZON = ["--days", "30", "--seed", "2"]
 
