@@ -1,5 +1,5 @@
 """The figures' matplotlib is imported without its ``set()`` docstrings
-(``plots._import_matplotlib``): the figures must not change, nor must matplotlib's behaviour
+(``opspec.evaluation.matplotlib_import``): the figures must not change, nor must matplotlib's behaviour
 for anyone else in the process."""
 
 from __future__ import annotations
