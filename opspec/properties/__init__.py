@@ -1,8 +1,11 @@
 """The property language: claims about one run's trace, with their text, meaning and evaluation.
 
-* :mod:`~opspec.properties.language` - the text form (``min_gap dispense 4h``,
-  ``bounded_response sound_alarm dispense 15 min``), the property classes and the one
-  evaluator, fed events online (while a run happens) or offline (over a stored trace);
+* :mod:`~opspec.properties.language` - the property classes and the one evaluator, fed
+  events online (while a run happens) or offline (over a stored trace);
+* :mod:`~opspec.properties.text_form` - the text form (``min_gap dispense 4h``,
+  ``bounded_response sound_alarm dispense 15 min``), read into those classes;
+* :mod:`~opspec.properties.subjects` - what a property counts: an activity, a trigger or a
+  process (``activity:dispense``, ``a|b``);
 * :mod:`~opspec.properties.vocabulary` - the language in Python: one set of constructors
   (``never``, ``within``, ``min_gap``, ``count(...) <= n``...) whose objects are monitors and
   trace predicates alike;
@@ -29,10 +32,10 @@ from opspec.properties.language import (
     Property,
     Subject,
     Violation,
-    parse_property,
-    parse_subject,
 )
 from opspec.properties.monitors import Monitor, declared_monitors, parse_monitor
+from opspec.properties.subjects import parse_subject
+from opspec.properties.text_form import parse_property
 
 __all__ = [
     "BoundedResponse",

@@ -14,27 +14,9 @@ A :class:`Property` is a claim about one run's trace ("no two dispenses closer t
 One evaluator, fed the same events, so a monitor and a predicate with the same text give the
 same verdict and the same witness (the events that show a violation) on the same run.
 
-The text form, read by :func:`parse_property` (keywords in any case; ``A``, ``B``, ``C`` are
-subjects, durations are read by :mod:`opspec.clock`: ``90``, ``90s``, ``5 min``, ``1h30m``,
-``PT4H``)::
-
-    never A                          absence: A never happens
-    eventually A                     existence: A happens at least once
-    min_gap A 4h                     no two A closer than 4 h   (also: never A twice within 4h)
-    max_count A 4 per 24h            at most 4 A in any window of 24 h
-    count A <= 4                     the number of A in the run (==, !=, <, <=, >, >=;
-                                     count A in [1, 3])
-    bounded_response A B 15min       every A is followed by a B within 15 min
-                                     (also: B within 15 min after A)
-    response A B                     every A is followed by a B before the run ends
-    A before B                       precedence: no B before the first A
-    A before each B                  every B has an A of its own before it
-    never_while A after B until C    absence between: no A after a B until the next C
-
-A *subject* is an activity id (its completion), a trigger name (raised) or a process id (an
-instance started), resolved against the spec's names by :meth:`Property.bind`; it may be made
-explicit: ``activity:dispense`` or ``activity dispense``, ``trigger:trg_2``,
-``process:notify_workflow``; ``a|b`` means either.
+The text form (``min_gap dispense 4h``, ``bounded_response sound_alarm dispense 15 min``)
+is read by :mod:`opspec.properties.text_form`; what a property counts (a *subject*: an
+activity, a trigger or a process) is :mod:`opspec.properties.subjects`.
 
 The verdicts follow the specification patterns of Dwyer, Avrunin and Corbett (ICSE 1999) read
 over the finite trace, in its order (``seq``: events at the same instant count in the order
@@ -51,17 +33,25 @@ from __future__ import annotations
 
 import math
 import operator
-import re
 from collections import deque
 from collections.abc import Callable, Iterable, Sequence
 from dataclasses import dataclass, field, replace
-from typing import Any, ClassVar, Protocol
+from typing import Any, ClassVar
 
-from opspec.clock import clock_time, parse_duration, span
+from opspec.clock import clock_time, span
 from opspec.engine.trace import EventKind, TraceEvent
-from opspec.errors import ConfigurationError, SourceLocation
+from opspec.errors import ConfigurationError
+from opspec.properties.subjects import (
+    Names,
+    Selector,
+    Selects,
+    Subject,
+    parse_subject,
+    spell,
+)
 
 __all__ = [
+    "COMPARISONS",
     "KEEP",
     "BoundedResponse",
     "CountBound",
@@ -79,7 +69,6 @@ __all__ = [
     "Subject",
     "Violation",
     "clock",
-    "parse_property",
     "parse_subject",
     "trace_end",
 ]
@@ -89,31 +78,15 @@ KEEP = 50
 #: events a witness of a window (max_count) or a count keeps at most
 SLICE = 8
 
-Selects = frozenset[tuple[str, str | None, str | None]]
-
-
-class Names(Protocol):
-    """The names a spec defines (:class:`opspec.engine.names.SpecNames` is one)."""
-
-    @property
-    def activities(self) -> tuple[str, ...]: ...
-    @property
-    def triggers(self) -> tuple[str, ...]: ...
-    @property
-    def processes(self) -> tuple[str, ...]: ...
-
-
-class Selector(Protocol):
-    """Anything that picks events: a :class:`Subject`, or a predicate's ``Match`` (which
-    may test any field); ``str()`` names it in messages."""
-
-    def matches(self, event: TraceEvent) -> bool: ...
-
 
 def clock(seconds: float) -> str:
     """``d1 08:00:00`` for simulated seconds: :func:`opspec.clock.clock_time`, the one way
     opspec shows a point of the run (kept under this name for the predicates' imports)."""
     return clock_time(seconds)
+
+
+def _duration_text(seconds: float) -> str:
+    return span(seconds).replace(" days", "d").replace(" day", "d").replace(" ", "")
 
 
 def trace_end(events: Sequence[TraceEvent]) -> float:
@@ -123,122 +96,6 @@ def trace_end(events: Sequence[TraceEvent]) -> float:
         if event.kind == EventKind.RUN_ENDED:
             return event.time
     return events[-1].time if events else 0.0
-
-
-# ---------------------------------------------------------------- subjects
-@dataclass(frozen=True, slots=True)
-class Subject:
-    """What a property counts: completions of an activity, raises of a trigger, starts of a
-    process; ``what`` is ``None`` until resolved (then any of the three match).
-    ``alternatives`` holds the others of ``a|b``."""
-
-    name: str
-    what: str | None = None
-    alternatives: tuple[Subject, ...] = ()
-
-    def __str__(self) -> str:
-        own = f"{self.what} {self.name}" if self.what else self.name
-        return " or ".join([own, *map(str, self.alternatives)])
-
-    def matches(self, event: TraceEvent) -> bool:
-        if self._own(event):
-            return True
-        return any(alt.matches(event) for alt in self.alternatives)
-
-    def _own(self, event: TraceEvent) -> bool:
-        what, kind = self.what, event.kind
-        if kind == EventKind.ACTIVITY_COMPLETED:
-            return what in (None, "activity") and event.activity == self.name
-        if kind == EventKind.TRIGGER_RAISED:
-            return what in (None, "trigger") and event.data.get("name") == self.name
-        if kind == EventKind.PROCESS_STARTED:
-            return what in (None, "process") and event.process == self.name
-        return False
-
-    @property
-    def selects(self) -> Selects:
-        """Engine selectors of the events this subject may match."""
-        own: set[tuple[str, str | None, str | None]] = set()
-        if self.what in (None, "activity"):
-            own.add((EventKind.ACTIVITY_COMPLETED, None, self.name))
-        if self.what in (None, "trigger"):
-            own.add((EventKind.TRIGGER_RAISED, None, None))
-        if self.what in (None, "process"):
-            own.add((EventKind.PROCESS_STARTED, self.name, None))
-        for alt in self.alternatives:
-            own |= alt.selects
-        return frozenset(own)
-
-    def spelling(self) -> str:
-        """The text form that reads back as this subject: ``activity:a|b``."""
-        own = f"{self.what}:{self.name}" if self.what else self.name
-        return "|".join([own, *(alt.spelling() for alt in self.alternatives)])
-
-    def bind(self, names: Names) -> Subject:
-        """This subject with ``what`` resolved (activity, then trigger, then process);
-        :class:`ConfigurationError` listing the spec's names when it has no such name."""
-        alternatives = tuple(alt.bind(names) for alt in self.alternatives)
-        table = {"activity": names.activities, "trigger": names.triggers,
-                 "process": names.processes}
-        if self.what is not None:
-            if self.name not in table[self.what]:
-                raise ConfigurationError(
-                    f"the spec has no {self.what} {self.name!r}",
-                    hint=f"its {self.what} names are: {', '.join(table[self.what]) or '(none)'}")
-            return replace(self, alternatives=alternatives)
-        for what, known in table.items():
-            if self.name in known:
-                return Subject(self.name, what, alternatives)
-        raise ConfigurationError(
-            f"the spec has no activity, trigger or process {self.name!r}",
-            hint="its activities are: " + ", ".join(names.activities)
-                 + "; triggers: " + (", ".join(names.triggers) or "(none)")
-                 + "; processes: " + ", ".join(names.processes))
-
-
-_KINDS = ("activity", "trigger", "process")
-_NAME = re.compile(r"[\w.-]+")
-_SPELT = re.compile(r"[\w.:-]+")       # a name after an explicit kind may hold a colon
-_SUBJECT_HINT = ("write a name, optionally prefixed: activity:NAME, trigger:NAME, "
-                 "process:NAME (or 'activity NAME'); 'a|b' for either")
-
-
-def parse_subject(text: str) -> Subject:
-    """``dispense``, ``activity:dispense``, ``activity dispense``, ``trigger:trg_2``,
-    ``process:p``, ``a|b``."""
-    tokens = _tokens(text)
-    subject, end = _subject(tokens, 0)
-    if end != len(tokens):
-        raise ConfigurationError(f"cannot read {text.strip()!r} as an activity, trigger or "
-                                 "process name", hint=_SUBJECT_HINT)
-    return subject
-
-
-def _subject(tokens: Sequence[str], i: int) -> tuple[Subject, int]:
-    parts: list[Subject] = []
-    while True:
-        if i >= len(tokens):
-            raise ConfigurationError("a name is missing", hint=_SUBJECT_HINT)
-        token = tokens[i]
-        what: str | None = None
-        if token.lower() in _KINDS and i + 1 < len(tokens) and _SPELT.fullmatch(tokens[i + 1]):
-            what, name, i = token.lower(), tokens[i + 1], i + 2
-        else:
-            head, colon, rest = token.partition(":")
-            if colon and head.lower() in _KINDS:
-                what, name = head.lower(), rest
-            else:
-                name = token
-            i += 1
-        pattern = _NAME if what is None else _SPELT
-        if not pattern.fullmatch(name):
-            raise ConfigurationError(f"cannot read {token!r} as an activity, trigger or "
-                                     "process name", hint=_SUBJECT_HINT)
-        parts.append(Subject(name, what))
-        if i < len(tokens) and tokens[i] == "|":
-            i += 1
-            continue
-        return replace(parts[0], alternatives=tuple(parts[1:])), i
 
 
 # ---------------------------------------------------------------- violations and runs
@@ -396,7 +253,7 @@ class Never(Property):
     subject: Selector
 
     def describe(self) -> str:
-        return f"never {_spell(self.subject)}"
+        return f"never {spell(self.subject)}"
 
 
 class _EventuallyRun(MonitorRun):
@@ -428,7 +285,7 @@ class Eventually(Property):
     subject: Selector
 
     def describe(self) -> str:
-        return f"eventually {_spell(self.subject)}"
+        return f"eventually {spell(self.subject)}"
 
 
 class _MinGapRun(MonitorRun):
@@ -458,7 +315,7 @@ class MinGap(Property):
     seconds: float
 
     def describe(self) -> str:
-        return f"min_gap {_spell(self.subject)} {_duration_text(self.seconds)}"
+        return f"min_gap {spell(self.subject)} {_duration_text(self.seconds)}"
 
 
 class _MaxCountRun(MonitorRun):
@@ -480,7 +337,7 @@ class _MaxCountRun(MonitorRun):
                          f"{span(m.seconds)} allowed", tuple(self.window)[-SLICE:])
 
 
-_COMPARE: dict[str, Callable[[float, float], bool]] = {
+COMPARISONS: dict[str, Callable[[float, float], bool]] = {
     "==": operator.eq, "!=": operator.ne, "<": operator.lt, "<=": operator.le,
     ">": operator.gt, ">=": operator.ge}
 
@@ -499,7 +356,7 @@ class MaxCount(Property):
     seconds: float
 
     def describe(self) -> str:
-        return f"max_count {_spell(self.subject)} {self.limit} per {_duration_text(self.seconds)}"
+        return f"max_count {spell(self.subject)} {self.limit} per {_duration_text(self.seconds)}"
 
 
 class _CountRun(MonitorRun):
@@ -550,7 +407,7 @@ class CountBound(Property):
     b: float | None = None
 
     def __post_init__(self) -> None:
-        if self.op not in _COMPARE and self.op != "in":
+        if self.op not in COMPARISONS and self.op != "in":
             raise ConfigurationError(f"unknown comparison {self.op!r}",
                                      hint="use ==, !=, <, <=, >, >= or in [lo, hi]")
         if self.op == "in" and (self.b is None or self.a > self.b):
@@ -562,13 +419,13 @@ class CountBound(Property):
         return f"in [{self.a:g}, {self.b:g}]" if self.op == "in" else f"{self.op} {self.a:g}"
 
     def describe(self) -> str:
-        return f"count {_spell(self.subject)} {self.target()}"
+        return f"count {spell(self.subject)} {self.target()}"
 
     def allows(self, n: float) -> bool:
         if self.op == "in":
             assert self.b is not None
             return self.a <= n <= self.b
-        return _COMPARE[self.op](n, self.a)
+        return COMPARISONS[self.op](n, self.a)
 
     def most(self) -> float:
         """The largest count allowed when the bound is an upper one (else infinity): the
@@ -659,8 +516,8 @@ class BoundedResponse(Property):
 
     def describe(self) -> str:
         if math.isinf(self.seconds):
-            return f"response {_spell(self.trigger)} {_spell(self.response)}"
-        return (f"bounded_response {_spell(self.trigger)} {_spell(self.response)} "
+            return f"response {spell(self.trigger)} {spell(self.response)}"
+        return (f"bounded_response {spell(self.trigger)} {spell(self.response)} "
                 f"{_duration_text(self.seconds)}")
 
 
@@ -709,7 +566,7 @@ class Precedence(Property):
     each: bool = False
 
     def describe(self) -> str:
-        return f"{_spell(self.first)} before {'each ' if self.each else ''}{_spell(self.then)}"
+        return f"{spell(self.first)} before {'each ' if self.each else ''}{spell(self.then)}"
 
 
 class _NeverWhileRun(MonitorRun):
@@ -747,176 +604,6 @@ class NeverWhile(Property):
     until: Selector
 
     def describe(self) -> str:
-        return (f"never_while {_spell(self.subject)} after {_spell(self.after)} "
-                f"until {_spell(self.until)}")
+        return (f"never_while {spell(self.subject)} after {spell(self.after)} "
+                f"until {spell(self.until)}")
 
-
-# ---------------------------------------------------------------- the text form
-FORMS = ("'min_gap A 4h' (or 'never A twice within 4h'), 'never A', 'eventually A', "
-         "'max_count A 4 per 24h', 'count A <= 4' (==, !=, <, <=, >, >=, in [lo, hi]), "
-         "'bounded_response A B 15min' (or 'B within 15min after A'), 'response A B', "
-         "'A before B', 'A before each B', 'never_while A after B until C'")
-_KEYWORDS = frozenset({"never", "eventually", "min_gap", "max_count", "count",
-                       "bounded_response", "response", "never_while"})
-_TOKEN = re.compile(r"==|!=|<=|>=|<|>|\[|\]|,|\||[^\s=!<>\[\],|]+|\S")
-_NUMBER = re.compile(r"[-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?")
-
-
-def _tokens(text: str) -> list[str]:
-    return _TOKEN.findall(text)
-
-
-def _spell(selector: Selector) -> str:
-    return selector.spelling() if isinstance(selector, Subject) else str(selector)
-
-
-def _duration_text(seconds: float) -> str:
-    return span(seconds).replace(" days", "d").replace(" day", "d").replace(" ", "")
-
-
-def _seconds(text: str, *, zero: bool = False) -> float:
-    value = parse_duration(text, error=ConfigurationError)
-    if value < 0 or (value == 0 and not zero):
-        raise ConfigurationError(f"{text!r} is not a {'' if zero else 'positive '}duration",
-                                 hint="write e.g. 90s, 5 min, 4h or PT4H")
-    return value
-
-
-class _Syntax(Exception):
-    """The text is not in any property form (not a mistake inside one)."""
-
-
-def _expect(tokens: Sequence[str], i: int, word: str) -> int:
-    if i >= len(tokens) or tokens[i].lower() != word:
-        raise _Syntax
-    return i + 1
-
-
-def _number(tokens: Sequence[str], i: int) -> float:
-    if i >= len(tokens) or not _NUMBER.fullmatch(tokens[i]):
-        raise _Syntax
-    return float(tokens[i])
-
-
-def _rest(tokens: Sequence[str], i: int) -> str:
-    if i >= len(tokens):
-        raise _Syntax
-    return " ".join(tokens[i:])
-
-
-def _read(tokens: list[str], text: str) -> tuple[Property, str | None]:
-    """The property and the text of its duration (if it has one); :class:`_Syntax` when the
-    tokens fit no form, :class:`ConfigurationError` for a mistake inside one."""
-    head = tokens[0].lower() if tokens else ""
-    try:
-        if head in _KEYWORDS:
-            a, i = _subject(tokens, 1)
-        else:
-            a, i = _subject(tokens, 0)
-    except ConfigurationError:
-        if head in _KEYWORDS or (len(tokens) > 1 and tokens[1].lower() in ("within", "before")):
-            raise
-        raise _Syntax from None
-    end = len(tokens)
-    if head == "never":
-        if i == end:
-            return Never(a, text=text), None
-        i = _expect(tokens, _expect(tokens, i, "twice"), "within")
-        gap = _rest(tokens, i)
-        return MinGap(a, _seconds(gap), text=text), gap
-    if head == "eventually" and i == end:
-        return Eventually(a, text=text), None
-    if head == "min_gap":
-        gap = _rest(tokens, i)
-        return MinGap(a, _seconds(gap), text=text), gap
-    if head == "max_count":
-        limit = _number(tokens, i)
-        if limit != int(limit) or limit < 0:
-            raise ConfigurationError(f"{tokens[i]!r} is not a whole number >= 0",
-                                     hint="write e.g. 'max_count dispense 4 per 24h'")
-        gap = _rest(tokens, _expect(tokens, i + 1, "per"))
-        return MaxCount(a, int(limit), _seconds(gap), text=text), None
-    if head == "count":
-        if i < end and tokens[i].lower() == "in":
-            i = _expect(tokens, i + 1, "[")
-            lo = _number(tokens, i)
-            hi = _number(tokens, _expect(tokens, i + 1, ","))
-            if _expect(tokens, i + 3, "]") != end:
-                raise _Syntax
-            return CountBound(a, "in", lo, hi, text=text), None
-        if i < end and tokens[i] in _COMPARE and i + 2 == end:
-            return CountBound(a, tokens[i], _number(tokens, i + 1), text=text), None
-        raise _Syntax
-    if head in ("bounded_response", "response", "never_while"):
-        if head == "never_while":
-            b, i = _subject(tokens, _expect(tokens, i, "after"))
-            c, i = _subject(tokens, _expect(tokens, i, "until"))
-            if i != end:
-                raise _Syntax
-            return NeverWhile(a, b, c, text=text), None
-        b, i = _subject(tokens, i)
-        if head == "response":
-            if i != end:
-                raise _Syntax
-            return BoundedResponse(a, b, math.inf, text=text), None
-        if i < end and tokens[i].lower() == "within":
-            i += 1
-        gap = _rest(tokens, i)
-        return BoundedResponse(a, b, _seconds(gap, zero=True), text=text), gap
-    if head in _KEYWORDS:
-        raise _Syntax
-    word = tokens[i].lower() if i < end else ""
-    if word == "before":
-        each = i + 1 < end and tokens[i + 1].lower() == "each"
-        b, j = _subject(tokens, i + 2 if each else i + 1)
-        if j != end:
-            raise _Syntax
-        return Precedence(a, b, each, text=text), None
-    if word == "within":
-        lowered = [t.lower() for t in tokens]
-        if "after" not in lowered[i + 1:]:
-            raise _Syntax
-        at = end - 1 - lowered[::-1].index("after")
-        gap = " ".join(tokens[i + 1:at])
-        cause, j = _subject(tokens, at + 1)
-        if j != end or not gap:
-            raise _Syntax
-        return BoundedResponse(cause, a, _seconds(gap, zero=True), text=text), gap
-    raise _Syntax
-
-
-def looks_like_property(text: str) -> bool:
-    """Whether ``text`` is written in one of the property forms (it may still hold a
-    mistake, such as a bad duration)."""
-    tokens = _tokens(text)
-    if not tokens:
-        return False
-    try:
-        _read(tokens, text)
-    except _Syntax:
-        return False
-    except ConfigurationError:
-        return True
-    return True
-
-
-def read_property(text: str, *, what: str = "property",
-                  location: SourceLocation | None = None) -> tuple[Property, str | None]:
-    """:func:`parse_property`, and the text of the property's duration (or ``None``)."""
-    cleaned = " ".join(text.split())
-    try:
-        return _read(_tokens(cleaned), cleaned)
-    except _Syntax:
-        raise ConfigurationError(f"cannot read the {what} {cleaned!r}", location=location,
-                                 hint=f"{what} forms: {FORMS}") from None
-    except ConfigurationError as error:
-        raise ConfigurationError(f"{what} {cleaned!r}: {error.message}", location=location,
-                                 hint=error.hint) from None
-
-
-def parse_property(text: str, *, what: str = "property",
-                   location: SourceLocation | None = None) -> Property:
-    """A property from its text form (whitespace is normalised: the cleaned text is its
-    ``text``); :class:`ConfigurationError` at ``location`` when it cannot be read, naming it
-    as a ``what`` ("monitor", "expectation") and listing the forms."""
-    return read_property(text, what=what, location=location)[0]

@@ -32,7 +32,8 @@ from collections.abc import Iterable
 from typing import Any
 
 from opspec.errors import ConfigurationError, SourceLocation
-from opspec.properties.language import Property, parse_property
+from opspec.properties.language import Property
+from opspec.properties.text_form import parse_property
 
 __all__ = ["MONITOR_ATTRIBUTE", "Monitor", "declared_monitors", "package_monitors",
            "parse_monitor"]

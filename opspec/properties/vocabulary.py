@@ -49,7 +49,7 @@ from typing import Any
 
 from opspec.engine.trace import EventKind, TraceEvent
 from opspec.errors import ConfigurationError
-from opspec.properties import language
+from opspec.properties import language, text_form
 
 __all__ = [
     "Count",
@@ -218,7 +218,7 @@ def as_predicate(what: Any) -> Predicate:
     if isinstance(what, language.Property):
         return _Holds(what)
     if isinstance(what, str) and len(what.split()) > 1:
-        return _Holds(language.parse_property(what))
+        return _Holds(text_form.parse_property(what))
     return _as_match(what)
 
 
@@ -604,7 +604,7 @@ def _span_text(seconds: float) -> str:
 def monitor(text: str) -> Predicate:
     """A property from its text form (``"min_gap dispense 4h"``, any form of
     :mod:`opspec.properties.language`)."""
-    return _Holds(language.parse_property(text, what="monitor"))
+    return _Holds(text_form.parse_property(text, what="monitor"))
 
 
 def min_gap(subject: str, *, seconds: float = 0, minutes: float = 0, hours: float = 0

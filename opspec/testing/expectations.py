@@ -50,10 +50,9 @@ from opspec.properties.language import (
     Precedence,
     Property,
     Subject,
-    looks_like_property,
-    read_property,
     trace_end,
 )
+from opspec.properties.text_form import looks_like_property, read_property
 from opspec.testing.simulation import FIELDS, SimulationResult, SpecNames
 
 __all__ = ["Expectation", "expect", "format_events", "parse_expectation"]

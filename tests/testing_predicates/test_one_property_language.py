@@ -23,7 +23,8 @@ from opspec.engine.compiled import compile_package
 from opspec.engine.names import spec_names
 from opspec.engine.trace import TraceEvent
 from opspec.engine.trace_sinks import read_trace
-from opspec.properties.language import MonitorResult, parse_property, trace_end
+from opspec.properties.language import MonitorResult, trace_end
+from opspec.properties.text_form import parse_property
 from opspec.testing.expectations import expect, parse_expectation
 from opspec.testing.monitors import min_gap
 from opspec.testing.predicates import check, failures, happens_before, holds, within

@@ -14,7 +14,8 @@ import pytest
 import opspec.properties.vocabulary as vocabulary
 import opspec.testing as testing
 from opspec.errors import ConfigurationError
-from opspec.properties.language import Property, parse_property
+from opspec.properties.language import Property
+from opspec.properties.text_form import parse_property
 from opspec.testing.predicates import failures
 from opspec.testing.simulation import simulate
 
