@@ -41,7 +41,7 @@ def what_happened(event: TraceEvent) -> str:
     elif kind.startswith("process."):
         what = f"{event.process} {kind.split('.', 1)[1]}"
     elif kind == "deadline.expired":
-        what = f"deadline of {event.activity} expired"
+        what = f"deadline of {event.activity or event.process} expired"
     elif kind == "exception.raised":
         what = f"exception {data.get('exception', '?')} at {event.activity}"
     else:
