@@ -151,12 +151,12 @@ class BriefTimeline(_Printer):
             if (process or "", activity or "") in self.quiet or (
                     activity is None and "choice" not in (data or {})):
                 return
-            if process in self.folds:
-                step = f"{activity} (chose {choice})" if choice else activity
+            if process is not None and process in self.folds:
+                step = f"{activity} (chose {choice})" if choice else str(activity)
                 if self._fold_step(process, instance, step):
                     return
         elif kind == "trigger.raised":
-            if process in self.folds:
+            if process is not None and process in self.folds:
                 step = f"trigger {(data or {}).get('name', '?')}"
                 if self._fold_step(process, instance, step):
                     return
@@ -165,7 +165,7 @@ class BriefTimeline(_Printer):
                 self.folded.discard(instance)
                 return
         elif kind in _ENDS:
-            self.folded.discard(instance)   # type: ignore[arg-type]
+            self.folded.discard(instance)
         elif kind == "exception.raised":    # the deadline line already said it
             if "deadline" in str((data or {}).get("message", "")):
                 return
