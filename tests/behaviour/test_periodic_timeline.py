@@ -140,3 +140,15 @@ def test_unusual_events_of_folded_instances_are_shown(kind):
     timeline.raw(0.5, kind, "sense", 2, "read_range" if kind.startswith("activity") else None,
                  {"reason": "mode change"})
     assert "sense#2" in out.getvalue().splitlines()[-1]
+
+
+def test_a_mode_change_is_shown_in_words():
+    """The battery workflow's ModeChange (the vacuum cleaner docks when its battery runs
+    low) is one of the lines never folded, and says which mode it left and entered."""
+    compiled = compile_package(open_spec(VACUUM))
+    out = io.StringIO()
+    timeline = BriefTimeline(out, compiled, full=0)
+    timeline.raw(10.0, "process.started", "battery", 7, None, {"trigger": "period"})
+    timeline.raw(10.001, "mode.changed", "battery", 7, "go_dock", {"from": "run", "to": "dock"})
+    (line,) = out.getvalue().splitlines()
+    assert "battery#7 " in line and line.endswith(" mode run -> dock by go_dock")
