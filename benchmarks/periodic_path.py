@@ -1,7 +1,7 @@
 """periodic-path: a robot-rate spec through the engine beside a bare SimPy loop of its periods.
 
     python benchmarks/periodic_path.py [--spec specs/vacuum_cleaner.xpdl] [--seconds 3600]
-                                       [--rounds 5] [--against CHECKOUT]
+                                       [--rounds 5] [--against CHECKOUT] [--instructions S]
 
 Runs, each in its own process and interleaved round after round (engine, loop, engine, …: the
 speed of a shared machine drifts over minutes):
@@ -18,6 +18,11 @@ per CPU second (the engine's are every timed callback of the run: periods, CPU d
 durations, deadlines; the world is stepped when a device is used, not by events of its own;
 the loop's are its timeouts) and the ratio of the two CPU times.
 
+``--instructions S`` also counts, under valgrind's callgrind (the same on every run, whatever
+the machine's load), the instructions each side executes for ``S`` more simulated seconds
+(a run of ``S + 60`` s minus one of 60 s: start-up and loading cancel out) and prints them
+per workflow instance and per simulated hour, and their ratio.
+
 ``--against CHECKOUT`` also runs, in the same rounds, the engine of another checkout of
 opspec (its own compiled modules if it has current ones, else its source; e.g. a
 ``git worktree`` of main) and prints this engine's CPU over that one's, paired per round:
@@ -32,6 +37,8 @@ from __future__ import annotations
 import argparse
 import json
 import os
+import re
+import shutil
 import statistics
 import subprocess
 import sys
@@ -108,6 +115,34 @@ def _run(code: str, *args: str, checkout: Path | None = None) -> dict[str, Any]:
     return result
 
 
+def _instructions(code: str, *args: str) -> int:
+    """Instructions executed by ``python -c code args`` under callgrind."""
+    done = subprocess.run(["valgrind", "--tool=callgrind", "--callgrind-out-file=/dev/null",
+                           sys.executable, "-c", code, *args], capture_output=True, text=True,
+                          check=False, cwd=ROOT)
+    found = re.search(r"Collected : (\d+)", done.stderr)
+    if done.returncode != 0 or found is None:
+        sys.exit(f"callgrind run failed:\n{done.stderr[-2000:]}")
+    return int(found.group(1))
+
+
+def _instruction_ratio(spec: str, seconds: float, found: list[tuple[float, float]]) -> None:
+    if shutil.which("valgrind") is None:
+        print("\ninstructions: valgrind is not installed (apt-get install valgrind)")
+        return
+    short, long = 60.0, 60.0 + seconds
+    engine = [_instructions(_ENGINE, spec, str(t)) for t in (short, long)]
+    loop = [_instructions(_LOOP, str(t), json.dumps(found)) for t in (short, long)]
+    runs = [_run(_ENGINE, spec, str(t)) for t in (short, long)]
+    instances = int(runs[1]["instances"]) - int(runs[0]["instances"])
+    e, b = engine[1] - engine[0], loop[1] - loop[0]
+    hour = 3600.0 / seconds
+    print(f"\ninstructions for {seconds:g} more simulated s (callgrind, {long:g} s - {short:g} s): "
+          f"engine {e / 1e9:.2f} x 10^9 ({e / instances / 1000:.1f}k per workflow instance, "
+          f"{e * hour / 1e9:.2f} x 10^9 per simulated hour), bare SimPy loop {b / 1e9:.3f} x 10^9 "
+          f"({b * hour / 1e9:.2f} x 10^9 per hour); engine / loop {e / b:.1f}x")
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--spec", default=str(ROOT / "specs" / "vacuum_cleaner.xpdl"))
@@ -115,6 +150,9 @@ def main() -> None:
     parser.add_argument("--rounds", type=int, default=5)
     parser.add_argument("--against", type=Path, default=None, metavar="CHECKOUT",
                         help="also run the engine of this other opspec checkout, interleaved")
+    parser.add_argument("--instructions", type=float, default=0.0, metavar="S",
+                        help="also count instructions for S more simulated seconds "
+                        "(callgrind)")
     args = parser.parse_args()
     spec = str(Path(args.spec).resolve())
     found = periods(spec)
@@ -152,6 +190,8 @@ def main() -> None:
           f"{statistics.median(ratios):.1f}x (paired median)")
     if others:
         _against(args.against, engines, others)
+    if args.instructions > 0:
+        _instruction_ratio(spec, args.instructions, found)
 
 
 def _against(checkout: Path, engines: list[dict[str, Any]],

@@ -36,15 +36,6 @@ if TYPE_CHECKING:
 
 __all__ = ["json_metrics", "register", "run", "timeline_line"]
 
-# Kinds shown in the default (brief) timeline: what a reader follows; the full trace has all.
-BRIEF_KINDS = frozenset({
-    "process.started", "process.completed", "process.terminated", "process.aborted",
-    "activity.completed", "activity.omitted", "activity.failed", "activity.aborted",
-    "activity.withdrawn", "trigger.raised", "deadline.expired", "exception.raised",
-    "mode.changed", "fault", "deadlock", "device.note", "user.decision",
-})
-
-
 def register(subparsers: Any) -> None:
     parser = _args.command(subparsers, "run", __doc__)
     _args.add_spec(parser)
@@ -112,9 +103,7 @@ def run(args: argparse.Namespace) -> int:
     params = inputs.for_run(args.seed, 0) or None
     config = _config(args)
     out = sys.stdout
-    printer = None if args.json or args.timeline == "none" else _Timeline(
-        out, brief=args.timeline == "brief", quiet=quiet_activities(compiled),
-        lanes=_lane_labels(compiled))
+    printer = _timeline(args, compiled, out)
     listeners: list[Any] = []
     with contextlib.ExitStack() as stack:
         devices = _devices(args, stack, compiled)  # a port that won't open stops us here
@@ -153,11 +142,20 @@ def run(args: argparse.Namespace) -> int:
             listeners.append(timing)
         if printer is not None:
             listeners.append(printer)
-            if not args.json:
-                print(file=out)
+            folding = getattr(printer, "periodic", ())
+            if folding:
+                from opspec.commands.run_timeline import FULL
+
+                print(f"  timeline: brief; periodic workflows ({', '.join(folding)}): "
+                      f"their first {FULL} instances, then a line each per simulated minute; "
+                      "deadline misses and failures always (--timeline all: every event)",
+                      file=out)
+            print(file=out)
         outcome = prepared.but(config=config, listeners=tuple(listeners),
                                devices=devices, params=params).build().execute()
         result = outcome.result
+        if printer is not None:
+            printer.finish(float(result.summary.get("time", 0.0)))
         absent = _waiting_for_absent_user(result.summary, compiled, user)
         monitors = {r.monitor: r for r in outcome.monitors}
         medians = outcome.medians
@@ -344,43 +342,15 @@ def _lane_labels(compiled: Any) -> Any:
     return lane_labels(compiled)
 
 
-def quiet_activities(compiled: Any) -> frozenset[tuple[str, str]]:
-    """(process, activity) pairs whose completion says nothing to a reader: routes, start and
-    end events, and other activities that do no work."""
-    from opspec.engine.compiled import K_GATEWAY, K_NOOP
-    from opspec.engine.lanes import all_activities
+def _timeline(args: argparse.Namespace, compiled: Any, out: Any) -> Any:
+    """The timeline printer the options ask for (None: no timeline)."""
+    from opspec.commands.run_timeline import AllTimeline, BriefTimeline
 
-    return frozenset((a.process, a.id) for a in all_activities(compiled)
-                     if a.kind in (K_NOOP, K_GATEWAY) and a.sampler is None and not a.raises)
-
-
-class _Timeline:
-    """A trace listener printing the timeline as the run goes (nothing is held back)."""
-
-    def __init__(self, out: Any, *, brief: bool, quiet: frozenset[tuple[str, str]],
-                 lanes: Any = None) -> None:
-        self.out = out
-        self.lanes = lanes
-        self.selects = None
-        self.brief = brief
-        self.quiet = quiet
-        self.shown = 0
-
-    def __call__(self, event: TraceEvent) -> None:
-        if self.brief and not self._worth_showing(event):
-            return
-        self.shown += 1
-        print(timeline_line(event, self.lanes), file=self.out)
-
-    def _worth_showing(self, event: TraceEvent) -> bool:
-        if event.kind not in BRIEF_KINDS:
-            return False
-        if event.kind == "activity.completed":
-            return (event.process or "", event.activity or "") not in self.quiet and (
-                "choice" in (event.data or {}) or event.activity is not None)
-        if event.kind == "exception.raised":   # the deadline line already said it
-            return "deadline" not in str((event.data or {}).get("message", ""))
-        return True
+    if args.json or args.timeline == "none":
+        return None
+    if args.timeline == "all":
+        return AllTimeline(out, _lane_labels(compiled))
+    return BriefTimeline(out, compiled, _lane_labels(compiled))
 
 
 def json_metrics(metrics: dict[str, dict[str, Any]],

@@ -28,6 +28,7 @@ from opspec.engine import escalations, joins
 from opspec.engine.instances import ActivityInstance, Frame, ProcessInstance
 from opspec.engine.lifecycle import ABORTED, LIFECYCLE, RUNNING, STATE_NAMES, SUSPENDED, TERMINATED
 from opspec.engine.part import Part
+from opspec.engine.scope import Scope
 from opspec.engine.trace import EventKind as EK
 from opspec.errors import OpspecError
 from opspec.model import ParameterMode
@@ -36,7 +37,8 @@ _NEXT = LIFECYCLE.table
 # Final: module statics in the compiled engine, where a plain global is a dictionary lookup
 _COMPLETED_FROM_RUNNING: Final = _NEXT[(RUNNING, "complete")]
 _IN: Final = ParameterMode.IN
-_CHAIN: Final = ChainMap
+# an instance's fields, then the package's (opspec.engine.scope: no KeyError per lookup)
+_CHAIN: Final = Scope
 
 
 class Flow(Part):

@@ -41,9 +41,12 @@ def what_happened(event: TraceEvent) -> str:
     elif kind.startswith("process."):
         what = f"{event.process} {kind.split('.', 1)[1]}"
     elif kind == "deadline.expired":
-        what = f"deadline of {event.activity} expired"
+        what = f"deadline of {event.activity or event.process} expired"
     elif kind == "exception.raised":
         what = f"exception {data.get('exception', '?')} at {event.activity}"
+    elif kind == "mode.changed":
+        what = f"mode {data.get('from')} -> {data.get('to')}" + (
+            f" by {event.activity}" if event.activity else "")
     else:
         what = kind + (f" {event.activity}" if event.activity else "")
     details = _DETAILS[:3] if kind == "exception.raised" else _DETAILS

@@ -41,6 +41,11 @@ DAY = 86_400.0
 class Triggers(Part):
     """Messages, signals, timers, rules, boundary events, deadlines, start/end triggers, modes."""
 
+    # the modes each workflow belongs to (asked at every periodic start), for the modes table
+    # they were read from: a mode that loads workflows replaces the table
+    _members_of: object = None
+    _members: dict[str, tuple[str, ...]] | None = None
+
     def wait_trigger(self, ai: ActivityInstance, trig: CTrigger, handler: Any, arg: Any,
                       persistent: bool = False) -> None:
         """Arrange ``handler(ai, arg, data)`` when ``trig`` happens while ``ai`` waits."""
@@ -295,7 +300,14 @@ class Triggers(Part):
         modes = self.state.compiled.modes
         if not modes:
             return True
-        member = [m for m, procs in modes.items() if process_id in procs]
+        members = self._members
+        if members is None or self._members_of is not modes:
+            members = self._members = {}
+            self._members_of = modes
+        member = members.get(process_id)
+        if member is None:
+            member = members[process_id] = tuple(
+                m for m, procs in modes.items() if process_id in procs)
         return not member or self.state.mode in member
 
     def boundary(self, ai: ActivityInstance, index: int, data: Mapping[str, Any] | None) -> None:
@@ -443,18 +455,7 @@ class Triggers(Part):
 
     def _next_timer(self, times: Iterator[float], fire: Callable[[str], None],
                     label: str) -> None:
-        at = next(times, None)
-        if at is None:
-            return
-        if self.state.resolution > 0.0:
-            at = math.ceil(at / self.state.resolution) * self.state.resolution
-        def fired() -> None:
-            fire(label)
-            self.state.drain()
-            self._next_timer(times, fire, label)
-        self.state.timer(max(0.0, at - self.state.now), fired)
-
-
+        _Timer(self, times, fire, label).arm()
 
     def _next_arrival(self, trig: CTrigger, fire: Callable[[str], None], made: int,
                       gap: float) -> None:
@@ -476,6 +477,33 @@ class Triggers(Part):
             drawn = interval(state.streams.stream(f"arrivals/{trig.name}"))
             self._next_arrival(trig, fire, made + 1, drawn)
         state.timer(max(0.0, at - state.now), fired)
+
+
+class _Timer:
+    """A start or end timer of a workflow: fires ``fire(label)`` at each of ``times``, then
+    drains the work it queued and arms itself for the next time (one object for all the
+    firings of a periodic workflow, not a closure per firing)."""
+
+    def __init__(self, triggers: Triggers, times: Iterator[float],
+                 fire: Callable[[str], None], label: str) -> None:
+        self.triggers = triggers
+        self.times = times
+        self.fire = fire
+        self.label = label
+
+    def arm(self) -> None:
+        at = next(self.times, None)
+        if at is None:
+            return
+        state = self.triggers.state
+        if state.resolution > 0.0:
+            at = math.ceil(at / state.resolution) * state.resolution
+        state.timer(max(0.0, at - state.now), self)
+
+    def __call__(self) -> None:
+        self.fire(self.label)
+        self.triggers.state.drain()
+        self.arm()
 
 
 def _root(inst: ProcessInstance) -> ProcessInstance:

@@ -17,7 +17,7 @@ from typing import TYPE_CHECKING, Any
 from opspec.worlds.base import STEP_S, RobotWorld, check_parameters
 from opspec.worlds.geometry import Box, wrap_angle
 from opspec.worlds.robot import COMMANDS, Robot
-from opspec.worlds.stepping import COVER, DONE, Straight
+from opspec.worlds.stepping import COVER, DONE, RayBox, Straight, cover, distance_ahead
 
 if TYPE_CHECKING:   # annotations only: `opspec validate` loads no NumPy
     import numpy as np
@@ -208,15 +208,11 @@ class RoomWorld(RobotWorld):
             cx0, cx1, cy0, cy1 = key
             cells = tuple((cx, cy) for cx in range(max(cx0, 0), min(cx1 + 1, self.cells_x))
                           for cy in range(max(cy0, 0), min(cy1 + 1, self.cells_y)))
-        robot, cell, reach = self.robot, self.cell, self.radius
-        covered = self.covered
-        for cx, cy in cells:
-            centre_x, centre_y = (cx + 0.5) * cell, (cy + 0.5) * cell
-            if (centre_x - robot.x) ** 2 + (centre_y - robot.y) ** 2 <= reach ** 2 + (
-                    cell / 2) ** 2 and (cx, cy) not in covered:
-                covered.add((cx, cy))
-                self.trace("world.covered", cell=[cx, cy])
-        self._uncovered[key] = tuple(c for c in cells if c not in covered)
+        robot = self.robot
+        new, self._uncovered[key] = cover(cells, robot.x, robot.y, self.cell, self.radius,
+                                          self.covered)
+        for cx, cy in new:
+            self.trace("world.covered", cell=[cx, cy])
 
     def _announce(self) -> None:
         for cx, cy in sorted(self.covered):
@@ -230,7 +226,7 @@ class RoomWorld(RobotWorld):
     # ------------------------------------------------------------------ devices
     def op_read_range(self, _data: Mapping[str, Any]) -> dict[str, Any]:
         robot = self.robot
-        best = _distance_ahead(robot.x, robot.y, robot.heading, self._boxes)
+        best = distance_ahead(robot.x, robot.y, robot.heading, self._boxes)
         distance = max(0.0, best - self.radius + float(self.rng.normal(0.0, self.range_noise)))
         return {"distance": round(distance, 4)}
 
@@ -253,42 +249,10 @@ class RoomWorld(RobotWorld):
         return {"patient_id": self.patient_id if self._near_tag() else ""}
 
 
-_RayBox = tuple[float, float, float, float, float, float, float, float]
-
-
-def _ray_box(box: Box) -> _RayBox:
+def _ray_box(box: Box) -> RayBox:
     """A box's sides and the 1e-9 tolerance ray_to_box_along puts around them."""
     return (box.x0, box.y0, box.x1, box.y1,
             box.y0 - 1e-9, box.y1 + 1e-9, box.x0 - 1e-9, box.x1 + 1e-9)
-
-
-def _distance_ahead(x: float, y: float, heading: float, boxes: tuple[_RayBox, ...]) -> float:
-    """``ray_to_box_along`` to the room's walls from inside (``boxes[0]``), then to each
-    obstacle's faces from outside, the nearest of them: the same arithmetic in one loop."""
-    dx, dy = math.cos(heading), math.sin(heading)
-    along_x, along_y = abs(dx) > 1e-12, abs(dy) > 1e-12
-    best = math.inf
-    inside = True
-    for x0, y0, x1, y1, y0_lo, y1_hi, x0_lo, x1_hi in boxes:
-        if not inside and x0 <= x <= x1 and y0 <= y <= y1:
-            best = 0.0 if 0.0 < best else best      # min(best, 0.0): touching an obstacle
-            continue
-        nearest = math.inf
-        if along_x:
-            for edge_x in (x0, x1):
-                t = (edge_x - x) / dx
-                if t > 1e-9 and y0_lo <= y + t * dy <= y1_hi and t < nearest:
-                    nearest = t
-        if along_y:
-            for edge_y in (y0, y1):
-                t = (edge_y - y) / dy
-                if t > 1e-9 and x0_lo <= x + t * dx <= x1_hi and t < nearest:
-                    nearest = t
-        if inside:
-            best, inside = nearest, False
-        elif nearest < best:
-            best = nearest
-    return best
 
 
 def _same(a: float, b: float) -> bool:

@@ -14,7 +14,7 @@ from __future__ import annotations
 import math
 from typing import Final
 
-__all__ = ["COLLISION", "COVER", "DONE", "STEP_S", "Straight"]
+__all__ = ["COLLISION", "COVER", "DONE", "STEP_S", "Straight", "cover", "distance_ahead"]
 
 #: integration step: 5 cm at 1 m/s, well under the robot's size
 STEP_S: Final = 0.05
@@ -25,6 +25,9 @@ COLLISION: Final = 2     # a contact began at this step
 
 Key = tuple[int, int, int, int]
 Cells = tuple[tuple[int, int], ...]
+#: a box as the range finder meets it: its sides, then the 1e-9 tolerance
+#: ``ray_to_box_along`` puts around them (y0 - 1e-9, y1 + 1e-9, x0 - 1e-9, x1 + 1e-9)
+RayBox = tuple[float, float, float, float, float, float, float, float]
 
 
 class Straight:
@@ -135,3 +138,58 @@ class Straight:
         self.settled = settled
         self.in_contact = in_contact
         return code
+
+
+def distance_ahead(x: float, y: float, heading: float, boxes: tuple[RayBox, ...]) -> float:
+    """``ray_to_box_along`` to the room's walls from inside (``boxes[0]``), then to each
+    obstacle's faces from outside, the nearest of them: the same arithmetic in one loop (the
+    range finder of :class:`~opspec.worlds.room.RoomWorld`)."""
+    dx = math.cos(heading)
+    dy = math.sin(heading)
+    along_x = abs(dx) > 1e-12
+    along_y = abs(dy) > 1e-12
+    best = math.inf
+    inside = True
+    for x0, y0, x1, y1, y0_lo, y1_hi, x0_lo, x1_hi in boxes:
+        if not inside and x0 <= x <= x1 and y0 <= y <= y1:
+            best = 0.0 if 0.0 < best else best      # min(best, 0.0): touching an obstacle
+            continue
+        nearest = math.inf
+        if along_x:
+            t = (x0 - x) / dx
+            if t > 1e-9 and y0_lo <= y + t * dy <= y1_hi and t < nearest:
+                nearest = t
+            t = (x1 - x) / dx
+            if t > 1e-9 and y0_lo <= y + t * dy <= y1_hi and t < nearest:
+                nearest = t
+        if along_y:
+            t = (y0 - y) / dy
+            if t > 1e-9 and x0_lo <= x + t * dx <= x1_hi and t < nearest:
+                nearest = t
+            t = (y1 - y) / dy
+            if t > 1e-9 and x0_lo <= x + t * dx <= x1_hi and t < nearest:
+                nearest = t
+        if inside:
+            best = nearest
+            inside = False
+        elif nearest < best:
+            best = nearest
+    return best
+
+
+def cover(cells: Cells, x: float, y: float, cell: float, reach: float,
+          covered: set[tuple[int, int]]) -> tuple[list[tuple[int, int]], Cells]:
+    """The robot at ``x``, ``y`` covers those of ``cells`` whose centre is within ``reach``
+    plus half a cell: they are added to ``covered``; returned are the newly covered ones, in
+    the order of ``cells`` (the room traces them in that order), and the ``cells`` still not
+    covered."""
+    limit = reach ** 2 + (cell / 2) ** 2
+    new: list[tuple[int, int]] = []
+    for c in cells:
+        cx, cy = c
+        centre_x = (cx + 0.5) * cell
+        centre_y = (cy + 0.5) * cell
+        if (centre_x - x) ** 2 + (centre_y - y) ** 2 <= limit and c not in covered:
+            covered.add(c)
+            new.append(c)
+    return new, tuple([c for c in cells if c not in covered])
