@@ -92,7 +92,9 @@ class StochasticUser:
             state = self._routine.state(now)
             notice, factor = state.notice_factor, state.duration_factor
             window, start_at = state.window, state.start_at
-        self._handover.pop(lane, None)
+        handover = self._handover
+        if lane in handover:    # (``in``, ``del``: primitives compiled, where pop is a call)
+            del handover[lane]
 
         if plan.ignored_when_busy and (
                 len(self._engaged) > 1 or (self._engaged and lane not in self._engaged)):
@@ -152,10 +154,12 @@ class StochasticUser:
 
         self._pending[item.key] = item
         total = max(0.0, start - now + max(0.0, delay) + max(0.0, duration))
-        session.call_later(total, lambda: self._finish(item, lane, choice))
+        session.call_later(total, _Finish(self, item, lane, choice))
 
     def withdraw(self, item: WorkItem, reason: str) -> None:
-        if self._pending.pop(item.key, None) is not None:
+        pending = self._pending
+        if item.key in pending:
+            del pending[item.key]
             self._release(self._lane_of(item))
 
     # ------------------------------------------------------------------ internals
@@ -212,8 +216,10 @@ class StochasticUser:
         return intended, owed
 
     def _finish(self, item: WorkItem, lane: int, choice: str | None) -> None:
-        if self._pending.pop(item.key, None) is None:
+        pending = self._pending
+        if item.key not in pending:
             return  # withdrawn meanwhile
+        del pending[item.key]
         busy = self.model.busy
         session = self._require_session()
         handover = False
@@ -229,7 +235,7 @@ class StochasticUser:
             # release if it ended (nothing offered when this zero-delay check runs). An
             # engine that routes in several zero-delay steps may release and re-engage at
             # the same instant, which no prompt can fall into except at that exact time.
-            session.call_later(0.0, lambda: self._end_handover(lane, item.key))
+            session.call_later(0.0, _EndHandover(self, lane, item.key))
 
     def _end_handover(self, lane: int, key: int) -> None:
         if self._handover.get(lane) == key:
@@ -259,6 +265,37 @@ class StochasticUser:
             payload: Mapping[str, Any] = {"instance": item.instance, "activity": item.activity,
                                           "process": item.process, **data}
             self._session.trace(kind, payload)
+
+
+class _Finish:
+    """The callback ending a work item (a small object, not a closure: compiled, a closure in
+    ``offer`` would make every call build an environment of its variables)."""
+
+    __slots__ = ("choice", "item", "lane", "user")
+
+    def __init__(self, user: StochasticUser, item: WorkItem, lane: int,
+                 choice: str | None) -> None:
+        self.user = user
+        self.item = item
+        self.lane = lane
+        self.choice = choice
+
+    def __call__(self) -> None:
+        self.user._finish(self.item, self.lane, self.choice)
+
+
+class _EndHandover:
+    """The zero-delay check after a handover (see ``StochasticUser._finish``)."""
+
+    __slots__ = ("key", "lane", "user")
+
+    def __init__(self, user: StochasticUser, lane: int, key: int) -> None:
+        self.user = user
+        self.lane = lane
+        self.key = key
+
+    def __call__(self) -> None:
+        self.user._end_handover(self.lane, self.key)
 
 
 class _Plan:
