@@ -67,6 +67,12 @@ class StochasticUser:
         self._plans: dict[str, _Plan] = {}
         self._alternatives: dict[str, ActivityModel | None] = {}
         self._handover: dict[int, int] = {}      # lane -> key of its last completed item
+        # the busy model's sets, read once (the model's frozen dataclasses are slow to read
+        # from compiled code, and _finish reads them for every work item)
+        busy = model.busy
+        self._busy = busy is not None
+        self._release_after: frozenset[str] = busy.release_after if busy else frozenset()
+        self._engaging: frozenset[str] = busy.engaged if busy else frozenset()
 
     # ------------------------------------------------------------------ Performer protocol
 
@@ -82,7 +88,6 @@ class StochasticUser:
         if plan is None:
             plan = self._plans[activity] = _Plan(activity, self.model.activity(activity),
                                                  self.model.busy)
-        model = plan.model
         root = item.root_instance
         lane = root if root is not None else item.instance
         now = session.now
@@ -117,7 +122,7 @@ class StochasticUser:
         delay = 0.0
         choice: str | None = None
         if item.choices:
-            choice, delay = self._choose(item, model, lane)
+            choice, delay = self._choose(item, plan, lane)
             picked = self._alternative(choice)
             if picked is not None:
                 delay += picked.duration.sample(self.rng) * factor
@@ -129,10 +134,10 @@ class StochasticUser:
             self._trace("user.delayed", item, seconds=extra)
 
         constant = plan.constant_duration
-        duration = (constant if constant is not None else model.duration.sample(self.rng)) * factor
+        duration = (constant if constant is not None else plan.duration.sample(self.rng)) * factor
         repetition = plan.repetition
         if repetition is not None and float(self._random()) < repetition.probability:
-            duration += model.duration.sample(self.rng) * factor
+            duration += plan.duration.sample(self.rng) * factor
             self._trace("user.repeated", item)
         slip = plan.commission
         if (slip is not None and not item.choices
@@ -177,14 +182,18 @@ class StochasticUser:
         self._alternatives[activity] = found
         return found
 
-    def _choose(self, item: WorkItem, model: ActivityModel, lane: int) -> tuple[str, float]:
+    def _choose(self, item: WorkItem, plan: _Plan, lane: int) -> tuple[str, float]:
         """Pick an alternative (draw order: see the module docstring); returns the choice and
         the recovery time owed from an earlier wrong pick of this choice."""
         choices = item.choices
         key = (lane, item.activity)
-        owed = self._recovery.pop(key, 0.0)
-        if model.probabilities:
-            weights = dict(model.probabilities)
+        recovery = self._recovery
+        owed = 0.0
+        if key in recovery:
+            owed = recovery[key]
+            del recovery[key]
+        if plan.probabilities:
+            weights = dict(plan.probabilities)
             offered = [(c, weights.get(c, 0.0)) for c in choices]
             total = sum(w for _, w in offered)
             u = float(self._random()) * total
@@ -193,14 +202,14 @@ class StochasticUser:
                     return choice, owed
                 u -= weight
             return offered[-1][0], owed
-        intended = model.intended
+        intended = plan.intended
         if intended is None or intended not in choices:
             if intended is not None:
                 raise UserModelError(
                     f"choice {item.activity!r}: intended alternative {intended!r} is not "
                     f"offered (offered: {', '.join(choices)})")
             return choices[int(self.rng.integers(len(choices)))], owed
-        commission = model.commission
+        commission = plan.commission
         count = self._wrong.get(key, 0)
         if (commission is not None and count < commission.max_per_instance
                 and float(self._random()) < commission.probability):
@@ -212,7 +221,8 @@ class StochasticUser:
                 self._recovery[key] = commission.recovery.sample(self.rng)
                 self._trace("user.wrong_choice", item, choice=pick, intended=intended)
                 return pick, owed
-        self._wrong.pop(key, None)
+        if key in self._wrong:
+            del self._wrong[key]
         return intended, owed
 
     def _finish(self, item: WorkItem, lane: int, choice: str | None) -> None:
@@ -220,16 +230,15 @@ class StochasticUser:
         if item.key not in pending:
             return  # withdrawn meanwhile
         del pending[item.key]
-        busy = self.model.busy
         session = self._require_session()
         handover = False
-        if busy is not None and lane in self._engaged:
-            if item.activity in busy.release_after or item.activity not in busy.engaged:
+        if self._busy and lane in self._engaged:
+            if item.activity in self._release_after or item.activity not in self._engaging:
                 self._engaged.discard(lane)
             else:
                 handover = True
                 self._handover[lane] = item.key
-        session.complete(item, choice=choice)
+        session.complete(item, None, choice)
         if handover and self._handover.get(lane) == item.key:
             # Stay engaged if the instance offers its next activity at this same moment;
             # release if it ended (nothing offered when this zero-delay check runs). An
@@ -318,3 +327,6 @@ class _Plan:
         self.delay = model.delay
         self.repetition = model.repetition
         self.commission = model.commission
+        self.duration = model.duration
+        self.probabilities = model.probabilities
+        self.intended = model.intended
