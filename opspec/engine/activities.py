@@ -16,6 +16,7 @@ from collections.abc import Callable, Mapping
 from typing import TYPE_CHECKING, Any
 
 from opspec.engine import coordination as coord
+from opspec.engine import multi_instance
 from opspec.engine.compiled import (
     K_ASYNC,
     K_BLOCK,
@@ -28,7 +29,6 @@ from opspec.engine.compiled import (
     CompiledActivity,
     CompiledProcess,
 )
-from opspec.engine import multi_instance
 from opspec.engine.instances import ActivityInstance, Frame, MultiInstance, ProcessInstance
 from opspec.engine.lifecycle import (
     ABORTED,

@@ -289,7 +289,8 @@ class RunState(Timers):
         if self.resolution > 0.0:
             delay = self._align(delay)
         self.sim_events += 1
-        self.schedule_timed(delay if delay > 0.0 else 0.0, _Later(self, fn, ai, arg))
+        self.schedule_timed(delay if delay > 0.0 else 0.0,  # noqa: FURB136 - no builtin call
+                           _Later(self, fn, ai, arg))
 
     def fire(self, fn: Callable[[ActivityInstance, Any], None], ai: ActivityInstance,
              arg: Any, gen: int) -> None:
@@ -336,13 +337,15 @@ class RunState(Timers):
             self.ready.append((_CALL, callback, None, None))
             return
         self.sim_events += 1
-        self.schedule_timed(delay if delay > 0.0 else 0.0, _CallAt(self, callback, True))
+        self.schedule_timed(delay if delay > 0.0 else 0.0,  # noqa: FURB136
+                           _CallAt(self, callback, True))
 
     def timer(self, delay: float, callback: Callable[[], None]) -> None:
         """Run ``callback`` after ``delay`` simulated seconds (it drains itself, if it
         must: the processors' and the start timers' callbacks)."""
         self.sim_events += 1
-        self.schedule_timed(delay if delay > 0.0 else 0.0, _CallAt(self, callback, False))
+        self.schedule_timed(delay if delay > 0.0 else 0.0,  # noqa: FURB136
+                           _CallAt(self, callback, False))
 
     def called(self, callback: Callable[[], None], drain: bool) -> None:
         outer = self.enter()

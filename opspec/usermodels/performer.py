@@ -159,8 +159,8 @@ class StochasticUser:
 
         self._pending[item.key] = item
         # (comparisons, not max(0.0, x): the same value, without a builtin call each)
-        total = (start - now + (delay if delay > 0.0 else 0.0)
-                 + (duration if duration > 0.0 else 0.0))
+        total = (start - now + (delay if delay > 0.0 else 0.0)  # noqa: FURB136
+                 + (duration if duration > 0.0 else 0.0))  # noqa: FURB136
         if not total > 0.0:
             total = 0.0
         session.call_later(total, _Finish(self, item, lane, choice))
