@@ -12,10 +12,11 @@ event, coordination), then :meth:`Activities.body_done` (loop again or complete)
 from __future__ import annotations
 
 from collections import deque
-from collections.abc import Mapping
-from typing import Any
+from collections.abc import Callable, Mapping
+from typing import TYPE_CHECKING, Any
 
 from opspec.engine import coordination as coord
+from opspec.engine import multi_instance
 from opspec.engine.compiled import (
     K_ASYNC,
     K_BLOCK,
@@ -28,7 +29,6 @@ from opspec.engine.compiled import (
     CompiledActivity,
     CompiledProcess,
 )
-from opspec.engine import multi_instance
 from opspec.engine.instances import ActivityInstance, Frame, MultiInstance, ProcessInstance
 from opspec.engine.lifecycle import (
     ABORTED,
@@ -43,6 +43,9 @@ from opspec.engine.trace import EventKind as EK
 from opspec.errors import OpspecError
 from opspec.model import CoordinationKind, ParameterMode
 
+if TYPE_CHECKING:
+    from opspec.engine.runstate import RunState
+
 #: Synchronous subflow calls nested deeper than this end the run's root instance with a
 #: located fault: bounded recursion (a base case) runs, runaway recursion is reported.
 MAX_CALL_DEPTH = 100
@@ -50,6 +53,13 @@ MAX_CALL_DEPTH = 100
 
 class Activities(Part):
     """An activity's life from start to completion (see the module docstring)."""
+
+    def __init__(self, state: RunState) -> None:
+        super().__init__(state)
+        # Bound once, for the ready queue (see Flow.__init__).
+        self.activate_q: Callable[[ActivityInstance, Any, Any], None] = self.activate
+        self.body_done_q: Callable[[ActivityInstance, Any, Any], None] = self.body_done
+        self.run_body_q: Callable[[ActivityInstance, Any, Any], None] = self._run_body
 
     def _too_deep(self, ai: ActivityInstance, target: CompiledProcess) -> None:
         """Runaway recursion: abort the outermost caller (which ends every nested call)."""
@@ -105,7 +115,7 @@ class Activities(Part):
             return None
 
     def _start_slow(self, frame: Frame, act: CompiledActivity) -> None:
-        ai = ActivityInstance(next(self.state.keys), act, frame, self.state.now)
+        ai = ActivityInstance(self.state.next_key(), act, frame, self.state.now)
         ai.state = RUNNING
         frame.running[ai.key] = ai
         if act.plain and not (act.general and self.state.pooled):
@@ -129,7 +139,7 @@ class Activities(Part):
         self.activate(ai)
 
     def _activate_cb(self, ai: ActivityInstance, _arg: Any, _data: Any = None) -> None:
-        self.state.ready.append((self.activate, ai, None, None))
+        self.state.ready.append((self.activate_q, ai, None, None))
 
     def activate(self, ai: ActivityInstance, _a: Any = None, _b: Any = None) -> None:
         if ai.state != RUNNING:
@@ -277,7 +287,7 @@ class Activities(Part):
                 starts = starts[:1]
             for index in starts:
                 frame.live += 1
-                self.state.ready.append((self.flow.start_at, frame, index, None))
+                self.state.ready.append((self.flow.start_at_q, frame, index, None))
             if not act.block.starts:
                 self.body_done(ai, None)
         elif kind == K_COORD:
@@ -286,7 +296,7 @@ class Activities(Part):
             self.offers.offer_choice(ai, act.out)
         else:                                       # noop, throw, task without a callable
             # queued, not called: a chain of such activities must not grow the stack
-            self.state.ready.append((self.body_done, ai, None, None))
+            self.state.ready.append((self.body_done_q, ai, None, None))
 
     def body_done(self, ai: ActivityInstance, data: Mapping[str, Any] | None,
                    _unused: Any = None) -> None:
@@ -294,7 +304,7 @@ class Activities(Part):
         if ai.state != RUNNING:
             return
         if ai.frame.inst.state == SUSPENDED:
-            ai.frame.inst.deferred.append((self.body_done, ai, data, None))
+            ai.frame.inst.defer((self.body_done, ai, data, None))
             return
         if data:
             inst = ai.frame.inst
@@ -314,7 +324,7 @@ class Activities(Part):
             if self._loop_again(ai):
                 if act.start_assign and not self.flow.assign(inst, act, act.start_assign):
                     return
-                self.state.ready.append((self._run_body, ai, None, None))
+                self.state.ready.append((self.run_body_q, ai, None, None))
                 return
         self._complete(ai)
 
@@ -364,7 +374,7 @@ class Activities(Part):
                                                                 tool.params, tool.script):
                 return
             index += 1
-        self.state.ready.append((self.body_done, ai, None, None))
+        self.state.ready.append((self.body_done_q, ai, None, None))
 
     def tool_done(self, ai: ActivityInstance, data: Mapping[str, Any] | None,
                    _unused: Any = None) -> None:
@@ -373,7 +383,7 @@ class Activities(Part):
             return
         inst = ai.frame.inst
         if inst.state == SUSPENDED:
-            inst.deferred.append((self.tool_done, ai, data, None))
+            inst.defer((self.tool_done, ai, data, None))
             return
         index = self.state.tool_at.pop(ai.key, 0)
         if data:
@@ -441,7 +451,9 @@ class Activities(Part):
         item = ai.item
         if item is not None:
             ai.item = None
-            self.state.offered.pop(item.key, None)
+            offered = self.state.offered
+            if item.key in offered:
+                del offered[item.key]
             self.state.emit_act(EK.ACTIVITY_WITHDRAWN, frame.inst, ai.act, {"reason": reason})
             performer = ai.performer
             if performer is not None:

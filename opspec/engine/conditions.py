@@ -208,8 +208,21 @@ def compile_condition(
     compiles to a function that is always true."""
     if expr is None:
         return lambda data, now: True
-    inner = compile_expression(expr, location=location)
-    return lambda data, now: truthy(inner(data, now))
+    try:
+        inner = _compile(expr)
+    except ConditionProblem as problem:
+        raise _fail(expr, problem, location, None) from None
+
+    # (one closure, not compile_expression's wrapped in another: a call between compiled
+    # closures goes through Python's calling convention)
+    def holds(data: Mapping[str, Any], now: float) -> bool:
+        try:
+            value = inner(data, now)
+        except (ConditionProblem, *_PYTHON_ERRORS) as problem:
+            raise _fail(expr, problem, location, now) from None
+        return value is True or (value is not False and truthy(value))
+
+    return holds
 
 
 _Fn = Callable[[Mapping[str, Any], float], Any]

@@ -11,8 +11,8 @@ docstring of :mod:`opspec.engine.interpreter` and in docs/semantics.md."""
 from __future__ import annotations
 
 from collections import ChainMap
-from collections.abc import Mapping, MutableMapping
-from typing import Any, Final
+from collections.abc import Callable, Mapping, MutableMapping
+from typing import TYPE_CHECKING, Any, Final
 
 from opspec.engine.compiled import (
     J_AND,
@@ -24,7 +24,7 @@ from opspec.engine.compiled import (
     CompiledProcess,
     CTransition,
 )
-from opspec.engine import escalations, joins
+from opspec.engine import drawing, escalations, joins
 from opspec.engine.instances import ActivityInstance, Frame, ProcessInstance
 from opspec.engine.lifecycle import ABORTED, LIFECYCLE, RUNNING, STATE_NAMES, SUSPENDED, TERMINATED
 from opspec.engine.part import Part
@@ -32,6 +32,9 @@ from opspec.engine.scope import Scope
 from opspec.engine.trace import EventKind as EK
 from opspec.errors import OpspecError
 from opspec.model import ParameterMode
+
+if TYPE_CHECKING:
+    from opspec.engine.runstate import RunState
 
 _NEXT = LIFECYCLE.table
 # Final: module statics in the compiled engine, where a plain global is a dictionary lookup
@@ -44,6 +47,14 @@ _CHAIN: Final = Scope
 class Flow(Part):
     """Tokens through graphs: process instances, transitions, splits, joins (see the module docstring)."""
 
+    def __init__(self, state: RunState) -> None:
+        super().__init__(state)
+        # Bound once, for the ready queue (compiled, ``self.start_at`` as a value builds a
+        # bound method object each time).
+        self.start_at_q: Callable[[Frame, int, Any], None] = self.start_at
+        self.arrive_q: Callable[[Frame, int, CTransition | None], None] = self._arrive
+        self.performed_q: Callable[[Frame, int, CTransition | None], None] = self.performed
+
     def start_process(self, proc: CompiledProcess, data: Mapping[str, Any] | None = None, *,
                       parent: ActivityInstance | None = None, trigger: str | None = None,
                       start: int = -1) -> ProcessInstance:
@@ -54,7 +65,7 @@ class Flow(Part):
             local.update(data)
         scope: MutableMapping[str, Any] = (
             _CHAIN(local, self.state.package_data) if self.state.package_data else local)
-        iid = next(self.state.ids)
+        iid = self.state.next_id()
         priority = proc.priority
         root = iid
         if parent is not None:
@@ -67,7 +78,7 @@ class Flow(Part):
             inst.depth = parent.frame.inst.depth + 1
             inst.partner = parent.frame.inst.partner
         self.state.live[iid] = inst
-        self.state.counts["started"] += 1
+        self.state.started += 1
         if self.state.proc_bits(proc) & 1:
             self.state.emit(EK.PROCESS_STARTED, proc.id, iid, None, proc.lane, None,
                       {"trigger": trigger, "parent": parent.frame.inst.id if parent else None})
@@ -76,7 +87,7 @@ class Flow(Part):
         self.state.start_counted(frame)
         if start >= 0:
             frame.live += 1
-            self.state.ready.append((self.start_at, frame, start, None))
+            self.state.ready.append((self.start_at_q, frame, start, None))
         else:
             starts = proc.graph.starts
             if proc.start_events:
@@ -85,12 +96,16 @@ class Flow(Part):
                 starts = proc.called_starts or starts
             for index in starts:
                 frame.live += 1
-                self.state.ready.append((self.start_at, frame, index, None))
+                self.state.ready.append((self.start_at_q, frame, index, None))
             if not starts:
                 self.state.pending[frame] = None
         if proc.deadline is not None:
-            self.state.call_at(proc.deadline, lambda: self._process_deadline(inst))
+            self._arm_deadline(inst, proc.deadline)
         return inst
+
+    def _arm_deadline(self, inst: ProcessInstance, deadline: float) -> None:
+        # (a closure in start_process would build its environment at every process start)
+        self.state.call_at(deadline, lambda: self._process_deadline(inst))
 
     def _process_deadline(self, inst: ProcessInstance) -> None:
         if inst.state in (RUNNING, SUSPENDED):
@@ -105,7 +120,7 @@ class Flow(Part):
         if owner is not None:                       # an activity set finished
             if frame.queue and inst.state == RUNNING:   # a sequential ad-hoc set: the next
                 frame.live += 1
-                self.state.ready.append((self.start_at, frame, frame.queue.pop(0), None))
+                self.state.ready.append((self.start_at_q, frame, frame.queue.pop(0), None))
                 return
             if frame in inst.frames:
                 inst.frames.remove(frame)
@@ -116,10 +131,10 @@ class Flow(Part):
             return
         inst.state = _COMPLETED_FROM_RUNNING
         inst.frames.clear()          # breaks the instance <-> frame cycle: freed by refcount
-        self.state.live.pop(inst.id, None)
+        self.state.gone(inst.id)
         if self.state.kept and inst.parent is None:
             self.triggers.drop_kept(inst)
-        self.state.counts["completed"] += 1
+        self.state.completed += 1
         proc = inst.process
         if self.state.proc_bits(proc) & 2:
             self.state.emit(EK.PROCESS_COMPLETED, proc.id, inst.id, None, proc.lane, None,
@@ -145,11 +160,14 @@ class Flow(Part):
             for ai in list(frame.running.values()):
                 self.activities.stop(ai, TERMINATED, reason)
         inst.frames.clear()
-        self.state.live.pop(inst.id, None)
+        self.state.gone(inst.id)
         if self.state.kept and inst.parent is None:
             self.triggers.drop_kept(inst)
         proc = inst.process
-        self.state.counts["terminated" if state == TERMINATED else "aborted"] += 1
+        if state == TERMINATED:
+            self.state.terminated += 1
+        else:
+            self.state.aborted += 1
         kind = EK.PROCESS_TERMINATED if state == TERMINATED else EK.PROCESS_ABORTED
         if self.state.wants(kind, proc.id, None):
             self.state.emit(kind, proc.id, inst.id, None, proc.lane, None, {"reason": reason})
@@ -179,7 +197,7 @@ class Flow(Part):
 
     def _dropped(self, frame: Frame, fn: Any, a: Any, b: Any) -> None:
         if frame.inst.state == SUSPENDED:
-            frame.inst.deferred.append((fn, frame, a, b))
+            frame.inst.defer((fn, frame, a, b))
         else:
             frame.live -= 1
 
@@ -193,9 +211,10 @@ class Flow(Part):
         join = act.join
         if join and trans is not None:
             if join == J_AND:
-                counts = frame.joins.get(index)
+                parked = frame.and_joins()
+                counts = parked.get(index)
                 if counts is None:
-                    counts = frame.joins[index] = [0] * len(act.in_slots)
+                    counts = parked[index] = [0] * len(act.in_slots)
                 counts[act.in_slots[trans.index]] += 1
                 if 0 in counts:
                     frame.parked += 1
@@ -205,9 +224,10 @@ class Flow(Part):
                     counts[slot] -= 1
                 frame.parked -= len(counts) - 1
             elif join == J_COUNT:                  # StartQuantity: N tokens, one start
-                counts = frame.joins.get(index)
+                parked = frame.and_joins()
+                counts = parked.get(index)
                 if counts is None:
-                    counts = frame.joins[index] = [0]
+                    counts = parked[index] = [0]
                 counts[0] += 1
                 if counts[0] < act.start_quantity:
                     frame.parked += 1
@@ -225,9 +245,10 @@ class Flow(Part):
                     self.state.pending[frame] = None
                 return
             else:                                   # OR join: resolved when the queue is dry
-                tokens = frame.ors.get(index)
+                ors = frame.or_joins()
+                tokens = ors.get(index)
                 if tokens is None:
-                    tokens = frame.ors[index] = [0] * len(act.in_slots)
+                    tokens = ors[index] = [0] * len(act.in_slots)
                 tokens[act.in_slots[trans.index]] += 1
                 frame.parked += 1
                 frame.live -= 1
@@ -276,8 +297,8 @@ class Flow(Part):
         # tokens still in the ready queue see the frame is gone (its owner no longer runs)
         frame.live = 0
         frame.parked = 0
-        frame.joins.clear()
-        frame.ors.clear()
+        frame.joins = None
+        frame.ors = None
         if frame.cjoins:
             frame.cjoins.clear()
         if frame.owed:
@@ -434,13 +455,13 @@ class Flow(Part):
 
     def _leave(self, frame: Frame, act: CompiledActivity) -> None:
         if act.choice:
-            ai = ActivityInstance(next(self.state.keys), act, frame, self.state.now)
+            ai = ActivityInstance(self.state.next_key(), act, frame, self.state.now)
             ai.state = RUNNING
             frame.running[ai.key] = ai
             self.offers.offer_choice(ai, act.choice)
             return
-        if act.drawn and (not act.inputs or self._inputs_missing(act)):
-            self._draw(frame, act)
+        if act.drawn and (not act.inputs or drawing.inputs_missing(self, act)):
+            drawing.draw(self, frame, act)
             self.token_gone(frame)
             return
         outs = act.out
@@ -476,44 +497,6 @@ class Flow(Part):
                 self.take(frame, act.otherwise[0])
         self.token_gone(frame)
 
-    def _inputs_missing(self, act: CompiledActivity) -> bool:
-        """Whether a run input the gateway's conditions read has no value in this run."""
-        data = self.state.package_data
-        for name in act.inputs:
-            if data.get(name) is None:
-                return True
-        return False
-
-    def _draw(self, frame: Frame, act: CompiledActivity) -> None:
-        """The branches of a gateway the spec leaves undecided, drawn from the gateway's own
-        seeded stream with the declared probabilities (docs/bpmn.md, Undecided gateways): an
-        exclusive gateway takes one; an inclusive one takes each with its probability, drawn
-        again until at least one is taken (so the shares given are conditional on that)."""
-        rng = self.state.streams.stream(f"branch:{act.process}:{act.id}")
-        drawn = act.drawn
-        picks: list[CTransition] = []
-        if act.split == S_XOR:
-            u = float(rng.random())
-            total = 0.0
-            picks.append(drawn[-1])
-            for trans in drawn:
-                total += trans.probability
-                if u < total:
-                    picks[0] = trans
-                    break
-        else:
-            for _attempt in range(1000):
-                picks = [t for t in drawn if float(rng.random()) < t.probability]
-                if picks:
-                    break
-            else:
-                picks = [max(drawn, key=lambda t: t.probability)]
-        inst = frame.inst
-        for trans in picks:
-            self.state.emit_act(EK.BRANCH_CHOSEN, inst, act,
-                                {"flow": trans.id, "probability": trans.probability})
-            self.take(frame, trans)
-
     def take(self, frame: Frame, trans: CTransition, performed: bool = False) -> None:
         if trans.assignments:
             inst = frame.inst
@@ -521,12 +504,12 @@ class Flow(Part):
             for target, fn in trans.assignments:
                 self.set_field(inst, None, target, fn(inst.scope, now))
         frame.live += 1
-        self.state.ready.append((self.performed if performed else self._arrive, frame,
+        self.state.ready.append((self.performed_q if performed else self.arrive_q, frame,
                             trans.target, trans))
         if trans.tokens > 1:                # a thread split (WCP-42): one token each
             for _ in range(trans.tokens - 1):
                 frame.live += 1
-                self.state.ready.append((self._arrive, frame, trans.target, trans))
+                self.state.ready.append((self.arrive_q, frame, trans.target, trans))
 
     def performed(self, frame: Frame, index: int, trans: CTransition | None) -> None:
         """A branch of a deferred choice: the performer's choice (or the caught event) *is*

@@ -58,11 +58,18 @@ class ProcessInstance:
         self.root = root
         self.frames: list[Frame] = []
         self.started_at = started_at
-        self.deferred: list[tuple[Any, ...]] = []
+        # work that arrived while suspended (made when first needed: see :meth:`defer`)
+        self.deferred: list[tuple[Any, ...]] | None = None
         self.trigger: str | None = None
         self.depth = 0                        # synchronous subflow calls above this one
         # the root instance whose message started this one (replies are correlated to it)
         self.partner: ProcessInstance | None = None
+
+    def defer(self, item: tuple[Any, Any, Any, Any]) -> None:
+        """Keep a ready-queue item until the suspended instance resumes."""
+        if self.deferred is None:
+            self.deferred = []
+        self.deferred.append(item)
 
     def __repr__(self) -> str:
         return f"<ProcessInstance {self.process.id}#{self.id}>"
@@ -85,8 +92,11 @@ class Frame:
         self.owner = owner                    # the block activity instance, for activity sets
         self.live = 0
         self.parked = 0
-        self.joins: dict[int, list[int]] = {}
-        self.ors: dict[int, list[int]] = {}   # OR joins: tokens per incoming slot
+        # AND / StartQuantity joins: tokens per incoming slot; OR joins likewise. Made when
+        # the first token parks (most frames have no join; an empty dict each costs its
+        # allocation and release per process instance)
+        self.joins: dict[int, list[int]] | None = None
+        self.ors: dict[int, list[int]] | None = None
         self.running: dict[int, ActivityInstance] = {}
         # complex joins: tokens per incoming slot, and the slots owed a token before the
         # join resets (after it fired; BPMN's "waiting for reset"); made when first needed
@@ -94,6 +104,18 @@ class Frame:
         self.cjoins: dict[int, list[int]] | None = None
         self.owed: dict[int, set[int]] | None = None
         self.queue: list[int] | None = None   # sequential ad-hoc sets: starts still to run
+
+    def and_joins(self) -> dict[int, list[int]]:
+        """:attr:`joins`, made if need be."""
+        if self.joins is None:
+            self.joins = {}
+        return self.joins
+
+    def or_joins(self) -> dict[int, list[int]]:
+        """:attr:`ors`, made if need be."""
+        if self.ors is None:
+            self.ors = {}
+        return self.ors
 
 
 class ActivityInstance:
@@ -148,7 +170,12 @@ class ActivityInstance:
         end an instance this one way."""
         self.state = state
         self.gen += 1
-        self.frame.running.pop(self.key, None)
+        # (``in`` and ``del``, not ``pop(key, None)``: compiled, a dict's pop is a Python
+        # method call, the others are primitives)
+        running = self.frame.running
+        key = self.key
+        if key in running:
+            del running[key]
         cleanup = self.cleanup
         if cleanup:
             for undo in cleanup:

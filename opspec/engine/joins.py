@@ -80,7 +80,8 @@ def resolve_frames(flow: Flow) -> None:
         if frame.inst.state != RUNNING:
             continue
         fired = False
-        for join, tokens in list(frame.ors.items()):
+        ors = frame.ors if frame.ors is not None else {}
+        for join, tokens in list(ors.items()):
             if or_ready(frame, join, tokens):
                 # one activation consumes one token of each incoming transition that
                 # has one (BPMN 2.0 Table 13.3); tokens left over wait for the next
@@ -89,12 +90,12 @@ def resolve_frames(flow: Flow) -> None:
                         tokens[slot] = count - 1
                         frame.parked -= 1
                 if not any(tokens):
-                    del frame.ors[join]
+                    del ors[join]
                 else:
                     flow.state.pending[frame] = None
                 frame.live += 1
                 fired = True
-                flow.state.ready.append((flow.start_at, frame, join, None))
+                flow.state.ready.append((flow.start_at_q, frame, join, None))
         if frame.owed and frame.live <= 0 and not fired:     # (only complex joins)
             # nothing can deliver the tokens a fired complex join waits for: it resets,
             # and the tokens that came meanwhile may fire it again at once
@@ -104,11 +105,12 @@ def resolve_frames(flow: Flow) -> None:
                 if any(counts) and complex_fires(flow, frame, acts[join], counts):
                     frame.live += 1
                     fired = True
-                    flow.state.ready.append((flow.start_at, frame, join, None))
+                    flow.state.ready.append((flow.start_at_q, frame, join, None))
         if not fired and frame.live <= 0:
             if frame.parked:
                 waiting = [frame.graph.activities[i].id
-                           for i, c in (list(frame.joins.items()) + list(frame.ors.items())
+                           for i, c in (list((frame.joins or {}).items())
+                                        + list((frame.ors or {}).items())
                                         + list((frame.cjoins or {}).items()))
                            if (c if isinstance(c, int) else any(c))]
                 flow.report_deadlock(frame.inst, waiting, "a join waits for branches "
@@ -128,10 +130,10 @@ def or_ready(frame: Frame, join: int, tokens: list[int]) -> bool:
     for ai in frame.running.values():
         if _or_blocks(reach, tokens, ai.act.index):
             return False
-    for other, waiting in frame.ors.items():
+    for other, waiting in (frame.ors or {}).items():
         if other != join and any(waiting) and _or_blocks(reach, tokens, other):
             return False
-    for other, counts in frame.joins.items():
+    for other, counts in (frame.joins or {}).items():
         if any(counts) and _or_blocks(reach, tokens, other):
             return False
     if frame.cjoins:

@@ -105,7 +105,9 @@ class MetricsListener:
                 if last or key not in pending:
                     pending[key] = time
             elif key in pending:
-                self.samples[name].append(time - pending.pop(key))
+                started = pending[key]
+                del pending[key]
+                self.samples[name].append(time - started)
                 if self.keep_times:
                     self.sample_times.setdefault(name, []).append(time)
 

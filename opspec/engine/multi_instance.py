@@ -58,7 +58,7 @@ def begin(acts: Activities, ai: ActivityInstance) -> bool:
         return False
     group = MultiInstance(count, items)
     if act.deadlines or act.boundary:
-        holder = ActivityInstance(next(acts.state.keys), act, frame, acts.state.now)
+        holder = ActivityInstance(acts.state.next_key(), act, frame, acts.state.now)
         holder.state = RUNNING
         holder.mi = group
         group.holder = holder
@@ -80,11 +80,11 @@ def _join(ai: ActivityInstance, group: MultiInstance, element: str | None) -> No
 
 
 def _next(acts: Activities, frame: Frame, act: CompiledActivity, group: MultiInstance) -> None:
-    ai = ActivityInstance(next(acts.state.keys), act, frame, acts.state.now)
+    ai = ActivityInstance(acts.state.next_key(), act, frame, acts.state.now)
     ai.state = RUNNING
     frame.running[ai.key] = ai
     _join(ai, group, act.mi_element)
-    acts.state.ready.append((acts.activate, ai, None, None))
+    acts.state.ready.append((acts.activate_q, ai, None, None))
 
 
 def done(acts: Activities, ai: ActivityInstance, group: MultiInstance) -> None:

@@ -9,9 +9,9 @@ items that were withdrawn meanwhile are counted as stale and otherwise ignored."
 from __future__ import annotations
 
 from collections import ChainMap
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
 from types import MappingProxyType
-from typing import Any, Final
+from typing import TYPE_CHECKING, Any, Final, cast
 
 from opspec.engine.compiled import (
     K_CATCH,
@@ -31,16 +31,27 @@ from opspec.engine.performers import Performer, WorkItem
 from opspec.engine.trace import EventKind as EK
 from opspec.errors import ExecutionError
 
+if TYPE_CHECKING:
+    from opspec.engine.runstate import RunState
+
 # Final: a module static in the compiled engine, where a plain global is a dictionary lookup
 _PROXY: Final = MappingProxyType
+_UNKNOWN: Final = object()          # performers_of has no answer for the activity yet
 
 
 class Offers(Part):
     """Work items to performers and their answers (see the module docstring)."""
 
+    def __init__(self, state: RunState) -> None:
+        super().__init__(state)
+        # Bound once, for the ready queue (see Flow.__init__).
+        self.choose_q: Callable[[ActivityInstance, CTransition, Any], None] = self._choose
+
     def performer_for(self, act: CompiledActivity) -> Performer | None:
-        if act in self.state.performers_of:
-            return self.state.performers_of[act]
+        known = self.state.performers_of
+        found = known.get(act, _UNKNOWN)
+        if found is not _UNKNOWN:
+            return cast("Performer | None", found)
         else:
             performer = self.state.registry.lookup(act.participant, act.lanes)
             if performer is None and not act.user_lane:
@@ -100,12 +111,12 @@ class Offers(Part):
             self.offer(ai, performer, tuple(acts[t.target].id for t in branches), None, None)
             return
         rng = self.state.streams.stream(f"{act.process}/{act.id}")
-        self.state.ready.append((self._choose, ai, branches[int(rng.integers(len(branches)))],
+        self.state.ready.append((self.choose_q, ai, branches[int(rng.integers(len(branches)))],
                             None))
 
     def _choice_event(self, ai: ActivityInstance, trans: CTransition,
                       data: Mapping[str, Any] | None) -> None:
-        self.state.ready.append((self._choose, ai, trans, data))
+        self.state.ready.append((self.choose_q, ai, trans, data))
 
     def _choose(self, ai: ActivityInstance, trans: CTransition,
                 data: Mapping[str, Any] | None) -> None:
@@ -116,7 +127,9 @@ class Offers(Part):
         item = ai.item
         if item is not None:
             ai.item = None
-            self.state.offered.pop(item.key, None)
+            offered = self.state.offered
+            if item.key in offered:
+                del offered[item.key]
             if ai.performer is not None:
                 ai.performer.withdraw(item, "another branch of the choice happened")
         ai.leave(COMPLETED)
@@ -140,14 +153,21 @@ class Offers(Part):
 
     def performer_complete(self, item: WorkItem, data: Mapping[str, Any] | None,
                            choice: str | None) -> None:
-        ai = self.state.offered.pop(item.key, None)
+        offered = self.state.offered
+        ai = offered.get(item.key)
+        if ai is not None:
+            del offered[item.key]
         if ai is None or ai.state != RUNNING:
             self.state.stale_completions += 1
             return
         ai.item = None
         if ai.choice:
             acts = ai.frame.graph.activities
-            trans = next((t for t in ai.choice if acts[t.target].id == choice), None)
+            trans: CTransition | None = None
+            for branch in ai.choice:
+                if acts[branch.target].id == choice:
+                    trans = branch
+                    break
             if trans is None:
                 if choice is None and len(item.choices) == 1:
                     trans = next(t for t in ai.choice if acts[t.target].id == item.choices[0])
@@ -158,20 +178,23 @@ class Offers(Part):
                         f"work item {item.key} ({item.activity}) needs a choice among "
                         f"{', '.join(item.choices)}, got {choice!r}",
                         hint="call complete(item, choice=ACTIVITY_ID)", sim_time=self.state.now)
-            self.state.ready.append((self._choose, ai, trans, data))
+            self.state.ready.append((self.choose_q, ai, trans, data))
         elif ai.act.toolchain and ai.key in self.state.tool_at:
             self.state.ready.append((self.activities.tool_done, ai, data, None))
         elif data:
             if ai.act.params:
                 data = self.activities.outputs(ai, data)
-            self.state.ready.append((self.activities.body_done, ai, data, None))
+            self.state.ready.append((self.activities.body_done_q, ai, data, None))
         else:
-            self.state.ready.append((self.activities.body_done, ai, None, None))
+            self.state.ready.append((self.activities.body_done_q, ai, None, None))
         if not self.state.draining:
             self.state.drain()
 
     def performer_omit(self, item: WorkItem, reason: str) -> None:
-        ai = self.state.offered.pop(item.key, None)
+        offered = self.state.offered
+        ai = offered.get(item.key)
+        if ai is not None:
+            del offered[item.key]
         if ai is None or ai.state != RUNNING:
             self.state.stale_completions += 1
             return
@@ -183,7 +206,10 @@ class Offers(Part):
         self.state.drain()
 
     def performer_fail(self, item: WorkItem, exception: str, message: str) -> None:
-        ai = self.state.offered.pop(item.key, None)
+        offered = self.state.offered
+        ai = offered.get(item.key)
+        if ai is not None:
+            del offered[item.key]
         if ai is None or ai.state != RUNNING:
             self.state.stale_completions += 1
             return

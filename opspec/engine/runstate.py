@@ -21,7 +21,7 @@ import itertools
 from collections import deque
 from collections.abc import Callable, Mapping
 from types import MappingProxyType
-from typing import TYPE_CHECKING, Any, final
+from typing import TYPE_CHECKING, Any, Final, final
 
 import simpy
 
@@ -34,6 +34,7 @@ from opspec.engine.compiled import (
 from opspec.engine.config import EngineConfig
 from opspec.engine.instances import ActivityInstance, Frame, ProcessInstance
 from opspec.engine.lifecycle import RUNNING, SUSPENDED
+from opspec.engine.metrics import MetricsListener
 from opspec.engine.performers import Performer
 from opspec.engine.processors import DedicatedProcessor, PooledProcessor
 from opspec.engine.random import Streams
@@ -79,13 +80,22 @@ class RunState(Timers):
         self.package_data: dict[str, Any] = dict(compiled.data)
         if params:
             self.package_data.update(params)
-        self.ready: deque[tuple[Any, Any, Any, Any]] = deque()
+        # The ready queue, FIFO: a list read from the front by drain (a list's append is a
+        # primitive in the compiled engine, a deque's a Python method call).
+        self.ready: list[tuple[Any, Any, Any, Any]] = []
         self.draining = False
         self.pending: dict[Frame, None] = {}
         self.ids = itertools.count(1)
         self.keys = itertools.count(1)
+        # next(count) bound once: the compiled engine looks ``next`` up in builtins at each call
+        self.next_id: Callable[[], int] = self.ids.__next__
+        self.next_key: Callable[[], int] = self.keys.__next__
         self.live: dict[int, ProcessInstance] = {}
-        self.counts = {"started": 0, "completed": 0, "terminated": 0, "aborted": 0}
+        # workflow instances started, completed, terminated, aborted (see :attr:`counts`)
+        self.started = 0
+        self.completed = 0
+        self.terminated = 0
+        self.aborted = 0
         self.faults: list[dict[str, Any]] = []
         self.deadlocks: list[dict[str, Any]] = []
         self.stale_completions = 0
@@ -131,8 +141,22 @@ class RunState(Timers):
         self.pkg = compiled.id
         (self.listeners, self.raw, self.wants_all, self.selectors, self.wanted,
          self.full) = _listener_tables(listeners, compiled)
+        self.raw_metrics = _metrics_only(self.raw)
         # which selection the wanted-kind bits cached on activities and processes are of
         self.flag_key = _flag_key(self.wants_all, self.wanted)
+
+    def gone(self, iid: int) -> None:
+        """Workflow instance ``iid`` ended (``in`` and ``del``, not ``pop(key, None)``:
+        compiled, a dict's pop is a Python method call, these are primitives)."""
+        live = self.live
+        if iid in live:
+            del live[iid]
+
+    @property
+    def counts(self) -> dict[str, int]:
+        """The workflow instances started, completed, terminated and aborted so far."""
+        return {"started": self.started, "completed": self.completed,
+                "terminated": self.terminated, "aborted": self.aborted}
 
     def wants(self, kind: str, process: str | None, activity: str | None) -> bool:
         return self.wants_all or (kind, process, activity) in self.wanted
@@ -173,8 +197,13 @@ class RunState(Timers):
         """Send one trace event to every listener (callers check :meth:`wants` first)."""
         self.seq += 1
         now = self.now
-        for raw in self.raw:
-            raw(now, kind, process, instance, activity, data)
+        metrics = self.raw_metrics
+        if metrics is not None:
+            for metric in metrics:
+                metric.raw(now, kind, process, instance, activity, data)
+        else:
+            for raw in self.raw:
+                raw(now, kind, process, instance, activity, data)
         if self.full:
             event = TraceEvent(now, kind, process, instance, activity, lane, participant,
                                self.pkg, data if data is not None else _EMPTY, self.seq)
@@ -199,7 +228,7 @@ class RunState(Timers):
             return
         self.draining = True
         ready = self.ready
-        pop = ready.popleft
+        done = 0                    # the items of ``ready`` run so far
         # Steps are counted without looking at the clock (reading it costs a dictionary
         # lookup per drain); only past the limit does _past_limit ask whether the clock
         # moved since the count began (then it starts again) or not (a zero-time cycle).
@@ -209,18 +238,23 @@ class RunState(Timers):
             if steps > limit:
                 steps = self._past_limit(steps, None, None)
             while True:
-                while ready:
-                    fn, a, b, c = pop()
+                while done < len(ready):
+                    fn, a, b, c = ready[done]
+                    done += 1
                     steps += 1
                     if steps > limit:
                         steps = self._past_limit(steps, a, b)
                     fn(a, b, c)
+                    if done >= _COMPACT:        # a long burst: drop what has run
+                        del ready[:done]
+                        done = 0
                 if not self.pending:
                     break
                 self.flow.resolve_frames()
-                if not ready:
+                if done >= len(ready):
                     break
         finally:
+            del ready[:done]
             self.draining = False
             self.instant_steps = steps
 
@@ -255,7 +289,8 @@ class RunState(Timers):
         if self.resolution > 0.0:
             delay = self._align(delay)
         self.sim_events += 1
-        self.schedule_timed(max(0.0, delay), _Later(self, fn, ai, arg))
+        self.schedule_timed(delay if delay > 0.0 else 0.0,  # noqa: FURB136 - no builtin call
+                           _Later(self, fn, ai, arg))
 
     def fire(self, fn: Callable[[ActivityInstance, Any], None], ai: ActivityInstance,
              arg: Any, gen: int) -> None:
@@ -274,7 +309,7 @@ class RunState(Timers):
         if ai.gen == gen and ai.state == RUNNING:
             inst = ai.frame.inst
             if inst.state == SUSPENDED:
-                inst.deferred.append((self._refire, fn, ai, (arg, gen)))
+                inst.defer((self._refire, fn, ai, (arg, gen)))
                 return
             fn(ai, arg)
             self.drain()
@@ -299,16 +334,18 @@ class RunState(Timers):
         becoming a clock event (saves an event per instant answer; the user model answers
         two or three offers per dose cycle that way)."""
         if delay <= 0.0 and self.draining:
-            self.ready.append((_call, callback, None, None))
+            self.ready.append((_CALL, callback, None, None))
             return
         self.sim_events += 1
-        self.schedule_timed(max(0.0, delay), _CallAt(self, callback, True))
+        self.schedule_timed(delay if delay > 0.0 else 0.0,  # noqa: FURB136
+                           _CallAt(self, callback, True))
 
     def timer(self, delay: float, callback: Callable[[], None]) -> None:
         """Run ``callback`` after ``delay`` simulated seconds (it drains itself, if it
         must: the processors' and the start timers' callbacks)."""
         self.sim_events += 1
-        self.schedule_timed(max(0.0, delay), _CallAt(self, callback, False))
+        self.schedule_timed(delay if delay > 0.0 else 0.0,  # noqa: FURB136
+                           _CallAt(self, callback, False))
 
     def called(self, callback: Callable[[], None], drain: bool) -> None:
         outer = self.enter()
@@ -333,6 +370,10 @@ class RunState(Timers):
         if self.instant_starts > self.max_instant_starts:
             starts = frame.graph.starts
             self.zero_time(frame, starts[0] if starts else None, self.instant_starts)
+
+
+#: how many run items of the ready queue drain keeps before dropping them from its front
+_COMPACT: Final = 4096
 
 
 def _same_instant(now: float, then: float) -> bool:
@@ -365,6 +406,9 @@ def _flag_key(wants_all: bool, wanted: frozenset[Any]) -> object:
 
 def _call(callback: Callable[[], None], _a: Any, _b: Any) -> None:
     callback()
+
+
+_CALL: Final = _call        # a module static compiled (a global is a dictionary lookup)
 
 
 @final
@@ -403,6 +447,16 @@ class _CallAt(Timed):
 
     def __call__(self, _event: Any) -> None:
         self.state.called(self.callback, self.drain)
+
+
+def _metrics_only(raw: list[Callable[..., None]]) -> list[MetricsListener] | None:
+    """The raw listeners when they are all metrics listeners' (a run's own, as a rule): the
+    compiled engine then calls them as native methods, not through Python's protocol."""
+    metrics = [getattr(listener, "__self__", None) for listener in raw]
+    chosen = [m for m in metrics if isinstance(m, MetricsListener)]
+    if len(chosen) != len(raw) or any(m.raw != r for m, r in zip(chosen, raw)):
+        return None
+    return chosen
 
 
 def discard(table: dict[Any, Any], key: Any) -> None:

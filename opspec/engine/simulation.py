@@ -229,8 +229,8 @@ class Simulation(Interpreter):
         inst.state = LIFECYCLE.next(inst.state, "resume", f"instance {instance_id}")
         if self.wants(EK.PROCESS_RESUMED, inst.process.id, None):
             self.emit(EK.PROCESS_RESUMED, inst.process.id, inst.id, None, inst.process.lane)
-        deferred, inst.deferred = inst.deferred, []
-        self.ready.extend(deferred)      # deferred tokens were still counted as live
+        deferred, inst.deferred = inst.deferred, None
+        self.ready.extend(deferred or ())      # deferred tokens were still counted as live
         self.drain()
 
     def terminate(self, instance_id: int, reason: str = "terminated by request") -> None:

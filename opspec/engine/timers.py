@@ -45,6 +45,9 @@ from opspec.engine.clock import Clock
 __all__ = ["Timed", "Timers", "exact_delay"]
 
 INF: Final = math.inf
+# Final: module statics in the compiled engine, where a plain global is a dictionary lookup
+_PUSH: Final = heappush
+_POP: Final = heappop
 
 
 class Timed:
@@ -135,7 +138,7 @@ class Timers:
             self.now = float(self.env.now)
         at = self.now + delay
         self.order += 1
-        heappush(self.heap, (at, self.order, entry))
+        _PUSH(self.heap, (at, self.order, entry))
         if at < self.armed_at and not self.ticking:
             self.arm()
 
@@ -186,7 +189,7 @@ class Timers:
 
     def _run_due(self, heap: list[tuple[float, int, Timed]], ahead: bool) -> None:
         while True:
-            at, _, entry = heappop(heap)
+            at, _, entry = _POP(heap)
             self.now = at
             entry.go()
             if not ahead or not heap or self.shared:

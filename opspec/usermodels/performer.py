@@ -67,6 +67,12 @@ class StochasticUser:
         self._plans: dict[str, _Plan] = {}
         self._alternatives: dict[str, ActivityModel | None] = {}
         self._handover: dict[int, int] = {}      # lane -> key of its last completed item
+        # the busy model's sets, read once (the model's frozen dataclasses are slow to read
+        # from compiled code, and _finish reads them for every work item)
+        busy = model.busy
+        self._busy = busy is not None
+        self._release_after: frozenset[str] = busy.release_after if busy else frozenset()
+        self._engaging: frozenset[str] = busy.engaged if busy else frozenset()
 
     # ------------------------------------------------------------------ Performer protocol
 
@@ -82,7 +88,6 @@ class StochasticUser:
         if plan is None:
             plan = self._plans[activity] = _Plan(activity, self.model.activity(activity),
                                                  self.model.busy)
-        model = plan.model
         root = item.root_instance
         lane = root if root is not None else item.instance
         now = session.now
@@ -92,7 +97,9 @@ class StochasticUser:
             state = self._routine.state(now)
             notice, factor = state.notice_factor, state.duration_factor
             window, start_at = state.window, state.start_at
-        self._handover.pop(lane, None)
+        handover = self._handover
+        if lane in handover:    # (``in``, ``del``: primitives compiled, where pop is a call)
+            del handover[lane]
 
         if plan.ignored_when_busy and (
                 len(self._engaged) > 1 or (self._engaged and lane not in self._engaged)):
@@ -115,7 +122,7 @@ class StochasticUser:
         delay = 0.0
         choice: str | None = None
         if item.choices:
-            choice, delay = self._choose(item, model, lane)
+            choice, delay = self._choose(item, plan, lane)
             picked = self._alternative(choice)
             if picked is not None:
                 delay += picked.duration.sample(self.rng) * factor
@@ -127,10 +134,10 @@ class StochasticUser:
             self._trace("user.delayed", item, seconds=extra)
 
         constant = plan.constant_duration
-        duration = (constant if constant is not None else model.duration.sample(self.rng)) * factor
+        duration = (constant if constant is not None else plan.duration.sample(self.rng)) * factor
         repetition = plan.repetition
         if repetition is not None and float(self._random()) < repetition.probability:
-            duration += model.duration.sample(self.rng) * factor
+            duration += plan.duration.sample(self.rng) * factor
             self._trace("user.repeated", item)
         slip = plan.commission
         if (slip is not None and not item.choices
@@ -151,11 +158,17 @@ class StochasticUser:
                 self._engaged.discard(lane)
 
         self._pending[item.key] = item
-        total = max(0.0, start - now + max(0.0, delay) + max(0.0, duration))
-        session.call_later(total, lambda: self._finish(item, lane, choice))
+        # (comparisons, not max(0.0, x): the same value, without a builtin call each)
+        total = (start - now + (delay if delay > 0.0 else 0.0)  # noqa: FURB136
+                 + (duration if duration > 0.0 else 0.0))  # noqa: FURB136
+        if not total > 0.0:
+            total = 0.0
+        session.call_later(total, _Finish(self, item, lane, choice))
 
     def withdraw(self, item: WorkItem, reason: str) -> None:
-        if self._pending.pop(item.key, None) is not None:
+        pending = self._pending
+        if item.key in pending:
+            del pending[item.key]
             self._release(self._lane_of(item))
 
     # ------------------------------------------------------------------ internals
@@ -173,14 +186,18 @@ class StochasticUser:
         self._alternatives[activity] = found
         return found
 
-    def _choose(self, item: WorkItem, model: ActivityModel, lane: int) -> tuple[str, float]:
+    def _choose(self, item: WorkItem, plan: _Plan, lane: int) -> tuple[str, float]:
         """Pick an alternative (draw order: see the module docstring); returns the choice and
         the recovery time owed from an earlier wrong pick of this choice."""
         choices = item.choices
         key = (lane, item.activity)
-        owed = self._recovery.pop(key, 0.0)
-        if model.probabilities:
-            weights = dict(model.probabilities)
+        recovery = self._recovery
+        owed = 0.0
+        if key in recovery:
+            owed = recovery[key]
+            del recovery[key]
+        if plan.probabilities:
+            weights = dict(plan.probabilities)
             offered = [(c, weights.get(c, 0.0)) for c in choices]
             total = sum(w for _, w in offered)
             u = float(self._random()) * total
@@ -189,14 +206,14 @@ class StochasticUser:
                     return choice, owed
                 u -= weight
             return offered[-1][0], owed
-        intended = model.intended
+        intended = plan.intended
         if intended is None or intended not in choices:
             if intended is not None:
                 raise UserModelError(
                     f"choice {item.activity!r}: intended alternative {intended!r} is not "
                     f"offered (offered: {', '.join(choices)})")
             return choices[int(self.rng.integers(len(choices)))], owed
-        commission = model.commission
+        commission = plan.commission
         count = self._wrong.get(key, 0)
         if (commission is not None and count < commission.max_per_instance
                 and float(self._random()) < commission.probability):
@@ -208,28 +225,30 @@ class StochasticUser:
                 self._recovery[key] = commission.recovery.sample(self.rng)
                 self._trace("user.wrong_choice", item, choice=pick, intended=intended)
                 return pick, owed
-        self._wrong.pop(key, None)
+        if key in self._wrong:
+            del self._wrong[key]
         return intended, owed
 
     def _finish(self, item: WorkItem, lane: int, choice: str | None) -> None:
-        if self._pending.pop(item.key, None) is None:
+        pending = self._pending
+        if item.key not in pending:
             return  # withdrawn meanwhile
-        busy = self.model.busy
+        del pending[item.key]
         session = self._require_session()
         handover = False
-        if busy is not None and lane in self._engaged:
-            if item.activity in busy.release_after or item.activity not in busy.engaged:
+        if self._busy and lane in self._engaged:
+            if item.activity in self._release_after or item.activity not in self._engaging:
                 self._engaged.discard(lane)
             else:
                 handover = True
                 self._handover[lane] = item.key
-        session.complete(item, choice=choice)
+        session.complete(item, None, choice)
         if handover and self._handover.get(lane) == item.key:
             # Stay engaged if the instance offers its next activity at this same moment;
             # release if it ended (nothing offered when this zero-delay check runs). An
             # engine that routes in several zero-delay steps may release and re-engage at
             # the same instant, which no prompt can fall into except at that exact time.
-            session.call_later(0.0, lambda: self._end_handover(lane, item.key))
+            session.call_later(0.0, _EndHandover(self, lane, item.key))
 
     def _end_handover(self, lane: int, key: int) -> None:
         if self._handover.get(lane) == key:
@@ -261,6 +280,37 @@ class StochasticUser:
             self._session.trace(kind, payload)
 
 
+class _Finish:
+    """The callback ending a work item (a small object, not a closure: compiled, a closure in
+    ``offer`` would make every call build an environment of its variables)."""
+
+    __slots__ = ("choice", "item", "lane", "user")
+
+    def __init__(self, user: StochasticUser, item: WorkItem, lane: int,
+                 choice: str | None) -> None:
+        self.user = user
+        self.item = item
+        self.lane = lane
+        self.choice = choice
+
+    def __call__(self) -> None:
+        self.user._finish(self.item, self.lane, self.choice)
+
+
+class _EndHandover:
+    """The zero-delay check after a handover (see ``StochasticUser._finish``)."""
+
+    __slots__ = ("key", "lane", "user")
+
+    def __init__(self, user: StochasticUser, lane: int, key: int) -> None:
+        self.user = user
+        self.lane = lane
+        self.key = key
+
+    def __call__(self) -> None:
+        self.user._end_handover(self.lane, self.key)
+
+
 class _Plan:
     """What ``offer`` reads of an activity's model, read once per user and activity: the
     model's frozen dataclasses are slow to read from compiled code, and ``offer`` runs for
@@ -281,3 +331,6 @@ class _Plan:
         self.delay = model.delay
         self.repetition = model.repetition
         self.commission = model.commission
+        self.duration = model.duration
+        self.probabilities = model.probabilities
+        self.intended = model.intended
