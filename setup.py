@@ -16,7 +16,6 @@ After compiling, ``opspec/_native_build.json`` records the SHA-256 of each compi
 
 from __future__ import annotations
 
-import importlib.machinery
 import json
 import os
 import runpy
@@ -31,6 +30,7 @@ NATIVE = runpy.run_path(str(ROOT / "opspec" / "_native.py"))
 MODULES: tuple[str, ...] = NATIVE["MODULES"]
 STAMP: str = NATIVE["STAMP"]
 source_digest = NATIVE["source_digest"]
+unlisted_extensions = NATIVE["unlisted_extensions"]
 
 
 def _wanted() -> bool:
@@ -72,12 +72,9 @@ def _remove_unlisted_extensions() -> None:
     """Delete compiled modules an earlier build left in the checkout that are no longer in
     MODULES: Python would import them instead of their source, and opspec._native only guards
     the listed ones."""
-    listed = {ROOT / (module.replace(".", "/")) for module in MODULES}
-    for suffix in importlib.machinery.EXTENSION_SUFFIXES:
-        for path in (ROOT / "opspec").rglob(f"*{suffix}"):
-            if path.with_name(path.name[: -len(suffix)]) not in listed:
-                print(f"removing {path.relative_to(ROOT)} (no longer compiled)", file=sys.stderr)
-                path.unlink()
+    for path in unlisted_extensions(ROOT):
+        print(f"removing {path.relative_to(ROOT)} (no longer compiled)", file=sys.stderr)
+        path.unlink()
 
 
 #: setup.py commands that only describe the package: pip runs this file for them before it

@@ -113,6 +113,22 @@ def _left_compiled() -> frozenset[str]:
     return frozenset(m for m in built - set(MODULES) if _has_extension(m))
 
 
+def unlisted_extensions(root: Path) -> list[Path]:
+    """Compiled modules under ``root``/opspec that are not in :data:`MODULES` (an earlier
+    build's, left in a checkout): setup.py deletes them before an in-place build, since
+    Python would import them instead of their source."""
+    listed = {root / module.replace(".", "/") for module in MODULES}
+    # longest first: 'flow.cpython-311-x86_64-linux-gnu.so' also ends in the bare '.so', and
+    # read with that suffix it would name a module 'flow.cpython-311-x86_64-linux-gnu'
+    suffixes = sorted(importlib.machinery.EXTENSION_SUFFIXES, key=len, reverse=True)
+    found = []
+    for path in sorted((root / "opspec").rglob("*")):
+        suffix = next((s for s in suffixes if path.name.endswith(s)), None)
+        if suffix is not None and path.with_name(path.name[: -len(suffix)]) not in listed:
+            found.append(path)
+    return found
+
+
 class _FromSource:
     """Meta-path finder importing modules from their .py files, not the extensions: the
     :data:`MODULES` when they must not run compiled, and always those no longer in it."""

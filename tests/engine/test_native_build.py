@@ -3,6 +3,7 @@ a compiled build whose source changed is never the one that runs."""
 
 from __future__ import annotations
 
+import importlib.machinery
 import json
 import os
 import subprocess
@@ -149,3 +150,19 @@ def test_a_work_item_reads_by_field_and_compares_by_value() -> None:
     if _native.COMPILED:
         with pytest.raises(AttributeError):
             item.key = 2  # type: ignore[misc]
+
+
+def test_an_in_place_build_removes_only_the_extensions_no_longer_listed(tmp_path: Path) -> None:
+    """setup.py deletes an earlier build's extensions of modules taken out of MODULES before
+    an in-place build. The platform's suffix ('.cpython-311-x86_64-linux-gnu.so') ends in the
+    bare '.so' too, so a listed module's file must be read with its longest suffix, or every
+    compiled module would look unlisted and the build would delete them all."""
+    platform = importlib.machinery.EXTENSION_SUFFIXES[0]
+    engine = tmp_path / "opspec" / "engine"
+    engine.mkdir(parents=True)
+    listed = [tmp_path / (m.replace(".", "/") + platform) for m in _native.MODULES]
+    stale = [engine / f"old_module{platform}", engine / "older.so"]
+    for path in [*listed, *stale, engine / "flow.py"]:
+        path.parent.mkdir(parents=True, exist_ok=True)
+        path.write_bytes(b"")
+    assert _native.unlisted_extensions(tmp_path) == sorted(stale)
