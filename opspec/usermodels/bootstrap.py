@@ -353,6 +353,34 @@ class _RateLevel:
         return {self.spread: sd, self.centre: mean}
 
 
+@dataclass(frozen=True)
+class _SharedRate:
+    """A rate everyone shares (no ``[vary]``): its value drawn from the Jeffreys posterior of
+    the pooled counts, Beta(k + 1/2, n - k + 1/2) (Chick 2001; Brown, Cai & DasGupta 2001).
+
+    The model says every person has this one rate, so the persons' counts are one binomial
+    sample of it and the pooled posterior is the whole uncertainty. The hierarchical
+    beta-binomial posterior (:class:`_RateLevel`) would let thirty alike persons' alikeness
+    be uncertain (``alpha + beta`` loosely fixed), which stretches the draws' upper tail
+    beyond what the counts warrant: groups of new people who slip *less* than the estimate
+    were then called a misfit too often (docs/fitting.md, what the check can detect)."""
+
+    centre: str
+    events: int
+    trials: int
+    spread: None = None                # no between-person spread to draw
+
+    def draw(self, rng: np.random.Generator) -> dict[str, float]:
+        return {self.centre: float(rng.beta(self.events + 0.5,
+                                            self.trials - self.events + 0.5))}
+
+
+def _shared_rate(centre: str, counts: Sequence[tuple[int, int]]) -> _SharedRate | None:
+    events = sum(int(k) for k, n in counts if n > 0)
+    trials = sum(int(n) for _, n in counts if n > 0)
+    return _SharedRate(centre, events, trials) if trials > 0 else None
+
+
 def _rate_level(spread: str | None, centre: str, counts: Sequence[tuple[int, int]]
                 ) -> _RateLevel | None:
     from opspec.usermodels.rate_posterior import rate_posterior
@@ -362,7 +390,7 @@ def _rate_level(spread: str | None, centre: str, counts: Sequence[tuple[int, int
 
 
 def _shared_level(target: _Target, persons: Sequence[dict[str, _Data]],
-                  estimate: dict[str, float]) -> _PersonLevel | _RateLevel | None:
+                  estimate: dict[str, float]) -> _PersonLevel | _SharedRate | None:
     """A parameter without a population whose centre is drawn as a population's is: a
     lognormal's median (not a choice's intended-pick time) and a rate everyone shares.
 
@@ -370,8 +398,8 @@ def _shared_level(target: _Target, persons: Sequence[dict[str, _Data]],
     (P - 1)/P of its variance — at 30 persons the predictive of a new group's mean is then
     narrower than Student's t in exactly the tails Holm reaches into (p <= 0.0125 of four
     items). The spread of the persons' own values (which holds the sampling error whether or
-    not people differ) gives the t-based posterior instead; a rate's centre comes from the
-    beta-binomial posterior of the persons' counts (:class:`_RateLevel`)."""
+    not people differ) gives the t-based posterior instead; a shared rate comes from the
+    Jeffreys posterior of the pooled counts (:class:`_SharedRate`)."""
     from opspec.usermodels.spread import duration_moments
 
     data = [d for person in persons if (d := person.get(target.activity)) is not None]
@@ -382,12 +410,12 @@ def _shared_level(target: _Target, persons: Sequence[dict[str, _Data]],
     elif target.kind == "commission" and target.intended is not None:
         if target.prefix not in estimate:
             return None
-        return _rate_level(None, target.prefix,
-                           [_wrong_picks(d.picks, target.intended) for d in data])
+        return _shared_rate(target.prefix,
+                            [_wrong_picks(d.picks, target.intended) for d in data])
     elif target.kind == "omission" and not target.own_rates_min:
         if target.prefix not in estimate:
             return None
-        return _rate_level(None, target.prefix, [(d.omitted, d.answered) for d in data])
+        return _shared_rate(target.prefix, [(d.omitted, d.answered) for d in data])
     else:
         return None
     if moments is None or moments.observed <= 0 or centre not in estimate:
@@ -397,10 +425,10 @@ def _shared_level(target: _Target, persons: Sequence[dict[str, _Data]],
 
 def _person_levels(targets: Sequence[_Target], persons: Sequence[dict[str, _Data]],
                    estimate: dict[str, float], shared: bool
-                   ) -> list[_PersonLevel | _RateLevel]:
+                   ) -> list[_PersonLevel | _RateLevel | _SharedRate]:
     """The parameters whose centre (and a population's spread) are drawn from their
     posterior; ``shared``: those without a population too (enough persons to resample)."""
-    out: list[_PersonLevel | _RateLevel] = []
+    out: list[_PersonLevel | _RateLevel | _SharedRate] = []
     for target in targets:
         if not target.kind.endswith(" spread"):
             continue
