@@ -39,12 +39,13 @@ skewed, and the normal model's symmetric draws are too narrow above a low estima
 percentile bootstrap of 30 persons gives them normal tails with (P - 1)/P of their
 variance, and groups of new people simulated under it are too alike — ``opspec
 model-check`` of a freshly fitted model then calls misfits above its level
-(docs/fitting.md). So is the centre of a parameter everyone shares (a lognormal
-duration's median, an omission or commission rate without ``[vary]``), from the same
-posterior with the persons' own values (:func:`_shared_level`): whether or not people
-differ, their own values' spread holds the estimate's error, and the t-based draws keep the
-tails a check of new people needs (a lognormal's sigma and the other duration families are
-still resampled). A resample that cannot be fitted (too few distinct durations) keeps the
+(docs/fitting.md). So is the centre of a lognormal duration everyone shares (its median),
+from the same posterior with the persons' own log mean times (:func:`_shared_level`):
+whether or not people differ, their own values' spread holds the estimate's error, and the
+t-based draws keep the tails a check of new people needs (a lognormal's sigma and the other
+duration families are still resampled). An omission or commission rate everyone shares (no
+``[vary]``) is drawn from the Jeffreys posterior of the pooled counts (:class:`_SharedRate`):
+the model says the persons' counts are one binomial sample of one rate. A resample that cannot be fitted (too few distinct durations) keeps the
 estimate for that parameter and is counted in ``failed``. Rates the data show no event of
 (no omission in 40 offers) are not written by ``opspec fit``, hence not redrawn.
 """
@@ -569,7 +570,9 @@ def parameter_draws(result: FitResult, draws: int, *, seed: int = 0) -> Paramete
               f"Davison & Hinkley 1997, 3.8), each fitted as the data were (family kept)"
               + ("; centres and between-person spreads drawn from their posterior over "
                  "persons (Gelman et al. 2013: 3.2 for times, 5.3's beta-binomial for "
-                 "rates)" if levels else "")
+                 "a population's rate)" if levels else "")
+              + ("; a rate everyone shares drawn from the Jeffreys posterior of its pooled "
+                 "counts" if any(isinstance(level, _SharedRate) for level in levels) else "")
               + ("" if by_persons else "; rates drawn from their Jeffreys posterior "
                  "(Chick 2001)")
               + (f"; {failed} parameter fit(s) of a resample failed and kept the estimate"
