@@ -23,7 +23,8 @@ sd 0.08) — and checks them at family-wise level 0.05 (399 bootstrap groups):
 Each rate is printed with its exact (Clopper-Pearson) 95 % interval. ``--start`` and
 ``--reps`` split the repetitions over processes (each repetition has its own seeds); the
 ``rep N:`` lines of several runs add up (``tally FILE...`` counts them). ``--detail FILE``
-appends each check's items (p-values, and which way the people differed) as JSON lines.
+appends each check's items (p-values, and which way the people differed) as JSON lines, with
+(``fitted``) the duration family AIC chose per activity and the runner-up's dAIC.
 """
 
 from __future__ import annotations
