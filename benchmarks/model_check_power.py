@@ -23,7 +23,8 @@ sd 0.08) — and checks them at family-wise level 0.05 (399 bootstrap groups):
 Each rate is printed with its exact (Clopper-Pearson) 95 % interval. ``--start`` and
 ``--reps`` split the repetitions over processes (each repetition has its own seeds); the
 ``rep N:`` lines of several runs add up (``tally FILE...`` counts them). ``--detail FILE``
-appends each check's items (p-values, and which way the people differed) as JSON lines.
+appends each check's items (p-values, and which way the people differed) as JSON lines, with
+(``fitted``) the duration family AIC chose per activity and the runner-up's dAIC.
 """
 
 from __future__ import annotations
@@ -111,6 +112,10 @@ def run_true(reps: int, work: Path, start: int = 0) -> None:
           f"{dict(flagged)}")
 
 
+#: the last fitted model's duration families (activity -> (family, dAIC of the runner-up))
+FAMILIES: dict[str, tuple[str, float | None]] = {}
+
+
 def fitted_model(truth: Path, work: Path, r: int) -> tuple[Path, list[Path]]:
     """Repetition ``r``'s model fitted (``opspec fit``, 200 redraws) on 30 people of
     ``truth`` (seed 20,000 + r), and the traces of 10 more people of it."""
@@ -120,6 +125,13 @@ def fitted_model(truth: Path, work: Path, r: int) -> tuple[Path, list[Path]]:
 
     traces = people(truth, work / f"fit{r}", 40, seed=20_000 + r)
     result = fit_traces(traces[:30], name="fitted")
+    # the family AIC chose per activity, and how far the runner-up is behind (dAIC): the
+    # redraws keep the chosen family, so a close call is where a wrong shape can come from
+    FAMILIES.clear()
+    FAMILIES.update({f.activity: (f.chosen, round(sorted(f.aic.values())[1]
+                                                  - sorted(f.aic.values())[0], 2)
+                                  if len(f.aic) > 1 else None)
+                     for f in result.fits if f.aic})
     draws = parameter_draws(result, 200, seed=r)
     fitted = work / f"fit{r}" / "fitted.users.toml"
     fitted.write_text(fitted_text(result, draws), encoding="utf-8")
@@ -131,7 +143,8 @@ def run_fitted(reps: int, work: Path, start: int = 0) -> None:
     alarms, flagged = 0, Counter[str]()
     for r in range(start, start + reps):
         fitted, held_out = fitted_model(truth, work, r)
-        fits, names = check(fitted, held_out, seed=r, mode="fitted", rep=r)
+        fits, names = check(fitted, held_out, seed=r, mode="fitted", rep=r,
+                            families=dict(FAMILIES))
         alarms += not fits
         flagged.update(names)
         print(f"  rep {r}: {'fits' if fits else 'MISFIT ' + ', '.join(names)}", flush=True)

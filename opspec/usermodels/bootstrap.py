@@ -39,12 +39,13 @@ skewed, and the normal model's symmetric draws are too narrow above a low estima
 percentile bootstrap of 30 persons gives them normal tails with (P - 1)/P of their
 variance, and groups of new people simulated under it are too alike — ``opspec
 model-check`` of a freshly fitted model then calls misfits above its level
-(docs/fitting.md). So is the centre of a parameter everyone shares (a lognormal
-duration's median, an omission or commission rate without ``[vary]``), from the same
-posterior with the persons' own values (:func:`_shared_level`): whether or not people
-differ, their own values' spread holds the estimate's error, and the t-based draws keep the
-tails a check of new people needs (a lognormal's sigma and the other duration families are
-still resampled). A resample that cannot be fitted (too few distinct durations) keeps the
+(docs/fitting.md). So is the centre of a lognormal duration everyone shares (its median),
+from the same posterior with the persons' own log mean times (:func:`_shared_level`):
+whether or not people differ, their own values' spread holds the estimate's error, and the
+t-based draws keep the tails a check of new people needs (a lognormal's sigma and the other
+duration families are still resampled). An omission or commission rate everyone shares (no
+``[vary]``) is drawn from the Jeffreys posterior of the pooled counts (:class:`_SharedRate`):
+the model says the persons' counts are one binomial sample of one rate. A resample that cannot be fitted (too few distinct durations) keeps the
 estimate for that parameter and is counted in ``failed``. Rates the data show no event of
 (no omission in 40 offers) are not written by ``opspec fit``, hence not redrawn.
 """
@@ -353,6 +354,34 @@ class _RateLevel:
         return {self.spread: sd, self.centre: mean}
 
 
+@dataclass(frozen=True)
+class _SharedRate:
+    """A rate everyone shares (no ``[vary]``): its value drawn from the Jeffreys posterior of
+    the pooled counts, Beta(k + 1/2, n - k + 1/2) (Chick 2001; Brown, Cai & DasGupta 2001).
+
+    The model says every person has this one rate, so the persons' counts are one binomial
+    sample of it and the pooled posterior is the whole uncertainty. The hierarchical
+    beta-binomial posterior (:class:`_RateLevel`) would let thirty alike persons' alikeness
+    be uncertain (``alpha + beta`` loosely fixed), which stretches the draws' upper tail
+    beyond what the counts warrant: groups of new people who slip *less* than the estimate
+    were then called a misfit too often (docs/fitting.md, what the check can detect)."""
+
+    centre: str
+    events: int
+    trials: int
+    spread: None = None                # no between-person spread to draw
+
+    def draw(self, rng: np.random.Generator) -> dict[str, float]:
+        return {self.centre: float(rng.beta(self.events + 0.5,
+                                            self.trials - self.events + 0.5))}
+
+
+def _shared_rate(centre: str, counts: Sequence[tuple[int, int]]) -> _SharedRate | None:
+    events = sum(int(k) for k, n in counts if n > 0)
+    trials = sum(int(n) for _, n in counts if n > 0)
+    return _SharedRate(centre, events, trials) if trials > 0 else None
+
+
 def _rate_level(spread: str | None, centre: str, counts: Sequence[tuple[int, int]]
                 ) -> _RateLevel | None:
     from opspec.usermodels.rate_posterior import rate_posterior
@@ -362,7 +391,7 @@ def _rate_level(spread: str | None, centre: str, counts: Sequence[tuple[int, int
 
 
 def _shared_level(target: _Target, persons: Sequence[dict[str, _Data]],
-                  estimate: dict[str, float]) -> _PersonLevel | _RateLevel | None:
+                  estimate: dict[str, float]) -> _PersonLevel | _SharedRate | None:
     """A parameter without a population whose centre is drawn as a population's is: a
     lognormal's median (not a choice's intended-pick time) and a rate everyone shares.
 
@@ -370,8 +399,8 @@ def _shared_level(target: _Target, persons: Sequence[dict[str, _Data]],
     (P - 1)/P of its variance — at 30 persons the predictive of a new group's mean is then
     narrower than Student's t in exactly the tails Holm reaches into (p <= 0.0125 of four
     items). The spread of the persons' own values (which holds the sampling error whether or
-    not people differ) gives the t-based posterior instead; a rate's centre comes from the
-    beta-binomial posterior of the persons' counts (:class:`_RateLevel`)."""
+    not people differ) gives the t-based posterior instead; a shared rate comes from the
+    Jeffreys posterior of the pooled counts (:class:`_SharedRate`)."""
     from opspec.usermodels.spread import duration_moments
 
     data = [d for person in persons if (d := person.get(target.activity)) is not None]
@@ -382,12 +411,12 @@ def _shared_level(target: _Target, persons: Sequence[dict[str, _Data]],
     elif target.kind == "commission" and target.intended is not None:
         if target.prefix not in estimate:
             return None
-        return _rate_level(None, target.prefix,
-                           [_wrong_picks(d.picks, target.intended) for d in data])
+        return _shared_rate(target.prefix,
+                            [_wrong_picks(d.picks, target.intended) for d in data])
     elif target.kind == "omission" and not target.own_rates_min:
         if target.prefix not in estimate:
             return None
-        return _rate_level(None, target.prefix, [(d.omitted, d.answered) for d in data])
+        return _shared_rate(target.prefix, [(d.omitted, d.answered) for d in data])
     else:
         return None
     if moments is None or moments.observed <= 0 or centre not in estimate:
@@ -397,10 +426,10 @@ def _shared_level(target: _Target, persons: Sequence[dict[str, _Data]],
 
 def _person_levels(targets: Sequence[_Target], persons: Sequence[dict[str, _Data]],
                    estimate: dict[str, float], shared: bool
-                   ) -> list[_PersonLevel | _RateLevel]:
+                   ) -> list[_PersonLevel | _RateLevel | _SharedRate]:
     """The parameters whose centre (and a population's spread) are drawn from their
     posterior; ``shared``: those without a population too (enough persons to resample)."""
-    out: list[_PersonLevel | _RateLevel] = []
+    out: list[_PersonLevel | _RateLevel | _SharedRate] = []
     for target in targets:
         if not target.kind.endswith(" spread"):
             continue
@@ -541,7 +570,9 @@ def parameter_draws(result: FitResult, draws: int, *, seed: int = 0) -> Paramete
               f"Davison & Hinkley 1997, 3.8), each fitted as the data were (family kept)"
               + ("; centres and between-person spreads drawn from their posterior over "
                  "persons (Gelman et al. 2013: 3.2 for times, 5.3's beta-binomial for "
-                 "rates)" if levels else "")
+                 "a population's rate)" if levels else "")
+              + ("; a rate everyone shares drawn from the Jeffreys posterior of its pooled "
+                 "counts" if any(isinstance(level, _SharedRate) for level in levels) else "")
               + ("" if by_persons else "; rates drawn from their Jeffreys posterior "
                  "(Chick 2001)")
               + (f"; {failed} parameter fit(s) of a resample failed and kept the estimate"
