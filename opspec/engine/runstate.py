@@ -131,9 +131,6 @@ class RunState(Timers):
         self.pkg = compiled.id
         (self.listeners, self.raw, self.wants_all, self.selectors, self.wanted,
          self.full) = _listener_tables(listeners, compiled)
-        # raw listeners that declare ``raw_kinds`` hear only events of those kinds, apart
-        self.raw_kinds = _raw_kinds(listeners)
-        self.raw = [raw for raw in self.raw if all(raw != r for r, _ in self.raw_kinds)]
         # which selection the wanted-kind bits cached on activities and processes are of
         self.flag_key = _flag_key(self.wants_all, self.wanted)
 
@@ -178,10 +175,6 @@ class RunState(Timers):
         now = self.now
         for raw in self.raw:
             raw(now, kind, process, instance, activity, data)
-        if self.raw_kinds:
-            for raw, kinds in self.raw_kinds:
-                if kind in kinds:
-                    raw(now, kind, process, instance, activity, data)
         if self.full:
             event = TraceEvent(now, kind, process, instance, activity, lane, participant,
                                self.pkg, data if data is not None else _EMPTY, self.seq)
@@ -418,18 +411,6 @@ def discard(table: dict[Any, Any], key: Any) -> None:
 
 
 _Selector = tuple[str, str | None, str | None]      # (kind, process, activity)
-
-
-def _raw_kinds(listeners: list[TraceListener]
-               ) -> list[tuple[Callable[..., None], frozenset[str]]]:
-    """The raw listeners that declare ``raw_kinds`` (a set of event kinds), each with its
-    kinds: the engine calls them only for events of those kinds, where the other raw
-    listeners hear every event any listener selects (an evaluation's counter of the user's
-    rare omissions and wrong choices was called for all 14 events of a dose cycle)."""
-    return [(lst.raw, frozenset(lst.raw_kinds))  # type: ignore[attr-defined]
-            for lst in listeners
-            if getattr(lst, "raw_kinds", None) is not None
-            and getattr(lst, "raw", None) is not None]
 
 
 def _listener_tables(listeners: list[TraceListener], compiled: CompiledPackage) -> tuple[

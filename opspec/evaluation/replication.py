@@ -20,8 +20,7 @@ from typing import Any
 
 from opspec.errors import OpspecError
 
-__all__ = ["USER_DECISIONS", "ActivityRecorder", "ReplicationRecord", "prepare",
-           "run_users"]
+__all__ = ["ActivityRecorder", "ReplicationRecord", "prepare", "run_users"]
 
 DAY = 86_400.0
 USER_KINDS_WRONG = ("user.wrong_choice", "user.slip")
@@ -55,63 +54,40 @@ class ReplicationRecord:
 #: wrong (``user.wrong_choice``, ``user.slip``).
 _COLUMN = {"activity.offered": 0, "activity.completed": 1, "user.omitted": 2,
            **dict.fromkeys(USER_KINDS_WRONG, 3)}
-#: The user's decisions, which name their activity in their data: counted by
-#: :meth:`ActivityRecorder.raw`, the only events the engine sends it.
-USER_DECISIONS = frozenset(("user.omitted", *USER_KINDS_WRONG))
 
 
 class ActivityRecorder:
     """Counts, per manual activity of the user lane, offers, completions, omissions and wrong
     actions (``user.wrong_choice``, ``user.slip``), selecting only the events it needs.
 
-    Two listeners (:attr:`listeners`, what a run is given). Offers and completions, eight
-    events of a dispenser's dose cycle, are counted by the engine's own counter, compiled
-    with it: a :class:`~opspec.engine.metrics.MetricsListener` of one count per activity
-    and kind. The user's decisions, rare, name their activity in their data, so this
-    object counts them in :meth:`raw`, which the engine calls for those kinds only
-    (``raw_kinds``). Counted in Python from every event, as before, the four columns cost
-    a sixth of a replication."""
+    A raw listener (:meth:`raw`): the engine hands it each event's fields without building a
+    trace-event object for it, which the dispenser's user lane emits four of per dose."""
 
     def __init__(self, manual: Sequence[str]) -> None:
-        from opspec.engine.metrics import MetricsListener
-        from opspec.model import EventSelector, MetricDefinition, MetricKind
-
-        self.manual = tuple(manual)
-        #: omitted, wrong per activity (offered, completed: :attr:`counter`)
-        self.decisions: dict[str, list[int]] = {a: [0, 0] for a in self.manual}
-        self.counter = MetricsListener(
-            MetricDefinition(name=f"{kind} {activity}", kind=MetricKind.COUNT,
-                             select=EventSelector(event=kind, activity=activity))
-            for activity in self.manual for kind in ("activity.offered", "activity.completed"))
-        self.selects = frozenset((kind, None, None) for kind in USER_DECISIONS)
-        self.raw_kinds = USER_DECISIONS
-
-    @property
-    def listeners(self) -> list[Any]:
-        """What a run is given: the counter of offers and completions, and this object."""
-        return [self.counter, self]
-
-    @property
-    def counts(self) -> dict[str, list[int]]:
-        """activity -> [offered, completed, omitted, wrong]."""
-        counted = self.counter.counts
-        return {a: [counted[f"activity.offered {a}"], counted[f"activity.completed {a}"],
-                    *self.decisions[a]] for a in self.manual}
+        self.counts: dict[str, list[int]] = {a: [0, 0, 0, 0] for a in manual}
+        selects: set[tuple[str, str | None, str | None]] = set()
+        for activity in manual:
+            selects.add(("activity.offered", None, activity))
+            selects.add(("activity.completed", None, activity))
+        for kind in ("user.omitted", *USER_KINDS_WRONG):
+            selects.add((kind, None, None))
+        self.selects = frozenset(selects)
 
     def raw(self, time: float, kind: str, process: str | None, instance: int | None,
             activity: str | None, data: Mapping[str, Any] | None = None) -> None:
-        """Count one of the user's decisions from its fields (its activity is in ``data``);
-        events of other kinds are not counted here."""
+        """Count one event from its fields. The engine sends a raw listener every event any
+        listener selects, so the kind is checked here (the activity too: the user events
+        name theirs in ``data``)."""
         column = _COLUMN.get(kind)
-        if column is None or column < 2:
+        if column is None:
             return
         if not activity:
             activity = data.get("activity") if data else None
             if activity is None:
                 return
-        row = self.decisions.get(activity)
+        row = self.counts.get(activity)
         if row is not None:
-            row[column - 2] += 1
+            row[column] += 1
 
     def __call__(self, event: Any) -> None:
         self.raw(event.time, event.kind, event.process, event.instance, event.activity,
@@ -202,7 +178,7 @@ def run_user(context: _Context, design: str, user: int, *, seed: int, horizon: f
             who = User.model(drawn.model, who.describe)
         recorder = ActivityRecorder(context.manual)
         outcome = build(context.spec, seed=seed, user=who, user_index=user,
-                        until=horizon, config=context.config, listeners=recorder.listeners,
+                        until=horizon, config=context.config, listeners=[recorder],
                         keep_trace=keep_trace, keep_times=True,
                         params=inputs.for_run(seed, user) if inputs else None).execute()
     except OpspecError as error:

@@ -34,6 +34,8 @@ __all__ = ["Column", "SpilledPairs", "SpilledUsers", "spill_activities", "spill_
 
 #: Rows read per batch (a few hundred kB of row tuples at most).
 BATCH = 4096
+#: Users whose values are written at once (their row tuples: about 0.4 MB).
+FLUSH = 512
 
 
 class Column(Sequence[Any]):
@@ -176,7 +178,7 @@ def spill_user_values(store: ResultStore, design: str,
             if y != y or n != n or v != v:
                 nan = True
             rows.append((y, n, v))
-        if count % BATCH == 0:
+        if count % FLUSH == 0:
             flush()
         if nan:
             break
