@@ -31,6 +31,7 @@ import math
 from collections.abc import Callable, Iterator, Mapping, Sequence
 from contextlib import contextmanager
 from contextvars import ContextVar
+from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -58,6 +59,8 @@ __all__ = [
     "subgroups_figure",
     "sweep_figure",
     "time_of_day_figure",
+    "user_distribution",
+    "UserDistribution",
 ]
 
 #: Resolution of PNG figures (journals ask for at least 200-300 dpi for line art in raster).
@@ -648,46 +651,85 @@ def time_of_day_figure(series: Mapping[str, Sequence[int]], path: Path) -> Path:
         return _save(fig, path)
 
 
+@dataclass(frozen=True)
+class UserDistribution:
+    """What the per-user figure draws of one metric (:func:`user_distribution`), a few
+    numbers whatever the number of users: the users' values (finite, scaled) ``kind``
+    ``"bars"``, each distinct value (``xs``) with its number of users (``counts``), or
+    ``"hist"``, numpy's ``"auto"`` bins (``xs`` their edges) with the users in each; their
+    ``low`` and ``high``, ``mean`` and ``users``."""
+
+    kind: str
+    xs: tuple[float, ...]
+    counts: tuple[int, ...]
+    low: float
+    high: float
+    mean: float
+    users: int
+
+
+def user_distribution(values: Sequence[float], scale: float = 1.0
+                      ) -> UserDistribution | None:
+    """The per-user figure's numbers of one metric's values (each user's own; None and the
+    non-finite values left out, as :func:`_finite` does) times ``scale``; None when none
+    is left. At most 30 distinct values are drawn as a bar each, more as a histogram."""
+    import numpy as np
+
+    # numpy throughout (no list of float objects: 100,000 users' values)
+    data = np.asarray(values, dtype=float)
+    arr = data[np.isfinite(data)] * scale
+    del data
+    if not arr.size:
+        return None
+    distinct = np.unique(arr)
+    if distinct.size <= 30:
+        kind = "bars"
+        xs = tuple(float(v) for v in distinct)
+        counts = tuple(int(np.sum(arr == v)) for v in distinct)
+    else:
+        kind = "hist"
+        tops, edges = np.histogram(arr, bins="auto")
+        xs = tuple(float(e) for e in edges)
+        counts = tuple(int(c) for c in tops)
+    return UserDistribution(kind, xs, counts, float(arr.min()), float(arr.max()),
+                            float(arr.mean()), int(arr.size))
+
+
 @_queueable
-def per_user_figure(series: Mapping[str, Sequence[float]], path: Path, *,
-                    units: Mapping[str, str] | None = None) -> Path:
+def per_user_figure(series: Mapping[str, Sequence[float] | UserDistribution | None],
+                    path: Path, *, units: Mapping[str, str] | None = None) -> Path:
     """How users differ: per metric, a histogram of each user's own value (their rate, their
     mean duration), each in its own panel and scale, the mean over users marked.
     ``units`` per metric: ``"%"`` draws a proportion as a percentage, another unit labels
-    the axis."""
-    import numpy as np
-
+    the axis. A metric's values may come as their :func:`user_distribution` (scaled as its
+    unit says): the figure then holds a few numbers per metric, not every user's value."""
     title = "How users differ"
     units = units or {}
-    present = {}
+    present: dict[str, UserDistribution] = {}
     for name, values in series.items():
-        # numpy throughout (no list of float objects: a figure of 100,000 users' values);
-        # None and the non-finite values are left out, as _finite does
-        data = np.asarray(values, dtype=float)
-        data = data[np.isfinite(data)]
-        if data.size:
-            present[name] = data
+        scale = 100.0 if units.get(name, "") == "%" else 1.0
+        shown = (values if isinstance(values, UserDistribution) or values is None
+                 else user_distribution(values, scale))
+        if shown is not None:
+            present[name] = shown
     if not present:
         return _empty(path, title)
     with _figure(9.0, 0.9 + 2.0 * len(present)) as fig:
         axes = _panels(fig, len(present), sharex=False)
-        for ax, (name, data) in zip(axes, present.items(), strict=True):
-            arr = np.asarray(data, dtype=float)
+        for ax, (name, shown) in zip(axes, present.items(), strict=True):
             unit = units.get(name, "")
             scale = 100.0 if unit == "%" else 1.0
-            arr = arr * scale
-            distinct = np.unique(arr)
-            if distinct.size <= 30:
+            if shown.kind == "bars":
                 # a few values (0, 1 of 28 doses, 2 of 28 …): each value users had is a
                 # thin bar of its own at that value, not a bin around it (a bin's width
                 # would claim values nobody can have, below 0 % or above 100 %)
-                counts = [int(np.sum(arr == v)) for v in distinct]
-                ax.vlines(distinct, 0, counts, colors=PALETTE[0], linewidth=5,
+                counts = list(shown.counts)
+                ax.vlines(list(shown.xs), 0, counts, colors=PALETTE[0], linewidth=5,
                           clip_on=False)
                 # each bar's number of users above it: one user at 7 % next to 180 at 0 %
                 # is a bar too short to see, and a reader should not have to guess it
-                for value, count in zip(distinct, counts, strict=True):
-                    ax.annotate(f"{count}", (float(value), count), xytext=(0, 2),
+                for value, count in zip(shown.xs, counts, strict=True):
+                    ax.annotate(f"{count}", (value, count), xytext=(0, 2),
                                 textcoords="offset points", ha="center", va="bottom",
                                 fontsize=8)
                 ax.set_ylim(0, max(counts) * 1.2)
@@ -696,13 +738,15 @@ def per_user_figure(series: Mapping[str, Sequence[float]], path: Path, *,
                 # and widening the axis instead would show a rate below 0 %
                 ax.spines["left"].set_position(("outward", 8))
             else:               # one outlined patch, not a rectangle per bin
-                ax.hist(arr, bins="auto", histtype="stepfilled", color=PALETTE[5],
-                        edgecolor=PALETTE[0], linewidth=0.8)
+                edges = list(shown.xs)
+                ax.hist(edges[:-1], bins=edges, weights=list(shown.counts),
+                        histtype="stepfilled", color=PALETTE[5], edgecolor=PALETTE[0],
+                        linewidth=0.8)
             if unit == "%":     # a rate's axis stays within [0, 100] %
-                low, high = float(arr.min()), float(arr.max())
+                low, high = shown.low, shown.high
                 pad = max((high - low) * 0.05, 0.5)
                 ax.set_xlim(max(0.0, low - pad), min(100.0, high + pad))
-            mean = float(arr.mean())
+            mean = shown.mean
             label = _fmt(mean / scale, unit == "%", "" if unit == "%" else unit)
             # the mean in the panel's title, not in a legend box: a box in a corner hid the
             # tallest bar when most users sit at one end (a taken rate near 100 %)

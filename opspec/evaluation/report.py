@@ -40,8 +40,8 @@ from opspec.evaluation.summary import (
     summarise_design,
     summarise_monitors,
     summarise_population,
+    per_user_values,
     user_pairs,
-    user_values,
 )
 from opspec.evaluation.tables import (
     DISTRIBUTION_HEADERS,
@@ -455,21 +455,17 @@ def _design_sections(store: ResultStore, figures: Path, design: str, name: str, 
         shown = [d for d in definitions
                  if (s := metrics.get(d["name"])) is not None and s["kind"] != "count"
                  and (s.get("per_user") or {}).get("users")]
-        by_metric = user_values(store, design, shown).pairs
-        import numpy as np
-
+        # the figure gets a few numbers per metric (plots.user_distribution), worked out
+        # one metric at a time from the users' values the summaries left on disk
+        values = per_user_values(store, design, definitions)
         for d in shown:
             s = metrics[d["name"]]
-            # each user's y / k as an array of doubles, not a list of float objects (a
-            # fifth of the memory: the figure holds every metric's at once)
-            pairs = by_metric[d["name"]]
-            y, k = np.frombuffer(pairs.y, dtype=float), np.frombuffer(pairs.n, dtype=float)
-            values = y[k > 0] / k[k > 0]
             label = (f"{metric_label(d['name'], s)}, mean per user"
                      if s["kind"] == "duration" else metric_label(d["name"], s))
-            series[label] = values
             units[label] = ("%" if is_rate(d["name"], s)
                             else (s.get("unit") or "s") if s["kind"] == "duration" else "")
+            series[label] = plots.user_distribution(
+                values.in_user_order(d["name"]), 100.0 if units[label] == "%" else 1.0)
         image = plots.per_user_figure(series, figures / f"{design}-per-user.png", units=units)
         groups = list((population or {}).get("subgroups") or {})
         spread_rows = distribution_rows(metrics)

@@ -15,7 +15,7 @@ import concurrent.futures as cf
 import math
 import os
 import time
-from collections.abc import Callable, Iterator, Sequence
+from collections.abc import Callable, Iterable, Iterator, Sequence
 from concurrent.futures import BrokenExecutor
 from contextlib import contextmanager
 from dataclasses import dataclass
@@ -26,7 +26,8 @@ from opspec.evaluation.plan import EvaluationPlan
 from opspec.evaluation.replication import ReplicationRecord, run_users
 from opspec.evaluation.store import ResultStore
 
-__all__ = ["EvaluationOutcome", "Progress", "check_scheduler", "chunks", "run_evaluation"]
+__all__ = ["EvaluationOutcome", "Progress", "check_scheduler", "chunks", "iter_chunks",
+           "run_evaluation"]
 
 
 @dataclass(frozen=True, slots=True)
@@ -74,19 +75,26 @@ def chunks(users: Sequence[int], workers: int, most: int = 50) -> list[list[int]
     with equal chunks, one worker was left running the last chunk of 50 users (about 0.5 s
     of a user-month each) while the other core stood idle. Which users go together changes
     nothing in the results (each user's streams are their own)."""
+    return list(iter_chunks(users, workers, most))
+
+
+def iter_chunks(users: Sequence[int], workers: int, most: int = 50) -> Iterator[list[int]]:
+    """:func:`chunks` one at a time, as they are sent: with ``users`` a ``range`` (a fresh
+    run), the run never holds a list of every user (100,000 users were 4 MiB of int objects
+    and lists in the evaluate process, the whole run long)."""
     if not users:
-        return []
+        return
     size = max(1, min(most, math.ceil(len(users) / (workers * 8))))
     if workers <= 1:
-        return [list(users[i:i + size]) for i in range(0, len(users), size)]
+        for i in range(0, len(users), size):
+            yield list(users[i:i + size])
+        return
     least = max(1, size // 8)
-    out: list[list[int]] = []
     start = 0
     while start < len(users):
         step = max(least, min(size, math.ceil((len(users) - start) / (4 * workers))))
-        out.append(list(users[start:start + step]))
+        yield list(users[start:start + step])
         start += step
-    return out
 
 
 def _connect(scheduler: str) -> Any:
@@ -211,7 +219,7 @@ Chunk = tuple[str, list[int]]
 Keep = Callable[[list[ReplicationRecord]], None]
 
 
-def _drain(executor: cf.Executor, doc: dict[str, object], pending: Sequence[Chunk],
+def _drain(executor: cf.Executor, doc: dict[str, object], pending: Iterable[Chunk],
            slots: int, keep: Keep, watch: Watch | None = None
            ) -> list[tuple[str, list[int], str]]:
     """Run ``pending`` chunks on ``executor``, at most ``slots`` in flight, storing each chunk
@@ -305,7 +313,9 @@ def run_evaluation(plan: EvaluationPlan, store: ResultStore, *, workers: int = 1
     """
     started = time.perf_counter()
     progress = progress or Progress()
-    pending: list[Chunk] = []
+    # the chunks are made as they are sent (pending is lazy), each from the users still to
+    # run: a range when none is stored yet, so a fresh run holds no list of every user
+    sources: list[tuple[str, Sequence[int], int]] = []
     skipped = 0
     # a user-month of the dispenser is ~0.4 MB of trace: small chunks when traces travel back
     most = EXPORT_CHUNK if plan.export else 50
@@ -315,9 +325,9 @@ def run_evaluation(plan: EvaluationPlan, store: ResultStore, *, workers: int = 1
         finished = store.finished(design.label)
         skipped += len(finished)
         stored.update((design.label, u) for u in finished)
-        todo = [u for u in range(plan.users) if retrace or u not in finished]
-        pending.extend((design.label, chunk)
-                       for chunk in chunks(todo, max(1, workers), most=most))
+        todo: Sequence[int] = (range(plan.users) if retrace or not finished
+                               else [u for u in range(plan.users) if u not in finished])
+        sources.append((design.label, todo, most))
     if plan.input_uncertainty:      # the parameter draws' users (never traced)
         from opspec.evaluation.input_uncertainty import draw_users, draws_label
 
@@ -326,8 +336,9 @@ def run_evaluation(plan: EvaluationPlan, store: ResultStore, *, workers: int = 1
             finished = store.finished(label)
             skipped += len(finished)
             not_retraced += len(finished)
-            pending.extend((label, chunk) for chunk in chunks(
-                [u for u in draw_users(plan) if u not in finished], max(1, workers)))
+            sources.append((label, [u for u in draw_users(plan) if u not in finished], 50))
+    pending: Iterator[Chunk] = ((label, chunk) for label, todo, size in sources
+                                for chunk in iter_chunks(todo, max(1, workers), most=size))
     total = (plan.users + plan.input_uncertainty * plan.users_per_draw) * len(plan.designs)
     progress.start(total, not_retraced if retrace else skipped)
     doc = plan.to_json()

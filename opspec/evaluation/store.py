@@ -115,6 +115,18 @@ def _insert(db: sqlite3.Connection, table: str, rows: Sequence[tuple[Any, ...]])
         db.executemany(f"INSERT INTO {table} VALUES {one}", rows[full:])
 
 
+def _in_transaction(db: sqlite3.Connection, sql: str, rows: Sequence[tuple[Any, ...]]
+                    ) -> None:
+    db.execute("BEGIN")
+    try:
+        db.executemany(sql, rows)
+        db.execute("COMMIT")
+    except BaseException:
+        if db.in_transaction:
+            db.execute("ROLLBACK")
+        raise
+
+
 def _full(error: BaseException) -> bool:
     """Whether ``error`` says the disk (or the database's size limit) is full."""
     return isinstance(error, sqlite3.OperationalError) and "full" in str(error)
@@ -149,6 +161,9 @@ class ResultStore:
             raise EvaluationError(f"{self.path}: no stored evaluation to resume",
                                   hint="run without --resume first, or give the --out folder "
                                   "of the run to finish")
+        #: replications stored through this object so far (readers that keep what they
+        #: read, :mod:`opspec.evaluation.spilled`, know when it is out of date)
+        self.writes = 0
         try:
             self._db = sqlite3.connect(self.path, timeout=30.0, isolation_level=None)
             self._db.execute("PRAGMA journal_mode=WAL")
@@ -224,6 +239,7 @@ class ResultStore:
     def _transaction(self, records: Sequence[ReplicationRecord]) -> None:
         db = self._db
         keys = [(r.design, r.user) for r in records]
+        self.writes += 1
         db.execute("BEGIN IMMEDIATE")
         try:
             # an earlier attempt's rows (a failed replication) are replaced whole. In a store
@@ -331,6 +347,19 @@ class ResultStore:
                 yield from chunk
         except sqlite3.Error as error:
             raise _fail(self.path, "read the stored results", error) from None
+
+    # ------------------------------------------------------------------ scratch tables
+
+    def scratch(self, sql: str) -> None:
+        """Run one statement on this connection's temporary tables (``CREATE TEMP TABLE``,
+        an index, ``DROP``): scratch space of the readers (:mod:`opspec.evaluation.spilled`),
+        in a temporary file SQLite deletes with the connection; the store is not changed."""
+        self._write(lambda db: db.execute(sql), "write a temporary table")
+
+    def scratch_rows(self, sql: str, rows: Sequence[tuple[Any, ...]]) -> None:
+        """Insert ``rows`` into a temporary table with ``sql`` (one transaction)."""
+        if rows:
+            self._write(lambda db: _in_transaction(db, sql, rows), "write a temporary table")
 
     # ------------------------------------------------------------------ plumbing
 

@@ -31,7 +31,7 @@ from __future__ import annotations
 import math
 import statistics as pystats
 from array import array
-from collections.abc import Iterator, Mapping, Sequence
+from collections.abc import Callable, Iterator, Mapping, Sequence
 from dataclasses import dataclass
 from typing import Any
 
@@ -45,6 +45,7 @@ from opspec.statistics import (
     rate_interval,
     ratio_estimate,
 )
+from opspec.statistics.clustered import ValuesAsPairs
 from opspec.statistics.percentiles import interpolation_point, linear
 
 __all__ = ["Pairs", "UserValues", "compare_designs", "has_population", "metric_definitions",
@@ -154,29 +155,38 @@ def user_values(store: ResultStore, design: str, definitions: Sequence[Mapping[s
     bytes per user and metric, never the stored rows'."""
     ids = array("q")
     out = {d["name"]: Pairs() for d in definitions}
-    plan = []
-    for definition in definitions:
-        column = out[definition["name"]]
-        if definition["kind"] == "ratio":
-            plan.append((column.y.append, column.n.append, True,
-                         definition.get("numerator") or "", definition.get("denominator") or ""))
-        else:
-            plan.append((column.y.append, column.n.append, False, definition["name"], ""))
+    columns = [out[d["name"]] for d in definitions]
+    read = pair_reader(definitions)
     for user, metrics in store.user_metrics(design):
         if users is not None and user not in users:
             continue
         ids.append(user)
-        for put_y, put_n, ratio, first, second in plan:
+        for column, (y, n) in zip(columns, read(metrics), strict=True):
+            column.y.append(y)
+            column.n.append(n)
+    return UserValues(ids, out)
+
+
+def pair_reader(definitions: Sequence[Mapping[str, Any]]
+                ) -> Callable[[Mapping[str, Any]], list[tuple[float, float]]]:
+    """A function from one user's stored metrics (their JSON object) to the ``(y, n)`` pair
+    of every metric in ``definitions``, in their order: a count ``(total, 1)``, a duration
+    ``(sum, number)``, a ratio ``(numerator, denominator)``."""
+    plan = [(True, d.get("numerator") or "", d.get("denominator") or "")
+            if d["kind"] == "ratio" else (False, d["name"], "") for d in definitions]
+
+    def read(metrics: Mapping[str, Any]) -> list[tuple[float, float]]:
+        out = []
+        for ratio, first, second in plan:
             if ratio:
                 num, _ = _scalar_pair(metrics.get(first))
                 den, _ = _scalar_pair(metrics.get(second))
-                put_y(num)
-                put_n(den)
+                out.append((num, den))
             else:
-                y, n = _scalar_pair(metrics.get(first))
-                put_y(y)
-                put_n(n)
-    return UserValues(ids, out)
+                out.append(_scalar_pair(metrics.get(first)))
+        return out
+
+    return read
 
 
 def user_pairs(store: ResultStore, design: str, definition: Mapping[str, Any],
@@ -213,13 +223,11 @@ def _sd(values: Sequence[float]) -> float | None:
     return pystats.stdev(values) if len(values) > 1 else None
 
 
-def _per_user(values: Sequence[float], level: float) -> dict[str, Any]:
+def _per_user(ordered: Sequence[float], level: float) -> dict[str, Any]:
     """The distribution over users of each user's own value (their mean duration, their
-    ratio): how much users differ, beside the pooled estimate."""
-    ordered = sorted(values)
-    # each value as the pair (v, 1) in two arrays, not a tuple per user: 16 bytes per user
-    estimate = ratio_estimate(Pairs(array("d", ordered), array("d", [1.0]) * len(ordered)),
-                              level)
+    ratio; ``ordered``: ascending): how much users differ, beside the pooled estimate."""
+    # each value as the pair (v, 1) made as it is read, not a tuple per user held
+    estimate = ratio_estimate(ValuesAsPairs(ordered), level)
     return {"users": len(ordered), "mean": estimate.value, "sd": _sd(ordered),
             "ci95": estimate.ci, "ci95_method": estimate.method,
             "median": _percentile(ordered, 0.5),
@@ -245,37 +253,75 @@ def _between_user_sd(pairs: Sequence[tuple[float, float]]) -> float | None:
     variance of the users' own rates less the mean binomial variance of a rate measured on
     ``n`` trials (estimated without bias by ``p(1-p)/(n-1)``). About 0 when every user has
     the same rate and they differ only by chance; users with fewer than 2 trials are left
-    out."""
+    out. Two passes over ``pairs``, nothing held per user."""
     if any(y > n or y < 0 or y != int(y) or n != int(n) for y, n in pairs):
         return None
-    rates, trials = array("d"), array("d")     # 16 bytes per user, not a tuple's 80
-    for y, n in pairs:
-        if n >= 2:
-            rates.append(y / n)
-            trials.append(n)
-    if len(rates) < 2:
+    measured = sum(1 for _, n in pairs if n >= 2)
+    if measured < 2:
         return None
-    observed = pystats.variance(rates)
-    noise = math.fsum(p * (1 - p) / (n - 1) for p, n in zip(rates, trials)) / len(rates)
+    observed = pystats.variance(y / n for y, n in pairs if n >= 2)
+    noise = math.fsum((y / n) * (1 - y / n) / (n - 1) for y, n in pairs if n >= 2) / measured
     return math.sqrt(max(observed - noise, 0.0))
+
+
+class _Held:
+    """Each finished user's ``(y, n)`` of every metric in arrays (:func:`user_values`):
+    what :class:`opspec.evaluation.spilled.SpilledUsers` reads from disk, for a value
+    SQLite cannot store (NaN)."""
+
+    def __init__(self, values: UserValues) -> None:
+        self.values = values
+
+    def pairs(self, name: str) -> Pairs:
+        return self.values.pairs[name]
+
+    def where_denominator(self, name: str) -> list[float]:
+        return [y for y, k in self.values.pairs[name] if k > 0]
+
+    def in_user_order(self, name: str) -> array[float]:
+        return array("d", (y / k for y, k in self.values.pairs[name] if k > 0))
+
+    def sorted(self, name: str, column: str) -> list[float]:
+        pairs = self.values.pairs[name]
+        if column == "y":
+            return sorted(pairs.y)
+        return sorted(y / k for y, k in pairs if k > 0)
+
+
+def per_user_values(store: ResultStore, design: str,
+                    definitions: Sequence[Mapping[str, Any]], users: set[int] | None = None
+                    ) -> Any:
+    """Each finished user's values of ``definitions`` (of ``users`` only, when given) as
+    the summaries read them: ``pairs(name)`` in user order, ``sorted(name, "y")`` (a
+    count's totals) and ``sorted(name, "v")`` (``y / n`` where ``n > 0``) ascending,
+    ``where_denominator(name)``; on disk (:mod:`opspec.evaluation.spilled`), or in arrays
+    when a value is NaN."""
+    from opspec.evaluation.spilled import spill_user_values
+
+    spilled = spill_user_values(store, design, definitions, users)
+    if spilled is not None:
+        return spilled
+    return _Held(user_values(store, design, definitions, users))
 
 
 def summarise_design(store: ResultStore, design: str, days: float, level: float = 0.95, *,
                      subgroup: str | None = None) -> dict[str, dict[str, Any]]:
     """Every declared metric of ``design`` summarised (see the module docstring), over the
-    users of ``subgroup`` only when it is given."""
+    users of ``subgroup`` only when it is given. The users' values are read from disk at
+    each pass (:func:`per_user_values`): the memory does not grow with the number of
+    users."""
     out: dict[str, dict[str, Any]] = {}
     users_of = subgroup_users(store, design, subgroup)
     where, where_params = _in_subgroup(design, subgroup)
     definitions = metric_definitions(store, design)
-    by_metric = user_values(store, design, definitions, users_of).pairs
+    values = per_user_values(store, design, definitions, users_of)
     for definition in definitions:
         name, kind = definition["name"], definition["kind"]
-        pairs = by_metric[name]
+        pairs = values.pairs(name)
         estimate = ratio_estimate(pairs, level)
         users = len(pairs)
         if kind == "count":
-            totals = sorted(y for y, _ in pairs)
+            totals = values.sorted(name, "y")
             counted = count_estimate(totals, level)
             out[name] = {
                 "kind": "count", "total": int(sum(totals)), "users": users,
@@ -288,7 +334,6 @@ def summarise_design(store: ResultStore, design: str, days: float, level: float 
             }
         elif kind == "duration":
             n = int(sum(n for _, n in pairs))
-            means = [y / k for y, k in pairs if k > 0]
             sq = store.query("SELECT SUM(value * value) FROM sample WHERE design = ? AND "
                              f"metric = ?{where}", (design, name, *where_params))
             sd = None
@@ -301,10 +346,9 @@ def summarise_design(store: ResultStore, design: str, days: float, level: float 
                 "ci95_method": estimate.method, "sd": sd,
                 "median": _pooled_quantile(store, design, name, n, 0.5, subgroup),
                 "p95": _pooled_quantile(store, design, name, n, 0.95, subgroup),
-                "per_user": _per_user(means, level),
+                "per_user": _per_user(values.sorted(name, "v"), level),
             }
         else:
-            ratios = [y / k for y, k in pairs if k > 0]
             proportion = is_proportion(pairs)
             ci = proportion_interval(pairs, level) if proportion else estimate.ci
             out[name] = {
@@ -316,8 +360,8 @@ def summarise_design(store: ResultStore, design: str, days: float, level: float 
                                 "wilson-neff" if proportion else estimate.method),
                 "numerator": definition.get("numerator"),
                 "denominator": definition.get("denominator"),
-                "per_user": {**_per_user(ratios, level),
-                             **_with_any([y for y, k in pairs if k > 0], level),
+                "per_user": {**_per_user(values.sorted(name, "v"), level),
+                             **_with_any(values.where_denominator(name), level),
                              "between_user_sd": _between_user_sd(pairs)},
             }
     return out
@@ -361,30 +405,18 @@ def summarise_activities(store: ResultStore, design: str) -> list[dict[str, Any]
     """Per manual activity of the user's lane (in the order first stored): ``offered``, the
     ``omission`` and ``error`` rates per offer, and their intervals over users (each user's
     omissions of their offers: a proportion pooled over users, as a metric's missed rate,
-    method ``wilson-neff``). Activities never offered are left out. Read streaming into
-    arrays: 24 bytes per user and activity."""
+    method ``wilson-neff``). Activities never offered are left out. The users' counts are
+    read from disk at each pass (:func:`opspec.evaluation.spilled.spill_activities`)."""
+    from opspec.evaluation.spilled import spill_activities
     from opspec.statistics import proportion_interval
 
-    per: dict[str, tuple[array[float], array[float], array[float]]] = {}
-    for activity, offered, omitted, wrong in store.rows(
-            "SELECT activity, offered, omitted, wrong FROM activity WHERE design = ? "
-            "ORDER BY rowid", (design,)):
-        columns = per.get(str(activity))
-        if columns is None:
-            columns = per[str(activity)] = (array("d"), array("d"), array("d"))
-        columns[0].append(int(offered or 0))
-        columns[1].append(int(omitted or 0))
-        columns[2].append(int(wrong or 0))
     out = []
-    for activity, (offers, omissions, wrongs) in per.items():
-        offered = int(sum(offers))
-        if not offered:
-            continue
+    for activity, offered, omissions, wrongs in spill_activities(store, design):
         out.append({"activity": activity, "offered": offered,
-                    "omission": int(sum(omissions)) / offered,
-                    "error": int(sum(wrongs)) / offered,
-                    "omission_ci95": proportion_interval(Pairs(omissions, offers)),
-                    "error_ci95": proportion_interval(Pairs(wrongs, offers)),
+                    "omission": int(sum(y for y, _ in omissions)) / offered,
+                    "error": int(sum(y for y, _ in wrongs)) / offered,
+                    "omission_ci95": proportion_interval(omissions),
+                    "error_ci95": proportion_interval(wrongs),
                     "ci95_method": "wilson-neff"})
     return out
 

@@ -5,12 +5,13 @@ the same users (docs/evaluation.md, *Statistics*)."""
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
+from collections.abc import Iterator, Sequence
 from dataclasses import dataclass
+from typing import Any
 
 from opspec.statistics.intervals import poisson_interval, t_quantile
 
-__all__ = ["RARE_DISCORDANT", "RARE_EVENTS", "RatioEstimate", "count_estimate",
+__all__ = ["RARE_DISCORDANT", "RARE_EVENTS", "RatioEstimate", "ValuesAsPairs", "count_estimate",
            "count_estimate_from_sums",
            "hazard_estimate", "paired_difference", "paired_variance", "ratio_estimate",
            "ratio_variance", "unpaired_difference"]
@@ -35,6 +36,28 @@ class RatioEstimate:
 
 
 Pairs = Sequence[tuple[float, float]]
+
+
+class ValuesAsPairs(Sequence[tuple[float, float]]):
+    """``(v, 1.0)`` for each of ``values``: one value per user as a ratio's pair (the t
+    interval of a mean is :func:`ratio_estimate` of them), made as they are read, so that
+    no tuple per user is held (``values`` may be read from disk at each pass)."""
+
+    __slots__ = ("values",)
+
+    def __init__(self, values: Sequence[float]) -> None:
+        self.values = values
+
+    def __len__(self) -> int:
+        return len(self.values)
+
+    def __iter__(self) -> Iterator[tuple[float, float]]:
+        return ((v, 1.0) for v in self.values)
+
+    def __getitem__(self, index: Any) -> Any:
+        if isinstance(index, slice):
+            return [(v, 1.0) for v in self.values[index]]
+        return self.values[index], 1.0
 
 
 def ratio_variance(pairs: Pairs) -> tuple[float, float] | None:
@@ -196,7 +219,7 @@ def count_estimate(totals: Sequence[float], level: float = 0.95) -> RatioEstimat
     (:func:`ratio_estimate` of ``(total, 1)`` pairs), widened to cover the exact Poisson
     (Garwood) interval of the sum over users when there are fewer than :data:`RARE_EVENTS`
     events in all (method ``"t+garwood"``)."""
-    estimate = ratio_estimate([(y, 1.0) for y in totals], level)
+    estimate = ratio_estimate(ValuesAsPairs(totals), level)
     total, users = sum(totals), len(totals)
     if users < 1 or total >= RARE_EVENTS:
         return estimate
