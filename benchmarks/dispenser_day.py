@@ -35,12 +35,13 @@ from __future__ import annotations
 import argparse
 import json
 import math
-import re
 import shutil
 import statistics
 import subprocess
 import sys
 from pathlib import Path
+
+from callgrind import instructions
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -115,17 +116,6 @@ def _run(code: str, *args: str) -> dict[str, float]:
     return json.loads(done.stdout.strip().splitlines()[-1])
 
 
-def _instructions(code: str, *args: str) -> int:
-    """Instructions executed by ``python -c code args`` under callgrind."""
-    done = subprocess.run(["valgrind", "--tool=callgrind", "--callgrind-out-file=/dev/null",
-                           sys.executable, "-c", code, *args], capture_output=True, text=True,
-                          check=False, cwd=ROOT)
-    found = re.search(r"Collected : (\d+)", done.stderr)
-    if done.returncode != 0 or found is None:
-        sys.exit(f"callgrind run failed:\n{done.stderr[-2000:]}")
-    return int(found.group(1))
-
-
 def _instruction_ratio(users: int, days: int, seed: int, spec: str, model: str) -> None:
     if shutil.which("valgrind") is None:
         print("\ninstructions: valgrind is not installed (apt-get install valgrind)")
@@ -133,7 +123,7 @@ def _instruction_ratio(users: int, days: int, seed: int, spec: str, model: str) 
     per_side = []
     for code, lead in ((_ENGINE, ()), (_BASELINE, (str(BENCH),))):
         tail = (spec, model) if code is _ENGINE else ()
-        counts = [_instructions(code, *lead, str(n), str(days), str(seed), *tail)
+        counts = [instructions(code, *lead, str(n), str(days), str(seed), *tail, cwd=ROOT)
                   for n in (users, 2 * users)]
         per_side.append(counts[1] - counts[0])
     engine, base = per_side

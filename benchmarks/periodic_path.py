@@ -37,13 +37,14 @@ from __future__ import annotations
 import argparse
 import json
 import os
-import re
 import shutil
 import statistics
 import subprocess
 import sys
 from pathlib import Path
 from typing import Any
+
+from callgrind import instructions
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -115,24 +116,13 @@ def _run(code: str, *args: str, checkout: Path | None = None) -> dict[str, Any]:
     return result
 
 
-def _instructions(code: str, *args: str) -> int:
-    """Instructions executed by ``python -c code args`` under callgrind."""
-    done = subprocess.run(["valgrind", "--tool=callgrind", "--callgrind-out-file=/dev/null",
-                           sys.executable, "-c", code, *args], capture_output=True, text=True,
-                          check=False, cwd=ROOT)
-    found = re.search(r"Collected : (\d+)", done.stderr)
-    if done.returncode != 0 or found is None:
-        sys.exit(f"callgrind run failed:\n{done.stderr[-2000:]}")
-    return int(found.group(1))
-
-
 def _instruction_ratio(spec: str, seconds: float, found: list[tuple[float, float]]) -> None:
     if shutil.which("valgrind") is None:
         print("\ninstructions: valgrind is not installed (apt-get install valgrind)")
         return
     short, long = 60.0, 60.0 + seconds
-    engine = [_instructions(_ENGINE, spec, str(t)) for t in (short, long)]
-    loop = [_instructions(_LOOP, str(t), json.dumps(found)) for t in (short, long)]
+    engine = [instructions(_ENGINE, spec, str(t), cwd=ROOT) for t in (short, long)]
+    loop = [instructions(_LOOP, str(t), json.dumps(found), cwd=ROOT) for t in (short, long)]
     runs = [_run(_ENGINE, spec, str(t)) for t in (short, long)]
     instances = int(runs[1]["instances"]) - int(runs[0]["instances"])
     e, b = engine[1] - engine[0], loop[1] - loop[0]

@@ -1,0 +1,25 @@
+"""Instructions a Python snippet executes, counted by valgrind's callgrind: the steady measure
+the benchmarks print beside CPU time, which swings on a shared machine.
+
+Imported by the benchmark scripts beside it (``python benchmarks/NAME.py`` puts this folder
+first on ``sys.path``).
+"""
+
+from __future__ import annotations
+
+import re
+import subprocess
+import sys
+from pathlib import Path
+
+
+def instructions(code: str, *args: str, cwd: Path) -> int:
+    """Instructions executed by ``python -c code args`` under callgrind (exits the benchmark
+    with callgrind's own output when the run fails)."""
+    done = subprocess.run(["valgrind", "--tool=callgrind", "--callgrind-out-file=/dev/null",
+                           sys.executable, "-c", code, *args], capture_output=True, text=True,
+                          check=False, cwd=cwd)
+    found = re.search(r"Collected : (\d+)", done.stderr)
+    if done.returncode != 0 or found is None:
+        sys.exit(f"callgrind run failed:\n{done.stderr[-2000:]}")
+    return int(found.group(1))
