@@ -118,7 +118,7 @@ def test_broken_references_are_errors_at_their_lines(tmp_path: Path) -> None:
               if d.severity is Severity.ERROR}
     assert "targetRef 'nowhere' is no flow node of process 'p'" in errors[(7, "unknown-reference")]
     assert "sourceRef 'ghost'" in errors[(8, "unknown-reference")]
-    assert "attachedToRef 'missing'" in errors[(9, "unknown-reference")]
+    assert "attachedToRef 'missing' is no activity of process 'p'" in errors[(9, "unknown-reference")]
     assert "messageRef 'no_such_message'" in errors[(13, "unknown-reference")]
     assert "id 'work' is used twice" in errors[(15, "duplicate-id")]
     assert "processRef 'absent'" in errors[(19, "unknown-reference")]

@@ -26,6 +26,7 @@ __all__ = [
     "literal_kind",
     "first",
     "kids",
+    "label",
     "local",
     "namespace",
     "tag",
@@ -54,6 +55,11 @@ def local(element: etree._Element) -> str:
     """The local name of an element (``""`` for comments and processing instructions)."""
     raw = element.tag
     return raw.rsplit("}", 1)[-1] if isinstance(raw, str) else ""
+
+
+def label(element: etree._Element) -> str:
+    """How a diagnostic names a flow node: ``bpmn:userTask 'take'``."""
+    return f"bpmn:{local(element)} {element.get('id')!r}"
 
 
 def namespace(element: etree._Element) -> str:

@@ -42,7 +42,7 @@ from opspec.model.activities import (
     TriggerKind,
 )
 from opspec.model.data import Assignment
-from opspec.xpdl.bpmn.common import Defs, first, text_of
+from opspec.xpdl.bpmn.common import Defs, first, label, text_of
 from opspec.xpdl.bpmn.events import trigger_of
 from opspec.xpdl.bpmn.extensions import actual_parameters, execution, task_applications
 
@@ -89,12 +89,6 @@ class Built:
     notes: list[str] = field(default_factory=list)
 
 
-def _label(element: etree._Element) -> str:
-    from opspec.xpdl.bpmn.common import local
-
-    return f"bpmn:{local(element)} {element.get('id')!r}"
-
-
 def _task(kind: TaskKind | None) -> Callable[[etree._Element, Defs], Built]:
     def build(element: etree._Element, defs: Defs) -> Built:
         applications = task_applications(element, defs)
@@ -133,7 +127,7 @@ def _script(element: etree._Element, defs: Defs, applications: tuple[object, ...
                 applications=applications)  # type: ignore[arg-type]
     if text is None or script_element is None:
         return Built(body)
-    statements, _ok = read_script(script_element, defs, _label(element))
+    statements, _ok = read_script(script_element, defs, label(element))
     return Built(body, assignments=statements)
 
 
@@ -142,7 +136,7 @@ def _call(element: etree._Element, defs: Defs) -> Built:
     called = defs.call_aliases.get(called, called)     # tns:proc of an imported file
     if not called:
         defs.ctx.error(element, "missing-subflow-target",
-                       f"{_label(element)} has no calledElement, so it calls nothing",
+                       f"{label(element)} has no calledElement, so it calls nothing",
                        "set calledElement to the id of the process to call")
     actuals = actual_parameters(element, defs)
     if not actuals and defs.process_io.get(called):
@@ -180,7 +174,7 @@ def _start(element: etree._Element, defs: Defs) -> Built:
     trigger, definition, _timer = trigger_of(element, defs, catching=True)
     if trigger.kind in (TriggerKind.ERROR, TriggerKind.ESCALATION, TriggerKind.COMPENSATION):
         defs.ctx.warning(definition, "unsupported-event",
-                         f"{_label(element)} starts on {trigger.kind.value}, which only an event "
+                         f"{label(element)} starts on {trigger.kind.value}, which only an event "
                          "sub-process can catch; opspec waits for a message of that name",
                          "start it with a message, signal, timer or none start event")
     return Built(Event(position=EventPosition.START, trigger=trigger))
@@ -192,7 +186,7 @@ def _end(element: etree._Element, defs: Defs) -> Built:
     # nearest enclosing boundary event for them); the others end their path and say so
     if trigger.kind in (TriggerKind.CANCEL, TriggerKind.COMPENSATION):
         defs.ctx.warning(definition, "unsupported-event",
-                         f"{_label(element)} throws {trigger.kind.value}: opspec ends the path "
+                         f"{label(element)} throws {trigger.kind.value}: opspec ends the path "
                          "there but does not hand the "
                          f"{trigger.kind.value} to a boundary event of an enclosing "
                          "sub-process or call activity",
@@ -207,12 +201,12 @@ def _intermediate(catching: bool) -> Callable[[etree._Element, Defs], Built]:
         trigger, definition, _timer = trigger_of(element, defs, catching=catching)
         if catching and trigger.kind is TriggerKind.NONE:
             defs.ctx.warning(element, "empty-event",
-                             f"{_label(element)} catches nothing (no event definition); it "
+                             f"{label(element)} catches nothing (no event definition); it "
                              "passes the token on at once", "give it a message, timer, signal "
                              "or conditional event definition")
         if not catching and trigger.kind in (TriggerKind.COMPENSATION, TriggerKind.ERROR):
             defs.ctx.warning(definition, "unsupported-event",
-                             f"{_label(element)} throws {trigger.kind.value}, which opspec raises "
+                             f"{label(element)} throws {trigger.kind.value}, which opspec raises "
                              "as a message of that name (a boundary event waiting for it "
                              "catches it)", "see docs/bpmn.md")
         return Built(Event(position=EventPosition.INTERMEDIATE, trigger=trigger))

@@ -2,54 +2,35 @@
 sequence flows (conditions, default flows), sub-processes (activity sets), boundary events,
 loops, lanes and performers, data.
 
-Boundary events follow the engine's existing constructs:
-
-* an interrupting boundary **timer** with a ``timeDuration`` is a synchronous ``Deadline`` of
-  the activity it is attached to, a non-interrupting one an asynchronous deadline; its
-  exception path leads to the boundary event, which passes the token on at once (timers with
-  a ``timeDate`` or ``timeCycle`` stay boundary events the engine arms itself);
-* a boundary **error** event catches the activity's failures (a device fault) as an
-  ``EXCEPTION`` path named by the error's ``errorCode`` (no ``errorRef``: every failure,
-  ``DEFAULTEXCEPTION``);
-* **message, signal, conditional and escalation** boundary events are boundary events of
-  the model (interrupting or not, as ``cancelActivity`` says).
+Boundary events are read in :mod:`.boundaries`, loops in :mod:`.loops`.
 """
 
 from __future__ import annotations
 
 import dataclasses
-import re
 from collections.abc import Iterable
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 from lxml import etree
 
-from opspec.errors import SpecError
 from opspec.model.activities import (
     Activity,
     ActivityBody,
     BlockActivity,
-    Deadline,
     Event,
-    EventPosition,
-    Execution,
     GatewayType,
     Join,
-    Loop,
-    LoopKind,
-    MIFlow,
     Mode,
     NoImplementation,
     Split,
     Task,
     TaskKind,
-    Trigger,
 )
-from opspec.model.data import Assignment, BasicKind, BasicType, DataField, FormalParameter
-from opspec.model.expressions import Expression
+from opspec.model.data import Assignment, BasicType, DataField, FormalParameter
 from opspec.model.process import ActivitySet, Condition, ConditionKind, Transition, WorkflowProcess
 from opspec.model.resources import Lane
 from opspec.model.sisarl import ActivityDirectives, ProcessDirectives
+from opspec.xpdl.bpmn.boundaries import Boundaries, read_boundaries
 from opspec.xpdl.bpmn.branches import decide_undecided
 from opspec.xpdl.bpmn.common import (
     BPMN,
@@ -57,14 +38,14 @@ from opspec.xpdl.bpmn.common import (
     expression_text,
     first,
     kids,
+    label,
     literal_kind,
     local,
     namespace,
     text_of,
 )
-from opspec.xpdl.bpmn.data import CAMUNDA, activity_data, process_fields
+from opspec.xpdl.bpmn.data import activity_data, process_fields
 from opspec.xpdl.bpmn.event_subprocesses import hoist_event_sub_processes
-from opspec.xpdl.bpmn.events import definitions_of, read_timer, trigger_of
 from opspec.xpdl.bpmn.extensions import (
     assignments,
     data_field,
@@ -72,9 +53,10 @@ from opspec.xpdl.bpmn.extensions import (
     formal_parameter,
     opspec_named,
 )
+from opspec.xpdl.bpmn.loops import read_loop
 from opspec.xpdl.bpmn.nodes import NODES, build_node
 from opspec.xpdl.bpmn.scripts import bpmn_condition
-from opspec.xpdl.handlers.common import parse_int, quantity
+from opspec.xpdl.handlers.common import quantity
 from opspec.xpdl.sisarl import (
     ACTIVITY_DIRECTIVES,
     PROCESS_DIRECTIVES,
@@ -98,9 +80,6 @@ _QUIET = frozenset({
 _USER_NAMES = frozenset({"user", "users", "user lane", "user_lane", "the user"})
 _ACTIVITY_STRUCTURE = ("TaskApplication", "ActualParameter", "Assignment", "Execution")
 
-_NAME = re.compile(r"^[A-Za-z_]\w*$")
-
-
 def is_user_name(*names: str | None) -> bool:
     """True when one of ``names`` (a lane's, a pool's, a resource's id or name) names the
     user: ``User``, ``Users``, ``User lane``… (the names the engine's user lane goes by)."""
@@ -114,16 +93,6 @@ class BuiltProcess:
 
     process: WorkflowProcess
     lanes: tuple[Lane, ...] = ()
-
-
-@dataclass(slots=True)
-class _Boundary:
-    """What the boundary events of one level add to their hosts."""
-
-    deadlines: dict[str, list[Deadline]] = field(default_factory=dict)
-    activities: list[Activity] = field(default_factory=list)
-    transitions: list[Transition] = field(default_factory=list)
-    skipped: set[str] = field(default_factory=set)
 
 
 class _Process:
@@ -193,7 +162,7 @@ class _Process:
                                    f"declare <bpmn:resource id=\"{ref}\"> or fix the reference")
                 else:
                     self.defs.info(assignment, "performer-expression",
-                                  f"the {local(assignment)} of {self.label(element)} is an "
+                                  f"the {local(assignment)} of {label(element)} is an "
                                   "expression, which opspec does not evaluate; its lane or pool "
                                   "performs it", "name a bpmn:resource with resourceRef")
         if named:
@@ -210,9 +179,6 @@ class _Process:
         if self.pool:
             return (self.pool[0],)
         return ()
-
-    def label(self, element: etree._Element) -> str:
-        return f"bpmn:{local(element)} {element.get('id')!r}"
 
     # -- levels ----------------------------------------------------------------------------
     def level(self, container: etree._Element, inherited_lane: str | None
@@ -251,7 +217,7 @@ class _Process:
                                  f"bpmn:{name} is not run by opspec; it is ignored",
                                  "docs/bpmn.md lists what opspec runs")
         ids = {node.get("id") or "" for node in nodes}
-        boundary = self.boundaries(boundaries, ids)
+        boundary = read_boundaries(boundaries, ids, self.defs, self.where, self.plain)
         ids |= {b.id for b in boundary.activities}
         transitions = self.flows(flows, ids, nodes, boundary.skipped)
         transitions = decide_undecided(nodes, transitions,
@@ -312,7 +278,7 @@ class _Process:
                 where = self.defs.by_id.get(flow_id or "")
                 if where is None or local(where) != "sequenceFlow":
                     self.ctx.error(node, "unknown-reference",
-                                   f"{self.label(node)}: default {flow_id!r} is no sequence flow "
+                                   f"{label(node)}: default {flow_id!r} is no sequence flow "
                                    "of this process", "name one of its outgoing sequence flows")
         return out
 
@@ -349,90 +315,9 @@ class _Process:
                                          f"condition of sequence flow {flow.get('id')!r}")
         return Condition(kind=ConditionKind.CONDITION, text=text, expression=parsed)
 
-    # -- boundary events -------------------------------------------------------------------
-    def boundaries(self, events: list[etree._Element], hosts: set[str]) -> _Boundary:
-        out = _Boundary()
-        for event in events:
-            event_id = event.get("id") or ""
-            host = (event.get("attachedToRef") or "").strip()
-            interrupting = (event.get("cancelActivity") or "true").strip().lower() != "false"
-            if host not in hosts:
-                where = self.defs.by_id.get(host)
-                self.ctx.error(event, "unknown-reference",
-                               f"boundary event {event_id!r}: attachedToRef {host!r} is no "
-                               f"activity of {self.where(event)}"
-                               + (f" (it is a bpmn:{local(where)}{self.defs.line(where)})"
-                                  if where is not None else ""),
-                               "attach it to an activity next to it (it is left out)")
-                out.skipped.add(event_id)
-                continue
-            found = definitions_of(event, self.defs)
-            kind = local(found[0]) if found else None
-            passing = Event(position=EventPosition.INTERMEDIATE, trigger=Trigger())
-            if kind == "timerEventDefinition" and not any(
-                    expression_text(first(found[0], k)) for k in _TIMER_KINDS):
-                # no time at all: an intermediate timer fires at once (said), but a boundary
-                # timer that fired at once would cut its activity off before it began
-                self.ctx.error(found[0], "bad-timer",
-                               f"boundary timer {event_id!r} has no timeDuration, timeDate or "
-                               "timeCycle, so when it interrupts its activity is not said",
-                               "give it a time, e.g. <bpmn:timeDuration>PT2H</bpmn:timeDuration>")
-                continue
-            if kind == "timerEventDefinition":
-                timer = read_timer(found[0], self.defs)
-                if timer is None or timer.kind == "duration":
-                    out.deadlines.setdefault(host, []).append(Deadline(
-                        duration_text=timer.text if timer else "",
-                        duration=timer.duration if timer else None,
-                        execution=Execution.SYNCHR if interrupting else Execution.ASYNCHR,
-                        exception_name=event_id, location=self.defs.loc(found[0])))
-                    self.exception_path(out, event, host, passing, event_id)
-                    continue
-            if kind == "errorEventDefinition":
-                from opspec.xpdl.bpmn.events import named_ref
-
-                code = named_ref(found[0], "errorRef", self.defs.errors, self.defs, "error")[1]
-                if not interrupting:
-                    self.ctx.warning(event, "non-interrupting-error",
-                                     f"boundary error event {event_id!r} is non-interrupting, "
-                                     "which BPMN does not allow; a failure ends the activity",
-                                     "remove cancelActivity=\"false\"")
-                self.exception_path(out, event, host, passing, code)
-                continue
-            if kind in ("compensateEventDefinition", "cancelEventDefinition") or kind is None:
-                what = ("it has no event definition" if kind is None
-                        else f"opspec does not run {kind.removesuffix('EventDefinition')} events")
-                self.ctx.warning(event, "unsupported-element",
-                                 f"boundary event {event_id!r}: {what}; it never fires, so its "
-                                 "outgoing flows never carry a token",
-                                 "docs/bpmn.md lists the boundary events opspec runs")
-                # kept as a boundary event that never fires: the nodes its flows lead to keep
-                # their incoming flows, so none of them starts when the process does
-                out.activities.append(self.plain(event, Event(
-                    position=EventPosition.INTERMEDIATE,
-                    trigger=Trigger(catching=True, attached_to=host,
-                                    interrupting=interrupting)), host))
-                continue
-            trigger = trigger_of(event, self.defs, catching=True, attached_to=host,
-                                 interrupting=interrupting)[0]
-            out.activities.append(self.plain(event, Event(position=EventPosition.INTERMEDIATE,
-                                                          trigger=trigger), host))
-        return out
-
-    def exception_path(self, out: _Boundary, event: etree._Element, host: str,
-                       body: Event, exception: str | None) -> None:
-        """The boundary event as a node reached by an exception path from ``host``."""
-        event_id = event.get("id") or ""
-        kind = ConditionKind.EXCEPTION if exception else ConditionKind.DEFAULTEXCEPTION
-        out.transitions.append(Transition(
-            id=f"{event_id}.exception", source=host, target=event_id,
-            condition=Condition(kind=kind, text=exception, exception_name=exception),
-            location=self.defs.loc(event)))
-        out.activities.append(self.plain(event, body, host))
-
     def plain(self, event: etree._Element, body: Event, host: str) -> Activity:
         lane = self.lane_of.get(event.get("id") or "") or self.lane_of.get(host)
-        found, kept = directives(event, self.defs, ACTIVITY_DIRECTIVES, self.label(event))
+        found, kept = directives(event, self.defs, ACTIVITY_DIRECTIVES, label(event))
         directive_values, coordination = activity_directives(event, self.ctx, found)
         return Activity(id=event.get("id") or "", name=event.get("name"),
                         description=text_of(first(event, "documentation")),
@@ -441,7 +326,7 @@ class _Process:
                         directives=directive_values, coordination=coordination)
 
     # -- activities ------------------------------------------------------------------------
-    def activity(self, element: etree._Element, inherited_lane: str | None, boundary: _Boundary,
+    def activity(self, element: etree._Element, inherited_lane: str | None, boundary: Boundaries,
                  incoming: dict[str, int], outgoing: dict[str, list[str]],
                  conditional: set[str]) -> Activity:
         node_id = element.get("id") or ""
@@ -461,22 +346,22 @@ class _Process:
             built = build_node(name, element, self.defs)
             built_body, gateway, extra = built.body, built.gateway, built.assignments
             sends, manual = built.sends, built.manual
-        found, kept = directives(element, self.defs, ACTIVITY_DIRECTIVES, self.label(element),
+        found, kept = directives(element, self.defs, ACTIVITY_DIRECTIVES, label(element),
                                  _ACTIVITY_STRUCTURE)
         self.message_directives(element, found, sends, built_body)
         directive_values, coordination = activity_directives(element, self.ctx, found)
         directive_values = self.simulated_duration(element, node_id, directive_values)
-        data = activity_data(element, self.defs, self.label(element))
+        data = activity_data(element, self.defs, label(element))
         for created in data.fields:
             self.created.setdefault(created.id, created)
-        self.reads.extend((name, where, self.label(element)) for name, where in data.reads)
+        self.reads.extend((name, where, label(element)) for name, where in data.reads)
         start_mode = Mode.AUTOMATIC
         if name == "task" and isinstance(built_body, NoImplementation) and data.writes:
             # SpiffWorkflow's plain task waits for someone; one whose outputs nothing in the
             # file computes must: its performer supplies them when completing it
             manual, start_mode = True, Mode.MANUAL
             self.defs.info(element, "task-supplies-data",
-                           f"{self.label(element)} writes {', '.join(data.writes)}, which "
+                           f"{label(element)} writes {', '.join(data.writes)}, which "
                            "nothing in the file computes: it waits for its performer, whose "
                            "completion supplies the value", "docs/bpmn.md, Data")
         join = split = None
@@ -505,7 +390,8 @@ class _Process:
             performers=self.performers(element, lane, manual), lane=lane,
             start_mode=start_mode,
             deadlines=tuple(boundary.deadlines.get(node_id, ())),
-            loop=self.loop(element), join=join, split=split,
+            loop=read_loop(element, self.defs, self.declared, self.collections),
+            join=join, split=split,
             directives=directive_values, coordination=coordination,
             assignments=assignments(element, self.defs) + extra + tuple(data.assignments),
             start_quantity=quantity(element, "startQuantity", self.ctx),
@@ -521,7 +407,7 @@ class _Process:
         source = self.defs.duration_source.get(node_id, "the file")
         if given.duration is not None:
             self.defs.info(element, "duration-given-twice",
-                           f"{self.label(element)} has its own opspec:Duration, which wins "
+                           f"{label(element)} has its own opspec:Duration, which wins "
                            f"over the {source} duration", "")
             return given
         return dataclasses.replace(given, duration=drawn)
@@ -550,7 +436,7 @@ class _Process:
                                         self.defs.loc(flow))
             if len(names) > 1:
                 self.ctx.warning(element, "several-messages",
-                                 f"{self.label(element)} sends {len(names)} messages "
+                                 f"{label(element)} sends {len(names)} messages "
                                  f"({', '.join(names)}); opspec raises only {names[0]!r}",
                                  "send each message from its own send task or throw event")
         incoming = [name for name, _ in self.defs.receives.get(node_id, [])]
@@ -579,134 +465,6 @@ class _Process:
                 "completionCondition"),
             location=self.defs.loc(element)))
         return BlockActivity(activity_set=set_id)
-
-    def loop(self, element: etree._Element) -> Loop | None:
-        standard = first(element, "standardLoopCharacteristics")
-        if standard is not None:
-            condition_element = first(standard, "loopCondition")
-            text = expression_text(condition_element)
-            maximum = parse_int(standard.get("loopMaximum"))
-            if text is None and maximum is None:
-                self.ctx.error(standard, "standard-loop-without-end",
-                               f"the loop of {self.label(element)} has neither a loopCondition "
-                               "nor a loopMaximum, so it never ends",
-                               "add <bpmn:loopCondition> (the activity repeats while it holds) "
-                               "or loopMaximum=\"N\"")
-            return Loop(kind=LoopKind.STANDARD, condition_text=text,
-                        condition=bpmn_condition(condition_element, text, self.defs,
-                                                          "loopCondition"),
-                        maximum=maximum,
-                        test_before=(standard.get("testBefore") or "").lower() == "true")
-        multi = first(element, "multiInstanceLoopCharacteristics")
-        if multi is None:
-            return None
-        cardinality = first(multi, "loopCardinality")
-        text = expression_text(cardinality)
-        collection = text_of(first(multi, "loopDataInputRef"))
-        variable = None
-        if text is None and collection is None:
-            vendor = self.vendor_collection(element, multi)
-            if vendor is False:
-                return None     # refused at its line; the file does not run
-            if vendor is not True:
-                text, variable = vendor
-        if text is None and collection is not None:
-            text = f"len({collection})"
-            self.defs.info(multi, "multi-instance-collection",
-                          f"{self.label(element)} runs one instance per item of {collection!r} "
-                          f"(loopCardinality len({collection})); opspec does not hand each "
-                          "instance its item", "read the item yourself if an instance needs it")
-        completion = first(multi, "completionCondition")
-        completion_text = expression_text(completion)
-        return Loop(kind=LoopKind.MULTI_INSTANCE, condition_text=text,
-                    condition=self.expression(cardinality if cardinality is not None else multi,
-                                              text, "loopCardinality"),
-                    parallel=(multi.get("isSequential") or "false").lower() != "true",
-                    flow=MIFlow.COMPLEX if completion_text else MIFlow.ALL,
-                    flow_condition_text=completion_text,
-                    flow_condition=bpmn_condition(completion, completion_text, self.defs,
-                                                  "completionCondition"),
-                    cancel_remaining=completion_text is not None,
-                    element_variable=variable)
-
-    def vendor_collection(self, element: etree._Element, multi: etree._Element
-                          ) -> tuple[str, str | None] | bool:
-        """A multi-instance over a vendor's collection (Camunda's ``camunda:collection``/
-        ``elementVariable``, Zeebe's ``inputCollection``/``inputElement``): the data field
-        holding the list and the element variable's name (without one: the list's length and
-        ``None``: one instance per item, none reading it); ``True`` when there is none,
-        ``False`` when it is refused at its line.
-
-        Each instance sees its own item under the element variable, over its process
-        instance's data (the engine's per-instance overlay), so parallel instances never
-        read one another's item. Only a task's instances have it: the activities inside a
-        sub-process read their process instance's data, not the overlay, so a sub-process
-        or call activity over a collection is refused rather than run with a shared item.
-        The collection must be a list data field of the process (or the package); the element
-        variable becomes a field of the element's type (so the scripts and conditions reading
-        it pass the checks), which each instance reads from its own overlay instead."""
-        zeebe = next((sub for sub in multi.iter() if isinstance(sub.tag, str)
-                      and local(sub) == "loopCharacteristics"
-                      and "zeebe" in (etree.QName(sub).namespace or "")), None)
-        items = multi.get(f"{{{CAMUNDA}}}collection")
-        variable = multi.get(f"{{{CAMUNDA}}}elementVariable")
-        vendor = "camunda:collection", "camunda:elementVariable"
-        if items is None and zeebe is not None:
-            items, variable = zeebe.get("inputCollection"), zeebe.get("inputElement")
-            vendor = "zeebe:inputCollection", "zeebe:inputElement"
-        if items is None:
-            return True
-        text = items.strip()
-        text = text[2:-1].strip() if text.startswith("${") and text.endswith("}") else (
-            text[1:].strip() if text.startswith("=") else text)
-        why = None
-        if not _NAME.match(text):
-            why = (f"its collection {items.strip()!r} ({vendor[0]}) is no data field's name",
-                   "name the data field holding the list, e.g. ${scores} (a field with "
-                   "IsArray=\"true\")")
-        elif variable is not None and not _NAME.match(variable.strip()):
-            why = (f"its element variable {variable!r} ({vendor[1]}) is no name",
-                   f"write {vendor[1]}=\"item\"")
-        elif variable and local(element) != "task" and not local(element).endswith("Task"):
-            why = (f"it is a {local(element)}: the activities inside read their process "
-                   f"instance's data, not each instance's own {variable.strip()!r}, so "
-                   "parallel instances would read one another's item",
-                   "put the multi-instance on the task that uses the item")
-        found = self.declared.get(text) or self.defs.package_data.get(text)
-        if why is None and found is None:
-            why = (f"its collection {text!r} is no data field",
-                   f"declare the list: <opspec:DataField Id={text!r} Type=\"INTEGER\" "
-                   "IsArray=\"true\" InitialValue=\"[1, 2, 3]\"/>")
-        elif why is None and found is not None and not found.is_array:
-            why = (f"its collection {text!r} is not a list (IsArray is not true)",
-                   f"declare {text!r} with IsArray=\"true\" and a JSON list value")
-        if variable and _NAME.match(variable.strip()):     # refused or not: no second error
-            element_type = (found.type if found is not None and found.is_array
-                            else BasicType(kind=BasicKind.STRING))
-            self.collections.append(DataField(id=variable.strip(), type=element_type,
-                                              location=self.defs.loc(multi)))
-        if why is not None:
-            self.ctx.error(multi, "multi-instance-without-count",
-                           f"{self.label(element)} runs one instance per item of a list, but "
-                           f"{why[0]}", why[1])
-            return False
-        if not variable:        # one instance per item, none reading it
-            return f"len({text})", None
-        return text, variable.strip()
-
-    def expression(self, element: etree._Element, text: str | None, what: str
-                   ) -> Expression | None:
-        from opspec.xpdl.conditions import parse_expression
-
-        if text is None:
-            return None
-        try:
-            return parse_expression(text, location=self.defs.loc(element))
-        except (SpecError, ValueError, RecursionError) as error:
-            self.ctx.error(element, "bad-expression", f"{what} {text!r} cannot be understood: "
-                           f"{getattr(error, 'message', error)}",
-                           "write an expression over data fields, e.g. 3 or count + 1")
-            return None
 
     # -- the process -----------------------------------------------------------------------
     def build(self) -> BuiltProcess:
@@ -771,8 +529,6 @@ class _Process:
                                "in a script task or a form field, or feed the input with a "
                                "bpmn:dataInputAssociation")
 
-
-_TIMER_KINDS = ("timeDuration", "timeDate", "timeCycle")
 
 
 def _with_script_fields(process: WorkflowProcess, element: etree._Element, defs: Defs
