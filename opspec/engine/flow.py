@@ -79,7 +79,9 @@ class Flow(Part):
             inst.partner = parent.frame.inst.partner
         self.state.live[iid] = inst
         self.state.started += 1
-        if self.state.proc_bits(proc) & 1:
+        cached = proc.flag_cache              # RunState.proc_bits's cached case, in line
+        if (cached.bits if cached is not None and cached.key is self.state.flag_key
+                else self.state.proc_bits(proc)) & 1:
             self.state.emit(EK.PROCESS_STARTED, proc.id, iid, None, proc.lane, None,
                       {"trigger": trigger, "parent": parent.frame.inst.id if parent else None})
         frame = Frame(proc.graph, inst, None)
@@ -131,12 +133,17 @@ class Flow(Part):
             return
         inst.state = _COMPLETED_FROM_RUNNING
         inst.frames.clear()          # breaks the instance <-> frame cycle: freed by refcount
-        self.state.gone(inst.id)
-        if self.state.kept and inst.parent is None:
+        state = self.state
+        live = state.live                   # RunState.gone, in line
+        if inst.id in live:
+            del live[inst.id]
+        if state.kept and inst.parent is None:
             self.triggers.drop_kept(inst)
-        self.state.completed += 1
+        state.completed += 1
         proc = inst.process
-        if self.state.proc_bits(proc) & 2:
+        cached = proc.flag_cache              # RunState.proc_bits's cached case, in line
+        if (cached.bits if cached is not None and cached.key is state.flag_key
+                else state.proc_bits(proc)) & 2:
             self.state.emit(EK.PROCESS_COMPLETED, proc.id, inst.id, None, proc.lane, None,
                       {"duration": self.state.now - inst.started_at})
         parent = inst.parent
@@ -372,15 +379,19 @@ class Flow(Part):
         """
         inst = frame.inst
         if act.simple_end:
-            if self.state.act_bits(act) & 2:
-                self.state.emit(EK.ACTIVITY_COMPLETED, act.process, inst.id, act.id, act.lane,
-                          act.participant)
+            state = self.state
+            # RunState.act_bits's cached case, in line (from source a call is a Python frame)
+            cached = act.flag_cache
+            if (cached.bits if cached is not None and cached.key is state.flag_key
+                    else state.act_bits(act)) & 2:
+                state.emit(EK.ACTIVITY_COMPLETED, act.process, inst.id, act.id, act.lane,
+                           act.participant)
             nxt = act.next
             if nxt >= 0:
                 target = frame.graph.activities[nxt]
                 if not target.join:
                     return target
-            return self._split(frame, act, inst)
+            return self.split(frame, act, inst)
         if act.end_assign and act.loop is None and assigns and not self.assign(
                 inst, act, act.end_assign, inst.scope if local is None else ChainMap(local, inst.scope)):
             return None
@@ -408,11 +419,12 @@ class Flow(Part):
             return None
         if inst.state != RUNNING:
             return None
-        return self._split(frame, act, inst)
+        return self.split(frame, act, inst)
 
-    def _split(self, frame: Frame, act: CompiledActivity, inst: ProcessInstance
+    def split(self, frame: Frame, act: CompiledActivity, inst: ProcessInstance
                ) -> CompiledActivity | None:
-        """The split of a completed activity (see :meth:`done_next`)."""
+        """The split of a completed activity (see :meth:`done_next`; also taken from
+        :meth:`~opspec.engine.activities.Activities.start`'s loop)."""
         acts = frame.graph.activities
         nxt = act.next
         if nxt >= 0:
@@ -526,16 +538,22 @@ class Flow(Part):
 
     def set_field(self, inst: ProcessInstance, act: CompiledActivity | None, target: str,
              value: Any) -> None:
-        if target in inst.data or target not in self.state.package_data:
+        state = self.state
+        if target in inst.data or target not in state.package_data:
             inst.data[target] = value
         else:
-            self.state.package_data[target] = value
-        if (self.state.act_bits(act) & 8 if act is not None
-                else self.state.wants_all or (EK.DATA_CHANGED, inst.process.id, None) in self.state.wanted):
-            self.state.emit(EK.DATA_CHANGED, inst.process.id, inst.id,
-                      act.id if act is not None else None, inst.process.lane, None,
-                      {target: value})
-        if self.state.rules:
+            state.package_data[target] = value
+        if act is None:
+            wanted = state.wants_all or (EK.DATA_CHANGED, inst.process.id, None) in state.wanted
+        else:
+            cached = act.flag_cache           # RunState.act_bits's cached case, in line
+            wanted = ((cached.bits if cached is not None and cached.key is state.flag_key
+                       else state.act_bits(act)) & 8) != 0
+        if wanted:
+            state.emit(EK.DATA_CHANGED, inst.process.id, inst.id,
+                       act.id if act is not None else None, inst.process.lane, None,
+                       {target: value})
+        if state.rules:
             self.triggers.check_rules()
 
     def assign(self, inst: ProcessInstance, act: CompiledActivity,

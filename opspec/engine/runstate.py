@@ -238,20 +238,25 @@ class RunState(Timers):
             if steps > limit:
                 steps = self._past_limit(steps, None, None)
             while True:
-                while done < len(ready):
-                    fn, a, b, c = ready[done]
+                # A list's iterator sees the items appended while it runs (from source, one
+                # FOR_ITER per item instead of a len() call and an index); it starts at the
+                # front, so what has run is dropped before it starts again.
+                for fn, a, b, c in ready:
                     done += 1
                     steps += 1
                     if steps > limit:
                         steps = self._past_limit(steps, a, b)
                     fn(a, b, c)
                     if done >= _COMPACT:        # a long burst: drop what has run
-                        del ready[:done]
-                        done = 0
+                        break
+                del ready[:done]
+                done = 0
+                if ready:                       # the burst broke off: go on with the rest
+                    continue
                 if not self.pending:
                     break
                 self.flow.resolve_frames()
-                if done >= len(ready):
+                if not ready:
                     break
         finally:
             del ready[:done]
