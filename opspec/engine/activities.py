@@ -357,7 +357,10 @@ class Activities(Part):
         if ai.mi is not None:
             multi_instance.done(self, ai, ai.mi)
             return
-        self.flow.finish(frame, ai.act)
+        # Flow.finish's two steps, here (the completion of every activity instance)
+        nxt = self.flow.done_next(frame, ai.act)
+        if nxt is not None:
+            self.start(frame, nxt)
 
     def _inputs(self, ai: ActivityInstance) -> dict[str, Any] | None:
         reads = ai.scope()
