@@ -458,6 +458,9 @@ class Flow(Part):
                     for target_name, fn in trans.assignments:
                         self.set_field(inst, None, target_name, fn(scope, now))
                 return target
+        elif not act.out and not act.otherwise and not act.choice and not act.drawn:
+            self.token_gone(frame)          # an end: _leave's last step, without its call
+            return None
         else:
             self._leave(frame, act)
             return None
