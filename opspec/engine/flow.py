@@ -60,36 +60,39 @@ class Flow(Part):
                       start: int = -1) -> ProcessInstance:
         """Create and start an instance of ``proc``: its start activities are queued, or
         only ``start`` when one of several triggered start events started it."""
+        state = self.state
         local = proc.data.copy()
         if data:
             local.update(data)
         scope: MutableMapping[str, Any] = (
-            _CHAIN(local, self.state.package_data) if self.state.package_data else local)
-        iid = self.state.next_id()
+            _CHAIN(local, state.package_data) if state.package_data else local)
+        iid = state.next_id()
         priority = proc.priority
         root = iid
         if parent is not None:
-            root = parent.frame.inst.root
-            priority = max(priority, parent.frame.inst.priority)
-        inst = ProcessInstance(iid, proc, local, scope, priority, parent, root, self.state.now)
+            caller = parent.frame.inst
+            root = caller.root
+            if caller.priority > priority:      # max(), without its call from source
+                priority = caller.priority
+        inst = ProcessInstance(iid, proc, local, scope, priority, parent, root, state.now)
         inst.state = RUNNING
         inst.trigger = trigger
         if parent is not None:
             inst.depth = parent.frame.inst.depth + 1
             inst.partner = parent.frame.inst.partner
-        self.state.live[iid] = inst
-        self.state.started += 1
+        state.live[iid] = inst
+        state.started += 1
         cached = proc.flag_cache              # RunState.proc_bits's cached case, in line
-        if (cached.bits if cached is not None and cached.key is self.state.flag_key
-                else self.state.proc_bits(proc)) & 1:
-            self.state.emit(EK.PROCESS_STARTED, proc.id, iid, None, proc.lane, None,
-                      {"trigger": trigger, "parent": parent.frame.inst.id if parent else None})
+        if (cached.bits if cached is not None and cached.key is state.flag_key
+                else state.proc_bits(proc)) & 1:
+            state.emit(EK.PROCESS_STARTED, proc.id, iid, None, proc.lane, None,
+                       {"trigger": trigger, "parent": parent.frame.inst.id if parent else None})
         frame = Frame(proc.graph, inst, None)
         inst.frames.append(frame)
-        self.state.start_counted(frame)
+        state.start_counted(frame)
         if start >= 0:
             frame.live += 1
-            self.state.ready.append((self.start_at_q, frame, start, None))
+            state.ready.append((self.start_at_q, frame, start, None))
         else:
             starts = proc.graph.starts
             if proc.start_events:
@@ -98,9 +101,9 @@ class Flow(Part):
                 starts = proc.called_starts or starts
             for index in starts:
                 frame.live += 1
-                self.state.ready.append((self.start_at_q, frame, index, None))
+                state.ready.append((self.start_at_q, frame, index, None))
             if not starts:
-                self.state.pending[frame] = None
+                state.pending[frame] = None
         if proc.deadline is not None:
             self._arm_deadline(inst, proc.deadline)
         return inst
@@ -397,7 +400,9 @@ class Flow(Part):
             return None
         if act.kind == K_THROW and act.trigger is not None:
             self.triggers.broadcast(act.trigger.kind, act.trigger.name or "", None, inst, act)
-        if self.state.act_bits(act) & 2:
+        cached = act.flag_cache               # RunState.act_bits's cached case, in line
+        if (cached.bits if cached is not None and cached.key is self.state.flag_key
+                else self.state.act_bits(act)) & 2:
             self.state.emit(EK.ACTIVITY_COMPLETED, act.process, inst.id, act.id, act.lane,
                       act.participant)
         if act.raises is not None and inst.state == RUNNING:
