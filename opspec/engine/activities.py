@@ -96,8 +96,7 @@ class Activities(Part):
             # RunState.act_bits, its cached case read here: this loop is the path of every
             # instantaneous activity, and from source each call is a Python frame
             cached = act.flag_cache
-            bits = (cached.bits if cached is not None and cached.key is state.flag_key
-                    else state.act_bits(act))
+            bits = (cached.bits if cached.key is state.flag_key else state.act_bits(act))
             if bits & 1:
                 state.emit(EK.ACTIVITY_STARTED, act.process, inst.id, act.id, act.lane,
                            act.participant)
@@ -142,8 +141,7 @@ class Activities(Part):
         if act.plain and not (act.general and self.state.pooled):
             inst = frame.inst
             cached = act.flag_cache           # RunState.act_bits's cached case, in line
-            if (cached.bits if cached is not None and cached.key is self.state.flag_key
-                    else self.state.act_bits(act)) & 1:
+            if (cached.bits if cached.key is self.state.flag_key else self.state.act_bits(act)) & 1:
                 self.state.emit(EK.ACTIVITY_STARTED, act.process, inst.id, act.id, act.lane,
                           act.participant)
             if act.start_assign and not self.flow.assign(inst, act, act.start_assign):

@@ -70,10 +70,8 @@ class Flow(Part):
         priority = proc.priority
         root = iid
         if parent is not None:
-            caller = parent.frame.inst
-            root = caller.root
-            if caller.priority > priority:      # max(), without its call from source
-                priority = caller.priority
+            root = parent.frame.inst.root
+            priority = max(priority, parent.frame.inst.priority)
         inst = ProcessInstance(iid, proc, local, scope, priority, parent, root, state.now)
         inst.state = RUNNING
         inst.trigger = trigger
@@ -83,8 +81,7 @@ class Flow(Part):
         state.live[iid] = inst
         state.started += 1
         cached = proc.flag_cache              # RunState.proc_bits's cached case, in line
-        if (cached.bits if cached is not None and cached.key is state.flag_key
-                else state.proc_bits(proc)) & 1:
+        if (cached.bits if cached.key is state.flag_key else state.proc_bits(proc)) & 1:
             state.emit(EK.PROCESS_STARTED, proc.id, iid, None, proc.lane, None,
                        {"trigger": trigger, "parent": parent.frame.inst.id if parent else None})
         frame = Frame(proc.graph, inst, None)
@@ -137,16 +134,13 @@ class Flow(Part):
         inst.state = _COMPLETED_FROM_RUNNING
         inst.frames.clear()          # breaks the instance <-> frame cycle: freed by refcount
         state = self.state
-        live = state.live                   # RunState.gone, in line
-        if inst.id in live:
-            del live[inst.id]
+        state.gone(inst.id)
         if state.kept and inst.parent is None:
             self.triggers.drop_kept(inst)
         state.completed += 1
         proc = inst.process
         cached = proc.flag_cache              # RunState.proc_bits's cached case, in line
-        if (cached.bits if cached is not None and cached.key is state.flag_key
-                else state.proc_bits(proc)) & 2:
+        if (cached.bits if cached.key is state.flag_key else state.proc_bits(proc)) & 2:
             self.state.emit(EK.PROCESS_COMPLETED, proc.id, inst.id, None, proc.lane, None,
                       {"duration": self.state.now - inst.started_at})
         parent = inst.parent
@@ -383,10 +377,8 @@ class Flow(Part):
         inst = frame.inst
         if act.simple_end:
             state = self.state
-            # RunState.act_bits's cached case, in line (from source a call is a Python frame)
-            cached = act.flag_cache
-            if (cached.bits if cached is not None and cached.key is state.flag_key
-                    else state.act_bits(act)) & 2:
+            cached = act.flag_cache           # RunState.act_bits's cached case, in line
+            if (cached.bits if cached.key is state.flag_key else state.act_bits(act)) & 2:
                 state.emit(EK.ACTIVITY_COMPLETED, act.process, inst.id, act.id, act.lane,
                            act.participant)
             nxt = act.next
@@ -401,8 +393,7 @@ class Flow(Part):
         if act.kind == K_THROW and act.trigger is not None:
             self.triggers.broadcast(act.trigger.kind, act.trigger.name or "", None, inst, act)
         cached = act.flag_cache               # RunState.act_bits's cached case, in line
-        if (cached.bits if cached is not None and cached.key is self.state.flag_key
-                else self.state.act_bits(act)) & 2:
+        if (cached.bits if cached.key is self.state.flag_key else self.state.act_bits(act)) & 2:
             self.state.emit(EK.ACTIVITY_COMPLETED, act.process, inst.id, act.id, act.lane,
                       act.participant)
         if act.raises is not None and inst.state == RUNNING:
@@ -428,8 +419,7 @@ class Flow(Part):
 
     def split(self, frame: Frame, act: CompiledActivity, inst: ProcessInstance
                ) -> CompiledActivity | None:
-        """The split of a completed activity (see :meth:`done_next`; also taken from
-        :meth:`~opspec.engine.activities.Activities.start`'s loop)."""
+        """The split of a completed activity (see :meth:`done_next`; Activities.start too)."""
         acts = frame.graph.activities
         nxt = act.next
         if nxt >= 0:
@@ -555,7 +545,7 @@ class Flow(Part):
             wanted = state.wants_all or (EK.DATA_CHANGED, inst.process.id, None) in state.wanted
         else:
             cached = act.flag_cache           # RunState.act_bits's cached case, in line
-            wanted = ((cached.bits if cached is not None and cached.key is state.flag_key
+            wanted = ((cached.bits if cached.key is state.flag_key
                        else state.act_bits(act)) & 8) != 0
         if wanted:
             state.emit(EK.DATA_CHANGED, inst.process.id, inst.id,

@@ -74,8 +74,7 @@ class Offers(Part):
         ai.waiting = "performer"
         self.state.offered[ai.key] = ai
         cached = act.flag_cache               # RunState.act_bits's cached case, in line
-        if (cached.bits if cached is not None and cached.key is self.state.flag_key
-                else self.state.act_bits(act)) & 4:
+        if (cached.bits if cached.key is self.state.flag_key else self.state.act_bits(act)) & 4:
             self.state.emit(EK.ACTIVITY_OFFERED, act.process, inst.id, act.id, act.lane,
                       act.participant, {"choices": list(choices)} if choices else None)
         performer.offer(item)

@@ -165,7 +165,7 @@ class RunState(Timers):
         """Which of ``_ACT_KINDS`` some listener wants of ``act``, as bits (computed once per
         listener selection and kept on the activity)."""
         cached = act.flag_cache
-        if cached is not None and cached.key is self.flag_key:
+        if cached.key is self.flag_key:
             return cached.bits
         bits = self._bits(_ACT_KINDS, act.process, act.id)
         act.flag_cache = FlagCache(self.flag_key, bits)
@@ -174,7 +174,7 @@ class RunState(Timers):
     def proc_bits(self, proc: CompiledProcess) -> int:
         """Which of ``_PROC_KINDS`` some listener wants of ``proc``, as bits."""
         cached = proc.flag_cache
-        if cached is not None and cached.key is self.flag_key:
+        if cached.key is self.flag_key:
             return cached.bits
         bits = self._bits(_PROC_KINDS, proc.id, None)
         proc.flag_cache = FlagCache(self.flag_key, bits)
