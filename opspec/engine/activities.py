@@ -147,7 +147,8 @@ class Activities(Part):
             if act.start_assign and not self.flow.assign(inst, act, act.start_assign):
                 return
             if act.kind == K_MANUAL and not act.params:
-                performer = self.offers.performer_for(act)
+                known = self.state.performers_of     # Offers.performer_for's cached case
+                performer = known[act] if act in known else self.offers.performer_for(act)
                 if performer is not None:
                     self.offers.offer(ai, performer, (), None, None)
                     return

@@ -96,7 +96,8 @@ class _Session:
     @property
     def now(self) -> float:
         sim = self._sim
-        sim.sync()
+        if not sim.inside:          # (inside the run's own callback the clock is read already)
+            sim.sync()
         return sim.now
 
     def complete(self, item: WorkItem, data: Mapping[str, Any] | None = None,
@@ -104,7 +105,8 @@ class _Session:
         # Interpreter.performer_complete's two steps, here: a performer's answer is on the
         # path of every work item (from source, each call level is a Python frame)
         sim = self._sim
-        sim.sync()
+        if not sim.inside:
+            sim.sync()
         sim.offers.performer_complete(item, data, choice)
 
     def omit(self, item: WorkItem, reason: str = "") -> None:
