@@ -93,11 +93,10 @@ class MetricsListener:
         """The same as calling with a TraceEvent, without building one (the engine uses
         this when no other listener needs the event object)."""
         key = (kind, process, activity)
-        matching = self._matching
-        if key in matching:
-            chosen = matching[key]
-        else:
-            chosen = matching[key] = self._match(kind, process, activity)
+        try:                        # (one lookup, so the key tuple is hashed once)
+            chosen = self._matching[key]
+        except KeyError:
+            chosen = self._matching[key] = self._match(kind, process, activity)
         for name, role, last in chosen:
             if role == _COUNT:
                 self.counts[name] += 1

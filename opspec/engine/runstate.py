@@ -259,7 +259,8 @@ class RunState(Timers):
                 if not ready:
                     break
         finally:
-            del ready[:done]
+            if done:                            # what ran before an exception
+                del ready[:done]
             self.draining = False
             self.instant_steps = steps
 
