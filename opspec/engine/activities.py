@@ -78,10 +78,12 @@ class Activities(Part):
         """Start ``act``. Instantaneous activities run here, in a loop that carries the
         token straight on to the next activity (no queue round trip) as long as the next
         one has no AND/OR join to synchronise at."""
-        pooled = self.state.pooled
-        apps = self.state.apps
+        state = self.state
+        pooled = state.pooled
+        apps = state.apps
         steps = 0
-        limit = self.state.start_limit
+        limit = state.start_limit
+        flow = self.flow
         while act is not None:
             if not act.fast or (act.general and pooled) or (
                     act.kind == K_TASK and act.application in apps):
@@ -90,19 +92,37 @@ class Activities(Part):
             inst = frame.inst
             steps += 1
             if steps > limit:                   # a zero-time cycle (see RunState.drain)
-                self.state.zero_time(frame, act)
-            if self.state.act_bits(act) & 1:
-                self.state.emit(EK.ACTIVITY_STARTED, act.process, inst.id, act.id, act.lane,
-                          act.participant)
-            if act.start_assign and not self.flow.assign(inst, act, act.start_assign):
+                state.zero_time(frame, act)
+            # RunState.act_bits, its cached case read here: this loop is the path of every
+            # instantaneous activity, and from source each call is a Python frame
+            cached = act.flag_cache
+            bits = (cached.bits if cached.key is state.flag_key else state.act_bits(act))
+            if bits & 1:
+                state.emit(EK.ACTIVITY_STARTED, act.process, inst.id, act.id, act.lane,
+                           act.participant)
+            if act.simple_end and not act.start_assign and act.kind != K_ASYNC:
+                # Flow.done_next's first case, in line: a straight run of instantaneous
+                # activities (route, event, no-op) is this one loop, one pass per activity
+                if bits & 2:
+                    state.emit(EK.ACTIVITY_COMPLETED, act.process, inst.id, act.id, act.lane,
+                               act.participant)
+                nxt = act.next
+                if nxt >= 0:
+                    target = frame.graph.activities[nxt]
+                    if not target.join:
+                        act = target
+                        continue
+                act = flow.split(frame, act, inst)
+                continue
+            if act.start_assign and not flow.assign(inst, act, act.start_assign):
                 return
             if act.kind == K_ASYNC:
                 data = self._params_in(inst, act)
                 if data is None:
                     return
-                self.flow.start_process(self.state.processes[act.subflow],  # type: ignore[index]
+                flow.start_process(state.processes[act.subflow],  # type: ignore[index]
                                    data, trigger=f"subflow:{act.id}")
-            act = self.flow.done_next(frame, act)
+            act = flow.done_next(frame, act)
 
     def _params_in(self, inst: ProcessInstance, act: CompiledActivity
                    ) -> dict[str, Any] | None:
@@ -120,13 +140,15 @@ class Activities(Part):
         frame.running[ai.key] = ai
         if act.plain and not (act.general and self.state.pooled):
             inst = frame.inst
-            if self.state.act_bits(act) & 1:
+            cached = act.flag_cache           # RunState.act_bits's cached case, in line
+            if (cached.bits if cached.key is self.state.flag_key else self.state.act_bits(act)) & 1:
                 self.state.emit(EK.ACTIVITY_STARTED, act.process, inst.id, act.id, act.lane,
                           act.participant)
             if act.start_assign and not self.flow.assign(inst, act, act.start_assign):
                 return
             if act.kind == K_MANUAL and not act.params:
-                performer = self.offers.performer_for(act)
+                known = self.state.performers_of     # Offers.performer_for's cached case
+                performer = known[act] if act in known else self.offers.performer_for(act)
                 if performer is not None:
                     self.offers.offer(ai, performer, (), None, None)
                     return
@@ -334,7 +356,10 @@ class Activities(Part):
         if ai.mi is not None:
             multi_instance.done(self, ai, ai.mi)
             return
-        self.flow.finish(frame, ai.act)
+        # Flow.finish's two steps, here (the completion of every activity instance)
+        nxt = self.flow.done_next(frame, ai.act)
+        if nxt is not None:
+            self.start(frame, nxt)
 
     def _inputs(self, ai: ActivityInstance) -> dict[str, Any] | None:
         reads = ai.scope()

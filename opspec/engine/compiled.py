@@ -157,6 +157,11 @@ class FlagCache:
         self.bits = bits
 
 
+#: what an activity or process holds before any run asked: of no selection (never ``None``,
+#: so the hot path reads ``flag_cache.key`` without a test first)
+NO_FLAGS: Final = FlagCache(object(), 0)
+
+
 @dataclass(slots=True, eq=False)
 class CompiledActivity:
     """One activity of a graph, ready to run. Not mutated after compilation."""
@@ -229,7 +234,7 @@ class CompiledActivity:
     simple_end: bool = False                 # completes with no assignment/throw/raise/terminate
     # which trace kinds the run's listeners want of it, as bits, with the selection they were
     # computed for (RunState.act_bits): one attribute read on the hot path, not a lookup
-    flag_cache: FlagCache | None = None
+    flag_cache: FlagCache = NO_FLAGS
 
     def where(self) -> str:
         return str(self.location) if self.location is not None else "<built in Python>"
@@ -273,7 +278,7 @@ class CompiledProcess:
     # none start events; BPMN 2.0 §13.3.4: the triggered ones "are ignored when the Process
     # is called from another Process")
     called_starts: tuple[int, ...] = ()
-    flag_cache: FlagCache | None = None    # as CompiledActivity.flag_cache
+    flag_cache: FlagCache = NO_FLAGS       # as CompiledActivity.flag_cache
 
 
 @dataclass(slots=True, eq=False)

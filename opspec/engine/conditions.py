@@ -187,6 +187,11 @@ def compile_expression(
     their parent's closure, and same-type comparisons take a fast path. ``now`` is the
     simulated time the time helpers read.
     """
+    if isinstance(expr, Literal):
+        # a constant cannot fail: no wrapper (an assignment of a constant is common, and
+        # from source each closure level is a Python call)
+        value = expr.value
+        return lambda data, now: value
     try:
         inner = _compile(expr)
     except ConditionProblem as problem:

@@ -60,34 +60,36 @@ class Flow(Part):
                       start: int = -1) -> ProcessInstance:
         """Create and start an instance of ``proc``: its start activities are queued, or
         only ``start`` when one of several triggered start events started it."""
+        state = self.state
         local = proc.data.copy()
         if data:
             local.update(data)
         scope: MutableMapping[str, Any] = (
-            _CHAIN(local, self.state.package_data) if self.state.package_data else local)
-        iid = self.state.next_id()
+            _CHAIN(local, state.package_data) if state.package_data else local)
+        iid = state.next_id()
         priority = proc.priority
         root = iid
         if parent is not None:
             root = parent.frame.inst.root
             priority = max(priority, parent.frame.inst.priority)
-        inst = ProcessInstance(iid, proc, local, scope, priority, parent, root, self.state.now)
+        inst = ProcessInstance(iid, proc, local, scope, priority, parent, root, state.now)
         inst.state = RUNNING
         inst.trigger = trigger
         if parent is not None:
             inst.depth = parent.frame.inst.depth + 1
             inst.partner = parent.frame.inst.partner
-        self.state.live[iid] = inst
-        self.state.started += 1
-        if self.state.proc_bits(proc) & 1:
-            self.state.emit(EK.PROCESS_STARTED, proc.id, iid, None, proc.lane, None,
-                      {"trigger": trigger, "parent": parent.frame.inst.id if parent else None})
+        state.live[iid] = inst
+        state.started += 1
+        cached = proc.flag_cache              # RunState.proc_bits's cached case, in line
+        if (cached.bits if cached.key is state.flag_key else state.proc_bits(proc)) & 1:
+            state.emit(EK.PROCESS_STARTED, proc.id, iid, None, proc.lane, None,
+                       {"trigger": trigger, "parent": parent.frame.inst.id if parent else None})
         frame = Frame(proc.graph, inst, None)
         inst.frames.append(frame)
-        self.state.start_counted(frame)
+        state.start_counted(frame)
         if start >= 0:
             frame.live += 1
-            self.state.ready.append((self.start_at_q, frame, start, None))
+            state.ready.append((self.start_at_q, frame, start, None))
         else:
             starts = proc.graph.starts
             if proc.start_events:
@@ -96,9 +98,9 @@ class Flow(Part):
                 starts = proc.called_starts or starts
             for index in starts:
                 frame.live += 1
-                self.state.ready.append((self.start_at_q, frame, index, None))
+                state.ready.append((self.start_at_q, frame, index, None))
             if not starts:
-                self.state.pending[frame] = None
+                state.pending[frame] = None
         if proc.deadline is not None:
             self._arm_deadline(inst, proc.deadline)
         return inst
@@ -131,12 +133,14 @@ class Flow(Part):
             return
         inst.state = _COMPLETED_FROM_RUNNING
         inst.frames.clear()          # breaks the instance <-> frame cycle: freed by refcount
-        self.state.gone(inst.id)
-        if self.state.kept and inst.parent is None:
+        state = self.state
+        state.gone(inst.id)
+        if state.kept and inst.parent is None:
             self.triggers.drop_kept(inst)
-        self.state.completed += 1
+        state.completed += 1
         proc = inst.process
-        if self.state.proc_bits(proc) & 2:
+        cached = proc.flag_cache              # RunState.proc_bits's cached case, in line
+        if (cached.bits if cached.key is state.flag_key else state.proc_bits(proc)) & 2:
             self.state.emit(EK.PROCESS_COMPLETED, proc.id, inst.id, None, proc.lane, None,
                       {"duration": self.state.now - inst.started_at})
         parent = inst.parent
@@ -372,21 +376,24 @@ class Flow(Part):
         """
         inst = frame.inst
         if act.simple_end:
-            if self.state.act_bits(act) & 2:
-                self.state.emit(EK.ACTIVITY_COMPLETED, act.process, inst.id, act.id, act.lane,
-                          act.participant)
+            state = self.state
+            cached = act.flag_cache           # RunState.act_bits's cached case, in line
+            if (cached.bits if cached.key is state.flag_key else state.act_bits(act)) & 2:
+                state.emit(EK.ACTIVITY_COMPLETED, act.process, inst.id, act.id, act.lane,
+                           act.participant)
             nxt = act.next
             if nxt >= 0:
                 target = frame.graph.activities[nxt]
                 if not target.join:
                     return target
-            return self._split(frame, act, inst)
+            return self.split(frame, act, inst)
         if act.end_assign and act.loop is None and assigns and not self.assign(
                 inst, act, act.end_assign, inst.scope if local is None else ChainMap(local, inst.scope)):
             return None
         if act.kind == K_THROW and act.trigger is not None:
             self.triggers.broadcast(act.trigger.kind, act.trigger.name or "", None, inst, act)
-        if self.state.act_bits(act) & 2:
+        cached = act.flag_cache               # RunState.act_bits's cached case, in line
+        if (cached.bits if cached.key is self.state.flag_key else self.state.act_bits(act)) & 2:
             self.state.emit(EK.ACTIVITY_COMPLETED, act.process, inst.id, act.id, act.lane,
                       act.participant)
         if act.raises is not None and inst.state == RUNNING:
@@ -408,11 +415,11 @@ class Flow(Part):
             return None
         if inst.state != RUNNING:
             return None
-        return self._split(frame, act, inst)
+        return self.split(frame, act, inst)
 
-    def _split(self, frame: Frame, act: CompiledActivity, inst: ProcessInstance
+    def split(self, frame: Frame, act: CompiledActivity, inst: ProcessInstance
                ) -> CompiledActivity | None:
-        """The split of a completed activity (see :meth:`done_next`)."""
+        """The split of a completed activity (see :meth:`done_next`; Activities.start too)."""
         acts = frame.graph.activities
         nxt = act.next
         if nxt >= 0:
@@ -446,6 +453,9 @@ class Flow(Part):
                     for target_name, fn in trans.assignments:
                         self.set_field(inst, None, target_name, fn(scope, now))
                 return target
+        elif not act.out and not act.otherwise and not act.choice and not act.drawn:
+            self.token_gone(frame)          # an end: _leave's last step, without its call
+            return None
         else:
             self._leave(frame, act)
             return None
@@ -526,16 +536,22 @@ class Flow(Part):
 
     def set_field(self, inst: ProcessInstance, act: CompiledActivity | None, target: str,
              value: Any) -> None:
-        if target in inst.data or target not in self.state.package_data:
+        state = self.state
+        if target in inst.data or target not in state.package_data:
             inst.data[target] = value
         else:
-            self.state.package_data[target] = value
-        if (self.state.act_bits(act) & 8 if act is not None
-                else self.state.wants_all or (EK.DATA_CHANGED, inst.process.id, None) in self.state.wanted):
-            self.state.emit(EK.DATA_CHANGED, inst.process.id, inst.id,
-                      act.id if act is not None else None, inst.process.lane, None,
-                      {target: value})
-        if self.state.rules:
+            state.package_data[target] = value
+        if act is None:
+            wanted = state.wants_all or (EK.DATA_CHANGED, inst.process.id, None) in state.wanted
+        else:
+            cached = act.flag_cache           # RunState.act_bits's cached case, in line
+            wanted = ((cached.bits if cached.key is state.flag_key
+                       else state.act_bits(act)) & 8) != 0
+        if wanted:
+            state.emit(EK.DATA_CHANGED, inst.process.id, inst.id,
+                       act.id if act is not None else None, inst.process.lane, None,
+                       {target: value})
+        if state.rules:
             self.triggers.check_rules()
 
     def assign(self, inst: ProcessInstance, act: CompiledActivity,

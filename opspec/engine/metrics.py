@@ -61,6 +61,11 @@ class MetricsListener:
         # kind -> (metric name, role, process, activity, keep the last start): plain values,
         # not the model's selector objects, because ``raw`` runs for every matching event.
         self._by_kind: dict[str, list[tuple[str, int, str | None, str | None, bool]]] = {}
+        # (kind, process, activity) -> the (metric name, role, keep the last start) of the
+        # selectors it matches, in their order: found once per distinct event, so ``raw``
+        # does not test every selector of the kind at every event
+        self._matching: dict[tuple[str, str | None, str | None],
+                             tuple[tuple[str, int, bool], ...]] = {}
         selects: set[tuple[str, str | None, str | None]] = set()
         for metric in self.definitions:
             if metric.kind is MetricKind.COUNT and metric.select is not None:
@@ -87,29 +92,37 @@ class MetricsListener:
             activity: str | None, data: Mapping[str, Any] | None = None) -> None:
         """The same as calling with a TraceEvent, without building one (the engine uses
         this when no other listener needs the event object)."""
-        interested = self._by_kind.get(kind)
-        if not interested:
-            return
-        for name, role, want_process, want_activity, last in interested:
-            if not ((want_process is None or want_process == process)
-                    and (want_activity is None or want_activity == activity)):
-                continue
+        key = (kind, process, activity)
+        try:                        # (one lookup, so the key tuple is hashed once)
+            chosen = self._matching[key]
+        except KeyError:
+            chosen = self._matching[key] = self._match(kind, process, activity)
+        for name, role, last in chosen:
             if role == _COUNT:
                 self.counts[name] += 1
                 if self.keep_times:
                     self.count_times.setdefault(name, []).append(time)
                 continue
-            key = instance or 0
+            which = instance or 0
             pending = self._open[name]
             if role == _START:
-                if last or key not in pending:
-                    pending[key] = time
-            elif key in pending:
-                started = pending[key]
-                del pending[key]
+                if last or which not in pending:
+                    pending[which] = time
+            elif which in pending:
+                started = pending[which]
+                del pending[which]
                 self.samples[name].append(time - started)
                 if self.keep_times:
                     self.sample_times.setdefault(name, []).append(time)
+
+    def _match(self, kind: str, process: str | None, activity: str | None
+               ) -> tuple[tuple[str, int, bool], ...]:
+        """The selectors of ``kind`` an event of ``process`` / ``activity`` matches."""
+        return tuple((name, role, last)
+                     for name, role, want_process, want_activity, last
+                     in self._by_kind.get(kind, ())
+                     if (want_process is None or want_process == process)
+                     and (want_activity is None or want_activity == activity))
 
     def values(self) -> dict[str, dict[str, Any]]:
         """Every declared metric in the shared output shape."""

@@ -11,7 +11,7 @@ from __future__ import annotations
 from collections import ChainMap
 from collections.abc import Callable, Mapping
 from types import MappingProxyType
-from typing import TYPE_CHECKING, Any, Final, cast
+from typing import TYPE_CHECKING, Any, Final
 
 from opspec.engine.compiled import (
     K_CATCH,
@@ -36,7 +36,6 @@ if TYPE_CHECKING:
 
 # Final: a module static in the compiled engine, where a plain global is a dictionary lookup
 _PROXY: Final = MappingProxyType
-_UNKNOWN: Final = object()          # performers_of has no answer for the activity yet
 
 
 class Offers(Part):
@@ -49,15 +48,14 @@ class Offers(Part):
 
     def performer_for(self, act: CompiledActivity) -> Performer | None:
         known = self.state.performers_of
-        found = known.get(act, _UNKNOWN)
-        if found is not _UNKNOWN:
-            return cast("Performer | None", found)
-        else:
-            performer = self.state.registry.lookup(act.participant, act.lanes)
-            if performer is None and not act.user_lane:
-                performer = self.state.registry.default_device
-            self.state.performers_of[act] = performer
-            return performer
+        # ``in`` and an index, no ``cast``: from source a call each
+        if act in known:
+            return known[act]
+        performer = self.state.registry.lookup(act.participant, act.lanes)
+        if performer is None and not act.user_lane:
+            performer = self.state.registry.default_device
+        known[act] = performer
+        return performer
 
     def offer(self, ai: ActivityInstance, performer: Performer, choices: tuple[str, ...],
                data: Mapping[str, Any] | None, duration: float | None,
@@ -75,7 +73,8 @@ class Offers(Part):
         ai.performer = performer
         ai.waiting = "performer"
         self.state.offered[ai.key] = ai
-        if self.state.act_bits(act) & 4:
+        cached = act.flag_cache               # RunState.act_bits's cached case, in line
+        if (cached.bits if cached.key is self.state.flag_key else self.state.act_bits(act)) & 4:
             self.state.emit(EK.ACTIVITY_OFFERED, act.process, inst.id, act.id, act.lane,
                       act.participant, {"choices": list(choices)} if choices else None)
         performer.offer(item)

@@ -165,7 +165,7 @@ class RunState(Timers):
         """Which of ``_ACT_KINDS`` some listener wants of ``act``, as bits (computed once per
         listener selection and kept on the activity)."""
         cached = act.flag_cache
-        if cached is not None and cached.key is self.flag_key:
+        if cached.key is self.flag_key:
             return cached.bits
         bits = self._bits(_ACT_KINDS, act.process, act.id)
         act.flag_cache = FlagCache(self.flag_key, bits)
@@ -174,7 +174,7 @@ class RunState(Timers):
     def proc_bits(self, proc: CompiledProcess) -> int:
         """Which of ``_PROC_KINDS`` some listener wants of ``proc``, as bits."""
         cached = proc.flag_cache
-        if cached is not None and cached.key is self.flag_key:
+        if cached.key is self.flag_key:
             return cached.bits
         bits = self._bits(_PROC_KINDS, proc.id, None)
         proc.flag_cache = FlagCache(self.flag_key, bits)
@@ -238,23 +238,29 @@ class RunState(Timers):
             if steps > limit:
                 steps = self._past_limit(steps, None, None)
             while True:
-                while done < len(ready):
-                    fn, a, b, c = ready[done]
+                # A list's iterator sees the items appended while it runs (from source, one
+                # FOR_ITER per item instead of a len() call and an index); it starts at the
+                # front, so what has run is dropped before it starts again.
+                for fn, a, b, c in ready:
                     done += 1
                     steps += 1
                     if steps > limit:
                         steps = self._past_limit(steps, a, b)
                     fn(a, b, c)
                     if done >= _COMPACT:        # a long burst: drop what has run
-                        del ready[:done]
-                        done = 0
+                        break
+                del ready[:done]
+                done = 0
+                if ready:                       # the burst broke off: go on with the rest
+                    continue
                 if not self.pending:
                     break
                 self.flow.resolve_frames()
-                if done >= len(ready):
+                if not ready:
                     break
         finally:
-            del ready[:done]
+            if done:                            # what ran before an exception
+                del ready[:done]
             self.draining = False
             self.instant_steps = steps
 
@@ -362,7 +368,9 @@ class RunState(Timers):
         instances (a workflow starting itself asynchronously), stopped and named like any
         zero-time cycle, within seconds and some tens of megabytes."""
         now = self.now
-        if not _same_instant(now, self.starts_at):
+        # (``!=`` first: most instances start at the instant of the one before, and from
+        # source _same_instant is three calls)
+        if now != self.starts_at and not _same_instant(now, self.starts_at):
             self.starts_at = now
             self.instant_starts = 1
             return

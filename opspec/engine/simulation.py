@@ -96,12 +96,18 @@ class _Session:
     @property
     def now(self) -> float:
         sim = self._sim
-        sim.sync()
+        if not sim.inside:          # (inside the run's own callback the clock is read already)
+            sim.sync()
         return sim.now
 
     def complete(self, item: WorkItem, data: Mapping[str, Any] | None = None,
                  choice: str | None = None) -> None:
-        self._sim.performer_complete(item, data, choice)
+        # Interpreter.performer_complete's two steps, here: a performer's answer is on the
+        # path of every work item (from source, each call level is a Python frame)
+        sim = self._sim
+        if not sim.inside:
+            sim.sync()
+        sim.offers.performer_complete(item, data, choice)
 
     def omit(self, item: WorkItem, reason: str = "") -> None:
         self._sim.performer_omit(item, reason)
