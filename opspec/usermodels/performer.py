@@ -67,6 +67,12 @@ class StochasticUser:
         self._plans: dict[str, _Plan] = {}
         self._alternatives: dict[str, ActivityModel | None] = {}
         self._handover: dict[int, int] = {}      # lane -> key of its last completed item
+        #: per activity of the lane, ``[offered, completed, omitted, wrong]`` (``opspec
+        #: evaluate``'s activity rows): when set, this user adds its omissions (column 2)
+        #: and wrong actions (column 3: wrong choices and slips) to it as it decides them, so
+        #: that no listener has to select its ``user.*`` events for them
+        #: (:mod:`opspec.evaluation.replication`); None: not counted
+        self.tally: dict[str, list[int]] | None = None
         # the busy model's sets, read once (the model's frozen dataclasses are slow to read
         # from compiled code, and _finish reads them for every work item)
         busy = model.busy
@@ -144,6 +150,7 @@ class StochasticUser:
                 and float(self._random()) < slip.probability):
             recovery = slip.recovery.sample(self.rng)
             duration += recovery
+            self._count(item, 3)
             self._trace("user.slip", item, recovery=recovery)
 
         start = now
@@ -223,6 +230,7 @@ class StochasticUser:
                 pick = wrong[0] if len(wrong) == 1 else wrong[int(self.rng.integers(len(wrong)))]
                 self._wrong[key] = count + 1
                 self._recovery[key] = commission.recovery.sample(self.rng)
+                self._count(item, 3)
                 self._trace("user.wrong_choice", item, choice=pick, intended=intended)
                 return pick, owed
         if key in self._wrong:
@@ -263,6 +271,7 @@ class StochasticUser:
     def _omit(self, item: WorkItem, lane: int, reason: str) -> None:
         if reason != "busy":
             self._release(lane)
+        self._count(item, 2)
         self._trace("user.omitted", item, reason=reason)
         self._require_session().omit(item, reason)
 
@@ -272,6 +281,15 @@ class StochasticUser:
             del self._wrong[key]
         for key in [k for k in self._recovery if k[0] == lane]:
             del self._recovery[key]
+
+    def _count(self, item: WorkItem, column: int) -> None:
+        """Count a decision in :attr:`tally`, where its ``user.*`` event is traced (the
+        same activity: the one the event names in its data)."""
+        tally = self.tally
+        if tally is not None and self.trace_decisions:
+            row = tally.get(item.activity)
+            if row is not None:
+                row[column] += 1
 
     def _trace(self, kind: str, item: WorkItem, **data: Any) -> None:
         if self.trace_decisions and self._session is not None:
