@@ -99,57 +99,32 @@ class ActivityRecorder:
 
 
 class ActivityCounter:
-    """The :class:`ActivityRecorder`'s counts, made where it is cheapest: the offers and
-    completions by the engine's own compiled metrics listener (a count per activity and kind,
-    selected as a metric selects, ``(kind, any process, activity)``), the omissions and wrong
-    actions by the stochastic user who decides them (:attr:`StochasticUser.tally
-    <opspec.usermodels.performer.StochasticUser.tally>`), where the recorder counted the
-    ``user.*`` events that user traces.
+    """The :class:`ActivityRecorder`'s counts, made where they are cheapest: the offers and
+    completions by a compiled metrics listener (:class:`ActivityTally
+    <opspec.usermodels.performer.ActivityTally>`, selecting as the recorder does), the
+    omissions and wrong actions by the stochastic user who decides them
+    (:attr:`StochasticUser.tally <opspec.usermodels.performer.StochasticUser.tally>`), where
+    the recorder counted the ``user.*`` events that user traces.
 
     The numbers are the recorder's; the difference is what a run pays for them. With a raw
     listener in Python beside the metrics, the engine called every selected event's
-    listeners through Python's protocol (its metrics' too), and every user decision was
-    traced as an event: about 4.5 M instructions per user-month of the dispenser, a sixth of
-    a replication. With only metrics listeners the engine calls them as native methods, and a
-    decision nobody else selects is not traced at all. Used when the user lane's performer
-    is a stochastic user (or nobody); any other performer gets the recorder."""
+    listeners through Python's protocol (its metrics' too), and every decision of the user
+    was traced as an event: about 4.5 M instructions per user-month of the dispenser, a sixth
+    of a replication. With only metrics listeners the engine calls them as native methods,
+    and a decision nobody else selects is not traced at all. Used when the user lane's
+    performer is a stochastic user (or nobody); any other performer gets the recorder."""
 
     def __init__(self, manual: Sequence[str]) -> None:
-        from opspec.engine.metrics import MetricsListener
+        from opspec.usermodels.performer import ActivityTally
 
-        activities, definitions = _count_definitions(tuple(manual))
-        #: the rows, in ``manual``'s order; columns 2 and 3 filled by the stochastic user
-        self.counts: dict[str, list[int]] = {a: [0, 0, 0, 0] for a in activities}
-        self.listener = MetricsListener(definitions)
+        #: the listener the run is built with
+        self.listener = ActivityTally(tuple(dict.fromkeys(manual)))
+        #: the rows, in ``manual``'s order; the stochastic user's ``tally``
+        self.counts: dict[str, list[int]] = self.listener.rows
 
     def finish(self) -> dict[str, list[int]]:
-        """The rows, once the run ended: the listener's counts put into them (its metrics
-        are named ``offered N`` and ``completed N`` for the N-th activity)."""
-        counted = self.listener.counts
-        for n, row in enumerate(self.counts.values()):
-            row[0] = counted[f"offered {n}"]
-            row[1] = counted[f"completed {n}"]
+        """The rows, once the run ended."""
         return self.counts
-
-
-_DEFINITIONS: dict[tuple[str, ...], tuple[tuple[str, ...], tuple[Any, ...]]] = {}
-
-
-def _count_definitions(manual: tuple[str, ...]) -> tuple[tuple[str, ...], tuple[Any, ...]]:
-    """The activities (each once, in order) and the count metrics of their offers and
-    completions (made once per process and lane: a replication only counts)."""
-    found = _DEFINITIONS.get(manual)
-    if found is None:
-        from opspec.model.sisarl import EventSelector, MetricDefinition, MetricKind
-
-        activities = tuple(dict.fromkeys(manual))
-        found = _DEFINITIONS[manual] = (activities, tuple(
-            MetricDefinition(name=f"{column} {n}", kind=MetricKind.COUNT,
-                             select=EventSelector(event=f"activity.{column}",
-                                                  activity=activity))
-            for n, activity in enumerate(activities)
-            for column in ("offered", "completed")))
-    return found
 
 
 @dataclass(frozen=True)

@@ -34,6 +34,7 @@ from typing import Any
 
 import numpy as np
 
+from opspec.engine.metrics import MetricsListener
 from opspec.engine.performers import PerformerSession, WorkItem
 from opspec.errors import UserModelError
 from opspec.usermodels.errors import Busy
@@ -41,7 +42,7 @@ from opspec.usermodels.model import ActivityModel, UserModel
 from opspec.usermodels.parametric import Constant
 from opspec.usermodels.routine import RoutineTracker
 
-__all__ = ["StochasticUser"]
+__all__ = ["ActivityTally", "StochasticUser"]
 
 
 class StochasticUser:
@@ -352,3 +353,36 @@ class _Plan:
         self.duration = model.duration
         self.probabilities = model.probabilities
         self.intended = model.intended
+
+
+class ActivityTally(MetricsListener):
+    """Counts, per activity of the user lane, the offers and completions the engine traces
+    (``activity.offered`` / ``activity.completed`` of that activity, in any process) into
+    :attr:`rows` (``[offered, completed, omitted, wrong]``; a :class:`StochasticUser` given
+    the same rows as its ``tally`` fills the last two as it decides).
+
+    ``opspec evaluate``'s activity table (:mod:`opspec.evaluation.replication`). A metrics
+    listener, so that the compiled engine calls it as a native method, as it calls a run's
+    own metrics, where a listener in Python made it call every selected event's listeners
+    through Python's protocol; and one dictionary look-up per event where a count metric per
+    activity and kind compared the event with each of them."""
+
+    def __init__(self, activities: tuple[str, ...]) -> None:
+        super().__init__(())
+        self.rows: dict[str, list[int]] = {a: [0, 0, 0, 0] for a in activities}
+        self.selects = frozenset((kind, None, a) for a in activities
+                                 for kind in ("activity.offered", "activity.completed"))
+
+    def raw(self, time: float, kind: str, process: str | None, instance: int | None,
+            activity: str | None, data: Mapping[str, Any] | None = None) -> None:
+        # (the engine sends every event some listener selects: the kind is checked here)
+        if kind == "activity.offered":
+            column = 0
+        elif kind == "activity.completed":
+            column = 1
+        else:
+            return
+        if activity is not None:
+            row = self.rows.get(activity)
+            if row is not None:
+                row[column] += 1

@@ -85,3 +85,19 @@ def test_a_performer_that_does_not_tally_gets_the_recorder(monkeypatch):
     assert counters, "the counter was tried first"
     assert record.activities == expected
     assert sum(row[2] + row[3] for row in expected.values()) > 0
+
+
+def test_the_tally_counts_only_offers_and_completions_of_its_activities():
+    """The engine sends a metrics listener every event any listener selects (a metric may
+    select ``activity.started`` of the same activity, or offers of another one)."""
+    from opspec.usermodels.performer import ActivityTally
+
+    tally = ActivityTally(("take_pill", "walk"))
+    assert ("activity.offered", None, "take_pill") in tally.selects
+    tally.raw(1.0, "activity.started", "user", 1, "take_pill")
+    tally.raw(2.0, "activity.offered", "user", 1, "take_pill")
+    tally.raw(3.0, "activity.completed", "user", 1, "take_pill")
+    tally.raw(4.0, "activity.offered", "device", 2, "notify")
+    tally.raw(5.0, "user.omitted", "user", 1, None, {"activity": "walk"})
+    tally.raw(6.0, "activity.completed", "user", 1, "walk")
+    assert tally.rows == {"take_pill": [1, 1, 0, 0], "walk": [0, 1, 0, 0]}
