@@ -549,6 +549,11 @@ def run(args: argparse.Namespace) -> int:
 
             print_sweep(sys.stdout, summaries["sweep"], plan.users)
         print(f"results: {store.path}\nreport: {report}")
+    from opspec.evaluation.memory import release_free_memory
+
+    # what the run left to the collector and the allocator grows with the users: give it
+    # back, so that the process (a notebook's, a service's) holds after the run what it uses
+    release_free_memory()
     return 1 if failures else 0
 
 

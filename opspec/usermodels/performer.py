@@ -34,6 +34,7 @@ from typing import Any
 
 import numpy as np
 
+from opspec.engine.metrics import MetricsListener
 from opspec.engine.performers import PerformerSession, WorkItem
 from opspec.errors import UserModelError
 from opspec.usermodels.errors import Busy
@@ -41,7 +42,7 @@ from opspec.usermodels.model import ActivityModel, UserModel
 from opspec.usermodels.parametric import Constant
 from opspec.usermodels.routine import RoutineTracker
 
-__all__ = ["StochasticUser"]
+__all__ = ["ActivityTally", "StochasticUser"]
 
 
 class StochasticUser:
@@ -67,6 +68,12 @@ class StochasticUser:
         self._plans: dict[str, _Plan] = {}
         self._alternatives: dict[str, ActivityModel | None] = {}
         self._handover: dict[int, int] = {}      # lane -> key of its last completed item
+        #: per activity of the lane, ``[offered, completed, omitted, wrong]`` (``opspec
+        #: evaluate``'s activity rows): when set, this user adds its omissions (column 2)
+        #: and wrong actions (column 3: wrong choices and slips) to it as it decides them, so
+        #: that no listener has to select its ``user.*`` events for them
+        #: (:mod:`opspec.evaluation.replication`); None: not counted
+        self.tally: dict[str, list[int]] | None = None
         # the busy model's sets, read once (the model's frozen dataclasses are slow to read
         # from compiled code, and _finish reads them for every work item)
         busy = model.busy
@@ -144,6 +151,7 @@ class StochasticUser:
                 and float(self._random()) < slip.probability):
             recovery = slip.recovery.sample(self.rng)
             duration += recovery
+            self._count(item, 3)
             self._trace("user.slip", item, recovery=recovery)
 
         start = now
@@ -223,6 +231,7 @@ class StochasticUser:
                 pick = wrong[0] if len(wrong) == 1 else wrong[int(self.rng.integers(len(wrong)))]
                 self._wrong[key] = count + 1
                 self._recovery[key] = commission.recovery.sample(self.rng)
+                self._count(item, 3)
                 self._trace("user.wrong_choice", item, choice=pick, intended=intended)
                 return pick, owed
         if key in self._wrong:
@@ -263,6 +272,7 @@ class StochasticUser:
     def _omit(self, item: WorkItem, lane: int, reason: str) -> None:
         if reason != "busy":
             self._release(lane)
+        self._count(item, 2)
         self._trace("user.omitted", item, reason=reason)
         self._require_session().omit(item, reason)
 
@@ -272,6 +282,15 @@ class StochasticUser:
             del self._wrong[key]
         for key in [k for k in self._recovery if k[0] == lane]:
             del self._recovery[key]
+
+    def _count(self, item: WorkItem, column: int) -> None:
+        """Count a decision in :attr:`tally`, where its ``user.*`` event is traced (the
+        same activity: the one the event names in its data)."""
+        tally = self.tally
+        if tally is not None and self.trace_decisions:
+            row = tally.get(item.activity)
+            if row is not None:
+                row[column] += 1
 
     def _trace(self, kind: str, item: WorkItem, **data: Any) -> None:
         if self.trace_decisions and self._session is not None:
@@ -334,3 +353,36 @@ class _Plan:
         self.duration = model.duration
         self.probabilities = model.probabilities
         self.intended = model.intended
+
+
+class ActivityTally(MetricsListener):
+    """Counts, per activity of the user lane, the offers and completions the engine traces
+    (``activity.offered`` / ``activity.completed`` of that activity, in any process) into
+    :attr:`rows` (``[offered, completed, omitted, wrong]``; a :class:`StochasticUser` given
+    the same rows as its ``tally`` fills the last two as it decides).
+
+    ``opspec evaluate``'s activity table (:mod:`opspec.evaluation.replication`). A metrics
+    listener, so that the compiled engine calls it as a native method, as it calls a run's
+    own metrics, where a listener in Python made it call every selected event's listeners
+    through Python's protocol; and one dictionary look-up per event where a count metric per
+    activity and kind compared the event with each of them."""
+
+    def __init__(self, activities: tuple[str, ...]) -> None:
+        super().__init__(())
+        self.rows: dict[str, list[int]] = {a: [0, 0, 0, 0] for a in activities}
+        self.selects = frozenset((kind, None, a) for a in activities
+                                 for kind in ("activity.offered", "activity.completed"))
+
+    def raw(self, time: float, kind: str, process: str | None, instance: int | None,
+            activity: str | None, data: Mapping[str, Any] | None = None) -> None:
+        # (the engine sends every event some listener selects: the kind is checked here)
+        if kind == "activity.offered":
+            column = 0
+        elif kind == "activity.completed":
+            column = 1
+        else:
+            return
+        if activity is not None:
+            row = self.rows.get(activity)
+            if row is not None:
+                row[column] += 1
