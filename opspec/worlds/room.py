@@ -217,8 +217,13 @@ class RoomWorld(RobotWorld):
 
     # ------------------------------------------------------------------ devices
     def op_read_range(self, _data: Mapping[str, Any]) -> dict[str, Any]:
-        return {"distance": self._state.read_range(float(self.rng.normal(0.0,
-                                                                         self.range_noise)))}
+        sd = self.range_noise
+        # Generator.normal(0, sd) is 0.0 + sd * standard_normal() (numpy's random_normal:
+        # loc + scale * z), the same draw and the same float for half its call's cost; a
+        # negative (or NaN) sd still goes to normal, which refuses it as before
+        noise = (0.0 + sd * self.rng.standard_normal() if sd >= 0.0
+                 else float(self.rng.normal(0.0, sd)))
+        return {"distance": self._state.read_range(noise)}
 
     def op_read_bump(self, _data: Mapping[str, Any]) -> dict[str, Any]:
         return self._state.read_bump()

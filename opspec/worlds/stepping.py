@@ -16,7 +16,8 @@ from typing import Any, Final
 
 from opspec.worlds.robot import COMMANDS, pose_after
 
-__all__ = ["ARC", "COLLISION", "COVER", "DONE", "STEP_S", "RoomState", "cover", "distance_ahead"]
+__all__ = ["ARC", "COLLISION", "COVER", "DONE", "STEP_S", "RoomState", "cover", "distance_ahead",
+           "round4"]
 
 #: integration step: 5 cm at 1 m/s, well under the robot's size
 STEP_S: Final = 0.05
@@ -216,7 +217,7 @@ class RoomState:
         robot's edge to the nearest wall or obstacle face ahead, 0 at the least, to 0.1 mm."""
         best = distance_ahead(self.x, self.y, self.heading, self.boxes)
         distance = best - self.radius + noise
-        return round(distance if distance > 0.0 else 0.0, 4)     # max(0.0, distance)
+        return round4(distance if distance > 0.0 else 0.0)     # max(0.0, distance)
 
     def read_bump(self) -> dict[str, Any]:
         """The bumper: whether it was pressed since it was last read (and clear it)."""
@@ -278,3 +279,23 @@ def cover(cells: Cells, x: float, y: float, cell: float, reach: float,
             covered.add(c)
             new.append(c)
     return new, tuple([c for c in cells if c not in covered])
+
+
+def round4(x: float) -> float:
+    """``round(x, 4)``, the same float, without its decimal conversion for the usual case.
+
+    ``round`` gives the double nearest to the decimal ``n / 10**4``, ``n`` the integer nearest
+    to the exact ``x * 10**4`` (half to even); ``n / 10000.0`` is that double too (a
+    correctly rounded division of two exact numbers). ``y = x * 10000.0`` is within half an
+    ulp (under 1e-8 below 10 km) of the exact product, so ``n`` is the integer nearest to
+    ``y`` unless ``y`` is within 1e-6 of a half: those, zero and negative numbers
+    (``-0.0``), large and non-finite ones go to ``round`` itself."""
+    if not 0.0 < x < 1e4:
+        return round(x, 4)
+    y = x * 10000.0
+    whole = math.floor(y)
+    part = y - whole                      # exact: y and its floor are close doubles
+    if abs(part - 0.5) < 1e-6:
+        return round(x, 4)
+    n = whole + 1 if part > 0.5 else whole
+    return n / 10000.0
