@@ -58,6 +58,7 @@ MODULES: tuple[str, ...] = (
     "opspec.engine.triggers",
     "opspec.engine.workitem",
     "opspec.usermodels.performer",
+    "opspec.worlds.room_devices",
     "opspec.worlds.stepping",
 )
 STAMP = "_native_build.json"

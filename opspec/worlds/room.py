@@ -138,16 +138,17 @@ class RoomWorld(RobotWorld):
             self._announce()
         code = self._state.advance(now)
         if code != DONE:
-            self._stopped(code, now)
+            self.finish_advance(code, now)
 
     def _advance(self, now: float) -> None:
         code = self._state.advance(now)
         if code != DONE:
-            self._stopped(code, now)
+            self.finish_advance(code, now)
 
-    def _stopped(self, code: int, now: float) -> None:
-        """The steps the compiled loop hands back: cells to cover, a contact to trace, an
-        arc to step; then on to ``now``."""
+    def finish_advance(self, code: int, now: float) -> None:
+        """The steps the compiled loop (``RoomState.advance``, returning ``code``) hands
+        back: cells to cover, a contact to trace, an arc to step; then on to ``now``. Also
+        called by the compiled performer (:mod:`opspec.worlds.room_devices`)."""
         state = self._state
         while code != DONE:
             if code == ARC:
