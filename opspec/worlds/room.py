@@ -16,7 +16,7 @@ from typing import TYPE_CHECKING, Any
 
 from opspec.worlds.base import RobotWorld, World, check_parameters
 from opspec.worlds.geometry import Box, wrap_angle
-from opspec.worlds.stepping import ARC, COVER, DONE, RayBox, RoomState, cover
+from opspec.worlds.stepping import ARC, COVER, DONE, RayBox, RoomState
 
 if TYPE_CHECKING:   # annotations only: `opspec validate` loads no NumPy
     import numpy as np
@@ -91,7 +91,8 @@ class RoomWorld(RobotWorld):
         self._uncovered: dict[tuple[int, int, int, int], tuple[tuple[int, int], ...]] = {}
         # the room and the obstacles as op_read_range's ray meets them (ray_to_box_along)
         boxes = tuple(_ray_box(box) for box in (self.room, *self.obstacles))
-        self._state.place(inside, grown, self.radius, self.cell, boxes, self._uncovered)
+        self._state.place(inside, grown, self.radius, self.cell, boxes, self._uncovered,
+                          self.covered, self.cells_x, self.cells_y)
         self._cover()
 
     # the world's state, kept in the compiled RoomState
@@ -154,9 +155,9 @@ class RoomWorld(RobotWorld):
             if code == ARC:
                 World._advance(self, now)       # no command of the bundled specs
                 return
-            if code == COVER:
-                key = state.key
-                self._cover_within(key, self._uncovered.get(key))
+            if code == COVER:                   # covered (by the loop), to be traced
+                for cx, cy in state.new_cells:
+                    self.trace("world.covered", cell=[cx, cy])
             else:
                 self.collisions += 1
                 self.trace("world.collision", x=round(state.x, 3), y=round(state.y, 3))
@@ -191,21 +192,6 @@ class RoomWorld(RobotWorld):
                         cell / 2) ** 2 and (cx, cy) not in self.covered:
                     self.covered.add((cx, cy))
                     self.trace("world.covered", cell=[cx, cy])
-
-    def _cover_within(self, key: tuple[int, int, int, int],
-                      cells: tuple[tuple[int, int], ...] | None) -> None:
-        """:meth:`_cover` at the robot's position, whose loops' cell range is ``key``,
-        looking only at the range's ``cells`` not covered when last looked (all of them when
-        ``None``): the same cells, in the same order, are covered and traced."""
-        if cells is None:
-            cx0, cx1, cy0, cy1 = key
-            cells = tuple((cx, cy) for cx in range(max(cx0, 0), min(cx1 + 1, self.cells_x))
-                          for cy in range(max(cy0, 0), min(cy1 + 1, self.cells_y)))
-        robot = self.robot
-        new, self._uncovered[key] = cover(cells, robot.x, robot.y, self.cell, self.radius,
-                                          self.covered)
-        for cx, cy in new:
-            self.trace("world.covered", cell=[cx, cy])
 
     def _announce(self) -> None:
         for cx, cy in sorted(self.covered):

@@ -5,7 +5,7 @@ Plain float arithmetic over plain fields, so that the compiled build (``opspec._
 compiles it with the engine: the same IEEE operations in the same order as from source, so
 the same floats and the same traces either way (tests/engine/test_native_every_spec.py).
 The loop stops and hands back to :class:`~opspec.worlds.room.RoomWorld` at the few steps that
-need the world itself: one that may cover new cells (``COVER``) and the first step of a
+need the world itself: one that covers new cells (``COVER``) and the first step of a
 contact (``COLLISION``), both traced there; it is then run again to go on.
 """
 
@@ -23,7 +23,7 @@ __all__ = ["ARC", "COLLISION", "COVER", "DONE", "STEP_S", "RoomState", "cover", 
 STEP_S: Final = 0.05
 
 DONE: Final = 0          # reached the time asked for
-COVER: Final = 1         # moved to where cells of ``key`` may still be uncovered
+COVER: Final = 1         # this step covered new cells (``new_cells``), to be traced
 COLLISION: Final = 2     # a contact began at this step
 ARC: Final = 3           # a command that drives and turns at once: the room steps it
 
@@ -46,10 +46,11 @@ class RoomState:
 
     :meth:`advance` moves the world to a time: driving straight (or standing) step by step,
     turning on the spot, or ``ARC`` for the room to step through ``_step``. It stops at a
-    step that may cover new cells (``COVER``) or starts a contact (``COLLISION``), both
-    traced by the room; :meth:`resume` then goes on. During such a stop ``time`` is the
-    time at that step's start (the world's time while it is handled), ``key`` the cell range
-    of the robot's reach; ``t`` is the loop's time after the step. ``after`` is
+    step that covers new cells (``COVER``: the room's ``covered`` has them already,
+    ``new_cells`` lists them in the order the room traces them) or starts a contact
+    (``COLLISION``), both traced by the room; :meth:`resume` then goes on. During such a
+    stop ``time`` is the time at that step's start (the world's time while it is handled),
+    ``key`` the cell range of the robot's reach; ``t`` is the loop's time after the step. ``after`` is
     ``wrap_angle(heading)``, which the next step sets the heading to, and ``settled`` says
     it equals ``heading`` bit for bit (wrapping no longer changes it)."""
 
@@ -64,6 +65,10 @@ class RoomState:
         self.radius = 0.0
         self.boxes: tuple[RayBox, ...] = ()
         self.uncovered: dict[Key, Cells] = {}
+        self.covered: set[tuple[int, int]] = set()
+        self.cells_x = 0
+        self.cells_y = 0
+        self.new_cells: list[tuple[int, int]] = []
         self.time = 0.0
         self.x = 0.0
         self.y = 0.0
@@ -80,10 +85,12 @@ class RoomState:
 
     def place(self, inside: tuple[float, float, float, float],
               grown: list[tuple[float, float, float, float]], reach: float, cell: float,
-              boxes: tuple[RayBox, ...], uncovered: dict[Key, Cells]) -> None:
+              boxes: tuple[RayBox, ...], uncovered: dict[Key, Cells],
+              covered: set[tuple[int, int]], cells_x: int, cells_y: int) -> None:
         """The fixed geometry: the box the robot's centre may be in, each obstacle grown by
         the robot's radius (``reach``), the coverage cell, the range finder's boxes and the
-        room's cells not yet covered per cell range (ranges not in it not looked at yet)."""
+        room's cells not yet covered per cell range (ranges not in it not looked at yet),
+        the room's covered cells and its size in cells."""
         self.x_lo = inside[0]
         self.x_hi = inside[1]
         self.y_lo = inside[2]
@@ -94,6 +101,9 @@ class RoomState:
         self.cell = cell
         self.boxes = boxes
         self.uncovered = uncovered
+        self.covered = covered
+        self.cells_x = cells_x
+        self.cells_y = cells_y
 
     # the robot's interface (opspec.worlds.robot.Robot), for _step and the worlds' tests
     def velocity(self) -> tuple[float, float]:
@@ -190,8 +200,15 @@ class RoomState:
                        int((y - reach) // cell), int((y + reach) // cell))
                 cells = uncovered.get(key)
                 if cells is None or len(cells) > 0:
-                    self.key = key
-                    code = COVER
+                    # RoomWorld._cover at this step, over the range's cells still uncovered
+                    # (cells are only ever added, so the others cannot be covered again)
+                    if cells is None:
+                        cells = self._cells(key)
+                    new, uncovered[key] = cover(cells, x, y, cell, reach, self.covered)
+                    if new:
+                        self.key = key
+                        self.new_cells = new
+                        code = COVER
             else:
                 self.bumped = True
                 if not in_contact:
@@ -211,6 +228,15 @@ class RoomState:
         self.in_contact = in_contact
         self.time = t if code == DONE else t_step
         return code
+
+    def _cells(self, key: Key) -> Cells:
+        """The cells of the room in ``key``'s range, in ``RoomWorld._cover``'s order."""
+        cx0, cx1, cy0, cy1 = key
+        found: list[tuple[int, int]] = []
+        for cx in range(max(cx0, 0), min(cx1 + 1, self.cells_x)):
+            for cy in range(max(cy0, 0), min(cy1 + 1, self.cells_y)):
+                found.append((cx, cy))
+        return tuple(found)
 
     def read_range(self, noise: float) -> float:
         """The range finder's reading with this ``noise`` drawn: the distance from the
