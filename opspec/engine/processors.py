@@ -31,7 +31,6 @@ the fair ``--workers`` to compare the pooled model against).
 
 from __future__ import annotations
 
-import heapq
 from collections import deque
 from collections.abc import Callable
 from typing import TYPE_CHECKING, Any
