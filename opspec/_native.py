@@ -37,6 +37,7 @@ MODULES: tuple[str, ...] = (
     "opspec.engine.compiling.context",
     "opspec.engine.compiling.graphs",
     "opspec.engine.conditions",
+    "opspec.engine.dedicated",
     "opspec.engine.escalations",
     "opspec.engine.flow",
     "opspec.engine.instances",
@@ -57,6 +58,7 @@ MODULES: tuple[str, ...] = (
     "opspec.engine.triggers",
     "opspec.engine.workitem",
     "opspec.usermodels.performer",
+    "opspec.worlds.room_devices",
     "opspec.worlds.stepping",
 )
 STAMP = "_native_build.json"

@@ -31,14 +31,13 @@ the fair ``--workers`` to compare the pooled model against).
 
 from __future__ import annotations
 
-import heapq
 from collections import deque
 from collections.abc import Callable
 from typing import TYPE_CHECKING, Any
 
 import simpy
 
-
+from opspec.engine.dedicated import DedicatedProcessor
 
 if TYPE_CHECKING:
     from opspec.engine.config import EngineConfig
@@ -167,37 +166,6 @@ class PooledProcessor:
                         self.free -= 1
                         self._run(job, cost)
                     break
-
-
-class DedicatedProcessor:
-    """Counts of the dedicated model's CPU use (it schedules nothing).
-
-    ``burst(now, cost)`` records one activity holding its own worker from ``now`` for
-    ``cost`` simulated seconds; ``bursts``, ``busy_time`` and ``max_busy`` (most bursts
-    overlapping at one time) summarise them. Called only for activities with a CPU demand.
-    """
-
-    __slots__ = ("_ends", "bursts", "busy_time", "max_busy")
-
-    def __init__(self) -> None:
-        self._ends: list[float] = []      # end times of the bursts under way (a heap)
-        self.bursts = 0
-        self.busy_time = 0.0
-        self.max_busy = 0
-
-    def burst(self, now: float, cost: float) -> None:
-        ends = self._ends
-        while ends and ends[0] <= now:
-            heapq.heappop(ends)
-        heapq.heappush(ends, now + cost)
-        self.bursts += 1
-        self.busy_time += cost
-        busy = len(ends)
-        if busy > self.max_busy:          # max() without a builtin call per burst
-            self.max_busy = busy
-
-    def summary(self) -> dict[str, float | int]:
-        return {"bursts": self.bursts, "busy_time": self.busy_time, "max_busy": self.max_busy}
 
 
 class PreemptiveProcessor(PooledProcessor):

@@ -5,7 +5,7 @@ CPU time, a performer's ``call_later``) is a :class:`Timed` entry. On a plain
 :class:`simpy.Environment` each entry is a SimPy timeout of its own
 (``env.timeout(delay).callbacks.append(entry)``), as before. On a
 :class:`~opspec.engine.clock.Clock` the run owns (the one it makes by default), entries go
-on a heap of ``(time, sequence, entry)`` in compiled code instead, and one SimPy timeout at
+on a heap ordered by ``(time, sequence)`` in compiled code instead, and one SimPy timeout at
 a time, at the heap's earliest time, wakes the run (the *driver*): a SimPy ``Timeout``,
 its scheduling and its step are Python code, thousands of instructions each from compiled
 code, and most of a run's timers never need one.
@@ -35,7 +35,6 @@ heap entry and a generation check, no SimPy event.
 from __future__ import annotations
 
 import math
-from heapq import heapify, heappop, heappush
 from typing import Any, Final, final
 
 import simpy
@@ -45,14 +44,19 @@ from opspec.engine.clock import Clock
 __all__ = ["Timed", "Timers", "exact_delay"]
 
 INF: Final = math.inf
-# Final: module statics in the compiled engine, where a plain global is a dictionary lookup
-_PUSH: Final = heappush
-_POP: Final = heappop
 
 
 class Timed:
     """A timed callback of a run: :meth:`go` from the run's heap (the run has set its time),
-    ``__call__`` as a SimPy timeout's callback (it reads the time itself)."""
+    ``__call__`` as a SimPy timeout's callback (it reads the time itself).
+
+    On the heap, ``at`` is its time and ``seq`` its place in the order of scheduling (set by
+    :meth:`Timers.schedule_timed`; an entry is scheduled once, so they are its own fields:
+    no ``(time, sequence, entry)`` tuple per entry, and compared as two native numbers
+    instead of by the tuple protocol)."""
+
+    at: float
+    seq: int
 
     def go(self) -> None:
         raise NotImplementedError
@@ -97,7 +101,7 @@ class Timers:
         # and at each call from outside one (:meth:`sync`), not at every use.
         self.now = float(clock.now)
         self.inside = False         # handling one of its own timed callbacks: now is fresh
-        self.heap: list[tuple[float, int, Timed]] = []
+        self.heap: list[Timed] = []     # a binary heap by (at, seq): _push, _pop
         # a heap only on a Clock no other run drives (the clock reports the others' events)
         self.heaped = False
         if isinstance(clock, Clock) and clock.owner is None:
@@ -138,7 +142,9 @@ class Timers:
             self.now = float(self.env.now)
         at = self.now + delay
         self.order += 1
-        _PUSH(self.heap, (at, self.order, entry))
+        entry.at = at
+        entry.seq = self.order
+        _push(self.heap, entry)
         if at < self.armed_at and not self.ticking:
             self.arm()
 
@@ -147,7 +153,7 @@ class Timers:
         heap = self.heap
         if not heap:
             return
-        at = heap[0][0]
+        at = heap[0].at
         if at >= self.armed_at:
             return
         self.driver += 1
@@ -167,7 +173,7 @@ class Timers:
         at = self.armed_at
         self.armed_at = INF
         heap = self.heap
-        if not heap or heap[0][0] != at:
+        if not heap or heap[0].at != at:
             self.arm()
             return
         ahead = self.ahead
@@ -187,14 +193,15 @@ class Timers:
                 self.catch_up()
             self.arm()
 
-    def _run_due(self, heap: list[tuple[float, int, Timed]], ahead: bool) -> None:
+    def _run_due(self, heap: list[Timed], ahead: bool) -> None:
         while True:
-            at, _, entry = _POP(heap)
+            entry = _pop(heap)
+            at = entry.at
             self.now = at
             entry.go()
             if not ahead or not heap or self.shared:
                 return
-            following = heap[0][0]
+            following = heap[0].at
             if following != at:
                 if not following < self.horizon:
                     return          # something else comes first: SimPy's turn
@@ -225,7 +232,7 @@ class Timers:
         if urgent:
             return                  # before every timeout of its instant anyway
         # entries due at its instant were scheduled before it, so they come first
-        if any(entry[0] == at for entry in self.heap):
+        if any(entry.at == at for entry in self.heap):
             self._give_to_simpy(at)
         if self.armed_at == at:
             self.driver += 1        # what is scheduled at ``at`` from now on comes after it
@@ -235,14 +242,65 @@ class Timers:
 
     def _give_to_simpy(self, at: float) -> None:
         heap = self.heap
-        due = sorted(entry for entry in heap if entry[0] == at)
-        heap[:] = [entry for entry in heap if entry[0] != at]
-        heapify(heap)
+        due = sorted([entry for entry in heap if entry.at == at], key=_order)
+        heap[:] = sorted([entry for entry in heap if entry.at != at], key=_order)  # a heap
         env = self.env
         delay = exact_delay(float(env.now), at)
         self.scheduling = True
         try:
             for entry in due:
-                env.timeout(delay).callbacks.append(entry[2])
+                env.timeout(delay).callbacks.append(entry)
         finally:
             self.scheduling = False
+
+
+def _order(entry: Timed) -> tuple[float, int]:
+    return entry.at, entry.seq
+
+
+def _push(heap: list[Timed], entry: Timed) -> None:
+    """``heapq.heappush`` by ``(at, seq)``: the same order, compared as native numbers."""
+    heap.append(entry)
+    at = entry.at
+    seq = entry.seq
+    pos = len(heap) - 1
+    while pos > 0:
+        up = (pos - 1) >> 1
+        parent = heap[up]
+        if at < parent.at or (at == parent.at and seq < parent.seq):
+            heap[pos] = parent
+            pos = up
+        else:
+            break
+    heap[pos] = entry
+
+
+def _pop(heap: list[Timed]) -> Timed:
+    """``heapq.heappop`` by ``(at, seq)``: the earliest entry (the first scheduled of its
+    time), taken off the heap."""
+    last = heap.pop()
+    if not heap:
+        return last
+    first = heap[0]
+    at = last.at
+    seq = last.seq
+    size = len(heap)
+    pos = 0
+    while True:
+        child = 2 * pos + 1
+        if child >= size:
+            break
+        low = heap[child]
+        right = child + 1
+        if right < size:
+            other = heap[right]
+            if other.at < low.at or (other.at == low.at and other.seq < low.seq):
+                child = right
+                low = other
+        if low.at < at or (low.at == at and low.seq < seq):
+            heap[pos] = low
+            pos = child
+        else:
+            break
+    heap[pos] = last
+    return first

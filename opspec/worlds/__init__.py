@@ -153,10 +153,10 @@ def world_performers(compiled: CompiledPackage, *, seed: int, user: int
                 compiled.package.source or "<spec>"),
             hint=f"known worlds: {', '.join(sorted(WORLDS))}")
     from opspec.engine.random import named_stream
-    from opspec.worlds.device import WorldDevices
+    from opspec.worlds.device import devices_of
 
     from_file, file = _file_parameters(compiled, attribute)
     inline = _inline_parameters(attribute)
     world = _build(name, factory, named_stream(seed, f"world/{name}", (user,)),
                    {**from_file, **inline}, attribute, file, inline)
-    return {"world": WorldDevices(world)}
+    return {"world": devices_of(world)}

@@ -7,8 +7,10 @@ from typing import Any
 
 from opspec.engine.performers import PerformerSession, WorkItem
 from opspec.worlds.base import World
+from opspec.worlds.room import RoomWorld
+from opspec.worlds.room_devices import RoomDevices
 
-__all__ = ["WorldDevices"]
+__all__ = ["WorldDevices", "devices_of"]
 
 
 class WorldDevices:
@@ -53,3 +55,13 @@ class WorldDevices:
 
     def withdraw(self, item: WorkItem, reason: str) -> None:
         """Operations complete at once: nothing is pending to withdraw."""
+
+
+def devices_of(world: World) -> WorldDevices | RoomDevices:
+    """The performer of ``world``'s devices: :class:`WorldDevices`, or for a room world as
+    it is (not a subclass, which may step or answer its own way) the compiled
+    :class:`~opspec.worlds.room_devices.RoomDevices` in front of it."""
+    general = WorldDevices(world)
+    if type(world) is RoomWorld:
+        return RoomDevices(world, world._state, general)
+    return general

@@ -5,7 +5,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-__all__ = ["COMMANDS", "Robot"]
+__all__ = ["COMMANDS", "Robot", "pose_after"]
 
 # command -> (forward speed m/s, turn rate rad/s)
 COMMANDS: dict[str, tuple[float, float]] = {
@@ -33,13 +33,19 @@ class Robot:
 
     def pose_after(self, dt: float) -> tuple[float, float, float]:
         """Where the current command takes the robot in ``dt`` seconds (exact arc)."""
-        v, w = self.velocity()
-        if abs(w) < 1e-12:
-            return (self.x + v * dt * math.cos(self.heading),
-                    self.y + v * dt * math.sin(self.heading), self.heading)
-        heading = self.heading + w * dt
-        if v == 0.0:
-            return self.x, self.y, heading
-        r = v / w
-        return (self.x + r * (math.sin(heading) - math.sin(self.heading)),
-                self.y - r * (math.cos(heading) - math.cos(self.heading)), heading)
+        return pose_after(self.x, self.y, self.heading, self.command, dt)
+
+
+def pose_after(x: float, y: float, heading: float, command: str,
+               dt: float) -> tuple[float, float, float]:
+    """Where ``command`` takes a robot at ``x``, ``y``, ``heading`` in ``dt`` seconds (exact
+    arc); also the room's compiled robot's (:class:`~opspec.worlds.stepping.RoomState`)."""
+    v, w = COMMANDS.get(command, (0.0, 0.0))
+    if abs(w) < 1e-12:
+        return x + v * dt * math.cos(heading), y + v * dt * math.sin(heading), heading
+    after = heading + w * dt
+    if v == 0.0:
+        return x, y, after
+    r = v / w
+    return (x + r * (math.sin(after) - math.sin(heading)),
+            y - r * (math.cos(after) - math.cos(heading)), after)

@@ -14,18 +14,14 @@ import math
 from collections.abc import Mapping, Sequence
 from typing import TYPE_CHECKING, Any
 
-from opspec.worlds.base import STEP_S, RobotWorld, check_parameters
+from opspec.worlds.base import RobotWorld, World, check_parameters
 from opspec.worlds.geometry import Box, wrap_angle
-from opspec.worlds.robot import COMMANDS, Robot
-from opspec.worlds.stepping import COVER, DONE, RayBox, Straight, cover, distance_ahead
+from opspec.worlds.stepping import ARC, COVER, DONE, RayBox, RoomState
 
 if TYPE_CHECKING:   # annotations only: `opspec validate` loads no NumPy
     import numpy as np
 
 __all__ = ["RoomWorld"]
-
-_STILL = (0.0, 0.0)         # Robot.velocity() of a command it does not know
-
 
 def _box(corners: Sequence[float]) -> Box:
     if len(corners) != 4:
@@ -47,6 +43,9 @@ class RoomWorld(RobotWorld):
                  cell: float = 0.25, range_noise: float = 0.01, drain_per_s: float = 0.02,
                  tag: Sequence[float] | None = None, tag_range: float = 0.8,
                  patient_id: str = "patient-17") -> None:
+        # the robot, the world's time and the bumper live in compiled fields (stepping.py),
+        # read and written through the properties below; the room is their only user
+        self._state = RoomState()
         super().__init__(rng)
         check_parameters(numbers={"width": width, "height": height, "radius": radius,
                                   "cell": cell, "range_noise": range_noise,
@@ -63,7 +62,8 @@ class RoomWorld(RobotWorld):
         self.obstacles = [_box(o) for o in obstacles]
         if len(start) != 3:
             raise ValueError(f"start must be [x, y, heading], not {list(start)}")
-        self.robot = Robot(float(start[0]), float(start[1]), float(start[2]))
+        self.robot = robot = self._state
+        robot.x, robot.y, robot.heading = float(start[0]), float(start[1]), float(start[2])
         if not self._free(self.robot.x, self.robot.y):
             raise ValueError(f"start ({start[0]}, {start[1]}) puts the robot in a wall or "
                              "an obstacle")
@@ -81,21 +81,44 @@ class RoomWorld(RobotWorld):
         self.bumped = False
         self.in_contact = False
         self.collisions = 0
-        # What _advance needs of the fixed geometry, computed once with _free's arithmetic:
-        # the box the robot's centre may be in, each obstacle grown by the robot's radius.
+        # What advance needs of the fixed geometry, computed once with _free's arithmetic:
+        # the box the robot's centre may be in, each obstacle grown by the robot's radius
         r = self.radius
-        self._inside = (self.room.x0 + r, self.room.x1 - r, self.room.y0 + r,
-                        self.room.y1 - r)
-        self._grown = tuple((o.x0 - r, o.x1 + r, o.y0 - r, o.y1 + r) for o in self.obstacles)
-        self._straight = Straight(self._inside, list(self._grown), self.radius, self.cell)
-        # the room and the obstacles as op_read_range's ray meets them (ray_to_box_along)
-        self._boxes = tuple(_ray_box(box) for box in (self.room, *self.obstacles))
+        inside = (self.room.x0 + r, self.room.x1 - r, self.room.y0 + r, self.room.y1 - r)
+        grown = [(o.x0 - r, o.x1 + r, o.y0 - r, o.y1 + r) for o in self.obstacles]
         # per cell range of _cover's loops, its cells (in the room) not yet covered, in the
         # loops' order; cells are only ever added, so the others can add nothing again
         self._uncovered: dict[tuple[int, int, int, int], tuple[tuple[int, int], ...]] = {}
-        # the heading object _advance last found wrap_angle leaves as it is
-        self._settled: float | None = None
+        # the room and the obstacles as op_read_range's ray meets them (ray_to_box_along)
+        boxes = tuple(_ray_box(box) for box in (self.room, *self.obstacles))
+        self._state.place(inside, grown, self.radius, self.cell, boxes, self._uncovered,
+                          self.covered, self.cells_x, self.cells_y)
         self._cover()
+
+    # the world's state, kept in the compiled RoomState
+    @property
+    def time(self) -> float:
+        return self._state.time
+
+    @time.setter
+    def time(self, value: float) -> None:
+        self._state.time = value
+
+    @property
+    def bumped(self) -> bool:
+        return self._state.bumped
+
+    @bumped.setter
+    def bumped(self, value: bool) -> None:
+        self._state.bumped = value
+
+    @property
+    def in_contact(self) -> bool:
+        return self._state.in_contact
+
+    @in_contact.setter
+    def in_contact(self, value: bool) -> None:
+        self._state.in_contact = value
 
     # ------------------------------------------------------------------ motion
     def _free(self, x: float, y: float) -> bool:
@@ -105,69 +128,40 @@ class RoomWorld(RobotWorld):
             return False
         return not any(o.contains(x, y, margin=r) for o in self.obstacles)
 
-    def _advance(self, now: float) -> None:
-        """World.advance's steps, the same floats as :meth:`_step` taken one by one: the
-        motor command cannot change between two device operations, so driving straight
-        (or standing) is :class:`~opspec.worlds.stepping.Straight`'s loop and turning on the
-        spot one over the heading; :meth:`_cover` looks only at cells still uncovered.
-        Driving along an arc takes the steps one by one."""
-        robot = self.robot
-        v, w = COMMANDS.get(robot.command, _STILL)          # robot.velocity()
-        if abs(w) >= 1e-12:
-            if v != 0.0:
-                super()._advance(now)           # an arc: no command of the bundled specs
-                return
-            self._turn_in_place(now, w)
-            return
-        heading: float = robot.heading
-        # each step sets the heading to wrap_angle(heading): ``after`` is that, ``settled``
-        # once it no longer changes (bit for bit, sign of zero included)
-        after: float
-        if heading is self._settled:
-            after, settled = heading, True
-        else:
-            after = wrap_angle(heading)
-            settled = _same(after, heading)
-        straight = self._straight
-        straight.start(self.time, robot.x, robot.y, heading, after, settled, self.in_contact)
-        stop = robot.command == "stop"
-        uncovered = self._uncovered
-        while True:
-            code = straight.run(now, v, stop, uncovered)
-            if code == DONE:
-                break
-            # the world as _step leaves it at this step, its time that of the step's start
-            robot.x, robot.y, robot.heading = straight.x, straight.y, straight.heading
-            self.time, self.in_contact = straight.t_step, straight.in_contact
-            if code == COVER:
-                key = straight.key
-                self._cover_within(key, uncovered.get(key))
-            else:
-                self.bumped = True
-                self.collisions += 1
-                self.trace("world.collision", x=round(straight.x, 3), y=round(straight.y, 3))
-        heading = straight.heading
-        robot.x, robot.y, robot.heading = straight.x, straight.y, heading
-        self.time, self.in_contact = straight.t, straight.in_contact
-        if straight.bumped:
-            self.bumped = True
-        if straight.settled:
-            self._settled = heading
+    def advance(self, now: float) -> None:
+        """World.advance's steps, the same floats as :meth:`_step` taken one by one (see
+        :class:`~opspec.worlds.stepping.RoomState`): the motor command cannot change between
+        two device operations, so driving straight (or standing) and turning on the spot are
+        compiled loops; :meth:`_cover` looks only at cells still uncovered. Driving along an
+        arc takes the steps one by one."""
+        if not self._announced:
+            self._announced = True
+            self._announce()
+        code = self._state.advance(now)
+        if code != DONE:
+            self.finish_advance(code, now)
 
-    def _turn_in_place(self, now: float, w: float) -> None:
-        """Steps of a command that turns without driving (``turn_left``…): :meth:`_step`
-        with the position, the contact and the coverage left as they are."""
-        robot = self.robot
-        limit = now - 1e-12
-        t, heading = self.time, robot.heading
-        while t < limit:
-            rest = now - t
-            dt = STEP_S if rest > STEP_S else rest
-            heading = wrap_angle(heading + w * dt)
-            t += dt
-        if robot.command == "stop":
-            self.in_contact = False
-        robot.heading, self.time = heading, t
+    def _advance(self, now: float) -> None:
+        code = self._state.advance(now)
+        if code != DONE:
+            self.finish_advance(code, now)
+
+    def finish_advance(self, code: int, now: float) -> None:
+        """The steps the compiled loop (``RoomState.advance``, returning ``code``) hands
+        back: cells to cover, a contact to trace, an arc to step; then on to ``now``. Also
+        called by the compiled performer (:mod:`opspec.worlds.room_devices`)."""
+        state = self._state
+        while code != DONE:
+            if code == ARC:
+                World._advance(self, now)       # no command of the bundled specs
+                return
+            if code == COVER:                   # covered (by the loop), to be traced
+                for cx, cy in state.new_cells:
+                    self.trace("world.covered", cell=[cx, cy])
+            else:
+                self.collisions += 1
+                self.trace("world.collision", x=round(state.x, 3), y=round(state.y, 3))
+            code = state.resume(now)
 
     def _step(self, dt: float) -> None:
         robot = self.robot
@@ -199,21 +193,6 @@ class RoomWorld(RobotWorld):
                     self.covered.add((cx, cy))
                     self.trace("world.covered", cell=[cx, cy])
 
-    def _cover_within(self, key: tuple[int, int, int, int],
-                      cells: tuple[tuple[int, int], ...] | None) -> None:
-        """:meth:`_cover` at the robot's position, whose loops' cell range is ``key``,
-        looking only at the range's ``cells`` not covered when last looked (all of them when
-        ``None``): the same cells, in the same order, are covered and traced."""
-        if cells is None:
-            cx0, cx1, cy0, cy1 = key
-            cells = tuple((cx, cy) for cx in range(max(cx0, 0), min(cx1 + 1, self.cells_x))
-                          for cy in range(max(cy0, 0), min(cy1 + 1, self.cells_y)))
-        robot = self.robot
-        new, self._uncovered[key] = cover(cells, robot.x, robot.y, self.cell, self.radius,
-                                          self.covered)
-        for cx, cy in new:
-            self.trace("world.covered", cell=[cx, cy])
-
     def _announce(self) -> None:
         for cx, cy in sorted(self.covered):
             self.trace("world.covered", cell=[cx, cy])
@@ -225,16 +204,16 @@ class RoomWorld(RobotWorld):
 
     # ------------------------------------------------------------------ devices
     def op_read_range(self, _data: Mapping[str, Any]) -> dict[str, Any]:
-        robot = self.robot
-        best = distance_ahead(robot.x, robot.y, robot.heading, self._boxes)
-        distance = max(0.0, best - self.radius + float(self.rng.normal(0.0, self.range_noise)))
-        return {"distance": round(distance, 4)}
+        sd = self.range_noise
+        # Generator.normal(0, sd) is 0.0 + sd * standard_normal() (numpy's random_normal:
+        # loc + scale * z), the same draw and the same float for half its call's cost; a
+        # negative (or NaN) sd still goes to normal, which refuses it as before
+        noise = (0.0 + sd * self.rng.standard_normal() if sd >= 0.0
+                 else float(self.rng.normal(0.0, sd)))
+        return {"distance": self._state.read_range(noise)}
 
     def op_read_bump(self, _data: Mapping[str, Any]) -> dict[str, Any]:
-        bumped, self.bumped = self.bumped, False
-        return {"bump": bumped, "edge": False}         # a room has no ring edge
-
-
+        return self._state.read_bump()
 
     def _near_tag(self) -> bool:
         if self.tag is None:
@@ -253,8 +232,3 @@ def _ray_box(box: Box) -> RayBox:
     """A box's sides and the 1e-9 tolerance ray_to_box_along puts around them."""
     return (box.x0, box.y0, box.x1, box.y1,
             box.y0 - 1e-9, box.y1 + 1e-9, box.x0 - 1e-9, box.x1 + 1e-9)
-
-
-def _same(a: float, b: float) -> bool:
-    """Equal bit for bit (``-0.0`` is not ``0.0`` here: the next step's sine would differ)."""
-    return a == b and math.copysign(1.0, a) == math.copysign(1.0, b)

@@ -5,23 +5,29 @@ Plain float arithmetic over plain fields, so that the compiled build (``opspec._
 compiles it with the engine: the same IEEE operations in the same order as from source, so
 the same floats and the same traces either way (tests/engine/test_native_every_spec.py).
 The loop stops and hands back to :class:`~opspec.worlds.room.RoomWorld` at the few steps that
-need the world itself: one that may cover new cells (``COVER``) and the first step of a
+need the world itself: one that covers new cells (``COVER``) and the first step of a
 contact (``COLLISION``), both traced there; it is then run again to go on.
 """
 
 from __future__ import annotations
 
 import math
-from typing import Final
+from typing import Any, Final
 
-__all__ = ["COLLISION", "COVER", "DONE", "STEP_S", "Straight", "cover", "distance_ahead"]
+from opspec.worlds.robot import COMMANDS, pose_after
+
+__all__ = ["ARC", "COLLISION", "COVER", "DONE", "STEP_S", "RoomState", "cover", "distance_ahead",
+           "round4"]
 
 #: integration step: 5 cm at 1 m/s, well under the robot's size
 STEP_S: Final = 0.05
 
 DONE: Final = 0          # reached the time asked for
-COVER: Final = 1         # moved to where cells of ``key`` may still be uncovered
+COVER: Final = 1         # this step covered new cells (``new_cells``), to be traced
 COLLISION: Final = 2     # a contact began at this step
+ARC: Final = 3           # a command that drives and turns at once: the room steps it
+
+STILL: Final = (0.0, 0.0)    # Robot.velocity() of a command it does not know
 
 Key = tuple[int, int, int, int]
 Cells = tuple[tuple[int, int], ...]
@@ -30,51 +36,126 @@ Cells = tuple[tuple[int, int], ...]
 RayBox = tuple[float, float, float, float, float, float, float, float]
 
 
-class Straight:
-    """The state of one straight drive: ``t`` the world's time, the robot's ``x``, ``y``
-    and ``heading``; ``after`` is ``wrap_angle(heading)``, which the next step sets the
-    heading to, and ``settled`` says it equals ``heading`` bit for bit (wrapping no longer
-    changes it); ``in_contact`` and ``bumped`` as the room's. After a ``COVER`` or
-    ``COLLISION`` stop, ``t_step`` is the time at that step's start (the world's time while
-    it is handled) and ``key`` the cell range of the robot's reach."""
+class RoomState:
+    """The room world's moving state in compiled fields: the world's ``time``, the robot's
+    ``x``, ``y``, ``heading`` and motor ``command`` (this object is the room's ``robot``),
+    the bumper latch ``bumped`` and ``in_contact``, with what the device operations do to
+    them between two of the room's traced facts. The room (:class:`~opspec.worlds.room.
+    RoomWorld`) reads and writes them through properties, so the glue around each device
+    operation runs compiled too.
 
-    def __init__(self, inside: tuple[float, float, float, float],
-                 grown: list[tuple[float, float, float, float]], reach: float,
-                 cell: float) -> None:
+    :meth:`advance` moves the world to a time: driving straight (or standing) step by step,
+    turning on the spot, or ``ARC`` for the room to step through ``_step``. It stops at a
+    step that covers new cells (``COVER``: the room's ``covered`` has them already,
+    ``new_cells`` lists them in the order the room traces them) or starts a contact
+    (``COLLISION``), both traced by the room; :meth:`resume` then goes on. During such a
+    stop ``time`` is the time at that step's start (the world's time while it is handled),
+    ``key`` the cell range of the robot's reach; ``t`` is the loop's time after the step. ``after`` is
+    ``wrap_angle(heading)``, which the next step sets the heading to, and ``settled`` says
+    it equals ``heading`` bit for bit (wrapping no longer changes it)."""
+
+    def __init__(self) -> None:
+        self.x_lo = 0.0
+        self.x_hi = 0.0
+        self.y_lo = 0.0
+        self.y_hi = 0.0
+        self.grown: list[tuple[float, float, float, float]] = []
+        self.reach = 0.0
+        self.cell = 0.0
+        self.radius = 0.0
+        self.boxes: tuple[RayBox, ...] = ()
+        self.uncovered: dict[Key, Cells] = {}
+        self.covered: set[tuple[int, int]] = set()
+        self.cells_x = 0
+        self.cells_y = 0
+        self.new_cells: list[tuple[int, int]] = []
+        self.time = 0.0
+        self.x = 0.0
+        self.y = 0.0
+        self.heading = 0.0
+        self.command = "stop"
+        self.bumped = False
+        self.in_contact = False
+        self.t = 0.0
+        self.after = 0.0
+        self.settled = False
+        self.v = 0.0
+        self.stop = False
+        self.key: Key = (0, 0, 0, 0)
+
+    def place(self, inside: tuple[float, float, float, float],
+              grown: list[tuple[float, float, float, float]], reach: float, cell: float,
+              boxes: tuple[RayBox, ...], uncovered: dict[Key, Cells],
+              covered: set[tuple[int, int]], cells_x: int, cells_y: int) -> None:
+        """The fixed geometry: the box the robot's centre may be in, each obstacle grown by
+        the robot's radius (``reach``), the coverage cell, the range finder's boxes and the
+        room's cells not yet covered per cell range (ranges not in it not looked at yet),
+        the room's covered cells and its size in cells."""
         self.x_lo = inside[0]
         self.x_hi = inside[1]
         self.y_lo = inside[2]
         self.y_hi = inside[3]
         self.grown = grown
         self.reach = reach
+        self.radius = reach
         self.cell = cell
-        self.t = 0.0
-        self.t_step = 0.0
-        self.x = 0.0
-        self.y = 0.0
-        self.heading = 0.0
-        self.after = 0.0
-        self.settled = False
-        self.in_contact = False
-        self.bumped = False
-        self.key: Key = (0, 0, 0, 0)
+        self.boxes = boxes
+        self.uncovered = uncovered
+        self.covered = covered
+        self.cells_x = cells_x
+        self.cells_y = cells_y
 
-    def start(self, t: float, x: float, y: float, heading: float, after: float,
-              settled: bool, in_contact: bool) -> None:
-        self.t = t
-        self.x = x
-        self.y = y
-        self.heading = heading
+    # the robot's interface (opspec.worlds.robot.Robot), for _step and the worlds' tests
+    def velocity(self) -> tuple[float, float]:
+        return COMMANDS.get(self.command, STILL)
+
+    def pose_after(self, dt: float) -> tuple[float, float, float]:
+        return pose_after(self.x, self.y, self.heading, self.command, dt)
+
+    def advance(self, now: float) -> int:
+        """World.advance's steps to ``now`` (nothing when the world is there already)."""
+        if not self.time < now - 1e-12:
+            return DONE
+        v, w = COMMANDS.get(self.command, STILL)
+        if abs(w) >= 1e-12:
+            if v != 0.0:
+                return ARC
+            self._turn_in_place(now, w)
+            return DONE
+        heading = self.heading
+        after = math.atan2(math.sin(heading), math.cos(heading))       # wrap_angle
         self.after = after
-        self.settled = settled
-        self.in_contact = in_contact
-        self.bumped = False
+        self.settled = after == heading and (
+            math.copysign(1.0, after) == math.copysign(1.0, heading))
+        self.t = self.time
+        self.v = v
+        self.stop = self.command == "stop"
+        return self.resume(now)
 
-    def run(self, now: float, v: float, stop: bool, uncovered: dict[Key, Cells]) -> int:
-        """Steps at speed ``v`` until ``now`` (``DONE``) or a step the world must see.
-        ``uncovered``: the room's cells not yet covered per cell range (ranges not in it
-        have not been looked at)."""
+    def _turn_in_place(self, now: float, w: float) -> None:
+        """Steps of a command that turns without driving (``turn_left``…): ``_step`` with
+        the position, the contact and the coverage left as they are."""
         limit = now - 1e-12
+        t = self.time
+        heading = self.heading
+        while t < limit:
+            rest = now - t
+            dt = STEP_S if rest > STEP_S else rest
+            heading = heading + w * dt
+            heading = math.atan2(math.sin(heading), math.cos(heading))   # wrap_angle
+            t += dt
+        if self.command == "stop":
+            self.in_contact = False
+        self.heading = heading
+        self.time = t
+
+    def resume(self, now: float) -> int:
+        """Steps at the speed of the drive :meth:`advance` began until ``now`` (``DONE``)
+        or a step the world must see."""
+        limit = now - 1e-12
+        v = self.v
+        stop = self.stop
+        uncovered = self.uncovered
         t = self.t
         x = self.x
         y = self.y
@@ -87,6 +168,7 @@ class Straight:
         cos_h = math.cos(heading)
         sin_h = math.sin(heading)
         code = DONE
+        t_step = 0.0
         while t < limit:
             rest = now - t
             dt = STEP_S if rest > STEP_S else rest      # min(STEP_S, now - t)
@@ -118,15 +200,22 @@ class Straight:
                        int((y - reach) // cell), int((y + reach) // cell))
                 cells = uncovered.get(key)
                 if cells is None or len(cells) > 0:
-                    self.key = key
-                    code = COVER
+                    # RoomWorld._cover at this step, over the range's cells still uncovered
+                    # (cells are only ever added, so the others cannot be covered again)
+                    if cells is None:
+                        cells = self._cells(key)
+                    new, uncovered[key] = cover(cells, x, y, cell, reach, self.covered)
+                    if new:
+                        self.key = key
+                        self.new_cells = new
+                        code = COVER
             else:
                 self.bumped = True
                 if not in_contact:
                     in_contact = True
                     code = COLLISION
             if code != DONE:
-                self.t_step = t
+                t_step = t
                 t += dt
                 break
             t += dt
@@ -137,7 +226,30 @@ class Straight:
         self.after = after
         self.settled = settled
         self.in_contact = in_contact
+        self.time = t if code == DONE else t_step
         return code
+
+    def _cells(self, key: Key) -> Cells:
+        """The cells of the room in ``key``'s range, in ``RoomWorld._cover``'s order."""
+        cx0, cx1, cy0, cy1 = key
+        found: list[tuple[int, int]] = []
+        for cx in range(max(cx0, 0), min(cx1 + 1, self.cells_x)):
+            for cy in range(max(cy0, 0), min(cy1 + 1, self.cells_y)):
+                found.append((cx, cy))
+        return tuple(found)
+
+    def read_range(self, noise: float) -> float:
+        """The range finder's reading with this ``noise`` drawn: the distance from the
+        robot's edge to the nearest wall or obstacle face ahead, 0 at the least, to 0.1 mm."""
+        best = distance_ahead(self.x, self.y, self.heading, self.boxes)
+        distance = best - self.radius + noise
+        return round4(distance if distance > 0.0 else 0.0)     # max(0.0, distance)
+
+    def read_bump(self) -> dict[str, Any]:
+        """The bumper: whether it was pressed since it was last read (and clear it)."""
+        bumped = self.bumped
+        self.bumped = False
+        return {"bump": bumped, "edge": False}         # a room has no ring edge
 
 
 def distance_ahead(x: float, y: float, heading: float, boxes: tuple[RayBox, ...]) -> float:
@@ -193,3 +305,23 @@ def cover(cells: Cells, x: float, y: float, cell: float, reach: float,
             covered.add(c)
             new.append(c)
     return new, tuple([c for c in cells if c not in covered])
+
+
+def round4(x: float) -> float:
+    """``round(x, 4)``, the same float, without its decimal conversion for the usual case.
+
+    ``round`` gives the double nearest to the decimal ``n / 10**4``, ``n`` the integer nearest
+    to the exact ``x * 10**4`` (half to even); ``n / 10000.0`` is that double too (a
+    correctly rounded division of two exact numbers). ``y = x * 10000.0`` is within half an
+    ulp (under 1e-8 below 10 km) of the exact product, so ``n`` is the integer nearest to
+    ``y`` unless ``y`` is within 1e-6 of a half: those, zero and negative numbers
+    (``-0.0``), large and non-finite ones go to ``round`` itself."""
+    if not 0.0 < x < 1e4:
+        return round(x, 4)
+    y = x * 10000.0
+    whole = math.floor(y)
+    part = y - whole                      # exact: y and its floor are close doubles
+    if abs(part - 0.5) < 1e-6:
+        return round(x, 4)
+    n = whole + 1 if part > 0.5 else whole
+    return n / 10000.0

@@ -25,7 +25,12 @@ COMMANDS = ("forward", "forward", "forward", "back", "stop", "turn_left", "turn_
 
 
 class _OneStepAtATime(RoomWorld):
-    """The reference: every step through ``_step``, as the world was first written."""
+    """The reference: every step through ``_step``, as the world was first written (the
+    world's state is the same compiled ``RoomState``, read and written through the room's
+    properties and the robot's fields, one step at a time)."""
+
+    def advance(self, now: float) -> None:
+        World.advance(self, now)
 
     def _advance(self, now: float) -> None:
         World._advance(self, now)

@@ -1,0 +1,76 @@
+"""The room world's devices as the engine's performer, compiled: what
+:class:`~opspec.worlds.device.WorldDevices` does for a :class:`~opspec.worlds.room.RoomWorld`
+on the operations a robot spec uses every period (``read_range``, ``read_bump``,
+``drive``), without an interpreted frame per operation.
+
+A robot spec uses a device several times a period (the vacuum cleaner: 54,000 times an
+hour); around the compiled stepping (:mod:`opspec.worlds.stepping`) the interpreted glue
+(``WorldDevices.offer``, ``RoomWorld.advance``, the ``op_`` method) cost more than the
+world's own work. Here the same steps run compiled, on the room's compiled state: advance the
+world to the engine's time (the room traces what the stepping stops at), do the operation,
+complete the item. The operations' definitions stay the room's: the bumper and the range
+reading are :class:`~opspec.worlds.stepping.RoomState`'s, the range noise and the random
+turn the room's own ``op_`` methods, called from here. Anything else (the first use, which
+traces the initial coverage; the battery, the tag reader, an operation the world does not
+know) goes to ``WorldDevices``.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+from opspec.engine.workitem import WorkItem
+from opspec.worlds.stepping import DONE, RoomState
+
+__all__ = ["RoomDevices"]
+
+
+class RoomDevices:
+    """The performer of a :class:`~opspec.worlds.room.RoomWorld` (``world``) with its state
+    ``state``; ``general`` is the :class:`~opspec.worlds.device.WorldDevices` of the same
+    world, which does every operation not done here."""
+
+    def __init__(self, world: Any, state: RoomState, general: Any) -> None:
+        self.world = world
+        self.state = state
+        self.general = general
+        self.applications: dict[str, None] = general.applications
+        self.session: Any = None
+        self.announced = False
+
+    def attach(self, session: Any) -> None:
+        self.session = session
+        self.general.attach(session)
+
+    def offer(self, item: WorkItem) -> None:
+        application = item.application or item.activity
+        fast = application == "read_bump" or application == "drive" or (
+            application == "read_range")
+        if not fast or not self.announced:
+            self.announced = True           # WorldDevices (World.advance) announces
+            self.general.offer(item)
+            return
+        session = self.session
+        now: float = session.now
+        state = self.state
+        code = state.advance(now)
+        if code != DONE:
+            self.world.finish_advance(code, now)
+        data = item.data
+        result: dict[str, Any]
+        if application == "read_bump":
+            result = state.read_bump()
+        elif application == "read_range":
+            result = self.world.op_read_range(data)
+        else:
+            command = data.get("motor_cmd")
+            command = str(command or "stop")
+            if command == "turn_random":
+                result = self.world.op_drive(data)
+            else:
+                state.command = command             # RobotWorld.op_drive
+                result = {}
+        session.complete(item, result or None)
+
+    def withdraw(self, item: WorkItem, reason: str) -> None:
+        """Operations complete at once: nothing is pending to withdraw."""

@@ -1,0 +1,48 @@
+"""The run's timer heap (opspec/engine/timers.py) orders its entries as ``heapq`` orders
+``(time, sequence, entry)`` tuples: by time, then in the order they were scheduled.
+
+SimPy's own rule, which the heap must keep (simpy.core.Environment.schedule): events are
+ordered by ``(time, priority, event id)``, so events of one instant are processed in the
+order they were scheduled. The heap's entries carry their time and sequence as fields,
+compared as numbers; this checks that against the standard library's heap, with many ties
+in time (a robot spec's periods meet at every second), pushes and pops interleaved."""
+
+from __future__ import annotations
+
+import heapq
+import random
+from collections.abc import Callable
+
+import pytest
+from builders import manual, pkg, proc
+
+from opspec.engine.builtin_performers import ScriptedUser
+from opspec.engine.simulation import Simulation
+from opspec.engine.timers import _pop
+
+
+@pytest.mark.parametrize("seed", range(5))
+def test_pops_in_time_then_scheduling_order_as_heapq(seed: int) -> None:
+    # a run's state (its Timers) whose clock is never run: only its heap is used here
+    run = Simulation(pkg(proc("p", [manual("a")], [])),
+                     performers={"user": ScriptedUser([])})
+    rng = random.Random(seed)
+    reference: list[tuple[float, int, Callable[[], None]]] = []
+    popped: list[Callable[[], None]] = []
+    expected: list[Callable[[], None]] = []
+    for seq in range(3000):
+        if run.heap and rng.random() < 0.45:
+            popped.append(_pop(run.heap).callback)      # type: ignore[attr-defined]
+            expected.append(heapq.heappop(reference)[2])
+            continue
+        delay = rng.choice([0.0, 0.2, 0.4, 1.0, 10.0]) + rng.choice([0, 1, 2]) * 0.2
+
+        def callback() -> None: ...
+
+        run.timer(delay, callback)
+        heapq.heappush(reference, (delay, seq, callback))
+    while run.heap:
+        popped.append(_pop(run.heap).callback)          # type: ignore[attr-defined]
+        expected.append(heapq.heappop(reference)[2])
+    assert popped == expected
+    assert len({id(c) for c in expected}) == len(expected) > 1500
