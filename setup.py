@@ -51,8 +51,7 @@ class OptionalNativeBuild(build_ext):
         self._stamp()
 
     def _stamp(self) -> None:
-        digests = {module: source_digest(ROOT / (module.replace(".", "/") + ".py"))
-                   for module in MODULES}
+        digests = _READ or _digests()
         text = json.dumps({"compiler": "mypyc", "modules": digests}, indent=1) + "\n"
         targets = [ROOT / "opspec" / STAMP] if self.inplace else []
         targets.append(Path(self.build_lib) / "opspec" / STAMP)
@@ -88,6 +87,17 @@ def _builds() -> bool:
     return not commands or commands[0] not in _METADATA_ONLY
 
 
+#: The sources' digests when mypyc read them: the record of the build must describe the code
+#: compiled, so a source edited while the C compiler runs is found stale by opspec._native
+#: (and runs from source) rather than recorded as what was compiled.
+_READ: dict[str, str] = {}
+
+
+def _digests() -> dict[str, str]:
+    return {module: source_digest(ROOT / (module.replace(".", "/") + ".py"))
+            for module in MODULES}
+
+
 def _extensions() -> list[object]:
     if not _wanted() or not _builds():
         return []
@@ -98,6 +108,7 @@ def _extensions() -> list[object]:
               file=sys.stderr)
         return []
     paths = [module.replace(".", "/") + ".py" for module in MODULES]
+    _READ.update(_digests())
     try:
         return list(mypycify(paths, group_name="opspec", opt_level="3", debug_level="0"))
     except (Exception, SystemExit) as error:  # noqa: BLE001 - mypyc refused the source

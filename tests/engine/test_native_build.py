@@ -166,3 +166,39 @@ def test_an_in_place_build_removes_only_the_extensions_no_longer_listed(tmp_path
         path.parent.mkdir(parents=True, exist_ok=True)
         path.write_bytes(b"")
     assert _native.unlisted_extensions(tmp_path) == sorted(stale)
+
+
+def test_the_build_record_describes_the_sources_mypyc_compiled(
+        tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    """A source edited while the C compiler runs (minutes, on one core) must not be recorded
+    as compiled: the record holds the digests of what mypyc read, so opspec._native finds the
+    edited module stale and runs it from its source instead of the older compiled code."""
+    import runpy
+    import shutil
+    import types
+
+    import setuptools
+
+    shutil.copy(ROOT / "setup.py", tmp_path / "setup.py")
+    for module in (*_native.MODULES, "opspec._native"):
+        relative = module.replace(".", "/") + ".py"
+        (tmp_path / relative).parent.mkdir(parents=True, exist_ok=True)
+        shutil.copy(ROOT / relative, tmp_path / relative)
+    # mypyc as the build sees it, without compiling anything (the test venv need not have it)
+    mypyc = types.ModuleType("mypyc")
+    build_module = types.ModuleType("mypyc.build")
+    build_module.mypycify = lambda paths, **options: ["extension"]  # type: ignore[attr-defined]
+    monkeypatch.setitem(sys.modules, "mypyc", mypyc)
+    monkeypatch.setitem(sys.modules, "mypyc.build", build_module)
+    monkeypatch.setattr(setuptools, "setup", lambda **options: None)
+    monkeypatch.setattr(sys, "argv", ["setup.py", "build_ext", "--inplace"])
+    monkeypatch.delenv(_native.ENV, raising=False)
+    setup = runpy.run_path(str(tmp_path / "setup.py"))
+    edited = tmp_path / (_native.MODULES[0].replace(".", "/") + ".py")
+    before = _native.source_digest(edited)
+    edited.write_text(edited.read_text(encoding="utf-8") + "\n# edited during the build\n",
+                      encoding="utf-8")
+    build = types.SimpleNamespace(inplace=True, build_lib=str(tmp_path / "build"))
+    setup["OptionalNativeBuild"]._stamp(build)
+    record = json.loads((tmp_path / "opspec" / _native.STAMP).read_text(encoding="utf-8"))
+    assert record["modules"][_native.MODULES[0]] == before != _native.source_digest(edited)
