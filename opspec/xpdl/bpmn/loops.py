@@ -145,6 +145,7 @@ def _vendor_collection(element: etree._Element, multi: etree._Element, defs: Def
         return f"len({text})", None
     return text, variable.strip()
 
+
 def _expression(element: etree._Element, text: str | None, what: str, defs: Defs
                 ) -> Expression | None:
     from opspec.xpdl.conditions import parse_expression
