@@ -79,6 +79,7 @@ def read_loop(element: etree._Element, defs: Defs,
                 cancel_remaining=completion_text is not None,
                 element_variable=variable)
 
+
 def _vendor_collection(element: etree._Element, multi: etree._Element, defs: Defs,
                        declared: Mapping[str, DataField | FormalParameter],
                        collections: list[DataField]) -> tuple[str, str | None] | bool:
