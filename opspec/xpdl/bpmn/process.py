@@ -530,7 +530,6 @@ class _Process:
                                "bpmn:dataInputAssociation")
 
 
-
 def _with_script_fields(process: WorkflowProcess, element: etree._Element, defs: Defs
                         ) -> WorkflowProcess:
     """BPMN engines create a variable when a script first sets it: a name a script task
