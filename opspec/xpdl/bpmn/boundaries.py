@@ -88,8 +88,6 @@ def read_boundaries(events: list[etree._Element], hosts: set[str], defs: Defs,
                 _exception_path(out, event, host, passing, event_id, defs, plain)
                 continue
         if kind == "errorEventDefinition":
-            from opspec.xpdl.bpmn.events import named_ref
-
             code = named_ref(found[0], "errorRef", defs.errors, defs, "error")[1]
             if not interrupting:
                 defs.ctx.warning(event, "non-interrupting-error",
@@ -115,8 +113,9 @@ def read_boundaries(events: list[etree._Element], hosts: set[str], defs: Defs,
         trigger = trigger_of(event, defs, catching=True, attached_to=host,
                              interrupting=interrupting)[0]
         out.activities.append(plain(event, Event(position=EventPosition.INTERMEDIATE,
-                                                      trigger=trigger), host))
+                                                 trigger=trigger), host))
     return out
+
 
 def _exception_path(out: Boundaries, event: etree._Element, host: str, body: Event,
                     exception: str | None, defs: Defs, plain: Plain) -> None:

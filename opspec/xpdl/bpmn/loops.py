@@ -10,13 +10,13 @@ from collections.abc import Mapping
 
 from lxml import etree
 
-from opspec.errors import SpecError
+from opspec.errors import Severity
 from opspec.model.activities import Loop, LoopKind, MIFlow
 from opspec.model.data import BasicKind, BasicType, DataField, FormalParameter
-from opspec.model.expressions import Expression
 from opspec.xpdl.bpmn.common import Defs, expression_text, first, label, local, text_of
 from opspec.xpdl.bpmn.data import CAMUNDA
 from opspec.xpdl.bpmn.scripts import bpmn_condition
+from opspec.xpdl.handlers.activities import read_expression
 from opspec.xpdl.handlers.common import parse_int
 
 __all__ = ["read_loop"]
@@ -63,14 +63,16 @@ def read_loop(element: etree._Element, defs: Defs,
     if text is None and collection is not None:
         text = f"len({collection})"
         defs.info(multi, "multi-instance-collection",
-                      f"{label(element)} runs one instance per item of {collection!r} "
-                      f"(loopCardinality len({collection})); opspec does not hand each "
-                      "instance its item", "read the item yourself if an instance needs it")
+                  f"{label(element)} runs one instance per item of {collection!r} "
+                  f"(loopCardinality len({collection})); opspec does not hand each "
+                  "instance its item", "read the item yourself if an instance needs it")
     completion = first(multi, "completionCondition")
     completion_text = expression_text(completion)
     return Loop(kind=LoopKind.MULTI_INSTANCE, condition_text=text,
-                condition=_expression(cardinality if cardinality is not None else multi,
-                                      text, "loopCardinality", defs),
+                condition=read_expression(
+                    cardinality if cardinality is not None else multi, text, defs.ctx,
+                    "loopCardinality", severity=Severity.ERROR,
+                    hint="write an expression over data fields, e.g. 3 or count + 1"),
                 parallel=(multi.get("isSequential") or "false").lower() != "true",
                 flow=MIFlow.COMPLEX if completion_text else MIFlow.ALL,
                 flow_condition_text=completion_text,
@@ -145,18 +147,3 @@ def _vendor_collection(element: etree._Element, multi: etree._Element, defs: Def
     if not variable:        # one instance per item, none reading it
         return f"len({text})", None
     return text, variable.strip()
-
-
-def _expression(element: etree._Element, text: str | None, what: str, defs: Defs
-                ) -> Expression | None:
-    from opspec.xpdl.conditions import parse_expression
-
-    if text is None:
-        return None
-    try:
-        return parse_expression(text, location=defs.loc(element))
-    except (SpecError, ValueError, RecursionError) as error:
-        defs.ctx.error(element, "bad-expression", f"{what} {text!r} cannot be understood: "
-                       f"{getattr(error, 'message', error)}",
-                       "write an expression over data fields, e.g. 3 or count + 1")
-        return None

@@ -7,7 +7,7 @@ import dataclasses
 
 from lxml import etree
 
-from opspec.errors import SpecError
+from opspec.errors import Severity, SpecError
 from opspec.model.activities import (
     Activity,
     ActivityBody,
@@ -43,7 +43,7 @@ from opspec.xpdl.handlers.resources import performers_of
 from opspec.xpdl.namespaces import qname
 from opspec.xpdl.sisarl import activity_directives
 
-__all__ = ["build_activity", "build_assignment", "build_assignments"]
+__all__ = ["build_activity", "build_assignment", "build_assignments", "read_expression"]
 
 
 def _mode(element: etree._Element, name: str, ctx: BuildContext) -> Mode:
@@ -136,17 +136,22 @@ def _loop(element: etree._Element, ctx: BuildContext) -> Loop | None:
                       "ComplexMI_FlowCondition", "give the condition (over data fields and "
                       "nrOfInstances, nrOfCompletedInstances, nrOfActiveInstances)")
         return Loop(kind=LoopKind.MULTI_INSTANCE, condition_text=text,
-                    condition=_expression(detail, text, ctx, "multi-instance count"),
+                    condition=read_expression(detail, text, ctx, "multi-instance count"),
                     parallel=ordering == "parallel", flow=flow,
                     flow_condition_text=complex_text,
-                    flow_condition=(_expression(detail, complex_text, ctx,
-                                                "ComplexMI_FlowCondition")
+                    flow_condition=(read_expression(detail, complex_text, ctx,
+                                                    "ComplexMI_FlowCondition")
                                     if flow is MIFlow.COMPLEX else None))
     return None  # LoopType="None"
 
 
-def _expression(element: etree._Element | None, text: str | None, ctx: BuildContext, what: str
-                ) -> Expression | None:
+def read_expression(element: etree._Element | None, text: str | None, ctx: BuildContext,
+                    what: str, *, severity: Severity = Severity.WARNING,
+                    hint: str = "write an expression over data fields") -> Expression | None:
+    """``text`` as an expression over data fields, located at ``element``'s line; ``None``
+    without text, or when it cannot be read (then a ``bad-expression`` diagnostic of
+    ``severity`` says why). The XPDL and BPMN readers' loop, multi-instance and gateway
+    expressions all come through here."""
     from opspec.xpdl.conditions import parse_expression
 
     if text is None:
@@ -154,8 +159,8 @@ def _expression(element: etree._Element | None, text: str | None, ctx: BuildCont
     try:
         return parse_expression(text, location=ctx.loc(element))
     except (SpecError, ValueError, RecursionError) as error:
-        ctx.warning(element, "bad-expression", f"{what} {text!r} cannot be understood: "
-                    f"{getattr(error, 'message', error)}", "write an expression over data fields")
+        ctx.report(element, severity, "bad-expression", f"{what} {text!r} cannot be "
+                   f"understood: {getattr(error, 'message', error)}", hint)
         return None
 
 
@@ -247,7 +252,7 @@ def build_activity(element: etree._Element, ctx: BuildContext) -> Activity:
     if join is not None and join.type is GatewayType.COMPLEX:
         # XPDL 2.1 writes a complex gateway's activation rule on the Route: IncomingCondition
         text = attr(body_element, "IncomingCondition") if body_element is not None else None
-        join = dataclasses.replace(join, condition_text=text, condition=_expression(
+        join = dataclasses.replace(join, condition_text=text, condition=read_expression(
             body_element, text, ctx, "IncomingCondition"))
     priority_text = text_of(child(element, "Priority")) if has("Priority") else None
     priority = parse_int(priority_text)
