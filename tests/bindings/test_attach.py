@@ -99,6 +99,17 @@ class Outcome:
         assert self.result.trace is not None
         return [dict(e.data or {}) for e in self.result.trace if e.kind == "fault"]
 
+    def fault_path(self) -> list[tuple[str, str]]:
+        """(fault, action) of each fault but a reply's timeout that its resend answered.
+
+        The fast profile waits 200 ms (wall) for a reply. On a loaded CI machine the
+        emulator's thread was once starved that long before the disconnect: one
+        ('timeout', 'retry'), then the disconnect's path exactly as without it. A resend
+        answered is the fallback working (tests of the timeout path follow); what the fault
+        tests check is the path of the fault they inject, so they read it without those."""
+        path = [(f["fault"], f["action"]) for f in self.faults()]
+        return [step for step in path if step != ("timeout", "retry")]
+
     def metric(self, name: str) -> Any:
         return self.result.metrics[name]["total"]
 
@@ -242,13 +253,14 @@ def test_a_socket_that_drops_mid_run_is_reconnected_and_the_dose_is_taken(
     # until 11:56: reconnecting takes real time (50 ms here, about 1000 simulated seconds)
     run = simulate([f"alarm:{FAST}={server.url}", f"dispenser:{FAST}={server.url}"],
                    script(tmp_path, ("after trg_2 30s", "press_report")), until=43000)
-    assert [(f["fault"], f["action"]) for f in run.faults()] == [("disconnected", "reconnect")]
+    assert run.fault_path() == [("disconnected", "reconnect")]
     notes = [e.data["message"] for e in run.result.trace or () if e.kind == "device.note"]
     assert any("reconnected" in note for note in notes)
     assert run.metric("doses_taken") == 1
     assert run.report["alarm, dispenser"]["mode"] == {"alarm": "device", "dispenser": "device"}
-    fault = run.report["alarm, dispenser"]["faults"][0]
-    assert fault["fault"] == "disconnected" and 28800 <= fault["at"] < FIRST_DOSE
+    faults = run.report["alarm, dispenser"]["faults"]
+    disconnects = [f for f in faults if f["fault"] == "disconnected"]
+    assert len(disconnects) == 1 and 28800 <= disconnects[0]["at"] < FIRST_DOSE
 
 
 @needs_pty
@@ -259,7 +271,7 @@ def test_a_vanished_drawer_aborts_the_dispense_along_its_exception_transition(
     # until 11:56: closing and reopening the port takes real time (simulated hours here)
     run = simulate([f"alarm:{FAST}={server.url}", f"dispenser:{FAST}={server.url}"],
                    script(tmp_path, ("after trg_2 30s", "press_report")), until=43000)
-    assert [(f["fault"], f["action"]) for f in run.faults()] == [
+    assert run.fault_path() == [
         ("disconnected", "reconnect"), ("reconnect-failed", "abort/simulate")]
     device = run.report["alarm, dispenser"]
     assert device["mode"] == {"alarm": "simulated", "dispenser": "aborted"}
