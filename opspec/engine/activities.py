@@ -74,15 +74,17 @@ class Activities(Part):
                             "instance": ai.frame.inst.id, "activity": act.id, "message": text})
         self.flow.end_instance(root, ABORTED, text)
 
-    def start(self, frame: Frame, act: CompiledActivity | None) -> None:
+    def start(self, frame: Frame, act: CompiledActivity | None, steps: int = 0,
+              limit: int = -1) -> None:
         """Start ``act``. Instantaneous activities run here, in a loop that carries the
         token straight on to the next activity (no queue round trip) as long as the next
-        one has no AND/OR join to synchronise at."""
+        one has no AND/OR join to synchronise at. (``steps`` and ``limit``: where
+        :func:`opspec.engine.lone.run`, which hands its token over, had got to.)"""
         state = self.state
         pooled = state.pooled
         apps = state.apps
-        steps = 0
-        limit = state.start_limit
+        if limit < 0:
+            limit = state.start_limit
         flow = self.flow
         while act is not None:
             if not act.fast or (act.general and pooled) or (
@@ -117,14 +119,14 @@ class Activities(Part):
             if act.start_assign and not flow.assign(inst, act, act.start_assign):
                 return
             if act.kind == K_ASYNC:
-                data = self._params_in(inst, act)
+                data = self.params_in(inst, act)
                 if data is None:
                     return
                 flow.start_process(state.processes[act.subflow],  # type: ignore[index]
                                    data, trigger=f"subflow:{act.id}")
             act = flow.done_next(frame, act)
 
-    def _params_in(self, inst: ProcessInstance, act: CompiledActivity
+    def params_in(self, inst: ProcessInstance, act: CompiledActivity
                    ) -> dict[str, Any] | None:
         now = self.state.now
         try:

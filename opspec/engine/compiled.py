@@ -232,6 +232,8 @@ class CompiledActivity:
     plain: bool = False                      # waits, but without deadline/loop/trigger/boundary
     next: int = -1                           # the one unconditional successor, if that is all
     simple_end: bool = False                 # completes with no assignment/throw/raise/terminate
+    # the one token of an instance without a frame can pass it (compiling.graphs._lone)
+    lone: bool = False
     # which trace kinds the run's listeners want of it, as bits, with the selection they were
     # computed for (RunState.act_bits): one attribute read on the hot path, not a lookup
     flag_cache: FlagCache = NO_FLAGS

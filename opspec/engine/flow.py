@@ -24,7 +24,7 @@ from opspec.engine.compiled import (
     CompiledProcess,
     CTransition,
 )
-from opspec.engine import drawing, escalations, joins
+from opspec.engine import drawing, escalations, joins, lone
 from opspec.engine.instances import ActivityInstance, Frame, ProcessInstance
 from opspec.engine.lifecycle import ABORTED, LIFECYCLE, RUNNING, STATE_NAMES, SUSPENDED, TERMINATED
 from opspec.engine.part import Part
@@ -54,6 +54,7 @@ class Flow(Part):
         self.start_at_q: Callable[[Frame, int, Any], None] = self.start_at
         self.arrive_q: Callable[[Frame, int, CTransition | None], None] = self._arrive
         self.performed_q: Callable[[Frame, int, CTransition | None], None] = self.performed
+        self.start_lone_q: Callable[[ProcessInstance, int, Any], None] = self.start_lone_at
 
     def start_process(self, proc: CompiledProcess, data: Mapping[str, Any] | None = None, *,
                       parent: ActivityInstance | None = None, trigger: str | None = None,
@@ -84,18 +85,24 @@ class Flow(Part):
         if (cached.bits if cached.key is state.flag_key else state.proc_bits(proc)) & 1:
             state.emit(EK.PROCESS_STARTED, proc.id, iid, None, proc.lane, None,
                        {"trigger": trigger, "parent": parent.frame.inst.id if parent else None})
-        frame = Frame(proc.graph, inst, None)
-        inst.frames.append(frame)
-        state.start_counted(frame)
+        graph = proc.graph
         if start >= 0:
-            frame.live += 1
-            state.ready.append((self.start_at_q, frame, start, None))
+            starts: tuple[int, ...] = (start,)
         else:
-            starts = proc.graph.starts
+            starts = graph.starts
             if proc.start_events:
                 # not started by one of its triggered start events (called, auto-started,
                 # from the API): at its none start events only (BPMN 2.0 §13.3.4)
                 starts = proc.called_starts or starts
+        if len(starts) == 1 and graph.completion is None:
+            # one token: the instance gets its frame only if the token reaches something
+            # that needs one (opspec.engine.lone); data-only workflows end without one
+            state.start_counted(inst)
+            state.ready.append((self.start_lone_q, inst, starts[0], None))
+        else:
+            frame = Frame(graph, inst, None)
+            inst.frames.append(frame)
+            state.start_counted(inst)
             for index in starts:
                 frame.live += 1
                 state.ready.append((self.start_at_q, frame, index, None))
@@ -129,6 +136,11 @@ class Flow(Part):
             owner.child = None
             self.activities.body_done(owner, None)
             return
+        self.instance_done(inst)
+
+    def instance_done(self, inst: ProcessInstance) -> None:
+        """The instance's top frame is done (or its one token ended before it had one):
+        the instance completes, and a synchronous caller gets its OUT parameters."""
         if inst.state != RUNNING:
             return
         inst.state = _COMPLETED_FROM_RUNNING
@@ -199,6 +211,15 @@ class Flow(Part):
             return
         self.activities.start(frame, frame.graph.activities[index])
 
+    def start_lone_at(self, inst: ProcessInstance, index: int, _unused: Any) -> None:
+        """The one token of a new instance, which has no frame yet, starts at activity
+        ``index`` (:func:`opspec.engine.lone.run`: a frame is made if the token needs one)."""
+        if inst.state != RUNNING:
+            if inst.state == SUSPENDED:
+                inst.defer((self.start_lone_at, inst, index, None))
+            return
+        lone.run(self.activities, inst, inst.process.graph.activities[index])
+
     def _dropped(self, frame: Frame, fn: Any, a: Any, b: Any) -> None:
         if frame.inst.state == SUSPENDED:
             frame.inst.defer((fn, frame, a, b))
@@ -266,26 +287,12 @@ class Flow(Part):
             return
         if frame.live <= 0 or frame.ors:
             if frame.live <= 0 and not frame.parked:
-                self.frame_done(frame)
+                if frame.owner is None:
+                    self.instance_done(frame.inst)      # frame_done's case, without its call
+                else:
+                    self.frame_done(frame)
             else:
                 self.state.pending[frame] = None
-
-    def throw_error(self, frame: Frame, act: CompiledActivity, code: str) -> None:
-        """An error end event: the nearest enclosing sub-process or call activity with a
-        boundary error event (an EXCEPTION path) for ``code``, else one catching every error,
-        is cancelled and takes that path (BPMN 2.0 §10.4.1, §13.5.3). Uncaught, the error
-        aborts the instance that threw it (and so its callers) with a located fault."""
-        what = f"error {code!r}" if code else "an error without a code"
-        holder = frame.owner if frame.owner is not None else frame.inst.parent
-        while holder is not None:
-            if holder.state == RUNNING and _catches(holder.act, code):
-                self.activities.fail(holder, code or "error",
-                                     f"{what} thrown by end event {act.id!r}")
-                return
-            up = holder.frame
-            holder = up.owner if up.owner is not None else up.inst.parent
-        self.abort(frame.inst, act, f"{what} thrown by this end event is caught by no "
-                   "boundary error event of an enclosing sub-process or call activity")
 
     def terminate_frame(self, frame: Frame, reason: str) -> None:
         """A terminate end event inside an activity set (an embedded sub-process) ends that
@@ -399,7 +406,7 @@ class Flow(Part):
         if act.raises is not None and inst.state == RUNNING:
             self.triggers.broadcast(act.raises.kind, act.raises.name or "", None, inst, act)
         if act.error is not None:
-            self.throw_error(frame, act, act.error)
+            escalations.throw_error(self, frame, act, act.error)
             return None
         if act.escalation is not None and not escalations.throw(self, frame, act.escalation):
             return None                     # an interrupting catcher cancelled this scope
@@ -591,9 +598,3 @@ class Flow(Part):
         if not beside:
             self.token_gone(frame)
 
-
-def _catches(act: CompiledActivity, code: str) -> bool:
-    """Whether ``act`` has an exception path (a boundary error event) for error ``code``."""
-    if act.default_exception is not None:
-        return True
-    return any(t.exception is None or t.exception == code for t in act.exceptions)

@@ -362,8 +362,8 @@ class RunState(Timers):
         finally:
             self.inside = outer
 
-    def start_counted(self, frame: Frame) -> None:
-        """A workflow instance was started (``frame`` its top frame): past
+    def start_counted(self, inst: ProcessInstance) -> None:
+        """A workflow instance was started: past
         ``max_instant_starts`` instances at one instant, a zero-time cycle that piles up
         instances (a workflow starting itself asynchronously), stopped and named like any
         zero-time cycle, within seconds and some tens of megabytes."""
@@ -376,8 +376,8 @@ class RunState(Timers):
             return
         self.instant_starts += 1
         if self.instant_starts > self.max_instant_starts:
-            starts = frame.graph.starts
-            self.zero_time(frame, starts[0] if starts else None, self.instant_starts)
+            starts = inst.process.graph.starts
+            self.zero_time(inst, starts[0] if starts else None, self.instant_starts)
 
 
 #: how many run items of the ready queue drain keeps before dropping them from its front
