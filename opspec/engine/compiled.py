@@ -281,6 +281,9 @@ class CompiledProcess:
     # is called from another Process")
     called_starts: tuple[int, ...] = ()
     flag_cache: FlagCache = NO_FLAGS       # as CompiledActivity.flag_cache
+    # where an instance not started by a triggered start event starts when that is one
+    # activity (its token then runs without a frame at first: opspec.engine.lone), else -1
+    one_start: int = -1
 
 
 @dataclass(slots=True, eq=False)

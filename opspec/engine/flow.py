@@ -72,7 +72,8 @@ class Flow(Part):
         root = iid
         if parent is not None:
             root = parent.frame.inst.root
-            priority = max(priority, parent.frame.inst.priority)
+            if parent.frame.inst.priority > priority:       # (max(), without its call)
+                priority = parent.frame.inst.priority
         inst = ProcessInstance(iid, proc, local, scope, priority, parent, root, state.now)
         inst.state = RUNNING
         inst.trigger = trigger
@@ -86,23 +87,27 @@ class Flow(Part):
             state.emit(EK.PROCESS_STARTED, proc.id, iid, None, proc.lane, None,
                        {"trigger": trigger, "parent": parent.frame.inst.id if parent else None})
         graph = proc.graph
-        if start >= 0:
-            starts: tuple[int, ...] = (start,)
+        # RunState.start_counted's common case in line: another instance at this instant
+        if state.now == state.starts_at and state.instant_starts < state.max_instant_starts:
+            state.instant_starts += 1
         else:
-            starts = graph.starts
-            if proc.start_events:
-                # not started by one of its triggered start events (called, auto-started,
-                # from the API): at its none start events only (BPMN 2.0 §13.3.4)
-                starts = proc.called_starts or starts
-        if len(starts) == 1 and graph.completion is None:
+            state.start_counted(inst)
+        one = proc.one_start if start < 0 else (start if graph.completion is None else -1)
+        if one >= 0:
             # one token: the instance gets its frame only if the token reaches something
             # that needs one (opspec.engine.lone); data-only workflows end without one
-            state.start_counted(inst)
-            state.ready.append((self.start_lone_q, inst, starts[0], None))
+            state.ready.append((self.start_lone_q, inst, one, None))
         else:
+            if start >= 0:
+                starts: tuple[int, ...] = (start,)
+            else:
+                starts = graph.starts
+                if proc.start_events:
+                    # not started by one of its triggered start events (called,
+                    # auto-started, from the API): its none start events (BPMN 2.0 §13.3.4)
+                    starts = proc.called_starts or starts
             frame = Frame(graph, inst, None)
             inst.frames.append(frame)
-            state.start_counted(inst)
             for index in starts:
                 frame.live += 1
                 state.ready.append((self.start_at_q, frame, index, None))
@@ -146,7 +151,9 @@ class Flow(Part):
         inst.state = _COMPLETED_FROM_RUNNING
         inst.frames.clear()          # breaks the instance <-> frame cycle: freed by refcount
         state = self.state
-        state.gone(inst.id)
+        live = state.live            # RunState.gone, in line
+        if inst.id in live:
+            del live[inst.id]
         if state.kept and inst.parent is None:
             self.triggers.drop_kept(inst)
         state.completed += 1
@@ -350,18 +357,6 @@ class Flow(Part):
         """OR joins that nothing can reach any more fire; a frame with only parked tokens
         left is deadlocked (:func:`opspec.engine.joins.resolve_frames`)."""
         joins.resolve_frames(self)
-
-    def report_deadlock(self, inst: ProcessInstance, waiting: list[str], why: str) -> None:
-        """Record a deadlock of ``inst`` (trace + summary) and abort it."""
-        proc = inst.process
-        text = (f"deadlock in process {proc.id!r} (instance {inst.id}) at "
-                f"t={self.state.now:.3f} s: {why}; waiting: {', '.join(waiting) or '-'}")
-        self.state.deadlocks.append({"time": self.state.now, "process": proc.id, "instance": inst.id,
-                               "waiting": waiting, "message": text})
-        if self.state.wants(EK.DEADLOCK, proc.id, None):
-            self.state.emit(EK.DEADLOCK, proc.id, inst.id, None, proc.lane, None,
-                      {"waiting": list(waiting), "message": text})
-        self.end_instance(inst, ABORTED, text)
 
     def finish(self, frame: Frame, act: CompiledActivity,
                local: dict[str, Any] | None = None, assigns: bool = True) -> None:

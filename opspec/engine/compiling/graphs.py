@@ -159,7 +159,9 @@ class Compiler(Context):
             formals=tuple((f.id, f.mode) for f in proc.formal_parameters), priority=priority,
             lane=lane, start_trigger=start, end_trigger=self.trigger_ref(directives.end_trigger),
             auto_start=bool(auto), deadline=directives.deadline, mode=directives.mode,
-            location=proc.location, start_events=start_events, called_starts=called_starts)
+            location=proc.location, start_events=start_events, called_starts=called_starts,
+            one_start=_one_start(graph, (called_starts or graph.starts) if start_events
+                                 else graph.starts))
 
     def start_trigger(self, proc: WorkflowProcess, graph: CompiledGraph
                       ) -> tuple[CTrigger | None, tuple[tuple[CTrigger, int], ...]]:
@@ -303,6 +305,11 @@ def _catchers(processes: Iterable[CompiledProcess]) -> dict[tuple[str, str], fro
                     if trig is not None and trig.kind in ("message", "signal"):
                         found.setdefault((trig.kind, trig.name or ""), set()).add(proc.id)
     return {key: frozenset(ids) for key, ids in found.items()}
+
+
+def _one_start(graph: CompiledGraph, starts: tuple[int, ...]) -> int:
+    """``CompiledProcess.one_start``: the start activity when an instance has one token."""
+    return starts[0] if len(starts) == 1 and graph.completion is None else -1
 
 
 def _lone(ca: CompiledActivity, acts: tuple[CompiledActivity, ...]) -> bool:
