@@ -89,7 +89,7 @@ class Activities(Part):
         while act is not None:
             if not act.fast or (act.general and pooled) or (
                     act.kind == K_TASK and act.application in apps):
-                self._start_slow(frame, act)
+                self.start_slow(frame, act)
                 return
             inst = frame.inst
             steps += 1
@@ -136,7 +136,8 @@ class Activities(Part):
             self.flow.abort(inst, act, f"an actual parameter failed: {error.message}")
             return None
 
-    def _start_slow(self, frame: Frame, act: CompiledActivity) -> None:
+    def start_slow(self, frame: Frame, act: CompiledActivity) -> None:
+        """Start ``act``, which waits or takes time: as an activity instance."""
         ai = ActivityInstance(self.state.next_key(), act, frame, self.state.now)
         ai.state = RUNNING
         frame.running[ai.key] = ai
@@ -358,10 +359,27 @@ class Activities(Part):
         if ai.mi is not None:
             multi_instance.done(self, ai, ai.mi)
             return
-        # Flow.finish's two steps, here (the completion of every activity instance)
-        nxt = self.flow.done_next(frame, ai.act)
-        if nxt is not None:
-            self.start(frame, nxt)
+        # Flow.finish's two steps, here (the completion of every activity instance), with
+        # Flow.done_next's first case in line, and what waits started without start's loop
+        act = ai.act
+        if act.simple_end:
+            state = self.state
+            inst = frame.inst
+            cached = act.flag_cache           # RunState.act_bits's cached case, in line
+            if (cached.bits if cached.key is state.flag_key else state.act_bits(act)) & 2:
+                state.emit(EK.ACTIVITY_COMPLETED, act.process, inst.id, act.id, act.lane,
+                           act.participant)
+            nxt = act.next
+            target = frame.graph.activities[nxt] if nxt >= 0 else None
+            if target is None or target.join:
+                target = self.flow.split(frame, act, inst)
+        else:
+            target = self.flow.done_next(frame, act)
+        if target is not None:
+            if target.fast:
+                self.start(frame, target)
+            else:
+                self.start_slow(frame, target)
 
     def _inputs(self, ai: ActivityInstance) -> dict[str, Any] | None:
         reads = ai.scope()

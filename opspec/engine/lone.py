@@ -47,7 +47,10 @@ def run(activities: Activities, inst: ProcessInstance, act: CompiledActivity | N
             frame = Frame(inst.process.graph, inst, None)
             inst.frames.append(frame)
             frame.live = 1
-            activities.start(frame, act, steps, limit)
+            if act.fast:
+                activities.start(frame, act, steps, limit)
+            else:
+                activities.start_slow(frame, act)       # start's first step
             return
         steps += 1
         if steps > limit:                       # a zero-time cycle (see RunState.drain)
