@@ -173,7 +173,11 @@ class Activities(Part):
         inst = ai.frame.inst
         if act.mi is not None and ai.mi is None and not multi_instance.begin(self, ai):
             return
-        self.state.emit_act(EK.ACTIVITY_STARTED, inst, act)
+        state = self.state                    # RunState.emit_act, by the cached bits
+        cached = act.flag_cache
+        if (cached.bits if cached.key is state.flag_key else state.act_bits(act)) & 1:
+            state.emit(EK.ACTIVITY_STARTED, act.process, inst.id, act.id, act.lane,
+                       act.participant)
         if act.start_assign and not self.flow.assign(inst, act, act.start_assign, ai.scope()):
             return
         now = self.state.now

@@ -531,7 +531,11 @@ class Flow(Part):
             self._dropped(frame, self.performed, index, trans)
             return
         act = frame.graph.activities[index]
-        self.state.emit_act(EK.ACTIVITY_STARTED, inst, act)
+        state = self.state                    # RunState.emit_act, by the cached bits
+        cached = act.flag_cache
+        if (cached.bits if cached.key is state.flag_key else state.act_bits(act)) & 1:
+            state.emit(EK.ACTIVITY_STARTED, act.process, inst.id, act.id, act.lane,
+                       act.participant)
         if act.start_assign and not self.assign(inst, act, act.start_assign):
             return
         self.finish(frame, act)
