@@ -415,7 +415,7 @@ class Activities(Part):
                 key = ai.key
                 if key not in self.state.tool_at:
                     table = self.state.tool_at
-                    ai.cleanup.append(lambda: discard(table, key))  # noqa: B023 - returns below
+                    ai.on_leave(lambda: discard(table, key))  # noqa: B023 - returns below
                 self.state.tool_at[key] = index
                 self.offers.offer(ai, performer, (), data, None, tool.application)
                 return

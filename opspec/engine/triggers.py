@@ -62,7 +62,7 @@ class Triggers(Part):
                 table = self.state.waiters[key] = {}
             token = next(self.state.keys)
             table[token] = (ai, handler, (arg, persistent, key, token))
-            ai.cleanup.append(lambda: discard(table, token))
+            ai.on_leave(lambda: discard(table, token))
         elif kind in ("timer", "period"):
             inst = ai.frame.inst
             every = trig.every or 0.0
@@ -91,7 +91,7 @@ class Triggers(Part):
             condition = trig.condition
             self.state.rules[rkey] = (lambda: condition(inst.scope, self.state.now),
                                  lambda: handler(ai, arg, None), ai)
-            ai.cleanup.append(lambda: discard(self.state.rules, rkey))
+            ai.on_leave(lambda: discard(self.state.rules, rkey))
 
     def _cycle(self, ai: ActivityInstance, trig: CTrigger, handler: Any, arg: Any,
                base: float, k: int, end: int) -> None:
