@@ -28,6 +28,13 @@ instructions (valgrind's callgrind, if installed) each side executes for N more 
 difference between runs of 2N and N users, so start-up and imports cancel out. Instructions
 are not time (the engine's code is larger and chases more pointers per instruction), but the
 count is the same on every run, which makes it the number to compare changes by.
+
+The two ratios differ, and not by noise (docs/engine-performance.md, "Why 2.9x in
+instructions is 4.6x in CPU"): from source the engine's instructions are slower than the
+baseline's (more of them are the interpreter's bytecode dispatch, and they read twice the
+data per instruction), and the baseline's count per dose cycle grows with the users it runs
+at once in one SimPy environment (168k at 1 -> 10 users, 192k at 20 -> 40, 200k at 1 -> 100)
+while the engine's, one Simulation per user, does not: compare counts taken at the same N.
 """
 
 from __future__ import annotations

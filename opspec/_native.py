@@ -45,6 +45,7 @@ MODULES: tuple[str, ...] = (
     "opspec.engine.joins",
     "opspec.engine.lanes",
     "opspec.engine.lifecycle",
+    "opspec.engine.lone",
     "opspec.engine.metrics",
     "opspec.engine.multi_instance",
     "opspec.engine.offers",

@@ -74,20 +74,22 @@ class Activities(Part):
                             "instance": ai.frame.inst.id, "activity": act.id, "message": text})
         self.flow.end_instance(root, ABORTED, text)
 
-    def start(self, frame: Frame, act: CompiledActivity | None) -> None:
+    def start(self, frame: Frame, act: CompiledActivity | None, steps: int = 0,
+              limit: int = -1) -> None:
         """Start ``act``. Instantaneous activities run here, in a loop that carries the
         token straight on to the next activity (no queue round trip) as long as the next
-        one has no AND/OR join to synchronise at."""
+        one has no AND/OR join to synchronise at. (``steps`` and ``limit``: where
+        :func:`opspec.engine.lone.run`, which hands its token over, had got to.)"""
         state = self.state
         pooled = state.pooled
         apps = state.apps
-        steps = 0
-        limit = state.start_limit
+        if limit < 0:
+            limit = state.start_limit
         flow = self.flow
         while act is not None:
             if not act.fast or (act.general and pooled) or (
                     act.kind == K_TASK and act.application in apps):
-                self._start_slow(frame, act)
+                self.start_slow(frame, act)
                 return
             inst = frame.inst
             steps += 1
@@ -117,14 +119,14 @@ class Activities(Part):
             if act.start_assign and not flow.assign(inst, act, act.start_assign):
                 return
             if act.kind == K_ASYNC:
-                data = self._params_in(inst, act)
+                data = self.params_in(inst, act)
                 if data is None:
                     return
                 flow.start_process(state.processes[act.subflow],  # type: ignore[index]
                                    data, trigger=f"subflow:{act.id}")
             act = flow.done_next(frame, act)
 
-    def _params_in(self, inst: ProcessInstance, act: CompiledActivity
+    def params_in(self, inst: ProcessInstance, act: CompiledActivity
                    ) -> dict[str, Any] | None:
         now = self.state.now
         try:
@@ -134,7 +136,8 @@ class Activities(Part):
             self.flow.abort(inst, act, f"an actual parameter failed: {error.message}")
             return None
 
-    def _start_slow(self, frame: Frame, act: CompiledActivity) -> None:
+    def start_slow(self, frame: Frame, act: CompiledActivity) -> None:
+        """Start ``act``, which waits or takes time: as an activity instance."""
         ai = ActivityInstance(self.state.next_key(), act, frame, self.state.now)
         ai.state = RUNNING
         frame.running[ai.key] = ai
@@ -170,7 +173,11 @@ class Activities(Part):
         inst = ai.frame.inst
         if act.mi is not None and ai.mi is None and not multi_instance.begin(self, ai):
             return
-        self.state.emit_act(EK.ACTIVITY_STARTED, inst, act)
+        state = self.state                    # RunState.emit_act, by the cached bits
+        cached = act.flag_cache
+        if (cached.bits if cached.key is state.flag_key else state.act_bits(act)) & 1:
+            state.emit(EK.ACTIVITY_STARTED, act.process, inst.id, act.id, act.lane,
+                       act.participant)
         if act.start_assign and not self.flow.assign(inst, act, act.start_assign, ai.scope()):
             return
         now = self.state.now
@@ -356,10 +363,27 @@ class Activities(Part):
         if ai.mi is not None:
             multi_instance.done(self, ai, ai.mi)
             return
-        # Flow.finish's two steps, here (the completion of every activity instance)
-        nxt = self.flow.done_next(frame, ai.act)
-        if nxt is not None:
-            self.start(frame, nxt)
+        # Flow.finish's two steps, here (the completion of every activity instance), with
+        # Flow.done_next's first case in line, and what waits started without start's loop
+        act = ai.act
+        if act.simple_end:
+            state = self.state
+            inst = frame.inst
+            cached = act.flag_cache           # RunState.act_bits's cached case, in line
+            if (cached.bits if cached.key is state.flag_key else state.act_bits(act)) & 2:
+                state.emit(EK.ACTIVITY_COMPLETED, act.process, inst.id, act.id, act.lane,
+                           act.participant)
+            nxt = act.next
+            target = frame.graph.activities[nxt] if nxt >= 0 else None
+            if target is None or target.join:
+                target = self.flow.split(frame, act, inst)
+        else:
+            target = self.flow.done_next(frame, act)
+        if target is not None:
+            if target.fast:
+                self.start(frame, target)
+            else:
+                self.start_slow(frame, target)
 
     def _inputs(self, ai: ActivityInstance) -> dict[str, Any] | None:
         reads = ai.scope()
@@ -391,7 +415,7 @@ class Activities(Part):
                 key = ai.key
                 if key not in self.state.tool_at:
                     table = self.state.tool_at
-                    ai.cleanup.append(lambda: discard(table, key))  # noqa: B023 - returns below
+                    ai.on_leave(lambda: discard(table, key))  # noqa: B023 - returns below
                 self.state.tool_at[key] = index
                 self.offers.offer(ai, performer, (), data, None, tool.application)
                 return

@@ -232,6 +232,8 @@ class CompiledActivity:
     plain: bool = False                      # waits, but without deadline/loop/trigger/boundary
     next: int = -1                           # the one unconditional successor, if that is all
     simple_end: bool = False                 # completes with no assignment/throw/raise/terminate
+    # the one token of an instance without a frame can pass it (compiling.graphs._lone)
+    lone: bool = False
     # which trace kinds the run's listeners want of it, as bits, with the selection they were
     # computed for (RunState.act_bits): one attribute read on the hot path, not a lookup
     flag_cache: FlagCache = NO_FLAGS
@@ -279,6 +281,9 @@ class CompiledProcess:
     # is called from another Process")
     called_starts: tuple[int, ...] = ()
     flag_cache: FlagCache = NO_FLAGS       # as CompiledActivity.flag_cache
+    # where an instance not started by a triggered start event starts when that is one
+    # activity (its token then runs without a frame at first: opspec.engine.lone), else -1
+    one_start: int = -1
 
 
 @dataclass(slots=True, eq=False)

@@ -24,7 +24,7 @@ from opspec.engine.compiled import (
     CompiledProcess,
     CTransition,
 )
-from opspec.engine import drawing, escalations, joins
+from opspec.engine import drawing, escalations, joins, lone
 from opspec.engine.instances import ActivityInstance, Frame, ProcessInstance
 from opspec.engine.lifecycle import ABORTED, LIFECYCLE, RUNNING, STATE_NAMES, SUSPENDED, TERMINATED
 from opspec.engine.part import Part
@@ -54,6 +54,7 @@ class Flow(Part):
         self.start_at_q: Callable[[Frame, int, Any], None] = self.start_at
         self.arrive_q: Callable[[Frame, int, CTransition | None], None] = self._arrive
         self.performed_q: Callable[[Frame, int, CTransition | None], None] = self.performed
+        self.start_lone_q: Callable[[ProcessInstance, int, Any], None] = self.start_lone_at
 
     def start_process(self, proc: CompiledProcess, data: Mapping[str, Any] | None = None, *,
                       parent: ActivityInstance | None = None, trigger: str | None = None,
@@ -71,7 +72,8 @@ class Flow(Part):
         root = iid
         if parent is not None:
             root = parent.frame.inst.root
-            priority = max(priority, parent.frame.inst.priority)
+            if parent.frame.inst.priority > priority:       # (max(), without its call)
+                priority = parent.frame.inst.priority
         inst = ProcessInstance(iid, proc, local, scope, priority, parent, root, state.now)
         inst.state = RUNNING
         inst.trigger = trigger
@@ -84,18 +86,28 @@ class Flow(Part):
         if (cached.bits if cached.key is state.flag_key else state.proc_bits(proc)) & 1:
             state.emit(EK.PROCESS_STARTED, proc.id, iid, None, proc.lane, None,
                        {"trigger": trigger, "parent": parent.frame.inst.id if parent else None})
-        frame = Frame(proc.graph, inst, None)
-        inst.frames.append(frame)
-        state.start_counted(frame)
-        if start >= 0:
-            frame.live += 1
-            state.ready.append((self.start_at_q, frame, start, None))
+        graph = proc.graph
+        # RunState.start_counted's common case in line: another instance at this instant
+        if state.now == state.starts_at and state.instant_starts < state.max_instant_starts:
+            state.instant_starts += 1
         else:
-            starts = proc.graph.starts
-            if proc.start_events:
-                # not started by one of its triggered start events (called, auto-started,
-                # from the API): at its none start events only (BPMN 2.0 §13.3.4)
-                starts = proc.called_starts or starts
+            state.start_counted(inst)
+        one = proc.one_start if start < 0 else (start if graph.completion is None else -1)
+        if one >= 0:
+            # one token: the instance gets its frame only if the token reaches something
+            # that needs one (opspec.engine.lone); data-only workflows end without one
+            state.ready.append((self.start_lone_q, inst, one, None))
+        else:
+            if start >= 0:
+                starts: tuple[int, ...] = (start,)
+            else:
+                starts = graph.starts
+                if proc.start_events:
+                    # not started by one of its triggered start events (called,
+                    # auto-started, from the API): its none start events (BPMN 2.0 §13.3.4)
+                    starts = proc.called_starts or starts
+            frame = Frame(graph, inst, None)
+            inst.frames.append(frame)
             for index in starts:
                 frame.live += 1
                 state.ready.append((self.start_at_q, frame, index, None))
@@ -129,12 +141,19 @@ class Flow(Part):
             owner.child = None
             self.activities.body_done(owner, None)
             return
+        self.instance_done(inst)
+
+    def instance_done(self, inst: ProcessInstance) -> None:
+        """The instance's top frame is done (or its one token ended before it had one):
+        the instance completes, and a synchronous caller gets its OUT parameters."""
         if inst.state != RUNNING:
             return
         inst.state = _COMPLETED_FROM_RUNNING
         inst.frames.clear()          # breaks the instance <-> frame cycle: freed by refcount
         state = self.state
-        state.gone(inst.id)
+        live = state.live            # RunState.gone, in line
+        if inst.id in live:
+            del live[inst.id]
         if state.kept and inst.parent is None:
             self.triggers.drop_kept(inst)
         state.completed += 1
@@ -198,6 +217,15 @@ class Flow(Part):
             self._dropped(frame, self.start_at, index, None)
             return
         self.activities.start(frame, frame.graph.activities[index])
+
+    def start_lone_at(self, inst: ProcessInstance, index: int, _unused: Any) -> None:
+        """The one token of a new instance, which has no frame yet, starts at activity
+        ``index`` (:func:`opspec.engine.lone.run`: a frame is made if the token needs one)."""
+        if inst.state != RUNNING:
+            if inst.state == SUSPENDED:
+                inst.defer((self.start_lone_at, inst, index, None))
+            return
+        lone.run(self.activities, inst, inst.process.graph.activities[index])
 
     def _dropped(self, frame: Frame, fn: Any, a: Any, b: Any) -> None:
         if frame.inst.state == SUSPENDED:
@@ -266,26 +294,12 @@ class Flow(Part):
             return
         if frame.live <= 0 or frame.ors:
             if frame.live <= 0 and not frame.parked:
-                self.frame_done(frame)
+                if frame.owner is None:
+                    self.instance_done(frame.inst)      # frame_done's case, without its call
+                else:
+                    self.frame_done(frame)
             else:
                 self.state.pending[frame] = None
-
-    def throw_error(self, frame: Frame, act: CompiledActivity, code: str) -> None:
-        """An error end event: the nearest enclosing sub-process or call activity with a
-        boundary error event (an EXCEPTION path) for ``code``, else one catching every error,
-        is cancelled and takes that path (BPMN 2.0 §10.4.1, §13.5.3). Uncaught, the error
-        aborts the instance that threw it (and so its callers) with a located fault."""
-        what = f"error {code!r}" if code else "an error without a code"
-        holder = frame.owner if frame.owner is not None else frame.inst.parent
-        while holder is not None:
-            if holder.state == RUNNING and _catches(holder.act, code):
-                self.activities.fail(holder, code or "error",
-                                     f"{what} thrown by end event {act.id!r}")
-                return
-            up = holder.frame
-            holder = up.owner if up.owner is not None else up.inst.parent
-        self.abort(frame.inst, act, f"{what} thrown by this end event is caught by no "
-                   "boundary error event of an enclosing sub-process or call activity")
 
     def terminate_frame(self, frame: Frame, reason: str) -> None:
         """A terminate end event inside an activity set (an embedded sub-process) ends that
@@ -344,18 +358,6 @@ class Flow(Part):
         left is deadlocked (:func:`opspec.engine.joins.resolve_frames`)."""
         joins.resolve_frames(self)
 
-    def report_deadlock(self, inst: ProcessInstance, waiting: list[str], why: str) -> None:
-        """Record a deadlock of ``inst`` (trace + summary) and abort it."""
-        proc = inst.process
-        text = (f"deadlock in process {proc.id!r} (instance {inst.id}) at "
-                f"t={self.state.now:.3f} s: {why}; waiting: {', '.join(waiting) or '-'}")
-        self.state.deadlocks.append({"time": self.state.now, "process": proc.id, "instance": inst.id,
-                               "waiting": waiting, "message": text})
-        if self.state.wants(EK.DEADLOCK, proc.id, None):
-            self.state.emit(EK.DEADLOCK, proc.id, inst.id, None, proc.lane, None,
-                      {"waiting": list(waiting), "message": text})
-        self.end_instance(inst, ABORTED, text)
-
     def finish(self, frame: Frame, act: CompiledActivity,
                local: dict[str, Any] | None = None, assigns: bool = True) -> None:
         """Completion of ``act``, then on to what follows it (``local``: the element of the
@@ -399,7 +401,7 @@ class Flow(Part):
         if act.raises is not None and inst.state == RUNNING:
             self.triggers.broadcast(act.raises.kind, act.raises.name or "", None, inst, act)
         if act.error is not None:
-            self.throw_error(frame, act, act.error)
+            escalations.throw_error(self, frame, act, act.error)
             return None
         if act.escalation is not None and not escalations.throw(self, frame, act.escalation):
             return None                     # an interrupting catcher cancelled this scope
@@ -529,7 +531,11 @@ class Flow(Part):
             self._dropped(frame, self.performed, index, trans)
             return
         act = frame.graph.activities[index]
-        self.state.emit_act(EK.ACTIVITY_STARTED, inst, act)
+        state = self.state                    # RunState.emit_act, by the cached bits
+        cached = act.flag_cache
+        if (cached.bits if cached.key is state.flag_key else state.act_bits(act)) & 1:
+            state.emit(EK.ACTIVITY_STARTED, act.process, inst.id, act.id, act.lane,
+                       act.participant)
         if act.start_assign and not self.assign(inst, act, act.start_assign):
             return
         self.finish(frame, act)
@@ -591,9 +597,3 @@ class Flow(Part):
         if not beside:
             self.token_gone(frame)
 
-
-def _catches(act: CompiledActivity, code: str) -> bool:
-    """Whether ``act`` has an exception path (a boundary error event) for error ``code``."""
-    if act.default_exception is not None:
-        return True
-    return any(t.exception is None or t.exception == code for t in act.exceptions)

@@ -156,7 +156,9 @@ class ActivityInstance:
         self.gen = 0
         self.waiting = ""                     # what it waits for, for deadlock reports
         self.choice: tuple[Any, ...] = ()     # deferred choice: the transitions offered
-        self.cleanup: list[Callable[[], None]] = []
+        # what undoes its armed waits when it leaves (made when the first is armed: most
+        # activity instances arm none)
+        self.cleanup: list[Callable[[], None]] | None = None
         self.performer: Any = None
         self.mi: MultiInstance | None = None
         # a collection multi-instance's own element ({elementVariable: item}), seen by this
@@ -181,6 +183,12 @@ class ActivityInstance:
             for undo in cleanup:
                 undo()
             cleanup.clear()
+
+    def on_leave(self, undo: Callable[[], None]) -> None:
+        """Call ``undo`` when this instance leaves (:meth:`leave`): an armed wait ends."""
+        if self.cleanup is None:
+            self.cleanup = []
+        self.cleanup.append(undo)
 
     def scope(self) -> MutableMapping[str, Any]:
         """The data this instance reads: its process instance's, under its own element

@@ -63,6 +63,7 @@ from typing import Any
 
 import simpy
 
+from opspec.engine import joins
 from opspec.engine.activities import MAX_CALL_DEPTH, Activities
 from opspec.engine.compiled import CompiledActivity, CompiledPackage, CompiledProcess
 from opspec.engine.config import EngineConfig
@@ -133,7 +134,7 @@ class Interpreter(RunState):
     def report_deadlock(self, inst: ProcessInstance, waiting: list[str], why: str) -> None:
         """Record a deadlock of ``inst`` (trace + summary) and abort it."""
         self.sync()
-        self.flow.report_deadlock(inst, waiting, why)
+        joins.report_deadlock(self.flow, inst, waiting, why)
 
     # ------------------------------------------------------------------ triggers
     def broadcast(self, kind: str, name: str, data: Mapping[str, Any] | None,

@@ -10,14 +10,15 @@ from collections import ChainMap
 from typing import TYPE_CHECKING
 
 from opspec.engine.compiled import CompiledActivity
-from opspec.engine.instances import Frame
-from opspec.engine.lifecycle import RUNNING
+from opspec.engine.instances import Frame, ProcessInstance
+from opspec.engine.lifecycle import ABORTED, RUNNING
+from opspec.engine.trace import EventKind as EK
 from opspec.errors import OpspecError
 
 if TYPE_CHECKING:
     from opspec.engine.flow import Flow
 
-__all__ = ["complex_arrival", "complex_fires", "or_ready", "resolve_frames"]
+__all__ = ["complex_arrival", "complex_fires", "or_ready", "report_deadlock", "resolve_frames"]
 
 
 def complex_arrival(flow: Flow, frame: Frame, act: CompiledActivity, slot: int) -> bool:
@@ -113,7 +114,7 @@ def resolve_frames(flow: Flow) -> None:
                                         + list((frame.ors or {}).items())
                                         + list((frame.cjoins or {}).items()))
                            if (c if isinstance(c, int) else any(c))]
-                flow.report_deadlock(frame.inst, waiting, "a join waits for branches "
+                report_deadlock(flow, frame.inst, waiting, "a join waits for branches "
                                      "that can no longer arrive")
             else:
                 flow.frame_done(frame)
@@ -153,3 +154,17 @@ def _or_blocks(reach: tuple[frozenset[int], ...], tokens: list[int], node: int) 
                 return False
             blocked = True
     return blocked
+
+
+def report_deadlock(flow: Flow, inst: ProcessInstance, waiting: list[str], why: str) -> None:
+    """Record a deadlock of ``inst`` (trace + summary) and abort it."""
+    state = flow.state
+    proc = inst.process
+    text = (f"deadlock in process {proc.id!r} (instance {inst.id}) at "
+            f"t={state.now:.3f} s: {why}; waiting: {', '.join(waiting) or '-'}")
+    state.deadlocks.append({"time": state.now, "process": proc.id, "instance": inst.id,
+                            "waiting": waiting, "message": text})
+    if state.wants(EK.DEADLOCK, proc.id, None):
+        state.emit(EK.DEADLOCK, proc.id, inst.id, None, proc.lane, None,
+                   {"waiting": list(waiting), "message": text})
+    flow.end_instance(inst, ABORTED, text)

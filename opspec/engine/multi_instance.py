@@ -152,6 +152,8 @@ def release(group: MultiInstance) -> None:
     if holder is not None and holder.state == RUNNING:
         holder.state = COMPLETED
         holder.gen += 1
-        for undo in holder.cleanup:
-            undo()
-        holder.cleanup.clear()
+        cleanup = holder.cleanup
+        if cleanup:
+            for undo in cleanup:
+                undo()
+            cleanup.clear()

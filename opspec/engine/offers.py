@@ -97,7 +97,8 @@ class Offers(Part):
             if performer is None:
                 ai.waiting = f"performer for the choice {[acts[t.target].id for t in manual]}"
                 return
-            self.offer(ai, performer, tuple(acts[t.target].id for t in manual), None, None)
+            # (a list, not a generator: from source a generator resumes once per item)
+            self.offer(ai, performer, tuple([acts[t.target].id for t in manual]), None, None)
 
     def _labelled_choice(self, ai: ActivityInstance, branches: tuple[CTransition, ...]) -> None:
         """A split between labelled branches: the performer bound to the deciding activity

@@ -362,22 +362,26 @@ class RunState(Timers):
         finally:
             self.inside = outer
 
-    def start_counted(self, frame: Frame) -> None:
-        """A workflow instance was started (``frame`` its top frame): past
+    def start_counted(self, inst: ProcessInstance) -> None:
+        """A workflow instance was started: past
         ``max_instant_starts`` instances at one instant, a zero-time cycle that piles up
         instances (a workflow starting itself asynchronously), stopped and named like any
         zero-time cycle, within seconds and some tens of megabytes."""
         now = self.now
-        # (``!=`` first: most instances start at the instant of the one before, and from
-        # source _same_instant is three calls)
-        if now != self.starts_at and not _same_instant(now, self.starts_at):
-            self.starts_at = now
-            self.instant_starts = 1
-            return
+        if now != self.starts_at:
+            # _same_instant in line (from source it is three calls): the clock moved
+            # unless by a Zeno step
+            moved = now - self.starts_at
+            scale = now if now >= 0.0 else -now
+            if not ((moved if moved >= 0.0 else -moved)
+                    <= 1e-9 * (scale if scale > 1.0 else 1.0)):
+                self.starts_at = now
+                self.instant_starts = 1
+                return
         self.instant_starts += 1
         if self.instant_starts > self.max_instant_starts:
-            starts = frame.graph.starts
-            self.zero_time(frame, starts[0] if starts else None, self.instant_starts)
+            starts = inst.process.graph.starts
+            self.zero_time(inst, starts[0] if starts else None, self.instant_starts)
 
 
 #: how many run items of the ready queue drain keeps before dropping them from its front

@@ -62,7 +62,7 @@ class Triggers(Part):
                 table = self.state.waiters[key] = {}
             token = next(self.state.keys)
             table[token] = (ai, handler, (arg, persistent, key, token))
-            ai.cleanup.append(lambda: discard(table, token))
+            ai.on_leave(lambda: discard(table, token))
         elif kind in ("timer", "period"):
             inst = ai.frame.inst
             every = trig.every or 0.0
@@ -91,7 +91,7 @@ class Triggers(Part):
             condition = trig.condition
             self.state.rules[rkey] = (lambda: condition(inst.scope, self.state.now),
                                  lambda: handler(ai, arg, None), ai)
-            ai.cleanup.append(lambda: discard(self.state.rules, rkey))
+            ai.on_leave(lambda: discard(self.state.rules, rkey))
 
     def _cycle(self, ai: ActivityInstance, trig: CTrigger, handler: Any, arg: Any,
                base: float, k: int, end: int) -> None:
@@ -141,11 +141,16 @@ class Triggers(Part):
         A *signal* reaches everything waiting for it now and is not kept: catch events,
         event-gateway branches, boundary events, start and end triggers.
         """
-        self.state.raised_names.add(name)
+        state = self.state
+        state.raised_names.add(name)
         proc = inst.process.id if inst is not None else None
         aid = act.id if act is not None else None
-        if (self.state.act_bits(act) & 16 if act is not None
-                else self.state.wants_all or (EK.TRIGGER_RAISED, proc, aid) in self.state.wanted):
+        if act is not None:
+            cached = act.flag_cache           # RunState.act_bits's cached case, in line
+            wanted = (cached.bits if cached.key is state.flag_key else state.act_bits(act)) & 16
+        else:
+            wanted = state.wants_all or (EK.TRIGGER_RAISED, proc, aid) in state.wanted
+        if wanted:
             self.state.emit(EK.TRIGGER_RAISED, proc, inst.id if inst else None, aid,
                       act.lane if act else None, act.participant if act else None,
                       {"trigger": kind, "name": name, **(dict(data) if data else {})})
@@ -204,7 +209,7 @@ class Triggers(Part):
         kind, name = key
         started = False
         for target, start in self.state.starts.get(key, ()):
-            if self.is_active(target.id):
+            if not self.state.compiled.modes or self.is_active(target.id):
                 child = self.flow.start_process(target, self._fields(target, data),
                                                 trigger=f"{kind}:{name}", start=start)
                 child.partner = _root(inst) if inst is not None else None

@@ -45,7 +45,9 @@ class WorkItem:
         self.offered_at: Final = offered_at
         self.application: Final = application
         self.data: Final = data
-        self.choices: Final[tuple[str, ...]] = tuple(choices)   # a list from a caller too
+        # a list from a caller too (no tuple() call for the engine's own tuples)
+        self.choices: Final[tuple[str, ...]] = (
+            choices if type(choices) is tuple else tuple(choices))
         self.root_instance: Final = root_instance
         self.duration: Final = duration
 

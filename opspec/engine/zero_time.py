@@ -66,7 +66,8 @@ class ZeroTimeSampler:
     """What the steps past the limit move, at the instant ``at``.
 
     :meth:`record` takes the two first arguments of a ready-queue item (a frame and an
-    activity index, an activity instance, ...) or a frame and the activity itself, or
+    activity index, an activity instance, ...) or a frame and the activity itself (a
+    workflow instance instead of a frame: its one token before it has a frame), or
     ``(None, None)`` for a drain (a clock event at this instant); it returns ``True`` once
     enough steps have been seen for :meth:`error` to name the cycle.
     """
@@ -91,6 +92,12 @@ class ZeroTimeSampler:
             graph = getattr(a, "graph", None)
             if graph is not None:                          # a Frame
                 inst = a.inst
+            elif getattr(a, "frames", None) is not None:
+                # a workflow instance whose one token runs without a frame yet
+                # (opspec.engine.lone): its top frame's graph and itself
+                graph = a.process.graph
+                inst = a
+            if graph is not None:
                 if isinstance(b, int) and 0 <= b < len(graph.activities):
                     act = graph.activities[b]
                 elif getattr(b, "process", None) is not None and hasattr(b, "index"):

@@ -129,6 +129,8 @@ class Compiler(Context):
                     and only.tokens == 1
                     and not ca.otherwise and not ca.choice and not ca.terminate):
                 ca.next = only.target
+        for ca in acts:
+            ca.lone = _lone(ca, acts)
 
     def process(self, proc: WorkflowProcess) -> CompiledProcess:
         directives = proc.directives
@@ -157,7 +159,9 @@ class Compiler(Context):
             formals=tuple((f.id, f.mode) for f in proc.formal_parameters), priority=priority,
             lane=lane, start_trigger=start, end_trigger=self.trigger_ref(directives.end_trigger),
             auto_start=bool(auto), deadline=directives.deadline, mode=directives.mode,
-            location=proc.location, start_events=start_events, called_starts=called_starts)
+            location=proc.location, start_events=start_events, called_starts=called_starts,
+            one_start=_one_start(graph, (called_starts or graph.starts) if start_events
+                                 else graph.starts))
 
     def start_trigger(self, proc: WorkflowProcess, graph: CompiledGraph
                       ) -> tuple[CTrigger | None, tuple[tuple[CTrigger, int], ...]]:
@@ -301,3 +305,28 @@ def _catchers(processes: Iterable[CompiledProcess]) -> dict[tuple[str, str], fro
                     if trig is not None and trig.kind in ("message", "signal"):
                         found.setdefault((trig.kind, trig.name or ""), set()).add(proc.id)
     return {key: frozenset(ids) for key, ids in found.items()}
+
+
+def _one_start(graph: CompiledGraph, starts: tuple[int, ...]) -> int:
+    """``CompiledProcess.one_start``: the start activity when an instance has one token."""
+    return starts[0] if len(starts) == 1 and graph.completion is None else -1
+
+
+def _lone(ca: CompiledActivity, acts: tuple[CompiledActivity, ...]) -> bool:
+    """Whether the one token of an instance without a frame yet can pass ``ca``
+    (:meth:`opspec.engine.activities.Activities.start_lone`): instantaneous, ending without a
+    throw, raise, error, escalation or terminate, and leaving by a split that takes one
+    transition into an activity without a join to synchronise at (or by none: an end).
+    Anything else gives the instance its frame first and goes the general way."""
+    if not ca.fast or ca.kind == K_THROW or ca.raises is not None or ca.terminate \
+            or ca.error is not None or ca.escalation is not None:
+        return False
+    if ca.next >= 0:
+        return not acts[ca.next].join
+    if ca.choice or ca.drawn:
+        return False
+    branches = ca.out + ca.otherwise
+    if not branches:
+        return True                                 # an end
+    return ca.split == S_XOR and all(not acts[t.target].join and t.tokens == 1
+                                     for t in branches)
