@@ -59,11 +59,11 @@ echo "== set up done after ${SECONDS} s"
 # removed when the run ends. On the 2-core CI machine's disk (ext4 mounted with `discard`) an
 # fdatasync of a SQLite result store took about 3 ms and an unlink about 2 ms of waiting: the
 # interval-coverage test alone (1,000 stores made, closed and deleted) waited about 35 s
-# with its core idle, and each pass's pytest deleted, as it exited, the numbered folders of
-# earlier runs in /tmp/pytest-of-$USER (pytest keeps the last three), among them the
-# fresh-venv test's 13,000 files: about 25 s more. No test depends on the file system under
-# its temporary folder (the full-disk tests inject their ENOSPC). OPSPEC_TEST_TMPDIR=DIR puts
-# the folder under DIR instead; empty, the tests keep the system's temporary folder.
+# with its core idle; and a pytest process deletes, as it exits, the numbered folders of
+# earlier runs in /tmp/pytest-of-$USER beyond the last three (24 s for one that held the
+# fresh-venv test's 13,000 files). No test depends on the file system under its temporary
+# folder (the full-disk tests inject their ENOSPC). OPSPEC_TEST_TMPDIR=DIR puts the folder
+# under DIR instead; empty, the tests keep the system's temporary folder.
 tmp_root="${OPSPEC_TEST_TMPDIR-/dev/shm}"
 if [ -n "$tmp_root" ] && [ -d "$tmp_root" ] && [ -w "$tmp_root" ] \
         && [ "$(df -Pk "$tmp_root" | awk 'NR == 2 {print $4}')" -ge $((2 * 1024 * 1024)) ]; then
