@@ -51,7 +51,9 @@ else
     # compiled-pass workers making the same files at once (a collection of the whole suite
     # from cold caches took 30 CPU-s, from warm ones 8). opspec is not installed yet, so it
     # is imported from the checkout and its pytest plugin named (`-p no:opspec`: not twice
-    # should the install finish meanwhile). Nothing depends on it succeeding.
+    # should the install finish meanwhile). Nothing depends on it succeeding, and it is
+    # stopped when the install ends (what it wrote stays: each file is written whole), so it
+    # never delays the tests -- on a loaded machine a niced process may have done little.
     PYTHONPATH="$PWD${PYTHONPATH:+:$PYTHONPATH}" OPSPEC_PURE_PYTHON=1 nice -n 19 \
         .venv/bin/python -m pytest --collect-only -q -p no:cacheprovider -p no:opspec \
         -p opspec.testing.plugin >"$logs/warm.log" 2>&1 & warm=$!
@@ -60,7 +62,8 @@ else
     echo "== engine installed at ${SECONDS} s"
     cat "$logs/build.log" >&2
     [ "$built" -eq 0 ] || { echo "installing opspec failed (above)" >&2; exit 1; }
-    wait "$warm" || true
+    kill "$warm" 2>/dev/null || true
+    wait "$warm" 2>/dev/null || true
 fi
 .venv/bin/opspec --version
 wait "$oracle" "$spiff" || true
