@@ -73,7 +73,7 @@ echo "== set up done after ${SECONDS} s"
 # The tests' files -- pytest's tmp_path and every temporary folder the code under test and the
 # processes it starts make (TMPDIR) -- go to a folder of this run's own on tmpfs (/dev/shm),
 # removed when the run ends. On the 2-core CI machine's disk (ext4 mounted with `discard`) an
-# fdatasync of a SQLite result store took about 3 ms and an unlink about 2 ms of waiting: the
+# fdatasync of a SQLite result store took about 3 ms and an unlink 2-3.5 ms of waiting: the
 # interval-coverage test alone (1,000 stores made, closed and deleted) waited about 35 s
 # with its core idle; and a pytest process deletes, as it exits, the numbered folders of
 # earlier runs in /tmp/pytest-of-$USER beyond the last three (24 s for one that held the
