@@ -41,6 +41,16 @@ def load_benchmark():
     return load
 
 
+@pytest.fixture
+def no_report():
+    """`opspec evaluate` in this test draws no report (tests/evaluate_without_report.py):
+    for a test that reads the store, ``--json`` or an export, and not the report."""
+    from evaluate_without_report import without_report
+
+    with without_report():
+        yield
+
+
 #: the names a Chromium (or Chrome) executable goes by
 CHROMIUM_NAMES = ("chromium", "chromium-browser", "google-chrome", "google-chrome-stable")
 

@@ -54,9 +54,13 @@ def diagram(tmp_path: Path) -> Path:
 
 
 def _evaluate(diagram: Path, out: Path, *options: str) -> dict[int, str]:
-    """The end each simulated user reached, by user index (from the exported trace)."""
-    code = main(["evaluate", str(diagram), "--days", "0.001", "--out", str(out), "--export",
-                 "jsonl", "--workers", "1", *options])
+    """The end each simulated user reached, by user index (from the exported trace; no
+    report is drawn: tests/evaluate_without_report.py)."""
+    from evaluate_without_report import without_report
+
+    with without_report():
+        code = main(["evaluate", str(diagram), "--days", "0.001", "--out", str(out),
+                     "--export", "jsonl", "--workers", "1", *options])
     assert code == 0
     ends: dict[int, str] = {}
     for line in (out / "traces.jsonl").read_text().splitlines():

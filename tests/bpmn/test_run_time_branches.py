@@ -89,7 +89,8 @@ def test_the_cli_option_reaches_the_trace(diagram: Path, tmp_path: Path,
 
 
 def test_evaluate_draws_the_same_branches_whatever_the_number_of_workers(
-        diagram: Path, tmp_path: Path) -> None:
+        diagram: Path, tmp_path: Path, no_report) -> None:
+    # the exported trace is the point: no report (tests/evaluate_without_report.py)
     def chosen(workers: str) -> list[str]:
         out = tmp_path / f"w{workers}"
         assert main(["evaluate", str(diagram), "--users", "4", "--days", "0.01", "--out",

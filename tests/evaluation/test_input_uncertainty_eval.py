@@ -72,7 +72,7 @@ def test_the_same_seed_gives_the_same_draws_whatever_the_workers(evaluate, fitte
                                                                    tmp_path) -> None:
     common = [str(SPEC), "--user-model", str(fitted), "--users", "6", "--days", "1",
               "--quiet", "--input-uncertainty", "5", "--users-per-draw", "3"]
-    one = evaluate(*common, "--out", str(tmp_path / "one"), "--workers", "1")[1]
+    one = evaluate(*common, "--out", str(tmp_path / "one"), "--workers", "1", report=False)[1]
     two = evaluate(*common, "--out", str(tmp_path / "two"), "--workers", "2", report=False)[1]
     assert one["input_uncertainty"] == two["input_uncertainty"]
     assert _rows(tmp_path / "one", "A~draws") == _rows(tmp_path / "two", "A~draws")

@@ -29,6 +29,7 @@ from pathlib import Path
 from typing import Any
 
 import pytest
+from evaluate_without_report import without_report
 from scipy import stats
 
 from opspec.cli import main
@@ -60,7 +61,9 @@ def evaluation(tmp_path_factory: pytest.TempPathFactory) -> tuple[dict[str, Any]
                                         "<Expression>alarms &lt; 4</Expression>"),
                       encoding="utf-8")
     out = io.StringIO()
-    with contextlib.redirect_stdout(out), contextlib.redirect_stderr(io.StringIO()):
+    # the numbers are the point: no report (tests/evaluate_without_report.py)
+    with contextlib.redirect_stdout(out), contextlib.redirect_stderr(io.StringIO()), \
+            without_report():
         status = main(["evaluate", str(spec_a), "--compare", str(spec_b), "--user-model",
                        str(USERS), "--users", "12", "--days", "3", "--seed", "2",
                        "--workers", "1", "--out", str(folder / "out"), "--json"])

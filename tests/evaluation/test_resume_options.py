@@ -14,6 +14,7 @@ import time
 
 import pytest
 from conftest import SPEC, USERS_TOML, metrics_of
+from evaluate_without_report import without_report
 
 from opspec.cli import main
 
@@ -21,10 +22,12 @@ from opspec.cli import main
 @pytest.fixture(scope="module")
 def stored_once(tmp_path_factory):
     """A finished run of 3 users x 1 day, seed 5, the companion user model: evaluated once
-    for the module (most of its cost is the fixed cost of the report), copied for each test."""
+    for the module and copied for each test. These tests are about what a resume accepts:
+    no report is drawn (tests/evaluate_without_report.py)."""
     out = tmp_path_factory.mktemp("stored") / "run"
     stdout, stderr = io.StringIO(), io.StringIO()
-    with contextlib.redirect_stdout(stdout), contextlib.redirect_stderr(stderr):
+    with contextlib.redirect_stdout(stdout), contextlib.redirect_stderr(stderr), \
+            without_report():
         status = main(["evaluate", str(SPEC), "--users", "3", "--days", "1", "--seed", "5",
                        "--out", str(out), "--workers", "1", "--json"])
     assert status == 0, stderr.getvalue()
@@ -85,7 +88,7 @@ def test_the_same_options_spelled_out_resume(stored, evaluate, monkeypatch):
     monkeypatch.chdir(SPEC.parents[1])
     status, again, err = evaluate(f"./specs/{SPEC.name}", "--resume", "--out", str(out),
                                   "--users", "3", "--days", "1", "--seed", "5",
-                                  "--user-model", str(USERS_TOML))
+                                  "--user-model", str(USERS_TOML), report=False)
     assert status == 0, err
     assert metrics_of(again) == metrics_of(doc)
 
@@ -95,7 +98,7 @@ def test_a_changed_user_model_file_is_refused_with_both_digests(tmp_path, evalua
     shutil.copy(USERS_TOML, model)
     out = tmp_path / "run"
     assert evaluate(str(SPEC), "--users", "2", "--days", "1", "--user-model", str(model),
-                    "--out", str(out))[0] == 0
+                    "--out", str(out), report=False)[0] == 0
     model.write_text(USERS_TOML.read_text(encoding="utf-8") + "\n# edited\n",
                      encoding="utf-8")
     status, _, err = evaluate("--resume", "--out", str(out))

@@ -24,13 +24,17 @@ USERS, DAYS = 3, 2
 @pytest.fixture(scope="module")
 def run(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, dict, str]:
     """3 users x 2 days exported as OCEL, XES and JSONL, in one run: the XES and JSONL cases
-    are chains by default (one per dose of the dispenser)."""
+    are chains by default (one per dose of the dispenser). No report: these tests read the
+    exports (tests/evaluate_without_report.py)."""
     out = tmp_path_factory.mktemp("ocel") / "run"
     import contextlib
     import io
 
+    from evaluate_without_report import without_report
+
     stdout, stderr = io.StringIO(), io.StringIO()
-    with contextlib.redirect_stdout(stdout), contextlib.redirect_stderr(stderr):
+    with contextlib.redirect_stdout(stdout), contextlib.redirect_stderr(stderr), \
+            without_report():
         status = main(["evaluate", str(SPEC), "--users", str(USERS), "--days", str(DAYS),
                        "--seed", "4", "--out", str(out), "--export", "ocel,xes,jsonl",
                        "--workers", "1", "--json"])
@@ -133,7 +137,7 @@ def test_xes_per_dose_has_the_same_cases(run):
     assert all(n.split("/")[2].startswith("timer_workflow#") for n in names)
 
 
-def test_case_per_instance_makes_one_case_per_workflow_instance(tmp_path):
+def test_case_per_instance_makes_one_case_per_workflow_instance(tmp_path, no_report):
     out = tmp_path / "run"
     assert main(["evaluate", str(SPEC), "--users", "2", "--days", "1", "--out", str(out),
                  "--export", "jsonl", "--case", "instance", "--workers", "1",
@@ -220,7 +224,8 @@ def test_an_interrupted_ocel_export_leaves_only_the_partial_file(tmp_path):
     assert not path.exists() and (tmp_path / "t.jsonocel.partial").exists()
 
 
-def test_ocel_relates_a_user_workflows_events_to_the_user_whatever_its_lanes_say(tmp_path):
+def test_ocel_relates_a_user_workflows_events_to_the_user_whatever_its_lanes_say(
+        tmp_path, no_report):
     """The pill template's user workflow has no opspec:Lane directive: its events carry no
     lane, yet they are the user's work (its activities are manual, performed by the HUMAN
     participant). OCEL 2.0 relationships qualify how an object takes part in an event; the

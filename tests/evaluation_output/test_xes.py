@@ -338,7 +338,7 @@ def test_pm4py_reads_the_log_back(tmp_path: Path, dispenser_day: list[TraceEvent
 KITCHEN = Path(__file__).resolve().parents[1] / "tui" / "data" / "kitchen_lanes.bpmn"
 
 
-def test_org_group_is_the_lanes_name_in_xes_and_ocel(tmp_path: Path) -> None:
+def test_org_group_is_the_lanes_name_in_xes_and_ocel(tmp_path: Path, no_report) -> None:
     """The XES Organizational extension: "group — The group within the organizational
     structure" (IEEE 1849-2016, org:group). A process-mining tool shows this string to the
     analyst, so a BPMN lane's name ("Stove guard appliance"), not its XML id (guard_lane),

@@ -28,7 +28,9 @@ USERS, DAYS, SEED = 6, 3, 2            # some of these users reach the second re
 
 def test_simulate_fails_the_same_replications_as_evaluate_and_names_the_fault(
         broken_spec: Path, fault_site: str, tmp_path: Path,
-        capsys: pytest.CaptureFixture[str]) -> None:
+        capsys: pytest.CaptureFixture[str], no_report) -> None:
+    # evaluate's failures in its report: test_evaluate_faults.py; here its --json
+    # (tests/evaluate_without_report.py)
     result = simulate(broken_spec, users=USERS, days=DAYS, seed=SEED)   # the companion users
     where = fault_site
     assert 1 <= len(result.failed) < USERS and result.complete == USERS - len(result.failed)
