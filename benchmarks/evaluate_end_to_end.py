@@ -26,6 +26,12 @@ process storing beside its workers and the workers' own, the tail after the repl
 the report's drawing processes - and from them an estimate of the speed-up of W workers over
 1 on W idle cores (``estimated_wall``), which a machine others load cannot show in wall time.
 
+``--instructions`` instead counts, with valgrind's callgrind, the instructions of the baseline,
+the engine alone and ``opspec evaluate --workers 1`` (store, summaries and report included)
+at ``--users`` x ``--days``, each once (``PYTHONHASHSEED=0``): a measure that the other work
+on a shared machine does not move, where CPU seconds of the same command swing by a third
+(200 users x 30 days take a few minutes under callgrind).
+
 ``--memory 10000,100000`` instead runs ``evaluate --days 1`` for each number of users and
 prints the peak and final resident memory of the evaluate process itself (not its workers;
 goal: flat from 10,000 to 100,000 users). ``--profile FILE`` also writes a CPU-time cProfile
@@ -33,7 +39,8 @@ of one ``evaluate --workers 1`` (``python -m pstats FILE``). The first line says
 ran (compiled with mypyc, or from source): run it from the checkout whose engine you measure.
 
     python benchmarks/evaluate_end_to_end.py [--users 1000] [--days 30] [--rounds 3]
-        [--workers 1,2] [--memory 10000,100000] [--profile FILE] [--no-bytecode]
+        [--workers 1,2] [--memory 10000,100000] [--instructions] [--profile FILE]
+        [--no-bytecode]
 
 Before measuring it writes the bytecode of opspec's modules (``compileall``), as an install
 or a first run leaves it on a user's machine; ``--no-bytecode`` skips that (see
@@ -261,6 +268,35 @@ def memory(args: argparse.Namespace) -> None:
               f"{run.wall:>9.1f}")
 
 
+def instruction_counts(args: argparse.Namespace, script: Path) -> None:
+    """Instructions of the baseline, the engine alone and ``evaluate --workers 1``, each
+    under callgrind once, and their ratios (see the module docstring)."""
+    from callgrind import instructions
+
+    sizes = [str(args.users), str(args.days), str(args.seed)]
+    run = "import sys\nfrom opspec.cli import main\nsys.exit(main(sys.argv[1:]))\n"
+    os.environ["PYTHONHASHSEED"] = "0"
+    print(f"medication dispenser, {args.users:,} users x {args.days} days, seed {args.seed}: "
+          f"instructions (callgrind), each once; {_load()}")
+    counts: dict[str, int] = {}
+    counts["baseline"] = instructions(
+        f"import runpy, sys\nsys.argv = [{str(script)!r}, '--users', {sizes[0]!r}, "
+        f"'--days', {sizes[1]!r}, '--seed', {sizes[2]!r}]\n"
+        f"runpy.run_path({str(script)!r}, run_name='__main__')\n", cwd=script.parent)
+    counts["engine alone"] = instructions(_ENGINE, str(SPEC), str(USERS_TOML), *sizes[:2],
+                                          sizes[2], cwd=ROOT)
+    with tempfile.TemporaryDirectory() as tmp:
+        counts["evaluate --workers 1"] = instructions(
+            run, "evaluate", str(SPEC), "--users", sizes[0], "--days", sizes[1], "--seed",
+            sizes[2], "--workers", "1", "--user-model", str(USERS_TOML), "--quiet", "--out",
+            str(Path(tmp) / "run"), cwd=ROOT)
+    for name, count in counts.items():
+        print(f"  {name:<24}{count / 1e9:8.2f} G instructions   "
+              f"{count / counts['baseline']:.2f} x the baseline")
+    print(f"  evaluate --workers 1 / engine alone   "
+          f"{counts['evaluate --workers 1'] / counts['engine alone']:.2f}")
+
+
 def byte_compile() -> str:
     """Write the bytecode of opspec's Python modules, as ``pip install`` or a first run leaves
     it on a user's machine, and say so. Where ``PYTHONDONTWRITEBYTECODE`` is set (this
@@ -285,6 +321,9 @@ def main() -> None:
                         help="comma-separated worker counts of evaluate (default 1)")
     parser.add_argument("--memory", metavar="USERS,...",
                         help="instead: memory of evaluate --days 1 at these numbers of users")
+    parser.add_argument("--instructions", action="store_true",
+                        help="instead: callgrind instruction counts of the baseline, the "
+                        "engine alone and evaluate --workers 1, each once")
     parser.add_argument("--profile", metavar="FILE",
                         help="also write a CPU-time cProfile of one evaluate --workers 1")
     parser.add_argument("--no-bytecode", action="store_true",
@@ -301,7 +340,10 @@ def main() -> None:
         if script is None:
             sys.exit("baseline not found: put shared/bench/handcoded_simpy.py beside a folder "
                      "above this checkout, or set OPSPEC_BENCH to its folder")
-        speed(args, script)
+        if args.instructions:
+            instruction_counts(args, script)
+        else:
+            speed(args, script)
     if args.profile:
         evaluate(args.users, args.days, args.seed, 1, profile=args.profile)
         print(f"profile of one evaluate --workers 1: {args.profile} (python -m pstats)")

@@ -441,7 +441,10 @@ def run(args: argparse.Namespace) -> int:
         _store_parameters(store, plan, definitions, __version__)
         if swept is not None:
             store.put("sweep", swept.to_json())
-    with store, contextlib.ExitStack() as stack:
+    from opspec.evaluation.memory import startup_frozen
+
+    # what is loaded by now lives through the run: the collector need not scan it again
+    with store, contextlib.ExitStack() as stack, startup_frozen():
         on_trace = _trace_writers(stack, store.folder, plan)
         progress = make_progress(sys.stderr, quiet=args.quiet or args.json,
                                  label="users" if len(plan.designs) == 1 else "replications")
@@ -553,7 +556,8 @@ def run(args: argparse.Namespace) -> int:
 
     # what the run left to the collector and the allocator grows with the users: give it
     # back, so that the process (a notebook's, a service's) holds after the run what it uses
-    release_free_memory()
+    # (the run's garbage was collected as startup_frozen ended)
+    release_free_memory(collect=False)
     return 1 if failures else 0
 
 

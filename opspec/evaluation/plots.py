@@ -203,19 +203,44 @@ def drawn_by(workers: int) -> Iterator[None]:
         yield
         return
     queue: list[_Job] = []
-    token = _QUEUE.set(queue)
+    # with started drawing processes, each figure is sent to them as it is asked for: they
+    # draw while this process still works out the report's other figures and tables
+    sent: dict[int, Any] | None = {} if _POOL.get() is not None else None
+    token, sending = _QUEUE.set(queue), _SENT.set(sent)
     try:
         yield
     finally:
         _QUEUE.reset(token)
-    _draw(queue, workers)
+        _SENT.reset(sending)
+    _draw(queue, workers, sent or {})
 
 
-def _draw(queue: Sequence[_Job], workers: int) -> None:
+#: Within :func:`drawn_by` with started drawing processes: the futures of the figures sent
+#: to them as they were asked for, by their place in the queue.
+_SENT: ContextVar[dict[int, Any] | None] = ContextVar("opspec_figures_sent", default=None)
+
+
+def _send_now(queue: Sequence[_Job], sent: dict[int, Any]) -> None:
+    """Send the figure last queued to the started drawing processes, when they know its
+    function; otherwise it waits for the block's end (:func:`_draw`)."""
+    started = _POOL.get()
+    draw, args, kwargs, fmt = queue[-1]
+    name = getattr(draw, "__name__", "")
+    if started is None or _FIGURES.get(name) is not draw:
+        return
+    try:
+        sent[len(queue) - 1] = started[0].submit(_draw_named, name, args, kwargs, fmt)
+    except Exception:  # noqa: BLE001, S110 - a process gone: drawn at the block's end
+        pass
+
+
+def _draw(queue: Sequence[_Job], workers: int, sent: Mapping[int, Any] | None = None
+          ) -> None:
     global _JOBS
-    if workers > 1 and len(queue) > 1:
+    sent = sent or {}
+    if workers > 1 and (len(queue) > 1 or sent):
         started = _POOL.get()
-        if started is not None and _on_started(started[0], queue):
+        if started is not None and _on_started(started[0], queue, sent):
             return
         import concurrent.futures as cf
         import multiprocessing
@@ -241,23 +266,23 @@ def _draw(queue: Sequence[_Job], workers: int) -> None:
         _draw_one(job)
 
 
-def _on_started(pool: Any, queue: Sequence[_Job]) -> bool:
+def _on_started(pool: Any, queue: Sequence[_Job], sent: Mapping[int, Any]) -> bool:
     """Draw ``queue`` on the processes :func:`drawing_processes` started, the figure
-    functions sent by name (they were forked before the figures were asked for). False
-    when that cannot be done (a figure function replaced by another, a process gone, a
-    figure that failed): the caller draws them as before, where an error is plain."""
-    named = []
-    for draw, args, kwargs, fmt in queue:
-        name = getattr(draw, "__name__", "")
-        if _FIGURES.get(name) is not draw:
-            return False
-        named.append((name, args, kwargs, fmt))
+    functions sent by name (they were forked before the figures were asked for); those
+    ``sent`` as they were asked for are only waited for. False when that cannot be done (a
+    figure function replaced by another, a process gone, a figure that failed): the caller
+    draws them as before, where an error is plain."""
     import concurrent.futures as cf
 
-    futures = []
+    futures = list(sent.values())
     try:
-        for job in named:
-            futures.append(pool.submit(_draw_named, *job))
+        for index, (draw, args, kwargs, fmt) in enumerate(queue):
+            if index in sent:
+                continue
+            name = getattr(draw, "__name__", "")
+            if _FIGURES.get(name) is not draw:
+                return False
+            futures.append(pool.submit(_draw_named, name, args, kwargs, fmt))
     except Exception:  # noqa: BLE001 - a process gone: drawn again by the caller
         return False
     finally:
@@ -320,6 +345,9 @@ def _queueable(draw: _Draw) -> _Draw:
             _import_matplotlib()
             return draw(*args, **kwargs)
         queue.append((draw, args, kwargs, _FORMAT.get()))
+        sent = _SENT.get()
+        if sent is not None:
+            _send_now(queue, sent)
         path, fmt = _written(signature.bind(*args, **kwargs).arguments["path"])
         return path.with_suffix(".svg") if fmt == "pdf" else path
 

@@ -13,16 +13,15 @@ their subgroup and drawn parameters) and its trace only when the run exports tra
 from __future__ import annotations
 
 import time
-from collections import Counter
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from typing import Any
 
 from opspec.errors import OpspecError
+from opspec.evaluation.columns import DAY, Columns, outcome_columns, sample_columns
 
 __all__ = ["ActivityCounter", "ActivityRecorder", "ReplicationRecord", "prepare", "run_users"]
 
-DAY = 86_400.0
 USER_KINDS_WRONG = ("user.wrong_choice", "user.slip")
 
 
@@ -48,6 +47,11 @@ class ReplicationRecord:
     # who the user is, when the user model is a population: (subgroup or None, the
     # parameters drawn for them as dotted path -> value); None for a model without variation
     person: tuple[str | None, dict[str, float]] | None = None
+    # the sample and outcome rows column by column (opspec.evaluation.columns), as
+    # run_user makes them: stored after the rows of ``samples`` and ``outcomes`` above (a
+    # record built by hand), which run_user leaves empty
+    sample_columns: Columns | None = None
+    outcome_columns: Columns | None = None
 
 
 #: The column of the activity table each event kind counts in: offered, completed, omitted,
@@ -246,13 +250,9 @@ def run_user(context: _Context, design: str, user: int, *, seed: int, horizon: f
         first = seen.violations[0] if seen.violations else None
         record.monitors[seen.monitor] = (
             seen.count, first.time if first else None, first.message if first else None)
-    for name, values in outcome.samples.items():
-        ends = outcome.sample_times.get(name, ())
-        record.samples.extend((name, v, t) for v, t in zip(values, ends, strict=True))
-    for name, times in outcome.count_times.items():
-        # counted by Counter's C loop, keys in the order first seen (the rows' order)
-        record.outcomes.update(Counter([(name, int(t // DAY), int((t % DAY) // 3600))
-                                        for t in times]))
+    # the rows as columns: counted and sent as a few arrays (opspec.evaluation.columns)
+    record.sample_columns = sample_columns(outcome.samples, outcome.sample_times)
+    record.outcome_columns = outcome_columns(outcome.count_times)
     if keep_trace and result.trace is not None:
         record.trace = [event.to_json() for event in result.trace]
     record.wall_s = time.perf_counter() - start

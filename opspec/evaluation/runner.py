@@ -5,8 +5,10 @@
 - ``scheduler``: an existing Dask distributed cluster, through ``client.get_executor()`` —
   the same code path as the pool.
 Users are sent in chunks so the per-task overhead stays negligible; every record is stored
-(and committed) in this process as soon as its chunk returns. A chunk whose worker dies is
-recorded as failed replications with the reason; ``--resume`` runs them again.
+(and committed) in this process as soon as its chunk and the chunks sent before it have
+returned: in the order sent, so that the store's rows (and the trace exports) are those of
+one worker whatever the number of workers. A chunk whose worker dies is recorded as failed
+replications with the reason; ``--resume`` runs them again.
 """
 
 from __future__ import annotations
@@ -231,16 +233,24 @@ def _drain(executor: cf.Executor, doc: dict[str, object], pending: Iterable[Chun
     second while no chunk finishes (and may raise: a cluster left without workers).
     """
     queue = iter(pending)
-    running: dict[cf.Future[list[ReplicationRecord]], Chunk] = {}
+    # each chunk's place in the order it was sent: chunks are stored in that order (those
+    # back early wait for the ones before them), so the store's rows, the trace exports and
+    # what is drawn from them are those of one worker whatever the number of workers
+    running: dict[cf.Future[list[ReplicationRecord]], tuple[int, Chunk]] = {}
+    back: dict[int, list[ReplicationRecord] | None] = {}   # None: lost, stored later
+    sent = stored = 0
     lost: list[tuple[str, list[int], str]] = []
 
     def fill() -> None:
-        while len(running) < slots:
+        nonlocal sent
+        # at most ``slots`` chunks back early wait for a slow one: a bounded memory
+        while len(running) < slots and len(back) < slots:
             item = next(queue, None)
             if item is None:
                 return
             try:
-                running[executor.submit(run_users, doc, *item)] = item
+                running[executor.submit(run_users, doc, *item)] = (sent, item)
+                sent += 1
             except BrokenExecutor as error:
                 reason = _dead_worker(error)
                 lost.append((*item, reason))
@@ -255,15 +265,19 @@ def _drain(executor: cf.Executor, doc: dict[str, object], pending: Iterable[Chun
         if not finished and watch is not None:
             watch()
         for future in finished:
-            label, users = running.pop(future)
+            place, (label, users) = running.pop(future)
             try:
-                records = future.result()
+                back[place] = future.result()
             except BrokenExecutor as error:
                 lost.append((label, users, _dead_worker(error)))
-                continue
+                back[place] = None
             except Exception as error:  # noqa: BLE001 - a failed task, recorded
-                records = _failed(label, users, error)
-            keep(records)
+                back[place] = _failed(label, users, error)
+        while stored in back:
+            records = back.pop(stored)
+            stored += 1
+            if records is not None:
+                keep(records)
             del records
         fill()
     return lost

@@ -40,11 +40,19 @@ from __future__ import annotations
 import json
 import sqlite3
 from collections.abc import Callable, Iterator, Sequence
-from itertools import chain
+from itertools import chain, groupby
 from pathlib import Path
 from typing import Any, Self
 
+import numpy as np
+
 from opspec.errors import EvaluationError
+from opspec.evaluation.columns import (
+    Columns,
+    columns_of_outcomes,
+    columns_of_samples,
+    object_rows,
+)
 from opspec.evaluation.replication import ReplicationRecord
 
 __all__ = ["SCHEMA_VERSION", "ResultStore"]
@@ -115,6 +123,103 @@ def _insert(db: sqlite3.Connection, table: str, rows: Sequence[tuple[Any, ...]])
         db.executemany(f"INSERT INTO {table} VALUES {one}", rows[full:])
 
 
+def _insert_flat(db: sqlite3.Connection, table: str, width: int, values: list[Any]) -> None:
+    """Append the rows of ``width`` values each that ``values`` holds one after another (as
+    :func:`opspec.evaluation.columns.object_rows` makes them) to ``table``, in their order:
+    :func:`_insert`'s statements, each given a slice of the list instead of a tuple per
+    row."""
+    rows = len(values) // width
+    if not rows:
+        return
+    one = "(" + ", ".join("?" * width) + ")"
+    full = rows - rows % _ROWS_PER_INSERT
+    step = width * _ROWS_PER_INSERT
+    if full:
+        db.executemany(f"INSERT INTO {table} VALUES " + ", ".join([one] * _ROWS_PER_INSERT),
+                       (values[i:i + step] for i in range(0, full * width, step)))
+    if full < rows:
+        db.executemany(f"INSERT INTO {table} VALUES {one}",
+                       (values[i:i + width] for i in range(full * width, rows * width, width)))
+
+
+def _sample_columns(record: ReplicationRecord) -> Columns:
+    """A record's sample rows as columns: those given as tuples, then its columns."""
+    return _joined(columns_of_samples(record.samples) if record.samples else None,
+                   record.sample_columns)
+
+
+def _outcome_columns(record: ReplicationRecord) -> Columns:
+    """A record's outcome rows as columns: those given as a mapping, then its columns."""
+    return _joined(columns_of_outcomes(record.outcomes) if record.outcomes else None,
+                   record.outcome_columns)
+
+
+def _joined(given: Columns | None, made: Columns | None) -> Columns:
+    if given is None or made is None:
+        found = given if given is not None else made
+        return found if found is not None else _EMPTY
+    names = given.metrics + made.metrics
+    return Columns(names, np.concatenate((given.which, made.which + len(given.metrics))),
+                   np.concatenate((given.data, made.data)))
+
+
+_EMPTY = Columns((), np.zeros(0, dtype=np.int64), np.zeros((0, 0)))
+
+
+class _RunningSums:
+    """One design's outcome rows summed over users by (metric, day, hour), and Σ over users
+    of (the user's count on a day)² by (metric, day), kept as each chunk is stored: numpy
+    arrays indexed by metric (in the order first stored), day and hour, grown as needed."""
+
+    def __init__(self) -> None:
+        self.metrics: dict[str, int] = {}
+        self.counts = np.zeros((0, 0, 24), dtype=np.int64)
+        self.squares = np.zeros((0, 0), dtype=np.int64)
+
+    def add(self, tables: Sequence[Columns]) -> None:
+        """Add the outcome rows of users stored together (``tables[i]``: user i's)."""
+        tables = [t for t in tables if len(t)]
+        if not tables:
+            return
+        metric = np.concatenate([np.asarray([self.metrics.setdefault(m, len(self.metrics))
+                                             for m in t.metrics], dtype=np.int64)[t.which]
+                                 for t in tables])
+        user = np.repeat(np.arange(len(tables)), [len(t) for t in tables])
+        data = np.concatenate([t.data for t in tables])
+        day, hour, n = data[:, 0], data[:, 1], data[:, 2]
+        self._grow(len(self.metrics), int(day.max()) + 1)
+        np.add.at(self.counts, (metric, day, hour), n)
+        # each user's count of a metric on a day, squared
+        days = self.counts.shape[1]
+        key = (user * len(self.metrics) + metric) * days + day
+        unique, inverse = np.unique(key, return_inverse=True)
+        totals = np.bincount(inverse.ravel(), weights=n).astype(np.int64)
+        at = unique % (len(self.metrics) * days)
+        np.add.at(self.squares, (at // days, at % days), totals * totals)
+
+    def _grow(self, metrics: int, days: int) -> None:
+        have_m, have_d = self.squares.shape
+        if metrics <= have_m and days <= have_d:
+            return
+        m, d = max(metrics, have_m), max(days, have_d)
+        counts = np.zeros((m, d, 24), dtype=np.int64)
+        counts[:have_m, :have_d] = self.counts
+        squares = np.zeros((m, d), dtype=np.int64)
+        squares[:have_m, :have_d] = self.squares
+        self.counts, self.squares = counts, squares
+
+    def sums(self) -> list[tuple[str, int, int, int]]:
+        names = list(self.metrics)
+        return [(names[m], d, h, int(self.counts[m, d, h]))
+                for m, d, h in zip(*(i.tolist() for i in np.nonzero(self.counts)),
+                                   strict=True)]
+
+    def day_squares(self) -> list[tuple[str, int, int]]:
+        names = list(self.metrics)
+        return [(names[m], d, int(self.squares[m, d]))
+                for m, d in zip(*(i.tolist() for i in np.nonzero(self.squares)), strict=True)]
+
+
 def _in_transaction(db: sqlite3.Connection, sql: str, rows: Sequence[tuple[Any, ...]]
                     ) -> None:
     db.execute("BEGIN")
@@ -180,11 +285,10 @@ class ResultStore:
             #: while a fresh store stores: what the report's counts-over-time figures read,
             #: without a pass over the largest table. None once any user's earlier rows
             #: were replaced (or the store had results when opened): then read from the table.
-            self._outcome_sums: dict[str, dict[tuple[str, int, int], int]] | None = (
+            #: With them, Σ over users of (the user's count on a day)², by (metric, day):
+            #: the day-by-day figures' intervals, without that pass either.
+            self._outcome_sums: dict[str, _RunningSums] | None = (
                 None if self._had_results else {})
-            #: likewise, per design, Σ over users of (the user's count on a day)², by
-            #: (metric, day): the day-by-day figures' intervals, without that pass either
-            self._day_squares: dict[str, dict[tuple[str, int], int]] = {}
         except sqlite3.Error as error:
             raise _fail(self.path, "open the result database", error) from None
 
@@ -257,10 +361,16 @@ class ResultStore:
             # a failed replication keeps its metrics (its replication row) and nothing
             # else: every reader of the other tables reads complete replications only
             complete = [r for r in records if r.status == "done"]
-            _insert(db, "sample", [(r.design, r.user, m, v, t) for r in complete
-                                   for m, v, t in r.samples])
-            _insert(db, "outcome", [(r.design, r.user, m, d, h, n) for r in complete
-                                    for (m, d, h), n in r.outcomes.items()])
+            # runs of records of one design (a chunk is one design), in their order: the
+            # rows as columns, flattened by numpy (opspec.evaluation.columns)
+            groups = [(design, list(group))
+                      for design, group in groupby(complete, key=lambda r: r.design)]
+            counted = [[_outcome_columns(r) for r in group] for _, group in groups]
+            for (design, group), outcomes in zip(groups, counted, strict=True):
+                users = [r.user for r in group]
+                _insert_flat(db, "sample", 5, object_rows(
+                    design, users, [_sample_columns(r) for r in group], 2))
+                _insert_flat(db, "outcome", 6, object_rows(design, users, outcomes, 3))
             _insert(db, "activity", [(r.design, r.user, a, *c) for r in complete
                                      for a, c in r.activities.items()])
             _insert(db, "monitor", [(r.design, r.user, m, *v) for r in complete
@@ -279,15 +389,8 @@ class ResultStore:
         if again:
             self._outcome_sums = None
         elif self._outcome_sums is not None:
-            for r in complete:
-                sums = self._outcome_sums.setdefault(r.design, {})
-                days: dict[tuple[str, int], int] = {}
-                for key, n in r.outcomes.items():
-                    sums[key] = sums.get(key, 0) + n
-                    days[key[:2]] = days.get(key[:2], 0) + n
-                squares = self._day_squares.setdefault(r.design, {})
-                for key, n in days.items():
-                    squares[key] = squares.get(key, 0) + n * n
+            for (design, _group), outcomes in zip(groups, counted, strict=True):
+                self._outcome_sums.setdefault(design, _RunningSums()).add(outcomes)
 
     def index(self) -> None:
         """Build the index readers need that is not kept during the run (the sample values
@@ -299,7 +402,8 @@ class ResultStore:
         the running sums of this store's writes when they are all there is, else from the
         table."""
         if self._outcome_sums is not None:
-            return [(m, d, h, n) for (m, d, h), n in self._outcome_sums.get(design, {}).items()]
+            sums = self._outcome_sums.get(design)
+            return sums.sums() if sums is not None else []
         return [(str(m), int(d), int(h), int(n)) for m, d, h, n in self.query(
             "SELECT metric, day, hour, SUM(n) FROM outcome WHERE design = ? "
             "GROUP BY metric, day, hour", (design,))]
@@ -309,7 +413,8 @@ class ResultStore:
         summed over users (with :meth:`outcome_sums`, the day's mean and its variance over
         users), kept while storing like the sums, else from the table."""
         if self._outcome_sums is not None:
-            return [(m, d, q) for (m, d), q in self._day_squares.get(design, {}).items()]
+            sums = self._outcome_sums.get(design)
+            return sums.day_squares() if sums is not None else []
         return [(str(m), int(d), int(q)) for m, d, q in self.query(
             "SELECT metric, day, SUM(t * t) FROM (SELECT metric, day, user, SUM(n) AS t "
             "FROM outcome WHERE design = ? GROUP BY metric, day, user) GROUP BY metric, day",
