@@ -430,28 +430,15 @@ class Flow(Part):
                 return target
             trans = act.out[0]
         elif act.split == S_XOR and not act.choice and not act.drawn and (act.out or act.otherwise):
-            scope = inst.scope
-            now = self.state.now
-            try:
-                for trans in act.out:
-                    cond = trans.condition
-                    if cond is None or cond(scope, now):
-                        break
-                else:
-                    if not act.otherwise and act.path_may_end:
-                        self.token_gone(frame)     # no condition holds: this path ends
-                        return None
-                    if not act.otherwise:
-                        self.abort(inst, act, "no outgoing transition can be taken (no "
-                                   "condition holds and there is no OTHERWISE transition)")
-                        return None
-                    trans = act.otherwise[0]
-            except OpspecError as error:
-                self.abort(inst, act, f"a transition condition failed: {error.message}")
+            chosen = lone.xor_transition(self, inst, act, frame)
+            if chosen is None:
                 return None
+            trans = chosen
             target = acts[trans.target]
             if not target.join and trans.tokens == 1:
                 if trans.assignments:
+                    scope = inst.scope
+                    now = self.state.now
                     for target_name, fn in trans.assignments:
                         self.set_field(inst, None, target_name, fn(scope, now))
                 return target

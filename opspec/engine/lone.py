@@ -17,7 +17,7 @@ from __future__ import annotations
 
 from typing import TYPE_CHECKING
 
-from opspec.engine.compiled import K_ASYNC, K_TASK, CompiledActivity
+from opspec.engine.compiled import K_ASYNC, K_TASK, CompiledActivity, CTransition
 from opspec.engine.instances import Frame, ProcessInstance
 from opspec.engine.lifecycle import RUNNING
 from opspec.engine.trace import EventKind as EK
@@ -90,31 +90,45 @@ def run(activities: Activities, inst: ProcessInstance, act: CompiledActivity | N
 
 def _split(flow: Flow, inst: ProcessInstance, act: CompiledActivity) -> CompiledActivity | None:
     """``Flow.split`` of a ``lone`` activity without a single successor: an XOR split into
-    activities without a join (the same conditions in the same order, the same faults), or
-    an end (the token is gone: the instance completes)."""
+    activities without a join, or an end (the token is gone: the instance completes)."""
     if act.out or act.otherwise:
-        scope = inst.scope
-        now = flow.state.now
-        try:
-            for trans in act.out:
-                cond = trans.condition
-                if cond is None or cond(scope, now):
-                    break
-            else:
-                if not act.otherwise and act.path_may_end:
-                    flow.instance_done(inst)        # no condition holds: this path ends
-                    return None
-                if not act.otherwise:
-                    flow.abort(inst, act, "no outgoing transition can be taken (no "
-                               "condition holds and there is no OTHERWISE transition)")
-                    return None
-                trans = act.otherwise[0]
-        except OpspecError as error:
-            flow.abort(inst, act, f"a transition condition failed: {error.message}")
+        trans = xor_transition(flow, inst, act, None)
+        if trans is None:
             return None
         if trans.assignments:
+            scope = inst.scope
+            now = flow.state.now
             for target_name, fn in trans.assignments:
                 flow.set_field(inst, None, target_name, fn(scope, now))
         return inst.process.graph.activities[trans.target]
     flow.instance_done(inst)                    # an end: the token is gone
+    return None
+
+
+def xor_transition(flow: Flow, inst: ProcessInstance, act: CompiledActivity,
+                   frame: Frame | None) -> CTransition | None:
+    """The transition ``act``'s exclusive split takes: the first whose condition holds, in
+    order, else its OTHERWISE transition. ``None`` when it takes none: where no condition
+    holds and the path may end, the token is gone (``frame``'s, or a frameless instance is
+    done); otherwise, or when a condition fails, the instance is aborted. The one choice of
+    both the general path (``Flow.split``) and the frameless token."""
+    scope = inst.scope
+    now = flow.state.now
+    try:
+        for trans in act.out:
+            cond = trans.condition
+            if cond is None or cond(scope, now):
+                return trans
+        if act.otherwise:
+            return act.otherwise[0]
+        if act.path_may_end:                    # no condition holds: this path ends
+            if frame is None:
+                flow.instance_done(inst)
+            else:
+                flow.token_gone(frame)
+            return None
+        flow.abort(inst, act, "no outgoing transition can be taken (no "
+                   "condition holds and there is no OTHERWISE transition)")
+    except OpspecError as error:
+        flow.abort(inst, act, f"a transition condition failed: {error.message}")
     return None
