@@ -118,17 +118,62 @@ class ActivityCounter:
     and a decision nobody else selects is not traced at all. Used when the user lane's
     performer is a stochastic user (or nobody); any other performer gets the recorder."""
 
-    def __init__(self, manual: Sequence[str]) -> None:
+    def __init__(self, manual: Sequence[str], user_offers: frozenset[str] = frozenset()
+                 ) -> None:
         from opspec.usermodels.performer import ActivityTally
 
-        #: the listener the run is built with
-        self.listener = ActivityTally(tuple(dict.fromkeys(manual)))
+        activities = tuple(dict.fromkeys(manual))
+        #: the listener the run is built with; the offers of ``user_offers`` are left to
+        #: the stochastic user (``StochasticUser.offers``: :attr:`user_offers`)
+        self.listener = ActivityTally(
+            activities, frozenset(a for a in activities if a not in user_offers))
         #: the rows, in ``manual``'s order; the stochastic user's ``tally``
         self.counts: dict[str, list[int]] = self.listener.rows
+        #: the rows whose offers the stochastic user counts: its ``offers``
+        self.user_offers: dict[str, list[int]] = {
+            a: row for a, row in self.counts.items() if a in user_offers}
 
     def finish(self) -> dict[str, list[int]]:
         """The rows, once the run ended."""
         return self.counts
+
+
+def offered_to_the_user_alone(compiled: Any) -> frozenset[str]:
+    """The activities of the user lane whose every offer goes to the user lane's performer:
+    a stochastic user counts their offers itself (``StochasticUser.offers``), so that no
+    listener selects their ``activity.offered`` events and the engine traces none for them
+    (about 1 M instructions per user-month of the dispenser: the event, and every raw
+    listener called with it).
+
+    The engine traces ``activity.offered`` of an activity where it offers a work item of it
+    to a performer (``Offers.offer``, then ``performer.offer(item)`` with ``item.activity``
+    its id) or finds no performer for it. The user's performer is bound to the participant
+    or first lane of every activity of the user lane (:func:`opspec.runs.build`), so an
+    activity ``X`` is counted the same by the user when every activity with the id ``X`` in
+    the package is of the user lane, is not a task (a task's work goes to its
+    application's performer) and, when it decides a deferred choice, every manual
+    alternative it offers is of the user lane too (the choice goes to the first one's
+    performer). A spec whose modes load other files (workflows compiled during the run) has
+    none: their activities are not known here."""
+    from opspec.engine.compiled import K_GATEWAY, K_MANUAL, K_TASK
+
+    if any(mode.source for mode in compiled.package.modes):
+        return frozenset()
+    seen: dict[str, bool] = {}
+    for proc in compiled.processes.values():
+        stack = [proc.graph]
+        while stack:
+            graph = stack.pop()
+            acts = graph.activities
+            for act in acts:
+                if act.block is not None:
+                    stack.append(act.block)
+                branches = act.choice or (act.out if act.kind == K_GATEWAY else ())
+                alone = (act.user_lane and act.kind != K_TASK
+                         and all(acts[t.target].user_lane for t in branches
+                                 if acts[t.target].kind == K_MANUAL))
+                seen[act.id] = seen.get(act.id, True) and alone
+    return frozenset(a for a, alone in seen.items() if alone)
 
 
 @dataclass(frozen=True)
@@ -138,6 +183,9 @@ class _Context:
     user: Any                               # opspec.runs.User of the user model, or None
     config: Any
     warnings: tuple[Any, ...] = ()          # the user model's, against this spec
+    #: the activities of ``manual`` a stochastic user counts the offers of itself
+    #: (:func:`offered_to_the_user_alone`)
+    user_offers: frozenset[str] = frozenset()
 
     @property
     def compiled(self) -> Any:
@@ -188,7 +236,9 @@ def prepare(spec: str, sha256: str, user_model: str | None, engine: Mapping[str,
         if model is not None:
             user = User.model(model, user.describe if user else None)
     config = EngineConfig.from_mapping(engine) if engine else EngineConfig()
-    context = _Context(loaded, (*lane.manual, *lane.choices), user, config, warnings)
+    manual = (*lane.manual, *lane.choices)
+    context = _Context(loaded, manual, user, config, warnings,
+                       offered_to_the_user_alone(loaded.compiled) & frozenset(manual))
     _CONTEXTS[key] = context
     return context
 
@@ -215,7 +265,9 @@ def run_user(context: _Context, design: str, user: int, *, seed: int, horizon: f
             person = (drawn.subgroup, dict(drawn.parameters))
             who = User.model(drawn.model, who.describe)
         params = inputs.for_run(seed, user) if inputs else None
-        counter = ActivityCounter(context.manual)
+        # a user model's performer (a stochastic user) counts the offers it alone is made
+        counter = ActivityCounter(context.manual, context.user_offers
+                                  if who is not None and who.kind == "model" else frozenset())
         run = build(context.spec, seed=seed, user=who, user_index=user, until=horizon,
                     config=context.config, listeners=[counter.listener],
                     keep_trace=keep_trace, keep_times=True, params=params)
@@ -223,6 +275,14 @@ def run_user(context: _Context, design: str, user: int, *, seed: int, horizon: f
         performer = run.performer
         if isinstance(performer, StochasticUser):
             performer.tally = counter.counts
+            performer.offers = counter.user_offers or None
+        elif performer is None and counter.user_offers:
+            # nobody to count them after all: the engine traces every offer (a fresh run)
+            counter = ActivityCounter(context.manual)
+            recorder = counter
+            run = build(context.spec, seed=seed, user=who, user_index=user, until=horizon,
+                        config=context.config, listeners=[counter.listener],
+                        keep_trace=keep_trace, keep_times=True, params=params)
         elif performer is not None:
             # a performer that does not tally its decisions: the recorder hears them (a
             # fresh run: nothing of the first was started or drawn)

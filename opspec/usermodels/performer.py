@@ -74,6 +74,12 @@ class StochasticUser:
         #: that no listener has to select its ``user.*`` events for them
         #: (:mod:`opspec.evaluation.replication`); None: not counted
         self.tally: dict[str, list[int]] | None = None
+        #: per activity whose offers this user counts (column 0 of the same rows), the row:
+        #: set by :mod:`opspec.evaluation.replication` for the activities the engine offers
+        #: to this user alone, so that no listener has to select their ``activity.offered``
+        #: events (each offer of one of them is this ``offer`` call, right after the engine
+        #: would have traced it); None: not counted here
+        self.offers: dict[str, list[int]] | None = None
         # the busy model's sets, read once (the model's frozen dataclasses are slow to read
         # from compiled code, and _finish reads them for every work item)
         busy = model.busy
@@ -91,6 +97,9 @@ class StochasticUser:
         if session is None:
             session = self._require_session()
         activity = item.activity
+        offers = self.offers
+        if offers is not None and activity in offers:
+            offers[activity][0] += 1
         plan = self._plans.get(activity)
         if plan is None:
             plan = self._plans[activity] = _Plan(activity, self.model.activity(activity),
@@ -367,22 +376,31 @@ class ActivityTally(MetricsListener):
     through Python's protocol; and one dictionary look-up per event where a count metric per
     activity and kind compared the event with each of them."""
 
-    def __init__(self, activities: tuple[str, ...]) -> None:
+    def __init__(self, activities: tuple[str, ...],
+                 offered_elsewhere: frozenset[str] | None = None) -> None:
         super().__init__(())
         self.rows: dict[str, list[int]] = {a: [0, 0, 0, 0] for a in activities}
-        self.selects = frozenset((kind, None, a) for a in activities
-                                 for kind in ("activity.offered", "activity.completed"))
+        # the rows whose offers this listener counts: all, or (``offered_elsewhere``) only
+        # those the stochastic user does not count itself (StochasticUser.offers)
+        self._offered: dict[str, list[int]] = (
+            self.rows if offered_elsewhere is None
+            else {a: row for a, row in self.rows.items() if a in offered_elsewhere})
+        self.selects = frozenset(
+            [("activity.completed", None, a) for a in activities]
+            + [("activity.offered", None, a) for a in self._offered])
 
     def raw(self, time: float, kind: str, process: str | None, instance: int | None,
             activity: str | None, data: Mapping[str, Any] | None = None) -> None:
         # (the engine sends every event some listener selects: the kind is checked here)
+        # (an offer of an activity the user counts may still come: another listener, a
+        # monitor or a kept trace, selects it)
         if kind == "activity.offered":
-            column = 0
+            if activity is not None:
+                row = self._offered.get(activity)
+                if row is not None:
+                    row[0] += 1
         elif kind == "activity.completed":
-            column = 1
-        else:
-            return
-        if activity is not None:
-            row = self.rows.get(activity)
-            if row is not None:
-                row[column] += 1
+            if activity is not None:
+                row = self.rows.get(activity)
+                if row is not None:
+                    row[1] += 1

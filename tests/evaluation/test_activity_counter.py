@@ -80,7 +80,8 @@ def test_a_performer_that_does_not_tally_gets_the_recorder(monkeypatch):
     counters: list[ActivityCounter] = []
     real_counter = replication.ActivityCounter
     monkeypatch.setattr(replication, "ActivityCounter",
-                        lambda manual: counters.append(real_counter(manual)) or counters[-1])
+                        lambda manual, *offers: counters.append(real_counter(manual, *offers))
+                        or counters[-1])
     record = run_user(context, "A", 2, seed=9, horizon=5 * DAY, keep_trace=False)
     assert counters, "the counter was tried first"
     assert record.activities == expected
