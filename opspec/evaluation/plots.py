@@ -365,20 +365,14 @@ def _figure(width: float, height: float) -> Iterator[Figure]:
 
     rc = {**_RC, "axes.prop_cycle": cycler(color=PALETTE)}
     with matplotlib.rc_context(rc):  # type: ignore[arg-type]  # keys are literal rc names
-        fig = Figure(figsize=(width, height), dpi=DPI, layout="constrained")
+        fig = Figure(figsize=(width, height), dpi=DPI)
         FigureCanvasAgg(fig)
         yield fig
 
 
 def _save(fig: Figure, path: Path) -> Path:
     path, fmt = _written(path)
-    # Lay the figure out once and freeze it there: with a layout engine attached, savefig
-    # draws twice (a pass to lay out, then the drawing, which lays out again). The frozen
-    # positions are the same, so are the pixels, at about two thirds of the cost.
-    engine = fig.get_layout_engine()
-    if engine is not None:
-        engine.execute(fig)
-        fig.set_layout_engine(None)
+    _lay_out(fig)
     fig.patch.set_facecolor("white")
     try:
         path.parent.mkdir(parents=True, exist_ok=True)
@@ -397,6 +391,19 @@ def _save(fig: Figure, path: Path) -> Path:
                               hint="check that the output folder exists, is writable and "
                                    "the disk is not full") from None
     return path
+
+
+def _lay_out(fig: Figure) -> None:
+    """Place the panels so that every text fits: from the texts' measured sizes
+    (:mod:`.figure_layout`), or with matplotlib's constrained layout for a figure that
+    module does not lay out. Either is done once, before the drawing, which then lays
+    nothing out again."""
+    from opspec.evaluation.figure_layout import lay_out
+
+    if not lay_out(fig):
+        from matplotlib.layout_engine import ConstrainedLayoutEngine
+
+        ConstrainedLayoutEngine().execute(fig)
 
 
 def _save_png(fig: Figure, path: Path) -> None:
