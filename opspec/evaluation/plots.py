@@ -136,10 +136,11 @@ def figure_format(name: str) -> Iterator[None]:
 def drawing_processes(workers: int) -> Iterator[None]:
     """Start up to ``workers`` drawing processes now, for the :func:`drawn_by` blocks within
     this one: each imports matplotlib (and loads its font) while this process still works
-    out what to draw. ``opspec evaluate --workers W`` starts them as its replications end,
-    so that matplotlib is ready, on a core the replications no longer use, by the time the
-    summaries and the report's tables are done. Nothing happens with one worker or where
-    processes cannot be forked."""
+    out what to draw. ``opspec evaluate --workers W`` starts them before its replications,
+    so that matplotlib is ready when the first figure is asked for: its import (0.3 CPU-s
+    in each process) shares the cores with the replications' chunks, which any core can
+    run, instead of delaying the figures after them. Nothing happens with one worker or
+    where processes cannot be forked."""
     import os
 
     if workers <= 1 or not hasattr(os, "fork") or _POOL.get() is not None:
@@ -149,6 +150,7 @@ def drawing_processes(workers: int) -> Iterator[None]:
     import multiprocessing
 
     pool = cf.ProcessPoolExecutor(max_workers=workers, initializer=_warm_up,
+                                  initargs=(os.getpid(),),
                                   mp_context=multiprocessing.get_context("fork"))
     try:
         for _ in range(workers):            # forks them all now (not at the first figure)
@@ -169,13 +171,24 @@ def drawing_processes(workers: int) -> Iterator[None]:
 _POOL: ContextVar[tuple[Any, int] | None] = ContextVar("opspec_drawing_pool", default=None)
 
 
-def _warm_up() -> None:
+def _warm_up(parent: int) -> None:
     """A drawing process's start: Ctrl-C left to the evaluate process (which stops the
-    pool; no traceback from each drawing process), matplotlib imported, its default font
-    found and loaded."""
+    pool; no traceback from each drawing process), an end of its own when that process is
+    gone (killed: it cannot stop the pool, and a drawing process waiting for figures would
+    live on), matplotlib imported, its default font found and loaded."""
+    import os
     import signal
+    import threading
+    import time
 
     signal.signal(signal.SIGINT, signal.SIG_IGN)
+
+    def watch() -> None:
+        while os.getppid() == parent:
+            time.sleep(1.0)
+        os._exit(1)
+
+    threading.Thread(target=watch, name="opspec-drawing-watch", daemon=True).start()
     try:
         _import_matplotlib()
         from matplotlib import font_manager
