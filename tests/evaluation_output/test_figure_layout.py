@@ -239,3 +239,24 @@ def test_panels_share_the_figure_evenly() -> None:
         line = 11 / 72 / 6.0
         assert 1.0 - top < 2 * line and bottom < 6 * line
         assert math.isclose(matplotlib.rcParams["font.size"], 11)
+
+
+def test_a_figure_off_the_grid_is_left_to_the_constrained_layout() -> None:
+    """An axes placed by hand (not a cell of the figure's grid) is not something the
+    measured layout knows: it says so, and the figure is laid out by matplotlib's
+    constrained layout instead, its texts inside the figure all the same."""
+    from opspec.evaluation.figure_layout import lay_out
+
+    with plots._figure(6.0, 4.0) as fig:
+        ax = fig.add_subplot()
+        ax.set_yticks([0.0, 1.0], ["none", LONG])
+        ax.set_xlabel("simulated day")
+        inset = fig.add_axes((0.6, 0.6, 0.3, 0.3))
+        inset.set_title("inset")
+        assert not lay_out(fig)
+        plots._lay_out(fig)
+        laid, _ = _boxes(fig)
+        width, height = fig.bbox.width, fig.bbox.height
+        assert all(box.x0 >= -0.5 and box.x1 <= width + 0.5 and box.y0 >= -0.5
+                   and box.y1 <= height + 0.5 for name, box in laid
+                   if name.startswith("axes 0"))
