@@ -30,6 +30,7 @@ from __future__ import annotations
 
 import math
 import statistics as pystats
+import weakref
 from array import array
 from collections.abc import Callable, Iterator, Mapping, Sequence
 from dataclasses import dataclass
@@ -294,14 +295,41 @@ def per_user_values(store: ResultStore, design: str,
     """Each finished user's values of ``definitions`` (of ``users`` only, when given) as
     the summaries read them: ``pairs(name)`` in user order, ``sorted(name, "y")`` (a
     count's totals) and ``sorted(name, "v")`` (``y / n`` where ``n > 0``) ascending,
-    ``where_denominator(name)``; on disk (:mod:`opspec.evaluation.spilled`), or in arrays
-    when a value is NaN."""
+    ``where_denominator(name)``; in arrays for at most :data:`HELD_USERS` users or when a
+    value is NaN, else on disk (:mod:`opspec.evaluation.spilled`). Either is made once per
+    state of the store and read again by the report's per-user figure."""
     from opspec.evaluation.spilled import spill_user_values
 
-    spilled = spill_user_values(store, design, definitions, users)
-    if spilled is not None:
-        return spilled
-    return _Held(user_values(store, design, definitions, users))
+    key = (store.writes, design, tuple(d["name"] for d in definitions),
+           None if users is None else frozenset(users))
+    held = _HELD.setdefault(store, {})
+    if key in held:
+        return held[key]
+    if _finished_users(store, design, users) > HELD_USERS:
+        spilled = spill_user_values(store, design, definitions, users)
+        if spilled is not None:
+            return spilled
+    # the same doubles in the same order as the spill's (tests/evaluation/
+    # test_spilled_values.py): the numbers do not depend on where they are kept
+    found = held[key] = _Held(user_values(store, design, definitions, users))
+    return found
+
+
+#: Users whose values are held in arrays rather than written to disk: a pass over spilled
+#: values reads a batch of this many rows at once (:data:`.spilled.BATCH`), so below it
+#: spilling saves no memory, and its 150-odd reads of SQLite cost 0.09 CPU-s at 1,000
+#: users (seventh pass, docs/engine-performance.md). At most 16 bytes per user and metric.
+HELD_USERS = 4096
+
+#: The values held in arrays, by store and (its writes, design, metrics, users filter).
+_HELD: weakref.WeakKeyDictionary[ResultStore, dict[Any, _Held]] = weakref.WeakKeyDictionary()
+
+
+def _finished_users(store: ResultStore, design: str, users: set[int] | None) -> int:
+    """How many users :func:`user_values` reads (at most ``len(users)``, when given)."""
+    count = int(store.query("SELECT COUNT(*) FROM replication WHERE design = ? AND status "
+                            "= 'done' AND error IS NULL", (design,))[0][0])
+    return count if users is None else min(count, len(users))
 
 
 def summarise_design(store: ResultStore, design: str, days: float, level: float = 0.95, *,
