@@ -441,9 +441,8 @@ def run(args: argparse.Namespace) -> int:
         _store_parameters(store, plan, definitions, __version__)
         if swept is not None:
             store.put("sweep", swept.to_json())
-    from opspec.evaluation.memory import startup_frozen
-
     from opspec.evaluation import plots
+    from opspec.evaluation.memory import startup_frozen
 
     # what is loaded by now lives through the run: the collector need not scan it again
     with store, contextlib.ExitStack() as stack, contextlib.ExitStack() as drawing, \
