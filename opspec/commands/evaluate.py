@@ -441,10 +441,16 @@ def run(args: argparse.Namespace) -> int:
         _store_parameters(store, plan, definitions, __version__)
         if swept is not None:
             store.put("sweep", swept.to_json())
+    from opspec.evaluation import plots
     from opspec.evaluation.memory import startup_frozen
 
     # what is loaded by now lives through the run: the collector need not scan it again
-    with store, contextlib.ExitStack() as stack, startup_frozen():
+    with store, contextlib.ExitStack() as stack, contextlib.ExitStack() as drawing, \
+            startup_frozen():
+        # the report's drawing processes (--workers W > 1) start now and import matplotlib
+        # beside the replications, whose chunks share the cores; started after them, that
+        # import was on the run's critical path (the first figure waited for it)
+        drawing.enter_context(plots.drawing_processes(min(workers, _local_cores())))
         on_trace = _trace_writers(stack, store.folder, plan)
         progress = make_progress(sys.stderr, quiet=args.quiet or args.json,
                                  label="users" if len(plan.designs) == 1 else "replications")
@@ -462,11 +468,6 @@ def run(args: argparse.Namespace) -> int:
                   f"replications are stored in {store.path}; finish with `opspec evaluate "
                   f"--resume --out {store.folder}`", file=sys.stderr)
             raise
-        from opspec.evaluation import plots
-
-        # the report's drawing processes start now and import matplotlib on the cores the
-        # replications left, while the summaries below are worked out (--workers W > 1)
-        stack.enter_context(plots.drawing_processes(min(workers, _local_cores())))
         from opspec.evaluation.report import write_report
         from opspec.evaluation.summary import (
             compare_designs,

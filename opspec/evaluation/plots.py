@@ -136,10 +136,11 @@ def figure_format(name: str) -> Iterator[None]:
 def drawing_processes(workers: int) -> Iterator[None]:
     """Start up to ``workers`` drawing processes now, for the :func:`drawn_by` blocks within
     this one: each imports matplotlib (and loads its font) while this process still works
-    out what to draw. ``opspec evaluate --workers W`` starts them as its replications end,
-    so that matplotlib is ready, on a core the replications no longer use, by the time the
-    summaries and the report's tables are done. Nothing happens with one worker or where
-    processes cannot be forked."""
+    out what to draw. ``opspec evaluate --workers W`` starts them before its replications,
+    so that matplotlib is ready when the first figure is asked for: its import (0.3 CPU-s
+    in each process) shares the cores with the replications' chunks, which any core can
+    run, instead of delaying the figures after them. Nothing happens with one worker or
+    where processes cannot be forked."""
     import os
 
     if workers <= 1 or not hasattr(os, "fork") or _POOL.get() is not None:
@@ -149,6 +150,7 @@ def drawing_processes(workers: int) -> Iterator[None]:
     import multiprocessing
 
     pool = cf.ProcessPoolExecutor(max_workers=workers, initializer=_warm_up,
+                                  initargs=(os.getpid(),),
                                   mp_context=multiprocessing.get_context("fork"))
     try:
         for _ in range(workers):            # forks them all now (not at the first figure)
@@ -169,13 +171,24 @@ def drawing_processes(workers: int) -> Iterator[None]:
 _POOL: ContextVar[tuple[Any, int] | None] = ContextVar("opspec_drawing_pool", default=None)
 
 
-def _warm_up() -> None:
+def _warm_up(parent: int) -> None:
     """A drawing process's start: Ctrl-C left to the evaluate process (which stops the
-    pool; no traceback from each drawing process), matplotlib imported, its default font
-    found and loaded."""
+    pool; no traceback from each drawing process), an end of its own when that process is
+    gone (killed: it cannot stop the pool, and a drawing process waiting for figures would
+    live on), matplotlib imported, its default font found and loaded."""
+    import os
     import signal
+    import threading
+    import time
 
     signal.signal(signal.SIGINT, signal.SIG_IGN)
+
+    def watch() -> None:
+        while os.getppid() == parent:
+            time.sleep(1.0)
+        os._exit(1)
+
+    threading.Thread(target=watch, name="opspec-drawing-watch", daemon=True).start()
     try:
         _import_matplotlib()
         from matplotlib import font_manager
@@ -365,20 +378,14 @@ def _figure(width: float, height: float) -> Iterator[Figure]:
 
     rc = {**_RC, "axes.prop_cycle": cycler(color=PALETTE)}
     with matplotlib.rc_context(rc):  # type: ignore[arg-type]  # keys are literal rc names
-        fig = Figure(figsize=(width, height), dpi=DPI, layout="constrained")
+        fig = Figure(figsize=(width, height), dpi=DPI)
         FigureCanvasAgg(fig)
         yield fig
 
 
 def _save(fig: Figure, path: Path) -> Path:
     path, fmt = _written(path)
-    # Lay the figure out once and freeze it there: with a layout engine attached, savefig
-    # draws twice (a pass to lay out, then the drawing, which lays out again). The frozen
-    # positions are the same, so are the pixels, at about two thirds of the cost.
-    engine = fig.get_layout_engine()
-    if engine is not None:
-        engine.execute(fig)
-        fig.set_layout_engine(None)
+    _lay_out(fig)
     fig.patch.set_facecolor("white")
     try:
         path.parent.mkdir(parents=True, exist_ok=True)
@@ -397,6 +404,19 @@ def _save(fig: Figure, path: Path) -> Path:
                               hint="check that the output folder exists, is writable and "
                                    "the disk is not full") from None
     return path
+
+
+def _lay_out(fig: Figure) -> None:
+    """Place the panels so that every text fits: from the texts' measured sizes
+    (:mod:`.figure_layout`), or with matplotlib's constrained layout for a figure that
+    module does not lay out. Either is done once, before the drawing, which then lays
+    nothing out again."""
+    from opspec.evaluation.figure_layout import lay_out
+
+    if not lay_out(fig):
+        from matplotlib.layout_engine import ConstrainedLayoutEngine
+
+        ConstrainedLayoutEngine().execute(fig)
 
 
 def _save_png(fig: Figure, path: Path) -> None:
@@ -502,10 +522,14 @@ def latency_figure(metric: str, values: Sequence[float], path: Path, *,
 
     metric = _text(label or metric)
     title = f"{metric}: distribution of durations"
-    data, dropped = _finite(values)
-    if not data:
+    # the finite values as _finite keeps them, in one numpy pass (a latency sample is tens
+    # of thousands of values; None becomes NaN and is left out with the others)
+    every = np.asarray(values, dtype=float)
+    arr = every[np.isfinite(every)]
+    dropped = int(every.size - arr.size)
+    del every
+    if not arr.size:
         return _empty(path, title)
-    arr = np.asarray(data, dtype=float)
     given = {k: float(v) for k, v in (marks or {}).items() if v is not None}
     own = {"mean": float(arr.mean()), "median": float(np.median(arr)),
            "p95": float(np.percentile(arr, 95))}

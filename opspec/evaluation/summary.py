@@ -30,6 +30,7 @@ from __future__ import annotations
 
 import math
 import statistics as pystats
+import weakref
 from array import array
 from collections.abc import Callable, Iterator, Mapping, Sequence
 from dataclasses import dataclass
@@ -294,14 +295,63 @@ def per_user_values(store: ResultStore, design: str,
     """Each finished user's values of ``definitions`` (of ``users`` only, when given) as
     the summaries read them: ``pairs(name)`` in user order, ``sorted(name, "y")`` (a
     count's totals) and ``sorted(name, "v")`` (``y / n`` where ``n > 0``) ascending,
-    ``where_denominator(name)``; on disk (:mod:`opspec.evaluation.spilled`), or in arrays
-    when a value is NaN."""
+    ``where_denominator(name)``; in arrays for at most :data:`HELD_USERS` users or when a
+    value is NaN, else on disk (:mod:`opspec.evaluation.spilled`). Either is made once per
+    state of the store and read again by the report's per-user figure."""
     from opspec.evaluation.spilled import spill_user_values
 
-    spilled = spill_user_values(store, design, definitions, users)
-    if spilled is not None:
-        return spilled
-    return _Held(user_values(store, design, definitions, users))
+    key = (store.writes, design, tuple(d["name"] for d in definitions),
+           None if users is None else frozenset(users))
+    held = _HELD.setdefault(store, {})
+    if key in held:
+        return held[key]
+    if _finished_users(store, design, users) > HELD_USERS:
+        spilled = spill_user_values(store, design, definitions, users)
+        if spilled is not None:
+            return spilled
+    # the same doubles in the same order as the spill's (tests/evaluation/
+    # test_spilled_values.py): the numbers do not depend on where they are kept
+    found = held[key] = _Held(user_values(store, design, definitions, users))
+    return found
+
+
+#: Users whose values are held in arrays rather than written to disk: a pass over spilled
+#: values reads a batch of this many rows at once (:data:`.spilled.BATCH`), so below it
+#: spilling saves no memory, and its 150-odd reads of SQLite cost 0.09 CPU-s at 1,000
+#: users (seventh pass, docs/engine-performance.md). At most 16 bytes per user and metric.
+HELD_USERS = 4096
+
+#: The values held in arrays, by store and (its writes, design, metrics, users filter).
+_HELD: weakref.WeakKeyDictionary[ResultStore, dict[Any, _Held]] = weakref.WeakKeyDictionary()
+
+
+def _held_activities(store: ResultStore, design: str
+                     ) -> list[tuple[str, int, list[tuple[float, float]],
+                                     list[tuple[float, float]]]]:
+    """What :func:`opspec.evaluation.spilled.spill_activities` gives, in lists: per activity
+    (in the order first stored) with offers, ``(activity, offered, (omitted, offered) per
+    user, (wrong, offered) per user)``, each count the float its REAL column gives back."""
+    rows: dict[str, list[tuple[int, int, int]]] = {}
+    for activity, offered, omitted, wrong in store.rows(
+            "SELECT activity, offered, omitted, wrong FROM activity WHERE design = ? "
+            "ORDER BY rowid", (design,)):
+        rows.setdefault(str(activity), []).append(
+            (int(offered or 0), int(omitted or 0), int(wrong or 0)))
+    out = []
+    for name, counts in rows.items():
+        offered = sum(given for given, _, _ in counts)   # whole numbers: exact in any order
+        if offered:
+            out.append((name, offered,
+                        [(float(omitted), float(given)) for given, omitted, _ in counts],
+                        [(float(wrong), float(given)) for given, _, wrong in counts]))
+    return out
+
+
+def _finished_users(store: ResultStore, design: str, users: set[int] | None) -> int:
+    """How many users :func:`user_values` reads (at most ``len(users)``, when given)."""
+    count = int(store.query("SELECT COUNT(*) FROM replication WHERE design = ? AND status "
+                            "= 'done' AND error IS NULL", (design,))[0][0])
+    return count if users is None else min(count, len(users))
 
 
 def summarise_design(store: ResultStore, design: str, days: float, level: float = 0.95, *,
@@ -406,12 +456,17 @@ def summarise_activities(store: ResultStore, design: str) -> list[dict[str, Any]
     ``omission`` and ``error`` rates per offer, and their intervals over users (each user's
     omissions of their offers: a proportion pooled over users, as a metric's missed rate,
     method ``wilson-neff``). Activities never offered are left out. The users' counts are
-    read from disk at each pass (:func:`opspec.evaluation.spilled.spill_activities`)."""
+    held in lists for at most :data:`HELD_USERS` users, else read from disk at each pass
+    (:func:`opspec.evaluation.spilled.spill_activities`)."""
     from opspec.evaluation.spilled import spill_activities
     from opspec.statistics import proportion_interval
 
+    most = store.query("SELECT MAX(c) FROM (SELECT COUNT(*) AS c FROM activity WHERE "
+                       "design = ? GROUP BY activity)", (design,))[0][0]
+    counts = (_held_activities(store, design) if int(most or 0) <= HELD_USERS
+              else spill_activities(store, design))
     out = []
-    for activity, offered, omissions, wrongs in spill_activities(store, design):
+    for activity, offered, omissions, wrongs in counts:
         out.append({"activity": activity, "offered": offered,
                     "omission": int(sum(y for y, _ in omissions)) / offered,
                     "error": int(sum(y for y, _ in wrongs)) / offered,
