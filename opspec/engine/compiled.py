@@ -304,6 +304,8 @@ class CompiledPackage:
     catchers: dict[tuple[str, str], frozenset[str]] = field(default_factory=dict)
     _want_cache: dict[Any, frozenset[tuple[str, str | None, str | None]]] = field(
         default_factory=dict)
+    # the workflows' plans (opspec.engine.plans.of: made at the first run from source)
+    plans: Any = None
 
     def expand_selectors(
         self, selectors: frozenset[tuple[str, str | None, str | None]]

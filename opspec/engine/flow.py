@@ -225,6 +225,13 @@ class Flow(Part):
             if inst.state == SUSPENDED:
                 inst.defer((self.start_lone_at, inst, index, None))
             return
+        plans = self.state.plans
+        if plans is not None:               # from source: the plan, if it starts there
+            proc = inst.process
+            plan = plans.get(proc.id)
+            if plan is not None and plan[0] is proc and plan[1] == index:
+                plan[2](self.activities, inst)
+                return
         lone.run(self.activities, inst, inst.process.graph.activities[index])
 
     def _dropped(self, frame: Frame, fn: Any, a: Any, b: Any) -> None:

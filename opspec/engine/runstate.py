@@ -35,6 +35,8 @@ from opspec.engine.config import EngineConfig
 from opspec.engine.instances import ActivityInstance, Frame, ProcessInstance
 from opspec.engine.lifecycle import RUNNING, SUSPENDED
 from opspec.engine.metrics import MetricsListener
+from opspec.engine.plans import Plan
+from opspec.engine.plans import of as plans_of
 from opspec.engine.performers import Performer
 from opspec.engine.processors import DedicatedProcessor, PooledProcessor
 from opspec.engine.random import Streams
@@ -142,6 +144,8 @@ class RunState(Timers):
         (self.listeners, self.raw, self.wants_all, self.selectors, self.wanted,
          self.full) = _listener_tables(listeners, compiled)
         self.raw_metrics = _metrics_only(self.raw)
+        # the frameless first tokens as straight-line code, from source (opspec.engine.plans)
+        self.plans: dict[str, Plan] | None = plans_of(compiled)
         # which selection the wanted-kind bits cached on activities and processes are of
         self.flag_key = _flag_key(self.wants_all, self.wanted)
 
