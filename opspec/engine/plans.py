@@ -154,8 +154,16 @@ class _Writer:
             if act.start_assign:
                 self.assign(act, act.start_assign, pad, out)
             if act.kind == K_ASYNC:
-                out += [f"{pad}data = activities.params_in(inst, {a})",
-                        f"{pad}if data is None:", f"{pad}    return",
+                # Activities.params_in, in line: the actual parameters in order, into a dict
+                items = ", ".join(f"{self.name('M', formal)}: {self.name('V', fn)}(scope, now)"
+                                  for _mode, formal, fn, _target in act.params
+                                  if fn is not None)
+                out += [f"{pad}now = state.now", f"{pad}scope = inst.scope", f"{pad}try:",
+                        f"{pad}    data = {{{items}}}",
+                        f"{pad}except OpspecError as error:",
+                        f"{pad}    flow.abort(inst, {a}, "
+                        f"f\"an actual parameter failed: {{error.message}}\")",
+                        f"{pad}    return",
                         f"{pad}flow.start_process(state.processes[{self.name('F', act.subflow)}],"
                         f" data, trigger={self.name('G', f'subflow:{act.id}')})"]
             if not act.simple_end and act.end_assign:

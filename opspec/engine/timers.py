@@ -165,7 +165,8 @@ class Timers:
         heap = self.heap
         if not heap:
             return
-        at = _first(heap)
+        rows: list[Any] = heap              # the same list, holding tuples (see TUPLES)
+        at: float = rows[0][0] if TUPLES else heap[0].at
         if at >= self.armed_at:
             return
         self.driver += 1
@@ -185,7 +186,8 @@ class Timers:
         at = self.armed_at
         self.armed_at = INF
         heap = self.heap
-        if not heap or _first(heap) != at:
+        rows: list[Any] = heap              # the same list, holding tuples (see TUPLES)
+        if not heap or (rows[0][0] if TUPLES else heap[0].at) != at:
             self.arm()
             return
         ahead = self.ahead
@@ -271,14 +273,6 @@ class Timers:
                 env.timeout(delay).callbacks.append(entry)
         finally:
             self.scheduling = False
-
-
-def _first(heap: list[Timed]) -> float:
-    """The time of the heap's earliest entry."""
-    if TUPLES:
-        rows: list[Any] = heap
-        return rows[0][0]  # type: ignore[no-any-return]
-    return heap[0].at
 
 
 def _at(item: Any) -> float:

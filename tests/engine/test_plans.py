@@ -278,3 +278,13 @@ def test_plans_are_made_once_per_package_and_only_from_source(
     assert "def plan(activities, inst):" in (made["lookup"][2].__doc__ or "")
     monkeypatch.setattr(plans, "COMPILED", True)
     assert plans.of(compiled) is None
+
+
+def test_a_failing_actual_parameter_of_an_asynchronous_start_aborts_the_same_way(
+        monkeypatch: pytest.MonkeyPatch) -> None:
+    child = proc("child", ["c"], formals=[formal("n", "IN")])
+    main = proc("main", [subflow("go", "child", ["missing + 1"], asynchronous=True), "end"],
+                [("go", "end")])
+    (_trace, summary, _metrics), ran = _three(monkeypatch, pkg(main, child))
+    assert ran == {"main": 1}
+    assert "an actual parameter failed" in summary["faults"][0]["message"]
