@@ -37,14 +37,11 @@ from opspec.engine.compiled import (
     CompiledPackage,
     CompiledProcess,
 )
-from opspec.engine.lifecycle import RUNNING
+from opspec.engine.lifecycle import RUNNING, SUSPENDED
 from opspec.engine.trace import EventKind as EK
 from opspec.errors import OpspecError
 
-__all__ = ["MAX_BLOCKS", "Plan", "of"]
-
-#: (the process, its start activity, the plan): what ``Flow.start_lone_at`` looks up
-Plan = tuple[CompiledProcess, int, Callable[[Any, Any], None]]
+__all__ = ["MAX_BLOCKS", "attach", "build"]
 
 #: Activity blocks written out per plan at most (merging branches are written once per
 #: path); past it, or deeper than :data:`_MAX_DEPTH` nested splits, the plan ends in
@@ -59,25 +56,27 @@ _NO_TRANSITION: Final = ("no outgoing transition can be taken (no condition hold
                          "there is no OTHERWISE transition)")
 
 
-def of(compiled: CompiledPackage) -> dict[str, Plan] | None:
-    """The plans of ``compiled``'s workflows by process id (made once per package and
-    kept on it), or ``None`` when the engine runs compiled."""
-    if COMPILED:
-        return None
-    made = compiled.plans
-    if made is None:
-        made = compiled.plans = {}
-        for proc in compiled.processes.values():
-            if proc.one_start >= 0:
-                made[proc.id] = (proc, proc.one_start, build(proc, proc.one_start))
-    return made  # type: ignore[no-any-return]
+def attach(compiled: CompiledPackage) -> None:
+    """Give each workflow of ``compiled`` that starts with one token its plan
+    (``CompiledProcess.plan``), once per package; none when the engine runs compiled."""
+    if COMPILED or compiled.plans:
+        return
+    for proc in compiled.processes.values():
+        if proc.one_start >= 0:
+            proc.plan = build(proc, proc.one_start)
+    compiled.plans = True
 
 
-def build(proc: CompiledProcess, start: int) -> Callable[[Any, Any], None]:
-    """The plan of ``proc``'s one token from activity ``start``: ``plan(activities, inst)``
-    does what ``lone.run(activities, inst, acts[start])`` does."""
+def build(proc: CompiledProcess, start: int) -> Callable[[Any, Any, Any], None]:
+    """The plan of ``proc``'s one token from activity ``start``: ``plan(inst, activities,
+    None)``, queued by ``Flow.start_process``, does what ``Flow.start_lone_at`` and
+    ``lone.run(activities, inst, acts[start])`` do."""
     writer = _Writer(proc)
-    lines = ["def plan(activities, inst):",
+    lines = ["def plan(inst, activities, _unused):",
+             "    if inst.state != RUNNING:         # (Flow.start_lone_at's test)",
+             "        if inst.state == SUSPENDED:",
+             "            inst.defer((plan, inst, activities, None))",
+             "        return",
              "    state = activities.state",
              "    flow = activities.flow",
              "    limit = state.start_limit",
@@ -91,7 +90,7 @@ def build(proc: CompiledProcess, start: int) -> Callable[[Any, Any], None]:
     source = "\n".join(lines) + "\n"
     space = writer.names
     exec(compile(source, f"<plan of {proc.id}>", "exec"), space)  # noqa: S102 - our own code
-    plan: Callable[[Any, Any], None] = space["plan"]
+    plan: Callable[[Any, Any, Any], None] = space["plan"]
     plan.__doc__ = source                   # what it runs, for whoever debugs it
     return plan
 
@@ -106,7 +105,7 @@ class _Writer:
         # the plan's globals: what its source names (activities, conditions, helpers)
         self.names: dict[str, Any] = {
             "__builtins__": __builtins__, "HAND": lone.hand_over, "REST": lone.run,
-            "OpspecError": OpspecError, "RUNNING": RUNNING,
+            "OpspecError": OpspecError, "RUNNING": RUNNING, "SUSPENDED": SUSPENDED,
             "STARTED": EK.ACTIVITY_STARTED, "COMPLETED": EK.ACTIVITY_COMPLETED,
             "CHANGED": EK.DATA_CHANGED}
 

@@ -35,8 +35,6 @@ from opspec.engine.config import EngineConfig
 from opspec.engine.instances import ActivityInstance, Frame, ProcessInstance
 from opspec.engine.lifecycle import RUNNING, SUSPENDED
 from opspec.engine.metrics import MetricsListener
-from opspec.engine.plans import Plan
-from opspec.engine.plans import of as plans_of
 from opspec.engine.performers import Performer
 from opspec.engine.processors import DedicatedProcessor, PooledProcessor
 from opspec.engine.random import Streams
@@ -144,8 +142,6 @@ class RunState(Timers):
         (self.listeners, self.raw, self.wants_all, self.selectors, self.wanted,
          self.full) = _listener_tables(listeners, compiled)
         self.raw_metrics = _metrics_only(self.raw)
-        # the frameless first tokens as straight-line code, from source (opspec.engine.plans)
-        self.plans: dict[str, Plan] | None = plans_of(compiled)
         # which selection the wanted-kind bits cached on activities and processes are of
         self.flag_key = _flag_key(self.wants_all, self.wanted)
 
@@ -230,8 +226,17 @@ class RunState(Timers):
         back (:mod:`opspec.engine.zero_time`)."""
         if self.draining:
             return
-        self.draining = True
         ready = self.ready
+        if not ready and not self.pending:
+            # nothing queued (a deadline that fired after its instance ended, a timer whose
+            # callback queued nothing): the drain only counts as a step of this instant
+            steps = self.instant_steps + 1
+            if steps > self.max_instant_steps:
+                self.instant_steps = steps      # (as the finally below, if this raises)
+                steps = self._past_limit(steps, None, None)
+            self.instant_steps = steps
+            return
+        self.draining = True
         done = 0                    # the items of ``ready`` run so far
         # Steps are counted without looking at the clock (reading it costs a dictionary
         # lookup per drain); only past the limit does _past_limit ask whether the clock

@@ -45,13 +45,20 @@ def _compiled(package: Package, way: str) -> CompiledPackage:
 def _counting(sim: Simulation) -> dict[str, int]:
     """Wrap the run's plans so the test sees that they ran (and which)."""
     ran: dict[str, int] = {}
-    assert sim.plans is not None
-    for pid, (proc_, start, fn) in list(sim.plans.items()):
-        def counted(activities: Any, inst: Any, fn: Any = fn, pid: str = pid) -> None:
+    for proc_ in sim.compiled.processes.values():
+        if proc_.plan is None:
+            continue
+
+        def counted(inst: Any, activities: Any, unused: Any, fn: Any = proc_.plan,
+                    pid: str = proc_.id) -> None:
             ran[pid] = ran.get(pid, 0) + 1
-            fn(activities, inst)
-        sim.plans[pid] = (proc_, start, counted)
+            fn(inst, activities, unused)
+        proc_.plan = counted
     return ran
+
+
+def _planless(sim: Simulation) -> bool:
+    return all(proc_.plan is None for proc_ in sim.compiled.processes.values())
 
 
 def _seen(result: Any) -> tuple[Any, ...]:
@@ -71,7 +78,7 @@ def _three(monkeypatch: pytest.MonkeyPatch, package: Package, until: float = 100
         if way == "plan":
             ran = _counting(sim)
         else:
-            assert way == "general" or sim.plans is None
+            assert _planless(sim)
         seen.append(_seen(sim.run(until=until)))
     assert seen[0] == seen[1] == seen[2]
     return seen[0], ran
@@ -270,14 +277,17 @@ def test_what_is_lone_only_on_some_runs_is_handed_over(monkeypatch: pytest.Monke
 
 def test_plans_are_made_once_per_package_and_only_from_source(
         monkeypatch: pytest.MonkeyPatch) -> None:
-    compiled = compile_package(pkg(_caller(), _lookup_child()))
-    monkeypatch.setattr(plans, "COMPILED", False)
-    made = plans.of(compiled)
-    assert made is not None and set(made) == {"main", "lookup"}
-    assert plans.of(compiled) is made
-    assert "def plan(activities, inst):" in (made["lookup"][2].__doc__ or "")
     monkeypatch.setattr(plans, "COMPILED", True)
-    assert plans.of(compiled) is None
+    compiled = compile_package(pkg(_caller(), _lookup_child()))
+    plans.attach(compiled)
+    assert not compiled.plans and _planless(Simulation(compiled))
+    monkeypatch.setattr(plans, "COMPILED", False)
+    plans.attach(compiled)
+    made = {pid: proc_.plan for pid, proc_ in compiled.processes.items()}
+    assert all(made.values()) and set(made) == {"main", "lookup"}
+    assert "def plan(inst, activities, _unused):" in (made["lookup"].__doc__ or "")
+    Simulation(compiled)                    # a second run: the same plans
+    assert {pid: proc_.plan for pid, proc_ in compiled.processes.items()} == made
 
 
 def test_a_failing_actual_parameter_of_an_asynchronous_start_aborts_the_same_way(
