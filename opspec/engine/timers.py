@@ -286,7 +286,7 @@ def _entry(item: Any) -> Timed:
 
 def _order(item: Any) -> tuple[float, int]:
     if TUPLES:
-        return item[0], item[1]  # type: ignore[no-any-return]
+        return item[0], item[1]
     return item.at, item.seq
 
 
