@@ -198,7 +198,10 @@ class Timers:
         self.ticking = True
         self.shared = False
         try:
-            self._run_due(heap, ahead)
+            if TUPLES:
+                self._run_rows(heap, ahead)
+            else:
+                self._run_due(heap, ahead)
         finally:
             self.inside = outer
             self.ticking = False
@@ -208,20 +211,29 @@ class Timers:
             self.arm()
 
     def _run_due(self, heap: list[Timed], ahead: bool) -> None:
-        rows: list[Any] = heap              # the same list, holding tuples (see TUPLES)
-        entry: Timed
-        at: float
         while True:
-            if TUPLES:
-                at, _seq, entry = heappop(rows)
-            else:
-                entry = _pop(heap)
-                at = entry.at
+            entry = _pop(heap)
+            at = entry.at
             self.now = at
             entry.go()
             if not ahead or not heap or self.shared:
                 return
-            following: float = rows[0][0] if TUPLES else heap[0].at
+            following = heap[0].at
+            if following != at:
+                if not following < self.horizon:
+                    return          # something else comes first: SimPy's turn
+                self.lagging = True
+
+    def _run_rows(self, rows: list[Any], ahead: bool) -> None:
+        """:meth:`_run_due` from source, the heap holding tuples (see ``TUPLES``): a method
+        of its own, so that the compiled one tests nothing per entry."""
+        while True:
+            at, _seq, entry = heappop(rows)
+            self.now = at
+            entry.go()
+            if not ahead or not rows or self.shared:
+                return
+            following = rows[0][0]
             if following != at:
                 if not following < self.horizon:
                     return          # something else comes first: SimPy's turn
@@ -309,10 +321,8 @@ def _push(heap: list[Timed], entry: Timed) -> None:
 
 def _pop(heap: list[Timed]) -> Timed:
     """``heapq.heappop`` by ``(at, seq)``: the earliest entry (the first scheduled of its
-    time), taken off the heap."""
-    if TUPLES:
-        rows: list[Any] = heap
-        return heappop(rows)[2]  # type: ignore[no-any-return]
+    time), taken off the heap (compiled; from source the heap holds tuples for
+    :mod:`heapq`, see ``TUPLES``)."""
     last = heap.pop()
     if not heap:
         return last
