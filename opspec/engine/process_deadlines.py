@@ -29,12 +29,18 @@ def arm(flow: Flow, inst: ProcessInstance, deadline: float) -> None:
     """``inst`` started: its workflow's deadline falls due ``deadline`` seconds from now."""
     state = flow.state
     if deadline <= 0.0 and state.draining:      # RunState.call_at queues it
-        state.call_at(deadline, lambda: expired(flow, inst))
+        _queue(flow, inst, deadline)
         return
     # RunState.call_at's timed case
     state.sim_events += 1
     state.schedule_timed(deadline if deadline > 0.0 else 0.0,  # noqa: FURB136
                          _Deadline(flow, inst))
+
+
+def _queue(flow: Flow, inst: ProcessInstance, deadline: float) -> None:
+    # (a function of its own: compiled, a lambda in arm would make its closure's
+    # environment at every call of arm, not only here)
+    flow.state.call_at(deadline, lambda: expired(flow, inst))
 
 
 def expired(flow: Flow, inst: ProcessInstance) -> None:
