@@ -7,6 +7,7 @@ first on ``sys.path``).
 
 from __future__ import annotations
 
+import os
 import re
 import subprocess
 import sys
@@ -16,9 +17,11 @@ from pathlib import Path
 def instructions(code: str, *args: str, cwd: Path) -> int:
     """Instructions executed by ``python -c code args`` under callgrind (exits the benchmark
     with callgrind's own output when the run fails)."""
+    # one OpenBLAS thread: numpy's server threads otherwise spin for a varying number of
+    # instructions that callgrind counts with the run's (about 2.5M a run of the robot specs)
     done = subprocess.run(["valgrind", "--tool=callgrind", "--callgrind-out-file=/dev/null",
                            sys.executable, "-c", code, *args], capture_output=True, text=True,
-                          check=False, cwd=cwd)
+                          check=False, cwd=cwd, env={**os.environ, "OPENBLAS_NUM_THREADS": "1"})
     found = re.search(r"Collected : (\d+)", done.stderr)
     if done.returncode != 0 or found is None:
         sys.exit(f"callgrind run failed:\n{done.stderr[-2000:]}")

@@ -49,6 +49,7 @@ MODULES: tuple[str, ...] = (
     "opspec.engine.metrics",
     "opspec.engine.multi_instance",
     "opspec.engine.offers",
+    "opspec.engine.process_deadlines",
     "opspec.engine.part",
     "opspec.engine.random",
     "opspec.engine.runstate",

@@ -284,6 +284,9 @@ class CompiledProcess:
     # where an instance not started by a triggered start event starts when that is one
     # activity (its token then runs without a frame at first: opspec.engine.lone), else -1
     one_start: int = -1
+    # from source, that token's plan (opspec.engine.plans: straight-line code, made per
+    # package at its first run), which the ready queue calls as plan(inst, activities, _)
+    plan: Any = None
 
 
 @dataclass(slots=True, eq=False)
@@ -304,6 +307,9 @@ class CompiledPackage:
     catchers: dict[tuple[str, str], frozenset[str]] = field(default_factory=dict)
     _want_cache: dict[Any, frozenset[tuple[str, str | None, str | None]]] = field(
         default_factory=dict)
+    # whether its workflows have their plans (opspec.engine.plans.attach: made at the
+    # first run from source)
+    plans: bool = False
 
     def expand_selectors(
         self, selectors: frozenset[tuple[str, str | None, str | None]]

@@ -24,7 +24,7 @@ from opspec.engine.compiled import (
     CompiledProcess,
     CTransition,
 )
-from opspec.engine import drawing, escalations, joins, lone
+from opspec.engine import drawing, escalations, joins, lone, process_deadlines
 from opspec.engine.instances import ActivityInstance, Frame, ProcessInstance
 from opspec.engine.lifecycle import ABORTED, LIFECYCLE, RUNNING, STATE_NAMES, SUSPENDED, TERMINATED
 from opspec.engine.part import Part
@@ -95,8 +95,13 @@ class Flow(Part):
         one = proc.one_start if start < 0 else (start if graph.completion is None else -1)
         if one >= 0:
             # one token: the instance gets its frame only if the token reaches something
-            # that needs one (opspec.engine.lone); data-only workflows end without one
-            state.ready.append((self.start_lone_q, inst, one, None))
+            # that needs one (opspec.engine.lone); data-only workflows end without one.
+            # From source, the token's plan when it starts where the plan does
+            plan = proc.plan
+            if plan is not None and one == proc.one_start:
+                state.ready.append((plan, inst, self.activities, None))
+            else:
+                state.ready.append((self.start_lone_q, inst, one, None))
         else:
             if start >= 0:
                 starts: tuple[int, ...] = (start,)
@@ -114,19 +119,8 @@ class Flow(Part):
             if not starts:
                 state.pending[frame] = None
         if proc.deadline is not None:
-            self._arm_deadline(inst, proc.deadline)
+            process_deadlines.arm(self, inst, proc.deadline)
         return inst
-
-    def _arm_deadline(self, inst: ProcessInstance, deadline: float) -> None:
-        # (a closure in start_process would build its environment at every process start)
-        self.state.call_at(deadline, lambda: self._process_deadline(inst))
-
-    def _process_deadline(self, inst: ProcessInstance) -> None:
-        if inst.state in (RUNNING, SUSPENDED):
-            proc = inst.process
-            if self.state.wants(EK.DEADLINE_EXPIRED, proc.id, None):
-                self.state.emit(EK.DEADLINE_EXPIRED, proc.id, inst.id, None, proc.lane, None,
-                          {"deadline": proc.deadline, "scope": "process"})
 
     def frame_done(self, frame: Frame) -> None:
         inst = frame.inst
@@ -583,4 +577,3 @@ class Flow(Part):
         self.take(frame, trans)
         if not beside:
             self.token_gone(frame)
-

@@ -63,7 +63,7 @@ from typing import Any
 
 import simpy
 
-from opspec.engine import joins
+from opspec.engine import joins, plans
 from opspec.engine.activities import MAX_CALL_DEPTH, Activities
 from opspec.engine.compiled import CompiledActivity, CompiledPackage, CompiledProcess
 from opspec.engine.config import EngineConfig
@@ -111,6 +111,8 @@ class Interpreter(RunState):
         # adds to each general activity (0 where the model charges its own switches)
         self.pool = make_processor(self.env, config, activities.after_cpu, _alive, self.timer)
         self.switch = self.pool.activity_switch if self.pool is not None else 0.0
+        # from source, each workflow's first token as straight-line code (engine/plans.py)
+        plans.attach(compiled)
 
     # ------------------------------------------------------------------ instances
     def start_process(self, proc: CompiledProcess, data: Mapping[str, Any] | None = None, *,

@@ -27,23 +27,25 @@ if TYPE_CHECKING:
     from opspec.engine.activities import Activities
     from opspec.engine.flow import Flow
 
-__all__ = ["run"]
+__all__ = ["hand_over", "run", "xor_transition"]
 
 
-def run(activities: Activities, inst: ProcessInstance, act: CompiledActivity | None) -> None:
+def run(activities: Activities, inst: ProcessInstance, act: CompiledActivity | None,
+        steps: int = 0, limit: int = -1) -> None:
     """Carry the one token of ``inst`` (no frame yet) from ``act`` on: the steps of
-    ``Activities.start`` and ``Flow.done_next`` for ``lone`` activities, in their order."""
+    ``Activities.start`` and ``Flow.done_next`` for ``lone`` activities, in their order.
+    (``steps`` and ``limit``: where a plan, :mod:`opspec.engine.plans`, had got to.)"""
     state = activities.state
     pooled = state.pooled
     apps = state.apps
-    steps = 0
-    limit = state.start_limit
+    if limit < 0:
+        limit = state.start_limit
     flow = activities.flow
     acts = inst.process.graph.activities
     while act is not None:
         if not act.lone or (act.general and pooled) or (
                 act.kind == K_TASK and act.application in apps):
-            # its frame, with the token in it: from here the token goes the general way
+            # hand_over's steps, in line (compiled, the call would cost more than they do)
             frame = Frame(inst.process.graph, inst, None)
             inst.frames.append(frame)
             frame.live = 1
@@ -86,6 +88,19 @@ def run(activities: Activities, inst: ProcessInstance, act: CompiledActivity | N
                 return
         nxt = act.next
         act = acts[nxt] if nxt >= 0 else _split(flow, inst, act)
+
+
+def hand_over(activities: Activities, inst: ProcessInstance, act: CompiledActivity,
+              steps: int, limit: int) -> None:
+    """The token reached ``act``, which is not lone (or not on this run): the instance gets
+    its frame, with the token in it, and from here the token goes the general way."""
+    frame = Frame(inst.process.graph, inst, None)
+    inst.frames.append(frame)
+    frame.live = 1
+    if act.fast:
+        activities.start(frame, act, steps, limit)
+    else:
+        activities.start_slow(frame, act)       # start's first step
 
 
 def _split(flow: Flow, inst: ProcessInstance, act: CompiledActivity) -> CompiledActivity | None:

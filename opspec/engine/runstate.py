@@ -226,8 +226,17 @@ class RunState(Timers):
         back (:mod:`opspec.engine.zero_time`)."""
         if self.draining:
             return
-        self.draining = True
         ready = self.ready
+        if not ready and not self.pending:
+            # nothing queued (a deadline that fired after its instance ended, a timer whose
+            # callback queued nothing): the drain only counts as a step of this instant
+            steps = self.instant_steps + 1
+            if steps > self.max_instant_steps:
+                self.instant_steps = steps      # (as the finally below, if this raises)
+                steps = self._past_limit(steps, None, None)
+            self.instant_steps = steps
+            return
+        self.draining = True
         done = 0                    # the items of ``ready`` run so far
         # Steps are counted without looking at the clock (reading it costs a dictionary
         # lookup per drain); only past the limit does _past_limit ask whether the clock

@@ -35,6 +35,8 @@ heap entry and a generation check, no SimPy event.
 from __future__ import annotations
 
 import math
+import types
+from heapq import heappop, heappush
 from typing import Any, Final, final
 
 import simpy
@@ -88,6 +90,12 @@ def exact_delay(base: float, target: float) -> float:
         delay = math.nextafter(delay, INF if at < target else -INF)
     return max(0.0, delay)
 
+
+#: Whether the engine runs from source (this module is not compiled): then the heap holds
+#: ``(at, seq, entry)`` tuples ordered by :mod:`heapq`'s C code, which costs a third of
+#: :func:`_push`'s and :func:`_pop`'s loops interpreted; compiled, those loops compare two
+#: native fields per step and beat the tuple protocol (docs/engine-performance.md).
+TUPLES: Final = isinstance(exact_delay, types.FunctionType)
 
 class Timers:
     """The clock side of a run's state (:class:`~opspec.engine.runstate.RunState` extends
@@ -144,7 +152,11 @@ class Timers:
         self.order += 1
         entry.at = at
         entry.seq = self.order
-        _push(self.heap, entry)
+        if TUPLES:
+            rows: list[Any] = self.heap     # the same list, holding tuples (see TUPLES)
+            heappush(rows, (at, self.order, entry))
+        else:
+            _push(self.heap, entry)
         if at < self.armed_at and not self.ticking:
             self.arm()
 
@@ -153,7 +165,8 @@ class Timers:
         heap = self.heap
         if not heap:
             return
-        at = heap[0].at
+        rows: list[Any] = heap              # the same list, holding tuples (see TUPLES)
+        at: float = rows[0][0] if TUPLES else heap[0].at
         if at >= self.armed_at:
             return
         self.driver += 1
@@ -173,7 +186,8 @@ class Timers:
         at = self.armed_at
         self.armed_at = INF
         heap = self.heap
-        if not heap or heap[0].at != at:
+        rows: list[Any] = heap              # the same list, holding tuples (see TUPLES)
+        if not heap or (rows[0][0] if TUPLES else heap[0].at) != at:
             self.arm()
             return
         ahead = self.ahead
@@ -184,7 +198,10 @@ class Timers:
         self.ticking = True
         self.shared = False
         try:
-            self._run_due(heap, ahead)
+            if TUPLES:
+                self._run_rows(heap, ahead)
+            else:
+                self._run_due(heap, ahead)
         finally:
             self.inside = outer
             self.ticking = False
@@ -202,6 +219,21 @@ class Timers:
             if not ahead or not heap or self.shared:
                 return
             following = heap[0].at
+            if following != at:
+                if not following < self.horizon:
+                    return          # something else comes first: SimPy's turn
+                self.lagging = True
+
+    def _run_rows(self, rows: list[Any], ahead: bool) -> None:
+        """:meth:`_run_due` from source, the heap holding tuples (see ``TUPLES``): a method
+        of its own, so that the compiled one tests nothing per entry."""
+        while True:
+            at, _seq, entry = heappop(rows)
+            self.now = at
+            entry.go()
+            if not ahead or not rows or self.shared:
+                return
+            following = rows[0][0]
             if following != at:
                 if not following < self.horizon:
                     return          # something else comes first: SimPy's turn
@@ -232,7 +264,7 @@ class Timers:
         if urgent:
             return                  # before every timeout of its instant anyway
         # entries due at its instant were scheduled before it, so they come first
-        if any(entry.at == at for entry in self.heap):
+        if any(_at(entry) == at for entry in self.heap):
             self._give_to_simpy(at)
         if self.armed_at == at:
             self.driver += 1        # what is scheduled at ``at`` from now on comes after it
@@ -242,8 +274,9 @@ class Timers:
 
     def _give_to_simpy(self, at: float) -> None:
         heap = self.heap
-        due = sorted([entry for entry in heap if entry.at == at], key=_order)
-        heap[:] = sorted([entry for entry in heap if entry.at != at], key=_order)  # a heap
+        due = [_entry(item) for item in sorted([item for item in heap if _at(item) == at],
+                                               key=_order)]
+        heap[:] = sorted([item for item in heap if _at(item) != at], key=_order)  # a heap
         env = self.env
         delay = exact_delay(float(env.now), at)
         self.scheduling = True
@@ -254,8 +287,19 @@ class Timers:
             self.scheduling = False
 
 
-def _order(entry: Timed) -> tuple[float, int]:
-    return entry.at, entry.seq
+def _at(item: Any) -> float:
+    """An item's time, a tuple's (from source) or an entry's."""
+    return item[0] if TUPLES else item.at  # type: ignore[no-any-return]
+
+
+def _entry(item: Any) -> Timed:
+    return item[2] if TUPLES else item  # type: ignore[no-any-return]
+
+
+def _order(item: Any) -> tuple[float, int]:
+    if TUPLES:
+        return item[0], item[1]
+    return item.at, item.seq
 
 
 def _push(heap: list[Timed], entry: Timed) -> None:
@@ -277,7 +321,8 @@ def _push(heap: list[Timed], entry: Timed) -> None:
 
 def _pop(heap: list[Timed]) -> Timed:
     """``heapq.heappop`` by ``(at, seq)``: the earliest entry (the first scheduled of its
-    time), taken off the heap."""
+    time), taken off the heap (compiled; from source the heap holds tuples for
+    :mod:`heapq`, see ``TUPLES``)."""
     last = heap.pop()
     if not heap:
         return last

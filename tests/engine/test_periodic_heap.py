@@ -18,7 +18,11 @@ from builders import manual, pkg, proc
 
 from opspec.engine.builtin_performers import ScriptedUser
 from opspec.engine.simulation import Simulation
-from opspec.engine.timers import _pop
+from opspec.engine.timers import TUPLES, _pop
+
+if TUPLES:          # from source the heap holds (at, seq, entry) tuples under heapq
+    def _pop(heap: list) -> object:     # type: ignore[no-redef, type-arg]  # noqa: F811
+        return heapq.heappop(heap)[2]
 
 
 @pytest.mark.parametrize("seed", range(5))

@@ -1,0 +1,265 @@
+"""Plans: the frameless first token of each workflow as straight-line Python, made at load time.
+
+:func:`opspec.engine.lone.run` carries the one token of a new instance through its ``lone``
+activities (instantaneous, one way out, no join ahead) by interpreting the graph: per
+activity it asks whether it is lone, whether it runs on a pooled worker or a bound
+application, whether it has assignments, a subflow to start, one successor or an XOR split,
+and looks the successor up. All of that is known when the package is compiled. A *plan* is
+that walk written out once per workflow as the source of one Python function (``exec`` once
+per package, :func:`attach`), with only what each activity does left in it: its trace events,
+its assignments, its conditions called in order, its successor's code following its own.
+It does exactly what ``lone.run`` does, step for step — the same zero-time step count, the
+same trace events in the same order, the same faults, the same hand-over to
+:meth:`Activities.start <opspec.engine.activities.Activities.start>` (a frame made with the
+token in it) at the first activity that is not lone (``tests/engine/test_plans.py`` holds
+every bundled spec and the corner cases to it).
+
+Only from source: interpreted, an instance of the dispenser's schedule workflow (start,
+queue, plan, completion) costs 32k instructions instead of 45k through ``lone.run``;
+compiled by mypyc, ``lone.run`` is native code and a plan (which ``exec`` makes, so it
+always runs interpreted) would be slower, so :func:`attach` makes none when the engine runs
+compiled. Branches that merge again are written out once per path
+(the dispenser's schedule workflow: four slots into one merge); a path that comes back to
+an activity already on it (a zero-time cycle) or grows past :data:`MAX_BLOCKS` goes on in
+``lone.run`` with the steps counted so far.
+"""
+
+from __future__ import annotations
+
+import types
+from collections.abc import Callable
+from typing import Any, Final
+
+from opspec.engine import lone
+from opspec.engine.compiled import (
+    K_ASYNC,
+    K_TASK,
+    CompiledActivity,
+    CompiledPackage,
+    CompiledProcess,
+)
+from opspec.engine.lifecycle import RUNNING, SUSPENDED
+from opspec.engine.trace import EventKind as EK
+from opspec.errors import OpspecError
+
+__all__ = ["MAX_BLOCKS", "attach", "build"]
+
+#: Activity blocks written out per plan at most (merging branches are written once per
+#: path); past it, or deeper than :data:`_MAX_DEPTH` nested splits, the plan ends in
+#: ``lone.run``.
+MAX_BLOCKS: Final = 64
+_MAX_DEPTH: Final = 24
+
+#: whether the engine runs compiled (mypyc): its functions are then not Python functions
+COMPILED: Final = not isinstance(lone.run, types.FunctionType)
+
+_NO_TRANSITION: Final = ("no outgoing transition can be taken (no condition holds and "
+                         "there is no OTHERWISE transition)")
+
+
+def attach(compiled: CompiledPackage) -> None:
+    """Give each workflow of ``compiled`` that starts with one token its plan
+    (``CompiledProcess.plan``), once per package; none when the engine runs compiled."""
+    if COMPILED or compiled.plans:
+        return
+    for proc in compiled.processes.values():
+        if proc.one_start >= 0:
+            proc.plan = build(proc, proc.one_start)
+    compiled.plans = True
+
+
+def build(proc: CompiledProcess, start: int) -> Callable[[Any, Any, Any], None]:
+    """The plan of ``proc``'s one token from activity ``start``: ``plan(inst, activities,
+    None)``, queued by ``Flow.start_process``, does what ``Flow.start_lone_at`` and
+    ``lone.run(activities, inst, acts[start])`` do."""
+    writer = _Writer(proc)
+    lines = ["def plan(inst, activities, _unused):",
+             "    if inst.state != RUNNING:         # (Flow.start_lone_at's test)",
+             "        if inst.state == SUSPENDED:",
+             "            inst.defer((plan, inst, activities, None))",
+             "        return",
+             "    state = activities.state",
+             "    flow = activities.flow",
+             "    limit = state.start_limit",
+             "    iid = inst.id",
+             "    steps = 0"]
+    if any(act.general for act in proc.graph.activities):
+        lines.append("    pooled = state.pooled")
+    if any(act.kind == K_TASK for act in proc.graph.activities):
+        lines.append("    apps = state.apps")
+    writer.block(start, (), 1, lines)
+    source = "\n".join(lines) + "\n"
+    space = writer.names
+    exec(compile(source, f"<plan of {proc.id}>", "exec"), space)  # noqa: S102 - our own code
+    plan: Callable[[Any, Any, Any], None] = space["plan"]
+    plan.__doc__ = source                   # what it runs, for whoever debugs it
+    return plan
+
+
+class _Writer:
+    """Writes one plan's source: a block per activity, the successor's after it."""
+
+    def __init__(self, proc: CompiledProcess) -> None:
+        self.proc = proc
+        self.acts = proc.graph.activities
+        self.blocks = 0
+        # the plan's globals: what its source names (activities, conditions, helpers)
+        self.names: dict[str, Any] = {
+            "__builtins__": __builtins__, "HAND": lone.hand_over, "REST": lone.run,
+            "OpspecError": OpspecError, "RUNNING": RUNNING, "SUSPENDED": SUSPENDED,
+            "STARTED": EK.ACTIVITY_STARTED, "COMPLETED": EK.ACTIVITY_COMPLETED,
+            "CHANGED": EK.DATA_CHANGED}
+
+    def name(self, prefix: str, value: Any) -> str:
+        key = f"{prefix}{len(self.names)}"
+        self.names[key] = value
+        return key
+
+    def block(self, index: int, path: tuple[int, ...], depth: int, out: list[str]) -> None:
+        """The code of the token at activity ``index`` (reached through ``path``)."""
+        pad = "    " * depth
+        act = self.acts[index]
+        a = f"A{index}"
+        self.names[a] = act
+        self.blocks += 1
+        if index in path or self.blocks > MAX_BLOCKS or depth > _MAX_DEPTH:
+            out.append(f"{pad}REST(activities, inst, {a}, steps, limit)")
+            out.append(f"{pad}return")
+            return
+        hand = [f"{pad}    HAND(activities, inst, {a}, steps, limit)", f"{pad}    return"]
+        if not act.lone:
+            out.extend(line[4:] for line in hand)
+            return
+        waits = []                          # lone, but not on this run
+        if act.general:
+            waits.append("pooled")
+        if act.kind == K_TASK:
+            waits.append(f"{self.name('APP', act.application)} in apps")
+        if waits:
+            out.append(f"{pad}if {' or '.join(waits)}:")
+            out.extend(hand)
+        fields = (f"{self.name('P', act.process)}, iid, {self.name('I', act.id)}, "
+                  f"{self.name('L', act.lane)}, {self.name('W', act.participant)}")
+        out += [f"{pad}steps += 1",
+                f"{pad}if steps > limit:",
+                f"{pad}    state.zero_time(inst, {a})",
+                f"{pad}cached = {a}.flag_cache",
+                f"{pad}bits = cached.bits if cached.key is state.flag_key "
+                f"else state.act_bits({a})",
+                f"{pad}if bits & 1:",
+                f"{pad}    state.emit(STARTED, {fields})"]
+        if act.simple_end and not act.start_assign and act.kind != K_ASYNC:
+            out += [f"{pad}if bits & 2:", f"{pad}    state.emit(COMPLETED, {fields})"]
+        else:
+            if act.start_assign:
+                self.assign(act, act.start_assign, pad, out)
+            if act.kind == K_ASYNC:
+                # Activities.params_in, in line: the actual parameters in order, into a dict
+                items = ", ".join(f"{self.name('M', formal)}: {self.name('V', fn)}(scope, now)"
+                                  for _mode, formal, fn, _target in act.params
+                                  if fn is not None)
+                out += [f"{pad}now = state.now", f"{pad}scope = inst.scope", f"{pad}try:",
+                        f"{pad}    data = {{{items}}}",
+                        f"{pad}except OpspecError as error:",
+                        f"{pad}    flow.abort(inst, {a}, "
+                        f"f\"an actual parameter failed: {{error.message}}\")",
+                        f"{pad}    return",
+                        f"{pad}flow.start_process(state.processes[{self.name('F', act.subflow)}],"
+                        f" data, trigger={self.name('G', f'subflow:{act.id}')})"]
+            if not act.simple_end and act.end_assign:
+                self.assign(act, act.end_assign, pad, out)
+            out += [f"{pad}cached = {a}.flag_cache",
+                    f"{pad}if (cached.bits if cached.key is state.flag_key "
+                    f"else state.act_bits({a})) & 2:",
+                    f"{pad}    state.emit(COMPLETED, {fields})"]
+            if not act.simple_end:
+                out += [f"{pad}if inst.state != RUNNING:", f"{pad}    return"]
+        path = (*path, index)
+        if act.next >= 0:
+            self.block(act.next, path, depth, out)
+        elif act.out or act.otherwise:
+            self.split(index, path, depth, out)
+        else:                               # an end: the token is gone
+            out += [f"{pad}flow.instance_done(inst)", f"{pad}return"]
+
+    def split(self, index: int, path: tuple[int, ...], depth: int, out: list[str]) -> None:
+        """``lone.xor_transition`` of activity ``index``, then the chosen target's code."""
+        pad = "    " * depth
+        act = self.acts[index]
+        a = f"A{index}"
+        out += [f"{pad}scope = inst.scope", f"{pad}now = state.now", f"{pad}try:"]
+        taken = list(act.out)
+        chain: list[str] = []
+        closed = False                      # a transition without a condition: always taken
+        for k, trans in enumerate(taken):
+            if trans.condition is None:
+                chain += ([f"{pad}    else:", f"{pad}        k = {k}"] if chain
+                          else [f"{pad}    k = {k}"])
+                closed = True
+                break
+            test = f"{self.name('C', trans.condition)}(scope, now)"
+            chain += [f"{pad}    {'elif' if chain else 'if'} {test}:", f"{pad}        k = {k}"]
+        if not closed:
+            inner = f"{pad}        " if chain else f"{pad}    "
+            if chain:
+                chain.append(f"{pad}    else:")
+            if act.otherwise:
+                taken.append(act.otherwise[0])
+                chain.append(f"{inner}k = {len(taken) - 1}")
+            elif act.path_may_end:          # no condition holds: this path ends
+                chain += [f"{inner}flow.instance_done(inst)", f"{inner}k = -1"]
+            else:
+                chain += [f"{inner}flow.abort(inst, {a}, {_NO_TRANSITION!r})", f"{inner}k = -1"]
+        out += chain
+        out += [f"{pad}except OpspecError as error:",
+                f"{pad}    flow.abort(inst, {a}, "
+                f"f\"a transition condition failed: {{error.message}}\")",
+                f"{pad}    return"]
+        for k, trans in enumerate(taken):
+            out.append(f"{pad}{'if' if k == 0 else 'elif'} k == {k}:")
+            for target_name, fn in trans.assignments:
+                # Flow.set_field(inst, None, ...), in line
+                out.append(f"{pad}    value = {self.name('V', fn)}(scope, now)")
+                self.set_field(None, target_name, pad + "    ", out)
+            self.block(trans.target, path, depth + 1, out)
+        out += [f"{pad}return"]
+
+    def assign(self, act: CompiledActivity, assignments: tuple[tuple[str, Any], ...],
+               pad: str, out: list[str]) -> None:
+        """``Flow.assign(inst, act, assignments)``, in line (a failed one aborts the
+        instance; the token stops where the instance no longer runs)."""
+        a = f"A{act.index}"
+        self.names[a] = act
+        out += [f"{pad}now = state.now", f"{pad}reads = inst.scope", f"{pad}try:"]
+        for target, fn in assignments:
+            out.append(f"{pad}    value = {self.name('V', fn)}(reads, now)")
+            self.set_field(act, target, pad + "    ", out)
+            out += [f"{pad}    if inst.state != RUNNING:", f"{pad}        return"]
+        out += [f"{pad}except OpspecError as error:",
+                f"{pad}    flow.abort(inst, {a}, f\"an assignment failed: {{error.message}}\")",
+                f"{pad}    return"]
+
+    def set_field(self, act: CompiledActivity | None, target: str, pad: str,
+                  out: list[str]) -> None:
+        """``Flow.set_field(inst, act, target, value)``, in line (``value`` is set)."""
+        t = self.name("T", target)
+        out += [f"{pad}data = inst.data",
+                f"{pad}if {t} in data or {t} not in state.package_data:",
+                f"{pad}    data[{t}] = value",
+                f"{pad}else:",
+                f"{pad}    state.package_data[{t}] = value"]
+        if act is None:
+            key = self.name("D", (EK.DATA_CHANGED, self.proc.id, None))
+            out.append(f"{pad}if state.wants_all or {key} in state.wanted:")
+            who = "None"
+        else:
+            a = f"A{act.index}"
+            self.names[a] = act
+            out += [f"{pad}cached = {a}.flag_cache",
+                    f"{pad}if (cached.bits if cached.key is state.flag_key "
+                    f"else state.act_bits({a})) & 8:"]
+            who = self.name("I", act.id)
+        out += [f"{pad}    state.emit(CHANGED, {self.name('P', self.proc.id)}, iid, {who}, "
+                f"{self.name('L', self.proc.lane)}, None, {{{t}: value}})",
+                f"{pad}if state.rules:",
+                f"{pad}    flow.triggers.check_rules()"]
