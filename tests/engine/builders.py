@@ -280,3 +280,14 @@ def coordination(kind: str, **kw: Any) -> CoordinationBuiltIn:
 
 
 __all__ = [name for name in dir() if not name.startswith("_")]
+
+
+def lookup_subflow(assignment: str = '"noon"') -> WorkflowProcess:
+    """A data-only subflow ``lookup(hour IN, dose OUT)``: an XOR split on its input into
+    assignments, a merge, an end (a token that never waits)."""
+    return proc("lookup",
+                [act("split", split="XOR"), act("low", assign=[("dose", '"morning"')]),
+                 act("high", assign=[("dose", assignment)]), act("merge", join="XOR"), "end"],
+                [("split", "low", "hour < 12"), ("split", "high", "otherwise"),
+                 ("low", "merge"), ("high", "merge"), ("merge", "end")],
+                formals=[formal("hour", "IN"), formal("dose", "OUT")])

@@ -61,3 +61,20 @@ def kinds(result: RunResult) -> list[str]:
 def before(order: Iterable[str], first: str, second: str) -> bool:
     items = list(order)
     return items.index(first) < items.index(second)
+
+
+class AnswersLater:
+    """A performer that completes every work item it is offered ``delay`` simulated
+    seconds later (a token that has to wait for someone)."""
+
+    def __init__(self, delay: float = 5.0) -> None:
+        self.delay = delay
+
+    def attach(self, session: Any) -> None:
+        self.session = session
+
+    def offer(self, item: Any) -> None:
+        self.session.call_later(self.delay, lambda: self.session.complete(item))
+
+    def withdraw(self, item: Any, reason: str) -> None:
+        pass

@@ -10,8 +10,8 @@ from pathlib import Path
 from typing import Any
 
 import pytest
-from builders import act, field, formal, manual, pkg, proc, subflow
-from conftest import events
+from builders import act, field, formal, lookup_subflow, manual, pkg, proc, subflow
+from conftest import AnswersLater, events
 
 from opspec.engine.compiled import CompiledPackage, compile_package
 from opspec.engine.lanes import user_lane
@@ -69,20 +69,10 @@ def test_the_dispenser_with_its_users_runs_the_same_event_for_event(spec: str) -
     assert len(events(lone, "process.completed", process="schedule_workflow")) == 16
 
 
-def _lookup_child(assignment: str = '"noon"') -> Any:
-    """A data-only subflow: an XOR split on its input into assignments, a merge, an end."""
-    return proc("lookup",
-                [act("split", split="XOR"), act("low", assign=[("dose", '"morning"')]),
-                 act("high", assign=[("dose", assignment)]), act("merge", join="XOR"), "end"],
-                [("split", "low", "hour < 12"), ("split", "high", "otherwise"),
-                 ("low", "merge"), ("high", "merge"), ("merge", "end")],
-                formals=[formal("hour", "IN"), formal("dose", "OUT")])
-
-
 def test_a_data_only_subflow_returns_its_out_parameters_as_before() -> None:
     main = proc("main", [subflow("call", "lookup", ["hour", "dose"]), "after"],
                 [("call", "after")], data=[field("hour", 14), field("dose", "")])
-    lone, general = _both(pkg(main, _lookup_child()))
+    lone, general = _both(pkg(main, lookup_subflow()))
     _same(lone, general)
     assert {"dose": "noon"} in [dict(e.data) for e in events(lone, "data.changed",
                                                              process="main")]
@@ -91,7 +81,7 @@ def test_a_data_only_subflow_returns_its_out_parameters_as_before() -> None:
 def test_a_failing_assignment_in_a_frameless_instance_is_the_same_located_fault() -> None:
     main = proc("main", [subflow("call", "lookup", ["hour", "dose"]), "after"],
                 [("call", "after")], data=[field("hour", 14), field("dose", "")])
-    lone, general = _both(pkg(main, _lookup_child("missing_field + 1")))
+    lone, general = _both(pkg(main, lookup_subflow("missing_field + 1")))
     _same(lone, general)
     assert lone.summary["faults"] and "missing_field" in lone.summary["faults"][0]["message"]
 
@@ -112,21 +102,11 @@ def test_a_token_that_reaches_a_waiting_activity_gets_its_frame_and_goes_on() ->
     """A start, an assignment, then a manual activity: the instance gets its frame there;
     a performer answering later completes it as on the general path."""
 
-    class Later:
-        def attach(self, session: Any) -> None:
-            self.session = session
-
-        def offer(self, item: Any) -> None:
-            self.session.call_later(5.0, lambda: self.session.complete(item))
-
-        def withdraw(self, item: Any, reason: str) -> None:
-            pass
-
     work = proc("work", [act("set", assign=[("n", "n + 1")]), manual("do"), "end"],
                 [("set", "do"), ("do", "end")], data=[field("n", 0)])
-    lone = Simulation(compile_package(pkg(work)), performers={"user": Later()},
+    lone = Simulation(compile_package(pkg(work)), performers={"user": AnswersLater()},
                       keep_trace=True).run(until=100.0)
-    general = Simulation(_general(compile_package(pkg(work))), performers={"user": Later()},
+    general = Simulation(_general(compile_package(pkg(work))), performers={"user": AnswersLater()},
                          keep_trace=True).run(until=100.0)
     _same(lone, general)
     assert [e.time for e in events(lone, "process.completed", process="work")] == [5.0]

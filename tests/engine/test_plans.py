@@ -12,7 +12,8 @@ from pathlib import Path
 from typing import Any
 
 import pytest
-from builders import act, app, field, formal, manual, pkg, proc, subflow, task
+from builders import act, app, field, formal, lookup_subflow, manual, pkg, proc, subflow, task
+from conftest import AnswersLater
 
 from opspec.engine import plans
 from opspec.engine.compiled import CompiledPackage, compile_package
@@ -124,16 +125,6 @@ def test_the_robot_specs_with_their_worlds_run_the_same(monkeypatch: pytest.Monk
     assert len(seen[0][0]) > 1000
 
 
-def _lookup_child(assignment: str = '"noon"') -> Any:
-    """A data-only subflow: an XOR split on its input into assignments, a merge, an end."""
-    return proc("lookup",
-                [act("split", split="XOR"), act("low", assign=[("dose", '"morning"')]),
-                 act("high", assign=[("dose", assignment)]), act("merge", join="XOR"), "end"],
-                [("split", "low", "hour < 12"), ("split", "high", "otherwise"),
-                 ("low", "merge"), ("high", "merge"), ("merge", "end")],
-                formals=[formal("hour", "IN"), formal("dose", "OUT")])
-
-
 def _caller(hour: Any = 14) -> Any:
     return proc("main", [subflow("call", "lookup", ["hour", "dose"]), "after"],
                 [("call", "after")], data=[field("hour", hour), field("dose", "")])
@@ -141,7 +132,7 @@ def _caller(hour: Any = 14) -> Any:
 
 def test_a_data_only_subflow_returns_its_out_parameters(monkeypatch: pytest.MonkeyPatch
                                                          ) -> None:
-    (trace, _summary, _metrics), ran = _three(monkeypatch, pkg(_caller(), _lookup_child()))
+    (trace, _summary, _metrics), ran = _three(monkeypatch, pkg(_caller(), lookup_subflow()))
     assert ran == {"main": 1, "lookup": 1}
     assert ("data.changed", {"dose": "noon"}) in [(e[1], e[8]) for e in trace]
 
@@ -149,7 +140,7 @@ def test_a_data_only_subflow_returns_its_out_parameters(monkeypatch: pytest.Monk
 def test_a_failing_assignment_is_the_same_located_fault(monkeypatch: pytest.MonkeyPatch
                                                         ) -> None:
     (_trace, summary, _metrics), _ran = _three(
-        monkeypatch, pkg(_caller(), _lookup_child("missing_field + 1")))
+        monkeypatch, pkg(_caller(), lookup_subflow("missing_field + 1")))
     assert summary["faults"] and "missing_field" in summary["faults"][0]["message"]
 
 
@@ -158,7 +149,7 @@ def test_a_failing_condition_is_the_same_located_fault(monkeypatch: pytest.Monke
     """``hour < 12`` on a text that is no number: the instance aborts with the condition's
     message, as the general path's split reports it."""
     (_trace, summary, _metrics), _ran = _three(
-        monkeypatch, pkg(_caller("noon"), _lookup_child()))
+        monkeypatch, pkg(_caller("noon"), lookup_subflow()))
     assert "a transition condition failed" in summary["faults"][0]["message"]
 
 
@@ -227,20 +218,10 @@ def test_a_token_that_reaches_a_waiting_activity_gets_its_frame(
     """A start, an assignment, then a manual activity: the instance gets its frame there;
     a performer answering later completes it as on the general path."""
 
-    class Later:
-        def attach(self, session: Any) -> None:
-            self.session = session
-
-        def offer(self, item: Any) -> None:
-            self.session.call_later(5.0, lambda: self.session.complete(item))
-
-        def withdraw(self, item: Any, reason: str) -> None:
-            pass
-
     work = proc("work", [act("set", assign=[("n", "n + 1")]), manual("do"), "end"],
                 [("set", "do"), ("do", "end")], data=[field("n", 0)])
     (trace, _summary, _metrics), ran = _three(monkeypatch, pkg(work),
-                                              performers={"user": Later()})
+                                              performers={"user": AnswersLater()})
     assert ran == {"work": 1}
     assert [e[0] for e in trace if e[1] == "process.completed"] == [5.0]
 
@@ -278,7 +259,7 @@ def test_what_is_lone_only_on_some_runs_is_handed_over(monkeypatch: pytest.Monke
 def test_plans_are_made_once_per_package_and_only_from_source(
         monkeypatch: pytest.MonkeyPatch) -> None:
     monkeypatch.setattr(plans, "COMPILED", True)
-    compiled = compile_package(pkg(_caller(), _lookup_child()))
+    compiled = compile_package(pkg(_caller(), lookup_subflow()))
     plans.attach(compiled)
     assert not compiled.plans and _planless(Simulation(compiled))
     monkeypatch.setattr(plans, "COMPILED", False)
