@@ -279,3 +279,28 @@ def test_a_failing_actual_parameter_of_an_asynchronous_start_aborts_the_same_way
     (_trace, summary, _metrics), ran = _three(monkeypatch, pkg(main, child))
     assert ran == {"main": 1}
     assert "an actual parameter failed" in summary["faults"][0]["message"]
+
+
+def test_no_text_of_the_spec_reaches_a_plans_source(monkeypatch: pytest.MonkeyPatch) -> None:
+    """A plan is Python made by ``exec``: what the spec names (activity, lane, participant
+    and field ids, assigned values, conditions) must reach it as objects bound by name,
+    never as source text, or a spec could run code of its own. Ids and a field written to
+    break out of a string literal or a line run the same three ways, and the plan's source
+    contains none of them."""
+    evil = "x'\"); __import__('os').system('echo owned') #\n"
+    ids = [f"set{evil}", f"split{evil}", f"low{evil}", f"high{evil}"]
+    target = f"f{evil}"
+    work = proc(f"work{evil}",
+                [act(ids[0], assign=[(target, '"a\\" }{ \\n"'), ("n", "n + 1")]),
+                 act(ids[1], split="XOR"), act(ids[2]), act(ids[3]), "end"],
+                [(ids[0], ids[1]), (ids[1], ids[2], "n > 5"), (ids[1], ids[3], "otherwise"),
+                 (ids[2], "end"), (ids[3], "end")],
+                data=[field(target, ""), field("n", 0)])
+    (trace, _summary, _metrics), ran = _three(monkeypatch, pkg(work))
+    assert ran == {f"work{evil}": 1}
+    assert [e[4] for e in trace if e[1] == "activity.started"][:3] == [ids[0], ids[1], ids[3]]
+    _way(monkeypatch, "plan")
+    compiled = _compiled(pkg(work), "plan")
+    process = compiled.processes[f"work{evil}"]
+    source = plans.build(process, process.one_start).__doc__ or ""
+    assert "owned" not in source and "__import__" not in source and "def plan" in source
