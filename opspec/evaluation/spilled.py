@@ -1,5 +1,7 @@
 """Each finished user's value of every metric, kept on disk rather than in memory, and read
-back a batch at a time for each pass of the summaries and the report.
+back a batch at a time for each pass of the summaries and the report (for many users; up to
+:data:`opspec.evaluation.summary.HELD_USERS` they are held in memory, where spilling saves
+nothing: ``summary.per_user_values`` and :func:`held_activities`).
 
 The summaries need every user's ``(y, n)`` pair of every metric (sums over users, the
 cluster-robust variance, the users with any) and percentiles of the users' own values. Held
@@ -236,3 +238,25 @@ def spill_activities(store: ResultStore, design: str
                                  counts[name])))
     return out
 
+
+def held_activities(store: ResultStore, design: str
+                    ) -> list[tuple[str, int, list[tuple[float, float]],
+                                    list[tuple[float, float]]]]:
+    """What :func:`spill_activities` gives, held in lists (for few users, where spilling
+    saves no memory): per activity (in the order first stored) with offers, ``(activity,
+    offered, (omitted, offered) per user, (wrong, offered) per user)``, each count the
+    float its REAL column gives back."""
+    rows: dict[str, list[tuple[int, int, int]]] = {}
+    for activity, offered, omitted, wrong in store.rows(
+            "SELECT activity, offered, omitted, wrong FROM activity WHERE design = ? "
+            "ORDER BY rowid", (design,)):
+        rows.setdefault(str(activity), []).append(
+            (int(offered or 0), int(omitted or 0), int(wrong or 0)))
+    out = []
+    for name, counts in rows.items():
+        offered = sum(given for given, _, _ in counts)   # whole numbers: exact in any order
+        if offered:
+            out.append((name, offered,
+                        [(float(omitted), float(given)) for given, omitted, _ in counts],
+                        [(float(wrong), float(given)) for given, _, wrong in counts]))
+    return out

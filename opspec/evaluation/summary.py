@@ -325,28 +325,6 @@ HELD_USERS = 4096
 _HELD: weakref.WeakKeyDictionary[ResultStore, dict[Any, _Held]] = weakref.WeakKeyDictionary()
 
 
-def _held_activities(store: ResultStore, design: str
-                     ) -> list[tuple[str, int, list[tuple[float, float]],
-                                     list[tuple[float, float]]]]:
-    """What :func:`opspec.evaluation.spilled.spill_activities` gives, in lists: per activity
-    (in the order first stored) with offers, ``(activity, offered, (omitted, offered) per
-    user, (wrong, offered) per user)``, each count the float its REAL column gives back."""
-    rows: dict[str, list[tuple[int, int, int]]] = {}
-    for activity, offered, omitted, wrong in store.rows(
-            "SELECT activity, offered, omitted, wrong FROM activity WHERE design = ? "
-            "ORDER BY rowid", (design,)):
-        rows.setdefault(str(activity), []).append(
-            (int(offered or 0), int(omitted or 0), int(wrong or 0)))
-    out = []
-    for name, counts in rows.items():
-        offered = sum(given for given, _, _ in counts)   # whole numbers: exact in any order
-        if offered:
-            out.append((name, offered,
-                        [(float(omitted), float(given)) for given, omitted, _ in counts],
-                        [(float(wrong), float(given)) for given, _, wrong in counts]))
-    return out
-
-
 def _finished_users(store: ResultStore, design: str, users: set[int] | None) -> int:
     """How many users :func:`user_values` reads (at most ``len(users)``, when given)."""
     count = int(store.query("SELECT COUNT(*) FROM replication WHERE design = ? AND status "
@@ -458,12 +436,12 @@ def summarise_activities(store: ResultStore, design: str) -> list[dict[str, Any]
     method ``wilson-neff``). Activities never offered are left out. The users' counts are
     held in lists for at most :data:`HELD_USERS` users, else read from disk at each pass
     (:func:`opspec.evaluation.spilled.spill_activities`)."""
-    from opspec.evaluation.spilled import spill_activities
+    from opspec.evaluation.spilled import held_activities, spill_activities
     from opspec.statistics import proportion_interval
 
     most = store.query("SELECT MAX(c) FROM (SELECT COUNT(*) AS c FROM activity WHERE "
                        "design = ? GROUP BY activity)", (design,))[0][0]
-    counts = (_held_activities(store, design) if int(most or 0) <= HELD_USERS
+    counts = (held_activities(store, design) if int(most or 0) <= HELD_USERS
               else spill_activities(store, design))
     out = []
     for activity, offered, omissions, wrongs in counts:
