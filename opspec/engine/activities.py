@@ -138,19 +138,20 @@ class Activities(Part):
 
     def start_slow(self, frame: Frame, act: CompiledActivity) -> None:
         """Start ``act``, which waits or takes time: as an activity instance."""
-        ai = ActivityInstance(self.state.next_key(), act, frame, self.state.now)
+        state = self.state
+        ai = ActivityInstance(state.next_key(), act, frame, state.now)
         ai.state = RUNNING
         frame.running[ai.key] = ai
-        if act.plain and not (act.general and self.state.pooled):
+        if act.plain and not (act.general and state.pooled):
             inst = frame.inst
             cached = act.flag_cache           # RunState.act_bits's cached case, in line
-            if (cached.bits if cached.key is self.state.flag_key else self.state.act_bits(act)) & 1:
-                self.state.emit(EK.ACTIVITY_STARTED, act.process, inst.id, act.id, act.lane,
-                          act.participant)
+            if (cached.bits if cached.key is state.flag_key else state.act_bits(act)) & 1:
+                state.emit(EK.ACTIVITY_STARTED, act.process, inst.id, act.id, act.lane,
+                           act.participant)
             if act.start_assign and not self.flow.assign(inst, act, act.start_assign):
                 return
             if act.kind == K_MANUAL and not act.params:
-                known = self.state.performers_of     # Offers.performer_for's cached case
+                known = state.performers_of     # Offers.performer_for's cached case
                 performer = known[act] if act in known else self.offers.performer_for(act)
                 if performer is not None:
                     self.offers.offer(ai, performer, (), None, None)
@@ -200,6 +201,15 @@ class Activities(Part):
                                                index, persistent=True)
         if act.loop is not None and act.loop[2] and not self._loop_again(ai):
             self._complete(ai)
+            return
+        if (act.cpu == 0.0 and act.cpu_sampler is None and act.sampler is None
+                and not act.general):
+            # _run_body and after_cpu with nothing to wait for (no CPU, no duration), in
+            # line: the body at once (an event caught with a deadline, a subflow call)
+            if ai.state == RUNNING:
+                self._body(ai)
+                if not state.draining:
+                    state.drain()
             return
         self._run_body(ai)
 
@@ -385,12 +395,16 @@ class Activities(Part):
             else:
                 self.start_slow(frame, target)
 
-    def _inputs(self, ai: ActivityInstance) -> dict[str, Any] | None:
+    def _inputs(self, ai: ActivityInstance,
+                params: tuple[tuple[ParameterMode, str, Any, str | None], ...] | None = None
+                ) -> dict[str, Any] | None:
+        """The actual parameters' values by formal (``params``: a tool's; by default the
+        activity's); ``None`` when one failed (the activity failed)."""
         reads = ai.scope()
         now = self.state.now
         out: dict[str, Any] = {}
         try:
-            for _mode, formal, fn, _target in ai.act.params:
+            for _mode, formal, fn, _target in (ai.act.params if params is None else params):
                 if fn is not None:                  # OUT parameters carry nothing in
                     out[formal] = fn(reads, now)
         except OpspecError as error:
@@ -409,7 +423,7 @@ class Activities(Part):
             tool = tools[index]
             performer = self.state.apps.get(tool.application)
             if performer is not None:
-                data = self._tool_inputs(ai, tool.params)
+                data = self._inputs(ai, tool.params)
                 if data is None:
                     return
                 key = ai.key
@@ -439,21 +453,6 @@ class Activities(Part):
             for key, value in self.outputs(ai, data, ai.act.tools[index].params).items():
                 self.flow.set_field(inst, ai.act, key, value)
         self._run_tools(ai, index + 1)
-
-    def _tool_inputs(self, ai: ActivityInstance,
-                     params: tuple[tuple[ParameterMode, str, Any, str | None], ...]
-                     ) -> dict[str, Any] | None:
-        reads = ai.scope()
-        now = self.state.now
-        out: dict[str, Any] = {}
-        try:
-            for _mode, formal, fn, _target in params:
-                if fn is not None:
-                    out[formal] = fn(reads, now)
-        except OpspecError as error:
-            self.fail(ai, "parameter", f"an actual parameter failed: {error.message}")
-            return None
-        return out
 
     def _run_script(self, ai: ActivityInstance, application: str,
                     params: tuple[tuple[ParameterMode, str, Any, str | None], ...],

@@ -37,6 +37,20 @@ if TYPE_CHECKING:
 # Final: a module static in the compiled engine, where a plain global is a dictionary lookup
 _PROXY: Final = MappingProxyType
 
+_ChoiceTable = tuple[tuple[CTransition, ...], tuple[tuple[CTransition, Any], ...],
+                     CompiledActivity | None, tuple[str, ...]]
+
+
+def _choice_table(acts: tuple[CompiledActivity, ...],
+                  branches: tuple[CTransition, ...]) -> _ChoiceTable:
+    """What :meth:`Offers.offer_choice` needs of ``branches``, in their order."""
+    catches = tuple((trans, acts[trans.target].trigger) for trans in branches
+                    if acts[trans.target].kind == K_CATCH
+                    and acts[trans.target].trigger is not None)
+    manual = [acts[trans.target] for trans in branches if acts[trans.target].kind == K_MANUAL]
+    return (branches, catches, manual[0] if manual else None,
+            tuple([target.id for target in manual]))
+
 
 class Offers(Part):
     """Work items to performers and their answers (see the module docstring)."""
@@ -45,6 +59,9 @@ class Offers(Part):
         super().__init__(state)
         # Bound once, for the ready queue (see Flow.__init__).
         self.choose_q: Callable[[ActivityInstance, CTransition, Any], None] = self._choose
+        # per deciding activity: its branches, (branch, trigger) of the catch events among
+        # them, the first manual branch's activity and the manual branches' ids
+        self.choices_of: dict[CompiledActivity, _ChoiceTable] = {}
 
     def performer_for(self, act: CompiledActivity) -> Performer | None:
         known = self.state.performers_of
@@ -62,8 +79,10 @@ class Offers(Part):
                application: str | None = None) -> None:
         act = ai.act
         inst = ai.frame.inst
-        item = WorkItem(ai.key, act.process, inst.id, act.id, act.label, act.participant,
-                        act.lane, self.state.now,
+        state = self.state
+        key = ai.key
+        item = WorkItem(key, act.process, inst.id, act.id, act.label, act.participant,
+                        act.lane, state.now,
                         application if application is not None else act.application,
                         data if data is not None else _PROXY(
                             inst.data if ai.local is None else ChainMap(ai.local, inst.data)),
@@ -72,33 +91,37 @@ class Offers(Part):
         ai.item = item
         ai.performer = performer
         ai.waiting = "performer"
-        self.state.offered[ai.key] = ai
+        state.offered[key] = ai
         cached = act.flag_cache               # RunState.act_bits's cached case, in line
-        if (cached.bits if cached.key is self.state.flag_key else self.state.act_bits(act)) & 4:
-            self.state.emit(EK.ACTIVITY_OFFERED, act.process, inst.id, act.id, act.lane,
-                      act.participant, {"choices": list(choices)} if choices else None)
+        if (cached.bits if cached.key is state.flag_key else state.act_bits(act)) & 4:
+            state.emit(EK.ACTIVITY_OFFERED, act.process, inst.id, act.id, act.lane,
+                       act.participant, {"choices": list(choices)} if choices else None)
         performer.offer(item)
 
     def offer_choice(self, ai: ActivityInstance, branches: tuple[CTransition, ...]) -> None:
         """A deferred choice: manual branches are offered as one work item with ``choices``;
         catch-event branches race it; the first to happen wins."""
-        acts = ai.frame.graph.activities
         ai.choice = branches
         ai.waiting = "choice"
-        manual = [t for t in branches if acts[t.target].kind == K_MANUAL]
-        for trans in branches:
-            target = acts[trans.target]
-            if target.kind == K_CATCH and target.trigger is not None:
-                self.triggers.wait_trigger(ai, target.trigger, self._choice_event, trans)
-        if ai.act.labelled:
+        act = ai.act
+        # what the branches are is fixed by the graph: worked out once per activity and
+        # its branches (from source, two list comprehensions are two frames per offer)
+        known = self.choices_of.get(act)
+        if known is None or known[0] is not branches:
+            known = self.choices_of[act] = _choice_table(ai.frame.graph.activities, branches)
+        _branches, catches, manual, choices = known
+        for trans, trigger in catches:
+            self.triggers.wait_trigger(ai, trigger, self._choice_event, trans)
+        if act.labelled:
             self._labelled_choice(ai, branches)
-        elif manual:
-            performer = self.performer_for(acts[manual[0].target])
+        elif manual is not None:
+            known_performers = self.state.performers_of     # performer_for's cached case
+            performer = (known_performers[manual] if manual in known_performers
+                         else self.performer_for(manual))
             if performer is None:
-                ai.waiting = f"performer for the choice {[acts[t.target].id for t in manual]}"
+                ai.waiting = f"performer for the choice {list(choices)}"
                 return
-            # (a list, not a generator: from source a generator resumes once per item)
-            self.offer(ai, performer, tuple([acts[t.target].id for t in manual]), None, None)
+            self.offer(ai, performer, choices, None, None)
 
     def _labelled_choice(self, ai: ActivityInstance, branches: tuple[CTransition, ...]) -> None:
         """A split between labelled branches: the performer bound to the deciding activity
@@ -140,8 +163,11 @@ class Offers(Part):
             inst = frame.inst
             if act.end_assign and not self.flow.assign(inst, act, act.end_assign):
                 return
-            self.state.emit_act(EK.ACTIVITY_COMPLETED, inst, act, {"choice": frame.graph.activities[
-                trans.target].id})
+            state = self.state                # RunState.emit_act, by the cached bits
+            cached = act.flag_cache
+            if (cached.bits if cached.key is state.flag_key else state.act_bits(act)) & 2:
+                state.emit(EK.ACTIVITY_COMPLETED, act.process, inst.id, act.id, act.lane,
+                           act.participant, {"choice": frame.graph.activities[trans.target].id})
         # a chosen manual branch *is* performed by the choice; a labelled one then runs
         self.flow.take(frame, trans, performed=not act.labelled)
         self.flow.token_gone(frame)
@@ -153,14 +179,17 @@ class Offers(Part):
 
     def performer_complete(self, item: WorkItem, data: Mapping[str, Any] | None,
                            choice: str | None) -> None:
-        offered = self.state.offered
-        ai = offered.get(item.key)
+        state = self.state
+        offered = state.offered
+        key = item.key
+        ai = offered.get(key)
         if ai is not None:
-            del offered[item.key]
+            del offered[key]
         if ai is None or ai.state != RUNNING:
-            self.state.stale_completions += 1
+            state.stale_completions += 1
             return
         ai.item = None
+        act = ai.act
         if ai.choice:
             acts = ai.frame.graph.activities
             trans: CTransition | None = None
@@ -172,23 +201,23 @@ class Offers(Part):
                 if choice is None and len(item.choices) == 1:
                     trans = next(t for t in ai.choice if acts[t.target].id == item.choices[0])
                 else:
-                    self.state.offered[item.key] = ai
+                    offered[key] = ai
                     ai.item = item
                     raise ExecutionError(
-                        f"work item {item.key} ({item.activity}) needs a choice among "
+                        f"work item {key} ({item.activity}) needs a choice among "
                         f"{', '.join(item.choices)}, got {choice!r}",
-                        hint="call complete(item, choice=ACTIVITY_ID)", sim_time=self.state.now)
-            self.state.ready.append((self.choose_q, ai, trans, data))
-        elif ai.act.toolchain and ai.key in self.state.tool_at:
-            self.state.ready.append((self.activities.tool_done, ai, data, None))
+                        hint="call complete(item, choice=ACTIVITY_ID)", sim_time=state.now)
+            state.ready.append((self.choose_q, ai, trans, data))
+        elif act.toolchain and key in state.tool_at:
+            state.ready.append((self.activities.tool_done, ai, data, None))
         elif data:
-            if ai.act.params:
+            if act.params:
                 data = self.activities.outputs(ai, data)
-            self.state.ready.append((self.activities.body_done_q, ai, data, None))
+            state.ready.append((self.activities.body_done_q, ai, data, None))
         else:
-            self.state.ready.append((self.activities.body_done_q, ai, None, None))
-        if not self.state.draining:
-            self.state.drain()
+            state.ready.append((self.activities.body_done_q, ai, None, None))
+        if not state.draining:
+            state.drain()
 
     def performer_omit(self, item: WorkItem, reason: str) -> None:
         offered = self.state.offered
