@@ -69,17 +69,18 @@ class Flow(Part):
             _CHAIN(local, state.package_data) if state.package_data else local)
         iid = state.next_id()
         priority = proc.priority
-        root = iid
-        if parent is not None:
-            root = parent.frame.inst.root
-            if parent.frame.inst.priority > priority:       # (max(), without its call)
-                priority = parent.frame.inst.priority
-        inst = ProcessInstance(iid, proc, local, scope, priority, parent, root, state.now)
+        if parent is None:
+            inst = ProcessInstance(iid, proc, local, scope, priority, None, iid, state.now)
+        else:
+            caller = parent.frame.inst
+            if caller.priority > priority:       # (max(), without its call)
+                priority = caller.priority
+            inst = ProcessInstance(iid, proc, local, scope, priority, parent, caller.root,
+                                   state.now)
+            inst.depth = caller.depth + 1
+            inst.partner = caller.partner
         inst.state = RUNNING
         inst.trigger = trigger
-        if parent is not None:
-            inst.depth = parent.frame.inst.depth + 1
-            inst.partner = parent.frame.inst.partner
         state.live[iid] = inst
         state.started += 1
         cached = proc.flag_cache              # RunState.proc_bits's cached case, in line
@@ -154,8 +155,8 @@ class Flow(Part):
         proc = inst.process
         cached = proc.flag_cache              # RunState.proc_bits's cached case, in line
         if (cached.bits if cached.key is state.flag_key else state.proc_bits(proc)) & 2:
-            self.state.emit(EK.PROCESS_COMPLETED, proc.id, inst.id, None, proc.lane, None,
-                      {"duration": self.state.now - inst.started_at})
+            state.emit(EK.PROCESS_COMPLETED, proc.id, inst.id, None, proc.lane, None,
+                       {"duration": state.now - inst.started_at})
         parent = inst.parent
         if parent is not None and parent.state == RUNNING:
             parent.child = None

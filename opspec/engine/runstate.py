@@ -446,7 +446,11 @@ class _Later(Timed):
         self.gen = ai.gen
 
     def go(self) -> None:
-        self.state.fired(self.fn, self.ai, self.arg, self.gen)
+        ai = self.ai
+        # RunState.fired's first test, here: a deadline that lost its race (the user
+        # reported in time) is due after its activity instance moved on, once a dose cycle
+        if ai.gen == self.gen and ai.state == RUNNING:
+            self.state.fired(self.fn, ai, self.arg, self.gen)
 
     def __call__(self, _event: Any) -> None:
         self.state.fire(self.fn, self.ai, self.arg, self.gen)
