@@ -8,7 +8,7 @@ cycle, so they stay small and cheap. Life-cycle states are ints from
 from __future__ import annotations
 
 from collections import ChainMap
-from collections.abc import Callable, MutableMapping
+from collections.abc import Callable, Mapping, MutableMapping
 from typing import TYPE_CHECKING, Any
 
 from opspec.engine.lifecycle import NOT_STARTED
@@ -43,6 +43,7 @@ class ProcessInstance:
         "started_at",
         "state",
         "trigger",
+        "view",
     )
 
     def __init__(self, id: int, process: CompiledProcess, data: dict[str, Any],
@@ -64,6 +65,9 @@ class ProcessInstance:
         self.depth = 0                        # synchronous subflow calls above this one
         # the root instance whose message started this one (replies are correlated to it)
         self.partner: ProcessInstance | None = None
+        # a read-only live view of ``data``, the work items' data (made at the first offer:
+        # one per instance, not one per work item)
+        self.view: Mapping[str, Any] | None = None
 
     def defer(self, item: tuple[Any, Any, Any, Any]) -> None:
         """Keep a ready-queue item until the suspended instance resumes."""

@@ -81,13 +81,18 @@ class Offers(Part):
         inst = ai.frame.inst
         state = self.state
         key = ai.key
+        if data is None:
+            if ai.local is None:
+                # a live view of the instance's data: one per instance, shared by its items
+                data = inst.view
+                if data is None:
+                    data = inst.view = _PROXY(inst.data)
+            else:
+                data = _PROXY(ChainMap(ai.local, inst.data))
         item = WorkItem(key, act.process, inst.id, act.id, act.label, act.participant,
                         act.lane, state.now,
                         application if application is not None else act.application,
-                        data if data is not None else _PROXY(
-                            inst.data if ai.local is None else ChainMap(ai.local, inst.data)),
-                        choices,
-                        inst.root, duration)
+                        data, choices, inst.root, duration)
         ai.item = item
         ai.performer = performer
         ai.waiting = "performer"
