@@ -11,7 +11,7 @@ from __future__ import annotations
 from typing import Any
 
 import pytest
-from builders import act, catch, field, manual, pkg, proc, route
+from builders import catch, field, manual, pkg, proc, route
 from conftest import events
 
 from opspec.engine.builtin_performers import ScriptedUser
