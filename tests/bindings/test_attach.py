@@ -26,7 +26,7 @@ from opspec.engine.trace import TraceEvent
 from opspec.errors import BindingError
 from opspec.request import scripted_user
 
-from .conftest import DATA, DEVICES, needs_pty
+from .conftest import DATA, DEVICES, _pty_available, needs_pty
 
 SPEC = Path(__file__).resolve().parents[2] / "specs" / "medication_dispenser.xpdl"
 SPEED = 20000.0
@@ -62,6 +62,19 @@ class ChattyDevice(EmulatedDevice):
         return actions
 
 
+def _start_board(servers: list[PtyEmulator | SocketEmulator],
+                 cls: type[EmulatedDevice] = EmulatedDevice, fault: str = "none",
+                 on: str = "pty", profile: str = FAST) -> PtyEmulator | SocketEmulator:
+    path = DATA / f"{profile}.toml" if profile == FAST else DEVICES / f"{profile}.toml"
+    device = cls(load_profile(path), Behaviour.parse(fault))
+    server: PtyEmulator | SocketEmulator = (
+        PtyEmulator(device) if on == "pty" else SocketEmulator(device))
+    device.server = server  # type: ignore[attr-defined]
+    servers.append(server)
+    server.start()
+    return server
+
+
 @pytest.fixture
 def board() -> Iterator[Any]:
     """``board(cls, fault, on, profile)``: a running emulator, stopped at teardown."""
@@ -69,14 +82,7 @@ def board() -> Iterator[Any]:
 
     def start(cls: type[EmulatedDevice] = EmulatedDevice, fault: str = "none",
               on: str = "pty", profile: str = FAST) -> PtyEmulator | SocketEmulator:
-        path = DATA / f"{profile}.toml" if profile == FAST else DEVICES / f"{profile}.toml"
-        device = cls(load_profile(path), Behaviour.parse(fault))
-        server: PtyEmulator | SocketEmulator = (
-            PtyEmulator(device) if on == "pty" else SocketEmulator(device))
-        device.server = server  # type: ignore[attr-defined]
-        servers.append(server)
-        server.start()
-        return server
+        return _start_board(servers, cls, fault, on, profile)
 
     yield start
     for server in servers:
@@ -123,8 +129,10 @@ def script(tmp_path: Path, *steps: tuple[str, str]) -> str:
 
 def simulate(bind: list[str], user: str, *, until: float = FIRST_DOSE, spec: Path = SPEC,
              profiles: Path = DATA, settle_s: float | None = None,
-             speed: float = SPEED) -> Outcome:
-    """What ``opspec run --bind`` does, through the public API."""
+             speed: float = SPEED, alone: bool = True) -> Outcome:
+    """What ``opspec run --bind`` does, through the public API. ``alone=False``: other
+    runs go on beside it (:func:`wall_clock_runs`), whose reader threads may still be
+    alive when it ends; the caller checks that none outlives them all."""
     compiled = compile_package(load_any_spec(spec))
     performer, listeners = scripted_user(user, compiled).make(0, 1)
     performers: dict[str, Any] = dict.fromkeys(user_lane(compiled).bind_names, performer)
@@ -144,7 +152,8 @@ def simulate(bind: list[str], user: str, *, until: float = FIRST_DOSE, spec: Pat
         result = sim.run(until=until)
         outcome = Outcome(result, devices.report(), list(devices.notes),
                           devices.requires_wall_clock, threads)
-    assert not _serial_threads(), "a reader thread outlived attach_devices"
+    if alone:
+        assert not _serial_threads(), "a reader thread outlived attach_devices"
     return outcome
 
 
@@ -297,18 +306,74 @@ def test_a_line_nobody_expects_is_a_named_fault_and_the_run_goes_on(
     assert run.report["alarm, dispenser"]["mode"] == {"alarm": "device", "dispenser": "device"}
 
 
+def _misbehaving_alarm(server: PtyEmulator | SocketEmulator, folder: Path) -> Outcome:
+    # timeout, hold for a late reply, resend, timeout: 3 x 200 ms (wall) span 3.3 simulated
+    # hours at 20,000x, which left too little slack before 12:00 on a busy CI machine; at
+    # 8,000x they span 1.3 h and the 08:00 alarm's fallback has 2.6 h (1.2 s wall) to spare
+    return simulate([f"alarm:{FAST}={server.url}"],
+                    script(folder, ("after trg_2 30s", "press_report")), until=43000,
+                    speed=8000.0, alone=False)
+
+
+def _drawer_fault(folder: Path) -> Outcome:
+    # garbage alone ends the attempt at its timeout (3 s wall: a reply may follow noise),
+    # 24,000 simulated seconds at 8,000x: the 08:00 dose's fallback comes at about 14:40,
+    # 1.6 s (wall) before the run ends at 18:20; the noon dose's DISPENSE waits behind it
+    url = f"emulator://{DEVICES / f'{SHIPPED}.toml'}?fault=garbage"
+    return simulate([f"dispenser={url}"], script(folder, ("after trg_2 30s", "press_report")),
+                    profiles=DEVICES, until=66000.0, speed=8000.0, alone=False)
+
+
+@pytest.fixture(scope="module")
+def wall_clock_runs(tmp_path_factory: pytest.TempPathFactory
+                    ) -> dict[str, Outcome | BaseException]:
+    """The runs of the tests below that wait on the wall clock (8,000x: 5.4, 5.4 and 8.3 s),
+    side by side, each in a thread with its own devices, emulator and script: together they
+    take the wall time of the longest, where one after another they held a test worker for
+    19 s. Each test reads its own run (a run's error is raised by its test); no serial
+    reader thread outlives them."""
+    jobs: dict[str, Any] = {"drawer": _drawer_fault}
+    servers: list[PtyEmulator | SocketEmulator] = []
+    if _pty_available():                        # else the alarm's tests are skipped
+        for fault in ("silent", "garbage"):
+            server = _start_board(servers, fault=fault, on="pty")
+            jobs[fault] = lambda folder, server=server: _misbehaving_alarm(server, folder)
+    outcomes: dict[str, Outcome | BaseException] = {}
+    # made here, not in the threads: pytest makes its base folder at the first mktemp
+    folders = {name: tmp_path_factory.mktemp(name) for name in jobs}
+
+    def run(name: str) -> None:
+        try:
+            outcomes[name] = jobs[name](folders[name])
+        except BaseException as error:  # noqa: BLE001 - raised by the test that reads it
+            outcomes[name] = error
+
+    threads = [threading.Thread(target=run, args=(name,), name=f"run-{name}") for name in jobs]
+    try:
+        for thread in threads:
+            thread.start()
+        for thread in threads:
+            thread.join()
+    finally:
+        for server in servers:
+            server.stop()
+    assert not _serial_threads(), "a reader thread outlived attach_devices"
+    return outcomes
+
+
+def _outcome(runs: dict[str, Outcome | BaseException], name: str) -> Outcome:
+    found = runs[name]
+    if isinstance(found, BaseException):
+        raise found
+    return found
+
+
 @needs_pty
 @pytest.mark.parametrize(("fault", "named"), [("silent", "timeout"), ("garbage", "garbage")],
                          ids=["no-reply", "garbage"])
 def test_a_misbehaving_alarm_retries_then_goes_on_simulated(
-        fault: str, named: str, board: Any, tmp_path: Path) -> None:
-    server = board(fault=fault, on="pty")
-    # timeout, hold for a late reply, resend, timeout: 3 x 200 ms (wall) span 3.3 simulated
-    # hours at 20,000x, which left too little slack before 12:00 on a busy CI machine; at
-    # 8,000x they span 1.3 h and the 08:00 alarm's fallback has 2.6 h (1.2 s wall) to spare
-    run = simulate([f"alarm:{FAST}={server.url}"],
-                   script(tmp_path, ("after trg_2 30s", "press_report")), until=43000,
-                   speed=8000.0)
+        fault: str, named: str, wall_clock_runs: dict[str, Any]) -> None:
+    run = _outcome(wall_clock_runs, fault)
     assert [(f["fault"], f["action"]) for f in run.faults()][:2] == [
         (named, "retry"), (named, "simulate")]
     assert run.report["alarm"]["mode"] == {"alarm": "simulated"}
@@ -349,17 +414,12 @@ def test_attach_refuses_a_participant_the_spec_does_not_have() -> None:
 
 
 def test_the_shipped_dispenser_profile_and_spec_agree_on_the_drawer_fault(
-        tmp_path: Path) -> None:
+        wall_clock_runs: dict[str, Any]) -> None:
     # the shipped files, a drawer that answers garbage: DispenserFault is handled by the spec
     profile = load_profile(DEVICES / f"{SHIPPED}.toml")
     fallback = profile.fallback_for("dispenser")
     assert (fallback.then, fallback.exception) == ("abort", "DispenserFault")
-    url = f"emulator://{DEVICES / f'{SHIPPED}.toml'}?fault=garbage"
-    # garbage alone ends the attempt at its timeout (3 s wall: a reply may follow noise),
-    # 24,000 simulated seconds at 8,000x: the 08:00 dose's fallback comes at about 14:40,
-    # 1.6 s (wall) before the run ends at 18:20; the noon dose's DISPENSE waits behind it
-    run = simulate([f"dispenser={url}"], script(tmp_path, ("after trg_2 30s", "press_report")),
-                   profiles=DEVICES, until=66000.0, speed=8000.0)
+    run = _outcome(wall_clock_runs, "drawer")        # the run: _drawer_fault
     failed = [e for e in run.result.trace or () if e.kind == "activity.failed"]
     assert [(e.activity, (e.data or {}).get("exception")) for e in failed] == [
         ("dispense", "DispenserFault")]

@@ -84,14 +84,67 @@ async def _status(url: str) -> int:
         return response.status
 
 
+#: Installed in the page before its own scripts: reads what the app's websocket sends to
+#: the terminal and keeps its last status line -- "d1 08:00:23  60x  running  |  ..." -- as
+#: [simulated seconds since the start, state] in ``window.__status``, so that the test
+#: sees the walkthrough's state as the person does instead of waiting a fixed time after
+#: each key. (The summary that opens at the run's end covers the status line, but the
+#: "[ENDED]" state is sent first.)
+RECORD_STATUS = r"""
+(() => {
+  const Native = window.WebSocket;
+  const decoder = new TextDecoder();
+  const line = /d(\d+) (\d\d):(\d\d):(\d\d)\s+[\d.]+x\s+(\[ENDED\]|skipping|running|PAUSED)/g;
+  let tail = "";                      // a status line may be cut between two messages
+  window.__status = null;
+  window.WebSocket = class extends Native {
+    constructor(...args) {
+      super(...args);
+      this.addEventListener("message", (event) => {
+        if (typeof event.data === "string") return;
+        const text = tail + decoder.decode(event.data, {stream: true});
+        for (const [, day, h, m, s, state] of text.matchAll(line)) {
+          window.__status = [86400 * (day - 1) + 3600 * h + 60 * m + 1 * s, state];
+        }
+        tail = text.slice(-200);
+      });
+    }
+  };
+})();
+"""
+STATUS = "window.__status"
+
+
+async def _skip_to_the_end(page: Browser) -> int:
+    """Press "u" (skip until the next call) until the status line says the run ended; each
+    next press only once the status line shows the skip done -- the clock moved on by more
+    than the run goes in a few seconds at this speed, and no longer "skipping" (a "u" pressed
+    during a skip stops it). Returns the number of presses. The bounds are on the loop, not
+    a timed check: a press that seems to have done nothing is simply followed by another."""
+    await page.wait_for(STATUS, 120)
+    for presses in range(40):
+        before, state = await page.evaluate(STATUS)
+        if state == "[ENDED]":
+            return presses
+        await page.press("u")
+        for _ in range(300):
+            now, state = await page.evaluate(STATUS)
+            if state == "[ENDED]" or (state != "skipping" and now - before >= 120):
+                break
+            await asyncio.sleep(0.1)
+    raise AssertionError("the run did not end after 40 presses of u")
+
+
 async def _take_part(chromium: str, link: str) -> dict[str, Any]:
     """P01 in the browser: read the briefing, click into the page, Enter, hand the lane to
     the model ("h", a stand-in for their own presses), skip ahead ("u") until the run's end,
-    quit ("q"). Keys are queued in order, so the presses need no timing; the pause between
-    skips lets each finish (a "u" pressed during a skip stops it), and the run of this
-    protocol ends after five of them (Textual's Pilot counts the same)."""
+    quit ("q"). Keys are queued in order, so the presses need no timing; each skip is
+    pressed once the page shows the last one done (the run of this protocol ends after
+    about six of them)."""
     seen: dict[str, Any] = {}
     async with Browser(chromium) as page:
+        await page.call("Page.enable")
+        await page.call("Page.addScriptToEvaluateOnNewDocument", source=RECORD_STATUS)
         await page.open(link)
         # textual-serve marks the page once the app's first screen arrived
         await page.wait_for("document.body.classList.contains('-first-byte')", 120)
@@ -101,9 +154,7 @@ async def _take_part(chromium: str, link: str) -> dict[str, Any]:
         await page.click(600, 150)                    # into the page, as a person does
         await page.press("enter")
         await page.press("h")
-        for _ in range(15):
-            await page.press("u")
-            await asyncio.sleep(1.0)
+        seen["skips"] = await _skip_to_the_end(page)
         await page.press("q")
         # the app closes, the session is marked done and textual-serve shows it closed
         seen["closed"] = await page.wait_for(
@@ -129,6 +180,7 @@ def test_a_participant_takes_part_in_a_browser(chromium: str, protocol_file: Pat
     assert seen["second_window"] == 409
     assert seen["unknown_link"] == 404
     assert seen["closed"]
+    assert seen["skips"] >= 1                       # the page showed the run's end
     # the run reached its end (only then is a session marked done), and the recording is
     # on the researcher's side, where a terminal session puts it
     assert first.done and first.recording.is_file()
