@@ -354,15 +354,32 @@ def _check_unchanged(store: Any, plan: Any) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
+    workers = args.workers if args.workers is not None else _local_cores()
+    if workers < 1:
+        raise EvaluationError(f"--workers must be >= 1, not {workers}")
+    from opspec.evaluation import plots
+
+    # the report's drawing processes (--workers W > 1) start now: as many as the cores this
+    # start-up leaves idle (it is the run's one serial part) import matplotlib while this
+    # process loads and checks the specs and the user model, the others once the
+    # replications start; a bad input ends them at once (plots.drawing_processes), so its
+    # error comes as fast as before
+    listing = bool(args.sweep) and args.sweep[0] == "list"
+    cores = _local_cores()
+    with plots.drawing_processes(1 if listing else min(workers, cores),
+                                 at_once=max(1, cores - 1)):
+        return _evaluate(args, workers)
+
+
+def _evaluate(args: argparse.Namespace, workers: int) -> int:
+    """:func:`run` with the drawing processes started: the plan, the replications, the
+    report."""
     from opspec import __version__
     from opspec.evaluation.plan import EvaluationPlan
     from opspec.evaluation.progress import make_progress
     from opspec.evaluation.runner import run_evaluation
     from opspec.evaluation.store import ResultStore
 
-    workers = args.workers if args.workers is not None else _local_cores()
-    if workers < 1:
-        raise EvaluationError(f"--workers must be >= 1, not {workers}")
     if getattr(args, "report_template", None):   # read after the runs: refuse a bad one now
         from opspec.files import open_regular, reason
 
@@ -444,13 +461,11 @@ def run(args: argparse.Namespace) -> int:
     from opspec.evaluation import plots
     from opspec.evaluation.memory import startup_frozen
 
+    # the drawing processes that waited for this start-up to end import matplotlib beside
+    # the replications, whose chunks share the cores
+    plots.warm_up_the_rest()
     # what is loaded by now lives through the run: the collector need not scan it again
-    with store, contextlib.ExitStack() as stack, contextlib.ExitStack() as drawing, \
-            startup_frozen():
-        # the report's drawing processes (--workers W > 1) start now and import matplotlib
-        # beside the replications, whose chunks share the cores; started after them, that
-        # import was on the run's critical path (the first figure waited for it)
-        drawing.enter_context(plots.drawing_processes(min(workers, _local_cores())))
+    with store, contextlib.ExitStack() as stack, startup_frozen():
         on_trace = _trace_writers(stack, store.folder, plan)
         progress = make_progress(sys.stderr, quiet=args.quiet or args.json,
                                  label="users" if len(plan.designs) == 1 else "replications")

@@ -26,6 +26,7 @@ in worker threads), and no GUI backend is ever chosen.
 
 from __future__ import annotations
 
+import contextlib
 import functools
 import math
 from collections.abc import Callable, Iterator, Mapping, Sequence
@@ -133,14 +134,21 @@ def figure_format(name: str) -> Iterator[None]:
 
 
 @contextmanager
-def drawing_processes(workers: int) -> Iterator[None]:
+def drawing_processes(workers: int, *, at_once: int | None = None) -> Iterator[None]:
     """Start up to ``workers`` drawing processes now, for the :func:`drawn_by` blocks within
     this one: each imports matplotlib (and loads its font) while this process still works
     out what to draw. ``opspec evaluate --workers W`` starts them before its replications,
     so that matplotlib is ready when the first figure is asked for: its import (0.3 CPU-s
     in each process) shares the cores with the replications' chunks, which any core can
     run, instead of delaying the figures after them. Nothing happens with one worker or
-    where processes cannot be forked."""
+    where processes cannot be forked.
+
+    ``at_once``: how many of them import matplotlib at once (all by default); the others
+    wait for :func:`warm_up_the_rest`. ``opspec evaluate`` starts them before it loads the
+    spec, whose start-up leaves every core but one idle: as many as those cores import
+    matplotlib then, without slowing that start-up (nor a bad input's error), and the rest
+    beside the replications. A failure or Ctrl-C within the block ends the processes at
+    once, without waiting for their import."""
     import os
 
     if workers <= 1 or not hasattr(os, "fork") or _POOL.get() is not None:
@@ -149,9 +157,16 @@ def drawing_processes(workers: int) -> Iterator[None]:
     import concurrent.futures as cf
     import multiprocessing
 
+    context = multiprocessing.get_context("fork")
+    gate: tuple[Any, Any] | None = None
+    if at_once is not None and at_once < workers:
+        try:        # the first ``at_once`` take the first semaphore; the others wait for the
+            # second (an Event would not do: setting it waits for a terminated waiter)
+            gate = (context.Semaphore(max(0, at_once)), context.Semaphore(0))
+        except Exception:  # noqa: BLE001 - no shared semaphores here: all import at once
+            gate = None
     pool = cf.ProcessPoolExecutor(max_workers=workers, initializer=_warm_up,
-                                  initargs=(os.getpid(),),
-                                  mp_context=multiprocessing.get_context("fork"))
+                                  initargs=(os.getpid(), gate), mp_context=context)
     try:
         for _ in range(workers):            # forks them all now (not at the first figure)
             pool.submit(_ready)
@@ -159,23 +174,59 @@ def drawing_processes(workers: int) -> Iterator[None]:
         pool.shutdown(wait=False, cancel_futures=True)
         yield
         return
-    token = _POOL.set((pool, workers))
+    token, waiting = _POOL.set((pool, workers)), _GATE.set(gate)
     try:
         yield
+    except BaseException:
+        # the command failed or was stopped (a bad spec, Ctrl-C): nothing more to draw, and
+        # a process still importing matplotlib is not waited for (the error is shown now)
+        _end_now(pool)
+        raise
     finally:
         _POOL.reset(token)
+        _GATE.reset(waiting)
+        _let_go(gate, workers)              # none waits for ever
         pool.shutdown(wait=True, cancel_futures=True)
+
+
+def warm_up_the_rest() -> None:
+    """Let the drawing processes of :func:`drawing_processes` that wait (past its
+    ``at_once``) import matplotlib now."""
+    started = _POOL.get()
+    if started is not None:
+        _let_go(_GATE.get(), started[1])
+
+
+def _let_go(gate: tuple[Any, Any] | None, workers: int) -> None:
+    if gate is not None:
+        for _ in range(workers):
+            gate[1].release()
+
+
+def _end_now(pool: Any) -> None:
+    """End the drawing processes of ``pool`` without waiting for their work."""
+    # the executor keeps its processes in a private field (terminate_workers: Python 3.14),
+    # which shutdown empties
+    processes = list((getattr(pool, "_processes", None) or {}).values())
+    pool.shutdown(wait=False, cancel_futures=True)
+    for process in processes:
+        with contextlib.suppress(Exception):
+            process.terminate()
 
 
 #: Within :func:`drawing_processes`: its pool and how many processes it has.
 _POOL: ContextVar[tuple[Any, int] | None] = ContextVar("opspec_drawing_pool", default=None)
+#: Within :func:`drawing_processes` with ``at_once``: the semaphores of those that import
+#: at once and of the others' turn.
+_GATE: ContextVar[tuple[Any, Any] | None] = ContextVar("opspec_drawing_gate", default=None)
 
 
-def _warm_up(parent: int) -> None:
+def _warm_up(parent: int, gate: tuple[Any, Any] | None = None) -> None:
     """A drawing process's start: Ctrl-C left to the evaluate process (which stops the
     pool; no traceback from each drawing process), an end of its own when that process is
     gone (killed: it cannot stop the pool, and a drawing process waiting for figures would
-    live on), matplotlib imported, its default font found and loaded."""
+    live on), its turn waited for (``gate``: see :func:`drawing_processes`), matplotlib
+    imported, its default font found and loaded."""
     import os
     import signal
     import threading
@@ -189,6 +240,8 @@ def _warm_up(parent: int) -> None:
         os._exit(1)
 
     threading.Thread(target=watch, name="opspec-drawing-watch", daemon=True).start()
+    if gate is not None and not gate[0].acquire(block=False):
+        gate[1].acquire()
     try:
         _import_matplotlib()
         from matplotlib import font_manager
