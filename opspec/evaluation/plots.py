@@ -143,12 +143,13 @@ def drawing_processes(workers: int, *, at_once: int | None = None) -> Iterator[N
     run, instead of delaying the figures after them. Nothing happens with one worker or
     where processes cannot be forked.
 
-    ``at_once``: how many of them import matplotlib at once (all by default); the others
-    wait for :func:`warm_up_the_rest`. ``opspec evaluate`` starts them before it loads the
-    spec, whose start-up leaves every core but one idle: as many as those cores import
-    matplotlib then, without slowing that start-up (nor a bad input's error), and the rest
-    beside the replications. A failure or Ctrl-C within the block ends the processes at
-    once, without waiting for their import."""
+    ``at_once``: how many of them import matplotlib at once (all by default); each of the
+    others waits until one of those is done or :func:`warm_up_the_rest` is called.
+    ``opspec evaluate`` starts them before it loads the spec, whose start-up leaves every
+    core but one idle: as many as those cores import matplotlib then, one after the other,
+    without slowing that start-up (nor a bad input's error), and those still waiting when
+    the replications start import it beside them. A failure or Ctrl-C within the block
+    ends the processes at once, without waiting for their import."""
     import os
 
     if workers <= 1 or not hasattr(os, "fork") or _POOL.get() is not None:
@@ -158,11 +159,11 @@ def drawing_processes(workers: int, *, at_once: int | None = None) -> Iterator[N
     import multiprocessing
 
     context = multiprocessing.get_context("fork")
-    gate: tuple[Any, Any] | None = None
+    gate: Any = None
     if at_once is not None and at_once < workers:
-        try:        # the first ``at_once`` take the first semaphore; the others wait for the
-            # second (an Event would not do: setting it waits for a terminated waiter)
-            gate = (context.Semaphore(max(0, at_once)), context.Semaphore(0))
+        try:        # each imports holding it (an Event would not do: setting one waits for
+            # a waiter that was terminated)
+            gate = context.Semaphore(max(1, at_once))
         except Exception:  # noqa: BLE001 - no shared semaphores here: all import at once
             gate = None
     pool = cf.ProcessPoolExecutor(max_workers=workers, initializer=_warm_up,
@@ -197,10 +198,10 @@ def warm_up_the_rest() -> None:
         _let_go(_GATE.get(), started[1])
 
 
-def _let_go(gate: tuple[Any, Any] | None, workers: int) -> None:
+def _let_go(gate: Any, workers: int) -> None:
     if gate is not None:
         for _ in range(workers):
-            gate[1].release()
+            gate.release()
 
 
 def _end_now(pool: Any) -> None:
@@ -212,16 +213,21 @@ def _end_now(pool: Any) -> None:
     for process in processes:
         with contextlib.suppress(Exception):
             process.terminate()
+    for process in processes:                # gone before the error is shown
+        with contextlib.suppress(Exception):
+            process.join(5)
+            if process.is_alive():
+                process.kill()
+                process.join(5)
 
 
 #: Within :func:`drawing_processes`: its pool and how many processes it has.
 _POOL: ContextVar[tuple[Any, int] | None] = ContextVar("opspec_drawing_pool", default=None)
-#: Within :func:`drawing_processes` with ``at_once``: the semaphores of those that import
-#: at once and of the others' turn.
-_GATE: ContextVar[tuple[Any, Any] | None] = ContextVar("opspec_drawing_gate", default=None)
+#: Within :func:`drawing_processes` with ``at_once``: the semaphore held while importing.
+_GATE: ContextVar[Any] = ContextVar("opspec_drawing_gate", default=None)
 
 
-def _warm_up(parent: int, gate: tuple[Any, Any] | None = None) -> None:
+def _warm_up(parent: int, gate: Any = None) -> None:
     """A drawing process's start: Ctrl-C left to the evaluate process (which stops the
     pool; no traceback from each drawing process), an end of its own when that process is
     gone (killed: it cannot stop the pool, and a drawing process waiting for figures would
@@ -240,8 +246,8 @@ def _warm_up(parent: int, gate: tuple[Any, Any] | None = None) -> None:
         os._exit(1)
 
     threading.Thread(target=watch, name="opspec-drawing-watch", daemon=True).start()
-    if gate is not None and not gate[0].acquire(block=False):
-        gate[1].acquire()
+    if gate is not None:
+        gate.acquire()
     try:
         _import_matplotlib()
         from matplotlib import font_manager
@@ -250,6 +256,9 @@ def _warm_up(parent: int, gate: tuple[Any, Any] | None = None) -> None:
         FT2Font(font_manager.findfont(font_manager.FontProperties()))
     except Exception:  # noqa: BLE001, S110 - a figure drawn later says what is wrong
         pass
+    finally:
+        if gate is not None:
+            gate.release()                  # the next one's turn
 
 
 def _ready() -> None:
