@@ -365,9 +365,7 @@ def run(args: argparse.Namespace) -> int:
     # replications start; a bad input ends them at once (plots.drawing_processes), so its
     # error comes as fast as before
     listing = bool(args.sweep) and args.sweep[0] == "list"
-    cores = _local_cores()
-    with plots.drawing_processes(1 if listing else min(workers, cores),
-                                 at_once=max(1, cores - 1)):
+    with plots.drawing_processes(1 if listing else min(workers, _local_cores())):
         return _evaluate(args, workers)
 
 

@@ -143,13 +143,14 @@ def drawing_processes(workers: int, *, at_once: int | None = None) -> Iterator[N
     run, instead of delaying the figures after them. Nothing happens with one worker or
     where processes cannot be forked.
 
-    ``at_once``: how many of them import matplotlib at once (all by default); each of the
-    others waits until one of those is done or :func:`warm_up_the_rest` is called.
-    ``opspec evaluate`` starts them before it loads the spec, whose start-up leaves every
-    core but one idle: as many as those cores import matplotlib then, one after the other,
-    without slowing that start-up (nor a bad input's error), and those still waiting when
-    the replications start import it beside them. A failure or Ctrl-C within the block
-    ends the processes at once, without waiting for their import."""
+    ``at_once``: how many of them import matplotlib at once (by default the cores this
+    process may run on but one: this process is busy meanwhile); each of the others waits
+    until one of those is done or :func:`warm_up_the_rest` is called. ``opspec evaluate``
+    starts them before it loads the spec, whose start-up leaves every core but one idle:
+    as many as those cores import matplotlib then, one after the other, without slowing
+    that start-up (nor a bad input's error), and those still waiting when the replications
+    start import it beside them. A failure or Ctrl-C within the block ends the processes
+    at once, without waiting for their import."""
     import os
 
     if workers <= 1 or not hasattr(os, "fork") or _POOL.get() is not None:
@@ -159,8 +160,11 @@ def drawing_processes(workers: int, *, at_once: int | None = None) -> Iterator[N
     import multiprocessing
 
     context = multiprocessing.get_context("fork")
+    if at_once is None:
+        at_once = max(1, len(os.sched_getaffinity(0)) - 1 if hasattr(os, "sched_getaffinity")
+                      else (os.cpu_count() or 1) - 1)
     gate: Any = None
-    if at_once is not None and at_once < workers:
+    if at_once < workers:
         try:        # each imports holding it (an Event would not do: setting one waits for
             # a waiter that was terminated)
             gate = context.Semaphore(max(1, at_once))
