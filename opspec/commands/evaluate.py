@@ -136,7 +136,9 @@ def _engine(path: str | None) -> dict[str, Any]:
     return asdict(EngineConfig.load(path))
 
 
-def _new_plan(args: argparse.Namespace) -> Any:
+def _new_plan(args: argparse.Namespace) -> tuple[Any, dict[str, Any]]:
+    """The plan of a new run, and the front hall's decision on each design's spec and the
+    user model (:func:`_check_plan` reuses them: nothing is read and checked twice)."""
     from opspec.evaluation.plan import DAY, Design, EvaluationPlan, file_digest
     from opspec.request import RunRequest, prepare
     from opspec.run_inputs import RunInputs
@@ -155,9 +157,11 @@ def _new_plan(args: argparse.Namespace) -> Any:
     a = prepare(RunRequest(args.spec, days=args.days, user_model=args.user_model,
                            branches=branches or None))
     model = a.user_model
+    decided = {str(args.spec): a}
     for _label, path in specs[1:]:
-        prepare(RunRequest(path, days=args.days, user_model=model, no_user=model is None,
-                           branches=branches or None))
+        b = prepare(RunRequest(path, days=args.days, user_model=model, no_user=model is None,
+                               branches=branches or None))
+        decided.setdefault(str(path), b)
     # --param: a value of a package data field (a BPMN diagram's run input) for every design,
     # applied as a parameter of one value (what --sweep applies per design)
     # draws and a data file's rows are per simulated user (opspec.run_inputs), in the plan
@@ -203,19 +207,22 @@ def _new_plan(args: argparse.Namespace) -> Any:
                           input_uncertainty=draws, users_per_draw=per_draw,
                           run_inputs=RunInputs(draws=inputs.draws, rows=inputs.rows,
                                                source=inputs.source).to_json()
-                          if inputs.draws or inputs.rows else {}, branches=branches)
+                          if inputs.draws or inputs.rows else {}, branches=branches), decided
 
 
-def _check_plan(plan: Any) -> dict[str, list[dict[str, Any]]]:
+def _check_plan(plan: Any, decided: dict[str, Any] | None = None
+                ) -> dict[str, list[dict[str, Any]]]:
     """Load every design and the user model once, before any simulation: bad inputs stop the
-    run here. Returns the metric definitions of each design, by label."""
+    run here (``decided``: what :func:`_new_plan` read and checked already, by spec).
+    Returns the metric definitions of each design, by label."""
     from opspec.evaluation.replication import prepare
 
     definitions: dict[str, list[dict[str, Any]]] = {}
     shown: set[str] = set()                 # the designs of a sweep share their warnings
     for design in plan.designs:
         context = prepare(design.spec, design.sha256, plan.user_model, plan.engine,
-                          design.parameters, plan.branches or None)
+                          design.parameters, plan.branches or None,
+                          decided=(decided or {}).get(design.spec))
         for warning in context.warnings:
             if str(warning) not in shown:
                 shown.add(str(warning))
@@ -432,7 +439,7 @@ def _evaluate(args: argparse.Namespace, workers: int) -> int:
                 store.close()
                 raise
     else:
-        plan = _new_plan(args)
+        plan, decided = _new_plan(args)
         swept = None
         if args.sweep:
             from opspec.evaluation.sweep import describe_parameters, plan_sweep
@@ -441,7 +448,7 @@ def _evaluate(args: argparse.Namespace, workers: int) -> int:
                 print(describe_parameters(plan))
                 return 0
             plan, swept = plan_sweep(plan, *args.sweep)
-        definitions = _check_plan(plan)
+        definitions = _check_plan(plan, decided)
         from opspec.evaluation.sweep import check_targets
 
         check_targets(args.target, args.target_users, definitions["A"], swept)
