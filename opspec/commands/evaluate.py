@@ -449,9 +449,10 @@ def _evaluate(args: argparse.Namespace, workers: int) -> int:
                 return 0
             plan, swept = plan_sweep(plan, *args.sweep)
         definitions = _check_plan(plan, decided)
-        from opspec.evaluation.sweep import check_targets
+        if args.target or args.target_users is not None or swept is not None:
+            from opspec.evaluation.sweep import check_targets
 
-        check_targets(args.target, args.target_users, definitions["A"], swept)
+            check_targets(args.target, args.target_users, definitions["A"], swept)
         out = Path(args.out) if args.out else _default_out(args.spec)
         if (out / "results.sqlite").exists():
             raise EvaluationError(f"{out} already holds an evaluation",
