@@ -368,11 +368,13 @@ def run(args: argparse.Namespace) -> int:
 
     # the report's drawing processes (--workers W > 1) start now: as many as the cores this
     # start-up leaves idle (it is the run's one serial part) import matplotlib while this
-    # process loads and checks the specs and the user model, the others once the
-    # replications start; a bad input ends them at once (plots.drawing_processes), so its
-    # error comes as fast as before
+    # process loads and checks the specs and the user model; the others are forked once the
+    # replications start (plots.staggered_start); a bad input ends them at once
+    # (plots.drawing_processes), so its error comes as fast as before
     listing = bool(args.sweep) and args.sweep[0] == "list"
-    with plots.drawing_processes(1 if listing else min(workers, _local_cores())):
+    cores = _local_cores()
+    with plots.staggered_start(max(1, cores - 1)), \
+            plots.drawing_processes(1 if listing else min(workers, cores)):
         return _evaluate(args, workers)
 
 
@@ -467,8 +469,8 @@ def _evaluate(args: argparse.Namespace, workers: int) -> int:
     from opspec.evaluation import plots
     from opspec.evaluation.memory import startup_frozen
 
-    # the drawing processes that waited for this start-up to end import matplotlib beside
-    # the replications, whose chunks share the cores
+    # the drawing processes not forked yet are forked now, inheriting what the start-up
+    # loaded, and import matplotlib beside the replications, whose chunks share the cores
     plots.warm_up_the_rest()
     # what is loaded by now lives through the run: the collector need not scan it again
     with store, contextlib.ExitStack() as stack, startup_frozen():
