@@ -469,11 +469,12 @@ def _evaluate(args: argparse.Namespace, workers: int) -> int:
     from opspec.evaluation import plots
     from opspec.evaluation.memory import startup_frozen
 
-    # the drawing processes not forked yet are forked now, inheriting what the start-up
-    # loaded, and import matplotlib beside the replications, whose chunks share the cores
-    plots.warm_up_the_rest()
     # what is loaded by now lives through the run: the collector need not scan it again
     with store, contextlib.ExitStack() as stack, startup_frozen():
+        # the drawing processes not forked yet are forked now, inheriting what the start-up
+        # loaded (frozen: their collector leaves it alone too), and import matplotlib beside
+        # the replications, whose chunks share the cores
+        plots.warm_up_the_rest()
         on_trace = _trace_writers(stack, store.folder, plan)
         progress = make_progress(sys.stderr, quiet=args.quiet or args.json,
                                  label="users" if len(plan.designs) == 1 else "replications")
