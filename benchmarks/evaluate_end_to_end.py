@@ -95,9 +95,10 @@ assert done == users, done
 # Also the CPU of each part (the phases of an estimate of the wall time on idle cores): this
 # process before the replications, during them and after them; the processes it waited for
 # (the replication workers; the report's drawing processes) until the replications ended and
-# after.
+# after; and of the drawing processes, what they spent before the replications (started with
+# the command, they use the cores its start-up leaves idle), from /proc.
 _EVALUATE = """
-import json, resource, sys, time
+import json, os, resource, sys, time
 import opspec.evaluation.runner as runner
 from opspec.cli import main
 
@@ -105,11 +106,25 @@ def cpu(who):
     usage = resource.getrusage(who)
     return usage.ru_utime + usage.ru_stime
 
+def children_cpu():
+    total = 0.0
+    try:
+        for task in os.listdir("/proc/self/task"):
+            with open(f"/proc/self/task/{task}/children") as f:
+                for pid in f.read().split():
+                    with open(f"/proc/{pid}/stat") as stat:
+                        fields = stat.read().rsplit(")", 1)[1].split()
+                    total += (int(fields[11]) + int(fields[12])) / os.sysconf("SC_CLK_TCK")
+    except OSError:
+        pass
+    return total
+
 marks = {}
 replications = runner.run_evaluation
 
 def timed(*args, **kwargs):
     marks["before"] = cpu(resource.RUSAGE_SELF)
+    marks["early"] = children_cpu()
     try:
         return replications(*args, **kwargs)
     finally:
@@ -162,10 +177,12 @@ def estimated_wall(phases: dict[str, float], workers: int) -> float:
     start-up alone, the replications' workers and this process's storing shared over the
     cores, this process's tail (summaries, tables), the figures' processes shared over the
     cores. An upper bound where the tail overlaps the figures' start (W > 1); what a
-    machine loaded by others cannot show in wall time."""
+    machine loaded by others cannot show in wall time. What the drawing processes spent
+    during the start-up (``early``), on the cores it leaves idle, costs no wall time."""
     cores = max(1, workers)
+    early = min(phases.get("early", 0.0), (cores - 1) * phases["before"])
     return (phases["before"] + (phases["workers"] + phases["during"]) / cores
-            + phases["after"] + phases["drawing"] / cores)
+            + phases["after"] + (phases["drawing"] - early) / cores)
 
 
 def evaluate(users: int, days: int, seed: int, workers: int, profile: str | None = None
@@ -253,7 +270,8 @@ def speed(args: argparse.Namespace, script: Path) -> None:
             print(f"  evaluate --workers {w}, CPU s by part (median): start-up "
                   f"{mean['before']:.2f}, storing {mean['during']:.2f} beside the workers' "
                   f"{mean['workers']:.2f}, tail {mean['after']:.2f}, figures' processes "
-                  f"{mean['drawing']:.2f}")
+                  f"{mean['drawing']:.2f} ({mean.get('early', 0.0):.2f} of it during "
+                  "the start-up)")
 
 
 def memory(args: argparse.Namespace) -> None:

@@ -136,7 +136,9 @@ def _engine(path: str | None) -> dict[str, Any]:
     return asdict(EngineConfig.load(path))
 
 
-def _new_plan(args: argparse.Namespace) -> Any:
+def _new_plan(args: argparse.Namespace) -> tuple[Any, dict[str, Any]]:
+    """The plan of a new run, and the front hall's decision on each design's spec and the
+    user model (:func:`_check_plan` reuses them: nothing is read and checked twice)."""
     from opspec.evaluation.plan import DAY, Design, EvaluationPlan, file_digest
     from opspec.request import RunRequest, prepare
     from opspec.run_inputs import RunInputs
@@ -155,9 +157,11 @@ def _new_plan(args: argparse.Namespace) -> Any:
     a = prepare(RunRequest(args.spec, days=args.days, user_model=args.user_model,
                            branches=branches or None))
     model = a.user_model
+    decided = {str(args.spec): a}
     for _label, path in specs[1:]:
-        prepare(RunRequest(path, days=args.days, user_model=model, no_user=model is None,
-                           branches=branches or None))
+        b = prepare(RunRequest(path, days=args.days, user_model=model, no_user=model is None,
+                               branches=branches or None))
+        decided.setdefault(str(path), b)
     # --param: a value of a package data field (a BPMN diagram's run input) for every design,
     # applied as a parameter of one value (what --sweep applies per design)
     # draws and a data file's rows are per simulated user (opspec.run_inputs), in the plan
@@ -203,19 +207,22 @@ def _new_plan(args: argparse.Namespace) -> Any:
                           input_uncertainty=draws, users_per_draw=per_draw,
                           run_inputs=RunInputs(draws=inputs.draws, rows=inputs.rows,
                                                source=inputs.source).to_json()
-                          if inputs.draws or inputs.rows else {}, branches=branches)
+                          if inputs.draws or inputs.rows else {}, branches=branches), decided
 
 
-def _check_plan(plan: Any) -> dict[str, list[dict[str, Any]]]:
+def _check_plan(plan: Any, decided: dict[str, Any] | None = None
+                ) -> dict[str, list[dict[str, Any]]]:
     """Load every design and the user model once, before any simulation: bad inputs stop the
-    run here. Returns the metric definitions of each design, by label."""
+    run here (``decided``: what :func:`_new_plan` read and checked already, by spec).
+    Returns the metric definitions of each design, by label."""
     from opspec.evaluation.replication import prepare
 
     definitions: dict[str, list[dict[str, Any]]] = {}
     shown: set[str] = set()                 # the designs of a sweep share their warnings
     for design in plan.designs:
         context = prepare(design.spec, design.sha256, plan.user_model, plan.engine,
-                          design.parameters, plan.branches or None)
+                          design.parameters, plan.branches or None,
+                          decided=(decided or {}).get(design.spec))
         for warning in context.warnings:
             if str(warning) not in shown:
                 shown.add(str(warning))
@@ -354,15 +361,32 @@ def _check_unchanged(store: Any, plan: Any) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
+    workers = args.workers if args.workers is not None else _local_cores()
+    if workers < 1:
+        raise EvaluationError(f"--workers must be >= 1, not {workers}")
+    from opspec.evaluation import plots
+
+    # the report's drawing processes (--workers W > 1) start now: as many as the cores this
+    # start-up leaves idle (it is the run's one serial part) import matplotlib while this
+    # process loads and checks the specs and the user model; the others are forked once the
+    # replications start (plots.staggered_start); a bad input ends them at once
+    # (plots.drawing_processes), so its error comes as fast as before
+    listing = bool(args.sweep) and args.sweep[0] == "list"
+    cores = _local_cores()
+    with plots.staggered_start(max(1, cores - 1)), \
+            plots.drawing_processes(1 if listing else min(workers, cores)):
+        return _evaluate(args, workers)
+
+
+def _evaluate(args: argparse.Namespace, workers: int) -> int:
+    """:func:`run` with the drawing processes started: the plan, the replications, the
+    report."""
     from opspec import __version__
     from opspec.evaluation.plan import EvaluationPlan
     from opspec.evaluation.progress import make_progress
     from opspec.evaluation.runner import run_evaluation
     from opspec.evaluation.store import ResultStore
 
-    workers = args.workers if args.workers is not None else _local_cores()
-    if workers < 1:
-        raise EvaluationError(f"--workers must be >= 1, not {workers}")
     if getattr(args, "report_template", None):   # read after the runs: refuse a bad one now
         from opspec.files import open_regular, reason
 
@@ -417,7 +441,7 @@ def run(args: argparse.Namespace) -> int:
                 store.close()
                 raise
     else:
-        plan = _new_plan(args)
+        plan, decided = _new_plan(args)
         swept = None
         if args.sweep:
             from opspec.evaluation.sweep import describe_parameters, plan_sweep
@@ -426,10 +450,11 @@ def run(args: argparse.Namespace) -> int:
                 print(describe_parameters(plan))
                 return 0
             plan, swept = plan_sweep(plan, *args.sweep)
-        definitions = _check_plan(plan)
-        from opspec.evaluation.sweep import check_targets
+        definitions = _check_plan(plan, decided)
+        if args.target or args.target_users is not None or swept is not None:
+            from opspec.evaluation.sweep import check_targets
 
-        check_targets(args.target, args.target_users, definitions["A"], swept)
+            check_targets(args.target, args.target_users, definitions["A"], swept)
         out = Path(args.out) if args.out else _default_out(args.spec)
         if (out / "results.sqlite").exists():
             raise EvaluationError(f"{out} already holds an evaluation",
@@ -445,12 +470,11 @@ def run(args: argparse.Namespace) -> int:
     from opspec.evaluation.memory import startup_frozen
 
     # what is loaded by now lives through the run: the collector need not scan it again
-    with store, contextlib.ExitStack() as stack, contextlib.ExitStack() as drawing, \
-            startup_frozen():
-        # the report's drawing processes (--workers W > 1) start now and import matplotlib
-        # beside the replications, whose chunks share the cores; started after them, that
-        # import was on the run's critical path (the first figure waited for it)
-        drawing.enter_context(plots.drawing_processes(min(workers, _local_cores())))
+    with store, contextlib.ExitStack() as stack, startup_frozen():
+        # the drawing processes not forked yet are forked now, inheriting what the start-up
+        # loaded (frozen: their collector leaves it alone too), and import matplotlib beside
+        # the replications, whose chunks share the cores
+        plots.warm_up_the_rest()
         on_trace = _trace_writers(stack, store.folder, plan)
         progress = make_progress(sys.stderr, quiet=args.quiet or args.json,
                                  label="users" if len(plan.designs) == 1 else "replications")

@@ -201,11 +201,14 @@ _CONTEXTS: dict[tuple[str, str, str | None, str, str], _Context] = {}
 
 def prepare(spec: str, sha256: str, user_model: str | None, engine: Mapping[str, Any],
             parameters: Sequence[Sequence[Any]] = (),
-            branches: Mapping[str, Mapping[str, float]] | None = None) -> _Context:
+            branches: Mapping[str, Mapping[str, float]] | None = None, *,
+            decided: Any = None) -> _Context:
     """Load (once per process) the spec, user model and engine configuration; with
     ``parameters`` (a design of ``--sweep``: ``(name, value)`` pairs) the spec and the user
     model changed as :mod:`opspec.evaluation.parameters` says; ``branches`` (``--branch``)
-    applied to the spec before it is compiled."""
+    applied to the spec before it is compiled. ``decided``: the front hall's
+    :class:`~opspec.request.PreparedRun` of this spec and user model, when the caller has
+    it (``opspec evaluate``'s plan): they are then not read and checked a second time."""
     import json
 
     key = (spec, sha256, user_model, json.dumps(dict(engine), sort_keys=True),
@@ -222,8 +225,8 @@ def prepare(spec: str, sha256: str, user_model: str | None, engine: Mapping[str,
 
     # the front hall decides the spec (validate's gate) and the user model (checked against
     # the spec's user lane), in the command and in every worker alike
-    prepared = decide(RunRequest(spec, user_model=user_model, no_user=user_model is None,
-                                 branches=branches or None))
+    prepared = decided if decided is not None else decide(RunRequest(
+        spec, user_model=user_model, no_user=user_model is None, branches=branches or None))
     loaded = prepared.spec
     lane = user_lane(loaded.compiled)
     user = prepared.user if prepared.user.kind == "model" else None

@@ -1,0 +1,55 @@
+"""`opspec evaluate --workers 2` forks one drawing process before it loads the spec (on the
+core its start-up leaves idle) and the other as the replications start, inheriting what the
+start-up loaded (``plots.staggered_start``). The figures those processes draw must be the
+bytes drawn one after another, whichever process draws each, and the processes not forked at
+first must be forked when asked, or at the first figure."""
+
+from __future__ import annotations
+
+import multiprocessing
+from pathlib import Path
+
+from opspec.evaluation import plots
+
+RATES = [("doses missed", 0.0034, 0.001, 0.008), ("doses taken", 0.95, 0.93, 0.97)]
+DAYS = {"doses_taken": [4, 3, 4, 4, 2], "doses_missed": [0, 1, 0, 0, 2]}
+LATENCIES = [30.0 + (i * 37 % 101) for i in range(300)]
+
+
+def _figures(folder: Path) -> list[Path]:
+    return [plots.rates_figure(RATES, folder / "rates.svg"),
+            plots.over_days_figure(DAYS, folder / "days.svg"),
+            plots.latency_figure("report_latency_s", LATENCIES, folder / "latency.svg",
+                                 marks={"mean": 80.0, "median": 79.0, "p95": 126.0}),
+            plots.rates_figure(RATES[:1], folder / "rates-1.svg")]
+
+
+def _drawing_children() -> int:
+    return len(multiprocessing.active_children())
+
+
+def test_one_forked_first_the_other_when_asked_and_the_same_figures(tmp_path: Path) -> None:
+    alone = _figures(tmp_path / "alone")
+    before = _drawing_children()
+    with plots.staggered_start(1), plots.drawing_processes(2):
+        assert _drawing_children() == before + 1
+        plots.warm_up_the_rest()
+        assert _drawing_children() == before + 2
+        plots.warm_up_the_rest()                # once only
+        assert _drawing_children() == before + 2
+        with plots.drawn_by(2):
+            together = _figures(tmp_path / "together")
+        assert all(p.is_file() for p in together)
+    assert [p.read_bytes() for p in together] == [p.read_bytes() for p in alone]
+    assert _drawing_children() == before
+
+
+def test_the_rest_are_forked_at_the_first_figure_when_not_asked_before(tmp_path: Path) -> None:
+    alone = _figures(tmp_path / "alone")
+    before = _drawing_children()
+    with plots.staggered_start(1), plots.drawing_processes(2):
+        assert _drawing_children() == before + 1
+        with plots.drawn_by(2):
+            together = _figures(tmp_path / "together")
+            assert _drawing_children() == before + 2
+    assert [p.read_bytes() for p in together] == [p.read_bytes() for p in alone]
