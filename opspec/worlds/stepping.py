@@ -245,14 +245,12 @@ class RoomState:
                     # (cells are only ever added, so the others cannot be covered again)
                     key = (kx0, kx1, ky0, ky1)
                     new, left = cover(cells, x, y, cell, reach, self.covered)
+                    uncovered[key] = left
+                    self.near_cells = left
                     if new:
-                        uncovered[key] = left
-                        self.near_cells = left
                         self.key = key
                         self.new_cells = new
                         code = COVER
-                    elif key not in uncovered:
-                        uncovered[key] = left
             else:
                 self.bumped = True
                 if not in_contact:
@@ -352,8 +350,7 @@ def cover(cells: Cells, x: float, y: float, cell: float, reach: float,
                 c not in covered):
             covered.add(c)
             new.append(c)
-    if not new:
-        return new, cells       # nothing covered here: what was uncovered still is
+    # (cells of other ranges overlap these: those covered there are left out too)
     return new, tuple([c for c in cells if c not in covered])
 
 
