@@ -527,7 +527,7 @@ class _Timer(Timed):
             at = math.ceil(at / state.resolution) * state.resolution
         delay = at - state.now
         state.sim_events += 1                   # RunState.timer
-        state.schedule_timed(delay if delay > 0.0 else 0.0, self)
+        state.schedule_timed(delay if delay > 0.0 else 0.0, self)  # noqa: FURB136
 
     def go(self) -> None:
         proc = self.proc

@@ -12,7 +12,7 @@ import random
 from pathlib import Path
 
 import numpy as np
-from spec_text import assign, compiled, process
+from spec_text import assign, compiled, field, process
 
 from opspec.engine.simulation import Simulation
 from opspec.engine.workitem import WorkItem
@@ -23,10 +23,7 @@ from opspec.worlds.stepping import cover
 
 def _starts(tmp_path: Path, until: float, **directives: str) -> list[float]:
     model = compiled(tmp_path, [process("tick", [assign("a", ("n", "n + 1"))],
-                                        fields=['<DataField Id="n"><DataType><BasicType '
-                                                'Type="INTEGER"/></DataType><InitialValue>0'
-                                                "</InitialValue></DataField>"],
-                                        **directives)])
+                                        fields=[field("n", "INTEGER", "0")], **directives)])
     result = Simulation(model, keep_trace=True).run(until=until)
     assert result.trace is not None
     return [e.time for e in result.trace if e.kind == "process.started"]
