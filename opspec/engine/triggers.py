@@ -488,7 +488,7 @@ class _Timer(Timed):
     callback (what ``RunState.timer`` does: counted in ``sim_events``, no ``_CallAt``); a
     period's times are counted here (``_occurrences``' arithmetic) instead of resuming a
     generator, and a start is a direct call, not one through a closure: a robot spec's
-    workflows fire 14,000 times an hour each (docs/engine-performance.md)."""
+    5 Hz workflows fire 18,000 times an hour each (docs/engine-performance.md)."""
 
     def __init__(self, triggers: Triggers, trig: CTrigger, fire: Callable[[str], None],
                  label: str, starts: tuple[CompiledProcess, int] | None) -> None:
