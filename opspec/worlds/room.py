@@ -207,7 +207,8 @@ class RoomWorld(RobotWorld):
         sd = self.range_noise
         # Generator.normal(0, sd) is 0.0 + sd * standard_normal() (numpy's random_normal:
         # loc + scale * z), the same draw and the same float for half its call's cost; a
-        # negative (or NaN) sd still goes to normal, which refuses it as before
+        # negative (or NaN) sd still goes to normal, which refuses it as before.
+        # RoomDevices.offer (room_devices.py, compiled) draws and reads the same way
         noise = (0.0 + sd * self.rng.standard_normal() if sd >= 0.0
                  else float(self.rng.normal(0.0, sd)))
         return {"distance": self._state.read_range(noise)}

@@ -9,10 +9,10 @@ hour); around the compiled stepping (:mod:`opspec.worlds.stepping`) the interpre
 world's own work. Here the same steps run compiled, on the room's compiled state: advance the
 world to the engine's time (the room traces what the stepping stops at), do the operation,
 complete the item. The operations' definitions stay the room's: the bumper and the range
-reading are :class:`~opspec.worlds.stepping.RoomState`'s, the range noise and the random
-turn the room's own ``op_`` methods, called from here. Anything else (the first use, which
-traces the initial coverage; the battery, the tag reader, an operation the world does not
-know) goes to ``WorldDevices``.
+reading are :class:`~opspec.worlds.stepping.RoomState`'s (the range noise is drawn here as
+``RoomWorld.op_read_range`` draws it), the random turn is the room's own ``op_drive``.
+Anything else (the first use, which traces the initial coverage; the battery, the tag
+reader, an operation the world does not know) goes to ``WorldDevices``.
 """
 
 from __future__ import annotations
@@ -61,7 +61,15 @@ class RoomDevices:
         if application == "read_bump":
             result = state.read_bump()
         elif application == "read_range":
-            result = self.world.op_read_range(data)
+            world = self.world
+            sd: float = world.range_noise
+            if sd >= 0.0:
+                # RoomWorld.op_read_range, compiled: the same draw from the room's
+                # generator and the same float operations (0.0 + sd * z, then the reading)
+                z: float = world.rng.standard_normal()
+                result = {"distance": state.read_range(0.0 + sd * z)}
+            else:
+                result = world.op_read_range(data)      # normal() refuses the sd
         else:
             command = data.get("motor_cmd")
             command = str(command or "stop")

@@ -82,6 +82,19 @@ class RoomState:
         self.v = 0.0
         self.stop = False
         self.key: Key = (0, 0, 0, 0)
+        # the cell range of the last step and its cells still uncovered (``uncovered[key]``
+        # then): a straight drive stays in one range for several steps, and a range all
+        # covered needs no look at all (``near`` says whether there is a last range)
+        self.near = False
+        self.kx0 = 0
+        self.kx1 = 0
+        self.ky0 = 0
+        self.ky1 = 0
+        self.near_cells: Cells = ()
+        # a heading known to wrap to itself bit for bit (``wrapped``, when ``known``):
+        # wrapping is a function of the heading, so advance need not compute it again
+        self.known = False
+        self.wrapped = 0.0
 
     def place(self, inside: tuple[float, float, float, float],
               grown: list[tuple[float, float, float, float]], reach: float, cell: float,
@@ -101,6 +114,7 @@ class RoomState:
         self.cell = cell
         self.boxes = boxes
         self.uncovered = uncovered
+        self.near = False
         self.covered = covered
         self.cells_x = cells_x
         self.cells_y = cells_y
@@ -123,10 +137,18 @@ class RoomState:
             self._turn_in_place(now, w)
             return DONE
         heading = self.heading
-        after = math.atan2(math.sin(heading), math.cos(heading))       # wrap_angle
-        self.after = after
-        self.settled = after == heading and (
-            math.copysign(1.0, after) == math.copysign(1.0, heading))
+        if self.known and heading == self.wrapped and (
+                math.copysign(1.0, heading) == math.copysign(1.0, self.wrapped)):
+            self.after = heading                # wrap_angle(heading) is heading itself
+            self.settled = True
+        else:
+            after = math.atan2(math.sin(heading), math.cos(heading))       # wrap_angle
+            self.after = after
+            self.settled = after == heading and (
+                math.copysign(1.0, after) == math.copysign(1.0, heading))
+            if self.settled:
+                self.known = True
+                self.wrapped = heading
         self.t = self.time
         self.v = v
         self.stop = self.command == "stop"
@@ -196,15 +218,35 @@ class RoomState:
                 x = nx
                 y = ny
                 in_contact = False
-                key = (int((x - reach) // cell), int((x + reach) // cell),
-                       int((y - reach) // cell), int((y + reach) // cell))
-                cells = uncovered.get(key)
-                if cells is None or len(cells) > 0:
+                kx0 = int((x - reach) // cell)
+                kx1 = int((x + reach) // cell)
+                ky0 = int((y - reach) // cell)
+                ky1 = int((y + reach) // cell)
+                if (self.near and kx0 == self.kx0 and kx1 == self.kx1 and ky0 == self.ky0
+                        and ky1 == self.ky1):
+                    cells = self.near_cells             # uncovered[key], as left
+                else:
+                    key = (kx0, kx1, ky0, ky1)
+                    found = uncovered.get(key)
+                    if found is None:
+                        cells = self._cells(key)
+                        if not cells:
+                            uncovered[key] = cells
+                    else:
+                        cells = found
+                    self.near = True
+                    self.kx0 = kx0
+                    self.kx1 = kx1
+                    self.ky0 = ky0
+                    self.ky1 = ky1
+                    self.near_cells = cells
+                if len(cells) > 0:
                     # RoomWorld._cover at this step, over the range's cells still uncovered
                     # (cells are only ever added, so the others cannot be covered again)
-                    if cells is None:
-                        cells = self._cells(key)
-                    new, uncovered[key] = cover(cells, x, y, cell, reach, self.covered)
+                    key = (kx0, kx1, ky0, ky1)
+                    new, left = cover(cells, x, y, cell, reach, self.covered)
+                    uncovered[key] = left
+                    self.near_cells = left
                     if new:
                         self.key = key
                         self.new_cells = new
@@ -295,15 +337,20 @@ def cover(cells: Cells, x: float, y: float, cell: float, reach: float,
     plus half a cell: they are added to ``covered``; returned are the newly covered ones, in
     the order of ``cells`` (the room traces them in that order), and the ``cells`` still not
     covered."""
-    limit = reach ** 2 + (cell / 2) ** 2
+    # math.pow(a, 2.0) is ``a ** 2``: both are the C library's pow(a, 2.0) (CPython's float
+    # power takes the sign off first, which pow of an even power does too), but compiled
+    # math.pow is that call itself, ``**`` a boxed number protocol call
+    limit = math.pow(reach, 2.0) + math.pow(cell / 2, 2.0)
     new: list[tuple[int, int]] = []
     for c in cells:
         cx, cy = c
         centre_x = (cx + 0.5) * cell
         centre_y = (cy + 0.5) * cell
-        if (centre_x - x) ** 2 + (centre_y - y) ** 2 <= limit and c not in covered:
+        if math.pow(centre_x - x, 2.0) + math.pow(centre_y - y, 2.0) <= limit and (
+                c not in covered):
             covered.add(c)
             new.append(c)
+    # (cells of other ranges overlap these: those covered there are left out too)
     return new, tuple([c for c in cells if c not in covered])
 
 
