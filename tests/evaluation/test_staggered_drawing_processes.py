@@ -11,17 +11,12 @@ from pathlib import Path
 
 from opspec.evaluation import plots
 
-RATES = [("doses missed", 0.0034, 0.001, 0.008), ("doses taken", 0.95, 0.93, 0.97)]
-DAYS = {"doses_taken": [4, 3, 4, 4, 2], "doses_missed": [0, 1, 0, 0, 2]}
-LATENCIES = [30.0 + (i * 37 % 101) for i in range(300)]
+from figure_samples import RATES, figures
 
 
 def _figures(folder: Path) -> list[Path]:
-    return [plots.rates_figure(RATES, folder / "rates.svg"),
-            plots.over_days_figure(DAYS, folder / "days.svg"),
-            plots.latency_figure("report_latency_s", LATENCIES, folder / "latency.svg",
-                                 marks={"mean": 80.0, "median": 79.0, "p95": 126.0}),
-            plots.rates_figure(RATES[:1], folder / "rates-1.svg")]
+    """The three sample figures and a fourth: a rates figure of one row."""
+    return [*figures(folder), plots.rates_figure(RATES[:1], folder / "rates-1.svg")]
 
 
 def _drawing_children() -> int:

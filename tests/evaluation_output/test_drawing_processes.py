@@ -1,5 +1,5 @@
-"""``opspec evaluate --workers W`` starts the report's drawing processes as its replications
-end (``plots.drawing_processes``), before it knows what to draw: the figures they draw must
+"""``opspec evaluate --workers W`` starts the report's drawing processes
+(``plots.drawing_processes``) before it knows what to draw: the figures they draw must
 be those drawn one after another, and what could not be sent to them is still drawn."""
 
 from __future__ import annotations
@@ -11,16 +11,8 @@ import pytest
 from opspec.errors import EvaluationError
 from opspec.evaluation import plots
 
-RATES = [("doses missed", 0.0034, 0.001, 0.008), ("doses taken", 0.95, 0.93, 0.97)]
-DAYS = {"doses_taken": [4, 3, 4, 4, 2], "doses_missed": [0, 1, 0, 0, 2]}
-LATENCIES = [30.0 + (i * 37 % 101) for i in range(300)]
-
-
-def _figures(folder: Path) -> list[Path]:
-    return [plots.rates_figure(RATES, folder / "rates.svg"),
-            plots.over_days_figure(DAYS, folder / "days.svg"),
-            plots.latency_figure("report_latency_s", LATENCIES, folder / "latency.svg",
-                                 marks={"mean": 80.0, "median": 79.0, "p95": 126.0})]
+from figure_samples import RATES
+from figure_samples import figures as _figures
 
 
 def test_started_processes_draw_the_figures_drawn_one_after_another(
