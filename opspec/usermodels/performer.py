@@ -120,10 +120,14 @@ class StochasticUser:
                                                  self.model.busy)
         root = item.root_instance
         lane = root if root is not None else item.instance
-        now = session.now
         if self._routine_is_trivial:    # RoutineTracker.state's own answer, without the call
             notice, factor, window, start_at = 1.0, 1.0, None, None
+            # the clock is read only for a deferred start (start_at - now); the engine reads
+            # it itself when it schedules the completion (``session.now`` is a property: a
+            # Python frame per offer from source)
+            now = 0.0
         else:
+            now = session.now
             state = self._routine.state(now)
             notice, factor = state.notice_factor, state.duration_factor
             window, start_at = state.window, state.start_at
@@ -188,10 +192,10 @@ class StochasticUser:
             self._count(item, 3)
             self._trace("user.slip", item, recovery=recovery)
 
-        start = now
+        lead = 0.0      # (start - now, and start is now unless the routine defers it)
         if start_at is not None:
-            start = start_at
-            self._trace("user.deferred", item, until=start)
+            lead = start_at - now
+            self._trace("user.deferred", item, until=start_at)
 
         if plan.engages is not None:
             if plan.engages:
@@ -201,7 +205,7 @@ class StochasticUser:
 
         self._pending[item.key] = item
         # (comparisons, not max(0.0, x): the same value, without a builtin call each)
-        total = (start - now + (delay if delay > 0.0 else 0.0)  # noqa: FURB136
+        total = (lead + (delay if delay > 0.0 else 0.0)  # noqa: FURB136
                  + (duration if duration > 0.0 else 0.0))  # noqa: FURB136
         if not total > 0.0:
             total = 0.0
