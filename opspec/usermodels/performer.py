@@ -158,7 +158,9 @@ class StochasticUser:
         choice: str | None = None
         if item.choices:
             choice, delay = self._choose(item, plan, lane)
-            picked = self._alternative(choice)
+            alternatives = self._alternatives
+            picked = (alternatives[choice] if choice in alternatives
+                      else self._alternative(choice))
             if picked is not None:
                 carry_out = picked.duration
                 # (Constant.sample draws nothing: its value, without the call)
