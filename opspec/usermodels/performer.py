@@ -31,7 +31,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable, Mapping
-from typing import Any
+from typing import Any, Final
 
 import numpy as np
 
@@ -47,7 +47,7 @@ __all__ = ["ActivityTally", "StochasticUser"]
 
 #: 2**-53: numpy's PCG64 ``next_double`` is ``(next64 >> 11) * (1.0 / 9007199254740992.0)``
 #: (numpy/random/src/pcg64/pcg64.h), the float ``Generator.random()`` returns
-_TWO_TO_MINUS_53 = 1.0 / 9007199254740992.0
+_TWO_TO_MINUS_53: Final = 1.0 / 9007199254740992.0  # (Final: a constant compiled)
 
 
 class StochasticUser:
