@@ -29,8 +29,9 @@ omission's reason, a routine window's name, or ``adherence``), ``user.wrong_choi
 
 from __future__ import annotations
 
-from collections.abc import Mapping
-from typing import Any
+import math
+from collections.abc import Callable, Mapping
+from typing import Any, Final
 
 import numpy as np
 
@@ -39,10 +40,14 @@ from opspec.engine.performers import PerformerSession, WorkItem
 from opspec.errors import UserModelError
 from opspec.usermodels.errors import Busy
 from opspec.usermodels.model import ActivityModel, UserModel
-from opspec.usermodels.parametric import Constant
+from opspec.usermodels.parametric import Constant, LogNormal
 from opspec.usermodels.routine import RoutineTracker
 
 __all__ = ["ActivityTally", "StochasticUser"]
+
+#: 2**-53: numpy's PCG64 ``next_double`` is ``(next64 >> 11) * (1.0 / 9007199254740992.0)``
+#: (numpy/random/src/pcg64/pcg64.h), the float ``Generator.random()`` returns
+_TWO_TO_MINUS_53: Final = 1.0 / 9007199254740992.0  # (Final: a constant compiled)
 
 
 class StochasticUser:
@@ -61,6 +66,15 @@ class StochasticUser:
         self._routine = RoutineTracker(model.routine, rng)
         self._routine_is_trivial = model.routine.is_trivial
         self._random = rng.random     # bound once: offer draws from it several times a cycle
+        self._normal = rng.standard_normal
+        # With numpy's default bit generator, PCG64, a uniform is taken from the raw 64-bit
+        # draw as numpy itself does (see _TWO_TO_MINUS_53): the same float from the same
+        # stream position, without Generator.random's dtype and size handling (~1k
+        # instructions a draw, two or more draws a dose cycle); other bit generators define
+        # their doubles otherwise, and go through Generator.random
+        bit_generator = rng.bit_generator
+        self._raw: Callable[[], int] | None = (
+            bit_generator.random_raw if type(bit_generator) is np.random.PCG64 else None)
         self._pending: dict[int, WorkItem] = {}
         self._engaged: set[int] = set()          # lane instances the person is engaged in
         self._wrong: dict[tuple[int, str], int] = {}
@@ -106,10 +120,14 @@ class StochasticUser:
                                                  self.model.busy)
         root = item.root_instance
         lane = root if root is not None else item.instance
-        now = session.now
         if self._routine_is_trivial:    # RoutineTracker.state's own answer, without the call
             notice, factor, window, start_at = 1.0, 1.0, None, None
+            # the clock is read only for a deferred start (start_at - now); the engine reads
+            # it itself when it schedules the completion (``session.now`` is a property: a
+            # Python frame per offer from source)
+            now = 0.0
         else:
+            now = session.now
             state = self._routine.state(now)
             notice, factor = state.notice_factor, state.duration_factor
             window, start_at = state.window, state.start_at
@@ -124,7 +142,8 @@ class StochasticUser:
 
         if plan.noticed_or_not:
             p_miss = plan.p_miss
-            u = float(self._random())
+            raw = self._raw
+            u = (raw() >> 11) * _TWO_TO_MINUS_53 if raw is not None else float(self._random())
             if u >= (1.0 - p_miss) * notice:
                 if u >= 1.0 - p_miss:
                     reason = plan.miss_reason
@@ -139,34 +158,46 @@ class StochasticUser:
         choice: str | None = None
         if item.choices:
             choice, delay = self._choose(item, plan, lane)
-            picked = self._alternative(choice)
+            alternatives = self._alternatives
+            picked = (alternatives[choice] if choice in alternatives
+                      else self._alternative(choice))
             if picked is not None:
-                delay += picked.duration.sample(self.rng) * factor
+                carry_out = picked.duration
+                # (Constant.sample draws nothing: its value, without the call)
+                delay += (carry_out.value if type(carry_out) is Constant
+                          else carry_out.sample(self.rng)) * factor
 
         extra_delay = plan.delay
-        if extra_delay is not None and float(self._random()) < extra_delay.probability:
+        if extra_delay is not None and self._uniform() < extra_delay.probability:
             extra = extra_delay.duration.sample(self.rng)
             delay += extra
             self._trace("user.delayed", item, seconds=extra)
 
         constant = plan.constant_duration
-        duration = (constant if constant is not None else plan.duration.sample(self.rng)) * factor
+        if constant is not None:
+            duration = constant * factor
+        elif plan.lognormal:
+            # LogNormal.sample's own expression, without its call (a Python frame in both
+            # builds: the distributions are not compiled); the same one standard normal
+            duration = math.exp(plan.mu + plan.sigma * float(self._normal())) * factor
+        else:
+            duration = plan.duration.sample(self.rng) * factor
         repetition = plan.repetition
-        if repetition is not None and float(self._random()) < repetition.probability:
+        if repetition is not None and self._uniform() < repetition.probability:
             duration += plan.duration.sample(self.rng) * factor
             self._trace("user.repeated", item)
         slip = plan.commission
         if (slip is not None and not item.choices
-                and float(self._random()) < slip.probability):
+                and self._uniform() < slip.probability):
             recovery = slip.recovery.sample(self.rng)
             duration += recovery
             self._count(item, 3)
             self._trace("user.slip", item, recovery=recovery)
 
-        start = now
+        lead = 0.0      # (start - now, and start is now unless the routine defers it)
         if start_at is not None:
-            start = start_at
-            self._trace("user.deferred", item, until=start)
+            lead = start_at - now
+            self._trace("user.deferred", item, until=start_at)
 
         if plan.engages is not None:
             if plan.engages:
@@ -176,7 +207,7 @@ class StochasticUser:
 
         self._pending[item.key] = item
         # (comparisons, not max(0.0, x): the same value, without a builtin call each)
-        total = (start - now + (delay if delay > 0.0 else 0.0)  # noqa: FURB136
+        total = (lead + (delay if delay > 0.0 else 0.0)  # noqa: FURB136
                  + (duration if duration > 0.0 else 0.0))  # noqa: FURB136
         if not total > 0.0:
             total = 0.0
@@ -189,6 +220,12 @@ class StochasticUser:
             self._release(self._lane_of(item))
 
     # ------------------------------------------------------------------ internals
+
+    def _uniform(self) -> float:
+        """One uniform in [0, 1): ``Generator.random()``'s float and stream position (offer
+        and _choose write this inline where it is drawn every dose cycle)."""
+        raw = self._raw
+        return (raw() >> 11) * _TWO_TO_MINUS_53 if raw is not None else float(self._random())
 
     def _require_session(self) -> PerformerSession:
         if self._session is None:
@@ -217,7 +254,7 @@ class StochasticUser:
             weights = dict(plan.probabilities)
             offered = [(c, weights.get(c, 0.0)) for c in choices]
             total = sum(w for _, w in offered)
-            u = float(self._random()) * total
+            u = self._uniform() * total
             for choice, weight in offered:
                 if u < weight:
                     return choice, owed
@@ -232,8 +269,12 @@ class StochasticUser:
             return choices[int(self.rng.integers(len(choices)))], owed
         commission = plan.commission
         count = self._wrong.get(key, 0)
-        if (commission is not None and count < commission.max_per_instance
-                and float(self._random()) < commission.probability):
+        slipped = False
+        if commission is not None and count < commission.max_per_instance:
+            raw = self._raw
+            u = (raw() >> 11) * _TWO_TO_MINUS_53 if raw is not None else float(self._random())
+            slipped = u < commission.probability
+        if commission is not None and slipped:
             wrong = [c for c in (commission.alternatives or choices)
                      if c != intended and c in choices]
             if wrong:
@@ -252,7 +293,9 @@ class StochasticUser:
         if item.key not in pending:
             return  # withdrawn meanwhile
         del pending[item.key]
-        session = self._require_session()
+        session = self._session
+        if session is None:
+            session = self._require_session()
         handover = False
         if self._busy and lane in self._engaged:
             if item.activity in self._release_after or item.activity not in self._engaging:
@@ -271,8 +314,13 @@ class StochasticUser:
     def _end_handover(self, lane: int, key: int) -> None:
         if self._handover.get(lane) == key:
             del self._handover[lane]
-            if not any(self._lane_of(i) == lane for i in self._pending.values()):
-                self._engaged.discard(lane)
+            # (a loop, not any() over a generator of _lane_of calls: from source each is a
+            # Python frame, and this runs after every handover)
+            for pending in self._pending.values():
+                root = pending.root_instance
+                if (root if root is not None else pending.instance) == lane:
+                    return
+            self._engaged.discard(lane)
 
     @staticmethod
     def _lane_of(item: WorkItem) -> int:
@@ -351,6 +399,11 @@ class _Plan:
         self.p_miss = omission.probability if omission is not None else 0.0
         self.miss_reason = omission.reason if omission is not None else "not noticed"
         # Constant.sample draws nothing, so skipping the call leaves the stream as it was.
+        # A lognormal's draw is written out in offer (LogNormal.sample's expression).
+        duration = model.duration
+        self.lognormal = type(duration) is LogNormal
+        self.mu = duration.mu if isinstance(duration, LogNormal) else 0.0
+        self.sigma = duration.sigma if isinstance(duration, LogNormal) else 0.0
         self.constant_duration = (model.duration.value if type(model.duration) is Constant
                                   else None)
         self.ignored_when_busy = busy is not None and busy.ignores(activity)
