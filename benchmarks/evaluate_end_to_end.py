@@ -167,6 +167,22 @@ def baseline(script: Path, users: int, days: int, seed: int) -> Measured:
                      "--seed", str(seed)], cwd=script.parent)
 
 
+def baselines_at_once(script: Path, users: int, days: int, seed: int, copies: int) -> float:
+    """The wall seconds of ``copies`` baselines started together: what this machine's cores
+    give CPU-bound work side by side (on this VM two identical processes at once ran 1.45x to
+    2.76x one alone, the cores' speed moving with the host's load), the ceiling of
+    ``--workers W`` measured in the same round."""
+    start = time.perf_counter()
+    children = [subprocess.Popen([sys.executable, str(script), "--users", str(users),
+                                  "--days", str(days), "--seed", str(seed)],
+                                 cwd=script.parent, stdout=subprocess.DEVNULL,
+                                 stderr=subprocess.DEVNULL) for _ in range(copies)]
+    for child in children:
+        if child.wait() != 0:
+            sys.exit(f"failed ({child.returncode}): the baseline, {copies} at once")
+    return time.perf_counter() - start
+
+
 def engine_alone(users: int, days: int, seed: int) -> Measured:
     return Measured([sys.executable, "-c", _ENGINE, str(SPEC), str(USERS_TOML), str(users),
                      str(days), str(seed)], cwd=ROOT)
@@ -228,6 +244,7 @@ def speed(args: argparse.Namespace, script: Path) -> None:
     wall: dict[str, list[float]] = {n: [] for n in names}
     estimate: dict[int, list[float]] = {w: [] for w in workers}
     parts: dict[int, list[dict[str, float]]] = {w: [] for w in workers}
+    at_once: dict[int, list[float]] = {w: [] for w in workers if w > 1}
     print(f"medication dispenser, {args.users:,} users x {args.days} days, seed {args.seed}, "
           f"{args.rounds} interleaved round(s); {_load()}")
     print(f"{'round':<7}" + "".join(f"{n:>24}" for n in names) + "   (CPU s / wall s)")
@@ -236,6 +253,8 @@ def speed(args: argparse.Namespace, script: Path) -> None:
         runs = [baseline(script, args.users, args.days, args.seed),
                 engine_alone(args.users, args.days, args.seed),
                 *(run for run, _ in evaluated)]
+        for w in at_once:
+            at_once[w].append(baselines_at_once(script, args.users, args.days, args.seed, w))
         for w, (_, memory) in zip(workers, evaluated, strict=True):
             if "cpu" in memory:
                 parts[w].append(memory["cpu"])
@@ -260,6 +279,13 @@ def speed(args: argparse.Namespace, script: Path) -> None:
                                               wall[f"evaluate --workers {w}"], strict=True)]
                 print(f"  {f'speed-up of --workers {w} over 1 (wall)':<44}{_spread(gain)}"
                       "   goal >= 1.8 on 2 idle cores")
+                machine = [w * one / together for one, together
+                           in zip(wall["baseline"], at_once[w], strict=True)]
+                print(f"  {f'  the machine: {w} baselines at once over one':<44}"
+                      f"{_spread(machine)}")
+                label = f"  --workers {w} speed-up / the machine's"
+                print(f"  {label:<44}"
+                      f"{_spread([g / m for g, m in zip(gain, machine, strict=True)])}")
                 if estimate[1] and estimate[w]:
                     est = [a / b for a, b in zip(estimate[1], estimate[w], strict=True)]
                     print(f"  {f'  estimated on {w} idle cores (CPU per part)':<44}"
