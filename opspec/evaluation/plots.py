@@ -248,12 +248,12 @@ class _Pools:
             pool.shutdown(wait=wait, cancel_futures=cancel_futures)
 
     def end_now(self) -> None:
-        """End every drawing process without waiting for its work."""
+        """End every drawing process without waiting for its work, and then each pool's
+        managing thread."""
         # the executor keeps its processes in a private field (terminate_workers: Python
         # 3.14), which shutdown empties
         processes = [process for pool in self._pools
                      for process in (getattr(pool, "_processes", None) or {}).values()]
-        self.shutdown(wait=False, cancel_futures=True)
         for process in processes:
             with contextlib.suppress(Exception):
                 process.terminate()
@@ -263,6 +263,12 @@ class _Pools:
                 if process.is_alive():
                     process.kill()
                     process.join(5)
+        # With its processes gone, each pool's managing thread finds the pool broken and
+        # ends, closing its wake-up pipe; waiting for that here matters: at the
+        # interpreter's exit Python 3.11 wakes every such thread without a lock, and one
+        # closing its pipe at that moment printed "Bad file descriptor" and a traceback
+        # after the error (CPython gh-84176; later 3.12 and 3.13 releases lock it, gh-125451)
+        self.shutdown(wait=True, cancel_futures=True)
 
 
 #: Within :func:`drawing_processes`: its processes (:class:`_Pools`) and how many.

@@ -2,12 +2,16 @@
 (they import matplotlib on the core its start-up leaves idle). A bad spec or user model must
 still stop the command before any simulation, with its message naming the file (and line), no
 traceback and nothing created - and that error must not wait for the drawing processes, which
-are ended at once: none outlives the command, none finishes its import."""
+are ended at once: none outlives the command, none finishes its import, and no thread of
+theirs is left for the interpreter's exit (Python 3.11 wakes each such thread there without a
+lock: one closing its pipe at that moment printed a traceback after the error)."""
 
 from __future__ import annotations
 
 import multiprocessing
+import threading
 import time
+from concurrent.futures import process as pool_internals
 from pathlib import Path
 
 import pytest
@@ -47,6 +51,13 @@ def slow_drawing(monkeypatch: pytest.MonkeyPatch, tmp_path: Path) -> tuple[Path,
     return done, asked
 
 
+def _pool_threads_alive() -> list[threading.Thread]:
+    """The process pools' managing threads still running (each one's wake-up pipe is
+    written to at the interpreter's exit)."""
+    return [t for t in threading.enumerate()
+            if isinstance(t, pool_internals._ExecutorManagerThread) and t.is_alive()]
+
+
 def _two_cores(monkeypatch: pytest.MonkeyPatch) -> None:
     # the drawing processes are as many as the workers, up to the cores
     import opspec.commands.evaluate as command
@@ -68,6 +79,7 @@ def test_bad_spec_fails_at_once_and_ends_the_drawing_processes(
     assert not out.exists()
     assert asked == [2]                         # they were started, before the spec was read
     assert multiprocessing.active_children() == []
+    assert _pool_threads_alive() == []
     assert not done.exists()
 
 
@@ -86,4 +98,5 @@ def test_bad_user_model_fails_at_once_and_ends_the_drawing_processes(
     assert not out.exists()
     assert asked == [2]
     assert multiprocessing.active_children() == []
+    assert _pool_threads_alive() == []
     assert not done.exists()
