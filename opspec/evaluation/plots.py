@@ -159,7 +159,7 @@ def drawing_processes(workers: int) -> Iterator[None]:
     try:
         pools.start_first()                 # forks them now (not at the first figure)
     except Exception:  # noqa: BLE001 - no processes: the figures are drawn as before
-        pools.shutdown(wait=False, cancel_futures=True)
+        pools.end_now()                     # those forked before the failure, if any
         yield
         return
     token = _POOL.set((pools, workers))

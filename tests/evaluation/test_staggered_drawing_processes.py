@@ -48,3 +48,30 @@ def test_the_rest_are_forked_at_the_first_figure_when_not_asked_before(tmp_path:
             together = _figures(tmp_path / "together")
             assert _drawing_children() == before + 2
     assert [p.read_bytes() for p in together] == [p.read_bytes() for p in alone]
+
+
+def test_a_drawing_process_that_cannot_be_forked_leaves_the_figures_to_this_process(
+        tmp_path: Path, monkeypatch) -> None:
+    """When the machine refuses a fork part way (too many processes), the processes already
+    forked are ended at once and every figure is drawn here, the same bytes."""
+    alone = _figures(tmp_path / "alone")
+    fork = multiprocessing.get_context("fork")
+    forked: list[object] = []
+
+    class SecondRefused(type(fork).Process):  # type: ignore[misc]
+        def start(self) -> None:
+            if forked:
+                raise OSError(11, "Resource temporarily unavailable")
+            forked.append(self)
+            super().start()
+
+    class Refusing(type(fork)):  # type: ignore[misc]
+        Process = SecondRefused
+
+    monkeypatch.setattr(multiprocessing, "get_context", lambda method=None: Refusing())
+    before = _drawing_children()
+    with plots.drawing_processes(2):
+        assert forked and _drawing_children() == before    # the one forked is gone already
+        with plots.drawn_by(2):
+            here = _figures(tmp_path / "here")
+    assert [p.read_bytes() for p in here] == [p.read_bytes() for p in alone]
