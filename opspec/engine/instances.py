@@ -182,6 +182,12 @@ class ActivityInstance:
         key = self.key
         if key in running:
             del running[key]
+        if self.cleanup:
+            self.undo_waits()
+
+    def undo_waits(self) -> None:
+        """Undo the armed waits (:meth:`leave`'s last step; ``Activities._complete`` takes
+        the others in line)."""
         cleanup = self.cleanup
         if cleanup:
             for undo in cleanup:
