@@ -368,7 +368,7 @@ class Activities(Part):
         self._complete(ai)
 
     def _complete(self, ai: ActivityInstance) -> None:
-        # the completion of every activity instance: ActivityInstance.leave's steps in line,
+        # the completion of every activity instance: ActivityInstance.leave's steps in line
         ai.state = COMPLETED
         ai.gen += 1
         frame = ai.frame

@@ -173,7 +173,8 @@ class ActivityInstance:
         """End this instance in ``state``: it stops waiting (``gen``: stale timers see it),
         leaves its frame's running set, and its cleanups (armed boundary events, deadlines,
         listeners) are undone. Completion, cancellation and a choice's losing branch all
-        end an instance this one way."""
+        end an instance by these steps (``Activities._complete``, the completion of every
+        activity instance, takes them in line)."""
         self.state = state
         self.gen += 1
         # (``in`` and ``del``, not ``pop(key, None)``: compiled, a dict's pop is a Python
