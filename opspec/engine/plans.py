@@ -188,9 +188,9 @@ class _Writer:
             out += [f"{pad}flow.instance_done(inst)", f"{pad}return"]
 
     def hand_over(self, index: int, pad: str) -> list[str]:
-        """``lone.hand_over`` at activity ``index``, in line: the instance gets its frame
-        with the token in it, and the token goes the general way from there (whether the
-        activity is instantaneous is known here: the call ``start`` or ``start_slow``)."""
+        """The hand-over at activity ``index`` (as in ``lone.run``): the instance gets its
+        frame with the token in it, and the token goes the general way from there (whether
+        the activity is instantaneous is known here: the call ``start`` or ``start_slow``)."""
         a = f"A{index}"
         start = (f"activities.start(frame, {a}, steps, limit)" if self.acts[index].fast
                  else f"activities.start_slow(frame, {a})")
