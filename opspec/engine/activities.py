@@ -368,13 +368,18 @@ class Activities(Part):
         self._complete(ai)
 
     def _complete(self, ai: ActivityInstance) -> None:
-        ai.leave(COMPLETED)
+        # the completion of every activity instance: ActivityInstance.leave's steps in line
+        ai.state = COMPLETED
+        ai.gen += 1
         frame = ai.frame
+        if ai.key in frame.running:
+            del frame.running[ai.key]
+        if ai.cleanup:
+            ai.undo_waits()
         if ai.mi is not None:
             multi_instance.done(self, ai, ai.mi)
             return
-        # Flow.finish's two steps, here (the completion of every activity instance), with
-        # Flow.done_next's first case in line, and what waits started without start's loop
+        # Flow.finish's steps, Flow.done_next's first case, a waiting target's start: in line
         act = ai.act
         if act.simple_end:
             state = self.state

@@ -173,7 +173,8 @@ class ActivityInstance:
         """End this instance in ``state``: it stops waiting (``gen``: stale timers see it),
         leaves its frame's running set, and its cleanups (armed boundary events, deadlines,
         listeners) are undone. Completion, cancellation and a choice's losing branch all
-        end an instance this one way."""
+        end an instance by these steps (``Activities._complete``, the completion of every
+        activity instance, takes them in line)."""
         self.state = state
         self.gen += 1
         # (``in`` and ``del``, not ``pop(key, None)``: compiled, a dict's pop is a Python
@@ -182,6 +183,12 @@ class ActivityInstance:
         key = self.key
         if key in running:
             del running[key]
+        if self.cleanup:
+            self.undo_waits()
+
+    def undo_waits(self) -> None:
+        """Undo the armed waits (:meth:`leave`'s last step; ``Activities._complete`` takes
+        the others in line)."""
         cleanup = self.cleanup
         if cleanup:
             for undo in cleanup:

@@ -168,8 +168,7 @@ class Interpreter(RunState):
     # ------------------------------------------------------------------ performers' answers
     def performer_complete(self, item: WorkItem, data: Mapping[str, Any] | None,
                            choice: str | None) -> None:
-        self.sync()
-        self.offers.performer_complete(item, data, choice)
+        self.offers.performer_complete(item, data, choice)    # (it reads the clock itself)
 
     def performer_omit(self, item: WorkItem, reason: str) -> None:
         self.sync()

@@ -27,7 +27,7 @@ if TYPE_CHECKING:
     from opspec.engine.activities import Activities
     from opspec.engine.flow import Flow
 
-__all__ = ["hand_over", "run", "xor_transition"]
+__all__ = ["run", "xor_transition"]
 
 
 def run(activities: Activities, inst: ProcessInstance, act: CompiledActivity | None,
@@ -45,7 +45,8 @@ def run(activities: Activities, inst: ProcessInstance, act: CompiledActivity | N
     while act is not None:
         if not act.lone or (act.general and pooled) or (
                 act.kind == K_TASK and act.application in apps):
-            # hand_over's steps, in line (compiled, the call would cost more than they do)
+            # the instance gets its frame, with the token in it, and from here the
+            # token goes the general way (a plan writes the same steps out)
             frame = Frame(inst.process.graph, inst, None)
             inst.frames.append(frame)
             frame.live = 1
@@ -88,19 +89,6 @@ def run(activities: Activities, inst: ProcessInstance, act: CompiledActivity | N
                 return
         nxt = act.next
         act = acts[nxt] if nxt >= 0 else _split(flow, inst, act)
-
-
-def hand_over(activities: Activities, inst: ProcessInstance, act: CompiledActivity,
-              steps: int, limit: int) -> None:
-    """The token reached ``act``, which is not lone (or not on this run): the instance gets
-    its frame, with the token in it, and from here the token goes the general way."""
-    frame = Frame(inst.process.graph, inst, None)
-    inst.frames.append(frame)
-    frame.live = 1
-    if act.fast:
-        activities.start(frame, act, steps, limit)
-    else:
-        activities.start_slow(frame, act)       # start's first step
 
 
 def _split(flow: Flow, inst: ProcessInstance, act: CompiledActivity) -> CompiledActivity | None:

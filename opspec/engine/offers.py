@@ -182,9 +182,12 @@ class Offers(Part):
         for key, value in data.items():
             self.flow.set_field(inst, ai.act, key, value)
 
-    def performer_complete(self, item: WorkItem, data: Mapping[str, Any] | None,
-                           choice: str | None) -> None:
+    def performer_complete(self, item: WorkItem, data: Mapping[str, Any] | None = None,
+                           choice: str | None = None) -> None:
+        """A performer completed ``item`` (the session's ``complete``, bound to this)."""
         state = self.state
+        if not state.inside:        # (RunState.sync: called from outside the run's callbacks)
+            state.now = float(state.env.now)
         offered = state.offered
         key = item.key
         ai = offered.get(key)

@@ -38,6 +38,7 @@ from opspec.engine.compiled import (
     CompiledPackage,
     CompiledProcess,
 )
+from opspec.engine.instances import Frame
 from opspec.engine.lifecycle import RUNNING, SUSPENDED
 from opspec.engine.trace import EventKind as EK
 from opspec.errors import OpspecError
@@ -109,7 +110,8 @@ class _Writer:
         self.blocks = 0
         # the plan's globals: what its source names (activities, conditions, helpers)
         self.names: dict[str, Any] = {
-            "__builtins__": __builtins__, "HAND": lone.hand_over, "REST": lone.run,
+            "__builtins__": __builtins__, "REST": lone.run,
+            "FRAME": Frame, "GRAPH": proc.graph,
             "OpspecError": OpspecError, "RUNNING": RUNNING, "SUSPENDED": SUSPENDED,
             "STARTED": EK.ACTIVITY_STARTED, "COMPLETED": EK.ACTIVITY_COMPLETED,
             "CHANGED": EK.DATA_CHANGED}
@@ -130,9 +132,8 @@ class _Writer:
             out.append(f"{pad}REST(activities, inst, {a}, steps, limit)")
             out.append(f"{pad}return")
             return
-        hand = [f"{pad}    HAND(activities, inst, {a}, steps, limit)", f"{pad}    return"]
         if not act.lone:
-            out.extend(line[4:] for line in hand)
+            out.extend(self.hand_over(index, pad))
             return
         waits = []                          # lone, but not on this run
         if act.general:
@@ -141,7 +142,7 @@ class _Writer:
             waits.append(f"{self.name('APP', act.application)} in apps")
         if waits:
             out.append(f"{pad}if {' or '.join(waits)}:")
-            out.extend(hand)
+            out.extend(self.hand_over(index, pad + "    "))
         fields = (f"{self.name('P', act.process)}, iid, {self.name('I', act.id)}, "
                   f"{self.name('L', act.lane)}, {self.name('W', act.participant)}")
         out += [f"{pad}steps += 1",
@@ -185,6 +186,16 @@ class _Writer:
             self.split(index, path, depth, out)
         else:                               # an end: the token is gone
             out += [f"{pad}flow.instance_done(inst)", f"{pad}return"]
+
+    def hand_over(self, index: int, pad: str) -> list[str]:
+        """The hand-over at activity ``index`` (as in ``lone.run``): the instance gets its
+        frame with the token in it, and the token goes the general way from there (whether
+        the activity is instantaneous is known here: the call ``start`` or ``start_slow``)."""
+        a = f"A{index}"
+        start = (f"activities.start(frame, {a}, steps, limit)" if self.acts[index].fast
+                 else f"activities.start_slow(frame, {a})")
+        return [f"{pad}frame = FRAME(GRAPH, inst, None)", f"{pad}inst.frames.append(frame)",
+                f"{pad}frame.live = 1", f"{pad}{start}", f"{pad}return"]
 
     def split(self, index: int, path: tuple[int, ...], depth: int, out: list[str]) -> None:
         """``lone.xor_transition`` of activity ``index``, then the chosen target's code."""

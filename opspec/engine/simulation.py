@@ -88,10 +88,18 @@ class RunResult:
 class _Session:
     """The :class:`~opspec.engine.performers.PerformerSession` of one simulation."""
 
-    __slots__ = ("_sim",)
+    __slots__ = ("_sim", "call_later", "complete")
 
     def __init__(self, sim: Simulation) -> None:
         self._sim = sim
+        # The two calls on the path of every work item (the answer, and the performer's
+        # callback that gives it) are the engine's own methods, bound once: a method here
+        # that forwarded them would be a Python frame more per call from source (two or
+        # three per dose cycle each). ``complete`` reads the clock itself when called from
+        # outside the run's callbacks (Offers.performer_complete), ``call_later`` is
+        # RunState.call_at.
+        self.complete: Callable[..., None] = sim.offers.performer_complete
+        self.call_later: Callable[..., None] = sim.call_at
 
     @property
     def now(self) -> float:
@@ -99,15 +107,6 @@ class _Session:
         if not sim.inside:          # (inside the run's own callback the clock is read already)
             sim.sync()
         return sim.now
-
-    def complete(self, item: WorkItem, data: Mapping[str, Any] | None = None,
-                 choice: str | None = None) -> None:
-        # Interpreter.performer_complete's two steps, here: a performer's answer is on the
-        # path of every work item (from source, each call level is a Python frame)
-        sim = self._sim
-        if not sim.inside:
-            sim.sync()
-        sim.offers.performer_complete(item, data, choice)
 
     def omit(self, item: WorkItem, reason: str = "") -> None:
         self._sim.performer_omit(item, reason)
@@ -117,9 +116,6 @@ class _Session:
 
     def raise_trigger(self, name: str, data: Mapping[str, Any] | None = None) -> None:
         self._sim.raise_trigger(name, data)
-
-    def call_later(self, delay: float, callback: Callable[[], None]) -> None:
-        self._sim.call_at(delay, callback)
 
     def trace(self, kind: str, data: Mapping[str, Any] | None = None) -> None:
         sim = self._sim
