@@ -12,9 +12,11 @@ It is a class of its own instead of a ChainMap subclass so that mypyc compiles i
 (``opspec._native``; a compiled class cannot extend ChainMap, a Python class): a periodic
 spec makes a scope per workflow instance and reads it a few times in each, and the
 interpreted ``ChainMap.__init__`` and ``__getitem__`` were about 4k instructions of the
-instance's 37.5k (docs/engine-performance.md, "periodic path, fifth pass"). Each map is
-asked whether it has the key instead of tried and its ``KeyError`` caught: a package field
-read by an instance without that field raised and caught an exception per read.
+instance's 37.5k (docs/engine-performance.md, "periodic path, fifth pass"). The
+instance's fields are asked whether they have the key instead of tried and their
+``KeyError`` caught (a package field read by an instance without that field raised and
+caught an exception per read); the package's are tried last, their ``KeyError`` being the
+scope's own.
 """
 
 from __future__ import annotations
@@ -41,10 +43,7 @@ class Scope(MutableMapping[str, Any]):
         fields = self.fields
         if key in fields:
             return fields[key]
-        package = self.package
-        if key in package:
-            return package[key]
-        raise KeyError(key)
+        return self.package[key]        # a field of neither: KeyError(key), as ChainMap's
 
     def get(self, key: str, default: Any = None) -> Any:
         fields = self.fields
