@@ -73,5 +73,14 @@ class Scope(MutableMapping[str, Any]):
     def __bool__(self) -> bool:
         return bool(self.fields) or bool(self.package)
 
+    def __copy__(self) -> Scope:
+        """A copy with its own instance fields over the same package (ChainMap's ``copy``)."""
+        return Scope(self.fields.copy(), self.package)
+
+    def __reduce__(self) -> tuple[type[Scope], tuple[dict[str, Any], dict[str, Any]]]:
+        # pickle and deepcopy rebuild it from its two maps (compiled, the default
+        # reduction would call __init__ without them)
+        return Scope, (self.fields, self.package)
+
     def __repr__(self) -> str:
         return f"Scope({self.fields!r}, {self.package!r})"

@@ -13,6 +13,8 @@ The engine's :class:`opspec.engine.scope.Scope` gives that reading; it must beha
 
 from __future__ import annotations
 
+import copy
+import pickle
 from collections import ChainMap
 from pathlib import Path
 
@@ -93,3 +95,13 @@ def test_scope_behaves_as_the_chainmap_it_replaced(key: str) -> None:
         else:
             del target[key]
     assert scope.maps == chain.maps
+
+
+def test_scope_copies_and_pickles_as_the_chainmap_it_replaced() -> None:
+    package = {"level": 1}
+    scope = Scope({"seen": 2}, package)
+    shallow = copy.copy(scope)
+    shallow["seen"] = 3                             # its own instance fields, as ChainMap's
+    assert scope["seen"] == 2 and shallow.package is package
+    for twin in (copy.deepcopy(scope), pickle.loads(pickle.dumps(scope))):
+        assert twin.maps == scope.maps and twin.maps[0] is not scope.maps[0]
