@@ -54,6 +54,7 @@ MODULES: tuple[str, ...] = (
     "opspec.engine.random",
     "opspec.engine.runstate",
     "opspec.engine.sampling",
+    "opspec.engine.scope",
     "opspec.engine.simulation",
     "opspec.engine.timers",
     "opspec.engine.timing",

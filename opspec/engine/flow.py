@@ -40,8 +40,6 @@ _NEXT = LIFECYCLE.table
 # Final: module statics in the compiled engine, where a plain global is a dictionary lookup
 _COMPLETED_FROM_RUNNING: Final = _NEXT[(RUNNING, "complete")]
 _IN: Final = ParameterMode.IN
-# an instance's fields, then the package's (opspec.engine.scope: no KeyError per lookup)
-_CHAIN: Final = Scope
 
 
 class Flow(Part):
@@ -66,7 +64,7 @@ class Flow(Part):
         if data:
             local.update(data)
         scope: MutableMapping[str, Any] = (
-            _CHAIN(local, state.package_data) if state.package_data else local)
+            Scope(local, state.package_data) if state.package_data else local)
         iid = state.next_id()
         priority = proc.priority
         if parent is None:

@@ -16,7 +16,7 @@ from typing import TYPE_CHECKING, Any
 
 from opspec.worlds.base import RobotWorld, World, check_parameters
 from opspec.worlds.geometry import Box, wrap_angle
-from opspec.worlds.stepping import ARC, COVER, DONE, RayBox, RoomState
+from opspec.worlds.stepping import ARC, COVER, DONE, Cell, Cells, RayBox, RoomState
 
 if TYPE_CHECKING:   # annotations only: `opspec validate` loads no NumPy
     import numpy as np
@@ -72,7 +72,7 @@ class RoomWorld(RobotWorld):
         self.cell = float(cell)
         self.cells_x = max(1, math.ceil(width / cell))
         self.cells_y = max(1, math.ceil(height / cell))
-        self.covered: set[tuple[int, int]] = set()
+        self.covered: set[Cell] = set()
         self.range_noise = float(range_noise)
         self.drain_per_s = float(drain_per_s)
         self.tag = tuple(map(float, tag)) if tag is not None else None
@@ -88,7 +88,7 @@ class RoomWorld(RobotWorld):
         grown = [(o.x0 - r, o.x1 + r, o.y0 - r, o.y1 + r) for o in self.obstacles]
         # per cell range of _cover's loops, its cells (in the room) not yet covered, in the
         # loops' order; cells are only ever added, so the others can add nothing again
-        self._uncovered: dict[tuple[int, int, int, int], tuple[tuple[int, int], ...]] = {}
+        self._uncovered: dict[tuple[int, int, int, int], Cells] = {}
         # the room and the obstacles as op_read_range's ray meets them (ray_to_box_along)
         boxes = tuple(_ray_box(box) for box in (self.room, *self.obstacles))
         self._state.place(inside, grown, self.radius, self.cell, boxes, self._uncovered,

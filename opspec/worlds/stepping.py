@@ -30,7 +30,11 @@ ARC: Final = 3           # a command that drives and turns at once: the room ste
 STILL: Final = (0.0, 0.0)    # Robot.velocity() of a command it does not know
 
 Key = tuple[int, int, int, int]
-Cells = tuple[tuple[int, int], ...]
+#: a floor cell (x, y), typed as a tuple of any length so that compiled code keeps it one
+#: Python object: a ``tuple[int, int]`` is read into two C integers and boxed anew each
+#: time it goes into a set or a list (four times a cell ``cover`` looks at)
+Cell = tuple[int, ...]
+Cells = tuple[Cell, ...]
 #: a box as the range finder meets it: its sides, then the 1e-9 tolerance
 #: ``ray_to_box_along`` puts around them (y0 - 1e-9, y1 + 1e-9, x0 - 1e-9, x1 + 1e-9)
 RayBox = tuple[float, float, float, float, float, float, float, float]
@@ -65,10 +69,10 @@ class RoomState:
         self.radius = 0.0
         self.boxes: tuple[RayBox, ...] = ()
         self.uncovered: dict[Key, Cells] = {}
-        self.covered: set[tuple[int, int]] = set()
+        self.covered: set[Cell] = set()
         self.cells_x = 0
         self.cells_y = 0
-        self.new_cells: list[tuple[int, int]] = []
+        self.new_cells: list[Cell] = []
         self.time = 0.0
         self.x = 0.0
         self.y = 0.0
@@ -99,7 +103,7 @@ class RoomState:
     def place(self, inside: tuple[float, float, float, float],
               grown: list[tuple[float, float, float, float]], reach: float, cell: float,
               boxes: tuple[RayBox, ...], uncovered: dict[Key, Cells],
-              covered: set[tuple[int, int]], cells_x: int, cells_y: int) -> None:
+              covered: set[Cell], cells_x: int, cells_y: int) -> None:
         """The fixed geometry: the box the robot's centre may be in, each obstacle grown by
         the robot's radius (``reach``), the coverage cell, the range finder's boxes and the
         room's cells not yet covered per cell range (ranges not in it not looked at yet),
@@ -274,7 +278,7 @@ class RoomState:
     def _cells(self, key: Key) -> Cells:
         """The cells of the room in ``key``'s range, in ``RoomWorld._cover``'s order."""
         cx0, cx1, cy0, cy1 = key
-        found: list[tuple[int, int]] = []
+        found: list[Cell] = []
         for cx in range(max(cx0, 0), min(cx1 + 1, self.cells_x)):
             for cy in range(max(cy0, 0), min(cy1 + 1, self.cells_y)):
                 found.append((cx, cy))
@@ -332,7 +336,7 @@ def distance_ahead(x: float, y: float, heading: float, boxes: tuple[RayBox, ...]
 
 
 def cover(cells: Cells, x: float, y: float, cell: float, reach: float,
-          covered: set[tuple[int, int]]) -> tuple[list[tuple[int, int]], Cells]:
+          covered: set[Cell]) -> tuple[list[Cell], Cells]:
     """The robot at ``x``, ``y`` covers those of ``cells`` whose centre is within ``reach``
     plus half a cell: they are added to ``covered``; returned are the newly covered ones, in
     the order of ``cells`` (the room traces them in that order), and the ``cells`` still not
@@ -341,7 +345,7 @@ def cover(cells: Cells, x: float, y: float, cell: float, reach: float,
     # power takes the sign off first, which pow of an even power does too), but compiled
     # math.pow is that call itself, ``**`` a boxed number protocol call
     limit = math.pow(reach, 2.0) + math.pow(cell / 2, 2.0)
-    new: list[tuple[int, int]] = []
+    new: list[Cell] = []
     for c in cells:
         cx, cy = c
         centre_x = (cx + 0.5) * cell
