@@ -13,7 +13,7 @@ from __future__ import annotations
 
 from collections import deque
 from collections.abc import Callable, Mapping
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, Final
 
 from opspec.engine import coordination as coord
 from opspec.engine import multi_instance
@@ -30,13 +30,7 @@ from opspec.engine.compiled import (
     CompiledProcess,
 )
 from opspec.engine.instances import ActivityInstance, Frame, MultiInstance, ProcessInstance
-from opspec.engine.lifecycle import (
-    ABORTED,
-    COMPLETED,
-    RUNNING,
-    SUSPENDED,
-    TERMINATED,
-)
+from opspec.engine.lifecycle import ABORTED, COMPLETED, RUNNING, SUSPENDED, TERMINATED
 from opspec.engine.part import Part
 from opspec.engine.runstate import discard
 from opspec.engine.trace import EventKind as EK
@@ -45,6 +39,13 @@ from opspec.model import CoordinationKind, ParameterMode
 
 if TYPE_CHECKING:
     from opspec.engine.runstate import RunState
+
+# Compiled, an enum member read from its class goes through the metaclass (2.5k per robot instance)
+_ARBITER: Final = CoordinationKind.ARBITER
+_VOTER: Final = CoordinationKind.VOTER
+_SUPERPOSITION: Final = CoordinationKind.SUPERPOSITION
+_PUSH_DATA: Final = CoordinationKind.PUSH_DATA
+_PULL_DATA: Final = CoordinationKind.PULL_DATA
 
 #: Synchronous subflow calls nested deeper than this end the run's root instance with a
 #: located fault: bounded recursion (a base case) runs, runaway recursion is reported.
@@ -547,7 +548,6 @@ class Activities(Part):
         act = ai.act
         spec = act.coordination
         assert spec is not None
-        inst = ai.frame.inst
         scope = ai.scope()
         try:
             values = [scope[name] for name in spec.inputs]
@@ -556,18 +556,18 @@ class Activities(Part):
             return
         kind = spec.kind
         try:
-            if kind is CoordinationKind.ARBITER:
+            if kind is _ARBITER:
                 result: Any = coord.arbiter(values)
-            elif kind is CoordinationKind.VOTER:
+            elif kind is _VOTER:
                 result = coord.voter(values, spec.options)
-            elif kind is CoordinationKind.SUPERPOSITION:
+            elif kind is _SUPERPOSITION:
                 result = coord.superposition(values, spec.weights)
-            elif kind is CoordinationKind.PUSH_DATA:
+            elif kind is _PUSH_DATA:
                 self.push_data(spec.channel or act.id, values[0] if len(values) == 1
                                else tuple(values))
                 self.body_done(ai, None)
                 return
-            elif kind is CoordinationKind.PULL_DATA:
+            elif kind is _PULL_DATA:
                 channel = spec.channel or act.id
                 box = self.state.mailboxes.get(channel)
                 if box:
@@ -579,7 +579,7 @@ class Activities(Part):
             else:
                 # at once: if the new mode ends this very instance, nothing after the mode
                 # change may run (its completion included)
-                self.triggers.change_mode(spec.target_mode or "", act, inst)
+                self.triggers.change_mode(spec.target_mode or "", act, ai.frame.inst)
                 self.body_done(ai, None)
                 return
         except (TypeError, ValueError) as error:
