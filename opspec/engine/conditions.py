@@ -39,8 +39,9 @@ Every problem raises :class:`opspec.errors.ExecutionError` quoting the condition
 
 from __future__ import annotations
 
+import types
 from collections.abc import Callable, Mapping
-from typing import Any
+from typing import Any, Final
 
 from opspec.engine.condition_values import (
     ARITHMETIC,
@@ -56,6 +57,7 @@ from opspec.engine.condition_values import (
     ordered,
     truthy,
 )
+from opspec.engine.condition_code import generate
 from opspec.errors import ExecutionError, SourceLocation
 from opspec.model.expression_text import to_text
 from opspec.model.expressions import Binary, Call, Expression, Literal, Name, Unary
@@ -196,6 +198,9 @@ def compile_expression(
         inner = _compile(expr)
     except ConditionProblem as problem:
         raise _fail(expr, problem, location, None) from None
+    written = _written(expr, location, condition=False)
+    if written is not None:
+        return written
 
     def run(data: Mapping[str, Any], now: float) -> Any:
         try:
@@ -217,6 +222,9 @@ def compile_condition(
         inner = _compile(expr)
     except ConditionProblem as problem:
         raise _fail(expr, problem, location, None) from None
+    written = _written(expr, location, condition=True)
+    if written is not None:
+        return written
 
     # (one closure, not compile_expression's wrapped in another: a call between compiled
     # closures goes through Python's calling convention)
@@ -231,6 +239,25 @@ def compile_condition(
 
 
 _Fn = Callable[[Mapping[str, Any], float], Any]
+
+#: whether this module runs compiled (mypyc): its closures are then native code, faster than
+#: a generated Python function (measured, docs/engine-performance.md), so none is written
+COMPILED: Final = not isinstance(_fail, types.FunctionType)
+
+
+def _written(expr: Expression, location: SourceLocation | None, *, condition: bool
+             ) -> _Fn | None:
+    """From source, ``expr`` as one generated Python function (:mod:`.condition_code`:
+    the closures' meaning, one Python call instead of one per node); ``None`` when compiled
+    or where the tree is too deep to write out."""
+    if COMPILED:
+        return None
+
+    def fail(problem: BaseException, now: float) -> ExecutionError:
+        return _fail(expr, problem, location, now)
+
+    return generate(expr, fail, condition=condition)
+
 
 
 def _compile(expr: Expression) -> _Fn:
