@@ -67,6 +67,7 @@ __all__ = [
     "CompiledExpression",
     "compile_condition",
     "compile_expression",
+    "constant_value",
     "evaluate",
     "evaluate_condition",
     "truthy",
@@ -193,7 +194,10 @@ def compile_expression(
         # a constant cannot fail: no wrapper (an assignment of a constant is common, and
         # from source each closure level is a Python call)
         value = expr.value
-        return lambda data, now: value
+        constant = lambda data, now: value  # noqa: E731
+        if not COMPILED:    # the plans write the value where they would call this
+            constant.opspec_constant = (value,)  # type: ignore[attr-defined]
+        return constant
     try:
         inner = _compile(expr)
     except ConditionProblem as problem:
@@ -209,6 +213,13 @@ def compile_expression(
             raise _fail(expr, problem, location, now) from None
 
     return run
+
+
+def constant_value(evaluator: Callable[..., Any]) -> tuple[Any] | None:
+    """``(value,)`` when ``evaluator`` is :func:`compile_expression`'s function of a constant
+    (from source only), else ``None``: the plans write the value in place of the call."""
+    found: tuple[Any] | None = getattr(evaluator, "opspec_constant", None)
+    return found
 
 
 def compile_condition(

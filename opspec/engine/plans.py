@@ -38,6 +38,7 @@ from opspec.engine.compiled import (
     CompiledPackage,
     CompiledProcess,
 )
+from opspec.engine.conditions import constant_value
 from opspec.engine.instances import Frame
 from opspec.engine.lifecycle import RUNNING, SUSPENDED
 from opspec.engine.trace import EventKind as EK
@@ -234,7 +235,7 @@ class _Writer:
             out.append(f"{pad}{'if' if k == 0 else 'elif'} k == {k}:")
             for target_name, fn in trans.assignments:
                 # Flow.set_field(inst, None, ...), in line
-                out.append(f"{pad}    value = {self.name('V', fn)}(scope, now)")
+                out.append(f"{pad}    value = {self.value(fn, 'scope')}")
                 self.set_field(None, target_name, pad + "    ", out)
             self.block(trans.target, path, depth + 1, out)
         out += [f"{pad}return"]
@@ -247,12 +248,20 @@ class _Writer:
         self.names[a] = act
         out += [f"{pad}now = state.now", f"{pad}reads = inst.scope", f"{pad}try:"]
         for target, fn in assignments:
-            out.append(f"{pad}    value = {self.name('V', fn)}(reads, now)")
+            out.append(f"{pad}    value = {self.value(fn, 'reads')}")
             self.set_field(act, target, pad + "    ", out)
             out += [f"{pad}    if inst.state != RUNNING:", f"{pad}        return"]
         out += [f"{pad}except OpspecError as error:",
                 f"{pad}    flow.abort(inst, {a}, f\"an assignment failed: {{error.message}}\")",
                 f"{pad}    return"]
+
+    def value(self, fn: Any, data: str) -> str:
+        """The call of the expression ``fn`` over ``data``, or its value where it is a
+        constant (bound by name, as every value of the spec)."""
+        constant = constant_value(fn)
+        if constant is not None:
+            return self.name("K", constant[0])
+        return f"{self.name('V', fn)}({data}, now)"
 
     def set_field(self, act: CompiledActivity | None, target: str, pad: str,
                   out: list[str]) -> None:

@@ -210,3 +210,13 @@ def test_unary_and_call_nodes_of_every_kind_are_written_out() -> None:
     written, nested = both(expr, condition=False)
     assert "AS_NUMBER" in written.__doc__ and "now" in written.__doc__
     assert written({"n": 0}, 1.5) is nested({"n": 0}, 1.5) is False
+
+
+def test_only_a_constant_expression_tells_its_value_to_the_plans() -> None:
+    for value in (None, True, 0, 2.5, "it's \\ é"):
+        fn = conditions.compile_expression(Literal(value))
+        assert conditions.constant_value(fn) == (value,) and fn({}, 0.0) is value
+    for text in ("n", "n + 1", "hour()"):
+        assert conditions.constant_value(conditions.compile_expression(
+            parse_expression(text))) is None
+    assert conditions.constant_value(conditions.compile_condition(Literal(True))) is None
