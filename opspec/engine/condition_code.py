@@ -83,8 +83,8 @@ def generate(expr: Expression, fail: Fail, *, condition: bool
     space = writer.names
     space["FAIL"] = fail
     space["ERRORS"] = _ERRORS
-    ending = (f"    return {result} is True or ({result} is not False and TRUTHY({result}))"
-              if condition else f"    return {result}")
+    ending = (f"    return {_truth(result)}" if condition and not _boolean(expr)
+              else f"    return {result}")
     lines = ["def evaluate(data, now):", "    try:", *body,
              "    except ERRORS as problem:",
              "        raise FAIL(problem, now) from None",
@@ -243,6 +243,16 @@ class _Writer:
         v = self.local()
         out.append(f"{pad}{v} = {self.bind(function)}({', '.join(args)})")
         return v
+
+
+def _boolean(expr: Expression) -> bool:
+    """Whether ``expr``'s value is always a boolean (its truth is itself): the logic
+    operators, and the comparisons (same-type ``==`` and ``<`` of texts and numbers give
+    one, as do :func:`equal` and :func:`ordered`)."""
+    if isinstance(expr, Unary):
+        return expr.op == "not"
+    return isinstance(expr, Binary) and (expr.op in ("and", "or", "==", "!=")
+                                         or expr.op in FAST_ORDERING)
 
 
 def _truth(name: str) -> str:
