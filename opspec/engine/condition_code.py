@@ -205,12 +205,12 @@ class _Writer:
         constant = expr.right.value if isinstance(expr.right, Literal) else None
         if type(constant) in (int, float):
             return [f"{pad}{v} = type({left})",
-                    f"{pad}{v} = {left} {op} {right} if {v} is int or {v} is float "
-                    f"else ORDERED({left}, {right}, {how})"]
+                    (f"{pad}{v} = {left} {op} {right} if {v} is int or {v} is float "
+                     f"else ORDERED({left}, {right}, {how})")]
         t = self.local()
         return [f"{pad}{v} = type({left})", f"{pad}{t} = type({right})",
-                f"{pad}if (({v} is int or {v} is float) and ({t} is int or {t} is float)) "
-                f"or ({v} is str and {t} is str):",
+                (f"{pad}if (({v} is int or {v} is float) and ({t} is int or {t} is float)) "
+                 f"or ({v} is str and {t} is str):"),
                 f"{pad}    {v} = {left} {op} {right}",
                 f"{pad}else:",
                 f"{pad}    {v} = ORDERED({left}, {right}, {how})"]

@@ -20,9 +20,9 @@ from opspec.model.functions import FUNCTIONS
 
 __all__ = [
     "ARITHMETIC",
-    "NUMBERS",
     "FAST_ORDERING",
     "IMPLEMENTATIONS",
+    "NUMBERS",
     "TIME_HELPERS",
     "ConditionProblem",
     "as_number",

@@ -43,6 +43,7 @@ import types
 from collections.abc import Callable, Mapping
 from typing import Any, Final
 
+from opspec.engine.condition_code import generate
 from opspec.engine.condition_values import (
     ARITHMETIC,
     FAST_ORDERING,
@@ -57,7 +58,6 @@ from opspec.engine.condition_values import (
     ordered,
     truthy,
 )
-from opspec.engine.condition_code import generate
 from opspec.errors import ExecutionError, SourceLocation
 from opspec.model.expression_text import to_text
 from opspec.model.expressions import Binary, Call, Expression, Literal, Name, Unary
@@ -194,7 +194,7 @@ def compile_expression(
         # a constant cannot fail: no wrapper (an assignment of a constant is common, and
         # from source each closure level is a Python call)
         value = expr.value
-        constant = lambda data, now: value  # noqa: E731
+        constant = lambda data, now: value
         if not COMPILED:    # the plans write the value where they would call this
             constant.opspec_constant = (value,)  # type: ignore[attr-defined]
         return constant

@@ -62,7 +62,8 @@ def result(run: Callable[[], Any]) -> tuple[str, Any, Any]:
 def agree(expr: Expression, data: Any, now: float = 0.0) -> tuple[str, Any, Any]:
     for condition in (True, False):
         written, nested = both(expr, condition=condition)
-        got, want = result(lambda: written(data, now)), result(lambda: nested(data, now))
+        got = result(lambda fn=written: fn(data, now))  # type: ignore[misc]
+        want = result(lambda fn=nested: fn(data, now))  # type: ignore[misc]
         if want[0] == "value" and isinstance(want[1], float) and math.isnan(want[1]):
             assert got[0] == "value" and math.isnan(got[1]), (got, want)
         else:
@@ -188,11 +189,11 @@ def test_evaluation_order_is_left_to_right_and_short_circuits() -> None:
 def test_random_trees_agree_with_the_closures(expr: Expression, data: dict[str, Any],
                                               now: float) -> None:
     for make in (conditions.compile_condition, conditions.compile_expression):
-        written = outcome(lambda: make(expr)(data, now))
+        written = outcome(lambda make=make: make(expr)(data, now))  # type: ignore[misc]
         saved = conditions.COMPILED
         conditions.COMPILED = True      # type: ignore[misc]
         try:
-            nested = outcome(lambda: make(expr)(data, now))
+            nested = outcome(lambda make=make: make(expr)(data, now))  # type: ignore[misc]
         finally:
             conditions.COMPILED = saved  # type: ignore[misc]
         assert written[0] == nested[0], (written, nested)
