@@ -369,12 +369,12 @@ class Activities(Part):
         self._complete(ai)
 
     def _complete(self, ai: ActivityInstance) -> None:
-        # the completion of every activity instance: ActivityInstance.leave's steps in line
-        ai.state = COMPLETED
+        ai.state = COMPLETED    # every activity's completion: ActivityInstance.leave in line
         ai.gen += 1
         frame = ai.frame
-        if ai.key in frame.running:
-            del frame.running[ai.key]
+        key: object = ai.key                # (boxed once: see ActivityInstance.leave)
+        if key in frame.running:
+            del frame.running[key]
         if ai.cleanup:
             ai.undo_waits()
         if ai.mi is not None:

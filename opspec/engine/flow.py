@@ -145,8 +145,9 @@ class Flow(Part):
         inst.frames.clear()          # breaks the instance <-> frame cycle: freed by refcount
         state = self.state
         live = state.live            # RunState.gone, in line
-        if inst.id in live:
-            del live[inst.id]
+        key: object = inst.id        # (boxed once: see ActivityInstance.leave)
+        if key in live:
+            del live[key]
         if state.kept and inst.parent is None:
             self.triggers.drop_kept(inst)
         state.completed += 1
