@@ -65,7 +65,8 @@ class Flow(Part):
             local.update(data)
         scope: MutableMapping[str, Any] = (
             Scope(local, state.package_data) if state.package_data else local)
-        iid = state.next_id()
+        state.last_id += 1                    # RunState.next_id, in line
+        iid = state.last_id
         priority = proc.priority
         if parent is None:
             inst = ProcessInstance(iid, proc, local, scope, priority, None, iid, state.now)
