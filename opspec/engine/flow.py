@@ -65,7 +65,7 @@ class Flow(Part):
             local.update(data)
         scope: MutableMapping[str, Any] = (
             Scope(local, state.package_data) if state.package_data else local)
-        state.last_id += 1                    # RunState.next_id, in line
+        state.last_id += 1                    # the next instance id (RunState.last_id)
         iid = state.last_id
         priority = proc.priority
         if parent is None:
