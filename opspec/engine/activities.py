@@ -140,7 +140,8 @@ class Activities(Part):
     def start_slow(self, frame: Frame, act: CompiledActivity) -> None:
         """Start ``act``, which waits or takes time: as an activity instance."""
         state = self.state
-        ai = ActivityInstance(state.next_key(), act, frame, state.now)
+        state.last_key += 1                   # RunState.next_key, in line
+        ai = ActivityInstance(state.last_key, act, frame, state.now)
         ai.state = RUNNING
         frame.running[ai.key] = ai
         if act.plain and not (act.general and state.pooled):
@@ -369,12 +370,12 @@ class Activities(Part):
         self._complete(ai)
 
     def _complete(self, ai: ActivityInstance) -> None:
-        # the completion of every activity instance: ActivityInstance.leave's steps in line
-        ai.state = COMPLETED
+        ai.state = COMPLETED    # every activity's completion: ActivityInstance.leave in line
         ai.gen += 1
         frame = ai.frame
-        if ai.key in frame.running:
-            del frame.running[ai.key]
+        key: object = ai.key                # (boxed once: see ActivityInstance.leave)
+        if key in frame.running:
+            del frame.running[key]
         if ai.cleanup:
             ai.undo_waits()
         if ai.mi is not None:
@@ -577,8 +578,7 @@ class Activities(Part):
                     self.state.pullers.setdefault(channel, deque()).append(ai)
                 return
             else:
-                # at once: if the new mode ends this very instance, nothing after the mode
-                # change may run (its completion included)
+                # at once: a mode ending this instance stops all after it (its completion too)
                 self.triggers.change_mode(spec.target_mode or "", act, ai.frame.inst)
                 self.body_done(ai, None)
                 return

@@ -65,7 +65,8 @@ class Flow(Part):
             local.update(data)
         scope: MutableMapping[str, Any] = (
             Scope(local, state.package_data) if state.package_data else local)
-        iid = state.next_id()
+        state.last_id += 1                    # the next instance id (RunState.last_id)
+        iid = state.last_id
         priority = proc.priority
         if parent is None:
             inst = ProcessInstance(iid, proc, local, scope, priority, None, iid, state.now)
@@ -145,8 +146,9 @@ class Flow(Part):
         inst.frames.clear()          # breaks the instance <-> frame cycle: freed by refcount
         state = self.state
         live = state.live            # RunState.gone, in line
-        if inst.id in live:
-            del live[inst.id]
+        key: object = inst.id        # (boxed once: see ActivityInstance.leave)
+        if key in live:
+            del live[key]
         if state.kept and inst.parent is None:
             self.triggers.drop_kept(inst)
         state.completed += 1

@@ -178,9 +178,11 @@ class ActivityInstance:
         self.state = state
         self.gen += 1
         # (``in`` and ``del``, not ``pop(key, None)``: compiled, a dict's pop is a Python
-        # method call, the others are primitives)
+        # method call, the others are primitives; the key is boxed once, as an ``object``:
+        # compiled, an ``int`` field is a C integer, and each use as a dictionary key would
+        # make a new Python int that the dictionary compares by value, not by identity)
         running = self.frame.running
-        key = self.key
+        key: object = self.key
         if key in running:
             del running[key]
         if self.cleanup:

@@ -85,11 +85,11 @@ class RunState(Timers):
         self.ready: list[tuple[Any, Any, Any, Any]] = []
         self.draining = False
         self.pending: dict[Frame, None] = {}
-        self.ids = itertools.count(1)
-        self.keys = itertools.count(1)
-        # next(count) bound once: the compiled engine looks ``next`` up in builtins at each call
-        self.next_id: Callable[[], int] = self.ids.__next__
-        self.next_key: Callable[[], int] = self.keys.__next__
+        # the last workflow instance id (Flow.start_process counts on) and the last key of an
+        # activity instance or a wait (next_key): native fields, where an itertools.count's
+        # ``__next__`` was a call through Python's protocol from compiled code (~230 instr.)
+        self.last_id = 0
+        self.last_key = 0
         self.live: dict[int, ProcessInstance] = {}
         # workflow instances started, completed, terminated, aborted (see :attr:`counts`)
         self.started = 0
@@ -258,7 +258,10 @@ class RunState(Timers):
                     fn(a, b, c)
                     if done >= _COMPACT:        # a long burst: drop what has run
                         break
-                del ready[:done]
+                if done == len(ready):          # (compiled, a slice's delete boxes its
+                    ready.clear()               # bounds into a slice object: 0.3k an instance)
+                else:
+                    del ready[:done]
                 done = 0
                 if ready:                       # the burst broke off: go on with the rest
                     continue
@@ -370,6 +373,11 @@ class RunState(Timers):
                 self.drain()
         finally:
             self.inside = outer
+
+    def next_key(self) -> int:
+        """A new key of an activity instance or a wait (1, 2, …)."""
+        self.last_key += 1
+        return self.last_key
 
     def start_counted(self, inst: ProcessInstance) -> None:
         """A workflow instance was started: past

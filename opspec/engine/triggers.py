@@ -61,7 +61,7 @@ class Triggers(Part):
             table = self.state.waiters.get(key)
             if table is None:
                 table = self.state.waiters[key] = {}
-            token = next(self.state.keys)
+            token = self.state.next_key()
             table[token] = (ai, handler, (arg, persistent, key, token))
             ai.on_leave(lambda: discard(table, token))
         elif kind in ("timer", "period"):
