@@ -87,27 +87,36 @@ def test_exporting_many_cases_keeps_memory_flat(
     after 3,100 is the same up to 16 bytes a case (holding each case's name alone would be
     about 60), and no case costs more at its peak than the first hundred did (the file
     buffer and caches do not grow with the number of cases). Two sizes show the growth as
-    well as 10,000 cases did, for a third of the traced allocations."""
+    well as 10,000 cases did, for a third of the traced allocations.
+
+    The peaks are taken per hundred cases, and the largest is left out: tracemalloc counts
+    every thread of the process, and a pytest-xdist worker's messaging thread once
+    allocated 350 KB within one such window (a buffer that grew with the cases would raise
+    every window after it, not one)."""
     # the user's part of a dispensing dose: prompts and completions; 6 events a case
     template = [e for e in dispenser_day if e.lane == "user" or e.kind ==
                 EventKind.DEADLINE_EXPIRED][:6]
     path = tmp_path / "traces.out"
     held: dict[int, int] = {}
-    peaks: dict[int, int] = {}
+    peaks: list[int] = []                    # per hundred cases
     tracemalloc.start()
     try:
         with writer_class(path) as writer:
             for case in range(3_100):
                 writer.add_case(f"user-{case}", synthetic_case(template, case), {"user": case})
-                if case + 1 in (100, 1_100, 3_100):
-                    held[case + 1], peaks[case + 1] = tracemalloc.get_traced_memory()
+                if (case + 1) % 100 == 0:
+                    now, peak = tracemalloc.get_traced_memory()
+                    peaks.append(peak)
                     tracemalloc.reset_peak()
+                    if case + 1 in (1_100, 3_100):
+                        held[case + 1] = now
     finally:
         tracemalloc.stop()
     assert writer.cases == 3_100
     growth = held[3_100] - held[1_100]
     assert growth < 16 * 2_000, (held, growth)
-    assert max(peaks[1_100], peaks[3_100]) < 2 * peaks[100] + 64 * 1024, peaks
+    first, later = peaks[0], sorted(peaks[1:])[:-1]
+    assert max(later) < 2 * first + 64 * 1024, peaks
     with path.open(encoding="utf-8") as handle:
         if writer_class is XesWriter:
             assert sum(1 for line in handle if line.strip() == "<trace>") == 3_100
