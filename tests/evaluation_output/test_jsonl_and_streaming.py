@@ -90,9 +90,9 @@ def test_exporting_many_cases_keeps_memory_flat(
     well as 10,000 cases did, for a third of the traced allocations.
 
     The peaks are taken per hundred cases, and the largest is left out: tracemalloc counts
-    every thread of the process, and a pytest-xdist worker's messaging thread once
-    allocated 350 KB within one such window (a buffer that grew with the cases would raise
-    every window after it, not one)."""
+    every thread of the process (a pytest-xdist worker runs a messaging thread beside the
+    test), and one clean CI run saw 350 KB more within one such window, not reproduced since
+    (a buffer that grew with the cases would raise every window after it, not one)."""
     # the user's part of a dispensing dose: prompts and completions; 6 events a case
     template = [e for e in dispenser_day if e.lane == "user" or e.kind ==
                 EventKind.DEADLINE_EXPIRED][:6]
