@@ -270,7 +270,6 @@ def _written(expr: Expression, location: SourceLocation | None, *, condition: bo
     return generate(expr, fail, condition=condition)
 
 
-
 def _compile(expr: Expression) -> _Fn:
     if isinstance(expr, Literal):
         value = expr.value
