@@ -22,11 +22,9 @@ __all__ = [
     "ARITHMETIC",
     "FAST_ORDERING",
     "IMPLEMENTATIONS",
-    "NUMBERS",
     "TIME_HELPERS",
     "ConditionProblem",
     "as_number",
-    "bounded",
     "equal",
     "lookup",
     "missing_field",
@@ -180,7 +178,7 @@ MAX_INT_BITS = 1024
 _MAX_INT = 1 << MAX_INT_BITS
 
 
-def bounded(value: Any, op: str) -> Any:
+def _bounded(value: Any, op: str) -> Any:
     if type(value) is int and not -_MAX_INT < value < _MAX_INT:
         raise ConditionProblem(
             f"the integer {op} makes has more than {MAX_INT_BITS} bits: a value that grows "
@@ -189,8 +187,8 @@ def bounded(value: Any, op: str) -> Any:
 
 
 def _add(a: Any, b: Any) -> Any:
-    if type(a) in NUMBERS and type(b) in NUMBERS:     # the common case, first
-        return bounded(a + b, "'+'")
+    if type(a) in _NUMBERS and type(b) in _NUMBERS:     # the common case, first
+        return _bounded(a + b, "'+'")
     if isinstance(a, str) or isinstance(b, str):
         x, y = _text(a), _text(b)
         if len(x) + len(y) > MAX_TEXT:
@@ -201,27 +199,27 @@ def _add(a: Any, b: Any) -> Any:
         return x + y
     if isinstance(a, _VECTORS) or isinstance(b, _VECTORS):
         return _elementwise(a, b, "+", operator.add, scalar=False)
-    return bounded(as_number(a, "'+'") + as_number(b, "'+'"), "'+'")
+    return _bounded(as_number(a, "'+'") + as_number(b, "'+'"), "'+'")
 
 
 def _subtract(a: Any, b: Any) -> Any:
-    if type(a) in NUMBERS and type(b) in NUMBERS:
-        return bounded(a - b, "'-'")
+    if type(a) in _NUMBERS and type(b) in _NUMBERS:
+        return _bounded(a - b, "'-'")
     if isinstance(a, _VECTORS) or isinstance(b, _VECTORS):
         return _elementwise(a, b, "-", operator.sub, scalar=False)
-    return bounded(as_number(a, "'-'") - as_number(b, "'-'"), "'-'")
+    return _bounded(as_number(a, "'-'") - as_number(b, "'-'"), "'-'")
 
 
 def _multiply(a: Any, b: Any) -> Any:
-    if type(a) in NUMBERS and type(b) in NUMBERS:
-        return bounded(a * b, "'*'")
+    if type(a) in _NUMBERS and type(b) in _NUMBERS:
+        return _bounded(a * b, "'*'")
     if isinstance(a, _VECTORS) or isinstance(b, _VECTORS):
         return _elementwise(a, b, "*", operator.mul, scalar=True)
-    return bounded(as_number(a, "'*'") * as_number(b, "'*'"), "'*'")
+    return _bounded(as_number(a, "'*'") * as_number(b, "'*'"), "'*'")
 
 
 _VECTORS = (tuple, list)
-NUMBERS = frozenset({int, float, bool})
+_NUMBERS = frozenset({int, float, bool})
 
 
 def _elementwise(a: Any, b: Any, op: str, fn: Callable[[Any, Any], Any], *,

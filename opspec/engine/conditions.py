@@ -43,7 +43,6 @@ import types
 from collections.abc import Callable, Mapping
 from typing import Any, Final
 
-from opspec.engine.condition_code import generate
 from opspec.engine.condition_values import (
     ARITHMETIC,
     FAST_ORDERING,
@@ -202,9 +201,6 @@ def compile_expression(
         inner = _compile(expr)
     except ConditionProblem as problem:
         raise _fail(expr, problem, location, None) from None
-    written = _written(expr, location, condition=False)
-    if written is not None:
-        return written
 
     def run(data: Mapping[str, Any], now: float) -> Any:
         try:
@@ -233,9 +229,6 @@ def compile_condition(
         inner = _compile(expr)
     except ConditionProblem as problem:
         raise _fail(expr, problem, location, None) from None
-    written = _written(expr, location, condition=True)
-    if written is not None:
-        return written
 
     # (one closure, not compile_expression's wrapped in another: a call between compiled
     # closures goes through Python's calling convention)
@@ -251,23 +244,9 @@ def compile_condition(
 
 _Fn = Callable[[Mapping[str, Any], float], Any]
 
-#: whether this module runs compiled (mypyc): its closures are then native code, faster than
-#: a generated Python function (measured, docs/engine-performance.md), so none is written
+#: whether this module runs compiled (mypyc): a constant's closure is then native code and
+#: the plans keep calling it (see :func:`constant_value`)
 COMPILED: Final = not isinstance(_fail, types.FunctionType)
-
-
-def _written(expr: Expression, location: SourceLocation | None, *, condition: bool
-             ) -> _Fn | None:
-    """From source, ``expr`` as one generated Python function (:mod:`.condition_code`:
-    the closures' meaning, one Python call instead of one per node); ``None`` when compiled
-    or where the tree is too deep to write out."""
-    if COMPILED:
-        return None
-
-    def fail(problem: BaseException, now: float) -> ExecutionError:
-        return _fail(expr, problem, location, now)
-
-    return generate(expr, fail, condition=condition)
 
 
 def _compile(expr: Expression) -> _Fn:
