@@ -58,6 +58,7 @@ MODULES: tuple[str, ...] = (
     "opspec.engine.simulation",
     "opspec.engine.timers",
     "opspec.engine.timing",
+    "opspec.engine.tools",
     "opspec.engine.triggers",
     "opspec.engine.workitem",
     "opspec.usermodels.performer",

@@ -16,7 +16,7 @@ from collections.abc import Callable, Mapping
 from typing import TYPE_CHECKING, Any, Final
 
 from opspec.engine import coordination as coord
-from opspec.engine import multi_instance
+from opspec.engine import multi_instance, tools
 from opspec.engine.compiled import (
     K_ASYNC,
     K_BLOCK,
@@ -32,7 +32,6 @@ from opspec.engine.compiled import (
 from opspec.engine.instances import ActivityInstance, Frame, MultiInstance, ProcessInstance
 from opspec.engine.lifecycle import ABORTED, COMPLETED, RUNNING, SUSPENDED, TERMINATED
 from opspec.engine.part import Part
-from opspec.engine.runstate import discard
 from opspec.engine.trace import EventKind as EK
 from opspec.errors import OpspecError
 from opspec.model import CoordinationKind, ParameterMode
@@ -279,7 +278,7 @@ class Activities(Part):
         kind = act.kind
         inst = ai.frame.inst
         if kind == K_TASK and act.toolchain:
-            self._run_tools(ai, 0)
+            tools.run(self, ai, 0)
         elif kind == K_MANUAL or (kind == K_TASK and act.application in self.state.apps):
             performer = (self.state.apps[act.application or ""] if kind == K_TASK
                          else self.offers.performer_for(act))
@@ -290,7 +289,7 @@ class Activities(Part):
                 return
             data: Mapping[str, Any] | None = None
             if act.params:
-                data = self._inputs(ai)
+                data = self.inputs(ai)
                 if data is None:
                     return
             duration = None
@@ -298,7 +297,7 @@ class Activities(Part):
                 duration = act.sampler(self.state.streams.stream(f"{act.process}/{act.id}"))
             self.offers.offer(ai, performer, (), data, duration)
         elif kind == K_SUBFLOW or kind == K_ASYNC:
-            data = self._inputs(ai)
+            data = self.inputs(ai)
             if data is None:
                 return
             target = self.state.processes[act.subflow]  # type: ignore[index]
@@ -402,7 +401,7 @@ class Activities(Part):
             else:
                 self.start_slow(frame, target)
 
-    def _inputs(self, ai: ActivityInstance,
+    def inputs(self, ai: ActivityInstance,
                 params: tuple[tuple[ParameterMode, str, Any, str | None], ...] | None = None
                 ) -> dict[str, Any] | None:
         """The actual parameters' values by formal (``params``: a tool's; by default the
@@ -419,71 +418,10 @@ class Activities(Part):
             return None
         return out
 
-    def _run_tools(self, ai: ActivityInstance, index: int) -> None:
-        """Run the task's tools from ``index`` on, in order (XPDL: every ``Tool`` of the
-        activity). A tool whose application is bound to a performer is offered to it as a
-        work item, and the next tool runs when that completes; a script tool runs its
-        statements; any other tool completes at once. The body is done after the last."""
-        act = ai.act
-        tools = act.tools
-        while index < len(tools):
-            tool = tools[index]
-            performer = self.state.apps.get(tool.application)
-            if performer is not None:
-                data = self._inputs(ai, tool.params)
-                if data is None:
-                    return
-                key = ai.key
-                if key not in self.state.tool_at:
-                    table = self.state.tool_at
-                    ai.on_leave(lambda: discard(table, key))  # noqa: B023 - returns below
-                self.state.tool_at[key] = index
-                self.offers.offer(ai, performer, (), data, None, tool.application)
-                return
-            if tool.script is not None and not self._run_script(ai, tool.application,
-                                                                tool.params, tool.script):
-                return
-            index += 1
-        self.state.ready.append((self.body_done_q, ai, None, None))
-
     def tool_done(self, ai: ActivityInstance, data: Mapping[str, Any] | None,
                    _unused: Any = None) -> None:
-        """The performer of one tool completed: its outputs, then the next tool."""
-        if ai.state != RUNNING:
-            return
-        inst = ai.frame.inst
-        if inst.state == SUSPENDED:
-            inst.defer((self.tool_done, ai, data, None))
-            return
-        index = self.state.tool_at.pop(ai.key, 0)
-        if data:
-            for key, value in self.outputs(ai, data, ai.act.tools[index].params).items():
-                self.flow.set_field(inst, ai.act, key, value)
-        self._run_tools(ai, index + 1)
-
-    def _run_script(self, ai: ActivityInstance, application: str,
-                    params: tuple[tuple[ParameterMode, str, Any, str | None], ...],
-                    script: tuple[tuple[str, Any], ...]) -> bool:
-        """A script tool agent's application, run as a built-in: IN/INOUT formals take the
-        actual parameters' values (OUT formals start unset), the statements run in order,
-        OUT/INOUT formals are written back to the actual parameters' data fields."""
-        inst = ai.frame.inst
-        now = self.state.now
-        local: dict[str, Any] = {}
-        reads = ai.scope()
-        try:
-            for _mode, formal, fn, _target in params:
-                local[formal] = fn(reads, now) if fn is not None else None
-            for variable, fn in script:
-                local[variable] = fn(local, now)
-        except OpspecError as error:
-            self.fail(ai, "script", f"the script of application {application!r} failed: "
-                       f"{error.message}")
-            return False
-        for mode, formal, _fn, target in params:
-            if mode is not ParameterMode.IN and target is not None:
-                self.flow.set_field(inst, ai.act, target, local.get(formal))
-        return True
+        """The performer of one tool completed (a ready-queue item): :func:`tools.done`."""
+        tools.done(self, ai, data)
 
     def fail(self, ai: ActivityInstance, exception: str, message: str) -> None:
         act = ai.act
@@ -526,24 +464,6 @@ class Activities(Part):
         for queue in self.state.pullers.values():
             if ai in queue:
                 queue.remove(ai)
-
-    def outputs(self, ai: ActivityInstance, data: Mapping[str, Any],
-                 params: tuple[tuple[ParameterMode, str, Any, str | None], ...] | None = None
-                 ) -> dict[str, Any]:
-        """Map a performer's results (by formal parameter id) onto the actual data fields;
-        keys that are not formal parameters are taken as data field names."""
-        out: dict[str, Any] = {}
-        if params is None:
-            params = ai.act.params
-        formal_to_target = {f: t for mode, f, _fn, t in params
-                            if mode is not ParameterMode.IN and t is not None}
-        inputs_only = {f for mode, f, _fn, _t in params if mode is ParameterMode.IN}
-        for key, value in data.items():
-            if key in formal_to_target:
-                out[formal_to_target[key]] = value
-            elif key not in inputs_only:
-                out[key] = value
-        return out
 
     def _coordinate(self, ai: ActivityInstance) -> None:
         act = ai.act

@@ -13,6 +13,7 @@ from collections.abc import Callable, Mapping
 from types import MappingProxyType
 from typing import TYPE_CHECKING, Any, Final
 
+from opspec.engine import tools
 from opspec.engine.compiled import (
     K_CATCH,
     K_GATEWAY,
@@ -220,7 +221,7 @@ class Offers(Part):
             state.ready.append((self.activities.tool_done, ai, data, None))
         elif data:
             if act.params:
-                data = self.activities.outputs(ai, data)
+                data = tools.outputs(ai, data)
             state.ready.append((self.activities.body_done_q, ai, data, None))
         else:
             state.ready.append((self.activities.body_done_q, ai, None, None))
