@@ -86,7 +86,6 @@ class Inert:
     include_elements: bool = True
 
 
-
 def entry(key: str, namespace: str, elements: str, attribute: str | None, kind: Kind, text: str,
           section: str, when: str | None = None, reported_by: tuple[str, ...] = (),
           hint: str = "") -> Construct:
