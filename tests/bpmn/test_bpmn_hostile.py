@@ -160,7 +160,7 @@ def test_unknown_elements_are_reported_at_their_line_with_what_happens(tmp_path:
         found[(5, "unsupported-element")].message
     assert "not a BPMN element; opspec ignores it" in found[(6, "unknown-element")].message
     # an event sub-process is refused at its line, never ignored while the rest runs
-    # (issue 32: opspec/xpdl/constructs.py, bpmn-event-sub-process)
+    # (issue 32: opspec/xpdl/constructs_bpmn.py, bpmn-event-sub-process)
     assert found[(7, "not-run")].severity.value == "error"
     unknown = found[(10, "unknown-directive")]
     assert "opspec:Perod" in unknown.message and "opspec:Duration" in unknown.hint

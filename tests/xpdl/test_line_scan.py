@@ -6,7 +6,8 @@ from __future__ import annotations
 
 import pytest
 
-from opspec.xpdl.reader import _byte_scan_lines, _expat_lines, read_tree
+from opspec.xpdl.read_lines import _byte_scan_lines, _expat_lines
+from opspec.xpdl.reader import read_tree
 
 NS = "http://www.wfmc.org/2008/XPDL2.1"
 

@@ -1,0 +1,60 @@
+"""Which encoding a specification file is in: the one its XML declaration names, ``ASCII``
+declarations on files that really hold UTF-8 (read as UTF-8, which loses nothing), and the
+warning given when a file that is not valid UTF-8 and declares nothing else is read as
+Latin-1 (it names the line and value of the first byte that is not UTF-8).
+"""
+
+from __future__ import annotations
+
+import re
+from typing import Final
+
+from lxml import etree
+
+from opspec.errors import Diagnostic, Severity, SourceLocation
+
+__all__ = ["ASCII_NAMES", "declared_encoding", "encoding_warning", "is_encoding_error"]
+
+_DECLARED_ENCODING = re.compile(rb"""^\s*<\?xml[^>]*?encoding\s*=\s*["']([A-Za-z0-9._-]+)["']""")
+ASCII_NAMES: Final = frozenset({"ascii", "us-ascii", "ansi_x3.4-1968", "iso646-us", "us"})
+
+
+def declared_encoding(data: bytes) -> str | None:
+    match = _DECLARED_ENCODING.match(data.removeprefix(b"\xef\xbb\xbf")[:512])
+    return match.group(1).decode("ascii").lower() if match else None
+
+
+def is_encoding_error(error: etree.XMLSyntaxError) -> bool:
+    text = str(error).lower()
+    return "encoding" in text or "utf-8" in text or "char 0x" in text
+
+
+def _first_bad_utf8(data: bytes) -> tuple[int, int] | None:
+    """The 1-based line and the value of the first byte that is not valid UTF-8."""
+    try:
+        data.decode("utf-8")
+    except UnicodeDecodeError as error:
+        return data.count(b"\n", 0, error.start) + 1, data[error.start]
+    return None
+
+
+def encoding_warning(data: bytes, path: str, declared: str | None, line: int | None
+                     ) -> Diagnostic:
+    bad = _first_bad_utf8(data)
+    where = f" (line {bad[0]}: byte 0x{bad[1]:02X})" if bad else ""
+    if bad:
+        line = bad[0]
+    if declared == "utf-8":
+        message = (f"the file declares UTF-8 but is not valid UTF-8{where}; read it as Latin-1")
+        hint = ("save the file as UTF-8, or make its XML declaration name the encoding it "
+                "really uses (e.g. encoding=\"ISO-8859-1\")")
+    elif declared in ASCII_NAMES:
+        message = (f"the file declares {declared.upper()} but holds bytes that are neither "
+                   f"ASCII nor UTF-8{where}; read it as Latin-1")
+        hint = "add an XML declaration naming the real encoding, or save the file as UTF-8"
+    else:
+        message = (f"the file is not valid UTF-8{where} and declares no other encoding; "
+                   "read it as Latin-1")
+        hint = "add an XML declaration naming the real encoding, or save the file as UTF-8"
+    return Diagnostic(SourceLocation(path, line), Severity.WARNING, "encoding-guessed",
+                      message, hint)

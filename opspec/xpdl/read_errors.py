@@ -1,0 +1,77 @@
+"""The reader's fatal errors: :class:`XmlReadError` (a :class:`~opspec.errors.SpecError` with
+a stable ``code`` and the file:line where the problem was found), and what the parse failures
+say: a DOCTYPE refused, XML that is not well-formed, or a well-formed file beyond one of
+libxml2's safety limits (with advice for the spec's author, not "fix the syntax").
+"""
+
+from __future__ import annotations
+
+import re
+from typing import Final
+
+from lxml import etree
+
+from opspec.errors import Diagnostic, Severity, SourceLocation, SpecError
+
+__all__ = ["XmlReadError", "doctype_error", "not_well_formed_error"]
+
+
+class XmlReadError(SpecError):
+    """A file cannot be read as XPDL at all. ``code`` is one of ``io-error``, ``too-big``,
+    ``empty-file``, ``not-well-formed``, ``resource-limit``, ``doctype``, ``unknown-root``,
+    ``unknown-version``, ``compiled-script``, ``bad-setting``."""
+
+    def __init__(self, code: str, message: str, *, location: SourceLocation, hint: str = "") -> None:
+        self.code = code
+        super().__init__(message, location=location, hint=hint)
+
+    def diagnostic(self) -> Diagnostic:
+        location = self.location or SourceLocation("<unknown>")
+        return Diagnostic(location, Severity.ERROR, self.code, self.message, self.hint)
+
+
+def doctype_error(path: str, line: int | None) -> XmlReadError:
+    return XmlReadError(
+        "doctype",
+        "DOCTYPE declarations are not allowed in specifications",
+        location=SourceLocation(path, line),
+        hint="remove the <!DOCTYPE ...> line; XPDL needs no DTD, and DTDs can read local files "
+        "or expand entities without bound",
+    )
+
+
+# libxml2's safety limits (huge_tree=False) and what they mean for a spec's author: a
+# well-formed file can hit them, so "fix the XML syntax" would be the wrong advice.
+_LIMITS: Final = (
+    (re.compile(r"excessive depth", re.IGNORECASE),
+     "elements are nested more than 256 levels deep, the XML reader's limit",
+     ("XPDL needs a few dozen levels at most: flatten the deeply nested content, often "
+      "inside an ExtendedAttribute, or move it to a file of its own")),
+    (re.compile(r"buffer size limit|text node too long|too long|huge text", re.IGNORECASE),
+     "a text or attribute value is longer than the XML reader's limit of 10,000,000 characters",
+     ("keep bulk data out of the spec: put it in a file of its own and refer to it; a value "
+      "this long usually means a damaged or generated file")),
+    (re.compile(r"resource limit|huge input|amplification|memory allocation", re.IGNORECASE),
+     "the XML exceeds a resource limit of the XML reader",
+     "simplify the file: no spec needs anything this large; is it damaged or generated?"),
+)
+
+
+def _one_line(text: str) -> str:
+    return " ".join(text.split())
+
+
+def not_well_formed_error(path: str, error: etree.XMLSyntaxError) -> XmlReadError:
+    message = error.msg or str(error)
+    message = re.sub(r"\s*\(<string>, line \d+\)$", "", message)
+    for pattern, what, hint in _LIMITS:
+        if pattern.search(message):
+            return XmlReadError("resource-limit", what,
+                                location=SourceLocation(path, error.lineno or None), hint=hint)
+    message = _one_line(message)
+    return XmlReadError(
+        "not-well-formed",
+        f"not well-formed XML: {message}",
+        location=SourceLocation(path, error.lineno or None),
+        hint="fix the XML syntax at that line (an editor with XML checking shows it)",
+    )
