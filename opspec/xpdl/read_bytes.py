@@ -110,6 +110,6 @@ def too_big_error(path: str, max_bytes: int) -> XmlReadError:
         f"the file is larger than the limit of {max_bytes:,} bytes, so it was not read",
         location=SourceLocation(path, 1),
         hint="split the package into several files referenced as ExternalPackages, or raise "
-        f"raise the limit: set the environment variable {MAX_BYTES_VARIABLE} to a number of "
+        f"the limit: set the environment variable {MAX_BYTES_VARIABLE} to a number of "
         "bytes",
     )
