@@ -14,7 +14,7 @@ import pytest
 from PIL import Image
 
 from opspec.cli import main
-from opspec.evaluation import figure_files, plots
+from opspec.evaluation import figure_files
 
 ROOT = Path(__file__).resolve().parents[2]
 SPEC = ROOT / "specs" / "medication_dispenser.xpdl"
