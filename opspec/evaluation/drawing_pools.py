@@ -23,13 +23,13 @@ __all__ = ["drawing_processes", "staggered_start", "started_pools", "warm_up_the
 
 @contextmanager
 def drawing_processes(workers: int) -> Iterator[None]:
-    """Start up to ``workers`` drawing processes now, for the :func:`.figure_queue.drawn_by` blocks within
-    this one: each imports matplotlib (and loads its font) while this process still works
-    out what to draw. ``opspec evaluate --workers W`` starts them before its replications,
-    so that matplotlib is ready when the first figure is asked for: its import (0.3 CPU-s
-    in each process) shares the cores with the replications' chunks, which any core can
-    run, instead of delaying the figures after them. Nothing happens with one worker or
-    where processes cannot be forked.
+    """Start up to ``workers`` drawing processes now, for the :func:`.figure_queue.drawn_by`
+    blocks within this one: each imports matplotlib (and loads its font) while this process
+    still works out what to draw. ``opspec evaluate --workers W`` starts them before its
+    replications, so that matplotlib is ready when the first figure is asked for: its
+    import (0.3 CPU-s in each process) shares the cores with the replications' chunks, which
+    any core can run, instead of delaying the figures after them. Nothing happens with one
+    worker or where processes cannot be forked.
 
     Within :func:`staggered_start` only that many are forked now, the others when
     :func:`warm_up_the_rest` is called or the first figure is sent. A failure or Ctrl-C

@@ -56,8 +56,9 @@ class UserDistribution:
 def user_distribution(values: Sequence[float], scale: float = 1.0
                       ) -> UserDistribution | None:
     """The per-user figure's numbers of one metric's values (each user's own; None and the
-    non-finite values left out, as :func:`_finite` does) times ``scale``; None when none
-    is left. At most 30 distinct values are drawn as a bar each, more as a histogram."""
+    non-finite values left out, as :func:`.figure_style._finite` does) times ``scale``; None
+    when none is left. At most 30 distinct values are drawn as a bar each, more as a
+    histogram."""
     import numpy as np
 
     # numpy throughout (no list of float objects: 100,000 users' values)
