@@ -17,7 +17,7 @@ from pathlib import Path
 import pytest
 from conftest import SPEC
 
-from opspec.evaluation import plots
+from opspec.evaluation import drawing_pools, plots
 
 BAD_SPEC = """<?xml version="1.0" encoding="UTF-8"?>
 <Package xmlns="http://www.wfmc.org/2008/XPDL2.1" Id="p" Name="p">
@@ -46,7 +46,7 @@ def slow_drawing(monkeypatch: pytest.MonkeyPatch, tmp_path: Path) -> tuple[Path,
         asked.append(workers)
         return started(workers, **options)
 
-    monkeypatch.setattr(plots, "_import_matplotlib", slow_import)
+    monkeypatch.setattr(drawing_pools, "_import_matplotlib", slow_import)
     monkeypatch.setattr(plots, "drawing_processes", counted)
     return done, asked
 

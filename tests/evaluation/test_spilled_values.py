@@ -13,7 +13,7 @@ from pathlib import Path
 
 import pytest
 
-from opspec.evaluation import summary
+from opspec.evaluation import summary, values_per_user
 from opspec.evaluation.replication import ReplicationRecord
 from opspec.evaluation.runner import chunks, iter_chunks
 from opspec.evaluation.spilled import spill_user_values
@@ -53,7 +53,7 @@ def _store(folder: Path, users: int, seed: int) -> ResultStore:
 def test_summaries_from_disk_are_exactly_those_of_the_arrays(tmp_path, monkeypatch, users,
                                                              seed):
     store = _store(tmp_path / "run", users, seed)
-    monkeypatch.setattr(summary, "HELD_USERS", 0)   # spilled however few the users
+    monkeypatch.setattr(values_per_user, "HELD_USERS", 0)   # spilled however few the users
     from_disk = summary.summarise_design(store, "A", 7.0)
     activities = summary.summarise_activities(store, "A")
     # the same summaries with the values held in arrays (what a NaN falls back to)

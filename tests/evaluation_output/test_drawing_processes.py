@@ -9,7 +9,7 @@ from pathlib import Path
 import pytest
 
 from opspec.errors import EvaluationError
-from opspec.evaluation import plots
+from opspec.evaluation import figure_queue, plots
 
 from figure_samples import RATES
 from figure_samples import figures as _figures
@@ -24,7 +24,7 @@ def test_started_processes_draw_the_figures_drawn_one_after_another(
         def not_here(job: object) -> None:
             raise AssertionError("drawn outside the started processes")
 
-        monkeypatch.setattr(plots, "_draw_one", not_here)
+        monkeypatch.setattr(figure_queue, "_draw_one", not_here)
         with plots.drawn_by(2):
             together = _figures(tmp_path / "together")
             # sent to the started processes as asked for, drawn by the block's end
@@ -38,7 +38,7 @@ def test_a_figure_function_made_after_the_processes_started_is_still_drawn(
     user's own figure) is drawn all the same, and so are the others."""
     with plots.drawing_processes(2):
 
-        @plots._queueable
+        @figure_queue.queueable
         def dots_figure(values: list[float], path: Path) -> Path:
             return plots.rates_figure([("dots", *values)], path)
 

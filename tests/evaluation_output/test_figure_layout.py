@@ -16,7 +16,7 @@ from typing import Any
 
 import pytest
 
-from opspec.evaluation import plots
+from opspec.evaluation import figure_files, figure_style, plots
 
 LONG = "a_rather_long_activity_name_a_modeller_wrote_out_in_full"
 LONG_METRIC = "time_from_the_alarm_to_the_caregiver_being_notified_s"
@@ -86,14 +86,14 @@ def _overlap(a: Any, b: Any) -> float:
 def drawn(monkeypatch: pytest.MonkeyPatch) -> Iterator[list[Any]]:
     """The figures drawn in the test, kept after their function wrote them."""
     figures: list[Any] = []
-    save = plots._save
+    save = figure_files.save
 
     def keep(fig: Any, path: Path) -> Path:
         written = save(fig, path)
         figures.append(fig)
         return written
 
-    monkeypatch.setattr(plots, "_save", keep)
+    monkeypatch.setattr(figure_files, "save", keep)
     yield figures
 
 
@@ -225,8 +225,8 @@ def test_panels_share_the_figure_evenly() -> None:
 
     from opspec.evaluation.figure_layout import lay_out
 
-    with plots._figure(9.0, 6.0) as fig:
-        axes = plots._panels(fig, 3)
+    with figure_style._figure(9.0, 6.0) as fig:
+        axes = figure_style._panels(fig, 3)
         for ax in axes:
             ax.set_ylabel("count")
         axes[-1].set_xlabel("simulated day")
@@ -247,14 +247,14 @@ def test_a_figure_off_the_grid_is_left_to_the_constrained_layout() -> None:
     constrained layout instead, its texts inside the figure all the same."""
     from opspec.evaluation.figure_layout import lay_out
 
-    with plots._figure(6.0, 4.0) as fig:
+    with figure_style._figure(6.0, 4.0) as fig:
         ax = fig.add_subplot()
         ax.set_yticks([0.0, 1.0], ["none", LONG])
         ax.set_xlabel("simulated day")
         inset = fig.add_axes((0.6, 0.6, 0.3, 0.3))
         inset.set_title("inset")
         assert not lay_out(fig)
-        plots._lay_out(fig)
+        figure_files._lay_out(fig)
         laid, _ = _boxes(fig)
         width, height = fig.bbox.width, fig.bbox.height
         assert all(box.x0 >= -0.5 and box.x1 <= width + 0.5 and box.y0 >= -0.5

@@ -14,7 +14,7 @@ import pytest
 from PIL import Image
 
 from opspec.cli import main
-from opspec.evaluation import plots
+from opspec.evaluation import figure_files
 
 ROOT = Path(__file__).resolve().parents[2]
 SPEC = ROOT / "specs" / "medication_dispenser.xpdl"
@@ -63,13 +63,13 @@ def test_figures_carry_no_titles_and_label_axes_in_words(
     from opspec.evaluation.store import ResultStore
 
     drawn: dict[str, Any] = {}
-    original = plots._save
+    original = figure_files.save
 
     def keep(fig: Any, path: Path) -> Path:
         drawn[Path(path).stem] = fig
         return original(fig, path)
 
-    monkeypatch.setattr(plots, "_save", keep)
+    monkeypatch.setattr(figure_files, "save", keep)
     with ResultStore(run, create=False) as store:
         report.write_report(store)
     for name, fig in drawn.items():

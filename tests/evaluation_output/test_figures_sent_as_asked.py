@@ -10,7 +10,7 @@ from pathlib import Path
 import pytest
 
 from opspec.errors import EvaluationError
-from opspec.evaluation import plots
+from opspec.evaluation import figure_queue, plots
 
 RATES = [("doses missed", 0.0034, 0.001, 0.008), ("doses taken", 0.95, 0.93, 0.97)]
 HOURS = {"alarms": [h % 5 for h in range(24)]}
@@ -21,7 +21,7 @@ def test_a_figure_is_drawn_before_the_report_is_done_asking(tmp_path: Path) -> N
              plots.time_of_day_figure(HOURS, tmp_path / "alone" / "hours.svg")]
     with plots.drawing_processes(2), plots.drawn_by(2):
         first = plots.rates_figure(RATES, tmp_path / "sent" / "rates.svg")
-        sent = plots._SENT.get()
+        sent = figure_queue._SENT.get()
         assert sent is not None and list(sent) == [0]
         sent[0].result()                    # drawn by a started process, block still open
         assert first.is_file()
@@ -40,5 +40,5 @@ def test_a_sent_figure_that_cannot_be_written_is_a_plain_error(tmp_path: Path) -
 def test_without_started_processes_nothing_is_sent(tmp_path: Path) -> None:
     with plots.drawn_by(2):
         path = plots.rates_figure(RATES, tmp_path / "rates.svg")
-        assert plots._SENT.get() is None and not path.exists()
+        assert figure_queue._SENT.get() is None and not path.exists()
     assert path.is_file()

@@ -12,6 +12,7 @@ import pytest
 from opspec.cli import main
 from opspec.errors import EvaluationError
 from opspec.evaluation import report as report_module
+from opspec.evaluation import report_design
 from opspec.evaluation.describe import describe_metric, describe_selector
 from opspec.evaluation.store import ResultStore
 
@@ -126,7 +127,7 @@ def test_figures_draw_the_tables_numbers_and_say_when_they_sample(
         return original(metric, values, path, marks=marks, total=total, **words)
 
     monkeypatch.setattr(plots, "latency_figure", spy)
-    monkeypatch.setattr(report_module, "PLOT_SAMPLE", 50)
+    monkeypatch.setattr(report_design, "PLOT_SAMPLE", 50)
     with ResultStore(run, create=False) as store:
         from opspec.evaluation.summary import summarise_design
 

@@ -10,7 +10,7 @@ from pathlib import Path
 
 import pytest
 
-from opspec.evaluation import summary
+from opspec.evaluation import summary, values_per_user
 from opspec.evaluation.replication import ReplicationRecord
 from opspec.evaluation.spilled import BATCH, SpilledUsers
 from opspec.evaluation.store import ResultStore
@@ -32,13 +32,13 @@ def _store(folder: Path, users: int) -> ResultStore:
 
 
 def test_the_threshold_is_the_spills_batch() -> None:
-    assert summary.HELD_USERS == BATCH
+    assert values_per_user.HELD_USERS == BATCH
 
 
 @pytest.mark.parametrize(("users", "spilled"), [(6, False), (7, True)])
 def test_few_users_are_held_more_are_spilled_with_the_same_numbers(
         tmp_path: Path, monkeypatch: pytest.MonkeyPatch, users: int, spilled: bool) -> None:
-    monkeypatch.setattr(summary, "HELD_USERS", 6)
+    monkeypatch.setattr(values_per_user, "HELD_USERS", 6)
     store = _store(tmp_path / "run", users)
     values = summary.per_user_values(store, "A", DEFINITIONS)
     assert isinstance(values, SpilledUsers) is spilled
@@ -46,7 +46,7 @@ def test_few_users_are_held_more_are_spilled_with_the_same_numbers(
     assert summary.per_user_values(store, "A", DEFINITIONS) is values
     here = (summary.summarise_design(store, "A", 3.0),
             summary.summarise_activities(store, "A"))
-    monkeypatch.setattr(summary, "HELD_USERS", 0 if not spilled else 10**9)
+    monkeypatch.setattr(values_per_user, "HELD_USERS", 0 if not spilled else 10**9)
     store.add(ReplicationRecord("B", 0, "done", metrics={}))     # a new state of the store
     there = (summary.summarise_design(store, "A", 3.0),
              summary.summarise_activities(store, "A"))
