@@ -91,8 +91,12 @@ def main() -> None:
                 parts[name] = parts.get(name, 0.0) + cpu() - begin
         return run
 
-    if hasattr(plots, "_lay_out"):      # a tree before the measured layout: "all" only
-        plots._lay_out = timed("layout", plots._lay_out)
+    try:                                # where saving a figure calls the layout
+        from opspec.evaluation import figure_files as saving
+    except ImportError:                 # a tree before plots.py was split: plots' own
+        saving = plots
+    if hasattr(saving, "_lay_out"):     # a tree before the measured layout: "all" only
+        saving._lay_out = timed("layout", saving._lay_out)
     Figure.savefig = timed("drawing and writing", Figure.savefig)  # type: ignore[method-assign]
     least: dict[str, dict[str, float]] = {}
     with tempfile.TemporaryDirectory() as folder:

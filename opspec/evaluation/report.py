@@ -1,6 +1,6 @@
 """The evaluation report: ``report.html`` (self-contained, rendered from a Jinja2 template a
-researcher can replace) and ``report.md`` with PNG figures, built from the result store alone
-(so a resumed or re-reported run gives the same report).
+researcher can replace) and ``report.md`` with its figures (SVG by default, ``--figures``),
+built from the result store alone (so a resumed or re-reported run gives the same report).
 
 What a reader gets, in order: key findings in plain words (estimates with their intervals,
 hazards); what was run; what each metric measures (from which event to which event a

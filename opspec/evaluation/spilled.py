@@ -1,7 +1,7 @@
 """Each finished user's value of every metric, kept on disk rather than in memory, and read
 back a batch at a time for each pass of the summaries and the report (for many users; up to
-:data:`opspec.evaluation.summary.HELD_USERS` they are held in memory, where spilling saves
-nothing: ``summary.per_user_values`` and :func:`held_activities`).
+:data:`opspec.evaluation.values_per_user.HELD_USERS` they are held in memory, where spilling saves
+nothing: ``values_per_user.per_user_values`` and :func:`held_activities`).
 
 The summaries need every user's ``(y, n)`` pair of every metric (sums over users, the
 cluster-robust variance, the users with any) and percentiles of the users' own values. Held
@@ -19,7 +19,7 @@ order, as ``sorted`` gave them), and the statistics only iterate over them
 (``math.fsum`` is exactly rounded, ``statistics.stdev`` exact, plain sums run in the same
 order as before). A percentile reads its two order statistics through an index on the
 value. A NaN, which SQLite cannot store as a number, is left to the in-memory arrays
-(:func:`opspec.evaluation.summary.user_values`), whose results it already was.
+(:func:`opspec.evaluation.values_per_user.user_values`), whose results it already was.
 """
 
 from __future__ import annotations
@@ -147,7 +147,7 @@ def spill_user_values(store: ResultStore, design: str,
                       definitions: Sequence[Mapping[str, Any]],
                       users: set[int] | None = None) -> SpilledUsers | None:
     """Per finished user of ``design`` (of ``users`` only, when given), the ``(y, n)`` pair
-    of every metric in ``definitions`` (as :func:`opspec.evaluation.summary.user_values`
+    of every metric in ``definitions`` (as :func:`opspec.evaluation.values_per_user.user_values`
     reads them), written to temporary tables in one streamed reading of the users' stored
     metrics. None when a value is NaN (the caller then holds them in arrays)."""
     from opspec.evaluation.summary import pair_reader
