@@ -4,8 +4,8 @@
 events it needs (``selects``), and how it is judged — :meth:`Property.start` gives a
 :class:`MonitorRun`, the trace listener a monitor is while a run happens, and
 :meth:`Property.judge` feeds the same :class:`MonitorRun` a stored trace's events one by one.
-What a run finds is a :class:`MonitorResult`: its :class:`Violation` s, each with its witness
-(the events that show it), and the obligations the end of the run left open.
+What a run finds is a :class:`MonitorResult`: its violations (:class:`Violation`), each with
+its witness (the events that show it), and the obligations the end of the run left open.
 
 Each kind of property (:mod:`opspec.properties.occurrence`, :mod:`opspec.properties.order`)
 is a :class:`Property` subclass with its own :class:`MonitorRun`.

@@ -15,8 +15,9 @@ Estimated, per activity:
   same alternative, fixed probabilities otherwise, and the time a wrong pick costs
   (:mod:`opspec.usermodels.choice_estimates`);
 * busy: activities in progress in another instance when a prompt was omitted as ``busy``;
-* how much people differ (:mod:`opspec.usermodels.spread`): a person's own lognormal sigma
-  and omission rate when they do.
+* how much people differ (:mod:`opspec.usermodels.spread`), written as ``[vary]`` tables
+  (:meth:`~opspec.usermodels.fit_report.FitResult.vary`) when they do: a lognormal's sigma
+  is then a person's own, and the omission rate the mean of the persons' own rates.
 
 :func:`fit_traces` does it; what it says about each activity is
 :mod:`opspec.usermodels.fit_report`. The names of those modules stay importable from here.
