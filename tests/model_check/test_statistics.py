@@ -6,8 +6,9 @@ import numpy as np
 import pytest
 from scipy import stats
 
-from opspec.usermodels.checking import anderson_darling, check_rate, commission_counts
+from opspec.usermodels.duration_check import anderson_darling
 from opspec.usermodels.holm import holm_adjust
+from opspec.usermodels.rate_check import check_rate, commission_counts
 
 
 def test_holm_worked_example() -> None:
@@ -93,7 +94,7 @@ def test_a_groups_people_share_its_parameter_redraw() -> None:
     parameters"). Redraws at 5 % and 15 % of one rate for everyone: a group of ten people
     at 15 % each is one the model predicts half the time; mixing the redraws person by
     person instead would make every group's mean about 10 % and call it a misfit."""
-    from opspec.usermodels.checking import RateGroups
+    from opspec.usermodels.rate_check import RateGroups
 
     trials = {f"P{i}": 100 for i in range(10)}
     counts = {p: (15, n) for p, n in trials.items()}

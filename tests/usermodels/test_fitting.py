@@ -13,8 +13,9 @@ from opspec.engine.trace import EventKind, TraceEvent
 from opspec.errors import UserModelError
 from opspec.usermodels import ActivityModel, UserModel, load_user_model
 from opspec.usermodels.distributions import ExGaussian, LogNormal
+from opspec.usermodels.duration_family import fit_duration
 from opspec.usermodels.errors import Omission
-from opspec.usermodels.fitting import fit_duration, fit_traces
+from opspec.usermodels.fitting import fit_traces
 
 from .fakes import DispenserLane, FakeSession, make_item, write_trace
 
