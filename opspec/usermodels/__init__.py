@@ -9,7 +9,14 @@
 * :mod:`~opspec.usermodels.loader` - TOML files and bundled presets;
 * :mod:`~opspec.usermodels.scripts` - scripted users (exact actions: ``opspec run --script``,
   spec tests, a walkthrough's recording);
-* :mod:`~opspec.usermodels.fitting` - estimating a model from recorded traces.
+* :mod:`~opspec.usermodels.fitting` - estimating a model from recorded traces (read by
+  :mod:`~opspec.usermodels.trace_reader`, paired by :mod:`~opspec.usermodels.observations`,
+  fitted by :mod:`~opspec.usermodels.duration_family` and
+  :mod:`~opspec.usermodels.choice_estimates`, said by :mod:`~opspec.usermodels.fit_report`);
+* :mod:`~opspec.usermodels.checking` - checking a model against people it was not fitted on
+  (``opspec model-check``: :mod:`~opspec.usermodels.duration_check`,
+  :mod:`~opspec.usermodels.rate_check`, :mod:`~opspec.usermodels.predictive_people`,
+  :mod:`~opspec.usermodels.check_report`).
 
 The format is documented in ``docs/user-models.md``.
 """

@@ -215,7 +215,7 @@ def _rate(events: int, trials: int, rng: np.random.Generator | None) -> float:
 
 
 def _wrong_picks(picks: Sequence[Sequence[str]], intended: str) -> tuple[int, int]:
-    """(wrong picks, eligible offers) as :func:`~opspec.usermodels.fitting._choice_model`
+    """(wrong picks, eligible offers) as :func:`~opspec.usermodels.choice_estimates.choice_model`
     counts them: at most as many wrong picks per instance as the most seen in one."""
     wrong_counts = [sum(1 for c in seq if c != intended) for seq in picks]
     cap = max(wrong_counts, default=0)
@@ -229,7 +229,7 @@ def _values(target: _Target, data: _Data, rng: np.random.Generator | None = None
             ) -> dict[str, float] | None:
     """The parameters ``target`` gives on ``data`` (path -> value); None: cannot be fitted.
     With ``rng`` (observations resampled within persons) rates are posterior draws."""
-    from opspec.usermodels.fitting import _choice_model
+    from opspec.usermodels.choice_estimates import choice_model
 
     if target.kind == "duration":
         values = (data.by_pick.get(target.intended, []) if target.intended is not None
@@ -253,7 +253,7 @@ def _values(target: _Target, data: _Data, rng: np.random.Generator | None = None
             assert target.intended is not None
             wrong, eligible = _wrong_picks(data.picks, target.intended)
             return {target.prefix: _rate(wrong, eligible, rng)} if eligible else None
-        model = _choice_model(data.picks)
+        model = choice_model(data.picks)
         if model.get("intended") != target.intended:
             return None
         commission = model.get("commission")
