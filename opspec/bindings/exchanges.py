@@ -182,7 +182,7 @@ class Exchanges(BindingState):
             self._note(f"{self._label()}: event {name!r} ignored: no activity {complete!r} "
                        "was waiting for it")
 
-    # ------------------------------------------------------------------ faults
+    # ------------------------------------------------------------------ timeouts and the hold
     def _on_timeout(self, seq: int) -> None:
         job = self._inflight
         if job is None or job.seq != seq or self._connection == "closed":

@@ -165,6 +165,7 @@ class SessionClock(SessionState):
             self.sim.check_waiting(horizon=self.horizon)
         return True, steps
 
+    # ------------------------------------------------------------------ a call from the device
     @property
     def calling(self) -> bool:
         """Whether the device calls the person now: its alarm (or other signal to the

@@ -15,6 +15,7 @@ __all__ = ["PersonLane"]
 class PersonLane(SessionState):
     """The person's offers and actions in a :class:`~opspec.tui.session.WalkSession`."""
 
+    # ------------------------------------------------------------------ the offers
     def has_new_offers(self, since: int) -> bool:
         """Whether an offer made after the ``since``-th one is waiting for the person."""
         return any(self._seq_of.get(o.item.key, 0) > since for o in self.offers)
