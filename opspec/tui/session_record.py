@@ -1,0 +1,86 @@
+"""The recording of a walkthrough session: every action (the person's, or the model's while
+the lane is handed over) written at once to the recording, a script ``opspec run --script``
+replays, and every trace event to ``<recording>.trace.jsonl`` with how long the person took
+(for ``opspec fit``)."""
+
+from __future__ import annotations
+
+import json
+import os
+import time
+from pathlib import Path
+from typing import Any
+
+from opspec.engine.performers import WorkItem
+from opspec.errors import ConfigurationError
+from opspec.tui.session_state import SessionState
+
+__all__ = ["Recording"]
+
+
+class Recording(SessionState):
+    """The recording of a :class:`~opspec.tui.session.WalkSession`."""
+
+    def _open_record(self, record: str | Path | None, seed: int, spec_path: str,
+                     person: str | None) -> None:
+        """Start the recording (``None``: none) and its trace file, both written as the
+        session goes on."""
+        self.record_path = Path(record) if record is not None else None
+        self._steps = []
+        self._trace_file = None
+        if self.record_path is not None:
+            trace_path = self.record_path.with_suffix(".trace.jsonl")
+            try:
+                self.record_path.parent.mkdir(parents=True, exist_ok=True)
+                self._write_record()
+                from opspec.engine.trace_sinks import JsonlSink
+
+                header: dict[str, Any] = {"spec": spec_path, "seed": seed, "walkthrough": True}
+                if person is not None:
+                    # whose session this is: opspec fit counts a participant's sessions as
+                    # one person (docs/trace-format.md, "person")
+                    header["person"] = person
+                self._trace_file = JsonlSink(trace_path, header, flush_every=1)
+            except OSError as error:
+                raise ConfigurationError(
+                    f"cannot write the recording {self.record_path}: "
+                    f"{error.strerror or error}",
+                    hint="give --record a path in a folder you can write to, or --no-record"
+                ) from None
+
+    def _record(self, action: str, *, by: str, item: WorkItem | None = None,
+                label: str = "") -> None:
+        """Write ``action`` to the recording and the trace. For an offered ``item`` the trace
+        says how long the person took (``response_wall_s``, wall seconds since the offer
+        reached them) and whether the simulated duration is real (``usable``: the clock ran
+        in real time throughout; else ``why`` not), which ``opspec fit`` honours."""
+        self._steps.append([f"at {self.now!r}", action])
+        self._write_record()
+        data: dict[str, Any] = {"action": action, "by": by,
+                                "wall": time.time()}          # wall-clock: the record
+        if item is not None:
+            response = self.times.answered(item.key, self.now, by=by, paused=self._paused,
+                                           speed=self._speed)
+            data.update(instance=item.instance, activity=item.activity,
+                        **response.trace_data())
+            if by == "person":
+                self.responses.append(response.named(label or item.activity, self.now))
+                self._acted_in_call = self._in_call or self._acted_in_call
+                self.aftermath.acted(label or item.activity, item, self.now)
+        self.sim.session.trace("walkthrough.action", data)
+
+    def _write_record(self) -> None:
+        if self.record_path is None:
+            return
+        # one step per line: readable, and diffable between two sessions
+        steps = ",\n  ".join(json.dumps(step) for step in self._steps)
+        text = ('{"otherwise": "wait", "steps": [' + (f"\n  {steps}\n" if steps else "")
+                + "]}\n")
+        tmp = self.record_path.with_suffix(self.record_path.suffix + ".tmp")
+        tmp.write_text(text, encoding="utf-8")
+        os.replace(tmp, self.record_path)
+
+    def close(self) -> None:
+        if self._trace_file is not None:
+            self._trace_file.close()
+            self._trace_file = None
