@@ -70,8 +70,8 @@ __all__ = [
     "gate",
     "load",
     "open_gated",
-    "run_problem",
     "run_length",
+    "run_problem",
 ]
 
 # the rules of a run's numbers (the seed, the run length) are opspec.run_rules'; named here too

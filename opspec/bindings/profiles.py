@@ -22,7 +22,6 @@ from typing import Any, Final, Literal
 
 from opspec.bindings.templates import LineTemplate, TemplateError
 from opspec.errors import BindingError, SourceLocation
-from opspec.files import toml_load
 
 __all__ = [
     "PROFILE_FORMAT",

@@ -68,8 +68,8 @@ def register(subparsers: Any) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    from opspec.model.soundness import SoundnessReport, check_process
     from opspec.errors import Severity
+    from opspec.model.soundness import SoundnessReport, check_process
     from opspec.xpdl.gate import RUNS_DIFFERENTLY
     from opspec.xpdl.loader import load_package
     from opspec.xpdl.validate import IO_CODES, spec_files

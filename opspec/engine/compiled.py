@@ -25,7 +25,6 @@ from opspec.model import CoordinationBuiltIn, Package, ParameterMode
 from opspec.model.bulk import gc_paused
 
 __all__ = [
-    "FlagCache",
     "J_AND",
     "J_COMPLEX",
     "J_COUNT",
@@ -57,6 +56,7 @@ __all__ = [
     "CompiledPackage",
     "CompiledProcess",
     "Evaluator",
+    "FlagCache",
     "compile_package",
     "expand_selectors_over",
 ]

@@ -14,6 +14,7 @@ from collections import ChainMap
 from collections.abc import Callable, Mapping, MutableMapping
 from typing import TYPE_CHECKING, Any, Final
 
+from opspec.engine import drawing, escalations, joins, lone, process_deadlines
 from opspec.engine.compiled import (
     J_AND,
     J_COMPLEX,
@@ -24,7 +25,6 @@ from opspec.engine.compiled import (
     CompiledProcess,
     CTransition,
 )
-from opspec.engine import drawing, escalations, joins, lone, process_deadlines
 from opspec.engine.instances import ActivityInstance, Frame, ProcessInstance
 from opspec.engine.lifecycle import ABORTED, LIFECYCLE, RUNNING, STATE_NAMES, SUSPENDED, TERMINATED
 from opspec.engine.part import Part

@@ -102,13 +102,13 @@ class PooledProcessor:
         "activity_switch",
         "busy_time",
         "env",
-        "timer",
         "free",
         "is_alive",
         "max_waiting",
         "on_done",
         "queues",
         "switches",
+        "timer",
         "waiting",
     )
 

@@ -24,8 +24,15 @@ from typing import Any
 
 import numpy as np
 
-__all__ = ["DAY", "Columns", "object_rows", "outcome_columns", "sample_columns",
-           "columns_of_outcomes", "columns_of_samples"]
+__all__ = [
+    "DAY",
+    "Columns",
+    "columns_of_outcomes",
+    "columns_of_samples",
+    "object_rows",
+    "outcome_columns",
+    "sample_columns",
+]
 
 DAY = 86_400.0
 

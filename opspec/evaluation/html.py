@@ -83,7 +83,7 @@ _SVG_START = re.compile(r"<svg\b")
 def _figure(section: Section, index: int, image: Path) -> dict[str, object]:
     """What the template needs of one figure: an SVG's markup, to be inlined (vector, and
     its text stays searchable), or a PNG as a ``data:`` URI; the caption; the file name."""
-    import markupsafe   # jinja2's own
+    import markupsafe  # jinja2's own
 
     caption = _alt(section, index, image)
     if Path(image).suffix.lower() == ".svg":

@@ -8,7 +8,6 @@ docs/evaluation.md say about each id, so the four cannot tell different stories.
 from __future__ import annotations
 
 import re
-
 from collections.abc import Iterable, Mapping
 from dataclasses import dataclass
 from typing import Any

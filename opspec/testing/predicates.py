@@ -43,8 +43,8 @@ from typing import Any
 
 from opspec.engine.trace import TraceEvent
 from opspec.errors import ConfigurationError
-from opspec.properties.language import trace_end
 from opspec.properties import vocabulary
+from opspec.properties.language import trace_end
 from opspec.properties.vocabulary import Match, Predicate, as_predicate
 
 #: the judging here; the predicates themselves are the one vocabulary's, handed out here too

@@ -31,7 +31,6 @@ from pathlib import Path
 from typing import Any
 
 from opspec.errors import ConfigurationError, OpspecError, SourceLocation
-from opspec.files import toml_loads
 from opspec.testing.expectations import Expectation, parse_expectation
 from opspec.usermodels.scripts import Script, load_script, parse_script
 

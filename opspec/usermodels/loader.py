@@ -19,7 +19,6 @@ from typing import Any
 import tomli_w
 
 from opspec.errors import SourceLocation, UserModelError
-from opspec.files import toml_loads
 from opspec.usermodels.distributions import Distribution, ParameterError, make_distribution
 from opspec.usermodels.errors import Busy, Commission, ExtraDelay, Omission, Repetition
 from opspec.usermodels.model import ActivityModel, Modifier, UserModel

@@ -31,7 +31,7 @@ from typing import TYPE_CHECKING, Any
 from xml.etree import ElementTree
 
 from opspec.errors import ConfigurationError, SourceLocation
-from opspec.files import toml_load, toml_loads
+from opspec.files import toml_loads
 from opspec.worlds.base import World
 from opspec.worlds.room import RoomWorld
 from opspec.worlds.sumo import SumoWorld

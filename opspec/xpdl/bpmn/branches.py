@@ -121,7 +121,7 @@ def _probabilities(gateway: etree._Element, kind: str, out: list[Transition],
                          f"({', '.join(inputs)}) that nothing in the diagram sets: in a run "
                          f"not given them, opspec decides it at random with {given_by} "
                          f"({shares}); it {how}, and each draw is a branch.chosen trace event",
-                         f"give the run inputs with --param NAME=VALUE, or each flow its "
+                         "give the run inputs with --param NAME=VALUE, or each flow its "
                          "probability (opspec:Probability, BPSim, QBP) (docs/bpmn.md, Run "
                          "inputs)")
     elif missing and not implied:

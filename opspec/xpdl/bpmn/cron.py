@@ -13,7 +13,7 @@ from __future__ import annotations
 
 import re
 
-from opspec.errors import SpecError, SourceLocation
+from opspec.errors import SourceLocation, SpecError
 
 __all__ = ["cron_cycle"]
 

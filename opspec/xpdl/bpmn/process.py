@@ -520,10 +520,10 @@ class _Process:
         name (as SpiffWorkflow does): something must declare or set it."""
         known = {f.id for f in (*process.data_fields, *process.formal_parameters)}
         known |= self.defs.package_fields
-        for name, where, label in self.reads:
+        for name, where, shown in self.reads:
             if name not in known:
                 self.ctx.error(where, "undefined-data-field",
-                               f"{label} takes its dataInput {name!r} from the process, but "
+                               f"{shown} takes its dataInput {name!r} from the process, but "
                                f"nothing in process {self.id!r} declares or sets {name!r}",
                                "declare a bpmn:dataObject or bpmn:property with that id, set it "
                                "in a script task or a form field, or feed the input with a "

@@ -16,8 +16,6 @@ from __future__ import annotations
 import dataclasses
 from collections.abc import Iterable
 
-from lxml import etree
-
 from opspec.model.checks_support import names_read
 from opspec.model.common import ExtendedAttribute
 from opspec.model.data import BasicKind, BasicType, DataField
