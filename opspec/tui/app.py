@@ -61,16 +61,18 @@ HELP = """\
   [b]n[/b]       step: skip to the next event
   [b]u[/b]       skip until something new needs you (again: stop)
   [b]h[/b]       hand your lane to the user model / take it back
-  [b]l[/b]       timeline: all lanes / device / user (/ hidden, with --large)
+  [b]l[/b]       timeline: all lanes / device / user
+          (/ hidden, with --large)
   [b]s[/b]       the summary so far (metrics, your response times)
   [b]?[/b]       this help (the clock stops while it is open)
   [b]q[/b], [b]ctrl+c[/b], [b]ctrl+q[/b] quit (the recording is kept)
 
-When the device calls you, the clock drops to real time (or pauses,
-with --on-call pause) and comes back when the call is over.
+When the device calls you, the clock drops to real time (or
+pauses, with --on-call pause) and comes back when the call is
+over.
 
-Device panel: (!) an alert (a ringing alarm), (x) a device fault,
-> what a participant is doing now.
+Device panel: (!) an alert (a ringing alarm), (x) a device
+fault, > what a participant is doing now.
 
 Press escape or ? to close."""
 
