@@ -79,6 +79,15 @@ def describe_selector(selector: Mapping[str, Any]) -> str:
         else f"a {event} event" + (f" in workflow {process}" if process else "")
 
 
+def _bare(phrase: str) -> str:
+    """A selector's words without their article, to follow "every" or "the first": they
+    start with "the " (an event of a named kind) or "a " (any other event)."""
+    for article in ("the ", "a "):
+        if phrase.startswith(article):
+            return phrase[len(article):]
+    return phrase
+
+
 def describe_metric(definition: Mapping[str, Any]) -> str:
     """One metric in words: its description from the spec, then how it is computed."""
     kind = definition.get("kind")
@@ -87,7 +96,7 @@ def describe_metric(definition: Mapping[str, Any]) -> str:
         own += "."
     if kind == "count":
         select = definition.get("select")
-        how = (f"Counted in the trace: every {describe_selector(select)[4:]}, per simulated "
+        how = (f"Counted in the trace: every {_bare(describe_selector(select))}, per simulated "
                "user over the whole run." if select else "A count of trace events per "
                "simulated user over the whole run.")
     elif kind == "duration":
@@ -96,7 +105,7 @@ def describe_metric(definition: Mapping[str, Any]) -> str:
         if start and end:
             which = "first" if (start.get("which") or "first") == "first" else "last"
             how = (f"Measured in the trace: time ({unit}) from the {which} "
-                   f"{describe_selector(start)[4:]} to "
+                   f"{_bare(describe_selector(start))} to "
                    f"{describe_selector(end)}, within the same workflow instance; one "
                    "observation per instance in which both happen.")
         else:

@@ -210,3 +210,17 @@ def test_words_for_selectors_and_metrics_without_detail() -> None:
                             "end": {"event": "activity.completed", "activity": "b"}})
     assert last.startswith("Measured in the trace: time (s) from the last start of activity a to the completion of "
                            "activity b")
+
+
+def test_a_count_of_events_of_any_other_kind_reads_whole() -> None:
+    # the dispenser's device_faults counts device.fault events: its report said "every ult
+    # event" when the article was cut by its length ("the " is four letters, "a " two)
+    assert describe_metric({"name": "device_faults", "kind": "count", "select": {
+        "event": "device.fault"}}) == (
+        "Counted in the trace: every device.fault event, per simulated user over the whole "
+        "run.")
+    first = describe_metric({"name": "d", "kind": "duration", "unit": "s",
+                             "start": {"event": "device.fault", "which": "first"},
+                             "end": {"event": "activity.completed", "activity": "b"}})
+    assert first.startswith("Measured in the trace: time (s) from the first device.fault "
+                            "event to the completion of activity b")
