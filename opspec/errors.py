@@ -56,6 +56,17 @@ class Severity(enum.Enum):
     INFO = "info"
 
 
+def with_hint(text: str, hint: str) -> str:
+    """A message and what to do about it: the hint in parentheses after the message, or,
+    when the hint has parentheses of its own, after a semicolon (a parenthesis inside a
+    parenthesis reads as a slip: "(e.g. --days 1 (or leave it out))")."""
+    if not hint:
+        return text
+    if "(" in hint:
+        return f"{text}; {hint}"
+    return f"{text} ({hint})"
+
+
 @dataclass(frozen=True, slots=True)
 class Diagnostic:
     """One problem found in an input, reported without stopping the load.
@@ -71,10 +82,7 @@ class Diagnostic:
     hint: str = ""
 
     def __str__(self) -> str:
-        text = f"{self.location}: {self.severity.value}: {self.message}"
-        if self.hint:
-            text = f"{text} ({self.hint})"
-        return text
+        return with_hint(f"{self.location}: {self.severity.value}: {self.message}", self.hint)
 
     def to_json(self) -> dict[str, object]:
         return {
@@ -106,9 +114,7 @@ class OpspecError(Exception):
         text = self.message
         if self.location is not None:
             text = f"{self.location}: {text}"
-        if self.hint:
-            text = f"{text} ({self.hint})"
-        return text
+        return with_hint(text, self.hint)
 
 
 class SpecError(OpspecError):
