@@ -3,14 +3,16 @@
 A module of its own so that the compiled build (``opspec._native``) compiles it with the
 engine: the dedicated model is the default, and every activity with a CPU demand records a
 burst here (a robot spec: 54,000 an hour), which from :mod:`opspec.engine.processors`
-(interpreted) cost a Python call each. See that module for the processor models.
+(interpreted) cost a Python call each. The bursts under way are kept on a heap by the functions
+of the run's timer heap (:mod:`opspec.engine.timers`). The processor models are described
+in :mod:`opspec.engine.processors`.
 """
 
 from __future__ import annotations
 
 import heapq
-import types
-from typing import Final
+
+from opspec.engine.timers import TUPLES, Timed, heap_pop, heap_push
 
 __all__ = ["DedicatedProcessor"]
 
@@ -24,73 +26,35 @@ class DedicatedProcessor:
     """
 
     def __init__(self) -> None:
-        self._ends: list[float] = []      # end times of the bursts under way (a heap)
+        # the end times of the bursts under way, a heap: from source floats under heapq;
+        # compiled, timed entries on the run's own heap functions (comparing their native
+        # fields, where heapq is a call through Python's protocol per burst)
+        self._ends: list[float] = []
+        self._marks: list[Timed] = []
         self.bursts = 0
         self.busy_time = 0.0
         self.max_busy = 0
 
     def burst(self, now: float, cost: float) -> None:
-        ends = self._ends
-        if COMPILED:
-            while ends and ends[0] <= now:
-                _pop(ends)
-            _push(ends, now + cost)
+        if not TUPLES:          # compiled (as the timers' heap)
+            marks = self._marks
+            while marks and marks[0].at <= now:
+                heap_pop(marks)
+            mark = Timed()
+            mark.at = now + cost
+            mark.seq = 0            # (bursts that end together: any order will do)
+            heap_push(marks, mark)
+            busy = len(marks)
         else:
+            ends = self._ends
             while ends and ends[0] <= now:
                 heapq.heappop(ends)
             heapq.heappush(ends, now + cost)
+            busy = len(ends)
         self.bursts += 1
         self.busy_time += cost
-        busy = len(ends)
-        if busy > self.max_busy:          # max() without a builtin call per burst
+        if busy > self.max_busy:  # noqa: PLR1730 - max() is a builtin call per burst
             self.max_busy = busy
 
     def summary(self) -> dict[str, float | int]:
         return {"bursts": self.bursts, "busy_time": self.busy_time, "max_busy": self.max_busy}
-
-
-# heapq's heappush and heappop on floats, in this module: compiled, they compare two native
-# floats, where heapq's (a module attribute looked up and called through Python's protocol per
-# burst) cost as much as the rest of the burst; from source heapq's C code is the faster
-
-
-def _push(heap: list[float], value: float) -> None:
-    heap.append(value)
-    pos = len(heap) - 1
-    while pos > 0:
-        up = (pos - 1) >> 1
-        parent = heap[up]
-        if value < parent:
-            heap[pos] = parent
-            pos = up
-        else:
-            break
-    heap[pos] = value
-
-
-def _pop(heap: list[float]) -> float:
-    last = heap.pop()
-    if not heap:
-        return last
-    first = heap[0]
-    size = len(heap)
-    pos = 0
-    while True:
-        child = 2 * pos + 1
-        if child >= size:
-            break
-        right = child + 1
-        if right < size and heap[right] < heap[child]:
-            child = right
-        low = heap[child]
-        if low < last:
-            heap[pos] = low
-            pos = child
-        else:
-            break
-    heap[pos] = last
-    return first
-
-
-#: whether this module runs compiled (then :func:`_push` and :func:`_pop` are native)
-COMPILED: Final = not isinstance(_push, types.FunctionType)

@@ -3,7 +3,9 @@ starts, it emits ``deadline.expired`` if the instance still runs when it falls d
 
 Most of them fall due after their instance ended (a robot spec's 50 ms deadline on a
 workflow that takes 5 ms) and do nothing but drain, which the zero-time guard counts as a
-step of that instant, so they stay armed; what they cost is kept small instead: a timed
+step, so they stay armed: the guard starts its count again only when the count passes its
+limit and the clock has moved, so every drain moves the point at which a zero-time cycle is
+stopped (and the trace before it); what they cost is kept small instead: a timed
 callback object of their own (:class:`_Deadline`) rather than a closure handed to
 :meth:`RunState.call_at <opspec.engine.runstate.RunState.call_at>`, which does the same
 (``sim_events``, the heap entry, the drain after it). Compiled with the engine
@@ -70,9 +72,4 @@ class _Deadline(Timed):
         flow.state.drain()
 
     def __call__(self, _event: Any) -> None:
-        run = self.flow.state
-        outer = run.enter()
-        try:
-            self.go()
-        finally:
-            run.inside = outer
+        self.flow.state.go_now(self)

@@ -43,7 +43,7 @@ import simpy
 
 from opspec.engine.clock import Clock
 
-__all__ = ["Timed", "Timers", "exact_delay"]
+__all__ = ["Timed", "Timers", "exact_delay", "heap_pop", "heap_push"]
 
 INF: Final = math.inf
 
@@ -93,8 +93,8 @@ def exact_delay(base: float, target: float) -> float:
 
 #: Whether the engine runs from source (this module is not compiled): then the heap holds
 #: ``(at, seq, entry)`` tuples ordered by :mod:`heapq`'s C code, which costs a third of
-#: :func:`_push`'s and :func:`_pop`'s loops interpreted; compiled, those loops compare two
-#: native fields per step and beat the tuple protocol (docs/engine-performance.md).
+#: :func:`heap_push`'s and :func:`heap_pop`'s loops interpreted; compiled, those loops compare
+#: two native fields per step and beat the tuple protocol (docs/engine-performance.md).
 TUPLES: Final = isinstance(exact_delay, types.FunctionType)
 
 class Timers:
@@ -109,7 +109,7 @@ class Timers:
         # and at each call from outside one (:meth:`sync`), not at every use.
         self.now = float(clock.now)
         self.inside = False         # handling one of its own timed callbacks: now is fresh
-        self.heap: list[Timed] = []     # a binary heap by (at, seq): _push, _pop
+        self.heap: list[Timed] = []     # a binary heap by (at, seq): heap_push, heap_pop
         # a heap only on a Clock no other run drives (the clock reports the others' events)
         self.heaped = False
         if isinstance(clock, Clock) and clock.owner is None:
@@ -141,6 +141,16 @@ class Timers:
         self.inside = True
         return outer
 
+    def go_now(self, entry: Timed) -> None:
+        """``entry`` is due as a SimPy timeout's callback (not from the heap): its ``go``,
+        with the time read as :meth:`enter` reads it (the ``__call__`` of a :class:`Timed`
+        whose ``go`` needs nothing else)."""
+        outer = self.enter()
+        try:
+            entry.go()
+        finally:
+            self.inside = outer
+
     def schedule_timed(self, delay: float, entry: Timed) -> None:
         """``entry`` is due ``delay`` (>= 0) simulated seconds from now."""
         if not self.heaped:
@@ -156,7 +166,7 @@ class Timers:
             rows: list[Any] = self.heap     # the same list, holding tuples (see TUPLES)
             heappush(rows, (at, self.order, entry))
         else:
-            _push(self.heap, entry)
+            heap_push(self.heap, entry)
         if at < self.armed_at and not self.ticking:
             self.arm()
 
@@ -212,7 +222,7 @@ class Timers:
 
     def _run_due(self, heap: list[Timed], ahead: bool) -> None:
         while True:
-            entry = _pop(heap)
+            entry = heap_pop(heap)
             at = entry.at
             self.now = at
             entry.go()
@@ -302,7 +312,7 @@ def _order(item: Any) -> tuple[float, int]:
     return item.at, item.seq
 
 
-def _push(heap: list[Timed], entry: Timed) -> None:
+def heap_push(heap: list[Timed], entry: Timed) -> None:
     """``heapq.heappush`` by ``(at, seq)``: the same order, compared as native numbers."""
     heap.append(entry)
     at = entry.at
@@ -319,32 +329,35 @@ def _push(heap: list[Timed], entry: Timed) -> None:
     heap[pos] = entry
 
 
-def _pop(heap: list[Timed]) -> Timed:
+def heap_pop(heap: list[Timed]) -> Timed:
     """``heapq.heappop`` by ``(at, seq)``: the earliest entry (the first scheduled of its
     time), taken off the heap (compiled; from source the heap holds tuples for
     :mod:`heapq`, see ``TUPLES``)."""
     last = heap.pop()
-    if not heap:
+    size = len(heap)
+    if size == 0:
         return last
     first = heap[0]
     at = last.at
     seq = last.seq
-    size = len(heap)
     pos = 0
-    while True:
-        child = 2 * pos + 1
-        if child >= size:
-            break
+    child = 1
+    # (each entry read from the list costs a type check compiled: read once, its time kept)
+    while child < size:
         low = heap[child]
+        low_at = low.at
         right = child + 1
         if right < size:
             other = heap[right]
-            if other.at < low.at or (other.at == low.at and other.seq < low.seq):
+            other_at = other.at
+            if other_at < low_at or (other_at == low_at and other.seq < low.seq):
                 child = right
                 low = other
-        if low.at < at or (low.at == at and low.seq < seq):
+                low_at = other_at
+        if low_at < at or (low_at == at and low.seq < seq):
             heap[pos] = low
             pos = child
+            child = child + child + 1
         else:
             break
     heap[pos] = last

@@ -539,12 +539,7 @@ class _Timer(Timed):
         self.arm()
 
     def __call__(self, _event: Any) -> None:
-        state = self.triggers.state
-        outer = state.enter()
-        try:
-            self.go()
-        finally:
-            state.inside = outer
+        self.triggers.state.go_now(self)
 
 
 def _root(inst: ProcessInstance) -> ProcessInstance:

@@ -17,11 +17,13 @@ import pytest
 from builders import manual, pkg, proc
 
 from opspec.engine.builtin_performers import ScriptedUser
+from opspec.engine.dedicated import DedicatedProcessor
 from opspec.engine.simulation import Simulation
-from opspec.engine.timers import TUPLES, _pop
+from opspec.engine.timers import TUPLES, Timed, heap_pop, heap_push
+from opspec.engine.timers import heap_pop as _pop
 
 if TUPLES:          # from source the heap holds (at, seq, entry) tuples under heapq
-    def _pop(heap: list) -> object:     # type: ignore[no-redef, type-arg]  # noqa: F811
+    def _pop(heap: list) -> object:     # type: ignore[no-redef, type-arg]
         return heapq.heappop(heap)[2]
 
 
@@ -50,3 +52,40 @@ def test_pops_in_time_then_scheduling_order_as_heapq(seed: int) -> None:
         expected.append(heapq.heappop(reference)[2])
     assert popped == expected
     assert len({id(c) for c in expected}) == len(expected) > 1500
+
+
+@pytest.mark.parametrize("seed", range(3))
+def test_the_heap_functions_order_entries_as_heapq(seed: int) -> None:
+    """``heap_push`` and ``heap_pop`` themselves (from source too, where a run's heap holds
+    tuples): the order of ``heapq`` over ``(at, seq)``, and the dedicated processor's
+    bursts (entries of one time, any order) counted as over floats."""
+    rng = random.Random(seed)
+    heap: list[Timed] = []
+    reference: list[tuple[float, int]] = []
+    popped: list[tuple[float, int]] = []
+    expected: list[tuple[float, int]] = []
+    for seq in range(2000):
+        if heap and rng.random() < 0.45:
+            entry = heap_pop(heap)
+            popped.append((entry.at, entry.seq))
+            expected.append(heapq.heappop(reference))
+            continue
+        entry = Timed()
+        entry.at = float(rng.randrange(12)) / 4
+        entry.seq = seq
+        heap_push(heap, entry)
+        heapq.heappush(reference, (entry.at, seq))
+    while heap:
+        entry = heap_pop(heap)
+        popped.append((entry.at, entry.seq))
+        expected.append(heapq.heappop(reference))
+    assert popped == expected
+
+
+def test_the_dedicated_processor_counts_overlapping_bursts() -> None:
+    dedicated = DedicatedProcessor()
+    for now, cost in [(0.0, 1.0), (0.5, 1.0), (0.5, 0.5), (1.0, 2.0), (1.0, 0.25), (3.5, 1.0)]:
+        dedicated.burst(now, cost)
+    # at 1.0 the first and third have ended (an end at ``now`` is over): 0.5+1.0, 1.0+2.0,
+    # 1.0+0.25 under way; at 3.5 all have
+    assert dedicated.summary() == {"bursts": 6, "busy_time": 5.75, "max_busy": 3}
