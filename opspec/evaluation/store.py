@@ -258,9 +258,15 @@ def _full(error: BaseException) -> bool:
     return isinstance(error, sqlite3.OperationalError) and "full" in str(error)
 
 
-def _fail(path: Path, doing: str, error: BaseException) -> EvaluationError:
+def _fail(path: Path, doing: str, error: BaseException, *,
+          started: bool = True) -> EvaluationError:
+    """The error of a store that cannot be written (``started``: a run may already be in it,
+    which ``--resume`` continues; not so when its folder cannot even be made)."""
     reason = getattr(error, "strerror", None) or str(error)
-    if isinstance(error, sqlite3.DatabaseError) and "not a database" in reason:
+    if not started:
+        hint = ("check that the folder's parent exists and is writable, or choose another "
+                "folder with --out DIR")
+    elif isinstance(error, sqlite3.DatabaseError) and "not a database" in reason:
         hint = ("the file is damaged or is not an opspec result store; start the run again "
                 "with another --out (the damaged file is left as it is)")
     elif _full(error):
@@ -282,7 +288,8 @@ class ResultStore:
             try:
                 self.folder.mkdir(parents=True, exist_ok=True)
             except OSError as error:
-                raise _fail(self.folder, "create the output folder", error) from None
+                raise _fail(self.folder, "create the output folder", error,
+                            started=False) from None
         elif not self.path.is_file():
             raise EvaluationError(f"{self.path}: no stored evaluation to resume",
                                   hint="run without --resume first, or give the --out folder "

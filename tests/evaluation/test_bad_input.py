@@ -43,6 +43,8 @@ def test_unwritable_output_folder_is_a_clear_error(evaluate, tmp_path):
                               str(blocker / "out"))
     assert status == 2
     assert "cannot create the output folder" in err and "Traceback" not in err
+    # nothing was started there: the hint is about the folder, not about resuming a run
+    assert "--out DIR" in err and "--resume" not in err
 
 
 def test_existing_results_need_resume_and_resume_refuses_other_options(evaluate, tmp_path):
