@@ -34,12 +34,23 @@ def walk_to_the_buttons(session: WalkSession) -> None:
     session.act(offer(session, "walk_to_dispenser"))
 
 
-def test_a_wrong_button_says_nothing_reached_the_device_and_what_is_asked_again(compiled):
+def test_a_wrong_button_says_nothing_was_sent_and_what_is_asked_again(compiled):
     session = WalkSession(compiled)
     walk_to_the_buttons(session)
     session.act(offer(session, choice="press_wrong_button"))
-    assert session.aftermath.text() == ("you: Press the wrong button at 08:00 -> nothing "
-                                        "reached the device -> asked next: Press a button")
+    assert session.aftermath.text() == ("you: Press the wrong button at 08:00 -> your own "
+                                        "action, nothing sent to the device -> asked next: "
+                                        "Press a button")
+
+
+def test_hearing_the_alarm_is_the_persons_own_action_not_a_fault(compiled):
+    session = WalkSession(compiled)
+    run_until(session, ALARM)
+    session.act(offer(session, "hear_alarm"))
+    text = session.aftermath.text()
+    assert text.startswith("you: Hear the alarm at 08:00 -> your own action, nothing sent "
+                           "to the device")
+    assert "reached" not in text
 
 
 def test_the_report_says_what_the_device_did(compiled):
