@@ -229,3 +229,15 @@ async def test_the_alarm_cue_sounds_at_each_alarm(compiled):
     async with app.run_test(size=(80, 24)):
         run_until(session, ALARM + 601)
     assert counted.played == 3
+
+
+def test_a_trigger_caught_with_no_device_activity_at_once_is_not_called_lost():
+    from opspec.engine.trace import TraceEvent
+    from opspec.tui.feedback import Aftermath
+
+    aftermath = Aftermath(lambda process, activity: activity)
+    aftermath.acted("Press the button", None, 60.0)
+    # caught by a device start event (quiet): neither kept nor lost, no device work yet
+    aftermath(TraceEvent(60.0, "trigger.raised", lane="user", data={"name": "trg_9"}))
+    assert aftermath.text() == ("you: Press the button at 00:01 -> sent trg_9 -> no device "
+                                "activity at once")
