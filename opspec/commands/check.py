@@ -13,7 +13,8 @@ file; --json prints one JSON object per file instead (JSON Lines).
 A spec with errors (any that opspec validate reports: the reader's, the structural checks'
 such as a dangling transition, what the engine refuses to compile) is still explored when a
 package could be built (its conditions do not matter here), but it is never called sound: the
-errors are printed first and make the status 1.
+errors are printed first and make the status 1, and a process level with an error in its own
+lines is 'not sound' whatever the exploration of what could be read of it found.
 
 Exit status: 0 every process level is sound; 1 a problem was found, a spec has errors, or the
 check ran out of its budget (more than --max-states states in a level, or out of memory): that
