@@ -13,7 +13,8 @@ file; --json prints one JSON object per file instead (JSON Lines).
 A spec with errors (any that opspec validate reports: the reader's, the structural checks'
 such as a dangling transition, what the engine refuses to compile) is still explored when a
 package could be built (its conditions do not matter here), but it is never called sound: the
-errors are printed first and make the status 1.
+errors are printed first and make the status 1, and a process level with an error in its own
+lines is 'not sound' whatever the exploration of what could be read of it found.
 
 Exit status: 0 every process level is sound; 1 a problem was found, a spec has errors, or the
 check ran out of its budget (more than --max-states states in a level, or out of memory): that
@@ -68,6 +69,7 @@ def register(subparsers: Any) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
+    from opspec.commands._check_levels import errors_by_level
     from opspec.errors import Severity
     from opspec.model.soundness import SoundnessReport, check_process
     from opspec.xpdl.gate import RUNS_DIFFERENTLY
@@ -122,7 +124,8 @@ def run(args: argparse.Namespace) -> int:
             done = {r.process for r in reports}
             reports = [*reports, *(SoundnessReport(p.id, 0, False, (), stopped="memory")
                                    for p in processes if p.id not in done)]
-        status = _print(path, reports, errors, as_json=args.json, max_states=args.max_states)
+        status = _print(path, reports, errors, as_json=args.json, max_states=args.max_states,
+                        in_levels=errors_by_level(package, errors))
         if getattr(args, "schedulability", False) and not errors:
             status = max(status, _schedulability(package, as_json=args.json))
         worst = max(worst, status)
@@ -266,10 +269,13 @@ def _problem_json(p: Any) -> dict[str, Any]:
 
 
 def _print(path: Path, reports: list[SoundnessReport], errors: Sequence[Diagnostic], *,
-           as_json: bool, max_states: int) -> int:
+           as_json: bool, max_states: int,
+           in_levels: dict[str, list[Diagnostic]] | None = None) -> int:
     """Print one file's verdict; return its exit status (0 or 1). Load ``errors`` make it
     1, and so does an inconclusive level (the budget ran out; the file is never called
-    sound then)."""
+    sound then). A level with errors in it (``in_levels``: the errors by level) is never
+    called sound either, whatever the exploration of what could be read of it found."""
+    in_levels = in_levels or {}
     problems = [p for r in reports for p in r.problems]
     failing = [p for p in problems if p.severity == "error"]
     undecided = [r for r in reports if not r.complete]
@@ -280,8 +286,10 @@ def _print(path: Path, reports: list[SoundnessReport], errors: Sequence[Diagnost
             "max_states": max_states,
             "inconclusive": bool(undecided),
             "processes": [{"process": r.process, "states": r.states, "complete": r.complete,
-                           "sound": r.sound, "problems": sum(
+                           "sound": r.sound and r.process not in in_levels, "problems": sum(
                                1 for p in r.problems if p.severity == "error"),
+                           **({"spec_errors": len(in_levels[r.process])}
+                              if r.process in in_levels else {}),
                            **({"stopped": r.stopped} if r.stopped else {})}
                           for r in reports],
             "problems": [_problem_json(p) for p in failing],
@@ -312,14 +320,27 @@ def _print(path: Path, reports: list[SoundnessReport], errors: Sequence[Diagnost
         for report in reports:
             warned = sum(1 for p in report.problems if p.severity != "error")
             also = f", {warned} warning(s)" if warned else ""
-            verdict = ("sound" + also if report.sound
+            mine = in_levels.get(report.process)
+            verdict = ("sound" + also if report.sound and not mine
+                       else "no problem" + also if report.sound
                        else f"{len(report.problems) - warned} problem(s)" + also
                        if len(report.problems) > warned else "inconclusive" + also)
+            if mine:
+                # the exploration followed only what could be read of this level
+                lines = ", ".join(str(d.location.line) for d in mine)
+                verdict = (f"not sound: {len(mine)} spec error(s) in it "
+                           f"(line{'s' if len(mine) > 1 else ''} {lines}); "
+                           f"in what could be read of it: {verdict}")
             print(f"{path}: {report.process}: {verdict} ({report.states} states)")
-        sound = sum(1 for r in reports if r.sound)
+        sound = sum(1 for r in reports if r.sound and r.process not in in_levels)
         warnings = len(problems) - len(failing)
         verdict = "not sound (the spec has errors): " if errors else ""
+        elsewhere = len(errors) - sum(len(in_levels.get(r.process, ())) for r in reports)
+        where = ("" if not elsewhere else " outside these process levels"
+                 if elsewhere == len(errors) else f", {elsewhere} of them outside these "
+                 "process levels")
         print(f"{path}: {verdict}{sound} of {len(reports)} process level(s) sound, "
-              f"{len(failing)} problem(s)" + (f", {warnings} warning(s)" if warnings else "") + (f", {len(errors)} spec error(s) (see "
-                                                "`opspec validate`)" if errors else ""))
+              f"{len(failing)} problem(s)" + (f", {warnings} warning(s)" if warnings else "") + (
+                  f", {len(errors)} spec error(s){where} (see `opspec validate`)"
+                  if errors else ""))
     return 1 if failing or errors or undecided else 0

@@ -28,7 +28,7 @@ from typing import TYPE_CHECKING, Any
 
 from opspec.clock import clock_time, figure, span
 from opspec.commands import _args
-from opspec.errors import ConfigurationError
+from opspec.errors import ConfigurationError, OpspecError
 
 if TYPE_CHECKING:
     from opspec.engine.simulation import RunResult
@@ -80,17 +80,23 @@ def register(subparsers: Any) -> None:
 def run(args: argparse.Namespace) -> int:
     from opspec.branch_choices import parse_branch_options
     from opspec.commands._params import read_run_inputs
+    from opspec.commands._wrong_file import misplaced
     from opspec.engine.trace_sinks import JsonlSink
     from opspec.request import RunRequest, prepare
     from opspec.run_rules import check_days, parse_until
 
     if args.days is not None:
         check_days(args.days, name="--days")
-    prepared = prepare(RunRequest(
-        args.spec, seed=args.seed, days=args.days,
-        until=None if args.until is None else parse_until(args.until, name="--until"),
-        script=args.script, user_model=args.user_model, no_user=args.no_user,
-        branches=parse_branch_options(args.branch) or None))
+    try:
+        prepared = prepare(RunRequest(
+            args.spec, seed=args.seed, days=args.days,
+            until=None if args.until is None else parse_until(args.until, name="--until"),
+            script=args.script, user_model=args.user_model, no_user=args.no_user,
+            branches=parse_branch_options(args.branch) or None))
+    except OpspecError as error:
+        # a user model given to --script, a spec to --user-model: say so
+        raise misplaced(error, (("--script", args.script),
+                                ("--user-model", args.user_model))) from None
     for warning in prepared.warnings:
         print(f"opspec run: {warning}", file=sys.stderr)
     package, compiled = prepared.package, prepared.compiled

@@ -96,6 +96,8 @@ def run(args: argparse.Namespace) -> int:
         text = describe_package(package, process=args.process)
     if getattr(args, "output", None):
         _write_whole(Path(args.output), text)
+        # as 'opspec compile' does: a file written says so, the standard output being free
+        print(f"{args.output}: {args.format} written from {args.spec}")
     else:
         sys.stdout.write(text)
     return 1 if errors else 0

@@ -7,7 +7,8 @@ instant: triggers the action sent, whether the device was waiting for them (``tr
 nobody was; ``trigger.lost``), what the device did in answer, and what the person is asked
 next. :meth:`Aftermath.text` says it in one line::
 
-    you: Press the wrong button at 12:09 -> nothing reached the device -> asked next: Press a button
+    you: Hear the alarm at 12:09 -> your own action, nothing sent to the device -> asked next:
+         Walk to the dispenser
     you: Press "report" at 12:09 -> sent trg_1 -> the device: Wait for the user's report
          (trg_1), Dispense the dose -> asked next: Take the pill
 """
@@ -89,7 +90,11 @@ class Aftermath:
             more = len(self.device) - _SHOWN
             parts.append(f"the device: {named}" + (f" and {more} more" if more > 0 else ""))
         elif not self.kept and not self.lost:
-            parts.append("nothing reached the device")
+            # nothing sent: hearing an alarm, walking, a button wired to nothing are the
+            # person's own doing, which by design involves no device (not a fault); sent:
+            # caught (neither kept nor lost), but no device activity finished at this instant
+            parts.append("no device activity at once" if self.sent
+                         else "your own action, nothing sent to the device")
         if self.asked:
             parts.append("asked next: " + ", ".join(dict.fromkeys(self.asked)))
         return " -> ".join(parts)

@@ -23,8 +23,17 @@ def test_without_graphviz_no_file_is_left(tmp_path: Path, monkeypatch: pytest.Mo
     assert not out.exists() and list(tmp_path.iterdir()) == []
 
 
-def test_the_text_goes_to_the_file(tmp_path: Path) -> None:
+def test_the_text_goes_to_the_file(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     out = tmp_path / "dispenser.txt"
     assert main(["show", str(SPEC), "-o", str(out)]) == 0
     text = out.read_text(encoding="utf-8")
     assert text.startswith("Package ") and "manual" in text
+    # it says what it wrote, as opspec compile does ('FILE: compiled from SPEC')
+    assert capsys.readouterr().out == f"{out}: text written from {SPEC}\n"
+
+
+def test_a_dot_file_written_says_so(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    out = tmp_path / "dispenser.dot"
+    assert main(["show", str(SPEC), "--format", "dot", "-o", str(out)]) == 0
+    assert out.read_text(encoding="utf-8").startswith("digraph")
+    assert capsys.readouterr().out == f"{out}: dot written from {SPEC}\n"

@@ -34,12 +34,23 @@ def walk_to_the_buttons(session: WalkSession) -> None:
     session.act(offer(session, "walk_to_dispenser"))
 
 
-def test_a_wrong_button_says_nothing_reached_the_device_and_what_is_asked_again(compiled):
+def test_a_wrong_button_says_nothing_was_sent_and_what_is_asked_again(compiled):
     session = WalkSession(compiled)
     walk_to_the_buttons(session)
     session.act(offer(session, choice="press_wrong_button"))
-    assert session.aftermath.text() == ("you: Press the wrong button at 08:00 -> nothing "
-                                        "reached the device -> asked next: Press a button")
+    assert session.aftermath.text() == ("you: Press the wrong button at 08:00 -> your own "
+                                        "action, nothing sent to the device -> asked next: "
+                                        "Press a button")
+
+
+def test_hearing_the_alarm_is_the_persons_own_action_not_a_fault(compiled):
+    session = WalkSession(compiled)
+    run_until(session, ALARM)
+    session.act(offer(session, "hear_alarm"))
+    text = session.aftermath.text()
+    assert text.startswith("you: Hear the alarm at 08:00 -> your own action, nothing sent "
+                           "to the device")
+    assert "reached" not in text
 
 
 def test_the_report_says_what_the_device_did(compiled):
@@ -218,3 +229,15 @@ async def test_the_alarm_cue_sounds_at_each_alarm(compiled):
     async with app.run_test(size=(80, 24)):
         run_until(session, ALARM + 601)
     assert counted.played == 3
+
+
+def test_a_trigger_caught_with_no_device_activity_at_once_is_not_called_lost():
+    from opspec.engine.trace import TraceEvent
+    from opspec.tui.feedback import Aftermath
+
+    aftermath = Aftermath(lambda process, activity: activity)
+    aftermath.acted("Press the button", None, 60.0)
+    # caught by a device start event (quiet): neither kept nor lost, no device work yet
+    aftermath(TraceEvent(60.0, "trigger.raised", lane="user", data={"name": "trg_9"}))
+    assert aftermath.text() == ("you: Press the button at 00:01 -> sent trg_9 -> no device "
+                                "activity at once")

@@ -126,7 +126,7 @@ def test_large_high_contrast_in_a_small_real_terminal(tmp_path):
         tmux("send-keys", "-t", session, "a")
         tmux("send-keys", "-t", session, "a")
         tmux("send-keys", "-t", session, "b")
-        wait_for(session, "nothing reached the")
+        wait_for(session, "your own action")
         tmux("send-keys", "-t", session, "q")
         wait_for(session, "EXIT=0", timeout=10.0)
     finally:

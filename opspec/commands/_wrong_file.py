@@ -1,0 +1,76 @@
+"""A file given to the wrong option of ``opspec run``: say which option it was given to and
+which one it is meant for.
+
+A user model passed to ``--script`` fails as a script with unknown keys, a spec passed to
+``--user-model`` as TOML that cannot be read: both messages are right about the file but do
+not say that the file is simply in the wrong place. :func:`misplaced` looks at a file whose
+reading failed and, when it is plainly a spec (XML, or a compiled ``.wfs``), a user model
+(``format = "opspec-user-model"``) or a script (``steps``), says where it goes instead.
+Only the error path reads the file again.
+"""
+
+from __future__ import annotations
+
+import contextlib
+from pathlib import Path
+from typing import Any
+
+from opspec.errors import ConfigurationError, OpspecError, UserModelError
+
+__all__ = ["misplaced"]
+
+_SPEC = "the spec (the first argument: opspec run SPEC)"
+
+
+def _same(a: str | Path, b: str | Path) -> bool:
+    try:
+        return Path(a).resolve() == Path(b).resolve()
+    except (OSError, RuntimeError, ValueError):
+        return False
+
+
+def _what(path: str | Path) -> tuple[str, str] | None:
+    """(what the file is, where it goes) when that is plain from its content."""
+    from opspec.files import json_loads, read_bytes, toml_loads
+
+    try:
+        raw = read_bytes(path)
+    except (OSError, OpspecError):
+        return None
+    head = raw.lstrip(b"\xef\xbb\xbf \t\r\n")
+    if head.startswith(b"<"):
+        kind = "BPMN" if b"omg.org/spec/BPMN" in head[:4096] else "XPDL"
+        return f"a spec ({kind})", _SPEC
+    document: Any = None
+    with contextlib.suppress(ValueError, RecursionError):   # not JSON, not TOML: unknown
+        document = (json_loads(raw) if head.startswith(b"{")
+                    else toml_loads(raw.decode("utf-8")))
+    if not isinstance(document, dict):
+        return None
+    if document.get("format") == "opspec-wfs":
+        return "a compiled spec (.wfs)", _SPEC
+    if document.get("format") == "opspec-user-model":
+        return "a user model", "--user-model"
+    if "steps" in document:
+        return "a script", "--script"
+    return None
+
+
+def misplaced(error: OpspecError, given: tuple[tuple[str, str | None], ...]) -> OpspecError:
+    """``error`` with a hint naming the option its file was given to and the one it is meant
+    for (``given``: option and value), when the file is plainly of another kind; else
+    ``error`` itself."""
+    if type(error) not in (ConfigurationError, UserModelError) or error.location is None:
+        return error
+    for option, value in given:
+        if value is None or not _same(error.location.path, value):
+            continue
+        found = _what(value)
+        if found is None or found[1] == option:
+            return error
+        what, goes = found
+        return type(error)(error.message, location=error.location,
+                           hint=f"given to {option}, but this is {what}: give it as {goes}"
+                           if goes == _SPEC else
+                           f"given to {option}, but this is {what}: give it to {goes}")
+    return error
