@@ -221,11 +221,26 @@ class RunState(Timers):
 
         Zero-time work at one simulated instant is counted across drains: each item run and
         each drain (a clock event at this instant, so a storm of zero-delay wakeups that queue
-        nothing counts too). Past ``max_instant_steps`` the run stops with a
+        nothing counts too); the count starts again when the clock has moved. Past
+        ``max_instant_steps`` the run stops with a
         :class:`~opspec.errors.ZeroTimeCycleError` naming the activities that keep coming
         back (:mod:`opspec.engine.zero_time`)."""
         if self.draining:
             return
+        now = self.now
+        instant = self.instant
+        if now != instant:
+            # _same_instant in line (a Python frame per drain from source; the time is never
+            # negative): a new instant starts its count at 0, a creep of no real time does not
+            moved = now - instant
+            if moved < 0.0:
+                moved = -moved
+            if moved > 1e-9 * (now if now > 1.0 else 1.0):
+                self.instant = now
+                self.instant_steps = 0
+                if self.sampler is not None:     # the clock moved on: no cycle after all
+                    self.sampler = None
+                    self.start_limit = self.max_instant_steps
         ready = self.ready
         if not ready and not self.pending:
             # nothing queued (a deadline that fired after its instance ended, a timer whose
@@ -238,9 +253,6 @@ class RunState(Timers):
             return
         self.draining = True
         done = 0                    # the items of ``ready`` run so far
-        # Steps are counted without looking at the clock (reading it costs a dictionary
-        # lookup per drain); only past the limit does _past_limit ask whether the clock
-        # moved since the count began (then it starts again) or not (a zero-time cycle).
         steps = self.instant_steps + 1
         limit = self.max_instant_steps
         try:
