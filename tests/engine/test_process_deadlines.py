@@ -18,6 +18,7 @@ from typing import Any
 
 import simpy
 from builders import act, pkg, proc
+from test_timer_heap import _Counted
 
 from opspec.engine.simulation import RunResult, Simulation
 from opspec.model.sisarl import DeclaredDistribution
@@ -40,19 +41,6 @@ def _package() -> Any:
     return pkg(proc("slow", [_work(0.12)], start=f"period:{PERIOD}", deadline=LONG),
                proc("fast", [_work(0.06)], start=f"period:{PERIOD}", deadline=SHORT),
                proc("twin", [_work(0.06)], start=f"period:{PERIOD}", deadline=SHORT))
-
-
-class _Counted(simpy.Environment):
-    """A plain SimPy environment that counts what is scheduled on it (SimPy's event ids)."""
-
-    def __init__(self) -> None:
-        super().__init__(0.0)
-        self.every = 0
-
-    def schedule(self, event: simpy.Event, priority: Any = simpy.events.NORMAL,
-                 delay: Any = 0) -> None:
-        self.every += 1
-        super().schedule(event, priority, delay)
 
 
 def _run(env: simpy.Environment | None, until: float = 60.0) -> tuple[Simulation, RunResult]:
