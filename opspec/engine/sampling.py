@@ -14,6 +14,7 @@ from __future__ import annotations
 from collections.abc import Callable
 from typing import TYPE_CHECKING
 
+from opspec.errors import with_hint
 from opspec.model import DeclaredDistribution
 
 if TYPE_CHECKING:   # NumPy only when a spec declares a distribution (`opspec validate` never)
@@ -38,8 +39,7 @@ def make_sampler(dist: DeclaredDistribution) -> Sampler:
     try:
         family = from_model(dist)
     except ParameterError as error:
-        raise ValueError(f"{dist.kind}: {error.message}"
-                         + (f" ({error.hint})" if error.hint else "")) from None
+        raise ValueError(with_hint(f"{dist.kind}: {error.message}", error.hint)) from None
     sample = family.sample
     if isinstance(family, (ExGaussian, TruncatedNormal, WithExponentialTail)):
         # these may draw below 0 (a truncated normal may be declared with min < 0): a
