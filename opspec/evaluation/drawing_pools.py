@@ -81,7 +81,7 @@ class _Drawer:
         self.jobs: queue.SimpleQueue[tuple[Any, Callable[..., Any], tuple[Any, ...]] | None]
         self.jobs = queue.SimpleQueue()
         self.futures: list[Any] = []        # sent to this process and not seen done
-        self.gone = False                   # the process ended (or never started)
+        self.gone = False                   # no more jobs for it: told to end, or gone
         self.known = threading.Event()      # its pid is known, or it is gone
         self.thread = threading.Thread(target=self._hand_over, name="opspec-drawing",
                                        daemon=True)
@@ -94,6 +94,7 @@ class _Drawer:
         from multiprocessing.reduction import ForkingPickler
 
         job = None
+        ended: BaseException | None = None
         try:
             if self.pid is None:
                 self.pid = self.end.recv()  # a process forked by the first says who it is
@@ -122,12 +123,15 @@ class _Drawer:
                 (future.set_result if done else future.set_exception)(value)
                 job = None
         except Exception as error:  # noqa: BLE001 - the pipe shut: the process is gone
-            self._ended(job, error)
+            ended = error
+        finally:
+            self._ended(job, ended)
 
-    def _ended(self, job: Any, error: BaseException) -> None:
-        """The process is gone: the job it had fails (the figures are then drawn by the
-        evaluate process, where an error is plain); those still waiting for it go to the
-        other processes (all of them, when this one never started)."""
+    def _ended(self, job: Any, error: BaseException | None) -> None:
+        """No more jobs go to this process (it was told to end, or it is gone): the job it
+        had fails (the figures are then drawn by the evaluate process, where an error is
+        plain); those still waiting for it go to the other processes (all of them, when
+        this one never started), or fail when none is left."""
         from concurrent.futures.process import BrokenProcessPool
 
         with _LOCK:
@@ -138,8 +142,8 @@ class _Drawer:
                 waiting.append(self.jobs.get())
         if job is not None and not job[0].done():
             with contextlib.suppress(Exception):
-                job[0].set_exception(
-                    BrokenProcessPool(f"a drawing process ended ({type(error).__name__})"))
+                job[0].set_exception(BrokenProcessPool(
+                    f"a drawing process ended ({type(error).__name__})"))
         for item in waiting:
             if item is not None:
                 self._pools.hand_to_another(item)
@@ -223,10 +227,18 @@ class _Pools:
         that sent them jobs."""
         import signal
 
-        for drawer in self._drawers[1:]:
-            if drawer.known.is_set() and not drawer.gone and drawer.pid is not None:
+        ended: set[int] = set()
+
+        def end(drawer: _Drawer) -> None:
+            # a process forked by the first: ended once its pid is known, and only while
+            # its pipe is open (a pid of a process gone may be another's by now)
+            if drawer.known.is_set() and not drawer.gone and drawer.pid not in (None, *ended):
+                ended.add(drawer.pid)
                 with contextlib.suppress(OSError):
                     os.kill(drawer.pid, signal.SIGTERM)
+
+        for drawer in self._drawers[1:]:
+            end(drawer)
         first = self._first
         if first is not None:
             with contextlib.suppress(Exception):
@@ -239,9 +251,8 @@ class _Pools:
         # the first is gone: a process it forked has said who it is, or is gone too (its
         # end of the pipe closed); one forked as the first was ended is ended now
         for drawer in self._drawers[1:]:
-            if drawer.known.wait(5) and not drawer.gone and drawer.pid is not None:
-                with contextlib.suppress(OSError):
-                    os.kill(drawer.pid, signal.SIGTERM)
+            drawer.known.wait(5)
+            end(drawer)
         for drawer in self._drawers:
             drawer.jobs.put(None)           # a thread waiting for a job finds the pipe shut
         for drawer in self._drawers:
@@ -306,6 +317,10 @@ def _fork_sibling(end: Any, ends: list[Any]) -> int:
 _fork = os.fork if hasattr(os, "fork") else None
 
 
+#: Seconds between two looks of a drawing process at its parent.
+_WATCH_EVERY = 1.0
+
+
 def _keep_to(parent: int) -> None:
     """Ctrl-C left to the evaluate process (which ends the drawing; no traceback from each
     drawing process), and an end of this process's own when its parent is gone (killed: it
@@ -317,20 +332,24 @@ def _keep_to(parent: int) -> None:
 
     def watch() -> None:
         while os.getppid() == parent:
-            time.sleep(1.0)
+            time.sleep(_WATCH_EVERY)
         os._exit(1)
 
     threading.Thread(target=watch, name="opspec-drawing-watch", daemon=True).start()
 
 
 def _warm_up() -> None:
-    """matplotlib imported, its default font found and loaded."""
+    """matplotlib imported, its default font found and loaded, and what the figure
+    functions import as they draw (the numbers' format, the panels' layout: 0.02 CPU-s,
+    which each process otherwise paid after the replications)."""
     try:
         _import_matplotlib()
         from matplotlib import font_manager
         from matplotlib.ft2font import FT2Font
 
         FT2Font(font_manager.findfont(font_manager.FontProperties()))
+        import opspec.evaluation.figure_layout
+        import opspec.evaluation.tables  # noqa: F401
     except Exception:  # noqa: BLE001, S110 - a figure drawn later says what is wrong
         pass
 

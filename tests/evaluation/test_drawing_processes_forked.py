@@ -107,7 +107,10 @@ def test_a_first_process_that_cannot_be_forked_leaves_the_figures_to_this_proces
     assert [p.read_bytes() for p in here] == [p.read_bytes() for p in alone]
 
 
-def test_a_failure_ends_both_processes_at_once_while_they_draw() -> None:
+def test_a_failure_ends_both_processes_at_once_while_they_draw(
+        monkeypatch: pytest.MonkeyPatch) -> None:
+    # a process left to notice its parent gone by itself would live on for a minute
+    monkeypatch.setattr(drawing_pools, "_WATCH_EVERY", 60.0)
     before = _drawing_children()
     started = time.monotonic()
     with pytest.raises(RuntimeError, match="a bad spec"), plots.drawing_processes(2):
@@ -121,9 +124,9 @@ def test_a_failure_ends_both_processes_at_once_while_they_draw() -> None:
         raise RuntimeError("a bad spec")
     assert time.monotonic() - started < 20
     assert _drawing_children() == before
-    deadline = time.monotonic() + 5
+    deadline = time.monotonic() + 2
     while not all(_gone(pid) for pid in pids) and time.monotonic() < deadline:
-        time.sleep(0.05)
+        time.sleep(0.02)
     assert all(_gone(pid) for pid in pids)
 
 
