@@ -67,40 +67,36 @@ def started_pools() -> _Pools | None:
     return _POOL.get()
 
 
+#: A figure to draw: its future, and the function (module-level, pickled by name) and its
+#: arguments; ``None`` tells a drawing process to end.
+_Job = tuple[Any, Callable[..., Any], tuple[Any, ...]]
+
+
 class _Drawer:
-    """One drawing process as the evaluate process sees it: its pipe, the jobs sent to it
-    and a thread that hands them over one at a time (a job waits here, not in the pipe, so
-    that a large one never blocks the evaluate process while the drawing process is busy),
-    and the process id (the first's known at its fork; the others say theirs as they start).
-    """
+    """One drawing process as the evaluate process sees it: its pipe, the thread that hands
+    it the jobs waiting in the pools' queue one at a time (whichever process is free takes
+    the next figure; a job waits there, not in a pipe, so that a large one never blocks the
+    evaluate process while the drawing processes are busy), and its process id (the first's
+    known at its fork; the others say theirs as they start)."""
 
     def __init__(self, end: Any, pid: int | None, pools: _Pools) -> None:
-        import queue
-
         self.end, self.pid, self._pools = end, pid, pools
-        self.jobs: queue.SimpleQueue[tuple[Any, Callable[..., Any], tuple[Any, ...]] | None]
-        self.jobs = queue.SimpleQueue()
-        self.futures: list[Any] = []        # sent to this process and not seen done
-        self.gone = False                   # no more jobs for it: told to end, or gone
+        self.gone = False                   # takes no more jobs: told to end, or gone
         self.known = threading.Event()      # its pid is known, or it is gone
         self.thread = threading.Thread(target=self._hand_over, name="opspec-drawing",
                                        daemon=True)
 
-    def unfinished(self) -> int:
-        self.futures = [f for f in self.futures if not f.done()]
-        return len(self.futures)
-
     def _hand_over(self) -> None:
         from multiprocessing.reduction import ForkingPickler
 
-        job = None
+        job: _Job | None = None
         ended: BaseException | None = None
         try:
             if self.pid is None:
                 self.pid = self.end.recv()  # a process forked by the first says who it is
             self.known.set()
             while True:
-                job = self.jobs.get()
+                job = self._pools.jobs.get()
                 if job is None:             # the block ended: the process may end
                     with contextlib.suppress(OSError):
                         self.end.send(None)
@@ -125,44 +121,25 @@ class _Drawer:
         except Exception as error:  # noqa: BLE001 - the pipe shut: the process is gone
             ended = error
         finally:
-            self._ended(job, ended)
-
-    def _ended(self, job: Any, error: BaseException | None) -> None:
-        """No more jobs go to this process (it was told to end, or it is gone): the job it
-        had fails (the figures are then drawn by the evaluate process, where an error is
-        plain); those still waiting for it go to the other processes (all of them, when
-        this one never started), or fail when none is left."""
-        from concurrent.futures.process import BrokenProcessPool
-
-        with _LOCK:
-            self.gone = True
             self.known.set()
-            waiting = []
-            while not self.jobs.empty():
-                waiting.append(self.jobs.get())
-        if job is not None and not job[0].done():
-            with contextlib.suppress(Exception):
-                job[0].set_exception(BrokenProcessPool(
-                    f"a drawing process ended ({type(error).__name__})"))
-        for item in waiting:
-            if item is not None:
-                self._pools.hand_to_another(item)
-
-
-#: Held while a job is given to a drawer or a drawer's ending is noted: no job is given to
-#: a drawer whose thread has stopped taking them.
-_LOCK = threading.Lock()
+            self._pools.ended(self, job, ended)
 
 
 class _Pools:
     """The drawing processes of :func:`drawing_processes` as one executor: the first forked
     by :meth:`start`, the others forked by the first once its matplotlib is imported; each
-    figure goes to the process with the fewest figures still to draw."""
+    figure goes to the first process free to draw it."""
 
     def __init__(self, context: Any, parent: int, workers: int) -> None:
+        import queue
+
         self._context, self._parent, self._workers = context, parent, workers
         self._first: Any = None
         self._drawers: list[_Drawer] = []
+        self.jobs: queue.SimpleQueue[_Job | None] = queue.SimpleQueue()
+        # held while a job is queued or a drawer's end is noted: no job is queued once
+        # every drawer has stopped taking them
+        self._lock = threading.Lock()
 
     def start(self) -> None:
         ends: list[tuple[Any, Any]] = []
@@ -187,36 +164,36 @@ class _Pools:
 
     def submit(self, fn: Callable[..., Any], /, *args: Any) -> Any:
         import concurrent.futures as cf
-
-        future: cf.Future[Any] = cf.Future()
-        if not self.hand_to_another((future, fn, args)):
-            from concurrent.futures.process import BrokenProcessPool
-
-            raise BrokenProcessPool("the drawing processes ended")
-        return future
-
-    def hand_to_another(self, job: tuple[Any, Callable[..., Any], tuple[Any, ...]]) -> bool:
-        """Give ``job`` to the live process with the fewest jobs not done; when none is
-        left, its future fails and False is returned."""
-        with _LOCK:
-            live = [drawer for drawer in self._drawers if not drawer.gone]
-            if live:
-                drawer = min(live, key=_Drawer.unfinished)
-                drawer.futures.append(job[0])
-                drawer.jobs.put(job)
-                return True
         from concurrent.futures.process import BrokenProcessPool
 
-        with contextlib.suppress(Exception):
-            job[0].set_exception(BrokenProcessPool("the drawing processes ended"))
-        return False
+        future: cf.Future[Any] = cf.Future()
+        with self._lock:
+            if all(drawer.gone for drawer in self._drawers):
+                raise BrokenProcessPool("the drawing processes ended")
+            self.jobs.put((future, fn, args))
+        return future
+
+    def ended(self, drawer: _Drawer, job: _Job | None, error: BaseException | None
+              ) -> None:
+        """``drawer`` takes no more jobs (it was told to end, or its process is gone): the
+        job it had fails (the figures are then drawn by the evaluate process, where an error
+        is plain); once no drawer is left, so do those still queued."""
+        from concurrent.futures.process import BrokenProcessPool
+
+        broken = BrokenProcessPool(f"a drawing process ended ({type(error).__name__})")
+        with self._lock:
+            drawer.gone = True
+            left = [] if not all(d.gone for d in self._drawers) else [
+                self.jobs.get() for _ in range(self.jobs.qsize())]
+        for item in [job, *left]:
+            if item is not None and not item[0].done():
+                with contextlib.suppress(Exception):
+                    item[0].set_exception(broken)
 
     def shutdown(self) -> None:
         """Let the processes end once they have drawn what was sent, and wait for them."""
-        for drawer in self._drawers:
-            for future in drawer.futures:
-                future.cancel()             # those not handed over yet
-            drawer.jobs.put(None)
+        for _ in self._drawers:
+            self.jobs.put(None)
         for drawer in self._drawers:
             drawer.thread.join()
         if self._first is not None:
@@ -253,8 +230,8 @@ class _Pools:
         for drawer in self._drawers[1:]:
             drawer.known.wait(5)
             end(drawer)
-        for drawer in self._drawers:
-            drawer.jobs.put(None)           # a thread waiting for a job finds the pipe shut
+        for _ in self._drawers:
+            self.jobs.put(None)             # a thread waiting for a job finds the pipe shut
         for drawer in self._drawers:
             drawer.thread.join(5)
 
@@ -365,7 +342,7 @@ def _serve(end: Any) -> None:
         except EOFError:
             return
         try:
-            job = pickle.loads(message)     # noqa: S301 - from the evaluate process
+            job = pickle.loads(message)     # from the evaluate process
             if job is None:
                 return
             fn, args = job

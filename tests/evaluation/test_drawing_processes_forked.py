@@ -16,10 +16,9 @@ import time
 from pathlib import Path
 
 import pytest
+from figure_samples import RATES, figures
 
 from opspec.evaluation import drawing_pools, plots
-
-from figure_samples import RATES, figures
 
 
 def _figures(folder: Path) -> list[Path]:
@@ -37,6 +36,18 @@ def _who(pause: float = 0.0) -> tuple[int, int, bool]:
     return os.getpid(), os.getppid(), "matplotlib.figure" in sys.modules
 
 
+def _both(pools: drawing_pools._Pools) -> list[tuple[int, int, bool]]:
+    """What :func:`_who` says in each of the two processes: two jobs at once, each taken by
+    a free process, until the second (forked once the first has imported matplotlib)
+    takes one."""
+    for _ in range(40):
+        answers = [future.result() for future in [pools.submit(_who, 0.25)
+                                                  for _ in range(2)]]
+        if answers[0][0] != answers[1][0]:
+            return answers
+    raise AssertionError("one process took every job")
+
+
 def _gone(pid: int) -> bool:
     try:
         state = Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()[0]
@@ -52,11 +63,10 @@ def test_one_forked_here_the_other_by_it_and_the_same_figures(tmp_path: Path) ->
         assert _drawing_children() == before + 1        # the second is not this one's child
         pools = drawing_pools.started_pools()
         assert pools is not None
-        # two jobs at once: one to each process (the least busy); both have matplotlib
-        # before drawing anything, the second forked by the first
-        a, b = pools.submit(_who, 0.5), pools.submit(_who, 0.5)
-        (first, parent, ready), (second, its_parent, its_ready) = a.result(), b.result()
-        assert parent == os.getpid() and its_parent == first and first != second
+        # both have matplotlib before drawing anything, the second forked by the first
+        (first, parent, ready), (second, its_parent, its_ready) = sorted(
+            _both(pools), key=lambda answer: answer[1] != os.getpid())
+        assert parent == os.getpid() and its_parent == first
         assert ready and its_ready
         with plots.drawn_by(2):
             together = _figures(tmp_path / "together")
@@ -116,8 +126,7 @@ def test_a_failure_ends_both_processes_at_once_while_they_draw(
     with pytest.raises(RuntimeError, match="a bad spec"), plots.drawing_processes(2):
         pools = drawing_pools.started_pools()
         assert pools is not None
-        a, b = pools.submit(_who), pools.submit(_who)
-        pids = [a.result()[0], b.result()[0]]
+        pids = [pid for pid, _, _ in _both(pools)]
         pools.submit(_who, 60)              # each busy for a minute
         pools.submit(_who, 60)
         time.sleep(0.2)
@@ -136,12 +145,16 @@ from opspec.evaluation import drawing_pools
 from opspec.evaluation.drawing_pools import drawing_processes
 
 def who():
+    time.sleep(0.25)
     return os.getpid()
 
 with drawing_processes(2):
     pools = drawing_pools.started_pools()
-    a, b = pools.submit(who), pools.submit(who)
-    print(a.result(), b.result(), flush=True)
+    for _ in range(40):
+        pids = {future.result() for future in [pools.submit(who), pools.submit(who)]}
+        if len(pids) == 2:
+            break
+    print(*pids, flush=True)
     time.sleep(120)
 """
 
@@ -152,9 +165,11 @@ def test_no_drawing_process_outlives_a_killed_evaluate_process(tmp_path: Path) -
     script.write_text(_KILLED, encoding="utf-8")
     with subprocess.Popen([sys.executable, str(script)], stdout=subprocess.PIPE,
                           text=True) as evaluate:
-        pids = [int(pid) for pid in evaluate.stdout.readline().split()]   # type: ignore[union-attr]
-        assert len(set(pids)) == 2
-        evaluate.send_signal(signal.SIGKILL)
+        try:
+            pids = [int(pid) for pid in evaluate.stdout.readline().split()]  # type: ignore[union-attr]
+        finally:
+            evaluate.send_signal(signal.SIGKILL)
+    assert len(set(pids)) == 2
     deadline = time.monotonic() + 10
     while not all(_gone(pid) for pid in pids) and time.monotonic() < deadline:
         time.sleep(0.1)
