@@ -5,9 +5,11 @@ spec or runs its replications, and then draw the figures :mod:`.figure_queue` se
 
 One process is forked at once; it imports matplotlib and then forks the others itself, so
 that they inherit its import instead of each paying for it again (0.27 CPU-s a process,
-during the replications, which ``--workers 1`` does not pay). Each process is sent its jobs
-(a module-level function, pickled by name, and its arguments) one at a time over a pipe of
-its own, by a thread of the evaluate process (:class:`_Drawer`).
+during the replications, which ``--workers 1`` does not pay). The figures wait in one queue
+of the evaluate process; a thread of it per drawing process (:class:`_Drawer`) hands the
+next one (a module-level function, pickled by name, and its arguments) to its process over
+a pipe of their own as soon as that process is free, so each figure goes to the first
+process free to draw it.
 """
 
 from __future__ import annotations
