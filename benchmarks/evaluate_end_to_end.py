@@ -206,9 +206,10 @@ def engine_alone(users: int, days: int, seed: int) -> Measured:
 def estimated_wall(phases: dict[str, float], workers: int) -> float:
     """The wall time of one evaluate on ``workers`` idle cores, from the CPU of its parts:
     start-up alone, the replications' workers and this process's storing shared over the
-    cores, this process's tail (summaries, tables), the figures' processes shared over the
-    cores. An upper bound where the tail overlaps the figures' start (W > 1); what a
-    machine loaded by others cannot show in wall time. What the drawing processes spent
+    cores, this process's tail (the sample index built once the last replication is
+    stored, summaries, tables), the figures' processes shared over the cores. An upper
+    bound where the tail overlaps the figures' start (W > 1); what a machine loaded by
+    others cannot show in wall time. What the drawing processes spent
     during the start-up (``early``), on the cores it leaves idle, costs no wall time."""
     cores = max(1, workers)
     early = min(phases.get("early", 0.0), (cores - 1) * phases["before"])
