@@ -1,8 +1,8 @@
 """A few figures of the report drawn from fixed numbers, for the tests that compare figures
 drawn in the report's drawing processes with those drawn one after another in the test's own
 process (tests/evaluation_output/test_drawing_processes.py, the processes started as the
-replications end; tests/evaluation/test_staggered_drawing_processes.py, the processes forked
-before the spec is loaded). Importable from every folder of tests/ (the root conftest's
+replications end; tests/evaluation/test_drawing_processes_forked.py, the first forked before
+the spec is loaded, the others by it). Importable from every folder of tests/ (the root conftest's
 folder is on sys.path)."""
 
 from __future__ import annotations

@@ -108,15 +108,14 @@ def run(args: argparse.Namespace) -> int:
         raise EvaluationError(f"--workers must be >= 1, not {workers}")
     from opspec.evaluation import plots
 
-    # the report's drawing processes (--workers W > 1) start now: as many as the cores this
-    # start-up leaves idle (it is the run's one serial part) import matplotlib while this
-    # process loads and checks the specs and the user model; the others are forked once the
-    # replications start (plots.staggered_start); a bad input ends them at once
-    # (plots.drawing_processes), so its error comes as fast as before
+    # the report's drawing processes (--workers W > 1) start now: the first imports
+    # matplotlib while this process loads and checks the specs and the user model (the
+    # run's one serial part, which leaves the other cores idle), then forks the others,
+    # which inherit its import; a bad input ends them at once (plots.drawing_processes), so
+    # its error comes as fast as before
     listing = bool(args.sweep) and args.sweep[0] == "list"
     cores = _local_cores()
-    with plots.staggered_start(max(1, cores - 1)), \
-            plots.drawing_processes(1 if listing else min(workers, cores)):
+    with plots.drawing_processes(1 if listing else min(workers, cores)):
         from opspec.commands.evaluate_run import evaluate
 
         return evaluate(args, workers, cores)

@@ -142,17 +142,12 @@ def _replicate(args: argparse.Namespace, store: Any, plan: Any, swept: Any, work
                cores: int, timeout: float) -> Results:
     """Run the replications ``store`` does not hold yet, summarise them and write the
     report; the store is closed at the end."""
-    from opspec.evaluation import plots
     from opspec.evaluation.memory import startup_frozen
     from opspec.evaluation.progress import make_progress
     from opspec.evaluation.runner import run_evaluation
 
     # what is loaded by now lives through the run: the collector need not scan it again
     with store, contextlib.ExitStack() as stack, startup_frozen():
-        # the drawing processes not forked yet are forked now, inheriting what the start-up
-        # loaded (frozen: their collector leaves it alone too), and import matplotlib beside
-        # the replications, whose chunks share the cores
-        plots.warm_up_the_rest()
         on_trace = trace_writers(stack, store.folder, plan)
         progress = make_progress(sys.stderr, quiet=args.quiet or args.json,
                                  label="users" if len(plan.designs) == 1 else "replications")

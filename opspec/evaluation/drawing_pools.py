@@ -1,16 +1,22 @@
 """The drawing processes: worker processes started before the report's figures are asked
-for, which import matplotlib (and load its font) while the evaluate process still runs its
-replications or works out what to draw, and then draw the figures :mod:`.figure_queue` sends
-them. ``opspec evaluate --workers W`` starts them (:func:`drawing_processes`, within
-:func:`staggered_start`).
+for, which import matplotlib (and load its font) while the evaluate process still loads the
+spec or runs its replications, and then draw the figures :mod:`.figure_queue` sends them.
+``opspec evaluate --workers W`` starts them (:func:`drawing_processes`).
 
-The functions they are sent (:func:`_warm_up`, :func:`_ready`, and the queue's
-``_draw_named``) are module-level functions, pickled by name.
+One process is forked at once; it imports matplotlib and then forks the others itself, so
+that they inherit its import instead of each paying for it again (0.27 CPU-s a process,
+during the replications, which ``--workers 1`` does not pay). The figures wait in one queue
+of the evaluate process; a thread of it per drawing process (:class:`_Drawer`) hands the
+next one (a module-level function, pickled by name, and its arguments) to its process over
+a pipe of their own as soon as that process is free, so each figure goes to the first
+process free to draw it.
 """
 
 from __future__ import annotations
 
 import contextlib
+import os
+import threading
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 from contextvars import ContextVar
@@ -18,39 +24,33 @@ from typing import Any
 
 from opspec.evaluation.matplotlib_import import import_matplotlib as _import_matplotlib
 
-__all__ = ["drawing_processes", "staggered_start", "started_pools", "warm_up_the_rest"]
+__all__ = ["drawing_processes", "started_pools"]
 
 
 @contextmanager
 def drawing_processes(workers: int) -> Iterator[None]:
     """Start up to ``workers`` drawing processes now, for the :func:`.figure_queue.drawn_by`
-    blocks within this one: each imports matplotlib (and loads its font) while this process
-    still works out what to draw. ``opspec evaluate --workers W`` starts them before its
-    replications, so that matplotlib is ready when the first figure is asked for: its
-    import (0.3 CPU-s in each process) shares the cores with the replications' chunks, which
-    any core can run, instead of delaying the figures after them. Nothing happens with one
-    worker or where processes cannot be forked.
+    blocks within this one. ``opspec evaluate --workers W`` starts them before it loads the
+    spec: the first one imports matplotlib (and loads its font) on the core that start-up
+    leaves idle, then forks the others, which inherit its import; matplotlib is ready when
+    the first figure is asked for. Nothing happens with one worker or where processes cannot
+    be forked.
 
-    Within :func:`staggered_start` only that many are forked now, the others when
-    :func:`warm_up_the_rest` is called or the first figure is sent. A failure or Ctrl-C
-    within the block ends the processes at once, without waiting for their import."""
-    import os
-
+    A failure or Ctrl-C within the block ends the processes at once, without waiting for
+    their import."""
     if workers <= 1 or not hasattr(os, "fork") or _POOL.get() is not None:
         yield
         return
     import multiprocessing
 
-    first = _FIRST.get()
-    pools = _Pools(multiprocessing.get_context("fork"), os.getpid(), workers,
-                   workers if first is None else min(workers, max(1, first)))
+    pools = _Pools(multiprocessing.get_context("fork"), os.getpid(), workers)
     try:
-        pools.start_first()                 # forks them now (not at the first figure)
+        pools.start()                       # forks the first now (not at the first figure)
     except Exception:  # noqa: BLE001 - no processes: the figures are drawn as before
-        pools.end_now()                     # those forked before the failure, if any
+        pools.end_now()                     # what was started before the failure, if any
         yield
         return
-    token = _POOL.set((pools, workers))
+    token = _POOL.set(pools)
     try:
         yield
     except BaseException:
@@ -60,144 +60,298 @@ def drawing_processes(workers: int) -> Iterator[None]:
         raise
     finally:
         _POOL.reset(token)
-        pools.shutdown(wait=True, cancel_futures=True)
+        pools.shutdown()
 
 
-@contextmanager
-def staggered_start(first: int) -> Iterator[None]:
-    """Within this block :func:`drawing_processes` forks only ``first`` processes at once;
-    the others when :func:`warm_up_the_rest` is called or the first figure is sent.
-    ``opspec evaluate`` starts its drawing processes before it loads the spec, whose
-    start-up leaves every core but one idle: as many processes as those cores import
-    matplotlib then, without slowing that start-up (nor a bad input's error); the others,
-    forked as the replications start, inherit what the start-up loaded (NumPy, importlib's
-    metadata: 0.1 CPU-s of each one's import)."""
-    token = _FIRST.set(first)
-    try:
-        yield
-    finally:
-        _FIRST.reset(token)
+def started_pools() -> _Pools | None:
+    """The drawing processes of the :func:`drawing_processes` block this is called in, if
+    they were started."""
+    return _POOL.get()
 
 
-#: Within :func:`staggered_start`: how many drawing processes are forked at once.
-_FIRST: ContextVar[int | None] = ContextVar("opspec_drawing_first", default=None)
+#: A figure to draw: its future, and the function (module-level, pickled by name) and its
+#: arguments; ``None`` tells a drawing process to end.
+_Job = tuple[Any, Callable[..., Any], tuple[Any, ...]]
 
 
-def warm_up_the_rest() -> None:
-    """Fork the drawing processes of :func:`drawing_processes` not forked yet (past
-    :func:`staggered_start`'s ``first``), to import matplotlib now."""
-    started = _POOL.get()
-    if started is not None:
-        started[0].start_rest()
+class _Drawer:
+    """One drawing process as the evaluate process sees it: its pipe, the thread that hands
+    it the jobs waiting in the pools' queue one at a time (whichever process is free takes
+    the next figure; a job waits there, not in a pipe, so that a large one never blocks the
+    evaluate process while the drawing processes are busy), and its process id (the first's
+    known at its fork; the others say theirs as they start)."""
+
+    def __init__(self, end: Any, pid: int | None, pools: _Pools) -> None:
+        self.end, self.pid, self._pools = end, pid, pools
+        self.gone = False                   # takes no more jobs: told to end, or gone
+        self.known = threading.Event()      # its pid is known, or it is gone
+        self.thread = threading.Thread(target=self._hand_over, name="opspec-drawing",
+                                       daemon=True)
+
+    def _hand_over(self) -> None:
+        from multiprocessing.reduction import ForkingPickler
+
+        job: _Job | None = None
+        ended: BaseException | None = None
+        try:
+            if self.pid is None:
+                self.pid = self.end.recv()  # a process forked by the first says who it is
+            self.known.set()
+            while True:
+                job = self._pools.jobs.get()
+                if job is None:             # the block ended: the process may end
+                    with contextlib.suppress(OSError):
+                        self.end.send(None)
+                    return
+                future, fn, args = job
+                if not future.set_running_or_notify_cancel():
+                    continue
+                try:
+                    message = ForkingPickler.dumps((fn, args))
+                except Exception as error:  # noqa: BLE001 - what cannot be sent fails alone
+                    future.set_exception(error)
+                    continue
+                self.end.send_bytes(message)
+                try:
+                    done, value = self.end.recv()
+                except (EOFError, OSError):
+                    raise
+                except Exception as error:  # noqa: BLE001 - an answer that cannot be read
+                    done, value = False, error
+                (future.set_result if done else future.set_exception)(value)
+                job = None
+        except Exception as error:  # noqa: BLE001 - the pipe shut: the process is gone
+            ended = error
+        finally:
+            self.known.set()
+            self._pools.ended(self, job, ended)
 
 
 class _Pools:
-    """The drawing processes of :func:`drawing_processes` as one executor: ``first`` of the
-    ``workers`` forked by :meth:`start_first`, the others by :meth:`start_rest` (or the
-    first figure sent); each figure goes to the pool with the fewest figures per process
-    still to draw."""
+    """The drawing processes of :func:`drawing_processes` as one executor: the first forked
+    by :meth:`start`, the others forked by the first once its matplotlib is imported; each
+    figure goes to the first process free to draw it."""
 
-    def __init__(self, context: Any, parent: int, workers: int, first: int) -> None:
-        self._context, self._parent = context, parent
-        self._sizes = [first, workers - first]
-        self._pools: list[Any] = []
-        self._sent: list[list[Any]] = []
+    def __init__(self, context: Any, parent: int, workers: int) -> None:
+        import queue
 
-    def _start(self, size: int) -> None:
-        import concurrent.futures as cf
+        self._context, self._parent, self._workers = context, parent, workers
+        self._first: Any = None
+        self._drawers: list[_Drawer] = []
+        self.jobs: queue.SimpleQueue[_Job | None] = queue.SimpleQueue()
+        # held while a job is queued or a drawer's end is noted: no job is queued once
+        # every drawer has stopped taking them
+        self._lock = threading.Lock()
 
-        pool = cf.ProcessPoolExecutor(max_workers=size, initializer=_warm_up,
-                                      initargs=(self._parent,), mp_context=self._context)
-        self._pools.append(pool)
-        self._sent.append([])
-        for _ in range(size):               # a fork context forks them all at the first
-            pool.submit(_ready)
-
-    def start_first(self) -> None:
-        self._start(self._sizes[0])
-
-    def start_rest(self) -> None:
-        if len(self._pools) == 1 and self._sizes[1] > 0:
-            try:
-                self._start(self._sizes[1])
-            except Exception:  # noqa: BLE001 - the first ones draw every figure
-                self._sizes[1] = 0
+    def start(self) -> None:
+        ends: list[tuple[Any, Any]] = []
+        try:
+            ends.extend(self._context.Pipe() for _ in range(self._workers))
+            self._first = self._context.Process(
+                target=_first_process, name="opspec-drawing",
+                args=(self._parent, [theirs for _, theirs in ends],
+                      [ours for ours, _ in ends]))
+            self._first.start()
+        except BaseException:
+            for ours, _ in ends:
+                ours.close()
+            raise
+        finally:
+            for _, theirs in ends:          # theirs alone: a gone process is an end of file
+                theirs.close()
+        self._drawers = [_Drawer(ours, self._first.pid if i == 0 else None, self)
+                         for i, (ours, _) in enumerate(ends)]
+        for drawer in self._drawers:
+            drawer.thread.start()
 
     def submit(self, fn: Callable[..., Any], /, *args: Any) -> Any:
-        self.start_rest()
-        live = [i for i in range(len(self._pools)) if self._sizes[i] > 0]
-        i = min(live, key=lambda k: sum(not f.done() for f in self._sent[k]) / self._sizes[k])
-        future = self._pools[i].submit(fn, *args)
-        self._sent[i].append(future)
+        import concurrent.futures as cf
+        from concurrent.futures.process import BrokenProcessPool
+
+        future: cf.Future[Any] = cf.Future()
+        with self._lock:
+            if all(drawer.gone for drawer in self._drawers):
+                raise BrokenProcessPool("the drawing processes ended")
+            self.jobs.put((future, fn, args))
         return future
 
-    def shutdown(self, wait: bool = True, *, cancel_futures: bool = False) -> None:
-        for pool in self._pools:
-            pool.shutdown(wait=wait, cancel_futures=cancel_futures)
+    def ended(self, drawer: _Drawer, job: _Job | None, error: BaseException | None
+              ) -> None:
+        """``drawer`` takes no more jobs (it was told to end, or its process is gone): the
+        job it had fails (the figures are then drawn by the evaluate process, where an error
+        is plain); once no drawer is left, so do those still queued."""
+        from concurrent.futures.process import BrokenProcessPool
+
+        broken = BrokenProcessPool(f"a drawing process ended ({type(error).__name__})")
+        with self._lock:
+            drawer.gone = True
+            left = [] if not all(d.gone for d in self._drawers) else [
+                self.jobs.get() for _ in range(self.jobs.qsize())]
+        for item in [job, *left]:
+            if item is not None and not item[0].done():
+                with contextlib.suppress(Exception):
+                    item[0].set_exception(broken)
+
+    def shutdown(self) -> None:
+        """Let the processes end once they have drawn what was sent, and wait for them."""
+        for _ in self._drawers:
+            self.jobs.put(None)
+        for drawer in self._drawers:
+            drawer.thread.join()
+        if self._first is not None:
+            self._first.join()              # which waits for the processes it forked
 
     def end_now(self) -> None:
-        """End every drawing process without waiting for its work, and then each pool's
-        managing thread."""
-        # the executor keeps its processes in a private field (terminate_workers: Python
-        # 3.14), which shutdown empties
-        processes = [process for pool in self._pools
-                     for process in (getattr(pool, "_processes", None) or {}).values()]
-        for process in processes:
+        """End every drawing process without waiting for its work, and then the threads
+        that sent them jobs."""
+        import signal
+
+        ended: set[int] = set()
+
+        def end(drawer: _Drawer) -> None:
+            # a process forked by the first: ended once its pid is known, and only while
+            # its pipe is open (a pid of a process gone may be another's by now)
+            if drawer.known.is_set() and not drawer.gone and drawer.pid not in (None, *ended):
+                ended.add(drawer.pid)
+                with contextlib.suppress(OSError):
+                    os.kill(drawer.pid, signal.SIGTERM)
+
+        for drawer in self._drawers[1:]:
+            end(drawer)
+        first = self._first
+        if first is not None:
             with contextlib.suppress(Exception):
-                process.terminate()
-        for process in processes:            # gone before the error is shown
+                first.terminate()
             with contextlib.suppress(Exception):
-                process.join(5)
-                if process.is_alive():
-                    process.kill()
-                    process.join(5)
-        # With its processes gone, each pool's managing thread finds the pool broken and
-        # ends, closing its wake-up pipe; waiting for that here matters: at the
-        # interpreter's exit Python 3.11 wakes every such thread without a lock, and one
-        # closing its pipe at that moment printed "Bad file descriptor" and a traceback
-        # after the error (CPython gh-84176; later 3.12 and 3.13 releases lock it, gh-125451)
-        self.shutdown(wait=True, cancel_futures=True)
+                first.join(5)
+                if first.is_alive():
+                    first.kill()
+                    first.join(5)
+        # the first is gone: a process it forked has said who it is, or is gone too (its
+        # end of the pipe closed); one forked as the first was ended is ended now
+        for drawer in self._drawers[1:]:
+            drawer.known.wait(5)
+            end(drawer)
+        for _ in self._drawers:
+            self.jobs.put(None)             # a thread waiting for a job finds the pipe shut
+        for drawer in self._drawers:
+            drawer.thread.join(5)
 
 
-#: Within :func:`drawing_processes`: its processes (:class:`_Pools`) and how many.
-_POOL: ContextVar[tuple[Any, int] | None] = ContextVar("opspec_drawing_pool", default=None)
+#: Within :func:`drawing_processes`: its processes (:class:`_Pools`).
+_POOL: ContextVar[_Pools | None] = ContextVar("opspec_drawing_pool", default=None)
 
 
-def _warm_up(parent: int) -> None:
-    """A drawing process's start: Ctrl-C left to the evaluate process (which stops the
-    pool; no traceback from each drawing process), an end of its own when that process is
-    gone (killed: it cannot stop the pool, and a drawing process waiting for figures would
-    live on), matplotlib imported, its default font found and loaded."""
-    import os
+def _first_process(parent: int, ends: list[Any], not_ours: list[Any]) -> None:
+    """The first drawing process: matplotlib imported, the others forked (each inherits the
+    import), its own jobs drawn; it ends once the processes it forked have ended."""
+    for end in not_ours:                    # the evaluate process's ends of the pipes
+        end.close()
+    _keep_to(parent)
+    _warm_up()
+    forked = []
+    for end in ends[1:]:
+        try:
+            forked.append(_fork_sibling(end, ends))
+        except OSError:                     # the first draws what that one would have
+            pass
+        end.close()                         # that process's alone now (or nobody's)
+    try:
+        _serve(ends[0])
+    finally:
+        for pid in forked:                  # their CPU time counts as this process's
+            with contextlib.suppress(OSError):
+                os.waitpid(pid, 0)
+
+
+def _fork_sibling(end: Any, ends: list[Any]) -> int:
+    """Fork a drawing process from the first, which has imported matplotlib: it draws the
+    jobs sent on ``end``. Returns its pid (in the first process)."""
+    import sys
+
+    first = os.getpid()
+    for stream in (sys.stdout, sys.stderr):     # nothing buffered is written twice
+        with contextlib.suppress(Exception):
+            stream.flush()
+    pid = _fork()
+    if pid:
+        return pid
+    status = 1
+    try:
+        for other in ends:
+            if other is not end:
+                other.close()
+        _keep_to(first)
+        end.send(os.getpid())
+        _serve(end)
+        status = 0
+    finally:
+        for stream in (sys.stdout, sys.stderr):
+            with contextlib.suppress(Exception):
+                stream.flush()
+        os._exit(status)
+
+
+#: How the first drawing process forks the others (a test refuses it).
+_fork = os.fork if hasattr(os, "fork") else None
+
+
+#: Seconds between two looks of a drawing process at its parent.
+_WATCH_EVERY = 1.0
+
+
+def _keep_to(parent: int) -> None:
+    """Ctrl-C left to the evaluate process (which ends the drawing; no traceback from each
+    drawing process), and an end of this process's own when its parent is gone (killed: it
+    cannot end it, and a drawing process waiting for figures would live on)."""
     import signal
-    import threading
     import time
 
     signal.signal(signal.SIGINT, signal.SIG_IGN)
 
     def watch() -> None:
         while os.getppid() == parent:
-            time.sleep(1.0)
+            time.sleep(_WATCH_EVERY)
         os._exit(1)
 
     threading.Thread(target=watch, name="opspec-drawing-watch", daemon=True).start()
+
+
+def _warm_up() -> None:
+    """matplotlib imported, its default font found and loaded, and what the figure
+    functions import as they draw (the numbers' format, the panels' layout: 0.02 CPU-s,
+    which each process otherwise paid after the replications)."""
     try:
         _import_matplotlib()
         from matplotlib import font_manager
         from matplotlib.ft2font import FT2Font
 
         FT2Font(font_manager.findfont(font_manager.FontProperties()))
+        import opspec.evaluation.figure_layout
+        import opspec.evaluation.tables  # noqa: F401
     except Exception:  # noqa: BLE001, S110 - a figure drawn later says what is wrong
         pass
 
 
-def _ready() -> None:
-    """The task that makes the pool fork its processes."""
+def _serve(end: Any) -> None:
+    """Run the jobs sent on ``end`` one after another, answering each with whether it
+    returned and its value or error, until told to stop or the pipe is shut."""
+    import pickle
 
-
-
-def started_pools() -> _Pools | None:
-    """The drawing processes of the :func:`drawing_processes` block this is called in, if
-    they were started."""
-    started = _POOL.get()
-    return None if started is None else started[0]
+    while True:
+        try:
+            message = end.recv_bytes()
+        except EOFError:
+            return
+        try:
+            job = pickle.loads(message)     # from the evaluate process
+            if job is None:
+                return
+            fn, args = job
+            reply: tuple[bool, Any] = (True, fn(*args))
+        except Exception as error:  # noqa: BLE001 - the evaluate process decides
+            reply = (False, error)
+        try:
+            end.send(reply)
+        except Exception as error:  # noqa: BLE001 - an answer that cannot be pickled
+            end.send((False, RuntimeError(f"{type(error).__name__}: {error}")))

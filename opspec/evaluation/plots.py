@@ -31,11 +31,7 @@ opspec.evaluation.plots`` stays light.
 from __future__ import annotations
 
 from opspec.evaluation.comparison_figures import comparison_figure, sweep_figure
-from opspec.evaluation.drawing_pools import (
-    drawing_processes,
-    staggered_start,
-    warm_up_the_rest,
-)
+from opspec.evaluation.drawing_pools import drawing_processes
 from opspec.evaluation.figure_files import (
     DPI,
     FORMATS,
@@ -82,10 +78,8 @@ __all__ = [
     "parameters_figure",
     "per_user_figure",
     "rates_figure",
-    "staggered_start",
     "subgroups_figure",
     "sweep_figure",
     "time_of_day_figure",
     "user_distribution",
-    "warm_up_the_rest",
 ]

@@ -53,9 +53,11 @@ def slow_drawing(monkeypatch: pytest.MonkeyPatch, tmp_path: Path) -> tuple[Path,
 
 def _pool_threads_alive() -> list[threading.Thread]:
     """The process pools' managing threads still running (each one's wake-up pipe is
-    written to at the interpreter's exit)."""
+    written to at the interpreter's exit), and the threads that send the drawing processes
+    their figures."""
     return [t for t in threading.enumerate()
-            if isinstance(t, pool_internals._ExecutorManagerThread) and t.is_alive()]
+            if (isinstance(t, pool_internals._ExecutorManagerThread)
+                or t.name == "opspec-drawing") and t.is_alive()]
 
 
 def _two_cores(monkeypatch: pytest.MonkeyPatch) -> None:

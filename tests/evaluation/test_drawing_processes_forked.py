@@ -1,0 +1,176 @@
+"""`opspec evaluate --workers 2` forks one drawing process before it loads the spec (on the
+core its start-up leaves idle); that one imports matplotlib and then forks the others, which
+inherit its import (``plots.drawing_processes``). The figures those processes draw must be
+the bytes drawn one after another, whichever process draws each; a process that cannot be
+forked leaves its figures to the others (or to this process); and none outlives the block,
+a failure within it, or a killed evaluate process."""
+
+from __future__ import annotations
+
+import multiprocessing
+import os
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import pytest
+from figure_samples import RATES, figures
+
+from opspec.evaluation import drawing_pools, plots
+
+
+def _figures(folder: Path) -> list[Path]:
+    """The three sample figures and a fourth: a rates figure of one row."""
+    return [*figures(folder), plots.rates_figure(RATES[:1], folder / "rates-1.svg")]
+
+
+def _drawing_children() -> int:
+    return len(multiprocessing.active_children())
+
+
+def _who(pause: float = 0.0) -> tuple[int, int, bool]:
+    """Run in a drawing process: its pid, its parent's, whether matplotlib is imported."""
+    time.sleep(pause)
+    return os.getpid(), os.getppid(), "matplotlib.figure" in sys.modules
+
+
+def _both(pools: drawing_pools._Pools) -> list[tuple[int, int, bool]]:
+    """What :func:`_who` says in each of the two processes: two jobs at once, each taken by
+    a free process, until the second (forked once the first has imported matplotlib)
+    takes one."""
+    for _ in range(40):
+        answers = [future.result() for future in [pools.submit(_who, 0.25)
+                                                  for _ in range(2)]]
+        if answers[0][0] != answers[1][0]:
+            return answers
+    raise AssertionError("one process took every job")
+
+
+def _gone(pid: int) -> bool:
+    try:
+        state = Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()[0]
+    except OSError:
+        return True
+    return state in ("Z", "X")              # ended, not yet collected by whoever adopted it
+
+
+def test_one_forked_here_the_other_by_it_and_the_same_figures(tmp_path: Path) -> None:
+    alone = _figures(tmp_path / "alone")
+    before = _drawing_children()
+    with plots.drawing_processes(2):
+        assert _drawing_children() == before + 1        # the second is not this one's child
+        pools = drawing_pools.started_pools()
+        assert pools is not None
+        # both have matplotlib before drawing anything, the second forked by the first
+        (first, parent, ready), (second, its_parent, its_ready) = sorted(
+            _both(pools), key=lambda answer: answer[1] != os.getpid())
+        assert parent == os.getpid() and its_parent == first
+        assert ready and its_ready
+        with plots.drawn_by(2):
+            together = _figures(tmp_path / "together")
+        assert all(p.is_file() for p in together)
+    assert [p.read_bytes() for p in together] == [p.read_bytes() for p in alone]
+    assert _drawing_children() == before
+    assert _gone(second)
+
+
+def test_a_process_the_first_cannot_fork_leaves_its_figures_to_the_first(
+        tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    alone = _figures(tmp_path / "alone")
+
+    def refused() -> int:
+        raise OSError(11, "Resource temporarily unavailable")
+
+    monkeypatch.setattr(drawing_pools, "_fork", refused)    # the first inherits it
+    with plots.drawing_processes(2):
+        pools = drawing_pools.started_pools()
+        assert pools is not None
+        pids = {future.result()[0] for future in [pools.submit(_who) for _ in range(4)]}
+        with plots.drawn_by(2):
+            together = _figures(tmp_path / "together")
+    assert len(pids) == 1 and os.getpid() not in pids
+    assert [p.read_bytes() for p in together] == [p.read_bytes() for p in alone]
+
+
+def test_a_first_process_that_cannot_be_forked_leaves_the_figures_to_this_process(
+        tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    """When the machine refuses the fork (too many processes), every figure is drawn here,
+    the same bytes."""
+    alone = _figures(tmp_path / "alone")
+    fork = multiprocessing.get_context("fork")
+
+    class Refused(type(fork).Process):  # type: ignore[misc]
+        def start(self) -> None:
+            raise OSError(11, "Resource temporarily unavailable")
+
+    class Refusing(type(fork)):  # type: ignore[misc]
+        Process = Refused
+
+    monkeypatch.setattr(multiprocessing, "get_context", lambda method=None: Refusing())
+    before = _drawing_children()
+    with plots.drawing_processes(2):
+        assert drawing_pools.started_pools() is None and _drawing_children() == before
+        with plots.drawn_by(2):
+            here = _figures(tmp_path / "here")
+    assert [p.read_bytes() for p in here] == [p.read_bytes() for p in alone]
+
+
+def test_a_failure_ends_both_processes_at_once_while_they_draw(
+        monkeypatch: pytest.MonkeyPatch) -> None:
+    # a process left to notice its parent gone by itself would live on for a minute
+    monkeypatch.setattr(drawing_pools, "_WATCH_EVERY", 60.0)
+    before = _drawing_children()
+    started = time.monotonic()
+    with pytest.raises(RuntimeError, match="a bad spec"), plots.drawing_processes(2):
+        pools = drawing_pools.started_pools()
+        assert pools is not None
+        pids = [pid for pid, _, _ in _both(pools)]
+        pools.submit(_who, 60)              # each busy for a minute
+        pools.submit(_who, 60)
+        time.sleep(0.2)
+        raise RuntimeError("a bad spec")
+    assert time.monotonic() - started < 20
+    assert _drawing_children() == before
+    deadline = time.monotonic() + 2
+    while not all(_gone(pid) for pid in pids) and time.monotonic() < deadline:
+        time.sleep(0.02)
+    assert all(_gone(pid) for pid in pids)
+
+
+_KILLED = """
+import os, sys, time
+from opspec.evaluation import drawing_pools
+from opspec.evaluation.drawing_pools import drawing_processes
+
+def who():
+    time.sleep(0.25)
+    return os.getpid()
+
+with drawing_processes(2):
+    pools = drawing_pools.started_pools()
+    for _ in range(40):
+        pids = {future.result() for future in [pools.submit(who), pools.submit(who)]}
+        if len(pids) == 2:
+            break
+    print(*pids, flush=True)
+    time.sleep(120)
+"""
+
+
+@pytest.mark.skipif(not hasattr(os, "fork"), reason="the drawing processes are forked")
+def test_no_drawing_process_outlives_a_killed_evaluate_process(tmp_path: Path) -> None:
+    script = tmp_path / "killed.py"
+    script.write_text(_KILLED, encoding="utf-8")
+    with subprocess.Popen([sys.executable, str(script)], stdout=subprocess.PIPE,
+                          text=True) as evaluate:
+        try:
+            pids = [int(pid) for pid in evaluate.stdout.readline().split()]  # type: ignore[union-attr]
+        finally:
+            evaluate.send_signal(signal.SIGKILL)
+    assert len(set(pids)) == 2
+    deadline = time.monotonic() + 10
+    while not all(_gone(pid) for pid in pids) and time.monotonic() < deadline:
+        time.sleep(0.1)
+    assert all(_gone(pid) for pid in pids), "orphaned drawing processes"
