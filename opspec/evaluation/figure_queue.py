@@ -42,24 +42,44 @@ class FiguresAhead:
 @contextmanager
 def asked_ahead(workers: int) -> Iterator[FiguresAhead]:
     """Within this block the figure functions queue their figures as within
-    :func:`drawn_by` (sent at once to the started drawing processes, if any) and return their
-    paths, but nothing is drawn or waited for at its end: a later ``drawn_by(workers,
-    ahead=...)`` block does that, with its own figures. ``opspec evaluate --workers W`` asks
-    so for the report's figures that need neither the sample index nor the summaries, as
-    soon as the last replication is stored: they are drawn while the evaluate process builds
-    the index and the summaries, when a core is idle otherwise. With one worker the figures
-    are drawn as they are asked for (nothing is left to the later block)."""
+    :func:`drawn_by` and return their paths; at its end the figures are sent to the started
+    drawing processes (if any), but nothing is waited for: a later ``drawn_by(workers,
+    ahead=...)`` block does that (or draws those not sent) with its own figures. ``opspec
+    evaluate --workers W`` asks so for the report's figures that need neither the sample
+    index nor the summaries, as soon as the last replication is stored: they are drawn while
+    the evaluate process builds the index and the summaries, when a core is idle otherwise.
+    With one worker the figures are drawn as they are asked for (nothing is left to the
+    later block).
+
+    They are sent in ``workers - 1`` batches, each drawn by one process figure after figure,
+    so that the evaluate process keeps a core of its own for the index: sent one by one to
+    two processes on two cores, they took a third of its core, and the index took about
+    twice as long."""
     ahead = FiguresAhead()
     if workers <= 1:
         yield ahead
         return
-    ahead.sent = {} if started_pools() is not None else None
-    token, sending = _QUEUE.set(ahead.queue), _SENT.set(ahead.sent)
+    token, sending = _QUEUE.set(ahead.queue), _SENT.set(None)
     try:
         yield ahead
     finally:
         _QUEUE.reset(token)
         _SENT.reset(sending)
+    pools = started_pools()
+    if pools is None or not ahead.queue:
+        return                          # drawn with the drawn_by block's figures
+    ahead.sent = {}
+    batches: list[list[int]] = [list(range(len(ahead.queue)))[first::workers - 1]
+                                for first in range(min(workers - 1, len(ahead.queue)))]
+    for batch in batches:
+        jobs = [_named(ahead.queue[index]) for index in batch]
+        if any(job is None for job in jobs):
+            continue                    # a replaced figure function: drawn by drawn_by
+        try:
+            future = pools.submit(_draw_all_named, jobs)
+        except Exception:  # noqa: BLE001, S112 - a process gone: drawn at drawn_by's end
+            continue
+        ahead.sent.update(dict.fromkeys(batch, future))
 
 
 @contextmanager
@@ -177,6 +197,20 @@ _FIGURES: dict[str, Any] = {}
 def _draw_named(name: str, args: tuple[Any, ...], kwargs: dict[str, Any], fmt: str | None
                 ) -> None:
     _draw_one((_FIGURES[name], args, kwargs, fmt))
+
+
+def _named(job: _Job) -> tuple[str, tuple[Any, ...], dict[str, Any], str | None] | None:
+    """``job`` as a started drawing process is sent it (its function by name), or None
+    when its function is not the one registered under its name."""
+    draw, args, kwargs, fmt = job
+    name = getattr(draw, "__name__", "")
+    return (name, args, kwargs, fmt) if _FIGURES.get(name) is draw else None
+
+
+def _draw_all_named(jobs: Sequence[tuple[str, tuple[Any, ...], dict[str, Any], str | None]]
+                    ) -> None:
+    for job in jobs:
+        _draw_named(*job)
 
 
 #: The queue :func:`_draw` hands to the processes it forks.
