@@ -119,6 +119,22 @@ def children_cpu():
         pass
     return total
 
+# {pid: CPU s} of every live process below this one (the drawing processes the first one
+# forked are its children, not this one's)
+def descendants_cpu(pid="self"):
+    out = {}
+    try:
+        for task in os.listdir(f"/proc/{pid}/task"):
+            with open(f"/proc/{pid}/task/{task}/children") as f:
+                for child in f.read().split():
+                    with open(f"/proc/{child}/stat") as stat:
+                        fields = stat.read().rsplit(")", 1)[1].split()
+                    out[child] = (int(fields[11]) + int(fields[12])) / os.sysconf("SC_CLK_TCK")
+                    out.update(descendants_cpu(child))
+    except OSError:
+        pass
+    return out
+
 marks = {}
 replications = runner.run_evaluation
 
@@ -142,19 +158,21 @@ def add_many(store, records):
         return storing(store, records)
     finally:
         marks["stored"] = cpu(resource.RUSAGE_SELF)
-        marks["drawing_stored"] = children_cpu()
+        below["stored"] = descendants_cpu()
 
 runner.ResultStore.add_many = add_many
 
 # what the drawing processes draw from then until the report is written (the figures asked
 # for ahead, beside the index and the summaries) runs on the core the evaluate process
-# leaves idle
+# leaves idle: the processes still there then (the replications' are gone) are theirs
 import opspec.evaluation.report as report
 writing = report.write_report
+below = {}
 
 def write_report(*args, **kwargs):
     marks["report"] = cpu(resource.RUSAGE_SELF)
-    marks["drawing_report"] = children_cpu()
+    then, now = below.get("stored", {}), descendants_cpu()
+    marks["beside"] = sum(c - then.get(pid, 0.0) for pid, c in now.items())
     return writing(*args, **kwargs)
 
 report.write_report = write_report
@@ -165,7 +183,6 @@ if "stored" in marks:
     marks["during"] -= tail
     marks["after"] += tail
     marks["alone"] = marks.pop("report") - marks.pop("stored")
-    marks["beside"] = marks.pop("drawing_report") - marks.pop("drawing_stored")
 marks["drawing"] = cpu(resource.RUSAGE_CHILDREN) - marks["workers"]
 with open("/proc/self/statm") as statm:
     now = int(statm.read().split()[1]) * resource.getpagesize() / 2**20
