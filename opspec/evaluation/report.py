@@ -20,12 +20,14 @@ comparison, the failures and the interval methods are its own); the others come 
 :mod:`.report_findings` (the key findings in words), :mod:`.report_users` (who the users
 are) and :mod:`.report_design` (each design's estimates, spread, durations, counts, actions
 and hazards). :mod:`.html` renders the sections as HTML and markdown, :mod:`.plots` draws
-the figures.
+the figures; those that need neither the sample index nor the summaries can be asked for
+before the report is written (:func:`ask_figures_ahead`), to be drawn meanwhile.
 """
 
 from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -113,13 +115,13 @@ def _methods_section(summaries: Any, sections: Sequence[Any]) -> Any:
                       "The interval methods used in this report"),) if rows else ())
 
 
+@dataclass(frozen=True)
 class ReportAhead:
-    """The report's figures asked for before it is written (:func:`ask_figures_ahead`): per
-    design described, what was computed and asked for, and the figures' queue."""
+    """The report's figures asked for before it is written (:func:`ask_figures_ahead`): the
+    figures' queue, and per design described what was computed and asked for."""
 
-    def __init__(self, figures: FiguresAhead, designs: Mapping[str, AskedAhead]) -> None:
-        self.figures = figures
-        self.designs = designs
+    figures: FiguresAhead
+    designs: Mapping[str, AskedAhead]
 
 
 def ask_figures_ahead(store: ResultStore, *, figures: str = "svg", workers: int = 1
