@@ -8,6 +8,9 @@ for once, the same bytes; a read that fails ahead leaves the figures to the repo
 from __future__ import annotations
 
 import inspect
+import multiprocessing
+import threading
+import time
 from collections.abc import Iterator
 from contextlib import contextmanager
 from pathlib import Path
@@ -18,7 +21,7 @@ from figure_samples import DAYS, figures
 
 from conftest import SPEC
 from opspec.errors import EvaluationError
-from opspec.evaluation import drawing_pools, plots, report, report_design
+from opspec.evaluation import drawing_pools, figure_queue, plots, report, report_design
 from opspec.evaluation.store import ResultStore
 
 
@@ -120,3 +123,37 @@ def test_a_read_that_fails_ahead_leaves_the_figures_to_the_report(
     monkeypatch.setattr(report_design, "_activity_rates", fails_once)
     assert _evaluate(evaluate, tmp_path / "two", 2) == alone
     assert failed == ["A"]
+
+
+def test_ctrl_c_at_the_index_does_not_wait_for_the_figures_sent(
+        evaluate: Any, tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    """The figures asked ahead are in a drawing process (slowed to 30 s here) when Ctrl-C
+    comes, as the index is built: the command stops at once with the usual message, the
+    replications stored, no drawing process or thread left."""
+    drawing, sent = figure_queue._draw_named, tmp_path / "a figure asked ahead is drawn"
+
+    def slow(*job: Any) -> None:        # in the drawing process (forked after this patch)
+        sent.touch()
+        time.sleep(30)
+        drawing(*job)
+
+    def interrupted(store: ResultStore) -> None:
+        for _ in range(200):                # the figures sent are being drawn
+            if sent.exists():
+                break
+            time.sleep(0.05)
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(figure_queue, "_draw_named", slow)
+    monkeypatch.setattr(ResultStore, "index", interrupted)
+    before = len(multiprocessing.active_children())
+    started = time.monotonic()
+    status, _, err = evaluate(str(SPEC), "--users", "6", "--days", "2", "--seed", "3",
+                              "--workers", "2", "--quiet", "--out", str(tmp_path / "run"))
+    assert time.monotonic() - started < 20
+    assert sent.exists()
+    assert status == 130
+    assert "evaluate: stopped; 6 of 6 replications are stored" in err
+    assert len(multiprocessing.active_children()) == before
+    assert not [t for t in threading.enumerate() if t.name == "opspec-drawing" and t.is_alive()]
+    assert not (tmp_path / "run" / "figures").exists()
