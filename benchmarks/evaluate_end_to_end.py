@@ -119,6 +119,22 @@ def children_cpu():
         pass
     return total
 
+# {pid: CPU s} of every live process below this one (the drawing processes the first one
+# forked are its children, not this one's)
+def descendants_cpu(pid="self"):
+    out = {}
+    try:
+        for task in os.listdir(f"/proc/{pid}/task"):
+            with open(f"/proc/{pid}/task/{task}/children") as f:
+                for child in f.read().split():
+                    with open(f"/proc/{child}/stat") as stat:
+                        fields = stat.read().rsplit(")", 1)[1].split()
+                    out[child] = (int(fields[11]) + int(fields[12])) / os.sysconf("SC_CLK_TCK")
+                    out.update(descendants_cpu(child))
+    except OSError:
+        pass
+    return out
+
 marks = {}
 replications = runner.run_evaluation
 
@@ -133,22 +149,40 @@ def timed(*args, **kwargs):
 
 runner.run_evaluation = timed
 
-# the index built once the last replication is stored runs after the workers, alone: the
-# tail's, not the storing's beside them
-indexing = runner.ResultStore.index
+# the tail starts as the last replication is stored: what comes after it (the sample index,
+# the summaries, the report's figures asked for ahead of it) runs after the workers, alone
+storing = runner.ResultStore.add_many
 
-def index(store):
-    started = cpu(resource.RUSAGE_SELF)
+def add_many(store, records):
     try:
-        return indexing(store)
+        return storing(store, records)
     finally:
-        marks["index"] = marks.get("index", 0.0) + cpu(resource.RUSAGE_SELF) - started
+        marks["stored"] = cpu(resource.RUSAGE_SELF)
+        below["stored"] = descendants_cpu()
 
-runner.ResultStore.index = index
+runner.ResultStore.add_many = add_many
+
+# what the drawing processes draw from then until the report is written (the figures asked
+# for ahead, beside the index and the summaries) runs on the core the evaluate process
+# leaves idle: the processes still there then (the replications' are gone) are theirs
+import opspec.evaluation.report as report
+writing = report.write_report
+below = {}
+
+def write_report(*args, **kwargs):
+    marks["report"] = cpu(resource.RUSAGE_SELF)
+    then, now = below.get("stored", {}), descendants_cpu()
+    marks["beside"] = sum(c - then.get(pid, 0.0) for pid, c in now.items())
+    return writing(*args, **kwargs)
+
+report.write_report = write_report
 status = main(sys.argv[1:])
 marks["after"] = cpu(resource.RUSAGE_SELF) - marks["before"] - marks["during"]
-marks["during"] -= marks.get("index", 0.0)
-marks["after"] += marks.get("index", 0.0)
+if "stored" in marks:
+    tail = marks["before"] + marks["during"] - marks["stored"]
+    marks["during"] -= tail
+    marks["after"] += tail
+    marks["alone"] = marks.pop("report") - marks.pop("stored")
 marks["drawing"] = cpu(resource.RUSAGE_CHILDREN) - marks["workers"]
 with open("/proc/self/statm") as statm:
     now = int(statm.read().split()[1]) * resource.getpagesize() / 2**20
@@ -206,15 +240,18 @@ def engine_alone(users: int, days: int, seed: int) -> Measured:
 def estimated_wall(phases: dict[str, float], workers: int) -> float:
     """The wall time of one evaluate on ``workers`` idle cores, from the CPU of its parts:
     start-up alone, the replications' workers and this process's storing shared over the
-    cores, this process's tail (the sample index built once the last replication is
-    stored, summaries, tables), the figures' processes shared over the cores. An upper
-    bound where the tail overlaps the figures' start (W > 1); what a machine loaded by
-    others cannot show in wall time. What the drawing processes spent
-    during the start-up (``early``), on the cores it leaves idle, costs no wall time."""
+    cores, this process's tail (from the last replication stored: the sample index, the
+    summaries, the tables), the figures' processes shared over the cores. An upper bound
+    where the tail overlaps the figures (W > 1); what a machine loaded by others cannot show
+    in wall time. What the drawing processes spent during the start-up (``early``), and
+    between the last replication stored and the report's start (``beside``: the figures
+    asked for ahead of it, while this process builds the index and the summaries, its CPU
+    over that span ``alone``), on the cores it leaves idle, costs no wall time."""
     cores = max(1, workers)
     early = min(phases.get("early", 0.0), (cores - 1) * phases["before"])
+    beside = min(phases.get("beside", 0.0), (cores - 1) * phases.get("alone", 0.0))
     return (phases["before"] + (phases["workers"] + phases["during"]) / cores
-            + phases["after"] + (phases["drawing"] - early) / cores)
+            + phases["after"] + (phases["drawing"] - early - beside) / cores)
 
 
 def evaluate(users: int, days: int, seed: int, workers: int, profile: str | None = None
@@ -313,7 +350,8 @@ def speed(args: argparse.Namespace, script: Path) -> None:
                   f"{mean['before']:.2f}, storing {mean['during']:.2f} beside the workers' "
                   f"{mean['workers']:.2f}, tail {mean['after']:.2f}, figures' processes "
                   f"{mean['drawing']:.2f} ({mean.get('early', 0.0):.2f} of it during "
-                  "the start-up)")
+                  f"the start-up, {mean.get('beside', 0.0):.2f} beside the tail's first "
+                  f"{mean.get('alone', 0.0):.2f})")
 
 
 def memory(args: argparse.Namespace) -> None:

@@ -146,6 +146,17 @@ def _replicate(args: argparse.Namespace, store: Any, plan: Any, swept: Any, work
     from opspec.evaluation.progress import make_progress
     from opspec.evaluation.runner import run_evaluation
 
+    figures = getattr(args, "figures", "svg")
+    drawing = min(workers, cores)  # the figures drawn side by side, as the users were
+    ahead: list[Any] = []
+
+    def ask_ahead() -> None:
+        # the report's figures that read neither the sample index nor the summaries, drawn
+        # while this process builds them (a core is idle otherwise)
+        from opspec.evaluation.report import ask_figures_ahead
+
+        ahead.append(ask_figures_ahead(store, figures=figures, workers=drawing))
+
     # what is loaded by now lives through the run: the collector need not scan it again
     with store, contextlib.ExitStack() as stack, startup_frozen():
         on_trace = trace_writers(stack, store.folder, plan)
@@ -155,7 +166,8 @@ def _replicate(args: argparse.Namespace, store: Any, plan: Any, swept: Any, work
             outcome = run_evaluation(plan, store, workers=workers, scheduler=args.scheduler,
                                      progress=progress, on_trace=on_trace,
                                      retrace=bool(args.resume and plan.export),
-                                     scheduler_timeout=timeout)
+                                     scheduler_timeout=timeout,
+                                     on_stored=ask_ahead if drawing > 1 else None)
             stack.close()                   # the exports are finished and moved into place
         except EvaluationError as error:
             raise with_resume_hint(error, store, plan) from None
@@ -169,11 +181,10 @@ def _replicate(args: argparse.Namespace, store: Any, plan: Any, swept: Any, work
         from opspec.evaluation.report import write_report
 
         try:
-            # the figures drawn side by side on this machine's cores, as the users were
             report = write_report(store, summaries,
                                   template=getattr(args, "report_template", None),
-                                  figures=getattr(args, "figures", "svg"),
-                                  workers=min(workers, cores))
+                                  figures=figures, workers=drawing,
+                                  ahead=ahead[0] if ahead else None)
         except EvaluationError as error:
             raise with_resume_hint(error, store, plan) from None
         except OSError as error:

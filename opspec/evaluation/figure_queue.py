@@ -3,7 +3,9 @@ figure and returns the path it will write at once; the figures are drawn at the 
 by worker processes, or sent as they are asked for to the drawing processes already started
 (:mod:`.drawing_pools`). Every figure function is made :func:`queueable`, which also
 registers it by name in :data:`_FIGURES`: a started drawing process is sent a figure's name
-and arguments, never the function.
+and arguments, never the function. Figures may also be asked for before that block
+(:func:`asked_ahead`): the report's that need neither the sample index nor the summaries are
+sent as soon as the last replication is stored.
 """
 
 from __future__ import annotations
@@ -19,7 +21,7 @@ from opspec.evaluation.drawing_pools import started_pools
 from opspec.evaluation.figure_files import chosen_format, figure_format, written_as
 from opspec.evaluation.matplotlib_import import import_matplotlib as _import_matplotlib
 
-__all__ = ["drawn_by", "queueable"]
+__all__ = ["FiguresAhead", "asked_ahead", "drawn_by", "queueable"]
 
 #: A figure asked for within :func:`drawn_by`: the figure function (undecorated), its
 #: arguments and the format it is to be written in.
@@ -28,22 +30,81 @@ _Job = tuple[Any, tuple[Any, ...], dict[str, Any], str | None]
 _QUEUE: ContextVar[list[_Job] | None] = ContextVar("opspec_figure_queue", default=None)
 
 
+class FiguresAhead:
+    """Figures asked for within :func:`asked_ahead`, before the :func:`drawn_by` block that
+    waits for them (or draws them) with its own: the queue and the futures of those sent."""
+
+    def __init__(self) -> None:
+        self.queue: list[_Job] = []
+        self.sent: dict[int, Any] | None = None
+
+
 @contextmanager
-def drawn_by(workers: int) -> Iterator[None]:
+def asked_ahead(workers: int) -> Iterator[FiguresAhead]:
+    """Within this block the figure functions queue their figures as within
+    :func:`drawn_by` and return their paths; at its end the figures are sent to the started
+    drawing processes (if any), but nothing is waited for: a later ``drawn_by(workers,
+    ahead=...)`` block does that (or draws those not sent) with its own figures. ``opspec
+    evaluate --workers W`` asks so for the report's figures that need neither the sample
+    index nor the summaries, as soon as the last replication is stored: they are drawn while
+    the evaluate process builds the index and the summaries, when a core is idle otherwise.
+    With one worker the figures are drawn as they are asked for (nothing is left to the
+    later block).
+
+    They are sent in ``workers - 1`` batches, each drawn by one process figure after figure,
+    so that the evaluate process keeps a core of its own for the index: sent one by one to
+    two processes on two cores, they took a third of its core, and the index took about
+    twice as long."""
+    ahead = FiguresAhead()
+    if workers <= 1:
+        yield ahead
+        return
+    token, sending = _QUEUE.set(ahead.queue), _SENT.set(None)
+    try:
+        yield ahead
+    finally:
+        _QUEUE.reset(token)
+        _SENT.reset(sending)
+    pools = started_pools()
+    if pools is None or not ahead.queue:
+        return                          # drawn with the drawn_by block's figures
+    ahead.sent = {}
+    batches: list[list[int]] = [list(range(len(ahead.queue)))[first::workers - 1]
+                                for first in range(min(workers - 1, len(ahead.queue)))]
+    for batch in batches:
+        jobs = [_named(ahead.queue[index]) for index in batch]
+        if any(job is None for job in jobs):
+            continue                    # a replaced figure function: drawn by drawn_by
+        try:
+            future = pools.submit(_draw_all_named, jobs)
+        except Exception:  # noqa: BLE001, S112 - a process gone: drawn at drawn_by's end
+            continue
+        ahead.sent.update(dict.fromkeys(batch, future))
+
+
+@contextmanager
+def drawn_by(workers: int, ahead: FiguresAhead | None = None) -> Iterator[None]:
     """Within this block, the figure functions return the path they will write at once and
     the figures are drawn at the block's end, by up to ``workers`` processes side by side
     (each figure is independent of the others; the same bytes as drawn one after another),
     those of an enclosing :func:`.drawing_pools.drawing_processes` when there is one. With
     one worker they are drawn as they are asked for (nothing queued). ``opspec evaluate
     --workers W`` draws its report's figures so: what runs after the replications runs on
-    one core otherwise, and with two workers it was most of the wall time saved."""
+    one core otherwise, and with two workers it was most of the wall time saved.
+
+    ``ahead``: figures asked for before this block (:func:`asked_ahead`, with the same
+    ``workers``), drawn (or, those sent, waited for) at its end with the block's own."""
     if workers <= 1:                # drawn as they are asked for, as without this block
         yield
         return
-    queue: list[_Job] = []
+    queue: list[_Job] = ahead.queue if ahead is not None else []
     # with started drawing processes, each figure is sent to them as it is asked for: they
     # draw while this process still works out the report's other figures and tables
-    sent: dict[int, Any] | None = {} if started_pools() is not None else None
+    sent: dict[int, Any] | None
+    if ahead is not None and ahead.queue:
+        sent = ahead.sent               # the processes that were there when they were sent
+    else:
+        sent = {} if started_pools() is not None else None
     token, sending = _QUEUE.set(queue), _SENT.set(sent)
     try:
         yield
@@ -136,6 +197,20 @@ _FIGURES: dict[str, Any] = {}
 def _draw_named(name: str, args: tuple[Any, ...], kwargs: dict[str, Any], fmt: str | None
                 ) -> None:
     _draw_one((_FIGURES[name], args, kwargs, fmt))
+
+
+def _named(job: _Job) -> tuple[str, tuple[Any, ...], dict[str, Any], str | None] | None:
+    """``job`` as a started drawing process is sent it (its function by name), or None
+    when its function is not the one registered under its name."""
+    draw, args, kwargs, fmt = job
+    name = getattr(draw, "__name__", "")
+    return (name, args, kwargs, fmt) if _FIGURES.get(name) is draw else None
+
+
+def _draw_all_named(jobs: Sequence[tuple[str, tuple[Any, ...], dict[str, Any], str | None]]
+                    ) -> None:
+    for job in jobs:
+        _draw_named(*job)
 
 
 #: The queue :func:`_draw` hands to the processes it forks.

@@ -19,7 +19,8 @@ Where each part is:
 - the look they share (palette, fonts, notes): :mod:`.figure_style`;
 - the formats and the writing of the files: :mod:`.figure_files` (the panels' layout:
   :mod:`.figure_layout`);
-- the figures drawn side by side (:func:`drawn_by`): :mod:`.figure_queue`, by the drawing
+- the figures drawn side by side (:func:`drawn_by`; some asked for earlier,
+  :func:`asked_ahead`): :mod:`.figure_queue`, by the drawing
   processes started early (:func:`drawing_processes`): :mod:`.drawing_pools`.
 
 The report calls the figure functions through this module (``plots.rates_figure(...)``), so
@@ -40,6 +41,7 @@ from opspec.evaluation.figure_files import (
 )
 from opspec.evaluation.figure_queue import (
     _FIGURES,  # noqa: F401 - benchmarks/report_figures.py: the figures by name
+    asked_ahead,
     drawn_by,
 )
 from opspec.evaluation.figure_style import NO_OBSERVATIONS, PALETTE, PERCENT
@@ -69,6 +71,7 @@ __all__ = [
     "PERCENT",
     "UserDistribution",
     "activity_rates_figure",
+    "asked_ahead",
     "comparison_figure",
     "drawing_processes",
     "drawn_by",

@@ -20,18 +20,26 @@ comparison, the failures and the interval methods are its own); the others come 
 :mod:`.report_findings` (the key findings in words), :mod:`.report_users` (who the users
 are) and :mod:`.report_design` (each design's estimates, spread, durations, counts, actions
 and hazards). :mod:`.html` renders the sections as HTML and markdown, :mod:`.plots` draws
-the figures.
+the figures; those that need neither the sample index nor the summaries can be asked for
+before the report is written (:func:`ask_figures_ahead`), to be drawn meanwhile.
 """
 
 from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
+from opspec.errors import EvaluationError
 from opspec.evaluation.describe import describe_metric
 from opspec.evaluation.plan import span
-from opspec.evaluation.report_design import PLOT_SAMPLE, design_sections
+from opspec.evaluation.report_design import (
+    PLOT_SAMPLE,
+    AskedAhead,
+    ask_ahead,
+    design_sections,
+)
 from opspec.evaluation.report_findings import key_findings, metric_label, population_findings
 from opspec.evaluation.report_users import user_model_section
 from opspec.evaluation.store import ResultStore
@@ -44,7 +52,10 @@ from opspec.evaluation.summary import (
 )
 from opspec.evaluation.tables import comparison_rows, is_rate, subgroup_comparison_rows
 
-__all__ = ["PLOT_SAMPLE", "Summaries", "write_report"]
+if TYPE_CHECKING:
+    from opspec.evaluation.figure_queue import FiguresAhead
+
+__all__ = ["PLOT_SAMPLE", "ReportAhead", "Summaries", "ask_figures_ahead", "write_report"]
 
 #: What the evaluate command has already computed, per design label: ``metrics``,
 #: ``monitors``; and ``difference`` for a comparison. Passed in so nothing is computed twice.
@@ -104,9 +115,48 @@ def _methods_section(summaries: Any, sections: Sequence[Any]) -> Any:
                       "The interval methods used in this report"),) if rows else ())
 
 
+@dataclass(frozen=True)
+class ReportAhead:
+    """The report's figures asked for before it is written (:func:`ask_figures_ahead`): the
+    figures' queue, and per design described what was computed and asked for."""
+
+    figures: FiguresAhead
+    designs: Mapping[str, AskedAhead]
+
+
+def ask_figures_ahead(store: ResultStore, *, figures: str = "svg", workers: int = 1
+                      ) -> ReportAhead:
+    """Ask, for every design the report describes, for its figures that need neither the
+    sample index nor the summaries (:func:`.report_design.ask_ahead`), to be drawn by the
+    drawing processes while the caller builds them; :func:`write_report` given the result
+    asks for the others and waits for all. ``opspec evaluate --workers W`` calls it as soon
+    as the last replication is stored (``figures`` and ``workers`` as it then gives
+    :func:`write_report`). A design whose reads fail is left out: the report reads it again
+    and fails where it does without this."""
+    from opspec.evaluation import plots
+
+    plan: dict[str, Any] = store.get("plan") or {}
+    days = float(plan.get("days", 1))
+    designs = [d["label"] for d in plan.get("designs", [])] or ["A"]
+    specs = {d["label"]: d["spec"] for d in plan.get("designs", [])}
+    digests = {d["label"]: d.get("sha256") for d in plan.get("designs", [])}
+    asked: dict[str, AskedAhead] = {}
+    with plots.figure_format(figures), plots.asked_ahead(workers) as queued:
+        # a sweep's report describes its first value only (as _report_sections)
+        for design in designs[:1] if store.get("sweep") else designs:
+            try:
+                definitions = _with_selectors(store, design, specs.get(design),
+                                              digests.get(design))
+                asked[design] = ask_ahead(store, store.folder / "figures", design, days,
+                                          _users_done(store, design), definitions)
+            except EvaluationError:
+                break
+    return ReportAhead(queued, asked)
+
+
 def write_report(store: ResultStore, summaries: Mapping[str, Summaries] | None = None, *,
                  template: str | Path | None = None, figures: str = "svg",
-                 workers: int = 1) -> Path:
+                 workers: int = 1, ahead: ReportAhead | None = None) -> Path:
     """Write ``report.html``, ``report.md`` and ``figures/*.svg`` (or ``.pdf`` beside SVG
     twins, or ``.png``: ``figures``, :data:`opspec.evaluation.plots.FORMATS`) into the
     store's folder.
@@ -114,20 +164,23 @@ def write_report(store: ResultStore, summaries: Mapping[str, Summaries] | None =
     ``summaries`` per design label (``metrics``, ``monitors``; ``difference`` under ``"B"``)
     are what the caller already computed; what is missing is computed here. ``template`` is
     a Jinja2 template to render the HTML with instead of the bundled one. The figures are
-    drawn by up to ``workers`` processes side by side (:func:`.plots.drawn_by`).
+    drawn by up to ``workers`` processes side by side (:func:`.plots.drawn_by`); ``ahead``:
+    those :func:`ask_figures_ahead` asked for with the same store, ``figures`` and
+    ``workers``, not asked for again.
     """
     from opspec.evaluation import plots
     from opspec.evaluation.html import write_html, write_markdown
 
     with plots.figure_format(figures):
-        with plots.drawn_by(workers):
-            title, sections = _report_sections(store, summaries)
+        with plots.drawn_by(workers, ahead.figures if ahead is not None else None):
+            title, sections = _report_sections(store, summaries,
+                                               ahead.designs if ahead is not None else {})
         write_markdown(store.folder / "report.md", title, sections)
         return write_html(store.folder / "report.html", title, sections, template=template)
 
 
-def _report_sections(store: ResultStore, summaries: Mapping[str, Summaries] | None
-                     ) -> tuple[str, list[Any]]:
+def _report_sections(store: ResultStore, summaries: Mapping[str, Summaries] | None,
+                     ahead: Mapping[str, AskedAhead]) -> tuple[str, list[Any]]:
     from opspec.evaluation import plots
     from opspec.evaluation.html import Section, Table
 
@@ -242,7 +295,7 @@ def _report_sections(store: ResultStore, summaries: Mapping[str, Summaries] | No
         prefix = f"{names[design]}: " if len(detailed) > 1 or sweep else ""
         sections += design_sections(store, figures, design, names[design], days,
                                     done.get(design, 0), metrics, monitors, definitions,
-                                    prefix, population, designs[0])
+                                    prefix, population, designs[0], ahead.get(design))
 
     if difference is not None:
         # each panel names its metric as the other figures do (report latency, not its id)

@@ -7,6 +7,7 @@ draw, read from the result store.
 from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
@@ -35,7 +36,7 @@ from opspec.evaluation.tables import (
 )
 from opspec.files import file_name
 
-__all__ = ["PLOT_SAMPLE", "design_sections"]
+__all__ = ["PLOT_SAMPLE", "AskedAhead", "ask_ahead", "design_sections"]
 
 # Figures draw at most this many observations per metric (a deterministic, even thinning,
 # said in the caption); the statistics and the marks in the figure always use all of them.
@@ -126,15 +127,70 @@ def _subgroup_rates(store: ResultStore, design: str, definition: Mapping[str, An
     return out
 
 
+def _count_series(store: ResultStore, design: str, counts: list[str], days: float,
+                  users: int) -> tuple[dict[str, Any], ...]:
+    """What the counts-over-time figures draw of the count metrics ``counts``, keyed by
+    their words: the mean per user on each day, its interval, the total in each hour."""
+    # one pass over the outcome table for all metrics, not two per metric (issue 20)
+    per_day, hours = _outcomes_all(store, design, counts, max(1, round(days)), users)
+    bands = _day_intervals(store, design, counts, max(1, round(days)), users)
+    return ({words(n): v for n, v in per_day.items()}, {words(n): v for n, v in bands.items()},
+            {words(n): v for n, v in hours.items()})
+
+
+def _count_figures(series: tuple[dict[str, Any], ...], figures: Path, design: str
+                   ) -> tuple[Path, Path]:
+    from opspec.evaluation import plots
+
+    per_day, bands, hours = series
+    return (plots.over_days_figure(per_day, figures / f"{design}-days.png", bands=bands),
+            plots.time_of_day_figure(hours, figures / f"{design}-hours.png"))
+
+
+def _activity_figure(activity: list[dict[str, Any]], figures: Path, design: str) -> Path:
+    from opspec.evaluation import plots
+
+    return plots.activity_rates_figure(
+        [(r["activity"], r["omission"], r["error"], r["omission_ci95"], r["error_ci95"])
+         for r in activity], figures / f"{design}-activities.png")
+
+
+@dataclass(frozen=True)
+class AskedAhead:
+    """What :func:`ask_ahead` computed of one design and the figures it asked for: the
+    counts-over-time figures (None without count metrics), the rows of the user's actions
+    and their figure (None without activities)."""
+
+    counts: tuple[Path, Path] | None
+    activity: list[dict[str, Any]]
+    activity_image: Path | None
+
+
+def ask_ahead(store: ResultStore, figures: Path, design: str, days: float, users: int,
+              definitions: Sequence[Mapping[str, Any]]) -> AskedAhead:
+    """Ask for the figures of ``design``'s sections that need neither the sample index nor
+    the summaries (counts over time, the user's actions: what the store keeps of the outcomes
+    and activities), the same :func:`design_sections` asks for. Everything is read before
+    the first figure is asked for: a read that fails leaves nothing asked."""
+    counts = [d["name"] for d in definitions if d["kind"] == "count"]
+    series = _count_series(store, design, counts, days, users) if counts else None
+    activity = _activity_rates(store, design)
+    return AskedAhead(_count_figures(series, figures, design) if series is not None else None,
+                      activity, _activity_figure(activity, figures, design) if activity
+                      else None)
+
+
 def design_sections(store: ResultStore, figures: Path, design: str, name: str, days: float,
                     users: int, metrics: Mapping[str, dict[str, Any]],
                     monitors: Mapping[str, Any], definitions: Sequence[Mapping[str, Any]],
                     prefix: str, population: Mapping[str, Any] | None = None,
-                    first: str = "A") -> list[Any]:
+                    first: str = "A", ahead: AskedAhead | None = None) -> list[Any]:
     """The sections on ``design`` (``name`` in their words; ``prefix`` before each title when
     the report describes several designs), in the report's order, their figures drawn into
     ``figures``. ``first`` is the design whose subgroup summaries are ``metrics`` in
-    ``population`` (the others': ``metrics_<label>``)."""
+    ``population`` (the others': ``metrics_<label>``). ``ahead``: what :func:`ask_ahead`
+    computed and asked for of ``design`` with the same store, definitions and users (its
+    figures are not asked for again)."""
     from opspec.evaluation import plots
     from opspec.evaluation.html import Section, Table
 
@@ -244,15 +300,10 @@ def design_sections(store: ResultStore, figures: Path, design: str, name: str, d
     # counts over time
     counts = [d["name"] for d in definitions if d["kind"] == "count"]
     if counts:
-        # one pass over the outcome table for all metrics, not two per metric (issue 20)
-        per_day, hours = _outcomes_all(store, design, counts, max(1, round(days)), users)
-        bands = _day_intervals(store, design, counts, max(1, round(days)), users)
-        per_day = {words(n): v for n, v in per_day.items()}
-        bands = {words(n): v for n, v in bands.items()}
-        hours = {words(n): v for n, v in hours.items()}
         sections.append(Section(f"{prefix}Counts over time", images=(
-            plots.over_days_figure(per_day, figures / f"{design}-days.png", bands=bands),
-            plots.time_of_day_figure(hours, figures / f"{design}-hours.png")), captions=(
+            ahead.counts if ahead is not None and ahead.counts is not None
+            else _count_figures(_count_series(store, design, counts, days, users), figures,
+                                design)), captions=(
             ("Count outcomes per user, day by day: the mean over users (line) and its 95 % "
             "interval (band; t over users, widened to the exact Poisson interval on days "
             "with fewer than 10 events); each metric on its own scale, so rare outcomes are "
@@ -261,11 +312,12 @@ def design_sections(store: ResultStore, figures: Path, design: str, name: str, d
             "scale)"))))
 
     # the user's actions
-    activity = _activity_rates(store, design)
+    if ahead is not None:
+        activity, image = ahead.activity, ahead.activity_image
+    else:
+        activity = _activity_rates(store, design)
+        image = _activity_figure(activity, figures, design) if activity else None
     if activity:
-        image = plots.activity_rates_figure(
-            [(r["activity"], r["omission"], r["error"], r["omission_ci95"], r["error_ci95"])
-             for r in activity], figures / f"{design}-activities.png")
 
         def rate(value: float, ci: Sequence[float | None]) -> str:
             return (f"{fmt(value, percent=True)} [{fmt(ci[0], percent=True)}, "

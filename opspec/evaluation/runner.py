@@ -310,7 +310,8 @@ def _dead_worker(error: BaseException) -> str:
 def run_evaluation(plan: EvaluationPlan, store: ResultStore, *, workers: int = 1,
                    scheduler: str | None = None, progress: Progress | None = None,
                    on_trace: TraceSink | None = None, retrace: bool = False,
-                   scheduler_timeout: float = WORKER_TIMEOUT) -> EvaluationOutcome:
+                   scheduler_timeout: float = WORKER_TIMEOUT,
+                   on_stored: Callable[[], Any] | None = None) -> EvaluationOutcome:
     """Run every replication of ``plan`` not yet stored as done, storing each as it ends.
 
     ``retrace`` (resuming a run that exports traces): the users already stored are simulated
@@ -324,6 +325,10 @@ def run_evaluation(plan: EvaluationPlan, store: ResultStore, *, workers: int = 1
     On a Dask cluster (``scheduler``), a cluster that has no worker for ``scheduler_timeout``
     seconds (at the start, or once all have left) stops the run with an EvaluationError;
     what finished is stored.
+
+    ``on_stored`` is called once every replication is stored, before the sample index is built
+    (:meth:`ResultStore.index`): ``opspec evaluate --workers W`` asks then for the report's
+    figures that do not read it, drawn beside the index.
     """
     started = time.perf_counter()
     progress = progress or Progress()
@@ -396,6 +401,8 @@ def run_evaluation(plan: EvaluationPlan, store: ResultStore, *, workers: int = 1
                               slots, keep)
         for label, users, reason in lost:
             keep([ReplicationRecord(label, u, "failed", error=reason) for u in users])
+        if on_stored is not None:
+            on_stored()
         store.index()               # once, now that every replication is stored
     finally:
         progress.finish()
