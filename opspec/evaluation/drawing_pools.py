@@ -111,7 +111,14 @@ class _Drawer:
                 except Exception as error:  # noqa: BLE001 - what cannot be sent fails alone
                     future.set_exception(error)
                     continue
-                self.end.send_bytes(message)
+                try:
+                    self.end.send_bytes(message)
+                finally:
+                    # the pickle is a view of a BytesIO: let it go now. Kept to the end of
+                    # this thread and caught in a reference cycle (the error below), it made
+                    # the collector print "Exception ignored in: <_io.BytesIO ...>
+                    # BufferError" to the user's terminal (CPython gh-111331)
+                    message.release()
                 try:
                     done, value = self.end.recv()
                 except (EOFError, OSError):
@@ -121,7 +128,7 @@ class _Drawer:
                 (future.set_result if done else future.set_exception)(value)
                 job = None
         except Exception as error:  # noqa: BLE001 - the pipe shut: the process is gone
-            ended = error
+            ended = error.with_traceback(None)  # no cycle through this frame
         finally:
             self.known.set()
             self._pools.ended(self, job, ended)

@@ -174,3 +174,34 @@ def test_no_drawing_process_outlives_a_killed_evaluate_process(tmp_path: Path) -
     while not all(_gone(pid) for pid in pids) and time.monotonic() < deadline:
         time.sleep(0.1)
     assert all(_gone(pid) for pid in pids), "orphaned drawing processes"
+
+
+def _die() -> None:
+    """Run in a drawing process: it ends at once, as a killed or crashed one does."""
+    os._exit(1)
+
+
+def test_a_drawing_process_that_dies_leaves_no_pickle_to_the_collector() -> None:
+    """A figure is sent to its drawing process as a pickle that is a view of a BytesIO. If
+    that view outlived the sending (kept by the thread's frame, which the pipe's error caught
+    in a reference cycle), the collector cleared the BytesIO while the view still held its
+    buffer, and on Python 3.12 and later printed "Exception ignored in: <_io.BytesIO ...>
+    BufferError: Existing exports of data" to the user's terminal (CPython gh-111331): seen
+    on 3.13 after `evaluate --workers 2` runs that exported traces or hit a full disk. The
+    garbage the drawing leaves must hold no such view, on every version."""
+    import gc
+
+    gc.collect()
+    with plots.drawing_processes(2):
+        pools = drawing_pools.started_pools()
+        assert pools is not None
+        with pytest.raises(Exception, match="drawing process ended"):
+            pools.submit(_die).result(timeout=60)
+    gc.set_debug(gc.DEBUG_SAVEALL)
+    try:
+        gc.collect()
+        views = [o for o in gc.garbage if isinstance(o, memoryview)]
+    finally:
+        gc.set_debug(0)
+        gc.garbage.clear()
+    assert views == []
