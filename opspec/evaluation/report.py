@@ -131,8 +131,8 @@ def ask_figures_ahead(store: ResultStore, *, figures: str = "svg", workers: int 
     drawing processes while the caller builds them; :func:`write_report` given the result
     asks for the others and waits for all. ``opspec evaluate --workers W`` calls it as soon
     as the last replication is stored (``figures`` and ``workers`` as it then gives
-    :func:`write_report`). A design whose reads fail is left out: the report reads it again
-    and fails where it does without this."""
+    :func:`write_report`). A design whose reads fail is left out, with those after it: the
+    report reads them again and fails where it does without this."""
     from opspec.evaluation import plots
 
     plan: dict[str, Any] = store.get("plan") or {}
