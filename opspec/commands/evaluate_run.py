@@ -157,6 +157,11 @@ def _replicate(args: argparse.Namespace, store: Any, plan: Any, swept: Any, work
 
         ahead.append(ask_figures_ahead(store, figures=figures, workers=drawing))
 
+    def prepare() -> None:
+        from opspec.evaluation.report import prepare_report
+
+        prepare_report(getattr(args, "report_template", None))
+
     # what is loaded by now lives through the run: the collector need not scan it again
     with store, contextlib.ExitStack() as stack, startup_frozen():
         on_trace = trace_writers(stack, store.folder, plan)
@@ -167,7 +172,8 @@ def _replicate(args: argparse.Namespace, store: Any, plan: Any, swept: Any, work
                                      progress=progress, on_trace=on_trace,
                                      retrace=bool(args.resume and plan.export),
                                      scheduler_timeout=timeout,
-                                     on_stored=ask_ahead if drawing > 1 else None)
+                                     on_stored=ask_ahead if drawing > 1 else None,
+                                     meanwhile=prepare)
             stack.close()                   # the exports are finished and moved into place
         except EvaluationError as error:
             raise with_resume_hint(error, store, plan) from None

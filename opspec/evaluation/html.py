@@ -23,16 +23,19 @@ from __future__ import annotations
 
 import base64
 import contextlib
+import functools
 import html
 import os
 import re
 from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Any
 
 from opspec.errors import EvaluationError
 
-__all__ = ["TEMPLATE", "Section", "Table", "render_html", "write_html", "write_markdown"]
+__all__ = ["TEMPLATE", "Section", "Table", "prepare_template", "render_html", "write_html",
+           "write_markdown"]
 
 
 @dataclass(frozen=True)
@@ -174,6 +177,25 @@ def render_html(title: str, sections: Sequence[Section],
     ``template`` (default: the bundled :data:`TEMPLATE`)."""
     import jinja2
 
+    source, compiled = _template(template)
+    try:
+        return compiled.render(_context(title, sections))
+    except jinja2.TemplateError as error:
+        raise _template_fails(source, error) from None
+
+
+def prepare_template(template: str | Path | None = None) -> None:
+    """Read and compile ``template`` now (Jinja2 imported, the template made Python code),
+    so that :func:`render_html` finds it ready; what fails here fails there again, with
+    its message (``opspec evaluate`` prepares it while its workers run)."""
+    _template(template)
+
+
+def _template(template: str | Path | None) -> tuple[Path, Any]:
+    """The template's path and its compiled form, compiled once per text: a changed file
+    is compiled again."""
+    import jinja2
+
     from opspec.files import read_text, reason
 
     source = Path(template) if template is not None else TEMPLATE
@@ -183,21 +205,32 @@ def render_html(title: str, sections: Sequence[Section],
         raise EvaluationError(f"cannot read the report template {source}: {reason(error)}",
                               hint="give an existing Jinja2 template (copy "
                               f"{TEMPLATE} to start from)") from None
+    try:
+        return source, _compiled(text)
+    except jinja2.TemplateError as error:
+        raise _template_fails(source, error) from None
+
+
+@functools.lru_cache(maxsize=4)
+def _compiled(text: str) -> Any:
+    from jinja2 import StrictUndefined
     from jinja2.sandbox import SandboxedEnvironment
 
     # a template is code: sandboxed, it sees the report's data and cannot reach Python's
     # internals (no ``''.__class__.__mro__``, no calls of unsafe methods)
-    env = SandboxedEnvironment(autoescape=True, undefined=jinja2.StrictUndefined,
+    env = SandboxedEnvironment(autoescape=True, undefined=StrictUndefined,
                                keep_trailing_newline=True, trim_blocks=True,
                                lstrip_blocks=True)
-    try:
-        return env.from_string(text).render(_context(title, sections))
-    except jinja2.TemplateError as error:
-        line = getattr(error, "lineno", None)
-        raise EvaluationError(f"{source}{f':{line}' if line else ''}: the report template "
-                              f"fails: {error.message or error}",
-                              hint="fix the template, or leave out --report-template to "
-                              "use the bundled one") from None
+    return env.from_string(text)
+
+
+def _template_fails(source: Path, error: Exception) -> EvaluationError:
+    line = getattr(error, "lineno", None)
+    message = getattr(error, "message", None)
+    return EvaluationError(f"{source}{f':{line}' if line else ''}: the report template "
+                           f"fails: {message or error}",
+                           hint="fix the template, or leave out --report-template to "
+                           "use the bundled one")
 
 
 def write_html(path: Path, title: str, sections: Sequence[Section], *,

@@ -26,6 +26,7 @@ before the report is written (:func:`ask_figures_ahead`), to be drawn meanwhile.
 
 from __future__ import annotations
 
+import contextlib
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -152,6 +153,22 @@ def ask_figures_ahead(store: ResultStore, *, figures: str = "svg", workers: int 
             except EvaluationError:
                 break
     return ReportAhead(queued, asked)
+
+
+def prepare_report(template: str | Path | None = None) -> None:
+    """Load now what writing the report and its summaries will need: the summaries'
+    modules and interval functions (scipy.special) and the HTML template, read and
+    compiled. ``opspec evaluate --workers W`` calls it while its workers run the
+    replications, when this process is mostly waiting; nothing it does changes a number or
+    a word of the report, and what fails here (an unreadable template) fails again when the
+    report is written, with its message."""
+    from opspec.evaluation import design_summary  # noqa: F401 - loaded for the summaries
+    from opspec.evaluation.html import prepare_template
+    from opspec.statistics.intervals import t_quantile
+
+    t_quantile(0.95, 1)
+    with contextlib.suppress(EvaluationError):
+        prepare_template(template)
 
 
 def write_report(store: ResultStore, summaries: Mapping[str, Summaries] | None = None, *,

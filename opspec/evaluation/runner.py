@@ -222,8 +222,8 @@ Keep = Callable[[list[ReplicationRecord]], None]
 
 
 def _drain(executor: cf.Executor, doc: dict[str, object], pending: Iterable[Chunk],
-           slots: int, keep: Keep, watch: Watch | None = None
-           ) -> list[tuple[str, list[int], str]]:
+           slots: int, keep: Keep, watch: Watch | None = None,
+           meanwhile: Callable[[], Any] | None = None) -> list[tuple[str, list[int], str]]:
     """Run ``pending`` chunks on ``executor``, at most ``slots`` in flight, storing each chunk
     as it returns. Returns the chunks lost because the process pool broke (a worker process
     died), with the reason; a chunk whose task raised becomes failed replications.
@@ -231,6 +231,7 @@ def _drain(executor: cf.Executor, doc: dict[str, object], pending: Iterable[Chun
     Keeping only a few chunks in flight bounds the memory of results waiting to be stored
     (traces, when exporting) whatever the number of users. ``watch`` is called about once a
     second while no chunk finishes (and may raise: a cluster left without workers).
+    ``meanwhile`` is called once the first chunks are sent (see :func:`_while_workers_start`).
     """
     queue = iter(pending)
     # each chunk's place in the order it was sent: chunks are stored in that order (those
@@ -258,7 +259,7 @@ def _drain(executor: cf.Executor, doc: dict[str, object], pending: Iterable[Chun
                 return
 
     fill()
-    _while_workers_start()
+    _while_workers_start(meanwhile)
     while running:
         finished, _ = cf.wait(running, timeout=_POLL if watch is not None else None,
                               return_when=cf.FIRST_COMPLETED)
@@ -283,16 +284,19 @@ def _drain(executor: cf.Executor, doc: dict[str, object], pending: Iterable[Chun
     return lost
 
 
-def _while_workers_start() -> None:
+def _while_workers_start(meanwhile: Callable[[], Any] | None = None) -> None:
     """What this process would do after the replications, done now that the workers have
-    their first chunks: the summaries' interval functions load scipy.special (about 0.3
-    CPU-s), which otherwise ran after the last chunk while the workers' cores stood idle.
-    The workers were forked before it, so they do not pay for it; the numbers are the
-    same whenever it is loaded."""
+    their first chunks: the summaries' interval functions load scipy.special (about 0.1
+    CPU-s), and ``meanwhile`` (``opspec evaluate``: the report's modules and template),
+    which otherwise ran after the last chunk while the workers' cores stood idle. The
+    workers were forked before it, so they do not pay for it; the numbers are the same
+    whenever it is loaded."""
     try:
         from opspec.statistics.intervals import t_quantile
 
         t_quantile(0.95, 1)
+        if meanwhile is not None:
+            meanwhile()
     except Exception:  # noqa: BLE001, S110 - the summaries load it again, and say why
         pass
 
@@ -311,7 +315,8 @@ def run_evaluation(plan: EvaluationPlan, store: ResultStore, *, workers: int = 1
                    scheduler: str | None = None, progress: Progress | None = None,
                    on_trace: TraceSink | None = None, retrace: bool = False,
                    scheduler_timeout: float = WORKER_TIMEOUT,
-                   on_stored: Callable[[], Any] | None = None) -> EvaluationOutcome:
+                   on_stored: Callable[[], Any] | None = None,
+                   meanwhile: Callable[[], Any] | None = None) -> EvaluationOutcome:
     """Run every replication of ``plan`` not yet stored as done, storing each as it ends.
 
     ``retrace`` (resuming a run that exports traces): the users already stored are simulated
@@ -329,6 +334,11 @@ def run_evaluation(plan: EvaluationPlan, store: ResultStore, *, workers: int = 1
     ``on_stored`` is called once every replication is stored, before the sample index is built
     (:meth:`ResultStore.index`): ``opspec evaluate --workers W`` asks then for the report's
     figures that do not read it, drawn beside the index.
+
+    ``meanwhile`` is called once the worker processes have their first chunks (never when
+    the replications run in this process): what the caller needs after the replications,
+    loaded while this process mostly waits for them. What it raises is ignored (the
+    caller meets it again where it is needed).
     """
     started = time.perf_counter()
     progress = progress or Progress()
@@ -392,7 +402,7 @@ def run_evaluation(plan: EvaluationPlan, store: ResultStore, *, workers: int = 1
                         records = _failed(label, users, error)
                     keep(records)
             else:
-                lost = _drain(executor, doc, pending, slots, keep, watch)
+                lost = _drain(executor, doc, pending, slots, keep, watch, meanwhile)
         if lost and scheduler is None:
             # one more try in a fresh pool (Dask reschedules lost tasks by itself)
             with _executor(workers, None) as (executor, slots, _):

@@ -54,7 +54,7 @@ def _drain(executor: cf.Executor, slots: int) -> tuple[list[list[int]], list[Any
 
 def test_chunks_back_out_of_order_are_stored_in_the_order_sent(monkeypatch) -> None:
     monkeypatch.setattr(runner, "run_users", _users)
-    monkeypatch.setattr(runner, "_while_workers_start", lambda: None)
+    monkeypatch.setattr(runner, "_while_workers_start", lambda meanwhile=None: None)
     kept, lost = _drain(_Backwards(hold=3), slots=4)
     assert kept == [[2 * i, 2 * i + 1] for i in range(7)] and lost == []
 
@@ -62,9 +62,36 @@ def test_chunks_back_out_of_order_are_stored_in_the_order_sent(monkeypatch) -> N
 def test_a_failed_chunk_keeps_its_place_and_a_lost_one_holds_back_nothing(
         monkeypatch) -> None:
     monkeypatch.setattr(runner, "run_users", _users)
-    monkeypatch.setattr(runner, "_while_workers_start", lambda: None)
+    monkeypatch.setattr(runner, "_while_workers_start", lambda meanwhile=None: None)
     kept, lost = _drain(_Backwards(hold=3, broken=4, failing=8), slots=4)
     # chunk [4, 5] was lost with its worker (run again by the caller), chunk [8, 9] failed:
     # its users are stored as failed replications, in their place
     assert kept == [[0, 1], [2, 3], [6, 7], [8, 9], [10, 11], [12, 13]]
     assert [(label, users) for label, users, _ in lost] == [("A", [4, 5])]
+
+
+def test_what_the_caller_needs_later_is_loaded_before_any_chunk_is_stored(
+        monkeypatch) -> None:
+    # ``meanwhile`` (evaluate: the report's modules and template) runs once the workers have
+    # their first chunks, not after the last one, when their cores would stand idle
+    monkeypatch.setattr(runner, "run_users", _users)
+    events: list[str] = []
+    chunks = [("A", [2 * i, 2 * i + 1]) for i in range(7)]
+    runner._drain(_Backwards(hold=3), {}, chunks, 4,
+                  lambda records: events.append(f"kept {records[0].user}"),
+                  meanwhile=lambda: events.append("meanwhile"))
+    assert events[0] == "meanwhile" and events.count("meanwhile") == 1
+    assert len(events) == 8
+
+
+def test_a_failing_meanwhile_loses_no_replication(monkeypatch) -> None:
+    monkeypatch.setattr(runner, "run_users", _users)
+    kept: list[int] = []
+
+    def fails() -> None:
+        raise OSError("the template's disk is gone")
+
+    lost = runner._drain(_Backwards(hold=2), {}, [("A", [0, 1]), ("A", [2, 3])], 4,
+                         lambda records: kept.extend(r.user for r in records),
+                         meanwhile=fails)
+    assert kept == [0, 1, 2, 3] and lost == []

@@ -42,3 +42,33 @@ def test_a_template_cannot_reach_pythons_internals(tmp_path, capsys) -> None:
         assert "the report template fails" in str(error) and "unsafe" in str(error)
     else:
         raise AssertionError("the sandbox let the template reach object.__subclasses__")
+
+
+def test_a_template_prepared_ahead_and_then_changed_is_rendered_as_it_is_now(
+        tmp_path) -> None:
+    # evaluate --workers W reads and compiles the template while its workers run; the
+    # report must still show the template as it is when the report is written
+    from opspec.evaluation.html import prepare_template, render_html
+
+    template = tmp_path / "report.j2"
+    template.write_text("<p>first {{ title }}</p>", encoding="utf-8")
+    prepare_template(template)
+    template.write_text("<p>second {{ title }}</p>", encoding="utf-8")
+    assert render_html("dose", [], template) == "<p>second dose</p>"
+
+
+def test_a_broken_template_prepared_ahead_still_fails_the_report_at_its_line(
+        tmp_path) -> None:
+    from opspec.errors import EvaluationError
+    from opspec.evaluation.html import render_html
+    from opspec.evaluation.report import prepare_report
+
+    template = tmp_path / "broken.j2"
+    template.write_text("<html>\n{{ title }\n</html>", encoding="utf-8")
+    prepare_report(template)                    # while the workers run: says nothing
+    try:
+        render_html("t", [], template)
+    except EvaluationError as error:
+        assert f"{template}:2: the report template fails" in str(error)
+    else:
+        raise AssertionError("a template that does not compile was rendered")
