@@ -53,3 +53,26 @@ def test_every_seed_is_checked_by_the_one_seed_rule(capsys):
             build_parser().parse_args([*command, "--seed", "-1"])
         assert exit_.value.code == 2
         assert "a seed is a whole number from 0 to 2**63 - 1" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize("name", sorted(_commands()))
+def test_a_command_named_on_the_command_line_parses_as_in_the_full_list(name):
+    # `opspec NAME ...` builds NAME's parser alone (the others' modules not imported): its
+    # help, defaults and options must be those of the full parser's NAME
+    alone = _subparsers(build_parser(name))
+    assert list(alone) == [name]
+    full = _subparsers(build_parser())[name]
+    assert alone[name].format_help() == full.format_help()
+    def defaults(parser):   # a handler made by register() is a new closure each time
+        return {k: getattr(v, "__qualname__", v) for k, v in parser._defaults.items()}
+
+    assert defaults(alone[name]) == defaults(full)
+
+
+def test_a_mistyped_command_still_lists_every_command(capsys):
+    from opspec.cli import main
+
+    with pytest.raises(SystemExit):
+        main(["valdate", "spec.xpdl"])
+    err = capsys.readouterr().err
+    assert "invalid choice: 'valdate'" in err and "'validate'" in err and "'model-check'" in err
