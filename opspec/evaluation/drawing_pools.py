@@ -10,6 +10,11 @@ of the evaluate process; a thread of it per drawing process (:class:`_Drawer`) h
 next one (a module-level function, pickled by name, and its arguments) to its process over
 a pipe of their own as soon as that process is free, so each figure goes to the first
 process free to draw it.
+
+No process forks while it has a thread of its own (a lock another thread held would stay
+held in the child; Python 3.12+ warns of it): the evaluate process starts those threads
+with the first figure, after it has forked its replication workers, and the first drawing
+process starts watching its parent only once it has forked the others.
 """
 
 from __future__ import annotations
@@ -168,14 +173,23 @@ class _Pools:
                 theirs.close()
         self._drawers = [_Drawer(ours, self._first.pid if i == 0 else None, self)
                          for i, (ours, _) in enumerate(ends)]
-        for drawer in self._drawers:
-            drawer.thread.start()
+
+    def _start_threads(self) -> None:
+        """The threads that hand the jobs over, started at the first job (or at the end):
+        not at the start, so that the evaluate process has no thread of its own when it
+        forks its replication workers (a fork of a process with threads is what Python 3.12+
+        warns of: a lock another thread held stays held in the child)."""
+        with self._lock:
+            for drawer in self._drawers:
+                if drawer.thread.ident is None:
+                    drawer.thread.start()
 
     def submit(self, fn: Callable[..., Any], /, *args: Any) -> Any:
         import concurrent.futures as cf
         from concurrent.futures.process import BrokenProcessPool
 
         future: cf.Future[Any] = cf.Future()
+        self._start_threads()
         with self._lock:
             if all(drawer.gone for drawer in self._drawers):
                 raise BrokenProcessPool("the drawing processes ended")
@@ -201,6 +215,7 @@ class _Pools:
 
     def shutdown(self) -> None:
         """Let the processes end once they have drawn what was sent, and wait for them."""
+        self._start_threads()
         for _ in self._drawers:
             self.jobs.put(None)
         for drawer in self._drawers:
@@ -214,6 +229,7 @@ class _Pools:
         import signal
 
         ended: set[int] = set()
+        self._start_threads()               # each thread learns its process's pid, or EOF
 
         def end(drawer: _Drawer) -> None:
             # a process forked by the first: ended once its pid is known, and only while
@@ -254,7 +270,7 @@ def _first_process(parent: int, ends: list[Any], not_ours: list[Any]) -> None:
     import), its own jobs drawn; it ends once the processes it forked have ended."""
     for end in not_ours:                    # the evaluate process's ends of the pipes
         end.close()
-    _keep_to(parent)
+    _leave_ctrl_c()
     _warm_up()
     forked = []
     for end in ends[1:]:
@@ -263,6 +279,10 @@ def _first_process(parent: int, ends: list[Any], not_ours: list[Any]) -> None:
         except OSError:                     # the first draws what that one would have
             pass
         end.close()                         # that process's alone now (or nobody's)
+    # watched from now on, not during the import: a thread of its own would be in the
+    # process it forks above (which Python 3.12+ warns of); a parent gone meanwhile is seen
+    # at the watch's first look
+    _watch(parent)
     try:
         _serve(ends[0])
     finally:
@@ -288,7 +308,8 @@ def _fork_sibling(end: Any, ends: list[Any]) -> int:
         for other in ends:
             if other is not end:
                 other.close()
-        _keep_to(first)
+        _leave_ctrl_c()
+        _watch(first)
         end.send(os.getpid())
         _serve(end)
         status = 0
@@ -307,14 +328,18 @@ _fork = os.fork if hasattr(os, "fork") else None
 _WATCH_EVERY = 1.0
 
 
-def _keep_to(parent: int) -> None:
+def _leave_ctrl_c() -> None:
     """Ctrl-C left to the evaluate process (which ends the drawing; no traceback from each
-    drawing process), and an end of this process's own when its parent is gone (killed: it
-    cannot end it, and a drawing process waiting for figures would live on)."""
+    drawing process)."""
     import signal
-    import time
 
     signal.signal(signal.SIGINT, signal.SIG_IGN)
+
+
+def _watch(parent: int) -> None:
+    """An end of this process's own when its parent is gone (killed: it cannot end it, and
+    a drawing process waiting for figures would live on)."""
+    import time
 
     def watch() -> None:
         while os.getppid() == parent:

@@ -205,3 +205,64 @@ def test_a_drawing_process_that_dies_leaves_no_pickle_to_the_collector() -> None
         gc.set_debug(0)
         gc.garbage.clear()
     assert views == []
+
+
+def _opspec_threads() -> list[str]:
+    import threading
+
+    return [t.name for t in threading.enumerate() if t.name.startswith("opspec-drawing")]
+
+
+def test_no_thread_of_this_process_or_the_first_is_there_when_they_fork(
+        tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    # evaluate forks its replication workers inside this block, and the first drawing
+    # process forks the others: a fork of a process with threads can leave a lock another
+    # thread held locked in the child (Python 3.12+ warns "This process is multi-threaded,
+    # use of fork() may lead to deadlocks in the child")
+    counts = tmp_path / "threads-at-fork"
+
+    def counting_fork() -> int:
+        import threading
+
+        with counts.open("a") as out:               # written by the first drawing process
+            out.write(f"{threading.active_count()}\n")
+        return os.fork()
+
+    monkeypatch.setattr(drawing_pools, "_fork", counting_fork)
+    with plots.drawing_processes(3):
+        pools = drawing_pools.started_pools()
+        assert pools is not None
+        for _ in range(100):                        # until the first has forked the others
+            if counts.is_file() and len(counts.read_text().split()) == 2:
+                break
+            time.sleep(0.05)
+        assert _opspec_threads() == []              # here, before the first figure
+        answers = {pools.submit(_who, 0.2).result()[0] for _ in range(6)}
+        assert answers and len(_opspec_threads()) == 3     # handing the figures over now
+    assert counts.read_text().split() == ["1", "1"]
+
+
+def test_a_block_ended_before_any_figure_ends_its_processes_without_waiting(
+        tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    # the threads that learn the forked processes' pids start only with the first figure:
+    # a block that asks for none (a bad input, Ctrl-C during the replications) still ends
+    # every process it started at once, not after the 5 s it would wait for a pid to be said
+    pids = tmp_path / "forked"
+
+    def recording_fork() -> int:
+        pid = os.fork()
+        if pid:
+            pids.write_text(str(pid))
+        return pid
+
+    monkeypatch.setattr(drawing_pools, "_fork", recording_fork)
+    started = time.monotonic()
+    with pytest.raises(KeyboardInterrupt), plots.drawing_processes(2):
+        for _ in range(100):                        # until the first has forked the second
+            if pids.is_file() and pids.read_text():
+                break
+            time.sleep(0.05)
+        raise KeyboardInterrupt
+    assert time.monotonic() - started < 4.5         # (the stall this guards against: 5 s)
+    assert _drawing_children() == 0
+    assert _gone(int(pids.read_text()))
