@@ -112,6 +112,10 @@ def _fit(args: argparse.Namespace) -> int:
     if args.json and args.output == "-":
         raise UserModelError("--json and -o - both want standard output",
                              hint="write the model to a file with -o FILE")
+    if args.holdout is not None and args.output == "-":
+        raise UserModelError("--holdout and -o - both want standard output (the folds' "
+                             "checks are printed after the model is written)",
+                             hint="write the model to a file with -o FILE")
     if args.draws < 0:
         raise UserModelError(f"--draws must be 0 or more, not {args.draws}")
     from opspec.usermodels.persons import PersonRule, parse_person_options
@@ -135,6 +139,10 @@ def _fit(args: argparse.Namespace) -> int:
     result = fit_traces(paths, lane=args.lane, name=name, criterion=args.criterion,
                         min_per_user=args.min_per_user, persons=persons)
     obs = result.observations
+    if args.holdout is not None:        # folds that cannot be made: said before writing
+        from opspec.commands.model_check import fold_persons
+
+        fold_persons(paths, obs, args.holdout)
     from opspec.usermodels.bootstrap import parameter_draws
 
     draws = parameter_draws(result, args.draws, seed=args.seed) if args.draws else None

@@ -281,19 +281,14 @@ class CrossValidation:
                             for f, i, a in self.misfits]}
 
 
-def cross_validate(paths: Sequence[Path], persons: PersonRule, k: int, *,
-                   fit: Any, options: CheckOptions, work: Path) -> CrossValidation:
-    """Fit on all persons but one fold, check on that fold, for each of ``k`` folds.
-    ``fit(train_paths, model_path, persons)`` writes the model fitted on ``train_paths`` (as ``opspec
-    fit`` would); persons are assigned to folds at random (``options.seed``)."""
-    import numpy as np
-
+def fold_persons(paths: Sequence[Path], obs: Any, k: int
+                 ) -> tuple[dict[int, set[str]], list[str]]:
+    """Whose each trace file is (file index -> persons) and the persons, for ``--holdout k``
+    over the observations ``obs`` of ``paths``; a UserModelError when they cannot be split
+    into ``k`` folds (a file holding several persons, too few persons). ``opspec fit`` asks
+    it before it writes anything."""
     from opspec.errors import UserModelError
-    from opspec.usermodels.fitting import collect
-    from opspec.usermodels.loader import load_user_model
 
-    check_options(options)
-    obs = collect(paths, options.lane, persons)
     files: dict[int, set[str]] = {}
     for (file_index, _), person in obs.person_of.items():
         files.setdefault(file_index, set()).add(person)
@@ -304,12 +299,27 @@ def cross_validate(paths: Sequence[Path], persons: PersonRule, k: int, *,
             f"{len(files[paths.index(Path(shared[0]))])} persons",
             hint="give each person's sessions their own files, or say whose a file is "
             "(--person-from file, --person-from header, --person FILE=ID)")
-    people = obs.persons
+    people = list(obs.persons)
     if not 2 <= k <= len(people) or len(people) - -(-len(people) // k) < 3:
         raise UserModelError(
             f"--holdout {k} cannot split {len(people)} person(s) into folds",
             hint="each fold needs one person or more and the rest three or more to fit on: "
             f"use 2 to {max(2, len(people))} folds with enough persons")
+    return files, people
+
+
+def cross_validate(paths: Sequence[Path], persons: PersonRule, k: int, *,
+                   fit: Any, options: CheckOptions, work: Path) -> CrossValidation:
+    """Fit on all persons but one fold, check on that fold, for each of ``k`` folds.
+    ``fit(train_paths, model_path, persons)`` writes the model fitted on ``train_paths`` (as ``opspec
+    fit`` would); persons are assigned to folds at random (``options.seed``)."""
+    import numpy as np
+
+    from opspec.usermodels.fitting import collect
+    from opspec.usermodels.loader import load_user_model
+
+    check_options(options)
+    files, people = fold_persons(paths, collect(paths, options.lane, persons), k)
     order = [people[i] for i in np.random.default_rng(options.seed).permutation(len(people))]
     folds = []
     for f in range(k):

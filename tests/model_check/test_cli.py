@@ -97,10 +97,24 @@ def test_holdout_needs_each_file_to_be_one_person(tmp_path, capsys) -> None:
                    "--holdout", "2", "--draws", "0"])
     assert status == 2
     assert "holds sessions of 2 persons" in capsys.readouterr().err
+    assert not (tmp_path / "m.toml").exists()       # refused before anything is written
 
 
 def test_holdout_with_too_few_persons_is_refused(reference_people, capsys, tmp_path) -> None:
-    status = main(["fit", *map(str, reference_people[:3]), "-o", str(tmp_path / "m.toml"),
-                   "--holdout", "3", "--draws", "0"])
-    assert status == 2
-    assert "cannot split 3 person(s)" in capsys.readouterr().err
+    for folds in ("3", "1"):
+        status = main(["fit", *map(str, reference_people[:3]), "-o", str(tmp_path / "m.toml"),
+                       "--holdout", folds, "--draws", "0"])
+        assert status == 2
+        assert f"--holdout {folds} cannot split 3 person(s)" in capsys.readouterr().err
+        # a refused command leaves no model behind: the user would take it for the result
+        assert not (tmp_path / "m.toml").exists()
+
+
+def test_holdout_with_the_model_on_standard_output_is_refused(reference_people, capsys
+                                                              ) -> None:
+    # the folds' checks would be skipped (they print after the model is written)
+    status = main(["fit", *map(str, reference_people[:4]), "-o", "-", "--holdout", "2",
+                   "--draws", "0"])
+    captured = capsys.readouterr()
+    assert status == 2 and captured.out == ""
+    assert "--holdout and -o - both want standard output" in captured.err
