@@ -77,7 +77,7 @@ def _register_broken(subparsers: argparse._SubParsersAction[argparse.ArgumentPar
                      module: str, error: Exception) -> None:
     """Stand in for a command whose module fails to import or register: the other commands
     keep working, and this one says what is wrong in one line when it is used."""
-    command = module.rsplit(".", 1)[-1]
+    command = module.rsplit(".", 1)[-1].replace("_", "-")   # as build_parser names it
     if command in subparsers.choices:
         return
     reason = " ".join(f"{type(error).__name__}: {error}".split())
@@ -102,6 +102,18 @@ def _subparsers(parser: argparse.ArgumentParser) -> dict[str, argparse.ArgumentP
         if isinstance(action, argparse._SubParsersAction):
             return dict(action.choices)
     return {}
+
+
+def _innermost(parser: argparse.ArgumentParser, args: argparse.Namespace
+               ) -> argparse.ArgumentParser:
+    """The parser of the deepest command ``args`` chose (``opspec devices list``: that of
+    ``list``), whose usage an unknown option is reported with."""
+    while True:
+        actions = [a for a in parser._actions if isinstance(a, argparse._SubParsersAction)]
+        chosen = getattr(args, actions[0].dest, None) if actions else None
+        if chosen is None or chosen not in actions[0].choices:
+            return parser
+        parser = actions[0].choices[chosen]
 
 
 def _named_command(argv: Sequence[str]) -> str | None:
@@ -134,8 +146,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     if unknown:
         # the subcommand's own usage, not the top-level one: what the mistyped option
         # belongs to and what it accepts
-        own = _subparsers(parser).get(getattr(args, "command", None) or "")
-        (own or parser).error(f"unrecognized arguments: {' '.join(unknown)}")
+        _innermost(parser, args).error(f"unrecognized arguments: {' '.join(unknown)}")
     handler = getattr(args, "handler", None)
     if handler is None:
         parser.print_help()

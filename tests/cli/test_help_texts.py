@@ -76,3 +76,14 @@ def test_a_mistyped_command_still_lists_every_command(capsys):
         main(["valdate", "spec.xpdl"])
     err = capsys.readouterr().err
     assert "invalid choice: 'valdate'" in err and "'validate'" in err and "'model-check'" in err
+
+
+def test_an_unknown_option_of_an_action_shows_that_actions_usage(capsys):
+    # README: "A mistyped option shows the usage of the command it was given to"
+    from opspec.cli import main
+
+    with pytest.raises(SystemExit):
+        main(["devices", "list", "--bogus"])
+    err = capsys.readouterr().err
+    assert err.startswith("usage: opspec devices list ")
+    assert "opspec devices list: error: unrecognized arguments: --bogus" in err

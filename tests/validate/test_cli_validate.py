@@ -221,10 +221,34 @@ def test_a_command_module_that_fails_to_import_breaks_only_that_command(
                         (*opspec.cli.COMMAND_MODULES, "opspec_broken_command_for_test"))
     assert main(["validate", str(DATA / "valid.xpdl")]) == 0
     capsys.readouterr()
-    assert main(["opspec_broken_command_for_test", "x", "--y"]) == 70
+    assert main(["opspec-broken-command-for-test", "x", "--y"]) == 70
     err = capsys.readouterr().err
     assert "Traceback" not in err and len(err.strip().splitlines()) == 1
     assert "SyntaxError" in err and "cannot be loaded" in err
+
+
+def test_a_broken_command_keeps_the_name_it_is_typed_with(
+    monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    # model_check's command is `model-check`: its stand-in must answer to that name, alone
+    # (`opspec model-check ...` builds its parser alone) or in the full list
+    import importlib
+    import types
+
+    import opspec.cli
+
+    def import_module(name: str) -> object:
+        if name == "opspec.commands.model_check":
+            raise RuntimeError("broken on purpose")
+        return importlib.import_module(name)
+
+    monkeypatch.setattr(opspec.cli, "importlib", types.SimpleNamespace(
+        import_module=import_module))
+    assert main(["model-check", "m.toml", "t.jsonl"]) == 70
+    err = capsys.readouterr().err
+    assert "the 'model-check' command cannot be loaded (RuntimeError: broken on purpose)" in err
+    listed = opspec.cli._subparsers(opspec.cli.build_parser())
+    assert "model-check" in listed and "model_check" not in listed
 
 
 @pytest.mark.skipif(os.name != "posix", reason="symbolic links")
