@@ -181,6 +181,7 @@ def _fit(args: argparse.Namespace) -> int:
                "uncertainty": None if draws is None else {
                    "draws": draws.count, "resampled": draws.resampled, "seed": draws.seed,
                    "parameters": draws.summary()},
+               "unusable_durations": dict(sorted(obs.unusable.items())),
                "holdout": None if holdout is None else holdout.to_json()}
         print(json.dumps(doc, indent=1, default=str))
         return status
@@ -193,6 +194,10 @@ def _fit(args: argparse.Namespace) -> int:
         print(f"parameter uncertainty: {draws.count} bootstrap redraws resampling "
               f"{draws.resampled} ([uncertainty]; opspec evaluate --input-uncertainty B)")
     print(f"wrote {out} ({len(result.fits)} activities: {activities})")
+    if obs.unusable:    # walkthrough answers whose clock was paused, fast or skipped
+        left = ", ".join(f"{activity} {n}" for activity, n in sorted(obs.unusable.items()))
+        print(f"left out: {sum(obs.unusable.values())} walkthrough duration(s) not timed in "
+              f"real time ({left}); their choices still count")
     if holdout is not None:
         print()
         for line in holdout.lines():

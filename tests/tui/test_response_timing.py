@@ -108,7 +108,7 @@ def test_the_models_answers_are_not_the_persons(compiled, tmp_path, model_factor
     assert data and all(d["by"] == "model" and d["usable"] is False for d in data)
 
 
-def test_fit_leaves_out_what_was_not_timed_in_real_time(compiled, tmp_path):
+def test_fit_leaves_out_what_was_not_timed_in_real_time(compiled, tmp_path, capsys):
     """Two answers at 1x (4.5 s and 9 s) and one while paused: fit sees 4.5 and 9 only."""
     session, wall = at_alarm(compiled, tmp_path)
     real_seconds(session, wall, 4.5)
@@ -124,6 +124,14 @@ def test_fit_leaves_out_what_was_not_timed_in_real_time(compiled, tmp_path):
     assert obs.durations["walk_to_dispenser"] == [pytest.approx(9.0)]
     assert "choose_button" not in obs.durations and obs.unusable["choose_button"] == 1
     assert obs.picks["choose_button"] == [["press_report"]]  # the choice itself still counts
+    # opspec fit says what it left out, of which activity
+    from opspec.cli import main
+
+    assert main(["fit", str(session.record_path.with_suffix(".trace.jsonl")), "-o",
+                 str(tmp_path / "fitted.users.toml")]) == 0
+    out = capsys.readouterr().out
+    assert ("left out: 1 walkthrough duration(s) not timed in real time (choose_button 1)"
+            in out)
 
 
 def test_sessions_of_one_participant_count_as_one_person_in_fit(compiled, tmp_path):
