@@ -85,8 +85,14 @@ def _build_lognormal(p: _Params) -> Distribution:
     elif p.has("mean"):
         d = LogNormal.from_mean_sd(p.take("mean"), p.take("sd", "standardDeviation"))
     else:
-        raise ParameterError("median", "lognormal needs median+sigma, mu+sigma, mean+sd or "
-                             "mean+sigma",
+        needs = "lognormal needs median+sigma, mu+sigma, mean+sd or mean+sigma"
+        if p.left:          # a misspelt name (medain = 60) is likelier than none at all
+            typo = min(p.left)
+            close = difflib.get_close_matches(typo, ("median", "mu", "mean"), n=1)
+            raise ParameterError(typo, "is not a parameter of a lognormal distribution",
+                                 hint=(f"did you mean {close[0]}? " if close else "")
+                                 + f"({needs})")
+        raise ParameterError("median", needs,
                              hint="for example { kind = \"lognormal\", median = 60, "
                              "sigma = 0.6 }")
     return d

@@ -205,10 +205,18 @@ class UserModel:
                 hint=f"combine it with a base model, e.g. --user-model "
                 f"SPEC.users.toml,{self.name}")
         if missing:
+            import difflib
+
             ids = ", ".join(missing)
+            # a table the spec has no activity for, named like a missing one: a typo
+            strays = [a for a in self.activities if a not in manual and a not in choice_map]
+            typos = [f"[activities.{stray}] is not an activity of the spec: did you mean "
+                     f"{close[0]}?" for stray in strays
+                     for close in [difflib.get_close_matches(stray, missing, n=1)] if close]
             raise UserModelError(
                 f"user model {self.name!r} does not cover manual "
-                f"activit{'y' if len(missing) == 1 else 'ies'} of the spec: {ids}",
+                f"activit{'y' if len(missing) == 1 else 'ies'} of the spec: {ids}"
+                + "".join(f"; {typo}" for typo in typos),
                 location=SourceLocation(self.path, key="activities"),
                 hint="add " + " ".join(f"[activities.{a}]" for a in missing)
                 + " with at least a duration, or a [defaults] table")

@@ -123,6 +123,9 @@ BAD = {
     "empty-data": ({"kind": "empirical", "values": []}, "values", r"at least one"),
     "text-parameter": ({"kind": "exponential", "mean": "ten"}, "mean", r"must be a number"),
     "nan": ({"kind": "exponential", "mean": float("nan")}, "mean", r"nan"),
+    # a misspelt name is named, not reported as the parameter it was meant to be
+    "lognormal-typo": ({"kind": "lognormal", "medain": 60, "sigma": 0.6}, "medain",
+                       r"not a parameter of a lognormal.*did you mean median\?"),
 }
 
 

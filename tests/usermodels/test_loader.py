@@ -117,6 +117,15 @@ def test_uncovered_manual_activities_name_the_file_the_ids_and_the_fix(tmp_path:
         model.validate_against(["hear_alarm", "walk_to_dispenser", "press_report", "take_pill"])
 
 
+def test_an_uncovered_activity_names_the_table_that_is_likely_its_typo(tmp_path: Path
+                                                                      ) -> None:
+    model = load_user_model(write(tmp_path, GOOD + '[activities.take_pil]\n'
+                                  'duration = { kind = "constant", value = 5 }\n'))
+    with pytest.raises(UserModelError, match=r"spec: take_pill; \[activities.take_pil\] is "
+                       r"not an activity of the spec: did you mean take_pill\?"):
+        model.validate_against(["hear_alarm", "walk_to_dispenser", "take_pill"])
+
+
 def test_a_choice_naming_an_alternative_the_spec_lacks_is_an_error(tmp_path: Path) -> None:
     model = load_user_model(write(tmp_path, GOOD + '[activities.c]\nintended = "press_reprot"\n'))
     with pytest.raises(UserModelError, match=r"choice 'c' has no alternative 'press_reprot' "
