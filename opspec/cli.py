@@ -116,6 +116,33 @@ def _innermost(parser: argparse.ArgumentParser, args: argparse.Namespace
         parser = actions[0].choices[chosen]
 
 
+def _refuse_unknown_command(parser: argparse.ArgumentParser, name: str) -> None:
+    """A name that is no command but close to one: argparse's refusal, with the one meant
+    (``opspec evalute``: did you mean 'evaluate'?)."""
+    import difflib
+
+    commands = list(_subparsers(parser))
+    if name in commands or name.startswith("-"):
+        return
+    close = difflib.get_close_matches(name, commands, n=1)
+    if close:
+        parser.error(f"argument COMMAND: invalid choice: {name!r} (did you mean "
+                     f"{close[0]!r}? choose from {', '.join(map(repr, commands))})")
+
+
+def _did_you_mean(parser: argparse.ArgumentParser, unknown: Sequence[str]) -> str:
+    """The options of ``parser`` the unknown ones are likely typos of (``--dayz``: did you
+    mean --days?); argparse may then have taken the typo's value for an argument."""
+    import difflib
+
+    options = [o for action in parser._actions for o in action.option_strings
+               if o.startswith("--")]
+    meant = [f"{typo}: did you mean {close[0]}?" for typo in unknown if typo.startswith("--")
+             for close in [difflib.get_close_matches(typo.split("=", 1)[0], options, n=1)]
+             if close]
+    return f" ({'; '.join(meant)})" if meant else ""
+
+
 def _named_command(argv: Sequence[str]) -> str | None:
     """The command the command line names first, if it names one before any option (the
     top-level options, ``--help`` and ``--version``, need every command's parser)."""
@@ -132,6 +159,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         parser = build_parser(named)
         if named is not None and named not in _subparsers(parser):
             parser = build_parser()        # not a command's name: the full list says so
+            _refuse_unknown_command(parser, named)
     except Exception as error:  # noqa: BLE001 - no traceback reaches a user
         print(f"opspec: internal error: {' '.join(f'{type(error).__name__}: {error}'.split())} "
               "(this is a bug in opspec; please report it)", file=sys.stderr)
@@ -146,7 +174,8 @@ def main(argv: Sequence[str] | None = None) -> int:
     if unknown:
         # the subcommand's own usage, not the top-level one: what the mistyped option
         # belongs to and what it accepts
-        _innermost(parser, args).error(f"unrecognized arguments: {' '.join(unknown)}")
+        own = _innermost(parser, args)
+        own.error(f"unrecognized arguments: {' '.join(unknown)}" + _did_you_mean(own, unknown))
     handler = getattr(args, "handler", None)
     if handler is None:
         parser.print_help()

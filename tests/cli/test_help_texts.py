@@ -87,3 +87,15 @@ def test_an_unknown_option_of_an_action_shows_that_actions_usage(capsys):
     err = capsys.readouterr().err
     assert err.startswith("usage: opspec devices list ")
     assert "opspec devices list: error: unrecognized arguments: --bogus" in err
+
+
+def test_a_mistyped_command_or_option_names_the_one_meant(capsys):
+    from opspec.cli import main
+
+    with pytest.raises(SystemExit):
+        main(["evalute", "spec.xpdl"])
+    assert "invalid choice: 'evalute' (did you mean 'evaluate'?" in capsys.readouterr().err
+    with pytest.raises(SystemExit):
+        main(["run", "--dayz", "1", "spec.xpdl"])       # argparse took 1 for SPEC
+    err = capsys.readouterr().err
+    assert "unrecognized arguments: --dayz spec.xpdl (--dayz: did you mean --days?)" in err
