@@ -15,7 +15,7 @@ import contextlib
 from pathlib import Path
 from typing import Any
 
-from opspec.errors import ConfigurationError, OpspecError, UserModelError
+from opspec.errors import ConfigurationError, OpspecError, SpecError, UserModelError
 
 __all__ = ["misplaced"]
 
@@ -60,17 +60,23 @@ def misplaced(error: OpspecError, given: tuple[tuple[str, str | None], ...]) -> 
     """``error`` with a hint naming the option its file was given to and the one it is meant
     for (``given``: option and value), when the file is plainly of another kind; else
     ``error`` itself."""
-    if type(error) not in (ConfigurationError, UserModelError) or error.location is None:
+    as_spec = isinstance(error, SpecError)      # a user model or script given as SPEC
+    if (type(error) not in (ConfigurationError, UserModelError) and not as_spec
+            or error.location is None):
         return error
     for option, value in given:
-        if value is None or not _same(error.location.path, value):
+        # a spec error comes from reading SPEC, the others from the options' files
+        if value is None or (option == "SPEC") != as_spec or not _same(
+                error.location.path, value):
             continue
         found = _what(value)
-        if found is None or found[1] == option:
+        if found is None or found[1] == (_SPEC if option == "SPEC" else option):
             return error
         what, goes = found
-        return type(error)(error.message, location=error.location,
-                           hint=f"given to {option}, but this is {what}: give it as {goes}"
-                           if goes == _SPEC else
-                           f"given to {option}, but this is {what}: give it to {goes}")
+        hint = (f"given to {option}, but this is {what}: give it as {goes}" if goes == _SPEC
+                else f"given {'as' if option == 'SPEC' else 'to'} {option}, but this is "
+                f"{what}: give it to {goes}")
+        if as_spec:     # the reader's complaint about the XML is beside the point
+            return SpecError(error.message, location=error.location, hint=hint)
+        return type(error)(error.message, location=error.location, hint=hint)
     return error

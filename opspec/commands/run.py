@@ -95,7 +95,7 @@ def run(args: argparse.Namespace) -> int:
             branches=parse_branch_options(args.branch) or None))
     except OpspecError as error:
         # a user model given to --script, a spec to --user-model: say so
-        raise misplaced(error, (("--script", args.script),
+        raise misplaced(error, (("SPEC", args.spec), ("--script", args.script),
                                 ("--user-model", args.user_model))) from None
     for warning in prepared.warnings:
         print(f"opspec run: {warning}", file=sys.stderr)

@@ -62,3 +62,20 @@ def test_a_broken_script_keeps_its_own_advice(tmp_path: Path,
     script.write_text('steps = [\n', encoding="utf-8")
     err = error_of(capsys, "--script", str(script))
     assert "the script is not valid TOML" in err and "given to" not in err
+
+
+def test_a_user_model_given_as_the_spec(capsys: pytest.CaptureFixture[str]) -> None:
+    assert main(["run", str(USERS), "--until", "1h"]) == 1
+    err = capsys.readouterr().err
+    assert "not well-formed XML" in err                     # what the reader found, as before
+    assert "(given as SPEC, but this is a user model: give it to --user-model)" in err
+    assert len(err.strip().splitlines()) == 1
+
+
+def test_a_broken_spec_given_as_the_spec_gets_no_hint_to_move_it(
+        tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    cut = tmp_path / "cut.xpdl"
+    cut.write_bytes(SPEC.read_bytes()[:3000])
+    assert main(["run", str(cut), "--until", "1h"]) == 1
+    err = capsys.readouterr().err
+    assert "not well-formed XML" in err and "given as SPEC" not in err
