@@ -2,8 +2,9 @@
 which one it is meant for.
 
 A user model passed to ``--script`` fails as a script with unknown keys, a spec passed to
-``--user-model`` as TOML that cannot be read: both messages are right about the file but do
-not say that the file is simply in the wrong place. :func:`misplaced` looks at a file whose
+``--user-model`` as TOML that cannot be read, a user model given as SPEC as XML that is not
+well-formed: the messages are right about the file but do not say that the file is simply
+in the wrong place. :func:`misplaced` looks at a file whose
 reading failed and, when it is plainly a spec (XML, or a compiled ``.wfs``), a user model
 (``format = "opspec-user-model"``) or a script (``steps``), says where it goes instead.
 Only the error path reads the file again.
