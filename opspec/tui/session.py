@@ -165,7 +165,9 @@ class WalkSession(SessionClock, PersonLane, TraceFollower, Recording):
             lines += ["", "Your response times (wall clock, from the offer to your key):",
                       *response_lines(self.responses)]
         if self.record_path is not None:
-            walk, run = replay_commands(self.spec_path or "SPEC", self.record_path)
+            stopped = final and not self.ended and self.failure is None
+            walk, run = replay_commands(self.spec_path or "SPEC", self.record_path,
+                                        until=self.now if stopped else None)
             lines += ["", f"Recording: {self.record_path}",
                       f"Trace (for opspec fit): {self.record_path.with_suffix('.trace.jsonl')}"
                       + (f" (person {self.person})" if self.person is not None else ""),

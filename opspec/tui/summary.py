@@ -67,9 +67,14 @@ def response_lines(responses: Sequence[Response]) -> list[str]:
     return lines
 
 
-def replay_commands(spec: str | Path, record: str | Path) -> tuple[str, str]:
+def replay_commands(spec: str | Path, record: str | Path, *, until: float | None = None
+                    ) -> tuple[str, str]:
     """The two commands that replay ``record`` (quoted for a POSIX shell, so a path with
-    spaces pastes as it is): in the walkthrough, and with ``opspec run``."""
+    spaces pastes as it is): in the walkthrough, and with ``opspec run``. ``until``: the
+    simulated second the session was stopped at, before the end of its run: ``opspec run``
+    stops there too (``--until``), so that it prints the numbers the summary shows, not
+    those of a run that goes on without the person."""
     spec_q, record_q = shlex.quote(str(spec)), shlex.quote(str(record))
+    stop = "" if until is None else f" --until {until!r}"
     return (f"opspec walkthrough {spec_q} --replay {record_q}",
-            f"opspec run {spec_q} --script {record_q}")
+            f"opspec run {spec_q}{stop} --script {record_q}")

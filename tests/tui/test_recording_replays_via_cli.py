@@ -54,11 +54,20 @@ async def test_a_recording_named_anything_replays_with_the_printed_command(compi
     assert stopped > 12 * 3600
     command = printed_run_command(session)
     assert command[:2] == ["opspec", "run"] and command[-2:] == ["--script", str(record)]
+    # stopped before the end of the day: the run stops there too, so that its numbers are
+    # those the summary showed, not those of a day that goes on without the person
+    assert command[command.index("--until") + 1] == repr(stopped)
     assert script_format(record.read_bytes(), str(record)) == "JSON"
+    shown = [line for line in session.summary_lines() if line.startswith("  ") and (
+        "doses" in line or "alarms" in line or "latency" in line)]
+    assert any(line.split() == ["doses_missed", "0"] for line in shown)
 
     run_trace = tmp_path / "run.jsonl"
     capsys.readouterr()
     assert main([*command[1:], "--trace", str(run_trace), "--timeline", "none"]) == 0
+    printed = capsys.readouterr().out.splitlines()
+    for line in shown:                                      # word for word
+        assert line in printed
     walked = record.with_suffix(".trace.jsonl").read_text(encoding="utf-8").splitlines()
     ran = run_trace.read_text(encoding="utf-8").splitlines()
     mine = events(walked, stopped)
