@@ -430,8 +430,9 @@ def _print_timing(out: Any, timing: dict[str, dict[str, Any]], pool: dict[str, A
     wall = any(t.get("clock") == "wall" for t in timing.values())
     clock = "wall-clock" if wall else "simulated"
     print(f"\ntiming (times in milliseconds of {clock} time; percentiles with their "
-          "distribution-free 95 % interval; misses: instances past their deadline, with the "
-          "miss rate's exact 95 % interval)", file=out)
+          "distribution-free 95 % interval, ? where too few instances give no such bound; "
+          "misses: instances past their deadline, with the miss rate's exact 95 % interval)",
+          file=out)
     print(f"  {'workflow':<20}{'started':>8}{'done':>8}{'misses':>8}{'miss % [95 % CI]':>24}"
           f"{'mean ms':>10}{'max ms':>10}{'jitter ms':>11}", file=out)
     for name, t in timing.items():

@@ -270,3 +270,13 @@ def test_the_simulation_event_count_does_not_depend_on_what_is_shown(capsys):
         last = capsys.readouterr().out.strip().splitlines()[-1]
         counts.append(last.split(": ", 1)[1].split(" simulation events")[0])
     assert len(set(counts)) == 1 and int(counts[0]) > 0
+
+
+def test_a_percentile_bound_too_few_instances_cannot_give_is_explained(capsys) -> None:
+    # 30 instances of the battery watch in 300 s: no distribution-free upper bound for p90
+    vacuum = ROOT / "specs" / "vacuum_cleaner.xpdl"
+    assert main(["run", str(vacuum), "--until", "300", "--timing", "--timeline", "none"]) == 0
+    out = capsys.readouterr().out
+    battery = out.split("\n  battery", 1)[1].splitlines()[1]
+    assert "p90 1.00 [1.00, ?]" in battery
+    assert "? where too few instances give no such bound" in out
