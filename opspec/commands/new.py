@@ -62,7 +62,9 @@ def register(subparsers: Any) -> None:
 def render(name: str, template: str = "pill") -> dict[str, str]:
     """The files of a new spec called ``name`` from ``template`` (:data:`SHAPES`): output
     file name -> text."""
-    values = {"name": name, "ident": identifier(name)}
+    # name_pad: spaces as wide as the name, so that a line without it (python -m pytest)
+    # keeps its comment in the column of the lines with it
+    values = {"name": name, "ident": identifier(name), "name_pad": " " * len(name)}
     folder = resources.files("opspec.commands").joinpath("templates", "new", template)
     return {string.Template(target).substitute(values):
             string.Template(folder.joinpath(source).read_text(encoding="utf-8"))

@@ -140,3 +140,12 @@ def test_pytest_comes_with_opspec_not_only_with_its_test_extras() -> None:
     project = tomllib.loads((Path(__file__).resolve().parents[2] / "pyproject.toml")
                             .read_text(encoding="utf-8"))["project"]
     assert any(d.replace(" ", "").startswith("pytest>") for d in project["dependencies"])
+
+
+@pytest.mark.parametrize("shape", sorted(SHAPES))
+@pytest.mark.parametrize("name", ["pb", "a-much-longer-name"])
+def test_the_readmes_commands_keep_their_comments_in_one_column(shape: str, name: str) -> None:
+    readme = render(name, shape)["README.md"]
+    block = readme.split("```sh\n", 1)[1].split("```", 1)[0]
+    columns = {line.index("  #") for line in block.splitlines() if "  #" in line}
+    assert len(columns) == 1, block
