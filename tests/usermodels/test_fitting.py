@@ -162,8 +162,8 @@ def test_unusable_traces_are_clear_errors(tmp_path: Path, text: str, message: st
      ":1: not valid JSON: Invalid control character at column 39 (each line"),
     ('{"kind": "activity.started", "x": "abc',
      ":1: not valid JSON: Unterminated string starting at column 35 (each line"),
-    ('{"time": 1,\n', ":1: not valid JSON: Expecting property name enclosed in double "
-     "quotes at the end of the line (each line"),
+    ('{"time": 1,\n', (":1: not valid JSON: Expecting property name enclosed in double "
+                       "quotes at the end of the line (each line")),
 ], ids=["control-character", "newline-in-string", "unterminated", "line-ends-early"])
 def test_a_line_that_is_not_json_is_a_whole_sentence_with_its_column(
         tmp_path: Path, capsys: pytest.CaptureFixture[str], line: str, message: str) -> None:
