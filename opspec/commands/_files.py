@@ -13,7 +13,7 @@ from typing import Any
 from opspec.errors import ConfigurationError
 
 __all__ = ["Named", "check_nesting", "input_problem", "overwrite_problem", "refuse_overwrite",
-           "same_file", "spec_inputs", "translation_problem"]
+           "same_file", "spec_inputs", "translation_problem", "write_problem"]
 
 #: a file as the command line names it: (the option or argument, e.g. ``"--trace"``, path)
 Named = tuple[str, "str | os.PathLike[str] | None"]
@@ -41,6 +41,24 @@ def translation_problem(command: str, source: Path, target: Path | None, *,
                              [("IN", source), ("IN's companion user model",
                                                companion_user_model(source))],
                              example=example)
+
+
+def write_problem(target: Path, error: OSError) -> str:
+    """``cannot write TARGET: why`` for ``error``, raised writing ``target``: when the folder
+    it goes in is missing (or a file stands where a folder should), that folder, named; the
+    operating system's bare "No such file or directory" names neither."""
+    import errno
+
+    folder = target.parent
+    if error.errno in (errno.ENOENT, errno.ENOTDIR):
+        existing = next((path for path in (folder, *folder.parents) if path.exists()), None)
+        if existing is not None and not existing.is_dir():
+            return (f"cannot write {target}: {existing} is a file, not a folder (give a path "
+                    "in a folder)")
+        if existing != folder:
+            return (f"cannot write {target}: the folder {folder} does not exist (create it "
+                    "first)")
+    return f"cannot write {target}: {error.strerror or error}"
 
 
 def same_file(source: Path, target: Path) -> bool:

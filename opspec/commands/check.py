@@ -259,7 +259,8 @@ def _print_unloadable(path: Path, errors: Sequence[Diagnostic], *, as_json: bool
         return
     for diagnostic in errors:
         print(diagnostic)
-    print(f"{path}: not checked: the file could not be read as XPDL")
+    print(f"{path}: not checked: the file could not be read as a spec (XPDL or BPMN); fix "
+          "the errors listed above")
 
 
 def _problem_json(p: Any) -> dict[str, Any]:

@@ -28,7 +28,7 @@ def register(subparsers: Any) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    from opspec.commands._files import translation_problem
+    from opspec.commands._files import input_problem, same_file, translation_problem, write_problem
     from opspec.commands.validate import engine_checks
     from opspec.errors import SpecError
     from opspec.xpdl.compile import compile_spec, default_output
@@ -36,6 +36,15 @@ def run(args: argparse.Namespace) -> int:
 
     source = Path(args.input)
     target = Path(args.output) if args.output else default_output(source)
+    if (source.suffix == ".wfs" and same_file(source, target)
+            and input_problem(source) is None):
+        # IN.wfs is its own default output: there is nothing to compile, not an -o to change
+        given = f"-o {args.output} is IN itself, and " if args.output else ""
+        print(f"opspec compile: {given}{source} is already compiled (a workflow script, "
+              ".wfs); nothing written. Compile the XPDL it was compiled from, or use "
+              f"{source} as it is: opspec show, run and evaluate read it directly",
+              file=sys.stderr)
+        return 2
     problem = translation_problem("compile", source, target,
                                   example=f"{source.with_suffix('.wfs').name} beside it")
     if problem is not None:
@@ -54,8 +63,7 @@ def run(args: argparse.Namespace) -> int:
         print(f"opspec compile: {source} has errors; nothing written", file=sys.stderr)
         return 1
     except OSError as error:
-        print(f"opspec compile: cannot write {target}: {error.strerror or error}",
-              file=sys.stderr)
+        print(f"opspec compile: {write_problem(target, error)}", file=sys.stderr)
         return 2
     for diagnostic in result.diagnostics:
         print(diagnostic, file=sys.stderr)

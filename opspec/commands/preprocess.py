@@ -41,7 +41,7 @@ def default_output(source: Path) -> Path:
 
 
 def run(args: argparse.Namespace) -> int:
-    from opspec.commands._files import translation_problem
+    from opspec.commands._files import translation_problem, write_problem
     from opspec.commands.validate import engine_checks
     from opspec.errors import Severity
     from opspec.model.codec import write_atomically
@@ -95,8 +95,7 @@ def run(args: argparse.Namespace) -> int:
     try:
         write_atomically(target, data)
     except OSError as error:
-        print(f"opspec preprocess: cannot write {target}: {error.strerror or error}",
-              file=sys.stderr)
+        print(f"opspec preprocess: {write_problem(target, error)}", file=sys.stderr)
         return 2
     print(f"{target}: standard XPDL 2.1 from {source}")
     _copy_user_model(source, target)

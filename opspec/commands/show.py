@@ -127,8 +127,26 @@ def _validated(path: str) -> Any:
     from opspec.xpdl.loader import LoadResult
     from opspec.xpdl.validate import validate_spec
 
+    unreadable = _unreadable(path)
+    if unreadable is not None:
+        return LoadResult(None, (unreadable,))
     package, report = validate_spec(path, extra=engine_checks)
     return LoadResult(package, report.diagnostics)
+
+
+def _unreadable(path: str) -> Any:
+    """The ``io-error`` diagnostic for a spec path that is no regular file, or None: said
+    here, as the reader would say it, but without calling the file XPDL (it may be BPMN)."""
+    from opspec.errors import Diagnostic, Severity, SourceLocation
+    from opspec.files import not_a_file
+
+    why = not_a_file(path)
+    if why is None:
+        return None
+    return Diagnostic(SourceLocation(path), Severity.ERROR, "io-error",
+                      f"cannot read the file: {why}",
+                      "give the path of an XPDL or BPMN spec, or of a compiled .wfs script; "
+                      "specs are not read from folders, pipes or devices")
 
 
 def _load_script(path: str) -> Any:

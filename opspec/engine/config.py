@@ -96,7 +96,7 @@ class EngineConfig:
             if key not in allowed:
                 raise ConfigurationError(
                     f"unknown engine option {key!r}",
-                    location=SourceLocation(path, key=key),
+                    location=SourceLocation(_shown(path), key=key),
                     hint=f"allowed options: {', '.join(sorted(allowed))}",
                 )
         merged = {f.name: getattr(base or _DEFAULT, f.name) for f in fields(cls)}
@@ -127,13 +127,41 @@ class EngineConfig:
         return config.with_options(**overrides) if overrides else config
 
     def with_options(self, **overrides: Any) -> EngineConfig:
-        """A copy with keyword ``overrides`` applied (validated like the file)."""
-        return EngineConfig.from_mapping(overrides, base=self)
+        """A copy with keyword ``overrides`` applied (validated like the file). The command
+        line's options arrive here (opspec run's ``--speed``, ``--workers``…), so a bad value
+        is named as the option that sets it: ``--speed must be a number > 0, not 0``."""
+        return EngineConfig.from_mapping(overrides, path=COMMAND_LINE, base=self)
+
+
+#: the ``path`` of values given as keyword options (:meth:`EngineConfig.with_options`): the
+#: command line's, whose errors name the option, not a file and key
+COMMAND_LINE = "<command line>"
+
+#: the command-line option that sets each key (a file sets the others)
+_OPTIONS = {"workers": "--workers", "queue_workers": "--queue-workers",
+            "switch_cost": "--switch-cost", "speed": "--speed"}
+
+
+def _shown(path: str | None) -> str:
+    """Where keyword options are said to come from when no command-line option names them."""
+    return "<options>" if path is None or path == COMMAND_LINE else path
 
 
 def _fail(path: str | None, key: str, message: str, hint: str) -> ConfigurationError:
-    return ConfigurationError(message, location=SourceLocation(path or "<options>", key=key),
-                              hint=hint)
+    return ConfigurationError(message, location=SourceLocation(_shown(path), key=key), hint=hint)
+
+
+def _bad_value(path: str | None, key: str, requirement: str, value: Any, example: str,
+               why: str = "") -> ConfigurationError:
+    """``key must be REQUIREMENT, not VALUE`` at ``path: key`` with the TOML to write, or, for
+    a command-line option, as the option: ``--speed must be a number > 0, not 0``."""
+    option = _OPTIONS.get(key)
+    if path == COMMAND_LINE and option is not None:
+        shown = f"{value:g}" if isinstance(value, float) else repr(value)
+        return ConfigurationError(f"{option} must be {requirement}, not {shown}",
+                                  hint=f"e.g. {option} {example}{why}")
+    return _fail(path, key, f"{key} must be {requirement}, not {value!r}",
+                 f"write e.g. {key} = {example}{why}")
 
 
 def _check(config: EngineConfig, path: str | None) -> None:
@@ -144,24 +172,22 @@ def _check(config: EngineConfig, path: str | None) -> None:
     for key in ("workers", "priorities", "queue_workers"):
         value = getattr(config, key)
         if isinstance(value, bool) or not isinstance(value, int) or value < 1:
-            raise _fail(path, key, f"{key} must be a whole number >= 1, not {value!r}",
-                        f"write e.g. {key} = 2")
+            raise _bad_value(path, key, "a whole number >= 1", value, "2")
     for key in ("timer_resolution", "switch_cost", "message_ttl"):
         value = getattr(config, key)
         if value is None and key == "message_ttl":
             continue
         if (isinstance(value, bool) or not isinstance(value, int | float) or math.isnan(value)
                 or (not math.isfinite(value) and key != "message_ttl") or value < 0):
-            raise _fail(path, key, f"{key} must be a number of seconds >= 0, not {value!r}",
-                        f"write e.g. {key} = 0.001")
+            raise _bad_value(path, key, "a number of seconds >= 0", value, "0.001")
     if not isinstance(config.realtime, bool):
         raise _fail(path, "realtime", f"realtime must be true or false, not {config.realtime!r}",
                     "allowed values: true, false")
     speed = config.speed
     if (isinstance(speed, bool) or not isinstance(speed, int | float)
             or not math.isfinite(speed) or speed <= 0):
-        raise _fail(path, "speed", f"speed must be a number > 0, not {speed!r}",
-                    "write e.g. speed = 60 (one simulated minute per wall second)")
+        raise _bad_value(path, "speed", "a number > 0", speed, "60",
+                         " (one simulated minute per wall second)")
 
 
 _DEFAULT = EngineConfig()

@@ -1,7 +1,8 @@
 """The reader's fatal errors: :class:`XmlReadError` (a :class:`~opspec.errors.SpecError` with
 a stable ``code`` and the file:line where the problem was found), and what the parse failures
-say: a DOCTYPE refused, XML that is not well-formed, or a well-formed file beyond one of
-libxml2's safety limits (with advice for the spec's author, not "fix the syntax").
+say: a DOCTYPE refused, XML that is not well-formed (a file that ends before its XML is
+complete said so, at its last line), or a well-formed file beyond one of libxml2's safety
+limits (with advice for the spec's author, not "fix the syntax").
 """
 
 from __future__ import annotations
@@ -57,8 +58,42 @@ _LIMITS: Final = (
 )
 
 
+# What libxml2 says only when the input stops inside something still open: the error is at
+# the end of the file, where "fix the XML syntax at that line" points at nothing to fix (a
+# line past the last, when the file ends with a newline), and the cure is the missing end.
+_ENDS_EARLY: Final = (
+    (re.compile(r"^Premature end of data in tag (\S+) line (\d+)"),
+     "<{0}>, opened at line {1}, is not closed"),
+    (re.compile(r"^Premature end of data"), "an element is not closed"),
+    (re.compile(r"^EndTag: '</' not found"), "an element is not closed"),
+    (re.compile(r"^Comment not terminated"), "a comment is not closed with -->"),
+    (re.compile(r"^CData section not finished"), "a CDATA section is not closed with ]]>"),
+    (re.compile(r"^ParsePI: PI .* never end"), "a processing instruction is not closed with ?>"),
+)
+
+
 def _one_line(text: str) -> str:
     return " ".join(text.split())
+
+
+def _ends_early(path: str, message: str, error: etree.XMLSyntaxError) -> XmlReadError | None:
+    """The error for a file that stops before its XML is complete, at its last line, or
+    None when ``message`` is not one of those libxml2 gives only at the end of the input."""
+    for pattern, what in _ENDS_EARLY:
+        found = pattern.search(message)
+        if found is None:
+            continue
+        line = error.lineno or None
+        if line is not None and line > 1 and not error.offset:
+            line -= 1       # column 1 of the line after the file's final newline: no such line
+        return XmlReadError(
+            "not-well-formed",
+            f"the file ends before the XML is complete ({what.format(*found.groups())})",
+            location=SourceLocation(path, line),
+            hint="the file may have been cut short: restore its end (from a copy, or from "
+            "the tool that wrote it)",
+        )
+    return None
 
 
 def not_well_formed_error(path: str, error: etree.XMLSyntaxError) -> XmlReadError:
@@ -69,6 +104,9 @@ def not_well_formed_error(path: str, error: etree.XMLSyntaxError) -> XmlReadErro
             return XmlReadError("resource-limit", what,
                                 location=SourceLocation(path, error.lineno or None), hint=hint)
     message = _one_line(message)
+    early = _ends_early(path, message, error)
+    if early is not None:
+        return early
     return XmlReadError(
         "not-well-formed",
         f"not well-formed XML: {message}",

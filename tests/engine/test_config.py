@@ -37,7 +37,35 @@ def test_bad_configuration_names_file_key_and_allowed_values(tmp_path: Path, tex
 
 
 def test_keyword_overrides_are_validated_too() -> None:
-    with pytest.raises(ConfigurationError, match="<options>: workers"):
+    with pytest.raises(ConfigurationError, match="--workers must be a whole number >= 1"):
         EngineConfig().with_options(workers=-1)
     with pytest.raises(ConfigurationError, match="timer_resolution"):
         EngineConfig(timer_resolution=-0.5)
+
+
+def test_a_bad_command_line_option_is_named_as_the_option_not_a_file_key(
+        capsys: pytest.CaptureFixture[str]) -> None:
+    # `opspec run ... --speed 0 --realtime` said "<options>: speed: ... write e.g. speed = 60":
+    # an internal label, and TOML for an option given on the command line.
+    from opspec.cli import main
+
+    spec = Path(__file__).resolve().parents[2] / "specs" / "medication_dispenser.xpdl"
+    status = main(["run", str(spec), "--speed", "0", "--realtime"])
+    err = capsys.readouterr().err
+    assert status == 2
+    assert "--speed must be a number > 0, not 0;" in err
+    assert "e.g. --speed 60" in err
+    assert "<options>" not in err and "speed =" not in err
+    with pytest.raises(ConfigurationError) as caught:
+        EngineConfig().with_options(processor_model="pooled", switch_cost=-1.0)
+    assert str(caught.value) == ("--switch-cost must be a number of seconds >= 0, not -1 "
+                                 "(e.g. --switch-cost 0.001)")
+
+
+def test_a_bad_value_in_the_engine_file_keeps_the_file_and_key(tmp_path: Path) -> None:
+    path = tmp_path / "engine.toml"
+    path.write_text("speed = 0\n")
+    with pytest.raises(ConfigurationError) as caught:
+        EngineConfig.load(path, realtime=True)
+    assert str(caught.value) == (f"{path}: speed: speed must be a number > 0, not 0; write "
+                                 "e.g. speed = 60 (one simulated minute per wall second)")

@@ -556,3 +556,16 @@ def test_cli_unreadable_xml_is_reported_not_checked(tmp_path, capsys):
     assert main(["check", str(spec)]) == 1
     out = capsys.readouterr().out
     assert f"{spec}:1: error: not well-formed XML" in out and "not checked" in out
+
+
+def test_cli_unreadable_bpmn_is_not_called_xpdl(tmp_path, capsys):
+    # It said "not checked: the file could not be read as XPDL" of a BPMN file too.
+    spec = tmp_path / "broken.bpmn"
+    spec.write_text('<bpmn:definitions xmlns:bpmn="http://www.omg.org/spec/BPMN/20100524/MODEL">'
+                    "<bpmn:process", encoding="utf-8")
+    assert main(["check", str(spec)]) == 1
+    out = capsys.readouterr().out
+    assert f"{spec}:1: error: not well-formed XML" in out
+    assert out.endswith(f"{spec}: not checked: the file could not be read as a spec (XPDL or "
+                        "BPMN); fix the errors listed above\n")
+    assert "as XPDL" not in out

@@ -155,6 +155,27 @@ def test_unusable_traces_are_clear_errors(tmp_path: Path, text: str, message: st
         fit_traces([path])
 
 
+@pytest.mark.parametrize(("line", "message"), [
+    ('{"kind": "activity.started", "x": "abc\x01"}\n',
+     ":1: not valid JSON: Invalid control character at column 39 (each line"),
+    ('{"kind": "activity.started", "x": "abc\n',
+     ":1: not valid JSON: Invalid control character at column 39 (each line"),
+    ('{"kind": "activity.started", "x": "abc',
+     ":1: not valid JSON: Unterminated string starting at column 35 (each line"),
+    ('{"time": 1,\n', (":1: not valid JSON: Expecting property name enclosed in double "
+                       "quotes at the end of the line (each line")),
+], ids=["control-character", "newline-in-string", "unterminated", "line-ends-early"])
+def test_a_line_that_is_not_json_is_a_whole_sentence_with_its_column(
+        tmp_path: Path, capsys: pytest.CaptureFixture[str], line: str, message: str) -> None:
+    # json's own message for these ends in "at" ("Invalid control character at"): the column
+    # it leaves to its str() was lost, and the sentence cut off before the hint.
+    path = tmp_path / "bad.jsonl"
+    path.write_text(line, encoding="utf-8")
+    status = main(["fit", str(path), "-o", str(tmp_path / "f.toml")])
+    assert status != 0
+    assert f"{path}{message}" in capsys.readouterr().err
+
+
 def test_cli_reports_a_missing_trace_without_a_traceback(
         tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     status = main(["fit", str(tmp_path / "missing.jsonl"), "-o", str(tmp_path / "m.toml")])

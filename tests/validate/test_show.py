@@ -254,3 +254,19 @@ def test_show_of_a_broken_script_is_one_located_error(
     assert main(["show", str(script)]) == 1
     err = capsys.readouterr().err.strip()
     assert err.startswith(f"{script}:1: error: ") and "\n" not in err
+
+
+@pytest.mark.parametrize("name", ["missing.xpdl", "missing.bpmn", "folder"])
+def test_show_of_a_path_that_is_no_file_does_not_call_it_xpdl(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], name: str
+) -> None:
+    # It said "give the path of an XPDL file", also of a BPMN spec.
+    path = tmp_path / name
+    if name == "folder":
+        path.mkdir()
+    assert main(["show", str(path)]) == 2
+    err = capsys.readouterr().err
+    why = "it is a folder" if name == "folder" else "it does not exist"
+    assert err == (f"{path}: error: cannot read the file: {why} (give the path of an XPDL or "
+                   "BPMN spec, or of a compiled .wfs script; specs are not read from folders, "
+                   "pipes or devices)\n")

@@ -247,6 +247,41 @@ def test_reader_limits_give_their_own_one_line_message_with_a_usable_hint(case: 
     assert diagnostic.hint
 
 
+DISPENSER = Path(__file__).resolve().parents[2] / "specs" / "medication_dispenser.xpdl"
+
+
+@pytest.mark.parametrize("newline", [True, False], ids=["ends-with-newline", "cut-mid-line"])
+def test_a_file_cut_short_is_said_to_end_early_at_its_last_line(newline: bool) -> None:
+    # `head -205 dispenser.xpdl` was "trunc.xpdl:206: ... Premature end of data ...; fix the
+    # XML syntax at that line": a line the file does not have, and nothing there to fix.
+    lines = DISPENSER.read_bytes().splitlines(keepends=True)[:205]
+    data = b"".join(lines) if newline else b"".join(lines).rstrip(b"\n")
+    diagnostic = parse_bytes(data, path="trunc.xpdl").diagnostics[0]
+    assert diagnostic.code == "not-well-formed"
+    assert str(diagnostic) == (
+        "trunc.xpdl:205: error: the file ends before the XML is complete (<Activity>, opened "
+        "at line 202, is not closed); the file may have been cut short: restore its end (from "
+        "a copy, or from the tool that wrote it)")
+
+
+@pytest.mark.parametrize(("data", "line", "what"), [
+    (b"<Package>\n<!-- a note\n", 2, "a comment is not closed with -->"),
+    (b"<Package>\n<![CDATA[ x\n", 2, "a CDATA section is not closed with ]]>"),
+    (b"<Package><A>text", 1, "<A>, opened at line 1, is not closed"),
+])
+def test_what_a_file_cut_short_leaves_open_is_named(data: bytes, line: int, what: str) -> None:
+    diagnostic = parse_bytes(data, path="cut.xpdl").diagnostics[0]
+    assert diagnostic.location.line == line
+    assert diagnostic.message == f"the file ends before the XML is complete ({what})"
+
+
+def test_a_syntax_error_inside_the_file_still_says_fix_the_syntax() -> None:
+    diagnostic = parse_bytes(b"<Package>\n<a b=1/>\n</Package>\n", path="x.xpdl").diagnostics[0]
+    assert diagnostic.location.line == 2
+    assert diagnostic.message.startswith("not well-formed XML: ")
+    assert diagnostic.hint.startswith("fix the XML syntax at that line")
+
+
 def test_not_well_formed_messages_are_one_line() -> None:
     result = parse_bytes(b'<Package xmlns="http://www.wfmc.org/2008/XPDL2.1" Id="p">\n<a',
                          path="cut.xpdl")
