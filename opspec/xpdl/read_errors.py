@@ -96,7 +96,10 @@ def _ends_early(path: str, message: str, error: etree.XMLSyntaxError) -> XmlRead
     return None
 
 
-def not_well_formed_error(path: str, error: etree.XMLSyntaxError) -> XmlReadError:
+def not_well_formed_error(path: str, error: etree.XMLSyntaxError,
+                          end: tuple[int, int] | None = None) -> XmlReadError:
+    """The error for XML libxml2 cannot read; ``end``: the file's last line and its width
+    (an error placed past them is the file ending inside a tag)."""
     message = error.msg or str(error)
     message = re.sub(r"\s*\(<string>, line \d+\)$", "", message)
     for pattern, what, hint in _LIMITS:
@@ -107,6 +110,17 @@ def not_well_formed_error(path: str, error: etree.XMLSyntaxError) -> XmlReadErro
     early = _ends_early(path, message, error)
     if early is not None:
         return early
+    line, column = error.lineno or 0, error.offset or 0
+    if end is not None and (line > end[0] or line == end[0] and column >= end[1]):
+        # libxml2 reads on past the end for the '>' or quote it still needs; its own
+        # position (a line after the last) is left out of the message
+        what = re.sub(r",?(\s*line \d+,)+\s*column \d+$", "", message)
+        return XmlReadError(
+            "not-well-formed",
+            f"the file ends inside a tag, before the XML is complete ({what})",
+            location=SourceLocation(path, end[0]),
+            hint="the file may have been cut short: restore its end (from a copy, or from "
+            "the tool that wrote it)")
     return XmlReadError(
         "not-well-formed",
         f"not well-formed XML: {message}",

@@ -95,13 +95,15 @@ def _parse(data: bytes, path: str) -> tuple[etree._Element, list[Diagnostic], st
         if _has_doctype(data):
             raise doctype_error(path, _doctype_line(data) or error.lineno) from None
         retry = not utf16 and is_encoding_error(error) and declared in (None, "utf-8", *ASCII_NAMES)
+        body = data.rstrip(b"\r\n")
+        end = (body.count(b"\n") + 1, len(body) - body.rfind(b"\n") - 1)
         if not retry:
-            raise not_well_formed_error(path, error) from None
+            raise not_well_formed_error(path, error, end) from None
         original = error
     try:
         root = etree.fromstring(data, _parser("iso-8859-1"))
     except etree.XMLSyntaxError:
-        raise not_well_formed_error(path, original) from None
+        raise not_well_formed_error(path, original, end) from None
     warnings.append(encoding_warning(data, path, declared, original.lineno or None))
     return root, warnings, "iso-8859-1"
 

@@ -287,3 +287,20 @@ def test_not_well_formed_messages_are_one_line() -> None:
                          path="cut.xpdl")
     assert result.diagnostics[0].code == "not-well-formed"
     assert "\n" not in str(result.diagnostics[0])
+
+
+@pytest.mark.parametrize(("data", "line"), [
+    (b"<Package>\n  <Activity Id=\"a\"><Impleme\n", 2),          # cut inside a tag
+    (b"<Package>\n  <Activity Id=\"a\"><Applicatio", 2),        # ... without a newline
+    ((DATA / "truncated.xpdl").read_bytes(), 6),
+])
+def test_a_file_cut_inside_a_tag_ends_at_its_last_line_not_past_it(data: bytes,
+                                                                    line: int) -> None:
+    # libxml2 looks past the end for the '>' it still needs, and placed the error there
+    # (truncated.xpdl:7 of a 6-line file)
+    diagnostic = parse_bytes(data, path="cut.xpdl").diagnostics[0]
+    assert diagnostic.code == "not-well-formed" and diagnostic.location.line == line
+    assert diagnostic.message.startswith("the file ends inside a tag, before the XML is "
+                                         "complete (")
+    assert "line" not in diagnostic.message             # no position past the file's end
+    assert diagnostic.hint.startswith("the file may have been cut short")
