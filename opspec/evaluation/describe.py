@@ -6,7 +6,8 @@
 - :func:`describe_metric` says it in words (the spec's own ``Description`` first, then how it
   is computed from the trace);
 - :func:`user_model_rows` and :func:`user_model_notes` list a user model's parameters and
-  assumptions (durations, omissions, errors, routines, modifiers, with their sources).
+  assumptions (durations, omissions, errors, routines, modifiers, with their sources);
+  :func:`can_do_wrongly` says whether it has a wrong action for an activity at all.
 """
 
 from __future__ import annotations
@@ -22,8 +23,9 @@ if TYPE_CHECKING:
     from opspec.usermodels.model import ActivityModel, UserModel
     from opspec.usermodels.population import Population
 
-__all__ = ["correlation_rows", "describe_metric", "describe_selector", "metric_record",
-           "population_notes", "user_model_notes", "user_model_rows", "variation_rows"]
+__all__ = ["can_do_wrongly", "correlation_rows", "describe_metric", "describe_selector",
+           "metric_record", "population_notes", "user_model_notes", "user_model_rows",
+           "variation_rows"]
 
 
 def _selector(selector: EventSelector | None) -> dict[str, Any] | None:
@@ -198,6 +200,18 @@ def _sources(model: ActivityModel) -> str:
         found.append(getattr(part, "source", None))
     unique = list(dict.fromkeys(str(s).rstrip(".") for s in found if s))
     return "; ".join(unique) or "–"
+
+
+def can_do_wrongly(model: UserModel, activity: str) -> bool | None:
+    """Whether a user of ``model`` can do ``activity`` wrongly: a wrong choice or a slip,
+    the only wrong actions a user is counted for, both its ``commission`` (in the typical
+    model or any subgroup's: a person's drawn values and modifiers change probabilities,
+    never add one). None when some model does not cover the activity (not known here)."""
+    models = [model, *(g.model for g in (model.population.subgroups
+                                         if model.population is not None else ()))]
+    if not all(m.covers(activity) for m in models):
+        return None
+    return any(m.activity(activity).commission is not None for m in models)
 
 
 def user_model_notes(model: UserModel) -> list[str]:

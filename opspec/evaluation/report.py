@@ -42,7 +42,7 @@ from opspec.evaluation.report_design import (
     design_sections,
 )
 from opspec.evaluation.report_findings import key_findings, metric_label, population_findings
-from opspec.evaluation.report_users import user_model_section
+from opspec.evaluation.report_users import user_model_as_run, user_model_section
 from opspec.evaluation.store import ResultStore
 from opspec.evaluation.summary import (
     compare_designs,
@@ -51,7 +51,13 @@ from opspec.evaluation.summary import (
     summarise_monitors,
     summarise_population,
 )
-from opspec.evaluation.tables import comparison_rows, is_rate, subgroup_comparison_rows
+from opspec.evaluation.tables import (
+    NO_DURATION_INTERVAL,
+    comparison_rows,
+    is_rate,
+    no_interval_reason,
+    subgroup_comparison_rows,
+)
 
 if TYPE_CHECKING:
     from opspec.evaluation.figure_queue import FiguresAhead
@@ -114,6 +120,21 @@ def _methods_section(summaries: Any, sections: Sequence[Any]) -> Any:
          "interpolation; per-user percentiles are of the users' own values."),),
         tables=(Table(("method", "definition", "references"), rows,
                       "The interval methods used in this report"),) if rows else ())
+
+
+def _no_interval_words(difference: Mapping[str, Any]) -> str:
+    """Why a difference of durations has no interval ('–'), when one has none: '–' is the
+    paired method's answer (:func:`opspec.statistics.paired_difference`), not a number left
+    out, and a count beside it with a zero difference still has an interval."""
+    bare = [n for n, d in difference.items() if no_interval_reason(d) == NO_DURATION_INTERVAL]
+    if not bare:
+        return ""
+    return (f" {', '.join(bare)} {'has' if len(bare) == 1 else 'have'} no interval ('–'): "
+            "fewer than 2 users' durations differ between the designs (on the same users and "
+            "random streams the others are identical), and a paired interval of durations "
+            "rests on the users who differ, so the data cannot say how much the designs "
+            "differ; a count with no difference still has an interval, the exact Poisson "
+            "bounds of the events that could have differed.")
 
 
 @dataclass(frozen=True)
@@ -307,12 +328,14 @@ def _report_sections(store: ResultStore, summaries: Mapping[str, Summaries] | No
             "Metrics the spec declares (opspec:Metrics), computed from each user's trace"),)))
     sections.append(user_model_section(store, plan, figures, population))
 
+    model = user_model_as_run(store, plan)      # which activities it can do wrongly
     for design in detailed:
         metrics, monitors, definitions = per_design[design]
         prefix = f"{names[design]}: " if len(detailed) > 1 or sweep else ""
         sections += design_sections(store, figures, design, names[design], days,
                                     done.get(design, 0), metrics, monitors, definitions,
-                                    prefix, population, designs[0], ahead.get(design))
+                                    prefix, population, designs[0], ahead.get(design),
+                                    user_model=model)
 
     if difference is not None:
         # each panel names its metric as the other figures do (report latency, not its id)
@@ -327,7 +350,8 @@ def _report_sections(store: ResultStore, summaries: Mapping[str, Summaries] | No
                                     "CI method", "")
         sections.append(Section(f"{names['B']} compared with {names['A']}", paragraphs=(
             (f"Differences {names['B']} − {names['A']} per metric on the same simulated users "
-            "(paired); 'differs' marks intervals that exclude zero."),),
+            "(paired); 'differs' marks intervals that exclude zero."
+            + _no_interval_words(difference)),),
             tables=(Table(headers, tuple(comparison_rows(difference))),),
             images=compared,
             captions=("Paired differences with 95 % CIs, each on its own scale",)

@@ -11,6 +11,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
+from opspec.evaluation.describe import can_do_wrongly
 from opspec.evaluation.plan import span
 from opspec.evaluation.report_findings import metric_label, words
 from opspec.evaluation.store import ResultStore
@@ -102,6 +103,26 @@ def _activity_rates(store: ResultStore, design: str) -> list[dict[str, Any]]:
     return summarise_activities(store, design)
 
 
+def _per_user_intervals(metrics: Mapping[str, Mapping[str, Any]]) -> str:
+    """Why a metric has one interval under Estimates and another under How users differ:
+    they are of two quantities, by two methods (the same words as docs/evaluation.md)."""
+    text = ("'95 % CI of that mean (t)' is a confidence interval of the mean of the users' "
+            "own values, every user counting once, by Student's t over those values; it is "
+            "not the interval under Estimates, which is of the pooled estimate (Σ numerator "
+            "/ Σ denominator over all users, a user with more observations weighing more) "
+            "and, for a proportion, Wilson's interval on the effective number of trials, so "
+            "one metric has two different intervals.")
+    flat = [name for name, s in metrics.items() if s["kind"] != "count"
+            and s.get("ci95_method") == "wilson-neff"
+            and (low := ((s.get("per_user") or {}).get("ci95") or [None])[0]) is not None
+            and low == (s["per_user"]["ci95"] or [None, None])[1]]
+    if flat:
+        text += (f" Every user had the same {' and the same '.join(flat)}, so the t interval "
+                 "of their mean has no width: that is no bound on the rate, whose interval "
+                 "is the one under Estimates.")
+    return text
+
+
 def _by_subgroup_section(metrics: Mapping[str, Any], population: Mapping[str, Any],
                          design: str, first: str, prefix: str) -> Any:
     from opspec.evaluation.html import Section, Table
@@ -184,13 +205,16 @@ def design_sections(store: ResultStore, figures: Path, design: str, name: str, d
                     users: int, metrics: Mapping[str, dict[str, Any]],
                     monitors: Mapping[str, Any], definitions: Sequence[Mapping[str, Any]],
                     prefix: str, population: Mapping[str, Any] | None = None,
-                    first: str = "A", ahead: AskedAhead | None = None) -> list[Any]:
+                    first: str = "A", ahead: AskedAhead | None = None, *,
+                    user_model: Any = None) -> list[Any]:
     """The sections on ``design`` (``name`` in their words; ``prefix`` before each title when
     the report describes several designs), in the report's order, their figures drawn into
     ``figures``. ``first`` is the design whose subgroup summaries are ``metrics`` in
     ``population`` (the others': ``metrics_<label>``). ``ahead``: what :func:`ask_ahead`
     computed and asked for of ``design`` with the same store, definitions and users (its
-    figures are not asked for again)."""
+    figures are not asked for again). ``user_model``: the run's, when known
+    (:func:`.report_users.user_model_as_run`), to leave out the error rate of an activity it
+    cannot do wrongly."""
     from opspec.evaluation import plots
     from opspec.evaluation.html import Section, Table
 
@@ -262,9 +286,10 @@ def design_sections(store: ResultStore, figures: Path, design: str, name: str, d
             "(Clopper-Pearson) interval; p50, p90 and p99 are percentiles of the users' own "
             "values; the between-user sd of a proportion is the sd of the users' true rates "
             "once each user's binomial noise is taken out (about 0 when users differ only by "
-            "chance)."),),
+            "chance)."), _per_user_intervals(metrics)),
             tables=(Table(PER_USER_HEADERS, tuple(spread),
-                          "Each user's own mean duration or ratio, over users"),
+                          "Each user's own mean duration or ratio, over users: the mean of "
+                          "their values (every user counting once) with its t interval"),
                     Table(DISTRIBUTION_HEADERS, tuple(spread_rows),
                           "Per-user distributions" + (", overall and by subgroup"
                                                       if groups else ""))),
@@ -323,22 +348,36 @@ def design_sections(store: ResultStore, figures: Path, design: str, name: str, d
             return (f"{fmt(value, percent=True)} [{fmt(ci[0], percent=True)}, "
                     f"{fmt(ci[1], percent=True)}]")
 
-        sections.append(Section(f"{prefix}The user's actions", paragraphs=(
-            ("For each activity of the user's lane: how often it was asked of the user "
-            "(offered), the share not done (omitted: an alarm not heard, a step forgotten) "
-            "and the share done wrongly (a wrong button chosen), with 95 % intervals over "
-            "users."),),
+        # no rate where the model has no wrong action: 0 % by construction, and its interval
+        # (0 to 2 % at 187 offers) would read as a measured error rate; one counted anyway
+        # (a model file changed since) is shown
+        never = {r["activity"] for r in activity if r["error"] == 0 and user_model is not None
+                 and can_do_wrongly(user_model, r["activity"]) is False}
+        paragraph = ("For each activity of the user's lane: how often it was asked of the user "
+                     "(offered), the share not done (omitted: an alarm not heard, a step "
+                     "forgotten) and the share done wrongly (a wrong button chosen), with 95 % "
+                     "intervals over users. Both are per offer, re-offers included: a choice "
+                     "offered again after a wrong button counts each time, so a rate per "
+                     "offer is not the user model's probability per dose (workflow "
+                     "instance).")
+        caption = ("The user's activities: omission and error rates per offer, in % of the "
+                   "times each was asked for, with 95 % intervals (the same numbers as the "
+                   "table")
+        if never:
+            paragraph += (" '–': the user model has no wrong action (a wrong choice or a "
+                          "slip) for the activity, so it cannot be done wrongly and there is "
+                          "no error rate to estimate.")
+            caption += "; an error rate that is '–' in the table is drawn as the 0 % counted"
+        sections.append(Section(f"{prefix}The user's actions", paragraphs=(paragraph,),
             tables=(Table(("activity", "offered", "omitted per offer [95 % CI]",
                            "wrong per offer [95 % CI]", "CI method"),
                           tuple((r["activity"], f"{r['offered']:,}",
                                  rate(r["omission"], r["omission_ci95"]),
-                                 rate(r["error"], r["error_ci95"]), method_name(r))
+                                 "–" if r["activity"] in never
+                                 else rate(r["error"], r["error_ci95"]), method_name(r))
                                 for r in activity),
                           "Per-activity rates of the user's lane"),),
-            images=(image,), captions=(
-                ("The user's activities: omission and error rates per offer, in % of the "
-                 "times each was asked for, with 95 % intervals (the same numbers as the "
-                 "table)"),)))
+            images=(image,), captions=(caption + ")",)))
 
     # hazards
     if monitors:

@@ -25,7 +25,26 @@ from opspec.evaluation.tables import (
     subgroup_rows,
 )
 
-__all__ = ["user_model_section"]
+__all__ = ["user_model_as_run", "user_model_section"]
+
+
+def user_model_as_run(store: ResultStore, plan: Mapping[str, Any]) -> Any:
+    """The run's user model (``plan``'s) as its file is now, when that is the file the run
+    used; None without one, when it cannot be loaded, or when it has changed since (what the
+    report then says of the model must not rest on it)."""
+    ref = plan.get("user_model")
+    if not ref:
+        return None
+    try:
+        from opspec.evaluation.plan import file_digest
+        from opspec.usermodels.loader import load_user_model
+
+        stored = store.get("user_model_sha256")
+        if stored and Path(str(ref)).is_file() and file_digest(str(ref)) != stored:
+            return None
+        return load_user_model(str(ref))
+    except Exception:  # noqa: BLE001 - the report says less, as user_model_section does
+        return None
 
 
 def _drawn_values(store: ResultStore, design: str, names: Sequence[str]

@@ -10,13 +10,16 @@ from opspec.properties.language import clock
 from opspec.statistics.methods import METHODS, methods_in
 
 __all__ = ["comparison_rows", "distribution_rows", "fmt", "is_rate", "method_legend",
-           "method_name", "metric_rows",
-           "monitor_rows", "parameter_rows", "per_user_rows", "print_summary",
+           "method_name", "metric_rows", "monitor_rows", "no_interval_reason",
+           "parameter_rows", "per_user_rows", "print_summary",
            "subgroup_comparison_rows", "subgroup_metric_rows", "subgroup_rows", "table"]
 
 METRIC_HEADERS = ("metric", "kind", "estimate", "95 % CI", "CI method", "sd", "median", "p95",
                   "users", "pooled")
-PER_USER_HEADERS = ("metric", "users", "mean", "sd", "95 % CI", "median", "p95")
+#: The mean of the users' own values, every user counting once, and its Student t interval
+#: over users: not the pooled estimate of METRIC_HEADERS nor its interval, hence the words
+PER_USER_HEADERS = ("metric", "users", "mean of users' values", "sd",
+                    "95 % CI of that mean (t)", "median", "p95")
 COMPARE_HEADERS = ("metric", "A", "B", "B − A", "95 % CI", "CI method", "")
 MONITOR_HEADERS = ("monitor", "violations", "users affected", "per user-day", "95 % CI",
                    "CI method", "first violation")
@@ -252,6 +255,23 @@ def _points(value: Any) -> str:
     return "–" if value is None else f"{value * 100:+.2f} pp"
 
 
+#: The CI method cell of a difference of durations without an interval: on common random
+#: numbers fewer than 2 users' values differed between the designs, and the paired interval
+#: cannot be estimated from them (opspec.statistics.paired_difference; docs/evaluation.md)
+NO_DURATION_INTERVAL = "none: fewer than 2 users differ"
+
+
+def no_interval_reason(d: Mapping[str, Any]) -> str | None:
+    """Why a paired difference ``d`` has no interval, in a table cell's words; None when it
+    has one (or no difference either)."""
+    low, high = d.get("ci95") or [None, None]
+    if d.get("difference") is None or (low is not None and high is not None):
+        return None
+    if (d.get("users") or 0) < 2:
+        return "none: fewer than 2 users"
+    return NO_DURATION_INTERVAL if d.get("kind") == "duration" else None
+
+
 def comparison_rows(difference: Mapping[str, Mapping[str, Any]]) -> list[tuple[str, ...]]:
     rows: list[tuple[str, ...]] = []
     for name, d in difference.items():
@@ -262,7 +282,8 @@ def comparison_rows(difference: Mapping[str, Mapping[str, Any]]) -> list[tuple[s
         ci = (f"[{_points(low)}, {_points(high)}]" if percent and low is not None
               and high is not None else _ci(d, unit))
         rows.append((name, fmt(d["a"], unit, percent=percent),
-                     fmt(d["b"], unit, percent=percent), diff, ci, method_name(d),
+                     fmt(d["b"], unit, percent=percent), diff, ci,
+                     no_interval_reason(d) or method_name(d),
                      "differs" if d["significant"] else ""))
     return rows
 

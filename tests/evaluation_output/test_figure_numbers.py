@@ -105,7 +105,7 @@ def test_each_users_own_values_are_the_per_user_tables(report: lxml_html.HtmlEle
     rows = {words(m.split(" (")[0]).removesuffix(" s"): row for m, row in per_user.items()}
     assert means and set(means) == set(rows), (means, rows)
     for label, mean in means.items():
-        assert mean == rows[label]["mean"], label
+        assert mean == rows[label]["mean of users' values"], label
     # a panel of discrete values labels each bar with its number of users (drawn after the
     # axis' "users" label, before the panel's title): together, every user of the table
     counted: dict[str, int] = {}
@@ -145,6 +145,11 @@ def test_the_users_actions_are_the_per_activity_tables(report: lxml_html.HtmlEle
     labels = [t for t in texts[last_name + 1:] if re.fullmatch(r"\d+\.\d+ %", t)]
     expected = [row[column].split(" [")[0] for row in activities.values()
                 for column in ("omitted per offer [95 % CI]", "wrong per offer [95 % CI]")]
-    assert labels == expected
+    # an activity the user model cannot do wrongly has no error rate in the table ('–'); the
+    # figure draws the 0 % counted, and its caption says so
+    assert "–" in expected
+    assert labels == [("0.00 %" if cell == "–" else cell) for cell in expected]
+    assert any("an error rate that is '–' in the table is drawn as the 0 % counted"
+               in cell(title) for title in report.iter("figcaption"))
     # the bars are labelled with the table's activities, in its order
     assert [t for t in texts if t in activities] == list(activities)
