@@ -116,7 +116,9 @@ def _write_whole(path: Path, text: str) -> None:
         os.replace(tmp, path)
     except OSError as error:
         tmp.unlink(missing_ok=True)
-        raise ConfigurationError(f"cannot write {path}: {error.strerror or error}") from None
+        from opspec.commands._files import write_problem
+
+        raise ConfigurationError(write_problem(path, error)) from None
 
 
 def _validated(path: str) -> Any:

@@ -90,8 +90,8 @@ def read_file(path: str | Path, *, max_bytes: int = DEFAULT_MAX_BYTES) -> bytes:
             "io-error",
             f"cannot read the file: {why}",
             location=SourceLocation(shown),
-            hint="give the path of an XPDL file; specs are not read from folders, pipes or "
-            "devices",
+            hint="give the path of a spec file (XPDL or BPMN); specs are not read from "
+            "folders, pipes or devices",
         ) from None
     except OSError as error:
         reason = error.strerror or type(error).__name__

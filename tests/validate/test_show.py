@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import os
 import re
 from pathlib import Path
 
@@ -270,3 +271,16 @@ def test_show_of_a_path_that_is_no_file_does_not_call_it_xpdl(
     assert err == (f"{path}: error: cannot read the file: {why} (give the path of an XPDL or "
                    "BPMN spec, or of a compiled .wfs script; specs are not read from folders, "
                    "pipes or devices)\n")
+
+
+@pytest.mark.skipif(not hasattr(os, "mkfifo"), reason="named pipes")
+def test_validate_of_a_pipe_does_not_call_a_spec_xpdl_only(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    # validate reads through read_bytes.read_file, whose hint said "an XPDL file"
+    pipe = tmp_path / "spec.bpmn"
+    os.mkfifo(pipe)
+    assert main(["validate", str(pipe)]) != 0
+    err = capsys.readouterr()
+    text = err.out + err.err
+    assert "give the path of a spec file (XPDL or BPMN)" in text
