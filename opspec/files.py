@@ -234,6 +234,19 @@ def toml_load(stream: BinaryIO) -> dict[str, Any]:
     return toml_loads(text)
 
 
+def json_problem(error: Any, *, one_line: bool = False) -> str:
+    """A ``json.JSONDecodeError``'s message as a whole sentence with its column (json ends
+    some with "at" and leaves the place to its own str(): "Invalid control character at:
+    line 1 column 30"); the line is the caller's to name. ``one_line``: the document is one
+    line of a file (a JSON Lines trace), so a place past its newline is the line ending too
+    soon."""
+    if "(" in error.msg:        # opspec's own (nested too deeply, a number too large): no place
+        return str(error.msg)
+    place = ("the end of the line" if one_line and error.lineno > 1
+             else f"column {error.colno}")
+    return f"{error.msg} {place}" if error.msg.endswith(" at") else f"{error.msg} at {place}"
+
+
 def json_loads(text: str | bytes, *, most: int = MAX_NESTING) -> Any:
     """``json.loads(text)``, with nesting beyond ``most`` levels or an integer of more
     than :data:`MAX_DIGITS` digits a ``json.JSONDecodeError`` like any other syntax error,

@@ -171,7 +171,7 @@ def _read_file(file: str, fields: Mapping[str, DataField], package: Package,
                ) -> tuple[Mapping[str, Any], ...]:
     """Fills ``values`` and ``draws`` from a TOML/JSON mapping; returns a CSV's (or JSON
     list's) rows."""
-    from opspec.files import json_loads, read_bytes, reason
+    from opspec.files import json_loads, json_problem, read_bytes, reason
 
     suffix = Path(file).suffix.lower()
     if suffix not in _SUFFIXES:
@@ -200,8 +200,8 @@ def _read_file(file: str, fields: Mapping[str, DataField], package: Package,
         try:
             doc = json_loads(text)
         except json.JSONDecodeError as error:
-            raise ConfigurationError(f"{file}:{error.lineno}: not valid JSON: {error.msg}"
-                                     ) from None
+            raise ConfigurationError(f"{file}:{error.lineno}: not valid JSON: "
+                                     f"{json_problem(error)}") from None
     if isinstance(doc, list):
         return tuple(_row(file, f"row {i + 1}", item, fields, package)
                      for i, item in enumerate(doc))

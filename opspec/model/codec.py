@@ -414,7 +414,7 @@ WFS_MAX_NESTING = 200
 
 def loads(text: str | bytes, *, where: str = "<.wfs text>") -> Package:
     """:func:`load` of JSON text; corrupt JSON is a :class:`SpecError` with its line."""
-    from opspec.files import json_loads
+    from opspec.files import json_loads, json_problem
 
     try:
         # a compiled package nests a few dozen levels; far deeper is not one of ours, and
@@ -422,7 +422,7 @@ def loads(text: str | bytes, *, where: str = "<.wfs text>") -> Package:
         obj = json_loads(text, most=WFS_MAX_NESTING)
     except json.JSONDecodeError as error:
         raise SpecError(
-            f"corrupt workflow script (invalid JSON: {error.msg})",
+            f"corrupt workflow script (invalid JSON: {json_problem(error)})",
             location=SourceLocation(where, error.lineno),
             hint="recompile the XPDL with `opspec compile`",
         ) from None

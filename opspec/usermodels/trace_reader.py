@@ -16,7 +16,7 @@ from pathlib import Path
 
 from opspec.engine.trace import TRACE_FORMAT, TRACE_FORMAT_VERSION, TraceEvent
 from opspec.errors import SourceLocation, UserModelError
-from opspec.files import json_loads
+from opspec.files import json_loads, json_problem
 
 __all__ = ["iter_paths", "read_trace"]
 
@@ -41,7 +41,7 @@ def read_trace(path: str | Path) -> Iterator[TraceEvent]:
             try:
                 obj = json_loads(line)
             except json.JSONDecodeError as error:
-                raise UserModelError(f"not valid JSON: {_json_problem(error)}",
+                raise UserModelError(f"not valid JSON: {json_problem(error, one_line=True)}",
                                      location=SourceLocation(name, number),
                                      hint="each line of a trace is one JSON object") from None
             if not header_seen:
@@ -75,16 +75,6 @@ def read_trace(path: str | Path) -> Iterator[TraceEvent]:
                              location=SourceLocation(name)) from None
     finally:
         handle.close()
-
-
-def _json_problem(error: json.JSONDecodeError) -> str:
-    """json's message as a whole sentence with the column: json ends some with "at" and leaves
-    the place to its own str() ("Invalid control character at: line 1 column 30")."""
-    if "(" in error.msg:        # opspec's own (nested too deeply, a number too large): no place
-        return error.msg
-    # past the line's newline (json counts it as a line 2): the line ended too soon
-    place = "the end of the line" if error.lineno > 1 else f"column {error.colno}"
-    return f"{error.msg} {place}" if error.msg.endswith(" at") else f"{error.msg} at {place}"
 
 
 def iter_paths(values: Iterable[str]) -> list[Path]:

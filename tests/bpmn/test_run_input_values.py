@@ -142,6 +142,8 @@ def test_a_normal_run_input_is_not_cut_at_zero() -> None:
     ('score = { kind = "unifrom", low = 0 }\n', "inputs.toml", (), "unknown distribution"),
     ("score = [1, 2]\n", "inputs.toml", (), "a value or a distribution table is expected"),
     ("score: 1\n", "inputs.yaml", (), "opspec reads .toml, .json or .csv files"),
+    ('{"score": "a\tb"}', "inputs.json", (),
+     "inputs.json:1: not valid JSON: Invalid control character at column 13"),
     ("", "none.csv", ("--param", "score~bogus(1)"), "unknown distribution 'bogus'"),
 ])
 def test_bad_values_are_refused_naming_the_file_and_line(

@@ -328,7 +328,11 @@ def test_a_missing_migration_is_a_clear_error(monkeypatch: pytest.MonkeyPatch) -
     ("text", "message"),
     [
         pytest.param('{"format": "opspec-wfs", "vers', r"bad\.wfs:1: corrupt workflow script "
-                     r"\(invalid JSON", id="truncated-json"),
+                     r"\(invalid JSON: Unterminated string starting at column 26\)",
+                     id="truncated-json"),
+        pytest.param('{"format": "opspec-wfs",\n "x": [1,,2]}', r"bad\.wfs:2: corrupt workflow "
+                     r"script \(invalid JSON: Expecting value at column 10\)",
+                     id="json-syntax-on-line-2"),
         pytest.param('{"some": "json"}', "not an opspec workflow script", id="other-json"),
         pytest.param("[1, 2]", "not an opspec workflow script", id="json-list"),
         pytest.param('<?xml version="1.0"?><Package/>', "this is XML", id="xpdl-given"),
