@@ -1,7 +1,7 @@
-"""Compile an XPDL spec into a workflow script (.wfs) the engine loads.
+"""Compile a spec (XPDL or BPMN) into a workflow script (.wfs) the engine loads.
 
-Load IN (XPDL or SISARL-XPDL), refuse it if it has errors, and write its compiled workflow
-script (versioned JSON, docs/wfs-format.md).
+Load IN (XPDL, SISARL-XPDL or BPMN 2.0), refuse it if it has errors, and write its compiled
+workflow script (versioned JSON, docs/wfs-format.md).
 
 Exit status: 0 written (warnings are printed); 1 the spec has errors, exactly those opspec
 validate reports (each printed as 'path:line: severity: message'; nothing is written); 2 the
@@ -23,7 +23,7 @@ __all__ = ["register"]
 
 def register(subparsers: Any) -> None:
     parser = command(subparsers, "compile", __doc__)
-    add_translation(parser, "XPDL", "OUT.wfs", "IN with the suffix .wfs")
+    add_translation(parser, "XPDL or BPMN", "OUT.wfs", "IN with the suffix .wfs")
     parser.set_defaults(handler=run)
 
 
