@@ -96,6 +96,12 @@ def _ends_early(path: str, message: str, error: etree.XMLSyntaxError) -> XmlRead
     return None
 
 
+#: libxml2's messages for a tag it could not finish: at the end of the file, the file ends
+#: inside it (a mismatched end tag at the end is a real syntax error, not a cut)
+_NEEDS_MORE = re.compile(r"expected '>'|Couldn't find end of Start Tag|AttValue|"
+                         r"attributes construct error|mandates value for attribute")
+
+
 def not_well_formed_error(path: str, error: etree.XMLSyntaxError,
                           end: tuple[int, int] | None = None) -> XmlReadError:
     """The error for XML libxml2 cannot read; ``end``: the file's last line and its width
@@ -111,7 +117,8 @@ def not_well_formed_error(path: str, error: etree.XMLSyntaxError,
     if early is not None:
         return early
     line, column = error.lineno or 0, error.offset or 0
-    if end is not None and (line > end[0] or line == end[0] and column >= end[1]):
+    if (end is not None and _NEEDS_MORE.search(message)
+            and (line > end[0] or line == end[0] and column >= end[1])):
         # libxml2 reads on past the end for the '>' or quote it still needs; its own
         # position (a line after the last) is left out of the message
         what = re.sub(r",?(\s*line \d+,)+\s*column \d+$", "", message)

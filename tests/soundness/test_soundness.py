@@ -565,7 +565,7 @@ def test_cli_unreadable_bpmn_is_not_called_xpdl(tmp_path, capsys):
                     "<bpmn:process", encoding="utf-8")
     assert main(["check", str(spec)]) == 1
     out = capsys.readouterr().out
-    assert f"{spec}:1: error: not well-formed XML" in out
+    assert f"{spec}:1: error: the file ends inside a tag" in out      # cut after <bpmn:process
     assert out.endswith(f"{spec}: not checked: the file could not be read as a spec (XPDL or "
                         "BPMN); fix the errors listed above\n")
     assert "as XPDL" not in out

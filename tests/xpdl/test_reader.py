@@ -275,6 +275,13 @@ def test_what_a_file_cut_short_leaves_open_is_named(data: bytes, line: int, what
     assert diagnostic.message == f"the file ends before the XML is complete ({what})"
 
 
+@pytest.mark.parametrize("data", [b"<Package><oops></Package>",
+                                  b"<Package>\n<oops>\n</Package>"])
+def test_a_mismatched_end_tag_at_the_end_is_a_syntax_error_not_a_cut(data: bytes) -> None:
+    diagnostic = parse_bytes(data, path="x.xpdl").diagnostics[0]
+    assert diagnostic.message.startswith("not well-formed XML: Opening and ending tag mismatch")
+
+
 def test_a_syntax_error_inside_the_file_still_says_fix_the_syntax() -> None:
     diagnostic = parse_bytes(b"<Package>\n<a b=1/>\n</Package>\n", path="x.xpdl").diagnostics[0]
     assert diagnostic.location.line == 2
