@@ -235,16 +235,21 @@ def time_of_day_figure(series: Mapping[str, Sequence[int]], path: Path) -> Path:
 def activity_rates_figure(rows: Sequence[tuple[Any, ...]], path: Path) -> Path:
     """Grouped horizontal bars: omission rate and error rate of each (manual) activity,
     ``(activity, omission, error)`` or, with their 95 % intervals drawn as error bars,
-    ``(activity, omission, error, (low, high), (low, high))``."""
+    ``(activity, omission, error, (low, high), (low, high))``. An error of ``None``: the
+    user model has no wrong action for that activity; no bar is drawn, "–" is written
+    (as the report's table does)."""
     title = "Omission and error rates per activity"
-    clean = [(_text(r[0]), float(r[1]), float(r[2])) for r in rows
-             if math.isfinite(float(r[1])) and math.isfinite(float(r[2]))]
-    intervals = [(r[3], r[4]) for r in rows if len(r) == 5
-                 and math.isfinite(float(r[1])) and math.isfinite(float(r[2]))]
+
+    def finite(value: Any) -> bool:
+        return value is not None and math.isfinite(float(value))
+
+    kept = [r for r in rows if finite(r[1]) and (r[2] is None or finite(r[2]))]
+    clean = [(_text(r[0]), float(r[1]), None if r[2] is None else float(r[2])) for r in kept]
+    intervals = [(r[3], r[4]) for r in kept if len(r) == 5]
     dropped = len(rows) - len(clean)
     if not clean:
         return _empty(path, title)
-    percent = _is_rate([v for _, o, e in clean for v in (o, e)])
+    percent = _is_rate([v for _, o, e in clean for v in (o, e) if v is not None])
     with _figure(8.5, _bar_height(int(1.5 * len(clean)) + 1)) as fig:
         ax = fig.add_subplot()
         n = len(clean)
@@ -253,27 +258,36 @@ def activity_rates_figure(rows: Sequence[tuple[Any, ...]], path: Path) -> Path:
         omission = ax.barh([c + height / 2 for c in centres], [o for _, o, _ in clean],
                            height=height, color=PALETTE[1], edgecolor="black", linewidth=0.5,
                            label="omission rate (not done)")
-        error = ax.barh([c - height / 2 for c in centres], [e for *_, e in clean],
+        wrong = [i for i in range(n) if clean[i][2] is not None]   # rows with an error rate
+        error = ax.barh([centres[i] - height / 2 for i in wrong],
+                        [clean[i][2] or 0.0 for i in wrong],
                         height=height, color=PALETTE[0], edgecolor="black", linewidth=0.5,
                         hatch="//", label="error rate (done wrongly)")
-        tops = [max(o, e) for _, o, e in clean]
+        tops = [max(o, e or 0.0) for _, o, e in clean]
         ends = [[b.get_width() for b in omission], [b.get_width() for b in error]]
         if len(intervals) == n:
-            for offset, k in ((height / 2, 0), (-height / 2, 1)):
-                ests = [clean[i][1 + k] for i in range(n)]
-                lows = [max(0.0, ests[i] - (intervals[i][k][0] or 0.0)) for i in range(n)]
-                highs = [max(0.0, (intervals[i][k][1] or 0.0) - ests[i]) for i in range(n)]
-                ax.errorbar(ests, [c + offset for c in centres], xerr=[lows, highs],
+            for offset, k, which in ((height / 2, 0, range(n)), (-height / 2, 1, wrong)):
+                ests = [float(clean[i][1 + k] or 0.0) for i in which]
+                lows = [max(0.0, ests[j] - (intervals[i][k][0] or 0.0))
+                        for j, i in enumerate(which)]
+                highs = [max(0.0, (intervals[i][k][1] or 0.0) - ests[j])
+                         for j, i in enumerate(which)]
+                ax.errorbar(ests, [centres[i] + offset for i in which], xerr=[lows, highs],
                             fmt="none", ecolor="black", capsize=3, linewidth=1.0)
-            tops = [max(o, e, intervals[i][0][1] or 0.0, intervals[i][1][1] or 0.0)
+            tops = [max(o, e or 0.0, intervals[i][0][1] or 0.0,
+                        (intervals[i][1][1] or 0.0) if e is not None else 0.0)
                     for i, (_, o, e) in enumerate(clean)]
-            ends = [[max(clean[i][1 + k], intervals[i][k][1] or 0.0) for i in range(n)]
-                    for k in (0, 1)]
+            ends = [[max(clean[i][1], intervals[i][0][1] or 0.0) for i in range(n)],
+                    [max(clean[i][2] or 0.0, intervals[i][1][1] or 0.0) for i in wrong]]
         # each value just past its bar, or past its interval when it has one
         for bars, at in zip((omission, error), ends, strict=True):
             for bar, x in zip(bars, at, strict=True):
                 ax.annotate(_fmt(bar.get_width(), percent),
                             (x, bar.get_y() + bar.get_height() / 2), xytext=(4, 0),
+                            textcoords="offset points", va="center", fontsize=9)
+        for i in range(n):              # no wrong action in the model: no rate to draw
+            if clean[i][2] is None:
+                ax.annotate("–", (0.0, centres[i] - height / 2), xytext=(4, 0),
                             textcoords="offset points", va="center", fontsize=9)
         ax.set_yticks(centres, [a for a, *_ in clean])
         # a rule between activities, none through them: a grid line at each name ran

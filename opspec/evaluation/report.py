@@ -163,6 +163,7 @@ def ask_figures_ahead(store: ResultStore, *, figures: str = "svg", workers: int 
     specs = {d["label"]: d["spec"] for d in plan.get("designs", [])}
     digests = {d["label"]: d.get("sha256") for d in plan.get("designs", [])}
     asked: dict[str, AskedAhead] = {}
+    model = user_model_as_run(store, plan)      # which activities it can do wrongly
     with plots.figure_format(figures), plots.asked_ahead(workers) as queued:
         # a sweep's report describes its first value only (as _report_sections)
         for design in designs[:1] if store.get("sweep") else designs:
@@ -170,7 +171,8 @@ def ask_figures_ahead(store: ResultStore, *, figures: str = "svg", workers: int 
                 definitions = _with_selectors(store, design, specs.get(design),
                                               digests.get(design))
                 asked[design] = ask_ahead(store, store.folder / "figures", design, days,
-                                          _users_done(store, design), definitions)
+                                          _users_done(store, design), definitions,
+                                          user_model=model)
             except EvaluationError:
                 break
     return ReportAhead(queued, asked)

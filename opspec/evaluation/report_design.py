@@ -168,12 +168,24 @@ def _count_figures(series: tuple[dict[str, Any], ...], figures: Path, design: st
             plots.time_of_day_figure(hours, figures / f"{design}-hours.png"))
 
 
-def _activity_figure(activity: list[dict[str, Any]], figures: Path, design: str) -> Path:
+def _never_wrong(activity: list[dict[str, Any]], user_model: Any) -> frozenset[str]:
+    """The activities with no error rate to show: the run's user model has no wrong action
+    for them, so 0 % is by construction and its interval (0 to 2 % at 187 offers) would read
+    as a measured error rate; one counted anyway (a model file changed since) is shown."""
+    if user_model is None:
+        return frozenset()
+    return frozenset(r["activity"] for r in activity if r["error"] == 0
+                     and can_do_wrongly(user_model, r["activity"]) is False)
+
+
+def _activity_figure(activity: list[dict[str, Any]], figures: Path, design: str,
+                     never: frozenset[str] = frozenset()) -> Path:
     from opspec.evaluation import plots
 
     return plots.activity_rates_figure(
-        [(r["activity"], r["omission"], r["error"], r["omission_ci95"], r["error_ci95"])
-         for r in activity], figures / f"{design}-activities.png")
+        [(r["activity"], r["omission"], None if r["activity"] in never else r["error"],
+          r["omission_ci95"], r["error_ci95"]) for r in activity],
+        figures / f"{design}-activities.png")
 
 
 @dataclass(frozen=True)
@@ -188,17 +200,20 @@ class AskedAhead:
 
 
 def ask_ahead(store: ResultStore, figures: Path, design: str, days: float, users: int,
-              definitions: Sequence[Mapping[str, Any]]) -> AskedAhead:
+              definitions: Sequence[Mapping[str, Any]], *, user_model: Any = None
+              ) -> AskedAhead:
     """Ask for the figures of ``design``'s sections that need neither the sample index nor
     the summaries (counts over time, the user's actions: what the store keeps of the outcomes
-    and activities), the same :func:`design_sections` asks for. Everything is read before
-    the first figure is asked for: a read that fails leaves nothing asked."""
+    and activities), the same :func:`design_sections` asks for (``user_model``: the run's,
+    as it is given). Everything is read before the first figure is asked for: a read that
+    fails leaves nothing asked."""
     counts = [d["name"] for d in definitions if d["kind"] == "count"]
     series = _count_series(store, design, counts, days, users) if counts else None
     activity = _activity_rates(store, design)
+    image = (_activity_figure(activity, figures, design, _never_wrong(activity, user_model))
+             if activity else None)
     return AskedAhead(_count_figures(series, figures, design) if series is not None else None,
-                      activity, _activity_figure(activity, figures, design) if activity
-                      else None)
+                      activity, image)
 
 
 def design_sections(store: ResultStore, figures: Path, design: str, name: str, days: float,
@@ -339,20 +354,17 @@ def design_sections(store: ResultStore, figures: Path, design: str, name: str, d
     # the user's actions
     if ahead is not None:
         activity, image = ahead.activity, ahead.activity_image
+        never = _never_wrong(activity, user_model)
     else:
         activity = _activity_rates(store, design)
-        image = _activity_figure(activity, figures, design) if activity else None
+        never = _never_wrong(activity, user_model)
+        image = _activity_figure(activity, figures, design, never) if activity else None
     if activity:
 
         def rate(value: float, ci: Sequence[float | None]) -> str:
             return (f"{fmt(value, percent=True)} [{fmt(ci[0], percent=True)}, "
                     f"{fmt(ci[1], percent=True)}]")
 
-        # no rate where the model has no wrong action: 0 % by construction, and its interval
-        # (0 to 2 % at 187 offers) would read as a measured error rate; one counted anyway
-        # (a model file changed since) is shown
-        never = {r["activity"] for r in activity if r["error"] == 0 and user_model is not None
-                 and can_do_wrongly(user_model, r["activity"]) is False}
         paragraph = ("For each activity of the user's lane: how often it was asked of the user "
                      "(offered), the share not done (omitted: an alarm not heard, a step "
                      "forgotten) and the share done wrongly (a wrong button chosen), with 95 % "
@@ -367,7 +379,7 @@ def design_sections(store: ResultStore, figures: Path, design: str, name: str, d
             paragraph += (" '–': the user model has no wrong action (a wrong choice or a "
                           "slip) for the activity, so it cannot be done wrongly and there is "
                           "no error rate to estimate.")
-            caption += "; an error rate that is '–' in the table is drawn as the 0 % counted"
+            caption += "; '–' where the user model has no wrong action, as in the table"
         sections.append(Section(f"{prefix}The user's actions", paragraphs=(paragraph,),
             tables=(Table(("activity", "offered", "omitted per offer [95 % CI]",
                            "wrong per offer [95 % CI]", "CI method"),

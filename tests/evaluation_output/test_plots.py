@@ -166,3 +166,20 @@ def test_a_figure_that_cannot_be_written_side_by_side_is_an_evaluation_error(
         plots.rates_figure([("x", 0.5, 0.4, 0.6)], tmp_path / "fine.png")
         plots.rates_figure([("x", 0.5, 0.4, 0.6)], blocker / "rates.png")
     assert (tmp_path / "fine.png").is_file()
+
+
+def test_an_activity_without_a_wrong_action_has_no_error_bar_but_a_dash(tmp_path: Path
+                                                                        ) -> None:
+    # as in the report's table: the user model cannot do hear_alarm wrongly, so there is no
+    # error rate to draw (a 0 % bar with an interval up to 2 % would read as measured)
+    rows = [("hear_alarm", 0.15, None, (0.12, 0.18), (0.0, 0.02)),
+            ("choose_button", 0.0, 0.05, (0.0, 0.02), (0.02, 0.09))]
+    with plots.figure_format("svg"):
+        svg = plots.activity_rates_figure(rows, tmp_path / "a.png").read_text(encoding="utf-8")
+    patches = svg.count('id="patch_')      # the axes, 2 omission bars, 1 error bar, legend
+    with plots.figure_format("svg"):
+        both = plots.activity_rates_figure(
+            [(*rows[0][:2], 0.0, *rows[0][3:]), rows[1]], tmp_path / "b.png"
+        ).read_text(encoding="utf-8")
+    assert patches == both.count('id="patch_') - 1
+    assert "–" in svg and "–" not in both
