@@ -76,9 +76,21 @@ def _one_line(text: str) -> str:
     return " ".join(text.split())
 
 
-def _ends_early(path: str, message: str, error: etree.XMLSyntaxError) -> XmlReadError | None:
+#: libxml2's messages for a tag it could not finish: at the end of the file, the file ends
+#: inside it (a mismatched end tag at the end is a real syntax error, not a cut)
+_NEEDS_MORE = re.compile(r"expected '>'|Couldn't find end of Start Tag|AttValue|"
+                         r"attributes construct error|mandates value for attribute")
+
+_CUT_SHORT = ("the file may have been cut short: restore its end (from a copy, or from the "
+              "tool that wrote it)")
+
+
+def _ends_early(path: str, message: str, error: etree.XMLSyntaxError,
+                end: tuple[int, int] | None) -> XmlReadError | None:
     """The error for a file that stops before its XML is complete, at its last line, or
-    None when ``message`` is not one of those libxml2 gives only at the end of the input."""
+    None when ``message`` is not one libxml2 gives at the end of the input: something still
+    open (:data:`_ENDS_EARLY`), or a tag it could not finish placed at or past ``end`` (the
+    file's last line and its width)."""
     for pattern, what in _ENDS_EARLY:
         found = pattern.search(message)
         if found is None:
@@ -89,17 +101,18 @@ def _ends_early(path: str, message: str, error: etree.XMLSyntaxError) -> XmlRead
         return XmlReadError(
             "not-well-formed",
             f"the file ends before the XML is complete ({what.format(*found.groups())})",
-            location=SourceLocation(path, line),
-            hint="the file may have been cut short: restore its end (from a copy, or from "
-            "the tool that wrote it)",
-        )
+            location=SourceLocation(path, line), hint=_CUT_SHORT)
+    line, column = error.lineno or 0, error.offset or 0
+    if (end is not None and _NEEDS_MORE.search(message)
+            and (line > end[0] or line == end[0] and column >= end[1])):
+        # libxml2 reads on past the end for the '>' or quote it still needs; its own
+        # position (a line after the last) is left out of the message
+        what = re.sub(r",?(\s*line \d+,)+\s*column \d+$", "", message)
+        return XmlReadError(
+            "not-well-formed",
+            f"the file ends inside a tag, before the XML is complete ({what})",
+            location=SourceLocation(path, end[0]), hint=_CUT_SHORT)
     return None
-
-
-#: libxml2's messages for a tag it could not finish: at the end of the file, the file ends
-#: inside it (a mismatched end tag at the end is a real syntax error, not a cut)
-_NEEDS_MORE = re.compile(r"expected '>'|Couldn't find end of Start Tag|AttValue|"
-                         r"attributes construct error|mandates value for attribute")
 
 
 def not_well_formed_error(path: str, error: etree.XMLSyntaxError,
@@ -113,21 +126,9 @@ def not_well_formed_error(path: str, error: etree.XMLSyntaxError,
             return XmlReadError("resource-limit", what,
                                 location=SourceLocation(path, error.lineno or None), hint=hint)
     message = _one_line(message)
-    early = _ends_early(path, message, error)
+    early = _ends_early(path, message, error, end)
     if early is not None:
         return early
-    line, column = error.lineno or 0, error.offset or 0
-    if (end is not None and _NEEDS_MORE.search(message)
-            and (line > end[0] or line == end[0] and column >= end[1])):
-        # libxml2 reads on past the end for the '>' or quote it still needs; its own
-        # position (a line after the last) is left out of the message
-        what = re.sub(r",?(\s*line \d+,)+\s*column \d+$", "", message)
-        return XmlReadError(
-            "not-well-formed",
-            f"the file ends inside a tag, before the XML is complete ({what})",
-            location=SourceLocation(path, end[0]),
-            hint="the file may have been cut short: restore its end (from a copy, or from "
-            "the tool that wrote it)")
     return XmlReadError(
         "not-well-formed",
         f"not well-formed XML: {message}",
