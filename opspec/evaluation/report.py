@@ -140,10 +140,12 @@ def _no_interval_words(difference: Mapping[str, Any]) -> str:
 @dataclass(frozen=True)
 class ReportAhead:
     """The report's figures asked for before it is written (:func:`ask_figures_ahead`): the
-    figures' queue, and per design described what was computed and asked for."""
+    figures' queue, per design described what was computed and asked for, and the run's
+    user model as it was read for them (None: none, or not the file the run used)."""
 
     figures: FiguresAhead
     designs: Mapping[str, AskedAhead]
+    user_model: Any = None
 
 
 def ask_figures_ahead(store: ResultStore, *, figures: str = "svg", workers: int = 1
@@ -175,7 +177,7 @@ def ask_figures_ahead(store: ResultStore, *, figures: str = "svg", workers: int 
                                           user_model=model)
             except EvaluationError:
                 break
-    return ReportAhead(queued, asked)
+    return ReportAhead(queued, asked, model)
 
 
 def prepare_report(template: str | Path | None = None) -> None:
@@ -213,16 +215,17 @@ def write_report(store: ResultStore, summaries: Mapping[str, Summaries] | None =
 
     with plots.figure_format(figures):
         with plots.drawn_by(workers, ahead.figures if ahead is not None else None):
-            title, sections = _report_sections(store, summaries,
-                                               ahead.designs if ahead is not None else {})
+            title, sections = _report_sections(store, summaries, ahead)
         write_markdown(store.folder / "report.md", title, sections)
         return write_html(store.folder / "report.html", title, sections, template=template)
 
 
 def _report_sections(store: ResultStore, summaries: Mapping[str, Summaries] | None,
-                     ahead: Mapping[str, AskedAhead]) -> tuple[str, list[Any]]:
+                     asked: ReportAhead | None) -> tuple[str, list[Any]]:
     from opspec.evaluation import plots
     from opspec.evaluation.html import Section, Table
+
+    ahead = asked.designs if asked is not None else {}
 
     summaries = summaries or {}
     folder = store.folder
@@ -330,7 +333,8 @@ def _report_sections(store: ResultStore, summaries: Mapping[str, Summaries] | No
             "Metrics the spec declares (opspec:Metrics), computed from each user's trace"),)))
     sections.append(user_model_section(store, plan, figures, population))
 
-    model = user_model_as_run(store, plan)      # which activities it can do wrongly
+    # which activities it can do wrongly (read once: as the figures asked ahead read it)
+    model = asked.user_model if asked is not None else user_model_as_run(store, plan)
     for design in detailed:
         metrics, monitors, definitions = per_design[design]
         prefix = f"{names[design]}: " if len(detailed) > 1 or sweep else ""
