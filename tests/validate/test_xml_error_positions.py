@@ -131,3 +131,18 @@ def test_check_says_a_file_with_blocks_nested_too_deeply_was_read(tmp_path, caps
     assert "nested more than 100 blocks deep" in out[0]
     assert out[-1] == (f"{spec}: not checked: its blocks nest deeper than the check follows; "
                        "change them as the nesting error above advises")
+
+
+def test_a_byte_that_is_not_utf8_is_placed_once(tmp_path, capsys) -> None:
+    # it said "...:47: warning: the file declares UTF-8 but is not valid UTF-8 (line 47:
+    # byte 0xE9); ..."
+    lines = (ROOT / "specs" / "medication_dispenser.xpdl").read_bytes().split(b"\n")
+    lines[46] = lines[46].replace(b'"dispense"', b'"dispens\xe9"', 1)
+    spec = tmp_path / "latin.xpdl"
+    spec.write_bytes(b"\n".join(lines))
+    main(["validate", str(spec)])
+    line = _error_line(capsys.readouterr().out, f"{spec}:47: warning: ")
+    message = line.split(f"{spec}:47: ", 1)[1]
+    assert message.startswith("warning: the file declares UTF-8 but is not valid UTF-8 (byte "
+                              "0xE9); read it as Latin-1; ")
+    assert "47" not in message
