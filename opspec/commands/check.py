@@ -101,7 +101,7 @@ def run(args: argparse.Namespace) -> int:
         if nesting_problem(package) is not None:
             # blocks nested past what the compiler and the exploration follow (listed
             # among the errors): nothing can be checked
-            _print_unloadable(path, errors, as_json=args.json)
+            _print_unloadable(path, errors, as_json=args.json, nested=True)
             worst = max(worst, 1)
             continue
         processes = [p for p in package.processes
@@ -247,11 +247,16 @@ def _spec_errors(package: Any, load_errors: Sequence[Diagnostic],
 
 
 def _errors_json(errors: Sequence[Diagnostic]) -> list[dict[str, Any]]:
+    # the hint too, as validate's --json: a reader limit's message says what is wrong, only
+    # its hint what to change
     return [{"line": d.location.line, "severity": d.severity.value, "code": d.code,
-             "message": d.message} for d in errors]
+             "message": d.message, "hint": d.hint} for d in errors]
 
 
-def _print_unloadable(path: Path, errors: Sequence[Diagnostic], *, as_json: bool) -> None:
+def _print_unloadable(path: Path, errors: Sequence[Diagnostic], *, as_json: bool,
+                      nested: bool = False) -> None:
+    """Print the errors of a file that is not checked and why; ``nested``: it was read, but
+    its blocks nest past what the check follows."""
     if as_json:
         print(json.dumps({
             "path": str(path), "sound": False, "loaded": False, "processes": [],
@@ -259,8 +264,17 @@ def _print_unloadable(path: Path, errors: Sequence[Diagnostic], *, as_json: bool
         return
     for diagnostic in errors:
         print(diagnostic)
-    print(f"{path}: not checked: the file could not be read as a spec (XPDL or BPMN); fix "
-          "the errors listed above")
+    if nested:
+        why = ("its blocks nest deeper than the check follows; change them as the nesting "
+               "error above advises")
+    elif any(d.code == "resource-limit" for d in errors):
+        # a well-formed file, maybe: "could not be read" would not say what to change
+        why = ("the file is beyond a safety limit of the XML reader, so it was not read; "
+               "change it as the error above advises")
+    else:
+        why = ("the file could not be read as a spec (XPDL or BPMN); fix the errors listed "
+               "above")
+    print(f"{path}: not checked: {why}")
 
 
 def _problem_json(p: Any) -> dict[str, Any]:

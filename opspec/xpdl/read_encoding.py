@@ -1,7 +1,7 @@
 """Which encoding a specification file is in: the one its XML declaration names, ``ASCII``
 declarations on files that really hold UTF-8 (read as UTF-8, which loses nothing), and the
 warning given when a file that is not valid UTF-8 and declares nothing else is read as
-Latin-1 (it names the line and value of the first byte that is not UTF-8).
+Latin-1 (at the line of the first byte that is not UTF-8, naming that byte's value).
 """
 
 from __future__ import annotations
@@ -41,7 +41,8 @@ def _first_bad_utf8(data: bytes) -> tuple[int, int] | None:
 def encoding_warning(data: bytes, path: str, declared: str | None, line: int | None
                      ) -> Diagnostic:
     bad = _first_bad_utf8(data)
-    where = f" (line {bad[0]}: byte 0x{bad[1]:02X})" if bad else ""
+    # the diagnostic's file:line is the byte's line: the message names the byte alone
+    where = f" (byte 0x{bad[1]:02X})" if bad else ""
     if bad:
         line = bad[0]
     if declared == "utf-8":

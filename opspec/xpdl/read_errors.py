@@ -1,8 +1,9 @@
 """The reader's fatal errors: :class:`XmlReadError` (a :class:`~opspec.errors.SpecError` with
 a stable ``code`` and the file:line where the problem was found), and what the parse failures
-say: a DOCTYPE refused, XML that is not well-formed (a file that ends before its XML is
-complete said so, at its last line), or a well-formed file beyond one of libxml2's safety
-limits (with advice for the spec's author, not "fix the syntax").
+say: a DOCTYPE refused, XML that is not well-formed (libxml2's message with its position
+said once: the line in the diagnostic's file:line, the column in words; a file that ends
+before its XML is complete said so, at its last line), or a well-formed file beyond one of
+libxml2's safety limits (with advice for the spec's author, not "fix the syntax").
 """
 
 from __future__ import annotations
@@ -76,6 +77,37 @@ def _one_line(text: str) -> str:
     return " ".join(text.split())
 
 
+#: the position lxml appends to libxml2's message (", line 52, column 19"): the diagnostic's
+#: file:line says the line already
+_POSITION = re.compile(r",\s*line \d+,\s*column (\d+)$")
+
+#: libxml2's "Foo line 47" (a tag and the line it was opened on) written as a tag; ``{at}``:
+#: " of line 47", or nothing when that is the diagnostic's own line
+_TAGS: Final = (
+    (re.compile(r"^Opening and ending tag mismatch: (?P<tag>\S+) line (?P<line>\d+) "
+                r"and (?P<end>\S+)$"),
+     "Opening and ending tag mismatch: <{tag}>{at} and </{end}>"),
+    (re.compile(r"^Couldn't find end of Start Tag (?P<tag>\S+) line (?P<line>\d+)$"),
+     "Couldn't find the end of the start tag <{tag}>{at}"),
+)
+
+
+def _without_position(message: str, line: int | None) -> tuple[str, int | None]:
+    """libxml2's ``message`` for an error the diagnostic places at ``line``, without the
+    position lxml appends to it and with its tags written as tags; and the column that
+    position named (``None``: it named none)."""
+    found = _POSITION.search(message)
+    column = int(found.group(1)) if found else None
+    text = message[:found.start()].rstrip() if found else message
+    for pattern, words in _TAGS:
+        tag = pattern.search(text)
+        if tag is not None:
+            opened = int(tag["line"])
+            at = "" if opened == line else f" of line {opened}"
+            return words.format(at=at, **tag.groupdict()), column
+    return text, column
+
+
 #: libxml2's messages for a tag it could not finish: at the end of the file, the file ends
 #: inside it (a mismatched end tag at the end is a real syntax error, not a cut)
 _NEEDS_MORE = re.compile(r"expected '>'|Couldn't find end of Start Tag|AttValue|"
@@ -107,7 +139,7 @@ def _ends_early(path: str, message: str, error: etree.XMLSyntaxError,
             and (line > end[0] or line == end[0] and column >= end[1])):
         # libxml2 reads on past the end for the '>' or quote it still needs; its own
         # position (a line after the last) is left out of the message
-        what = re.sub(r",?(\s*line \d+,)+\s*column \d+$", "", message)
+        what, _past_the_end = _without_position(message, end[0])
         return XmlReadError(
             "not-well-formed",
             f"the file ends inside a tag, before the XML is complete ({what})",
@@ -129,9 +161,12 @@ def not_well_formed_error(path: str, error: etree.XMLSyntaxError,
     early = _ends_early(path, message, error, end)
     if early is not None:
         return early
+    line = error.lineno or None
+    what, column = _without_position(message, line)
     return XmlReadError(
         "not-well-formed",
-        f"not well-formed XML: {message}",
-        location=SourceLocation(path, error.lineno or None),
+        f"not well-formed XML at column {column}: {what}" if column else
+        f"not well-formed XML: {what}",
+        location=SourceLocation(path, line),
         hint="fix the XML syntax at that line (an editor with XML checking shows it)",
     )
