@@ -259,7 +259,7 @@ def _print_unloadable(path: Path, errors: Sequence[Diagnostic], *, as_json: bool
     its blocks nest past what the check follows."""
     if as_json:
         print(json.dumps({
-            "path": str(path), "sound": False, "loaded": False, "processes": [],
+            "path": str(path), "sound": False, "loaded": nested, "processes": [],
             "problems": [], "errors": _errors_json(errors)}, ensure_ascii=False))
         return
     for diagnostic in errors:

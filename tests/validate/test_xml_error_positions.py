@@ -102,7 +102,9 @@ def test_check_says_what_to_change_in_a_file_nested_past_the_readers_limit(
     assert out[-1] == (f"{spec}: not checked: the file is beyond a safety limit of the XML "
                        "reader, so it was not read; change it as the error above advises")
     assert main(["check", "--json", str(spec)]) == 1
-    (error,) = json.loads(capsys.readouterr().out)["errors"]
+    doc = json.loads(capsys.readouterr().out)
+    assert doc["loaded"] is False        # not read
+    (error,) = doc["errors"]
     assert error["code"] == "resource-limit"
     assert "nested more than 256 levels deep" in error["message"]
     assert error["hint"].startswith("XPDL needs a few dozen levels at most: flatten")
@@ -131,6 +133,11 @@ def test_check_says_a_file_with_blocks_nested_too_deeply_was_read(tmp_path, caps
     assert "nested more than 100 blocks deep" in out[0]
     assert out[-1] == (f"{spec}: not checked: its blocks nest deeper than the check follows; "
                        "change them as the nesting error above advises")
+    assert main(["check", "--json", str(spec)]) == 1
+    doc = json.loads(capsys.readouterr().out)
+    # read, but not checked: loaded, no process verdicts, the nesting error listed
+    assert doc["loaded"] is True and doc["sound"] is False and doc["processes"] == []
+    assert any("nested more than 100 blocks deep" in e["message"] for e in doc["errors"])
 
 
 def test_a_byte_that_is_not_utf8_is_placed_once(tmp_path, capsys) -> None:
