@@ -114,6 +114,15 @@ def _one_line(text: str) -> str:
     return " ".join(text.split())
 
 
+def _readable(message: str, namespace: str | None) -> str:
+    """libxml2's schema ``message`` as a sentence of opspec's: the file's own namespace left
+    out of element names (``'{http://www.wfmc.org/2008/XPDL2.1}Bogus'`` is ``'Bogus'``; other
+    namespaces stay), without the full stop that the hint's ``;`` would follow."""
+    if namespace:
+        message = message.replace("{" + namespace + "}", "")
+    return message.rstrip().removesuffix(".")
+
+
 def schema_errors(root: etree._Element) -> list[tuple[int | None, str]]:
     """``(line, message)`` of every schema error of the document of ``root`` (empty: valid).
     Raises :class:`SchemaUnavailable` when no schema is bundled for its namespace."""
@@ -155,9 +164,10 @@ def schema_diagnostics(path: str | Path, *, strict: bool = False) -> list[Diagno
         return [Diagnostic(SourceLocation(shown, 1), Severity.ERROR, "no-schema",
                            f"the bundled schema does not compile: {_one_line(str(error))}",
                            "this is a bug in opspec; please report it")]
-    name = SCHEMA_FILES.get(etree.QName(root).namespace or NO_NAMESPACE, "")
+    namespace = etree.QName(root).namespace
+    name = SCHEMA_FILES.get(namespace or NO_NAMESPACE, "")
     out = [Diagnostic(SourceLocation(shown, line), Severity.ERROR, "schema-invalid",
-                      f"the WfMC schema {name} rejects this: {message}",
+                      f"the WfMC schema {name} rejects this: {_readable(message, namespace)}",
                       "fix the element named (opspec itself reads many files the schema "
                       "rejects; --schema asks for the schema's verdict)")
            for line, message in errors[:MAX_ERRORS]]
