@@ -479,14 +479,15 @@ def _print_summary(out: Any, result: RunResult, medians: dict[str, float], trace
                    absent: list[dict[str, Any]] | None = None, no_user: bool = False,
                    definitions: Iterable[MetricDefinition] = ()) -> None:
     """The text summary after the timeline: the spec's metrics (``definitions``: the spec's,
-    for a ratio's numerator and denominator; :mod:`opspec.commands.run_metrics`), how the run
-    ended, drift, devices, problems, the trace file."""
-    from opspec.commands.run_metrics import metric_lines
+    for a ratio's numerator and denominator; :mod:`opspec.evaluation.run_metrics_text`), how
+    the run ended, drift, devices, problems, the trace file."""
+    from opspec.evaluation.run_metrics_text import metric_lines
 
     summary = result.summary
     print(file=out)
-    for line in metric_lines(json_metrics(result.metrics, medians), definitions):
-        print(line, file=out)
+    lines = metric_lines(result.metrics, medians, definitions)
+    if lines:
+        print("metrics", *lines, sep="\n", file=out)
     counts = summary.get("instances", {})
     parts = ", ".join(f"{k} {v}" for k, v in counts.items() if v)
     # simulation events do not depend on the options; trace events are only those some

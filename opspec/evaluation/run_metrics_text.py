@@ -1,12 +1,14 @@
-"""The ``metrics`` block of ``opspec run``'s text summary: the spec's metrics, one line each.
+"""One run's metrics as text, one line each: the ``metrics`` block of ``opspec run`` (and what
+the walkthrough's summary should print, word for word: :mod:`opspec.tui.summary`).
 
 Counts as they are, durations as mean, median, p95 and n. A ratio of two counts reads as
-``opspec evaluate``'s table reads it: the counts it divides follow its value, ``(13 of 12)``,
-as in that table's pooled column; and a proportion that table shows in percent (``taken_rate``:
-doses taken of doses due) is in percent here too, by the table's own formatter
-(:func:`opspec.evaluation.tables.fmt`), ``100.00 % (12 of 12)``. Other ratios (of durations,
-of other ratios) are their bare value. ``opspec run --json`` does not use this (its metrics
-are shaped as ``opspec evaluate --json``'s).
+``opspec evaluate``'s table reads it (:mod:`.tables`, hence here and not in the commands: the
+walkthrough, a layer below them, can use it too): the counts it divides follow its value,
+``(13 of 12)``, as in that table's pooled column; and a proportion that table shows in percent
+(``taken_rate``: doses taken of doses due) is in percent here too, by the table's own
+formatter (:func:`.tables.fmt`), ``100.00 % (12 of 12)``. Other ratios (of durations, of other
+ratios) are their bare value. ``opspec run --json`` does not use this (its metrics are shaped
+as ``opspec evaluate --json``'s).
 """
 
 from __future__ import annotations
@@ -20,23 +22,27 @@ from opspec.model import MetricDefinition, MetricKind
 __all__ = ["metric_lines"]
 
 
-def metric_lines(metrics: Mapping[str, Mapping[str, Any]],
-                 definitions: Iterable[MetricDefinition]) -> list[str]:
-    """The block's lines (none without metrics): ``metrics`` as
-    :func:`opspec.commands.run.json_metrics` shapes them, ``definitions`` the spec's (a
-    ratio's numerator and denominator)."""
+def metric_lines(metrics: Mapping[str, Mapping[str, Any]], medians: Mapping[str, float],
+                 definitions: Iterable[MetricDefinition] = ()) -> list[str]:
+    """The spec's metrics, one line each (none without metrics): ``metrics`` as a run gives
+    them (:meth:`opspec.engine.metrics.MetricsListener.values`), ``medians`` of the
+    durations, ``definitions`` the spec's (a ratio's numerator and denominator; without them
+    every ratio is its bare value)."""
     if not metrics:
         return []
     ratios = {d.name: d for d in definitions if d.kind is MetricKind.RATIO}
-    width = max(len(n) for n in metrics)
-    lines = ["metrics"]
+    width = max(len(name) for name in metrics)
+    lines = []
     for name, value in metrics.items():
-        if value["kind"] == "count":
-            text = f"{value['total']}"
-        elif value["kind"] == "duration":
-            text = (f"n {value['n']}" if not value["n"] else
-                    f"mean {figure(value['mean'], ' s')}, median {figure(value['median'], ' s')}"
-                    f", p95 {figure(value['p95'], ' s')}, n {value['n']}")
+        kind = value.get("kind")
+        if kind == "count":
+            text = f"{value.get('total', 0)}"
+        elif kind == "duration":
+            n = value.get("n", 0)
+            text = (f"n {n}" if not n else
+                    f"mean {figure(value.get('mean'), ' s')}, median "
+                    f"{figure(medians.get(name), ' s')}, p95 {figure(value.get('p95'), ' s')}, "
+                    f"n {n}")
         else:
             text = _ratio(name, value, _counts(ratios.get(name), metrics))
         lines.append(f"  {name:<{width}}  {text}")
@@ -50,10 +56,10 @@ def _counts(definition: MetricDefinition | None, metrics: Mapping[str, Mapping[s
         return None
     numerator = metrics.get(definition.numerator or "")
     denominator = metrics.get(definition.denominator or "")
-    if (numerator is None or denominator is None or numerator["kind"] != "count"
-            or denominator["kind"] != "count"):
+    if (numerator is None or denominator is None or numerator.get("kind") != "count"
+            or denominator.get("kind") != "count"):
         return None
-    return int(numerator["total"]), int(denominator["total"])
+    return int(numerator.get("total", 0)), int(denominator.get("total", 0))
 
 
 def _ratio(name: str, value: Mapping[str, Any], counts: tuple[int, int] | None) -> str:
