@@ -22,7 +22,7 @@ import argparse
 import contextlib
 import json
 import sys
-from collections.abc import Iterator
+from collections.abc import Iterable, Iterator
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -33,6 +33,7 @@ from opspec.errors import ConfigurationError, OpspecError
 if TYPE_CHECKING:
     from opspec.engine.simulation import RunResult
     from opspec.engine.trace import TraceEvent
+    from opspec.model import MetricDefinition
 
 __all__ = ["json_metrics", "register", "run", "timeline_line"]
 
@@ -189,7 +190,7 @@ def run(args: argparse.Namespace) -> int:
                           result.summary.get("dedicated"))
         _print_summary(out, result, medians, args.trace, device_report,
                        shown=printer.shown if printer else 0, absent=absent,
-                       no_user=args.no_user)
+                       no_user=args.no_user, definitions=package.metrics)
         _print_monitors(out, monitors)
     trace_lost = sink is not None and sink.failure is not None
     if sink is not None and sink.truncated is not None:      # the cap, or a full disk
@@ -475,23 +476,18 @@ def _print_timing(out: Any, timing: dict[str, dict[str, Any]], pool: dict[str, A
 
 def _print_summary(out: Any, result: RunResult, medians: dict[str, float], trace: str | None,
                    devices: dict[str, Any] | None, *, shown: int,
-                   absent: list[dict[str, Any]] | None = None, no_user: bool = False) -> None:
+                   absent: list[dict[str, Any]] | None = None, no_user: bool = False,
+                   definitions: Iterable[MetricDefinition] = ()) -> None:
+    """The text summary after the timeline: the spec's metrics (``definitions``: the spec's,
+    for a ratio's numerator and denominator; :mod:`opspec.evaluation.run_metrics_text`), how
+    the run ended, drift, devices, problems, the trace file."""
+    from opspec.evaluation.run_metrics_text import metric_lines
+
     summary = result.summary
     print(file=out)
-    metrics = json_metrics(result.metrics, medians)
-    if metrics:
-        print("metrics", file=out)
-        width = max(len(n) for n in metrics)
-        for name, value in metrics.items():
-            if value["kind"] == "count":
-                text = f"{value['total']}"
-            elif value["kind"] == "duration":
-                text = (f"n {value['n']}" if not value["n"] else
-                        f"mean {figure(value['mean'], ' s')}, median {figure(value['median'], ' s')}"
-                        f", p95 {figure(value['p95'], ' s')}, n {value['n']}")
-            else:
-                text = figure(value.get("value"))
-            print(f"  {name:<{width}}  {text}", file=out)
+    lines = metric_lines(result.metrics, medians, definitions)
+    if lines:
+        print("metrics", *lines, sep="\n", file=out)
     counts = summary.get("instances", {})
     parts = ", ".join(f"{k} {v}" for k, v in counts.items() if v)
     # simulation events do not depend on the options; trace events are only those some
