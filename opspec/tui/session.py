@@ -160,7 +160,7 @@ class WalkSession(SessionClock, PersonLane, TraceFollower, Recording):
             medians = {k: statistics.median(v) for k, v in samples.items() if v}
         if metrics:
             lines += ["", "The spec's metrics (as opspec run prints them):",
-                      *metric_lines(metrics, medians)]
+                      *metric_lines(metrics, medians, self.compiled.package.metrics)]
         if self.has_user_lane and not self.replaying:
             lines += ["", "Your response times (wall clock, from the offer to your key):",
                       *response_lines(self.responses)]

@@ -13,38 +13,14 @@ from __future__ import annotations
 
 import shlex
 from collections import Counter
-from collections.abc import Mapping, Sequence
+from collections.abc import Sequence
 from pathlib import Path
 from statistics import median
-from typing import Any
 
-from opspec.clock import figure
+from opspec.evaluation.run_metrics_text import metric_lines
 from opspec.tui.timing import Response
 
 __all__ = ["metric_lines", "replay_commands", "response_lines"]
-
-
-def metric_lines(metrics: Mapping[str, Mapping[str, Any]],
-                 medians: Mapping[str, float]) -> list[str]:
-    """The spec's metrics, one line each, as in ``opspec run``'s ``metrics`` section."""
-    if not metrics:
-        return []
-    width = max(len(name) for name in metrics)
-    lines = []
-    for name, value in metrics.items():
-        kind = value.get("kind")
-        if kind == "count":
-            text = f"{value.get('total', 0)}"
-        elif kind == "duration":
-            n = value.get("n", 0)
-            text = (f"n {n}" if not n else
-                    f"mean {figure(value.get('mean'), ' s')}, median "
-                    f"{figure(medians.get(name), ' s')}, p95 {figure(value.get('p95'), ' s')}, "
-                    f"n {n}")
-        else:
-            text = figure(value.get("value"))
-        lines.append(f"  {name:<{width}}  {text}")
-    return lines
 
 
 def response_lines(responses: Sequence[Response]) -> list[str]:
