@@ -85,8 +85,8 @@ def test_an_output_that_would_replace_the_spec_is_said_once_prefixed(
     spec.write_bytes(SPEC.read_bytes())
     assert main(["run", str(spec), "--trace", str(spec)]) == 2
     assert lines(capsys.readouterr().err) == [
-        f"opspec run: --trace {spec} is the file this command reads as SPEC; refusing to "
-        "overwrite it (give --trace another file)"]
+        (f"opspec run: --trace {spec} is the file this command reads as SPEC; refusing to "
+         "overwrite it (give --trace another file)")]
 
 
 def test_a_translation_prints_its_own_refusal_once_prefixed(
@@ -101,7 +101,7 @@ def test_a_translation_prints_its_own_refusal_once_prefixed(
 
 def _handler_raising(monkeypatch: pytest.MonkeyPatch, error: BaseException) -> None:
     """``opspec validate`` raises ``error`` as soon as it runs."""
-    import opspec.commands.validate as validate
+    from opspec.commands import validate
 
     def run(_args: argparse.Namespace) -> int:
         raise error
@@ -128,7 +128,7 @@ def test_an_internal_error_begins_with_the_command(
 
 def test_a_command_that_cannot_load_begins_with_its_name(
         monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]) -> None:
-    import opspec.commands.new as new
+    from opspec.commands import new
 
     def register(_subparsers: object) -> None:
         raise RuntimeError("broken on purpose")
