@@ -5,6 +5,8 @@ Each subcommand lives in its own module under :mod:`opspec.commands` and exposes
 ``register(subparsers) -> None``, which adds its parser and sets ``handler`` to a function
 ``(args) -> int`` returning the exit status. This module only wires them together and turns
 every :class:`~opspec.errors.OpspecError` into a one-line message: no traceback reaches a user.
+Each message begins with the command that was run (``opspec run: ...``, ``opspec devices
+list: ...``), as argparse's usage errors do; ``opspec:`` alone where no command was parsed.
 
 Exit statuses: 0 success, 1 a problem found in the user's input or run (a spec error, a failed
 check), 2 usage, configuration or I/O errors, 130 interrupted.
@@ -81,17 +83,17 @@ def _register_broken(subparsers: argparse._SubParsersAction[argparse.ArgumentPar
     if command in subparsers.choices:
         return
     reason = " ".join(f"{type(error).__name__}: {error}".split())
+    parser = subparsers.add_parser(command, help="(unavailable: this command failed to load)",
+                                   add_help=False)
 
     def broken(_args: argparse.Namespace) -> int:
-        print(f"opspec: internal error: the {command!r} command cannot be loaded ({reason}) "
-              "(this is a bug in opspec; rerun with OPSPEC_DEBUG=1 for a traceback and "
-              "report it)", file=sys.stderr)
+        print(f"{parser.prog}: internal error: the {command!r} command cannot be loaded "
+              f"({reason}) (this is a bug in opspec; rerun with OPSPEC_DEBUG=1 for a "
+              "traceback and report it)", file=sys.stderr)
         if os.environ.get("OPSPEC_DEBUG"):
             traceback.print_exception(error)
         return 70
 
-    parser = subparsers.add_parser(command, help="(unavailable: this command failed to load)",
-                                   add_help=False)
     parser.add_argument("rest", nargs=argparse.REMAINDER, help=argparse.SUPPRESS)
     parser.set_defaults(handler=broken)
 
@@ -107,7 +109,9 @@ def _subparsers(parser: argparse.ArgumentParser) -> dict[str, argparse.ArgumentP
 def _innermost(parser: argparse.ArgumentParser, args: argparse.Namespace
                ) -> argparse.ArgumentParser:
     """The parser of the deepest command ``args`` chose (``opspec devices list``: that of
-    ``list``), whose usage an unknown option is reported with."""
+    ``list``), whose usage an unknown option is reported with and whose ``prog`` begins
+    every message the command prints on stderr (``opspec devices list: ...``, as argparse's
+    own errors begin)."""
     while True:
         actions = [a for a in parser._actions if isinstance(a, argparse._SubParsersAction)]
         chosen = getattr(args, actions[0].dest, None) if actions else None
@@ -171,31 +175,33 @@ def main(argv: Sequence[str] | None = None) -> int:
             return 0
         argcomplete.autocomplete(parser)
     args, unknown = parser.parse_known_args(argv)
+    # the subcommand's own parser, not the top-level one: its usage says what a mistyped
+    # option belongs to and what it accepts, and its prog begins the command's messages
+    own = _innermost(parser, args)
     if unknown:
-        # the subcommand's own usage, not the top-level one: what the mistyped option
-        # belongs to and what it accepts
-        own = _innermost(parser, args)
         own.error(f"unrecognized arguments: {' '.join(unknown)}" + _did_you_mean(own, unknown))
     handler = getattr(args, "handler", None)
     if handler is None:
         parser.print_help()
         return 2
+    # The one place the prefix of what reaches here is added: an error's text carries none.
+    said = f"{own.prog}:"
     try:
         status: int = handler(args)
         return status
     except SpecError as error:
-        print(f"opspec: {error}", file=sys.stderr)
+        print(f"{said} {error}", file=sys.stderr)
         for diagnostic in error.diagnostics[1:]:
             print(f"  {diagnostic}", file=sys.stderr)
         return 1
     except ZeroTimeCycleError as error:         # a problem of the run, not of the usage
-        print(f"opspec: {error}", file=sys.stderr)
+        print(f"{said} {error}", file=sys.stderr)
         return 1
     except OpspecError as error:
-        print(f"opspec: {error}", file=sys.stderr)
+        print(f"{said} {error}", file=sys.stderr)
         return 2
     except KeyboardInterrupt:
-        print("opspec: interrupted", file=sys.stderr)
+        print(f"{said} interrupted", file=sys.stderr)
         return 130
     except BrokenPipeError:
         # `opspec show … | head`: the reader went away; not an error worth a message.
@@ -206,7 +212,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         if os.environ.get("OPSPEC_DEBUG"):
             traceback.print_exc()
         print(
-            f"opspec: internal error: {type(error).__name__}: {error} "
+            f"{said} internal error: {type(error).__name__}: {error} "
             "(this is a bug in opspec; rerun with OPSPEC_DEBUG=1 for a traceback and report it)",
             file=sys.stderr,
         )

@@ -27,14 +27,21 @@ def input_problem(path: Path) -> str | None:
     return not_a_file(path)
 
 
+def _said(command: str, message: str) -> str:
+    """``message`` as ``opspec COMMAND`` prints it itself (what reaches :func:`opspec.cli.main`
+    as an error is prefixed there, and carries no prefix)."""
+    return f"opspec {command}: {message}"
+
+
 def translation_problem(command: str, source: Path, target: Path | None, *,
                         example: str) -> str | None:
     """Why ``opspec COMMAND IN -o OUT`` (a translation: ``compile``, ``preprocess``) cannot
     run: IN (``source``) cannot be read, or OUT (``target``; None: standard output) would
-    replace IN or IN's companion user model. None when it can."""
+    replace IN or IN's companion user model, as the line the command prints (``opspec
+    COMMAND: ...``). None when it can."""
     problem = input_problem(source)
     if problem is not None:
-        return f"opspec {command}: cannot read {source}: {problem}"
+        return _said(command, f"cannot read {source}: {problem}")
     from opspec.commands._spec import companion_user_model
 
     return overwrite_problem(command, [("-o", target)],
@@ -82,9 +89,17 @@ def _inside(path: Path, folder: Path) -> bool:
 
 def overwrite_problem(command: str, writes: Iterable[Named], reads: Iterable[Named], *,
                       folders: Iterable[Named] = (), example: str = "") -> str | None:
-    """The message when a file the command writes (``writes``), or a file inside a folder it
-    fills (``folders``: every file there may be replaced), is one the command reads
-    (``reads``), naming both; ``None`` when none is. ``example``: a file name to suggest."""
+    """The line ``opspec COMMAND`` prints when a file the command writes (``writes``), or a
+    file inside a folder it fills (``folders``: every file there may be replaced), is one the
+    command reads (``reads``), naming both; ``None`` when none is. ``example``: a file name
+    to suggest."""
+    problem = _overwrite(writes, reads, folders=folders, example=example)
+    return None if problem is None else _said(command, problem)
+
+
+def _overwrite(writes: Iterable[Named], reads: Iterable[Named], *, folders: Iterable[Named],
+               example: str) -> str | None:
+    """:func:`overwrite_problem`'s message, without the command's prefix."""
     instead = f", e.g. {example}" if example else ""
     inputs = [(what, Path(path)) for what, path in reads if path]
     for what, path in writes:
@@ -95,27 +110,28 @@ def overwrite_problem(command: str, writes: Iterable[Named], reads: Iterable[Nam
             if same_file(source, target):
                 shown = (f"{target}" if str(target) == str(source)
                          else f"{target} (the same file as {source})")
-                return (f"opspec {command}: {what} {shown} is the file this command reads as "
-                        f"{read_as}; refusing to overwrite it (give {what} another file"
-                        f"{instead})")
+                return (f"{what} {shown} is the file this command reads as {read_as}; "
+                        f"refusing to overwrite it (give {what} another file{instead})")
     for what, path in folders:
         if not path:
             continue
         for read_as, source in inputs:
             if _inside(source, Path(path)):
-                return (f"opspec {command}: {what} writes into {path}, which holds "
-                        f"{source}, a file this command reads as {read_as}; refusing to "
-                        f"overwrite it (move {read_as} out of it, or choose another folder)")
+                return (f"{what} writes into {path}, which holds {source}, a file this "
+                        f"command reads as {read_as}; refusing to overwrite it (move "
+                        f"{read_as} out of it, or choose another folder)")
     return None
 
 
 def refuse_overwrite(command: str, writes: Iterable[Named], reads: Iterable[Named], *,
                      folders: Iterable[Named] = (), example: str = "") -> None:
     """Raise a :class:`ConfigurationError` (exit status 2, nothing written) when an output
-    would replace an input (:func:`overwrite_problem`)."""
-    problem = overwrite_problem(command, writes, reads, folders=folders, example=example)
+    would replace an input (:func:`overwrite_problem`). Its message carries no prefix:
+    :func:`opspec.cli.main` begins it with the command that was run, so ``command`` (the
+    callers name it) is not used."""
+    problem = _overwrite(writes, reads, folders=folders, example=example)
     if problem is not None:
-        raise ConfigurationError(problem.removeprefix(f"opspec {command}: "))
+        raise ConfigurationError(problem)
 
 
 def spec_inputs(spec: str | os.PathLike[str], package: Any) -> list[Named]:

@@ -65,7 +65,7 @@ def register(subparsers: Any) -> None:
     parser.add_argument("--scheduler-timeout", type=float, default=None, metavar="SECONDS",
                         help="with --scheduler: how long to wait for the cluster to have a "
                         "worker, at the start and whenever all have left (default 60)")
-    parser.add_argument("--out", metavar="DIR",
+    parser.add_argument("-o", "--out", metavar="DIR",
                         help="output folder (default: runs/<spec>-<date-time>)")
     parser.add_argument("--resume", action="store_true",
                         help="finish the evaluation stored in --out (missing or failed users)")

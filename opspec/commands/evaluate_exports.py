@@ -123,7 +123,7 @@ def export_estimate(plan: Any, folder: Path, quiet: bool) -> None:
     except (OSError, EvaluationError) as error:
         # the scratch folder (the system's temporary folder) is not the output's disk
         if not quiet:
-            print(f"evaluate: the size of the export could not be estimated ({error})",
+            print(f"opspec evaluate: the size of the export could not be estimated ({error})",
                   file=sys.stderr)
         return
     total = sum(sizes.values())
@@ -131,7 +131,7 @@ def export_estimate(plan: Any, folder: Path, quiet: bool) -> None:
         f" x {len(plan.designs)} designs" if len(plan.designs) > 1 else "")
     if not quiet:
         for fmt, size in sizes.items():
-            print(f"evaluate: {EXPORT_FILES[fmt]} will be about {_bytes(size)} ({span}; "
+            print(f"opspec evaluate: {EXPORT_FILES[fmt]} will be about {_bytes(size)} ({span}; "
                   "estimated from one simulated user-day)", file=sys.stderr)
     cap = trace_max_bytes()
     over = [fmt for fmt, size in sizes.items() if size > cap]

@@ -179,7 +179,7 @@ def _replicate(args: argparse.Namespace, store: Any, plan: Any, swept: Any, work
             raise with_resume_hint(error, store, plan) from None
         except KeyboardInterrupt:
             stored = sum(len(store.finished(d.label)) for d in plan.designs)
-            print(f"evaluate: stopped; {stored} of {plan.users * len(plan.designs)} "
+            print(f"opspec evaluate: stopped; {stored} of {plan.users * len(plan.designs)} "
                   f"replications are stored in {store.path}; finish with `opspec evaluate "
                   f"--resume --out {store.folder}`", file=sys.stderr)
             raise

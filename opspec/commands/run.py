@@ -194,7 +194,7 @@ def run(args: argparse.Namespace) -> int:
         _print_monitors(out, monitors)
     trace_lost = sink is not None and sink.failure is not None
     if sink is not None and sink.truncated is not None:      # the cap, or a full disk
-        print(f"opspec: {'error' if trace_lost else 'note'}: {sink.message()} "
+        print(f"opspec run: {'error' if trace_lost else 'note'}: {sink.message()} "
               f"({sink.dropped:,} not written)", file=sys.stderr)
     device_faults = any(info.get("faults") for info in (device_report or {}).values())
     summary = result.summary

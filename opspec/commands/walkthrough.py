@@ -179,7 +179,7 @@ def run(args: argparse.Namespace) -> int:
             cue.close()
             session.close()
     if session.failure is not None:            # shown in the app; said again in one line
-        print(f"opspec: {session.failure}", file=sys.stderr)
+        print(f"opspec walkthrough: {session.failure}", file=sys.stderr)
     # the end in words, as the app showed it: metrics, response times, the recording and the
     # commands that replay it (quoted: they paste as they are)
     print("\n".join(session.summary_lines()))

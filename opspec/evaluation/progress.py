@@ -26,7 +26,7 @@ class LogProgress(Progress):
         self.total, self.already, self.done = total, already, already
         self._start = self._last = time.perf_counter()
         if already:
-            print(f"evaluate: resuming, {already} of {total} {self.label} already stored",
+            print(f"opspec evaluate: resuming, {already} of {total} {self.label} already stored",
                   file=self.stream, flush=True)
 
     def advance(self, n: int) -> None:
@@ -45,7 +45,7 @@ class LogProgress(Progress):
             left = f"about {(self.total - self.done) / rate:.0f} s left"
         else:
             left = "time left not known yet"
-        print(f"evaluate: {self.done}/{self.total} {self.label} ({rate:.0f}/s, {left})",
+        print(f"opspec evaluate: {self.done}/{self.total} {self.label} ({rate:.0f}/s, {left})",
               file=self.stream, flush=True)
 
     def finish(self) -> None:

@@ -28,7 +28,7 @@ HANGS = {
     "loop": ("looping", "spin"),
     "zero_timer": ("ticking", "A, wait"),
 }
-START = "opspec: the simulated clock stopped advancing at t=0.000 s (d1 00:00:00): "
+START = "the simulated clock stopped advancing at t=0.000 s (d1 00:00:00): "
 
 
 @pytest.fixture(autouse=True)
@@ -36,11 +36,14 @@ def small_limit(monkeypatch: pytest.MonkeyPatch) -> None:
     monkeypatch.setenv("OPSPEC_MAX_INSTANT_STEPS", "20000")
 
 
-def one_line(stderr: str, process: str, cycle: str) -> str:
-    lines = [line for line in stderr.splitlines() if line.startswith("opspec: ")]
+def one_line(stderr: str, command: str, process: str, cycle: str) -> str:
+    """The one line ``opspec COMMAND`` said about the cycle, begun with that command (the
+    spec's load warnings, such as a cycle of subflows, are said before it)."""
+    lines = [line for line in stderr.splitlines()
+             if line.startswith("opspec") and ": warning: " not in line]
     assert len(lines) == 1, stderr
     [line] = lines
-    assert line.startswith(START), line
+    assert line.startswith(f"opspec {command}: {START}"), line
     assert f"process {process!r} (" in line and f"): {cycle} (" in line, line
     assert "Traceback" not in stderr
     return line
@@ -53,7 +56,7 @@ def test_opspec_run_exits_1_with_one_line(name: str, capsys: pytest.CaptureFixtu
     status = main(["run", str(SPECS / f"{name}.xpdl"), "--timeline", "none",
                    "--until", "3600"])
     assert status == 1
-    one_line(capsys.readouterr().err, *HANGS[name])
+    one_line(capsys.readouterr().err, "run", *HANGS[name])
     assert time.perf_counter() - began < 30
 
 
@@ -65,7 +68,7 @@ def test_opspec_run_in_a_process_with_the_default_limit_ends_within_seconds(
                           capture_output=True, text=True, timeout=120, check=False, env=env,
                           cwd=tmp_path)
     assert done.returncode == 1
-    line = one_line(done.stderr, "spin", "B, C")
+    line = one_line(done.stderr, "run", "spin", "B, C")
     from opspec.engine.zero_time import MAX_INSTANT_STEPS
 
     assert f"{MAX_INSTANT_STEPS:,} steps ran at that instant" in line
@@ -129,7 +132,7 @@ def test_opspec_walkthrough_that_cannot_start_exits_1(capsys: pytest.CaptureFixt
                                                       ) -> None:
     status = main(["walkthrough", str(SPECS / "loop.xpdl"), "--no-record"])
     assert status == 1
-    one_line(capsys.readouterr().err, "looping", "spin")
+    one_line(capsys.readouterr().err, "walkthrough", "looping", "spin")
 
 
 def test_opspec_testing_simulate_raises_it() -> None:
@@ -167,7 +170,7 @@ def test_a_trace_file_stops_at_its_cap_and_says_so(tmp_path: Path,
     assert status == 0
     notes = [line for line in capsys.readouterr().err.splitlines() if "cap" in line]
     assert len(notes) == 1
-    assert notes[0].startswith(f"opspec: note: the trace {trace} reached its cap of 20,000 "
+    assert notes[0].startswith(f"opspec run: note: the trace {trace} reached its cap of 20,000 "
                                "bytes at t=")
     assert "OPSPEC_TRACE_MAX_BYTES" in notes[0]
     events = list(read_trace(trace))

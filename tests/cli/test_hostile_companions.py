@@ -126,8 +126,9 @@ def test_a_fifo_among_the_device_profiles_is_refused(tmp_path: Path) -> None:
     for command in (["run", str(SPEC), "--until", "60"], ["walkthrough", str(SPEC)]):
         done = opspec(*command, "--bind", "dispenser=auto", "--devices", str(profiles))
         assert done.returncode == 2, done.stderr
-        assert one_line(done.stderr) == (f"opspec: cannot read device profile {profiles}/"
-                                         "evil.toml: it is a named pipe (FIFO), not a regular file")
+        assert one_line(done.stderr) == (f"opspec {command[0]}: cannot read device profile "
+                                         f"{profiles}/evil.toml: it is a named pipe (FIFO), "
+                                         "not a regular file")
 
 
 def test_a_fifo_given_as_the_device_profile_folder_is_refused(tmp_path: Path) -> None:
@@ -249,7 +250,8 @@ def test_an_unreadable_file_given_to_an_option_exits_2(
     status = main(_arguments(option, path, tmp_path))
     out, err = capsys.readouterr()
     assert status == 2, (out, err)
-    assert one_line(err) == f"opspec: {path}: {OPTIONS[option][1]}: Permission denied"
+    command = option.split()[0]
+    assert one_line(err) == f"opspec {command}: {path}: {OPTIONS[option][1]}: Permission denied"
 
 
 def test_an_unreadable_device_profile_exits_2(tmp_path: Path, deny: Callable[[Path], Path],
@@ -261,7 +263,7 @@ def test_an_unreadable_device_profile_exits_2(tmp_path: Path, deny: Callable[[Pa
                    "--devices", str(profiles)])
     assert status == 2
     assert one_line(capsys.readouterr().err) == (
-        f"opspec: cannot read device profile {profile}: Permission denied")
+        f"opspec run: cannot read device profile {profile}: Permission denied")
 
 
 def test_a_report_template_that_cannot_be_read_is_refused_before_the_runs(
@@ -278,7 +280,8 @@ def test_a_report_template_that_cannot_be_read_is_refused_before_the_runs(
                        str(tmp_path / f"out-{path.stem}"), "--report-template", str(path)])
         _, err = capsys.readouterr()
         assert status == 2
-        assert one_line(err) == f"opspec: cannot read the report template {path}: {why}"
+        assert one_line(err) == (f"opspec evaluate: cannot read the report template {path}: "
+                                 f"{why}")
         assert not (tmp_path / f"out-{path.stem}").exists()     # refused before any run
 
 

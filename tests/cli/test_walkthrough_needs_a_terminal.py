@@ -18,7 +18,7 @@ def test_without_a_terminal_the_walkthrough_refuses_at_once(tmp_path: Path) -> N
                           stdin=subprocess.DEVNULL, capture_output=True, text=True,
                           cwd=tmp_path, env=env, timeout=120, check=False)
     assert done.returncode == 2, done.stdout + done.stderr
-    assert done.stderr.startswith("opspec: the walkthrough needs a terminal")
+    assert done.stderr.startswith("opspec walkthrough: the walkthrough needs a terminal")
     assert "standard input is not one" in done.stderr and "--script FILE" in done.stderr
     assert "Traceback" not in done.stderr
     assert not (tmp_path / "walkthroughs").exists()

@@ -47,7 +47,7 @@ VARYING: tuple[tuple[re.Pattern[str], str], ...] = (
     (re.compile(r" in [\d.]+s( \(\d+:\d+:\d+\))?$", re.M), " in Ts"),
 )
 #: Lines of stderr that only show progress on a terminal.
-PROGRESS = re.compile(r"^evaluate: \d+/\d+ users .*$\n?", re.M)
+PROGRESS = re.compile(r"^opspec evaluate: \d+/\d+ users .*$\n?", re.M)
 
 
 @dataclass(frozen=True)

@@ -66,7 +66,7 @@ def test_opspec_run_exits_1_with_one_line_and_keeps_the_trace(tmp_path: Path) ->
                           env={**__import__("os").environ, "OPSPEC_MAX_INSTANT_STEPS": "20000"})
     assert done.returncode == 1
     [line] = done.stderr.strip().splitlines()
-    assert line.startswith("opspec: the simulated clock stopped advancing at t=0.000 s")
+    assert line.startswith("opspec run: the simulated clock stopped advancing at t=0.000 s")
     assert "Traceback" not in done.stderr
     assert trace.read_text().count('"activity.started"') > 1000
 

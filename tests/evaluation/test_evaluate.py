@@ -192,7 +192,7 @@ def test_summary_table_on_a_terminal_run(tmp_path, capsys):
     out = captured.out
     assert status == 0
     # not a terminal: plain progress lines on stderr, ending with the total
-    assert "evaluate: 3/3 users (" in captured.err and "done)" in captured.err
+    assert "opspec evaluate: 3/3 users (" in captured.err and "done)" in captured.err
     assert "95 % CI" in out and "taken_rate" in out and "%" in out
     assert f"report: {tmp_path / 't' / 'report.html'}" in out
 

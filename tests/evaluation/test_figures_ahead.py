@@ -153,7 +153,7 @@ def test_ctrl_c_at_the_index_does_not_wait_for_the_figures_sent(
     assert time.monotonic() - started < 20
     assert sent.exists()
     assert status == 130
-    assert "evaluate: stopped; 6 of 6 replications are stored" in err
+    assert "opspec evaluate: stopped; 6 of 6 replications are stored" in err
     assert len(multiprocessing.active_children()) == before
     assert not [t for t in threading.enumerate() if t.name == "opspec-drawing" and t.is_alive()]
     assert not (tmp_path / "run" / "figures").exists()

@@ -154,8 +154,8 @@ def test_case_per_instance_makes_one_case_per_workflow_instance(tmp_path, no_rep
 def test_the_size_estimate_is_printed_and_close(run):
     out, _, err = run
     for name in ("traces.xes", "traces.jsonocel", "traces.jsonl"):
-        line = next(x for x in err.splitlines() if x.startswith(f"evaluate: {name} will be "
-                                                               "about"))
+        line = next(x for x in err.splitlines()
+                    if x.startswith(f"opspec evaluate: {name} will be about"))
         number, unit = line.split("about ")[1].split(" (")[0].split()
         estimate = float(number) * {"kB": 1e3, "MB": 1e6, "GB": 1e9}[unit]
         actual = (out / name).stat().st_size
