@@ -31,6 +31,7 @@ the wall clock.
 from __future__ import annotations
 
 import asyncio
+import contextvars
 import gc
 import math
 import threading
@@ -80,12 +81,18 @@ class WallClock:
         return _perf() - self.wall_due(sim_time)
 
 
-_ACTIVE: WallClock | None = None
+# The loop's clock, seen only by the code its own asyncio task runs (the engine's steps and
+# the input it drains): a module global was seen by every thread and task of the process, so a
+# wall-clock run in one thread (a device test's, a study session's) turned the timing of a
+# simulated run in another into wall-clock times, and two loops in one event loop restored
+# each other's clock out of turn.
+_ACTIVE: contextvars.ContextVar[WallClock | None] = contextvars.ContextVar(
+    "opspec_wall_clock", default=None)
 
 
 def active() -> WallClock | None:
-    """The clock of the wall-clock loop running now on this process, if any."""
-    return _ACTIVE
+    """The clock of the wall-clock loop this code runs in, if any."""
+    return _ACTIVE.get()
 
 
 def run_realtime(sim: Simulation, until: float | None, speed: float) -> dict[str, Any]:
@@ -151,13 +158,12 @@ def _drain_posts(sim: Simulation, posts: _Posts, clock: WallClock,
 
 async def drive(sim: Simulation, until: float | None, speed: float) -> dict[str, Any]:
     """The asyncio stepping loop (usable inside an existing loop, e.g. the TUI's)."""
-    global _ACTIVE
     posts = _Posts(asyncio.get_running_loop())
     posted = posts.posted
     coarse, spin = COARSE_S, SPIN_S    # read once (benchmarks/realtime_drift.py sets 0, 0)
     env = sim.env
     clock = WallClock(env.now, _perf(), speed)
-    previous, _ACTIVE = _ACTIVE, clock
+    token = _ACTIVE.set(clock)
     sim.wake = posts.wake
     lateness = array("d")              # one double per event, for the percentiles
     late_max = 0.0
@@ -201,7 +207,10 @@ async def drive(sim: Simulation, until: float | None, speed: float) -> dict[str,
     finally:
         gc.unfreeze()
         sim.wake = None
-        _ACTIVE = previous
+        try:
+            _ACTIVE.reset(token)
+        except ValueError:      # closed from another context (a loop abandoned, collected)
+            pass
     return summarise(lateness, late_max, speed)
 
 

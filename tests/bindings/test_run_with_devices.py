@@ -130,7 +130,7 @@ def test_unopenable_port_stops_the_run_before_it_begins(capsys):
     status, _, output = run(capsys, "--bind", "alarm=/dev/opspec-no-such-port")
     assert status == 2
     assert "/dev/opspec-no-such-port" in output and "No such file" in output
-    assert "opspec run:" not in output          # nothing ran
+    assert ", seed " not in output   # nothing ran: no header "opspec run: NAME (SPEC), seed N, ..."
     assert "Traceback" not in output
 
 
@@ -168,7 +168,7 @@ def test_bind_of_a_participant_the_spec_lacks_is_a_usage_error_naming_the_bindab
     assert "--bind 'motors=emulator://cart_motors': the spec has no participant 'motors'" \
         in output
     assert "bindable participants of this spec: alarm, dispenser" in output
-    assert "opspec run:" not in output          # nothing ran
+    assert ", seed " not in output   # nothing ran: no header "opspec run: NAME (SPEC), seed N, ..."
 
 
 def test_speed_with_auto_falling_back_to_simulation_says_it_has_no_effect(capsys, tmp_path):

@@ -122,3 +122,54 @@ def test_a_device_answer_is_placed_at_its_wall_clock_arrival(tmp_path: Path,
     assert placed == pytest.approx(clock.sim_at(posted), abs=0.003 * speed)
     # and at least the device's 10 ms after the offer
     assert placed - offered >= 0.010 * speed * 0.999
+
+
+def test_a_wall_clock_run_in_another_thread_leaves_a_simulated_runs_timing_simulated(
+        tmp_path: Path) -> None:
+    """Two runs in one process (a device run in a thread, a study server's sessions): while
+    one runs against the wall clock, the other's --timing is still in simulated time. The
+    loop's clock was a module global, which the other thread's timing read as its own."""
+    ref: list[Simulation] = []
+    inside = threading.Event()
+
+    class Telling(Device):
+        def offer(self, item: Any) -> None:
+            inside.set()                        # the wall-clock loop is running
+            super().offer(item)
+
+    device = Telling(ref)
+    wall = Simulation(load_spec(periodic(tmp_path, 0.01)),
+                      EngineConfig(realtime=True, speed=1.0), performers={"dev": device})
+    ref.append(wall)
+    thread = threading.Thread(target=lambda: wall.run(until=1.5), daemon=True)
+    thread.start()
+    assert inside.wait(10.0)
+    ticks = tmp_path / "simulated"          # (periodic writes tick.xpdl in the folder)
+    ticks.mkdir()
+    listener = TimingListener()
+
+    class Instant:
+        """Performs ``act`` at once."""
+
+        def __init__(self) -> None:
+            self.applications = {"act": self}
+
+        def attach(self, session: Any) -> None:
+            self.session = session
+
+        def offer(self, item: Any) -> None:
+            self.session.complete(item)
+
+        def withdraw(self, item: Any, reason: str) -> None:
+            pass
+
+    performer = Instant()
+    simulated = Simulation(load_spec(periodic(ticks, 2.0)), EngineConfig(),
+                           performers={"dev": performer}, listeners=[listener])
+    simulated.run(until=20.0)
+    running = thread.is_alive()
+    thread.join(10.0)
+    tick = listener.summary()["tick"]
+    assert running                      # the wall-clock run was going on all along
+    assert tick["clock"] == "simulated"
+    assert tick["response_max_s"] == 0.0      # answered at once, in simulated time

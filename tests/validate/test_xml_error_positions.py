@@ -45,7 +45,7 @@ def test_a_mismatched_tag_is_placed_once_by_every_command(command, tmp_path, cap
     said = ("not well-formed XML at column 19: Opening and ending tag mismatch: <Foo> of line "
             "47 and </Application>")
     line = _error_line(out.out + out.err, f"{spec}:52: " if command[0] != "run"
-                       else f"opspec: {spec}:52: ")
+                       else f"opspec run: {spec}:52: ")
     assert line.endswith(f"{said}; {HINT}"), line
     message = line.split(f"{spec}:52: ", 1)[1]
     assert "52" not in message and message.count("column") == 1    # the position, once
