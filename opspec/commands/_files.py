@@ -123,12 +123,11 @@ def _overwrite(writes: Iterable[Named], reads: Iterable[Named], *, folders: Iter
     return None
 
 
-def refuse_overwrite(command: str, writes: Iterable[Named], reads: Iterable[Named], *,
+def refuse_overwrite(writes: Iterable[Named], reads: Iterable[Named], *,
                      folders: Iterable[Named] = (), example: str = "") -> None:
     """Raise a :class:`ConfigurationError` (exit status 2, nothing written) when an output
     would replace an input (:func:`overwrite_problem`). Its message carries no prefix:
-    :func:`opspec.cli.main` begins it with the command that was run, so ``command`` (the
-    callers name it) is not used."""
+    :func:`opspec.cli.main` begins it with the command that was run."""
     problem = _overwrite(writes, reads, folders=folders, example=example)
     if problem is not None:
         raise ConfigurationError(problem)

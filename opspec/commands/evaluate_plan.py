@@ -198,4 +198,4 @@ def refuse_inputs_in_out(args: argparse.Namespace, plan: Any, out: Path) -> None
     writes = [(f"--out {out}: {name}", out / name) for name in (
         *OUT_FILES, *(EXPORT_FILES[f] for f in plan.export),
         *(EXPORT_FILES[f] + ".partial" for f in plan.export))]
-    refuse_overwrite("evaluate", writes, reads, folders=[(f"--out {out}", out / "figures")])
+    refuse_overwrite(writes, reads, folders=[(f"--out {out}", out / "figures")])

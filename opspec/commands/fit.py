@@ -134,7 +134,7 @@ def _fit(args: argparse.Namespace) -> int:
     out = Path(args.output) if args.output != "-" else None
     from opspec.commands._files import refuse_overwrite
 
-    refuse_overwrite("fit", [("-o", out)], [("a TRACE", path) for path in paths])
+    refuse_overwrite([("-o", out)], [("a TRACE", path) for path in paths])
     name = args.name or (out.stem.removesuffix(".users") if out else "fitted")
     result = fit_traces(paths, lane=args.lane, name=name, criterion=args.criterion,
                         min_per_user=args.min_per_user, persons=persons)

@@ -234,7 +234,7 @@ def _refuse_trace_over_input(args: argparse.Namespace, package: Any) -> None:
                  args.user_model).exists() else None),
              ("the companion user model", companion_user_model(args.spec)),
              ("--engine-config", args.engine_config), *spec_inputs(args.spec, package)]
-    refuse_overwrite("run", [("--trace", args.trace)], reads)
+    refuse_overwrite([("--trace", args.trace)], reads)
 
 
 def _real_deadlocks(result: RunResult, absent: list[dict[str, Any]]) -> list[dict[str, Any]]:

@@ -114,7 +114,7 @@ def run(args: argparse.Namespace) -> int:
         from opspec.commands._files import refuse_overwrite, spec_inputs
 
         # the recording and its trace beside it (tui.session) may not replace an input
-        refuse_overwrite("walkthrough", [
+        refuse_overwrite([
             ("--record", record), ("--record's trace", record.with_suffix(".trace.jsonl"))], [
             ("SPEC", args.spec),
             ("the user model", model_ref if model_ref and Path(model_ref).exists() else None),
