@@ -10,6 +10,7 @@ import shutil
 from pathlib import Path
 
 import pytest
+from nested_blocks import nested_blocks
 
 from opspec.cli import main
 
@@ -121,28 +122,6 @@ def test_extends_inside_the_folder_and_its_allowed_roots_still_work(tmp_path, mo
     assert load_user_model(sibling).activities == load_user_model(users).activities
 
 
-def _nested_blocks(path: Path, depth: int, *, cycle: bool = False) -> Path:
-    """A process whose BlockActivity's activity set holds a BlockActivity… ``depth`` deep,
-    or (``cycle``) whose last set's block refers back to the first set."""
-    sets = []
-    for i in range(1, depth + 1):
-        target = 1 if cycle and i == depth else i + 1
-        inner = (f'<Activity Id="b{i + 1}"><BlockActivity ActivitySetId="s{target}"/>'
-                 "</Activity>" if i < depth or cycle else
-                 '<Activity Id="leaf"><Implementation><No/></Implementation></Activity>')
-        sets.append(f'<ActivitySet Id="s{i}"><Activities>{inner}</Activities></ActivitySet>')
-    path.write_text(
-        '<?xml version="1.0" encoding="UTF-8"?>\n'
-        '<Package xmlns="http://www.wfmc.org/2008/XPDL2.1" Id="deep" Name="deep">\n'
-        "<PackageHeader><XPDLVersion>2.1</XPDLVersion><Vendor>t</Vendor>"
-        "<Created>2026-01-01</Created></PackageHeader>\n"
-        '<WorkflowProcesses><WorkflowProcess Id="p"><ProcessHeader/>\n'
-        f"<ActivitySets>{''.join(sets)}</ActivitySets>\n"
-        '<Activities><Activity Id="b1"><BlockActivity ActivitySetId="s1"/></Activity>'
-        "</Activities>\n</WorkflowProcess></WorkflowProcesses></Package>\n", encoding="utf-8")
-    return path
-
-
 @pytest.mark.parametrize("command", [["check"], ["validate"], ["run", "--until", "10"],
                                      ["compile"]])
 @pytest.mark.parametrize("shape", ["1500-deep", "cycle"])
@@ -151,7 +130,7 @@ def test_deeply_nested_or_cyclic_blocks_are_located_errors(command, shape, tmp_p
     # 1,500 deep is past Python's recursion limit (1,000): a guard that recursed would crash
     # here as the unguarded compile does (an internal RecursionError), and the file is a
     # quarter of the 5,000-deep one (the loader's cost grows faster than the depth)
-    spec = _nested_blocks(tmp_path / "deep.xpdl", 1500 if shape == "1500-deep" else 2,
+    spec = nested_blocks(tmp_path / "deep.xpdl", 1500 if shape == "1500-deep" else 2,
                           cycle=shape == "cycle")
     status = main([command[0], str(spec), *command[1:]])
     out = capsys.readouterr()
@@ -162,7 +141,7 @@ def test_deeply_nested_or_cyclic_blocks_are_located_errors(command, shape, tmp_p
 
 
 def test_a_few_nested_blocks_still_run(tmp_path, capsys) -> None:
-    spec = _nested_blocks(tmp_path / "three.xpdl", 3)
+    spec = nested_blocks(tmp_path / "three.xpdl", 3)
     assert main(["check", str(spec)]) == 0
     assert main(["run", str(spec), "--until", "10"]) == 0
 

@@ -10,6 +10,7 @@ import re
 from pathlib import Path
 
 import pytest
+from nested_blocks import nested_blocks
 
 from opspec.cli import main
 from opspec.xpdl.loader import parse_bytes
@@ -112,22 +113,7 @@ def test_check_says_what_to_change_in_a_file_nested_past_the_readers_limit(
 
 def test_check_says_a_file_with_blocks_nested_too_deeply_was_read(tmp_path, capsys) -> None:
     # the file was read (validate lists its nesting error); "could not be read" was wrong
-    sets = []
-    for i in range(1, 103):
-        inner = (f'<Activity Id="b{i + 1}"><BlockActivity ActivitySetId="s{i + 1}"/>'
-                 "</Activity>" if i < 102 else
-                 '<Activity Id="leaf"><Implementation><No/></Implementation></Activity>')
-        sets.append(f'<ActivitySet Id="s{i}"><Activities>{inner}</Activities></ActivitySet>')
-    spec = tmp_path / "blocks.xpdl"
-    spec.write_text(
-        '<?xml version="1.0" encoding="UTF-8"?>\n'
-        '<Package xmlns="http://www.wfmc.org/2008/XPDL2.1" Id="deep" Name="deep">\n'
-        "<PackageHeader><XPDLVersion>2.1</XPDLVersion><Vendor>t</Vendor>"
-        "<Created>2026-01-01</Created></PackageHeader>\n"
-        '<WorkflowProcesses><WorkflowProcess Id="p"><ProcessHeader/>\n'
-        f"<ActivitySets>{''.join(sets)}</ActivitySets>\n"
-        '<Activities><Activity Id="b1"><BlockActivity ActivitySetId="s1"/></Activity>'
-        "</Activities>\n</WorkflowProcess></WorkflowProcesses></Package>\n", encoding="utf-8")
+    spec = nested_blocks(tmp_path / "blocks.xpdl", 102)
     assert main(["check", str(spec)]) == 1
     out = capsys.readouterr().out.splitlines()
     assert "nested more than 100 blocks deep" in out[0]
