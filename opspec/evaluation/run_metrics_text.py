@@ -65,12 +65,12 @@ def _counts(definition: MetricDefinition | None, metrics: Mapping[str, Mapping[s
 def _ratio(name: str, value: Mapping[str, Any], counts: tuple[int, int] | None) -> str:
     if counts is None:                  # of durations, of other ratios: the value alone
         return figure(value.get("value"))
-    taken, due = counts
+    part, whole = counts
     # "k of 0", not "no doses_due": every ratio of counts ends in the same "(k of n)", as
     # evaluate's pooled column, so the 0 that leaves no value stands where the eye looks for
     # the denominator, and the line stays true when the numerator is not 0
-    if due == 0:
-        return f"{figure(None)} ({taken} of 0)"
+    if whole == 0:
+        return f"{figure(None)} ({part} of 0)"
     from opspec.evaluation.tables import fmt, is_rate
     from opspec.statistics.proportions import is_proportion
 
@@ -78,6 +78,6 @@ def _ratio(name: str, value: Mapping[str, Any], counts: tuple[int, int] | None) 
     # and 1) and the counts are a proportion (is_proportion, evaluate's test for its
     # interval); the name matters too: alarms_per_dose is 4 of 4 in some runs, and
     # evaluate never shows it as 100.00 %
-    if is_proportion([(taken, due)]) and is_rate(name, value):
-        return f"{fmt(value.get('value'), percent=True)} ({taken} of {due})"
-    return f"{figure(value.get('value'))} ({taken} of {due})"
+    if is_proportion([(part, whole)]) and is_rate(name, value):
+        return f"{fmt(value.get('value'), percent=True)} ({part} of {whole})"
+    return f"{figure(value.get('value'))} ({part} of {whole})"
