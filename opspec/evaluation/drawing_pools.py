@@ -84,10 +84,12 @@ class _Drawer:
     it the jobs waiting in the pools' queue one at a time (whichever process is free takes
     the next figure; a job waits there, not in a pipe, so that a large one never blocks the
     evaluate process while the drawing processes are busy), and its process id (the first's
-    known at its fork; the others say theirs as they start)."""
+    known at its fork; the others say theirs as they start, and are then held by a pidfd,
+    which stays that process's whatever becomes of its pid)."""
 
     def __init__(self, end: Any, pid: int | None, pools: _Pools) -> None:
         self.end, self.pid, self._pools = end, pid, pools
+        self.pidfd: int | None = None
         self.gone = False                   # takes no more jobs: told to end, or gone
         self.known = threading.Event()      # its pid is known, or it is gone
         self.thread = threading.Thread(target=self._hand_over, name="opspec-drawing",
@@ -101,6 +103,7 @@ class _Drawer:
         try:
             if self.pid is None:
                 self.pid = self.end.recv()  # a process forked by the first says who it is
+                self.pidfd = _pidfd(self.pid)
             self.known.set()
             while True:
                 job = self._pools.jobs.get()
@@ -222,6 +225,7 @@ class _Pools:
             drawer.thread.join()
         if self._first is not None:
             self._first.join()              # which waits for the processes it forked
+        self._close_pidfds(wait=5.0)        # (reaped by the first: no wait)
 
     def end_now(self) -> None:
         """End every drawing process without waiting for its work, and then the threads
@@ -237,7 +241,10 @@ class _Pools:
             if drawer.known.is_set() and not drawer.gone and drawer.pid not in (None, *ended):
                 ended.add(drawer.pid)
                 with contextlib.suppress(OSError):
-                    os.kill(drawer.pid, signal.SIGTERM)
+                    if drawer.pidfd is not None:
+                        signal.pidfd_send_signal(drawer.pidfd, signal.SIGTERM)
+                    else:
+                        os.kill(drawer.pid, signal.SIGTERM)
 
         for drawer in self._drawers[1:]:
             end(drawer)
@@ -259,6 +266,27 @@ class _Pools:
             self.jobs.put(None)             # a thread waiting for a job finds the pipe shut
         for drawer in self._drawers:
             drawer.thread.join(5)
+        # a signal is only a request, and the first's end (which join waits for) is seen
+        # once the processes it forked have closed their files, a moment before they have
+        # ended: on a busy machine one was still there after the block (CI saw it)
+        self._close_pidfds(wait=5.0)
+
+    def _close_pidfds(self, wait: float) -> None:
+        """Wait up to ``wait`` seconds for the processes forked by the first to have ended
+        (each pidfd turns readable then; they are not this process's children, so it cannot
+        wait for them as such), and let the pidfds go."""
+        import select
+        import time
+
+        pidfds = [drawer.pidfd for drawer in self._drawers if drawer.pidfd is not None]
+        deadline = time.monotonic() + wait
+        for pidfd in pidfds:
+            with contextlib.suppress(OSError, ValueError):
+                select.select([pidfd], [], [], max(0.0, deadline - time.monotonic()))
+            with contextlib.suppress(OSError):
+                os.close(pidfd)
+        for drawer in self._drawers:
+            drawer.pidfd = None
 
 
 #: Within :func:`drawing_processes`: its processes (:class:`_Pools`).
@@ -309,8 +337,8 @@ def _fork_sibling(end: Any, ends: list[Any]) -> int:
             if other is not end:
                 other.close()
         _leave_ctrl_c()
-        _watch(first)
-        end.send(os.getpid())
+        end.send(os.getpid())               # said before the watch can end this process:
+        _watch(first)                       # the evaluate process then waits for its end
         _serve(end)
         status = 0
     finally:
@@ -318,6 +346,15 @@ def _fork_sibling(end: Any, ends: list[Any]) -> int:
             with contextlib.suppress(Exception):
                 stream.flush()
         os._exit(status)
+
+
+def _pidfd(pid: int) -> int | None:
+    """A pidfd of process ``pid`` (Linux 5.3 and later), or None where there is none or the
+    process is gone."""
+    try:
+        return os.pidfd_open(pid)
+    except (AttributeError, OSError):
+        return None
 
 
 #: How the first drawing process forks the others (a test refuses it).

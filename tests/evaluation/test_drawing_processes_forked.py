@@ -266,3 +266,32 @@ def test_a_block_ended_before_any_figure_ends_its_processes_without_waiting(
     assert time.monotonic() - started < 4.5         # (the stall this guards against: 5 s)
     assert _drawing_children() == 0
     assert _gone(int(pids.read_text()))
+
+
+def test_a_block_ended_early_returns_only_once_its_processes_have_ended(
+        tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    # a process forked by the first closes its files (its pipe, the first's sentinel, which
+    # the block's wait for the first watches) a moment before it has ended: on a busy machine
+    # CI once saw it still there after the block. Here that moment lasts half a second.
+    pids = tmp_path / "forked"
+
+    def slow_to_end(signum: int, frame: object) -> None:
+        os.closerange(3, 4096)
+        time.sleep(0.5)
+        os._exit(1)
+
+    def recording_fork() -> int:
+        pid = os.fork()
+        if pid:
+            pids.write_text(str(pid))
+        else:
+            signal.signal(signal.SIGTERM, slow_to_end)
+        return pid
+
+    monkeypatch.setattr(drawing_pools, "_fork", recording_fork)
+    with pytest.raises(KeyboardInterrupt), plots.drawing_processes(2):
+        pools = drawing_pools.started_pools()
+        assert pools is not None
+        _both(pools)                                # both have started and said who they are
+        raise KeyboardInterrupt
+    assert _gone(int(pids.read_text()))
