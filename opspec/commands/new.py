@@ -6,12 +6,14 @@ device workflow with a timed start, a reminder whose wait has a deadline, a retr
 escalation to a caregiver, and the user's manual lane; --template stove: a stove guard - the
 device watches, the user must confirm, the guard escalates by cutting the power),
 NAME.users.toml (its user model, picked up by opspec run and opspec evaluate because it sits
-beside the spec), test_NAME.py (spec tests: run them with 'python -m pytest NAME') and a
-README.md listing the commands to try. The spec validates, runs and passes its tests as
-written. The templates are package data (opspec/commands/templates/new/<template>/).
+beside the spec), test_NAME.py (spec tests, NAME as a Python name: test_pill_box.py for
+pill-box; run them with 'python -m pytest NAME') and a README.md listing the commands to try.
+The spec validates, runs and passes its tests as written. The templates are package data
+(opspec/commands/templates/new/<template>/).
 
 Exit status: 0 written; 2 the folder already exists (it is never overwritten), the name is
-not usable, or the folder cannot be written.
+not usable (no folder's name, such as '.', or a spec file's, such as pill.xpdl), or the folder
+cannot be written (nothing is left behind).
 """
 
 from __future__ import annotations

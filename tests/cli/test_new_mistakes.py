@@ -94,3 +94,10 @@ def test_the_readme_lists_each_of_opspecs_ways_to_use_the_spec(shape: str) -> No
     used = [line.split()[1] for line in block.splitlines() if line.startswith("opspec ")]
     assert set(used) <= set(commands)
     assert {"validate", "run", "evaluate", "check", "walkthrough"} <= set(used)
+
+
+def test_the_help_names_the_test_file_it_writes() -> None:
+    """The help said test_NAME.py; for pill-box the file is test_pill_box.py."""
+    help_text = " ".join(_subparsers(build_parser())["new"].format_help().split())
+    assert "test_pill_box.py for pill-box" in help_text
+    assert "test_pill_box.py" in render("pill-box")
