@@ -94,8 +94,9 @@ def _name_problem(typed: str, folder: Path) -> str | None:
                 "part names the files (e.g. 'opspec new pill_reminder' writes "
                 "pill_reminder/pill_reminder.xpdl)")
     if not _NAME.fullmatch(name) or "--" in name:
-        return (f"{name!r} cannot name a spec: use letters, digits, '_', '-' and '.', "
-                "starting with a letter or digit (e.g. 'pill_reminder')")
+        return (f"{name!r} cannot name a spec: use the letters a-z and A-Z (no accents), "
+                "digits, '_', '-' and '.', starting with a letter or digit (e.g. "
+                "'pill_reminder')")
     if name.lower().endswith(_SPEC_SUFFIXES):
         bare = folder.with_name(folder.stem)
         return (f"{typed!r} is a spec file's name, but NAME is the folder to create, and "

@@ -101,3 +101,11 @@ def test_the_help_names_the_test_file_it_writes() -> None:
     help_text = " ".join(_subparsers(build_parser())["new"].format_help().split())
     assert "test_pill_box.py for pill-box" in help_text
     assert "test_pill_box.py" in render("pill-box")
+
+
+def test_a_name_with_an_accent_is_told_which_letters_are_meant(
+        tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """'médicament' was refused with "use letters, digits, ...": é is a letter."""
+    assert main(["new", str(tmp_path / "médicament")]) == 2
+    assert "the letters a-z and A-Z (no accents)" in capsys.readouterr().err
+    assert list(tmp_path.iterdir()) == []
