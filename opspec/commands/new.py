@@ -6,18 +6,22 @@ device workflow with a timed start, a reminder whose wait has a deadline, a retr
 escalation to a caregiver, and the user's manual lane; --template stove: a stove guard - the
 device watches, the user must confirm, the guard escalates by cutting the power),
 NAME.users.toml (its user model, picked up by opspec run and opspec evaluate because it sits
-beside the spec), test_NAME.py (spec tests: run them with 'python -m pytest NAME') and a
-README.md listing the commands to try. The spec validates, runs and passes its tests as
-written. The templates are package data (opspec/commands/templates/new/<template>/).
+beside the spec), test_NAME.py (spec tests, NAME as a Python name: test_pill_box.py for
+pill-box; run them with 'python -m pytest NAME') and a README.md listing the commands to try.
+The spec validates, runs and passes its tests as written. The templates are package data
+(opspec/commands/templates/new/<template>/).
 
 Exit status: 0 written; 2 the folder already exists (it is never overwritten), the name is
-not usable, or the folder cannot be written.
+not usable (no folder's name, such as '.', or a spec file's, such as pill.xpdl), or the folder
+cannot be written (nothing is left behind).
 """
 
 from __future__ import annotations
 
 import argparse
+import contextlib
 import re
+import shlex
 import string
 import sys
 from importlib import resources
@@ -47,6 +51,8 @@ TEMPLATES: tuple[tuple[str, str], ...] = (
 # A name is used in file names, an XML comment and an XPDL Id: letters, digits, '_', '-', '.'
 # (no '--', which XML comments forbid), starting with a letter or digit.
 _NAME = re.compile(r"[A-Za-z0-9][A-Za-z0-9_.-]*")
+# NAME is the folder, so 'pill.xpdl' would write pill.xpdl/pill.xpdl.xpdl
+_SPEC_SUFFIXES = (".xpdl", ".bpmn", ".wfs")
 
 
 def register(subparsers: Any) -> None:
@@ -78,29 +84,66 @@ def identifier(name: str) -> str:
     return ident if ident[:1].isalpha() or ident[:1] == "_" else f"spec_{ident}"
 
 
+def _name_problem(typed: str, folder: Path) -> str | None:
+    """Why ``typed`` (the NAME argument, as ``folder``) cannot be the new spec's folder, or
+    None. Said with what was typed: ``.`` has no last part, and quoting ``''`` reads as if
+    nothing had been typed."""
+    name = folder.name
+    if name in ("", ".", ".."):
+        return (f"{typed!r} names no new folder: NAME is the folder to create, and its last "
+                "part names the files (e.g. 'opspec new pill_reminder' writes "
+                "pill_reminder/pill_reminder.xpdl)")
+    if not _NAME.fullmatch(name) or "--" in name:
+        return (f"{name!r} cannot name a spec: use the letters a-z and A-Z (no accents), "
+                "digits, '_', '-' and '.', starting with a letter or digit (e.g. "
+                "'pill_reminder')")
+    if name.lower().endswith(_SPEC_SUFFIXES):
+        bare = folder.with_name(folder.stem)
+        return (f"{typed!r} is a spec file's name, but NAME is the folder to create, and "
+                f"its last part names the files: opspec new {shlex.quote(str(bare))} "
+                f"writes {bare / (bare.name + '.xpdl')}")
+    return None
+
+
 def run(args: argparse.Namespace) -> int:
     folder = Path(args.name)
     name = folder.name
-    if not _NAME.fullmatch(name) or "--" in name:
-        print(f"opspec new: {name!r} cannot name a spec: use letters, digits, '_', '-' and "
-              "'.', starting with a letter or digit (e.g. 'pill_reminder')", file=sys.stderr)
+    problem = _name_problem(args.name, folder)
+    if problem:
+        print(f"opspec new: {problem}", file=sys.stderr)
         return 2
     if folder.exists() or folder.is_symlink():
         print(f"opspec new: {folder} already exists; nothing written (choose another name or "
               "move it away)", file=sys.stderr)
         return 2
     files = render(name, getattr(args, "template", "pill"))
+    # the folders mkdir makes, innermost first: a failed write takes them away again, so
+    # that trying again is not refused with "already exists" by a half-written folder
+    made = [folder, *(p for p in folder.parents if not p.exists())]
     try:
         folder.mkdir(parents=True)
         for file_name, text in files.items():
             (folder / file_name).write_text(text, encoding="utf-8")
     except OSError as error:
         reason = error.strerror or str(error)
-        print(f"opspec new: cannot write {folder}: {reason}", file=sys.stderr)
+        _remove(made, files)
+        print(f"opspec new: cannot write {folder}: {reason}; nothing written", file=sys.stderr)
         return 2
     spec = folder / f"{name}.xpdl"
     print(f"opspec new: wrote {folder}/ ({', '.join(files)})")
-    print(f"  try: opspec run {spec}")
-    print(f"       opspec evaluate {spec} --users 20 --days 2")
-    print(f"       python -m pytest {folder}")
+    # quoted, so that each line pasted into a shell runs as shown (a folder with a space)
+    print(f"  try: opspec run {shlex.quote(str(spec))}")
+    print(f"       opspec evaluate {shlex.quote(str(spec))} --users 20 --days 2")
+    print(f"       python -m pytest {shlex.quote(str(folder))}")
     return 0
+
+
+def _remove(made: list[Path], files: dict[str, str]) -> None:
+    """Take away what a failed :func:`run` wrote: ``files`` in the first of ``made``, then
+    the folders of ``made`` that are empty (only these: nothing else is touched)."""
+    for file_name in files:
+        with contextlib.suppress(OSError):
+            (made[0] / file_name).unlink(missing_ok=True)
+    for folder in made:
+        with contextlib.suppress(OSError):
+            folder.rmdir()
