@@ -14,7 +14,9 @@ one rule for each part of a run and hands the result to :func:`opspec.runs.build
   steps; every name it uses must be the spec's), ``user_model`` (a preset, a TOML path or a
   :class:`~opspec.usermodels.UserModel`, checked against the spec's user lane), ``user`` (a
   prepared :class:`~opspec.runs.User`: a person, a replay) or ``no_user``; with none of them,
-  the spec's companion ``SPEC.users.toml`` when its file has one, else nobody.
+  the spec's companion ``SPEC.users.toml`` when its file has one, else nobody
+  (:func:`side_files` names the files a run picks up beside the spec; ``opspec validate``
+  checks them with :func:`user_model_warnings`, as a run does).
 
 A :class:`PreparedRun` builds user ``u`` of the run as often as a door needs
 (:meth:`PreparedRun.build`), so a door running many users prepares once.
@@ -40,7 +42,7 @@ if TYPE_CHECKING:
     from opspec.runs import LoadedSpec, Run, RunOutcome, User
 
 __all__ = ["PreparedRun", "RunRequest", "companion_user_model", "gate", "open_gated",
-           "prepare", "run", "scripted_user"]
+           "prepare", "run", "scripted_user", "side_files", "user_model_warnings"]
 
 _EMPTY: Mapping[str, Any] = MappingProxyType({})
 
@@ -172,6 +174,14 @@ def companion_user_model(spec_path: str | Path | None) -> Path | None:
     return candidate if candidate.is_file() else None
 
 
+def side_files(spec_path: str | Path | None) -> dict[str, Path]:
+    """The files beside the spec's file that a run of it picks up by their name, by what they
+    are (``"user model"``: :func:`companion_user_model`); absent ones are left out.
+    ``opspec validate SPEC`` checks each as a run would."""
+    found = {"user model": companion_user_model(spec_path)}
+    return {what: path for what, path in found.items() if path is not None}
+
+
 def _spec(spec: Any) -> tuple[LoadedSpec, tuple[Any, ...], Path | None]:
     """The spec through the gate (:func:`opspec.runs.load`), validate's warnings on it and
     its file."""
@@ -227,7 +237,7 @@ def _user(request: RunRequest, loaded: LoadedSpec, path: Path | None
         return scripted_user(request.script, loaded.compiled), (), None
     ref = request.user_model
     if ref is None and not request.no_user:
-        ref = companion_user_model(path)
+        ref = side_files(path).get("user model")
     if ref is None:
         why = ("--no-user" if request.no_user
                else "no --script or --user-model, and no companion .users.toml")
@@ -235,9 +245,21 @@ def _user(request: RunRequest, loaded: LoadedSpec, path: Path | None
                            else "nobody (no user lane)"), (), None
     user = User.model(ref)
     named = str(ref) if isinstance(ref, (str, os.PathLike)) else None
+    return user, user_model_warnings(user.source, loaded.compiled), named
+
+
+def user_model_warnings(model: Any, compiled: Any) -> tuple[Any, ...]:
+    """The warnings of the user model ``model`` (a loaded
+    :class:`~opspec.usermodels.UserModel`) against the user lane of the spec ``compiled``;
+    refused (a :class:`~opspec.errors.UserModelError` at the file and key) when it does not
+    cover the lane. Every door checks a user model so, and ``opspec validate`` the spec's
+    companion."""
+    from opspec.engine.lanes import user_lane
+
+    lane = user_lane(compiled)
     if lane.empty:
-        return user, (), named
-    return user, tuple(user.source.validate_against(lane.manual, choices=lane.choices)), named
+        return ()
+    return tuple(model.validate_against(lane.manual, choices=lane.choices))
 
 
 def scripted_user(script: Any, compiled: Any) -> User:

@@ -3,10 +3,16 @@
 Load each PATH (a file, or a folder: every *.xpdl, *.xml and *.bpmn below it, sorted), run the
 structural checks and report every problem at once as 'path:line: severity: message (hint)',
 followed by a summary line; --json prints one JSON object per file instead (JSON Lines,
-opspec.xpdl.validate.FileReport.to_json). Codes are listed in docs/validation.md.
+opspec.xpdl.validate.FileReport.to_json, with each diagnostic's TOML key and the side files).
+Codes are listed in docs/validation.md.
 
-Exit status: 0 no errors; 1 errors in a spec; 2 usage or I/O (a path that does not exist, an
-unreadable file, a folder without specs).
+The files opspec run SPEC would read beside the spec are checked with it, as the run checks
+them: the companion user model SPEC.users.toml (read, and checked against the spec's user lane)
+and the world file the spec names (opspec:WorldFile). The summary names them ('1 file checked
+with pill.users.toml beside it'); one that is absent is no problem.
+
+Exit status: 0 no errors; 1 errors in a spec or a file beside it; 2 usage or I/O (a path that
+does not exist, an unreadable file, a folder without specs).
 """
 
 from __future__ import annotations
@@ -58,26 +64,56 @@ _FOREIGN_SCRIPTS = ("javascript", "java", "python", "groovy", "mvel", "ecmascrip
 
 
 def run(args: argparse.Namespace) -> int:
-    from opspec.xpdl.validate import spec_files, summary, validate_file
+    from opspec.xpdl.validate import spec_files, summary
 
     files, problems = spec_files(args.paths)
     for problem in problems:
         print(f"opspec validate: {problem}", file=sys.stderr)
     reports = []
+    beside: dict[str, bool] = {}          # name: checked (not only read)
     for path in files:
-        report = validate_file(path, strict=args.strict, extra=engine_checks)
+        report, side = _with_side_files(path, strict=args.strict)
         if args.schema:
             from opspec.xpdl.schema import add_schema
 
             report = add_schema(report, path, strict=args.strict)
         reports.append(report)
+        for side_file in side:
+            beside[side_file.path.name] = beside.get(side_file.path.name, True) and (
+                side_file.checked)
         if args.json:
-            print(json.dumps(report.to_json(), ensure_ascii=False))
+            doc = report.to_json()
+            # a problem in a TOML file (a side file) is placed by its key, which only the
+            # text line showed: activities.walk.duration
+            doc["diagnostics"] = [{**d.to_json(), **({"key": d.location.key}
+                                                     if d.location.key else {})}
+                                  for d in report.diagnostics]
+            doc["side_files"] = [f.to_json() for f in side]
+            print(json.dumps(doc, ensure_ascii=False))
         else:
             for line in report.lines():
                 print(line)
     if not args.json and reports:
-        print(summary(reports))
+        print(summary(reports, beside=[name for name, checked in beside.items() if checked],
+                      only_read=[name for name, checked in beside.items() if not checked]))
     if problems or any(r.unreadable for r in reports):
         return 2
     return 0 if all(r.ok for r in reports) else 1
+
+
+def _with_side_files(path: Any, *, strict: bool) -> tuple[Any, list[Any]]:
+    """The report on the spec at ``path`` with the problems of the files a run of it reads
+    beside it (:mod:`opspec.commands.validate_side_files`), and those files."""
+    import dataclasses
+
+    from opspec.commands.validate_side_files import check_side_files
+    from opspec.errors import Severity
+    from opspec.xpdl.validate import FileReport, merge_diagnostics, validate_spec
+
+    package, report = validate_spec(path, extra=engine_checks)
+    found, side = check_side_files(path, package, report.diagnostics)
+    diagnostics = merge_diagnostics(report.diagnostics, found) if found else report.diagnostics
+    if strict:          # every warning an error, the side files' too
+        diagnostics = tuple(dataclasses.replace(d, severity=Severity.ERROR)
+                            if d.severity is Severity.WARNING else d for d in diagnostics)
+    return FileReport(report.path, report.version, diagnostics), side

@@ -266,8 +266,12 @@ def _target(link: Path) -> str:
         return "?"
 
 
-def summary(reports: Sequence[FileReport]) -> str:
-    """``3 files checked: 1 with errors (4 errors, 2 warnings)`` and the like."""
+def summary(reports: Sequence[FileReport], beside: Sequence[str] = (),
+            only_read: Sequence[str] = ()) -> str:
+    """``3 files checked: 1 with errors (4 errors, 2 warnings)`` and the like; ``beside``
+    names the files checked with the specs (``1 file checked with pill.users.toml beside it:
+    …``), ``only_read`` those that could not be checked against a spec with errors (more than
+    four are counted)."""
     files = len(reports)
     errors = sum(r.count(Severity.ERROR) for r in reports)
     warnings = sum(r.count(Severity.WARNING) for r in reports)
@@ -281,5 +285,14 @@ def summary(reports: Sequence[FileReport]) -> str:
         verdict = f"{failed} with errors"
     else:
         verdict = "no errors"
-    return (f"{files} {noun} checked: {verdict} "
+    def listed(names: Sequence[str]) -> str:
+        return ", ".join(names) if len(names) <= 4 else plural(len(names), "side file")
+
+    checked = f"{files} {noun} checked"
+    if beside:
+        checked += f" with {listed(beside)} beside {'it' if files == 1 else 'them'}"
+    if only_read:
+        checked += (f" ({listed(only_read)} beside {'it' if files == 1 else 'them'} only read: "
+                    f"{'the spec has' if files == 1 else 'their spec has'} errors)")
+    return (f"{checked}: {verdict} "
             f"({plural(errors, 'error')}, {plural(warnings, 'warning')})")
