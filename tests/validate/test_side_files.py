@@ -188,9 +188,9 @@ def test_every_shipped_spec_validates_clean_with_its_side_files(
     assert len(specs) >= 5
     status, out = validate(capsys, *map(str, specs))
     assert status == 0, out
-    assert out == [f"{len(specs)} files checked with medication_cart_guidance.world.toml, "
-                   "medication_dispenser.users.toml, toy_sumo.world.toml, "
-                   "vacuum_cleaner.world.toml beside them: no errors (0 errors, 0 warnings)"]
+    assert out == [(f"{len(specs)} files checked with medication_cart_guidance.world.toml, "
+                    "medication_dispenser.users.toml, toy_sumo.world.toml, "
+                    "vacuum_cleaner.world.toml beside them: no errors (0 errors, 0 warnings)")]
     for spec in specs:          # each one names what it read
         status, out = validate(capsys, str(spec))
         assert status == 0, out
