@@ -3,7 +3,8 @@
 Load each PATH (a file, or a folder: every *.xpdl, *.xml and *.bpmn below it, sorted), run the
 structural checks and report every problem at once as 'path:line: severity: message (hint)',
 followed by a summary line; --json prints one JSON object per file instead (JSON Lines,
-opspec.xpdl.validate.FileReport.to_json, with each diagnostic's TOML key and the side files).
+opspec.xpdl.validate.FileReport.to_json, plus the key of a problem in a TOML file and the
+side files).
 Codes are listed in docs/validation.md.
 
 The files opspec run SPEC would read beside the spec are checked with it, as the run checks
