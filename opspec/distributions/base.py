@@ -10,16 +10,19 @@ from abc import ABC, abstractmethod
 from collections.abc import Callable
 from dataclasses import fields
 from statistics import NormalDist
-from typing import Any
-
-import numpy as np
-import numpy.typing as npt
+from typing import TYPE_CHECKING, Any, TypeAlias
 
 from opspec.errors import UserModelError
 
+if TYPE_CHECKING:
+    import numpy as np
+    import numpy.typing as npt
+
 __all__ = ["Distribution", "FloatArray", "ParameterError"]
 
-FloatArray = npt.NDArray[np.float64]
+# numpy is imported where an array is made, not here: a user model is loaded and checked
+# without it (`opspec validate SPEC` checks the companion user model: issue 31's start-up)
+FloatArray: TypeAlias = "npt.NDArray[np.float64]"
 _STD_NORMAL = NormalDist()
 _SQRT2 = math.sqrt(2.0)
 

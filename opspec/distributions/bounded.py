@@ -7,9 +7,7 @@ from __future__ import annotations
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass, field
-from typing import Any
-
-import numpy as np
+from typing import TYPE_CHECKING, Any
 
 from opspec.distributions.base import (
     Distribution,
@@ -21,6 +19,10 @@ from opspec.distributions.base import (
     _non_negative,
     _positive,
 )
+
+if TYPE_CHECKING:
+    # imported where an array is made (FloatArray: base.py)
+    import numpy as np
 
 __all__ = ["Empirical", "Triangular", "Uniform", "WithExponentialTail"]
 
@@ -47,6 +49,7 @@ class Triangular(Distribution):
         return self.quantile(float(rng.random()))
 
     def sample_many(self, rng: np.random.Generator, n: int) -> FloatArray:
+        import numpy as np
         u = rng.random(n)
         a, c, b = self.low, self.mode, self.high
         fc = (c - a) / (b - a)
@@ -136,6 +139,7 @@ class Empirical(Distribution):
     _array: FloatArray = field(init=False, repr=False, compare=False)
 
     def __post_init__(self) -> None:
+        import numpy as np
         if isinstance(self.values, (str, bytes)) or not isinstance(self.values, Sequence):
             raise ParameterError("values", "must be a list of durations in seconds")
         if not self.values:
@@ -152,6 +156,7 @@ class Empirical(Distribution):
         return x
 
     def sample_many(self, rng: np.random.Generator, n: int) -> FloatArray:
+        import numpy as np
         x = self._array[rng.integers(len(self.values), size=n)]
         if self.jitter > 0.0:
             x = np.maximum(0.0, x + self.jitter * rng.standard_normal(n))
@@ -166,11 +171,13 @@ class Empirical(Distribution):
         return float(self._array.var()) + self.jitter**2
 
     def cdf(self, x: float) -> float:
+        import numpy as np
         if self.jitter > 0.0:
             raise NotImplementedError("empirical with jitter: cdf is not available")
         return float(np.count_nonzero(self._array <= x)) / len(self.values)
 
     def quantile(self, q: float) -> float:
+        import numpy as np
         return float(np.quantile(self._array, _check_q(q)))
 
     def scaled(self, factor: float) -> Empirical:

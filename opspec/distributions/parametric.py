@@ -5,9 +5,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import Any, Self
-
-import numpy as np
+from typing import TYPE_CHECKING, Any, Self
 
 from opspec.distributions.base import (
     _STD_NORMAL,
@@ -22,6 +20,10 @@ from opspec.distributions.base import (
     _phi,
     _positive,
 )
+
+if TYPE_CHECKING:
+    # imported where an array is made (FloatArray: base.py)
+    import numpy as np
 
 __all__ = ["Constant", "ExGaussian", "Exponential", "Gamma", "LogNormal", "TruncatedNormal",
            "Weibull"]
@@ -41,6 +43,7 @@ class Constant(Distribution):
         return self.value
 
     def sample_many(self, rng: np.random.Generator, n: int) -> FloatArray:
+        import numpy as np
         return np.full(n, self.value, dtype=float)
 
     @property
@@ -92,6 +95,7 @@ class LogNormal(Distribution):
         return math.exp(self.mu + self.sigma * float(rng.standard_normal()))
 
     def sample_many(self, rng: np.random.Generator, n: int) -> FloatArray:
+        import numpy as np
         return np.exp(self.mu + self.sigma * rng.standard_normal(n))
 
     @property
@@ -247,6 +251,7 @@ class TruncatedNormal(Distribution):
         return self._from_uniform(float(rng.random()))
 
     def sample_many(self, rng: np.random.Generator, n: int) -> FloatArray:
+        import numpy as np
         from scipy import special  # type: ignore[import-untyped,unused-ignore]  # lazy: 0.3 s at start-up
 
         a, b = self._ab()

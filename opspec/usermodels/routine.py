@@ -20,13 +20,16 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
-
-import numpy as np
+from typing import TYPE_CHECKING
 
 from opspec import clock
 from opspec.errors import UserModelError
 from opspec.usermodels.distributions import ParameterError
 from opspec.usermodels.errors import check_probability
+
+if TYPE_CHECKING:
+    # a run imports it for its random streams; a check of a user model does not
+    import numpy as np
 
 __all__ = ["DAY", "Drift", "Routine", "RoutineState", "RoutineTracker", "Window",
            "parse_time_of_day"]
