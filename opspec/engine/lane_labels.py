@@ -62,7 +62,11 @@ class LaneLabels:
         if event.process is None:
             return ""
         if event.activity is not None and self.is_user(event):
-            return USER
+            # an activity in no lane of a user workflow (its end event, drawn with no
+            # performer) is shown in the workflow's lane, as its other activities are
+            own = (self.process_lane.get(event.process, "")
+                   if event.process in self.user_processes else "")
+            return _cut(own or USER, self.width)
         return _cut(self.process_lane.get(event.process, DEVICE), self.width)
 
     def is_user(self, event: Any) -> bool:

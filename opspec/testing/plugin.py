@@ -92,16 +92,20 @@ def _warned(node: pytest.Item | None, config: pytest.Config, result: Any) -> Non
 
 
 # ---------------------------------------------------------------- paths and specs
-def resolve_path(ref: str | Path, config: pytest.Config, near: Path | None) -> Path:
+def resolve_path(ref: str | Path, config: pytest.Config, near: Path | None,
+                 fix: str = "") -> Path:
     """``ref`` as an existing path: absolute, else next to ``near`` (a test file), else under
-    the rootdir. Fails the test with the places tried when none exists."""
+    the rootdir. Fails the test with the places tried when none exists (each once: a test in
+    the rootdir looks in one place), and ``fix``, what to correct, when given."""
     path = Path(ref)
     candidates = [path] if path.is_absolute() else [
         *([near.parent / path] if near is not None else []), config.rootpath / path]
     for candidate in candidates:
         if candidate.exists():
             return candidate.resolve()
-    pytest.fail(f"{ref}: file not found (looked at {', '.join(map(str, candidates))})",
+    places = list(dict.fromkeys(str(candidate) for candidate in candidates))
+    advice = f"; {fix}" if fix else ""
+    pytest.fail(f"{ref}: file not found (looked at {', '.join(places)}){advice}",
                 pytrace=False)
 
 
@@ -149,7 +153,10 @@ def spec(request: pytest.FixtureRequest) -> Any:
     if ref is None:
         pytest.fail("the 'spec' fixture needs @pytest.mark.spec('path/to/spec.xpdl') on the "
                     "test or a module-level SPEC = 'path/to/spec.xpdl'", pytrace=False)
-    path = resolve_path(ref, request.config, request.node.path)
+    where = request.node.path.name if request.node.path is not None else "the test file"
+    fix = (f"fix @pytest.mark.spec(...) in {where}" if marker is not None else
+           f"fix SPEC = ... in {where} (a path relative to it or to the rootdir)")
+    path = resolve_path(ref, request.config, request.node.path, fix)
     return load_cached(path, request.config)[0]
 
 
@@ -193,14 +200,18 @@ class Simulator:
             pytest.fail("simulate() needs a spec: simulate(spec, ...) with the 'spec' fixture "
                         "or a path", pytrace=False)
         if isinstance(spec, (str, Path)):
-            spec = load_cached(resolve_path(spec, self.config, self.near), self.config)[1]
+            spec = load_cached(resolve_path(spec, self.config, self.near,
+                                            "fix the spec path given to simulate()"),
+                               self.config)[1]
         else:
             spec = _compiled_for(spec, self.config)
         if isinstance(user_model, Path) or (isinstance(user_model, str)
                                             and user_model.endswith(".toml")):
-            user_model = resolve_path(user_model, self.config, self.near)
+            user_model = resolve_path(user_model, self.config, self.near,
+                                      "fix user_model= given to simulate()")
         if isinstance(script, (str, Path)):
-            script = resolve_path(script, self.config, self.near)
+            script = resolve_path(script, self.config, self.near,
+                                  "fix script= given to simulate()")
         try:
             result = simulate(spec, users=users, days=days, script=script,
                               user_model=user_model, seed=self.seed if seed is None else seed,

@@ -17,10 +17,11 @@ from collections.abc import Sequence
 from pathlib import Path
 from statistics import median
 
+from opspec.clock import try_duration
 from opspec.evaluation.run_metrics_text import metric_lines
 from opspec.tui.timing import Response
 
-__all__ = ["metric_lines", "replay_commands", "response_lines"]
+__all__ = ["metric_lines", "replay_commands", "response_lines", "until_text"]
 
 
 def response_lines(responses: Sequence[Response]) -> list[str]:
@@ -51,6 +52,27 @@ def replay_commands(spec: str | Path, record: str | Path, *, until: float | None
     stops there too (``--until``), so that it prints the numbers the summary shows, not
     those of a run that goes on without the person."""
     spec_q, record_q = shlex.quote(str(spec)), shlex.quote(str(record))
-    stop = "" if until is None else f" --until {until!r}"
+    stop = "" if until is None else f" --until {until_text(until)}"
     return (f"opspec walkthrough {spec_q} --replay {record_q}",
             f"opspec run {spec_q}{stop} --script {record_q}")
+
+
+def until_text(until: float) -> str:
+    """``until`` as ``--until`` reads it back to the same float: in days, hours, minutes and
+    seconds (``18h16m4.89972954505s``, the walkthrough's clock at a glance) when that text
+    reads back exactly, else the shortest number that does (``repr``). Never rounded: a run
+    stopped a fraction of a second earlier or later could leave out, or take in, an event the
+    session did not have."""
+    exact = repr(float(until))
+    whole, dot, fraction = exact.partition(".")
+    if not dot or not whole.isdigit() or not fraction.isdigit() or int(whole) < 60:
+        return exact                   # under a minute, or 1e+20: nothing clearer to say
+    days, rest = divmod(int(whole), 86_400)
+    hours, rest = divmod(rest, 3_600)
+    minutes, seconds = divmod(rest, 60)
+    fraction = fraction.rstrip("0")
+    second = f"{seconds}.{fraction}" if fraction else (str(seconds) if seconds else "")
+    text = "".join(f"{count}{unit}" for count, unit in (
+        (days, "d"), (hours, "h"), (minutes, "m"), (second, "s")) if count)
+    # the digits are repr's, split at whole minutes; the sum is checked, not trusted
+    return text if try_duration(text) == until else exact

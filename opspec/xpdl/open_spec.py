@@ -8,7 +8,8 @@ from pathlib import Path
 from opspec.errors import ConfigurationError, Diagnostic, Severity, SourceLocation, SpecError
 from opspec.model import Package
 
-__all__ = ["IO_CODES", "mode_loader_for", "open_spec", "refuse_unreadable", "unreadable"]
+__all__ = ["IO_CODES", "SPEC_SUFFIXES", "mode_loader_for", "open_spec", "refuse_folder",
+           "refuse_unreadable", "unreadable"]
 
 
 def open_spec(path: str | Path) -> Package:
@@ -24,8 +25,9 @@ def open_spec(path: str | Path) -> Package:
     target = Path(path)
     reason = not_a_file(target)
     if reason is not None:
-        what = {"it does not exist": "not found", "it is a folder": "a folder"}.get(
-            reason, f"cannot read it: {reason}")
+        if reason == "it is a folder":
+            refuse_folder(target)
+        what = {"it does not exist": "not found"}.get(reason, f"cannot read it: {reason}")
         raise ConfigurationError(f"{target}: {what}; give one specification file",
                                  hint="e.g. specs/medication_dispenser.xpdl")
     if target.suffix == ".wfs":
@@ -41,6 +43,34 @@ def open_spec(path: str | Path) -> Package:
         raise SpecError.from_diagnostics(result.diagnostics or (
             Diagnostic(SourceLocation(str(path)), Severity.ERROR, "unreadable", "cannot load"),))
     return result.package
+
+
+#: What a specification file's name ends with, for the files a folder is told to hold.
+SPEC_SUFFIXES = (".xpdl", ".bpmn", ".wfs")
+#: How many of a folder's spec files a refusal names.
+_NAMED = 4
+
+
+def refuse_folder(folder: Path) -> None:
+    """Raise the :class:`ConfigurationError` for a folder given where a spec file is meant,
+    naming the spec files in it (a command never picks one itself: which one is meant is the
+    user's to say)."""
+    try:
+        names = sorted(entry.name for entry in folder.iterdir()
+                       if entry.suffix.lower() in SPEC_SUFFIXES
+                       and not entry.name.startswith(".") and entry.is_file())
+    except OSError:
+        names = []
+    files = [str(folder / name) for name in names]
+    if len(files) == 1:
+        raise ConfigurationError(f"{folder}: a folder; give the spec file: {files[0]}")
+    if files:
+        shown = files if len(files) <= _NAMED + 1 else files[:_NAMED]
+        more = f" (and {len(files) - len(shown)} more)" if len(shown) < len(files) else ""
+        raise ConfigurationError(f"{folder}: a folder; give one specification file: "
+                                 f"{', '.join(shown)}{more}")
+    raise ConfigurationError(f"{folder}: a folder; give one specification file",
+                             hint="e.g. specs/medication_dispenser.xpdl")
 
 
 #: Diagnostic codes meaning "the file could not be read at all" (exit status 2, not 1).

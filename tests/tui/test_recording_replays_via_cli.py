@@ -14,6 +14,7 @@ import pytest
 from conftest import SPEC
 
 from opspec.cli import main
+from opspec.run_rules import parse_until
 from opspec.testing.script import load_script, script_format
 from opspec.tui.app import SummaryScreen, WalkthroughApp
 from opspec.tui.session import WalkSession
@@ -56,7 +57,7 @@ async def test_a_recording_named_anything_replays_with_the_printed_command(compi
     assert command[:2] == ["opspec", "run"] and command[-2:] == ["--script", str(record)]
     # stopped before the end of the day: the run stops there too, so that its numbers are
     # those the summary showed, not those of a day that goes on without the person
-    assert command[command.index("--until") + 1] == repr(stopped)
+    assert parse_until(command[command.index("--until") + 1]) == stopped   # exactly
     assert script_format(record.read_bytes(), str(record)) == "JSON"
     shown = [line for line in session.summary_lines() if line.startswith("  ") and (
         "doses" in line or "alarms" in line or "latency" in line)]

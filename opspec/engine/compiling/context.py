@@ -13,7 +13,7 @@ import re
 from collections.abc import Mapping
 from typing import Any
 
-from opspec.clock import try_duration
+from opspec.clock import DURATION_HINT, try_duration
 from opspec.engine.compiled import CompiledGraph, CTool, CTrigger, Evaluator
 from opspec.engine.conditions import compile_condition, compile_expression
 from opspec.engine.sampling import make_sampler
@@ -119,6 +119,14 @@ class Context:
             value = try_duration(text)
             if value is not None:
                 return _constant(value)
+            stripped = text.strip()
+            if stripped and not IDENT.match(stripped):
+                # text the reader could not read (a deadline in JavaScript): a length of
+                # time is meant, so the hint lists the durations as well as the expressions
+                raise spec_error(f"{what} {stripped!r} is neither a duration nor an "
+                                 "expression opspec reads", location,
+                                 f"{DURATION_HINT}, or an expression over data fields "
+                                 "giving seconds (timeout * 60)")
         return self.expr(expression, text, location, what)
 
     def trigger_ref(self, ref: TriggerRef | None) -> CTrigger | None:

@@ -7,6 +7,7 @@ import dataclasses
 
 from lxml import etree
 
+from opspec.clock import DURATION_HINT, parse_duration
 from opspec.errors import Severity, SpecError
 from opspec.model.activities import (
     Activity,
@@ -25,6 +26,7 @@ from opspec.model.activities import (
 )
 from opspec.model.data import Assignment
 from opspec.model.expressions import Expression
+from opspec.xpdl.conditions import ConditionSyntaxError
 from opspec.xpdl.handlers.bodies import BODIES, gateway_type
 from opspec.xpdl.handlers.common import (
     BuildContext,
@@ -80,12 +82,15 @@ def _deadlines(element: etree._Element, ctx: BuildContext) -> tuple[Deadline, ..
         if text:
             try:
                 duration = parse_duration_expression(text)
-            except (SpecError, ValueError, RecursionError):
-                ctx.warning(duration_element, "bad-deadline",
-                            f"deadline {text!r} is not a duration opspec understands; it never "
-                            "expires in a simulation",
-                            "write an ISO 8601 duration (PT5M), seconds (300) or an expression "
-                            "over data fields")
+            except (SpecError, ValueError, RecursionError) as error:
+                refusal = _misspelt_duration(text, error)
+                # the engine cannot run either kind; a misspelt duration is refused here, at
+                # once (validate then leaves the engine's checks out, so this is the one
+                # message); a script in another language (JaWE's JavaScript) the engine
+                # refuses, naming the package's script language
+                if refusal is not None:
+                    ctx.error(duration_element, "bad-deadline", f"Deadline: {refusal}",
+                              _DEADLINE_HINT)
         else:
             ctx.warning(deadline, "bad-deadline", "Deadline has no duration; it never expires",
                         "add <DeadlineDuration>PT5M</DeadlineDuration>")
@@ -95,6 +100,28 @@ def _deadlines(element: etree._Element, ctx: BuildContext) -> tuple[Deadline, ..
                             exception_name=text_of(child(deadline, "ExceptionName")),
                             location=ctx.loc(deadline)))
     return tuple(out)
+
+
+# characters only an expression has: unreadable text without one was meant as a duration
+_EXPRESSION_SIGNS = frozenset("+-*/%()<>=!&|?,;\"'[]{}")
+_DEADLINE_HINT = (f"{DURATION_HINT}, or an expression over data fields giving seconds "
+                  "(timeout * 60)")
+
+
+def _misspelt_duration(text: str, error: Exception) -> str | None:
+    """The duration grammar's refusal of a DeadlineDuration meant as a duration (``10
+    minuts``, ``-5``), or ``None`` for an expression opspec cannot read (``timeout *``,
+    JavaScript). XPDL's DeadlineDuration is an Expression, so ``timeout * 60`` is a deadline,
+    and so is ``timeout`` alone."""
+    if isinstance(error, ConditionSyntaxError) and _EXPRESSION_SIGNS.intersection(text):
+        return None
+    if isinstance(error, SpecError) and not isinstance(error, ConditionSyntaxError):
+        return error.message           # the duration grammar's own (negative, too large)
+    try:
+        parse_duration(text)
+    except SpecError as refusal:
+        return refusal.message
+    return None
 
 
 def _loop(element: etree._Element, ctx: BuildContext) -> Loop | None:
