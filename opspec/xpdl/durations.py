@@ -14,7 +14,7 @@ import re
 from opspec.clock import DURATION_HINT, is_duration, parse_duration, parse_time_of_day
 from opspec.errors import SourceLocation, SpecError
 from opspec.model.expressions import Expression, Literal
-from opspec.xpdl.conditions import parse_expression
+from opspec.xpdl.conditions import ConditionSyntaxError, parse_expression
 
 __all__ = [
     "parse_duration",            # opspec.clock's, for callers not yet moved (commands/run.py)
@@ -34,12 +34,23 @@ def parse_duration_expression(
     """A Deadline duration: ``Literal(seconds)`` when ``text`` is a plain duration (``300``,
     ``PT5M``, ``5 min``), else the parsed expression (``timeout * 60``), whose value the engine
     takes as seconds. Raises :class:`SpecError` for empty text and
-    :class:`~opspec.xpdl.conditions.ConditionSyntaxError` for unreadable expressions."""
+    :class:`~opspec.xpdl.conditions.ConditionSyntaxError` for unreadable expressions; text
+    that is no expression and has none of an expression's signs (``10 minuts``, ``1h30x``)
+    was meant as a duration, and is refused as every other door refuses that duration."""
     if not text.strip():
         raise _error("duration", text, "it is empty", location, DURATION_HINT)
     if is_duration(text):
         return Literal(parse_duration(text, location=location))
-    return parse_expression(text, location=location, kind="duration")
+    try:
+        return parse_expression(text, location=location, kind="duration")
+    except ConditionSyntaxError:
+        if EXPRESSION_SIGNS.isdisjoint(text):
+            parse_duration(text, location=location)     # raises the grammar's refusal
+        raise
+
+
+#: characters only an expression has: unreadable text without one was meant as a duration
+EXPRESSION_SIGNS = frozenset("+-*/%()<>=!&|?,;\"'[]{}")
 
 
 _DATE_TIME = re.compile(

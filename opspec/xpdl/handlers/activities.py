@@ -102,8 +102,6 @@ def _deadlines(element: etree._Element, ctx: BuildContext) -> tuple[Deadline, ..
     return tuple(out)
 
 
-# characters only an expression has: unreadable text without one was meant as a duration
-_EXPRESSION_SIGNS = frozenset("+-*/%()<>=!&|?,;\"'[]{}")
 _DEADLINE_HINT = (f"{DURATION_HINT}, or an expression over data fields giving seconds "
                   "(timeout * 60)")
 
@@ -112,11 +110,12 @@ def _misspelt_duration(text: str, error: Exception) -> str | None:
     """The duration grammar's refusal of a DeadlineDuration meant as a duration (``10
     minuts``, ``-5``), or ``None`` for an expression opspec cannot read (``timeout *``,
     JavaScript). XPDL's DeadlineDuration is an Expression, so ``timeout * 60`` is a deadline,
-    and so is ``timeout`` alone."""
-    if isinstance(error, ConditionSyntaxError) and _EXPRESSION_SIGNS.intersection(text):
+    and so is ``timeout`` alone. (:func:`~opspec.xpdl.durations.parse_duration_expression`
+    refuses text meant as a duration with the duration grammar's own message.)"""
+    if isinstance(error, ConditionSyntaxError):
         return None
-    if isinstance(error, SpecError) and not isinstance(error, ConditionSyntaxError):
-        return error.message           # the duration grammar's own (negative, too large)
+    if isinstance(error, SpecError):
+        return error.message           # the duration grammar's (misspelt, negative, too large)
     try:
         parse_duration(text)
     except SpecError as refusal:
