@@ -124,6 +124,17 @@ BPMN_CONSTRUCTS: tuple[Construct, ...] = (
        "a node whose every incoming flow comes from a boundary event that never fires "
        "(compensation, cancel) waits for a token, so never starts", "§13.2, §13.5.3",
        when="fed-only-by-ignored"),
+    _c("bpmn-unstarted-node", BPMN, f"{_ACTIVITIES} {_GATEWAYS} intermediateCatchEvent "
+       "intermediateThrowEvent endEvent", None, W,
+       "no sequence flow leads to it, and the process's instances start at start events "
+       "with a trigger, each running only its own path: it never runs in those instances, "
+       "only in one started without a trigger (beside a none start event, called from "
+       "another process, or from the API); opspec check reports it dead when no such "
+       "instance runs (BPMN 2.0: \"All Flow Objects that do not have an incoming Sequence "
+       "Flow (i.e., are not a target of a Sequence Flow) SHALL be instantiated when the "
+       "Process is instantiated\")", "§10.4.2", when="unstarted-beside-triggered-start",
+       hint="add a sequence flow to it from the node after which it should run, or remove "
+            "it"),
     _c("bpmn-compensation-activity", BPMN, _ACTIVITIES, "isForCompensation", W,
        "opspec has no compensation: this is an ordinary activity (one no sequence flow leads "
        "to starts with the instance)", "§10.2.1, §13.5.5", when="true"),

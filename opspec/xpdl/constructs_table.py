@@ -49,6 +49,8 @@ _WHEN_TEXT = {
     "on-multi-instance": "of a multi-instance activity",
     "fed-only-by-ignored": "all its incoming flows come from ignored elements",
     "role-without-implementation": "no implementation, performed by a ROLE participant",
+    "unstarted-beside-triggered-start": "no incoming flow, in a process with a start event "
+                                        "that has a trigger",
 }
 
 

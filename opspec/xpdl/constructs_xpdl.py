@@ -100,6 +100,17 @@ XPDL_CONSTRUCTS: tuple[Construct, ...] = (
     _c("xpdl-completion-quantity", XPDL, "Activity", "CompletionQuantity", R,
        "CompletionQuantity tokens leave on each outgoing transition (thread split, WCP-42)",
        "§7.6", when="not-one"),
+    _c("xpdl-unstarted-activity", XPDL, "Activity", None, W,
+       "no transition leads to it, and the process's instances start at start events with "
+       "a trigger, each running only its own path: it never runs in those instances, only "
+       "in one started without a trigger (beside a StartEvent with Trigger None, called as "
+       "a subflow, or from the API); opspec check reports it dead when no such instance "
+       "runs (BPMN 2.0 §10.4.2, which XPDL 2.1's events follow: \"All Flow Objects that do "
+       "not have an incoming Sequence Flow (i.e., are not a target of a Sequence Flow) SHALL "
+       "be instantiated when the Process is instantiated\")", "§7.6.2; BPMN §10.4.2",
+       when="unstarted-beside-triggered-start",
+       hint="add a transition to it from the activity after which it should run, or remove "
+            "it"),
     _c("xpdl-compensation", XPDL, "Activity", "IsForCompensation", W,
        "opspec has no compensation: this is an ordinary activity", "§7.6", when="true"),
     _c("xpdl-transaction", XPDL, "Activity", "IsATransaction", W,
