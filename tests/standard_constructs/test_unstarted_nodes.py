@@ -139,9 +139,9 @@ def test_a_message_start_event_counts_as_a_trigger(tmp_path: Path) -> None:
 
 @pytest.mark.parametrize("node", [
     '<bpmn:task id="x" isForCompensation="true"/>',          # BPMN's own exception
-    '<bpmn:boundaryEvent id="x" attachedToRef="a"><bpmn:timerEventDefinition>'
-    '<bpmn:timeDuration>PT1M</bpmn:timeDuration></bpmn:timerEventDefinition>'
-    '</bpmn:boundaryEvent>',                                  # its host starts it
+    ('<bpmn:boundaryEvent id="x" attachedToRef="a"><bpmn:timerEventDefinition>'
+     '<bpmn:timeDuration>PT1M</bpmn:timeDuration></bpmn:timerEventDefinition>'
+     '</bpmn:boundaryEvent>'),                                # its host starts it
 ])
 def test_nodes_the_standard_excepts_are_not_reported(node: str, tmp_path: Path) -> None:
     warnings = _gate_warnings(_bpmn(tmp_path, node))
