@@ -201,6 +201,14 @@ BPMN_CONSTRUCTS: tuple[Construct, ...] = (
        "the first only)", "§10.4.2, §13.3.4", when="several-none-starts",
        hint="draw one none start event and a parallel gateway after it, or one process per "
        "start event"),
+    _c("bpmn-sub-process-start-trigger", BPMN, "startEvent", None, W,
+       "its trigger is ignored: it starts with the sub-process, at once, as a none start "
+       "event does (BPMN 2.0 §10.4.2: \"There is only one type of Start Event for "
+       "Sub-Processes in BPMN (…): None.\")", "§10.4.2",
+       when="triggered-start-in-sub-level",
+       hint="remove its event definition and wait for the timer or message in an "
+            "intermediate catch event after it, or make the sub-process an event "
+            "sub-process (triggeredByEvent=\"true\")"),
     _c("bpmn-several-definitions", BPMN, "startEvent intermediateCatchEvent boundaryEvent",
        None, W, "only the first event definition counts (BPMN: any one of them triggers it)",
        "§10.4.5", when="several-definitions", reported_by=("multiple-event-definitions",)),

@@ -51,6 +51,7 @@ _WHEN_TEXT = {
     "role-without-implementation": "no implementation, performed by a ROLE participant",
     "unstarted-beside-triggered-start": "no incoming flow, in a process with a start event "
                                         "that has a trigger",
+    "triggered-start-in-sub-level": "with a trigger, in an embedded sub-process or activity set",
 }
 
 

@@ -154,6 +154,13 @@ XPDL_CONSTRUCTS: tuple[Construct, ...] = (
        "and only its own path runs; an instance started without a trigger begins at the "
        "StartEvents with Trigger None, all of them (as XPDL 1.0 engines start every activity "
        "without incoming transitions)", "§7.6.2", when="several-starts"),
+    _c("xpdl-activity-set-start-trigger", XPDL, "StartEvent", None, W,
+       "its trigger is ignored: it starts with its activity set, at once, as a StartEvent "
+       "with Trigger None does (BPMN 2.0 §10.4.2, which XPDL 2.1's events follow: \"There "
+       "is only one type of Start Event for Sub-Processes in BPMN (…): "
+       "None.\")", "§7.6.2; BPMN §10.4.2", when="triggered-start-in-sub-level",
+       hint="give it Trigger=\"None\" and wait for the timer or message in an "
+            "IntermediateEvent after it"),
     _c("xpdl-event-trigger", XPDL, "StartEvent IntermediateEvent", "Trigger", R, "its trigger",
        "§7.6.2"),
     _c("xpdl-event-result", XPDL, "EndEvent", "Result", R,

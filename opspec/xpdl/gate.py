@@ -27,7 +27,7 @@ from opspec.xpdl.constructs import (
     Construct,
     Kind,
 )
-from opspec.xpdl.gate_unstarted import unstarted_by_triggered_starts
+from opspec.xpdl.gate_starts import triggered_start_in_sub_level, unstarted_by_triggered_starts
 from opspec.xpdl.namespaces import is_xpdl_namespace
 from opspec.xpdl.reader import line_of
 
@@ -389,6 +389,7 @@ CONDITIONS: dict[str, _Condition] = {
     "role-without-implementation": _role_without_implementation,
     "unstarted-beside-triggered-start": lambda e, v, d: unstarted_by_triggered_starts(
         e, d.levels),
+    "triggered-start-in-sub-level": lambda e, v, d: triggered_start_in_sub_level(e),
 }
 
 

@@ -237,3 +237,29 @@ def test_the_pill_box_of_opspec_new_with_its_escalation_cut_off(
     status, doc = _check(spec, capsys)
     dead = [p["activity"] for p in doc["problems"] if p["kind"] == "dead"]
     assert dead == ["tell_caregiver"] and status == 1
+
+
+@pytest.mark.parametrize("name", ["start_trigger_in_sub_process.bpmn",
+                                  "start_trigger_in_activity_set.xpdl"])
+def test_a_start_trigger_in_a_sub_process_is_ignored_and_validate_says_so(name: str) -> None:
+    """BPMN 2.0 §10.4.2: "There is only one type of Start Event for Sub-Processes in BPMN
+    (…): None." A timer start event in an embedded sub-process (an XPDL
+    activity set) starts with it, at once: "inner" completes at t = 0, not after the hour.
+    Validate says so at the start event's line (it said nothing)."""
+    from .conftest import completed
+
+    outcome = run(name, until=7200)
+    assert (0.0, "inner") in completed(outcome)
+    path = DATA / name
+    warnings = _gate_warnings(path)
+    assert [line for line, _ in warnings] == [
+        next(n for n, text in enumerate(path.read_text().splitlines(), 1)
+             if 'd="sub_begin"' in text and "tartEvent" in text)]
+    assert "its trigger is ignored" in warnings[0][1]
+
+
+def test_an_event_sub_process_start_trigger_is_not_that_case() -> None:
+    """An event sub-process's timer start event is its trigger (opspec runs it): not
+    reported as ignored."""
+    path = DATA / "event_sub_process_timer.bpmn"
+    assert not [m for _, m in _gate_warnings(path) if "its trigger is ignored" in m]

@@ -1,24 +1,31 @@
-"""The semantics gate's test for a flow node no triggered instance starts: a node without an
-incoming sequence flow (transition) at the top level of a process that has a start event with
-a trigger (timer, message, signal, conditional, link, error, escalation).
+"""The semantics gate's tests about where a process level starts.
 
-BPMN 2.0 §10.4.2 instantiates "All Flow Objects that do not have an incoming Sequence Flow"
-with every instance. The engine does not: an instance that a triggered start event starts runs
-only that start event's path (:mod:`opspec.engine.compiling.graphs`, ``start_events``); the
-node runs only in an instance started without a trigger (beside a none start event, called
-from another process, from the API). The gate reports it at the node's line
-(``bpmn-unstarted-node``, ``xpdl-unstarted-activity`` in the registry), and ``opspec check``
-plays the same instances (:mod:`opspec.model.instance_starts`).
+**A flow node no triggered instance starts**: a node without an incoming sequence flow
+(transition) at the top level of a process that has a start event with a trigger (timer,
+message, signal, conditional, link, error, escalation). BPMN 2.0 §10.4.2 instantiates "All
+Flow Objects that do not have an incoming Sequence Flow" with every instance. The engine does
+not: an instance that a triggered start event starts runs only that start event's path
+(:mod:`opspec.engine.compiling.graphs`, ``start_events``); the node runs only in an instance
+started without a trigger (beside a none start event, called from another process, from the
+API). Reported at the node's line (``bpmn-unstarted-node``, ``xpdl-unstarted-activity`` in
+the registry); ``opspec check`` plays the same instances
+(:mod:`opspec.model.instance_starts`). A process-level ``opspec:StartTrigger`` or
+``opspec:Arrival`` makes every instance start at every start node: then nothing is reported.
 
-Read on the file as written: a process-level ``opspec:StartTrigger`` or ``opspec:Arrival``
-makes every instance start at every start node, so then nothing is reported.
+**A start event with a trigger inside a sub-process** (an embedded sub-process, an XPDL
+activity set; not an event sub-process): BPMN 2.0 §10.4.2 allows only None there, and the
+engine starts it with the sub-process, its trigger ignored (``bpmn-sub-process-start-trigger``,
+``xpdl-activity-set-start-trigger``).
+
+Read on the file as written, before the reader rewrites it.
 """
 
 from __future__ import annotations
 
 from lxml import etree
 
-__all__ = ["BPMN_TRIGGERS", "XPDL_TRIGGERS", "unstarted_by_triggered_starts"]
+__all__ = ["BPMN_TRIGGERS", "XPDL_TRIGGERS", "triggered_start_in_sub_level",
+           "unstarted_by_triggered_starts"]
 
 #: Event definitions that make a BPMN start event a triggered one (the engine arms it).
 BPMN_TRIGGERS = frozenset({
@@ -121,3 +128,22 @@ def unstarted_by_triggered_starts(element: etree._Element,
         level = levels[process] = analyse(process)
     triggered, targets = level
     return triggered and ident.strip() not in targets
+
+
+def triggered_start_in_sub_level(element: etree._Element) -> bool:
+    """Whether ``element`` (a BPMN startEvent, or an XPDL StartEvent) has a trigger the engine
+    would arm at a top level, but starts an embedded sub-process (not an event sub-process)
+    or an XPDL activity set, where it starts with its level and the trigger is ignored."""
+    parent = element.getparent()
+    if parent is None:
+        return False
+    if _local(element) == "startEvent":
+        return (_local(parent) in ("subProcess", "adHocSubProcess", "transaction")
+                and (parent.get("triggeredByEvent") or "").strip().lower() != "true"
+                and any(isinstance(c.tag, str) and _local(c) in BPMN_TRIGGERS
+                        for c in element))
+    activity = parent.getparent()                   # Activity/Event/StartEvent
+    activities = activity.getparent() if activity is not None else None
+    owner = activities.getparent() if activities is not None else None
+    return (owner is not None and _local(owner) == "ActivitySet"
+            and _xpdl_trigger(activity) in XPDL_TRIGGERS)
