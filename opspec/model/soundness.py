@@ -8,7 +8,9 @@ A subflow, a BlockActivity, a loop or an event is one move of its level; the sub
 and the activity set are checked as levels of their own.
 
 Breadth-first exploration from the start over markings (token counts per place, plus whether
-an end has been reached), up to ``max_states`` of them, with the parent of each kept, so every
+an end has been reached; one root marking per kind of instance the engine starts, as
+:mod:`opspec.model.instance_starts` finds them: a triggered start event's instance runs only
+its path), up to ``max_states`` of them, with the parent of each kept, so every
 problem comes with the shortest witness (the activities fired from the start):
 
 - **deadlock**: tokens left, nothing can fire, no end reached;
