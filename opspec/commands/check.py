@@ -71,6 +71,7 @@ def register(subparsers: Any) -> None:
 def run(args: argparse.Namespace) -> int:
     from opspec.commands._check_levels import errors_by_level
     from opspec.errors import Severity
+    from opspec.model.instance_starts import called_processes
     from opspec.model.soundness import SoundnessReport, check_process
     from opspec.xpdl.gate import RUNS_DIFFERENTLY
     from opspec.xpdl.loader import load_package
@@ -113,10 +114,12 @@ def run(args: argparse.Namespace) -> int:
             worst = 2
             continue
         reports: list[SoundnessReport] = []
+        called = called_processes(package)
         try:
             for process in processes:
                 reports.extend(check_process(process, conformance=package.conformance_class,
-                                             max_states=args.max_states))
+                                             max_states=args.max_states,
+                                             called=process.id in called))
             reports = _with_zero_time_cycles(package, reports, [p.id for p in processes])
         except MemoryError:
             # each level's exploration reports its own; this is what is left (the net of a

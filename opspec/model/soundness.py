@@ -8,7 +8,9 @@ A subflow, a BlockActivity, a loop or an event is one move of its level; the sub
 and the activity set are checked as levels of their own.
 
 Breadth-first exploration from the start over markings (token counts per place, plus whether
-an end has been reached), up to ``max_states`` of them, with the parent of each kept, so every
+an end has been reached; one root marking per kind of instance the engine starts, as
+:mod:`opspec.model.instance_starts` finds them: a triggered start event's instance runs only
+its path), up to ``max_states`` of them, with the parent of each kept, so every
 problem comes with the shortest witness (the activities fired from the start):
 
 - **deadlock**: tokens left, nothing can fire, no end reached;
@@ -37,6 +39,7 @@ from dataclasses import dataclass, replace
 
 from opspec.model.activities import BlockActivity, GatewayType
 from opspec.model.graph import FlowGraph, attached_to, levels
+from opspec.model.instance_starts import instance_starts
 from opspec.model.process import WorkflowProcess
 from opspec.model.soundness_conformance import conformance_violations
 from opspec.model.soundness_net import Marking, TokenNet
@@ -94,8 +97,14 @@ def _line(graph: FlowGraph, activity: str | None) -> int | None:
 
 
 def check_level(process: str, graph: FlowGraph, starts: tuple[str, ...], *,
-                max_states: int = 100_000) -> SoundnessReport:
+                max_states: int = 100_000,
+                instances: tuple[tuple[str, ...], ...] | None = None) -> SoundnessReport:
     """Explore one level from ``starts`` and report its problems (conformance aside).
+
+    ``instances`` are the start sets of the kinds of instance the engine makes of the level
+    (:func:`opspec.model.instance_starts.instance_starts`), each a subset of ``starts``,
+    explored together as one space with a root each; default: one, starting at all of
+    ``starts``. A start in none of them never runs: it is reported dead.
 
     Memory is bounded by ``max_states``: at most that many states are kept (a state is its
     marked places and token counts packed in bytes, its parent, the activity fired to reach
@@ -104,7 +113,7 @@ def check_level(process: str, graph: FlowGraph, starts: tuple[str, ...], *,
     machine run out of memory first, the level is reported inconclusive
     (``stopped="memory"``) rather than raising."""
     try:
-        return _explore(process, graph, starts, max_states)
+        return _explore(process, graph, starts, max_states, instances or (starts,))
     except MemoryError:
         # the states explored so far are gone with the frame; say so instead of crashing
         return SoundnessReport(process, 0, False, (), stopped="memory")
@@ -141,6 +150,14 @@ class _Space:
         self.targets = array("I")
         self.edges = True             # dropped once the exploration cannot be complete
 
+    def add_root(self, key: bytes) -> None:
+        """Another initial state (another kind of instance), before the exploration."""
+        self.index.setdefault(key, len(self.keys))
+        if self.index[key] == len(self.keys):
+            self.keys.append(key)
+            self.parent.append(-1)
+            self.via.append(-1)
+
     def witness(self, state: int) -> tuple[str, ...]:
         path: list[str] = []
         while self.parent[state] >= 0:
@@ -153,14 +170,17 @@ class _Space:
 
 
 def _explore(process: str, graph: FlowGraph, starts: tuple[str, ...],
-             max_states: int) -> SoundnessReport:
+             max_states: int, instances: tuple[tuple[str, ...], ...]) -> SoundnessReport:
     """The exploration: its memory is bounded by ``max_states`` states (see check_level)."""
     net = TokenNet(graph, starts)
     names = list(graph.by_id)
     number = {name: n for n, name in enumerate(names)}
-    space = _Space(_pack(net.initial(), False), names)
+    roots = list(dict.fromkeys(net.initial(only) for only in instances))
+    space = _Space(_pack(roots[0], False), names)
+    for root in roots[1:]:            # each kind of instance is a root of its own
+        space.add_root(_pack(root, False))
     fired: set[str] = set()
-    marked: set[int] = {p for p, _ in net.initial()}     # places ever marked
+    marked: set[int] = {p for root in roots for p, _ in root}     # places ever marked
     problems: list[Problem] = []
     complete = True
     unbounded = False
@@ -211,7 +231,7 @@ def _explore(process: str, graph: FlowGraph, starts: tuple[str, ...],
     problems.extend(_stuck(process, graph, net, space, stuck_states))
     if complete and not unbounded:
         problems.extend(_livelock(process, graph, net, space, stuck_states))
-        problems.extend(_dead(process, graph, net, fired, marked))
+        problems.extend(_dead(process, graph, net, fired, marked, instances))
     return SoundnessReport(process, len(space.keys), complete, tuple(problems),
                            stopped=None if complete else "states")
 
@@ -302,8 +322,10 @@ def _fired_between(net: TokenNet, before: bytes, after: bytes) -> str:
 
 
 def _dead(process: str, graph: FlowGraph, net: TokenNet, fired: set[str],
-          marked: set[int]) -> list[Problem]:
+          marked: set[int], instances: tuple[tuple[str, ...], ...]) -> list[Problem]:
     out: list[Problem] = []
+    started = {s for only in instances for s in only}
+    unstarted = [s for s in net.start_place if s not in started]
     for activity in graph.by_id.values():
         if activity.id in fired or attached_to(activity) is not None:
             continue     # a boundary event not interrupting anything is not dead code
@@ -324,6 +346,14 @@ def _dead(process: str, graph: FlowGraph, net: TokenNet, fired: set[str],
                 "and-join-never-fires", process, activity.id,
                 f"AND-join {activity.id!r} can never fire: of its incoming transitions, {why}",
                 (), _line(graph, activity.id)))
+        elif activity.id in unstarted:
+            begins = " or ".join(", ".join(repr(s) for s in only) for only in instances)
+            out.append(Problem(
+                "dead", process, activity.id,
+                f"dead activity: {activity.id!r} can never run: no transition leads to it, "
+                f"and no instance starts there (an instance begins at {begins}: a start "
+                "event with a trigger starts an instance that runs only its path); add a "
+                "transition to it, or remove it", (), _line(graph, activity.id)))
         else:
             out.append(Problem("dead", process, activity.id,
                                f"dead activity: {activity.id!r} can never run", (),
@@ -343,18 +373,22 @@ def _block_starts(process: WorkflowProcess) -> dict[str, str | None]:
 
 
 def check_process(process: WorkflowProcess, *, conformance: str | None = None,
-                  max_states: int = 100_000) -> list[SoundnessReport]:
+                  max_states: int = 100_000, called: bool = False) -> list[SoundnessReport]:
     """A report per level of ``process`` (the process, then each activity set), each explored
-    up to ``max_states`` markings; ``conformance`` is the package's GraphConformance."""
+    up to ``max_states`` markings; ``conformance`` is the package's GraphConformance;
+    ``called``: a SubFlow of the package calls the process (its instances then start as a
+    call starts them, :func:`opspec.model.instance_starts.instance_starts`)."""
     reports = []
     block_starts = _block_starts(process)
     for activity_set, graph in levels(process):
+        instances = None
         if activity_set is None:
             name, starts = process.id, graph.starts()
+            instances = instance_starts(process, graph, called=called)
         else:
             name = f"{process.id}/{activity_set.id}"
             starts = graph.starts(block_starts.get(activity_set.id))
-        report = check_level(name, graph, starts, max_states=max_states)
+        report = check_level(name, graph, starts, max_states=max_states, instances=instances)
         extra = tuple(Problem("conformance", name, activity, message, witness,
                               _line(graph, activity))
                       for activity, message, witness in

@@ -368,8 +368,11 @@ class TokenNet:
         return frozenset(seen)
 
     # ------------------------------------------------------------------ markings
-    def initial(self) -> Marking:
-        return tuple((place, 1) for place in sorted(self.start_place.values()))
+    def initial(self, starts: tuple[str, ...] | None = None) -> Marking:
+        """A token on the start place of each of ``starts`` (default: every start)."""
+        if starts is None:
+            return tuple((place, 1) for place in sorted(self.start_place.values()))
+        return tuple((place, 1) for place in sorted(self.start_place[s] for s in starts))
 
     def has_tokens(self, marking: Marking) -> bool:
         """Whether any token is left (owed flags of complex joins are not tokens)."""

@@ -124,6 +124,17 @@ BPMN_CONSTRUCTS: tuple[Construct, ...] = (
        "a node whose every incoming flow comes from a boundary event that never fires "
        "(compensation, cancel) waits for a token, so never starts", "§13.2, §13.5.3",
        when="fed-only-by-ignored"),
+    _c("bpmn-unstarted-node", BPMN, f"{_ACTIVITIES} {_GATEWAYS} intermediateCatchEvent "
+       "intermediateThrowEvent endEvent", None, W,
+       "no sequence flow leads to it, and the process's instances start at start events "
+       "with a trigger, each running only its own path: it never runs in those instances, "
+       "only in one started without a trigger (beside a none start event, called from "
+       "another process, or from the API); opspec check reports it dead when no such "
+       "instance runs (BPMN 2.0: \"All Flow Objects that do not have an incoming Sequence "
+       "Flow (i.e., are not a target of a Sequence Flow) SHALL be instantiated when the "
+       "Process is instantiated\")", "§10.4.2", when="unstarted-beside-triggered-start",
+       hint="add a sequence flow to it from the node after which it should run, or remove "
+            "it"),
     _c("bpmn-compensation-activity", BPMN, _ACTIVITIES, "isForCompensation", W,
        "opspec has no compensation: this is an ordinary activity (one no sequence flow leads "
        "to starts with the instance)", "§10.2.1, §13.5.5", when="true"),
@@ -190,6 +201,14 @@ BPMN_CONSTRUCTS: tuple[Construct, ...] = (
        "the first only)", "§10.4.2, §13.3.4", when="several-none-starts",
        hint="draw one none start event and a parallel gateway after it, or one process per "
        "start event"),
+    _c("bpmn-sub-process-start-trigger", BPMN, "startEvent", None, W,
+       "its trigger is ignored: it starts with the sub-process, at once, as a none start "
+       "event does (BPMN 2.0 §10.4.2: \"There is only one type of Start Event for "
+       "Sub-Processes in BPMN (…): None.\")", "§10.4.2",
+       when="triggered-start-in-sub-level",
+       hint="remove its event definition and wait for the timer or message in an "
+            "intermediate catch event after it, or make the sub-process an event "
+            "sub-process (triggeredByEvent=\"true\")"),
     _c("bpmn-several-definitions", BPMN, "startEvent intermediateCatchEvent boundaryEvent",
        None, W, "only the first event definition counts (BPMN: any one of them triggers it)",
        "§10.4.5", when="several-definitions", reported_by=("multiple-event-definitions",)),

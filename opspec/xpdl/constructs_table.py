@@ -49,6 +49,9 @@ _WHEN_TEXT = {
     "on-multi-instance": "of a multi-instance activity",
     "fed-only-by-ignored": "all its incoming flows come from ignored elements",
     "role-without-implementation": "no implementation, performed by a ROLE participant",
+    "unstarted-beside-triggered-start": "no incoming flow, in a process with a start event "
+                                        "that has a trigger",
+    "triggered-start-in-sub-level": "with a trigger, in an embedded sub-process or activity set",
 }
 
 

@@ -100,6 +100,17 @@ XPDL_CONSTRUCTS: tuple[Construct, ...] = (
     _c("xpdl-completion-quantity", XPDL, "Activity", "CompletionQuantity", R,
        "CompletionQuantity tokens leave on each outgoing transition (thread split, WCP-42)",
        "§7.6", when="not-one"),
+    _c("xpdl-unstarted-activity", XPDL, "Activity", None, W,
+       "no transition leads to it, and the process's instances start at start events with "
+       "a trigger, each running only its own path: it never runs in those instances, only "
+       "in one started without a trigger (beside a StartEvent with Trigger None, called as "
+       "a subflow, or from the API); opspec check reports it dead when no such instance "
+       "runs (BPMN 2.0 §10.4.2, which XPDL 2.1's events follow: \"All Flow Objects that do "
+       "not have an incoming Sequence Flow (i.e., are not a target of a Sequence Flow) SHALL "
+       "be instantiated when the Process is instantiated\")", "§7.6.2; BPMN §10.4.2",
+       when="unstarted-beside-triggered-start",
+       hint="add a transition to it from the activity after which it should run, or remove "
+            "it"),
     _c("xpdl-compensation", XPDL, "Activity", "IsForCompensation", W,
        "opspec has no compensation: this is an ordinary activity", "§7.6", when="true"),
     _c("xpdl-transaction", XPDL, "Activity", "IsATransaction", W,
@@ -143,6 +154,13 @@ XPDL_CONSTRUCTS: tuple[Construct, ...] = (
        "and only its own path runs; an instance started without a trigger begins at the "
        "StartEvents with Trigger None, all of them (as XPDL 1.0 engines start every activity "
        "without incoming transitions)", "§7.6.2", when="several-starts"),
+    _c("xpdl-activity-set-start-trigger", XPDL, "StartEvent", None, W,
+       "its trigger is ignored: it starts with its activity set, at once, as a StartEvent "
+       "with Trigger None does (BPMN 2.0 §10.4.2, which XPDL 2.1's events follow: \"There "
+       "is only one type of Start Event for Sub-Processes in BPMN (…): "
+       "None.\")", "§7.6.2; BPMN §10.4.2", when="triggered-start-in-sub-level",
+       hint="give it Trigger=\"None\" and wait for the timer or message in an "
+            "IntermediateEvent after it"),
     _c("xpdl-event-trigger", XPDL, "StartEvent IntermediateEvent", "Trigger", R, "its trigger",
        "§7.6.2"),
     _c("xpdl-event-result", XPDL, "EndEvent", "Result", R,

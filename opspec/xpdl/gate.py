@@ -27,6 +27,7 @@ from opspec.xpdl.constructs import (
     Construct,
     Kind,
 )
+from opspec.xpdl.gate_starts import triggered_start_in_sub_level, unstarted_by_triggered_starts
 from opspec.xpdl.namespaces import is_xpdl_namespace
 from opspec.xpdl.reader import line_of
 
@@ -64,6 +65,8 @@ class _Doc:
         self._by_id: dict[str, etree._Element] | None = None
         self._flows: tuple[dict[str, int], dict[str, list[str]]] | None = None
         self._participants: dict[str, str] | None = None
+        # process element -> (has a triggered start event, targets of its flows)
+        self.levels: dict[etree._Element, tuple[bool, set[str]]] = {}
 
     @property
     def by_id(self) -> dict[str, etree._Element]:
@@ -384,6 +387,9 @@ CONDITIONS: dict[str, _Condition] = {
     "on-multi-instance": _on_multi_instance,
     "fed-only-by-ignored": _fed_only_by_ignored,
     "role-without-implementation": _role_without_implementation,
+    "unstarted-beside-triggered-start": lambda e, v, d: unstarted_by_triggered_starts(
+        e, d.levels),
+    "triggered-start-in-sub-level": lambda e, v, d: triggered_start_in_sub_level(e),
 }
 
 
