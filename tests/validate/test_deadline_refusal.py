@@ -9,6 +9,7 @@ that contradicted each other, neither of them naming the duration spellings.
 
 from __future__ import annotations
 
+import json
 from pathlib import Path
 
 import pytest
@@ -93,3 +94,22 @@ def test_run_refuses_a_misspelt_deadline_with_the_same_error(
     assert f"{spec}:{line}: " in err
     assert "cannot read duration '10 minuts': not a duration" in err
     assert "was not understood" not in err
+
+
+def test_a_deadline_without_duration_never_expires_and_says_so_once(
+        tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """XPDL 2.1's Deadline has ``DeadlineDuration minOccurs="0"`` (the schema), so a Deadline
+    with none is valid: it never expires, which validate says once as a warning, and the run
+    runs. (The engine refused it, "has no expression", beside the reader's warning that it
+    never expires: two messages that contradicted each other.)"""
+    spec, line = _spec_with_deadline(tmp_path, "")
+    status, rows = _validate(spec, capsys)
+    assert status == 0
+    assert rows == [(f"{spec}:{line}: warning: Deadline has no duration; it never expires "
+                     "(add <DeadlineDuration>PT5M</DeadlineDuration>)")]
+    trace = tmp_path / "trace.jsonl"
+    # nobody answers: with its PT10M the deadline expired; without a duration, never
+    assert main(["run", str(spec), "--days", "1", "--no-user", "--timeline", "none",
+                 "--trace", str(trace)]) == 0
+    kinds = {json.loads(row)["kind"] for row in trace.read_text().splitlines()[1:]}
+    assert "activity.started" in kinds and "deadline.expired" not in kinds

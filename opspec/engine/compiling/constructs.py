@@ -362,12 +362,15 @@ def _time(c: Context, site: Site) -> None:
         ca.cpu_sampler = _sampler(directives.cpu_distribution, "CPU demand", act)
     if directives.duration is not None:
         ca.sampler = _sampler(directives.duration, "duration", act)
-    if act.deadlines:
+    # a Deadline with no DeadlineDuration (XPDL 2.x: minOccurs="0") never expires, as the
+    # reader's warning says: it is left out, not refused
+    timed = [d for d in act.deadlines if d.duration is not None or (d.duration_text or "").strip()]
+    if timed:
         ca.deadlines = tuple(
             (c.seconds(d.duration, d.duration_text, d.location or act.location,
                        f"deadline of activity {act.id!r}"),
              d.execution is Execution.SYNCHR, d.exception_name or "deadline")
-            for d in act.deadlines)
+            for d in timed)
 
 
 def _sampler(distribution: Any, what: str, act: Activity) -> Any:
