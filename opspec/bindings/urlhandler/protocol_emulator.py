@@ -20,7 +20,7 @@ from typing import Any
 from serial.serialutil import PortNotOpenError, SerialException
 from serial.urlhandler import protocol_loop
 
-from opspec.bindings.emulator import Behaviour, EmulatedDevice, Reply
+from opspec.bindings.emulator import Behaviour, EmulatedDevice, Reply, parse_event
 from opspec.bindings.profiles import DeviceProfile, resolve_profile
 from opspec.errors import OpspecError
 
@@ -55,11 +55,13 @@ class Serial(protocol_loop.Serial):
         self.device = EmulatedDevice(profile, behaviour)
         self._vanished = False
         for spec in options.get("event", []):
-            name, _, delay = spec.partition("@")
+            try:
+                name, seconds = parse_event(spec, "event=")
+            except OpspecError as error:
+                raise SerialException(f"emulator: {error}") from None
             try:
                 line = self.device.event_line(name)
-                seconds = float(delay or 0)
-            except (OpspecError, ValueError) as error:
+            except OpspecError as error:
                 raise SerialException(f"emulator: bad event {spec!r}: {error}") from None
             self._later(seconds, line)
 
