@@ -110,8 +110,9 @@ def _open_hint(url: str) -> str:
 
 def _reason(error: BaseException) -> str:
     text = str(error)
-    # pyserial repeats itself: "[Errno 2] could not open port X: [Errno 2] No such file…"
-    if "could not open port" in text and ": [Errno" in text:
+    # pyserial repeats itself: "[Errno 2] could not open port X: [Errno 2] No such file…",
+    # and socket:// "Could not open port socket://…: [Errno 111] Connection refused"
+    if "could not open port" in text.lower() and ": [Errno" in text:
         text = text[text.rindex(": [Errno") + 2:]
     return text
 

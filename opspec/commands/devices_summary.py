@@ -32,6 +32,9 @@ def device_lines(report: Mapping[str, Mapping[str, Any]], when: str = "at the en
                      f"{len(faults)} fault(s)")
         lines.extend(f"  fault {fault.get('fault')}: {fault.get('message')} "
                      f"(then {fault.get('action')})" for fault in faults[:FAULTS_SHOWN])
+        if len(faults) > FAULTS_SHOWN:
+            lines.append(f"  … and {len(faults) - FAULTS_SHOWN} more fault(s) (each is a "
+                         "`fault` event in the trace)")
         lines.extend(f"  unfinished {when}: {waiting.get('message')}"
                      for waiting in info.get("pending") or [])
     return lines

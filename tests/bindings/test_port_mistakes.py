@@ -111,3 +111,12 @@ def test_emulator_profile_missing_everywhere_lists_the_devices_folder(tmp_path: 
     with pytest.raises(BindingError, match=f"no device profile named 'my_boar' in {tmp_path}"
                        r".*available: my_board"):
         bindings_from_args(["alarm=emulator://my_boar"], folder, settle_s=0)
+
+
+def test_a_refused_socket_says_the_reason_once(dispenser_profile: DeviceProfile) -> None:
+    # was "cannot open socket://…: Could not open port socket://…: [Errno 111] …"
+    url = f"socket://127.0.0.1:{_closed_port()}"
+    with pytest.raises(BindingError) as refused:
+        bind("alarm", url, dispenser_profile)
+    assert refused.value.message.startswith(f"alarm: cannot open {url}: [Errno ")
+    assert "Could not open port" not in refused.value.message
