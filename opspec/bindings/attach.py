@@ -99,8 +99,14 @@ class AttachedDevices:
                             "simulation; add --realtime to follow the wall clock")
         if self.real_devices:
             chosen = speed if speed is not None else 1.0
-            return (config.with_options(realtime=True, speed=chosen),
-                    "a real device is bound: running on the wall clock")
+            note = "a real device is bound: running on the wall clock"
+            if horizon is not None:
+                # the default horizon is a day: at 1x, a run that seems to hang for hours
+                from opspec.clock import span
+
+                note += (f" at {chosen:g}x, so the run takes {span(horizon / chosen)} of wall "
+                         "time (--until or --speed shortens it; Ctrl+C stops it)")
+            return config.with_options(realtime=True, speed=chosen), note
         chosen = speed if speed is not None else (
             max(1.0, horizon / EMULATOR_RUN_S) if horizon is not None else 60.0)
         note = ("only in-process emulators are bound: running on the wall clock (their "
