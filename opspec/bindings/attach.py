@@ -196,4 +196,32 @@ def attach_devices(bind_args: Sequence[str], profiles_dir: str | Path | None = N
         p.id for process in spec.package.processes for p in process.participants}
     bindings = bindings_from_args(bind_args, folder, inbox=inbox, settle_s=settle_s,
                                   ports=ports, participants=participants)
+    if spec is not None:
+        _say_what_runs_by_itself(bindings, spec)
     return AttachedDevices(bindings, inbox)
+
+
+def _say_what_runs_by_itself(bindings: Sequence[DeviceBinding], spec: CompiledPackage) -> None:
+    """A note on each binding for the automatic activities of its participants whose
+    Application id none of the bound profiles has as an operation. The engine sends an
+    automatic activity to a device by its Application id only; without one it runs by itself
+    (instantly, or for its duration), so a misspelt ``[operations.alarm_onn]`` looked like a
+    device that worked: bound, no fault, and the buzzer never asked."""
+    from opspec.engine.compiled import K_TASK
+    from opspec.engine.lanes import all_activities
+
+    routed = {op for binding in bindings for op in binding.profile.operations}
+    missing: dict[tuple[int, str, str], list[str]] = {}
+    for act in all_activities(spec):
+        if act.kind != K_TASK or not act.application or act.application in routed:
+            continue
+        for index, binding in enumerate(bindings):
+            if act.participant in binding.participants:
+                key = (index, act.participant, act.application)
+                missing.setdefault(key, []).append(f"{act.id} in {act.process}")
+    for (index, participant, application), where in missing.items():
+        profile = bindings[index].profile
+        bindings[index].notes.append(
+            f"{participant}: application {application!r} ({', '.join(sorted(set(where)))}) "
+            f"is not an operation of profile {profile.name}, so it runs by itself, not on "
+            f"the device (operations: {', '.join(sorted(profile.operations))})")
