@@ -1,6 +1,6 @@
 """The line of a device profile that a dotted key (``serial.baudrate``,
 ``operations.dispense.command``) comes from, so a profile error reads ``file:line: key``
-and an editor can jump to it.
+(a TOML syntax error ``file:line:``) and an editor can jump to it.
 
 tomllib keeps no positions, so the text is scanned for table headers and ``key =`` lines.
 A key written inside an inline table (``emulate = { reply = … }``) or never written (a
@@ -10,11 +10,41 @@ required key that is missing) is placed at the nearest enclosing key or table th
 from __future__ import annotations
 
 import re
+from pathlib import Path
 
-__all__ = ["key_line"]
+from opspec.errors import BindingError, SourceLocation
+
+__all__ = ["key_line", "located"]
+
+#: where tomllib says a syntax error is: "… (at line 14, column 18)"
+_SYNTAX_AT = re.compile(r"\(at line (\d+), column \d+\)")
 
 _HEADER = re.compile(r"^\s*\[\[?\s*(?P<path>[^\[\]]+?)\s*\]\]?\s*(#.*)?$")
 _BARE = re.compile(r"[A-Za-z0-9_-]+")
+
+
+def located(error: BindingError, where: str) -> BindingError:
+    """``error`` about the profile file ``where``, placed at its line: the line its key is
+    written on (or the nearest written parent's), or a syntax error's line. Unchanged when
+    it has a line already, is about another file, or names no line to find."""
+    at = error.location
+    if at is None or at.line is not None or at.path != where:
+        return error
+    syntax = _SYNTAX_AT.search(error.message)
+    if syntax is not None:
+        line: int | None = int(syntax.group(1))
+    elif at.key:
+        try:
+            text = Path(where).read_text(encoding="utf-8")   # just read: it is text
+        except (OSError, UnicodeDecodeError):
+            return error
+        line = key_line(text, at.key)
+    else:
+        line = None
+    if line is None:
+        return error
+    return BindingError(error.message, location=SourceLocation(at.path, line, at.key),
+                        hint=error.hint)
 
 
 def key_line(text: str, key: str) -> int | None:

@@ -321,35 +321,18 @@ class _Table:
 
 def load_profile(path: str | os.PathLike[str]) -> DeviceProfile:
     """Read and validate one profile file; raise BindingError naming file and key."""
+    from opspec.bindings.profile_lines import located
     from opspec.toml_files import read_toml
 
     where = str(path)
-    data = read_toml(path, what=f"device profile {where}", error=BindingError,
-                     syntax_hint="fix the syntax; see devices/README.md", missing=(
-                         f"device profile {where} does not exist",
-                         "profiles live in devices/; see `opspec devices list`"))
     try:
+        data = read_toml(path, what=f"device profile {where}", error=BindingError,
+                         syntax_hint="fix the syntax; see devices/README.md", missing=(
+                             f"device profile {where} does not exist",
+                             "profiles live in devices/; see `opspec devices list`"))
         return _build(where, data)
     except BindingError as error:
-        raise _with_line(error, where) from None
-
-
-def _with_line(error: BindingError, where: str) -> BindingError:
-    """``error`` placed at the line its key is written on (``file:line: key``)."""
-    from opspec.bindings.profile_lines import key_line
-
-    at = error.location
-    if at is None or at.line is not None or at.path != where:
-        return error
-    try:
-        text = Path(where).read_text(encoding="utf-8")   # read a moment ago: it is text
-    except (OSError, UnicodeDecodeError):
-        return error
-    line = key_line(text, at.key) if at.key else None
-    if line is None:
-        return error
-    return BindingError(error.message, location=SourceLocation(at.path, line, at.key),
-                        hint=error.hint)
+        raise located(error, where) from None
 
 
 def _build(path: str, data: Mapping[str, Any]) -> DeviceProfile:

@@ -86,3 +86,19 @@ def test_key_line_reads_quoted_dotted_and_nested_keys() -> None:
     assert key_line(text, "operations.go.port.url") == 7
     assert key_line(text, "operations.go.missing") == 4
     assert key_line(text, "participants") is None
+
+
+def test_a_syntax_error_is_placed_at_its_line(tmp_path: Path) -> None:
+    path = tmp_path / "board.toml"
+    path.write_text('format = 1\nparticipants = ["alarm"]\nx = = 3\n', encoding="utf-8")
+    with pytest.raises(BindingError) as refused:
+        load_profile(path)
+    assert str(refused.value).startswith(f"{path}:3: not valid TOML: ")
+
+
+def test_a_syntax_error_at_the_end_of_the_file_has_no_line(tmp_path: Path) -> None:
+    path = tmp_path / "board.toml"
+    path.write_text('format = 1\nparticipants = ["alarm"\n', encoding="utf-8")
+    with pytest.raises(BindingError) as refused:
+        load_profile(path)
+    assert str(refused.value).startswith(f"{path}: not valid TOML: ")
