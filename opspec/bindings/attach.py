@@ -198,6 +198,7 @@ def attach_devices(bind_args: Sequence[str], profiles_dir: str | Path | None = N
                                   ports=ports, participants=participants)
     if spec is not None:
         _say_what_runs_by_itself(bindings, spec)
+        _say_which_events_nothing_hears(bindings, spec)
     return AttachedDevices(bindings, inbox)
 
 
@@ -225,3 +226,27 @@ def _say_what_runs_by_itself(bindings: Sequence[DeviceBinding], spec: CompiledPa
             f"{participant}: application {application!r} ({', '.join(sorted(set(where)))}) "
             f"is not an operation of profile {profile.name}, so it runs by itself, not on "
             f"the device (operations: {', '.join(sorted(profile.operations))})")
+
+
+def _say_which_events_nothing_hears(bindings: Sequence[DeviceBinding],
+                                    spec: CompiledPackage) -> None:
+    """A note on each binding whose profile raises a message trigger the spec never names
+    (no catch, throw or start event): the device's line, a button press, would be kept a
+    while and lost, with nothing saying the profile's ``trigger`` is misspelt."""
+    from opspec.engine.lanes import all_activities
+
+    triggers = [t for act in all_activities(spec)
+                for t in (act.raises, act.trigger, act.start_trigger, act.end_trigger)]
+    for process in spec.processes.values():
+        triggers += [process.start_trigger, process.end_trigger,
+                     *(t for t, _ in process.start_events)]
+    named = {t.name for t in triggers if t is not None and t.name}
+    for binding in bindings:
+        for event in binding.profile.events.values():
+            raised = (event.trigger or "").removeprefix("message:").removeprefix("signal:")
+            if raised and raised not in named:
+                binding.notes.append(
+                    f"{binding.profile.name}: event {event.name!r} raises trigger "
+                    f"{event.trigger!r}, which this spec never catches: such lines from the "
+                    f"device ({event.line.text!r}) are lost (the spec's triggers: "
+                    f"{', '.join(sorted(named)) or 'none'})")

@@ -49,3 +49,15 @@ def test_the_caregivers_message_is_said_to_be_no_device_work() -> None:
 def test_without_a_spec_nothing_is_checked() -> None:
     with attach_devices([f"alarm={URL}"], DEVICES) as devices:
         assert len(devices.notes) == 1
+
+
+def test_an_event_raising_a_trigger_the_spec_never_names_is_said_to_be_lost(
+        tmp_path: Path) -> None:
+    text = (DEVICES / "medication_dispenser.toml").read_text(encoding="utf-8")
+    (tmp_path / "medication_dispenser.toml").write_text(
+        text.replace('trigger = "trg_1"', 'trigger = "trg_11"'), encoding="utf-8")
+    with attach_devices([f"alarm={URL}"], tmp_path, spec=_compiled()) as devices:
+        assert devices.notes[1:] == [(
+            "medication_dispenser: event 'report' raises trigger 'trg_11', which this spec "
+            "never catches: such lines from the device ('BUTTON REPORT') are lost (the spec's "
+            "triggers: trg_1, trg_2)")]
