@@ -58,6 +58,8 @@ class AttachedDevices:
         self.performers: dict[str, DeviceBinding] = {
             participant: binding for binding in self.bindings
             for participant in binding.participants}
+        for binding in self.bindings:   # work routed by Application id to the wrong one
+            binding.peers = self.performers
         self.notes: list[str] = [note for b in self.bindings for note in b.notes]
         self._sim: Simulation | None = None
         self._reported = False
@@ -97,8 +99,14 @@ class AttachedDevices:
                             "simulation; add --realtime to follow the wall clock")
         if self.real_devices:
             chosen = speed if speed is not None else 1.0
-            return (config.with_options(realtime=True, speed=chosen),
-                    "a real device is bound: running on the wall clock")
+            note = "a real device is bound: running on the wall clock"
+            if horizon is not None:
+                # the default horizon is a day: at 1x, a run that seems to hang for hours
+                from opspec.clock import span
+
+                note += (f" at {chosen:g}x, so the run takes {span(horizon / chosen)} of wall "
+                         "time (--until or --speed shortens it; Ctrl+C stops it)")
+            return config.with_options(realtime=True, speed=chosen), note
         chosen = speed if speed is not None else (
             max(1.0, horizon / EMULATOR_RUN_S) if horizon is not None else 60.0)
         note = ("only in-process emulators are bound: running on the wall clock (their "
@@ -188,4 +196,57 @@ def attach_devices(bind_args: Sequence[str], profiles_dir: str | Path | None = N
         p.id for process in spec.package.processes for p in process.participants}
     bindings = bindings_from_args(bind_args, folder, inbox=inbox, settle_s=settle_s,
                                   ports=ports, participants=participants)
+    if spec is not None:
+        _say_what_runs_by_itself(bindings, spec)
+        _say_which_events_nothing_hears(bindings, spec)
     return AttachedDevices(bindings, inbox)
+
+
+def _say_what_runs_by_itself(bindings: Sequence[DeviceBinding], spec: CompiledPackage) -> None:
+    """A note on each binding for the automatic activities of its participants whose
+    Application id none of the bound profiles has as an operation. The engine sends an
+    automatic activity to a device by its Application id only; without one it runs by itself
+    (instantly, or for its duration), so a misspelt ``[operations.alarm_onn]`` looked like a
+    device that worked: bound, no fault, and the buzzer never asked."""
+    from opspec.engine.compiled import K_TASK
+    from opspec.engine.lanes import all_activities
+
+    routed = {op for binding in bindings for op in binding.profile.operations}
+    missing: dict[tuple[int, str, str], list[str]] = {}
+    for act in all_activities(spec):
+        if act.kind != K_TASK or not act.application or act.application in routed:
+            continue
+        for index, binding in enumerate(bindings):
+            if act.participant in binding.participants:
+                key = (index, act.participant, act.application)
+                missing.setdefault(key, []).append(f"{act.id} in {act.process}")
+    for (index, participant, application), where in missing.items():
+        profile = bindings[index].profile
+        bindings[index].notes.append(
+            f"{participant}: application {application!r} ({', '.join(sorted(set(where)))}) "
+            f"is not an operation of profile {profile.name}, so it runs by itself, not on "
+            f"the device (operations: {', '.join(sorted(profile.operations))})")
+
+
+def _say_which_events_nothing_hears(bindings: Sequence[DeviceBinding],
+                                    spec: CompiledPackage) -> None:
+    """A note on each binding whose profile raises a message trigger the spec never names
+    (no catch, throw or start event): the device's line, a button press, would be kept a
+    while and lost, with nothing saying the profile's ``trigger`` is misspelt."""
+    from opspec.engine.lanes import all_activities
+
+    triggers = [t for act in all_activities(spec)
+                for t in (act.raises, act.trigger, act.start_trigger, act.end_trigger)]
+    for process in spec.processes.values():
+        triggers += [process.start_trigger, process.end_trigger,
+                     *(t for t, _ in process.start_events)]
+    named = {t.name for t in triggers if t is not None and t.name}
+    for binding in bindings:
+        for event in binding.profile.events.values():
+            raised = (event.trigger or "").removeprefix("message:").removeprefix("signal:")
+            if raised and raised not in named:
+                binding.notes.append(
+                    f"{binding.profile.name}: event {event.name!r} raises trigger "
+                    f"{event.trigger!r}, which this spec never catches: such lines from the "
+                    f"device ({event.line.text!r}) are lost (the spec's triggers: "
+                    f"{', '.join(sorted(named)) or 'none'})")

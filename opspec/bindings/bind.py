@@ -49,13 +49,14 @@ def bind(participants: str | Sequence[str], url: str, profile: DeviceProfile, *,
             return DeviceBinding(profile, names, None, None, inbox=inbox, notes=[
                 f"{label}: {how}, using the simulated {label}"])
         try:
-            port = open_port(found, profile.serial, label)
+            port = open_port(found, profile.serial, label, Path(profile.path).parent)
         except BindingError as error:
             return DeviceBinding(profile, names, None, None, inbox=inbox, notes=[
                 f"{error.message}; using the simulated {label}"])
         url, notes = found, [how, f"{label}: bound to {found} ({profile.name})"]
     else:
-        port = open_port(url, profile.serial, label)
+        # emulator://NAME finds NAME beside the bound profile first (--devices DIR)
+        port = open_port(url, profile.serial, label, Path(profile.path).parent)
         notes = [f"{label}: bound to {url} ({profile.name})"]
     settle = settle_s if settle_s is not None else (
         profile.serial.settle_s if "://" not in url else 0.0)

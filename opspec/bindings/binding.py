@@ -124,8 +124,22 @@ class DeviceBinding(Exchanges, Reconnection, Fallback):
         if self._port is not None and self._reader is None:
             self._start_reader(self._port)
 
+    def _peer(self, item: WorkItem) -> DeviceBinding | None:
+        """The other binding of this run that serves ``item``'s participant, if any."""
+        participant = item.participant or ""
+        if participant in self._modes:
+            return None
+        peer = self.peers.get(participant)
+        return peer if isinstance(peer, DeviceBinding) and peer is not self else None
+
     def offer(self, item: WorkItem) -> None:
         participant = item.participant or ""
+        peer = self._peer(item)
+        if peer is not None:
+            # routed here by Application id (the engine keeps one binding per id) for a
+            # participant bound to another port: that port performs it
+            peer.offer(item)
+            return
         # routed here by Application id (see ``applications``) for a participant this run
         # did not bind to the device: the simulated device performs it
         if self.mode(participant) == "simulated" or (
@@ -159,6 +173,10 @@ class DeviceBinding(Exchanges, Reconnection, Fallback):
         self._pump()
 
     def withdraw(self, item: WorkItem, reason: str) -> None:
+        peer = self._peer(item)
+        if peer is not None:
+            peer.withdraw(item, reason)
+            return
         self._sim.withdraw(item, reason)
         self._waiting = [w for w in self._waiting if w.key != item.key]
         for job in (*self._queue, self._inflight):

@@ -12,7 +12,7 @@ from __future__ import annotations
 
 import threading
 from collections import deque
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any, Final, Literal
 
@@ -75,6 +75,11 @@ class BindingState:
         #: The data of every fault reported, in order (also in the trace), plus ``at``: the
         #: simulated time it was reported (None before :meth:`attach`).
         self.faults: list[dict[str, Any]] = []
+        #: participant id → the binding of the same run that serves it (set by
+        #: :class:`~opspec.bindings.attach.AttachedDevices`): the engine routes each
+        #: Application id to one binding, whichever registered it last, so work for a
+        #: participant bound elsewhere is passed on (see ``DeviceBinding.offer``).
+        self.peers: Mapping[str, Any] = {}
         self._session: PerformerSession | None = None
         self._sim = ProfileSimulator(profile)
         start: Mode = "device" if port is not None else "simulated"

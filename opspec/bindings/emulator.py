@@ -30,12 +30,39 @@ from opspec.errors import BindingError
 __all__ = [
     "DISCONNECT",
     "GARBAGE",
+    "MAX_DELAY_S",
     "Behaviour",
     "EmulatedDevice",
     "PtyEmulator",
     "Reply",
     "SocketEmulator",
+    "parse_event",
 ]
+
+#: The longest wait the emulator takes (a late reply, an event's delay): a week. Beyond it (or
+#: ``inf``, ``nan``) the select loop's timeout overflows and the emulator thread dies.
+MAX_DELAY_S: Final = 7 * 86400.0
+
+
+def _delay(text: str, scale: float = 1.0) -> float:
+    """``text`` (a number) times ``scale`` as seconds; ValueError unless 0 to MAX_DELAY_S."""
+    value = float(text) * scale
+    if not 0.0 <= value <= MAX_DELAY_S:        # nan compares false: refused too
+        raise ValueError(text)
+    return value
+
+
+def parse_event(spec: str, option: str = "--event") -> tuple[str, float]:
+    """``NAME@SECONDS`` (``--event``, ``emulator://…?event=``): the event's name and how many
+    seconds from now it is sent; BindingError naming ``option`` for a bad delay."""
+    name, _, after = spec.partition("@")
+    try:
+        return name, _delay(after or "0")
+    except ValueError:
+        raise BindingError(f"{option} {spec!r}: expected NAME@SECONDS, e.g. report@5",
+                           hint=f"SECONDS is a number from 0 to {MAX_DELAY_S:,.0f} "
+                           "(a week)") from None
+
 
 BehaviourKind = Literal["none", "silent", "garbage", "late", "disconnect", "error"]
 #: What the ``garbage`` behaviour sends: undecodable bytes and no known reply.
@@ -68,16 +95,17 @@ class Behaviour:
             if kind == "none" and not arg:
                 return cls()
             if kind in ("silent", "garbage"):
-                return cls(kind, count=int(arg) if arg else None)  # type: ignore[arg-type]
+                return cls(kind, count=_count(arg) if arg else None)  # type: ignore[arg-type]
             if kind == "late":
-                return cls("late", delay_s=float(arg) / 1000.0)
+                return cls("late", delay_s=_delay(arg, 1e-3))
             if kind == "disconnect":
-                return cls("disconnect", count=int(arg))
+                return cls("disconnect", count=_count(arg))
             if kind == "error" and arg:
                 return cls("error", line=arg)
         except ValueError:
             pass
-        raise BindingError(f"unknown emulator fault {spec!r}", hint=usage)
+        raise BindingError(f"unknown emulator fault {spec!r}", hint=f"{usage}; N is a whole "
+                           f"number >= 0, MS from 0 to {MAX_DELAY_S * 1000:,.0f}")
 
     def describe(self) -> str:
         if self.kind == "late":
@@ -85,6 +113,13 @@ class Behaviour:
         if self.kind == "error":
             return f"error:{self.line}"
         return self.kind if self.count is None else f"{self.kind}:{self.count}"
+
+
+def _count(text: str) -> int:
+    value = int(text)
+    if value < 0:
+        raise ValueError(text)
+    return value
 
 
 @dataclass(frozen=True, slots=True)

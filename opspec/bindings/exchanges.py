@@ -108,6 +108,10 @@ class Exchanges(BindingState):
     def _on_garbage(self, gen: int, raw: bytes, why: str) -> None:
         if gen != self._generation or self._connection == "closed":
             return
+        if self.url is not None and "://" not in self.url:
+            # on a serial line, garbage is mostly a baud rate the device does not use
+            why += (f"; is {self.profile.serial.baudrate} baud, the profile's [serial] "
+                    "baudrate, the device's?")
         message = f"garbled data from {self.url} ({why}): {raw[:40]!r}"
         if self._inflight is not None:       # the reply may follow (see _on_line)
             self._inflight.noise.append(("garbage", message))

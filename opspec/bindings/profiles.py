@@ -321,14 +321,18 @@ class _Table:
 
 def load_profile(path: str | os.PathLike[str]) -> DeviceProfile:
     """Read and validate one profile file; raise BindingError naming file and key."""
+    from opspec.bindings.profile_lines import located
     from opspec.toml_files import read_toml
 
     where = str(path)
-    data = read_toml(path, what=f"device profile {where}", error=BindingError,
-                     syntax_hint="fix the syntax; see devices/README.md", missing=(
-                         f"device profile {where} does not exist",
-                         "profiles live in devices/; see `opspec devices list`"))
-    return _build(where, data)
+    try:
+        data = read_toml(path, what=f"device profile {where}", error=BindingError,
+                         syntax_hint="fix the syntax; see devices/README.md", missing=(
+                             f"device profile {where} does not exist",
+                             "profiles live in devices/; see `opspec devices list`"))
+        return _build(where, data)
+    except BindingError as error:
+        raise located(error, where) from None
 
 
 def _build(path: str, data: Mapping[str, Any]) -> DeviceProfile:

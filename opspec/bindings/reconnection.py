@@ -7,6 +7,7 @@ from __future__ import annotations
 import threading
 from collections import deque
 from functools import partial
+from pathlib import Path
 
 import serial
 
@@ -98,7 +99,8 @@ class Reconnection(BindingState):
                 if self._closed.wait(self.profile.fallback.reconnect_delay_s):
                     return
                 try:
-                    port = open_port(self.url, self.profile.serial)
+                    port = open_port(self.url, self.profile.serial,
+                                     profiles_dir=Path(self.profile.path).parent)
                 except BindingError as error:
                     last = error.message
                     continue

@@ -10,10 +10,13 @@ must only post into an :class:`~opspec.bindings.inbox.Inbox` from there.
 
 from __future__ import annotations
 
+import errno
+import os
 import threading
 import time
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
+from typing import Any
 
 import serial
 import serial.threaded
@@ -45,36 +48,71 @@ def register_url_handlers() -> None:
 register_url_handlers()
 
 
-def open_port(url: str, settings: SerialSettings, who: str = "") -> serial.Serial:
+def open_port(url: str, settings: SerialSettings, who: str = "",
+              profiles_dir: str | os.PathLike[str] | None = None) -> serial.Serial:
     """Open ``url`` with the profile's settings, or raise BindingError naming the port and
-    the reason (the operating system's words, e.g. ``[Errno 2] No such file or directory``)."""
+    the reason (the operating system's words, e.g. ``[Errno 2] No such file or directory``).
+
+    A device path is opened for this process alone (POSIX ``flock``, as pySerial's
+    ``exclusive``): a second run bound to the same board would otherwise read half of the
+    first one's replies, and both would report garbage instead of a busy port.
+    ``profiles_dir``: where ``emulator://PROFILE`` looks a profile name up first (the folder
+    of the bound profile, i.e. ``--devices``)."""
     prefix = f"{who}: " if who else ""
+    extra: dict[str, Any] = {}
+    if "://" not in url:
+        extra["exclusive"] = True
+    elif url.startswith("emulator://") and profiles_dir is not None:
+        extra["profiles_dir"] = profiles_dir
     try:
         # every URL handler's class offers the serial.Serial API; the stubs say SerialBase
         port: serial.Serial = serial.serial_for_url(
             url, baudrate=settings.baudrate, bytesize=settings.bytesize,
             parity=settings.parity, stopbits=settings.stopbits, timeout=_POLL_S,
-            write_timeout=max(1.0, settings.reply_timeout_s),
+            write_timeout=max(1.0, settings.reply_timeout_s), **extra,
         )
     except ValueError as error:  # unknown URL scheme, bad option in the URL
         raise BindingError(f"{prefix}cannot open {url}: {error}",
                            hint="use a device path, loop://, socket://HOST:PORT, "
                            "rfc2217://HOST:PORT or emulator://PROFILE") from None
     except (serial.SerialException, OSError) as error:
+        if _locked(error):
+            raise BindingError(f"{prefix}cannot open {url}: it is in use by another program",
+                               hint="close the other program that has the port open (another "
+                               "opspec run, a serial monitor) and try again") from None
         raise BindingError(f"{prefix}cannot open {url}: {_reason(error)}",
-                           hint="check the cable and the path (`opspec devices list`), and "
-                           "that you may use the port (e.g. membership of the dialout group)"
-                           ) from None
+                           hint=_open_hint(url)) from None
     except Exception as error:  # noqa: BLE001 - e.g. termios.error from a dying pty
         raise BindingError(f"{prefix}cannot open {url}: {type(error).__name__}: {error}",
                            hint="the port vanished or is not a serial device") from None
     return port
 
 
+def _locked(error: BaseException) -> bool:
+    """Whether opening failed because another process holds the port's exclusive lock."""
+    return (getattr(error, "errno", None) in (errno.EAGAIN, errno.EWOULDBLOCK)
+            and "exclusively lock" in str(error))
+
+
+def _open_hint(url: str) -> str:
+    """What to check when ``url`` would not open: a cable and permissions for a device path,
+    a listening server for a network URL, the URL itself for an emulator."""
+    scheme = url.split("://", 1)[0].lower() if "://" in url else ""
+    if scheme in ("socket", "rfc2217"):
+        return ("check that a device server (or `opspec devices emulate PROFILE --port "
+                "socket://HOST:PORT`) is listening at that host and port")
+    if scheme == "emulator":
+        return ("write emulator://PROFILE (a profile name or .toml path) with optional "
+                "?fault=SPEC&event=NAME@SECONDS; see devices/README.md")
+    return ("check the cable and the path (`opspec devices list`), and that you may use "
+            "the port (e.g. membership of the dialout group)")
+
+
 def _reason(error: BaseException) -> str:
     text = str(error)
-    # pyserial repeats itself: "[Errno 2] could not open port X: [Errno 2] No such file…"
-    if "could not open port" in text and ": [Errno" in text:
+    # pyserial repeats itself: "[Errno 2] could not open port X: [Errno 2] No such file…",
+    # and socket:// "Could not open port socket://…: [Errno 111] Connection refused"
+    if "could not open port" in text.lower() and ": [Errno" in text:
         text = text[text.rindex(": [Errno") + 2:]
     return text
 

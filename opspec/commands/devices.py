@@ -7,6 +7,7 @@ pseudo-terminal or a socket. Device profiles live in devices/ (see devices/READM
 from __future__ import annotations
 
 import argparse
+import math
 import sys
 import threading
 from typing import Any
@@ -42,11 +43,28 @@ def register(subparsers: Any) -> None:
                          help="none, silent[:N], garbage[:N], late:MS, disconnect:N, error:LINE")
     emulate.add_argument("--event", action="append", default=[], metavar="NAME@SECONDS",
                          help="send event NAME after SECONDS (repeatable), e.g. report@5")
-    emulate.add_argument("--duration", type=float, metavar="SECONDS",
+    emulate.add_argument("--duration", type=_duration, metavar="SECONDS",
                          help="stop after SECONDS instead of waiting for Ctrl+C")
     emulate.add_argument("--quiet", action="store_true", help="do not print the traffic")
     emulate.add_argument("--profiles", metavar="DIR", help="profile folder (default: devices/)")
     emulate.set_defaults(handler=_emulate)
+
+
+#: The longest --duration: a year (longer, or inf, overflows the wait; leave it out instead).
+MAX_DURATION_S = 366 * 86400.0
+
+
+def _duration(text: str) -> float:
+    """``--duration``: seconds from 0 to :data:`MAX_DURATION_S`."""
+    try:
+        value = float(text)
+    except ValueError:
+        value = math.nan
+    if not 0.0 <= value <= MAX_DURATION_S:     # nan compares false: refused too
+        raise argparse.ArgumentTypeError(
+            f"{text!r}: expected seconds from 0 to {MAX_DURATION_S:,.0f} (a year); "
+            "leave --duration out to emulate until Ctrl+C")
+    return value
 
 
 def _list(args: argparse.Namespace) -> int:
@@ -81,19 +99,14 @@ def _emulate(args: argparse.Namespace) -> int:
         EmulatedDevice,
         PtyEmulator,
         SocketEmulator,
+        parse_event,
     )
     from opspec.bindings.profiles import resolve_profile
     from opspec.errors import BindingError
 
     profile = resolve_profile(args.profile, args.profiles)
     device = EmulatedDevice(profile, Behaviour.parse(args.fault))
-    events: list[tuple[str, float]] = []
-    for spec in args.event:
-        name, _, after = spec.partition("@")
-        try:
-            events.append((name, float(after or 0)))
-        except ValueError:
-            raise BindingError(f"--event {spec!r}: expected NAME@SECONDS, e.g. report@5") from None
+    events = [parse_event(spec) for spec in args.event]
     if args.port == "pty":
         server: PtyEmulator | SocketEmulator = PtyEmulator(device)
     elif args.port.startswith("socket://"):
@@ -118,7 +131,9 @@ def _emulate(args: argparse.Namespace) -> int:
         participants = ", ".join(profile.participants)
         print(f"Emulating {profile.name} ({participants}), fault "
               f"{device.behaviour.describe()}, on {server.url}", flush=True)
-        print(f"  bind it with: --bind {profile.participants[0]}={server.url}", flush=True)
+        # every participant the device serves: one left out would run simulated, unsaid
+        binds = " ".join(f"--bind {p}={server.url}" for p in profile.participants)
+        print(f"  bind it with: {binds}", flush=True)
         if profile.events:
             print(f"  events: {', '.join(profile.events)} (type a name and Enter to send it)",
                   flush=True)

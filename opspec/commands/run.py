@@ -158,6 +158,10 @@ def run(args: argparse.Namespace) -> int:
                       "deadline misses and failures always (--timeline all: every event)",
                       file=out)
             print(file=out)
+        if devices is not None:   # after the trace opened: Ctrl+C still traces what was open
+            from opspec.commands.devices_summary import report_when_interrupted
+
+            stack.push(report_when_interrupted(devices, sys.stderr))
         outcome = prepared.but(config=config, listeners=tuple(listeners),
                                devices=devices, params=params).build().execute()
         result = outcome.result
@@ -500,21 +504,11 @@ def _print_summary(out: Any, result: RunResult, medians: dict[str, float], trace
         print(f"wall-clock drift: mean {drift.get('mean_s', 0) * 1000:.2f} ms, "
               f"max {drift.get('max_s', 0) * 1000:.2f} ms over {drift.get('events', 0)} "
               "events", file=out)
-    for name, info in (devices or {}).items():
-        latency = info.get("latency_ms") or {}
-        modes = ", ".join(f"{p} {m}" for p, m in (info.get("mode") or {}).items())
-        where = info.get("url") or "simulated"
-        rtt = (f"round trip mean {latency.get('mean')} ms, p99 {latency.get('p99')} ms, "
-               f"max {latency.get('max')} ms over {latency.get('count')} commands"
-               if latency.get("count") else "no commands answered")
-        faults = info.get("faults") or []
-        print(f"device {name} ({info.get('profile')} on {where}): {modes}; {rtt}; "
-              f"{len(faults)} fault(s)", file=out)
-        for fault in faults[:5]:
-            print(f"  fault {fault.get('fault')}: {fault.get('message')} "
-                  f"(then {fault.get('action')})", file=out)
-        for waiting in info.get("pending") or []:
-            print(f"  unfinished at the end: {waiting.get('message')}", file=out)
+    if devices:
+        from opspec.commands.devices_summary import device_lines
+
+        for line in device_lines(devices):
+            print(line, file=out)
     if absent:
         print(_absent_note(absent, no_user), file=out)
     for problem in _real_deadlocks(result, absent or []):

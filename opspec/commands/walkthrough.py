@@ -171,18 +171,28 @@ def run(args: argparse.Namespace) -> int:
         app = WalkthroughApp(session, title=package.name or package.id, notes=notes,
                              large=args.large, high_contrast=args.high_contrast, sound=cue)
         interrupted = False
+        device_report = None
         try:
             app.run()
         except KeyboardInterrupt:          # a SIGINT from outside the terminal's keys
             interrupted = True
         finally:
             cue.close()
-            session.close()
+            try:
+                if devices is not None:    # traced (device.pending) while the trace is open
+                    device_report = devices.report()
+            finally:
+                session.close()
     if session.failure is not None:            # shown in the app; said again in one line
         print(f"opspec walkthrough: {session.failure}", file=sys.stderr)
     # the end in words, as the app showed it: metrics, response times, the recording and the
     # commands that replay it (quoted: they paste as they are)
     print("\n".join(session.summary_lines()))
+    if device_report:                          # how the bound devices did, as opspec run says
+        from opspec.commands.devices_summary import device_lines
+
+        print("\n".join(device_lines(device_report, "when interrupted" if interrupted
+                                      else "at the end")))
     return 130 if interrupted else 1 if session.failure is not None else 0
 
 

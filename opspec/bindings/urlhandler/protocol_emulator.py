@@ -3,14 +3,16 @@
 Built on pySerial's ``loop://``: what the binding writes is answered by an
 :class:`~opspec.bindings.emulator.EmulatedDevice` on the writing thread, and the replies are
 queued for reading (late replies and events from a timer). No thread, pty or socket, so unit
-tests are fast and deterministic. ``PROFILE`` is a profile file path or a profile name in the
-default profile directory; ``fault`` takes the ``--fault`` forms of ``opspec devices
+tests are fast and deterministic. ``PROFILE`` is a profile file path or a profile name, looked
+up in the folder of the profile it is bound with (``--devices``; ``profiles_dir``, passed by
+:func:`~opspec.bindings.transport.open_port`), then in the default profile directory; ``fault`` takes the ``--fault`` forms of ``opspec devices
 emulate``. A ``disconnect`` makes the next read raise ``SerialException`` while ``is_open``
 stays True, exactly like an unplugged USB adapter; reopening gives a fresh device.
 """
 
 from __future__ import annotations
 
+import os
 import threading
 import urllib.parse
 from typing import Any
@@ -18,8 +20,8 @@ from typing import Any
 from serial.serialutil import PortNotOpenError, SerialException
 from serial.urlhandler import protocol_loop
 
-from opspec.bindings.emulator import Behaviour, EmulatedDevice, Reply
-from opspec.bindings.profiles import resolve_profile
+from opspec.bindings.emulator import Behaviour, EmulatedDevice, Reply, parse_event
+from opspec.bindings.profiles import DeviceProfile, resolve_profile
 from opspec.errors import OpspecError
 
 __all__ = ["Serial"]
@@ -28,7 +30,9 @@ __all__ = ["Serial"]
 class Serial(protocol_loop.Serial):
     """A loop:// port whose other end is an emulated device."""
 
-    def __init__(self, *args: Any, **kwargs: Any) -> None:
+    def __init__(self, *args: Any, profiles_dir: str | os.PathLike[str] | None = None,
+                 **kwargs: Any) -> None:
+        self.profiles_dir = profiles_dir
         self.device: EmulatedDevice | None = None
         self._vanished = False
         self._pending = b""
@@ -44,20 +48,35 @@ class Serial(protocol_loop.Serial):
             raise ValueError(f"unknown option {min(unknown)!r} in {url} "
                              "(emulator:// takes fault= and event=NAME@SECONDS)")
         try:
-            profile = resolve_profile(urllib.parse.unquote(where))
+            profile = self._profile(urllib.parse.unquote(where))
             behaviour = Behaviour.parse(options.get("fault", ["none"])[-1])
         except OpspecError as error:
             raise SerialException(f"emulator: {error}") from None
         self.device = EmulatedDevice(profile, behaviour)
         self._vanished = False
         for spec in options.get("event", []):
-            name, _, delay = spec.partition("@")
+            try:
+                name, seconds = parse_event(spec, "event=")
+            except OpspecError as error:
+                raise SerialException(f"emulator: {error}") from None
             try:
                 line = self.device.event_line(name)
-                seconds = float(delay or 0)
-            except (OpspecError, ValueError) as error:
+            except OpspecError as error:
                 raise SerialException(f"emulator: bad event {spec!r}: {error}") from None
             self._later(seconds, line)
+
+    def _profile(self, name: str) -> DeviceProfile:
+        """``name`` in ``profiles_dir`` when it is there (a designer's ``--devices`` folder
+        holds the boards being emulated), else as :func:`resolve_profile` finds it."""
+        if self.profiles_dir is None:
+            return resolve_profile(name)
+        try:
+            return resolve_profile(name, self.profiles_dir)
+        except OpspecError as there:
+            try:
+                return resolve_profile(name)
+            except OpspecError:
+                raise there from None   # the folder the designer named is the one to list
 
     def _later(self, delay: float, data: bytes) -> None:
         if delay <= 0:
