@@ -16,7 +16,6 @@ and a note (``info``) says it was not checked against the spec's user lane, and 
 
 from __future__ import annotations
 
-import re
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -33,8 +32,6 @@ NOT_CHECKED = "side-file-not-checked"
 # Errors that are found only once the engine compiled the spec: the user lane is known then.
 _AFTER_COMPILING = frozenset({"bad-world", "bad-monitor"})
 
-# tomllib names the place of a syntax error in its message only: "(at line 33, column 7)"
-_TOML_PLACE = re.compile(r"\(at line (\d+), column \d+\)")
 
 
 @dataclass(frozen=True, slots=True)
@@ -120,10 +117,12 @@ def _check_user_model(path: Path, compiled: Any) -> tuple[list[Diagnostic], bool
 def _as_diagnostic(error: OpspecError, path: Path) -> Diagnostic:
     """The run's refusal, as validate's error: the same message and hint, at the file and key
     the loader gives (and at the line tomllib names in a syntax error)."""
+    from opspec.toml_lines import syntax_line
+
     location = error.location or SourceLocation(str(path))
-    place = _TOML_PLACE.search(error.message)
-    if place is not None and location.line is None and location.key is None:
-        location = SourceLocation(location.path, int(place.group(1)))
+    line = syntax_line(error.message)
+    if line is not None and location.line is None and location.key is None:
+        location = SourceLocation(location.path, line)
     return Diagnostic(location, Severity.ERROR, BAD_USER_MODEL, error.message, error.hint)
 
 

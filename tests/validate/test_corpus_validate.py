@@ -50,8 +50,6 @@ ERRORS: dict[str, set[str]] = {
     "tibco-af__Test_multiple_pools_processes_and_lanes.xpdl": {"not-runnable"},
     # SubFlow Id="-unknown-"
     "tibcofrg___GPkNEEeyEd-eq-1NLZ2xQg.frg.xpdl": {"undefined-subflow"},
-    # a deadline with no duration
-    "tibcofrg___GQAR8EeyEd-eq-1NLZ2xQg.frg.xpdl": {"not-runnable"},
     # a Python 'timedelta(seconds=3)' deadline (shoobx.wfmc's grammar)
     "wfmc__deadline.xpdl": {"not-runnable"},
 }

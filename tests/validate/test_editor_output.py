@@ -64,10 +64,13 @@ def flow(*, fields: str = "", work: str = "<Implementation><No/></Implementation
 
 # -- validate reports what the engine refuses, at its line --------------------------------
 
-def test_an_empty_deadline_is_a_located_error_of_validate_and_compile_writes_nothing(
+def test_an_unreadable_deadline_is_a_located_error_of_validate_and_compile_writes_nothing(
         tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    # (a deadline with no duration is valid XPDL 2.x and never expires: a warning, it runs;
+    # tests/validate/test_deadline_refusal.py)
     path = spec(tmp_path, flow(work="<Implementation><No/></Implementation>"
-                               "<Deadline><DeadlineDuration></DeadlineDuration></Deadline>"))
+                               "<Deadline><DeadlineDuration>timedelta(seconds=3)"
+                               "</DeadlineDuration></Deadline>"))
     text = path.read_text(encoding="utf-8")
     assert codes(path, Severity.ERROR) == ["not-runnable"]
     assert main(["validate", str(path)]) == 1
