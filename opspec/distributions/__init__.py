@@ -31,9 +31,11 @@ lognormal, gamma, Weibull, truncated normal, exponential, ex-Gaussian),
 
 from __future__ import annotations
 
-# The public names are each module's own ``__all__``, written once there.
+# The public names are each module's own ``__all__``, written once there; base's FloatArray
+# is made on first use (its __getattr__, and this module's), so base is not star-imported.
 from opspec.distributions import base, bounded, factory, parametric
-from opspec.distributions.base import *  # noqa: F403
+from opspec.distributions.base import Distribution as Distribution
+from opspec.distributions.base import ParameterError as ParameterError
 from opspec.distributions.bounded import *  # noqa: F403
 from opspec.distributions.factory import *  # noqa: F403
 from opspec.distributions.parametric import *  # noqa: F403
@@ -43,3 +45,10 @@ __all__ += base.__all__
 __all__ += bounded.__all__
 __all__ += factory.__all__
 __all__ += parametric.__all__
+
+
+def __getattr__(name: str) -> object:
+    """``FloatArray``, from :mod:`opspec.distributions.base` when first read (numpy)."""
+    if name == "FloatArray":
+        return base.FloatArray
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

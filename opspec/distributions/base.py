@@ -20,9 +20,21 @@ if TYPE_CHECKING:
 
 __all__ = ["Distribution", "FloatArray", "ParameterError"]
 
-# numpy is imported where an array is made, not here: a user model is loaded and checked
-# without it (`opspec validate SPEC` checks the companion user model: issue 31's start-up)
-FloatArray: TypeAlias = "npt.NDArray[np.float64]"
+if TYPE_CHECKING:
+    FloatArray: TypeAlias = npt.NDArray[np.float64]
+
+
+def __getattr__(name: str) -> Any:
+    """``FloatArray`` (numpy's array of floats), made when first read: numpy is imported
+    where an array is made, not by this module, so that a user model is loaded and checked
+    without it (`opspec validate SPEC` checks the companion user model: issue 31's
+    start-up)."""
+    if name == "FloatArray":
+        import numpy as np
+        import numpy.typing as npt
+
+        return npt.NDArray[np.float64]
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
 _STD_NORMAL = NormalDist()
 _SQRT2 = math.sqrt(2.0)
 

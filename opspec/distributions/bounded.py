@@ -11,7 +11,6 @@ from typing import TYPE_CHECKING, Any
 
 from opspec.distributions.base import (
     Distribution,
-    FloatArray,
     ParameterError,
     _check_fields,
     _check_q,
@@ -23,6 +22,8 @@ from opspec.distributions.base import (
 if TYPE_CHECKING:
     # imported where an array is made (FloatArray: base.py)
     import numpy as np
+
+    from opspec.distributions.base import FloatArray
 
 __all__ = ["Empirical", "Triangular", "Uniform", "WithExponentialTail"]
 

@@ -10,7 +10,6 @@ from typing import TYPE_CHECKING, Any, Self
 from opspec.distributions.base import (
     _STD_NORMAL,
     Distribution,
-    FloatArray,
     ParameterError,
     _check_fields,
     _check_q,
@@ -24,6 +23,8 @@ from opspec.distributions.base import (
 if TYPE_CHECKING:
     # imported where an array is made (FloatArray: base.py)
     import numpy as np
+
+    from opspec.distributions.base import FloatArray
 
 __all__ = ["Constant", "ExGaussian", "Exponential", "Gamma", "LogNormal", "TruncatedNormal",
            "Weibull"]
