@@ -44,7 +44,7 @@ from typing import Any
 
 from opspec.errors import ConfigurationError, SourceLocation
 
-__all__ = ["Protocol", "Session", "Variant", "latin_square", "load_protocol"]
+__all__ = ["Protocol", "Session", "Variant", "keep_partial", "latin_square", "load_protocol"]
 
 
 @dataclass(frozen=True)
@@ -273,9 +273,16 @@ def session_app(protocol: Protocol, session: Session) -> tuple[Any, Any]:
 
 
 def _move_partial(session: Session) -> None:
-    """A broken-off attempt's recording and trace, kept as ``VARIANT.partial-N.*``."""
+    keep_partial(session)
+
+
+def keep_partial(session: Session) -> Path | None:
+    """A broken-off attempt's recording and trace, kept as ``VARIANT.partial-N.*`` (the
+    recording's new path; None when the session is done or recorded nothing). Done as soon
+    as the session breaks off, so that what is under ``VARIANT.json`` is a whole session,
+    and again before the session is started anew (a terminal closed gives no chance)."""
     if session.done or not (session.recording.exists() or session.trace.exists()):
-        return
+        return None
     n = 1
     while session.recording.with_name(f"{session.variant.id}.partial-{n}.json").exists() or \
             session.recording.with_name(f"{session.variant.id}.partial-{n}.trace.jsonl"
@@ -284,6 +291,7 @@ def _move_partial(session: Session) -> None:
     for old, suffix in ((session.recording, ".json"), (session.trace, ".trace.jsonl")):
         if old.exists():
             old.replace(old.with_name(f"{session.variant.id}.partial-{n}{suffix}"))
+    return session.recording.with_name(f"{session.variant.id}.partial-{n}.json")
 
 
 def finish_session(session: Session, walk: Any) -> bool:
@@ -344,10 +352,44 @@ def session_pairs(session: Session) -> dict[str, tuple[float, float]]:
     return _pairs(listener)
 
 
+def _metric_kinds(variant: Variant) -> dict[str, str]:
+    """Each metric of ``variant``'s spec and its kind (``count``, ``duration``, ``ratio``)."""
+    from opspec.xpdl.open_spec import open_spec
+
+    return {m.name: m.kind.value for m in open_spec(variant.spec).metrics}
+
+
+def variant_estimate(kind: str | None, pairs: list[tuple[float, float]]) -> dict[str, Any]:
+    """One metric of one variant over its participants, as ``opspec evaluate`` summarises a
+    design: a count's mean per participant with the t interval widened to the exact Poisson
+    (Garwood) one when there are few events, a proportion of counts (missed / due doses)
+    with Wilson's interval on the effective number of trials, anything else Σy/Σn with the
+    cluster-robust t interval. A t interval alone says [0, 0] for a count nobody had and a
+    rate of 0 of 16 doses, as if they could not happen."""
+    from opspec.statistics import (
+        count_estimate,
+        is_proportion,
+        proportion_interval,
+        ratio_estimate,
+    )
+
+    estimate = ratio_estimate(pairs)
+    ci, method = estimate.ci, estimate.method
+    if kind == "count":
+        estimate = count_estimate([y for y, _ in pairs])
+        ci, method = estimate.ci, estimate.method
+    elif kind == "ratio" and is_proportion(pairs):
+        ci = proportion_interval(pairs)
+        method = None if ci[0] is None else "wilson-neff"
+    return {"value": estimate.value, "ci95": list(ci), "ci95_method": method,
+            "unit": "s" if kind == "duration" else None, "participants": len(pairs)}
+
+
 def summary(protocol: Protocol) -> dict[str, Any]:
-    """Per variant, each metric over the participants who finished it; per pair of variants,
-    the paired difference over the participants who finished both (``opspec evaluate
-    --compare``'s statistics: a ratio over users with its delta-method interval)."""
+    """Per variant, each metric over the participants who finished it
+    (:func:`variant_estimate`); per pair of variants, the paired difference over the
+    participants who finished both (``opspec evaluate --compare``'s statistics: a ratio
+    over users with its delta-method interval)."""
     from opspec.statistics import paired_difference, ratio_estimate
 
     done: dict[str, dict[str, dict[str, tuple[float, float]]]] = {}
@@ -359,15 +401,16 @@ def summary(protocol: Protocol) -> dict[str, Any]:
             if s.done:
                 done.setdefault(s.variant.id, {})[participant] = session_pairs(s)
     variants: dict[str, Any] = {}
+    kinds: dict[str, str] = {}
     for v in protocol.variants:
         people = done.get(v.id, {})
         metrics: dict[str, Any] = {}
         names = sorted({m for pairs in people.values() for m in pairs})
+        of_variant = _metric_kinds(v) if names else {}
         for name in names:
+            kinds.setdefault(name, of_variant.get(name, ""))
             pairs = [p[name] for p in people.values() if name in p]
-            estimate = ratio_estimate(pairs)
-            metrics[name] = {"value": estimate.value, "ci95": list(estimate.ci),
-                             "participants": len(pairs)}
+            metrics[name] = variant_estimate(of_variant.get(name), pairs)
         variants[v.id] = {"participants": len(people), "metrics": metrics}
     comparisons = []
     ids = [v.id for v in protocol.variants]
@@ -386,6 +429,8 @@ def summary(protocol: Protocol) -> dict[str, Any]:
                 rows[name] = {"a": ratio_estimate([done[a][p][name] for p in who]).value,
                               "b": ratio_estimate([done[b][p][name] for p in who]).value,
                               "difference": diff.value, "ci95": list(diff.ci),
+                              "ci95_method": diff.method,
+                              "unit": "s" if kinds.get(name) == "duration" else None,
                               "participants": len(who)}
             comparisons.append({"a": a, "b": b, "participants": both, "metrics": rows})
     return {"study": protocol.name, "status": status, "variants": variants,
@@ -393,8 +438,8 @@ def summary(protocol: Protocol) -> dict[str, Any]:
 
 
 def summary_lines(doc: dict[str, Any]) -> list[str]:
-    def num(x: Any) -> str:
-        return "-" if x is None else f"{x:.4g}"
+    def num(x: Any, unit: str | None = None) -> str:
+        return "-" if x is None else f"{x:.4g}" + (f" {unit}" if unit else "")
 
     lines = [f"study {doc['study']}"]
     for participant, sessions in doc["status"].items():
@@ -404,7 +449,9 @@ def summary_lines(doc: dict[str, Any]) -> list[str]:
         lines.append(f"variant {vid} ({v['participants']} participant(s) finished):")
         for name, m in v["metrics"].items():
             lo, hi = m["ci95"]
-            lines.append(f"  {name}: {num(m['value'])} (95 % CI [{num(lo)}, {num(hi)}])")
+            unit = m.get("unit")
+            lines.append(f"  {name}: {num(m['value'], unit)} (95 % CI [{num(lo)}, {num(hi)}]"
+                         f"{' ' + unit if unit else ''}; n = {m['participants']})")
     for c in doc["comparisons"]:
         lines.append(f"{c['b']} - {c['a']}, paired over {len(c['participants'])} "
                      "participant(s) who did both:")
@@ -412,7 +459,9 @@ def summary_lines(doc: dict[str, Any]) -> list[str]:
             lines.append("  (needs two participants or more who did both)")
         for name, m in c["metrics"].items():
             lo, hi = m["ci95"]
-            lines.append(f"  {name}: {num(m['a'])} -> {num(m['b'])}, difference "
-                         f"{num(m['difference'])} (95 % CI [{num(lo)}, {num(hi)}])")
+            unit = m.get("unit")
+            lines.append(f"  {name}: {num(m['a'], unit)} -> {num(m['b'], unit)}, difference "
+                         f"{num(m['difference'], unit)} (95 % CI [{num(lo)}, {num(hi)}]"
+                         f"{' ' + unit if unit else ''}; n = {m['participants']})")
     return lines
 
