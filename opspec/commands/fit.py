@@ -103,7 +103,7 @@ def fitted_text(result: Any, draws: ParameterDraws | None, header: str = "") -> 
 
 def _fit(args: argparse.Namespace) -> int:
     from opspec.errors import UserModelError
-    from opspec.usermodels.fitting import fit_traces, iter_paths
+    from opspec.usermodels.fitting import fit_traces
     from opspec.usermodels.loader import load_user_model
 
     if args.min_per_user < 2:
@@ -127,10 +127,9 @@ def _fit(args: argparse.Namespace) -> int:
 
         check_options(CheckOptions(level=args.level, replicates=args.replicates,
                                    runs=args.runs))
-    paths = iter_paths(args.traces)
-    if not paths:
-        raise UserModelError("no trace files found in " + ", ".join(args.traces),
-                             hint="give .jsonl trace files or folders holding them")
+    from opspec.commands.model_check import trace_files
+
+    paths = trace_files(args.traces, "fit")
     out = Path(args.output) if args.output != "-" else None
     from opspec.commands._files import refuse_overwrite
 

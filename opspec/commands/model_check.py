@@ -29,7 +29,7 @@ if TYPE_CHECKING:
     from opspec.usermodels.persons import PersonRule
 
 __all__ = ["CheckOptions", "CrossValidation", "add_person_options", "check_model", "check_options",
-           "cross_validate", "register"]
+           "cross_validate", "register", "trace_files"]
 
 
 def add_person_options(parser: Any, counted: str = "") -> None:
@@ -109,6 +109,28 @@ def _draws(ref: str) -> Any:
     return _ComposedDraws(ref, draws, index)
 
 
+def trace_files(values: Sequence[str], command: str) -> list[Path]:
+    """The trace files ``values`` name (folders searched with their subfolders,
+    :func:`~opspec.usermodels.trace_reader.expand_traces`); the broken-off study sessions
+    left out are said on standard error, and no trace at all is a UserModelError."""
+    import sys
+
+    from opspec.errors import UserModelError
+    from opspec.usermodels.trace_reader import expand_traces
+
+    paths, left_out = expand_traces(values)
+    if left_out:
+        shown = ", ".join(str(p) for p in left_out[:3]) + (" ..." if len(left_out) > 3 else "")
+        print(f"opspec {command}: note: left out {len(left_out)} trace(s) of study sessions "
+              f"that broke off and were done again ({shown}); name such a file to read it",
+              file=sys.stderr)
+    if not paths:
+        raise UserModelError("no trace files found in " + ", ".join(values),
+                             hint="give .jsonl trace files or folders holding them (their "
+                             "subfolders are searched too)")
+    return paths
+
+
 def check_options(options: CheckOptions) -> None:
     from opspec.errors import UserModelError
 
@@ -185,15 +207,10 @@ def check_model(model: UserModel, model_ref: str | None, paths: Sequence[Path],
 
 
 def _model_check(args: argparse.Namespace) -> int:
-    from opspec.errors import UserModelError
-    from opspec.usermodels.fitting import iter_paths
     from opspec.usermodels.loader import load_user_model
     from opspec.usermodels.persons import PersonRule, parse_person_options
 
-    paths = iter_paths(args.traces)
-    if not paths:
-        raise UserModelError("no trace files found in " + ", ".join(args.traces),
-                             hint="give .jsonl trace files or folders holding them")
+    paths = trace_files(args.traces, "model-check")
     model = load_user_model(args.model)
     persons = PersonRule(args.person_from, args.person_pattern,
                          parse_person_options(args.person))
