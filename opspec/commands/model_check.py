@@ -177,6 +177,7 @@ def check_model(model: UserModel, model_ref: str | None, paths: Sequence[Path],
         )
 
         package = load_any_spec(options.spec, command="model-check")
+        notes.extend(_other_spec_notes(paths, options.spec))
         definitions = package.metrics
         if not definitions:
             notes.append(f"{options.spec} declares no outcome metrics (opspec:Metrics): "
@@ -204,6 +205,28 @@ def check_model(model: UserModel, model_ref: str | None, paths: Sequence[Path],
     return CheckReport(finish(items, options.level), options.level, len(obs.persons),
                        obs.sessions, options.replicates, options.seed, uncertainty,
                        tuple(notes))
+
+
+def _other_spec_notes(paths: Sequence[Path], spec: str) -> list[str]:
+    """A note when traces name (in their header's ``spec``) another spec than ``--spec``:
+    a study's variants recorded side by side (recordings/P01/A and B) would have their
+    metrics replayed with one spec's definitions and averaged per person."""
+    from opspec.usermodels.trace_reader import trace_header
+
+    others: dict[str, list[str]] = {}
+    for path in paths:
+        recorded = trace_header(path).get("spec")
+        if isinstance(recorded, str) and recorded and Path(recorded).stem != Path(spec).stem:
+            others.setdefault(Path(recorded).name, []).append(str(path))
+    if not others:
+        return []
+    files = [f for found in others.values() for f in found]
+    note = (f"{len(files)} of {len(paths)} trace file(s) were recorded with another spec than "
+            f"--spec {spec} ({', '.join(sorted(others))}: {', '.join(files[:3])}"
+            f"{' ...' if len(files) > 3 else ''}): their metrics are replayed with this "
+            "spec's definitions and averaged with the others per person; check each spec's "
+            "traces on their own")
+    return [note]
 
 
 def _model_check(args: argparse.Namespace) -> int:

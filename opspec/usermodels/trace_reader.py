@@ -20,7 +20,7 @@ from opspec.engine.trace import TRACE_FORMAT, TRACE_FORMAT_VERSION, TraceEvent
 from opspec.errors import SourceLocation, UserModelError
 from opspec.files import json_loads, json_problem
 
-__all__ = ["expand_traces", "iter_paths", "read_trace"]
+__all__ = ["expand_traces", "iter_paths", "read_trace", "trace_header"]
 
 
 def read_trace(path: str | Path) -> Iterator[TraceEvent]:
@@ -87,6 +87,23 @@ def read_trace(path: str | Path) -> Iterator[TraceEvent]:
                              location=SourceLocation(name)) from None
     finally:
         handle.close()
+
+
+def trace_header(path: str | Path) -> dict[str, object]:
+    """The first JSON line of a trace file (an empty dict when it cannot be read: the trace
+    reader then says what is wrong with the file, naming it)."""
+    from opspec.files import open_regular
+
+    try:
+        # a pipe or device is refused, never read (it would block); read_trace then says so
+        with io.TextIOWrapper(open_regular(path), encoding="utf-8") as handle:
+            for line in handle:
+                if line.strip():
+                    head = json_loads(line)
+                    return head if isinstance(head, dict) else {}
+    except (OSError, UnicodeDecodeError, json.JSONDecodeError):
+        return {}
+    return {}
 
 
 def _is_script(path: str | Path) -> bool:
