@@ -94,11 +94,14 @@ def _uncertainty_text(draws: ParameterDraws | None) -> str:
 
 def fitted_text(result: Any, draws: ParameterDraws | None, header: str = "") -> str:
     """The model file ``opspec fit`` writes for ``result``: the model with its comments, the
-    ``[vary]`` tables and the ``[uncertainty]`` redraws."""
+    ``[vary]`` tables, whom it was fitted on (``[fitted_on]``) and the ``[uncertainty]``
+    redraws."""
+    from opspec.usermodels.fitted_on import fitted_on_text
     from opspec.usermodels.loader import dump_user_model
 
     text = dump_user_model(result.model, comments=result.comments(), header=header)
-    return text + _vary_text(result.vary()) + _uncertainty_text(draws)
+    return (text + _vary_text(result.vary()) + fitted_on_text(result.observations.persons)
+            + _uncertainty_text(draws))
 
 
 def _fit(args: argparse.Namespace) -> int:

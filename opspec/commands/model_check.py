@@ -160,6 +160,7 @@ def check_model(model: UserModel, model_ref: str | None, paths: Sequence[Path],
     if persons is not None:
         persons.check_used(list(paths))
     obs = collect(paths, options.lane, persons)
+    overlap = _fitted_on_notes(model_ref, obs.persons)
     draws = (_draws(model_ref) if options.parameter_uncertainty and model_ref else None)
     repeated: dict[str, dict[str, int]] = {}
     traced = False
@@ -204,7 +205,25 @@ def check_model(model: UserModel, model_ref: str | None, paths: Sequence[Path],
         uncertainty = "ignored (--no-parameter-uncertainty)"
     return CheckReport(finish(items, options.level), options.level, len(obs.persons),
                        obs.sessions, options.replicates, options.seed, uncertainty,
-                       tuple(notes))
+                       tuple(overlap + notes))
+
+
+def _fitted_on_notes(model_ref: str | None, persons: Sequence[str]) -> list[str]:
+    """A note when people checked are among those the model was fitted on (its
+    ``[fitted_on]`` table): their fit to the model says little of new people."""
+    from opspec.usermodels.fitted_on import fitted_persons
+
+    fitted = fitted_persons(model_ref)
+    if not fitted:
+        return []
+    both = [p for p in persons if p in set(fitted)]
+    if not both:
+        return []
+    shown = ", ".join(both[:6]) + (" ..." if len(both) > 6 else "")
+    note = (f"{len(both)} of the {len(persons)} person(s) checked are among the "
+            f"{len(fitted)} the model was fitted on ({shown}; its [fitted_on] table): a check "
+            "on them is not a check on new people; give only people left out of the fit")
+    return [note]
 
 
 def _other_spec_notes(paths: Sequence[Path], spec: str) -> list[str]:
