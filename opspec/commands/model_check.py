@@ -314,7 +314,12 @@ class CrossValidation:
         out = []
         for f, (held, report) in enumerate(self.folds):
             names = ", ".join(held[:6]) + (" ..." if len(held) > 6 else "")
-            flagged = ", ".join(i.name for i in report.misfits) or "nothing misfits"
+            # the fold's own Holm is over its items only: what misfits there need not
+            # misfit over all folds (the verdict below), and is said to be the fold's
+            flagged = (f"misfit within this fold (Holm over its {len(report.items)} "
+                       "item(s), not over all folds): "
+                       + ", ".join(i.name for i in report.misfits)
+                       if report.misfits else "nothing misfits")
             out.append(f"fold {f + 1}/{k}: fitted without {len(held)} person(s) ({names}), "
                        f"checked on them: {flagged}")
         total = len(self.items)
@@ -359,11 +364,18 @@ def fold_persons(paths: Sequence[Path], obs: Any, k: int
             hint="give each person's sessions their own files, or say whose a file is "
             "(--person-from file, --person-from header, --person FILE=ID)")
     people = list(obs.persons)
-    if not 2 <= k <= len(people) or len(people) - -(-len(people) // k) < 3:
+
+    def splits(folds: int) -> bool:      # each fold a person or more, the rest 3 or more
+        return 2 <= folds <= len(people) and len(people) - -(-len(people) // folds) >= 3
+
+    if not splits(k):
+        can = [f for f in range(2, len(people) + 1) if splits(f)]
         raise UserModelError(
             f"--holdout {k} cannot split {len(people)} person(s) into folds",
             hint="each fold needs one person or more and the rest three or more to fit on: "
-            f"use 2 to {max(2, len(people))} folds with enough persons")
+            + (f"use {can[0]} to {can[-1]} folds" if can else
+               "that takes 4 persons or more; record more people, or check the model on "
+               "people kept apart with `opspec model-check`"))
     return files, people
 
 
