@@ -52,6 +52,7 @@ def _study(args: argparse.Namespace) -> int:
     from opspec.commands._spec import load_any_spec
     from opspec.errors import ConfigurationError
     from opspec.tui.study import (
+        check_recordings,
         finish_session,
         keep_partial,
         load_protocol,
@@ -63,6 +64,7 @@ def _study(args: argparse.Namespace) -> int:
     protocol = load_protocol(args.protocol)
     for variant in protocol.variants:          # a broken spec opens no session
         load_any_spec(variant.spec)
+    check_recordings(protocol)                 # sessions done with another spec: refused
     if args.serve:
         if args.participant is not None:
             raise ConfigurationError("--serve serves every participant's link: leave out "

@@ -44,7 +44,8 @@ from typing import Any
 
 from opspec.errors import ConfigurationError, SourceLocation
 
-__all__ = ["Protocol", "Session", "Variant", "keep_partial", "latin_square", "load_protocol"]
+__all__ = ["Protocol", "Session", "Variant", "check_recordings", "keep_partial", "latin_square",
+           "load_protocol"]
 
 
 @dataclass(frozen=True)
@@ -123,6 +124,36 @@ class Protocol:
 
     def pending(self, participant: str) -> list[Session]:
         return [s for s in self.sessions(participant) if not s.done]
+
+
+def check_recordings(protocol: Protocol) -> None:
+    """Every session marked done was recorded with its variant's spec (compared by file
+    name, so that a study folder can move): a recordings folder left by another study, or
+    a protocol whose variant now names another spec, would otherwise count those sessions
+    as done and replay their traces with the wrong spec's metrics."""
+    for participant in protocol.participants:
+        for session in protocol.sessions(participant):
+            if not session.done:
+                continue
+            marker = session.done_marker
+            try:
+                recorded = json.loads(marker.read_text(encoding="utf-8")).get("spec")
+            except (OSError, ValueError, AttributeError):
+                recorded = None
+            if not isinstance(recorded, str):
+                raise ConfigurationError(
+                    "this session's done marker does not say which spec it was recorded "
+                    "with", location=SourceLocation(str(marker)),
+                    hint="delete the marker to run the session again")
+            if Path(recorded).name != session.variant.spec.name:
+                raise ConfigurationError(
+                    f"session {session.variant.id} of {participant} was recorded with "
+                    f"{Path(recorded).name}, but variant {session.variant.id} is now "
+                    f"{session.variant.spec.name}",
+                    location=SourceLocation(str(marker)),
+                    hint="the protocol changed after the session, or its recordings folder "
+                    "holds another study's: give this study a folder of its own "
+                    "(recordings = \"...\" under [study]), or move those sessions aside")
 
 
 def _file_safe(text: str) -> str:
@@ -346,8 +377,30 @@ def session_pairs(session: Session) -> dict[str, tuple[float, float]]:
     from opspec.engine.trace_sinks import read_trace
     from opspec.xpdl.open_spec import open_spec
 
+    trace = session.trace
+    try:
+        with trace.open("rb") as handle:
+            last = b"\n"
+            if handle.seek(0, 2) > 0:
+                handle.seek(-1, 2)
+                last = handle.read(1)
+        cut = last != b"\n"
+    except OSError as error:
+        raise ConfigurationError(
+            f"the trace of a session marked done cannot be read ({error.strerror or error})",
+            location=SourceLocation(str(trace)),
+            hint=f"put it back, or delete {session.done_marker.name} to run the session "
+            "again") from None
+    if cut:
+        # a reader of a crashed run's trace skips a cut last line; a session marked done
+        # ended whole, so its trace was cut afterwards and its metrics would be short
+        raise ConfigurationError(
+            "the trace of a session marked done ends in a cut line: it is not the whole "
+            "session", location=SourceLocation(str(trace)),
+            hint=f"restore it from a copy, or delete {session.done_marker.name} to run the "
+            "session again")
     listener = MetricsListener(open_spec(session.variant.spec).metrics)
-    for event in read_trace(session.trace):
+    for event in read_trace(trace):
         listener(event)
     return _pairs(listener)
 

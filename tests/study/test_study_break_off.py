@@ -11,7 +11,7 @@ from typing import Any
 
 import pytest
 
-import opspec.tui.study as study
+from opspec.tui import study
 from opspec.cli import main
 
 

@@ -22,7 +22,8 @@ def _done_by_model(protocol_file: Path) -> None:
             session.trace.parent.mkdir(parents=True, exist_ok=True)
             assert main(["run", str(session.variant.spec), "--days", "1", "--seed", str(i),
                          "--trace", str(session.trace)]) == 0
-            session.done_marker.write_text("{}", encoding="utf-8")
+            session.done_marker.write_text(json.dumps({"spec": str(session.variant.spec)}),
+                                           encoding="utf-8")
 
 
 @pytest.mark.slow          # six simulated days
