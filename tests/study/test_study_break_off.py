@@ -11,8 +11,8 @@ from typing import Any
 
 import pytest
 
-from opspec.tui import study
 from opspec.cli import main
+from opspec.tui import study
 
 
 class _QuitEarly:

@@ -30,6 +30,6 @@ def test_one_duration_is_said_to_be_one(tmp_path: Path, capsys) -> None:
 
 
 def test_equal_durations_are_still_all_equal() -> None:
-    dist, chosen, fits, note = fit_duration_families([4.0, 4.0, 4.0])
+    _, chosen, fits, note = fit_duration_families([4.0, 4.0, 4.0])
     assert (chosen, fits, note) == ("constant", (), "all durations equal")
     assert fit_duration_families([4.0])[3].startswith("one duration only")
