@@ -162,7 +162,7 @@ def expand_traces(values: Iterable[str]) -> tuple[list[Path], list[Path]]:
         for found in sorted(path.rglob("*.jsonl")):
             if _BROKEN_OFF.search(found.name):
                 left_out.append(found)
-            elif found.is_file():
+            else:               # a pipe or a folder so named: read_trace says what it is
                 take(found)
     return out, [p for p in left_out if p.resolve() not in seen]
 
