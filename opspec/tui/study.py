@@ -494,6 +494,14 @@ def summary_lines(doc: dict[str, Any]) -> list[str]:
     def num(x: Any, unit: str | None = None) -> str:
         return "-" if x is None else f"{x:.4g}" + (f" {unit}" if unit else "")
 
+    def interval(m: dict[str, Any], none: str) -> str:
+        lo, hi = m["ci95"]
+        unit = m.get("unit")
+        if lo is None or hi is None:        # "[-, -]" said nothing of why
+            return f"no 95 % CI: {none}; n = {m['participants']}"
+        return (f"95 % CI [{num(lo)}, {num(hi)}]{' ' + unit if unit else ''}; "
+                f"n = {m['participants']}")
+
     lines = [f"study {doc['study']}"]
     for participant, sessions in doc["status"].items():
         lines.append(f"  {participant}: " + ", ".join(
@@ -501,20 +509,18 @@ def summary_lines(doc: dict[str, Any]) -> list[str]:
     for vid, v in doc["variants"].items():
         lines.append(f"variant {vid} ({v['participants']} participant(s) finished):")
         for name, m in v["metrics"].items():
-            lo, hi = m["ci95"]
-            unit = m.get("unit")
-            lines.append(f"  {name}: {num(m['value'], unit)} (95 % CI [{num(lo)}, {num(hi)}]"
-                         f"{' ' + unit if unit else ''}; n = {m['participants']})")
+            lines.append(f"  {name}: {num(m['value'], m.get('unit'))} "
+                         f"({interval(m, 'one participant')})")
     for c in doc["comparisons"]:
         lines.append(f"{c['b']} - {c['a']}, paired over {len(c['participants'])} "
                      "participant(s) who did both:")
         if not c["metrics"]:
             lines.append("  (needs two participants or more who did both)")
         for name, m in c["metrics"].items():
-            lo, hi = m["ci95"]
             unit = m.get("unit")
             lines.append(f"  {name}: {num(m['a'], unit)} -> {num(m['b'], unit)}, difference "
-                         f"{num(m['difference'], unit)} (95 % CI [{num(lo)}, {num(hi)}]"
-                         f"{' ' + unit if unit else ''}; n = {m['participants']})")
+                         f"{num(m['difference'], unit)} ("
+                         + interval(m, "fewer than two participants differ between the "
+                                    "variants") + ")")
     return lines
 

@@ -55,3 +55,18 @@ def test_rare_counts_and_rates_have_the_intervals_evaluate_gives(protocol_file: 
     assert main(["study", str(protocol_file), "--json"]) == 0
     printed = json.loads(capsys.readouterr().out)
     assert printed["variants"]["A"]["metrics"]["missed_rate"]["ci95"] == missed["ci95"]
+
+
+def test_a_metric_without_an_interval_says_why() -> None:
+    doc = {"study": "s", "status": {"P01": {"A": True, "B": True}},
+           "variants": {"A": {"participants": 1, "metrics": {"report_latency_s": {
+               "value": 12.5, "ci95": [None, None], "unit": "s", "participants": 1}}}},
+           "comparisons": [{"a": "A", "b": "B", "participants": ["P01", "P02"],
+                            "metrics": {"report_latency_s": {
+                                "a": 12.5, "b": 10.0, "difference": -2.5,
+                                "ci95": [None, None], "unit": "s", "participants": 2}}}]}
+    lines = summary_lines(doc)
+    assert "  report_latency_s: 12.5 s (no 95 % CI: one participant; n = 1)" in lines
+    assert ("  report_latency_s: 12.5 s -> 10 s, difference -2.5 s (no 95 % CI: fewer than "
+            "two participants differ between the variants; n = 2)") in lines
+    assert not any("[-, -]" in line for line in lines)
