@@ -137,9 +137,10 @@ def check_recordings(protocol: Protocol) -> None:
                 continue
             marker = session.done_marker
             try:
-                recorded = json.loads(marker.read_text(encoding="utf-8")).get("spec")
+                written = json.loads(marker.read_text(encoding="utf-8"))
+                recorded, position = written.get("spec"), written.get("position")
             except (OSError, ValueError, AttributeError):
-                recorded = None
+                recorded = position = None
             if not isinstance(recorded, str):
                 raise ConfigurationError(
                     "this session's done marker does not say which spec it was recorded "
@@ -154,6 +155,15 @@ def check_recordings(protocol: Protocol) -> None:
                     hint="the protocol changed after the session, or its recordings folder "
                     "holds another study's: give this study a folder of its own "
                     "(recordings = \"...\" under [study]), or move those sessions aside")
+            if isinstance(position, int) and position != session.position:
+                # a participant put before others in the list moves them to other rows of
+                # the Latin square: their remaining sessions would run out of balance
+                raise ConfigurationError(
+                    f"{participant} did variant {session.variant.id} as session {position}, "
+                    f"but the protocol now puts it at {session.position}: the participants' "
+                    "order changed", location=SourceLocation(str(marker)),
+                    hint="each participant's order is their place in the list: keep the "
+                    "list's order and add new participants at its end")
 
 
 def _file_safe(text: str) -> str:

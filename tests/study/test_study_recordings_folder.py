@@ -64,3 +64,19 @@ def test_a_marker_that_names_no_spec_is_refused(protocol_file: Path, capsys) -> 
     marker.write_text("{}", encoding="utf-8")
     assert main(["study", str(protocol_file)]) == 2
     assert f"{marker}: this session's done marker does not say" in capsys.readouterr().err
+
+
+def test_a_participant_put_before_others_is_refused(protocol_file: Path, capsys) -> None:
+    # P02 did B first (row 2 of the square); a participant inserted before P02 moves P02
+    # to row 3, A first: the rest of P02's sessions would run out of balance
+    marker = _mark_done(protocol_file, "P02", "B", "dispenser-30s.xpdl")
+    written = json.loads(marker.read_text(encoding="utf-8"))
+    marker.write_text(json.dumps({**written, "position": 1}), encoding="utf-8")
+    text = protocol_file.read_text(encoding="utf-8")
+    protocol_file.write_text(text.replace('["P01", "P02", "P03"]',
+                                          '["P01", "P00", "P02", "P03"]'), encoding="utf-8")
+    assert main(["study", str(protocol_file)]) == 2
+    err = capsys.readouterr().err
+    assert (f"{marker}: P02 did variant B as session 1, but the protocol now puts it at 2: "
+            "the participants' order changed") in err
+    assert "add new participants at its end" in err
