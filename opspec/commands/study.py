@@ -57,9 +57,8 @@ def _study(args: argparse.Namespace) -> int:
         keep_partial,
         load_protocol,
         session_app,
-        summary,
-        summary_lines,
     )
+    from opspec.tui.study_summary import summary, summary_lines
 
     protocol = load_protocol(args.protocol)
     for variant in protocol.variants:          # a broken spec opens no session
