@@ -94,16 +94,19 @@ def _uncertainty_text(draws: ParameterDraws | None) -> str:
 
 def fitted_text(result: Any, draws: ParameterDraws | None, header: str = "") -> str:
     """The model file ``opspec fit`` writes for ``result``: the model with its comments, the
-    ``[vary]`` tables and the ``[uncertainty]`` redraws."""
+    ``[vary]`` tables, whom it was fitted on (``[fitted_on]``) and the ``[uncertainty]``
+    redraws."""
+    from opspec.usermodels.fitted_on import fitted_on_text
     from opspec.usermodels.loader import dump_user_model
 
     text = dump_user_model(result.model, comments=result.comments(), header=header)
-    return text + _vary_text(result.vary()) + _uncertainty_text(draws)
+    return (text + _vary_text(result.vary()) + fitted_on_text(result.observations.persons)
+            + _uncertainty_text(draws))
 
 
 def _fit(args: argparse.Namespace) -> int:
     from opspec.errors import UserModelError
-    from opspec.usermodels.fitting import fit_traces, iter_paths
+    from opspec.usermodels.fitting import fit_traces
     from opspec.usermodels.loader import load_user_model
 
     if args.min_per_user < 2:
@@ -127,10 +130,9 @@ def _fit(args: argparse.Namespace) -> int:
 
         check_options(CheckOptions(level=args.level, replicates=args.replicates,
                                    runs=args.runs))
-    paths = iter_paths(args.traces)
-    if not paths:
-        raise UserModelError("no trace files found in " + ", ".join(args.traces),
-                             hint="give .jsonl trace files or folders holding them")
+    from opspec.commands.model_check import trace_files
+
+    paths = trace_files(args.traces, "fit")
     out = Path(args.output) if args.output != "-" else None
     from opspec.commands._files import refuse_overwrite
 

@@ -29,7 +29,7 @@ if TYPE_CHECKING:
     from opspec.usermodels.persons import PersonRule
 
 __all__ = ["CheckOptions", "CrossValidation", "add_person_options", "check_model", "check_options",
-           "cross_validate", "register"]
+           "cross_validate", "register", "trace_files"]
 
 
 def add_person_options(parser: Any, counted: str = "") -> None:
@@ -109,6 +109,28 @@ def _draws(ref: str) -> Any:
     return _ComposedDraws(ref, draws, index)
 
 
+def trace_files(values: Sequence[str], command: str) -> list[Path]:
+    """The trace files ``values`` name (folders searched with their subfolders,
+    :func:`~opspec.usermodels.trace_reader.expand_traces`); the broken-off study sessions
+    left out are said on standard error, and no trace at all is a UserModelError."""
+    import sys
+
+    from opspec.errors import UserModelError
+    from opspec.usermodels.trace_reader import expand_traces
+
+    paths, left_out = expand_traces(values)
+    if left_out:
+        shown = ", ".join(str(p) for p in left_out[:3]) + (" ..." if len(left_out) > 3 else "")
+        print(f"opspec {command}: note: left out {len(left_out)} trace(s) of study sessions "
+              f"that broke off and were done again ({shown}); name such a file to read it",
+              file=sys.stderr)
+    if not paths:
+        raise UserModelError("no trace files found in " + ", ".join(values),
+                             hint="give .jsonl trace files or folders holding them (their "
+                             "subfolders are searched too)")
+    return paths
+
+
 def check_options(options: CheckOptions) -> None:
     from opspec.errors import UserModelError
 
@@ -138,6 +160,7 @@ def check_model(model: UserModel, model_ref: str | None, paths: Sequence[Path],
     if persons is not None:
         persons.check_used(list(paths))
     obs = collect(paths, options.lane, persons)
+    overlap = _fitted_on_notes(model_ref, obs.persons)
     draws = (_draws(model_ref) if options.parameter_uncertainty and model_ref else None)
     repeated: dict[str, dict[str, int]] = {}
     traced = False
@@ -155,6 +178,7 @@ def check_model(model: UserModel, model_ref: str | None, paths: Sequence[Path],
         )
 
         package = load_any_spec(options.spec, command="model-check")
+        notes.extend(_other_spec_notes(paths, options.spec))
         definitions = package.metrics
         if not definitions:
             notes.append(f"{options.spec} declares no outcome metrics (opspec:Metrics): "
@@ -181,19 +205,54 @@ def check_model(model: UserModel, model_ref: str | None, paths: Sequence[Path],
         uncertainty = "ignored (--no-parameter-uncertainty)"
     return CheckReport(finish(items, options.level), options.level, len(obs.persons),
                        obs.sessions, options.replicates, options.seed, uncertainty,
-                       tuple(notes))
+                       tuple(overlap + notes))
+
+
+def _fitted_on_notes(model_ref: str | None, persons: Sequence[str]) -> list[str]:
+    """A note when people checked are among those the model was fitted on (its
+    ``[fitted_on]`` table): their fit to the model says little of new people."""
+    from opspec.usermodels.fitted_on import fitted_persons
+
+    fitted = fitted_persons(model_ref)
+    if not fitted:
+        return []
+    both = [p for p in persons if p in set(fitted)]
+    if not both:
+        return []
+    shown = ", ".join(both[:6]) + (" ..." if len(both) > 6 else "")
+    note = (f"{len(both)} of the {len(persons)} person(s) checked are among the "
+            f"{len(fitted)} the model was fitted on ({shown}; its [fitted_on] table): a check "
+            "on them is not a check on new people; give only people left out of the fit")
+    return [note]
+
+
+def _other_spec_notes(paths: Sequence[Path], spec: str) -> list[str]:
+    """A note when traces name (in their header's ``spec``) another spec than ``--spec``:
+    a study's variants recorded side by side (recordings/P01/A and B) would have their
+    metrics replayed with one spec's definitions and averaged per person."""
+    from opspec.usermodels.trace_reader import trace_header
+
+    others: dict[str, list[str]] = {}
+    for path in paths:
+        recorded = trace_header(path).get("spec")
+        if isinstance(recorded, str) and recorded and Path(recorded).stem != Path(spec).stem:
+            others.setdefault(Path(recorded).name, []).append(str(path))
+    if not others:
+        return []
+    files = [f for found in others.values() for f in found]
+    note = (f"{len(files)} of {len(paths)} trace file(s) were recorded with another spec than "
+            f"--spec {spec} ({', '.join(sorted(others))}: {', '.join(files[:3])}"
+            f"{' ...' if len(files) > 3 else ''}): their metrics are replayed with this "
+            "spec's definitions and averaged with the others per person; check each spec's "
+            "traces on their own")
+    return [note]
 
 
 def _model_check(args: argparse.Namespace) -> int:
-    from opspec.errors import UserModelError
-    from opspec.usermodels.fitting import iter_paths
     from opspec.usermodels.loader import load_user_model
     from opspec.usermodels.persons import PersonRule, parse_person_options
 
-    paths = iter_paths(args.traces)
-    if not paths:
-        raise UserModelError("no trace files found in " + ", ".join(args.traces),
-                             hint="give .jsonl trace files or folders holding them")
+    paths = trace_files(args.traces, "model-check")
     model = load_user_model(args.model)
     persons = PersonRule(args.person_from, args.person_pattern,
                          parse_person_options(args.person))
@@ -255,7 +314,12 @@ class CrossValidation:
         out = []
         for f, (held, report) in enumerate(self.folds):
             names = ", ".join(held[:6]) + (" ..." if len(held) > 6 else "")
-            flagged = ", ".join(i.name for i in report.misfits) or "nothing misfits"
+            # the fold's own Holm is over its items only: what misfits there need not
+            # misfit over all folds (the verdict below), and is said to be the fold's
+            flagged = (f"misfit within this fold (Holm over its {len(report.items)} "
+                       "item(s), not over all folds): "
+                       + ", ".join(i.name for i in report.misfits)
+                       if report.misfits else "nothing misfits")
             out.append(f"fold {f + 1}/{k}: fitted without {len(held)} person(s) ({names}), "
                        f"checked on them: {flagged}")
         total = len(self.items)
@@ -300,11 +364,18 @@ def fold_persons(paths: Sequence[Path], obs: Any, k: int
             hint="give each person's sessions their own files, or say whose a file is "
             "(--person-from file, --person-from header, --person FILE=ID)")
     people = list(obs.persons)
-    if not 2 <= k <= len(people) or len(people) - -(-len(people) // k) < 3:
+
+    def splits(folds: int) -> bool:      # each fold a person or more, the rest 3 or more
+        return 2 <= folds <= len(people) and len(people) - -(-len(people) // folds) >= 3
+
+    if not splits(k):
+        can = [f for f in range(2, len(people) + 1) if splits(f)]
         raise UserModelError(
             f"--holdout {k} cannot split {len(people)} person(s) into folds",
             hint="each fold needs one person or more and the rest three or more to fit on: "
-            f"use 2 to {max(2, len(people))} folds with enough persons")
+            + (f"use {can[0]} to {can[-1]} folds" if can else
+               "that takes 4 persons or more; record more people, or check the model on "
+               "people kept apart with `opspec model-check`"))
     return files, people
 
 

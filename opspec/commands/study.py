@@ -52,16 +52,18 @@ def _study(args: argparse.Namespace) -> int:
     from opspec.commands._spec import load_any_spec
     from opspec.errors import ConfigurationError
     from opspec.tui.study import (
+        check_recordings,
         finish_session,
+        keep_partial,
         load_protocol,
         session_app,
-        summary,
-        summary_lines,
     )
+    from opspec.tui.study_summary import summary, summary_lines
 
     protocol = load_protocol(args.protocol)
     for variant in protocol.variants:          # a broken spec opens no session
         load_any_spec(variant.spec)
+    check_recordings(protocol)                 # sessions done with another spec: refused
     if args.serve:
         if args.participant is not None:
             raise ConfigurationError("--serve serves every participant's link: leave out "
@@ -96,10 +98,13 @@ def _study(args: argparse.Namespace) -> int:
         finally:
             walk.close()
         if not finish_session(session, walk):
+            kept = keep_partial(session)
+            where = ("nothing was recorded" if kept is None else
+                     f"what was recorded is kept apart as {kept} (and "
+                     f"{kept.name.removesuffix('.json')}.trace.jsonl), not as a session done")
             print(f"participant {args.participant}, session {session.position} "
-                  f"({session.variant.id}) broke off before its end; its recording is kept "
-                  f"as a partial one. Resume with: opspec study {args.protocol} "
-                  f"--participant {args.participant}", file=say)
+                  f"({session.variant.id}) broke off before its end; {where}. Resume with: "
+                  f"opspec study {args.protocol} --participant {args.participant}", file=say)
             return 1
         print(f"participant {args.participant}, session {session.position} "
               f"({session.variant.id}) done: {session.recording}", file=say)

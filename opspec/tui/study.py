@@ -31,7 +31,9 @@ A session is done when its run reached its end: a ``.done`` file beside the reco
 so. A session that breaks off (the participant quits early, the terminal closes) keeps its
 recording as ``<variant>.partial-N.json`` and is started again the next time the participant
 resumes (``opspec study PROTOCOL --participant P02`` goes on with the first session not
-done).
+done). :func:`check_recordings` refuses a recordings folder whose done sessions were recorded
+with another spec or in another order. The summary over the participants is
+:mod:`opspec.tui.study_summary`.
 """
 
 from __future__ import annotations
@@ -44,7 +46,11 @@ from typing import Any
 
 from opspec.errors import ConfigurationError, SourceLocation
 
-__all__ = ["Protocol", "Session", "Variant", "latin_square", "load_protocol"]
+# the summary, opspec.tui.study_summary, stays importable from here
+from opspec.tui.study_summary import session_pairs, summary, summary_lines, variant_estimate
+
+__all__ = ["Protocol", "Session", "Variant", "check_recordings", "keep_partial", "latin_square",
+           "load_protocol", "session_pairs", "summary", "summary_lines", "variant_estimate"]
 
 
 @dataclass(frozen=True)
@@ -123,6 +129,46 @@ class Protocol:
 
     def pending(self, participant: str) -> list[Session]:
         return [s for s in self.sessions(participant) if not s.done]
+
+
+def check_recordings(protocol: Protocol) -> None:
+    """Every session marked done was recorded with its variant's spec (compared by file
+    name, so that a study folder can move): a recordings folder left by another study, or
+    a protocol whose variant now names another spec, would otherwise count those sessions
+    as done and replay their traces with the wrong spec's metrics."""
+    for participant in protocol.participants:
+        for session in protocol.sessions(participant):
+            if not session.done:
+                continue
+            marker = session.done_marker
+            try:
+                written = json.loads(marker.read_text(encoding="utf-8"))
+                recorded, position = written.get("spec"), written.get("position")
+            except (OSError, ValueError, AttributeError):
+                recorded = position = None
+            if not isinstance(recorded, str):
+                raise ConfigurationError(
+                    "this session's done marker does not say which spec it was recorded "
+                    "with", location=SourceLocation(str(marker)),
+                    hint="delete the marker to run the session again")
+            if Path(recorded).name != session.variant.spec.name:
+                raise ConfigurationError(
+                    f"session {session.variant.id} of {participant} was recorded with "
+                    f"{Path(recorded).name}, but variant {session.variant.id} is now "
+                    f"{session.variant.spec.name}",
+                    location=SourceLocation(str(marker)),
+                    hint="the protocol changed after the session, or its recordings folder "
+                    "holds another study's: give this study a folder of its own "
+                    "(recordings = \"...\" under [study]), or move those sessions aside")
+            if isinstance(position, int) and position != session.position:
+                # a participant put before others in the list moves them to other rows of
+                # the Latin square: their remaining sessions would run out of balance
+                raise ConfigurationError(
+                    f"{participant} did variant {session.variant.id} as session {position}, "
+                    f"but the protocol now puts it at {session.position}: the participants' "
+                    "order changed", location=SourceLocation(str(marker)),
+                    hint="each participant's order is their place in the list: keep the "
+                    "list's order and add new participants at its end")
 
 
 def _file_safe(text: str) -> str:
@@ -273,9 +319,16 @@ def session_app(protocol: Protocol, session: Session) -> tuple[Any, Any]:
 
 
 def _move_partial(session: Session) -> None:
-    """A broken-off attempt's recording and trace, kept as ``VARIANT.partial-N.*``."""
+    keep_partial(session)
+
+
+def keep_partial(session: Session) -> Path | None:
+    """A broken-off attempt's recording and trace, kept as ``VARIANT.partial-N.*`` (the
+    recording's new path; None when the session is done or recorded nothing). Done as soon
+    as the session breaks off, so that what is under ``VARIANT.json`` is a whole session,
+    and again before the session is started anew (a terminal closed gives no chance)."""
     if session.done or not (session.recording.exists() or session.trace.exists()):
-        return
+        return None
     n = 1
     while session.recording.with_name(f"{session.variant.id}.partial-{n}.json").exists() or \
             session.recording.with_name(f"{session.variant.id}.partial-{n}.trace.jsonl"
@@ -284,6 +337,7 @@ def _move_partial(session: Session) -> None:
     for old, suffix in ((session.recording, ".json"), (session.trace, ".trace.jsonl")):
         if old.exists():
             old.replace(old.with_name(f"{session.variant.id}.partial-{n}{suffix}"))
+    return session.recording.with_name(f"{session.variant.id}.partial-{n}.json")
 
 
 def finish_session(session: Session, walk: Any) -> bool:
@@ -296,123 +350,4 @@ def finish_session(session: Session, walk: Any) -> bool:
         "recording": session.recording.name, "trace": session.trace.name}, indent=1) + "\n",
         encoding="utf-8")
     return True
-
-
-# ------------------------------------------------------------------ the summary
-
-
-def _pairs(listener: Any) -> dict[str, tuple[float, float]]:
-    """Per metric of one session, the (numerator, denominator) pair ``opspec evaluate
-    --compare`` pairs by user: a count (total, 1), a duration (sum, n), a ratio (its
-    numerator's value, its denominator's)."""
-    from opspec.model import MetricKind
-
-    values = listener.values()
-    out: dict[str, tuple[float, float]] = {}
-
-    def scalar(name: str | None) -> float | None:
-        v = values.get(name or "")
-        if v is None:
-            return None
-        result = (v.get("total") if v["kind"] == "count" else v.get("mean")
-                  if v["kind"] == "duration" else v.get("value"))
-        return None if result is None else float(result)
-
-    for metric in listener.definitions:
-        if metric.kind is MetricKind.COUNT:
-            out[metric.name] = (float(values[metric.name]["total"]), 1.0)
-        elif metric.kind is MetricKind.DURATION:
-            samples = listener.samples.get(metric.name, [])
-            if samples:
-                out[metric.name] = (float(sum(samples)), float(len(samples)))
-        elif metric.kind is MetricKind.RATIO:
-            num, den = scalar(metric.numerator), scalar(metric.denominator)
-            if num is not None and den:
-                out[metric.name] = (num, den)
-    return out
-
-
-def session_pairs(session: Session) -> dict[str, tuple[float, float]]:
-    """The metric pairs of a done session, replayed from its trace."""
-    from opspec.engine.metrics import MetricsListener
-    from opspec.engine.trace_sinks import read_trace
-    from opspec.xpdl.open_spec import open_spec
-
-    listener = MetricsListener(open_spec(session.variant.spec).metrics)
-    for event in read_trace(session.trace):
-        listener(event)
-    return _pairs(listener)
-
-
-def summary(protocol: Protocol) -> dict[str, Any]:
-    """Per variant, each metric over the participants who finished it; per pair of variants,
-    the paired difference over the participants who finished both (``opspec evaluate
-    --compare``'s statistics: a ratio over users with its delta-method interval)."""
-    from opspec.statistics import paired_difference, ratio_estimate
-
-    done: dict[str, dict[str, dict[str, tuple[float, float]]]] = {}
-    status: dict[str, dict[str, bool]] = {}
-    for participant in protocol.participants:
-        status[participant] = {}
-        for s in protocol.sessions(participant):
-            status[participant][s.variant.id] = s.done
-            if s.done:
-                done.setdefault(s.variant.id, {})[participant] = session_pairs(s)
-    variants: dict[str, Any] = {}
-    for v in protocol.variants:
-        people = done.get(v.id, {})
-        metrics: dict[str, Any] = {}
-        names = sorted({m for pairs in people.values() for m in pairs})
-        for name in names:
-            pairs = [p[name] for p in people.values() if name in p]
-            estimate = ratio_estimate(pairs)
-            metrics[name] = {"value": estimate.value, "ci95": list(estimate.ci),
-                             "participants": len(pairs)}
-        variants[v.id] = {"participants": len(people), "metrics": metrics}
-    comparisons = []
-    ids = [v.id for v in protocol.variants]
-    for i, a in enumerate(ids):
-        for b in ids[i + 1:]:
-            both = sorted(set(done.get(a, {})) & set(done.get(b, {})))
-            rows: dict[str, Any] = {}
-            names = sorted({m for p in both for m in done[a][p]} &
-                           {m for p in both for m in done[b][p]})
-            for name in names:
-                who = [p for p in both if name in done[a][p] and name in done[b][p]]
-                if len(who) < 2:
-                    continue
-                diff = paired_difference([done[a][p][name] for p in who],
-                                         [done[b][p][name] for p in who])
-                rows[name] = {"a": ratio_estimate([done[a][p][name] for p in who]).value,
-                              "b": ratio_estimate([done[b][p][name] for p in who]).value,
-                              "difference": diff.value, "ci95": list(diff.ci),
-                              "participants": len(who)}
-            comparisons.append({"a": a, "b": b, "participants": both, "metrics": rows})
-    return {"study": protocol.name, "status": status, "variants": variants,
-            "comparisons": comparisons}
-
-
-def summary_lines(doc: dict[str, Any]) -> list[str]:
-    def num(x: Any) -> str:
-        return "-" if x is None else f"{x:.4g}"
-
-    lines = [f"study {doc['study']}"]
-    for participant, sessions in doc["status"].items():
-        lines.append(f"  {participant}: " + ", ".join(
-            f"{v} {'done' if ok else 'to do'}" for v, ok in sessions.items()))
-    for vid, v in doc["variants"].items():
-        lines.append(f"variant {vid} ({v['participants']} participant(s) finished):")
-        for name, m in v["metrics"].items():
-            lo, hi = m["ci95"]
-            lines.append(f"  {name}: {num(m['value'])} (95 % CI [{num(lo)}, {num(hi)}])")
-    for c in doc["comparisons"]:
-        lines.append(f"{c['b']} - {c['a']}, paired over {len(c['participants'])} "
-                     "participant(s) who did both:")
-        if not c["metrics"]:
-            lines.append("  (needs two participants or more who did both)")
-        for name, m in c["metrics"].items():
-            lo, hi = m["ci95"]
-            lines.append(f"  {name}: {num(m['a'])} -> {num(m['b'])}, difference "
-                         f"{num(m['difference'])} (95 % CI [{num(lo)}, {num(hi)}])")
-    return lines
 

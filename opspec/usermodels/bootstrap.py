@@ -262,9 +262,13 @@ def _values(target: _Target, data: _Data, rng: np.random.Generator | None = None
     wrong_times = [v for p, vs in data.by_pick.items() if p != target.intended for v in vs]
     if not right or not wrong_times:
         return None
-    lost = np.maximum(np.asarray(wrong_times) - float(np.mean(right)), 0.0)
     if target.family is None:
-        return {f"{target.prefix}.value": float(lost.mean())}
+        # a constant loss is the difference of means, none when the wrong picks were not
+        # slower (choice_estimates.wrong_choice_loss): the mean of the losses clipped at 0
+        # would put a cost in every redraw that the estimate does not have
+        return {f"{target.prefix}.value": max(float(np.mean(wrong_times))
+                                              - float(np.mean(right)), 0.0)}
+    lost = np.maximum(np.asarray(wrong_times) - float(np.mean(right)), 0.0)
     found = _refit(target.family, lost.tolist())
     return None if found is None else {f"{target.prefix}.{k}": v for k, v in found.items()}
 

@@ -58,8 +58,9 @@ class CheckItem:
         """One line: the verdict, what was observed against what was predicted, the test."""
         what = self.comparison()
         verdict = "MISFIT" if self.misfit else "fits  "
+        unit = f" {self.unit}" if self.kind == "metric" and self.unit else ""
         return (f"{verdict} {self.name}: {what}; {self.test}: {self.statistic_label} = "
-                f"{self.statistic:.4g}, "
+                f"{self.statistic:.4g}{unit}, "
                 f"p = {_fmt_p(self.p)}, Holm-adjusted p = {_fmt_p(self.p_holm)}")
 
     @property

@@ -96,6 +96,14 @@ def check_observations(model: UserModel, obs: Observations, *, replicates: int =
     uncovered = [a for a in activities if not model.covers(a)]
     if uncovered:
         notes.append("observed but not in the model (not checked): " + ", ".join(uncovered))
+    picked = {a for sequences in obs.picks.values() for seq in sequences for a in seq}
+    alternatives = {a for am in model.activities.values() for a in am.choice_ids()}
+    unseen = sorted(set(model.activities) - set(activities) - picked - alternatives)
+    if unseen:
+        # a verdict over what was seen says nothing of these: traces of another spec, or
+        # of another lane, would otherwise "fit" on the few activities the two share
+        notes.append("in the model but not in these traces (not checked): "
+                     + ", ".join(unseen))
     if not model.routine.is_trivial:
         notes.append("the model's routine (time-of-day windows, adherence drift) is not part "
                      "of the per-activity checks, which pool all times of day; with --spec "

@@ -15,7 +15,7 @@ from typing import Any
 
 import numpy as np
 
-from opspec.usermodels.distributions import Distribution
+from opspec.usermodels.distributions import Constant, Distribution
 from opspec.usermodels.duration_family import fit_duration_families
 from opspec.usermodels.errors import Commission
 
@@ -37,10 +37,12 @@ class WrongChoiceLoss:
 
     def comment(self) -> str:
         lo, hi = self.ci
+        written = ("written as the wrong alternative's duration" if self.seconds > 0 else
+                   "the wrong picks were not slower: no time lost, written as 0 s")
         return (f"time lost to a wrong choice ({', '.join(self.alternatives)}): "
                 f"{self.seconds:.4g} s (95 % interval [{lo:.4g}, {hi:.4g}]) = mean of "
-                f"{self.wrong} wrong pick(s) - mean of {self.right} intended pick(s); written "
-                "as the wrong alternative's duration")
+                f"{self.wrong} wrong pick(s) - mean of {self.right} intended pick(s); "
+                + written)
 
     def to_json(self) -> dict[str, Any]:
         return {"choice": self.choice, "alternatives": list(self.alternatives),
@@ -92,7 +94,13 @@ def wrong_choice_loss(choice: str, intended: str, by_pick: dict[str, list[float]
         interval = (float(ci.low), float(ci.high))
     else:
         interval = (seconds, seconds)
-    lost = np.maximum(wrong - right.mean(), 0.0)
-    dist, _, _, _ = fit_duration_families(lost.tolist(), criterion)
+    if seconds <= 0:
+        # the wrong picks were not slower: no time lost is measured. A family fitted to the
+        # differences clipped at 0 would write a cost the data do not show (its mean above 0
+        # while the difference of means is below)
+        dist: Distribution = Constant(0.0)
+    else:
+        lost = np.maximum(wrong - right.mean(), 0.0)
+        dist, _, _, _ = fit_duration_families(lost.tolist(), criterion)
     return WrongChoiceLoss(choice, wrong_names, int(wrong.size), int(right.size), seconds,
                            interval, dist)

@@ -32,7 +32,12 @@ def fit_duration_families(values: Sequence[float], criterion: str = "aic"
     x = np.asarray(values, dtype=float)
     if x.size == 0:
         return Constant(0.0), "constant", (), "no completed performance: duration 0"
-    if x.size == 1 or float(np.ptp(x)) < 1e-9:
+    if x.size == 1:
+        # one value says nothing of the spread: not "all equal", and no family fits it
+        note = ("one duration only: too few to fit a distribution, written as that one value "
+                "(record more sessions)")
+        return Constant(float(x[0])), "constant", (), note
+    if float(np.ptp(x)) < 1e-9:
         return Constant(float(x[0])), "constant", (), "all durations equal"
     fits = tuple(fit_families(x))
     if not fits:

@@ -146,7 +146,9 @@ def fit_traces(paths: Sequence[str | Path], *, lane: str = "user", name: str = "
         activities[alternative] = replace(
             old, duration=loss.distribution,
             source=f"fitted by opspec fit: the time a wrong pick at {loss.choice} costs, "
-            f"{loss.seconds:.4g} s on average ({loss.wrong} wrong picks)")
+            f"{max(loss.seconds, 0.0):.4g} s on average ({loss.wrong} wrong picks"
+            + ("" if loss.seconds > 0 else f"; the difference of means, {loss.seconds:.4g} s, "
+               "is not above 0") + ")")
     busy = None
     if obs.busy_omitted:
         engaged = obs.engaged or set(obs.durations) - set(obs.busy_omitted)

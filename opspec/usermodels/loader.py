@@ -42,7 +42,8 @@ FORMAT_VERSION = 1
 _TOP_KEYS = ("format", "version", "name", "description", "source", "extends", "defaults",
              "activities", "busy", "routine", "modifier", "operators",
              "vary", "correlations", "subgroups",   # these three: a population
-             "uncertainty")   # parameter redraws of a fitted model (usermodels.uncertainty)
+             "uncertainty",   # parameter redraws of a fitted model (usermodels.uncertainty)
+             "fitted_on")     # whom a fitted model was fitted on (usermodels.fitted_on)
 #: keys of a population (docs/user-models.md, "Populations")
 POPULATION_KEYS = ("vary", "correlations", "subgroups")
 _ACTIVITY_KEYS = ("duration", "omission", "prompt", "commission", "repetition", "delay",
@@ -313,6 +314,10 @@ def parse_user_model(doc: Mapping[str, Any], path: str = "<toml>", *,
         from opspec.usermodels.uncertainty import ParameterDraws
 
         ParameterDraws.from_table(doc["uncertainty"], path)
+    if "fitted_on" in doc:
+        from opspec.usermodels.fitted_on import check_table
+
+        check_table(doc["fitted_on"], path)
     declares = any(key in doc for key in POPULATION_KEYS)
     if declares or (base is not None and base.population is not None):
         from dataclasses import replace

@@ -23,39 +23,19 @@ A session is ``(file index, run index)``; a person is a string.
 
 from __future__ import annotations
 
-import json
 import re
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 
 from opspec.errors import SourceLocation, UserModelError
-from opspec.files import json_loads
+from opspec.usermodels.trace_reader import trace_header as _header
 
 __all__ = ["PERSON_FROM", "PERSON_KEY", "PersonRule", "parse_person_options"]
 
 PERSON_FROM = ("auto", "header", "file", "folder", "run")
 #: the trace header key naming the participant (docs/trace-format.md)
 PERSON_KEY = "person"
-
-
-def _header(path: Path) -> dict[str, object]:
-    """The first JSON line of a trace file (an empty dict when it cannot be read: the trace
-    reader then says what is wrong with the file, naming it)."""
-    import io
-
-    from opspec.files import open_regular
-
-    try:
-        # a pipe or device is refused, never read (it would block); read_trace then says so
-        with io.TextIOWrapper(open_regular(path), encoding="utf-8") as handle:
-            for line in handle:
-                if line.strip():
-                    head = json_loads(line)
-                    return head if isinstance(head, dict) else {}
-    except (OSError, UnicodeDecodeError, json.JSONDecodeError):
-        return {}
-    return {}
 
 
 @dataclass(frozen=True)

@@ -86,7 +86,7 @@ class DurationSpread:
                  (f"  per-user distribution: every duration x F, F ~ lognormal(median 1, "
                  f"sigma {self.between_sd:.3f})"),
                  "  user mean durations: " + ", ".join(
-                     f"{k} {v:.4g}" for k, v in self.user_means.items() if k != "sd")]
+                     f"{k} {v:.4g} s" for k, v in self.user_means.items() if k != "sd")]
         for name, s in self.parameters.items():
             lines.append(f"  per-user {name}: mean {s['mean']:.4g}, sd {s['sd']:.4g}, "
                          f"p5 {s['p5']:.4g}, median {s['p50']:.4g}, p95 {s['p95']:.4g}")

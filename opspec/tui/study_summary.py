@@ -1,0 +1,202 @@
+"""The summary of a walkthrough study (``opspec study PROTOCOL.toml`` without
+``--participant``): each metric of each variant over the participants who finished it, and
+the paired difference of each pair of variants over the participants who did both, replayed
+from the sessions' traces (:mod:`opspec.tui.study` runs the sessions).
+"""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING, Any
+
+from opspec.errors import ConfigurationError, SourceLocation
+
+if TYPE_CHECKING:
+    from opspec.tui.study import Protocol, Session, Variant
+
+__all__ = ["session_pairs", "summary", "summary_lines", "variant_estimate"]
+
+
+def _pairs(listener: Any) -> dict[str, tuple[float, float]]:
+    """Per metric of one session, the (numerator, denominator) pair ``opspec evaluate
+    --compare`` pairs by user: a count (total, 1), a duration (sum, n), a ratio (its
+    numerator's value, its denominator's)."""
+    from opspec.model import MetricKind
+
+    values = listener.values()
+    out: dict[str, tuple[float, float]] = {}
+
+    def scalar(name: str | None) -> float | None:
+        v = values.get(name or "")
+        if v is None:
+            return None
+        result = (v.get("total") if v["kind"] == "count" else v.get("mean")
+                  if v["kind"] == "duration" else v.get("value"))
+        return None if result is None else float(result)
+
+    for metric in listener.definitions:
+        if metric.kind is MetricKind.COUNT:
+            out[metric.name] = (float(values[metric.name]["total"]), 1.0)
+        elif metric.kind is MetricKind.DURATION:
+            samples = listener.samples.get(metric.name, [])
+            if samples:
+                out[metric.name] = (float(sum(samples)), float(len(samples)))
+        elif metric.kind is MetricKind.RATIO:
+            num, den = scalar(metric.numerator), scalar(metric.denominator)
+            if num is not None and den:
+                out[metric.name] = (num, den)
+    return out
+
+
+def session_pairs(session: Session) -> dict[str, tuple[float, float]]:
+    """The metric pairs of a done session, replayed from its trace."""
+    from opspec.engine.metrics import MetricsListener
+    from opspec.engine.trace_sinks import read_trace
+    from opspec.xpdl.open_spec import open_spec
+
+    trace = session.trace
+    try:
+        with trace.open("rb") as handle:
+            last = b"\n"
+            if handle.seek(0, 2) > 0:
+                handle.seek(-1, 2)
+                last = handle.read(1)
+        cut = last != b"\n"
+    except OSError as error:
+        raise ConfigurationError(
+            f"the trace of a session marked done cannot be read ({error.strerror or error})",
+            location=SourceLocation(str(trace)),
+            hint=f"put it back, or delete {session.done_marker.name} to run the session "
+            "again") from None
+    if cut:
+        # a reader of a crashed run's trace skips a cut last line; a session marked done
+        # ended whole, so its trace was cut afterwards and its metrics would be short
+        raise ConfigurationError(
+            "the trace of a session marked done ends in a cut line: it is not the whole "
+            "session", location=SourceLocation(str(trace)),
+            hint=f"restore it from a copy, or delete {session.done_marker.name} to run the "
+            "session again")
+    listener = MetricsListener(open_spec(session.variant.spec).metrics)
+    for event in read_trace(trace):
+        listener(event)
+    return _pairs(listener)
+
+
+def _metric_kinds(variant: Variant) -> dict[str, str]:
+    """Each metric of ``variant``'s spec and its kind (``count``, ``duration``, ``ratio``)."""
+    from opspec.xpdl.open_spec import open_spec
+
+    return {m.name: m.kind.value for m in open_spec(variant.spec).metrics}
+
+
+def variant_estimate(kind: str | None, pairs: list[tuple[float, float]]) -> dict[str, Any]:
+    """One metric of one variant over its participants, as ``opspec evaluate`` summarises a
+    design: a count's mean per participant with the t interval widened to the exact Poisson
+    (Garwood) one when there are few events, a proportion of counts (missed / due doses)
+    with Wilson's interval on the effective number of trials, anything else Σy/Σn with the
+    cluster-robust t interval. A t interval alone says [0, 0] for a count nobody had and a
+    rate of 0 of 16 doses, as if they could not happen."""
+    from opspec.statistics import (
+        count_estimate,
+        is_proportion,
+        proportion_interval,
+        ratio_estimate,
+    )
+
+    estimate = ratio_estimate(pairs)
+    ci, method = estimate.ci, estimate.method
+    if kind == "count":
+        estimate = count_estimate([y for y, _ in pairs])
+        ci, method = estimate.ci, estimate.method
+    elif kind == "ratio" and is_proportion(pairs):
+        ci = proportion_interval(pairs)
+        method = None if ci[0] is None else "wilson-neff"
+    return {"value": estimate.value, "ci95": list(ci), "ci95_method": method,
+            "unit": "s" if kind == "duration" else None, "participants": len(pairs)}
+
+
+def summary(protocol: Protocol) -> dict[str, Any]:
+    """Per variant, each metric over the participants who finished it
+    (:func:`variant_estimate`); per pair of variants, the paired difference over the
+    participants who finished both (``opspec evaluate --compare``'s statistics: a ratio
+    over users with its delta-method interval)."""
+    from opspec.statistics import paired_difference, ratio_estimate
+
+    done: dict[str, dict[str, dict[str, tuple[float, float]]]] = {}
+    status: dict[str, dict[str, bool]] = {}
+    for participant in protocol.participants:
+        status[participant] = {}
+        for s in protocol.sessions(participant):
+            status[participant][s.variant.id] = s.done
+            if s.done:
+                done.setdefault(s.variant.id, {})[participant] = session_pairs(s)
+    variants: dict[str, Any] = {}
+    kinds: dict[str, str] = {}
+    for v in protocol.variants:
+        people = done.get(v.id, {})
+        metrics: dict[str, Any] = {}
+        names = sorted({m for pairs in people.values() for m in pairs})
+        of_variant = _metric_kinds(v) if names else {}
+        for name in names:
+            kinds.setdefault(name, of_variant.get(name, ""))
+            pairs = [p[name] for p in people.values() if name in p]
+            metrics[name] = variant_estimate(of_variant.get(name), pairs)
+        variants[v.id] = {"participants": len(people), "metrics": metrics}
+    comparisons = []
+    ids = [v.id for v in protocol.variants]
+    for i, a in enumerate(ids):
+        for b in ids[i + 1:]:
+            both = sorted(set(done.get(a, {})) & set(done.get(b, {})))
+            rows: dict[str, Any] = {}
+            names = sorted({m for p in both for m in done[a][p]} &
+                           {m for p in both for m in done[b][p]})
+            for name in names:
+                who = [p for p in both if name in done[a][p] and name in done[b][p]]
+                if len(who) < 2:
+                    continue
+                diff = paired_difference([done[a][p][name] for p in who],
+                                         [done[b][p][name] for p in who])
+                rows[name] = {"a": ratio_estimate([done[a][p][name] for p in who]).value,
+                              "b": ratio_estimate([done[b][p][name] for p in who]).value,
+                              "difference": diff.value, "ci95": list(diff.ci),
+                              "ci95_method": diff.method,
+                              "unit": "s" if kinds.get(name) == "duration" else None,
+                              "participants": len(who)}
+            comparisons.append({"a": a, "b": b, "participants": both, "metrics": rows})
+    return {"study": protocol.name, "status": status, "variants": variants,
+            "comparisons": comparisons}
+
+
+def summary_lines(doc: dict[str, Any]) -> list[str]:
+    def num(x: Any, unit: str | None = None) -> str:
+        return "-" if x is None else f"{x:.4g}" + (f" {unit}" if unit else "")
+
+    def interval(m: dict[str, Any], none: str) -> str:
+        lo, hi = m["ci95"]
+        unit = m.get("unit")
+        if lo is None or hi is None:        # "[-, -]" said nothing of why
+            return f"no 95 % CI: {none}; n = {m['participants']}"
+        return (f"95 % CI [{num(lo)}, {num(hi)}]{' ' + unit if unit else ''}; "
+                f"n = {m['participants']}")
+
+    lines = [f"study {doc['study']}"]
+    for participant, sessions in doc["status"].items():
+        lines.append(f"  {participant}: " + ", ".join(
+            f"{v} {'done' if ok else 'to do'}" for v, ok in sessions.items()))
+    for vid, v in doc["variants"].items():
+        lines.append(f"variant {vid} ({v['participants']} participant(s) finished):")
+        for name, m in v["metrics"].items():
+            lines.append(f"  {name}: {num(m['value'], m.get('unit'))} "
+                         f"({interval(m, 'one participant')})")
+    for c in doc["comparisons"]:
+        lines.append(f"{c['b']} - {c['a']}, paired over {len(c['participants'])} "
+                     "participant(s) who did both:")
+        if not c["metrics"]:
+            lines.append("  (needs two participants or more who did both)")
+        for name, m in c["metrics"].items():
+            unit = m.get("unit")
+            lines.append(f"  {name}: {num(m['a'], unit)} -> {num(m['b'], unit)}, difference "
+                         f"{num(m['difference'], unit)} ("
+                         + interval(m, "fewer than two participants differ between the "
+                                    "variants") + ")")
+    return lines
+
