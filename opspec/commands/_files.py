@@ -13,7 +13,7 @@ from typing import Any
 from opspec.errors import ConfigurationError
 
 __all__ = ["Named", "check_nesting", "input_problem", "overwrite_problem", "refuse_overwrite",
-           "same_file", "spec_inputs", "translation_problem", "write_problem"]
+           "same_file", "spec_inputs", "translation_problem", "unwritable", "write_problem"]
 
 #: a file as the command line names it: (the option or argument, e.g. ``"--trace"``, path)
 Named = tuple[str, "str | os.PathLike[str] | None"]
@@ -66,6 +66,27 @@ def write_problem(target: Path, error: OSError) -> str:
             return (f"cannot write {target}: the folder {folder} does not exist (create it "
                     "first)")
     return f"cannot write {target}: {error.strerror or error}"
+
+
+def unwritable(target: Path, *, folder: bool = False) -> str | None:
+    """Why ``target`` (a file, or with ``folder`` a folder, that a command writes once its
+    work is done) cannot be written, found before that work starts (``opspec fit -o`` fitted
+    and bootstrapped, ``model-check --report`` checked, for minutes, and only then said they
+    could not write); None when it can. A temporary file is made and removed in the nearest
+    folder that exists; nothing else is created."""
+    import tempfile
+
+    place = target if folder else target.parent
+    existing = next((path for path in (place, *place.parents) if path.exists()), None)
+    if existing is None or not existing.is_dir():
+        return (f"cannot write {target}: {existing} is a file, not a folder (give a path "
+                "in a folder)") if existing is not None else f"cannot write {target}"
+    try:
+        with tempfile.TemporaryFile(dir=existing):
+            pass
+    except OSError as error:
+        return f"cannot write {target}: {existing}: {error.strerror or error}"
+    return None
 
 
 def same_file(source: Path, target: Path) -> bool:

@@ -137,6 +137,12 @@ def _fit(args: argparse.Namespace) -> int:
     from opspec.commands._files import refuse_overwrite
 
     refuse_overwrite([("-o", out)], [("a TRACE", path) for path in paths])
+    if out is not None:
+        from opspec.commands._files import unwritable
+
+        problem = unwritable(out)
+        if problem is not None:     # said now, not after the fitting and its bootstrap
+            raise UserModelError(problem, hint="choose a writable path with -o")
     name = args.name or (out.stem.removesuffix(".users") if out else "fitted")
     result = fit_traces(paths, lane=args.lane, name=name, criterion=args.criterion,
                         min_per_user=args.min_per_user, persons=persons)

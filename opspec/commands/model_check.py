@@ -253,6 +253,13 @@ def _model_check(args: argparse.Namespace) -> int:
     from opspec.usermodels.persons import PersonRule, parse_person_options
 
     paths = trace_files(args.traces, "model-check")
+    if args.report:
+        from opspec.commands._files import unwritable
+        from opspec.errors import UserModelError
+
+        problem = unwritable(Path(args.report), folder=True)
+        if problem is not None:     # said now, not after the check
+            raise UserModelError(problem, hint="choose a writable folder with --report")
     model = load_user_model(args.model)
     persons = PersonRule(args.person_from, args.person_pattern,
                          parse_person_options(args.person))
