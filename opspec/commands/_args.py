@@ -84,9 +84,12 @@ def add_engine_config(parser: argparse.ArgumentParser) -> None:
 
 def add_device_options(parser: argparse.ArgumentParser) -> None:
     """``--bind`` and ``--devices``: real or emulated devices in place of participants."""
-    parser.add_argument("--bind", action="append", default=[], metavar="PARTICIPANT=URL",
-                        help="bind a participant to a serial device URL or 'auto' "
-                        "(repeatable; see devices/README.md)")
+    parser.add_argument("--bind", action="append", default=[],
+                        metavar="PARTICIPANT[:PROFILE]=URL",
+                        help="bind a participant to a serial device URL (a device path, "
+                        "socket://HOST:PORT, emulator://PROFILE) or 'auto'; :PROFILE picks the "
+                        "profile when several serve the participant (repeatable; see "
+                        "devices/README.md)")
     parser.add_argument("--devices", metavar="DIR",
                         help="folder of device profiles for --bind (default: devices/)")
 

@@ -126,3 +126,17 @@ def test_ambiguous_participant_asks_for_a_profile(tmp_path: Path) -> None:
     (tmp_path / "b.toml").write_text(text.replace('name = "medication_dispenser"', 'name = "b"'))
     with pytest.raises(BindingError, match=re.escape("pick one: alarm:a=auto")):
         bindings_from_args(["alarm=auto"], tmp_path)
+
+
+def test_the_help_of_bind_shows_the_profile_form_and_the_kinds_of_url(capsys) -> None:
+    """``PARTICIPANT:PROFILE=URL`` (devices/README.md) was not in ``--help``: a participant
+    that several profiles serve could not be bound from what the help said."""
+    import pytest
+
+    from opspec.cli import main
+
+    with pytest.raises(SystemExit):
+        main(["run", "--help"])
+    out = " ".join(capsys.readouterr().out.split())
+    assert "--bind PARTICIPANT[:PROFILE]=URL" in out
+    assert "socket://HOST:PORT" in out and "emulator://PROFILE" in out
