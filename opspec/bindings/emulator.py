@@ -391,8 +391,18 @@ class SocketEmulator(_Server):
         try:
             self._listener = socket.create_server((host, port))
         except OSError as error:
-            raise BindingError(f"cannot listen on {host}:{port}: {error.strerror or error}"
-                               ) from None
+            import errno
+
+            hint = {errno.EADDRINUSE: ("another program listens on that port: choose another "
+                                       "port, or port 0 for a free one "
+                                       "(socket://127.0.0.1:0)"),
+                    errno.EADDRNOTAVAIL: (f"{host} is not an address of this machine: use "
+                                          "127.0.0.1, or 0.0.0.0 for every address")
+                    }.get(error.errno or 0, "")
+            # (os.strerror: create_server's strerror adds "while attempting to bind on …")
+            reason = os.strerror(error.errno) if error.errno else str(error)
+            raise BindingError(f"cannot listen on {host}:{port}: {reason}",
+                               hint=hint) from None
         self.host, self.port = self._listener.getsockname()[:2]
         self._client: socket.socket | None = None
 

@@ -68,3 +68,21 @@ def test_emulate_says_how_to_bind_every_participant_of_the_device(
     line = next(text for text in out.splitlines() if "bind it with:" in text)
     url = line.split("--bind alarm=", 1)[1].split()[0]
     assert line.strip() == f"bind it with: --bind alarm={url} --bind dispenser={url}"
+
+
+def test_a_socket_port_in_use_says_what_to_do(capsys) -> None:
+    """``Address already in use`` alone left the designer guessing; the refusal says another
+    program listens there and how to get a free port."""
+    import socket
+
+    from opspec.cli import main
+
+    with socket.create_server(("127.0.0.1", 0)) as taken:
+        port = taken.getsockname()[1]
+        status = main(["devices", "emulate", "medication_dispenser", "--port",
+                       f"socket://127.0.0.1:{port}", "--duration", "0.1", "--quiet"])
+    err = capsys.readouterr().err
+    assert status == 2
+    assert f"cannot listen on 127.0.0.1:{port}: Address already in use" in err
+    assert "while attempting" not in err
+    assert "another program listens on that port" in err and "socket://127.0.0.1:0" in err
