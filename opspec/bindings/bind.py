@@ -17,7 +17,7 @@ from pathlib import Path
 from opspec.bindings.binding import DeviceBinding
 from opspec.bindings.inbox import Inbox
 from opspec.bindings.profiles import DeviceProfile, load_profiles, profiles_serving
-from opspec.bindings.transport import PortInfo, find_port, open_port
+from opspec.bindings.transport import PortInfo, find_port, open_port, settles
 from opspec.errors import BindingError
 
 __all__ = ["AUTO", "BindSpec", "bind", "bindings_from_args", "parse_bind_spec"]
@@ -59,7 +59,7 @@ def bind(participants: str | Sequence[str], url: str, profile: DeviceProfile, *,
         port = open_port(url, profile.serial, label, Path(profile.path).parent)
         notes = [f"{label}: bound to {url} ({profile.name})"]
     settle = settle_s if settle_s is not None else (
-        profile.serial.settle_s if "://" not in url else 0.0)
+        profile.serial.settle_s if settles(url) else 0.0)
     if settle > 0:
         time.sleep(settle)  # before the run: the board boots and would drop our commands
         port.reset_input_buffer()

@@ -12,7 +12,7 @@ from pathlib import Path
 import serial
 
 from opspec.bindings.binding_state import BindingState
-from opspec.bindings.transport import LineFramer, LineReaderThread, open_port
+from opspec.bindings.transport import LineFramer, LineReaderThread, open_port, settles
 from opspec.errors import BindingError
 
 __all__ = ["Reconnection"]
@@ -104,7 +104,7 @@ class Reconnection(BindingState):
                 except BindingError as error:
                     last = error.message
                     continue
-                if self.profile.serial.settle_s and "://" not in self.url:
+                if self.profile.serial.settle_s and settles(self.url):
                     self._closed.wait(self.profile.serial.settle_s)
                 self.inbox.post(partial(self._reconnected, gen, port))
                 return

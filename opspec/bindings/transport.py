@@ -33,6 +33,7 @@ __all__ = [
     "list_ports",
     "open_port",
     "register_url_handlers",
+    "settles",
 ]
 
 _HANDLER_PACKAGE = "opspec.bindings.urlhandler"
@@ -46,6 +47,19 @@ def register_url_handlers() -> None:
 
 
 register_url_handlers()
+
+
+def settles(url: str) -> bool:
+    """Whether the device at ``url`` is waited for after it is opened (the profile's
+    ``settle_ms``): a device path of a board, which resets when its port opens and drops
+    what it is sent meanwhile; not a pySerial URL (``socket://``, ``emulator://``), nor a
+    pseudo-terminal (``opspec devices emulate``'s, a socat pair), which resets nothing."""
+    if "://" in url:
+        return False
+    import re
+
+    real = os.path.realpath(url)
+    return not (real.startswith("/dev/pts/") or re.fullmatch(r"/dev/ttys\d+", real))
 
 
 def open_port(url: str, settings: SerialSettings, who: str = "",

@@ -2,8 +2,9 @@
 (dispenser_board.py, which imports nothing from opspec) over real pseudo-terminal pairs made by
 socat: one `opspec run` per board behaviour, all of them at once.
 
-Each run goes from 00:00 to 11:40 simulated at 5000x (about 8.4 s of wall time plus the
-profile's 2 s settle after opening the port): one dose, at 08:00, slot 1. A run spends that
+Each run goes from 00:00 to 11:40 simulated at 5000x (about 8.4 s of wall time; a
+pseudo-terminal is not waited for as a board that resets when opened is): one dose, at 08:00,
+slot 1. A run spends that
 time waiting on the wall clock, so the runs go side by side, each in a process of its own with
 a socat pair and a board of its own (nothing is shared but the machine): all of them take the
 wall time of one, where one after another they held a test worker idle for 10 s each. The
@@ -140,7 +141,7 @@ def run_all(folder: Path, scenarios: dict[str, tuple[tuple[str, ...], str]] = SC
                                           text=True)
         # each board starts once its run has opened the port (the runs start up meanwhile,
         # side by side), so a board's clock (--press-at-ms) starts with its run's, however
-        # long the start-up took; the first command comes after the 2 s settle
+        # long the start-up took
         for name, (options, _) in scenarios.items():
             _await_open(runs[name], rigs[name].host, name)
             rigs[name].start_board(*options)

@@ -120,3 +120,48 @@ def test_a_refused_socket_says_the_reason_once(dispenser_profile: DeviceProfile)
         bind("alarm", url, dispenser_profile)
     assert refused.value.message.startswith(f"alarm: cannot open {url}: [Errno ")
     assert "Could not open port" not in refused.value.message
+
+
+def test_only_a_device_path_of_a_board_is_waited_for_after_opening(tmp_path) -> None:
+    """The profile's settle_ms is for boards that reset when their port opens; a
+    pseudo-terminal (`opspec devices emulate`'s, a socat pair) resets nothing, and binding
+    one waited 2 s for nothing; pySerial URLs never waited."""
+    import os
+    import pty
+
+    from opspec.bindings.transport import settles
+
+    leader, follower = pty.openpty()
+    try:
+        name = os.ttyname(follower)
+        link = tmp_path / "board"
+        link.symlink_to(name)                     # a stable name for the pty, as socat makes
+        assert not settles(name) and not settles(str(link))
+    finally:
+        os.close(leader)
+        os.close(follower)
+    assert not settles("socket://127.0.0.1:4000") and not settles("emulator://bumper")
+    assert settles("/dev/ttyACM0") and settles("/dev/ttyUSB0") and settles("COM3")
+
+
+@needs_pty
+def test_binding_an_emulator_on_a_pseudo_terminal_does_not_wait_the_boards_settle(
+        emulate, monkeypatch) -> None:
+    """The shipped dispenser profile waits 2 s after opening a board's port (an Uno resets);
+    bound to `opspec devices emulate`'s pseudo-terminal it waited those 2 s for nothing."""
+    import importlib
+
+    from opspec.bindings import load_profile
+
+    binding_module = importlib.import_module("opspec.bindings.bind")   # (bind: the function)
+
+    profile = load_profile(DEVICES / "medication_dispenser.toml")
+    assert profile.serial.settle_s == 2.0
+    waits: list[float] = []
+    monkeypatch.setattr(binding_module.time, "sleep", waits.append)
+    server = emulate(profile)
+    binding = binding_module.bind(["dispenser"], server.path, profile)
+    try:
+        assert waits == []
+    finally:
+        binding.close()
