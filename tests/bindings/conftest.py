@@ -4,6 +4,7 @@ always closed, and the fake engine session."""
 from __future__ import annotations
 
 import os
+import tty
 from collections.abc import Callable, Iterator
 from pathlib import Path
 from typing import Any
@@ -99,3 +100,15 @@ def board_runs(tmp_path_factory: pytest.TempPathFactory) -> dict[str, BoardRun]:
     """Every scenario of board_runs.SCENARIOS, run side by side once per test process (the
     tests that ask need socat and a pty: they skip before asking)."""
     return run_all(tmp_path_factory.mktemp("board-runs"))
+
+@pytest.fixture
+def raw_pty() -> Iterator[tuple[int, str]]:
+    """A pseudo-terminal whose device side the test writes by hand."""
+    try:
+        master, slave = os.openpty()
+    except OSError:
+        pytest.skip("os.openpty() is unavailable here")
+    tty.setraw(slave)
+    yield master, os.ttyname(slave)
+    os.close(master)
+    os.close(slave)

@@ -4,10 +4,7 @@ pseudo-terminal pair (``os.openpty``) and over ``socket://`` on localhost."""
 from __future__ import annotations
 
 import os
-import tty
-from collections.abc import Callable, Iterator
-
-import pytest
+from collections.abc import Callable
 
 from opspec.bindings import DEVICE_NOTE, DeviceBinding
 from opspec.bindings.emulator import PtyEmulator, SocketEmulator
@@ -72,19 +69,6 @@ def test_pty_vanishing_mid_run_falls_back_per_participant(
     assert session.completed[-1] == (off, None)
     assert session.failed[-1][:2] == (again, "DispenserFault")
     assert session.faults()[-1] == "unavailable"
-
-
-@pytest.fixture
-def raw_pty() -> Iterator[tuple[int, str]]:
-    """A pseudo-terminal whose device side the test writes by hand."""
-    try:
-        master, slave = os.openpty()
-    except OSError:
-        pytest.skip("os.openpty() is unavailable here")
-    tty.setraw(slave)
-    yield master, os.ttyname(slave)
-    os.close(master)
-    os.close(slave)
 
 
 def test_unexpected_and_garbled_lines_while_idle_are_faults(

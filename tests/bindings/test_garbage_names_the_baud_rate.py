@@ -5,10 +5,7 @@ where to look. Network URLs have no baud rate: not said there."""
 from __future__ import annotations
 
 import os
-import tty
-from collections.abc import Callable, Iterator
-
-import pytest
+from collections.abc import Callable
 
 from opspec.bindings import DeviceBinding
 from opspec.bindings.emulator import PtyEmulator, SocketEmulator
@@ -18,18 +15,6 @@ from .fakes import FakeSession, item, run_until
 
 Binder = Callable[..., DeviceBinding]
 Emulate = Callable[..., PtyEmulator | SocketEmulator]
-
-
-@pytest.fixture
-def raw_pty() -> Iterator[tuple[int, str]]:
-    try:
-        master, slave = os.openpty()
-    except OSError:
-        pytest.skip("os.openpty() is unavailable here")
-    tty.setraw(slave)
-    yield master, os.ttyname(slave)
-    os.close(master)
-    os.close(slave)
 
 
 def test_undecodable_bytes_on_a_serial_line_name_the_baud_rate(

@@ -35,6 +35,16 @@ def kinds(outcome: opspec.RunOutcome, kind: str) -> list[opspec.engine.trace.Tra
     return [e for e in outcome.trace if e.kind == kind]
 
 
+def instances(outcome: opspec.RunOutcome, process: str = "p") -> list[list[str]]:
+    """The activities each instance of ``process`` completed, in order, one list per
+    instance (sorted: instances' ids are not what a test asserts)."""
+    found: dict[int, list[str]] = {}
+    for event in outcome.trace:
+        if event.process == process and event.kind == "activity.completed":
+            found.setdefault(event.instance or 0, []).append(event.activity or "")
+    return sorted(found.values())
+
+
 @pytest.fixture
 def data() -> Path:
     return DATA

@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import pytest
 
-from .conftest import completed, kinds, run
+from .conftest import completed, instances, kinds, run
 
 
 @pytest.mark.parametrize("name", ["several_start_events.bpmn", "several_start_events.xpdl"])
@@ -50,14 +50,6 @@ def test_a_called_process_starts_at_its_none_start_event_only() -> None:
     assert [e.process for e in kinds(outcome, "process.completed")][:2] == ["p", "main"]
 
 
-def _instances(outcome: object) -> list[list[str]]:
-    found: dict[int, list[str]] = {}
-    for event in outcome.trace:  # type: ignore[attr-defined]
-        if event.process == "p" and event.kind == "activity.completed":
-            found.setdefault(event.instance or 0, []).append(event.activity or "")
-    return sorted(found.values())
-
-
 def test_a_none_start_beside_a_message_start_starts_its_own_instance() -> None:
     """BPMN 2.0 §10.4.2 (Start Event): "Each Start Event is an independent event. That is, a
     Process instance SHALL be generated when the Start Event is triggered." The none start
@@ -68,7 +60,7 @@ def test_a_none_start_beside_a_message_start_starts_its_own_instance() -> None:
     started = [(e.time, e.data["trigger"]) for e in outcome.trace
                if e.process == "p" and e.kind == "process.started"]
     assert started == [(0.0, "auto"), (600.0, "message:call")]
-    assert _instances(outcome) == [["begin", "open", "end_open"],
+    assert instances(outcome) == [["begin", "open", "end_open"],
                                    ["on_call", "answer", "end_answer"]]
 
 
@@ -85,4 +77,4 @@ def test_the_api_starts_a_process_at_its_none_start_events_only() -> None:
                             keep_trace=True)
     simulation.start("p")
     result = simulation.run(until=60)
-    assert _instances(result) == [["begin", "open", "end_open"]] * 2
+    assert instances(result) == [["begin", "open", "end_open"]] * 2

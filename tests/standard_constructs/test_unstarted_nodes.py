@@ -21,7 +21,7 @@ from opspec.cli import main
 from opspec.errors import Severity
 from opspec.xpdl.validate import validate_spec
 
-from .conftest import DATA, run
+from .conftest import DATA, instances, run
 
 QUOTE = ("All Flow Objects that do not have an incoming Sequence Flow (i.e., are not a target "
          "of a Sequence Flow) SHALL be instantiated when the Process is instantiated")
@@ -42,20 +42,12 @@ def _check(path: Path, capsys: pytest.CaptureFixture[str]) -> tuple[int, dict]:
     return status, json.loads(capsys.readouterr().out.splitlines()[-1])
 
 
-def _instances(outcome: object) -> list[list[str]]:
-    found: dict[int, list[str]] = {}
-    for event in outcome.trace:  # type: ignore[attr-defined]
-        if event.process == "p" and event.kind == "activity.completed":
-            found.setdefault(event.instance or 0, []).append(event.activity or "")
-    return sorted(found.values())
-
-
 @pytest.mark.parametrize("name", ["unstarted_beside_timer.bpmn", "unstarted_beside_timer.xpdl"])
 def test_run_never_runs_it_in_the_instances_a_timer_start_makes(name: str) -> None:
     """The timer start makes an instance at 1 h and at 2 h; each runs "hourly" only: "report"
     (no incoming flow) runs in none of them, and no other instance is made."""
     outcome = run(name, until=7300)
-    assert _instances(outcome) == [["every_hour", "hourly", "end_hourly"]] * 2
+    assert instances(outcome) == [["every_hour", "hourly", "end_hourly"]] * 2
 
 
 @pytest.mark.parametrize("name", ["unstarted_beside_timer.bpmn", "unstarted_beside_timer.xpdl"])
@@ -173,7 +165,7 @@ def test_beside_none_start_events_it_runs_with_its_level_and_nothing_is_said(
     its level, as §10.4.2 says: run runs it, validate is quiet, check finds it sound."""
     path = DATA / "unstarted_beside_none_start.bpmn"
     outcome = run(path.name, until=60)
-    assert sorted(_instances(outcome)[0]) == sorted(
+    assert sorted(instances(outcome)[0]) == sorted(
         ["begin", "report", "work", "sub_begin", "inner", "inner_report", "sub", "done"])
     assert not _gate_warnings(path)
     status, doc = _check(path, capsys)
@@ -191,7 +183,7 @@ def test_beside_a_none_and_a_timer_start_it_runs_in_the_untriggered_instance(
     import opspec
 
     outcome = opspec.run(path, until=7300, seed=0)
-    assert sorted(map(sorted, _instances(outcome))) == [["a", "s"], ["a", "s"], ["b", "n", "x"]]
+    assert sorted(map(sorted, instances(outcome))) == [["a", "s"], ["a", "s"], ["b", "n", "x"]]
     assert [line for line, _ in _gate_warnings(path)] == [_line(path, 'id="x"')]
     _status, doc = _check(path, capsys)
     assert not [p for p in doc["problems"] if p["kind"] == "dead"]
@@ -214,7 +206,7 @@ def test_a_called_process_runs_it_and_check_agrees(tmp_path: Path,
     import opspec
 
     outcome = opspec.run(path, until=60, seed=0)
-    assert ["report", "end_report"] in _instances(outcome)
+    assert ["report", "end_report"] in instances(outcome)
     _status, doc = _check(path, capsys)
     assert not [p for p in doc["problems"] if p["kind"] == "dead"]
 
