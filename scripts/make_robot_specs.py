@@ -383,7 +383,7 @@ def main() -> None:
             count("bouts_lost", "world.bout_lost"), count("collisions", "world.collision"),
             count("manoeuvres", "activity.completed", "manoeuvre", "move_back"),
             count("dockings", "mode.changed"),
-            '      <opspec:Ratio Name="win_rate" Numerator="bouts_won" Denominator="bouts"/>']),
+            '      <opspec:Ratio Name="win_rate" Numerator="bouts_won" Denominator="bouts" Proportion="true"/>']),
         # a tournament of bouts (60 s at most each), over before the battery asks to dock
         ROBOT_APPS, ROBOT_FIELDS, run_length="PT30M")
     cart_fields = [*ROBOT_FIELDS, field("tag", "STRING", '""'),

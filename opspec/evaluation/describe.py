@@ -36,9 +36,13 @@ def _selector(selector: EventSelector | None) -> dict[str, Any] | None:
 
 
 def metric_record(metric: MetricDefinition) -> dict[str, Any]:
-    """The stored form of one declared metric (``run.metrics`` in ``results.sqlite``)."""
+    """The stored form of one declared metric (``run.metrics`` in ``results.sqlite``);
+    ``proportion`` is the spec's declaration (``Proportion="true"``), which the summaries
+    read to choose a ratio's interval (a store written before it was kept has none: every
+    ratio of it is a ratio)."""
     return {"name": metric.name, "kind": metric.kind.value.lower(),
             "numerator": metric.numerator, "denominator": metric.denominator,
+            "proportion": metric.proportion,
             "unit": metric.unit, "description": metric.description,
             "select": _selector(metric.select), "start": _selector(metric.start),
             "end": _selector(metric.end)}

@@ -7,12 +7,14 @@
 - duration: pooled ``n``, ``mean`` (with ``ci95``), ``sd``, ``median``, ``p95`` of all
   observations, and ``per_user``: ``users``, ``mean``, ``sd``, ``ci95``, ``median``, ``p90``,
   ``p95``, ``p99`` of the users' own means (users without observations left out);
-- ratio: ``value`` = Σ numerator / Σ denominator over users with ``ci95`` (for a proportion
-  of counts, such as missed / due doses, Wilson's score interval on the effective number of
-  trials, :func:`opspec.statistics.proportions.proportion_interval`; otherwise the
-  cluster-robust t interval), and ``per_user``
+- ratio: ``value`` = Σ numerator / Σ denominator over users with ``ci95`` by what the spec
+  declares of it (:func:`opspec.statistics.ratios.ratio_interval`: for a ratio declared a
+  proportion, ``Proportion="true"``, such as missed / due doses, Wilson's score interval on
+  the effective number of trials, and an error if a user's numerator exceeds its denominator;
+  otherwise the cluster-robust t interval, widened to the exact Poisson one for a ratio of
+  counts with few events), ``proportion`` (the declaration), and ``per_user``
   (the same fields over the users' own ratios, plus ``users_with_any``, ``share_with_any``
-  and its exact interval: users whose numerator is not 0; and, for a proportion,
+  and its exact interval: users whose numerator is not 0; and, for a declared proportion,
   ``between_user_sd``: the sd of the users' true rates with the binomial noise of each
   user's own rate taken out, about 0 when users differ only by chance).
 ``summarise_design(..., subgroup=NAME)`` summarises the users of one subgroup of a population
@@ -42,13 +44,12 @@ from opspec.evaluation.values_per_user import (
 from opspec.statistics import (
     count_estimate,
     hazard_estimate,
-    is_proportion,
     paired_difference,
-    proportion_interval,
     rate_interval,
     ratio_estimate,
 )
 from opspec.statistics.clustered import ValuesAsPairs
+from opspec.statistics.ratios import ratio_interval
 from opspec.statistics.percentiles import interpolation_point, linear
 
 __all__ = ["compare_designs", "metric_definitions", "subgroup_users", "summarise_activities",
@@ -134,13 +135,12 @@ def _with_any(values: Sequence[float], level: float) -> dict[str, Any]:
 
 
 def _between_user_sd(pairs: Sequence[tuple[float, float]]) -> float | None:
-    """For a proportion: the sd of the users' true rates, by the method of moments — the
-    variance of the users' own rates less the mean binomial variance of a rate measured on
-    ``n`` trials (estimated without bias by ``p(1-p)/(n-1)``). About 0 when every user has
-    the same rate and they differ only by chance; users with fewer than 2 trials are left
-    out. Two passes over ``pairs``, nothing held per user."""
-    if any(y > n or y < 0 or y != int(y) or n != int(n) for y, n in pairs):
-        return None
+    """For a declared proportion (whose every ``y <= n``, checked before): the sd of the
+    users' true rates, by the method of moments — the variance of the users' own rates less
+    the mean binomial variance of a rate measured on ``n`` trials (estimated without bias by
+    ``p(1-p)/(n-1)``). About 0 when every user has the same rate and they differ only by
+    chance; users with fewer than 2 trials are left out. Two passes over ``pairs``, nothing
+    held per user."""
     measured = sum(1 for _, n in pairs if n >= 2)
     if measured < 2:
         return None
@@ -160,6 +160,7 @@ def summarise_design(store: ResultStore, design: str, days: float, level: float 
     where, where_params = _in_subgroup(design, subgroup)
     definitions = metric_definitions(store, design)
     values = per_user_values(store, design, definitions, users_of)
+    counts = {d["name"] for d in definitions if d["kind"] == "count"}
     for definition in definitions:
         name, kind = definition["name"], definition["kind"]
         pairs = values.pairs(name)
@@ -194,20 +195,25 @@ def summarise_design(store: ResultStore, design: str, days: float, level: float 
                 "per_user": _per_user(values.sorted(name, "v"), level),
             }
         else:
-            proportion = is_proportion(pairs)
-            ci = proportion_interval(pairs, level) if proportion else estimate.ci
+            # the declaration, never the numbers of this run, says whether it is a proportion
+            # (a store written before it was kept: every ratio is a ratio)
+            proportion = bool(definition.get("proportion"))
+            numerator, denominator = definition.get("numerator"), definition.get("denominator")
+            interval = ratio_interval(pairs, proportion=proportion,
+                                      of_counts=numerator in counts and denominator in counts,
+                                      name=name, numerator=str(numerator),
+                                      denominator=str(denominator), level=level)
             out[name] = {
                 "kind": "ratio", "value": estimate.value, "users": users,
                 "numerator_total": sum(y for y, _ in pairs),
                 "denominator_total": sum(k for _, k in pairs),
-                "ci95": ci,
-                "ci95_method": (None if ci[0] is None else
-                                "wilson-neff" if proportion else estimate.method),
-                "numerator": definition.get("numerator"),
-                "denominator": definition.get("denominator"),
+                "ci95": interval.ci, "ci95_method": interval.method,
+                "proportion": proportion,
+                "numerator": numerator, "denominator": denominator,
                 "per_user": {**_per_user(values.sorted(name, "v"), level),
                              **_with_any(values.where_denominator(name), level),
-                             "between_user_sd": _between_user_sd(pairs)},
+                             "between_user_sd": (_between_user_sd(pairs) if proportion
+                                                 else None)},
             }
     return out
 

@@ -4,9 +4,10 @@ the walkthrough's summary should print, word for word: :mod:`opspec.tui.summary`
 Counts as they are, durations as mean, median, p95 and n. A ratio of two counts reads as
 ``opspec evaluate``'s table reads it (:mod:`.tables`, hence here and not in the commands: the
 walkthrough, a layer below them, can use it too): the counts it divides follow its value,
-``(13 of 12)``, as in that table's pooled column; and a proportion that table shows in percent
-(``taken_rate``: doses taken of doses due) is in percent here too, by the table's own
-formatter (:func:`.tables.fmt`), ``100.00 % (12 of 12)``. Other ratios (of durations, of other
+``(13 of 12)``, as in that table's pooled column; and a ratio the spec declares a proportion
+(``Proportion="true"``: ``taken_rate``, doses taken of doses due) is in percent, by the table's
+own formatter (:func:`.tables.fmt`), ``100.00 % (12 of 12)`` — unless this run's counts make
+the declaration false, which its line then says. Other ratios (of durations, of other
 ratios) are their bare value. ``opspec run --json`` does not use this (its metrics are shaped
 as ``opspec evaluate --json``'s).
 """
@@ -44,7 +45,7 @@ def metric_lines(metrics: Mapping[str, Mapping[str, Any]], medians: Mapping[str,
                     f"{figure(medians.get(name), ' s')}, p95 {figure(value.get('p95'), ' s')}, "
                     f"n {n}")
         else:
-            text = _ratio(name, value, _counts(ratios.get(name), metrics))
+            text = _ratio(ratios.get(name), value, _counts(ratios.get(name), metrics))
         lines.append(f"  {name:<{width}}  {text}")
     return lines
 
@@ -62,8 +63,9 @@ def _counts(definition: MetricDefinition | None, metrics: Mapping[str, Mapping[s
     return int(numerator.get("total", 0)), int(denominator.get("total", 0))
 
 
-def _ratio(name: str, value: Mapping[str, Any], counts: tuple[int, int] | None) -> str:
-    if counts is None:                  # of durations, of other ratios: the value alone
+def _ratio(definition: MetricDefinition | None, value: Mapping[str, Any],
+           counts: tuple[int, int] | None) -> str:
+    if definition is None or counts is None:   # of durations, of other ratios: the value
         return figure(value.get("value"))
     part, whole = counts
     # "k of 0", not "no doses_due": every ratio of counts ends in the same "(k of n)", as
@@ -71,13 +73,17 @@ def _ratio(name: str, value: Mapping[str, Any], counts: tuple[int, int] | None) 
     # the denominator, and the line stays true when the numerator is not 0
     if whole == 0:
         return f"{figure(None)} ({part} of 0)"
-    from opspec.evaluation.tables import fmt, is_rate
-    from opspec.statistics.proportions import is_proportion
+    from opspec.evaluation.tables import fmt
 
-    # in percent when evaluate's table would show it so (is_rate: a …rate/…share between 0
-    # and 1) and the counts are a proportion (is_proportion, evaluate's test for its
-    # interval); the name matters too: alarms_per_dose is 4 of 4 in some runs, and
-    # evaluate never shows it as 100.00 %
-    if is_proportion([(part, whole)]) and is_rate(name, value):
-        return f"{fmt(value.get('value'), percent=True)} ({part} of {whole})"
-    return f"{figure(value.get('value'))} ({part} of {whole})"
+    # in percent when the spec declares it a proportion (Proportion="true"), as evaluate
+    # gives it an interval of a proportion; never from its name or these numbers:
+    # alarms_per_dose is 4 of 4 in some runs, and is no proportion
+    if not definition.proportion:
+        return f"{figure(value.get('value'))} ({part} of {whole})"
+    if part > whole:
+        # the declaration is false in this run: said where the number is (evaluate refuses
+        # the proportion's interval for it, docs/evaluation.md)
+        return (f"{figure(value.get('value'))} ({part} of {whole}: more "
+                f"{definition.numerator} than {definition.denominator}, though the spec "
+                "declares it a proportion)")
+    return f"{fmt(value.get('value'), percent=True)} ({part} of {whole})"

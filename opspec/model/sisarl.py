@@ -171,5 +171,9 @@ class MetricDefinition:
     end: EventSelector | None = None           # DURATION
     numerator: str | None = None               # RATIO: metric names
     denominator: str | None = None
+    #: RATIO: declared a proportion (``Proportion="true"``): each numerator event is one of
+    #: the denominator's trials, at most one per trial; its interval is Wilson's, an
+    #: undeclared ratio's the ratio's (docs/evaluation.md), never chosen from the data
+    proportion: bool = False
     unit: str | None = None
     location: SourceLocation | None = None

@@ -7,6 +7,8 @@ opspec comes from here (spec tests, evaluations, user-model fitting, the engine'
   evaluation (cluster-robust t), counts with rare events, hazards, paired differences;
 * :mod:`~opspec.statistics.proportions` — a proportion pooled over users: Wilson's score
   interval on the effective number of trials;
+* :mod:`~opspec.statistics.ratios` — a ratio metric's interval by its declaration in the spec
+  (a proportion's or a ratio's, with few events the exact Poisson one);
 * :mod:`~opspec.statistics.percentiles` — the two percentile conventions (interpolated,
   nearest rank);
 * :mod:`~opspec.statistics.claims` — deciding a claim "X >= b with 95 % confidence";
@@ -36,7 +38,7 @@ from opspec.statistics.intervals import (
     rate_interval,
     t_quantile,
 )
-from opspec.statistics.proportions import effective_trials, is_proportion, proportion_interval
+from opspec.statistics.proportions import effective_trials, proportion_interval
 
 __all__ = [
     "MEAN_METHODS",
@@ -49,7 +51,6 @@ __all__ = [
     "count_estimate_from_sums",
     "effective_trials",
     "hazard_estimate",
-    "is_proportion",
     "mean_interval",
     "normal_quantile",
     "one_sided",

@@ -55,10 +55,21 @@ METHODS: Mapping[str, Method] = {m.id: m for m in (
            "above and the exact Poisson interval of the total k over U users, "
            "[χ²(0.025; 2k)/2, χ²(0.975; 2k+2)/2] / U (0 for the lower end when k = 0).",
            (_T, _GARWOOD)),
+    Method("t+garwood-rate", "t ∪ Garwood rate",
+           "a ratio of counts with fewer than 10 numerator events: the t interval widened to "
+           "the exact Poisson interval of the events per trial",
+           "a ratio of two counts not declared a proportion (alarms per dose due) with fewer "
+           "than 10 numerator events over all users: the union of the t interval above and "
+           "the exact Poisson interval of the k events over the Σn trials of the "
+           "denominator, [χ²(0.025; 2k)/2, χ²(0.975; 2k+2)/2] / Σn (0 for the lower end "
+           "when k = 0).",
+           (_T, _GARWOOD, "Ulm (1990), Am J Epidemiol 131:373–375 (exact Poisson interval "
+                          "of a rate)")),
     Method("wilson-neff", "Wilson, eff. n",
            "a proportion of counts: Wilson's score interval on the effective number of trials "
            "(design effect of users who differ)",
-           "a proportion of counts (missed of due doses): p = Σy/Σn; the binomial variance "
+           "a ratio of counts the spec declares a proportion (Proportion=\"true\": missed of "
+           "due doses): p = Σy/Σn; the binomial variance "
            "v_bin = p(1−p)/Σn and the cluster-robust variance v_users (as for t); "
            "v = v_bin + (t[0.975; U−1]/z[0.975])²·max(0, v_users − v_bin); the Wilson score "
            "interval of p on n_eff = p(1−p)/v trials (Σn when p is 0 or 1 or U < 2). With 1 or "

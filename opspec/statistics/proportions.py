@@ -8,6 +8,9 @@ few or no events, on the *effective* number of trials, Kish's ``n / deff``, with
 effect estimated from the between-user (cluster-robust) variance:
 :func:`proportion_interval` is Wilson's (1927) score interval on the effective trials (Korn &
 Graubard 1998; Franco, Little, Louis & Slud 2019).
+
+Which ratio is a proportion is the spec's declaration (``Proportion="true"``), not a test of
+the numbers (:mod:`opspec.statistics.ratios`).
 """
 
 from __future__ import annotations
@@ -18,14 +21,9 @@ from collections.abc import Sequence
 from opspec.statistics.clustered import ratio_variance
 from opspec.statistics.intervals import normal_quantile, t_quantile
 
-__all__ = ["effective_trials", "is_proportion", "proportion_interval"]
+__all__ = ["effective_trials", "proportion_interval"]
 
 Pairs = Sequence[tuple[float, float]]
-
-
-def is_proportion(pairs: Pairs) -> bool:
-    """Whole numbers of events out of whole numbers of trials (missed out of due doses)."""
-    return bool(pairs) and all(0 <= y <= n and y == int(y) and n == int(n) for y, n in pairs)
 
 
 def _wilson(p: float, n: float, z: float) -> tuple[float, float]:

@@ -11,6 +11,7 @@ from typing import TYPE_CHECKING, Any
 from opspec.errors import ConfigurationError, SourceLocation
 
 if TYPE_CHECKING:
+    from opspec.model import MetricDefinition
     from opspec.tui.study import Protocol, Session, Variant
 
 __all__ = ["session_pairs", "summary", "summary_lines", "variant_estimate"]
@@ -81,35 +82,38 @@ def session_pairs(session: Session) -> dict[str, tuple[float, float]]:
     return _pairs(listener)
 
 
-def _metric_kinds(variant: Variant) -> dict[str, str]:
-    """Each metric of ``variant``'s spec and its kind (``count``, ``duration``, ``ratio``)."""
+def _metric_definitions(variant: Variant) -> dict[str, MetricDefinition]:
+    """Each metric of ``variant``'s spec, by name."""
     from opspec.xpdl.open_spec import open_spec
 
-    return {m.name: m.kind.value for m in open_spec(variant.spec).metrics}
+    return {m.name: m for m in open_spec(variant.spec).metrics}
 
 
-def variant_estimate(kind: str | None, pairs: list[tuple[float, float]]) -> dict[str, Any]:
+def variant_estimate(kind: str | None, pairs: list[tuple[float, float]],
+                     definition: MetricDefinition | None = None,
+                     of_counts: bool = False) -> dict[str, Any]:
     """One metric of one variant over its participants, as ``opspec evaluate`` summarises a
     design: a count's mean per participant with the t interval widened to the exact Poisson
-    (Garwood) one when there are few events, a proportion of counts (missed / due doses)
-    with Wilson's interval on the effective number of trials, anything else Σy/Σn with the
-    cluster-robust t interval. A t interval alone says [0, 0] for a count nobody had and a
-    rate of 0 of 16 doses, as if they could not happen."""
-    from opspec.statistics import (
-        count_estimate,
-        is_proportion,
-        proportion_interval,
-        ratio_estimate,
-    )
+    (Garwood) one when there are few events, a ratio by its ``definition``
+    (:func:`opspec.statistics.ratios.ratio_interval`: one the spec declares a proportion,
+    missed / due doses, with Wilson's interval on the effective number of trials; another
+    with the cluster-robust t interval, widened to the exact Poisson one for a ratio of
+    counts, ``of_counts``, with few events), anything else Σy/Σn with the cluster-robust t
+    interval. A t interval alone says [0, 0] for a count nobody had and a rate of 0 of 16
+    doses, as if they could not happen."""
+    from opspec.statistics import count_estimate, ratio_estimate
+    from opspec.statistics.ratios import ratio_interval
 
     estimate = ratio_estimate(pairs)
     ci, method = estimate.ci, estimate.method
     if kind == "count":
         estimate = count_estimate([y for y, _ in pairs])
         ci, method = estimate.ci, estimate.method
-    elif kind == "ratio" and is_proportion(pairs):
-        ci = proportion_interval(pairs)
-        method = None if ci[0] is None else "wilson-neff"
+    elif kind == "ratio" and definition is not None:
+        interval = ratio_interval(pairs, proportion=definition.proportion, of_counts=of_counts,
+                                  name=definition.name, numerator=str(definition.numerator),
+                                  denominator=str(definition.denominator))
+        ci, method = interval.ci, interval.method
     return {"value": estimate.value, "ci95": list(ci), "ci95_method": method,
             "unit": "s" if kind == "duration" else None, "participants": len(pairs)}
 
@@ -135,11 +139,16 @@ def summary(protocol: Protocol) -> dict[str, Any]:
         people = done.get(v.id, {})
         metrics: dict[str, Any] = {}
         names = sorted({m for pairs in people.values() for m in pairs})
-        of_variant = _metric_kinds(v) if names else {}
+        of_variant = _metric_definitions(v) if names else {}
+        counted = {n for n, m in of_variant.items() if m.kind.value == "count"}
         for name in names:
-            kinds.setdefault(name, of_variant.get(name, ""))
+            declared = of_variant.get(name)
+            kind = declared.kind.value if declared is not None else None
+            kinds.setdefault(name, kind or "")
             pairs = [p[name] for p in people.values() if name in p]
-            metrics[name] = variant_estimate(of_variant.get(name), pairs)
+            metrics[name] = variant_estimate(
+                kind, pairs, declared, of_counts=declared is not None
+                and {declared.numerator, declared.denominator} <= counted)
         variants[v.id] = {"participants": len(people), "metrics": metrics}
     comparisons = []
     ids = [v.id for v in protocol.variants]

@@ -142,11 +142,24 @@ def _selector(element: etree._Element) -> EventSelector:
                          activity=element.get("Activity"), which=which)
 
 
+def _flag(element: etree._Element, name: str) -> bool:
+    """A ``true``/``false`` attribute (absent: false)."""
+    value = (element.get(name) or "false").strip().lower()
+    if value not in ("true", "false"):
+        raise _Bad(element, f"{name} must be true or false, not {value!r}",
+                   f"write {name}=\"true\"")
+    return value == "true"
+
+
 def _metric(element: etree._Element, location: SourceLocation) -> MetricDefinition:
     kind = _local(element)
     name = _need(element, "Name")
     common = {"name": name, "description": element.get("Description"),
               "unit": element.get("Unit"), "location": location}
+    if kind != "Ratio" and element.get("Proportion") is not None:
+        # a declaration the summaries would not read is one the author believes in vain
+        raise _Bad(element, f"Proportion is declared of a ratio, not of opspec:{kind} {name!r}",
+                   "put Proportion=\"true\" on the opspec:Ratio that divides this metric")
     if kind == "Count":
         return MetricDefinition(kind=MetricKind.COUNT, select=_selector(element), **common)
     if kind == "Duration":
@@ -158,7 +171,8 @@ def _metric(element: etree._Element, location: SourceLocation) -> MetricDefiniti
                                 end=_selector(ends["To"]), **common)
     if kind == "Ratio":
         return MetricDefinition(kind=MetricKind.RATIO, numerator=_need(element, "Numerator"),
-                                denominator=_need(element, "Denominator"), **common)
+                                denominator=_need(element, "Denominator"),
+                                proportion=_flag(element, "Proportion"), **common)
     raise _Bad(element, f"unknown metric opspec:{kind}",
                f"use one of {', '.join('opspec:' + m for m in _METRICS)}")
 
@@ -185,22 +199,34 @@ def _declarations(directive: Directive, ctx: BuildContext, build: Callable[[etre
 
 
 def build_metrics(directive: Directive, ctx: BuildContext) -> tuple[MetricDefinition, ...]:
-    return _declarations(directive, ctx, lambda element: _metric(element, ctx.loc(element)),
-                         lambda metric: metric.name, "bad-metric", "metric",
-                         "give every metric its own Name")
+    metrics = _declarations(directive, ctx, lambda element: _metric(element, ctx.loc(element)),
+                            lambda metric: metric.name, "bad-metric", "metric",
+                            "give every metric its own Name")
+    counts = {m.name for m in metrics if m.kind is MetricKind.COUNT}
+    declared = {m.name for m in metrics}
+    for metric in metrics:
+        # whole events of whole trials or Wilson's interval means nothing; a name that is no
+        # metric at all is checks_refs' to report
+        wrong = [ref for ref in (metric.numerator, metric.denominator)
+                 if metric.proportion and ref in declared and ref not in counts]
+        if wrong:
+            ctx.diagnostics.append(Diagnostic(
+                metric.location, Severity.ERROR, "bad-metric",
+                f"opspec:Ratio {metric.name!r} is declared a proportion, but {wrong[0]!r} is "
+                "not an opspec:Count: a proportion counts events out of counted trials",
+                "leave Proportion out (the ratio's own interval is used), or divide two "
+                "opspec:Count metrics"))
+    return metrics
 
 
 def _mode(element: etree._Element, ctx: BuildContext) -> WorkflowMode:
     if _local(element) != "Mode":
         raise _Bad(element, f"opspec:Modes may only hold opspec:Mode, not opspec:{_local(element)}",
                    "write <opspec:Mode Id=... Workflows=.../>")
-    initial = (element.get("Initial") or "false").strip().lower()
-    if initial not in ("true", "false"):
-        raise _Bad(element, f"Initial must be true or false, not {initial!r}",
-                   "write Initial=\"true\"")
+    initial = _flag(element, "Initial")
     return WorkflowMode(id=_need(element, "Id"),
                         workflows=tuple((element.get("Workflows") or "").split()),
-                        initial=initial == "true", source=element.get("Source"),
+                        initial=initial, source=element.get("Source"),
                         location=ctx.loc(element))
 
 

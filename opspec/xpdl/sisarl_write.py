@@ -222,8 +222,9 @@ def _metric_xml(metric: MetricDefinition) -> str:
         return _attr_xml("Duration", {"Name": metric.name, "Unit": metric.unit,
                                       "Description": metric.description}, children)
     return _attr_xml("Ratio", {"Name": metric.name, "Numerator": metric.numerator,
-                               "Denominator": metric.denominator, "Unit": metric.unit,
-                               "Description": metric.description})
+                               "Denominator": metric.denominator,
+                               "Proportion": "true" if metric.proportion else None,
+                               "Unit": metric.unit, "Description": metric.description})
 
 
 def _mode_xml(mode: WorkflowMode) -> str:

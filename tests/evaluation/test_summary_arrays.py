@@ -6,9 +6,9 @@ from __future__ import annotations
 import random
 
 from opspec.evaluation.summary import Pairs
+from opspec.statistics.ratios import ratio_interval
 from opspec.statistics import (
     count_estimate,
-    is_proportion,
     paired_difference,
     proportion_interval,
     ratio_estimate,
@@ -35,8 +35,10 @@ def test_array_pairs_give_exactly_the_estimates_of_a_list_of_pairs():
         assert arrays[users - 1] == listed[-1]
         assert list(arrays[1:]) == listed[1:]
         assert ratio_estimate(arrays) == ratio_estimate(listed)
-        assert is_proportion(arrays) == is_proportion(listed) is True
         assert proportion_interval(arrays) == proportion_interval(listed)
+        for proportion in (True, False):
+            assert ratio_interval(arrays, proportion=proportion, of_counts=True) == \
+                ratio_interval(listed, proportion=proportion, of_counts=True)
         assert count_estimate([y for y, _ in arrays]) == count_estimate([y for y, _ in listed])
         other = _pairs(seed + 10, users)
         assert paired_difference(arrays, other) == paired_difference(listed, other)

@@ -53,23 +53,19 @@ def _from_pairs(benchmark: Any, spec_b: str, users: int, days: float, seed: int
     from opspec.evaluation.plan import Design, EvaluationPlan, file_digest
     from opspec.evaluation.replication import prepare, run_users
     from opspec.evaluation.summary import pair_reader
-    from opspec.statistics import (
-        is_proportion,
-        paired_difference,
-        proportion_interval,
-        ratio_estimate,
-    )
+    from opspec.statistics import paired_difference, ratio_estimate
+    from opspec.statistics.ratios import ratio_interval
 
     spec_a = str(benchmark.SPEC)
     designs = (Design("A", spec_a, file_digest(spec_a)), Design("B", spec_b, file_digest(spec_b)))
     doc = EvaluationPlan(designs=designs, users=users, days=days, seed=seed,
                          user_model=benchmark.USER_MODEL).to_json()
     pairs: dict[str, dict[str, list[tuple[float, float]]]] = {}
-    kinds: dict[str, str] = {}
+    declared: dict[str, dict[str, Any]] = {}
     for design in designs:
         compiled = prepare(design.spec, design.sha256, benchmark.USER_MODEL, {}).compiled
         definitions = [metric_record(m) for m in compiled.package.metrics]
-        kinds.update((d["name"], d["kind"]) for d in definitions)
+        declared.update((d["name"], d) for d in definitions)
         read = pair_reader(definitions)
         records = run_users(doc, design.label, range(users))
         assert all(r.status == "done" and r.error is None for r in records), seed
@@ -81,10 +77,12 @@ def _from_pairs(benchmark: Any, spec_b: str, users: int, days: float, seed: int
     for metric in benchmark.METRICS:
         for label in ("A", "B"):
             of = pairs[label][metric]
-            estimate = ratio_estimate(of)
-            ci = (proportion_interval(of) if kinds[metric] == "ratio" and is_proportion(of)
-                  else estimate.ci)
-            out[label][metric] = (estimate.value, ci)
+            d = declared[metric]
+            estimate = (ratio_interval(of, proportion=bool(d["proportion"]), of_counts={
+                d["numerator"], d["denominator"]} <= {n for n, m in declared.items()
+                                                      if m["kind"] == "count"})
+                        if d["kind"] == "ratio" else ratio_estimate(of))
+            out[label][metric] = (estimate.value, estimate.ci)
         difference = paired_difference(pairs["A"][metric], pairs["B"][metric])
         out["B-A"][metric] = (difference.value, difference.ci)
     return out
