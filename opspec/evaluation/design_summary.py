@@ -49,8 +49,8 @@ from opspec.statistics import (
     ratio_estimate,
 )
 from opspec.statistics.clustered import ValuesAsPairs
-from opspec.statistics.ratios import ratio_interval
 from opspec.statistics.percentiles import interpolation_point, linear
+from opspec.statistics.ratios import ratio_interval
 
 __all__ = ["compare_designs", "metric_definitions", "subgroup_users", "summarise_activities",
            "summarise_design", "summarise_monitors"]

@@ -39,6 +39,7 @@ _RATIO = "Cochran (1977), Sampling Techniques, 3rd ed., §6 (ratio estimator)"
 _GARWOOD = "Garwood (1936), Biometrika 28:437–442"
 _WILSON = "Wilson (1927), J Am Stat Assoc 22:209–212"
 _CP = "Clopper & Pearson (1934), Biometrika 26:404–413"
+_ULM = "Ulm (1990), Am J Epidemiol 131:373–375 (exact Poisson interval of a rate)"
 
 METHODS: Mapping[str, Method] = {m.id: m for m in (
     Method("t", "t",
@@ -63,8 +64,7 @@ METHODS: Mapping[str, Method] = {m.id: m for m in (
            "the exact Poisson interval of the k events over the Σn trials of the "
            "denominator, [χ²(0.025; 2k)/2, χ²(0.975; 2k+2)/2] / Σn (0 for the lower end "
            "when k = 0).",
-           (_T, _GARWOOD, "Ulm (1990), Am J Epidemiol 131:373–375 (exact Poisson interval "
-                          "of a rate)")),
+           (_T, _GARWOOD, _ULM)),
     Method("wilson-neff", "Wilson, eff. n",
            "a proportion of counts: Wilson's score interval on the effective number of trials "
            "(design effect of users who differ)",

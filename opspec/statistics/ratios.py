@@ -56,8 +56,9 @@ def _false(name: str, numerator: str, denominator: str, over: int, users: int,
     return FalseProportion(
         f"{name} is declared a proportion (Proportion=\"true\" on its opspec:Ratio: each of "
         f"{numerator} is one of {denominator}), but {over} of {users} users had more "
-        f"{numerator} than {denominator} (one had {y:g} of {n:g}); a proportion's interval "
-        "(Wilson's, at most 1) would be false, so none is given",
+        f"{numerator} than {denominator} (one had {y:g} of {n:g}): the declaration is false, "
+        "and a proportion's interval (Wilson's, at most 1) of it would be too, so it is not "
+        "summarised",
         hint=f"if at most one {numerator} per {denominator} is what the device must do, the "
         "evaluation found that it does not: read those users' traces; otherwise remove "
         f"Proportion=\"true\" from the opspec:Ratio Name=\"{name}\" (its interval is then a "

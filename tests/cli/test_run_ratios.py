@@ -1,6 +1,6 @@
 """`opspec run`'s metrics block shows a ratio of two counts as `opspec evaluate` does: a
-proportion evaluate's table gives in percent in percent, every ratio of counts with the counts
-it divides, `(k of n)`; `--json` keeps the bare value, shaped as `opspec evaluate --json`."""
+ratio the spec declares a proportion (`Proportion="true"`) in percent, every ratio of counts
+with the counts it divides, `(k of n)`; `--json` keeps the bare value, shaped as `opspec evaluate --json`."""
 
 from __future__ import annotations
 
@@ -60,8 +60,8 @@ def test_a_ratio_that_is_not_a_proportion_keeps_its_value_and_gains_its_counts(c
 
 
 def test_alarms_per_dose_is_never_a_percentage_even_when_its_counts_are_equal(capsys):
-    # one day of seed 1: 4 alarms for 4 doses; evaluate's table never shows this ratio in
-    # percent (its name is no rate), so run does not either
+    # one day of seed 1: 4 alarms for 4 doses; the spec does not declare this ratio a
+    # proportion (a dose may have three alarms), so it is never in percent
     block = metrics_block(capsys, "--days", "1", "--seed", "1")
     assert block["alarms_per_dose"] == "1 (4 of 4)"
     assert block["taken_rate"] == "100.00 % (4 of 4)"
@@ -108,3 +108,29 @@ def test_ratios_of_durations_and_of_ratios_are_their_bare_value():
         "  wait_share     0.25",
         "  rate_of_rates  1",
         "  trip_rate      -"]
+
+
+def _counts_ratio(proportion: bool) -> list[MetricDefinition]:
+    return [MetricDefinition(name="due", kind=MetricKind.COUNT),
+            MetricDefinition(name="hit", kind=MetricKind.COUNT),
+            MetricDefinition(name="hit_rate", kind=MetricKind.RATIO, numerator="hit",
+                             denominator="due", proportion=proportion)]
+
+
+def _counted(hit: int, due: int) -> dict[str, dict]:
+    return {"due": {"kind": "count", "total": due}, "hit": {"kind": "count", "total": hit},
+            "hit_rate": {"kind": "ratio", "value": hit / due}}
+
+
+def test_percent_follows_the_declaration_not_the_name():
+    # named like a rate and between 0 and 1, but not declared a proportion: its value
+    assert metric_lines(_counted(3, 4), {}, _counts_ratio(False))[-1] == \
+        "  hit_rate  0.75 (3 of 4)"
+    assert metric_lines(_counted(3, 4), {}, _counts_ratio(True))[-1] == \
+        "  hit_rate  75.00 % (3 of 4)"
+
+
+def test_a_run_that_contradicts_a_declared_proportion_says_so_on_its_line():
+    line = metric_lines(_counted(5, 4), {}, _counts_ratio(True))[-1]
+    assert line == ("  hit_rate  1.25 (5 of 4: more hit than due, though the spec declares "
+                    "it a proportion)")

@@ -12,8 +12,11 @@ the stated method with statsmodels and scipy — independent implementations, no
   interval of the mean of the users' totals (statsmodels ``DescrStatsW.tconfint_mean``);
 * ``t+garwood``: the union with the exact Poisson interval [χ²(α/2; 2k)/2, χ²(1−α/2; 2k+2)/2]
   (Garwood 1936), divided by the users;
+* ``t+garwood-rate``: the union with the exact Poisson interval of the numerator's events over
+  the denominator's trials, for a ratio of counts with fewer than 10 events;
 * ``wilson-neff``: statsmodels' Wilson interval (``proportion_confint(method="wilson")``) on
-  the effective number of trials, with the stated design effect;
+  the effective number of trials, with the stated design effect, for a ratio the spec
+  declares a proportion;
 * ``clopper-pearson``: statsmodels' ``proportion_confint(method="beta")``;
 * ``garwood+t``, ``paired-t``, ``paired-t+garwood``, ``paired-t-few``: as defined.
 """
@@ -216,13 +219,20 @@ def _design(checked: list[str], label: str, summary: dict[str, Any],
                 ci, method = _union(ci, _garwood(int(sum(totals)), len(totals))), "t+garwood"
             _expect(checked, where, method, ci, s["ci95_method"], s["ci95"])
             own = totals
-        elif kind == "ratio" and all(y <= n and y == int(y) for y, n in pairs):
+        elif kind == "ratio" and definition["proportion"]:
+            # the spec's declaration (Proportion="true"), not the numbers, makes it one
             _expect(checked, where, "wilson-neff", _wilson_neff(pairs), s["ci95_method"],
                     s["ci95"])
             own = [y / n for y, n in pairs if n > 0]
         else:
             _, low, high = _t(pairs)
-            _expect(checked, where, "t", (low, high), s["ci95_method"], s["ci95"])
+            method, ci = "t", (low, high)
+            events = sum(y for y, _ in pairs)
+            if kind == "ratio" and events < 10 and {definition["numerator"], definition[
+                    "denominator"]} <= {d["name"] for d in definitions if d["kind"] == "count"}:
+                method = "t+garwood-rate"
+                ci = _union(ci, _garwood(int(events), sum(n for _, n in pairs)))
+            _expect(checked, where, method, ci, s["ci95_method"], s["ci95"])
             own = [y / n for y, n in pairs if n > 0]
         per_user = s if kind == "count" else s["per_user"]
         if kind != "count":

@@ -6,13 +6,13 @@ from __future__ import annotations
 import random
 
 from opspec.evaluation.summary import Pairs
-from opspec.statistics.ratios import ratio_interval
 from opspec.statistics import (
     count_estimate,
     paired_difference,
     proportion_interval,
     ratio_estimate,
 )
+from opspec.statistics.ratios import ratio_interval
 
 
 def _pairs(seed: int, users: int) -> list[tuple[float, float]]:

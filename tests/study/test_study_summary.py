@@ -45,6 +45,8 @@ def test_rare_counts_and_rates_have_the_intervals_evaluate_gives(protocol_file: 
     z2 = stats.norm.ppf(0.975) ** 2
     assert missed["ci95"][1] == pytest.approx(z2 / (12 + z2))
     assert missed["ci95_method"] == "wilson-neff"
+    # a ratio the spec does not declare a proportion is a ratio, whatever its numbers
+    assert a["alarms_per_dose"]["ci95_method"] in ("t", "t+garwood-rate")
     # a duration carries its unit, and every line its number of participants
     assert a["report_latency_s"]["unit"] == "s"
     out = "\n".join(summary_lines(doc))
@@ -70,3 +72,23 @@ def test_a_metric_without_an_interval_says_why() -> None:
     assert ("  report_latency_s: 12.5 s -> 10 s, difference -2.5 s (no 95 % CI: fewer than "
             "two participants differ between the variants; n = 2)") in lines
     assert not any("[-, -]" in line for line in lines)
+
+
+def test_a_variants_ratio_gets_the_interval_its_declaration_calls_for() -> None:
+    from opspec.model import MetricDefinition, MetricKind
+    from opspec.statistics.ratios import FalseProportion
+    from opspec.tui.study import variant_estimate
+
+    def ratio(proportion: bool) -> MetricDefinition:
+        return MetricDefinition(name="alarms_per_dose", kind=MetricKind.RATIO,
+                                numerator="alarms", denominator="doses_due",
+                                proportion=proportion)
+
+    # every participant's alarms at most their doses: still a ratio, not capped at 1
+    pairs = [(3.0, 4.0), (4.0, 4.0), (4.0, 4.0), (2.0, 4.0), (4.0, 4.0)]
+    undeclared = variant_estimate("ratio", pairs, ratio(False), of_counts=True)
+    assert undeclared["ci95_method"] == "t" and undeclared["ci95"][1] > 1.0
+    declared = variant_estimate("ratio", pairs, ratio(True), of_counts=True)
+    assert declared["ci95_method"] == "wilson-neff" and declared["ci95"][1] < 1.0
+    with pytest.raises(FalseProportion, match="alarms_per_dose is declared a proportion"):
+        variant_estimate("ratio", [*pairs, (5.0, 4.0)], ratio(True), of_counts=True)
