@@ -43,7 +43,7 @@ def pill_spec(tmp_path: Path, beeps: int = 1) -> Path:
              f'Type="INTEGER"/></DataType><InitialValue>{beeps}</InitialValue></DataField>'
              '\n        <DataField Id="beeps"')),
             ('<opspec:Ratio Name="taken_rate"',
-             ('<opspec:Ratio Name="missed_rate" Numerator="doses_missed" '
+             ('<opspec:Ratio Name="missed_rate" Numerator="doses_missed" Proportion="true" '
              'Denominator="doses_due" Description="Share of the doses due that were missed"/>'
              '\n      <opspec:Ratio Name="taken_rate"'))):
         assert text.count(old) == 1, old
