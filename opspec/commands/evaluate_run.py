@@ -16,6 +16,7 @@ from opspec.commands.evaluate_plan import (
     check_plan,
     default_out,
     new_plan,
+    refuse_earlier_outputs,
     refuse_inputs_in_out,
     refuse_spec_template,
 )
@@ -129,6 +130,7 @@ def _start(args: argparse.Namespace) -> tuple[Any, Any, Any] | None:
         raise EvaluationError(f"{out} already holds an evaluation",
                               hint="add --resume to finish it, or choose another --out")
     refuse_inputs_in_out(args, plan, out)
+    refuse_earlier_outputs(out)
     if plan.export:                     # before anything is created
         export_estimate(plan, out, quiet=args.quiet)
     store = ResultStore(out, create=True)
