@@ -202,7 +202,9 @@ def _replicate(args: argparse.Namespace, store: Any, plan: Any, swept: Any, work
                 f"--resume --out {store.folder}` to write the report again") from None
         failures = store.failures()
         return Results(summaries, compare, report, outcome, failures,
-                       replication_counts(store, plan, failures))
+                       replication_counts(store, plan, failures),
+                       {key: store.get(key) for key in ("user_model_sha256",
+                                                        "opspec_version")})
 
 
 def _summarise(args: argparse.Namespace, store: Any, plan: Any, swept: Any

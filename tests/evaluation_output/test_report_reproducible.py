@@ -79,3 +79,19 @@ def test_the_command_says_every_option_of_the_plan_or_nothing() -> None:
 def test_days_are_written_exactly(days: float) -> None:
     words = shlex.split(rerun_command({**PLAN, "days": days}) or "")
     assert float(words[words.index("--days") + 1]) == days
+
+
+def test_json_names_the_files_digests_and_opspecs_version(tmp_path: Path, capsys) -> None:
+    import json
+
+    from opspec import __version__
+
+    assert main(["evaluate", str(SPEC), "--compare", str(SPEC.with_suffix(".bpmn")),
+                 "--users", "2", "--days", "0.25", "--workers", "1",
+                 "--out", str(tmp_path / "run"), "--quiet", "--json"]) == 0
+    doc = json.loads(capsys.readouterr().out)
+    assert doc["spec_sha256"] == hashlib.sha256(SPEC.read_bytes()).hexdigest()
+    assert doc["user_model_sha256"] == hashlib.sha256(USERS.read_bytes()).hexdigest()
+    assert doc["opspec_version"] == __version__
+    assert doc["compare"]["spec_sha256"] == hashlib.sha256(
+        SPEC.with_suffix(".bpmn").read_bytes()).hexdigest()
