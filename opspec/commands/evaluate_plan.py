@@ -16,7 +16,8 @@ from typing import Any
 from opspec.commands.evaluate_exports import EXPORT_FILES, export_formats
 from opspec.errors import EvaluationError
 
-__all__ = ["DEFAULT_SEED", "DEFAULT_USERS", "OUT_FILES", "check_plan", "default_out",
+__all__ = ["DEFAULT_SEED", "DEFAULT_USERS", "OUT_FILES", "check_plan", "claim_default_out",
+           "default_out",
            "engine_settings", "new_plan", "refuse_earlier_outputs", "refuse_inputs_in_out",
            "refuse_spec_template"]
 
@@ -29,6 +30,23 @@ def default_out(spec: str) -> Path:
     stem = Path(spec).name.split(".")[0]
     stamp = datetime.now(UTC).strftime("%Y%m%d-%H%M%S")
     return Path("runs") / f"{stem}-{stamp}"
+
+
+def claim_default_out(out: Path) -> Path:
+    """``out`` (the default folder, :func:`default_out`) created now, or when another run
+    took it (two started in the same second, by a script) the first of ``out-2``,
+    ``out-3``… that this call creates: runs started together each get their own folder.
+    A folder that cannot be made is returned as it is, for the store to say why."""
+    for n in range(1, 1000):
+        candidate = out if n == 1 else out.with_name(f"{out.name}-{n}")
+        try:
+            candidate.mkdir(parents=True)
+        except FileExistsError:
+            continue
+        except OSError:
+            return candidate
+        return candidate
+    return out
 
 
 def engine_settings(path: str | None) -> dict[str, Any]:

@@ -14,6 +14,7 @@ from opspec.commands.evaluate_exports import export_estimate, trace_writers
 from opspec.commands.evaluate_output import Results, print_results, replication_counts
 from opspec.commands.evaluate_plan import (
     check_plan,
+    claim_default_out,
     default_out,
     new_plan,
     refuse_earlier_outputs,
@@ -126,14 +127,17 @@ def _start(args: argparse.Namespace) -> tuple[Any, Any, Any] | None:
 
         check_targets(args.target, args.target_users, definitions["A"], swept)
     out = Path(args.out) if args.out else default_out(args.spec)
-    if (out / "results.sqlite").exists():
+    if args.out and (out / "results.sqlite").exists():
         raise EvaluationError(f"{out} already holds an evaluation",
                               hint="add --resume to finish it, or choose another --out")
     refuse_inputs_in_out(args, plan, out)
-    refuse_earlier_outputs(out)
+    if args.out:
+        refuse_earlier_outputs(out)
     if plan.export:                     # before anything is created
         export_estimate(plan, out, quiet=args.quiet)
-    store = ResultStore(out, create=True)
+    if not args.out:                    # the default folder: this run's own
+        out = claim_default_out(out)
+    store = ResultStore(out, create=True, new=True)
     store_parameters(store, plan, definitions, __version__)
     if swept is not None:
         store.put("sweep", swept.to_json())
