@@ -297,6 +297,8 @@ def _report_sections(store: ResultStore, summaries: Mapping[str, Summaries] | No
                             items=tuple(findings[1:])))
 
     total_users = plan.get("users")
+    software = (f"Python {store.get('python_version')}, NumPy {store.get('numpy_version')}"
+                if store.get("numpy_version") else None)
     # the files' digests: a reader can tell that a spec is the one the numbers are of
     run_rows = [("specification", specs.get("A", "?")),
                 ("specification SHA-256", str(digests.get("A")))]
@@ -319,6 +321,7 @@ def _report_sections(store: ResultStore, summaries: Mapping[str, Summaries] | No
                  ("users finished", finished),
                  ("replications failed", str(len(failures))),
                  ("opspec version", str(store.get("opspec_version"))),
+                 *([("Python and NumPy versions", software)] if software else []),
                  ("started", str(store.get("started")))]
     command = rerun_command(plan, swept=bool(sweep))
     if command is not None:

@@ -95,3 +95,18 @@ def test_json_names_the_files_digests_and_opspecs_version(tmp_path: Path, capsys
     assert doc["opspec_version"] == __version__
     assert doc["compare"]["spec_sha256"] == hashlib.sha256(
         SPEC.with_suffix(".bpmn").read_bytes()).hexdigest()
+
+
+def test_the_report_names_the_numpy_its_random_numbers_came_from(tmp_path: Path) -> None:
+    """NumPy may change a Generator's numbers between versions (NEP 19): reproducing a
+    run's numbers needs its NumPy, which the report now names."""
+    import platform
+
+    import numpy
+
+    out = tmp_path / "run"
+    assert main(["evaluate", str(SPEC), "--users", "2", "--days", "0.25", "--workers", "1",
+                 "--out", str(out), "--quiet"]) == 0
+    rows = _run_table(out / "report.html")
+    assert rows["Python and NumPy versions"] == (
+        f"Python {platform.python_version()}, NumPy {numpy.__version__}")
