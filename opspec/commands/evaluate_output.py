@@ -26,6 +26,8 @@ class Results:
     failures: list[tuple[str, int, str]]
     #: replications planned, complete and failed (:func:`replication_counts`)
     counts: dict[str, Any]
+    #: what the store says of the run: ``user_model_sha256``, ``opspec_version``
+    stored: dict[str, Any] | None = None
 
 
 def replication_counts(store: Any, plan: Any, failures: list[tuple[str, int, str]]
@@ -50,7 +52,12 @@ def print_results(args: argparse.Namespace, plan: Any, store: Any, workers: int,
     swept = "sweep" in summaries
     if args.json:
         doc = {"spec": plan.design("A").spec, "users": plan.users, "days": plan.days,
-               "seed": plan.seed, "user_model": plan.user_model, "workers": workers,
+               "seed": plan.seed, "user_model": plan.user_model,
+               # which files the numbers are of, and by which opspec (as the report says)
+               "spec_sha256": plan.design("A").sha256,
+               "user_model_sha256": (results.stored or {}).get("user_model_sha256"),
+               "opspec_version": (results.stored or {}).get("opspec_version"),
+               "workers": workers,
                "scheduler": args.scheduler,
                "out": str(store.folder), "report": str(results.report), "metrics": metrics,
                "monitors": monitors, "population": population,
@@ -60,7 +67,9 @@ def print_results(args: argparse.Namespace, plan: Any, store: Any, workers: int,
                           for d, u, e in results.failures],
                "wall_s": round(results.outcome.wall_s, 3)}
         if compare is not None:
-            doc["compare"] = compare
+            doc["compare"] = {"spec": compare["spec"],
+                              "spec_sha256": plan.design("B").sha256,
+                              **{k: v for k, v in compare.items() if k != "spec"}}
         if swept:
             doc["sweep"] = summaries["sweep"]
         from opspec.statistics.methods import describe, methods_in

@@ -6,6 +6,7 @@ a report template that came with a spec, and an input the output folder would ov
 from __future__ import annotations
 
 import argparse
+import contextlib
 import sys
 from dataclasses import asdict
 from datetime import UTC, datetime
@@ -15,8 +16,10 @@ from typing import Any
 from opspec.commands.evaluate_exports import EXPORT_FILES, export_formats
 from opspec.errors import EvaluationError
 
-__all__ = ["DEFAULT_SEED", "DEFAULT_USERS", "OUT_FILES", "check_plan", "default_out",
-           "engine_settings", "new_plan", "refuse_inputs_in_out", "refuse_spec_template"]
+__all__ = ["DEFAULT_SEED", "DEFAULT_USERS", "OUT_FILES", "check_plan", "claim_default_out",
+           "default_out",
+           "engine_settings", "new_plan", "refuse_earlier_outputs", "refuse_inputs_in_out",
+           "refuse_spec_template"]
 
 DEFAULT_USERS = 100
 DEFAULT_SEED = 0
@@ -27,6 +30,23 @@ def default_out(spec: str) -> Path:
     stem = Path(spec).name.split(".")[0]
     stamp = datetime.now(UTC).strftime("%Y%m%d-%H%M%S")
     return Path("runs") / f"{stem}-{stamp}"
+
+
+def claim_default_out(out: Path) -> Path:
+    """``out`` (the default folder, :func:`default_out`) created now, or when another run
+    took it (two started in the same second, by a script) the first of ``out-2``,
+    ``out-3``… that this call creates: runs started together each get their own folder.
+    A folder that cannot be made is returned as it is, for the store to say why."""
+    for n in range(1, 1000):
+        candidate = out if n == 1 else out.with_name(f"{out.name}-{n}")
+        try:
+            candidate.mkdir(parents=True)
+        except FileExistsError:
+            continue
+        except OSError:
+            return candidate
+        return candidate
+    return out
 
 
 def engine_settings(path: str | None) -> dict[str, Any]:
@@ -199,3 +219,22 @@ def refuse_inputs_in_out(args: argparse.Namespace, plan: Any, out: Path) -> None
         *OUT_FILES, *(EXPORT_FILES[f] for f in plan.export),
         *(EXPORT_FILES[f] + ".partial" for f in plan.export))]
     refuse_overwrite(writes, reads, folders=[(f"--out {out}", out / "figures")])
+
+
+def refuse_earlier_outputs(out: Path) -> None:
+    """A new run does not go into a folder that holds what an earlier evaluation wrote
+    (its results.sqlite gone): it would overwrite the report and leave that run's figures
+    (a comparison's B-*), traces and SQLite write-ahead log beside its own results (exit 2,
+    the files named)."""
+    names = [*(name for name in OUT_FILES if name != "results.sqlite"), *EXPORT_FILES.values(),
+             *(name + ".partial" for name in EXPORT_FILES.values())]
+    found = [name for name in names if (out / name).exists()]
+    with contextlib.suppress(OSError):
+        if (out / "figures").is_dir() and any((out / "figures").iterdir()):
+            found.append("figures/")
+    if found:
+        raise EvaluationError(
+            f"--out {out} holds the outputs of an earlier evaluation ({', '.join(found)}) "
+            "but no results.sqlite; a new run would overwrite some and leave the others "
+            "beside its results",
+            hint="choose another --out, or move those files away first")

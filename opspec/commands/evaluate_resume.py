@@ -46,6 +46,14 @@ def store_parameters(store: Any, plan: Any, definitions: dict[str, list[dict[str
     store.put("user_model", plan.user_model)
     store.put("user_model_sha256", user_model_digest(plan))
     store.put("opspec_version", version)
+    # NumPy does not promise the same random numbers from one version to the next (NEP 19):
+    # the versions a run's numbers came from, for whoever reproduces them
+    import platform
+
+    import numpy
+
+    store.put("python_version", platform.python_version())
+    store.put("numpy_version", numpy.__version__)
     store.put("started", datetime.now(UTC).isoformat(timespec="seconds"))
 
 

@@ -14,8 +14,10 @@ from opspec.commands.evaluate_exports import export_estimate, trace_writers
 from opspec.commands.evaluate_output import Results, print_results, replication_counts
 from opspec.commands.evaluate_plan import (
     check_plan,
+    claim_default_out,
     default_out,
     new_plan,
+    refuse_earlier_outputs,
     refuse_inputs_in_out,
     refuse_spec_template,
 )
@@ -125,13 +127,17 @@ def _start(args: argparse.Namespace) -> tuple[Any, Any, Any] | None:
 
         check_targets(args.target, args.target_users, definitions["A"], swept)
     out = Path(args.out) if args.out else default_out(args.spec)
-    if (out / "results.sqlite").exists():
+    if args.out and (out / "results.sqlite").exists():
         raise EvaluationError(f"{out} already holds an evaluation",
                               hint="add --resume to finish it, or choose another --out")
     refuse_inputs_in_out(args, plan, out)
+    if args.out:
+        refuse_earlier_outputs(out)
     if plan.export:                     # before anything is created
         export_estimate(plan, out, quiet=args.quiet)
-    store = ResultStore(out, create=True)
+    if not args.out:                    # the default folder: this run's own
+        out = claim_default_out(out)
+    store = ResultStore(out, create=True, new=True)
     store_parameters(store, plan, definitions, __version__)
     if swept is not None:
         store.put("sweep", swept.to_json())
@@ -178,29 +184,47 @@ def _replicate(args: argparse.Namespace, store: Any, plan: Any, swept: Any, work
         except EvaluationError as error:
             raise with_resume_hint(error, store, plan) from None
         except KeyboardInterrupt:
-            stored = sum(len(store.finished(d.label)) for d in plan.designs)
-            print(f"opspec evaluate: stopped; {stored} of {plan.users * len(plan.designs)} "
-                  f"replications are stored in {store.path}; finish with `opspec evaluate "
-                  f"--resume --out {store.folder}`", file=sys.stderr)
+            _say_stopped(store, plan, "finish with")
             raise
-        summaries, compare = _summarise(args, store, plan, swept)
-        from opspec.evaluation.report import write_report
-
         try:
-            report = write_report(store, summaries,
-                                  template=getattr(args, "report_template", None),
-                                  figures=figures, workers=drawing,
-                                  ahead=ahead[0] if ahead else None)
-        except EvaluationError as error:
-            raise with_resume_hint(error, store, plan) from None
-        except OSError as error:
-            raise EvaluationError(
-                f"{store.folder}: cannot write the report: {error.strerror or error}",
-                hint="the results are stored; free some space and run `opspec evaluate "
-                f"--resume --out {store.folder}` to write the report again") from None
+            summaries, compare = _summarise(args, store, plan, swept)
+            report = _write_report(args, store, plan, summaries, figures, drawing, ahead)
+        except KeyboardInterrupt:
+            # every replication is stored: only the report is missing (or half drawn)
+            _say_stopped(store, plan, "the report is not written; write it with")
+            raise
         failures = store.failures()
         return Results(summaries, compare, report, outcome, failures,
-                       replication_counts(store, plan, failures))
+                       replication_counts(store, plan, failures),
+                       {key: store.get(key) for key in ("user_model_sha256",
+                                                        "opspec_version")})
+
+
+def _write_report(args: argparse.Namespace, store: Any, plan: Any, summaries: Any,
+                  figures: str, drawing: int, ahead: list[Any]) -> Any:
+    """The report of the stored run; what stops it is an error that says the results are
+    stored and how to write the report again."""
+    from opspec.evaluation.report import write_report
+
+    try:
+        return write_report(store, summaries, template=getattr(args, "report_template", None),
+                            figures=figures, workers=drawing,
+                            ahead=ahead[0] if ahead else None)
+    except EvaluationError as error:
+        raise with_resume_hint(error, store, plan) from None
+    except OSError as error:
+        raise EvaluationError(
+            f"{store.folder}: cannot write the report: {error.strerror or error}",
+            hint="the results are stored; free some space and run `opspec evaluate "
+            f"--resume --out {store.folder}` to write the report again") from None
+
+
+def _say_stopped(store: Any, plan: Any, then: str) -> None:
+    """Ctrl-C: what is kept, and the command that goes on from there."""
+    stored = sum(len(store.finished(d.label)) for d in plan.designs)
+    print(f"opspec evaluate: stopped; {stored} of {plan.users * len(plan.designs)} "
+          f"replications are stored in {store.path}; {then} `opspec evaluate "
+          f"--resume --out {store.folder}`", file=sys.stderr)
 
 
 def _summarise(args: argparse.Namespace, store: Any, plan: Any, swept: Any

@@ -67,6 +67,9 @@ _RC: dict[str, Any] = {
     # a reader can select and search them (in the report too), a journal's editor can fix a
     # word, and writing outlines was a sixth of the report's drawing time (PDF embeds its fonts)
     "svg.fonttype": "none",
+    # PDF embeds its fonts as TrueType (Type 42), not Type 3: publishers' PDF checks (IEEE
+    # PDF eXpress, ACM's) refuse a paper whose figures carry Type 3 fonts
+    "pdf.fonttype": 42,
 }
 
 NO_OBSERVATIONS = "no observations"

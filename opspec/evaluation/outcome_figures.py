@@ -140,19 +140,31 @@ def rates_figure(rows: Sequence[tuple[str, float, float, float]], path: Path) ->
             ax.annotate(text, (lo, 0.0) if on_left else (hi, 0.0),
                         xytext=(-6 if on_left else 6, 0), textcoords="offset points",
                         va="center", ha="right" if on_left else "left", fontsize=9)
+            locator = MaxNLocator(6)
             if percent:
                 from matplotlib.ticker import PercentFormatter
 
                 left, right = max(left, 0.0), min(right, 1.0)
-                step = max((right - left) * 100.0 / 6.0, 1e-9)   # about six ticks
+                # as many decimals as the ticks the locator puts there need: a step of
+                # 1.5 % printed without one labelled 94.5 % "94 %" and 97.5 % "98 %"
                 ax.xaxis.set_major_formatter(PercentFormatter(
-                    xmax=1.0, decimals=max(0, -math.floor(math.log10(step))), symbol=PERCENT))
+                    xmax=1.0, decimals=_tick_decimals(locator.tick_values(left, right)),
+                    symbol=PERCENT))
             ax.set_xlim(left, right)
-            ax.xaxis.set_major_locator(MaxNLocator(6))
+            ax.xaxis.set_major_locator(locator)
         if all(_is_rate([e, lo, hi]) for _, e, lo, hi in clean):
             fig.supxlabel("rate (% of opportunities)", fontsize=11)
         _note_dropped(fig, dropped)
         return figure_files.save(fig, path)
+
+
+def _tick_decimals(ticks: Sequence[float]) -> int:
+    """The decimals that print every one of ``ticks`` (fractions, shown as %) exactly."""
+    for decimals in range(7):
+        if all(abs(t * 100.0 * 10 ** decimals - round(t * 100.0 * 10 ** decimals)) < 1e-6
+               for t in ticks):
+            return decimals
+    return 6
 
 
 @queueable

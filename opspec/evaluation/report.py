@@ -43,6 +43,7 @@ from opspec.evaluation.report_design import (
 )
 from opspec.evaluation.report_findings import key_findings, metric_label, population_findings
 from opspec.evaluation.report_users import user_model_as_run, user_model_section
+from opspec.evaluation.run_command import rerun_command
 from opspec.evaluation.store import ResultStore
 from opspec.evaluation.summary import (
     compare_designs,
@@ -296,9 +297,14 @@ def _report_sections(store: ResultStore, summaries: Mapping[str, Summaries] | No
                             items=tuple(findings[1:])))
 
     total_users = plan.get("users")
-    run_rows = [("specification", specs.get("A", "?"))]
+    software = (f"Python {store.get('python_version')}, NumPy {store.get('numpy_version')}"
+                if store.get("numpy_version") else None)
+    # the files' digests: a reader can tell that a spec is the one the numbers are of
+    run_rows = [("specification", specs.get("A", "?")),
+                ("specification SHA-256", str(digests.get("A")))]
     if "B" in specs:
-        run_rows.append(("compared with", specs["B"]))
+        run_rows += [("compared with", specs["B"]),
+                     ("compared specification SHA-256", str(digests.get("B")))]
     if sweep:
         run_rows.append(("swept", f"{sweep['parameter']} = "
                          + ", ".join(v["text"] for v in sweep["values"])))
@@ -310,10 +316,16 @@ def _report_sections(store: ResultStore, summaries: Mapping[str, Summaries] | No
                  ("simulated time per user", span(days)),
                  ("seed", str(plan.get("seed"))),
                  ("user model", str(plan.get("user_model") or "none")),
+                 *([("user model SHA-256", str(store.get("user_model_sha256")))]
+                   if store.get("user_model_sha256") else []),
                  ("users finished", finished),
                  ("replications failed", str(len(failures))),
                  ("opspec version", str(store.get("opspec_version"))),
+                 *([("Python and NumPy versions", software)] if software else []),
                  ("started", str(store.get("started")))]
+    command = rerun_command(plan, swept=bool(sweep))
+    if command is not None:
+        run_rows.append(("command (the same results with any --workers)", command))
     sections.append(Section("What was run", paragraphs=(
         "Each simulated user is an independent replication with their own random streams"
         + ("; the designs are compared on the same users (common random numbers)."

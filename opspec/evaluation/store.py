@@ -278,10 +278,28 @@ def _fail(path: Path, doing: str, error: BaseException, *,
     return EvaluationError(f"{path}: cannot {doing}: {reason}", hint=hint)
 
 
+def _claim(path: Path) -> None:
+    """Create ``path`` empty (an empty file is an empty SQLite database), failing if it
+    exists: the one step that decides which of two runs started together gets the folder."""
+    import os
+
+    try:
+        os.close(os.open(path, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o666))
+    except FileExistsError:
+        raise EvaluationError(f"{path.parent} already holds an evaluation",
+                              hint="add --resume to finish it, or choose another --out"
+                              ) from None
+    except OSError as error:
+        raise _fail(path, "create the result store", error, started=False) from None
+
+
 class ResultStore:
     """An open result store. Use as a context manager; every write commits at once."""
 
-    def __init__(self, folder: str | Path, *, create: bool) -> None:
+    def __init__(self, folder: str | Path, *, create: bool, new: bool = False) -> None:
+        """``create``: make the folder and the database when missing; ``new`` too: the
+        database must not exist yet, decided in one step (two runs started into one folder
+        at the same moment: one of them is refused, never both let in)."""
         self.folder = Path(folder)
         self.path = self.folder / FILENAME
         if create:
@@ -290,6 +308,8 @@ class ResultStore:
             except OSError as error:
                 raise _fail(self.folder, "create the output folder", error,
                             started=False) from None
+            if new:
+                _claim(self.path)
         elif not self.path.is_file():
             raise EvaluationError(f"{self.path}: no stored evaluation to resume",
                                   hint="run without --resume first, or give the --out folder "
