@@ -1,8 +1,8 @@
 """Reading and writing user-model TOML files; resolving presets by name.
 
-The format is documented in ``docs/user-models.md``. Every error names the file and the dotted
-key (``users.toml: activities.walk_to_dispenser.duration.sigma: must be > 0, got -1``) and
-says how to fix it. ``load_user_model`` accepts a path, a preset name (``older-adults``), or
+The format is documented in ``docs/user-models.md``. Every error names the file, the line and
+the dotted key (``users.toml:12: activities.walk_to_dispenser.duration.sigma: must be > 0, got
+-1``; the line is the key's, or its nearest written parent's) and says how to fix it. ``load_user_model`` accepts a path, a preset name (``older-adults``), or
 a comma-separated composition ``BASE,MODIFIER,...`` (``specs/x.users.toml,older-adults``).
 """
 
@@ -61,8 +61,12 @@ class _Ctx:
         self.prefix = prefix
 
     def error(self, key: str, message: str, hint: str = "") -> UserModelError:
-        return UserModelError(message, location=SourceLocation(
-            self.path, key=f"{self.prefix}{key}" if key else self.prefix.rstrip(".") or None),
+        """The error ``message`` at ``file:line: key`` (the line the key, or its nearest
+        written parent, is on: an editor jumps to it)."""
+        from opspec.toml_lines import located
+
+        return UserModelError(message, location=located(
+            self.path, f"{self.prefix}{key}" if key else self.prefix.rstrip(".") or None),
             hint=hint)
 
     def table(self, value: Any, key: str, allowed: tuple[str, ...]) -> Mapping[str, Any]:
@@ -70,8 +74,13 @@ class _Ctx:
             raise self.error(key, f"must be a table, got {type(value).__name__}")
         for name in value:
             if name not in allowed:
-                raise self.error(f"{key}.{name}" if key else name, "unknown key",
-                                 hint="expected one of: " + ", ".join(allowed))
+                hint = "expected one of: " + ", ".join(allowed)
+                if key and name in _TOP_KEYS:
+                    # "name = ..." appended at the end of the file lands in its last table
+                    hint += (f"; {name} belongs at the top of the file: a key written below "
+                             "a [table] line is in that table, so move it above the first "
+                             "[table] line")
+                raise self.error(f"{key}.{name}" if key else name, "unknown key", hint=hint)
         return value
 
     def wrap(self, key: str, error: ParameterError) -> UserModelError:
@@ -140,6 +149,8 @@ def _activity(ctx: _Ctx, value: Any, key: str) -> ActivityModel:
     try:
         if "duration" in table:
             kwargs["duration"] = _distribution(ctx, table["duration"], f"{key}.duration")
+        else:
+            kwargs["untimed"] = True
         if "omission" in table:
             sub = f"{key}.omission"
             t = _probability_table(ctx, table["omission"], sub,
