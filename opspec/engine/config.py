@@ -134,12 +134,12 @@ class EngineConfig:
                         location=located(text_path, key),
                         hint="move it under [engine] (keys after a [table] line belong to "
                         "that table), or write every key at the top and leave out [engine]")
+        prefix = "engine." if table is not document else ""
         table = {k: v for k, v in table.items() if k != "engine"}
         try:
             config = cls.from_mapping(table, path=text_path)
         except ConfigurationError as error:
-            raise _at_its_line(error, text_path, "engine." if table is not document
-                               else "") from None
+            raise _at_its_line(error, text_path, prefix) from None
         return config.with_options(**overrides) if overrides else config
 
     def with_options(self, **overrides: Any) -> EngineConfig:

@@ -213,14 +213,17 @@ class UserModel:
             ids = ", ".join(missing)
             # a table the spec has no activity for, named like a missing one: a typo
             strays = [a for a in self.activities if a not in manual and a not in choice_map]
-            typos = [f"[activities.{stray}] is not an activity of the spec: did you mean "
-                     f"{close[0]}?" for stray in strays
+            named = [(stray, close[0]) for stray in strays
                      for close in [difflib.get_close_matches(stray, missing, n=1)] if close]
+            typos = [f"[activities.{stray}] is not an activity of the spec: did you mean "
+                     f"{close}?" for stray, close in named]
             raise UserModelError(
                 f"user model {self.name!r} does not cover manual "
                 f"activit{'y' if len(missing) == 1 else 'ies'} of the spec: {ids}"
                 + "".join(f"; {typo}" for typo in typos),
-                location=located(self.path, "activities"),
+                # at the likely typo's table, where the fix is made
+                location=located(self.path, f"activities.{named[0][0]}" if named
+                                 else "activities"),
                 hint="add " + " ".join(f"[activities.{a}]" for a in missing)
                 + " with at least a duration, or a [defaults] table")
         for choice_id, alternatives in choice_map.items():
@@ -271,14 +274,15 @@ class UserModel:
     def _untimed(self, manual: list[str], choices: Mapping[str, list[str]]) -> list[Diagnostic]:
         """Warnings for manual activities of the spec whose table (or the ``[defaults]`` they
         fall back to) gives no duration: they take no time, which a forgotten or misspelt
-        ``duration`` line does silently."""
+        ``duration`` line does silently. Noticing a prompt (an activity with an omission)
+        takes no time as a rule, and a choice's alternatives need no duration."""
         found = []
         for activity_id in manual:
             if activity_id in choices:
                 continue
             written = activity_id in self.activities
             model = self.activities.get(activity_id, self.default)
-            if model is None or not model.untimed:
+            if model is None or not model.untimed or model.prompt:
                 continue
             table = f"activities.{activity_id}" if written else "defaults"
             found.append(Diagnostic(
