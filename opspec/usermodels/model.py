@@ -277,8 +277,9 @@ class UserModel:
         ``duration`` line does silently. Noticing a prompt (an activity with an omission)
         takes no time as a rule, and a choice's alternatives need no duration."""
         found = []
+        picked = {a for alternatives in choices.values() for a in alternatives}
         for activity_id in manual:
-            if activity_id in choices:
+            if activity_id in choices or activity_id in picked:
                 continue
             written = activity_id in self.activities
             model = self.activities.get(activity_id, self.default)

@@ -131,7 +131,7 @@ def _build(name: str, factory: Callable[..., World], rng: Any, params: Mapping[s
         return factory(rng, **params)
     except (TypeError, ValueError) as error:
         key = _named_parameter(str(error), params)
-        if key is not None and key in inline:
+        if key is not None and key.split("[")[0] in inline:
             where = attribute.location
         elif key is not None and file is not None:
             where = located(file, key)          # the line of the value the world refuses
@@ -144,7 +144,8 @@ def _build(name: str, factory: Callable[..., World], rng: Any, params: Mapping[s
 
 def _named_parameter(message: str, params: Mapping[str, Any]) -> str | None:
     """The given parameter a world's refusal ``message`` names first (``start must be
-    [x, y, heading]``, ``obstacle [1, 2, 1, 3] needs x0 < x1``), or None."""
+    [x, y, heading]``), the entry of a list it shows (``obstacle [1, 2, 1, 3] needs x0 < x1``:
+    ``obstacles[0]``), or None."""
     import re
 
     first: tuple[int, str] | None = None
@@ -155,7 +156,15 @@ def _named_parameter(message: str, params: Mapping[str, Any]) -> str | None:
                           message)
         if found is not None and (first is None or found.start() < first[0]):
             first = (found.start(), key)
-    return None if first is None else first[1]
+    if first is None:
+        return None
+    key = first[1]
+    value = params[key]
+    if isinstance(value, list):         # the entry the message shows: obstacles[1]
+        for index, entry in enumerate(value):
+            if isinstance(entry, list) and str(entry) in message:
+                return f"{key}[{index}]"
+    return key
 
 
 def world_performers(compiled: CompiledPackage, *, seed: int, user: int
