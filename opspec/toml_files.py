@@ -38,7 +38,8 @@ def parse_toml(text: str, *, where: str, error: type[OpspecError] = Configuratio
 
         said = f"{what} is not valid TOML" if what else "not valid TOML"
         line = syntax_line(str(problem))
-        if line is not None and (location is None or location.path != where):
+        if line is not None and (location is None or (location.line is not None
+                                                       and location.path != where)):
             # the mistake is in this file, at tomllib's line: placed there (not at the line
             # of the spec that names the file), so that an editor jumps to it
             location = SourceLocation(where, line)

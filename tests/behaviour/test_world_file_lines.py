@@ -56,8 +56,8 @@ def _line_of(text: str, written: str) -> int:
      "range_noise: world 'vacuum-room': range_noise must be 0 or more, not -0.01"),
     ("drain_per_s = 0.02", "drain_per_s = -0.02",
      "drain_per_s: world 'vacuum-room': drain_per_s must be 0 or more, not -0.02"),
-    ("height = 4.0", "height = nan", "height: world 'vacuum-room': height must be a number, "
-     "not nan"),
+    ("height = 4.0", "height = nan",
+     "height: world 'vacuum-room': height must be a number, not nan"),
 ], ids=["start-in-an-obstacle", "inverted-obstacle", "text-width", "negative-cell",
         "negative-noise", "negative-drain", "nan-height"])
 def test_a_value_the_world_refuses_is_placed_at_its_line(

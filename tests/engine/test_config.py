@@ -24,8 +24,8 @@ def test_config_loads_from_an_engine_table_and_applies_overrides(tmp_path: Path)
                                  r"\(allowed values: dedicated, pooled, preemptive, "
                                  r"priority-queues\)")),
     ("workers = 0", r"engine.toml:1: workers: workers must be a whole number >= 1"),
-    ("switch_cost = -1.0", r"engine.toml:1: switch_cost: switch_cost must be a number of "
-                           r"seconds >= 0"),
+    ("switch_cost = -1.0", (r"engine.toml:1: switch_cost: switch_cost must be a number of "
+                            r"seconds >= 0")),
     ("speed = 0", r"engine.toml:1: speed: speed must be a number > 0"),
     ("workers = [", r"engine.toml: not valid TOML"),
     ("workers = = 2", r"engine.toml:1: not valid TOML"),

@@ -43,10 +43,10 @@ def test_a_misspelt_activity_in_busy_is_warned_at_its_line(tmp_path: Path, key: 
     path, text = _shipped(tmp_path, 'ignore = ["hear_alarm"]',
                           f'{key} = ["hear_alrm"]')
     warnings = load_user_model(path).validate_against(MANUAL, choices=CHOICES)
-    assert [str(w) for w in warnings] == [
+    assert [str(w) for w in warnings] == [(
         f"{path}:{_line_of(text, 'hear_alrm')}: busy.{key}: warning: busy.{key} names "
         "'hear_alrm', which the spec's user lane lacks (check the spelling against the "
-        "spec's activity ids)"]
+        "spec's activity ids)")]
 
 
 def test_a_manual_activity_without_a_duration_is_warned(tmp_path: Path) -> None:

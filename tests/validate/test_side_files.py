@@ -215,10 +215,10 @@ def test_json_carries_the_line_of_a_side_files_warning_as_of_a_specs(
         tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     spec = make_spec(tmp_path, MODEL + "\n[activities.tkae_pill]\nduration = 3.0\n")
     line = len(MODEL.splitlines()) + 2
-    status, out = validate(capsys, str(spec))
+    _, out = validate(capsys, str(spec))
     assert out[0].startswith(f"{tmp_path / 'pill.users.toml'}:{line}: activities.tkae_pill: "
                              "warning: ")
-    status, out = validate(capsys, "--json", str(spec))
+    _, out = validate(capsys, "--json", str(spec))
     (problem,) = json.loads(out[0])["diagnostics"]
     assert (problem["path"], problem["line"], problem["key"], problem["code"]) == (
         str(tmp_path / "pill.users.toml"), line, "activities.tkae_pill", "unused-user-activity")
