@@ -79,7 +79,9 @@ def read_toml(path: str | os.PathLike[str], *, what: str,
     except OSError as problem:
         raise refuse(f"cannot read {what}: {reason(problem)}", hint) from None
     try:
-        text = raw.decode("utf-8")        # TOML files are UTF-8
+        # TOML files are UTF-8; the byte-order mark Windows editors put in front is no
+        # mistake of the text (tomllib called it an "Invalid statement" at line 1)
+        text = raw.decode("utf-8-sig")
     except UnicodeDecodeError as problem:
         raise refuse(f"not UTF-8 text: byte 0x{problem.object[problem.start]:02x} at offset "
                      f"{problem.start}", "save the file as UTF-8") from None

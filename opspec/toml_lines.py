@@ -66,7 +66,7 @@ def _text_of(path: str) -> str | None:
         file = Path(path)
         if not file.is_file() or file.stat().st_size > _MAX_SCANNED:
             return None                     # a pipe or device is never opened
-        return file.read_text(encoding="utf-8")
+        return file.read_text(encoding="utf-8-sig")     # as the file was read
     except (OSError, UnicodeDecodeError, ValueError):
         return None
 

@@ -180,7 +180,8 @@ def _fail(path: str | None, key: str, message: str, hint: str) -> ConfigurationE
 
 def _bad_value(path: str | None, key: str, requirement: str, value: Any, example: str,
                why: str = "") -> ConfigurationError:
-    """``key must be REQUIREMENT, not VALUE`` at ``path: key`` with the TOML to write, or, for
+    """``key must be REQUIREMENT, not VALUE`` at ``path: key`` (a file's line added by
+    :meth:`EngineConfig.load`) with the TOML to write, or, for
     a command-line option, as the option: ``--speed must be a number > 0, not 0``."""
     option = _OPTIONS.get(key)
     if path == COMMAND_LINE and option is not None:

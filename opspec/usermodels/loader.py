@@ -316,7 +316,8 @@ def parse_user_model(doc: Mapping[str, Any], path: str = "<toml>", *,
         name=name if base is None else (f"{base.name}+{name}" if raw_activities else base.name),
         activities=activities, default=default, busy=busy, routine=routine,
         modifiers=base.modifiers if base else (),
-        description=str(doc.get("description", "")), source=str(doc.get("source", "")),
+        description=_string(ctx, doc.get("description", ""), "description"),
+        source=_string(ctx, doc.get("source", ""), "source"),
         path=path)
     modifier = _modifier(ctx, doc["modifier"], name) if "modifier" in doc else None
     if modifier is not None:
@@ -389,6 +390,13 @@ def load_named(ctx: _Ctx, ref: str, path: str, key: str = "extends",
     token = _EXTENDING.set((*chain, own) if own is not None else chain)
     try:
         return load_user_model(str(local) if local.is_file() else ref, base=base)
+    except UserModelError as error:
+        at = error.location
+        if at is not None and (at.line is not None or at.key is not None):
+            raise                   # a mistake inside the model it names, at its own line
+        # nothing by that name, or a file that cannot be read: said at this file's line
+        # that names it
+        raise ctx.error(key, f"{word} {ref!r}: {error.message}", error.hint) from None
     finally:
         _EXTENDING.reset(token)
 

@@ -1,8 +1,8 @@
 """Reading a population from a user-model file: ``[vary]``, ``[[correlations]]``,
 ``[subgroups]`` (the format is in ``docs/user-models.md``, section "Populations").
 
-Everything is checked before any simulation, and every error names the file and the TOML key
-(``people.toml: subgroups: shares add up to 0.95, not 1 (...)``):
+Everything is checked before any simulation, and every error names the file, the line and
+the TOML key (``people.toml:40: subgroups: shares add up to 0.95, not 1 (...)``):
 
 * a varied parameter must name a number of the (subgroup's) model, and its per-user
   distribution must only draw values that number allows: a probability drawn from a

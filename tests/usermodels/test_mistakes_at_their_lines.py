@@ -142,3 +142,35 @@ def test_the_second_correlation_of_a_population_is_at_its_line(tmp_path: Path) -
     with pytest.raises(UserModelError) as refused:
         load_user_model(path)
     assert str(refused.value).startswith(f"{path}:11: correlations[1].spearman: ")
+
+
+@pytest.mark.parametrize(("ref", "says"), [
+    ("nope.toml", "extends 'nope.toml': user model file not found"),
+    ("older-adult", "extends 'older-adult': no user model file or preset called 'older-adult'"),
+])
+def test_a_base_that_does_not_exist_is_refused_at_the_extends_line(
+        tmp_path: Path, ref: str, says: str) -> None:
+    # it said "nope.toml: user model file not found", naming neither this file nor its line
+    path = _write(tmp_path, f'name = "mine"\nextends = "{ref}"\n')
+    with pytest.raises(UserModelError) as refused:
+        load_user_model(path)
+    assert str(refused.value).startswith(f"{path}:2: extends: {says}")
+
+
+def test_a_description_that_is_not_text_is_refused(tmp_path: Path) -> None:
+    path = _write(tmp_path, 'name = "mine"\ndescription = 3\n')
+    with pytest.raises(UserModelError) as refused:
+        load_user_model(path)
+    assert str(refused.value) == f"{path}:2: description: must be a string, got 3"
+
+
+def test_a_byte_order_mark_in_front_is_no_syntax_error(tmp_path: Path) -> None:
+    # Windows editors save UTF-8 with a BOM; tomllib called it an "Invalid statement" at line 1
+    path = tmp_path / "users.toml"
+    path.write_text('\ufeffname = "mine"\n[activities.walk]\nduration = { kind = "gamma", '
+                    'shape = -1, scale = 1 }\n', encoding="utf-8")
+    with pytest.raises(UserModelError) as refused:
+        load_user_model(path)
+    assert str(refused.value).startswith(f"{path}:3: activities.walk.duration.shape: ")
+    path.write_text('\ufeffname = "mine"\n', encoding="utf-8")
+    assert load_user_model(path).name == "mine"
