@@ -2,14 +2,13 @@
 
 A run picks up files beside the spec by their name (:func:`opspec.request.side_files`: the
 companion user model ``SPEC.users.toml``) and reads the world file the spec names
-(``opspec:WorldFile``); ``SPEC.population.toml`` beside it is the population ``opspec
-evaluate SPEC --user-model SPEC.population.toml`` reads. ``validate`` promises that what it
-accepts runs, so it checks each side file with the loader the run uses
-(:func:`opspec.usermodels.load_user_model`, then :func:`opspec.request.user_model_warnings`
-against the spec's user lane), reporting what the run would refuse as an error at the file,
-line and key the loader gives (:mod:`opspec.toml_lines`: ``--json`` carries the line as a
-spec's diagnostic does), the run's warnings as warnings. The world file is checked already,
-with the spec (``bad-world``, :func:`opspec.commands.validate.engine_checks`); here it
+(``opspec:WorldFile``). ``validate`` promises that what it accepts runs, so it checks each
+side file with the loader the run uses (:func:`opspec.usermodels.load_user_model`, then
+:func:`opspec.request.user_model_warnings` against the spec's user lane), reporting what the
+run would refuse as an error at the file, line and key the loader gives
+(:mod:`opspec.toml_lines`: ``--json`` carries the line as a spec's diagnostic does), the run's
+warnings as warnings. The world file is checked
+already, with the spec (``bad-world``, :func:`opspec.commands.validate.engine_checks`); here it
 is only named in the summary. A side file that is absent is no problem.
 
 When the spec has errors, the user model is still read (what can be checked without the spec)
@@ -24,13 +23,10 @@ from typing import Any
 
 from opspec.errors import Diagnostic, OpspecError, Severity, SourceLocation
 
-__all__ = ["BAD_USER_MODEL", "NOT_CHECKED", "POPULATION_SUFFIX", "SideFile",
-           "check_side_files"]
+__all__ = ["BAD_USER_MODEL", "NOT_CHECKED", "SideFile", "check_side_files"]
 
 #: the code of a companion user model a run would refuse
 BAD_USER_MODEL = "bad-user-model"
-#: the name ending of the population beside a spec (``SPEC.population.toml``)
-POPULATION_SUFFIX = ".population.toml"
 #: the code of the note saying a side file was not (fully) checked, and why
 NOT_CHECKED = "side-file-not-checked"
 
@@ -67,8 +63,8 @@ def check_side_files(spec_path: Path, package: Any, diagnostics: tuple[Diagnosti
         compiled, why = _compiled(package)
     found: list[Diagnostic] = []
     files: list[SideFile] = []
-    for what, path in [*side_files(spec_path).items(), *_population(spec_path)]:
-        problems, checked = _check_user_model(path, compiled)     # both are user models
+    for what, path in side_files(spec_path).items():
+        problems, checked = _check_user_model(path, compiled)     # the one kind there is
         found.extend(problems)
         if checked or not why:
             files.append(SideFile(path, what))
@@ -81,14 +77,6 @@ def check_side_files(spec_path: Path, package: Any, diagnostics: tuple[Diagnosti
                 f"user lane: {why}", "fix the spec, then validate again"))
     files.extend(_world_file(spec_path, package, why))
     return found, files
-
-
-def _population(spec_path: Path) -> list[tuple[str, Path]]:
-    """``SPEC.population.toml`` beside the spec, when it is there: not read by a run by
-    itself, but by ``evaluate --user-model`` (a mistake in it was found only then)."""
-    path = spec_path.with_name(spec_path.name.removesuffix(spec_path.suffix)
-                               + POPULATION_SUFFIX)
-    return [("population", path)] if path.is_file() else []
 
 
 def _why_not(package: Any, diagnostics: tuple[Diagnostic, ...]) -> str | None:

@@ -198,13 +198,13 @@ def test_every_shipped_spec_validates_clean_with_its_side_files(
     assert len(specs) >= 5
     status, out = validate(capsys, *map(str, specs))
     assert status == 0, out
-    assert out == [(f"{len(specs)} files checked with 5 side files beside them: no errors "
-                    "(0 errors, 0 warnings)")]
+    assert out == [(f"{len(specs)} files checked with medication_cart_guidance.world.toml, "
+                    "medication_dispenser.users.toml, toy_sumo.world.toml, "
+                    "vacuum_cleaner.world.toml beside them: no errors (0 errors, 0 warnings)")]
     for spec in specs:          # each one names what it read
         status, out = validate(capsys, str(spec))
         assert status == 0, out
         beside = [p.name for p in side_files(spec).values()] + [
-            p.name for p in SPECS.glob(f"{spec.stem}.population.toml")] + [
             p.name for p in SPECS.glob(f"{spec.stem}.world.toml")]
         assert out[-1] == (f"1 file checked with {', '.join(beside)} beside it: no errors "
                            "(0 errors, 0 warnings)" if beside else
@@ -222,26 +222,3 @@ def test_json_carries_the_line_of_a_side_files_warning_as_of_a_specs(
     (problem,) = json.loads(out[0])["diagnostics"]
     assert (problem["path"], problem["line"], problem["key"], problem["code"]) == (
         str(tmp_path / "pill.users.toml"), line, "activities.tkae_pill", "unused-user-activity")
-
-
-def test_the_population_beside_the_spec_is_checked_at_its_lines(
-        tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
-    # a mistake in SPEC.population.toml was found only by evaluate --user-model, validate
-    # called the spec clean
-    spec = make_spec(tmp_path)
-    text = (SPECS / "medication_dispenser.population.toml").read_text(encoding="utf-8")
-    text = text.replace('extends = "medication_dispenser.users.toml"',
-                        'extends = "pill.users.toml"', 1).replace("share = 0.1", "share = 0.2", 1)
-    (tmp_path / "pill.population.toml").write_text(text, encoding="utf-8")
-    status, out = validate(capsys, str(spec))
-    assert status == 1
-    line = next(n for n, row in enumerate(text.splitlines(), start=1)
-                if row.startswith("[subgroups."))
-    assert out == [
-        f"{tmp_path / 'pill.population.toml'}:{line}: subgroups: error: shares add up to 1.1, "
-        "not 1 (independent 0.7, MCI 0.2, frail 0.2) (every simulated user belongs to exactly "
-        "one subgroup: make the shares add up to 1)",
-        "1 file checked with pill.users.toml, pill.population.toml beside it: 1 with errors "
-        "(1 error, 0 warnings)"]
-    status, out = validate(capsys, "--json", str(spec))
-    assert [f["what"] for f in json.loads(out[0])["side_files"]] == ["user model", "population"]
