@@ -306,7 +306,10 @@ def parse_population(ctx: _Ctx, doc: Mapping[str, Any], model: UserModel,
     for name, table in raw.items():
         key = f"subgroups.{dotted((name,))}"
         t = ctx.table(table, key, _SUBGROUP_KEYS)
-        share = t.get("share")
+        if "share" not in t:            # said as missing, not as "got None"
+            raise ctx.error(f"{key}.share", "is required: the share of the users in this "
+                            "subgroup", hint="write a fraction: 70 % is share = 0.7")
+        share = t["share"]
         if isinstance(share, bool) or not isinstance(share, (int, float)) or not (
                 0 < share <= 1):
             raise ctx.error(f"{key}.share", f"must be a share in (0, 1], got {share!r}",

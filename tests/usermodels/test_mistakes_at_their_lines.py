@@ -174,3 +174,15 @@ def test_a_byte_order_mark_in_front_is_no_syntax_error(tmp_path: Path) -> None:
     assert str(refused.value).startswith(f"{path}:3: activities.walk.duration.shape: ")
     path.write_text('\ufeffname = "mine"\n', encoding="utf-8")
     assert load_user_model(path).name == "mine"
+
+
+def test_a_subgroup_without_a_share_is_told_it_needs_one(tmp_path: Path) -> None:
+    # it said "must be a share in (0, 1], got None"
+    _write(tmp_path, USERS.read_text(encoding="utf-8"), USERS.name)
+    path = _write(tmp_path, f'extends = "{USERS.name}"\n[subgroups.a]\ndescription = "x"\n',
+                  "people.toml")
+    with pytest.raises(UserModelError) as refused:
+        load_user_model(path)
+    assert str(refused.value) == (f"{path}:2: subgroups.a.share: is required: the share of the "
+                                  "users in this subgroup (write a fraction: 70 % is "
+                                  "share = 0.7)")
