@@ -4,9 +4,10 @@ User models (``SPEC.users.toml``, populations), scripts and recordings, scenario
 device profiles and world files are all read by :func:`read_toml`: a pipe or a device is
 refused without blocking (:mod:`opspec.files`), and whatever goes wrong is one line naming
 the file — ``cannot read the user model: Permission denied``, ``not UTF-8 text: byte 0xe9
-at offset 12``, ``FILE:3: not valid TOML: Expected '=' after a key in a key/value pair (at line 3,
-column 7)`` (at tomllib's line) — raised as the caller's own error class (a user model's
-:class:`~opspec.errors.UserModelError`, a profile's :class:`~opspec.errors.BindingError`).
+at offset 12``, ``FILE:3: not valid TOML: Expected '=' after a key in a key/value pair (at
+line 3, column 7)`` (at tomllib's line) — raised as the caller's own error class (a user
+model's :class:`~opspec.errors.UserModelError`, a profile's
+:class:`~opspec.errors.BindingError`).
 """
 
 from __future__ import annotations
@@ -27,8 +28,9 @@ def parse_toml(text: str, *, where: str, error: type[OpspecError] = Configuratio
                what: str | None = None) -> dict[str, Any]:
     """The document in ``text`` (read from ``where``); a syntax error is ``error`` at
     ``where`` and the line tomllib names (at ``location``, the place that named the file,
-    when tomllib names no line), with tomllib's message, which names the line and column (``what`` in front: ``the script
-    is not valid TOML: …``)."""
+    when tomllib names no line or ``location`` is this file without a line), with tomllib's
+    message, which names the line and column (``what`` in front: ``the script is not valid
+    TOML: …``)."""
     from opspec.files import toml_loads
 
     try:

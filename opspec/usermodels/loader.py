@@ -2,8 +2,9 @@
 
 The format is documented in ``docs/user-models.md``. Every error names the file, the line and
 the dotted key (``users.toml:12: activities.walk_to_dispenser.duration.sigma: must be > 0, got
--1``; the line is the key's, or its nearest written parent's) and says how to fix it. ``load_user_model`` accepts a path, a preset name (``older-adults``), or
-a comma-separated composition ``BASE,MODIFIER,...`` (``specs/x.users.toml,older-adults``).
+-1``; the line is the key's, or its nearest written parent's: :mod:`opspec.toml_lines`) and
+says how to fix it. ``load_user_model`` accepts a path, a preset name (``older-adults``), or a
+comma-separated composition ``BASE,MODIFIER,...`` (``specs/x.users.toml,older-adults``).
 """
 
 from __future__ import annotations
