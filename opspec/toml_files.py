@@ -4,9 +4,10 @@ User models (``SPEC.users.toml``, populations), scripts and recordings, scenario
 device profiles and world files are all read by :func:`read_toml`: a pipe or a device is
 refused without blocking (:mod:`opspec.files`), and whatever goes wrong is one line naming
 the file — ``cannot read the user model: Permission denied``, ``not UTF-8 text: byte 0xe9
-at offset 12``, ``not valid TOML: Expected '=' after a key in a key/value pair (at line 3,
-column 7)`` — raised as the caller's own error class (a user model's
-:class:`~opspec.errors.UserModelError`, a profile's :class:`~opspec.errors.BindingError`).
+at offset 12``, ``FILE:3: not valid TOML: Expected '=' after a key in a key/value pair (at
+line 3, column 7)`` (at tomllib's line) — raised as the caller's own error class (a user
+model's :class:`~opspec.errors.UserModelError`, a profile's
+:class:`~opspec.errors.BindingError`).
 """
 
 from __future__ import annotations
@@ -25,15 +26,25 @@ TOML_HINT = "check quotes, brackets and '=' signs near that line (TOML: https://
 def parse_toml(text: str, *, where: str, error: type[OpspecError] = ConfigurationError,
                location: SourceLocation | None = None, hint: str | None = None,
                what: str | None = None) -> dict[str, Any]:
-    """The document in ``text`` (read from ``where``); a syntax error is ``error`` with
-    tomllib's message, which names the line and column (``what`` in front: ``the script is
-    not valid TOML: …``)."""
+    """The document in ``text`` (read from ``where``); a syntax error is ``error`` at
+    ``where`` and the line tomllib names (at ``location``, the place that named the file,
+    when tomllib names no line or ``location`` is this file without a line), with tomllib's
+    message, which names the line and column (``what`` in front: ``the script is not valid
+    TOML: …``)."""
     from opspec.files import toml_loads
 
     try:
         return toml_loads(text)           # nesting bounded: a syntax error, never recursion
     except tomllib.TOMLDecodeError as problem:
+        from opspec.toml_lines import syntax_line
+
         said = f"{what} is not valid TOML" if what else "not valid TOML"
+        line = syntax_line(str(problem))
+        if line is not None and (location is None or (location.line is not None
+                                                       and location.path != where)):
+            # the mistake is in this file, at tomllib's line: placed there (not at the line
+            # of the spec that names the file), so that an editor jumps to it
+            location = SourceLocation(where, line)
         raise error(_named(f"{said}: {problem}", where, location),
                     location=location or SourceLocation(where),
                     hint=hint or TOML_HINT) from None
@@ -70,7 +81,9 @@ def read_toml(path: str | os.PathLike[str], *, what: str,
     except OSError as problem:
         raise refuse(f"cannot read {what}: {reason(problem)}", hint) from None
     try:
-        text = raw.decode("utf-8")        # TOML files are UTF-8
+        # TOML files are UTF-8; the byte-order mark Windows editors put in front is no
+        # mistake of the text (tomllib called it an "Invalid statement" at line 1)
+        text = raw.decode("utf-8-sig")
     except UnicodeDecodeError as problem:
         raise refuse(f"not UTF-8 text: byte 0x{problem.object[problem.start]:02x} at offset "
                      f"{problem.start}", "save the file as UTF-8") from None
@@ -80,6 +93,6 @@ def read_toml(path: str | os.PathLike[str], *, what: str,
 def _named(message: str, where: str, location: SourceLocation | None) -> str:
     """The message, naming the file when the error is located at a line of another file
     (the spec's line that names a world file)."""
-    if location is None or location.line is None or where in message:
+    if location is None or location.line is None or location.path == where or where in message:
         return message
     return f"{where}: {message}"

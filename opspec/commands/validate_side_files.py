@@ -5,8 +5,9 @@ companion user model ``SPEC.users.toml``) and reads the world file the spec name
 (``opspec:WorldFile``). ``validate`` promises that what it accepts runs, so it checks each
 side file with the loader the run uses (:func:`opspec.usermodels.load_user_model`, then
 :func:`opspec.request.user_model_warnings` against the spec's user lane), reporting what the
-run would refuse as an error at the file and key the loader gives, the run's warnings as
-warnings. The world file is checked
+run would refuse as an error at the file, line and key the loader gives
+(:mod:`opspec.toml_lines`: ``--json`` carries the line as a spec's diagnostic does), the run's
+warnings as warnings. The world file is checked
 already, with the spec (``bad-world``, :func:`opspec.commands.validate.engine_checks`); here it
 is only named in the summary. A side file that is absent is no problem.
 
@@ -115,8 +116,9 @@ def _check_user_model(path: Path, compiled: Any) -> tuple[list[Diagnostic], bool
 
 
 def _as_diagnostic(error: OpspecError, path: Path) -> Diagnostic:
-    """The run's refusal, as validate's error: the same message and hint, at the file and key
-    the loader gives (and at the line tomllib names in a syntax error)."""
+    """The run's refusal, as validate's error: the same message and hint, at the file, line
+    and key the loader gives (a syntax error's line is tomllib's; placed here too for an
+    error that arrives without it)."""
     from opspec.toml_lines import syntax_line
 
     location = error.location or SourceLocation(str(path))

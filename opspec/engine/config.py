@@ -15,8 +15,9 @@ arguments or load it from TOML::
     realtime = false
     speed = 1.0                    # wall-clock mode: simulated seconds per wall second
 
-Keys may also sit at the top level of the file. Unknown keys and bad values raise
-:class:`~opspec.errors.ConfigurationError` naming ``path: key`` and what is allowed.
+Keys may also sit at the top level of the file (then without an ``[engine]`` table: beside
+one, a key outside it is refused, not ignored). Unknown keys and bad values raise
+:class:`~opspec.errors.ConfigurationError` naming ``path:line: key`` and what is allowed.
 """
 
 from __future__ import annotations
@@ -28,6 +29,7 @@ from pathlib import Path
 from typing import Any, Literal
 
 from opspec.errors import ConfigurationError, SourceLocation
+from opspec.toml_lines import located
 
 __all__ = ["PROCESSOR_MODELS", "EngineConfig"]
 
@@ -121,9 +123,23 @@ class EngineConfig:
         table = document.get("engine", document)
         if not isinstance(table, dict):
             raise ConfigurationError("[engine] must be a table",
-                                     location=SourceLocation(text_path, key="engine"))
+                                     location=located(text_path, "engine"))
+        if table is not document:
+            # beside an [engine] table, a key at the top (or one written after another
+            # table) would be left out without a word
+            for key in document:
+                if key != "engine":
+                    raise ConfigurationError(
+                        f"{key!r} is outside the [engine] table, so it would be ignored",
+                        location=located(text_path, key),
+                        hint="move it under [engine] (keys after a [table] line belong to "
+                        "that table), or write every key at the top and leave out [engine]")
+        prefix = "engine." if table is not document else ""
         table = {k: v for k, v in table.items() if k != "engine"}
-        config = cls.from_mapping(table, path=text_path)
+        try:
+            config = cls.from_mapping(table, path=text_path)
+        except ConfigurationError as error:
+            raise _at_its_line(error, text_path, prefix) from None
         return config.with_options(**overrides) if overrides else config
 
     def with_options(self, **overrides: Any) -> EngineConfig:
@@ -147,13 +163,25 @@ def _shown(path: str | None) -> str:
     return "<options>" if path is None or path == COMMAND_LINE else path
 
 
+def _at_its_line(error: ConfigurationError, path: str, table: str) -> ConfigurationError:
+    """``error`` about a key of the file ``path`` placed at the line it is written on
+    (``table``: the table the keys are in, ``"engine."``), the key shown as before."""
+    at = error.location
+    if at is None or at.path != path or not at.key or at.line is not None:
+        return error
+    line = located(path, f"{table}{at.key}").line
+    return ConfigurationError(error.message, location=SourceLocation(path, line, at.key),
+                              hint=error.hint)
+
+
 def _fail(path: str | None, key: str, message: str, hint: str) -> ConfigurationError:
     return ConfigurationError(message, location=SourceLocation(_shown(path), key=key), hint=hint)
 
 
 def _bad_value(path: str | None, key: str, requirement: str, value: Any, example: str,
                why: str = "") -> ConfigurationError:
-    """``key must be REQUIREMENT, not VALUE`` at ``path: key`` with the TOML to write, or, for
+    """``key must be REQUIREMENT, not VALUE`` at ``path: key`` (a file's line added by
+    :meth:`EngineConfig.load`) with the TOML to write, or, for
     a command-line option, as the option: ``--speed must be a number > 0, not 0``."""
     option = _OPTIONS.get(key)
     if path == COMMAND_LINE and option is not None:

@@ -17,7 +17,8 @@ from collections.abc import Iterable
 from pathlib import Path
 from typing import Any
 
-from opspec.errors import SourceLocation, UserModelError
+from opspec.errors import UserModelError
+from opspec.toml_lines import located
 
 __all__ = ["TABLE", "check_table", "fitted_on_text", "fitted_persons"]
 
@@ -36,12 +37,12 @@ def check_table(table: Any, path: str) -> tuple[str, ...]:
     """The persons of a ``[fitted_on]`` table, or a UserModelError naming the key."""
     if not isinstance(table, dict) or set(table) - {"persons"}:
         raise UserModelError("must be a table with one key, persons",
-                             location=SourceLocation(path, key=TABLE),
+                             location=located(path, TABLE),
                              hint="write it again with `opspec fit`")
     persons = table.get("persons", [])
     if not isinstance(persons, list) or not all(isinstance(p, str) for p in persons):
         raise UserModelError("must be a list of the persons' identifiers",
-                             location=SourceLocation(path, key=f"{TABLE}.persons"),
+                             location=located(path, f"{TABLE}.persons"),
                              hint="write it again with `opspec fit`")
     return tuple(persons)
 

@@ -1,9 +1,10 @@
 """Reading and writing user-model TOML files; resolving presets by name.
 
-The format is documented in ``docs/user-models.md``. Every error names the file and the dotted
-key (``users.toml: activities.walk_to_dispenser.duration.sigma: must be > 0, got -1``) and
-says how to fix it. ``load_user_model`` accepts a path, a preset name (``older-adults``), or
-a comma-separated composition ``BASE,MODIFIER,...`` (``specs/x.users.toml,older-adults``).
+The format is documented in ``docs/user-models.md``. Every error names the file, the line and
+the dotted key (``users.toml:12: activities.walk_to_dispenser.duration.sigma: must be > 0, got
+-1``; the line is the key's, or its nearest written parent's: :mod:`opspec.toml_lines`) and
+says how to fix it. ``load_user_model`` accepts a path, a preset name (``older-adults``), or a
+comma-separated composition ``BASE,MODIFIER,...`` (``specs/x.users.toml,older-adults``).
 """
 
 from __future__ import annotations
@@ -61,8 +62,12 @@ class _Ctx:
         self.prefix = prefix
 
     def error(self, key: str, message: str, hint: str = "") -> UserModelError:
-        return UserModelError(message, location=SourceLocation(
-            self.path, key=f"{self.prefix}{key}" if key else self.prefix.rstrip(".") or None),
+        """The error ``message`` at ``file:line: key`` (the line the key, or its nearest
+        written parent, is on: an editor jumps to it)."""
+        from opspec.toml_lines import located
+
+        return UserModelError(message, location=located(
+            self.path, f"{self.prefix}{key}" if key else self.prefix.rstrip(".") or None),
             hint=hint)
 
     def table(self, value: Any, key: str, allowed: tuple[str, ...]) -> Mapping[str, Any]:
@@ -70,8 +75,13 @@ class _Ctx:
             raise self.error(key, f"must be a table, got {type(value).__name__}")
         for name in value:
             if name not in allowed:
-                raise self.error(f"{key}.{name}" if key else name, "unknown key",
-                                 hint="expected one of: " + ", ".join(allowed))
+                hint = "expected one of: " + ", ".join(allowed)
+                if key and name in _TOP_KEYS:
+                    # "name = ..." appended at the end of the file lands in its last table
+                    hint += (f"; {name} belongs at the top of the file: a key written below "
+                             "a [table] line is in that table, so move it above the first "
+                             "[table] line")
+                raise self.error(f"{key}.{name}" if key else name, "unknown key", hint=hint)
         return value
 
     def wrap(self, key: str, error: ParameterError) -> UserModelError:
@@ -140,6 +150,8 @@ def _activity(ctx: _Ctx, value: Any, key: str) -> ActivityModel:
     try:
         if "duration" in table:
             kwargs["duration"] = _distribution(ctx, table["duration"], f"{key}.duration")
+        else:
+            kwargs["untimed"] = True
         if "omission" in table:
             sub = f"{key}.omission"
             t = _probability_table(ctx, table["omission"], sub,
@@ -305,7 +317,8 @@ def parse_user_model(doc: Mapping[str, Any], path: str = "<toml>", *,
         name=name if base is None else (f"{base.name}+{name}" if raw_activities else base.name),
         activities=activities, default=default, busy=busy, routine=routine,
         modifiers=base.modifiers if base else (),
-        description=str(doc.get("description", "")), source=str(doc.get("source", "")),
+        description=_string(ctx, doc.get("description", ""), "description"),
+        source=_string(ctx, doc.get("source", ""), "source"),
         path=path)
     modifier = _modifier(ctx, doc["modifier"], name) if "modifier" in doc else None
     if modifier is not None:
@@ -378,6 +391,13 @@ def load_named(ctx: _Ctx, ref: str, path: str, key: str = "extends",
     token = _EXTENDING.set((*chain, own) if own is not None else chain)
     try:
         return load_user_model(str(local) if local.is_file() else ref, base=base)
+    except UserModelError as error:
+        at = error.location
+        if at is not None and (at.line is not None or at.key is not None):
+            raise                   # a mistake inside the model it names, at its own line
+        # nothing by that name, or a file that cannot be read: said at this file's line
+        # that names it
+        raise ctx.error(key, f"{word} {ref!r}: {error.message}", error.hint) from None
     finally:
         _EXTENDING.reset(token)
 

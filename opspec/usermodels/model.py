@@ -15,6 +15,7 @@ from types import MappingProxyType
 from typing import TYPE_CHECKING
 
 from opspec.errors import Diagnostic, Severity, SourceLocation, UserModelError
+from opspec.toml_lines import located
 from opspec.usermodels.distributions import (
     Constant,
     Distribution,
@@ -52,6 +53,8 @@ class ActivityModel:
     intended: str | None = None
     probabilities: tuple[tuple[str, float], ...] = ()
     source: str | None = None
+    #: written without a duration (so it takes no time): a manual activity's is warned of
+    untimed: bool = field(default=False, compare=False, repr=False)
 
     def __post_init__(self) -> None:
         if self.probabilities:
@@ -166,7 +169,7 @@ class UserModel:
         if found is None:
             raise UserModelError(
                 f"activity {activity_id!r} is not covered by user model {self.name!r}",
-                location=SourceLocation(self.path, key="activities"),
+                location=located(self.path, "activities"),
                 hint=f"add [activities.{activity_id}] with a duration, or a [defaults] table")
         return found
 
@@ -210,14 +213,17 @@ class UserModel:
             ids = ", ".join(missing)
             # a table the spec has no activity for, named like a missing one: a typo
             strays = [a for a in self.activities if a not in manual and a not in choice_map]
-            typos = [f"[activities.{stray}] is not an activity of the spec: did you mean "
-                     f"{close[0]}?" for stray in strays
+            named = [(stray, close[0]) for stray in strays
                      for close in [difflib.get_close_matches(stray, missing, n=1)] if close]
+            typos = [f"[activities.{stray}] is not an activity of the spec: did you mean "
+                     f"{close}?" for stray, close in named]
             raise UserModelError(
                 f"user model {self.name!r} does not cover manual "
                 f"activit{'y' if len(missing) == 1 else 'ies'} of the spec: {ids}"
                 + "".join(f"; {typo}" for typo in typos),
-                location=SourceLocation(self.path, key="activities"),
+                # at the likely typo's table, where the fix is made
+                location=located(self.path, f"activities.{named[0][0]}" if named
+                                 else "activities"),
                 hint="add " + " ".join(f"[activities.{a}]" for a in missing)
                 + " with at least a duration, or a [defaults] table")
         for choice_id, alternatives in choice_map.items():
@@ -226,7 +232,7 @@ class UserModel:
             if unknown:
                 raise UserModelError(
                     f"choice {choice_id!r} has no alternative {', '.join(map(repr, unknown))}",
-                    location=SourceLocation(self.path, key=f"activities.{choice_id}"),
+                    location=located(self.path, f"activities.{choice_id}"),
                     hint="the spec offers: " + ", ".join(alternatives))
         # alternatives are performed by their choice: a model may give them a duration (the
         # time to carry out that pick), but need not
@@ -237,7 +243,7 @@ class UserModel:
             if model.intended is None and not model.probabilities and len(alternatives) > 1:
                 key = f"activities.{choice_id}" if choice_id in self.activities else "defaults"
                 warnings.append(Diagnostic(
-                    SourceLocation(self.path, key=key),
+                    located(self.path, key),
                     Severity.WARNING, "random-choice",
                     f"choice {choice_id!r}: the model names no intended alternative, so it "
                     f"picks one of {', '.join(alternatives)} uniformly at random (and no pick "
@@ -247,17 +253,45 @@ class UserModel:
         for activity_id in self.activities:
             if activity_id not in known:
                 warnings.append(Diagnostic(
-                    SourceLocation(self.path, key=f"activities.{activity_id}"),
+                    located(self.path, f"activities.{activity_id}"),
                     Severity.WARNING, "unused-user-activity",
                     f"activity {activity_id!r} is not a manual activity or choice of the spec",
                     hint="check the spelling against the spec's activity ids"))
         if self.busy is not None:
-            for activity_id in sorted(self.busy.engaged - known):
-                warnings.append(Diagnostic(
-                    SourceLocation(self.path, key="busy.engaged"), Severity.WARNING,
-                    "unused-user-activity",
-                    f"busy.engaged names {activity_id!r}, which the spec's user lane lacks"))
+            # ignore and release_after too: a misspelt id there silently never matches
+            for name, ids in (("engaged", self.busy.engaged),
+                              ("ignore", self.busy.ignore or frozenset()),
+                              ("release_after", self.busy.release_after)):
+                for activity_id in sorted(ids - known):
+                    warnings.append(Diagnostic(
+                        located(self.path, f"busy.{name}"), Severity.WARNING,
+                        "unused-user-activity",
+                        f"busy.{name} names {activity_id!r}, which the spec's user lane lacks",
+                        hint="check the spelling against the spec's activity ids"))
+        warnings.extend(self._untimed(manual, choice_map))
         return warnings
+
+    def _untimed(self, manual: list[str], choices: Mapping[str, list[str]]) -> list[Diagnostic]:
+        """Warnings for manual activities of the spec whose table (or the ``[defaults]`` they
+        fall back to) gives no duration: they take no time, which a forgotten or misspelt
+        ``duration`` line does silently. Noticing a prompt (an activity with an omission)
+        takes no time as a rule, and a choice's alternatives need no duration."""
+        found = []
+        picked = {a for alternatives in choices.values() for a in alternatives}
+        for activity_id in manual:
+            if activity_id in choices or activity_id in picked:
+                continue
+            written = activity_id in self.activities
+            model = self.activities.get(activity_id, self.default)
+            if model is None or not model.untimed or model.prompt:
+                continue
+            table = f"activities.{activity_id}" if written else "defaults"
+            found.append(Diagnostic(
+                located(self.path, table), Severity.WARNING, "no-duration",
+                f"activity {activity_id!r} has no duration in [{table}], so it takes no time",
+                hint=f"write duration = 0.0 in [{table}] if it takes no time, or a "
+                'distribution: duration = { kind = "lognormal", median = 20, sigma = 0.4 }'))
+        return found
 
     def with_modifier(self, modifier: Modifier) -> UserModel:
         """This model with ``modifier`` applied to every activity (and the default). A

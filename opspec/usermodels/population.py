@@ -42,7 +42,8 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 import numpy.typing as npt
 
-from opspec.errors import SourceLocation, UserModelError
+from opspec.errors import UserModelError
+from opspec.toml_lines import located
 from opspec.usermodels.distributions import (
     Distribution,
     ParameterError,
@@ -367,7 +368,7 @@ class Population:
         except ParameterError as error:     # a draw on the edge of what a parameter allows
             raise UserModelError(
                 f"user {user}: drawn {error.param} is not allowed: {error.detail}",
-                location=SourceLocation(self.path, key=f"vary.{error.param}"),
+                location=located(self.path, f"vary.{error.param}"),
                 hint="give the per-user distribution a support inside what the parameter "
                 "allows (a beta for a probability, a lognormal or gamma for a scale)"
             ) from None

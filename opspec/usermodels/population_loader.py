@@ -1,8 +1,8 @@
 """Reading a population from a user-model file: ``[vary]``, ``[[correlations]]``,
 ``[subgroups]`` (the format is in ``docs/user-models.md``, section "Populations").
 
-Everything is checked before any simulation, and every error names the file and the TOML key
-(``people.toml: subgroups: shares add up to 0.95, not 1 (...)``):
+Everything is checked before any simulation, and every error names the file, the line and
+the TOML key (``people.toml:40: subgroups: shares add up to 0.95, not 1 (...)``):
 
 * a varied parameter must name a number of the (subgroup's) model, and its per-user
   distribution must only draw values that number allows: a probability drawn from a
@@ -306,7 +306,10 @@ def parse_population(ctx: _Ctx, doc: Mapping[str, Any], model: UserModel,
     for name, table in raw.items():
         key = f"subgroups.{dotted((name,))}"
         t = ctx.table(table, key, _SUBGROUP_KEYS)
-        share = t.get("share")
+        if "share" not in t:            # said as missing, not as "got None"
+            raise ctx.error(f"{key}.share", "is required: the share of the users in this "
+                            "subgroup", hint="write a fraction: 70 % is share = 0.7")
+        share = t["share"]
         if isinstance(share, bool) or not isinstance(share, (int, float)) or not (
                 0 < share <= 1):
             raise ctx.error(f"{key}.share", f"must be a share in (0, 1], got {share!r}",

@@ -39,7 +39,8 @@ from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any
 
-from opspec.errors import SourceLocation, UserModelError
+from opspec.errors import UserModelError
+from opspec.toml_lines import located
 from opspec.usermodels.distributions import ParameterError
 
 __all__ = ["TABLE", "ParameterDraws", "drawn_model", "parse_path", "read_parameter_draws"]
@@ -87,7 +88,7 @@ class ParameterDraws:
         """Draw ``draw`` (1-based): parameter -> value."""
         if not 1 <= draw <= self.count:
             raise UserModelError(f"no parameter draw {draw}: the file holds {self.count}",
-                                 location=SourceLocation(self.path, key=TABLE))
+                                 location=located(self.path, TABLE))
         return dict(zip(self.parameters, self.draws[draw - 1], strict=True))
 
     def to_toml(self) -> dict[str, Any]:
@@ -133,7 +134,7 @@ class ParameterDraws:
     def from_table(cls, table: Any, path: str) -> ParameterDraws:
         """The ``[uncertainty]`` table of the file ``path``, checked (errors name the key)."""
         def bad(key: str, message: str, hint: str = "") -> UserModelError:
-            return UserModelError(message, location=SourceLocation(path, key=key),
+            return UserModelError(message, location=located(path, key),
                                   hint=hint or "write it again with `opspec fit`")
 
         if not isinstance(table, Mapping):
@@ -198,8 +199,8 @@ class ParameterDraws:
                                                                    strict=True)])
         except ParameterError as error:
             raise UserModelError(f"parameter draw {draw}: {error.param} {error.detail}",
-                                 location=SourceLocation(self.path,
-                                                         key=f"{TABLE}.parameters"),
+                                 location=located(self.path,
+                                                         f"{TABLE}.parameters"),
                                  hint=error.hint or "fit the model again") from None
 
 

@@ -32,6 +32,7 @@ from xml.etree import ElementTree
 
 from opspec.errors import ConfigurationError, SourceLocation
 from opspec.files import toml_loads
+from opspec.toml_lines import located
 from opspec.worlds.base import World
 from opspec.worlds.room import RoomWorld
 from opspec.worlds.sumo import SumoWorld
@@ -122,18 +123,48 @@ def _build(name: str, factory: Callable[..., World], rng: Any, params: Mapping[s
     for key in params:
         if key not in known:
             where = (attribute.location if key in inline or file is None
-                     else SourceLocation(file, key=key))
+                     else located(file, key))
             raise ConfigurationError(
                 f"world {name!r} has no parameter {key!r}", location=where,
                 hint=f"its parameters: {', '.join(sorted(known))}")
     try:
         return factory(rng, **params)
     except (TypeError, ValueError) as error:
-        raise ConfigurationError(f"world {name!r}: {error}",
-                                 location=SourceLocation(file) if file and not inline
-                                 else attribute.location,
+        key = _named_parameter(str(error), params)
+        if key is not None and key.split("[")[0] in inline:
+            where = attribute.location
+        elif key is not None and file is not None:
+            where = located(file, key)          # the line of the value the world refuses
+        else:
+            where = SourceLocation(file) if file and not inline else attribute.location
+        raise ConfigurationError(f"world {name!r}: {error}", location=where,
                                  hint="check the world's parameters "
                                       "(docs/behaviour-specs.md, 'The worlds')") from None
+
+
+def _named_parameter(message: str, params: Mapping[str, Any]) -> str | None:
+    """The given parameter a world's refusal ``message`` names first (``start must be
+    [x, y, heading]``), the entry of a list it shows (``obstacle [1, 2, 1, 3] needs x0 < x1``:
+    ``obstacles[0]``), or None."""
+    import re
+
+    first: tuple[int, str] | None = None
+    for key in params:
+        # a parameter named in the singular ("obstacle" of obstacles), and not as a part of
+        # another name (the "radius" of "ring_radius")
+        found = re.search(rf"(?<![\w-]){re.escape(key.removesuffix('s'))}s?(?![\w-])",
+                          message)
+        if found is not None and (first is None or found.start() < first[0]):
+            first = (found.start(), key)
+    if first is None:
+        return None
+    key = first[1]
+    value = params[key]
+    if isinstance(value, list):         # the entry the message shows: obstacles[1]
+        for index, entry in enumerate(value):
+            if isinstance(entry, list) and str(entry) in message:
+                return f"{key}[{index}]"
+    return key
 
 
 def world_performers(compiled: CompiledPackage, *, seed: int, user: int

@@ -25,14 +25,18 @@ def _is_number(value: Any) -> bool:
 
 def check_parameters(*, numbers: Mapping[str, Any] | None = None,
                      vectors: Mapping[str, tuple[Any, int | None]] | None = None,
-                     boxes: Mapping[str, Any] | None = None) -> None:
+                     boxes: Mapping[str, Any] | None = None,
+                     not_negative: tuple[str, ...] = ()) -> None:
     """Raise ``ValueError`` naming the first parameter of the wrong type: ``numbers`` must be
-    numbers, ``vectors`` (value, length or None) lists of numbers of that length (a ``None``
-    value is allowed), ``boxes`` lists of such [x0, y0, x1, y1] lists. Worlds call it first,
+    finite numbers (those in ``not_negative`` also >= 0: a noise's sd, a rate), ``vectors``
+    (value, length or None) lists of numbers of that length (a ``None`` value is allowed),
+    ``boxes`` lists of such [x0, y0, x1, y1] lists. Worlds call it first,
     so a user reads "width must be a number, not 'wide'", not a Python comparison error."""
     for name, value in (numbers or {}).items():
-        if not _is_number(value):
+        if not _is_number(value) or not math.isfinite(value):   # nan, inf: no length
             raise ValueError(f"{name} must be a number, not {value!r}")
+        if name in not_negative and value < 0:      # here, not as a crash mid-run
+            raise ValueError(f"{name} must be 0 or more, not {value!r}")
     for name, (value, size) in (vectors or {}).items():
         if value is None:
             continue

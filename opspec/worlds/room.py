@@ -51,10 +51,12 @@ class RoomWorld(RobotWorld):
                                   "cell": cell, "range_noise": range_noise,
                                   "drain_per_s": drain_per_s, "tag_range": tag_range},
                          vectors={"start": (start, 3), "tag": (tag, 2)},
-                         boxes={"obstacles": obstacles})
+                         boxes={"obstacles": obstacles},
+                         not_negative=("range_noise", "drain_per_s", "tag_range"))
         self.radius = float(radius)
-        if not (self.radius > 0 and float(cell) > 0):
-            raise ValueError(f"radius ({radius}) and cell ({cell}) must be positive")
+        for name, value in (("radius", radius), ("cell", cell)):
+            if not value > 0:               # the message names the one to fix first
+                raise ValueError(f"{name} ({value}) must be positive")
         if not (width > 2 * self.radius and height > 2 * self.radius):
             raise ValueError(f"a {width} x {height} m room has no room for a robot of "
                              f"radius {radius} m")

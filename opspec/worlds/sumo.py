@@ -35,9 +35,11 @@ class SumoWorld(RobotWorld):
         check_parameters(numbers={"ring_radius": ring_radius, "radius": radius,
                                   "opponent_speed": opponent_speed,
                                   "bout_limit_s": bout_limit_s, "range_noise": range_noise,
-                                  "drain_per_s": drain_per_s, "edge_band": edge_band})
+                                  "drain_per_s": drain_per_s, "edge_band": edge_band},
+                         not_negative=("opponent_speed", "range_noise", "drain_per_s",
+                                       "edge_band"))
         if not (radius > 0 and ring_radius > 4 * radius and bout_limit_s > 0):
-            raise ValueError(f"the ring (radius {ring_radius} m) must hold two robots of "
+            raise ValueError(f"the ring (ring_radius {ring_radius} m) must hold two robots of "
                              f"radius {radius} m apart, and bout_limit_s must be positive")
         self.ring = float(ring_radius)
         self.radius = float(radius)

@@ -234,7 +234,7 @@ def test_an_unknown_key_in_the_world_file_is_located_at_that_key(tmp_path: Path)
                                         encoding="utf-8")
     model = spec_with_world(tmp_path, '<ExtendedAttribute Name="opspec:World" Value="sumo-ring"/>'
                             '<ExtendedAttribute Name="opspec:WorldFile" Value="ring.toml"/>')
-    with pytest.raises(ConfigurationError, match=r"ring.toml: opponent: world 'sumo-ring' has "
+    with pytest.raises(ConfigurationError, match=r"ring.toml:2: opponent: world 'sumo-ring' has "
                                                  r"no parameter 'opponent'"):
         world_performers(model, seed=0, user=0)  # type: ignore[arg-type]
 

@@ -35,7 +35,7 @@ def test_a_spec_given_to_script(capsys: pytest.CaptureFixture[str]) -> None:
 
 def test_a_spec_given_to_user_model(capsys: pytest.CaptureFixture[str]) -> None:
     err = error_of(capsys, "--user-model", str(SPEC))
-    assert "medication_dispenser.xpdl: not valid TOML" in err
+    assert "medication_dispenser.xpdl:1: not valid TOML" in err
     assert f"given to --user-model, but this is a spec (XPDL): {AS_SPEC}" in err
 
 

@@ -19,21 +19,43 @@ def test_config_loads_from_an_engine_table_and_applies_overrides(tmp_path: Path)
 
 
 @pytest.mark.parametrize(("text", "message"), [
-    ("wokers = 2", r"engine.toml: wokers: unknown engine option 'wokers'"),
-    ('processor_model = "fast"', (r"processor_model: processor_model 'fast' is not known "
+    ("wokers = 2", r"engine.toml:1: wokers: unknown engine option 'wokers'"),
+    ('processor_model = "fast"', (r"engine.toml:1: processor_model: processor_model 'fast' is not known "
                                  r"\(allowed values: dedicated, pooled, preemptive, "
                                  r"priority-queues\)")),
-    ("workers = 0", r"workers: workers must be a whole number >= 1"),
-    ("switch_cost = -1.0", r"switch_cost: switch_cost must be a number of seconds >= 0"),
-    ("speed = 0", r"speed: speed must be a number > 0"),
+    ("workers = 0", r"engine.toml:1: workers: workers must be a whole number >= 1"),
+    ("switch_cost = -1.0", (r"engine.toml:1: switch_cost: switch_cost must be a number of "
+                            r"seconds >= 0")),
+    ("speed = 0", r"engine.toml:1: speed: speed must be a number > 0"),
     ("workers = [", r"engine.toml: not valid TOML"),
-], ids=["unknown-key", "bad-model", "zero-workers", "negative-switch", "zero-speed", "syntax"])
-def test_bad_configuration_names_file_key_and_allowed_values(tmp_path: Path, text: str,
+    ("workers = = 2", r"engine.toml:1: not valid TOML"),
+], ids=["unknown-key", "bad-model", "zero-workers", "negative-switch", "zero-speed", "syntax",
+        "syntax-at-a-line"])
+def test_bad_configuration_names_file_line_key_and_allowed_values(tmp_path: Path, text: str,
                                                             message: str) -> None:
     path = tmp_path / "engine.toml"
     path.write_text(text + "\n")
     with pytest.raises(ConfigurationError, match=message):
         EngineConfig.load(path)
+
+
+def test_a_bad_key_in_the_engine_table_is_placed_at_its_line(tmp_path: Path) -> None:
+    path = tmp_path / "engine.toml"
+    path.write_text('# tuned for the board\n[engine]\nprocessor_model = "pooled"\nwokers = 2\n')
+    with pytest.raises(ConfigurationError) as refused:
+        EngineConfig.load(path)
+    assert str(refused.value).startswith(f"{path}:4: wokers: unknown engine option 'wokers'")
+
+
+def test_a_key_outside_the_engine_table_is_refused_not_ignored(tmp_path: Path) -> None:
+    # workers = 4 above [engine] was left out without a word: the run used 1 worker
+    path = tmp_path / "engine.toml"
+    path.write_text('workers = 4\n[engine]\nprocessor_model = "pooled"\n')
+    with pytest.raises(ConfigurationError) as refused:
+        EngineConfig.load(path)
+    assert str(refused.value).startswith(
+        f"{path}:1: workers: 'workers' is outside the [engine] table, so it would be ignored; "
+        "move it under [engine]")
 
 
 def test_keyword_overrides_are_validated_too() -> None:
@@ -67,5 +89,5 @@ def test_a_bad_value_in_the_engine_file_keeps_the_file_and_key(tmp_path: Path) -
     path.write_text("speed = 0\n")
     with pytest.raises(ConfigurationError) as caught:
         EngineConfig.load(path, realtime=True)
-    assert str(caught.value) == (f"{path}: speed: speed must be a number > 0, not 0; write "
+    assert str(caught.value) == (f"{path}:1: speed: speed must be a number > 0, not 0; write "
                                  "e.g. speed = 60 (one simulated minute per wall second)")

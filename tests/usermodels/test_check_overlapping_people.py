@@ -56,4 +56,4 @@ def test_a_broken_fitted_on_table_names_the_file(tmp_path: Path, capsys) -> None
                      '[fitted_on]\npersons = "P01"\n', encoding="utf-8")
     trace = _person(tmp_path, "P01", 1)
     assert main(["model-check", str(model), str(trace), "--replicates", "19"]) == 2
-    assert f"{model}: fitted_on.persons: must be a list" in capsys.readouterr().err
+    assert f"{model}:7: fitted_on.persons: must be a list" in capsys.readouterr().err

@@ -78,5 +78,7 @@ def test_run_warns_about_a_misspelt_activity_and_a_choice_left_to_chance(tmp_pat
                    "--timeline", "none"])
     err = capsys.readouterr().err
     assert status == 0
-    assert f"{path}: activities.take_pil: warning: activity 'take_pil' is not a manual " in err
+    line = path.read_text(encoding="utf-8").splitlines().index("[activities.take_pil]") + 1
+    assert (f"{path}:{line}: activities.take_pil: warning: activity 'take_pil' is not a "
+            "manual ") in err
     assert "choice 'choose_button': the model names no intended alternative" in err

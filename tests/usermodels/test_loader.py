@@ -62,36 +62,36 @@ def test_the_dispenser_preset_equals_the_spec_user_model(dispenser_users_path) -
 BAD = {
     "negative-sigma": (('[activities.walk_to_dispenser]\n'
                        'duration = { kind = "lognormal", median = 60, sigma = -1 }'),
-                       (r"users.toml: activities.walk_to_dispenser.duration.sigma: "
+                       (r"users.toml:2: activities.walk_to_dispenser.duration.sigma: "
                        r"must be > 0, got -1")),
     "unknown-distribution": ('[activities.walk]\nduration = { kind = "gauss", mean = 1 }',
-                             (r"users.toml: activities.walk.duration.kind: unknown "
+                             (r"users.toml:2: activities.walk.duration.kind: unknown "
                              r"distribution 'gauss' \(use one of: constant")),
     "probability-above-1": ('[activities.hear]\nomission = 1.5',
-                            (r"users.toml: activities.hear.omission.probability: must be a "
+                            (r"users.toml:2: activities.hear.omission.probability: must be a "
                             r"probability in \[0, 1\], got 1.5")),
     "negative-probability": (('[activities.c]\nintended = "a"\n'
                              'commission = { probability = -0.1 }'),
-                             r"activities.c.commission.probability: must be a probability"),
+                             r"users.toml:3: activities.c.commission.probability: must be a probability"),
     "unknown-activity-key": ('[activities.walk]\nduraton = 3',
-                             (r"users.toml: activities.walk.duraton: unknown key \(expected "
+                             (r"users.toml:2: activities.walk.duraton: unknown key \(expected "
                              r"one of: duration")),
-    "unknown-top-key": ('[activites.walk]\nduration = 3', r"users.toml: activites: unknown key"),
+    "unknown-top-key": ('[activites.walk]\nduration = 3', r"users.toml:1: activites: unknown key"),
     "bad-window": ('[[routine.windows]]\nname = "asleep"\nstart = "23:00"\nend = "31:00"',
-                   r"routine.windows\[0\].end: cannot read time of day '31:00'"),
-    "busy-string": ('[busy]\nengaged = "walk"', r"busy.engaged: must be a list"),
+                   r"users.toml:4: routine.windows\[0\].end: cannot read time of day '31:00'"),
+    "busy-string": ('[busy]\nengaged = "walk"', r"users.toml:2: busy.engaged: must be a list"),
     "probabilities-sum": ('[activities.c]\nprobabilities = { a = 0.5, b = 0.6 }',
-                          r"activities.c.probabilities: must add up to 1, got 1.1"),
-    "bad-version": ('version = 7', r"users.toml: version: unsupported version 7"),
+                          r"users.toml:2: activities.c.probabilities: must add up to 1, got 1.1"),
+    "bad-version": ('version = 7', r"users.toml:1: version: unsupported version 7"),
     "nested-typo": (('[activities.w]\nduration = { kind = "with_tail", tau = 1, '
                     'base = { kind = "gamma", shape = -1, scale = 1 } }'),
-                    r"activities.w.duration.base.shape: must be > 0"),
-    "not-toml": ('[activities.walk\n', r"users.toml: not valid TOML"),
+                    r"users.toml:2: activities.w.duration.base.shape: must be > 0"),
+    "not-toml": ('[activities.walk\n', r"users.toml:1: not valid TOML"),
 }
 
 
 @pytest.mark.parametrize(("text", "message"), BAD.values(), ids=BAD.keys())
-def test_invalid_files_name_the_file_and_dotted_key(tmp_path: Path, text: str,
+def test_invalid_files_name_the_file_line_and_dotted_key(tmp_path: Path, text: str,
                                                     message: str) -> None:
     with pytest.raises(UserModelError, match=message):
         load_user_model(write(tmp_path, text))
@@ -111,7 +111,7 @@ def test_an_unknown_preset_lists_the_presets() -> None:
 
 def test_uncovered_manual_activities_name_the_file_the_ids_and_the_fix(tmp_path: Path) -> None:
     model = load_user_model(write(tmp_path, GOOD))
-    with pytest.raises(UserModelError, match=r"users.toml: activities: user model 'users' does "
+    with pytest.raises(UserModelError, match=r"users.toml:3: activities: user model 'users' does "
                        r"not cover manual activities of the spec: press_report, take_pill "
                        r"\(add \[activities.press_report\] \[activities.take_pill\]"):
         model.validate_against(["hear_alarm", "walk_to_dispenser", "press_report", "take_pill"])

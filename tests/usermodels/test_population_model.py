@@ -200,9 +200,9 @@ BAD = {
 share = 0.7
 [subgroups.b]
 share = 0.25
-''', r"people.toml: subgroups: shares add up to 0.95, not 1 \(a 0.7, b 0.25\)"),
+''', r"people.toml:3: subgroups: shares add up to 0.95, not 1 \(a 0.7, b 0.25\)"),
     "share-range": ('[subgroups.a]\nshare = 70\n',
-                    r"people.toml: subgroups.a.share: must be a share in \(0, 1\]"),
+                    r"people.toml:3: subgroups.a.share: must be a share in \(0, 1\]"),
     "not-psd": (f'''
 [vary.activities.hear_alarm.omission]
 probability = {{ kind = "beta", a = 2, b = 10 }}
@@ -218,12 +218,12 @@ gaussian = 0.9
 [[correlations]]
 parameters = ["{OMISSION}", "activities.walk_to_dispenser.duration.sigma"]
 gaussian = -0.9
-''', (r"people.toml: correlations: the correlations cannot hold together: their matrix is "
+''', (r"people.toml:8: correlations: the correlations cannot hold together: their matrix is "
         r"not positive semi-definite \(smallest eigenvalue -0.8")),
     "probability-support": ('''
 [vary.activities.hear_alarm.omission]
 probability = { kind = "lognormal", median = 0.1, sigma = 0.5 }
-''', (r"people.toml: vary.activities.hear_alarm.omission.probability: lognormal \(median 0.1, "
+''', (r"people.toml:4: vary.activities.hear_alarm.omission.probability: lognormal \(median 0.1, "
         r"sigma 0.5\) draws values up to inf .*must be a probability in \[0, 1\].*beta")),
     "negative-median": ('''
 [vary.activities.walk_to_dispenser.duration]
@@ -286,15 +286,15 @@ median = {{ kind = "lognormal", median = 60, sigma = 0.3 }}
 [[correlations]]
 parameters = ["{OMISSION}", "{WALK}"]
 spearman = 1.3
-''', r"correlations\[0\].spearman: must be a correlation in \[-1, 1\]"),
+''', r"people.toml:9: correlations\[0\].spearman: must be a correlation in \[-1, 1\]"),
     "subgroup-key": ('[subgroups.a]\nshare = 1.0\nshares = 2\n',
-                     r"subgroups.a.shares: unknown key"),
+                     r"people.toml:4: subgroups.a.shares: unknown key"),
     "subgroup-activity": ('''
 [subgroups.a]
 share = 1.0
 [subgroups.a.activities.take_pill]
 duration = { kind = "lognormal", median = 20, sigma = -1 }
-''', r"people.toml: subgroups.a.activities.take_pill.duration.sigma: must be > 0"),
+''', r"people.toml:6: subgroups.a.activities.take_pill.duration.sigma: must be > 0"),
     "subgroup-vary": ('''
 [subgroups.a]
 share = 1.0
@@ -322,6 +322,6 @@ def test_two_populations_do_not_compose(tmp_path):
     other.write_text('[vary.activities.take_pill.duration]\n'
                      'median = { kind = "lognormal", median = 20, sigma = 0.2 }\n',
                      encoding="utf-8")
-    with pytest.raises(UserModelError, match=r"more.toml: vary: this file declares a "
+    with pytest.raises(UserModelError, match=r"more.toml:1: vary: this file declares a "
                        "population on top of the population of"):
         load_user_model(f"{EXAMPLE},{other}")

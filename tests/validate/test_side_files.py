@@ -30,6 +30,11 @@ def make_spec(folder: Path, model: str | None = MODEL) -> Path:
     return spec
 
 
+def _line_of(written: str) -> int:
+    """The line of the shipped user model holding ``written`` (the first)."""
+    return next(n for n, line in enumerate(MODEL.splitlines(), start=1) if written in line)
+
+
 def validate(capsys: pytest.CaptureFixture[str], *argv: str) -> tuple[int, list[str]]:
     status = main(["validate", *argv])
     return status, capsys.readouterr().out.splitlines()
@@ -69,10 +74,11 @@ def test_a_user_model_run_refuses_is_an_error_in_the_runs_words(
     refused = run_refusal(capsys, spec)
     status, out = validate(capsys, str(spec))
     assert status == 1
-    # path: key: error: message (hint), where run says path: key: message (hint)
+    # path:line: key: error: message (hint), where run says path:line: key: message (hint);
+    # the line is the one the typo is on (an editor jumps to it)
     problems = [line for line in out if ": error: " in line]
     assert [p.replace(": error: ", ": ", 1) for p in problems] == [refused]
-    assert problems[0].startswith(f"{tmp_path / 'pill.users.toml'}: ")
+    assert problems[0].startswith(f"{tmp_path / 'pill.users.toml'}:{_line_of(old)}: ")
     assert out[-1] == ("1 file checked with pill.users.toml beside it: 1 with errors "
                        "(1 error, 0 warnings)")
 
@@ -89,7 +95,9 @@ def test_a_toml_syntax_error_is_placed_at_its_line(
     model = tmp_path / "pill.users.toml"
     # run names the line in its message; validate also puts it where editors look for it
     assert f"(at line {broken + 1}, column" in refused
-    assert out[0] == f"{model}:{broken + 1}: error: " + refused.removeprefix(f"{model}: ")
+    assert refused.startswith(f"{model}:{broken + 1}: not valid TOML: ")
+    assert out[0] == f"{model}:{broken + 1}: error: " + refused.removeprefix(
+        f"{model}:{broken + 1}: ")
 
 
 def test_the_runs_warnings_on_the_user_model_are_validates_warnings(
@@ -135,7 +143,8 @@ def test_json_reports_the_side_files_problem_with_its_key(
     assert doc["ok"] is False
     (problem,) = doc["diagnostics"]
     assert problem == {
-        "path": str(tmp_path / "pill.users.toml"), "line": None, "severity": "error",
+        "path": str(tmp_path / "pill.users.toml"), "line": _line_of("probability = 0.15"),
+        "severity": "error",
         "code": "bad-user-model", "message": "must be a probability in [0, 1], got -0.15",
         "hint": "write a fraction: 15 % is 0.15",
         "key": "activities.hear_alarm.omission.probability"}
@@ -151,7 +160,8 @@ def test_a_broken_spec_still_has_its_user_model_read(
     status, out = validate(capsys, str(spec))
     assert status == 1
     assert any(line.startswith(f"{spec}:") and ": error: " in line for line in out)
-    assert any(line.startswith(f"{tmp_path / 'pill.users.toml'}: activities.hear_alarm."
+    users = tmp_path / "pill.users.toml"
+    assert any(line.startswith(f"{users}:{_line_of('probability = 0.15')}: activities.hear_alarm."
                                "omission.probability: error: must be a probability")
                for line in out)
     assert out[-1].startswith("1 file checked (pill.users.toml beside it only read: the spec "
@@ -199,3 +209,16 @@ def test_every_shipped_spec_validates_clean_with_its_side_files(
         assert out[-1] == (f"1 file checked with {', '.join(beside)} beside it: no errors "
                            "(0 errors, 0 warnings)" if beside else
                            "1 file checked: no errors (0 errors, 0 warnings)")
+
+
+def test_json_carries_the_line_of_a_side_files_warning_as_of_a_specs(
+        tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    spec = make_spec(tmp_path, MODEL + "\n[activities.tkae_pill]\nduration = 3.0\n")
+    line = len(MODEL.splitlines()) + 2
+    _, out = validate(capsys, str(spec))
+    assert out[0].startswith(f"{tmp_path / 'pill.users.toml'}:{line}: activities.tkae_pill: "
+                             "warning: ")
+    _, out = validate(capsys, "--json", str(spec))
+    (problem,) = json.loads(out[0])["diagnostics"]
+    assert (problem["path"], problem["line"], problem["key"], problem["code"]) == (
+        str(tmp_path / "pill.users.toml"), line, "activities.tkae_pill", "unused-user-activity")
