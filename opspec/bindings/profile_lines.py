@@ -5,10 +5,9 @@ syntax error ``file:line:``) and an editor can jump to it; the scanning is
 
 from __future__ import annotations
 
-from pathlib import Path
-
 from opspec.errors import BindingError, SourceLocation
 from opspec.toml_lines import key_line, syntax_line
+from opspec.toml_lines import located as key_location
 
 __all__ = ["key_line", "located"]
 
@@ -22,11 +21,8 @@ def located(error: BindingError, where: str) -> BindingError:
         return error
     line = syntax_line(error.message)
     if line is None and at.key:
-        try:
-            text = Path(where).read_text(encoding="utf-8")   # just read: it is text
-        except (OSError, UnicodeDecodeError):
-            return error
-        line = key_line(text, at.key)
+        # read as the profile was (past a byte-order mark an editor may have saved)
+        line = key_location(where, at.key).line
     if line is None:
         return error
     return BindingError(error.message, location=SourceLocation(at.path, line, at.key),

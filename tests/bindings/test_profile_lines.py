@@ -102,3 +102,14 @@ def test_a_syntax_error_at_the_end_of_the_file_has_no_line(tmp_path: Path) -> No
     with pytest.raises(BindingError) as refused:
         load_profile(path)
     assert str(refused.value).startswith(f"{path}: not valid TOML: ")
+
+
+def test_a_profile_saved_with_a_byte_order_mark_is_placed_at_its_line(tmp_path: Path) -> None:
+    # editors on Windows save UTF-8 with a BOM; the profile is read past it, and a key on the
+    # first line is still found there (the scanner read the BOM as part of the key)
+    text = 'fromat = "opspec-device-profile"\n' + SHIPPED
+    path = tmp_path / "medication_dispenser.toml"
+    path.write_bytes(b"\xef\xbb\xbf" + text.encode("utf-8"))
+    with pytest.raises(BindingError) as refused:
+        load_profile(path)
+    assert str(refused.value).startswith(f"{path}:1: fromat")
