@@ -45,6 +45,7 @@ from pathlib import Path
 from typing import Any
 
 from opspec.errors import ConfigurationError, SourceLocation
+from opspec.toml_lines import located
 
 # the summary, opspec.tui.study_summary, stays importable from here
 from opspec.tui.study_summary import session_pairs, summary, summary_lines, variant_estimate
@@ -116,7 +117,7 @@ class Protocol:
         if participant not in self.participants:
             raise ConfigurationError(
                 f"participant {participant!r} is not in the protocol",
-                location=SourceLocation(str(self.path), key="study.participants"),
+                location=located(str(self.path), "study.participants"),
                 hint="the protocol's participants: " + ", ".join(self.participants))
         rows = latin_square(len(self.variants))
         row = rows[self.participants.index(participant) % len(rows)]
@@ -183,7 +184,8 @@ def load_protocol(path: str | Path) -> Protocol:
     where = str(source)
 
     def bad(key: str, message: str, hint: str = "") -> ConfigurationError:
-        return ConfigurationError(message, location=SourceLocation(where, key=key), hint=hint)
+        # at the line the key (or its table) is written on, as every TOML input's errors
+        return ConfigurationError(message, location=located(where, key), hint=hint)
 
     from opspec.toml_files import read_toml
 

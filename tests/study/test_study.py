@@ -86,7 +86,18 @@ def test_a_protocol_naming_a_missing_spec_is_refused(tmp_path: Path, capsys) -> 
                         'spec = "nowhere.xpdl"\n', encoding="utf-8")
     assert main(["study", str(protocol)]) == 2
     err = capsys.readouterr().err
-    assert "study.toml" in err and "variants[0].spec" in err and "no spec at" in err
+    # at the line the key is written on, so that an editor jumps to it
+    assert f"{protocol}:5: variants[0].spec: no spec at" in err
+
+
+def test_a_protocol_key_error_is_placed_at_its_line(tmp_path: Path, capsys) -> None:
+    protocol = tmp_path / "study.toml"
+    (tmp_path / "pill.xpdl").write_text("", encoding="utf-8")   # found; never read
+    protocol.write_text('[study]\nparticipants = ["P1"]\ndays = -2\n[[variants]]\nid = "A"\n'
+                        'spec = "pill.xpdl"\n', encoding="utf-8")
+    assert main(["study", str(protocol)]) == 2
+    assert f"{protocol}:3: study.days: must be a positive number" in (
+        capsys.readouterr().err)
 
 
 def test_an_unknown_participant_is_refused(protocol_file: Path, capsys) -> None:
