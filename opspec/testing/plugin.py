@@ -140,7 +140,10 @@ def _compiled_for(package: Any, config: pytest.Config) -> Any:
 
 @pytest.fixture
 def spec(request: pytest.FixtureRequest) -> Any:
-    """The spec of ``@pytest.mark.spec(path)`` or the module's ``SPEC``."""
+    """The spec (a :class:`~opspec.model.Package`) named by ``@pytest.mark.spec("path")`` on
+    the test, class or module, else by a module-level ``SPEC = "path"``: a path next to the
+    test file or under the rootdir, loaded once per session; a spec ``opspec validate``
+    refuses fails the test with its ``path:line`` message. Guide: docs/spec-testing.md."""
     marker = request.node.get_closest_marker("spec")
     ref: Any = None
     if marker is not None:
@@ -162,7 +165,9 @@ def spec(request: pytest.FixtureRequest) -> Any:
 
 @pytest.fixture
 def opspec_seed(request: pytest.FixtureRequest) -> int:
-    """The test's seed: ``--opspec-seed`` mixed with the test id."""
+    """The test's seed, the one ``simulate`` uses unless given ``seed=``: ``--opspec-seed``
+    (default 0) mixed with the test id, so each test draws differently and reproducibly (the
+    same on every machine and number of xdist workers); a failing test's report shows it."""
     from opspec.testing.simulation import derive_seed
 
     seed = derive_seed(request.config.getoption("--opspec-seed"), request.node.nodeid)
@@ -194,11 +199,17 @@ class Simulator:
                  script: Any = None, user_model: Any = None, seed: int | None = None,
                  until: float | None = None, engine_config: Any = None,
                  **options: Any) -> Any:
+        __tracebackhide__ = True            # a failure is the test's line, not this frame
         from opspec.testing.simulation import simulate
 
         if spec is None:
             pytest.fail("simulate() needs a spec: simulate(spec, ...) with the 'spec' fixture "
                         "or a path", pytrace=False)
+        takes = _simulate_takes(simulate)
+        unknown = [name for name in options if name not in takes]
+        if unknown:
+            pytest.fail(f"{self._calling_line()}{_unknown_options(unknown, takes)}",
+                        pytrace=False)
         if isinstance(spec, (str, Path)):
             spec = load_cached(resolve_path(spec, self.config, self.near,
                                             "fix the spec path given to simulate()"),
@@ -217,16 +228,61 @@ class Simulator:
                               user_model=user_model, seed=self.seed if seed is None else seed,
                               until=until, engine_config=engine_config, **options)
         except OpspecError as error:
-            problem = f"simulate(): {error}"
+            problem = f"{self._calling_line()}simulate(): {error}"
         else:
             _warned(self.node, self.config, result)
             return result
         pytest.fail(problem, pytrace=False)     # outside the except: the message once
 
+    def _calling_line(self) -> str:
+        """``test_x.py:12: result = simulate(...)`` and a new line: the line of the test
+        file that called (a test may simulate several times), or nothing when none did."""
+        import linecache
+        import sys
+
+        frame = sys._getframe(1)
+        while frame is not None:
+            if self.near is not None and Path(frame.f_code.co_filename) == self.near:
+                line = linecache.getline(frame.f_code.co_filename, frame.f_lineno).strip()
+                return f"{self.near.name}:{frame.f_lineno}: {line}\n"
+            frame = frame.f_back  # type: ignore[assignment]
+        return ""
+
+
+def _simulate_takes(simulate: Any) -> tuple[str, ...]:
+    """The arguments of ``simulate`` (what the fixture passes on), in its order."""
+    import inspect
+
+    return tuple(inspect.signature(simulate).parameters)
+
+
+def _unknown_options(unknown: Sequence[str], takes: Sequence[str]) -> str:
+    """What to say of keywords ``simulate`` does not take (a misspelt ``user=`` was a
+    ``TypeError`` through the plugin's frame)."""
+    import difflib
+
+    lines = []
+    for name in unknown:
+        close = difflib.get_close_matches(name, takes, n=1)
+        lines.append(f"simulate() has no argument {name!r}"
+                     + (f": did you mean {close[0]}=?" if close else ""))
+    lines.append(f"it takes: {', '.join(takes)} (docs/spec-testing.md, Fixtures)")
+    return "\n".join(lines)
+
 
 @pytest.fixture
 def simulate(request: pytest.FixtureRequest, opspec_seed: int) -> Simulator:
-    """Run a spec; see :class:`Simulator`."""
+    """``simulate(spec, users=1, days=None, until=None, script=None, user_model=None,
+    seed=None, ...)`` -> ``SimulationResult``: run ``spec`` (the ``spec`` fixture or a path)
+    for ``users`` simulated users, each scripted (``script=[("after trg_2 90s",
+    "press_report")]``) or drawn from a user model (``user_model="x.users.toml"``), for
+    ``days`` or ``until`` seconds, seeded with the test's seed (``opspec_seed``); paths are
+    next to the test file or under the rootdir. Check the result with ``expect``, ``check``
+    or ``assert_rate`` (opspec.testing). Guide: docs/spec-testing.md.
+
+    The other arguments are those of :func:`opspec.testing.simulate` (``monitors``,
+    ``no_user``, ``params``, ``performers``, ``keep_trace``, ``engine_config``,
+    ``branches``); see :class:`Simulator`."""
     return Simulator(request.config, request.node.path, opspec_seed, request.node)
 
 
@@ -246,7 +302,8 @@ def simulator_for(request: pytest.FixtureRequest) -> Simulator:
 
 @pytest.fixture
 def regen_golden(request: pytest.FixtureRequest) -> bool:
-    """True when ``--opspec-regen-golden`` was given."""
+    """True when ``--opspec-regen-golden`` was given (golden traces are written instead of
+    compared)."""
     return bool(request.config.getoption("--opspec-regen-golden"))
 
 

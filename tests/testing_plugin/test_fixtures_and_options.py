@@ -151,3 +151,51 @@ def test_the_options_are_in_pytest_help(pytester: pytest.Pytester) -> None:
     text = pytester.runpytest("--help").stdout.str()
     for option in ("--opspec-seed", "--opspec-regen-golden", "--device-url", "--device-profile"):
         assert re.search(rf"^\s+{option}", text, re.MULTILINE), option
+
+
+def test_the_fixtures_say_what_they_give_in_pytest_fixtures(pytester: pytest.Pytester) -> None:
+    # `pytest --fixtures` shows a fixture's first paragraph: simulate's said only "see
+    # Simulator", a class a test author never sees
+    text = pytester.runpytest("--fixtures").stdout.str()
+    shown = dict(re.findall(r"^(\w+) -- .*\n((?:    .*\n)+)", text, re.MULTILINE))
+    assert "simulate(spec, users=1, days=None, until=None, script=None" in shown["simulate"]
+    assert "SimulationResult" in shown["simulate"]
+    assert 'SPEC = "path"' in shown["spec"] and "@pytest.mark.spec" in shown["spec"]
+    assert "--opspec-seed" in shown["opspec_seed"]
+
+
+def test_a_misspelt_argument_of_simulate_is_named_with_the_test_line(
+        project: pytest.Pytester) -> None:
+    # was a TypeError shown through the plugin's own frame (its source and locals)
+    project.makepyfile(test_misspelt="""
+        SPEC = "specs/dispenser.xpdl"
+
+        def test_it(spec, simulate):
+            simulate(spec, until=3600)
+            simulate(spec, user=3, montors=["never dispense"])
+    """)
+    result = project.runpytest("-rN")
+    result.assert_outcomes(failed=1)
+    result.stdout.fnmatch_lines([
+        "test_misspelt.py:5: simulate(spec, user=3, montors=[[]\"never dispense\"[]])",
+        "simulate() has no argument 'user': did you mean users=?",
+        "simulate() has no argument 'montors': did you mean monitors=?",
+        "it takes: spec, users, days, until, script, user_model, seed, engine_config, *"])
+    out = result.stdout.str()
+    assert "TypeError" not in out and "opspec/testing/" not in out
+
+
+def test_a_failing_simulate_call_names_the_line_that_made_it(project: pytest.Pytester) -> None:
+    # a test that simulates several times: which call was refused
+    project.makepyfile(test_two_calls="""
+        SPEC = "specs/dispenser.xpdl"
+
+        def test_it(spec, simulate):
+            simulate(spec, script=[("never", "press_report")], until=3600)
+            simulate(spec, script=[("never", "press_reprot")], until=3600)
+    """)
+    result = project.runpytest("-rN")
+    result.assert_outcomes(failed=1)
+    result.stdout.fnmatch_lines([
+        "test_two_calls.py:5: simulate(spec, script=[[](\"never\", \"press_reprot\")[]], *",
+        "simulate(): <script>: the script names activity 'press_reprot'*"])
