@@ -41,7 +41,9 @@ __all__ = [
     "pytest_addoption",
     "pytest_collect_file",
     "pytest_configure",
+    "pytest_sessionfinish",
     "pytest_terminal_summary",
+    "pytest_testnodedown",
     "simulator_for",
 ]
 
@@ -363,6 +365,22 @@ def pytest_runtest_makereport(item: pytest.Item, call: pytest.CallInfo[None]
         lines.extend(item.stash.get(_WARNED_KEY, {}))
     if lines:
         report.sections.append(("opspec", "\n".join(lines)))
+
+
+def pytest_sessionfinish(session: pytest.Session) -> None:
+    """On a pytest-xdist worker: hand the warnings it saw to the controller, which prints the
+    session's (its terminal summary is the only one shown; with ``-n 2`` they were lost)."""
+    output = getattr(session.config, "workeroutput", None)
+    if output is not None:
+        output["opspec_warned"] = list(session.config.stash.get(_WARNED_KEY, {}))
+
+
+@pytest.hookimpl(optionalhook=True)
+def pytest_testnodedown(node: Any, error: Any) -> None:
+    """On the pytest-xdist controller: a worker's warnings join the session's."""
+    warned = node.config.stash.setdefault(_WARNED_KEY, {})
+    for line in getattr(node, "workeroutput", {}).get("opspec_warned", ()):
+        warned[line] = None
 
 
 def pytest_terminal_summary(terminalreporter: Any) -> None:

@@ -117,6 +117,37 @@ def test_the_seed_option_makes_runs_reproducible_and_tests_independent(
     assert first["one"] != other["one"]          # and the base seed matters
 
 
+def test_the_same_seed_gives_the_same_runs_whatever_the_number_of_xdist_workers(
+        project: pytest.Pytester) -> None:
+    # each test writes what it drew (a worker's prints are not shown)
+    project.makepyfile(test_drawn="""
+        import pytest
+        from opspec.testing import simulator_for
+
+        SPEC = "specs/dispenser.xpdl"
+        USERS = "specs/dispenser.users.toml"
+
+        @pytest.fixture(scope="module")
+        def shared(request):
+            return simulator_for(request)(SPEC, users=3, user_model=USERS)
+
+        @pytest.mark.parametrize("k", range(3))
+        def test_drawn(spec, simulate, shared, k, request):
+            result = simulate(spec, users=3, user_model=USERS)
+            line = (request.node.name, result.seed, result.samples("report_latency_s"),
+                    shared.seed, shared.samples("report_latency_s"))
+            with open(f"drawn-{k}.txt", "w") as out:
+                out.write(repr(line))
+    """)
+
+    def drawn(*args: str) -> list[str]:
+        project.runpytest_subprocess("--opspec-seed=3", *args).assert_outcomes(passed=3)
+        return [(project.path / f"drawn-{k}.txt").read_text() for k in range(3)]
+
+    alone = drawn("-p", "no:xdist")
+    assert drawn("-n", "2") == alone and len(set(alone)) == 3
+
+
 def test_a_failing_test_reports_its_seed(project: pytest.Pytester) -> None:
     project.makepyfile("""
         SPEC = "specs/dispenser.xpdl"
