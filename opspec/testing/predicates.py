@@ -88,6 +88,11 @@ def _runs(obj: Any) -> list[_Run]:
     if isinstance(obj, (str, os.PathLike)):               # a stored trace (opspec run --trace)
         from opspec.engine.trace_sinks import read_trace
 
+        if not os.path.isfile(obj):     # not a FileNotFoundError through the trace reader
+            raise ConfigurationError(
+                f"{os.fspath(obj)}: no trace file there (looked at {os.path.abspath(obj)})",
+                hint="a relative path is from the folder pytest runs in; write a trace with "
+                     "opspec run SPEC --trace FILE, or judge simulate()'s result itself")
         events = list(read_trace(os.fspath(obj)))
         return [_Run("", events, trace_end(events))]
     if isinstance(obj, Sequence) and all(isinstance(e, TraceEvent) for e in obj):
