@@ -288,11 +288,21 @@ def _check_offered(plan: Any, compiled: Any) -> None:
     """Refuse a step acting on an activity the spec's user lane is never offered (a device's
     ``dispense``): the scripted user plays that lane only, so the step would never be used
     and the run would go on as if it were not written."""
-    from opspec.engine.lanes import all_activities, user_offers
+    from opspec.engine.lanes import all_activities, user_lane, user_offers
     from opspec.errors import SourceLocation
 
     offered = user_offers(compiled)
+    lane = user_lane(compiled)
     for step in plan.steps:
+        alternatives = lane.choices.get(step.target)
+        if step.verb in ("complete", "choose") and alternatives and step.target not in lane.manual:
+            # completing the choice itself names no branch: the engine refused it mid-run
+            raise ConfigurationError(
+                f"the script's step '{step.verb} {step.target}' names the choice "
+                f"{step.target!r}, not one of its alternatives",
+                location=SourceLocation(plan.where),
+                hint=f"write e.g. (5, 'choose {alternatives[0]}'); its alternatives: "
+                     + ", ".join(alternatives))
         if step.verb == "raise" or step.target in offered:
             continue
         act = next(a for a in all_activities(compiled) if a.id == step.target)

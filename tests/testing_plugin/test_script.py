@@ -88,6 +88,19 @@ def test_a_step_on_an_activity_the_user_is_never_offered_is_refused(spec: object
         simulate(spec, script=[(10, action)], until=9 * 3600)  # type: ignore[arg-type]
 
 
+@pytest.mark.parametrize("action", ["choose_button", "choose choose_button"])
+def test_a_step_completing_a_choice_by_its_own_name_says_to_choose_an_alternative(
+        spec: object, action: str) -> None:
+    # was an ExecutionError mid-run: "call complete(item, choice=ACTIVITY_ID)"
+    with pytest.raises(ConfigurationError, match=(
+            r"<script>: the script's step '.*choose_button' names the choice "
+            r"'choose_button', not one of its alternatives; write e.g. \(5, 'choose "
+            r"press_report'\); its alternatives: press_report, press_wrong_button")):
+        simulate(spec, script=[(5, action)], until=9 * 3600)  # type: ignore[arg-type]
+    omitted = simulate(spec, script=[(5, "omit choose_button")], until=9 * 3600)  # type: ignore[arg-type]
+    assert omitted.value("alarms") == 2
+
+
 def test_steps_on_the_users_offers_choices_and_device_anchors_are_accepted(spec: object) -> None:
     result = simulate(spec, script=[("after sound_alarm 5s", "choose press_report"),  # type: ignore[arg-type]
                                     ("after dispense 5s", "take_pill"),
