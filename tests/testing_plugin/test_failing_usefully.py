@@ -110,3 +110,17 @@ def test_it(spec, simulate):
         "*expected alarms == 1", "*but alarms = 3", "*alarms: total=3",
         "*d1 08:00:00*sound_alarm", "*d1 08:05:00*sound_alarm",
         "*d1 08:10:00*sound_alarm", "*(seed *, 1 replication(s))"])
+
+
+def test_a_failing_test_shows_its_spec_argument_in_one_short_line(
+        project: pytest.Pytester) -> None:
+    # pytest shows a failing test's arguments: the spec's was 240 characters of its fields
+    result = _run(project, """
+def test_it(spec, simulate):
+    result = simulate(spec, script=[("never", "press_report")], until=9 * 3600)
+    assert result.value("doses_taken") == 1
+""")
+    result.assert_outcomes(failed=1)
+    result.stdout.fnmatch_lines([
+        "spec = <Package 'medication_dispenser' from */specs/dispenser.xpdl: 4 process(es)>"])
+    assert "extended_attribut" not in result.stdout.str()
