@@ -185,6 +185,9 @@ def assert_no_violations(result: Any, *monitors: str, limit: int = 3) -> None:
     """``AssertionError`` when a monitor (any, or those named by their text) fired in any
     replication, showing the report and the first violations with their events."""
     __tracebackhide__ = True
+    from opspec.testing.simulation import require_result
+
+    require_result(result, "assert_no_violations", "monitor_results")
     report = monitor_report(result)
     rows = report.rows if not monitors else tuple(report.row(m) for m in monitors)
     if not rows:
