@@ -13,6 +13,7 @@ import re
 import subprocess
 import sys
 import textwrap
+from collections.abc import Callable
 from pathlib import Path
 
 import pytest
@@ -172,3 +173,48 @@ def test_the_scenario_file_of_the_guide_passes(pytester: pytest.Pytester,
     (beside_the_spec / "dispenser.scenario.toml").write_text(text, encoding="utf-8")
     result = pytester.runpytest(str(beside_the_spec))
     result.assert_outcomes(passed=text.count("[[scenario]]"))
+
+
+# ---------------------------------------------------------------- the failures the guide shows
+PLAIN = re.compile(r"^```\n(expected .*?)^```", re.MULTILINE | re.DOTALL)
+PROMPT_EACH = [("each after trg_2 45s", "press_report")]
+
+
+def _failure(claim: Callable[[], object]) -> str:
+    """The message of the AssertionError ``claim`` raises, without its seed line (the guide
+    leaves it out)."""
+    with pytest.raises(AssertionError) as failed:
+        claim()
+    return re.sub(r"\n+\(seed \d+.*\)$", "", str(failed.value)) + "\n"
+
+
+def _shown_failures(dispenser: object) -> dict[str, Callable[[], object]]:
+    """The run and the claim behind each failure the guide shows, by its first line."""
+    from opspec.testing import assert_rate, check, expect, simulate, within
+
+    def run(**given: object) -> object:
+        return simulate(dispenser, **given)  # type: ignore[arg-type]
+
+    return {
+        "expected rate doses_taken/doses_due >= 0.99 with 95% confidence": lambda: expect(
+            run(users=10, script=PROMPT_EACH),
+            "rate doses_taken/doses_due >= 0.99 with 95% confidence"),
+        "expected never activity notify_caregiver": lambda: expect(
+            run(script=[("never", "press_report")], days=3), "never activity notify_caregiver"),
+        "expected within(sound_alarm, press_report, 60 s)": lambda: check(
+            run(script=[("after trg_2 90s", "press_report")], until=9 * 3600),
+            within("sound_alarm", "press_report", 60)),
+        "expected rate taken_rate >= 0.99 with 95% confidence": lambda: assert_rate(
+            run(users=3, script=PROMPT_EACH), "taken_rate", at_least=0.99),
+    }
+
+
+def test_the_failures_the_guide_shows_are_those_of_its_runs() -> None:
+    from opspec.engine.compiled import compile_package
+    from opspec.testing.simulation import load_spec_file
+
+    shown = PLAIN.findall(GUIDE.read_text(encoding="utf-8"))
+    claims = _shown_failures(compile_package(load_spec_file(DISPENSER)))
+    assert sorted(text.splitlines()[0] for text in shown) == sorted(claims)
+    for text in shown:
+        assert _failure(claims[text.splitlines()[0]]) == text
