@@ -359,7 +359,10 @@ def pytest_runtest_makereport(item: pytest.Item, call: pytest.CallInfo[None]
     lines = []
     if seed is not None and report.failed:
         base = item.config.getoption("--opspec-seed")
-        lines.append(f"seed {seed} (from --opspec-seed={base} and the test id; "
+        # the id is relative to the rootdir, which without a pytest configuration file
+        # follows the folder pytest runs in: say which, or a rerun from elsewhere differs
+        lines.append(f"seed {seed} (from --opspec-seed={base} and the test id "
+                     f"{item.nodeid!r}, relative to the rootdir {item.config.rootpath}; "
                      "simulate(seed=...) overrides it)")
     if report.when == "call":
         lines.extend(item.stash.get(_WARNED_KEY, {}))

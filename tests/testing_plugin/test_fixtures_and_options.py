@@ -158,6 +158,10 @@ def test_a_failing_test_reports_its_seed(project: pytest.Pytester) -> None:
     """)
     result = project.runpytest("--opspec-seed=11")
     result.stdout.fnmatch_lines(["*opspec*", "seed * (from --opspec-seed=11 and the test id*"])
+    # the id and the rootdir it is relative to: a rerun from another folder may differ
+    result.stdout.fnmatch_lines([
+        ("seed * (from --opspec-seed=11 and the test id 'test_a_failing_test_reports_its_seed.py"
+         f"::test_it', relative to the rootdir {project.path}; simulate(seed=...) overrides it)")])
 
 
 def test_device_url_skips_hardware_tests_without_it_and_passes_it_on(
