@@ -30,7 +30,7 @@ from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
 from typing import Any
 
-from opspec.errors import ConfigurationError
+from opspec.errors import ConfigurationError, OpspecError
 from opspec.properties.language import MonitorResult, Names, Property, Violation, clock
 from opspec.properties.monitors import Monitor, declared_monitors, parse_monitor
 from opspec.properties.vocabulary import (
@@ -133,8 +133,14 @@ class MonitorReport:
         return all(row.violations == 0 for row in self.rows)
 
     def row(self, monitor: str) -> MonitorRow:
+        """The row of ``monitor``: its text as the result has it, or the same property
+        spelt otherwise (``min_gap dispense 3h45m`` for ``min_gap dispense 3.75h``)."""
         for r in self.rows:
             if r.monitor == monitor:
+                return r
+        wanted = _canonical(monitor)
+        for r in self.rows:
+            if wanted is not None and _canonical(r.monitor) == wanted:
                 return r
         raise ConfigurationError(f"no monitor {monitor!r} in this result",
                                  hint="its monitors are: "
@@ -160,6 +166,14 @@ class MonitorReport:
                 lines.append(f"  ... {row.violations - min(limit, len(row.first))} more "
                              f"violation(s) of {row.monitor}")
         return "\n".join(lines)
+
+
+def _canonical(text: str) -> str | None:
+    """The property ``text`` reads as, in one spelling (None when it reads as none)."""
+    try:
+        return parse_monitor(text).describe()
+    except OpspecError:
+        return None
 
 
 def monitor_report(result: Any, confidence: float = 0.95) -> MonitorReport:
