@@ -21,7 +21,8 @@ Fixtures:
   instead of compared).
 
 Scenario files (``*.scenario.toml``, see :mod:`opspec.testing.scenario`) are collected as
-tests, one item per ``[[scenario]]``.
+tests, one item per ``[[scenario]]``. The warnings on the specs simulated are listed once at
+the end of the session (pytest-xdist workers hand theirs to the controller).
 """
 
 from __future__ import annotations
