@@ -11,7 +11,8 @@ one rule for each part of a run and hands the result to :func:`opspec.runs.build
   in :attr:`PreparedRun.warnings` for the door to show;
 * **the seed and the run length** — :mod:`opspec.run_rules`;
 * **the user lane** — ``script`` (a path, a :class:`~opspec.usermodels.scripts.Script` or its
-  steps; every name it uses must be the spec's), ``user_model`` (a preset, a TOML path or a
+  steps; every name it uses must be the spec's, and every activity it acts on one the user
+  lane is offered), ``user_model`` (a preset, a TOML path or a
   :class:`~opspec.usermodels.UserModel`, checked against the spec's user lane), ``user`` (a
   prepared :class:`~opspec.runs.User`: a person, a replay) or ``no_user``; with none of them,
   the spec's companion ``SPEC.users.toml`` when its file has one, else nobody
@@ -265,7 +266,8 @@ def user_model_warnings(model: Any, compiled: Any) -> tuple[Any, ...]:
 def scripted_user(script: Any, compiled: Any) -> User:
     """A scripted user (a script file's path, a Script or its steps), every activity and
     trigger it names checked against the spec ``compiled`` (a misspelt name would never
-    match an offer): ``opspec run --script``, the walkthrough's ``--replay``, ``simulate``."""
+    match an offer), and every activity a step acts on checked to be one the user lane is
+    offered: ``opspec run --script``, the walkthrough's ``--replay``, ``simulate``."""
     from opspec.engine.names import spec_names
     from opspec.runs import User
     from opspec.usermodels.scripts import Script, load_script, parse_script
@@ -278,7 +280,43 @@ def scripted_user(script: Any, compiled: Any) -> User:
         plan, describe = parse_script(script), "a script"
     names = spec_names(compiled)
     plan.check_names(names.activities, names.triggers)
+    _check_offered(plan, compiled)
     return User.script(plan, describe)
+
+
+def _check_offered(plan: Any, compiled: Any) -> None:
+    """Refuse a step acting on an activity the spec's user lane is never offered (a device's
+    ``dispense``): the scripted user plays that lane only, so the step would never be used
+    and the run would go on as if it were not written."""
+    from opspec.engine.lanes import all_activities, user_lane, user_offers
+    from opspec.errors import SourceLocation
+
+    offered = user_offers(compiled)
+    lane = user_lane(compiled)
+    for step in plan.steps:
+        alternatives = lane.choices.get(step.target)
+        if step.verb in ("complete", "choose") and alternatives and step.target not in lane.manual:
+            # completing the choice itself names no branch: the engine refused it mid-run
+            raise ConfigurationError(
+                f"the script's step '{step.verb} {step.target}' names the choice "
+                f"{step.target!r}, not one of its alternatives",
+                location=SourceLocation(plan.where),
+                hint=f"write e.g. (5, 'choose {alternatives[0]}'); its alternatives: "
+                     + ", ".join(alternatives))
+        if step.verb == "raise" or step.target in offered:
+            continue
+        act = next(a for a in all_activities(compiled) if a.id == step.target)
+        who = (f"lane {act.lane!r}" if act.lane else f"participant {act.participant!r}"
+               if act.participant else "the device")
+        yours = ", ".join(sorted(offered)) or "(none: the spec has no user lane)"
+        raise ConfigurationError(
+            f"the script's step '{step.verb} {step.target}' names activity {step.target!r}, "
+            f"which is never offered to the user ({who} performs it in process "
+            f"{act.process!r}), so the step would never be used",
+            location=SourceLocation(plan.where),
+            hint=f"a script plays the user lane, whose activities are: {yours}; to act "
+                 f"after {step.target}, time a step from it: "
+                 f"('after {step.target} 10s', 'ACTIVITY')")
 
 
 # ---------------------------------------------------------------------------- prepare

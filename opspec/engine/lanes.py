@@ -19,7 +19,7 @@ from opspec.engine.compiled import (
     CTransition,
 )
 
-__all__ = ["UserLane", "all_activities", "user_lane"]
+__all__ = ["UserLane", "all_activities", "user_lane", "user_offers"]
 
 
 @dataclass(frozen=True, slots=True)
@@ -94,3 +94,26 @@ def user_lane(compiled: CompiledPackage) -> UserLane:
                 if alternatives:
                     choices[act.id] = alternatives
     return UserLane(tuple(names) or ("user",), tuple(manual), choices)
+
+
+def user_offers(compiled: CompiledPackage) -> frozenset[str]:
+    """Ids of the activities a performer bound to the user lane (:attr:`UserLane.bind_names`)
+    can be offered: the manual activities and deferred choices whose participant or a lane is
+    one of those names, and the choices' alternatives. A script step naming any other
+    activity would never be used (``opspec.request.scripted_user`` refuses it)."""
+    bound = set(user_lane(compiled).bind_names)
+    out: set[str] = set()
+    for proc in compiled.processes.values():
+        stack = [proc.graph]
+        while stack:
+            graph = stack.pop()
+            for act in graph.activities:
+                if act.block is not None:
+                    stack.append(act.block)
+                if act.participant not in bound and not any(n in bound for n in act.lanes):
+                    continue
+                branches = _branches(act)
+                if act.kind == K_MANUAL or branches or act.labelled:
+                    out.add(act.id)
+                out.update(graph.activities[t.target].id for t in branches)
+    return frozenset(out)

@@ -78,6 +78,12 @@ class Package(Element):
     # opspec:MessageTTL: how long a message nobody waits for is kept (s); None: until caught
     message_ttl: float | None = None
 
+    def __repr__(self) -> str:
+        # the whole spec, field by field, is no one's reading: a failing test showed 240
+        # characters of it for its ``spec`` argument
+        where = f" from {self.source}" if self.source else ""
+        return f"<Package {self.id!r}{where}: {len(self.processes)} process(es)>"
+
     @property
     def source_format(self) -> str:
         """What the file was written in: ``"XPDL 2.1"``, ``"BPMN 2.0"``…"""

@@ -215,6 +215,14 @@ def _rate_counts(result: Any, metric: Any) -> tuple[int, int, str, str]:
                              f"pair, not {metric!r}")
 
 
+def _require(result: Any, who: str, needs: str) -> None:
+    __tracebackhide__ = True
+    # imported here: the numeric core stays free of the engine
+    from opspec.testing.simulation import require_result
+
+    require_result(result, who, needs)
+
+
 def _fail(decision: Decision, result: Any) -> None:
     __tracebackhide__ = True
     if decision.passed:
@@ -232,6 +240,8 @@ def assert_rate(result: Any, metric: str | tuple[Any, Any], *, at_least: float |
     counts (``"taken_ratio"``), a pair of count metrics (``("doses_taken", "doses_due")``),
     or a pair of ints. Returns the :class:`Decision` when it passes."""
     __tracebackhide__ = True
+    if not (isinstance(metric, tuple) and all(isinstance(x, int) for x in metric)):
+        _require(result, "assert_rate", "counts")
     _check_confidence(confidence)
     at_least, at_most = _target(at_least, at_most, None)
     if method not in RATE_METHODS:
@@ -271,6 +281,7 @@ def assert_mean(result: Any, metric: str, *, at_least: float | None = None,
     duration never observed) are left out of the mean, and the decision says how many: a
     mean over the successful runs only says nothing about how often runs fail."""
     __tracebackhide__ = True
+    _require(result, "assert_mean", "samples")
     at_least, at_most, bound, claim, level, sides = _claim(
         f"mean {metric}", confidence, at_least, at_most, between)
     values = result.samples(metric)
@@ -308,6 +319,7 @@ def assert_quantile(result: Any, metric: str, q: float, *, at_most: float | None
     """Assert the ``q``-quantile of every observation of a duration metric
     (``result.observations``) with the distribution-free order-statistic interval."""
     __tracebackhide__ = True
+    _require(result, "assert_quantile", "observations")
     at_least, at_most, bound, claim, level, sides = _claim(
         f"p{q * 100:g} {metric}", confidence, at_least, at_most, None)
     values = result.observations(metric)

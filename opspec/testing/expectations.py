@@ -53,7 +53,7 @@ from opspec.properties.language import (
     trace_end,
 )
 from opspec.properties.text_form import looks_like_property, read_property
-from opspec.testing.simulation import FIELDS, SimulationResult, SpecNames
+from opspec.testing.simulation import FIELDS, SimulationResult, SpecNames, require_result
 
 __all__ = ["Expectation", "expect", "format_events", "parse_expectation"]
 
@@ -317,6 +317,7 @@ def expect(result: SimulationResult, *lines: str) -> None:
     A line naming something the spec lacks raises :class:`ConfigurationError` listing the
     names it has."""
     __tracebackhide__ = True     # pytest: the failure is the test's line, not ours
+    require_result(result, "expect", "names")
     failures = []
     for line in lines:
         expectation = parse_expectation(line, where="expect()")

@@ -30,7 +30,7 @@ from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
 from typing import Any
 
-from opspec.errors import ConfigurationError
+from opspec.errors import ConfigurationError, OpspecError
 from opspec.properties.language import MonitorResult, Names, Property, Violation, clock
 from opspec.properties.monitors import Monitor, declared_monitors, parse_monitor
 from opspec.properties.vocabulary import (
@@ -133,8 +133,14 @@ class MonitorReport:
         return all(row.violations == 0 for row in self.rows)
 
     def row(self, monitor: str) -> MonitorRow:
+        """The row of ``monitor``: its text as the result has it, or the same property
+        spelt otherwise (``min_gap dispense 3h45m`` for ``min_gap dispense 3.75h``)."""
         for r in self.rows:
             if r.monitor == monitor:
+                return r
+        wanted = _canonical(monitor)
+        for r in self.rows:
+            if wanted is not None and _canonical(r.monitor) == wanted:
                 return r
         raise ConfigurationError(f"no monitor {monitor!r} in this result",
                                  hint="its monitors are: "
@@ -162,6 +168,14 @@ class MonitorReport:
         return "\n".join(lines)
 
 
+def _canonical(text: str) -> str | None:
+    """The property ``text`` reads as, in one spelling (None when it reads as none)."""
+    try:
+        return parse_monitor(text).describe()
+    except OpspecError:
+        return None
+
+
 def monitor_report(result: Any, confidence: float = 0.95) -> MonitorReport:
     """The monitor report of a :class:`~opspec.testing.simulation.SimulationResult`."""
     outcomes: Sequence[MonitorResult] = result.monitor_results
@@ -185,6 +199,9 @@ def assert_no_violations(result: Any, *monitors: str, limit: int = 3) -> None:
     """``AssertionError`` when a monitor (any, or those named by their text) fired in any
     replication, showing the report and the first violations with their events."""
     __tracebackhide__ = True
+    from opspec.testing.simulation import require_result
+
+    require_result(result, "assert_no_violations", "monitor_results")
     report = monitor_report(result)
     rows = report.rows if not monitors else tuple(report.row(m) for m in monitors)
     if not rows:

@@ -21,7 +21,8 @@ Fixtures:
   instead of compared).
 
 Scenario files (``*.scenario.toml``, see :mod:`opspec.testing.scenario`) are collected as
-tests, one item per ``[[scenario]]``.
+tests, one item per ``[[scenario]]``. The warnings on the specs simulated are listed once at
+the end of the session (pytest-xdist workers hand theirs to the controller).
 """
 
 from __future__ import annotations
@@ -41,7 +42,9 @@ __all__ = [
     "pytest_addoption",
     "pytest_collect_file",
     "pytest_configure",
+    "pytest_sessionfinish",
     "pytest_terminal_summary",
+    "pytest_testnodedown",
     "simulator_for",
 ]
 
@@ -140,7 +143,10 @@ def _compiled_for(package: Any, config: pytest.Config) -> Any:
 
 @pytest.fixture
 def spec(request: pytest.FixtureRequest) -> Any:
-    """The spec of ``@pytest.mark.spec(path)`` or the module's ``SPEC``."""
+    """The spec (a :class:`~opspec.model.Package`) named by ``@pytest.mark.spec("path")`` on
+    the test, class or module, else by a module-level ``SPEC = "path"``: a path next to the
+    test file or under the rootdir, loaded once per session; a spec ``opspec validate``
+    refuses fails the test with its ``path:line`` message. Guide: docs/spec-testing.md."""
     marker = request.node.get_closest_marker("spec")
     ref: Any = None
     if marker is not None:
@@ -162,7 +168,9 @@ def spec(request: pytest.FixtureRequest) -> Any:
 
 @pytest.fixture
 def opspec_seed(request: pytest.FixtureRequest) -> int:
-    """The test's seed: ``--opspec-seed`` mixed with the test id."""
+    """The test's seed, the one ``simulate`` uses unless given ``seed=``: ``--opspec-seed``
+    (default 0) mixed with the test id, so each test draws differently and reproducibly (the
+    same on every machine and number of xdist workers); a failing test's report shows it."""
     from opspec.testing.simulation import derive_seed
 
     seed = derive_seed(request.config.getoption("--opspec-seed"), request.node.nodeid)
@@ -194,11 +202,17 @@ class Simulator:
                  script: Any = None, user_model: Any = None, seed: int | None = None,
                  until: float | None = None, engine_config: Any = None,
                  **options: Any) -> Any:
+        __tracebackhide__ = True            # a failure is the test's line, not this frame
         from opspec.testing.simulation import simulate
 
         if spec is None:
             pytest.fail("simulate() needs a spec: simulate(spec, ...) with the 'spec' fixture "
                         "or a path", pytrace=False)
+        takes = _simulate_takes(simulate)
+        unknown = [name for name in options if name not in takes]
+        if unknown:
+            pytest.fail(f"{self._calling_line()}{_unknown_options(unknown, takes)}",
+                        pytrace=False)
         if isinstance(spec, (str, Path)):
             spec = load_cached(resolve_path(spec, self.config, self.near,
                                             "fix the spec path given to simulate()"),
@@ -217,16 +231,61 @@ class Simulator:
                               user_model=user_model, seed=self.seed if seed is None else seed,
                               until=until, engine_config=engine_config, **options)
         except OpspecError as error:
-            problem = f"simulate(): {error}"
+            problem = f"{self._calling_line()}simulate(): {error}"
         else:
             _warned(self.node, self.config, result)
             return result
         pytest.fail(problem, pytrace=False)     # outside the except: the message once
 
+    def _calling_line(self) -> str:
+        """``test_x.py:12: result = simulate(...)`` and a new line: the line of the test
+        file that called (a test may simulate several times), or nothing when none did."""
+        import linecache
+        import sys
+
+        frame = sys._getframe(1)
+        while frame is not None:
+            if self.near is not None and Path(frame.f_code.co_filename) == self.near:
+                line = linecache.getline(frame.f_code.co_filename, frame.f_lineno).strip()
+                return f"{self.near.name}:{frame.f_lineno}: {line}\n"
+            frame = frame.f_back  # type: ignore[assignment]
+        return ""
+
+
+def _simulate_takes(simulate: Any) -> tuple[str, ...]:
+    """The arguments of ``simulate`` (what the fixture passes on), in its order."""
+    import inspect
+
+    return tuple(inspect.signature(simulate).parameters)
+
+
+def _unknown_options(unknown: Sequence[str], takes: Sequence[str]) -> str:
+    """What to say of keywords ``simulate`` does not take (a misspelt ``user=`` was a
+    ``TypeError`` through the plugin's frame)."""
+    import difflib
+
+    lines = []
+    for name in unknown:
+        close = difflib.get_close_matches(name, takes, n=1)
+        lines.append(f"simulate() has no argument {name!r}"
+                     + (f": did you mean {close[0]}=?" if close else ""))
+    lines.append(f"it takes: {', '.join(takes)} (docs/spec-testing.md, Fixtures)")
+    return "\n".join(lines)
+
 
 @pytest.fixture
 def simulate(request: pytest.FixtureRequest, opspec_seed: int) -> Simulator:
-    """Run a spec; see :class:`Simulator`."""
+    """``simulate(spec, users=1, days=None, until=None, script=None, user_model=None,
+    seed=None, ...)`` -> ``SimulationResult``: run ``spec`` (the ``spec`` fixture or a path)
+    for ``users`` simulated users, each scripted (``script=[("after trg_2 90s",
+    "press_report")]``) or drawn from a user model (``user_model="x.users.toml"``), for
+    ``days`` or ``until`` seconds, seeded with the test's seed (``opspec_seed``); paths are
+    next to the test file or under the rootdir. Check the result with ``expect``, ``check``
+    or ``assert_rate`` (opspec.testing). Guide: docs/spec-testing.md.
+
+    The other arguments are those of :func:`opspec.testing.simulate` (``monitors``,
+    ``no_user``, ``params``, ``performers``, ``keep_trace``, ``engine_config``,
+    ``branches``); see :class:`Simulator`."""
     return Simulator(request.config, request.node.path, opspec_seed, request.node)
 
 
@@ -246,7 +305,8 @@ def simulator_for(request: pytest.FixtureRequest) -> Simulator:
 
 @pytest.fixture
 def regen_golden(request: pytest.FixtureRequest) -> bool:
-    """True when ``--opspec-regen-golden`` was given."""
+    """True when ``--opspec-regen-golden`` was given (golden traces are written instead of
+    compared)."""
     return bool(request.config.getoption("--opspec-regen-golden"))
 
 
@@ -300,12 +360,31 @@ def pytest_runtest_makereport(item: pytest.Item, call: pytest.CallInfo[None]
     lines = []
     if seed is not None and report.failed:
         base = item.config.getoption("--opspec-seed")
-        lines.append(f"seed {seed} (from --opspec-seed={base} and the test id; "
+        # the id is relative to the rootdir, which without a pytest configuration file
+        # follows the folder pytest runs in: say which, or a rerun from elsewhere differs
+        lines.append(f"seed {seed} (from --opspec-seed={base} and the test id "
+                     f"{item.nodeid!r}, relative to the rootdir {item.config.rootpath}; "
                      "simulate(seed=...) overrides it)")
     if report.when == "call":
         lines.extend(item.stash.get(_WARNED_KEY, {}))
     if lines:
         report.sections.append(("opspec", "\n".join(lines)))
+
+
+def pytest_sessionfinish(session: pytest.Session) -> None:
+    """On a pytest-xdist worker: hand the warnings it saw to the controller, which prints the
+    session's (its terminal summary is the only one shown; with ``-n 2`` they were lost)."""
+    output = getattr(session.config, "workeroutput", None)
+    if output is not None:
+        output["opspec_warned"] = list(session.config.stash.get(_WARNED_KEY, {}))
+
+
+@pytest.hookimpl(optionalhook=True)
+def pytest_testnodedown(node: Any, error: Any) -> None:
+    """On the pytest-xdist controller: a worker's warnings join the session's."""
+    warned = node.config.stash.setdefault(_WARNED_KEY, {})
+    for line in getattr(node, "workeroutput", {}).get("opspec_warned", ()):
+        warned[line] = None
 
 
 def pytest_terminal_summary(terminalreporter: Any) -> None:

@@ -70,7 +70,8 @@ class _Run:
 
 
 # ---------------------------------------------------------------- judging results
-def _runs(obj: Any) -> list[_Run]:
+def _runs(obj: Any, who: str) -> list[_Run]:
+    __tracebackhide__ = True
     from opspec.engine.simulation import RunResult
 
     if isinstance(obj, RunResult):
@@ -88,12 +89,19 @@ def _runs(obj: Any) -> list[_Run]:
     if isinstance(obj, (str, os.PathLike)):               # a stored trace (opspec run --trace)
         from opspec.engine.trace_sinks import read_trace
 
+        if not os.path.isfile(obj):     # not a FileNotFoundError through the trace reader
+            raise ConfigurationError(
+                f"{os.fspath(obj)}: no trace file there (looked at {os.path.abspath(obj)})",
+                hint="a relative path is from the folder pytest runs in; write a trace with "
+                     "opspec run SPEC --trace FILE, or judge simulate()'s result itself")
         events = list(read_trace(os.fspath(obj)))
         return [_Run("", events, trace_end(events))]
     if isinstance(obj, Sequence) and all(isinstance(e, TraceEvent) for e in obj):
         return [_Run("", obj, trace_end(obj))]
-    raise TypeError("expected a SimulationResult, a RunResult, a sequence of TraceEvent or the "
-                    f"path of a JSON Lines trace, not {type(obj).__name__}")
+    from opspec.testing.simulation import not_a_result
+
+    raise not_a_result(obj, who, "a SimulationResult, a RunResult, a sequence of TraceEvent or "
+                                 "the path of a JSON Lines trace")
 
 
 def _end(trace: Sequence[TraceEvent]) -> float:
@@ -125,16 +133,17 @@ def check_names(predicate: Predicate, names: Any) -> None:
 
 
 def failures(obj: Any, predicate: Predicate | str | Match, *, spec: Any = None,
-             first: bool = True) -> list[str]:
+             first: bool = True, who: str = "failures") -> list[str]:
     """The failure messages of ``predicate`` on each trace of ``obj`` (the first only, by
-    default); empty when it holds."""
+    default); empty when it holds. ``who`` names the caller in a wrong argument's error."""
+    __tracebackhide__ = True
     predicate = as_predicate(predicate)
     names = _names(obj, spec)
     if names is not None:
         check_names(predicate, names)
         predicate = predicate.bind(names)
     out = []
-    for run in _runs(obj):
+    for run in _runs(obj, who):
         failure = predicate.fail(run.events, run.end)
         if failure is None:
             continue
@@ -150,14 +159,17 @@ def failures(obj: Any, predicate: Predicate | str | Match, *, spec: Any = None,
 def holds(obj: Any, predicate: Predicate | str | Match, *, spec: Any = None) -> bool:
     """Whether ``predicate`` holds on every trace of ``obj``. Names the spec lacks raise
     :class:`ConfigurationError` (they are a mistake in the test, not a failed claim)."""
-    return not failures(obj, predicate, spec=spec)
+    __tracebackhide__ = True
+    return not failures(obj, predicate, spec=spec, who="holds")
 
 
 def check(obj: Any, *predicates: Predicate | str | Match, spec: Any = None) -> None:
     """Assert every predicate on ``obj``; ``AssertionError`` with each failure's claim,
     reason and trace slice."""
     __tracebackhide__ = True
-    messages = [m for p in predicates for m in failures(obj, p, spec=spec)]
+    messages = []
+    for predicate in predicates:     # a loop, not a comprehension: no frame of ours shown
+        messages.extend(failures(obj, predicate, spec=spec, who="check"))
     if messages:
         seed = getattr(obj, "seed", None)
         if seed is not None and hasattr(obj, "replications"):

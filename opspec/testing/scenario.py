@@ -187,11 +187,12 @@ def load_scenarios(path: str | Path, *, rootdir: Path | None = None) -> Scenario
         raise _error(path, "spec", f"spec {ref!r} not found",
                      "a path relative to this file or the rootdir")
     from opspec.engine.compiled import compile_package
-    from opspec.request import open_gated
+    from opspec.request import open_gated, scripted_user
     from opspec.testing.simulation import spec_names
 
     try:
-        names = spec_names(compile_package(open_gated(spec_path)[0]))
+        compiled = compile_package(open_gated(spec_path)[0])
+        names = spec_names(compiled)
     except OpspecError as error:
         raise _error(path, "spec", f"the spec does not load: {error}") from None
     defaults = _given(path, "given", document.get("given", {}), rootdir)
@@ -232,8 +233,8 @@ def load_scenarios(path: str | Path, *, rootdir: Path | None = None) -> Scenario
             expectations.append(expectation)
         script = given.get("script")
         if isinstance(script, Script):
-            try:
-                script.check_names(names.activities, names.triggers)
+            try:     # the names it uses, and that each step acts on an offer of the user's
+                scripted_user(script, compiled)
             except ConfigurationError as error:
                 raise _error(path, f"{key}.given.script", error.message, error.hint) from None
         if script is not None and "user_model" in given:

@@ -54,6 +54,8 @@ __all__ = [
     "SpecNames",
     "derive_seed",
     "load_spec_file",
+    "not_a_result",
+    "require_result",
     "simulate",
     "spec_names",
 ]
@@ -67,6 +69,29 @@ def derive_seed(base: int, text: str) -> int:
     """A seed mixing ``base`` with ``text`` (a test id): independent per test, reproducible,
     stable across processes and Python versions (CRC-32, not ``hash``)."""
     return (int(base) * 1_000_003 + zlib.crc32(text.encode("utf-8"))) % 2**63
+
+
+def not_a_result(obj: Any, who: str,
+                 takes: str = "a SimulationResult (what simulate() returns)") -> TypeError:
+    """The error of ``who`` (``expect``, ``check``...) given something it cannot judge: the
+    spec, or the ``simulate`` fixture itself (not called), are the usual slips; say what to
+    write instead of an ``AttributeError`` from inside opspec."""
+    kind = type(obj).__name__
+    if isinstance(obj, (Package, CompiledPackage)) or kind == "LoadedSpec":
+        return TypeError(f"{who}() judges a run, not the spec ({kind}): write "
+                         f"{who}(simulate(spec, ...), ...)")
+    if kind == "Simulator":
+        return TypeError(f"{who}() judges what simulate() returns, not the simulate fixture "
+                         f"itself: call it, {who}(simulate(spec, ...), ...)")
+    return TypeError(f"{who}() judges {takes}, not {kind}")
+
+
+def require_result(obj: Any, who: str, needs: str) -> None:
+    """Raise :func:`not_a_result` unless ``obj`` has ``needs`` (what ``who`` reads of a
+    :class:`SimulationResult`)."""
+    __tracebackhide__ = True
+    if not hasattr(obj, needs):
+        raise not_a_result(obj, who)
 
 
 def load_spec_file(path: str | Path) -> Package:

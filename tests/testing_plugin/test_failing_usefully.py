@@ -110,3 +110,48 @@ def test_it(spec, simulate):
         "*expected alarms == 1", "*but alarms = 3", "*alarms: total=3",
         "*d1 08:00:00*sound_alarm", "*d1 08:05:00*sound_alarm",
         "*d1 08:10:00*sound_alarm", "*(seed *, 1 replication(s))"])
+
+
+def test_a_failing_test_shows_its_spec_argument_in_one_short_line(
+        project: pytest.Pytester) -> None:
+    # pytest shows a failing test's arguments: the spec's was 240 characters of its fields
+    result = _run(project, """
+def test_it(spec, simulate):
+    result = simulate(spec, script=[("never", "press_report")], until=9 * 3600)
+    assert result.value("doses_taken") == 1
+""")
+    result.assert_outcomes(failed=1)
+    result.stdout.fnmatch_lines([
+        "spec = <Package 'medication_dispenser' from */specs/dispenser.xpdl: 4 process(es)>"])
+    assert "extended_attribut" not in result.stdout.str()
+
+
+def test_judging_the_spec_or_the_uncalled_fixture_says_to_call_simulate(
+        project: pytest.Pytester) -> None:
+    # were an AttributeError ('Package' object has no attribute 'names') or a TypeError
+    # raised inside opspec, shown with opspec's source
+    result = _run(project, """
+from opspec.testing import assert_rate, check
+
+def test_expect_on_the_spec(spec):
+    expect(spec, "doses_taken == 1")
+
+def test_a_rate_of_the_fixture(simulate):
+    assert_rate(simulate, "taken_rate", at_least=0.9)
+
+def test_a_predicate_on_the_fixture(simulate):
+    check(simulate, "never dispense")
+
+def test_a_predicate_on_a_number():
+    check(42, "never dispense")
+""", "-rN")
+    result.assert_outcomes(failed=4)
+    result.stdout.fnmatch_lines([
+        ("E * TypeError: expect() judges a run, not the spec (Package): write "
+         "expect(simulate(spec, ...), ...)"),
+        ("E * TypeError: assert_rate() judges what simulate() returns, not the simulate fixture "
+         "itself: call it, assert_rate(simulate(spec, ...), ...)"),
+        "E * TypeError: check() judges what simulate() returns, not the simulate fixture itself*",
+        "E * TypeError: check() judges a SimulationResult, a RunResult, *, not int"])
+    out = result.stdout.str()
+    assert "opspec/testing/" not in out and "AttributeError" not in out

@@ -117,6 +117,37 @@ def test_the_seed_option_makes_runs_reproducible_and_tests_independent(
     assert first["one"] != other["one"]          # and the base seed matters
 
 
+def test_the_same_seed_gives_the_same_runs_whatever_the_number_of_xdist_workers(
+        project: pytest.Pytester) -> None:
+    # each test writes what it drew (a worker's prints are not shown)
+    project.makepyfile(test_drawn="""
+        import pytest
+        from opspec.testing import simulator_for
+
+        SPEC = "specs/dispenser.xpdl"
+        USERS = "specs/dispenser.users.toml"
+
+        @pytest.fixture(scope="module")
+        def shared(request):
+            return simulator_for(request)(SPEC, users=3, user_model=USERS)
+
+        @pytest.mark.parametrize("k", range(3))
+        def test_drawn(spec, simulate, shared, k, request):
+            result = simulate(spec, users=3, user_model=USERS)
+            line = (request.node.name, result.seed, result.samples("report_latency_s"),
+                    shared.seed, shared.samples("report_latency_s"))
+            with open(f"drawn-{k}.txt", "w") as out:
+                out.write(repr(line))
+    """)
+
+    def drawn(*args: str) -> list[str]:
+        project.runpytest_subprocess("--opspec-seed=3", *args).assert_outcomes(passed=3)
+        return [(project.path / f"drawn-{k}.txt").read_text() for k in range(3)]
+
+    alone = drawn("-p", "no:xdist")
+    assert drawn("-n", "2") == alone and len(set(alone)) == 3
+
+
 def test_a_failing_test_reports_its_seed(project: pytest.Pytester) -> None:
     project.makepyfile("""
         SPEC = "specs/dispenser.xpdl"
@@ -127,6 +158,10 @@ def test_a_failing_test_reports_its_seed(project: pytest.Pytester) -> None:
     """)
     result = project.runpytest("--opspec-seed=11")
     result.stdout.fnmatch_lines(["*opspec*", "seed * (from --opspec-seed=11 and the test id*"])
+    # the id and the rootdir it is relative to: a rerun from another folder may differ
+    result.stdout.fnmatch_lines([
+        ("seed * (from --opspec-seed=11 and the test id 'test_a_failing_test_reports_its_seed.py"
+         f"::test_it', relative to the rootdir {project.path}; simulate(seed=...) overrides it)")])
 
 
 def test_device_url_skips_hardware_tests_without_it_and_passes_it_on(
@@ -151,3 +186,51 @@ def test_the_options_are_in_pytest_help(pytester: pytest.Pytester) -> None:
     text = pytester.runpytest("--help").stdout.str()
     for option in ("--opspec-seed", "--opspec-regen-golden", "--device-url", "--device-profile"):
         assert re.search(rf"^\s+{option}", text, re.MULTILINE), option
+
+
+def test_the_fixtures_say_what_they_give_in_pytest_fixtures(pytester: pytest.Pytester) -> None:
+    # `pytest --fixtures` shows a fixture's first paragraph: simulate's said only "see
+    # Simulator", a class a test author never sees
+    text = pytester.runpytest("--fixtures").stdout.str()
+    shown = dict(re.findall(r"^(\w+) -- .*\n((?:    .*\n)+)", text, re.MULTILINE))
+    assert "simulate(spec, users=1, days=None, until=None, script=None" in shown["simulate"]
+    assert "SimulationResult" in shown["simulate"]
+    assert 'SPEC = "path"' in shown["spec"] and "@pytest.mark.spec" in shown["spec"]
+    assert "--opspec-seed" in shown["opspec_seed"]
+
+
+def test_a_misspelt_argument_of_simulate_is_named_with_the_test_line(
+        project: pytest.Pytester) -> None:
+    # was a TypeError shown through the plugin's own frame (its source and locals)
+    project.makepyfile(test_misspelt="""
+        SPEC = "specs/dispenser.xpdl"
+
+        def test_it(spec, simulate):
+            simulate(spec, until=3600)
+            simulate(spec, user=3, montors=["never dispense"])
+    """)
+    result = project.runpytest("-rN")
+    result.assert_outcomes(failed=1)
+    result.stdout.fnmatch_lines([
+        "test_misspelt.py:5: simulate(spec, user=3, montors=[[]\"never dispense\"[]])",
+        "simulate() has no argument 'user': did you mean users=?",
+        "simulate() has no argument 'montors': did you mean monitors=?",
+        "it takes: spec, users, days, until, script, user_model, seed, engine_config, *"])
+    out = result.stdout.str()
+    assert "TypeError" not in out and "opspec/testing/" not in out
+
+
+def test_a_failing_simulate_call_names_the_line_that_made_it(project: pytest.Pytester) -> None:
+    # a test that simulates several times: which call was refused
+    project.makepyfile(test_two_calls="""
+        SPEC = "specs/dispenser.xpdl"
+
+        def test_it(spec, simulate):
+            simulate(spec, script=[("never", "press_report")], until=3600)
+            simulate(spec, script=[("never", "press_reprot")], until=3600)
+    """)
+    result = project.runpytest("-rN")
+    result.assert_outcomes(failed=1)
+    result.stdout.fnmatch_lines([
+        "test_two_calls.py:5: simulate(spec, script=[[](\"never\", \"press_reprot\")[]], *",
+        "simulate(): <script>: the script names activity 'press_reprot'*"])

@@ -105,6 +105,11 @@ BAD = {
                                 'given = { script = [["never", "report"]] }\n'
                                 'then = ["alarms == 1"]\n'),
                                 "scenario[0].given.script: the script names activity 'report'*"),
+    "script-step-on-a-device-activity": (
+        ('spec = "specs/dispenser.xpdl"\n[[scenario]]\nname = "x"\n'
+         'given = { script = [["10s", "dispense"]] }\nthen = ["alarms == 1"]\n'),
+        ("scenario[0].given.script: the script's step 'complete dispense' names activity "
+         "'dispense', which is never offered to the user (lane 'device' performs it*")),
     "negative-users": (('spec = "specs/dispenser.xpdl"\n[[scenario]]\nname = "x"\n'
                        'given = { users = 0 }\nthen = ["alarms == 1"]\n'),
                        "scenario[0].given.users: users must be a whole number >= 1, not 0"),

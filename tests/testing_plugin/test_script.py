@@ -74,6 +74,40 @@ def test_unknown_names_are_listed_against_the_spec(spec: object) -> None:
                  until=60)
 
 
+@pytest.mark.parametrize("action", ["dispense", "omit record_missed", "fail notify_caregiver"])
+def test_a_step_on_an_activity_the_user_is_never_offered_is_refused(spec: object,
+                                                                    action: str) -> None:
+    # the scripted user plays the user lane: a step on the device's dispense would never be
+    # used, and the run went on as if it were not written (the dose taken all the same)
+    target = action.split()[-1]
+    with pytest.raises(ConfigurationError, match=(
+            rf"step '.*{target}' names activity '{target}', which is never offered to the "
+            r"user \(lane 'device' performs it in process 'notify_workflow'\), so the step "
+            r"would never be used.*the user lane, whose activities are: choose_button, "
+            r"hear_alarm, press_report, press_wrong_button, take_pill, walk_to_dispenser")):
+        simulate(spec, script=[(10, action)], until=9 * 3600)  # type: ignore[arg-type]
+
+
+@pytest.mark.parametrize("action", ["choose_button", "choose choose_button"])
+def test_a_step_completing_a_choice_by_its_own_name_says_to_choose_an_alternative(
+        spec: object, action: str) -> None:
+    # was an ExecutionError mid-run: "call complete(item, choice=ACTIVITY_ID)"
+    with pytest.raises(ConfigurationError, match=(
+            r"<script>: the script's step '.*choose_button' names the choice "
+            r"'choose_button', not one of its alternatives; write e.g. \(5, 'choose "
+            r"press_report'\); its alternatives: press_report, press_wrong_button")):
+        simulate(spec, script=[(5, action)], until=9 * 3600)  # type: ignore[arg-type]
+    omitted = simulate(spec, script=[(5, "omit choose_button")], until=9 * 3600)  # type: ignore[arg-type]
+    assert omitted.value("alarms") == 2
+
+
+def test_steps_on_the_users_offers_choices_and_device_anchors_are_accepted(spec: object) -> None:
+    result = simulate(spec, script=[("after sound_alarm 5s", "choose press_report"),  # type: ignore[arg-type]
+                                    ("after dispense 5s", "take_pill"),
+                                    ("at 08:30", "raise trg_1")], until=9 * 3600)
+    assert result.value("doses_taken") == 1
+
+
 def test_a_script_file_reads_pairs_and_tables(tmp_path: Path, spec: object) -> None:
     path = tmp_path / "late.toml"
     path.write_text('otherwise = "complete"\nsteps = [\n  ["after trg_2 120s", "press_report"],\n'

@@ -96,3 +96,24 @@ def test_a_scenario_file_over_faulted_runs_fails_naming_the_fault(
     result.stdout.fnmatch_lines([
         "*scenario[[]0[]]: * of 6 replication(s) failed*",
         "*replication *: fault: *dispenser.xpdl:*: activity 'R'*division by zero*"])
+
+
+def test_a_spec_warning_is_shown_at_the_end_of_a_session_run_on_xdist_workers(
+        project: pytest.Pytester) -> None:
+    # with -n 2 the workers saw the warnings and the controller printed none
+    _with_warning(project)
+    project.makepyfile('''
+SPEC = "specs/warned.xpdl"
+
+def test_runs(spec, simulate):
+    assert simulate(spec, until=3600, no_user=True).runs
+
+def test_runs_too(spec, simulate):
+    assert simulate(spec, until=3600, no_user=True).runs
+''')
+    result = project.runpytest_subprocess("-n", "2")
+    result.assert_outcomes(passed=2)
+    result.stdout.fnmatch_lines([
+        "*= opspec: warnings on the specs simulated =*",
+        "*warned.xpdl:79: warning: activity set 'never_used'*"])
+    assert result.stdout.str().count("activity set 'never_used'") == 1

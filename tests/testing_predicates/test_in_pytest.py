@@ -52,6 +52,24 @@ def test_typo(spec, simulate):
     assert "Traceback" not in result.stdout.str()
 
 
+def test_a_trace_file_that_is_not_there_is_named_with_the_place_looked_at(
+        pytester: pytest.Pytester) -> None:
+    # was a FileNotFoundError through the predicates' and the trace reader's frames
+    result = _run(pytester, '''
+from opspec.testing import holds
+
+def test_stored(spec):
+    assert holds("runs/monday.jsonl", "never notify_caregiver", spec=spec)
+''')
+    result.assert_outcomes(failed=1)
+    result.stdout.fnmatch_lines([
+        "test_spec.py:*: assert holds(\"runs/monday.jsonl\", \"never notify_caregiver\", spec=spec)",
+        (f"ConfigurationError: runs/monday.jsonl: no trace file there (looked at "
+         f"{pytester.path}/runs/monday.jsonl); a relative path is from the folder pytest "
+         "runs in; write a trace with opspec run SPEC --trace FILE*")])
+    assert "FileNotFoundError" not in result.stdout.str()
+
+
 def test_too_few_users_for_a_rate_say_how_many_are_needed(pytester: pytest.Pytester) -> None:
     result = _run(pytester, '''
 def test_rate(spec, simulate):

@@ -92,6 +92,24 @@ def test_the_4_hour_gap_is_broken_by_a_late_then_prompt_report_and_3h45m_is_not(
     assert_no_violations(result, "min_gap dispense 225 min")
 
 
+def test_a_monitor_is_named_by_any_spelling_of_its_property(
+        dispenser: CompiledPackage) -> None:
+    # by its text only, "min_gap dispense 3h45m" was "no monitor" in a result watching
+    # min_gap("dispense", minutes=225) (whose text is "min_gap dispense 3.75h")
+    result = simulate(dispenser, script=LATE_THEN_PROMPT, days=1,
+                      monitors=[min_gap("dispense", minutes=225), "min_gap dispense 4h"])
+    for same in ("min_gap dispense 3h45m", "never dispense twice within 225 min",
+                 "MIN_GAP dispense PT3H45M"):
+        assert_no_violations(result, same)
+    assert result.monitor_report().row("min_gap dispense 240min").violations == 1
+    with pytest.raises(AssertionError, match="min_gap dispense 4h: 1 violation"):
+        assert_no_violations(result, "never dispense twice within 4 h")
+    with pytest.raises(ConfigurationError, match=r"no monitor 'min_gap dispense 3h' in this "
+                                                 r"result \(its monitors are: min_gap "
+                                                 r"dispense 3.75h, min_gap dispense 4h\)"):
+        assert_no_violations(result, "min_gap dispense 3h")
+
+
 def test_python_constructors_build_the_same_monitors_as_the_text_form() -> None:
     assert min_gap("dispense", hours=4) == parse_monitor("min_gap dispense 4h")
     assert within("a", "b", 60) == BoundedResponse(
