@@ -331,9 +331,24 @@ def prepare(request: RunRequest) -> PreparedRun:
         loaded = _with_branches(loaded, request.branches)
         spec_warnings = loaded.warnings
     horizon = run_length(loaded.compiled, days=request.days, until=request.until)
+    if request.params:
+        _check_params(request.params, loaded.package)
     user, user_warnings, named = _user(request, loaded, path)
     return PreparedRun(request, loaded, seed, horizon, user,
                        (*spec_warnings, *user_warnings), path, named)
+
+
+def _check_params(params: Mapping[str, Any], package: Any) -> None:
+    """Every name of the API's ``params`` is a package data field, as ``--param`` checks: the
+    run writes the value into the package's data, where nothing reads an undeclared name
+    (and a process's own field of that name hides it), so a misspelt one would change
+    nothing and say nothing."""
+    from opspec.run_inputs import no_such_field
+
+    declared = {f.id for f in package.data_fields}
+    for name in params:
+        if name not in declared:
+            raise no_such_field(str(name), package, "params")
 
 
 def run(spec: Any, *, seed: Any = 0, days: Any = None, until: Any = None,

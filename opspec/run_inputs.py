@@ -14,6 +14,7 @@ new run input changes no other draw.
 
 from __future__ import annotations
 
+import difflib
 import math
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
@@ -21,8 +22,27 @@ from typing import Any
 
 from opspec.distributions import make_distribution
 from opspec.engine.random import named_stream
+from opspec.errors import ConfigurationError
+from opspec.model import Package
 
-__all__ = ["RunInputs"]
+__all__ = ["RunInputs", "no_such_field"]
+
+
+def no_such_field(name: str, package: Package, where: str) -> ConfigurationError:
+    """The error for a value given to ``name``, which is not a package data field of
+    ``package`` (what ``--param``, ``--params`` and the API's ``params`` may set: a run's value
+    for anything else would be set nowhere anyone reads it), with the closest name."""
+    fields = [f.id for f in package.data_fields]
+    inputs = [f.id for f in package.data_fields
+              if any(e.name == "opspec:RunInput" for e in f.extended_attributes)]
+    close = difflib.get_close_matches(name, fields, n=1)
+    known = (f"its run inputs: {', '.join(inputs)}" if inputs else
+             f"its package data fields: {', '.join(fields)}" if fields else
+             "it has no package data fields")
+    return ConfigurationError(
+        f"{where}: the spec has no package data field {name!r}"
+        + (f" (did you mean {close[0]!r}?)" if close else ""),
+        hint=f"{known}; opspec validate lists the run inputs")
 
 
 @dataclass(frozen=True, slots=True)

@@ -20,7 +20,6 @@ for one run or evaluation.
 from __future__ import annotations
 
 import csv
-import difflib
 import io
 import math
 from collections.abc import Iterable, Mapping
@@ -30,7 +29,7 @@ from typing import Any
 from opspec.errors import ConfigurationError, OpspecError
 from opspec.model import Package
 from opspec.model.data import BasicKind, BasicType, DataField
-from opspec.run_inputs import RunInputs
+from opspec.run_inputs import RunInputs, no_such_field
 
 __all__ = ["read_run_inputs"]
 
@@ -78,18 +77,9 @@ def _split(text: str) -> tuple[str, str, str]:
 def _field(name: str, fields: Mapping[str, DataField], package: Package, where: str
            ) -> DataField:
     field = fields.get(name)
-    if field is not None:
-        return field
-    inputs = [f.id for f in package.data_fields
-              if any(e.name == "opspec:RunInput" for e in f.extended_attributes)]
-    close = difflib.get_close_matches(name, list(fields), n=1)
-    known = (f"its run inputs: {', '.join(inputs)}" if inputs else
-             f"its package data fields: {', '.join(fields)}" if fields else
-             "it has no package data fields")
-    raise ConfigurationError(
-        f"{where}: the spec has no package data field {name!r}"
-        + (f" (did you mean {close[0]!r}?)" if close else ""),
-        hint=f"{known}; opspec validate lists the run inputs")
+    if field is None:
+        raise no_such_field(name, package, where)
+    return field
 
 
 def _kind(field: DataField) -> BasicKind:

@@ -178,9 +178,13 @@ class _Livelock(Exception):
 
 
 def given(path: Path) -> dict[str, Any]:
-    """The values of :data:`GIVEN` for the file that opspec reads (its data fields)."""
+    """The values of :data:`GIVEN` that opspec's ``params`` can set for the file: its package
+    data fields (its run inputs). A process's own field is set by the process (and hides a
+    package value of that name), so ``params`` refuses it, as ``--param`` does."""
     values = GIVEN.get(path.relative_to(DATA).as_posix(), {})
-    return {name: value for name, value in values.items() if name in declared_data(path)}
+    package, _report = validated(path)
+    settable = {f.id for f in package.data_fields} if package is not None else set()
+    return {name: value for name, value in values.items() if name in settable}
 
 
 def opspec_facts(path: Path, delay: float = 0.0) -> Facts:

@@ -397,3 +397,40 @@ def test_a_request_cannot_change_once_a_door_has_filled_it() -> None:
     for decided in ({"seed": 4}, {"spec": DISPENSER}, {"no_user": True}):
         with pytest.raises(ConfigurationError, match="decided"):
             prepared.but(**decided)
+
+
+LOAN = """<?xml version="1.0" encoding="UTF-8"?>
+<bpmn:definitions xmlns:bpmn="http://www.omg.org/spec/BPMN/20100524/MODEL"
+    xmlns:xsi="http://www.w3.org/2001/XMLSchema-instance" id="d" targetNamespace="t">
+  <bpmn:process id="p" isExecutable="true">
+    <bpmn:startEvent id="start"/>
+    <bpmn:sequenceFlow id="f0" sourceRef="start" targetRef="ask"/>
+    <bpmn:exclusiveGateway id="ask"/>
+    <bpmn:sequenceFlow id="yes" sourceRef="ask" targetRef="done">
+      <bpmn:conditionExpression xsi:type="bpmn:tFormalExpression">${score &gt; 50}</bpmn:conditionExpression>
+    </bpmn:sequenceFlow>
+    <bpmn:sequenceFlow id="no" sourceRef="ask" targetRef="remind">
+      <bpmn:conditionExpression xsi:type="bpmn:tFormalExpression">${score &lt;= 50}</bpmn:conditionExpression>
+    </bpmn:sequenceFlow>
+    <bpmn:endEvent id="done"/>
+    <bpmn:endEvent id="remind"/>
+  </bpmn:process>
+</bpmn:definitions>
+"""
+
+
+def test_a_value_for_a_name_the_spec_does_not_have_is_refused_by_every_door(
+        tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    # a misspelt run input was set where nothing reads it: the run went on with the diagram's
+    # own fallback and said nothing (the API's params; --param refused it already)
+    diagram = tmp_path / "loan.bpmn"
+    diagram.write_text(LOAN, encoding="utf-8")
+    assert main(["run", str(diagram), "--param", "scroe=70"]) == 2
+    messages = {"run --param": capsys.readouterr().err,
+                "opspec.run": _refusal(lambda: opspec.run(diagram, params={"scroe": 70})),
+                "simulate": _refusal(lambda: simulate(diagram, params={"scroe": 70}))}
+    for door, text in messages.items():
+        assert "no package data field 'scroe' (did you mean 'score'?)" in text, f"{door}: {text}"
+    # the name it has is taken, and decides the route
+    done = opspec.run(diagram, params={"score": 70}, keep_trace=True)
+    assert "done" in {e.activity for e in done.trace if e.kind == "activity.completed"}
