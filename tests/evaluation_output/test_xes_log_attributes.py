@@ -42,7 +42,7 @@ def test_the_log_is_named_after_the_spec_and_documented(tmp_path, capsys):
     assert log["concept:name"] == "Smart medication dispenser and its user"
     assert log["spec"] == str(SPEC) and log["seed"] == "7" and log["case_notion"] == "user"
     # docs/xes-export.md's table of the log's attributes names every one written
-    documented = set(re.findall(r"^\| `([^`]+)` \|", DOC.read_text(encoding="utf-8"), re.M))
+    documented = set(re.findall(r"^\| `([^`]+)` \|", DOC.read_text(encoding="utf-8"), re.MULTILINE))
     assert set(log) <= documented, set(log) - documented
     assert f'<string key="concept:name" value="{log["concept:name"]}"/>' in DOC.read_text(
         encoding="utf-8")
