@@ -1,6 +1,7 @@
-"""What the subcommands declare alike, written once: how a command is added (its module
+"""What the subcommands declare alike, written once: the parser of every command
+(:class:`Parser`: a bad value of an option is one line), how a command is added (its module
 docstring is its ``--help``), the options several commands share, and the argument types
-(argparse turns their errors into usage errors)."""
+(their errors are such one-line usage errors, exit status 2)."""
 
 from __future__ import annotations
 
@@ -12,6 +13,7 @@ __all__ = ["Parser", "add_branch_option", "add_check_options", "add_days", "add_
            "add_engine_config", "add_json", "add_lane", "add_run_inputs", "add_seed",
            "add_spec", "add_strict", "add_translation", "add_user_model", "command", "seed",
            "share", "sweep"]
+
 
 class Parser(argparse.ArgumentParser):
     """The parser of ``opspec`` and of every command (argparse gives each subparser its
