@@ -81,10 +81,12 @@ def comparison_figure(rows: Sequence[tuple[str, float, float | None, float | Non
             ax.set_yticks([0.0], [f"{name} ({unit})" if unit else name])
             ax.set_ylim(-1.0, 1.0)
             ax.grid(axis="y", visible=False)
-        if bare:
-            fig.text(0.01, 0.005 + (0.03 if dropped else 0.0), _unshown(bare), fontsize=9,
-                     color="#444444", ha="left", va="bottom")
-        _note_dropped(fig, dropped)
+        if bare:                # one note (two at the foot would overlap)
+            fig.text(0.01, 0.005, _unshown(bare) + (
+                f"; {dropped} non-finite value(s) left out" if dropped else ""), fontsize=9,
+                color="#444444", ha="left", va="bottom")
+        else:
+            _note_dropped(fig, dropped)
         return figure_files.save(fig, path)
 
 
