@@ -50,7 +50,10 @@ def build_parser(only: str | None = None) -> argparse.ArgumentParser:
     """The ``opspec`` parser with every subcommand, or with command ``only`` alone (its
     module named after it: ``model-check`` is ``opspec.commands.model_check``), which spares
     importing and registering the others (about 30 ms) when the command line names one."""
-    parser = argparse.ArgumentParser(
+    from opspec.commands._args import Parser
+
+    # every command's parser is a Parser too (argparse makes subparsers of the parent's class)
+    parser = Parser(
         prog="opspec",
         description="Execute operational specifications (XPDL / SISARL-XPDL, or BPMN 2.0) of "
         "assistive "

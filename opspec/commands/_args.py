@@ -1,17 +1,76 @@
-"""What the subcommands declare alike, written once: how a command is added (its module
+"""What the subcommands declare alike, written once: the parser of every command
+(:class:`Parser`: a bad value of an option is one line), how a command is added (its module
 docstring is its ``--help``), the options several commands share, and the argument types
-(argparse turns their errors into usage errors)."""
+(their errors are such one-line usage errors, exit status 2)."""
 
 from __future__ import annotations
 
 import argparse
 import inspect
-from typing import Any
+from typing import Any, NoReturn
 
-__all__ = ["add_branch_option", "add_check_options", "add_days", "add_device_options",
+__all__ = ["Parser", "add_branch_option", "add_check_options", "add_days", "add_device_options",
            "add_engine_config", "add_json", "add_lane", "add_run_inputs", "add_seed",
            "add_spec", "add_strict", "add_translation", "add_user_model", "command", "seed",
            "share", "sweep"]
+
+
+class Parser(argparse.ArgumentParser):
+    """The parser of ``opspec`` and of every command (argparse gives each subparser its
+    parent's class): a bad value of an option is one line, as every other error of the
+    command line is (``opspec evaluate: --seed: 'abc' is not a whole number …``, exit 2),
+    not argparse's usage block before it; the line names the option, the value and what
+    it accepts. An unknown option still shows the command's usage (README: a mistyped option
+    shows the usage of the command it was given to)."""
+
+    _bad_value: str | None = None
+
+    def _get_value(self, action: argparse.Action, arg_string: str) -> Any:
+        try:
+            return super()._get_value(action, arg_string)
+        except argparse.ArgumentError as error:
+            self._bad_value = _value_error(action, arg_string, error)
+            raise
+
+    def _check_value(self, action: argparse.Action, value: Any) -> None:
+        try:
+            super()._check_value(action, value)
+        except argparse.ArgumentError as error:
+            if not isinstance(action, argparse._SubParsersAction):  # a command's name: cli
+                self._bad_value = _value_error(action, value, error)
+            raise
+
+    def _match_argument(self, action: argparse.Action, arg_strings_pattern: str) -> int:
+        try:
+            return super()._match_argument(action, arg_strings_pattern)
+        except argparse.ArgumentError:
+            if action.option_strings:       # an option given without its value
+                metavar = action.metavar if isinstance(action.metavar, str) else (
+                    action.dest.upper())
+                self._bad_value = (f"{max(action.option_strings, key=len)} needs a value "
+                                   f"({metavar})")
+            raise
+
+    def error(self, message: str) -> NoReturn:
+        said, self._bad_value = self._bad_value, None
+        if said is not None:
+            self.exit(2, f"{self.prog}: {said}\n")
+        super().error(message)
+
+
+def _value_error(action: argparse.Action, value: Any, error: argparse.ArgumentError) -> str:
+    """One line on a bad value of ``action``: the option, the value, what it accepts."""
+    option = max(action.option_strings, key=len) if action.option_strings else (
+        action.metavar if isinstance(action.metavar, str) else action.dest.upper())
+    if action.choices is not None and value not in action.choices:
+        return (f"{option} takes one of {', '.join(map(str, action.choices))}, "
+                f"not {value!r}")
+    if action.type in (int, float):
+        return (f"{option} takes {'a whole number' if action.type is int else 'a number'}, "
+                f"not {value!r}")
+    # the option's own type says what is wrong and what it takes (argparse.ArgumentTypeError)
+    return f"{option}: {error.message}"
+
 
 #: what --days means when it is left out, wherever a spec is run
 SPEC_RUN_LENGTH = "the spec's opspec:RunLength if it declares one, else 1"
@@ -141,7 +200,8 @@ def seed(text: str) -> int:
     try:
         value = int(text)
     except ValueError:
-        raise argparse.ArgumentTypeError(f"{text!r} is not a whole number") from None
+        raise argparse.ArgumentTypeError(f"{text!r} is not a whole number (a seed is a "
+                                         "whole number from 0 to 2**63 - 1)") from None
     try:
         return check_seed(value)
     except ConfigurationError as error:

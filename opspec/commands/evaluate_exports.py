@@ -12,7 +12,7 @@ from typing import Any
 from opspec.errors import EvaluationError
 
 __all__ = ["EXPORTS", "EXPORT_FILES", "export_estimate", "export_formats", "export_writer",
-           "trace_writers"]
+           "log_name", "trace_writers"]
 
 EXPORTS = ("xes", "jsonl", "ocel")
 #: the file each export format writes, in the output folder
@@ -53,9 +53,27 @@ def export_writer(fmt: str, path: Path, plan: Any) -> Any:
     # org:group names a lane as the timeline does: its name, its id where it has none
     lanes = lane_labels(compiled).names
     if fmt == "xes":
-        return XesWriter(path, log_attributes=attrs, lane_names=lanes)
+        # the log's concept:name is the name of the process executed (XES Concept extension:
+        # "for logs, the name attribute may store the name of the process having been
+        # executed"): the spec's, which a process-mining tool lists the log by
+        return XesWriter(path, log_attributes={"concept:name": log_name(plan, package),
+                                               **attrs}, lane_names=lanes)
     people = people_of(package, user_lane(compiled).bind_names, compiled)
     return OcelWriter(path, people=people, lane_names=lanes)
+
+
+def log_name(plan: Any, package: Any) -> str:
+    """The XES log's name: the spec's (its package's name, else its id); with --compare,
+    both specs' (``A compared with B``), for the log holds the cases of both designs."""
+    from opspec.commands._spec import load_any_spec
+
+    names = [package.label]
+    for design in plan.designs:
+        if design.spec != plan.design("A").spec:
+            label = load_any_spec(design.spec).label
+            if label not in names:
+                names.append(label)
+    return " compared with ".join(names)
 
 
 def trace_writers(stack: contextlib.ExitStack, folder: Path, plan: Any) -> Any:

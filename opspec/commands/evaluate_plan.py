@@ -18,7 +18,8 @@ from opspec.errors import EvaluationError
 
 __all__ = ["DEFAULT_SEED", "DEFAULT_USERS", "OUT_FILES", "check_plan", "claim_default_out",
            "default_out",
-           "engine_settings", "new_plan", "refuse_earlier_outputs", "refuse_inputs_in_out",
+           "engine_settings", "new_plan", "refuse_earlier_outputs", "refuse_file_out",
+           "refuse_inputs_in_out",
            "refuse_spec_template"]
 
 DEFAULT_USERS = 100
@@ -219,6 +220,23 @@ def refuse_inputs_in_out(args: argparse.Namespace, plan: Any, out: Path) -> None
         *OUT_FILES, *(EXPORT_FILES[f] for f in plan.export),
         *(EXPORT_FILES[f] + ".partial" for f in plan.export))]
     refuse_overwrite(writes, reads, folders=[(f"--out {out}", out / "figures")])
+
+
+def refuse_file_out(out: Path) -> None:
+    """``--out`` names the folder the evaluation writes into: a file there (or a file
+    where one of its parent folders would be) is refused before anything runs, saying so
+    (exit 2; it was "cannot create the output folder: File exists")."""
+    for where in (out, *out.parents):
+        if where.exists() or where.is_symlink():
+            if not where.is_dir():
+                what = (f"--out {out} is a file" if where == out
+                        else f"--out {out}: {where} is a file")
+                raise EvaluationError(
+                    f"{what}, not a folder: --out (-o) names the folder the evaluation "
+                    "writes its results, report and figures into",
+                    hint="give a new or an existing folder (--out runs/my-evaluation), or "
+                    "leave --out out for runs/<spec>-<date-time>")
+            return
 
 
 def refuse_earlier_outputs(out: Path) -> None:

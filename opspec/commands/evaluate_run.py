@@ -18,6 +18,7 @@ from opspec.commands.evaluate_plan import (
     default_out,
     new_plan,
     refuse_earlier_outputs,
+    refuse_file_out,
     refuse_inputs_in_out,
     refuse_spec_template,
 )
@@ -72,6 +73,7 @@ def _resume(args: argparse.Namespace) -> tuple[Any, Any, Any]:
 
     if not args.out:
         raise EvaluationError("--resume needs --out DIR (the folder of the run to finish)")
+    refuse_file_out(Path(args.out))
     store = ResultStore(args.out, create=False)
     plan = EvaluationPlan.from_json(store.get("plan"))
     differs = resume_differences(args, plan)
@@ -127,6 +129,8 @@ def _start(args: argparse.Namespace) -> tuple[Any, Any, Any] | None:
 
         check_targets(args.target, args.target_users, definitions["A"], swept)
     out = Path(args.out) if args.out else default_out(args.spec)
+    if args.out:
+        refuse_file_out(out)
     if args.out and (out / "results.sqlite").exists():
         raise EvaluationError(f"{out} already holds an evaluation",
                               hint="add --resume to finish it, or choose another --out")

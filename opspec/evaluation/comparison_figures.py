@@ -30,27 +30,38 @@ __all__ = ["comparison_figure", "sweep_figure"]
 
 
 @queueable
-def comparison_figure(rows: Sequence[tuple[str, float, float, float]], path: Path,
-                      units: Mapping[str, str] | None = None) -> Path:
+def comparison_figure(rows: Sequence[tuple[str, float, float | None, float | None]],
+                      path: Path, units: Mapping[str, str] | None = None, *,
+                      no_interval: Mapping[str, str] | None = None) -> Path:
     """Each ``(metric, difference B − A, ci_low, ci_high)`` in its own panel with its own
     scale and a zero line (metrics differ in unit and size: one shared axis would flatten a
     rate's ±0.005 next to a latency's −40 s). ``units`` per metric: ``"pp"`` draws a rate's
-    difference in percentage points, other units label the axis.
+    difference in percentage points, other units label the axis. Each label is written as
+    the report's table writes it (:func:`.tables.difference_text`: signed, a difference).
 
-    Differences whose interval excludes zero are drawn filled; the others hollow.
+    Differences whose interval excludes zero are drawn filled; the others hollow. A
+    difference without an interval (``ci_low``, ``ci_high`` None) is not drawn; the figure's
+    note names it, with ``no_interval``'s reason for it when given.
     """
+    from opspec.evaluation.tables import difference_text
+
     title = "Design B minus design A, with 95 % confidence intervals"
     clean = [(_text(m), float(d), float(lo), float(hi)) for m, d, lo, hi in rows
              if all(v is not None and math.isfinite(float(v)) for v in (d, lo, hi))]
-    dropped = len(rows) - len(clean)
+    bare = [(_text(m), (no_interval or {}).get(m)) for m, d, lo, hi in rows
+            if d is not None and math.isfinite(float(d)) and (lo is None or hi is None)]
+    dropped = len(rows) - len(clean) - len(bare)
     if not clean:
-        return _empty(path, title)
+        return _empty(path, title + (f"\n{_unshown(bare)}" if bare else ""))
     units = units or {}
     with _figure(9.0, 0.9 + 0.75 * len(clean)) as fig:
         axes = fig.subplots(len(clean), 1, squeeze=False)[:, 0]
         for ax, (name, diff, lo, hi) in zip(axes, clean, strict=True):
             unit = units.get(name, "")
             scale = 100.0 if unit == "pp" else 1.0
+            label = (f"{difference_text(diff, unit, percent=unit == 'pp')}  "
+                     f"[{difference_text(lo, unit, percent=unit == 'pp')}, "
+                     f"{difference_text(hi, unit, percent=unit == 'pp')}]")
             diff, lo, hi = diff * scale, lo * scale, hi * scale
             significant = lo > 0.0 or hi < 0.0
             colour = PALETTE[4] if significant else PALETTE[0]
@@ -59,8 +70,7 @@ def comparison_figure(rows: Sequence[tuple[str, float, float, float]], path: Pat
                         fmt="D" if significant else "o", color=colour, ecolor=colour,
                         markerfacecolor=colour if significant else "white", capsize=5,
                         markersize=7, linewidth=1.8)
-            suffix = f" {unit}" if unit else ""
-            ax.annotate(f"{diff:+.4g}{suffix}  [{lo:+.4g}, {hi:+.4g}]", (hi, 0.0),
+            ax.annotate(label, (hi, 0.0),
                         xytext=(6, 0), textcoords="offset points", va="center", fontsize=9)
             reach = max(abs(lo), abs(hi))
             if reach == 0.0:             # the same for every user: no scale to show
@@ -71,8 +81,19 @@ def comparison_figure(rows: Sequence[tuple[str, float, float, float]], path: Pat
             ax.set_yticks([0.0], [f"{name} ({unit})" if unit else name])
             ax.set_ylim(-1.0, 1.0)
             ax.grid(axis="y", visible=False)
-        _note_dropped(fig, dropped)
+        if bare:                # one note (two at the foot would overlap)
+            fig.text(0.01, 0.005, _unshown(bare) + (
+                f"; {dropped} non-finite value(s) left out" if dropped else ""), fontsize=9,
+                color="#444444", ha="left", va="bottom")
+        else:
+            _note_dropped(fig, dropped)
         return figure_files.save(fig, path)
+
+
+def _unshown(bare: Sequence[tuple[str, str | None]]) -> str:
+    """The note naming the differences drawn without an interval, and why each has none."""
+    return "not drawn, no 95 % interval: " + "; ".join(
+        name + (f" ({why})" if why else "") for name, why in bare)
 
 
 @queueable

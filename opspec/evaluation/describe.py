@@ -119,8 +119,9 @@ def describe_metric(definition: Mapping[str, Any]) -> str:
     elif kind == "ratio":
         num, den = definition.get("numerator"), definition.get("denominator")
         how = (f"{num} divided by {den}, both summed over all users (Σ {num} / Σ {den})."
-               + (" Shown as a percentage." if str(definition.get("name", "")).endswith(
-                   ("rate", "share")) else ""))
+               # the spec's declaration, as the tables read it (tables.in_percent)
+               + (" Shown as a percentage."
+                  if definition.get("proportion") is True else ""))
     else:
         how = ""
     return " ".join(part for part in (own, how) if part)

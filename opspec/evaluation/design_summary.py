@@ -248,6 +248,10 @@ def compare_designs(store: ResultStore, a: str = "A", b: str = "B", level: float
             "difference": diff.value, "ci95": diff.ci, "ci95_method": diff.method,
             "users": len(users),
             "significant": significant,
+            # a ratio's declaration, as its summaries carry it: the tables show the
+            # difference of a proportion in percentage points (tables.in_percent)
+            **({"proportion": bool(definition.get("proportion"))}
+               if definition["kind"] == "ratio" else {}),
         }
     return out
 

@@ -24,7 +24,6 @@ from __future__ import annotations
 import base64
 import contextlib
 import functools
-import html
 import os
 import re
 from collections.abc import Sequence
@@ -247,18 +246,25 @@ def write_html(path: Path, title: str, sections: Sequence[Section], *,
 # -------------------------------------------------------------------------------- Markdown
 
 _MD_SPECIAL = re.compile(r"([\\`*_\[\]|~])")
+# what alone makes markup of "<" and "&" in CommonMark: "<" before a letter, "/", "!" or "?"
+# (an HTML tag, comment or declaration; an autolink <scheme:…>), "&" starting an entity
+# (&amp; &#38; &#x26;); "U < 2" and "Korn & Graubard" are plain text as they are
+_MD_MARKUP = re.compile(r"(<)(?=[A-Za-z/!?])|(&)(?=#?[A-Za-z0-9]+;)")
 # what would start a block at the beginning of a line: "> ", "# ", "- ", "+ ", "1. ", "2) "
 _MD_LINE_START = re.compile(r"^(\s*\d*)(>|(?<=\d)[.)](?=\s|$)|(?<![\d])[#+-](?=\s|$))")
 
 
 def _md(text: object) -> str:
-    """Plain text made inert in Markdown: HTML escaped, Markdown punctuation backslashed.
+    """Plain text made inert in Markdown, and left readable: Markdown punctuation
+    backslashed, and ``<`` and ``&`` only where they would start markup (a tag such as
+    ``<script>`` becomes ``\\<script>``, which shows as written and is no tag; ``U < 2``
+    stays as it is, not ``U &lt; 2``).
 
     With ``[`` and ``]`` escaped no link or image can form, so parentheses stay as they are;
     a leading ``#``, ``>``, ``+``, ``-`` or ``1.`` is escaped so it starts no block.
     """
-    escaped = html.escape(" ".join(str(text).splitlines()), quote=False)
-    escaped = _MD_SPECIAL.sub(r"\\\1", escaped)
+    escaped = _MD_SPECIAL.sub(r"\\\1", " ".join(str(text).splitlines()))
+    escaped = _MD_MARKUP.sub(lambda m: "\\" + (m.group(1) or m.group(2)), escaped)
     return _MD_LINE_START.sub(lambda m: m.group(1) + "\\" + m.group(2), escaped)
 
 

@@ -55,7 +55,7 @@ from opspec.evaluation.summary import (
 from opspec.evaluation.tables import (
     NO_DURATION_INTERVAL,
     comparison_rows,
-    is_rate,
+    in_percent,
     no_interval_reason,
     subgroup_comparison_rows,
 )
@@ -357,12 +357,18 @@ def _report_sections(store: ResultStore, summaries: Mapping[str, Summaries] | No
 
     if difference is not None:
         # each panel names its metric as the other figures do (report latency, not its id)
-        rows = [(metric_label(n, d), d["difference"],
-                 *(d["ci95"] or [d["difference"], d["difference"]]))
+        rows = [(metric_label(n, d), d["difference"], *(d["ci95"] or [None, None]))
                 for n, d in difference.items() if d["difference"] is not None]
-        units = {metric_label(n, d): "pp" if is_rate(n, d) else (d.get("unit") or "")
+        units = {metric_label(n, d): "pp" if in_percent(d) else (d.get("unit") or "")
                  for n, d in difference.items()}
-        compared = ((plots.comparison_figure(rows, figures / "comparison.png", units),)
+        # a difference the paired method gives no interval is named in the figure's note,
+        # with the reason the table's CI method cell gives
+        reasons = {metric_label(n, d): ("fewer than 2 users' durations differ between the "
+                                         "designs" if why == NO_DURATION_INTERVAL
+                                         else why.removeprefix("none: "))
+                   for n, d in difference.items() if (why := no_interval_reason(d))}
+        compared = ((plots.comparison_figure(rows, figures / "comparison.png", units,
+                                             no_interval=reasons),)
                     if rows else ())
         headers: tuple[str, ...] = ("metric", names["A"], names["B"], "difference", "95 % CI",
                                     "CI method", "")

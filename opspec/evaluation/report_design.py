@@ -28,7 +28,7 @@ from opspec.evaluation.tables import (
     PER_USER_HEADERS,
     distribution_rows,
     fmt,
-    is_rate,
+    in_percent,
     method_name,
     metric_rows,
     monitor_rows,
@@ -236,7 +236,7 @@ def design_sections(store: ResultStore, figures: Path, design: str, name: str, d
     sections: list[Any] = []
     # the estimates: the table, and the rates each on its own scale (same numbers)
     rates = [(words(n), s["value"], *(s["ci95"] or [s["value"], s["value"]]))
-             for n, s in metrics.items() if is_rate(n, s) and s["value"] is not None]
+             for n, s in metrics.items() if in_percent(s) and s["value"] is not None]
     images, captions = [], []
     if rates:
         images.append(plots.rates_figure(rates, figures / f"{design}-rates.png"))
@@ -268,7 +268,7 @@ def design_sections(store: ResultStore, figures: Path, design: str, name: str, d
             s = metrics[d["name"]]
             label = (f"{metric_label(d['name'], s)}, mean per user"
                      if s["kind"] == "duration" else metric_label(d["name"], s))
-            units[label] = ("%" if is_rate(d["name"], s)
+            units[label] = ("%" if in_percent(s)
                             else (s.get("unit") or "s") if s["kind"] == "duration" else "")
             series[label] = plots.user_distribution(
                 values.in_user_order(d["name"]), 100.0 if units[label] == "%" else 1.0)
@@ -286,7 +286,7 @@ def design_sections(store: ResultStore, figures: Path, design: str, name: str, d
         if groups:
             for d in definitions:
                 s_ = metrics.get(d["name"])
-                if s_ is None or not is_rate(d["name"], s_) or not (
+                if s_ is None or not in_percent(s_) or not (
                         s_.get("per_user") or {}).get("users"):
                     continue
                 images.append(plots.subgroups_figure(

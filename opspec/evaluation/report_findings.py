@@ -10,7 +10,7 @@ from collections.abc import Mapping, Sequence
 from typing import Any
 
 from opspec.evaluation.plan import span
-from opspec.evaluation.tables import fmt, is_rate
+from opspec.evaluation.tables import fmt, in_percent
 
 __all__ = ["key_findings", "metric_label", "population_findings", "words"]
 
@@ -67,7 +67,7 @@ def _finding(metric: str, s: Mapping[str, Any], definition: Mapping[str, Any]
                 f"({s['n']:,} observations).")
     if s.get("value") is None:
         return None
-    percent = is_rate(metric, s)
+    percent = in_percent(s)
     if words:
         of = ""
     elif percent and definition.get("denominator"):
@@ -121,7 +121,7 @@ def population_findings(metrics: Mapping[str, Mapping[str, Any]],
     lines = []
     for name, s in metrics.items():
         own = s.get("per_user") or {}
-        if not is_rate(name, s) or not own.get("users") or own.get("share_with_any") is None:
+        if not in_percent(s) or not own.get("users") or own.get("share_with_any") is None:
             continue
         if own["share_with_any"] in (0.0, 1.0) and name.endswith("taken_rate"):
             continue
@@ -137,7 +137,7 @@ def population_findings(metrics: Mapping[str, Mapping[str, Any]],
     for group, entry in groups.items():
         rates = [f"{metric_label(n, m)} {fmt(m['value'], percent=True)}{_ci_words(m, percent=True)}"
                  for n, m in (entry.get("metrics") or {}).items()
-                 if is_rate(n, m) and m.get("value") is not None]
+                 if in_percent(m) and m.get("value") is not None]
         if rates:
             lines.append(f"Subgroup {group} ({entry['users']:,} users, "
                          f"{fmt(entry['share'], percent=True)}): " + "; ".join(rates) + ".")

@@ -320,11 +320,11 @@ def summarise_sweep(store: ResultStore, sweep: Sweep, days: float,
 
 
 def _cells(name: str, summary: Mapping[str, Any] | None) -> tuple[str, str]:
-    from opspec.evaluation.tables import fmt, is_rate
+    from opspec.evaluation.tables import fmt, in_percent
 
     if summary is None:
         return "–", "–"
-    percent = is_rate(name, summary)
+    percent = in_percent(summary)
     unit = "" if percent or summary["kind"] != "duration" else (summary.get("unit") or "s")
     estimate, (low, high) = _estimate(summary)
     ci = ("–" if low is None or high is None
@@ -333,11 +333,11 @@ def _cells(name: str, summary: Mapping[str, Any] | None) -> tuple[str, str]:
 
 
 def _difference_cells(name: str, d: Mapping[str, Any] | None) -> tuple[str, str, str]:
-    from opspec.evaluation.tables import is_rate
+    from opspec.evaluation.tables import in_percent
 
     if d is None:
         return "(reference)", "", ""
-    percent = is_rate(name, d)
+    percent = in_percent(d)
     unit = "" if percent else (d.get("unit") or "")
 
     def show(x: Any) -> str:
@@ -377,13 +377,16 @@ def metric_table(summary: Mapping[str, Any], metric: str) -> list[tuple[str, ...
     return rows
 
 
-def target_table(answer: Mapping[str, Any]) -> tuple[tuple[str, ...], list[tuple[str, ...]]]:
+def target_table(answer: Mapping[str, Any], summary: Mapping[str, Any]
+                 ) -> tuple[tuple[str, ...], list[tuple[str, ...]]]:
     """Per value: the estimate and its verdict; with a share of users, the share of users
-    meeting the target with its exact interval and that verdict."""
-    from opspec.evaluation.tables import fmt, is_rate
+    meeting the target with its exact interval and that verdict. ``summary``: the sweep's
+    (:func:`summarise_sweep`), whose metric summaries carry the spec's declaration, which
+    says whether the estimates are in percent."""
+    from opspec.evaluation.tables import fmt, in_percent
 
-    first = answer["values"][0]["estimate"] if answer["values"] else None
-    percent = is_rate(answer["metric"], {"kind": answer["kind"], "value": first})
+    percent = any(in_percent(v["metrics"].get(answer["metric"]) or {})
+                  for v in summary["values"])
     headers: tuple[str, ...] = ("value", "estimate", "95 % CI", "mean")
     share = answer.get("users_share")
     if share is not None:
@@ -420,7 +423,7 @@ def print_sweep(out: IO[str], summary: Mapping[str, Any], users: int) -> None:
             print("  " + line, file=out)
     for answer in summary["targets"]:
         print(f"\ntarget {answer['target']}:", file=out)
-        for line in table(*target_table(answer)):
+        for line in table(*target_table(answer, summary)):
             print("  " + line, file=out)
         print(f"  {answer['answer']}", file=out)
         if answer.get("users_answer"):
@@ -445,7 +448,7 @@ def report_sections(summary: Mapping[str, Any], figures: Path, users: int) -> li
     metric against the parameter with its interval band, and the tables."""
     from opspec.evaluation import plots
     from opspec.evaluation.html import Section, Table
-    from opspec.evaluation.tables import is_rate
+    from opspec.evaluation.tables import in_percent
 
     values = summary["values"]
     numeric = _numeric_axis(summary)
@@ -461,7 +464,7 @@ def report_sections(summary: Mapping[str, Any], figures: Path, users: int) -> li
             low.append(lo)
             high.append(hi)
         series[metric] = (est, low, high)
-        percent[metric] = is_rate(metric, first)
+        percent[metric] = in_percent(first)
         units[metric] = (first.get("unit") or "s") if first["kind"] == "duration" else (
             "per user" if first["kind"] == "count" else "")
     lines: dict[str, list[tuple[str, float]]] = {}
@@ -500,7 +503,7 @@ def report_sections(summary: Mapping[str, Any], figures: Path, users: int) -> li
                     f"{summary['reference']} (* the interval excludes 0)")
               for metric in values[0]["metrics"]]
     for answer in summary["targets"]:
-        headers, rows = target_table(answer)
+        headers, rows = target_table(answer, summary)
         tables.append(Table(headers, tuple(rows), f"Target {answer['target']}"))
     sections.append(Section(f"Sweep of {summary['parameter']}: tables", paragraphs=(
         ("A target is met when the whole 95 % interval lies on its side, failed when the "

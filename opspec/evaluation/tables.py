@@ -9,9 +9,9 @@ from opspec.evaluation.plan import span
 from opspec.properties.language import clock
 from opspec.statistics.methods import METHODS, methods_in
 
-__all__ = ["comparison_rows", "distribution_rows", "fmt", "is_rate", "method_legend",
+__all__ = ["comparison_rows", "difference_text", "distribution_rows", "fmt", "in_percent", "method_legend",
            "method_name", "metric_rows", "monitor_rows", "no_interval_reason",
-           "parameter_rows", "per_user_rows", "print_summary",
+           "parameter_rows", "per_user_rows", "points", "print_summary", "signed",
            "subgroup_comparison_rows", "subgroup_metric_rows", "subgroup_rows", "table"]
 
 METRIC_HEADERS = ("metric", "kind", "estimate", "95 % CI", "CI method", "sd", "median", "p95",
@@ -42,11 +42,14 @@ def fmt(value: Any, unit: str = "", *, percent: bool = False) -> str:
     return f"{text} {unit}".rstrip()
 
 
-def is_rate(name: str, summary: Mapping[str, Any]) -> bool:
-    """A ratio read as a percentage: named ``…rate``/``…share`` and between 0 and 1."""
-    value = summary.get("value", summary.get("a"))
-    return (summary["kind"] == "ratio" and name.endswith(("rate", "share"))
-            and (value is None or 0.0 <= value <= 1.0))
+def in_percent(summary: Mapping[str, Any]) -> bool:
+    """Whether a metric's summary (or a difference of it) is shown in percent: a ratio the
+    spec declares a proportion (``Proportion="true"``, the summary's ``proportion``), the
+    rule of ``opspec run`` (:mod:`.run_metrics_text`); never from its name or its numbers
+    (``alarms_per_dose`` is 4 of 4 in some runs, and is no proportion). A summary of a store
+    written before the declaration was kept has no ``proportion``: a plain number, as its
+    interval is a ratio's (docs/evaluation.md, Declared proportions)."""
+    return summary.get("kind") == "ratio" and summary.get("proportion") is True
 
 
 def _ci(summary: Mapping[str, Any], unit: str = "", *, percent: bool = False) -> str:
@@ -87,7 +90,7 @@ def metric_rows(metrics: Mapping[str, Mapping[str, Any]]) -> list[tuple[str, ...
                          fmt(s["sd"], unit), fmt(s["median"], unit), fmt(s["p95"], unit),
                          users, f"{s['n']} obs."))
         else:
-            percent = is_rate(name, s)
+            percent = in_percent(s)
             pooled = (f"{_count(s.get('numerator_total'))} of "
                       f"{_count(s.get('denominator_total'))}"
                       if s.get("denominator_total") is not None else "–")
@@ -118,7 +121,7 @@ def per_user_rows(metrics: Mapping[str, Mapping[str, Any]]) -> list[tuple[str, .
         if not per_user or not per_user.get("users"):
             continue
         unit = (s.get("unit") or "s") if s["kind"] == "duration" else ""
-        percent = is_rate(name, s)
+        percent = in_percent(s)
         rows.append((f"{name} ({'mean per user' if unit else 'per user'})",
                      str(per_user["users"]), fmt(per_user["mean"], unit, percent=percent),
                      fmt(per_user["sd"], unit, percent=percent),
@@ -145,7 +148,7 @@ def monitor_rows(monitors: Mapping[str, Mapping[str, Any]]) -> list[tuple[str, .
 def _estimate(name: str, s: Mapping[str, Any]) -> str:
     """One metric's estimate with its interval in one cell: ``0.36 % [0.33 %, 0.39 %]``."""
     kind = s["kind"]
-    percent = is_rate(name, s)
+    percent = in_percent(s)
     unit = (s.get("unit") or "s") if kind == "duration" else ""
     value = s.get("value") if kind == "ratio" else s.get("mean")
     ci = _ci(s, unit, percent=percent)
@@ -216,7 +219,7 @@ def distribution_rows(metrics: Mapping[str, Mapping[str, Any]], label: str = "",
             continue
         if informative and kind == "count" and own.get("share_with_any") in (0.0, 1.0):
             continue
-        percent = is_rate(name, s)
+        percent = in_percent(s)
         unit = (s.get("unit") or "s") if kind == "duration" else ""
         share = own.get("share_with_any")
         if share is not None:
@@ -250,9 +253,27 @@ def parameter_rows(population: Mapping[str, Any]) -> list[tuple[str, ...]]:
     return rows
 
 
-def _points(value: Any) -> str:
-    """A difference of two rates in percentage points: ``-0.54 pp``."""
+def points(value: Any) -> str:
+    """A difference of two proportions in percentage points: ``-0.54 pp``."""
     return "–" if value is None else f"{value * 100:+.2f} pp"
+
+
+def signed(value: Any, unit: str = "") -> str:
+    """A difference B − A as :func:`fmt` writes a number, with its sign: ``+0.7378``,
+    ``-12.5 s`` (the levels A and B carry none; a difference without one read as a level);
+    no difference at all is ``0``."""
+    if value is None:
+        return "–"
+    value = float(value)
+    text = ("0" if value == 0 else f"{value:+.4g}" if abs(value) < 1e6
+            else f"{value:+.3e}")
+    return f"{text} {unit}".rstrip()
+
+
+def difference_text(value: Any, unit: str = "", *, percent: bool = False) -> str:
+    """A difference as the tables and the comparison figure write it: in percentage points
+    for a proportion, else signed in its unit."""
+    return points(value) if percent else signed(value, unit)
 
 
 #: The CI method cell of a difference of durations without an interval: on common random
@@ -275,12 +296,13 @@ def no_interval_reason(d: Mapping[str, Any]) -> str | None:
 def comparison_rows(difference: Mapping[str, Mapping[str, Any]]) -> list[tuple[str, ...]]:
     rows: list[tuple[str, ...]] = []
     for name, d in difference.items():
-        percent = is_rate(name, d)
+        percent = in_percent(d)
         unit = "" if percent else (d.get("unit") or "")
-        diff = _points(d["difference"]) if percent else fmt(d["difference"], unit)
+        diff = difference_text(d["difference"], unit, percent=percent)
         low, high = d.get("ci95") or [None, None]
-        ci = (f"[{_points(low)}, {_points(high)}]" if percent and low is not None
-              and high is not None else _ci(d, unit))
+        ci = ("–" if low is None or high is None else
+              f"[{difference_text(low, unit, percent=percent)}, "
+              f"{difference_text(high, unit, percent=percent)}]")
         rows.append((name, fmt(d["a"], unit, percent=percent),
                      fmt(d["b"], unit, percent=percent), diff, ci,
                      no_interval_reason(d) or method_name(d),

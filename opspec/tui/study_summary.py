@@ -115,7 +115,11 @@ def variant_estimate(kind: str | None, pairs: list[tuple[float, float]],
                                   denominator=str(definition.denominator))
         ci, method = interval.ci, interval.method
     return {"value": estimate.value, "ci95": list(ci), "ci95_method": method,
-            "unit": "s" if kind == "duration" else None, "participants": len(pairs)}
+            "unit": "s" if kind == "duration" else None, "participants": len(pairs),
+            # the spec's declaration: a proportion is shown in percent, as opspec run and
+            # opspec evaluate show it (never from its name or numbers)
+            "proportion": bool(kind == "ratio" and definition is not None
+                               and definition.proportion)}
 
 
 def summary(protocol: Protocol) -> dict[str, Any]:
@@ -169,22 +173,37 @@ def summary(protocol: Protocol) -> dict[str, Any]:
                               "difference": diff.value, "ci95": list(diff.ci),
                               "ci95_method": diff.method,
                               "unit": "s" if kinds.get(name) == "duration" else None,
-                              "participants": len(who)}
+                              "participants": len(who),
+                              "proportion": any(variants[v]["metrics"].get(name, {}).get(
+                                  "proportion") for v in (a, b))}
             comparisons.append({"a": a, "b": b, "participants": both, "metrics": rows})
     return {"study": protocol.name, "status": status, "variants": variants,
             "comparisons": comparisons}
 
 
 def summary_lines(doc: dict[str, Any]) -> list[str]:
-    def num(x: Any, unit: str | None = None) -> str:
-        return "-" if x is None else f"{x:.4g}" + (f" {unit}" if unit else "")
+    """The summary as the terminal shows it: a declared proportion in percent (a difference
+    of two in percentage points), a difference signed, as opspec evaluate's tables write
+    them (:mod:`opspec.evaluation.tables`)."""
+    from opspec.evaluation.tables import difference_text
 
-    def interval(m: dict[str, Any], none: str) -> str:
+    def num(x: Any, unit: str | None = None, *, percent: bool = False,
+            difference: bool = False) -> str:
+        if x is None:
+            return "-"
+        if difference:
+            return difference_text(x, unit or "", percent=percent)
+        if percent:
+            return f"{x * 100:.2f} %"
+        return f"{x:.4g}" + (f" {unit}" if unit else "")
+
+    def interval(m: dict[str, Any], none: str, *, difference: bool = False) -> str:
         lo, hi = m["ci95"]
-        unit = m.get("unit")
+        unit, percent = m.get("unit"), bool(m.get("proportion"))
         if lo is None or hi is None:        # "[-, -]" said nothing of why
             return f"no 95 % CI: {none}; n = {m['participants']}"
-        return (f"95 % CI [{num(lo)}, {num(hi)}]{' ' + unit if unit else ''}; "
+        shown = [num(x, percent=percent, difference=difference) for x in (lo, hi)]
+        return (f"95 % CI [{shown[0]}, {shown[1]}]{' ' + unit if unit else ''}; "
                 f"n = {m['participants']}")
 
     lines = [f"study {doc['study']}"]
@@ -194,18 +213,20 @@ def summary_lines(doc: dict[str, Any]) -> list[str]:
     for vid, v in doc["variants"].items():
         lines.append(f"variant {vid} ({v['participants']} participant(s) finished):")
         for name, m in v["metrics"].items():
-            lines.append(f"  {name}: {num(m['value'], m.get('unit'))} "
-                         f"({interval(m, 'one participant')})")
+            lines.append(f"  {name}: "
+                         f"{num(m['value'], m.get('unit'), percent=bool(m.get('proportion')))}"
+                         f" ({interval(m, 'one participant')})")
     for c in doc["comparisons"]:
         lines.append(f"{c['b']} - {c['a']}, paired over {len(c['participants'])} "
                      "participant(s) who did both:")
         if not c["metrics"]:
             lines.append("  (needs two participants or more who did both)")
         for name, m in c["metrics"].items():
-            unit = m.get("unit")
-            lines.append(f"  {name}: {num(m['a'], unit)} -> {num(m['b'], unit)}, difference "
-                         f"{num(m['difference'], unit)} ("
+            unit, percent = m.get("unit"), bool(m.get("proportion"))
+            lines.append(f"  {name}: {num(m['a'], unit, percent=percent)} -> "
+                         f"{num(m['b'], unit, percent=percent)}, difference "
+                         f"{num(m['difference'], unit, percent=percent, difference=True)} ("
                          + interval(m, "fewer than two participants differ between the "
-                                    "variants") + ")")
+                                    "variants", difference=True) + ")")
     return lines
 

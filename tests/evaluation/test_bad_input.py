@@ -42,9 +42,10 @@ def test_unwritable_output_folder_is_a_clear_error(evaluate, tmp_path):
     status, _, err = evaluate(str(SPEC), "--users", "2", "--days", "1", "--out",
                               str(blocker / "out"))
     assert status == 2
-    assert "cannot create the output folder" in err and "Traceback" not in err
+    # said before anything is made: a file where a folder of --out would be
+    assert f"{blocker} is a file, not a folder" in err and "Traceback" not in err
     # nothing was started there: the hint is about the folder, not about resuming a run
-    assert "--out DIR" in err and "--resume" not in err
+    assert "give a new or an existing folder" in err and "--resume" not in err
 
 
 def test_existing_results_need_resume_and_resume_refuses_other_options(evaluate, tmp_path):

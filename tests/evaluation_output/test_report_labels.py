@@ -118,7 +118,8 @@ def test_users_who_differ_get_no_sentence_on_a_zero_width_interval(tmp_path: Pat
     compared = _section(md, "compared with medication_dispenser.xpdl")
     head, rows = _rows(compared, "| metric |")
     latency = rows["report_latency_s"]
-    assert re.fullmatch(r"\[-?[\d.]+ s, -?[\d.]+ s\]", latency[head.index("95 % CI")])
+    # (a difference, signed: [-38.55 s, +1.973 s])
+    assert re.fullmatch(r"\[[-+]?[\d.]+ s, [-+]?[\d.]+ s\]", latency[head.index("95 % CI")])
     assert latency[head.index("CI method")] in {"paired t", "paired t, few"}
     assert "has no interval" not in compared
 
@@ -136,7 +137,7 @@ def test_a_duration_difference_without_interval_says_why(run: Path) -> None:
     assert latency[head.index("difference")] == "0 s"
     assert latency[head.index("95 % CI")] == "–"
     assert latency[head.index("CI method")] == "none: fewer than 2 users differ"
-    assert rows["alarms"][head.index("95 % CI")] == "[-0.1844, 0.1844]"
+    assert rows["alarms"][head.index("95 % CI")] == "[-0.1844, +0.1844]"
     assert ("report_latency_s has no interval ('–'): fewer than 2 users' durations differ "
             "between the designs") in compared
     assert "none: fewer than 2 users differ" in _visible(run)
