@@ -259,14 +259,14 @@ class UserModel:
                     hint="check the spelling against the spec's activity ids"))
         if self.busy is not None:
             # ignore and release_after too: a misspelt id there silently never matches
-            for name, ids in (("engaged", self.busy.engaged),
-                              ("ignore", self.busy.ignore or frozenset()),
-                              ("release_after", self.busy.release_after)):
-                for activity_id in sorted(ids - known):
+            for busy_key, busy_ids in (("engaged", self.busy.engaged),
+                                       ("ignore", self.busy.ignore or frozenset()),
+                                       ("release_after", self.busy.release_after)):
+                for activity_id in sorted(busy_ids - known):
                     warnings.append(Diagnostic(
-                        located(self.path, f"busy.{name}"), Severity.WARNING,
+                        located(self.path, f"busy.{busy_key}"), Severity.WARNING,
                         "unused-user-activity",
-                        f"busy.{name} names {activity_id!r}, which the spec's user lane lacks",
+                        f"busy.{busy_key} names {activity_id!r}, which the spec's user lane lacks",
                         hint="check the spelling against the spec's activity ids"))
         warnings.extend(self._untimed(manual, choice_map))
         return warnings

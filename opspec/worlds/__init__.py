@@ -130,11 +130,11 @@ def _build(name: str, factory: Callable[..., World], rng: Any, params: Mapping[s
     try:
         return factory(rng, **params)
     except (TypeError, ValueError) as error:
-        key = _named_parameter(str(error), params)
-        if key is not None and key.split("[")[0] in inline:
+        refused = _named_parameter(str(error), params)
+        if refused is not None and refused.split("[")[0] in inline:
             where = attribute.location
-        elif key is not None and file is not None:
-            where = located(file, key)          # the line of the value the world refuses
+        elif refused is not None and file is not None:
+            where = located(file, refused)      # the line of the value the world refuses
         else:
             where = SourceLocation(file) if file and not inline else attribute.location
         raise ConfigurationError(f"world {name!r}: {error}", location=where,
