@@ -10,6 +10,8 @@ one rule for each part of a run and hands the result to :func:`opspec.runs.build
   in memory is refused with the errors of the same structural checks. Its warnings come back
   in :attr:`PreparedRun.warnings` for the door to show;
 * **the seed and the run length** — :mod:`opspec.run_rules`;
+* **the world** the spec declares — built once (:func:`opspec.worlds.check_world`), so a
+  world file that cannot be read or a parameter its world refuses is refused before any run;
 * **the user lane** — ``script`` (a path, a :class:`~opspec.usermodels.scripts.Script` or its
   steps; every name it uses must be the spec's, and every activity it acts on one the user
   lane is offered), ``user_model`` (a preset, a TOML path or a
@@ -331,11 +333,21 @@ def prepare(request: RunRequest) -> PreparedRun:
         loaded = _with_branches(loaded, request.branches)
         spec_warnings = loaded.warnings
     horizon = run_length(loaded.compiled, days=request.days, until=request.until)
+    _check_world(loaded.compiled, seed)
     if request.params:
         _check_params(request.params, loaded.package)
     user, user_warnings, named = _user(request, loaded, path)
     return PreparedRun(request, loaded, seed, horizon, user,
                        (*spec_warnings, *user_warnings), path, named)
+
+
+def _check_world(compiled: Any, seed: int) -> None:
+    """The world the spec declares is built once here: a world file that cannot be read, or
+    a parameter its world refuses, is refused by every door before any run (``opspec run``
+    did so as it built its one run; an evaluation ran every replication into it)."""
+    from opspec.worlds import check_world
+
+    check_world(compiled, seed=seed)
 
 
 def _check_params(params: Mapping[str, Any], package: Any) -> None:
