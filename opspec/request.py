@@ -291,18 +291,17 @@ def _check_offered(plan: Any, compiled: Any) -> None:
     ``dispense``): the scripted user plays that lane only, so the step would never be used
     and the run would go on as if it were not written."""
     from opspec.engine.lanes import all_activities, user_lane, user_offers
-    from opspec.errors import SourceLocation
 
     offered = user_offers(compiled)
     lane = user_lane(compiled)
-    for step in plan.steps:
+    for index, step in enumerate(plan.steps):
         alternatives = lane.choices.get(step.target)
         if step.verb in ("complete", "choose") and alternatives and step.target not in lane.manual:
             # completing the choice itself names no branch: the engine refused it mid-run
             raise ConfigurationError(
                 f"the script's step '{step.verb} {step.target}' names the choice "
                 f"{step.target!r}, not one of its alternatives",
-                location=SourceLocation(plan.where),
+                location=plan.place(index),
                 hint=f"write e.g. (5, 'choose {alternatives[0]}'); its alternatives: "
                      + ", ".join(alternatives))
         if step.verb == "raise" or step.target in offered:
@@ -315,7 +314,7 @@ def _check_offered(plan: Any, compiled: Any) -> None:
             f"the script's step '{step.verb} {step.target}' names activity {step.target!r}, "
             f"which is never offered to the user ({who} performs it in process "
             f"{act.process!r}), so the step would never be used",
-            location=SourceLocation(plan.where),
+            location=plan.place(index),
             hint=f"a script plays the user lane, whose activities are: {yours}; to act "
                  f"after {step.target}, time a step from it: "
                  f"('after {step.target} 10s', 'ACTIVITY')")
