@@ -38,20 +38,21 @@ def _said(make: Callable[[], Any]) -> str:
 
 
 @pytest.mark.parametrize(("make", "says"), [
-    (lambda: count("x") == "3", "count(x) == '3': a count compares with a number (of events), "
-                                "not the text '3' (write 3, without quotes)"),
+    (lambda: count("x") == "3", ("count(x) == '3': a count compares with a number (of events), "
+                                "not the text '3' (write 3, without quotes)")),
     (lambda: count("x") != "3", "count(x) != '3': a count compares with a number"),
     (lambda: count("x") < "3", "count(x) < '3': a count compares with a number"),
-    (lambda: count("x") <= None, "count(x) <= None: a count compares with a number (of events), "
-                                 "not None"),
-    (lambda: count("x") > True, "count(x) > True: a count compares with a number (of events), "
-                                "not the truth value True"),
-    (lambda: count("x") >= math.nan, "count(x) >= nan: a count compares with a number"),
+    (lambda: count("x") <= None, ("count(x) <= None: a count compares with a number (of events), "
+                                 "not None")),
+    (lambda: count("x") > True, ("count(x) > True: a count compares with a number (of events), "
+                                "not the truth value True")),
+    (lambda: count("x") >= math.nan,  # noqa: PLW0177  (nan is the value refused)
+     "count(x) >= nan: a count compares with a number"),
     (lambda: count("x").at_least("2"), "count(x) >= '2': a count compares with a number"),
-    (lambda: count("x").exactly("two"), "count(x) == 'two': a count compares with a number "
-                                        "(of events), not the text 'two'"),
-    (lambda: count("x").between("1", 3), "count(x).between('1', 3): a count compares with a "
-                                         "number (of events), not the text '1'"),
+    (lambda: count("x").exactly("two"), ("count(x) == 'two': a count compares with a number "
+                                        "(of events), not the text 'two'")),
+    (lambda: count("x").between("1", 3), ("count(x).between('1', 3): a count compares with a "
+                                         "number (of events), not the text '1'")),
 ], ids=["eq", "ne", "lt", "le-none", "gt-bool", "ge-nan", "at-least", "exactly", "between"])
 def test_a_count_compared_with_what_is_no_number(make: Callable[[], Any], says: str) -> None:
     assert _said(make).startswith(says)
@@ -67,13 +68,13 @@ def test_a_count_compared_with_a_number_is_as_before() -> None:
 
 @pytest.mark.parametrize(("make", "says"), [
     (lambda: within("a", "b", "5 min"),
-     "within(a, b, '5 min'): seconds takes a number of seconds >= 0 (math.inf: by the end of "
-     "the run), not the text '5 min'; write 300 (the seconds of '5 min')"),
+     ("within(a, b, '5 min'): seconds takes a number of seconds >= 0 (math.inf: by the end of "
+     "the run), not the text '5 min'; write 300 (the seconds of '5 min')")),
     (lambda: within("a", "b", None), "within(a, b, None): seconds takes a number of seconds"),
     (lambda: min_gap("dispense", hours="2"),
      "min_gap(): hours= takes a number, not the text '2' (write 2, without quotes)"),
-    (lambda: min_gap("dispense", seconds="abc"), "min_gap(): seconds= takes a number, not the "
-                                                 "text 'abc'"),
+    (lambda: min_gap("dispense", seconds="abc"), ("min_gap(): seconds= takes a number, not the "
+                                                 "text 'abc'")),
     (lambda: max_count_per("dispense", 4, minutes="90"),
      "max_count_per(): minutes= takes a number, not the text '90'"),
 ], ids=["within-text", "within-none", "min-gap-hours", "min-gap-seconds", "max-count-minutes"])
@@ -96,8 +97,8 @@ def test_a_time_as_a_number_is_as_before() -> None:
     (lambda: never_while("a", after=3, until="b"), "never_while(): an event is named by text"),
     (lambda: max_count_per(7, 4, hours=24), "max_count_per(): an event is named by text"),
     (lambda: monitor(5), "monitor(): takes a property's text form"),
-    (lambda: never("a") & 3, "expected a predicate, a property, its text or an event name, "
-                             "not 3"),
+    (lambda: never("a") & 3, ("expected a predicate, a property, its text or an event name, "
+                             "not 3")),
     (lambda: activity_completed(3), "activity_completed(): the activity is named by text, not 3"),
     (lambda: trigger_raised(1), "trigger_raised(): the trigger is named by text, not 1"),
     (lambda: event(3), "event(): the kind is text ('activity.omitted'), not 3"),
@@ -128,6 +129,6 @@ def test_it():
     result = pytester.runpytest("-p", "no:cacheprovider")
     result.assert_outcomes(failed=1)
     result.stdout.fnmatch_lines(["test_it.py:4: count(\"dispense\") == \"3\"",
-                                 "ConfigurationError: count(dispense) == '3': a count compares "
-                                 "with a number (of events), not the text '3'*"])
+                                 ("ConfigurationError: count(dispense) == '3': a count compares "
+                                 "with a number (of events), not the text '3'*")])
     assert "opspec/properties/" not in result.stdout.str()
