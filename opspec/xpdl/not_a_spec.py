@@ -32,8 +32,9 @@ def _kind(data: bytes, path: str) -> tuple[str, str] | None:
     """(what the file is, where it goes instead), or None when it may be XML after all."""
     from opspec.files import json_loads, toml_loads
 
-    if data.startswith((b"\xff\xfe", b"\xfe\xff")):     # UTF-16: libxml2's to judge
-        return None
+    if data.lstrip(b" \t\r\n").startswith((b"\xff\xfe", b"\xfe\xff", b"<\x00", b"\x00<",
+                                            b"\x00\x00\xfe\xff")):
+        return None             # UTF-16 or UTF-32 (with or without a BOM): libxml2's to judge
     try:
         text = data.decode("utf-8")
     except UnicodeDecodeError:

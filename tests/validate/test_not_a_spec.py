@@ -89,3 +89,14 @@ def test_broken_xml_keeps_the_readers_message(tmp_path: Path,
     assert main(["validate", str(cut)]) == 1
     out = capsys.readouterr().out
     assert "the file ends inside a tag" in out and "not a specification" not in out
+
+
+@pytest.mark.parametrize("encoding", ["utf-16-le", "utf-16"], ids=["no-bom", "bom"])
+def test_broken_utf16_xml_is_still_xml(tmp_path: Path, encoding: str,
+                                       capsys: pytest.CaptureFixture[str]) -> None:
+    # its NUL bytes are no sign of a binary file: libxml2 reads UTF-16 with or without a BOM
+    broken = tmp_path / "wide.xpdl"
+    broken.write_bytes("<Package><x></Package>".encode(encoding))
+    assert main(["validate", str(broken)]) == 1
+    out = capsys.readouterr().out
+    assert "not a specification" not in out and "binary" not in out
