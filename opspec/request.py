@@ -10,6 +10,8 @@ one rule for each part of a run and hands the result to :func:`opspec.runs.build
   in memory is refused with the errors of the same structural checks. Its warnings come back
   in :attr:`PreparedRun.warnings` for the door to show;
 * **the seed and the run length** — :mod:`opspec.run_rules`;
+* **the world** the spec declares — built once (:func:`opspec.worlds.check_world`), so a
+  world file that cannot be read or a parameter its world refuses is refused before any run;
 * **the user lane** — ``script`` (a path, a :class:`~opspec.usermodels.scripts.Script` or its
   steps; every name it uses must be the spec's, and every activity it acts on one the user
   lane is offered), ``user_model`` (a preset, a TOML path or a
@@ -289,18 +291,17 @@ def _check_offered(plan: Any, compiled: Any) -> None:
     ``dispense``): the scripted user plays that lane only, so the step would never be used
     and the run would go on as if it were not written."""
     from opspec.engine.lanes import all_activities, user_lane, user_offers
-    from opspec.errors import SourceLocation
 
     offered = user_offers(compiled)
     lane = user_lane(compiled)
-    for step in plan.steps:
+    for index, step in enumerate(plan.steps):
         alternatives = lane.choices.get(step.target)
         if step.verb in ("complete", "choose") and alternatives and step.target not in lane.manual:
             # completing the choice itself names no branch: the engine refused it mid-run
             raise ConfigurationError(
                 f"the script's step '{step.verb} {step.target}' names the choice "
                 f"{step.target!r}, not one of its alternatives",
-                location=SourceLocation(plan.where),
+                location=plan.place(index),
                 hint=f"write e.g. (5, 'choose {alternatives[0]}'); its alternatives: "
                      + ", ".join(alternatives))
         if step.verb == "raise" or step.target in offered:
@@ -313,7 +314,7 @@ def _check_offered(plan: Any, compiled: Any) -> None:
             f"the script's step '{step.verb} {step.target}' names activity {step.target!r}, "
             f"which is never offered to the user ({who} performs it in process "
             f"{act.process!r}), so the step would never be used",
-            location=SourceLocation(plan.where),
+            location=plan.place(index),
             hint=f"a script plays the user lane, whose activities are: {yours}; to act "
                  f"after {step.target}, time a step from it: "
                  f"('after {step.target} 10s', 'ACTIVITY')")
@@ -331,11 +332,21 @@ def prepare(request: RunRequest) -> PreparedRun:
         loaded = _with_branches(loaded, request.branches)
         spec_warnings = loaded.warnings
     horizon = run_length(loaded.compiled, days=request.days, until=request.until)
+    _check_world(loaded.compiled, seed)
     if request.params:
         _check_params(request.params, loaded.package)
     user, user_warnings, named = _user(request, loaded, path)
     return PreparedRun(request, loaded, seed, horizon, user,
                        (*spec_warnings, *user_warnings), path, named)
+
+
+def _check_world(compiled: Any, seed: int) -> None:
+    """The world the spec declares is built once here: a world file that cannot be read, or
+    a parameter its world refuses, is refused by every door before any run (``opspec run``
+    did so as it built its one run; an evaluation ran every replication into it)."""
+    from opspec.worlds import check_world
+
+    check_world(compiled, seed=seed)
 
 
 def _check_params(params: Mapping[str, Any], package: Any) -> None:

@@ -2,9 +2,10 @@
 which one it is meant for.
 
 A user model passed to ``--script`` fails as a script with unknown keys, a spec passed to
-``--user-model`` as TOML that cannot be read, a user model given as SPEC as XML that is not
-well-formed: the messages are right about the file but do not say that the file is simply
-in the wrong place. :func:`misplaced` looks at a file whose
+``--user-model`` as TOML that cannot be read: the messages are right about the file but do
+not say that the file is simply in the wrong place (a user model or script given as SPEC is
+named so by the spec reader, :mod:`opspec.xpdl.not_a_spec`, at every door; here ``run``
+adds which of its options it goes to). :func:`misplaced` looks at a file whose
 reading failed and, when it is plainly a spec (XML, or a compiled ``.wfs``), a user model
 (``format = "opspec-user-model"``) or a script (``steps``), says where it goes instead.
 Only the error path reads the file again.

@@ -12,12 +12,17 @@ from typing import Any
 from opspec.engine.trace import EventKind, TraceEvent
 from opspec.properties import language
 from opspec.properties.simple_predicates import Match
+from opspec.properties.term_arguments import text
 
 __all__ = ["activity_completed", "activity_started", "event", "process_started", "trigger_raised"]
 
 
 def _selector(kind: str, what: str, name: str, process: str | None,
               test: Callable[[TraceEvent], bool]) -> Match:
+    # a number would be taken and never match: say so (activity_completed(3))
+    text(f"{what}_{kind.split('.')[1]}()", name, f"the {what} is named by text")
+    if process is not None:
+        text(f"{what}_{kind.split('.')[1]}()", process, "process= is named by text")
     in_process = f" in {process}" if process else ""
     return Match(lambda e: e.kind == kind and test(e) and (process is None or e.process == process),
                  f"{what} {name} {kind.split('.')[1]}{in_process}", language.Subject(name, what),
@@ -51,6 +56,10 @@ def process_started(name: str) -> Match:
 def event(kind: str, *, activity: str | None = None, process: str | None = None,
           **data: Any) -> Match:
     """Events of ``kind`` (e.g. ``"activity.omitted"``) with these fields and data values."""
+    text("event()", kind, "the kind is text ('activity.omitted')")
+    for field, value in (("activity", activity), ("process", process)):
+        if value is not None:
+            text("event()", value, f"{field}= is named by text")
     def test(e: TraceEvent) -> bool:
         return (e.kind == kind and (activity is None or e.activity == activity)
                 and (process is None or e.process == process)

@@ -225,4 +225,7 @@ class _PerInstance(Predicate):
 def per_instance(process: str, predicate: Predicate | str | Match) -> Predicate:
     """``predicate`` on each instance of ``process`` separately, seeing only that instance's
     events (so ``count("dispense") == 1`` means once per dose, not once per run)."""
+    from opspec.properties.term_arguments import text
+
+    text("per_instance()", process, "the process is named by text")
     return _PerInstance(process, _as_predicate(predicate))

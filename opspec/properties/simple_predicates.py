@@ -17,8 +17,10 @@ from dataclasses import replace
 from typing import Any
 
 from opspec.engine.trace import TraceEvent
+from opspec.errors import ConfigurationError
 from opspec.properties import language, text_form
 from opspec.properties.predicate import Failure, Negation, Predicate
+from opspec.properties.term_arguments import described
 
 __all__ = ["Holds", "Match", "as_match", "as_predicate", "eventually", "never"]
 
@@ -83,14 +85,18 @@ def _subject_match(subject: language.Subject) -> Match:
     return Match(subject.matches, str(subject), subject)
 
 
-def as_match(what: str | Match | Callable[[TraceEvent], bool]) -> Match:
+def as_match(what: str | Match | Callable[[TraceEvent], bool], term: str = "an event") -> Match:
+    """``what`` as the events it selects; ``term`` (``"count()"``) names the term it is given
+    to when it selects none (a number, None: a :class:`ConfigurationError`)."""
     if isinstance(what, Match):
         return what
     if isinstance(what, str):
         return _subject_match(language.parse_subject(what))
     if callable(what):
         return Match(what, getattr(what, "__name__", repr(what)))
-    raise TypeError(f"expected an event name, a Match or a callable, not {what!r}")
+    raise ConfigurationError(f"{term}: expected an event name, a Match or a callable, not "
+                             f"{described(what)}",
+                             hint="name an event by text: 'dispense', 'trigger:trg_1', 'a|b'")
 
 
 def as_predicate(what: Any) -> Predicate:
@@ -102,6 +108,11 @@ def as_predicate(what: Any) -> Predicate:
         return Holds(what)
     if isinstance(what, str) and len(what.split()) > 1:
         return Holds(text_form.parse_property(what))
+    if not isinstance(what, (str, Match)) and not callable(what):
+        raise ConfigurationError(
+            f"expected a predicate, a property, its text or an event name, not "
+            f"{described(what)}", hint="e.g. never('notify_caregiver') & "
+                                       "within('sound_alarm', 'press_report', 60)")
     return as_match(what)
 
 
@@ -188,7 +199,7 @@ def eventually(what: str | Match | Predicate | Callable[[TraceEvent], bool]) -> 
     """``what`` happens at least once (a predicate is returned as it is)."""
     if isinstance(what, Predicate) and not isinstance(what, Match):
         return what
-    match = as_match(what)
+    match = as_match(what, "eventually()")
     return Holds(language.Eventually(match.selector()), f"eventually({match.describe()})")
 
 
@@ -196,5 +207,5 @@ def never(what: str | Match | Predicate | Callable[[TraceEvent], bool]) -> Predi
     """``what`` never happens (for a predicate: it does not hold, i.e. ``~what``)."""
     if isinstance(what, Predicate) and not isinstance(what, Match):
         return Negation(what)
-    match = as_match(what)
+    match = as_match(what, "never()")
     return Holds(language.Never(match.selector()), f"never({match.describe()})")

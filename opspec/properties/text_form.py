@@ -73,6 +73,16 @@ def _number(tokens: Sequence[str], i: int) -> float:
     return float(tokens[i])
 
 
+def _bound(tokens: Sequence[str], i: int) -> float:
+    """A count's bound: a word where it stands that is no number (a duration, a name, text
+    in quotes) is a mistake inside the count form, said as one."""
+    if i < len(tokens) and tokens[i] not in ("[", "]", ",") and not _NUMBER.fullmatch(tokens[i]):
+        raise ConfigurationError(f"a count compares with a number (of events), not {tokens[i]!r}",
+                                 hint="write e.g. 'count dispense <= 4' or "
+                                      "'count dispense in [1, 4]'")
+    return _number(tokens, i)
+
+
 def _rest(tokens: Sequence[str], i: int) -> str:
     if i >= len(tokens):
         raise _Syntax
@@ -105,6 +115,9 @@ def _read(tokens: list[str], text: str) -> tuple[Property, str | None]:
         gap = _rest(tokens, i)
         return MinGap(a, _seconds(gap), text=text), gap
     if head == "max_count":
+        if i < len(tokens) and tokens[i].lower() != "per" and not _NUMBER.fullmatch(tokens[i]):
+            raise ConfigurationError(f"{tokens[i]!r} is not a whole number >= 0",
+                                     hint="write e.g. 'max_count dispense 4 per 24h'")
         limit = _number(tokens, i)
         if limit != int(limit) or limit < 0:
             raise ConfigurationError(f"{tokens[i]!r} is not a whole number >= 0",
@@ -114,13 +127,13 @@ def _read(tokens: list[str], text: str) -> tuple[Property, str | None]:
     if head == "count":
         if i < end and tokens[i].lower() == "in":
             i = _expect(tokens, i + 1, "[")
-            lo = _number(tokens, i)
-            hi = _number(tokens, _expect(tokens, i + 1, ","))
+            lo = _bound(tokens, i)
+            hi = _bound(tokens, _expect(tokens, i + 1, ","))
             if _expect(tokens, i + 3, "]") != end:
                 raise _Syntax
             return CountBound(a, "in", lo, hi, text=text), None
         if i < end and tokens[i] in COMPARISONS and i + 2 == end:
-            return CountBound(a, tokens[i], _number(tokens, i + 1), text=text), None
+            return CountBound(a, tokens[i], _bound(tokens, i + 1), text=text), None
         raise _Syntax
     if head in ("bounded_response", "response", "never_while"):
         if head == "never_while":

@@ -45,7 +45,7 @@ entries are ``[when, action]`` pairs or tables ``{when = "...", do = "..."}``::
 from __future__ import annotations
 
 import re
-from collections.abc import Iterable, Mapping, Sequence
+from collections.abc import Callable, Iterable, Mapping, Sequence
 from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any
@@ -55,6 +55,7 @@ from opspec.engine.performers import WorkItem
 from opspec.engine.trace import EventKind, TraceEvent
 from opspec.errors import ConfigurationError, SourceLocation
 from opspec.files import json_loads
+from opspec.toml_lines import located
 
 __all__ = ["DEFAULTS", "Script", "ScriptEntry", "ScriptUser", "load_script", "parse_script",
            "script_format"]
@@ -91,29 +92,44 @@ class Script:
     anchors: Mapping[int, str]
     otherwise: str = "complete"
     where: str = "<script>"
+    #: where each step is written (a script file's ``file:line: steps[N]``), by step index
+    places: tuple[SourceLocation, ...] = ()
 
     @property
     def names(self) -> dict[str, str]:
         """Name -> what it must be (``activity``, ``trigger`` or ``anchor``)."""
-        out: dict[str, str] = {}
+        return {name: what for name, (what, _index) in self._first_uses().items()}
+
+    def _first_uses(self) -> dict[str, tuple[str, int]]:
+        """Name -> (what it must be, the index of the first step naming it)."""
+        out: dict[str, tuple[str, int]] = {}
         for index, step in enumerate(self.steps):
-            out[step.target] = "trigger" if step.verb == "raise" else "activity"
+            out.setdefault(step.target, ("trigger" if step.verb == "raise" else "activity",
+                                         index))
             if index in self.anchors:
-                out.setdefault(self.anchors[index], "anchor")
+                out.setdefault(self.anchors[index], ("anchor", index))
         return out
 
+    def place(self, index: int) -> SourceLocation:
+        """Where step ``index`` is written (the script itself when that is not known)."""
+        return self.places[index] if index < len(self.places) else SourceLocation(self.where)
+
     def check_names(self, activities: Iterable[str], triggers: Iterable[str]) -> None:
-        """Raise :class:`ConfigurationError` for names the spec does not have, listing those
-        it has (a misspelt activity would otherwise just never match an offer)."""
+        """Raise :class:`ConfigurationError` for names the spec does not have, at the step
+        that names one, with the closest names first and then those it has (a misspelt
+        activity would otherwise just never match an offer)."""
+        import difflib
+
         acts, trigs = set(activities), set(triggers)
-        for name, what in self.names.items():
+        for name, (what, index) in self._first_uses().items():
             known = {"activity": acts, "trigger": trigs, "anchor": acts | trigs}[what]
             if name not in known:
+                close = difflib.get_close_matches(name, sorted(known), n=3)
+                meant = (f" (did you mean {' or '.join(map(repr, close))}?)" if close else "")
                 listing = ", ".join(sorted(known)) or "(none)"
                 raise ConfigurationError(
-                    f"the script names {what} {name!r}, which the spec does not have",
-                    location=SourceLocation(self.where),
-                    hint=f"known {_PLURAL[what]}: {listing}")
+                    f"the script names {what} {name!r}, which the spec does not have{meant}",
+                    location=self.place(index), hint=f"known {_PLURAL[what]}: {listing}")
 
     def performer(self) -> ScriptUser:
         """A fresh performer following this script (one per simulated user)."""
@@ -155,7 +171,7 @@ class ScriptUser(ScriptedUser):
         super().offer(item)
 
 
-def _seconds(text: str, where: str) -> float:
+def _seconds(text: str, at: SourceLocation) -> float:
     from opspec.clock import parse_duration
 
     cleaned = text.strip().removeprefix("+").strip()
@@ -163,13 +179,13 @@ def _seconds(text: str, where: str) -> float:
         return parse_duration(cleaned, error=ConfigurationError)
     except ConfigurationError as error:
         raise ConfigurationError(f"cannot read the time {text.strip()!r}: {error.message}",
-                                 location=SourceLocation(where), hint=error.hint) from None
+                                 location=at, hint=error.hint) from None
 
 
 _AT = re.compile(r"(?P<time>.+?)(?:\s+on\s+day\s+(?P<day>\d+))?", re.IGNORECASE)
 
 
-def _absolute(text: str, where: str) -> float:
+def _absolute(text: str, at: SourceLocation) -> float:
     from opspec.clock import parse_time_of_day
 
     match = _AT.fullmatch(text.strip())
@@ -177,26 +193,27 @@ def _absolute(text: str, where: str) -> float:
     clock, day = match["time"].strip(), int(match["day"] or 1)
     if day < 1:
         raise ConfigurationError(f"day {day} does not exist (the first day is day 1)",
-                                 location=SourceLocation(where), hint=_HINT)
+                                 location=at, hint=_HINT)
     if ":" in clock:
-        return (day - 1) * _DAY + parse_time_of_day(clock, location=SourceLocation(where),
+        return (day - 1) * _DAY + parse_time_of_day(clock, location=at,
                                                      error=ConfigurationError)
-    return (day - 1) * _DAY + _seconds(clock, where)
+    return (day - 1) * _DAY + _seconds(clock, at)
 
 
-def _entry(when: Any, action: Any, where: str) -> tuple[Step | None, str | None, str | None]:
+def _entry(when: Any, action: Any, at: SourceLocation
+           ) -> tuple[Step | None, str | None, str | None]:
     """One entry -> (step, anchor, otherwise)."""
     if not isinstance(action, str) or not action.split():
         raise ConfigurationError(f"the action {action!r} is not text",
-                                 location=SourceLocation(where), hint=_HINT)
+                                 location=at, hint=_HINT)
     if isinstance(when, bool) or not isinstance(when, (int, float, str)):
         raise ConfigurationError(f"the time {when!r} is neither seconds nor text",
-                                 location=SourceLocation(where), hint=_HINT)
+                                 location=at, hint=_HINT)
     if isinstance(when, (int, float)):
         if when < 0:
             raise ConfigurationError(f"the time {when!r} is negative",
-                                     location=SourceLocation(where), hint=_HINT)
-        return _step(float(when), action, where), None, None
+                                     location=at, hint=_HINT)
+        return _step(float(when), action, at), None, None
     text = when.strip()
     words = text.split()
     head = words[0].lower() if words else ""
@@ -204,52 +221,51 @@ def _entry(when: Any, action: Any, where: str) -> tuple[Step | None, str | None,
         mode = action.strip().lower()
         if mode not in DEFAULTS:
             raise ConfigurationError(f"'otherwise' takes one of {', '.join(DEFAULTS)}, "
-                                     f"not {action!r}", location=SourceLocation(where))
+                                     f"not {action!r}", location=at)
         return None, None, mode
     if head == "never" and len(words) == 1:
         target = action.split()
         if len(target) != 1:
             raise ConfigurationError(f"'never' takes one activity name, not {action!r}",
-                                     location=SourceLocation(where), hint=_HINT)
+                                     location=at, hint=_HINT)
         return Step("omit", target[0], 0.0, repeat=True), None, None
     repeat = head == "each"
     if repeat:
         text = text[len(words[0]):].strip()
         if not text:
             raise ConfigurationError("'each' needs a time after it ('each 0', 'each after "
-                                     "trg_2 90s')", location=SourceLocation(where))
+                                     "trg_2 90s')", location=at)
     lowered = text.lower()
     if lowered.startswith("after "):
         parts = text.split(None, 2)
         if len(parts) < 3:
             raise ConfigurationError(f"{when!r} needs a name and a time: 'after NAME 90s'",
-                                     location=SourceLocation(where), hint=_HINT)
-        step = _step(_seconds(parts[2], where), action, where, repeat=repeat)
+                                     location=at, hint=_HINT)
+        step = _step(_seconds(parts[2], at), action, at, repeat=repeat)
         if step.verb == "raise":
             raise ConfigurationError("a 'raise' step takes an absolute time ('at 08:03'), "
-                                     f"not {when!r}", location=SourceLocation(where))
+                                     f"not {when!r}", location=at)
         return step, parts[1], None
     if lowered.startswith(("at ", "@")):
         clock = text[1:] if text.startswith("@") else text[3:]
-        return _step(_absolute(clock, where), action, where, absolute=True,
+        return _step(_absolute(clock, at), action, at, absolute=True,
                      repeat=repeat), None, None
-    return _step(_seconds(text, where), action, where, repeat=repeat), None, None
+    return _step(_seconds(text, at), action, at, repeat=repeat), None, None
 
 
-def _step(delay: float, action: str, where: str, *, absolute: bool = False,
+def _step(delay: float, action: str, at: SourceLocation, *, absolute: bool = False,
           repeat: bool = False) -> Step:
     words = action.split()
     if words[0] not in _VERBS:
         words = ["complete", *words]
     if len(words) < 2:
         raise ConfigurationError(f"the action {action!r} names no activity",
-                                 location=SourceLocation(where), hint=_HINT)
+                                 location=at, hint=_HINT)
     text = " ".join(words)
     try:
-        step = Step.parse(0.0, text, where=where, repeat=repeat)
+        step = Step.parse(0.0, text, where=str(at), repeat=repeat)
     except ConfigurationError as error:
-        raise ConfigurationError(error.message, location=SourceLocation(where),
-                                 hint=_HINT) from None
+        raise ConfigurationError(error.message, location=at, hint=_HINT) from None
     return replace(step, delay=delay, absolute=absolute or step.verb == "raise")
 
 
@@ -260,14 +276,20 @@ def parse_script(entries: Sequence[Any] | Script, *, where: str = "<script>") ->
     """
     if isinstance(entries, Script):
         return entries
+    return _parsed(entries, where, lambda n: SourceLocation(f"{where}: steps[{n}]"))
+
+
+def _parsed(entries: Any, where: str, place: Callable[[int], SourceLocation]) -> Script:
+    """The script of ``entries``, entry ``n`` written at ``place(n)``."""
     if isinstance(entries, (str, bytes)) or not isinstance(entries, Sequence):
         raise ConfigurationError("a script is a list of (when, action) pairs",
                                  location=SourceLocation(where), hint=_HINT)
     steps: list[Step] = []
+    places: list[SourceLocation] = []
     anchors: dict[int, str] = {}
     otherwise = "complete"
     for n, entry in enumerate(entries):
-        at = f"{where}: steps[{n}]"
+        at = place(n)
         when, action = _pair(entry, at)
         step, anchor, mode = _entry(when, action, at)
         if mode is not None:
@@ -277,23 +299,24 @@ def parse_script(entries: Sequence[Any] | Script, *, where: str = "<script>") ->
         if anchor is not None:
             anchors[len(steps)] = anchor
         steps.append(step)
-    return Script(tuple(steps), anchors, otherwise, where)
+        places.append(at)
+    return Script(tuple(steps), anchors, otherwise, where, tuple(places))
 
 
-def _pair(entry: Any, where: str) -> tuple[Any, Any]:
+def _pair(entry: Any, at: SourceLocation) -> tuple[Any, Any]:
     if isinstance(entry, Mapping):
         unknown = set(entry) - {"when", "do"}
         if unknown or "do" not in entry:
             raise ConfigurationError(
                 "a step table has 'do' (the action) and 'when' (default 0)"
                 + (f"; unknown key(s) {', '.join(sorted(unknown))}" if unknown else ""),
-                location=SourceLocation(where), hint='{ when = "after trg_2 90s", do = '
+                location=at, hint='{ when = "after trg_2 90s", do = '
                 '"press_report" }')
         return entry.get("when", 0), entry["do"]
     if isinstance(entry, (list, tuple)) and len(entry) == 2:
         return entry[0], entry[1]
     raise ConfigurationError(f"a step is a (when, action) pair, not {entry!r}",
-                             location=SourceLocation(where), hint=_HINT)
+                             location=at, hint=_HINT)
 
 
 def script_format(raw: bytes, name: str = "") -> str:
@@ -319,25 +342,38 @@ def load_script(path: str | Path) -> Script:
     kind = script_format(raw, where)
     hint = ('a script file is TOML (steps = [...]) or a JSON object ({"steps": [...]}, as '
             "walkthroughs record)")
+    text = ""
     try:
+        if kind == "TOML":
+            text = raw.decode("utf-8")
         document = (json_loads(raw) if kind == "JSON" else   # nesting bounded (opspec.files)
-                    parse_toml(raw.decode("utf-8"), where=where, what="the script", hint=hint))
+                    parse_toml(text, where=where, what="the script", hint=hint))
     except ValueError as error:        # JSON, or bytes that are not UTF-8
         raise ConfigurationError(f"the script is not valid {kind}: {error}",
                                  location=SourceLocation(where), hint=hint) from None
     if not isinstance(document, dict):
         raise ConfigurationError("a script file is a table with 'steps'",
                                  location=SourceLocation(where))
+
+    def key(name: str) -> SourceLocation:
+        # a TOML script's mistakes at their lines (file:line: steps[3]); a JSON one's keys
+        return (located(where, name, text.removeprefix("\ufeff")) if kind == "TOML"
+                else SourceLocation(where, key=name))
+
     unknown = set(document) - {"steps", "otherwise"}
     if unknown:
         raise ConfigurationError(f"unknown key(s) {', '.join(sorted(unknown))}",
-                                 location=SourceLocation(where, key=min(unknown)),
+                                 location=key(min(unknown)),
                                  hint="a script file has 'otherwise' and 'steps'")
-    script = parse_script(list(document.get("steps", [])), where=where)
+    steps = document.get("steps", [])
+    if not isinstance(steps, list):
+        raise ConfigurationError("'steps' is a list of [when, action] pairs",
+                                 location=key("steps"), hint=_HINT)
+    script = _parsed(steps, where, lambda n: key(f"steps[{n}]"))
     if "otherwise" in document:
         mode = document["otherwise"]
         if mode not in DEFAULTS:
             raise ConfigurationError(f"'otherwise' takes one of {', '.join(DEFAULTS)}, not "
-                                     f"{mode!r}", location=SourceLocation(where, key="otherwise"))
+                                     f"{mode!r}", location=key("otherwise"))
         script = replace(script, otherwise=mode)
     return script

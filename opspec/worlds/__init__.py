@@ -16,6 +16,8 @@ an inline ``Value`` is read as a TOML value (a bare word is a string). :func:`wo
 gives the performers ``opspec run``, ``opspec evaluate``, the walkthrough and the test helpers
 bind: one per world, serving the world's applications by Application id. Each simulated user
 gets a world of their own, drawing from a stream derived from ``(seed, user)``.
+:func:`check_world` builds it once, so that every door refuses a world it cannot build
+before any run (:func:`opspec.request.prepare`).
 
 Worlds are registered here by name; spec text never names Python code.
 """
@@ -42,7 +44,7 @@ if TYPE_CHECKING:
     from opspec.engine.performers import Performer
     from opspec.model import ExtendedAttribute
 
-__all__ = ["WORLDS", "world_parameters", "world_performers"]
+__all__ = ["WORLDS", "check_world", "world_parameters", "world_performers"]
 
 #: the ward: a 20 x 3 m corridor with two carts in the way and the patient near its far end
 WARD: dict[str, Any] = {"width": 20.0, "height": 3.0, "start": (0.6, 1.5, 0.0),
@@ -173,9 +175,25 @@ def world_performers(compiled: CompiledPackage, *, seed: int, user: int
 
     Raises :class:`ConfigurationError` for an unknown world (naming the known ones), an
     unreadable world file, an unknown parameter or an impossible value."""
+    world = _world(compiled, seed=seed, user=user)
+    if world is None:
+        return {}
+    from opspec.worlds.device import devices_of
+
+    return {"world": devices_of(world)}
+
+
+def check_world(compiled: CompiledPackage, *, seed: int = 0) -> None:
+    """Build the world ``compiled`` declares once and drop it: the refusals of
+    :func:`world_performers` (its file, its parameters) before any run, not in every one
+    (an evaluation's replications each failing with the same message)."""
+    _world(compiled, seed=seed, user=0)
+
+
+def _world(compiled: CompiledPackage, *, seed: int, user: int) -> World | None:
     attribute = _attribute(compiled, "opspec:World")
     if attribute is None:
-        return {}
+        return None
     name = (attribute.value or "").strip()
     factory = WORLDS.get(name)
     if factory is None:
@@ -184,10 +202,8 @@ def world_performers(compiled: CompiledPackage, *, seed: int, user: int
                 compiled.package.source or "<spec>"),
             hint=f"known worlds: {', '.join(sorted(WORLDS))}")
     from opspec.engine.random import named_stream
-    from opspec.worlds.device import devices_of
 
     from_file, file = _file_parameters(compiled, attribute)
     inline = _inline_parameters(attribute)
-    world = _build(name, factory, named_stream(seed, f"world/{name}", (user,)),
-                   {**from_file, **inline}, attribute, file, inline)
-    return {"world": devices_of(world)}
+    return _build(name, factory, named_stream(seed, f"world/{name}", (user,)),
+                  {**from_file, **inline}, attribute, file, inline)

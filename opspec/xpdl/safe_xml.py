@@ -2,6 +2,7 @@
 ``Package``, BPMN ``definitions``): the size limit (:mod:`opspec.xpdl.read_bytes`), no network,
 no DTD loading, no entity expansion, any ``DOCTYPE`` refused outright (XPDL never needs one;
 DTDs are how XXE and entity bombs get in), empty files and compiled ``.wfs`` scripts refused,
+files that are no XML at all refused saying what they are (:mod:`opspec.xpdl.not_a_spec`),
 encodings handled (:mod:`opspec.xpdl.read_encoding`) and the exact lines of elements past line
 65,534 found (:mod:`opspec.xpdl.read_lines`).
 """
@@ -15,6 +16,7 @@ from typing import Final
 from lxml import etree
 
 from opspec.errors import Diagnostic, SourceLocation
+from opspec.xpdl.not_a_spec import not_a_spec
 from opspec.xpdl.read_bytes import DEFAULT_MAX_BYTES, effective_max_bytes, too_big_error
 from opspec.xpdl.read_encoding import (
     ASCII_NAMES,
@@ -131,7 +133,16 @@ def parse_safely(data: bytes, *, path: str, max_bytes: int = DEFAULT_MAX_BYTES) 
             hint="validate the XPDL it was compiled from; opspec show, run and evaluate "
             "read .wfs scripts directly",
         )
-    root, warnings, encoding = _parse(data, path)
+    try:
+        root, warnings, encoding = _parse(data, path)
+    except XmlReadError as error:
+        # a user model, a world file, JSON, a binary file… given as the spec: say what it is
+        # and what is wanted, not where libxml2 first stumbled
+        wrong = not_a_spec(data, path) if error.code == "not-well-formed" else None
+        if wrong is None:
+            raise
+        message, location, hint = wrong
+        raise XmlReadError("not-well-formed", message, location=location, hint=hint) from None
     tree = root.getroottree()
     if tree.docinfo.doctype or tree.docinfo.internalDTD is not None:
         raise doctype_error(path, _doctype_line(data) or 1)

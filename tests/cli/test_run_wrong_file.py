@@ -67,7 +67,7 @@ def test_a_broken_script_keeps_its_own_advice(tmp_path: Path,
 def test_a_user_model_given_as_the_spec(capsys: pytest.CaptureFixture[str]) -> None:
     assert main(["run", str(USERS), "--until", "1h"]) == 1
     err = capsys.readouterr().err
-    assert "not well-formed XML" in err                     # what the reader found, as before
+    assert "this is a user model (TOML), not a specification" in err   # what the reader found
     assert "(given as SPEC, but this is a user model: give it to --user-model)" in err
     assert len(err.strip().splitlines()) == 1
 

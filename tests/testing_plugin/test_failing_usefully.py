@@ -49,8 +49,9 @@ def test_a_script_naming_an_unknown_activity_lists_the_activities(
 def test_it(spec, simulate):
     simulate(spec, script=[("after trg_2 90s", "press_reprot")])
 """)
-    result.stdout.fnmatch_lines([("*simulate(): *names activity 'press_reprot', which the spec "
-                                  "does not have (known activities: *press_report*")])
+    result.stdout.fnmatch_lines([("*simulate(): <script>: steps[[]0[]]: the script names activity "
+                                  "'press_reprot', which the spec does not have (did you mean "
+                                  "'press_report'*?) (known activities: *press_report*")])
 
 
 def test_a_statistical_claim_with_too_few_replications_says_how_many_it_needs(

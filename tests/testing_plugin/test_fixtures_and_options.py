@@ -233,4 +233,4 @@ def test_a_failing_simulate_call_names_the_line_that_made_it(project: pytest.Pyt
     result.assert_outcomes(failed=1)
     result.stdout.fnmatch_lines([
         "test_two_calls.py:5: simulate(spec, script=[[](\"never\", \"press_reprot\")[]], *",
-        "simulate(): <script>: the script names activity 'press_reprot'*"])
+        "simulate(): <script>: steps[[]0[]]: the script names activity 'press_reprot'*"])

@@ -93,7 +93,7 @@ def test_a_step_completing_a_choice_by_its_own_name_says_to_choose_an_alternativ
         spec: object, action: str) -> None:
     # was an ExecutionError mid-run: "call complete(item, choice=ACTIVITY_ID)"
     with pytest.raises(ConfigurationError, match=(
-            r"<script>: the script's step '.*choose_button' names the choice "
+            r"<script>: steps\[0\]: the script's step '.*choose_button' names the choice "
             r"'choose_button', not one of its alternatives; write e.g. \(5, 'choose "
             r"press_report'\); its alternatives: press_report, press_wrong_button")):
         simulate(spec, script=[(5, action)], until=9 * 3600)  # type: ignore[arg-type]
@@ -119,11 +119,12 @@ def test_a_script_file_reads_pairs_and_tables(tmp_path: Path, spec: object) -> N
 
 
 @pytest.mark.parametrize(("text", "message"), [
-    ("steps = [[1]]", r"late.toml: steps\[0\]: a step is a \(when, action\) pair"),
-    ('steps = []\nspeed = 2', r"late.toml: speed: unknown key"),
-    ('otherwise = "later"', r"late.toml: otherwise: 'otherwise' takes one of"),
+    ("steps = [[1]]", r"late.toml:1: steps\[0\]: a step is a \(when, action\) pair"),
+    ('steps = []\nspeed = 2', r"late.toml:2: speed: unknown key"),
+    ('otherwise = "later"', r"late.toml:1: otherwise: 'otherwise' takes one of"),
     ("steps = [", r"late.toml: the script is not valid TOML"),
-    ('steps = [{ do = "x", after = 3 }]', r"steps\[0\]: a step table has 'do'.*unknown key"),
+    ('steps = [{ do = "x", after = 3 }]',
+     r"late.toml:1: steps\[0\]: a step table has 'do'.*unknown key"),
 ], ids=["short-pair", "unknown-key", "bad-otherwise", "not-toml", "table-key"])
 def test_bad_script_files_name_the_file_and_key(tmp_path: Path, text: str,
                                                 message: str) -> None:
