@@ -12,7 +12,8 @@ when the picture is drawn; without dot, a one-line error with the install hint a
 status 2). Every error opspec validate finds is printed on stderr (the spec is still shown).
 
 Exit status: 0 shown, no errors; 1 shown, but the spec has errors (or the file holds no usable
-package); 2 the file cannot be read or the process does not exist.
+package); 2 the file cannot be read, the process does not exist, or -o names the spec itself
+(nothing is written then).
 """
 
 from __future__ import annotations
@@ -56,6 +57,16 @@ def run(args: argparse.Namespace) -> int:
     from opspec.errors import Severity
     from opspec.xpdl.dot import package_to_dot
 
+    if getattr(args, "output", None):
+        from opspec.commands._files import overwrite_problem
+
+        # -o SPEC would replace the spec with its own description
+        problem = overwrite_problem("show", [("-o", Path(args.output))],
+                                    [("SPEC", Path(args.spec))],
+                                    example=f"{Path(args.spec).stem}.{_SUFFIXES[args.format]}")
+        if problem is not None:
+            print(problem, file=sys.stderr)
+            return 2
     if str(args.spec).endswith(".wfs"):
         result = _load_script(args.spec)
     else:
@@ -101,6 +112,10 @@ def run(args: argparse.Namespace) -> int:
     else:
         sys.stdout.write(text)
     return 1 if errors else 0
+
+
+#: The file name suffix suggested for each --format.
+_SUFFIXES = {"text": "txt", "dot": "dot", "svg": "svg", "html": "html"}
 
 
 def _write_whole(path: Path, text: str) -> None:
