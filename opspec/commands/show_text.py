@@ -16,7 +16,7 @@ from opspec.model.data import BasicType, DataField, DataType, DeclaredType, Form
 from opspec.model.package import Package
 from opspec.model.process import ConditionKind, Transition, WorkflowProcess
 from opspec.model.resources import Lane, ParticipantType
-from opspec.model.sisarl import ProcessDirectives, TriggerRef
+from opspec.model.sisarl import ProcessDirectives, TriggerRef, WorkflowMode
 
 __all__ = ["describe_package"]
 
@@ -49,9 +49,7 @@ def describe_package(package: Package, *, process: str | None = None) -> str:
             out.append(f"  {pool.id} {pool.name or ''}{owner}".rstrip())
             _lanes(out, pool.lanes, "    ")
     if package.modes:
-        out.append("Modes: " + "; ".join(
-            f"{m.id}{' (initial)' if m.initial else ''}: {', '.join(m.workflows)}"
-            for m in package.modes))
+        out.append("Modes: " + "; ".join(_mode(m, package) for m in package.modes))
     if package.metrics:
         out.append("Metrics: " + ", ".join(f"{m.name} ({m.kind.value})" for m in package.metrics))
     for proc in package.processes:
@@ -59,6 +57,16 @@ def describe_package(package: Package, *, process: str | None = None) -> str:
             out.append("")
             _process(out, proc, package)
     return "\n".join(out) + "\n"
+
+
+def _mode(mode: WorkflowMode, package: Package) -> str:
+    """A mode and the workflows it runs: those it lists and those whose ``opspec:Mode`` names
+    it, as the engine gathers them (most specs only use the latter)."""
+    workflows = dict.fromkeys((*mode.workflows, *(p.id for p in package.processes
+                                                  if p.directives.mode == mode.id)))
+    text = mode.id + (" (initial)" if mode.initial else "")
+    text += f": {', '.join(workflows)}" if workflows else ": no workflow"
+    return text + (f", loads {mode.source}" if mode.source else "")
 
 
 def _role(kind: ParticipantType) -> str:
