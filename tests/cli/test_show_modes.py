@@ -18,8 +18,8 @@ def test_modes_name_the_workflows_whose_directive_names_them(
     assert main(["show", str(ROOT / "specs" / "vacuum_cleaner.xpdl")]) == 0
     modes = [line for line in capsys.readouterr().out.splitlines()
              if line.startswith("Modes:")]
-    assert modes == ["Modes: run (initial): sense, avoid, wander, manoeuvre, arbitrate, "
-                     "battery; dock: dock"]
+    assert modes == [("Modes: run (initial): sense, avoid, wander, manoeuvre, arbitrate, "
+                      "battery; dock: dock")]
 
 
 def test_listed_workflows_and_a_source_are_shown(tmp_path: Path,
@@ -33,5 +33,5 @@ def test_listed_workflows_and_a_source_are_shown(tmp_path: Path,
     main(["show", str(spec)])
     modes = [line for line in capsys.readouterr().out.splitlines()
              if line.startswith("Modes:")]
-    assert modes == ["Modes: run (initial): sense, avoid, wander, manoeuvre, arbitrate, "
-                     "battery; dock: battery, dock, loads dock.xpdl"]
+    assert modes == [("Modes: run (initial): sense, avoid, wander, manoeuvre, arbitrate, "
+                      "battery; dock: battery, dock, loads dock.xpdl")]
