@@ -1,7 +1,9 @@
 """Compile a spec (XPDL or BPMN) into a workflow script (.wfs) the engine loads.
 
 Load IN (XPDL, SISARL-XPDL or BPMN 2.0), refuse it if it has errors, and write its compiled
-workflow script (versioned JSON, docs/wfs-format.md).
+workflow script (versioned JSON, docs/wfs-format.md). The spec's companion user model
+IN.users.toml is copied to OUT.users.toml (an existing different file is kept), so that
+opspec run OUT draws the same users as opspec run IN.
 
 Exit status: 0 written (warnings are printed); 1 the spec has errors, exactly those opspec
 validate reports (each printed as 'path:line: severity: message'; nothing is written); 2 the
@@ -28,6 +30,7 @@ def register(subparsers: Any) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
+    from opspec.commands._companions import copy_user_model
     from opspec.commands._files import input_problem, same_file, translation_problem, write_problem
     from opspec.commands.validate import engine_checks
     from opspec.errors import SpecError
@@ -68,4 +71,7 @@ def run(args: argparse.Namespace) -> int:
     for diagnostic in result.diagnostics:
         print(diagnostic, file=sys.stderr)
     print(f"{result.output}: compiled from {source}")
+    # a run of OUT looks for OUT.users.toml: without it, the user lane of a script compiled
+    # to another name would run with nobody on it
+    copy_user_model("compile", source, result.output)
     return 0

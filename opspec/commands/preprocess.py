@@ -41,6 +41,7 @@ def default_output(source: Path) -> Path:
 
 
 def run(args: argparse.Namespace) -> int:
+    from opspec.commands._companions import copy_companion, copy_user_model
     from opspec.commands._files import translation_problem, write_problem
     from opspec.commands.validate import engine_checks
     from opspec.errors import Severity
@@ -98,42 +99,7 @@ def run(args: argparse.Namespace) -> int:
         print(f"opspec preprocess: {write_problem(target, error)}", file=sys.stderr)
         return 2
     print(f"{target}: standard XPDL 2.1 from {source}")
-    _copy_user_model(source, target)
+    copy_user_model("preprocess", source, target)
     for original, copy in copies:
-        _copy_companion(original, copy, "world file")
+        copy_companion("preprocess", original, copy, "world file")
     return 0
-
-
-def _copy_user_model(source: Path, target: Path) -> None:
-    """Copy the spec's companion ``SPEC.users.toml`` to the output's companion name, so
-    ``opspec evaluate OUT`` draws the same users (an existing different file is kept)."""
-
-    from opspec.request import companion_user_model
-
-    model = companion_user_model(source)
-    if model is None:
-        return
-    copy = target.with_name(target.name.removesuffix(target.suffix) + ".users.toml")
-    _copy_companion(model, copy, "user model")
-
-
-def _copy_companion(original: Path, copy: Path, what: str) -> None:
-    """Copy ``original`` to ``copy`` for the output (an existing different file is kept)."""
-    import shutil
-
-    from opspec.commands._files import same_file
-
-    if same_file(original, copy):
-        return
-    try:
-        if copy.exists():
-            if copy.read_bytes() != original.read_bytes():
-                print(f"opspec preprocess: kept {copy}, which differs from {original} (the "
-                      f"output's {what})", file=sys.stderr)
-            return
-        shutil.copyfile(original, copy)
-    except OSError as error:
-        print(f"opspec preprocess: could not copy the {what} {original} to {copy}: "
-              f"{error.strerror or error}", file=sys.stderr)
-        return
-    print(f"{copy}: {what} of the output, copied from {original}")
