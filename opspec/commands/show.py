@@ -25,7 +25,7 @@ from typing import Any
 
 from opspec.commands._args import add_spec, command
 
-__all__ = ["describe_package", "register", "run"]
+__all__ = ["describe_package", "load_script", "register", "run"]
 
 
 def __getattr__(name: str) -> Any:
@@ -68,7 +68,7 @@ def run(args: argparse.Namespace) -> int:
             print(problem, file=sys.stderr)
             return 2
     if str(args.spec).endswith(".wfs"):
-        result = _load_script(args.spec)
+        result = load_script(args.spec)
     else:
         result = _validated(args.spec)
     package = result.package
@@ -166,7 +166,7 @@ def _unreadable(path: str) -> Any:
                       "specs are not read from folders, pipes or devices")
 
 
-def _load_script(path: str) -> Any:
+def load_script(path: str) -> Any:
     """A compiled workflow script (``.wfs``) as a :class:`~opspec.xpdl.loader.LoadResult`
     (compiled only from specs without errors, so it carries no diagnostics)."""
     from pathlib import Path
