@@ -25,7 +25,7 @@ __all__ = ["register"]
 
 def register(subparsers: Any) -> None:
     parser = command(subparsers, "compile", __doc__)
-    add_translation(parser, "XPDL or BPMN", "OUT.wfs", "IN with the suffix .wfs")
+    add_translation(parser, "XPDL or BPMN", "OUT.wfs", "IN with the suffix .wfs; '-' for stdout")
     parser.set_defaults(handler=run)
 
 
@@ -38,6 +38,8 @@ def run(args: argparse.Namespace) -> int:
     from opspec.xpdl.open_spec import IO_CODES
 
     source = Path(args.input)
+    if args.output == "-":
+        return _to_stdout(args, source)
     target = Path(args.output) if args.output else default_output(source)
     if (source.suffix == ".wfs" and same_file(source, target)
             and input_problem(source) is None):
@@ -74,4 +76,36 @@ def run(args: argparse.Namespace) -> int:
     # a run of OUT looks for OUT.users.toml: without it, the user lane of a script compiled
     # to another name would run with nobody on it
     copy_user_model("compile", source, result.output)
+    return 0
+
+
+def _to_stdout(args: argparse.Namespace, source: Path) -> int:
+    """``-o -``: the script on the standard output, as ``preprocess -o -`` writes its XPDL
+    (a file named '-' was written before). Its spec's path is written as given, so it holds
+    for a script saved in the current folder; no user model is copied."""
+    from opspec.commands._files import translation_problem
+    from opspec.commands.validate import engine_checks
+    from opspec.errors import SpecError
+    from opspec.model.codec import dumps
+    from opspec.xpdl.compile import compiled_package
+    from opspec.xpdl.open_spec import IO_CODES
+
+    problem = translation_problem("compile", source, None,
+                                  example=f"{source.with_suffix('.wfs').name} beside it")
+    if problem is not None:
+        print(problem, file=sys.stderr)
+        return 2
+    try:
+        package, warnings = compiled_package(source, strict=args.strict, extra=engine_checks)
+    except SpecError as error:
+        for diagnostic in error.diagnostics or ():
+            print(diagnostic, file=sys.stderr)
+        if any(d.code in IO_CODES for d in error.diagnostics):
+            print(f"opspec compile: cannot read {source}; nothing written", file=sys.stderr)
+            return 2
+        print(f"opspec compile: {source} has errors; nothing written", file=sys.stderr)
+        return 1
+    for diagnostic in warnings:
+        print(diagnostic, file=sys.stderr)
+    sys.stdout.write(dumps(package) + "\n")
     return 0

@@ -47,7 +47,8 @@ def register(subparsers: Any) -> None:
                         "in one picture)")
     parser.add_argument("--process", metavar="ID", help="only this process (by Id)")
     parser.add_argument("-o", "--output", metavar="FILE",
-                        help="write to FILE instead of the standard output; nothing is "
+                        help="write to FILE instead of the standard output ('-': the "
+                        "standard output); nothing is "
                         "written (no empty file) when the output cannot be made, e.g. "
                         "without Graphviz")
     parser.set_defaults(handler=run)
@@ -57,6 +58,8 @@ def run(args: argparse.Namespace) -> int:
     from opspec.errors import Severity
     from opspec.xpdl.dot import package_to_dot
 
+    if getattr(args, "output", None) == "-":
+        args.output = None                  # '-': the standard output (a file named '-' before)
     if getattr(args, "output", None):
         from opspec.commands._files import overwrite_problem
 
