@@ -7,8 +7,8 @@ opspec run OUT draws the same users as opspec run IN.
 
 Exit status: 0 written (warnings are printed); 1 the spec has errors, exactly those opspec
 validate reports (each printed as 'path:line: severity: message'; nothing is written); 2 the
-input cannot be read (missing, a folder, a pipe or device, no permission), the output is the
-input itself, or the output cannot be written.
+input cannot be read (missing, a folder, a pipe or device, no permission) or is a compiled
+script already, the output is the input itself, or the output cannot be written.
 """
 
 from __future__ import annotations
@@ -35,7 +35,6 @@ def run(args: argparse.Namespace) -> int:
     from opspec.commands.validate import engine_checks
     from opspec.errors import SpecError
     from opspec.xpdl.compile import compile_spec, default_output
-    from opspec.xpdl.open_spec import IO_CODES
 
     source = Path(args.input)
     if args.output == "-":
@@ -45,10 +44,7 @@ def run(args: argparse.Namespace) -> int:
             and input_problem(source) is None):
         # IN.wfs is its own default output: there is nothing to compile, not an -o to change
         given = f"-o {args.output} is IN itself, and " if args.output else ""
-        print(f"opspec compile: {given}{source} is already compiled (a workflow script, "
-              ".wfs); nothing written. Compile the XPDL it was compiled from, or use "
-              f"{source} as it is: opspec show, run and evaluate read it directly",
-              file=sys.stderr)
+        print(_already_compiled(source, given), file=sys.stderr)
         return 2
     problem = translation_problem("compile", source, target,
                                   example=f"{source.with_suffix('.wfs').name} beside it")
@@ -58,15 +54,7 @@ def run(args: argparse.Namespace) -> int:
     try:
         result = compile_spec(source, target, strict=args.strict, extra=engine_checks)
     except SpecError as error:
-        for diagnostic in error.diagnostics or ():
-            print(diagnostic, file=sys.stderr)
-        if not error.diagnostics:
-            print(f"opspec compile: {error}", file=sys.stderr)
-        if any(d.code in IO_CODES for d in error.diagnostics):
-            print(f"opspec compile: cannot read {source}; nothing written", file=sys.stderr)
-            return 2
-        print(f"opspec compile: {source} has errors; nothing written", file=sys.stderr)
-        return 1
+        return _refused(error, source)
     except OSError as error:
         print(f"opspec compile: {write_problem(target, error)}", file=sys.stderr)
         return 2
@@ -88,7 +76,6 @@ def _to_stdout(args: argparse.Namespace, source: Path) -> int:
     from opspec.errors import SpecError
     from opspec.model.codec import dumps
     from opspec.xpdl.compile import compiled_package
-    from opspec.xpdl.open_spec import IO_CODES
 
     problem = translation_problem("compile", source, None,
                                   example=f"{source.with_suffix('.wfs').name} beside it")
@@ -98,14 +85,35 @@ def _to_stdout(args: argparse.Namespace, source: Path) -> int:
     try:
         package, warnings = compiled_package(source, strict=args.strict, extra=engine_checks)
     except SpecError as error:
-        for diagnostic in error.diagnostics or ():
-            print(diagnostic, file=sys.stderr)
-        if any(d.code in IO_CODES for d in error.diagnostics):
-            print(f"opspec compile: cannot read {source}; nothing written", file=sys.stderr)
-            return 2
-        print(f"opspec compile: {source} has errors; nothing written", file=sys.stderr)
-        return 1
+        return _refused(error, source)
     for diagnostic in warnings:
         print(diagnostic, file=sys.stderr)
     sys.stdout.write(dumps(package) + "\n")
     return 0
+
+
+def _already_compiled(source: Path, given: str = "") -> str:
+    return (f"opspec compile: {given}{source} is already compiled (a workflow script, .wfs); "
+            "nothing written. Compile the XPDL it was compiled from, or use "
+            f"{source} as it is: opspec show, run and evaluate read it directly")
+
+
+def _refused(error: Any, source: Path) -> int:
+    """Print why IN was not compiled (a :class:`SpecError`'s diagnostics, then one line);
+    the exit status: 2 when IN cannot be read or is a compiled script itself (the wrong
+    file, not a spec with errors), else 1."""
+    from opspec.xpdl.open_spec import IO_CODES
+
+    diagnostics = error.diagnostics or ()
+    if any(d.code == "compiled-script" for d in diagnostics):
+        print(_already_compiled(source), file=sys.stderr)
+        return 2
+    for diagnostic in diagnostics:
+        print(diagnostic, file=sys.stderr)
+    if not diagnostics:
+        print(f"opspec compile: {error}", file=sys.stderr)
+    if any(d.code in IO_CODES for d in diagnostics):
+        print(f"opspec compile: cannot read {source}; nothing written", file=sys.stderr)
+        return 2
+    print(f"opspec compile: {source} has errors; nothing written", file=sys.stderr)
+    return 1

@@ -14,8 +14,8 @@ XPDL 2.1 XSD rejects gets a not-schema-valid warning.
 
 Exit status: 0 written; 1 the spec has errors (those opspec validate reports, or a built-in
 that cannot be expanded; nothing written); 2 the input cannot be read (missing, a folder, a
-pipe or device, no permission), the output is the input itself, or the output cannot be
-written.
+pipe or device, no permission) or is a compiled workflow script (.wfs), the output is the
+input itself, or the output cannot be written.
 """
 
 from __future__ import annotations
@@ -64,6 +64,11 @@ def run(args: argparse.Namespace) -> int:
     # The spec is refused for exactly the errors `opspec validate` reports.
     package, report = validate_spec(source, strict=args.strict, extra=engine_checks)
     diagnostics = list(report.diagnostics)
+    if any(d.code == "compiled-script" for d in diagnostics):
+        # the wrong file (a script has no SISARL built-ins left), not a spec with errors
+        print(f"opspec preprocess: {source} is a compiled workflow script (.wfs), not XPDL; "
+              "nothing written. Preprocess the XPDL it was compiled from", file=sys.stderr)
+        return 2
     if any(d.code in IO_CODES for d in diagnostics):
         for diagnostic in diagnostics:
             print(diagnostic, file=sys.stderr)
