@@ -140,7 +140,20 @@ _SCALARS = (str, int, float, bool, type(None))
 
 
 class _CorruptError(Exception):
-    """Internal: the document does not describe a model; turned into a SpecError by callers."""
+    """Internal: the document does not describe a model; turned into a SpecError by callers.
+    ``where``: the objects and field it was found in, outermost first (a hand-edited script's
+    "expected str, got 5" alone does not say which of its thousands of values it is)."""
+
+    def __init__(self, message: str, where: tuple[str, ...] = ()) -> None:
+        super().__init__(message)
+        self.message = message
+        self.where = where
+
+    def __str__(self) -> str:
+        if not self.where:
+            return self.message
+        *objects, field = self.where
+        return f"{self.message} (in {' > '.join(objects)}, field {field})"
 
 
 # --------------------------------------------------------------------------- encoding
@@ -334,7 +347,12 @@ def _decode_object(cls: type, value: dict[str, Any]) -> Any:
         decoder = decoders.get(key)
         if decoder is None:
             raise _CorruptError(f"{value['$']} has no field {key!r}")
-        kwargs[key] = decoder(item)
+        try:
+            kwargs[key] = decoder(item)
+        except _CorruptError as error:
+            ident = value.get("id")
+            label = value["$"] + (f" {ident!r}" if type(ident) is str else "")
+            raise _CorruptError(error.message, (label, *(error.where or (key,)))) from None
     try:
         return cls(**kwargs)
     except TypeError as error:  # a required field is missing
