@@ -2,8 +2,10 @@
 
 Print what SPEC holds, as readable text or as Graphviz DOT, or draw the whole package as SVG
 or as an HTML page. text (the default) prints the package header, participants (human or
-system), pools and lanes, and every process with its directives, data, activities (kind,
-performer, manual or automatic, deadlines) and transitions with their conditions. dot prints a
+system), pools and lanes, modes and their workflows, and every process with its directives,
+data, activities (kind, performer, manual or automatic, deadlines, the messages they raise,
+their triggers, durations and CPU demands, what a built-in reads and writes) and transitions
+with their conditions. dot prints a
 Graphviz digraph per process (opspec.xpdl.dot; render it with e.g.
 'opspec show SPEC --format dot | dot -Tsvg -o out.svg'). svg and html draw every process with
 its lanes and the messages between them in one picture (opspec.xpdl.picture, laid out by

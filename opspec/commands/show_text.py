@@ -16,7 +16,14 @@ from opspec.model.data import BasicType, DataField, DataType, DeclaredType, Form
 from opspec.model.package import Package
 from opspec.model.process import ConditionKind, Transition, WorkflowProcess
 from opspec.model.resources import Lane, ParticipantType
-from opspec.model.sisarl import ProcessDirectives, TriggerRef, WorkflowMode
+from opspec.model.sisarl import (
+    ActivityDirectives,
+    CoordinationBuiltIn,
+    CoordinationKind,
+    ProcessDirectives,
+    TriggerRef,
+    WorkflowMode,
+)
 
 __all__ = ["describe_package"]
 
@@ -103,6 +110,10 @@ def _trigger(trigger: TriggerRef) -> str:
 
     if trigger.name:
         return f"{trigger.kind}:{trigger.name}"
+    if trigger.kind == "rule" and trigger.condition is not None:
+        from opspec.model.expression_text import to_text
+
+        return f"rule {to_text(trigger.condition)}"
     text = trigger.kind
     if trigger.at:
         text += " at " + ", ".join(time_of_day(t) for t in trigger.at)
@@ -195,10 +206,51 @@ def _activity(activity: Activity, process: WorkflowProcess, package: Package) ->
                      + (f" while {activity.loop.condition_text}"
                         if activity.loop.condition_text else ""))
     if activity.coordination is not None:
-        parts.append(f"built-in {activity.coordination.kind.value}")
-    if activity.directives.priority_increment:
-        parts.append(f"priority +{activity.directives.priority_increment}")
+        parts.append(_built_in(activity.coordination))
+    parts.extend(_activity_directives(activity.directives))
     return ", ".join(parts)
+
+
+def _built_in(built_in: CoordinationBuiltIn) -> str:
+    """``built-in arbiter motor_cmd <- escape_cmd, avoid_cmd``, ``built-in push distance ->
+    channel range``, ``built-in mode-change to dock``: what it reads and writes."""
+    text = f"built-in {built_in.kind.value}"
+    inputs = ", ".join(built_in.inputs)
+    if built_in.kind is CoordinationKind.PUSH_DATA:
+        return f"{text} {inputs} -> channel {built_in.channel}"
+    if built_in.kind is CoordinationKind.PULL_DATA:
+        return f"{text} {built_in.output} <- channel {built_in.channel}"
+    if built_in.kind is CoordinationKind.MODE_CHANGE:
+        return f"{text} to {built_in.target_mode}"
+    text += f" {built_in.output} <- {inputs}"
+    if built_in.weights:
+        text += f" (weights {', '.join(f'{w:g}' for w in built_in.weights)})"
+    if built_in.options:
+        text += f" (options {', '.join(built_in.options)})"
+    return text
+
+
+def _activity_directives(directives: ActivityDirectives) -> list[str]:
+    """What the SISARL directives of an activity add: when it starts and ends, what it raises
+    (the messages that link the device's workflows to the user's), its time and CPU."""
+    from opspec.xpdl.sisarl_write import distribution_text
+
+    parts = []
+    if directives.start_trigger is not None:
+        parts.append(f"starts on {_trigger(directives.start_trigger)}")
+    if directives.end_trigger is not None:
+        parts.append(f"ends on {_trigger(directives.end_trigger)}")
+    if directives.raises is not None:
+        parts.append(f"raises {_trigger(directives.raises)}")
+    if directives.duration is not None:
+        parts.append(f"takes {distribution_text(directives.duration)}")
+    if directives.cpu_demand is not None:
+        parts.append(f"cpu {directives.cpu_demand:g} s")
+    elif directives.cpu_distribution is not None:
+        parts.append(f"cpu {distribution_text(directives.cpu_distribution)}")
+    if directives.priority_increment:
+        parts.append(f"priority +{directives.priority_increment}")
+    return parts
 
 
 def _kind(activity: Activity) -> str:
