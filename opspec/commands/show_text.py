@@ -30,6 +30,8 @@ __all__ = ["describe_package"]
 
 def describe_package(package: Package, *, process: str | None = None) -> str:
     """The ``text`` format: a compact, indented description of ``package``."""
+    from opspec.clock import span
+
     out: list[str] = []
     title = f"Package {package.id!r}" + (f" {package.name!r}" if package.name else "")
     out.append(f"{title}  ({package.source_format}"
@@ -57,6 +59,10 @@ def describe_package(package: Package, *, process: str | None = None) -> str:
             _lanes(out, pool.lanes, "    ")
     if package.modes:
         out.append("Modes: " + "; ".join(_mode(m, package) for m in package.modes))
+    if package.run_length is not None:
+        out.append(f"Run length: {span(package.run_length)}")
+    if package.message_ttl is not None:
+        out.append(f"Message TTL: {span(package.message_ttl)} (a message nobody waits for)")
     if package.metrics:
         out.append("Metrics: " + ", ".join(f"{m.name} ({m.kind.value})" for m in package.metrics))
     for proc in package.processes:
@@ -136,6 +142,12 @@ def _directives(directives: ProcessDirectives) -> str:
         parts.append(f"ends on {_trigger(directives.end_trigger)}")
     if directives.auto_start is not None:
         parts.append("auto-start" if directives.auto_start else "no auto-start")
+    if directives.arrival is not None:
+        from opspec.xpdl.sisarl_write import distribution_text
+
+        count = ("" if directives.arrival_count is None
+                 else f", {directives.arrival_count} in all")
+        parts.append(f"arrivals every {distribution_text(directives.arrival)}{count}")
     if directives.lane:
         parts.append(f"lane {directives.lane}")
     if directives.mode:

@@ -60,3 +60,15 @@ def test_an_activity_trigger_and_a_rule_s_condition_are_shown(
         encoding="utf-8")
     line = _lines(spec, capsys)["sound_alarm"]
     assert line.endswith(", ends on rule alarms > 2, raises message:trg_2")
+
+
+def test_arrivals_run_length_and_message_ttl_are_shown(
+        capsys: pytest.CaptureFixture[str]) -> None:
+    main(["show", str(ROOT / "tests" / "bpmn" / "data" / "simulation" / "qbp_loan.bpmn")])
+    assert ("  directives: arrivals every ExponentialDistribution(mean=600), 200 in all"
+            in capsys.readouterr().out.splitlines())
+    main(["show", str(SPECS / "vacuum_cleaner.xpdl")])
+    assert "Run length: 1.25 h" in capsys.readouterr().out.splitlines()
+    main(["show", str(SPECS / "medication_dispenser.xpdl")])
+    assert ("Message TTL: 1 min (a message nobody waits for)"
+            in capsys.readouterr().out.splitlines())
