@@ -8,7 +8,8 @@ opspec run OUT draws the same users as opspec run IN.
 Exit status: 0 written (warnings are printed); 1 the spec has errors, exactly those opspec
 validate reports (each printed as 'path:line: severity: message'; nothing is written); 2 the
 input cannot be read (missing, a folder, a pipe or device, no permission) or is a compiled
-script already, the output is the input itself, or the output cannot be written.
+script already, the output is a file the spec reads (itself, its user model, its world file, a
+mode's spec), or the output cannot be written.
 """
 
 from __future__ import annotations
@@ -31,10 +32,18 @@ def register(subparsers: Any) -> None:
 
 def run(args: argparse.Namespace) -> int:
     from opspec.commands._companions import copy_user_model
-    from opspec.commands._files import input_problem, same_file, translation_problem, write_problem
+    from opspec.commands._files import (
+        input_problem,
+        overwrite_problem,
+        same_file,
+        spec_inputs,
+        translation_problem,
+        write_problem,
+    )
     from opspec.commands.validate import engine_checks
     from opspec.errors import SpecError
-    from opspec.xpdl.compile import compile_spec, default_output
+    from opspec.model.codec import write_wfs
+    from opspec.xpdl.compile import compiled_package, default_output
 
     source = Path(args.input)
     if args.output == "-":
@@ -52,18 +61,26 @@ def run(args: argparse.Namespace) -> int:
         print(problem, file=sys.stderr)
         return 2
     try:
-        result = compile_spec(source, target, strict=args.strict, extra=engine_checks)
+        package, warnings = compiled_package(source, strict=args.strict, extra=engine_checks)
     except SpecError as error:
         return _refused(error, source)
+    # -o naming a file the spec reads (its world file, a mode's spec) would replace it
+    problem = overwrite_problem("compile", [("-o", target)], spec_inputs(source, package),
+                                example=f"{source.with_suffix('.wfs').name} beside it")
+    if problem is not None:
+        print(problem, file=sys.stderr)
+        return 2
+    try:
+        write_wfs(package, target)
     except OSError as error:
         print(f"opspec compile: {write_problem(target, error)}", file=sys.stderr)
         return 2
-    for diagnostic in result.diagnostics:
+    for diagnostic in warnings:
         print(diagnostic, file=sys.stderr)
-    print(f"{result.output}: compiled from {source}")
+    print(f"{target}: compiled from {source}")
     # a run of OUT looks for OUT.users.toml: without it, the user lane of a script compiled
     # to another name would run with nobody on it
-    copy_user_model("compile", source, result.output)
+    copy_user_model("compile", source, target)
     return 0
 
 

@@ -14,8 +14,9 @@ XPDL 2.1 XSD rejects gets a not-schema-valid warning.
 
 Exit status: 0 written; 1 the spec has errors (those opspec validate reports, or a built-in
 that cannot be expanded; nothing written); 2 the input cannot be read (missing, a folder, a
-pipe or device, no permission) or is a compiled workflow script (.wfs), the output is the
-input itself, or the output cannot be written.
+pipe or device, no permission) or is a compiled workflow script (.wfs), the output is a file
+the spec reads (itself, its user model, its world file, a mode's spec), or the output cannot
+be written.
 """
 
 from __future__ import annotations
@@ -42,7 +43,12 @@ def default_output(source: Path) -> Path:
 
 def run(args: argparse.Namespace) -> int:
     from opspec.commands._companions import copy_companion, copy_user_model
-    from opspec.commands._files import translation_problem, write_problem
+    from opspec.commands._files import (
+        overwrite_problem,
+        spec_inputs,
+        translation_problem,
+        write_problem,
+    )
     from opspec.commands.validate import engine_checks
     from opspec.errors import Severity
     from opspec.model.codec import write_atomically
@@ -74,6 +80,14 @@ def run(args: argparse.Namespace) -> int:
             print(diagnostic, file=sys.stderr)
         print(f"opspec preprocess: cannot read {source}; nothing written", file=sys.stderr)
         return 2
+    if target is not None and package is not None:
+        # -o naming a file the spec reads (its world file, a mode's spec) would replace it
+        problem = overwrite_problem("preprocess", [("-o", target)],
+                                    spec_inputs(source, package),
+                                    example=default_output(source).name)
+        if problem is not None:
+            print(problem, file=sys.stderr)
+            return 2
     copies: list[tuple[Path, Path]] = []          # world files to copy beside the output
     if report.ok and package is not None:
         result = preprocess(package)

@@ -14,8 +14,8 @@ when the picture is drawn; without dot, a one-line error with the install hint a
 status 2). Every error opspec validate finds is printed on stderr (the spec is still shown).
 
 Exit status: 0 shown, no errors; 1 shown, but the spec has errors (or the file holds no usable
-package); 2 the file cannot be read, the process does not exist, or -o names the spec itself
-(nothing is written then).
+package); 2 the file cannot be read, the process does not exist, or -o names the spec or a
+file it reads (its user model, its world file, a mode's spec; nothing is written then).
 """
 
 from __future__ import annotations
@@ -62,16 +62,6 @@ def run(args: argparse.Namespace) -> int:
 
     if getattr(args, "output", None) == "-":
         args.output = None                  # '-': the standard output (a file named '-' before)
-    if getattr(args, "output", None):
-        from opspec.commands._files import overwrite_problem
-
-        # -o SPEC would replace the spec with its own description
-        problem = overwrite_problem("show", [("-o", Path(args.output))],
-                                    [("SPEC", Path(args.spec))],
-                                    example=f"{Path(args.spec).stem}.{_SUFFIXES[args.format]}")
-        if problem is not None:
-            print(problem, file=sys.stderr)
-            return 2
     if str(args.spec).endswith(".wfs"):
         result = load_script(args.spec)
     else:
@@ -82,6 +72,12 @@ def run(args: argparse.Namespace) -> int:
             print(diagnostic, file=sys.stderr)
         unreadable = any(d.code == "io-error" for d in result.diagnostics)
         return 2 if unreadable else 1
+    if getattr(args, "output", None):
+        # -o naming the spec or a file it reads would replace it with the description
+        problem = _overwrite_problem(args, package)
+        if problem is not None:
+            print(problem, file=sys.stderr)
+            return 2
     if args.process is not None and package.process(args.process) is None:
         known = ", ".join(repr(p.id) for p in package.processes) or "none"
         print(f"opspec show: {args.spec} has no process {args.process!r} (processes: {known})",
@@ -117,6 +113,19 @@ def run(args: argparse.Namespace) -> int:
     else:
         sys.stdout.write(text)
     return 1 if errors else 0
+
+
+def _overwrite_problem(args: argparse.Namespace, package: Any) -> str | None:
+    """Why ``-o`` may not be written: it is the spec, its companion user model, or a file the
+    spec reads (its world file, a mode's spec); None when it may."""
+    from opspec.commands._files import overwrite_problem, spec_inputs
+    from opspec.request import companion_user_model
+
+    spec = Path(args.spec)
+    reads = [("SPEC", spec), ("SPEC's companion user model", companion_user_model(spec)),
+             *spec_inputs(package.source or spec, package)]
+    return overwrite_problem("show", [("-o", Path(args.output))], reads,
+                             example=f"{spec.stem}.{_SUFFIXES[args.format]}")
 
 
 #: The file name suffix suggested for each --format.
