@@ -278,6 +278,10 @@ def _print_unloadable(path: Path, errors: Sequence[Diagnostic], *, as_json: bool
         return
     for diagnostic in errors:
         print(diagnostic)
+    from opspec.xpdl.validate import IO_CODES
+
+    if errors and all(d.code in IO_CODES for d in errors):
+        return      # a device, a pipe, no permission: the line above says it all
     if nested:
         why = ("its blocks nest deeper than the check follows; change them as the nesting "
                "error above advises")
@@ -285,6 +289,9 @@ def _print_unloadable(path: Path, errors: Sequence[Diagnostic], *, as_json: bool
         # a well-formed file, maybe: "could not be read" would not say what to change
         why = ("the file is beyond a safety limit of the XML reader, so it was not read; "
                "change it as the error above advises")
+    elif Path(path).suffix == ".wfs":
+        why = ("the file could not be read as a compiled workflow script; fix or recompile "
+               "it as the error above says")
     else:
         why = ("the file could not be read as a spec (XPDL or BPMN); fix the errors listed "
                "above")
