@@ -6,6 +6,9 @@ taken) and report deadlocks, livelocks, activities that can never run, improper 
 AND-joins that can't fire and unbounded places, each with a witness path; plus violations of
 the package's declared graph conformance class (docs/soundness.md, opspec.model.soundness).
 
+SPEC is an XPDL or BPMN file, a compiled workflow script (.wfs: checked as the spec it was
+compiled from), or a folder of specs.
+
 Each problem prints as 'path:line: error: process: message' with its witness (the activities
 fired from the start) on the next line, then one line per process level and a summary per
 file; --json prints one JSON object per file instead (JSON Lines).
@@ -82,7 +85,13 @@ def run(args: argparse.Namespace) -> int:
         print(f"opspec check: {message}", file=sys.stderr)
     worst = 2 if usage else 0
     for path in files:
-        result = load_package(path)
+        if Path(path).suffix == ".wfs":
+            # a compiled script holds the package as the engine runs it: checked as its spec
+            from opspec.commands.show import load_script
+
+            result = load_script(str(path))
+        else:
+            result = load_package(path)
         errors = result.errors
         if result.package is None:
             _print_unloadable(path, result.diagnostics, as_json=args.json)
@@ -127,8 +136,10 @@ def run(args: argparse.Namespace) -> int:
             done = {r.process for r in reports}
             reports = [*reports, *(SoundnessReport(p.id, 0, False, (), stopped="memory")
                                    for p in processes if p.id not in done)]
+        # a script's lines are those of the spec it was compiled from
+        lines_in = (package.source or None) if Path(path).suffix == ".wfs" else None
         status = _print(path, reports, errors, as_json=args.json, max_states=args.max_states,
-                        in_levels=errors_by_level(package, errors))
+                        in_levels=errors_by_level(package, errors), lines_in=lines_in)
         if getattr(args, "schedulability", False) and not errors:
             status = max(status, _schedulability(package, as_json=args.json))
         worst = max(worst, status)
@@ -267,6 +278,10 @@ def _print_unloadable(path: Path, errors: Sequence[Diagnostic], *, as_json: bool
         return
     for diagnostic in errors:
         print(diagnostic)
+    from opspec.xpdl.validate import IO_CODES
+
+    if errors and all(d.code in IO_CODES for d in errors):
+        return      # a device, a pipe, no permission: the line above says it all
     if nested:
         why = ("its blocks nest deeper than the check follows; change them as the nesting "
                "error above advises")
@@ -274,6 +289,9 @@ def _print_unloadable(path: Path, errors: Sequence[Diagnostic], *, as_json: bool
         # a well-formed file, maybe: "could not be read" would not say what to change
         why = ("the file is beyond a safety limit of the XML reader, so it was not read; "
                "change it as the error above advises")
+    elif Path(path).suffix == ".wfs":
+        why = ("the file could not be read as a compiled workflow script; fix or recompile "
+               "it as the error above says")
     else:
         why = ("the file could not be read as a spec (XPDL or BPMN); fix the errors listed "
                "above")
@@ -288,18 +306,22 @@ def _problem_json(p: Any) -> dict[str, Any]:
 
 def _print(path: Path, reports: list[SoundnessReport], errors: Sequence[Diagnostic], *,
            as_json: bool, max_states: int,
-           in_levels: dict[str, list[Diagnostic]] | None = None) -> int:
+           in_levels: dict[str, list[Diagnostic]] | None = None,
+           lines_in: str | None = None) -> int:
     """Print one file's verdict; return its exit status (0 or 1). Load ``errors`` make it
     1, and so does an inconclusive level (the budget ran out; the file is never called
     sound then). A level with errors in it (``in_levels``: the errors by level) is never
-    called sound either, whatever the exploration of what could be read of it found."""
+    called sound either, whatever the exploration of what could be read of it found.
+    ``lines_in``: the file the problems' lines are in, when not ``path`` (a compiled
+    script's are its spec's)."""
     in_levels = in_levels or {}
     problems = [p for r in reports for p in r.problems]
     failing = [p for p in problems if p.severity == "error"]
     undecided = [r for r in reports if not r.complete]
     if as_json:
         print(json.dumps({
-            "path": str(path), "sound": not failing and not undecided and not errors,
+            "path": str(path), **({"lines_in": lines_in} if lines_in else {}),
+            "sound": not failing and not undecided and not errors,
             "loaded": True,
             "max_states": max_states,
             "inconclusive": bool(undecided),
@@ -320,7 +342,7 @@ def _print(path: Path, reports: list[SoundnessReport], errors: Sequence[Diagnost
         for diagnostic in errors:
             print(diagnostic)
         for problem in problems:
-            where = f"{path}:{problem.line}" if problem.line else str(path)
+            where = (f"{lines_in or path}:{problem.line}" if problem.line else str(path))
             print(f"{where}: {problem.severity}: {problem.process}: {problem.message}")
             if problem.witness:
                 cyclic = problem.kind == "conformance" and len(problem.witness) > 1 and (

@@ -14,8 +14,9 @@ XPDL 2.1 XSD rejects gets a not-schema-valid warning.
 
 Exit status: 0 written; 1 the spec has errors (those opspec validate reports, or a built-in
 that cannot be expanded; nothing written); 2 the input cannot be read (missing, a folder, a
-pipe or device, no permission), the output is the input itself, or the output cannot be
-written.
+pipe or device, no permission) or is a compiled workflow script (.wfs), the output is a file
+the spec reads (itself, its user model, its world file, a mode's spec), or the output cannot
+be written.
 """
 
 from __future__ import annotations
@@ -41,7 +42,13 @@ def default_output(source: Path) -> Path:
 
 
 def run(args: argparse.Namespace) -> int:
-    from opspec.commands._files import translation_problem, write_problem
+    from opspec.commands._companions import copy_companion, copy_user_model
+    from opspec.commands._files import (
+        overwrite_problem,
+        spec_inputs,
+        translation_problem,
+        write_problem,
+    )
     from opspec.commands.validate import engine_checks
     from opspec.errors import Severity
     from opspec.model.codec import write_atomically
@@ -63,11 +70,24 @@ def run(args: argparse.Namespace) -> int:
     # The spec is refused for exactly the errors `opspec validate` reports.
     package, report = validate_spec(source, strict=args.strict, extra=engine_checks)
     diagnostics = list(report.diagnostics)
+    if any(d.code == "compiled-script" for d in diagnostics):
+        # the wrong file (a script has no SISARL built-ins left), not a spec with errors
+        print(f"opspec preprocess: {source} is a compiled workflow script (.wfs), not XPDL; "
+              "nothing written. Preprocess the XPDL it was compiled from", file=sys.stderr)
+        return 2
     if any(d.code in IO_CODES for d in diagnostics):
         for diagnostic in diagnostics:
             print(diagnostic, file=sys.stderr)
         print(f"opspec preprocess: cannot read {source}; nothing written", file=sys.stderr)
         return 2
+    if target is not None and package is not None:
+        # -o naming a file the spec reads (its world file, a mode's spec) would replace it
+        problem = overwrite_problem("preprocess", [("-o", target)],
+                                    spec_inputs(source, package),
+                                    example=default_output(source).name)
+        if problem is not None:
+            print(problem, file=sys.stderr)
+            return 2
     copies: list[tuple[Path, Path]] = []          # world files to copy beside the output
     if report.ok and package is not None:
         result = preprocess(package)
@@ -98,42 +118,7 @@ def run(args: argparse.Namespace) -> int:
         print(f"opspec preprocess: {write_problem(target, error)}", file=sys.stderr)
         return 2
     print(f"{target}: standard XPDL 2.1 from {source}")
-    _copy_user_model(source, target)
+    copy_user_model("preprocess", source, target)
     for original, copy in copies:
-        _copy_companion(original, copy, "world file")
+        copy_companion("preprocess", original, copy, "world file")
     return 0
-
-
-def _copy_user_model(source: Path, target: Path) -> None:
-    """Copy the spec's companion ``SPEC.users.toml`` to the output's companion name, so
-    ``opspec evaluate OUT`` draws the same users (an existing different file is kept)."""
-
-    from opspec.request import companion_user_model
-
-    model = companion_user_model(source)
-    if model is None:
-        return
-    copy = target.with_name(target.name.removesuffix(target.suffix) + ".users.toml")
-    _copy_companion(model, copy, "user model")
-
-
-def _copy_companion(original: Path, copy: Path, what: str) -> None:
-    """Copy ``original`` to ``copy`` for the output (an existing different file is kept)."""
-    import shutil
-
-    from opspec.commands._files import same_file
-
-    if same_file(original, copy):
-        return
-    try:
-        if copy.exists():
-            if copy.read_bytes() != original.read_bytes():
-                print(f"opspec preprocess: kept {copy}, which differs from {original} (the "
-                      f"output's {what})", file=sys.stderr)
-            return
-        shutil.copyfile(original, copy)
-    except OSError as error:
-        print(f"opspec preprocess: could not copy the {what} {original} to {copy}: "
-              f"{error.strerror or error}", file=sys.stderr)
-        return
-    print(f"{copy}: {what} of the output, copied from {original}")

@@ -2,8 +2,10 @@
 
 Print what SPEC holds, as readable text or as Graphviz DOT, or draw the whole package as SVG
 or as an HTML page. text (the default) prints the package header, participants (human or
-system), pools and lanes, and every process with its directives, data, activities (kind,
-performer, manual or automatic, deadlines) and transitions with their conditions. dot prints a
+system), pools and lanes, modes and their workflows, and every process with its directives,
+data, activities (kind, performer, manual or automatic, deadlines, the messages they raise,
+their triggers, durations and CPU demands, what a built-in reads and writes) and transitions
+with their conditions. dot prints a
 Graphviz digraph per process (opspec.xpdl.dot; render it with e.g.
 'opspec show SPEC --format dot | dot -Tsvg -o out.svg'). svg and html draw every process with
 its lanes and the messages between them in one picture (opspec.xpdl.picture, laid out by
@@ -12,7 +14,8 @@ when the picture is drawn; without dot, a one-line error with the install hint a
 status 2). Every error opspec validate finds is printed on stderr (the spec is still shown).
 
 Exit status: 0 shown, no errors; 1 shown, but the spec has errors (or the file holds no usable
-package); 2 the file cannot be read or the process does not exist.
+package); 2 the file cannot be read, the process does not exist, or -o names the spec or a
+file it reads (its user model, its world file, a mode's spec; nothing is written then).
 """
 
 from __future__ import annotations
@@ -24,7 +27,7 @@ from typing import Any
 
 from opspec.commands._args import add_spec, command
 
-__all__ = ["describe_package", "register", "run"]
+__all__ = ["describe_package", "load_script", "register", "run"]
 
 
 def __getattr__(name: str) -> Any:
@@ -46,7 +49,8 @@ def register(subparsers: Any) -> None:
                         "in one picture)")
     parser.add_argument("--process", metavar="ID", help="only this process (by Id)")
     parser.add_argument("-o", "--output", metavar="FILE",
-                        help="write to FILE instead of the standard output; nothing is "
+                        help="write to FILE instead of the standard output ('-': the "
+                        "standard output); nothing is "
                         "written (no empty file) when the output cannot be made, e.g. "
                         "without Graphviz")
     parser.set_defaults(handler=run)
@@ -56,8 +60,10 @@ def run(args: argparse.Namespace) -> int:
     from opspec.errors import Severity
     from opspec.xpdl.dot import package_to_dot
 
+    if getattr(args, "output", None) == "-":
+        args.output = None                  # '-': the standard output (a file named '-' before)
     if str(args.spec).endswith(".wfs"):
-        result = _load_script(args.spec)
+        result = load_script(args.spec)
     else:
         result = _validated(args.spec)
     package = result.package
@@ -66,6 +72,12 @@ def run(args: argparse.Namespace) -> int:
             print(diagnostic, file=sys.stderr)
         unreadable = any(d.code == "io-error" for d in result.diagnostics)
         return 2 if unreadable else 1
+    if getattr(args, "output", None):
+        # -o naming the spec or a file it reads would replace it with the description
+        problem = _overwrite_problem(args, package)
+        if problem is not None:
+            print(problem, file=sys.stderr)
+            return 2
     if args.process is not None and package.process(args.process) is None:
         known = ", ".join(repr(p.id) for p in package.processes) or "none"
         print(f"opspec show: {args.spec} has no process {args.process!r} (processes: {known})",
@@ -101,6 +113,23 @@ def run(args: argparse.Namespace) -> int:
     else:
         sys.stdout.write(text)
     return 1 if errors else 0
+
+
+def _overwrite_problem(args: argparse.Namespace, package: Any) -> str | None:
+    """Why ``-o`` may not be written: it is the spec, its companion user model, or a file the
+    spec reads (its world file, a mode's spec); None when it may."""
+    from opspec.commands._files import overwrite_problem, spec_inputs
+    from opspec.request import companion_user_model
+
+    spec = Path(args.spec)
+    reads = [("SPEC", spec), ("SPEC's companion user model", companion_user_model(spec)),
+             *spec_inputs(package.source or spec, package)]
+    return overwrite_problem("show", [("-o", Path(args.output))], reads,
+                             example=f"{spec.stem}.{_SUFFIXES[args.format]}")
+
+
+#: The file name suffix suggested for each --format.
+_SUFFIXES = {"text": "txt", "dot": "dot", "svg": "svg", "html": "html"}
 
 
 def _write_whole(path: Path, text: str) -> None:
@@ -151,7 +180,7 @@ def _unreadable(path: str) -> Any:
                       "specs are not read from folders, pipes or devices")
 
 
-def _load_script(path: str) -> Any:
+def load_script(path: str) -> Any:
     """A compiled workflow script (``.wfs``) as a :class:`~opspec.xpdl.loader.LoadResult`
     (compiled only from specs without errors, so it carries no diagnostics)."""
     from pathlib import Path

@@ -16,13 +16,22 @@ from opspec.model.data import BasicType, DataField, DataType, DeclaredType, Form
 from opspec.model.package import Package
 from opspec.model.process import ConditionKind, Transition, WorkflowProcess
 from opspec.model.resources import Lane, ParticipantType
-from opspec.model.sisarl import ProcessDirectives, TriggerRef
+from opspec.model.sisarl import (
+    ActivityDirectives,
+    CoordinationBuiltIn,
+    CoordinationKind,
+    ProcessDirectives,
+    TriggerRef,
+    WorkflowMode,
+)
 
 __all__ = ["describe_package"]
 
 
 def describe_package(package: Package, *, process: str | None = None) -> str:
     """The ``text`` format: a compact, indented description of ``package``."""
+    from opspec.clock import span
+
     out: list[str] = []
     title = f"Package {package.id!r}" + (f" {package.name!r}" if package.name else "")
     out.append(f"{title}  ({package.source_format}"
@@ -49,9 +58,11 @@ def describe_package(package: Package, *, process: str | None = None) -> str:
             out.append(f"  {pool.id} {pool.name or ''}{owner}".rstrip())
             _lanes(out, pool.lanes, "    ")
     if package.modes:
-        out.append("Modes: " + "; ".join(
-            f"{m.id}{' (initial)' if m.initial else ''}: {', '.join(m.workflows)}"
-            for m in package.modes))
+        out.append("Modes: " + "; ".join(_mode(m, package) for m in package.modes))
+    if package.run_length is not None:
+        out.append(f"Run length: {span(package.run_length)}")
+    if package.message_ttl is not None:
+        out.append(f"Message TTL: {span(package.message_ttl)} (a message nobody waits for)")
     if package.metrics:
         out.append("Metrics: " + ", ".join(f"{m.name} ({m.kind.value})" for m in package.metrics))
     for proc in package.processes:
@@ -59,6 +70,16 @@ def describe_package(package: Package, *, process: str | None = None) -> str:
             out.append("")
             _process(out, proc, package)
     return "\n".join(out) + "\n"
+
+
+def _mode(mode: WorkflowMode, package: Package) -> str:
+    """A mode and the workflows it runs: those it lists and those whose ``opspec:Mode`` names
+    it, as the engine gathers them (most specs only use the latter)."""
+    workflows = dict.fromkeys((*mode.workflows, *(p.id for p in package.processes
+                                                  if p.directives.mode == mode.id)))
+    text = mode.id + (" (initial)" if mode.initial else "")
+    text += f": {', '.join(workflows)}" if workflows else ": no workflow"
+    return text + (f", loads {mode.source}" if mode.source else "")
 
 
 def _role(kind: ParticipantType) -> str:
@@ -95,6 +116,10 @@ def _trigger(trigger: TriggerRef) -> str:
 
     if trigger.name:
         return f"{trigger.kind}:{trigger.name}"
+    if trigger.kind == "rule" and trigger.condition is not None:
+        from opspec.model.expression_text import to_text
+
+        return f"rule {to_text(trigger.condition)}"
     text = trigger.kind
     if trigger.at:
         text += " at " + ", ".join(time_of_day(t) for t in trigger.at)
@@ -117,6 +142,12 @@ def _directives(directives: ProcessDirectives) -> str:
         parts.append(f"ends on {_trigger(directives.end_trigger)}")
     if directives.auto_start is not None:
         parts.append("auto-start" if directives.auto_start else "no auto-start")
+    if directives.arrival is not None:
+        from opspec.xpdl.sisarl_write import distribution_text
+
+        count = ("" if directives.arrival_count is None
+                 else f", {directives.arrival_count} in all")
+        parts.append(f"arrivals every {distribution_text(directives.arrival)}{count}")
     if directives.lane:
         parts.append(f"lane {directives.lane}")
     if directives.mode:
@@ -187,10 +218,51 @@ def _activity(activity: Activity, process: WorkflowProcess, package: Package) ->
                      + (f" while {activity.loop.condition_text}"
                         if activity.loop.condition_text else ""))
     if activity.coordination is not None:
-        parts.append(f"built-in {activity.coordination.kind.value}")
-    if activity.directives.priority_increment:
-        parts.append(f"priority +{activity.directives.priority_increment}")
+        parts.append(_built_in(activity.coordination))
+    parts.extend(_activity_directives(activity.directives))
     return ", ".join(parts)
+
+
+def _built_in(built_in: CoordinationBuiltIn) -> str:
+    """``built-in arbiter motor_cmd <- escape_cmd, avoid_cmd``, ``built-in push distance ->
+    channel range``, ``built-in mode-change to dock``: what it reads and writes."""
+    text = f"built-in {built_in.kind.value}"
+    inputs = ", ".join(built_in.inputs)
+    if built_in.kind is CoordinationKind.PUSH_DATA:
+        return f"{text} {inputs} -> channel {built_in.channel}"
+    if built_in.kind is CoordinationKind.PULL_DATA:
+        return f"{text} {built_in.output} <- channel {built_in.channel}"
+    if built_in.kind is CoordinationKind.MODE_CHANGE:
+        return f"{text} to {built_in.target_mode}"
+    text += f" {built_in.output} <- {inputs}"
+    if built_in.weights:
+        text += f" (weights {', '.join(f'{w:g}' for w in built_in.weights)})"
+    if built_in.options:
+        text += f" (options {', '.join(built_in.options)})"
+    return text
+
+
+def _activity_directives(directives: ActivityDirectives) -> list[str]:
+    """What the SISARL directives of an activity add: when it starts and ends, what it raises
+    (the messages that link the device's workflows to the user's), its time and CPU."""
+    from opspec.xpdl.sisarl_write import distribution_text
+
+    parts = []
+    if directives.start_trigger is not None:
+        parts.append(f"starts on {_trigger(directives.start_trigger)}")
+    if directives.end_trigger is not None:
+        parts.append(f"ends on {_trigger(directives.end_trigger)}")
+    if directives.raises is not None:
+        parts.append(f"raises {_trigger(directives.raises)}")
+    if directives.duration is not None:
+        parts.append(f"takes {distribution_text(directives.duration)}")
+    if directives.cpu_demand is not None:
+        parts.append(f"cpu {directives.cpu_demand:g} s")
+    elif directives.cpu_distribution is not None:
+        parts.append(f"cpu {distribution_text(directives.cpu_distribution)}")
+    if directives.priority_increment:
+        parts.append(f"priority +{directives.priority_increment}")
+    return parts
 
 
 def _kind(activity: Activity) -> str:

@@ -140,7 +140,20 @@ _SCALARS = (str, int, float, bool, type(None))
 
 
 class _CorruptError(Exception):
-    """Internal: the document does not describe a model; turned into a SpecError by callers."""
+    """Internal: the document does not describe a model; turned into a SpecError by callers.
+    ``where``: the objects and field it was found in, outermost first (a hand-edited script's
+    "expected str, got 5" alone does not say which of its thousands of values it is)."""
+
+    def __init__(self, message: str, where: tuple[str, ...] = ()) -> None:
+        super().__init__(message)
+        self.message = message
+        self.where = where
+
+    def __str__(self) -> str:
+        if not self.where:
+            return self.message
+        *objects, field = self.where
+        return f"{self.message} (in {' > '.join(objects)}, field {field})"
 
 
 # --------------------------------------------------------------------------- encoding
@@ -334,7 +347,12 @@ def _decode_object(cls: type, value: dict[str, Any]) -> Any:
         decoder = decoders.get(key)
         if decoder is None:
             raise _CorruptError(f"{value['$']} has no field {key!r}")
-        kwargs[key] = decoder(item)
+        try:
+            kwargs[key] = decoder(item)
+        except _CorruptError as error:
+            ident = value.get("id")
+            label = value["$"] + (f" {ident!r}" if type(ident) is str else "")
+            raise _CorruptError(error.message, (label, *(error.where or (key,)))) from None
     try:
         return cls(**kwargs)
     except TypeError as error:  # a required field is missing
@@ -450,9 +468,46 @@ def _file_mode(target: Path) -> int:
 
 def write_wfs(package: Package, path: str | os.PathLike[str]) -> None:
     """Write ``package`` to ``path`` atomically (see :func:`write_atomically`), so a reader
-    never sees half a script. ``OSError`` propagates (the caller reports it as an I/O
-    problem)."""
+    never sees half a script. Its ``source`` is written relative to the script's folder
+    (:func:`read_wfs` turns it back into a path from the current folder). ``OSError``
+    propagates (the caller reports it as an I/O problem)."""
+    if package.source:
+        package = dataclasses.replace(package, source=_from_folder(package.source, path))
     write_atomically(path, dumps(package).encode("ascii") + b"\n")
+
+
+# A spec names its companion files (opspec:WorldFile, a mode's Source, ExternalPackage hrefs)
+# relative to its own folder, found from Package.source. A source written as compile was
+# given it (relative to the folder compile ran in) led nowhere from any other folder: 'opspec
+# run specs/vacuum_cleaner.wfs' worked from one folder only. Relative to the script, it holds
+# wherever the command runs and when the script and its spec move together (an absolute path
+# is kept as given).
+
+def _from_folder(source: str, script: str | os.PathLike[str]) -> str:
+    """``source`` (a path from the current folder) as a path from ``script``'s folder; an
+    absolute path stays as it is."""
+    if "://" in source or os.path.isabs(source):
+        return source
+    try:
+        moved = os.path.relpath(os.path.abspath(source),
+                                os.path.dirname(os.path.abspath(script)))
+    except ValueError:                  # another drive (Windows): no relative path there
+        return source
+    return Path(moved).as_posix()
+
+
+def _from_here(source: str, script: str | os.PathLike[str]) -> str:
+    """``source`` as stored in ``script`` (relative to the script's folder) as a path from
+    the current folder: relative when it lies below it, else absolute. A script written before
+    sources were stored that way holds a path from the folder it was compiled in: when only
+    that path leads to a file, it is kept."""
+    if "://" in source or os.path.isabs(source):
+        return source
+    found = os.path.normpath(os.path.join(os.path.dirname(os.path.abspath(script)), source))
+    if not os.path.exists(found) and os.path.isfile(source):
+        return source
+    here = os.path.relpath(found)
+    return found if here == os.pardir or here.startswith(os.pardir + os.sep) else here
 
 
 def write_atomically(path: str | os.PathLike[str], data: bytes) -> None:
@@ -480,7 +535,8 @@ def write_atomically(path: str | os.PathLike[str], data: bytes) -> None:
 
 
 def read_wfs(path: str | os.PathLike[str]) -> Package:
-    """The package stored in the ``.wfs`` file at ``path``.
+    """The package stored in the ``.wfs`` file at ``path``, its ``source`` a path from the
+    current folder (:func:`write_wfs`).
 
     Raises :class:`SpecError` when the file cannot be read, is not a workflow script (an XPDL
     file given by mistake, another JSON file), comes from a newer opspec, or is corrupt.
@@ -498,4 +554,7 @@ def read_wfs(path: str | os.PathLike[str]) -> Package:
             f"{where}: this is XML (an XPDL file?), not a compiled workflow script",
             hint=f"compile it with `opspec compile {where}`, or load it as XPDL",
         )
-    return loads(raw, where=where)
+    package = loads(raw, where=where)
+    if package.source:
+        package = dataclasses.replace(package, source=_from_here(package.source, path))
+    return package

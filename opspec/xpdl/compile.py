@@ -18,7 +18,7 @@ from opspec.model.codec import write_wfs
 from opspec.model.package import Package
 from opspec.xpdl.validate import validate_spec
 
-__all__ = ["CompileResult", "compile_spec", "default_output"]
+__all__ = ["CompileResult", "compile_spec", "compiled_package", "default_output"]
 
 
 @dataclass(frozen=True, slots=True)
@@ -55,9 +55,21 @@ def compile_spec(
     if target.exists() and Path(source).exists() and os.path.samefile(source, target):
         raise ConfigurationError(f"the output {target} is the input file itself",
                                  hint="write the compiled script to another file")
+    package, warnings = compiled_package(source, strict=strict, extra=extra)
+    write_wfs(package, target)
+    return CompileResult(package, target, warnings)
+
+
+def compiled_package(
+    source: str | os.PathLike[str],
+    *,
+    strict: bool = False,
+    extra: Callable[[Package], Iterable[Diagnostic]] | None = None,
+) -> tuple[Package, tuple[Diagnostic, ...]]:
+    """The package :func:`compile_spec` writes, and its warnings; nothing is written.
+    Raises :class:`SpecError` as :func:`compile_spec` does."""
     package, report = validate_spec(Path(source), strict=strict, extra=extra)
     if package is None or not report.ok:
         raise SpecError.from_diagnostics(report.diagnostics)
-    write_wfs(package, target)
     warnings = tuple(d for d in report.diagnostics if d.severity is not Severity.ERROR)
-    return CompileResult(package, target, warnings)
+    return package, warnings
