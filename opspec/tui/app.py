@@ -75,6 +75,10 @@ Device panel: (!) an alert (a ringing alarm), (x) a device
 fault, > what a participant is doing now.
 
 Press escape or ? to close."""
+# In the frame of the help and the summary, so that it shows however little of them fits
+# (at 80 x 24 neither fits whole; the arrow keys scroll them).
+CLOSE_HELP = "escape or ?: close  q: quit  arrows: scroll"
+CLOSE_SUMMARY = "escape: close  q: quit  arrows: scroll"
 
 
 class HelpScreen(ModalScreen[None]):
@@ -82,12 +86,15 @@ class HelpScreen(ModalScreen[None]):
                           Binding("q", "app.quit_walk", "quit")]
     DEFAULT_CSS = """
     HelpScreen { align: center middle; }
-    HelpScreen > Static { width: 70; max-width: 100%; border: heavy $accent; padding: 1 2;
-                          background: $surface; }
+    HelpScreen > VerticalScroll { width: 72; max-width: 100%; height: auto;
+                                  max-height: 100%; border: heavy $accent; padding: 1 2;
+                                  background: $surface; }
     """
 
     def compose(self) -> ComposeResult:
-        yield Static(HELP, id="help-text")
+        with VerticalScroll() as frame:
+            frame.border_subtitle = CLOSE_HELP
+            yield Static(HELP, id="help-text")
 
 
 class SummaryScreen(ModalScreen[None]):
@@ -107,7 +114,8 @@ class SummaryScreen(ModalScreen[None]):
         self.lines = list(lines)
 
     def compose(self) -> ComposeResult:
-        with VerticalScroll():
+        with VerticalScroll() as frame:
+            frame.border_subtitle = CLOSE_SUMMARY
             yield Static(Text("\n".join([*self.lines, "", "q: quit   escape: close"])),
                          id="summary-text")
 
