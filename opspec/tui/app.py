@@ -348,7 +348,10 @@ class WalkthroughApp(App[str | None]):
         self.refresh_views()
 
     def action_hand_over(self) -> None:
-        if self.session.replaying:
+        if not self.session.has_user_lane:     # a user model would have nothing to do
+            self.notify("This spec has no user lane: there is nothing to hand over.",
+                        severity="warning")
+        elif self.session.replaying:
             self.notify("The recording performs your lane: there is nothing to hand over.",
                         severity="warning")
         elif self.session.handed_over:
