@@ -445,7 +445,12 @@ class WalkthroughApp(App[str | None]):
         call = self.query_one("#call", Static)
         if session.calling:
             person.add_class("calling")
-            call.update(Text("(!) THE DEVICE CALLS YOU", style="bold reverse"))
+            banner = Text("(!) THE DEVICE CALLS YOU", style="bold reverse")
+            if session.person_performs and not session.offers:
+                # the alarm rings on after the person let it pass (x), or before their
+                # lane offers anything: say that nothing is asked of them, not a blank
+                banner.append("\n" + self._idle_text())
+            call.update(banner)
         else:
             person.remove_class("calling")
             call.update(self._idle_text())
