@@ -33,6 +33,7 @@ from textual.theme import Theme
 from textual.widgets import Digits, Footer, Static
 
 from opspec.engine.lane_labels import lane_labels
+from opspec.tui.pace import Pace
 from opspec.tui.session import WalkSession, clock, time_of_day_shown
 from opspec.tui.sound import Cue
 
@@ -246,6 +247,7 @@ class WalkthroughApp(App[str | None]):
         #: the timeline's lane column: the spec's lane names, one width for all lines
         self._lanes = lane_labels(session.compiled)
         self._was_calling = False
+        self._pace = Pace()                  # the speed the clock really keeps
         self._summary_shown = False          # the end-of-run summary opens once
         self._views_ready = False            # set once mounted, cleared when quitting
         session.listeners.append(self._on_event)
@@ -288,10 +290,16 @@ class WalkthroughApp(App[str | None]):
         before = len(session.offers)
         skipping = session.skipping
         if skipping or session.paused or session.ended:
+            self._pace.reset()
             session.advance(wall_seconds, SLICE_STEPS)
             self._go_on_skipping()
         else:
-            self._run_slices(session.now + wall_seconds * session.speed)
+            start = session.now
+            self._run_slices(start + wall_seconds * session.speed)
+            if session.waiting_for_devices:        # the clock waits for a real answer
+                self._pace.reset()
+            else:
+                self._pace.ran(wall_seconds, session.now - start, session.speed)
         if not session.paused or skipping or len(session.offers) != before:
             self.refresh_views()
 
@@ -433,10 +441,11 @@ class WalkthroughApp(App[str | None]):
                else "no user lane" if not session.has_user_lane
                else "model performs your lane" if session.handed_over
                else "you perform the lane")
+        pace = self._pace.shown() if state == "running" else ""
         if session.call_mode and state == "running":
             state = "running in real time: the device calls"
         self.query_one("#status", Static).update(Text(
-            f"{clock(session.now)}  {session.speed:g}x  {state}  |  {who}  |  "
+            f"{clock(session.now)}  {session.speed:g}x{pace}  {state}  |  {who}  |  "
             f"{self.spec_title}", no_wrap=True, overflow="ellipsis"))
         if self.large:
             self.query_one("#bigclock", Digits).update(time_of_day_shown(session.now)[:5])
