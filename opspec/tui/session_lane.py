@@ -31,9 +31,13 @@ class PersonLane(SessionState):
 
     @guarded()
     def ignore(self, offer: Offer) -> None:
-        """The person explicitly does not do ``offer`` (omission)."""
-        engine = self._take(offer, tagged_action("omit", offer.item.activity,
-                                                 offer.item.instance), f"not: {offer.label}")
+        """The person explicitly does not do ``offer`` (omission). Of a deferred choice the
+        whole choice is omitted, none of its alternatives done: it is named, not the first."""
+        item = offer.item
+        what = offer.label if offer.choice is None else self._label_of(item.process,
+                                                                       item.activity)
+        engine = self._take(offer, tagged_action("omit", item.activity, item.instance),
+                            f"not: {what}")
         if engine is not None:
             engine.omit(offer.item, "the person chose not to")
             self._follow_call()
