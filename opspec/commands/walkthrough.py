@@ -179,6 +179,7 @@ def run(args: argparse.Namespace) -> int:
         device_report = None
         try:
             app.run()
+            interrupted = getattr(app, "interrupted", False)   # the app caught a SIGINT
         except KeyboardInterrupt:          # a SIGINT from outside the terminal's keys
             interrupted = True
         finally:

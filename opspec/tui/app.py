@@ -27,17 +27,19 @@ from rich.text import Text
 from textual import events
 from textual.app import App, ComposeResult
 from textual.binding import Binding
-from textual.containers import Horizontal, Vertical, VerticalScroll
+from textual.containers import Horizontal, Vertical
 from textual.screen import ModalScreen
 from textual.theme import Theme
 from textual.widgets import Digits, Footer, Static
 
 from opspec.engine.lane_labels import lane_labels
+from opspec.tui.interrupt import watch_interrupts
+from opspec.tui.modals import HELP, HelpScreen, SummaryScreen
 from opspec.tui.pace import Pace
 from opspec.tui.session import WalkSession, clock, time_of_day_shown
 from opspec.tui.sound import Cue
 
-__all__ = ["WalkthroughApp"]
+__all__ = ["HELP", "SummaryScreen", "WalkthroughApp"]
 
 SPEEDS = {"1": 1.0, "2": 10.0, "3": 60.0, "4": 600.0}
 # the offers shown: every letter no other action uses (h l n q s u w x are taken), a..f first
@@ -50,76 +52,6 @@ TICK_S = 0.1
 SLICE_STEPS = 200
 SLICE_S = 0.08
 KEY_S = 0.25                  # a key's own jump (w, n) may take a little longer
-
-HELP = """\
-[b]opspec walkthrough — keys[/b]
-
-  [b]a[/b]–[b]z[/b]     do the action shown next to the letter (or click it)
-  [b]x[/b]       do not do the first action (an omission, recorded)
-  [b]space[/b]   pause / resume the clock
-  [b]1 2 3 4[/b] speed: real time, 10x, 60x, 600x
-  [b]w[/b]       let 30 simulated seconds pass
-  [b]n[/b]       step: skip to the next event
-  [b]u[/b]       skip until something new needs you (again: stop)
-  [b]h[/b]       hand your lane to the user model / take it back
-  [b]l[/b]       timeline: all lanes / device / user
-          (/ hidden, with --large)
-  [b]s[/b]       the summary so far (metrics, your response times)
-  [b]?[/b]       this help (the clock stops while it is open)
-  [b]q[/b], [b]ctrl+c[/b], [b]ctrl+q[/b] quit (the recording is kept)
-
-When the device calls you, the clock drops to real time (or
-pauses, with --on-call pause) and comes back when the call is
-over.
-
-Device panel: (!) an alert (a ringing alarm), (x) a device
-fault, > what a participant is doing now.
-
-Press escape or ? to close."""
-# In the frame of the help and the summary, so that it shows however little of them fits
-# (at 80 x 24 neither fits whole; the arrow keys scroll them).
-CLOSE_HELP = "escape or ?: close  q: quit  arrows: scroll"
-CLOSE_SUMMARY = "escape: close  q: quit  arrows: scroll"
-
-
-class HelpScreen(ModalScreen[None]):
-    BINDINGS: ClassVar = [Binding("escape,question_mark", "dismiss", "close"),
-                          Binding("q", "app.quit_walk", "quit")]
-    DEFAULT_CSS = """
-    HelpScreen { align: center middle; }
-    HelpScreen > VerticalScroll { width: 72; max-width: 100%; height: auto;
-                                  max-height: 100%; border: heavy $accent; padding: 1 2;
-                                  background: $surface; }
-    """
-
-    def compose(self) -> ComposeResult:
-        with VerticalScroll() as frame:
-            frame.border_subtitle = CLOSE_HELP
-            yield Static(HELP, id="help-text")
-
-
-class SummaryScreen(ModalScreen[None]):
-    """The summary: at the end of the run (it opens by itself), or so far (``s``)."""
-
-    BINDINGS: ClassVar = [Binding("escape,s,space", "dismiss", "close"),
-                          Binding("q", "app.quit_walk", "quit")]
-    DEFAULT_CSS = """
-    SummaryScreen { align: center middle; }
-    SummaryScreen > VerticalScroll { width: 100; max-width: 100%; height: auto;
-                                     max-height: 100%; border: heavy $accent; padding: 0 1;
-                                     background: $surface; }
-    """
-
-    def __init__(self, lines: Sequence[str]) -> None:
-        super().__init__()
-        self.lines = list(lines)
-
-    def compose(self) -> ComposeResult:
-        with VerticalScroll() as frame:
-            frame.border_subtitle = CLOSE_SUMMARY
-            yield Static(Text("\n".join([*self.lines, "", "q: quit   escape: close"])),
-                         id="summary-text")
-
 
 class FittingFooter(Footer):
     """The footer, its keys closed up on a terminal narrower than the spaced-out footer, so
@@ -248,6 +180,9 @@ class WalkthroughApp(App[str | None]):
         self._lanes = lane_labels(session.compiled)
         self._was_calling = False
         self._pace = Pace()                  # the speed the clock really keeps
+        #: a SIGINT from outside ended the session (the command exits with status 130)
+        self.interrupted = False
+        self._release_interrupts = lambda: None
         self._summary_shown = False          # the end-of-run summary opens once
         self._views_ready = False            # set once mounted, cleared when quitting
         session.listeners.append(self._on_event)
@@ -282,7 +217,15 @@ class WalkthroughApp(App[str | None]):
         self.query_one("#person", Vertical).border_title = "You (the user lane)"
         self.query_one("#timeline", Static).border_title = "Timeline (newest first)"
         self._views_ready = True
+        self._release_interrupts = watch_interrupts(self._interrupted)
         self.refresh_views()
+
+    def on_unmount(self) -> None:
+        self._release_interrupts()
+
+    def _interrupted(self) -> None:
+        self.interrupted = True
+        self.action_quit_walk()
 
     # ------------------------------------------------------------------ time
     def tick(self, wall_seconds: float) -> None:
@@ -417,6 +360,7 @@ class WalkthroughApp(App[str | None]):
         self.push_screen(screen, resume)
 
     def action_quit_walk(self) -> None:
+        self._release_interrupts()
         self._views_ready = False
         self.cue.close()
         self.session.close()
