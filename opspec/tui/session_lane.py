@@ -64,6 +64,7 @@ class PersonLane(SessionState):
         current = list({o.item.key: o.item for o in self.offers}.values())
         self.offers.clear()
         self.lane_user.hand_over(self.model_factory(), current)
+        self._follow_call()        # a call to the person is over: the model is not slowed
         return True
 
     @guarded()
@@ -76,6 +77,7 @@ class PersonLane(SessionState):
             self._offered(item)
             # offered to the engine long ago: its duration is not the person's
             self.times.spoil("taken back from the user model", keys=(item.key,))
+        self._follow_call()        # the device still calls: now it calls the person
 
     @property
     def handed_over(self) -> bool:
