@@ -299,7 +299,10 @@ class WalkthroughApp(App[str | None]):
         self.refresh_views()
 
     def action_hand_over(self) -> None:
-        if not self.session.has_user_lane:     # a user model would have nothing to do
+        if self.session.ended:
+            self.notify("The run has ended: there is nothing to hand over (q quits).",
+                        severity="warning")
+        elif not self.session.has_user_lane:   # a user model would have nothing to do
             self.notify("This spec has no user lane: there is nothing to hand over.",
                         severity="warning")
         elif self.session.replaying:
