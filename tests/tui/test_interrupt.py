@@ -11,15 +11,17 @@ from __future__ import annotations
 import os
 import signal
 import sys
+from pathlib import Path
 from typing import Any
 
 import pytest
-from conftest import SPEC
 
 import opspec.tui.app
 from opspec.cli import main
 from opspec.tui.app import WalkthroughApp
 from opspec.tui.session import WalkSession
+
+SPEC = Path(__file__).resolve().parents[2] / "specs" / "medication_dispenser.xpdl"
 
 
 @pytest.mark.asyncio
