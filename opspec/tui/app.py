@@ -162,6 +162,11 @@ class WalkthroughApp(App[str | None]):
         Binding("s", "summary", "summary", show=False),
         Binding("ctrl+c,ctrl+q", "quit_walk", "quit", show=False, priority=True),
         *[Binding(k, f"offer({i})", show=False) for i, k in enumerate(OFFER_KEYS)],
+        # without a letter: the arrows (or Tab, which the screen would take) pick, Enter does
+        Binding("down", "select(1)", show=False), Binding("up", "select(-1)", show=False),
+        Binding("tab", "select(1)", show=False, priority=True),
+        Binding("shift+tab", "select(-1)", show=False, priority=True),
+        Binding("enter", "do_selected", show=False),
     ]
 
     def __init__(self, session: WalkSession, *, title: str = "",
@@ -180,6 +185,7 @@ class WalkthroughApp(App[str | None]):
         self._lanes = lane_labels(session.compiled)
         self._was_calling = False
         self._pace = Pace()                  # the speed the clock really keeps
+        self._selected: tuple[int, str | None] | None = None   # the offer Enter does
         #: a SIGINT from outside ended the session (the command exits with status 130)
         self.interrupted = False
         self._release_interrupts = lambda: None
@@ -334,6 +340,22 @@ class WalkthroughApp(App[str | None]):
             self.session.act(offers[index])
             self.refresh_views()
 
+    def _shown_offers(self) -> list[Any]:
+        return self.session.offers[:len(OFFER_KEYS)] if self.session.person_performs else []
+
+    def action_select(self, step: int) -> None:
+        offers = [(o.item.key, o.choice) for o in self._shown_offers()]
+        if not offers or isinstance(self.screen, ModalScreen):   # the help, the summary
+            return
+        at = offers.index(self._selected) if self._selected in offers else -1 if step > 0 else 0
+        self._selected = offers[(at + step) % len(offers)]
+        self.refresh_views()
+
+    def action_do_selected(self) -> None:
+        offers = [(o.item.key, o.choice) for o in self._shown_offers()]
+        if self._selected in offers and not isinstance(self.screen, ModalScreen):
+            self.do_offer(offers.index(self._selected))
+
     def action_ignore(self) -> None:
         if self.session.offers:
             self.session.ignore(self.session.offers[0])
@@ -427,6 +449,8 @@ class WalkthroughApp(App[str | None]):
                 if labels.count(offer.label) > 1:      # tell identical offers apart
                     line.append(f" #{offer.item.instance}",
                                 style="" if self.high_contrast else "dim")
+                if (offer.item.key, offer.choice) == self._selected:
+                    line.append("  <- Enter", style="bold")
                 lines.append(OfferLine(n, line))
             more = len(offers) - len(OFFER_KEYS)
             if more > 0:

@@ -22,6 +22,7 @@ HELP = """\
 
   [b]a[/b]–[b]z[/b]     do the action shown next to the letter (or click it)
   [b]x[/b]       do not do the first action (an omission, recorded)
+  [b]↑↓[/b] [b]enter[/b] pick an action, then do it (tab picks too)
   [b]space[/b]   pause / resume the clock
   [b]1 2 3 4[/b] speed: real time, 10x, 60x, 600x
   [b]w[/b]       let 30 simulated seconds pass
