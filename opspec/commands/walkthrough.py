@@ -88,6 +88,11 @@ def run(args: argparse.Namespace) -> int:
         raise ConfigurationError(f"--speed must be positive, not {args.speed:g}")
     if args.days is not None:
         check_days(args.days, name="--days")
+    if args.replay and args.record:
+        # a replay records nothing: the recording asked for would silently not be written
+        raise ConfigurationError(
+            f"--record {args.record} with --replay: a replay records nothing",
+            hint=f"its trace: opspec run {args.spec} --script {args.replay} --trace FILE")
     # the person performs the lane; the request's user is the model they hand it over to
     # (--user-model, else the companion SPEC.users.toml), checked against the spec
     prepared = prepare(RunRequest(args.spec, seed=args.seed, days=args.days,
@@ -174,6 +179,7 @@ def run(args: argparse.Namespace) -> int:
         device_report = None
         try:
             app.run()
+            interrupted = getattr(app, "interrupted", False)   # the app caught a SIGINT
         except KeyboardInterrupt:          # a SIGINT from outside the terminal's keys
             interrupted = True
         finally:

@@ -27,16 +27,19 @@ from rich.text import Text
 from textual import events
 from textual.app import App, ComposeResult
 from textual.binding import Binding
-from textual.containers import Horizontal, Vertical, VerticalScroll
+from textual.containers import Horizontal, Vertical
 from textual.screen import ModalScreen
 from textual.theme import Theme
 from textual.widgets import Digits, Footer, Static
 
 from opspec.engine.lane_labels import lane_labels
+from opspec.tui.interrupt import watch_interrupts
+from opspec.tui.modals import HELP, HelpScreen, SummaryScreen
+from opspec.tui.pace import Pace
 from opspec.tui.session import WalkSession, clock, time_of_day_shown
 from opspec.tui.sound import Cue
 
-__all__ = ["WalkthroughApp"]
+__all__ = ["HELP", "SummaryScreen", "WalkthroughApp"]
 
 SPEEDS = {"1": 1.0, "2": 10.0, "3": 60.0, "4": 600.0}
 # the offers shown: every letter no other action uses (h l n q s u w x are taken), a..f first
@@ -49,68 +52,6 @@ TICK_S = 0.1
 SLICE_STEPS = 200
 SLICE_S = 0.08
 KEY_S = 0.25                  # a key's own jump (w, n) may take a little longer
-
-HELP = """\
-[b]opspec walkthrough — keys[/b]
-
-  [b]a[/b]–[b]z[/b]     do the action shown next to the letter (or click it)
-  [b]x[/b]       do not do the first action (an omission, recorded)
-  [b]space[/b]   pause / resume the clock
-  [b]1 2 3 4[/b] speed: real time, 10x, 60x, 600x
-  [b]w[/b]       let 30 simulated seconds pass
-  [b]n[/b]       step: skip to the next event
-  [b]u[/b]       skip until something new needs you (again: stop)
-  [b]h[/b]       hand your lane to the user model / take it back
-  [b]l[/b]       timeline: all lanes / device / user
-          (/ hidden, with --large)
-  [b]s[/b]       the summary so far (metrics, your response times)
-  [b]?[/b]       this help (the clock stops while it is open)
-  [b]q[/b], [b]ctrl+c[/b], [b]ctrl+q[/b] quit (the recording is kept)
-
-When the device calls you, the clock drops to real time (or
-pauses, with --on-call pause) and comes back when the call is
-over.
-
-Device panel: (!) an alert (a ringing alarm), (x) a device
-fault, > what a participant is doing now.
-
-Press escape or ? to close."""
-
-
-class HelpScreen(ModalScreen[None]):
-    BINDINGS: ClassVar = [Binding("escape,question_mark", "dismiss", "close"),
-                          Binding("q", "app.quit_walk", "quit")]
-    DEFAULT_CSS = """
-    HelpScreen { align: center middle; }
-    HelpScreen > Static { width: 70; max-width: 100%; border: heavy $accent; padding: 1 2;
-                          background: $surface; }
-    """
-
-    def compose(self) -> ComposeResult:
-        yield Static(HELP, id="help-text")
-
-
-class SummaryScreen(ModalScreen[None]):
-    """The summary: at the end of the run (it opens by itself), or so far (``s``)."""
-
-    BINDINGS: ClassVar = [Binding("escape,s,space", "dismiss", "close"),
-                          Binding("q", "app.quit_walk", "quit")]
-    DEFAULT_CSS = """
-    SummaryScreen { align: center middle; }
-    SummaryScreen > VerticalScroll { width: 100; max-width: 100%; height: auto;
-                                     max-height: 100%; border: heavy $accent; padding: 0 1;
-                                     background: $surface; }
-    """
-
-    def __init__(self, lines: Sequence[str]) -> None:
-        super().__init__()
-        self.lines = list(lines)
-
-    def compose(self) -> ComposeResult:
-        with VerticalScroll():
-            yield Static(Text("\n".join([*self.lines, "", "q: quit   escape: close"])),
-                         id="summary-text")
-
 
 class FittingFooter(Footer):
     """The footer, its keys closed up on a terminal narrower than the spaced-out footer, so
@@ -221,6 +162,11 @@ class WalkthroughApp(App[str | None]):
         Binding("s", "summary", "summary", show=False),
         Binding("ctrl+c,ctrl+q", "quit_walk", "quit", show=False, priority=True),
         *[Binding(k, f"offer({i})", show=False) for i, k in enumerate(OFFER_KEYS)],
+        # without a letter: the arrows (or Tab, which the screen would take) pick, Enter does
+        Binding("down", "select(1)", show=False), Binding("up", "select(-1)", show=False),
+        Binding("tab", "select(1)", show=False, priority=True),
+        Binding("shift+tab", "select(-1)", show=False, priority=True),
+        Binding("enter", "do_selected", show=False),
     ]
 
     def __init__(self, session: WalkSession, *, title: str = "",
@@ -238,6 +184,11 @@ class WalkthroughApp(App[str | None]):
         #: the timeline's lane column: the spec's lane names, one width for all lines
         self._lanes = lane_labels(session.compiled)
         self._was_calling = False
+        self._pace = Pace()                  # the speed the clock really keeps
+        self._selected: tuple[int, str | None] | None = None   # the offer Enter does
+        #: a SIGINT from outside ended the session (the command exits with status 130)
+        self.interrupted = False
+        self._release_interrupts = lambda: None
         self._summary_shown = False          # the end-of-run summary opens once
         self._views_ready = False            # set once mounted, cleared when quitting
         session.listeners.append(self._on_event)
@@ -272,7 +223,15 @@ class WalkthroughApp(App[str | None]):
         self.query_one("#person", Vertical).border_title = "You (the user lane)"
         self.query_one("#timeline", Static).border_title = "Timeline (newest first)"
         self._views_ready = True
+        self._release_interrupts = watch_interrupts(self._interrupted)
         self.refresh_views()
+
+    def on_unmount(self) -> None:
+        self._release_interrupts()
+
+    def _interrupted(self) -> None:
+        self.interrupted = True
+        self.action_quit_walk()
 
     # ------------------------------------------------------------------ time
     def tick(self, wall_seconds: float) -> None:
@@ -280,10 +239,16 @@ class WalkthroughApp(App[str | None]):
         before = len(session.offers)
         skipping = session.skipping
         if skipping or session.paused or session.ended:
+            self._pace.reset()
             session.advance(wall_seconds, SLICE_STEPS)
             self._go_on_skipping()
         else:
-            self._run_slices(session.now + wall_seconds * session.speed)
+            start = session.now
+            self._run_slices(start + wall_seconds * session.speed)
+            if session.waiting_for_devices:        # the clock waits for a real answer
+                self._pace.reset()
+            else:
+                self._pace.ran(wall_seconds, session.now - start, session.speed)
         if not session.paused or skipping or len(session.offers) != before:
             self.refresh_views()
 
@@ -340,7 +305,13 @@ class WalkthroughApp(App[str | None]):
         self.refresh_views()
 
     def action_hand_over(self) -> None:
-        if self.session.replaying:
+        if self.session.ended:
+            self.notify("The run has ended: there is nothing to hand over (q quits).",
+                        severity="warning")
+        elif not self.session.has_user_lane:   # a user model would have nothing to do
+            self.notify("This spec has no user lane: there is nothing to hand over.",
+                        severity="warning")
+        elif self.session.replaying:
             self.notify("The recording performs your lane: there is nothing to hand over.",
                         severity="warning")
         elif self.session.handed_over:
@@ -368,6 +339,22 @@ class WalkthroughApp(App[str | None]):
         if 0 <= index < len(offers):
             self.session.act(offers[index])
             self.refresh_views()
+
+    def _shown_offers(self) -> list[Any]:
+        return self.session.offers[:len(OFFER_KEYS)] if self.session.person_performs else []
+
+    def action_select(self, step: int) -> None:
+        offers = [(o.item.key, o.choice) for o in self._shown_offers()]
+        if not offers or isinstance(self.screen, ModalScreen):   # the help, the summary
+            return
+        at = offers.index(self._selected) if self._selected in offers else -1 if step > 0 else 0
+        self._selected = offers[(at + step) % len(offers)]
+        self.refresh_views()
+
+    def action_do_selected(self) -> None:
+        offers = [(o.item.key, o.choice) for o in self._shown_offers()]
+        if self._selected in offers and not isinstance(self.screen, ModalScreen):
+            self.do_offer(offers.index(self._selected))
 
     def action_ignore(self) -> None:
         if self.session.offers:
@@ -398,6 +385,7 @@ class WalkthroughApp(App[str | None]):
         self.push_screen(screen, resume)
 
     def action_quit_walk(self) -> None:
+        self._release_interrupts()
         self._views_ready = False
         self.cue.close()
         self.session.close()
@@ -422,10 +410,11 @@ class WalkthroughApp(App[str | None]):
                else "no user lane" if not session.has_user_lane
                else "model performs your lane" if session.handed_over
                else "you perform the lane")
+        pace = self._pace.shown() if state == "running" else ""
         if session.call_mode and state == "running":
             state = "running in real time: the device calls"
         self.query_one("#status", Static).update(Text(
-            f"{clock(session.now)}  {session.speed:g}x  {state}  |  {who}  |  "
+            f"{clock(session.now)}  {session.speed:g}x{pace}  {state}  |  {who}  |  "
             f"{self.spec_title}", no_wrap=True, overflow="ellipsis"))
         if self.large:
             self.query_one("#bigclock", Digits).update(time_of_day_shown(session.now)[:5])
@@ -434,7 +423,12 @@ class WalkthroughApp(App[str | None]):
         call = self.query_one("#call", Static)
         if session.calling:
             person.add_class("calling")
-            call.update(Text("(!) THE DEVICE CALLS YOU", style="bold reverse"))
+            banner = Text("(!) THE DEVICE CALLS YOU", style="bold reverse")
+            if session.person_performs and not session.offers:
+                # the alarm rings on after the person let it pass (x), or before their
+                # lane offers anything: say that nothing is asked of them, not a blank
+                banner.append("\n" + self._idle_text())
+            call.update(banner)
         else:
             person.remove_class("calling")
             call.update(self._idle_text())
@@ -455,6 +449,8 @@ class WalkthroughApp(App[str | None]):
                 if labels.count(offer.label) > 1:      # tell identical offers apart
                     line.append(f" #{offer.item.instance}",
                                 style="" if self.high_contrast else "dim")
+                if (offer.item.key, offer.choice) == self._selected:
+                    line.append("  <- Enter", style="bold")
                 lines.append(OfferLine(n, line))
             more = len(offers) - len(OFFER_KEYS)
             if more > 0:

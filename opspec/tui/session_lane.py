@@ -31,9 +31,13 @@ class PersonLane(SessionState):
 
     @guarded()
     def ignore(self, offer: Offer) -> None:
-        """The person explicitly does not do ``offer`` (omission)."""
-        engine = self._take(offer, tagged_action("omit", offer.item.activity,
-                                                 offer.item.instance), f"not: {offer.label}")
+        """The person explicitly does not do ``offer`` (omission). Of a deferred choice the
+        whole choice is omitted, none of its alternatives done: it is named, not the first."""
+        item = offer.item
+        what = offer.label if offer.choice is None else self._label_of(item.process,
+                                                                       item.activity)
+        engine = self._take(offer, tagged_action("omit", item.activity, item.instance),
+                            f"not: {what}")
         if engine is not None:
             engine.omit(offer.item, "the person chose not to")
             self._follow_call()
@@ -60,6 +64,7 @@ class PersonLane(SessionState):
         current = list({o.item.key: o.item for o in self.offers}.values())
         self.offers.clear()
         self.lane_user.hand_over(self.model_factory(), current)
+        self._follow_call()        # a call to the person is over: the model is not slowed
         return True
 
     @guarded()
@@ -72,6 +77,7 @@ class PersonLane(SessionState):
             self._offered(item)
             # offered to the engine long ago: its duration is not the person's
             self.times.spoil("taken back from the user model", keys=(item.key,))
+        self._follow_call()        # the device still calls: now it calls the person
 
     @property
     def handed_over(self) -> bool:

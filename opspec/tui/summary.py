@@ -38,8 +38,10 @@ def response_lines(responses: Sequence[Response]) -> list[str]:
              f"n {len(times)}" for label, times in per.items()]
     usable = sum(1 for r in responses if r.usable)
     why = Counter(r.why for r in responses if not r.usable and r.why)
+    # the count after its reason: "2x the clock ran at 60x" read as a speed
     lines.append(f"  usable for opspec fit: {usable} of {len(responses)}"
-                 + (" (not: " + "; ".join(f"{n}x {reason}" for reason, n in why.most_common())
+                 + (" (not usable: " + "; ".join(f"{reason} ({n})"
+                                                for reason, n in why.most_common())
                     + ")" if why else " (the clock ran in real time)"))
     return lines
 

@@ -120,3 +120,20 @@ async def test_the_clock_stands_while_the_summary_is_open(compiled):
         await pilot.press("escape")
         await pilot.pause(0.3)
         assert not session.paused and session.now > stood
+
+
+def test_handing_over_during_a_call_gives_the_speed_back_and_taking_back_drops_it(
+        compiled, model_factory):
+    """The lane handed to the model while the alarm rings: the clock stayed at 1x, so the
+    model walked over and reported in real time, minutes, while the status said "model
+    performs your lane" (a model is never slowed down, says docs/walkthrough.md). Taken back
+    while it still rings, the person answers in real time."""
+    session = WalkSession(compiled, model_factory=model_factory)
+    session.skip_until_user()
+    assert session.now == ALARM and session.speed == 1.0 and session.call_mode
+    session.act(offer(session, "hear_alarm"))
+    assert session.speed == 1.0                        # the person is in the call
+    assert session.hand_over()
+    assert session.speed == 60.0 and not session.call_mode
+    session.take_back()
+    assert session.calling and session.speed == 1.0 and session.call_mode

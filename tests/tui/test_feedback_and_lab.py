@@ -241,3 +241,23 @@ def test_a_trigger_caught_with_no_device_activity_at_once_is_not_called_lost():
     aftermath(TraceEvent(60.0, "trigger.raised", lane="user", data={"name": "trg_9"}))
     assert aftermath.text() == ("you: Press the button at 00:01 -> sent trg_9 -> no device "
                                 "activity at once")
+
+
+@pytest.mark.asyncio
+async def test_x_at_a_choice_names_the_choice_it_leaves_undone(compiled, tmp_path):
+    """``x`` at "Press a button" omits the whole choice (the recording says ``omit
+    choose_button``): the panel said 'you: not: Press "report"', as if the person had
+    passed on one button and the other were still theirs to press."""
+    session = WalkSession(compiled, record=tmp_path / "walk.json")
+    app = WalkthroughApp(session)
+    async with app.run_test(size=(80, 24)) as pilot:
+        await pilot.press("space", "u", "a", "a")   # 08:00: heard, walked over
+        await pilot.pause()
+        assert [o.label for o in session.offers] == ['Press "report"',
+                                                     "Press the wrong button"]
+        await pilot.press("x")
+        await pilot.pause()
+        said = session.aftermath.text()
+        assert said.startswith("you: not: Press a button at 08:00"), said
+        assert not session.offers
+    assert "omit choose_button #4" in (tmp_path / "walk.json").read_text(encoding="utf-8")

@@ -116,3 +116,18 @@ def test_opspec_run_script_honours_the_instance_tags_too(compiled, tmp_path, cap
              if '"activity.completed"' in line and '"hear_alarm"' in line]
     assert [(e["instance"], e["time"]) for e in heard] == [(offer.item.instance,
                                                             pytest.approx(session.now))]
+
+
+def test_the_walkthrough_command_refuses_record_with_replay(tmp_path, capsys):
+    """A replay records nothing: ``--record`` with it was silently ignored (no file, no word),
+    so a researcher who asked for the replay's recording found none."""
+    from opspec.cli import main
+
+    rec = tmp_path / "rec.json"
+    rec.write_text('{"otherwise": "wait", "steps": [["at 28800", "complete hear_alarm"]]}',
+                   encoding="utf-8")
+    out = tmp_path / "again.json"
+    assert main(["walkthrough", str(SPEC), "--replay", str(rec), "--record", str(out)]) == 2
+    err = capsys.readouterr().err
+    assert "with --replay: a replay records nothing" in err and "--trace" in err
+    assert not out.exists()

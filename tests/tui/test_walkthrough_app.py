@@ -352,3 +352,24 @@ async def test_a_fault_in_the_timeline_is_in_the_device_lane(compiled):
                                             "device": "medication_dispenser"})
         await pilot.press("l")                         # device lane only
         assert "device  FAULT medication_dispenser" in str(app.query_one("#timeline").render())
+
+
+@pytest.mark.asyncio
+async def test_a_call_with_nothing_to_do_says_so(compiled):
+    """After ``x`` (the person lets the alarm pass) the alarm rings on for five minutes, in
+    real time: the panel showed "THE DEVICE CALLS YOU" and no action, nothing saying that
+    nothing was asked of the person or how to move on."""
+    session = WalkSession(compiled)
+    app = WalkthroughApp(session, title="dispenser")
+    async with app.run_test(size=(80, 24)) as pilot:
+        await start(app, pilot)
+        await pilot.press("u")                      # 08:00: the alarm
+        await pilot.pause()
+        call = str(app.query_one("#call").render())
+        assert "THE DEVICE CALLS YOU" in call and "nothing to do now" not in call
+        await pilot.press("x")                      # let "Hear the alarm" pass
+        await pilot.pause()
+        assert session.calling and not session.offers
+        call = str(app.query_one("#call").render())
+        assert "THE DEVICE CALLS YOU" in call
+        assert "(nothing to do now: press u to skip until something needs you)" in call
