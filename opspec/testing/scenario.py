@@ -26,7 +26,7 @@ Every mistake is reported when the file is collected, as ``path: key: what (how 
 from __future__ import annotations
 
 from collections.abc import Callable, Mapping, Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any
 
@@ -236,6 +236,16 @@ def load_scenarios(path: str | Path, *, rootdir: Path | None = None) -> Scenario
             try:     # the names it uses, and that each step acts on an offer of the user's
                 scripted_user(script, compiled)
             except ConfigurationError as error:
+                at = error.location
+                if at is not None and at.line is not None and at.path != str(path):
+                    # a script file's step: at its own line, where it must be fixed, the
+                    # file named as the scenario file is (relative to the rootdir)
+                    script_file = Path(at.path)
+                    if rootdir is not None and script_file.is_relative_to(rootdir):
+                        at = replace(at, path=str(script_file.relative_to(rootdir)))
+                    raise ConfigurationError(
+                        f"{error.message} (scenario {name.strip()!r}, {path}: "
+                        f"{key}.given.script)", location=at, hint=error.hint) from None
                 raise _error(path, f"{key}.given.script", error.message, error.hint) from None
         if script is not None and "user_model" in given:
             raise _error(path, f"{key}.given", "give a script or a user model, not both")

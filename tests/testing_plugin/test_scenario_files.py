@@ -133,3 +133,20 @@ def test_a_bad_scenario_file_is_a_collection_error_naming_the_file_and_key(
     result.assert_outcomes(errors=1)
     result.stdout.fnmatch_lines([_literal(f"bad scenario file: bad.scenario.toml: {message}*")])
     assert "Traceback" not in result.stdout.str()
+
+
+def test_a_script_file_s_bad_step_is_placed_at_its_own_line(project: pytest.Pytester) -> None:
+    # the step is written in the script file, so that is where an editor must jump; the
+    # scenario that uses the script is named beside it (it was placed at the scenario's key)
+    (project.path / "late.toml").write_text(
+        'otherwise = "complete"\nsteps = [\n  ["after trg_2 60s", "press_report"],\n'
+        '  ["10s", "dispense"],\n]\n')
+    (project.path / "bad.scenario.toml").write_text(
+        'spec = "specs/dispenser.xpdl"\n[[scenario]]\nname = "x"\n'
+        'given = { script = "late.toml" }\nthen = ["alarms == 1"]\n')
+    result = project.runpytest()
+    result.assert_outcomes(errors=1)
+    result.stdout.fnmatch_lines([_literal(
+        "bad scenario file: late.toml:4: steps[1]: the script's step 'complete dispense' "
+        "names activity 'dispense'") + "*"
+        + _literal("(scenario 'x', bad.scenario.toml: scenario[0].given.script)") + "*"])
