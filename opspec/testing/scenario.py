@@ -32,6 +32,7 @@ from typing import Any
 
 from opspec.errors import ConfigurationError, OpspecError, SourceLocation
 from opspec.testing.expectations import Expectation, parse_expectation
+from opspec.toml_lines import located
 from opspec.usermodels.scripts import Script, load_script, parse_script
 
 __all__ = ["Scenario", "ScenarioDocument", "load_scenarios", "run_scenario"]
@@ -168,14 +169,35 @@ def _until(value: Any) -> float:
 def load_scenarios(path: str | Path, *, rootdir: Path | None = None) -> ScenarioDocument:
     """Read and check a scenario file, including its names against its spec.
 
-    Raises :class:`ConfigurationError` (``path: key: ...``) or the spec's own error.
+    Raises :class:`ConfigurationError` (``path:line: key: ...``, at the line the key or its
+    table is written on) or the spec's own error.
     """
     path = Path(path)
     if rootdir is not None and path.is_absolute() and path.is_relative_to(rootdir):
         path = path.relative_to(rootdir)     # messages name the file as the user wrote it
+    full = path if path.is_absolute() or rootdir is None else rootdir / path
+    try:
+        return _load(path, full, rootdir)
+    except ConfigurationError as error:
+        raise _at_its_line(error, path, full) from None
+
+
+def _at_its_line(error: ConfigurationError, path: Path, full: Path) -> ConfigurationError:
+    """``error`` about a key of the scenario file placed at the line the key is written on
+    (the checks name keys; the file is read for their lines only when one is refused)."""
+    at = error.location
+    if (type(error) is not ConfigurationError or at is None or at.line is not None
+            or at.path != str(path) or not at.key):
+        return error
+    line = located(str(full), at.key).line
+    if line is None:
+        return error
+    return ConfigurationError(error.message, location=replace(at, line=line), hint=error.hint)
+
+
+def _load(path: Path, full: Path, rootdir: Path | None) -> ScenarioDocument:
     from opspec.toml_files import read_toml
 
-    full = path if path.is_absolute() or rootdir is None else rootdir / path
     document = read_toml(full, what="the scenario file", location=SourceLocation(str(path)))
     _unknown(path, "", document, _TOP)
     ref = document.get("spec")

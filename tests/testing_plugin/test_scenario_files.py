@@ -124,14 +124,24 @@ BAD = {
 }
 
 
+#: the line each mistake of BAD is written on (none: a key that is not written at all); a key
+#: inside an inline table (given = { users = 0 }) is placed at the line of that table
+LINES = {"unknown-top-key": 2, "spec-not-found": 1, "unreadable-then": 4, "unknown-metric": 4,
+         "unknown-given-key": 4, "script-unknown-activity": 4,
+         "script-step-on-a-device-activity": 4, "negative-users": 4,
+         "twice-the-same-name": 6, "unknown-user-model": 4}
+
+
 @pytest.mark.parametrize("case", list(BAD), ids=list(BAD))
-def test_a_bad_scenario_file_is_a_collection_error_naming_the_file_and_key(
+def test_a_bad_scenario_file_is_a_collection_error_naming_the_file_line_and_key(
         project: pytest.Pytester, case: str) -> None:
     text, message = BAD[case]
     (project.path / "bad.scenario.toml").write_text(text)
     result = project.runpytest()
     result.assert_outcomes(errors=1)
-    result.stdout.fnmatch_lines([_literal(f"bad scenario file: bad.scenario.toml: {message}*")])
+    line = f":{LINES[case]}" if case in LINES else ""
+    result.stdout.fnmatch_lines([_literal(
+        f"bad scenario file: bad.scenario.toml{line}: {message}*")])
     assert "Traceback" not in result.stdout.str()
 
 
