@@ -42,14 +42,16 @@ def run(args: argparse.Namespace) -> int:
     )
     from opspec.commands.validate import engine_checks
     from opspec.errors import SpecError
-    from opspec.model.codec import write_wfs
+    from opspec.model.codec import dumps, write_wfs
     from opspec.xpdl.compile import compiled_package, default_output
 
     source = Path(args.input)
-    if args.output == "-":
-        return _to_stdout(args, source)
-    target = Path(args.output) if args.output else default_output(source)
-    if (source.suffix == ".wfs" and same_file(source, target)
+    # -o -: the script on the standard output, as preprocess -o - writes its XPDL (its spec's
+    # path is written as given, so it holds for a script saved in the current folder; no
+    # user model is copied)
+    target = None if args.output == "-" else (
+        Path(args.output) if args.output else default_output(source))
+    if (target is not None and source.suffix == ".wfs" and same_file(source, target)
             and input_problem(source) is None):
         # IN.wfs is its own default output: there is nothing to compile, not an -o to change
         given = f"-o {args.output} is IN itself, and " if args.output else ""
@@ -64,6 +66,11 @@ def run(args: argparse.Namespace) -> int:
         package, warnings = compiled_package(source, strict=args.strict, extra=engine_checks)
     except SpecError as error:
         return _refused(error, source)
+    if target is None:
+        for diagnostic in warnings:
+            print(diagnostic, file=sys.stderr)
+        sys.stdout.write(dumps(package) + "\n")
+        return 0
     # -o naming a file the spec reads (its world file, a mode's spec) would replace it
     problem = overwrite_problem("compile", [("-o", target)], spec_inputs(source, package),
                                 example=f"{source.with_suffix('.wfs').name} beside it")
@@ -81,31 +88,6 @@ def run(args: argparse.Namespace) -> int:
     # a run of OUT looks for OUT.users.toml: without it, the user lane of a script compiled
     # to another name would run with nobody on it
     copy_user_model("compile", source, target)
-    return 0
-
-
-def _to_stdout(args: argparse.Namespace, source: Path) -> int:
-    """``-o -``: the script on the standard output, as ``preprocess -o -`` writes its XPDL
-    (a file named '-' was written before). Its spec's path is written as given, so it holds
-    for a script saved in the current folder; no user model is copied."""
-    from opspec.commands._files import translation_problem
-    from opspec.commands.validate import engine_checks
-    from opspec.errors import SpecError
-    from opspec.model.codec import dumps
-    from opspec.xpdl.compile import compiled_package
-
-    problem = translation_problem("compile", source, None,
-                                  example=f"{source.with_suffix('.wfs').name} beside it")
-    if problem is not None:
-        print(problem, file=sys.stderr)
-        return 2
-    try:
-        package, warnings = compiled_package(source, strict=args.strict, extra=engine_checks)
-    except SpecError as error:
-        return _refused(error, source)
-    for diagnostic in warnings:
-        print(diagnostic, file=sys.stderr)
-    sys.stdout.write(dumps(package) + "\n")
     return 0
 
 
