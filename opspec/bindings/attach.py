@@ -58,7 +58,7 @@ class AttachedDevices:
         self.performers: dict[str, DeviceBinding] = {
             participant: binding for binding in self.bindings
             for participant in binding.participants}
-        for binding in self.bindings:   # work routed by Application id to the wrong one
+        for binding in self.bindings:   # work handed to the wrong one goes on to its port
             binding.peers = self.performers
         self.notes: list[str] = [note for b in self.bindings for note in b.notes]
         self._sim: Simulation | None = None

@@ -136,8 +136,9 @@ class DeviceBinding(Exchanges, Reconnection, Fallback):
         participant = item.participant or ""
         peer = self._peer(item)
         if peer is not None:
-            # routed here by Application id (the engine keeps one binding per id) for a
-            # participant bound to another port: that port performs it
+            # handed work of a participant bound to another port (the engine routes by
+            # participant, SharedApplication; a caller offering directly may not): that
+            # port performs it
             peer.offer(item)
             return
         # routed here by Application id (see ``applications``) for a participant this run

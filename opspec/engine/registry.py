@@ -6,15 +6,99 @@ device performer for activities outside the user lane. A user-lane activity with
 waits (and is reported as a deadlock if nothing else can happen). Automatic task activities
 go to the performer bound to their Application id, if any, else complete by themselves
 (instantly or after their declared duration).
+
+Several performers may serve one Application id (two motors, each its own participant, both
+offering ``drive``). The activity's Performer says which one does the work (XPDL 2.1,
+WfMC-TC-1025, 7.6: "Performers ... the resource that is requested to or should perform the
+activity"), so such an id is served by
+:class:`SharedApplication`, which hands each work item to the performer bound to the
+activity's participant or lane; it had gone, silently, to whichever was bound last.
 """
 
 from __future__ import annotations
 
 from collections.abc import Iterator, Mapping
 
-from opspec.engine.performers import Performer
+from opspec.engine.compiled import CompiledPackage
+from opspec.engine.performers import Performer, PerformerSession, WorkItem
 
-__all__ = ["PerformerRegistry"]
+__all__ = ["PerformerRegistry", "SharedApplication", "spec_names"]
+
+
+def spec_names(compiled: CompiledPackage) -> set[str]:
+    """The participant and lane ids the activities of ``compiled`` may be performed under
+    (nested blocks included): the names a performer is bound under for one participant's
+    work."""
+    names: set[str] = set()
+    for proc in compiled.processes.values():
+        graphs = [proc.graph]
+        while graphs:
+            graph = graphs.pop()
+            for act in graph.activities:
+                if act.participant is not None:
+                    names.add(act.participant)
+                names.update(act.lanes)
+                if act.block is not None:
+                    graphs.append(act.block)
+    return names
+
+
+class SharedApplication:
+    """One Application id served by several bound performers. A work item goes to the one
+    bound to its activity's participant, else to its lane, else to the one *general* server
+    (bound under no name of the spec's participants and lanes: a world's devices, a
+    performer bound by Application id alone). Where none of these chooses, it fails with a
+    message saying how to choose (the engine does not guess which device was meant)."""
+
+    __slots__ = ("_session", "application", "claimed", "names", "servers")
+
+    def __init__(self, application: str, names: Mapping[str, Performer],
+                 servers: list[Performer]) -> None:
+        self.application = application
+        self.names = names          # the registry's own, live: bindings made later count
+        self.servers = servers
+        #: the spec's participant and lane ids (:meth:`PerformerRegistry.claim`)
+        self.claimed: frozenset[str] = frozenset()
+        self._session: PerformerSession | None = None
+
+    def _bound_names(self, performer: Performer) -> list[str]:
+        return sorted(name for name, p in self.names.items() if p is performer)
+
+    def _server(self, item: WorkItem) -> Performer | None:
+        servers = self.servers
+        for name in (item.participant, item.lane):
+            if name is not None:
+                performer = self.names.get(name)
+                if performer is not None and any(performer is s for s in servers):
+                    return performer
+        general = [s for s in servers
+                   if not any(n in self.claimed for n in self._bound_names(s))]
+        return general[0] if len(general) == 1 else None
+
+    def attach(self, session: PerformerSession) -> None:
+        # the servers are attached as performers of the registry in their own right
+        self._session = session
+
+    def offer(self, item: WorkItem) -> None:
+        server = self._server(item)
+        if server is not None:
+            server.offer(item)
+            return
+        if self._session is None:
+            raise RuntimeError("SharedApplication was offered work before attach()")
+        bound = sorted(n for s in self.servers for n in self._bound_names(s))
+        self._session.fail(
+            item, "AmbiguousApplication",
+            f"activity {item.activity!r}: application {self.application!r} is served by "
+            f"{len(self.servers)} bound performers ({', '.join(bound) or 'bound by id'}) and "
+            f"the activity's performer {item.participant!r} is none of them; give the "
+            "activity the participant whose device should do it, or bind one performer to "
+            "the application")
+
+    def withdraw(self, item: WorkItem, reason: str) -> None:
+        server = self._server(item)
+        if server is not None:
+            server.withdraw(item, reason)
 
 
 class PerformerRegistry:
@@ -38,12 +122,32 @@ class PerformerRegistry:
         """
         self.names[name] = performer
         for app in getattr(performer, "applications", {}) or {}:
-            self.applications[app] = performer
+            self.bind_application(app, performer)
         return self
 
     def bind_application(self, application: str, performer: Performer) -> PerformerRegistry:
-        self.applications[application] = performer
+        """Bind an Application id to ``performer``; a second, different performer makes the
+        id a :class:`SharedApplication` (the activity's performer chooses between them)."""
+        bound = self.applications.get(application)
+        if bound is None or bound is performer:
+            self.applications[application] = performer
+        elif isinstance(bound, SharedApplication):
+            if not any(performer is s for s in bound.servers):
+                bound.servers.append(performer)
+        else:
+            self.applications[application] = SharedApplication(
+                application, self.names, [bound, performer])
         return self
+
+    def claim(self, compiled: CompiledPackage) -> None:
+        """Tell the shared Application ids which bound names are the participants and lanes
+        of ``compiled`` (the simulation does, once, before its performers are attached): a
+        performer bound under one of them does that participant's work, not another's."""
+        shared = [b for b in self.applications.values() if isinstance(b, SharedApplication)]
+        if shared:
+            claimed = frozenset(spec_names(compiled))
+            for bound in shared:
+                bound.claimed = claimed
 
     def lookup(self, participant: str | None, lanes: tuple[str, ...]) -> Performer | None:
         if participant is not None:
@@ -59,7 +163,10 @@ class PerformerRegistry:
     def performers(self) -> Iterator[Performer]:
         """Every distinct performer bound (each once, in binding order)."""
         seen: set[int] = set()
-        for performer in [*self.names.values(), *self.applications.values(),
+        served = [p for bound in self.applications.values()
+                  for p in (bound.servers if isinstance(bound, SharedApplication) else [bound])]
+        shared = [p for p in self.applications.values() if isinstance(p, SharedApplication)]
+        for performer in [*self.names.values(), *served, *shared,
                           *([self.default_device] if self.default_device else [])]:
             if id(performer) not in seen:
                 seen.add(id(performer))

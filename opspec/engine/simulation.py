@@ -180,6 +180,7 @@ class Simulation(Interpreter):
             return
         self._booted = True
         self.sync()
+        self.registry.claim(self.compiled)
         for performer in self.registry.performers():
             performer.attach(self.session)
         if self.wants(EK.RUN_STARTED, None, None):

@@ -1,8 +1,10 @@
 """Two participants of one profile bound to two ports (``--bind alarm=URL1 --bind
-dispenser=URL2``): each participant's work goes to its own port. The engine routes an
-Application id to one binding only (the last registered, here the dispenser's), which used to
-play the alarm's ``ALARM ON`` on the simulated device at once, while the summary said the alarm
-was on its device with no fault."""
+dispenser=URL2``): each participant's work goes to its own port. The engine used to route an
+Application id to one binding only (the last registered, here the dispenser's), which played
+the alarm's ``ALARM ON`` on the simulated device at once, while the summary said the alarm
+was on its device with no fault; it now routes by the activity's participant
+(``opspec.engine.registry.SharedApplication``), and a binding handed another participant's
+work still passes it to that participant's port."""
 
 from __future__ import annotations
 
@@ -39,7 +41,7 @@ def test_the_alarm_goes_to_the_alarms_port_when_the_dispenser_has_another(
 
 
 def test_a_dispense_routed_to_the_alarms_binding_reaches_the_drawer() -> None:
-    # bound in this order the engine routes every application id to the alarm's binding
+    # work handed to the alarm's binding for the dispenser (as the engine once routed it)
     with attach_devices([f"dispenser={WELL}", f"alarm={SILENT}"], DEVICES,
                         settle_s=0) as devices:
         session = FakeSession()
