@@ -454,7 +454,7 @@ class ScenarioItem(pytest.Item):
             failures = run_scenario(self.scenario, package, seed=seed,
                                     seen=lambda result: _warned(self, self.config, result))
         except OpspecError as error:
-            raise ScenarioFailure(f"{self.scenario.where}: {error}") from None
+            raise ScenarioFailure(f"{self.scenario.place()}: {error}") from None
         if failures:
             raise ScenarioFailure("\n\n".join(failures))
 

@@ -20,11 +20,14 @@ test's seed), ``engine`` (engine options, as in ``[engine]`` of a config file), 
 (package data overrides), ``branches`` (``{ GATEWAY = { FLOW = P } }``: branch
 probabilities of undecided gateways, as ``--branch``). ``then`` lines are :mod:`opspec.testing.expectations`.
 
-Every mistake is reported when the file is collected, as ``path: key: what (how to fix)``.
+Every mistake is reported when the file is collected, as ``path:line: key: what (how to
+fix)``, at the line the key or its table is written on; so is every failure of a scenario run
+(``path:line: scenario[N].then[M]: …``, the file read for lines only then).
 """
 
 from __future__ import annotations
 
+import re
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field, replace
 from pathlib import Path
@@ -45,7 +48,8 @@ _GIVEN = ("script", "user_model", "users", "days", "until", "seed", "engine", "p
 
 @dataclass(frozen=True, slots=True)
 class Scenario:
-    """One ``[[scenario]]`` ready to run (``where`` is ``path: scenario[N]``)."""
+    """One ``[[scenario]]`` ready to run (``where`` is ``path: scenario[N]``; ``file`` is the
+    scenario file to read the lines of a failure from, ``key`` is ``scenario[N]``)."""
 
     name: str
     where: str
@@ -62,6 +66,17 @@ class Scenario:
     #: branch probabilities of undecided gateways (:mod:`opspec.branch_choices`)
     branches: Mapping[str, Mapping[str, float]] = field(default_factory=dict)
     description: str = ""
+    file: Path | None = None
+    key: str = ""
+
+    def place(self, key: str = "") -> str:
+        """``path:line: scenario[N]`` followed by ``key`` (``.then[1]``): where that is written
+        in the scenario file, which is read now (call it for a failure only); ``where`` and
+        ``key`` when the file or the line is unknown."""
+        if self.file is None or not self.key:
+            return f"{self.where}{key}"
+        at = located(str(self.file), self.key + key)
+        return str(replace(at, path=self.where.removesuffix(f": {self.key}")))
 
 
 @dataclass(frozen=True, slots=True)
@@ -102,7 +117,6 @@ def _given(path: Path, key: str, table: Any, rootdir: Path | None) -> dict[str, 
     out: dict[str, Any] = {}
     if "script" in table:
         value = table["script"]
-        where = f"{path}: {key}.script"
         if isinstance(value, str):
             found = _find(path, value, rootdir)
             if found is None:
@@ -110,7 +124,7 @@ def _given(path: Path, key: str, table: Any, rootdir: Path | None) -> dict[str, 
                              "give a path relative to this file, or a list of [when, action]")
             out["script"] = load_script(found)
         else:
-            out["script"] = parse_script(value, where=where)
+            out["script"] = _inline_script(path, f"{key}.script", value)
     if "user_model" in table:
         ref = table["user_model"]
         if not isinstance(ref, str):
@@ -154,8 +168,45 @@ def _given(path: Path, key: str, table: Any, rootdir: Path | None) -> dict[str, 
     if "engine" in out:
         from opspec.engine.config import EngineConfig
 
-        EngineConfig.from_mapping(out["engine"], path=f"{path}: {key}.engine")
+        try:
+            EngineConfig.from_mapping(out["engine"], path=str(path))
+        except ConfigurationError as error:
+            at = error.location     # an option's key, placed at its line as the others
+            option = f".{at.key}" if at is not None and at.path == str(path) and at.key else ""
+            raise _error(path, f"{key}.engine{option}", error.message,
+                         error.hint or "") from None
     return out
+
+
+def _inline_script(path: Path, key: str, steps: Any) -> Script:
+    """The script written in the scenario file at ``key`` (a list of ``[when, action]``),
+    each step placed at its entry's key (``scenario[0].given.script[2]``) so that a mistake
+    in it is reported at the line the entry is written on."""
+    where = f"{path}: {key}"
+    try:
+        script = parse_script(steps, where=where)
+    except ConfigurationError as error:
+        entry = _entry_key(error.location, where, key)
+        if entry is None:
+            raise
+        raise _error(path, entry, error.message, error.hint or "") from None
+    places = []
+    for place in script.places:
+        entry = _entry_key(place, where, key)
+        places.append(place if entry is None else SourceLocation(str(path), key=entry))
+    return replace(script, places=tuple(places))
+
+
+def _entry_key(at: SourceLocation | None, where: str, key: str) -> str | None:
+    """The scenario file's key of ``at``, a place :func:`parse_script` gives in the script
+    it read with ``where`` (``where: steps[N]``, entry N, or ``where``, the whole list):
+    ``key[N]`` or ``key``; None for any other place."""
+    if at is None or at.line is not None or at.key:
+        return None
+    if at.path == where:
+        return key
+    entry = re.fullmatch(r"steps\[(\d+)\]", at.path.removeprefix(f"{where}: "))
+    return f"{key}[{entry.group(1)}]" if entry is not None else None
 
 
 def _until(value: Any) -> float:
@@ -177,7 +228,7 @@ def load_scenarios(path: str | Path, *, rootdir: Path | None = None) -> Scenario
         path = path.relative_to(rootdir)     # messages name the file as the user wrote it
     full = path if path.is_absolute() or rootdir is None else rootdir / path
     try:
-        return _load(path, full, rootdir)
+        return _load(path, full.absolute(), rootdir)
     except ConfigurationError as error:
         raise _at_its_line(error, path, full) from None
 
@@ -239,6 +290,8 @@ def _load(path: Path, full: Path, rootdir: Path | None) -> ScenarioDocument:
         inherited = {k: v for k, v in defaults.items()
                      if not ({k, *own} >= {"days", "until"})}   # own days/until win
         given = {**inherited, **own}
+        #: where the script is given: this scenario's given, else the file's
+        script_key = f"{key}.given.script" if "script" in own else "given.script"
         if "days" in given and "until" in given:
             raise _error(path, f"{key}.given", "give days or until, not both")
         then = entry.get("then")
@@ -265,10 +318,15 @@ def _load(path: Path, full: Path, rootdir: Path | None) -> ScenarioDocument:
                     script_file = Path(at.path)
                     if rootdir is not None and script_file.is_relative_to(rootdir):
                         at = replace(at, path=str(script_file.relative_to(rootdir)))
+                    given_at = replace(located(str(full), script_key), path=str(path))
                     raise ConfigurationError(
-                        f"{error.message} (scenario {name.strip()!r}, {path}: "
-                        f"{key}.given.script)", location=at, hint=error.hint) from None
-                raise _error(path, f"{key}.given.script", error.message, error.hint) from None
+                        f"{error.message} (scenario {name.strip()!r}, {given_at})",
+                        location=at, hint=error.hint) from None
+                if at is not None and at.path == str(path) and at.key:
+                    # a step written in this file: at its entry's line (_at_its_line)
+                    raise ConfigurationError(error.message, location=at,
+                                             hint=error.hint) from None
+                raise _error(path, script_key, error.message, error.hint) from None
         if script is not None and "user_model" in given:
             raise _error(path, f"{key}.given", "give a script or a user model, not both")
         scenarios.append(Scenario(
@@ -278,14 +336,15 @@ def _load(path: Path, full: Path, rootdir: Path | None) -> ScenarioDocument:
             days=given.get("days"), until=given.get("until"), seed=given.get("seed"),
             engine=given.get("engine", {}), params=given.get("params", {}),
             branches=given.get("branches", {}),
-            description=str(entry.get("description", ""))))
+            description=str(entry.get("description", "")), file=full, key=key))
     return ScenarioDocument(path, spec_path, tuple(scenarios))
 
 
 def run_scenario(scenario: Scenario, spec: Any, *, seed: int = 0,
                  seen: Callable[[Any], None] | None = None) -> list[str]:
     """Run ``scenario`` on ``spec`` (a Package, CompiledPackage or LoadedSpec); return one
-    failure message per expectation that does not hold (empty when all do). ``seen`` gets
+    failure message per expectation that does not hold (empty when all do), each at the
+    line the expectation is written on (``path:line: scenario[N].then[M]: …``). ``seen`` gets
     the simulation's result (its warnings, its failed replications). A replication a fault
     cut short fails the scenario, naming the fault's file:line."""
     from opspec.testing.simulation import simulate
@@ -302,13 +361,13 @@ def run_scenario(scenario: Scenario, spec: Any, *, seed: int = 0,
     if result.failed:       # runs cut short by a fault: no line of them is the spec's
         from opspec.testing.simulation import failed_text
 
-        return [f"{scenario.where}: {failed_text(result.failed, result.replications)}",
+        return [f"{scenario.place()}: {failed_text(result.failed, result.replications)}",
                 f"(seed {result.seed}; {result.replications} replication(s))"]
     failures = []
     for number, expectation in enumerate(scenario.expectations):
         message = expectation.check(result)
         if message is not None:
-            failures.append(f"{scenario.where}.then[{number}]: {message}")
+            failures.append(f"{scenario.place(f'.then[{number}]')}: {message}")
     if failures:
         failures.append(f"(seed {result.seed}; {result.replications} replication(s))")
     return failures

@@ -41,10 +41,10 @@ def test_a_failing_scenario_shows_the_expectation_the_values_and_a_trace_slice(
     result = project.runpytest()
     result.assert_outcomes(passed=1, failed=1)
     result.stdout.fnmatch_lines([_literal(line) for line in [
-        "*dispenser.scenario.toml: scenario[1].then[0]: expected alarms == 1",
+        "*dispenser.scenario.toml:13: scenario[1].then[0]: expected alarms == 1",
         "  but alarms = 3",
         "*d1 08:10:00*sound_alarm",
-        "*dispenser.scenario.toml: scenario[1].then[1]: expected eventually activity dispense",
+        "*dispenser.scenario.toml:13: scenario[1].then[1]: expected eventually activity dispense",
         "  but activity dispense never happened (the run went to d1 09:00:00)",
         "  the trace ends with:",
         "(seed *; 1 replication(s))"]])
@@ -100,15 +100,16 @@ BAD = {
                           "scenario[0].given.user: unknown key 'user'"),
     "bad-script-step": (('spec = "specs/dispenser.xpdl"\n[[scenario]]\nname = "x"\n'
                         'given = { script = [["soon", "press_report"]] }\nthen = ["alarms == 1"]\n'),
-                        "scenario[0].given.script: steps[0]: cannot read the time 'soon'*"),
+                        "scenario[0].given.script[0]: cannot read the time 'soon'*"),
     "script-unknown-activity": (('spec = "specs/dispenser.xpdl"\n[[scenario]]\nname = "x"\n'
                                 'given = { script = [["never", "report"]] }\n'
                                 'then = ["alarms == 1"]\n'),
-                                "scenario[0].given.script: the script names activity 'report'*"),
+                                ("scenario[0].given.script[0]: the script names activity "
+                                 "'report'*")),
     "script-step-on-a-device-activity": (
         ('spec = "specs/dispenser.xpdl"\n[[scenario]]\nname = "x"\n'
          'given = { script = [["10s", "dispense"]] }\nthen = ["alarms == 1"]\n'),
-        ("scenario[0].given.script: the script's step 'complete dispense' names activity "
+        ("scenario[0].given.script[0]: the script's step 'complete dispense' names activity "
          "'dispense', which is never offered to the user (lane 'device' performs it*")),
     "negative-users": (('spec = "specs/dispenser.xpdl"\n[[scenario]]\nname = "x"\n'
                        'given = { users = 0 }\nthen = ["alarms == 1"]\n'),
@@ -127,7 +128,7 @@ BAD = {
 #: the line each mistake of BAD is written on (none: a key that is not written at all); a key
 #: inside an inline table (given = { users = 0 }) is placed at the line of that table
 LINES = {"unknown-top-key": 2, "spec-not-found": 1, "unreadable-then": 4, "unknown-metric": 4,
-         "unknown-given-key": 4, "script-unknown-activity": 4,
+         "unknown-given-key": 4, "bad-script-step": 4, "script-unknown-activity": 4,
          "script-step-on-a-device-activity": 4, "negative-users": 4,
          "twice-the-same-name": 6, "unknown-user-model": 4}
 
@@ -159,4 +160,4 @@ def test_a_script_file_s_bad_step_is_placed_at_its_own_line(project: pytest.Pyte
     result.stdout.fnmatch_lines([_literal(
         "bad scenario file: late.toml:4: steps[1]: the script's step 'complete dispense' "
         "names activity 'dispense'") + "*"
-        + _literal("(scenario 'x', bad.scenario.toml: scenario[0].given.script)") + "*"])
+        + _literal("(scenario 'x', bad.scenario.toml:4: scenario[0].given.script)") + "*"])

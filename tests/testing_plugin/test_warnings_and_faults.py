@@ -94,7 +94,7 @@ def test_a_scenario_file_over_faulted_runs_fails_naming_the_fault(
     result = project.runpytest()
     result.assert_outcomes(failed=1)
     result.stdout.fnmatch_lines([
-        "*scenario[[]0[]]: * of 6 replication(s) failed*",
+        "missed.scenario.toml:2: scenario[[]0[]]: * of 6 replication(s) failed*",
         "*replication *: fault: *dispenser.xpdl:*: activity 'R'*division by zero*"])
 
 
