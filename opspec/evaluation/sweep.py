@@ -19,6 +19,7 @@ from pathlib import Path
 from typing import IO, Any
 
 from opspec.errors import EvaluationError
+from opspec.evaluation.no_spread_notes import no_spread_note, with_mark
 from opspec.evaluation.parameters import Parameter, describe_value, parse_value, resolve
 from opspec.evaluation.plan import Design, EvaluationPlan
 from opspec.evaluation.store import ResultStore
@@ -328,7 +329,8 @@ def _cells(name: str, summary: Mapping[str, Any] | None) -> tuple[str, str]:
     unit = "" if percent or summary["kind"] != "duration" else (summary.get("unit") or "s")
     estimate, (low, high) = _estimate(summary)
     ci = ("–" if low is None or high is None
-          else f"[{fmt(low, unit, percent=percent)}, {fmt(high, unit, percent=percent)}]")
+          else with_mark(f"[{fmt(low, unit, percent=percent)}, "
+                         f"{fmt(high, unit, percent=percent)}]", summary))
     return fmt(estimate, unit, percent=percent), ci
 
 
@@ -346,12 +348,19 @@ def _difference_cells(name: str, d: Mapping[str, Any] | None) -> tuple[str, str,
         return f"{x * 100:+.3g} pp" if percent else f"{x:+.4g}" + (f" {unit}" if unit else "")
 
     low, high = d.get("ci95") or [None, None]
-    ci = "–" if low is None or high is None else f"[{show(low)}, {show(high)}]"
+    ci = "–" if low is None or high is None else with_mark(f"[{show(low)}, {show(high)}]", d)
     paired = _width(d.get("ci95"))
     unpaired = _width(d.get("unpaired_ci95"))
     ratio = (f"{paired / unpaired:.2f}" if paired is not None and unpaired
              else "–")
     return show(d["difference"]) + (" *" if d.get("significant") else ""), ci, ratio
+
+
+def _note(summary: Mapping[str, Any]) -> str | None:
+    """What a marked interval of the sweep's tables means, once (:mod:`.no_spread_notes`)."""
+    return no_spread_note([*(s for v in summary["values"] for s in v["metrics"].values()),
+                           *(d for v in summary["values"]
+                             for d in (v["difference"] or {}).values())])
 
 
 def _width(ci: Sequence[float | None] | None) -> float | None:
@@ -392,12 +401,14 @@ def target_table(answer: Mapping[str, Any], summary: Mapping[str, Any]
     if share is not None:
         headers += ("users meeting", "95 % CI (exact)", f"{100 * share:.4g} % of users")
     rows = []
+    of = {v["design"]: v["metrics"].get(answer["metric"]) for v in summary["values"]}
     for row in answer["values"]:
         low, high = row["ci95"]
         cells: tuple[str, ...] = (
             row["text"], fmt(row["estimate"], percent=percent),
             "–" if low is None or high is None
-            else f"[{fmt(low, percent=percent)}, {fmt(high, percent=percent)}]",
+            else with_mark(f"[{fmt(low, percent=percent)}, {fmt(high, percent=percent)}]",
+                           of.get(row["design"])),
             row["verdict"])
         if share is not None:
             users = row["users"]
@@ -421,6 +432,8 @@ def print_sweep(out: IO[str], summary: Mapping[str, Any], users: int) -> None:
         print(f"\n{metric} ({first['kind']})", file=out)
         for line in table(SWEEP_HEADERS, metric_table(summary, metric)):
             print("  " + line, file=out)
+    if note := _note(summary):
+        print(f"\n{note}", file=out)
     for answer in summary["targets"]:
         print(f"\ntarget {answer['target']}:", file=out)
         for line in table(*target_table(answer, summary)):
@@ -513,7 +526,8 @@ def report_sections(summary: Mapping[str, Any], figures: Path, users: int) -> li
          "exact Clopper-Pearson interval) is compared with the share asked for; a longer "
          "period measures each user's own rate more exactly. 'paired/unpaired width' is the "
          "width of the paired interval over the width the interval would have with "
-         "independent users for each value."),), tables=tuple(tables)))
+         "independent users for each value."), *filter(None, [_note(summary)])),
+        tables=tuple(tables)))
     return sections
 
 
