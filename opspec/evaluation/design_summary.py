@@ -23,7 +23,9 @@
 activity are summarised by :func:`summarise_activities`, the monitors the spec declares
 (``opspec:Monitor``) by :func:`summarise_monitors`.
 Every interval carries the id of its method (``ci95_method``, ``share_with_any_ci95_method``…;
-:mod:`opspec.statistics.methods`). Quantiles of pooled
+:mod:`opspec.statistics.methods`), and every ``ci95`` of a metric, of ``per_user`` and of a
+difference its ``ci95_no_spread``: None, or what an interval of no width from users who all
+gave the same value shows (:func:`opspec.statistics.no_spread.no_spread`). Quantiles of pooled
 observations are computed in the database, so memory does not grow with the number of users.
 Each user's values are read as :mod:`.values_per_user` holds or spills them.
 """

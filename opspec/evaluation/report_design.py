@@ -312,7 +312,7 @@ def design_sections(store: ResultStore, figures: Path, design: str, name: str, d
             "values; the between-user sd of a proportion is the sd of the users' true rates "
             "once each user's binomial noise is taken out (about 0 when users differ only by "
             "chance)."), _per_user_intervals(metrics),
-            *_noted((s.get("per_user") for s in metrics.values()))),
+            *_noted(s.get("per_user") for s in metrics.values())),
             tables=(Table(PER_USER_HEADERS, tuple(spread),
                           "Each user's own mean duration or ratio, over users: the mean of "
                           "their values (every user counting once) with its t interval"),
