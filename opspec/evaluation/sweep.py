@@ -19,7 +19,7 @@ from pathlib import Path
 from typing import IO, Any
 
 from opspec.errors import EvaluationError
-from opspec.evaluation.no_spread_notes import no_spread_note, with_mark
+from opspec.evaluation.no_spread_notes import marked, no_spread_note, with_mark
 from opspec.evaluation.parameters import Parameter, describe_value, parse_value, resolve
 from opspec.evaluation.plan import Design, EvaluationPlan
 from opspec.evaluation.store import ResultStore
@@ -203,7 +203,8 @@ def _target_summary(store: ResultStore, sweep: Sweep, target: Target,
         estimate, ci = _estimate(summary)
         row: dict[str, Any] = {"design": value.design, "value": value.value,
                                "text": value.text, "estimate": estimate, "ci95": ci,
-                               "verdict": verdict(target, ci)}
+                               "ci95_no_spread": summary.get("ci95_no_spread"),
+                               "verdict": verdict(target, ci, alike=marked(summary))}
         if share is not None:
             own = _own_values(store, value.design, definition)
             hit = sum(1 for v in own if target.holds(v))
@@ -220,7 +221,8 @@ def _target_summary(store: ResultStore, sweep: Sweep, target: Target,
                 s = per_value[value.design]["subgroups"][group][target.metric]
                 g_estimate, g_ci = _estimate(s)
                 entry: dict[str, Any] = {"estimate": g_estimate, "ci95": g_ci,
-                                         "verdict": verdict(target, g_ci)}
+                                         "verdict": verdict(target, g_ci,
+                                                            alike=marked(s))}
                 if share is not None:
                     own = _own_values(store, value.design, definition,
                                       subgroup_users(store, value.design, group))
@@ -256,14 +258,21 @@ def _answer(sweep: Sweep, target: Target, rows: Sequence[Mapping[str, Any]], key
         text = (head + f"met with {sweep.parameter} = {', '.join(meets)}"
                 + (" (every value)" if len(meets) == len(rows) else ""))
         if undecided:
-            text += f"; undecided at {', '.join(undecided)} (the interval contains the target)"
+            text += f"; undecided at {', '.join(undecided)} ({_why(rows, key)})"
         return text + "."
     fails = [r["text"] for r in rows if verdict_of(r) == "fails"]
     if undecided:
         return (head + f"no value is shown to meet it; undecided at {', '.join(undecided)} "
-                "(the 95 % interval contains the target: more users would tell)"
+                f"({_why(rows, key, '95 % ')}: more users would tell)"
                 + (f"; failed at {', '.join(fails)}" if fails else "") + ".")
     return head + f"no value of {sweep.parameter} meets it; every value fails it."
+
+
+def _why(rows: Sequence[Mapping[str, Any]], key: str, level: str = "") -> str:
+    """Why the verdicts on the target's interval are undecided, in the answer's words."""
+    alike = key == "verdict" and any(r["verdict"] == "undecided" and marked(r) for r in rows)
+    return (f"the {level}interval contains the target"
+            + (", or has no width because the users were all alike" if alike else ""))
 
 
 def summarise_sweep(store: ResultStore, sweep: Sweep, days: float,
@@ -401,14 +410,13 @@ def target_table(answer: Mapping[str, Any], summary: Mapping[str, Any]
     if share is not None:
         headers += ("users meeting", "95 % CI (exact)", f"{100 * share:.4g} % of users")
     rows = []
-    of = {v["design"]: v["metrics"].get(answer["metric"]) for v in summary["values"]}
     for row in answer["values"]:
         low, high = row["ci95"]
         cells: tuple[str, ...] = (
             row["text"], fmt(row["estimate"], percent=percent),
             "–" if low is None or high is None
             else with_mark(f"[{fmt(low, percent=percent)}, {fmt(high, percent=percent)}]",
-                           of.get(row["design"])),
+                           row),
             row["verdict"])
         if share is not None:
             users = row["users"]

@@ -82,14 +82,21 @@ def test_a_difference_every_user_shares_is_marked_in_the_comparison(tmp_path):
     assert note.startswith("† all 3 users gave the same difference between the designs")
 
 
-def test_a_sweep_marks_it_and_says_so_once(capsys, tmp_path):
+def test_a_sweep_marks_it_says_so_once_and_decides_no_target_on_it(capsys, tmp_path):
     status = main(["evaluate", str(SPEC), *SMALL, "--out", str(tmp_path / "s"), "--quiet",
-                   "--sweep", "user.activities.hear_alarm.omission.probability=15%,0%"])
+                   "--sweep", "user.activities.hear_alarm.omission.probability=15%,0%",
+                   "--target", "alarms_per_dose < 1.5"])
     assert status == 0
     text = capsys.readouterr().out
     sweep = text[text.index("sweep of"):]
     assert "4         [4, 4] †" in sweep
     assert sweep.count(NOTE) == 1
+    # one alarm per dose in every user's run at both values: no value is shown to meet the
+    # target (the old answer: met with every value)
+    target = sweep[sweep.index("target alarms_per_dose"):]
+    assert "[1, 1] †  undecided" in target and "meets" not in target
+    assert ("undecided at 15 %, 0 % (the 95 % interval contains the target, or has no width "
+            "because the users were all alike: more users would tell)") in target
 
 
 def test_many_users_all_alike_are_not_marked():
