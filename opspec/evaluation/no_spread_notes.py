@@ -27,7 +27,8 @@ def _users(counts: list[int]) -> str:
     distinct = sorted(set(counts))
     if len(distinct) == 1:
         return f"all {distinct[0]:,} users"
-    return ("all the users it is over (" + ", ".join(f"{n:,}" for n in distinct[:-1])
+    return ("all the users of each marked interval (" + ", ".join(f"{n:,}" for n in
+                                                                distinct[:-1])
             + f" or {distinct[-1]:,})")
 
 
@@ -48,6 +49,7 @@ def no_spread_note(summaries: Iterable[Mapping[str, Any] | None]) -> str | None:
             "spread between users, not a value known exactly. Unless the spec fixes the value (a "
             "count of events on a fixed schedule), more users are needed to estimate its "
             "interval: "
-            f"with {fewest['users']:,} users all alike, up to "
+            f"with {fewest['users']:,} users all alike"
+            f"{' (the fewest)' if len(set(counts)) > 1 else ''}, up to "
             f"{100 * fewest['share_unlike_ci95_high']:.3g} % of users could give another value "
             "(exact 95 % bound).")

@@ -384,13 +384,13 @@ def _report_sections(store: ResultStore, summaries: Mapping[str, Summaries] | No
             if compared else ()))
         if population and population.get("subgroups"):
             headers, rows = subgroup_comparison_rows(population)
+            marked_note = no_spread_note(d for g in population["subgroups"].values()
+                                         for d in (g.get("difference") or {}).values())
             sections.append(Section(f"{names['B']} compared with {names['A']}, by subgroup",
                                     paragraphs=(
                 ("The same paired differences within each subgroup: a design change can "
                  "help one kind of user and not another. * marks intervals that exclude "
-                 "zero."), *filter(None, [no_spread_note(
-                     d for g in population["subgroups"].values()
-                     for d in (g.get("difference") or {}).values())])), tables=(Table(headers, tuple(rows),
+                 "zero."), *filter(None, [marked_note])), tables=(Table(headers, tuple(rows),
                                            "Paired differences B − A per subgroup "
                                            "[95 % CI]"),)))
 

@@ -111,3 +111,15 @@ def test_many_users_all_alike_are_not_marked():
     (row,) = tables.metric_rows({"doses_due": s})
     assert row[3] == "[120, 120]"
     assert no_spread_note([s]) is None
+
+
+def test_one_note_for_intervals_over_different_numbers_of_users():
+    from opspec.evaluation.no_spread_notes import no_spread_note
+    from opspec.statistics.no_spread import no_spread
+
+    # a population's subgroups: 6 independent users and all 8 alike
+    note = no_spread_note([{"ci95_no_spread": no_spread([4.0, 4.0], 8)},
+                           {"ci95_no_spread": no_spread([4.0, 4.0], 6)}, {"ci95": [1, 2]}])
+    assert note.startswith("† all the users of each marked interval (6 or 8) gave the same "
+                           "value")
+    assert "with 6 users all alike (the fewest), up to 45.9 % of users" in note
