@@ -23,7 +23,9 @@
 activity are summarised by :func:`summarise_activities`, the monitors the spec declares
 (``opspec:Monitor``) by :func:`summarise_monitors`.
 Every interval carries the id of its method (``ci95_method``, ``share_with_any_ci95_method``…;
-:mod:`opspec.statistics.methods`). Quantiles of pooled
+:mod:`opspec.statistics.methods`), and every ``ci95`` of a metric, of ``per_user`` and of a
+difference its ``ci95_no_spread``: None, or what an interval of no width from users who all
+gave the same value shows (:func:`opspec.statistics.no_spread.no_spread`). Quantiles of pooled
 observations are computed in the database, so memory does not grow with the number of users.
 Each user's values are read as :mod:`.values_per_user` holds or spills them.
 """
@@ -49,6 +51,7 @@ from opspec.statistics import (
     ratio_estimate,
 )
 from opspec.statistics.clustered import ValuesAsPairs
+from opspec.statistics.no_spread import no_spread
 from opspec.statistics.percentiles import interpolation_point, linear
 from opspec.statistics.ratios import ratio_interval
 
@@ -116,6 +119,7 @@ def _per_user(ordered: Sequence[float], level: float) -> dict[str, Any]:
     estimate = ratio_estimate(ValuesAsPairs(ordered), level)
     return {"users": len(ordered), "mean": estimate.value, "sd": _sd(ordered),
             "ci95": estimate.ci, "ci95_method": estimate.method,
+            "ci95_no_spread": no_spread(estimate.ci, len(ordered), level),
             "median": _percentile(ordered, 0.5),
             **{name: _percentile(ordered, q) for name, q in PERCENTILES}}
 
@@ -173,6 +177,7 @@ def summarise_design(store: ResultStore, design: str, days: float, level: float 
                 "kind": "count", "total": int(sum(totals)), "users": users,
                 "mean": counted.value, "sd": _sd(totals),
                 "ci95": counted.ci, "ci95_method": counted.method,
+                "ci95_no_spread": no_spread(counted.ci, users, level),
                 "median": _percentile(totals, 0.5), "p95": _percentile(totals, 0.95),
                 "per_day": (estimate.value / days) if estimate.value is not None else None,
                 "p90": _percentile(totals, 0.90), "p99": _percentile(totals, 0.99),
@@ -190,6 +195,7 @@ def summarise_design(store: ResultStore, design: str, days: float, level: float 
                 "kind": "duration", "unit": definition.get("unit") or "s", "n": n,
                 "users": users, "mean": estimate.value, "ci95": estimate.ci,
                 "ci95_method": estimate.method, "sd": sd,
+                "ci95_no_spread": no_spread(estimate.ci, estimate.users, level),
                 "median": _pooled_quantile(store, design, name, n, 0.5, subgroup),
                 "p95": _pooled_quantile(store, design, name, n, 0.95, subgroup),
                 "per_user": _per_user(values.sorted(name, "v"), level),
@@ -208,6 +214,7 @@ def summarise_design(store: ResultStore, design: str, days: float, level: float 
                 "numerator_total": sum(y for y, _ in pairs),
                 "denominator_total": sum(k for _, k in pairs),
                 "ci95": interval.ci, "ci95_method": interval.method,
+                "ci95_no_spread": no_spread(interval.ci, interval.users, level),
                 "proportion": proportion,
                 "numerator": numerator, "denominator": denominator,
                 "per_user": {**_per_user(values.sorted(name, "v"), level),
@@ -246,6 +253,7 @@ def compare_designs(store: ResultStore, a: str = "A", b: str = "B", level: float
                 "s" if definition["kind"] == "duration" else None),
             "a": ea.value, "b": eb.value,
             "difference": diff.value, "ci95": diff.ci, "ci95_method": diff.method,
+            "ci95_no_spread": no_spread(diff.ci, len(users), level),
             "users": len(users),
             "significant": significant,
             # a ratio's declaration, as its summaries carry it: the tables show the

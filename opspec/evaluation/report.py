@@ -34,6 +34,7 @@ from typing import TYPE_CHECKING, Any
 
 from opspec.errors import EvaluationError
 from opspec.evaluation.describe import describe_metric
+from opspec.evaluation.no_spread_notes import no_spread_note
 from opspec.evaluation.plan import span
 from opspec.evaluation.report_design import (
     PLOT_SAMPLE,
@@ -375,18 +376,21 @@ def _report_sections(store: ResultStore, summaries: Mapping[str, Summaries] | No
         sections.append(Section(f"{names['B']} compared with {names['A']}", paragraphs=(
             (f"Differences {names['B']} − {names['A']} per metric on the same simulated users "
             "(paired); 'differs' marks intervals that exclude zero."
-            + _no_interval_words(difference)),),
+            + _no_interval_words(difference)),
+            *filter(None, [no_spread_note(difference.values())])),
             tables=(Table(headers, tuple(comparison_rows(difference))),),
             images=compared,
             captions=("Paired differences with 95 % CIs, each on its own scale",)
             if compared else ()))
         if population and population.get("subgroups"):
             headers, rows = subgroup_comparison_rows(population)
+            marked_note = no_spread_note(d for g in population["subgroups"].values()
+                                         for d in (g.get("difference") or {}).values())
             sections.append(Section(f"{names['B']} compared with {names['A']}, by subgroup",
                                     paragraphs=(
                 ("The same paired differences within each subgroup: a design change can "
                  "help one kind of user and not another. * marks intervals that exclude "
-                 "zero."),), tables=(Table(headers, tuple(rows),
+                 "zero."), *filter(None, [marked_note])), tables=(Table(headers, tuple(rows),
                                            "Paired differences B − A per subgroup "
                                            "[95 % CI]"),)))
 

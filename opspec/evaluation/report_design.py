@@ -12,6 +12,7 @@ from pathlib import Path
 from typing import Any
 
 from opspec.evaluation.describe import can_do_wrongly
+from opspec.evaluation.no_spread_notes import no_spread_note
 from opspec.evaluation.plan import span
 from opspec.evaluation.report_findings import metric_label, words
 from opspec.evaluation.store import ResultStore
@@ -123,16 +124,24 @@ def _per_user_intervals(metrics: Mapping[str, Mapping[str, Any]]) -> str:
     return text
 
 
+def _noted(summaries: Any) -> tuple[str, ...]:
+    """The note on a table's marked intervals (:mod:`.no_spread_notes`), as a paragraph."""
+    note = no_spread_note(summaries)
+    return (note,) if note else ()
+
+
 def _by_subgroup_section(metrics: Mapping[str, Any], population: Mapping[str, Any],
                          design: str, first: str, prefix: str) -> Any:
     from opspec.evaluation.html import Section, Table
 
     key = "metrics" if design == first else f"metrics_{design}"
     headers, rows = subgroup_metric_rows(metrics, population, key)
+    shown = [*metrics.values(), *(s for g in (population.get("subgroups") or {}).values()
+                                  for s in (g.get(key) or {}).values())]
     return Section(f"{prefix}By subgroup", paragraphs=(
         ("Every metric over all users and over the users of each subgroup (in brackets the "
          "number of users), each with its 95 % confidence interval computed as for all "
-         "users. A subgroup's interval is wider: it has fewer users."),),
+         "users. A subgroup's interval is wider: it has fewer users."), *_noted(shown)),
         tables=(Table(headers, tuple(rows), "Metrics per subgroup: estimate [95 % CI]"),))
 
 
@@ -245,7 +254,8 @@ def design_sections(store: ResultStore, figures: Path, design: str, name: str, d
     sections.append(Section(f"{prefix}Estimates", paragraphs=(
         ("Counts are per user over the whole run (sd, median and p95 are of the users' "
         "totals); durations are pooled over all observations; ratios are the sum of the "
-        "numerator over the sum of the denominator over all users."),),
+        "numerator over the sum of the denominator over all users."),
+        *_noted(metrics.values())),
         tables=(Table(METRIC_HEADERS, tuple(metric_rows(metrics)),
                       f"Declared metrics of {name}: {users:,} simulated users × "
                       f"{span(days)} each"),),
@@ -301,7 +311,8 @@ def design_sections(store: ResultStore, figures: Path, design: str, name: str, d
             "(Clopper-Pearson) interval; p50, p90 and p99 are percentiles of the users' own "
             "values; the between-user sd of a proportion is the sd of the users' true rates "
             "once each user's binomial noise is taken out (about 0 when users differ only by "
-            "chance)."), _per_user_intervals(metrics)),
+            "chance)."), _per_user_intervals(metrics),
+            *_noted(s.get("per_user") for s in metrics.values())),
             tables=(Table(PER_USER_HEADERS, tuple(spread),
                           "Each user's own mean duration or ratio, over users: the mean of "
                           "their values (every user counting once) with its t interval"),

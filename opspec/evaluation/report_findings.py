@@ -9,6 +9,7 @@ from __future__ import annotations
 from collections.abc import Mapping, Sequence
 from typing import Any
 
+from opspec.evaluation.no_spread_notes import marked
 from opspec.evaluation.plan import span
 from opspec.evaluation.tables import fmt, in_percent
 
@@ -39,8 +40,13 @@ def _ci_words(summary: Mapping[str, Any], unit: str = "", *, percent: bool = Fal
     low, high = summary.get("ci95") or [None, None]
     if low is None or high is None:
         return ""
+    alike = ""
+    if marked(summary):
+        alike = (f"; all {summary['ci95_no_spread']['users']:,} users gave the same value, "
+                 "so it shows no spread between users, not a value known exactly (unless the "
+                 "spec fixes the value): more users would estimate one")
     return (f" (95 % confidence interval {fmt(low, unit, percent=percent)} to "
-            f"{fmt(high, unit, percent=percent)})")
+            f"{fmt(high, unit, percent=percent)}{alike})")
 
 
 def _finding(metric: str, s: Mapping[str, Any], definition: Mapping[str, Any]

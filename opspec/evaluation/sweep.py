@@ -19,6 +19,7 @@ from pathlib import Path
 from typing import IO, Any
 
 from opspec.errors import EvaluationError
+from opspec.evaluation.no_spread_notes import marked, no_spread_note, with_mark
 from opspec.evaluation.parameters import Parameter, describe_value, parse_value, resolve
 from opspec.evaluation.plan import Design, EvaluationPlan
 from opspec.evaluation.store import ResultStore
@@ -202,7 +203,8 @@ def _target_summary(store: ResultStore, sweep: Sweep, target: Target,
         estimate, ci = _estimate(summary)
         row: dict[str, Any] = {"design": value.design, "value": value.value,
                                "text": value.text, "estimate": estimate, "ci95": ci,
-                               "verdict": verdict(target, ci)}
+                               "ci95_no_spread": summary.get("ci95_no_spread"),
+                               "verdict": verdict(target, ci, alike=marked(summary))}
         if share is not None:
             own = _own_values(store, value.design, definition)
             hit = sum(1 for v in own if target.holds(v))
@@ -219,7 +221,8 @@ def _target_summary(store: ResultStore, sweep: Sweep, target: Target,
                 s = per_value[value.design]["subgroups"][group][target.metric]
                 g_estimate, g_ci = _estimate(s)
                 entry: dict[str, Any] = {"estimate": g_estimate, "ci95": g_ci,
-                                         "verdict": verdict(target, g_ci)}
+                                         "verdict": verdict(target, g_ci,
+                                                            alike=marked(s))}
                 if share is not None:
                     own = _own_values(store, value.design, definition,
                                       subgroup_users(store, value.design, group))
@@ -255,14 +258,21 @@ def _answer(sweep: Sweep, target: Target, rows: Sequence[Mapping[str, Any]], key
         text = (head + f"met with {sweep.parameter} = {', '.join(meets)}"
                 + (" (every value)" if len(meets) == len(rows) else ""))
         if undecided:
-            text += f"; undecided at {', '.join(undecided)} (the interval contains the target)"
+            text += f"; undecided at {', '.join(undecided)} ({_why(rows, key)})"
         return text + "."
     fails = [r["text"] for r in rows if verdict_of(r) == "fails"]
     if undecided:
         return (head + f"no value is shown to meet it; undecided at {', '.join(undecided)} "
-                "(the 95 % interval contains the target: more users would tell)"
+                f"({_why(rows, key, '95 % ')}: more users would tell)"
                 + (f"; failed at {', '.join(fails)}" if fails else "") + ".")
     return head + f"no value of {sweep.parameter} meets it; every value fails it."
+
+
+def _why(rows: Sequence[Mapping[str, Any]], key: str, level: str = "") -> str:
+    """Why the verdicts on the target's interval are undecided, in the answer's words."""
+    alike = key == "verdict" and any(r["verdict"] == "undecided" and marked(r) for r in rows)
+    return (f"the {level}interval contains the target"
+            + (", or has no width because the users were all alike" if alike else ""))
 
 
 def summarise_sweep(store: ResultStore, sweep: Sweep, days: float,
@@ -328,7 +338,8 @@ def _cells(name: str, summary: Mapping[str, Any] | None) -> tuple[str, str]:
     unit = "" if percent or summary["kind"] != "duration" else (summary.get("unit") or "s")
     estimate, (low, high) = _estimate(summary)
     ci = ("–" if low is None or high is None
-          else f"[{fmt(low, unit, percent=percent)}, {fmt(high, unit, percent=percent)}]")
+          else with_mark(f"[{fmt(low, unit, percent=percent)}, "
+                         f"{fmt(high, unit, percent=percent)}]", summary))
     return fmt(estimate, unit, percent=percent), ci
 
 
@@ -346,12 +357,19 @@ def _difference_cells(name: str, d: Mapping[str, Any] | None) -> tuple[str, str,
         return f"{x * 100:+.3g} pp" if percent else f"{x:+.4g}" + (f" {unit}" if unit else "")
 
     low, high = d.get("ci95") or [None, None]
-    ci = "–" if low is None or high is None else f"[{show(low)}, {show(high)}]"
+    ci = "–" if low is None or high is None else with_mark(f"[{show(low)}, {show(high)}]", d)
     paired = _width(d.get("ci95"))
     unpaired = _width(d.get("unpaired_ci95"))
     ratio = (f"{paired / unpaired:.2f}" if paired is not None and unpaired
              else "–")
     return show(d["difference"]) + (" *" if d.get("significant") else ""), ci, ratio
+
+
+def _note(summary: Mapping[str, Any]) -> str | None:
+    """What a marked interval of the sweep's tables means, once (:mod:`.no_spread_notes`)."""
+    return no_spread_note([*(s for v in summary["values"] for s in v["metrics"].values()),
+                           *(d for v in summary["values"]
+                             for d in (v["difference"] or {}).values())])
 
 
 def _width(ci: Sequence[float | None] | None) -> float | None:
@@ -397,7 +415,8 @@ def target_table(answer: Mapping[str, Any], summary: Mapping[str, Any]
         cells: tuple[str, ...] = (
             row["text"], fmt(row["estimate"], percent=percent),
             "–" if low is None or high is None
-            else f"[{fmt(low, percent=percent)}, {fmt(high, percent=percent)}]",
+            else with_mark(f"[{fmt(low, percent=percent)}, {fmt(high, percent=percent)}]",
+                           row),
             row["verdict"])
         if share is not None:
             users = row["users"]
@@ -421,6 +440,8 @@ def print_sweep(out: IO[str], summary: Mapping[str, Any], users: int) -> None:
         print(f"\n{metric} ({first['kind']})", file=out)
         for line in table(SWEEP_HEADERS, metric_table(summary, metric)):
             print("  " + line, file=out)
+    if note := _note(summary):
+        print(f"\n{note}", file=out)
     for answer in summary["targets"]:
         print(f"\ntarget {answer['target']}:", file=out)
         for line in table(*target_table(answer, summary)):
@@ -513,7 +534,8 @@ def report_sections(summary: Mapping[str, Any], figures: Path, users: int) -> li
          "exact Clopper-Pearson interval) is compared with the share asked for; a longer "
          "period measures each user's own rate more exactly. 'paired/unpaired width' is the "
          "width of the paired interval over the width the interval would have with "
-         "independent users for each value."),), tables=tuple(tables)))
+         "independent users for each value."), *filter(None, [_note(summary)])),
+        tables=tuple(tables)))
     return sections
 
 

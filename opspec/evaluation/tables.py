@@ -5,6 +5,7 @@ from __future__ import annotations
 from collections.abc import Mapping, Sequence
 from typing import IO, Any
 
+from opspec.evaluation.no_spread_notes import no_spread_note, with_mark
 from opspec.evaluation.plan import span
 from opspec.properties.language import clock
 from opspec.statistics.methods import METHODS, methods_in
@@ -53,10 +54,13 @@ def in_percent(summary: Mapping[str, Any]) -> bool:
 
 
 def _ci(summary: Mapping[str, Any], unit: str = "", *, percent: bool = False) -> str:
+    """``[low, high]``, marked when it has no width because its few users were all alike
+    (:mod:`.no_spread_notes`)."""
     low, high = (summary.get("ci95") or [None, None])
     if low is None or high is None:
         return "–"
-    return f"[{fmt(low, unit, percent=percent)}, {fmt(high, unit, percent=percent)}]"
+    return with_mark(f"[{fmt(low, unit, percent=percent)}, {fmt(high, unit, percent=percent)}]",
+                     summary)
 
 
 def method_name(summary: Mapping[str, Any], key: str = "ci95_method") -> str:
@@ -301,8 +305,8 @@ def comparison_rows(difference: Mapping[str, Mapping[str, Any]]) -> list[tuple[s
         diff = difference_text(d["difference"], unit, percent=percent)
         low, high = d.get("ci95") or [None, None]
         ci = ("–" if low is None or high is None else
-              f"[{difference_text(low, unit, percent=percent)}, "
-              f"{difference_text(high, unit, percent=percent)}]")
+              with_mark(f"[{difference_text(low, unit, percent=percent)}, "
+                        f"{difference_text(high, unit, percent=percent)}]", d))
         rows.append((name, fmt(d["a"], unit, percent=percent),
                      fmt(d["b"], unit, percent=percent), diff, ci,
                      no_interval_reason(d) or method_name(d),
@@ -377,6 +381,10 @@ def print_summary(out: IO[str], plan: Any, metrics: Mapping[str, Any],
         if len(failures) > 10:
             print(f"  … and {len(failures) - 10} more", file=out)
         print(advice(failures), file=out)
+    # what a marked interval means, once for every table above
+    note = no_spread_note(_shown(metrics, compare, population))
+    if note:
+        print(f"\n{note}", file=out)
     # the intervals the tables above show (the exact shares of users only with a population)
     legend = method_legend([metrics, monitors, compare, population],
                            None if population else ("ci95_method",))
@@ -386,6 +394,21 @@ def print_summary(out: IO[str], plan: Any, metrics: Mapping[str, Any],
         for line in legend:
             print(line, file=out)
     print(file=out)
+
+
+def _shown(metrics: Mapping[str, Any], compare: Mapping[str, Any] | None,
+           population: Mapping[str, Any] | None) -> list[Any]:
+    """The summaries whose intervals the terminal's tables show: every metric, per subgroup
+    too, and every difference."""
+    shown = list(metrics.values())
+    groups = (population or {}).get("subgroups") or {}
+    for g in groups.values():
+        shown += list((g.get("metrics") or {}).values())
+    if compare is not None:
+        shown += list((compare.get("difference") or {}).values())
+        for g in groups.values():
+            shown += list((g.get("difference") or {}).values())
+    return shown
 
 
 def _print_population(out: IO[str], metrics: Mapping[str, Any],

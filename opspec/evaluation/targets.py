@@ -9,7 +9,8 @@ The verdict on a design is three-way, as a reviewer reads an interval:
 
 * **meets** — the whole 95 % interval lies on the target's side of the threshold;
 * **fails** — the whole interval lies on the other side;
-* **undecided** — the interval contains the threshold: more users would tell.
+* **undecided** — the interval contains the threshold, or has no width because the few users
+  it is over all gave the same value: more users would tell.
 
 ``--target-users 95%`` asks instead about each user's own value over the run (their missed
 rate over the simulated days): the share of users whose own value satisfies the target, with
@@ -124,10 +125,13 @@ def parse_target(text: str, definitions: Sequence[Mapping[str, Any]]) -> Target:
     return Target(text, metric, op, threshold, kind, percent=percent)
 
 
-def verdict(target: Target, ci: Sequence[float | None] | None) -> str:
+def verdict(target: Target, ci: Sequence[float | None] | None, *, alike: bool = False
+            ) -> str:
     """``meets``, ``fails`` or ``undecided``: where the interval ``ci`` lies against the
-    threshold (undecided without an interval)."""
-    if not ci or ci[0] is None or ci[1] is None:
+    threshold (undecided without an interval, and for an interval of no width because its
+    few users were all ``alike``: it shows no spread, not a value known exactly,
+    :mod:`opspec.statistics.no_spread`)."""
+    if not ci or ci[0] is None or ci[1] is None or alike:
         return "undecided"
     low, high = float(ci[0]), float(ci[1])
     if target.below:

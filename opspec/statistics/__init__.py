@@ -11,6 +11,8 @@ opspec comes from here (spec tests, evaluations, user-model fitting, the engine'
   (a proportion's or a ratio's, with few events the exact Poisson one);
 * :mod:`~opspec.statistics.percentiles` — the two percentile conventions (interpolated,
   nearest rank);
+* :mod:`~opspec.statistics.no_spread` — an interval of no width because every user gave the
+  same value: how many users, and how large a share could still differ;
 * :mod:`~opspec.statistics.claims` — deciding a claim "X >= b with 95 % confidence";
 * :mod:`~opspec.statistics.methods` — how each interval is computed, in words, with its
   references (what the report, ``--json`` and the docs say).

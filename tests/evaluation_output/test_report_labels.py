@@ -84,7 +84,8 @@ def test_the_per_user_interval_is_labelled_as_the_mean_of_users_values(run: Path
     assert "95 % CI" not in head, "the per-user interval is headed as the estimate's"
     column = head.index("95 % CI of that mean (t)")
     assert head[2] == "mean of users' values"
-    assert own["taken_rate (per user)"][column] == "[100.00 %, 100.00 %]"
+    # marked: 20 users all alike (tests/evaluation/test_no_spread_shown.py)
+    assert own["taken_rate (per user)"][column] == "[100.00 %, 100.00 %] †"
     # what it is, in one sentence, and why the two differ
     assert ("'95 % CI of that mean (t)' is a confidence interval of the mean of the users' "
             "own values, every user counting once, by Student's t over those values; it is "
