@@ -6,17 +6,28 @@ instance they were done in: ``complete hear_alarm #6``. The script language keep
 ``--replay`` and in ``opspec run --script`` alike. When three identical "Hear the alarm" offers wait and the person took the
 newest, the replay takes the newest too. Recordings written before the tags (plain
 ``complete hear_alarm``) still replay, matching offers in order as before.
+
+A replay ends where the recorded session ended (:func:`recorded_end`): the person quit at
+12:34, so the replay stops at 12:34 instead of running the rest of the day without them.
+The script language has no place for that time (a script file holds ``steps`` and
+``otherwise``, which ``opspec run --script`` checks), so the session writes it to the trace
+beside the recording (``walkthrough.ended``) when it closes.
 """
 
 from __future__ import annotations
 
+import json
 import re
 from pathlib import Path
 
 from opspec.engine.compiled import CompiledPackage
 from opspec.usermodels.scripts import ScriptUser, load_script
 
-__all__ = ["instance_tag", "load_recording", "tagged_action"]
+__all__ = ["ENDED", "instance_tag", "load_recording", "recorded_end", "tagged_action"]
+
+#: the trace event a session writes when it closes: where it ended (``until``, simulated
+#: seconds) and whether the person quit before the end of the run (``quit``)
+ENDED = "walkthrough.ended"
 
 _TAG = re.compile(r"(?:^|\s)#(\d+)(?=\s|$)")
 
@@ -52,3 +63,29 @@ def load_recording(path: str | Path, compiled: CompiledPackage | None = None) ->
     # each step keeps its "#6" (Step.instance): it acts only on an offer of that instance
     performer: ScriptUser = scripted_user(path, compiled).source.performer()
     return performer
+
+
+def recorded_end(path: str | Path) -> float | None:
+    """Where the session recorded in ``path`` ended (the end of its run, or the second the
+    person quit at), as its trace beside it (``REC.trace.jsonl``) says; ``None`` when nothing
+    says so: a recording made before sessions wrote it, any other script, a session the
+    engine failed in (its replay fails at the same place), a trace gone or not a
+    walkthrough's."""
+    trace = Path(path).with_suffix(".trace.jsonl")
+    end = None
+    try:
+        with trace.open(encoding="utf-8") as lines:
+            header = json.loads(next(lines, "{}"))
+            if not isinstance(header, dict) or header.get("walkthrough") is not True:
+                return None
+            for line in lines:
+                if ENDED not in line:
+                    continue
+                event = json.loads(line)
+                until = event.get("data", {}).get("until") if isinstance(event, dict) else None
+                if event.get("kind") == ENDED and isinstance(until, (int, float)) and (
+                        not isinstance(until, bool)) and until > 0:
+                    end = float(until)
+    except (OSError, UnicodeDecodeError, ValueError, AttributeError):
+        return None      # unreadable: the replay runs the whole run, as before
+    return end

@@ -13,6 +13,7 @@ from typing import Any
 
 from opspec.engine.performers import WorkItem
 from opspec.errors import ConfigurationError
+from opspec.tui.replay import ENDED
 from opspec.tui.session_state import SessionState
 
 __all__ = ["Recording"]
@@ -82,5 +83,9 @@ class Recording(SessionState):
 
     def close(self) -> None:
         if self._trace_file is not None:
+            if self.failure is None:
+                # where the session ended (the run's end, or where the person quit): a replay
+                # of the recording ends there too (opspec.tui.replay.recorded_end)
+                self.sim.session.trace(ENDED, {"until": self.now, "quit": not self.ended})
             self._trace_file.close()
             self._trace_file = None
