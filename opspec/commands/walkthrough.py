@@ -139,8 +139,14 @@ def run(args: argparse.Namespace) -> int:
     # once the spec is known to start (its own error first), with nothing recorded and no
     # device opened (opening a serial port may reset the board behind it)
     terminal = sys.stdin.isatty() and sys.stdout.isatty()
-    if args.record and record is not None and not terminal:
-        _check_record_folder(record)            # an option's own error comes first
+    if not terminal:                            # an option's own error comes first
+        if args.record and record is not None:
+            _check_record_folder(record)
+        if args.bind:
+            from opspec.bindings.profiles import default_profiles_dir, load_profiles
+
+            # the profiles are read (a broken one is said), no port is opened
+            load_profiles(args.devices if args.devices else default_profiles_dir())
     with contextlib.ExitStack() as stack:
         performers: dict[str, Any] = {}          # the world: opspec.runs.build adds it
         notes: list[str] = list(spec_warnings)

@@ -10,8 +10,9 @@ newest, the replay takes the newest too. Recordings written before the tags (pla
 A replay ends where the recorded session ended (:func:`recorded_end`): the person quit at
 12:34, so the replay stops at 12:34 instead of running the rest of the day without them.
 The script language has no place for that time (a script file holds ``steps`` and
-``otherwise``, which ``opspec run --script`` checks), so the session writes it to the trace
-beside the recording (``walkthrough.ended``) when it closes.
+``otherwise``, which ``opspec run --script`` checks), so the trace beside the recording keeps
+it: its header says where the run was to end (``until``), and a session the person quit
+before then ends with a ``walkthrough.quit`` event (``until``: the second they quit at).
 """
 
 from __future__ import annotations
@@ -23,11 +24,11 @@ from pathlib import Path
 from opspec.engine.compiled import CompiledPackage
 from opspec.usermodels.scripts import ScriptUser, load_script
 
-__all__ = ["ENDED", "instance_tag", "load_recording", "recorded_end", "tagged_action"]
+__all__ = ["QUIT", "instance_tag", "load_recording", "recorded_end", "tagged_action"]
 
-#: the trace event a session writes when it closes: where it ended (``until``, simulated
-#: seconds) and whether the person quit before the end of the run (``quit``)
-ENDED = "walkthrough.ended"
+#: the trace event of a session the person quit before the end of its run: ``until``, the
+#: simulated second they quit at
+QUIT = "walkthrough.quit"
 
 _TAG = re.compile(r"(?:^|\s)#(\d+)(?=\s|$)")
 
@@ -66,26 +67,30 @@ def load_recording(path: str | Path, compiled: CompiledPackage | None = None) ->
 
 
 def recorded_end(path: str | Path) -> float | None:
-    """Where the session recorded in ``path`` ended (the end of its run, or the second the
-    person quit at), as its trace beside it (``REC.trace.jsonl``) says; ``None`` when nothing
-    says so: a recording made before sessions wrote it, any other script, a session the
-    engine failed in (its replay fails at the same place), a trace gone or not a
-    walkthrough's."""
+    """Where the session recorded in ``path`` ended, as its trace beside it
+    (``REC.trace.jsonl``) says: the second the person quit at, else the end of its run;
+    ``None`` when nothing says so: a recording made before sessions wrote it, any other
+    script, a trace gone or not a walkthrough's."""
     trace = Path(path).with_suffix(".trace.jsonl")
-    end = None
     try:
         with trace.open(encoding="utf-8") as lines:
             header = json.loads(next(lines, "{}"))
             if not isinstance(header, dict) or header.get("walkthrough") is not True:
                 return None
+            end = _seconds(header.get("until"))
             for line in lines:
-                if ENDED not in line:
-                    continue
-                event = json.loads(line)
-                until = event.get("data", {}).get("until") if isinstance(event, dict) else None
-                if event.get("kind") == ENDED and isinstance(until, (int, float)) and (
-                        not isinstance(until, bool)) and until > 0:
-                    end = float(until)
-    except (OSError, UnicodeDecodeError, ValueError, AttributeError):
+                if QUIT in line:
+                    event = json.loads(line)
+                    if isinstance(event, dict) and event.get("kind") == QUIT and isinstance(
+                            event.get("data"), dict):
+                        end = _seconds(event["data"].get("until")) or end
+    except (OSError, UnicodeDecodeError, ValueError):
         return None      # unreadable: the replay runs the whole run, as before
     return end
+
+
+def _seconds(value: object) -> float | None:
+    """A positive number of seconds, or ``None``."""
+    if isinstance(value, (int, float)) and not isinstance(value, bool) and value > 0:
+        return float(value)
+    return None

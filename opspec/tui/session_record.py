@@ -13,7 +13,7 @@ from typing import Any
 
 from opspec.engine.performers import WorkItem
 from opspec.errors import ConfigurationError
-from opspec.tui.replay import ENDED
+from opspec.tui.replay import QUIT
 from opspec.tui.session_state import SessionState
 
 __all__ = ["Recording"]
@@ -36,7 +36,9 @@ class Recording(SessionState):
                 self._write_record()
                 from opspec.engine.trace_sinks import JsonlSink
 
-                header: dict[str, Any] = {"spec": spec_path, "seed": seed, "walkthrough": True}
+                # where the run is to end: a replay of the recording ends there too
+                header: dict[str, Any] = {"spec": spec_path, "seed": seed, "walkthrough": True,
+                                          "until": self.horizon}
                 if person is not None:
                     # whose session this is: opspec fit counts a participant's sessions as
                     # one person (docs/trace-format.md, "person")
@@ -83,9 +85,9 @@ class Recording(SessionState):
 
     def close(self) -> None:
         if self._trace_file is not None:
-            if self.failure is None:
-                # where the session ended (the run's end, or where the person quit): a replay
-                # of the recording ends there too (opspec.tui.replay.recorded_end)
-                self.sim.session.trace(ENDED, {"until": self.now, "quit": not self.ended})
+            if not self.ended and self.failure is None:
+                # the person quit here: a replay of the recording ends here too
+                # (opspec.tui.replay.recorded_end)
+                self.sim.session.trace(QUIT, {"until": self.now})
             self._trace_file.close()
             self._trace_file = None

@@ -9,9 +9,9 @@ import sys
 from typing import Any
 
 import pytest
-from conftest import SPEC
 
 import opspec.bindings.attach
+from conftest import SPEC
 from opspec.cli import main
 
 BIND = "alarm=emulator://medication_dispenser"

@@ -3,8 +3,9 @@ session ended, as `opspec run SPEC --until T --script REC` (the command the summ
 does: a replay reproduces the session, not the rest of the day without the person.
 
 The recording's script has no place for the end (a script file holds ``steps`` and
-``otherwise``), so the session writes it to the trace beside the recording when it closes
-(``walkthrough.ended``); recordings made before that replay to the run's end as they did.
+``otherwise``), so the trace beside the recording keeps it: the run's end in its header
+(``until``), and a ``walkthrough.quit`` event where the person quit; recordings made before
+that replay to the run's end as they did.
 ``--until`` (or ``--days``) on the command line says where a replay ends instead.
 Before, every replay ran on to the end of the day: every later dose missed.
 """
@@ -15,12 +16,12 @@ import json
 import shlex
 import sys
 from pathlib import Path
-from typing import Any
+from typing import Any, ClassVar
 
 import pytest
-from conftest import SPEC
 
 import opspec.tui.app
+from conftest import SPEC
 from opspec.cli import main
 from opspec.tui.replay import recorded_end
 from opspec.tui.session import WalkSession
@@ -45,7 +46,7 @@ class _Terminal:
 class _WatchTheReplay:
     """Stands in for the Textual app: lets the replay run until it ends by itself."""
 
-    sessions: list[WalkSession] = []
+    sessions: ClassVar[list[WalkSession]] = []
 
     def __init__(self, session: WalkSession, **_kw: Any) -> None:
         self.session = session
@@ -102,6 +103,9 @@ def test_the_replay_of_a_session_quit_early_ends_where_it_was_quit(compiled, tmp
                                                                   replay):
     record = tmp_path / "P07.json"
     walked = _quit_after_the_first_dose(compiled, record)
+    last = json.loads(record.with_suffix(".trace.jsonl").read_text(encoding="utf-8")
+                      .splitlines()[-1])
+    assert last["kind"] == "walkthrough.quit" and last["data"] == {"until": walked.now}
     assert recorded_end(record) == walked.now                   # exactly
     shown = _metric_lines(walked.summary_lines())
     assert any(line.split() == ["doses_missed", "0"] for line in shown)
@@ -125,9 +129,11 @@ def test_a_recording_without_its_end_replays_the_whole_run_as_before(compiled, t
     _quit_after_the_first_dose(compiled, record)
     trace = record.with_suffix(".trace.jsonl")
     # a recording made before sessions wrote their end: the same trace without it
-    trace.write_text("".join(line for line in trace.read_text(encoding="utf-8")
-                             .splitlines(keepends=True) if "walkthrough.ended" not in line),
-                     encoding="utf-8")
+    header, *events = trace.read_text(encoding="utf-8").splitlines(keepends=True)
+    old = json.loads(header)
+    del old["until"]
+    trace.write_text(json.dumps(old) + "\n" + "".join(
+        line for line in events if "walkthrough.quit" not in line), encoding="utf-8")
     assert recorded_end(record) is None
     session, out = replay(str(SPEC), "--replay", str(record))
     assert session.now == 86_400.0 and "The run ended at d2 00:00:00." in out
@@ -158,10 +164,11 @@ def test_a_session_that_ran_to_its_end_records_its_end(compiled, tmp_path):
     while not session.ended:
         session.run_to(session.horizon)
     session.close()
-    events = [json.loads(line) for line in
-              record.with_suffix(".trace.jsonl").read_text(encoding="utf-8").splitlines()[1:]]
-    assert events[-1]["kind"] == "walkthrough.ended"
-    assert events[-1]["data"] == {"until": 43_200.0, "quit": False}
+    header, *events = (json.loads(line) for line in
+                       record.with_suffix(".trace.jsonl").read_text(encoding="utf-8")
+                       .splitlines())
+    assert header["until"] == 43_200.0
+    assert not any(event["kind"] == "walkthrough.quit" for event in events)
     assert recorded_end(record) == 43_200.0
     # its own end, not the spec's day: both printed replays stop there
     walk, run = (line.split(":", 1)[1] for line in session.summary_lines()
