@@ -1,7 +1,9 @@
 """The recording of a walkthrough session: every action (the person's, or the model's while
 the lane is handed over) written at once to the recording, a script ``opspec run --script``
 replays, and every trace event to ``<recording>.trace.jsonl`` with how long the person took
-(for ``opspec fit``)."""
+(for ``opspec fit``). The trace also keeps where the session ended, which the script cannot
+hold: the run's end in its header (``until``), and a ``walkthrough.quit`` event where the
+person quit before it, so that a replay ends there too (:func:`opspec.tui.replay.recorded_end`)."""
 
 from __future__ import annotations
 
