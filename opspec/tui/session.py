@@ -68,14 +68,15 @@ class WalkSession(SessionClock, PersonLane, TraceFollower, Recording):
     """One walkthrough (see the module docstring)."""
 
     def __init__(self, compiled: CompiledPackage, *, seed: int = 0, days: float | None = None,
-                 until: float | None = None, record: str | Path | None = None, model_factory: Callable[[], Any] | None = None,
+                 until: float | None = None, record: str | Path | None = None,
+                 model_factory: Callable[[], Any] | None = None,
                  performers: Mapping[str, Any] | None = None, config: Any = None,
                  replay: Any = None, spec_path: str = "",
                  device_participants: Mapping[str, Sequence[str]] | None = None,
                  wall_devices: bool = False, on_call: str = "realtime",
                  person: str | None = None) -> None:
-        super().__init__(compiled, seed=seed, days=days, until=until, model_factory=model_factory,
-                         replay=replay, spec_path=spec_path,
+        super().__init__(compiled, seed=seed, days=days, until=until,
+                         model_factory=model_factory, replay=replay, spec_path=spec_path,
                          device_participants=device_participants, wall_devices=wall_devices,
                          on_call=on_call, person=person)
         self._open_record(record, seed, spec_path, person)
