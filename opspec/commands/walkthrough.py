@@ -50,7 +50,11 @@ def register(subparsers: Any) -> None:
                         help="simulated seconds per wall second at start (default 60; 1 "
                         "with a real device bound)")
     _args.add_seed(parser, what="run seed: the run of opspec run --seed")
-    _args.add_days(parser)
+    length = parser.add_mutually_exclusive_group()
+    _args.add_days(length)
+    length.add_argument("--until", metavar="T",
+                        help="simulated end time: seconds, or a duration (12h30m, PT8H); "
+                        "with --replay the default is where the recorded session ended")
     _args.add_user_model(parser, role="what performs your lane when you hand it over: ")
     parser.add_argument("--record", metavar="FILE",
                         help="where to write the recording (default "
@@ -82,12 +86,13 @@ def register(subparsers: Any) -> None:
 
 def run(args: argparse.Namespace) -> int:
     from opspec.request import RunRequest, prepare
-    from opspec.run_rules import check_days
+    from opspec.run_rules import check_days, parse_until
 
     if args.speed is not None and not (args.speed > 0):
         raise ConfigurationError(f"--speed must be positive, not {args.speed:g}")
     if args.days is not None:
         check_days(args.days, name="--days")
+    until = None if args.until is None else parse_until(args.until, name="--until")
     if args.replay and args.record:
         # a replay records nothing: the recording asked for would silently not be written
         raise ConfigurationError(
@@ -95,7 +100,7 @@ def run(args: argparse.Namespace) -> int:
             hint=f"its trace: opspec run {args.spec} --script {args.replay} --trace FILE")
     # the person performs the lane; the request's user is the model they hand it over to
     # (--user-model, else the companion SPEC.users.toml), checked against the spec
-    prepared = prepare(RunRequest(args.spec, seed=args.seed, days=args.days,
+    prepared = prepare(RunRequest(args.spec, seed=args.seed, days=args.days, until=until,
                                   user_model=args.user_model))   # a broken spec opens nothing
     # validate's warnings (what runs differently) are shown as notes on the screen
     spec_warnings: list[str] = [str(w) for w in prepared.warnings]
@@ -110,6 +115,12 @@ def run(args: argparse.Namespace) -> int:
         # checked against the spec like `opspec run --script` (a misspelt name would never
         # match an offer)
         replay = load_recording(args.replay, compiled)
+        if args.days is None and until is None:
+            from opspec.tui.replay import recorded_end
+
+            # the replay ends where the session did (the person quit at 12:34: not the rest
+            # of the day without them), as the recording's trace says
+            until = recorded_end(args.replay)
     who = f"{_file_safe(args.person)}-" if args.person else ""
     record = None if args.no_record or args.replay else Path(
         args.record or Path("walkthroughs") / (
@@ -124,22 +135,29 @@ def run(args: argparse.Namespace) -> int:
             ("SPEC", args.spec),
             ("the user model", model_ref if model_ref and Path(model_ref).exists() else None),
             *spec_inputs(args.spec, package)])
+    # Textual would wait for keys that never come (< /dev/null, a pipe): refused below,
+    # once the spec is known to start (its own error first), with nothing recorded and no
+    # device opened (opening a serial port may reset the board behind it)
+    terminal = sys.stdin.isatty() and sys.stdout.isatty()
+    if not terminal:                            # an option's own error comes first
+        if args.record and record is not None:
+            _check_record_folder(record)
+        if args.bind:
+            from opspec.bindings.profiles import default_profiles_dir, load_profiles
+
+            # the profiles are read (a broken one is said), no port is opened
+            load_profiles(args.devices if args.devices else default_profiles_dir())
     with contextlib.ExitStack() as stack:
         performers: dict[str, Any] = {}          # the world: opspec.runs.build adds it
         notes: list[str] = list(spec_warnings)
         devices = None
-        if args.bind:
+        if args.bind and terminal:
             from opspec.bindings.attach import attach_devices
 
             devices = stack.enter_context(attach_devices(args.bind, args.devices,
                                                          spec=compiled))
             performers.update(devices.performers)
             notes.extend(devices.notes)
-        # Textual would wait for keys that never come (< /dev/null, a pipe): refused below,
-        # once the spec is known to start (its own error first), with nothing recorded
-        terminal = sys.stdin.isatty() and sys.stdout.isatty()
-        if args.record and record is not None and not terminal:
-            _check_record_folder(record)        # an option's own error comes first
         from opspec.tui.app import WalkthroughApp
         from opspec.tui.session import WalkSession
 
@@ -149,7 +167,7 @@ def run(args: argparse.Namespace) -> int:
                 binding.participants)
         # a real device answers in wall time: start in real time unless told otherwise
         real = devices is not None and devices.requires_wall_clock
-        session = WalkSession(compiled, seed=args.seed, days=args.days,
+        session = WalkSession(compiled, seed=args.seed, days=args.days, until=until,
                               record=record if terminal else None,
                               model_factory=factory, performers=performers, replay=replay,
                               spec_path=str(args.spec), device_participants=served,

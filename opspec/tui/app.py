@@ -38,6 +38,7 @@ from opspec.tui.modals import HELP, HelpScreen, SummaryScreen
 from opspec.tui.pace import Pace
 from opspec.tui.session import WalkSession, clock, time_of_day_shown
 from opspec.tui.sound import Cue
+from opspec.tui.terminal_size import SizeWarning
 
 __all__ = ["HELP", "SummaryScreen", "WalkthroughApp"]
 
@@ -191,6 +192,8 @@ class WalkthroughApp(App[str | None]):
         self._release_interrupts = lambda: None
         self._summary_shown = False          # the end-of-run summary opens once
         self._views_ready = False            # set once mounted, cleared when quitting
+        #: the line that says so while the terminal is smaller than the layout needs
+        self._size_warning = SizeWarning(large=large)
         session.listeners.append(self._on_event)
 
     # ------------------------------------------------------------------ layout
@@ -204,6 +207,7 @@ class WalkthroughApp(App[str | None]):
                 yield Vertical(id="offers")
                 yield Static(id="aftermath")
         yield Static(id="timeline")
+        yield self._size_warning
         yield FittingFooter()
 
     def on_mount(self) -> None:
@@ -224,7 +228,11 @@ class WalkthroughApp(App[str | None]):
         self.query_one("#timeline", Static).border_title = "Timeline (newest first)"
         self._views_ready = True
         self._release_interrupts = watch_interrupts(self._interrupted)
+        self._size_warning.fit(self.size)
         self.refresh_views()
+
+    def on_resize(self, event: events.Resize) -> None:
+        self._size_warning.fit(event.size)     # (also under the help or the summary)
 
     def on_unmount(self) -> None:
         self._release_interrupts()

@@ -6,17 +6,29 @@ instance they were done in: ``complete hear_alarm #6``. The script language keep
 ``--replay`` and in ``opspec run --script`` alike. When three identical "Hear the alarm" offers wait and the person took the
 newest, the replay takes the newest too. Recordings written before the tags (plain
 ``complete hear_alarm``) still replay, matching offers in order as before.
+
+A replay ends where the recorded session ended (:func:`recorded_end`): the person quit at
+12:34, so the replay stops at 12:34 instead of running the rest of the day without them.
+The script language has no place for that time (a script file holds ``steps`` and
+``otherwise``, which ``opspec run --script`` checks), so the trace beside the recording keeps
+it: its header says where the run was to end (``until``), and a session the person quit
+before then ends with a ``walkthrough.quit`` event (``until``: the second they quit at).
 """
 
 from __future__ import annotations
 
+import json
 import re
 from pathlib import Path
 
 from opspec.engine.compiled import CompiledPackage
 from opspec.usermodels.scripts import ScriptUser, load_script
 
-__all__ = ["instance_tag", "load_recording", "tagged_action"]
+__all__ = ["QUIT", "instance_tag", "load_recording", "recorded_end", "tagged_action"]
+
+#: the trace event of a session the person quit before the end of its run: ``until``, the
+#: simulated second they quit at
+QUIT = "walkthrough.quit"
 
 _TAG = re.compile(r"(?:^|\s)#(\d+)(?=\s|$)")
 
@@ -52,3 +64,33 @@ def load_recording(path: str | Path, compiled: CompiledPackage | None = None) ->
     # each step keeps its "#6" (Step.instance): it acts only on an offer of that instance
     performer: ScriptUser = scripted_user(path, compiled).source.performer()
     return performer
+
+
+def recorded_end(path: str | Path) -> float | None:
+    """Where the session recorded in ``path`` ended, as its trace beside it
+    (``REC.trace.jsonl``) says: the second the person quit at, else the end of its run;
+    ``None`` when nothing says so: a recording made before sessions wrote it, any other
+    script, a trace gone or not a walkthrough's."""
+    trace = Path(path).with_suffix(".trace.jsonl")
+    try:
+        with trace.open(encoding="utf-8") as lines:
+            header = json.loads(next(lines, "{}"))
+            if not isinstance(header, dict) or header.get("walkthrough") is not True:
+                return None
+            end = _seconds(header.get("until"))
+            for line in lines:
+                if QUIT in line:
+                    event = json.loads(line)
+                    if isinstance(event, dict) and event.get("kind") == QUIT and isinstance(
+                            event.get("data"), dict):
+                        end = _seconds(event["data"].get("until")) or end
+    except (OSError, UnicodeDecodeError, ValueError):
+        return None      # unreadable: the replay runs the whole run, as before
+    return end
+
+
+def _seconds(value: object) -> float | None:
+    """A positive number of seconds, or ``None``."""
+    if isinstance(value, (int, float)) and not isinstance(value, bool) and value > 0:
+        return float(value)
+    return None

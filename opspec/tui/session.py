@@ -45,6 +45,7 @@ from opspec.engine.compiled import K_GATEWAY, K_NOOP, CompiledPackage
 from opspec.engine.lanes import all_activities, user_lane
 from opspec.engine.trace import TraceEvent
 from opspec.errors import ExecutionError
+from opspec.run_rules import run_length
 from opspec.tui.feedback import Aftermath
 from opspec.tui.lane import LaneUser, Offer
 from opspec.tui.session_clock import SessionClock, clock, time_of_day_shown
@@ -67,14 +68,15 @@ class WalkSession(SessionClock, PersonLane, TraceFollower, Recording):
     """One walkthrough (see the module docstring)."""
 
     def __init__(self, compiled: CompiledPackage, *, seed: int = 0, days: float | None = None,
-                 record: str | Path | None = None, model_factory: Callable[[], Any] | None = None,
+                 until: float | None = None, record: str | Path | None = None,
+                 model_factory: Callable[[], Any] | None = None,
                  performers: Mapping[str, Any] | None = None, config: Any = None,
                  replay: Any = None, spec_path: str = "",
                  device_participants: Mapping[str, Sequence[str]] | None = None,
                  wall_devices: bool = False, on_call: str = "realtime",
                  person: str | None = None) -> None:
-        super().__init__(compiled, seed=seed, days=days, model_factory=model_factory,
-                         replay=replay, spec_path=spec_path,
+        super().__init__(compiled, seed=seed, days=days, until=until,
+                         model_factory=model_factory, replay=replay, spec_path=spec_path,
                          device_participants=device_participants, wall_devices=wall_devices,
                          on_call=on_call, person=person)
         self._open_record(record, seed, spec_path, person)
@@ -166,8 +168,11 @@ class WalkSession(SessionClock, PersonLane, TraceFollower, Recording):
                       *response_lines(self.responses)]
         if self.record_path is not None:
             stopped = final and not self.ended and self.failure is None
+            # the end to replay to: where the person quit, or a --days / --until of its own
+            end = self.now if stopped else None if (
+                self.horizon == run_length(self.compiled)) else self.horizon
             walk, run = replay_commands(self.spec_path or "SPEC", self.record_path,
-                                        until=self.now if stopped else None)
+                                        until=end, seed=self.seed)
             lines += ["", f"Recording: {self.record_path}",
                       f"Trace (for opspec fit): {self.record_path.with_suffix('.trace.jsonl')}"
                       + (f" (person {self.person})" if self.person is not None else ""),

@@ -1,7 +1,9 @@
 """The recording of a walkthrough session: every action (the person's, or the model's while
 the lane is handed over) written at once to the recording, a script ``opspec run --script``
 replays, and every trace event to ``<recording>.trace.jsonl`` with how long the person took
-(for ``opspec fit``)."""
+(for ``opspec fit``). The trace also keeps where the session ended, which the script cannot
+hold: the run's end in its header (``until``), and a ``walkthrough.quit`` event where the
+person quit before it, so that a replay ends there too (:func:`opspec.tui.replay.recorded_end`)."""
 
 from __future__ import annotations
 
@@ -13,6 +15,7 @@ from typing import Any
 
 from opspec.engine.performers import WorkItem
 from opspec.errors import ConfigurationError
+from opspec.tui.replay import QUIT
 from opspec.tui.session_state import SessionState
 
 __all__ = ["Recording"]
@@ -35,7 +38,9 @@ class Recording(SessionState):
                 self._write_record()
                 from opspec.engine.trace_sinks import JsonlSink
 
-                header: dict[str, Any] = {"spec": spec_path, "seed": seed, "walkthrough": True}
+                # where the run is to end: a replay of the recording ends there too
+                header: dict[str, Any] = {"spec": spec_path, "seed": seed, "walkthrough": True,
+                                          "until": self.horizon}
                 if person is not None:
                     # whose session this is: opspec fit counts a participant's sessions as
                     # one person (docs/trace-format.md, "person")
@@ -82,5 +87,9 @@ class Recording(SessionState):
 
     def close(self) -> None:
         if self._trace_file is not None:
+            if not self.ended and self.failure is None:
+                # the person quit here: a replay of the recording ends here too
+                # (opspec.tui.replay.recorded_end)
+                self.sim.session.trace(QUIT, {"until": self.now})
             self._trace_file.close()
             self._trace_file = None

@@ -46,17 +46,21 @@ def response_lines(responses: Sequence[Response]) -> list[str]:
     return lines
 
 
-def replay_commands(spec: str | Path, record: str | Path, *, until: float | None = None
-                    ) -> tuple[str, str]:
+def replay_commands(spec: str | Path, record: str | Path, *, until: float | None = None,
+                    seed: int = 0) -> tuple[str, str]:
     """The two commands that replay ``record`` (quoted for a POSIX shell, so a path with
     spaces pastes as it is): in the walkthrough, and with ``opspec run``. ``until``: the
-    simulated second the session was stopped at, before the end of its run: ``opspec run``
-    stops there too (``--until``), so that it prints the numbers the summary shows, not
-    those of a run that goes on without the person."""
+    simulated second the session ended at, when that is not where the spec's run ends by
+    itself (the person quit before the end, or ``--days`` set another end): both replays stop
+    there too (``--until``), so that they print the numbers the summary shows, not those of a
+    run that goes on without the person. ``seed``: the session's run seed (``--seed``, left
+    out when 0): the device's draws of another seed would be another session."""
     spec_q, record_q = shlex.quote(str(spec)), shlex.quote(str(record))
-    stop = "" if until is None else f" --until {until_text(until)}"
-    return (f"opspec walkthrough {spec_q} --replay {record_q}",
-            f"opspec run {spec_q}{stop} --script {record_q}")
+    same = "" if not seed else f" --seed {seed}"
+    if until is not None:
+        same += f" --until {until_text(until)}"
+    return (f"opspec walkthrough {spec_q} --replay {record_q}{same}",
+            f"opspec run {spec_q}{same} --script {record_q}")
 
 
 def until_text(until: float) -> str:
