@@ -11,11 +11,13 @@ from __future__ import annotations
 
 import math
 import operator
+from decimal import Decimal
 from typing import Any
 
 from opspec.errors import ConfigurationError
 
-__all__ = ["DAY", "MAX_SEED", "check_days", "check_seed", "parse_until", "run_length"]
+__all__ = ["DAY", "MAX_SEED", "check_days", "check_seed", "parse_until", "run_length",
+           "seconds_of_days"]
 
 DAY = 86_400.0
 #: numpy's SeedSequence takes non-negative integers; 2**63 - 1 keeps seeds in an SQLite integer
@@ -53,6 +55,13 @@ def check_days(days: Any, *, name: str = "days") -> float:
     return float(days)
 
 
+def seconds_of_days(days: float) -> float:
+    """``days`` in seconds, as the decimal number written: 0.7 days ends at 16:48:00
+    (60480 s), not at the float product 60479.99999999999 s, which a clock of whole seconds
+    shows as 16:47:59 (and ``--json`` as the run's end). Whole days are unchanged."""
+    return float(Decimal(repr(float(days))) * Decimal(86_400))
+
+
 def parse_until(until: Any, *, name: str = "until") -> float:
     """An end time in simulated seconds: a positive number, or text in the one duration
     grammar (:func:`opspec.clock.parse_duration`: ``90``, ``8h``, ``PT8H``)."""
@@ -77,7 +86,7 @@ def run_length(spec: Any, *, days: Any = None, until: Any = None) -> float:
     if days is not None and until is not None:
         raise ConfigurationError("give days or until, not both")
     if days is not None:
-        return check_days(days) * DAY
+        return seconds_of_days(check_days(days))
     if until is not None:
         return parse_until(until)
     package = getattr(spec, "package", spec)          # a CompiledPackage, or the Package

@@ -151,11 +151,12 @@ def _context(plan: Mapping[str, Any], base: Mapping[str, Any], draw: int) -> Any
 def run_draw_users(plan: Mapping[str, Any], label: str, users: Sequence[int]) -> list[Any]:
     """Worker entry point for the users of ``label`` (``A~draws``): each user simulated with
     their draw's model, on their own streams (no traces are kept)."""
-    from opspec.evaluation.replication import DAY, ReplicationRecord, run_user
+    from opspec.evaluation.replication import ReplicationRecord, run_user
+    from opspec.run_rules import seconds_of_days
 
     base_label = base_design(label)
     base = next(d for d in plan["designs"] if d["label"] == base_label)
-    horizon = float(plan["days"]) * DAY
+    horizon = seconds_of_days(float(plan["days"]))
     ordinary, per_draw = int(plan["users"]), int(plan["users_per_draw"])
     records = []
     for u in users:

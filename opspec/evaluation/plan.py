@@ -90,7 +90,9 @@ class EvaluationPlan:
 
     @property
     def horizon(self) -> float:
-        return float(self.days) * DAY
+        from opspec.run_rules import seconds_of_days
+
+        return seconds_of_days(float(self.days))
 
     def design(self, label: str) -> Design:
         for design in self.designs:

@@ -18,7 +18,8 @@ from dataclasses import dataclass, field
 from typing import Any
 
 from opspec.errors import OpspecError
-from opspec.evaluation.columns import DAY, Columns, outcome_columns, sample_columns
+from opspec.evaluation.columns import Columns, outcome_columns, sample_columns
+from opspec.run_rules import seconds_of_days
 
 __all__ = ["ActivityCounter", "ActivityRecorder", "ReplicationRecord", "prepare", "run_users"]
 
@@ -333,7 +334,7 @@ def run_users(plan: Mapping[str, Any], design: str, users: Sequence[int]
     context = prepare(spec["spec"], spec["sha256"], plan.get("user_model"),
                       plan.get("engine") or {}, spec.get("parameters") or (),
                       plan.get("branches") or None)
-    horizon = float(plan["days"]) * DAY
+    horizon = seconds_of_days(float(plan["days"]))
     keep = bool(plan.get("export"))
     from opspec.run_inputs import RunInputs
 

@@ -13,7 +13,6 @@ from __future__ import annotations
 import functools
 from collections import deque
 from collections.abc import Callable, Mapping, Sequence
-from decimal import Decimal
 from typing import TYPE_CHECKING, Any, TypeVar
 
 from opspec.engine.compiled import CompiledPackage
@@ -87,11 +86,6 @@ class SessionState:
         #: where the run ends: the one rule of every run (opspec.runs.run_length): ``days``
         #: (or ``until``, in seconds), else the spec's opspec:RunLength, else one day
         self.horizon = run_length(compiled, days=days, until=until)
-        if days is not None:
-            # the days as the decimal number written: 0.7 days ends at 16:48:00 (60480 s),
-            # not at the float product 60479.99999999999 s, which the clock (whole seconds)
-            # showed as 16:47:59
-            self.horizon = float(Decimal(repr(float(days))) * Decimal(86_400))
         if on_call not in ON_CALL:
             raise ConfigurationError(f"--on-call takes one of {', '.join(ON_CALL)}, not "
                                      f"{on_call!r}")

@@ -28,6 +28,20 @@ def test_the_run_length_is_days_or_until_else_the_specs_run_length_else_one_day(
             run_length(dispenser.compiled, **bad)
 
 
+def test_fractional_days_end_at_the_second_the_decimal_says(capsys) -> None:
+    """0.7 days is 16:48:00, not the float product 0.7 * 86400 = 60479.99999999999 s, which
+    a clock of whole seconds shows as 16:47:59 — the same end for every door."""
+    dispenser = load(DISPENSER)
+    assert run_length(dispenser.compiled, days=0.7) == 60_480.0
+    assert run_length(dispenser.compiled, days=2.3) == 198_720.0
+    assert main(["run", str(DISPENSER), "--days", "0.7", "--json"]) == 0
+    assert '"until": 60480.0' in capsys.readouterr().out
+    from opspec.evaluation.plan import EvaluationPlan
+
+    plan = EvaluationPlan(designs=(), users=2, days=0.7, seed=0)
+    assert plan.horizon == 60_480.0
+
+
 def test_every_front_door_defaults_to_the_same_length(tmp_path: Path, capsys) -> None:
     from opspec.testing import simulate
     from opspec.tui.session import WalkSession
