@@ -16,7 +16,7 @@ from collections.abc import Callable, Mapping
 from typing import TYPE_CHECKING, Any, Final
 
 from opspec.engine import coordination as coord
-from opspec.engine import multi_instance, tools
+from opspec.engine import multi_instance, plans, tools
 from opspec.engine.compiled import (
     K_ASYNC,
     K_BLOCK,
@@ -60,6 +60,10 @@ class Activities(Part):
         self.activate_q: Callable[[ActivityInstance, Any, Any], None] = self.activate
         self.body_done_q: Callable[[ActivityInstance, Any, Any], None] = self.body_done
         self.run_body_q: Callable[[ActivityInstance, Any, Any], None] = self._run_body
+        # from source, the resume plans of the package's workflows (opspec.engine.plans):
+        # by the activity whose completion they carry on from; empty compiled
+        self.resumes: dict[CompiledActivity, Callable[[Activities, Frame], None]] = (
+            plans.resumes(state.compiled))
 
     def _too_deep(self, ai: ActivityInstance, target: CompiledProcess) -> None:
         """Runaway recursion: abort the outermost caller (which ends every nested call)."""
@@ -383,6 +387,10 @@ class Activities(Part):
         # Flow.finish's steps, Flow.done_next's first case, a waiting target's start: in line
         act = ai.act
         if act.simple_end:
+            resumes = self.resumes
+            if act in resumes:                # from source: its completion written out
+                resumes[act](self, frame)
+                return
             state = self.state
             inst = frame.inst
             cached = act.flag_cache           # RunState.act_bits's cached case, in line

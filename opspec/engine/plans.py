@@ -34,6 +34,7 @@ from opspec.engine import lone
 from opspec.engine.compiled import (
     K_ASYNC,
     K_TASK,
+    S_XOR,
     CompiledActivity,
     CompiledPackage,
     CompiledProcess,
@@ -44,7 +45,7 @@ from opspec.engine.lifecycle import RUNNING, SUSPENDED
 from opspec.engine.trace import EventKind as EK
 from opspec.errors import OpspecError
 
-__all__ = ["MAX_BLOCKS", "attach", "build"]
+__all__ = ["MAX_BLOCKS", "attach", "build", "build_resume", "resumes"]
 
 #: Activity blocks written out per plan at most (merging branches are written once per
 #: path); past it, or deeper than :data:`_MAX_DEPTH` nested splits, the plan ends in
@@ -61,20 +62,66 @@ _NO_TRANSITION: Final = ("no outgoing transition can be taken (no condition hold
 
 def attach(compiled: CompiledPackage) -> None:
     """Give each workflow of ``compiled`` that starts with one token its plan
-    (``CompiledProcess.plan``), once per package; none when the engine runs compiled."""
+    (``CompiledProcess.plan``) and its resume plans (the plan's ``resumes``), once per
+    package; none when the engine runs compiled."""
     if COMPILED or compiled.plans:
         return
     for proc in compiled.processes.values():
         if proc.one_start >= 0:
-            proc.plan = build(proc, proc.one_start)
+            plan: Any = build(proc, proc.one_start)
+            plan.resumes = {proc.graph.activities[index]: build_resume(proc, index)
+                            for index in resumable(proc)}
+            proc.plan = plan
     compiled.plans = True
+
+
+def resumes(compiled: CompiledPackage) -> dict[CompiledActivity, Callable[[Any, Any], None]]:
+    """The resume plans of ``compiled``'s workflows by the activity whose completion they
+    carry on from (``Activities._complete`` calls ``resume(activities, frame)``); empty when
+    the engine runs compiled."""
+    attach(compiled)
+    found: dict[CompiledActivity, Callable[[Any, Any], None]] = {}
+    for proc in compiled.processes.values():
+        found.update(getattr(proc.plan, "resumes", None) or {})
+    return found
+
+
+def resumable(proc: CompiledProcess) -> list[int]:
+    """The activities of ``proc``'s graph whose completion a resume plan carries on from:
+    those that complete without end assignments, throws or ends of their own
+    (``simple_end``), whose way out is known before the run (one transition into an
+    activity without a join, or an exclusive split into such activities, one token each)
+    and leads into at least one ``lone`` activity. Anything else completes through the
+    interpreter (``Activities._complete``)."""
+    acts = proc.graph.activities
+    found = []
+    for act in acts:
+        if not act.simple_end or act.fast and not act.general and act.kind != K_TASK:
+            continue                        # (an activity that never waits never completes)
+        targets = _ways_out(act, acts)
+        if targets and any(acts[t].lone for t in targets):
+            found.append(act.index)
+    return found
+
+
+def _ways_out(act: CompiledActivity, acts: tuple[CompiledActivity, ...]) -> list[int]:
+    """Where ``act``'s token goes on completion when that is decided without a join or a
+    second token (``Flow.split``'s first two cases); empty otherwise."""
+    if act.next >= 0:
+        return [] if acts[act.next].join else [act.next]
+    if act.choice or act.drawn or act.split != S_XOR or not (act.out or act.otherwise):
+        return []
+    branches = act.out + act.otherwise
+    if any(acts[t.target].join or t.tokens != 1 for t in branches):
+        return []
+    return [t.target for t in branches]
 
 
 def build(proc: CompiledProcess, start: int) -> Callable[[Any, Any, Any], None]:
     """The plan of ``proc``'s one token from activity ``start``: ``plan(inst, activities,
     None)``, queued by ``Flow.start_process``, does what ``Flow.start_lone_at`` and
     ``lone.run(activities, inst, acts[start])`` do."""
-    writer = _Writer(proc)
+    writer = _Writer(proc, framed=False)
     lines = ["def plan(inst, activities, _unused):",
              "    if inst.state != RUNNING:         # (Flow.start_lone_at's test)",
              "        if inst.state == SUSPENDED:",
@@ -90,23 +137,62 @@ def build(proc: CompiledProcess, start: int) -> Callable[[Any, Any, Any], None]:
     if any(act.kind == K_TASK for act in proc.graph.activities):
         lines.append("    apps = state.apps")
     writer.block(start, (), 1, lines)
+    return _made(writer, lines, f"<plan of {proc.id}>", "plan")
+
+
+def build_resume(proc: CompiledProcess, index: int) -> Callable[[Any, Any], None]:
+    """The resume plan of ``proc``'s activity ``index`` (one of :func:`resumable`):
+    ``resume(activities, frame)`` does what ``Activities._complete`` does after the activity
+    instance has left (its completion traced, its split) and what ``Activities.start`` then
+    does with the token, in the instance's frame."""
+    writer = _Writer(proc, framed=True)
+    act = proc.graph.activities[index]
+    a = f"A{index}"
+    writer.names[a] = act
+    lines = ["def resume(activities, frame):",
+             "    state = activities.state",
+             "    flow = activities.flow",
+             "    inst = frame.inst",
+             "    limit = state.start_limit",
+             "    iid = inst.id",
+             "    steps = 0"]
+    if any(other.general for other in proc.graph.activities):
+        lines.append("    pooled = state.pooled")
+    if any(other.kind == K_TASK for other in proc.graph.activities):
+        lines.append("    apps = state.apps")
+    lines += ["    cached = {a}.flag_cache".format(a=a),
+              f"    if (cached.bits if cached.key is state.flag_key else state.act_bits({a}))"
+              " & 2:",
+              f"        state.emit(COMPLETED, {writer.fields(act)})"]
+    if act.next >= 0:
+        writer.block(act.next, (), 1, lines)
+    else:
+        writer.split(index, (), 1, lines)
+    return _made(writer, lines, f"<resume plan of {proc.id}/{index}>", "resume")
+
+
+def _made(writer: _Writer, lines: list[str], where: str, name: str) -> Any:
+    """The function ``name`` that ``lines`` define, made once."""
     source = "\n".join(lines) + "\n"
     space = writer.names
     # Safe to exec: the source is the engine's own. Nothing the spec wrote (ids, names,
     # values, conditions) is in it; each is an object bound by name in ``space``
     # (``_Writer.name``), and conditions and assignments are the safe evaluator's compiled
     # functions, called (tests/engine/test_plans.py: no text of the spec reaches a plan).
-    exec(compile(source, f"<plan of {proc.id}>", "exec"), space)  # noqa: S102 - see above
-    plan: Callable[[Any, Any, Any], None] = space["plan"]
-    plan.__doc__ = source                   # what it runs, for whoever debugs it
-    return plan
+    exec(compile(source, where, "exec"), space)  # noqa: S102 - see above
+    made = space[name]
+    made.__doc__ = source                   # what it runs, for whoever debugs it
+    return made
 
 
 class _Writer:
     """Writes one plan's source: a block per activity, the successor's after it."""
 
-    def __init__(self, proc: CompiledProcess) -> None:
+    def __init__(self, proc: CompiledProcess, framed: bool) -> None:
         self.proc = proc
+        # in the instance's frame (a resume plan: ``Activities.start``'s steps) or before
+        # it has one (the first token: ``lone.run``'s)
+        self.framed = framed
         self.acts = proc.graph.activities
         self.blocks = 0
         # the plan's globals: what its source names (activities, conditions, helpers)
@@ -130,7 +216,8 @@ class _Writer:
         self.names[a] = act
         self.blocks += 1
         if index in path or self.blocks > MAX_BLOCKS or depth > _MAX_DEPTH:
-            out.append(f"{pad}REST(activities, inst, {a}, steps, limit)")
+            out.append(f"{pad}activities.start(frame, {a}, steps, limit)" if self.framed
+                       else f"{pad}REST(activities, inst, {a}, steps, limit)")
             out.append(f"{pad}return")
             return
         if not act.lone:
@@ -144,11 +231,10 @@ class _Writer:
         if waits:
             out.append(f"{pad}if {' or '.join(waits)}:")
             out.extend(self.hand_over(index, pad + "    "))
-        fields = (f"{self.name('P', act.process)}, iid, {self.name('I', act.id)}, "
-                  f"{self.name('L', act.lane)}, {self.name('W', act.participant)}")
+        fields = self.fields(act)
         out += [f"{pad}steps += 1",
                 f"{pad}if steps > limit:",
-                f"{pad}    state.zero_time(inst, {a})",
+                f"{pad}    state.zero_time({'frame' if self.framed else 'inst'}, {a})",
                 f"{pad}cached = {a}.flag_cache",
                 f"{pad}bits = cached.bits if cached.key is state.flag_key "
                 f"else state.act_bits({a})",
@@ -186,15 +272,28 @@ class _Writer:
         elif act.out or act.otherwise:
             self.split(index, path, depth, out)
         else:                               # an end: the token is gone
-            out += [f"{pad}flow.instance_done(inst)", f"{pad}return"]
+            out += [f"{pad}{self.gone()}", f"{pad}return"]
+
+    def fields(self, act: CompiledActivity) -> str:
+        """The arguments of ``act``'s trace events after their kind."""
+        return (f"{self.name('P', act.process)}, iid, {self.name('I', act.id)}, "
+                f"{self.name('L', act.lane)}, {self.name('W', act.participant)}")
+
+    def gone(self) -> str:
+        """The token ends: the frameless instance is done, or the frame loses a token
+        (``Flow.split``'s end, ``Flow.token_gone``)."""
+        return "flow.token_gone(frame)" if self.framed else "flow.instance_done(inst)"
 
     def hand_over(self, index: int, pad: str) -> list[str]:
         """The hand-over at activity ``index`` (as in ``lone.run``): the instance gets its
-        frame with the token in it, and the token goes the general way from there (whether
-        the activity is instantaneous is known here: the call ``start`` or ``start_slow``)."""
+        frame with the token in it (a resume plan's has one), and the token goes the
+        general way from there (whether the activity is instantaneous is known here: the
+        call ``start`` or ``start_slow``)."""
         a = f"A{index}"
         start = (f"activities.start(frame, {a}, steps, limit)" if self.acts[index].fast
                  else f"activities.start_slow(frame, {a})")
+        if self.framed:
+            return [f"{pad}{start}", f"{pad}return"]
         return [f"{pad}frame = FRAME(GRAPH, inst, None)", f"{pad}inst.frames.append(frame)",
                 f"{pad}frame.live = 1", f"{pad}{start}", f"{pad}return"]
 
@@ -223,7 +322,7 @@ class _Writer:
                 taken.append(act.otherwise[0])
                 chain.append(f"{inner}k = {len(taken) - 1}")
             elif act.path_may_end:          # no condition holds: this path ends
-                chain += [f"{inner}flow.instance_done(inst)", f"{inner}k = -1"]
+                chain += [f"{inner}{self.gone()}", f"{inner}k = -1"]
             else:
                 chain += [f"{inner}flow.abort(inst, {a}, {_NO_TRANSITION!r})", f"{inner}k = -1"]
         out += chain
