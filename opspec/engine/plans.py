@@ -34,10 +34,12 @@ from opspec.engine import lone
 from opspec.engine.compiled import (
     K_ASYNC,
     K_TASK,
+    K_THROW,
     S_XOR,
     CompiledActivity,
     CompiledPackage,
     CompiledProcess,
+    CTrigger,
 )
 from opspec.engine.conditions import constant_value
 from opspec.engine.instances import Frame
@@ -99,9 +101,21 @@ def resumable(proc: CompiledProcess) -> list[int]:
         if not act.simple_end or act.fast and not act.general and act.kind != K_TASK:
             continue                        # (an activity that never waits never completes)
         targets = _ways_out(act, acts)
-        if targets and any(acts[t].lone for t in targets):
+        if targets and any(acts[t].lone or _thrown_on(acts[t], acts) for t in targets):
             found.append(act.index)
     return found
+
+
+def _thrown_on(act: CompiledActivity, acts: tuple[CompiledActivity, ...]) -> bool:
+    """Whether ``act``, not ``lone`` for a throw or a raised trigger only, is written out
+    in a resume plan: in the instance's frame, ``Activities.start`` carries the token
+    through it as through a lone one, with ``Flow.done_next``'s broadcasts (an error,
+    escalation or terminate, a join or several tokens ahead: the interpreter takes it)."""
+    if not act.fast or act.terminate or act.error is not None or act.escalation is not None:
+        return False
+    if act.next < 0 and not (act.out or act.otherwise or act.choice or act.drawn):
+        return True                         # an end
+    return bool(_ways_out(act, acts))
 
 
 def _ways_out(act: CompiledActivity, acts: tuple[CompiledActivity, ...]) -> list[int]:
@@ -220,7 +234,7 @@ class _Writer:
                        else f"{pad}REST(activities, inst, {a}, steps, limit)")
             out.append(f"{pad}return")
             return
-        if not act.lone:
+        if not (act.lone or self.framed and _thrown_on(act, self.acts)):
             out.extend(self.hand_over(index, pad))
             return
         waits = []                          # lone, but not on this run
@@ -260,10 +274,17 @@ class _Writer:
                         f" data, trigger={self.name('G', f'subflow:{act.id}')})"]
             if not act.simple_end and act.end_assign:
                 self.assign(act, act.end_assign, pad, out)
+            if act.kind == K_THROW and act.trigger is not None:     # (Flow.done_next's)
+                out.append(f"{pad}flow.triggers.broadcast({self.trigger(act.trigger)}, "
+                           f"None, inst, {a})")
             out += [f"{pad}cached = {a}.flag_cache",
                     f"{pad}if (cached.bits if cached.key is state.flag_key "
                     f"else state.act_bits({a})) & 2:",
                     f"{pad}    state.emit(COMPLETED, {fields})"]
+            if act.raises is not None:
+                out += [f"{pad}if inst.state == RUNNING:",
+                        f"{pad}    flow.triggers.broadcast({self.trigger(act.raises)}, "
+                        f"None, inst, {a})"]
             if not act.simple_end:
                 out += [f"{pad}if inst.state != RUNNING:", f"{pad}    return"]
         path = (*path, index)
@@ -273,6 +294,10 @@ class _Writer:
             self.split(index, path, depth, out)
         else:                               # an end: the token is gone
             out += [f"{pad}{self.gone()}", f"{pad}return"]
+
+    def trigger(self, trig: CTrigger) -> str:
+        """A thrown or raised trigger's kind and name, as ``Triggers.broadcast`` takes them."""
+        return f"{self.name('G', trig.kind)}, {self.name('G', trig.name or '')}"
 
     def fields(self, act: CompiledActivity) -> str:
         """The arguments of ``act``'s trace events after their kind."""

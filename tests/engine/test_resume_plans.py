@@ -26,6 +26,7 @@ from builders import (
     proc,
     subflow,
     task,
+    throw,
 )
 from conftest import AnswersLater
 
@@ -231,3 +232,27 @@ def test_a_subflow_an_activity_set_and_a_loop_complete_into_lone_activities(
     assert summary["instances"]["terminated"] + summary["instances"]["completed"] == 2
     assert [e[8] for e in trace if e[1] == "data.changed" and e[4] == "after_loop"] == [
         {"n": 22}]
+
+
+def test_throws_and_raised_triggers_after_a_completion_are_sent_the_same(
+        monkeypatch: pytest.MonkeyPatch) -> None:
+    """A throw event and an activity that raises a trigger are not lone (a frameless token
+    hands over before them) but a resume plan, in the frame, writes them out with
+    ``Flow.done_next``'s broadcasts: the message starts its workflow, the signal is sent to
+    the catch waiting for it, at the same step; an error end event is handed over (and
+    aborts the instance before the caught signal goes on)."""
+    work = proc("work", [act("fork", split="AND"), manual("do"), throw("ping", "ping"),
+                         act("shout", raises="signal:sig", assign=[("n", "n + 1")]),
+                         end_event("oops", "Error"), catch("hear", "signal", "sig"), "heard"],
+                [("fork", "do"), ("fork", "hear"), ("do", "ping"), ("ping", "shout"),
+                 ("shout", "oops"), ("hear", "heard")], data=[field("n", 0)])
+    listener = proc("listener", ["got", "got_end"], [("got", "got_end")],
+                    start="message:ping")
+    (trace, summary, _metrics), ran = _both(monkeypatch, pkg(work, listener),
+                                            performers={"user": AnswersLater()})
+    assert ran == {"do": 1}
+    kinds = [(e[1], e[2], e[4]) for e in trace]
+    assert ("trigger.raised", "work", "ping") in kinds
+    assert ("trigger.raised", "work", "shout") in kinds
+    assert ("process.completed", "listener", None) in kinds
+    assert "an error without a code" in summary["faults"][0]["message"]
