@@ -293,7 +293,8 @@ class _Writer:
         elif act.out or act.otherwise:
             self.split(index, path, depth, out)
         else:                               # an end: the token is gone
-            out += [f"{pad}{self.gone()}", f"{pad}return"]
+            out += self.gone(pad)
+            out.append(f"{pad}return")
 
     def trigger(self, trig: CTrigger) -> str:
         """A thrown or raised trigger's kind and name, as ``Triggers.broadcast`` takes them."""
@@ -304,10 +305,20 @@ class _Writer:
         return (f"{self.name('P', act.process)}, iid, {self.name('I', act.id)}, "
                 f"{self.name('L', act.lane)}, {self.name('W', act.participant)}")
 
-    def gone(self) -> str:
+    def gone(self, pad: str) -> list[str]:
         """The token ends: the frameless instance is done, or the frame loses a token
-        (``Flow.split``'s end, ``Flow.token_gone``)."""
-        return "flow.token_gone(frame)" if self.framed else "flow.instance_done(inst)"
+        (``Flow.split``'s end, ``Flow.token_gone``: in line, as the instance's top frame is
+        never an activity set's, when the workflow is no ad-hoc set)."""
+        if not self.framed:
+            return [f"{pad}flow.instance_done(inst)"]
+        if self.proc.graph.completion is not None:
+            return [f"{pad}flow.token_gone(frame)"]
+        return [f"{pad}frame.live -= 1",
+                f"{pad}if frame.live <= 0 or frame.ors:",
+                f"{pad}    if frame.live <= 0 and not frame.parked:",
+                f"{pad}        flow.instance_done(inst)",
+                f"{pad}    else:",
+                f"{pad}        state.pending[frame] = None"]
 
     def hand_over(self, index: int, pad: str) -> list[str]:
         """The hand-over at activity ``index`` (as in ``lone.run``): the instance gets its
@@ -347,7 +358,7 @@ class _Writer:
                 taken.append(act.otherwise[0])
                 chain.append(f"{inner}k = {len(taken) - 1}")
             elif act.path_may_end:          # no condition holds: this path ends
-                chain += [f"{inner}{self.gone()}", f"{inner}k = -1"]
+                chain += [*self.gone(inner), f"{inner}k = -1"]
             else:
                 chain += [f"{inner}flow.abort(inst, {a}, {_NO_TRANSITION!r})", f"{inner}k = -1"]
         out += chain
