@@ -28,11 +28,13 @@ from __future__ import annotations
 
 import types
 from collections.abc import Callable
+from types import MappingProxyType
 from typing import Any, Final
 
 from opspec.engine import lone
 from opspec.engine.compiled import (
     K_ASYNC,
+    K_MANUAL,
     K_TASK,
     K_THROW,
     S_XOR,
@@ -42,8 +44,9 @@ from opspec.engine.compiled import (
     CTrigger,
 )
 from opspec.engine.conditions import constant_value
-from opspec.engine.instances import Frame
+from opspec.engine.instances import ActivityInstance, Frame
 from opspec.engine.lifecycle import RUNNING, SUSPENDED
+from opspec.engine.performers import WorkItem
 from opspec.engine.trace import EventKind as EK
 from opspec.errors import OpspecError
 
@@ -215,7 +218,8 @@ class _Writer:
             "FRAME": Frame, "GRAPH": proc.graph,
             "OpspecError": OpspecError, "RUNNING": RUNNING, "SUSPENDED": SUSPENDED,
             "STARTED": EK.ACTIVITY_STARTED, "COMPLETED": EK.ACTIVITY_COMPLETED,
-            "CHANGED": EK.DATA_CHANGED}
+            "CHANGED": EK.DATA_CHANGED, "OFFERED": EK.ACTIVITY_OFFERED,
+            "ACTIVITY": ActivityInstance, "ITEM": WorkItem, "PROXY": MappingProxyType}
 
     def name(self, prefix: str, value: Any) -> str:
         key = f"{prefix}{len(self.names)}"
@@ -326,12 +330,57 @@ class _Writer:
         general way from there (whether the activity is instantaneous is known here: the
         call ``start`` or ``start_slow``)."""
         a = f"A{index}"
-        start = (f"activities.start(frame, {a}, steps, limit)" if self.acts[index].fast
-                 else f"activities.start_slow(frame, {a})")
+        act = self.acts[index]
+        if act.fast:
+            start = [f"{pad}activities.start(frame, {a}, steps, limit)", f"{pad}return"]
+        elif (act.plain and act.kind == K_MANUAL and not act.params and not act.start_assign
+              and not act.general):
+            start = self.offer(act, pad)
+        else:
+            start = [f"{pad}activities.start_slow(frame, {a})", f"{pad}return"]
         if self.framed:
-            return [f"{pad}{start}", f"{pad}return"]
+            return start
         return [f"{pad}frame = FRAME(GRAPH, inst, None)", f"{pad}inst.frames.append(frame)",
-                f"{pad}frame.live = 1", f"{pad}{start}", f"{pad}return"]
+                f"{pad}frame.live = 1", *start]
+
+    def offer(self, act: CompiledActivity, pad: str) -> list[str]:
+        """``Activities.start_slow`` of a plain manual activity without parameters or start
+        assignments, and its ``Offers.offer`` to the performer bound to it, in line (no
+        performer: ``Activities._body``, which says what it waits for)."""
+        a = f"A{act.index}"
+        fields = self.fields(act)
+        return [f"{pad}state.last_key += 1",
+                f"{pad}key = state.last_key",
+                f"{pad}ai = ACTIVITY(key, {a}, frame, state.now)",
+                f"{pad}ai.state = RUNNING",
+                f"{pad}frame.running[key] = ai",
+                f"{pad}cached = {a}.flag_cache",
+                f"{pad}bits = cached.bits if cached.key is state.flag_key "
+                f"else state.act_bits({a})",
+                f"{pad}if bits & 1:",
+                f"{pad}    state.emit(STARTED, {fields})",
+                f"{pad}known = state.performers_of",
+                f"{pad}performer = known[{a}] if {a} in known "
+                f"else activities.offers.performer_for({a})",
+                f"{pad}if performer is None:",
+                f"{pad}    activities._body(ai)",
+                f"{pad}    return",
+                f"{pad}view = inst.view",
+                f"{pad}if view is None:",
+                f"{pad}    view = inst.view = PROXY(inst.data)",
+                f"{pad}item = ITEM(key, {self.name('P', act.process)}, iid, "
+                f"{self.name('I', act.id)}, {self.name('B', act.label)}, "
+                f"{self.name('W', act.participant)}, {self.name('L', act.lane)}, state.now, "
+                f"{self.name('APP', act.application)}, view, (), inst.root, None)",
+                f"{pad}ai.item = item",
+                f"{pad}ai.performer = performer",
+                f"{pad}ai.waiting = \"performer\"",
+                f"{pad}state.offered[key] = ai",
+                f"{pad}if (cached.bits if cached.key is state.flag_key "
+                f"else state.act_bits({a})) & 4:",
+                f"{pad}    state.emit(OFFERED, {fields}, None)",
+                f"{pad}performer.offer(item)",
+                f"{pad}return"]
 
     def split(self, index: int, path: tuple[int, ...], depth: int, out: list[str]) -> None:
         """``lone.xor_transition`` of activity ``index``, then the chosen target's code."""

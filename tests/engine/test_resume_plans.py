@@ -256,3 +256,47 @@ def test_throws_and_raised_triggers_after_a_completion_are_sent_the_same(
     assert ("trigger.raised", "work", "shout") in kinds
     assert ("process.completed", "listener", None) in kinds
     assert "an error without a code" in summary["faults"][0]["message"]
+
+
+class _Recorder(AnswersLater):
+    """Answers later, and keeps what each work item offered to it says."""
+
+    def __init__(self) -> None:
+        super().__init__()
+        self.items: list[tuple[Any, ...]] = []
+
+    def offer(self, item: Any) -> None:
+        self.items.append((item.key, item.process, item.instance, item.activity, item.label,
+                           item.participant, item.lane, item.offered_at, item.application,
+                           dict(item.data), item.choices, item.root_instance, item.duration))
+        super().offer(item)
+
+
+def test_a_manual_activity_offered_from_a_plan_is_the_same_work_item(
+        monkeypatch: pytest.MonkeyPatch) -> None:
+    """A plan offers a plain manual activity itself (``start_slow`` and ``offer`` in line):
+    the same work items (keys, data, root instance) reach the performer, and with nobody
+    bound the activity waits for a performer as the interpreter says."""
+    child = proc("child", [act("first", assign=[("n", "n + 1")]), manual("ask"),
+                           act("then", assign=[("n", "n * 3")]), manual("ask_again"), "end"],
+                 [("first", "ask"), ("ask", "then"), ("then", "ask_again"),
+                  ("ask_again", "end")], formals=[formal("n", "INOUT")])
+    main = proc("main", [subflow("call", "child", ["n"]), "done"], [("call", "done")],
+                data=[field("n", 1)])
+    items = []
+    ran: dict[str, int] = {}
+    for way in WAYS:
+        _way(monkeypatch, way)
+        user = _Recorder()
+        sim = Simulation(compile_package(pkg(main, child)), keep_trace=True,
+                         performers={"user": user})
+        if way == "plans":
+            ran = _counting(sim)
+        items.append((user.items, _seen(sim.run(until=100.0))))
+    assert items[0] == items[1]
+    assert ran == {"ask": 1, "ask_again": 1, "call": 1}
+    assert [(i[3], i[9]) for i in items[0][0]] == [("ask", {"n": 2}), ("ask_again", {"n": 6})]
+    unbound = proc("unbound", [act("first"), manual("ask", performer="nobody"), "end"],
+                   [("first", "ask"), ("ask", "end")])
+    (trace, _summary, _metrics), _ran = _both(monkeypatch, pkg(unbound))
+    assert [e[8] for e in trace if e[1] == "activity.offered"] == [{"performer": None}]
