@@ -104,9 +104,17 @@ def resumable(proc: CompiledProcess) -> list[int]:
         if not act.simple_end or act.fast and not act.general and act.kind != K_TASK:
             continue                        # (an activity that never waits never completes)
         targets = _ways_out(act, acts)
-        if targets and any(acts[t].lone or _thrown_on(acts[t], acts) for t in targets):
+        if targets and any(acts[t].lone or _thrown_on(acts[t], acts) or _offered(acts[t])
+                           for t in targets):
             found.append(act.index)
     return found
+
+
+def _offered(act: CompiledActivity) -> bool:
+    """Whether a plan offers ``act`` itself (``_Writer.offer``): a plain manual activity
+    without parameters, start assignments or a worker to wait for."""
+    return (act.plain and act.kind == K_MANUAL and not act.params and not act.start_assign
+            and not act.general)
 
 
 def _thrown_on(act: CompiledActivity, acts: tuple[CompiledActivity, ...]) -> bool:
@@ -333,8 +341,7 @@ class _Writer:
         act = self.acts[index]
         if act.fast:
             start = [f"{pad}activities.start(frame, {a}, steps, limit)", f"{pad}return"]
-        elif (act.plain and act.kind == K_MANUAL and not act.params and not act.start_assign
-              and not act.general):
+        elif _offered(act):
             start = self.offer(act, pad)
         else:
             start = [f"{pad}activities.start_slow(frame, {a})", f"{pad}return"]
