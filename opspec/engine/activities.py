@@ -61,8 +61,8 @@ class Activities(Part):
         self.body_done_q: Callable[[ActivityInstance, Any, Any], None] = self.body_done
         self.run_body_q: Callable[[ActivityInstance, Any, Any], None] = self._run_body
         # from source, the resume plans of the package's workflows (opspec.engine.plans):
-        # by the activity whose completion they carry on from; empty compiled
-        self.resumes: dict[CompiledActivity, Callable[[Activities, Frame], None]] = (
+        # by the activity whose completion (body_done's) they carry on from; empty compiled
+        self.resumes: dict[CompiledActivity, Callable[[Activities, ActivityInstance], None]] = (
             plans.resumes(state.compiled))
 
     def _too_deep(self, ai: ActivityInstance, target: CompiledProcess) -> None:
@@ -370,6 +370,10 @@ class Activities(Part):
                     return
                 self.state.ready.append((self.run_body_q, ai, None, None))
                 return
+        resumes = self.resumes
+        if act in resumes:                  # from source: _complete and on, written out
+            resumes[act](self, ai)
+            return
         self._complete(ai)
 
     def _complete(self, ai: ActivityInstance) -> None:
@@ -387,10 +391,6 @@ class Activities(Part):
         # Flow.finish's steps, Flow.done_next's first case, a waiting target's start: in line
         act = ai.act
         if act.simple_end:
-            resumes = self.resumes
-            if act in resumes:                # from source: its completion written out
-                resumes[act](self, frame)
-                return
             state = self.state
             inst = frame.inst
             cached = act.flag_cache           # RunState.act_bits's cached case, in line

@@ -45,7 +45,7 @@ from opspec.engine.compiled import (
 )
 from opspec.engine.conditions import constant_value
 from opspec.engine.instances import ActivityInstance, Frame
-from opspec.engine.lifecycle import RUNNING, SUSPENDED
+from opspec.engine.lifecycle import COMPLETED, RUNNING, SUSPENDED
 from opspec.engine.performers import WorkItem
 from opspec.engine.trace import EventKind as EK
 from opspec.errors import OpspecError
@@ -82,7 +82,7 @@ def attach(compiled: CompiledPackage) -> None:
 
 def resumes(compiled: CompiledPackage) -> dict[CompiledActivity, Callable[[Any, Any], None]]:
     """The resume plans of ``compiled``'s workflows by the activity whose completion they
-    carry on from (``Activities._complete`` calls ``resume(activities, frame)``); empty when
+    carry on from (``Activities.body_done`` calls ``resume(activities, ai)``); empty when
     the engine runs compiled."""
     attach(compiled)
     found: dict[CompiledActivity, Callable[[Any, Any], None]] = {}
@@ -101,7 +101,8 @@ def resumable(proc: CompiledProcess) -> list[int]:
     acts = proc.graph.activities
     found = []
     for act in acts:
-        if not act.simple_end or act.fast and not act.general and act.kind != K_TASK:
+        if (not act.simple_end or act.mi is not None
+                or act.fast and not act.general and act.kind != K_TASK):
             continue                        # (an activity that never waits never completes)
         targets = _ways_out(act, acts)
         if targets and any(acts[t].lone or _thrown_on(acts[t], acts) or _offered(acts[t])
@@ -167,14 +168,24 @@ def build(proc: CompiledProcess, start: int) -> Callable[[Any, Any, Any], None]:
 
 def build_resume(proc: CompiledProcess, index: int) -> Callable[[Any, Any], None]:
     """The resume plan of ``proc``'s activity ``index`` (one of :func:`resumable`):
-    ``resume(activities, frame)`` does what ``Activities._complete`` does after the activity
-    instance has left (its completion traced, its split) and what ``Activities.start`` then
-    does with the token, in the instance's frame."""
+    ``resume(activities, ai)``, called by ``Activities.body_done``, does what
+    ``Activities._complete`` does with ``ai`` (it leaves, its completion is traced, its
+    split taken) and what ``Activities.start`` then does with the token, in the instance's
+    frame."""
     writer = _Writer(proc, framed=True)
     act = proc.graph.activities[index]
     a = f"A{index}"
     writer.names[a] = act
-    lines = ["def resume(activities, frame):",
+    lines = ["def resume(activities, ai):",
+             "    ai.state = DONE                  # (Activities._complete's first steps)",
+             "    ai.gen += 1",
+             "    frame = ai.frame",
+             "    running = frame.running",
+             "    key = ai.key",
+             "    if key in running:",
+             "        del running[key]",
+             "    if ai.cleanup:",
+             "        ai.undo_waits()",
              "    state = activities.state",
              "    flow = activities.flow",
              "    inst = frame.inst",
@@ -226,7 +237,7 @@ class _Writer:
             "FRAME": Frame, "GRAPH": proc.graph,
             "OpspecError": OpspecError, "RUNNING": RUNNING, "SUSPENDED": SUSPENDED,
             "STARTED": EK.ACTIVITY_STARTED, "COMPLETED": EK.ACTIVITY_COMPLETED,
-            "CHANGED": EK.DATA_CHANGED, "OFFERED": EK.ACTIVITY_OFFERED,
+            "CHANGED": EK.DATA_CHANGED, "OFFERED": EK.ACTIVITY_OFFERED, "DONE": COMPLETED,
             "ACTIVITY": ActivityInstance, "ITEM": WorkItem, "PROXY": MappingProxyType}
 
     def name(self, prefix: str, value: Any) -> str:

@@ -52,9 +52,9 @@ def _counting(sim: Any) -> dict[str, int]:
     ran: dict[str, int] = {}
     resumes = sim.activities.resumes
     for key, fn in list(resumes.items()):
-        def counted(activities: Any, frame: Any, fn: Any = fn, aid: str = key.id) -> None:
+        def counted(activities: Any, ai: Any, fn: Any = fn, aid: str = key.id) -> None:
             ran[aid] = ran.get(aid, 0) + 1
-            fn(activities, frame)
+            fn(activities, ai)
         resumes[key] = counted
     return ran
 
