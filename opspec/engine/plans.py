@@ -163,7 +163,9 @@ def build(proc: CompiledProcess, start: int) -> Callable[[Any, Any, Any], None]:
     if any(act.kind == K_TASK for act in proc.graph.activities):
         lines.append("    apps = state.apps")
     writer.block(start, (), 1, lines)
-    return _made(writer, lines, f"<plan of {proc.id}>", "plan")
+    plan: Callable[[Any, Any, Any], None] = _made(writer, lines, f"<plan of {proc.id}>",
+                                                  "plan")
+    return plan
 
 
 def build_resume(proc: CompiledProcess, index: int) -> Callable[[Any, Any], None]:
@@ -204,7 +206,9 @@ def build_resume(proc: CompiledProcess, index: int) -> Callable[[Any, Any], None
         writer.block(act.next, (), 1, lines)
     else:
         writer.split(index, (), 1, lines)
-    return _made(writer, lines, f"<resume plan of {proc.id}/{index}>", "resume")
+    resume: Callable[[Any, Any], None] = _made(
+        writer, lines, f"<resume plan of {proc.id}/{index}>", "resume")
+    return resume
 
 
 def _made(writer: _Writer, lines: list[str], where: str, name: str) -> Any:
