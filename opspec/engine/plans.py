@@ -198,9 +198,9 @@ def build_resume(proc: CompiledProcess, index: int) -> Callable[[Any, Any], None
         lines.append("    pooled = state.pooled")
     if any(other.kind == K_TASK for other in proc.graph.activities):
         lines.append("    apps = state.apps")
-    lines += ["    cached = {a}.flag_cache".format(a=a),
-              f"    if (cached.bits if cached.key is state.flag_key else state.act_bits({a}))"
-              " & 2:",
+    lines += [f"    cached = {a}.flag_cache",
+              (f"    if (cached.bits if cached.key is state.flag_key else state.act_bits({a}))"
+               " & 2:"),
               f"        state.emit(COMPLETED, {writer.fields(act)})"]
     if act.next >= 0:
         writer.block(act.next, (), 1, lines)
@@ -310,8 +310,8 @@ class _Writer:
                     f"{pad}    state.emit(COMPLETED, {fields})"]
             if act.raises is not None:
                 out += [f"{pad}if inst.state == RUNNING:",
-                        f"{pad}    flow.triggers.broadcast({self.trigger(act.raises)}, "
-                        f"None, inst, {a})"]
+                        (f"{pad}    flow.triggers.broadcast({self.trigger(act.raises)}, "
+                         f"None, inst, {a})")]
             if not act.simple_end:
                 out += [f"{pad}if inst.state != RUNNING:", f"{pad}    return"]
         path = (*path, index)
@@ -377,29 +377,29 @@ class _Writer:
                 f"{pad}ai.state = RUNNING",
                 f"{pad}frame.running[key] = ai",
                 f"{pad}cached = {a}.flag_cache",
-                f"{pad}bits = cached.bits if cached.key is state.flag_key "
-                f"else state.act_bits({a})",
+                (f"{pad}bits = cached.bits if cached.key is state.flag_key "
+                 f"else state.act_bits({a})"),
                 f"{pad}if bits & 1:",
                 f"{pad}    state.emit(STARTED, {fields})",
                 f"{pad}known = state.performers_of",
-                f"{pad}performer = known[{a}] if {a} in known "
-                f"else activities.offers.performer_for({a})",
+                (f"{pad}performer = known[{a}] if {a} in known "
+                 f"else activities.offers.performer_for({a})"),
                 f"{pad}if performer is None:",
                 f"{pad}    activities._body(ai)",
                 f"{pad}    return",
                 f"{pad}view = inst.view",
                 f"{pad}if view is None:",
                 f"{pad}    view = inst.view = PROXY(inst.data)",
-                f"{pad}item = ITEM(key, {self.name('P', act.process)}, iid, "
-                f"{self.name('I', act.id)}, {self.name('B', act.label)}, "
-                f"{self.name('W', act.participant)}, {self.name('L', act.lane)}, state.now, "
-                f"{self.name('APP', act.application)}, view, (), inst.root, None)",
+                (f"{pad}item = ITEM(key, {self.name('P', act.process)}, iid, "
+                 f"{self.name('I', act.id)}, {self.name('B', act.label)}, "
+                 f"{self.name('W', act.participant)}, {self.name('L', act.lane)}, state.now, "
+                 f"{self.name('APP', act.application)}, view, (), inst.root, None)"),
                 f"{pad}ai.item = item",
                 f"{pad}ai.performer = performer",
                 f"{pad}ai.waiting = \"performer\"",
                 f"{pad}state.offered[key] = ai",
-                f"{pad}if (cached.bits if cached.key is state.flag_key "
-                f"else state.act_bits({a})) & 4:",
+                (f"{pad}if (cached.bits if cached.key is state.flag_key "
+                 f"else state.act_bits({a})) & 4:"),
                 f"{pad}    state.emit(OFFERED, {fields}, None)",
                 f"{pad}performer.offer(item)",
                 f"{pad}return"]
