@@ -63,7 +63,7 @@ class Activities(Part):
         # from source, the resume plans of the package's workflows (opspec.engine.plans):
         # by the activity whose completion (body_done's) they carry on from; empty compiled
         self.resumes: dict[CompiledActivity, Callable[[Activities, ActivityInstance], None]] = (
-            plans.resumes(state.compiled))
+            {} if plans.COMPILED else plans.resumes(state.compiled))
 
     def _too_deep(self, ai: ActivityInstance, target: CompiledProcess) -> None:
         """Runaway recursion: abort the outermost caller (which ends every nested call)."""
@@ -370,8 +370,8 @@ class Activities(Part):
                     return
                 self.state.ready.append((self.run_body_q, ai, None, None))
                 return
-        resumes = self.resumes
-        if act in resumes:                  # from source: _complete and on, written out
+        resumes = self.resumes              # (empty compiled: its size, no look-up)
+        if resumes and act in resumes:      # from source: _complete and on, written out
             resumes[act](self, ai)
             return
         self._complete(ai)
