@@ -301,3 +301,28 @@ def test_a_manual_activity_offered_from_a_plan_is_the_same_work_item(
                    [("first", "ask"), ("ask", "end")])
     (trace, _summary, _metrics), _unused = _both(monkeypatch, pkg(unbound))
     assert [e[8] for e in trace if e[1] == "activity.offered"] == [{"performer": None}]
+
+
+def test_an_answer_to_a_suspended_instance_waits_for_its_resumption(
+        monkeypatch: pytest.MonkeyPatch) -> None:
+    """The performer answers while the instance is suspended: ``body_done`` defers the
+    completion, and the resume plan carries the token through the lone activities after
+    it once the instance resumes."""
+    work = proc("work", [manual("do"), act("set", assign=[("n", "n + 1")]), "end"],
+                [("do", "set"), ("set", "end")], data=[field("n", 0)])
+    seen = []
+    ran: dict[str, int] = {}
+    for way in WAYS:
+        _way(monkeypatch, way)
+        sim = Simulation(compile_package(pkg(work)), keep_trace=True,
+                         performers={"user": AnswersLater()})
+        if way == "plans":
+            ran = _counting(sim)
+        sim.run(until=3.0)
+        sim.suspend(1)
+        sim.run(until=8.0)
+        sim.resume(1)
+        seen.append(_seen(sim.run(until=20.0)))
+    assert seen[0] == seen[1]
+    assert ran == {"do": 1}
+    assert [e[0] for e in seen[0][0] if e[1] == "process.completed"] == [8.0]
