@@ -358,6 +358,11 @@ class _Writer:
             start = [f"{pad}activities.start(frame, {a}, steps, limit)", f"{pad}return"]
         elif _offered(act):
             start = self.offer(act, pad)
+        elif not act.plain and act.start_trigger is None:
+            start = [*self.instance(act, pad), f"{pad}activities.activate(ai)", f"{pad}return"]
+        elif act.plain and not act.general and not act.start_assign:
+            start = [*self.instance(act, pad), *self.started(act, pad),
+                     f"{pad}activities._body(ai)", f"{pad}return"]
         else:
             start = [f"{pad}activities.start_slow(frame, {a})", f"{pad}return"]
         if self.framed:
@@ -365,22 +370,34 @@ class _Writer:
         return [f"{pad}frame = FRAME(GRAPH, inst, None)", f"{pad}inst.frames.append(frame)",
                 f"{pad}frame.live = 1", *start]
 
+    def instance(self, act: CompiledActivity, pad: str) -> list[str]:
+        """``Activities.start_slow``'s first steps: ``act``'s activity instance ``ai``,
+        running in the frame (a plan hands over to ``activate`` or ``_body`` after them,
+        where ``start_slow`` would: an activity that waits for more than a performer and
+        has no start trigger, or a plain one without start assignments or a worker)."""
+        return [f"{pad}state.last_key += 1",
+                f"{pad}key = state.last_key",
+                f"{pad}ai = ACTIVITY(key, A{act.index}, frame, state.now)",
+                f"{pad}ai.state = RUNNING",
+                f"{pad}frame.running[key] = ai"]
+
+    def started(self, act: CompiledActivity, pad: str) -> list[str]:
+        """A plain activity's start traced (``Activities.start_slow``); ``cached`` is left
+        set for its offer."""
+        a = f"A{act.index}"
+        return [f"{pad}cached = {a}.flag_cache",
+                (f"{pad}bits = cached.bits if cached.key is state.flag_key "
+                 f"else state.act_bits({a})"),
+                f"{pad}if bits & 1:",
+                f"{pad}    state.emit(STARTED, {self.fields(act)})"]
+
     def offer(self, act: CompiledActivity, pad: str) -> list[str]:
         """``Activities.start_slow`` of a plain manual activity without parameters or start
         assignments, and its ``Offers.offer`` to the performer bound to it, in line (no
         performer: ``Activities._body``, which says what it waits for)."""
         a = f"A{act.index}"
         fields = self.fields(act)
-        return [f"{pad}state.last_key += 1",
-                f"{pad}key = state.last_key",
-                f"{pad}ai = ACTIVITY(key, {a}, frame, state.now)",
-                f"{pad}ai.state = RUNNING",
-                f"{pad}frame.running[key] = ai",
-                f"{pad}cached = {a}.flag_cache",
-                (f"{pad}bits = cached.bits if cached.key is state.flag_key "
-                 f"else state.act_bits({a})"),
-                f"{pad}if bits & 1:",
-                f"{pad}    state.emit(STARTED, {fields})",
+        return [*self.instance(act, pad), *self.started(act, pad),
                 f"{pad}known = state.performers_of",
                 (f"{pad}performer = known[{a}] if {a} in known "
                  f"else activities.offers.performer_for({a})"),
