@@ -22,6 +22,14 @@ compiled. Branches that merge again are written out once per path
 (the dispenser's schedule workflow: four slots into one merge); a path that comes back to
 an activity already on it (a zero-time cycle) or grows past :data:`MAX_BLOCKS` goes on in
 ``lone.run`` with the steps counted so far.
+
+*Resume plans* (:func:`build_resume`) are the same code for a token that has a frame: per
+activity whose completion goes on into activities a plan can write out (:func:`resumable`),
+what ``Activities._complete`` and then ``Activities.start`` do, called by
+``Activities.body_done`` (``tests/engine/test_resume_plans.py`` holds them to the
+interpreter). In the frame they also write out instantaneous activities that throw or raise
+a trigger; at an activity that waits, a plan makes its activity instance and offers a plain
+manual activity itself (``start_slow`` and ``Offers.offer`` in line).
 """
 
 from __future__ import annotations
