@@ -16,7 +16,7 @@ from collections.abc import Callable, Mapping
 from typing import TYPE_CHECKING, Any, Final
 
 from opspec.engine import coordination as coord
-from opspec.engine import multi_instance, tools
+from opspec.engine import multi_instance, plans, tools
 from opspec.engine.compiled import (
     K_ASYNC,
     K_BLOCK,
@@ -60,6 +60,10 @@ class Activities(Part):
         self.activate_q: Callable[[ActivityInstance, Any, Any], None] = self.activate
         self.body_done_q: Callable[[ActivityInstance, Any, Any], None] = self.body_done
         self.run_body_q: Callable[[ActivityInstance, Any, Any], None] = self._run_body
+        # from source, the resume plans of the package's workflows (opspec.engine.plans):
+        # by the activity whose completion (body_done's) they carry on from; empty compiled
+        self.resumes: dict[CompiledActivity, Callable[[Activities, ActivityInstance], None]] = (
+            {} if plans.COMPILED else plans.resumes(state.compiled))
 
     def _too_deep(self, ai: ActivityInstance, target: CompiledProcess) -> None:
         """Runaway recursion: abort the outermost caller (which ends every nested call)."""
@@ -366,6 +370,10 @@ class Activities(Part):
                     return
                 self.state.ready.append((self.run_body_q, ai, None, None))
                 return
+        resumes = self.resumes              # (empty compiled: its size, no look-up)
+        if resumes and act in resumes:      # from source: _complete and on, written out
+            resumes[act](self, ai)
+            return
         self._complete(ai)
 
     def _complete(self, ai: ActivityInstance) -> None:

@@ -22,29 +22,43 @@ compiled. Branches that merge again are written out once per path
 (the dispenser's schedule workflow: four slots into one merge); a path that comes back to
 an activity already on it (a zero-time cycle) or grows past :data:`MAX_BLOCKS` goes on in
 ``lone.run`` with the steps counted so far.
+
+*Resume plans* (:func:`build_resume`) are the same code for a token that has a frame: per
+activity whose completion goes on into activities a plan can write out (:func:`resumable`),
+what ``Activities._complete`` and then ``Activities.start`` do, called by
+``Activities.body_done`` (``tests/engine/test_resume_plans.py`` holds them to the
+interpreter). In the frame they also write out instantaneous activities that throw or raise
+a trigger; at an activity that waits, a plan makes its activity instance and offers a plain
+manual activity itself (``start_slow`` and ``Offers.offer`` in line).
 """
 
 from __future__ import annotations
 
 import types
 from collections.abc import Callable
+from types import MappingProxyType
 from typing import Any, Final
 
 from opspec.engine import lone
 from opspec.engine.compiled import (
     K_ASYNC,
+    K_MANUAL,
     K_TASK,
+    K_THROW,
+    S_XOR,
     CompiledActivity,
     CompiledPackage,
     CompiledProcess,
+    CTrigger,
 )
 from opspec.engine.conditions import constant_value
-from opspec.engine.instances import Frame
-from opspec.engine.lifecycle import RUNNING, SUSPENDED
+from opspec.engine.instances import ActivityInstance, Frame
+from opspec.engine.lifecycle import COMPLETED, RUNNING, SUSPENDED
+from opspec.engine.performers import WorkItem
 from opspec.engine.trace import EventKind as EK
 from opspec.errors import OpspecError
 
-__all__ = ["MAX_BLOCKS", "attach", "build"]
+__all__ = ["MAX_BLOCKS", "attach", "build", "build_resume", "resumes"]
 
 #: Activity blocks written out per plan at most (merging branches are written once per
 #: path); past it, or deeper than :data:`_MAX_DEPTH` nested splits, the plan ends in
@@ -61,20 +75,87 @@ _NO_TRANSITION: Final = ("no outgoing transition can be taken (no condition hold
 
 def attach(compiled: CompiledPackage) -> None:
     """Give each workflow of ``compiled`` that starts with one token its plan
-    (``CompiledProcess.plan``), once per package; none when the engine runs compiled."""
+    (``CompiledProcess.plan``) and its resume plans (the plan's ``resumes``), once per
+    package; none when the engine runs compiled."""
     if COMPILED or compiled.plans:
         return
     for proc in compiled.processes.values():
         if proc.one_start >= 0:
-            proc.plan = build(proc, proc.one_start)
+            plan: Any = build(proc, proc.one_start)
+            plan.resumes = {proc.graph.activities[index]: build_resume(proc, index)
+                            for index in resumable(proc)}
+            proc.plan = plan
     compiled.plans = True
+
+
+def resumes(compiled: CompiledPackage) -> dict[CompiledActivity, Callable[[Any, Any], None]]:
+    """The resume plans of ``compiled``'s workflows by the activity whose completion they
+    carry on from (``Activities.body_done`` calls ``resume(activities, ai)``); empty when
+    the engine runs compiled."""
+    attach(compiled)
+    found: dict[CompiledActivity, Callable[[Any, Any], None]] = {}
+    for proc in compiled.processes.values():
+        found.update(getattr(proc.plan, "resumes", None) or {})
+    return found
+
+
+def resumable(proc: CompiledProcess) -> list[int]:
+    """The activities of ``proc``'s graph whose completion a resume plan carries on from:
+    those that complete without end assignments, throws or ends of their own
+    (``simple_end``), whose way out is known before the run (one transition into an
+    activity without a join, or an exclusive split into such activities, one token each)
+    and leads into at least one ``lone`` activity. Anything else completes through the
+    interpreter (``Activities._complete``)."""
+    acts = proc.graph.activities
+    found = []
+    for act in acts:
+        if (not act.simple_end or act.mi is not None
+                or act.fast and not act.general and act.kind != K_TASK):
+            continue                        # (an activity that never waits never completes)
+        targets = _ways_out(act, acts)
+        if targets and any(acts[t].lone or _thrown_on(acts[t], acts) or _offered(acts[t])
+                           for t in targets):
+            found.append(act.index)
+    return found
+
+
+def _offered(act: CompiledActivity) -> bool:
+    """Whether a plan offers ``act`` itself (``_Writer.offer``): a plain manual activity
+    without parameters, start assignments or a worker to wait for."""
+    return (act.plain and act.kind == K_MANUAL and not act.params and not act.start_assign
+            and not act.general)
+
+
+def _thrown_on(act: CompiledActivity, acts: tuple[CompiledActivity, ...]) -> bool:
+    """Whether ``act``, not ``lone`` for a throw or a raised trigger only, is written out
+    in a resume plan: in the instance's frame, ``Activities.start`` carries the token
+    through it as through a lone one, with ``Flow.done_next``'s broadcasts (an error,
+    escalation or terminate, a join or several tokens ahead: the interpreter takes it)."""
+    if not act.fast or act.terminate or act.error is not None or act.escalation is not None:
+        return False
+    if act.next < 0 and not (act.out or act.otherwise or act.choice or act.drawn):
+        return True                         # an end
+    return bool(_ways_out(act, acts))
+
+
+def _ways_out(act: CompiledActivity, acts: tuple[CompiledActivity, ...]) -> list[int]:
+    """Where ``act``'s token goes on completion when that is decided without a join or a
+    second token (``Flow.split``'s first two cases); empty otherwise."""
+    if act.next >= 0:
+        return [] if acts[act.next].join else [act.next]
+    if act.choice or act.drawn or act.split != S_XOR or not (act.out or act.otherwise):
+        return []
+    branches = act.out + act.otherwise
+    if any(acts[t.target].join or t.tokens != 1 for t in branches):
+        return []
+    return [t.target for t in branches]
 
 
 def build(proc: CompiledProcess, start: int) -> Callable[[Any, Any, Any], None]:
     """The plan of ``proc``'s one token from activity ``start``: ``plan(inst, activities,
     None)``, queued by ``Flow.start_process``, does what ``Flow.start_lone_at`` and
     ``lone.run(activities, inst, acts[start])`` do."""
-    writer = _Writer(proc)
+    writer = _Writer(proc, framed=False)
     lines = ["def plan(inst, activities, _unused):",
              "    if inst.state != RUNNING:         # (Flow.start_lone_at's test)",
              "        if inst.state == SUSPENDED:",
@@ -90,23 +171,76 @@ def build(proc: CompiledProcess, start: int) -> Callable[[Any, Any, Any], None]:
     if any(act.kind == K_TASK for act in proc.graph.activities):
         lines.append("    apps = state.apps")
     writer.block(start, (), 1, lines)
+    plan: Callable[[Any, Any, Any], None] = _made(writer, lines, f"<plan of {proc.id}>",
+                                                  "plan")
+    return plan
+
+
+def build_resume(proc: CompiledProcess, index: int) -> Callable[[Any, Any], None]:
+    """The resume plan of ``proc``'s activity ``index`` (one of :func:`resumable`):
+    ``resume(activities, ai)``, called by ``Activities.body_done``, does what
+    ``Activities._complete`` does with ``ai`` (it leaves, its completion is traced, its
+    split taken) and what ``Activities.start`` then does with the token, in the instance's
+    frame."""
+    writer = _Writer(proc, framed=True)
+    act = proc.graph.activities[index]
+    a = f"A{index}"
+    writer.names[a] = act
+    lines = ["def resume(activities, ai):",
+             "    ai.state = DONE                  # (Activities._complete's first steps)",
+             "    ai.gen += 1",
+             "    frame = ai.frame",
+             "    running = frame.running",
+             "    key = ai.key",
+             "    if key in running:",
+             "        del running[key]",
+             "    if ai.cleanup:",
+             "        ai.undo_waits()",
+             "    state = activities.state",
+             "    flow = activities.flow",
+             "    inst = frame.inst",
+             "    limit = state.start_limit",
+             "    iid = inst.id",
+             "    steps = 0"]
+    if any(other.general for other in proc.graph.activities):
+        lines.append("    pooled = state.pooled")
+    if any(other.kind == K_TASK for other in proc.graph.activities):
+        lines.append("    apps = state.apps")
+    lines += [f"    cached = {a}.flag_cache",
+              (f"    if (cached.bits if cached.key is state.flag_key else state.act_bits({a}))"
+               " & 2:"),
+              f"        state.emit(COMPLETED, {writer.fields(act)})"]
+    if act.next >= 0:
+        writer.block(act.next, (), 1, lines)
+    else:
+        writer.split(index, (), 1, lines)
+    resume: Callable[[Any, Any], None] = _made(
+        writer, lines, f"<resume plan of {proc.id}/{index}>", "resume")
+    return resume
+
+
+def _made(writer: _Writer, lines: list[str], where: str, name: str) -> Any:
+    """The function ``name`` that ``lines`` define, made once."""
     source = "\n".join(lines) + "\n"
     space = writer.names
     # Safe to exec: the source is the engine's own. Nothing the spec wrote (ids, names,
     # values, conditions) is in it; each is an object bound by name in ``space``
     # (``_Writer.name``), and conditions and assignments are the safe evaluator's compiled
     # functions, called (tests/engine/test_plans.py: no text of the spec reaches a plan).
-    exec(compile(source, f"<plan of {proc.id}>", "exec"), space)  # noqa: S102 - see above
-    plan: Callable[[Any, Any, Any], None] = space["plan"]
-    plan.__doc__ = source                   # what it runs, for whoever debugs it
-    return plan
+    exec(compile(source, where, "exec"), space)  # noqa: S102 - see above
+    made = space[name]
+    made.__doc__ = source                   # what it runs, for whoever debugs it
+    return made
 
 
 class _Writer:
     """Writes one plan's source: a block per activity, the successor's after it."""
 
-    def __init__(self, proc: CompiledProcess) -> None:
+    def __init__(self, proc: CompiledProcess, framed: bool) -> None:
         self.proc = proc
+        # in the instance's frame (a resume plan: ``Activities.start``'s steps) or before
+        # it has one (the first token: ``lone.run``'s)
+        self.framed = framed
         self.acts = proc.graph.activities
         self.blocks = 0
         # the plan's globals: what its source names (activities, conditions, helpers)
@@ -115,7 +249,8 @@ class _Writer:
             "FRAME": Frame, "GRAPH": proc.graph,
             "OpspecError": OpspecError, "RUNNING": RUNNING, "SUSPENDED": SUSPENDED,
             "STARTED": EK.ACTIVITY_STARTED, "COMPLETED": EK.ACTIVITY_COMPLETED,
-            "CHANGED": EK.DATA_CHANGED}
+            "CHANGED": EK.DATA_CHANGED, "OFFERED": EK.ACTIVITY_OFFERED, "DONE": COMPLETED,
+            "ACTIVITY": ActivityInstance, "ITEM": WorkItem, "PROXY": MappingProxyType}
 
     def name(self, prefix: str, value: Any) -> str:
         key = f"{prefix}{len(self.names)}"
@@ -130,10 +265,11 @@ class _Writer:
         self.names[a] = act
         self.blocks += 1
         if index in path or self.blocks > MAX_BLOCKS or depth > _MAX_DEPTH:
-            out.append(f"{pad}REST(activities, inst, {a}, steps, limit)")
+            out.append(f"{pad}activities.start(frame, {a}, steps, limit)" if self.framed
+                       else f"{pad}REST(activities, inst, {a}, steps, limit)")
             out.append(f"{pad}return")
             return
-        if not act.lone:
+        if not (act.lone or self.framed and _thrown_on(act, self.acts)):
             out.extend(self.hand_over(index, pad))
             return
         waits = []                          # lone, but not on this run
@@ -144,11 +280,10 @@ class _Writer:
         if waits:
             out.append(f"{pad}if {' or '.join(waits)}:")
             out.extend(self.hand_over(index, pad + "    "))
-        fields = (f"{self.name('P', act.process)}, iid, {self.name('I', act.id)}, "
-                  f"{self.name('L', act.lane)}, {self.name('W', act.participant)}")
+        fields = self.fields(act)
         out += [f"{pad}steps += 1",
                 f"{pad}if steps > limit:",
-                f"{pad}    state.zero_time(inst, {a})",
+                f"{pad}    state.zero_time({'frame' if self.framed else 'inst'}, {a})",
                 f"{pad}cached = {a}.flag_cache",
                 f"{pad}bits = cached.bits if cached.key is state.flag_key "
                 f"else state.act_bits({a})",
@@ -174,10 +309,17 @@ class _Writer:
                         f" data, trigger={self.name('G', f'subflow:{act.id}')})"]
             if not act.simple_end and act.end_assign:
                 self.assign(act, act.end_assign, pad, out)
+            if act.kind == K_THROW and act.trigger is not None:     # (Flow.done_next's)
+                out.append(f"{pad}flow.triggers.broadcast({self.trigger(act.trigger)}, "
+                           f"None, inst, {a})")
             out += [f"{pad}cached = {a}.flag_cache",
                     f"{pad}if (cached.bits if cached.key is state.flag_key "
                     f"else state.act_bits({a})) & 2:",
                     f"{pad}    state.emit(COMPLETED, {fields})"]
+            if act.raises is not None:
+                out += [f"{pad}if inst.state == RUNNING:",
+                        (f"{pad}    flow.triggers.broadcast({self.trigger(act.raises)}, "
+                         f"None, inst, {a})")]
             if not act.simple_end:
                 out += [f"{pad}if inst.state != RUNNING:", f"{pad}    return"]
         path = (*path, index)
@@ -186,17 +328,106 @@ class _Writer:
         elif act.out or act.otherwise:
             self.split(index, path, depth, out)
         else:                               # an end: the token is gone
-            out += [f"{pad}flow.instance_done(inst)", f"{pad}return"]
+            out += self.gone(pad)
+            out.append(f"{pad}return")
+
+    def trigger(self, trig: CTrigger) -> str:
+        """A thrown or raised trigger's kind and name, as ``Triggers.broadcast`` takes them."""
+        return f"{self.name('G', trig.kind)}, {self.name('G', trig.name or '')}"
+
+    def fields(self, act: CompiledActivity) -> str:
+        """The arguments of ``act``'s trace events after their kind."""
+        return (f"{self.name('P', act.process)}, iid, {self.name('I', act.id)}, "
+                f"{self.name('L', act.lane)}, {self.name('W', act.participant)}")
+
+    def gone(self, pad: str) -> list[str]:
+        """The token ends: the frameless instance is done, or the frame loses a token
+        (``Flow.split``'s end, ``Flow.token_gone``: in line, as the instance's top frame is
+        never an activity set's, when the workflow is no ad-hoc set)."""
+        if not self.framed:
+            return [f"{pad}flow.instance_done(inst)"]
+        if self.proc.graph.completion is not None:
+            return [f"{pad}flow.token_gone(frame)"]
+        return [f"{pad}frame.live -= 1",
+                f"{pad}if frame.live <= 0 or frame.ors:",
+                f"{pad}    if frame.live <= 0 and not frame.parked:",
+                f"{pad}        flow.instance_done(inst)",
+                f"{pad}    else:",
+                f"{pad}        state.pending[frame] = None"]
 
     def hand_over(self, index: int, pad: str) -> list[str]:
         """The hand-over at activity ``index`` (as in ``lone.run``): the instance gets its
-        frame with the token in it, and the token goes the general way from there (whether
-        the activity is instantaneous is known here: the call ``start`` or ``start_slow``)."""
+        frame with the token in it (a resume plan's has one), and the token goes the
+        general way from there (whether the activity is instantaneous is known here: the
+        call ``start`` or ``start_slow``)."""
         a = f"A{index}"
-        start = (f"activities.start(frame, {a}, steps, limit)" if self.acts[index].fast
-                 else f"activities.start_slow(frame, {a})")
+        act = self.acts[index]
+        if act.fast:
+            start = [f"{pad}activities.start(frame, {a}, steps, limit)", f"{pad}return"]
+        elif _offered(act):
+            start = self.offer(act, pad)
+        elif not act.plain and act.start_trigger is None:
+            start = [*self.instance(act, pad), f"{pad}activities.activate(ai)", f"{pad}return"]
+        elif act.plain and not act.general and not act.start_assign:
+            start = [*self.instance(act, pad), *self.started(act, pad),
+                     f"{pad}activities._body(ai)", f"{pad}return"]
+        else:
+            start = [f"{pad}activities.start_slow(frame, {a})", f"{pad}return"]
+        if self.framed:
+            return start
         return [f"{pad}frame = FRAME(GRAPH, inst, None)", f"{pad}inst.frames.append(frame)",
-                f"{pad}frame.live = 1", f"{pad}{start}", f"{pad}return"]
+                f"{pad}frame.live = 1", *start]
+
+    def instance(self, act: CompiledActivity, pad: str) -> list[str]:
+        """``Activities.start_slow``'s first steps: ``act``'s activity instance ``ai``,
+        running in the frame (a plan hands over to ``activate`` or ``_body`` after them,
+        where ``start_slow`` would: an activity that waits for more than a performer and
+        has no start trigger, or a plain one without start assignments or a worker)."""
+        return [f"{pad}state.last_key += 1",
+                f"{pad}key = state.last_key",
+                f"{pad}ai = ACTIVITY(key, A{act.index}, frame, state.now)",
+                f"{pad}ai.state = RUNNING",
+                f"{pad}frame.running[key] = ai"]
+
+    def started(self, act: CompiledActivity, pad: str) -> list[str]:
+        """A plain activity's start traced (``Activities.start_slow``); ``cached`` is left
+        set for its offer."""
+        a = f"A{act.index}"
+        return [f"{pad}cached = {a}.flag_cache",
+                (f"{pad}bits = cached.bits if cached.key is state.flag_key "
+                 f"else state.act_bits({a})"),
+                f"{pad}if bits & 1:",
+                f"{pad}    state.emit(STARTED, {self.fields(act)})"]
+
+    def offer(self, act: CompiledActivity, pad: str) -> list[str]:
+        """``Activities.start_slow`` of a plain manual activity without parameters or start
+        assignments, and its ``Offers.offer`` to the performer bound to it, in line (no
+        performer: ``Activities._body``, which says what it waits for)."""
+        a = f"A{act.index}"
+        fields = self.fields(act)
+        return [*self.instance(act, pad), *self.started(act, pad),
+                f"{pad}known = state.performers_of",
+                (f"{pad}performer = known[{a}] if {a} in known "
+                 f"else activities.offers.performer_for({a})"),
+                f"{pad}if performer is None:",
+                f"{pad}    activities._body(ai)",
+                f"{pad}    return",
+                f"{pad}view = inst.view",
+                f"{pad}if view is None:",
+                f"{pad}    view = inst.view = PROXY(inst.data)",
+                (f"{pad}item = ITEM(key, {self.name('P', act.process)}, iid, "
+                 f"{self.name('I', act.id)}, {self.name('B', act.label)}, "
+                 f"{self.name('W', act.participant)}, {self.name('L', act.lane)}, state.now, "
+                 f"{self.name('APP', act.application)}, view, (), inst.root, None)"),
+                f"{pad}ai.item = item",
+                f"{pad}ai.performer = performer",
+                f"{pad}ai.waiting = \"performer\"",
+                f"{pad}state.offered[key] = ai",
+                (f"{pad}if (cached.bits if cached.key is state.flag_key "
+                 f"else state.act_bits({a})) & 4:"),
+                f"{pad}    state.emit(OFFERED, {fields}, None)",
+                f"{pad}performer.offer(item)",
+                f"{pad}return"]
 
     def split(self, index: int, path: tuple[int, ...], depth: int, out: list[str]) -> None:
         """``lone.xor_transition`` of activity ``index``, then the chosen target's code."""
@@ -223,7 +454,7 @@ class _Writer:
                 taken.append(act.otherwise[0])
                 chain.append(f"{inner}k = {len(taken) - 1}")
             elif act.path_may_end:          # no condition holds: this path ends
-                chain += [f"{inner}flow.instance_done(inst)", f"{inner}k = -1"]
+                chain += [*self.gone(inner), f"{inner}k = -1"]
             else:
                 chain += [f"{inner}flow.abort(inst, {a}, {_NO_TRANSITION!r})", f"{inner}k = -1"]
         out += chain
