@@ -190,8 +190,17 @@ def run(args: argparse.Namespace) -> int:
                 hint=f"run it in a terminal; without a person, 'opspec run {args.spec} "
                 "--script FILE' plays a script or a recorded walkthrough")
         session.speed = args.speed if args.speed is not None else 1.0 if real else 60.0
+        reported: list[dict[str, Any]] = []
         if devices is not None:
             devices.install(session.sim)
+
+            def report_devices() -> None:
+                # traced (device.pending) while the trace is open: when the person quits,
+                # the app closes the session before the run below returns
+                if not reported:
+                    reported.append(devices.report())
+
+            session.before_close(report_devices)
         from opspec.tui.sound import Cue
 
         cue = Cue(args.sound)
@@ -201,7 +210,6 @@ def run(args: argparse.Namespace) -> int:
         app = WalkthroughApp(session, title=package.name or package.id, notes=notes,
                              large=args.large, high_contrast=args.high_contrast, sound=cue)
         interrupted = False
-        device_report = None
         try:
             app.run()
             interrupted = getattr(app, "interrupted", False)   # the app caught a SIGINT
@@ -209,11 +217,8 @@ def run(args: argparse.Namespace) -> int:
             interrupted = True
         finally:
             cue.close()
-            try:
-                if devices is not None:    # traced (device.pending) while the trace is open
-                    device_report = devices.report()
-            finally:
-                session.close()
+            session.close()                # (reports the devices, if the app did not)
+    device_report = reported[0] if reported else None
     if session.failure is not None:            # shown in the app; said again in one line
         print(f"opspec walkthrough: {session.failure}", file=sys.stderr)
     # the end in words, as the app showed it: metrics, response times, the recording and the
