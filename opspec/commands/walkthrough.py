@@ -49,7 +49,10 @@ def register(subparsers: Any) -> None:
     parser.add_argument("--speed", type=float, default=None,
                         help="simulated seconds per wall second at start (default 60; 1 "
                         "with a real device bound)")
-    _args.add_seed(parser, what="run seed: the run of opspec run --seed")
+    # not given (None) is not 0: a replay runs the recorded session's seed instead
+    parser.add_argument("--seed", type=_args.seed, default=None,
+                        help="run seed: the run of opspec run --seed (default 0; with "
+                        "--replay, the recorded session's)")
     length = parser.add_mutually_exclusive_group()
     _args.add_days(length)
     length.add_argument("--until", metavar="T",
@@ -98,12 +101,16 @@ def run(args: argparse.Namespace) -> int:
         raise ConfigurationError(
             f"--record {args.record} with --replay: a replay records nothing",
             hint=f"its trace: opspec run {args.spec} --script {args.replay} --trace FILE")
+    seed, seed_note = _seed(args)
     # the person performs the lane; the request's user is the model they hand it over to
     # (--user-model, else the companion SPEC.users.toml), checked against the spec
-    prepared = prepare(RunRequest(args.spec, seed=args.seed, days=args.days, until=until,
+    prepared = prepare(RunRequest(args.spec, seed=seed, days=args.days, until=until,
                                   user_model=args.user_model))   # a broken spec opens nothing
     # validate's warnings (what runs differently) are shown as notes on the screen
     spec_warnings: list[str] = [str(w) for w in prepared.warnings]
+    if seed_note is not None:
+        print(f"opspec walkthrough: {seed_note}", file=sys.stderr)
+        spec_warnings.append(seed_note)
     package, compiled = prepared.package, prepared.compiled
     model = prepared.user.source if prepared.user.kind == "model" else None
     factory = _model_factory(model, prepared.seed) if model is not None else None
@@ -167,7 +174,7 @@ def run(args: argparse.Namespace) -> int:
                 binding.participants)
         # a real device answers in wall time: start in real time unless told otherwise
         real = devices is not None and devices.requires_wall_clock
-        session = WalkSession(compiled, seed=args.seed, days=args.days, until=until,
+        session = WalkSession(compiled, seed=prepared.seed, days=args.days, until=until,
                               record=record if terminal else None,
                               model_factory=factory, performers=performers, replay=replay,
                               spec_path=str(args.spec), device_participants=served,
@@ -183,8 +190,17 @@ def run(args: argparse.Namespace) -> int:
                 hint=f"run it in a terminal; without a person, 'opspec run {args.spec} "
                 "--script FILE' plays a script or a recorded walkthrough")
         session.speed = args.speed if args.speed is not None else 1.0 if real else 60.0
+        reported: list[dict[str, Any]] = []
         if devices is not None:
             devices.install(session.sim)
+
+            def report_devices() -> None:
+                # traced (device.pending) while the trace is open: when the person quits,
+                # the app closes the session before the run below returns
+                if not reported:
+                    reported.append(devices.report())
+
+            session.before_close(report_devices)
         from opspec.tui.sound import Cue
 
         cue = Cue(args.sound)
@@ -194,7 +210,6 @@ def run(args: argparse.Namespace) -> int:
         app = WalkthroughApp(session, title=package.name or package.id, notes=notes,
                              large=args.large, high_contrast=args.high_contrast, sound=cue)
         interrupted = False
-        device_report = None
         try:
             app.run()
             interrupted = getattr(app, "interrupted", False)   # the app caught a SIGINT
@@ -202,11 +217,8 @@ def run(args: argparse.Namespace) -> int:
             interrupted = True
         finally:
             cue.close()
-            try:
-                if devices is not None:    # traced (device.pending) while the trace is open
-                    device_report = devices.report()
-            finally:
-                session.close()
+            session.close()                # (reports the devices, if the app did not)
+    device_report = reported[0] if reported else None
     if session.failure is not None:            # shown in the app; said again in one line
         print(f"opspec walkthrough: {session.failure}", file=sys.stderr)
     # the end in words, as the app showed it: metrics, response times, the recording and the
@@ -218,6 +230,24 @@ def run(args: argparse.Namespace) -> int:
         print("\n".join(device_lines(device_report, "when interrupted" if interrupted
                                       else "at the end")))
     return 130 if interrupted else 1 if session.failure is not None else 0
+
+
+def _seed(args: argparse.Namespace) -> tuple[int, str | None]:
+    """The run's seed: ``--seed``, else a replay's recorded session's (its trace header
+    says it; the device's draws of another seed would be another session), else 0; and
+    what to say when ``--seed`` and the recording's differ (``None``: nothing)."""
+    recorded = None
+    if args.replay:
+        from opspec.tui.replay import recorded_seed
+
+        recorded = recorded_seed(args.replay)
+    if args.seed is None:
+        return (recorded if recorded is not None else 0), None
+    if recorded is None or recorded == args.seed:
+        return args.seed, None
+    return args.seed, (f"--seed {args.seed} is used, not the recorded session's seed "
+                       f"{recorded}: the device's draws are not those the recording was "
+                       "made with (leave out --seed to replay the session as it was)")
 
 
 def _check_record_folder(record: Path) -> None:

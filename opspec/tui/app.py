@@ -474,6 +474,11 @@ class WalkthroughApp(App[str | None]):
         """The person's panel when the device is not calling: one line saying what now."""
         session = self.session
         if session.ended:
+            # a replay, or a session run with --no-record, wrote no recording to keep
+            if session.replaying:
+                return "(the replay has ended: q quits; a replay records nothing)"
+            if session.record_path is None:
+                return "(the run has ended: q quits; nothing was recorded)"
             return "(the run has ended: q quits, the recording is kept)"
         if session.replaying:
             return "(the recording performs your lane: watch, or press u / n to move on)"

@@ -13,18 +13,25 @@ The script language has no place for that time (a script file holds ``steps`` an
 ``otherwise``, which ``opspec run --script`` checks), so the trace beside the recording keeps
 it: its header says where the run was to end (``until``), and a session the person quit
 before then ends with a ``walkthrough.quit`` event (``until``: the second they quit at).
+
+A replay runs the recorded session's seed (:func:`recorded_seed`, the trace header's
+``seed``) unless ``--seed`` says otherwise: the device's draws (a duration, a branch) of
+another seed are another session, which the recorded actions would not fit.
 """
 
 from __future__ import annotations
 
 import json
 import re
+from collections.abc import Iterator
 from pathlib import Path
+from typing import Any
 
 from opspec.engine.compiled import CompiledPackage
 from opspec.usermodels.scripts import ScriptUser, load_script
 
-__all__ = ["QUIT", "instance_tag", "load_recording", "recorded_end", "tagged_action"]
+__all__ = ["QUIT", "instance_tag", "load_recording", "recorded_end", "recorded_seed",
+           "tagged_action"]
 
 #: the trace event of a session the person quit before the end of its run: ``until``, the
 #: simulated second they quit at
@@ -71,11 +78,10 @@ def recorded_end(path: str | Path) -> float | None:
     (``REC.trace.jsonl``) says: the second the person quit at, else the end of its run;
     ``None`` when nothing says so: a recording made before sessions wrote it, any other
     script, a trace gone or not a walkthrough's."""
-    trace = Path(path).with_suffix(".trace.jsonl")
     try:
-        with trace.open(encoding="utf-8") as lines:
-            header = json.loads(next(lines, "{}"))
-            if not isinstance(header, dict) or header.get("walkthrough") is not True:
+        with _trace_of(path).open(encoding="utf-8") as lines:
+            header = _walkthrough_header(lines)
+            if header is None:
                 return None
             end = _seconds(header.get("until"))
             for line in lines:
@@ -87,6 +93,39 @@ def recorded_end(path: str | Path) -> float | None:
     except (OSError, UnicodeDecodeError, ValueError):
         return None      # unreadable: the replay runs the whole run, as before
     return end
+
+
+def recorded_seed(path: str | Path) -> int | None:
+    """The run seed of the session recorded in ``path``, as its trace beside it
+    (``REC.trace.jsonl``) says in its header; ``None`` when nothing says so (as
+    :func:`recorded_end`)."""
+    from opspec.errors import ConfigurationError
+    from opspec.run_rules import check_seed
+
+    try:
+        with _trace_of(path).open(encoding="utf-8") as lines:
+            header = _walkthrough_header(lines)
+    except (OSError, UnicodeDecodeError, ValueError):
+        return None
+    seed = None if header is None else header.get("seed")
+    if isinstance(seed, bool) or not isinstance(seed, int):
+        return None
+    try:
+        return check_seed(seed)
+    except ConfigurationError:
+        return None                     # not a seed any door takes: not one to run
+
+
+def _trace_of(path: str | Path) -> Path:
+    return Path(path).with_suffix(".trace.jsonl")
+
+
+def _walkthrough_header(lines: Iterator[str]) -> dict[str, Any] | None:
+    """The header (the first line) of a walkthrough's trace; ``None`` for another file's."""
+    header = json.loads(next(lines, "{}"))
+    if not isinstance(header, dict) or header.get("walkthrough") is not True:
+        return None
+    return header
 
 
 def _seconds(value: object) -> float | None:

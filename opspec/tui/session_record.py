@@ -3,13 +3,16 @@ the lane is handed over) written at once to the recording, a script ``opspec run
 replays, and every trace event to ``<recording>.trace.jsonl`` with how long the person took
 (for ``opspec fit``). The trace also keeps where the session ended, which the script cannot
 hold: the run's end in its header (``until``), and a ``walkthrough.quit`` event where the
-person quit before it, so that a replay ends there too (:func:`opspec.tui.replay.recorded_end`)."""
+person quit before it, so that a replay ends there too (:func:`opspec.tui.replay.recorded_end`),
+and what is traced when the session closes (:meth:`Recording.before_close`: the bound devices'
+unfinished work, ``device.pending``), whoever closes it."""
 
 from __future__ import annotations
 
 import json
 import os
 import time
+from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
@@ -31,6 +34,7 @@ class Recording(SessionState):
         self.record_path = Path(record) if record is not None else None
         self._steps = []
         self._trace_file = None
+        self._closing = []
         if self.record_path is not None:
             trace_path = self.record_path.with_suffix(".trace.jsonl")
             try:
@@ -85,11 +89,23 @@ class Recording(SessionState):
         tmp.write_text(text, encoding="utf-8")
         os.replace(tmp, self.record_path)
 
+    def before_close(self, hook: Callable[[], object]) -> None:
+        """Call ``hook`` when the session closes, while its trace is still open: the app
+        closes the session when the person quits, before ``opspec walkthrough`` gets back
+        control, so what the command traces at the end (``device.pending``) would otherwise
+        reach a closed trace."""
+        self._closing.append(hook)
+
     def close(self) -> None:
-        if self._trace_file is not None:
-            if not self.ended and self.failure is None:
-                # the person quit here: a replay of the recording ends here too
-                # (opspec.tui.replay.recorded_end)
-                self.sim.session.trace(QUIT, {"until": self.now})
-            self._trace_file.close()
-            self._trace_file = None
+        hooks, self._closing = self._closing, []        # once, however often it is closed
+        try:
+            for hook in hooks:
+                hook()
+        finally:
+            if self._trace_file is not None:
+                if not self.ended and self.failure is None:
+                    # the person quit here: a replay of the recording ends here too
+                    # (opspec.tui.replay.recorded_end)
+                    self.sim.session.trace(QUIT, {"until": self.now})
+                self._trace_file.close()
+                self._trace_file = None

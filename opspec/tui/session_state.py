@@ -74,6 +74,7 @@ class SessionState:
     record_path: Path | None
     _steps: list[list[str]]
     _trace_file: JsonlSink | None
+    _closing: list[Callable[[], object]]
 
     def __init__(self, compiled: CompiledPackage, *, seed: int, days: float | None,
                  until: float | None, model_factory: Callable[[], Any] | None, replay: Any, spec_path: str,

@@ -1,7 +1,10 @@
 """The summary of a walkthrough study (``opspec study PROTOCOL.toml`` without
 ``--participant``): each metric of each variant over the participants who finished it, and
 the paired difference of each pair of variants over the participants who did both, replayed
-from the sessions' traces (:mod:`opspec.tui.study` runs the sessions).
+from the sessions' traces (:mod:`opspec.tui.study` runs the sessions). An interval of no width
+from too few participants who were all alike is marked and explained as ``opspec evaluate``
+does (:mod:`opspec.statistics.no_spread`, :mod:`opspec.evaluation.no_spread_notes`): it shows
+no spread between them, not a value known exactly.
 """
 
 from __future__ import annotations
@@ -102,6 +105,7 @@ def variant_estimate(kind: str | None, pairs: list[tuple[float, float]],
     interval. A t interval alone says [0, 0] for a count nobody had and a rate of 0 of 16
     doses, as if they could not happen."""
     from opspec.statistics import count_estimate, ratio_estimate
+    from opspec.statistics.no_spread import no_spread
     from opspec.statistics.ratios import ratio_interval
 
     estimate = ratio_estimate(pairs)
@@ -115,6 +119,8 @@ def variant_estimate(kind: str | None, pairs: list[tuple[float, float]],
                                   denominator=str(definition.denominator))
         ci, method = interval.ci, interval.method
     return {"value": estimate.value, "ci95": list(ci), "ci95_method": method,
+            # [v, v] because every participant gave v: said as opspec evaluate says it
+            "ci95_no_spread": no_spread(ci, len(pairs)),
             "unit": "s" if kind == "duration" else None, "participants": len(pairs),
             # the spec's declaration: a proportion is shown in percent, as opspec run and
             # opspec evaluate show it (never from its name or numbers)
@@ -128,6 +134,7 @@ def summary(protocol: Protocol) -> dict[str, Any]:
     participants who finished both (``opspec evaluate --compare``'s statistics: a ratio
     over users with its delta-method interval)."""
     from opspec.statistics import paired_difference, ratio_estimate
+    from opspec.statistics.no_spread import no_spread
 
     done: dict[str, dict[str, dict[str, tuple[float, float]]]] = {}
     status: dict[str, dict[str, bool]] = {}
@@ -172,6 +179,7 @@ def summary(protocol: Protocol) -> dict[str, Any]:
                               "b": ratio_estimate([done[b][p][name] for p in who]).value,
                               "difference": diff.value, "ci95": list(diff.ci),
                               "ci95_method": diff.method,
+                              "ci95_no_spread": no_spread(diff.ci, len(who)),
                               "unit": "s" if kinds.get(name) == "duration" else None,
                               "participants": len(who),
                               "proportion": any(variants[v]["metrics"].get(name, {}).get(
@@ -184,7 +192,10 @@ def summary(protocol: Protocol) -> dict[str, Any]:
 def summary_lines(doc: dict[str, Any]) -> list[str]:
     """The summary as the terminal shows it: a declared proportion in percent (a difference
     of two in percentage points), a difference signed, as opspec evaluate's tables write
-    them (:mod:`opspec.evaluation.tables`)."""
+    them (:mod:`opspec.evaluation.tables`); an interval of no width from too few participants
+    all alike marked ``†``, with one note at the end saying what the mark means, in the words
+    of opspec evaluate's (:mod:`opspec.evaluation.no_spread_notes`)."""
+    from opspec.evaluation.no_spread_notes import no_spread_note, with_mark
     from opspec.evaluation.tables import difference_text
 
     def num(x: Any, unit: str | None = None, *, percent: bool = False,
@@ -203,8 +214,8 @@ def summary_lines(doc: dict[str, Any]) -> list[str]:
         if lo is None or hi is None:        # "[-, -]" said nothing of why
             return f"no 95 % CI: {none}; n = {m['participants']}"
         shown = [num(x, percent=percent, difference=difference) for x in (lo, hi)]
-        return (f"95 % CI [{shown[0]}, {shown[1]}]{' ' + unit if unit else ''}; "
-                f"n = {m['participants']}")
+        ci = with_mark(f"[{shown[0]}, {shown[1]}]{' ' + unit if unit else ''}", m)
+        return f"95 % CI {ci}; n = {m['participants']}"
 
     lines = [f"study {doc['study']}"]
     for participant, sessions in doc["status"].items():
@@ -228,5 +239,11 @@ def summary_lines(doc: dict[str, Any]) -> list[str]:
                          f"{num(m['difference'], unit, percent=percent, difference=True)} ("
                          + interval(m, "fewer than two participants differ between the "
                                     "variants", difference=True) + ")")
+    # what a marked interval means, once for every line above (as under evaluate's tables)
+    note = no_spread_note([*(m for v in doc["variants"].values()
+                             for m in v["metrics"].values()),
+                           *(m for c in doc["comparisons"] for m in c["metrics"].values())])
+    if note:
+        lines += ["", note]
     return lines
 
