@@ -35,8 +35,8 @@ def arm(flow: Flow, inst: ProcessInstance, deadline: float) -> None:
         return
     # RunState.call_at's timed case
     state.sim_events += 1
-    state.schedule_timed(deadline if deadline > 0.0 else 0.0,  # noqa: FURB136
-                         _Deadline(flow, inst))
+    state.schedule_droppable(deadline if deadline > 0.0 else 0.0,  # noqa: FURB136
+                             _Deadline(flow, inst))
 
 
 def _queue(flow: Flow, inst: ProcessInstance, deadline: float) -> None:
@@ -70,6 +70,10 @@ class _Deadline(Timed):
         if state == RUNNING or state == SUSPENDED:
             expired(flow, self.inst)
         flow.state.drain()
+
+    def needed(self) -> bool:
+        state = self.inst.state
+        return state == RUNNING or state == SUSPENDED
 
     def __call__(self, _event: Any) -> None:
         self.flow.state.go_now(self)

@@ -42,6 +42,7 @@ from typing import Any, Final, final
 import simpy
 
 from opspec.engine.clock import Clock
+from opspec.engine.zero_time import SAMPLE_STEPS
 
 __all__ = ["Timed", "Timers", "exact_delay", "heap_pop", "heap_push"]
 
@@ -62,6 +63,11 @@ class Timed:
 
     def go(self) -> None:
         raise NotImplementedError
+
+    def needed(self) -> bool:
+        """Whether :meth:`go` still has anything to do but drain (asked of the entries
+        scheduled with :meth:`Timers.schedule_droppable` before they come due)."""
+        return True
 
     def __call__(self, _event: Any) -> None:
         raise NotImplementedError
@@ -124,6 +130,10 @@ class Timers:
         self.horizon = INF          # the earliest event anything else has on SimPy's queue
         self.shared = False         # something else is due at the instant being run
         self.scheduling = False     # the run is scheduling on the clock itself
+        # entries of schedule_droppable not on the heap yet, and the earliest time of them
+        self.droppable: list[Timed] = []
+        self.droppable_at = INF
+        self.moot: list[Timed] = []     # (_come_due's: the entries found not needed)
 
     def sync(self) -> None:
         """Control enters the engine from outside its own timed callbacks (a performer
@@ -170,14 +180,100 @@ class Timers:
         if at < self.armed_at and not self.ticking:
             self.arm()
 
+    def schedule_droppable(self, delay: float, entry: Timed) -> None:
+        """:meth:`schedule_timed` for an entry that will most often have nothing to do but
+        drain when it comes due (a workflow's deadline, its instance long ended): it waits
+        beside the heap, in its place in the order of scheduling, and goes on the heap just
+        before the run reaches its time, unless it is no longer :meth:`~Timed.needed` and
+        its drain could not be seen (:meth:`_come_due`): then it is dropped, no heap entry,
+        pop or drain."""
+        if not self.heaped:
+            self.env.timeout(delay).callbacks.append(entry)
+            return
+        if not self.inside:
+            self.now = float(self.env.now)
+        at = self.now + delay
+        self.order += 1
+        entry.at = at
+        entry.seq = self.order
+        self.droppable.append(entry)
+        if at < self.droppable_at:
+            self.droppable_at = at
+            if at < self.armed_at and not self.ticking:
+                self.arm()
+
+    def idle(self) -> bool:
+        """Whether a drain now would only count a step (nothing queued: see
+        :meth:`_come_due`; the run's state says, ``RunState.idle``)."""
+        return True
+
+    def _come_due(self, until: float, drop: bool) -> None:
+        """The run is about to run what is due at ``until``: the droppable entries due by
+        then go on the heap (in their place: each keeps its time and sequence).
+
+        With ``drop`` (the run going through its own instants, :meth:`_run_due`), one that
+        is no longer needed is dropped instead where nothing can tell: its drain would only
+        count a step of the zero-time guard at its instant (:meth:`idle`), and the next
+        thing that runs after it (the heap's earliest entry, the alive ones of these
+        included, or the next event on SimPy's queue) is at another instant as the guard
+        tells instants apart, so that the count starts again there whether or not the
+        drain ran; and fewer of them than the guard samples past its limit (so that the
+        count of theirs alone could never stop the run). Stepped, or when something else
+        is scheduled on the clock (:meth:`tick`, :meth:`foreign`), they all go on the heap
+        and run as any entry: one callback per step, as before."""
+        waiting = self.droppable
+        moot = self.moot
+        later = INF
+        kept = 0
+        for entry in waiting:
+            at = entry.at
+            if at > until:
+                waiting[kept] = entry
+                kept += 1
+                if at < later:
+                    later = at
+            elif drop and not entry.needed():
+                moot.append(entry)
+            else:
+                self._push(entry)
+        if kept:
+            del waiting[kept:]
+        else:
+            waiting.clear()
+        self.droppable_at = later
+        if moot:
+            heap = self.heap
+            rows: list[Any] = heap          # the same list, holding tuples (see TUPLES)
+            nearest = self.horizon
+            if heap:
+                first: float = rows[0][0] if TUPLES else heap[0].at
+                if first < nearest:
+                    nearest = first
+            # RunState.drain's test of a new instant, at the next thing to run
+            quiet = (len(moot) < SAMPLE_STEPS and self.idle())
+            scale = nearest if nearest > 1.0 else 1.0
+            for entry in moot:
+                if not (quiet and nearest - entry.at > 1e-9 * scale):
+                    self._push(entry)
+            moot.clear()
+
+    def _push(self, entry: Timed) -> None:
+        if TUPLES:
+            rows: list[Any] = self.heap     # the same list, holding tuples (see TUPLES)
+            heappush(rows, (entry.at, entry.seq, entry))
+        else:
+            heap_push(self.heap, entry)
+
     def arm(self) -> None:
         """Have SimPy wake the run at the heap's earliest time, unless a driver will by then."""
         heap = self.heap
-        if not heap:
-            return
         rows: list[Any] = heap              # the same list, holding tuples (see TUPLES)
-        at: float = rows[0][0] if TUPLES else heap[0].at
-        if at >= self.armed_at:
+        at: float = INF
+        if heap:
+            at = rows[0][0] if TUPLES else heap[0].at
+        if self.droppable_at < at:
+            at = self.droppable_at
+        if at >= self.armed_at:             # (INF: nothing to wake the run for)
             return
         self.driver += 1
         self.armed_at = at
@@ -195,6 +291,8 @@ class Timers:
             return                  # superseded by an earlier driver, or its instant shared
         at = self.armed_at
         self.armed_at = INF
+        if self.droppable_at <= at:
+            self._come_due(at, False)
         heap = self.heap
         rows: list[Any] = heap              # the same list, holding tuples (see TUPLES)
         if not heap or (rows[0][0] if TUPLES else heap[0].at) != at:
@@ -229,6 +327,10 @@ class Timers:
             if not ahead or not heap or self.shared:
                 return
             following = heap[0].at
+            if self.droppable_at <= following and (following == at
+                                                    or following < self.horizon):
+                self._come_due(following, True)     # (what runs next is due by then)
+                following = heap[0].at
             if following != at:
                 if not following < self.horizon:
                     return          # something else comes first: SimPy's turn
@@ -244,6 +346,10 @@ class Timers:
             if not ahead or not rows or self.shared:
                 return
             following = rows[0][0]
+            if self.droppable_at <= following and (following == at
+                                                    or following < self.horizon):
+                self._come_due(following, True)     # (what runs next is due by then)
+                following = rows[0][0]
             if following != at:
                 if not following < self.horizon:
                     return          # something else comes first: SimPy's turn
@@ -273,6 +379,8 @@ class Timers:
             self.shared = True      # it comes before what this instant schedules from now on
         if urgent:
             return                  # before every timeout of its instant anyway
+        if self.droppable_at <= at:
+            self._come_due(at, False)
         # entries due at its instant were scheduled before it, so they come first
         if any(_at(entry) == at for entry in self.heap):
             self._give_to_simpy(at)
