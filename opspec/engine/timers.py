@@ -30,6 +30,14 @@ through an instant something else now shares. Which entries a driver runs:
 Not with a shared processor model (the processors read ``env.now`` themselves): then the
 run steps one entry per driver. A lost race (a deadline whose activity completed) costs a
 heap entry and a generation check, no SimPy event.
+
+A workflow's own deadline mostly falls due long after its instance ended: it waits beside
+the heap (:meth:`Timers.schedule_droppable`) and is dropped, no heap entry at all, where
+running it could not be told from not running it (:meth:`Timers._come_due`).
+
+Compiled, the heap is a *line* while it holds few entries (a list sorted the latest first,
+:func:`line_push`; the earliest is its last item) and a binary heap past :data:`LINE_MAX`;
+from source, :mod:`heapq` over tuples (see ``TUPLES``).
 """
 
 from __future__ import annotations
@@ -47,6 +55,11 @@ from opspec.engine.zero_time import SAMPLE_STEPS
 __all__ = ["Timed", "Timers", "exact_delay", "heap_pop", "heap_push"]
 
 INF: Final = math.inf
+#: The run's entries are kept as a line (:func:`line_push`) up to this many, then as a
+#: binary heap until they are fewer than ``LINE_MIN`` again (an insertion into a line moves
+#: the entries after its place, a heap's cost grows with the logarithm of its size).
+LINE_MAX: Final = 64
+LINE_MIN: Final = 16
 
 
 class Timed:
@@ -115,7 +128,10 @@ class Timers:
         # and at each call from outside one (:meth:`sync`), not at every use.
         self.now = float(clock.now)
         self.inside = False         # handling one of its own timed callbacks: now is fresh
-        self.heap: list[Timed] = []     # a binary heap by (at, seq): heap_push, heap_pop
+        # the entries by (at, seq): compiled, a line (sorted, the earliest last) while it is
+        # short, else a binary heap (heap_push, heap_pop); from source heapq's (see TUPLES)
+        self.heap: list[Timed] = []
+        self.lined = not TUPLES
         # a heap only on a Clock no other run drives (the clock reports the others' events)
         self.heaped = False
         if isinstance(clock, Clock) and clock.owner is None:
@@ -172,11 +188,7 @@ class Timers:
         self.order += 1
         entry.at = at
         entry.seq = self.order
-        if TUPLES:
-            rows: list[Any] = self.heap     # the same list, holding tuples (see TUPLES)
-            heappush(rows, (at, self.order, entry))
-        else:
-            heap_push(self.heap, entry)
+        self._push(entry)
         if at < self.armed_at and not self.ticking:
             self.arm()
 
@@ -230,7 +242,7 @@ class Timers:
             if at > until:
                 waiting[kept] = entry
                 kept += 1
-                if at < later:
+                if at < later:  # noqa: PLR1730 - min() is a builtin call compiled
                     later = at
             elif drop and not entry.needed():
                 moot.append(entry)
@@ -242,36 +254,57 @@ class Timers:
             waiting.clear()
         self.droppable_at = later
         if moot:
-            heap = self.heap
-            rows: list[Any] = heap          # the same list, holding tuples (see TUPLES)
             nearest = self.horizon
-            if heap:
-                first: float = rows[0][0] if TUPLES else heap[0].at
-                if first < nearest:
+            if self.heap:
+                first = self.first_at()
+                if first < nearest:  # noqa: PLR1730
                     nearest = first
             # RunState.drain's test of a new instant, at the next thing to run
             quiet = (len(moot) < SAMPLE_STEPS and self.idle())
-            scale = nearest if nearest > 1.0 else 1.0
+            scale = nearest if nearest > 1.0 else 1.0  # noqa: FURB136
             for entry in moot:
                 if not (quiet and nearest - entry.at > 1e-9 * scale):
                     self._push(entry)
             moot.clear()
 
     def _push(self, entry: Timed) -> None:
+        heap = self.heap
         if TUPLES:
-            rows: list[Any] = self.heap     # the same list, holding tuples (see TUPLES)
+            rows: list[Any] = heap          # the same list, holding tuples (see TUPLES)
             heappush(rows, (entry.at, entry.seq, entry))
+        elif self.lined:
+            line_push(heap, entry)
+            if len(heap) > LINE_MAX:
+                heap.reverse()          # the earliest first: sorted, so a binary heap
+                self.lined = False
         else:
-            heap_push(self.heap, entry)
+            heap_push(heap, entry)
+
+    def take_first(self) -> Timed:
+        """Take the heap's earliest entry off it (there is one)."""
+        heap = self.heap
+        if TUPLES:
+            rows: list[Any] = heap          # the same list, holding tuples (see TUPLES)
+            return heappop(rows)[2]  # type: ignore[no-any-return]
+        if self.lined:
+            return heap.pop()
+        entry = heap_pop(heap)
+        if len(heap) < LINE_MIN:
+            self._line_up()
+        return entry
+
+    def first_at(self) -> float:
+        """The time of the heap's earliest entry (there is one)."""
+        heap = self.heap
+        if TUPLES:
+            rows: list[Any] = heap          # the same list, holding tuples (see TUPLES)
+            return rows[0][0]  # type: ignore[no-any-return]
+        return heap[-1].at if self.lined else heap[0].at
 
     def arm(self) -> None:
         """Have SimPy wake the run at the heap's earliest time, unless a driver will by then."""
-        heap = self.heap
-        rows: list[Any] = heap              # the same list, holding tuples (see TUPLES)
-        at: float = INF
-        if heap:
-            at = rows[0][0] if TUPLES else heap[0].at
-        if self.droppable_at < at:
+        at = self.first_at() if self.heap else INF
+        if self.droppable_at < at:  # noqa: PLR1730
             at = self.droppable_at
         if at >= self.armed_at:             # (INF: nothing to wake the run for)
             return
@@ -294,8 +327,7 @@ class Timers:
         if self.droppable_at <= at:
             self._come_due(at, False)
         heap = self.heap
-        rows: list[Any] = heap              # the same list, holding tuples (see TUPLES)
-        if not heap or (rows[0][0] if TUPLES else heap[0].at) != at:
+        if not heap or self.first_at() != at:
             self.arm()
             return
         ahead = self.ahead
@@ -320,17 +352,17 @@ class Timers:
 
     def _run_due(self, heap: list[Timed], ahead: bool) -> None:
         while True:
-            entry = heap_pop(heap)
+            entry = self.take_first()
             at = entry.at
             self.now = at
             entry.go()
             if not ahead or not heap or self.shared:
                 return
-            following = heap[0].at
+            following = heap[-1].at if self.lined else heap[0].at
             if self.droppable_at <= following and (following == at
                                                     or following < self.horizon):
                 self._come_due(following, True)     # (what runs next is due by then)
-                following = heap[0].at
+                following = heap[-1].at if self.lined else heap[0].at
             if following != at:
                 if not following < self.horizon:
                     return          # something else comes first: SimPy's turn
@@ -354,6 +386,11 @@ class Timers:
                 if not following < self.horizon:
                     return          # something else comes first: SimPy's turn
                 self.lagging = True
+
+    def _line_up(self) -> None:
+        """The heap is short again: a line (see :func:`line_push`)."""
+        self.heap.sort(key=_order, reverse=True)
+        self.lined = True
 
     def catch_up(self) -> None:
         """Move SimPy's clock to the run's time (it went ahead: see the module docstring)."""
@@ -394,7 +431,9 @@ class Timers:
         heap = self.heap
         due = [_entry(item) for item in sorted([item for item in heap if _at(item) == at],
                                                key=_order)]
-        heap[:] = sorted([item for item in heap if _at(item) != at], key=_order)  # a heap
+        # (sorted: a heap, or as a line the latest first)
+        heap[:] = sorted([item for item in heap if _at(item) != at], key=_order,
+                         reverse=self.lined)
         env = self.env
         delay = exact_delay(float(env.now), at)
         self.scheduling = True
@@ -418,6 +457,27 @@ def _order(item: Any) -> tuple[float, int]:
     if TUPLES:
         return item[0], item[1]
     return item.at, item.seq
+
+
+def line_push(line: list[Timed], entry: Timed) -> None:
+    """Insert ``entry`` into ``line``, a list sorted by ``(at, seq)`` the latest first, in its
+    place (found by bisection): the run's entries while they are few. The earliest is then
+    taken with ``line.pop()``: compiled, that and an insertion of a few places cost less
+    than :func:`heap_pop`'s sifting, which reads and type-checks an entry per comparison
+    (docs/engine-performance.md, the deadlines pass)."""
+    at = entry.at
+    seq = entry.seq
+    lo = 0
+    hi = len(line)
+    while lo < hi:
+        mid = (lo + hi) >> 1
+        other = line[mid]
+        other_at = other.at
+        if other_at > at or (other_at == at and other.seq > seq):
+            lo = mid + 1
+        else:
+            hi = mid
+    line.insert(lo, entry)
 
 
 def heap_push(heap: list[Timed], entry: Timed) -> None:
