@@ -2,14 +2,14 @@
 starts, it emits ``deadline.expired`` if the instance still runs when it falls due.
 
 Most of them fall due after their instance ended (a robot spec's 50 ms deadline on a
-workflow that takes 5 ms) and do nothing but drain, which the zero-time guard counts as a
-step, so they stay armed: the guard starts its count again only when the count passes its
-limit and the clock has moved, so every drain moves the point at which a zero-time cycle is
-stopped (and the trace before it); what they cost is kept small instead: a timed
-callback object of their own (:class:`_Deadline`) rather than a closure handed to
-:meth:`RunState.call_at <opspec.engine.runstate.RunState.call_at>`, which does the same
-(``sim_events``, the heap entry, the drain after it). Compiled with the engine
-(``opspec._native``): the callback extends the compiled ``Timed``.
+workflow that takes 5 ms) and would do nothing but drain: they are scheduled with
+:meth:`Timers.schedule_droppable <opspec.engine.timers.Timers.schedule_droppable>`, which
+keeps them off the timer heap and drops those no longer :meth:`_Deadline.needed` where their
+drain could not be seen (a step of the zero-time guard at an instant where nothing else
+runs); the others run as before, in their place. Each is still counted in ``sim_events`` when
+it is armed. The timed callback is an object of its own (:class:`_Deadline`, extending the
+compiled ``Timed``) rather than a closure handed to :meth:`RunState.call_at
+<opspec.engine.runstate.RunState.call_at>`.
 """
 
 from __future__ import annotations
@@ -35,8 +35,8 @@ def arm(flow: Flow, inst: ProcessInstance, deadline: float) -> None:
         return
     # RunState.call_at's timed case
     state.sim_events += 1
-    state.schedule_timed(deadline if deadline > 0.0 else 0.0,  # noqa: FURB136
-                         _Deadline(flow, inst))
+    state.schedule_droppable(deadline if deadline > 0.0 else 0.0,  # noqa: FURB136
+                             _Deadline(flow, inst))
 
 
 def _queue(flow: Flow, inst: ProcessInstance, deadline: float) -> None:
@@ -70,6 +70,11 @@ class _Deadline(Timed):
         if state == RUNNING or state == SUSPENDED:
             expired(flow, self.inst)
         flow.state.drain()
+
+    def needed(self) -> bool:
+        """Whether the instance still runs (else the deadline can only drain)."""
+        state = self.inst.state
+        return state == RUNNING or state == SUSPENDED
 
     def __call__(self, _event: Any) -> None:
         self.flow.state.go_now(self)

@@ -145,6 +145,11 @@ class RunState(Timers):
         # which selection the wanted-kind bits cached on activities and processes are of
         self.flag_key = _flag_key(self.wants_all, self.wanted)
 
+    def idle(self) -> bool:
+        """Whether a drain now would only count a step: nothing queued, no frame pending
+        (the timer heap asks before it drops a deadline nobody needs any more)."""
+        return not self.ready and not self.pending
+
     def gone(self, iid: int) -> None:
         """Workflow instance ``iid`` ended (``in`` and ``del``, not ``pop(key, None)``:
         compiled, a dict's pop is a Python method call, these are primitives)."""

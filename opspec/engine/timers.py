@@ -30,6 +30,14 @@ through an instant something else now shares. Which entries a driver runs:
 Not with a shared processor model (the processors read ``env.now`` themselves): then the
 run steps one entry per driver. A lost race (a deadline whose activity completed) costs a
 heap entry and a generation check, no SimPy event.
+
+A workflow's own deadline mostly falls due long after its instance ended: it waits beside
+the heap (:meth:`Timers.schedule_droppable`) and is dropped, no heap entry at all, where
+running it could not be told from not running it (:meth:`Timers._come_due`).
+
+Compiled, the heap is a *line* while it holds few entries (a list sorted the latest first,
+:func:`line_push`; the earliest is its last item) and a binary heap past :data:`LINE_MAX`;
+from source, :mod:`heapq` over tuples (see ``TUPLES``).
 """
 
 from __future__ import annotations
@@ -42,10 +50,16 @@ from typing import Any, Final, final
 import simpy
 
 from opspec.engine.clock import Clock
+from opspec.engine.zero_time import SAMPLE_STEPS
 
 __all__ = ["Timed", "Timers", "exact_delay", "heap_pop", "heap_push"]
 
 INF: Final = math.inf
+#: The run's entries are kept as a line (:func:`line_push`) up to this many, then as a
+#: binary heap until they are fewer than ``LINE_MIN`` again (an insertion into a line moves
+#: the entries after its place, a heap's cost grows with the logarithm of its size).
+LINE_MAX: Final = 64
+LINE_MIN: Final = 16
 
 
 class Timed:
@@ -62,6 +76,11 @@ class Timed:
 
     def go(self) -> None:
         raise NotImplementedError
+
+    def needed(self) -> bool:
+        """Whether :meth:`go` still has anything to do but drain (asked of the entries
+        scheduled with :meth:`Timers.schedule_droppable` before they come due)."""
+        return True
 
     def __call__(self, _event: Any) -> None:
         raise NotImplementedError
@@ -109,7 +128,10 @@ class Timers:
         # and at each call from outside one (:meth:`sync`), not at every use.
         self.now = float(clock.now)
         self.inside = False         # handling one of its own timed callbacks: now is fresh
-        self.heap: list[Timed] = []     # a binary heap by (at, seq): heap_push, heap_pop
+        # the entries by (at, seq): compiled, a line (sorted, the earliest last) while it is
+        # short, else a binary heap (heap_push, heap_pop); from source heapq's (see TUPLES)
+        self.heap: list[Timed] = []
+        self.lined = not TUPLES
         # a heap only on a Clock no other run drives (the clock reports the others' events)
         self.heaped = False
         if isinstance(clock, Clock) and clock.owner is None:
@@ -124,6 +146,10 @@ class Timers:
         self.horizon = INF          # the earliest event anything else has on SimPy's queue
         self.shared = False         # something else is due at the instant being run
         self.scheduling = False     # the run is scheduling on the clock itself
+        # entries of schedule_droppable not on the heap yet, and the earliest time of them
+        self.droppable: list[Timed] = []
+        self.droppable_at = INF
+        self.moot: list[Timed] = []     # (_come_due's: the entries found not needed)
 
     def sync(self) -> None:
         """Control enters the engine from outside its own timed callbacks (a performer
@@ -162,22 +188,125 @@ class Timers:
         self.order += 1
         entry.at = at
         entry.seq = self.order
-        if TUPLES:
-            rows: list[Any] = self.heap     # the same list, holding tuples (see TUPLES)
-            heappush(rows, (at, self.order, entry))
-        else:
-            heap_push(self.heap, entry)
+        self._push(entry)
         if at < self.armed_at and not self.ticking:
             self.arm()
 
+    def schedule_droppable(self, delay: float, entry: Timed) -> None:
+        """:meth:`schedule_timed` for an entry that will most often have nothing to do but
+        drain when it comes due (a workflow's deadline, its instance long ended): it waits
+        beside the heap, in its place in the order of scheduling, and goes on the heap just
+        before the run reaches its time, unless it is no longer :meth:`~Timed.needed` and
+        its drain could not be seen (:meth:`_come_due`): then it is dropped, no heap entry,
+        pop or drain."""
+        if not self.heaped:
+            self.env.timeout(delay).callbacks.append(entry)
+            return
+        if not self.inside:
+            self.now = float(self.env.now)
+        at = self.now + delay
+        self.order += 1
+        entry.at = at
+        entry.seq = self.order
+        self.droppable.append(entry)
+        if at < self.droppable_at:
+            self.droppable_at = at
+            if at < self.armed_at and not self.ticking:
+                self.arm()
+
+    def idle(self) -> bool:
+        """Whether a drain now would only count a step (nothing queued: see
+        :meth:`_come_due`; the run's state says, ``RunState.idle``)."""
+        return True
+
+    def _come_due(self, until: float, drop: bool) -> None:
+        """The run is about to run what is due at ``until``: the droppable entries due by
+        then go on the heap (in their place: each keeps its time and sequence).
+
+        With ``drop`` (the run going through its own instants, :meth:`_run_due`), one that
+        is no longer needed is dropped instead where nothing can tell: its drain would only
+        count a step of the zero-time guard at its instant (:meth:`idle`), and the next
+        thing that runs after it (the heap's earliest entry, the alive ones of these
+        included, or the next event on SimPy's queue) is at another instant as the guard
+        tells instants apart, so that the count starts again there whether or not the
+        drain ran; and fewer of them than the guard samples past its limit (so that the
+        count of theirs alone could never stop the run). Stepped, or when something else
+        is scheduled on the clock (:meth:`tick`, :meth:`foreign`), they all go on the heap
+        and run as any entry: one callback per step, as before."""
+        waiting = self.droppable
+        moot = self.moot
+        later = INF
+        kept = 0
+        for entry in waiting:
+            at = entry.at
+            if at > until:
+                waiting[kept] = entry
+                kept += 1
+                if at < later:  # noqa: PLR1730 - min() is a builtin call compiled
+                    later = at
+            elif drop and not entry.needed():
+                moot.append(entry)
+            else:
+                self._push(entry)
+        if kept:
+            del waiting[kept:]
+        else:
+            waiting.clear()
+        self.droppable_at = later
+        if moot:
+            nearest = self.horizon
+            if self.heap:
+                first = self.first_at()
+                if first < nearest:  # noqa: PLR1730
+                    nearest = first
+            # RunState.drain's test of a new instant, at the next thing to run
+            quiet = (len(moot) < SAMPLE_STEPS and self.idle())
+            scale = nearest if nearest > 1.0 else 1.0  # noqa: FURB136
+            for entry in moot:
+                if not (quiet and nearest - entry.at > 1e-9 * scale):
+                    self._push(entry)
+            moot.clear()
+
+    def _push(self, entry: Timed) -> None:
+        heap = self.heap
+        if TUPLES:
+            rows: list[Any] = heap          # the same list, holding tuples (see TUPLES)
+            heappush(rows, (entry.at, entry.seq, entry))
+        elif self.lined:
+            line_push(heap, entry)
+            if len(heap) > LINE_MAX:
+                heap.reverse()          # the earliest first: sorted, so a binary heap
+                self.lined = False
+        else:
+            heap_push(heap, entry)
+
+    def take_first(self) -> Timed:
+        """Take the heap's earliest entry off it (there is one)."""
+        heap = self.heap
+        if TUPLES:
+            rows: list[Any] = heap          # the same list, holding tuples (see TUPLES)
+            return heappop(rows)[2]  # type: ignore[no-any-return]
+        if self.lined:
+            return heap.pop()
+        entry = heap_pop(heap)
+        if len(heap) < LINE_MIN:
+            self._line_up()
+        return entry
+
+    def first_at(self) -> float:
+        """The time of the heap's earliest entry (there is one)."""
+        heap = self.heap
+        if TUPLES:
+            rows: list[Any] = heap          # the same list, holding tuples (see TUPLES)
+            return rows[0][0]  # type: ignore[no-any-return]
+        return heap[-1].at if self.lined else heap[0].at
+
     def arm(self) -> None:
         """Have SimPy wake the run at the heap's earliest time, unless a driver will by then."""
-        heap = self.heap
-        if not heap:
-            return
-        rows: list[Any] = heap              # the same list, holding tuples (see TUPLES)
-        at: float = rows[0][0] if TUPLES else heap[0].at
-        if at >= self.armed_at:
+        at = self.first_at() if self.heap else INF
+        if self.droppable_at < at:  # noqa: PLR1730
+            at = self.droppable_at
+        if at >= self.armed_at:             # (INF: nothing to wake the run for)
             return
         self.driver += 1
         self.armed_at = at
@@ -195,9 +324,10 @@ class Timers:
             return                  # superseded by an earlier driver, or its instant shared
         at = self.armed_at
         self.armed_at = INF
+        if self.droppable_at <= at:
+            self._come_due(at, False)
         heap = self.heap
-        rows: list[Any] = heap              # the same list, holding tuples (see TUPLES)
-        if not heap or (rows[0][0] if TUPLES else heap[0].at) != at:
+        if not heap or self.first_at() != at:
             self.arm()
             return
         ahead = self.ahead
@@ -222,13 +352,17 @@ class Timers:
 
     def _run_due(self, heap: list[Timed], ahead: bool) -> None:
         while True:
-            entry = heap_pop(heap)
+            entry = self.take_first()
             at = entry.at
             self.now = at
             entry.go()
             if not ahead or not heap or self.shared:
                 return
-            following = heap[0].at
+            following = heap[-1].at if self.lined else heap[0].at
+            if self.droppable_at <= following and (following == at
+                                                    or following < self.horizon):
+                self._come_due(following, True)     # (what runs next is due by then)
+                following = heap[-1].at if self.lined else heap[0].at
             if following != at:
                 if not following < self.horizon:
                     return          # something else comes first: SimPy's turn
@@ -244,10 +378,19 @@ class Timers:
             if not ahead or not rows or self.shared:
                 return
             following = rows[0][0]
+            if self.droppable_at <= following and (following == at
+                                                    or following < self.horizon):
+                self._come_due(following, True)     # (what runs next is due by then)
+                following = rows[0][0]
             if following != at:
                 if not following < self.horizon:
                     return          # something else comes first: SimPy's turn
                 self.lagging = True
+
+    def _line_up(self) -> None:
+        """The heap is short again: a line (see :func:`line_push`)."""
+        self.heap.sort(key=_order, reverse=True)
+        self.lined = True
 
     def catch_up(self) -> None:
         """Move SimPy's clock to the run's time (it went ahead: see the module docstring)."""
@@ -273,6 +416,8 @@ class Timers:
             self.shared = True      # it comes before what this instant schedules from now on
         if urgent:
             return                  # before every timeout of its instant anyway
+        if self.droppable_at <= at:
+            self._come_due(at, False)
         # entries due at its instant were scheduled before it, so they come first
         if any(_at(entry) == at for entry in self.heap):
             self._give_to_simpy(at)
@@ -286,7 +431,9 @@ class Timers:
         heap = self.heap
         due = [_entry(item) for item in sorted([item for item in heap if _at(item) == at],
                                                key=_order)]
-        heap[:] = sorted([item for item in heap if _at(item) != at], key=_order)  # a heap
+        # (sorted: a heap, or as a line the latest first)
+        heap[:] = sorted([item for item in heap if _at(item) != at], key=_order,
+                         reverse=self.lined)
         env = self.env
         delay = exact_delay(float(env.now), at)
         self.scheduling = True
@@ -310,6 +457,27 @@ def _order(item: Any) -> tuple[float, int]:
     if TUPLES:
         return item[0], item[1]
     return item.at, item.seq
+
+
+def line_push(line: list[Timed], entry: Timed) -> None:
+    """Insert ``entry`` into ``line``, a list sorted by ``(at, seq)`` the latest first, in its
+    place (found by bisection): the run's entries while they are few. The earliest is then
+    taken with ``line.pop()``: compiled, that and an insertion of a few places cost less
+    than :func:`heap_pop`'s sifting, which reads and type-checks an entry per comparison
+    (docs/engine-performance.md, the deadlines pass)."""
+    at = entry.at
+    seq = entry.seq
+    lo = 0
+    hi = len(line)
+    while lo < hi:
+        mid = (lo + hi) >> 1
+        other = line[mid]
+        other_at = other.at
+        if other_at > at or (other_at == at and other.seq > seq):
+            lo = mid + 1
+        else:
+            hi = mid
+    line.insert(lo, entry)
 
 
 def heap_push(heap: list[Timed], entry: Timed) -> None:

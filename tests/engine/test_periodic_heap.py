@@ -19,12 +19,7 @@ from builders import manual, pkg, proc
 from opspec.engine.builtin_performers import ScriptedUser
 from opspec.engine.dedicated import DedicatedProcessor
 from opspec.engine.simulation import Simulation
-from opspec.engine.timers import TUPLES, Timed, heap_pop, heap_push
-from opspec.engine.timers import heap_pop as _pop
-
-if TUPLES:          # from source the heap holds (at, seq, entry) tuples under heapq
-    def _pop(heap: list) -> object:     # type: ignore[no-redef, type-arg]
-        return heapq.heappop(heap)[2]
+from opspec.engine.timers import LINE_MAX, TUPLES, Timed, heap_pop, heap_push
 
 
 @pytest.mark.parametrize("seed", range(5))
@@ -36,9 +31,11 @@ def test_pops_in_time_then_scheduling_order_as_heapq(seed: int) -> None:
     reference: list[tuple[float, int, Callable[[], None]]] = []
     popped: list[Callable[[], None]] = []
     expected: list[Callable[[], None]] = []
+    sizes: set[tuple[bool, int]] = set()    # compiled: a line while short, else a heap
     for seq in range(3000):
+        sizes.add((run.lined, len(run.heap)))
         if run.heap and rng.random() < 0.45:
-            popped.append(_pop(run.heap).callback)      # type: ignore[attr-defined]
+            popped.append(run.take_first().callback)    # type: ignore[attr-defined]
             expected.append(heapq.heappop(reference)[2])
             continue
         delay = rng.choice([0.0, 0.2, 0.4, 1.0, 10.0]) + rng.choice([0, 1, 2]) * 0.2
@@ -48,10 +45,12 @@ def test_pops_in_time_then_scheduling_order_as_heapq(seed: int) -> None:
         run.timer(delay, callback)
         heapq.heappush(reference, (delay, seq, callback))
     while run.heap:
-        popped.append(_pop(run.heap).callback)          # type: ignore[attr-defined]
+        popped.append(run.take_first().callback)        # type: ignore[attr-defined]
         expected.append(heapq.heappop(reference)[2])
     assert popped == expected
     assert len({id(c) for c in expected}) == len(expected) > 1500
+    assert max(size for _lined, size in sizes) > LINE_MAX
+    assert TUPLES or {lined for lined, _size in sizes} == {True, False}
 
 
 @pytest.mark.parametrize("seed", range(3))
