@@ -17,12 +17,15 @@
 a TOML path), ``users`` (independent simulated users, default 1), ``days`` (default 1) or
 ``until`` (seconds or a duration such as ``"9h"`` / ``"09:00"``), ``seed`` (default: the
 test's seed), ``engine`` (engine options, as in ``[engine]`` of a config file), ``params``
-(package data overrides), ``branches`` (``{ GATEWAY = { FLOW = P } }``: branch
-probabilities of undecided gateways, as ``--branch``). ``then`` lines are :mod:`opspec.testing.expectations`.
+(package data overrides: each name a package data field of the spec), ``branches``
+(``{ GATEWAY = { FLOW = P } }``: branch probabilities of undecided gateways, as
+``--branch``). ``then`` lines are :mod:`opspec.testing.expectations`.
 
 Every mistake is reported when the file is collected, as ``path:line: key: what (how to
-fix)``, at the line the key or its table is written on; so is every failure of a scenario run
-(``path:line: scenario[N].then[M]: …``, the file read for lines only then).
+fix)``, at the line the key or its table is written on (a name the spec lacks too: a
+``params`` field, a ``branches`` gateway or flow, ``scenario[0].given.branches."Pill
+taken?".Yess``); so is every failure of a scenario run (``path:line: scenario[N].then[M]:
+…``, the file read for lines only then).
 """
 
 from __future__ import annotations
@@ -44,6 +47,9 @@ _TOP = ("spec", "given", "scenario", "description")
 _SCENARIO = ("name", "given", "then", "description")
 _GIVEN = ("script", "user_model", "users", "days", "until", "seed", "engine", "params",
           "branches")
+_BARE_KEY = re.compile(r"[A-Za-z0-9_-]+")
+#: a quoted part of a key (``branches."Pill taken?"``), as :func:`_key_below` writes it
+_QUOTED_PART = re.compile(r'(?<![^.])"((?:[^"\\]|\\.)*)"(?![^.])')
 
 
 @dataclass(frozen=True, slots=True)
@@ -159,12 +165,12 @@ def _given(path: Path, key: str, table: Any, rootdir: Path | None) -> dict[str, 
                 raise _error(path, f"{key}.{name}", f"{name} is a table")
             out[name] = dict(table[name])
     if "branches" in table:
-        from opspec.branch_choices import check_branches
+        from opspec.branch_choices import BranchRefusal, read_branch_table
 
         try:
-            out["branches"] = check_branches(table["branches"], "branches")
-        except ConfigurationError as error:
-            raise _error(path, f"{key}.branches", error.message, error.hint or "") from None
+            out["branches"] = read_branch_table(table["branches"])
+        except BranchRefusal as refusal:
+            raise _refused(path, f"{key}.branches", refusal) from None
     if "engine" in out:
         from opspec.engine.config import EngineConfig
 
@@ -176,6 +182,49 @@ def _given(path: Path, key: str, table: Any, rootdir: Path | None) -> dict[str, 
             raise _error(path, f"{key}.engine{option}", error.message,
                          error.hint or "") from None
     return out
+
+
+def _refused(path: Path, key: str, refusal: Any) -> ConfigurationError:
+    """A :class:`~opspec.branch_choices.BranchRefusal` of the ``branches`` table at ``key``,
+    in the file's words, at the key of the gateway or flow it is about."""
+    return _error(path, _key_below(key, refusal.at), refusal.in_file, refusal.file_hint)
+
+
+def _check_against_spec(path: Path, key: str, given: Mapping[str, Any], package: Any) -> None:
+    """The names ``given`` (the ``given`` table at ``key``) gives values to, checked against
+    the spec as a run given them checks them: a ``params`` name is a package data field (a
+    run writes the value into the package's data, where nothing reads an undeclared name),
+    a ``branches`` gateway is one the diagram leaves undecided, with these flows."""
+    from opspec.branch_choices import BranchRefusal, check_branch_table
+    from opspec.run_inputs import no_such_field
+
+    declared = {f.id for f in package.data_fields}
+    for name in given.get("params", {}):
+        if name not in declared:
+            error = no_such_field(str(name), package, "params")
+            # the key is the place: the message without the API's "params: "
+            raise _error(path, _key_below(f"{key}.params", (str(name),)),
+                         error.message.removeprefix("params: "), error.hint)
+    if given.get("branches"):
+        try:
+            check_branch_table(package, given["branches"])
+        except BranchRefusal as refusal:
+            raise _refused(path, f"{key}.branches", refusal) from None
+
+
+def _key_below(key: str, names: Sequence[str]) -> str:
+    """``key`` and the ``names`` below it as TOML writes them (``branches."Pill taken?".Yes``:
+    quoted unless bare)."""
+    return ".".join([key, *(n if _BARE_KEY.fullmatch(n) else _quoted(n) for n in names)])
+
+
+def _quoted(name: str) -> str:
+    return '"' + name.replace("\\", "\\\\").replace('"', '\\"') + '"'
+
+
+def _unquoted(key: str) -> str:
+    """``key`` with its quoted parts as the file's keys are looked up (:func:`located`)."""
+    return _QUOTED_PART.sub(lambda m: re.sub(r"\\(.)", r"\1", m.group(1)), key)
 
 
 def _inline_script(path: Path, key: str, steps: Any) -> Script:
@@ -240,7 +289,7 @@ def _at_its_line(error: ConfigurationError, path: Path, full: Path) -> Configura
     if (type(error) is not ConfigurationError or at is None or at.line is not None
             or at.path != str(path) or not at.key):
         return error
-    line = located(str(full), at.key).line
+    line = located(str(full), _unquoted(at.key)).line
     if line is None:
         return error
     return ConfigurationError(error.message, location=replace(at, line=line), hint=error.hint)
@@ -264,11 +313,13 @@ def _load(path: Path, full: Path, rootdir: Path | None) -> ScenarioDocument:
     from opspec.testing.simulation import spec_names
 
     try:
-        compiled = compile_package(open_gated(spec_path)[0])
+        package = open_gated(spec_path)[0]
+        compiled = compile_package(package)
         names = spec_names(compiled)
     except OpspecError as error:
         raise _error(path, "spec", f"the spec does not load: {error}") from None
     defaults = _given(path, "given", document.get("given", {}), rootdir)
+    _check_against_spec(path, "given", defaults, package)
     entries = document.get("scenario")
     if not isinstance(entries, list) or not entries:
         raise _error(path, "scenario", "no [[scenario]] tables",
@@ -287,6 +338,7 @@ def _load(path: Path, full: Path, rootdir: Path | None) -> ScenarioDocument:
             raise _error(path, f"{key}.name", f"scenario name {name!r} is used twice")
         seen.add(name)
         own = _given(path, f"{key}.given", entry.get("given", {}), rootdir)
+        _check_against_spec(path, f"{key}.given", own, package)
         inherited = {k: v for k, v in defaults.items()
                      if not ({k, *own} >= {"days", "until"})}   # own days/until win
         given = {**inherited, **own}
