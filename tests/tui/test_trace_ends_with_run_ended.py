@@ -157,3 +157,6 @@ def test_a_session_quit_with_a_bound_device_ends_its_trace_whole(
     # end" (of the run, d2 00:00) for a session left at 08:00
     assert f"unfinished {when}: alarm: sound_alarm (instance" in printed.out
     assert "unfinished at the end" not in printed.out
+    # and that the printed replays simulate the device instead
+    assert ("Both replays simulate alarm, performed here by a bound device: their numbers "
+            "may differ from this session's.") in printed.out
