@@ -227,8 +227,11 @@ def run(args: argparse.Namespace) -> int:
     if device_report:                          # how the bound devices did, as opspec run says
         from opspec.commands.devices_summary import device_lines
 
-        print("\n".join(device_lines(device_report, "when interrupted" if interrupted
-                                      else "at the end")))
+        # when the work was found unfinished: not "at the end" of a run the person left
+        when = ("when interrupted" if interrupted
+                else "when the run failed" if session.failure is not None
+                else "at the end" if session.ended else "when the session was quit")
+        print("\n".join(device_lines(device_report, when)))
     return 130 if interrupted else 1 if session.failure is not None else 0
 
 

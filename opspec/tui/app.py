@@ -34,7 +34,7 @@ from textual.widgets import Digits, Footer, Static
 
 from opspec.engine.lane_labels import lane_labels
 from opspec.tui.interrupt import watch_interrupts
-from opspec.tui.modals import HELP, HelpScreen, SummaryScreen
+from opspec.tui.modals import HELP, HelpScreen, SummaryScreen, help_text
 from opspec.tui.pace import Pace
 from opspec.tui.session import WalkSession, clock, time_of_day_shown
 from opspec.tui.sound import Cue
@@ -370,7 +370,9 @@ class WalkthroughApp(App[str | None]):
             self.refresh_views()
 
     def action_help(self) -> None:
-        self._push_paused(HelpScreen())
+        session = self.session
+        self._push_paused(HelpScreen(help_text(replaying=session.replaying,
+                                               recording=session.record_path is not None)))
 
     def action_summary(self) -> None:
         if not isinstance(self.screen, SummaryScreen):

@@ -165,7 +165,7 @@ class WalkSession(SessionClock, PersonLane, TraceFollower, Recording):
                       *metric_lines(metrics, medians, self.compiled.package.metrics)]
         if self.has_user_lane and not self.replaying:
             lines += ["", "Your response times (wall clock, from the offer to your key):",
-                      *response_lines(self.responses)]
+                      *response_lines(self.responses, recorded=self.record_path is not None)]
         if self.record_path is not None:
             stopped = final and not self.ended and self.failure is None
             # the end to replay to: where the person quit, or a --days / --until of its own
@@ -177,4 +177,10 @@ class WalkSession(SessionClock, PersonLane, TraceFollower, Recording):
                       f"Trace (for opspec fit): {self.record_path.with_suffix('.trace.jsonl')}"
                       + (f" (person {self.person})" if self.person is not None else ""),
                       f"Replay it with: {walk}", f"           or: {run}"]
+            bound = sorted({p for ps in self.board.device_participants.values() for p in ps})
+            if bound:
+                # the replays bind nothing: what the devices did (their timing, a fault, an
+                # answer that never came) is not what the spec's simulated devices do
+                lines.append(f"Both replays simulate {', '.join(bound)}, performed here by a "
+                             "bound device: their numbers may differ from this session's.")
         return lines

@@ -163,6 +163,7 @@ class SessionClock(SessionState):
         if self.now >= self.horizon - 1e-9 and not self.ended:
             self.ended = True
             self.sim.check_waiting(horizon=self.horizon)
+            self._trace_run_ended()        # as opspec run's trace ends (session_record)
         return True, steps
 
     # ------------------------------------------------------------------ a call from the device

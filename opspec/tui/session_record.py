@@ -3,9 +3,13 @@ the lane is handed over) written at once to the recording, a script ``opspec run
 replays, and every trace event to ``<recording>.trace.jsonl`` with how long the person took
 (for ``opspec fit``). The trace also keeps where the session ended, which the script cannot
 hold: the run's end in its header (``until``), and a ``walkthrough.quit`` event where the
-person quit before it, so that a replay ends there too (:func:`opspec.tui.replay.recorded_end`),
-and what is traced when the session closes (:meth:`Recording.before_close`: the bound devices'
-unfinished work, ``device.pending``), whoever closes it."""
+person quit before it, so that a replay ends there too (:func:`opspec.tui.replay.recorded_end`).
+Every session's trace ends as ``opspec run``'s does, with ``run.ended``
+(:meth:`Recording._trace_run_ended`): at the end of the run, or right after the
+``walkthrough.quit`` of a session quit before it (by ``q``, Ctrl+C or an interrupt); then what
+is traced when the session closes (:meth:`Recording.before_close`: the bound devices'
+unfinished work, ``device.pending``, which ``opspec run`` also traces after ``run.ended``),
+whoever closes it. A run that failed has no ``run.ended``, as in ``opspec run``."""
 
 from __future__ import annotations
 
@@ -17,6 +21,7 @@ from pathlib import Path
 from typing import Any
 
 from opspec.engine.performers import WorkItem
+from opspec.engine.trace import EventKind
 from opspec.errors import ConfigurationError
 from opspec.tui.replay import QUIT
 from opspec.tui.session_state import SessionState
@@ -96,16 +101,28 @@ class Recording(SessionState):
         reach a closed trace."""
         self._closing.append(hook)
 
+    def _trace_run_ended(self) -> None:
+        """Trace ``run.ended`` (``open`` instances, ``deadlocks``), as ``opspec run`` does when
+        its run returns: a stored trace's readers take the run's end from it
+        (:func:`opspec.properties.evaluator.trace_end`; without it, the last event's time,
+        and what was still pending at the end would be judged too early)."""
+        sim = self.sim
+        sim.session.trace(EventKind.RUN_ENDED, {"open": len(sim.live),
+                                                "deadlocks": len(sim.deadlocks)})
+
     def close(self) -> None:
         hooks, self._closing = self._closing, []        # once, however often it is closed
         try:
-            for hook in hooks:
-                hook()
+            try:
+                if self._trace_file is not None and not self.ended and self.failure is None:
+                    # the person quit here: a replay of the recording ends here too
+                    # (opspec.tui.replay.recorded_end), and so does the run
+                    self.sim.session.trace(QUIT, {"until": self.now})
+                    self._trace_run_ended()
+            finally:
+                for hook in hooks:          # after run.ended, as in opspec run's trace
+                    hook()
         finally:
             if self._trace_file is not None:
-                if not self.ended and self.failure is None:
-                    # the person quit here: a replay of the recording ends here too
-                    # (opspec.tui.replay.recorded_end)
-                    self.sim.session.trace(QUIT, {"until": self.now})
                 self._trace_file.close()
                 self._trace_file = None

@@ -24,9 +24,10 @@ from opspec.tui.timing import Response
 __all__ = ["metric_lines", "replay_commands", "response_lines", "until_text"]
 
 
-def response_lines(responses: Sequence[Response]) -> list[str]:
+def response_lines(responses: Sequence[Response], *, recorded: bool = True) -> list[str]:
     """The person's response times per action (wall clock), and how many are usable for
-    ``opspec fit`` (with the reasons the others are not)."""
+    ``opspec fit`` (with the reasons the others are not); not ``recorded`` (``--no-record``),
+    none is: there is no trace to fit."""
     if not responses:
         return ["  (you answered nothing)"]
     per: dict[str, list[float]] = {}
@@ -36,6 +37,9 @@ def response_lines(responses: Sequence[Response]) -> list[str]:
     width = max((len(label) for label in per), default=0)
     lines = [f"  {label:<{width}}  median {median(times):.1f} s, max {max(times):.1f} s, "
              f"n {len(times)}" for label, times in per.items()]
+    if not recorded:
+        lines.append("  (nothing was recorded: opspec fit has no trace of them)")
+        return lines
     usable = sum(1 for r in responses if r.usable)
     why = Counter(r.why for r in responses if not r.usable and r.why)
     # the count after its reason: "2x the clock ran at 60x" read as a speed

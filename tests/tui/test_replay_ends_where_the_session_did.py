@@ -103,9 +103,10 @@ def test_the_replay_of_a_session_quit_early_ends_where_it_was_quit(compiled, tmp
                                                                   replay):
     record = tmp_path / "P07.json"
     walked = _quit_after_the_first_dose(compiled, record)
-    last = json.loads(record.with_suffix(".trace.jsonl").read_text(encoding="utf-8")
-                      .splitlines()[-1])
-    assert last["kind"] == "walkthrough.quit" and last["data"] == {"until": walked.now}
+    quitted, ended = map(json.loads, record.with_suffix(".trace.jsonl").read_text(
+        encoding="utf-8").splitlines()[-2:])
+    assert quitted["kind"] == "walkthrough.quit" and quitted["data"] == {"until": walked.now}
+    assert ended["kind"] == "run.ended" and ended["time"] == walked.now   # the run ends there
     assert recorded_end(record) == walked.now                   # exactly
     shown = _metric_lines(walked.summary_lines())
     assert any(line.split() == ["doses_missed", "0"] for line in shown)
