@@ -46,7 +46,7 @@ def _app_that(action: str) -> type:
     return App
 
 
-@pytest.mark.parametrize(("action", "when", "status"), [("quit", "at the end", 0),
+@pytest.mark.parametrize(("action", "when", "status"), [("quit", "when the session was quit", 0),
                                                         ("ctrl-c", "when interrupted", 130)])
 def test_the_walkthrough_ends_saying_how_the_devices_did(
         monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str],
