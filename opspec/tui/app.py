@@ -407,10 +407,10 @@ class WalkthroughApp(App[str | None]):
         if not self._views_ready:
             return
         session = self.session
+        summary = False
         if session.ended and not self._summary_shown:
             self._summary_shown = True           # once: the end of the run in words
-            if not isinstance(self.screen, HelpScreen):
-                self._open_summary()
+            summary = not isinstance(self.screen, HelpScreen)
         # the state comes first: the line is cut at the right in a narrow terminal
         state = ("[ENDED]" if session.ended
                  else "[waiting for the device]" if session.waiting_for_devices
@@ -471,6 +471,11 @@ class WalkthroughApp(App[str | None]):
             Text(session.aftermath.text()) if session.person_performs or session.ended
             else Text())
         self.query_one("#timeline", Static).update(self._timeline_text())
+        if summary:
+            # after the frame that shows [ENDED] on the status line: pushed in this same
+            # refresh, the summary could cover the line before it was ever drawn, and a
+            # screen reader or a browser page following the status line missed the end
+            self.call_after_refresh(self._open_summary)
 
     def _idle_text(self) -> str:
         """The person's panel when the device is not calling: one line saying what now."""
