@@ -20,6 +20,7 @@ from __future__ import annotations
 from collections.abc import Iterator, Mapping
 
 from opspec.engine.compiled import CompiledPackage
+from opspec.engine.lanes import all_activities
 from opspec.engine.performers import Performer, PerformerSession, WorkItem
 
 __all__ = ["PerformerRegistry", "SharedApplication", "spec_names"]
@@ -30,16 +31,10 @@ def spec_names(compiled: CompiledPackage) -> set[str]:
     (nested blocks included): the names a performer is bound under for one participant's
     work."""
     names: set[str] = set()
-    for proc in compiled.processes.values():
-        graphs = [proc.graph]
-        while graphs:
-            graph = graphs.pop()
-            for act in graph.activities:
-                if act.participant is not None:
-                    names.add(act.participant)
-                names.update(act.lanes)
-                if act.block is not None:
-                    graphs.append(act.block)
+    for act in all_activities(compiled):
+        if act.participant is not None:
+            names.add(act.participant)
+        names.update(act.lanes)
     return names
 
 
