@@ -28,6 +28,13 @@ BPMN_CONSTRUCTS: tuple[Construct, ...] = (
     # -- sequence flow ------------------------------------------------------------------------
     _c("bpmn-process", BPMN, "definitions process", None, R,
        "each process is a workflow; its instances run on the simulated clock", "§10.1, §13"),
+    _c("bpmn-non-executable", BPMN, "process", "isExecutable", W,
+       "opspec runs it all the same, as drawn, by the execution semantics of §13 (a "
+       "non-executable process is modelled to document behaviour, not to be executed, and "
+       "may leave out what execution needs, such as formal conditions)",
+       "§10.2, Table 10.1", when="false",
+       hint="set isExecutable=\"true\" when the process is meant to run as drawn; the run "
+       "is the same either way"),
     _c("bpmn-sequence-flow", BPMN, "sequenceFlow", None, R,
        "a token moves along it when its source completes", "§13.2"),
     _c("bpmn-flow-ends", BPMN, "sequenceFlow", "sourceRef", R,

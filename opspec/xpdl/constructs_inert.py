@@ -26,8 +26,7 @@ INERT: tuple[Inert, ...] = (
           "artifacts and documentation: BPMN §7.2 (they do not affect the flow)"),
     Inert(BPMN, ("definitions",), ("exporter", "exporterVersion", "targetNamespace",
                                    "typeLanguage"), _META, include_elements=False),
-    Inert(BPMN, ("process",), ("isExecutable", "isClosed", "processType",
-                               "definitionalCollaborationRef"),
+    Inert(BPMN, ("process",), ("isClosed", "processType", "definitionalCollaborationRef"),
           "process metadata: every process of the file runs", include_elements=False),
     Inert(BPMN, ("extensionElements", "extension"), ("*",),
           "extensions: opspec's own are directives (docs/bpmn.md), others kept and reported "

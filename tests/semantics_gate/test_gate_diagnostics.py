@@ -230,6 +230,22 @@ def test_a_node_fed_only_by_an_ignored_boundary_event_is_not_reported():
     assert (_line(data, '<task id="undo"'), "runs-differently") not in found
 
 
+def test_a_non_executable_process_is_run_and_said_to_be():
+    """BPMN 2.0 Table 10.1 (isExecutable): "A non-executable Process is a private Process that
+    has been modeled for the purpose of documenting Process behavior at a modeler-defined
+    level of detail." The standard runs no such process; opspec simulates it as drawn, and
+    says so at the process's line. An executable process, or one that does not say, is quiet
+    (the attribute is optional)."""
+    body = '<startEvent id="s"/>\n<endEvent id="e"/>\n<sequenceFlow id="f" sourceRef="s" targetRef="e"/>\n'
+    documented = _bpmn(body).replace(b'isExecutable="true"', b'isExecutable="false"')
+    found = _gate(documented)
+    assert [(line, code) for line, code, _m in found] == [
+        (_line(documented, '<process id="p"'), "runs-differently")]
+    assert "isExecutable='false'" in found[0][2] and "opspec runs it" in found[0][2]
+    assert _gate(_bpmn(body)) == []
+    assert _gate(_bpmn(body).replace(b' isExecutable="true"', b"")) == []
+
+
 def _xpdl(activities: str, transitions: str = "", sets: str = "") -> bytes:
     return (f'<Package xmlns="{XPDL21}" Id="pk">\n<WorkflowProcesses>\n'
             f'<WorkflowProcess Id="w">{sets}<Activities>\n{activities}</Activities>\n'
