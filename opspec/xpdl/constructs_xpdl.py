@@ -216,6 +216,16 @@ XPDL_CONSTRUCTS: tuple[Construct, ...] = (
     _c("xpdl-deadlines", XPDL, "Deadline DeadlineDuration ExceptionName", None, R,
        "when the duration has passed, the activity is interrupted (SYNCHR) or the exception "
        "path starts beside it (ASYNCHR)", "§7.6.8"),
+    _c("xpdl-duration-unit", XPDL, "DeadlineDuration DeadlineCondition TimeCycle", None, W,
+       "a bare number is read as seconds, not in the unit the process header's DurationUnit "
+       "names (XPDL applies it to \"an integer duration value that has no unit tag\")",
+       "Process Header (DurationUnit), §7.6.8", when="unitless-in-other-unit",
+       hint="write the unit with the number (PT2H, 2 h, 120 min)"),
+    _c("xpdl-duration-unit-attr", XPDL, "TriggerTimer", "TimeCycle", W,
+       "a bare number is read as seconds, not in the unit the process header's DurationUnit "
+       "names (XPDL applies it to \"an integer duration value that has no unit tag\")",
+       "Process Header (DurationUnit), §7.6.2", when="unitless-in-other-unit",
+       hint="write the unit with the number (PT2H, 2 h, 120 min)"),
     _c("xpdl-deadline-execution", XPDL, "Deadline", "Execution", R, "SYNCHR or ASYNCHR",
        "§7.6.8"),
     _c("xpdl-mi-deadline", XPDL, "Deadline", None, R,

@@ -11,6 +11,7 @@ quiet; a quantity of 2 is not).
 
 from __future__ import annotations
 
+import re
 from collections.abc import Callable, Iterable, Iterator
 from dataclasses import dataclass
 
@@ -315,6 +316,22 @@ def _not_a_date(element: etree._Element, value: str | None, doc: _Doc) -> bool:
         return False            # an impossible date: the reader's bad-timer error says it
 
 
+_UNITLESS = re.compile(r"\s*\d+(?:\.\d*)?\s*")
+
+
+def _unitless_in_other_unit(element: etree._Element, value: str | None, doc: _Doc) -> bool:
+    """A time value written as a bare number (element text or attribute) in a process whose
+    header's DurationUnit is not seconds: XPDL applies that unit to "an integer duration
+    value that has no unit tag"; opspec reads the number as seconds."""
+    text = "".join(element.itertext()) if value is None else value
+    if not _UNITLESS.fullmatch(text):
+        return False
+    process = next((a for a in _ancestors(element) if _local(a) == "WorkflowProcess"), None)
+    header = next(_children(process, "ProcessHeader"), None) if process is not None else None
+    unit = (header.get("DurationUnit") or "").strip() if header is not None else ""
+    return unit not in ("", "s")
+
+
 def _throws(element: etree._Element, value: str | None, doc: _Doc) -> bool:
     parent = element.getparent()
     return ((element.get("CatchThrow") or "").strip().upper() == "THROW"
@@ -383,6 +400,7 @@ CONDITIONS: dict[str, _Condition] = {
     "attached-timer": _attached_timer,
     "terminate-in-activity-set": _terminate_in_activity_set,
     "throws": _throws,
+    "unitless-in-other-unit": _unitless_in_other_unit,
     "not-a-date": _not_a_date,
     "on-multi-instance": _on_multi_instance,
     "fed-only-by-ignored": _fed_only_by_ignored,

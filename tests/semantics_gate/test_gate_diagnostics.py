@@ -259,6 +259,30 @@ def _xpdl_gate(data: bytes) -> list[tuple[int | None, str, str]]:
             if d.code in ("runs-differently", "not-run")]
 
 
+@pytest.mark.parametrize(("unit", "value", "said"), [
+    ("h", "2", True), ("D", " 30 ", True), ("m", "1.5", True),
+    ("s", "2", False), (None, "2", False),
+    ("h", "PT2H", False), ("h", "2 h", False), ("h", "timeout * 60", False)])
+def test_a_bare_number_in_another_duration_unit_is_said(unit, value, said):
+    """XPDL's Process Header, DurationUnit: "Describes the default unit to be applied to an
+    integer duration value that has no unit tag." opspec reads a bare number as seconds
+    (docs/sisarl-xpdl.md), so a DeadlineDuration or TimeCycle of ``2`` under
+    ``DurationUnit="h"`` is said at its line; one with its unit, an expression, or a header
+    in seconds (or none) is quiet."""
+    header = f'<ProcessHeader DurationUnit="{unit}"/>' if unit else "<ProcessHeader/>"
+    deadline = (f'<Activity Id="a"><Deadline Execution="SYNCHR"><DeadlineDuration>{value}'
+                '</DeadlineDuration><ExceptionName>late</ExceptionName></Deadline></Activity>\n')
+    timer = (f'<Activity Id="t"><Event><IntermediateEvent Trigger="Timer"><TriggerTimer>'
+             f'<TimeCycle>{value}</TimeCycle></TriggerTimer></IntermediateEvent></Event>'
+             '</Activity>\n')
+    data = _xpdl(deadline + timer, sets=header)
+    found = {(line, code) for line, code, message in _xpdl_gate(data)
+             if "DurationUnit" in message}
+    expected = {(_line(data, "<DeadlineDuration>"), "runs-differently"),
+                (_line(data, "<TimeCycle>"), "runs-differently")}
+    assert found == (expected if said else set())
+
+
 def test_xpdl_several_start_events_are_not_reported():
     """BPMN 2.0 §10.4.2, which XPDL 2.1's events follow: "Each Start Event is an independent
     Event." opspec starts an instance per triggered start event (tests/standard_constructs runs it; the gate is quiet)."""
