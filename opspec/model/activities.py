@@ -283,6 +283,9 @@ class Activity(Element):
     # sends down each outgoing transition it takes (thread split, WCP-42)
     start_quantity: int = 1
     completion_quantity: int = 1
+    # XPDL 2.x Activity StartActivity="true": where an instance starts when nothing else
+    # says (every activity of the level has an incoming transition, no start event)
+    marked_start: bool = False
 
     @property
     def is_route(self) -> bool:

@@ -363,7 +363,8 @@ def _flow(process: WorkflowProcess, aset: ActivitySet | None, graph: FlowGraph,
                      f"{scope} has no start activity: every activity has an incoming "
                      "transition and there is no start event",
                      "add a start event (or an activity without incoming transitions) in "
-                     "front of the cycle")
+                     "front of the cycle, or mark where it starts (XPDL: "
+                     "StartActivity=\"true\")")
         return
     reached = graph.reachable(starts)
     for activity in graph.by_id.values():

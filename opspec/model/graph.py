@@ -102,14 +102,17 @@ class FlowGraph:
 
         ``start_activity`` (a BlockActivity's StartActivityId) wins when it names an activity
         of the level; otherwise every activity without incoming transitions that is not a
-        boundary event, in file order.
+        boundary event, in file order; where there is none (a cycle), the activities marked
+        StartActivity="true" (XPDL: "Used when there is no other way to determine this").
         """
         if start_activity is not None and start_activity in self.by_id:
             return (start_activity,)
-        return tuple(
+        natural = tuple(
             key for key, activity in self.by_id.items()
             if not self.incoming[key] and (attached_to(activity) or "") not in self.by_id
         )
+        return natural or tuple(key for key, activity in self.by_id.items()
+                                if activity.marked_start)
 
     def reachable(self, sources: Iterable[str], *, avoid: Iterable[str] = ()) -> frozenset[str]:
         """Activities reachable from ``sources`` (included) without entering ``avoid``."""

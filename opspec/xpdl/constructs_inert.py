@@ -118,7 +118,7 @@ INERT: tuple[Inert, ...] = (
     Inert(XPDL, ("Activity", "WorkflowProcess", "Package", "ActivitySet", "BlockActivity",
                  "SubFlow", "Route", "Pool", "ProcessHeader", "RedefinableHeader", "Lane",
                  "MessageFlow", "Transition", "TransitionRef", "Application"),
-          ("Status", "StartActivity", "AccessLevel", "ProcessType", "View", "MarkerVisible",
+          ("Status", "AccessLevel", "ProcessType", "View", "MarkerVisible",
            "BoundaryVisible", "MainPool", "Orientation", "DurationUnit", "PublicationStatus",
            "Instantiation"),
           "display, access and status flags: " + _LAYOUT, include_elements=False),

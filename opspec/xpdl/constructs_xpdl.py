@@ -94,6 +94,18 @@ XPDL_CONSTRUCTS: tuple[Construct, ...] = (
        "Manual: the activity waits for its performer", "§7.6"),
     _c("xpdl-finish-mode", XPDL, "Activity", "FinishMode", R,
        "Manual: the activity waits for its performer", "§7.6"),
+    _c("xpdl-start-activity", XPDL, "Activity", "StartActivity", R,
+       "where every activity of the level has an incoming transition (a cycle, no start "
+       "event), instances start at the activities marked true (\"Used when there is no other "
+       "way to determine this\")", "§7.6 (Activity, StartActivity)"),
+    _c("xpdl-start-activity-overruled", XPDL, "Activity", "StartActivity", W,
+       "ignored: instances start at the level's activities without incoming transitions, "
+       "not at this one, which has an incoming transition (XPDL designates it \"the first "
+       "activity to be executed\" but uses it only \"when there is no other way to determine "
+       "this\")", "§7.6 (Activity, StartActivity)",
+       when="start-activity-overruled",
+       hint="remove the incoming transitions of the activities the process does not start "
+       "at, or remove StartActivity"),
     _c("xpdl-quantities", XPDL, "Activity", "StartQuantity", R,
        "the activity waits for StartQuantity tokens (thread merge, WCP-41)", "§7.6",
        when="not-one"),

@@ -332,6 +332,16 @@ def _unitless_in_other_unit(element: etree._Element, value: str | None, doc: _Do
     return unit not in ("", "s")
 
 
+def _start_activity_overruled(element: etree._Element, value: str | None, doc: _Doc) -> bool:
+    """StartActivity="true" on an activity with an incoming transition, in a level that has
+    an activity without one: instances start there, not here."""
+    if (value or "").strip().lower() != "true" or not doc.incoming.get(element.get("Id") or ""):
+        return False
+    level = element.getparent()
+    return level is not None and any(
+        not doc.incoming.get(other.get("Id") or "") for other in _children(level, "Activity"))
+
+
 def _throws(element: etree._Element, value: str | None, doc: _Doc) -> bool:
     parent = element.getparent()
     return ((element.get("CatchThrow") or "").strip().upper() == "THROW"
@@ -400,6 +410,7 @@ CONDITIONS: dict[str, _Condition] = {
     "attached-timer": _attached_timer,
     "terminate-in-activity-set": _terminate_in_activity_set,
     "throws": _throws,
+    "start-activity-overruled": _start_activity_overruled,
     "unitless-in-other-unit": _unitless_in_other_unit,
     "not-a-date": _not_a_date,
     "on-multi-instance": _on_multi_instance,

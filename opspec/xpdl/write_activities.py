@@ -138,6 +138,8 @@ def write_activity(parent: etree._Element, activity: Activity, script_language: 
         element.set("StartQuantity", str(activity.start_quantity))
     if activity.completion_quantity != 1:
         element.set("CompletionQuantity", str(activity.completion_quantity))
+    if activity.marked_start:
+        element.set("StartActivity", "true")
     if activity.description is not None:
         sub(element, "Description", activity.description)
     _write_body(element, activity, script_language)

@@ -210,19 +210,22 @@ def _starts(proc: WorkflowProcess, name: str, activities: tuple[Activity, ...],
             acts: list[CompiledActivity], incoming: dict[int, list[int]],
             by_id: dict[str, int], start: str | None) -> tuple[int, ...]:
     """Where a graph's instances start: the named start activity, else every activity
-    without an incoming transition (boundary events excepted)."""
+    without an incoming transition (boundary events excepted), else (a cycle) the activities
+    marked StartActivity="true" (:meth:`opspec.model.graph.FlowGraph.starts`)."""
     if start is not None:
         if start not in by_id:
             raise spec_error(f"start activity {start!r} is not in {name!r}", None)
         return (by_id[start],)
     starts = tuple(i for i in range(len(activities))
                    if not incoming[i] and acts[i].attached_to < 0)
+    if not starts:
+        starts = tuple(i for i, activity in enumerate(activities) if activity.marked_start)
     if activities and not starts:
         raise spec_error(
             f"{name!r} has no start activity: every activity has an incoming "
             f"transition", proc.location,
             "add a start event (or an activity without incoming transitions) in "
-            "front of the cycle")
+            "front of the cycle, or mark where it starts (XPDL: StartActivity=\"true\")")
     return starts
 
 

@@ -303,8 +303,16 @@ def build_activity(element: etree._Element, ctx: BuildContext) -> Activity:
         assignments=build_assignments(element, ctx) if has("Assignments") else (),
         start_quantity=quantity(element, "StartQuantity", ctx),
         completion_quantity=quantity(element, "CompletionQuantity", ctx),
+        marked_start=_marked_start(element),
         **fields,
     )
+
+
+def _marked_start(element: etree._Element) -> bool:
+    """XPDL 2.x ``StartActivity="true"``: "Designates the first activity to be executed when
+    the process is instantiated. Used when there is no other way to determine this"
+    (:meth:`opspec.model.graph.FlowGraph.starts`)."""
+    return (attr(element, "StartActivity") or "").strip().lower() == "true"
 
 
 def _bare_activity(element: etree._Element, ctx: BuildContext) -> Activity:
@@ -320,5 +328,6 @@ def _bare_activity(element: etree._Element, ctx: BuildContext) -> Activity:
         coordination=coordination,
         start_quantity=quantity(element, "StartQuantity", ctx),
         completion_quantity=quantity(element, "CompletionQuantity", ctx),
+        marked_start=_marked_start(element),
         **fields,
     )
