@@ -43,6 +43,7 @@ from opspec.model.process import (
     Transition,
     WorkflowProcess,
 )
+from opspec.model.unpassed_parameters import unpassed_parameters
 
 __all__ = ["check_package", "check_process"]
 
@@ -76,6 +77,7 @@ def _check_package(package: Package, packages: Mapping[str, Package]) -> list[Di
     refs.sisarl()
     for process in package.processes:
         _check_process(process, package, refs, report)
+    unpassed_parameters(package, packages, report)
     from opspec.model.checks_triggers import trigger_name_diagnostics
 
     return [*report.diagnostics, *trigger_name_diagnostics(package, packages)]

@@ -41,6 +41,7 @@ from opspec.model import (
     Loop,
     MetricDefinition,
     MetricKind,
+    ParameterMode,
     Name,
     Participant,
     Pool,
@@ -102,6 +103,30 @@ def test_a_data_field_with_a_formal_parameters_id_is_one_variable_with_a_warning
     found = one(diagnostics, "parameter-data-field")
     assert found.severity is Severity.WARNING and found.location.line == 20
     assert "formal parameter 'n' (line 19)" in found.message and "one variable" in found.message
+
+
+def test_an_in_parameter_of_a_process_nothing_calls_is_said_to_start_null() -> None:
+    """XPDL gives a process's IN parameters their values from its invoker (a SubFlow's
+    actual parameters); a process no SubFlow calls is started by opspec itself, with the
+    parameter null. Said at the parameter, for IN and INOUT (not OUT), unless a DataField of
+    its Id gives it an initial value or a SubFlow calls the process."""
+    formals = (FormalParameter(id="dose", type=INT, location=loc(19)),
+               FormalParameter(id="count", type=INT, mode=ParameterMode.INOUT,
+                               location=loc(20)),
+               FormalParameter(id="result", type=INT, mode=ParameterMode.OUT,
+                               location=loc(21)))
+    found = [(d.location.line, d.severity) for d in check_package(
+        package(process(formal_parameters=formals))) if d.code == "unpassed-parameter"]
+    assert found == [(19, Severity.WARNING), (20, Severity.WARNING)]
+    with_default = package(process(formal_parameters=formals, data_fields=(field("dose", 30),)))
+    assert [d.location.line for d in check_package(with_default)
+            if d.code == "unpassed-parameter"] == [20]
+    callee = process(formal_parameters=formals)
+    caller = process("Caller", activities=(start("s", 40), act("call", 41, body=SubFlow(
+        process=callee.id, actual_parameters=(ActualParameter(text="1"),) * 3)), end("e", 42)),
+        transitions=(tr("c1", "s", "call", 43), tr("c2", "call", "e", 44)))
+    called = package(caller, callee)
+    assert not [d for d in check_package(called) if d.code == "unpassed-parameter"]
 
 
 def test_activity_ids_are_scoped_per_process_and_per_activity_set() -> None:
@@ -265,7 +290,8 @@ def test_formal_parameters_and_package_fields_are_in_scope() -> None:
     model = package(process(activities=(start(), work, end()),
                             formal_parameters=(FormalParameter(id="hour", type=INT),)),
                     data_fields=(field("dose"),))
-    assert check_package(model) == []
+    # in scope: no undefined-name; only that nothing passes 'hour' to a process run on its own
+    assert [d.code for d in check_package(model)] == ["unpassed-parameter"]
 
 
 def test_a_subflow_to_a_missing_process_is_an_error_and_one_into_another_package_too() -> None:
