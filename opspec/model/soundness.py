@@ -295,6 +295,7 @@ def _livelock(process: str, graph: FlowGraph, net: TokenNet, space: _Space,
     walk: list[str] = []
     loop: list[str] = []
     seen = {state: 0}
+    path = [state]
     node = state
     while len(space.successors(node)):
         nxt = space.successors(node)[0]
@@ -303,13 +304,24 @@ def _livelock(process: str, graph: FlowGraph, net: TokenNet, space: _Space,
             loop = walk[seen[nxt]:]
             break
         seen[nxt] = len(walk)
+        path.append(nxt)
         node = nxt
-    active = net.holders(_unpack(space.keys[state])[0])
+    # placed where the tokens enter the loop (the first state of the walk that holds one at
+    # an activity of the loop), not at the first lost state, which is often the start event
+    # of a process lost from its start
+    in_loop = set(loop)
+    entered = next((n for n in path
+                    if in_loop.intersection(net.holders(_unpack(space.keys[n])[0]))), state)
+    holders = net.holders(_unpack(space.keys[entered])[0])
+    active = [a for a in holders if a in in_loop] or holders
     where = active[0] if active else None
+    if where in in_loop:        # the loop's activities named from where it is entered
+        turn = loop.index(where)
+        loop = loop[turn:] + loop[:turn]
     names = ", ".join(dict.fromkeys(loop)) or ", ".join(active)
     return [Problem(
         "livelock", process, where,
-        "livelock: from here the process can never complete, it loops for ever through "
+        "livelock: once here the process can never complete, it loops for ever through "
         f"{names} (give the loop a way out)", (*space.witness(state), *walk),
         _line(graph, where))]
 

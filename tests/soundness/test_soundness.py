@@ -438,10 +438,12 @@ def test_livelock_witness_leads_into_the_loop():
                    transitions=(tr("t0", "start", "a"), tr("t1", "a", "b"),
                                 tr("t2", "b", "a")))
     livelock = next(p for p in problems(proc) if p.kind == "livelock")
-    # from the start on, completion is impossible: the witness runs once round the loop
+    # from the start on, completion is impossible: the witness runs once round the loop,
+    # and the problem is placed where the tokens enter the loop (line 11, "a"), not at the
+    # start event, which has nothing to change
     assert livelock.witness == ("start", "a", "b", "a")
-    assert livelock.activity == "start" and "never complete" in livelock.message
-    assert "through b, a" in livelock.message
+    assert livelock.activity == "a" and livelock.line == 11
+    assert "never complete" in livelock.message and "through a, b" in livelock.message
     assert [p.kind for p in problems(proc)] == ["livelock"]
 
 
