@@ -431,7 +431,9 @@ class WalkthroughApp(App[str | None]):
                else "you perform the lane")
         pace = self._pace.shown() if state == "running" else ""
         if session.call_mode and state == "running":
-            state = "running in real time: the device calls"
+            # the call goes on after the alarm stopped, until nothing waits for the person
+            state = ("running in real time: the device calls" if session.calling
+                     else "running in real time while something waits for you")
         self.query_one("#status", Static).update(Text(
             f"{clock(session.now)}  {session.speed:g}x{pace}  {state}  |  {who}  |  "
             f"{self.spec_title}", no_wrap=True, overflow="ellipsis"))
