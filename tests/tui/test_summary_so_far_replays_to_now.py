@@ -10,8 +10,8 @@ from __future__ import annotations
 import shlex
 
 import pytest
-from conftest import SPEC
 
+from conftest import SPEC
 from opspec.cli import main
 from opspec.run_rules import parse_until
 from opspec.tui.app import SummaryScreen, WalkthroughApp
