@@ -34,7 +34,7 @@ from textual.widgets import Digits, Footer, Static
 
 from opspec.engine.lane_labels import lane_labels
 from opspec.tui.interrupt import watch_interrupts
-from opspec.tui.modals import HELP, HelpScreen, SummaryScreen, help_text
+from opspec.tui.modals import HELP, HelpScreen, SummaryScreen, session_help
 from opspec.tui.pace import Pace
 from opspec.tui.session import WalkSession, clock, time_of_day_shown
 from opspec.tui.sound import Cue
@@ -157,7 +157,9 @@ class WalkthroughApp(App[str | None]):
         Binding("w", "wait", "wait 30s"),
         Binding("n", "next_event", "step"),
         Binding("u", "until_user", "until me"),
+        Binding("u", "until_user('end')", "to the end"),   # nobody to wait for (check_action)
         Binding("h", "hand_over", "model/me"),
+        Binding("h", "hand_over('none')", show=False),     # (there: says why not)
         Binding("l", "lane", "lanes", show=False),
         Binding("x", "ignore", "don't", show=False),
         Binding("s", "summary", "summary", show=False),
@@ -304,7 +306,7 @@ class WalkthroughApp(App[str | None]):
         self.session.skip_to_next_event(SLICE_STEPS)
         self.refresh_views()
 
-    def action_until_user(self) -> None:
+    def action_until_user(self, _shown: str = "") -> None:
         if self.session.skipping:           # pressed again: stop where it is
             self.session.cancel_skip()
         else:
@@ -312,7 +314,16 @@ class WalkthroughApp(App[str | None]):
             self._go_on_skipping()
         self.refresh_views()
 
-    def action_hand_over(self) -> None:
+    def check_action(self, action: str, parameters: tuple[object, ...]) -> bool | None:
+        """The footer's keys as they work in this session: in a replay, or for a spec
+        without a user lane, nothing will need the person (u runs "to the end") and nothing
+        can be handed over (h is left out of the footer; pressed, it says why)."""
+        if action in ("until_user", "hand_over"):
+            lane = self.session.has_user_lane and not self.session.replaying
+            return lane != bool(parameters)       # the binding with a parameter: no lane
+        return True
+
+    def action_hand_over(self, _shown: str = "") -> None:
         if self.session.ended:
             self.notify("The run has ended: there is nothing to hand over (q quits).",
                         severity="warning")
@@ -370,9 +381,7 @@ class WalkthroughApp(App[str | None]):
             self.refresh_views()
 
     def action_help(self) -> None:
-        session = self.session
-        self._push_paused(HelpScreen(help_text(replaying=session.replaying,
-                                               recording=session.record_path is not None)))
+        self._push_paused(HelpScreen(session_help(self.session, large=self.large)))
 
     def action_summary(self) -> None:
         if not isinstance(self.screen, SummaryScreen):
@@ -422,7 +431,9 @@ class WalkthroughApp(App[str | None]):
                else "you perform the lane")
         pace = self._pace.shown() if state == "running" else ""
         if session.call_mode and state == "running":
-            state = "running in real time: the device calls"
+            # the call goes on after the alarm stopped, until nothing waits for the person
+            state = ("running in real time: the device calls" if session.calling
+                     else "running in real time while something waits for you")
         self.query_one("#status", Static).update(Text(
             f"{clock(session.now)}  {session.speed:g}x{pace}  {state}  |  {who}  |  "
             f"{self.spec_title}", no_wrap=True, overflow="ellipsis"))
@@ -431,13 +442,15 @@ class WalkthroughApp(App[str | None]):
         self.query_one("#device", Static).update(self._device_text())
         person = self.query_one("#person", Vertical)
         call = self.query_one("#call", Static)
-        if session.calling:
+        # a run that has ended calls nobody (its alarm was ringing when it ended)
+        if session.calling and not session.ended:
             person.add_class("calling")
             banner = Text("(!) THE DEVICE CALLS YOU", style="bold reverse")
-            if session.person_performs and not session.offers:
-                # the alarm rings on after the person let it pass (x), or before their
-                # lane offers anything: say that nothing is asked of them, not a blank
-                banner.append("\n" + self._idle_text())
+            idle = self._idle_text()
+            if idle and not self._shown_offers():
+                # the alarm rings on after the person let it pass (x), before their lane
+                # offers anything, or for the recording to answer: say what now, not a blank
+                banner.append("\n" + idle)
             call.update(banner)
         else:
             person.remove_class("calling")

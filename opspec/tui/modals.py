@@ -1,15 +1,19 @@
-"""The walkthrough's two screens over the session: the help (``?``: every key) and the
+"""The walkthrough's two screens over the session: the help (``?``: its keys) and the
 summary (``s``, and by itself at the end of the run). Both stop the clock while open
 (:class:`opspec.tui.app.WalkthroughApp` pushes them paused), say in their frame how to close
 them, and scroll with the arrow keys where they do not fit (at 80 x 24 neither does).
 
-The help says what the session shown keeps (:func:`help_text`): a recording when it records,
-nothing in a replay or with ``--no-record``."""
+The help is the session's own (:func:`help_text`): it lists only the keys that do something
+in it (a replay, or a spec without a user lane, has nothing to answer and nothing to hand
+over), says what a replay lets the person do, what the clock does when the device calls, and
+what quitting keeps: a recording when it records, nothing in a replay or with
+``--no-record``."""
 
 from __future__ import annotations
 
+import textwrap
 from collections.abc import Sequence
-from typing import ClassVar
+from typing import Any, ClassVar
 
 from rich.text import Text
 from textual.app import ComposeResult
@@ -18,47 +22,98 @@ from textual.containers import VerticalScroll
 from textual.screen import ModalScreen
 from textual.widgets import Static
 
+from opspec.tui.session_clock import clock
+
 __all__ = ["CLOSE_HELP", "CLOSE_SUMMARY", "HELP", "HelpScreen", "SummaryScreen",
-           "help_text"]
+           "help_text", "session_help"]
 
-_HELP = """\
-[b]opspec walkthrough — keys[/b]
-
-  [b]a[/b]–[b]z[/b]     do the action shown next to the letter (or click it)
-  [b]x[/b]       do not do the first action (an omission{recorded})
-  [b]↑↓[/b] [b]enter[/b] pick an action, then do it (tab picks too)
-  [b]space[/b]   pause / resume the clock
-  [b]1 2 3 4[/b] speed: real time, 10x, 60x, 600x
-  [b]w[/b]       let 30 simulated seconds pass
-  [b]n[/b]       step: skip to the next event
-  [b]u[/b]       skip until something new needs you (again: stop)
-  [b]h[/b]       hand your lane to the user model / take it back
-  [b]l[/b]       timeline: all lanes / device / user
-          (/ hidden, with --large)
-  [b]s[/b]       the summary so far (metrics, your response times)
-  [b]?[/b]       this help (the clock stops while it is open)
-  [b]q[/b], [b]ctrl+c[/b], [b]ctrl+q[/b] quit ({kept})
-
-When the device calls you, the clock drops to real time (or
-pauses, with --on-call pause) and comes back when the call is
-over.
-
-Device panel: (!) an alert (a ringing alarm), (x) a device
-fault, > what a participant is doing now.
-
-Press escape or ? to close."""
+_KEYS = "[b]opspec walkthrough — keys[/b]"
+# the help's lines are at most this wide: its box is 72 columns less border and padding,
+# and less the scrollbar on a terminal too short for it (tests/tui/test_help_fits.py)
+_WIDTH = 62
 
 
-def help_text(*, replaying: bool = False, recording: bool = True) -> str:
-    """The help for a session: what quitting keeps, and whether an omission is recorded,
-    are said as they are for it (a replay and ``--no-record`` record nothing)."""
+def help_text(*, replaying: bool = False, recording: bool = True, user_lane: bool = True,
+              model: bool = True, on_call: str = "realtime", large: bool = False,
+              ends_at: str = "") -> str:
+    """The help for a session, listing only the keys that do something in it: a replay
+    (``replaying``; the recording performs the lane, ending at ``ends_at``) and a spec
+    without a user lane (``user_lane``) have no actions to answer, and hand nothing over; a
+    session without a user ``model`` has nobody to hand the lane to. What quitting keeps and
+    whether an omission is recorded are said as they are (a replay and ``--no-record``
+    record nothing), and what the clock does when the device calls (``on_call``) as this
+    session does it (a replay is never slowed down)."""
+    person = user_lane and not replaying
     kept = ("a replay records nothing" if replaying
             else "the recording is kept" if recording else "nothing is recorded")
-    return _HELP.format(kept=kept, recorded=", recorded" if recording and not replaying
-                        else "")
+    keys: list[tuple[str, str]] = []
+    if person:
+        keys += [("[b]a[/b] [b]b[/b] [b]c[/b]…",
+                  "do the action shown next to its letter (or click it)"),
+                 ("[b]x[/b]", "do not do the first action (an omission"
+                  + (", recorded)" if recording else ")")),
+                 ("[b]↑↓[/b] [b]enter[/b]", "pick an action, then do it (tab picks too)")]
+    keys += [("[b]space[/b]", "pause / resume the clock"),
+             ("[b]1 2 3 4[/b]", "speed: real time, 10x, 60x, 600x"),
+             ("[b]w[/b]", "let 30 simulated seconds pass"),
+             ("[b]n[/b]", "step: skip to the next event"),
+             ("[b]u[/b]", "skip until something new needs you (again: stop)" if person
+              else "skip to the end of the "
+              + ("replay" if replaying else "run") + " (again: stop)")]
+    if person and model:
+        keys.append(("[b]h[/b]", "hand your lane to the user model / take it back"))
+    keys += [("[b]l[/b]", "timeline: all lanes / device / user"
+              + (" / hidden" if large else "")),
+             ("[b]s[/b]", "the summary so far (metrics, your response times)" if person
+              else "the summary so far (the spec's metrics)"),
+             ("[b]?[/b]", "this help (the clock stops while it is open)"),
+             ("[b]q[/b], [b]ctrl+c[/b], [b]ctrl+q[/b]", f"quit ({kept})")]
+    lines = [_KEYS, ""]
+    for key, does in keys:
+        shown = Text.from_markup(key).cell_len
+        # the key column is 8 wide; a wider key runs into its text after one space
+        lead = f"  {key}{' ' * max(1, 8 - shown)}"
+        width = _WIDTH - 2 - max(8, shown + 1)
+        first, *more = textwrap.wrap(does, width) or [""]
+        lines.append(lead + first)
+        lines += [" " * 10 + line for line in more]
+    paragraphs = []
+    if replaying:
+        paragraphs.append(
+            "This is a replay: the recording performs your lane, so nothing waits for "
+            "your answer. Watch it, pause it, change its speed or skip ahead (w, n, u); "
+            "it is never slowed down when the device calls, and it ends at "
+            f"{ends_at or 'the end of its run'}.")
+    elif not user_lane:
+        paragraphs.append("This spec has no user lane: nothing waits for your answer; "
+                          "watch the device.")
+    else:
+        paragraphs.append({
+            "realtime": "When the device calls you, the clock drops to real time and "
+                        "comes back when the call is over" + (
+                            " (never while the user model performs your lane)."
+                            if model else "."),
+            "pause": "When the device calls you, the clock pauses (space resumes it).",
+            "keep": "When the device calls you, the clock keeps its speed.",
+        }.get(on_call, ""))
+    paragraphs.append("Device panel: (!) an alert (a ringing alarm), (x) a device fault, "
+                      "> what a participant is doing now.")
+    for paragraph in paragraphs:
+        if paragraph:
+            lines += ["", *textwrap.wrap(paragraph, _WIDTH)]
+    return "\n".join([*lines, "", "Press escape or ? to close."])
 
 
-#: the help of a recorded session
+def session_help(session: Any, *, large: bool = False) -> str:
+    """:func:`help_text` for ``session`` (a :class:`~opspec.tui.session.WalkSession`) as it
+    is; ``large``: the app's ``--large`` layout."""
+    return help_text(
+        replaying=session.replaying, recording=session.record_path is not None,
+        user_lane=session.has_user_lane, model=session.model_factory is not None,
+        on_call=session.on_call, large=large, ends_at=clock(session.horizon))
+
+
+#: the help of a recorded session with every key (a user lane, a user model)
 HELP = help_text()
 # In the frame of the help and the summary, so that it shows however little of them fits
 # (at 80 x 24 neither fits whole; the arrow keys scroll them).

@@ -136,9 +136,9 @@ class WalkSession(SessionClock, PersonLane, TraceFollower, Recording):
     def summary_lines(self, *, final: bool = True) -> list[str]:
         """The session in words: when, the spec's metrics (the numbers
         ``opspec run SPEC --script RECORDING`` prints), the person's response times, and
-        where the recording is with the commands that replay it. ``final``: the end of the
-        session (the run's outcome is taken, once); else the numbers so far, with the run
-        going on."""
+        where the recording is with the commands that replay it to the second shown.
+        ``final``: the end of the session (the run's outcome is taken, once); else the
+        numbers so far, with the run going on."""
         if self.failure is not None:
             head = f"The run failed at {clock(self.now)}: {self.failure}"
         elif self.ended:
@@ -167,8 +167,10 @@ class WalkSession(SessionClock, PersonLane, TraceFollower, Recording):
             lines += ["", "Your response times (wall clock, from the offer to your key):",
                       *response_lines(self.responses, recorded=self.record_path is not None)]
         if self.record_path is not None:
-            stopped = final and not self.ended and self.failure is None
-            # the end to replay to: where the person quit, or a --days / --until of its own
+            # the end to replay to: where the person quit (or, so far, where the session
+            # stands: the numbers above are those of the run up to now), or a --days /
+            # --until of its own
+            stopped = not self.ended and self.failure is None
             end = self.now if stopped else None if (
                 self.horizon == run_length(self.compiled)) else self.horizon
             walk, run = replay_commands(self.spec_path or "SPEC", self.record_path,

@@ -5,8 +5,9 @@ replays, and every trace event to ``<recording>.trace.jsonl`` with how long the 
 hold: the run's end in its header (``until``), and a ``walkthrough.quit`` event where the
 person quit before it, so that a replay ends there too (:func:`opspec.tui.replay.recorded_end`).
 Every session's trace ends as ``opspec run``'s does, with ``run.ended``
-(:meth:`Recording._trace_run_ended`): at the end of the run, or right after the
-``walkthrough.quit`` of a session quit before it (by ``q``, Ctrl+C or an interrupt); then what
+(:meth:`Recording._trace_run_ended`): at the end of the run, or after the ``walkthrough.quit``
+of a session quit before it (by ``q``, Ctrl+C or an interrupt) and the deadlocks the end of a
+run would report there (:meth:`Recording._judge_waiting`); then what
 is traced when the session closes (:meth:`Recording.before_close`: the bound devices'
 unfinished work, ``device.pending``, which ``opspec run`` also traces after ``run.ended``),
 whoever closes it. A run that failed has no ``run.ended``, as in ``opspec run``."""
@@ -14,6 +15,7 @@ whoever closes it. A run that failed has no ``run.ended``, as in ``opspec run``.
 from __future__ import annotations
 
 import json
+import math
 import os
 import time
 from collections.abc import Callable
@@ -24,7 +26,7 @@ from opspec.engine.performers import WorkItem
 from opspec.engine.trace import EventKind
 from opspec.errors import ConfigurationError
 from opspec.tui.replay import QUIT
-from opspec.tui.session_state import SessionState
+from opspec.tui.session_state import SessionState, guarded
 
 __all__ = ["Recording"]
 
@@ -40,6 +42,7 @@ class Recording(SessionState):
         self._steps = []
         self._trace_file = None
         self._closing = []
+        self._quit = False               # the person quit before the end of the run
         if self.record_path is not None:
             trace_path = self.record_path.with_suffix(".trace.jsonl")
             try:
@@ -110,15 +113,32 @@ class Recording(SessionState):
         sim.session.trace(EventKind.RUN_ENDED, {"open": len(sim.live),
                                                 "deadlocks": len(sim.deadlocks)})
 
+    @guarded()
+    def _judge_waiting(self) -> None:
+        """What can never go on, judged where the person quit as at the end of a run that
+        stopped at its horizon (:meth:`~opspec.engine.simulation.Simulation.check_waiting`,
+        as ``opspec run --until`` the quit second does): an activity waiting for a performer
+        that does not exist is a deadlock; what waits for the person, or for a device, is
+        not (they could still have answered). With nothing scheduled at all (a session quit
+        before its clock first moved) ``check_waiting`` would take every instance waiting
+        for the person as deadlocked: nothing is judged then."""
+        if math.isfinite(self.sim.peek()):
+            self.sim.check_waiting(horizon=self.now)
+
     def close(self) -> None:
         hooks, self._closing = self._closing, []        # once, however often it is closed
         try:
             try:
-                if self._trace_file is not None and not self.ended and self.failure is None:
-                    # the person quit here: a replay of the recording ends here too
-                    # (opspec.tui.replay.recorded_end), and so does the run
-                    self.sim.session.trace(QUIT, {"until": self.now})
-                    self._trace_run_ended()
+                if not self.ended and self.failure is None and not self._quit:
+                    self._quit = True
+                    if self._trace_file is not None:
+                        # the person quit here: a replay of the recording ends here too
+                        # (opspec.tui.replay.recorded_end), and so does the run
+                        self.sim.session.trace(QUIT, {"until": self.now})
+                    # (also unrecorded: the summary's numbers are those of opspec run)
+                    self._judge_waiting()
+                    if self._trace_file is not None and self.failure is None:
+                        self._trace_run_ended()
             finally:
                 for hook in hooks:          # after run.ended, as in opspec run's trace
                     hook()

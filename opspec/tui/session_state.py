@@ -75,6 +75,7 @@ class SessionState:
     _steps: list[list[str]]
     _trace_file: JsonlSink | None
     _closing: list[Callable[[], object]]
+    _quit: bool
 
     def __init__(self, compiled: CompiledPackage, *, seed: int, days: float | None,
                  until: float | None, model_factory: Callable[[], Any] | None, replay: Any, spec_path: str,

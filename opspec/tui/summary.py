@@ -54,10 +54,10 @@ def replay_commands(spec: str | Path, record: str | Path, *, until: float | None
                     seed: int = 0) -> tuple[str, str]:
     """The two commands that replay ``record`` (quoted for a POSIX shell, so a path with
     spaces pastes as it is): in the walkthrough, and with ``opspec run``. ``until``: the
-    simulated second the session ended at, when that is not where the spec's run ends by
-    itself (the person quit before the end, or ``--days`` set another end): both replays stop
-    there too (``--until``), so that they print the numbers the summary shows, not those of a
-    run that goes on without the person. ``seed``: the session's run seed (``--seed``, left
+    simulated second the session ended at (or stands at, in a summary so far), when that is
+    not where the spec's run ends by itself (the person quit before the end, or ``--days``
+    set another end): both replays stop there too (``--until``), so that they print the
+    numbers the summary shows, not those of a run that goes on without the person. ``seed``: the session's run seed (``--seed``, left
     out when 0): the device's draws of another seed would be another session."""
     spec_q, record_q = shlex.quote(str(spec)), shlex.quote(str(record))
     same = "" if not seed else f" --seed {seed}"

@@ -24,16 +24,16 @@ def visible(app: WalkthroughApp) -> str:
     return html.unescape(re.sub(r"<[^>]+>", "", svg)).replace("\xa0", " ")
 
 
-def _app(compiled) -> WalkthroughApp:
-    session = WalkSession(compiled)
+def _app(compiled, model_factory=None) -> WalkthroughApp:
+    session = WalkSession(compiled, model_factory=model_factory)
     session.paused = True
     return WalkthroughApp(session, title="Smart medication dispenser")
 
 
 @pytest.mark.asyncio
 @pytest.mark.parametrize("size", [(80, 24), (64, 20)])
-async def test_help_says_how_to_close_and_scrolls_to_its_end(compiled, size):
-    app = _app(compiled)
+async def test_help_says_how_to_close_and_scrolls_to_its_end(compiled, model_factory, size):
+    app = _app(compiled, model_factory)             # every key: the longest help
     async with app.run_test(size=size) as pilot:
         await pilot.press("question_mark")
         await pilot.pause()

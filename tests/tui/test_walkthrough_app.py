@@ -116,8 +116,8 @@ async def test_recorded_session_replays_to_the_same_trace(compiled, tmp_path):
 
 
 @pytest.mark.asyncio
-async def test_help_screen_lists_the_keys_and_closes(compiled):
-    app = WalkthroughApp(WalkSession(compiled))
+async def test_help_screen_lists_the_keys_and_closes(compiled, model_factory):
+    app = WalkthroughApp(WalkSession(compiled, model_factory=model_factory))
     async with app.run_test(size=(80, 24)) as pilot:
         await pilot.press("question_mark")
         await pilot.pause()
