@@ -10,7 +10,9 @@ Codes are listed in docs/validation.md.
 The files opspec run SPEC would read beside the spec are checked with it, as the run checks
 them: the companion user model SPEC.users.toml (read, and checked against the spec's user lane)
 and the world file the spec names (opspec:WorldFile). The summary names them ('1 file checked
-with pill.users.toml beside it'); one that is absent is no problem.
+with pill.users.toml beside it'); one that is absent is no problem. --user-model FILE|PRESET
+checks that user model (or population) instead of the companion, as opspec run or evaluate
+given it would read it ('1 file checked with pill.population.toml as its user model').
 
 Exit status: 0 no errors; 1 errors in a spec or a file beside it; 2 usage or I/O (a path that
 does not exist, an unreadable file, a folder without specs).
@@ -33,6 +35,10 @@ def register(subparsers: Any) -> None:
     parser.add_argument("paths", nargs="+", metavar="PATH", help="spec files or folders")
     add_strict(parser)
     add_json(parser, "one JSON object per file (JSON Lines)")
+    parser.add_argument("--user-model", metavar="FILE|PRESET",
+                        help="check this user model (or population) against each spec's "
+                        "user lane, as opspec run / evaluate --user-model would read it, "
+                        "instead of the companion SPEC.users.toml")
     parser.add_argument("--schema", action="store_true",
                         help="also validate each file against the bundled WfMC XSD of its "
                         "XPDL version (1.0, 2.1; docs/validation.md)")
@@ -72,15 +78,17 @@ def run(args: argparse.Namespace) -> int:
         print(f"opspec validate: {problem}", file=sys.stderr)
     reports = []
     beside: dict[str, bool] = {}          # name: checked (not only read)
+    given: dict[str, bool] = {}           # the same, of --user-model
     for path in files:
-        report, side = _with_side_files(path, strict=args.strict)
+        report, side = _with_side_files(path, strict=args.strict, user_model=args.user_model)
         if args.schema:
             from opspec.xpdl.schema import add_schema
 
             report = add_schema(report, path, strict=args.strict)
         reports.append(report)
         for side_file in side:
-            beside[side_file.path.name] = beside.get(side_file.path.name, True) and (
+            names = given if side_file.given else beside
+            names[side_file.path.name] = names.get(side_file.path.name, True) and (
                 side_file.checked)
         if args.json:
             doc = report.to_json()
@@ -96,13 +104,17 @@ def run(args: argparse.Namespace) -> int:
                 print(line)
     if not args.json and reports:
         print(summary(reports, beside=[name for name, checked in beside.items() if checked],
-                      only_read=[name for name, checked in beside.items() if not checked]))
+                      only_read=[name for name, checked in beside.items() if not checked],
+                      given=[name for name, checked in given.items() if checked],
+                      given_only_read=[name for name, checked in given.items()
+                                       if not checked]))
     if problems or any(r.unreadable for r in reports):
         return 2
     return 0 if all(r.ok for r in reports) else 1
 
 
-def _with_side_files(path: Any, *, strict: bool) -> tuple[Any, list[Any]]:
+def _with_side_files(path: Any, *, strict: bool, user_model: str | None = None
+                     ) -> tuple[Any, list[Any]]:
     """The report on the spec at ``path`` with the problems of the files a run of it reads
     beside it (:mod:`opspec.commands.validate_side_files`), and those files."""
     import dataclasses
@@ -112,7 +124,7 @@ def _with_side_files(path: Any, *, strict: bool) -> tuple[Any, list[Any]]:
     from opspec.xpdl.validate import FileReport, merge_diagnostics, validate_spec
 
     package, report = validate_spec(path, extra=engine_checks)
-    found, side = check_side_files(path, package, report.diagnostics)
+    found, side = check_side_files(path, package, report.diagnostics, user_model)
     diagnostics = merge_diagnostics(report.diagnostics, found) if found else report.diagnostics
     if strict:          # every warning an error, the side files' too
         diagnostics = tuple(dataclasses.replace(d, severity=Severity.ERROR)

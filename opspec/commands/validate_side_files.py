@@ -44,17 +44,21 @@ class SideFile:
     what: str
     checked: bool = True
     why_not: str = ""
+    #: given on the command line (``--user-model``), not picked up beside the spec
+    given: bool = False
 
     def to_json(self) -> dict[str, Any]:
         return {"path": str(self.path), "what": self.what, "checked": self.checked,
-                "why_not": self.why_not or None}
+                "why_not": self.why_not or None, "given": self.given}
 
 
-def check_side_files(spec_path: Path, package: Any, diagnostics: tuple[Diagnostic, ...]
-                     ) -> tuple[list[Diagnostic], list[SideFile]]:
+def check_side_files(spec_path: Path, package: Any, diagnostics: tuple[Diagnostic, ...],
+                     user_model: str | None = None) -> tuple[list[Diagnostic], list[SideFile]]:
     """The problems of the side files of the spec at ``spec_path`` and the files themselves.
     ``package`` is what validate read from the spec (None: nothing could be read) and
-    ``diagnostics`` what it found in it, before ``--strict``."""
+    ``diagnostics`` what it found in it, before ``--strict``. ``user_model`` (``--user-model``:
+    a file or preset, as ``opspec run``/``evaluate`` take it) is checked instead of the
+    companion, as a run given it reads it instead."""
     from opspec.request import side_files
 
     why = _why_not(package, diagnostics)
@@ -63,18 +67,22 @@ def check_side_files(spec_path: Path, package: Any, diagnostics: tuple[Diagnosti
         compiled, why = _compiled(package)
     found: list[Diagnostic] = []
     files: list[SideFile] = []
-    for what, path in side_files(spec_path).items():
+    given = user_model is not None
+    beside = {"user model": Path(user_model)} if user_model is not None else side_files(
+        spec_path)
+    for what, path in beside.items():
         problems, checked = _check_user_model(path, compiled)     # the one kind there is
         found.extend(problems)
         if checked or not why:
-            files.append(SideFile(path, what))
+            files.append(SideFile(path, what, given=given))
             continue
-        files.append(SideFile(path, what, checked=False, why_not=why))
+        files.append(SideFile(path, what, checked=False, why_not=why, given=given))
         if not problems:
             found.append(Diagnostic(
                 SourceLocation(str(path)), Severity.INFO, NOT_CHECKED,
-                f"the {what} beside the spec was read but not checked against the spec's "
-                f"user lane: {why}", "fix the spec, then validate again"))
+                f"the {what} {'given' if given else 'beside the spec'} was read but not "
+                f"checked against the spec's user lane: {why}",
+                "fix the spec, then validate again"))
     files.extend(_world_file(spec_path, package, why))
     return found, files
 

@@ -267,11 +267,13 @@ def _target(link: Path) -> str:
 
 
 def summary(reports: Sequence[FileReport], beside: Sequence[str] = (),
-            only_read: Sequence[str] = ()) -> str:
+            only_read: Sequence[str] = (), given: Sequence[str] = (),
+            given_only_read: Sequence[str] = ()) -> str:
     """``3 files checked: 1 with errors (4 errors, 2 warnings)`` and the like; ``beside``
     names the files checked with the specs (``1 file checked with pill.users.toml beside it:
     …``), ``only_read`` those that could not be checked against a spec with errors (more than
-    four are counted)."""
+    four are counted); ``given`` and ``given_only_read`` the same of a user model given with
+    ``--user-model`` (``… with pill.population.toml as its user model``)."""
     files = len(reports)
     errors = sum(r.count(Severity.ERROR) for r in reports)
     warnings = sum(r.count(Severity.WARNING) for r in reports)
@@ -293,6 +295,12 @@ def summary(reports: Sequence[FileReport], beside: Sequence[str] = (),
         checked += f" with {listed(beside)} beside {'it' if files == 1 else 'them'}"
     if only_read:
         checked += (f" ({listed(only_read)} beside {'it' if files == 1 else 'them'} only read: "
+                    f"{'the spec has' if files == 1 else 'their spec has'} errors)")
+    model = "its user model" if files == 1 else "their user model"
+    if given:
+        checked += f" with {listed(given)} as {model}"
+    if given_only_read:
+        checked += (f" ({listed(given_only_read)} as {model} only read: "
                     f"{'the spec has' if files == 1 else 'their spec has'} errors)")
     return (f"{checked}: {verdict} "
             f"({plural(errors, 'error')}, {plural(warnings, 'warning')})")

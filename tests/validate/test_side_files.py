@@ -149,7 +149,8 @@ def test_json_reports_the_side_files_problem_with_its_key(
         "hint": "write a fraction: 15 % is 0.15",
         "key": "activities.hear_alarm.omission.probability"}
     assert doc["side_files"] == [{"path": str(tmp_path / "pill.users.toml"),
-                                  "what": "user model", "checked": True, "why_not": None}]
+                                  "what": "user model", "checked": True, "why_not": None,
+                                  "given": False}]
 
 
 def test_a_broken_spec_still_has_its_user_model_read(
@@ -183,7 +184,7 @@ def test_with_a_broken_spec_validate_says_the_user_model_was_not_checked_against
     status, out = validate(capsys, "--json", str(spec))
     assert json.loads(out[0])["side_files"] == [
         {"path": str(tmp_path / "pill.users.toml"), "what": "user model", "checked": False,
-         "why_not": "the spec could not be read"}]
+         "why_not": "the spec could not be read", "given": False}]
 
 
 def test_validate_picks_up_what_the_front_hall_picks_up(tmp_path: Path) -> None:
@@ -222,3 +223,48 @@ def test_json_carries_the_line_of_a_side_files_warning_as_of_a_specs(
     (problem,) = json.loads(out[0])["diagnostics"]
     assert (problem["path"], problem["line"], problem["key"], problem["code"]) == (
         str(tmp_path / "pill.users.toml"), line, "activities.tkae_pill", "unused-user-activity")
+
+
+POPULATION = (SPECS / "medication_dispenser.population.toml").read_text(encoding="utf-8")
+
+
+def test_a_user_model_given_is_checked_instead_of_the_companion(
+        tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """``--user-model`` checks the model (a population here) a run given it would read, in
+    place of the companion, and the summary says it was given, not found beside the spec."""
+    spec = make_spec(tmp_path, MODEL.replace("[activities.take_pill]", "[activities.take_pil]"))
+    shutil.copyfile(SPECS / "medication_dispenser.users.toml",
+                    tmp_path / "medication_dispenser.users.toml")   # what it extends
+    population = tmp_path / "pill.population.toml"
+    population.write_text(POPULATION, encoding="utf-8")
+    assert validate(capsys, str(spec), "--user-model", str(population)) == (
+        0, ["1 file checked with pill.population.toml as its user model: no errors "
+            "(0 errors, 0 warnings)"])
+    status, out = validate(capsys, str(spec), "--user-model", str(population), "--json")
+    assert status == 0
+    assert json.loads(out[0])["side_files"] == [
+        {"path": str(population), "what": "user model", "checked": True, "why_not": None,
+         "given": True}]
+
+
+def test_a_population_evaluate_refuses_is_an_error_at_its_line_in_evaluates_words(
+        tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """A population is the kind of file no run picks up by itself; validate checks it when
+    given, and what ``opspec evaluate --user-model`` would refuse is an error at its line."""
+    spec = make_spec(tmp_path)
+    shutil.copyfile(SPECS / "medication_dispenser.users.toml",
+                    tmp_path / "medication_dispenser.users.toml")
+    population = tmp_path / "pill.population.toml"
+    broken = POPULATION.replace('spearman = 0.3', 'spearman = 1.7', 1)
+    assert broken != POPULATION
+    population.write_text(broken, encoding="utf-8")
+    line = next(n for n, text in enumerate(broken.splitlines(), start=1)
+                if "spearman = 1.7" in text)
+    status, out = validate(capsys, str(spec), "--user-model", str(population))
+    assert status == 1
+    problems = [text for text in out if ": error: " in text]
+    assert len(problems) == 1 and problems[0].startswith(f"{population}:{line}")
+    assert main(["evaluate", str(spec), "--user-model", str(population), "--users", "2",
+                 "--days", "0.01", "--out", str(tmp_path / "out")]) == 2
+    refused = capsys.readouterr().err.strip().removeprefix("opspec evaluate: ")
+    assert problems[0].replace(": error: ", ": ", 1) == refused
