@@ -184,9 +184,10 @@ def _combine(estimate: float | None, ordinary: Sequence[float | None] | None,
     """The widened interval of one metric (see the module docstring). Each interval of no
     width because the users were all alike has its ``…_no_spread`` beside it
     (:mod:`opspec.statistics.no_spread`): the ordinary one's is ``ordinary_no_spread`` (the
-    summary's own), the widened one's over the ``users`` of the ordinary run (it has no
-    width only when they were all alike), the direct bootstrap's over the ``draw_users`` of
-    the batches when every one of them gave the same value too."""
+    summary's own), the widened one's over the same users of the ordinary run (it has no
+    width only when they were all alike; ``users`` when the summary's is not given), the
+    direct bootstrap's over the ``draw_users`` of the batches (those with a value) when
+    every one of them gave the same value too."""
     from opspec.statistics import t_quantile
 
     out: dict[str, Any] = {"estimate": estimate, "ci95": list(ordinary) if ordinary else None,
@@ -225,7 +226,8 @@ def _combine(estimate: float | None, ordinary: Sequence[float | None] | None,
     tiny = (1e-12 * max(abs(v) for v in values)) ** 2
     alike = between <= tiny and noise <= tiny
     return {**out, "ci95_with_parameters": [low, high],
-            "ci95_with_parameters_no_spread": no_spread([low, high], users, level),
+            "ci95_with_parameters_no_spread": no_spread(
+                [low, high], (ordinary_no_spread or {}).get("users", users), level),
             "direct_bootstrap_ci95": bootstrap,
             "direct_bootstrap_ci95_no_spread": (no_spread(bootstrap, draw_users, level)
                                                 if alike else None),
@@ -274,7 +276,9 @@ def summarise_input_uncertainty(store: Any, plan: Any, metrics: Mapping[str, Any
         ordinary = metrics.get(name) or {}
         pairs = [p for _, p in user_pairs(store, design, definition)]
         plain = ratio_variance(pairs)
-        drawn = [(len(users), e) for users in _batches(store, plan, design, definition).values()
+        # a user without a denominator (no dose, for a rate per dose) gives no value
+        drawn = [(sum(1 for _, n in users.values() if n > 0), e)
+                 for users in _batches(store, plan, design, definition).values()
                  if (e := ratio_variance(list(users.values()))) is not None]
         estimate = ordinary.get("value", ordinary.get("mean"))
         out["metrics"][name] = _combine(estimate, ordinary.get("ci95"),
@@ -303,7 +307,7 @@ def summarise_input_uncertainty(store: Any, plan: Any, metrics: Mapping[str, Any
                 found = paired_variance([users_a[u] for u in both], [users_b[u] for u in both])
                 if found is not None:
                     batches.append(found)
-                    drawn += len(both)
+                    drawn += sum(1 for u in both if users_a[u][1] > 0 or users_b[u][1] > 0)
             entry = compare[name]
             out["difference"][name] = _combine(entry.get("difference"), entry.get("ci95"),
                                                plain[1] if plain else None, len(common),
