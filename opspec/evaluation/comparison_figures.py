@@ -20,11 +20,14 @@ from opspec.evaluation.figure_style import (
     PERCENT,
     _empty,
     _figure,
-    _note_dropped,
+    _note,
+    _notes,
     _outside_legend,
     _panels,
     _text,
+    _wrapped,
 )
+from opspec.evaluation.no_spread_notes import MARK
 
 __all__ = ["comparison_figure", "sweep_figure"]
 
@@ -32,7 +35,9 @@ __all__ = ["comparison_figure", "sweep_figure"]
 @queueable
 def comparison_figure(rows: Sequence[tuple[str, float, float | None, float | None]],
                       path: Path, units: Mapping[str, str] | None = None, *,
-                      no_interval: Mapping[str, str] | None = None) -> Path:
+                      no_interval: Mapping[str, str] | None = None,
+                      no_spread: Sequence[str] = (), no_spread_note: str | None = None
+                      ) -> Path:
     """Each ``(metric, difference B − A, ci_low, ci_high)`` in its own panel with its own
     scale and a zero line (metrics differ in unit and size: one shared axis would flatten a
     rate's ±0.005 next to a latency's −40 s). ``units`` per metric: ``"pp"`` draws a rate's
@@ -41,7 +46,10 @@ def comparison_figure(rows: Sequence[tuple[str, float, float | None, float | Non
 
     Differences whose interval excludes zero are drawn filled; the others hollow. A
     difference without an interval (``ci_low``, ``ci_high`` None) is not drawn; the figure's
-    note names it, with ``no_interval``'s reason for it when given.
+    note names it, with ``no_interval``'s reason for it when given. The metrics in
+    ``no_spread`` have an interval of no width because the few users all differed by the
+    same amount: it is marked (†) and ``no_spread_note`` says under the figure what that
+    means (:mod:`.no_spread_notes`).
     """
     from opspec.evaluation.tables import difference_text
 
@@ -54,6 +62,7 @@ def comparison_figure(rows: Sequence[tuple[str, float, float | None, float | Non
     if not clean:
         return _empty(path, title + (f"\n{_unshown(bare)}" if bare else ""))
     units = units or {}
+    alike = {_text(m) for m in no_spread}
     with _figure(9.0, 0.9 + 0.75 * len(clean)) as fig:
         axes = fig.subplots(len(clean), 1, squeeze=False)[:, 0]
         for ax, (name, diff, lo, hi) in zip(axes, clean, strict=True):
@@ -61,7 +70,8 @@ def comparison_figure(rows: Sequence[tuple[str, float, float | None, float | Non
             scale = 100.0 if unit == "pp" else 1.0
             label = (f"{difference_text(diff, unit, percent=unit == 'pp')}  "
                      f"[{difference_text(lo, unit, percent=unit == 'pp')}, "
-                     f"{difference_text(hi, unit, percent=unit == 'pp')}]")
+                     f"{difference_text(hi, unit, percent=unit == 'pp')}]"
+                     + (f" {MARK}" if name in alike else ""))
             diff, lo, hi = diff * scale, lo * scale, hi * scale
             significant = lo > 0.0 or hi < 0.0
             colour = PALETTE[4] if significant else PALETTE[0]
@@ -81,12 +91,13 @@ def comparison_figure(rows: Sequence[tuple[str, float, float | None, float | Non
             ax.set_yticks([0.0], [f"{name} ({unit})" if unit else name])
             ax.set_ylim(-1.0, 1.0)
             ax.grid(axis="y", visible=False)
-        if bare:                # one note (two at the foot would overlap)
-            fig.text(0.01, 0.005, _unshown(bare) + (
-                f"; {dropped} non-finite value(s) left out" if dropped else ""), fontsize=9,
-                color="#444444", ha="left", va="bottom")
-        else:
-            _note_dropped(fig, dropped)
+        left_out = f"{dropped} non-finite value(s) left out" if dropped else ""
+        # one note (two at the foot would overlap)
+        foot = _notes(_unshown(bare) + (f"; {left_out}" if left_out else "") if bare
+                      else left_out,
+                      _wrapped(no_spread_note, 9.0) if alike & {c[0] for c in clean} else "")
+        if foot:
+            fig.text(0.01, 0.005, foot, fontsize=9, color="#444444", ha="left", va="bottom")
         return figure_files.save(fig, path)
 
 
@@ -103,14 +114,17 @@ def sweep_figure(parameter: str, xs: Sequence[float], labels: Sequence[str],
                  path: Path, *, percent: Mapping[str, bool] | None = None,
                  units: Mapping[str, str] | None = None,
                  targets: Mapping[str, Sequence[tuple[str, float]]] | None = None,
-                 per_user: Mapping[str, tuple[str, Sequence[float | None]]] | None = None
+                 per_user: Mapping[str, tuple[str, Sequence[float | None]]] | None = None,
+                 no_spread: Sequence[str] = (), no_spread_note: str | None = None
                  ) -> Path:
     """Each metric of a sweep against the swept parameter (``opspec evaluate --sweep``): per
     metric ``(estimates, ci lows, ci highs)``, one per value at ``xs`` (tick ``labels`` as the
     values read), each metric in its own panel with its own scale; the estimate as a line with
     markers, its 95 % interval as a band. ``targets`` draws each target's threshold on its
     metric's panel (dashed), ``per_user`` a per-user quantile (dotted) that a share-of-users
-    target is judged by."""
+    target is judged by. The metrics in ``no_spread`` have a band of no width at some value
+    because the few users were all alike: its legend line is marked (†) and
+    ``no_spread_note`` says under the figure what that means (:mod:`.no_spread_notes`)."""
     title = f"Metrics against {parameter}"
     names = [n for n, (est, _, _) in series.items()
              if any(e is not None and math.isfinite(float(e)) for e in est)]
@@ -118,7 +132,9 @@ def sweep_figure(parameter: str, xs: Sequence[float], labels: Sequence[str],
         return _empty(path, title)
     percent, units = percent or {}, units or {}
     targets, per_user = targets or {}, per_user or {}
+    alike = set(no_spread) & set(names)
     with _figure(9.0, 1.2 + 2.1 * len(names)) as fig:
+        _note(fig, _wrapped(no_spread_note if alike else None, 9.0))
         axes = _panels(fig, len(names), sharex=True)
         for ax, name in zip(axes, names, strict=True):
             est, low, high = series[name]
@@ -132,7 +148,8 @@ def sweep_figure(parameter: str, xs: Sequence[float], labels: Sequence[str],
                                 [float(low[i]) * scale for i in band],   # type: ignore[arg-type]
                                 [float(high[i]) * scale for i in band],  # type: ignore[arg-type]
                                 color=PALETTE[0], alpha=0.22, linewidth=0,
-                                label="95 % interval")
+                                label="95 % interval" + (f" {MARK}" if name in alike
+                                                         else ""))
             ax.plot(x, y, marker="o", color=PALETTE[0], linewidth=1.8, label="estimate")
             for i, (text, threshold) in enumerate(targets.get(name, ())):
                 ax.axhline(threshold * scale, color=PALETTE[4], linewidth=1.4,

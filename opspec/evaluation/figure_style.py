@@ -155,6 +155,24 @@ def _note(fig: Figure, text: str) -> None:
         fig.supxlabel(text, fontsize=9, color="#444444", ha="left", x=0.01)
 
 
+#: Characters of a note's line per inch of the figure's width: the 9-point notes stay
+#: inside the figure (about 5.4 points a character, less the 1 % margin on the left)
+_NOTE_CHARACTERS_PER_INCH = 11.5
+
+
+def _wrapped(text: str | None, width: float) -> str:
+    """A note (one of :mod:`.no_spread_notes`') in lines that fit a figure ``width``
+    inches wide; the layout makes room under the panels for as many as it takes."""
+    import textwrap
+
+    return textwrap.fill(text, int(width * _NOTE_CHARACTERS_PER_INCH)) if text else ""
+
+
+def _notes(*texts: str) -> str:
+    """The notes given, one under the other, for :func:`_note`."""
+    return "\n".join(t for t in texts if t)
+
+
 def _outside_legend(ax: Axes) -> None:
     """The legend to the right of the plot, where it never hides a line."""
     ax.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), borderaxespad=0.0)

@@ -43,7 +43,9 @@ from dataclasses import replace
 from typing import IO, Any
 
 from opspec.errors import EvaluationError, OpspecError
+from opspec.evaluation.no_spread_notes import no_spread_note, with_mark
 from opspec.statistics.clustered import paired_variance, ratio_variance
+from opspec.statistics.no_spread import no_spread
 from opspec.statistics.percentiles import linear
 
 __all__ = ["SUFFIX", "base_design", "check_draws", "draw_of", "draw_users", "draws_label",
@@ -176,14 +178,24 @@ def run_draw_users(plan: Mapping[str, Any], label: str, users: Sequence[int]) ->
 
 def _combine(estimate: float | None, ordinary: Sequence[float | None] | None,
              simulation: float | None, users: int, batches: Sequence[tuple[float, float]],
-             level: float, *, proportion: bool = False) -> dict[str, Any]:
-    """The widened interval of one metric (see the module docstring)."""
+             level: float, *, proportion: bool = False,
+             ordinary_no_spread: Mapping[str, Any] | None = None,
+             draw_users: int = 0) -> dict[str, Any]:
+    """The widened interval of one metric (see the module docstring). Each interval of no
+    width because the users were all alike has its ``…_no_spread`` beside it
+    (:mod:`opspec.statistics.no_spread`): the ordinary one's is ``ordinary_no_spread`` (the
+    summary's own), the widened one's over the same users of the ordinary run (it has no
+    width only when they were all alike; ``users`` when the summary's is not given), the
+    direct bootstrap's over the ``draw_users`` of the batches (those with a value) when
+    every one of them gave the same value too."""
     from opspec.statistics import t_quantile
 
     out: dict[str, Any] = {"estimate": estimate, "ci95": list(ordinary) if ordinary else None,
-                           "draws": len(batches)}
+                           "ci95_no_spread": ordinary_no_spread, "draws": len(batches)}
     if estimate is None or simulation is None or len(batches) < 2:
-        return {**out, "ci95_with_parameters": None, "direct_bootstrap_ci95": None,
+        return {**out, "ci95_with_parameters": None,
+                "ci95_with_parameters_no_spread": None, "direct_bootstrap_ci95": None,
+                "direct_bootstrap_ci95_no_spread": None,
                 "variance": None, "parameter_share": None}
     values = [v for v, _ in batches]
     between = pystats.variance(values)
@@ -207,8 +219,18 @@ def _combine(estimate: float | None, ordinary: Sequence[float | None] | None,
         high = min(high, 1.0)
     ordered = sorted(values)
     alpha = (1 - level) / 2
+    bootstrap = [linear(ordered, alpha), linear(ordered, 1 - alpha)]
+    # the batches' estimates all alike is no spread seen only when their users were too
+    # (equal batch means of users who differ are no such thing); a variance of users all
+    # alike can come out a few units in the last place above 0
+    tiny = (1e-12 * max(abs(v) for v in values)) ** 2
+    alike = between <= tiny and noise <= tiny
     return {**out, "ci95_with_parameters": [low, high],
-            "direct_bootstrap_ci95": [linear(ordered, alpha), linear(ordered, 1 - alpha)],
+            "ci95_with_parameters_no_spread": no_spread(
+                [low, high], (ordinary_no_spread or {}).get("users", users), level),
+            "direct_bootstrap_ci95": bootstrap,
+            "direct_bootstrap_ci95_no_spread": (no_spread(bootstrap, draw_users, level)
+                                                if alike else None),
             "variance": {"parameters": parameters, "simulation": simulation,
                          "between_draws": between, "within_draws": noise},
             "parameter_share": parameters / total if total > 0 else 0.0,
@@ -254,12 +276,17 @@ def summarise_input_uncertainty(store: Any, plan: Any, metrics: Mapping[str, Any
         ordinary = metrics.get(name) or {}
         pairs = [p for _, p in user_pairs(store, design, definition)]
         plain = ratio_variance(pairs)
-        batches = [e for users in _batches(store, plan, design, definition).values()
-                   if (e := ratio_variance(list(users.values()))) is not None]
+        # a user without a denominator (no dose, for a rate per dose) gives no value
+        drawn = [(sum(1 for _, n in users.values() if n > 0), e)
+                 for users in _batches(store, plan, design, definition).values()
+                 if (e := ratio_variance(list(users.values()))) is not None]
         estimate = ordinary.get("value", ordinary.get("mean"))
         out["metrics"][name] = _combine(estimate, ordinary.get("ci95"),
-                                        plain[1] if plain else None, len(pairs), batches,
-                                        level, proportion=_proportion(pairs))
+                                        plain[1] if plain else None, len(pairs),
+                                        [e for _, e in drawn], level,
+                                        proportion=_proportion(pairs),
+                                        ordinary_no_spread=ordinary.get("ci95_no_spread"),
+                                        draw_users=sum(n for n, _ in drawn))
     if compare:
         out["difference"] = {}
         theirs = {d["name"]: d for d in metric_definitions(store, "B")}
@@ -273,17 +300,20 @@ def summarise_input_uncertainty(store: Any, plan: Any, metrics: Mapping[str, Any
             plain = paired_variance([a[u] for u in common], [b[u] for u in common])
             batch_a = _batches(store, plan, design, definition)
             batch_b = _batches(store, plan, "B", theirs[name])
-            batches = []
+            batches, drawn = [], 0
             for draw, users_a in batch_a.items():
                 users_b = batch_b.get(draw, {})
                 both = sorted(set(users_a) & set(users_b))
                 found = paired_variance([users_a[u] for u in both], [users_b[u] for u in both])
                 if found is not None:
                     batches.append(found)
+                    drawn += sum(1 for u in both if users_a[u][1] > 0 or users_b[u][1] > 0)
             entry = compare[name]
             out["difference"][name] = _combine(entry.get("difference"), entry.get("ci95"),
                                                plain[1] if plain else None, len(common),
-                                               batches, level)
+                                               batches, level,
+                                               ordinary_no_spread=entry.get("ci95_no_spread"),
+                                               draw_users=drawn)
     return out
 
 
@@ -303,17 +333,35 @@ HEADERS = ("metric", "estimate", "95 % CI (simulation)", "95 % CI (+ parameters)
            "direct bootstrap", "from parameters")
 
 
+#: The intervals of a row, each with the key of its ``…_no_spread`` (:func:`_combine`).
+_INTERVALS = (("ci95", "ci95_no_spread"),
+              ("ci95_with_parameters", "ci95_with_parameters_no_spread"),
+              ("direct_bootstrap_ci95", "direct_bootstrap_ci95_no_spread"))
+
+
+def _alike(entry: Mapping[str, Any], key: str, difference: bool) -> dict[str, Any]:
+    """One interval of ``entry`` as :mod:`.no_spread_notes` reads a summary."""
+    return {"ci95_no_spread": entry.get(key), **({"difference": True} if difference else {})}
+
+
 def _rows(summary: Mapping[str, Any]) -> list[tuple[str, ...]]:
     rows: list[tuple[str, ...]] = []
     for section, prefix in (("metrics", ""), ("difference", "B - A: ")):
         for name, entry in (summary.get(section) or {}).items():
             share = entry.get("parameter_share")
             rows.append((prefix + name, _number(entry.get("estimate")),
-                         _interval(entry.get("ci95")),
-                         _interval(entry.get("ci95_with_parameters")),
-                         _interval(entry.get("direct_bootstrap_ci95")),
+                         *(with_mark(_interval(entry.get(ci)), _alike(entry, alike, False))
+                           for ci, alike in _INTERVALS),
                          "-" if share is None else f"{100 * share:.0f} %"))
     return rows
+
+
+def _note(summary: Mapping[str, Any]) -> str | None:
+    """What a marked interval of the table means, once (:mod:`.no_spread_notes`)."""
+    return no_spread_note(_alike(entry, alike, section == "difference")
+                          for section in ("metrics", "difference")
+                          for entry in (summary.get(section) or {}).values()
+                          for _, alike in _INTERVALS)
 
 
 def _title(summary: Mapping[str, Any]) -> str:
@@ -345,7 +393,8 @@ def report_section(store: Any, given: Mapping[str, Any],
         "only the rest, more recorded observations narrow this part. The widened "
         "interval adds the between-draw variance of the estimates, less their "
         "within-draw (simulation) variance, to the ordinary variance, on Satterthwaite's "
-        "degrees of freedom, and covers the ordinary interval."),),
+        "degrees of freedom, and covers the ordinary interval."),
+        *filter(None, [_note(summary)])),
         tables=(Table(HEADERS, tuple(_rows(summary)),
                       "Ordinary 95 % intervals (simulation noise only) and intervals that "
                       "include the fitted parameters' uncertainty"),))
@@ -364,3 +413,5 @@ def print_input_uncertainty(out: IO[str], summary: Mapping[str, Any] | None) -> 
               file=out)
     print("  'from parameters': the share of the widened interval's variance due to the "
           "fitted parameters;\n  more users narrow only the rest.", file=out)
+    if note := _note(summary):
+        print(f"\n{note}", file=out)

@@ -1,13 +1,14 @@
-"""How the tables and the report show an interval of no width from too few users who were all
-alike (:mod:`opspec.statistics.no_spread`): a mark after the interval, and one note, in
-plain words, under the table that has it (docs/evaluation.md, *Intervals of no width*)."""
+"""How the tables, the report and its figures show an interval of no width from too few users
+who were all alike (:mod:`opspec.statistics.no_spread`): a mark after the interval, and one
+note, in plain words, under the table or figure that has it (docs/evaluation.md, *Intervals
+of no width*)."""
 
 from __future__ import annotations
 
 from collections.abc import Iterable, Mapping
 from typing import Any
 
-__all__ = ["MARK", "marked", "no_spread_note", "with_mark"]
+__all__ = ["MARK", "figure_marks", "marked", "no_spread_note", "with_mark"]
 
 #: After an interval of no width from too few users: ``[4, 4] †``.
 MARK = "†"
@@ -53,3 +54,17 @@ def no_spread_note(summaries: Iterable[Mapping[str, Any] | None]) -> str | None:
             f"{' (the fewest)' if len(set(counts)) > 1 else ''}, up to "
             f"{100 * fewest['share_unlike_ci95_high']:.3g} % of users could give another value "
             "(exact 95 % bound).")
+
+
+def figure_marks(summaries: Mapping[str, Iterable[Mapping[str, Any] | None]]
+                 ) -> dict[str, Any]:
+    """What a figure function is given to mark its intervals (``no_spread``: the panels or
+    rows, by name, with one interval of no width from too few users, ``no_spread_note``:
+    :func:`no_spread_note` of them all), from each name's summaries (one per interval it
+    draws); nothing when none is marked, so the figure is asked for as before."""
+    every = {name: list(shown) for name, shown in summaries.items()}
+    alike = [name for name, shown in every.items() if any(map(marked, shown))]
+    if not alike:
+        return {}
+    return {"no_spread": alike,
+            "no_spread_note": no_spread_note(s for shown in every.values() for s in shown)}

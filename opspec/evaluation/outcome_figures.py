@@ -30,10 +30,13 @@ from opspec.evaluation.figure_style import (
     _never,
     _note,
     _note_dropped,
+    _notes,
     _panels,
     _percent_axis,
     _text,
+    _wrapped,
 )
+from opspec.evaluation.no_spread_notes import MARK
 
 __all__ = ["activity_rates_figure", "latency_figure", "over_days_figure", "rates_figure",
            "time_of_day_figure"]
@@ -170,10 +173,15 @@ def _tick_decimals(ticks: Sequence[float]) -> int:
 @queueable
 def over_days_figure(series: Mapping[str, Sequence[float]], path: Path, *,
                      bands: Mapping[str, Sequence[tuple[float | None, float | None]]]
-                     | None = None) -> Path:
+                     | None = None, no_spread: Sequence[str] = (),
+                     no_spread_note: str | None = None) -> Path:
     """One panel per metric, each on its own scale: its value on day 1, 2, …, D, with the
-    95 % interval of each day as a band when ``bands`` gives them (per metric, per day)."""
+    95 % interval of each day as a band when ``bands`` gives them (per metric, per day).
+    The metrics in ``no_spread`` have a band of no width on some day because the few users
+    were all alike: their panels are marked (†) and ``no_spread_note`` says under the
+    figure what that means (:mod:`.no_spread_notes`)."""
     bands = {_text(name): list(b) for name, b in (bands or {}).items()}
+    alike = {_text(name) for name in no_spread}
     title = "Outcomes over the simulated days"
     present = {_text(name): list(vals) for name, vals in series.items() if len(vals) > 0}
     never = [name for name, vals in present.items() if all(v == 0 for v in vals)]
@@ -182,7 +190,8 @@ def over_days_figure(series: Mapping[str, Sequence[float]], path: Path, *,
         return _empty(path, title + (": every outcome was 0 on every day" if never else ""))
     longest = max(len(v) for v in present.values())
     with _figure(9.0, 0.9 + 1.45 * len(present)) as fig:
-        _note(fig, _never(never))
+        _note(fig, _notes(_never(never), _wrapped(no_spread_note if alike & set(present)
+                                                  else None, 9.0)))
         axes = _panels(fig, len(present))
         for i, (ax, (name, vals)) in enumerate(zip(axes, present.items(), strict=True)):
             days = list(range(1, len(vals) + 1))
@@ -200,7 +209,8 @@ def over_days_figure(series: Mapping[str, Sequence[float]], path: Path, *,
                 ys_all = ys + [h for h in highs if math.isfinite(h)]
             else:
                 ys_all = ys
-            ax.set_ylabel(f"{name}\n(per user)", rotation=0, ha="right", va="center")
+            mark = f" {MARK}" if name in alike else ""
+            ax.set_ylabel(f"{name}{mark}\n(per user)", rotation=0, ha="right", va="center")
             finite = [y for y in ys_all if math.isfinite(y)]
             if finite and min(finite) >= 0:
                 ax.set_ylim(bottom=0, top=max(max(finite) * 1.15, 1e-9))

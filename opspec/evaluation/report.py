@@ -34,7 +34,7 @@ from typing import TYPE_CHECKING, Any
 
 from opspec.errors import EvaluationError
 from opspec.evaluation.describe import describe_metric
-from opspec.evaluation.no_spread_notes import no_spread_note
+from opspec.evaluation.no_spread_notes import figure_marks, no_spread_note
 from opspec.evaluation.plan import span
 from opspec.evaluation.report_design import (
     PLOT_SAMPLE,
@@ -368,8 +368,12 @@ def _report_sections(store: ResultStore, summaries: Mapping[str, Summaries] | No
                                          "designs" if why == NO_DURATION_INTERVAL
                                          else why.removeprefix("none: "))
                    for n, d in difference.items() if (why := no_interval_reason(d))}
+        # a difference every user shared is marked in the figure as in the table, and the
+        # figure says what that means too (it is printed on its own)
+        alike = figure_marks({metric_label(n, d): [d] for n, d in difference.items()
+                              if d["difference"] is not None})
         compared = ((plots.comparison_figure(rows, figures / "comparison.png", units,
-                                             no_interval=reasons),)
+                                             no_interval=reasons, **alike),)
                     if rows else ())
         headers: tuple[str, ...] = ("metric", names["A"], names["B"], "difference", "95 % CI",
                                     "CI method", "")

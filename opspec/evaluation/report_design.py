@@ -12,7 +12,7 @@ from pathlib import Path
 from typing import Any
 
 from opspec.evaluation.describe import can_do_wrongly
-from opspec.evaluation.no_spread_notes import no_spread_note
+from opspec.evaluation.no_spread_notes import figure_marks, no_spread_note
 from opspec.evaluation.plan import span
 from opspec.evaluation.report_findings import metric_label, words
 from opspec.evaluation.store import ResultStore
@@ -160,20 +160,32 @@ def _subgroup_rates(store: ResultStore, design: str, definition: Mapping[str, An
 def _count_series(store: ResultStore, design: str, counts: list[str], days: float,
                   users: int) -> tuple[dict[str, Any], ...]:
     """What the counts-over-time figures draw of the count metrics ``counts``, keyed by
-    their words: the mean per user on each day, its interval, the total in each hour."""
+    their words: the mean per user on each day, its interval, the total in each hour, and
+    what each day's interval of no width says (:func:`no_spread`, None for the others)."""
+    from opspec.statistics.no_spread import no_spread
+
     # one pass over the outcome table for all metrics, not two per metric (issue 20)
     per_day, hours = _outcomes_all(store, design, counts, max(1, round(days)), users)
     bands = _day_intervals(store, design, counts, max(1, round(days)), users)
     return ({words(n): v for n, v in per_day.items()}, {words(n): v for n, v in bands.items()},
-            {words(n): v for n, v in hours.items()})
+            {words(n): v for n, v in hours.items()},
+            {words(n): [no_spread(day, users) for day in v] for n, v in bands.items()})
+
+
+def _day_marks(series: tuple[dict[str, Any], ...]) -> dict[str, Any]:
+    """How the days' intervals of no width from users all alike are marked in the figure
+    (:func:`.no_spread_notes.figure_marks`), and so in its caption."""
+    return figure_marks({name: [{"ci95_no_spread": alike} for alike in days]
+                         for name, days in series[3].items()})
 
 
 def _count_figures(series: tuple[dict[str, Any], ...], figures: Path, design: str
                    ) -> tuple[Path, Path]:
     from opspec.evaluation import plots
 
-    per_day, bands, hours = series
-    return (plots.over_days_figure(per_day, figures / f"{design}-days.png", bands=bands),
+    per_day, bands, hours, _ = series
+    return (plots.over_days_figure(per_day, figures / f"{design}-days.png", bands=bands,
+                                   **_day_marks(series)),
             plots.time_of_day_figure(hours, figures / f"{design}-hours.png"))
 
 
@@ -201,11 +213,13 @@ def _activity_figure(activity: list[dict[str, Any]], figures: Path, design: str,
 class AskedAhead:
     """What :func:`ask_ahead` computed of one design and the figures it asked for: the
     counts-over-time figures (None without count metrics), the rows of the user's actions
-    and their figure (None without activities)."""
+    and their figure (None without activities), and the note on the days' intervals of no
+    width from users all alike (None without one)."""
 
     counts: tuple[Path, Path] | None
     activity: list[dict[str, Any]]
     activity_image: Path | None
+    counts_note: str | None = None
 
 
 def ask_ahead(store: ResultStore, figures: Path, design: str, days: float, users: int,
@@ -222,7 +236,8 @@ def ask_ahead(store: ResultStore, figures: Path, design: str, days: float, users
     image = (_activity_figure(activity, figures, design, _never_wrong(activity, user_model))
              if activity else None)
     return AskedAhead(_count_figures(series, figures, design) if series is not None else None,
-                      activity, image)
+                      activity, image,
+                      _day_marks(series).get("no_spread_note") if series is not None else None)
 
 
 def design_sections(store: ResultStore, figures: Path, design: str, name: str, days: float,
@@ -351,14 +366,17 @@ def design_sections(store: ResultStore, figures: Path, design: str, name: str, d
     # counts over time
     counts = [d["name"] for d in definitions if d["kind"] == "count"]
     if counts:
-        sections.append(Section(f"{prefix}Counts over time", images=(
-            ahead.counts if ahead is not None and ahead.counts is not None
-            else _count_figures(_count_series(store, design, counts, days, users), figures,
-                                design)), captions=(
+        if ahead is not None and ahead.counts is not None:
+            drawn, alike = ahead.counts, ahead.counts_note
+        else:
+            counted = _count_series(store, design, counts, days, users)
+            drawn = _count_figures(counted, figures, design)
+            alike = _day_marks(counted).get("no_spread_note")
+        sections.append(Section(f"{prefix}Counts over time", images=drawn, captions=(
             ("Count outcomes per user, day by day: the mean over users (line) and its 95 % "
             "interval (band; t over users, widened to the exact Poisson interval on days "
             "with fewer than 10 events); each metric on its own scale, so rare outcomes are "
-            "visible"),
+            "visible" + (f". {alike}" if alike else "")),
             ("Count outcomes by hour of the day, all users and days (each metric on its own "
             "scale)"))))
 

@@ -19,12 +19,13 @@ from pathlib import Path
 from typing import IO, Any
 
 from opspec.errors import EvaluationError
-from opspec.evaluation.no_spread_notes import marked, no_spread_note, with_mark
+from opspec.evaluation.no_spread_notes import MARK, figure_marks, marked, no_spread_note, with_mark
 from opspec.evaluation.parameters import Parameter, describe_value, parse_value, resolve
 from opspec.evaluation.plan import Design, EvaluationPlan
 from opspec.evaluation.store import ResultStore
 from opspec.evaluation.targets import Target, parse_target, share_verdict, verdict
 from opspec.statistics.clustered import unpaired_difference
+from opspec.statistics.no_spread import no_spread
 from opspec.statistics.percentiles import nearest_rank
 
 __all__ = ["Sweep", "describe_parameters", "plan_sweep", "print_sweep", "report_sections",
@@ -159,6 +160,8 @@ def _differences(store: ResultStore, reference: str, design: str, level: float
         unpaired = unpaired_difference([pa[u] for u in users], [pb[u] for u in users], level)
         entry["unpaired_ci95"] = unpaired.ci
         entry["unpaired_ci95_method"] = unpaired.method
+        # no width when each value's users were all alike, as a ci95's (docs/evaluation.md)
+        entry["unpaired_ci95_no_spread"] = no_spread(unpaired.ci, len(users), level)
     return out
 
 
@@ -362,14 +365,22 @@ def _difference_cells(name: str, d: Mapping[str, Any] | None) -> tuple[str, str,
     unpaired = _width(d.get("unpaired_ci95"))
     ratio = (f"{paired / unpaired:.2f}" if paired is not None and unpaired
              else "–")
+    if marked(_unpaired(d)):        # no ratio, as the unpaired interval has no width
+        ratio += f" {MARK}"
     return show(d["difference"]) + (" *" if d.get("significant") else ""), ci, ratio
+
+
+def _unpaired(d: Mapping[str, Any]) -> dict[str, Any]:
+    """A difference's unpaired interval as :mod:`.no_spread_notes` reads a summary: of
+    each value's users apart (all alike in both, when it has no width)."""
+    return {"ci95_no_spread": d.get("unpaired_ci95_no_spread")}
 
 
 def _note(summary: Mapping[str, Any]) -> str | None:
     """What a marked interval of the sweep's tables means, once (:mod:`.no_spread_notes`)."""
+    differences = [d for v in summary["values"] for d in (v["difference"] or {}).values()]
     return no_spread_note([*(s for v in summary["values"] for s in v["metrics"].values()),
-                           *(d for v in summary["values"]
-                             for d in (v["difference"] or {}).values())])
+                           *differences, *map(_unpaired, differences)])
 
 
 def _width(ci: Sequence[float | None] | None) -> float | None:
@@ -501,9 +512,11 @@ def report_sections(summary: Mapping[str, Any], figures: Path, users: int) -> li
                 f"{side} of the users' own values",
                 [row["users"]["quantile"] for row in answer["values"]])
     axis = f"{summary['parameter']} ({summary['unit']})"
+    # a band of no width from users all alike: marked in the figure and its caption
+    alike = figure_marks({m: [v["metrics"].get(m) for v in values] for m in series})
     image = plots.sweep_figure(axis, xs, [v["text"] for v in values], series,
                                figures / "sweep.png", percent=percent, units=units,
-                               targets=lines, per_user=per_user)
+                               targets=lines, per_user=per_user, **alike)
     findings = [a["answer"] for a in summary["targets"]]
     findings += [a["users_answer"] for a in summary["targets"] if a.get("users_answer")]
     sections = [Section(f"Sweep of {summary['parameter']}", paragraphs=(
@@ -518,7 +531,7 @@ def report_sections(summary: Mapping[str, Any], figures: Path, users: int) -> li
             ("Each metric against the parameter: the line is the estimate, the band its 95 % "
              "confidence interval (each metric on its own scale); dashed lines are the "
              "targets, dotted lines the per-user quantile a share-of-users target is "
-             "judged by"),))]
+             "judged by" + (f". {alike['no_spread_note']}" if alike else "")),))]
     tables = [Table(SWEEP_HEADERS, tuple(metric_table(summary, metric)),
                     f"{metric}: per value, and the paired difference against "
                     f"{summary['reference']} (* the interval excludes 0)")

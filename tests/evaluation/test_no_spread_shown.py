@@ -51,7 +51,8 @@ def test_the_terminal_table_and_the_report_mark_it_and_say_once_why(capsys, tmp_
     assert "up to 70.8 % of users could give another value" in text
     report = (out / "report.md").read_text(encoding="utf-8")
     assert "| doses\\_due | count | 4 per user | \\[4, 4\\] † |" in report
-    assert report.count(NOTE) == 2              # under Estimates and How users differ
+    # under Estimates and How users differ, and in the caption of the counts day by day
+    assert report.count(NOTE) == 3
     assert "Alarms per dose due: 1 (95 % confidence interval 1 to 1; all 3 users gave" in report
     html = (out / "report.html").read_text(encoding="utf-8")
     assert "[4, 4] †" in html and NOTE in html

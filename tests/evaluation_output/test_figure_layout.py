@@ -185,10 +185,46 @@ def _empty(path: Path) -> Path:
     return plots.latency_figure(LONG_METRIC, [], path)
 
 
+def _alike(*names: str) -> dict[str, Any]:
+    """The marks of intervals of no width from 3 users all alike (docs/evaluation.md,
+    Intervals of no width): the panels marked, and the note under the figure."""
+    from opspec.evaluation.no_spread_notes import no_spread_note
+    from opspec.statistics.no_spread import no_spread
+
+    return {"no_spread": list(names),
+            "no_spread_note": no_spread_note([{"ci95_no_spread": no_spread([4, 4], 3)}])}
+
+
+def _over_days_alike(path: Path) -> Path:
+    # with the note on what never happened above it
+    return plots.over_days_figure(
+        {f"{LONG}_count": [4.0] * 30, "alarms": [4.7] * 30, "device_faults": [0.0] * 30},
+        path, bands={f"{LONG}_count": [(4.0, 4.0)] * 30}, **_alike(f"{LONG}_count"))
+
+
+def _comparison_alike(path: Path) -> Path:
+    # with the note on a difference without an interval above it
+    return plots.comparison_figure([("alarms", 4.0, 4.0, 4.0),
+                                    ("report_latency_s", 0.0, None, None)], path,
+                                   no_interval={"report_latency_s": "fewer than 2 users' "
+                                                "durations differ between the designs"},
+                                   **_alike("alarms"))
+
+
+def _sweep_alike(path: Path) -> Path:
+    return plots.sweep_figure(
+        "reminder_delay_s", [60.0, 120.0], ["1 min", "2 min"],
+        {"alarms": ([4.0, 4.0], [4.0, 4.0], [4.0, 4.0]),
+         LONG_METRIC: ([100.0, 130.0], [90.0, 120.0], [110.0, 140.0])}, path,
+        **_alike("alarms"))
+
+
 FIGURES: dict[str, Callable[[Path], Path]] = {
     "rates": _rates, "per-user": _per_user, "latency": _latency, "over-days": _over_days,
     "hours": _hours, "activities": _activities, "comparison": _comparison,
-    "subgroups": _subgroups, "parameters": _parameters, "sweep": _sweep, "empty": _empty}
+    "subgroups": _subgroups, "parameters": _parameters, "sweep": _sweep, "empty": _empty,
+    "over-days-alike": _over_days_alike, "comparison-alike": _comparison_alike,
+    "sweep-alike": _sweep_alike}
 
 
 @pytest.mark.parametrize("kind", sorted(FIGURES))
