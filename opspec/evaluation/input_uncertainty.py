@@ -215,8 +215,9 @@ def _combine(estimate: float | None, ordinary: Sequence[float | None] | None,
         if ordinary[0] >= 0 and low < 0 and estimate >= 0:
             low = 0.0           # as the ordinary interval: a rate cannot be negative
         low, high = min(low, ordinary[0]), max(high, ordinary[1])
-    if proportion:
-        high = min(high, 1.0)
+    if proportion:      # never below the ordinary interval it widens
+        high = min(high, max(1.0, ordinary[1] if ordinary and ordinary[1] is not None
+                             else 1.0))
     ordered = sorted(values)
     alpha = (1 - level) / 2
     bootstrap = [linear(ordered, alpha), linear(ordered, 1 - alpha)]
@@ -237,10 +238,12 @@ def _combine(estimate: float | None, ordinary: Sequence[float | None] | None,
             "df": df}
 
 
-def _proportion(pairs: Sequence[tuple[float, float]]) -> bool:
-    """Whether every user's (y, n) is a count of events out of n trials (a rate <= 1)."""
-    return bool(pairs) and all(0 <= y <= n and y == int(y) and n == int(n) and n > 0
-                               or n == 0 for y, n in pairs) and any(y < n for y, n in pairs)
+def _proportion(definition: Mapping[str, Any]) -> bool:
+    """Whether the metric is a proportion (bounded by 1): a ratio the spec declares one
+    (``Proportion="true"``). The declaration, never the numbers of this run, says it, as for
+    the ordinary summary (:mod:`opspec.evaluation.design_summary`): a count whose users each
+    had 0 or 1 events looks like one, and its interval must not be cut at 1."""
+    return definition.get("kind") == "ratio" and definition.get("proportion") is True
 
 
 def _batches(store: Any, plan: Any, label: str, definition: Mapping[str, Any]
@@ -284,7 +287,7 @@ def summarise_input_uncertainty(store: Any, plan: Any, metrics: Mapping[str, Any
         out["metrics"][name] = _combine(estimate, ordinary.get("ci95"),
                                         plain[1] if plain else None, len(pairs),
                                         [e for _, e in drawn], level,
-                                        proportion=_proportion(pairs),
+                                        proportion=_proportion(definition),
                                         ordinary_no_spread=ordinary.get("ci95_no_spread"),
                                         draw_users=sum(n for n, _ in drawn))
     if compare:

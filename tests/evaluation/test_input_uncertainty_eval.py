@@ -66,6 +66,28 @@ def test_draws_leave_the_ordinary_results_as_they_were(evaluate, fitted, tmp_pat
     assert latency["variance"]["parameters"] >= 0
     rate = summary["metrics"]["taken_rate"]["ci95_with_parameters"]
     assert 0 <= rate[0] <= rate[1] <= 1
+    # the widened interval contains the ordinary one, for every metric
+    for name, entry in summary["metrics"].items():
+        if entry["ci95"] and entry["ci95_with_parameters"]:
+            (low, high), (wide_low, wide_high) = entry["ci95"], entry["ci95_with_parameters"]
+            assert wide_low <= low and wide_high >= high, name
+
+
+def test_only_a_declared_proportion_is_cut_at_one() -> None:
+    """A count whose few users each had 0 or 1 events looks like a proportion; its ordinary
+    interval ([0, 1.23] here) reaches past 1, and the widened one must contain it. Only the
+    spec's declaration (Proportion="true" on a ratio) makes a metric a proportion, as in the
+    ordinary summary; even then the cut never falls below the ordinary interval."""
+    from opspec.evaluation.input_uncertainty import _combine, _proportion
+
+    assert not _proportion({"kind": "count", "name": "doses_missed"})
+    assert not _proportion({"kind": "ratio", "proportion": False})
+    assert _proportion({"kind": "ratio", "proportion": True})
+    batches = [(0.2, 0.1), (0.6, 0.1), (0.4, 0.1)]
+    for proportion in (False, True):
+        out = _combine(0.33, [0.0, 1.23], 0.1, 3, batches, 0.95, proportion=proportion)
+        low, high = out["ci95_with_parameters"]
+        assert low <= 0.0 and high >= 1.23
 
 
 def test_the_same_seed_gives_the_same_draws_whatever_the_workers(evaluate, fitted,
