@@ -14,9 +14,12 @@ and takes the rest; an inclusive gateway's are each flow's own chance (flows lef
 file's). A gateway whose conditions decide it is refused: there is nothing to draw.
 
 Each refusal is a :class:`BranchRefusal`: its message is the command line's (``--branch
-GATEWAY: …``); a scenario file, which gives the same probabilities as a TOML table, checks
-them when it is collected (:func:`read_branch_table`, :func:`check_branch_table`) and says
-the refusal in its own words (``in_file``) at the key it is about (``at``).
+GATEWAY: …``) when the probabilities came from it (:func:`parse_branch_options` gives
+:class:`CommandLineBranches`); a scenario file, which gives the same probabilities as a TOML
+table, checks them when it is collected (:func:`read_branch_table`, :func:`check_branch_table`)
+and says the refusal in its own words (``in_file``) at the key it is about (``at``); the
+Python API's ``branches={...}`` is refused in its words, at its keys
+(:meth:`BranchRefusal.in_api_words`).
 """
 
 from __future__ import annotations
@@ -32,7 +35,8 @@ from opspec.model import Package
 from opspec.model.activities import Activity, GatewayType
 from opspec.model.process import ConditionKind, Transition
 
-__all__ = ["BranchRefusal", "Branches", "check_branch_table", "check_branches",
+__all__ = ["BranchRefusal", "Branches", "CommandLineBranches", "check_branch_table",
+           "check_branches",
            "gateway_lines", "parse_branch_options", "read_branch_table", "with_branches"]
 
 #: gateway -> flow -> probability, as the user named them
@@ -59,11 +63,23 @@ class BranchRefusal(ConfigurationError):
         self.in_file = in_file or message
         self.file_hint = hint if file_hint is None else file_hint
 
+    def in_api_words(self) -> BranchRefusal:
+        """The same refusal for ``opspec.run(branches={...})`` (and ``simulate``): placed at
+        its keys (``branches['Pill taken?']['Yes']``), without the command line's syntax."""
+        keys = "".join(f"[{key!r}]" for key in self.at)
+        return BranchRefusal(f"branches{keys}: {self.in_file}",
+                             hint=self.file_hint.replace("given.params", "params"),
+                             at=self.at, in_file=self.in_file, file_hint=self.file_hint)
 
-def parse_branch_options(texts: Iterable[str]) -> dict[str, dict[str, float]]:
+
+class CommandLineBranches(dict[str, dict[str, float]]):
+    """Branch probabilities as ``--branch`` gave them: refused in the command line's words."""
+
+
+def parse_branch_options(texts: Iterable[str]) -> CommandLineBranches:
     """The ``--branch`` texts as gateway -> flow -> probability (a later one for the same
     gateway replaces the earlier)."""
-    out: dict[str, dict[str, float]] = {}
+    out = CommandLineBranches()
     for text in texts:
         gateway, sep, rest = text.partition("=")
         if not sep or not gateway.strip() or not rest.strip():

@@ -200,10 +200,20 @@ def _spec(spec: Any) -> tuple[LoadedSpec, tuple[Any, ...], Path | None]:
 def _with_branches(loaded: LoadedSpec, branches: Any) -> LoadedSpec:
     """``loaded`` recompiled with the run-time branch probabilities (before compile, so the
     run, its workers and its seed see one spec)."""
-    from opspec.branch_choices import gateway_lines, with_branches
+    from opspec.branch_choices import (
+        BranchRefusal,
+        CommandLineBranches,
+        gateway_lines,
+        with_branches,
+    )
     from opspec.runs import load
 
-    changed = load(with_branches(loaded.package, branches))
+    try:
+        changed = load(with_branches(loaded.package, branches))
+    except BranchRefusal as refusal:
+        if isinstance(branches, CommandLineBranches):
+            raise
+        raise refusal.in_api_words() from None
     # the file's warning about the shares it would draw no longer holds for these gateways
     lines = gateway_lines(loaded.package, branches)
     kept = tuple(w for w in loaded.warnings if getattr(w, "code", None) != "undecided-gateway"

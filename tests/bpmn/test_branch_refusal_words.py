@@ -99,3 +99,39 @@ def test_a_refusal_travels_between_processes() -> None:
 
     refusal = BranchRefusal("--branch x: no gateway", hint="h", at=("x",), in_file="no gateway")
     assert str(pickle.loads(pickle.dumps(refusal))) == str(refusal)
+
+
+@pytest.mark.parametrize(("branches", "said"), [
+    ({"Pill takn?": {"Yes": 0.8}},
+     "branches['Pill takn?']: no gateway of this id or name (did you mean 'Pill taken?'?); "
+     "name a gateway by its id or name, as opspec validate prints them (docs/bpmn.md, "
+     "Undecided gateways)"),
+    ({"ask": {"Yess": 0.8, "No": 0.2}},
+     "branches['ask']['Yess']: no flow of this id or name out of ask ('Pill taken?') (did you "
+     "mean 'Yes'?); its flows are yes ('Yes'), no ('No')"),
+    ({"check": {"high": 0.5, "low": 0.5}},
+     "branches['check']: the conditions of check ('Score high?') decide it; branch "
+     "probabilities apply only to a gateway the diagram leaves undecided; leave it out of "
+     "branches, or give the run inputs its conditions read (params)"),
+], ids=["gateway", "flow", "decided"])
+def test_the_python_api_is_refused_in_its_own_words(
+        tmp_path: Path, branches: dict[str, dict[str, float]], said: str) -> None:
+    """``opspec.run(branches={...})`` and ``simulate`` take a dict, not ``--branch`` text: the
+    refusal names the dict's keys and no command-line option; ``--branch`` keeps its words
+    (the command line passes :class:`CommandLineBranches`)."""
+    import opspec
+    from opspec.branch_choices import CommandLineBranches, parse_branch_options
+    from opspec.errors import with_hint
+    from opspec.testing import simulate
+
+    diagram = tmp_path / "pill.bpmn"
+    diagram.write_text(DIAGRAM, encoding="utf-8")
+    for door in (lambda: opspec.run(diagram, branches=branches, until=60),
+                 lambda: simulate(diagram, branches=branches, users=1, days=0.01)):
+        with pytest.raises(BranchRefusal) as raised:
+            door()
+        assert with_hint(raised.value.message, raised.value.hint) == said
+    assert isinstance(parse_branch_options(["ask=Yes:1"]), CommandLineBranches)
+    with pytest.raises(BranchRefusal) as raised:
+        opspec.run(diagram, branches=CommandLineBranches(branches), until=60)
+    assert str(raised.value).startswith("--branch ")
