@@ -465,4 +465,7 @@ class ScenarioItem(pytest.Item):
         return str(super().repr_failure(excinfo, style=style))
 
     def reportinfo(self) -> tuple[Path, int | None, str]:
-        return self.path, None, f"scenario: {self.name}"
+        # the line its [[scenario]] is written on (pytest's lines count from 0): a test
+        # report's header, --verbose and an editor's jump land on the scenario
+        line = self.scenario.line()
+        return self.path, None if line is None else line - 1, f"scenario: {self.name}"

@@ -75,6 +75,12 @@ class Scenario:
     file: Path | None = None
     key: str = ""
 
+    def line(self) -> int | None:
+        """The line its ``[[scenario]]`` table starts on (read now), or None when unknown."""
+        if self.file is None or not self.key:
+            return None
+        return located(str(self.file), self.key).line
+
     def place(self, key: str = "") -> str:
         """``path:line: scenario[N]`` followed by ``key`` (``.then[1]``): where that is written
         in the scenario file, which is read now (call it for a failure only); ``where`` and

@@ -184,3 +184,16 @@ def test_the_error_raised_is_at_the_line_for_a_caller_of_load_scenarios(
         load_scenarios(tmp_path / "x.scenario.toml")
     at = raised.value.location
     assert (at.line, at.key) == (5, "scenario[0].given.script[0]")
+
+
+def test_each_scenario_item_is_located_at_its_table(project: pytest.Pytester) -> None:
+    """pytest places an item by ``reportinfo`` (its header in a failure, ``item.location``):
+    a scenario is at the line of its ``[[scenario]]`` table, not at the top of the file."""
+    (project.path / "specs" / "tests").mkdir()
+    path = project.path / "specs" / "tests" / "pill.scenario.toml"
+    path.write_text(FAILING)
+    items, _ = project.inline_genitems(str(path))
+    tables = [n for n, line in enumerate(FAILING.splitlines()) if line == "[[scenario]]"]
+    assert [(item.name, item.location[1]) for item in items] == [
+        ("prompt user", tables[0]), ("silent user", tables[1]), ("one line", tables[2])]
+    assert all(item.location[2] == f"scenario: {item.name}" for item in items)
