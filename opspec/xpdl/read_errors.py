@@ -21,7 +21,7 @@ __all__ = ["XmlReadError", "doctype_error", "not_well_formed_error"]
 class XmlReadError(SpecError):
     """A file cannot be read as XPDL at all. ``code`` is one of ``io-error``, ``too-big``,
     ``empty-file``, ``not-well-formed``, ``resource-limit``, ``doctype``, ``unknown-root``,
-    ``unknown-version``, ``compiled-script``, ``bad-setting``."""
+    ``unknown-version``, ``compiled-script``, ``not-a-spec``, ``bad-setting``."""
 
     def __init__(self, code: str, message: str, *, location: SourceLocation, hint: str = "") -> None:
         self.code = code

@@ -142,7 +142,7 @@ def parse_safely(data: bytes, *, path: str, max_bytes: int = DEFAULT_MAX_BYTES) 
         if wrong is None:
             raise
         message, location, hint = wrong
-        raise XmlReadError("not-well-formed", message, location=location, hint=hint) from None
+        raise XmlReadError("not-a-spec", message, location=location, hint=hint) from None
     tree = root.getroottree()
     if tree.docinfo.doctype or tree.docinfo.internalDTD is not None:
         raise doctype_error(path, _doctype_line(data) or 1)

@@ -5,6 +5,7 @@ well-formed XML at column 1". A broken XML file keeps the reader's own message."
 
 from __future__ import annotations
 
+import json
 import shutil
 from pathlib import Path
 
@@ -50,6 +51,10 @@ def test_validate_says_what_the_file_is(tmp_path: Path, name: str,
     out = capsys.readouterr().out
     assert f"{says}; {WANTED}" in out.replace(":1: error: ", ":1: ")
     assert "well-formed" not in out
+    # its own code, for a tool reading --json: it is no spec, not a broken one
+    assert main(["validate", str(path), "--json"]) == 1
+    codes = [d["code"] for d in json.loads(capsys.readouterr().out)["diagnostics"]]
+    assert codes == ["not-a-spec"]
 
 
 def test_a_user_model_is_told_where_it_goes(tmp_path: Path,
