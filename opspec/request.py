@@ -60,7 +60,7 @@ def __getattr__(name: str) -> Any:
     raise AttributeError(f"module 'opspec.request' has no attribute {name!r}")
 #: the parts of a request that prepare() decides from (the rest goes to runs.build as it is)
 _DECIDED = frozenset({"spec", "seed", "days", "until", "script", "user_model", "user",
-                      "no_user"})
+                      "no_user", "default_metrics"})
 
 
 @dataclass(frozen=True, eq=False)
@@ -91,6 +91,9 @@ class RunRequest:
     branches: Mapping[str, Mapping[str, float]] | None = None
     keep_trace: bool = False
     keep_times: bool = False
+    #: when the spec declares no metrics, measure each process's completed instances and
+    #: cycle time (:mod:`opspec.model.default_metrics`; ``opspec evaluate`` asks for it)
+    default_metrics: bool = False
     monitors: tuple[Any, ...] | None = None
     devices: Any = None
 
@@ -221,6 +224,15 @@ def _with_branches(loaded: LoadedSpec, branches: Any) -> LoadedSpec:
     return replace(changed, warnings=kept)
 
 
+def _with_default_metrics(loaded: LoadedSpec) -> LoadedSpec:
+    """``loaded`` recompiled with opspec's default metrics (the spec declares none)."""
+    from opspec.model.default_metrics import default_metrics
+    from opspec.runs import load
+
+    package = replace(loaded.package, metrics=default_metrics(loaded.package))
+    return replace(load(package), warnings=loaded.warnings)
+
+
 def _source(package: Any) -> Path | None:
     source = getattr(package, "source", None)
     return Path(source) if source else None
@@ -341,6 +353,8 @@ def prepare(request: RunRequest) -> PreparedRun:
     if request.branches:
         loaded = _with_branches(loaded, request.branches)
         spec_warnings = loaded.warnings
+    if request.default_metrics and not loaded.package.metrics:
+        loaded = _with_default_metrics(loaded)
     horizon = run_length(loaded.compiled, days=request.days, until=request.until)
     _check_world(loaded.compiled, seed)
     if request.params:

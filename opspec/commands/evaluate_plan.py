@@ -79,13 +79,14 @@ def new_plan(args: argparse.Namespace) -> tuple[Any, dict[str, Any]]:
     from opspec.branch_choices import parse_branch_options
 
     branches = parse_branch_options(args.branch)
+    # a spec that declares no metrics is measured per process (opspec.model.default_metrics)
     a = prepare(RunRequest(args.spec, days=args.days, user_model=args.user_model,
-                           branches=branches or None))
+                           branches=branches or None, default_metrics=True))
     model = a.user_model
     decided = {str(args.spec): a}
     for _label, path in specs[1:]:
         b = prepare(RunRequest(path, days=args.days, user_model=model, no_user=model is None,
-                               branches=branches or None))
+                               branches=branches or None, default_metrics=True))
         decided.setdefault(str(path), b)
     # --param: a value of a package data field (a BPMN diagram's run input) for every design,
     # applied as a parameter of one value (what --sweep applies per design)
@@ -165,11 +166,25 @@ def check_plan(plan: Any, decided: dict[str, Any] | None = None
         from opspec.evaluation.describe import metric_record
 
         definitions[design.label] = [metric_record(m) for m in context.compiled.package.metrics]
+        _say_default_metrics(design.spec, context.compiled.package.metrics, shown)
     if plan.input_uncertainty:          # the fitted model's draws: there, and enough of them
         from opspec.evaluation.input_uncertainty import check_draws
 
         check_draws(plan)
     return definitions
+
+
+def _say_default_metrics(spec: str, metrics: Any, shown: set[str]) -> None:
+    """Say, once, that a spec declaring no metrics is measured by opspec's defaults."""
+    from opspec.model.default_metrics import is_default
+
+    names = [m.name for m in metrics if is_default(m.description)]
+    said = (f"opspec evaluate: {spec}: the spec declares no metrics (opspec:Metrics), so "
+            f"each process is measured by default: {', '.join(names)} (docs/evaluation.md, "
+            "Default metrics; declare your own to measure what matters)")
+    if names and said not in shown:
+        shown.add(said)
+        print(said, file=sys.stderr)
 
 
 def refuse_spec_template(args: argparse.Namespace) -> None:

@@ -227,7 +227,8 @@ def prepare(spec: str, sha256: str, user_model: str | None, engine: Mapping[str,
     # the front hall decides the spec (validate's gate) and the user model (checked against
     # the spec's user lane), in the command and in every worker alike
     prepared = decided if decided is not None else decide(RunRequest(
-        spec, user_model=user_model, no_user=user_model is None, branches=branches or None))
+        spec, user_model=user_model, no_user=user_model is None, branches=branches or None,
+        default_metrics=True))
     loaded = prepared.spec
     lane = user_lane(loaded.compiled)
     user = prepared.user if prepared.user.kind == "model" else None

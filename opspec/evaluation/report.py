@@ -124,6 +124,21 @@ def _methods_section(summaries: Any, sections: Sequence[Any]) -> Any:
                       "The interval methods used in this report"),) if rows else ())
 
 
+def _metrics_caption(definitions: Sequence[Mapping[str, Any]]) -> str:
+    """Whose metrics these are: the spec's, or opspec's defaults for a spec declaring none."""
+    from opspec.model.default_metrics import is_default
+
+    if not definitions:
+        return ("The spec declares no metrics (opspec:Metrics) and has no process to measure: "
+                "nothing was estimated")
+    if all(is_default(d.get("description")) for d in definitions):
+        return ("The spec declares no metrics (opspec:Metrics): opspec measured each process "
+                "by default, its completed instances and their cycle time, from each user's "
+                "trace (declare your own to measure what matters: docs/evaluation.md, Default "
+                "metrics)")
+    return "Metrics the spec declares (opspec:Metrics), computed from each user's trace"
+
+
 def _no_interval_words(difference: Mapping[str, Any]) -> str:
     """Why a difference of durations has no interval ('–'), when one has none: '–' is the
     paired method's answer (:func:`opspec.statistics.paired_difference`), not a number left
@@ -343,7 +358,7 @@ def _report_sections(store: ResultStore, summaries: Mapping[str, Summaries] | No
         sections.append(Section(f"What each metric measures{suffix}", tables=(Table(
             ("metric", "kind", "definition"),
             tuple((d["name"], str(d["kind"]), describe_metric(d)) for d in definitions),
-            "Metrics the spec declares (opspec:Metrics), computed from each user's trace"),)))
+            _metrics_caption(definitions)),)))
     sections.append(user_model_section(store, plan, figures, population))
 
     # which activities it can do wrongly (read once: as the figures asked ahead read it)
