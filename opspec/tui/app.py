@@ -513,8 +513,9 @@ class WalkthroughApp(App[str | None]):
         text = Text(no_wrap=True, overflow="ellipsis")
         rows = session.board.rows()
         deadlines = Text()
-        for (instance, activity), due in sorted(session.deadlines.items(),
-                                                key=lambda kv: kv[1])[:3]:
+        # an ended run has no countdown left; what rang then is the state it ended in
+        for (instance, activity), due in ([] if session.ended else sorted(
+                session.deadlines.items(), key=lambda kv: kv[1])[:3]):
             left = max(0.0, due - session.now)
             deadlines.append(f"deadline {activity} (#{instance}) in {int(left // 60):02d}:"
                              f"{int(left % 60):02d}\n", style="bold")
@@ -527,13 +528,16 @@ class WalkthroughApp(App[str | None]):
             marker = "(x)" if row.status.startswith("FAULT") else "(!)" if row.alert else " * "
             line = Text(no_wrap=True, overflow="ellipsis")
             line.append(f"{marker} {row.id}: ", style="bold")
+            if session.ended and row.alert:
+                line.append("at the end: ")
             line.append(row.status, style="bold reverse" if row.alert else "")
             text.append_text(line)
             text.append("\n")
             if row.detail:
                 text.append(f"      {row.detail}\n", style="italic")
         if session.current:
-            text.append("Running:\n", style="bold")
+            text.append("Running when the run ended:\n" if session.ended else "Running:\n",
+                        style="bold")
             running = sorted(session.current.items())
             for instance, (process, activity) in running[:4]:
                 text.append(f"  {process}#{instance} at {activity}\n")

@@ -130,6 +130,10 @@ async def test_a_run_that_ended_while_the_alarm_rang_calls_nobody(compiled, tmp_
         await pilot.press("escape")                     # the summary that opened
         await pilot.pause()
         panel = str(app.query_one("#call").render())
+        device = app._device_text().plain
         await pilot.press("q")
     assert "THE DEVICE CALLS YOU" not in panel
     assert panel == "(the replay has ended: q quits; a replay records nothing)"
+    # the device panel shows the state the run ended in, with no countdown that never ends
+    assert "alarm: at the end: ((( RINGING ))) since 08:00" in device
+    assert "deadline " not in device and "Running when the run ended:" in device
