@@ -53,10 +53,11 @@ from opspec.engine.compiled import (
 )
 from opspec.engine.conditions import constant_value
 from opspec.engine.instances import ActivityInstance, Frame
-from opspec.engine.lifecycle import COMPLETED, RUNNING, SUSPENDED
+from opspec.engine.lifecycle import COMPLETED, LIFECYCLE, RUNNING, SUSPENDED
 from opspec.engine.performers import WorkItem
 from opspec.engine.trace import EventKind as EK
 from opspec.errors import OpspecError
+from opspec.model import ParameterMode
 
 __all__ = ["MAX_BLOCKS", "attach", "build", "build_resume", "resumes"]
 
@@ -68,6 +69,9 @@ _MAX_DEPTH: Final = 24
 
 #: whether the engine runs compiled (mypyc): its functions are then not Python functions
 COMPILED: Final = not isinstance(lone.run, types.FunctionType)
+
+#: a completed instance's state (``Flow.instance_done``'s)
+ENDED: Final = LIFECYCLE.table[(RUNNING, "complete")]
 
 _NO_TRANSITION: Final = ("no outgoing transition can be taken (no condition holds and "
                          "there is no OTHERWISE transition)")
@@ -250,7 +254,8 @@ class _Writer:
             "OpspecError": OpspecError, "RUNNING": RUNNING, "SUSPENDED": SUSPENDED,
             "STARTED": EK.ACTIVITY_STARTED, "COMPLETED": EK.ACTIVITY_COMPLETED,
             "CHANGED": EK.DATA_CHANGED, "OFFERED": EK.ACTIVITY_OFFERED, "DONE": COMPLETED,
-            "ACTIVITY": ActivityInstance, "ITEM": WorkItem, "PROXY": MappingProxyType}
+            "ACTIVITY": ActivityInstance, "ITEM": WorkItem, "PROXY": MappingProxyType,
+            "ENDED": ENDED, "ENDED_KIND": EK.PROCESS_COMPLETED, "IN": ParameterMode.IN}
 
     def name(self, prefix: str, value: Any) -> str:
         key = f"{prefix}{len(self.names)}"
@@ -345,15 +350,44 @@ class _Writer:
         (``Flow.split``'s end, ``Flow.token_gone``: in line, as the instance's top frame is
         never an activity set's, when the workflow is no ad-hoc set)."""
         if not self.framed:
-            return [f"{pad}flow.instance_done(inst)"]
+            return self.done(pad)
         if self.proc.graph.completion is not None:
             return [f"{pad}flow.token_gone(frame)"]
         return [f"{pad}frame.live -= 1",
                 f"{pad}if frame.live <= 0 or frame.ors:",
                 f"{pad}    if frame.live <= 0 and not frame.parked:",
-                f"{pad}        flow.instance_done(inst)",
+                *self.done(pad + "        "),
                 f"{pad}    else:",
                 f"{pad}        state.pending[frame] = None"]
+
+    def done(self, pad: str) -> list[str]:
+        """``Flow.instance_done(inst)``, in line: the instance completes, and a synchronous
+        caller gets its OUT parameters (a frameless instance has no frames to clear)."""
+        proc = self.proc
+        p = self.name("PR", proc)
+        return [f"{pad}if inst.state == RUNNING:          # (Flow.instance_done's steps)",
+                f"{pad}    inst.state = ENDED",
+                *([f"{pad}    inst.frames.clear()"] if self.framed else []),
+                f"{pad}    live = state.live",
+                f"{pad}    if iid in live:",
+                f"{pad}        del live[iid]",
+                f"{pad}    parent = inst.parent",
+                f"{pad}    if state.kept and parent is None:",
+                f"{pad}        flow.triggers.drop_kept(inst)",
+                f"{pad}    state.completed += 1",
+                f"{pad}    cached = {p}.flag_cache",
+                (f"{pad}    if (cached.bits if cached.key is state.flag_key "
+                 f"else state.proc_bits({p})) & 2:"),
+                (f"{pad}        state.emit(ENDED_KIND, {self.name('P', proc.id)}, iid, None, "
+                 f"{self.name('L', proc.lane)}, None, "
+                 f"{{\"duration\": state.now - inst.started_at}})"),
+                f"{pad}    if parent is not None and parent.state == RUNNING:",
+                f"{pad}        parent.child = None",
+                f"{pad}        out = {{}}",
+                f"{pad}        for mode, formal, _fn, target in parent.act.params:",
+                f"{pad}            if mode is not IN and target is not None:",
+                f"{pad}                out[target] = inst.data.get(formal)",
+                f"{pad}        activities.body_done(parent, out or None)"]
 
     def hand_over(self, index: int, pad: str) -> list[str]:
         """The hand-over at activity ``index`` (as in ``lone.run``): the instance gets its
