@@ -43,6 +43,7 @@ from opspec.engine import lone
 from opspec.engine.compiled import (
     K_ASYNC,
     K_MANUAL,
+    K_SUBFLOW,
     K_TASK,
     K_THROW,
     S_XOR,
@@ -404,13 +405,38 @@ class _Writer:
             start = [*self.instance(act, pad), f"{pad}activities.activate(ai)", f"{pad}return"]
         elif act.plain and not act.general and not act.start_assign:
             start = [*self.instance(act, pad), *self.started(act, pad),
-                     f"{pad}activities._body(ai)", f"{pad}return"]
+                     *(self.call(act, pad) if act.kind == K_SUBFLOW
+                       else [f"{pad}activities._body(ai)"]), f"{pad}return"]
         else:
             start = [f"{pad}activities.start_slow(frame, {a})", f"{pad}return"]
         if self.framed:
             return start
         return [f"{pad}frame = FRAME(GRAPH, inst, None)", f"{pad}inst.frames.append(frame)",
                 f"{pad}frame.live = 1", *start]
+
+    def call(self, act: CompiledActivity, pad: str) -> list[str]:
+        """``Activities._body`` of a synchronous subflow call, in line: its actual
+        parameters (``Activities.inputs``), the depth guard, the called instance started
+        with ``ai`` waiting for it."""
+        from opspec.engine.activities import MAX_CALL_DEPTH  # (activities imports plans)
+        a = f"A{act.index}"
+        target = self.name("F", act.subflow)
+        items = ", ".join(f"{self.name('M', formal)}: {self.name('V', fn)}(scope, now)"
+                          for _mode, formal, fn, _target in act.params if fn is not None)
+        return [f"{pad}now = state.now",
+                f"{pad}scope = inst.scope",
+                f"{pad}try:",
+                f"{pad}    data = {{{items}}}",
+                f"{pad}except OpspecError as error:",
+                (f"{pad}    activities.fail(ai, \"parameter\", "
+                 f"f\"an actual parameter failed: {{error.message}}\")"),
+                f"{pad}    return",
+                f"{pad}called = state.processes[{target}]",
+                f"{pad}if inst.depth >= {MAX_CALL_DEPTH}:",
+                f"{pad}    activities._too_deep(ai, called)",
+                f"{pad}    return",
+                f"{pad}ai.waiting = {self.name('G', 'subflow ')} + called.id",
+                f"{pad}ai.child = flow.start_process(called, data, parent=ai)"]
 
     def instance(self, act: CompiledActivity, pad: str) -> list[str]:
         """``Activities.start_slow``'s first steps: ``act``'s activity instance ``ai``,
