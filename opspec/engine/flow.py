@@ -14,7 +14,7 @@ from collections import ChainMap
 from collections.abc import Callable, Mapping, MutableMapping
 from typing import TYPE_CHECKING, Any, Final
 
-from opspec.engine import drawing, escalations, joins, lone, process_deadlines
+from opspec.engine import drawing, escalations, joins, lone, plans, process_deadlines
 from opspec.engine.compiled import (
     J_AND,
     J_COMPLEX,
@@ -53,6 +53,10 @@ class Flow(Part):
         self.arrive_q: Callable[[Frame, int, CTransition | None], None] = self._arrive
         self.performed_q: Callable[[Frame, int, CTransition | None], None] = self.performed
         self.start_lone_q: Callable[[ProcessInstance, int, Any], None] = self.start_lone_at
+        # from source, the plans of the deferred choices' branches (opspec.engine.plans): by
+        # the transition into the branch, queued in performed's place; empty compiled
+        self.performs: dict[CTransition, Callable[[Frame, Any, CTransition], None]] = (
+            {} if plans.COMPILED else plans.performs(state.compiled))
 
     def start_process(self, proc: CompiledProcess, data: Mapping[str, Any] | None = None, *,
                       parent: ActivityInstance | None = None, trigger: str | None = None,
@@ -498,8 +502,12 @@ class Flow(Part):
             for target, fn in trans.assignments:
                 self.set_field(inst, None, target, fn(inst.scope, now))
         frame.live += 1
-        self.state.ready.append((self.performed_q if performed else self.arrive_q, frame,
-                            trans.target, trans))
+        performs = self.performs            # (empty compiled: its size, no look-up)
+        if performed and performs and trans in performs:
+            self.state.ready.append((performs[trans], frame, self.activities, trans))
+        else:
+            self.state.ready.append((self.performed_q if performed else self.arrive_q, frame,
+                                     trans.target, trans))
         if trans.tokens > 1:                # a thread split (WCP-42): one token each
             for _ in range(trans.tokens - 1):
                 frame.live += 1

@@ -42,6 +42,7 @@ from typing import Any, Final
 from opspec.engine import lone
 from opspec.engine.compiled import (
     K_ASYNC,
+    K_GATEWAY,
     K_MANUAL,
     K_SUBFLOW,
     K_TASK,
@@ -50,6 +51,7 @@ from opspec.engine.compiled import (
     CompiledActivity,
     CompiledPackage,
     CompiledProcess,
+    CTransition,
     CTrigger,
 )
 from opspec.engine.conditions import constant_value
@@ -60,7 +62,8 @@ from opspec.engine.trace import EventKind as EK
 from opspec.errors import OpspecError
 from opspec.model import ParameterMode
 
-__all__ = ["MAX_BLOCKS", "attach", "build", "build_resume", "resumes"]
+__all__ = ["MAX_BLOCKS", "attach", "build", "build_performed", "build_resume", "performs",
+           "resumes"]
 
 #: Activity blocks written out per plan at most (merging branches are written once per
 #: path); past it, or deeper than :data:`_MAX_DEPTH` nested splits, the plan ends in
@@ -89,6 +92,8 @@ def attach(compiled: CompiledPackage) -> None:
             plan: Any = build(proc, proc.one_start)
             plan.resumes = {proc.graph.activities[index]: build_resume(proc, index)
                             for index in resumable(proc)}
+            plan.performs = {trans: build_performed(proc, trans.target)
+                             for trans in performable(proc)}
             proc.plan = plan
     compiled.plans = True
 
@@ -101,6 +106,38 @@ def resumes(compiled: CompiledPackage) -> dict[CompiledActivity, Callable[[Any, 
     found: dict[CompiledActivity, Callable[[Any, Any], None]] = {}
     for proc in compiled.processes.values():
         found.update(getattr(proc.plan, "resumes", None) or {})
+    return found
+
+
+def performs(compiled: CompiledPackage) -> dict[CTransition, Callable[[Any, Any, Any], None]]:
+    """The performed-branch plans of ``compiled``'s workflows by the deferred choice's
+    transition into the branch (``Flow.take`` queues ``plan(frame, activities, trans)`` in
+    ``Flow.performed``'s place); empty when the engine runs compiled."""
+    attach(compiled)
+    found: dict[CTransition, Callable[[Any, Any, Any], None]] = {}
+    for proc in compiled.processes.values():
+        found.update(getattr(proc.plan, "performs", None) or {})
+    return found
+
+
+def performable(proc: CompiledProcess) -> list[CTransition]:
+    """The branches of ``proc``'s deferred choices (not labelled ones: those run their
+    branch) whose chosen activity a plan completes and carries on from
+    (``Flow.performed``, ``Flow.finish``): it completes without error, escalation,
+    terminate, loop or multi-instance, is no asynchronous call, and its way out is known
+    before the run (as a resume plan's) or it ends the path."""
+    acts = proc.graph.activities
+    found = []
+    for act in acts:
+        if act.labelled or not (act.choice or act.kind == K_GATEWAY):
+            continue
+        for trans in act.choice or act.out:
+            target = acts[trans.target]
+            if (target.error is None and target.escalation is None and not target.terminate
+                    and target.loop is None and target.mi is None and target.kind != K_ASYNC
+                    and (_ways_out(target, acts) or target.next < 0 and not (
+                        target.out or target.otherwise or target.choice or target.drawn))):
+                found.append(trans)
     return found
 
 
@@ -224,6 +261,35 @@ def build_resume(proc: CompiledProcess, index: int) -> Callable[[Any, Any], None
     return resume
 
 
+def build_performed(proc: CompiledProcess, index: int) -> Callable[[Any, Any, Any], None]:
+    """The plan of a deferred choice's branch into ``proc``'s activity ``index`` (one of
+    :func:`performable`): ``performed(frame, activities, trans)``, queued by ``Flow.take``,
+    does what ``Flow.performed`` does (the chosen activity starts and completes at once)
+    and then what ``Activities.start`` does with the token, in the instance's frame."""
+    writer = _Writer(proc, framed=True)
+    act = proc.graph.activities[index]
+    writer.names["PERFORMED"] = index
+    lines = ["def performed(frame, activities, trans):",
+             "    inst = frame.inst",
+             "    flow = activities.flow",
+             "    if inst.state != RUNNING or (frame.owner is not None",
+             "                                 and frame.owner.state != RUNNING):",
+             "        flow._dropped(frame, flow.performed, PERFORMED, trans)",
+             "        return",
+             "    state = activities.state",
+             "    limit = state.start_limit",
+             "    iid = inst.id",
+             "    steps = 0"]
+    if any(other.general for other in proc.graph.activities):
+        lines.append("    pooled = state.pooled")
+    if any(other.kind == K_TASK for other in proc.graph.activities):
+        lines.append("    apps = state.apps")
+    writer.block(index, (), 1, lines, performed=True)
+    made: Callable[[Any, Any, Any], None] = _made(
+        writer, lines, f"<performed plan of {proc.id}/{act.index}>", "performed")
+    return made
+
+
 def _made(writer: _Writer, lines: list[str], where: str, name: str) -> Any:
     """The function ``name`` that ``lines`` define, made once."""
     source = "\n".join(lines) + "\n"
@@ -263,34 +329,38 @@ class _Writer:
         self.names[key] = value
         return key
 
-    def block(self, index: int, path: tuple[int, ...], depth: int, out: list[str]) -> None:
-        """The code of the token at activity ``index`` (reached through ``path``)."""
+    def block(self, index: int, path: tuple[int, ...], depth: int, out: list[str],
+              performed: bool = False) -> None:
+        """The code of the token at activity ``index`` (reached through ``path``;
+        ``performed``: the branch a deferred choice took, which starts and completes at
+        once without a step of its own, as ``Flow.performed`` runs it)."""
         pad = "    " * depth
         act = self.acts[index]
         a = f"A{index}"
         self.names[a] = act
         self.blocks += 1
-        if index in path or self.blocks > MAX_BLOCKS or depth > _MAX_DEPTH:
-            out.append(f"{pad}activities.start(frame, {a}, steps, limit)" if self.framed
-                       else f"{pad}REST(activities, inst, {a}, steps, limit)")
-            out.append(f"{pad}return")
-            return
-        if not (act.lone or self.framed and _thrown_on(act, self.acts)):
-            out.extend(self.hand_over(index, pad))
-            return
-        waits = []                          # lone, but not on this run
-        if act.general:
-            waits.append("pooled")
-        if act.kind == K_TASK:
-            waits.append(f"{self.name('APP', act.application)} in apps")
-        if waits:
-            out.append(f"{pad}if {' or '.join(waits)}:")
-            out.extend(self.hand_over(index, pad + "    "))
+        if not performed:
+            if index in path or self.blocks > MAX_BLOCKS or depth > _MAX_DEPTH:
+                out.append(f"{pad}activities.start(frame, {a}, steps, limit)" if self.framed
+                           else f"{pad}REST(activities, inst, {a}, steps, limit)")
+                out.append(f"{pad}return")
+                return
+            if not (act.lone or self.framed and _thrown_on(act, self.acts)):
+                out.extend(self.hand_over(index, pad))
+                return
+            waits = []                      # lone, but not on this run
+            if act.general:
+                waits.append("pooled")
+            if act.kind == K_TASK:
+                waits.append(f"{self.name('APP', act.application)} in apps")
+            if waits:
+                out.append(f"{pad}if {' or '.join(waits)}:")
+                out.extend(self.hand_over(index, pad + "    "))
+            out += [f"{pad}steps += 1",
+                    f"{pad}if steps > limit:",
+                    f"{pad}    state.zero_time({'frame' if self.framed else 'inst'}, {a})"]
         fields = self.fields(act)
-        out += [f"{pad}steps += 1",
-                f"{pad}if steps > limit:",
-                f"{pad}    state.zero_time({'frame' if self.framed else 'inst'}, {a})",
-                f"{pad}cached = {a}.flag_cache",
+        out += [f"{pad}cached = {a}.flag_cache",
                 f"{pad}bits = cached.bits if cached.key is state.flag_key "
                 f"else state.act_bits({a})",
                 f"{pad}if bits & 1:",
