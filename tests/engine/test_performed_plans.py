@@ -1,0 +1,155 @@
+"""A deferred choice's chosen branch carried on by a plan (opspec/engine/plans.py, from
+source: ``Flow.take`` queues the branch's plan in ``Flow.performed``'s place) changes nothing
+a user can see: every trace event, its order and instance ids, the summary, the metrics and
+the faults are those of the interpreter (``Flow.performed``, ``Flow.finish`` and
+``Activities.start``, no plans at all). Each test runs the same package both ways and counts
+that the branch plans ran; in the compiled build the plans are made for the test
+(``plans.COMPILED`` off), so the generated code is held to the compiled engine too."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any
+
+import pytest
+from builders import activity_set, block, catch, end_event, field, manual, pkg, proc, route
+
+from opspec.engine import plans
+from opspec.engine.builtin_performers import ScriptedUser
+from opspec.engine.compiled import compile_package
+from opspec.engine.simulation import Simulation
+from opspec.model import Package
+from opspec.request import RunRequest, prepare
+
+ROOT = Path(__file__).resolve().parents[2]
+WAYS = ("plans", "interpreter")
+
+
+def _way(monkeypatch: pytest.MonkeyPatch, way: str) -> None:
+    monkeypatch.setattr(plans, "COMPILED", way != "plans")
+
+
+def _counting(sim: Any) -> dict[str, int]:
+    """Wrap the run's branch plans so the test sees that they ran (by branch activity)."""
+    ran: dict[str, int] = {}
+    performs = sim.flow.performs
+    for trans, fn in list(performs.items()):
+        def counted(frame: Any, activities: Any, taken: Any, fn: Any = fn) -> None:
+            aid = frame.graph.activities[taken.target].id
+            ran[aid] = ran.get(aid, 0) + 1
+            fn(frame, activities, taken)
+        performs[trans] = counted
+    return ran
+
+
+def _seen(result: Any) -> tuple[Any, ...]:
+    trace = [(e.time, e.kind, e.process, e.instance, e.activity, e.lane, e.participant,
+              e.package, dict(e.data), e.seq) for e in result.trace]
+    return trace, result.summary, result.metrics
+
+
+class _Picks(ScriptedUser):
+    """Completes every item at once, choosing the choice's alternatives in turn."""
+
+    def __init__(self) -> None:
+        super().__init__(default="complete")
+        self.turn = 0
+
+    def offer(self, item: Any) -> None:
+        if item.choices:
+            choice = item.choices[self.turn % len(item.choices)]
+            self.turn += 1
+            self.session.call_later(1.0, lambda: self.session.complete(item, choice=choice))
+            return
+        super().offer(item)
+
+
+def _both(monkeypatch: pytest.MonkeyPatch, package: Package, make_user: Any = _Picks,
+          until: float = 1000.0) -> tuple[Any, dict[str, int]]:
+    """Run ``package`` both ways; assert they agree; the result and the branches run."""
+    seen = []
+    ran: dict[str, int] = {}
+    for way in WAYS:
+        _way(monkeypatch, way)
+        sim = Simulation(compile_package(package), keep_trace=True,
+                         performers={"user": make_user()})
+        if way == "plans":
+            ran = _counting(sim)
+        else:
+            assert not sim.flow.performs
+        seen.append(_seen(sim.run(until=until)))
+    assert seen[0] == seen[1]
+    return seen[0], ran
+
+
+@pytest.mark.parametrize("name", ["medication_dispenser.xpdl", "medication_dispenser.bpmn"])
+def test_the_dispenser_runs_the_same_event_for_event(monkeypatch: pytest.MonkeyPatch,
+                                                     name: str) -> None:
+    """The user's button (a deferred choice between reporting and the wrong button, raising
+    the report message) with the stochastic user, three days, as ``opspec run`` builds it."""
+    seen = []
+    ran: dict[str, int] = {}
+    for way in WAYS:
+        _way(monkeypatch, way)
+        request = RunRequest(spec=ROOT / "specs" / name, seed=7, keep_trace=True, days=3.0)
+        run = prepare(request).build(0)
+        if way == "plans":
+            ran = _counting(run.sim)
+        seen.append(_seen(run.execute().result))
+    assert seen[0] == seen[1]
+    assert len(seen[0][0]) > 100
+    assert sum(ran.values()) >= 6          # (at least one decision a dose)
+
+
+def test_branches_with_assignments_a_split_and_a_cycle(monkeypatch: pytest.MonkeyPatch) -> None:
+    """An event-based gateway decides three times (a cycle back to it): each branch's end
+    assignment, the exclusive split after it and the path back are the interpreter's, and
+    the racing timer never wins; the other alternative is taken in turn."""
+    loop = [("l", "x"), ("r", "x"), ("x", "g", "n < 3"), ("x", "done", "otherwise")]
+    work = proc("work", ["a", route("g", "EVENT", join="XOR"),
+                         manual("l", assign=[("n", "n + 1")]),
+                         catch("late", "timer", seconds=50.0),
+                         manual("r", assign=[("n", "n + 10")]), route("x", split="XOR"),
+                         "done"],
+                [("a", "g"), ("g", "l"), ("g", "late"), ("g", "r"), ("late", "done"), *loop],
+                data=[field("n", 0)])
+    (trace, summary, _metrics), ran = _both(monkeypatch, pkg(work))
+    assert ran == {"l": 1, "r": 1}
+    assert [e[8] for e in trace if e[1] == "data.changed"] == [{"n": 1}, {"n": 11}]
+    assert summary["instances"]["completed"] == 1
+
+
+def test_a_branch_that_ends_and_one_that_ends_in_error(monkeypatch: pytest.MonkeyPatch) -> None:
+    """A branch into an end (the token is gone, the instance completes) is planned; a
+    branch that is an error end event is not (the interpreter throws it and the instance
+    aborts as before)."""
+    work = proc("work", ["a", route("g", "EVENT"), manual("stop"), manual("fail"),
+                         end_event("oops", "Error")],
+                [("a", "g"), ("g", "stop"), ("g", "fail"), ("fail", "oops")])
+    for picks in (0, 1):
+        def user(picks: int = picks) -> _Picks:
+            made = _Picks()
+            made.turn = picks
+            return made
+        (_trace, summary, _metrics), ran = _both(monkeypatch, pkg(work), user)
+        if picks == 0:
+            assert ran == {"stop": 1} and summary["instances"]["completed"] == 1
+        else:
+            assert ran == {"fail": 1} and summary["faults"]
+
+
+def test_a_choice_inside_an_activity_set_goes_through_the_interpreter(
+        monkeypatch: pytest.MonkeyPatch) -> None:
+    """The plans are written for the workflow's own graph: a deferred choice inside an
+    activity set (its own frame and graph) is run by ``Flow.performed`` as before."""
+    work = proc("work", [block("set", "S"), "after"], [("set", "after")],
+                data=[field("n", 0)],
+                sets=[activity_set("S", ["a", route("g", "EVENT"),
+                                          manual("l", assign=[("n", "n + 1")]),
+                                          manual("r", assign=[("n", "n + 2")]), "b"],
+                                   [("a", "g"), ("g", "l"), ("g", "r"), ("l", "b"),
+                                    ("r", "b")])])
+    (trace, summary, _metrics), ran = _both(monkeypatch, pkg(work))
+    assert ran == {}
+    assert summary["instances"]["completed"] == 1
+    assert [e[8] for e in trace if e[1] == "data.changed"] == [{"n": 1}]
