@@ -73,17 +73,16 @@ class Flow(Part):
         iid = state.last_id
         priority = proc.priority
         if parent is None:
-            inst = ProcessInstance(iid, proc, local, scope, priority, None, iid, state.now)
+            inst = ProcessInstance(iid, proc, local, scope, priority, None, iid, state.now,
+                                   RUNNING, trigger)
         else:
             caller = parent.frame.inst
             if caller.priority > priority:       # (max(), without its call)
                 priority = caller.priority
             inst = ProcessInstance(iid, proc, local, scope, priority, parent, caller.root,
-                                   state.now)
+                                   state.now, RUNNING, trigger)
             inst.depth = caller.depth + 1
             inst.partner = caller.partner
-        inst.state = RUNNING
-        inst.trigger = trigger
         state.live[iid] = inst
         state.started += 1
         cached = proc.flag_cache              # RunState.proc_bits's cached case, in line
@@ -453,8 +452,7 @@ class Flow(Part):
 
     def _leave(self, frame: Frame, act: CompiledActivity) -> None:
         if act.choice:
-            ai = ActivityInstance(self.state.next_key(), act, frame, self.state.now)
-            ai.state = RUNNING
+            ai = ActivityInstance(self.state.next_key(), act, frame, self.state.now, RUNNING)
             frame.running[ai.key] = ai
             self.offers.offer_choice(ai, act.choice)
             return

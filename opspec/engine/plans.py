@@ -515,8 +515,7 @@ class _Writer:
         has no start trigger, or a plain one without start assignments or a worker)."""
         return [f"{pad}state.last_key += 1",
                 f"{pad}key = state.last_key",
-                f"{pad}ai = ACTIVITY(key, A{act.index}, frame, state.now)",
-                f"{pad}ai.state = RUNNING",
+                f"{pad}ai = ACTIVITY(key, A{act.index}, frame, state.now, RUNNING)",
                 f"{pad}frame.running[key] = ai"]
 
     def started(self, act: CompiledActivity, pad: str) -> list[str]:
