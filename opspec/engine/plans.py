@@ -34,6 +34,7 @@ manual activity itself (``start_slow`` and ``Offers.offer`` in line).
 
 from __future__ import annotations
 
+import re
 import types
 from collections.abc import Callable
 from types import MappingProxyType
@@ -204,6 +205,8 @@ def build(proc: CompiledProcess, start: int) -> Callable[[Any, Any, Any], None]:
              "            inst.defer((plan, inst, activities, None))",
              "        return",
              "    state = activities.state",
+             "    if state.flag_key is not KEY:    # (the listeners' bits: see _by_selection)",
+             "        SELECT(state)",
              "    flow = activities.flow",
              "    limit = state.start_limit",
              "    iid = inst.id",
@@ -239,6 +242,8 @@ def build_resume(proc: CompiledProcess, index: int) -> Callable[[Any, Any], None
              "    if ai.cleanup:",
              "        ai.undo_waits()",
              "    state = activities.state",
+             "    if state.flag_key is not KEY:    # (the listeners' bits: see _by_selection)",
+             "        SELECT(state)",
              "    flow = activities.flow",
              "    inst = frame.inst",
              "    limit = state.start_limit",
@@ -277,6 +282,8 @@ def build_performed(proc: CompiledProcess, index: int) -> Callable[[Any, Any, An
              "        flow._dropped(frame, flow.performed, PERFORMED, trans)",
              "        return",
              "    state = activities.state",
+             "    if state.flag_key is not KEY:    # (the listeners' bits: see _by_selection)",
+             "        SELECT(state)",
              "    limit = state.start_limit",
              "    iid = inst.id",
              "    steps = 0"]
@@ -290,10 +297,49 @@ def build_performed(proc: CompiledProcess, index: int) -> Callable[[Any, Any, An
     return made
 
 
+_CACHED: Final = re.compile(r"\n *cached = \w+\.flag_cache(?=\n)")
+_BITS: Final = re.compile(
+    r"cached\.bits if cached\.key is state\.flag_key else state\.(act|proc)_bits\((\w+)\)")
+
+
+def _by_selection(source: str, space: dict[str, Any]) -> str:
+    """``source`` with each activity's and workflow's listener bits read from a global of
+    the plan (``BITS_A3``) instead of from its cache (``RunState.act_bits``'s cached case:
+    the cache, its key and the run's key read at every event a plan might trace).
+
+    The plan tests once, where it starts, that its globals hold the bits of this run's
+    listener selection (``KEY``, the run's ``flag_key``) and has ``SELECT`` set them for it
+    if not (another run of the package, a new selection). A selection changes within a run
+    only when a mode loads workflows (``Triggers.change_mode``), which adds selectors of the
+    loaded workflows alone: the bits of the activities a plan writes out stay what they were
+    (and the plan's next start sees the new key and selects again)."""
+    source = _CACHED.sub("", source)
+    wanted: dict[str, tuple[Any, bool]] = {}
+
+    def named(found: re.Match[str]) -> str:
+        kind, obj = found.group(1), found.group(2)
+        global_name = f"BITS_{obj}"
+        wanted[global_name] = (space[obj], kind == "proc")
+        return global_name
+
+    source = _BITS.sub(named, source)
+    entries = tuple((global_name, obj, is_proc)
+                    for global_name, (obj, is_proc) in wanted.items())
+
+    def select(state: Any) -> None:
+        for global_name, obj, is_proc in entries:
+            space[global_name] = state.proc_bits(obj) if is_proc else state.act_bits(obj)
+        space["KEY"] = state.flag_key
+
+    space["KEY"] = None                     # (no run's key: the first start selects)
+    space["SELECT"] = select
+    return source
+
+
 def _made(writer: _Writer, lines: list[str], where: str, name: str) -> Any:
     """The function ``name`` that ``lines`` define, made once."""
-    source = "\n".join(lines) + "\n"
     space = writer.names
+    source = _by_selection("\n".join(lines) + "\n", space)
     # Safe to exec: the source is the engine's own. Nothing the spec wrote (ids, names,
     # values, conditions) is in it; each is an object bound by name in ``space``
     # (``_Writer.name``), and conditions and assignments are the safe evaluator's compiled

@@ -12,7 +12,18 @@ from pathlib import Path
 from typing import Any
 
 import pytest
-from builders import activity_set, block, catch, end_event, field, manual, pkg, proc, route
+from builders import (
+    activity_set,
+    block,
+    catch,
+    count,
+    end_event,
+    field,
+    manual,
+    pkg,
+    proc,
+    route,
+)
 
 from opspec.engine import plans
 from opspec.engine.builtin_performers import ScriptedUser
@@ -153,3 +164,33 @@ def test_a_choice_inside_an_activity_set_goes_through_the_interpreter(
     assert ran == {}
     assert summary["instances"]["completed"] == 1
     assert [e[8] for e in trace if e[1] == "data.changed"] == [{"n": 1}]
+
+
+def test_two_runs_of_one_package_with_other_listeners_take_turns(
+        monkeypatch: pytest.MonkeyPatch) -> None:
+    """The plans read which events the listeners want from globals set for a run's
+    selection where each plan starts (``plans._by_selection``): two runs of one compiled
+    package, one keeping its whole trace and one only its metrics, stepped in turn, trace
+    and count what each would alone, as the interpreter does."""
+    work = proc("work", ["a", manual("ask"), route("g", "EVENT"),
+                         manual("l", assign=[("n", "n + 1")]), manual("r"), "b", "end"],
+                [("a", "ask"), ("ask", "g"), ("g", "l"), ("g", "r"), ("l", "b"), ("r", "b"),
+                 ("b", "end")], data=[field("n", 0)], start="period:900")
+    package = pkg(work, metrics=[count("asked", "activity.completed", "work", "ask"),
+                                 count("ended", "process.completed", "work")])
+    seen = []
+    for way in WAYS:
+        _way(monkeypatch, way)
+        compiled = compile_package(package)
+        traced = Simulation(compiled, keep_trace=True, performers={"user": _Picks()})
+        counted = Simulation(compiled, performers={"user": _Picks()})
+        results = []
+        for step in range(1, 97):           # two days, half an hour at a time each
+            for sim in (counted, traced):     # (the counting run selects first)
+                results.append(sim.run(until=step * 1800.0))
+        seen.append((_seen(results[-1]), results[-2].metrics, results[-2].summary))
+    assert seen[0] == seen[1]
+    trace, _summary, metrics = seen[0][0]
+    assert seen[0][1] == metrics
+    assert metrics["asked"]["total"] == metrics["ended"]["total"] >= 190
+    assert len(trace) > 190 * 10
