@@ -43,6 +43,7 @@ from typing import Any, Final
 from opspec.engine import lone
 from opspec.engine.compiled import (
     K_ASYNC,
+    K_CATCH,
     K_GATEWAY,
     K_MANUAL,
     K_SUBFLOW,
@@ -157,7 +158,7 @@ def resumable(proc: CompiledProcess) -> list[int]:
             continue                        # (an activity that never waits never completes)
         targets = _ways_out(act, acts)
         if targets and any(acts[t].lone or _thrown_on(acts[t], acts) or _offered(acts[t])
-                           for t in targets):
+                           or _chooses(acts[t]) for t in targets):
             found.append(act.index)
     return found
 
@@ -167,6 +168,14 @@ def _offered(act: CompiledActivity) -> bool:
     without parameters, start assignments or a worker to wait for."""
     return (act.plain and act.kind == K_MANUAL and not act.params and not act.start_assign
             and not act.general)
+
+
+def _chooses(act: CompiledActivity) -> bool:
+    """Whether a plan offers ``act``'s deferred choice itself (``_Writer.choice``): an
+    event-based gateway whose branches are not labelled, without start assignments or a
+    worker to wait for."""
+    return (act.kind == K_GATEWAY and act.plain and not act.labelled and not act.general
+            and not act.start_assign)
 
 
 def _thrown_on(act: CompiledActivity, acts: tuple[CompiledActivity, ...]) -> bool:
@@ -519,6 +528,8 @@ class _Writer:
             start = self.offer(act, pad)
         elif not act.plain and act.start_trigger is None:
             start = [*self.instance(act, pad), f"{pad}activities.activate(ai)", f"{pad}return"]
+        elif _chooses(act):
+            start = [*self.instance(act, pad), *self.started(act, pad), *self.choice(act, pad)]
         elif act.plain and not act.general and not act.start_assign:
             start = [*self.instance(act, pad), *self.started(act, pad),
                      *(self.call(act, pad) if act.kind == K_SUBFLOW
@@ -530,12 +541,60 @@ class _Writer:
         return [f"{pad}frame = FRAME(GRAPH, inst, None)", f"{pad}inst.frames.append(frame)",
                 f"{pad}frame.live = 1", *start]
 
+    def choice(self, act: CompiledActivity, pad: str) -> list[str]:
+        """``Offers.offer_choice`` of a deferred choice's gateway, in line: the catch events
+        among its branches wait, and its manual branches are offered as one work item
+        (``Offers.offer`` with the branches' ids as its choices)."""
+        a = f"A{act.index}"
+        branches = act.out
+        out = [f"{pad}ai.choice = {self.name('BR', branches)}",
+               f"{pad}ai.waiting = \"choice\"",
+               f"{pad}offers = activities.offers"]
+        manual = []
+        for trans in branches:
+            target = self.acts[trans.target]
+            if target.kind == K_CATCH and target.trigger is not None:
+                out.append(f"{pad}activities.triggers.wait_trigger(ai, "
+                           f"{self.name('TRG', target.trigger)}, offers._choice_event, "
+                           f"{self.name('TR', trans)})")
+            elif target.kind == K_MANUAL:
+                manual.append(target)
+        if not manual:
+            return [*out, f"{pad}return"]
+        m = f"A{manual[0].index}"
+        self.names[m] = manual[0]
+        choices = tuple(target.id for target in manual)
+        ch = self.name("CH", choices)
+        waiting = self.name("G", f"performer for the choice {list(choices)}")
+        return [*out,
+                f"{pad}known = state.performers_of",
+                f"{pad}performer = known[{m}] if {m} in known else offers.performer_for({m})",
+                f"{pad}if performer is None:",
+                f"{pad}    ai.waiting = {waiting}",
+                f"{pad}    return",
+                f"{pad}view = inst.view",
+                f"{pad}if view is None:",
+                f"{pad}    view = inst.view = PROXY(inst.data)",
+                (f"{pad}item = ITEM(key, {self.name('P', act.process)}, iid, "
+                 f"{self.name('I', act.id)}, {self.name('B', act.label)}, "
+                 f"{self.name('W', act.participant)}, {self.name('L', act.lane)}, state.now, "
+                 f"{self.name('APP', act.application)}, view, {ch}, "
+                 f"inst.root, None)"),
+                f"{pad}ai.item = item",
+                f"{pad}ai.performer = performer",
+                f"{pad}ai.waiting = \"performer\"",
+                f"{pad}state.offered[key] = ai",
+                (f"{pad}if (cached.bits if cached.key is state.flag_key "
+                 f"else state.act_bits({a})) & 4:"),
+                f"{pad}    state.emit(OFFERED, {self.fields(act)}, {{\"choices\": list({ch})}})",
+                f"{pad}performer.offer(item)",
+                f"{pad}return"]
+
     def call(self, act: CompiledActivity, pad: str) -> list[str]:
         """``Activities._body`` of a synchronous subflow call, in line: its actual
         parameters (``Activities.inputs``), the depth guard, the called instance started
         with ``ai`` waiting for it."""
         from opspec.engine.activities import MAX_CALL_DEPTH  # (activities imports plans)
-        a = f"A{act.index}"
         target = self.name("F", act.subflow)
         items = ", ".join(f"{self.name('M', formal)}: {self.name('V', fn)}(scope, now)"
                           for _mode, formal, fn, _target in act.params if fn is not None)

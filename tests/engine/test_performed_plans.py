@@ -194,3 +194,57 @@ def test_two_runs_of_one_package_with_other_listeners_take_turns(
     assert seen[0][1] == metrics
     assert metrics["asked"]["total"] == metrics["ended"]["total"] >= 190
     assert len(trace) > 190 * 10
+
+
+class _Slow(ScriptedUser):
+    """Completes plain items at once and answers a choice only after 20 s."""
+
+    def __init__(self) -> None:
+        super().__init__(default="complete")
+
+    def offer(self, item: Any) -> None:
+        if item.choices:
+            self.session.call_later(20.0, lambda: self.session.complete(
+                item, choice=item.choices[0]))
+            return
+        super().offer(item)
+
+
+def test_a_choice_offered_by_a_resume_plan_races_its_catch_event(
+        monkeypatch: pytest.MonkeyPatch) -> None:
+    """After a manual activity, a resume plan makes the gateway's instance, arms its catch
+    event and offers its manual branches itself (``Offers.offer_choice`` in line): the
+    timer wins against a slow answer (the work item is withdrawn) and where nobody is bound
+    to the branches, and a quick answer wins against the timer, as in the interpreter."""
+    work = proc("work", [manual("ask", performer="clerk"), route("g", "EVENT"), manual("l"),
+                         catch("late", "timer", seconds=5.0), manual("r"), "b", "end"],
+                [("ask", "g"), ("g", "l"), ("g", "late"), ("g", "r"), ("l", "b"),
+                 ("late", "b"), ("r", "b"), ("b", "end")])
+    resumed = []
+    for user in (_Slow, _Picks, None):
+        seen = []
+        for way in WAYS:
+            _way(monkeypatch, way)
+            performers: dict[str, Any] = {"clerk": ScriptedUser(default="complete")}
+            if user is not None:
+                performers["user"] = user()
+            sim = Simulation(compile_package(pkg(work)), keep_trace=True,
+                             performers=performers)
+            if way == "plans":
+                ran: dict[str, int] = {}
+                resumes = sim.activities.resumes
+                for key, fn in list(resumes.items()):
+                    def counted(activities: Any, ai: Any, fn: Any = fn, aid: str = key.id,
+                                ran: dict[str, int] = ran) -> None:
+                        ran[aid] = ran.get(aid, 0) + 1
+                        fn(activities, ai)
+                    resumes[key] = counted
+                resumed.append(ran)
+            seen.append(_seen(sim.run(until=100.0)))
+        assert seen[0] == seen[1]
+        done = [e[4] for e in seen[0][0] if e[1] == "activity.completed"]
+        if user is _Picks:
+            assert "l" in done and "late" not in done
+        else:                               # too slow, or nobody to answer: the timer
+            assert "late" in done and "l" not in done
+    assert resumed == [{"ask": 1}] * 3
