@@ -158,7 +158,7 @@ def resumable(proc: CompiledProcess) -> list[int]:
             continue                        # (an activity that never waits never completes)
         targets = _ways_out(act, acts)
         if targets and any(acts[t].lone or _thrown_on(acts[t], acts) or _offered(acts[t])
-                           or _chooses(acts[t]) for t in targets):
+                           or _chooses(acts[t]) or _caught(acts[t]) for t in targets):
             found.append(act.index)
     return found
 
@@ -168,6 +168,16 @@ def _offered(act: CompiledActivity) -> bool:
     without parameters, start assignments or a worker to wait for."""
     return (act.plain and act.kind == K_MANUAL and not act.params and not act.start_assign
             and not act.general)
+
+
+def _caught(act: CompiledActivity) -> bool:
+    """Whether a plan starts ``act`` itself (``_Writer.catch``): a catch event whose only
+    waits beside its trigger are deadlines and boundary events (no start trigger or
+    assignments, loop, multi-instance, duration or worker)."""
+    return (act.kind == K_CATCH and act.trigger is not None and not act.plain
+            and act.start_trigger is None and not act.start_assign and act.loop is None
+            and act.mi is None and act.cpu == 0.0 and act.cpu_sampler is None
+            and act.sampler is None and not act.general)
 
 
 def _chooses(act: CompiledActivity) -> bool:
@@ -526,6 +536,8 @@ class _Writer:
             start = [f"{pad}activities.start(frame, {a}, steps, limit)", f"{pad}return"]
         elif _offered(act):
             start = self.offer(act, pad)
+        elif _caught(act):
+            start = [*self.instance(act, pad), *self.catch(act, pad)]
         elif not act.plain and act.start_trigger is None:
             start = [*self.instance(act, pad), f"{pad}activities.activate(ai)", f"{pad}return"]
         elif _chooses(act):
@@ -540,6 +552,42 @@ class _Writer:
             return start
         return [f"{pad}frame = FRAME(GRAPH, inst, None)", f"{pad}inst.frames.append(frame)",
                 f"{pad}frame.live = 1", *start]
+
+    def catch(self, act: CompiledActivity, pad: str) -> list[str]:
+        """``Activities.activate`` of a catch event under deadlines or boundary events, and
+        its body (``Activities._body``: the event waited for), in line."""
+        a = f"A{act.index}"
+        trig = act.trigger
+        assert trig is not None
+        out = self.started(act, pad)
+        triggers = "activities.triggers"
+        if act.deadlines:
+            out += [f"{pad}now = state.now", f"{pad}triggers = activities.triggers"]
+            triggers = "triggers"
+        for seconds, synchronous, exception in act.deadlines:
+            out += [f"{pad}try:",
+                    f"{pad}    delay = float({self.name('V', seconds)}(inst.scope, now))",
+                    f"{pad}except OpspecError as error:",
+                    (f"{pad}    flow.abort(inst, {a}, "
+                     f"f\"deadline cannot be computed: {{error.message}}\")"),
+                    f"{pad}    return",
+                    (f"{pad}state.later(delay, triggers.deadline, ai, "
+                     f"({self.name('K', synchronous)}, {self.name('K', exception)}, delay))")]
+        for index in act.boundary:
+            event = self.acts[index]
+            if event.trigger is not None:
+                out.append(f"{pad}{triggers}.wait_trigger(ai, "
+                           f"{self.name('TRG', event.trigger)}, {triggers}.boundary, "
+                           f"{self.name('K', index)}, persistent=True)")
+        waiting = f"{trig.kind}:{trig.name}" if trig.name else trig.kind
+        return [*out,
+                f"{pad}if ai.state == RUNNING:",
+                f"{pad}    ai.waiting = {self.name('G', waiting)}",
+                (f"{pad}    {triggers}.wait_trigger(ai, {self.name('TRG', trig)}, "
+                 f"{triggers}.caught, None)"),
+                f"{pad}    if not state.draining:",
+                f"{pad}        state.drain()",
+                f"{pad}return"]
 
     def choice(self, act: CompiledActivity, pad: str) -> list[str]:
         """``Offers.offer_choice`` of a deferred choice's gateway, in line: the catch events

@@ -15,8 +15,10 @@ import pytest
 from builders import (
     activity_set,
     block,
+    act,
     catch,
     count,
+    deadline,
     end_event,
     field,
     manual,
@@ -248,3 +250,32 @@ def test_a_choice_offered_by_a_resume_plan_races_its_catch_event(
         else:                               # too slow, or nobody to answer: the timer
             assert "late" in done and "l" not in done
     assert resumed == [{"ask": 1}] * 3
+
+
+@pytest.mark.parametrize("sent_at", [3.0, 30.0])
+def test_a_caught_event_under_a_deadline_and_a_boundary_event_started_by_a_plan(
+        monkeypatch: pytest.MonkeyPatch, sent_at: float) -> None:
+    """After a manual activity, a resume plan starts the catch event itself
+    (``Activities.activate`` and ``_body`` in line): its deadline is armed, its boundary
+    timer waits beside it, and the message caught in time, the boundary timer or the
+    deadline ends the wait, as the interpreter does."""
+    work = proc("work", [manual("ask"),
+                         catch("wait", "message", "go", deadlines=[deadline(20.0, "late")]),
+                         catch("tick", "timer", seconds=10.0, attached_to="wait",
+                               interrupting=False),
+                         "got", "ticked", "timed_out", "end"],
+                [("ask", "wait"), ("wait", "got"), ("tick", "ticked"),
+                 ("wait", "timed_out", "exception:late"), ("got", "end"),
+                 ("timed_out", "end")])
+    sender = proc("sender", [catch("pause", "timer", seconds=sent_at),
+                             act("send", raises="message:go")], [("pause", "send")])
+    package = pkg(work, sender)
+    (trace, _summary, _metrics), _ran = _both(monkeypatch, package,
+                                              lambda: ScriptedUser(default="complete"))
+    done = [e[4] for e in trace if e[1] == "activity.completed"]
+    assert ("ticked" in done) == (sent_at > 10.0)
+    assert ("got" in done) == (sent_at < 20.0) and ("timed_out" in done) == (sent_at > 20.0)
+    _way(monkeypatch, "plans")              # (the completion of ask is planned)
+    planned = plans.resumes(compile_package(package))
+    ask = next(fn for a, fn in planned.items() if a.id == "ask")
+    assert "triggers.deadline" in ask.__doc__ and "activate" not in ask.__doc__
