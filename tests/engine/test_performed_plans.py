@@ -13,9 +13,9 @@ from typing import Any
 
 import pytest
 from builders import (
+    act,
     activity_set,
     block,
-    act,
     catch,
     count,
     deadline,
