@@ -40,7 +40,7 @@ from collections.abc import Callable
 from types import MappingProxyType
 from typing import Any, Final
 
-from opspec.engine import lone
+from opspec.engine import lone, process_deadlines
 from opspec.engine.compiled import (
     K_ASYNC,
     K_CATCH,
@@ -57,9 +57,10 @@ from opspec.engine.compiled import (
     CTrigger,
 )
 from opspec.engine.conditions import constant_value
-from opspec.engine.instances import ActivityInstance, Frame
+from opspec.engine.instances import ActivityInstance, Frame, ProcessInstance
 from opspec.engine.lifecycle import COMPLETED, LIFECYCLE, RUNNING, SUSPENDED
 from opspec.engine.performers import WorkItem
+from opspec.engine.scope import Scope
 from opspec.engine.trace import EventKind as EK
 from opspec.errors import OpspecError
 from opspec.model import ParameterMode
@@ -387,7 +388,9 @@ class _Writer:
             "STARTED": EK.ACTIVITY_STARTED, "COMPLETED": EK.ACTIVITY_COMPLETED,
             "CHANGED": EK.DATA_CHANGED, "OFFERED": EK.ACTIVITY_OFFERED, "DONE": COMPLETED,
             "ACTIVITY": ActivityInstance, "ITEM": WorkItem, "PROXY": MappingProxyType,
-            "ENDED": ENDED, "ENDED_KIND": EK.PROCESS_COMPLETED, "IN": ParameterMode.IN}
+            "ENDED": ENDED, "ENDED_KIND": EK.PROCESS_COMPLETED, "IN": ParameterMode.IN,
+            "INSTANCE": ProcessInstance, "SCOPE": Scope, "DEADLINES": process_deadlines,
+            "PROCESS_STARTED": EK.PROCESS_STARTED}
 
     def name(self, prefix: str, value: Any) -> str:
         key = f"{prefix}{len(self.names)}"
@@ -446,8 +449,8 @@ class _Writer:
                         f"{pad}    flow.abort(inst, {a}, "
                         f"f\"an actual parameter failed: {{error.message}}\")",
                         f"{pad}    return",
-                        f"{pad}flow.start_process(state.processes[{self.name('F', act.subflow)}],"
-                        f" data, trigger={self.name('G', f'subflow:{act.id}')})"]
+                        f"{pad}called = state.processes[{self.name('F', act.subflow)}]",
+                        *self.launch(pad, self.name("G", f"subflow:{act.id}"))]
             if not act.simple_end and act.end_assign:
                 self.assign(act, act.end_assign, pad, out)
             if act.kind == K_THROW and act.trigger is not None:     # (Flow.done_next's)
@@ -659,7 +662,58 @@ class _Writer:
                 f"{pad}    activities._too_deep(ai, called)",
                 f"{pad}    return",
                 f"{pad}ai.waiting = {self.name('G', 'subflow ')} + called.id",
-                f"{pad}ai.child = flow.start_process(called, data, parent=ai)"]
+                *self.launch(pad, None),
+                f"{pad}ai.child = child"]
+
+    def launch(self, pad: str, trigger: str | None) -> list[str]:
+        """``Flow.start_process(called, data, ...)`` of a subflow call, in line where the
+        called workflow starts with one token and has its plan: an asynchronous start
+        (``trigger``: the name of its trigger's text) or a synchronous call by ``ai``;
+        the instance started is ``child``."""
+        sync = trigger is None
+        p = f"{pad}    "
+        if sync:
+            made = [f"{p}priority = called.priority",
+                    f"{p}if inst.priority > priority:",
+                    f"{p}    priority = inst.priority",
+                    (f"{p}child = INSTANCE(new_id, called, child_data, child_scope, priority, "
+                     f"ai, inst.root, state.now, RUNNING, None)"),
+                    f"{p}child.depth = inst.depth + 1",
+                    f"{p}child.partner = inst.partner"]
+            started = "{\"trigger\": None, \"parent\": iid}"
+        else:
+            made = [(f"{p}child = INSTANCE(new_id, called, child_data, child_scope, "
+                     f"called.priority, None, new_id, state.now, RUNNING, {trigger})")]
+            started = f"{{\"trigger\": {trigger}, \"parent\": None}}"
+        fallback = ("flow.start_process(called, data, parent=ai)" if sync
+                    else f"flow.start_process(called, data, trigger={trigger})")
+        return [f"{pad}child_plan = called.plan",
+                f"{pad}if child_plan is None or called.one_start < 0:",
+                f"{pad}    child = {fallback}",
+                f"{pad}else:                              # (Flow.start_process's steps)",
+                f"{p}child_data = called.data.copy()",
+                f"{p}if data:",
+                f"{p}    child_data.update(data)",
+                (f"{p}child_scope = (SCOPE(child_data, state.package_data) if state.package_data"
+                 f" else child_data)"),
+                f"{p}state.last_id += 1",
+                f"{p}new_id = state.last_id",
+                *made,
+                f"{p}state.live[new_id] = child",
+                f"{p}state.started += 1",
+                f"{p}flags = called.flag_cache        # (the called workflow's own bits)",
+                (f"{p}if (flags.bits if flags.key is state.flag_key "
+                 f"else state.proc_bits(called)) & 1:"),
+                (f"{p}    state.emit(PROCESS_STARTED, called.id, new_id, None, called.lane, None, "
+                 f"{started})"),
+                (f"{p}if state.now == state.starts_at and "
+                 f"state.instant_starts < state.max_instant_starts:"),
+                f"{p}    state.instant_starts += 1",
+                f"{p}else:",
+                f"{p}    state.start_counted(child)",
+                f"{p}state.ready.append((child_plan, child, activities, None))",
+                f"{p}if called.deadline is not None:",
+                f"{p}    DEADLINES.arm(flow, child, called.deadline)"]
 
     def instance(self, act: CompiledActivity, pad: str) -> list[str]:
         """``Activities.start_slow``'s first steps: ``act``'s activity instance ``ai``,

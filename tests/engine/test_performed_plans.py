@@ -19,12 +19,14 @@ from builders import (
     catch,
     count,
     deadline,
+    formal,
     end_event,
     field,
     manual,
     pkg,
     proc,
     route,
+    subflow,
 )
 
 from opspec.engine import plans
@@ -279,3 +281,30 @@ def test_a_caught_event_under_a_deadline_and_a_boundary_event_started_by_a_plan(
     planned = plans.resumes(compile_package(package))
     ask = next(fn for a, fn in planned.items() if a.id == "ask")
     assert "triggers.deadline" in ask.__doc__ and "activate" not in ask.__doc__
+
+
+def test_subflows_started_by_a_plan_with_their_process_deadlines(
+        monkeypatch: pytest.MonkeyPatch) -> None:
+    """A plan starts an asynchronous subflow and calls a synchronous one itself
+    (``Flow.start_process`` in line): the same instance ids, data, trace and process
+    deadlines (each called workflow has one, which ends a slow instance) as the
+    interpreter, and a caller's higher priority passed on."""
+    slow = proc("slow", [manual("work", performer="clerk"), "slow_end"],
+                [("work", "slow_end")], formals=[formal("n", "INOUT")], deadline=3.0,
+                auto_start=False)
+    quick = proc("quick", [act("bump", assign=[("n", "n + 1")]), "quick_end"],
+                 [("bump", "quick_end")], formals=[formal("n", "INOUT")], deadline=30.0,
+                 priority=2, auto_start=False)
+    main = proc("main", [manual("ask"), subflow("fire", "slow", ["n"], asynchronous=True),
+                         subflow("call", "quick", ["n"]), "main_end"],
+                [("ask", "fire"), ("fire", "call"), ("call", "main_end")],
+                data=[field("n", 1)], priority=5)
+    (trace, summary, _metrics), _ran = _both(
+        monkeypatch, pkg(main, slow, quick), lambda: ScriptedUser(default="complete"))
+    started = [(e[2], e[3], e[8]) for e in trace if e[1] == "process.started"]
+    assert started == [("main", 1, {"trigger": "auto", "parent": None}),
+                       ("slow", 2, {"trigger": "subflow:fire", "parent": None}),
+                       ("quick", 3, {"trigger": None, "parent": 1})]
+    assert [e[8] for e in trace if e[1] == "data.changed"] == [{"n": 2}, {"n": 2}]
+    assert summary["instances"]["completed"] == 2
+    assert summary["instances"]["aborted"] + summary["instances"]["terminated"] == 1
