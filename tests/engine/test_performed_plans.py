@@ -173,7 +173,7 @@ def test_a_choice_inside_an_activity_set_goes_through_the_interpreter(
 def test_two_runs_of_one_package_with_other_listeners_take_turns(
         monkeypatch: pytest.MonkeyPatch) -> None:
     """The plans read which events the listeners want from globals set for a run's
-    selection where each plan starts (``plans._by_selection``): two runs of one compiled
+    selection where each plan starts (``plan_writer.by_selection``): two runs of one compiled
     package, one keeping its whole trace and one only its metrics, stepped in turn, trace
     and count what each would alone, as the interpreter does."""
     work = proc("work", ["a", manual("ask"), route("g", "EVENT"),
