@@ -144,8 +144,7 @@ class Activities(Part):
         """Start ``act``, which waits or takes time: as an activity instance."""
         state = self.state
         state.last_key += 1                   # RunState.next_key, in line
-        ai = ActivityInstance(state.last_key, act, frame, state.now)
-        ai.state = RUNNING
+        ai = ActivityInstance(state.last_key, act, frame, state.now, RUNNING)
         frame.running[ai.key] = ai
         if act.plain and not (act.general and state.pooled):
             inst = frame.inst

@@ -14,7 +14,7 @@ from collections import ChainMap
 from collections.abc import Callable, Mapping, MutableMapping
 from typing import TYPE_CHECKING, Any, Final
 
-from opspec.engine import drawing, escalations, joins, lone, process_deadlines
+from opspec.engine import drawing, escalations, joins, lone, plans, process_deadlines
 from opspec.engine.compiled import (
     J_AND,
     J_COMPLEX,
@@ -53,6 +53,10 @@ class Flow(Part):
         self.arrive_q: Callable[[Frame, int, CTransition | None], None] = self._arrive
         self.performed_q: Callable[[Frame, int, CTransition | None], None] = self.performed
         self.start_lone_q: Callable[[ProcessInstance, int, Any], None] = self.start_lone_at
+        # from source, the plans of the deferred choices' branches (opspec.engine.plans): by
+        # the transition into the branch, queued in performed's place; empty compiled
+        self.performs: dict[CTransition, Callable[[Frame, Any, CTransition], None]] = (
+            {} if plans.COMPILED else plans.performs(state.compiled))
 
     def start_process(self, proc: CompiledProcess, data: Mapping[str, Any] | None = None, *,
                       parent: ActivityInstance | None = None, trigger: str | None = None,
@@ -69,17 +73,16 @@ class Flow(Part):
         iid = state.last_id
         priority = proc.priority
         if parent is None:
-            inst = ProcessInstance(iid, proc, local, scope, priority, None, iid, state.now)
+            inst = ProcessInstance(iid, proc, local, scope, priority, None, iid, state.now,
+                                   RUNNING, trigger)
         else:
             caller = parent.frame.inst
             if caller.priority > priority:       # (max(), without its call)
                 priority = caller.priority
             inst = ProcessInstance(iid, proc, local, scope, priority, parent, caller.root,
-                                   state.now)
+                                   state.now, RUNNING, trigger)
             inst.depth = caller.depth + 1
             inst.partner = caller.partner
-        inst.state = RUNNING
-        inst.trigger = trigger
         state.live[iid] = inst
         state.started += 1
         cached = proc.flag_cache              # RunState.proc_bits's cached case, in line
@@ -449,8 +452,7 @@ class Flow(Part):
 
     def _leave(self, frame: Frame, act: CompiledActivity) -> None:
         if act.choice:
-            ai = ActivityInstance(self.state.next_key(), act, frame, self.state.now)
-            ai.state = RUNNING
+            ai = ActivityInstance(self.state.next_key(), act, frame, self.state.now, RUNNING)
             frame.running[ai.key] = ai
             self.offers.offer_choice(ai, act.choice)
             return
@@ -498,8 +500,12 @@ class Flow(Part):
             for target, fn in trans.assignments:
                 self.set_field(inst, None, target, fn(inst.scope, now))
         frame.live += 1
-        self.state.ready.append((self.performed_q if performed else self.arrive_q, frame,
-                            trans.target, trans))
+        performs = self.performs            # (empty compiled: its size, no look-up)
+        if performed and performs and trans in performs:
+            self.state.ready.append((performs[trans], frame, self.activities, trans))
+        else:
+            self.state.ready.append((self.performed_q if performed else self.arrive_q, frame,
+                                     trans.target, trans))
         if trans.tokens > 1:                # a thread split (WCP-42): one token each
             for _ in range(trans.tokens - 1):
                 frame.live += 1

@@ -48,12 +48,13 @@ class ProcessInstance:
 
     def __init__(self, id: int, process: CompiledProcess, data: dict[str, Any],
                  scope: MutableMapping[str, Any], priority: int,
-                 parent: ActivityInstance | None, root: int, started_at: float) -> None:
+                 parent: ActivityInstance | None, root: int, started_at: float,
+                 state: int = NOT_STARTED, trigger: str | None = None) -> None:
         self.id = id
         self.process = process
         self.data = data
         self.scope = scope
-        self.state = NOT_STARTED
+        self.state = state
         self.priority = priority
         self.parent = parent
         self.root = root
@@ -61,7 +62,7 @@ class ProcessInstance:
         self.started_at = started_at
         # work that arrived while suspended (made when first needed: see :meth:`defer`)
         self.deferred: list[tuple[Any, ...]] | None = None
-        self.trigger: str | None = None
+        self.trigger = trigger
         self.depth = 0                        # synchronous subflow calls above this one
         # the root instance whose message started this one (replies are correlated to it)
         self.partner: ProcessInstance | None = None
@@ -148,11 +149,12 @@ class ActivityInstance:
         "waiting",
     )
 
-    def __init__(self, key: int, act: CompiledActivity, frame: Frame, started_at: float) -> None:
+    def __init__(self, key: int, act: CompiledActivity, frame: Frame, started_at: float,
+                 state: int = NOT_STARTED) -> None:
         self.key = key
         self.act = act
         self.frame = frame
-        self.state = NOT_STARTED
+        self.state = state
         self.started_at = started_at
         self.item: WorkItem | None = None
         self.child: Any = None                # ProcessInstance or Frame

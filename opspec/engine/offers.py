@@ -161,8 +161,15 @@ class Offers(Part):
                 del offered[item.key]
             if ai.performer is not None:
                 ai.performer.withdraw(item, "another branch of the choice happened")
-        ai.leave(COMPLETED)
+        ai.state = COMPLETED                # ActivityInstance.leave(COMPLETED), in line
+        ai.gen += 1
         frame = ai.frame
+        running = frame.running
+        key: object = ai.key                # (boxed once: see ActivityInstance.leave)
+        if key in running:
+            del running[key]
+        if ai.cleanup:
+            ai.undo_waits()
         act = ai.act
         if act.kind == K_GATEWAY and not act.choice:
             # the gateway itself completes now (its own split is the choice)
@@ -175,8 +182,23 @@ class Offers(Part):
                 state.emit(EK.ACTIVITY_COMPLETED, act.process, inst.id, act.id, act.lane,
                            act.participant, {"choice": frame.graph.activities[trans.target].id})
         # a chosen manual branch *is* performed by the choice; a labelled one then runs
-        self.flow.take(frame, trans, performed=not act.labelled)
-        self.flow.token_gone(frame)
+        performed = not act.labelled
+        flow = self.flow
+        if trans.assignments or trans.tokens != 1 or frame.graph.completion is not None:
+            flow.take(frame, trans, performed=performed)
+            flow.token_gone(frame)
+            return
+        # Flow.take and Flow.token_gone, in line: the branch's token is queued and the
+        # choice's own is gone (the frame's live count is the same; it stays above 0)
+        performs = flow.performs            # (empty compiled: its size, no look-up)
+        state = self.state
+        if performed and performs and trans in performs:
+            state.ready.append((performs[trans], frame, self.activities, trans))
+        else:
+            state.ready.append((flow.performed_q if performed else flow.arrive_q, frame,
+                                trans.target, trans))
+        if frame.ors:
+            state.pending[frame] = None
 
     def _body_done_data(self, ai: ActivityInstance, data: Mapping[str, Any]) -> None:
         inst = ai.frame.inst
