@@ -260,11 +260,7 @@ class RunState(Timers):
         done = 0                    # the items of ``ready`` run so far
         steps = self.instant_steps + 1
         limit = self.max_instant_steps
-        # Compiled, the two items every workflow instance queues (its first token, a body's
-        # end) are called as the native methods they are bound to: through Python's protocol
-        # (the bound method, its argument parsing) each call cost about 180 instructions
-        # more. From source the bound method is the cheaper call (no ``is`` tests).
-        flow = self.flow
+        flow = self.flow            # (the commonest items' native methods: see DIRECT)
         acts = flow.activities
         lone_q = flow.start_lone_q if DIRECT else None
         done_q = acts.body_done_q if DIRECT else None
@@ -434,7 +430,10 @@ class RunState(Timers):
 #: how many run items of the ready queue drain keeps before dropping them from its front
 _COMPACT: Final = 4096
 
-#: Whether drain calls the commonest items as native methods (compiled: see drain).
+#: Whether drain calls the two items every workflow instance queues (its first token, a
+#: body's end) as the native methods they are bound to (compiled: through Python's protocol,
+#: the bound method and its argument parsing, each call cost about 180 instructions more;
+#: from source the bound method is the cheaper call).
 DIRECT: Final = not TUPLES
 
 
