@@ -6,8 +6,8 @@ is the current one, one of no mode always, and a mode changed back starts it aga
 from __future__ import annotations
 
 from builders import act, catch, coordination, pkg, proc
-from conftest import events, run
 
+from conftest import events, run
 from opspec.model import WorkflowMode
 
 
