@@ -29,17 +29,17 @@ class DedicatedProcessor:
         # compiled, while they are few, a *line* as the run's timers keep theirs
         # (timers.line_push): sorted the latest first, the ended ones taken off its end, a
         # new one put in its place found by bisection (heapq's functions are calls through
-        # Python's protocol from compiled code). Past LINE_MAX they are a heap, until
+        # Python's protocol from compiled code). Past LINE_MAX they are a heap again, until
         # fewer than LINE_MIN are under way.
         self._ends: list[float] = []
-        self._lined = True
+        self._lined = not TUPLES
         self.bursts = 0
         self.busy_time = 0.0
         self.max_busy = 0
 
     def burst(self, now: float, cost: float) -> None:
         ends = self._ends
-        if not TUPLES and self._lined:
+        if self._lined:
             while ends and ends[-1] <= now:
                 ends.pop()
             end = now + cost
@@ -61,7 +61,7 @@ class DedicatedProcessor:
                 heapq.heappop(ends)
             heapq.heappush(ends, now + cost)
             busy = len(ends)
-            if not TUPLES and busy < LINE_MIN:
+            if busy < LINE_MIN and not TUPLES:
                 ends.sort(reverse=True)
                 self._lined = True
         self.bursts += 1

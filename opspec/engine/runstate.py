@@ -224,17 +224,19 @@ class RunState(Timers):
     def drain(self) -> None:
         """Run queued zero-time work until none is left (re-entrant calls just return).
 
-        Each item run and each drain (a storm of zero-delay wakeups that queue nothing counts
-        too) is a step of its simulated instant, counted across drains and from 0 again when
-        the clock has moved (a creep of no real time does not move it); past
-        ``max_instant_steps`` the run stops with a :class:`~opspec.errors.ZeroTimeCycleError`
-        naming the activities that keep coming back (:mod:`opspec.engine.zero_time`)."""
+        Zero-time work at one simulated instant is counted across drains: each item run and
+        each drain (a clock event at this instant, so a storm of zero-delay wakeups that queue
+        nothing counts too); the count starts again when the clock has moved. Past
+        ``max_instant_steps`` the run stops with a
+        :class:`~opspec.errors.ZeroTimeCycleError` naming the activities that keep coming
+        back (:mod:`opspec.engine.zero_time`)."""
         if self.draining:
             return
         now = self.now
         instant = self.instant
         if now != instant:
-            # _same_instant in line (a Python frame per drain from source; the time is >= 0)
+            # _same_instant in line (a Python frame per drain from source; the time is never
+            # negative): a new instant starts its count at 0, a creep of no real time does not
             moved = now - instant
             if moved < 0.0:
                 moved = -moved
@@ -246,43 +248,42 @@ class RunState(Timers):
                     self.start_limit = self.max_instant_steps
         ready = self.ready
         if not ready and not self.pending:
-            self._step_only()
+            # nothing queued (a deadline that fired after its instance ended, a timer whose
+            # callback queued nothing): the drain only counts as a step of this instant
+            steps = self.instant_steps + 1
+            if steps > self.max_instant_steps:
+                self.instant_steps = steps      # (as the finally below, if this raises)
+                steps = self._past_limit(steps, None, None)
+            self.instant_steps = steps
             return
         self.draining = True
         done = 0                    # the items of ``ready`` run so far
         steps = self.instant_steps + 1
         limit = self.max_instant_steps
         flow = self.flow            # (the commonest items' native methods: see DIRECT)
+        acts = flow.activities
+        lone_q = flow.start_lone_q if DIRECT else None
+        done_q = acts.body_done_q if DIRECT else None
         try:
             if steps > limit:
                 steps = self._past_limit(steps, None, None)
             while True:
-                # a list's iterator sees the items appended while it runs (from source, a
-                # FOR_ITER per item); it starts at the front: what ran is dropped before again
-                if DIRECT:
-                    lone_q, done_q = flow.start_lone_q, flow.activities.body_done_q
-                    for fn, a, b, c in ready:
-                        done += 1
-                        steps += 1
-                        if steps > limit:
-                            steps = self._past_limit(steps, a, b)
-                        if fn is lone_q:
-                            flow.start_lone_at(a, b, c)
-                        elif fn is done_q:
-                            flow.activities.body_done(a, b, c)
-                        else:
-                            fn(a, b, c)
-                        if done >= _COMPACT:    # a long burst: drop what has run
-                            break
-                else:
-                    for fn, a, b, c in ready:
-                        done += 1
-                        steps += 1
-                        if steps > limit:
-                            steps = self._past_limit(steps, a, b)
+                # A list's iterator sees the items appended while it runs (from source, one
+                # FOR_ITER per item instead of a len() call and an index); it starts at the
+                # front, so what has run is dropped before it starts again.
+                for fn, a, b, c in ready:
+                    done += 1
+                    steps += 1
+                    if steps > limit:
+                        steps = self._past_limit(steps, a, b)
+                    if fn is lone_q:
+                        flow.start_lone_at(a, b, c)
+                    elif fn is done_q:
+                        acts.body_done(a, b, c)
+                    else:
                         fn(a, b, c)
-                        if done >= _COMPACT:
-                            break
+                    if done >= _COMPACT:        # a long burst: drop what has run
+                        break
                 if done == len(ready):          # (compiled, a slice's delete boxes its
                     ready.clear()               # bounds into a slice object: 0.3k an instance)
                 else:
@@ -292,7 +293,7 @@ class RunState(Timers):
                     continue
                 if not self.pending:
                     break
-                flow.resolve_frames()
+                self.flow.resolve_frames()
                 if not ready:
                     break
         finally:
@@ -300,15 +301,6 @@ class RunState(Timers):
                 del ready[:done]
             self.draining = False
             self.instant_steps = steps
-
-    def _step_only(self) -> None:
-        """A drain with nothing queued (a deadline that fired after its instance ended, a
-        timer whose callback queued nothing) only counts as a step of this instant."""
-        steps = self.instant_steps + 1
-        if steps > self.max_instant_steps:
-            self.instant_steps = steps          # (as drain's finally, if this raises)
-            steps = self._past_limit(steps, None, None)
-        self.instant_steps = steps
 
     def _past_limit(self, steps: int, a: Any, b: Any) -> int:
         """The step count passed the limit: a new count if the clock moved since the count
