@@ -3,16 +3,15 @@
 A module of its own so that the compiled build (``opspec._native``) compiles it with the
 engine: the dedicated model is the default, and every activity with a CPU demand records a
 burst here (a robot spec: 54,000 an hour), which from :mod:`opspec.engine.processors`
-(interpreted) cost a Python call each. The bursts under way are kept on a heap by the functions
-of the run's timer heap (:mod:`opspec.engine.timers`). The processor models are described
-in :mod:`opspec.engine.processors`.
+(interpreted) cost a Python call each. The processor models are described in
+:mod:`opspec.engine.processors`.
 """
 
 from __future__ import annotations
 
 import heapq
 
-from opspec.engine.timers import TUPLES, Timed, heap_pop, heap_push
+from opspec.engine.timers import LINE_MAX, LINE_MIN, TUPLES
 
 __all__ = ["DedicatedProcessor"]
 
@@ -26,31 +25,45 @@ class DedicatedProcessor:
     """
 
     def __init__(self) -> None:
-        # the end times of the bursts under way, a heap: from source floats under heapq;
-        # compiled, timed entries on the run's own heap functions (comparing their native
-        # fields, where heapq is a call through Python's protocol per burst)
+        # the end times of the bursts under way. From source a heap under heapq (its C code);
+        # compiled, while they are few, a *line* as the run's timers keep theirs
+        # (timers.line_push): sorted the latest first, the ended ones taken off its end, a
+        # new one put in its place found by bisection (heapq's functions are calls through
+        # Python's protocol from compiled code). Past LINE_MAX they are a heap again, until
+        # fewer than LINE_MIN are under way.
         self._ends: list[float] = []
-        self._marks: list[Timed] = []
+        self._lined = not TUPLES
         self.bursts = 0
         self.busy_time = 0.0
         self.max_busy = 0
 
     def burst(self, now: float, cost: float) -> None:
-        if not TUPLES:          # compiled (as the timers' heap)
-            marks = self._marks
-            while marks and marks[0].at <= now:
-                heap_pop(marks)
-            mark = Timed()
-            mark.at = now + cost
-            mark.seq = 0            # (bursts that end together: any order will do)
-            heap_push(marks, mark)
-            busy = len(marks)
+        ends = self._ends
+        if self._lined:
+            while ends and ends[-1] <= now:
+                ends.pop()
+            end = now + cost
+            lo = 0
+            hi = len(ends)
+            while lo < hi:
+                mid = (lo + hi) >> 1
+                if ends[mid] > end:
+                    lo = mid + 1
+                else:
+                    hi = mid
+            ends.insert(lo, end)
+            busy = len(ends)
+            if busy > LINE_MAX:
+                ends.reverse()          # the earliest first: sorted, so a heap
+                self._lined = False
         else:
-            ends = self._ends
             while ends and ends[0] <= now:
                 heapq.heappop(ends)
             heapq.heappush(ends, now + cost)
             busy = len(ends)
+            if busy < LINE_MIN and not TUPLES:
+                ends.sort(reverse=True)
+                self._lined = True
         self.bursts += 1
         self.busy_time += cost
         if busy > self.max_busy:  # noqa: PLR1730 - max() is a builtin call per burst

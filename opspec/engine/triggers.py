@@ -303,9 +303,15 @@ class Triggers(Part):
 
     def is_active(self, process_id: str) -> bool:
         """Whether ``process_id`` belongs to no mode or to the current mode."""
-        modes = self.state.compiled.modes
-        if not modes:
+        if not self.state.compiled.modes:
             return True
+        member = self.mode_members(process_id)
+        return not member or self.state.mode in member
+
+    def mode_members(self, process_id: str) -> tuple[str, ...]:
+        """The modes ``process_id`` belongs to (none: it runs in every mode), as found in
+        the package's table of modes now (kept until the table is another)."""
+        modes = self.state.compiled.modes
         members = self._members
         if members is None or self._members_of is not modes:
             members = self._members = {}
@@ -314,7 +320,7 @@ class Triggers(Part):
         if member is None:
             member = members[process_id] = tuple(
                 m for m, procs in modes.items() if process_id in procs)
-        return not member or self.state.mode in member
+        return member
 
     def boundary(self, ai: ActivityInstance, index: int, data: Mapping[str, Any] | None) -> None:
         event = ai.frame.graph.activities[index]
@@ -497,6 +503,10 @@ class _Timer(Timed):
         self.label = label
         self.proc: CompiledProcess | None = None
         self.start = -1
+        # the modes its workflow belongs to (Triggers.mode_members), and the table of
+        # modes they were found in: a firing tests the mode without a call of is_active
+        self.modes: object = None
+        self.member: tuple[str, ...] = ()
         if starts is not None:
             self.proc, self.start = starts
         now = triggers.state.now
@@ -531,11 +541,20 @@ class _Timer(Timed):
 
     def go(self) -> None:
         proc = self.proc
+        triggers = self.triggers
+        state = triggers.state
         if proc is not None:
-            self.triggers._triggered_start(proc, self.label, self.start)
+            # Triggers._triggered_start, the workflow's modes kept here
+            modes = state.compiled.modes
+            if modes is not self.modes:
+                self.member = triggers.mode_members(proc.id)
+                self.modes = modes
+            member = self.member
+            if not member or state.mode in member:
+                triggers.flow.start_process(proc, trigger=self.label, start=self.start)
         else:
             self.fire(self.label)
-        self.triggers.state.drain()
+        state.drain()
         self.arm()
 
     def __call__(self, _event: Any) -> None:
