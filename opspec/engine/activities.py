@@ -32,7 +32,7 @@ from opspec.engine.compiled import (
 from opspec.engine.instances import ActivityInstance, Frame, MultiInstance, ProcessInstance
 from opspec.engine.lifecycle import ABORTED, COMPLETED, RUNNING, SUSPENDED, TERMINATED
 from opspec.engine.part import Part
-from opspec.engine.timers import Timed
+from opspec.engine.timers import TUPLES, Timed
 from opspec.engine.trace import EventKind as EK
 from opspec.errors import OpspecError
 from opspec.model import CoordinationKind, ParameterMode
@@ -46,6 +46,12 @@ _VOTER: Final = CoordinationKind.VOTER
 _SUPERPOSITION: Final = CoordinationKind.SUPERPOSITION
 _PUSH_DATA: Final = CoordinationKind.PUSH_DATA
 _PULL_DATA: Final = CoordinationKind.PULL_DATA
+
+#: Whether ``body_done`` reads a dict of answers as one (compiled: the dict's own iteration;
+#: a Mapping's is an ``items`` method call through Python's protocol and an iterator, 0.7k a
+#: workflow instance on the periodic path, where a world's answer carries its readings).
+#: From source the test alone would cost more than it saves.
+DICTS: Final = not TUPLES
 
 #: Synchronous subflow calls nested deeper than this end the run's root instance with a
 #: located fault: bounded recursion (a base case) runs, runaway recursion is reported.
@@ -353,8 +359,12 @@ class Activities(Part):
         if data:
             inst = ai.frame.inst
             act = ai.act
-            for key, value in data.items():
-                self.flow.set_field(inst, act, key, value)
+            if DICTS and type(data) is dict:
+                for key, value in data.items():
+                    self.flow.set_field(inst, act, key, value)
+            else:
+                for key, value in data.items():
+                    self.flow.set_field(inst, act, key, value)
         act = ai.act
         if act.loop is not None:
             # each iteration is one execution of the activity: its assignments apply each time

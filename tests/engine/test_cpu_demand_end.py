@@ -6,8 +6,8 @@ from __future__ import annotations
 import pytest
 import simpy
 from builders import act, pkg, proc
-from conftest import completed, events
 
+from conftest import completed, events
 from opspec.engine.simulation import Simulation
 
 
