@@ -13,7 +13,7 @@ from __future__ import annotations
 
 from collections import deque
 from collections.abc import Callable, Mapping
-from typing import TYPE_CHECKING, Any, Final
+from typing import TYPE_CHECKING, Any, Final, final
 
 from opspec.engine import coordination as coord
 from opspec.engine import multi_instance, plans, tools
@@ -32,6 +32,7 @@ from opspec.engine.compiled import (
 from opspec.engine.instances import ActivityInstance, Frame, MultiInstance, ProcessInstance
 from opspec.engine.lifecycle import ABORTED, COMPLETED, RUNNING, SUSPENDED, TERMINATED
 from opspec.engine.part import Part
+from opspec.engine.timers import TUPLES, Timed
 from opspec.engine.trace import EventKind as EK
 from opspec.errors import OpspecError
 from opspec.model import CoordinationKind, ParameterMode
@@ -45,6 +46,12 @@ _VOTER: Final = CoordinationKind.VOTER
 _SUPERPOSITION: Final = CoordinationKind.SUPERPOSITION
 _PUSH_DATA: Final = CoordinationKind.PUSH_DATA
 _PULL_DATA: Final = CoordinationKind.PULL_DATA
+
+#: Whether ``body_done`` reads a dict of answers as one (compiled: the dict's own iteration;
+#: a Mapping's is an ``items`` method call through Python's protocol and an iterator, 0.7k a
+#: workflow instance on the periodic path, where a world's answer carries its readings).
+#: From source the test alone would cost more than it saves.
+DICTS: Final = not TUPLES
 
 #: Synchronous subflow calls nested deeper than this end the run's root instance with a
 #: located fault: bounded recursion (a base case) runs, runaway recursion is reported.
@@ -251,7 +258,7 @@ class Activities(Part):
             if cpu > 0.0:
                 self.state.dedicated.burst(self.state.now, cpu)
                 ai.waiting = "cpu"
-                self.state.later(cpu, self._after_cpu_cb, ai)
+                self.state.later_entry(cpu, _CpuDone(self, ai))
                 return
         self.after_cpu(ai)
 
@@ -352,8 +359,12 @@ class Activities(Part):
         if data:
             inst = ai.frame.inst
             act = ai.act
-            for key, value in data.items():
-                self.flow.set_field(inst, act, key, value)
+            if DICTS and type(data) is dict:
+                for key, value in data.items():
+                    self.flow.set_field(inst, act, key, value)
+            else:
+                for key, value in data.items():
+                    self.flow.set_field(inst, act, key, value)
         act = ai.act
         if act.loop is not None:
             # each iteration is one execution of the activity: its assignments apply each time
@@ -525,3 +536,29 @@ class Activities(Part):
                                     {output: value} if output else None, None))
                 return
         self.state.mailboxes.setdefault(channel, deque()).append(value)
+
+
+@final
+class _CpuDone(Timed):
+    """A CPU demand's end (:meth:`RunState.later` of :meth:`Activities.after_cpu`, and what
+    :meth:`RunState.fired` does with it): compiled, ``after_cpu`` is called as the native
+    method it is, not as a bound method made per demand and called through Python's protocol
+    (once a workflow instance on the periodic path)."""
+
+    def __init__(self, acts: Activities, ai: ActivityInstance) -> None:
+        self.acts = acts
+        self.ai = ai
+        self.gen = ai.gen
+
+    def go(self) -> None:
+        ai = self.ai
+        if ai.gen == self.gen and ai.state == RUNNING:
+            acts = self.acts
+            if ai.frame.inst.state == SUSPENDED:    # RunState.fired defers it
+                acts.state.fired(acts._after_cpu_cb, ai, None, self.gen)
+                return
+            acts.after_cpu(ai)
+            acts.state.drain()
+
+    def __call__(self, _event: Any) -> None:
+        self.acts.state.fire(self.acts._after_cpu_cb, self.ai, None, self.gen)

@@ -336,6 +336,15 @@ class RunState(Timers):
         self.schedule_timed(delay if delay > 0.0 else 0.0,  # noqa: FURB136 - no builtin call
                            _Later(self, fn, ai, arg))
 
+    def later_entry(self, delay: float, entry: Timed) -> None:
+        """:meth:`later` for a timed callback of the caller's own (one that calls its method
+        as the native method it is, not a bound method made per call)."""
+        if self.resolution > 0.0:
+            delay = self._align(delay)
+        self.sim_events += 1
+        self.schedule_timed(delay if delay > 0.0 else 0.0,  # noqa: FURB136 - no builtin call
+                           entry)
+
     def fire(self, fn: Callable[[ActivityInstance, Any], None], ai: ActivityInstance,
              arg: Any, gen: int) -> None:
         """A :meth:`later` callback is due as a SimPy timeout's (nothing to do, not even a
