@@ -148,17 +148,8 @@ def build(proc: CompiledProcess, start: int) -> Callable[[Any, Any, Any], None]:
              "        if inst.state == SUSPENDED:",
              "            inst.defer((plan, inst, activities, None))",
              "        return",
-             "    state = activities.state",
-             "    if state.flag_key is not KEY:    # (the listeners' bits: see by_selection)",
-             "        SELECT(state)",
              "    flow = activities.flow",
-             "    limit = state.start_limit",
-             "    iid = inst.id",
-             "    steps = 0"]
-    if any(act.general for act in proc.graph.activities):
-        lines.append("    pooled = state.pooled")
-    if any(act.kind == K_TASK for act in proc.graph.activities):
-        lines.append("    apps = state.apps")
+             *_token_locals(proc)]
     writer.block(start, (), 1, lines)
     plan: Callable[[Any, Any, Any], None] = _made(writer, lines, f"<plan of {proc.id}>",
                                                   "plan")
@@ -225,20 +216,28 @@ def build_performed(proc: CompiledProcess, index: int) -> Callable[[Any, Any, An
              "                                 and frame.owner.state != RUNNING):",
              "        flow._dropped(frame, flow.performed, PERFORMED, trans)",
              "        return",
-             "    state = activities.state",
+             *_token_locals(proc)]
+    writer.block(index, (), 1, lines, performed=True)
+    made: Callable[[Any, Any, Any], None] = _made(
+        writer, lines, f"<performed plan of {proc.id}/{act.index}>", "performed")
+    return made
+
+
+def _token_locals(proc: CompiledProcess) -> list[str]:
+    """The locals a plan that carries a token reads (``inst`` and ``activities`` given):
+    the run state with this run's listener bits selected, the zero-time guard's limit and
+    count, and the pooled processor and the applications where ``proc`` has any."""
+    lines = ["    state = activities.state",
              "    if state.flag_key is not KEY:    # (the listeners' bits: see by_selection)",
              "        SELECT(state)",
              "    limit = state.start_limit",
              "    iid = inst.id",
              "    steps = 0"]
-    if any(other.general for other in proc.graph.activities):
+    if any(act.general for act in proc.graph.activities):
         lines.append("    pooled = state.pooled")
-    if any(other.kind == K_TASK for other in proc.graph.activities):
+    if any(act.kind == K_TASK for act in proc.graph.activities):
         lines.append("    apps = state.apps")
-    writer.block(index, (), 1, lines, performed=True)
-    made: Callable[[Any, Any, Any], None] = _made(
-        writer, lines, f"<performed plan of {proc.id}/{act.index}>", "performed")
-    return made
+    return lines
 
 
 def _made(writer: Writer, lines: list[str], where: str, name: str) -> Any:
