@@ -424,7 +424,7 @@ class WalkthroughApp(App[str | None]):
         state = ("[ENDED]" if session.ended
                  else "[waiting for the device]" if session.waiting_for_devices
                  else "skipping... (u: stop)" if session.skipping
-                 else "PAUSED" if session.paused else "running")
+                 else session.paused_words if session.paused else "running")
         who = ("replaying the recording" if session.replaying
                else "no user lane" if not session.has_user_lane
                else "model performs your lane" if session.handed_over

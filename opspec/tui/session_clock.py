@@ -201,6 +201,14 @@ class SessionClock(SessionState):
                 self.speed = before
 
     @property
+    def paused_words(self) -> str:
+        """The status line's word for a paused clock: it says when the device's call paused
+        it (``--on-call pause``) and how to go on, which a bare PAUSED did not."""
+        if self._in_call and self.on_call == "pause" and self.calling:
+            return "PAUSED: the device calls (space resumes)"
+        return "PAUSED"
+
+    @property
     def call_mode(self) -> str:
         """What the clock does during this call, in words ("" when there is no call)."""
         if not self._in_call:

@@ -67,6 +67,17 @@ def test_on_call_pause_and_keep(compiled, mode, speed, paused):
     assert session.calling and session.speed == speed and session.paused is paused
 
 
+def test_a_clock_the_call_paused_says_so(compiled):
+    """With --on-call pause the status line said only PAUSED at the alarm: the person did not
+    know the device had stopped the clock, or how to go on. A pause of their own is PAUSED."""
+    session = WalkSession(compiled, on_call="pause")
+    session.skip_until_user()
+    assert session.paused and session.paused_words == "PAUSED: the device calls (space resumes)"
+    mine = WalkSession(compiled)
+    mine.paused = True
+    assert mine.paused_words == "PAUSED"
+
+
 def test_a_model_performing_the_lane_is_not_slowed_down(compiled, model_factory):
     session = WalkSession(compiled, model_factory=model_factory)
     session.hand_over()
