@@ -8,7 +8,9 @@ is mapped to a person, in the order a study coordinator would reach for:
 1. ``--person FILE=ID`` (repeatable): that file's sessions are participant ``ID`` (``FILE``
    as given on the command line, its resolved path, or its bare file name);
 2. ``--person-pattern REGEX``: the participant is the first group (else the whole match) of
-   ``REGEX`` searched in the file's path, e.g. ``'(P\\d+)'`` for ``recordings/P07-day2.jsonl``;
+   ``REGEX`` searched in the file's path nearest the file first (its name, then its folder,
+   and up; a pattern that spans folders in the whole path), e.g. ``'(P\\d+)'`` for
+   ``recordings/P07-day2.jsonl`` — a ``P1`` in a folder far above is not the participant;
 3. ``--person-from``:
 
    * ``auto`` (default): the header's ``person`` key when the file has one, else each run
@@ -65,7 +67,7 @@ class PersonRule:
         if found is not None:
             return found
         if self.pattern is not None:
-            match = re.search(self.pattern, str(path))
+            match = _nearest_match(self.pattern, path)
             if match is None:
                 raise UserModelError(
                     f"--person-pattern {self.pattern!r} does not match this file's path",
@@ -140,3 +142,14 @@ def parse_person_options(values: Sequence[str]) -> dict[str, str]:
             raise UserModelError(f"--person names {file} twice ({out[file]} and {person})")
         out[file] = person.strip()
     return out
+
+
+def _nearest_match(pattern: str, path: Path) -> re.Match[str] | None:
+    """``pattern`` searched in ``path``'s parts from the file's name upwards, then (a pattern
+    that spans folders) in the whole path: the participant is named nearest the file, and a
+    folder far above it (a study's, a temporary one) must not name every file alike."""
+    for part in reversed(path.parts):
+        match = re.search(pattern, part)
+        if match is not None:
+            return match
+    return re.search(pattern, str(path))

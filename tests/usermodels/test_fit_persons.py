@@ -191,9 +191,13 @@ def test_fit_cli_names_persons_and_writes_loadable_redraws(tmp_path: Path, capsy
     assert model.activities["walk"].duration != third.activities["walk"].duration
 
 
-def test_person_options_refuse_what_they_cannot_honour(tmp_path: Path, capsys) -> None:
-    a = write_session(tmp_path / "a.jsonl", [50.0, 60.0, 70.0])
-    out = str(tmp_path / "m.users.toml")
+def test_person_options_refuse_what_they_cannot_honour(tmp_path: Path, capsys,
+                                                       monkeypatch) -> None:
+    # the path as given, relative: a temporary folder's random name (…NXnP0q) must not be
+    # what the pattern below finds
+    monkeypatch.chdir(tmp_path)
+    a = write_session(tmp_path / "a.jsonl", [50.0, 60.0, 70.0]).relative_to(tmp_path)
+    out = "m.users.toml"
     assert main(["fit", str(a), "-o", out, "--person-from", "header"]) == 2
     err = capsys.readouterr().err
     assert "a.jsonl:1" in err and "'person'" in err
@@ -205,6 +209,21 @@ def test_person_options_refuse_what_they_cannot_honour(tmp_path: Path, capsys) -
     assert "not a regular expression" in capsys.readouterr().err
     assert main(["fit", str(a), "-o", out, "--person-pattern", r"(P\d+)"]) == 2
     assert "does not match" in capsys.readouterr().err
+
+
+def test_the_pattern_finds_the_participant_nearest_the_file(tmp_path: Path) -> None:
+    """A folder far above the recordings whose name the pattern also matches (a study
+    called P1-pilot, a temporary folder …NXnP0q) named every file's participant alike: the
+    pattern is searched from the file's name upwards, then across folders."""
+    from opspec.usermodels.persons import PersonRule
+
+    study = tmp_path / "P1-pilot" / "recordings"
+    rule = PersonRule("auto", r"(P\d+)", {})
+    assert rule.of_file(study / "P07-day1.jsonl") == "P07"
+    assert rule.of_file(study / "P09" / "day1.jsonl") == "P09"
+    assert rule.of_file(study / "day1.jsonl") == "P1"          # nothing nearer: the study's
+    spanning = PersonRule("auto", r"recordings/(P\d+)", {})
+    assert spanning.of_file(study / "P11" / "day1.jsonl") == "P11"
 
 
 def test_a_broken_uncertainty_table_names_the_file_and_key(tmp_path: Path) -> None:
