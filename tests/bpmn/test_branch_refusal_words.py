@@ -103,16 +103,16 @@ def test_a_refusal_travels_between_processes() -> None:
 
 @pytest.mark.parametrize(("branches", "said"), [
     ({"Pill takn?": {"Yes": 0.8}},
-     "branches['Pill takn?']: no gateway of this id or name (did you mean 'Pill taken?'?); "
-     "name a gateway by its id or name, as opspec validate prints them (docs/bpmn.md, "
-     "Undecided gateways)"),
+     ("branches['Pill takn?']: no gateway of this id or name (did you mean 'Pill taken?'?); "
+      "name a gateway by its id or name, as opspec validate prints them (docs/bpmn.md, "
+      "Undecided gateways)")),
     ({"ask": {"Yess": 0.8, "No": 0.2}},
-     "branches['ask']['Yess']: no flow of this id or name out of ask ('Pill taken?') (did you "
-     "mean 'Yes'?); its flows are yes ('Yes'), no ('No')"),
+     ("branches['ask']['Yess']: no flow of this id or name out of ask ('Pill taken?') (did "
+      "you mean 'Yes'?); its flows are yes ('Yes'), no ('No')")),
     ({"check": {"high": 0.5, "low": 0.5}},
-     "branches['check']: the conditions of check ('Score high?') decide it; branch "
-     "probabilities apply only to a gateway the diagram leaves undecided; leave it out of "
-     "branches, or give the run inputs its conditions read (params)"),
+     ("branches['check']: the conditions of check ('Score high?') decide it; branch "
+      "probabilities apply only to a gateway the diagram leaves undecided; leave it out of "
+      "branches, or give the run inputs its conditions read (params)")),
 ], ids=["gateway", "flow", "decided"])
 def test_the_python_api_is_refused_in_its_own_words(
         tmp_path: Path, branches: dict[str, dict[str, float]], said: str) -> None:

@@ -238,8 +238,8 @@ def test_a_user_model_given_is_checked_instead_of_the_companion(
     population = tmp_path / "pill.population.toml"
     population.write_text(POPULATION, encoding="utf-8")
     assert validate(capsys, str(spec), "--user-model", str(population)) == (
-        0, ["1 file checked with pill.population.toml as its user model: no errors "
-            "(0 errors, 0 warnings)"])
+        0, [("1 file checked with pill.population.toml as its user model: no errors "
+             "(0 errors, 0 warnings)")])
     status, out = validate(capsys, str(spec), "--user-model", str(population), "--json")
     assert status == 0
     assert json.loads(out[0])["side_files"] == [
