@@ -10,7 +10,10 @@ and 1, unlike the Wald interval),
 Student t for means of per-replication values, and the distribution-free order-statistic
 interval (binomial) for quantiles of pooled observations.
 
-Each ``decide_*`` returns ``None`` when the claim holds, else the failure message.
+Each ``decide_*`` returns ``None`` when the claim holds, else the failure message. A mean
+claim that holds on replications that all gave the same value holds on an interval of no
+width, which shows no spread between them, not a value known exactly:
+:func:`alike_caveat` says so (:mod:`opspec.statistics.no_spread`).
 """
 
 from __future__ import annotations
@@ -25,8 +28,9 @@ from opspec.statistics.intervals import (
     rate_interval,
     t_quantile,
 )
+from opspec.statistics.no_spread import ALIKE_SHARE, unlike_share_high
 
-__all__ = ["confidence_text", "decide_mean", "decide_quantile", "decide_rate"]
+__all__ = ["alike_caveat", "confidence_text", "decide_mean", "decide_quantile", "decide_rate"]
 
 _MAX_N = 10**9
 
@@ -164,6 +168,28 @@ def decide_mean(text: str, values: Sequence[float], op: str, a: float, b: float 
         lines.append(f"  too few replications to decide: about {needed} would, if the "
                      f"estimate and spread stay where they are")
     return "\n".join(lines)
+
+
+def alike_caveat(text: str, values: Sequence[float], level: float) -> str | None:
+    """What to say of a mean claim ``text`` that held on ``values`` all alike (a t interval of
+    no width), when they are too few to bound the share of replications that could give
+    another value below :data:`~opspec.statistics.no_spread.ALIKE_SHARE`; None when the
+    values differ, or are enough."""
+    n = len(values)
+    if n < 2 or any(v != values[0] for v in values):
+        return None
+    share = unlike_share_high(n, level)
+    if share <= ALIKE_SHARE:
+        return None
+    # the n at which none of n unlike bounds the share at ALIKE_SHARE (368 at 95 %)
+    enough = math.ceil(math.log((1.0 - level) / 2.0) / math.log(1.0 - ALIKE_SHARE))
+    return (f"{text!r} held, but all {n} replications gave {values[0]:g}: that shows no "
+            f"spread between them, not a value known exactly; with none of {n} unlike, up "
+            f"to {share:.0%} of replications could give another value (the exact "
+            f"{confidence_text(level)} bound), and about {enough} replications all alike "
+            f"would bound that below {ALIKE_SHARE:.0%}. If the spec fixes this value (a "
+            "schedule, a scripted user and no chance in the devices), the claim is exact "
+            "and this note does not apply")
 
 
 def decide_quantile(text: str, values: Sequence[float], q: float, op: str, a: float,

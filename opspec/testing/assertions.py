@@ -28,6 +28,12 @@ confidence; a one-sided bound at level C is one end of the two-sided interval at
 * quantiles of pooled observations: the distribution-free order-statistic interval (the ranks
   come from the binomial distribution; valid for any continuous distribution).
 
+A mean claim that passes on replications that all gave the same value passes on an interval
+of no width: that shows no spread between them, not a value known exactly, and unless they
+are enough (368 at 95 %) to bound the share that could give another value below 1 %,
+:func:`assert_mean` says so in an :class:`AllAlikeWarning` (pytest lists it in its warnings
+summary).
+
 Sequential mode (:func:`assert_rate_sequential`) simulates batches until the claim is decided
 or ``max_users`` is reached; with at most K looks it decides each look at confidence
 ``1 - (1 - C)/K`` (Bonferroni), so the chance of a wrong pass (or a wrong refutation) over
@@ -37,6 +43,7 @@ all looks stays at most ``1 - C``.
 from __future__ import annotations
 
 import math
+import warnings
 from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
@@ -51,9 +58,10 @@ from opspec.statistics import (
     t_quantile,
 )
 from opspec.statistics import Interval as Estimate
-from opspec.statistics.claims import confidence_text, smallest_deciding
+from opspec.statistics.claims import alike_caveat, confidence_text, smallest_deciding
 
 __all__ = [
+    "AllAlikeWarning",
     "Decision",
     "Estimate",
     "SequentialOutcome",
@@ -76,6 +84,11 @@ def _check_confidence(confidence: float) -> None:
 
 
 # ---------------------------------------------------------------- deciding
+class AllAlikeWarning(UserWarning):
+    """A mean claim passed on replications that all gave the same value, too few of them to
+    bound the share of replications that could give another (:func:`assert_mean`)."""
+
+
 @dataclass(frozen=True, slots=True, repr=False)
 class Decision:
     """The outcome of a statistical claim: ``verdict`` is ``"pass"``, ``"refuted"`` or
@@ -311,6 +324,9 @@ def assert_mean(result: Any, metric: str, *, at_least: float | None = None,
     decision = Decision(claim, verdict, est, lo, hi, n, confidence, sides, name, bound,
                         f"(sd {sd:.3g}, {n} replications{left_out})", needed)
     _fail(decision, result)
+    caveat = alike_caveat(claim, values, confidence)
+    if caveat is not None:
+        warnings.warn(caveat, AllAlikeWarning, stacklevel=2)
     return decision
 
 

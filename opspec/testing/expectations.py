@@ -200,6 +200,17 @@ class Expectation:
         return decide_mean(self.text, result.samples(self.groups["metric"]), op, a, b,
                            float(self.groups["conf"]) / 100.0)
 
+    def caveat(self, result: SimulationResult) -> str | None:
+        """What a reader must know of this expectation's pass on ``result``: a mean over
+        replications that were all alike (:func:`~opspec.statistics.claims.alike_caveat`);
+        None for any other."""
+        if self.property is not None or self.form != "mean":
+            return None
+        from opspec.statistics.claims import alike_caveat
+
+        return alike_caveat(self.text, result.samples(self.groups["metric"]),
+                            float(self.groups["conf"]) / 100.0)
+
     def _check_quantile(self, result: SimulationResult) -> str | None:
         from opspec.statistics.claims import decide_quantile
 

@@ -21,8 +21,9 @@ Fixtures:
   instead of compared).
 
 Scenario files (``*.scenario.toml``, see :mod:`opspec.testing.scenario`) are collected as
-tests, one item per ``[[scenario]]``. The warnings on the specs simulated are listed once at
-the end of the session (pytest-xdist workers hand theirs to the controller).
+tests, one item per ``[[scenario]]``. The warnings on the specs simulated, and the notes on
+claims that held on replications all alike, are listed once at the end of the session
+(pytest-xdist workers hand theirs to the controller).
 """
 
 from __future__ import annotations
@@ -53,6 +54,9 @@ _SPECS_KEY = pytest.StashKey[dict[Path, Any]]()
 #: the front hall's warnings on what a test simulated (validate's on the spec, the user
 #: model's), per test and over the session: shown in the report and at the end
 _WARNED_KEY = pytest.StashKey[dict[str, None]]()
+#: the notes on ``then`` lines that held on replications all alike (a mean's interval of no
+#: width), per test and over the session: shown in the report and at the end
+_NOTED_KEY = pytest.StashKey[dict[str, None]]()
 
 
 def pytest_addoption(parser: pytest.Parser) -> None:
@@ -77,6 +81,7 @@ def pytest_configure(config: pytest.Config) -> None:
         "markers", "hardware: needs a real serial device (--device-url)")
     config.stash[_SPECS_KEY] = {}
     config.stash[_WARNED_KEY] = {}
+    config.stash[_NOTED_KEY] = {}
 
 
 def _warned(node: pytest.Item | None, config: pytest.Config, result: Any) -> None:
@@ -92,6 +97,13 @@ def _warned(node: pytest.Item | None, config: pytest.Config, result: Any) -> Non
             seen[line] = None
         for failed in getattr(result, "failed", ()):
             seen[f"failed {failed}"] = None
+
+
+def _noted(node: pytest.Item, config: pytest.Config, line: str) -> None:
+    """Keep a note on a claim that held (:meth:`Expectation.caveat`) for the test's report
+    and the session's end: a green test must not read as a value known exactly."""
+    config.stash[_NOTED_KEY][line] = None
+    node.stash.setdefault(_NOTED_KEY, {})[line] = None
 
 
 # ---------------------------------------------------------------- paths and specs
@@ -367,6 +379,7 @@ def pytest_runtest_makereport(item: pytest.Item, call: pytest.CallInfo[None]
                      "simulate(seed=...) overrides it)")
     if report.when == "call":
         lines.extend(item.stash.get(_WARNED_KEY, {}))
+        lines.extend(f"note: {line}" for line in item.stash.get(_NOTED_KEY, {}))
     if lines:
         report.sections.append(("opspec", "\n".join(lines)))
 
@@ -377,14 +390,17 @@ def pytest_sessionfinish(session: pytest.Session) -> None:
     output = getattr(session.config, "workeroutput", None)
     if output is not None:
         output["opspec_warned"] = list(session.config.stash.get(_WARNED_KEY, {}))
+        output["opspec_noted"] = list(session.config.stash.get(_NOTED_KEY, {}))
 
 
 @pytest.hookimpl(optionalhook=True)
 def pytest_testnodedown(node: Any, error: Any) -> None:
     """On the pytest-xdist controller: a worker's warnings join the session's."""
-    warned = node.config.stash.setdefault(_WARNED_KEY, {})
-    for line in getattr(node, "workeroutput", {}).get("opspec_warned", ()):
-        warned[line] = None
+    output = getattr(node, "workeroutput", {})
+    for key, name in ((_WARNED_KEY, "opspec_warned"), (_NOTED_KEY, "opspec_noted")):
+        kept = node.config.stash.setdefault(key, {})
+        for line in output.get(name, ()):
+            kept[line] = None
 
 
 def pytest_terminal_summary(terminalreporter: Any) -> None:
@@ -394,6 +410,11 @@ def pytest_terminal_summary(terminalreporter: Any) -> None:
     if warned:
         terminalreporter.write_sep("=", "opspec: warnings on the specs simulated")
         for line in warned:
+            terminalreporter.write_line(line)
+    noted = terminalreporter.config.stash.get(_NOTED_KEY, {})
+    if noted:
+        terminalreporter.write_sep("=", "opspec: claims that held on replications all alike")
+        for line in noted:
             terminalreporter.write_line(line)
 
 
@@ -452,7 +473,8 @@ class ScenarioItem(pytest.Item):
         package = load_cached(self.scenario.spec_path, self.config)[1]
         try:
             failures = run_scenario(self.scenario, package, seed=seed,
-                                    seen=lambda result: _warned(self, self.config, result))
+                                    seen=lambda result: _warned(self, self.config, result),
+                                    noted=lambda line: _noted(self, self.config, line))
         except OpspecError as error:
             raise ScenarioFailure(f"{self.scenario.place()}: {error}") from None
         if failures:

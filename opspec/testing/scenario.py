@@ -399,12 +399,15 @@ def _load(path: Path, full: Path, rootdir: Path | None) -> ScenarioDocument:
 
 
 def run_scenario(scenario: Scenario, spec: Any, *, seed: int = 0,
-                 seen: Callable[[Any], None] | None = None) -> list[str]:
+                 seen: Callable[[Any], None] | None = None,
+                 noted: Callable[[str], None] | None = None) -> list[str]:
     """Run ``scenario`` on ``spec`` (a Package, CompiledPackage or LoadedSpec); return one
     failure message per expectation that does not hold (empty when all do), each at the
     line the expectation is written on (``path:line: scenario[N].then[M]: …``). ``seen`` gets
-    the simulation's result (its warnings, its failed replications). A replication a fault
-    cut short fails the scenario, naming the fault's file:line."""
+    the simulation's result (its warnings, its failed replications); ``noted`` gets, at the
+    same kind of place, what a reader must know of an expectation that held (a mean over
+    replications all alike: :meth:`Expectation.caveat`). A replication a fault cut short
+    fails the scenario, naming the fault's file:line."""
     from opspec.testing.simulation import simulate
 
     needs_trace = any(e.property is not None for e in scenario.expectations)   # trace lines
@@ -426,6 +429,11 @@ def run_scenario(scenario: Scenario, spec: Any, *, seed: int = 0,
         message = expectation.check(result)
         if message is not None:
             failures.append(f"{scenario.place(f'.then[{number}]')}: {message}")
+        elif noted is not None:
+            caveat = expectation.caveat(result)
+            if caveat is not None:
+                noted(f"{scenario.place(f'.then[{number}]')}: {caveat} "
+                      f"(seed {result.seed})")
     if failures:
         failures.append(f"(seed {result.seed}; {result.replications} replication(s))")
     return failures

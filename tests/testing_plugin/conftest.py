@@ -2,13 +2,21 @@
 
 from __future__ import annotations
 
+import importlib
+import pkgutil
 from pathlib import Path
 
 import pytest
 import scipy.stats  # noqa: F401
 
+import opspec.engine
+
 # pytester's in-process runs drop the modules an inner run imported; numpy (and so the engine)
-# cannot be imported twice in one process, so everything the inner runs use is imported here.
+# cannot be imported twice in one process, so everything the inner runs use is imported here:
+# the whole engine too (a compiled module that imports another lazily finds it gone, and this
+# folder run alone failed every scenario test that way).
+for _module in pkgutil.walk_packages(opspec.engine.__path__, "opspec.engine."):
+    importlib.import_module(_module.name)
 
 pytest_plugins = ["pytester"]
 
