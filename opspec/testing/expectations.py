@@ -326,7 +326,8 @@ def expect(result: SimulationResult, *lines: str) -> None:
     """Assert ``then`` lines on a result from Python (``AssertionError`` with every failure
     message), e.g. ``expect(result, "rate doses_taken/doses_due >= 0.99 with 95% confidence")``.
     A line naming something the spec lacks raises :class:`ConfigurationError` listing the
-    names it has."""
+    names it has. A mean line that holds on replications all alike warns
+    (:class:`~opspec.testing.assertions.AllAlikeWarning`, as ``assert_mean``)."""
     __tracebackhide__ = True     # pytest: the failure is the test's line, not ours
     require_result(result, "expect", "names")
     failures = []
@@ -336,6 +337,14 @@ def expect(result: SimulationResult, *lines: str) -> None:
         message = expectation.check(result)
         if message is not None:
             failures.append(message)
+            continue
+        caveat = expectation.caveat(result)
+        if caveat is not None:
+            import warnings
+
+            from opspec.testing.assertions import AllAlikeWarning
+
+            warnings.warn(caveat, AllAlikeWarning, stacklevel=2)
     if failures:
         failures.append(f"(seed {result.seed}, {result.replications} replication(s))")
         raise AssertionError("\n\n".join(failures))

@@ -79,3 +79,18 @@ def test_the_bound_is_the_exact_one_of_none_unlike() -> None:
     # at 99 % it takes more: 1 - 0.005^(1/n) <= 1 % from n = 528
     assert alike_caveat("c", [2.0] * 527, 0.99) is not None
     assert alike_caveat("c", [2.0] * 528, 0.99) is None
+
+
+def test_expect_warns_as_assert_mean_does(project: pytest.Pytester) -> None:
+    project.makepyfile('''
+from opspec.testing import expect
+
+def test_mean(simulate):
+    result = simulate("specs/dispenser.xpdl", users=3, days=1,
+                      user_model="specs/dispenser.users.toml")
+    expect(result, "mean doses_due <= 4 with 95% confidence")
+''')
+    result = project.runpytest()
+    result.assert_outcomes(passed=1, warnings=1)
+    result.stdout.fnmatch_lines([("*AllAlikeWarning: 'mean doses_due <= 4 with 95% "
+                                  "confidence' held, but all 3 replications gave 4*")])
