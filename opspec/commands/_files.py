@@ -53,11 +53,12 @@ def translation_problem(command: str, source: Path, target: Path | None, *,
 def write_problem(target: Path, error: OSError) -> str:
     """``cannot write TARGET: why`` for ``error``, raised writing ``target``: when the folder
     it goes in is missing (or a file stands where a folder should), that folder, named; the
-    operating system's bare "No such file or directory" names neither."""
+    operating system's bare "No such file or directory" names neither, and the "File exists"
+    of making a folder where a file stands names nothing at all."""
     import errno
 
     folder = target.parent
-    if error.errno in (errno.ENOENT, errno.ENOTDIR):
+    if error.errno in (errno.ENOENT, errno.ENOTDIR, errno.EEXIST):
         existing = next((path for path in (folder, *folder.parents) if path.exists()), None)
         if existing is not None and not existing.is_dir():
             return (f"cannot write {target}: {existing} is a file, not a folder (give a path "

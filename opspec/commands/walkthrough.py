@@ -260,8 +260,11 @@ def _check_record_folder(record: Path) -> None:
     try:
         record.parent.mkdir(parents=True, exist_ok=True)
     except OSError as error:
+        from opspec.commands._files import write_problem
+
         raise ConfigurationError(
-            f"cannot write the recording {record}: {error.strerror or error}",
+            write_problem(record, error).replace("cannot write ",
+                                                 "cannot write the recording ", 1),
             hint="give --record a path in a folder you can write to, or --no-record") from None
     for folder in missing:                    # innermost first
         try:
