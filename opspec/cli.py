@@ -144,10 +144,35 @@ def _did_you_mean(parser: argparse.ArgumentParser, unknown: Sequence[str]) -> st
 
     options = [o for action in parser._actions for o in action.option_strings
                if o.startswith("--")]
-    meant = [f"{typo}: did you mean {close[0]}?" for typo in unknown if typo.startswith("--")
-             for close in [difflib.get_close_matches(typo.split("=", 1)[0], options, n=1)]
-             if close]
+    meant = []
+    for typo in unknown:
+        if not typo.startswith("--"):
+            continue
+        name = typo.split("=", 1)[0]
+        # another command's option (`run --users`: evaluate's) is no typo: the closest
+        # name of this command (--no-user) would point the other way
+        others = _commands_with(name, parser.prog)
+        close = difflib.get_close_matches(name, options, n=1)
+        if others:
+            meant.append(f"{name} is not an option of {parser.prog}, but of "
+                         f"{', '.join(other.removeprefix('opspec ') for other in others)}")
+        elif close:
+            meant.append(f"{typo}: did you mean {close[0]}?")
     return f" ({'; '.join(meant)})" if meant else ""
+
+
+def _commands_with(option: str, own: str) -> list[str]:
+    """The commands other than ``own`` (a prog: ``opspec run``) that take ``option``, as
+    their progs; every command's parser is built for this (an error's path only)."""
+    found: list[str] = []
+    pending = list(_subparsers(build_parser()).values())
+    while pending:
+        command = pending.pop(0)
+        pending.extend(_subparsers(command).values())
+        if command.prog != own and any(option in action.option_strings
+                                       for action in command._actions):
+            found.append(command.prog)
+    return found
 
 
 def _named_command(argv: Sequence[str]) -> str | None:
