@@ -175,6 +175,23 @@ def _commands_with(option: str, own: str) -> list[str]:
     return found
 
 
+def _gather_files(parser: argparse.ArgumentParser, args: argparse.Namespace,
+                  unknown: list[str]) -> list[str]:
+    """``unknown`` without the files given after an option to a command taking several
+    (``opspec validate a.xpdl --strict b.xpdl``, ``fit a.jsonl -o m.toml b.jsonl``), which
+    join the others: argparse fills a list of files from one run of arguments and leaves
+    the rest "unrecognized"."""
+    if not unknown or any(value.startswith("-") for value in unknown):
+        return unknown          # an unknown option: its usage error says which
+    lists = [action for action in parser._actions if not action.option_strings
+             and action.nargs in ("+", "*")]
+    if len(lists) != 1:
+        return unknown
+    dest = lists[0].dest
+    setattr(args, dest, [*(getattr(args, dest, None) or []), *unknown])
+    return []
+
+
 def _named_command(argv: Sequence[str]) -> str | None:
     """The command the command line names first, if it names one before any option (the
     top-level options, ``--help`` and ``--version``, need every command's parser)."""
@@ -206,6 +223,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     # the subcommand's own parser, not the top-level one: its usage says what a mistyped
     # option belongs to and what it accepts, and its prog begins the command's messages
     own = _innermost(parser, args)
+    unknown = _gather_files(own, args, unknown)
     if unknown:
         own.error(f"unrecognized arguments: {' '.join(unknown)}" + _did_you_mean(own, unknown))
     handler = getattr(args, "handler", None)
