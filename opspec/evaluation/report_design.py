@@ -399,8 +399,8 @@ def design_sections(store: ResultStore, figures: Path, design: str, name: str, d
                      "forgotten) and the share done wrongly (a wrong button chosen), with 95 % "
                      "intervals over users. Both are per offer, re-offers included: a choice "
                      "offered again after a wrong button counts each time, so a rate per "
-                     "offer is not the user model's probability per dose (workflow "
-                     "instance).")
+                     "offer is not the user model's probability per workflow instance "
+                     "(per dose of a dispenser).")
         caption = ("The user's activities: omission and error rates per offer, in % of the "
                    "times each was asked for, with 95 % intervals (the same numbers as the "
                    "table")
