@@ -251,10 +251,9 @@ def _other_spec_notes(paths: Sequence[Path], spec: str) -> list[str]:
 
 
 def _model_check(args: argparse.Namespace) -> int:
+    from opspec.commands._wrong_file import refuse_misplaced_model
     from opspec.usermodels.loader import load_user_model
     from opspec.usermodels.persons import PersonRule, parse_person_options
-
-    from opspec.commands._wrong_file import refuse_misplaced_model
 
     refuse_misplaced_model(args.model)
     paths = trace_files(args.traces, "model-check")

@@ -5,8 +5,6 @@ slow walker "is slow at every dose"."""
 
 from __future__ import annotations
 
-from pathlib import Path
-
 import pytest
 
 from opspec.cli import main
