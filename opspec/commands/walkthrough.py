@@ -101,6 +101,12 @@ def run(args: argparse.Namespace) -> int:
         raise ConfigurationError(
             f"--record {args.record} with --replay: a replay records nothing",
             hint=f"its trace: opspec run {args.spec} --script {args.replay} --trace FILE")
+    if args.no_record and args.record:
+        # one says where to record, the other not to: the recording asked for would
+        # silently not be written
+        raise ConfigurationError(f"--record {args.record} with --no-record: the session "
+                                 "cannot be recorded and not recorded",
+                                 hint="leave out one of them")
     seed, seed_note = _seed(args)
     # the person performs the lane; the request's user is the model they hand it over to
     # (--user-model, else the companion SPEC.users.toml), checked against the spec
