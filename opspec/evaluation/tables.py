@@ -22,8 +22,8 @@ METRIC_HEADERS = ("metric", "kind", "estimate", "95 % CI", "CI method", "sd", "m
 PER_USER_HEADERS = ("metric", "users", "mean of users' values", "sd",
                     "95 % CI of that mean (t)", "median", "p95")
 COMPARE_HEADERS = ("metric", "A", "B", "B − A", "95 % CI", "CI method", "")
-MONITOR_HEADERS = ("monitor", "violations", "users affected", "per user-day", "95 % CI",
-                   "CI method", "first violation")
+MONITOR_HEADERS = ("monitor", "violations", "users affected", "95 % CI (exact)",
+                   "per user-day", "95 % CI", "CI method", "first violation")
 SUBGROUP_HEADERS = ("subgroup", "users", "share", "asked", "95 % CI (exact)")
 DISTRIBUTION_HEADERS = ("metric", "users", "users with any", "95 % CI (exact)", "p50", "p90",
                         "p99", "between-user sd")
@@ -144,8 +144,13 @@ def monitor_rows(monitors: Mapping[str, Mapping[str, Any]]) -> list[tuple[str, .
                  and first.get("time") is not None else "–")
         share = fmt(m.get("share_affected"), percent=True)
         affected = f"{m['users_affected']} of {m['users']} ({share})"
-        rows.append((name, str(m["violations"]), affected, fmt(m["per_user_day"]), _ci(m),
-                     method_name(m), where))
+        # the share's exact interval (docs/evaluation.md, Monitors): 0 of 50 users is not
+        # "nobody", but at most 7.11 %
+        low, high = m.get("share_affected_ci95") or (None, None)
+        exact = ("–" if low is None or high is None
+                 else f"[{fmt(low, percent=True)}, {fmt(high, percent=True)}]")
+        rows.append((name, str(m["violations"]), affected, exact, fmt(m["per_user_day"]),
+                     _ci(m), method_name(m), where))
     return rows
 
 
@@ -387,7 +392,8 @@ def print_summary(out: IO[str], plan: Any, metrics: Mapping[str, Any],
         print(f"\n{note}", file=out)
     # the intervals the tables above show (the exact shares of users only with a population)
     legend = method_legend([metrics, monitors, compare, population],
-                           None if population else ("ci95_method",))
+                           None if population else ("ci95_method",
+                                                    "share_affected_ci95_method"))
     if legend:
         print(f"\n95 % intervals over the {plan.users} users (the independent units):",
               file=out)
