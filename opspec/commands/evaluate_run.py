@@ -40,6 +40,10 @@ def evaluate(args: argparse.Namespace, workers: int, cores: int) -> int:
         except OSError as error:
             raise EvaluationError(f"cannot read the report template {args.report_template}: "
                                   f"{reason(error)}") from None
+        from opspec.evaluation.html import prepare_template
+
+        # compiled now: a syntax error is said (file:line) before the run, not after it
+        prepare_template(args.report_template)
     from opspec.evaluation.runner import WORKER_TIMEOUT
 
     timeout = args.scheduler_timeout if args.scheduler_timeout is not None else WORKER_TIMEOUT
