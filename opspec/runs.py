@@ -154,16 +154,24 @@ def open_gated(path: str | Path) -> tuple[Package, tuple[Any, ...]]:
     return valid, tuple(d for d in report.diagnostics if d.severity is Severity.WARNING)
 
 
-def _not_here(target: Path, error: ConfigurationError) -> ConfigurationError:
-    """``error`` (the spec cannot be opened) with, for a relative path that does not exist,
-    the folder it was looked for in and where the bundled specs are: ``opspec run
-    specs/medication_dispenser.xpdl`` outside the clone was told to give
-    "e.g. specs/medication_dispenser.xpdl", the very path it had given."""
+def where_to_look(target: str | Path) -> str | None:
+    """For a relative spec path that does not exist, the folder it was looked for in and
+    where the bundled specs are (``opspec run specs/medication_dispenser.xpdl`` outside the
+    clone); None for any other path."""
+    target = Path(target)
     if target.is_absolute() or target.exists() or target.is_symlink():
-        return error
+        return None
     bundled = Path(__file__).resolve().parents[1] / "specs"
-    hint = (f"a relative path starts in the current folder, {Path.cwd()}"
+    return (f"a relative path starts in the current folder, {Path.cwd()}"
             + (f"; the bundled specs are in {bundled}" if bundled.is_dir() else ""))
+
+
+def _not_here(target: Path, error: ConfigurationError) -> ConfigurationError:
+    """``error`` (the spec cannot be opened) with :func:`where_to_look`'s hint: it was told
+    to give "e.g. specs/medication_dispenser.xpdl", the very path it had given."""
+    hint = where_to_look(target)
+    if hint is None:
+        return error
     return ConfigurationError(error.message, location=error.location, hint=hint)
 
 

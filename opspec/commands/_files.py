@@ -41,7 +41,11 @@ def translation_problem(command: str, source: Path, target: Path | None, *,
     COMMAND: ...``). None when it can."""
     problem = input_problem(source)
     if problem is not None:
-        return _said(command, f"cannot read {source}: {problem}")
+        from opspec.runs import where_to_look
+
+        where = where_to_look(source)
+        return _said(command, f"cannot read {source}: {problem}"
+                     + (f" ({where})" if where else ""))
     from opspec.commands._spec import companion_user_model
 
     return overwrite_problem(command, [("-o", target)],

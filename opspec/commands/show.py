@@ -173,12 +173,14 @@ def _unreadable(path: str) -> Any:
     here, as the reader would say it, but without calling the file XPDL (it may be BPMN)."""
     from opspec.errors import Diagnostic, Severity, SourceLocation
     from opspec.files import not_a_file
+    from opspec.runs import where_to_look
 
     why = not_a_file(path)
     if why is None:
         return None
     return Diagnostic(SourceLocation(path), Severity.ERROR, "io-error",
                       f"cannot read the file: {why}",
+                      where_to_look(path) or
                       "give the path of an XPDL or BPMN spec, or of a compiled .wfs script; "
                       "specs are not read from folders, pipes or devices")
 

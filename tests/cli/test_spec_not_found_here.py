@@ -34,3 +34,14 @@ def test_an_absolute_path_keeps_its_message(tmp_path: Path,
     assert capsys.readouterr().err == (f"opspec run: {missing}: not found; give one "
                                        "specification file (e.g. "
                                        "specs/medication_dispenser.xpdl)\n")
+
+
+@pytest.mark.parametrize("command", ["show", "compile", "preprocess"])
+def test_the_other_commands_say_it_too(command: str, tmp_path: Path,
+                                       monkeypatch: pytest.MonkeyPatch,
+                                       capsys: pytest.CaptureFixture[str]) -> None:
+    monkeypatch.chdir(tmp_path)
+    assert main([command, "specs/medication_dispenser.xpdl"]) == 2
+    err = capsys.readouterr().err
+    assert (f"(a relative path starts in the current folder, {tmp_path}; the bundled specs "
+            f"are in {ROOT / 'specs'})\n") in err
