@@ -11,7 +11,7 @@ from opspec.properties.language import clock
 from opspec.statistics.methods import METHODS, methods_in
 
 __all__ = ["comparison_rows", "difference_text", "distribution_rows", "fmt", "in_percent", "method_legend",
-           "method_name", "metric_rows", "monitor_rows", "no_interval_reason",
+           "method_name", "metric_rows", "monitor_rows", "no_interval_reason", "one_user_note",
            "parameter_rows", "per_user_rows", "points", "print_summary", "signed",
            "subgroup_comparison_rows", "subgroup_metric_rows", "subgroup_rows", "table"]
 
@@ -102,6 +102,24 @@ def metric_rows(metrics: Mapping[str, Mapping[str, Any]]) -> list[tuple[str, ...
                          _ci(s, percent=percent), method_name(s), "–", "–", "–", users,
                          pooled))
     return rows
+
+
+def one_user_note(metrics: Mapping[str, Mapping[str, Any]], users: int) -> str | None:
+    """Why an evaluation of one user shows '–' for some intervals: the t interval needs the
+    spread between users (the exact Poisson and binomial ones do not); None otherwise."""
+    if users >= 2:
+        return None
+    bare = [name for name, s in metrics.items()
+            if not s.get("ci95") or None in s["ci95"]]
+    if not bare:
+        return None
+    return (f"– (no interval) for {', '.join(bare)}: one simulated user shows no spread "
+            "between users to compute it from; evaluate two users or more (--users N, a few "
+            "hundred for narrow intervals).")
+
+
+def _users(n: int) -> str:
+    return f"{n} user" if n == 1 else f"{n} users"
 
 
 def method_legend(summaries: Any, keys: Sequence[str] | None = ("ci95_method",)
@@ -335,7 +353,7 @@ def print_summary(out: IO[str], plan: Any, metrics: Mapping[str, Any],
                   monitors: Mapping[str, Any] | None = None,
                   population: Mapping[str, Any] | None = None) -> None:
     design = plan.design("A")
-    print(f"opspec evaluate: {design.spec}, {plan.users} users x {span(plan.days)}, seed "
+    print(f"opspec evaluate: {design.spec}, {_users(plan.users)} x {span(plan.days)}, seed "
           f"{plan.seed}, user model {plan.user_model or 'none'}", file=out)
     if getattr(plan, "run_inputs", None):
         from opspec.run_inputs import RunInputs
@@ -386,6 +404,8 @@ def print_summary(out: IO[str], plan: Any, metrics: Mapping[str, Any],
         if len(failures) > 10:
             print(f"  … and {len(failures) - 10} more", file=out)
         print(advice(failures), file=out)
+    if bare := one_user_note(metrics, plan.users):
+        print(f"\n{bare}", file=out)
     # what a marked interval means, once for every table above
     note = no_spread_note(_shown(metrics, compare, population))
     if note:
@@ -395,7 +415,7 @@ def print_summary(out: IO[str], plan: Any, metrics: Mapping[str, Any],
                            None if population else ("ci95_method",
                                                     "share_affected_ci95_method"))
     if legend:
-        print(f"\n95 % intervals over the {plan.users} users (the independent units):",
+        print(f"\n95 % intervals over the {_users(plan.users)} (the independent units):",
               file=out)
         for line in legend:
             print(line, file=out)
