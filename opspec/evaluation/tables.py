@@ -360,7 +360,8 @@ def print_summary(out: IO[str], plan: Any, metrics: Mapping[str, Any],
 
         print(f"run inputs per user: {RunInputs.from_json(plan.run_inputs).describe()}",
               file=out)
-    ran = (f"{outcome.done + outcome.failed} replications in {outcome.wall_s:.1f} s on "
+    count = outcome.done + outcome.failed
+    ran = (f"{count} replication{'' if count == 1 else 's'} in {outcome.wall_s:.1f} s on "
            f"{workers} worker(s)")
     if outcome.skipped:
         ran += f" ({outcome.skipped} already stored)"

@@ -33,6 +33,7 @@ def test_the_terminal_says_why_an_interval_is_missing(one_user: tuple[str, Path]
     text, _ = one_user
     assert NOTE in text
     assert ", 1 user x 2 days," in text and "over the 1 user (the independent units)" in text
+    assert "\n1 replication in " in text
 
 
 def test_the_report_says_it_too(one_user: tuple[str, Path]) -> None:
