@@ -144,10 +144,52 @@ def _did_you_mean(parser: argparse.ArgumentParser, unknown: Sequence[str]) -> st
 
     options = [o for action in parser._actions for o in action.option_strings
                if o.startswith("--")]
-    meant = [f"{typo}: did you mean {close[0]}?" for typo in unknown if typo.startswith("--")
-             for close in [difflib.get_close_matches(typo.split("=", 1)[0], options, n=1)]
-             if close]
+    meant = []
+    for typo in unknown:
+        if not typo.startswith("--"):
+            continue
+        name = typo.split("=", 1)[0]
+        # another command's option (`run --users`: evaluate's) is no typo: the closest
+        # name of this command (--no-user) would point the other way
+        others = _commands_with(name, parser.prog)
+        close = difflib.get_close_matches(name, options, n=1)
+        if others:
+            meant.append(f"{name} is not an option of {parser.prog}, but of "
+                         f"{', '.join(other.removeprefix('opspec ') for other in others)}")
+        elif close:
+            meant.append(f"{typo}: did you mean {close[0]}?")
     return f" ({'; '.join(meant)})" if meant else ""
+
+
+def _commands_with(option: str, own: str) -> list[str]:
+    """The commands other than ``own`` (a prog: ``opspec run``) that take ``option``, as
+    their progs; every command's parser is built for this (an error's path only)."""
+    found: list[str] = []
+    pending = list(_subparsers(build_parser()).values())
+    while pending:
+        command = pending.pop(0)
+        pending.extend(_subparsers(command).values())
+        if command.prog != own and any(option in action.option_strings
+                                       for action in command._actions):
+            found.append(command.prog)
+    return found
+
+
+def _gather_files(parser: argparse.ArgumentParser, args: argparse.Namespace,
+                  unknown: list[str]) -> list[str]:
+    """``unknown`` without the files given after an option to a command taking several
+    (``opspec validate a.xpdl --strict b.xpdl``, ``fit a.jsonl -o m.toml b.jsonl``), which
+    join the others: argparse fills a list of files from one run of arguments and leaves
+    the rest "unrecognized"."""
+    if not unknown or any(value.startswith("-") for value in unknown):
+        return unknown          # an unknown option: its usage error says which
+    lists = [action for action in parser._actions if not action.option_strings
+             and action.nargs in ("+", "*")]
+    if len(lists) != 1:
+        return unknown
+    dest = lists[0].dest
+    setattr(args, dest, [*(getattr(args, dest, None) or []), *unknown])
+    return []
 
 
 def _named_command(argv: Sequence[str]) -> str | None:
@@ -181,6 +223,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     # the subcommand's own parser, not the top-level one: its usage says what a mistyped
     # option belongs to and what it accepts, and its prog begins the command's messages
     own = _innermost(parser, args)
+    unknown = _gather_files(own, args, unknown)
     if unknown:
         own.error(f"unrecognized arguments: {' '.join(unknown)}" + _did_you_mean(own, unknown))
     handler = getattr(args, "handler", None)

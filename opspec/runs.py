@@ -49,6 +49,7 @@ from typing import TYPE_CHECKING, Any, Protocol
 from opspec.engine.compiled import CompiledPackage, compile_package
 from opspec.engine.config import EngineConfig
 from opspec.engine.simulation import RunResult, Simulation
+from opspec.errors import ConfigurationError
 from opspec.model import Package
 from opspec.run_rules import DAY, MAX_SEED, check_seed, run_length
 
@@ -133,7 +134,10 @@ def open_gated(path: str | Path) -> tuple[Package, tuple[Any, ...]]:
 
     target = Path(path)
     if target.suffix == ".wfs" or not_a_file(target) is not None:
-        package = open_spec(path)
+        try:
+            package = open_spec(path)
+        except ConfigurationError as error:
+            raise _not_here(target, error) from None
         _passed(package)
         _not_too_deep(package)
         return package, ()
@@ -148,6 +152,27 @@ def open_gated(path: str | Path) -> tuple[Package, tuple[Any, ...]]:
     _passed(valid)
     _not_too_deep(valid)
     return valid, tuple(d for d in report.diagnostics if d.severity is Severity.WARNING)
+
+
+def where_to_look(target: str | Path) -> str | None:
+    """For a relative spec path that does not exist, the folder it was looked for in and
+    where the bundled specs are (``opspec run specs/medication_dispenser.xpdl`` outside the
+    clone); None for any other path."""
+    target = Path(target)
+    if target.is_absolute() or target.exists() or target.is_symlink():
+        return None
+    bundled = Path(__file__).resolve().parents[1] / "specs"
+    return (f"a relative path starts in the current folder, {Path.cwd()}"
+            + (f"; the bundled specs are in {bundled}" if bundled.is_dir() else ""))
+
+
+def _not_here(target: Path, error: ConfigurationError) -> ConfigurationError:
+    """``error`` (the spec cannot be opened) with :func:`where_to_look`'s hint: it was told
+    to give "e.g. specs/medication_dispenser.xpdl", the very path it had given."""
+    hint = where_to_look(target)
+    if hint is None:
+        return error
+    return ConfigurationError(error.message, location=error.location, hint=hint)
 
 
 def _not_too_deep(package: Package) -> None:

@@ -41,7 +41,11 @@ def translation_problem(command: str, source: Path, target: Path | None, *,
     COMMAND: ...``). None when it can."""
     problem = input_problem(source)
     if problem is not None:
-        return _said(command, f"cannot read {source}: {problem}")
+        from opspec.runs import where_to_look
+
+        where = where_to_look(source)
+        return _said(command, f"cannot read {source}: {problem}"
+                     + (f" ({where})" if where else ""))
     from opspec.commands._spec import companion_user_model
 
     return overwrite_problem(command, [("-o", target)],
@@ -53,11 +57,12 @@ def translation_problem(command: str, source: Path, target: Path | None, *,
 def write_problem(target: Path, error: OSError) -> str:
     """``cannot write TARGET: why`` for ``error``, raised writing ``target``: when the folder
     it goes in is missing (or a file stands where a folder should), that folder, named; the
-    operating system's bare "No such file or directory" names neither."""
+    operating system's bare "No such file or directory" names neither, and the "File exists"
+    of making a folder where a file stands names nothing at all."""
     import errno
 
     folder = target.parent
-    if error.errno in (errno.ENOENT, errno.ENOTDIR):
+    if error.errno in (errno.ENOENT, errno.ENOTDIR, errno.EEXIST):
         existing = next((path for path in (folder, *folder.parents) if path.exists()), None)
         if existing is not None and not existing.is_dir():
             return (f"cannot write {target}: {existing} is a file, not a folder (give a path "

@@ -9,6 +9,9 @@ adds which of its options it goes to). :func:`misplaced` looks at a file whose
 reading failed and, when it is plainly a spec (XML, or a compiled ``.wfs``), a user model
 (``format = "opspec-user-model"``) or a script (``steps``), says where it goes instead.
 Only the error path reads the file again.
+
+``opspec fit`` and ``model-check`` ask the same of their TRACE files and of model-check's
+MODEL before reading them (:func:`refuse_misplaced_traces`, :func:`refuse_misplaced_model`).
 """
 
 from __future__ import annotations
@@ -19,7 +22,7 @@ from typing import Any
 
 from opspec.errors import ConfigurationError, OpspecError, SpecError, UserModelError
 
-__all__ = ["misplaced"]
+__all__ = ["misplaced", "refuse_misplaced_model", "refuse_misplaced_traces"]
 
 _SPEC = "the spec (the first argument: opspec run SPEC)"
 
@@ -82,3 +85,49 @@ def misplaced(error: OpspecError, given: tuple[tuple[str, str | None], ...]) -> 
             return SpecError(error.message, location=error.location, hint=hint)
         return type(error)(error.message, location=error.location, hint=hint)
     return error
+
+
+def refuse_misplaced_traces(values: tuple[str, ...] | list[str], command: str) -> None:
+    """Refuse, before anything is read as a trace, a TRACE of ``opspec fit`` or
+    ``model-check`` (``command``) that is plainly a spec or a user model: read as JSON Lines
+    it failed with "not valid JSON" at its line 1, which says nothing of the mix-up."""
+    for value in values:
+        if not Path(value).is_file():
+            continue
+        found = _what(value)
+        if found is None or found[1] == "--script":     # a recording is a trace to fit
+            continue
+        what = found[0]
+        if found[1] == "--user-model":
+            hint = ("one user model, the first argument: opspec model-check MODEL TRACE..."
+                    if command == "model-check" else
+                    "opspec fit writes the model it fits to -o MODEL.toml; give it traces")
+        else:
+            hint = ("record traces with opspec run SPEC --trace FILE, opspec evaluate SPEC "
+                    "--export jsonl or opspec walkthrough SPEC"
+                    + ("; the spec's outcome metrics are checked with --spec SPEC"
+                       if command == "model-check" else ""))
+        raise UserModelError(f"{value}: {what}, not a trace (TRACE: the .jsonl traces, or "
+                             "folders of them)", hint=hint)
+
+
+def refuse_misplaced_model(ref: str) -> None:
+    """Refuse a MODEL of ``opspec model-check`` that is plainly traces (a folder, a .jsonl
+    file: the arguments swapped) or a spec, which the TOML reader called "not valid TOML"
+    or "no preset called …"."""
+    path = Path(ref)
+    swapped = "the user model goes first: opspec model-check MODEL TRACE..."
+    if path.is_dir():
+        raise UserModelError(f"{ref}: a folder, not a user model (MODEL: a user-model TOML "
+                             "file or a preset)", hint=swapped)
+    if not path.is_file():
+        return
+    found = _what(ref)
+    if path.suffix.lower() == ".jsonl" and found is None:
+        raise UserModelError(f"{ref}: a trace, not a user model (MODEL: a user-model TOML "
+                             "file or a preset)", hint=swapped)
+    if found is not None and found[1] == _SPEC:
+        raise UserModelError(f"{ref}: {found[0]}, not a user model (MODEL: a user-model "
+                             "TOML file or a preset)",
+                             hint="give the spec with --spec SPEC to check its outcome "
+                             "metrics too")

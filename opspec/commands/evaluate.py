@@ -91,7 +91,23 @@ def register(subparsers: Any) -> None:
                         "with the spec) is refused unless --trust-spec-template is given")
     parser.add_argument("--trust-spec-template", action="store_true",
                         help="allow a --report-template that lies in the spec's folder")
+    # `--report DIR` (model-check's option) would be taken for --report-template, its value
+    # read as a template: said here what writes the report instead
+    parser.add_argument("--report", nargs="?", action=_NoReportOption, help=argparse.SUPPRESS)
     parser.set_defaults(handler=run)
+
+
+class _NoReportOption(argparse.Action):
+    """``--report``, which evaluate does not take: every evaluation writes its report."""
+
+    def __call__(self, parser: argparse.ArgumentParser, namespace: argparse.Namespace,
+                 values: Any, option_string: str | None = None) -> None:
+        message = ("--report is not an option of evaluate: every evaluation writes its "
+                   "report, OUT/report.html with report.md and figures/ beside it; choose "
+                   "OUT with --out DIR (--report-template FILE: a template of your own for "
+                   "report.html)")
+        parser._bad_value = message        # type: ignore[attr-defined]  # one line (Parser)
+        parser.error(message)
 
 
 def _local_cores() -> int:

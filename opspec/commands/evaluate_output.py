@@ -84,7 +84,8 @@ def print_results(args: argparse.Namespace, plan: Any, store: Any, workers: int,
                       workers, monitors=monitors, population=population)
         from opspec.evaluation.input_uncertainty import print_input_uncertainty
 
-        print_input_uncertainty(sys.stdout, uncertainty)
+        print_input_uncertainty(sys.stdout, uncertainty, metrics,
+                                (compare or {}).get("difference"))
         if swept:
             from opspec.evaluation.sweep import print_sweep
 

@@ -40,6 +40,10 @@ def evaluate(args: argparse.Namespace, workers: int, cores: int) -> int:
         except OSError as error:
             raise EvaluationError(f"cannot read the report template {args.report_template}: "
                                   f"{reason(error)}") from None
+        from opspec.evaluation.html import prepare_template
+
+        # compiled now: a syntax error is said (file:line) before the run, not after it
+        prepare_template(args.report_template)
     from opspec.evaluation.runner import WORKER_TIMEOUT
 
     timeout = args.scheduler_timeout if args.scheduler_timeout is not None else WORKER_TIMEOUT
@@ -188,14 +192,14 @@ def _replicate(args: argparse.Namespace, store: Any, plan: Any, swept: Any, work
         except EvaluationError as error:
             raise with_resume_hint(error, store, plan) from None
         except KeyboardInterrupt:
-            _say_stopped(store, plan, "finish with")
+            _say_stopped(store, plan)
             raise
         try:
             summaries, compare = _summarise(args, store, plan, swept)
             report = _write_report(args, store, plan, summaries, figures, drawing, ahead)
         except KeyboardInterrupt:
             # every replication is stored: only the report is missing (or half drawn)
-            _say_stopped(store, plan, "the report is not written; write it with")
+            _say_stopped(store, plan, report=True)
             raise
         failures = store.failures()
         return Results(summaries, compare, report, outcome, failures,
@@ -223,12 +227,23 @@ def _write_report(args: argparse.Namespace, store: Any, plan: Any, summaries: An
             f"--resume --out {store.folder}` to write the report again") from None
 
 
-def _say_stopped(store: Any, plan: Any, then: str) -> None:
-    """Ctrl-C: what is kept, and the command that goes on from there."""
-    stored = sum(len(store.finished(d.label)) for d in plan.designs)
-    print(f"opspec evaluate: stopped; {stored} of {plan.users * len(plan.designs)} "
-          f"replications are stored in {store.path}; {then} `opspec evaluate "
-          f"--resume --out {store.folder}`", file=sys.stderr)
+def _say_stopped(store: Any, plan: Any, *, report: bool = False) -> None:
+    """Ctrl-C: what is kept, and the command that goes on from there. ``report``: stopped
+    while the report was drawn; a run stopped once its last replication was stored is told
+    the same (only the report is missing). The users of --input-uncertainty's parameter
+    draws are replications too (stored as ``A~draws``), as the progress line counts them."""
+    from opspec.evaluation.input_uncertainty import draws_label
+
+    labels = [d.label for d in plan.designs]
+    if plan.input_uncertainty:
+        labels += [draws_label(label) for label in labels]
+    stored = sum(len(store.finished(label)) for label in labels)
+    planned = (plan.users + plan.input_uncertainty * plan.users_per_draw) * len(plan.designs)
+    then = ("the report is not written; write it with" if report or stored >= planned
+            else "finish with")
+    print(f"opspec evaluate: stopped; {stored} of {planned} replications are stored in "
+          f"{store.path}; {then} `opspec evaluate --resume --out {store.folder}`",
+          file=sys.stderr)
 
 
 def _summarise(args: argparse.Namespace, store: Any, plan: Any, swept: Any

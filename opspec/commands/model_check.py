@@ -115,9 +115,11 @@ def trace_files(values: Sequence[str], command: str) -> list[Path]:
     left out are said on standard error, and no trace at all is a UserModelError."""
     import sys
 
+    from opspec.commands._wrong_file import refuse_misplaced_traces
     from opspec.errors import UserModelError
     from opspec.usermodels.trace_reader import expand_traces
 
+    refuse_misplaced_traces(values, command)
     paths, left_out = expand_traces(values)
     if left_out:
         shown = ", ".join(str(p) for p in left_out[:3]) + (" ..." if len(left_out) > 3 else "")
@@ -249,9 +251,11 @@ def _other_spec_notes(paths: Sequence[Path], spec: str) -> list[str]:
 
 
 def _model_check(args: argparse.Namespace) -> int:
+    from opspec.commands._wrong_file import refuse_misplaced_model
     from opspec.usermodels.loader import load_user_model
     from opspec.usermodels.persons import PersonRule, parse_person_options
 
+    refuse_misplaced_model(args.model)
     paths = trace_files(args.traces, "model-check")
     if args.report:
         from opspec.commands._files import unwritable

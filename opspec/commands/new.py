@@ -125,9 +125,10 @@ def run(args: argparse.Namespace) -> int:
         for file_name, text in files.items():
             (folder / file_name).write_text(text, encoding="utf-8")
     except OSError as error:
-        reason = error.strerror or str(error)
+        from opspec.commands._files import write_problem
+
         _remove(made, files)
-        print(f"opspec new: cannot write {folder}: {reason}; nothing written", file=sys.stderr)
+        print(f"opspec new: {write_problem(folder, error)}; nothing written", file=sys.stderr)
         return 2
     spec = folder / f"{name}.xpdl"
     print(f"opspec new: wrote {folder}/ ({', '.join(files)})")

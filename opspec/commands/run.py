@@ -327,9 +327,11 @@ def _open_sink(factory: Any, path: str, header: dict[str, Any]) -> Iterator[Any]
         Path(path).parent.mkdir(parents=True, exist_ok=True)
         sink = factory(path, header)
     except OSError as error:
-        raise ConfigurationError(f"cannot write the trace {path}: "
-                                 f"{error.strerror or error}",
-                                 hint="choose a writable path with --trace") from None
+        from opspec.commands._files import write_problem
+
+        raise ConfigurationError(write_problem(Path(path), error).replace(
+            "cannot write ", "cannot write the trace ", 1),
+            hint="choose a writable path with --trace") from None
     try:
         yield sink
     finally:

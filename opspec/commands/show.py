@@ -135,6 +135,7 @@ _SUFFIXES = {"text": "txt", "dot": "dot", "svg": "svg", "html": "html"}
 def _write_whole(path: Path, text: str) -> None:
     """``text`` into ``path`` all at once (a temporary file renamed over it): a failure
     leaves no empty or half-written file."""
+    import contextlib
     import os
 
     from opspec.errors import ConfigurationError
@@ -144,7 +145,9 @@ def _write_whole(path: Path, text: str) -> None:
         tmp.write_text(text, encoding="utf-8")
         os.replace(tmp, path)
     except OSError as error:
-        tmp.unlink(missing_ok=True)
+        # in a "folder" that is a file, removing the temporary file fails as writing did
+        with contextlib.suppress(OSError):
+            tmp.unlink(missing_ok=True)
         from opspec.commands._files import write_problem
 
         raise ConfigurationError(write_problem(path, error)) from None
@@ -170,12 +173,14 @@ def _unreadable(path: str) -> Any:
     here, as the reader would say it, but without calling the file XPDL (it may be BPMN)."""
     from opspec.errors import Diagnostic, Severity, SourceLocation
     from opspec.files import not_a_file
+    from opspec.runs import where_to_look
 
     why = not_a_file(path)
     if why is None:
         return None
     return Diagnostic(SourceLocation(path), Severity.ERROR, "io-error",
                       f"cannot read the file: {why}",
+                      where_to_look(path) or
                       "give the path of an XPDL or BPMN spec, or of a compiled .wfs script; "
                       "specs are not read from folders, pipes or devices")
 

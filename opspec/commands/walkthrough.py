@@ -101,6 +101,12 @@ def run(args: argparse.Namespace) -> int:
         raise ConfigurationError(
             f"--record {args.record} with --replay: a replay records nothing",
             hint=f"its trace: opspec run {args.spec} --script {args.replay} --trace FILE")
+    if args.no_record and args.record:
+        # one says where to record, the other not to: the recording asked for would
+        # silently not be written
+        raise ConfigurationError(f"--record {args.record} with --no-record: the session "
+                                 "cannot be recorded and not recorded",
+                                 hint="leave out one of them")
     seed, seed_note = _seed(args)
     # the person performs the lane; the request's user is the model they hand it over to
     # (--user-model, else the companion SPEC.users.toml), checked against the spec
@@ -260,8 +266,11 @@ def _check_record_folder(record: Path) -> None:
     try:
         record.parent.mkdir(parents=True, exist_ok=True)
     except OSError as error:
+        from opspec.commands._files import write_problem
+
         raise ConfigurationError(
-            f"cannot write the recording {record}: {error.strerror or error}",
+            write_problem(record, error).replace("cannot write ",
+                                                 "cannot write the recording ", 1),
             hint="give --record a path in a folder you can write to, or --no-record") from None
     for folder in missing:                    # innermost first
         try:

@@ -230,8 +230,10 @@ def user_model_notes(model: UserModel) -> list[str]:
         b = model.busy
         ignored = ("every other prompt" if b.ignore is None
                    else ", ".join(sorted(b.ignore)) or "nothing")
-        notes.append(f"While busy with {', '.join(sorted(b.engaged))} for one dose (workflow "
-                     f"instance), the user ignores {ignored} from other instances"
+        # in the spec's terms (a workflow instance), not the dispenser's (a dose): a stove
+        # guard's report said "for one dose" too
+        notes.append(f"While busy with {', '.join(sorted(b.engaged))} in one workflow "
+                     f"instance, the user ignores {ignored} from other instances"
                      + (f" ({b.source.rstrip('.')})." if b.source else "."))
     for modifier in model.modifiers:
         changes = []

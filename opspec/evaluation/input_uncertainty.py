@@ -326,10 +326,10 @@ def _number(value: float | None) -> str:
     return "-" if value is None else f"{value:.4g}"
 
 
-def _interval(ci: Sequence[float | None] | None) -> str:
+def _interval(ci: Sequence[float | None] | None, show: Any = _number) -> str:
     if not ci or ci[0] is None or ci[1] is None:
         return "-"
-    return f"[{_number(ci[0])}, {_number(ci[1])}]"
+    return f"[{show(ci[0])}, {show(ci[1])}]"
 
 
 HEADERS = ("metric", "estimate", "95 % CI (simulation)", "95 % CI (+ parameters)",
@@ -347,13 +347,35 @@ def _alike(entry: Mapping[str, Any], key: str, difference: bool) -> dict[str, An
     return {"ci95_no_spread": entry.get(key), **({"difference": True} if difference else {})}
 
 
-def _rows(summary: Mapping[str, Any]) -> list[tuple[str, ...]]:
+def _in_units(declared: Mapping[str, Any] | None, difference: bool) -> Any:
+    """How a number of the metric ``declared`` (its summary, or its difference's) is written,
+    as the run's own tables write it: a proportion in %, its difference in pp, a duration
+    with its unit; without ``declared``, a plain number."""
+    from opspec.evaluation.tables import difference_text, fmt, in_percent
+
+    if declared is None:
+        return _number
+    percent = in_percent(declared)
+    unit = "" if percent else (declared.get("unit") or "")
+    if difference:
+        return lambda value: difference_text(value, unit, percent=percent)
+    return lambda value: fmt(value, unit, percent=percent)
+
+
+def _rows(summary: Mapping[str, Any], metrics: Mapping[str, Any] | None = None,
+          difference: Mapping[str, Any] | None = None) -> list[tuple[str, ...]]:
+    """The table's rows; with the run's ``metrics`` (and the ``difference`` of a
+    comparison), in each metric's units: 98.83 %, not 0.9883, beside the run's table."""
     rows: list[tuple[str, ...]] = []
-    for section, prefix in (("metrics", ""), ("difference", "B - A: ")):
+    for section, prefix, declared in (("metrics", "", metrics),
+                                      ("difference", "B - A: ", difference)):
         for name, entry in (summary.get(section) or {}).items():
             share = entry.get("parameter_share")
-            rows.append((prefix + name, _number(entry.get("estimate")),
-                         *(with_mark(_interval(entry.get(ci)), _alike(entry, alike, False))
+            show = _in_units(None if declared is None else declared.get(name),
+                             section == "difference")
+            rows.append((prefix + name, show(entry.get("estimate")),
+                         *(with_mark(_interval(entry.get(ci), show),
+                                     _alike(entry, alike, False))
                            for ci, alike in _INTERVALS),
                          "-" if share is None else f"{100 * share:.0f} %"))
     return rows
@@ -398,16 +420,19 @@ def report_section(store: Any, given: Mapping[str, Any],
         "within-draw (simulation) variance, to the ordinary variance, on Satterthwaite's "
         "degrees of freedom, and covers the ordinary interval."),
         *filter(None, [_note(summary)])),
-        tables=(Table(HEADERS, tuple(_rows(summary)),
+        tables=(Table(HEADERS, tuple(_rows(summary, given.get("metrics"), difference)),
                       "Ordinary 95 % intervals (simulation noise only) and intervals that "
                       "include the fitted parameters' uncertainty"),))
 
 
-def print_input_uncertainty(out: IO[str], summary: Mapping[str, Any] | None) -> None:
-    """The table of ordinary and widened intervals, after the ordinary summary."""
+def print_input_uncertainty(out: IO[str], summary: Mapping[str, Any] | None,
+                            metrics: Mapping[str, Any] | None = None,
+                            difference: Mapping[str, Any] | None = None) -> None:
+    """The table of ordinary and widened intervals, after the ordinary summary (``metrics``,
+    ``difference``: the run's summaries, whose units the table's numbers are written in)."""
     if not summary:
         return
-    rows = [HEADERS, *_rows(summary)]
+    rows = [HEADERS, *_rows(summary, metrics, difference)]
     widths = [max(len(r[i]) for r in rows) for i in range(len(rows[0]))]
     print(f"\nInput uncertainty: {_title(summary)}", file=out)
     for row in rows:

@@ -49,6 +49,8 @@ class LogProgress(Progress):
               file=self.stream, flush=True)
 
     def finish(self) -> None:
+        if self.done == self.already >= self.total:
+            return      # nothing ran: start() said every one was stored ("0/s, done" was all)
         self._line(time.perf_counter())
 
 

@@ -115,7 +115,7 @@ def _methods_section(summaries: Any, sections: Sequence[Any]) -> Any:
     return Section("How the intervals were computed", paragraphs=(
         ("Every interval is a two-sided 95 % confidence interval. The simulated users are the "
          "independent units: observations within one user are not independent (a slow walker "
-         "is slow at every dose), so each metric is reduced to one pair (y, n) per user and "
+         "is slow every time), so each metric is reduced to one pair (y, n) per user and "
          "the intervals are over users. The 'CI method' column of each table names the "
          "method below; an interval of something that cannot be negative is cut at zero. "
          "Medians and p95 of durations are of all pooled observations, by linear "

@@ -33,6 +33,7 @@ from opspec.evaluation.tables import (
     method_name,
     metric_rows,
     monitor_rows,
+    one_user_note,
     per_user_rows,
     subgroup_metric_rows,
 )
@@ -270,9 +271,10 @@ def design_sections(store: ResultStore, figures: Path, design: str, name: str, d
         ("Counts are per user over the whole run (sd, median and p95 are of the users' "
         "totals); durations are pooled over all observations; ratios are the sum of the "
         "numerator over the sum of the denominator over all users."),
-        *_noted(metrics.values())),
+        *_noted(metrics.values()), *filter(None, [one_user_note(metrics, users)])),
         tables=(Table(METRIC_HEADERS, tuple(metric_rows(metrics)),
-                      f"Declared metrics of {name}: {users:,} simulated users × "
+                      f"Declared metrics of {name}: {users:,} simulated "
+                      f"user{'' if users == 1 else 's'} × "
                       f"{span(days)} each"),),
         images=tuple(images), captions=tuple(captions)))
     if population and population.get("subgroups"):
@@ -399,8 +401,8 @@ def design_sections(store: ResultStore, figures: Path, design: str, name: str, d
                      "forgotten) and the share done wrongly (a wrong button chosen), with 95 % "
                      "intervals over users. Both are per offer, re-offers included: a choice "
                      "offered again after a wrong button counts each time, so a rate per "
-                     "offer is not the user model's probability per dose (workflow "
-                     "instance).")
+                     "offer is not the user model's probability per workflow instance "
+                     "(per dose of a dispenser).")
         caption = ("The user's activities: omission and error rates per offer, in % of the "
                    "times each was asked for, with 95 % intervals (the same numbers as the "
                    "table")

@@ -11,7 +11,7 @@ from opspec.properties.language import clock
 from opspec.statistics.methods import METHODS, methods_in
 
 __all__ = ["comparison_rows", "difference_text", "distribution_rows", "fmt", "in_percent", "method_legend",
-           "method_name", "metric_rows", "monitor_rows", "no_interval_reason",
+           "method_name", "metric_rows", "monitor_rows", "no_interval_reason", "one_user_note",
            "parameter_rows", "per_user_rows", "points", "print_summary", "signed",
            "subgroup_comparison_rows", "subgroup_metric_rows", "subgroup_rows", "table"]
 
@@ -22,8 +22,8 @@ METRIC_HEADERS = ("metric", "kind", "estimate", "95 % CI", "CI method", "sd", "m
 PER_USER_HEADERS = ("metric", "users", "mean of users' values", "sd",
                     "95 % CI of that mean (t)", "median", "p95")
 COMPARE_HEADERS = ("metric", "A", "B", "B − A", "95 % CI", "CI method", "")
-MONITOR_HEADERS = ("monitor", "violations", "users affected", "per user-day", "95 % CI",
-                   "CI method", "first violation")
+MONITOR_HEADERS = ("monitor", "violations", "users affected", "95 % CI (exact)",
+                   "per user-day", "95 % CI", "CI method", "first violation")
 SUBGROUP_HEADERS = ("subgroup", "users", "share", "asked", "95 % CI (exact)")
 DISTRIBUTION_HEADERS = ("metric", "users", "users with any", "95 % CI (exact)", "p50", "p90",
                         "p99", "between-user sd")
@@ -104,6 +104,24 @@ def metric_rows(metrics: Mapping[str, Mapping[str, Any]]) -> list[tuple[str, ...
     return rows
 
 
+def one_user_note(metrics: Mapping[str, Mapping[str, Any]], users: int) -> str | None:
+    """Why an evaluation of one user shows '–' for some intervals: the t interval needs the
+    spread between users (the exact Poisson and binomial ones do not); None otherwise."""
+    if users >= 2:
+        return None
+    bare = [name for name, s in metrics.items()
+            if not s.get("ci95") or None in s["ci95"]]
+    if not bare:
+        return None
+    return (f"– (no interval) for {', '.join(bare)}: one simulated user shows no spread "
+            "between users to compute it from; evaluate two users or more (--users N, a few "
+            "hundred for narrow intervals).")
+
+
+def _users(n: int) -> str:
+    return f"{n} user" if n == 1 else f"{n} users"
+
+
 def method_legend(summaries: Any, keys: Sequence[str] | None = ("ci95_method",)
                   ) -> list[str]:
     """One line per interval method used in ``summaries`` (under the names ``keys``; None:
@@ -144,8 +162,13 @@ def monitor_rows(monitors: Mapping[str, Mapping[str, Any]]) -> list[tuple[str, .
                  and first.get("time") is not None else "–")
         share = fmt(m.get("share_affected"), percent=True)
         affected = f"{m['users_affected']} of {m['users']} ({share})"
-        rows.append((name, str(m["violations"]), affected, fmt(m["per_user_day"]), _ci(m),
-                     method_name(m), where))
+        # the share's exact interval (docs/evaluation.md, Monitors): 0 of 50 users is not
+        # "nobody", but at most 7.11 %
+        low, high = m.get("share_affected_ci95") or (None, None)
+        exact = ("–" if low is None or high is None
+                 else f"[{fmt(low, percent=True)}, {fmt(high, percent=True)}]")
+        rows.append((name, str(m["violations"]), affected, exact, fmt(m["per_user_day"]),
+                     _ci(m), method_name(m), where))
     return rows
 
 
@@ -330,14 +353,15 @@ def print_summary(out: IO[str], plan: Any, metrics: Mapping[str, Any],
                   monitors: Mapping[str, Any] | None = None,
                   population: Mapping[str, Any] | None = None) -> None:
     design = plan.design("A")
-    print(f"opspec evaluate: {design.spec}, {plan.users} users x {span(plan.days)}, seed "
+    print(f"opspec evaluate: {design.spec}, {_users(plan.users)} x {span(plan.days)}, seed "
           f"{plan.seed}, user model {plan.user_model or 'none'}", file=out)
     if getattr(plan, "run_inputs", None):
         from opspec.run_inputs import RunInputs
 
         print(f"run inputs per user: {RunInputs.from_json(plan.run_inputs).describe()}",
               file=out)
-    ran = (f"{outcome.done + outcome.failed} replications in {outcome.wall_s:.1f} s on "
+    count = outcome.done + outcome.failed
+    ran = (f"{count} replication{'' if count == 1 else 's'} in {outcome.wall_s:.1f} s on "
            f"{workers} worker(s)")
     if outcome.skipped:
         ran += f" ({outcome.skipped} already stored)"
@@ -381,15 +405,18 @@ def print_summary(out: IO[str], plan: Any, metrics: Mapping[str, Any],
         if len(failures) > 10:
             print(f"  … and {len(failures) - 10} more", file=out)
         print(advice(failures), file=out)
+    if bare := one_user_note(metrics, plan.users):
+        print(f"\n{bare}", file=out)
     # what a marked interval means, once for every table above
     note = no_spread_note(_shown(metrics, compare, population))
     if note:
         print(f"\n{note}", file=out)
     # the intervals the tables above show (the exact shares of users only with a population)
     legend = method_legend([metrics, monitors, compare, population],
-                           None if population else ("ci95_method",))
+                           None if population else ("ci95_method",
+                                                    "share_affected_ci95_method"))
     if legend:
-        print(f"\n95 % intervals over the {plan.users} users (the independent units):",
+        print(f"\n95 % intervals over the {_users(plan.users)} (the independent units):",
               file=out)
         for line in legend:
             print(line, file=out)

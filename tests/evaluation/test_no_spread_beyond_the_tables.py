@@ -74,7 +74,8 @@ def test_a_sweep_marks_its_bands_and_its_unpaired_interval(evaluate, tmp_path):
         "unpaired_ci95_no_spread"] is None
     report = (out / "report.md").read_text(encoding="utf-8")
     # no width ratio when the unpaired interval has no width: the mark says why
-    assert "| 0 % | 4 | \\[4, 4\\] † | +0 | \\[-1.23, +1.23\\] | – † |" in report
+    assert ("| 0 % | 4 | \\[4, 4\\] † | t | +0 | \\[-1.23, +1.23\\] | paired t ∪ Garwood "
+            "| – † |") in report
     assert "judged by. † " + NOTE in report                  # the figure's caption
     sweep = (out / "figures" / "sweep.svg").read_text(encoding="utf-8")
     assert ">95 % interval †<" in sweep and f">† {NOTE}: it shows" in sweep
