@@ -391,7 +391,7 @@ def _report_sections(store: ResultStore, summaries: Mapping[str, Summaries] | No
                                              no_interval=reasons, **alike),)
                     if rows else ())
         headers: tuple[str, ...] = ("metric", names["A"], names["B"], "difference", "95 % CI",
-                                    "CI method", "")
+                                    "CI method", "verdict")
         sections.append(Section(f"{names['B']} compared with {names['A']}", paragraphs=(
             (f"Differences {names['B']} − {names['A']} per metric on the same simulated users "
             "(paired); 'differs' marks intervals that exclude zero."

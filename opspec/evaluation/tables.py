@@ -21,7 +21,7 @@ METRIC_HEADERS = ("metric", "kind", "estimate", "95 % CI", "CI method", "sd", "m
 #: over users: not the pooled estimate of METRIC_HEADERS nor its interval, hence the words
 PER_USER_HEADERS = ("metric", "users", "mean of users' values", "sd",
                     "95 % CI of that mean (t)", "median", "p95")
-COMPARE_HEADERS = ("metric", "A", "B", "B − A", "95 % CI", "CI method", "")
+COMPARE_HEADERS = ("metric", "A", "B", "B − A", "95 % CI", "CI method", "verdict")
 MONITOR_HEADERS = ("monitor", "violations", "users affected", "95 % CI (exact)",
                    "per user-day", "95 % CI", "CI method", "first violation")
 SUBGROUP_HEADERS = ("subgroup", "users", "share", "asked", "95 % CI (exact)")
@@ -385,7 +385,8 @@ def print_summary(out: IO[str], plan: Any, metrics: Mapping[str, Any],
     if population:
         _print_population(out, metrics, population)
     if compare is not None:
-        print(f"\ncompared with B = {compare['spec']} (same users, paired):", file=out)
+        print(f"\ncompared with B = {compare['spec']} (same users, paired; 'differs': the "
+              "95 % interval excludes 0):", file=out)
         for line in table(COMPARE_HEADERS, comparison_rows(compare["difference"])):
             print(line, file=out)
         if population and population.get("subgroups"):

@@ -68,8 +68,9 @@ METHODS: Mapping[str, Method] = {m.id: m for m in (
     Method("wilson-neff", "Wilson, eff. n",
            "a proportion of counts: Wilson's score interval on the effective number of trials "
            "(design effect of users who differ)",
-           "a ratio of counts the spec declares a proportion (Proportion=\"true\": missed of "
-           "due doses): p = Σy/Σn; the binomial variance "
+           "a proportion of counts pooled over users (a ratio the spec declares a proportion, "
+           "Proportion=\"true\"; an activity's omissions or errors per offer): "
+           "p = Σy/Σn; the binomial variance "
            "v_bin = p(1−p)/Σn and the cluster-robust variance v_users (as for t); "
            "v = v_bin + (t[0.975; U−1]/z[0.975])²·max(0, v_users − v_bin); the Wilson score "
            "interval of p on n_eff = p(1−p)/v trials (Σn when p is 0 or 1 or U < 2). With 1 or "

@@ -11,8 +11,9 @@ files of a folder of this repository:
   that step (``test_tutorial_files_are_the_pages_blocks`` checks they hold what the page
   shows);
 * ``<!-- docs-test: exit 1 -->`` — the command's exit status (default 0);
-* ``<!-- docs-test: slow REASON -->`` — runs only with ``OPSPEC_DOCS_SLOW=1`` (the README's
-  first command, 1,000 users x 30 days: 20 s of CPU on its own, too long for every CI run);
+* ``<!-- docs-test: slow REASON -->`` — runs only with ``OPSPEC_DOCS_SLOW=1`` (no block is
+  marked so now: the README's first command, 1,000 users x 30 days, takes about 20 s from
+  source, and its table is the evidence that the speed work changed no outcome);
 * ``<!-- docs-test: skip REASON -->`` — not run (say why).
 
 What varies between runs is marked in the shown output: a line ``...`` stands for any lines;

@@ -269,6 +269,9 @@ def test_comparison_table_gives_units_and_rate_differences_in_points(tmp_path, c
     rows = {line.split()[0]: line for line in printed.splitlines()[3:] if line.strip()}
     latency = rows["report_latency_s"]
     assert latency.count(" s") >= 4 and "differs" in latency   # A, B, B − A and the CI
+    # the column of 'differs' has a name, and the line above the table says what it means
+    assert printed.splitlines()[1].split()[-1] == "verdict"
+    assert "'differs': the 95 % interval excludes 0" in printed.splitlines()[0]
     assert " pp" in rows["taken_rate"] and "%" in rows["taken_rate"]
     assert (tmp_path / "out" / "figures" / "comparison.svg").stat().st_size > 10_000
 
