@@ -1,0 +1,62 @@
+"""What the mutation harness (benchmarks/mutation_fuzz.py) found in damaged XPDL files: each
+message is true of the file and names its line, and validate refuses what run refuses."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+
+from opspec.errors import Severity
+from opspec.xpdl.validate import validate_spec
+
+
+CAUGHT = ('<Activity Id="b"><Implementation><No/></Implementation></Activity>\n',
+          '<Transition Id="t" From="a" To="b"><Condition Type="EXCEPTION">late</Condition>'
+          '</Transition>')
+
+
+def _spec(tmp_path: Path, activities: str, transitions: str = "") -> Path:
+    path = tmp_path / "damaged.xpdl"
+    path.write_text(
+        '<?xml version="1.0" encoding="UTF-8"?>\n'
+        '<Package xmlns="http://www.wfmc.org/2008/XPDL2.1" Id="pkg">\n'
+        '<WorkflowProcesses><WorkflowProcess Id="p">\n'
+        f'<Activities>\n{activities}</Activities>\n'
+        f'<Transitions>{transitions}</Transitions>\n'
+        '</WorkflowProcess></WorkflowProcesses>\n</Package>\n', encoding="utf-8")
+    return path
+
+
+def _errors(path: Path) -> list[str]:
+    return [str(d) for d in validate_spec(path)[1].diagnostics if d.severity is Severity.ERROR]
+
+
+@pytest.mark.parametrize(("duration", "said"), [
+    ("PT5M5M", "cannot read duration 'PT5M5M'"),
+    ("P1DT", "cannot read duration 'P1DT'"),
+    ("R3/PT5M", "it is a repeating interval (a cycle), not a duration"),
+])
+def test_a_misspelt_iso_deadline_is_refused_as_a_duration_not_read_as_data_fields(
+        tmp_path: Path, duration: str, said: str) -> None:
+    # 'PT5M5M' was "a deadline of activity 'a' reads 'PT5M5M', which is not a data field"
+    path = _spec(tmp_path, '<Activity Id="a"><Implementation><No/></Implementation>\n'
+                 '<Deadline Execution="SYNCHR">\n'
+                 f'<DeadlineDuration>{duration}</DeadlineDuration>\n'
+                 '<ExceptionName>late</ExceptionName></Deadline></Activity>\n' + CAUGHT[0],
+                 CAUGHT[1])
+    errors = _errors(path)
+    assert len(errors) == 1, errors
+    assert errors[0].startswith(f"{path}:7: error: Deadline: cannot read duration"), errors
+    assert said in errors[0] and "which is not a data field" not in errors[0]
+
+
+def test_a_deadline_reading_a_data_field_is_still_an_expression(tmp_path: Path) -> None:
+    # a name that only looks like a unit-less ISO duration ('P1') is a data field's
+    path = _spec(tmp_path, '<Activity Id="a"><Implementation><No/></Implementation>\n'
+                 '<Deadline Execution="SYNCHR">\n'
+                 '<DeadlineDuration>P1</DeadlineDuration>\n'
+                 '<ExceptionName>late</ExceptionName></Deadline></Activity>\n' + CAUGHT[0],
+                 CAUGHT[1])
+    errors = _errors(path)
+    assert any("reads 'P1', which is not a data field" in e for e in errors), errors
