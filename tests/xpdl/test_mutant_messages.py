@@ -60,3 +60,36 @@ def test_a_deadline_reading_a_data_field_is_still_an_expression(tmp_path: Path) 
                  CAUGHT[1])
     errors = _errors(path)
     assert any("reads 'P1', which is not a data field" in e for e in errors), errors
+
+
+SMALL = ('<Package xmlns="http://www.wfmc.org/2008/XPDL2.1" Id="pkg"><WorkflowProcesses>'
+         '<WorkflowProcess Id="p" Name="Caf\xe9"><Activities><Activity Id="a"><Implementation>'
+         '<No/></Implementation></Activity></Activities></WorkflowProcess></WorkflowProcesses>'
+         '</Package>\n')
+
+
+@pytest.mark.parametrize(("declared", "said"), [
+    ("bogus-8", "the XML declaration names encoding 'bogus-8', which is no encoding opspec "
+                "knows"),
+    ("UTF-16", "the XML declaration says UTF-16, but the file is 8-bit text"),
+    ("UTF-32", "the XML declaration says UTF-32, but the file is 8-bit text"),
+])
+def test_an_impossible_encoding_declaration_is_said_at_its_line(
+        tmp_path: Path, declared: str, said: str) -> None:
+    # were "not well-formed XML at column 39: Unsupported encoding" / "Blank needed here" with
+    # "fix the XML syntax at that line", and with one Latin-1 byte "a binary file (not text)"
+    for body in (SMALL.replace("\xe9", "e").encode(), SMALL.encode("latin-1")):
+        path = tmp_path / "damaged.xpdl"
+        path.write_bytes(f'<?xml version="1.0" encoding="{declared}"?>\n'.encode() + body)
+        errors = _errors(path)
+        assert errors == [f"{path}:1: error: {said}" + errors[0].split(said, 1)[1]], errors
+        assert "binary" not in errors[0] and "XML syntax" not in errors[0]
+
+
+def test_a_broken_latin_1_file_is_broken_xml_not_a_binary_file(tmp_path: Path) -> None:
+    path = tmp_path / "damaged.xpdl"
+    path.write_bytes(b'<?xml version="1.0" encoding="ISO-8859-1"?>\n'
+                     + SMALL.encode("latin-1")[:150])
+    errors = _errors(path)
+    assert len(errors) == 1 and "binary" not in errors[0], errors
+    assert errors[0].startswith(f"{path}:2: error: the file ends"), errors
