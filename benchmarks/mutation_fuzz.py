@@ -24,7 +24,8 @@ An outcome is a finding when it is
 - ``validate-ok-run-refuses``: validate exits 0 and run refuses the spec before it starts
   (validate = run: what run refuses, validate reports);
 - ``validate-refuses-run-ok``: validate exits 1 and run exits 0;
-- ``odd-message``: a message leaking Python (``None``, ``{http://…}`` names, ``object at``).
+- ``odd-message``: a message leaking Python (``None``, ``{http://…}`` names, ``object at``);
+- ``untrue-message``: a message of a kind found untrue by reading them (``UNTRUE``).
 
 It prints the counts by class and by operator and the distinct messages of each class
 (numbers, quoted names and paths folded), and writes one JSON line a mutant to ``--out``.
@@ -110,7 +111,8 @@ class Runner:
             pid, status = os.waitpid(-1, os.WNOHANG)
             if pid:
                 _, stem, record = self.running.pop(pid)
-                record["rc"] = (os.waitstatus_to_exitcode(status))
+                record["rc"] = os.waitstatus_to_exitcode(status)
+                Path(f"{stem}.rc").write_text(str(record["rc"]))
                 _collect(stem, record)
                 return
             now = time.monotonic()
@@ -120,6 +122,7 @@ class Runner:
                     os.waitpid(pid, 0)
                     self.running.pop(pid)
                     record["rc"] = "timeout"
+                    Path(f"{stem}.rc").write_text("timeout")
                     _collect(stem, record)
                     return
             if not block:
@@ -140,6 +143,16 @@ def _collect(stem: str, record: dict) -> None:
 LOCATED = r"{name}:\d+"
 ODD = re.compile(r"(?<!Trigger )\bNone\b|\{https?://|object at 0x|<Element |\bKeyError\b|\bAttributeError\b"
                  r"|\bTypeError\b|\bValueError\b|\bIndexError\b")
+
+
+# messages found untrue by reading the harness's output (each pattern is one class of them,
+# fixed): a file of XML text called binary; libxml2's words for an encoding declaration the file
+# cannot be in, with "fix the XML syntax"; an ISO 8601 duration, misspelt, read as data fields;
+# a flow node of the flow's own level, or no flow node, said to be "of another process"
+UNTRUE = re.compile(r"a binary file \(not text\)|Unsupported encoding|Blank needed here"
+                    r"|reads '(-?P(T|\d+[YMWDHS])[\dYMWDTHS.,]*|R\d*)', which is not a data"
+                    r"|bpmn:(dataObject|message|error|signal|property|dataStoreReference|"
+                    r"textAnnotation)\b[^;]* of another process")
 
 
 def classify(name: str, validate: dict, run: dict) -> list[str]:
@@ -165,6 +178,8 @@ def classify(name: str, validate: dict, run: dict) -> list[str]:
             found.append(f"no-location:{which}")
         if ODD.search(rec["err"]) or any(ODD.search(line) for line in errors):
             found.append(f"odd-message:{which}")
+        if any(UNTRUE.search(line) for line in errors):
+            found.append(f"untrue-message:{which}")
     started = "ended at" in run["out"]
     if validate["rc"] == 0 and run["rc"] in (1, 2) and not started:
         found.append("validate-ok-run-refuses")
@@ -204,6 +219,42 @@ def _link_siblings(original: Path, folder: Path) -> None:
                 pass
 
 
+def plan(files: list[Path], operators: list[str], args: argparse.Namespace):
+    """Every mutant of the run, in order: (original, operator, label, bytes); the same for the
+    same arguments, so a run's folder can be classified again, or its mutants rerun."""
+    for original in files:
+        data = original.read_bytes()
+        steps = [("original", -1)] if args.originals else []
+        chosen = operators
+        if args.sample:
+            chosen = random.Random(f"{args.seed}:{original.name}").sample(
+                operators, min(args.sample, len(operators)))
+        steps += [(op, i) for op in chosen for i in range(args.per_operator)]
+        for operator, i in steps:
+            if operator == "original":
+                yield original, operator, "original", data
+                continue
+            made = mutate(data, operator, random.Random(
+                f"{args.seed}:{original.name}:{operator}:{i}"))
+            if made is not None:
+                yield original, operator, made[0], made[1]
+
+
+def _rc_of(stem: Path, record: dict) -> int | str:
+    """The exit status a run wrote, or (a run stopped before it wrote them) the one its
+    output shows: 70 an internal error, 1 an error said, else 0."""
+    written = Path(f"{stem}.rc")
+    if written.exists():
+        text = written.read_text().strip()
+        return int(text) if text.lstrip("-").isdigit() else text
+    text = record["out"] + record["err"]
+    if "internal error" in text or "Traceback" in text:
+        return 70
+    if ": error:" in text or (stem.name == "run" and "ended at" not in record["out"]):
+        return 1
+    return 0
+
+
 def main() -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("files", nargs="*", type=Path)
@@ -219,6 +270,10 @@ def main() -> int:
     parser.add_argument("--out", type=Path, default=Path("/tmp/mutation_fuzz.jsonl"))
     parser.add_argument("--keep", type=Path, help="keep the mutants in this folder")
     parser.add_argument("--originals", action="store_true", help="also run each original")
+    parser.add_argument("--limit-mutants", type=int, help="stop after this many mutants")
+    parser.add_argument("--classify", type=Path, metavar="DIR",
+                        help="run nothing: classify the outcomes an earlier run (--keep DIR, "
+                             "same arguments) left in DIR")
     args = parser.parse_args()
     files = args.files or default_files()
     operators = args.operators.split(",")
@@ -229,40 +284,31 @@ def main() -> int:
     opspec.cli.build_parser("run")
     opspec.cli.build_parser("validate")
 
-    work = Path(tempfile.mkdtemp(prefix="opspec-fuzz-")) if args.keep is None else args.keep
+    work = args.classify or args.keep or Path(tempfile.mkdtemp(prefix="opspec-fuzz-"))
     work.mkdir(parents=True, exist_ok=True)
     runner = Runner(args.jobs, args.timeout)
     mutants: list[dict] = []
     started = time.monotonic()
-    for original in files:
-        data = original.read_bytes()
-        plan = [("original", -1)] if args.originals else []
-        chosen = operators
-        if args.sample:
-            chosen = random.Random(f"{args.seed}:{original.name}").sample(
-                operators, min(args.sample, len(operators)))
-        plan += [(op, i) for op in chosen for i in range(args.per_operator)]
-        for operator, i in plan:
-            if operator == "original":
-                label, body = "original", data
-            else:
-                rng = random.Random(f"{args.seed}:{original.name}:{operator}:{i}")
-                made = mutate(data, operator, rng)
-                if made is None:
-                    continue
-                label, body = made
-            folder = work / f"m{len(mutants):05d}"
-            folder.mkdir()
-            _link_siblings(original, folder)
-            spec = folder / original.name
-            spec.write_bytes(body)
-            record = {"id": len(mutants), "file": str(original), "operator": operator,
-                      "mutation": label, "mutant": str(spec),
-                      "validate": {}, "run": {}}
-            mutants.append(record)
-            runner.start(["validate", str(spec)], str(folder / "validate"), record["validate"])
-            runner.start(["run", str(spec), "--days", args.days], str(folder / "run"),
-                         record["run"])
+    for original, operator, label, body in plan(files, operators, args):
+        if args.limit_mutants is not None and len(mutants) >= args.limit_mutants:
+            break
+        folder = work / f"m{len(mutants):05d}"
+        record = {"id": len(mutants), "file": str(original), "operator": operator,
+                  "mutation": label, "mutant": str(folder / original.name),
+                  "validate": {}, "run": {}}
+        mutants.append(record)
+        if args.classify is not None:     # outcomes a run left in that folder
+            for which in ("validate", "run"):
+                _collect(str(folder / which), record[which])
+                record[which]["rc"] = _rc_of(folder / which, record[which])
+            continue
+        folder.mkdir()
+        _link_siblings(original, folder)
+        spec = folder / original.name
+        spec.write_bytes(body)
+        runner.start(["validate", str(spec)], str(folder / "validate"), record["validate"])
+        runner.start(["run", str(spec), "--days", args.days], str(folder / "run"),
+                     record["run"])
     runner.drain()
     elapsed = time.monotonic() - started
 
@@ -287,7 +333,7 @@ def main() -> int:
                     examples.setdefault((finding, sig), f"{record['mutant']} "
                                         f"({record['mutation']})")
             out.write(json.dumps(record) + "\n")
-    if args.keep is None:
+    if args.keep is None and args.classify is None:
         shutil.rmtree(work, ignore_errors=True)
 
     print(f"{len(files)} files, {len(mutants)} mutants, {elapsed:.0f} s")

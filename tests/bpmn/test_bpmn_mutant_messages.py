@@ -81,3 +81,22 @@ def test_a_flow_into_a_sub_process_still_says_so(tmp_path: Path) -> None:
                      '<bpmn:sequenceFlow id="f1" sourceRef="s" targetRef="inner"/>\n')
     assert any("it is a bpmn:task (line 5) of another process or sub-process" in e
                for e in errors), errors
+
+
+@pytest.mark.parametrize(("declaration", "where"), [
+    ('xmlns:bpmn="http://example.com/wrong"', "in namespace 'http://example.com/wrong'"),
+    ('xmlns="http://www.omg.org/spec/BPMN/20100524/MODEL"', "in no namespace"),
+])
+def test_a_definitions_root_without_the_bpmn_namespace_says_so(
+        tmp_path: Path, declaration: str, where: str) -> None:
+    # was "root element is <definitions>, not an XPDL <Package> or a BPMN 2.0 <definitions>"
+    path = tmp_path / "damaged.bpmn"
+    prefix = "bpmn:" if declaration.startswith("xmlns:") else ""
+    path.write_text('<?xml version="1.0" encoding="UTF-8"?>\n'
+                    f'<{prefix}definitions {declaration if prefix else ""} id="d">\n'
+                    f'<{prefix}process id="p"/>\n</{prefix}definitions>\n', encoding="utf-8")
+    errors = [str(d) for d in validate_spec(path)[1].diagnostics]
+    assert errors == [f"{path}:2: error: root element <definitions> is {where}, not BPMN "
+                      "2.0's, so this is no BPMN 2.0 file; give <definitions> (and the "
+                      "elements in it) the BPMN 2.0 namespace, "
+                      "http://www.omg.org/spec/BPMN/20100524/MODEL, as its xmlns declaration"]
