@@ -49,7 +49,7 @@ import time
 from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from spec_mutations import OPERATORS, mutate  # noqa: E402
+from spec_mutations import OPERATORS, mutate
 
 ROOT = Path(__file__).resolve().parents[1]
 CORPUS = ROOT.parent / "shared" / "corpus" / "xpdl"
@@ -279,8 +279,8 @@ def main() -> int:
     operators = args.operators.split(",")
 
     import opspec.cli
-    import opspec.commands.run  # noqa: F401 - imported once, before the forks
-    import opspec.commands.validate  # noqa: F401
+    import opspec.commands.run
+    import opspec.commands.validate
     opspec.cli.build_parser("run")
     opspec.cli.build_parser("validate")
 

@@ -48,7 +48,7 @@ NUMBER_ATTRS = {
     "Length", "Precision", "Scale", "LowerIndex", "UpperIndex", "Instantiation",
 }
 NUMBER_EA = re.compile(r"Priority|Rate|CpuDemand|Deadline|Duration|RunLength|Period|TTL|"
-                       r"Probability|Count|Limit|Seed|Weight|Delay|Interval|Ratio", re.I)
+                       r"Probability|Count|Limit|Seed|Weight|Delay|Interval|Ratio", re.IGNORECASE)
 JUNK = ["", "abc", "-1", "1e999", "nan", "PT", "P-1D", "12:99", "R/PT0S", "∞"]
 
 

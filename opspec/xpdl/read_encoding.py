@@ -41,13 +41,13 @@ def impossible_declaration(declared: str | None, error: etree.XMLSyntaxError
         codecs.lookup(declared)
     except LookupError:
         if is_encoding_error(error):
-            return (f"the XML declaration names encoding {declared!r}, which is no encoding "
-                    "opspec knows, so the file cannot be read", hint)
+            return ((f"the XML declaration names encoding {declared!r}, which is no "
+                     "encoding opspec knows, so the file cannot be read"), hint)
         return None
     if declared.replace("-", "").startswith(("utf16", "utf32", "ucs2", "ucs4")):
-        return (f"the XML declaration says {declared.upper()}, but the file is 8-bit text (the "
-                f"declaration itself is), so it cannot be {declared.upper()} and cannot be "
-                "read", hint)
+        return ((f"the XML declaration says {declared.upper()}, but the file is 8-bit text "
+                 f"(the declaration itself is), so it cannot be {declared.upper()} and cannot "
+                 "be read"), hint)
     return None
 
 

@@ -10,10 +10,9 @@ import pytest
 from opspec.errors import Severity
 from opspec.xpdl.validate import validate_spec
 
-
 CAUGHT = ('<Activity Id="b"><Implementation><No/></Implementation></Activity>\n',
-          '<Transition Id="t" From="a" To="b"><Condition Type="EXCEPTION">late</Condition>'
-          '</Transition>')
+          ('<Transition Id="t" From="a" To="b"><Condition Type="EXCEPTION">late</Condition>'
+           '</Transition>'))
 
 
 def _spec(tmp_path: Path, activities: str, transitions: str = "") -> Path:
@@ -69,8 +68,8 @@ SMALL = ('<Package xmlns="http://www.wfmc.org/2008/XPDL2.1" Id="pkg"><WorkflowPr
 
 
 @pytest.mark.parametrize(("declared", "said"), [
-    ("bogus-8", "the XML declaration names encoding 'bogus-8', which is no encoding opspec "
-                "knows"),
+    ("bogus-8", ("the XML declaration names encoding 'bogus-8', which is no encoding "
+                 "opspec knows")),
     ("UTF-16", "the XML declaration says UTF-16, but the file is 8-bit text"),
     ("UTF-32", "the XML declaration says UTF-32, but the file is 8-bit text"),
 ])
