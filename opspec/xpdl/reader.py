@@ -97,10 +97,11 @@ def xpdl_outcome(parsed: ParsedXml, *, path: str) -> ReadOutcome:
         raise XmlReadError(
             "unknown-root",
             f"root element <definitions> is {where}, not BPMN 2.0's, so this is no BPMN 2.0 "
-            "file",
+            "file (nor an XPDL <Package>)",
             location=SourceLocation(path, line),
-            hint="give <definitions> (and the elements in it) the BPMN 2.0 namespace, "
-            "http://www.omg.org/spec/BPMN/20100524/MODEL, as its xmlns declaration",
+            hint="give opspec an XPDL or a BPMN 2.0 file; if this one is BPMN, its namespace "
+            "was lost or misspelt: declare it on <definitions>, "
+            'xmlns:bpmn="http://www.omg.org/spec/BPMN/20100524/MODEL"',
         )
     if qname.localname != "Package":
         raise XmlReadError(

@@ -97,7 +97,7 @@ def test_a_definitions_root_without_the_bpmn_namespace_says_so(
                     f'<{prefix}process id="p"/>\n</{prefix}definitions>\n', encoding="utf-8")
     errors = [str(d) for d in validate_spec(path)[1].diagnostics]
     assert errors == [(f"{path}:2: error: root element <definitions> is {where}, not BPMN "
-                       "2.0's, so this is no BPMN 2.0 file; give <definitions> (and the "
-                       "elements in it) the BPMN 2.0 namespace, "
-                       "http://www.omg.org/spec/BPMN/20100524/MODEL, as its xmlns "
-                       "declaration")]
+                       "2.0's, so this is no BPMN 2.0 file (nor an XPDL <Package>) (give "
+                       "opspec an XPDL or a BPMN 2.0 file; if this one is BPMN, its namespace "
+                       "was lost or misspelt: declare it on <definitions>, "
+                       'xmlns:bpmn="http://www.omg.org/spec/BPMN/20100524/MODEL")')]
