@@ -150,7 +150,7 @@ ODD = re.compile(r"(?<!Trigger )\bNone\b|\{https?://|object at 0x|<Element |\bKe
 # cannot be in, with "fix the XML syntax"; an ISO 8601 duration, misspelt, read as data fields;
 # a flow node of the flow's own level, or no flow node, said to be "of another process"
 UNTRUE = re.compile(r"a binary file \(not text\)|Unsupported encoding|Blank needed here"
-                    r"|reads '(-?P(T|\d+[YMWDHS])[\dYMWDTHS.,]*|R\d*)', which is not a data"
+                    r"|reads '(P|-?P(T|\d+[YMWDHS])[\dYMWDTHS.,]*|R\d*)', which is not a data"
                     r"|bpmn:(dataObject|message|error|signal|property|dataStoreReference|"
                     r"textAnnotation)\b[^;]* of another process")
 

@@ -49,6 +49,7 @@ def test_an_emptied_boundary_timer_is_one_error_and_no_flow_blamed_on_another_pr
     ("PT", "cannot read duration 'PT'"),
     ("PT5M5M", "cannot read duration 'PT5M5M'"),
     ("-PT5M", "cannot read duration '-PT5M'"),
+    ("P-1D", "cannot read duration 'P-1D'"),
     ("R3/PT5M", "it is a repeating interval (a cycle), not a duration"),
 ])
 def test_a_misspelt_iso_duration_is_refused_as_a_duration_not_read_as_data_fields(
