@@ -92,3 +92,18 @@ def test_a_broken_latin_1_file_is_broken_xml_not_a_binary_file(tmp_path: Path) -
     errors = _errors(path)
     assert len(errors) == 1 and "binary" not in errors[0], errors
     assert errors[0].startswith(f"{path}:2: error: the file ends"), errors
+
+
+@pytest.mark.parametrize(("timer", "said"), [
+    ("1e999", "(cannot read duration '1e999': the number is too large)"),
+    ("PT5M5M", "(cannot read duration 'PT5M5M': not a duration)"),
+])
+def test_an_unreadable_timer_says_why(tmp_path: Path, timer: str, said: str) -> None:
+    # was only "timer '1e999' is not a duration, date or cycle opspec understands"
+    path = _spec(tmp_path, '<Activity Id="a"><Event><IntermediateEvent Trigger="Timer">\n'
+                 f'<TriggerTimer><TimeCycle>{timer}</TimeCycle></TriggerTimer>\n'
+                 '</IntermediateEvent></Event></Activity>\n')
+    errors = _errors(path)
+    assert errors == [f"{path}:6: error: timer {timer!r} is not a duration, date or cycle "
+                      f"opspec understands {said}, so the spec cannot run" + errors[0].split(
+                          "so the spec cannot run", 1)[1]], errors
