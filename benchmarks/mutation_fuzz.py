@@ -137,7 +137,7 @@ class Runner:
 def _collect(stem: str, record: dict) -> None:
     for suffix in ("out", "err"):
         path = Path(f"{stem}.{suffix}")
-        record[suffix] = path.read_text("utf-8", "replace")[-6000:] if path.exists() else ""
+        record[suffix] = path.read_text("utf-8", "replace") if path.exists() else ""
 
 
 LOCATED = r"{name}:\d+"
