@@ -56,9 +56,10 @@ def parse_duration_expression(
 #: characters only an expression has: unreadable text without one was meant as a duration
 EXPRESSION_SIGNS = frozenset("+-*/%()<>=!&|?,;\"'[]{}")
 
-#: an ISO 8601 duration's shape, misspelt ('PT', 'P1DT', 'PT5M5M', '-PT5M', 'P-1D'), or a repeating
-#: interval (R3/PT5M, R/2026-01-01T08:00/P1D) where a duration goes; a data field named like
-#: one (P1, R) is no such text: P and a digit need a unit after them, R a slash and a P or date
+#: an ISO 8601 duration's shape, misspelt ('PT', 'P1DT', 'PT5M5M', '-PT5M', 'P-1D'), or a
+#: repeating interval (R3/PT5M, R/2026-01-01T08:00/P1D) where a duration goes; a data field
+#: named like one (P1, R) is no such text: P and a digit need a unit after them, R a slash and
+#: a P or a date
 _ISO_LIKE = re.compile(r"[+-]?P[+-]?(T|\d+([.,]\d+)?[YMWDHS])[\dYMWDTHS.,]*"
                        r"|R\d*/(P|\d{4}-)\S*")
 

@@ -1,7 +1,9 @@
 """Which encoding a specification file is in: the one its XML declaration names, ``ASCII``
-declarations on files that really hold UTF-8 (read as UTF-8, which loses nothing), and the
+declarations on files that really hold UTF-8 (read as UTF-8, which loses nothing), the
 warning given when a file that is not valid UTF-8 and declares nothing else is read as
-Latin-1 (at the line of the first byte that is not UTF-8, naming that byte's value).
+Latin-1 (at the line of the first byte that is not UTF-8, naming that byte's value), and the
+refusal of a declaration the file cannot be in (no such encoding; UTF-16 or UTF-32 declared in
+8-bit text).
 """
 
 from __future__ import annotations

@@ -103,7 +103,7 @@ def _parse(data: bytes, path: str) -> tuple[etree._Element, list[Diagnostic], st
         if _has_doctype(data):
             raise doctype_error(path, _doctype_line(data) or error.lineno) from None
         impossible = impossible_declaration(declared, error)
-        if impossible is not None:      # its declaration's line: the first, or after comments
+        if impossible is not None:      # said at the declaration's line (blank lines may lead)
             raise XmlReadError("not-well-formed", impossible[0], hint=impossible[1],
                                location=SourceLocation(path, _declaration_line(data)))
         retry = not utf16 and is_encoding_error(error) and declared in (None, "utf-8", *ASCII_NAMES)
