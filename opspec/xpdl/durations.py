@@ -41,6 +41,10 @@ def parse_duration_expression(
         raise _error("duration", text, "it is empty", location, DURATION_HINT)
     if is_duration(text):
         return Literal(parse_duration(text, location=location))
+    if _ISO_LIKE.fullmatch(text.strip()):
+        # meant as ISO 8601, though it reads as a name ('PT5M5M') or a division ('R3/PT5M'):
+        # refused as a duration, not as data fields named 'PT5M5M' or 'R3'
+        _refuse_iso_like(text, location)
     try:
         return parse_expression(text, location=location, kind="duration")
     except ConditionSyntaxError:
@@ -51,6 +55,23 @@ def parse_duration_expression(
 
 #: characters only an expression has: unreadable text without one was meant as a duration
 EXPRESSION_SIGNS = frozenset("+-*/%()<>=!&|?,;\"'[]{}")
+
+#: an ISO 8601 duration's shape, misspelt ('PT', 'P1DT', 'PT5M5M', '-PT5M', 'P-1D'), or a
+#: repeating interval (R3/PT5M, R/2026-01-01T08:00/P1D) where a duration goes; a data field
+#: named like one (P1, R) is no such text: P and a digit need a unit after them, R a slash and
+#: a P or a date
+_ISO_LIKE = re.compile(r"[+-]?P[+-]?(T|\d+([.,]\d+)?[YMWDHS])[\dYMWDTHS.,]*"
+                       r"|R\d*/(P|\d{4}-)\S*")
+
+
+def _refuse_iso_like(text: str, location: SourceLocation | None) -> None:
+    """Raise the duration grammar's refusal of ISO-8601-like ``text``; a repeating interval
+    is said to be a cycle, which has its own place."""
+    if text.strip().startswith("R"):
+        raise _error("duration", text, "it is a repeating interval (a cycle), not a duration",
+                     location, "write a duration such as PT5M here, or put the repeating "
+                     "interval where a cycle goes (a timer's timeCycle / TimeCycle)")
+    parse_duration(text, location=location)        # raises: it is no duration
 
 
 _DATE_TIME = re.compile(

@@ -38,6 +38,10 @@ def _kind(data: bytes, path: str) -> tuple[str, str] | None:
     try:
         text = data.decode("utf-8")
     except UnicodeDecodeError:
+        # 8-bit text in another encoding (Latin-1, or one its declaration names wrongly) is
+        # still XML when it starts with markup: broken XML, the reader's message says where
+        if _starts_with_markup(data[:512].decode("latin-1")) and b"\x00" not in data[:512]:
+            return None
         text = None
     if text is None or "\x00" in text:
         return "a binary file (not text)", ""

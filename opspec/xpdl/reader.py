@@ -90,6 +90,19 @@ def xpdl_outcome(parsed: ParsedXml, *, path: str) -> ReadOutcome:
     root = parsed.root
     qname = etree.QName(root)
     line = line_of(root)
+    if qname.localname == "definitions":
+        # BPMN's root with its namespace lost or misspelt: "root element is <definitions>, not
+        # a BPMN 2.0 <definitions>" would say the same name twice and not why
+        where = f"in namespace {qname.namespace!r}" if qname.namespace else "in no namespace"
+        raise XmlReadError(
+            "unknown-root",
+            f"root element <definitions> is {where}, not BPMN 2.0's, so this is no BPMN 2.0 "
+            "file (nor an XPDL <Package>)",
+            location=SourceLocation(path, line),
+            hint="give opspec an XPDL or a BPMN 2.0 file; if this one is BPMN, its namespace "
+            "was lost or misspelt: declare it on <definitions>, "
+            'xmlns:bpmn="http://www.omg.org/spec/BPMN/20100524/MODEL"',
+        )
     if qname.localname != "Package":
         raise XmlReadError(
             "unknown-root",

@@ -22,6 +22,7 @@ from opspec.xpdl.read_encoding import (
     ASCII_NAMES,
     declared_encoding,
     encoding_warning,
+    impossible_declaration,
     is_encoding_error,
 )
 from opspec.xpdl.read_errors import XmlReadError, doctype_error, not_well_formed_error
@@ -82,6 +83,11 @@ def _doctype_line(data: bytes) -> int | None:
     return None
 
 
+def _declaration_line(data: bytes) -> int:
+    at = data.find(b"<?xml")
+    return data.count(b"\n", 0, at) + 1 if at >= 0 else 1
+
+
 def _parse(data: bytes, path: str) -> tuple[etree._Element, list[Diagnostic], str | None]:
     """The root, the reading warnings, and the encoding the parser was told to use (``None``:
     the file's own)."""
@@ -96,6 +102,10 @@ def _parse(data: bytes, path: str) -> tuple[etree._Element, list[Diagnostic], st
     except etree.XMLSyntaxError as error:
         if _has_doctype(data):
             raise doctype_error(path, _doctype_line(data) or error.lineno) from None
+        impossible = impossible_declaration(declared, error)
+        if impossible is not None:      # said at the declaration's line (blank lines may lead)
+            raise XmlReadError("not-well-formed", impossible[0], hint=impossible[1],
+                               location=SourceLocation(path, _declaration_line(data)))
         retry = not utf16 and is_encoding_error(error) and declared in (None, "utf-8", *ASCII_NAMES)
         body = data.rstrip(b"\r\n")
         end = (body.count(b"\n") + 1, len(body) - body.rfind(b"\n") - 1)

@@ -72,10 +72,14 @@ def read_boundaries(events: list[etree._Element], hosts: set[str], defs: Defs,
                 expression_text(first(found[0], k)) for k in _TIMER_KINDS):
             # no time at all: an intermediate timer fires at once (said), but a boundary
             # timer that fired at once would cut its activity off before it began
+            empty = [k for k in _TIMER_KINDS if first(found[0], k) is not None]
             defs.ctx.error(found[0], "bad-timer",
-                           f"boundary timer {event_id!r} has no timeDuration, timeDate or "
-                           "timeCycle, so when it interrupts its activity is not said",
+                           f"boundary timer {event_id!r} has "
+                           + (f"an empty {empty[0]}" if empty
+                              else "no timeDuration, timeDate or timeCycle")
+                           + ", so when it interrupts its activity is not said",
                            "give it a time, e.g. <bpmn:timeDuration>PT2H</bpmn:timeDuration>")
+            out.skipped.add(event_id)     # its flows are left out with it, said once here
             continue
         if kind == "timerEventDefinition":
             timer = read_timer(found[0], defs)

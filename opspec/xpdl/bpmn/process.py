@@ -251,10 +251,7 @@ class _Process:
                     broken = True
                 elif ref not in ids:
                     broken = True
-                    where = self.defs.by_id.get(ref)
-                    detail = (f"; it is a bpmn:{local(where)}{self.defs.line(where)} of another "
-                              "process or sub-process (a sequence flow stays inside one)"
-                              if where is not None else "")
+                    detail = self.not_here(self.defs.by_id.get(ref), flow)
                     self.ctx.error(flow, "unknown-reference",
                                    f"sequence flow {flow_id!r}: {attribute} {ref!r} is no flow "
                                    f"node of {self.where(flow)}{detail}" if ref else
@@ -281,6 +278,21 @@ class _Process:
                                    f"{label(node)}: default {flow_id!r} is no sequence flow "
                                    "of this process", "name one of its outgoing sequence flows")
         return out
+
+    def not_here(self, where: etree._Element | None, flow: etree._Element) -> str:
+        """Why the element a flow's end names is no node of the flow's level, in words true
+        of it: a flow node of another level, one of this level opspec left out (said at its
+        line), or no flow node at all (a data object, a message)."""
+        if where is None:
+            return ""
+        kind = local(where)
+        if kind not in NODES and kind not in _SUB_PROCESSES and kind != "boundaryEvent":
+            return f"; it is a bpmn:{kind}{self.defs.line(where)}, not a flow node"
+        if where.getparent() is flow.getparent():
+            return (f"; it is a bpmn:{kind}{self.defs.line(where)} that opspec leaves out "
+                    "(its line says why)")
+        return (f"; it is a bpmn:{kind}{self.defs.line(where)} of another process or "
+                "sub-process (a sequence flow stays inside one)")
 
     def flow_id(self, source: str, target: str) -> str:
         """An id for a sequence flow written without one: ``source->target`` (``#2``… when

@@ -126,10 +126,15 @@ def _timer(element: etree._Element, ctx: BuildContext) -> dict[str, Any]:
     if text:
         try:
             duration = parse_duration_expression(text)
-        except (SpecError, ValueError, RecursionError):
-            # an error, as the engine refuses to run it (validate and run agree)
+        except (SpecError, ValueError, RecursionError) as error:
+            # an error, as the engine refuses to run it (validate and run agree); the duration
+            # grammar's reason ("the number is too large") said, not an expression's parse
+            from opspec.xpdl.conditions import ConditionSyntaxError
+
+            why = (f" ({error.message})" if isinstance(error, SpecError)
+                   and not isinstance(error, ConditionSyntaxError) else "")
             ctx.error(timer, "bad-timer", f"timer {text!r} is not a duration, date or cycle "
-                      "opspec understands, so the spec cannot run",
+                      f"opspec understands{why}, so the spec cannot run",
                       "write an ISO 8601 duration (PT5M), a number of seconds, 5min, an "
                       "expression over data fields, a date (2026-01-01T08:00:00) or a cycle "
                       "(R3/PT10M)")
