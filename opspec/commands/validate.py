@@ -56,6 +56,8 @@ def engine_checks(package: Any) -> list[Any]:
     from opspec.commands._spec import NOT_RUNNABLE, engine_diagnostics
 
     found = engine_diagnostics(package, world=True)
+    if not any(d.code == NOT_RUNNABLE for d in found):
+        found.extend(_zero_time_cycles(package))
     language = (getattr(package, "script_language", None) or "").strip()
     if language and any(word in language.lower() for word in _FOREIGN_SCRIPTS):
         note = (f"the package declares Script Type {language!r}: opspec evaluates its own "
@@ -64,6 +66,25 @@ def engine_checks(package: Any) -> list[Any]:
         found = [dataclasses.replace(d, hint=f"{note}; {d.hint}" if d.hint else note)
                  if d.code == NOT_RUNNABLE else d for d in found]
     return found
+
+
+def _zero_time_cycles(package: Any) -> list[Any]:
+    """The cycles a run can stop in with its clock stopped (``zero-time-cycle``, as ``opspec
+    check`` finds them: a warning, an error for workflows certain to start each other without
+    end). Without them validate passed a spec whose run stops at t = 0, and only ``check``
+    said why."""
+    from opspec.engine.compiled import compile_package
+    from opspec.engine.zero_time_check import KIND, zero_time_cycles
+    from opspec.errors import Diagnostic, Severity, SourceLocation
+
+    source = str(getattr(package, "source", None) or "<spec>")
+    return [Diagnostic(SourceLocation(source, problem.line),
+                       Severity.ERROR if problem.severity == "error" else Severity.WARNING,
+                       KIND, f"{problem.process}: {problem.message}",
+                       "give the cycle a duration, a wait, or a condition that lets the token "
+                       "out; opspec check shows the way into it"
+                       + (f" ({' -> '.join(problem.witness)})" if problem.witness else ""))
+            for problem in zero_time_cycles(compile_package(package))]
 
 
 # Script languages whose expressions opspec does not evaluate (the package's Script Type).
