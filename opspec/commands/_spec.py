@@ -15,7 +15,7 @@ if TYPE_CHECKING:
     from opspec.model import Package
 
 __all__ = ["MAX_BLOCK_NESTING", "companion_user_model", "engine_diagnostics", "load_any_spec",
-           "nesting_problem"]
+           "nesting_problem", "where_to_look"]
 
 
 def load_any_spec(path: str | Path, *, command: str | None = None,
@@ -35,6 +35,14 @@ def load_any_spec(path: str | Path, *, command: str | None = None,
         if warnings is not None:
             warnings.append(str(warning))
     return package
+
+
+def where_to_look(path: Path) -> str | None:
+    """:func:`opspec.runs.where_to_look`, imported only for a path that is missing (the
+    front hall's imports are not what ``validate`` and ``check`` start with)."""
+    from opspec.runs import where_to_look as where
+
+    return where(path)
 
 
 # The code of what the engine's compilation refuses (compile_package's SpecError).

@@ -80,7 +80,9 @@ def run(args: argparse.Namespace) -> int:
     from opspec.xpdl.loader import load_package
     from opspec.xpdl.validate import IO_CODES, spec_files
 
-    files, usage = spec_files(args.specs)
+    from opspec.commands._spec import where_to_look
+
+    files, usage = spec_files(args.specs, where_to_look=where_to_look)
     for message in usage:
         print(f"opspec check: {message}", file=sys.stderr)
     worst = 2 if usage else 0

@@ -94,7 +94,9 @@ _FOREIGN_SCRIPTS = ("javascript", "java", "python", "groovy", "mvel", "ecmascrip
 def run(args: argparse.Namespace) -> int:
     from opspec.xpdl.validate import spec_files, summary
 
-    files, problems = spec_files(args.paths)
+    from opspec.commands._spec import where_to_look
+
+    files, problems = spec_files(args.paths, where_to_look=where_to_look)
     for problem in problems:
         print(f"opspec validate: {problem}", file=sys.stderr)
     reports = []

@@ -228,14 +228,18 @@ def validate_spec(path: str | Path, *, strict: bool = False,
     return result.package, FileReport(str(path), version, diagnostics)
 
 
-def spec_files(paths: Sequence[str | Path]) -> tuple[list[Path], list[str]]:
+def spec_files(paths: Sequence[str | Path], *,
+               where_to_look: Callable[[Path], str | None] | None = None
+               ) -> tuple[list[Path], list[str]]:
     """The files to validate, and a problem line for every argument that cannot be used.
 
     A file argument is taken as it is (whatever its suffix); a folder contributes every
     ``*.xpdl`` and ``*.xml`` file below it, recursively, sorted. A missing path, a folder
     holding no such file, or a broken symbolic link with such a name in a folder gives a
-    problem. Files named twice are validated once. (``*.bpmn`` files are BPMN 2.0; what a
-    file holds is decided by its content, so any of them may be either.)
+    problem; ``where_to_look`` adds to a missing path's where it was looked for (the
+    commands' :func:`opspec.runs.where_to_look`). Files named twice are validated once.
+    (``*.bpmn`` files are BPMN 2.0; what a file holds is decided by its content, so any of
+    them may be either.)
     """
     files: list[Path] = []
     problems: list[str] = []
@@ -255,7 +259,8 @@ def spec_files(paths: Sequence[str | Path]) -> tuple[list[Path], list[str]]:
         elif path.exists():
             files.append(path)
         else:
-            problems.append(f"{path}: no such file or folder")
+            hint = where_to_look(path) if where_to_look is not None else None
+            problems.append(f"{path}: no such file or folder" + (f" ({hint})" if hint else ""))
     return list(dict.fromkeys(files)), problems
 
 

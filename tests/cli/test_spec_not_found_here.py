@@ -36,7 +36,7 @@ def test_an_absolute_path_keeps_its_message(tmp_path: Path,
                                        "specs/medication_dispenser.xpdl)\n")
 
 
-@pytest.mark.parametrize("command", ["show", "compile", "preprocess"])
+@pytest.mark.parametrize("command", ["show", "compile", "preprocess", "validate", "check"])
 def test_the_other_commands_say_it_too(command: str, tmp_path: Path,
                                        monkeypatch: pytest.MonkeyPatch,
                                        capsys: pytest.CaptureFixture[str]) -> None:
