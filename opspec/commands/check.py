@@ -73,14 +73,13 @@ def register(subparsers: Any) -> None:
 
 def run(args: argparse.Namespace) -> int:
     from opspec.commands._check_levels import errors_by_level
+    from opspec.commands._spec import where_to_look
     from opspec.errors import Severity
     from opspec.model.instance_starts import called_processes
     from opspec.model.soundness import SoundnessReport, check_process
     from opspec.xpdl.gate import RUNS_DIFFERENTLY
     from opspec.xpdl.loader import load_package
     from opspec.xpdl.validate import IO_CODES, spec_files
-
-    from opspec.commands._spec import where_to_look
 
     files, usage = spec_files(args.specs, where_to_look=where_to_look)
     for message in usage:

@@ -27,7 +27,12 @@ def register(subparsers: Any) -> None:
     parser.set_defaults(handler=usage)
     sub = parser.add_subparsers(dest="devices_command", metavar="ACTION")
 
-    listing = sub.add_parser("list", help="show serial ports and which profiles match them")
+    listing = sub.add_parser(
+        "list", help="show serial ports and which profiles match them",
+        description="Show the serial ports of this machine, each with the device profiles "
+        "whose port rules match it, then every profile of the folder with its participants "
+        "and port rules. Virtual ports (pseudo-terminals, socket://, emulator://) are not "
+        "listed: bind them by path or URL (--bind PARTICIPANT=URL).")
     listing.add_argument("--profiles", metavar="DIR", help="profile folder (default: devices/)")
     listing.set_defaults(handler=_list)
 

@@ -92,9 +92,8 @@ _FOREIGN_SCRIPTS = ("javascript", "java", "python", "groovy", "mvel", "ecmascrip
 
 
 def run(args: argparse.Namespace) -> int:
-    from opspec.xpdl.validate import spec_files, summary
-
     from opspec.commands._spec import where_to_look
+    from opspec.xpdl.validate import spec_files, summary
 
     files, problems = spec_files(args.paths, where_to_look=where_to_look)
     for problem in problems:

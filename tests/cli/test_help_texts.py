@@ -31,6 +31,18 @@ def test_the_description_is_the_module_docstring(name):
     assert " ".join(listed.split()).find(summary[:1].lower() + summary[1:60]) >= 0
 
 
+def test_every_action_of_a_command_says_what_it_does():
+    # `opspec devices list --help` printed only its usage and options
+    pending = list(_subparsers(build_parser()).values())
+    bare = []
+    while pending:
+        parser = pending.pop()
+        actions = _subparsers(parser)
+        pending.extend(actions.values())
+        bare += [action.prog for action in actions.values() if not action.description]
+    assert bare == []
+
+
 def _help_of(parser, option: str) -> str | None:
     for action in parser._actions:
         if option in action.option_strings:
