@@ -30,7 +30,7 @@ import os
 from typing import Any, Final
 
 from opspec.clock import clock_time
-from opspec.errors import ZeroTimeCycleError
+from opspec.errors import SourceLocation, ZeroTimeCycleError
 
 __all__ = ["INSTANT_STEPS_ENV", "MAX_INSTANT_STARTS", "MAX_INSTANT_STEPS", "SAMPLE_STARTS",
            "SAMPLE_STEPS", "ZeroTimeSampler", "max_instant_steps"]
@@ -81,6 +81,8 @@ class ZeroTimeSampler:
         self.activities: dict[str, dict[str, tuple[int, str]]] = {}
         self.instances: dict[str, set[int]] = {}
         self.hits: dict[str, int] = {}
+        # process id -> activity -> where it is written (the error is placed at the cycle)
+        self.places: dict[str, dict[str, SourceLocation | None]] = {}
 
     def record(self, a: Any, b: Any) -> bool:
         self.steps += 1
@@ -108,9 +110,20 @@ class ZeroTimeSampler:
             if act is not None and inst is not None:
                 pid: str = inst.process.id
                 self.activities.setdefault(pid, {})[act.id] = (act.index, act.id)
+                self.places.setdefault(pid, {})[act.id] = act.location
                 self.instances.setdefault(pid, set()).add(inst.id)
                 self.hits[pid] = self.hits.get(pid, 0) + 1
         return self.steps >= SAMPLE_STEPS
+
+    def place(self) -> SourceLocation | None:
+        """Where the cycle is written: the first activity (in the graph's order) of the
+        process seen most, as :meth:`describe` names it first; None when no activity moved
+        or it was built in Python."""
+        if not self.hits:
+            return None
+        pid = max(self.hits, key=lambda p: self.hits[p])
+        first = min(self.activities[pid].values())[1]
+        return self.places[pid][first]
 
     def describe(self) -> str:
         """``process 'p' (instance 1): B, C`` for the processes seen most, or the events."""
@@ -139,6 +152,7 @@ class ZeroTimeSampler:
         return ZeroTimeCycleError(
             f"the simulated clock stopped advancing at t={self.at:.3f} s ({clock_time(self.at)}): "
             f"{ran}, {self.describe()}",
+            location=self.place(),
             hint="give the cycle a duration, a wait, or a condition that ends it; "
                  f"{INSTANT_STEPS_ENV} raises the limit if this much work at one instant "
                  "is intended",

@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import json
 import os
+import re
 import subprocess
 import sys
 import time
@@ -43,7 +44,8 @@ def one_line(stderr: str, command: str, process: str, cycle: str) -> str:
              if line.startswith("opspec") and ": warning: " not in line]
     assert len(lines) == 1, stderr
     [line] = lines
-    assert line.startswith(f"opspec {command}: {START}"), line
+    # at the spec's line of the cycle (its first activity the message names)
+    assert re.match(rf"opspec {command}: \S+\.xpdl:\d+: {re.escape(START)}", line), line
     assert f"process {process!r} (" in line and f"): {cycle} (" in line, line
     assert "Traceback" not in stderr
     return line

@@ -54,7 +54,8 @@ def test_a_zero_time_cycle_begins_with_opspec_run(tmp_path: Path) -> None:
                   OPSPEC_MAX_INSTANT_STEPS="20000")
     assert done.returncode == 1
     [line] = lines(done.stderr)
-    assert line.startswith("opspec run: the simulated clock stopped advancing at t=0.000 s"), line
+    assert line.startswith(f"opspec run: {CYCLE}:"), line
+    assert ": the simulated clock stopped advancing at t=0.000 s" in line, line
 
 
 def test_an_opspec_error_from_evaluate_begins_with_opspec_evaluate(

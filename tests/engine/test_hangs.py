@@ -48,7 +48,13 @@ def test_each_hang_shape_stops_with_the_process_the_cycle_and_the_time(name: str
         sim.run(until=3600)
     message = str(caught.value)
     assert "\n" not in message
-    assert message.startswith("the simulated clock stopped advancing at t=0.000 s (d1 00:00:00)")
+    # placed at the cycle: the line of the first activity it names
+    path = SPECS / f"{name}.xpdl"
+    first = cycle[0]
+    line = next(n for n, text in enumerate(path.read_text().splitlines(), 1)
+                if f'<Activity Id="{first}"' in text)
+    assert message.startswith(f"{path}:{line}: the simulated clock stopped advancing at "
+                              "t=0.000 s (d1 00:00:00)")
     assert named(message, process) == cycle
     assert "OPSPEC_MAX_INSTANT_STEPS" in message
     assert caught.value.sim_time == 0.0

@@ -3,6 +3,7 @@ line naming the workflow, the activities that keep coming back and the simulated
 
 from __future__ import annotations
 
+import re
 import subprocess
 import sys
 from pathlib import Path
@@ -66,7 +67,8 @@ def test_opspec_run_exits_1_with_one_line_and_keeps_the_trace(tmp_path: Path) ->
                           env={**__import__("os").environ, "OPSPEC_MAX_INSTANT_STEPS": "20000"})
     assert done.returncode == 1
     [line] = done.stderr.strip().splitlines()
-    assert line.startswith("opspec run: the simulated clock stopped advancing at t=0.000 s")
+    assert re.match(r"opspec run: \S+\.xpdl:\d+: the simulated clock stopped advancing at "
+                    r"t=0\.000 s", line), line
     assert "Traceback" not in done.stderr
     assert trace.read_text().count('"activity.started"') > 1000
 
