@@ -13,7 +13,6 @@ from __future__ import annotations
 
 from collections import deque
 from collections.abc import Callable, Mapping
-from types import MappingProxyType
 from typing import TYPE_CHECKING, Any, Final, final
 
 from opspec.engine import call_depth, multi_instance, plans, tools
@@ -47,7 +46,6 @@ _VOTER: Final = CoordinationKind.VOTER
 _SUPERPOSITION: Final = CoordinationKind.SUPERPOSITION
 _PUSH_DATA: Final = CoordinationKind.PUSH_DATA
 _PULL_DATA: Final = CoordinationKind.PULL_DATA
-_PROXY: Final = MappingProxyType
 
 #: Whether ``body_done`` reads a dict of answers as one (compiled: the dict's own iteration;
 #: a Mapping's is an ``items`` method call through Python's protocol and an iterator, 0.7k a
@@ -352,16 +350,13 @@ class Activities(Part):
         state = self.state
         ai.performer = performer
         ai.waiting = "performer"
-        data = inst.view                    # (the data a work item would carry)
-        if data is None:
-            data = inst.view = _PROXY(inst.data)
         cached = act.flag_cache
         if (cached.bits if cached.key is state.flag_key else state.act_bits(act)) & 4:
             state.emit(EK.ACTIVITY_OFFERED, act.process, inst.id, act.id, act.lane,
                        act.participant, None)
         if not state.inside:                # (the session's clock, read from outside)
             state.sync()
-        result = performer.answer(act.application or "", data, state.now)
+        result = performer.answer(act.application or "", inst.data, state.now)
         if ai.state != RUNNING:
             state.stale_completions += 1
             return
@@ -569,8 +564,8 @@ class AnswersAtOnce:
         return False
 
     def answer(self, application: str, data: Mapping[str, Any], now: float) -> dict[str, Any]:
-        """Do ``application`` at ``now`` with the instance's ``data``: the data it completes
-        with."""
+        """Do ``application`` at ``now`` with the instance's ``data`` (read, never changed:
+        a work item's is a read-only view): the data it completes with."""
         raise NotImplementedError
 
 
