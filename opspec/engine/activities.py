@@ -548,7 +548,7 @@ class Activities(Part):
             ai = pullers.popleft()
             if ai.state == RUNNING:
                 output = ai.act.coordination.output if ai.act.coordination else None
-                self.state.ready.append((self.body_done, ai,
+                self.state.ready.append((self.body_done_q, ai,
                                     {output: value} if output else None, None))
                 return
         self.state.mailboxes.setdefault(channel, deque()).append(value)
