@@ -54,8 +54,8 @@ class _Session:
 
 
 def _run(spec: str, seconds: float, offered: bool) -> tuple[list[Any], dict[str, Any], int]:
-    run = prepare(RunRequest(spec=str(SPECS / spec), until=seconds, no_user=True,
-                             keep_trace=True)).build(3)
+    run = prepare(RunRequest(spec=str(SPECS / spec), until=seconds, no_user=True, seed=3,
+                             keep_trace=True)).build(0)
     apps = run.sim.apps
     devices = {id(performer): performer for performer in apps.values()}
     assert [type(d) for d in devices.values()] == [RoomDevices]
