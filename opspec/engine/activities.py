@@ -15,8 +15,8 @@ from collections import deque
 from collections.abc import Callable, Mapping
 from typing import TYPE_CHECKING, Any, Final, final
 
+from opspec.engine import call_depth, multi_instance, plans, tools
 from opspec.engine import coordination as coord
-from opspec.engine import multi_instance, plans, tools
 from opspec.engine.compiled import (
     K_ASYNC,
     K_BLOCK,
@@ -53,9 +53,8 @@ _PULL_DATA: Final = CoordinationKind.PULL_DATA
 #: From source the test alone would cost more than it saves.
 DICTS: Final = not TUPLES
 
-#: Synchronous subflow calls nested deeper than this end the run's root instance with a
-#: located fault: bounded recursion (a base case) runs, runaway recursion is reported.
-MAX_CALL_DEPTH = 100
+MAX_CALL_DEPTH: Final = call_depth.MAX_CALL_DEPTH      # (call_depth's, for its importers)
+
 
 
 class Activities(Part):
@@ -73,17 +72,7 @@ class Activities(Part):
             {} if plans.COMPILED else plans.resumes(state.compiled))
 
     def _too_deep(self, ai: ActivityInstance, target: CompiledProcess) -> None:
-        """Runaway recursion: abort the outermost caller (which ends every nested call)."""
-        root = ai.frame.inst
-        while root.parent is not None:
-            root = root.parent.frame.inst
-        act = ai.act
-        text = (f"{act.where()}: activity {act.id!r} of process {act.process!r} calls "
-                f"{target.id!r} {MAX_CALL_DEPTH + 1} synchronous subflow calls deep at "
-                f"t={self.state.now:.3f} s: the recursion does not reach its base case")
-        self.state.faults.append({"time": self.state.now, "process": act.process,
-                            "instance": ai.frame.inst.id, "activity": act.id, "message": text})
-        self.flow.end_instance(root, ABORTED, text)
+        call_depth.too_deep(self, ai, target)       # (runaway recursion: a rare path)
 
     def start(self, frame: Frame, act: CompiledActivity | None, steps: int = 0,
               limit: int = -1) -> None:
@@ -297,6 +286,11 @@ class Activities(Part):
                               f" / lanes {', '.join(act.lanes) or '-'}")
                 self.state.emit_act(EK.ACTIVITY_OFFERED, inst, act, {"performer": None})
                 return
+            if (kind == K_TASK and isinstance(performer, AnswersAtOnce) and not act.params
+                    and act.sampler is None and ai.local is None and act.application
+                    and performer.answers_at_once(act.application)):
+                self._answered(ai, performer)
+                return
             data: Mapping[str, Any] | None = None
             if act.params:
                 data = self.inputs(ai)
@@ -347,6 +341,28 @@ class Activities(Part):
         else:                                       # noop, throw, task without a callable
             # queued, not called: a chain of such activities must not grow the stack
             self.state.ready.append((self.body_done_q, ai, None, None))
+
+    def _answered(self, ai: ActivityInstance, performer: AnswersAtOnce) -> None:
+        """What ``Offers.offer``, the performer's ``offer`` and ``complete`` do for a task
+        answered at once, without the work item nobody else sees."""
+        act = ai.act
+        inst = ai.frame.inst
+        state = self.state
+        ai.performer = performer
+        ai.waiting = "performer"
+        cached = act.flag_cache
+        if (cached.bits if cached.key is state.flag_key else state.act_bits(act)) & 4:
+            state.emit(EK.ACTIVITY_OFFERED, act.process, inst.id, act.id, act.lane,
+                       act.participant, None)
+        if not state.inside:                # (the session's clock, read from outside)
+            state.sync()
+        result = performer.answer(act.application or "", inst.data, state.now)
+        if ai.state != RUNNING:
+            state.stale_completions += 1
+            return
+        state.ready.append((self.body_done_q, ai, result or None, None))
+        if not state.draining:
+            state.drain()
 
     def body_done(self, ai: ActivityInstance, data: Mapping[str, Any] | None,
                    _unused: Any = None) -> None:
@@ -532,10 +548,25 @@ class Activities(Part):
             ai = pullers.popleft()
             if ai.state == RUNNING:
                 output = ai.act.coordination.output if ai.act.coordination else None
-                self.state.ready.append((self.body_done, ai,
+                self.state.ready.append((self.body_done_q, ai,
                                     {output: value} if output else None, None))
                 return
         self.state.mailboxes.setdefault(channel, deque()).append(value)
+
+
+class AnswersAtOnce:
+    """A performer whose operations answer as soon as asked (a simulated world's devices):
+    such a task runs without a work item (:meth:`Activities._answered`), with the same
+    trace, data and completion as through its ``offer`` and its session's ``complete``."""
+
+    def answers_at_once(self, application: str) -> bool:
+        """Whether :meth:`answer` does ``application`` now (else it is offered)."""
+        return False
+
+    def answer(self, application: str, data: Mapping[str, Any], now: float) -> dict[str, Any]:
+        """Do ``application`` at ``now`` with the instance's ``data`` (read, never changed:
+        a work item's is a read-only view): the data it completes with."""
+        raise NotImplementedError
 
 
 @final

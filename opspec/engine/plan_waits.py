@@ -14,6 +14,7 @@ from __future__ import annotations
 
 from typing import Any
 
+from opspec.engine.call_depth import MAX_CALL_DEPTH
 from opspec.engine.compiled import (
     K_CATCH,
     K_GATEWAY,
@@ -182,7 +183,6 @@ class WaitingCode:
         """``Activities._body`` of a synchronous subflow call, in line: its actual
         parameters (``Activities.inputs``), the depth guard, the called instance started
         with ``ai`` waiting for it."""
-        from opspec.engine.activities import MAX_CALL_DEPTH  # (activities imports plans)
         target = self.name("F", act.subflow)
         items = ", ".join(f"{self.name('M', formal)}: {self.name('V', fn)}(scope, now)"
                           for _mode, formal, fn, _target in act.params if fn is not None)

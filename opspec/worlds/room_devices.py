@@ -17,18 +17,22 @@ reader, an operation the world does not know) goes to ``WorldDevices``.
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from typing import Any
 
+from opspec.engine.activities import AnswersAtOnce
 from opspec.engine.workitem import WorkItem
 from opspec.worlds.stepping import DONE, RoomState
 
 __all__ = ["RoomDevices"]
 
 
-class RoomDevices:
+class RoomDevices(AnswersAtOnce):
     """The performer of a :class:`~opspec.worlds.room.RoomWorld` (``world``) with its state
     ``state``; ``general`` is the :class:`~opspec.worlds.device.WorldDevices` of the same
-    world, which does every operation not done here."""
+    world, which does every operation not done here. The engine asks it for those
+    operations directly (:class:`~opspec.engine.activities.AnswersAtOnce`), without a work
+    item."""
 
     def __init__(self, world: Any, state: RoomState, general: Any) -> None:
         self.world = world
@@ -42,21 +46,30 @@ class RoomDevices:
         self.session = session
         self.general.attach(session)
 
+    def answers_at_once(self, application: str) -> bool:
+        """The operations done here, once the world has announced its first state."""
+        return self.announced and (application == "read_bump" or application == "drive"
+                                   or application == "read_range")
+
     def offer(self, item: WorkItem) -> None:
         application = item.application or item.activity
-        fast = application == "read_bump" or application == "drive" or (
-            application == "read_range")
-        if not fast or not self.announced:
+        if not self.answers_at_once(application):
             self.announced = True           # WorldDevices (World.advance) announces
             self.general.offer(item)
             return
         session = self.session
-        now: float = session.now
+        result = self.answer(application, item.data, session.now)
+        session.complete(item, result or None)
+
+    def answer(self, application: str, data: Mapping[str, Any], now: float
+               ) -> dict[str, Any]:
+        """One of the operations done here (:meth:`answers_at_once`) at ``now``: the world
+        advanced to it, then the reading or the command. The engine asks it directly
+        (``Activities._answered``); :meth:`offer` for anyone offering a work item."""
         state = self.state
         code = state.advance(now)
         if code != DONE:
             self.world.finish_advance(code, now)
-        data = item.data
         result: dict[str, Any]
         if application == "read_bump":
             result = state.read_bump()
@@ -78,7 +91,7 @@ class RoomDevices:
             else:
                 state.command = command             # RobotWorld.op_drive
                 result = {}
-        session.complete(item, result or None)
+        return result
 
     def withdraw(self, item: WorkItem, reason: str) -> None:
         """Operations complete at once: nothing is pending to withdraw."""
