@@ -48,6 +48,13 @@ class OptionalNativeBuild(build_ext):
         except Exception as error:  # noqa: BLE001 - any compiler failure: install pure Python
             self._pure(f"compiling the engine with mypyc failed ({error})")
             return
+        if not self.extensions:
+            # Nothing was compiled (pure Python asked for, no mypyc, or mypyc refused the
+            # source: said above). A record of this source would vouch for the extensions an
+            # earlier in-place build left, and opspec._native would run that older code as
+            # this source's compiled build; with no record it runs the source.
+            self._unstamp()
+            return
         self._stamp()
 
     def _stamp(self) -> None:
@@ -62,6 +69,9 @@ class OptionalNativeBuild(build_ext):
     def _pure(self, why: str) -> None:
         print(f"warning: {why}; opspec is installed as pure Python (same results, slower "
               f"engine)", file=sys.stderr)
+        self._unstamp()
+
+    def _unstamp(self) -> None:
         stale = ROOT / "opspec" / STAMP
         if self.inplace and stale.exists():
             stale.unlink()
@@ -112,6 +122,7 @@ def _extensions() -> list[object]:
     try:
         return list(mypycify(paths, group_name="opspec", opt_level="3", debug_level="0"))
     except (Exception, SystemExit) as error:  # noqa: BLE001 - mypyc refused the source
+        _READ.clear()
         print(f"warning: mypyc cannot compile the engine ({error}); opspec is installed as "
               f"pure Python", file=sys.stderr)
         return []

@@ -202,3 +202,46 @@ def test_the_build_record_describes_the_sources_mypyc_compiled(
     setup["OptionalNativeBuild"]._stamp(build)
     record = json.loads((tmp_path / "opspec" / _native.STAMP).read_text(encoding="utf-8"))
     assert record["modules"][_native.MODULES[0]] == before != _native.source_digest(edited)
+
+
+def test_a_build_mypyc_refused_leaves_no_record_to_vouch_for_an_older_build(
+        tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    """mypyc refuses the source (a type error a change brought in): the build compiles
+    nothing and says so. It wrote the record of this source all the same, over the extensions
+    an earlier in-place build had left, and opspec._native ran that older code as this
+    source's compiled build. Now no record is left: the source runs."""
+    import runpy
+    import shutil
+    import types
+
+    import setuptools
+    from setuptools import Distribution
+
+    shutil.copy(ROOT / "setup.py", tmp_path / "setup.py")
+    for module in (*_native.MODULES, "opspec._native"):
+        relative = module.replace(".", "/") + ".py"
+        (tmp_path / relative).parent.mkdir(parents=True, exist_ok=True)
+        shutil.copy(ROOT / relative, tmp_path / relative)
+    stamp = tmp_path / "opspec" / _native.STAMP
+    stamp.write_text('{"compiler": "mypyc", "modules": {}}\n', encoding="utf-8")  # the old one
+
+    def refuse(paths: object, **options: object) -> list[object]:
+        raise SystemExit("opspec/engine/flow.py:1: error: Incompatible types")
+
+    mypyc = types.ModuleType("mypyc")
+    build_module = types.ModuleType("mypyc.build")
+    build_module.mypycify = refuse  # type: ignore[attr-defined]
+    monkeypatch.setitem(sys.modules, "mypyc", mypyc)
+    monkeypatch.setitem(sys.modules, "mypyc.build", build_module)
+    monkeypatch.setattr(setuptools, "setup", lambda **options: None)
+    monkeypatch.setattr(sys, "argv", ["setup.py", "build_ext", "--inplace"])
+    monkeypatch.delenv(_native.ENV, raising=False)
+    monkeypatch.chdir(tmp_path)
+    setup = runpy.run_path(str(tmp_path / "setup.py"))
+    extensions = setup["_extensions"]()
+    assert extensions == [] and setup["_READ"] == {}
+    build = setup["OptionalNativeBuild"](Distribution({"ext_modules": extensions}))
+    build.ensure_finalized()
+    build.inplace = True
+    build.run()
+    assert not stamp.exists()
