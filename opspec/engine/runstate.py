@@ -34,7 +34,7 @@ from opspec.engine.compiled import (
 from opspec.engine.config import EngineConfig
 from opspec.engine.instances import ActivityInstance, Frame, ProcessInstance
 from opspec.engine.lifecycle import RUNNING, SUSPENDED
-from opspec.engine.metrics import MetricsListener
+from opspec.engine.listener_tables import flag_key, listener_tables, metrics_only
 from opspec.engine.performers import Performer
 from opspec.engine.processors import DedicatedProcessor, PooledProcessor
 from opspec.engine.random import Streams
@@ -140,10 +140,10 @@ class RunState(Timers):
         self.seq = 0
         self.pkg = compiled.id
         (self.listeners, self.raw, self.wants_all, self.selectors, self.wanted,
-         self.full) = _listener_tables(listeners, compiled)
-        self.raw_metrics = _metrics_only(self.raw)
+         self.full) = listener_tables(listeners, compiled)
+        self.raw_metrics = metrics_only(self.raw)
         # which selection the wanted-kind bits cached on activities and processes are of
-        self.flag_key = _flag_key(self.wants_all, self.wanted)
+        self.flag_key = flag_key(self.wants_all, self.wanted)
 
     def idle(self) -> bool:
         """Whether a drain now would only count a step: nothing queued, no frame pending
@@ -194,7 +194,7 @@ class RunState(Timers):
 
     def reselect(self) -> None:
         """The listeners' selection changed (workflows loaded at run time)."""
-        self.flag_key = _flag_key(self.wants_all, self.wanted)
+        self.flag_key = flag_key(self.wants_all, self.wanted)
 
     def emit(self, kind: str, process: str | None = None, instance: int | None = None,
              activity: str | None = None, lane: str | None = None,
@@ -393,6 +393,20 @@ class RunState(Timers):
         self.schedule_timed(delay if delay > 0.0 else 0.0,  # noqa: FURB136
                            _CallAt(self, callback, True))
 
+    def call_at_with(self, delay: float, fn: Callable[[Any, Any, Any], None],
+                     a: Any, b: Any, c: Any) -> None:
+        """:meth:`call_at` for ``fn(a, b, c)``: the arguments kept beside the callback, not
+        in a ``functools.partial`` of it. A zero delay while draining queues the call itself
+        as a ready-queue item (no trampoline through ``_call``); otherwise its own timed
+        entry calls it, then drains. The session's ``call_later_with`` (the stochastic user's
+        answers from source: two or three a dose cycle go to the ready queue this way)."""
+        if delay <= 0.0 and self.draining:
+            self.ready.append((fn, a, b, c))
+            return
+        self.sim_events += 1
+        self.schedule_timed(delay if delay > 0.0 else 0.0,  # noqa: FURB136
+                           _CallWith(self, fn, a, b, c))
+
     def timer(self, delay: float, callback: Callable[[], None]) -> None:
         """Run ``callback`` after ``delay`` simulated seconds (it drains itself, if it
         must: the processors' and the start timers' callbacks)."""
@@ -458,22 +472,6 @@ _ACT_KINDS = (EK.ACTIVITY_STARTED, EK.ACTIVITY_COMPLETED, EK.ACTIVITY_OFFERED,
 _PROC_KINDS = (EK.PROCESS_STARTED, EK.PROCESS_COMPLETED)
 
 
-_FLAG_KEYS: dict[tuple[bool, frozenset[Any]], object] = {}
-
-
-def _flag_key(wants_all: bool, wanted: frozenset[Any]) -> object:
-    """One object per distinct listener selection: runs that select the same events share
-    the bits cached on a compiled package's activities (households run one after another
-    on one package)."""
-    key = (wants_all, wanted)
-    found = _FLAG_KEYS.get(key)
-    if found is None:
-        if len(_FLAG_KEYS) > 1000:           # a long-lived process with many selections
-            _FLAG_KEYS.clear()
-        found = _FLAG_KEYS[key] = object()
-    return found
-
-
 def _call(callback: Callable[[], None], _a: Any, _b: Any) -> None:
     callback()
 
@@ -523,47 +521,26 @@ class _CallAt(Timed):
         self.state.called(self.callback, self.drain)
 
 
-def _metrics_only(raw: list[Callable[..., None]]) -> list[MetricsListener] | None:
-    """The raw listeners when they are all metrics listeners' (a run's own, as a rule): the
-    compiled engine then calls them as native methods, not through Python's protocol."""
-    metrics = [getattr(listener, "__self__", None) for listener in raw]
-    chosen = [m for m in metrics if isinstance(m, MetricsListener)]
-    if len(chosen) != len(raw) or any(m.raw != r for m, r in zip(chosen, raw)):
-        return None
-    return chosen
+@final
+class _CallWith(Timed):
+    """The timed callback of :meth:`RunState.call_at_with`."""
+
+    def __init__(self, state: RunState, fn: Callable[[Any, Any, Any], None],
+                 a: Any, b: Any, c: Any) -> None:
+        self.state = state
+        self.fn = fn
+        self.a = a
+        self.b = b
+        self.c = c
+
+    def go(self) -> None:
+        self.fn(self.a, self.b, self.c)
+        self.state.drain()
+
+    def __call__(self, _event: Any) -> None:
+        self.state.go_now(self)
 
 
 def discard(table: dict[Any, Any], key: Any) -> None:
     """Remove ``key`` from ``table`` if it is there (an activity's cleanup)."""
     table.pop(key, None)
-
-
-_Selector = tuple[str, str | None, str | None]      # (kind, process, activity)
-
-
-def _listener_tables(listeners: list[TraceListener], compiled: CompiledPackage) -> tuple[
-        list[TraceListener], list[Callable[..., None]], bool,
-        frozenset[_Selector], frozenset[_Selector],
-        list[tuple[TraceListener, frozenset[_Selector] | None]]]:
-    """Who hears what: the full listeners (a ``raw`` method gets the fields without a
-    TraceEvent object), whether any wants everything, and the (kind, process, activity)
-    selectors the others asked for, expanded over the compiled package."""
-    full_listeners = [lst for lst in listeners if getattr(lst, "raw", None) is None]
-    raw = [lst.raw for lst in listeners  # type: ignore[attr-defined]
-           if getattr(lst, "raw", None) is not None]
-    wants_all = False
-    selectors: set[_Selector] = set()
-    for listener in listeners:
-        wanted = getattr(listener, "selects", None)
-        if wanted is None:
-            wants_all = True
-            break
-        selectors.update(wanted)
-    chosen = frozenset(selectors)
-    expanded = (frozenset() if wants_all or not selectors
-                else compiled.expand_selectors(chosen))
-    # each full listener only receives what it selects (None: everything)
-    full = [(lst, None if getattr(lst, "selects", None) is None
-             else compiled.expand_selectors(frozenset(lst.selects)))  # type: ignore[attr-defined]
-            for lst in full_listeners]
-    return full_listeners, raw, wants_all, chosen, expanded, full
