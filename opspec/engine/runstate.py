@@ -224,12 +224,10 @@ class RunState(Timers):
     def drain(self) -> None:
         """Run queued zero-time work until none is left (re-entrant calls just return).
 
-        Zero-time work at one simulated instant is counted across drains: each item run and
-        each drain (a clock event at this instant, so a storm of zero-delay wakeups that queue
-        nothing counts too); the count starts again when the clock has moved. Past
-        ``max_instant_steps`` the run stops with a
-        :class:`~opspec.errors.ZeroTimeCycleError` naming the activities that keep coming
-        back (:mod:`opspec.engine.zero_time`)."""
+        Each item run and each drain counts as a step of this simulated instant (a storm of
+        zero-delay wakeups that queue nothing counts too); past ``max_instant_steps`` the
+        run stops with a :class:`~opspec.errors.ZeroTimeCycleError` naming the activities
+        that keep coming back (:mod:`opspec.engine.zero_time`)."""
         if self.draining:
             return
         now = self.now
@@ -237,9 +235,7 @@ class RunState(Timers):
         if now != instant:
             # _same_instant in line (a Python frame per drain from source; the time is never
             # negative): a new instant starts its count at 0, a creep of no real time does not
-            moved = now - instant
-            if moved < 0.0:
-                moved = -moved
+            moved = now - instant if now > instant else instant - now
             if moved > 1e-9 * (now if now > 1.0 else 1.0):
                 self.instant = now
                 self.instant_steps = 0
@@ -247,9 +243,7 @@ class RunState(Timers):
                     self.sampler = None
                     self.start_limit = self.max_instant_steps
         ready = self.ready
-        if not ready and not self.pending:
-            # nothing queued (a deadline that fired after its instance ended, a timer whose
-            # callback queued nothing): the drain only counts as a step of this instant
+        if not ready and not self.pending:      # nothing queued: a step of this instant
             steps = self.instant_steps + 1
             if steps > self.max_instant_steps:
                 self.instant_steps = steps      # (as the finally below, if this raises)
@@ -260,6 +254,7 @@ class RunState(Timers):
         done = 0                    # the items of ``ready`` run so far
         steps = self.instant_steps + 1
         limit = self.max_instant_steps
+        base = steps                # (the step count is base + done while items run)
         flow = self.flow            # (the commonest items' native methods: see DIRECT)
         acts = flow.activities
         lone_q = flow.start_lone_q if DIRECT else None
@@ -268,22 +263,26 @@ class RunState(Timers):
             if steps > limit:
                 steps = self._past_limit(steps, None, None)
             while True:
-                # A list's iterator sees the items appended while it runs (from source, one
-                # FOR_ITER per item instead of a len() call and an index); it starts at the
-                # front, so what has run is dropped before it starts again.
+                # (a list's iterator sees what is appended meanwhile) ``check``: the first
+                # ``done`` at which the count passes the limit or the burst is long
+                base = steps
+                check = limit - base + 1 if limit - base < _COMPACT else _COMPACT + 1
                 for fn, a, b, c in ready:
                     done += 1
-                    steps += 1
-                    if steps > limit:
-                        steps = self._past_limit(steps, a, b)
-                    if fn is lone_q:
+                    if done >= check:
+                        if done > _COMPACT:     # a long burst: this item in the next pass
+                            done -= 1
+                            break
+                        base, check = self._past_check(base, done, a, b)
+                    if not DIRECT:
+                        fn(a, b, c)
+                    elif fn is lone_q:
                         flow.start_lone_at(a, b, c)
                     elif fn is done_q:
                         acts.body_done(a, b, c)
                     else:
                         fn(a, b, c)
-                    if done >= _COMPACT:        # a long burst: drop what has run
-                        break
+                steps = base + done
                 if done == len(ready):          # (compiled, a slice's delete boxes its
                     ready.clear()               # bounds into a slice object: 0.3k an instance)
                 else:
@@ -299,8 +298,17 @@ class RunState(Timers):
         finally:
             if done:                            # what ran before an exception
                 del ready[:done]
+                steps = base + done
             self.draining = False
             self.instant_steps = steps
+
+    def _past_check(self, base: int, done: int, a: Any, b: Any) -> tuple[int, int]:
+        """:meth:`drain`'s count passed the limit at its item ``done`` (``a``, ``b``): the
+        count's new base and the next ``done`` to look at (:meth:`_past_limit`)."""
+        steps = self._past_limit(base + done, a, b)
+        base = steps - done
+        limit = self.max_instant_steps
+        return base, (limit - base + 1 if limit - base < _COMPACT else _COMPACT + 1)
 
     def _past_limit(self, steps: int, a: Any, b: Any) -> int:
         """The step count passed the limit: a new count if the clock moved since the count

@@ -185,10 +185,15 @@ class Timers:
         if not self.inside:
             self.now = float(self.env.now)
         at = self.now + delay
-        self.order += 1
+        seq = self.order + 1
+        self.order = seq
         entry.at = at
-        entry.seq = self.order
-        self._push(entry)
+        entry.seq = seq
+        if TUPLES:      # (_push's case from source in line: a Python frame less an entry)
+            rows: list[Any] = self.heap
+            heappush(rows, (at, seq, entry))
+        else:
+            self._push(entry)
         if at < self.armed_at and not self.ticking:
             self.arm()
 
