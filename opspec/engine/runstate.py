@@ -523,7 +523,12 @@ class _CallAt(Timed):
     def go(self) -> None:
         self.callback()
         if self.drain:
-            self.state.drain()
+            state = self.state
+            if (state.ready or state.pending or state.draining or state.now != state.instant
+                    or state.instant_steps >= state.max_instant_steps):
+                state.drain()
+            else:                   # (drain's case of nothing queued at this instant)
+                state.instant_steps += 1
 
     def __call__(self, _event: Any) -> None:
         self.state.called(self.callback, self.drain)
@@ -543,7 +548,14 @@ class _CallWith(Timed):
 
     def go(self) -> None:
         self.fn(self.a, self.b, self.c)
-        self.state.drain()
+        state = self.state
+        # drain's case of nothing queued at this instant in line: a step counted (the
+        # callback, a performer's answer, has drained what it queued as a rule)
+        if (state.ready or state.pending or state.draining or state.now != state.instant
+                or state.instant_steps >= state.max_instant_steps):
+            state.drain()
+        else:
+            state.instant_steps += 1
 
     def __call__(self, _event: Any) -> None:
         self.state.go_now(self)

@@ -125,14 +125,20 @@ def test_a_callback_with_arguments_keeps_its_place_at_once_and_later(shared: boo
 
 class _Storm:
     """Asks, from each zero-delay callback, for the next one at the same instant: a storm
-    of clock events that queue nothing, which the zero-time guard must stop as it stops
-    one of ``call_later``'s (each callback's drain counts a step)."""
+    of clock events that queue nothing, which the zero-time guard must stop (each
+    callback's drain counts a step, also where it is only counted, nothing being queued)."""
+
+    def __init__(self, with_args: bool) -> None:
+        self.with_args = with_args
 
     def attach(self, session: Any) -> None:
         self.session = session
 
     def _again(self, _a: Any = None, _b: Any = None, _c: Any = None) -> None:
-        self.session.call_later_with(0.0, self._again, None, None, None)
+        if self.with_args:
+            self.session.call_later_with(0.0, self._again, None, None, None)
+        else:
+            self.session.call_later(0.0, self._again)
 
     def offer(self, item: WorkItem) -> None:
         self.session.call_later(1.0, self._again)
@@ -141,9 +147,50 @@ class _Storm:
         pass
 
 
-def test_a_storm_of_callbacks_with_arguments_is_stopped_as_a_zero_time_cycle(
-        monkeypatch: pytest.MonkeyPatch) -> None:
+@pytest.mark.parametrize("with_args", [True, False], ids=["call_later_with", "call_later"])
+def test_a_storm_of_callbacks_is_stopped_as_a_zero_time_cycle(
+        monkeypatch: pytest.MonkeyPatch, with_args: bool) -> None:
     monkeypatch.setenv("OPSPEC_MAX_INSTANT_STEPS", "2000")
-    sim = Simulation(pkg(proc("p", [manual("a")], [])), performers={"user": _Storm()})
+    sim = Simulation(pkg(proc("p", [manual("a")], [])), performers={"user": _Storm(with_args)})
     with pytest.raises(ZeroTimeCycleError):
         sim.run(until=20.0)
+
+
+class _Queues:
+    """A callback that queues zero-time work without draining it (as no performer's answer
+    does: the session's calls drain what they queue): its drain runs it at that time."""
+
+    def __init__(self, with_args: bool, sim_of: list[Simulation]) -> None:
+        self.with_args = with_args
+        self.sim_of = sim_of
+        self.ran: list[float] = []
+
+    def attach(self, session: Any) -> None:
+        self.session = session
+
+    def _queue(self, _a: Any = None, _b: Any = None, _c: Any = None) -> None:
+        sim = self.sim_of[0]
+        sim.ready.append((lambda _x, _y, _z: self.ran.append(sim.now), None, None, None))
+
+    def offer(self, item: WorkItem) -> None:
+        # (a callback before it at that instant: the instant's count has begun)
+        self.session.call_later(3.0, lambda: None)
+        if self.with_args:
+            self.session.call_later_with(3.0, self._queue, None, None, None)
+        else:
+            self.session.call_later(3.0, self._queue)
+        self.session.call_later(5.0, lambda: self.session.complete(item))
+
+    def withdraw(self, item: WorkItem, reason: str) -> None:
+        pass
+
+
+@pytest.mark.parametrize("with_args", [True, False], ids=["call_later_with", "call_later"])
+def test_work_a_callback_queued_runs_at_its_time(with_args: bool) -> None:
+    sim_of: list[Simulation] = []
+    user = _Queues(with_args, sim_of)
+    sim = Simulation(pkg(proc("p", [manual("a")], [])), performers={"user": user})
+    sim_of.append(sim)
+    sim.run(until=20.0)
+    assert user.ran == [3.0]
+    assert not sim.ready
