@@ -11,7 +11,7 @@ from opspec.engine.compiled import CompiledPackage
 from opspec.engine.metrics import MetricsListener
 from opspec.engine.trace import TraceListener
 
-__all__ = ["flag_key", "listener_tables", "metrics_only"]
+__all__ = ["flag_key", "listener_tables", "metrics_only", "own_metrics"]
 
 _FLAG_KEYS: dict[tuple[bool, frozenset[Any]], object] = {}
 
@@ -37,6 +37,16 @@ def metrics_only(raw: list[Callable[..., None]]) -> list[MetricsListener] | None
     if len(chosen) != len(raw) or any(m.raw != r for m, r in zip(chosen, raw)):
         return None
     return chosen
+
+
+def own_metrics(raw_metrics: list[MetricsListener] | None) -> MetricsListener | None:
+    """The one raw listener when it is a run's own metrics (a plain MetricsListener, whose
+    steps ``RunState.emit`` takes in line), else None."""
+    if raw_metrics is not None and len(raw_metrics) == 1:
+        only = raw_metrics[0]
+        if type(only) is MetricsListener:
+            return only
+    return None
 
 
 _Selector = tuple[str, str | None, str | None]      # (kind, process, activity)

@@ -22,9 +22,9 @@ from opspec.statistics.percentiles import linear
 __all__ = ["MetricsListener", "percentile", "summarise_durations"]
 
 # What a selector is to its metric (Final: mypyc inlines them).
-_COUNT: Final = 0
-_START: Final = 1
-_END: Final = 2
+COUNT: Final = 0
+START: Final = 1
+END: Final = 2
 
 
 def percentile(values: list[float], q: float) -> float:
@@ -51,7 +51,7 @@ class MetricsListener:
         self.definitions = tuple(definitions)
         self.counts: dict[str, int] = {}
         self.samples: dict[str, list[float]] = {}
-        self._open: dict[str, dict[int, float]] = {}
+        self.opened: dict[str, dict[int, float]] = {}
         # When ``keep_times`` is set (evaluation runs), the simulated time of every counted
         # event and of the end of every duration sample is kept too, for outcomes over days
         # and time of day; plain runs don't pay for it.
@@ -64,18 +64,18 @@ class MetricsListener:
         # (kind, process, activity) -> the (metric name, role, keep the last start) of the
         # selectors it matches, in their order: found once per distinct event, so ``raw``
         # does not test every selector of the kind at every event
-        self._matching: dict[tuple[str, str | None, str | None],
+        self.matching: dict[tuple[str, str | None, str | None],
                              tuple[tuple[str, int, bool], ...]] = {}
         selects: set[tuple[str, str | None, str | None]] = set()
         for metric in self.definitions:
             if metric.kind is MetricKind.COUNT and metric.select is not None:
                 self.counts[metric.name] = 0
-                self._add(metric, metric.select, _COUNT, selects)
+                self._add(metric, metric.select, COUNT, selects)
             elif metric.kind is MetricKind.DURATION and metric.start and metric.end:
                 self.samples[metric.name] = []
-                self._open[metric.name] = {}
-                self._add(metric, metric.start, _START, selects)
-                self._add(metric, metric.end, _END, selects)
+                self.opened[metric.name] = {}
+                self._add(metric, metric.start, START, selects)
+                self._add(metric, metric.end, END, selects)
         self.selects = frozenset(selects)
 
     def _add(self, metric: MetricDefinition, selector: EventSelector, role: int,
@@ -91,21 +91,23 @@ class MetricsListener:
     def raw(self, time: float, kind: str, process: str | None, instance: int | None,
             activity: str | None, data: Mapping[str, Any] | None = None) -> None:
         """The same as calling with a TraceEvent, without building one (the engine uses
-        this when no other listener needs the event object)."""
+        this when no other listener needs the event object). ``RunState.emit`` takes these
+        steps in line for a run's own metrics (a plain MetricsListener, its one raw
+        listener): a change here is a change there."""
         key = (kind, process, activity)
         try:                        # (one lookup, so the key tuple is hashed once)
-            chosen = self._matching[key]
+            chosen = self.matching[key]
         except KeyError:
-            chosen = self._matching[key] = self._match(kind, process, activity)
+            chosen = self.matching[key] = self.match(kind, process, activity)
         for name, role, last in chosen:
-            if role == _COUNT:
+            if role == COUNT:
                 self.counts[name] += 1
                 if self.keep_times:
                     self.count_times.setdefault(name, []).append(time)
                 continue
             which = instance or 0
-            pending = self._open[name]
-            if role == _START:
+            pending = self.opened[name]
+            if role == START:
                 if last or which not in pending:
                     pending[which] = time
             elif which in pending:
@@ -115,7 +117,7 @@ class MetricsListener:
                 if self.keep_times:
                     self.sample_times.setdefault(name, []).append(time)
 
-    def _match(self, kind: str, process: str | None, activity: str | None
+    def match(self, kind: str, process: str | None, activity: str | None
                ) -> tuple[tuple[str, int, bool], ...]:
         """The selectors of ``kind`` an event of ``process`` / ``activity`` matches."""
         return tuple((name, role, last)

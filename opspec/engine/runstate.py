@@ -34,7 +34,13 @@ from opspec.engine.compiled import (
 from opspec.engine.config import EngineConfig
 from opspec.engine.instances import ActivityInstance, Frame, ProcessInstance
 from opspec.engine.lifecycle import RUNNING, SUSPENDED
-from opspec.engine.listener_tables import flag_key, listener_tables, metrics_only
+from opspec.engine.listener_tables import (
+    flag_key,
+    listener_tables,
+    metrics_only,
+    own_metrics,
+)
+from opspec.engine.metrics import COUNT, START
 from opspec.engine.performers import Performer
 from opspec.engine.processors import DedicatedProcessor, PooledProcessor
 from opspec.engine.random import Streams
@@ -86,8 +92,7 @@ class RunState(Timers):
         self.draining = False
         self.pending: dict[Frame, None] = {}
         # the last workflow instance id (Flow.start_process counts on) and the last key of an
-        # activity instance or a wait (next_key): native fields, where an itertools.count's
-        # ``__next__`` was a call through Python's protocol from compiled code (~230 instr.)
+        # activity instance or a wait (next_key): native fields, not an itertools.count
         self.last_id = 0
         self.last_key = 0
         self.live: dict[int, ProcessInstance] = {}
@@ -142,7 +147,8 @@ class RunState(Timers):
         (self.listeners, self.raw, self.wants_all, self.selectors, self.wanted,
          self.full) = listener_tables(listeners, compiled)
         self.raw_metrics = metrics_only(self.raw)
-        # which selection the wanted-kind bits cached on activities and processes are of
+        self.one_metric = own_metrics(self.raw_metrics)     # (emit takes its steps in line)
+        # (which selection the bits cached on activities and processes are of)
         self.flag_key = flag_key(self.wants_all, self.wanted)
 
     def idle(self) -> bool:
@@ -202,10 +208,36 @@ class RunState(Timers):
         """Send one trace event to every listener (callers check :meth:`wants` first)."""
         self.seq += 1
         now = self.now
-        metrics = self.raw_metrics
-        if metrics is not None:
-            for metric in metrics:
-                metric.raw(now, kind, process, instance, activity, data)
+        metric = self.one_metric
+        if metric is not None:
+            # MetricsListener.raw in line (the run's own metrics, as a rule its one raw
+            # listener: five events a dose cycle, a Python frame each from source)
+            key = (kind, process, activity)
+            matching = metric.matching
+            try:                    # (one lookup, so the key tuple is hashed once)
+                chosen = matching[key]
+            except KeyError:
+                chosen = matching[key] = metric.match(kind, process, activity)
+            for name, role, last in chosen:
+                if role == COUNT:
+                    metric.counts[name] += 1
+                    if metric.keep_times:
+                        metric.count_times.setdefault(name, []).append(now)
+                    continue
+                which = instance or 0
+                pending = metric.opened[name]
+                if role == START:
+                    if last or which not in pending:
+                        pending[which] = now
+                elif which in pending:
+                    started = pending[which]
+                    del pending[which]
+                    metric.samples[name].append(now - started)
+                    if metric.keep_times:
+                        metric.sample_times.setdefault(name, []).append(now)
+        elif self.raw_metrics is not None:
+            for each in self.raw_metrics:
+                each.raw(now, kind, process, instance, activity, data)
         else:
             for raw in self.raw:
                 raw(now, kind, process, instance, activity, data)
