@@ -12,14 +12,18 @@ The output shape is shared with ``opspec evaluate --json``.
 
 from __future__ import annotations
 
-from collections.abc import Iterable, Mapping
-from typing import Any, Final
+from collections.abc import Callable, Iterable, Mapping
+from typing import TYPE_CHECKING, Any, Final
 
-from opspec.engine.trace import TraceEvent
+from opspec.engine.trace import TraceEvent, TraceListener
 from opspec.model import EventSelector, MetricDefinition, MetricKind
 from opspec.statistics.percentiles import linear
 
-__all__ = ["MetricsListener", "percentile", "summarise_durations"]
+if TYPE_CHECKING:
+    from opspec.engine.compiled import CompiledPackage
+
+__all__ = ["MetricsListener", "flag_key", "listener_tables", "metrics_only", "own_metrics",
+           "percentile", "summarise_durations"]
 
 # What a selector is to its metric (Final: mypyc inlines them).
 COUNT: Final = 0
@@ -150,3 +154,74 @@ def _scalar(value: dict[str, Any] | None) -> float | None:
         return float(value["total"])
     result = value["mean"] if value["kind"] == "duration" else value.get("value")
     return None if result is None else float(result)
+
+
+# Who hears which trace events of a run: the tables RunState makes once per run from its
+# listeners (here, compiled beside the metrics listener they single out; none of this runs
+# per event).
+
+_FLAG_KEYS: dict[tuple[bool, frozenset[Any]], object] = {}
+
+
+def flag_key(wants_all: bool, wanted: frozenset[Any]) -> object:
+    """One object per distinct listener selection: runs that select the same events share
+    the bits cached on a compiled package's activities (households run one after another
+    on one package)."""
+    key = (wants_all, wanted)
+    found = _FLAG_KEYS.get(key)
+    if found is None:
+        if len(_FLAG_KEYS) > 1000:           # a long-lived process with many selections
+            _FLAG_KEYS.clear()
+        found = _FLAG_KEYS[key] = object()
+    return found
+
+
+def metrics_only(raw: list[Callable[..., None]]) -> list[MetricsListener] | None:
+    """The raw listeners when they are all metrics listeners' (a run's own, as a rule): the
+    compiled engine then calls them as native methods, not through Python's protocol."""
+    metrics = [getattr(listener, "__self__", None) for listener in raw]
+    chosen = [m for m in metrics if isinstance(m, MetricsListener)]
+    if len(chosen) != len(raw) or any(m.raw != r for m, r in zip(chosen, raw)):
+        return None
+    return chosen
+
+
+def own_metrics(raw_metrics: list[MetricsListener] | None) -> MetricsListener | None:
+    """The one raw listener when it is a run's own metrics (a plain MetricsListener, whose
+    steps ``RunState.emit`` takes in line), else None."""
+    if raw_metrics is not None and len(raw_metrics) == 1:
+        only = raw_metrics[0]
+        if type(only) is MetricsListener:
+            return only
+    return None
+
+
+_Selector = tuple[str, str | None, str | None]      # (kind, process, activity)
+
+
+def listener_tables(listeners: list[TraceListener], compiled: CompiledPackage) -> tuple[
+        list[TraceListener], list[Callable[..., None]], bool,
+        frozenset[_Selector], frozenset[_Selector],
+        list[tuple[TraceListener, frozenset[_Selector] | None]]]:
+    """Who hears what: the full listeners (a ``raw`` method gets the fields without a
+    TraceEvent object), whether any wants everything, and the (kind, process, activity)
+    selectors the others asked for, expanded over the compiled package."""
+    full_listeners = [lst for lst in listeners if getattr(lst, "raw", None) is None]
+    raw = [lst.raw for lst in listeners  # type: ignore[attr-defined]
+           if getattr(lst, "raw", None) is not None]
+    wants_all = False
+    selectors: set[_Selector] = set()
+    for listener in listeners:
+        wanted = getattr(listener, "selects", None)
+        if wanted is None:
+            wants_all = True
+            break
+        selectors.update(wanted)
+    chosen = frozenset(selectors)
+    expanded = (frozenset() if wants_all or not selectors
+                else compiled.expand_selectors(chosen))
+    # each full listener only receives what it selects (None: everything)
+    full = [(lst, None if getattr(lst, "selects", None) is None
+             else compiled.expand_selectors(frozenset(lst.selects)))  # type: ignore[attr-defined]
+            for lst in full_listeners]
+    return full_listeners, raw, wants_all, chosen, expanded, full

@@ -34,13 +34,14 @@ from opspec.engine.compiled import (
 from opspec.engine.config import EngineConfig
 from opspec.engine.instances import ActivityInstance, Frame, ProcessInstance
 from opspec.engine.lifecycle import RUNNING, SUSPENDED
-from opspec.engine.listener_tables import (
+from opspec.engine.metrics import (
+    COUNT,
+    START,
     flag_key,
     listener_tables,
     metrics_only,
     own_metrics,
 )
-from opspec.engine.metrics import COUNT, START
 from opspec.engine.performers import Performer
 from opspec.engine.processors import DedicatedProcessor, PooledProcessor
 from opspec.engine.random import Streams
