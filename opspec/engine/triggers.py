@@ -211,17 +211,24 @@ class Triggers(Part):
                            f"#{partner.id}) has ended")
             return
         if table:
-            for token, entry in list(table.items()):
+            # (no copy of the table: the loop ends at the first waiter handed the message)
+            for token, entry in table.items():
                 if entry[0].state == RUNNING:
                     self._hand(table, token, entry, data)
                     return
         kind, name = key
         started = False
-        for target, start in self.state.starts.get(key, ()):
-            if not self.state.compiled.modes or self.is_active(target.id):
-                child = self.flow.start_process(target, self._fields(target, data),
-                                                trigger=f"{kind}:{name}", start=start)
-                child.partner = _root(inst) if inst is not None else None
+        state = self.state
+        for target, start in state.starts.get(key, ()):
+            if not state.compiled.modes or self.is_active(target.id):
+                child = self.flow.start_process(
+                    target, self._fields(target, data) if data else None,
+                    trigger=f"{kind}:{name}", start=start)
+                root = inst                 # the sender's root instance
+                if root is not None:
+                    while root.parent is not None:
+                        root = root.parent.frame.inst
+                child.partner = root
                 started = True
         if started:
             return
@@ -567,9 +574,3 @@ class _Timer(Timed):
 
     def __call__(self, _event: Any) -> None:
         self.triggers.state.go_now(self)
-
-
-def _root(inst: ProcessInstance) -> ProcessInstance:
-    while inst.parent is not None:
-        inst = inst.parent.frame.inst
-    return inst
