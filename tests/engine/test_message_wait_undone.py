@@ -6,8 +6,8 @@ interrupted wait is not handed to it: it starts the workflow it starts, or it is
 from __future__ import annotations
 
 from builders import act, catch, deadline, pkg, proc
-from conftest import completed, events
 
+from conftest import completed, events
 from opspec.engine.compiled import compile_package
 from opspec.engine.simulation import Simulation
 
