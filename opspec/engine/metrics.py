@@ -12,19 +12,23 @@ The output shape is shared with ``opspec evaluate --json``.
 
 from __future__ import annotations
 
-from collections.abc import Iterable, Mapping
-from typing import Any, Final
+from collections.abc import Callable, Iterable, Mapping
+from typing import TYPE_CHECKING, Any, Final
 
-from opspec.engine.trace import TraceEvent
+from opspec.engine.trace import TraceEvent, TraceListener
 from opspec.model import EventSelector, MetricDefinition, MetricKind
 from opspec.statistics.percentiles import linear
 
-__all__ = ["MetricsListener", "percentile", "summarise_durations"]
+if TYPE_CHECKING:
+    from opspec.engine.compiled import CompiledPackage
+
+__all__ = ["MetricsListener", "flag_key", "listener_tables", "metrics_only", "own_metrics",
+           "percentile", "summarise_durations"]
 
 # What a selector is to its metric (Final: mypyc inlines them).
-_COUNT: Final = 0
-_START: Final = 1
-_END: Final = 2
+COUNT: Final = 0
+START: Final = 1
+END: Final = 2
 
 
 def percentile(values: list[float], q: float) -> float:
@@ -51,7 +55,7 @@ class MetricsListener:
         self.definitions = tuple(definitions)
         self.counts: dict[str, int] = {}
         self.samples: dict[str, list[float]] = {}
-        self._open: dict[str, dict[int, float]] = {}
+        self.opened: dict[str, dict[int, float]] = {}
         # When ``keep_times`` is set (evaluation runs), the simulated time of every counted
         # event and of the end of every duration sample is kept too, for outcomes over days
         # and time of day; plain runs don't pay for it.
@@ -64,18 +68,18 @@ class MetricsListener:
         # (kind, process, activity) -> the (metric name, role, keep the last start) of the
         # selectors it matches, in their order: found once per distinct event, so ``raw``
         # does not test every selector of the kind at every event
-        self._matching: dict[tuple[str, str | None, str | None],
+        self.matching: dict[tuple[str, str | None, str | None],
                              tuple[tuple[str, int, bool], ...]] = {}
         selects: set[tuple[str, str | None, str | None]] = set()
         for metric in self.definitions:
             if metric.kind is MetricKind.COUNT and metric.select is not None:
                 self.counts[metric.name] = 0
-                self._add(metric, metric.select, _COUNT, selects)
+                self._add(metric, metric.select, COUNT, selects)
             elif metric.kind is MetricKind.DURATION and metric.start and metric.end:
                 self.samples[metric.name] = []
-                self._open[metric.name] = {}
-                self._add(metric, metric.start, _START, selects)
-                self._add(metric, metric.end, _END, selects)
+                self.opened[metric.name] = {}
+                self._add(metric, metric.start, START, selects)
+                self._add(metric, metric.end, END, selects)
         self.selects = frozenset(selects)
 
     def _add(self, metric: MetricDefinition, selector: EventSelector, role: int,
@@ -91,21 +95,23 @@ class MetricsListener:
     def raw(self, time: float, kind: str, process: str | None, instance: int | None,
             activity: str | None, data: Mapping[str, Any] | None = None) -> None:
         """The same as calling with a TraceEvent, without building one (the engine uses
-        this when no other listener needs the event object)."""
+        this when no other listener needs the event object). ``RunState.emit`` takes these
+        steps in line for a run's own metrics (a plain MetricsListener, its one raw
+        listener): a change here is a change there."""
         key = (kind, process, activity)
         try:                        # (one lookup, so the key tuple is hashed once)
-            chosen = self._matching[key]
+            chosen = self.matching[key]
         except KeyError:
-            chosen = self._matching[key] = self._match(kind, process, activity)
+            chosen = self.matching[key] = self.match(kind, process, activity)
         for name, role, last in chosen:
-            if role == _COUNT:
+            if role == COUNT:
                 self.counts[name] += 1
                 if self.keep_times:
                     self.count_times.setdefault(name, []).append(time)
                 continue
             which = instance or 0
-            pending = self._open[name]
-            if role == _START:
+            pending = self.opened[name]
+            if role == START:
                 if last or which not in pending:
                     pending[which] = time
             elif which in pending:
@@ -115,7 +121,7 @@ class MetricsListener:
                 if self.keep_times:
                     self.sample_times.setdefault(name, []).append(time)
 
-    def _match(self, kind: str, process: str | None, activity: str | None
+    def match(self, kind: str, process: str | None, activity: str | None
                ) -> tuple[tuple[str, int, bool], ...]:
         """The selectors of ``kind`` an event of ``process`` / ``activity`` matches."""
         return tuple((name, role, last)
@@ -148,3 +154,74 @@ def _scalar(value: dict[str, Any] | None) -> float | None:
         return float(value["total"])
     result = value["mean"] if value["kind"] == "duration" else value.get("value")
     return None if result is None else float(result)
+
+
+# Who hears which trace events of a run: the tables RunState makes once per run from its
+# listeners (here, compiled beside the metrics listener they single out; none of this runs
+# per event).
+
+_FLAG_KEYS: dict[tuple[bool, frozenset[Any]], object] = {}
+
+
+def flag_key(wants_all: bool, wanted: frozenset[Any]) -> object:
+    """One object per distinct listener selection: runs that select the same events share
+    the bits cached on a compiled package's activities (households run one after another
+    on one package)."""
+    key = (wants_all, wanted)
+    found = _FLAG_KEYS.get(key)
+    if found is None:
+        if len(_FLAG_KEYS) > 1000:           # a long-lived process with many selections
+            _FLAG_KEYS.clear()
+        found = _FLAG_KEYS[key] = object()
+    return found
+
+
+def metrics_only(raw: list[Callable[..., None]]) -> list[MetricsListener] | None:
+    """The raw listeners when they are all metrics listeners' (a run's own, as a rule): the
+    compiled engine then calls them as native methods, not through Python's protocol."""
+    metrics = [getattr(listener, "__self__", None) for listener in raw]
+    chosen = [m for m in metrics if isinstance(m, MetricsListener)]
+    if len(chosen) != len(raw) or any(m.raw != r for m, r in zip(chosen, raw)):
+        return None
+    return chosen
+
+
+def own_metrics(raw_metrics: list[MetricsListener] | None) -> MetricsListener | None:
+    """The one raw listener when it is a run's own metrics (a plain MetricsListener, whose
+    steps ``RunState.emit`` takes in line), else None."""
+    if raw_metrics is not None and len(raw_metrics) == 1:
+        only = raw_metrics[0]
+        if type(only) is MetricsListener:
+            return only
+    return None
+
+
+_Selector = tuple[str, str | None, str | None]      # (kind, process, activity)
+
+
+def listener_tables(listeners: list[TraceListener], compiled: CompiledPackage) -> tuple[
+        list[TraceListener], list[Callable[..., None]], bool,
+        frozenset[_Selector], frozenset[_Selector],
+        list[tuple[TraceListener, frozenset[_Selector] | None]]]:
+    """Who hears what: the full listeners (a ``raw`` method gets the fields without a
+    TraceEvent object), whether any wants everything, and the (kind, process, activity)
+    selectors the others asked for, expanded over the compiled package."""
+    full_listeners = [lst for lst in listeners if getattr(lst, "raw", None) is None]
+    raw = [lst.raw for lst in listeners  # type: ignore[attr-defined]
+           if getattr(lst, "raw", None) is not None]
+    wants_all = False
+    selectors: set[_Selector] = set()
+    for listener in listeners:
+        wanted = getattr(listener, "selects", None)
+        if wanted is None:
+            wants_all = True
+            break
+        selectors.update(wanted)
+    chosen = frozenset(selectors)
+    expanded = (frozenset() if wants_all or not selectors
+                else compiled.expand_selectors(chosen))
+    # each full listener only receives what it selects (None: everything)
+    full = [(lst, None if getattr(lst, "selects", None) is None
+             else compiled.expand_selectors(frozenset(lst.selects)))  # type: ignore[attr-defined]
+            for lst in full_listeners]
+    return full_listeners, raw, wants_all, chosen, expanded, full

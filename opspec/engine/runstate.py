@@ -34,7 +34,14 @@ from opspec.engine.compiled import (
 from opspec.engine.config import EngineConfig
 from opspec.engine.instances import ActivityInstance, Frame, ProcessInstance
 from opspec.engine.lifecycle import RUNNING, SUSPENDED
-from opspec.engine.metrics import MetricsListener
+from opspec.engine.metrics import (
+    COUNT,
+    START,
+    flag_key,
+    listener_tables,
+    metrics_only,
+    own_metrics,
+)
 from opspec.engine.performers import Performer
 from opspec.engine.processors import DedicatedProcessor, PooledProcessor
 from opspec.engine.random import Streams
@@ -86,8 +93,7 @@ class RunState(Timers):
         self.draining = False
         self.pending: dict[Frame, None] = {}
         # the last workflow instance id (Flow.start_process counts on) and the last key of an
-        # activity instance or a wait (next_key): native fields, where an itertools.count's
-        # ``__next__`` was a call through Python's protocol from compiled code (~230 instr.)
+        # activity instance or a wait (next_key): native fields, not an itertools.count
         self.last_id = 0
         self.last_key = 0
         self.live: dict[int, ProcessInstance] = {}
@@ -140,10 +146,11 @@ class RunState(Timers):
         self.seq = 0
         self.pkg = compiled.id
         (self.listeners, self.raw, self.wants_all, self.selectors, self.wanted,
-         self.full) = _listener_tables(listeners, compiled)
-        self.raw_metrics = _metrics_only(self.raw)
-        # which selection the wanted-kind bits cached on activities and processes are of
-        self.flag_key = _flag_key(self.wants_all, self.wanted)
+         self.full) = listener_tables(listeners, compiled)
+        self.raw_metrics = metrics_only(self.raw)
+        self.one_metric = own_metrics(self.raw_metrics)     # (emit takes its steps in line)
+        # (which selection the bits cached on activities and processes are of)
+        self.flag_key = flag_key(self.wants_all, self.wanted)
 
     def idle(self) -> bool:
         """Whether a drain now would only count a step: nothing queued, no frame pending
@@ -194,7 +201,7 @@ class RunState(Timers):
 
     def reselect(self) -> None:
         """The listeners' selection changed (workflows loaded at run time)."""
-        self.flag_key = _flag_key(self.wants_all, self.wanted)
+        self.flag_key = flag_key(self.wants_all, self.wanted)
 
     def emit(self, kind: str, process: str | None = None, instance: int | None = None,
              activity: str | None = None, lane: str | None = None,
@@ -202,10 +209,36 @@ class RunState(Timers):
         """Send one trace event to every listener (callers check :meth:`wants` first)."""
         self.seq += 1
         now = self.now
-        metrics = self.raw_metrics
-        if metrics is not None:
-            for metric in metrics:
-                metric.raw(now, kind, process, instance, activity, data)
+        metric = self.one_metric
+        if metric is not None:
+            # MetricsListener.raw in line (the run's own metrics, as a rule its one raw
+            # listener: five events a dose cycle, a Python frame each from source)
+            key = (kind, process, activity)
+            matching = metric.matching
+            try:                    # (one lookup, so the key tuple is hashed once)
+                chosen = matching[key]
+            except KeyError:
+                chosen = matching[key] = metric.match(kind, process, activity)
+            for name, role, last in chosen:
+                if role == COUNT:
+                    metric.counts[name] += 1
+                    if metric.keep_times:
+                        metric.count_times.setdefault(name, []).append(now)
+                    continue
+                which = instance or 0
+                pending = metric.opened[name]
+                if role == START:
+                    if last or which not in pending:
+                        pending[which] = now
+                elif which in pending:
+                    started = pending[which]
+                    del pending[which]
+                    metric.samples[name].append(now - started)
+                    if metric.keep_times:
+                        metric.sample_times.setdefault(name, []).append(now)
+        elif self.raw_metrics is not None:
+            for each in self.raw_metrics:
+                each.raw(now, kind, process, instance, activity, data)
         else:
             for raw in self.raw:
                 raw(now, kind, process, instance, activity, data)
@@ -224,12 +257,10 @@ class RunState(Timers):
     def drain(self) -> None:
         """Run queued zero-time work until none is left (re-entrant calls just return).
 
-        Zero-time work at one simulated instant is counted across drains: each item run and
-        each drain (a clock event at this instant, so a storm of zero-delay wakeups that queue
-        nothing counts too); the count starts again when the clock has moved. Past
-        ``max_instant_steps`` the run stops with a
-        :class:`~opspec.errors.ZeroTimeCycleError` naming the activities that keep coming
-        back (:mod:`opspec.engine.zero_time`)."""
+        Each item run and each drain counts as a step of this simulated instant (a storm of
+        zero-delay wakeups that queue nothing counts too); past ``max_instant_steps`` the
+        run stops with a :class:`~opspec.errors.ZeroTimeCycleError` naming the activities
+        that keep coming back (:mod:`opspec.engine.zero_time`)."""
         if self.draining:
             return
         now = self.now
@@ -237,9 +268,7 @@ class RunState(Timers):
         if now != instant:
             # _same_instant in line (a Python frame per drain from source; the time is never
             # negative): a new instant starts its count at 0, a creep of no real time does not
-            moved = now - instant
-            if moved < 0.0:
-                moved = -moved
+            moved = now - instant if now > instant else instant - now
             if moved > 1e-9 * (now if now > 1.0 else 1.0):
                 self.instant = now
                 self.instant_steps = 0
@@ -247,9 +276,7 @@ class RunState(Timers):
                     self.sampler = None
                     self.start_limit = self.max_instant_steps
         ready = self.ready
-        if not ready and not self.pending:
-            # nothing queued (a deadline that fired after its instance ended, a timer whose
-            # callback queued nothing): the drain only counts as a step of this instant
+        if not ready and not self.pending:      # nothing queued: a step of this instant
             steps = self.instant_steps + 1
             if steps > self.max_instant_steps:
                 self.instant_steps = steps      # (as the finally below, if this raises)
@@ -260,6 +287,7 @@ class RunState(Timers):
         done = 0                    # the items of ``ready`` run so far
         steps = self.instant_steps + 1
         limit = self.max_instant_steps
+        base = steps                # (the step count is base + done while items run)
         flow = self.flow            # (the commonest items' native methods: see DIRECT)
         acts = flow.activities
         lone_q = flow.start_lone_q if DIRECT else None
@@ -268,22 +296,26 @@ class RunState(Timers):
             if steps > limit:
                 steps = self._past_limit(steps, None, None)
             while True:
-                # A list's iterator sees the items appended while it runs (from source, one
-                # FOR_ITER per item instead of a len() call and an index); it starts at the
-                # front, so what has run is dropped before it starts again.
+                # (a list's iterator sees what is appended meanwhile) ``check``: the first
+                # ``done`` at which the count passes the limit or the burst is long
+                base = steps
+                check = limit - base + 1 if limit - base < _COMPACT else _COMPACT + 1
                 for fn, a, b, c in ready:
                     done += 1
-                    steps += 1
-                    if steps > limit:
-                        steps = self._past_limit(steps, a, b)
-                    if fn is lone_q:
+                    if done >= check:
+                        if done > _COMPACT:     # a long burst: this item in the next pass
+                            done -= 1
+                            break
+                        base, check = self._past_check(base, done, a, b)
+                    if not DIRECT:
+                        fn(a, b, c)
+                    elif fn is lone_q:
                         flow.start_lone_at(a, b, c)
                     elif fn is done_q:
                         acts.body_done(a, b, c)
                     else:
                         fn(a, b, c)
-                    if done >= _COMPACT:        # a long burst: drop what has run
-                        break
+                steps = base + done
                 if done == len(ready):          # (compiled, a slice's delete boxes its
                     ready.clear()               # bounds into a slice object: 0.3k an instance)
                 else:
@@ -299,8 +331,17 @@ class RunState(Timers):
         finally:
             if done:                            # what ran before an exception
                 del ready[:done]
+                steps = base + done
             self.draining = False
             self.instant_steps = steps
+
+    def _past_check(self, base: int, done: int, a: Any, b: Any) -> tuple[int, int]:
+        """:meth:`drain`'s count passed the limit at its item ``done`` (``a``, ``b``): the
+        count's new base and the next ``done`` to look at (:meth:`_past_limit`)."""
+        steps = self._past_limit(base + done, a, b)
+        base = steps - done
+        limit = self.max_instant_steps
+        return base, (limit - base + 1 if limit - base < _COMPACT else _COMPACT + 1)
 
     def _past_limit(self, steps: int, a: Any, b: Any) -> int:
         """The step count passed the limit: a new count if the clock moved since the count
@@ -393,6 +434,20 @@ class RunState(Timers):
         self.schedule_timed(delay if delay > 0.0 else 0.0,  # noqa: FURB136
                            _CallAt(self, callback, True))
 
+    def call_at_with(self, delay: float, fn: Callable[[Any, Any, Any], None],
+                     a: Any, b: Any, c: Any) -> None:
+        """:meth:`call_at` for ``fn(a, b, c)``: the arguments kept beside the callback, not
+        in a ``functools.partial`` of it. A zero delay while draining queues the call itself
+        as a ready-queue item (no trampoline through ``_call``); otherwise its own timed
+        entry calls it, then drains. The session's ``call_later_with`` (the stochastic user's
+        answers from source: two or three a dose cycle go to the ready queue this way)."""
+        if delay <= 0.0 and self.draining:
+            self.ready.append((fn, a, b, c))
+            return
+        self.sim_events += 1
+        self.schedule_timed(delay if delay > 0.0 else 0.0,  # noqa: FURB136
+                           _CallWith(self, fn, a, b, c))
+
     def timer(self, delay: float, callback: Callable[[], None]) -> None:
         """Run ``callback`` after ``delay`` simulated seconds (it drains itself, if it
         must: the processors' and the start timers' callbacks)."""
@@ -458,22 +513,6 @@ _ACT_KINDS = (EK.ACTIVITY_STARTED, EK.ACTIVITY_COMPLETED, EK.ACTIVITY_OFFERED,
 _PROC_KINDS = (EK.PROCESS_STARTED, EK.PROCESS_COMPLETED)
 
 
-_FLAG_KEYS: dict[tuple[bool, frozenset[Any]], object] = {}
-
-
-def _flag_key(wants_all: bool, wanted: frozenset[Any]) -> object:
-    """One object per distinct listener selection: runs that select the same events share
-    the bits cached on a compiled package's activities (households run one after another
-    on one package)."""
-    key = (wants_all, wanted)
-    found = _FLAG_KEYS.get(key)
-    if found is None:
-        if len(_FLAG_KEYS) > 1000:           # a long-lived process with many selections
-            _FLAG_KEYS.clear()
-        found = _FLAG_KEYS[key] = object()
-    return found
-
-
 def _call(callback: Callable[[], None], _a: Any, _b: Any) -> None:
     callback()
 
@@ -517,53 +556,44 @@ class _CallAt(Timed):
     def go(self) -> None:
         self.callback()
         if self.drain:
-            self.state.drain()
+            state = self.state
+            if (state.ready or state.pending or state.draining or state.now != state.instant
+                    or state.instant_steps >= state.max_instant_steps):
+                state.drain()
+            else:                   # (drain's case of nothing queued at this instant)
+                state.instant_steps += 1
 
     def __call__(self, _event: Any) -> None:
         self.state.called(self.callback, self.drain)
 
 
-def _metrics_only(raw: list[Callable[..., None]]) -> list[MetricsListener] | None:
-    """The raw listeners when they are all metrics listeners' (a run's own, as a rule): the
-    compiled engine then calls them as native methods, not through Python's protocol."""
-    metrics = [getattr(listener, "__self__", None) for listener in raw]
-    chosen = [m for m in metrics if isinstance(m, MetricsListener)]
-    if len(chosen) != len(raw) or any(m.raw != r for m, r in zip(chosen, raw)):
-        return None
-    return chosen
+@final
+class _CallWith(Timed):
+    """The timed callback of :meth:`RunState.call_at_with`."""
+
+    def __init__(self, state: RunState, fn: Callable[[Any, Any, Any], None],
+                 a: Any, b: Any, c: Any) -> None:
+        self.state = state
+        self.fn = fn
+        self.a = a
+        self.b = b
+        self.c = c
+
+    def go(self) -> None:
+        self.fn(self.a, self.b, self.c)
+        state = self.state
+        # drain's case of nothing queued at this instant in line: a step counted (the
+        # callback, a performer's answer, has drained what it queued as a rule)
+        if (state.ready or state.pending or state.draining or state.now != state.instant
+                or state.instant_steps >= state.max_instant_steps):
+            state.drain()
+        else:
+            state.instant_steps += 1
+
+    def __call__(self, _event: Any) -> None:
+        self.state.go_now(self)
 
 
 def discard(table: dict[Any, Any], key: Any) -> None:
     """Remove ``key`` from ``table`` if it is there (an activity's cleanup)."""
     table.pop(key, None)
-
-
-_Selector = tuple[str, str | None, str | None]      # (kind, process, activity)
-
-
-def _listener_tables(listeners: list[TraceListener], compiled: CompiledPackage) -> tuple[
-        list[TraceListener], list[Callable[..., None]], bool,
-        frozenset[_Selector], frozenset[_Selector],
-        list[tuple[TraceListener, frozenset[_Selector] | None]]]:
-    """Who hears what: the full listeners (a ``raw`` method gets the fields without a
-    TraceEvent object), whether any wants everything, and the (kind, process, activity)
-    selectors the others asked for, expanded over the compiled package."""
-    full_listeners = [lst for lst in listeners if getattr(lst, "raw", None) is None]
-    raw = [lst.raw for lst in listeners  # type: ignore[attr-defined]
-           if getattr(lst, "raw", None) is not None]
-    wants_all = False
-    selectors: set[_Selector] = set()
-    for listener in listeners:
-        wanted = getattr(listener, "selects", None)
-        if wanted is None:
-            wants_all = True
-            break
-        selectors.update(wanted)
-    chosen = frozenset(selectors)
-    expanded = (frozenset() if wants_all or not selectors
-                else compiled.expand_selectors(chosen))
-    # each full listener only receives what it selects (None: everything)
-    full = [(lst, None if getattr(lst, "selects", None) is None
-             else compiled.expand_selectors(frozenset(lst.selects)))  # type: ignore[attr-defined]
-            for lst in full_listeners]
-    return full_listeners, raw, wants_all, chosen, expanded, full

@@ -88,7 +88,7 @@ class RunResult:
 class _Session:
     """The :class:`~opspec.engine.performers.PerformerSession` of one simulation."""
 
-    __slots__ = ("_sim", "call_later", "complete")
+    __slots__ = ("_sim", "call_later", "call_later_with", "complete")
 
     def __init__(self, sim: Simulation) -> None:
         self._sim = sim
@@ -100,6 +100,10 @@ class _Session:
         # RunState.call_at.
         self.complete: Callable[..., None] = sim.offers.performer_complete
         self.call_later: Callable[..., None] = sim.call_at
+        # not part of the PerformerSession protocol: ``call_later(delay, partial(fn, a, b,
+        # c))`` without the partial (RunState.call_at_with), for a performer that looks for
+        # it (the stochastic user, from source)
+        self.call_later_with: Callable[..., None] = sim.call_at_with
 
     @property
     def now(self) -> float:

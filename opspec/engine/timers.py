@@ -44,15 +44,19 @@ from __future__ import annotations
 
 import math
 import types
+from collections.abc import Iterator
 from heapq import heappop, heappush
-from typing import Any, Final, final
+from typing import TYPE_CHECKING, Any, Final, final
 
 import simpy
 
 from opspec.engine.clock import Clock
 from opspec.engine.zero_time import SAMPLE_STEPS
 
-__all__ = ["Timed", "Timers", "exact_delay", "heap_pop", "heap_push"]
+if TYPE_CHECKING:
+    from opspec.engine.compiled import CTrigger
+
+__all__ = ["Timed", "Timers", "exact_delay", "heap_pop", "heap_push", "occurrences"]
 
 INF: Final = math.inf
 #: The run's entries are kept as a line (:func:`line_push`) up to this many, then as a
@@ -185,10 +189,15 @@ class Timers:
         if not self.inside:
             self.now = float(self.env.now)
         at = self.now + delay
-        self.order += 1
+        seq = self.order + 1
+        self.order = seq
         entry.at = at
-        entry.seq = self.order
-        self._push(entry)
+        entry.seq = seq
+        if TUPLES:      # (_push's case from source in line: a Python frame less an entry)
+            rows: list[Any] = self.heap
+            heappush(rows, (at, seq, entry))
+        else:
+            self._push(entry)
         if at < self.armed_at and not self.ticking:
             self.arm()
 
@@ -530,3 +539,39 @@ def heap_pop(heap: list[Timed]) -> Timed:
             break
     heap[pos] = last
     return first
+
+
+#: seconds in a day: a timer at times of day without a period repeats daily
+DAY: Final = 86_400.0
+
+
+def occurrences(trig: CTrigger, now: float) -> Iterator[float]:
+    """Absolute firing times (>= ``now``) of a timer or period trigger."""
+    if trig.kind == "period":
+        # firings offset, offset + every, ...: ``count`` of them (-1: no end); armed later
+        # than some of them (a mode change), the past ones are skipped and still counted
+        every = trig.every or 0.0
+        if every <= 0:
+            yield max(now, trig.offset)
+            return
+        k = max(0, math.ceil((now - trig.offset) / every))
+        while trig.count < 0 or k < trig.count:
+            yield trig.offset + k * every
+            k += 1
+        return
+    if not trig.at:
+        if trig.every:
+            k = 1
+            while True:
+                yield trig.offset + k * trig.every
+                k += 1
+        yield now + trig.offset
+        return
+    every = trig.every or DAY
+    cycle = max(0, math.floor((now - trig.offset) / every))
+    while True:
+        for at in trig.at:
+            t = cycle * every + at + trig.offset
+            if t >= now:
+                yield t
+        cycle += 1

@@ -14,6 +14,7 @@ import dataclasses
 import math
 from collections import deque
 from collections.abc import Callable, Iterable, Iterator, Mapping
+from functools import partial
 from typing import Any, final
 
 from opspec.engine.compiled import (
@@ -30,13 +31,12 @@ from opspec.engine.lifecycle import (
 )
 from opspec.engine.part import Part
 from opspec.engine.runstate import discard
-from opspec.engine.timers import Timed
+from opspec.engine.timers import TUPLES, Timed, occurrences
 from opspec.engine.trace import EventKind as EK
 from opspec.errors import OpspecError
 
 #: Messages of one name kept with nobody waiting (per receiving instance, or for anyone).
 MESSAGE_BUFFER = 100
-DAY = 86_400.0
 
 
 class Triggers(Part):
@@ -58,12 +58,20 @@ class Triggers(Part):
                 if kept is not None:                # it came before we waited: caught now
                     handler(ai, arg, kept[0])
                     return
-            table = self.state.waiters.get(key)
+            state = self.state
+            table = state.waiters.get(key)
             if table is None:
-                table = self.state.waiters[key] = {}
-            token = self.state.next_key()
+                table = state.waiters[key] = {}
+            state.last_key += 1                 # (RunState.next_key in line)
+            token = state.last_key
             table[token] = (ai, handler, (arg, persistent, key, token))
-            ai.on_leave(lambda: discard(table, token))
+            # its undoing (ActivityInstance.on_leave in line): from source made and called in C
+            undo: Callable[[], Any] = (partial(table.pop, token, None) if TUPLES
+                                       else lambda: discard(table, token))
+            if ai.cleanup is None:
+                ai.cleanup = [undo]
+            else:
+                ai.cleanup.append(undo)
         elif kind in ("timer", "period"):
             inst = ai.frame.inst
             every = trig.every or 0.0
@@ -203,17 +211,24 @@ class Triggers(Part):
                            f"#{partner.id}) has ended")
             return
         if table:
-            for token, entry in list(table.items()):
+            # (no copy of the table: the loop ends at the first waiter handed the message)
+            for token, entry in table.items():
                 if entry[0].state == RUNNING:
                     self._hand(table, token, entry, data)
                     return
         kind, name = key
         started = False
-        for target, start in self.state.starts.get(key, ()):
-            if not self.state.compiled.modes or self.is_active(target.id):
-                child = self.flow.start_process(target, self._fields(target, data),
-                                                trigger=f"{kind}:{name}", start=start)
-                child.partner = _root(inst) if inst is not None else None
+        state = self.state
+        for target, start in state.starts.get(key, ()):
+            if not state.compiled.modes or self.is_active(target.id):
+                child = self.flow.start_process(
+                    target, self._fields(target, data) if data else None,
+                    trigger=f"{kind}:{name}", start=start)
+                root = inst                 # the sender's root instance
+                if root is not None:
+                    while root.parent is not None:
+                        root = root.parent.frame.inst
+                child.partner = root
                 started = True
         if started:
             return
@@ -492,7 +507,7 @@ class _Timer(Timed):
     workflow, or calls ``fire(label)``), drains the work that queued and arms itself for the
     next time. One object for all the firings of a workflow, and itself the run's timed
     callback (what ``RunState.timer`` does: counted in ``sim_events``, no ``_CallAt``); a
-    period's times are counted here (``_occurrences``' arithmetic) instead of resuming a
+    period's times are counted here (``timers.occurrences``' arithmetic) instead of resuming a
     generator, and a start is a direct call, not one through a closure: a robot spec's
     5 Hz workflows fire 18,000 times an hour each (docs/engine-performance.md)."""
 
@@ -511,9 +526,9 @@ class _Timer(Timed):
             self.proc, self.start = starts
         now = triggers.state.now
         every = trig.every or 0.0
-        # a period with no end or ``count`` firings at offset + k * every (_occurrences)
+        # a period with no end or ``count`` firings at offset + k * every (timers.occurrences)
         self.periodic = trig.kind == "period" and every > 0
-        self.times: Iterator[float] | None = None if self.periodic else _occurrences(trig, now)
+        self.times: Iterator[float] | None = None if self.periodic else occurrences(trig, now)
         self.offset = trig.offset
         self.every = every
         self.count = trig.count
@@ -559,41 +574,3 @@ class _Timer(Timed):
 
     def __call__(self, _event: Any) -> None:
         self.triggers.state.go_now(self)
-
-
-def _root(inst: ProcessInstance) -> ProcessInstance:
-    while inst.parent is not None:
-        inst = inst.parent.frame.inst
-    return inst
-
-
-def _occurrences(trig: CTrigger, now: float) -> Iterator[float]:
-    """Absolute firing times (>= ``now``) of a timer or period trigger."""
-    if trig.kind == "period":
-        # firings offset, offset + every, ...: ``count`` of them (-1: no end); armed later
-        # than some of them (a mode change), the past ones are skipped and still counted
-        every = trig.every or 0.0
-        if every <= 0:
-            yield max(now, trig.offset)
-            return
-        k = max(0, math.ceil((now - trig.offset) / every))
-        while trig.count < 0 or k < trig.count:
-            yield trig.offset + k * every
-            k += 1
-        return
-    if not trig.at:
-        if trig.every:
-            k = 1
-            while True:
-                yield trig.offset + k * trig.every
-                k += 1
-        yield now + trig.offset
-        return
-    every = trig.every or DAY
-    cycle = max(0, math.floor((now - trig.offset) / every))
-    while True:
-        for at in trig.at:
-            t = cycle * every + at + trig.offset
-            if t >= now:
-                yield t
-        cycle += 1

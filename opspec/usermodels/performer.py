@@ -84,6 +84,7 @@ class StochasticUser:
         self._plans: dict[str, _Plan] = {}
         self._alternatives: dict[str, ActivityModel | None] = {}
         self._handover: dict[int, int] = {}      # lane -> key of its last completed item
+        self._call_with: Callable[..., None] | None = None     # (see attach)
         #: per activity of the lane, ``[offered, completed, omitted, wrong]`` (``opspec
         #: evaluate``'s activity rows): when set, this user adds its omissions (column 2)
         #: and wrong actions (column 3: wrong choices and slips) to it as it decides them, so
@@ -107,6 +108,11 @@ class StochasticUser:
 
     def attach(self, session: PerformerSession) -> None:
         self._session = session
+        # From source, a session that has it (the engine's) takes the callback's arguments
+        # beside it: ``call_later_with(delay, fn, a, b, c)``, no partial made and called
+        # per work item, and an answer at once is queued as the call itself
+        self._call_with = (getattr(session, "call_later_with", None) if _FROM_SOURCE
+                           else None)
 
     def offer(self, item: WorkItem) -> None:
         session = self._session
@@ -213,7 +219,10 @@ class StochasticUser:
                  + (duration if duration > 0.0 else 0.0))  # noqa: FURB136
         if not total > 0.0:
             total = 0.0
-        if _FROM_SOURCE:
+        call_with = self._call_with
+        if call_with is not None:
+            call_with(total, self._finish, item, lane, choice)
+        elif _FROM_SOURCE:
             session.call_later(total, partial(self._finish, item, lane, choice))
         else:
             session.call_later(total, _Finish(self, item, lane, choice))
@@ -314,12 +323,15 @@ class StochasticUser:
             # release if it ended (nothing offered when this zero-delay check runs). An
             # engine that routes in several zero-delay steps may release and re-engage at
             # the same instant, which no prompt can fall into except at that exact time.
-            if _FROM_SOURCE:
+            call_with = self._call_with
+            if call_with is not None:
+                call_with(0.0, self._end_handover, lane, item.key, None)
+            elif _FROM_SOURCE:
                 session.call_later(0.0, partial(self._end_handover, lane, item.key))
             else:
                 session.call_later(0.0, _EndHandover(self, lane, item.key))
 
-    def _end_handover(self, lane: int, key: int) -> None:
+    def _end_handover(self, lane: int, key: int, _unused: Any = None) -> None:
         if self._handover.get(lane) == key:
             del self._handover[lane]
             # (a loop, not any() over a generator of _lane_of calls: from source each is a
