@@ -299,7 +299,8 @@ def parse_user_model(doc: Mapping[str, Any], path: str = "<toml>", *,
     name = _string(ctx, doc.get("name", Path(path).stem.removesuffix(".users")), "name")
     if "operators" in doc:
         ctx.operators = _operators(ctx, doc["operators"])
-    if base is None and "extends" in doc:
+    extended = base is None and "extends" in doc
+    if extended:
         base = load_named(ctx, _string(ctx, doc["extends"], "extends"), path)
     activities: dict[str, ActivityModel] = dict(base.activities) if base else {}
     raw_activities = doc.get("activities", {})
@@ -313,8 +314,14 @@ def parse_user_model(doc: Mapping[str, Any], path: str = "<toml>", *,
     busy = _busy(ctx, doc["busy"]) if "busy" in doc else (base.busy if base else None)
     routine = _routine(ctx, doc["routine"]) if "routine" in doc else (
         base.routine if base else Routine())
+    # a file that extends another and names itself is called so (a population extending
+    # its reference user); composed on a base (SPEC.users.toml,older-adults), or unnamed,
+    # it is its base with what it changes
+    called = name
+    if base is not None and not (extended and "name" in doc):
+        called = f"{base.name}+{name}" if raw_activities else base.name
     model = UserModel(
-        name=name if base is None else (f"{base.name}+{name}" if raw_activities else base.name),
+        name=called,
         activities=activities, default=default, busy=busy, routine=routine,
         modifiers=base.modifiers if base else (),
         description=_string(ctx, doc.get("description", ""), "description"),

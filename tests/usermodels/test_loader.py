@@ -172,6 +172,21 @@ def test_a_file_can_extend_a_preset_and_override_an_activity(tmp_path: Path) -> 
     assert model.activities["walk_to_dispenser"].duration.sigma == 0.6
 
 
+def test_a_file_that_extends_another_and_names_itself_is_called_so(tmp_path: Path) -> None:
+    # the bundled population extends the reference user: its report said "User model
+    # medication-dispenser-user (…population.toml)", not the name the file gives
+    shipped = Path(__file__).resolve().parents[2] / "specs"
+    assert load_user_model(shipped / "medication_dispenser.population.toml").name == (
+        "dispenser-population")
+    named = write(tmp_path, 'name = "careful"\nextends = "dispenser-reference"\n'
+                  '[activities.take_pill]\nduration = 5\n')
+    assert load_user_model(named).name == "careful"
+    # unnamed, it is its base with what it changes; composed with a comma, the same
+    unnamed = write(tmp_path, 'extends = "dispenser-reference"\n[activities.take_pill]\n'
+                    'duration = 5\n', "faster.users.toml")
+    assert load_user_model(unnamed).name == "dispenser-reference+faster"
+
+
 def test_klm_operators_add_up() -> None:
     model = load_user_model("klm")
     assert model.activity("press_report").duration.mean == pytest.approx(1.35 + 0.28)
