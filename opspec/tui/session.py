@@ -173,8 +173,11 @@ class WalkSession(SessionClock, PersonLane, TraceFollower, Recording):
             stopped = not self.ended and self.failure is None
             end = self.now if stopped else None if (
                 self.horizon == run_length(self.compiled)) else self.horizon
+            # opspec fit reads the user lane's activities: a spec without one leaves it
+            # nothing to fit ("no activity of lane 'user'")
+            trace = "Trace (for opspec fit)" if self.has_user_lane else "Trace"
             lines += ["", f"Recording: {self.record_path}",
-                      f"Trace (for opspec fit): {self.record_path.with_suffix('.trace.jsonl')}"
+                      f"{trace}: {self.record_path.with_suffix('.trace.jsonl')}"
                       + (f" (person {self.person})" if self.person is not None else "")]
             if end is not None and end <= 0:
                 # quit before the clock first moved: no run ends at 0 s (--until refuses
