@@ -34,7 +34,7 @@ from textual.widgets import Digits, Footer, Static
 
 from opspec.engine.lane_labels import lane_labels
 from opspec.tui.interrupt import watch_interrupts
-from opspec.tui.modals import HELP, HelpScreen, SummaryScreen, session_help
+from opspec.tui.modals import HELP, HelpScreen, SummaryScreen, help_screen
 from opspec.tui.pace import Pace
 from opspec.tui.session import WalkSession, clock, time_of_day_shown
 from opspec.tui.sound import Cue
@@ -381,7 +381,7 @@ class WalkthroughApp(App[str | None]):
             self.refresh_views()
 
     def action_help(self) -> None:
-        self._push_paused(HelpScreen(session_help(self.session, large=self.large)))
+        self._push_paused(help_screen(self.session, large=self.large))
 
     def action_summary(self) -> None:
         if not isinstance(self.screen, SummaryScreen):
