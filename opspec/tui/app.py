@@ -425,8 +425,8 @@ class WalkthroughApp(App[str | None]):
                  else "[waiting for the device]" if session.waiting_for_devices
                  else "skipping... (u: stop)" if session.skipping
                  else session.paused_words if session.paused else "running")
-        who = ("replaying the recording" if session.replaying
-               else "no user lane" if not session.has_user_lane
+        who = ("no user lane" if not session.has_user_lane      # (a replay of it performs none)
+               else "replaying the recording" if session.replaying
                else "model performs your lane" if session.handed_over
                else "you perform the lane")
         pace = self._pace.shown() if state == "running" else ""
@@ -500,10 +500,10 @@ class WalkthroughApp(App[str | None]):
             if session.record_path is None:
                 return "(the run has ended: q quits; nothing was recorded)"
             return "(the run has ended: q quits, the recording is kept)"
+        if not session.has_user_lane:          # (replayed too: there is no lane to perform)
+            return "(this spec has no user lane: watch the device; u skips to the end)"
         if session.replaying:
             return "(the recording performs your lane: watch, or press u / n to move on)"
-        if not session.has_user_lane:
-            return "(this spec has no user lane: watch the device; u skips to the end)"
         if session.handed_over or session.offers:
             return ""
         return "(nothing to do now: press u to skip until something needs you)"

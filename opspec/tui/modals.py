@@ -86,9 +86,11 @@ def help_text(*, replaying: bool = False, recording: bool = True, user_lane: boo
     paragraphs = []
     if replaying:
         paragraphs.append(
-            "This is a replay: the recording performs your lane, so nothing waits for "
-            "your answer. Watch it, pause it, change its speed or skip ahead (w, n, u); "
-            "it is never slowed down when the device calls, and it ends at "
+            "This is a replay: " + ("the recording performs your lane" if user_lane
+                                    else "this spec has no user lane")
+            + ", so nothing waits for your answer. Watch it, pause it, change its speed or "
+            "skip ahead (w, n, u); it is never slowed down when the device calls, and it "
+            "ends at "
             f"{ends_at or 'the end of its run'}.")
     elif not user_lane:
         paragraphs.append("This spec has no user lane: nothing waits for your answer; "
