@@ -9,8 +9,8 @@ from __future__ import annotations
 import shlex
 
 import pytest
-from conftest import SPEC
 
+from conftest import SPEC
 from opspec.cli import main
 from opspec.tui.app import WalkthroughApp
 from opspec.tui.session import WalkSession

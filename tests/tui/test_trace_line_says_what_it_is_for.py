@@ -8,8 +8,8 @@ from __future__ import annotations
 from pathlib import Path
 
 import pytest
-from conftest import SPEC
 
+from conftest import SPEC
 from opspec.engine.compiled import compile_package
 from opspec.tui.app import WalkthroughApp
 from opspec.tui.session import WalkSession
