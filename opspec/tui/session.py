@@ -182,7 +182,8 @@ class WalkSession(SessionClock, PersonLane, TraceFollower, Recording):
             if end is not None and end <= 0:
                 # quit before the clock first moved: no run ends at 0 s (--until refuses
                 # it), and a replay would have nothing of the session's to show
-                lines.append("Nothing to replay: the session stopped before its clock moved.")
+                lines.append("Nothing to replay: the session stopped before its clock moved."
+                             if final else "Nothing to replay yet: the clock has not moved.")
                 return lines
             walk, run = replay_commands(self.spec_path or "SPEC", self.record_path,
                                         until=end, seed=self.seed)

@@ -55,3 +55,11 @@ async def test_quit_a_moment_later_still_prints_commands_that_run(compiled, tmp_
     run = commands[1]
     assert run[run.index("--until") + 1] == "30.0"
     assert main(run[1:]) == 0
+
+
+def test_the_summary_so_far_at_0_s_does_not_say_the_session_stopped(compiled, tmp_path):
+    session = WalkSession(compiled, record=tmp_path / "so far.json", spec_path=str(SPEC))
+    lines = session.summary_lines(final=False)       # s, before the clock moved
+    session.close()
+    assert lines[-1] == "Nothing to replay yet: the clock has not moved."
+    assert not _commands(lines)
