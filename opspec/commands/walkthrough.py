@@ -134,6 +134,12 @@ def run(args: argparse.Namespace) -> int:
             # the replay ends where the session did (the person quit at 12:34: not the rest
             # of the day without them), as the recording's trace says
             until = recorded_end(args.replay)
+            if until == 0.0:
+                # (the run would go on to its end without the person: not the session)
+                raise ConfigurationError(
+                    f"--replay {args.replay}: the session was quit before its clock moved: "
+                    "there is nothing to replay",
+                    hint="--until T or --days D replays to then without the person")
     who = f"{_file_safe(args.person)}-" if args.person else ""
     record = None if args.no_record or args.replay else Path(
         args.record or Path("walkthroughs") / (

@@ -34,7 +34,7 @@ from textual.widgets import Digits, Footer, Static
 
 from opspec.engine.lane_labels import lane_labels
 from opspec.tui.interrupt import watch_interrupts
-from opspec.tui.modals import HELP, HelpScreen, SummaryScreen, session_help
+from opspec.tui.modals import HELP, HelpScreen, SummaryScreen, help_screen
 from opspec.tui.pace import Pace
 from opspec.tui.session import WalkSession, clock, time_of_day_shown
 from opspec.tui.sound import Cue
@@ -381,7 +381,7 @@ class WalkthroughApp(App[str | None]):
             self.refresh_views()
 
     def action_help(self) -> None:
-        self._push_paused(HelpScreen(session_help(self.session, large=self.large)))
+        self._push_paused(help_screen(self.session, large=self.large))
 
     def action_summary(self) -> None:
         if not isinstance(self.screen, SummaryScreen):
@@ -425,8 +425,8 @@ class WalkthroughApp(App[str | None]):
                  else "[waiting for the device]" if session.waiting_for_devices
                  else "skipping... (u: stop)" if session.skipping
                  else session.paused_words if session.paused else "running")
-        who = ("replaying the recording" if session.replaying
-               else "no user lane" if not session.has_user_lane
+        who = ("no user lane" if not session.has_user_lane      # (a replay of it performs none)
+               else "replaying the recording" if session.replaying
                else "model performs your lane" if session.handed_over
                else "you perform the lane")
         pace = self._pace.shown() if state == "running" else ""
@@ -500,10 +500,10 @@ class WalkthroughApp(App[str | None]):
             if session.record_path is None:
                 return "(the run has ended: q quits; nothing was recorded)"
             return "(the run has ended: q quits, the recording is kept)"
+        if not session.has_user_lane:          # (replayed too: there is no lane to perform)
+            return "(this spec has no user lane: watch the device; u skips to the end)"
         if session.replaying:
             return "(the recording performs your lane: watch, or press u / n to move on)"
-        if not session.has_user_lane:
-            return "(this spec has no user lane: watch the device; u skips to the end)"
         if session.handed_over or session.offers:
             return ""
         return "(nothing to do now: press u to skip until something needs you)"

@@ -11,6 +11,7 @@ next. :meth:`Aftermath.text` says it in one line::
          Walk to the dispenser
     you: Press "report" at 12:09 -> sent trg_1 -> the device: Wait for the user's report
          (trg_1), Dispense the dose -> asked next: Take the pill
+    you did not: Hear the alarm at 08:00 -> nothing sent to the device
 """
 
 from __future__ import annotations
@@ -79,7 +80,11 @@ class Aftermath:
         if not self.label:
             return ""
         rest = self.at % 86_400.0
-        parts = [f"you: {self.label} at {int(rest // 3600):02d}:{int(rest % 3600 // 60):02d}"]
+        # an omission (x) is labelled "not: …" (opspec.tui.session_lane): not done, so not
+        # "your own action"
+        omitted = self.label.startswith("not: ")
+        did = f"you did not: {self.label[5:]}" if omitted else f"you: {self.label}"
+        parts = [f"{did} at {int(rest // 3600):02d}:{int(rest % 3600 // 60):02d}"]
         if self.sent:
             parts.append("sent " + ", ".join(self.sent))
         if self.kept or self.lost:
@@ -94,6 +99,7 @@ class Aftermath:
             # person's own doing, which by design involves no device (not a fault); sent:
             # caught (neither kept nor lost), but no device activity finished at this instant
             parts.append("no device activity at once" if self.sent
+                         else "nothing sent to the device" if omitted
                          else "your own action, nothing sent to the device")
         if self.asked:
             parts.append("asked next: " + ", ".join(dict.fromkeys(self.asked)))

@@ -1,7 +1,9 @@
 """The walkthrough's two screens over the session: the help (``?``: its keys) and the
 summary (``s``, and by itself at the end of the run). Both stop the clock while open
 (:class:`opspec.tui.app.WalkthroughApp` pushes them paused), say in their frame how to close
-them, and scroll with the arrow keys where they do not fit (at 80 x 24 neither does).
+them, and scroll with the arrow keys where they do not fit (at 80 x 24 neither does). The
+help is written for the width of its box: narrower than its 72 columns (``--large`` at 64),
+its lines are wrapped with each key's text under its text, never under the keys.
 
 The help is the session's own (:func:`help_text`): it lists only the keys that do something
 in it (a replay, or a spec without a user lane, has nothing to answer and nothing to hand
@@ -12,7 +14,7 @@ what quitting keeps: a recording when it records, nothing in a replay or with
 from __future__ import annotations
 
 import textwrap
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from typing import Any, ClassVar
 
 from rich.text import Text
@@ -25,24 +27,28 @@ from textual.widgets import Static
 from opspec.tui.session_clock import clock
 
 __all__ = ["CLOSE_HELP", "CLOSE_SUMMARY", "HELP", "HelpScreen", "SummaryScreen",
-           "help_text", "session_help"]
+           "help_screen", "help_text", "session_help"]
 
 _KEYS = "[b]opspec walkthrough — keys[/b]"
 # the help's lines are at most this wide: its box is 72 columns less border and padding,
 # and less the scrollbar on a terminal too short for it (tests/tui/test_help_fits.py)
 _WIDTH = 62
+_BOX = 72
+# the box's border and padding, and the scrollbar a terminal too short for the help shows
+_FRAME = 2 + 4 + 2
 
 
 def help_text(*, replaying: bool = False, recording: bool = True, user_lane: bool = True,
               model: bool = True, on_call: str = "realtime", large: bool = False,
-              ends_at: str = "") -> str:
+              ends_at: str = "", width: int = _WIDTH) -> str:
     """The help for a session, listing only the keys that do something in it: a replay
     (``replaying``; the recording performs the lane, ending at ``ends_at``) and a spec
     without a user lane (``user_lane``) have no actions to answer, and hand nothing over; a
     session without a user ``model`` has nobody to hand the lane to. What quitting keeps and
     whether an omission is recorded are said as they are (a replay and ``--no-record``
     record nothing), and what the clock does when the device calls (``on_call``) as this
-    session does it (a replay is never slowed down)."""
+    session does it (a replay is never slowed down). ``width``: the widest line, in cells
+    (at most 62: the help's box on a terminal of 80 columns or more)."""
     person = user_lane and not replaying
     kept = ("a replay records nothing" if replaying
             else "the recording is kept" if recording else "nothing is recorded")
@@ -73,16 +79,18 @@ def help_text(*, replaying: bool = False, recording: bool = True, user_lane: boo
         shown = Text.from_markup(key).cell_len
         # the key column is 8 wide; a wider key runs into its text after one space
         lead = f"  {key}{' ' * max(1, 8 - shown)}"
-        width = _WIDTH - 2 - max(8, shown + 1)
-        first, *more = textwrap.wrap(does, width) or [""]
+        first, *more = textwrap.wrap(does, max(12, width - 2 - max(8, shown + 1))) or [""]
         lines.append(lead + first)
-        lines += [" " * 10 + line for line in more]
+        # under the key's text: a word wrapped under the keys would read as a key
+        lines += [" " * (2 + max(8, shown + 1)) + line for line in more]
     paragraphs = []
     if replaying:
         paragraphs.append(
-            "This is a replay: the recording performs your lane, so nothing waits for "
-            "your answer. Watch it, pause it, change its speed or skip ahead (w, n, u); "
-            "it is never slowed down when the device calls, and it ends at "
+            "This is a replay: " + ("the recording performs your lane" if user_lane
+                                    else "this spec has no user lane")
+            + ", so nothing waits for your answer. Watch it, pause it, change its speed or "
+            "skip ahead (w, n, u); it is never slowed down when the device calls, and it "
+            "ends at "
             f"{ends_at or 'the end of its run'}.")
     elif not user_lane:
         paragraphs.append("This spec has no user lane: nothing waits for your answer; "
@@ -100,17 +108,23 @@ def help_text(*, replaying: bool = False, recording: bool = True, user_lane: boo
                       "> what a participant is doing now.")
     for paragraph in paragraphs:
         if paragraph:
-            lines += ["", *textwrap.wrap(paragraph, _WIDTH)]
+            lines += ["", *textwrap.wrap(paragraph, width)]
     return "\n".join([*lines, "", "Press escape or ? to close."])
 
 
-def session_help(session: Any, *, large: bool = False) -> str:
+def session_help(session: Any, *, large: bool = False, width: int = _WIDTH) -> str:
     """:func:`help_text` for ``session`` (a :class:`~opspec.tui.session.WalkSession`) as it
-    is; ``large``: the app's ``--large`` layout."""
+    is; ``large``: the app's ``--large`` layout; ``width``: its widest line."""
     return help_text(
         replaying=session.replaying, recording=session.record_path is not None,
         user_lane=session.has_user_lane, model=session.model_factory is not None,
-        on_call=session.on_call, large=large, ends_at=clock(session.horizon))
+        on_call=session.on_call, large=large, ends_at=clock(session.horizon), width=width)
+
+
+def help_screen(session: Any, *, large: bool = False) -> HelpScreen:
+    """The help screen of ``session``: :func:`session_help`, written for the width the
+    terminal gives it."""
+    return HelpScreen(lambda width: session_help(session, large=large, width=width))
 
 
 #: the help of a recorded session with every key (a user lane, a user model)
@@ -131,14 +145,34 @@ class HelpScreen(ModalScreen[None]):
                                   background: $surface; }
     """
 
-    def __init__(self, text: str = HELP) -> None:
+    def __init__(self, text: str | Callable[[int], str] = HELP) -> None:
+        """``text``: the help, or what writes it for a width (the widest line, in cells):
+        then it is rewritten whenever the terminal's width changes."""
         super().__init__()
-        self.text = text
+        self._write = None if isinstance(text, str) else text
+        self._width = _WIDTH
+        self.text = text if isinstance(text, str) else text(_WIDTH)
 
     def compose(self) -> ComposeResult:
         with VerticalScroll() as frame:
             frame.border_subtitle = CLOSE_HELP
             yield Static(self.text, id="help-text")
+
+    def on_mount(self) -> None:
+        self._fit()
+
+    def on_resize(self) -> None:
+        self._fit()
+
+    def _fit(self) -> None:
+        # Textual would wrap a line too wide for the box at its first column: "click it)"
+        # under the keys, as if it were one
+        width = max(20, min(_WIDTH, min(_BOX, self.app.size.width) - _FRAME))
+        if self._write is None or width == self._width:
+            return
+        self._width = width
+        self.text = self._write(width)
+        self.query_one("#help-text", Static).update(self.text)
 
 
 class SummaryScreen(ModalScreen[None]):

@@ -75,7 +75,8 @@ def load_recording(path: str | Path, compiled: CompiledPackage | None = None) ->
 
 def recorded_end(path: str | Path) -> float | None:
     """Where the session recorded in ``path`` ended, as its trace beside it
-    (``REC.trace.jsonl``) says: the second the person quit at, else the end of its run;
+    (``REC.trace.jsonl``) says: the second the person quit at (``0.0``: before the clock
+    moved, nothing to replay), else the end of its run;
     ``None`` when nothing says so: a recording made before sessions wrote it, any other
     script, a trace gone or not a walkthrough's."""
     try:
@@ -89,7 +90,10 @@ def recorded_end(path: str | Path) -> float | None:
                     event = json.loads(line)
                     if isinstance(event, dict) and event.get("kind") == QUIT and isinstance(
                             event.get("data"), dict):
-                        end = _seconds(event["data"].get("until")) or end
+                        quit_at = event["data"].get("until")
+                        # quit before the clock moved: 0 s, which no --until can say
+                        end = 0.0 if quit_at == 0 and not isinstance(quit_at, bool) else (
+                            _seconds(quit_at) or end)
     except (OSError, UnicodeDecodeError, ValueError):
         return None      # unreadable: the replay runs the whole run, as before
     return end

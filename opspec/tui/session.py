@@ -173,12 +173,21 @@ class WalkSession(SessionClock, PersonLane, TraceFollower, Recording):
             stopped = not self.ended and self.failure is None
             end = self.now if stopped else None if (
                 self.horizon == run_length(self.compiled)) else self.horizon
+            # opspec fit reads the user lane's activities: a spec without one leaves it
+            # nothing to fit ("no activity of lane 'user'")
+            trace = "Trace (for opspec fit)" if self.has_user_lane else "Trace"
+            lines += ["", f"Recording: {self.record_path}",
+                      f"{trace}: {self.record_path.with_suffix('.trace.jsonl')}"
+                      + (f" (person {self.person})" if self.person is not None else "")]
+            if end is not None and end <= 0:
+                # quit before the clock first moved: no run ends at 0 s (--until refuses
+                # it), and a replay would have nothing of the session's to show
+                lines.append("Nothing to replay: the session stopped before its clock moved."
+                             if final else "Nothing to replay yet: the clock has not moved.")
+                return lines
             walk, run = replay_commands(self.spec_path or "SPEC", self.record_path,
                                         until=end, seed=self.seed)
-            lines += ["", f"Recording: {self.record_path}",
-                      f"Trace (for opspec fit): {self.record_path.with_suffix('.trace.jsonl')}"
-                      + (f" (person {self.person})" if self.person is not None else ""),
-                      f"Replay it with: {walk}", f"           or: {run}"]
+            lines += [f"Replay it with: {walk}", f"           or: {run}"]
             bound = sorted({p for ps in self.board.device_participants.values() for p in ps})
             if bound:
                 # the replays bind nothing: what the devices did (their timing, a fault, an

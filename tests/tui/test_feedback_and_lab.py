@@ -258,6 +258,22 @@ async def test_x_at_a_choice_names_the_choice_it_leaves_undone(compiled, tmp_pat
         await pilot.press("x")
         await pilot.pause()
         said = session.aftermath.text()
-        assert said.startswith("you: not: Press a button at 08:00"), said
+        assert said.startswith("you did not: Press a button at 08:00"), said
         assert not session.offers
     assert "omit choose_button #4" in (tmp_path / "walk.json").read_text(encoding="utf-8")
+
+
+@pytest.mark.asyncio
+async def test_x_is_not_called_your_own_action(compiled):
+    """``x`` at "Hear the alarm" said 'you: not: Hear the alarm at 08:00 -> your own action,
+    nothing sent to the device': an action the person did not do is not their action."""
+    session = WalkSession(compiled)
+    app = WalkthroughApp(session)
+    async with app.run_test(size=(80, 24)) as pilot:
+        await pilot.press("space", "u")             # 08:00: the alarm
+        await pilot.pause()
+        assert [o.label for o in session.offers] == ["Hear the alarm"]
+        await pilot.press("x")
+        await pilot.pause()
+        assert session.aftermath.text() == ("you did not: Hear the alarm at 08:00 -> nothing "
+                                            "sent to the device")

@@ -56,3 +56,30 @@ async def test_h_after_the_end_of_the_run_hands_nothing_over(compiled, model_fac
         assert said == ["The run has ended: there is nothing to hand over (q quits)."]
         assert not session.handed_over
         assert "you perform the lane" in str(app.query_one("#status").render())
+
+
+@pytest.mark.asyncio
+async def test_a_replay_of_it_does_not_say_the_recording_performs_your_lane(tmp_path):
+    """A replay of a vacuum-cleaner session said "replaying the recording", "(the recording
+    performs your lane: …)" and, in its help, "the recording performs your lane": the spec
+    has no user lane, and the recording holds no step."""
+    from opspec.tui.replay import load_recording
+
+    compiled = compile_package(open_spec(VACUUM))
+    script = tmp_path / "vacuum.json"
+    script.write_text('{"otherwise": "wait", "steps": []}', encoding="utf-8")
+    session = WalkSession(compiled, replay=load_recording(script, compiled))
+    session.paused = True
+    app = WalkthroughApp(session, title="Automatic vacuum cleaner")
+    async with app.run_test(size=(100, 50)) as pilot:
+        await pilot.pause()
+        assert "|  no user lane  |" in str(app.query_one("#status").render())
+        assert str(app.query_one("#call").render()) == (
+            "(this spec has no user lane: watch the device; u skips to the end)")
+        await pilot.press("question_mark")
+        await pilot.pause()
+        shown = " ".join(app.screen.text.split())
+        assert "This is a replay: this spec has no user lane, so nothing waits" in shown
+        assert "performs your lane" not in shown
+        await pilot.press("escape")
+        await pilot.press("q")

@@ -182,3 +182,17 @@ def test_the_printed_replays_run_the_session_s_seed():
     assert shlex.split(walk)[3:] == ["--replay", "r.json", "--seed", "7"]
     assert shlex.split(run)[3:] == ["--seed", "7", "--script", "r.json"]
     assert "--seed" not in "".join(replay_commands("pill.xpdl", "r.json"))    # 0: as before
+
+
+def test_a_session_quit_before_its_clock_moved_has_nothing_to_replay(compiled, tmp_path,
+                                                                     replay, capsys):
+    """Its replay ran the whole day without the person (every dose missed): not the session,
+    which ran nothing. It is refused, saying why; ``--until`` still replays to then."""
+    record = tmp_path / "at once.json"
+    WalkSession(compiled, record=record, spec_path=str(SPEC)).close()     # q at 0 s
+    assert recorded_end(record) == 0.0
+    capsys.readouterr()
+    assert main(["walkthrough", str(SPEC), "--replay", str(record), "--sound", "off"]) == 2
+    err = capsys.readouterr().err
+    assert "the session was quit before its clock moved: there is nothing to replay" in err
+    assert replay(str(SPEC), "--replay", str(record), "--until", "9h")[0].now == 9 * 3600.0
