@@ -190,6 +190,8 @@ def _fit(args: argparse.Namespace) -> int:
                    "draws": draws.count, "resampled": draws.resampled, "seed": draws.seed,
                    "parameters": draws.summary()},
                "unusable_durations": dict(sorted(obs.unusable.items())),
+               "left_out_without_lane": [{"file": path, "lanes_seen": lanes}
+                                         for path, lanes in obs.without_lane],
                "holdout": None if holdout is None else holdout.to_json()}
         print(json.dumps(doc, indent=1, default=str))
         return status
@@ -206,6 +208,11 @@ def _fit(args: argparse.Namespace) -> int:
         left = ", ".join(f"{activity} {n}" for activity, n in sorted(obs.unusable.items()))
         print(f"left out: {sum(obs.unusable.values())} walkthrough duration(s) not timed in "
               f"real time ({left}); their choices still count")
+    from opspec.usermodels.observations import without_lane_text
+
+    without = without_lane_text(obs, args.lane)
+    if without is not None:
+        print(without)
     if holdout is not None:
         print()
         for line in holdout.lines():

@@ -161,8 +161,11 @@ def check_model(model: UserModel, model_ref: str | None, paths: Sequence[Path],
     check_options(options)
     if persons is not None:
         persons.check_used(list(paths))
+    from opspec.usermodels.observations import without_lane_text
+
     obs = collect(paths, options.lane, persons)
-    overlap = _fitted_on_notes(model_ref, obs.persons)
+    without = without_lane_text(obs, options.lane)
+    overlap = _fitted_on_notes(model_ref, obs.persons) + ([without] if without else [])
     draws = (_draws(model_ref) if options.parameter_uncertainty and model_ref else None)
     repeated: dict[str, dict[str, int]] = {}
     traced = False
