@@ -60,7 +60,10 @@ def _study(args: argparse.Namespace) -> int:
     )
     from opspec.tui.study_summary import summary, summary_lines
 
+    from opspec.commands.study_protocol import refuse_unknown_keys
+
     protocol = load_protocol(args.protocol)
+    refuse_unknown_keys(args.protocol)         # a misspelt told left a variant unbriefed
     for variant in protocol.variants:          # a broken spec opens no session
         load_any_spec(variant.spec)
     check_recordings(protocol)                 # sessions done with another spec: refused
