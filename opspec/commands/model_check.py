@@ -184,6 +184,7 @@ def check_model(model: UserModel, model_ref: str | None, paths: Sequence[Path],
 
         package = load_any_spec(options.spec, command="model-check")
         notes.extend(_other_spec_notes(paths, options.spec))
+        notes.extend(_short_session_notes(paths, package, options.days))
         definitions = package.metrics
         if not definitions:
             notes.append(f"{options.spec} declares no outcome metrics (opspec:Metrics): "
@@ -251,6 +252,39 @@ def _other_spec_notes(paths: Sequence[Path], spec: str) -> list[str]:
             "spec's definitions and averaged with the others per person; check each spec's "
             "traces on their own")
     return [note]
+
+
+def _short_session_notes(paths: Sequence[Path], package: Any, days: float | None
+                         ) -> list[str]:
+    """A note naming the traces whose last session ends before the run length the metrics
+    are predicted for: a recording cut short (no ``run.ended``: a crash, a kill) or a session
+    quit early has fewer doses due, fewer alarms, and its metrics would be compared with
+    whole runs (a correct model called a misfit of ``doses_due``)."""
+    from opspec.engine.trace import EventKind
+    from opspec.run_rules import run_length
+    from opspec.usermodels.trace_reader import read_trace
+
+    horizon = run_length(package, days=days)
+    short: list[str] = []
+    for path in paths:
+        last, ended = 0.0, False
+        for event in read_trace(path):
+            if event.kind == EventKind.RUN_STARTED:
+                ended = False
+            elif event.kind == EventKind.RUN_ENDED:
+                ended = True
+            last = max(last, event.time) if event.kind != EventKind.RUN_STARTED else 0.0
+        if not ended:
+            short.append(f"{path} (cut short at {last / 86400:.2f} day(s): no run.ended)")
+        elif last < horizon - 1e-6:
+            short.append(f"{path} (ends at {last / 86400:.2f} day(s))")
+    if not short:
+        return []
+    return [f"{len(short)} of {len(paths)} trace file(s) end before the {horizon / 86400:g} "
+            f"day(s) the metrics are predicted for: {'; '.join(short[:3])}"
+            f"{' ...' if len(short) > 3 else ''}; their metrics cover part of a run and are "
+            "compared with whole runs: give --days as long as the sessions, or leave those "
+            "traces out of a metric check"]
 
 
 def _model_check(args: argparse.Namespace) -> int:
