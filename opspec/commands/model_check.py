@@ -280,11 +280,12 @@ def _short_session_notes(paths: Sequence[Path], package: Any, days: float | None
             short.append(f"{path} (ends at {last / 86400:.2f} day(s))")
     if not short:
         return []
-    return [f"{len(short)} of {len(paths)} trace file(s) end before the {horizon / 86400:g} "
+    note = (f"{len(short)} of {len(paths)} trace file(s) end before the {horizon / 86400:g} "
             f"day(s) the metrics are predicted for: {'; '.join(short[:3])}"
             f"{' ...' if len(short) > 3 else ''}; their metrics cover part of a run and are "
             "compared with whole runs: give --days as long as the sessions, or leave those "
-            "traces out of a metric check"]
+            "traces out of a metric check")
+    return [note]
 
 
 def _model_check(args: argparse.Namespace) -> int:

@@ -50,6 +50,7 @@ def register(subparsers: Any) -> None:
 
 def _study(args: argparse.Namespace) -> int:
     from opspec.commands._spec import load_any_spec
+    from opspec.commands.study_protocol import refuse_unknown_keys
     from opspec.errors import ConfigurationError
     from opspec.tui.study import (
         check_recordings,
@@ -59,8 +60,6 @@ def _study(args: argparse.Namespace) -> int:
         session_app,
     )
     from opspec.tui.study_summary import summary, summary_lines
-
-    from opspec.commands.study_protocol import refuse_unknown_keys
 
     protocol = load_protocol(args.protocol)
     refuse_unknown_keys(args.protocol)         # a misspelt told left a variant unbriefed
