@@ -83,6 +83,29 @@ def _persons_line(obs: Any, source: str) -> str:
             + (f" ({shown}{more})" if any(n > 1 for n in counts.values()) else "") + how)
 
 
+def _specs(paths: list[Path]) -> dict[str, int]:
+    """How many of the traces each spec named in their headers was recorded with."""
+    from opspec.usermodels.trace_reader import trace_header
+
+    files: dict[str, int] = {}
+    for path in paths:
+        spec = trace_header(path).get("spec")
+        if isinstance(spec, str) and spec:
+            files[Path(spec).name] = files.get(Path(spec).name, 0) + 1
+    return dict(sorted(files.items()))
+
+
+def _specs_line(files: dict[str, int]) -> str | None:
+    """A line when the traces were recorded with more than one spec (a study's variants, a
+    trace of another device): one model is fitted over all of them, which is said."""
+    if len(files) < 2:
+        return None
+    shown = "; ".join(f"{name}: {n} file(s)" for name, n in files.items())
+    return (f"specs: the traces were recorded with {len(files)} specs ({shown}): one model "
+            "is fitted over all of them; fit each spec's traces on their own for a model of "
+            "each")
+
+
 def _uncertainty_text(draws: ParameterDraws | None) -> str:
     """The ``[uncertainty]`` table: the bootstrap redraws of the fitted parameters."""
     if draws is None:
@@ -190,6 +213,7 @@ def _fit(args: argparse.Namespace) -> int:
                    "draws": draws.count, "resampled": draws.resampled, "seed": draws.seed,
                    "parameters": draws.summary()},
                "unusable_durations": dict(sorted(obs.unusable.items())),
+               "specs": _specs(paths),
                "left_out_without_lane": [{"file": path, "lanes_seen": lanes}
                                          for path, lanes in obs.without_lane],
                "holdout": None if holdout is None else holdout.to_json()}
@@ -200,6 +224,9 @@ def _fit(args: argparse.Namespace) -> int:
         print()
     activities = ", ".join(f.activity for f in result.fits)
     print(f"persons: {_persons_line(obs, args.person_from)}")
+    specs = _specs_line(_specs(paths))
+    if specs is not None:
+        print(specs)
     if draws is not None:
         print(f"parameter uncertainty: {draws.count} bootstrap redraws resampling "
               f"{draws.resampled} ([uncertainty]; opspec evaluate --input-uncertainty B)")
