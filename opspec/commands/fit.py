@@ -233,8 +233,12 @@ def _fit(args: argparse.Namespace) -> int:
     print(f"wrote {out} ({len(result.fits)} activities: {activities})")
     if obs.unusable:    # walkthrough answers whose clock was paused, fast or skipped
         left = ", ".join(f"{activity} {n}" for activity, n in sorted(obs.unusable.items()))
+        fitted = {f.activity for f in result.fits}
+        missing = sorted(a for a in obs.unusable if a not in fitted)
         print(f"left out: {sum(obs.unusable.values())} walkthrough duration(s) not timed in "
-              f"real time ({left}); their choices still count")
+              f"real time ({left}); their choices still count"
+              + (f"; not in the model, none of their answers timed: {', '.join(missing)} "
+                 "(record sessions in real time: docs/walkthrough.md)" if missing else ""))
     from opspec.usermodels.observations import without_lane_text
 
     without = without_lane_text(obs, args.lane)

@@ -79,3 +79,28 @@ def test_an_activity_never_timed_says_so(tmp_path, capsys) -> None:
     printed = capsys.readouterr().out
     assert "no duration timed in real time (8 completion(s) left out)" in printed
     assert "omission: 2/10 = 0.2000" in printed
+
+
+def test_activities_never_timed_are_named_as_not_in_the_model(tmp_path, capsys) -> None:
+    """Every walk untimed (the model had the lane): the walk is not in the model, and the
+    line that said 'their choices still count' says so."""
+    lines: list[dict] = [{"format": "opspec-trace", "version": 1, "person": "P01"},
+                         {"time": 0.0, "kind": "run.started"}]
+    for i in range(1, 6):
+        t = 1000.0 * i
+        lines += [{"time": t, "kind": "activity.offered", "activity": "hear", "lane": "user",
+                   "instance": i},
+                  {"time": t + 5, "kind": "activity.completed", "activity": "hear",
+                   "lane": "user", "instance": i},
+                  {"time": t + 5, "kind": "activity.offered", "activity": "walk",
+                   "lane": "user", "instance": i},
+                  {"time": t + 60, "kind": "walkthrough.action", "data": {
+                      "usable": False, "instance": i, "activity": "walk"}},
+                  {"time": t + 60, "kind": "activity.completed", "activity": "walk",
+                   "lane": "user", "instance": i}]
+    path = tmp_path / "P01.jsonl"
+    path.write_text("".join(json.dumps(x) + "\n" for x in lines), encoding="utf-8")
+    assert main(["fit", str(path), "-o", str(tmp_path / "m.users.toml"), "--draws", "0"]) == 0
+    out = capsys.readouterr().out
+    assert "wrote" in out and "(1 activities: hear)" in out
+    assert "not in the model, none of their answers timed: walk" in out
