@@ -256,10 +256,11 @@ def _other_spec_notes(paths: Sequence[Path], spec: str) -> list[str]:
 
 def _short_session_notes(paths: Sequence[Path], package: Any, days: float | None
                          ) -> list[str]:
-    """A note naming the traces whose last session ends before the run length the metrics
+    """A note naming the traces whose last session does not last the run length the metrics
     are predicted for: a recording cut short (no ``run.ended``: a crash, a kill) or a session
-    quit early has fewer doses due, fewer alarms, and its metrics would be compared with
-    whole runs (a correct model called a misfit of ``doses_due``)."""
+    quit early has fewer doses due, fewer alarms, and a week's session more than a day's
+    run; their metrics would be compared with runs of another length (a correct model
+    called a misfit of ``doses_due``)."""
     from opspec.engine.trace import EventKind
     from opspec.run_rules import run_length
     from opspec.usermodels.trace_reader import read_trace
@@ -276,15 +277,16 @@ def _short_session_notes(paths: Sequence[Path], package: Any, days: float | None
             last = max(last, event.time) if event.kind != EventKind.RUN_STARTED else 0.0
         if not ended:
             short.append(f"{path} (cut short at {last / 86400:.2f} day(s): no run.ended)")
-        elif last < horizon - 1e-6:
-            short.append(f"{path} (ends at {last / 86400:.2f} day(s))")
+        elif abs(last - horizon) > 1e-6:
+            short.append(f"{path} ({'ends at' if last < horizon else 'runs to'} "
+                         f"{last / 86400:.2f} day(s))")
     if not short:
         return []
-    note = (f"{len(short)} of {len(paths)} trace file(s) end before the {horizon / 86400:g} "
+    note = (f"{len(short)} of {len(paths)} trace file(s) do not last the {horizon / 86400:g} "
             f"day(s) the metrics are predicted for: {'; '.join(short[:3])}"
-            f"{' ...' if len(short) > 3 else ''}; their metrics cover part of a run and are "
-            "compared with whole runs: give --days as long as the sessions, or leave those "
-            "traces out of a metric check")
+            f"{' ...' if len(short) > 3 else ''}; their metrics are compared with runs of "
+            "another length: give --days as long as the sessions, or leave those traces out "
+            "of a metric check")
     return [note]
 
 

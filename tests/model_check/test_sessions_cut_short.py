@@ -34,10 +34,23 @@ def test_a_recording_cut_short_is_named_in_a_metric_check(tmp_path, capsys) -> N
     traces = write_person_traces(SPEC, HERE / "truth.population.toml", tmp_path / "p",
                                  people=range(3), seed=5, days=2)
     whole = _check(capsys, tmp_path / "p")
-    assert not any("end before" in n for n in whole["notes"])
+    assert not any("do not last" in n for n in whole["notes"])
     lines = traces[0].read_text(encoding="utf-8").splitlines(keepends=True)
     traces[0].write_text("".join(lines[:len(lines) // 2]), encoding="utf-8")
     cut = _check(capsys, tmp_path / "p")
-    [note] = [n for n in cut["notes"] if "end before" in n]
-    assert note.startswith("1 of 3 trace file(s) end before the 2 day(s)")
+    [note] = [n for n in cut["notes"] if "do not last" in n]
+    assert note.startswith("1 of 3 trace file(s) do not last the 2 day(s)")
     assert f"{traces[0]} (cut short at " in note and "no run.ended" in note
+
+
+def test_sessions_longer_than_the_predicted_runs_are_named(tmp_path, capsys) -> None:
+    """Two-day sessions checked without --days (the spec's run is one day): every count
+    metric doubles against the prediction; the note says why and what to give."""
+    write_person_traces(SPEC, HERE / "truth.population.toml", tmp_path / "p",
+                        people=range(2), seed=5, days=2)
+    main(["model-check", str(HERE / "truth.population.toml"), str(tmp_path / "p"),
+          "--spec", str(SPEC), "--runs", "20", "--replicates", "19", "--json"])
+    doc = json.loads(capsys.readouterr().out)
+    [note] = [n for n in doc["notes"] if "do not last" in n]
+    assert note.startswith("2 of 2 trace file(s) do not last the 1 day(s)")
+    assert "(runs to 2.00 day(s))" in note and "give --days as long as the sessions" in note
