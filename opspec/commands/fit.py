@@ -83,6 +83,29 @@ def _persons_line(obs: Any, source: str) -> str:
             + (f" ({shown}{more})" if any(n > 1 for n in counts.values()) else "") + how)
 
 
+def _specs(paths: list[Path]) -> dict[str, int]:
+    """How many of the traces each spec named in their headers was recorded with."""
+    from opspec.usermodels.trace_reader import trace_header
+
+    files: dict[str, int] = {}
+    for path in paths:
+        spec = trace_header(path).get("spec")
+        if isinstance(spec, str) and spec:
+            files[Path(spec).name] = files.get(Path(spec).name, 0) + 1
+    return dict(sorted(files.items()))
+
+
+def _specs_line(files: dict[str, int]) -> str | None:
+    """A line when the traces were recorded with more than one spec (a study's variants, a
+    trace of another device): one model is fitted over all of them, which is said."""
+    if len(files) < 2:
+        return None
+    shown = "; ".join(f"{name}: {n} file(s)" for name, n in files.items())
+    return (f"specs: the traces were recorded with {len(files)} specs ({shown}): one model "
+            "is fitted over all of them; fit each spec's traces on their own for a model of "
+            "each")
+
+
 def _uncertainty_text(draws: ParameterDraws | None) -> str:
     """The ``[uncertainty]`` table: the bootstrap redraws of the fitted parameters."""
     if draws is None:
@@ -190,6 +213,9 @@ def _fit(args: argparse.Namespace) -> int:
                    "draws": draws.count, "resampled": draws.resampled, "seed": draws.seed,
                    "parameters": draws.summary()},
                "unusable_durations": dict(sorted(obs.unusable.items())),
+               "specs": _specs(paths),
+               "left_out_without_lane": [{"file": path, "lanes_seen": lanes}
+                                         for path, lanes in obs.without_lane],
                "holdout": None if holdout is None else holdout.to_json()}
         print(json.dumps(doc, indent=1, default=str))
         return status
@@ -198,14 +224,26 @@ def _fit(args: argparse.Namespace) -> int:
         print()
     activities = ", ".join(f.activity for f in result.fits)
     print(f"persons: {_persons_line(obs, args.person_from)}")
+    specs = _specs_line(_specs(paths))
+    if specs is not None:
+        print(specs)
     if draws is not None:
         print(f"parameter uncertainty: {draws.count} bootstrap redraws resampling "
               f"{draws.resampled} ([uncertainty]; opspec evaluate --input-uncertainty B)")
     print(f"wrote {out} ({len(result.fits)} activities: {activities})")
     if obs.unusable:    # walkthrough answers whose clock was paused, fast or skipped
         left = ", ".join(f"{activity} {n}" for activity, n in sorted(obs.unusable.items()))
+        fitted = {f.activity for f in result.fits}
+        missing = sorted(a for a in obs.unusable if a not in fitted)
         print(f"left out: {sum(obs.unusable.values())} walkthrough duration(s) not timed in "
-              f"real time ({left}); their choices still count")
+              f"real time ({left}); their choices still count"
+              + (f"; not in the model, none of their answers timed: {', '.join(missing)} "
+                 "(record sessions in real time: docs/walkthrough.md)" if missing else ""))
+    from opspec.usermodels.observations import without_lane_text
+
+    without = without_lane_text(obs, args.lane)
+    if without is not None:
+        print(without)
     if holdout is not None:
         print()
         for line in holdout.lines():

@@ -161,8 +161,11 @@ def check_model(model: UserModel, model_ref: str | None, paths: Sequence[Path],
     check_options(options)
     if persons is not None:
         persons.check_used(list(paths))
+    from opspec.usermodels.observations import without_lane_text
+
     obs = collect(paths, options.lane, persons)
-    overlap = _fitted_on_notes(model_ref, obs.persons)
+    without = without_lane_text(obs, options.lane)
+    overlap = _fitted_on_notes(model_ref, obs.persons) + ([without] if without else [])
     draws = (_draws(model_ref) if options.parameter_uncertainty and model_ref else None)
     repeated: dict[str, dict[str, int]] = {}
     traced = False
@@ -181,6 +184,7 @@ def check_model(model: UserModel, model_ref: str | None, paths: Sequence[Path],
 
         package = load_any_spec(options.spec, command="model-check")
         notes.extend(_other_spec_notes(paths, options.spec))
+        notes.extend(_short_session_notes(paths, package, options.days))
         definitions = package.metrics
         if not definitions:
             notes.append(f"{options.spec} declares no outcome metrics (opspec:Metrics): "
@@ -247,6 +251,42 @@ def _other_spec_notes(paths: Sequence[Path], spec: str) -> list[str]:
             f"{' ...' if len(files) > 3 else ''}): their metrics are replayed with this "
             "spec's definitions and averaged with the others per person; check each spec's "
             "traces on their own")
+    return [note]
+
+
+def _short_session_notes(paths: Sequence[Path], package: Any, days: float | None
+                         ) -> list[str]:
+    """A note naming the traces whose last session does not last the run length the metrics
+    are predicted for: a recording cut short (no ``run.ended``: a crash, a kill) or a session
+    quit early has fewer doses due, fewer alarms, and a week's session more than a day's
+    run; their metrics would be compared with runs of another length (a correct model
+    called a misfit of ``doses_due``)."""
+    from opspec.engine.trace import EventKind
+    from opspec.run_rules import run_length
+    from opspec.usermodels.trace_reader import read_trace
+
+    horizon = run_length(package, days=days)
+    short: list[str] = []
+    for path in paths:
+        last, ended = 0.0, False
+        for event in read_trace(path):
+            if event.kind == EventKind.RUN_STARTED:
+                ended = False
+            elif event.kind == EventKind.RUN_ENDED:
+                ended = True
+            last = max(last, event.time) if event.kind != EventKind.RUN_STARTED else 0.0
+        if not ended:
+            short.append(f"{path} (cut short at {last / 86400:.2f} day(s): no run.ended)")
+        elif abs(last - horizon) > 1e-6:
+            short.append(f"{path} ({'ends at' if last < horizon else 'runs to'} "
+                         f"{last / 86400:.2f} day(s))")
+    if not short:
+        return []
+    note = (f"{len(short)} of {len(paths)} trace file(s) do not last the {horizon / 86400:g} "
+            f"day(s) the metrics are predicted for: {'; '.join(short[:3])}"
+            f"{' ...' if len(short) > 3 else ''}; their metrics are compared with runs of "
+            "another length: give --days as long as the sessions, or leave those traces out "
+            "of a metric check")
     return [note]
 
 

@@ -50,6 +50,7 @@ def register(subparsers: Any) -> None:
 
 def _study(args: argparse.Namespace) -> int:
     from opspec.commands._spec import load_any_spec
+    from opspec.commands.study_protocol import refuse_unknown_keys
     from opspec.errors import ConfigurationError
     from opspec.tui.study import (
         check_recordings,
@@ -61,6 +62,7 @@ def _study(args: argparse.Namespace) -> int:
     from opspec.tui.study_summary import summary, summary_lines
 
     protocol = load_protocol(args.protocol)
+    refuse_unknown_keys(args.protocol)         # a misspelt told left a variant unbriefed
     for variant in protocol.variants:          # a broken spec opens no session
         load_any_spec(variant.spec)
     check_recordings(protocol)                 # sessions done with another spec: refused

@@ -97,8 +97,14 @@ def fit_traces(paths: Sequence[str | Path], *, lane: str = "user", name: str = "
                     for alternative in wrong_choice.alternatives:
                         losses[alternative] = wrong_choice
         dist, chosen, families, note = fit_duration_families(values, criterion)
+        if not values and obs.unusable.get(activity):
+            note = (f"no duration timed in real time ({obs.unusable[activity]} completion(s) "
+                    "left out): duration 0")
         omitted = obs.omitted.get(activity, 0)
-        answered = omitted + len(obs.durations.get(activity, []))
+        # every offer answered, by an omission or a completion, timed in real time or not:
+        # a walkthrough answer whose duration is left out still answered its offer (without
+        # it, 6 omissions beside 24 untimed completions were written as a rate of 6/6)
+        answered = sum(n for _, n in obs.user_omissions.get(activity, {}).values())
         omission_stats = None
         kwargs["duration"] = dist
         if omitted:

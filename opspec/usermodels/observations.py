@@ -25,7 +25,7 @@ from opspec.errors import SourceLocation, UserModelError
 from opspec.usermodels.persons import PersonRule
 from opspec.usermodels.trace_reader import read_trace
 
-__all__ = ["Observations", "collect"]
+__all__ = ["Observations", "collect", "without_lane_text"]
 
 _ANSWERS = (EventKind.ACTIVITY_COMPLETED, EventKind.ACTIVITY_OMITTED,
             EventKind.ACTIVITY_WITHDRAWN)
@@ -62,6 +62,9 @@ class Observations:
     runs: int = 0
     files: int = 0
     lanes_seen: set[str] = field(default_factory=set)
+    #: files with no event of the lane (a trace of another spec, a run nobody performed the
+    #: lane in) and the lanes each did show: read, but no session of them is a person
+    without_lane: list[tuple[str, list[str]]] = field(default_factory=list)
 
     @property
     def activities(self) -> list[str]:
@@ -114,6 +117,8 @@ def collect(paths: Sequence[str | Path], lane: str = "user",
         pending_choice: dict[tuple[int, Any], tuple[str, tuple[str, ...]]] = {}
         unreal: set[tuple[int, Any, str]] = set()     # (run, instance, activity)
         picks_of: dict[tuple[int, Any], dict[str, list[str]]] = {}
+        of_lane = 0
+        file_lanes: set[str] = set()
         for event in read_trace(path):
             obs.events += 1
             if event.kind == EventKind.RUN_STARTED:
@@ -124,6 +129,7 @@ def collect(paths: Sequence[str | Path], lane: str = "user",
                 continue
             if event.lane:
                 obs.lanes_seen.add(event.lane)
+                file_lanes.add(event.lane)
             if event.kind == "walkthrough.action" and event.data.get("usable") is False:
                 # a walkthrough's answer whose simulated duration is not the person's
                 # (docs/walkthrough.md): its duration is not fitted
@@ -131,6 +137,7 @@ def collect(paths: Sequence[str | Path], lane: str = "user",
                 continue
             if event.activity is None or (event.lane != lane and event.participant != lane):
                 continue
+            of_lane += 1
             inst = (run, event.instance)
             key = (run, event.instance, event.activity)
             if event.kind == EventKind.ACTIVITY_OFFERED:
@@ -184,6 +191,12 @@ def collect(paths: Sequence[str | Path], lane: str = "user",
         if run == 0:                    # a trace without run.started: one session
             obs.person_of[(file_index, 0)] = (whose if whose is not None
                                               else f"{Path(path).name}#0")
+        if not of_lane:
+            # counted as a person it would add one with nothing observed: to the persons a
+            # fit names and resamples, to a check's group size
+            for session in [s for s in obs.person_of if s[0] == file_index]:
+                del obs.person_of[session]
+            obs.without_lane.append((str(path), sorted(file_lanes)))
     if not obs.durations and not obs.omitted and not obs.busy_omitted:
         seen = ", ".join(sorted(obs.lanes_seen)) or "none"
         unusable = sum(obs.unusable.values())
@@ -196,6 +209,19 @@ def collect(paths: Sequence[str | Path], lane: str = "user",
             hint="record traces of the user lane (for instance a TUI walkthrough), or pick "
             "the lane with --lane")
     return obs
+
+
+def without_lane_text(obs: Observations, lane: str) -> str | None:
+    """What ``opspec fit`` and ``opspec model-check`` say of the files with no event of
+    ``lane`` (None when there are none): read, and left out of the persons."""
+    if not obs.without_lane:
+        return None
+    shown = "; ".join(f"{path}: lanes seen {', '.join(lanes) or 'none'}"
+                      for path, lanes in obs.without_lane[:3])
+    more = f"; ... {len(obs.without_lane) - 3} more" if len(obs.without_lane) > 3 else ""
+    return (f"left out {len(obs.without_lane)} trace file(s) with no activity of lane "
+            f"{lane!r} ({shown}{more}), not counted as persons: a trace of another spec, or "
+            "a session nobody performed the lane in (pick the lane with --lane)")
 
 
 def _real_duration(unreal: set[tuple[int, Any, str]], key: tuple[int, Any, str],

@@ -56,7 +56,7 @@ class PersonRule:
             try:
                 re.compile(self.pattern)
             except re.error as error:
-                raise UserModelError(f"--person-pattern {self.pattern!r} is not a regular "
+                raise UserModelError(f"--person-pattern {_typed(self.pattern)} is not a regular "
                                      f"expression: {error}",
                                      hint="for example '(P\\d+)' takes P07 out of "
                                      "recordings/P07-day2.jsonl") from None
@@ -70,7 +70,7 @@ class PersonRule:
             match = _nearest_match(self.pattern, path)
             if match is None:
                 raise UserModelError(
-                    f"--person-pattern {self.pattern!r} does not match this file's path",
+                    f"--person-pattern {_typed(self.pattern)} does not match this file's path",
                     location=SourceLocation(str(path)),
                     hint="fix the pattern, or name the file's person with --person "
                     f"{path.name}=ID")
@@ -153,3 +153,11 @@ def _nearest_match(pattern: str, path: Path) -> re.Match[str] | None:
         if match is not None:
             return match
     return re.search(pattern, str(path))
+
+
+def _typed(pattern: str) -> str:
+    """The pattern as it is typed in a shell: ``'(P\\d+)'``, not Python's repr with its
+    doubled backslash, which pasted back is another pattern."""
+    import shlex
+
+    return shlex.quote(pattern)
