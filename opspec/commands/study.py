@@ -61,8 +61,10 @@ def _study(args: argparse.Namespace) -> int:
     )
     from opspec.tui.study_summary import summary, summary_lines
 
+    # first: a misspelt told left a variant unbriefed, and a misspelt [[variants]] was said
+    # to be missing, not misspelt
+    refuse_unknown_keys(args.protocol)
     protocol = load_protocol(args.protocol)
-    refuse_unknown_keys(args.protocol)         # a misspelt told left a variant unbriefed
     for variant in protocol.variants:          # a broken spec opens no session
         load_any_spec(variant.spec)
     check_recordings(protocol)                 # sessions done with another spec: refused

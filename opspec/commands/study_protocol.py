@@ -31,8 +31,8 @@ def _unknown(where: str, key: str, known: tuple[str, ...], name: str,
 
 def refuse_unknown_keys(path: str | Path) -> None:
     """A ConfigurationError naming ``file:line: key`` for the first key of the protocol
-    ``path`` that no part of ``opspec study`` reads (call it after ``load_protocol``, which
-    has said what is wrong with the keys it does read)."""
+    ``path`` that no part of ``opspec study`` reads (call it before ``load_protocol``: a
+    misspelt ``[[varaints]]`` would otherwise be said to be no variants at all)."""
     from opspec.toml_files import read_toml
 
     where = str(path)

@@ -33,3 +33,14 @@ def test_a_table_the_protocol_does_not_have_is_refused(protocol_file: Path, caps
 def test_the_protocol_as_written_is_taken(protocol_file: Path, capsys) -> None:
     assert main(["study", str(protocol_file)]) == 0
     assert "P01: A to do, B to do" in capsys.readouterr().out
+
+
+def test_every_variants_table_misspelt_is_said_to_be_misspelt(protocol_file: Path,
+                                                              capsys) -> None:
+    # with no [[variants]] left, it was said to have no variants at all
+    text = protocol_file.read_text(encoding="utf-8")
+    protocol_file.write_text(text.replace("[[variants]]", "[[varaints]]"), encoding="utf-8")
+    assert main(["study", str(protocol_file)]) == 2
+    err = capsys.readouterr().err
+    assert ": varaints: unknown key 'varaints' (did you mean 'variants'?)" in err
+    assert "needs at least one" not in err
