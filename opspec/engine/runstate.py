@@ -374,8 +374,12 @@ class RunState(Timers):
         if self.resolution > 0.0:
             delay = self._align(delay)
         self.sim_events += 1
-        self.schedule_timed(delay if delay > 0.0 else 0.0,  # noqa: FURB136 - no builtin call
-                           _Later(self, fn, ai, arg))
+        if TUPLES:      # from source, made without a Python frame for its __init__
+            entry: Any = _NEW(_Later)
+            entry.state, entry.fn, entry.ai, entry.arg, entry.gen = self, fn, ai, arg, ai.gen
+        else:
+            entry = _Later(self, fn, ai, arg)
+        self.schedule_timed(delay if delay > 0.0 else 0.0, entry)  # noqa: FURB136
 
     def later_entry(self, delay: float, entry: Timed) -> None:
         """:meth:`later` for a timed callback of the caller's own (one that calls its method
@@ -421,12 +425,9 @@ class RunState(Timers):
         return max(0.0, target - now)
 
     def call_at(self, delay: float, callback: Callable[[], None]) -> None:
-        """Run ``callback`` after ``delay`` simulated seconds, then drain.
-
-        A zero delay asked for while zero-time work is being drained (a performer answering
-        an offer at once) goes to the ready queue, after the work queued now, instead of
-        becoming a clock event (saves an event per instant answer; the user model answers
-        two or three offers per dose cycle that way)."""
+        """Run ``callback`` after ``delay`` simulated seconds, then drain. A zero delay while
+        draining (a performer answering at once) is queued behind the work queued now, not a
+        clock event (an event less per instant answer)."""
         if delay <= 0.0 and self.draining:
             self.ready.append((_CALL, callback, None, None))
             return
@@ -436,17 +437,19 @@ class RunState(Timers):
 
     def call_at_with(self, delay: float, fn: Callable[[Any, Any, Any], None],
                      a: Any, b: Any, c: Any) -> None:
-        """:meth:`call_at` for ``fn(a, b, c)``: the arguments kept beside the callback, not
-        in a ``functools.partial`` of it. A zero delay while draining queues the call itself
-        as a ready-queue item (no trampoline through ``_call``); otherwise its own timed
-        entry calls it, then drains. The session's ``call_later_with`` (the stochastic user's
-        answers from source: two or three a dose cycle go to the ready queue this way)."""
+        """:meth:`call_at` for ``fn(a, b, c)``, no ``functools.partial`` of it: at once while
+        draining, the call itself queued (no ``_call``); else a timed entry calls it, then
+        drains. The session's ``call_later_with`` (the stochastic user's, from source)."""
         if delay <= 0.0 and self.draining:
             self.ready.append((fn, a, b, c))
             return
         self.sim_events += 1
-        self.schedule_timed(delay if delay > 0.0 else 0.0,  # noqa: FURB136
-                           _CallWith(self, fn, a, b, c))
+        if TUPLES:      # from source, made without a Python frame for its __init__
+            entry: Any = _NEW(_CallWith)
+            entry.state, entry.fn, entry.a, entry.b, entry.c = self, fn, a, b, c
+        else:
+            entry = _CallWith(self, fn, a, b, c)
+        self.schedule_timed(delay if delay > 0.0 else 0.0, entry)  # noqa: FURB136
 
     def timer(self, delay: float, callback: Callable[[], None]) -> None:
         """Run ``callback`` after ``delay`` simulated seconds (it drains itself, if it
@@ -494,17 +497,14 @@ class RunState(Timers):
 #: how many run items of the ready queue drain keeps before dropping them from its front
 _COMPACT: Final = 4096
 
-#: Whether drain calls the two items every workflow instance queues (its first token, a
-#: body's end) as the native methods they are bound to (compiled: through Python's protocol,
-#: the bound method and its argument parsing, each call cost about 180 instructions more;
-#: from source the bound method is the cheaper call).
+#: Whether drain calls the two items every instance queues (its first token, a body's end)
+#: as native methods (compiled, Python's protocol cost ~180 instructions more a call).
 DIRECT: Final = not TUPLES
 
 
 def _same_instant(now: float, then: float) -> bool:
-    """Whether the clock has not really moved from ``then`` to ``now``: a Zeno run that
-    creeps by 1e-17 s a step (durations too short to matter, a fuzzed spec's) counts as one
-    instant, so the zero-time guard stops it as it stops a cycle of no time at all."""
+    """Whether the clock has not really moved: a Zeno creep of 1e-17 s a step (a fuzzed
+    spec's) is one instant, stopped by the zero-time guard as a cycle of no time at all."""
     return abs(now - then) <= 1e-9 * max(1.0, abs(now))
 
 
@@ -518,12 +518,13 @@ def _call(callback: Callable[[], None], _a: Any, _b: Any) -> None:
 
 
 _CALL: Final = _call        # a module static compiled (a global is a dictionary lookup)
+#: from source, a timed entry made without calling its class (see RunState.later)
+_NEW: Final[Callable[[type], Any]] = object.__new__
 
 
 @final
 class _Later(Timed):
-    """The timed callback of :meth:`RunState.later` (a small object, not a closure: one
-    allocation instead of two per timeout)."""
+    """The timed callback of :meth:`RunState.later` (not a closure: one allocation, not two)."""
 
     def __init__(self, state: RunState, fn: Callable[[ActivityInstance, Any], None],
                  ai: ActivityInstance, arg: Any) -> None:
