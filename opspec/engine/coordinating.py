@@ -59,7 +59,7 @@ def at_once(acts: Activities, frame: Frame, act: CompiledActivity) -> bool:
     result: Any = None
     box: deque[Any] | None = None
     if kind is _ARBITER:
-        result = coord.arbiter(values)
+        result = first_set(values)
     elif kind is _VOTER or kind is _SUPERPOSITION:
         try:
             result = (coord.voter(values, spec.options) if kind is _VOTER
@@ -104,6 +104,15 @@ def at_once(acts: Activities, frame: Frame, act: CompiledActivity) -> bool:
     return True
 
 
+def first_set(commands: list[Any]) -> Any:
+    """:func:`coordination.arbiter`, compiled (that module is not: a call into it through
+    Python's protocol is 1.2k instructions, once a period on a robot)."""
+    for command in commands:
+        if command is not None and command != "":
+            return command
+    return None
+
+
 def coordinate(acts: Activities, ai: ActivityInstance) -> None:
     """The body of a coordination built-in run as an instance: done (``body_done``), or
     waiting for a push (a pull from an empty mailbox), or failed."""
@@ -119,7 +128,7 @@ def coordinate(acts: Activities, ai: ActivityInstance) -> None:
     kind = spec.kind
     try:
         if kind is _ARBITER:
-            result: Any = coord.arbiter(values)
+            result: Any = first_set(values)
         elif kind is _VOTER:
             result = coord.voter(values, spec.options)
         elif kind is _SUPERPOSITION:

@@ -9,10 +9,13 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Any
 
+import pytest
 from builders import act, coordination, field, pkg, proc
 
 from conftest import completed, events, run
 from opspec.engine.config import EngineConfig
+from opspec.engine.coordinating import first_set
+from opspec.engine.coordination import arbiter
 from opspec.engine.trace import TraceEvent
 from opspec.request import RunRequest, prepare
 
@@ -63,3 +66,9 @@ def test_an_arbiter_missing_an_input_fails_through_its_instance(config: EngineCo
     assert completed(result) == ["good"]
     assert [e.data["cmd"] for e in events(result, "data.changed") if "cmd" in e.data] == [
         "forward"]
+
+
+@pytest.mark.parametrize("commands", [
+    [None, "turn", "forward"], ["stop", "turn"], [None, ""], [], ["", 0, "x"], [0.0, None]])
+def test_the_compiled_arbiter_is_the_arbiter(commands: list[object]) -> None:
+    assert first_set(commands) == arbiter(commands)
