@@ -37,6 +37,7 @@ MODULES: tuple[str, ...] = (
     "opspec.engine.compiling.context",
     "opspec.engine.compiling.graphs",
     "opspec.engine.conditions",
+    "opspec.engine.coordinating",
     "opspec.engine.dedicated",
     "opspec.engine.escalations",
     "opspec.engine.flow",

@@ -11,12 +11,10 @@ event, coordination), then :meth:`Activities.body_done` (loop again or complete)
 
 from __future__ import annotations
 
-from collections import deque
 from collections.abc import Callable, Mapping
 from typing import TYPE_CHECKING, Any, Final, final
 
-from opspec.engine import call_depth, multi_instance, plans, tools
-from opspec.engine import coordination as coord
+from opspec.engine import call_depth, coordinating, multi_instance, plans, tools
 from opspec.engine.compiled import (
     K_ASYNC,
     K_BLOCK,
@@ -35,17 +33,10 @@ from opspec.engine.part import Part
 from opspec.engine.timers import TUPLES, Timed
 from opspec.engine.trace import EventKind as EK
 from opspec.errors import OpspecError
-from opspec.model import CoordinationKind, ParameterMode
+from opspec.model import ParameterMode
 
 if TYPE_CHECKING:
     from opspec.engine.runstate import RunState
-
-# Compiled, an enum member read from its class goes through the metaclass (2.5k per robot instance)
-_ARBITER: Final = CoordinationKind.ARBITER
-_VOTER: Final = CoordinationKind.VOTER
-_SUPERPOSITION: Final = CoordinationKind.SUPERPOSITION
-_PUSH_DATA: Final = CoordinationKind.PUSH_DATA
-_PULL_DATA: Final = CoordinationKind.PULL_DATA
 
 #: Whether ``body_done`` reads a dict of answers as one (compiled: the dict's own iteration;
 #: a Mapping's is an ``items`` method call through Python's protocol and an iterator, 0.7k a
@@ -137,7 +128,10 @@ class Activities(Part):
             return None
 
     def start_slow(self, frame: Frame, act: CompiledActivity) -> None:
-        """Start ``act``, which waits or takes time: as an activity instance."""
+        """Start ``act``, which waits or takes time: as an activity instance (a coordination
+        built-in done at once without one: :func:`coordinating.at_once`)."""
+        if act.kind == K_COORD and act.plain and coordinating.at_once(self, frame, act):
+            return
         state = self.state
         state.last_key += 1                   # RunState.next_key, in line
         ai = ActivityInstance(state.last_key, act, frame, state.now, RUNNING)
@@ -500,58 +494,11 @@ class Activities(Part):
                 queue.remove(ai)
 
     def _coordinate(self, ai: ActivityInstance) -> None:
-        act = ai.act
-        spec = act.coordination
-        assert spec is not None
-        scope = ai.scope()
-        try:
-            values = [scope[name] for name in spec.inputs]
-        except KeyError as error:
-            self.fail(ai, "coordination", f"data field {error.args[0]!r} does not exist")
-            return
-        kind = spec.kind
-        try:
-            if kind is _ARBITER:
-                result: Any = coord.arbiter(values)
-            elif kind is _VOTER:
-                result = coord.voter(values, spec.options)
-            elif kind is _SUPERPOSITION:
-                result = coord.superposition(values, spec.weights)
-            elif kind is _PUSH_DATA:
-                self.push_data(spec.channel or act.id, values[0] if len(values) == 1
-                               else tuple(values))
-                self.body_done(ai, None)
-                return
-            elif kind is _PULL_DATA:
-                channel = spec.channel or act.id
-                box = self.state.mailboxes.get(channel)
-                if box:
-                    self.body_done(ai, {spec.output: box.popleft()} if spec.output else None)
-                else:
-                    ai.waiting = f"pull from mailbox {channel!r}"
-                    self.state.pullers.setdefault(channel, deque()).append(ai)
-                return
-            else:
-                # at once: a mode ending this instance stops all after it (its completion too)
-                self.triggers.change_mode(spec.target_mode or "", act, ai.frame.inst)
-                self.body_done(ai, None)
-                return
-        except (TypeError, ValueError) as error:
-            self.fail(ai, "coordination", f"{kind.value} failed: {error}")
-            return
-        self.body_done(ai, {spec.output: result} if spec.output else None)
+        coordinating.coordinate(self, ai)
 
     def push_data(self, channel: str, value: Any) -> None:
         """Put ``value`` into supervisor mailbox ``channel``; a waiting pull gets it."""
-        pullers = self.state.pullers.get(channel)
-        while pullers:
-            ai = pullers.popleft()
-            if ai.state == RUNNING:
-                output = ai.act.coordination.output if ai.act.coordination else None
-                self.state.ready.append((self.body_done_q, ai,
-                                    {output: value} if output else None, None))
-                return
-        self.state.mailboxes.setdefault(channel, deque()).append(value)
+        coordinating.push(self, channel, value)
 
 
 class AnswersAtOnce:

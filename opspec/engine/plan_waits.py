@@ -17,12 +17,14 @@ from typing import Any
 from opspec.engine.call_depth import MAX_CALL_DEPTH
 from opspec.engine.compiled import (
     K_CATCH,
+    K_COORD,
     K_GATEWAY,
     K_MANUAL,
     K_SUBFLOW,
     CompiledActivity,
     CompiledProcess,
 )
+from opspec.engine.coordinating import at_once
 
 __all__ = ["WaitingCode", "catches_itself", "chooses_itself", "offers_itself"]
 
@@ -84,7 +86,10 @@ class WaitingCode:
         elif chooses_itself(act):
             start = [*self.instance(act, pad), *self.started(act, pad), *self.choice(act, pad)]
         elif act.plain and not act.general and not act.start_assign:
-            start = [*self.instance(act, pad), *self.started(act, pad),
+            # a coordination built-in done at once needs no instance (coordinating.at_once)
+            coordinates = ([f"{pad}if {self.name('F', at_once)}(activities, frame, {a}):",
+                            f"{pad}    return"] if act.kind == K_COORD else [])
+            start = [*coordinates, *self.instance(act, pad), *self.started(act, pad),
                      *(self.call(act, pad) if act.kind == K_SUBFLOW
                        else [f"{pad}activities._body(ai)"]), f"{pad}return"]
         else:
