@@ -28,6 +28,9 @@ from builders import (
     route,
     subflow,
 )
+from plan_ways import WAYS, run_both
+from plan_ways import seen as _seen
+from plan_ways import use_way as _way
 
 from opspec.engine import plans
 from opspec.engine.builtin_performers import ScriptedUser
@@ -37,13 +40,6 @@ from opspec.model import Package
 from opspec.request import RunRequest, prepare
 
 ROOT = Path(__file__).resolve().parents[2]
-WAYS = ("plans", "interpreter")
-
-
-def _way(monkeypatch: pytest.MonkeyPatch, way: str) -> None:
-    monkeypatch.setattr(plans, "COMPILED", way != "plans")
-
-
 def _counting(sim: Any) -> dict[str, int]:
     """Wrap the run's branch plans so the test sees that they ran (by branch activity)."""
     ran: dict[str, int] = {}
@@ -55,12 +51,6 @@ def _counting(sim: Any) -> dict[str, int]:
             fn(frame, activities, taken)
         performs[trans] = counted
     return ran
-
-
-def _seen(result: Any) -> tuple[Any, ...]:
-    trace = [(e.time, e.kind, e.process, e.instance, e.activity, e.lane, e.participant,
-              e.package, dict(e.data), e.seq) for e in result.trace]
-    return trace, result.summary, result.metrics
 
 
 class _Picks(ScriptedUser):
@@ -82,19 +72,8 @@ class _Picks(ScriptedUser):
 def _both(monkeypatch: pytest.MonkeyPatch, package: Package, make_user: Any = _Picks,
           until: float = 1000.0) -> tuple[Any, dict[str, int]]:
     """Run ``package`` both ways; assert they agree; the result and the branches run."""
-    seen = []
-    ran: dict[str, int] = {}
-    for way in WAYS:
-        _way(monkeypatch, way)
-        sim = Simulation(compile_package(package), keep_trace=True,
-                         performers={"user": make_user()})
-        if way == "plans":
-            ran = _counting(sim)
-        else:
-            assert not sim.flow.performs
-        seen.append(_seen(sim.run(until=until)))
-    assert seen[0] == seen[1]
-    return seen[0], ran
+    return run_both(monkeypatch, package, until, _counting, lambda sim: sim.flow.performs,
+                    lambda: {"performers": {"user": make_user()}})
 
 
 @pytest.mark.parametrize("name", ["medication_dispenser.xpdl", "medication_dispenser.bpmn"])

@@ -13,8 +13,9 @@ from typing import Any
 
 import pytest
 from builders import act, app, field, formal, lookup_subflow, manual, pkg, proc, subflow, task
-from conftest import AnswersLater
+from plan_ways import seen as _seen
 
+from conftest import AnswersLater
 from opspec.engine import plans
 from opspec.engine.compiled import CompiledPackage, compile_package
 from opspec.engine.config import EngineConfig
@@ -60,12 +61,6 @@ def _counting(sim: Simulation) -> dict[str, int]:
 
 def _planless(sim: Simulation) -> bool:
     return all(proc_.plan is None for proc_ in sim.compiled.processes.values())
-
-
-def _seen(result: Any) -> tuple[Any, ...]:
-    trace = [(e.time, e.kind, e.process, e.instance, e.activity, e.lane, e.participant,
-              e.package, dict(e.data), e.seq) for e in result.trace]
-    return trace, result.summary, result.metrics
 
 
 def _three(monkeypatch: pytest.MonkeyPatch, package: Package, until: float = 100.0,

@@ -28,9 +28,11 @@ from builders import (
     task,
     throw,
 )
+from plan_ways import WAYS, run_both
+from plan_ways import seen as _seen
+from plan_ways import use_way as _way
 
 from conftest import AnswersLater
-from opspec.engine import plans
 from opspec.engine.compiled import compile_package
 from opspec.engine.config import EngineConfig
 from opspec.engine.simulation import Simulation
@@ -40,13 +42,6 @@ from opspec.request import RunRequest, prepare
 from opspec.xpdl.conditions import parse_condition
 
 ROOT = Path(__file__).resolve().parents[2]
-WAYS = ("plans", "interpreter")
-
-
-def _way(monkeypatch: pytest.MonkeyPatch, way: str) -> None:
-    monkeypatch.setattr(plans, "COMPILED", way != "plans")
-
-
 def _counting(sim: Any) -> dict[str, int]:
     """Wrap the run's resume plans so the test sees that they ran (by activity id)."""
     ran: dict[str, int] = {}
@@ -59,27 +54,11 @@ def _counting(sim: Any) -> dict[str, int]:
     return ran
 
 
-def _seen(result: Any) -> tuple[Any, ...]:
-    trace = [(e.time, e.kind, e.process, e.instance, e.activity, e.lane, e.participant,
-              e.package, dict(e.data), e.seq) for e in result.trace]
-    return trace, result.summary, result.metrics
-
-
 def _both(monkeypatch: pytest.MonkeyPatch, package: Package, until: float = 100.0,
           **kwargs: Any) -> tuple[Any, dict[str, int]]:
     """Run ``package`` both ways; assert they agree; the result and the resumes that ran."""
-    seen = []
-    ran: dict[str, int] = {}
-    for way in WAYS:
-        _way(monkeypatch, way)
-        sim = Simulation(compile_package(package), keep_trace=True, **kwargs)
-        if way == "plans":
-            ran = _counting(sim)
-        else:
-            assert not sim.activities.resumes
-        seen.append(_seen(sim.run(until=until)))
-    assert seen[0] == seen[1]
-    return seen[0], ran
+    return run_both(monkeypatch, package, until, _counting,
+                    lambda sim: sim.activities.resumes, lambda: dict(kwargs))
 
 
 @pytest.mark.parametrize("spec", ["medication_dispenser.xpdl --days 3",
