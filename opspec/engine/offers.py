@@ -241,51 +241,13 @@ class Offers(Part):
             state.ready.append((self.choose_q, ai, trans, data))
         elif act.toolchain and key in state.tool_at:
             state.ready.append((self.activities.tool_done, ai, data, None))
-        else:
-            if not data:
-                data = None
-            elif act.params:
+        elif data:
+            if act.params:
                 data = tools.outputs(ai, data)
-            if not state.draining:
-                self._body_done_now(ai, data)
-                return
             state.ready.append((self.activities.body_done_q, ai, data, None))
+        else:
+            state.ready.append((self.activities.body_done_q, ai, None, None))
         if not state.draining:
-            state.drain()
-
-    def _body_done_now(self, ai: ActivityInstance, data: Mapping[str, Any] | None) -> None:
-        """``drain`` with ``body_done(ai, data)`` queued first, that first item run here
-        (a performer's answer from a timed callback, about three a dose cycle: no tuple
-        queued and taken back). The step counts, the instant and the zero-time guard are
-        drain's own; where drain would have work before it, a frame to resolve, or its
-        guard near the limit, the item is queued and drained as before."""
-        state = self.state
-        now = state.now                 # drain's start, as it is (the instant moved on?)
-        instant = state.instant
-        if now != instant:
-            moved = now - instant if now > instant else instant - now
-            if moved > 1e-9 * (now if now > 1.0 else 1.0):  # noqa: FURB136 (no call)
-                state.instant = now
-                state.instant_steps = 0
-                if state.sampler is not None:   # the clock moved on: no cycle after all
-                    state.sampler = None
-                    state.start_limit = state.max_instant_steps
-        ready = state.ready
-        steps = state.instant_steps
-        if ready or state.pending or steps + 2 > state.max_instant_steps:
-            ready.append((self.activities.body_done_q, ai, data, None))
-            state.drain()
-            return
-        # drain counts a step for itself and one for each item run; while the item runs it
-        # still holds the count from before (drain stores it when it ends)
-        state.draining = True
-        try:
-            self.activities.body_done(ai, data, None)
-        finally:
-            state.draining = False
-            state.instant_steps = steps + 2
-        if ready or state.pending:      # what it queued: drain's own step stands for ours
-            state.instant_steps = steps + 1
             state.drain()
 
     def performer_omit(self, item: WorkItem, reason: str) -> None:
