@@ -26,7 +26,7 @@ day), optionally followed by ``am``/``pm``.
 Rates: ``10``, ``10Hz``, ``2.5 kHz``, ``10/s``, ``6 per minute``, ``3/h``, ``2/day``.
 
 Writing: :func:`clock_time` (``d1 08:00:00``, the timeline of ``opspec run``, traces and
-violations), :func:`time_of_day` (``08:00``), :func:`span` (``4 h``, ``90 s``) and
+violations), :func:`time_of_day` (``08:00``), :func:`span` (``4 h``, ``1 min 11.833 s``) and
 :func:`figure` (a measured value as ``opspec run`` and the walkthrough print a metric:
 ``97.49 s``). A trace event as a line of text is :mod:`opspec.engine.trace_text`'s.
 
@@ -256,14 +256,38 @@ def time_of_day(seconds: float) -> str:
 
 def span(seconds: float) -> str:
     """A length of time for people, in the largest unit that reads well: ``2 days``,
-    ``4 h``, ``1.5 h``, ``15 min``, ``90 s``, ``0.25 s`` (what :func:`parse_duration` reads
-    back)."""
+    ``4 h``, ``1.5 h``, ``3.75 h``, ``15 min``, ``1.5 min``, ``45 s``, ``0.25 s``; a length
+    that is no number of hours or minutes with at most two decimals is written in parts, to
+    the millisecond as :func:`clock_time` is: ``1 min 11.833 s``, ``1 h 10 min`` (what
+    :func:`parse_duration` reads back)."""
     for unit, size in (("day", DAY), ("h", 3600.0), ("min", 60.0)):
         if seconds >= size and (seconds % size == 0 or unit != "day"):
             count = seconds / size
-            plural = "s" if unit == "day" and count != 1 else ""
-            return f"{count:g} {unit}{plural}"
+            if unit == "day" or _two_decimals(count):
+                plural = "s" if unit == "day" and count != 1 else ""
+                return f"{count:g} {unit}{plural}"
+            return _parts(seconds)
     return f"{seconds:g} s"
+
+
+def _two_decimals(count: float) -> bool:
+    """Whether ``count`` is written exactly with at most two decimals (``3.75``, not the
+    ``1.19722`` of 71.833 s in minutes), allowing for the float's rounding (``4.2 * 3600``)."""
+    hundredths = count * 100.0
+    return abs(hundredths - round(hundredths)) <= 1e-9 * max(1.0, hundredths)
+
+
+def _parts(seconds: float) -> str:
+    """``1 h 25 min 42.857 s`` for a span of a minute and more that :func:`span` cannot
+    write as one number of its unit: whole hours and minutes, then the seconds to the
+    millisecond (``1.19722 min`` is not how anyone writes 71.833 s)."""
+    millis = round(seconds * 1000.0)
+    hours, rest = divmod(millis, 3_600_000)
+    minutes, rest = divmod(rest, 60_000)
+    parts = [f"{count} {unit}" for count, unit in ((hours, "h"), (minutes, "min")) if count]
+    if rest:
+        parts.append(f"{rest / 1000:g} s")
+    return " ".join(parts)
 
 
 def figure(value: object, unit: str = "") -> str:

@@ -207,7 +207,19 @@ def test_times_of_day_are_written_as_they_are_read(seconds: float, text: str) ->
 
 @pytest.mark.parametrize(("seconds", "text"), [
     (86_400.0, "1 day"), (2 * 86_400.0, "2 days"), (90_000.0, "25 h"), (14_400.0, "4 h"),
-    (5400.0, "1.5 h"), (900.0, "15 min"), (90.0, "1.5 min"), (45.0, "45 s"), (0.25, "0.25 s")])
+    (5400.0, "1.5 h"), (900.0, "15 min"), (90.0, "1.5 min"), (45.0, "45 s"), (0.25, "0.25 s"),
+    (13_500.0, "3.75 h"), (66.0, "1.1 min"), (4.2 * 3600.0, "4.2 h"),
+    # no number of the unit with two decimals: written in parts, as a person writes it (the
+    # dispenser's mean walk, 1.19722 min before), to the millisecond
+    (71.833, "1 min 11.833 s"), (4200.0, "1 h 10 min"), (14_120.0, "3 h 55 min 20 s"),
+    (12342.857, "3 h 25 min 42.857 s"), (90061.0, "25 h 1 min 1 s"), (3630.0, "1 h 30 s")])
 def test_spans_are_written_as_they_are_read(seconds: float, text: str) -> None:
     assert clock.span(seconds) == text
     assert clock.parse_duration(text) == pytest.approx(seconds)
+
+
+@pytest.mark.parametrize("seconds", [119.9996, 3599.9996, 71.83333333, 86_399.9])
+def test_a_span_in_parts_is_read_back_to_the_millisecond(seconds: float) -> None:
+    text = clock.span(seconds)
+    assert "." not in text.split()[0]          # no 1.19722 min, no 0.999999 h
+    assert clock.parse_duration(text) == pytest.approx(seconds, abs=0.0005)

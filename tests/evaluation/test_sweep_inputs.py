@@ -84,6 +84,9 @@ def test_sweep_list_prints_every_parameter_with_its_unit_and_value(capsys, tmp_p
     line = next(x for x in out.splitlines() if "wait_report.deadline" in x)
     assert "duration" in line and "5 min" in line
     assert "user.activities.walk_to_dispenser.duration.median" in out
+    # a derived value is written as a person writes it, not as 1.19722 min
+    mean = next(x for x in out.splitlines() if "walk_to_dispenser.duration.mean" in x)
+    assert "1 min 11.833 s" in mean
 
 
 def test_the_report_draws_the_sweep_and_resume_reports_it_again(capsys, tmp_path):

@@ -98,5 +98,5 @@ def test_gap(spec, simulate):
         "E * monitor violations:",
         "E * min_gap dispense 4h: 1 violation(s) in 1/1 replication(s); 1 per user-day *",
         ("E * min_gap dispense 4h: d1 22:00:10: activity dispense at d1 18:04:50 and "
-        "again at d1 22:00:10, 3.92222 h apart (at least 4 h required)"),
+        "again at d1 22:00:10, 3 h 55 min 20 s apart (at least 4 h required)"),
         "E *d1 18:04:50 * activity.completed   dispense"])

@@ -84,7 +84,7 @@ def test_the_4_hour_gap_is_broken_by_a_late_then_prompt_report_and_3h45m_is_not(
     (violation,) = four.first
     assert violation.time == 22 * 3600 + 10
     assert [e.activity for e in violation.events] == ["dispense", "dispense"]
-    assert "18:04:50 and again at d1 22:00:10, 3.92222 h apart" in violation.message
+    assert "18:04:50 and again at d1 22:00:10, 3 h 55 min 20 s apart" in violation.message
     assert not report.ok
     with pytest.raises(AssertionError, match=r"(?s)min_gap dispense 4h: 1 violation.*"
                                              r"#10 notify_workflow +activity.completed +dispense"):
