@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import argparse
 import os
+import sys
 from typing import Any
 
 from opspec.commands import _args
@@ -59,7 +60,8 @@ def register(subparsers: Any) -> None:
                         "--users / B, at least 10)")
     _args.add_engine_config(parser)
     parser.add_argument("--workers", type=int, default=None,
-                        help="worker processes (default: all local cores)")
+                        help="worker processes (default, and at most: the cores this "
+                        "process may run on)")
     parser.add_argument("--scheduler", metavar="ADDRESS",
                         help="run on an existing Dask distributed cluster (tcp://host:8786)")
     parser.add_argument("--scheduler-timeout", type=float, default=None, metavar="SECONDS",
@@ -119,9 +121,18 @@ def _local_cores() -> int:
 
 
 def run(args: argparse.Namespace) -> int:
-    workers = args.workers if args.workers is not None else _local_cores()
+    cores = _local_cores()
+    workers = args.workers if args.workers is not None else cores
     if workers < 1:
         raise EvaluationError(f"--workers must be >= 1, not {workers}")
+    listing = bool(args.sweep) and args.sweep[0] == "list"
+    if workers > cores and not args.scheduler and not listing:
+        # the results are the same for any number of workers (docs/evaluation.md): a
+        # process more than the cores runs no sooner, it only takes memory and start-up
+        print(f"opspec evaluate: --workers {workers}: this process may run on {cores} "
+              f"core{'s' * (cores != 1)}, so {cores} worker{'s run' if cores != 1 else ' runs'} (the "
+              "results are the same for any number of workers)", file=sys.stderr)
+        workers = cores
     from opspec.evaluation import plots
 
     # the report's drawing processes (--workers W > 1) start now: the first imports
@@ -129,8 +140,6 @@ def run(args: argparse.Namespace) -> int:
     # run's one serial part, which leaves the other cores idle), then forks the others,
     # which inherit its import; a bad input ends them at once (plots.drawing_processes), so
     # its error comes as fast as before
-    listing = bool(args.sweep) and args.sweep[0] == "list"
-    cores = _local_cores()
     with plots.drawing_processes(1 if listing else min(workers, cores)):
         from opspec.commands.evaluate_run import evaluate
 

@@ -15,7 +15,13 @@ from conftest import SPEC, USERS_TOML, metrics_of
 from opspec.cli import main
 
 
-def test_same_seed_gives_the_same_results_with_one_or_two_workers(evaluate, tmp_path):
+def test_same_seed_gives_the_same_results_with_one_or_two_workers(evaluate, monkeypatch,
+                                                                    tmp_path):
+    import opspec.commands.evaluate as command
+
+    # two worker processes even on a machine of one core (the command runs at most as many
+    # as the cores it may run on)
+    monkeypatch.setattr(command, "_local_cores", lambda: 2)
     args = [str(SPEC), "--users", "12", "--days", "3", "--seed", "5"]
     s1, one, _ = evaluate(*args, "--workers", "1", "--out", str(tmp_path / "w1"))
     s2, two, _ = evaluate(*args, "--workers", "2", "--out", str(tmp_path / "w2"), report=False)
