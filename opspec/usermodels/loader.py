@@ -417,11 +417,16 @@ def preset_names() -> list[str]:
 
 
 def resolve_preset(name: str) -> Path:
-    """The file of bundled preset ``name``; :class:`UserModelError` listing the presets."""
+    """The file of bundled preset ``name``; :class:`UserModelError` naming the closest
+    preset and listing them all."""
     folder = resources.files("opspec.usermodels") / "presets"
     candidate = folder / f"{name}.toml"
     if not candidate.is_file():
-        raise UserModelError(f"no user model file or preset called {name!r}",
+        import difflib
+
+        close = difflib.get_close_matches(name, preset_names(), n=1)
+        meant = f"; did you mean {close[0]!r}?" if close else ""
+        raise UserModelError(f"no user model file or preset called {name!r}{meant}",
                              hint="give a path to a .toml file or one of the presets: "
                              + ", ".join(preset_names()))
     return Path(str(candidate))

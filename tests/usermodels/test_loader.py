@@ -109,6 +109,23 @@ def test_an_unknown_preset_lists_the_presets() -> None:
         load_user_model("young")
 
 
+@pytest.mark.parametrize(("typo", "meant"), [("older-adlts", "older-adults"),
+                                             ("olderadults", "older-adults"),
+                                             ("dispenser-referance", "dispenser-reference")])
+def test_a_misspelt_preset_gets_the_closest_one_and_the_list(typo: str, meant: str) -> None:
+    with pytest.raises(UserModelError) as refused:
+        load_user_model(typo)
+    said = str(refused.value)
+    assert f"no user model file or preset called {typo!r}; did you mean {meant!r}?" in said
+    assert "klm" in said                  # and every preset, as before
+
+
+def test_a_name_near_no_preset_gets_no_guess() -> None:
+    with pytest.raises(UserModelError) as refused:
+        load_user_model("zzzz")
+    assert "did you mean" not in str(refused.value)
+
+
 def test_uncovered_manual_activities_name_the_file_the_ids_and_the_fix(tmp_path: Path) -> None:
     model = load_user_model(write(tmp_path, GOOD))
     with pytest.raises(UserModelError, match=r"users.toml:3: activities: user model 'users' does "
