@@ -165,7 +165,8 @@ def check_model(model: UserModel, model_ref: str | None, paths: Sequence[Path],
 
     obs = collect(paths, options.lane, persons)
     without = without_lane_text(obs, options.lane)
-    overlap = _fitted_on_notes(model_ref, obs.persons) + ([without] if without else [])
+    fitted_on, overlap = _fitted_on_notes(model_ref, obs.persons)
+    overlap += [without] if without else []
     draws = (_draws(model_ref) if options.parameter_uncertainty and model_ref else None)
     repeated: dict[str, dict[str, int]] = {}
     traced = False
@@ -211,25 +212,26 @@ def check_model(model: UserModel, model_ref: str | None, paths: Sequence[Path],
         uncertainty = "ignored (--no-parameter-uncertainty)"
     return CheckReport(finish(items, options.level), options.level, len(obs.persons),
                        obs.sessions, options.replicates, options.seed, uncertainty,
-                       tuple(overlap + notes))
+                       tuple(overlap + notes), fitted_on)
 
 
-def _fitted_on_notes(model_ref: str | None, persons: Sequence[str]) -> list[str]:
-    """A note when people checked are among those the model was fitted on (its
-    ``[fitted_on]`` table): their fit to the model says little of new people."""
+def _fitted_on_notes(model_ref: str | None, persons: Sequence[str]) -> tuple[int, list[str]]:
+    """How many people checked are among those the model was fitted on (its
+    ``[fitted_on]`` table), and a note naming them: their fit to the model says little of
+    new people."""
     from opspec.usermodels.fitted_on import fitted_persons
 
     fitted = fitted_persons(model_ref)
     if not fitted:
-        return []
+        return 0, []
     both = [p for p in persons if p in set(fitted)]
     if not both:
-        return []
+        return 0, []
     shown = ", ".join(both[:6]) + (" ..." if len(both) > 6 else "")
     note = (f"{len(both)} of the {len(persons)} person(s) checked are among the "
             f"{len(fitted)} the model was fitted on ({shown}; its [fitted_on] table): a check "
             "on them is not a check on new people; give only people left out of the fit")
-    return [note]
+    return len(both), [note]
 
 
 def _other_spec_notes(paths: Sequence[Path], spec: str) -> list[str]:
@@ -316,9 +318,11 @@ def _model_check(args: argparse.Namespace) -> int:
     if args.report:
         from opspec.evaluation.model_check_report import write_report
 
+        # "held-out" only when none of them is known to have been in the fit
+        held = "" if report.fitted_on else "held-out "
         written = write_report(report, args.report,
                                title=f"Model check: {args.model} against "
-                               f"{report.persons} held-out person(s)")
+                               f"{report.persons} {held}person(s)")
     if args.json:
         doc = {"model": args.model, "traces": [str(p) for p in paths], **report.to_json(),
                "report": str(written) if written else None}

@@ -120,6 +120,8 @@ class CheckReport:
     seed: int
     uncertainty: str
     notes: tuple[str, ...] = ()
+    #: how many of the persons checked the model was fitted on (its ``[fitted_on]`` table)
+    fitted_on: int = 0
 
     @property
     def misfits(self) -> tuple[CheckItem, ...]:
@@ -142,15 +144,29 @@ class CheckReport:
             out.append(f"verdict: {len(self.misfits)} of {len(self.items)} item(s) misfit "
                        f"at family-wise level {self.level:g}: {names}")
         else:
-            out.append(f"verdict: the model fits these {self.persons} person(s): none of "
-                       f"{len(self.items)} item(s) misfits at family-wise level {self.level:g}")
+            out.append(f"verdict: {self._fits_verdict()}")
         return out
+
+    def _fits_verdict(self) -> str:
+        """What no misfit says: that the model fits these people, and — when they were
+        all in its fit — only that it reproduces what it was fitted on."""
+        none = (f"none of {len(self.items)} item(s) misfits at family-wise level "
+                f"{self.level:g}")
+        if self.fitted_on >= self.persons > 0:
+            return (f"{none}, but all {self.persons} person(s) checked are among those the "
+                    "model was fitted on: it reproduces the people it was fitted on, which "
+                    "says nothing of how it predicts new people")
+        if self.fitted_on:
+            return (f"the model fits these {self.persons} person(s), {self.fitted_on} of "
+                    f"them among those it was fitted on: {none}")
+        return f"the model fits these {self.persons} person(s): {none}"
 
     def to_json(self) -> dict[str, Any]:
         return {"fits": self.fits, "level": self.level,
                 "family_wise": {"method": "holm", "items": len(self.items),
                                 "statement": self.method()},
-                "persons": self.persons, "sessions": self.sessions,
+                "persons": self.persons, "persons_fitted_on": self.fitted_on,
+                "sessions": self.sessions,
                 "replicates": self.replicates, "seed": self.seed,
                 "parameter_uncertainty": self.uncertainty,
                 "misfits": [i.name for i in self.misfits],
