@@ -11,7 +11,8 @@ Graphviz digraph per process (opspec.xpdl.dot; render it with e.g.
 its lanes and the messages between them in one picture (opspec.xpdl.picture, laid out by
 Graphviz's dot program: 'opspec show SPEC --format html -o spec.html' writes the file only
 when the picture is drawn; without dot, a one-line error with the install hint and exit
-status 2). Every error opspec validate finds is printed on stderr (the spec is still shown).
+status 2). Every error opspec validate finds is printed on stderr (the spec is still shown),
+in a compiled workflow script (.wfs) too: it may have been edited since it was compiled.
 
 Exit status: 0 shown, no errors; 1 shown, but the spec has errors (or the file holds no usable
 package); 2 the file cannot be read, the process does not exist, or -o names the spec or a
@@ -63,7 +64,7 @@ def run(args: argparse.Namespace) -> int:
     if getattr(args, "output", None) == "-":
         args.output = None                  # '-': the standard output (a file named '-' before)
     if str(args.spec).endswith(".wfs"):
-        result = load_script(args.spec)
+        result = _checked_script(args.spec)
     else:
         result = _validated(args.spec)
     package = result.package
@@ -88,9 +89,12 @@ def run(args: argparse.Namespace) -> int:
         print(diagnostic, file=sys.stderr)
     if errors:
         count = len(errors)
+        # validate reads no script: a script's errors are said as check says them
+        said = (f"as 'opspec check {args.spec}' counts them; fix the script or compile its "
+                "spec again" if str(args.spec).endswith(".wfs") else
+                f"as 'opspec validate {args.spec}' reports them")
         print(f"opspec show: {args.spec} has {count} error{'s' * (count != 1)} (listed above, "
-              f"as 'opspec validate {args.spec}' reports them); it cannot run",
-              file=sys.stderr)
+              f"{said}); it cannot run", file=sys.stderr)
     if not package.processes:
         print(f"opspec show: {args.spec} declares no process", file=sys.stderr)
     if args.format in ("svg", "html"):
@@ -206,6 +210,34 @@ def load_script(path: str) -> Any:
         message = error.message.removeprefix(f"{path}: ")
         return LoadResult(None, (Diagnostic(location, Severity.ERROR, "bad-script", message,
                                             error.hint or ""),))
+
+
+def _checked_script(path: str) -> Any:
+    """:func:`load_script` with every error ``opspec validate`` finds in the package it
+    holds, as ``opspec check`` checks a script: it was compiled from a spec without errors,
+    but may have been edited since (a transition to an activity that is not there showed
+    with exit status 0, and only ``run`` refused it)."""
+    from opspec.commands.validate import engine_checks
+    from opspec.errors import Severity
+    from opspec.model.checks import check_package
+    from opspec.xpdl.loader import LoadResult
+    from opspec.xpdl.validate import (
+        merge_diagnostics,
+        mode_source_diagnostics,
+        preprocessed_mode_diagnostics,
+    )
+
+    result = load_script(path)
+    package = result.package
+    if package is None:
+        return result
+    # as validate_spec checks a package it read: the engine's judgement only of a package
+    # the structural checks pass
+    checks = [*check_package(package), *mode_source_diagnostics(package),
+              *preprocessed_mode_diagnostics(package)]
+    if not any(d.severity is Severity.ERROR for d in checks):
+        checks.extend(engine_checks(package))
+    return LoadResult(package, merge_diagnostics(checks))
 
 
 #: The largest picture handed to Graphviz, in lines of its input (about one per node and

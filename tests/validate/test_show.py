@@ -236,6 +236,31 @@ def test_show_reads_a_compiled_script_like_its_source(
     assert capsys.readouterr().out == from_source
 
 
+def test_show_of_an_edited_script_says_its_errors_as_check_does(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A script is compiled from a spec without errors, but may be edited since: show checks
+    it as validate checks a spec (it showed a transition to nowhere with exit status 0;
+    only run refused it)."""
+    import json
+
+    script = tmp_path / "dispenser.wfs"
+    _compile(DISPENSER, script, capsys)
+    doc = json.loads(script.read_text(encoding="utf-8"))
+    doc["package"]["processes"][0]["transitions"][0]["target"] = "nowhere"
+    edited = tmp_path / "edited.wfs"
+    edited.write_text(json.dumps(doc), encoding="utf-8")
+    assert main(["show", str(edited)]) == 1
+    shown = capsys.readouterr()
+    assert "timer_workflow" in shown.out                   # still shown
+    assert ":93: error: Transition 't_tick' points to activity 'nowhere'" in shown.err
+    assert shown.err.splitlines()[-1] == (
+        f"opspec show: {edited} has 1 error (listed above, as 'opspec check {edited}' counts "
+        "them; fix the script or compile its spec again); it cannot run")
+    assert main(["show", str(script)]) == 0                # as compiled: nothing to say
+    assert capsys.readouterr().err == ""
+
+
 def test_validate_of_a_compiled_script_says_it_takes_xpdl(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
