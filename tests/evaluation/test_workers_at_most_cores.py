@@ -8,7 +8,7 @@ from __future__ import annotations
 from pathlib import Path
 
 import opspec.commands.evaluate as command
-import opspec.evaluation.runner as runner
+from opspec.evaluation import runner
 
 ROOT = Path(__file__).resolve().parents[2]
 SPEC = ROOT / "specs" / "medication_dispenser.xpdl"
@@ -35,8 +35,8 @@ def test_more_workers_than_cores_run_as_many_as_the_cores(evaluate, monkeypatch,
     assert status == 0 and doc is not None
     assert doc["workers"] == 2 and pools == [2]
     said = [line for line in err.splitlines() if "--workers 100" in line]
-    assert said == ["opspec evaluate: --workers 100: this process may run on 2 cores, so 2 "
-                    "workers run (the results are the same for any number of workers)"]
+    assert said == [("opspec evaluate: --workers 100: this process may run on 2 cores, so 2 "
+                     "workers run (the results are the same for any number of workers)")]
 
 
 def test_workers_up_to_the_cores_are_taken_as_given(evaluate, monkeypatch, tmp_path):

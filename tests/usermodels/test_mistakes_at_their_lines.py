@@ -146,8 +146,8 @@ def test_the_second_correlation_of_a_population_is_at_its_line(tmp_path: Path) -
 
 @pytest.mark.parametrize(("ref", "says"), [
     ("nope.toml", "extends 'nope.toml': user model file not found"),
-    ("older-adult", "extends 'older-adult': no user model file or preset called 'older-adult'"
-                    "; did you mean 'older-adults'?"),
+    ("older-adult", ("extends 'older-adult': no user model file or preset called "
+                     "'older-adult'; did you mean 'older-adults'?")),
 ])
 def test_a_base_that_does_not_exist_is_refused_at_the_extends_line(
         tmp_path: Path, ref: str, says: str) -> None:
