@@ -30,8 +30,23 @@ __all__ = ["RunInputs", "no_such_field"]
 
 def no_such_field(name: str, package: Package, where: str) -> ConfigurationError:
     """The error for a value given to ``name``, which is not a package data field of
-    ``package`` (what ``--param``, ``--params`` and the API's ``params`` may set: a run's value
-    for anything else would be set nowhere anyone reads it), with the closest name."""
+    ``package`` (what ``--param``, ``--params``, the API's ``params`` and a scenario's
+    ``given.params`` may set: a run's value for anything else would be set nowhere anyone
+    reads it): that it is a process's formal parameter when it is one, else the closest
+    name."""
+    owners = [p.id for p in package.processes
+              if any(f.id == name for f in p.formal_parameters)]
+    if owners:
+        # validate's unpassed-parameter warning sends the user here: "no package data
+        # field" would leave them guessing what to change
+        return ConfigurationError(
+            f"{where}: {name!r} is a formal parameter of process {owners[0]!r}, not a "
+            "package data field: run inputs set package data fields only (a formal "
+            "parameter gets its value from the SubFlow or call activity that calls its "
+            "process)",
+            hint=f"to give {name!r} a value per run, declare it as a package data field "
+            "instead of a formal parameter (as validate's unpassed-parameter warning says); "
+            "opspec validate lists the run inputs")
     fields = [f.id for f in package.data_fields]
     inputs = [f.id for f in package.data_fields
               if any(e.name == "opspec:RunInput" for e in f.extended_attributes)]

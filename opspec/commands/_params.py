@@ -78,27 +78,8 @@ def _field(name: str, fields: Mapping[str, DataField], package: Package, where: 
            ) -> DataField:
     field = fields.get(name)
     if field is None:
-        raise _formal_parameter(name, package, where) or no_such_field(name, package, where)
+        raise no_such_field(name, package, where)
     return field
-
-
-def _formal_parameter(name: str, package: Package, where: str) -> ConfigurationError | None:
-    """The refusal of a value for ``name`` when it is a process's formal parameter, which
-    no run input reaches (the engine sets package data fields; a parameter gets its value
-    from the SubFlow that calls its process): said so, with what to change, where "no
-    package data field" left the user who read validate's unpassed-parameter warning
-    guessing; None for any other name."""
-    owners = [p.id for p in package.processes
-              if any(f.id == name for f in p.formal_parameters)]
-    if not owners:
-        return None
-    return ConfigurationError(
-        f"{where}: {name!r} is a formal parameter of process {owners[0]!r}, not a package "
-        "data field: run inputs set package data fields only (a formal parameter gets its "
-        "value from the SubFlow or call activity that calls its process)",
-        hint=f"to give {name!r} a value per run, declare it as a package data field instead "
-        "of a formal parameter (as validate's unpassed-parameter warning says); opspec "
-        "validate lists the run inputs")
 
 
 def _kind(field: DataField) -> BasicKind:

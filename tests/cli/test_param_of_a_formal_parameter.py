@@ -1,7 +1,8 @@
 """``--param NAME=VALUE`` for a process's formal parameter: run inputs set package data
 fields only, and the refusal says that NAME is a formal parameter and what to change (it said
 "the spec has no package data field", after validate's unpassed-parameter warning had said
---param would set the value once it is a package data field)."""
+--param would set the value once it is a package data field). The API's ``params`` and a
+scenario file's ``given.params`` are the same door and say the same."""
 
 from __future__ import annotations
 
@@ -9,7 +10,9 @@ from pathlib import Path
 
 import pytest
 
+import opspec
 from opspec.cli import main
+from opspec.errors import ConfigurationError
 
 ROOT = Path(__file__).resolve().parents[2]
 HEADER = """    <WorkflowProcess Id="user_workflow" Name="The user's manual workflow" AccessLevel="PUBLIC">
@@ -51,3 +54,27 @@ def test_a_name_that_is_nothing_is_refused_as_before(spec: Path, capsys) -> None
     assert main(["run", str(spec), "--days", "1", "--param", "speed=2"]) == 2
     said = capsys.readouterr().err
     assert "the spec has no package data field 'speed'" in said
+
+
+IS_ONE = ("'pace' is a formal parameter of process 'user_workflow', not a package data field: "
+          "run inputs set package data fields only")
+
+
+def test_the_api_s_params_say_the_same(spec: Path) -> None:
+    with pytest.raises(ConfigurationError) as raised:
+        opspec.run(spec, days=1, params={"pace": 2})
+    assert str(raised.value).startswith("params: " + IS_ONE)
+    assert "declare it as a package data field instead" in str(raised.value)
+
+
+def test_a_scenario_file_s_given_params_say_the_same(spec: Path, tmp_path: Path) -> None:
+    from opspec.testing.scenario import load_scenarios
+
+    scenarios = tmp_path / "paced.scenario.toml"
+    scenarios.write_text(f'spec = "{spec.name}"\n\n[[scenario]]\nname = "paced"\n'
+                         'given.days = 1\ngiven.params.pace = 2\n'
+                         'then = ["eventually activity take_pill done"]\n', encoding="utf-8")
+    with pytest.raises(ConfigurationError) as raised:
+        load_scenarios(scenarios)
+    said = str(raised.value).removeprefix(str(scenarios))
+    assert said.startswith(":6: scenario[0].given.params.pace: " + IS_ONE), said
