@@ -13,6 +13,12 @@ activities (in spec order) it keeps:
   bound device, put on the participant it concerns. A fault without a participant (a port that
   disappeared) goes to every participant the device serves (``device_participants``).
 
+A BPMN pool or lane is a participant too: the events and gateways drawn in it, which nobody
+performs, are put on it. Where its workflow has performers of its own (the dispenser pool's
+alarm and pill drawer), the pool is not a device beside them: it gets no row (unless it
+signals the user or faults), so the panel lists the devices the diagram's reader knows, once,
+as the XPDL version of the spec lists them.
+
 The Textual view renders :meth:`DeviceBoard.rows`; tests assert on them directly.
 """
 
@@ -25,6 +31,7 @@ from dataclasses import dataclass, field
 from opspec.engine.compiled import CompiledPackage
 from opspec.engine.lanes import all_activities
 from opspec.engine.trace import TraceEvent
+from opspec.model.activities import Event, Route
 
 __all__ = ["DeviceBoard", "ParticipantRow", "ParticipantState"]
 
@@ -78,6 +85,8 @@ class DeviceBoard:
                 self.states[pid] = ParticipantState(
                     pid, names.get(pid, pid),
                     sounding=bool(_SOUNDING.search(pid) or _SOUNDING.search(names.get(pid, ""))))
+        #: pools and lanes standing in for the performers of their workflow: no row of their own
+        self.hidden = _pools_beside_performers(compiled)
         #: device name (profile) → the participants it serves, for faults without a participant
         self.device_participants = {k: tuple(v) for k, v in (device_participants or {}).items()}
         #: every device note seen in the trace (the view lists other notes apart)
@@ -146,6 +155,8 @@ class DeviceBoard:
         """One row per participant, in spec order (devices seen only in faults last)."""
         out = []
         for state in self.states.values():
+            if state.id in self.hidden and state.fault is None and not state.signalling:
+                continue
             last = f"last: {state.last[0]} {_hhmm(state.last[1])}" if state.last else ""
             alert = True
             if state.fault is not None:
@@ -176,6 +187,32 @@ class DeviceBoard:
     def ringing(self) -> bool:
         """Whether any participant is signalling the user now."""
         return any(s.signalling for s in self.states.values())
+
+
+def _pools_beside_performers(compiled: CompiledPackage) -> frozenset[str]:
+    """The pools and lanes (of a BPMN diagram) that perform only the events and gateways drawn
+    in them, in a workflow where someone else performs the work (a task, a call)."""
+    package = compiled.package
+    containers = {pool.participant or pool.id for pool in package.pools}
+    containers.update(lane.id for pool in package.pools for lane in pool.all_lanes())
+    structural: set[tuple[str, str]] = set()     # the events and gateways, by workflow
+    for process in package.processes:
+        for activity in process.all_activities():
+            containers.update([activity.lane] if activity.lane else [])
+            if isinstance(activity.body, Event | Route):
+                structural.add((process.id, activity.id))
+    owns: dict[str, set[str]] = {}        # pool or lane -> the workflows it has activities in
+    doers: dict[str, set[str]] = {}       # workflow -> who performs its work
+    working: set[str] = set()             # pools and lanes that perform work themselves
+    for act in all_activities(compiled):
+        who = act.participant or ""
+        if who in containers:
+            owns.setdefault(who, set()).add(act.process)
+        if (act.process, act.id) not in structural:
+            doers.setdefault(act.process, set()).add(who)
+            working.add(who)
+    return frozenset(who for who, processes in owns.items() if who not in working
+                     and any(doers.get(p, set()) - {who} for p in processes))
 
 
 def _mentioned(message: str, states: Mapping[str, ParticipantState]) -> tuple[str, ...]:
