@@ -68,9 +68,12 @@ def help_text(*, replaying: bool = False, recording: bool = True, user_lane: boo
               + ("replay" if replaying else "run") + " (again: stop)")]
     if person and model:
         keys.append(("[b]h[/b]", "hand your lane to the user model / take it back"))
-    keys += [("[b]l[/b]", "timeline: all lanes / device / user"
-              + (" / hidden" if large else "")),
-             ("[b]s[/b]", "the summary so far (metrics, your response times)" if person
+    if user_lane:
+        keys.append(("[b]l[/b]", "timeline: all lanes / device / user"
+                     + (" / hidden" if large else "")))
+    elif large:                      # (without a user lane there is no lane to pick)
+        keys.append(("[b]l[/b]", "timeline: shown / hidden"))
+    keys += [("[b]s[/b]", "the summary so far (metrics, your response times)" if person
               else "the summary so far (the spec's metrics)"),
              ("[b]?[/b]", "this help (the clock stops while it is open)"),
              ("[b]q[/b], [b]ctrl+c[/b], [b]ctrl+q[/b]", f"quit ({kept})")]
