@@ -98,6 +98,12 @@ def run(args: argparse.Namespace) -> int:
         # a user model given to --script, a spec to --user-model: say so
         raise misplaced(error, (("SPEC", args.spec), ("--script", args.script),
                                 ("--user-model", args.user_model))) from None
+    if args.script and args.days is None and args.until is None:
+        from opspec.tui.replay import refuse_nothing_to_replay
+
+        # a walkthrough quit at 0 s: the whole run without the person is not that session
+        # (its summary printed no command; the walkthrough's --replay refuses it too)
+        refuse_nothing_to_replay(args.script, "--script")
     for warning in prepared.warnings:
         print(f"opspec run: {warning}", file=sys.stderr)
     package, compiled = prepared.package, prepared.compiled

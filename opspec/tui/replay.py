@@ -31,7 +31,7 @@ from opspec.engine.compiled import CompiledPackage
 from opspec.usermodels.scripts import ScriptUser, load_script
 
 __all__ = ["QUIT", "instance_tag", "load_recording", "recorded_end", "recorded_seed",
-           "tagged_action"]
+           "refuse_nothing_to_replay", "tagged_action"]
 
 #: the trace event of a session the person quit before the end of its run: ``until``, the
 #: simulated second they quit at
@@ -96,6 +96,23 @@ def recorded_end(path: str | Path) -> float | None:
                             _seconds(quit_at) or end)
     except (OSError, UnicodeDecodeError, ValueError):
         return None      # unreadable: the replay runs the whole run, as before
+    return end
+
+
+def refuse_nothing_to_replay(path: str | Path, option: str) -> float | None:
+    """:func:`recorded_end` of ``path``, refusing a session quit before its clock moved
+    (``option``: ``--replay`` or ``--script``, the option that named it): replayed without an
+    end of its own, it would run the whole run without the person, which is not the session.
+
+    Raises :class:`~opspec.errors.ConfigurationError`."""
+    from opspec.errors import ConfigurationError
+
+    end = recorded_end(path)
+    if end == 0.0:
+        raise ConfigurationError(
+            f"{option} {path}: the session was quit before its clock moved: "
+            "there is nothing to replay",
+            hint="--until T or --days D replays to then without the person")
     return end
 
 
