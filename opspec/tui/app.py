@@ -44,6 +44,8 @@ from opspec.tui.timeline import HIDDEN, lane_filters, timeline_text
 __all__ = ["HELP", "SummaryScreen", "WalkthroughApp"]
 
 SPEEDS = {"1": 1.0, "2": 10.0, "3": 60.0, "4": 600.0}
+# the keys that move or hold the clock: nothing to do once the run has ended
+_TIME_KEYS = frozenset({"pause", "speed", "wait", "next_event", "until_user"})
 # the offers shown: every letter no other action uses (h l n q s u w x are taken), a..f first
 OFFER_KEYS = "".join(k for k in string.ascii_lowercase if k not in "hlnqsuwx")
 FOOTER_SPACED_WIDTH = 84      # the footer's keys with their padding (tests/tui checks 80 fits)
@@ -163,6 +165,7 @@ class WalkthroughApp(App[str | None]):
         Binding("l", "lane", "lanes", show=False),
         Binding("x", "ignore", "don't", show=False),
         Binding("s", "summary", "summary", show=False),
+        Binding("s", "summary('end')", "summary"),         # in the footer once the run ended
         Binding("ctrl+c,ctrl+q", "quit_walk", "quit", show=False, priority=True),
         *[Binding(k, f"offer({i})", show=False) for i, k in enumerate(OFFER_KEYS)],
         # without a letter: the arrows (or Tab, which the screen would take) pick, Enter does
@@ -319,9 +322,17 @@ class WalkthroughApp(App[str | None]):
     def check_action(self, action: str, parameters: tuple[object, ...]) -> bool | None:
         """The footer's keys as they work in this session: in a replay, or for a spec
         without a user lane, nothing will need the person (u runs "to the end") and nothing
-        can be handed over (h is left out of the footer; pressed, it says why)."""
+        can be handed over (h is left out of the footer; pressed, it says why). Once the run
+        has ended the clock has nowhere to go: the time keys leave the footer (they did
+        nothing), and the summary comes into it."""
+        ended = self.session.ended
+        if action in _TIME_KEYS and ended:
+            return False
+        if action == "summary":
+            return ended == bool(parameters)      # the binding with a parameter: the end
         if action in ("until_user", "hand_over"):
-            lane = self.session.has_user_lane and not self.session.replaying
+            lane = self.session.has_user_lane and not self.session.replaying and not (
+                ended and action == "hand_over")
             return lane != bool(parameters)       # the binding with a parameter: no lane
         return True
 
@@ -388,7 +399,7 @@ class WalkthroughApp(App[str | None]):
     def action_help(self) -> None:
         self._push_paused(help_screen(self.session, large=self.large))
 
-    def action_summary(self) -> None:
+    def action_summary(self, _shown: str = "") -> None:
         if not isinstance(self.screen, SummaryScreen):
             self._open_summary()
 
@@ -425,6 +436,7 @@ class WalkthroughApp(App[str | None]):
         if session.ended and not self._summary_shown:
             self._summary_shown = True           # once: the end of the run in words
             summary = not isinstance(self.screen, HelpScreen)
+            self.refresh_bindings()              # the footer's keys after the end
         # the state comes first: the line is cut at the right in a narrow terminal
         state = ("[ENDED]" if session.ended
                  else "[waiting for the device]" if session.waiting_for_devices
