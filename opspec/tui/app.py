@@ -549,7 +549,7 @@ class WalkthroughApp(App[str | None]):
         for row in rows:
             marker = "(x)" if row.status.startswith("FAULT") else "(!)" if row.alert else " * "
             line = Text(no_wrap=True, overflow="ellipsis")
-            line.append(f"{marker} {row.id}: ", style="bold")
+            line.append(f"{marker} {row.shown or row.id}: ", style="bold")
             if session.ended and row.alert:
                 line.append("at the end: ")
             line.append(row.status, style="bold reverse" if row.alert else "")

@@ -17,7 +17,9 @@ A BPMN pool or lane is a participant too: the events and gateways drawn in it, w
 performs, are put on it. Where its workflow has performers of its own (the dispenser pool's
 alarm and pill drawer), the pool is not a device beside them: it gets no row (unless it
 signals the user or faults), so the panel lists the devices the diagram's reader knows, once,
-as the XPDL version of the spec lists them.
+as the XPDL version of the spec lists them. A pool or lane that has a row is shown by the
+name the diagram gives it (``Stove guard appliance``, not ``guard_lane``, an id no modeller
+shows).
 
 The Textual view renders :meth:`DeviceBoard.rows`; tests assert on them directly.
 """
@@ -66,6 +68,8 @@ class ParticipantRow:
     status: str
     detail: str
     alert: bool
+    #: what the panel calls it: the participant's id, a BPMN pool's or lane's name
+    shown: str = ""
 
 
 class DeviceBoard:
@@ -86,7 +90,7 @@ class DeviceBoard:
                     pid, names.get(pid, pid),
                     sounding=bool(_SOUNDING.search(pid) or _SOUNDING.search(names.get(pid, ""))))
         #: pools and lanes standing in for the performers of their workflow: no row of their own
-        self.hidden = _pools_beside_performers(compiled)
+        self.pools, self.hidden = _pools_and_lanes(compiled)
         #: device name (profile) → the participants it serves, for faults without a participant
         self.device_participants = {k: tuple(v) for k, v in (device_participants or {}).items()}
         #: every device note seen in the trace (the view lists other notes apart)
@@ -180,7 +184,9 @@ class DeviceBoard:
             parts.extend(f"{k}={v}" for k, v in state.display.items())
             if state.note and state.fault is None:
                 parts.append(f"note: {state.note}")
-            out.append(ParticipantRow(state.id, state.name, status, "  ".join(parts), alert))
+            out.append(ParticipantRow(
+                state.id, state.name, status, "  ".join(parts), alert,
+                state.name if state.id in self.pools else state.id))
         return out
 
     @property
@@ -189,9 +195,10 @@ class DeviceBoard:
         return any(s.signalling for s in self.states.values())
 
 
-def _pools_beside_performers(compiled: CompiledPackage) -> frozenset[str]:
-    """The pools and lanes (of a BPMN diagram) that perform only the events and gateways drawn
-    in them, in a workflow where someone else performs the work (a task, a call)."""
+def _pools_and_lanes(compiled: CompiledPackage) -> tuple[frozenset[str], frozenset[str]]:
+    """The pools and lanes (of a BPMN diagram) that are participants, and of those the ones
+    that perform only the events and gateways drawn in them, in a workflow where someone else
+    performs the work (a task, a call)."""
     package = compiled.package
     containers = {pool.participant or pool.id for pool in package.pools}
     containers.update(lane.id for pool in package.pools for lane in pool.all_lanes())
@@ -211,8 +218,9 @@ def _pools_beside_performers(compiled: CompiledPackage) -> frozenset[str]:
         if (act.process, act.id) not in structural:
             doers.setdefault(act.process, set()).add(who)
             working.add(who)
-    return frozenset(who for who, processes in owns.items() if who not in working
-                     and any(doers.get(p, set()) - {who} for p in processes))
+    return frozenset(owns), frozenset(
+        who for who, processes in owns.items() if who not in working
+        and any(doers.get(p, set()) - {who} for p in processes))
 
 
 def _mentioned(message: str, states: Mapping[str, ParticipantState]) -> tuple[str, ...]:

@@ -2,7 +2,8 @@
 ``timer_pool``, ``schedule_pool`` and ``dispenser_pool`` as device rows beside the clock, the
 schedule, the alarm and the drawer that perform their work (the pools only "performed" the
 events and gateways drawn in them), seven rows where the XPDL version of the same spec has
-four. A lane holding the resident's work (``kitchen_lanes.bpmn``) was a device row too."""
+four. A lane holding the resident's work (``kitchen_lanes.bpmn``) was a device row too. A
+pool or lane that is a device row is called by its name in the diagram, not its id."""
 
 from __future__ import annotations
 
@@ -30,6 +31,20 @@ def test_the_bpmn_dispenser_lists_the_devices_of_its_xpdl_twin(compiled):
 def test_a_lane_of_the_residents_work_is_no_device_but_a_working_lane_is():
     rows = DeviceBoard(compile_package(open_spec(KITCHEN))).rows()
     assert [(r.id, r.name) for r in rows] == [("guard_lane", "Stove guard appliance")]
+
+
+@pytest.mark.asyncio
+async def test_a_lane_s_row_is_called_by_the_name_the_diagram_shows():
+    """It read "guard_lane: …", an id no BPMN modeller shows; a participant of an XPDL spec
+    (or a BPMN resource) keeps its id, as before."""
+    session = WalkSession(compile_package(open_spec(KITCHEN)))
+    session.paused = True
+    app = WalkthroughApp(session, title="Kitchen watch")
+    async with app.run_test(size=(100, 30)) as pilot:
+        await pilot.pause()
+        panel = str(app.query_one("#device").render())
+        assert " *  Stove guard appliance: " in panel and "guard_lane" not in panel
+        await pilot.press("q")
 
 
 def test_a_pool_that_is_all_there_is_keeps_its_row(tmp_path):
