@@ -10,8 +10,9 @@ activities (in spec order) it keeps:
 - **last**: the last activity it completed, with its simulated time (``Dispense the dose``);
 - **display**: the data fields its activities set (``alarms=2``, ``outcome=taken``);
 - **fault** / **note**: the last device fault (trace kind ``fault``) or ``device.note`` of a
-  bound device, put on the participant it concerns. A fault without a participant (a port that
-  disappeared) goes to every participant the device serves (``device_participants``).
+  bound device, put on the participant it concerns (the one its message names first, else
+  every participant the device serves: ``device_participants``). A fault without a participant
+  (a port that disappeared) goes to every participant the device serves.
 
 A BPMN pool or lane is a participant too: the events and gateways drawn in it, which nobody
 performs, are put on it. Where its workflow has performers of its own (the dispenser pool's
@@ -142,8 +143,10 @@ class DeviceBoard:
         if data.get("participant"):
             who = (str(data["participant"]),)
         else:
+            # a message that names one participant first ("dispenser: …", of a device that
+            # serves the alarm too) is that participant's; else it concerns the whole device
             device = str(data.get("device") or "device")
-            who = self.device_participants.get(device) or _mentioned(message, self.states) or (
+            who = _mentioned(message, self.states) or self.device_participants.get(device) or (
                 device,)
         for pid in who:
             state = self.states.get(pid)

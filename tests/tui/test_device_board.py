@@ -87,3 +87,23 @@ def test_a_device_note_is_shown_beside_the_participant_without_alarming(compiled
         board(event)
     alarm = next(r for r in board.rows() if r.id == "alarm")
     assert "note: alarm: reconnected" in alarm.detail and not alarm.alert
+
+
+def test_a_note_naming_one_participant_of_a_shared_device_is_that_participant_s(compiled):
+    """One device served both the alarm and the drawer (``--bind alarm=… --bind
+    dispenser=…`` of one profile): its note "dispenser: application 'notify_caregiver' …"
+    showed on the alarm's row too, as if the alarm had the problem."""
+    session = WalkSession(compiled, device_participants={
+        "medication_dispenser": ("alarm", "dispenser")})
+    note = ("dispenser: application 'notify_caregiver' (notify_caregiver in notify_workflow) "
+            "is not an operation of profile medication_dispenser, so it runs by itself, not "
+            "on the device (operations: alarm_on, dispense)")
+    session.sim.session.trace("device.note", {"device": "medication_dispenser",
+                                              "message": note})
+    assert f"note: {note}" in row(session, "dispenser").detail
+    assert "note:" not in row(session, "alarm").detail
+    # a note of the whole device (both participants named) is on both
+    session.sim.session.trace("device.note", {"device": "medication_dispenser",
+                                              "message": "alarm, dispenser: reconnected"})
+    assert "reconnected" in row(session, "alarm").detail
+    assert "reconnected" in row(session, "dispenser").detail
