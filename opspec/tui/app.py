@@ -159,7 +159,7 @@ class WalkthroughApp(App[str | None]):
         Binding("w", "wait", "wait 30s"),
         Binding("n", "next_event", "step"),
         Binding("u", "until_user", "until me"),
-        Binding("u", "until_user('end')", "to the end"),   # nobody to wait for (check_action)
+        Binding("u", "until_user('end')", "to end"),   # nobody to wait for (check_action)
         Binding("h", "hand_over", "model/me"),
         Binding("h", "hand_over('none')", show=False),     # (there: says why not)
         Binding("l", "lane", "lanes", show=False),
