@@ -31,12 +31,12 @@ def test_a_session_quit_early_with_another_seed_is_said(compiled, tmp_path, caps
     record = recording(compiled, tmp_path, seed=7)
     capsys.readouterr()
     assert main(["run", str(SPEC), "--script", str(record), "--timeline", "none"]) == 0
-    assert notes(capsys) == [
-        f"opspec run: note: {record} records a walkthrough that ended at d1 09:00:00: this "
-        "run goes on to d2 00:00:00 without the person (--until 9h ends where the session "
-        "did)",
-        f"opspec run: note: {record} records a walkthrough run with seed 7, this run has "
-        "seed 0 (--seed 7 replays the session's device draws)"]
+    end = (f"opspec run: note: {record} records a walkthrough that ended at d1 09:00:00: "
+           "this run goes on to d2 00:00:00 without the person (--until 9h ends where the "
+           "session did)")
+    seed = (f"opspec run: note: {record} records a walkthrough run with seed 7, this run "
+            "has seed 0 (--seed 7 replays the session's device draws)")
+    assert notes(capsys) == [end, seed]
     # the commands the summary prints say nothing more
     assert main(["run", str(SPEC), "--seed", "7", "--until", "9h", "--script", str(record),
                  "--timeline", "none"]) == 0
@@ -50,10 +50,10 @@ def test_a_session_that_ran_to_its_end_is_replayed_without_a_note(compiled, tmp_
                  "--timeline", "none"]) == 0
     assert notes(capsys) == []
     assert main(["run", str(SPEC), "--script", str(record), "--timeline", "none"]) == 0
-    assert notes(capsys) == [
-        f"opspec run: note: {record} records a walkthrough that ended at d1 06:00:00: this "
-        "run goes on to d2 00:00:00 without the person (--until 6h ends where the session "
-        "did)"]
+    end = (f"opspec run: note: {record} records a walkthrough that ended at d1 06:00:00: "
+           "this run goes on to d2 00:00:00 without the person (--until 6h ends where the "
+           "session did)")
+    assert notes(capsys) == [end]
 
 
 def test_any_other_script_gets_no_note(tmp_path, capsys):
