@@ -94,7 +94,8 @@ class DeviceBoard:
         self.pools, self.hidden = _pools_and_lanes(compiled)
         #: device name (profile) → the participants it serves, for faults without a participant
         self.device_participants = {k: tuple(v) for k, v in (device_participants or {}).items()}
-        #: every device note seen in the trace (the view lists other notes apart)
+        #: every device note seen in the trace (the view lists other notes apart), in order
+        self.notes: list[str] = []
         self.notes_seen: set[str] = set()
 
     # ------------------------------------------------------------------ events
@@ -137,8 +138,9 @@ class DeviceBoard:
     def _device_event(self, event: TraceEvent) -> None:
         data = event.data or {}
         message = str(data.get("message", "") or data.get("fault", ""))
-        if event.kind == "device.note":
+        if event.kind == "device.note" and message not in self.notes_seen:
             self.notes_seen.add(message)
+            self.notes.append(message)
         who: tuple[str, ...]
         if data.get("participant"):
             who = (str(data["participant"]),)
