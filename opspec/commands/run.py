@@ -98,6 +98,19 @@ def run(args: argparse.Namespace) -> int:
         # a user model given to --script, a spec to --user-model: say so
         raise misplaced(error, (("SPEC", args.spec), ("--script", args.script),
                                 ("--user-model", args.user_model))) from None
+    if args.script:
+        from opspec.tui.replay import refuse_nothing_to_replay, script_notes
+
+        end_given = args.days is not None or args.until is not None
+        if not end_given:
+            # a walkthrough quit at 0 s: the whole run without the person is not that
+            # session (its summary printed no command; --replay refuses it too)
+            refuse_nothing_to_replay(args.script, "--script")
+        # a recording of a session quit at 12:34, or run with another seed: said, as the
+        # walkthrough's --replay would have ended there and taken its seed
+        for note in script_notes(args.script, horizon=prepared.horizon, seed=args.seed,
+                                 end_given=end_given):
+            print(f"opspec run: note: {note}", file=sys.stderr)
     for warning in prepared.warnings:
         print(f"opspec run: {warning}", file=sys.stderr)
     package, compiled = prepared.package, prepared.compiled

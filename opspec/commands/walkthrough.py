@@ -129,17 +129,11 @@ def run(args: argparse.Namespace) -> int:
         # match an offer)
         replay = load_recording(args.replay, compiled)
         if args.days is None and until is None:
-            from opspec.tui.replay import recorded_end
+            from opspec.tui.replay import refuse_nothing_to_replay
 
             # the replay ends where the session did (the person quit at 12:34: not the rest
             # of the day without them), as the recording's trace says
-            until = recorded_end(args.replay)
-            if until == 0.0:
-                # (the run would go on to its end without the person: not the session)
-                raise ConfigurationError(
-                    f"--replay {args.replay}: the session was quit before its clock moved: "
-                    "there is nothing to replay",
-                    hint="--until T or --days D replays to then without the person")
+            until = refuse_nothing_to_replay(args.replay, "--replay")
     who = f"{_file_safe(args.person)}-" if args.person else ""
     record = None if args.no_record or args.replay else Path(
         args.record or Path("walkthroughs") / (

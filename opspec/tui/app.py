@@ -39,13 +39,15 @@ from opspec.tui.pace import Pace
 from opspec.tui.session import WalkSession, clock, time_of_day_shown
 from opspec.tui.sound import Cue
 from opspec.tui.terminal_size import SizeWarning
+from opspec.tui.timeline import HIDDEN, lane_filters, timeline_text
 
 __all__ = ["HELP", "SummaryScreen", "WalkthroughApp"]
 
 SPEEDS = {"1": 1.0, "2": 10.0, "3": 60.0, "4": 600.0}
+# the keys that move or hold the clock: nothing to do once the run has ended
+_TIME_KEYS = frozenset({"pause", "speed", "wait", "next_event", "until_user"})
 # the offers shown: every letter no other action uses (h l n q s u w x are taken), a..f first
 OFFER_KEYS = "".join(k for k in string.ascii_lowercase if k not in "hlnqsuwx")
-LANES = ("all", "device", "user")
 FOOTER_SPACED_WIDTH = 84      # the footer's keys with their padding (tests/tui checks 80 fits)
 TICK_S = 0.1
 # The engine runs in slices so that keys (q, ctrl+c, space) are read between them: at most
@@ -157,12 +159,13 @@ class WalkthroughApp(App[str | None]):
         Binding("w", "wait", "wait 30s"),
         Binding("n", "next_event", "step"),
         Binding("u", "until_user", "until me"),
-        Binding("u", "until_user('end')", "to the end"),   # nobody to wait for (check_action)
+        Binding("u", "until_user('end')", "to end"),   # nobody to wait for (check_action)
         Binding("h", "hand_over", "model/me"),
         Binding("h", "hand_over('none')", show=False),     # (there: says why not)
         Binding("l", "lane", "lanes", show=False),
         Binding("x", "ignore", "don't", show=False),
         Binding("s", "summary", "summary", show=False),
+        Binding("s", "summary('end')", "summary"),         # in the footer once the run ended
         Binding("ctrl+c,ctrl+q", "quit_walk", "quit", show=False, priority=True),
         *[Binding(k, f"offer({i})", show=False) for i, k in enumerate(OFFER_KEYS)],
         # without a letter: the arrows (or Tab, which the screen would take) pick, Enter does
@@ -183,6 +186,8 @@ class WalkthroughApp(App[str | None]):
         self.high_contrast = high_contrast
         #: the cue at every alarm (default: the terminal bell)
         self.cue = sound if sound is not None else Cue("bell")
+        #: what l cycles through (a spec without a user lane has only "all" to show)
+        self.lane_filters = lane_filters(user_lane=session.has_user_lane, large=large)
         self.lane_filter = 0
         #: the timeline's lane column: the spec's lane names, one width for all lines
         self._lanes = lane_labels(session.compiled)
@@ -220,7 +225,7 @@ class WalkthroughApp(App[str | None]):
         if self.large:
             self.screen.add_class("large")
             # the timeline is for the coordinator: hidden until l shows it
-            self.lane_filter = len(LANES)
+            self.lane_filter = self.lane_filters.index(HIDDEN)
             self.query_one("#timeline", Static).add_class("hidden")
             # the person's panel comes first (on top) when the font is big
             panels = self.query_one("#panels", Horizontal)
@@ -317,9 +322,17 @@ class WalkthroughApp(App[str | None]):
     def check_action(self, action: str, parameters: tuple[object, ...]) -> bool | None:
         """The footer's keys as they work in this session: in a replay, or for a spec
         without a user lane, nothing will need the person (u runs "to the end") and nothing
-        can be handed over (h is left out of the footer; pressed, it says why)."""
+        can be handed over (h is left out of the footer; pressed, it says why). Once the run
+        has ended the clock has nowhere to go: the time keys leave the footer (they did
+        nothing), and the summary comes into it."""
+        ended = self.session.ended
+        if action in _TIME_KEYS and ended:
+            return False
+        if action == "summary":
+            return ended == bool(parameters)      # the binding with a parameter: the end
         if action in ("until_user", "hand_over"):
-            lane = self.session.has_user_lane and not self.session.replaying
+            lane = self.session.has_user_lane and not self.session.replaying and not (
+                ended and action == "hand_over")
             return lane != bool(parameters)       # the binding with a parameter: no lane
         return True
 
@@ -345,9 +358,12 @@ class WalkthroughApp(App[str | None]):
 
     def action_lane(self) -> None:
         # large: all, device, user, hidden (the big font leaves little room for it)
-        self.lane_filter = (self.lane_filter + 1) % (len(LANES) + self.large)
-        self.query_one("#timeline", Static).set_class(self.lane_filter == len(LANES),
-                                                      "hidden")
+        if len(self.lane_filters) == 1:
+            self.notify("This spec has no user lane: the timeline shows all its events.")
+            return
+        self.lane_filter = (self.lane_filter + 1) % len(self.lane_filters)
+        self.query_one("#timeline", Static).set_class(
+            self.lane_filters[self.lane_filter] == HIDDEN, "hidden")
         self.refresh_views()
 
     def action_offer(self, index: int) -> None:
@@ -383,7 +399,7 @@ class WalkthroughApp(App[str | None]):
     def action_help(self) -> None:
         self._push_paused(help_screen(self.session, large=self.large))
 
-    def action_summary(self) -> None:
+    def action_summary(self, _shown: str = "") -> None:
         if not isinstance(self.screen, SummaryScreen):
             self._open_summary()
 
@@ -420,6 +436,7 @@ class WalkthroughApp(App[str | None]):
         if session.ended and not self._summary_shown:
             self._summary_shown = True           # once: the end of the run in words
             summary = not isinstance(self.screen, HelpScreen)
+            self.refresh_bindings()              # the footer's keys after the end
         # the state comes first: the line is cut at the right in a narrow terminal
         state = ("[ENDED]" if session.ended
                  else "[waiting for the device]" if session.waiting_for_devices
@@ -483,7 +500,12 @@ class WalkthroughApp(App[str | None]):
         self.query_one("#aftermath", Static).update(
             Text(session.aftermath.text()) if session.person_performs or session.ended
             else Text())
-        self.query_one("#timeline", Static).update(self._timeline_text())
+        timeline = self.query_one("#timeline", Static)
+        timeline.update(timeline_text(
+            session.events, self._lanes, self.lane_filters[self.lane_filter],
+            # as many events as the box holds (it grows with the terminal)
+            max(3, timeline.content_size.height - 1), filters=self.lane_filters,
+            dim="" if self.high_contrast else "dim"))
         if summary:
             # after the frame that shows [ENDED] on the status line: pushed in this same
             # refresh, the summary could cover the line before it was ever drawn, and a
@@ -527,7 +549,7 @@ class WalkthroughApp(App[str | None]):
         for row in rows:
             marker = "(x)" if row.status.startswith("FAULT") else "(!)" if row.alert else " * "
             line = Text(no_wrap=True, overflow="ellipsis")
-            line.append(f"{marker} {row.id}: ", style="bold")
+            line.append(f"{marker} {row.shown or row.id}: ", style="bold")
             if session.ended and row.alert:
                 line.append("at the end: ")
             line.append(row.status, style="bold reverse" if row.alert else "")
@@ -551,50 +573,3 @@ class WalkthroughApp(App[str | None]):
         if not text.plain:
             text.append("(idle)")
         return text
-
-    def _timeline_text(self) -> Text:
-        if self.lane_filter >= len(LANES):
-            return Text()                                  # hidden (large)
-        lane = LANES[self.lane_filter]
-        lanes = self._lanes
-        text = Text(no_wrap=True, overflow="ellipsis")
-        text.append(f"showing: {lane} (l: change)\n",
-                    style="" if self.high_contrast else "dim")
-        # as many events as the box holds (it grows with the terminal)
-        rows = max(3, self.query_one("#timeline", Static).content_size.height - 1)
-        shown = 0
-        for event in reversed(self.session.events):
-            if event.kind not in _TIMELINE_KINDS:
-                continue
-            # the person's (or the model's) actions belong to the user lane, faults and
-            # device notes to the device; the rest to the lane the spec puts them in, by
-            # its name (a BPMN lane "Resident" whose work is manual is the user lane)
-            if event.kind == "walkthrough.action":
-                users, label = True, "user"
-            elif event.kind in ("fault", "device.note"):
-                users, label = False, "device"
-            else:
-                users, label = lanes.is_user(event), lanes.label(event)
-            if lane != "all" and users != (lane == "user"):
-                continue
-            what = f"{event.activity or event.process or ''} {event.kind.split('.')[-1]}"
-            if event.kind == "trigger.raised":
-                what = f"trigger {(event.data or {}).get('name', '?')} raised"
-            elif event.kind == "fault":
-                data = event.data or {}
-                what = f"FAULT {data.get('device') or ''} {data.get('participant') or ''}: " \
-                       f"{data.get('fault', '')}"
-            elif event.kind == "walkthrough.action":
-                data = event.data or {}
-                what = f"{'you' if data.get('by') == 'person' else 'model'}: {data.get('action')}"
-            text.append(f"{time_of_day_shown(event.time)}  {label:<{lanes.width}} {what}\n")
-            shown += 1
-            if shown >= rows:
-                break
-        return text
-
-
-_TIMELINE_KINDS = frozenset({
-    "activity.completed", "activity.omitted", "activity.withdrawn", "activity.offered",
-    "trigger.raised", "deadline.expired", "process.started", "process.completed", "fault",
-    "mode.changed", "walkthrough.action"})

@@ -10,8 +10,17 @@ activities (in spec order) it keeps:
 - **last**: the last activity it completed, with its simulated time (``Dispense the dose``);
 - **display**: the data fields its activities set (``alarms=2``, ``outcome=taken``);
 - **fault** / **note**: the last device fault (trace kind ``fault``) or ``device.note`` of a
-  bound device, put on the participant it concerns. A fault without a participant (a port that
-  disappeared) goes to every participant the device serves (``device_participants``).
+  bound device, put on the participant it concerns (the one its message names first, else
+  every participant the device serves: ``device_participants``). A fault without a participant
+  (a port that disappeared) goes to every participant the device serves.
+
+A BPMN pool or lane is a participant too: the events and gateways drawn in it, which nobody
+performs, are put on it. Where its workflow has performers of its own (the dispenser pool's
+alarm and pill drawer), the pool is not a device beside them: it gets no row (unless it
+signals the user or faults), so the panel lists the devices the diagram's reader knows, once,
+as the XPDL version of the spec lists them. A pool or lane that has a row is shown by the
+name the diagram gives it (``Stove guard appliance``, not ``guard_lane``, an id no modeller
+shows).
 
 The Textual view renders :meth:`DeviceBoard.rows`; tests assert on them directly.
 """
@@ -25,6 +34,7 @@ from dataclasses import dataclass, field
 from opspec.engine.compiled import CompiledPackage
 from opspec.engine.lanes import all_activities
 from opspec.engine.trace import TraceEvent
+from opspec.model.activities import Event, Route
 
 __all__ = ["DeviceBoard", "ParticipantRow", "ParticipantState"]
 
@@ -59,6 +69,8 @@ class ParticipantRow:
     status: str
     detail: str
     alert: bool
+    #: what the panel calls it: the participant's id, a BPMN pool's or lane's name
+    shown: str = ""
 
 
 class DeviceBoard:
@@ -78,9 +90,12 @@ class DeviceBoard:
                 self.states[pid] = ParticipantState(
                     pid, names.get(pid, pid),
                     sounding=bool(_SOUNDING.search(pid) or _SOUNDING.search(names.get(pid, ""))))
+        #: pools and lanes standing in for the performers of their workflow: no row of their own
+        self.pools, self.hidden = _pools_and_lanes(compiled)
         #: device name (profile) → the participants it serves, for faults without a participant
         self.device_participants = {k: tuple(v) for k, v in (device_participants or {}).items()}
-        #: every device note seen in the trace (the view lists other notes apart)
+        #: every device note seen in the trace (the view lists other notes apart), in order
+        self.notes: list[str] = []
         self.notes_seen: set[str] = set()
 
     # ------------------------------------------------------------------ events
@@ -123,14 +138,17 @@ class DeviceBoard:
     def _device_event(self, event: TraceEvent) -> None:
         data = event.data or {}
         message = str(data.get("message", "") or data.get("fault", ""))
-        if event.kind == "device.note":
+        if event.kind == "device.note" and message not in self.notes_seen:
             self.notes_seen.add(message)
+            self.notes.append(message)
         who: tuple[str, ...]
         if data.get("participant"):
             who = (str(data["participant"]),)
         else:
+            # a message that names one participant first ("dispenser: …", of a device that
+            # serves the alarm too) is that participant's; else it concerns the whole device
             device = str(data.get("device") or "device")
-            who = self.device_participants.get(device) or _mentioned(message, self.states) or (
+            who = _mentioned(message, self.states) or self.device_participants.get(device) or (
                 device,)
         for pid in who:
             state = self.states.get(pid)
@@ -146,6 +164,8 @@ class DeviceBoard:
         """One row per participant, in spec order (devices seen only in faults last)."""
         out = []
         for state in self.states.values():
+            if state.id in self.hidden and state.fault is None and not state.signalling:
+                continue
             last = f"last: {state.last[0]} {_hhmm(state.last[1])}" if state.last else ""
             alert = True
             if state.fault is not None:
@@ -169,13 +189,43 @@ class DeviceBoard:
             parts.extend(f"{k}={v}" for k, v in state.display.items())
             if state.note and state.fault is None:
                 parts.append(f"note: {state.note}")
-            out.append(ParticipantRow(state.id, state.name, status, "  ".join(parts), alert))
+            out.append(ParticipantRow(
+                state.id, state.name, status, "  ".join(parts), alert,
+                state.name if state.id in self.pools else state.id))
         return out
 
     @property
     def ringing(self) -> bool:
         """Whether any participant is signalling the user now."""
         return any(s.signalling for s in self.states.values())
+
+
+def _pools_and_lanes(compiled: CompiledPackage) -> tuple[frozenset[str], frozenset[str]]:
+    """The pools and lanes (of a BPMN diagram) that are participants, and of those the ones
+    that perform only the events and gateways drawn in them, in a workflow where someone else
+    performs the work (a task, a call)."""
+    package = compiled.package
+    containers = {pool.participant or pool.id for pool in package.pools}
+    containers.update(lane.id for pool in package.pools for lane in pool.all_lanes())
+    structural: set[tuple[str, str]] = set()     # the events and gateways, by workflow
+    for process in package.processes:
+        for activity in process.all_activities():
+            containers.update([activity.lane] if activity.lane else [])
+            if isinstance(activity.body, Event | Route):
+                structural.add((process.id, activity.id))
+    owns: dict[str, set[str]] = {}        # pool or lane -> the workflows it has activities in
+    doers: dict[str, set[str]] = {}       # workflow -> who performs its work
+    working: set[str] = set()             # pools and lanes that perform work themselves
+    for act in all_activities(compiled):
+        who = act.participant or ""
+        if who in containers:
+            owns.setdefault(who, set()).add(act.process)
+        if (act.process, act.id) not in structural:
+            doers.setdefault(act.process, set()).add(who)
+            working.add(who)
+    return frozenset(owns), frozenset(
+        who for who, processes in owns.items() if who not in working
+        and any(doers.get(p, set()) - {who} for p in processes))
 
 
 def _mentioned(message: str, states: Mapping[str, ParticipantState]) -> tuple[str, ...]:

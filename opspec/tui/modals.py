@@ -40,7 +40,7 @@ _FRAME = 2 + 4 + 2
 
 def help_text(*, replaying: bool = False, recording: bool = True, user_lane: bool = True,
               model: bool = True, on_call: str = "realtime", large: bool = False,
-              ends_at: str = "", width: int = _WIDTH) -> str:
+              ends_at: str = "", width: int = _WIDTH, ended: bool = False) -> str:
     """The help for a session, listing only the keys that do something in it: a replay
     (``replaying``; the recording performs the lane, ending at ``ends_at``) and a spec
     without a user lane (``user_lane``) have no actions to answer, and hand nothing over; a
@@ -48,7 +48,13 @@ def help_text(*, replaying: bool = False, recording: bool = True, user_lane: boo
     whether an omission is recorded are said as they are (a replay and ``--no-record``
     record nothing), and what the clock does when the device calls (``on_call``) as this
     session does it (a replay is never slowed down). ``width``: the widest line, in cells
-    (at most 62: the help's box on a terminal of 80 columns or more)."""
+    (at most 62: the help's box on a terminal of 80 columns or more). Once the run has
+    ``ended`` only the timeline, the summary, the help and quitting are left."""
+    if ended:
+        return _help_after_the_end(kept="a replay records nothing" if replaying
+                                   else "the recording is kept" if recording
+                                   else "nothing is recorded",
+                                   user_lane=user_lane, large=large, width=width)
     person = user_lane and not replaying
     kept = ("a replay records nothing" if replaying
             else "the recording is kept" if recording else "nothing is recorded")
@@ -68,21 +74,16 @@ def help_text(*, replaying: bool = False, recording: bool = True, user_lane: boo
               + ("replay" if replaying else "run") + " (again: stop)")]
     if person and model:
         keys.append(("[b]h[/b]", "hand your lane to the user model / take it back"))
-    keys += [("[b]l[/b]", "timeline: all lanes / device / user"
-              + (" / hidden" if large else "")),
-             ("[b]s[/b]", "the summary so far (metrics, your response times)" if person
+    if user_lane:
+        keys.append(("[b]l[/b]", "timeline: all lanes / device / user"
+                     + (" / hidden" if large else "")))
+    elif large:                      # (without a user lane there is no lane to pick)
+        keys.append(("[b]l[/b]", "timeline: shown / hidden"))
+    keys += [("[b]s[/b]", "the summary so far (metrics, your response times)" if person
               else "the summary so far (the spec's metrics)"),
              ("[b]?[/b]", "this help (the clock stops while it is open)"),
              ("[b]q[/b], [b]ctrl+c[/b], [b]ctrl+q[/b]", f"quit ({kept})")]
-    lines = [_KEYS, ""]
-    for key, does in keys:
-        shown = Text.from_markup(key).cell_len
-        # the key column is 8 wide; a wider key runs into its text after one space
-        lead = f"  {key}{' ' * max(1, 8 - shown)}"
-        first, *more = textwrap.wrap(does, max(12, width - 2 - max(8, shown + 1))) or [""]
-        lines.append(lead + first)
-        # under the key's text: a word wrapped under the keys would read as a key
-        lines += [" " * (2 + max(8, shown + 1)) + line for line in more]
+    lines = _key_lines(keys, width)
     paragraphs = []
     if replaying:
         paragraphs.append(
@@ -112,13 +113,43 @@ def help_text(*, replaying: bool = False, recording: bool = True, user_lane: boo
     return "\n".join([*lines, "", "Press escape or ? to close."])
 
 
+def _help_after_the_end(*, kept: str, user_lane: bool, large: bool, width: int) -> str:
+    """The help once the run has ended: the clock has nowhere to go, nothing is offered."""
+    keys = [("[b]s[/b]", "the summary of the run")]
+    if user_lane:
+        keys.append(("[b]l[/b]", "timeline: all lanes / device / user"
+                     + (" / hidden" if large else "")))
+    elif large:
+        keys.append(("[b]l[/b]", "timeline: shown / hidden"))
+    keys += [("[b]?[/b]", "this help"),
+             ("[b]q[/b], [b]ctrl+c[/b], [b]ctrl+q[/b]", f"quit ({kept})")]
+    return "\n".join([*_key_lines(keys, width), "", *textwrap.wrap(
+        "The run has ended: nothing happens any more, so the keys that move the clock or "
+        "answer the device do nothing.", width), "", "Press escape or ? to close."])
+
+
+def _key_lines(keys: Sequence[tuple[str, str]], width: int) -> list[str]:
+    """The help's heading and its keys, each key's text wrapped under its text."""
+    lines = [_KEYS, ""]
+    for key, does in keys:
+        shown = Text.from_markup(key).cell_len
+        # the key column is 8 wide; a wider key runs into its text after one space
+        lead = f"  {key}{' ' * max(1, 8 - shown)}"
+        first, *more = textwrap.wrap(does, max(12, width - 2 - max(8, shown + 1))) or [""]
+        lines.append(lead + first)
+        # under the key's text: a word wrapped under the keys would read as a key
+        lines += [" " * (2 + max(8, shown + 1)) + line for line in more]
+    return lines
+
+
 def session_help(session: Any, *, large: bool = False, width: int = _WIDTH) -> str:
     """:func:`help_text` for ``session`` (a :class:`~opspec.tui.session.WalkSession`) as it
     is; ``large``: the app's ``--large`` layout; ``width``: its widest line."""
     return help_text(
         replaying=session.replaying, recording=session.record_path is not None,
         user_lane=session.has_user_lane, model=session.model_factory is not None,
-        on_call=session.on_call, large=large, ends_at=clock(session.horizon), width=width)
+        on_call=session.on_call, large=large, ends_at=clock(session.horizon), width=width,
+        ended=session.ended)
 
 
 def help_screen(session: Any, *, large: bool = False) -> HelpScreen:

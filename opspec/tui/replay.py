@@ -31,7 +31,7 @@ from opspec.engine.compiled import CompiledPackage
 from opspec.usermodels.scripts import ScriptUser, load_script
 
 __all__ = ["QUIT", "instance_tag", "load_recording", "recorded_end", "recorded_seed",
-           "tagged_action"]
+           "refuse_nothing_to_replay", "script_notes", "tagged_action"]
 
 #: the trace event of a session the person quit before the end of its run: ``until``, the
 #: simulated second they quit at
@@ -97,6 +97,47 @@ def recorded_end(path: str | Path) -> float | None:
     except (OSError, UnicodeDecodeError, ValueError):
         return None      # unreadable: the replay runs the whole run, as before
     return end
+
+
+def refuse_nothing_to_replay(path: str | Path, option: str) -> float | None:
+    """:func:`recorded_end` of ``path``, refusing a session quit before its clock moved
+    (``option``: ``--replay`` or ``--script``, the option that named it): replayed without an
+    end of its own, it would run the whole run without the person, which is not the session.
+
+    Raises :class:`~opspec.errors.ConfigurationError`."""
+    from opspec.errors import ConfigurationError
+
+    end = recorded_end(path)
+    if end == 0.0:
+        raise ConfigurationError(
+            f"{option} {path}: the session was quit before its clock moved: "
+            "there is nothing to replay",
+            hint="--until T or --days D replays to then without the person")
+    return end
+
+
+def script_notes(path: str | Path, *, horizon: float, seed: int,
+                 end_given: bool) -> list[str]:
+    """What a run of the recording ``path`` as a script (``opspec run --script``) does not
+    replay of the session, in words: it goes on to ``horizon`` (no ``end_given``: no
+    ``--until`` nor ``--days``) where the session ended earlier, or it runs ``seed`` where
+    the session ran another (the device's draws of another seed are another session). A
+    walkthrough's ``--replay`` takes both from the recording's trace; a script cannot say
+    them, so the run does not, and says how to."""
+    from opspec.clock import clock_time
+    from opspec.tui.summary import until_text
+
+    notes = []
+    end = None if end_given else recorded_end(path)
+    if end is not None and end != horizon:
+        notes.append(f"{path} records a walkthrough that ended at {clock_time(end)}: this "
+                     f"run goes on to {clock_time(horizon)} without the person "
+                     f"(--until {until_text(end)} ends where the session did)")
+    recorded = recorded_seed(path)
+    if recorded is not None and recorded != seed:
+        notes.append(f"{path} records a walkthrough run with seed {recorded}, this run has "
+                     f"seed {seed} (--seed {recorded} replays the session's device draws)")
+    return notes
 
 
 def recorded_seed(path: str | Path) -> int | None:

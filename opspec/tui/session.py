@@ -136,7 +136,8 @@ class WalkSession(SessionClock, PersonLane, TraceFollower, Recording):
     def summary_lines(self, *, final: bool = True) -> list[str]:
         """The session in words: when, the spec's metrics (the numbers
         ``opspec run SPEC --script RECORDING`` prints), the person's response times, and
-        where the recording is with the commands that replay it to the second shown.
+        what the bound devices said (in full), and where the recording is with the commands
+        that replay it to the second shown.
         ``final``: the end of the session (the run's outcome is taken, once); else the
         numbers so far, with the run going on."""
         if self.failure is not None:
@@ -166,6 +167,10 @@ class WalkSession(SessionClock, PersonLane, TraceFollower, Recording):
         if self.has_user_lane and not self.replaying:
             lines += ["", "Your response times (wall clock, from the offer to your key):",
                       *response_lines(self.responses, recorded=self.record_path is not None)]
+        if self.board.notes:
+            # the device panel shows a note on one line, cut at the panel's edge: in full here
+            lines += ["", "What the bound devices said:",
+                      *(f"  {note}" for note in self.board.notes)]
         if self.record_path is not None:
             # the end to replay to: where the person quit (or, so far, where the session
             # stands: the numbers above are those of the run up to now), or a --days /

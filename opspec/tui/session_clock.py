@@ -41,6 +41,8 @@ class SessionClock(SessionState):
             # waits now would count that time as zero
             self.times.spoil("the clock was paused")
         self._paused = value
+        if not value:
+            self._call_paused = False
 
     def spoil_timing(self, why: str) -> None:
         """Simulated time jumped (a skip, a wait): what waits now has no real duration."""
@@ -191,14 +193,20 @@ class SessionClock(SessionState):
                 before = self._speed
                 self.speed = 1.0
                 self._speed_before_call = before
-            elif self.on_call == "pause":
+            elif self.on_call == "pause" and not self._paused:
                 self.paused = True
+                self._call_paused = True
         elif not calling and self._in_call and (not self._acted_in_call or not self.offers):
             # over: the person let it pass, or answered and nothing waits any more
             self._in_call = False
             if self._speed_before_call is not None:
                 before, self._speed_before_call = self._speed_before_call, None
                 self.speed = before
+            if self._call_paused and self.handed_over:
+                # the call's pause was for the person: the model takes the lane at once,
+                # as it takes back the speed (space resumes only what the person paused)
+                self.paused = False
+            self._call_paused = False
 
     @property
     def paused_words(self) -> str:

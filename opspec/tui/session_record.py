@@ -81,7 +81,11 @@ class Recording(SessionState):
             data.update(instance=item.instance, activity=item.activity,
                         **response.trace_data())
             if by == "person":
-                self.responses.append(response.named(label or item.activity, self.now))
+                # x is recorded as "omit hear_alarm #6" and labelled "not: Hear the alarm"
+                omitted = action.split(" ", 1)[0] == "omit"
+                self.responses.append(response.named(
+                    (label.removeprefix("not: ") if omitted else label) or item.activity,
+                    self.now, omitted=omitted))
                 self._acted_in_call = self._in_call or self._acted_in_call
                 self.aftermath.acted(label or item.activity, item, self.now)
         self.sim.session.trace("walkthrough.action", data)

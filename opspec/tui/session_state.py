@@ -98,6 +98,8 @@ class SessionState:
         self._paused = False
         #: the speed the person had before a call dropped the clock to real time
         self._speed_before_call: float | None = None
+        #: --on-call pause paused the clock for this call (the person has not resumed it)
+        self._call_paused = False
         self._in_call = False                # the device calls the person now
         self._acted_in_call = False          # ... and the person has answered something
         self._call_began = False             # set by an event: stop stepping, apply on_call

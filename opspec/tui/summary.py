@@ -27,9 +27,15 @@ __all__ = ["metric_lines", "replay_commands", "response_lines", "until_text"]
 def response_lines(responses: Sequence[Response], *, recorded: bool = True) -> list[str]:
     """The person's response times per action (wall clock), and how many are usable for
     ``opspec fit`` (with the reasons the others are not); not ``recorded`` (``--no-record``),
-    none is: there is no trace to fit."""
+    none is: there is no trace to fit. What the person chose not to do (``x``) has no
+    response time: it is counted apart, by action."""
+    skipped = Counter(r.label for r in responses if r.omitted)
+    # (opspec fit counts them as omissions, timed or not: they are not its durations either)
+    said = ["  not done (x, no response time): "
+            + "; ".join(f"{label} ({n})" for label, n in skipped.items())] if skipped else []
+    responses = [r for r in responses if not r.omitted]
     if not responses:
-        return ["  (you answered nothing)"]
+        return ["  (you answered nothing)", *said]
     per: dict[str, list[float]] = {}
     for response in responses:
         if response.wall_s is not None:
@@ -37,6 +43,7 @@ def response_lines(responses: Sequence[Response], *, recorded: bool = True) -> l
     width = max((len(label) for label in per), default=0)
     lines = [f"  {label:<{width}}  median {median(times):.1f} s, max {max(times):.1f} s, "
              f"n {len(times)}" for label, times in per.items()]
+    lines += said
     if not recorded:
         lines.append("  (nothing was recorded: opspec fit has no trace of them)")
         return lines

@@ -28,7 +28,8 @@ __all__ = ["OfferTimes", "Response"]
 class Response:
     """One answer to an offer: who gave it, how long it took in wall seconds (``None``: the
     offer was never shown to the person, e.g. a model's), and whether the simulated duration
-    is real (``usable``; ``why`` not)."""
+    is real (``usable``; ``why`` not). ``omitted``: the answer was not to do it (``x``), which
+    has no response time (the time to a decision not to act is no duration of the action)."""
 
     by: str
     wall_s: float | None
@@ -36,9 +37,10 @@ class Response:
     why: str | None = None
     label: str = ""
     at: float = 0.0
+    omitted: bool = False
 
-    def named(self, label: str, at: float) -> Response:
-        return replace(self, label=label, at=at)
+    def named(self, label: str, at: float, *, omitted: bool = False) -> Response:
+        return replace(self, label=label, at=at, omitted=omitted)
 
     def trace_data(self) -> dict[str, Any]:
         data: dict[str, Any] = {"usable": self.usable}

@@ -87,3 +87,41 @@ def test_a_device_note_is_shown_beside_the_participant_without_alarming(compiled
         board(event)
     alarm = next(r for r in board.rows() if r.id == "alarm")
     assert "note: alarm: reconnected" in alarm.detail and not alarm.alert
+
+
+def test_a_note_naming_one_participant_of_a_shared_device_is_that_participant_s(compiled):
+    """One device served both the alarm and the drawer (``--bind alarm=… --bind
+    dispenser=…`` of one profile): its note "dispenser: application 'notify_caregiver' …"
+    showed on the alarm's row too, as if the alarm had the problem."""
+    session = WalkSession(compiled, device_participants={
+        "medication_dispenser": ("alarm", "dispenser")})
+    note = ("dispenser: application 'notify_caregiver' (notify_caregiver in notify_workflow) "
+            "is not an operation of profile medication_dispenser, so it runs by itself, not "
+            "on the device (operations: alarm_on, dispense)")
+    session.sim.session.trace("device.note", {"device": "medication_dispenser",
+                                              "message": note})
+    assert f"note: {note}" in row(session, "dispenser").detail
+    assert "note:" not in row(session, "alarm").detail
+    # a note of the whole device (both participants named) is on both
+    session.sim.session.trace("device.note", {"device": "medication_dispenser",
+                                              "message": "alarm, dispenser: reconnected"})
+    assert "reconnected" in row(session, "alarm").detail
+    assert "reconnected" in row(session, "dispenser").detail
+
+
+def test_the_summary_says_the_devices_notes_in_full(compiled):
+    """The panel shows a note on one line, cut at its edge ("note: dispenser: application
+    'notify_caregiver' (…" at 100 columns), and nothing else said it: the researcher never
+    learnt that the caregiver's notice ran simulated, not on the device."""
+    session = WalkSession(compiled, device_participants={
+        "medication_dispenser": ("alarm", "dispenser")})
+    note = ("dispenser: application 'notify_caregiver' (notify_caregiver in notify_workflow) "
+            "is not an operation of profile medication_dispenser, so it runs by itself, not "
+            "on the device (operations: alarm_on, dispense)")
+    for _ in range(2):                                 # (said once)
+        session.sim.session.trace("device.note", {"device": "medication_dispenser",
+                                                  "message": note})
+    lines = session.summary_lines(final=False)
+    at = lines.index("What the bound devices said:")
+    assert lines[at + 1:] == [f"  {note}"]
+    assert "What the bound devices said:" not in WalkSession(compiled).summary_lines()

@@ -46,3 +46,24 @@ async def test_footer_closes_up_only_when_it_must(compiled):
         await pilot.resize_terminal(120, 24)
         await pilot.pause()
         assert not app.query_one(Footer).compact
+
+
+@pytest.mark.asyncio
+async def test_every_footer_key_of_a_spec_without_a_user_lane_fits_64_columns_large():
+    """With --large at 64 x 20 (the smallest it is made for) the footer of a spec without a
+    user lane (or of a replay) ended in "u to the e": its last key's words were cut."""
+    from pathlib import Path
+
+    from opspec.engine.compiled import compile_package
+    from opspec.xpdl.open_spec import open_spec
+
+    vacuum = Path(__file__).resolve().parents[2] / "specs" / "vacuum_cleaner.xpdl"
+    session = WalkSession(compile_package(open_spec(vacuum)))
+    session.paused = True
+    app = WalkthroughApp(session, title="Automatic vacuum cleaner", large=True)
+    async with app.run_test(size=(64, 20)) as pilot:
+        await pilot.pause()
+        keys = list(app.query_one(Footer).query(FooterKey))
+        assert "u" in {key.key for key in keys}
+        for key in keys:
+            assert key.region.right <= 64, f"{key.key} is cut at 64 columns"

@@ -65,7 +65,7 @@ async def test_the_help_of_a_replay_lists_what_a_replay_does(compiled, tmp_path)
     assert ("This is a replay: the recording performs your lane, so nothing waits for your "
             "answer. Watch it, pause it, change its speed or skip ahead (w, n, u); it is "
             "never slowed down when the device calls, and it ends at d1 08:01:00.") in said
-    assert "u to the end" in footer and "u until me" not in footer
+    assert "u to end" in footer and "u until me" not in footer
     assert not any(key.startswith("h ") for key in footer)
 
 
@@ -100,7 +100,7 @@ async def test_the_help_of_a_spec_without_a_user_lane(model_factory):
         assert words not in text
     assert "u       skip to the end of the run (again: stop)" in text
     assert "This spec has no user lane" in text
-    assert "u to the end" in footer and not any(key.startswith("h ") for key in footer)
+    assert "u to end" in footer and not any(key.startswith("h ") for key in footer)
 
 
 @pytest.mark.asyncio
