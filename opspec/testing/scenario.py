@@ -14,8 +14,9 @@
 
 ``given`` keys: ``script`` (a list of ``[when, action]`` pairs, see
 :mod:`opspec.testing.script`, or the path of a script file), ``user_model`` (a preset name or
-a TOML path), ``users`` (independent simulated users, default 1), ``days`` (default 1) or
-``until`` (seconds or a duration such as ``"9h"`` / ``"09:00"``), ``seed`` (default: the
+a TOML path), ``users`` (independent simulated users, default 1), ``days`` or ``until``
+(seconds or a duration such as ``"9h"`` / ``"09:00"``; with neither, the spec's
+``opspec:RunLength``, else 1 day), ``seed`` (default: the
 test's seed), ``engine`` (engine options, as in ``[engine]`` of a config file), ``params``
 (package data overrides: each name a package data field of the spec), ``branches``
 (``{ GATEWAY = { FLOW = P } }``: branch probabilities of undecided gateways, as
