@@ -43,7 +43,8 @@ def register(subparsers: Any) -> None:
     length = parser.add_mutually_exclusive_group()
     _args.add_days(length, what=" to run")
     length.add_argument("--until", metavar="T",
-                        help="simulated end time: seconds, or an ISO 8601 duration (PT8H)")
+                        help="simulated end time: seconds, or a duration (8h, PT8H, 10:00 "
+                        "for 10 h)")
     _args.add_seed(parser, what="run seed: draws as user 0 of opspec evaluate --seed")
     user = parser.add_mutually_exclusive_group()
     user.add_argument("--script", metavar="FILE",
