@@ -23,7 +23,7 @@ evaluator a monitor runs online (same verdict, same witness), and holding when i
 every replication (``count`` too: a total over all replications is a count metric's line,
 ``alarms == 12``). ``activity X`` may also be ``trigger X`` (a message or signal raised),
 ``process X`` (an instance started) or a bare name. Metric comparisons use the metrics pooled over all
-replications; ``==`` allows a relative error of 1e-9. The statistical lines are decided by
+replications; ``==`` and ``!=`` allow an error of 1e-9, relative, or absolute near 0. The statistical lines are decided by
 :mod:`opspec.statistics.claims`: they pass when the one-sided bound at that confidence is on
 the right side, fail when the claim is refuted at that confidence, and otherwise fail saying
 how many replications would decide it.

@@ -104,3 +104,13 @@ def test_scenario_days_default_is_the_spec_run_length(tmp_path: Path) -> None:
     failures = run_scenario(document.scenarios[0], ROOT / "specs" / "toy_sumo.xpdl", seed=0,
                             seen=seen.append)
     assert failures == [] and seen[0].horizon == 1800.0
+
+
+def test_equality_tolerance_of_an_expectation_is_spec_testing_mds() -> None:
+    from opspec.testing.expectations import _OPS
+
+    assert "(`==` and `!=` allow an error of 1e-9, relative, or absolute near 0)" in _page(
+        "spec-testing.md")
+    assert _OPS["=="](1e12, 1e12 + 900) and not _OPS["=="](1e12, 1e12 + 1100)   # relative
+    assert _OPS["=="](0.0, 9e-10) and not _OPS["=="](0.0, 1.1e-9)              # absolute
+    assert _OPS["!="](0.0, 1.1e-9) and not _OPS["!="](0.0, 9e-10)
