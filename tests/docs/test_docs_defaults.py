@@ -114,3 +114,32 @@ def test_equality_tolerance_of_an_expectation_is_spec_testing_mds() -> None:
     assert _OPS["=="](1e12, 1e12 + 900) and not _OPS["=="](1e12, 1e12 + 1100)   # relative
     assert _OPS["=="](0.0, 9e-10) and not _OPS["=="](0.0, 1.1e-9)              # absolute
     assert _OPS["!="](0.0, 1.1e-9) and not _OPS["!="](0.0, 9e-10)
+
+
+@pytest.mark.parametrize(("change", "status", "says"), [
+    (("[activities.take_pill]", "[activities.take_pil]"), 1,
+     "activities.take_pil: error: "),
+    (("probability = 0.2,", "probability = 1.2,"), 1,
+     "activities.hear_beep.omission.probability: error: "),
+    (("[activities.press_taken]", ("[activities.wash_hands]\nduration = 5.0\n\n"
+                                   "[activities.press_taken]")), 0,
+     "activities.wash_hands: warning: "),
+])
+def test_what_validate_says_of_a_user_model_typo_is_what_the_tutorial_says(
+        tmp_path: Path, capsys: pytest.CaptureFixture[str], change: tuple[str, str],
+        status: int, says: str) -> None:
+    """tutorial.md, step 6: a misspelt activity and a probability above 1 are errors of
+    validate's at the file and key; an activity the spec does not have at all, a warning."""
+    from opspec.cli import main
+
+    assert ("a typo in it (a misspelt activity, which leaves the spec's activity without a "
+            "duration; a probability above 1) is an error of validate's, at the file and key; "
+            "an activity the spec does not have at all is a warning") in _page("tutorial.md")
+    step = ROOT / "tests" / "docs" / "tutorial" / "step6"
+    (tmp_path / "pill.xpdl").write_bytes((step / "pill.xpdl").read_bytes())
+    model = (step / "pill.users.toml").read_text(encoding="utf-8")
+    assert change[0] in model
+    (tmp_path / "pill.users.toml").write_text(model.replace(change[0], change[1], 1),
+                                              encoding="utf-8")
+    assert main(["validate", str(tmp_path / "pill.xpdl")]) == status
+    assert says in capsys.readouterr().out
