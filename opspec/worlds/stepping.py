@@ -16,8 +16,8 @@ from typing import Any, Final
 
 from opspec.worlds.robot import COMMANDS, pose_after
 
-__all__ = ["ARC", "COLLISION", "COVER", "DONE", "STEP_S", "RoomState", "cells_of", "cover",
-           "distance_ahead", "round4"]
+__all__ = ["ARC", "COLLISION", "COVER", "DONE", "STEP_S", "Normals", "RoomState", "cells_of",
+           "cover", "distance_ahead", "round4"]
 
 #: integration step: 5 cm at 1 m/s, well under the robot's size
 STEP_S: Final = 0.05
@@ -310,6 +310,55 @@ class RoomState:
         bumped = self.bumped
         self.bumped = False
         return {"bump": bumped, "edge": False}         # a room has no ring edge
+
+
+#: how many standard normal draws :class:`Normals` takes at once
+BATCH: Final = 64
+
+
+class Normals:
+    """A world's standard normal draws (the range finder's noise) from its generator
+    ``rng``, taken :data:`BATCH` at a time: compiled, ``Generator.standard_normal()`` is a
+    call through Python's protocol of about 3.3k instructions, once a period on a robot;
+    an array of them costs that once and little more a draw. They are the generator's own
+    draws in its order: numpy fills an array with the same ziggurat draws, one after
+    another, that its scalar calls make.
+
+    The generator has then gone ahead of the draws handed out. :meth:`settle` puts it back
+    where they leave it (its state before the batch, then as many draws again), as anything
+    else drawing from it must find it: the world's ``rng`` settles first
+    (:attr:`~opspec.worlds.base.World.rng`)."""
+
+    def __init__(self, rng: Any) -> None:
+        self.rng = rng
+        self.drawn: list[float] = []
+        self.used = 0
+        self.before: Any = None         # the generator's state before the batch
+
+    def draw(self) -> float:
+        """The next standard normal draw of the generator, as ``rng.standard_normal()``."""
+        used = self.used
+        drawn = self.drawn
+        if used >= len(drawn):          # (all handed out: the generator is where they leave it)
+            rng = self.rng
+            self.before = rng.bit_generator.state
+            drawn = rng.standard_normal(BATCH).tolist()
+            self.drawn = drawn
+            used = 0
+        self.used = used + 1
+        return drawn[used]
+
+    def settle(self) -> None:
+        """Put the generator where the draws handed out leave it; the rest dropped."""
+        used = self.used
+        if used < len(self.drawn):
+            rng = self.rng
+            rng.bit_generator.state = self.before
+            if used:
+                rng.standard_normal(used)
+        self.drawn = []
+        self.used = 0
+        self.before = None
 
 
 def distance_ahead(x: float, y: float, heading: float, boxes: tuple[RayBox, ...]) -> float:
