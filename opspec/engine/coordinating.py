@@ -66,7 +66,7 @@ class Coord:
 
 #: each coordination activity's :class:`Coord`, made at its first run (compiled activities
 #: are not changed after compilation; at most ``_COORDS_MAX`` kept, then made again)
-_COORDS: dict[CompiledActivity, Coord] = {}
+_COORDS: Final[dict[CompiledActivity, Coord]] = {}     # (Final: read natively, not by name)
 _COORDS_MAX: Final = 4096
 
 
