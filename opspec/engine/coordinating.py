@@ -10,14 +10,16 @@ through one; a robot's periodic workflows run an arbiter, a push or a pull most 
 from __future__ import annotations
 
 from collections import deque
-from typing import TYPE_CHECKING, Any, Final
+from collections.abc import MutableMapping
+from typing import TYPE_CHECKING, Any, Final, final
 
 from opspec.engine import coordination as coord
 from opspec.engine.compiled import CompiledActivity
 from opspec.engine.instances import ActivityInstance, Frame
 from opspec.engine.lifecycle import RUNNING, SUSPENDED
+from opspec.engine.scope import Scope
 from opspec.engine.trace import EventKind as EK
-from opspec.model import CoordinationKind
+from opspec.model import CoordinationBuiltIn, CoordinationKind
 
 if TYPE_CHECKING:
     from opspec.engine.activities import Activities
@@ -31,6 +33,77 @@ _PULL_DATA: Final = CoordinationKind.PULL_DATA
 
 #: what :func:`at_once` returns when it did nothing: the caller starts an instance
 _NOT_NOW: Final = False
+
+# The kinds as the native integers a :class:`Coord` holds
+ARBITER: Final = 0
+VOTER: Final = 1
+SUPERPOSITION: Final = 2
+PUSH: Final = 3
+PULL: Final = 4
+OTHER: Final = 5                        # a mode change
+
+
+@final
+class Coord:
+    """An activity's coordination built-in (``spec``, the model's
+    :class:`~opspec.model.CoordinationBuiltIn`) as compiled fields: the model's class is a
+    Python dataclass, and compiled code read each of its fields through Python's protocol
+    (about five reads a built-in run at once, once a period on a robot). ``channel`` is the
+    mailbox (the activity's id without a channel of its own), ``waiting`` what a pull
+    waiting on it says."""
+
+    def __init__(self, spec: CoordinationBuiltIn, act_id: str) -> None:
+        self.spec = spec
+        kind = spec.kind
+        self.kind = (ARBITER if kind is _ARBITER else VOTER if kind is _VOTER
+                     else SUPERPOSITION if kind is _SUPERPOSITION else PUSH
+                     if kind is _PUSH_DATA else PULL if kind is _PULL_DATA else OTHER)
+        self.inputs: tuple[str, ...] = spec.inputs
+        self.output: str | None = spec.output
+        self.channel: str = spec.channel or act_id
+        self.waiting = f"pull from mailbox {self.channel!r}"
+
+
+#: each coordination activity's :class:`Coord`, made at its first run (compiled activities
+#: are not changed after compilation; at most ``_COORDS_MAX`` kept, then made again)
+_COORDS: Final[dict[CompiledActivity, Coord]] = {}     # (Final: read natively, not by name)
+_COORDS_MAX: Final = 4096
+
+
+def coord_of(act: CompiledActivity, spec: CoordinationBuiltIn) -> Coord:
+    """``act``'s coordination built-in ``spec`` as a :class:`Coord`."""
+    found = _COORDS.get(act)
+    if found is None or found.spec is not spec:
+        if len(_COORDS) >= _COORDS_MAX:
+            _COORDS.clear()
+        found = Coord(spec, act.id)
+        _COORDS[act] = found
+    return found
+
+
+#: a field of neither map (:func:`inputs_of`)
+_MISSING: Final = object()
+
+
+def inputs_of(scope: MutableMapping[str, Any], inputs: tuple[str, ...]) -> list[Any]:
+    """The values of the fields ``inputs`` as ``scope[name]`` reads them, ``KeyError(name)``
+    for one of neither map. A :class:`Scope` is read through its two dictionaries: compiled,
+    ``scope[name]`` is a call of its ``__getitem__`` through Python's protocol."""
+    values: list[Any] = []
+    if isinstance(scope, Scope):
+        fields = scope.fields
+        package = scope.package
+        for name in inputs:
+            value = fields.get(name, _MISSING)
+            if value is _MISSING:
+                value = package.get(name, _MISSING)
+                if value is _MISSING:
+                    raise KeyError(name)
+            values.append(value)
+        return values
+    for name in inputs:
+        values.append(scope[name])
+    return values
 
 
 def at_once(acts: Activities, frame: Frame, act: CompiledActivity) -> bool:
@@ -48,41 +121,39 @@ def at_once(acts: Activities, frame: Frame, act: CompiledActivity) -> bool:
     if (spec is None or act.start_assign or state.rules or inst.state == SUSPENDED
             or act.general and state.pooled):
         return _NOT_NOW
-    kind = spec.kind
-    scope = inst.scope                      # ActivityInstance.scope without its locals
-    values: list[Any] = []
-    try:
-        for name in spec.inputs:
-            values.append(scope[name])
+    built = coord_of(act, spec)
+    kind = built.kind
+    try:                                    # ActivityInstance.scope without its locals
+        values = inputs_of(inst.scope, built.inputs)
     except KeyError:
         return _NOT_NOW
     result: Any = None
     box: deque[Any] | None = None
-    if kind is _ARBITER:
+    if kind == ARBITER:
         result = first_set(values)
-    elif kind is _VOTER or kind is _SUPERPOSITION:
+    elif kind == VOTER or kind == SUPERPOSITION:
         try:
-            result = (coord.voter(values, spec.options) if kind is _VOTER
+            result = (coord.voter(values, spec.options) if kind == VOTER
                       else coord.superposition(values, spec.weights))
         except (TypeError, ValueError):
             return _NOT_NOW
-    elif kind is _PULL_DATA:
-        box = state.mailboxes.get(spec.channel or act.id)
+    elif kind == PULL:
+        box = state.mailboxes.get(built.channel)
         if not box:
             return _NOT_NOW
-    elif kind is not _PUSH_DATA:
+    elif kind != PUSH:
         return _NOT_NOW
     state.last_key += 1                     # the key the instance would have taken
     cached = act.flag_cache                 # RunState.act_bits's cached case, in line
     if (cached.bits if cached.key is state.flag_key else state.act_bits(act)) & 1:
         state.emit(EK.ACTIVITY_STARTED, act.process, inst.id, act.id, act.lane,
                    act.participant)
-    output = spec.output
-    if kind is _PUSH_DATA:
-        push(acts, spec.channel or act.id, values[0] if len(values) == 1 else tuple(values))
+    output = built.output
+    if kind == PUSH:
+        push(acts, built.channel, values[0] if len(values) == 1 else tuple(values))
     elif box is not None and output:      # (without an output the value stays, as there)
         result = box.popleft()
-    if output and kind is not _PUSH_DATA:
+    if output and kind != PUSH:
         acts.flow.set_field(inst, act, output, result)
     # Activities._complete, the instance's part left out
     if act.simple_end:
@@ -119,33 +190,38 @@ def coordinate(acts: Activities, ai: ActivityInstance) -> None:
     act = ai.act
     spec = act.coordination
     assert spec is not None
-    scope = ai.scope()
+    built = coord_of(act, spec)
     try:
-        values = [scope[name] for name in spec.inputs]
+        values = inputs_of(ai.scope(), built.inputs)
     except KeyError as error:
         acts.fail(ai, "coordination", f"data field {error.args[0]!r} does not exist")
         return
-    kind = spec.kind
+    kind = built.kind
+    output = built.output
     try:
-        if kind is _ARBITER:
+        if kind == ARBITER:
             result: Any = first_set(values)
-        elif kind is _VOTER:
+        elif kind == VOTER:
             result = coord.voter(values, spec.options)
-        elif kind is _SUPERPOSITION:
+        elif kind == SUPERPOSITION:
             result = coord.superposition(values, spec.weights)
-        elif kind is _PUSH_DATA:
-            push(acts, spec.channel or act.id, values[0] if len(values) == 1
-                 else tuple(values))
+        elif kind == PUSH:
+            push(acts, built.channel, values[0] if len(values) == 1 else tuple(values))
             acts.body_done(ai, None)
             return
-        elif kind is _PULL_DATA:
-            channel = spec.channel or act.id
+        elif kind == PULL:
+            channel = built.channel
             box = acts.state.mailboxes.get(channel)
             if box:
-                acts.body_done(ai, {spec.output: box.popleft()} if spec.output else None)
+                acts.body_done(ai, {output: box.popleft()} if output else None)
             else:
-                ai.waiting = f"pull from mailbox {channel!r}"
-                acts.state.pullers.setdefault(channel, deque()).append(ai)
+                ai.waiting = built.waiting
+                pullers = acts.state.pullers
+                waiting = pullers.get(channel)
+                if waiting is None:         # (setdefault's, without a deque made per call)
+                    waiting = deque()
+                    pullers[channel] = waiting
+                waiting.append(ai)
             return
         else:
             # at once: a mode ending this instance stops all after it (its completion too)
@@ -153,9 +229,9 @@ def coordinate(acts: Activities, ai: ActivityInstance) -> None:
             acts.body_done(ai, None)
             return
     except (TypeError, ValueError) as error:
-        acts.fail(ai, "coordination", f"{kind.value} failed: {error}")
+        acts.fail(ai, "coordination", f"{spec.kind.value} failed: {error}")
         return
-    acts.body_done(ai, {spec.output: result} if spec.output else None)
+    acts.body_done(ai, {output: result} if output else None)
 
 
 def push(acts: Activities, channel: str, value: Any) -> None:
@@ -165,8 +241,15 @@ def push(acts: Activities, channel: str, value: Any) -> None:
     while pullers:
         ai = pullers.popleft()
         if ai.state == RUNNING:
-            output = ai.act.coordination.output if ai.act.coordination else None
+            act = ai.act
+            spec = act.coordination
+            output = coord_of(act, spec).output if spec is not None else None
             state.ready.append((acts.body_done_q, ai, {output: value} if output else None,
                                 None))
             return
-    state.mailboxes.setdefault(channel, deque()).append(value)
+    mailboxes = state.mailboxes
+    box = mailboxes.get(channel)
+    if box is None:                         # (setdefault's, without a deque made per call)
+        box = deque()
+        mailboxes[channel] = box
+    box.append(value)

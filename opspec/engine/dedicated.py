@@ -39,10 +39,18 @@ class DedicatedProcessor:
 
     def burst(self, now: float, cost: float) -> None:
         ends = self._ends
-        if self._lined:
+        end = now + cost
+        size = len(ends)
+        if (self._lined and size and ends[-1] <= now
+                and (size == 1 or (ends[-2] > now and ends[-2] > end))):
+            # the commonest case: the earliest burst has ended, no other has, and the new
+            # one ends first: it takes the ended one's place (a pop and an insertion
+            # resized the list's storage each time it went from one to none and back)
+            ends[-1] = end
+            busy = size
+        elif self._lined:
             while ends and ends[-1] <= now:
                 ends.pop()
-            end = now + cost
             lo = 0
             hi = len(ends)
             while lo < hi:
@@ -59,7 +67,7 @@ class DedicatedProcessor:
         else:
             while ends and ends[0] <= now:
                 heapq.heappop(ends)
-            heapq.heappush(ends, now + cost)
+            heapq.heappush(ends, end)
             busy = len(ends)
             if busy < LINE_MIN and not TUPLES:
                 ends.sort(reverse=True)

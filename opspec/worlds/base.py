@@ -8,7 +8,7 @@ from collections.abc import Callable, Mapping
 from typing import TYPE_CHECKING, Any
 
 from opspec.worlds.geometry import wrap_angle
-from opspec.worlds.stepping import STEP_S
+from opspec.worlds.stepping import STEP_S, Normals
 
 if TYPE_CHECKING:   # annotations only: `opspec validate` loads no NumPy
     import numpy as np
@@ -60,10 +60,36 @@ class World:
     """
 
     def __init__(self, rng: np.random.Generator) -> None:
-        self.rng = rng
+        self._rng = rng
+        self._normals: Normals | None = None
         self.time = 0.0
         self.tracer: Tracer | None = None
         self._announced = False
+
+    @property
+    def rng(self) -> np.random.Generator:
+        """The world's random stream, where the draws made so far leave it (the normal draws
+        taken ahead, :meth:`normal_draws`, settled first)."""
+        normals = self._normals
+        if normals is not None:
+            normals.settle()
+        return self._rng
+
+    @rng.setter
+    def rng(self, rng: np.random.Generator) -> None:
+        normals = self._normals
+        if normals is not None:
+            normals.settle()
+            normals.rng = rng
+        self._rng = rng
+
+    def normal_draws(self) -> Normals:
+        """The standard normal draws of :attr:`rng` taken a batch at a time (one object per
+        world, drawing from its stream as ``rng.standard_normal()`` would)."""
+        normals = self._normals
+        if normals is None:
+            normals = self._normals = Normals(self._rng)
+        return normals
 
     def trace(self, kind: str, **data: Any) -> None:
         if self.tracer is not None:

@@ -22,7 +22,7 @@ from typing import Any
 
 from opspec.engine.activities import AnswersAtOnce
 from opspec.engine.workitem import WorkItem
-from opspec.worlds.stepping import DONE, RoomState
+from opspec.worlds.stepping import DONE, Normals, RoomState
 
 __all__ = ["RoomDevices"]
 
@@ -41,6 +41,8 @@ class RoomDevices(AnswersAtOnce):
         self.applications: dict[str, None] = general.applications
         self.session: Any = None
         self.announced = False
+        # the range noise's draws, a batch at a time (the world's rng settles them)
+        self.normals: Normals = world.normal_draws()
 
     def attach(self, session: Any) -> None:
         self.session = session
@@ -79,12 +81,15 @@ class RoomDevices(AnswersAtOnce):
             if sd >= 0.0:
                 # RoomWorld.op_read_range, compiled: the same draw from the room's
                 # generator and the same float operations (0.0 + sd * z, then the reading)
-                z: float = world.rng.standard_normal()
+                z = self.normals.draw()
                 result = {"distance": state.read_range(0.0 + sd * z)}
             else:
                 result = world.op_read_range(data)      # normal() refuses the sd
         else:
-            command = data.get("motor_cmd")
+            if isinstance(data, dict):      # a dict's get called natively
+                command = data.get("motor_cmd")
+            else:                           # (a Mapping's through Python's protocol)
+                command = data.get("motor_cmd")
             command = str(command or "stop")
             if command == "turn_random":
                 result = self.world.op_drive(data)

@@ -16,8 +16,8 @@ from typing import Any, Final
 
 from opspec.worlds.robot import COMMANDS, pose_after
 
-__all__ = ["ARC", "COLLISION", "COVER", "DONE", "STEP_S", "RoomState", "cover", "distance_ahead",
-           "round4"]
+__all__ = ["ARC", "COLLISION", "COVER", "DONE", "STEP_S", "Normals", "RoomState", "cells_of",
+           "cover", "distance_ahead", "round4"]
 
 #: integration step: 5 cm at 1 m/s, well under the robot's size
 STEP_S: Final = 0.05
@@ -66,6 +66,7 @@ class RoomState:
         self.grown: list[tuple[float, float, float, float]] = []
         self.reach = 0.0
         self.cell = 0.0
+        self.inv = 0.0          # 1 / cell where cells_of may multiply by it (see place)
         self.radius = 0.0
         self.boxes: tuple[RayBox, ...] = ()
         self.uncovered: dict[Key, Cells] = {}
@@ -116,6 +117,12 @@ class RoomState:
         self.reach = reach
         self.radius = reach
         self.cell = cell
+        # a cell of a power of two metres: ``v // cell`` is then ``floor(v * (1 / cell))``
+        # bit for bit (both exact), without float floor division's fmod; bounded so that
+        # the product neither overflows nor rounds a subnormal (see cells_of)
+        bound = max(abs(inside[0]), abs(inside[1]), abs(inside[2]), abs(inside[3])) + reach
+        self.inv = (1.0 / cell if math.frexp(cell)[0] == 0.5 and 2.0 ** -20 <= cell <= 1.0
+                    and bound < 1e290 else 0.0)
         self.boxes = boxes
         self.uncovered = uncovered
         self.near = False
@@ -191,6 +198,7 @@ class RoomState:
         in_contact = self.in_contact
         reach = self.reach
         cell = self.cell
+        inv = self.inv
         cos_h = math.cos(heading)
         sin_h = math.sin(heading)
         code = DONE
@@ -222,10 +230,16 @@ class RoomState:
                 x = nx
                 y = ny
                 in_contact = False
-                kx0 = int((x - reach) // cell)
-                kx1 = int((x + reach) // cell)
-                ky0 = int((y - reach) // cell)
-                ky1 = int((y + reach) // cell)
+                if inv > 0.0:
+                    kx0 = math.floor((x - reach) * inv)     # cells_of, in line
+                    kx1 = math.floor((x + reach) * inv)
+                    ky0 = math.floor((y - reach) * inv)
+                    ky1 = math.floor((y + reach) * inv)
+                else:
+                    kx0 = int((x - reach) // cell)
+                    kx1 = int((x + reach) // cell)
+                    ky0 = int((y - reach) // cell)
+                    ky1 = int((y + reach) // cell)
                 if (self.near and kx0 == self.kx0 and kx1 == self.kx1 and ky0 == self.ky0
                         and ky1 == self.ky1):
                     cells = self.near_cells             # uncovered[key], as left
@@ -298,6 +312,55 @@ class RoomState:
         return {"bump": bumped, "edge": False}         # a room has no ring edge
 
 
+#: how many standard normal draws :class:`Normals` takes at once
+BATCH: Final = 64
+
+
+class Normals:
+    """A world's standard normal draws (the range finder's noise) from its generator
+    ``rng``, taken :data:`BATCH` at a time: compiled, ``Generator.standard_normal()`` is a
+    call through Python's protocol of about 3.3k instructions, once a period on a robot;
+    an array of them costs that once and little more a draw. They are the generator's own
+    draws in its order: numpy fills an array with the same ziggurat draws, one after
+    another, that its scalar calls make.
+
+    The generator has then gone ahead of the draws handed out. :meth:`settle` puts it back
+    where they leave it (its state before the batch, then as many draws again), as anything
+    else drawing from it must find it: the world's ``rng`` settles first
+    (:attr:`~opspec.worlds.base.World.rng`)."""
+
+    def __init__(self, rng: Any) -> None:
+        self.rng = rng
+        self.drawn: list[float] = []
+        self.used = 0
+        self.before: Any = None         # the generator's state before the batch
+
+    def draw(self) -> float:
+        """The next standard normal draw of the generator, as ``rng.standard_normal()``."""
+        used = self.used
+        drawn = self.drawn
+        if used >= len(drawn):          # (all handed out: the generator is where they leave it)
+            rng = self.rng
+            self.before = rng.bit_generator.state
+            drawn = rng.standard_normal(BATCH).tolist()
+            self.drawn = drawn
+            used = 0
+        self.used = used + 1
+        return drawn[used]
+
+    def settle(self) -> None:
+        """Put the generator where the draws handed out leave it; the rest dropped."""
+        used = self.used
+        if used < len(self.drawn):
+            rng = self.rng
+            rng.bit_generator.state = self.before
+            if used:
+                rng.standard_normal(used)
+        self.drawn = []
+        self.used = 0
+        self.before = None
+
+
 def distance_ahead(x: float, y: float, heading: float, boxes: tuple[RayBox, ...]) -> float:
     """``ray_to_box_along`` to the room's walls from inside (``boxes[0]``), then to each
     obstacle's faces from outside, the nearest of them: the same arithmetic in one loop (the
@@ -346,16 +409,32 @@ def cover(cells: Cells, x: float, y: float, cell: float, reach: float,
     # math.pow is that call itself, ``**`` a boxed number protocol call
     limit = math.pow(reach, 2.0) + math.pow(cell / 2, 2.0)
     new: list[Cell] = []
+    left: list[Cell] = []
+    # one membership test a cell: ``cells`` has no cell twice, so one covered here is in
+    # no later test, and those still not covered afterwards are the ones tested here
     for c in cells:
+        if c in covered:
+            continue                # (cells of other ranges overlap these: covered there)
         cx, cy = c
         centre_x = (cx + 0.5) * cell
         centre_y = (cy + 0.5) * cell
-        if math.pow(centre_x - x, 2.0) + math.pow(centre_y - y, 2.0) <= limit and (
-                c not in covered):
+        if math.pow(centre_x - x, 2.0) + math.pow(centre_y - y, 2.0) <= limit:
             covered.add(c)
             new.append(c)
-    # (cells of other ranges overlap these: those covered there are left out too)
-    return new, tuple([c for c in cells if c not in covered])
+        else:
+            left.append(c)
+    return new, tuple(left)
+
+
+def cells_of(v: float, cell: float, inv: float) -> int:
+    """``int(v // cell)``, the cell index of the coordinate ``v``, as
+    :meth:`RoomState.resume` computes it: with ``inv`` (``1 / cell`` of a cell of a power of
+    two metres, :meth:`RoomState.place`; else 0.0) as ``floor(v * inv)``. Float floor
+    division is fmod, a subtraction and a division (CPython's ``float_floor_div``); by a
+    power of two each step is exact, as the product is, so both are the exact floor."""
+    if inv > 0.0:
+        return math.floor(v * inv)
+    return int(v // cell)
 
 
 def round4(x: float) -> float:
