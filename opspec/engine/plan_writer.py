@@ -134,7 +134,7 @@ class Writer(WaitingCode):
             "ACTIVITY": ActivityInstance, "ITEM": WorkItem, "PROXY": MappingProxyType,
             "ENDED": ENDED, "ENDED_KIND": EK.PROCESS_COMPLETED, "IN": ParameterMode.IN,
             "INSTANCE": ProcessInstance, "SCOPE": Scope, "DEADLINES": process_deadlines,
-            "PROCESS_STARTED": EK.PROCESS_STARTED}
+            "PROCESS_STARTED": EK.PROCESS_STARTED, "NEW": object.__new__}
 
     def name(self, prefix: str, value: Any) -> str:
         key = f"{prefix}{len(self.names)}"

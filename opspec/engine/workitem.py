@@ -10,8 +10,10 @@ from typing import Any, Final
 __all__ = ["WorkItem"]
 
 _NO_DATA: Final[Mapping[str, Any]] = MappingProxyType({})
-_FIELDS: Final = ("key", "process", "instance", "activity", "label", "participant", "lane",
-                  "offered_at", "application", "data", "choices", "root_instance", "duration")
+#: the fields, in ``__init__``'s order (from source, the plans make items in line:
+#: ``opspec.engine.instances``' note on its tables)
+FIELDS: Final = ("key", "process", "instance", "activity", "label", "participant", "lane",
+                 "offered_at", "application", "data", "choices", "root_instance", "duration")
 
 
 class WorkItem:
@@ -62,6 +64,6 @@ class WorkItem:
         return self._values() == other._values()
 
     def __repr__(self) -> str:
-        fields = ", ".join(f"{name}={value!r}" for name, value in zip(_FIELDS, self._values(),
+        fields = ", ".join(f"{name}={value!r}" for name, value in zip(FIELDS, self._values(),
                                                                        strict=True))
         return f"WorkItem({fields})"
