@@ -18,7 +18,7 @@ if TYPE_CHECKING:
     from opspec.engine.performers import WorkItem
 
 __all__ = ["ACTIVITY_FIELDS", "FRAME_FIELDS", "PROCESS_FIELDS", "ActivityInstance", "Frame",
-           "MultiInstance", "ProcessInstance"]
+           "MultiInstance", "ProcessInstance", "process_instance"]
 
 # From source, the plans (opspec.engine.plans) make these objects in line: ``object.__new__``
 # and the fields stored one by one, not a class call, which from source runs ``__init__``
@@ -99,6 +99,36 @@ class ProcessInstance:
 
     def __repr__(self) -> str:
         return f"<ProcessInstance {self.process.id}#{self.id}>"
+
+
+_NEW: Final[Callable[[type], Any]] = object.__new__
+
+
+def process_instance(id: int, process: CompiledProcess, data: dict[str, Any],
+                     scope: MutableMapping[str, Any], priority: int,
+                     parent: ActivityInstance | None, root: int, started_at: float,
+                     state: int, trigger: str | None) -> ProcessInstance:
+    """From source, ``ProcessInstance(...)`` without calling the class (see
+    :data:`PROCESS_FIELDS`): ``Flow.start_process``'s, two a dose cycle of the dispenser
+    (the compiled engine calls the class)."""
+    inst: Any = _NEW(ProcessInstance)
+    inst.id = id
+    inst.process = process
+    inst.data = data
+    inst.scope = scope
+    inst.state = state
+    inst.priority = priority
+    inst.parent = parent
+    inst.root = root
+    inst.frames = []
+    inst.started_at = started_at
+    inst.deferred = None
+    inst.trigger = trigger
+    inst.depth = 0
+    inst.partner = None
+    inst.view = None
+    made: ProcessInstance = inst
+    return made
 
 
 class Frame:

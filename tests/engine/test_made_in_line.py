@@ -21,6 +21,7 @@ from opspec.engine.instances import (
     ActivityInstance,
     Frame,
     ProcessInstance,
+    process_instance,
 )
 from opspec.engine.lanes import user_lane
 from opspec.engine.random import user_stream
@@ -99,3 +100,14 @@ def test_what_the_plans_make_is_whole() -> None:
     user.sim = sim
     sim.run(until=3 * 86400.0)
     assert user.checked >= 40  # type: ignore[attr-defined]
+
+
+def test_a_process_instance_made_in_line_is_the_classes() -> None:
+    """``Flow.start_process``'s from-source maker stores what ``__init__`` stores."""
+    values = [object() for _ in range(10)]
+    made, called = process_instance(*values), ProcessInstance(*values)  # type: ignore[arg-type]
+    assert type(made) is ProcessInstance
+    for name in _slots(ProcessInstance):
+        assert getattr(made, name) == getattr(called, name), name
+        assert type(getattr(made, name)) is type(getattr(called, name)), name
+    assert made.frames is not called.frames
