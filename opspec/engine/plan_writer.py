@@ -270,7 +270,12 @@ class Writer(WaitingCode):
                 f"{pad}        for mode, formal, _fn, target in parent.act.params:",
                 f"{pad}            if mode is not IN and target is not None:",
                 f"{pad}                out[target] = inst.data.get(formal)",
-                f"{pad}        activities.body_done(parent, out or None)"]
+                # (body_done's first step: the caller's done plan, if it has one)
+                f"{pad}        dones = activities.dones",
+                f"{pad}        if parent.act in dones:",
+                f"{pad}            dones[parent.act](parent, activities, out or None)",
+                f"{pad}        else:",
+                f"{pad}            activities.body_done(parent, out or None)"]
 
     def split(self, index: int, path: tuple[int, ...], depth: int, out: list[str]) -> None:
         """``lone.xor_transition`` of activity ``index``, then the chosen target's code."""
