@@ -25,7 +25,13 @@ from opspec.engine.compiled import (
     CompiledProcess,
     CTransition,
 )
-from opspec.engine.instances import ActivityInstance, Frame, ProcessInstance, process_instance
+from opspec.engine.instances import (
+    IN_LINE,
+    ActivityInstance,
+    Frame,
+    ProcessInstance,
+    process_instance,
+)
 from opspec.engine.lifecycle import ABORTED, LIFECYCLE, RUNNING, STATE_NAMES, SUSPENDED, TERMINATED
 from opspec.engine.part import Part
 from opspec.engine.scope import Scope
@@ -40,8 +46,6 @@ _NEXT = LIFECYCLE.table
 # Final: module statics in the compiled engine, where a plain global is a dictionary lookup
 _COMPLETED_FROM_RUNNING: Final = _NEXT[(RUNNING, "complete")]
 _IN: Final = ParameterMode.IN
-#: from source, a process instance made without calling its class (instances.process_instance)
-_IN_LINE: Final = not plans.COMPILED
 
 
 class Flow(Part):
@@ -75,7 +79,7 @@ class Flow(Part):
         iid = state.last_id
         priority = proc.priority
         if parent is None:
-            if _IN_LINE:
+            if IN_LINE:          # (from source: no class call)
                 inst = process_instance(iid, proc, local, scope, priority, None, iid,
                                         state.now, RUNNING, trigger)
             else:

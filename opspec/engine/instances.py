@@ -7,6 +7,7 @@ cycle, so they stay small and cheap. Life-cycle states are ints from
 
 from __future__ import annotations
 
+import types
 from collections import ChainMap
 from collections.abc import Callable, Mapping, MutableMapping
 from typing import TYPE_CHECKING, Any, Final
@@ -18,7 +19,7 @@ if TYPE_CHECKING:
     from opspec.engine.performers import WorkItem
 
 __all__ = ["ACTIVITY_FIELDS", "FRAME_FIELDS", "PROCESS_FIELDS", "ActivityInstance", "Frame",
-           "MultiInstance", "ProcessInstance", "process_instance"]
+           "IN_LINE", "MultiInstance", "ProcessInstance", "process_instance"]
 
 # From source, the plans (opspec.engine.plans) make these objects in line: ``object.__new__``
 # and the fields stored one by one, not a class call, which from source runs ``__init__``
@@ -129,6 +130,10 @@ def process_instance(id: int, process: CompiledProcess, data: dict[str, Any],
     inst.view = None
     made: ProcessInstance = inst
     return made
+
+
+#: whether this module runs from source (then :func:`process_instance` is worth its call)
+IN_LINE: Final = isinstance(process_instance, types.FunctionType)
 
 
 class Frame:

@@ -247,12 +247,12 @@ class Offers(Part):
                     data = tools.outputs(ai, data)
             else:
                 data = None
-            acts = self.activities
-            dones = acts.dones              # (empty compiled: its size, no look-up)
+            activities = self.activities
+            dones = activities.dones        # (empty compiled: its size, no look-up)
             if dones and act in dones:      # from source: body_done's steps and on, in one
-                state.ready.append((dones[act], ai, acts, data))
+                state.ready.append((dones[act], ai, activities, data))
             else:
-                state.ready.append((acts.body_done_q, ai, data, None))
+                state.ready.append((activities.body_done_q, ai, data, None))
         if not state.draining:
             state.drain()
 

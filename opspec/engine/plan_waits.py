@@ -245,7 +245,7 @@ class WaitingCode:
                 "id": "new_id", "process": "called", "data": "child_data",
                 "scope": "child_scope", "priority": "called.priority", "parent": "None",
                 "root": "new_id", "started_at": "state.now", "state": "RUNNING",
-                "trigger": trigger}, p)
+                "trigger": str(trigger)}, p)
             started = f"{{\"trigger\": {trigger}, \"parent\": None}}"
         fallback = ("flow.start_process(called, data, parent=ai)" if sync
                     else f"flow.start_process(called, data, trigger={trigger})")
