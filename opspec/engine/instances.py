@@ -18,8 +18,8 @@ if TYPE_CHECKING:
     from opspec.engine.compiled import CompiledActivity, CompiledGraph, CompiledProcess
     from opspec.engine.performers import WorkItem
 
-__all__ = ["ACTIVITY_FIELDS", "FRAME_FIELDS", "PROCESS_FIELDS", "ActivityInstance", "Frame",
-           "IN_LINE", "MultiInstance", "ProcessInstance", "process_instance"]
+__all__ = ["ACTIVITY_FIELDS", "FRAME_FIELDS", "IN_LINE", "PROCESS_FIELDS", "ActivityInstance",
+           "Frame", "MultiInstance", "ProcessInstance", "process_instance"]
 
 # From source, the plans (opspec.engine.plans) make these objects in line: ``object.__new__``
 # and the fields stored one by one, not a class call, which from source runs ``__init__``

@@ -34,8 +34,8 @@ class WorkItem:
     makes it cheaper to make from source (the plans store its fields in line).
     """
 
-    __slots__ = ("key", "process", "instance", "activity", "label", "participant", "lane",
-                 "offered_at", "application", "data", "choices", "root_instance", "duration")
+    __slots__ = ("activity", "application", "choices", "data", "duration", "instance", "key",
+                 "label", "lane", "offered_at", "participant", "process", "root_instance")
 
     def __init__(self, key: int, process: str, instance: int, activity: str, label: str,
                  participant: str | None, lane: str | None, offered_at: float,
