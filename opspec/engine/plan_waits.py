@@ -25,7 +25,7 @@ from opspec.engine.compiled import (
     CompiledProcess,
 )
 from opspec.engine.coordinating import at_once
-from opspec.engine.instances import ACTIVITY_FIELDS, FRAME_FIELDS, PROCESS_FIELDS
+from opspec.engine.instances import ACTIVITY_FIELDS, FRAME_FIELDS, IN_LINE, PROCESS_FIELDS
 from opspec.engine.workitem import FIELDS as ITEM_FIELDS
 
 __all__ = ["WaitingCode", "catches_itself", "chooses_itself", "made", "offers_itself"]
@@ -36,7 +36,14 @@ def made(var: str, cls: str, fields: tuple[str | tuple[str, str], ...],
     """The lines that make ``var``, an object of the plan's global class ``cls``, without
     calling the class: ``object.__new__`` and ``fields`` (``opspec.engine.instances``' tables,
     the work item's ``FIELDS``) stored in ``__init__``'s order, each a parameter's value from
-    ``given`` or its start (``given`` may name a start's field too: its value then)."""
+    ``given`` or its start (``given`` may name a start's field too: its value then). The
+    compiled engine's classes cannot be made so: there, a call of ``cls`` by keywords."""
+    if not IN_LINE:     # compiled classes (a test's plans under the compiled engine)
+        args = ", ".join(f"{field}={given[field]}" for field in fields
+                         if isinstance(field, str))
+        return [f"{pad}{var} = {cls}({args})",
+                *(f"{pad}{var}.{field[0]} = {given[field[0]]}" for field in fields
+                  if not isinstance(field, str) and field[0] in given)]
     lines = [f"{pad}{var} = NEW({cls})"]
     for field in fields:
         if isinstance(field, str):
