@@ -61,6 +61,10 @@ class Activities(Part):
         # by the activity whose completion (body_done's) they carry on from; empty compiled
         self.resumes: dict[CompiledActivity, Callable[[Activities, ActivityInstance], None]] = (
             {} if plans.COMPILED else plans.resumes(state.compiled))
+        # ... and for the activities without a loop, their done plans, body_done's own steps
+        # written out before the resume (Offers.performer_complete queues them itself)
+        self.dones: dict[CompiledActivity, Callable[[ActivityInstance, Activities, Any], None]] = (
+            {} if plans.COMPILED else plans.dones(state.compiled))
 
     def _too_deep(self, ai: ActivityInstance, target: CompiledProcess) -> None:
         call_depth.too_deep(self, ai, target)       # (runaway recursion: a rare path)
@@ -361,6 +365,10 @@ class Activities(Part):
     def body_done(self, ai: ActivityInstance, data: Mapping[str, Any] | None,
                    _unused: Any = None) -> None:
         """One execution of the body finished: loop again or complete."""
+        dones = self.dones                  # (empty compiled: its size, no look-up)
+        if dones and ai.act in dones:       # from source: these steps and on, written out
+            dones[ai.act](ai, self, data)
+            return
         if ai.state != RUNNING:
             return
         if ai.frame.inst.state == SUSPENDED:

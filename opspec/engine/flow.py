@@ -25,7 +25,13 @@ from opspec.engine.compiled import (
     CompiledProcess,
     CTransition,
 )
-from opspec.engine.instances import ActivityInstance, Frame, ProcessInstance
+from opspec.engine.instances import (
+    IN_LINE,
+    ActivityInstance,
+    Frame,
+    ProcessInstance,
+    process_instance,
+)
 from opspec.engine.lifecycle import ABORTED, LIFECYCLE, RUNNING, STATE_NAMES, SUSPENDED, TERMINATED
 from opspec.engine.part import Part
 from opspec.engine.scope import Scope
@@ -73,8 +79,12 @@ class Flow(Part):
         iid = state.last_id
         priority = proc.priority
         if parent is None:
-            inst = ProcessInstance(iid, proc, local, scope, priority, None, iid, state.now,
-                                   RUNNING, trigger)
+            if IN_LINE:          # (from source: no class call)
+                inst = process_instance(iid, proc, local, scope, priority, None, iid,
+                                        state.now, RUNNING, trigger)
+            else:
+                inst = ProcessInstance(iid, proc, local, scope, priority, None, iid,
+                                       state.now, RUNNING, trigger)
         else:
             caller = parent.frame.inst
             if caller.priority > priority:       # (max(), without its call)

@@ -7,9 +7,10 @@ cycle, so they stay small and cheap. Life-cycle states are ints from
 
 from __future__ import annotations
 
+import types
 from collections import ChainMap
 from collections.abc import Callable, Mapping, MutableMapping
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, Final
 
 from opspec.engine.lifecycle import NOT_STARTED
 
@@ -17,7 +18,28 @@ if TYPE_CHECKING:
     from opspec.engine.compiled import CompiledActivity, CompiledGraph, CompiledProcess
     from opspec.engine.performers import WorkItem
 
-__all__ = ["ActivityInstance", "Frame", "MultiInstance", "ProcessInstance"]
+__all__ = ["ACTIVITY_FIELDS", "FRAME_FIELDS", "IN_LINE", "PROCESS_FIELDS", "ActivityInstance",
+           "Frame", "MultiInstance", "ProcessInstance", "process_instance"]
+
+# From source, the plans (opspec.engine.plans) make these objects in line: ``object.__new__``
+# and the fields stored one by one, not a class call, which from source runs ``__init__``
+# in a C-level call of its own (about 150 ns of an object's 250-300, and the dispenser's
+# plans make about 15 a dose cycle). Each class's fields, in its ``__init__``'s order: a
+# name alone is the constructor's parameter of that name; a pair, a field ``__init__`` is
+# not given and the Python literal it starts at (tests/engine/test_made_in_line.py holds
+# each table to its ``__init__``).
+ACTIVITY_FIELDS: Final[tuple[str | tuple[str, str], ...]] = (
+    "key", "act", "frame", "state", "started_at", ("item", "None"), ("child", "None"),
+    ("iteration", "0"), ("gen", "0"), ("waiting", '""'), ("choice", "()"),
+    ("cleanup", "None"), ("performer", "None"), ("mi", "None"), ("local", "None"))
+PROCESS_FIELDS: Final[tuple[str | tuple[str, str], ...]] = (
+    "id", "process", "data", "scope", "state", "priority", "parent", "root", ("frames", "[]"),
+    "started_at", ("deferred", "None"), "trigger", ("depth", "0"), ("partner", "None"),
+    ("view", "None"))
+FRAME_FIELDS: Final[tuple[str | tuple[str, str], ...]] = (
+    "graph", "inst", "owner", ("live", "0"), ("parked", "0"), ("joins", "None"),
+    ("ors", "None"), ("running", "{}"), ("cjoins", "None"), ("owed", "None"),
+    ("queue", "None"))
 
 
 class ProcessInstance:
@@ -78,6 +100,40 @@ class ProcessInstance:
 
     def __repr__(self) -> str:
         return f"<ProcessInstance {self.process.id}#{self.id}>"
+
+
+_NEW: Final[Callable[[type], Any]] = object.__new__
+
+
+def process_instance(id: int, process: CompiledProcess, data: dict[str, Any],
+                     scope: MutableMapping[str, Any], priority: int,
+                     parent: ActivityInstance | None, root: int, started_at: float,
+                     state: int, trigger: str | None) -> ProcessInstance:
+    """From source, ``ProcessInstance(...)`` without calling the class (see
+    :data:`PROCESS_FIELDS`): ``Flow.start_process``'s, two a dose cycle of the dispenser
+    (the compiled engine calls the class)."""
+    inst: Any = _NEW(ProcessInstance)
+    inst.id = id
+    inst.process = process
+    inst.data = data
+    inst.scope = scope
+    inst.state = state
+    inst.priority = priority
+    inst.parent = parent
+    inst.root = root
+    inst.frames = []
+    inst.started_at = started_at
+    inst.deferred = None
+    inst.trigger = trigger
+    inst.depth = 0
+    inst.partner = None
+    inst.view = None
+    made: ProcessInstance = inst
+    return made
+
+
+#: whether this module runs from source (then :func:`process_instance` is worth its call)
+IN_LINE: Final = isinstance(process_instance, types.FunctionType)
 
 
 class Frame:

@@ -241,12 +241,18 @@ class Offers(Part):
             state.ready.append((self.choose_q, ai, trans, data))
         elif act.toolchain and key in state.tool_at:
             state.ready.append((self.activities.tool_done, ai, data, None))
-        elif data:
-            if act.params:
-                data = tools.outputs(ai, data)
-            state.ready.append((self.activities.body_done_q, ai, data, None))
         else:
-            state.ready.append((self.activities.body_done_q, ai, None, None))
+            if data:
+                if act.params:
+                    data = tools.outputs(ai, data)
+            else:
+                data = None
+            activities = self.activities
+            dones = activities.dones        # (empty compiled: its size, no look-up)
+            if dones and act in dones:      # from source: body_done's steps and on, in one
+                state.ready.append((dones[act], ai, activities, data))
+            else:
+                state.ready.append((activities.body_done_q, ai, data, None))
         if not state.draining:
             state.drain()
 

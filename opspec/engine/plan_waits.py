@@ -25,8 +25,33 @@ from opspec.engine.compiled import (
     CompiledProcess,
 )
 from opspec.engine.coordinating import at_once
+from opspec.engine.instances import ACTIVITY_FIELDS, FRAME_FIELDS, IN_LINE, PROCESS_FIELDS
+from opspec.engine.workitem import FIELDS as ITEM_FIELDS
 
-__all__ = ["WaitingCode", "catches_itself", "chooses_itself", "offers_itself"]
+__all__ = ["WaitingCode", "catches_itself", "chooses_itself", "made", "offers_itself"]
+
+
+def made(var: str, cls: str, fields: tuple[str | tuple[str, str], ...],
+         given: dict[str, str], pad: str) -> list[str]:
+    """The lines that make ``var``, an object of the plan's global class ``cls``, without
+    calling the class: ``object.__new__`` and ``fields`` (``opspec.engine.instances``' tables,
+    the work item's ``FIELDS``) stored in ``__init__``'s order, each a parameter's value from
+    ``given`` or its start (``given`` may name a start's field too: its value then). The
+    compiled engine's classes cannot be made so: there, a call of ``cls`` by keywords."""
+    if not IN_LINE:     # compiled classes (a test's plans under the compiled engine)
+        args = ", ".join(f"{field}={given[field]}" for field in fields
+                         if isinstance(field, str))
+        return [f"{pad}{var} = {cls}({args})",
+                *(f"{pad}{var}.{field[0]} = {given[field[0]]}" for field in fields
+                  if not isinstance(field, str) and field[0] in given)]
+    lines = [f"{pad}{var} = NEW({cls})"]
+    for field in fields:
+        if isinstance(field, str):
+            lines.append(f"{pad}{var}.{field} = {given[field]}")
+        else:
+            name, start = field
+            lines.append(f"{pad}{var}.{name} = {given.get(name, start)}")
+    return lines
 
 
 def offers_itself(act: CompiledActivity) -> bool:
@@ -96,8 +121,9 @@ class WaitingCode:
             start = [f"{pad}activities.start_slow(frame, {a})", f"{pad}return"]
         if self.framed:
             return start
-        return [f"{pad}frame = FRAME(GRAPH, inst, None)", f"{pad}inst.frames.append(frame)",
-                f"{pad}frame.live = 1", *start]
+        return [*made("frame", "FRAME", FRAME_FIELDS,
+                      {"graph": "GRAPH", "inst": "inst", "owner": "None", "live": "1"}, pad),
+                f"{pad}inst.frames.append(frame)", *start]
 
     def catch(self, act: CompiledActivity, pad: str) -> list[str]:
         """``Activities.activate`` of a catch event under deadlines or boundary events, and
@@ -169,11 +195,7 @@ class WaitingCode:
                 f"{pad}view = inst.view",
                 f"{pad}if view is None:",
                 f"{pad}    view = inst.view = PROXY(inst.data)",
-                (f"{pad}item = ITEM(key, {self.name('P', act.process)}, iid, "
-                 f"{self.name('I', act.id)}, {self.name('B', act.label)}, "
-                 f"{self.name('W', act.participant)}, {self.name('L', act.lane)}, state.now, "
-                 f"{self.name('APP', act.application)}, view, {ch}, "
-                 f"inst.root, None)"),
+                *self.item(act, ch, pad),
                 f"{pad}ai.item = item",
                 f"{pad}ai.performer = performer",
                 f"{pad}ai.waiting = \"performer\"",
@@ -215,17 +237,22 @@ class WaitingCode:
         sync = trigger is None
         p = f"{pad}    "
         if sync:
-            made = [f"{p}priority = called.priority",
+            making = [f"{p}priority = called.priority",
                     f"{p}if inst.priority > priority:",
                     f"{p}    priority = inst.priority",
-                    (f"{p}child = INSTANCE(new_id, called, child_data, child_scope, priority, "
-                     f"ai, inst.root, state.now, RUNNING, None)"),
-                    f"{p}child.depth = inst.depth + 1",
-                    f"{p}child.partner = inst.partner"]
+                    *made("child", "INSTANCE", PROCESS_FIELDS, {
+                        "id": "new_id", "process": "called", "data": "child_data",
+                        "scope": "child_scope", "priority": "priority", "parent": "ai",
+                        "root": "inst.root", "started_at": "state.now", "state": "RUNNING",
+                        "trigger": "None", "depth": "inst.depth + 1",
+                        "partner": "inst.partner"}, p)]
             started = "{\"trigger\": None, \"parent\": iid}"
         else:
-            made = [(f"{p}child = INSTANCE(new_id, called, child_data, child_scope, "
-                     f"called.priority, None, new_id, state.now, RUNNING, {trigger})")]
+            making = made("child", "INSTANCE", PROCESS_FIELDS, {
+                "id": "new_id", "process": "called", "data": "child_data",
+                "scope": "child_scope", "priority": "called.priority", "parent": "None",
+                "root": "new_id", "started_at": "state.now", "state": "RUNNING",
+                "trigger": str(trigger)}, p)
             started = f"{{\"trigger\": {trigger}, \"parent\": None}}"
         fallback = ("flow.start_process(called, data, parent=ai)" if sync
                     else f"flow.start_process(called, data, trigger={trigger})")
@@ -240,7 +267,7 @@ class WaitingCode:
                  f" else child_data)"),
                 f"{p}state.last_id += 1",
                 f"{p}new_id = state.last_id",
-                *made,
+                *making,
                 f"{p}state.live[new_id] = child",
                 f"{p}state.started += 1",
                 f"{p}flags = called.flag_cache        # (the called workflow's own bits)",
@@ -264,8 +291,22 @@ class WaitingCode:
         has no start trigger, or a plain one without start assignments or a worker)."""
         return [f"{pad}state.last_key += 1",
                 f"{pad}key = state.last_key",
-                f"{pad}ai = ACTIVITY(key, A{act.index}, frame, state.now, RUNNING)",
+                *made("ai", "ACTIVITY", ACTIVITY_FIELDS,
+                      {"key": "key", "act": f"A{act.index}", "frame": "frame",
+                       "started_at": "state.now", "state": "RUNNING"}, pad),
                 f"{pad}frame.running[key] = ai"]
+
+    def item(self, act: CompiledActivity, choices: str, pad: str) -> list[str]:
+        """``act``'s work item ``item`` for the activity instance ``ai`` (``key``), offered
+        now with the instance's data ``view`` and ``choices`` (a tuple's name): what
+        ``Offers.offer`` makes, without calling ``WorkItem``."""
+        return made("item", "ITEM", ITEM_FIELDS, {
+            "key": "key", "process": self.name("P", act.process), "instance": "iid",
+            "activity": self.name("I", act.id), "label": self.name("B", act.label),
+            "participant": self.name("W", act.participant), "lane": self.name("L", act.lane),
+            "offered_at": "state.now", "application": self.name("APP", act.application),
+            "data": "view", "choices": choices, "root_instance": "inst.root",
+            "duration": "None"}, pad)
 
     def started(self, act: CompiledActivity, pad: str) -> list[str]:
         """A plain activity's start traced (``Activities.start_slow``); ``cached`` is left
@@ -293,10 +334,7 @@ class WaitingCode:
                 f"{pad}view = inst.view",
                 f"{pad}if view is None:",
                 f"{pad}    view = inst.view = PROXY(inst.data)",
-                (f"{pad}item = ITEM(key, {self.name('P', act.process)}, iid, "
-                 f"{self.name('I', act.id)}, {self.name('B', act.label)}, "
-                 f"{self.name('W', act.participant)}, {self.name('L', act.lane)}, state.now, "
-                 f"{self.name('APP', act.application)}, view, (), inst.root, None)"),
+                *self.item(act, "()", pad),
                 f"{pad}ai.item = item",
                 f"{pad}ai.performer = performer",
                 f"{pad}ai.waiting = \"performer\"",

@@ -134,7 +134,7 @@ class Writer(WaitingCode):
             "ACTIVITY": ActivityInstance, "ITEM": WorkItem, "PROXY": MappingProxyType,
             "ENDED": ENDED, "ENDED_KIND": EK.PROCESS_COMPLETED, "IN": ParameterMode.IN,
             "INSTANCE": ProcessInstance, "SCOPE": Scope, "DEADLINES": process_deadlines,
-            "PROCESS_STARTED": EK.PROCESS_STARTED}
+            "PROCESS_STARTED": EK.PROCESS_STARTED, "NEW": object.__new__}
 
     def name(self, prefix: str, value: Any) -> str:
         key = f"{prefix}{len(self.names)}"
@@ -270,7 +270,12 @@ class Writer(WaitingCode):
                 f"{pad}        for mode, formal, _fn, target in parent.act.params:",
                 f"{pad}            if mode is not IN and target is not None:",
                 f"{pad}                out[target] = inst.data.get(formal)",
-                f"{pad}        activities.body_done(parent, out or None)"]
+                # (body_done's first step: the caller's done plan, if it has one)
+                f"{pad}        dones = activities.dones",
+                f"{pad}        if parent.act in dones:",
+                f"{pad}            dones[parent.act](parent, activities, out or None)",
+                f"{pad}        else:",
+                f"{pad}            activities.body_done(parent, out or None)"]
 
     def split(self, index: int, path: tuple[int, ...], depth: int, out: list[str]) -> None:
         """``lone.xor_transition`` of activity ``index``, then the chosen target's code."""

@@ -29,7 +29,13 @@ what ``Activities._complete`` and then ``Activities.start`` do, called by
 ``Activities.body_done`` (``tests/engine/test_resume_plans.py`` holds them to the
 interpreter). In the frame they also write out instantaneous activities that throw or raise
 a trigger; at an activity that waits, a plan makes its activity instance and offers a plain
-manual activity itself (``start_slow`` and ``Offers.offer`` in line).
+manual activity itself (``start_slow`` and ``Offers.offer`` in line). For an activity that
+does not loop, the resume plan is a *done plan*: ``Activities.body_done``'s own steps first,
+queued by ``Offers.performer_complete`` in ``body_done``'s place (a Python frame less an
+answer). The activity instances, frames, process instances and work items a plan makes are
+made without calling their classes (``object.__new__`` and their fields stored in line, from
+the tables in :mod:`opspec.engine.instances` and the work item's ``FIELDS``): from source a
+class call costs about 150 ns more an object.
 """
 
 from __future__ import annotations
@@ -51,8 +57,8 @@ from opspec.engine.compiled import (
 from opspec.engine.plan_waits import catches_itself, chooses_itself, offers_itself
 from opspec.engine.plan_writer import MAX_BLOCKS, Writer, by_selection, thrown_on, ways_out
 
-__all__ = ["MAX_BLOCKS", "attach", "build", "build_performed", "build_resume", "performs",
-           "resumes"]
+__all__ = ["MAX_BLOCKS", "attach", "build", "build_performed", "build_resume", "dones",
+           "performs", "resumes"]
 
 #: whether the engine runs compiled (mypyc): its functions are then not Python functions
 COMPILED: Final = not isinstance(lone.run, types.FunctionType)
@@ -60,15 +66,19 @@ COMPILED: Final = not isinstance(lone.run, types.FunctionType)
 
 def attach(compiled: CompiledPackage) -> None:
     """Give each workflow of ``compiled`` that starts with one token its plan
-    (``CompiledProcess.plan``) and its resume plans (the plan's ``resumes``), once per
-    package; none when the engine runs compiled."""
+    (``CompiledProcess.plan``) and its resume plans (the plan's ``resumes``, and ``dones``
+    for the activities that do not loop), once per package; none when the engine runs
+    compiled."""
     if COMPILED or compiled.plans:
         return
     for proc in compiled.processes.values():
         if proc.one_start >= 0:
             plan: Any = build(proc, proc.one_start)
-            plan.resumes = {proc.graph.activities[index]: build_resume(proc, index)
-                            for index in resumable(proc)}
+            acts = proc.graph.activities
+            plan.resumes = {acts[index]: build_resume(proc, index)
+                            for index in resumable(proc) if acts[index].loop is not None}
+            plan.dones = {acts[index]: build_resume(proc, index, queued=True)
+                          for index in resumable(proc) if acts[index].loop is None}
             plan.performs = {trans: build_performed(proc, trans.target)
                              for trans in performable(proc)}
             proc.plan = plan
@@ -83,6 +93,19 @@ def resumes(compiled: CompiledPackage) -> dict[CompiledActivity, Callable[[Any, 
     found: dict[CompiledActivity, Callable[[Any, Any], None]] = {}
     for proc in compiled.processes.values():
         found.update(getattr(proc.plan, "resumes", None) or {})
+    return found
+
+
+def dones(compiled: CompiledPackage) -> dict[CompiledActivity, Callable[[Any, Any, Any], None]]:
+    """The done plans of ``compiled``'s workflows (resume plans with ``Activities.body_done``'s
+    steps before them, for activities that do not loop) by the activity whose answer they
+    take: ``done(ai, activities, data)``, queued by ``Offers.performer_complete`` in
+    ``body_done``'s place and called by ``body_done``; empty when the engine runs
+    compiled."""
+    attach(compiled)
+    found: dict[CompiledActivity, Callable[[Any, Any, Any], None]] = {}
+    for proc in compiled.processes.values():
+        found.update(getattr(proc.plan, "dones", None) or {})
     return found
 
 
@@ -156,17 +179,31 @@ def build(proc: CompiledProcess, start: int) -> Callable[[Any, Any, Any], None]:
     return plan
 
 
-def build_resume(proc: CompiledProcess, index: int) -> Callable[[Any, Any], None]:
+def build_resume(proc: CompiledProcess, index: int, queued: bool = False) -> Any:
     """The resume plan of ``proc``'s activity ``index`` (one of :func:`resumable`):
     ``resume(activities, ai)``, called by ``Activities.body_done``, does what
     ``Activities._complete`` does with ``ai`` (it leaves, its completion is traced, its
     split taken) and what ``Activities.start`` then does with the token, in the instance's
-    frame."""
+    frame. ``queued`` (an activity without a loop): ``done(ai, activities, data)``, the
+    same with ``body_done``'s steps before it (a ready-queue item in ``body_done``'s place:
+    a Python frame less an answer)."""
     writer = Writer(proc, framed=True)
     act = proc.graph.activities[index]
     a = f"A{index}"
     writer.names[a] = act
-    lines = ["def resume(activities, ai):",
+    first = (["def done(ai, activities, data):",
+              "    if ai.state != RUNNING:          # (Activities.body_done's steps)",
+              "        return",
+              "    if ai.frame.inst.state == SUSPENDED:",
+              "        ai.frame.inst.defer((activities.body_done, ai, data, None))",
+              "        return",
+              "    if data:",
+              "        inst = ai.frame.inst",
+              "        set_field = activities.flow.set_field",
+              "        for key, value in data.items():",
+              f"            set_field(inst, {a}, key, value)"]
+             if queued else ["def resume(activities, ai):"])
+    lines = [*first,
              "    ai.state = DONE                  # (Activities._complete's first steps)",
              "    ai.gen += 1",
              "    frame = ai.frame",
@@ -196,9 +233,8 @@ def build_resume(proc: CompiledProcess, index: int) -> Callable[[Any, Any], None
         writer.block(act.next, (), 1, lines)
     else:
         writer.split(index, (), 1, lines)
-    resume: Callable[[Any, Any], None] = _made(
-        writer, lines, f"<resume plan of {proc.id}/{index}>", "resume")
-    return resume
+    return _made(writer, lines, f"<{'done' if queued else 'resume'} plan of {proc.id}/{index}>",
+                 "done" if queued else "resume")
 
 
 def build_performed(proc: CompiledProcess, index: int) -> Callable[[Any, Any, Any], None]:

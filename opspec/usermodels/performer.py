@@ -68,7 +68,8 @@ class StochasticUser:
         self._routine = RoutineTracker(model.routine, rng)
         self._routine_is_trivial = model.routine.is_trivial
         self._random = rng.random     # bound once: offer draws from it several times a cycle
-        self._normal = rng.standard_normal
+        # (found at the first lognormal draw: _standard_normal; most users draw one)
+        self._normal: Callable[[], float] | None = None
         # With numpy's default bit generator, PCG64, a uniform is taken from the raw 64-bit
         # draw as numpy itself does (see _TWO_TO_MINUS_53): the same float from the same
         # stream position, without Generator.random's dtype and size handling (~1k
@@ -187,7 +188,10 @@ class StochasticUser:
         elif plan.lognormal:
             # LogNormal.sample's own expression, without its call (a Python frame in both
             # builds: the distributions are not compiled); the same one standard normal
-            duration = math.exp(plan.mu + plan.sigma * float(self._normal())) * factor
+            normal = self._normal
+            if normal is None:
+                normal = self._normal = _standard_normal(self.rng)
+            duration = math.exp(plan.mu + plan.sigma * float(normal())) * factor
         else:
             duration = plan.duration.sample(self.rng) * factor
         repetition = plan.repetition
@@ -374,6 +378,45 @@ class StochasticUser:
             payload: Mapping[str, Any] = {"instance": item.instance, "activity": item.activity,
                                           "process": item.process, **data}
             self._session.trace(kind, payload)
+
+
+#: numpy's ``random_standard_normal`` through ctypes, looked up once (None: not found)
+_C_NORMAL: Final[list[Any]] = []
+
+
+def _standard_normal(rng: np.random.Generator) -> Callable[[], float]:
+    """``rng.standard_normal()``'s draw without its method: numpy's own ziggurat,
+    ``random_standard_normal``, the C function that method calls (numpy's C API for
+    distributions), called through ctypes on ``rng``'s bit generator. The same function on
+    the same state gives the same float and leaves the stream where the method would; what
+    is saved is the method's argument and dtype handling and its lock (about 350 ns of 750
+    a draw, two a dose cycle of the dispenser). The lock guards a generator shared between
+    threads; a user's is its own, on the engine's one thread. The method itself where
+    numpy's extension does not export the function."""
+    if not _C_NORMAL:
+        _C_NORMAL.append(_c_function())
+    draw = _C_NORMAL[0]
+    if draw is None:
+        method: Callable[[], float] = rng.standard_normal
+        return method
+    # (a partial: called in C, no Python frame; it keeps the pointer alive, ``rng`` keeps
+    # the bit generator it points into)
+    normal: Callable[[], float] = partial(draw, rng.bit_generator.ctypes.bit_generator)
+    return normal
+
+
+def _c_function() -> Any:
+    """numpy's ``random_standard_normal(bitgen_t *)`` as a ctypes function, or None."""
+    try:
+        import ctypes
+
+        from numpy.random import _generator
+        draw = ctypes.CDLL(_generator.__file__).random_standard_normal
+    except (ImportError, OSError, AttributeError):
+        return None
+    draw.restype = ctypes.c_double
+    draw.argtypes = [ctypes.c_void_p]
+    return draw
 
 
 class _Finish:

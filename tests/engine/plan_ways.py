@@ -11,6 +11,7 @@ import pytest
 
 from opspec.engine import plans
 from opspec.engine.compiled import compile_package
+from opspec.engine.lifecycle import RUNNING, SUSPENDED
 from opspec.engine.simulation import Simulation
 from opspec.model import Package
 
@@ -20,6 +21,32 @@ WAYS = ("plans", "interpreter")
 
 def use_way(monkeypatch: pytest.MonkeyPatch, way: str) -> None:
     monkeypatch.setattr(plans, "COMPILED", way != "plans")
+
+
+def count_resumes(sim: Simulation) -> dict[str, int]:
+    """Wrap the run's resume plans (``resumes``, called by ``body_done``, and ``dones``,
+    queued in its place) so the test sees how often each ran (by activity id)."""
+    ran: dict[str, int] = {}
+    table: dict[Any, Any] = sim.activities.resumes
+    for key, fn in list(table.items()):
+        def resumed(activities: Any, ai: Any, fn: Any = fn, aid: str = key.id) -> None:
+            ran[aid] = ran.get(aid, 0) + 1
+            fn(activities, ai)
+        table[key] = resumed
+    table = sim.activities.dones
+    for key, fn in list(table.items()):
+        def done(ai: Any, activities: Any, data: Any, fn: Any = fn, aid: str = key.id) -> None:
+            # (counted where it goes on to the resume: body_done's steps let it)
+            if ai.state == RUNNING and ai.frame.inst.state != SUSPENDED:
+                ran[aid] = ran.get(aid, 0) + 1
+            fn(ai, activities, data)
+        table[key] = done
+    return ran
+
+
+def resume_plans(sim: Simulation) -> dict[Any, Any]:
+    """The run's resume plans of both kinds (none when the interpreter runs alone)."""
+    return {**sim.activities.resumes, **sim.activities.dones}
 
 
 def seen(result: Any) -> tuple[Any, ...]:

@@ -28,7 +28,7 @@ from builders import (
     route,
     subflow,
 )
-from plan_ways import WAYS, run_both
+from plan_ways import WAYS, count_resumes, run_both
 from plan_ways import seen as _seen
 from plan_ways import use_way as _way
 
@@ -214,15 +214,7 @@ def test_a_choice_offered_by_a_resume_plan_races_its_catch_event(
             sim = Simulation(compile_package(pkg(work)), keep_trace=True,
                              performers=performers)
             if way == "plans":
-                ran: dict[str, int] = {}
-                resumes = sim.activities.resumes
-                for key, fn in list(resumes.items()):
-                    def counted(activities: Any, ai: Any, fn: Any = fn, aid: str = key.id,
-                                ran: dict[str, int] = ran) -> None:
-                        ran[aid] = ran.get(aid, 0) + 1
-                        fn(activities, ai)
-                    resumes[key] = counted
-                resumed.append(ran)
+                resumed.append(count_resumes(sim))
             seen.append(_seen(sim.run(until=100.0)))
         assert seen[0] == seen[1]
         done = [e[4] for e in seen[0][0] if e[1] == "activity.completed"]
@@ -257,7 +249,7 @@ def test_a_caught_event_under_a_deadline_and_a_boundary_event_started_by_a_plan(
     assert ("ticked" in done) == (sent_at > 10.0)
     assert ("got" in done) == (sent_at < 20.0) and ("timed_out" in done) == (sent_at > 20.0)
     _way(monkeypatch, "plans")              # (the completion of ask is planned)
-    planned = plans.resumes(compile_package(package))
+    planned = plans.dones(compile_package(package))
     ask = next(fn for a, fn in planned.items() if a.id == "ask")
     assert "triggers.deadline" in ask.__doc__ and "activate" not in ask.__doc__
 

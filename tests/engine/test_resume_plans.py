@@ -28,7 +28,7 @@ from builders import (
     task,
     throw,
 )
-from plan_ways import WAYS, run_both
+from plan_ways import WAYS, count_resumes, resume_plans, run_both
 from plan_ways import seen as _seen
 from plan_ways import use_way as _way
 
@@ -44,21 +44,14 @@ from opspec.xpdl.conditions import parse_condition
 ROOT = Path(__file__).resolve().parents[2]
 def _counting(sim: Any) -> dict[str, int]:
     """Wrap the run's resume plans so the test sees that they ran (by activity id)."""
-    ran: dict[str, int] = {}
-    resumes = sim.activities.resumes
-    for key, fn in list(resumes.items()):
-        def counted(activities: Any, ai: Any, fn: Any = fn, aid: str = key.id) -> None:
-            ran[aid] = ran.get(aid, 0) + 1
-            fn(activities, ai)
-        resumes[key] = counted
-    return ran
+    return count_resumes(sim)
 
 
 def _both(monkeypatch: pytest.MonkeyPatch, package: Package, until: float = 100.0,
           **kwargs: Any) -> tuple[Any, dict[str, int]]:
     """Run ``package`` both ways; assert they agree; the result and the resumes that ran."""
     return run_both(monkeypatch, package, until, _counting,
-                    lambda sim: sim.activities.resumes, lambda: dict(kwargs))
+                    resume_plans, lambda: dict(kwargs))
 
 
 @pytest.mark.parametrize("spec", ["medication_dispenser.xpdl --days 3",

@@ -11,11 +11,13 @@ silently change every evaluation's numbers.
 
 from __future__ import annotations
 
+import types
+
 import numpy as np
 import pytest
 
 from opspec.engine.performers import WorkItem
-from opspec.usermodels import parse_user_model
+from opspec.usermodels import parse_user_model, performer
 from opspec.usermodels.parametric import LogNormal
 from opspec.usermodels.performer import _TWO_TO_MINUS_53, StochasticUser
 
@@ -78,3 +80,30 @@ def test_offer_draws_a_lognormal_duration_as_lognormal_sample(median: float,
         user.offer(WorkItem(key, "p", key, "walk", "Walk", "user", "user", 0.0))
     assert finished == [duration.sample(reference) for _ in range(5000)]
     assert fast.bit_generator.state == reference.bit_generator.state
+
+
+@pytest.mark.parametrize("seed", [0, 3, 2026])
+def test_the_users_normal_is_generator_standard_normal_at_the_same_position(seed: int) -> None:
+    """The user's standard normal (numpy's ziggurat called on the bit generator itself)
+    gives ``Generator.standard_normal()``'s floats and stream positions, interleaved with
+    the user's other draws; the tail of the ziggurat (about 0.7 % of draws) included."""
+    fast, reference = np.random.default_rng(seed), np.random.default_rng(seed)
+    user = _user(fast)
+    normal = performer._standard_normal(fast)
+    assert normal != fast.standard_normal      # the C function is the one taken
+    for i in range(30_000):
+        assert float(normal()) == float(reference.standard_normal())
+        if i % 2 == 0:
+            assert user._uniform() == reference.random()
+        if i % 11 == 0:
+            assert int(fast.integers(5)) == int(reference.integers(5))
+    assert fast.bit_generator.state == reference.bit_generator.state
+
+
+@pytest.mark.skipif(not isinstance(performer._standard_normal, types.FunctionType),
+                    reason="compiled, the module's lookup cannot be replaced")
+def test_without_the_c_function_the_user_calls_the_method(
+        monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.setattr(performer, "_C_NORMAL", [None])
+    rng = np.random.default_rng(4)
+    assert performer._standard_normal(rng) == rng.standard_normal
