@@ -133,7 +133,13 @@ class Triggers(Part):
                 fire()
 
     def caught(self, ai: ActivityInstance, _arg: Any, data: Mapping[str, Any] | None) -> None:
-        self.state.ready.append((self.activities.body_done, ai, self._known(ai, data), None))
+        activities = self.activities
+        dones = activities.dones        # (empty compiled: its size, no look-up)
+        act = ai.act
+        if dones and act in dones:      # from source: body_done's steps and on, in one
+            self.state.ready.append((dones[act], ai, activities, self._known(ai, data)))
+        else:
+            self.state.ready.append((activities.body_done, ai, self._known(ai, data), None))
 
     def _known(self, ai: ActivityInstance, data: Mapping[str, Any] | None
                ) -> Mapping[str, Any] | None:
