@@ -57,6 +57,7 @@ MODULES: tuple[str, ...] = (
     "opspec.engine.sampling",
     "opspec.engine.scope",
     "opspec.engine.simulation",
+    "opspec.engine.timed_calls",
     "opspec.engine.timers",
     "opspec.engine.timing",
     "opspec.engine.tools",

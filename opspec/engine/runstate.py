@@ -20,8 +20,9 @@ from __future__ import annotations
 import itertools
 from collections import deque
 from collections.abc import Callable, Mapping
+from heapq import heappush
 from types import MappingProxyType
-from typing import TYPE_CHECKING, Any, Final, final
+from typing import TYPE_CHECKING, Any, Final
 
 import simpy
 
@@ -46,6 +47,9 @@ from opspec.engine.performers import Performer
 from opspec.engine.processors import DedicatedProcessor, PooledProcessor
 from opspec.engine.random import Streams
 from opspec.engine.registry import PerformerRegistry
+from opspec.engine.timed_calls import CallAt as _CallAt
+from opspec.engine.timed_calls import CallWith as _CallWith
+from opspec.engine.timed_calls import Later as _Later
 from opspec.engine.timers import TUPLES, Timed, Timers
 from opspec.engine.trace import EventKind as EK
 from opspec.engine.trace import TraceEvent, TraceListener
@@ -377,6 +381,18 @@ class RunState(Timers):
         if TUPLES:      # from source, made without a Python frame for its __init__
             entry: Any = _NEW(_Later)
             entry.state, entry.fn, entry.ai, entry.arg, entry.gen = self, fn, ai, arg, ai.gen
+            if self.heaped:     # (and put on the heap without one for schedule_timed)
+                if not self.inside:
+                    self.now = float(self.env.now)
+                at = self.now + (delay if delay > 0.0 else 0.0)  # noqa: FURB136
+                seq = self.order = self.order + 1
+                entry.at = at
+                entry.seq = seq
+                rows: list[Any] = self.heap
+                heappush(rows, (at, seq, entry))
+                if at < self.armed_at and not self.ticking:
+                    self.arm()
+                return
         else:
             entry = _Later(self, fn, ai, arg)
         self.schedule_timed(delay if delay > 0.0 else 0.0, entry)  # noqa: FURB136
@@ -447,6 +463,18 @@ class RunState(Timers):
         if TUPLES:      # from source, made without a Python frame for its __init__
             entry: Any = _NEW(_CallWith)
             entry.state, entry.fn, entry.a, entry.b, entry.c = self, fn, a, b, c
+            if self.heaped:     # schedule_timed's steps in line (later's, above)
+                if not self.inside:
+                    self.now = float(self.env.now)
+                at = self.now + (delay if delay > 0.0 else 0.0)  # noqa: FURB136
+                seq = self.order = self.order + 1
+                entry.at = at
+                entry.seq = seq
+                rows: list[Any] = self.heap
+                heappush(rows, (at, seq, entry))
+                if at < self.armed_at and not self.ticking:
+                    self.arm()
+                return
         else:
             entry = _CallWith(self, fn, a, b, c)
         self.schedule_timed(delay if delay > 0.0 else 0.0, entry)  # noqa: FURB136
@@ -520,79 +548,6 @@ def _call(callback: Callable[[], None], _a: Any, _b: Any) -> None:
 _CALL: Final = _call        # a module static compiled (a global is a dictionary lookup)
 #: from source, a timed entry made without calling its class (see RunState.later)
 _NEW: Final[Callable[[type], Any]] = object.__new__
-
-
-@final
-class _Later(Timed):
-    """The timed callback of :meth:`RunState.later` (not a closure: one allocation, not two)."""
-
-    def __init__(self, state: RunState, fn: Callable[[ActivityInstance, Any], None],
-                 ai: ActivityInstance, arg: Any) -> None:
-        self.state = state
-        self.fn = fn
-        self.ai = ai
-        self.arg = arg
-        self.gen = ai.gen
-
-    def go(self) -> None:
-        ai = self.ai
-        # RunState.fired's first test, here: a deadline that lost its race (the user
-        # reported in time) is due after its activity instance moved on, once a dose cycle
-        if ai.gen == self.gen and ai.state == RUNNING:
-            self.state.fired(self.fn, ai, self.arg, self.gen)
-
-    def __call__(self, _event: Any) -> None:
-        self.state.fire(self.fn, self.ai, self.arg, self.gen)
-
-
-@final
-class _CallAt(Timed):
-    """The timed callback of :meth:`RunState.call_at` and :meth:`RunState.timer`."""
-
-    def __init__(self, state: RunState, callback: Callable[[], None], drain: bool) -> None:
-        self.state = state
-        self.callback = callback
-        self.drain = drain
-
-    def go(self) -> None:
-        self.callback()
-        if self.drain:
-            state = self.state
-            if (state.ready or state.pending or state.draining or state.now != state.instant
-                    or state.instant_steps >= state.max_instant_steps):
-                state.drain()
-            else:                   # (drain's case of nothing queued at this instant)
-                state.instant_steps += 1
-
-    def __call__(self, _event: Any) -> None:
-        self.state.called(self.callback, self.drain)
-
-
-@final
-class _CallWith(Timed):
-    """The timed callback of :meth:`RunState.call_at_with`."""
-
-    def __init__(self, state: RunState, fn: Callable[[Any, Any, Any], None],
-                 a: Any, b: Any, c: Any) -> None:
-        self.state = state
-        self.fn = fn
-        self.a = a
-        self.b = b
-        self.c = c
-
-    def go(self) -> None:
-        self.fn(self.a, self.b, self.c)
-        state = self.state
-        # drain's case of nothing queued at this instant in line: a step counted (the
-        # callback, a performer's answer, has drained what it queued as a rule)
-        if (state.ready or state.pending or state.draining or state.now != state.instant
-                or state.instant_steps >= state.max_instant_steps):
-            state.drain()
-        else:
-            state.instant_steps += 1
-
-    def __call__(self, _event: Any) -> None:
-        self.state.go_now(self)
 
 
 def discard(table: dict[Any, Any], key: Any) -> None:

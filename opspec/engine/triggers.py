@@ -133,7 +133,14 @@ class Triggers(Part):
                 fire()
 
     def caught(self, ai: ActivityInstance, _arg: Any, data: Mapping[str, Any] | None) -> None:
-        self.state.ready.append((self.activities.body_done, ai, self._known(ai, data), None))
+        activities = self.activities
+        dones = activities.dones        # (empty compiled: its size, no look-up)
+        act = ai.act
+        known = self._known(ai, data) if data else None     # (no frame for no data)
+        if dones and act in dones:      # from source: body_done's steps and on, in one
+            self.state.ready.append((dones[act], ai, activities, known))
+        else:
+            self.state.ready.append((activities.body_done, ai, known, None))
 
     def _known(self, ai: ActivityInstance, data: Mapping[str, Any] | None
                ) -> Mapping[str, Any] | None:
@@ -213,8 +220,13 @@ class Triggers(Part):
         if table:
             # (no copy of the table: the loop ends at the first waiter handed the message)
             for token, entry in table.items():
-                if entry[0].state == RUNNING:
-                    self._hand(table, token, entry, data)
+                ai = entry[0]
+                if ai.state == RUNNING:
+                    # _hand in line (a Python frame a message from source)
+                    _ai, handler, (arg, persistent, _key, _token) = entry
+                    if not persistent:
+                        table.pop(token, None)
+                    handler(ai, arg, data)
                     return
         kind, name = key
         started = False

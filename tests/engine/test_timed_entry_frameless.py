@@ -59,22 +59,15 @@ def test_entries_made_without_their_class_run_as_the_classes_did(
     assert sum(1 for e in trace if e[1] == "activity.completed" and e[4] == "take_pill") >= 15
 
 
-class _Noted:
-    def __init__(self) -> None:
-        self.entries: list[Any] = []
-
-    def schedule_timed(self, delay: float, entry: Any) -> None:
-        self.entries.append((delay, entry))
-
-
 @from_source     # (compiled, the run's methods cannot be patched: the outcomes compare it)
 @pytest.mark.parametrize("tuples", [True, False], ids=["frameless", "class called"])
 def test_the_entry_holds_what_its_init_would_set(
         tuples: bool, monkeypatch: pytest.MonkeyPatch) -> None:
+    """Frameless, the entries also go on the heap without ``schedule_timed`` (its steps in
+    line): the heap, the order and the clock's wake-up are what ``schedule_timed`` leaves."""
     monkeypatch.setattr(runstate, "TUPLES", tuples)
     sim = Simulation(compile_package(open_spec(ROOT / "specs" / "medication_dispenser.xpdl")))
-    noted = _Noted()
-    monkeypatch.setattr(sim, "schedule_timed", noted.schedule_timed)
+    assert sim.heaped and sim.heap == [] and sim.order == 0
 
     class _Ai:
         gen = 7
@@ -85,8 +78,12 @@ def test_the_entry_holds_what_its_init_would_set(
     ai: Any = _Ai()
     sim.later(-1.0, fn, ai, "arg")
     sim.call_at_with(2.5, fn, "a", "b", "c")
-    (d1, later), (d2, with_) = noted.entries
-    assert (d1, d2) == (0.0, 2.5)
+    sim.call_at_with(1.0, fn, "d", "e", "f")
+    rows = sorted(sim.heap, key=lambda row: row[1])
+    assert [(at, seq) for at, seq, _entry in rows] == [(0.0, 1), (2.5, 2), (1.0, 3)]
+    assert all((entry.at, entry.seq) == (at, seq) for at, seq, entry in rows)
+    assert sim.order == 3 and sim.armed_at == 0.0      # armed for the earliest entry
+    later, with_ = rows[0][2], rows[1][2]
     assert type(later) is runstate._Later and type(with_) is runstate._CallWith
     assert (later.state, later.fn, later.ai, later.arg, later.gen) == (sim, fn, ai, "arg", 7)
     assert (with_.state, with_.fn, with_.a, with_.b, with_.c) == (sim, fn, "a", "b", "c")
