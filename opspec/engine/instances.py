@@ -207,7 +207,11 @@ class ActivityInstance:
 
     def __init__(self, key: int, act: CompiledActivity, frame: Frame, started_at: float,
                  state: int = NOT_STARTED) -> None:
-        self.key = key
+        # (an object, not an ``int``: compiled, an ``int`` field is a C integer, and each
+        # read of it as a dictionary key would make a new Python int (ids pass 256 at
+        # once), which the frame's running table then compares by value; boxed once here,
+        # its insertion, test and deletion use the one object, found by identity)
+        self.key: Any = key
         self.act = act
         self.frame = frame
         self.state = state
