@@ -20,7 +20,6 @@ from __future__ import annotations
 import itertools
 from collections import deque
 from collections.abc import Callable, Mapping
-from heapq import heappush
 from types import MappingProxyType
 from typing import TYPE_CHECKING, Any, Final
 
@@ -381,18 +380,6 @@ class RunState(Timers):
         if TUPLES:      # from source, made without a Python frame for its __init__
             entry: Any = _NEW(_Later)
             entry.state, entry.fn, entry.ai, entry.arg, entry.gen = self, fn, ai, arg, ai.gen
-            if self.heaped:     # (and put on the heap without one for schedule_timed)
-                if not self.inside:
-                    self.now = float(self.env.now)
-                at = self.now + (delay if delay > 0.0 else 0.0)  # noqa: FURB136
-                seq = self.order = self.order + 1
-                entry.at = at
-                entry.seq = seq
-                rows: list[Any] = self.heap
-                heappush(rows, (at, seq, entry))
-                if at < self.armed_at and not self.ticking:
-                    self.arm()
-                return
         else:
             entry = _Later(self, fn, ai, arg)
         self.schedule_timed(delay if delay > 0.0 else 0.0, entry)  # noqa: FURB136
@@ -463,18 +450,6 @@ class RunState(Timers):
         if TUPLES:      # from source, made without a Python frame for its __init__
             entry: Any = _NEW(_CallWith)
             entry.state, entry.fn, entry.a, entry.b, entry.c = self, fn, a, b, c
-            if self.heaped:     # schedule_timed's steps in line (later's, above)
-                if not self.inside:
-                    self.now = float(self.env.now)
-                at = self.now + (delay if delay > 0.0 else 0.0)  # noqa: FURB136
-                seq = self.order = self.order + 1
-                entry.at = at
-                entry.seq = seq
-                rows: list[Any] = self.heap
-                heappush(rows, (at, seq, entry))
-                if at < self.armed_at and not self.ticking:
-                    self.arm()
-                return
         else:
             entry = _CallWith(self, fn, a, b, c)
         self.schedule_timed(delay if delay > 0.0 else 0.0, entry)  # noqa: FURB136
