@@ -12,21 +12,13 @@ from pathlib import Path
 
 from opspec.cli import main
 
+from .trace_files import walks, write_trace
+
 
 def _person(path: Path, person: str, seed: int) -> Path:
     rng = random.Random(seed)
-    lines: list[dict] = [{"format": "opspec-trace", "version": 1, "person": person},
-                         {"time": 0.0, "kind": "run.started"}]
-    t = 0.0
-    for i in range(1, 16):
-        lines.append({"time": t, "kind": "activity.offered", "activity": "walk",
-                      "lane": "user", "instance": i})
-        t += rng.lognormvariate(3.5, 0.3)
-        lines.append({"time": t, "kind": "activity.completed", "activity": "walk",
-                      "lane": "user", "instance": i})
-        t += 100
-    path.write_text("".join(json.dumps(x) + "\n" for x in lines), encoding="utf-8")
-    return path
+    return write_trace(path, walks(rng.lognormvariate(3.5, 0.3) for _ in range(15)),
+                       person=person)
 
 
 def _devices_only(path: Path) -> Path:

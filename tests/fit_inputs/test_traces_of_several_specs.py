@@ -9,21 +9,12 @@ from pathlib import Path
 
 from opspec.cli import main
 
+from .trace_files import walks, write_trace
+
 
 def _session(path: Path, person: str, spec: str) -> Path:
-    lines: list[dict] = [{"format": "opspec-trace", "version": 1, "person": person,
-                          "spec": spec}, {"time": 0.0, "kind": "run.started"}]
-    t = 0.0
-    for i in range(1, 13):
-        lines.append({"time": t, "kind": "activity.offered", "activity": "walk",
-                      "lane": "user", "instance": i})
-        t += 20.0 + (i * 7 + len(person)) % 30
-        lines.append({"time": t, "kind": "activity.completed", "activity": "walk",
-                      "lane": "user", "instance": i})
-        t += 100
-    path.parent.mkdir(parents=True, exist_ok=True)
-    path.write_text("".join(json.dumps(x) + "\n" for x in lines), encoding="utf-8")
-    return path
+    return write_trace(path, walks(20.0 + (i * 7 + len(person)) % 30 for i in range(1, 13)),
+                       person=person, spec=spec)
 
 
 def test_two_variants_fitted_together_are_said(tmp_path, capsys) -> None:

@@ -14,11 +14,12 @@ import pytest
 
 from opspec.cli import main
 
+from .trace_files import write_trace
+
 
 def _session(path: Path, person: str) -> Path:
     """Ten alarms: two missed, eight heard; of those, every other one not timed."""
-    lines: list[dict] = [{"format": "opspec-trace", "version": 1, "person": person},
-                         {"time": 0.0, "kind": "run.started"}]
+    lines: list[dict] = []
     t = 0.0
     for i in range(1, 11):
         lines.append({"time": t, "kind": "activity.offered", "activity": "hear",
@@ -34,8 +35,7 @@ def _session(path: Path, person: str) -> Path:
             lines.append({"time": t, "kind": "activity.completed", "activity": "hear",
                           "lane": "user", "instance": i})
         t += 100
-    path.write_text("".join(json.dumps(x) + "\n" for x in lines), encoding="utf-8")
-    return path
+    return write_trace(path, lines, person=person)
 
 
 @pytest.fixture
