@@ -178,6 +178,7 @@ def test_the_build_record_describes_the_sources_mypyc_compiled(
     import types
 
     import setuptools
+    from setuptools import Extension
 
     shutil.copy(ROOT / "setup.py", tmp_path / "setup.py")
     for module in (*_native.MODULES, "opspec._native"):
@@ -187,7 +188,8 @@ def test_the_build_record_describes_the_sources_mypyc_compiled(
     # mypyc as the build sees it, without compiling anything (the test venv need not have it)
     mypyc = types.ModuleType("mypyc")
     build_module = types.ModuleType("mypyc.build")
-    build_module.mypycify = lambda paths, **options: ["extension"]  # type: ignore[attr-defined]
+    build_module.mypycify = lambda paths, **options: [  # type: ignore[attr-defined]
+        Extension("opspec__mypyc", ["build/__native_opspec.c"])]
     monkeypatch.setitem(sys.modules, "mypyc", mypyc)
     monkeypatch.setitem(sys.modules, "mypyc.build", build_module)
     monkeypatch.setattr(setuptools, "setup", lambda **options: None)
