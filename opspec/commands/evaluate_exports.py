@@ -38,8 +38,9 @@ def export_writer(fmt: str, path: Path, plan: Any) -> Any:
     """The streaming writer of one export format."""
     from opspec.evaluation.exporters import JsonlTraceWriter, XesWriter
 
+    # one key in both logs (XES keys hold no spaces, and a JSON reader looks up the same name)
     attrs: dict[str, Any] = {"spec": plan.design("A").spec, "seed": plan.seed,
-                             "case notion": plan.case}
+                             "case_notion": plan.case}
     if fmt == "jsonl":
         return JsonlTraceWriter(path, log_attributes=attrs)
     from opspec.commands._spec import load_any_spec

@@ -27,12 +27,12 @@ def _log_attributes(path: Path) -> dict[str, str]:
             if child.get("key") is not None and child.tag != f"{{{XES_NAMESPACE}}}trace"}
 
 
-def _export(tmp_path: Path, *more: str) -> dict[str, str]:
+def _export(tmp_path: Path, *more: str, formats: str = "xes") -> dict[str, str]:
     out = tmp_path / "run"
     with without_report():
         assert main(["evaluate", str(SPEC), "--users", "1", "--days", "1", "--seed", "7",
                      "--workers", "1", "--user-model", str(USERS), "--quiet", "--export",
-                     "xes", "--case", "user", "--out", str(out), *more]) == 0
+                     formats, "--case", "user", "--out", str(out), *more]) == 0
     return _log_attributes(out / "traces.xes")
 
 
@@ -58,3 +58,21 @@ def test_a_comparison_of_two_specs_names_both(tmp_path, capsys):
     capsys.readouterr()
     assert log["concept:name"] == ("Smart medication dispenser and its user compared with "
                                    "Quieter dispenser")
+
+
+def test_the_jsonl_header_names_the_run_in_the_xes_log_s_words(tmp_path, capsys):
+    """Both exports of one evaluation say which spec, seed and case notion they hold, under
+    the same keys (the JSON Lines header said ``"case notion"``, with a space, where the XES
+    log says ``case_notion``), and docs/trace-format.md names the header's keys."""
+    import json
+
+    log = _export(tmp_path, formats="xes,jsonl")
+    capsys.readouterr()
+    with (tmp_path / "run" / "traces.jsonl").open(encoding="utf-8") as handle:
+        head = json.loads(handle.readline())
+    assert head["cases"] is True
+    for key in ("spec", "seed", "case_notion"):
+        assert str(head[key]) == log[key], key
+    documented = (ROOT / "docs" / "trace-format.md").read_text(encoding="utf-8")
+    for key in head:
+        assert f"`{key}`" in documented or f'"{key}"' in documented, key
