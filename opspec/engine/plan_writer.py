@@ -343,12 +343,13 @@ class Writer(WaitingCode):
         return f"{self.name('V', fn)}({data}, now)"
 
     def set_field(self, act: CompiledActivity | None, target: str, pad: str,
-                  out: list[str]) -> None:
-        """``Flow.set_field(inst, act, target, value)``, in line (``value`` is set)."""
-        t = self.name("T", target)
-        out += [f"{pad}data = inst.data",
-                f"{pad}if {t} in data or {t} not in state.package_data:",
-                f"{pad}    data[{t}] = value",
+                  out: list[str], named: bool = False) -> None:
+        """``Flow.set_field(inst, act, target, value)``, in line (``value`` is set; with
+        ``named``, ``target`` is the name of the local that holds the field's name)."""
+        t = target if named else self.name("T", target)
+        out += [f"{pad}fields = inst.data",
+                f"{pad}if {t} in fields or {t} not in state.package_data:",
+                f"{pad}    fields[{t}] = value",
                 f"{pad}else:",
                 f"{pad}    state.package_data[{t}] = value"]
         if act is None:
