@@ -198,7 +198,7 @@ def compile_expression(
             constant.opspec_constant = (value,)  # type: ignore[attr-defined]
         return constant
     try:
-        own = _compile(expr, (expr, location))
+        own = _compile_root(expr, (expr, location))
         if own is not None:
             return own
         inner = _compile(expr)
@@ -260,18 +260,20 @@ _Whole = tuple[Expression, SourceLocation | None] | None
 COMPILED: Final = not isinstance(_fail, types.FunctionType)
 
 
-def _compile(expr: Expression, whole: _Whole = None) -> Any:
-    """``expr``'s closure; with ``whole`` (at the root) the closure of a shape that answers
-    for its own errors, or ``None`` for any other (the caller wraps it)."""
-    if whole is not None:
-        if isinstance(expr, Name) and len(expr.path) == 1:
-            return _compile_name(expr.path, whole)
-        if isinstance(expr, Call) and expr.function in TIME_HELPERS:
-            return _compile_call(expr, whole)
-        if (isinstance(expr, Binary) and expr.op in ARITHMETIC and isinstance(expr.left, Name)
-                and len(expr.left.path) == 1 and isinstance(expr.right, Literal)):
-            return _compile_binary(expr, whole)
-        return None
+def _compile_root(expr: Expression, whole: _Whole) -> _Fn | None:
+    """The closure of ``expr`` at an expression's root, ``whole``, for a shape whose closure
+    answers for its own errors; ``None`` for any other (the caller wraps it)."""
+    if isinstance(expr, Name) and len(expr.path) == 1:
+        return _compile_name(expr.path, whole)
+    if isinstance(expr, Call) and expr.function in TIME_HELPERS:
+        return _compile_call(expr, whole)
+    if (isinstance(expr, Binary) and expr.op in ARITHMETIC and isinstance(expr.left, Name)
+            and len(expr.left.path) == 1 and isinstance(expr.right, Literal)):
+        return _compile_binary(expr, whole)
+    return None
+
+
+def _compile(expr: Expression) -> _Fn:
     if isinstance(expr, Literal):
         value = expr.value
         return lambda data, now: value
