@@ -198,6 +198,9 @@ def compile_expression(
             constant.opspec_constant = (value,)  # type: ignore[attr-defined]
         return constant
     try:
+        own = _compile_root(expr, (expr, location))
+        if own is not None:
+            return own
         inner = _compile(expr)
     except ConditionProblem as problem:
         raise _fail(expr, problem, location, None) from None
@@ -226,6 +229,10 @@ def compile_condition(
     if expr is None:
         return lambda data, now: True
     try:
+        if isinstance(expr, Binary) and (expr.op in ("==", "!=") or expr.op in FAST_ORDERING):
+            # a comparison's closure gives a bool and, as the root, names the condition in
+            # its own errors: no wrapper (from source each closure level is a Python call)
+            return _compile_binary(expr, (expr, location))
         inner = _compile(expr)
     except ConditionProblem as problem:
         raise _fail(expr, problem, location, None) from None
@@ -243,10 +250,27 @@ def compile_condition(
 
 
 _Fn = Callable[[Mapping[str, Any], float], Any]
+#: the whole expression and its place, given to the closure at an expression's root: it then
+#: turns its own problems into :func:`_fail`'s error (``None`` below the root: the problem
+#: goes up to the root's closure as it is)
+_Whole = tuple[Expression, SourceLocation | None] | None
 
 #: whether this module runs compiled (mypyc): a constant's closure is then native code and
 #: the plans keep calling it (see :func:`constant_value`)
 COMPILED: Final = not isinstance(_fail, types.FunctionType)
+
+
+def _compile_root(expr: Expression, whole: _Whole) -> _Fn | None:
+    """The closure of ``expr`` at an expression's root, ``whole``, for a shape whose closure
+    answers for its own errors; ``None`` for any other (the caller wraps it)."""
+    if isinstance(expr, Name) and len(expr.path) == 1:
+        return _compile_name(expr.path, whole)
+    if isinstance(expr, Call) and expr.function in TIME_HELPERS:
+        return _compile_call(expr, whole)
+    if (isinstance(expr, Binary) and expr.op in ARITHMETIC and isinstance(expr.left, Name)
+            and len(expr.left.path) == 1 and isinstance(expr.right, Literal)):
+        return _compile_binary(expr, whole)
+    return None
 
 
 def _compile(expr: Expression) -> _Fn:
@@ -269,21 +293,26 @@ def _compile(expr: Expression) -> _Fn:
     raise ConditionProblem(f"not an expression node: {expr!r}")
 
 
-def _compile_name(path: tuple[str, ...]) -> _Fn:
+def _compile_name(path: tuple[str, ...], whole: _Whole = None) -> _Fn:
     root = path[0]
     if len(path) == 1:
 
         def field(data: Mapping[str, Any], now: float) -> Any:
             try:
-                return data[root]
-            except KeyError:
-                missing_field(data, root)
+                try:
+                    return data[root]
+                except KeyError:
+                    missing_field(data, root)
+            except (ConditionProblem, *_PYTHON_ERRORS) as problem:
+                if whole is None:
+                    raise
+                raise _fail(whole[0], problem, whole[1], now) from None
 
         return field
     return lambda data, now: lookup(data, path)
 
 
-def _compile_binary(expr: Binary) -> _Fn:
+def _compile_binary(expr: Binary, whole: _Whole = None) -> _Fn:
     op = expr.op
     left, right = _compile(expr.left), _compile(expr.right)
     if op == "and":
@@ -307,17 +336,38 @@ def _compile_binary(expr: Binary) -> _Fn:
 
         return either
     if op in ("==", "!="):
-        return _compile_equality(expr, left, right, negate=op == "!=")
+        return _compile_equality(expr, left, right, whole, negate=op == "!=")
     if op in FAST_ORDERING:
-        return _compile_ordering(expr, left, right)
+        return _compile_ordering(expr, left, right, whole)
     if op in ARITHMETIC:
         arithmetic = ARITHMETIC[op]
+        if isinstance(expr.left, Name) and len(expr.left.path) == 1 and isinstance(
+            expr.right, Literal
+        ):
+            # "field + 1": the field read and the constant inlined
+            root, constant = expr.left.path[0], expr.right.value
+
+            def field_arithmetic(data: Mapping[str, Any], now: float) -> Any:
+                try:
+                    try:
+                        value = data[root]
+                    except KeyError:
+                        missing_field(data, root)
+                    return arithmetic(value, constant)
+                except (ConditionProblem, *_PYTHON_ERRORS) as problem:
+                    if whole is None:
+                        raise
+                    raise _fail(whole[0], problem, whole[1], now) from None
+
+            return field_arithmetic
         return lambda data, now: arithmetic(left(data, now), right(data, now))
     raise ConditionProblem(f"unknown operator {op!r}")
 
 
-def _compile_equality(expr: Binary, left: _Fn, right: _Fn, *, negate: bool) -> _Fn:
+def _compile_equality(expr: Binary, left: _Fn, right: _Fn, whole: _Whole, *,
+                      negate: bool) -> _Fn:
     # The common shape "field == 'constant'" gets one closure with both operands inlined.
+    # (Each returns a bool, so at a condition's root it is the condition: see ``whole``.)
     if isinstance(expr.left, Name) and len(expr.left.path) == 1 and isinstance(
         expr.right, Literal
     ):
@@ -326,12 +376,17 @@ def _compile_equality(expr: Binary, left: _Fn, right: _Fn, *, negate: bool) -> _
 
         def field_equals(data: Mapping[str, Any], now: float) -> bool:
             try:
-                value = data[root]
-            except KeyError:
-                missing_field(data, root)
-            if type(value) is kind:
-                return (value == constant) is not negate
-            return equal(value, constant) is not negate
+                try:
+                    value = data[root]
+                except KeyError:
+                    missing_field(data, root)
+                if type(value) is kind:
+                    return (value == constant) is not negate
+                return equal(value, constant) is not negate
+            except (ConditionProblem, *_PYTHON_ERRORS) as problem:
+                if whole is None:
+                    raise
+                raise _fail(whole[0], problem, whole[1], now) from None
 
         return field_equals
 
@@ -340,23 +395,35 @@ def _compile_equality(expr: Binary, left: _Fn, right: _Fn, *, negate: bool) -> _
         fixed_kind = type(fixed)
 
         def equals_constant(data: Mapping[str, Any], now: float) -> bool:
-            a = left(data, now)
-            if type(a) is fixed_kind:
-                return (a == fixed) is not negate
-            return equal(a, fixed) is not negate
+            try:
+                a = left(data, now)
+                if type(a) is fixed_kind:
+                    return (a == fixed) is not negate
+                return equal(a, fixed) is not negate
+            except (ConditionProblem, *_PYTHON_ERRORS) as problem:
+                if whole is None:
+                    raise
+                raise _fail(whole[0], problem, whole[1], now) from None
 
         return equals_constant
 
     def equals(data: Mapping[str, Any], now: float) -> bool:
-        a, b = left(data, now), right(data, now)
-        if type(a) is type(b) and type(a) in (str, int, float, bool):
-            return (a == b) is not negate
-        return equal(a, b) is not negate
+        try:
+            a, b = left(data, now), right(data, now)
+            if type(a) is type(b) and type(a) in (str, int, float, bool):
+                return (a == b) is not negate
+            return equal(a, b) is not negate
+        except (ConditionProblem, *_PYTHON_ERRORS) as problem:
+            if whole is None:
+                raise
+            raise _fail(whole[0], problem, whole[1], now) from None
 
     return equals
 
 
-def _compile_ordering(expr: Binary, left: _Fn, right: _Fn) -> _Fn:
+def _compile_ordering(expr: Binary, left: _Fn, right: _Fn, whole: _Whole) -> _Fn:
+    # (At a condition's root, ``whole``, the closure is the condition: the fast paths give
+    # Python bools, and ``_held`` makes :func:`ordered`'s answer one, as a condition's is.)
     op = expr.op
     fast = FAST_ORDERING[op]
     constant = expr.right.value if isinstance(expr.right, Literal) else None
@@ -369,46 +436,78 @@ def _compile_ordering(expr: Binary, left: _Fn, right: _Fn) -> _Fn:
 
         def field_ordering(data: Mapping[str, Any], now: float) -> bool:
             try:
-                value = data[root]
-            except KeyError:
-                missing_field(data, root)
-            kind = type(value)
-            if kind is int or kind is float:
-                return fast(value, constant)
-            if kind is str:  # XPDL data often holds numbers as text ("3")
-                number = numeric_text(value)
-                if number is not None:
-                    return fast(number, constant)
-            return ordered(value, constant, op)
+                try:
+                    value = data[root]
+                except KeyError:
+                    missing_field(data, root)
+                kind = type(value)
+                if kind is int or kind is float:
+                    return fast(value, constant)
+                if kind is str:  # XPDL data often holds numbers as text ("3")
+                    number = numeric_text(value)
+                    if number is not None:
+                        return fast(number, constant)
+                found = ordered(value, constant, op)
+                return found if whole is None else _held(found)
+            except (ConditionProblem, *_PYTHON_ERRORS) as problem:
+                if whole is None:
+                    raise
+                raise _fail(whole[0], problem, whole[1], now) from None
 
         return field_ordering
     if type(constant) in (int, float):
 
         def ordering_constant(data: Mapping[str, Any], now: float) -> bool:
-            value = left(data, now)
-            kind = type(value)
-            if kind is int or kind is float:
-                return fast(value, constant)
-            return ordered(value, constant, op)
+            try:
+                value = left(data, now)
+                kind = type(value)
+                if kind is int or kind is float:
+                    return fast(value, constant)
+                found = ordered(value, constant, op)
+                return found if whole is None else _held(found)
+            except (ConditionProblem, *_PYTHON_ERRORS) as problem:
+                if whole is None:
+                    raise
+                raise _fail(whole[0], problem, whole[1], now) from None
 
         return ordering_constant
 
     def ordering(data: Mapping[str, Any], now: float) -> bool:
-        a, b = left(data, now), right(data, now)
-        ta, tb = type(a), type(b)
-        if (ta is int or ta is float) and (tb is int or tb is float):
-            return fast(a, b)
-        if ta is str and tb is str:
-            return fast(a, b)
-        return ordered(a, b, op)
+        try:
+            a, b = left(data, now), right(data, now)
+            ta, tb = type(a), type(b)
+            if (ta is int or ta is float) and (tb is int or tb is float):
+                return fast(a, b)
+            if ta is str and tb is str:
+                return fast(a, b)
+            found = ordered(a, b, op)
+            return found if whole is None else _held(found)
+        except (ConditionProblem, *_PYTHON_ERRORS) as problem:
+            if whole is None:
+                raise
+            raise _fail(whole[0], problem, whole[1], now) from None
 
     return ordering
 
 
-def _compile_call(expr: Call) -> _Fn:
+def _held(value: Any) -> bool:
+    """A condition's answer for ``value`` (a comparison's, which may be NumPy's bool)."""
+    return value is True or (value is not False and truthy(value))
+
+
+def _compile_call(expr: Call, whole: _Whole = None) -> _Fn:
     if expr.function in TIME_HELPERS:
         helper = TIME_HELPERS[expr.function]
-        return lambda data, now: helper(now)
+        if whole is None:
+            return lambda data, now: helper(now)
+
+        def time_helper(data: Mapping[str, Any], now: float) -> Any:
+            try:
+                return helper(now)
+            except (ConditionProblem, *_PYTHON_ERRORS) as problem:
+                raise _fail(whole[0], problem, whole[1], now) from None
+
+        return time_helper
     function = IMPLEMENTATIONS.get(expr.function)
     if function is None:
         raise ConditionProblem(f"unknown function {expr.function!r}")

@@ -93,6 +93,9 @@ class WaitingCode:
     def fields(self, act: CompiledActivity) -> str:
         raise NotImplementedError
 
+    def value(self, fn: Any, data: str) -> str:
+        raise NotImplementedError
+
     def hand_over(self, index: int, pad: str) -> list[str]:
         """The hand-over at activity ``index`` (as in ``lone.run``): the instance gets its
         frame with the token in it (a resume plan's has one), and the token goes the
@@ -138,7 +141,7 @@ class WaitingCode:
             triggers = "triggers"
         for seconds, synchronous, exception in act.deadlines:
             out += [f"{pad}try:",
-                    f"{pad}    delay = float({self.name('V', seconds)}(inst.scope, now))",
+                    f"{pad}    delay = float({self.value(seconds, 'inst.scope')})",
                     f"{pad}except OpspecError as error:",
                     (f"{pad}    flow.abort(inst, {a}, "
                      f"f\"deadline cannot be computed: {{error.message}}\")"),

@@ -131,6 +131,7 @@ class Writer(WaitingCode):
             "OpspecError": OpspecError, "RUNNING": RUNNING, "SUSPENDED": SUSPENDED,
             "STARTED": EK.ACTIVITY_STARTED, "COMPLETED": EK.ACTIVITY_COMPLETED,
             "CHANGED": EK.DATA_CHANGED, "OFFERED": EK.ACTIVITY_OFFERED, "DONE": COMPLETED,
+            "RAISED": EK.TRIGGER_RAISED,
             "ACTIVITY": ActivityInstance, "ITEM": WorkItem, "PROXY": MappingProxyType,
             "ENDED": ENDED, "ENDED_KIND": EK.PROCESS_COMPLETED, "IN": ParameterMode.IN,
             "INSTANCE": ProcessInstance, "SCOPE": Scope, "DEADLINES": process_deadlines,
@@ -198,16 +199,14 @@ class Writer(WaitingCode):
             if not act.simple_end and act.end_assign:
                 self.assign(act, act.end_assign, pad, out)
             if act.kind == K_THROW and act.trigger is not None:     # (Flow.done_next's)
-                out.append(f"{pad}flow.triggers.broadcast({self.trigger(act.trigger)}, "
-                           f"None, inst, {a})")
+                out += self.raised(act.trigger, act, pad)
             out += [f"{pad}cached = {a}.flag_cache",
                     f"{pad}if (cached.bits if cached.key is state.flag_key "
                     f"else state.act_bits({a})) & 2:",
                     f"{pad}    state.emit(COMPLETED, {fields})"]
             if act.raises is not None:
                 out += [f"{pad}if inst.state == RUNNING:",
-                        (f"{pad}    flow.triggers.broadcast({self.trigger(act.raises)}, "
-                         f"None, inst, {a})")]
+                        *self.raised(act.raises, act, pad + "    ")]
             if not act.simple_end:
                 out += [f"{pad}if inst.state != RUNNING:", f"{pad}    return"]
         path = (*path, index)
@@ -222,6 +221,24 @@ class Writer(WaitingCode):
     def trigger(self, trig: CTrigger) -> str:
         """A thrown or raised trigger's kind and name, as ``Triggers.broadcast`` takes them."""
         return f"{self.name('G', trig.kind)}, {self.name('G', trig.name or '')}"
+
+    def raised(self, trig: CTrigger, act: CompiledActivity, pad: str) -> list[str]:
+        """``Triggers.broadcast(kind, name, None, inst, act)`` of the trigger ``act`` throws
+        or raises; a message's steps before ``Triggers.send`` in line (the name noted as
+        raised, the trace event), the message then sent by its key."""
+        a = f"A{act.index}"
+        self.names[a] = act
+        if trig.kind != "message":
+            return [f"{pad}flow.triggers.broadcast({self.trigger(trig)}, None, inst, {a})"]
+        kind, name = self.name("G", trig.kind), self.name("G", trig.name or "")
+        return [f"{pad}state.raised_names.add({name})",
+                f"{pad}cached = {a}.flag_cache",
+                (f"{pad}if (cached.bits if cached.key is state.flag_key "
+                 f"else state.act_bits({a})) & 16:"),
+                (f"{pad}    state.emit(RAISED, {self.fields(act)}, "
+                 f"{{\"trigger\": {kind}, \"name\": {name}}})"),
+                (f"{pad}flow.triggers.send({self.name('Q', (trig.kind, trig.name or ''))}, "
+                 f"None, inst, {a})")]
 
     def fields(self, act: CompiledActivity) -> str:
         """The arguments of ``act``'s trace events after their kind."""
@@ -343,12 +360,13 @@ class Writer(WaitingCode):
         return f"{self.name('V', fn)}({data}, now)"
 
     def set_field(self, act: CompiledActivity | None, target: str, pad: str,
-                  out: list[str]) -> None:
-        """``Flow.set_field(inst, act, target, value)``, in line (``value`` is set)."""
-        t = self.name("T", target)
-        out += [f"{pad}data = inst.data",
-                f"{pad}if {t} in data or {t} not in state.package_data:",
-                f"{pad}    data[{t}] = value",
+                  out: list[str], named: bool = False) -> None:
+        """``Flow.set_field(inst, act, target, value)``, in line (``value`` is set; with
+        ``named``, ``target`` is the name of the local that holds the field's name)."""
+        t = target if named else self.name("T", target)
+        out += [f"{pad}fields = inst.data",
+                f"{pad}if {t} in fields or {t} not in state.package_data:",
+                f"{pad}    fields[{t}] = value",
                 f"{pad}else:",
                 f"{pad}    state.package_data[{t}] = value"]
         if act is None:

@@ -197,12 +197,17 @@ def build_resume(proc: CompiledProcess, index: int, queued: bool = False) -> Any
               "    if ai.frame.inst.state == SUSPENDED:",
               "        ai.frame.inst.defer((activities.body_done, ai, data, None))",
               "        return",
-              "    if data:",
+              "    if data:                         # (Flow.set_field, each in line)",
               "        inst = ai.frame.inst",
-              "        set_field = activities.flow.set_field",
-              "        for key, value in data.items():",
-              f"            set_field(inst, {a}, key, value)"]
+              "        state = activities.state",
+              "        if state.flag_key is not KEY:",
+              "            SELECT(state)",
+              "        flow = activities.flow",
+              "        iid = inst.id",
+              "        for key, value in data.items():"]
              if queued else ["def resume(activities, ai):"])
+    if queued:
+        writer.set_field(act, "key", "            ", first, named=True)
     lines = [*first,
              "    ai.state = DONE                  # (Activities._complete's first steps)",
              "    ai.gen += 1",

@@ -152,7 +152,7 @@ class Triggers(Part):
     def broadcast(self, kind: str, name: str, data: Mapping[str, Any] | None,
                   inst: ProcessInstance | None = None, act: CompiledActivity | None = None
                   ) -> None:
-        """Raise a signal or send a message (see :meth:`_send`).
+        """Raise a signal or send a message (see :meth:`send`).
 
         A *signal* reaches everything waiting for it now and is not kept: catch events,
         event-gateway branches, boundary events, start and end triggers.
@@ -172,7 +172,7 @@ class Triggers(Part):
                       {"trigger": kind, "name": name, **(dict(data) if data else {})})
         key = (kind, name)
         if kind == "message":
-            self._send(key, data, inst, act)
+            self.send(key, data, inst, act)
             return
         table = self.state.waiters.get(key)
         if table:
@@ -189,9 +189,10 @@ class Triggers(Part):
         for target in self.state.ends.get(key, ()):
             self.terminate_all(target.id, f"end trigger {kind}:{name}")
 
-    def _send(self, key: tuple[str, str], data: Mapping[str, Any] | None,
-              inst: ProcessInstance | None, act: CompiledActivity | None) -> None:
-        """A message goes to exactly one receiver (BPMN 2.0 §9.3, message flow):
+    def send(self, key: tuple[str, str], data: Mapping[str, Any] | None,
+             inst: ProcessInstance | None, act: CompiledActivity | None) -> None:
+        """A message goes to exactly one receiver (BPMN 2.0 §9.3, message flow; after
+        :meth:`broadcast`'s trace event, and from a plan, which writes that event itself):
 
         * a *reply* — thrown by an instance that a message started, named like a message
           the starting workflow catches — goes to that starting instance only: to the
@@ -204,30 +205,29 @@ class Triggers(Part):
         """
         table = self.state.waiters.get(key)
         partner = inst.partner if inst is not None else None
-        if partner is not None and partner.process.id in self.state.compiled.catchers.get(key, ()):
-            if table:
-                for token, entry in list(table.items()):
-                    ai = entry[0]
-                    if ai.state == RUNNING and ai.frame.inst.root == partner.id:
-                        self._hand(table, token, entry, data)
-                        return
+        # a reply: the id of the instance it answers (None: any other message)
+        answers = (partner.id if partner is not None
+                   and partner.process.id in self.state.compiled.catchers.get(key, ())
+                   else None)
+        if table:
+            # the first running waiter (of a reply, in the instance it answers) is handed
+            # the message; no copy of the table: the loop ends at the first one handed it
+            for token, entry in table.items():
+                ai = entry[0]
+                if ai.state == RUNNING and (answers is None or ai.frame.inst.root == answers):
+                    _ai, handler, (arg, persistent, _key, _token) = entry
+                    if not persistent:
+                        table.pop(token, None)
+                    handler(ai, arg, data)
+                    return
+        if answers is not None:
+            assert partner is not None
             if partner.state in (RUNNING, SUSPENDED):
                 self._keep(key, data, inst, act, partner)
             else:
                 self._lose(key, inst, act, f"the instance it answers ({partner.process.id} "
                            f"#{partner.id}) has ended")
             return
-        if table:
-            # (no copy of the table: the loop ends at the first waiter handed the message)
-            for token, entry in table.items():
-                ai = entry[0]
-                if ai.state == RUNNING:
-                    # _hand in line (a Python frame a message from source)
-                    _ai, handler, (arg, persistent, _key, _token) = entry
-                    if not persistent:
-                        table.pop(token, None)
-                    handler(ai, arg, data)
-                    return
         kind, name = key
         started = False
         state = self.state
@@ -251,14 +251,6 @@ class Triggers(Part):
                 ended = True
         if not ended:
             self._keep(key, data, inst, act, None)
-
-    def _hand(self, table: dict[int, tuple[ActivityInstance, Any, Any]], token: int,
-              entry: tuple[ActivityInstance, Any, Any], data: Mapping[str, Any] | None
-              ) -> None:
-        ai, handler, (arg, persistent, _key, _token) = entry
-        if not persistent:
-            table.pop(token, None)
-        handler(ai, arg, data)
 
     def _keep(self, key: tuple[str, str], data: Mapping[str, Any] | None,
               inst: ProcessInstance | None, act: CompiledActivity | None,
