@@ -131,7 +131,6 @@ class Writer(WaitingCode):
             "OpspecError": OpspecError, "RUNNING": RUNNING, "SUSPENDED": SUSPENDED,
             "STARTED": EK.ACTIVITY_STARTED, "COMPLETED": EK.ACTIVITY_COMPLETED,
             "CHANGED": EK.DATA_CHANGED, "OFFERED": EK.ACTIVITY_OFFERED, "DONE": COMPLETED,
-            "RAISED": EK.TRIGGER_RAISED,
             "ACTIVITY": ActivityInstance, "ITEM": WorkItem, "PROXY": MappingProxyType,
             "ENDED": ENDED, "ENDED_KIND": EK.PROCESS_COMPLETED, "IN": ParameterMode.IN,
             "INSTANCE": ProcessInstance, "SCOPE": Scope, "DEADLINES": process_deadlines,
@@ -199,14 +198,16 @@ class Writer(WaitingCode):
             if not act.simple_end and act.end_assign:
                 self.assign(act, act.end_assign, pad, out)
             if act.kind == K_THROW and act.trigger is not None:     # (Flow.done_next's)
-                out += self.raised(act.trigger, act, pad)
+                out.append(f"{pad}flow.triggers.broadcast({self.trigger(act.trigger)}, "
+                           f"None, inst, {a})")
             out += [f"{pad}cached = {a}.flag_cache",
                     f"{pad}if (cached.bits if cached.key is state.flag_key "
                     f"else state.act_bits({a})) & 2:",
                     f"{pad}    state.emit(COMPLETED, {fields})"]
             if act.raises is not None:
                 out += [f"{pad}if inst.state == RUNNING:",
-                        *self.raised(act.raises, act, pad + "    ")]
+                        (f"{pad}    flow.triggers.broadcast({self.trigger(act.raises)}, "
+                         f"None, inst, {a})")]
             if not act.simple_end:
                 out += [f"{pad}if inst.state != RUNNING:", f"{pad}    return"]
         path = (*path, index)
@@ -221,24 +222,6 @@ class Writer(WaitingCode):
     def trigger(self, trig: CTrigger) -> str:
         """A thrown or raised trigger's kind and name, as ``Triggers.broadcast`` takes them."""
         return f"{self.name('G', trig.kind)}, {self.name('G', trig.name or '')}"
-
-    def raised(self, trig: CTrigger, act: CompiledActivity, pad: str) -> list[str]:
-        """``Triggers.broadcast(kind, name, None, inst, act)`` of the trigger ``act`` throws
-        or raises; a message's steps before ``Triggers.send`` in line (the name noted as
-        raised, the trace event), the message then sent by its key."""
-        a = f"A{act.index}"
-        self.names[a] = act
-        if trig.kind != "message":
-            return [f"{pad}flow.triggers.broadcast({self.trigger(trig)}, None, inst, {a})"]
-        kind, name = self.name("G", trig.kind), self.name("G", trig.name or "")
-        return [f"{pad}state.raised_names.add({name})",
-                f"{pad}cached = {a}.flag_cache",
-                (f"{pad}if (cached.bits if cached.key is state.flag_key "
-                 f"else state.act_bits({a})) & 16:"),
-                (f"{pad}    state.emit(RAISED, {self.fields(act)}, "
-                 f"{{\"trigger\": {kind}, \"name\": {name}}})"),
-                (f"{pad}flow.triggers.send({self.name('Q', (trig.kind, trig.name or ''))}, "
-                 f"None, inst, {a})")]
 
     def fields(self, act: CompiledActivity) -> str:
         """The arguments of ``act``'s trace events after their kind."""

@@ -152,7 +152,7 @@ class Triggers(Part):
     def broadcast(self, kind: str, name: str, data: Mapping[str, Any] | None,
                   inst: ProcessInstance | None = None, act: CompiledActivity | None = None
                   ) -> None:
-        """Raise a signal or send a message (see :meth:`send`).
+        """Raise a signal or send a message (see :meth:`_send`).
 
         A *signal* reaches everything waiting for it now and is not kept: catch events,
         event-gateway branches, boundary events, start and end triggers.
@@ -172,7 +172,7 @@ class Triggers(Part):
                       {"trigger": kind, "name": name, **(dict(data) if data else {})})
         key = (kind, name)
         if kind == "message":
-            self.send(key, data, inst, act)
+            self._send(key, data, inst, act)
             return
         table = self.state.waiters.get(key)
         if table:
@@ -189,10 +189,9 @@ class Triggers(Part):
         for target in self.state.ends.get(key, ()):
             self.terminate_all(target.id, f"end trigger {kind}:{name}")
 
-    def send(self, key: tuple[str, str], data: Mapping[str, Any] | None,
-             inst: ProcessInstance | None, act: CompiledActivity | None) -> None:
-        """A message goes to exactly one receiver (BPMN 2.0 §9.3, message flow; after
-        :meth:`broadcast`'s trace event, and from a plan, which writes that event itself):
+    def _send(self, key: tuple[str, str], data: Mapping[str, Any] | None,
+              inst: ProcessInstance | None, act: CompiledActivity | None) -> None:
+        """A message goes to exactly one receiver (BPMN 2.0 §9.3, message flow):
 
         * a *reply* — thrown by an instance that a message started, named like a message
           the starting workflow catches — goes to that starting instance only: to the
