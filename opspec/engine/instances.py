@@ -72,7 +72,10 @@ class ProcessInstance:
                  scope: MutableMapping[str, Any], priority: int,
                  parent: ActivityInstance | None, root: int, started_at: float,
                  state: int = NOT_STARTED, trigger: str | None = None) -> None:
-        self.id = id
+        # (an object, as ActivityInstance.key: compiled, an ``int`` field is a C integer,
+        # boxed anew at each use as the run's ``live`` table's key, found there by value;
+        # boxed once here, its insertion and deletion use the one object)
+        self.id: Any = id
         self.process = process
         self.data = data
         self.scope = scope
