@@ -170,7 +170,12 @@ class RoomState:
         """World.advance's steps to ``now`` (nothing when the world is there already)."""
         if not self.time < now - 1e-12:
             return DONE
-        v, w = COMMANDS.get(self.command, STILL)
+        # (STILL only for a command it does not know: compiled, a default handed to the
+        # get is the constant boxed anew, a tuple and two floats at every call)
+        motion = COMMANDS.get(self.command)
+        if motion is None:
+            motion = STILL
+        v, w = motion
         if abs(w) >= 1e-12:
             if v != 0.0:
                 return ARC
