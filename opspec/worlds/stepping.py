@@ -28,6 +28,9 @@ COLLISION: Final = 2     # a contact began at this step
 ARC: Final = 3           # a command that drives and turns at once: the room steps it
 
 STILL: Final = (0.0, 0.0)    # Robot.velocity() of a command it does not know
+#: robot.COMMANDS as a static of this module: compiled, a name imported from a module that
+#: is not compiled is looked up in this module's globals at each use (once a device use)
+_COMMANDS: Final = COMMANDS
 
 Key = tuple[int, int, int, int]
 #: a floor cell (x, y), typed as a tuple of any length so that compiled code keeps it one
@@ -172,7 +175,7 @@ class RoomState:
             return DONE
         # (STILL only for a command it does not know: compiled, a default handed to the
         # get is the constant boxed anew, a tuple and two floats at every call)
-        motion = COMMANDS.get(self.command)
+        motion = _COMMANDS.get(self.command)
         if motion is None:
             motion = STILL
         v, w = motion
