@@ -27,7 +27,11 @@ COVER: Final = 1         # this step covered new cells (``new_cells``), to be tr
 COLLISION: Final = 2     # a contact began at this step
 ARC: Final = 3           # a command that drives and turns at once: the room steps it
 
-STILL: Final = (0.0, 0.0)    # Robot.velocity() of a command it does not know
+#: Robot.velocity() of a command it does not know, as one Python object: compiled, a
+#: ``tuple[float, float]`` constant is two C doubles, boxed anew (a tuple and two floats)
+#: wherever it is used as an object, and mypyc 2.4 inverts the check of its read where it
+#: is assigned (it raised "value for final name was not set")
+STILL: Final[tuple[float, ...]] = (0.0, 0.0)
 #: robot.COMMANDS as a static of this module: compiled, a name imported from a module that
 #: is not compiled is looked up in this module's globals at each use (once a device use)
 _COMMANDS: Final = COMMANDS
@@ -164,7 +168,7 @@ class RoomState:
 
     # the robot's interface (opspec.worlds.robot.Robot), for _step and the worlds' tests
     def velocity(self) -> tuple[float, float]:
-        return COMMANDS.get(self.command, STILL)
+        return COMMANDS.get(self.command, (0.0, 0.0))     # (Robot.velocity's)
 
     def pose_after(self, dt: float) -> tuple[float, float, float]:
         return pose_after(self.x, self.y, self.heading, self.command, dt)
@@ -173,10 +177,8 @@ class RoomState:
         """World.advance's steps to ``now`` (nothing when the world is there already)."""
         if not self.time < now - 1e-12:
             return DONE
-        # (STILL only for a command it does not know: compiled, a default handed to the
-        # get is the constant boxed anew, a tuple and two floats at every call)
-        motion = _COMMANDS.get(self.command)
-        if motion is None:
+        motion: tuple[float, ...] | None = _COMMANDS.get(self.command)
+        if motion is None:                  # (no default to the get: see STILL)
             motion = STILL
         v, w = motion
         if abs(w) >= 1e-12:
