@@ -83,6 +83,8 @@ def coord_of(act: CompiledActivity, spec: CoordinationBuiltIn) -> Coord:
 
 #: a field of neither map (:func:`inputs_of`)
 _MISSING: Final = object()
+#: the values of a built-in without inputs (:func:`at_once`; never changed)
+_NO_VALUES: Final[list[Any]] = []
 
 
 def inputs_of(scope: MutableMapping[str, Any], inputs: tuple[str, ...]) -> list[Any]:
@@ -123,10 +125,12 @@ def at_once(acts: Activities, frame: Frame, act: CompiledActivity) -> bool:
         return _NOT_NOW
     built = coord_of(act, spec)
     kind = built.kind
-    try:                                    # ActivityInstance.scope without its locals
-        values = inputs_of(inst.scope, built.inputs)
-    except KeyError:
-        return _NOT_NOW
+    values = _NO_VALUES
+    if built.inputs:                        # (a pull reads none: no list made for it)
+        try:                                # ActivityInstance.scope without its locals
+            values = inputs_of(inst.scope, built.inputs)
+        except KeyError:
+            return _NOT_NOW
     result: Any = None
     box: deque[Any] | None = None
     if kind == ARBITER:
@@ -179,7 +183,12 @@ def first_set(commands: list[Any]) -> Any:
     """:func:`coordination.arbiter`, compiled (that module is not: a call into it through
     Python's protocol is 1.2k instructions, once a period on a robot)."""
     for command in commands:
-        if command is not None and command != "":
+        if isinstance(command, str):
+            # (a string is set when not empty: its length read, where ``!= ""`` is a
+            # comparison through Python's protocol, about three an arbiter's run)
+            if len(command) > 0:
+                return command
+        elif command is not None and command != "":
             return command
     return None
 

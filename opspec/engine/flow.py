@@ -93,7 +93,7 @@ class Flow(Part):
                                    state.now, RUNNING, trigger)
             inst.depth = caller.depth + 1
             inst.partner = caller.partner
-        state.live[iid] = inst
+        state.live[inst.id] = inst          # (the id boxed once, by the instance)
         state.started += 1
         cached = proc.flag_cache              # RunState.proc_bits's cached case, in line
         if (cached.bits if cached.key is state.flag_key else state.proc_bits(proc)) & 1:
@@ -159,7 +159,7 @@ class Flow(Part):
         inst.frames.clear()          # breaks the instance <-> frame cycle: freed by refcount
         state = self.state
         live = state.live            # RunState.gone, in line
-        key: object = inst.id        # (boxed once: see ActivityInstance.leave)
+        key = inst.id                # (boxed once: see ProcessInstance.__init__)
         if key in live:
             del live[key]
         if state.kept and inst.parent is None:

@@ -72,7 +72,10 @@ class ProcessInstance:
                  scope: MutableMapping[str, Any], priority: int,
                  parent: ActivityInstance | None, root: int, started_at: float,
                  state: int = NOT_STARTED, trigger: str | None = None) -> None:
-        self.id = id
+        # (an object, as ActivityInstance.key: compiled, an ``int`` field is a C integer,
+        # boxed anew at each use as the run's ``live`` table's key, found there by value;
+        # boxed once here, its insertion and deletion use the one object)
+        self.id: Any = id
         self.process = process
         self.data = data
         self.scope = scope
@@ -158,7 +161,10 @@ class Frame:
         # allocation and release per process instance)
         self.joins: dict[int, list[int]] | None = None
         self.ors: dict[int, list[int]] | None = None
-        self.running: dict[int, ActivityInstance] = {}
+        # (keyed by ``Any``, not ``int``: compiled, a deletion from a ``dict[int, ...]`` turns
+        # its key into a C integer and boxes it anew, found then by value; the activity
+        # instances' keys are boxed once, see ActivityInstance.__init__)
+        self.running: dict[Any, ActivityInstance] = {}
         # complex joins: tokens per incoming slot, and the slots owed a token before the
         # join resets (after it fired; BPMN's "waiting for reset"); made when first needed
         # (a frame per instance: most never have a complex join)
@@ -240,11 +246,11 @@ class ActivityInstance:
         self.state = state
         self.gen += 1
         # (``in`` and ``del``, not ``pop(key, None)``: compiled, a dict's pop is a Python
-        # method call, the others are primitives; the key is boxed once, as an ``object``:
-        # compiled, an ``int`` field is a C integer, and each use as a dictionary key would
-        # make a new Python int that the dictionary compares by value, not by identity)
+        # method call, the others are primitives; the key is the one object boxed in
+        # ``__init__``, found by identity, kept ``Any`` here: compiled, a local annotated
+        # ``object`` was turned back into a C integer for the deletion and boxed anew)
         running = self.frame.running
-        key: object = self.key
+        key = self.key
         if key in running:
             del running[key]
         if self.cleanup:

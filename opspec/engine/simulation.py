@@ -204,7 +204,8 @@ class Simulation(Interpreter):
                                  hint="known: " + ", ".join(sorted(self.processes)))
         inst = self.start_process(proc, data, trigger="api")    # (reads the clock)
         self.drain()
-        return inst.id
+        iid: int = inst.id
+        return iid
 
     def raise_trigger(self, name: str, data: Mapping[str, Any] | None = None) -> None:
         """Raise ``message:NAME``, ``signal:NAME`` or a bare NAME (a message), now."""

@@ -16,8 +16,8 @@ from typing import Any, Final
 
 from opspec.worlds.robot import COMMANDS, pose_after
 
-__all__ = ["ARC", "COLLISION", "COVER", "DONE", "STEP_S", "Normals", "RoomState", "cells_of",
-           "cover", "distance_ahead", "round4"]
+__all__ = ["ARC", "COLLISION", "COVER", "DONE", "STEP_S", "Grown", "Normals", "RayBox",
+           "RoomState", "Sides", "cells_of", "cover", "distance_ahead", "round4"]
 
 #: integration step: 5 cm at 1 m/s, well under the robot's size
 STEP_S: Final = 0.05
@@ -27,7 +27,14 @@ COVER: Final = 1         # this step covered new cells (``new_cells``), to be tr
 COLLISION: Final = 2     # a contact began at this step
 ARC: Final = 3           # a command that drives and turns at once: the room steps it
 
-STILL: Final = (0.0, 0.0)    # Robot.velocity() of a command it does not know
+#: Robot.velocity() of a command it does not know, as one Python object: compiled, a
+#: ``tuple[float, float]`` constant is two C doubles, boxed anew (a tuple and two floats)
+#: wherever it is used as an object, and mypyc 2.4 inverts the check of its read where it
+#: is assigned (it raised "value for final name was not set")
+STILL: Final[tuple[float, ...]] = (0.0, 0.0)
+#: robot.COMMANDS as a static of this module: compiled, a name imported from a module that
+#: is not compiled is looked up in this module's globals at each use (once a device use)
+_COMMANDS: Final = COMMANDS
 
 Key = tuple[int, int, int, int]
 #: a floor cell (x, y), typed as a tuple of any length so that compiled code keeps it one
@@ -38,6 +45,35 @@ Cells = tuple[Cell, ...]
 #: a box as the range finder meets it: its sides, then the 1e-9 tolerance
 #: ``ray_to_box_along`` puts around them (y0 - 1e-9, y1 + 1e-9, x0 - 1e-9, x1 + 1e-9)
 RayBox = tuple[float, float, float, float, float, float, float, float]
+
+
+# The fixed geometry that each step (``RoomState.resume``) or each range reading
+# (``distance_ahead``) reads, as objects of compiled floats: compiled, a tuple of floats is
+# unboxed float by float at each unpacking (eight reads of an obstacle's four sides a step
+# in a room of two obstacles, 24 a reading of three boxes), a field of these is read as it is
+class Grown:
+    """An obstacle grown by the robot's radius: the box its centre may not enter."""
+
+    def __init__(self, x0: float, x1: float, y0: float, y1: float) -> None:
+        self.x0 = x0
+        self.x1 = x1
+        self.y0 = y0
+        self.y1 = y1
+
+
+class Sides:
+    """A :data:`RayBox`: a box's sides as the range finder meets them, then those sides
+    with the 1e-9 tolerance around them."""
+
+    def __init__(self, box: RayBox) -> None:
+        self.x0 = box[0]
+        self.y0 = box[1]
+        self.x1 = box[2]
+        self.y1 = box[3]
+        self.y0_lo = box[4]
+        self.y1_hi = box[5]
+        self.x0_lo = box[6]
+        self.x1_hi = box[7]
 
 
 class RoomState:
@@ -63,12 +99,12 @@ class RoomState:
         self.x_hi = 0.0
         self.y_lo = 0.0
         self.y_hi = 0.0
-        self.grown: list[tuple[float, float, float, float]] = []
+        self.grown: list[Grown] = []
         self.reach = 0.0
         self.cell = 0.0
         self.inv = 0.0          # 1 / cell where cells_of may multiply by it (see place)
         self.radius = 0.0
-        self.boxes: tuple[RayBox, ...] = ()
+        self.boxes: tuple[Sides, ...] = ()
         self.uncovered: dict[Key, Cells] = {}
         self.covered: set[Cell] = set()
         self.cells_x = 0
@@ -113,7 +149,7 @@ class RoomState:
         self.x_hi = inside[1]
         self.y_lo = inside[2]
         self.y_hi = inside[3]
-        self.grown = grown
+        self.grown = [Grown(g[0], g[1], g[2], g[3]) for g in grown]
         self.reach = reach
         self.radius = reach
         self.cell = cell
@@ -123,7 +159,7 @@ class RoomState:
         bound = max(abs(inside[0]), abs(inside[1]), abs(inside[2]), abs(inside[3])) + reach
         self.inv = (1.0 / cell if math.frexp(cell)[0] == 0.5 and 2.0 ** -20 <= cell <= 1.0
                     and bound < 1e290 else 0.0)
-        self.boxes = boxes
+        self.boxes = tuple([Sides(box) for box in boxes])
         self.uncovered = uncovered
         self.near = False
         self.covered = covered
@@ -132,7 +168,7 @@ class RoomState:
 
     # the robot's interface (opspec.worlds.robot.Robot), for _step and the worlds' tests
     def velocity(self) -> tuple[float, float]:
-        return COMMANDS.get(self.command, STILL)
+        return COMMANDS.get(self.command, (0.0, 0.0))     # (Robot.velocity's)
 
     def pose_after(self, dt: float) -> tuple[float, float, float]:
         return pose_after(self.x, self.y, self.heading, self.command, dt)
@@ -141,7 +177,10 @@ class RoomState:
         """World.advance's steps to ``now`` (nothing when the world is there already)."""
         if not self.time < now - 1e-12:
             return DONE
-        v, w = COMMANDS.get(self.command, STILL)
+        motion: tuple[float, ...] | None = _COMMANDS.get(self.command)
+        if motion is None:                  # (no default to the get: see STILL)
+            motion = STILL
+        v, w = motion
         if abs(w) >= 1e-12:
             if v != 0.0:
                 return ARC
@@ -222,8 +261,8 @@ class RoomState:
                 continue
             free = self.x_lo <= nx <= self.x_hi and self.y_lo <= ny <= self.y_hi
             if free:
-                for gx0, gx1, gy0, gy1 in self.grown:
-                    if gx0 <= nx <= gx1 and gy0 <= ny <= gy1:
+                for g in self.grown:
+                    if g.x0 <= nx <= g.x1 and g.y0 <= ny <= g.y1:
                         free = False
                         break
             if free:
@@ -361,7 +400,7 @@ class Normals:
         self.before = None
 
 
-def distance_ahead(x: float, y: float, heading: float, boxes: tuple[RayBox, ...]) -> float:
+def distance_ahead(x: float, y: float, heading: float, boxes: tuple[Sides, ...]) -> float:
     """``ray_to_box_along`` to the room's walls from inside (``boxes[0]``), then to each
     obstacle's faces from outside, the nearest of them: the same arithmetic in one loop (the
     range finder of :class:`~opspec.worlds.room.RoomWorld`)."""
@@ -371,24 +410,28 @@ def distance_ahead(x: float, y: float, heading: float, boxes: tuple[RayBox, ...]
     along_y = abs(dy) > 1e-12
     best = math.inf
     inside = True
-    for x0, y0, x1, y1, y0_lo, y1_hi, x0_lo, x1_hi in boxes:
+    for box in boxes:
+        x0 = box.x0
+        y0 = box.y0
+        x1 = box.x1
+        y1 = box.y1
         if not inside and x0 <= x <= x1 and y0 <= y <= y1:
             best = 0.0 if 0.0 < best else best      # min(best, 0.0): touching an obstacle
             continue
         nearest = math.inf
         if along_x:
             t = (x0 - x) / dx
-            if t > 1e-9 and y0_lo <= y + t * dy <= y1_hi and t < nearest:
+            if t > 1e-9 and box.y0_lo <= y + t * dy <= box.y1_hi and t < nearest:
                 nearest = t
             t = (x1 - x) / dx
-            if t > 1e-9 and y0_lo <= y + t * dy <= y1_hi and t < nearest:
+            if t > 1e-9 and box.y0_lo <= y + t * dy <= box.y1_hi and t < nearest:
                 nearest = t
         if along_y:
             t = (y0 - y) / dy
-            if t > 1e-9 and x0_lo <= x + t * dx <= x1_hi and t < nearest:
+            if t > 1e-9 and box.x0_lo <= x + t * dx <= box.x1_hi and t < nearest:
                 nearest = t
             t = (y1 - y) / dy
-            if t > 1e-9 and x0_lo <= x + t * dx <= x1_hi and t < nearest:
+            if t > 1e-9 and box.x0_lo <= x + t * dx <= box.x1_hi and t < nearest:
                 nearest = t
         if inside:
             best = nearest
