@@ -54,6 +54,9 @@ from opspec.engine.clock import Clock
 from opspec.engine.zero_time import SAMPLE_STEPS
 
 if TYPE_CHECKING:
+    # (a native 64-bit integer compiled; from source only an annotation: no import)
+    from mypy_extensions import i64
+
     from opspec.engine.compiled import CTrigger
 
 __all__ = ["Timed", "Timers", "exact_delay", "heap_pop", "heap_push", "occurrences"]
@@ -476,8 +479,9 @@ def line_push(line: list[Timed], entry: Timed) -> None:
     (docs/engine-performance.md, the deadlines pass)."""
     at = entry.at
     seq = entry.seq
-    lo = 0
-    hi = len(line)
+    # (i64: compiled, the bounds are machine integers, no tagged-int arithmetic or checks)
+    lo: i64 = 0
+    hi: i64 = len(line)
     while lo < hi:
         mid = (lo + hi) >> 1
         other = line[mid]
