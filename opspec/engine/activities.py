@@ -274,11 +274,17 @@ class Activities(Part):
         act = ai.act
         kind = act.kind
         inst = ai.frame.inst
+        app = act.application
+        apps = self.state.apps
+        # a task's performer, looked up once: the application's name is equal to the
+        # registry's key but not the same string, so each look-up compares the text
+        performer = (apps.get(app) if kind == K_TASK and app is not None
+                     and not act.toolchain else None)
         if kind == K_TASK and act.toolchain:
             tools.run(self, ai, 0)
-        elif kind == K_MANUAL or (kind == K_TASK and act.application in self.state.apps):
-            performer = (self.state.apps[act.application or ""] if kind == K_TASK
-                         else self.offers.performer_for(act))
+        elif kind == K_MANUAL or performer is not None or (kind == K_TASK and app in apps):
+            if kind == K_MANUAL:
+                performer = self.offers.performer_for(act)
             if performer is None:
                 ai.waiting = (f"performer for participant {act.participant!r}"
                               f" / lanes {', '.join(act.lanes) or '-'}")
