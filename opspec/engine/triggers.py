@@ -525,6 +525,10 @@ class _Timer(Timed):
         # modes they were found in: a firing tests the mode without a call of is_active
         self.modes: object = None
         self.member: tuple[str, ...] = ()
+        # the mode last tested (the very object) and whether the workflow runs in it: the
+        # mode changes seldom, so a firing mostly tests one identity, not the tuple
+        self.mode: object = None
+        self.runs = True
         if starts is not None:
             self.proc, self.start = starts
         now = triggers.state.now
@@ -564,11 +568,15 @@ class _Timer(Timed):
         if proc is not None:
             # Triggers._triggered_start, the workflow's modes kept here
             modes = state.compiled.modes
-            if modes is not self.modes:
-                self.member = triggers.mode_members(proc.id)
-                self.modes = modes
-            member = self.member
-            if not member or state.mode in member:
+            mode = state.mode
+            if modes is not self.modes or mode is not self.mode:
+                if modes is not self.modes:
+                    self.member = triggers.mode_members(proc.id)
+                    self.modes = modes
+                member = self.member
+                self.runs = not member or mode in member
+                self.mode = mode
+            if self.runs:
                 triggers.flow.start_process(proc, trigger=self.label, start=self.start)
         else:
             self.fire(self.label)
