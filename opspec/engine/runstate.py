@@ -62,6 +62,9 @@ from opspec.engine.zero_time import max_instant_steps as _max_instant_steps
 from opspec.model import Package
 
 if TYPE_CHECKING:
+    # (a native 64-bit integer compiled; from source only an annotation: no import)
+    from mypy_extensions import i64
+
     from opspec.engine.flow import Flow
 
 __all__ = ["RunState", "discard"]
@@ -121,10 +124,10 @@ class RunState(Timers):
         self.kept: dict[tuple[int, tuple[str, str]],
                          deque[tuple[Mapping[str, Any] | None, float]]] = {}
         self.lost_messages = 0
-        # the zero-time cycle guard (see drain)
+        # the zero-time cycle guard (see drain; its counts i64: machine integers compiled)
         self.instant = -1.0
-        self.instant_steps = 0
-        self.max_instant_steps = _max_instant_steps()
+        self.instant_steps: i64 = 0
+        self.max_instant_steps: i64 = _max_instant_steps()
         self.sampler: ZeroTimeSampler | None = None
         self.start_limit = self.max_instant_steps    # 0 while a sampler names the cycle
         # workflow instances started at one instant (each holds memory until it ends: a
@@ -287,7 +290,7 @@ class RunState(Timers):
             self.instant_steps = steps
             return
         self.draining = True
-        done = 0                    # the items of ``ready`` run so far
+        done: i64 = 0               # the items of ``ready`` run so far
         steps = self.instant_steps + 1
         limit = self.max_instant_steps
         base = steps                # (the step count is base + done while items run)
@@ -302,7 +305,7 @@ class RunState(Timers):
                 # (a list's iterator sees what is appended meanwhile) ``check``: the first
                 # ``done`` at which the count passes the limit or the burst is long
                 base = steps
-                check = limit - base + 1 if limit - base < _COMPACT else _COMPACT + 1
+                check: i64 = limit - base + 1 if limit - base < _COMPACT else _COMPACT + 1
                 for fn, a, b, c in ready:
                     done += 1
                     if done >= check:
@@ -338,15 +341,16 @@ class RunState(Timers):
             self.draining = False
             self.instant_steps = steps
 
-    def _past_check(self, base: int, done: int, a: Any, b: Any) -> tuple[int, int]:
+    def _past_check(self, base: i64, done: i64, a: Any, b: Any) -> tuple[i64, i64]:
         """:meth:`drain`'s count passed the limit at its item ``done`` (``a``, ``b``): the
         count's new base and the next ``done`` to look at (:meth:`_past_limit`)."""
         steps = self._past_limit(base + done, a, b)
         base = steps - done
         limit = self.max_instant_steps
-        return base, (limit - base + 1 if limit - base < _COMPACT else _COMPACT + 1)
+        check: i64 = limit - base + 1 if limit - base < _COMPACT else _COMPACT + 1
+        return base, check
 
-    def _past_limit(self, steps: int, a: Any, b: Any) -> int:
+    def _past_limit(self, steps: i64, a: Any, b: Any) -> i64:
         """The step count passed the limit: a new count if the clock moved since the count
         began, else a step of a zero-time cycle (see :meth:`zero_time`)."""
         now = self.now
