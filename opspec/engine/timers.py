@@ -79,7 +79,7 @@ class Timed:
     instead of by the tuple protocol)."""
 
     at: float
-    seq: int
+    seq: i64                    # (machine integers compiled, as Timers.order)
 
     def go(self) -> None:
         raise NotImplementedError
@@ -144,7 +144,7 @@ class Timers:
         if isinstance(clock, Clock) and clock.owner is None:
             clock.owner = self
             self.heaped = True
-        self.order = 0              # the sequence of the heap's entries
+        self.order: i64 = 0         # the sequence of the heap's entries
         self.armed_at = INF         # the time of the driver that is valid, if any
         self.driver = 0             # which driver is valid
         self.ticking = False        # a driver is running entries
