@@ -15,7 +15,7 @@ import math
 from collections import deque
 from collections.abc import Callable, Iterable, Iterator, Mapping
 from functools import partial
-from typing import Any, final
+from typing import TYPE_CHECKING, Any, final
 
 from opspec.engine.compiled import (
     CompiledActivity,
@@ -34,6 +34,10 @@ from opspec.engine.runstate import discard
 from opspec.engine.timers import TUPLES, Timed, occurrences
 from opspec.engine.trace import EventKind as EK
 from opspec.errors import OpspecError
+
+if TYPE_CHECKING:
+    # (a native 64-bit integer compiled; from source only an annotation: no import)
+    from mypy_extensions import i64
 
 #: Messages of one name kept with nobody waiting (per receiving instance, or for anyone).
 MESSAGE_BUFFER = 100
@@ -538,8 +542,9 @@ class _Timer(Timed):
         self.times: Iterator[float] | None = None if self.periodic else occurrences(trig, now)
         self.offset = trig.offset
         self.every = every
-        self.count = trig.count
-        self.k = max(0, math.ceil((now - trig.offset) / every)) if self.periodic else 0
+        # (i64: a firing's count and test in machine integers compiled)
+        self.count: i64 = trig.count
+        self.k: i64 = max(0, math.ceil((now - trig.offset) / every)) if self.periodic else 0
 
     def arm(self) -> None:
         times = self.times
@@ -547,7 +552,7 @@ class _Timer(Timed):
             k = self.k
             if 0 <= self.count <= k:
                 return
-            at = self.offset + k * self.every
+            at = self.offset + float(k) * self.every   # (k * every: the same float)
             self.k = k + 1
         else:
             following = next(times, None)
