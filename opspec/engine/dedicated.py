@@ -10,8 +10,13 @@ burst here (a robot spec: 54,000 an hour), which from :mod:`opspec.engine.proces
 from __future__ import annotations
 
 import heapq
+from typing import TYPE_CHECKING
 
 from opspec.engine.timers import LINE_MAX, LINE_MIN, TUPLES
+
+if TYPE_CHECKING:
+    # (a native 64-bit integer compiled; from source only an annotation: no import)
+    from mypy_extensions import i64
 
 __all__ = ["DedicatedProcessor"]
 
@@ -51,8 +56,8 @@ class DedicatedProcessor:
         elif self._lined:
             while ends and ends[-1] <= now:
                 ends.pop()
-            lo = 0
-            hi = len(ends)
+            lo: i64 = 0                 # (as timers.line_push's bisection)
+            hi: i64 = len(ends)
             while lo < hi:
                 mid = (lo + hi) >> 1
                 if ends[mid] > end:
