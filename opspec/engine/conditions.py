@@ -39,6 +39,7 @@ Every problem raises :class:`opspec.errors.ExecutionError` quoting the condition
 
 from __future__ import annotations
 
+import sys
 import types
 from collections.abc import Callable, Mapping
 from typing import Any, Final
@@ -69,6 +70,7 @@ __all__ = [
     "constant_value",
     "evaluate",
     "evaluate_condition",
+    "field_name",
     "truthy",
 ]
 
@@ -76,6 +78,17 @@ CompiledExpression = Callable[[Mapping[str, Any], float], Any]
 """``f(data, now)``: the value of a compiled expression; ``now`` is the simulated time."""
 CompiledCondition = Callable[[Mapping[str, Any], float], bool]
 """``f(data, now)``: whether a compiled condition holds."""
+
+
+def field_name(name: str) -> str:
+    """``name`` as the one string object of its text (``sys.intern``): the names a run reads
+    and writes data fields by. A dictionary finds a key by identity before comparing the
+    text, so the compiled data dictionaries' keys, the assignments' targets, the names the
+    conditions read and the engine's own literals (interned by Python and by mypyc) meet
+    without a comparison of characters; otherwise the names parsed from the spec are
+    separate strings and each look-up compares them (about 300 instructions a robot's
+    workflow instance)."""
+    return sys.intern(name) if type(name) is str else name
 
 
 # --------------------------------------------------------------------------- errors
@@ -294,7 +307,7 @@ def _compile(expr: Expression) -> _Fn:
 
 
 def _compile_name(path: tuple[str, ...], whole: _Whole = None) -> _Fn:
-    root = path[0]
+    root = field_name(path[0])
     if len(path) == 1:
 
         def field(data: Mapping[str, Any], now: float) -> Any:
@@ -345,7 +358,7 @@ def _compile_binary(expr: Binary, whole: _Whole = None) -> _Fn:
             expr.right, Literal
         ):
             # "field + 1": the field read and the constant inlined
-            root, constant = expr.left.path[0], expr.right.value
+            root, constant = field_name(expr.left.path[0]), expr.right.value
 
             def field_arithmetic(data: Mapping[str, Any], now: float) -> Any:
                 try:
@@ -371,7 +384,7 @@ def _compile_equality(expr: Binary, left: _Fn, right: _Fn, whole: _Whole, *,
     if isinstance(expr.left, Name) and len(expr.left.path) == 1 and isinstance(
         expr.right, Literal
     ):
-        root, constant = expr.left.path[0], expr.right.value
+        root, constant = field_name(expr.left.path[0]), expr.right.value
         kind = type(constant)
 
         def field_equals(data: Mapping[str, Any], now: float) -> bool:
@@ -432,7 +445,7 @@ def _compile_ordering(expr: Binary, left: _Fn, right: _Fn, whole: _Whole) -> _Fn
         and type(constant) in (int, float)
     ):
         # "field < 3": the field read and the constant inlined, numbers compared directly.
-        root = expr.left.path[0]
+        root = field_name(expr.left.path[0])
 
         def field_ordering(data: Mapping[str, Any], now: float) -> bool:
             try:

@@ -15,6 +15,7 @@ from typing import TYPE_CHECKING, Any, Final, final
 
 from opspec.engine import coordination as coord
 from opspec.engine.compiled import CompiledActivity
+from opspec.engine.conditions import field_name
 from opspec.engine.instances import ActivityInstance, Frame
 from opspec.engine.lifecycle import RUNNING, SUSPENDED
 from opspec.engine.scope import Scope
@@ -58,9 +59,11 @@ class Coord:
         self.kind = (ARBITER if kind is _ARBITER else VOTER if kind is _VOTER
                      else SUPERPOSITION if kind is _SUPERPOSITION else PUSH
                      if kind is _PUSH_DATA else PULL if kind is _PULL_DATA else OTHER)
-        self.inputs: tuple[str, ...] = spec.inputs
-        self.output: str | None = spec.output
-        self.channel: str = spec.channel or act_id
+        # (the names interned: found by identity in the data and the mailboxes, see
+        # opspec.engine.conditions.field_name)
+        self.inputs: tuple[str, ...] = tuple(field_name(name) for name in spec.inputs)
+        self.output: str | None = None if spec.output is None else field_name(spec.output)
+        self.channel: str = field_name(spec.channel or act_id)
         self.waiting = f"pull from mailbox {self.channel!r}"
 
 

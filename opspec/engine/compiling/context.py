@@ -15,7 +15,7 @@ from typing import Any
 
 from opspec.clock import DURATION_HINT, try_duration
 from opspec.engine.compiled import CompiledGraph, CTool, CTrigger, Evaluator
-from opspec.engine.conditions import compile_condition, compile_expression
+from opspec.engine.conditions import compile_condition, compile_expression, field_name
 from opspec.engine.sampling import make_sampler
 from opspec.errors import OpspecError, SourceLocation, SpecError
 from opspec.model import (
@@ -270,7 +270,7 @@ class Context:
             expression = actual.expression
             if expression is None and IDENT.match(actual.text.strip()):
                 expression = Name(tuple(actual.text.strip().split(".")))
-            target = expression.path[0] if isinstance(expression, Name) else None
+            target = field_name(expression.path[0]) if isinstance(expression, Name) else None
             if mode is not ParameterMode.IN and target is None:
                 raise spec_error(
                     f"actual parameter {n + 1} of activity {act.id!r} ({actual.text!r}) must "
