@@ -67,20 +67,13 @@ class Coord:
         self.waiting = f"pull from mailbox {self.channel!r}"
 
 
-#: each coordination activity's :class:`Coord`, made at its first run (compiled activities
-#: are not changed after compilation; at most ``_COORDS_MAX`` kept, then made again)
-_COORDS: Final[dict[CompiledActivity, Coord]] = {}     # (Final: read natively, not by name)
-_COORDS_MAX: Final = 4096
-
-
 def coord_of(act: CompiledActivity, spec: CoordinationBuiltIn) -> Coord:
-    """``act``'s coordination built-in ``spec`` as a :class:`Coord`."""
-    found = _COORDS.get(act)
+    """``act``'s coordination built-in ``spec`` as a :class:`Coord`, made at its first run
+    and kept by the activity (``CompiledActivity.coord``; made again for another ``spec``)."""
+    found: Coord | None = act.coord
     if found is None or found.spec is not spec:
-        if len(_COORDS) >= _COORDS_MAX:
-            _COORDS.clear()
         found = Coord(spec, act.id)
-        _COORDS[act] = found
+        act.coord = found
     return found
 
 
