@@ -42,7 +42,7 @@ from __future__ import annotations
 import sys
 import types
 from collections.abc import Callable, Mapping
-from typing import Any, Final
+from typing import Any, Final, final
 
 from opspec.engine.condition_values import (
     ARITHMETIC,
@@ -65,6 +65,7 @@ from opspec.model.expressions import Binary, Call, Expression, Literal, Name, Un
 __all__ = [
     "CompiledCondition",
     "CompiledExpression",
+    "Constant",
     "compile_condition",
     "compile_expression",
     "constant_value",
@@ -206,9 +207,10 @@ def compile_expression(
         # a constant cannot fail: no wrapper (an assignment of a constant is common, and
         # from source each closure level is a Python call)
         value = expr.value
+        if COMPILED:        # (its value read natively where the engine runs assignments)
+            return Constant(value)
         constant = lambda data, now: value
-        if not COMPILED:    # the plans write the value where they would call this
-            constant.opspec_constant = (value,)  # type: ignore[attr-defined]
+        constant.opspec_constant = (value,)  # type: ignore[attr-defined]   # for the plans
         return constant
     try:
         own = _compile_root(expr, (expr, location))
@@ -225,6 +227,20 @@ def compile_expression(
             raise _fail(expr, problem, location, now) from None
 
     return run
+
+
+@final
+class Constant:
+    """A constant expression's function, compiled (:func:`compile_expression`): called, its
+    ``value``; ``Flow.assign`` reads the value without the call (compiled, a call of a
+    closure goes through Python's calling convention, the simulated time boxed for it:
+    about 150 instructions an assignment of a constant, two a robot's period)."""
+
+    def __init__(self, value: Any) -> None:
+        self.value = value
+
+    def __call__(self, data: Mapping[str, Any], now: float) -> Any:
+        return self.value
 
 
 def constant_value(evaluator: Callable[..., Any]) -> tuple[Any] | None:
