@@ -7,7 +7,6 @@ Each activity in a graph is compiled by the construct table of
 
 from __future__ import annotations
 
-import sys
 from collections.abc import Iterable
 from typing import Any
 
