@@ -92,6 +92,13 @@ def field_name(name: str) -> str:
     return sys.intern(name) if type(name) is str else name
 
 
+def _value(literal: Literal) -> Any:
+    """A literal's value, a string interned (:func:`field_name`): the values a constant
+    assignment writes are then found by identity where they are compared or looked up (a
+    robot's commands, ``COMMANDS[command]``)."""
+    return field_name(literal.value) if type(literal.value) is str else literal.value
+
+
 # --------------------------------------------------------------------------- errors
 
 
@@ -206,7 +213,7 @@ def compile_expression(
     if isinstance(expr, Literal):
         # a constant cannot fail: no wrapper (an assignment of a constant is common, and
         # from source each closure level is a Python call)
-        value = expr.value
+        value = _value(expr)
         if COMPILED:        # (its value read natively where the engine runs assignments)
             return Constant(value)
         constant = lambda data, now: value
@@ -304,7 +311,7 @@ def _compile_root(expr: Expression, whole: _Whole) -> _Fn | None:
 
 def _compile(expr: Expression) -> _Fn:
     if isinstance(expr, Literal):
-        value = expr.value
+        value = _value(expr)
         return lambda data, now: value
     if isinstance(expr, Name):
         return _compile_name(expr.path)
@@ -400,7 +407,7 @@ def _compile_equality(expr: Binary, left: _Fn, right: _Fn, whole: _Whole, *,
     if isinstance(expr.left, Name) and len(expr.left.path) == 1 and isinstance(
         expr.right, Literal
     ):
-        root, constant = field_name(expr.left.path[0]), expr.right.value
+        root, constant = field_name(expr.left.path[0]), _value(expr.right)
         kind = type(constant)
 
         def field_equals(data: Mapping[str, Any], now: float) -> bool:
@@ -420,7 +427,7 @@ def _compile_equality(expr: Binary, left: _Fn, right: _Fn, whole: _Whole, *,
         return field_equals
 
     if isinstance(expr.right, Literal):
-        fixed = expr.right.value
+        fixed = _value(expr.right)
         fixed_kind = type(fixed)
 
         def equals_constant(data: Mapping[str, Any], now: float) -> bool:

@@ -251,7 +251,8 @@ class Context:
                     f"script statement {a.text!r} of application {app.id!r}")))
                 known.add(a.target)
             script = tuple(statements)
-        return CTool(application=call.application, params=params, script=script)
+        # (the name interned: performers and worlds compare it with their literals)
+        return CTool(application=field_name(call.application), params=params, script=script)
 
 
     def params(self, actuals: tuple[Any, ...], formals: tuple[Any, ...], act: Activity,
