@@ -257,6 +257,10 @@ def constant_value(evaluator: Callable[..., Any]) -> tuple[Any] | None:
     return found
 
 
+#: the operators whose closures give a bool (see :func:`compile_condition`)
+_BOOLEAN: Final = frozenset({"==", "!=", "and", "or"})
+
+
 def compile_condition(
     expr: Expression | None, *, location: SourceLocation | None = None
 ) -> CompiledCondition:
@@ -265,9 +269,10 @@ def compile_condition(
     if expr is None:
         return lambda data, now: True
     try:
-        if isinstance(expr, Binary) and (expr.op in ("==", "!=") or expr.op in FAST_ORDERING):
-            # a comparison's closure gives a bool and, as the root, names the condition in
-            # its own errors: no wrapper (from source each closure level is a Python call)
+        if isinstance(expr, Binary) and (expr.op in _BOOLEAN or expr.op in FAST_ORDERING):
+            # a comparison's or a conjunction's closure gives a bool and, as the root, names
+            # the condition in its own errors: no wrapper (from source each closure level is
+            # a Python call; compiled, a call through Python's calling convention)
             return _compile_binary(expr, (expr, location))
         inner = _compile(expr)
     except ConditionProblem as problem:
@@ -351,24 +356,36 @@ def _compile_name(path: tuple[str, ...], whole: _Whole = None) -> _Fn:
 def _compile_binary(expr: Binary, whole: _Whole = None) -> _Fn:
     op = expr.op
     left, right = _compile(expr.left), _compile(expr.right)
+    # (``and`` and ``or`` give a bool: at a condition's root, ``whole``, they are the
+    # condition, naming it in their operands' errors as ``compile_condition``'s wrapper would)
     if op == "and":
 
         def both(data: Mapping[str, Any], now: float) -> bool:
-            a = left(data, now)
-            if not (a is True or (a is not False and truthy(a))):
-                return False
-            b = right(data, now)
-            return b is True or (b is not False and truthy(b))
+            try:
+                a = left(data, now)
+                if not (a is True or (a is not False and truthy(a))):
+                    return False
+                b = right(data, now)
+                return b is True or (b is not False and truthy(b))
+            except (ConditionProblem, *_PYTHON_ERRORS) as problem:
+                if whole is None:
+                    raise
+                raise _fail(whole[0], problem, whole[1], now) from None
 
         return both
     if op == "or":
 
         def either(data: Mapping[str, Any], now: float) -> bool:
-            a = left(data, now)
-            if a is True or (a is not False and truthy(a)):
-                return True
-            b = right(data, now)
-            return b is True or (b is not False and truthy(b))
+            try:
+                a = left(data, now)
+                if a is True or (a is not False and truthy(a)):
+                    return True
+                b = right(data, now)
+                return b is True or (b is not False and truthy(b))
+            except (ConditionProblem, *_PYTHON_ERRORS) as problem:
+                if whole is None:
+                    raise
+                raise _fail(whole[0], problem, whole[1], now) from None
 
         return either
     if op in ("==", "!="):
