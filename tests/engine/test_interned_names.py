@@ -48,7 +48,7 @@ def test_the_vacuum_cleaners_names_are_interned() -> None:
 
 
 def test_field_name_keeps_the_text() -> None:
-    text = "".join(["le", "vel"])               # a string of its own, not the literal
+    text = b"level".decode()                    # a string of its own, not the literal
     assert field_name(text) == "level" and field_name(text) is field_name("level")
 
 
