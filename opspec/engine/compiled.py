@@ -164,7 +164,8 @@ NO_FLAGS: Final = FlagCache(object(), 0)
 
 @dataclass(slots=True, eq=False)
 class CompiledActivity:
-    """One activity of a graph, ready to run. Not mutated after compilation."""
+    """One activity of a graph, ready to run. Not mutated after compilation but for the
+    caches a run fills (``flag_cache``, ``coord``)."""
 
     index: int
     id: str
@@ -237,6 +238,9 @@ class CompiledActivity:
     # which trace kinds the run's listeners want of it, as bits, with the selection they were
     # computed for (RunState.act_bits): one attribute read on the hot path, not a lookup
     flag_cache: FlagCache = NO_FLAGS
+    # a coordination built-in's compiled fields (opspec.engine.coordinating.Coord), made at
+    # its first run: one attribute read a run, not a look-up by the activity
+    coord: Any = None
 
     def where(self) -> str:
         return str(self.location) if self.location is not None else "<built in Python>"

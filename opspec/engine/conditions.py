@@ -39,9 +39,10 @@ Every problem raises :class:`opspec.errors.ExecutionError` quoting the condition
 
 from __future__ import annotations
 
+import sys
 import types
 from collections.abc import Callable, Mapping
-from typing import Any, Final
+from typing import Any, Final, final
 
 from opspec.engine.condition_values import (
     ARITHMETIC,
@@ -64,11 +65,13 @@ from opspec.model.expressions import Binary, Call, Expression, Literal, Name, Un
 __all__ = [
     "CompiledCondition",
     "CompiledExpression",
+    "Constant",
     "compile_condition",
     "compile_expression",
     "constant_value",
     "evaluate",
     "evaluate_condition",
+    "field_name",
     "truthy",
 ]
 
@@ -76,6 +79,24 @@ CompiledExpression = Callable[[Mapping[str, Any], float], Any]
 """``f(data, now)``: the value of a compiled expression; ``now`` is the simulated time."""
 CompiledCondition = Callable[[Mapping[str, Any], float], bool]
 """``f(data, now)``: whether a compiled condition holds."""
+
+
+def field_name(name: str) -> str:
+    """``name`` as the one string object of its text (``sys.intern``): the names a run reads
+    and writes data fields by. A dictionary finds a key by identity before comparing the
+    text, so the compiled data dictionaries' keys, the assignments' targets, the names the
+    conditions read and the engine's own literals (interned by Python and by mypyc) meet
+    without a comparison of characters; otherwise the names parsed from the spec are
+    separate strings and each look-up compares them (about 300 instructions a robot's
+    workflow instance)."""
+    return sys.intern(name) if type(name) is str else name
+
+
+def _value(literal: Literal) -> Any:
+    """A literal's value, a string interned (:func:`field_name`): the values a constant
+    assignment writes are then found by identity where they are compared or looked up (a
+    robot's commands, ``COMMANDS[command]``)."""
+    return field_name(literal.value) if type(literal.value) is str else literal.value
 
 
 # --------------------------------------------------------------------------- errors
@@ -192,10 +213,11 @@ def compile_expression(
     if isinstance(expr, Literal):
         # a constant cannot fail: no wrapper (an assignment of a constant is common, and
         # from source each closure level is a Python call)
-        value = expr.value
+        value = _value(expr)
+        if COMPILED:        # (its value read natively where the engine runs assignments)
+            return Constant(value)
         constant = lambda data, now: value
-        if not COMPILED:    # the plans write the value where they would call this
-            constant.opspec_constant = (value,)  # type: ignore[attr-defined]
+        constant.opspec_constant = (value,)  # type: ignore[attr-defined]   # for the plans
         return constant
     try:
         own = _compile_root(expr, (expr, location))
@@ -214,11 +236,29 @@ def compile_expression(
     return run
 
 
+@final
+class Constant:
+    """A constant expression's function, compiled (:func:`compile_expression`): called, its
+    ``value``; ``Flow.assign`` reads the value without the call (compiled, a call of a
+    closure goes through Python's calling convention, the simulated time boxed for it:
+    about 150 instructions an assignment of a constant, two a robot's period)."""
+
+    def __init__(self, value: Any) -> None:
+        self.value = value
+
+    def __call__(self, data: Mapping[str, Any], now: float) -> Any:
+        return self.value
+
+
 def constant_value(evaluator: Callable[..., Any]) -> tuple[Any] | None:
     """``(value,)`` when ``evaluator`` is :func:`compile_expression`'s function of a constant
     (from source only), else ``None``: the plans write the value in place of the call."""
     found: tuple[Any] | None = getattr(evaluator, "opspec_constant", None)
     return found
+
+
+#: the operators whose closures give a bool (see :func:`compile_condition`)
+_BOOLEAN: Final = frozenset({"==", "!=", "and", "or"})
 
 
 def compile_condition(
@@ -229,9 +269,10 @@ def compile_condition(
     if expr is None:
         return lambda data, now: True
     try:
-        if isinstance(expr, Binary) and (expr.op in ("==", "!=") or expr.op in FAST_ORDERING):
-            # a comparison's closure gives a bool and, as the root, names the condition in
-            # its own errors: no wrapper (from source each closure level is a Python call)
+        if isinstance(expr, Binary) and (expr.op in _BOOLEAN or expr.op in FAST_ORDERING):
+            # a comparison's or a conjunction's closure gives a bool and, as the root, names
+            # the condition in its own errors: no wrapper (from source each closure level is
+            # a Python call; compiled, a call through Python's calling convention)
             return _compile_binary(expr, (expr, location))
         inner = _compile(expr)
     except ConditionProblem as problem:
@@ -275,7 +316,7 @@ def _compile_root(expr: Expression, whole: _Whole) -> _Fn | None:
 
 def _compile(expr: Expression) -> _Fn:
     if isinstance(expr, Literal):
-        value = expr.value
+        value = _value(expr)
         return lambda data, now: value
     if isinstance(expr, Name):
         return _compile_name(expr.path)
@@ -294,7 +335,7 @@ def _compile(expr: Expression) -> _Fn:
 
 
 def _compile_name(path: tuple[str, ...], whole: _Whole = None) -> _Fn:
-    root = path[0]
+    root = field_name(path[0])
     if len(path) == 1:
 
         def field(data: Mapping[str, Any], now: float) -> Any:
@@ -315,24 +356,36 @@ def _compile_name(path: tuple[str, ...], whole: _Whole = None) -> _Fn:
 def _compile_binary(expr: Binary, whole: _Whole = None) -> _Fn:
     op = expr.op
     left, right = _compile(expr.left), _compile(expr.right)
+    # (``and`` and ``or`` give a bool: at a condition's root, ``whole``, they are the
+    # condition, naming it in their operands' errors as ``compile_condition``'s wrapper would)
     if op == "and":
 
         def both(data: Mapping[str, Any], now: float) -> bool:
-            a = left(data, now)
-            if not (a is True or (a is not False and truthy(a))):
-                return False
-            b = right(data, now)
-            return b is True or (b is not False and truthy(b))
+            try:
+                a = left(data, now)
+                if not (a is True or (a is not False and truthy(a))):
+                    return False
+                b = right(data, now)
+                return b is True or (b is not False and truthy(b))
+            except (ConditionProblem, *_PYTHON_ERRORS) as problem:
+                if whole is None:
+                    raise
+                raise _fail(whole[0], problem, whole[1], now) from None
 
         return both
     if op == "or":
 
         def either(data: Mapping[str, Any], now: float) -> bool:
-            a = left(data, now)
-            if a is True or (a is not False and truthy(a)):
-                return True
-            b = right(data, now)
-            return b is True or (b is not False and truthy(b))
+            try:
+                a = left(data, now)
+                if a is True or (a is not False and truthy(a)):
+                    return True
+                b = right(data, now)
+                return b is True or (b is not False and truthy(b))
+            except (ConditionProblem, *_PYTHON_ERRORS) as problem:
+                if whole is None:
+                    raise
+                raise _fail(whole[0], problem, whole[1], now) from None
 
         return either
     if op in ("==", "!="):
@@ -345,7 +398,7 @@ def _compile_binary(expr: Binary, whole: _Whole = None) -> _Fn:
             expr.right, Literal
         ):
             # "field + 1": the field read and the constant inlined
-            root, constant = expr.left.path[0], expr.right.value
+            root, constant = field_name(expr.left.path[0]), expr.right.value
 
             def field_arithmetic(data: Mapping[str, Any], now: float) -> Any:
                 try:
@@ -371,7 +424,7 @@ def _compile_equality(expr: Binary, left: _Fn, right: _Fn, whole: _Whole, *,
     if isinstance(expr.left, Name) and len(expr.left.path) == 1 and isinstance(
         expr.right, Literal
     ):
-        root, constant = expr.left.path[0], expr.right.value
+        root, constant = field_name(expr.left.path[0]), _value(expr.right)
         kind = type(constant)
 
         def field_equals(data: Mapping[str, Any], now: float) -> bool:
@@ -391,7 +444,7 @@ def _compile_equality(expr: Binary, left: _Fn, right: _Fn, whole: _Whole, *,
         return field_equals
 
     if isinstance(expr.right, Literal):
-        fixed = expr.right.value
+        fixed = _value(expr.right)
         fixed_kind = type(fixed)
 
         def equals_constant(data: Mapping[str, Any], now: float) -> bool:
@@ -432,7 +485,7 @@ def _compile_ordering(expr: Binary, left: _Fn, right: _Fn, whole: _Whole) -> _Fn
         and type(constant) in (int, float)
     ):
         # "field < 3": the field read and the constant inlined, numbers compared directly.
-        root = expr.left.path[0]
+        root = field_name(expr.left.path[0])
 
         def field_ordering(data: Mapping[str, Any], now: float) -> bool:
             try:

@@ -15,6 +15,7 @@ from typing import TYPE_CHECKING, Any, Final, final
 
 from opspec.engine import coordination as coord
 from opspec.engine.compiled import CompiledActivity
+from opspec.engine.conditions import field_name
 from opspec.engine.instances import ActivityInstance, Frame
 from opspec.engine.lifecycle import RUNNING, SUSPENDED
 from opspec.engine.scope import Scope
@@ -58,26 +59,21 @@ class Coord:
         self.kind = (ARBITER if kind is _ARBITER else VOTER if kind is _VOTER
                      else SUPERPOSITION if kind is _SUPERPOSITION else PUSH
                      if kind is _PUSH_DATA else PULL if kind is _PULL_DATA else OTHER)
-        self.inputs: tuple[str, ...] = spec.inputs
-        self.output: str | None = spec.output
-        self.channel: str = spec.channel or act_id
+        # (the names interned: found by identity in the data and the mailboxes, see
+        # opspec.engine.conditions.field_name)
+        self.inputs: tuple[str, ...] = tuple(field_name(name) for name in spec.inputs)
+        self.output: str | None = None if spec.output is None else field_name(spec.output)
+        self.channel: str = field_name(spec.channel or act_id)
         self.waiting = f"pull from mailbox {self.channel!r}"
 
 
-#: each coordination activity's :class:`Coord`, made at its first run (compiled activities
-#: are not changed after compilation; at most ``_COORDS_MAX`` kept, then made again)
-_COORDS: Final[dict[CompiledActivity, Coord]] = {}     # (Final: read natively, not by name)
-_COORDS_MAX: Final = 4096
-
-
 def coord_of(act: CompiledActivity, spec: CoordinationBuiltIn) -> Coord:
-    """``act``'s coordination built-in ``spec`` as a :class:`Coord`."""
-    found = _COORDS.get(act)
+    """``act``'s coordination built-in ``spec`` as a :class:`Coord`, made at its first run
+    and kept by the activity (``CompiledActivity.coord``; made again for another ``spec``)."""
+    found: Coord | None = act.coord
     if found is None or found.spec is not spec:
-        if len(_COORDS) >= _COORDS_MAX:
-            _COORDS.clear()
         found = Coord(spec, act.id)
-        _COORDS[act] = found
+        act.coord = found
     return found
 
 

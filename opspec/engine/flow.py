@@ -25,6 +25,7 @@ from opspec.engine.compiled import (
     CompiledProcess,
     CTransition,
 )
+from opspec.engine.conditions import COMPILED, Constant
 from opspec.engine.instances import (
     IN_LINE,
     ActivityInstance,
@@ -567,8 +568,9 @@ class Flow(Part):
         now = self.state.now
         reads = inst.scope if scope is None else scope
         try:
-            for target, fn in assignments:
-                self.set_field(inst, act, target, fn(reads, now))
+            for target, fn in assignments:      # (a Constant's value without its call)
+                value = fn.value if COMPILED and isinstance(fn, Constant) else fn(reads, now)
+                self.set_field(inst, act, target, value)
                 if inst.state != RUNNING:
                     return False
         except OpspecError as error:

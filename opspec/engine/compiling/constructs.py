@@ -45,6 +45,7 @@ from opspec.engine.compiled import (
     CTransition,
 )
 from opspec.engine.compiling.context import Context, spec_error
+from opspec.engine.conditions import field_name
 from opspec.engine.coordination import APPLICATION_BUILTINS, application_builtin
 from opspec.engine.sampling import make_sampler
 from opspec.model import (
@@ -335,10 +336,12 @@ def _assignments(c: Context, site: Site) -> None:
     act, ca = site.act, site.ca
     if act.assignments:
         ca.start_assign = tuple(
-            (a.target, c.expr(a.expression, a.text, a.location, f"assignment to {a.target!r}"))
+            (field_name(a.target),
+             c.expr(a.expression, a.text, a.location, f"assignment to {a.target!r}"))
             for a in act.assignments if a.assign_time.lower() == "start")
         ca.end_assign = tuple(
-            (a.target, c.expr(a.expression, a.text, a.location, f"assignment to {a.target!r}"))
+            (field_name(a.target),
+             c.expr(a.expression, a.text, a.location, f"assignment to {a.target!r}"))
             for a in act.assignments if a.assign_time.lower() != "start")
 
 

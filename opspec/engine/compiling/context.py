@@ -15,7 +15,7 @@ from typing import Any
 
 from opspec.clock import DURATION_HINT, try_duration
 from opspec.engine.compiled import CompiledGraph, CTool, CTrigger, Evaluator
-from opspec.engine.conditions import compile_condition, compile_expression
+from opspec.engine.conditions import compile_condition, compile_expression, field_name
 from opspec.engine.sampling import make_sampler
 from opspec.errors import OpspecError, SourceLocation, SpecError
 from opspec.model import (
@@ -251,7 +251,8 @@ class Context:
                     f"script statement {a.text!r} of application {app.id!r}")))
                 known.add(a.target)
             script = tuple(statements)
-        return CTool(application=call.application, params=params, script=script)
+        # (the name interned: performers and worlds compare it with their literals)
+        return CTool(application=field_name(call.application), params=params, script=script)
 
 
     def params(self, actuals: tuple[Any, ...], formals: tuple[Any, ...], act: Activity,
@@ -270,7 +271,7 @@ class Context:
             expression = actual.expression
             if expression is None and IDENT.match(actual.text.strip()):
                 expression = Name(tuple(actual.text.strip().split(".")))
-            target = expression.path[0] if isinstance(expression, Name) else None
+            target = field_name(expression.path[0]) if isinstance(expression, Name) else None
             if mode is not ParameterMode.IN and target is None:
                 raise spec_error(
                     f"actual parameter {n + 1} of activity {act.id!r} ({actual.text!r}) must "

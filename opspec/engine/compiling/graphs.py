@@ -30,6 +30,7 @@ from opspec.engine.compiled import (
 )
 from opspec.engine.compiling.constructs import Site, compile_activity, transition_kind
 from opspec.engine.compiling.context import Context, spec_error
+from opspec.engine.conditions import field_name
 from opspec.model import Activity, Event, EventPosition, Package, Transition, WorkflowProcess
 from opspec.model.checks_support import names_read
 
@@ -85,7 +86,7 @@ class Compiler(Context):
         exc = tr.condition.exception_name
         if kind == T_EXCEPTION and exc is None and tr.condition.text:
             exc = tr.condition.text.strip() or None
-        assigns = tuple((a.target, self.expr(a.expression, a.text, a.location,
+        assigns = tuple((field_name(a.target), self.expr(a.expression, a.text, a.location,
                                              f"assignment to {a.target!r}"))
                         for a in tr.assignments)
         if tr.probability is not None and self.run_inputs and tr.condition.expression:
@@ -137,8 +138,10 @@ class Compiler(Context):
         lane = directives.lane
         graph = self.graph(proc, proc.id, proc.activities, proc.transitions, lane)
         self.finish_choices(graph)
-        data: dict[str, Any] = {f.id: None for f in proc.formal_parameters}
-        data.update({f.id: self.initial(f) for f in proc.data_fields})
+        # (the names interned, as every name the engine reads or writes a field by: see
+        # opspec.engine.compiling.context.field_name)
+        data: dict[str, Any] = {field_name(f.id): None for f in proc.formal_parameters}
+        data.update({field_name(f.id): self.initial(f) for f in proc.data_fields})
         start, start_events = self.start_trigger(proc, graph)
         # several start events: the untriggered (none) ones are where an instance started
         # without a trigger begins (auto-start, API, call; BPMN 2.0 §13.3.4)
@@ -288,7 +291,7 @@ def compile_package(package: Package) -> CompiledPackage:
         initial = next(iter(modes))
     return CompiledPackage(
         id=package.id, source=package.source, package=package, processes=processes,
-        data={f.id: compiler.initial(f) for f in package.data_fields},
+        data={field_name(f.id): compiler.initial(f) for f in package.data_fields},
         throwable=frozenset(compiler.throwable), modes=modes, initial_mode=initial,
         mode_sources={m.id: m.source for m in package.modes if m.source},
         catchers=_catchers(processes.values()))
