@@ -345,9 +345,7 @@ def _compile_name(path: tuple[str, ...], whole: _Whole = None) -> _Fn:
                 except KeyError:
                     missing_field(data, root)
             except (ConditionProblem, *_PYTHON_ERRORS) as problem:
-                if whole is None:
-                    raise
-                raise _fail(whole[0], problem, whole[1], now) from None
+                raise _at_root(whole, problem, now) from None
 
         return field
     return lambda data, now: lookup(data, path)
@@ -368,9 +366,7 @@ def _compile_binary(expr: Binary, whole: _Whole = None) -> _Fn:
                 b = right(data, now)
                 return b is True or (b is not False and truthy(b))
             except (ConditionProblem, *_PYTHON_ERRORS) as problem:
-                if whole is None:
-                    raise
-                raise _fail(whole[0], problem, whole[1], now) from None
+                raise _at_root(whole, problem, now) from None
 
         return both
     if op == "or":
@@ -383,9 +379,7 @@ def _compile_binary(expr: Binary, whole: _Whole = None) -> _Fn:
                 b = right(data, now)
                 return b is True or (b is not False and truthy(b))
             except (ConditionProblem, *_PYTHON_ERRORS) as problem:
-                if whole is None:
-                    raise
-                raise _fail(whole[0], problem, whole[1], now) from None
+                raise _at_root(whole, problem, now) from None
 
         return either
     if op in ("==", "!="):
@@ -408,9 +402,7 @@ def _compile_binary(expr: Binary, whole: _Whole = None) -> _Fn:
                         missing_field(data, root)
                     return arithmetic(value, constant)
                 except (ConditionProblem, *_PYTHON_ERRORS) as problem:
-                    if whole is None:
-                        raise
-                    raise _fail(whole[0], problem, whole[1], now) from None
+                    raise _at_root(whole, problem, now) from None
 
             return field_arithmetic
         return lambda data, now: arithmetic(left(data, now), right(data, now))
@@ -437,9 +429,7 @@ def _compile_equality(expr: Binary, left: _Fn, right: _Fn, whole: _Whole, *,
                     return (value == constant) is not negate
                 return equal(value, constant) is not negate
             except (ConditionProblem, *_PYTHON_ERRORS) as problem:
-                if whole is None:
-                    raise
-                raise _fail(whole[0], problem, whole[1], now) from None
+                raise _at_root(whole, problem, now) from None
 
         return field_equals
 
@@ -454,9 +444,7 @@ def _compile_equality(expr: Binary, left: _Fn, right: _Fn, whole: _Whole, *,
                     return (a == fixed) is not negate
                 return equal(a, fixed) is not negate
             except (ConditionProblem, *_PYTHON_ERRORS) as problem:
-                if whole is None:
-                    raise
-                raise _fail(whole[0], problem, whole[1], now) from None
+                raise _at_root(whole, problem, now) from None
 
         return equals_constant
 
@@ -467,9 +455,7 @@ def _compile_equality(expr: Binary, left: _Fn, right: _Fn, whole: _Whole, *,
                 return (a == b) is not negate
             return equal(a, b) is not negate
         except (ConditionProblem, *_PYTHON_ERRORS) as problem:
-            if whole is None:
-                raise
-            raise _fail(whole[0], problem, whole[1], now) from None
+            raise _at_root(whole, problem, now) from None
 
     return equals
 
@@ -503,9 +489,7 @@ def _compile_ordering(expr: Binary, left: _Fn, right: _Fn, whole: _Whole) -> _Fn
                 found = ordered(value, constant, op)
                 return found if whole is None else _held(found)
             except (ConditionProblem, *_PYTHON_ERRORS) as problem:
-                if whole is None:
-                    raise
-                raise _fail(whole[0], problem, whole[1], now) from None
+                raise _at_root(whole, problem, now) from None
 
         return field_ordering
     if type(constant) in (int, float):
@@ -519,9 +503,7 @@ def _compile_ordering(expr: Binary, left: _Fn, right: _Fn, whole: _Whole) -> _Fn
                 found = ordered(value, constant, op)
                 return found if whole is None else _held(found)
             except (ConditionProblem, *_PYTHON_ERRORS) as problem:
-                if whole is None:
-                    raise
-                raise _fail(whole[0], problem, whole[1], now) from None
+                raise _at_root(whole, problem, now) from None
 
         return ordering_constant
 
@@ -536,11 +518,16 @@ def _compile_ordering(expr: Binary, left: _Fn, right: _Fn, whole: _Whole) -> _Fn
             found = ordered(a, b, op)
             return found if whole is None else _held(found)
         except (ConditionProblem, *_PYTHON_ERRORS) as problem:
-            if whole is None:
-                raise
-            raise _fail(whole[0], problem, whole[1], now) from None
+            raise _at_root(whole, problem, now) from None
 
     return ordering
+
+
+def _at_root(whole: _Whole, problem: BaseException, now: float) -> BaseException:
+    """What a closure raises for ``problem``: at an expression's root (``whole``), the
+    expression's own error, naming it and its place (:func:`_fail`); below the root, the
+    problem itself, for the root's closure to name."""
+    return problem if whole is None else _fail(whole[0], problem, whole[1], now)
 
 
 def _held(value: Any) -> bool:
