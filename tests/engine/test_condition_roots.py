@@ -1,5 +1,6 @@
 """A condition's or expression's root closure answers for its own errors (no wrapper around
-it): the same values, booleans and messages as the tree walker's."""
+it; a comparison, a field, a time helper, "field op constant", a conjunction): the same
+values, booleans and messages as the tree walker's."""
 
 from __future__ import annotations
 
@@ -19,14 +20,20 @@ from opspec.xpdl.conditions import parse_condition
 WHERE = SourceLocation("spec.xpdl", 3)
 
 CONDITIONS = ["hour < 10", "hour >= 10.5", "fault != \"\"", "fault == \"x\"", "hour < slot",
-              "hour + 1 < 10", "hour == slot", "hour > \"9\"", "!(hour < 3)"]
+              "hour + 1 < 10", "hour == slot", "hour > \"9\"", "!(hour < 3)",
+              # a conjunction at the root is its own closure too, whichever operand fails
+              "hour < 10 && fault == \"\"", "hour > 3 || slot == 2", "fault && hour < 10",
+              "hour + 1 < 10 || fault", "bump == true && escaping == false",
+              "!(hour < 3) && slot", "hour() > 1 || alarms > 1", "missing == 1 && hour < 10",
+              "hour < 10 || missing == 1"]
 EXPRESSIONS = ["hour", "hour + 1", "alarms * 2", "hour()", "slot - 1", "fault + 1"]
 DATA = [
-    {"hour": 9, "fault": "", "slot": 3, "alarms": 1},
-    {"hour": 12.5, "fault": "x", "slot": "12.5", "alarms": 2},
-    {"hour": "7", "fault": "y", "slot": 2, "alarms": "3"},
-    {"hour": np.float64(9.0), "fault": "", "slot": np.float64(9.0), "alarms": 1},
-    {"hour": "abc", "fault": None, "slot": None, "alarms": None},
+    {"hour": 9, "fault": "", "slot": 3, "alarms": 1, "bump": True, "escaping": False},
+    {"hour": 12.5, "fault": "x", "slot": "12.5", "alarms": 2, "bump": False, "escaping": True},
+    {"hour": "7", "fault": "y", "slot": 2, "alarms": "3", "bump": True, "escaping": True},
+    {"hour": np.float64(9.0), "fault": "", "slot": np.float64(9.0), "alarms": 1,
+     "bump": np.bool_(True), "escaping": np.bool_(False)},
+    {"hour": "abc", "fault": None, "slot": None, "alarms": None, "bump": None},
     {"fault": ""},
 ]
 
