@@ -233,13 +233,21 @@ def test_the_button_on_a_pseudo_terminal_reports_and_the_dose_is_taken(
                    script(tmp_path, ("never", "press_report")), profiles=DEVICES, settle_s=0)
     assert run.wall_clock
     assert run.metric("doses_taken") == 1 and run.metric("doses_missed") == 0
+    # The press comes 2 ms (wall) after the board reads ALARM ON; the spec re-alarms after
+    # 300 s without a report, 15 ms of wall time at 20,000x. On a loaded machine the press
+    # once reached the engine after that (CI: ALARM ON, ALARM ON, DISPENSE 1): the spec's
+    # own path for a late report, not a fault. So: one to three alarms, each answered by
+    # a press, then the one dispense.
     exchanges = [e.data for e in run.result.trace or () if e.kind == "device.exchange"]
-    assert [x["command"] for x in exchanges] == ["ALARM ON", "DISPENSE 1"]
+    commands = [x["command"] for x in exchanges]
+    alarms = commands.count("ALARM ON")
+    assert 1 <= alarms <= 3 and commands == ["ALARM ON"] * alarms + ["DISPENSE 1"]
+    assert alarms == run.metric("alarms")
     events = [e.data for e in run.result.trace or () if e.kind == "device.event"]
-    assert [x["event"] for x in events] == ["report"]
+    assert 1 <= len(events) <= alarms and {x["event"] for x in events} == {"report"}
     assert run.faults() == []
     device = run.report["alarm, dispenser"]
-    assert device["latency_ms"]["count"] == 2 and device["latency_ms"]["max"] > 0
+    assert device["latency_ms"]["count"] == len(commands) and device["latency_ms"]["max"] > 0
     assert device["faults"] == []
     # reader-thread lines were handled on the engine's (this) thread
     assert run.threads == {threading.get_ident()}
