@@ -316,9 +316,8 @@ class WaitingCode:
         set for its offer."""
         a = f"A{act.index}"
         return [f"{pad}cached = {a}.flag_cache",
-                (f"{pad}bits = cached.bits if cached.key is state.flag_key "
-                 f"else state.act_bits({a})"),
-                f"{pad}if bits & 1:",
+                (f"{pad}if (cached.bits if cached.key is state.flag_key "
+                 f"else state.act_bits({a})) & 1:"),
                 f"{pad}    state.emit(STARTED, {self.fields(act)})"]
 
     def offer(self, act: CompiledActivity, pad: str) -> list[str]:
