@@ -84,6 +84,7 @@ class WaitingCode:
 
     proc: CompiledProcess
     framed: bool
+    steps: int              # the zero-time steps taken so far where a hand-over is written
     acts: tuple[CompiledActivity, ...]
     names: dict[str, Any]
 
@@ -104,7 +105,7 @@ class WaitingCode:
         a = f"A{index}"
         act = self.acts[index]
         if act.fast:
-            start = [f"{pad}activities.start(frame, {a}, steps, limit)", f"{pad}return"]
+            start = [f"{pad}activities.start(frame, {a}, {self.steps}, limit)", f"{pad}return"]
         elif offers_itself(act):
             start = self.offer(act, pad)
         elif catches_itself(act):

@@ -128,6 +128,8 @@ class Writer(WaitingCode):
         self.framed = framed
         self.acts = proc.graph.activities
         self.blocks = 0
+        self.steps = 0                      # (see block)
+        self.uncounted = 0
         # the plan's globals: what its source names (activities, conditions, helpers)
         self.names: dict[str, Any] = {
             "__builtins__": __builtins__, "REST": lone.run,
@@ -155,10 +157,15 @@ class Writer(WaitingCode):
         a = f"A{index}"
         self.names[a] = act
         self.blocks += 1
+        # the zero-time steps the token has taken in this plan so far: one per block on its
+        # path but a performed branch's, known here (a constant in the plan, not a count)
+        steps = self.steps = len(path) - self.uncounted
+        if performed:                       # (a plan's first block: no step of its own)
+            self.uncounted = 1
         if not performed:
             if index in path or self.blocks > MAX_BLOCKS or depth > _MAX_DEPTH:
-                out.append(f"{pad}activities.start(frame, {a}, steps, limit)" if self.framed
-                           else f"{pad}REST(activities, inst, {a}, steps, limit)")
+                out.append(f"{pad}activities.start(frame, {a}, {steps}, limit)" if self.framed
+                           else f"{pad}REST(activities, inst, {a}, {steps}, limit)")
                 out.append(f"{pad}return")
                 return
             if not (act.lone or self.framed and thrown_on(act, self.acts)):
@@ -172,8 +179,7 @@ class Writer(WaitingCode):
             if waits:
                 out.append(f"{pad}if {' or '.join(waits)}:")
                 out.extend(self.hand_over(index, pad + "    "))
-            out += [f"{pad}steps += 1",
-                    f"{pad}if steps > limit:",
+            out += [f"{pad}if {steps + 1} > limit:",
                     f"{pad}    state.zero_time({'frame' if self.framed else 'inst'}, {a})"]
         fields = self.fields(act)
         out += [f"{pad}cached = {a}.flag_cache",

@@ -224,8 +224,7 @@ def build_resume(proc: CompiledProcess, index: int, queued: bool = False) -> Any
              "    flow = activities.flow",
              "    inst = frame.inst",
              "    limit = state.start_limit",
-             "    iid = inst.id",
-             "    steps = 0"]
+             "    iid = inst.id"]
     if any(other.general for other in proc.graph.activities):
         lines.append("    pooled = state.pooled")
     if any(other.kind == K_TASK for other in proc.graph.activities):
@@ -272,8 +271,7 @@ def _token_locals(proc: CompiledProcess) -> list[str]:
              "    if state.flag_key is not KEY:    # (the listeners' bits: see by_selection)",
              "        SELECT(state)",
              "    limit = state.start_limit",
-             "    iid = inst.id",
-             "    steps = 0"]
+             "    iid = inst.id"]
     if any(act.general for act in proc.graph.activities):
         lines.append("    pooled = state.pooled")
     if any(act.kind == K_TASK for act in proc.graph.activities):
