@@ -86,6 +86,10 @@ class StochasticUser:
         self._alternatives: dict[str, ActivityModel | None] = {}
         self._handover: dict[int, int] = {}      # lane -> key of its last completed item
         self._call_with: Callable[..., None] | None = None     # (see attach)
+        # (with _call_with: _finish and _end_handover bound once, not a method object made
+        # and freed per work item)
+        self._finishing: Callable[[WorkItem, int, str | None], None] | None = None
+        self._ending: Callable[[int, int, Any], None] | None = None
         #: per activity of the lane, ``[offered, completed, omitted, wrong]`` (``opspec
         #: evaluate``'s activity rows): when set, this user adds its omissions (column 2)
         #: and wrong actions (column 3: wrong choices and slips) to it as it decides them, so
@@ -114,6 +118,9 @@ class StochasticUser:
         # per work item, and an answer at once is queued as the call itself
         self._call_with = (getattr(session, "call_later_with", None) if _FROM_SOURCE
                            else None)
+        if self._call_with is not None:
+            self._finishing = self._finish
+            self._ending = self._end_handover
 
     def offer(self, item: WorkItem) -> None:
         session = self._session
@@ -225,7 +232,7 @@ class StochasticUser:
             total = 0.0
         call_with = self._call_with
         if call_with is not None:
-            call_with(total, self._finish, item, lane, choice)
+            call_with(total, self._finishing, item, lane, choice)
         elif _FROM_SOURCE:
             session.call_later(total, partial(self._finish, item, lane, choice))
         else:
@@ -329,7 +336,7 @@ class StochasticUser:
             # the same instant, which no prompt can fall into except at that exact time.
             call_with = self._call_with
             if call_with is not None:
-                call_with(0.0, self._end_handover, lane, item.key, None)
+                call_with(0.0, self._ending, lane, item.key, None)
             elif _FROM_SOURCE:
                 session.call_later(0.0, partial(self._end_handover, lane, item.key))
             else:
