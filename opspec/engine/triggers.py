@@ -30,7 +30,7 @@ from opspec.engine.lifecycle import (
     TERMINATED,
 )
 from opspec.engine.part import Part
-from opspec.engine.runstate import discard
+from opspec.engine.runstate import RunState, discard
 from opspec.engine.timers import TUPLES, Timed, occurrences
 from opspec.engine.trace import EventKind as EK
 from opspec.errors import OpspecError
@@ -50,6 +50,12 @@ class Triggers(Part):
     # they were read from: a mode that loads workflows replaces the table
     _members_of: object = None
     _members: dict[str, tuple[str, ...]] | None = None
+
+    def __init__(self, state: RunState) -> None:
+        super().__init__(state)
+        # a catch's handler and its deadline's, bound once for the plans (see Flow.__init__)
+        self.caught_q: Callable[[ActivityInstance, Any, Any], None] = self.caught
+        self.deadline_q: Callable[[ActivityInstance, Any], None] = self.deadline
 
     def wait_trigger(self, ai: ActivityInstance, trig: CTrigger, handler: Any, arg: Any,
                       persistent: bool = False) -> None:
