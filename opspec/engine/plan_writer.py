@@ -129,7 +129,7 @@ class Writer(WaitingCode):
         self.acts = proc.graph.activities
         self.blocks = 0
         self.steps = 0                      # (see block)
-        self.uncounted = 0
+        self.uncounted = 0                  # (1: the first block is a performed branch's)
         # the plan's globals: what its source names (activities, conditions, helpers)
         self.names: dict[str, Any] = {
             "__builtins__": __builtins__, "REST": lone.run,
@@ -157,11 +157,9 @@ class Writer(WaitingCode):
         a = f"A{index}"
         self.names[a] = act
         self.blocks += 1
-        # the zero-time steps the token has taken in this plan so far: one per block on its
-        # path but a performed branch's, known here (a constant in the plan, not a count)
-        steps = self.steps = len(path) - self.uncounted
-        if performed:                       # (a plan's first block: no step of its own)
-            self.uncounted = 1
+        # the token's zero-time steps so far, a constant of the plan: a block on its path each
+        steps = self.steps = len(path) - self.uncounted     # (but a performed branch's)
+        self.uncounted |= performed
         if not performed:
             if index in path or self.blocks > MAX_BLOCKS or depth > _MAX_DEPTH:
                 out.append(f"{pad}activities.start(frame, {a}, {steps}, limit)" if self.framed

@@ -276,15 +276,7 @@ class StochasticUser:
             owed = recovery[key]
             del recovery[key]
         if plan.probabilities:
-            weights = dict(plan.probabilities)
-            offered = [(c, weights.get(c, 0.0)) for c in choices]
-            total = sum(w for _, w in offered)
-            u = self._uniform() * total
-            for choice, weight in offered:
-                if u < weight:
-                    return choice, owed
-                u -= weight
-            return offered[-1][0], owed
+            return self._by_probability(choices, plan), owed
         intended = plan.intended
         if intended is None or intended not in choices:
             if intended is not None:
@@ -300,8 +292,12 @@ class StochasticUser:
             u = (raw() >> 11) * _TWO_TO_MINUS_53 if raw is not None else float(self._random())
             slipped = u < commission.probability
         if commission is not None and slipped:
-            wrong = [c for c in (commission.alternatives or choices)
-                     if c != intended and c in choices]
+            # (a loop: a comprehension would make intended and choices a closure's cells,
+            # made at every call of _choose from source)
+            wrong: list[str] = []
+            for c in commission.alternatives or choices:
+                if c != intended and c in choices:
+                    wrong.append(c)
             if wrong:
                 pick = wrong[0] if len(wrong) == 1 else wrong[int(self.rng.integers(len(wrong)))]
                 self._wrong[key] = count + 1
@@ -312,6 +308,18 @@ class StochasticUser:
         if key in self._wrong:
             del self._wrong[key]
         return intended, owed
+
+    def _by_probability(self, choices: tuple[str, ...], plan: _Plan) -> str:
+        """The alternative drawn by the plan's probabilities (one uniform)."""
+        weights = dict(plan.probabilities)
+        offered = [(c, weights.get(c, 0.0)) for c in choices]
+        total = sum(w for _, w in offered)
+        u = self._uniform() * total
+        for choice, weight in offered:
+            if u < weight:
+                return choice
+            u -= weight
+        return offered[-1][0]
 
     def _finish(self, item: WorkItem, lane: int, choice: str | None) -> None:
         pending = self._pending
