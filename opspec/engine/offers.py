@@ -255,7 +255,9 @@ class Offers(Part):
         ``performer_complete``: its generator would make that a closure's cells a call.)"""
         acts = ai.frame.graph.activities
         if choice is None and len(item.choices) == 1:
-            return next(t for t in ai.choice if acts[t.target].id == item.choices[0])
+            only: CTransition = next(t for t in ai.choice
+                                     if acts[t.target].id == item.choices[0])
+            return only
         key = item.key
         self.state.offered[key] = ai
         ai.item = item
