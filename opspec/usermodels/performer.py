@@ -198,7 +198,7 @@ class StochasticUser:
             normal = self._normal
             if normal is None:
                 normal = self._normal = _standard_normal(self.rng)
-            duration = math.exp(plan.mu + plan.sigma * normal()) * factor
+            duration = math.exp(plan.mu + plan.sigma * float(normal())) * factor
         else:
             duration = plan.duration.sample(self.rng) * factor
         repetition = plan.repetition
