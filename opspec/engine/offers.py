@@ -252,7 +252,8 @@ class Offers(Part):
                   choice: str | None) -> CTransition:
         """The branch of an answer that named none of ``ai``'s: the one offered, if only
         one was; else the answer is refused (the item stays offered). (Apart from
-        ``performer_complete``: its generator would make that a closure's cells a call.)"""
+        ``performer_complete``: there the generator's closure would make cells at every
+        answer, from source.)"""
         acts = ai.frame.graph.activities
         if choice is None and len(item.choices) == 1:
             only: CTransition = next(t for t in ai.choice
