@@ -190,7 +190,7 @@ class Activities(Part):
                 except OpspecError as error:
                     self.flow.abort(inst, act, f"deadline cannot be computed: {error.message}")
                     return
-                self.state.later(delay, self.triggers.deadline, armed,
+                self.state.later(delay, self.triggers.deadline_q, armed,
                                  (synchronous, exception, delay))
             for index in act.boundary:
                 event = ai.frame.graph.activities[index]
@@ -322,7 +322,7 @@ class Activities(Part):
             trig = act.trigger
             assert trig is not None
             ai.waiting = f"{trig.kind}:{trig.name}" if trig.name else trig.kind
-            self.triggers.wait_trigger(ai, trig, self.triggers.caught, None)
+            self.triggers.wait_trigger(ai, trig, self.triggers.caught_q, None)
         elif kind == K_BLOCK:
             assert act.block is not None
             frame = Frame(act.block, inst, ai)

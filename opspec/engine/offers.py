@@ -229,15 +229,7 @@ class Offers(Part):
                     trans = branch
                     break
             if trans is None:
-                if choice is None and len(item.choices) == 1:
-                    trans = next(t for t in ai.choice if acts[t.target].id == item.choices[0])
-                else:
-                    offered[key] = ai
-                    ai.item = item
-                    raise ExecutionError(
-                        f"work item {key} ({item.activity}) needs a choice among "
-                        f"{', '.join(item.choices)}, got {choice!r}",
-                        hint="call complete(item, choice=ACTIVITY_ID)", sim_time=state.now)
+                trans = self._unchosen(ai, item, choice)
             state.ready.append((self.choose_q, ai, trans, data))
         elif act.toolchain and key in state.tool_at:
             state.ready.append((self.activities.tool_done, ai, data, None))
@@ -255,6 +247,25 @@ class Offers(Part):
                 state.ready.append((activities.body_done_q, ai, data, None))
         if not state.draining:
             state.drain()
+
+    def _unchosen(self, ai: ActivityInstance, item: WorkItem,
+                  choice: str | None) -> CTransition:
+        """The branch of an answer that named none of ``ai``'s: the one offered, if only
+        one was; else the answer is refused (the item stays offered). (Apart from
+        ``performer_complete``: there the generator's closure would make cells at every
+        answer, from source.)"""
+        acts = ai.frame.graph.activities
+        if choice is None and len(item.choices) == 1:
+            only: CTransition = next(t for t in ai.choice
+                                     if acts[t.target].id == item.choices[0])
+            return only
+        key = item.key
+        self.state.offered[key] = ai
+        ai.item = item
+        raise ExecutionError(
+            f"work item {key} ({item.activity}) needs a choice among "
+            f"{', '.join(item.choices)}, got {choice!r}",
+            hint="call complete(item, choice=ACTIVITY_ID)", sim_time=self.state.now)
 
     def performer_omit(self, item: WorkItem, reason: str) -> None:
         offered = self.state.offered

@@ -24,6 +24,7 @@ from opspec.engine.compiled import (
     CompiledActivity,
     CompiledProcess,
 )
+from opspec.engine.conditions import constant_value
 from opspec.engine.coordinating import at_once
 from opspec.engine.instances import ACTIVITY_FIELDS, FRAME_FIELDS, IN_LINE, PROCESS_FIELDS
 from opspec.engine.workitem import FIELDS as ITEM_FIELDS
@@ -84,6 +85,7 @@ class WaitingCode:
 
     proc: CompiledProcess
     framed: bool
+    steps: int              # the zero-time steps taken so far where a hand-over is written
     acts: tuple[CompiledActivity, ...]
     names: dict[str, Any]
 
@@ -104,7 +106,7 @@ class WaitingCode:
         a = f"A{index}"
         act = self.acts[index]
         if act.fast:
-            start = [f"{pad}activities.start(frame, {a}, steps, limit)", f"{pad}return"]
+            start = [f"{pad}activities.start(frame, {a}, {self.steps}, limit)", f"{pad}return"]
         elif offers_itself(act):
             start = self.offer(act, pad)
         elif catches_itself(act):
@@ -140,13 +142,20 @@ class WaitingCode:
             out += [f"{pad}now = state.now", f"{pad}triggers = activities.triggers"]
             triggers = "triggers"
         for seconds, synchronous, exception in act.deadlines:
+            constant = constant_value(seconds)
+            if constant is not None and type(constant[0]) in (int, float):
+                # a constant duration: its float and the callback's argument made once, here
+                delay = float(constant[0])
+                out.append(f"{pad}state.later({self.name('K', delay)}, triggers.deadline_q, ai, "
+                           f"{self.name('K', (synchronous, exception, delay))})")
+                continue
             out += [f"{pad}try:",
                     f"{pad}    delay = float({self.value(seconds, 'inst.scope')})",
                     f"{pad}except OpspecError as error:",
                     (f"{pad}    flow.abort(inst, {a}, "
                      f"f\"deadline cannot be computed: {{error.message}}\")"),
                     f"{pad}    return",
-                    (f"{pad}state.later(delay, triggers.deadline, ai, "
+                    (f"{pad}state.later(delay, triggers.deadline_q, ai, "
                      f"({self.name('K', synchronous)}, {self.name('K', exception)}, delay))")]
         for index in act.boundary:
             event = self.acts[index]
@@ -159,7 +168,7 @@ class WaitingCode:
                 f"{pad}if ai.state == RUNNING:",
                 f"{pad}    ai.waiting = {self.name('G', waiting)}",
                 (f"{pad}    {triggers}.wait_trigger(ai, {self.name('TRG', trig)}, "
-                 f"{triggers}.caught, None)"),
+                 f"{triggers}.caught_q, None)"),
                 f"{pad}    if not state.draining:",
                 f"{pad}        state.drain()",
                 f"{pad}return"]
@@ -316,9 +325,8 @@ class WaitingCode:
         set for its offer."""
         a = f"A{act.index}"
         return [f"{pad}cached = {a}.flag_cache",
-                (f"{pad}bits = cached.bits if cached.key is state.flag_key "
-                 f"else state.act_bits({a})"),
-                f"{pad}if bits & 1:",
+                (f"{pad}if (cached.bits if cached.key is state.flag_key "
+                 f"else state.act_bits({a})) & 1:"),
                 f"{pad}    state.emit(STARTED, {self.fields(act)})"]
 
     def offer(self, act: CompiledActivity, pad: str) -> list[str]:

@@ -77,13 +77,16 @@ def ways_out(act: CompiledActivity, acts: tuple[CompiledActivity, ...]) -> list[
 
 _CACHED: Final = re.compile(r"\n *cached = \w+\.flag_cache(?=\n)")
 _BITS: Final = re.compile(
-    r"cached\.bits if cached\.key is state\.flag_key else state\.(act|proc)_bits\((\w+)\)")
+    r"\(cached\.bits if cached\.key is state\.flag_key else state\.(act|proc)_bits\((\w+)\)\)"
+    r" & (\d+)")
 
 
 def by_selection(source: str, space: dict[str, Any]) -> str:
-    """``source`` with each activity's and workflow's listener bits read from a global of
-    the plan (``BITS_A3``) instead of from its cache (``RunState.act_bits``'s cached case:
-    the cache, its key and the run's key read at every event a plan might trace).
+    """``source`` with each test of an activity's or workflow's listener bits, ``(its
+    bits) & 2``, read from a global of the plan (``BITS_A3_2``: whether that bit is set)
+    instead of from its cache (``RunState.act_bits``'s cached case: the cache, its key and
+    the run's key read, the mask taken and the int tested at every event a plan might
+    trace).
 
     The plan tests once, where it starts, that its globals hold the bits of this run's
     listener selection (``KEY``, the run's ``flag_key``) and has ``SELECT`` set them for it
@@ -92,21 +95,22 @@ def by_selection(source: str, space: dict[str, Any]) -> str:
     loaded workflows alone: the bits of the activities a plan writes out stay what they were
     (and the plan's next start sees the new key and selects again)."""
     source = _CACHED.sub("", source)
-    wanted: dict[str, tuple[Any, bool]] = {}
+    wanted: dict[str, tuple[Any, bool, int]] = {}
 
     def named(found: re.Match[str]) -> str:
-        kind, obj = found.group(1), found.group(2)
-        global_name = f"BITS_{obj}"
-        wanted[global_name] = (space[obj], kind == "proc")
+        kind, obj, mask = found.group(1), found.group(2), found.group(3)
+        global_name = f"BITS_{obj}_{mask}"
+        wanted[global_name] = (space[obj], kind == "proc", int(mask))
         return global_name
 
     source = _BITS.sub(named, source)
-    entries = tuple((global_name, obj, is_proc)
-                    for global_name, (obj, is_proc) in wanted.items())
+    entries = tuple((global_name, obj, is_proc, mask)
+                    for global_name, (obj, is_proc, mask) in wanted.items())
 
     def select(state: Any) -> None:
-        for global_name, obj, is_proc in entries:
-            space[global_name] = state.proc_bits(obj) if is_proc else state.act_bits(obj)
+        for global_name, obj, is_proc, mask in entries:
+            bits = state.proc_bits(obj) if is_proc else state.act_bits(obj)
+            space[global_name] = (bits & mask) != 0     # (a bool: tested without a call)
         space["KEY"] = state.flag_key
 
     space["KEY"] = None                     # (no run's key: the first start selects)
@@ -124,6 +128,8 @@ class Writer(WaitingCode):
         self.framed = framed
         self.acts = proc.graph.activities
         self.blocks = 0
+        self.steps = 0                      # (see block)
+        self.uncounted = 0                  # (1: the first block is a performed branch's)
         # the plan's globals: what its source names (activities, conditions, helpers)
         self.names: dict[str, Any] = {
             "__builtins__": __builtins__, "REST": lone.run,
@@ -151,10 +157,13 @@ class Writer(WaitingCode):
         a = f"A{index}"
         self.names[a] = act
         self.blocks += 1
+        # the token's zero-time steps so far, a constant of the plan: a block on its path each
+        steps = self.steps = len(path) - self.uncounted     # (but a performed branch's)
+        self.uncounted |= performed
         if not performed:
             if index in path or self.blocks > MAX_BLOCKS or depth > _MAX_DEPTH:
-                out.append(f"{pad}activities.start(frame, {a}, steps, limit)" if self.framed
-                           else f"{pad}REST(activities, inst, {a}, steps, limit)")
+                out.append(f"{pad}activities.start(frame, {a}, {steps}, limit)" if self.framed
+                           else f"{pad}REST(activities, inst, {a}, {steps}, limit)")
                 out.append(f"{pad}return")
                 return
             if not (act.lone or self.framed and thrown_on(act, self.acts)):
@@ -168,17 +177,17 @@ class Writer(WaitingCode):
             if waits:
                 out.append(f"{pad}if {' or '.join(waits)}:")
                 out.extend(self.hand_over(index, pad + "    "))
-            out += [f"{pad}steps += 1",
-                    f"{pad}if steps > limit:",
+            out += [f"{pad}if {steps + 1} > limit:",
                     f"{pad}    state.zero_time({'frame' if self.framed else 'inst'}, {a})"]
         fields = self.fields(act)
         out += [f"{pad}cached = {a}.flag_cache",
-                f"{pad}bits = cached.bits if cached.key is state.flag_key "
-                f"else state.act_bits({a})",
-                f"{pad}if bits & 1:",
+                f"{pad}if (cached.bits if cached.key is state.flag_key "
+                f"else state.act_bits({a})) & 1:",
                 f"{pad}    state.emit(STARTED, {fields})"]
         if act.simple_end and not act.start_assign and act.kind != K_ASYNC:
-            out += [f"{pad}if bits & 2:", f"{pad}    state.emit(COMPLETED, {fields})"]
+            out += [f"{pad}if (cached.bits if cached.key is state.flag_key "
+                    f"else state.act_bits({a})) & 2:",
+                    f"{pad}    state.emit(COMPLETED, {fields})"]
         else:
             if act.start_assign:
                 self.assign(act, act.start_assign, pad, out)

@@ -191,19 +191,20 @@ def build_resume(proc: CompiledProcess, index: int, queued: bool = False) -> Any
     act = proc.graph.activities[index]
     a = f"A{index}"
     writer.names[a] = act
+    # (a done plan reads the frame, the instance and the run's parts once, before its data)
+    parts = ["    frame = ai.frame", "    inst = frame.inst", "    state = activities.state",
+             "    flow = activities.flow", "    iid = inst.id"]
     first = (["def done(ai, activities, data):",
               "    if ai.state != RUNNING:          # (Activities.body_done's steps)",
               "        return",
-              "    if ai.frame.inst.state == SUSPENDED:",
-              "        ai.frame.inst.defer((activities.body_done, ai, data, None))",
+              *parts[:2],
+              "    if inst.state == SUSPENDED:",
+              "        inst.defer((activities.body_done, ai, data, None))",
               "        return",
+              *parts[2:],
               "    if data:                         # (Flow.set_field, each in line)",
-              "        inst = ai.frame.inst",
-              "        state = activities.state",
               "        if state.flag_key is not KEY:",
               "            SELECT(state)",
-              "        flow = activities.flow",
-              "        iid = inst.id",
               "        for key, value in data.items():"]
              if queued else ["def resume(activities, ai):"])
     if queued:
@@ -211,21 +212,17 @@ def build_resume(proc: CompiledProcess, index: int, queued: bool = False) -> Any
     lines = [*first,
              "    ai.state = DONE                  # (Activities._complete's first steps)",
              "    ai.gen += 1",
-             "    frame = ai.frame",
+             *([] if queued else parts[:1]),
              "    running = frame.running",
              "    key = ai.key",
              "    if key in running:",
              "        del running[key]",
              "    if ai.cleanup:",
              "        ai.undo_waits()",
-             "    state = activities.state",
+             *([] if queued else parts[1:]),
              "    if state.flag_key is not KEY:    # (the listeners' bits: see by_selection)",
              "        SELECT(state)",
-             "    flow = activities.flow",
-             "    inst = frame.inst",
-             "    limit = state.start_limit",
-             "    iid = inst.id",
-             "    steps = 0"]
+             "    limit = state.start_limit"]
     if any(other.general for other in proc.graph.activities):
         lines.append("    pooled = state.pooled")
     if any(other.kind == K_TASK for other in proc.graph.activities):
@@ -272,8 +269,7 @@ def _token_locals(proc: CompiledProcess) -> list[str]:
              "    if state.flag_key is not KEY:    # (the listeners' bits: see by_selection)",
              "        SELECT(state)",
              "    limit = state.start_limit",
-             "    iid = inst.id",
-             "    steps = 0"]
+             "    iid = inst.id"]
     if any(act.general for act in proc.graph.activities):
         lines.append("    pooled = state.pooled")
     if any(act.kind == K_TASK for act in proc.graph.activities):

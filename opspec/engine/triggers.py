@@ -17,20 +17,11 @@ from collections.abc import Callable, Iterable, Iterator, Mapping
 from functools import partial
 from typing import TYPE_CHECKING, Any, final
 
-from opspec.engine.compiled import (
-    CompiledActivity,
-    CompiledPackage,
-    CompiledProcess,
-    CTrigger,
-)
+from opspec.engine.compiled import CompiledActivity, CompiledPackage, CompiledProcess, CTrigger
 from opspec.engine.instances import ActivityInstance, ProcessInstance
-from opspec.engine.lifecycle import (
-    RUNNING,
-    SUSPENDED,
-    TERMINATED,
-)
+from opspec.engine.lifecycle import RUNNING, SUSPENDED, TERMINATED
 from opspec.engine.part import Part
-from opspec.engine.runstate import discard
+from opspec.engine.runstate import RunState, discard
 from opspec.engine.timers import TUPLES, Timed, occurrences
 from opspec.engine.trace import EventKind as EK
 from opspec.errors import OpspecError
@@ -43,6 +34,10 @@ if TYPE_CHECKING:
 MESSAGE_BUFFER = 100
 
 
+def _undo(table: dict[Any, Any], token: int) -> Callable[[], None]:
+    return lambda: discard(table, token)        # (compiled: a message wait's undoing)
+
+
 class Triggers(Part):
     """Messages, signals, timers, rules, boundary events, deadlines, start/end triggers, modes."""
 
@@ -50,6 +45,12 @@ class Triggers(Part):
     # they were read from: a mode that loads workflows replaces the table
     _members_of: object = None
     _members: dict[str, tuple[str, ...]] | None = None
+
+    def __init__(self, state: RunState) -> None:
+        super().__init__(state)
+        # a catch's handler and its deadline's, bound once for the plans (see Flow.__init__)
+        self.caught_q: Callable[[ActivityInstance, Any, Any], None] = self.caught
+        self.deadline_q: Callable[[ActivityInstance, Any], None] = self.deadline
 
     def wait_trigger(self, ai: ActivityInstance, trig: CTrigger, handler: Any, arg: Any,
                       persistent: bool = False) -> None:
@@ -71,12 +72,17 @@ class Triggers(Part):
             table[token] = (ai, handler, (arg, persistent, key, token))
             # its undoing (ActivityInstance.on_leave in line): from source made and called in C
             undo: Callable[[], Any] = (partial(table.pop, token, None) if TUPLES
-                                       else lambda: discard(table, token))
+                                       else _undo(table, token))
             if ai.cleanup is None:
                 ai.cleanup = [undo]
             else:
                 ai.cleanup.append(undo)
-        elif kind in ("timer", "period"):
+        else:       # (apart: their closures' cells would be made at every message wait)
+            self._wait_other(ai, trig, handler, arg, persistent)
+
+    def _wait_other(self, ai: ActivityInstance, trig: CTrigger, handler: Any, arg: Any,
+                    persistent: bool) -> None:
+        if trig.kind in ("timer", "period"):
             inst = ai.frame.inst
             every = trig.every or 0.0
             if persistent and trig.planned and every > 0.0 and trig.count != 1:
@@ -94,7 +100,7 @@ class Triggers(Part):
             else:
                 delay = trig.offset or (trig.every or 0.0)
             self.state.later(delay, lambda a, _x: handler(a, arg, None), ai)
-        elif kind == "rule":
+        elif trig.kind == "rule":
             assert trig.condition is not None
             inst = ai.frame.inst
             if trig.condition(inst.scope, self.state.now):
@@ -249,9 +255,11 @@ class Triggers(Part):
             return
         ended = False
         for target in self.state.ends.get(key, ()):
-            if any(i.process.id == target.id for i in self.state.live.values()):
-                self.terminate_all(target.id, f"end trigger {kind}:{name}")
-                ended = True
+            for i in self.state.live.values():      # (a loop: no closure's cell a message)
+                if i.process.id == target.id:
+                    self.terminate_all(target.id, f"end trigger {kind}:{name}")
+                    ended = True
+                    break
         if not ended:
             self._keep(key, data, inst, act, None)
 

@@ -86,6 +86,10 @@ class StochasticUser:
         self._alternatives: dict[str, ActivityModel | None] = {}
         self._handover: dict[int, int] = {}      # lane -> key of its last completed item
         self._call_with: Callable[..., None] | None = None     # (see attach)
+        # (with _call_with: _finish and _end_handover bound once, not a method object made
+        # and freed per work item)
+        self._finishing: Callable[[WorkItem, int, str | None], None] | None = None
+        self._ending: Callable[[int, int, Any], None] | None = None
         #: per activity of the lane, ``[offered, completed, omitted, wrong]`` (``opspec
         #: evaluate``'s activity rows): when set, this user adds its omissions (column 2)
         #: and wrong actions (column 3: wrong choices and slips) to it as it decides them, so
@@ -114,6 +118,9 @@ class StochasticUser:
         # per work item, and an answer at once is queued as the call itself
         self._call_with = (getattr(session, "call_later_with", None) if _FROM_SOURCE
                            else None)
+        if self._call_with is not None:
+            self._finishing = self._finish
+            self._ending = self._end_handover
 
     def offer(self, item: WorkItem) -> None:
         session = self._session
@@ -225,7 +232,7 @@ class StochasticUser:
             total = 0.0
         call_with = self._call_with
         if call_with is not None:
-            call_with(total, self._finish, item, lane, choice)
+            call_with(total, self._finishing, item, lane, choice)
         elif _FROM_SOURCE:
             session.call_later(total, partial(self._finish, item, lane, choice))
         else:
@@ -269,15 +276,7 @@ class StochasticUser:
             owed = recovery[key]
             del recovery[key]
         if plan.probabilities:
-            weights = dict(plan.probabilities)
-            offered = [(c, weights.get(c, 0.0)) for c in choices]
-            total = sum(w for _, w in offered)
-            u = self._uniform() * total
-            for choice, weight in offered:
-                if u < weight:
-                    return choice, owed
-                u -= weight
-            return offered[-1][0], owed
+            return self._by_probability(choices, plan), owed
         intended = plan.intended
         if intended is None or intended not in choices:
             if intended is not None:
@@ -293,8 +292,12 @@ class StochasticUser:
             u = (raw() >> 11) * _TWO_TO_MINUS_53 if raw is not None else float(self._random())
             slipped = u < commission.probability
         if commission is not None and slipped:
-            wrong = [c for c in (commission.alternatives or choices)
-                     if c != intended and c in choices]
+            # (a loop: a comprehension would make intended and choices a closure's cells,
+            # made at every call of _choose from source)
+            wrong: list[str] = []
+            for c in commission.alternatives or choices:
+                if c != intended and c in choices:
+                    wrong.append(c)
             if wrong:
                 pick = wrong[0] if len(wrong) == 1 else wrong[int(self.rng.integers(len(wrong)))]
                 self._wrong[key] = count + 1
@@ -305,6 +308,18 @@ class StochasticUser:
         if key in self._wrong:
             del self._wrong[key]
         return intended, owed
+
+    def _by_probability(self, choices: tuple[str, ...], plan: _Plan) -> str:
+        """The alternative drawn by the plan's probabilities (one uniform)."""
+        weights = dict(plan.probabilities)
+        offered = [(c, weights.get(c, 0.0)) for c in choices]
+        total = sum(w for _, w in offered)
+        u = self._uniform() * total
+        for choice, weight in offered:
+            if u < weight:
+                return choice
+            u -= weight
+        return offered[-1][0]
 
     def _finish(self, item: WorkItem, lane: int, choice: str | None) -> None:
         pending = self._pending
@@ -329,7 +344,7 @@ class StochasticUser:
             # the same instant, which no prompt can fall into except at that exact time.
             call_with = self._call_with
             if call_with is not None:
-                call_with(0.0, self._end_handover, lane, item.key, None)
+                call_with(0.0, self._ending, lane, item.key, None)
             elif _FROM_SOURCE:
                 session.call_later(0.0, partial(self._end_handover, lane, item.key))
             else:
