@@ -116,6 +116,9 @@ class RoomState:
         self.y = 0.0
         self.heading = 0.0
         self.command = "stop"
+        # the motion of the command object last looked up (advance's, in the constant table)
+        self.moved_by: str | None = None
+        self.motion: tuple[float, ...] = STILL
         self.bumped = False
         self.in_contact = False
         self.t = 0.0
@@ -132,6 +135,10 @@ class RoomState:
         self.kx1 = 0
         self.ky0 = 0
         self.ky1 = 0
+        self.fx0 = 0.0          # (the same four as floats)
+        self.fx1 = 0.0
+        self.fy0 = 0.0
+        self.fy1 = 0.0
         self.near_cells: Cells = ()
         # whether none of ``near_cells`` was in ``covered`` when it had ``near_count`` cells
         # (then, the set no larger, none is now: cells are only ever added, and ``cover``
@@ -190,9 +197,14 @@ class RoomState:
         """World.advance's steps to ``now`` (nothing when the world is there already)."""
         if not self.time < now - 1e-12:
             return DONE
-        motion: tuple[float, ...] | None = _COMMANDS.get(self.command)
-        if motion is None:                  # (no default to the get: see STILL)
-            motion = STILL
+        command = self.command
+        if command is self.moved_by:        # (the same command object as last time)
+            motion = self.motion
+        else:
+            found: tuple[float, ...] | None = _COMMANDS.get(command)
+            motion = STILL if found is None else found  # (no default to the get: see STILL)
+            self.moved_by = command
+            self.motion = motion
         v, w = motion
         if abs(w) >= 1e-12:
             if v != 0.0:
@@ -283,17 +295,36 @@ class RoomState:
                 y = ny
                 in_contact = False
                 if inv > 0.0:
-                    kx0 = math.floor((x - reach) * inv)     # cells_of, in line
-                    kx1 = math.floor((x + reach) * inv)
-                    ky0 = math.floor((y - reach) * inv)
-                    ky1 = math.floor((y + reach) * inv)
+                    ax0 = (x - reach) * inv                 # cells_of, in line
+                    ax1 = (x + reach) * inv
+                    ay0 = (y - reach) * inv
+                    ay1 = (y + reach) * inv
+                    # the last range's, without the four floors: floor(a) is k exactly
+                    # when k <= a < k + 1 (k a whole float, far below 2**53)
+                    fx0 = self.fx0
+                    fx1 = self.fx1
+                    fy0 = self.fy0
+                    fy1 = self.fy1
+                    same = (self.near and fx0 <= ax0 < fx0 + 1.0 and fx1 <= ax1 < fx1 + 1.0
+                            and fy0 <= ay0 < fy0 + 1.0 and fy1 <= ay1 < fy1 + 1.0)
+                    if same:
+                        kx0 = self.kx0
+                        kx1 = self.kx1
+                        ky0 = self.ky0
+                        ky1 = self.ky1
+                    else:
+                        kx0 = math.floor(ax0)
+                        kx1 = math.floor(ax1)
+                        ky0 = math.floor(ay0)
+                        ky1 = math.floor(ay1)
                 else:
                     kx0 = int((x - reach) // cell)
                     kx1 = int((x + reach) // cell)
                     ky0 = int((y - reach) // cell)
                     ky1 = int((y + reach) // cell)
-                if (self.near and kx0 == self.kx0 and kx1 == self.kx1 and ky0 == self.ky0
-                        and ky1 == self.ky1):
+                    same = (self.near and kx0 == self.kx0 and kx1 == self.kx1
+                            and ky0 == self.ky0 and ky1 == self.ky1)
+                if same:
                     cells = self.near_cells             # uncovered[key], as left
                 else:
                     key = (kx0, kx1, ky0, ky1)
@@ -308,6 +339,10 @@ class RoomState:
                     self.kx1 = kx1
                     self.ky0 = ky0
                     self.ky1 = ky1
+                    self.fx0 = float(kx0)
+                    self.fx1 = float(kx1)
+                    self.fy0 = float(ky0)
+                    self.fy1 = float(ky1)
                     self.near_cells = cells
                     self.near_clean = False
                 if len(cells) > 0:
