@@ -18,7 +18,7 @@ from opspec.worlds.robot import COMMANDS, pose_after
 
 __all__ = ["ARC", "COLLISION", "COVER", "DONE", "STEP_S", "Grown", "Normals", "RayBox",
            "RoomState", "Sides", "cells_of", "cover", "cover_limit", "cover_within",
-           "distance_ahead", "far_from", "round4"]
+           "distance_ahead", "distance_along", "far_from", "round4"]
 
 #: integration step: 5 cm at 1 m/s, well under the robot's size
 STEP_S: Final = 0.05
@@ -153,6 +153,12 @@ class RoomState:
         # wrapping is a function of the heading, so advance need not compute it again
         self.known = False
         self.wrapped = 0.0
+        # cos and sin of the heading ``trig_of`` (when ``trig_known``): functions of it, so
+        # a straight drive's steps and readings need not compute them again
+        self.trig_known = False
+        self.trig_of = 0.0
+        self.cos_h = 1.0
+        self.sin_h = 0.0
 
     def place(self, inside: tuple[float, float, float, float],
               grown: list[tuple[float, float, float, float]], reach: float, cell: float,
@@ -229,6 +235,16 @@ class RoomState:
         self.stop = self.command == "stop"
         return self.resume(now)
 
+    def trig(self, heading: float) -> None:
+        """Have ``cos_h`` and ``sin_h`` be ``math.cos(heading)`` and ``math.sin(heading)``
+        (computed only for another heading than last time: -0.0 is another than 0.0)."""
+        if not (self.trig_known and heading == self.trig_of
+                and math.copysign(1.0, heading) == math.copysign(1.0, self.trig_of)):
+            self.cos_h = math.cos(heading)
+            self.sin_h = math.sin(heading)
+            self.trig_of = heading
+            self.trig_known = True
+
     def _turn_in_place(self, now: float, w: float) -> None:
         """Steps of a command that turns without driving (``turn_left``…): ``_step`` with
         the position, the contact and the coverage left as they are."""
@@ -263,8 +279,9 @@ class RoomState:
         reach = self.reach
         cell = self.cell
         inv = self.inv
-        cos_h = math.cos(heading)
-        sin_h = math.sin(heading)
+        self.trig(heading)
+        cos_h = self.cos_h                  # (of ``heading`` throughout the loop)
+        sin_h = self.sin_h
         code = DONE
         t_step = 0.0
         while t < limit:
@@ -375,6 +392,9 @@ class RoomState:
         self.x = x
         self.y = y
         self.heading = heading
+        self.trig_of = heading
+        self.cos_h = cos_h
+        self.sin_h = sin_h
         self.after = after
         self.settled = settled
         self.in_contact = in_contact
@@ -393,7 +413,8 @@ class RoomState:
     def read_range(self, noise: float) -> float:
         """The range finder's reading with this ``noise`` drawn: the distance from the
         robot's edge to the nearest wall or obstacle face ahead, 0 at the least, to 0.1 mm."""
-        best = distance_ahead(self.x, self.y, self.heading, self.boxes)
+        self.trig(self.heading)
+        best = distance_along(self.x, self.y, self.cos_h, self.sin_h, self.boxes)
         distance = best - self.radius + noise
         return round4(distance if distance > 0.0 else 0.0)     # max(0.0, distance)
 
@@ -457,8 +478,12 @@ def distance_ahead(x: float, y: float, heading: float, boxes: tuple[Sides, ...])
     """``ray_to_box_along`` to the room's walls from inside (``boxes[0]``), then to each
     obstacle's faces from outside, the nearest of them: the same arithmetic in one loop (the
     range finder of :class:`~opspec.worlds.room.RoomWorld`)."""
-    dx = math.cos(heading)
-    dy = math.sin(heading)
+    return distance_along(x, y, math.cos(heading), math.sin(heading), boxes)
+
+
+def distance_along(x: float, y: float, dx: float, dy: float, boxes: tuple[Sides, ...]
+                   ) -> float:
+    """:func:`distance_ahead` with the heading's cosine ``dx`` and sine ``dy`` given."""
     along_x = abs(dx) > 1e-12
     along_y = abs(dy) > 1e-12
     best = math.inf
