@@ -18,7 +18,7 @@ from opspec.worlds.robot import COMMANDS, pose_after
 
 __all__ = ["ARC", "COLLISION", "COVER", "DONE", "STEP_S", "Grown", "Normals", "RayBox",
            "RoomState", "Sides", "cells_of", "cover", "cover_limit", "cover_within",
-           "distance_ahead", "distance_along", "far_from", "round4"]
+           "distance_ahead", "far_from", "round4"]
 
 #: integration step: 5 cm at 1 m/s, well under the robot's size
 STEP_S: Final = 0.05
@@ -135,10 +135,6 @@ class RoomState:
         self.kx1 = 0
         self.ky0 = 0
         self.ky1 = 0
-        self.fx0 = 0.0          # (the same four as floats)
-        self.fx1 = 0.0
-        self.fy0 = 0.0
-        self.fy1 = 0.0
         self.near_cells: Cells = ()
         # whether none of ``near_cells`` was in ``covered`` when it had ``near_count`` cells
         # (then, the set no larger, none is now: cells are only ever added, and ``cover``
@@ -153,10 +149,9 @@ class RoomState:
         # wrapping is a function of the heading, so advance need not compute it again
         self.known = False
         self.wrapped = 0.0
-        # cos and sin of the heading ``trig_of`` (when ``trig_known``): functions of it, so
-        # a straight drive's steps and readings need not compute them again
-        self.trig_known = False
-        self.trig_of = 0.0
+        # cos and sin of the heading ``trig_of`` (NaN: none yet), left by resume: functions
+        # of it, so a straight drive's steps need not compute them again
+        self.trig_of = math.nan
         self.cos_h = 1.0
         self.sin_h = 0.0
 
@@ -235,16 +230,6 @@ class RoomState:
         self.stop = self.command == "stop"
         return self.resume(now)
 
-    def trig(self, heading: float) -> None:
-        """Have ``cos_h`` and ``sin_h`` be ``math.cos(heading)`` and ``math.sin(heading)``
-        (computed only for another heading than last time: -0.0 is another than 0.0)."""
-        if not (self.trig_known and heading == self.trig_of
-                and math.copysign(1.0, heading) == math.copysign(1.0, self.trig_of)):
-            self.cos_h = math.cos(heading)
-            self.sin_h = math.sin(heading)
-            self.trig_of = heading
-            self.trig_known = True
-
     def _turn_in_place(self, now: float, w: float) -> None:
         """Steps of a command that turns without driving (``turn_left``…): ``_step`` with
         the position, the contact and the coverage left as they are."""
@@ -279,9 +264,14 @@ class RoomState:
         reach = self.reach
         cell = self.cell
         inv = self.inv
-        self.trig(heading)
-        cos_h = self.cos_h                  # (of ``heading`` throughout the loop)
-        sin_h = self.sin_h
+        # (equal floats other than zero are the same float; -0.0 and 0.0 have sines of
+        # two signs, so zero is computed; a NaN is never equal)
+        if heading == self.trig_of and heading != 0.0:
+            cos_h = self.cos_h
+            sin_h = self.sin_h
+        else:
+            cos_h = math.cos(heading)
+            sin_h = math.sin(heading)
         code = DONE
         t_step = 0.0
         while t < limit:
@@ -312,36 +302,17 @@ class RoomState:
                 y = ny
                 in_contact = False
                 if inv > 0.0:
-                    ax0 = (x - reach) * inv                 # cells_of, in line
-                    ax1 = (x + reach) * inv
-                    ay0 = (y - reach) * inv
-                    ay1 = (y + reach) * inv
-                    # the last range's, without the four floors: floor(a) is k exactly
-                    # when k <= a < k + 1 (k a whole float, far below 2**53)
-                    fx0 = self.fx0
-                    fx1 = self.fx1
-                    fy0 = self.fy0
-                    fy1 = self.fy1
-                    same = (self.near and fx0 <= ax0 < fx0 + 1.0 and fx1 <= ax1 < fx1 + 1.0
-                            and fy0 <= ay0 < fy0 + 1.0 and fy1 <= ay1 < fy1 + 1.0)
-                    if same:
-                        kx0 = self.kx0
-                        kx1 = self.kx1
-                        ky0 = self.ky0
-                        ky1 = self.ky1
-                    else:
-                        kx0 = math.floor(ax0)
-                        kx1 = math.floor(ax1)
-                        ky0 = math.floor(ay0)
-                        ky1 = math.floor(ay1)
+                    kx0 = math.floor((x - reach) * inv)     # cells_of, in line
+                    kx1 = math.floor((x + reach) * inv)
+                    ky0 = math.floor((y - reach) * inv)
+                    ky1 = math.floor((y + reach) * inv)
                 else:
                     kx0 = int((x - reach) // cell)
                     kx1 = int((x + reach) // cell)
                     ky0 = int((y - reach) // cell)
                     ky1 = int((y + reach) // cell)
-                    same = (self.near and kx0 == self.kx0 and kx1 == self.kx1
-                            and ky0 == self.ky0 and ky1 == self.ky1)
-                if same:
+                if (self.near and kx0 == self.kx0 and kx1 == self.kx1 and ky0 == self.ky0
+                        and ky1 == self.ky1):
                     cells = self.near_cells             # uncovered[key], as left
                 else:
                     key = (kx0, kx1, ky0, ky1)
@@ -356,10 +327,6 @@ class RoomState:
                     self.kx1 = kx1
                     self.ky0 = ky0
                     self.ky1 = ky1
-                    self.fx0 = float(kx0)
-                    self.fx1 = float(kx1)
-                    self.fy0 = float(ky0)
-                    self.fy1 = float(ky1)
                     self.near_cells = cells
                     self.near_clean = False
                 if len(cells) > 0:
@@ -413,8 +380,7 @@ class RoomState:
     def read_range(self, noise: float) -> float:
         """The range finder's reading with this ``noise`` drawn: the distance from the
         robot's edge to the nearest wall or obstacle face ahead, 0 at the least, to 0.1 mm."""
-        self.trig(self.heading)
-        best = distance_along(self.x, self.y, self.cos_h, self.sin_h, self.boxes)
+        best = distance_ahead(self.x, self.y, self.heading, self.boxes)
         distance = best - self.radius + noise
         return round4(distance if distance > 0.0 else 0.0)     # max(0.0, distance)
 
@@ -478,12 +444,8 @@ def distance_ahead(x: float, y: float, heading: float, boxes: tuple[Sides, ...])
     """``ray_to_box_along`` to the room's walls from inside (``boxes[0]``), then to each
     obstacle's faces from outside, the nearest of them: the same arithmetic in one loop (the
     range finder of :class:`~opspec.worlds.room.RoomWorld`)."""
-    return distance_along(x, y, math.cos(heading), math.sin(heading), boxes)
-
-
-def distance_along(x: float, y: float, dx: float, dy: float, boxes: tuple[Sides, ...]
-                   ) -> float:
-    """:func:`distance_ahead` with the heading's cosine ``dx`` and sine ``dy`` given."""
+    dx = math.cos(heading)
+    dy = math.sin(heading)
     along_x = abs(dx) > 1e-12
     along_y = abs(dy) > 1e-12
     best = math.inf
