@@ -54,10 +54,14 @@ class DedicatedProcessor:
             ends[-1] = end
             busy = size
         elif self._lined:
-            while ends and ends[-1] <= now:
+            # the ended bursts taken off but the last of them, ``spare``, which goes only
+            # after the new one is in: a list emptied frees its storage, which the insertion
+            # would allocate again at once (the earlier ones end no earlier than it)
+            while len(ends) > 1 and ends[-2] <= now:
                 ends.pop()
+            spare = len(ends) > 0 and ends[-1] <= now
             lo: i64 = 0                 # (as timers.line_push's bisection)
-            hi: i64 = len(ends)
+            hi: i64 = len(ends) - 1 if spare else len(ends)
             while lo < hi:
                 mid = (lo + hi) >> 1
                 if ends[mid] > end:
@@ -65,6 +69,8 @@ class DedicatedProcessor:
                 else:
                     hi = mid
             ends.insert(lo, end)
+            if spare:
+                ends.pop()
             busy = len(ends)
             if busy > LINE_MAX:
                 ends.reverse()          # the earliest first: sorted, so a heap

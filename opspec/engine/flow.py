@@ -159,10 +159,12 @@ class Flow(Part):
         inst.state = _COMPLETED_FROM_RUNNING
         inst.frames.clear()          # breaks the instance <-> frame cycle: freed by refcount
         state = self.state
-        live = state.live            # RunState.gone, in line
-        key = inst.id                # (boxed once: see ProcessInstance.__init__)
-        if key in live:
-            del live[key]
+        live = state.live            # RunState.gone, in line, but one look-up: a running
+        key = inst.id                # instance is as a rule in the table (boxed once: see
+        try:                         # ProcessInstance.__init__; compiled, a try costs
+            del live[key]            # nothing until it catches)
+        except KeyError:
+            pass
         if state.kept and inst.parent is None:
             self.triggers.drop_kept(inst)
         state.completed += 1

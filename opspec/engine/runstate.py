@@ -164,11 +164,13 @@ class RunState(Timers):
         return not self.ready and not self.pending
 
     def gone(self, iid: int) -> None:
-        """Workflow instance ``iid`` ended (``in`` and ``del``, not ``pop(key, None)``:
-        compiled, a dict's pop is a Python method call, these are primitives)."""
-        live = self.live
-        if iid in live:
-            del live[iid]
+        """Workflow instance ``iid`` ended (``del`` in a ``try``, not ``pop(key, None)``:
+        compiled, a dict's pop is a Python method call, a deletion is a primitive and its
+        ``try`` costs nothing until it catches)."""
+        try:
+            del self.live[iid]
+        except KeyError:
+            pass
 
     @property
     def counts(self) -> dict[str, int]:

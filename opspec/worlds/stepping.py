@@ -17,7 +17,8 @@ from typing import Any, Final
 from opspec.worlds.robot import COMMANDS, pose_after
 
 __all__ = ["ARC", "COLLISION", "COVER", "DONE", "STEP_S", "Grown", "Normals", "RayBox",
-           "RoomState", "Sides", "cells_of", "cover", "distance_ahead", "round4"]
+           "RoomState", "Sides", "cells_of", "cover", "cover_limit", "cover_within",
+           "distance_ahead", "far_from", "round4"]
 
 #: integration step: 5 cm at 1 m/s, well under the robot's size
 STEP_S: Final = 0.05
@@ -115,6 +116,9 @@ class RoomState:
         self.y = 0.0
         self.heading = 0.0
         self.command = "stop"
+        # the motion of the command object last looked up (advance's, in the constant table)
+        self.moved_by: str | None = None
+        self.motion: tuple[float, ...] = STILL
         self.bumped = False
         self.in_contact = False
         self.t = 0.0
@@ -132,10 +136,24 @@ class RoomState:
         self.ky0 = 0
         self.ky1 = 0
         self.near_cells: Cells = ()
+        # whether none of ``near_cells`` was in ``covered`` when it had ``near_count`` cells
+        # (then, the set no larger, none is now: cells are only ever added, and ``cover``
+        # need not test them)
+        self.near_clean = False
+        self.near_count = 0
+        # ``cover``'s bound and the distance past which a cell is surely outside it (fixed
+        # with the geometry: see place)
+        self.limit = 0.0
+        self.far = 0.0
         # a heading known to wrap to itself bit for bit (``wrapped``, when ``known``):
         # wrapping is a function of the heading, so advance need not compute it again
         self.known = False
         self.wrapped = 0.0
+        # cos and sin of the heading ``trig_of`` (NaN: none yet), left by resume: functions
+        # of it, so a straight drive's steps need not compute them again
+        self.trig_of = math.nan
+        self.cos_h = 1.0
+        self.sin_h = 0.0
 
     def place(self, inside: tuple[float, float, float, float],
               grown: list[tuple[float, float, float, float]], reach: float, cell: float,
@@ -162,6 +180,9 @@ class RoomState:
         self.boxes = tuple([Sides(box) for box in boxes])
         self.uncovered = uncovered
         self.near = False
+        self.near_clean = False
+        self.limit = cover_limit(reach, cell)
+        self.far = far_from(self.limit)
         self.covered = covered
         self.cells_x = cells_x
         self.cells_y = cells_y
@@ -177,9 +198,14 @@ class RoomState:
         """World.advance's steps to ``now`` (nothing when the world is there already)."""
         if not self.time < now - 1e-12:
             return DONE
-        motion: tuple[float, ...] | None = _COMMANDS.get(self.command)
-        if motion is None:                  # (no default to the get: see STILL)
-            motion = STILL
+        command = self.command
+        if command is self.moved_by:        # (the same command object as last time)
+            motion = self.motion
+        else:
+            found: tuple[float, ...] | None = _COMMANDS.get(command)
+            motion = STILL if found is None else found  # (no default to the get: see STILL)
+            self.moved_by = command
+            self.motion = motion
         v, w = motion
         if abs(w) >= 1e-12:
             if v != 0.0:
@@ -238,8 +264,14 @@ class RoomState:
         reach = self.reach
         cell = self.cell
         inv = self.inv
-        cos_h = math.cos(heading)
-        sin_h = math.sin(heading)
+        # (equal floats other than zero are the same float; -0.0 and 0.0 have sines of
+        # two signs, so zero is computed; a NaN is never equal)
+        if heading == self.trig_of and heading != 0.0:
+            cos_h = self.cos_h
+            sin_h = self.sin_h
+        else:
+            cos_h = math.cos(heading)
+            sin_h = math.sin(heading)
         code = DONE
         t_step = 0.0
         while t < limit:
@@ -287,8 +319,7 @@ class RoomState:
                     found = uncovered.get(key)
                     if found is None:
                         cells = self._cells(key)
-                        if not cells:
-                            uncovered[key] = cells
+                        uncovered[key] = cells          # (near_cells is uncovered[key])
                     else:
                         cells = found
                     self.near = True
@@ -297,15 +328,21 @@ class RoomState:
                     self.ky0 = ky0
                     self.ky1 = ky1
                     self.near_cells = cells
+                    self.near_clean = False
                 if len(cells) > 0:
                     # RoomWorld._cover at this step, over the range's cells still uncovered
                     # (cells are only ever added, so the others cannot be covered again)
-                    key = (kx0, kx1, ky0, ky1)
-                    new, left = cover(cells, x, y, cell, reach, self.covered)
-                    uncovered[key] = left
-                    self.near_cells = left
+                    covered = self.covered
+                    check = not (self.near_clean and len(covered) == self.near_count)
+                    new, left = cover_within(cells, x, y, cell, self.limit, self.far,
+                                             covered, check)
+                    if left is not cells:               # (else uncovered[key] is cells)
+                        uncovered[(kx0, kx1, ky0, ky1)] = left
+                        self.near_cells = left
+                    self.near_clean = True
+                    self.near_count = len(covered)
                     if new:
-                        self.key = key
+                        self.key = (kx0, kx1, ky0, ky1)
                         self.new_cells = new
                         code = COVER
             else:
@@ -322,6 +359,9 @@ class RoomState:
         self.x = x
         self.y = y
         self.heading = heading
+        self.trig_of = heading
+        self.cos_h = cos_h
+        self.sin_h = sin_h
         self.after = after
         self.settled = settled
         self.in_contact = in_contact
@@ -447,25 +487,49 @@ def cover(cells: Cells, x: float, y: float, cell: float, reach: float,
     plus half a cell: they are added to ``covered``; returned are the newly covered ones, in
     the order of ``cells`` (the room traces them in that order), and the ``cells`` still not
     covered."""
+    limit = cover_limit(reach, cell)
+    return cover_within(cells, x, y, cell, limit, far_from(limit), covered, True)
+
+
+def cover_limit(reach: float, cell: float) -> float:
+    """The squared distance within which a cell's centre is covered (``RoomWorld._cover``'s
+    ``reach ** 2 + (cell / 2) ** 2``)."""
     # math.pow(a, 2.0) is ``a ** 2``: both are the C library's pow(a, 2.0) (CPython's float
     # power takes the sign off first, which pow of an even power does too), but compiled
     # math.pow is that call itself, ``**`` a boxed number protocol call
-    limit = math.pow(reach, 2.0) + math.pow(cell / 2, 2.0)
+    return math.pow(reach, 2.0) + math.pow(cell / 2, 2.0)
+
+
+def far_from(limit: float) -> float:
+    """A distance along one axis past which a centre is surely not within ``limit``: the
+    square of anything above it exceeds ``limit`` by far more than pow's and the sum's
+    rounding (under an ulp each), so the test it spares could only have failed."""
+    return math.sqrt(limit) * (1.0 + 2.0 ** -20)
+
+
+def cover_within(cells: Cells, x: float, y: float, cell: float, limit: float, far: float,
+                 covered: set[Cell], check: bool) -> tuple[list[Cell], Cells]:
+    """:func:`cover` with its bound ``limit`` (and ``far_from(limit)``) given; ``check``
+    false when none of ``cells`` is in ``covered`` (the membership tests then spared). The
+    cells still not covered are ``cells`` itself when they are all of them."""
     new: list[Cell] = []
     left: list[Cell] = []
     # one membership test a cell: ``cells`` has no cell twice, so one covered here is in
     # no later test, and those still not covered afterwards are the ones tested here
     for c in cells:
-        if c in covered:
+        if check and c in covered:
             continue                # (cells of other ranges overlap these: covered there)
         cx, cy = c
-        centre_x = (cx + 0.5) * cell
-        centre_y = (cy + 0.5) * cell
-        if math.pow(centre_x - x, 2.0) + math.pow(centre_y - y, 2.0) <= limit:
+        dx = (cx + 0.5) * cell - x
+        dy = (cy + 0.5) * cell - y
+        if (abs(dx) <= far and abs(dy) <= far
+                and math.pow(dx, 2.0) + math.pow(dy, 2.0) <= limit):
             covered.add(c)
             new.append(c)
         else:
             left.append(c)
+    if len(left) == len(cells):
+        return new, cells           # (the same cells, in order: no copy)
     return new, tuple(left)
 
 
