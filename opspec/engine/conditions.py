@@ -418,6 +418,10 @@ def _compile_equality(expr: Binary, left: _Fn, right: _Fn, whole: _Whole, *,
     ):
         root, constant = field_name(expr.left.path[0]), _value(expr.right)
         kind = type(constant)
+        # a boolean or null constant is one object: a value of its type equals it when it
+        # is that object (compiled, ``==`` of two values of unknown type is a call through
+        # Python's comparison protocol, about 70 instructions a robot's flag tested)
+        single = constant is None or kind is bool
 
         def field_equals(data: Mapping[str, Any], now: float) -> bool:
             try:
@@ -426,6 +430,8 @@ def _compile_equality(expr: Binary, left: _Fn, right: _Fn, whole: _Whole, *,
                 except KeyError:
                     missing_field(data, root)
                 if type(value) is kind:
+                    if single:
+                        return (value is constant) is not negate
                     return (value == constant) is not negate
                 return equal(value, constant) is not negate
             except (ConditionProblem, *_PYTHON_ERRORS) as problem:
