@@ -355,10 +355,12 @@ def _compile_binary(expr: Binary, whole: _Whole = None) -> _Fn:
     op = expr.op
     left, right = _compile(expr.left), _compile(expr.right)
     # (``and`` and ``or`` give a bool: at a condition's root, ``whole``, they are the
-    # condition, naming it in their operands' errors as ``compile_condition``'s wrapper would)
+    # condition, naming it in their operands' errors as ``compile_condition``'s wrapper would;
+    # ``now`` untyped: compiled, a float parameter is unboxed on entry and boxed again for
+    # each operand's call, where the caller's box can be handed on)
     if op == "and":
 
-        def both(data: Mapping[str, Any], now: float) -> bool:
+        def both(data: Mapping[str, Any], now: Any) -> bool:
             try:
                 a = left(data, now)
                 if not (a is True or (a is not False and truthy(a))):
@@ -371,7 +373,7 @@ def _compile_binary(expr: Binary, whole: _Whole = None) -> _Fn:
         return both
     if op == "or":
 
-        def either(data: Mapping[str, Any], now: float) -> bool:
+        def either(data: Mapping[str, Any], now: Any) -> bool:
             try:
                 a = left(data, now)
                 if a is True or (a is not False and truthy(a)):
