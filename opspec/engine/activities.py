@@ -415,8 +415,10 @@ class Activities(Part):
         ai.gen += 1
         frame = ai.frame
         key: object = ai.key                # (boxed once: see ActivityInstance.leave)
-        if key in frame.running:
-            del frame.running[key]
+        try:                                # (one look-up where a test and a del took two;
+            del frame.running[key]          # compiled, a try costs nothing until it catches)
+        except KeyError:
+            pass
         if ai.cleanup:
             ai.undo_waits()
         if ai.mi is not None:

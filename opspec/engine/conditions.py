@@ -355,10 +355,12 @@ def _compile_binary(expr: Binary, whole: _Whole = None) -> _Fn:
     op = expr.op
     left, right = _compile(expr.left), _compile(expr.right)
     # (``and`` and ``or`` give a bool: at a condition's root, ``whole``, they are the
-    # condition, naming it in their operands' errors as ``compile_condition``'s wrapper would)
+    # condition, naming it in their operands' errors as ``compile_condition``'s wrapper would;
+    # ``now`` untyped: compiled, a float parameter is unboxed on entry and boxed again for
+    # each operand's call, where the caller's box can be handed on)
     if op == "and":
 
-        def both(data: Mapping[str, Any], now: float) -> bool:
+        def both(data: Mapping[str, Any], now: Any) -> bool:
             try:
                 a = left(data, now)
                 if not (a is True or (a is not False and truthy(a))):
@@ -371,7 +373,7 @@ def _compile_binary(expr: Binary, whole: _Whole = None) -> _Fn:
         return both
     if op == "or":
 
-        def either(data: Mapping[str, Any], now: float) -> bool:
+        def either(data: Mapping[str, Any], now: Any) -> bool:
             try:
                 a = left(data, now)
                 if a is True or (a is not False and truthy(a)):
@@ -418,6 +420,10 @@ def _compile_equality(expr: Binary, left: _Fn, right: _Fn, whole: _Whole, *,
     ):
         root, constant = field_name(expr.left.path[0]), _value(expr.right)
         kind = type(constant)
+        # a boolean or null constant is one object: a value of its type equals it when it
+        # is that object (compiled, ``==`` of two values of unknown type is a call through
+        # Python's comparison protocol, about 70 instructions a robot's flag tested)
+        single = constant is None or kind is bool
 
         def field_equals(data: Mapping[str, Any], now: float) -> bool:
             try:
@@ -426,6 +432,8 @@ def _compile_equality(expr: Binary, left: _Fn, right: _Fn, whole: _Whole, *,
                 except KeyError:
                     missing_field(data, root)
                 if type(value) is kind:
+                    if single:
+                        return (value is constant) is not negate
                     return (value == constant) is not negate
                 return equal(value, constant) is not negate
             except (ConditionProblem, *_PYTHON_ERRORS) as problem:

@@ -15,7 +15,7 @@ token-gone and frame-done steps of the general path.
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 from opspec.engine.compiled import K_ASYNC, K_TASK, CompiledActivity, CTransition
 from opspec.engine.instances import Frame, ProcessInstance
@@ -116,7 +116,7 @@ def xor_transition(flow: Flow, inst: ProcessInstance, act: CompiledActivity,
     done); otherwise, or when a condition fails, the instance is aborted. The one choice of
     both the general path (``Flow.split``) and the frameless token."""
     scope = inst.scope
-    now = flow.state.now
+    now: Any = flow.state.now                   # (boxed once for all the conditions tried)
     try:
         for trans in act.out:
             cond = trans.condition
