@@ -221,12 +221,10 @@ class RunState(Timers):
         if metric is not None:
             # MetricsListener.raw in line (the run's own metrics, as a rule its one raw
             # listener: five events a dose cycle, a Python frame each from source)
-            key = (kind, process, activity)
-            matching = metric.matching
-            try:                    # (one lookup, so the key tuple is hashed once)
-                chosen = matching[key]
+            try:
+                chosen = metric.matching[kind][process][activity]
             except KeyError:
-                chosen = matching[key] = metric.match(kind, process, activity)
+                chosen = metric.chosen(kind, process, activity)
             for name, role, last in chosen:
                 if role == COUNT:
                     metric.counts[name] += 1
