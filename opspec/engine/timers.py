@@ -194,12 +194,12 @@ class Timers:
         at = self.now + delay
         seq = self.order + 1
         self.order = seq
-        if TUPLES:      # (_push's case from source in line: a Python frame less an entry;
-            rows: list[Any] = self.heap     # the row holds the time and the sequence, and
-            heappush(rows, (at, seq, entry))    # nothing reads the entry's own from source)
+        entry.at = at
+        entry.seq = seq
+        if TUPLES:      # (_push's case from source in line: a Python frame less an entry)
+            rows: list[Any] = self.heap
+            heappush(rows, (at, seq, entry))
         else:
-            entry.at = at
-            entry.seq = seq
             self._push(entry)
         if at < self.armed_at and not self.ticking:
             self.arm()
