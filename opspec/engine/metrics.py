@@ -65,11 +65,13 @@ class MetricsListener:
         # kind -> (metric name, role, process, activity, keep the last start): plain values,
         # not the model's selector objects, because ``raw`` runs for every matching event.
         self._by_kind: dict[str, list[tuple[str, int, str | None, str | None, bool]]] = {}
-        # (kind, process, activity) -> the (metric name, role, keep the last start) of the
-        # selectors it matches, in their order: found once per distinct event, so ``raw``
-        # does not test every selector of the kind at every event
-        self.matching: dict[tuple[str, str | None, str | None],
-                             tuple[tuple[str, int, bool], ...]] = {}
+        # kind -> process -> activity -> the (metric name, role, keep the last start) of
+        # the selectors it matches, in their order: found once per distinct event
+        # (:meth:`chosen`), so ``raw`` does not test every selector of the kind at every
+        # event; nested, so that an event looks its entry up without a key tuple made and
+        # hashed for it
+        self.matching: dict[str, dict[str | None, dict[
+            str | None, tuple[tuple[str, int, bool], ...]]]] = {}
         selects: set[tuple[str, str | None, str | None]] = set()
         for metric in self.definitions:
             if metric.kind is MetricKind.COUNT and metric.select is not None:
@@ -98,11 +100,10 @@ class MetricsListener:
         this when no other listener needs the event object). ``RunState.emit`` takes these
         steps in line for a run's own metrics (a plain MetricsListener, its one raw
         listener): a change here is a change there."""
-        key = (kind, process, activity)
-        try:                        # (one lookup, so the key tuple is hashed once)
-            chosen = self.matching[key]
+        try:
+            chosen = self.matching[kind][process][activity]
         except KeyError:
-            chosen = self.matching[key] = self.match(kind, process, activity)
+            chosen = self.chosen(kind, process, activity)
         for name, role, last in chosen:
             if role == COUNT:
                 self.counts[name] += 1
@@ -120,6 +121,13 @@ class MetricsListener:
                 self.samples[name].append(time - started)
                 if self.keep_times:
                     self.sample_times.setdefault(name, []).append(time)
+
+    def chosen(self, kind: str, process: str | None, activity: str | None
+               ) -> tuple[tuple[str, int, bool], ...]:
+        """:meth:`match`, kept in ``matching`` (an event's first time)."""
+        found = self.match(kind, process, activity)
+        self.matching.setdefault(kind, {}).setdefault(process, {})[activity] = found
+        return found
 
     def match(self, kind: str, process: str | None, activity: str | None
                ) -> tuple[tuple[str, int, bool], ...]:

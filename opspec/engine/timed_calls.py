@@ -84,7 +84,8 @@ class CallWith(Timed):
         self.c = c
 
     def go(self) -> None:
-        self.fn(self.a, self.b, self.c)
+        fn = self.fn    # (read as a field, then called: from source a method load of a
+        fn(self.a, self.b, self.c)      # field is never specialised)
         state = self.state
         # drain's case of nothing queued at this instant in line: a step counted (the
         # callback, a performer's answer, has drained what it queued as a rule)

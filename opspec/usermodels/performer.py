@@ -336,7 +336,8 @@ class StochasticUser:
             else:
                 handover = True
                 self._handover[lane] = item.key
-        session.complete(item, None, choice)
+        complete = session.complete     # (the session's field, as a rule: read, then
+        complete(item, None, choice)    # called, its load specialised from source)
         if handover and self._handover.get(lane) == item.key:
             # Stay engaged if the instance offers its next activity at this same moment;
             # release if it ended (nothing offered when this zero-delay check runs). An
