@@ -384,9 +384,8 @@ class RunState(Timers):
         if TUPLES:      # from source, made without a Python frame for its __init__
             entry: Any = _NEW(_Later)
             entry.state, entry.fn, entry.ai, entry.arg, entry.gen = self, fn, ai, arg, ai.gen
-            _SCHEDULE_TIMED(self, delay if delay > 0.0 else 0.0, entry)  # noqa: FURB136
-            return
-        entry = _Later(self, fn, ai, arg)
+        else:
+            entry = _Later(self, fn, ai, arg)
         self.schedule_timed(delay if delay > 0.0 else 0.0, entry)  # noqa: FURB136
 
     def later_entry(self, delay: float, entry: Timed) -> None:
@@ -455,9 +454,8 @@ class RunState(Timers):
         if TUPLES:      # from source, made without a Python frame for its __init__
             entry: Any = _NEW(_CallWith)
             entry.state, entry.fn, entry.a, entry.b, entry.c = self, fn, a, b, c
-            _SCHEDULE_TIMED(self, delay if delay > 0.0 else 0.0, entry)  # noqa: FURB136
-            return
-        entry = _CallWith(self, fn, a, b, c)
+        else:
+            entry = _CallWith(self, fn, a, b, c)
         self.schedule_timed(delay if delay > 0.0 else 0.0, entry)  # noqa: FURB136
 
     def timer(self, delay: float, callback: Callable[[], None]) -> None:
@@ -529,10 +527,6 @@ def _call(callback: Callable[[], None], _a: Any, _b: Any) -> None:
 _CALL: Final = _call        # a module static compiled (a global is a dictionary lookup)
 #: from source, a timed entry made without calling its class (see RunState.later)
 _NEW: Final[Callable[[type], Any]] = object.__new__
-#: from source, ``schedule_timed`` called as the class's function: a method loaded from the
-#: run's state is never specialised by CPython 3.11 (a ``Simulation`` has about 90 fields,
-#: past what a class's shared keys hold, so its own dictionary is searched at each load)
-_SCHEDULE_TIMED: Final[Callable[[Timers, float, Timed], None]] = Timers.schedule_timed
 
 
 def discard(table: dict[Any, Any], key: Any) -> None:
