@@ -275,10 +275,11 @@ class WalkthroughApp(App[str | None]):
                and time.monotonic() < deadline):
             session.advance(0.0, SLICE_STEPS)
 
-    def _run_slices(self, target: float, seconds: float = SLICE_S) -> None:
-        """Step towards simulated ``target`` for at most SLICE_S of wall time (the clock
-        falls behind the speed asked rather than the keys going unread)."""
-        deadline = time.monotonic() + seconds
+    def _run_slices(self, target: float, seconds: float | None = None) -> None:
+        """Step towards simulated ``target`` for at most ``seconds`` (SLICE_S) of wall time
+        (the clock falls behind the speed asked rather than the keys going unread)."""
+        # (SLICE_S read at the call, not bound as a default when the module loaded)
+        deadline = time.monotonic() + (SLICE_S if seconds is None else seconds)
         while not self.session.run_to(target, SLICE_STEPS) and time.monotonic() < deadline:
             pass
 

@@ -29,7 +29,10 @@ def status(app: WalkthroughApp) -> str:
 async def test_a_clock_that_falls_behind_says_its_real_speed(monkeypatch):
     # one engine step per tick: no machine simulates the vacuum at 600x so (one slice of
     # the usual size per tick was not enough: a fast machine with the compiled engine kept
-    # up, and the test then failed on a quiet machine only)
+    # up, and the test then failed on a quiet machine only; and until _run_slices read
+    # SLICE_S at the call, its default had bound the usual 0.08 s, so a tick stepped one
+    # event at a time for that long: once the engine's periodic path was 6 % faster, it
+    # kept 94 % of 600x so, short of the 90 % that is said, and the test failed in CI)
     monkeypatch.setattr(app_module, "SLICE_S", 0.0)
     monkeypatch.setattr(app_module, "SLICE_STEPS", 1)
     session = WalkSession(compile_package(open_spec(VACUUM)))
