@@ -11,6 +11,16 @@ Run a spec from Python with :func:`opspec.run` (:mod:`opspec.runs`, which builds
 Importing ``opspec`` stays light: no lxml, Textual or pyserial is imported here.
 """
 
+import os
+
+# numpy's OpenBLAS starts a server thread per core when numpy is first imported, and each
+# spins for about 0.1 CPU-s before it sleeps, whether or not a BLAS routine is ever called.
+# opspec's numpy work (random streams, small statistics) gains nothing from those threads, and
+# it runs replications in processes of their own: the spinning only took CPU from the run
+# beside it (25 % of an hour of the vacuum cleaner, docs/engine-performance.md). A value the
+# user set is kept.
+os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
+
 from opspec import _native
 
 _native.install()      # the engine compiled with mypyc, or from source if that build is stale
