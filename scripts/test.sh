@@ -109,8 +109,7 @@ if [ -z "${OPSPEC_PURE_PYTHON:-}" ] && command -v cc >/dev/null 2>&1; then
     # (compiled pass) runs every spec of specs/ on both engines and requires byte-identical
     # traces -- every event at the same instant from the same random draws -- which no
     # statistic over such runs can tell apart. (It took 150 of the pass's 300 s, loaded.)
-    # Two folders per pytest process (the folders' conftest modules share one name, so the
-    # pairs are ones that collect together) and the two processes side by side.
+    # Two folders per pytest process, the two processes side by side.
     pure() {
         OPSPEC_PURE_PYTHON=1 .venv/bin/python -m pytest -q -p no:cacheprovider "$@" \
             >"$logs/${1//\//_}.log" 2>&1

@@ -12,7 +12,7 @@ from typing import Any
 import pytest
 from builders import act, coordination, field, pkg, proc
 
-from conftest import completed, events, run
+from engine_runs import completed, events, run
 from opspec.engine.config import EngineConfig
 from opspec.engine.coordinating import first_set
 from opspec.engine.coordination import arbiter

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import pytest
 from builders import act, catch, coordination, field, pkg, proc
-from conftest import completed, events, run
+from engine_runs import completed, events, run
 
 from opspec.engine.config import EngineConfig
 from opspec.engine.coordination import arbiter, superposition, voter

@@ -7,7 +7,7 @@ import pytest
 import simpy
 from builders import act, pkg, proc
 
-from conftest import completed, events
+from engine_runs import completed, events
 from opspec.engine.simulation import Simulation
 
 

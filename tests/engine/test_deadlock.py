@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 from builders import act, catch, manual, pkg, proc, route
-from conftest import events, run
+from engine_runs import events, run
 
 from opspec.engine.builtin_performers import ScriptedUser
 

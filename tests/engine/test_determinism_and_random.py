@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 from builders import act, pkg, proc
-from conftest import run
+from engine_runs import run
 
 from opspec.engine.random import Streams, named_stream, user_stream
 from opspec.model import DeclaredDistribution as Distribution

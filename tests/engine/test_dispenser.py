@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 import pytest
-from conftest import completed, events
+from engine_runs import completed, events
 from dispenser_model import DOSES, dispenser_package
 
 from opspec.engine.builtin_performers import ScriptedUser

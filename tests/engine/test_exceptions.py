@@ -6,7 +6,7 @@ import re
 
 import pytest
 from builders import act, app, catch, deadline, field, manual, pkg, proc, subflow, task
-from conftest import completed, events, run
+from engine_runs import completed, events, run
 
 from opspec.engine.builtin_performers import CallablePerformer, ScriptedUser
 from opspec.engine.config import EngineConfig

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import pytest
 from builders import catch, pkg, proc
-from conftest import completed, events
+from engine_runs import completed, events
 
 from opspec.engine.lifecycle import (
     ABORTED,

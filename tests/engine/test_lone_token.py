@@ -11,7 +11,7 @@ from typing import Any
 
 import pytest
 from builders import act, field, formal, lookup_subflow, manual, pkg, proc, subflow
-from conftest import AnswersLater, events
+from engine_runs import AnswersLater, events
 
 from opspec.engine.compiled import CompiledPackage, compile_package
 from opspec.engine.lanes import user_lane

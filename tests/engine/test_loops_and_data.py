@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 from builders import act, catch, end_event, field, pkg, proc, trigger
-from conftest import completed, events, run
+from engine_runs import completed, events, run
 
 from opspec.engine.config import EngineConfig
 from opspec.model import Loop

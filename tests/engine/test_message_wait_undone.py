@@ -7,7 +7,7 @@ from __future__ import annotations
 
 from builders import act, catch, deadline, pkg, proc
 
-from conftest import completed, events
+from engine_runs import completed, events
 from opspec.engine.compiled import compile_package
 from opspec.engine.simulation import Simulation
 

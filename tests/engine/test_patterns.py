@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 from builders import act, catch, field, manual, pkg, proc, route
-from conftest import before, completed, events, run
+from engine_runs import before, completed, events, run
 
 from opspec.engine.builtin_performers import ScriptedUser
 from opspec.engine.config import EngineConfig

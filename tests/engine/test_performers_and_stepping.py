@@ -8,7 +8,7 @@ from pathlib import Path
 
 import pytest
 from builders import act, catch, manual, pkg, proc
-from conftest import completed, events, run
+from engine_runs import completed, events, run
 
 from opspec.engine.builtin_performers import ScriptedUser, SimulatedDevice, Step
 from opspec.engine.config import EngineConfig

@@ -15,7 +15,7 @@ import pytest
 from builders import act, app, field, formal, lookup_subflow, manual, pkg, proc, subflow, task
 from plan_ways import seen as _seen
 
-from conftest import AnswersLater
+from engine_runs import AnswersLater
 from opspec.engine import plans
 from opspec.engine.compiled import CompiledPackage, compile_package
 from opspec.engine.config import EngineConfig

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import pytest
 from builders import act, pkg, proc
-from conftest import events, run
+from engine_runs import events, run
 
 from opspec.engine.config import EngineConfig
 

@@ -15,7 +15,7 @@ declared order.
 from __future__ import annotations
 
 from builders import act, pkg, proc
-from conftest import completed, events, run
+from engine_runs import completed, events, run
 
 from opspec.model import Package
 

@@ -32,7 +32,7 @@ from plan_ways import WAYS, count_resumes, resume_plans, run_both
 from plan_ways import seen as _seen
 from plan_ways import use_way as _way
 
-from conftest import AnswersLater
+from engine_runs import AnswersLater
 from opspec.engine.compiled import compile_package
 from opspec.engine.config import EngineConfig
 from opspec.engine.simulation import Simulation

@@ -10,7 +10,7 @@ from __future__ import annotations
 
 from builders import app, pkg, proc, task
 
-from conftest import completed, events, run
+from engine_runs import completed, events, run
 from opspec.engine.builtin_performers import CallablePerformer
 from opspec.engine.config import EngineConfig
 from opspec.engine.registry import PerformerRegistry, SharedApplication

@@ -7,7 +7,7 @@ from pathlib import Path
 
 import pytest
 from builders import act, count, duration, pkg, proc, ratio
-from conftest import run
+from engine_runs import run
 
 from opspec.engine.metrics import MetricsListener, percentile
 from opspec.engine.simulation import Simulation

@@ -7,7 +7,7 @@ from __future__ import annotations
 
 from builders import act, catch, coordination, pkg, proc
 
-from conftest import events, run
+from engine_runs import events, run
 from opspec.model import WorkflowMode
 
 

@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 from builders import act, activity_set, block, field, formal, pkg, proc, subflow
-from conftest import completed, events, run
+from engine_runs import completed, events, run
 
 from opspec.engine.config import EngineConfig
 

@@ -6,7 +6,7 @@ from __future__ import annotations
 import dataclasses
 
 from builders import act, catch, deadline, field, pkg, proc, throw
-from conftest import completed, events, run
+from engine_runs import completed, events, run
 
 from opspec.engine.builtin_performers import ScriptedUser
 from opspec.engine.config import EngineConfig

@@ -12,7 +12,7 @@ from typing import Any
 
 import pytest
 from builders import catch, field, manual, pkg, proc, route
-from conftest import events
+from engine_runs import events
 
 from opspec.engine.builtin_performers import ScriptedUser
 from opspec.engine.compiled import compile_package

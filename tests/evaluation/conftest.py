@@ -2,17 +2,11 @@ from __future__ import annotations
 
 import json
 from contextlib import nullcontext
-from pathlib import Path
 
 import pytest
 from evaluate_without_report import without_report
 
 from opspec.cli import main
-
-ROOT = Path(__file__).resolve().parents[2]
-SPEC = ROOT / "specs" / "medication_dispenser.xpdl"
-USERS_TOML = ROOT / "specs" / "medication_dispenser.users.toml"
-
 
 @pytest.fixture
 def evaluate(capsys: pytest.CaptureFixture[str]):
@@ -32,8 +26,3 @@ def evaluate(capsys: pytest.CaptureFixture[str]):
         return status, doc, captured.err
 
     return run
-
-
-def metrics_of(doc: dict) -> dict:
-    """The metrics of an ``--json`` document, without each metric's ``users`` count."""
-    return {k: {f: v for f, v in m.items() if f != "users"} for k, m in doc["metrics"].items()}

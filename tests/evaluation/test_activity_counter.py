@@ -5,7 +5,7 @@ them) are those of the recorder that hears every one of those events, for the sa
 from __future__ import annotations
 
 import pytest
-from conftest import ROOT, SPEC, USERS_TOML
+from evaluation_inputs import ROOT, SPEC, USERS_TOML
 
 from opspec.evaluation.plan import file_digest
 from opspec.evaluation.replication import (

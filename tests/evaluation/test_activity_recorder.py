@@ -5,7 +5,7 @@ from __future__ import annotations
 
 from collections import Counter
 
-from conftest import SPEC, USERS_TOML
+from evaluation_inputs import SPEC, USERS_TOML
 
 from opspec.evaluation.plan import file_digest
 from opspec.evaluation.replication import ActivityRecorder, prepare, run_user

@@ -4,7 +4,7 @@ where and how to fix it, and leaves nothing behind."""
 from __future__ import annotations
 
 import pytest
-from conftest import SPEC, USERS_TOML
+from evaluation_inputs import SPEC, USERS_TOML
 
 
 @pytest.mark.parametrize("content, message", [

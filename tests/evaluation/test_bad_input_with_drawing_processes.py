@@ -15,7 +15,7 @@ from concurrent.futures import process as pool_internals
 from pathlib import Path
 
 import pytest
-from conftest import SPEC
+from evaluation_inputs import SPEC
 
 from opspec.evaluation import drawing_pools, plots
 

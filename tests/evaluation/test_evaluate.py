@@ -10,7 +10,7 @@ import sqlite3
 from pathlib import Path
 
 import pytest
-from conftest import SPEC, USERS_TOML, metrics_of
+from evaluation_inputs import SPEC, USERS_TOML, metrics_of
 
 from opspec.cli import main
 

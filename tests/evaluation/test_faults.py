@@ -12,7 +12,7 @@ import time
 from pathlib import Path
 
 import pytest
-from conftest import SPEC, USERS_TOML, metrics_of
+from evaluation_inputs import SPEC, USERS_TOML, metrics_of
 
 
 def test_interrupted_run_resumes_to_the_same_results(tmp_path, evaluate):

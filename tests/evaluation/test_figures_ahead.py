@@ -19,7 +19,7 @@ from typing import Any
 import pytest
 from figure_samples import DAYS, figures
 
-from conftest import SPEC
+from evaluation_inputs import SPEC
 from opspec.errors import EvaluationError
 from opspec.evaluation import drawing_pools, figure_queue, plots, report, report_design
 from opspec.evaluation.store import ResultStore

@@ -16,7 +16,7 @@ import sqlite3
 from pathlib import Path
 
 import pytest
-from conftest import SPEC
+from evaluation_inputs import SPEC
 
 from opspec.cli import main
 

@@ -8,7 +8,7 @@ import json
 from pathlib import Path
 
 import pytest
-from conftest import SPEC, USERS_TOML
+from evaluation_inputs import SPEC, USERS_TOML
 
 from opspec.cli import main
 from opspec.properties.language import clock

@@ -13,7 +13,7 @@ from __future__ import annotations
 from pathlib import Path
 
 import pytest
-from conftest import SPEC, USERS_TOML
+from evaluation_inputs import SPEC, USERS_TOML
 
 from opspec.evaluation.plan import file_digest
 from opspec.evaluation.replication import ActivityRecorder, prepare, run_user

@@ -9,7 +9,7 @@ import sqlite3
 from collections import Counter
 
 import numpy as np
-from conftest import SPEC, USERS_TOML
+from evaluation_inputs import SPEC, USERS_TOML
 from hypothesis import given, settings
 from hypothesis import strategies as st
 

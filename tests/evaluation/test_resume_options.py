@@ -13,7 +13,7 @@ import threading
 import time
 
 import pytest
-from conftest import SPEC, USERS_TOML, metrics_of
+from evaluation_inputs import SPEC, USERS_TOML, metrics_of
 from evaluate_without_report import without_report
 
 from opspec.cli import main

@@ -6,7 +6,7 @@ from __future__ import annotations
 
 import sqlite3
 
-from conftest import SPEC
+from evaluation_inputs import SPEC
 
 from opspec.evaluation.replication import ReplicationRecord
 from opspec.evaluation.store import ResultStore

@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import sqlite3
 
-from conftest import SPEC, metrics_of
+from evaluation_inputs import SPEC, metrics_of
 
 USER_INDEXES = {"sample_by_user", "outcome_by_user", "sample_by_metric"}
 BY_USER = {"sample_by_user", "outcome_by_user"}

@@ -6,18 +6,12 @@ from __future__ import annotations
 
 import sys
 from pathlib import Path
-from typing import Any
 
 import pytest
 
-HERE = Path(__file__).resolve().parent
-SPECS = HERE / "specs"
-ROOT = HERE.parents[1]
-CORPUS = ROOT.parent / "shared" / "corpus" / "xpdl"
-if not CORPUS.is_dir():
-    CORPUS = Path("/work/shared/corpus/xpdl")
+sys.path.insert(0, str(Path(__file__).resolve().parent))
 
-sys.path.insert(0, str(HERE))
+from pattern_paths import CORPUS  # noqa: E402  (found through the path entry above)
 
 
 @pytest.fixture

@@ -22,7 +22,7 @@ from __future__ import annotations
 from functools import cache
 
 import pytest
-from conftest import CORPUS
+from pattern_paths import CORPUS
 from patternlib import dump, outcomes, run
 
 from opspec.engine.builtin_performers import SimulatedDevice

@@ -22,7 +22,7 @@ from collections import Counter
 from pathlib import Path
 
 import pytest
-from conftest import CORPUS, HERE, ROOT
+from pattern_paths import CORPUS, HERE, ROOT
 from patternlib import SPECS, run, started
 
 VENV = ROOT / ".oracle-venv"

@@ -1,15 +1,11 @@
 from __future__ import annotations
 
-from pathlib import Path
-
 import pytest
 
 from opspec.engine.compiled import compile_package
 from opspec.xpdl.open_spec import open_spec
 
-ROOT = Path(__file__).resolve().parents[2]
-SPEC = ROOT / "specs" / "medication_dispenser.xpdl"
-USERS = ROOT / "specs" / "medication_dispenser.users.toml"
+from walkthrough_inputs import SPEC, USERS
 
 
 @pytest.fixture(scope="session")

@@ -17,7 +17,7 @@ from pathlib import Path
 
 import pytest
 
-from conftest import ROOT
+from walkthrough_inputs import ROOT
 from opspec.engine.compiled import compile_package
 from opspec.tui.app import WalkthroughApp
 from opspec.tui.modals import HelpScreen

@@ -11,7 +11,7 @@ from typing import Any
 import pytest
 
 import opspec.bindings.attach
-from conftest import SPEC
+from walkthrough_inputs import SPEC
 from opspec.cli import main
 
 BIND = "alarm=emulator://medication_dispenser"

@@ -10,7 +10,7 @@ import shlex
 
 import pytest
 
-from conftest import SPEC
+from walkthrough_inputs import SPEC
 from opspec.cli import main
 from opspec.tui.app import WalkthroughApp
 from opspec.tui.session import WalkSession

@@ -13,7 +13,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from conftest import ROOT
+from walkthrough_inputs import ROOT
 from opspec.cli import main
 from opspec.engine.compiled import compile_package
 from opspec.engine.trace_sinks import read_trace

@@ -19,7 +19,7 @@ from typing import Any
 import pytest
 
 import opspec.tui.app
-from conftest import ROOT, SPEC
+from walkthrough_inputs import ROOT, SPEC
 from opspec.cli import main
 from opspec.engine.trace_sinks import read_trace
 

@@ -11,7 +11,7 @@ import json
 import shlex
 
 import pytest
-from conftest import SPEC
+from walkthrough_inputs import SPEC
 
 from opspec.cli import main
 from opspec.run_rules import parse_until

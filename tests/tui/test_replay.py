@@ -7,7 +7,7 @@ from __future__ import annotations
 import json
 
 import pytest
-from conftest import SPEC
+from walkthrough_inputs import SPEC
 
 from opspec.errors import ConfigurationError
 from opspec.testing.script import load_script

@@ -21,7 +21,7 @@ from typing import Any, ClassVar
 import pytest
 
 import opspec.tui.app
-from conftest import SPEC
+from walkthrough_inputs import SPEC
 from opspec.cli import main
 from opspec.tui.replay import recorded_end
 from opspec.tui.session import WalkSession

@@ -16,7 +16,7 @@ from typing import Any, ClassVar
 import pytest
 
 import opspec.tui.app
-from conftest import ROOT
+from walkthrough_inputs import ROOT
 from opspec.cli import main
 from opspec.engine.compiled import compile_package
 from opspec.tui.replay import recorded_seed

@@ -6,7 +6,7 @@ to replay the session."""
 
 from __future__ import annotations
 
-from conftest import SPEC
+from walkthrough_inputs import SPEC
 from opspec.cli import main
 from opspec.tui.session import WalkSession
 

@@ -5,7 +5,7 @@ it in "usable for opspec fit: 2 of 2", though ``opspec fit`` fits no duration fr
 
 from __future__ import annotations
 
-from conftest import SPEC
+from walkthrough_inputs import SPEC
 from opspec.tui.session import WalkSession
 
 

@@ -4,7 +4,7 @@ is as long as the spec says (opspec:RunLength), and the end shows at 80 columns.
 from __future__ import annotations
 
 import pytest
-from conftest import ROOT
+from walkthrough_inputs import ROOT
 
 from opspec.engine.compiled import compile_package
 from opspec.errors import ConfigurationError
@@ -89,7 +89,7 @@ async def test_the_end_of_the_run_shows_at_80_columns(compiled):
     (["--record", "/proc/no/such/walk.json"], "cannot write the recording /proc/no/such"),
 ], ids=["negative-days", "zero-days", "unwritable-record"])
 def test_the_command_refuses_bad_options_with_a_clear_message(args, message, capsys):
-    from conftest import SPEC
+    from walkthrough_inputs import SPEC
 
     from opspec.cli import main
 

@@ -16,7 +16,7 @@ import re
 from pathlib import Path
 
 import pytest
-from conftest import ROOT, SPEC
+from walkthrough_inputs import ROOT, SPEC
 
 from opspec.cli import main
 from opspec.engine.compiled import compile_package

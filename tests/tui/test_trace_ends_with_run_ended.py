@@ -21,7 +21,7 @@ from typing import Any, ClassVar
 import pytest
 
 import opspec.tui.app
-from conftest import ROOT, SPEC
+from walkthrough_inputs import ROOT, SPEC
 from opspec.cli import main
 from opspec.engine.trace_sinks import read_trace
 from opspec.properties.evaluator import trace_end

@@ -9,7 +9,7 @@ from pathlib import Path
 
 import pytest
 
-from conftest import SPEC
+from walkthrough_inputs import SPEC
 from opspec.engine.compiled import compile_package
 from opspec.tui.app import WalkthroughApp
 from opspec.tui.session import WalkSession

@@ -7,7 +7,7 @@ from __future__ import annotations
 import json
 
 import pytest
-from conftest import SPEC
+from walkthrough_inputs import SPEC
 
 from opspec.tui.app import WalkthroughApp
 from opspec.tui.replay import load_recording
