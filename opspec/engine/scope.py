@@ -41,13 +41,13 @@ class Scope(MutableMapping[str, Any]):
 
     def __getitem__(self, key: str) -> Any:
         fields = self.fields
-        if key in fields:
+        if fields and key in fields:    # (empty, not looked in: most periodic workflows')
             return fields[key]
         return self.package[key]        # a field of neither: KeyError(key), as ChainMap's
 
     def get(self, key: str, default: Any = None) -> Any:
         fields = self.fields
-        if key in fields:
+        if fields and key in fields:
             return fields[key]
         return self.package.get(key, default)
 
