@@ -65,6 +65,9 @@ class Activities(Part):
         # written out before the resume (Offers.performer_complete queues them itself)
         self.dones: dict[CompiledActivity, Callable[[ActivityInstance, Activities, Any], None]] = (
             {} if plans.COMPILED else plans.dones(state.compiled))
+        # the free ends of CPU demands (_CpuDone), each holding the next (not a list: one
+        # that empties and fills again reallocates its array each time)
+        self.cpu_ends: _CpuDone | None = None
 
     def _too_deep(self, ai: ActivityInstance, target: CompiledProcess) -> None:
         call_depth.too_deep(self, ai, target)       # (runaway recursion: a rare path)
@@ -245,7 +248,14 @@ class Activities(Part):
             if cpu > 0.0:
                 self.state.dedicated.burst(self.state.now, cpu)
                 ai.waiting = "cpu"
-                self.state.later_entry(cpu, _CpuDone(self, ai))
+                end = self.cpu_ends
+                if end is None:
+                    end = _CpuDone(self)
+                else:
+                    self.cpu_ends = end.spare
+                end.ai = ai
+                end.gen = ai.gen
+                self.state.later_entry(cpu, end)
                 return
         self.after_cpu(ai)
 
@@ -553,22 +563,38 @@ class _CpuDone(Timed):
     """A CPU demand's end (:meth:`RunState.later` of :meth:`Activities.after_cpu`, and what
     :meth:`RunState.fired` does with it): compiled, ``after_cpu`` is called as the native
     method it is, not as a bound method made per demand and called through Python's protocol
-    (once a workflow instance on the periodic path)."""
+    (once a workflow instance on the periodic path).
 
-    def __init__(self, acts: Activities, ai: ActivityInstance) -> None:
+    Used again, not made and freed per demand: the run's heap (or SimPy) calls an entry once
+    each time it was scheduled and then holds it no more (a CPU demand's end is never
+    dropped, unlike a workflow's deadline), so at the end of that call it is free: back to
+    :attr:`Activities.cpu_ends`, no longer holding its activity instance."""
+
+    def __init__(self, acts: Activities) -> None:
         self.acts = acts
-        self.ai = ai
-        self.gen = ai.gen
+        self.ai: ActivityInstance | None = None
+        self.gen = 0
+        self.spare: _CpuDone | None = None     # the next free one, while this one is free
 
     def go(self) -> None:
         ai = self.ai
-        if ai.gen == self.gen and ai.state == RUNNING:
-            acts = self.acts
-            if ai.frame.inst.state == SUSPENDED:    # RunState.fired defers it
-                acts.state.fired(acts._after_cpu_cb, ai, None, self.gen)
-                return
-            acts.after_cpu(ai)
-            acts.state.drain()
+        acts = self.acts
+        if ai is not None:
+            self.ai = None
+            if ai.gen == self.gen and ai.state == RUNNING:
+                if ai.frame.inst.state == SUSPENDED:    # RunState.fired defers it
+                    acts.state.fired(acts._after_cpu_cb, ai, None, self.gen)
+                else:
+                    acts.after_cpu(ai)
+                    acts.state.drain()
+        self.spare = acts.cpu_ends
+        acts.cpu_ends = self
 
     def __call__(self, _event: Any) -> None:
-        self.acts.state.fire(self.acts._after_cpu_cb, self.ai, None, self.gen)
+        ai = self.ai
+        acts = self.acts
+        if ai is not None:
+            self.ai = None
+            acts.state.fire(acts._after_cpu_cb, ai, None, self.gen)
+        self.spare = acts.cpu_ends
+        acts.cpu_ends = self

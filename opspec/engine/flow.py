@@ -544,8 +544,8 @@ class Flow(Part):
     def set_field(self, inst: ProcessInstance, act: CompiledActivity | None, target: str,
              value: Any) -> None:
         state = self.state
-        if target in inst.data or target not in state.package_data:
-            inst.data[target] = value
+        if ((data := inst.data) and target in data) or target not in state.package_data:
+            data[target] = value
         else:
             state.package_data[target] = value
         if act is None:

@@ -22,9 +22,12 @@ scope's own.
 from __future__ import annotations
 
 from collections.abc import Iterator, MutableMapping
-from typing import Any
+from typing import Any, Final
 
 __all__ = ["Scope"]
+
+#: a field the instance does not have (``dict.get``'s default in :meth:`Scope.__getitem__`)
+_MISSING: Final = object()
 
 
 class Scope(MutableMapping[str, Any]):
@@ -41,14 +44,18 @@ class Scope(MutableMapping[str, Any]):
 
     def __getitem__(self, key: str) -> Any:
         fields = self.fields
-        if key in fields:
-            return fields[key]
+        if fields:                      # (empty, not looked in: most periodic workflows')
+            value = fields.get(key, _MISSING)       # (one look-up, not ``in`` then ``[]``)
+            if value is not _MISSING:
+                return value
         return self.package[key]        # a field of neither: KeyError(key), as ChainMap's
 
     def get(self, key: str, default: Any = None) -> Any:
         fields = self.fields
-        if key in fields:
-            return fields[key]
+        if fields:
+            value = fields.get(key, _MISSING)
+            if value is not _MISSING:
+                return value
         return self.package.get(key, default)
 
     def __contains__(self, key: object) -> bool:
