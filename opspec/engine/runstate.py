@@ -305,7 +305,9 @@ class RunState(Timers):
                 # (a list's iterator sees what is appended meanwhile) ``check``: the first
                 # ``done`` at which the count passes the limit or the burst is long
                 base = steps
-                check: i64 = limit - base + 1 if limit - base < _COMPACT else _COMPACT + 1
+                check: i64 = _COMPACT + 1   # (a statement: compiled, a conditional expression
+                if limit - base < _COMPACT:     # boxed its two values as ints and unboxed one)
+                    check = limit - base + 1
                 for fn, a, b, c in ready:
                     done += 1
                     if done >= check:
@@ -347,7 +349,9 @@ class RunState(Timers):
         steps = self._past_limit(base + done, a, b)
         base = steps - done
         limit = self.max_instant_steps
-        check: i64 = limit - base + 1 if limit - base < _COMPACT else _COMPACT + 1
+        check: i64 = _COMPACT + 1       # (as in drain)
+        if limit - base < _COMPACT:
+            check = limit - base + 1
         return base, check
 
     def _past_limit(self, steps: i64, a: Any, b: Any) -> i64:
