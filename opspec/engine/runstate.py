@@ -294,10 +294,6 @@ class RunState(Timers):
         steps = self.instant_steps + 1
         limit = self.max_instant_steps
         base = steps                # (the step count is base + done while items run)
-        flow = self.flow            # (the commonest items' native methods: see DIRECT)
-        acts = flow.activities
-        lone_q = flow.start_lone_q if DIRECT else None
-        done_q = acts.body_done_q if DIRECT else None
         try:
             if steps > limit:
                 steps = self._past_limit(steps, None, None)
@@ -315,12 +311,14 @@ class RunState(Timers):
                             done -= 1
                             break
                         base, check = self._past_check(base, done, a, b)
+                    # (the commonest items' native methods, see DIRECT: read where used,
+                    # compiled without a reference held, as a drain runs about one item)
                     if not DIRECT:
                         fn(a, b, c)
-                    elif fn is lone_q:
-                        flow.start_lone_at(a, b, c)
-                    elif fn is done_q:
-                        acts.body_done(a, b, c)
+                    elif fn is self.flow.start_lone_q:
+                        self.flow.start_lone_at(a, b, c)
+                    elif fn is self.flow.activities.body_done_q:
+                        self.flow.activities.body_done(a, b, c)
                     else:
                         fn(a, b, c)
                 steps = base + done
