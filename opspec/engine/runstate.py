@@ -302,7 +302,7 @@ class RunState(Timers):
                 # ``done`` at which the count passes the limit or the burst is long
                 base = steps
                 check: i64 = _COMPACT + 1   # (a statement: compiled, a conditional expression
-                if limit - base < _COMPACT:     # boxed its two values as ints and unboxed one)
+                if limit - base < _COMPACT:     # boxed its value as an int, then unboxed it)
                     check = limit - base + 1
                 for fn, a, b, c in ready:
                     done += 1
