@@ -35,16 +35,16 @@ def run(activities: Activities, inst: ProcessInstance, act: CompiledActivity | N
     """Carry the one token of ``inst`` (no frame yet) from ``act`` on: the steps of
     ``Activities.start`` and ``Flow.done_next`` for ``lone`` activities, in their order.
     (``steps`` and ``limit``: where a plan, :mod:`opspec.engine.plans`, had got to.)"""
+    # (the run's applications and the flow read where used, not held: compiled, a local
+    # takes and drops a reference, and most instances use neither)
     state = activities.state
     pooled = state.pooled
-    apps = state.apps
     if limit < 0:
         limit = state.start_limit
-    flow = activities.flow
     acts = inst.process.graph.activities
     while act is not None:
         if not act.lone or (act.general and pooled) or (
-                act.kind == K_TASK and act.application in apps):
+                act.kind == K_TASK and act.application in state.apps):
             # the instance gets its frame, with the token in it, and from here the
             # token goes the general way (a plan writes the same steps out)
             frame = Frame(inst.process.graph, inst, None)
@@ -68,17 +68,18 @@ def run(activities: Activities, inst: ProcessInstance, act: CompiledActivity | N
                 state.emit(EK.ACTIVITY_COMPLETED, act.process, inst.id, act.id, act.lane,
                            act.participant)
         else:
-            if act.start_assign and not flow.assign(inst, act, act.start_assign):
+            if act.start_assign and not activities.flow.assign(inst, act, act.start_assign):
                 return
             if act.kind == K_ASYNC:
                 data = activities.params_in(inst, act)
                 if data is None:
                     return
-                flow.start_process(state.processes[act.subflow],  # type: ignore[index]
-                                   data, trigger=f"subflow:{act.id}")
+                activities.flow.start_process(
+                    state.processes[act.subflow], data,  # type: ignore[index]
+                    trigger=f"subflow:{act.id}")
             # Flow.done_next's steps for a lone activity (no throw, raise, error,
             # escalation or terminate to take care of)
-            if not act.simple_end and act.end_assign and not flow.assign(
+            if not act.simple_end and act.end_assign and not activities.flow.assign(
                     inst, act, act.end_assign):
                 return
             cached = act.flag_cache
@@ -88,7 +89,7 @@ def run(activities: Activities, inst: ProcessInstance, act: CompiledActivity | N
             if not act.simple_end and inst.state != RUNNING:
                 return
         nxt = act.next
-        act = acts[nxt] if nxt >= 0 else _split(flow, inst, act)
+        act = acts[nxt] if nxt >= 0 else _split(activities.flow, inst, act)
 
 
 def _split(flow: Flow, inst: ProcessInstance, act: CompiledActivity) -> CompiledActivity | None:

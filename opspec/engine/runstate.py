@@ -294,10 +294,6 @@ class RunState(Timers):
         steps = self.instant_steps + 1
         limit = self.max_instant_steps
         base = steps                # (the step count is base + done while items run)
-        flow = self.flow            # (the commonest items' native methods: see DIRECT)
-        acts = flow.activities
-        lone_q = flow.start_lone_q if DIRECT else None
-        done_q = acts.body_done_q if DIRECT else None
         try:
             if steps > limit:
                 steps = self._past_limit(steps, None, None)
@@ -305,7 +301,9 @@ class RunState(Timers):
                 # (a list's iterator sees what is appended meanwhile) ``check``: the first
                 # ``done`` at which the count passes the limit or the burst is long
                 base = steps
-                check: i64 = limit - base + 1 if limit - base < _COMPACT else _COMPACT + 1
+                check: i64 = _COMPACT + 1   # (a statement: compiled, a conditional expression
+                if limit - base < _COMPACT:     # boxed its value as an int, then unboxed it)
+                    check = limit - base + 1
                 for fn, a, b, c in ready:
                     done += 1
                     if done >= check:
@@ -313,12 +311,14 @@ class RunState(Timers):
                             done -= 1
                             break
                         base, check = self._past_check(base, done, a, b)
+                    # (the commonest items' native methods, see DIRECT: read where used,
+                    # compiled without a reference held, as a drain runs about one item)
                     if not DIRECT:
                         fn(a, b, c)
-                    elif fn is lone_q:
-                        flow.start_lone_at(a, b, c)
-                    elif fn is done_q:
-                        acts.body_done(a, b, c)
+                    elif fn is self.flow.start_lone_q:
+                        self.flow.start_lone_at(a, b, c)
+                    elif fn is self.flow.activities.body_done_q:
+                        self.flow.activities.body_done(a, b, c)
                     else:
                         fn(a, b, c)
                 steps = base + done
@@ -347,7 +347,9 @@ class RunState(Timers):
         steps = self._past_limit(base + done, a, b)
         base = steps - done
         limit = self.max_instant_steps
-        check: i64 = limit - base + 1 if limit - base < _COMPACT else _COMPACT + 1
+        check: i64 = _COMPACT + 1       # (as in drain)
+        if limit - base < _COMPACT:
+            check = limit - base + 1
         return base, check
 
     def _past_limit(self, steps: i64, a: Any, b: Any) -> i64:

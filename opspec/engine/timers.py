@@ -364,7 +364,8 @@ class Timers:
 
     def _run_due(self, heap: list[Timed], ahead: bool) -> None:
         while True:
-            entry = self.take_first()
+            # (take_first's line in place: a native call less an entry)
+            entry = heap.pop() if self.lined else self.take_first()
             at = entry.at
             self.now = at
             entry.go()
