@@ -80,6 +80,7 @@ class Timed:
 
     at: float
     seq: i64                    # (machine integers compiled, as Timers.order)
+    spare_next: Timed | None    # the next of Timers.spare (set when it is put there)
 
     def go(self) -> None:
         raise NotImplementedError
@@ -157,6 +158,9 @@ class Timers:
         self.droppable: list[Timed] = []
         self.droppable_at = INF
         self.moot: list[Timed] = []     # (_come_due's: the entries found not needed)
+        # the droppable entries _come_due dropped: nothing holds them any more, so the one
+        # who schedules them may use them again (Timed.spare_next chains them)
+        self.spare: Timed | None = None
 
     def sync(self) -> None:
         """Control enters the engine from outside its own timed callbacks (a performer
@@ -277,6 +281,9 @@ class Timers:
             for entry in moot:
                 if not (quiet and nearest - entry.at > 1e-9 * scale):
                     self._push(entry)
+                else:
+                    entry.spare_next = self.spare
+                    self.spare = entry
             moot.clear()
 
     def _push(self, entry: Timed) -> None:
