@@ -16,7 +16,7 @@ from typing import TYPE_CHECKING, Any
 
 from opspec.worlds.base import RobotWorld, World, check_parameters
 from opspec.worlds.geometry import Box, wrap_angle
-from opspec.worlds.stepping import ARC, COVER, DONE, Cell, Cells, RayBox, RoomState
+from opspec.worlds.stepping import ARC, DONE, Cell, Cells, RayBox, RoomState, finish
 
 if TYPE_CHECKING:   # annotations only: `opspec validate` loads no NumPy
     import numpy as np
@@ -152,18 +152,8 @@ class RoomWorld(RobotWorld):
         """The steps the compiled loop (``RoomState.advance``, returning ``code``) hands
         back: cells to cover, a contact to trace, an arc to step; then on to ``now``. Also
         called by the compiled performer (:mod:`opspec.worlds.room_devices`)."""
-        state = self._state
-        while code != DONE:
-            if code == ARC:
-                World._advance(self, now)       # no command of the bundled specs
-                return
-            if code == COVER:                   # covered (by the loop), to be traced
-                for cx, cy in state.new_cells:
-                    self.trace("world.covered", cell=[cx, cy])
-            else:
-                self.collisions += 1
-                self.trace("world.collision", x=round(state.x, 3), y=round(state.y, 3))
-            code = state.resume(now)
+        if finish(self, self._state, code, now) == ARC:
+            World._advance(self, now)           # no command of the bundled specs
 
     def _step(self, dt: float) -> None:
         robot = self.robot
