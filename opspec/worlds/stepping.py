@@ -131,10 +131,20 @@ class RoomState:
         # then): a straight drive stays in one range for several steps, and a range all
         # covered needs no look at all (``near`` says whether there is a last range)
         self.near = False
+        self.near_key: Key = (0, 0, 0, 0)
         self.kx0 = 0
         self.kx1 = 0
         self.ky0 = 0
         self.ky1 = 0
+        # the last range's bounds as whole floats: ``kx0`` and ``kx0 + 1``, ... (see resume)
+        self.ax0 = 0.0
+        self.bx0 = 0.0
+        self.ax1 = 0.0
+        self.bx1 = 0.0
+        self.ay0 = 0.0
+        self.by0 = 0.0
+        self.ay1 = 0.0
+        self.by1 = 0.0
         self.near_cells: Cells = ()
         # whether none of ``near_cells`` was in ``covered`` when it had ``near_count`` cells
         # (then, the set no larger, none is now: cells are only ever added, and ``cover``
@@ -302,33 +312,28 @@ class RoomState:
                 y = ny
                 in_contact = False
                 if inv > 0.0:
-                    kx0 = math.floor((x - reach) * inv)     # cells_of, in line
-                    kx1 = math.floor((x + reach) * inv)
-                    ky0 = math.floor((y - reach) * inv)
-                    ky1 = math.floor((y + reach) * inv)
+                    ax0 = (x - reach) * inv                 # cells_of, in line
+                    ax1 = (x + reach) * inv
+                    ay0 = (y - reach) * inv
+                    ay1 = (y + reach) * inv
+                    # (floor(a) == k exactly when k <= a < k + 1: the last range's bounds,
+                    # whole floats, compared without the four floors; a NaN fails them)
+                    if (self.near and self.ax0 <= ax0 < self.bx0 and self.ax1 <= ax1 < self.bx1
+                            and self.ay0 <= ay0 < self.by0 and self.ay1 <= ay1 < self.by1):
+                        cells = self.near_cells         # uncovered[key], as left
+                    else:
+                        cells = self._enter(math.floor(ax0), math.floor(ax1),
+                                            math.floor(ay0), math.floor(ay1))
                 else:
                     kx0 = int((x - reach) // cell)
                     kx1 = int((x + reach) // cell)
                     ky0 = int((y - reach) // cell)
                     ky1 = int((y + reach) // cell)
-                if (self.near and kx0 == self.kx0 and kx1 == self.kx1 and ky0 == self.ky0
-                        and ky1 == self.ky1):
-                    cells = self.near_cells             # uncovered[key], as left
-                else:
-                    key = (kx0, kx1, ky0, ky1)
-                    found = uncovered.get(key)
-                    if found is None:
-                        cells = self._cells(key)
-                        uncovered[key] = cells          # (near_cells is uncovered[key])
+                    if (self.near and kx0 == self.kx0 and kx1 == self.kx1
+                            and ky0 == self.ky0 and ky1 == self.ky1):
+                        cells = self.near_cells         # uncovered[key], as left
                     else:
-                        cells = found
-                    self.near = True
-                    self.kx0 = kx0
-                    self.kx1 = kx1
-                    self.ky0 = ky0
-                    self.ky1 = ky1
-                    self.near_cells = cells
-                    self.near_clean = False
+                        cells = self._enter(kx0, kx1, ky0, ky1)
                 if len(cells) > 0:
                     # RoomWorld._cover at this step, over the range's cells still uncovered
                     # (cells are only ever added, so the others cannot be covered again)
@@ -337,12 +342,12 @@ class RoomState:
                     new, left = cover_within(cells, x, y, cell, self.limit, self.far,
                                              covered, check)
                     if left is not cells:               # (else uncovered[key] is cells)
-                        uncovered[(kx0, kx1, ky0, ky1)] = left
+                        uncovered[self.near_key] = left
                         self.near_cells = left
                     self.near_clean = True
                     self.near_count = len(covered)
                     if new:
-                        self.key = (kx0, kx1, ky0, ky1)
+                        self.key = self.near_key
                         self.new_cells = new
                         code = COVER
             else:
@@ -367,6 +372,35 @@ class RoomState:
         self.in_contact = in_contact
         self.time = t if code == DONE else t_step
         return code
+
+    def _enter(self, kx0: int, kx1: int, ky0: int, ky1: int) -> Cells:
+        """The robot's reach is now in the cell range ``kx0``..``ky1``: it becomes the last
+        range (``near``), its cells still uncovered looked up or listed, and returned."""
+        key = (kx0, kx1, ky0, ky1)
+        uncovered = self.uncovered
+        found = uncovered.get(key)
+        if found is None:
+            cells = self._cells(key)
+            uncovered[key] = cells                  # (near_cells is uncovered[key])
+        else:
+            cells = found
+        self.near = True
+        self.near_key = key
+        self.kx0 = kx0
+        self.kx1 = kx1
+        self.ky0 = ky0
+        self.ky1 = ky1
+        self.ax0 = float(kx0)
+        self.bx0 = float(kx0 + 1)
+        self.ax1 = float(kx1)
+        self.bx1 = float(kx1 + 1)
+        self.ay0 = float(ky0)
+        self.by0 = float(ky0 + 1)
+        self.ay1 = float(ky1)
+        self.by1 = float(ky1 + 1)
+        self.near_cells = cells
+        self.near_clean = False
+        return cells
 
     def _cells(self, key: Key) -> Cells:
         """The cells of the room in ``key``'s range, in ``RoomWorld._cover``'s order."""
