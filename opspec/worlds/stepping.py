@@ -18,7 +18,7 @@ from opspec.worlds.robot import COMMANDS, pose_after
 
 __all__ = ["ARC", "COLLISION", "COVER", "DONE", "STEP_S", "Grown", "Normals", "RayBox",
            "RoomState", "Sides", "cells_of", "cover", "cover_limit", "cover_within",
-           "distance_ahead", "far_from", "finish", "round4"]
+           "cover_step", "distance_ahead", "far_from", "finish", "round4"]
 
 #: integration step: 5 cm at 1 m/s, well under the robot's size
 STEP_S: Final = 0.05
@@ -339,8 +339,8 @@ class RoomState:
                     # (cells are only ever added, so the others cannot be covered again)
                     covered = self.covered
                     check = not (self.near_clean and len(covered) == self.near_count)
-                    new, left = cover_within(cells, x, y, cell, self.limit, self.far,
-                                             covered, check)
+                    new, left = cover_step(cells, x, y, cell, self.limit, self.far,
+                                           covered, check)
                     if left is not cells:               # (else uncovered[key] is cells)
                         uncovered[self.near_key] = left
                         self.near_cells = left
@@ -565,23 +565,42 @@ def cover_within(cells: Cells, x: float, y: float, cell: float, limit: float, fa
     """:func:`cover` with its bound ``limit`` (and ``far_from(limit)``) given; ``check``
     false when none of ``cells`` is in ``covered`` (the membership tests then spared). The
     cells still not covered are ``cells`` itself when they are all of them."""
-    new: list[Cell] = []
-    left: list[Cell] = []
+    new, left = cover_step(cells, x, y, cell, limit, far, covered, check)
+    return ([] if new is None else new), left
+
+
+def cover_step(cells: Cells, x: float, y: float, cell: float, limit: float, far: float,
+               covered: set[Cell], check: bool) -> tuple[list[Cell] | None, Cells]:
+    """:func:`cover_within` as :meth:`RoomState.resume` calls it at each step: ``None``
+    for no cell newly covered, and no list made at all when no cell is covered or dropped
+    (most steps)."""
+    new: list[Cell] | None = None
+    left: list[Cell] | None = None          # (made at the first cell that is not left)
+    i = 0
     # one membership test a cell: ``cells`` has no cell twice, so one covered here is in
     # no later test, and those still not covered afterwards are the ones tested here
     for c in cells:
         if check and c in covered:
-            continue                # (cells of other ranges overlap these: covered there)
-        cx, cy = c
-        dx = (cx + 0.5) * cell - x
-        dy = (cy + 0.5) * cell - y
-        if (abs(dx) <= far and abs(dy) <= far
-                and math.pow(dx, 2.0) + math.pow(dy, 2.0) <= limit):
-            covered.add(c)
-            new.append(c)
+            gone = True             # (cells of other ranges overlap these: covered there)
         else:
+            cx, cy = c
+            dx = (cx + 0.5) * cell - x
+            dy = (cy + 0.5) * cell - y
+            gone = (abs(dx) <= far and abs(dy) <= far
+                    and math.pow(dx, 2.0) + math.pow(dy, 2.0) <= limit)
+            if gone:
+                covered.add(c)
+                if new is None:
+                    new = [c]
+                else:
+                    new.append(c)
+        if gone:
+            if left is None:
+                left = list(cells[:i])
+        elif left is not None:
             left.append(c)
-    if len(left) == len(cells):
+        i += 1
+    if left is None:
         return new, cells           # (the same cells, in order: no copy)
     return new, tuple(left)
 
