@@ -422,7 +422,9 @@ class RoomState:
         """The bumper: whether it was pressed since it was last read (and clear it)."""
         bumped = self.bumped
         self.bumped = False
-        return {"bump": bumped, "edge": False}         # a room has no ring edge
+        # (a copy of a fixed answer: compiled, a dict copied is one key table cloned, where
+        # a new one is filled key by key, about 0.4k instructions a reading)
+        return (_BUMPED if bumped else _NOT_BUMPED).copy()     # a room has no ring edge
 
 
 def finish(world: Any, state: RoomState, code: int, now: float) -> int:
@@ -442,6 +444,11 @@ def finish(world: Any, state: RoomState, code: int, now: float) -> int:
             world.trace("world.collision", x=round(state.x, 3), y=round(state.y, 3))
         code = state.resume(now)
     return DONE
+
+
+#: the bumper's two answers (:meth:`RoomState.read_bump` hands out copies)
+_BUMPED: Final[dict[str, Any]] = {"bump": True, "edge": False}
+_NOT_BUMPED: Final[dict[str, Any]] = {"bump": False, "edge": False}
 
 
 #: how many standard normal draws :class:`Normals` takes at once
