@@ -115,6 +115,14 @@ class RoomWorld(RobotWorld):
         self._state.bumped = value
 
     @property
+    def range_noise(self) -> float:
+        return self._state.range_noise
+
+    @range_noise.setter
+    def range_noise(self, value: float) -> None:
+        self._state.range_noise = value
+
+    @property
     def in_contact(self) -> bool:
         return self._state.in_contact
 

@@ -121,6 +121,9 @@ class RoomState:
         self.motion: tuple[float, ...] = STILL
         self.bumped = False
         self.in_contact = False
+        # the range finder's noise (its standard deviation): the room's ``range_noise``,
+        # kept here so that the compiled performer reads it natively
+        self.range_noise = 0.0
         self.t = 0.0
         self.after = 0.0
         self.settled = False
