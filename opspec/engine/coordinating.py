@@ -196,11 +196,13 @@ def coordinate(acts: Activities, ai: ActivityInstance) -> None:
     spec = act.coordination
     assert spec is not None
     built = coord_of(act, spec)
-    try:
-        values = inputs_of(ai.scope(), built.inputs)
-    except KeyError as error:
-        acts.fail(ai, "coordination", f"data field {error.args[0]!r} does not exist")
-        return
+    values = _NO_VALUES
+    if built.inputs:                        # (a pull reads none: no list made for it)
+        try:
+            values = inputs_of(ai.scope(), built.inputs)
+        except KeyError as error:
+            acts.fail(ai, "coordination", f"data field {error.args[0]!r} does not exist")
+            return
     kind = built.kind
     output = built.output
     try:
