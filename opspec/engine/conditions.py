@@ -424,8 +424,10 @@ def _compile_equality(expr: Binary, left: _Fn, right: _Fn, whole: _Whole, *,
         # is that object (compiled, ``==`` of two values of unknown type is a call through
         # Python's comparison protocol, about 70 instructions a robot's flag tested)
         single = constant is None or kind is bool
+        # (``now`` untyped, as a conjunction's: compiled, a float parameter is unboxed on
+        # entry, where only an error reads it)
 
-        def field_equals(data: Mapping[str, Any], now: float) -> bool:
+        def field_equals(data: Mapping[str, Any], now: Any) -> bool:
             try:
                 try:
                     value = data[root]
