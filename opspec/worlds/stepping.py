@@ -116,9 +116,11 @@ class RoomState:
         self.y = 0.0
         self.heading = 0.0
         self.command = "stop"
-        # the motion of the command object last looked up (advance's, in the constant table)
+        # the motion of the command object last looked up (advance's, in the constant
+        # table), its speeds ``v`` and ``w`` as compiled floats (not unpacked a use)
         self.moved_by: str | None = None
-        self.motion: tuple[float, ...] = STILL
+        self.mv = 0.0
+        self.mw = 0.0
         self.bumped = False
         self.in_contact = False
         # the range finder's noise (its standard deviation): the room's ``range_noise``,
@@ -213,13 +215,15 @@ class RoomState:
             return DONE
         command = self.command
         if command is self.moved_by:        # (the same command object as last time)
-            motion = self.motion
+            v = self.mv
+            w = self.mw
         else:
             found: tuple[float, ...] | None = _COMMANDS.get(command)
             motion = STILL if found is None else found  # (no default to the get: see STILL)
+            v, w = motion
             self.moved_by = command
-            self.motion = motion
-        v, w = motion
+            self.mv = v
+            self.mw = w
         if abs(w) >= 1e-12:
             if v != 0.0:
                 return ARC
