@@ -37,6 +37,10 @@ STILL: Final[tuple[float, ...]] = (0.0, 0.0)
 #: is not compiled is looked up in this module's globals at each use (once a device use)
 _COMMANDS: Final = COMMANDS
 
+#: math.atan2 as a static of this module: mypyc has no native atan2, and the name was
+#: looked up in the math module at each call (a step of a turn, about 0.2k instructions)
+_atan2: Final = math.atan2
+
 Key = tuple[int, int, int, int]
 #: a floor cell (x, y), typed as a tuple of any length so that compiled code keeps it one
 #: Python object: a ``tuple[int, int]`` is read into two C integers and boxed anew each
@@ -235,7 +239,7 @@ class RoomState:
             self.after = heading                # wrap_angle(heading) is heading itself
             self.settled = True
         else:
-            after = math.atan2(math.sin(heading), math.cos(heading))       # wrap_angle
+            after = _atan2(math.sin(heading), math.cos(heading))       # wrap_angle
             self.after = after
             self.settled = after == heading and (
                 math.copysign(1.0, after) == math.copysign(1.0, heading))
@@ -257,7 +261,7 @@ class RoomState:
             rest = now - t
             dt = STEP_S if rest > STEP_S else rest
             heading = heading + w * dt
-            heading = math.atan2(math.sin(heading), math.cos(heading))   # wrap_angle
+            heading = _atan2(math.sin(heading), math.cos(heading))   # wrap_angle
             t += dt
         if self.command == "stop":
             self.in_contact = False
@@ -300,7 +304,7 @@ class RoomState:
                 heading = after
                 cos_h = math.cos(heading)
                 sin_h = math.sin(heading)
-                after = math.atan2(math.sin(heading), math.cos(heading))    # wrap_angle
+                after = _atan2(math.sin(heading), math.cos(heading))    # wrap_angle
                 settled = after == heading and (
                     math.copysign(1.0, after) == math.copysign(1.0, heading))
             if nx == x and ny == y:
