@@ -89,7 +89,8 @@ class RoomDevices(AnswersAtOnce):
                 command = data.get("motor_cmd")
             else:                           # (a Mapping's through Python's protocol)
                 command = data.get("motor_cmd")
-            command = str(command or "stop")
+            if type(command) is not str or not command:     # (else str() gives it back)
+                command = str(command or "stop")
             if command == "turn_random":
                 result = self.world.op_drive(data)
             else:
