@@ -18,7 +18,8 @@ from opspec.worlds.robot import COMMANDS, pose_after
 
 __all__ = ["ARC", "COLLISION", "COVER", "DONE", "STEP_S", "Grown", "Normals", "RayBox",
            "RoomState", "Sides", "cells_of", "cover", "cover_limit", "cover_within",
-           "cover_step", "distance_ahead", "far_from", "finish", "round4"]
+           "cover_step", "distance_ahead", "far_from", "finish", "round3", "round4",
+           "rounded"]
 
 #: integration step: 5 cm at 1 m/s, well under the robot's size
 STEP_S: Final = 0.05
@@ -452,7 +453,7 @@ def finish(world: Any, state: RoomState, code: int, now: float) -> int:
                 world.trace("world.covered", cell=[c[0], c[1]])
         else:
             world.collisions += 1
-            world.trace("world.collision", x=round(state.x, 3), y=round(state.y, 3))
+            world.trace("world.collision", x=round3(state.x), y=round3(state.y))
         code = state.resume(now)
     return DONE
 
@@ -635,20 +636,32 @@ def cells_of(v: float, cell: float, inv: float) -> int:
 
 
 def round4(x: float) -> float:
-    """``round(x, 4)``, the same float, without its decimal conversion for the usual case.
+    """``round(x, 4)``, the same float, without its decimal conversion for the usual case
+    (:func:`rounded`)."""
+    return rounded(x, 4, 10000.0)
 
-    ``round`` gives the double nearest to the decimal ``n / 10**4``, ``n`` the integer nearest
-    to the exact ``x * 10**4`` (half to even); ``n / 10000.0`` is that double too (a
-    correctly rounded division of two exact numbers). ``y = x * 10000.0`` is within half an
+
+def round3(x: float) -> float:
+    """``round(x, 3)``, the same float (:func:`rounded`): where a contact is traced."""
+    return rounded(x, 3, 1000.0)
+
+
+def rounded(x: float, places: int, scale: float) -> float:
+    """``round(x, places)``, the same float, ``scale`` being ``10.0 ** places`` (3 or 4
+    places), without its decimal conversion for the usual case.
+
+    ``round`` gives the double nearest to the decimal ``n / scale``, ``n`` the integer
+    nearest to the exact ``x * scale`` (half to even); ``n / scale`` is that double too (a
+    correctly rounded division of two exact numbers). ``y = x * scale`` is within half an
     ulp (under 1e-8 below 10 km) of the exact product, so ``n`` is the integer nearest to
     ``y`` unless ``y`` is within 1e-6 of a half: those, zero and negative numbers
     (``-0.0``), large and non-finite ones go to ``round`` itself."""
     if not 0.0 < x < 1e4:
-        return round(x, 4)
-    y = x * 10000.0
+        return round(x, places)
+    y = x * scale
     whole = math.floor(y)
     part = y - whole                      # exact: y and its floor are close doubles
     if abs(part - 0.5) < 1e-6:
-        return round(x, 4)
+        return round(x, places)
     n = whole + 1 if part > 0.5 else whole
-    return n / 10000.0
+    return n / scale
