@@ -428,7 +428,8 @@ class RoomState:
         robot's edge to the nearest wall or obstacle face ahead, 0 at the least, to 0.1 mm."""
         best = distance_ahead(self.x, self.y, self.heading, self.boxes)
         distance = best - self.radius + noise
-        return round4(distance if distance > 0.0 else 0.0)     # max(0.0, distance)
+        # (round4 itself: from source, a call less a reading)
+        return rounded(distance if distance > 0.0 else 0.0, 4, 10000.0)  # max(0.0, distance)
 
     def read_bump(self) -> dict[str, Any]:
         """The bumper: whether it was pressed since it was last read (and clear it)."""
