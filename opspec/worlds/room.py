@@ -16,7 +16,7 @@ from typing import TYPE_CHECKING, Any
 
 from opspec.worlds.base import RobotWorld, World, check_parameters
 from opspec.worlds.geometry import Box, wrap_angle
-from opspec.worlds.stepping import ARC, DONE, Cell, Cells, RayBox, RoomState, finish
+from opspec.worlds.stepping import ARC, COVER, DONE, Cell, Cells, RayBox, RoomState, rounded
 
 if TYPE_CHECKING:   # annotations only: `opspec validate` loads no NumPy
     import numpy as np
@@ -160,8 +160,21 @@ class RoomWorld(RobotWorld):
         """The steps the compiled loop (``RoomState.advance``, returning ``code``) hands
         back: cells to cover, a contact to trace, an arc to step; then on to ``now``. Also
         called by the compiled performer (:mod:`opspec.worlds.room_devices`)."""
-        if finish(self, self._state, code, now) == ARC:
-            World._advance(self, now)           # no command of the bundled specs
+        state = self._state
+        while code != DONE:
+            if code == ARC:
+                World._advance(self, now)       # no command of the bundled specs
+                return
+            if code == COVER:                   # covered (by the loop), to be traced
+                for cx, cy in state.new_cells:
+                    self.trace("world.covered", cell=[cx, cy])
+            else:
+                # (round(x, 3), the same float: round's decimal conversion is about 5k
+                # instructions, rounded's shortcut compiled)
+                self.collisions += 1
+                self.trace("world.collision", x=rounded(state.x, 3, 1000.0),
+                           y=rounded(state.y, 3, 1000.0))
+            code = state.resume(now)
 
     def _step(self, dt: float) -> None:
         robot = self.robot

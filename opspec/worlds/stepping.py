@@ -18,8 +18,7 @@ from opspec.worlds.robot import COMMANDS, pose_after
 
 __all__ = ["ARC", "COLLISION", "COVER", "DONE", "STEP_S", "Grown", "Normals", "RayBox",
            "RoomState", "Sides", "cells_of", "cover", "cover_limit", "cover_within",
-           "cover_step", "distance_ahead", "far_from", "finish", "round3", "round4",
-           "rounded"]
+           "cover_step", "distance_ahead", "far_from", "round4", "rounded"]
 
 #: integration step: 5 cm at 1 m/s, well under the robot's size
 STEP_S: Final = 0.05
@@ -37,9 +36,7 @@ STILL: Final[tuple[float, ...]] = (0.0, 0.0)
 #: robot.COMMANDS as a static of this module: compiled, a name imported from a module that
 #: is not compiled is looked up in this module's globals at each use (once a device use)
 _COMMANDS: Final = COMMANDS
-
-#: math.atan2 as a static of this module: mypyc has no native atan2, and the name was
-#: looked up in the math module at each call (a step of a turn, about 0.2k instructions)
+#: math.atan2 likewise: mypyc has no native atan2 (it was looked up in the module a call)
 _atan2: Final = math.atan2
 
 Key = tuple[int, int, int, int]
@@ -121,15 +118,12 @@ class RoomState:
         self.y = 0.0
         self.heading = 0.0
         self.command = "stop"
-        # the motion of the command object last looked up (advance's, in the constant
-        # table), its speeds ``v`` and ``w`` as compiled floats (not unpacked a use)
+        # the speeds of the command object last looked up (advance's, in the constant table)
         self.moved_by: str | None = None
-        self.mv = 0.0
-        self.mw = 0.0
+        self.mv = self.mw = 0.0
         self.bumped = False
         self.in_contact = False
-        # the range finder's noise (its standard deviation): the room's ``range_noise``,
-        # kept here so that the compiled performer reads it natively
+        # the room's ``range_noise``, here where the compiled performer reads it natively
         self.range_noise = 0.0
         self.t = 0.0
         self.after = 0.0
@@ -142,19 +136,9 @@ class RoomState:
         # covered needs no look at all (``near`` says whether there is a last range)
         self.near = False
         self.near_key: Key = (0, 0, 0, 0)
-        self.kx0 = 0
-        self.kx1 = 0
-        self.ky0 = 0
-        self.ky1 = 0
-        # the last range's bounds as whole floats: ``kx0`` and ``kx0 + 1``, ... (see resume)
-        self.ax0 = 0.0
-        self.bx0 = 0.0
-        self.ax1 = 0.0
-        self.bx1 = 0.0
-        self.ay0 = 0.0
-        self.by0 = 0.0
-        self.ay1 = 0.0
-        self.by1 = 0.0
+        # its bounds as whole floats: ``floor(a) == k`` exactly when ``k <= a < k + 1`` (a NaN
+        # fails), so resume tests a step's four products against them, without floors
+        self.ax0 = self.bx0 = self.ax1 = self.bx1 = self.ay0 = self.by0 = self.ay1 = self.by1 = 0.0
         self.near_cells: Cells = ()
         # whether none of ``near_cells`` was in ``covered`` when it had ``near_count`` cells
         # (then, the set no larger, none is now: cells are only ever added, and ``cover``
@@ -328,24 +312,17 @@ class RoomState:
                     ax1 = (x + reach) * inv
                     ay0 = (y - reach) * inv
                     ay1 = (y + reach) * inv
-                    # (floor(a) == k exactly when k <= a < k + 1: the last range's bounds,
-                    # whole floats, compared without the four floors; a NaN fails them)
                     if (self.near and self.ax0 <= ax0 < self.bx0 and self.ax1 <= ax1 < self.bx1
                             and self.ay0 <= ay0 < self.by0 and self.ay1 <= ay1 < self.by1):
                         cells = self.near_cells         # uncovered[key], as left
                     else:
-                        cells = self._enter(math.floor(ax0), math.floor(ax1),
-                                            math.floor(ay0), math.floor(ay1))
+                        cells = self._enter((math.floor(ax0), math.floor(ax1),
+                                             math.floor(ay0), math.floor(ay1)))
                 else:
-                    kx0 = int((x - reach) // cell)
-                    kx1 = int((x + reach) // cell)
-                    ky0 = int((y - reach) // cell)
-                    ky1 = int((y + reach) // cell)
-                    if (self.near and kx0 == self.kx0 and kx1 == self.kx1
-                            and ky0 == self.ky0 and ky1 == self.ky1):
-                        cells = self.near_cells         # uncovered[key], as left
-                    else:
-                        cells = self._enter(kx0, kx1, ky0, ky1)
+                    key = (int((x - reach) // cell), int((x + reach) // cell),
+                           int((y - reach) // cell), int((y + reach) // cell))
+                    cells = (self.near_cells if self.near and key == self.near_key
+                             else self._enter(key))     # (near_cells: uncovered[key], as left)
                 if len(cells) > 0:
                     # RoomWorld._cover at this step, over the range's cells still uncovered
                     # (cells are only ever added, so the others cannot be covered again)
@@ -385,81 +362,43 @@ class RoomState:
         self.time = t if code == DONE else t_step
         return code
 
-    def _enter(self, kx0: int, kx1: int, ky0: int, ky1: int) -> Cells:
-        """The robot's reach is now in the cell range ``kx0``..``ky1``: it becomes the last
-        range (``near``), its cells still uncovered looked up or listed, and returned."""
-        key = (kx0, kx1, ky0, ky1)
-        uncovered = self.uncovered
-        found = uncovered.get(key)
-        if found is None:
-            cells = self._cells(key)
-            uncovered[key] = cells                  # (near_cells is uncovered[key])
-        else:
-            cells = found
+    def _enter(self, key: Key) -> Cells:
+        """The cell range ``key`` made the last range (``near``): its cells still uncovered,
+        found or listed (the room's in it, in ``RoomWorld._cover``'s order)."""
+        kx0, kx1, ky0, ky1 = key
+        cells = self.uncovered.get(key)
+        if cells is None:
+            found: list[Cell] = []
+            for cx in range(max(kx0, 0), min(kx1 + 1, self.cells_x)):
+                for cy in range(max(ky0, 0), min(ky1 + 1, self.cells_y)):
+                    found.append((cx, cy))
+            cells = tuple(found)
+            self.uncovered[key] = cells             # (near_cells is uncovered[key])
         self.near = True
         self.near_key = key
-        self.kx0 = kx0
-        self.kx1 = kx1
-        self.ky0 = ky0
-        self.ky1 = ky1
-        self.ax0 = float(kx0)
-        self.bx0 = float(kx0 + 1)
-        self.ax1 = float(kx1)
-        self.bx1 = float(kx1 + 1)
-        self.ay0 = float(ky0)
-        self.by0 = float(ky0 + 1)
-        self.ay1 = float(ky1)
-        self.by1 = float(ky1 + 1)
+        self.ax0, self.bx0 = float(kx0), float(kx0 + 1)
+        self.ax1, self.bx1 = float(kx1), float(kx1 + 1)
+        self.ay0, self.by0 = float(ky0), float(ky0 + 1)
+        self.ay1, self.by1 = float(ky1), float(ky1 + 1)
         self.near_cells = cells
         self.near_clean = False
         return cells
-
-    def _cells(self, key: Key) -> Cells:
-        """The cells of the room in ``key``'s range, in ``RoomWorld._cover``'s order."""
-        cx0, cx1, cy0, cy1 = key
-        found: list[Cell] = []
-        for cx in range(max(cx0, 0), min(cx1 + 1, self.cells_x)):
-            for cy in range(max(cy0, 0), min(cy1 + 1, self.cells_y)):
-                found.append((cx, cy))
-        return tuple(found)
 
     def read_range(self, noise: float) -> float:
         """The range finder's reading with this ``noise`` drawn: the distance from the
         robot's edge to the nearest wall or obstacle face ahead, 0 at the least, to 0.1 mm."""
         best = distance_ahead(self.x, self.y, self.heading, self.boxes)
         distance = best - self.radius + noise
-        # (round4 itself: from source, a call less a reading)
-        return rounded(distance if distance > 0.0 else 0.0, 4, 10000.0)  # max(0.0, distance)
+        return rounded(distance if distance > 0.0 else 0.0, 4, 10000.0)  # (round4, max(0, d))
 
     def read_bump(self) -> dict[str, Any]:
         """The bumper: whether it was pressed since it was last read (and clear it)."""
         bumped = self.bumped
         self.bumped = False
-        # (a copy of a fixed answer: compiled, a dict copied is one key table cloned, where
-        # a new one is filled key by key, about 0.4k instructions a reading)
+        # (compiled, a dict copied clones one key table; a dict built is filled key by key)
         return (_BUMPED if bumped else _NOT_BUMPED).copy()     # a room has no ring edge
 
 
-def finish(world: Any, state: RoomState, code: int, now: float) -> int:
-    """``RoomWorld.finish_advance``'s loop, compiled: the steps :meth:`RoomState.advance`
-    stopped at (``code``) traced through ``world.trace`` (cells covered, a contact begun,
-    ``world.collisions`` counted), the stepping resumed each time, until ``now`` (``DONE``)
-    or an arc that the room steps itself (``ARC``). Interpreted, this loop and its calls
-    were about 15k instructions a stop (once every few seconds on the vacuum cleaner)."""
-    while code != DONE:
-        if code == ARC:
-            return ARC
-        if code == COVER:                   # covered (by the loop), to be traced
-            for c in state.new_cells:
-                world.trace("world.covered", cell=[c[0], c[1]])
-        else:
-            world.collisions += 1
-            world.trace("world.collision", x=round3(state.x), y=round3(state.y))
-        code = state.resume(now)
-    return DONE
-
-
-#: the bumper's two answers (:meth:`RoomState.read_bump` hands out copies)
 _BUMPED: Final[dict[str, Any]] = {"bump": True, "edge": False}
 _NOT_BUMPED: Final[dict[str, Any]] = {"bump": False, "edge": False}
 
@@ -591,9 +530,8 @@ def cover_within(cells: Cells, x: float, y: float, cell: float, limit: float, fa
 
 def cover_step(cells: Cells, x: float, y: float, cell: float, limit: float, far: float,
                covered: set[Cell], check: bool) -> tuple[list[Cell] | None, Cells]:
-    """:func:`cover_within` as :meth:`RoomState.resume` calls it at each step: ``None``
-    for no cell newly covered, and no list made at all when no cell is covered or dropped
-    (most steps)."""
+    """:func:`cover_within` for :meth:`RoomState.resume`'s steps: ``None`` for no cell newly
+    covered, no list made when no cell is covered or dropped (most steps)."""
     new: list[Cell] | None = None
     left: list[Cell] | None = None          # (made at the first cell that is not left)
     i = 0
@@ -637,14 +575,8 @@ def cells_of(v: float, cell: float, inv: float) -> int:
 
 
 def round4(x: float) -> float:
-    """``round(x, 4)``, the same float, without its decimal conversion for the usual case
-    (:func:`rounded`)."""
+    """``round(x, 4)``, the same float, without its decimal conversion (:func:`rounded`)."""
     return rounded(x, 4, 10000.0)
-
-
-def round3(x: float) -> float:
-    """``round(x, 3)``, the same float (:func:`rounded`): where a contact is traced."""
-    return rounded(x, 3, 1000.0)
 
 
 def rounded(x: float, places: int, scale: float) -> float:

@@ -85,8 +85,8 @@ def test_the_range_noise_set_on_the_room_is_the_devices_noise() -> None:
 
 
 @pytest.mark.parametrize("seed", range(3))
-def test_round3_is_round_to_three_places_bit_for_bit(seed: int) -> None:
-    from opspec.worlds.stepping import round3, round4
+def test_rounded_is_round_to_three_and_four_places_bit_for_bit(seed: int) -> None:
+    from opspec.worlds.stepping import round4, rounded
 
     rng = np.random.default_rng(seed)
     values = [float(v) for v in rng.uniform(0.0, 6.0, 40_000)]
@@ -98,6 +98,6 @@ def test_round3_is_round_to_three_places_bit_for_bit(seed: int) -> None:
     values += [0.0, -0.0, 1e-300, 5e-4, 1.5e-3, 2.675, 0.0005, 9999.9995, 1e4, 1e20,
                math.inf, -1.25e-4, -0.0004]
     for x in values:
-        assert round3(x).hex() == round(x, 3).hex(), x
+        assert rounded(x, 3, 1000.0).hex() == round(x, 3).hex(), x
         assert round4(x).hex() == round(x, 4).hex(), x
-    assert math.isnan(round3(math.nan))
+    assert math.isnan(rounded(math.nan, 3, 1000.0))
