@@ -424,8 +424,10 @@ def _compile_equality(expr: Binary, left: _Fn, right: _Fn, whole: _Whole, *,
         # is that object (compiled, ``==`` of two values of unknown type is a call through
         # Python's comparison protocol, about 70 instructions a robot's flag tested)
         single = constant is None or kind is bool
+        # (``now`` untyped, as a conjunction's: compiled, a float parameter is unboxed on
+        # entry, where only an error reads it)
 
-        def field_equals(data: Mapping[str, Any], now: float) -> bool:
+        def field_equals(data: Mapping[str, Any], now: Any) -> bool:
             try:
                 try:
                     value = data[root]
@@ -468,6 +470,10 @@ def _compile_equality(expr: Binary, left: _Fn, right: _Fn, whole: _Whole, *,
     return equals
 
 
+#: the ordering operators as the codes ``field_ordering`` branches on
+_ORDER_CODES: Final = {"<": 0, "<=": 1, ">": 2, ">=": 3}
+
+
 def _compile_ordering(expr: Binary, left: _Fn, right: _Fn, whole: _Whole) -> _Fn:
     # (At a condition's root, ``whole``, the closure is the condition: the fast paths give
     # Python bools, and ``_held`` makes :func:`ordered`'s answer one, as a condition's is.)
@@ -480,14 +486,30 @@ def _compile_ordering(expr: Binary, left: _Fn, right: _Fn, whole: _Whole) -> _Fn
     ):
         # "field < 3": the field read and the constant inlined, numbers compared directly.
         root = field_name(expr.left.path[0])
+        # A float field is compared with the constant as two C doubles where that is
+        # Python's comparison: a float constant, or an int one a double holds exactly
+        # (compiled, ``fast`` is a call of ``operator.lt`` through Python's protocol)
+        native = isinstance(constant, float) or (isinstance(constant, int)
+                                                 and -(2 ** 53) <= constant <= 2 ** 53)
+        bound = float(constant) if native and isinstance(constant, int | float) else 0.0
+        order = _ORDER_CODES[op]
 
-        def field_ordering(data: Mapping[str, Any], now: float) -> bool:
+        def field_ordering(data: Mapping[str, Any], now: Any) -> bool:
             try:
                 try:
                     value = data[root]
                 except KeyError:
                     missing_field(data, root)
                 kind = type(value)
+                if kind is float and native:
+                    held: float = value
+                    if order == 0:
+                        return held < bound
+                    if order == 1:
+                        return held <= bound
+                    if order == 2:
+                        return held > bound
+                    return held >= bound
                 if kind is int or kind is float:
                     return fast(value, constant)
                 if kind is str:  # XPDL data often holds numbers as text ("3")

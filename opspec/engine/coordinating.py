@@ -32,6 +32,11 @@ _SUPERPOSITION: Final = CoordinationKind.SUPERPOSITION
 _PUSH_DATA: Final = CoordinationKind.PUSH_DATA
 _PULL_DATA: Final = CoordinationKind.PULL_DATA
 
+#: a deque's two methods used here, called as functions: compiled, a method of a class
+#: mypyc does not compile is looked up by name at each call (about 90 instructions)
+_APPEND: Final = deque.append
+_POPLEFT: Final = deque.popleft
+
 #: what :func:`at_once` returns when it did nothing: the caller starts an instance
 _NOT_NOW: Final = False
 
@@ -152,7 +157,7 @@ def at_once(acts: Activities, frame: Frame, act: CompiledActivity) -> bool:
     if kind == PUSH:
         push(acts, built.channel, values[0] if len(values) == 1 else tuple(values))
     elif box is not None and output:      # (without an output the value stays, as there)
-        result = box.popleft()
+        result = _POPLEFT(box)
     if output and kind != PUSH:
         acts.flow.set_field(inst, act, output, result)
     # Activities._complete, the instance's part left out
@@ -196,11 +201,13 @@ def coordinate(acts: Activities, ai: ActivityInstance) -> None:
     spec = act.coordination
     assert spec is not None
     built = coord_of(act, spec)
-    try:
-        values = inputs_of(ai.scope(), built.inputs)
-    except KeyError as error:
-        acts.fail(ai, "coordination", f"data field {error.args[0]!r} does not exist")
-        return
+    values = _NO_VALUES
+    if built.inputs:                        # (a pull reads none: no list made for it)
+        try:
+            values = inputs_of(ai.scope(), built.inputs)
+        except KeyError as error:
+            acts.fail(ai, "coordination", f"data field {error.args[0]!r} does not exist")
+            return
     kind = built.kind
     output = built.output
     try:
@@ -218,7 +225,7 @@ def coordinate(acts: Activities, ai: ActivityInstance) -> None:
             channel = built.channel
             box = acts.state.mailboxes.get(channel)
             if box:
-                acts.body_done(ai, {output: box.popleft()} if output else None)
+                acts.body_done(ai, {output: _POPLEFT(box)} if output else None)
             else:
                 ai.waiting = built.waiting
                 pullers = acts.state.pullers
@@ -226,7 +233,7 @@ def coordinate(acts: Activities, ai: ActivityInstance) -> None:
                 if waiting is None:         # (setdefault's, without a deque made per call)
                     waiting = deque()
                     pullers[channel] = waiting
-                waiting.append(ai)
+                _APPEND(waiting, ai)
             return
         else:
             # at once: a mode ending this instance stops all after it (its completion too)
@@ -244,7 +251,7 @@ def push(acts: Activities, channel: str, value: Any) -> None:
     state = acts.state
     pullers = state.pullers.get(channel)
     while pullers:
-        ai = pullers.popleft()
+        ai = _POPLEFT(pullers)
         if ai.state == RUNNING:
             act = ai.act
             spec = act.coordination
@@ -257,4 +264,4 @@ def push(acts: Activities, channel: str, value: Any) -> None:
     if box is None:                         # (setdefault's, without a deque made per call)
         box = deque()
         mailboxes[channel] = box
-    box.append(value)
+    _APPEND(box, value)

@@ -76,21 +76,21 @@ class RoomDevices(AnswersAtOnce):
         if application == "read_bump":
             result = state.read_bump()
         elif application == "read_range":
-            world = self.world
-            sd: float = world.range_noise
+            sd = state.range_noise              # (the room's range_noise)
             if sd >= 0.0:
                 # RoomWorld.op_read_range, compiled: the same draw from the room's
                 # generator and the same float operations (0.0 + sd * z, then the reading)
                 z = self.normals.draw()
                 result = {"distance": state.read_range(0.0 + sd * z)}
             else:
-                result = world.op_read_range(data)      # normal() refuses the sd
+                result = self.world.op_read_range(data)     # normal() refuses the sd
         else:
             if isinstance(data, dict):      # a dict's get called natively
                 command = data.get("motor_cmd")
             else:                           # (a Mapping's through Python's protocol)
                 command = data.get("motor_cmd")
-            command = str(command or "stop")
+            if type(command) is not str or not command:     # (else str() gives it back)
+                command = str(command or "stop")
             if command == "turn_random":
                 result = self.world.op_drive(data)
             else:

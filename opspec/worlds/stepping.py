@@ -18,7 +18,7 @@ from opspec.worlds.robot import COMMANDS, pose_after
 
 __all__ = ["ARC", "COLLISION", "COVER", "DONE", "STEP_S", "Grown", "Normals", "RayBox",
            "RoomState", "Sides", "cells_of", "cover", "cover_limit", "cover_within",
-           "distance_ahead", "far_from", "round4"]
+           "cover_step", "distance_ahead", "far_from", "round4", "rounded"]
 
 #: integration step: 5 cm at 1 m/s, well under the robot's size
 STEP_S: Final = 0.05
@@ -36,6 +36,8 @@ STILL: Final[tuple[float, ...]] = (0.0, 0.0)
 #: robot.COMMANDS as a static of this module: compiled, a name imported from a module that
 #: is not compiled is looked up in this module's globals at each use (once a device use)
 _COMMANDS: Final = COMMANDS
+#: math.atan2 likewise: mypyc has no native atan2 (it was looked up in the module a call)
+_atan2: Final = math.atan2
 
 Key = tuple[int, int, int, int]
 #: a floor cell (x, y), typed as a tuple of any length so that compiled code keeps it one
@@ -116,11 +118,13 @@ class RoomState:
         self.y = 0.0
         self.heading = 0.0
         self.command = "stop"
-        # the motion of the command object last looked up (advance's, in the constant table)
+        # the speeds of the command object last looked up (advance's, in the constant table)
         self.moved_by: str | None = None
-        self.motion: tuple[float, ...] = STILL
+        self.mv = self.mw = 0.0
         self.bumped = False
         self.in_contact = False
+        # the room's ``range_noise``, here where the compiled performer reads it natively
+        self.range_noise = 0.0
         self.t = 0.0
         self.after = 0.0
         self.settled = False
@@ -131,10 +135,10 @@ class RoomState:
         # then): a straight drive stays in one range for several steps, and a range all
         # covered needs no look at all (``near`` says whether there is a last range)
         self.near = False
-        self.kx0 = 0
-        self.kx1 = 0
-        self.ky0 = 0
-        self.ky1 = 0
+        self.near_key: Key = (0, 0, 0, 0)
+        # its bounds as whole floats: ``floor(a) == k`` exactly when ``k <= a < k + 1`` (a NaN
+        # fails), so resume tests a step's four products against them, without floors
+        self.ax0 = self.bx0 = self.ax1 = self.bx1 = self.ay0 = self.by0 = self.ay1 = self.by1 = 0.0
         self.near_cells: Cells = ()
         # whether none of ``near_cells`` was in ``covered`` when it had ``near_count`` cells
         # (then, the set no larger, none is now: cells are only ever added, and ``cover``
@@ -200,13 +204,15 @@ class RoomState:
             return DONE
         command = self.command
         if command is self.moved_by:        # (the same command object as last time)
-            motion = self.motion
+            v = self.mv
+            w = self.mw
         else:
             found: tuple[float, ...] | None = _COMMANDS.get(command)
             motion = STILL if found is None else found  # (no default to the get: see STILL)
+            v, w = motion
             self.moved_by = command
-            self.motion = motion
-        v, w = motion
+            self.mv = v
+            self.mw = w
         if abs(w) >= 1e-12:
             if v != 0.0:
                 return ARC
@@ -218,7 +224,7 @@ class RoomState:
             self.after = heading                # wrap_angle(heading) is heading itself
             self.settled = True
         else:
-            after = math.atan2(math.sin(heading), math.cos(heading))       # wrap_angle
+            after = _atan2(math.sin(heading), math.cos(heading))       # wrap_angle
             self.after = after
             self.settled = after == heading and (
                 math.copysign(1.0, after) == math.copysign(1.0, heading))
@@ -240,7 +246,7 @@ class RoomState:
             rest = now - t
             dt = STEP_S if rest > STEP_S else rest
             heading = heading + w * dt
-            heading = math.atan2(math.sin(heading), math.cos(heading))   # wrap_angle
+            heading = _atan2(math.sin(heading), math.cos(heading))   # wrap_angle
             t += dt
         if self.command == "stop":
             self.in_contact = False
@@ -283,7 +289,7 @@ class RoomState:
                 heading = after
                 cos_h = math.cos(heading)
                 sin_h = math.sin(heading)
-                after = math.atan2(math.sin(heading), math.cos(heading))    # wrap_angle
+                after = _atan2(math.sin(heading), math.cos(heading))    # wrap_angle
                 settled = after == heading and (
                     math.copysign(1.0, after) == math.copysign(1.0, heading))
             if nx == x and ny == y:
@@ -302,47 +308,35 @@ class RoomState:
                 y = ny
                 in_contact = False
                 if inv > 0.0:
-                    kx0 = math.floor((x - reach) * inv)     # cells_of, in line
-                    kx1 = math.floor((x + reach) * inv)
-                    ky0 = math.floor((y - reach) * inv)
-                    ky1 = math.floor((y + reach) * inv)
-                else:
-                    kx0 = int((x - reach) // cell)
-                    kx1 = int((x + reach) // cell)
-                    ky0 = int((y - reach) // cell)
-                    ky1 = int((y + reach) // cell)
-                if (self.near and kx0 == self.kx0 and kx1 == self.kx1 and ky0 == self.ky0
-                        and ky1 == self.ky1):
-                    cells = self.near_cells             # uncovered[key], as left
-                else:
-                    key = (kx0, kx1, ky0, ky1)
-                    found = uncovered.get(key)
-                    if found is None:
-                        cells = self._cells(key)
-                        uncovered[key] = cells          # (near_cells is uncovered[key])
+                    ax0 = (x - reach) * inv                 # cells_of, in line
+                    ax1 = (x + reach) * inv
+                    ay0 = (y - reach) * inv
+                    ay1 = (y + reach) * inv
+                    if (self.near and self.ax0 <= ax0 < self.bx0 and self.ax1 <= ax1 < self.bx1
+                            and self.ay0 <= ay0 < self.by0 and self.ay1 <= ay1 < self.by1):
+                        cells = self.near_cells         # uncovered[key], as left
                     else:
-                        cells = found
-                    self.near = True
-                    self.kx0 = kx0
-                    self.kx1 = kx1
-                    self.ky0 = ky0
-                    self.ky1 = ky1
-                    self.near_cells = cells
-                    self.near_clean = False
+                        cells = self._enter((math.floor(ax0), math.floor(ax1),
+                                             math.floor(ay0), math.floor(ay1)))
+                else:
+                    key = (int((x - reach) // cell), int((x + reach) // cell),
+                           int((y - reach) // cell), int((y + reach) // cell))
+                    cells = (self.near_cells if self.near and key == self.near_key
+                             else self._enter(key))     # (near_cells: uncovered[key], as left)
                 if len(cells) > 0:
                     # RoomWorld._cover at this step, over the range's cells still uncovered
                     # (cells are only ever added, so the others cannot be covered again)
                     covered = self.covered
                     check = not (self.near_clean and len(covered) == self.near_count)
-                    new, left = cover_within(cells, x, y, cell, self.limit, self.far,
-                                             covered, check)
+                    new, left = cover_step(cells, x, y, cell, self.limit, self.far,
+                                           covered, check)
                     if left is not cells:               # (else uncovered[key] is cells)
-                        uncovered[(kx0, kx1, ky0, ky1)] = left
+                        uncovered[self.near_key] = left
                         self.near_cells = left
                     self.near_clean = True
                     self.near_count = len(covered)
                     if new:
-                        self.key = (kx0, kx1, ky0, ky1)
+                        self.key = self.near_key
                         self.new_cells = new
                         code = COVER
             else:
@@ -368,27 +362,45 @@ class RoomState:
         self.time = t if code == DONE else t_step
         return code
 
-    def _cells(self, key: Key) -> Cells:
-        """The cells of the room in ``key``'s range, in ``RoomWorld._cover``'s order."""
-        cx0, cx1, cy0, cy1 = key
-        found: list[Cell] = []
-        for cx in range(max(cx0, 0), min(cx1 + 1, self.cells_x)):
-            for cy in range(max(cy0, 0), min(cy1 + 1, self.cells_y)):
-                found.append((cx, cy))
-        return tuple(found)
+    def _enter(self, key: Key) -> Cells:
+        """The cell range ``key`` made the last range (``near``): its cells still uncovered,
+        found or listed (the room's in it, in ``RoomWorld._cover``'s order)."""
+        kx0, kx1, ky0, ky1 = key
+        cells = self.uncovered.get(key)
+        if cells is None:
+            found: list[Cell] = []
+            for cx in range(max(kx0, 0), min(kx1 + 1, self.cells_x)):
+                for cy in range(max(ky0, 0), min(ky1 + 1, self.cells_y)):
+                    found.append((cx, cy))
+            cells = tuple(found)
+            self.uncovered[key] = cells             # (near_cells is uncovered[key])
+        self.near = True
+        self.near_key = key
+        self.ax0, self.bx0 = float(kx0), float(kx0 + 1)
+        self.ax1, self.bx1 = float(kx1), float(kx1 + 1)
+        self.ay0, self.by0 = float(ky0), float(ky0 + 1)
+        self.ay1, self.by1 = float(ky1), float(ky1 + 1)
+        self.near_cells = cells
+        self.near_clean = False
+        return cells
 
     def read_range(self, noise: float) -> float:
         """The range finder's reading with this ``noise`` drawn: the distance from the
         robot's edge to the nearest wall or obstacle face ahead, 0 at the least, to 0.1 mm."""
         best = distance_ahead(self.x, self.y, self.heading, self.boxes)
         distance = best - self.radius + noise
-        return round4(distance if distance > 0.0 else 0.0)     # max(0.0, distance)
+        return rounded(distance if distance > 0.0 else 0.0, 4, 10000.0)  # (round4, max(0, d))
 
     def read_bump(self) -> dict[str, Any]:
         """The bumper: whether it was pressed since it was last read (and clear it)."""
         bumped = self.bumped
         self.bumped = False
-        return {"bump": bumped, "edge": False}         # a room has no ring edge
+        # (compiled, a dict copied clones one key table; a dict built is filled key by key)
+        return (_BUMPED if bumped else _NOT_BUMPED).copy()     # a room has no ring edge
+
+
+_BUMPED: Final[dict[str, Any]] = {"bump": True, "edge": False}
+_NOT_BUMPED: Final[dict[str, Any]] = {"bump": False, "edge": False}
 
 
 #: how many standard normal draws :class:`Normals` takes at once
@@ -512,23 +524,41 @@ def cover_within(cells: Cells, x: float, y: float, cell: float, limit: float, fa
     """:func:`cover` with its bound ``limit`` (and ``far_from(limit)``) given; ``check``
     false when none of ``cells`` is in ``covered`` (the membership tests then spared). The
     cells still not covered are ``cells`` itself when they are all of them."""
-    new: list[Cell] = []
-    left: list[Cell] = []
+    new, left = cover_step(cells, x, y, cell, limit, far, covered, check)
+    return ([] if new is None else new), left
+
+
+def cover_step(cells: Cells, x: float, y: float, cell: float, limit: float, far: float,
+               covered: set[Cell], check: bool) -> tuple[list[Cell] | None, Cells]:
+    """:func:`cover_within` for :meth:`RoomState.resume`'s steps: ``None`` for no cell newly
+    covered, no list made when no cell is covered or dropped (most steps)."""
+    new: list[Cell] | None = None
+    left: list[Cell] | None = None          # (made at the first cell that is not left)
+    i = 0
     # one membership test a cell: ``cells`` has no cell twice, so one covered here is in
     # no later test, and those still not covered afterwards are the ones tested here
     for c in cells:
         if check and c in covered:
-            continue                # (cells of other ranges overlap these: covered there)
-        cx, cy = c
-        dx = (cx + 0.5) * cell - x
-        dy = (cy + 0.5) * cell - y
-        if (abs(dx) <= far and abs(dy) <= far
-                and math.pow(dx, 2.0) + math.pow(dy, 2.0) <= limit):
-            covered.add(c)
-            new.append(c)
+            gone = True             # (cells of other ranges overlap these: covered there)
         else:
+            cx, cy = c
+            dx = (cx + 0.5) * cell - x
+            dy = (cy + 0.5) * cell - y
+            gone = (abs(dx) <= far and abs(dy) <= far
+                    and math.pow(dx, 2.0) + math.pow(dy, 2.0) <= limit)
+            if gone:
+                covered.add(c)
+                if new is None:
+                    new = [c]
+                else:
+                    new.append(c)
+        if gone:
+            if left is None:
+                left = list(cells[:i])
+        elif left is not None:
             left.append(c)
-    if len(left) == len(cells):
+        i += 1
+    if left is None:
         return new, cells           # (the same cells, in order: no copy)
     return new, tuple(left)
 
@@ -545,20 +575,26 @@ def cells_of(v: float, cell: float, inv: float) -> int:
 
 
 def round4(x: float) -> float:
-    """``round(x, 4)``, the same float, without its decimal conversion for the usual case.
+    """``round(x, 4)``, the same float, without its decimal conversion (:func:`rounded`)."""
+    return rounded(x, 4, 10000.0)
 
-    ``round`` gives the double nearest to the decimal ``n / 10**4``, ``n`` the integer nearest
-    to the exact ``x * 10**4`` (half to even); ``n / 10000.0`` is that double too (a
-    correctly rounded division of two exact numbers). ``y = x * 10000.0`` is within half an
+
+def rounded(x: float, places: int, scale: float) -> float:
+    """``round(x, places)``, the same float, ``scale`` being ``10.0 ** places`` (3 or 4
+    places), without its decimal conversion for the usual case.
+
+    ``round`` gives the double nearest to the decimal ``n / scale``, ``n`` the integer
+    nearest to the exact ``x * scale`` (half to even); ``n / scale`` is that double too (a
+    correctly rounded division of two exact numbers). ``y = x * scale`` is within half an
     ulp (under 1e-8 below 10 km) of the exact product, so ``n`` is the integer nearest to
     ``y`` unless ``y`` is within 1e-6 of a half: those, zero and negative numbers
     (``-0.0``), large and non-finite ones go to ``round`` itself."""
     if not 0.0 < x < 1e4:
-        return round(x, 4)
-    y = x * 10000.0
+        return round(x, places)
+    y = x * scale
     whole = math.floor(y)
     part = y - whole                      # exact: y and its floor are close doubles
     if abs(part - 0.5) < 1e-6:
-        return round(x, 4)
+        return round(x, places)
     n = whole + 1 if part > 0.5 else whole
-    return n / 10000.0
+    return n / scale
