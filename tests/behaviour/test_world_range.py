@@ -1,6 +1,7 @@
 """The range finder's reading is rounded to 0.1 mm as Python's ``round(x, 4)`` rounds it,
 bit for bit, whether by ``round`` itself or by the compiled shortcut the room takes
-(``opspec.worlds.stepping.round4``), and its noise is the draw ``Generator.normal`` gives.
+(``opspec.worlds.stepping.round4``; a collision's position to 1 mm by ``rounded``), and its
+noise is the draw ``Generator.normal`` gives.
 
 Python's documentation of ``round``: "values are rounded to the closest multiple of 10 to
 the power minus ndigits; if two multiples are equally close, rounding is done toward the
@@ -16,26 +17,35 @@ import numpy as np
 import pytest
 
 from opspec.worlds.room import RoomWorld
-from opspec.worlds.stepping import round4
+from opspec.worlds.stepping import round4, rounded
 
 
-def _values(seed: int) -> list[float]:
+def _values(seed: int, places: int) -> list[float]:
     rng = np.random.default_rng(seed)
+    scale = 10.0 ** places
     values = [float(v) for v in rng.uniform(0.0, 6.0, 40_000)]
     values += [float(v) for v in 10.0 ** rng.uniform(-9.0, 5.0, 20_000)]
     # exact and nearly exact halves of the last digit kept: where a shortcut could go wrong
-    for k in rng.integers(0, 60_000, 5_000):
-        half = (int(k) + 0.5) / 10_000.0
+    for k in rng.integers(0, int(6 * scale), 5_000):
+        half = (int(k) + 0.5) / scale
         values += [half, math.nextafter(half, 0.0), math.nextafter(half, 1.0)]
-    values += [0.0, -0.0, 1e-300, 5e-5, 1.5e-4, 2.675, 9999.99995, 1e4, 1e20,
-               math.inf, -1.25e-5]
+    values += [0.0, -0.0, 1e-300, 5 / scale / 10, 1.5 / scale, 2.675, 1e4 - 0.5 / scale, 1e4,
+               1e20, math.inf, -1.25 / scale / 10]
     return values
 
 
 @pytest.mark.parametrize("seed", range(3))
 def test_round4_is_round_to_four_places_bit_for_bit(seed: int) -> None:
-    for x in _values(seed):
+    for x in _values(seed, 4):
         assert round4(x).hex() == round(x, 4).hex(), x
+
+
+@pytest.mark.parametrize("seed", range(3))
+def test_rounded_is_round_to_three_places_bit_for_bit(seed: int) -> None:
+    """``rounded(x, 3, 1000.0)``, as a collision's traced position is rounded."""
+    for x in _values(seed, 3):
+        assert rounded(x, 3, 1000.0).hex() == round(x, 3).hex(), x
+    assert math.isnan(rounded(math.nan, 3, 1000.0))
 
 
 def test_the_documented_example_of_binary_halves() -> None:
