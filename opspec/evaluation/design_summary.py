@@ -165,6 +165,7 @@ def summarise_design(store: ResultStore, design: str, days: float, level: float 
     definitions = metric_definitions(store, design)
     values = per_user_values(store, design, definitions, users_of)
     counts = {d["name"] for d in definitions if d["kind"] == "count"}
+    pooled: list[tuple[str, int, float | None]] = []     # durations: (name, n, mean)
     for definition in definitions:
         name, kind = definition["name"], definition["kind"]
         pairs = values.pairs(name)
@@ -185,19 +186,16 @@ def summarise_design(store: ResultStore, design: str, days: float, level: float 
             }
         elif kind == "duration":
             n = int(sum(n for _, n in pairs))
-            sq = store.query("SELECT SUM(value * value) FROM sample WHERE design = ? AND "
-                             f"metric = ?{where}", (design, name, *where_params))
-            sd = None
-            if n > 1 and estimate.value is not None and sq and sq[0][0] is not None:
-                var = (float(sq[0][0]) - n * estimate.value ** 2) / (n - 1)
-                sd = math.sqrt(max(var, 0.0))
+            # sd, median and p95 read the observations themselves: after every other
+            # number (below), so that they wait last for the sample index being built
+            # beside the summaries (ResultStore.index)
+            pooled.append((name, n, estimate.value))
             out[name] = {
                 "kind": "duration", "unit": definition.get("unit") or "s", "n": n,
                 "users": users, "mean": estimate.value, "ci95": estimate.ci,
-                "ci95_method": estimate.method, "sd": sd,
+                "ci95_method": estimate.method, "sd": None,
                 "ci95_no_spread": no_spread(estimate.ci, estimate.users, level),
-                "median": _pooled_quantile(store, design, name, n, 0.5, subgroup),
-                "p95": _pooled_quantile(store, design, name, n, 0.95, subgroup),
+                "median": None, "p95": None,
                 "per_user": _per_user(values.sorted(name, "v"), level),
             }
         else:
@@ -222,6 +220,14 @@ def summarise_design(store: ResultStore, design: str, days: float, level: float 
                              "between_user_sd": (_between_user_sd(pairs) if proportion
                                                  else None)},
             }
+    for name, n, mean in pooled:
+        sq = store.query("SELECT SUM(value * value) FROM sample WHERE design = ? AND "
+                         f"metric = ?{where}", (design, name, *where_params))
+        if n > 1 and mean is not None and sq and sq[0][0] is not None:
+            var = (float(sq[0][0]) - n * mean ** 2) / (n - 1)
+            out[name]["sd"] = math.sqrt(max(var, 0.0))
+        out[name]["median"] = _pooled_quantile(store, design, name, n, 0.5, subgroup)
+        out[name]["p95"] = _pooled_quantile(store, design, name, n, 0.95, subgroup)
     return out
 
 

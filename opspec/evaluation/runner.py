@@ -331,9 +331,9 @@ def run_evaluation(plan: EvaluationPlan, store: ResultStore, *, workers: int = 1
     seconds (at the start, or once all have left) stops the run with an EvaluationError;
     what finished is stored.
 
-    ``on_stored`` is called once every replication is stored, before the sample index is built
-    (:meth:`ResultStore.index`): ``opspec evaluate --workers W`` asks then for the report's
-    figures that do not read it, drawn beside the index.
+    ``on_stored`` is called once every replication is stored, as the sample index is begun
+    (:meth:`ResultStore.index`; with W > 1 it is built beside): ``opspec evaluate --workers
+    W`` asks then for the report's figures that do not read it, drawn beside the index.
 
     ``meanwhile`` is called once the worker processes have their first chunks (never when
     the replications run in this process): what the caller needs after the replications,
@@ -411,9 +411,12 @@ def run_evaluation(plan: EvaluationPlan, store: ResultStore, *, workers: int = 1
                               slots, keep)
         for label, users, reason in lost:
             keep([ReplicationRecord(label, u, "failed", error=reason) for u in users])
+        # once, now that every replication is stored; with workers (W > 1) on a thread of
+        # its own, beside what this process does next (the figures asked for ahead, the
+        # summaries): what reads the samples waits for it
+        store.index(beside=workers > 1)
         if on_stored is not None:
             on_stored()
-        store.index()               # once, now that every replication is stored
     finally:
         progress.finish()
     return EvaluationOutcome(done, skipped, failed, time.perf_counter() - started)

@@ -53,6 +53,7 @@ from opspec.evaluation.columns import (
     columns_of_samples,
 )
 from opspec.evaluation.replication import ReplicationRecord
+from opspec.evaluation.sample_index import IndexBeside, reads_samples
 
 __all__ = ["SCHEMA_VERSION", "ResultStore"]
 
@@ -317,6 +318,8 @@ class ResultStore:
         #: replications stored through this object so far (readers that keep what they
         #: read, :mod:`opspec.evaluation.spilled`, know when it is out of date)
         self.writes = 0
+        #: the sample index being built beside (:meth:`index`), until it is waited for
+        self._indexing: IndexBeside | None = None
         try:
             # (room for _insert_runs's statements, one per table and length of a run,
             # beside the others: a statement prepared again costs more than its rows)
@@ -375,6 +378,7 @@ class ResultStore:
         queue = list(records)
         if not queue:
             return
+        self._index_built()
         try:
             self._transaction(queue)
             return
@@ -443,10 +447,35 @@ class ResultStore:
             for (design, _group), outcomes in zip(groups, counted, strict=True):
                 self._outcome_sums.setdefault(design, _RunningSums()).add(outcomes)
 
-    def index(self) -> None:
+    def index(self, *, beside: bool = False) -> None:
         """Build the index readers need that is not kept during the run (the sample values
-        by metric: quantiles, histograms); nothing to do when it exists."""
+        by metric: quantiles, histograms); nothing to do when it exists.
+
+        ``beside`` (``opspec evaluate --workers W``, W > 1): build it on a thread of its own
+        and return at once. Every later read of the sample table, and every write, waits
+        for it first, and the error that stopped it (a full disk) is raised there, as this
+        method raises it otherwise; so whatever reads the samples reads them indexed, as
+        with one worker, and the results are the same."""
+        self._index_built()
+        if beside:
+            try:
+                self._indexing = IndexBeside(self.path, _SAMPLE_INDEX)
+                return
+            except sqlite3.Error as error:
+                raise _fail(self.path, "index the stored results", error) from None
+            except RuntimeError:            # no thread to be had: built here, as with one
+                pass                        # worker
         self._write(lambda db: db.execute(_SAMPLE_INDEX), "index the stored results")
+
+    def _index_built(self) -> None:
+        """Wait for the index being built beside, if any; its failure as an EvaluationError."""
+        indexing = self._indexing
+        if indexing is None:
+            return
+        error = indexing.wait()         # a Ctrl-C meanwhile leaves it to __exit__ to stop
+        self._indexing = None
+        if error is not None:
+            raise _fail(self.path, "index the stored results", error) from None
 
     def outcome_sums(self, design: str) -> list[tuple[str, int, int, int]]:
         """``(metric, day, hour, n)``: the outcome rows of ``design`` summed over users, from
@@ -488,6 +517,8 @@ class ResultStore:
     def query(self, sql: str, params: tuple[Any, ...] = ()) -> list[tuple[Any, ...]]:
         """Rows of a read. A failure, such as a disk too full for SQLite's temporary files, is
         an EvaluationError with the resume hint."""
+        if self._indexing is not None and reads_samples(sql):
+            self._index_built()
         try:
             return list(self._db.execute(sql, params))
         except sqlite3.Error as error:
@@ -497,6 +528,8 @@ class ResultStore:
              ) -> Iterator[tuple[Any, ...]]:
         """Rows of a read, streamed a batch at a time (the memory of one batch, whatever the
         number of users); a failure is an EvaluationError as with :meth:`query`."""
+        if self._indexing is not None and reads_samples(sql):
+            self._index_built()
         try:
             cursor = self._db.execute(sql, params)
             while chunk := cursor.fetchmany(batch):
@@ -510,29 +543,45 @@ class ResultStore:
         """Run one statement on this connection's temporary tables (``CREATE TEMP TABLE``,
         an index, ``DROP``): scratch space of the readers (:mod:`opspec.evaluation.spilled`),
         in a temporary file SQLite deletes with the connection; the store is not changed."""
-        self._write(lambda db: db.execute(sql), "write a temporary table")
+        self._write(lambda db: db.execute(sql), "write a temporary table", temporary=True)
 
     def scratch_rows(self, sql: str, rows: Sequence[tuple[Any, ...]]) -> None:
         """Insert ``rows`` into a temporary table with ``sql`` (one transaction)."""
         if rows:
-            self._write(lambda db: _in_transaction(db, sql, rows), "write a temporary table")
+            self._write(lambda db: _in_transaction(db, sql, rows), "write a temporary table",
+                        temporary=True)
 
     # ------------------------------------------------------------------ plumbing
 
-    def _write(self, action: Callable[[sqlite3.Connection], Any], doing: str) -> None:
+    def _write(self, action: Callable[[sqlite3.Connection], Any], doing: str, *,
+               temporary: bool = False) -> None:
+        """``action`` on the database; ``temporary``: on this connection's temporary
+        tables alone, which lock nothing another connection writes (the index being built
+        beside is not waited for)."""
+        if not temporary:
+            self._index_built()
         try:
             action(self._db)
         except sqlite3.Error as error:
             raise _fail(self.path, doing, error) from None
 
     def close(self) -> None:
+        """Close the database, once the index being built beside is there (its failure
+        raised, as at any write)."""
         try:
-            self._db.close()
-        except sqlite3.Error:
-            pass
+            self._index_built()
+        finally:
+            try:
+                self._db.close()
+            except sqlite3.Error:
+                pass
 
     def __enter__(self) -> Self:
         return self
 
-    def __exit__(self, *exc: object) -> None:
+    def __exit__(self, kind: type[BaseException] | None, *exc: object) -> None:
+        if kind is not None and self._indexing is not None:
+            # the run is stopping (Ctrl-C, an error): not the time to finish an index
+            indexing, self._indexing = self._indexing, None
+            indexing.stop()
         self.close()

@@ -22,6 +22,7 @@ from figure_samples import DAYS, figures
 from evaluation_inputs import SPEC
 from opspec.errors import EvaluationError
 from opspec.evaluation import drawing_pools, figure_queue, plots, report, report_design
+from opspec.evaluation import sample_index
 from opspec.evaluation.store import ResultStore
 
 
@@ -72,16 +73,16 @@ def _evaluate(evaluate: Any, out: Path, workers: int) -> dict[str, bytes]:
     return {p.name: p.read_bytes() for p in sorted((out / "figures").iterdir())}
 
 
-def test_evaluate_asks_them_before_the_index_and_once(
+def test_evaluate_asks_them_as_the_index_is_built_beside_and_once(
         evaluate: Any, tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
     alone = _evaluate(evaluate, tmp_path / "one", 1)
     order: list[str] = []
     indexing, asking = ResultStore.index, report.ask_figures_ahead
     queued = plots.drawn_by
 
-    def index(store: ResultStore) -> None:
-        order.append("index")
-        indexing(store)
+    def index(store: ResultStore, *, beside: bool = False) -> None:
+        order.append("index beside" if beside else "index")
+        indexing(store, beside=beside)
 
     def ask(*args: Any, **kwargs: Any) -> Any:
         ahead = asking(*args, **kwargs)
@@ -103,8 +104,9 @@ def test_evaluate_asks_them_before_the_index_and_once(
     monkeypatch.setattr(report, "ask_figures_ahead", ask)
     monkeypatch.setattr(plots, "drawn_by", drawn_by)
     together = _evaluate(evaluate, tmp_path / "two", 2)
-    assert order == ["ahead: activity_rates_figure, over_days_figure, time_of_day_figure",
-                     "index", "report: 3 ahead", f"{len(alone)} figures, {len(alone)} paths"]
+    assert order == ["index beside",
+                     "ahead: activity_rates_figure, over_days_figure, time_of_day_figure",
+                     "report: 3 ahead", f"{len(alone)} figures, {len(alone)} paths"]
     assert together == alone
 
 
@@ -128,8 +130,9 @@ def test_a_read_that_fails_ahead_leaves_the_figures_to_the_report(
 def test_ctrl_c_at_the_index_does_not_wait_for_the_figures_sent(
         evaluate: Any, tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
     """The figures asked ahead are in a drawing process (slowed to 30 s here) when Ctrl-C
-    comes, as the index is built: the command stops at once with the usual message, the
-    replications stored, no drawing process or thread left."""
+    comes, as the evaluate process waits for the index built beside it: the command stops
+    at once with the usual message, the replications stored, no drawing process or thread
+    left, nor the thread that built the index."""
     drawing, sent = figure_queue._draw_named, tmp_path / "a figure asked ahead is drawn"
 
     def slow(*job: Any) -> None:        # in the drawing process (forked after this patch)
@@ -137,7 +140,7 @@ def test_ctrl_c_at_the_index_does_not_wait_for_the_figures_sent(
         time.sleep(30)
         drawing(*job)
 
-    def interrupted(store: ResultStore) -> None:
+    def interrupted(indexing: Any) -> None:
         for _ in range(200):                # the figures sent are being drawn
             if sent.exists():
                 break
@@ -145,7 +148,7 @@ def test_ctrl_c_at_the_index_does_not_wait_for_the_figures_sent(
         raise KeyboardInterrupt
 
     monkeypatch.setattr(figure_queue, "_draw_named", slow)
-    monkeypatch.setattr(ResultStore, "index", interrupted)
+    monkeypatch.setattr(sample_index.IndexBeside, "wait", interrupted)
     before = len(multiprocessing.active_children())
     started = time.monotonic()
     status, _, err = evaluate(str(SPEC), "--users", "6", "--days", "2", "--seed", "3",
@@ -155,5 +158,6 @@ def test_ctrl_c_at_the_index_does_not_wait_for_the_figures_sent(
     assert status == 130
     assert "opspec evaluate: stopped; 6 of 6 replications are stored" in err
     assert len(multiprocessing.active_children()) == before
-    assert not [t for t in threading.enumerate() if t.name == "opspec-drawing" and t.is_alive()]
+    assert not [t for t in threading.enumerate() if t.is_alive()
+                and t.name in ("opspec-drawing", "opspec-sample-index")]
     assert not (tmp_path / "run" / "figures").exists()

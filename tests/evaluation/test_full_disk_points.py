@@ -118,8 +118,8 @@ def point(name: str, monkeypatch: pytest.MonkeyPatch, out: Path) -> None:
     elif name == "summary-reads":
         real_index = store.ResultStore.index
 
-        def index(self):
-            real_index(self)
+        def index(self, **how):
+            real_index(self, **how)
             self._db = _FullReads(self._db)
         monkeypatch.setattr(store.ResultStore, "index", index)
     else:
