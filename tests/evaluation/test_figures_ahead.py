@@ -17,12 +17,18 @@ from pathlib import Path
 from typing import Any
 
 import pytest
+from evaluation_inputs import SPEC
 from figure_samples import DAYS, figures
 
-from evaluation_inputs import SPEC
 from opspec.errors import EvaluationError
-from opspec.evaluation import drawing_pools, figure_queue, plots, report, report_design
-from opspec.evaluation import sample_index
+from opspec.evaluation import (
+    drawing_pools,
+    figure_queue,
+    plots,
+    report,
+    report_design,
+    sample_index,
+)
 from opspec.evaluation.store import ResultStore
 
 
