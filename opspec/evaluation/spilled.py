@@ -56,10 +56,13 @@ class Column(Sequence[Any]):
         return self._length
 
     def __iter__(self) -> Iterator[Any]:
-        rows = self._store.rows(self._select, batch=BATCH)
+        # a batch's values made at once, then handed out by chain (C): no Python step per
+        # row between SQLite and the statistic's own loop (a 100,000-user summary reads
+        # about 18 million rows so)
+        batches = self._store.batches(self._select, batch=BATCH)
         if self._single:
-            return (row[0] for row in rows)
-        return iter(rows)
+            return itertools.chain.from_iterable([row[0] for row in rows] for rows in batches)
+        return itertools.chain.from_iterable(batches)
 
     def __getitem__(self, index: Any) -> Any:
         if isinstance(index, slice):
@@ -116,9 +119,12 @@ class SpilledUsers:
     def in_user_order(self, name: str) -> array[float]:
         """``y / n`` of metric ``name`` of the users whose ``n`` is above 0, in user order,
         as an array (one metric's values held at a time: what a figure of them needs)."""
-        return array("d", (row[0] for row in self.store.rows(
-            f"SELECT v FROM {self.tables[name]} WHERE v IS NOT NULL ORDER BY rowid",
-            batch=BATCH)))
+        values = array("d")
+        for rows in self.store.batches(
+                f"SELECT v FROM {self.tables[name]} WHERE v IS NOT NULL ORDER BY rowid",
+                batch=BATCH):
+            values.extend([row[0] for row in rows])
+        return values
 
     def sorted(self, name: str, column: str) -> Column:
         """Metric ``name``'s ``y`` (every user's: a count's totals) or ``v`` (``y / n`` of

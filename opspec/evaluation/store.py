@@ -528,12 +528,19 @@ class ResultStore:
              ) -> Iterator[tuple[Any, ...]]:
         """Rows of a read, streamed a batch at a time (the memory of one batch, whatever the
         number of users); a failure is an EvaluationError as with :meth:`query`."""
+        return chain.from_iterable(self.batches(sql, params, batch))
+
+    def batches(self, sql: str, params: tuple[Any, ...] = (), batch: int = 1000
+                ) -> Iterator[list[tuple[Any, ...]]]:
+        """The rows of a read in lists of ``batch`` rows (the last one shorter), as
+        :meth:`rows` streams them: a pass over many users' values (the summaries read each
+        metric several times) steps through Python once per batch, not once per row."""
         if self._indexing is not None and reads_samples(sql):
             self._index_built()
         try:
             cursor = self._db.execute(sql, params)
             while chunk := cursor.fetchmany(batch):
-                yield from chunk
+                yield chunk
         except sqlite3.Error as error:
             raise _fail(self.path, "read the stored results", error) from None
 
