@@ -21,15 +21,16 @@ DAY = 86_400.0
 
 
 def span(days: float) -> str:
-    """A run length for people: ``30 days``, ``1 day``, ``75 min``, ``1.5 h``."""
-    if days >= 1:
+    """A run length for people: ``30 days``, ``1 day``, ``1.5 days``, ``12 h``, ``75 min``;
+    a length that is no number of days with at most two decimals is written as
+    :func:`opspec.clock.span` writes it, in parts to the millisecond when no one unit
+    writes it exactly (``2 h 57 min 46.598 s`` for 0.123456 days, never a rounded
+    ``2.963 h``; ``29 h 37 min 46.666 s`` for 1.23456789 days, not ``1.23457 days``)."""
+    from opspec.clock import span as clock_span
+
+    if days >= 1 and round(days, 2) == days:
         return f"{days:g} day{'s' if days != 1 else ''}"
-    seconds = days * DAY
-    if seconds >= 3600 and round(seconds) % 3600 == 0 or seconds >= 7200:
-        return f"{seconds / 3600:.4g} h"
-    if seconds >= 60:
-        return f"{seconds / 60:.4g} min"
-    return f"{seconds:.4g} s"
+    return clock_span(days * DAY)
 
 
 def file_digest(path: str | Path) -> str:
