@@ -463,8 +463,8 @@ class ResultStore:
                 return
             except sqlite3.Error as error:
                 raise _fail(self.path, "index the stored results", error) from None
-            except RuntimeError:            # no thread to be had: built here, as with one
-                pass                        # worker
+            except RuntimeError:
+                pass                        # no thread to be had: built here, as with one
         self._write(lambda db: db.execute(_SAMPLE_INDEX), "index the stored results")
 
     def _index_built(self) -> None:
