@@ -96,3 +96,14 @@ def test_a_full_disk_as_the_index_is_built_beside_is_exit_2_and_resume_finishes(
     assert status == 0, err
     assert doc is not None and doc["metrics"]["doses_due"]["users"] == 4
     assert "sample_by_metric" in _indexes(out / "results.sqlite")
+
+
+def test_without_a_thread_the_index_is_built_in_place(
+        stored: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    def no_thread(_thread: Any) -> None:
+        raise RuntimeError("can't start new thread")
+
+    monkeypatch.setattr(sample_index.threading.Thread, "start", no_thread)
+    with ResultStore(stored, create=False) as store:
+        store.index(beside=True)
+        assert "sample_by_metric" in _indexes(stored / "results.sqlite")
